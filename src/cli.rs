@@ -1,0 +1,238 @@
+//! The command line, in two layers: clap structs parsed with no side effects, then
+//! validated into the library's types before anything runs or any file is written.
+
+use crate::error::{Error, Result};
+use crate::params::{EdgeShift, Params};
+use crate::render::camera::Camera;
+use crate::render::tracer::ModelKind;
+use crate::scene::SceneSource;
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(name = "fxrt", version, about = "Fixed-point hardware ray tracing: scene ROMs, a bit-exact golden model, float references and renders")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene through a model (golden integer, f64, f32 or watertight).
+    Render(RenderArgs),
+    /// Quantise a scene, build its BIH and write the ROM images and scene.json.
+    Scene(SceneArgs),
+    /// Count where the golden model and a float reference disagree on a frame.
+    Compare(CompareArgs),
+    /// Measure golden-model render speed (teapot, primary rays).
+    Bench(BenchArgs),
+}
+
+/// The parameter set (seed 001 §2.1–2.4), shared by every subcommand.
+#[derive(Args, Debug, Clone)]
+pub struct ParamArgs {
+    /// Vertex grid bits: the longest scene side maps to 2^n − 1 (4..=40).
+    #[arg(long, default_value_t = 29)]
+    pub n: u32,
+    /// Bits of fixed-point vectors in [−1, 1]: normals, edges, directions (8..=64).
+    #[arg(long, default_value_t = 32)]
+    pub m: u32,
+    /// Edge shift E: 'auto' (scene-adaptive, seed 003) or an integer (the thesis used 10).
+    #[arg(long = "edge-shift", default_value = "auto")]
+    pub edge_shift: EdgeShift,
+    /// Division precision drop T: numerator and denominator lose T low bits (0..=m−2).
+    #[arg(long, default_value_t = 0)]
+    pub t: u32,
+    /// Extra bits C of the reciprocal ray direction (m+C bits) used in BIH traversal.
+    #[arg(long, default_value_t = 16)]
+    pub c: u32,
+    /// Largest number of triangles in a BIH leaf.
+    #[arg(long = "leaf-size", default_value_t = 4)]
+    pub leaf_size: u32,
+    /// Hardware traversal stack entries; bounds the BIH depth.
+    #[arg(long = "stack-depth", default_value_t = 32)]
+    pub stack_depth: u32,
+}
+
+impl ParamArgs {
+    pub fn params(&self) -> Result<Params> {
+        let p = Params { n: self.n, m: self.m, edge_shift: self.edge_shift, t: self.t, c: self.c, leaf_size: self.leaf_size, stack_depth: self.stack_depth };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SceneChoice {
+    /// An OBJ file (polygons are fan-triangulated, numbered in file order).
+    pub scene: Option<PathBuf>,
+    /// A built-in scene instead of a file: teapot, jackstraws, thin, random, cornell.
+    #[arg(long, conflicts_with = "scene")]
+    pub builtin: Option<String>,
+}
+
+impl SceneChoice {
+    /// The embedded teapot when neither a file nor a built-in is named.
+    pub fn source(&self) -> SceneSource {
+        match (&self.scene, &self.builtin) {
+            (Some(p), _) => SceneSource::Obj(p.clone()),
+            (None, Some(b)) => SceneSource::Builtin(b.clone()),
+            (None, None) => SceneSource::Builtin("teapot".into()),
+        }
+    }
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct CameraArgs {
+    /// Eye position X,Y,Z (world units). Default: a view framing the whole scene.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<[f64; 3]>,
+    /// Look-at point X,Y,Z. Default: the scene's centre.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub at: Option<[f64; 3]>,
+    /// Up vector X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
+    pub up: [f64; 3],
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f64,
+    /// Image size WxH.
+    #[arg(long, value_parser = parse_size, default_value = "256x256")]
+    pub size: (u32, u32),
+}
+
+impl CameraArgs {
+    pub fn camera(&self, scene: &crate::scene::Scene) -> Result<Camera> {
+        let (w, h) = self.size;
+        let mut cam = Camera::framing(scene, w, h);
+        if let Some(e) = self.eye {
+            cam.eye = e;
+        }
+        if let Some(a) = self.at {
+            cam.at = a;
+        }
+        cam.up = self.up;
+        cam.fov_deg = self.fov;
+        cam.validate().map_err(|(opt, msg)| Error::param(opt, msg))?;
+        Ok(cam)
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Which model computes the intersections.
+    #[arg(long, value_enum, default_value = "golden")]
+    pub model: ModelKind,
+    /// Write a picture.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Write W·H little-endian i32: input triangle number per pixel, −1 for a miss.
+    #[arg(long)]
+    pub ids: Option<PathBuf>,
+    /// Write W·H little-endian f32: world distance from the eye, +inf for a miss.
+    #[arg(long)]
+    pub depth: Option<PathBuf>,
+    /// Shade with one shadow ray per hit towards a point light near the eye.
+    #[arg(long)]
+    pub shade: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct SceneArgs {
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    /// Output directory for the ROM images and scene.json.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also print statistics and the edge-component histogram (seed 001 figure 2.1).
+    #[arg(long)]
+    pub stats: bool,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// The reference the golden model is compared with.
+    #[arg(long, value_enum, default_value = "f64")]
+    pub against: ModelKind,
+    #[arg(long)]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Image size WxH.
+    #[arg(long, value_parser = parse_size, default_value = "1024x1024")]
+    pub size: (u32, u32),
+    /// Worker threads.
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    /// Repetitions; the best is reported.
+    #[arg(long, default_value_t = 3)]
+    pub repeat: u32,
+}
+
+fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("'{s}' is not X,Y,Z"));
+    }
+    let mut v = [0.0; 3];
+    for (k, p) in parts.iter().enumerate() {
+        v[k] = p.trim().parse::<f64>().map_err(|_| format!("'{p}' is not a number"))?;
+        if !v[k].is_finite() {
+            return Err(format!("'{p}' is not a finite number"));
+        }
+    }
+    Ok(v)
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let w: u32 = w.parse().map_err(|_| format!("'{w}' is not a positive integer"))?;
+    let h: u32 = h.parse().map_err(|_| format!("'{h}' is not a positive integer"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("{w}x{h} is out of range: each side must be 1..=16384"));
+    }
+    Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parsers() {
+        assert_eq!(parse_vec3("1,-2.5,3").unwrap(), [1.0, -2.5, 3.0]);
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,nan,2").is_err());
+        assert_eq!(parse_size("640x480").unwrap(), (640, 480));
+        assert!(parse_size("0x4").is_err());
+    }
+
+    #[test]
+    fn render_args_parse_without_side_effects() {
+        let cli = Cli::try_parse_from(["fxrt", "render", "--builtin", "cornell", "--eye", "-1,2,3", "--n", "20", "--edge-shift", "10"]).unwrap();
+        let Some(Command::Render(r)) = cli.command else { panic!("not render") };
+        assert_eq!(r.scene.source(), SceneSource::Builtin("cornell".into()));
+        assert_eq!(r.camera.eye, Some([-1.0, 2.0, 3.0]));
+        let p = r.params.params().unwrap();
+        assert_eq!((p.n, p.edge_shift), (20, EdgeShift::Fixed(10)));
+    }
+}

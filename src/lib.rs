@@ -1,0 +1,10 @@
+//! fxrt: a generator of fixed-point ray tracing hardware (after Hanika 2007), and the models
+//! that prove it correct. The modules follow the data path: scene → model → render.
+
+pub mod cli;
+pub mod error;
+pub mod io;
+pub mod model;
+pub mod params;
+pub mod render;
+pub mod scene;

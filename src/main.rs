@@ -1,0 +1,134 @@
+use clap::Parser;
+use fxrt::cli::{BenchArgs, Cli, Command, CompareArgs, RenderArgs, SceneArgs};
+use fxrt::error::{Error, Result};
+use fxrt::render::{self, tracer};
+use fxrt::scene::{self, Scene, rom};
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(a)) => run_render(a),
+        Some(Command::Scene(a)) => run_scene(a),
+        Some(Command::Compare(a)) => run_compare(a),
+        Some(Command::Bench(a)) => run_bench(a),
+        None => {
+            // The main job on the embedded default: render the teapot to teapot.png.
+            let a = Cli::parse_from(["fxrt", "render", "--png", "teapot.png", "--shade", "--size", "512x512"]);
+            match a.command {
+                Some(Command::Render(a)) => run_render(a),
+                _ => unreachable!("the default command is a render"),
+            }
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("fxrt: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        if n == 0 || n > 1024 {
+            return Err(Error::param("threads", format!("{n} is out of range: must be 1..=1024")));
+        }
+        b = b.num_threads(n);
+    }
+    b.build().map_err(|e| Error::param("threads", e.to_string()))
+}
+
+fn run_render(a: RenderArgs) -> Result<()> {
+    let params = a.params.params()?;
+    let pool = thread_pool(a.threads)?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let cam = a.camera.camera(&scene)?;
+    let tracer = tracer::make_tracer(&scene, a.model);
+    let frame = pool.install(|| render::render(&scene, tracer.as_ref(), &cam, a.shade, true));
+    // Everything is computed before the first file is written.
+    let mut files = Vec::new();
+    if let Some(p) = &a.png {
+        files.push((p.clone(), frame.png_bytes()));
+    }
+    if let Some(p) = &a.ids {
+        files.push((p.clone(), frame.ids_bytes()));
+    }
+    if let Some(p) = &a.depth {
+        files.push((p.clone(), frame.depth_bytes()));
+    }
+    fxrt::io::write_all_atomic(&files)?;
+    println!(
+        "rays: {}, hits: {}, seconds: {:.3}, Mrays/s: {:.2}",
+        frame.rays,
+        frame.hits,
+        frame.seconds,
+        frame.rays as f64 / frame.seconds.max(1e-9) / 1e6
+    );
+    Ok(())
+}
+
+fn run_compare(a: CompareArgs) -> Result<()> {
+    let params = a.params.params()?;
+    let pool = thread_pool(a.threads)?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let cam = a.camera.camera(&scene)?;
+    let (g, r) = pool.install(|| {
+        let golden = tracer::make_tracer(&scene, tracer::ModelKind::Golden);
+        let reference = tracer::make_tracer(&scene, a.against);
+        (render::render(&scene, golden.as_ref(), &cam, false, true), render::render(&scene, reference.as_ref(), &cam, false, true))
+    });
+    let d = render::compare::compare(&g, &r);
+    println!("{}", serde_json::json!({ "scene": scene.name, "against": format!("{:?}", a.against).to_lowercase(), "edge_shift": scene.edge_shift, "disagreement": d, "rate": d.rate() }));
+    Ok(())
+}
+
+fn run_bench(a: BenchArgs) -> Result<()> {
+    let pool = thread_pool(Some(a.threads))?;
+    let scene = Scene::load(&scene::SceneSource::Builtin("teapot".into()), &fxrt::params::Params::default())?;
+    let cam = render::camera::Camera::framing(&scene, a.size.0, a.size.1);
+    let golden = tracer::make_tracer(&scene, tracer::ModelKind::Golden);
+    let mut best = f64::INFINITY;
+    let mut rays = 0;
+    for _ in 0..a.repeat.max(1) {
+        let f = pool.install(|| render::render(&scene, golden.as_ref(), &cam, false, false));
+        best = best.min(f.seconds);
+        rays = f.rays;
+    }
+    println!("teapot {}x{} golden primary rays, {} thread(s): best of {}: {:.3} s, {:.2} Mrays/s", a.size.0, a.size.1, a.threads, a.repeat.max(1), best, rays as f64 / best / 1e6);
+    Ok(())
+}
+
+fn run_scene(a: SceneArgs) -> Result<()> {
+    let params = a.params.params()?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let roms = rom::words(&scene);
+    let mut files = Vec::new();
+    for (layout, words) in &roms {
+        let text = rom::readmemh(layout, words);
+        files.push((a.out.join(format!("{}.hex", layout.rom)), text.clone().into_bytes()));
+        files.push((a.out.join(format!("{}.mem", layout.rom)), text.into_bytes()));
+        files.push((a.out.join(format!("{}.coe", layout.rom)), rom::coe(layout, words).into_bytes()));
+    }
+    files.push((a.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).into_bytes()));
+    let json = scene::report::scene_json(&scene, &roms);
+    files.push((a.out.join("scene.json"), (serde_json::to_string_pretty(&json).unwrap_or_default() + "\n").into_bytes()));
+    fxrt::io::write_all_atomic(&files)?;
+    if a.stats {
+        print!("{}", scene::report::stats_text(&scene));
+    }
+    println!(
+        "{}: {} triangles ({} degenerate, {} clamped), E = {}, {} BIH nodes, depth {}, written to {}",
+        scene.name,
+        scene.counts.stored,
+        scene.counts.degenerate,
+        scene.counts.clamped,
+        scene.edge_shift,
+        scene.bih_stats.nodes,
+        scene.bih_stats.depth,
+        a.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,6 @@
+//! The models: the bit-exact golden integer model and the float references it is measured by.
+
+pub mod float;
+pub mod golden;
+pub mod ray;
+pub mod reference;

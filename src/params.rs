@@ -1,0 +1,155 @@
+//! The one parameter set every subcommand shares (seed 001 §2.1–2.4), with its validation.
+//!
+//! Validation guarantees that every intermediate value of the golden model fits an `i128`
+//! (the integer type the model computes in), so the model never has to check for overflow.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// The edge shift E: forced, or chosen per scene (seed 003).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EdgeShift {
+    Auto,
+    Fixed(u32),
+}
+
+impl FromStr for EdgeShift {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        if s.eq_ignore_ascii_case("auto") {
+            return Ok(EdgeShift::Auto);
+        }
+        s.parse::<u32>()
+            .map(EdgeShift::Fixed)
+            .map_err(|_| format!("'{s}' is neither 'auto' nor a non-negative integer"))
+    }
+}
+
+impl fmt::Display for EdgeShift {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            EdgeShift::Auto => write!(f, "auto"),
+            EdgeShift::Fixed(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Params {
+    /// Bits of the vertex grid: the scene's longest side maps to 2^n − 1.
+    pub n: u32,
+    /// Bits of signed fixed-point vectors in [−1, 1] (normals, edges, directions); F = m − 1.
+    pub m: u32,
+    /// Edge shift: edge components are clamped to (−2^−E, 2^−E).
+    pub edge_shift: EdgeShift,
+    /// Division precision drop: numerator and denominator lose their T low bits.
+    pub t: u32,
+    /// Extra bits of the reciprocal ray direction used in BIH traversal (m + C bits).
+    pub c: u32,
+    /// A BIH node with at most this many triangles becomes a leaf.
+    pub leaf_size: u32,
+    /// Entries of the hardware traversal stack; bounds the BIH depth.
+    pub stack_depth: u32,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params { n: 29, m: 32, edge_shift: EdgeShift::Auto, t: 0, c: 16, leaf_size: 4, stack_depth: 32 }
+    }
+}
+
+/// Largest magnitude, in bits, any intermediate may reach (i128 keeps one bit for the sign).
+const MODEL_BITS: u32 = 126;
+
+/// The documented range of every parameter, used by validation and by `--help`.
+pub const RANGES: &[(&str, u32, u32)] = &[
+    ("n", 4, 40),
+    ("m", 8, 64),
+    ("t", 0, 62),
+    ("c", 0, 64),
+    ("edge-shift", 0, 120),
+    ("leaf-size", 1, 64),
+    ("stack-depth", 1, 256),
+];
+
+fn check_range(name: &str, value: u32) -> Result<()> {
+    let (_, lo, hi) = RANGES.iter().find(|r| r.0 == name).copied().expect("known parameter");
+    if value < lo || value > hi {
+        return Err(Error::param(name, format!("{value} is out of range: must be {lo}..={hi}")));
+    }
+    Ok(())
+}
+
+impl Params {
+    /// Fraction bits of an m-bit fixed-point value in [−1, 1].
+    pub fn f(&self) -> u32 {
+        self.m - 1
+    }
+
+    /// Checks every range and every cross-parameter limit; the message names the parameter,
+    /// the value and the limit.
+    pub fn validate(&self) -> Result<()> {
+        check_range("n", self.n)?;
+        check_range("m", self.m)?;
+        check_range("t", self.t)?;
+        check_range("c", self.c)?;
+        check_range("leaf-size", self.leaf_size)?;
+        check_range("stack-depth", self.stack_depth)?;
+        if let EdgeShift::Fixed(e) = self.edge_shift {
+            check_range("edge-shift", e)?;
+        }
+        let f = self.f();
+        // Quantising np = n_p / n_r needs n_p · 2^F with |n_p| < 2^(2n+1).
+        if 2 * self.n + 1 + f > MODEL_BITS {
+            return Err(Error::param(
+                "m",
+                format!("{} with --n {} needs 2n+m = {} bits; the limit is {}", self.m, self.n, 2 * self.n + self.m, MODEL_BITS),
+            ));
+        }
+        // BIH plane distance: (P − O) · inv with n+1 and m+C bits.
+        if self.n + 1 + self.m + self.c > MODEL_BITS {
+            return Err(Error::param(
+                "c",
+                format!("{} with --n {} --m {} needs n+m+C+1 = {} bits; the limit is {}", self.c, self.n, self.m, self.n + self.m + self.c + 1, MODEL_BITS),
+            ));
+        }
+        // The denominator has m+2 bits; dropping T ≥ m−1 of them leaves nothing to divide by.
+        if self.t > self.m - 2 {
+            return Err(Error::param("t", format!("{} must be at most m−2 = {}", self.t, self.m - 2)));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_thesis_values_and_valid() {
+        let p = Params::default();
+        assert_eq!((p.n, p.m, p.t, p.c), (29, 32, 0, 16));
+        p.validate().unwrap();
+    }
+
+    #[test]
+    fn out_of_range_names_parameter_value_and_limit() {
+        let p = Params { n: 41, ..Params::default() };
+        let e = p.validate().unwrap_err();
+        assert_eq!(e.to_string(), "--n: 41 is out of range: must be 4..=40");
+        let p = Params { t: 31, ..Params::default() };
+        assert!(p.validate().unwrap_err().to_string().starts_with("--t: 31"));
+        let p = Params { n: 40, m: 64, ..Params::default() };
+        assert!(p.validate().unwrap_err().to_string().starts_with("--m: 64"));
+    }
+
+    #[test]
+    fn edge_shift_parses() {
+        assert_eq!("auto".parse::<EdgeShift>().unwrap(), EdgeShift::Auto);
+        assert_eq!("10".parse::<EdgeShift>().unwrap(), EdgeShift::Fixed(10));
+        assert!("-3".parse::<EdgeShift>().is_err());
+    }
+}
