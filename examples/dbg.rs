@@ -19,7 +19,7 @@ fn main() {
             shown += 1;
             let q = quantize_ray(&s, &g, &r).unwrap();
             let brute: Vec<_> = (0..s.tris.len()).filter_map(|i| g.intersect(&s.tris[i], &q.ray).map(|h| (h.t, i))).collect();
-            let mut visited = vec![]; g.traverse(&s, &q.ray, |i| visited.push(i));
+            let mut visited = vec![]; g.traverse(&s, &q.ray, |i, _| visited.push(i));
             let fid = b.unwrap().id;
             let ti = s.tri_ids.iter().position(|&x| x == fid).unwrap();
             println!("px {px},{py} ray o={:?} w={:?} f64 hit id {} dist {}; brute golden {:?}; visited {:?}; tri {:?}; box_exit {}", q.ray.o, q.ray.w, fid, b.unwrap().dist, brute, visited.len(), s.tris[ti], g.box_exit(&q.ray));

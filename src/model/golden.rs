@@ -87,25 +87,22 @@ impl Golden {
         GridRay { o, w, inv: w.map(|x| self.reciprocal(x, mc)) }
     }
 
-    /// Ray/triangle (eq. 2.1, 2.2) with the hardware divider's semantics.
+    /// Ray/triangle (eq. 2.1, 2.2) with the hardware divider's semantics. Every product has
+    /// 64-bit operands (`wmul`), so it is exact in i128 and costs one machine multiply.
     #[inline]
     pub fn intersect(&self, tri: &AccelTri, ray: &GridRay) -> Option<TriHit> {
         let (r, p, q) = perm(tri.r);
         let f = self.f;
-        let (np, nq) = (tri.np as i128, tri.nq as i128);
-        let (op, oq) = (ray.o[p] as i128, ray.o[q] as i128);
-        let (wp, wq) = (ray.w[p] as i128, ray.w[q] as i128);
         // Numerator with F fraction bits (exact), denominator rounded to F fraction bits.
-        let num = (((tri.d - ray.o[r]) as i128) << f) - op * np - oq * nq;
-        let den = ray.w[r] as i128 + shr_round(wp * np + wq * nq, f);
+        let num = (((tri.d - ray.o[r]) as i128) << f) - wmul(ray.o[p], tri.np) - wmul(ray.o[q], tri.nq);
+        let den = ray.w[r] as i128 + shr_round(wmul(ray.w[p], tri.np) + wmul(ray.w[q], tri.nq), f);
         // Division precision T: both operands lose their T low bits (floor).
-        let (num, den) = (num >> self.t, den >> self.t);
-        let t = self.divide(num, den)?;
-        let kp = (ray.o[p] - tri.pp) as i128 + shr_round(t as i128 * wp, f);
-        let kq = (ray.o[q] - tri.pq) as i128 + shr_round(t as i128 * wq, f);
+        let t = self.divide(num >> self.t, den >> self.t)?;
+        let kp = (ray.o[p] - tri.pp) + shr_round(wmul(t, ray.w[p]), f) as i64;
+        let kq = (ray.o[q] - tri.pq) + shr_round(wmul(t, ray.w[q]), f) as i64;
         // Barycentrics with E+F fraction bits: u weighs x2, v weighs x1.
-        let u = tri.e1p as i128 * kq - tri.e1q as i128 * kp;
-        let v = tri.e2q as i128 * kp - tri.e2p as i128 * kq;
+        let u = wmul(tri.e1p, kq) - wmul(tri.e1q, kp);
+        let v = wmul(tri.e2q, kp) - wmul(tri.e2p, kq);
         if u < 0 || v < 0 || u + v > 1i128 << (self.e + f) {
             return None;
         }
@@ -119,17 +116,19 @@ impl Golden {
         if den == 0 || num == 0 || (num < 0) != (den < 0) {
             return None;
         }
-        let (a, b) = (num.abs(), den.abs());
+        let (a, b) = (num.unsigned_abs(), den.unsigned_abs());
         if a < b || a >= b << (self.n + 1) {
             return None;
         }
-        Some((a / b) as i64)
+        Some(floor_div(a, b) as i64)
     }
 
     /// Distance to the axis plane x_axis = plane: ((plane − O) · inv) >> C, saturated.
     #[inline(always)]
     pub fn plane_t(&self, ray: &GridRay, axis: usize, plane: i64) -> i64 {
-        let prod = (plane - ray.o[axis]) as i128 * ray.inv[axis];
+        let d = plane - ray.o[axis];
+        let inv = ray.inv[axis];
+        let prod = if inv as i64 as i128 == inv { wmul(d, inv as i64) } else { d as i128 * inv };
         (prod >> self.c).clamp(-1, self.t_sat as i128) as i64
     }
 
@@ -142,57 +141,61 @@ impl Golden {
     }
 
     /// BIH traversal in the hardware FSM's order: near child first, far child pushed; every
-    /// triangle of every visited leaf is handed to `visit` (no early out, as in seed 001).
-    pub fn traverse(&self, scene: &Scene, ray: &GridRay, mut visit: impl FnMut(u32)) -> TraversalStats {
+    /// triangle of every visited leaf is handed to the visitor with the leaf's entry distance
+    /// (no early out, as in seed 001). A visitor may prune: then a node whose entry distance
+    /// it rejects is skipped as if both children were missed (software early out).
+    pub fn walk(&self, scene: &Scene, ray: &GridRay, visitor: &mut impl Visitor) -> TraversalStats {
         let mut stats = TraversalStats::default();
         let tmax0 = self.box_exit(ray);
         if tmax0 < 0 {
             return stats;
         }
-        let mut stack: [(u32, i64, i64); 256] = [(0, 0, 0); 256];
+        // The hardware stack holds at most stack_depth ≤ 256 entries (Params::validate). Left
+        // uninitialised: zeroing 6 KiB per ray cost more than the traversal of a small scene.
+        let mut stack = [const { std::mem::MaybeUninit::<(u32, i64, i64)>::uninit() }; 256];
         let mut sp = 0usize;
         let (mut node, mut tmin, mut tmax) = (0u32, 0i64, tmax0);
         let nodes = &scene.bih.nodes;
         loop {
-            stats.nodes += 1;
-            let mut go_pop = false;
-            match nodes[node as usize] {
-                Node::Inner { axis, clip0, clip1, child } => {
-                    let a = axis as usize;
-                    let d0 = self.plane_t(ray, a, clip0);
-                    let d1 = self.plane_t(ray, a, clip1);
-                    // Positive direction: left (below clip0) is near. Negative: right.
-                    let (near, far, near_end, far_start) =
-                        if ray.inv[a] >= 0 { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
-                    let near_max = tmax.min(near_end);
-                    let far_min = tmin.max(far_start);
-                    let near_ok = tmin <= near_max;
-                    let far_ok = far_min <= tmax;
-                    match (near_ok, far_ok) {
-                        (true, true) => {
-                            stack[sp] = (far, far_min, tmax);
-                            sp += 1;
-                            stats.max_stack = stats.max_stack.max(sp as u32);
-                            node = near;
-                            tmax = near_max;
+            let mut go_pop = visitor.prune(tmin);
+            if !go_pop {
+                stats.nodes += 1;
+                match nodes[node as usize] {
+                    Node::Inner { axis, clip0, clip1, child } => {
+                        let a = axis as usize;
+                        let d0 = self.plane_t(ray, a, clip0);
+                        let d1 = self.plane_t(ray, a, clip1);
+                        // Positive direction: left (below clip0) is near. Negative: right.
+                        let (near, far, near_end, far_start) =
+                            if ray.inv[a] >= 0 { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
+                        let near_max = tmax.min(near_end);
+                        let far_min = tmin.max(far_start);
+                        match (tmin <= near_max, far_min <= tmax) {
+                            (true, true) => {
+                                stack[sp].write((far, far_min, tmax));
+                                sp += 1;
+                                stats.max_stack = stats.max_stack.max(sp as u32);
+                                node = near;
+                                tmax = near_max;
+                            }
+                            (true, false) => {
+                                node = near;
+                                tmax = near_max;
+                            }
+                            (false, true) => {
+                                node = far;
+                                tmin = far_min;
+                            }
+                            (false, false) => go_pop = true,
                         }
-                        (true, false) => {
-                            node = near;
-                            tmax = near_max;
-                        }
-                        (false, true) => {
-                            node = far;
-                            tmin = far_min;
-                        }
-                        (false, false) => go_pop = true,
                     }
-                }
-                Node::Leaf { first, count } => {
-                    for &t in &scene.bih.leaf_tris[first as usize..(first + count) as usize] {
-                        visit(t);
+                    Node::Leaf { first, count } => {
+                        for &t in &scene.bih.leaf_tris[first as usize..(first + count) as usize] {
+                            visitor.triangle(t, tmin);
+                        }
+                        stats.tri_tests += count;
+                        go_pop = true;
                     }
-                    stats.tri_tests += count;
-                    go_pop = true;
                 }
             }
             if go_pop {
@@ -200,22 +203,38 @@ impl Golden {
                     return stats;
                 }
                 sp -= 1;
-                (node, tmin, tmax) = stack[sp];
+                // SAFETY: entries below the stack pointer were written by a push.
+                (node, tmin, tmax) = unsafe { stack[sp].assume_init() };
             }
         }
     }
 
-    /// Closest hit: the smallest (t, triangle number), so test order does not matter.
-    pub fn trace(&self, scene: &Scene, ray: &GridRay) -> (Option<Hit>, TraversalStats) {
-        let mut best: Option<Hit> = None;
-        let stats = self.traverse(scene, ray, |i| {
-            if let Some(h) = self.intersect(&scene.tris[i as usize], ray) {
-                if best.is_none_or(|b| (h.t, i) < (b.t, b.tri)) {
-                    best = Some(Hit { tri: i, t: h.t, u: h.u, v: h.v });
-                }
+    /// The full traversal, calling `visit(triangle, leaf entry distance)` in FSM order.
+    pub fn traverse(&self, scene: &Scene, ray: &GridRay, visit: impl FnMut(u32, i64)) -> TraversalStats {
+        struct All<F>(F);
+        impl<F: FnMut(u32, i64)> Visitor for All<F> {
+            fn triangle(&mut self, tri: u32, leaf_tmin: i64) {
+                (self.0)(tri, leaf_tmin)
             }
-        });
-        (best, stats)
+        }
+        self.walk(scene, ray, &mut All(visit))
+    }
+
+    /// Closest hit over every triangle the hardware traversal visits: the smallest
+    /// (t, triangle number) among accepted hits, so test order does not matter. A hit is
+    /// accepted only if t ≥ lower_t(entry distance of its leaf) — see `lower_t`.
+    pub fn trace(&self, scene: &Scene, ray: &GridRay) -> (Option<Hit>, TraversalStats) {
+        let mut c = Closest { g: self, scene, ray, best: None, early_out: false };
+        let stats = self.walk(scene, ray, &mut c);
+        (c.best, stats)
+    }
+
+    /// The same answer as `trace`, bit for bit, but skipping every node whose entry distance
+    /// proves it cannot hold a better hit (what makes the software model fast).
+    pub fn trace_fast(&self, scene: &Scene, ray: &GridRay) -> (Option<Hit>, TraversalStats) {
+        let mut c = Closest { g: self, scene, ray, best: None, early_out: true };
+        let stats = self.walk(scene, ray, &mut c);
+        (c.best, stats)
     }
 
     /// The hit point rounded to the grid: h_k = O_k + round(t·ω_k / 2^F) (seed 001 §2.1.5).
@@ -237,6 +256,69 @@ impl Golden {
             (hit[k] + step).clamp(0, self.box_hi[k])
         })
     }
+}
+
+/// Smallest t accepted for a triangle of a leaf entered at distance `leaf_tmin`:
+/// leaf_tmin − leaf_tmin/64 − 8. A true hit lies inside its leaf's box, so this only rejects
+/// hits whose t is off by more than 1/64 + 8 units; it is what makes an early out exact: a
+/// node entered beyond lower_t⁻¹(best t) cannot hold a better hit (lower_t is monotone).
+#[inline(always)]
+pub fn lower_t(leaf_tmin: i64) -> i64 {
+    leaf_tmin - (leaf_tmin >> 6) - 8
+}
+
+/// What a traversal does with the triangles of each visited leaf.
+pub trait Visitor {
+    fn triangle(&mut self, tri: u32, leaf_tmin: i64);
+    /// True to skip a node entered at `tmin`. The hardware never skips.
+    fn prune(&self, _tmin: i64) -> bool {
+        false
+    }
+}
+
+struct Closest<'a> {
+    g: &'a Golden,
+    scene: &'a Scene,
+    ray: &'a GridRay,
+    best: Option<Hit>,
+    early_out: bool,
+}
+
+impl Visitor for Closest<'_> {
+    #[inline]
+    fn triangle(&mut self, i: u32, leaf_tmin: i64) {
+        if let Some(h) = self.g.intersect(&self.scene.tris[i as usize], self.ray) {
+            if h.t >= lower_t(leaf_tmin) && self.best.is_none_or(|b| (h.t, i) < (b.t, b.tri)) {
+                self.best = Some(Hit { tri: i, t: h.t, u: h.u, v: h.v });
+            }
+        }
+    }
+    #[inline]
+    fn prune(&self, tmin: i64) -> bool {
+        self.early_out && self.best.is_some_and(|b| lower_t(tmin) > b.t)
+    }
+}
+
+/// Exact product of two 64-bit values (a single widening multiply).
+#[inline(always)]
+pub fn wmul(a: i64, b: i64) -> i128 {
+    a as i128 * b as i128
+}
+
+/// floor(a / b) for a quotient known to be below 2^53: a float estimate corrected to the
+/// exact integer (a 128-bit division would dominate the model's run time).
+#[inline(always)]
+fn floor_div(a: u128, b: u128) -> u128 {
+    // u64 → f64 is one instruction; u128 → f64 is a library call.
+    let to_f64 = |x: u128| if x >> 64 == 0 { x as u64 as f64 } else { x as f64 };
+    let mut q = (to_f64(a) / to_f64(b)) as u64 as u128;
+    while q * b > a {
+        q -= 1;
+    }
+    while (q + 1) * b <= a {
+        q += 1;
+    }
+    q
 }
 
 /// (r, p, q) from the stored projection axis.

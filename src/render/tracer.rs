@@ -57,7 +57,7 @@ impl<'a> GoldenTracer<'a> {
 impl Tracer for GoldenTracer<'_> {
     fn primary(&self, ray: &WorldRay) -> Option<PrimaryHit> {
         let q = quantize_ray(self.scene, &self.golden, ray)?;
-        let (hit, _) = self.golden.trace(self.scene, &q.ray);
+        let (hit, _) = self.golden.trace_fast(self.scene, &q.ray);
         let hit = hit?;
         Some(PrimaryHit {
             id: self.scene.tri_ids[hit.tri as usize],
@@ -72,7 +72,7 @@ impl Tracer for GoldenTracer<'_> {
         let to_light = sub(self.scene.transform.to_grid_f64(light), h);
         let dist = dot(to_light, to_light).sqrt();
         let sray = self.secondary(&gray, &ghit, normalize(to_light));
-        match self.golden.trace(self.scene, &sray).0 {
+        match self.golden.trace_fast(self.scene, &sray).0 {
             Some(b) => (b.t as f64) < dist - 2.0,
             None => false,
         }
