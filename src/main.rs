@@ -6,7 +6,17 @@ use fxrt::scene::{self, Scene, rom};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) => e.exit(),
+        Err(e) => {
+            // One line, like every other input error; `--help` has the details.
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+            eprintln!("fxrt: {first}");
+            return ExitCode::from(2);
+        }
+    };
     let result = match cli.command {
         Some(Command::Render(a)) => run_render(a),
         Some(Command::Scene(a)) => run_scene(a),

@@ -1,0 +1,111 @@
+//! The command line as a user meets it: outputs, determinism and bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn fxrt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fxrt")).args(args).output().expect("fxrt runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn render_writes_ids_and_depth_of_the_documented_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ids, depth, png) = (dir.path().join("i.bin"), dir.path().join("d.bin"), dir.path().join("p.png"));
+    let o = fxrt(&["render", "--builtin", "cornell", "--size", "40x30", "--ids", ids.to_str().unwrap(), "--depth", depth.to_str().unwrap(), "--png", png.to_str().unwrap(), "--shade"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = String::from_utf8_lossy(&o.stdout);
+    assert!(line.starts_with("rays: ") && line.contains("Mrays/s"), "{line}");
+    let ids = std::fs::read(&ids).unwrap();
+    let depth = std::fs::read(&depth).unwrap();
+    assert_eq!(ids.len(), 40 * 30 * 4);
+    assert_eq!(depth.len(), 40 * 30 * 4);
+    let ids: Vec<i32> = ids.chunks(4).map(|c| i32::from_le_bytes(c.try_into().unwrap())).collect();
+    let depth: Vec<f32> = depth.chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    // The framing camera sees the box: hits have finite depth, misses +inf.
+    assert!(ids.iter().filter(|&&i| i >= 0).count() > 600);
+    for (i, d) in ids.iter().zip(&depth) {
+        assert_eq!(*i < 0, d.is_infinite());
+        assert!(*i < 32);
+    }
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+}
+
+#[test]
+fn scene_output_is_complete_and_byte_identical_across_runs() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    for d in [&a, &b] {
+        let o = fxrt(&["scene", "--builtin", "random", "--out", d.path().to_str().unwrap(), "--n", "23", "--m", "27", "--stats"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("edge components"));
+    }
+    let mut names: Vec<String> = std::fs::read_dir(a.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    let want = ["fxrt_scene_pkg.vhd", "leaf.coe", "leaf.hex", "leaf.mem", "node.coe", "node.hex", "node.mem", "scene.json", "tri.coe", "tri.hex", "tri.mem"];
+    assert_eq!(names, want);
+    for n in want {
+        assert_eq!(std::fs::read(a.path().join(n)).unwrap(), std::fs::read(b.path().join(n)).unwrap(), "{n} differs between runs");
+    }
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(a.path().join("scene.json")).unwrap()).unwrap();
+    assert_eq!(json["triangles"]["input"], 2000);
+    assert_eq!(json["params"]["n"], 23);
+    let tri_hex = std::fs::read_to_string(a.path().join("tri.hex")).unwrap();
+    let words: Vec<&str> = tri_hex.lines().filter(|l| !l.starts_with("//")).collect();
+    assert_eq!(words.len() as u64, json["triangles"]["stored"].as_u64().unwrap());
+    assert!(words.iter().all(|w| w.len() == (2 + 3 * 23 + 3 + 6 * 27usize).div_ceil(4)));
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+/// Exit 2, one line naming the subject, and no output file left behind.
+fn assert_rejected(args: &[&str], subject: &str, out: &Path) {
+    let o = fxrt(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(err.contains(subject), "{args:?}: {err:?} should name {subject}");
+    assert!(!err.contains("panicked"));
+    assert!(!out.exists(), "{args:?} left {} behind", out.display());
+}
+
+#[test]
+fn bad_input_is_exit_2_with_one_line_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let png = d.join("out.png");
+    let png_s = png.to_str().unwrap();
+    let cases: &[(&str, &[u8])] = &[
+        ("malformed.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n"),
+        ("binary.obj", b"v 0 0 0\n\xff\xfe\x00\x01\nf 1 2 3\n"),
+        ("nan.obj", b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"),
+        ("inf.obj", b"v 0 0 0\nv 1 inf 0\nv 0 1 0\nf 1 2 3\n"),
+        ("range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"),
+        ("negative.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n"),
+        ("noface.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
+        ("point.obj", b"v 1 2 3\n"),
+        ("degenerate.obj", b"v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\nf 1 1 2\n"),
+        ("empty.obj", b""),
+    ];
+    for (name, text) in cases {
+        let p = write(d, name, text);
+        assert_rejected(&["render", &p, "--png", png_s], &p, &png);
+        assert_rejected(&["scene", &p, "--out", d.join("rom").to_str().unwrap()], &p, &d.join("rom"));
+    }
+    assert_rejected(&["render", &d.join("missing.obj").to_string_lossy(), "--png", png_s], "missing.obj", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--n", "41", "--png", png_s], "--n: 41", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--t", "31", "--png", png_s], "--t", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--m", "64", "--n", "40", "--png", png_s], "--m", &png);
+    assert_rejected(&["render", "--builtin", "nosuch", "--png", png_s], "--builtin", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--eye", "0,0,0", "--at", "0,0,0", "--png", png_s], "--at", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--threads", "0", "--png", png_s], "--threads", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--size", "0x4", "--png", png_s], "--size", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--edge-shift", "-3", "--png", png_s], "--edge-shift", &png);
+    assert_rejected(&["render", "--builtin", "teapot", "--eye", "1,2", "--png", png_s], "--eye", &png);
+}
