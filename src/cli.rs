@@ -38,7 +38,7 @@ pub struct ParamArgs {
     #[arg(long, default_value_t = 32)]
     pub m: u32,
     /// Edge shift E: 'auto' (scene-adaptive, seed 003) or an integer (the thesis used 10).
-    #[arg(long = "edge-shift", default_value = "auto")]
+    #[arg(long = "edge-shift", default_value = "auto", allow_hyphen_values = true)]
     pub edge_shift: EdgeShift,
     /// Division precision drop T: numerator and denominator lose T low bits (0..=m−2).
     #[arg(long, default_value_t = 0)]
