@@ -104,7 +104,7 @@ pub struct CameraArgs {
 impl CameraArgs {
     pub fn camera(&self, scene: &crate::scene::Scene) -> Result<Camera> {
         let (w, h) = self.size;
-        let mut cam = Camera::framing(scene, w, h);
+        let mut cam = Camera::default_for(scene, w, h);
         if let Some(e) = self.eye {
             cam.eye = e;
         }

@@ -13,6 +13,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, format!("cannot create directory: {e}")))?;
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::file(path, format!("cannot write: {e}")))?;
     tmp.write_all(bytes).map_err(|e| Error::file(path, format!("cannot write: {e}")))?;
+    // Temporary files are private (0600); an output file gets the usual 0644.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
     tmp.persist(path).map_err(|e| Error::file(path, format!("cannot write: {}", e.error)))?;
     Ok(())
 }

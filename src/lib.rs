@@ -3,8 +3,10 @@
 
 pub mod cli;
 pub mod error;
+pub mod flow;
 pub mod io;
 pub mod model;
 pub mod params;
 pub mod render;
+pub mod rtl;
 pub mod scene;

@@ -14,7 +14,7 @@ use fxrt::render::{compare, render};
 fn golden_agrees_with_f64_on_hit_or_miss_for_all_but_1_in_10000_rays() {
     let params = Params::default();
     for scene in common::all_scenes(&params) {
-        let cam = Camera::framing(&scene, 256, 256);
+        let cam = Camera::default_for(&scene, 256, 256);
         let g = render(&scene, make_tracer(&scene, ModelKind::Golden).as_ref(), &cam, false, false);
         let f = render(&scene, make_tracer(&scene, ModelKind::F64).as_ref(), &cam, false, false);
         let d = compare::compare(&g, &f);
@@ -30,7 +30,7 @@ fn secondary_rays_never_hit_their_own_triangle() {
     for scene in common::all_scenes(&params) {
         let tracer = GoldenTracer::new(&scene);
         let g = &tracer.golden;
-        let cam = Camera::framing(&scene, 128, 128);
+        let cam = Camera::default_for(&scene, 128, 128);
         let (mut spawned, mut self_hits) = (0u64, 0u64);
         for py in 0..cam.height {
             for px in 0..cam.width {
@@ -61,7 +61,7 @@ fn early_out_gives_the_hardware_traversal_answer_bit_for_bit() {
     for params in [Params::default(), Params { n: 16, m: 16, ..Params::default() }, Params { n: 23, m: 27, t: 5, ..Params::default() }] {
         for scene in common::all_scenes(&params).into_iter().take(5) {
             let g = Golden::new(&scene);
-            let cam = Camera::framing(&scene, 96, 96);
+            let cam = Camera::default_for(&scene, 96, 96);
             let mut hits = 0;
             for py in 0..cam.height {
                 for px in 0..cam.width {

@@ -36,28 +36,63 @@ impl Camera {
     }
 
     pub fn ray(&self, px: u32, py: u32) -> WorldRay {
-        let (w, h) = (self.width as f64, self.height as f64);
-        let tan = (self.fov_deg.to_radians() / 2.0).tan();
-        let sx = (2.0 * (px as f64 + 0.5) / w - 1.0) * tan * w / h;
-        let sy = (1.0 - 2.0 * (py as f64 + 0.5) / h) * tan;
+        self.pixel_rays().ray(px, py)
+    }
+
+    /// The per-frame part of `ray` (basis and tan), so a renderer computes it once.
+    pub fn pixel_rays(&self) -> PixelRays {
         let f = normalize(sub(self.at, self.eye));
         let r = normalize(cross(f, self.up));
         let u = cross(r, f);
-        let d = normalize(std::array::from_fn(|k| f[k] + sx * r[k] + sy * u[k]));
-        WorldRay { o: self.eye, d }
+        let (w, h) = (self.width as f64, self.height as f64);
+        PixelRays { eye: self.eye, w, h, tan: (self.fov_deg.to_radians() / 2.0).tan(), f, r, u }
     }
 
-    /// A camera that frames the whole scene from the front-right, above: used when
-    /// --eye/--at are not given.
+    /// The camera used when --eye/--at are not given: the published Cornell box camera for
+    /// the built-in `cornell`, otherwise `framing`.
+    pub fn default_for(scene: &Scene, width: u32, height: u32) -> Camera {
+        if scene.name == "cornell" {
+            // The Cornell Program of Computer Graphics' camera: 0.035 m focal length,
+            // 0.025 m film, i.e. a 39.3° field of view, looking into the open side.
+            let fov_deg = 2.0 * (0.0125f64 / 0.035).atan().to_degrees();
+            return Camera { eye: [278.0, 273.0, -800.0], at: [278.0, 273.0, 0.0], up: [0.0, 1.0, 0.0], fov_deg, width, height };
+        }
+        Camera::framing(scene, width, height)
+    }
+
+    /// A camera that frames the whole scene from the front (−z), right and above.
     pub fn framing(scene: &Scene, width: u32, height: u32) -> Camera {
         let (lo, hi) = world_bounds(scene);
         let at: [f64; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
         let radius = 0.5 * (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
         let fov_deg: f64 = 45.0;
         let dist = 0.8 * radius / (fov_deg.to_radians() / 2.0).sin();
-        let dir = normalize([0.55, 0.45, 1.0]);
+        let dir = normalize([0.5, 0.4, -1.0]);
         let eye = std::array::from_fn(|k| at[k] + dist * dir[k]);
         Camera { eye, at, up: [0.0, 1.0, 0.0], fov_deg, width, height }
+    }
+}
+
+/// A camera's primary rays: `ray` gives bit for bit what `Camera::ray` specifies.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelRays {
+    eye: [f64; 3],
+    w: f64,
+    h: f64,
+    tan: f64,
+    f: [f64; 3],
+    r: [f64; 3],
+    u: [f64; 3],
+}
+
+impl PixelRays {
+    #[inline]
+    pub fn ray(&self, px: u32, py: u32) -> WorldRay {
+        let (w, h, tan) = (self.w, self.h, self.tan);
+        let sx = (2.0 * (px as f64 + 0.5) / w - 1.0) * tan * w / h;
+        let sy = (1.0 - 2.0 * (py as f64 + 0.5) / h) * tan;
+        let d = normalize(std::array::from_fn(|k| self.f[k] + sx * self.r[k] + sy * self.u[k]));
+        WorldRay { o: self.eye, d }
     }
 }
 

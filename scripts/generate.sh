@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Rebuilds generated/ (the committed default build: built-in teapot, default parameters).
+# Usage: scripts/generate.sh [OUT_DIR]   (default: generated)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-generated}"
+cargo build --release --quiet
+bin=target/release/fxrt
+rm -rf "$out/scene"
+"$bin" scene --builtin teapot --out "$out/scene" >/dev/null

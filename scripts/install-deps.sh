@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs what fxrt's build and tests need on a fresh Debian machine (run as root).
+# The Rust toolchain itself comes with the machine (rustup); everything else is here.
+set -euo pipefail
+if ! command -v cargo >/dev/null 2>&1; then
+    echo "install-deps: cargo is missing; install Rust with rustup first" >&2
+    exit 1
+fi
+# HDL simulators and synthesis (used by the HDL issues; cheap to have, ~35 s).
+if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
+    need=""
+    for tool in ghdl iverilog verilator yosys; do
+        command -v "$tool" >/dev/null 2>&1 || need="yes"
+    done
+    if [ -n "$need" ]; then
+        if [ "$(id -u)" = "0" ]; then
+            # Not fatal yet: no test needs them before the HDL back ends land.
+            if ! { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ghdl ghdl-llvm iverilog verilator yosys >/dev/null; }; then
+                echo "install-deps: warning: could not install the HDL tools" >&2
+            fi
+        else
+            echo "install-deps: not root; skipping ghdl/iverilog/verilator/yosys" >&2
+        fi
+    fi
+fi
+cargo fetch --quiet

@@ -1,0 +1,4 @@
+//! Running the generated HDL: testbenches and the external simulators.
+
+pub mod simulators;
+pub mod testbench;

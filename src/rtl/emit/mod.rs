@@ -1,0 +1,28 @@
+//! The two printers. Both walk the same netlist with the same function list and match every
+//! definition exhaustively; they differ only in syntax. Neither computes a width: every type
+//! comes from the netlist.
+
+pub mod verilog;
+pub mod vhdl;
+
+/// ROM depth as printed: the next power of two, padded with zero words, so every address of
+/// the port is in range (the simulator reads 0 beyond the end too).
+pub fn rom_depth(words: usize) -> usize {
+    words.next_power_of_two()
+}
+
+/// Bits needed to address a ROM of `words` words.
+pub fn rom_addr_bits(words: usize) -> u32 {
+    rom_depth(words).trailing_zeros().max(1)
+}
+
+/// The bits of `v` as a string of width `w`, most significant first.
+pub fn bit_string(v: u128, w: u32) -> String {
+    (0..w).rev().map(|b| if (v >> b) & 1 == 1 { '1' } else { '0' }).collect()
+}
+
+/// The bits of `v` in hex, ⌈w/4⌉ digits.
+pub fn hex_string(v: u128, w: u32) -> String {
+    let digits = w.div_ceil(4) as usize;
+    format!("{v:0digits$x}")
+}

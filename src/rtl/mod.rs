@@ -1,0 +1,10 @@
+//! The runtime-width RTL description: one netlist drives the cycle-accurate simulator and the
+//! VHDL and Verilog printers, so the three cannot disagree on a width or a sign.
+
+pub mod emit;
+pub mod netlist;
+pub mod sim;
+pub mod width;
+
+pub use netlist::{Module, Sig};
+pub use width::{BinOp, Ty, UnOp};
