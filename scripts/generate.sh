@@ -5,6 +5,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-generated}"
 cargo build --release --quiet
-bin=target/release/fxrt
+bin="${CARGO_TARGET_DIR:-target}/release/fxrt"
 rm -rf "$out/scene"
 "$bin" scene --builtin teapot --out "$out/scene" >/dev/null

@@ -2,6 +2,7 @@
 //! that prove it correct. The modules follow the data path: scene → model → render.
 
 pub mod cli;
+pub mod cores;
 pub mod error;
 pub mod flow;
 pub mod io;

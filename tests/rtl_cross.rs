@@ -3,6 +3,7 @@
 //! simulator that is not installed is reported as skipped.
 
 use fxrt::flow::simulators::Simulator;
+use std::io::Write;
 use fxrt::flow::testbench::{Stimulus, record, render};
 use fxrt::rtl::emit::{verilog, vhdl};
 use fxrt::rtl::{BinOp, Module, Ty, UnOp};
@@ -91,7 +92,7 @@ fn rust_ghdl_iverilog_and_verilator_agree_on_every_operator() {
     let mut ran = 0;
     for sim in Simulator::ALL {
         if !sim.available() {
-            eprintln!("skipped: {} is not installed", sim.name());
+            let _ = writeln!(std::io::stderr().lock(), "skipped: {} is not installed", sim.name());
             continue;
         }
         let sources: &[&str] = if sim == Simulator::Ghdl { &["ops_check.vhd", "tb.vhd"] } else { &["ops_check.v", "tb.v"] };
@@ -111,7 +112,7 @@ fn printers_are_deterministic_and_lint_clean() {
     let v = verilog::print(&m);
     assert!(!v.contains('$') || v.matches('$').count() == v.matches("$signed").count() + v.matches("$unsigned").count());
     if !Simulator::Verilator.available() {
-        eprintln!("skipped: verilator is not installed");
+        let _ = writeln!(std::io::stderr().lock(), "skipped: verilator is not installed");
         return;
     }
     let dir = tempfile::tempdir().unwrap();

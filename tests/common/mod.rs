@@ -19,7 +19,13 @@ pub fn all_scenes(params: &Params) -> Vec<Scene> {
     let mut out: Vec<Scene> = BUILTIN_NAMES.iter().map(|n| Scene::load(&SceneSource::Builtin(n.to_string()), params).unwrap()).collect();
     match shared_scenes() {
         Some(paths) => out.extend(paths.into_iter().map(|p| Scene::load(&SceneSource::Obj(p), params).unwrap())),
-        None => eprintln!("skipped: ../shared/scenes is not there; only built-in scenes were tested"),
+        None => say("skipped: ../shared/scenes is not there; only built-in scenes were tested"),
     }
     out
+}
+
+/// A line on the real stderr, past the test harness's capture, so a skip is always visible.
+pub fn say(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }

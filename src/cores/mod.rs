@@ -1,0 +1,5 @@
+//! Hardware cores: each builds its netlist from the parameters; its golden twin lives in
+//! `model/`.
+
+pub mod divider;
+pub mod intersect;
