@@ -26,6 +26,65 @@ pub enum Command {
     Compare(CompareArgs),
     /// Measure golden-model render speed (teapot, primary rays).
     Bench(BenchArgs),
+    /// Generate the HDL cores (VHDL-93, Verilog-2001) and their JSON manifests.
+    Gen(GenArgs),
+    /// Check the intersection pipeline against the golden model in a simulator.
+    Test(TestArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct GenArgs {
+    /// The scene whose edge shift E the pipeline is built for (with --edge-shift auto).
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Languages to write.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "vhdl,verilog")]
+    pub lang: Vec<Lang>,
+    /// Width of the tag passed through the intersection pipeline.
+    #[arg(long = "tag-width", default_value_t = 32)]
+    pub tag_width: u32,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Lang {
+    Vhdl,
+    Verilog,
+}
+
+#[derive(Args, Debug)]
+pub struct TestArgs {
+    /// The scene the vectors are drawn from (and whose E the pipeline uses).
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    /// Where the pipeline runs: the Rust simulator or an HDL simulator.
+    #[arg(long, value_enum, default_value = "rust")]
+    pub sim: SimChoice,
+    /// Number of (ray, triangle) vectors. Default: 100,000 (rust, verilator), 2,000 (ghdl), 20,000 (iverilog).
+    #[arg(long)]
+    pub vectors: Option<usize>,
+    /// Build folder for the HDL, testbench and vectors. Default: target/fxrt-test/SIM.
+    #[arg(long)]
+    pub build: Option<PathBuf>,
+    /// Seed of the random vectors.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long = "tag-width", default_value_t = 32)]
+    pub tag_width: u32,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SimChoice {
+    Rust,
+    Ghdl,
+    Iverilog,
+    Verilator,
 }
 
 /// The parameter set (seed 001 §2.1–2.4), shared by every subcommand.

@@ -1,5 +1,7 @@
 use clap::Parser;
-use fxrt::cli::{BenchArgs, Cli, Command, CompareArgs, RenderArgs, SceneArgs};
+use fxrt::cli::{BenchArgs, Cli, Command, CompareArgs, GenArgs, Lang, RenderArgs, SceneArgs, SimChoice, TestArgs};
+use fxrt::cores::intersect::IntersectParams;
+use fxrt::flow::simulators::Simulator;
 use fxrt::error::{Error, Result};
 use fxrt::render::{self, tracer};
 use fxrt::scene::{self, Scene, rom};
@@ -22,6 +24,12 @@ fn main() -> ExitCode {
         Some(Command::Scene(a)) => run_scene(a),
         Some(Command::Compare(a)) => run_compare(a),
         Some(Command::Bench(a)) => run_bench(a),
+        Some(Command::Gen(a)) => run_gen(a),
+        Some(Command::Test(a)) => match run_test(a) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(1),
+            Err(e) => Err(e),
+        },
         None => {
             // The main job on the embedded default: render the teapot to teapot.png.
             let a = Cli::parse_from(["fxrt", "render", "--png", "teapot.png", "--shade", "--size", "512x512"]);
@@ -141,4 +149,65 @@ fn run_scene(a: SceneArgs) -> Result<()> {
         a.out.display()
     );
     Ok(())
+}
+
+/// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
+fn intersect_params(params: &fxrt::params::Params, scene: &Scene, tag_width: u32) -> Result<IntersectParams> {
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width };
+    p.check()?;
+    Ok(p)
+}
+
+fn run_gen(a: GenArgs) -> Result<()> {
+    let params = a.params.params()?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let p = intersect_params(&params, &scene, a.tag_width)?;
+    let files: Vec<(std::path::PathBuf, Vec<u8>)> = fxrt::flow::generate::files(&p, a.lang.contains(&Lang::Vhdl), a.lang.contains(&Lang::Verilog))
+        .into_iter()
+        .map(|(n, t)| (a.out.join(n), t.into_bytes()))
+        .collect();
+    fxrt::io::write_all_atomic(&files)?;
+    println!("{} (latency {} cycles) and its divider written to {}", p.name(), p.latency(), a.out.display());
+    Ok(())
+}
+
+fn run_test(a: TestArgs) -> Result<bool> {
+    let params = a.params.params()?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let p = intersect_params(&params, &scene, a.tag_width)?;
+    let count = a.vectors.unwrap_or(match a.sim {
+        SimChoice::Rust | SimChoice::Verilator => 100_000,
+        SimChoice::Iverilog => 20_000,
+        SimChoice::Ghdl => 2_000,
+    });
+    if count == 0 {
+        return Err(Error::param("vectors", "0: nothing would run"));
+    }
+    let vectors = fxrt::flow::vectors::generate(&scene, count, a.seed);
+    let hits = vectors.iter().filter(|v| v.expected.is_some()).count();
+    let start = std::time::Instant::now();
+    let (outcome, unit) = match a.sim {
+        SimChoice::Rust => (fxrt::flow::check::run_rust(&p, &vectors), "vectors"),
+        hdl => {
+            let sim = match hdl {
+                SimChoice::Ghdl => Simulator::Ghdl,
+                SimChoice::Iverilog => Simulator::Iverilog,
+                _ => Simulator::Verilator,
+            };
+            let dir = a.build.clone().unwrap_or_else(|| std::path::PathBuf::from("target/fxrt-test").join(sim.name()));
+            (fxrt::flow::check::run_hdl(sim, &p, &vectors, &dir)?, "clock cycles")
+        }
+    };
+    println!(
+        "{}: {} vectors ({} hits) from {}, latency {}, {:?} simulator, {:.1} s; counting {unit}",
+        p.name(),
+        vectors.len(),
+        hits,
+        scene.name,
+        p.latency(),
+        a.sim,
+        start.elapsed().as_secs_f64()
+    );
+    println!("{} passed, {} failed", outcome.passed, outcome.failed);
+    Ok(outcome.failed == 0 && outcome.passed > 0)
 }

@@ -32,6 +32,28 @@ impl IntersectParams {
     pub fn name(&self) -> String {
         format!("fxrt_intersect_n{}_m{}_t{}_e{}", self.n, self.m, self.t, self.e)
     }
+    /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
+    /// parameter to change.
+    pub fn check(&self) -> crate::error::Result<()> {
+        use crate::error::Error;
+        let max = crate::rtl::width::MAX_WIDTH;
+        let f = self.f();
+        for (what, bits, param) in [
+            ("the numerator (n + m + 2)", self.num_width(), "m"),
+            ("ω·np (2m + 1)", 2 * self.m + 1, "m"),
+            ("the barycentric sums (n + m + 4)", self.n + self.m + 4, "n"),
+            ("the u + v limit (E + m + 1)", self.e + f + 2, "edge-shift"),
+        ] {
+            if bits > max {
+                return Err(Error::param(param, format!("{what} needs {bits} bits; the RTL layer holds at most {max}")));
+            }
+        }
+        if self.tag_width == 0 || self.tag_width > 64 {
+            return Err(Error::param("tag-width", format!("{} is out of range: must be 1..=64", self.tag_width)));
+        }
+        Ok(())
+    }
+
     /// Input register, products, numerator/denominator, divider, t·ω, k, e·k, u/v and test.
     pub fn latency(&self) -> u32 {
         3 + divider::latency(self.n) + 4

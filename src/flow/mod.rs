@@ -1,4 +1,7 @@
 //! Running the generated HDL: testbenches and the external simulators.
 
+pub mod check;
+pub mod generate;
 pub mod simulators;
 pub mod testbench;
+pub mod vectors;

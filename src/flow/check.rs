@@ -1,0 +1,83 @@
+//! `fxrt test`: the intersection pipeline against the golden model, in the Rust simulator or
+//! in an HDL simulator through a generated self-checking testbench.
+
+use super::simulators::Simulator;
+use super::testbench::{Stimulus, record, render};
+use super::vectors::Vector;
+use crate::cores::intersect::{IntersectParams, expected_outputs, intersect_core, pack_inputs};
+use crate::error::{Error, Result};
+use crate::rtl::emit::{verilog, vhdl};
+use crate::rtl::netlist::Module;
+use crate::rtl::sim::Sim;
+use std::path::Path;
+
+/// Counts of vectors (Rust) or clock cycles (HDL) that matched and did not.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Outcome {
+    pub passed: u64,
+    pub failed: u64,
+}
+
+/// Inputs of every vector, then `latency` idle cycles to drain the pipeline.
+fn stimuli(module: &Module, latency: u32, vectors: &[Vector]) -> Vec<Stimulus> {
+    let width = module.inputs.len();
+    let mut v: Vec<Stimulus> = vectors.iter().enumerate().map(|(i, x)| Stimulus { reset: false, inputs: pack_inputs(tag_of(module, i), &x.tri, &x.ray) }).collect();
+    v.extend((0..latency).map(|_| Stimulus { reset: false, inputs: vec![0; width] }));
+    v
+}
+
+/// Vector numbers wrap at the tag width.
+fn tag_of(module: &Module, i: usize) -> u64 {
+    let w = module.sig(module.inputs[1]).ty.width;
+    (i as u64) & if w >= 64 { u64::MAX } else { (1u64 << w) - 1 }
+}
+
+/// Runs the pipeline in the Rust simulator and compares every output with the golden model.
+pub fn run_rust(p: &IntersectParams, vectors: &[Vector]) -> Outcome {
+    let module = intersect_core(p);
+    let mut sim = Sim::new(&module);
+    let ins: Vec<_> = module.inputs.iter().map(|&i| module.handle(i)).collect();
+    let outs: Vec<_> = module.outputs.iter().map(|(_, i)| module.handle(*i)).collect();
+    let lat = p.latency() as usize;
+    let mut o = Outcome { passed: 0, failed: 0 };
+    for (i, st) in stimuli(&module, p.latency(), vectors).iter().enumerate() {
+        for (s, v) in ins.iter().zip(&st.inputs) {
+            sim.set(*s, *v);
+        }
+        sim.tick();
+        if i + 1 >= lat && i + 1 - lat < vectors.len() {
+            let k = i + 1 - lat;
+            let want = expected_outputs(tag_of(&module, k), vectors[k].expected);
+            let ok = outs.iter().zip(want).all(|(s, w)| sim.get(*s) == w);
+            if ok { o.passed += 1 } else { o.failed += 1 }
+        }
+    }
+    o
+}
+
+/// Writes the HDL, a testbench and its vectors into `dir` and runs `sim` on them. The
+/// expected outputs are the Rust simulator's, which must first agree with the golden model.
+pub fn run_hdl(sim_kind: Simulator, p: &IntersectParams, vectors: &[Vector], dir: &Path) -> Result<Outcome> {
+    let rust = run_rust(p, vectors);
+    if rust.failed > 0 {
+        return Err(Error::new("rust", format!("the Rust simulation disagrees with the golden model on {} of {} vectors", rust.failed, vectors.len())));
+    }
+    if !sim_kind.available() {
+        return Err(Error::new(sim_kind.name(), "is not installed (scripts/install-deps.sh installs it)"));
+    }
+    let module = intersect_core(p);
+    let transcript = record(&module, stimuli(&module, p.latency(), vectors));
+    let files = render(&module, &transcript);
+    let name = &module.name;
+    let io = |e: std::io::Error| Error::file(dir, e.to_string());
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let (design, tb) = match sim_kind {
+        Simulator::Ghdl => ((format!("{name}.vhd"), vhdl::print(&module)), ("tb.vhd", &files.vhdl_tb)),
+        _ => ((format!("{name}.v"), verilog::print(&module)), ("tb.v", &files.verilog_tb)),
+    };
+    for (file, text) in [(design.0.as_str(), design.1.as_str()), (tb.0, tb.1.as_str()), ("vectors.txt", files.vectors_txt.as_str()), ("vectors.hex", files.vectors_hex.as_str())] {
+        std::fs::write(dir.join(file), text).map_err(io)?;
+    }
+    let (passed, failed) = sim_kind.run(dir, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim_kind.name(), e))?;
+    Ok(Outcome { passed, failed })
+}

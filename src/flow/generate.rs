@@ -1,0 +1,52 @@
+//! `fxrt gen`: the cores' HDL and their manifests.
+
+use crate::cores::divider::{self, divider_core};
+use crate::cores::intersect::{IntersectParams, intersect_core};
+use crate::rtl::emit::{verilog, vhdl};
+use crate::rtl::netlist::Module;
+use serde_json::{Value, json};
+
+/// The JSON manifest written beside a core's HDL.
+pub fn manifest(m: &Module, latency: u32, params: Value) -> Value {
+    let port = |name: &str, dir: &str, ty: crate::rtl::Ty| json!({ "name": name, "direction": dir, "width": ty.width, "signed": ty.signed });
+    let mut ports = vec![json!({ "name": "clk", "direction": "in", "width": 1, "signed": false })];
+    if m.has_reset() {
+        ports.push(json!({ "name": "rst", "direction": "in", "width": 1, "signed": false }));
+    }
+    ports.extend(m.inputs.iter().map(|&i| port(&m.sig(i).name, "in", m.sig(i).ty)));
+    ports.extend(m.outputs.iter().map(|(n, i)| port(n, "out", m.sig(*i).ty)));
+    json!({
+        "name": m.name,
+        "generator": format!("fxrt {}", env!("CARGO_PKG_VERSION")),
+        "latency_cycles": latency,
+        "params": params,
+        "ports": ports,
+        "registers": m.signals.iter().filter(|s| matches!(s.def, crate::rtl::netlist::Def::Reg { .. })).map(|s| s.ty.width as u64).sum::<u64>(),
+    })
+}
+
+/// Every core for one parameter set: (module, latency, manifest parameters).
+pub fn cores(p: &IntersectParams) -> Vec<(Module, u32, Value)> {
+    let ip = intersect_core(p);
+    let div = divider_core(p.n, p.num_width() - p.t, p.den_width() - p.t);
+    vec![
+        (ip, p.latency(), serde_json::to_value(p).unwrap_or(Value::Null)),
+        (div, divider::latency(p.n), json!({ "n": p.n, "num_width": p.num_width() - p.t, "den_width": p.den_width() - p.t })),
+    ]
+}
+
+/// (file name, contents) of everything `fxrt gen` writes.
+pub fn files(p: &IntersectParams, vhdl_out: bool, verilog_out: bool) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for (m, lat, params) in cores(p) {
+        if vhdl_out {
+            out.push((format!("{}.vhd", m.name), vhdl::print(&m)));
+        }
+        if verilog_out {
+            out.push((format!("{}.v", m.name), verilog::print(&m)));
+        }
+        let text = serde_json::to_string_pretty(&manifest(&m, lat, params)).unwrap_or_default() + "\n";
+        out.push((format!("{}.json", m.name), text));
+    }
+    out
+}
