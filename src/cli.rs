@@ -30,6 +30,25 @@ pub enum Command {
     Gen(GenArgs),
     /// Check the intersection pipeline against the golden model in a simulator.
     Test(TestArgs),
+    /// Virtex-5 area of the cores from yosys (LUT, FF, DSP48E, BRAM), as JSON.
+    Synth(SynthArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct SynthArgs {
+    /// The scene whose edge shift E the pipeline is built for (with --edge-shift auto).
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    /// Target family; only Virtex-5 (xc5v) is supported.
+    #[arg(long, default_value = "xc5v")]
+    pub family: String,
+    /// Folder for the netlists and yosys logs. Default: target/fxrt-synth.
+    #[arg(long)]
+    pub build: Option<PathBuf>,
+    #[arg(long = "tag-width", default_value_t = 32)]
+    pub tag_width: u32,
+    #[command(flatten)]
+    pub params: ParamArgs,
 }
 
 #[derive(Args, Debug)]

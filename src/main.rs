@@ -1,5 +1,5 @@
 use clap::Parser;
-use fxrt::cli::{BenchArgs, Cli, Command, CompareArgs, GenArgs, Lang, RenderArgs, SceneArgs, SimChoice, TestArgs};
+use fxrt::cli::{BenchArgs, Cli, Command, CompareArgs, GenArgs, Lang, RenderArgs, SceneArgs, SimChoice, SynthArgs, TestArgs};
 use fxrt::cores::intersect::IntersectParams;
 use fxrt::flow::simulators::Simulator;
 use fxrt::error::{Error, Result};
@@ -25,6 +25,7 @@ fn main() -> ExitCode {
         Some(Command::Compare(a)) => run_compare(a),
         Some(Command::Bench(a)) => run_bench(a),
         Some(Command::Gen(a)) => run_gen(a),
+        Some(Command::Synth(a)) => run_synth(a),
         Some(Command::Test(a)) => match run_test(a) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
@@ -210,4 +211,22 @@ fn run_test(a: TestArgs) -> Result<bool> {
     );
     println!("{} passed, {} failed", outcome.passed, outcome.failed);
     Ok(outcome.failed == 0 && outcome.passed > 0)
+}
+
+fn run_synth(a: SynthArgs) -> Result<()> {
+    if a.family != "xc5v" {
+        return Err(Error::param("family", format!("'{}' is not supported: only xc5v (Virtex-5)", a.family)));
+    }
+    let params = a.params.params()?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let p = intersect_params(&params, &scene, a.tag_width)?;
+    let build = a.build.clone().unwrap_or_else(|| std::path::PathBuf::from("target/fxrt-synth"));
+    let mut cores = Vec::new();
+    for (m, latency, _) in fxrt::flow::generate::cores(&p) {
+        let area = fxrt::flow::synth::synth_xc5v(&m, &build.join(&m.name))?;
+        cores.push(serde_json::json!({ "latency_cycles": latency, "area": area }));
+    }
+    let thesis = serde_json::json!({ "note": "whole design of seed 001 table 3.2 (BIH + intersection + ray generator), XST", "luts": 5278, "registers": 3274, "dsp48e": 52, "bram18": 22 });
+    println!("{}", serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "params": p, "cores": cores, "thesis": thesis }));
+    Ok(())
 }

@@ -3,5 +3,6 @@
 pub mod check;
 pub mod generate;
 pub mod simulators;
+pub mod synth;
 pub mod testbench;
 pub mod vectors;

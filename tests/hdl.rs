@@ -1,0 +1,113 @@
+//! The intersection pipeline's generated HDL against the golden model in every simulator, at
+//! the defaults and at widths chosen to stress the RTL layer. A simulator that is not
+//! installed is reported as skipped (scripts/test.sh installs them all).
+
+mod common;
+
+use fxrt::cores::intersect::IntersectParams;
+use fxrt::flow::check::{run_hdl, run_rust};
+use fxrt::flow::simulators::Simulator;
+use fxrt::flow::vectors::generate;
+use fxrt::params::Params;
+use fxrt::scene::{Scene, SceneSource};
+
+fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
+    let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 20 };
+    p.check().unwrap();
+    let v = generate(&scene, count, 7);
+    let hits = v.iter().filter(|x| x.expected.is_some()).count();
+    assert!(hits > count / 20 && hits < count, "{hits} hits in {count} vectors");
+    (p, v)
+}
+
+fn hdl(sim: Simulator, params: Params, count: usize) {
+    if !sim.available() {
+        common::say(&format!("skipped: {} is not installed", sim.name()));
+        return;
+    }
+    let (p, v) = setup(params, count);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("hdl_{}_{}", sim.name(), p.name()));
+    let o = run_hdl(sim, &p, &v, &dir).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((o.passed, o.failed), ((count + p.latency() as usize) as u64, 0), "{} {}", sim.name(), p.name());
+}
+
+const SMALL: Params = Params { n: 16, m: 16, ..DEFAULTS };
+const ODD: Params = Params { n: 23, m: 27, t: 5, ..DEFAULTS };
+const WIDE: Params = Params { n: 32, m: 40, ..DEFAULTS };
+const DEFAULTS: Params = Params { n: 29, m: 32, edge_shift: fxrt::params::EdgeShift::Auto, t: 0, c: 16, leaf_size: 4, stack_depth: 32 };
+
+#[test]
+fn rust_simulator_matches_golden_on_a_million_vectors_at_defaults() {
+    let (p, v) = setup(DEFAULTS, 1_000_000);
+    let o = run_rust(&p, &v);
+    assert_eq!((o.passed, o.failed), (1_000_000, 0));
+}
+
+#[test]
+fn rust_simulator_matches_golden_at_stress_widths() {
+    for params in [SMALL, ODD, WIDE] {
+        let (p, v) = setup(params, 100_000);
+        let o = run_rust(&p, &v);
+        assert_eq!((o.passed, o.failed), (100_000, 0), "{}", p.name());
+    }
+}
+
+#[test]
+fn ghdl_defaults() {
+    hdl(Simulator::Ghdl, DEFAULTS, 1500);
+}
+
+#[test]
+fn ghdl_small() {
+    hdl(Simulator::Ghdl, SMALL, 1500);
+}
+
+#[test]
+fn verilator_defaults() {
+    hdl(Simulator::Verilator, DEFAULTS, 100_000);
+}
+
+#[test]
+fn verilator_odd() {
+    hdl(Simulator::Verilator, ODD, 100_000);
+}
+
+#[test]
+fn iverilog_wide() {
+    hdl(Simulator::Iverilog, WIDE, 3000);
+}
+
+#[test]
+fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
+    let (p, _) = setup(SMALL, 100);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("hdl_tools");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, text) in fxrt::flow::generate::files(&p, true, true) {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let run = |prog: &str, args: &[&str]| -> Option<std::process::Output> {
+        match std::process::Command::new(prog).args(args).current_dir(&dir).output() {
+            Ok(o) => Some(o),
+            Err(_) => {
+                common::say(&format!("skipped: {prog} is not installed"));
+                None
+            }
+        }
+    };
+    let name = p.name();
+    if let Some(o) = run("ghdl", &["--synth", "--std=93c", "--out=none", &format!("{name}.vhd"), "-e", &name]) {
+        assert!(o.status.success(), "ghdl --synth: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    if let Some(o) = run("verilator", &["--lint-only", "-Wall", &format!("{name}.v")]) {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success() && !err.contains("%Warning"), "verilator lint: {err}");
+    }
+    if run("yosys", &["-V"]).is_some() {
+        let module = fxrt::cores::intersect::intersect_core(&p);
+        let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
+        // Four products ahead of the divider, two after it, four for u and v: all on DSP48E.
+        assert!(area.dsp48e >= 10, "{area:?}");
+        assert!(area.luts > 500 && area.ffs > 500, "{area:?}");
+    }
+}
