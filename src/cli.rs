@@ -253,8 +253,25 @@ pub struct CompareArgs {
     pub params: ParamArgs,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchWhat {
+    /// Golden-model render speed: teapot, primary rays, Mrays/s.
+    Render,
+    /// Simulator speed on the intersection pipeline: Rust, Verilator and GHDL, cycles/s.
+    Sim,
+}
+
 #[derive(Args, Debug)]
 pub struct BenchArgs {
+    /// What to measure.
+    #[arg(value_enum, default_value = "render")]
+    pub what: BenchWhat,
+    /// Vectors for `bench sim` (the same ones for every simulator; GHDL runs a prefix).
+    #[arg(long, default_value_t = 200_000)]
+    pub vectors: usize,
+    /// How many of those vectors GHDL runs.
+    #[arg(long = "ghdl-vectors", default_value_t = 3000)]
+    pub ghdl_vectors: usize,
     /// Image size WxH.
     #[arg(long, value_parser = parse_size, default_value = "1024x1024")]
     pub size: (u32, u32),

@@ -105,6 +105,24 @@ fn run_compare(a: CompareArgs) -> Result<()> {
 }
 
 fn run_bench(a: BenchArgs) -> Result<()> {
+    if a.what == fxrt::cli::BenchWhat::Sim {
+        let params = fxrt::params::Params::default();
+        let scene = Scene::load(&scene::SceneSource::Builtin("teapot".into()), &params)?;
+        let p = intersect_params(&params, &scene, 32)?;
+        let vectors = fxrt::flow::vectors::generate(&scene, a.vectors.max(1), 1);
+        let speeds = fxrt::flow::check::bench_sims(&p, &vectors, a.ghdl_vectors, std::path::Path::new("target/fxrt-bench"))?;
+        for s in &speeds {
+            println!("{:>9}: {:>9} cycles in {:>7.3} s = {:>12.0} cycles/s{}", s.simulator, s.cycles, s.seconds, s.cycles_per_second, if s.all_passed { "" } else { "  (MISMATCHES)" });
+        }
+        let rate = |n: &str| speeds.iter().find(|s| s.simulator == n).map(|s| s.cycles_per_second);
+        if let (Some(r), Some(v)) = (rate("rust"), rate("verilator")) {
+            println!("rust / verilator = {:.2}", r / v);
+        }
+        if let (Some(r), Some(g)) = (rate("rust"), rate("ghdl")) {
+            println!("rust / ghdl = {:.1}", r / g);
+        }
+        return Ok(());
+    }
     let pool = thread_pool(Some(a.threads))?;
     let scene = Scene::load(&scene::SceneSource::Builtin("teapot".into()), &fxrt::params::Params::default())?;
     let cam = render::camera::Camera::default_for(&scene, a.size.0, a.size.1);

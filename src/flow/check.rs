@@ -81,3 +81,46 @@ pub fn run_hdl(sim_kind: Simulator, p: &IntersectParams, vectors: &[Vector], dir
     let (passed, failed) = sim_kind.run(dir, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim_kind.name(), e))?;
     Ok(Outcome { passed, failed })
 }
+
+/// Cycles per second of each simulator on the same vectors (`fxrt bench sim`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SimSpeed {
+    pub simulator: &'static str,
+    pub cycles: u64,
+    pub seconds: f64,
+    pub cycles_per_second: f64,
+    pub all_passed: bool,
+}
+
+/// GHDL runs only the first `ghdl_vectors` of the vectors: it is three orders of magnitude
+/// slower, and a cycles-per-second figure needs no more.
+pub fn bench_sims(p: &IntersectParams, vectors: &[Vector], ghdl_vectors: usize, dir: &Path) -> Result<Vec<SimSpeed>> {
+    let cycles = (vectors.len() + p.latency() as usize) as u64;
+    let start = std::time::Instant::now();
+    let rust = run_rust(p, vectors);
+    let secs = start.elapsed().as_secs_f64();
+    let mut out = vec![SimSpeed { simulator: "rust", cycles, seconds: secs, cycles_per_second: cycles as f64 / secs, all_passed: rust.failed == 0 }];
+    let module = intersect_core(p);
+    for sim in [Simulator::Verilator, Simulator::Ghdl] {
+        if !sim.available() {
+            continue;
+        }
+        let vectors = if sim == Simulator::Ghdl { &vectors[..ghdl_vectors.min(vectors.len())] } else { vectors };
+        let cycles = (vectors.len() + p.latency() as usize) as u64;
+        let transcript = record(&module, stimuli(&module, p.latency(), vectors));
+        let files = render(&module, &transcript);
+        let d = dir.join(sim.name());
+        let io = |e: std::io::Error| Error::file(&d, e.to_string());
+        std::fs::create_dir_all(&d).map_err(io)?;
+        let (design, tb) = match sim {
+            Simulator::Ghdl => ((format!("{}.vhd", module.name), vhdl::print(&module)), ("tb.vhd", &files.vhdl_tb)),
+            _ => ((format!("{}.v", module.name), verilog::print(&module)), ("tb.v", &files.verilog_tb)),
+        };
+        for (file, text) in [(design.0.as_str(), design.1.as_str()), (tb.0, tb.1.as_str()), ("vectors.txt", files.vectors_txt.as_str()), ("vectors.hex", files.vectors_hex.as_str())] {
+            std::fs::write(d.join(file), text).map_err(io)?;
+        }
+        let r = sim.run_timed(&d, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim.name(), e))?;
+        out.push(SimSpeed { simulator: sim.name(), cycles, seconds: r.seconds, cycles_per_second: cycles as f64 / r.seconds, all_passed: r.failed == 0 && r.passed == cycles });
+    }
+    Ok(out)
+}

@@ -39,6 +39,11 @@ impl Simulator {
     /// Compiles and runs the testbench `tb` in `dir`, whose HDL files are `sources` (design
     /// first). Returns (passed, failed) from the testbench's closing line.
     pub fn run(self, dir: &Path, sources: &[&str], tb: &str) -> Result<(u64, u64), String> {
+        self.run_timed(dir, sources, tb).map(|r| (r.passed, r.failed))
+    }
+
+    /// Like `run`, also timing the simulation step alone (not the compilation).
+    pub fn run_timed(self, dir: &Path, sources: &[&str], tb: &str) -> Result<RunResult, String> {
         let steps: Vec<Vec<String>> = match self {
             Simulator::Ghdl => {
                 let std = "--std=93c".to_string();
@@ -63,6 +68,7 @@ impl Simulator {
             }
         };
         let mut last = String::new();
+        let mut seconds = 0.0;
         for step in steps {
             let mut cmd = Command::new(&step[0]);
             cmd.args(&step[1..]).current_dir(dir);
@@ -72,15 +78,26 @@ impl Simulator {
                     cmd.env("GHDL_BACKEND", "llvm");
                 }
             }
+            let start = std::time::Instant::now();
             let out = cmd.output().map_err(|e| format!("{}: cannot run {}: {e}", self.name(), step[0]))?;
+            seconds = start.elapsed().as_secs_f64();
             last = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
             if !out.status.success() {
                 let tail: Vec<&str> = last.lines().rev().take(12).collect::<Vec<_>>().into_iter().rev().collect();
                 return Err(format!("{}: `{}` failed:\n{}", self.name(), step.join(" "), tail.join("\n")));
             }
         }
-        parse_summary(&last).ok_or_else(|| format!("{}: no 'N passed, N failed' line in:\n{last}", self.name()))
+        let (passed, failed) = parse_summary(&last).ok_or_else(|| format!("{}: no 'N passed, N failed' line in:\n{last}", self.name()))?;
+        Ok(RunResult { passed, failed, seconds })
     }
+}
+
+/// A testbench run: its counts and the seconds the simulation step took.
+#[derive(Clone, Copy, Debug)]
+pub struct RunResult {
+    pub passed: u64,
+    pub failed: u64,
+    pub seconds: f64,
 }
 
 /// Finds the testbench's `N passed, M failed`, wherever the simulator put it on the line.
