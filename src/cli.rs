@@ -45,8 +45,8 @@ pub struct SynthArgs {
     /// Folder for the netlists and yosys logs. Default: target/fxrt-synth.
     #[arg(long)]
     pub build: Option<PathBuf>,
-    #[arg(long = "tag-width", default_value_t = 32)]
-    pub tag_width: u32,
+    #[command(flatten)]
+    pub hw: HwArgs,
     #[command(flatten)]
     pub params: ParamArgs,
 }
@@ -63,10 +63,21 @@ pub struct GenArgs {
     #[arg(long, value_enum, value_delimiter = ',', default_value = "vhdl,verilog")]
     pub lang: Vec<Lang>,
     /// Width of the tag passed through the intersection pipeline.
-    #[arg(long = "tag-width", default_value_t = 32)]
-    pub tag_width: u32,
+    #[command(flatten)]
+    pub hw: HwArgs,
     #[command(flatten)]
     pub params: ParamArgs,
+}
+
+/// Choices of the hardware that do not change the arithmetic.
+#[derive(Args, Debug, Clone)]
+pub struct HwArgs {
+    /// Width of the tag passed through the intersection pipeline (1..=64).
+    #[arg(long = "tag-width", default_value_t = 32)]
+    pub tag_width: u32,
+    /// Quotient bits per divider stage: 1 (latency n + 2) or 2 (latency 1 + ⌈(n+1)/2⌉).
+    #[arg(long = "div-bits", default_value_t = 1)]
+    pub div_bits: u32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -92,8 +103,8 @@ pub struct TestArgs {
     /// Seed of the random vectors.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    #[arg(long = "tag-width", default_value_t = 32)]
-    pub tag_width: u32,
+    #[command(flatten)]
+    pub hw: HwArgs,
     #[command(flatten)]
     pub params: ParamArgs,
 }

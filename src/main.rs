@@ -108,7 +108,7 @@ fn run_bench(a: BenchArgs) -> Result<()> {
     if a.what == fxrt::cli::BenchWhat::Sim {
         let params = fxrt::params::Params::default();
         let scene = Scene::load(&scene::SceneSource::Builtin("teapot".into()), &params)?;
-        let p = intersect_params(&params, &scene, 32)?;
+        let p = intersect_params(&params, &scene, &fxrt::cli::HwArgs { tag_width: 32, div_bits: 1 })?;
         let vectors = fxrt::flow::vectors::generate(&scene, a.vectors.max(1), 1);
         let speeds = fxrt::flow::check::bench_sims(&p, &vectors, a.ghdl_vectors, std::path::Path::new("target/fxrt-bench"))?;
         for s in &speeds {
@@ -171,8 +171,8 @@ fn run_scene(a: SceneArgs) -> Result<()> {
 }
 
 /// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
-fn intersect_params(params: &fxrt::params::Params, scene: &Scene, tag_width: u32) -> Result<IntersectParams> {
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width };
+fn intersect_params(params: &fxrt::params::Params, scene: &Scene, hw: &fxrt::cli::HwArgs) -> Result<IntersectParams> {
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: hw.tag_width, div_bits: hw.div_bits };
     p.check()?;
     Ok(p)
 }
@@ -180,7 +180,7 @@ fn intersect_params(params: &fxrt::params::Params, scene: &Scene, tag_width: u32
 fn run_gen(a: GenArgs) -> Result<()> {
     let params = a.params.params()?;
     let scene = Scene::load(&a.scene.source(), &params)?;
-    let p = intersect_params(&params, &scene, a.tag_width)?;
+    let p = intersect_params(&params, &scene, &a.hw)?;
     let files: Vec<(std::path::PathBuf, Vec<u8>)> = fxrt::flow::generate::files(&p, a.lang.contains(&Lang::Vhdl), a.lang.contains(&Lang::Verilog))
         .into_iter()
         .map(|(n, t)| (a.out.join(n), t.into_bytes()))
@@ -193,7 +193,7 @@ fn run_gen(a: GenArgs) -> Result<()> {
 fn run_test(a: TestArgs) -> Result<bool> {
     let params = a.params.params()?;
     let scene = Scene::load(&a.scene.source(), &params)?;
-    let p = intersect_params(&params, &scene, a.tag_width)?;
+    let p = intersect_params(&params, &scene, &a.hw)?;
     let count = a.vectors.unwrap_or(match a.sim {
         SimChoice::Rust | SimChoice::Verilator => 100_000,
         SimChoice::Iverilog => 20_000,
@@ -237,7 +237,7 @@ fn run_synth(a: SynthArgs) -> Result<()> {
     }
     let params = a.params.params()?;
     let scene = Scene::load(&a.scene.source(), &params)?;
-    let p = intersect_params(&params, &scene, a.tag_width)?;
+    let p = intersect_params(&params, &scene, &a.hw)?;
     let build = a.build.clone().unwrap_or_else(|| std::path::PathBuf::from("target/fxrt-synth"));
     let mut cores = Vec::new();
     for (m, latency, _) in fxrt::flow::generate::cores(&p) {

@@ -12,8 +12,12 @@ use fxrt::params::Params;
 use fxrt::scene::{Scene, SceneSource};
 
 fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
+    setup_bits(params, 1, count)
+}
+
+fn setup_bits(params: Params, div_bits: u32, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 20 };
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 20, div_bits };
     p.check().unwrap();
     let v = generate(&scene, count, 7);
     let hits = v.iter().filter(|x| x.expected.is_some()).count();
@@ -22,11 +26,15 @@ fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::flow::vect
 }
 
 fn hdl(sim: Simulator, params: Params, count: usize) {
+    hdl_bits(sim, params, 1, count)
+}
+
+fn hdl_bits(sim: Simulator, params: Params, div_bits: u32, count: usize) {
     if !sim.available() {
         common::say(&format!("skipped: {} is not installed", sim.name()));
         return;
     }
-    let (p, v) = setup(params, count);
+    let (p, v) = setup_bits(params, div_bits, count);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("hdl_{}_{}", sim.name(), p.name()));
     let o = run_hdl(sim, &p, &v, &dir).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!((o.passed, o.failed), ((count + p.latency() as usize) as u64, 0), "{} {}", sim.name(), p.name());
@@ -71,6 +79,12 @@ fn verilator_defaults() {
 #[test]
 fn verilator_odd() {
     hdl(Simulator::Verilator, ODD, 100_000);
+}
+
+#[test]
+fn two_quotient_bits_per_stage_in_ghdl_and_verilator() {
+    hdl_bits(Simulator::Ghdl, SMALL, 2, 800);
+    hdl_bits(Simulator::Verilator, DEFAULTS, 2, 50_000);
 }
 
 #[test]

@@ -8,7 +8,7 @@
 //! hi < b (the overflow test), and each stage shifts in one bit of lo and subtracts b if it
 //! can. Latency n + 2 (the thesis's divider: n + 3): one stage for the magnitudes and signs,
 //! then n + 1 quotient stages; the first also makes the overflow test, the last also forms
-//! the result flag.
+//! the result flag. With two quotient bits per stage: 1 + ⌈(n + 1)/2⌉.
 
 use crate::rtl::{BinOp, Module, Sig, Ty, UnOp};
 
@@ -23,9 +23,10 @@ pub struct DividerOut {
     pub sidecar: Sidecar,
 }
 
-/// Latency in clock cycles of `divider_stages` for grid bits `n`.
-pub fn latency(n: u32) -> u32 {
-    n + 2
+/// Latency in clock cycles of `divider_stages` for grid bits `n` and `bits_per_stage`
+/// quotient bits computed between two registers.
+pub fn latency(n: u32, bits_per_stage: u32) -> u32 {
+    1 + (n + 1).div_ceil(bits_per_stage)
 }
 
 fn delay_all(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Sidecar {
@@ -33,7 +34,10 @@ fn delay_all(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Sidecar {
 }
 
 /// Appends the divider to `m`. `num` and `den` are signed; `sidecar` travels alongside.
-pub fn divider_stages(m: &mut Module, n: u32, num: Sig, den: Sig, sidecar: &[Sig]) -> DividerOut {
+/// `bits_per_stage` quotient bits (1 or 2) are computed between two pipeline registers: 2
+/// halves the registers and the latency at the price of two subtractors in series.
+pub fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den: Sig, sidecar: &[Sig]) -> DividerOut {
+    assert!((1..=2).contains(&bits_per_stage));
     assert!(num.ty.signed && den.ty.signed);
     let (wn, wd) = (num.ty.width, den.ty.width);
     let qbits = n + 1;
@@ -103,6 +107,11 @@ pub fn divider_stages(m: &mut Module, n: u32, num: Sig, den: Sig, sidecar: &[Sig
             let sidecar = delay_all(m, &format!("div{}_side", k + 2), &side_s);
             return DividerOut { t, ok, sidecar };
         }
+        if (k + 1) % bits_per_stage != 0 {
+            // The next quotient bit is computed in the same clock cycle.
+            (p, q) = (pn, qn);
+            continue;
+        }
         p = m.delay(&format!("div{}_p", k + 2), pn);
         q = m.delay(&format!("div{}_q", k + 2), qn);
         b_s = m.delay(&format!("div{}_b", k + 2), b_s);
@@ -114,12 +123,13 @@ pub fn divider_stages(m: &mut Module, n: u32, num: Sig, den: Sig, sidecar: &[Sig
     unreachable!("the loop returns at its last stage")
 }
 
-/// The divider as a standalone core: ports num, den → t, ok, latency n + 2.
-pub fn divider_core(n: u32, num_width: u32, den_width: u32) -> Module {
-    let mut m = Module::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}"));
+/// The divider as a standalone core: ports num, den → t, ok.
+pub fn divider_core(n: u32, bits_per_stage: u32, num_width: u32, den_width: u32) -> Module {
+    let suffix = if bits_per_stage == 2 { "_r4" } else { "" };
+    let mut m = Module::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}{suffix}"));
     let num = m.input("num", Ty::s(num_width));
     let den = m.input("den", Ty::s(den_width));
-    let out = divider_stages(&mut m, n, num, den, &[]);
+    let out = divider_stages(&mut m, n, bits_per_stage, num, den, &[]);
     m.output("t", out.t);
     m.output("ok", out.ok);
     m
@@ -144,11 +154,16 @@ mod tests {
     }
 
     fn check(n: u32, wn: u32, wd: u32, cases: &[(i128, i128)]) {
-        let m = divider_core(n, wn, wd);
+        check_bps(n, 1, wn, wd, cases);
+        check_bps(n, 2, wn, wd, cases);
+    }
+
+    fn check_bps(n: u32, bps: u32, wn: u32, wd: u32, cases: &[(i128, i128)]) {
+        let m = divider_core(n, bps, wn, wd);
         let mut sim = Sim::new(&m);
         let (num, den) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
         let (t, ok) = (m.handle(m.outputs[0].1), m.handle(m.outputs[1].1));
-        let lat = latency(n) as usize;
+        let lat = latency(n, bps) as usize;
         let mut got = Vec::new();
         for i in 0..cases.len() + lat {
             let (a, b) = cases.get(i).copied().unwrap_or((0, 0));
@@ -160,7 +175,7 @@ mod tests {
             }
         }
         for (i, &(a, b)) in cases.iter().enumerate() {
-            assert_eq!(got[i], divide(n, a, b), "n={n} {a}/{b}");
+            assert_eq!(got[i], divide(n, a, b), "n={n} bits/stage {bps}: {a}/{b}");
         }
     }
 

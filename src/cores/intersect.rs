@@ -16,6 +16,8 @@ pub struct IntersectParams {
     pub e: u32,
     /// Width of the pass-through tag (ray id and triangle number, packed by the user).
     pub tag_width: u32,
+    /// Quotient bits per divider stage: 1, or 2 for half the divider latency.
+    pub div_bits: u32,
 }
 
 impl IntersectParams {
@@ -30,7 +32,8 @@ impl IntersectParams {
         self.m + 2
     }
     pub fn name(&self) -> String {
-        format!("fxrt_intersect_n{}_m{}_t{}_e{}", self.n, self.m, self.t, self.e)
+        let r4 = if self.div_bits == 2 { "_r4" } else { "" };
+        format!("fxrt_intersect_n{}_m{}_t{}_e{}{r4}", self.n, self.m, self.t, self.e)
     }
     /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
     /// parameter to change.
@@ -48,6 +51,9 @@ impl IntersectParams {
                 return Err(Error::param(param, format!("{what} needs {bits} bits; the RTL layer holds at most {max}")));
             }
         }
+        if !(1..=2).contains(&self.div_bits) {
+            return Err(Error::param("div-bits", format!("{} is out of range: must be 1 or 2", self.div_bits)));
+        }
         if self.tag_width == 0 || self.tag_width > 64 {
             return Err(Error::param("tag-width", format!("{} is out of range: must be 1..=64", self.tag_width)));
         }
@@ -56,7 +62,7 @@ impl IntersectParams {
 
     /// Input register, products, numerator/denominator, divider, t·ω, k, e·k, u/v and test.
     pub fn latency(&self) -> u32 {
-        3 + divider::latency(self.n) + 4
+        3 + divider::latency(self.n, self.div_bits) + 4
     }
 }
 
@@ -197,7 +203,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
         m.delay(&name, *s)
     }).collect();
     // The divider, with everything else riding along.
-    let dv = divider_stages(&mut m, n, num_r, den_r, &side);
+    let dv = divider_stages(&mut m, n, p.div_bits, num_r, den_r, &side);
     let [valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = dv.sidecar[..] else { unreachable!() };
     // Stage D+1: t·ω_p, t·ω_q (t as signed n+2 bits).
     let t_s = as_signed_wider(&mut m, "t_s", dv.t);
@@ -304,10 +310,10 @@ mod tests {
 
     /// Random rays against random triangles of a built-in scene, through the Rust simulation
     /// of the pipeline, against the golden model.
-    fn check(params: Params, count: usize) -> usize {
+    fn check(params: Params, div_bits: u32, count: usize) -> usize {
         let scene = Scene::load(&crate::scene::SceneSource::Builtin("random".into()), &params).unwrap();
         let g = Golden::new(&scene);
-        let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 24 };
+        let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 24, div_bits };
         let module = intersect_core(&p);
         let mut sim = Sim::new(&module);
         let ins: Vec<_> = module.inputs.iter().map(|&i| module.handle(i)).collect();
@@ -366,14 +372,15 @@ mod tests {
             Params { n: 23, m: 27, t: 5, ..Params::default() },
             Params { n: 32, m: 40, ..Params::default() },
         ] {
-            let hits = check(params, 3000);
+            let hits = check(params, 1, 3000);
+            assert_eq!(hits, check(params, 2, 3000));
             assert!(hits > 1000 && hits < 2900, "{hits} hits of 3000 with {params:?}: both outcomes must be exercised");
         }
     }
 
     #[test]
     fn latency_at_the_thesis_setting_is_within_41() {
-        let p = IntersectParams { n: 29, m: 32, t: 0, e: 10, tag_width: 8 };
+        let p = IntersectParams { n: 29, m: 32, t: 0, e: 10, tag_width: 8, div_bits: 1 };
         assert!(p.latency() <= 41, "{}", p.latency());
     }
 }
