@@ -9,5 +9,6 @@ pub mod io;
 pub mod model;
 pub mod params;
 pub mod render;
+pub mod rng;
 pub mod rtl;
 pub mod scene;

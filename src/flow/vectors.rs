@@ -6,6 +6,7 @@ use crate::model::golden::{Golden, GridRay, TriHit};
 use crate::model::ray::{quantize_direction, quantize_ray};
 use crate::render::camera::Camera;
 use crate::scene::Scene;
+use crate::rng::SplitMix64;
 use crate::scene::accel::AccelTri;
 
 /// One pipeline input and the golden answer.
@@ -14,24 +15,6 @@ pub struct Vector {
     pub tri: AccelTri,
     pub ray: GridRay,
     pub expected: Option<TriHit>,
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // SplitMix64: deterministic, so the same command writes the same vectors.
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n.max(1)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 fn vector(g: &Golden, tri: &AccelTri, ray: GridRay) -> Vector {
@@ -55,7 +38,7 @@ fn aimed(scene: &Scene, g: &Golden, ti: usize, o: [i64; 3], b1: f64, b2: f64) ->
 /// rendered frame, and the rest edge cases (cycled).
 pub fn generate(scene: &Scene, count: usize, seed: u64) -> Vec<Vector> {
     let g = Golden::new(scene);
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     let mut out = Vec::with_capacity(count);
     let hi = scene.grid_box.hi;
     let nt = scene.tris.len() as u64;
@@ -63,7 +46,7 @@ pub fn generate(scene: &Scene, count: usize, seed: u64) -> Vec<Vector> {
     while out.len() < count / 3 {
         let ti = rng.below(nt) as usize;
         let o: [i64; 3] = std::array::from_fn(|k| rng.below(hi[k] as u64 + 1) as i64);
-        let (b1, b2) = (rng.unit() * 1.2 - 0.1, rng.unit() * 1.2 - 0.1);
+        let (b1, b2) = (rng.next_f64() * 1.2 - 0.1, rng.next_f64() * 1.2 - 0.1);
         if let Some(ray) = aimed(scene, &g, ti, o, b1, b2) {
             out.push(vector(&g, &scene.tris[ti], ray));
         }
@@ -101,7 +84,7 @@ pub fn generate(scene: &Scene, count: usize, seed: u64) -> Vec<Vector> {
             0 => aimed(scene, &g, ti, [rng.below(top[0] as u64) as i64, rng.below(top[1] as u64) as i64, rng.below(top[2] as u64) as i64], [0.0, 1.0, 0.0][rng.below(3) as usize], 0.0),
             1 => aimed(scene, &g, ti, [0, 0, 0], 0.5, 0.5),
             2 => {
-                let t = rng.unit();
+                let t = rng.next_f64();
                 aimed(scene, &g, ti, top, t, 0.0)
             }
             // Parallel to the plane (zero or tiny denominator): along an edge direction.
@@ -128,7 +111,7 @@ pub fn generate(scene: &Scene, count: usize, seed: u64) -> Vec<Vector> {
             // Origin on the triangle's plane (t = 0) or one unit off it (t near 1).
             6 => {
                 let o = v[0];
-                let w = quantize_direction([rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5].map(|x| x * 2.0), f);
+                let w = quantize_direction([rng.next_f64() - 0.5, rng.next_f64() - 0.5, rng.next_f64() - 0.5].map(|x| x * 2.0), f);
                 Some(g.ray(o, w))
             }
             _ => {

@@ -78,29 +78,14 @@ fn push_quad(tris: &mut Vec<Tri>, [v0, v1, v2, v3]: [V3; 4]) {
     tris.push([v0, v2, v3]);
 }
 
-/// SplitMix64 (Steele, Lea & Flood 2014): tiny, fast and fully specified, so
-/// scenes do not depend on any external RNG crate or its version.
-struct SplitMix64(u64);
+use crate::rng::SplitMix64;
 
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
+/// Extra draws the scenes need on top of the shared generator.
+trait Directions {
+    fn unit_vector(&mut self) -> V3;
+}
 
-    /// Uniform in [0, 1), using the top 53 bits (exactly representable).
-    fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-
+impl Directions for SplitMix64 {
     /// Uniformly distributed direction: by Archimedes' hat-box theorem a
     /// uniform height and a uniform azimuth cover the sphere uniformly.
     fn unit_vector(&mut self) -> V3 {
