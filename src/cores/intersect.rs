@@ -101,6 +101,16 @@ fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
     m.mux(name, is2, v[2], a)
 }
 
+/// (a + 1) mod 3 for a 2-bit axis number.
+fn next_axis(m: &mut Module, name: &str, a: Sig) -> Sig {
+    let zero = m.konst(&format!("{name}_zero"), Ty::u(2), 0);
+    let one = m.konst(&format!("{name}_one"), Ty::u(2), 1);
+    let two = m.konst(&format!("{name}_two"), Ty::u(2), 2);
+    let wraps = m.bin(&format!("{name}_wraps"), BinOp::Eq, a, two);
+    let inc = m.add(&format!("{name}_inc"), a, one);
+    m.mux(name, wraps, zero, inc)
+}
+
 /// round(x / 2^s): (x + 2^(s−1)) >> s, at x's width.
 fn shr_round(m: &mut Module, name: &str, x: Sig, s: u32) -> Sig {
     if s == 0 {
@@ -128,22 +138,8 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let [valid, tag, ox, oy, oz, wx, wy, wz, rr, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = r[..] else { unreachable!() };
     // Permute by r: (r, p, q) = (r, r+1 mod 3, r+2 mod 3).
     let (o, w) = ([ox, oy, oz], [wx, wy, wz]);
-    let sel_p = {
-        let one = m.konst("perm_one", Ty::u(2), 1);
-        let two = m.konst("perm_two", Ty::u(2), 2);
-        let zero = m.konst("perm_zero", Ty::u(2), 0);
-        let is2 = m.bin("perm_r_is2", BinOp::Eq, rr, two);
-        let rp1 = m.add("perm_r_plus1", rr, one);
-        m.mux("perm_p", is2, zero, rp1)
-    };
-    let sel_q = {
-        let zero = m.konst("perm_zero_q", Ty::u(2), 0);
-        let two = m.konst("perm_two_q", Ty::u(2), 2);
-        let is2 = m.bin("perm_p_is2", BinOp::Eq, sel_p, two);
-        let one = m.konst("perm_one_q", Ty::u(2), 1);
-        let pp1 = m.add("perm_p_plus1", sel_p, one);
-        m.mux("perm_q", is2, zero, pp1)
-    };
+    let sel_p = next_axis(&mut m, "perm_p", rr);
+    let sel_q = next_axis(&mut m, "perm_q", sel_p);
     let o_r = pick(&mut m, "o_r", rr, o);
     let o_p = pick(&mut m, "o_p", sel_p, o);
     let o_q = pick(&mut m, "o_q", sel_q, o);
