@@ -6,5 +6,6 @@ cd "$(dirname "$0")/.."
 out="${1:-generated}"
 cargo build --release --quiet
 bin="${CARGO_TARGET_DIR:-target}/release/fxrt"
-rm -rf "$out/scene"
+rm -rf "$out/scene" "$out/hdl"
 "$bin" scene --builtin teapot --out "$out/scene" >/dev/null
+"$bin" gen --builtin teapot --out "$out/hdl" >/dev/null

@@ -10,7 +10,7 @@ cargo test --release
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 scripts/generate.sh "$tmp"
-if ! diff -r -q generated/scene "$tmp/scene"; then
+if ! diff -r -q generated/scene "$tmp/scene" || ! diff -r -q generated/hdl "$tmp/hdl"; then
     echo "generated/ is stale: run scripts/generate.sh and commit the result" >&2
     exit 1
 fi
