@@ -16,7 +16,7 @@ fn all_ops() -> Module {
     let d = m.input("d", Ty::u(7));
     let sel = m.input("sel", Ty::BIT);
     let wide = m.input("wide", Ty::s(70));
-    let mut out = |m: &mut Module, name: &str, s| m.output(name, s);
+    let out = |m: &mut Module, name: &str, s| m.output(name, s);
     for (name, op) in [("add", BinOp::Add), ("sub", BinOp::Sub), ("and", BinOp::And), ("or", BinOp::Or), ("xor", BinOp::Xor), ("mul", BinOp::Mul), ("eq", BinOp::Eq), ("lt", BinOp::Lt), ("le", BinOp::Le), ("ne", BinOp::Ne)] {
         let s = m.bin(&format!("{name}_s"), op, a, b);
         out(&mut m, &format!("o_{name}_s"), s);
