@@ -47,29 +47,24 @@ pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, pro
     bar.set_style(indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows ({eta})").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
     bar.set_message("render");
     let start = std::time::Instant::now();
-    let rows: Vec<Vec<(i32, f32, f32, u64)>> = (0..h)
+    let pixel_rays = cam.pixel_rays();
+    let rows: Vec<Vec<(i32, f32, f32, u8)>> = (0..h)
         .into_par_iter()
         .map(|py| {
-            let row = (0..w)
-                .map(|px| {
-                    let ray = cam.ray(px, py);
-                    match tracer.primary(&ray) {
-                        None => (-1, f32::INFINITY, -1.0, 1),
-                        Some(hit) => {
-                            let n = normals[hit.id as usize];
-                            let (brightness, rays) = if shade {
-                                let p: [f64; 3] = std::array::from_fn(|k| ray.o[k] + hit.dist * ray.d[k]);
-                                let l = normalize(sub(light, p));
-                                let lit = !tracer.shadowed(&ray, &hit, light);
-                                (0.12 + if lit { 0.88 * dot(n, l).abs() } else { 0.0 }, 2)
-                            } else {
-                                (0.12 + 0.88 * dot(n, ray.d).abs(), 1)
-                            };
-                            (hit.id as i32, hit.dist as f32, brightness as f32, rays)
-                        }
-                    }
-                })
-                .collect();
+            let rays: Vec<_> = (0..w).map(|px| pixel_rays.ray(px, py)).collect();
+            let mut row = vec![(-1, f32::INFINITY, -1.0, 1); w as usize];
+            tracer.primary_row(&rays, &mut |px, hit| {
+                let (ray, n) = (&rays[px], normals[hit.id as usize]);
+                let (brightness, traced) = if shade {
+                    let p: [f64; 3] = std::array::from_fn(|k| ray.o[k] + hit.dist * ray.d[k]);
+                    let l = normalize(sub(light, p));
+                    let lit = !tracer.shadowed(ray, &hit, light);
+                    (0.12 + if lit { 0.88 * dot(n, l).abs() } else { 0.0 }, 2)
+                } else {
+                    (0.12 + 0.88 * dot(n, ray.d).abs(), 1)
+                };
+                row[px] = (hit.id as i32, hit.dist as f32, brightness as f32, traced);
+            });
             bar.inc(1);
             row
         })
@@ -82,7 +77,7 @@ pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, pro
         f.ids.push(id);
         f.depth.push(d);
         f.shade.push(s);
-        f.rays += rays;
+        f.rays += rays as u64;
         f.hits += (id >= 0) as u64;
     }
     f
