@@ -101,6 +101,16 @@ fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
     m.mux(name, is2, v[2], a)
 }
 
+/// A pipeline register for each signal, named after it with the stage's prefix.
+fn stage(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Vec<Sig> {
+    sigs.iter()
+        .map(|s| {
+            let name = format!("{prefix}_{}", m.sig(s.id).name);
+            m.delay(&name, *s)
+        })
+        .collect()
+}
+
 /// (a + 1) mod 3 for a 2-bit axis number.
 fn next_axis(m: &mut Module, name: &str, a: Sig) -> Sig {
     let zero = m.konst(&format!("{name}_zero"), Ty::u(2), 0);
@@ -131,10 +141,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let mut m = Module::new(&p.name());
     let ins: Vec<Sig> = input_ports(p).iter().map(|(name, ty)| m.input(name, *ty)).collect();
     // Stage 1: register the inputs.
-    let r: Vec<Sig> = ins.iter().map(|s| {
-        let name = format!("s1_{}", m.sig(s.id).name);
-        m.delay(&name, *s)
-    }).collect();
+    let r = stage(&mut m, "s1", &ins);
     let [valid, tag, ox, oy, oz, wx, wy, wz, rr, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = r[..] else { unreachable!() };
     // Permute by r: (r, p, q) = (r, r+1 mod 3, r+2 mod 3).
     let (o, w) = ([ox, oy, oz], [wx, wy, wz]);
@@ -162,13 +169,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let dmo = m.sub("d_minus_or", d_w, o_r_w);
     let kp0 = m.sub("kp_base", o_p_s, pp_s);
     let kq0 = m.sub("kq_base", o_q_s, pq_s);
-    let s2: Vec<Sig> = [onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]
-        .iter()
-        .map(|s| {
-            let name = format!("s2_{}", m.sig(s.id).name);
-            m.delay(&name, *s)
-        })
-        .collect();
+    let s2: Vec<Sig> = stage(&mut m, "s2", &[onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
     let [onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = s2[..] else { unreachable!() };
     // Stage 3: num = ((d − O_r) << F) − O_p·np − O_q·nq, den = ω_r + rnd(ω_p·np + ω_q·nq, F).
     let wn = p.num_width();
@@ -194,10 +195,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let den_t = m.resize("den_short", den_t, wd - p.t);
     let num_r = m.delay("s3_num", num_t);
     let den_r = m.delay("s3_den", den_t);
-    let side: Vec<Sig> = [valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q].iter().map(|s| {
-        let name = format!("s3_{}", m.sig(s.id).name);
-        m.delay(&name, *s)
-    }).collect();
+    let side: Vec<Sig> = stage(&mut m, "s3", &[valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
     // The divider, with everything else riding along.
     let dv = divider_stages(&mut m, n, p.div_bits, num_r, den_r, &side);
     let [valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = dv.sidecar[..] else { unreachable!() };
@@ -205,10 +203,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let t_s = as_signed_wider(&mut m, "t_s", dv.t);
     let tp = m.mul("t_wp", t_s, w_p);
     let tq = m.mul("t_wq", t_s, w_q);
-    let x1: Vec<Sig> = [tp, tq, dv.t, dv.ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q].iter().map(|s| {
-        let name = format!("x1_{}", m.sig(s.id).name);
-        m.delay(&name, *s)
-    }).collect();
+    let x1: Vec<Sig> = stage(&mut m, "x1", &[tp, tq, dv.t, dv.ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q]);
     let [tp, tq, t, ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q] = x1[..] else { unreachable!() };
     // Stage D+2: kp = (O_p − pp) + rnd(t·ω_p, F), kq likewise (n+3 bits).
     let tp_r = shr_round(&mut m, "tp_rounded", tp, f);
@@ -220,20 +215,14 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let kq0_w = m.resize("kq_base_w", kq0, kw);
     let kp = m.add("kp", kp0_w, tp_n);
     let kq = m.add("kq", kq0_w, tq_n);
-    let x2: Vec<Sig> = [kp, kq, t, ok, valid, tag, e1p, e1q, e2p, e2q].iter().map(|s| {
-        let name = format!("x2_{}", m.sig(s.id).name);
-        m.delay(&name, *s)
-    }).collect();
+    let x2: Vec<Sig> = stage(&mut m, "x2", &[kp, kq, t, ok, valid, tag, e1p, e1q, e2p, e2q]);
     let [kp, kq, t, ok, valid, tag, e1p, e1q, e2p, e2q] = x2[..] else { unreachable!() };
     // Stage D+3: the four barycentric products.
     let a1 = m.mul("e1p_kq", e1p, kq);
     let a2 = m.mul("e1q_kp", e1q, kp);
     let b1 = m.mul("e2q_kp", e2q, kp);
     let b2 = m.mul("e2p_kq", e2p, kq);
-    let x3: Vec<Sig> = [a1, a2, b1, b2, t, ok, valid, tag].iter().map(|s| {
-        let name = format!("x3_{}", m.sig(s.id).name);
-        m.delay(&name, *s)
-    }).collect();
+    let x3: Vec<Sig> = stage(&mut m, "x3", &[a1, a2, b1, b2, t, ok, valid, tag]);
     let [a1, a2, b1, b2, t, ok, valid, tag] = x3[..] else { unreachable!() };
     // Stage D+4: u, v, the hit test, outputs zeroed on a miss.
     let uw = (mm + kw + 1).max(p.e + f + 2);
