@@ -10,7 +10,11 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
-#[command(name = "fxrt", version, about = "Fixed-point hardware ray tracing: scene ROMs, a bit-exact golden model, float references and renders")]
+#[command(
+    name = "fxrt",
+    version,
+    about = "Fixed-point hardware ray tracing: scene ROMs, a bit-exact golden model, float references and renders"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
@@ -145,7 +149,15 @@ pub struct ParamArgs {
 
 impl ParamArgs {
     pub fn params(&self) -> Result<Params> {
-        let p = Params { n: self.n, m: self.m, edge_shift: self.edge_shift, t: self.t, c: self.c, leaf_size: self.leaf_size, stack_depth: self.stack_depth };
+        let p = Params {
+            n: self.n,
+            m: self.m,
+            edge_shift: self.edge_shift,
+            t: self.t,
+            c: self.c,
+            leaf_size: self.leaf_size,
+            stack_depth: self.stack_depth,
+        };
         p.validate()?;
         Ok(p)
     }
@@ -334,7 +346,19 @@ mod tests {
 
     #[test]
     fn render_args_parse_without_side_effects() {
-        let cli = Cli::try_parse_from(["fxrt", "render", "--builtin", "cornell", "--eye", "-1,2,3", "--n", "20", "--edge-shift", "10"]).unwrap();
+        let cli = Cli::try_parse_from([
+            "fxrt",
+            "render",
+            "--builtin",
+            "cornell",
+            "--eye",
+            "-1,2,3",
+            "--n",
+            "20",
+            "--edge-shift",
+            "10",
+        ])
+        .unwrap();
         let Some(Command::Render(r)) = cli.command else { panic!("not render") };
         assert_eq!(r.scene.source(), SceneSource::Builtin("cornell".into()));
         assert_eq!(r.camera.eye, Some([-1.0, 2.0, 3.0]));

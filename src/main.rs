@@ -1,8 +1,10 @@
 use clap::Parser;
-use fxrt::cli::{BenchArgs, Cli, Command, CompareArgs, GenArgs, Lang, RenderArgs, SceneArgs, SimChoice, SynthArgs, TestArgs};
+use fxrt::cli::{
+    BenchArgs, Cli, Command, CompareArgs, GenArgs, Lang, RenderArgs, SceneArgs, SimChoice, SynthArgs, TestArgs,
+};
 use fxrt::cores::intersect::IntersectParams;
-use fxrt::flow::simulators::Simulator;
 use fxrt::error::{Error, Result};
+use fxrt::flow::simulators::Simulator;
 use fxrt::render::{self, tracer};
 use fxrt::scene::{self, Scene, rom};
 use std::process::ExitCode;
@@ -10,7 +12,9 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
-        Err(e) if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) => e.exit(),
+        Err(e) if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) => {
+            e.exit()
+        }
         Err(e) => {
             // One line, like every other input error; `--help` has the details.
             let text = e.render().to_string();
@@ -97,10 +101,16 @@ fn run_compare(a: CompareArgs) -> Result<()> {
     let (g, r) = pool.install(|| {
         let golden = tracer::make_tracer(&scene, tracer::ModelKind::Golden);
         let reference = tracer::make_tracer(&scene, a.against);
-        (render::render(&scene, golden.as_ref(), &cam, false, true), render::render(&scene, reference.as_ref(), &cam, false, true))
+        (
+            render::render(&scene, golden.as_ref(), &cam, false, true),
+            render::render(&scene, reference.as_ref(), &cam, false, true),
+        )
     });
     let d = render::compare::compare(&g, &r);
-    println!("{}", serde_json::json!({ "scene": scene.name, "against": format!("{:?}", a.against).to_lowercase(), "edge_shift": scene.edge_shift, "disagreement": d, "rate": d.rate() }));
+    println!(
+        "{}",
+        serde_json::json!({ "scene": scene.name, "against": format!("{:?}", a.against).to_lowercase(), "edge_shift": scene.edge_shift, "disagreement": d, "rate": d.rate() })
+    );
     Ok(())
 }
 
@@ -110,9 +120,17 @@ fn run_bench(a: BenchArgs) -> Result<()> {
         let scene = Scene::load(&scene::SceneSource::Builtin("teapot".into()), &params)?;
         let p = intersect_params(&params, &scene, &fxrt::cli::HwArgs { tag_width: 32, div_bits: 1 })?;
         let vectors = fxrt::flow::vectors::generate(&scene, a.vectors.max(1), 1);
-        let speeds = fxrt::flow::check::bench_sims(&p, &vectors, a.ghdl_vectors, std::path::Path::new("target/fxrt-bench"))?;
+        let speeds =
+            fxrt::flow::check::bench_sims(&p, &vectors, a.ghdl_vectors, std::path::Path::new("target/fxrt-bench"))?;
         for s in &speeds {
-            println!("{:>9}: {:>9} cycles in {:>7.3} s = {:>12.0} cycles/s{}", s.simulator, s.cycles, s.seconds, s.cycles_per_second, if s.all_passed { "" } else { "  (MISMATCHES)" });
+            println!(
+                "{:>9}: {:>9} cycles in {:>7.3} s = {:>12.0} cycles/s{}",
+                s.simulator,
+                s.cycles,
+                s.seconds,
+                s.cycles_per_second,
+                if s.all_passed { "" } else { "  (MISMATCHES)" }
+            );
         }
         let rate = |n: &str| speeds.iter().find(|s| s.simulator == n).map(|s| s.cycles_per_second);
         if let (Some(r), Some(v)) = (rate("rust"), rate("verilator")) {
@@ -134,7 +152,15 @@ fn run_bench(a: BenchArgs) -> Result<()> {
         best = best.min(f.seconds);
         rays = f.rays;
     }
-    println!("teapot {}x{} golden primary rays, {} thread(s): best of {}: {:.3} s, {:.2} Mrays/s", a.size.0, a.size.1, a.threads, a.repeat.max(1), best, rays as f64 / best / 1e6);
+    println!(
+        "teapot {}x{} golden primary rays, {} thread(s): best of {}: {:.3} s, {:.2} Mrays/s",
+        a.size.0,
+        a.size.1,
+        a.threads,
+        a.repeat.max(1),
+        best,
+        rays as f64 / best / 1e6
+    );
     Ok(())
 }
 
@@ -151,7 +177,10 @@ fn run_scene(a: SceneArgs) -> Result<()> {
     }
     files.push((a.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).into_bytes()));
     let json = scene::report::scene_json(&scene, &roms);
-    files.push((a.out.join("scene.json"), (serde_json::to_string_pretty(&json).unwrap_or_default() + "\n").into_bytes()));
+    files.push((
+        a.out.join("scene.json"),
+        (serde_json::to_string_pretty(&json).unwrap_or_default() + "\n").into_bytes(),
+    ));
     fxrt::io::write_all_atomic(&files)?;
     if a.stats {
         print!("{}", scene::report::stats_text(&scene));
@@ -172,7 +201,14 @@ fn run_scene(a: SceneArgs) -> Result<()> {
 
 /// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
 fn intersect_params(params: &fxrt::params::Params, scene: &Scene, hw: &fxrt::cli::HwArgs) -> Result<IntersectParams> {
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: hw.tag_width, div_bits: hw.div_bits };
+    let p = IntersectParams {
+        n: params.n,
+        m: params.m,
+        t: params.t,
+        e: scene.edge_shift,
+        tag_width: hw.tag_width,
+        div_bits: hw.div_bits,
+    };
     p.check()?;
     Ok(p)
 }
@@ -181,10 +217,11 @@ fn run_gen(a: GenArgs) -> Result<()> {
     let params = a.params.params()?;
     let scene = Scene::load(&a.scene.source(), &params)?;
     let p = intersect_params(&params, &scene, &a.hw)?;
-    let files: Vec<(std::path::PathBuf, Vec<u8>)> = fxrt::flow::generate::files(&p, a.lang.contains(&Lang::Vhdl), a.lang.contains(&Lang::Verilog))
-        .into_iter()
-        .map(|(n, t)| (a.out.join(n), t.into_bytes()))
-        .collect();
+    let files: Vec<(std::path::PathBuf, Vec<u8>)> =
+        fxrt::flow::generate::files(&p, a.lang.contains(&Lang::Vhdl), a.lang.contains(&Lang::Verilog))
+            .into_iter()
+            .map(|(n, t)| (a.out.join(n), t.into_bytes()))
+            .collect();
     fxrt::io::write_all_atomic(&files)?;
     println!("{} (latency {} cycles) and its divider written to {}", p.name(), p.latency(), a.out.display());
     Ok(())
@@ -245,6 +282,9 @@ fn run_synth(a: SynthArgs) -> Result<()> {
         cores.push(serde_json::json!({ "latency_cycles": latency, "area": area }));
     }
     let thesis = serde_json::json!({ "note": "whole design of seed 001 table 3.2 (BIH + intersection + ray generator), XST", "luts": 5278, "registers": 3274, "dsp48e": 52, "bram18": 22 });
-    println!("{}", serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "params": p, "cores": cores, "thesis": thesis }));
+    println!(
+        "{}",
+        serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "params": p, "cores": cores, "thesis": thesis })
+    );
     Ok(())
 }

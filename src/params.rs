@@ -106,14 +106,27 @@ impl Params {
         if 2 * self.n + 1 + f > MODEL_BITS {
             return Err(Error::param(
                 "m",
-                format!("{} with --n {} needs 2n+m = {} bits; the limit is {}", self.m, self.n, 2 * self.n + self.m, MODEL_BITS),
+                format!(
+                    "{} with --n {} needs 2n+m = {} bits; the limit is {}",
+                    self.m,
+                    self.n,
+                    2 * self.n + self.m,
+                    MODEL_BITS
+                ),
             ));
         }
         // BIH plane distance: (P − O) · inv with n+1 and m+C bits.
         if self.n + 1 + self.m + self.c > MODEL_BITS {
             return Err(Error::param(
                 "c",
-                format!("{} with --n {} --m {} needs n+m+C+1 = {} bits; the limit is {}", self.c, self.n, self.m, self.n + self.m + self.c + 1, MODEL_BITS),
+                format!(
+                    "{} with --n {} --m {} needs n+m+C+1 = {} bits; the limit is {}",
+                    self.c,
+                    self.n,
+                    self.m,
+                    self.n + self.m + self.c + 1,
+                    MODEL_BITS
+                ),
             ));
         }
         // The denominator has m+2 bits; dropping T ≥ m−1 of them leaves nothing to divide by.

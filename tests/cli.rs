@@ -15,7 +15,20 @@ fn stderr(o: &Output) -> String {
 fn render_writes_ids_and_depth_of_the_documented_size() {
     let dir = tempfile::tempdir().unwrap();
     let (ids, depth, png) = (dir.path().join("i.bin"), dir.path().join("d.bin"), dir.path().join("p.png"));
-    let o = fxrt(&["render", "--builtin", "cornell", "--size", "40x30", "--ids", ids.to_str().unwrap(), "--depth", depth.to_str().unwrap(), "--png", png.to_str().unwrap(), "--shade"]);
+    let o = fxrt(&[
+        "render",
+        "--builtin",
+        "cornell",
+        "--size",
+        "40x30",
+        "--ids",
+        ids.to_str().unwrap(),
+        "--depth",
+        depth.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--shade",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let line = String::from_utf8_lossy(&o.stdout);
     assert!(line.starts_with("rays: ") && line.contains("Mrays/s"), "{line}");
@@ -38,16 +51,44 @@ fn render_writes_ids_and_depth_of_the_documented_size() {
 fn scene_output_is_complete_and_byte_identical_across_runs() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     for d in [&a, &b] {
-        let o = fxrt(&["scene", "--builtin", "random", "--out", d.path().to_str().unwrap(), "--n", "23", "--m", "27", "--stats"]);
+        let o = fxrt(&[
+            "scene",
+            "--builtin",
+            "random",
+            "--out",
+            d.path().to_str().unwrap(),
+            "--n",
+            "23",
+            "--m",
+            "27",
+            "--stats",
+        ]);
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(String::from_utf8_lossy(&o.stdout).contains("edge components"));
     }
-    let mut names: Vec<String> = std::fs::read_dir(a.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    let mut names: Vec<String> =
+        std::fs::read_dir(a.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     names.sort();
-    let want = ["fxrt_scene_pkg.vhd", "leaf.coe", "leaf.hex", "leaf.mem", "node.coe", "node.hex", "node.mem", "scene.json", "tri.coe", "tri.hex", "tri.mem"];
+    let want = [
+        "fxrt_scene_pkg.vhd",
+        "leaf.coe",
+        "leaf.hex",
+        "leaf.mem",
+        "node.coe",
+        "node.hex",
+        "node.mem",
+        "scene.json",
+        "tri.coe",
+        "tri.hex",
+        "tri.mem",
+    ];
     assert_eq!(names, want);
     for n in want {
-        assert_eq!(std::fs::read(a.path().join(n)).unwrap(), std::fs::read(b.path().join(n)).unwrap(), "{n} differs between runs");
+        assert_eq!(
+            std::fs::read(a.path().join(n)).unwrap(),
+            std::fs::read(b.path().join(n)).unwrap(),
+            "{n} differs between runs"
+        );
     }
     let json: serde_json::Value = serde_json::from_slice(&std::fs::read(a.path().join("scene.json")).unwrap()).unwrap();
     assert_eq!(json["triangles"]["input"], 2000);
@@ -103,7 +144,11 @@ fn bad_input_is_exit_2_with_one_line_and_no_output() {
     assert_rejected(&["render", "--builtin", "teapot", "--t", "31", "--png", png_s], "--t", &png);
     assert_rejected(&["render", "--builtin", "teapot", "--m", "64", "--n", "40", "--png", png_s], "--m", &png);
     assert_rejected(&["render", "--builtin", "nosuch", "--png", png_s], "--builtin", &png);
-    assert_rejected(&["render", "--builtin", "teapot", "--eye", "0,0,0", "--at", "0,0,0", "--png", png_s], "--at", &png);
+    assert_rejected(
+        &["render", "--builtin", "teapot", "--eye", "0,0,0", "--at", "0,0,0", "--png", png_s],
+        "--at",
+        &png,
+    );
     assert_rejected(&["render", "--builtin", "teapot", "--threads", "0", "--png", png_s], "--threads", &png);
     assert_rejected(&["render", "--builtin", "teapot", "--size", "0x4", "--png", png_s], "--size", &png);
     assert_rejected(&["render", "--builtin", "teapot", "--edge-shift", "-3", "--png", png_s], "--edge-shift", &png);

@@ -33,7 +33,8 @@ fn exact(v: &[GridVertex; 3], o: [i64; 3], w: [i64; 3], f: u32) -> Option<(f64, 
 fn golden_for(e: u32) -> Golden {
     // A scene only supplies widths and the box; the triangles under test are quantised here.
     let tri = vec![[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 1.0]]];
-    let scene = Scene::build("box", tri, &Params { n: N, m: 32, edge_shift: EdgeShift::Fixed(e), ..Params::default() }).unwrap();
+    let scene = Scene::build("box", tri, &Params { n: N, m: 32, edge_shift: EdgeShift::Fixed(e), ..Params::default() })
+        .unwrap();
     Golden::new(&scene)
 }
 

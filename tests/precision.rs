@@ -38,7 +38,10 @@ fn secondary_rays_never_hit_their_own_triangle() {
                 let Some(q) = quantize_ray(&scene, g, &ray) else { continue };
                 let Some(hit) = g.trace(&scene, &q.ray).0 else { continue };
                 let w = scene.world[scene.tri_ids[hit.tri as usize] as usize];
-                let n = fxrt::model::ray::normalize(fxrt::model::ray::cross(fxrt::model::ray::sub(w[1], w[0]), fxrt::model::ray::sub(w[2], w[0])));
+                let n = fxrt::model::ray::normalize(fxrt::model::ray::cross(
+                    fxrt::model::ray::sub(w[1], w[0]),
+                    fxrt::model::ray::sub(w[2], w[0]),
+                ));
                 let k = 2.0 * dot(ray.d, n);
                 let reflected: [f64; 3] = std::array::from_fn(|i| ray.d[i] - k * n[i]);
                 for dir in [reflected, ray.d] {
@@ -58,7 +61,11 @@ fn secondary_rays_never_hit_their_own_triangle() {
 
 #[test]
 fn early_out_gives_the_hardware_traversal_answer_bit_for_bit() {
-    for params in [Params::default(), Params { n: 16, m: 16, ..Params::default() }, Params { n: 23, m: 27, t: 5, ..Params::default() }] {
+    for params in [
+        Params::default(),
+        Params { n: 16, m: 16, ..Params::default() },
+        Params { n: 23, m: 27, t: 5, ..Params::default() },
+    ] {
         for scene in common::all_scenes(&params).into_iter().take(5) {
             let g = Golden::new(&scene);
             let cam = Camera::default_for(&scene, 96, 96);

@@ -3,10 +3,10 @@
 //! simulator that is not installed is reported as skipped.
 
 use fxrt::flow::simulators::Simulator;
-use std::io::Write;
 use fxrt::flow::testbench::{Stimulus, record, render};
 use fxrt::rtl::emit::{verilog, vhdl};
 use fxrt::rtl::{BinOp, Module, Ty, UnOp};
+use std::io::Write;
 
 fn all_ops() -> Module {
     let mut m = Module::new("ops_check");
@@ -17,17 +17,38 @@ fn all_ops() -> Module {
     let sel = m.input("sel", Ty::BIT);
     let wide = m.input("wide", Ty::s(70));
     let out = |m: &mut Module, name: &str, s| m.output(name, s);
-    for (name, op) in [("add", BinOp::Add), ("sub", BinOp::Sub), ("and", BinOp::And), ("or", BinOp::Or), ("xor", BinOp::Xor), ("mul", BinOp::Mul), ("eq", BinOp::Eq), ("lt", BinOp::Lt), ("le", BinOp::Le), ("ne", BinOp::Ne)] {
+    for (name, op) in [
+        ("add", BinOp::Add),
+        ("sub", BinOp::Sub),
+        ("and", BinOp::And),
+        ("or", BinOp::Or),
+        ("xor", BinOp::Xor),
+        ("mul", BinOp::Mul),
+        ("eq", BinOp::Eq),
+        ("lt", BinOp::Lt),
+        ("le", BinOp::Le),
+        ("ne", BinOp::Ne),
+    ] {
         let s = m.bin(&format!("{name}_s"), op, a, b);
         out(&mut m, &format!("o_{name}_s"), s);
         let u = m.bin(&format!("{name}_u"), op, c, d);
         out(&mut m, &format!("o_{name}_u"), u);
     }
-    for (name, op) in [("not", UnOp::Not), ("neg", UnOp::Neg), ("shl", UnOp::Shl(3)), ("shr", UnOp::Shr(5)), ("slice", UnOp::Slice { lsb: 2, width: 6 }), ("grow", UnOp::Resize(20)), ("shrink", UnOp::Resize(9)), ("cast", UnOp::AsUnsigned)] {
+    for (name, op) in [
+        ("not", UnOp::Not),
+        ("neg", UnOp::Neg),
+        ("shl", UnOp::Shl(3)),
+        ("shr", UnOp::Shr(5)),
+        ("slice", UnOp::Slice { lsb: 2, width: 6 }),
+        ("grow", UnOp::Resize(20)),
+        ("shrink", UnOp::Resize(9)),
+        ("cast", UnOp::AsUnsigned),
+    ] {
         let s = m.un(&format!("{name}_s"), op, a);
         out(&mut m, &format!("o_{name}_s"), s);
     }
-    for (name, op) in [("neg", UnOp::Neg), ("shr", UnOp::Shr(2)), ("grow", UnOp::Resize(11)), ("cast", UnOp::AsSigned)] {
+    for (name, op) in [("neg", UnOp::Neg), ("shr", UnOp::Shr(2)), ("grow", UnOp::Resize(11)), ("cast", UnOp::AsSigned)]
+    {
         let u = m.un(&format!("{name}_u"), op, c);
         out(&mut m, &format!("o_{name}_u"), u);
     }
@@ -69,7 +90,10 @@ fn stimuli(n: usize) -> Vec<Stimulus> {
             let a = (next() % 8192) as i128 - 4096;
             let b = if i % 7 == 0 { a } else { (next() % 8192) as i128 - 4096 };
             let wide = ((next() as i128) << 5) ^ (next() as i128 & 0x1f);
-            Stimulus { reset: i == 3, inputs: vec![a, b, (next() % 128) as i128, (next() % 128) as i128, (next() % 2) as i128, wide] }
+            Stimulus {
+                reset: i == 3,
+                inputs: vec![a, b, (next() % 128) as i128, (next() % 128) as i128, (next() % 2) as i128, wide],
+            }
         })
         .collect()
 }
@@ -95,7 +119,8 @@ fn rust_ghdl_iverilog_and_verilator_agree_on_every_operator() {
             let _ = writeln!(std::io::stderr().lock(), "skipped: {} is not installed", sim.name());
             continue;
         }
-        let sources: &[&str] = if sim == Simulator::Ghdl { &["ops_check.vhd", "tb.vhd"] } else { &["ops_check.v", "tb.v"] };
+        let sources: &[&str] =
+            if sim == Simulator::Ghdl { &["ops_check.vhd", "tb.vhd"] } else { &["ops_check.v", "tb.v"] };
         let (passed, failed) = sim.run(dir.as_path(), sources, &files.tb_name).unwrap_or_else(|e| panic!("{e}"));
         eprintln!("{}: {passed} passed, {failed} failed", sim.name());
         assert_eq!((passed, failed), (400, 0), "{}", sim.name());
@@ -110,14 +135,20 @@ fn printers_are_deterministic_and_lint_clean() {
     assert_eq!(vhdl::print(&m), vhdl::print(&all_ops()));
     assert_eq!(verilog::print(&m), verilog::print(&all_ops()));
     let v = verilog::print(&m);
-    assert!(!v.contains('$') || v.matches('$').count() == v.matches("$signed").count() + v.matches("$unsigned").count());
+    assert!(
+        !v.contains('$') || v.matches('$').count() == v.matches("$signed").count() + v.matches("$unsigned").count()
+    );
     if !Simulator::Verilator.available() {
         let _ = writeln!(std::io::stderr().lock(), "skipped: verilator is not installed");
         return;
     }
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("ops_check.v"), &v).unwrap();
-    let out = std::process::Command::new("verilator").args(["--lint-only", "-Wall", "ops_check.v"]).current_dir(dir.path()).output().unwrap();
+    let out = std::process::Command::new("verilator")
+        .args(["--lint-only", "-Wall", "ops_check.v"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
     let text = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && !text.contains("%Warning"), "{text}");
 }

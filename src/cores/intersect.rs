@@ -48,7 +48,10 @@ impl IntersectParams {
             ("the u + v limit (E + m + 1)", self.e + f + 2, "edge-shift"),
         ] {
             if bits > max {
-                return Err(Error::param(param, format!("{what} needs {bits} bits; the RTL layer holds at most {max}")));
+                return Err(Error::param(
+                    param,
+                    format!("{what} needs {bits} bits; the RTL layer holds at most {max}"),
+                ));
             }
         }
         if !(1..=2).contains(&self.div_bits) {
@@ -169,8 +172,11 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let dmo = m.sub("d_minus_or", d_w, o_r_w);
     let kp0 = m.sub("kp_base", o_p_s, pp_s);
     let kq0 = m.sub("kq_base", o_q_s, pq_s);
-    let s2: Vec<Sig> = stage(&mut m, "s2", &[onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
-    let [onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = s2[..] else { unreachable!() };
+    let s2: Vec<Sig> =
+        stage(&mut m, "s2", &[onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
+    let [onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = s2[..] else {
+        unreachable!()
+    };
     // Stage 3: num = ((d − O_r) << F) − O_p·np − O_q·nq, den = ω_r + rnd(ω_p·np + ω_q·nq, F).
     let wn = p.num_width();
     let dmo_w = m.resize("num_dmo", dmo, wn);
@@ -323,7 +329,9 @@ mod tests {
                 let o: [i64; 3] = std::array::from_fn(|k| (next() % (hi[k] as u64 + 1)) as i64);
                 let v = scene.grid_tris[ti];
                 let (b1, b2) = ((next() % 1201) as f64 / 1000.0 - 0.1, (next() % 1201) as f64 / 1000.0 - 0.1);
-                let target: [f64; 3] = std::array::from_fn(|k| v[0][k] as f64 + b1 * (v[1][k] - v[0][k]) as f64 + b2 * (v[2][k] - v[0][k]) as f64);
+                let target: [f64; 3] = std::array::from_fn(|k| {
+                    v[0][k] as f64 + b1 * (v[1][k] - v[0][k]) as f64 + b2 * (v[2][k] - v[0][k]) as f64
+                });
                 let dir: [f64; 3] = std::array::from_fn(|k| target[k] - o[k] as f64);
                 let len = dir.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
                 let w = crate::model::ray::quantize_direction(dir.map(|x| x / len), g.f);

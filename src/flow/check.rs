@@ -21,7 +21,11 @@ pub struct Outcome {
 /// Inputs of every vector, then `latency` idle cycles to drain the pipeline.
 fn stimuli(module: &Module, latency: u32, vectors: &[Vector]) -> Vec<Stimulus> {
     let width = module.inputs.len();
-    let mut v: Vec<Stimulus> = vectors.iter().enumerate().map(|(i, x)| Stimulus { reset: false, inputs: pack_inputs(tag_of(module, i), &x.tri, &x.ray) }).collect();
+    let mut v: Vec<Stimulus> = vectors
+        .iter()
+        .enumerate()
+        .map(|(i, x)| Stimulus { reset: false, inputs: pack_inputs(tag_of(module, i), &x.tri, &x.ray) })
+        .collect();
     v.extend((0..latency).map(|_| Stimulus { reset: false, inputs: vec![0; width] }));
     v
 }
@@ -60,7 +64,14 @@ pub fn run_rust(p: &IntersectParams, vectors: &[Vector]) -> Outcome {
 pub fn run_hdl(sim_kind: Simulator, p: &IntersectParams, vectors: &[Vector], dir: &Path) -> Result<Outcome> {
     let rust = run_rust(p, vectors);
     if rust.failed > 0 {
-        return Err(Error::new("rust", format!("the Rust simulation disagrees with the golden model on {} of {} vectors", rust.failed, vectors.len())));
+        return Err(Error::new(
+            "rust",
+            format!(
+                "the Rust simulation disagrees with the golden model on {} of {} vectors",
+                rust.failed,
+                vectors.len()
+            ),
+        ));
     }
     if !sim_kind.available() {
         return Err(Error::new(sim_kind.name(), "is not installed (scripts/install-deps.sh installs it)"));
@@ -75,10 +86,16 @@ pub fn run_hdl(sim_kind: Simulator, p: &IntersectParams, vectors: &[Vector], dir
         Simulator::Ghdl => ((format!("{name}.vhd"), vhdl::print(&module)), ("tb.vhd", &files.vhdl_tb)),
         _ => ((format!("{name}.v"), verilog::print(&module)), ("tb.v", &files.verilog_tb)),
     };
-    for (file, text) in [(design.0.as_str(), design.1.as_str()), (tb.0, tb.1.as_str()), ("vectors.txt", files.vectors_txt.as_str()), ("vectors.hex", files.vectors_hex.as_str())] {
+    for (file, text) in [
+        (design.0.as_str(), design.1.as_str()),
+        (tb.0, tb.1.as_str()),
+        ("vectors.txt", files.vectors_txt.as_str()),
+        ("vectors.hex", files.vectors_hex.as_str()),
+    ] {
         std::fs::write(dir.join(file), text).map_err(io)?;
     }
-    let (passed, failed) = sim_kind.run(dir, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim_kind.name(), e))?;
+    let (passed, failed) =
+        sim_kind.run(dir, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim_kind.name(), e))?;
     Ok(Outcome { passed, failed })
 }
 
@@ -99,7 +116,13 @@ pub fn bench_sims(p: &IntersectParams, vectors: &[Vector], ghdl_vectors: usize, 
     let start = std::time::Instant::now();
     let rust = run_rust(p, vectors);
     let secs = start.elapsed().as_secs_f64();
-    let mut out = vec![SimSpeed { simulator: "rust", cycles, seconds: secs, cycles_per_second: cycles as f64 / secs, all_passed: rust.failed == 0 }];
+    let mut out = vec![SimSpeed {
+        simulator: "rust",
+        cycles,
+        seconds: secs,
+        cycles_per_second: cycles as f64 / secs,
+        all_passed: rust.failed == 0,
+    }];
     let module = intersect_core(p);
     for sim in [Simulator::Verilator, Simulator::Ghdl] {
         if !sim.available() {
@@ -116,11 +139,22 @@ pub fn bench_sims(p: &IntersectParams, vectors: &[Vector], ghdl_vectors: usize, 
             Simulator::Ghdl => ((format!("{}.vhd", module.name), vhdl::print(&module)), ("tb.vhd", &files.vhdl_tb)),
             _ => ((format!("{}.v", module.name), verilog::print(&module)), ("tb.v", &files.verilog_tb)),
         };
-        for (file, text) in [(design.0.as_str(), design.1.as_str()), (tb.0, tb.1.as_str()), ("vectors.txt", files.vectors_txt.as_str()), ("vectors.hex", files.vectors_hex.as_str())] {
+        for (file, text) in [
+            (design.0.as_str(), design.1.as_str()),
+            (tb.0, tb.1.as_str()),
+            ("vectors.txt", files.vectors_txt.as_str()),
+            ("vectors.hex", files.vectors_hex.as_str()),
+        ] {
             std::fs::write(d.join(file), text).map_err(io)?;
         }
         let r = sim.run_timed(&d, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim.name(), e))?;
-        out.push(SimSpeed { simulator: sim.name(), cycles, seconds: r.seconds, cycles_per_second: cycles as f64 / r.seconds, all_passed: r.failed == 0 && r.passed == cycles });
+        out.push(SimSpeed {
+            simulator: sim.name(),
+            cycles,
+            seconds: r.seconds,
+            cycles_per_second: cycles as f64 / r.seconds,
+            all_passed: r.failed == 0 && r.passed == cycles,
+        });
     }
     Ok(out)
 }

@@ -31,7 +31,11 @@ pub fn cores(p: &IntersectParams) -> Vec<(Module, u32, Value)> {
     let div = divider_core(p.n, p.div_bits, p.num_width() - p.t, p.den_width() - p.t);
     vec![
         (ip, p.latency(), serde_json::to_value(p).unwrap_or(Value::Null)),
-        (div, divider::latency(p.n, p.div_bits), json!({ "n": p.n, "bits_per_stage": p.div_bits, "num_width": p.num_width() - p.t, "den_width": p.den_width() - p.t })),
+        (
+            div,
+            divider::latency(p.n, p.div_bits),
+            json!({ "n": p.n, "bits_per_stage": p.div_bits, "num_width": p.num_width() - p.t, "den_width": p.den_width() - p.t }),
+        ),
     ]
 }
 

@@ -56,13 +56,29 @@ impl Simulator {
                 ]
             }
             Simulator::Iverilog => {
-                let mut compile = vec!["iverilog".into(), "-g2005".into(), "-o".into(), "tb.vvp".into(), "-s".into(), tb.into()];
+                let mut compile =
+                    vec!["iverilog".into(), "-g2005".into(), "-o".into(), "tb.vvp".into(), "-s".into(), tb.into()];
                 compile.extend(sources.iter().map(|s| s.to_string()));
                 vec![compile, vec!["vvp".into(), "-n".into(), "tb.vvp".into()]]
             }
             Simulator::Verilator => {
-                let mut build: Vec<String> =
-                    ["verilator", "--binary", "--timing", "-j", "2", "-Wno-fatal", "-Wno-lint", "-Wno-style", "--top-module", tb, "-o", "tbsim"].iter().map(|s| s.to_string()).collect();
+                let mut build: Vec<String> = [
+                    "verilator",
+                    "--binary",
+                    "--timing",
+                    "-j",
+                    "2",
+                    "-Wno-fatal",
+                    "-Wno-lint",
+                    "-Wno-style",
+                    "--top-module",
+                    tb,
+                    "-o",
+                    "tbsim",
+                ]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
                 build.extend(sources.iter().map(|s| s.to_string()));
                 vec![build, vec!["./obj_dir/tbsim".into()]]
             }
@@ -87,7 +103,8 @@ impl Simulator {
                 return Err(format!("{}: `{}` failed:\n{}", self.name(), step.join(" "), tail.join("\n")));
             }
         }
-        let (passed, failed) = parse_summary(&last).ok_or_else(|| format!("{}: no 'N passed, N failed' line in:\n{last}", self.name()))?;
+        let (passed, failed) =
+            parse_summary(&last).ok_or_else(|| format!("{}: no 'N passed, N failed' line in:\n{last}", self.name()))?;
         Ok(RunResult { passed, failed, seconds })
     }
 }

@@ -53,7 +53,8 @@ pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
     std::fs::create_dir_all(dir).map_err(io)?;
     let file = format!("{}.v", m.name);
     std::fs::write(dir.join(&file), verilog::print(m)).map_err(io)?;
-    let script = format!("read_verilog {file}; synth_xilinx -family xc5v -top {}; tee -q -o stat.json stat -json", m.name);
+    let script =
+        format!("read_verilog {file}; synth_xilinx -family xc5v -top {}; tee -q -o stat.json stat -json", m.name);
     let out = Command::new("yosys")
         .args(["-q", "-l", "yosys.log", "-p", &script])
         .current_dir(dir)
@@ -63,7 +64,8 @@ pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
         return Err(Error::new("yosys", format!("synthesis failed, see {}", dir.join("yosys.log").display())));
     }
     let text = std::fs::read_to_string(dir.join("stat.json")).map_err(io)?;
-    let stat: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("stat.json"), e.to_string()))?;
+    let stat: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("stat.json"), e.to_string()))?;
     Ok(area_from_stat(&m.name, &stat))
 }
 

@@ -136,9 +136,10 @@ pub fn render(m: &Module, t: &Transcript) -> TestbenchFiles {
         hex.push_str(&word.hex(total_width));
         hex.push('\n');
     }
-    let vhdl_tb = VhdlTb { tb: &tb_name, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
-        .render()
-        .expect("testbench template renders");
+    let vhdl_tb =
+        VhdlTb { tb: &tb_name, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
+            .render()
+            .expect("testbench template renders");
     let verilog_tb = VerilogTb {
         tb: &tb_name,
         module: &m.name,
@@ -152,7 +153,13 @@ pub fn render(m: &Module, t: &Transcript) -> TestbenchFiles {
     }
     .render()
     .expect("testbench template renders");
-    TestbenchFiles { vhdl_tb: vhdl_tb + "\n", verilog_tb: verilog_tb + "\n", vectors_txt: txt, vectors_hex: hex, tb_name }
+    TestbenchFiles {
+        vhdl_tb: vhdl_tb + "\n",
+        verilog_tb: verilog_tb + "\n",
+        vectors_txt: txt,
+        vectors_hex: hex,
+        tb_name,
+    }
 }
 
 /// A wide word built field by field, most significant first.
@@ -171,7 +178,9 @@ mod num_word {
             let digits = width.div_ceil(4) as usize;
             let pad = digits * 4 - self.bits.len();
             let all: Vec<bool> = std::iter::repeat_n(false, pad).chain(self.bits.iter().copied()).collect();
-            all.chunks(4).map(|c| char::from_digit(c.iter().fold(0, |a, &b| a * 2 + b as u32), 16).unwrap_or('0')).collect()
+            all.chunks(4)
+                .map(|c| char::from_digit(c.iter().fold(0, |a, &b| a * 2 + b as u32), 16).unwrap_or('0'))
+                .collect()
         }
     }
 }

@@ -5,8 +5,8 @@
 use crate::model::golden::{Golden, GridRay, TriHit};
 use crate::model::ray::{quantize_direction, quantize_ray};
 use crate::render::camera::Camera;
-use crate::scene::Scene;
 use crate::rng::SplitMix64;
+use crate::scene::Scene;
 use crate::scene::accel::AccelTri;
 
 /// One pipeline input and the golden answer.
@@ -24,7 +24,8 @@ fn vector(g: &Golden, tri: &AccelTri, ray: GridRay) -> Vector {
 /// A ray from `o` towards barycentric point (b1, b2) of table triangle `ti`.
 fn aimed(scene: &Scene, g: &Golden, ti: usize, o: [i64; 3], b1: f64, b2: f64) -> Option<GridRay> {
     let v = scene.grid_tris[ti];
-    let target: [f64; 3] = std::array::from_fn(|k| v[0][k] as f64 + b1 * (v[1][k] - v[0][k]) as f64 + b2 * (v[2][k] - v[0][k]) as f64);
+    let target: [f64; 3] =
+        std::array::from_fn(|k| v[0][k] as f64 + b1 * (v[1][k] - v[0][k]) as f64 + b2 * (v[2][k] - v[0][k]) as f64);
     let d: [f64; 3] = std::array::from_fn(|k| target[k] - o[k] as f64);
     let len = d.iter().map(|x| x * x).sum::<f64>().sqrt();
     if len < 1.0 {
@@ -81,7 +82,14 @@ pub fn generate(scene: &Scene, count: usize, seed: u64) -> Vec<Vector> {
         k += 1;
         let ray = match case {
             // Exactly at a vertex or along an edge: u, v or u + v on the boundary.
-            0 => aimed(scene, &g, ti, [rng.below(top[0] as u64) as i64, rng.below(top[1] as u64) as i64, rng.below(top[2] as u64) as i64], [0.0, 1.0, 0.0][rng.below(3) as usize], 0.0),
+            0 => aimed(
+                scene,
+                &g,
+                ti,
+                [rng.below(top[0] as u64) as i64, rng.below(top[1] as u64) as i64, rng.below(top[2] as u64) as i64],
+                [0.0, 1.0, 0.0][rng.below(3) as usize],
+                0.0,
+            ),
             1 => aimed(scene, &g, ti, [0, 0, 0], 0.5, 0.5),
             2 => {
                 let t = rng.next_f64();
@@ -111,7 +119,10 @@ pub fn generate(scene: &Scene, count: usize, seed: u64) -> Vec<Vector> {
             // Origin on the triangle's plane (t = 0) or one unit off it (t near 1).
             6 => {
                 let o = v[0];
-                let w = quantize_direction([rng.next_f64() - 0.5, rng.next_f64() - 0.5, rng.next_f64() - 0.5].map(|x| x * 2.0), f);
+                let w = quantize_direction(
+                    [rng.next_f64() - 0.5, rng.next_f64() - 0.5, rng.next_f64() - 0.5].map(|x| x * 2.0),
+                    f,
+                );
                 Some(g.ray(o, w))
             }
             _ => {

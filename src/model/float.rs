@@ -65,11 +65,7 @@ fn sub3<F: Real>(a: [F; 3], b: [F; 3]) -> [F; 3] {
 }
 
 fn cross<F: Real>(a: [F; 3], b: [F; 3]) -> [F; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Smallest index of the largest |a_k| (ties go to the lower axis, as in the integer design).
@@ -78,8 +74,7 @@ fn argmax_abs<F: Real>(a: [F; 3]) -> usize {
 }
 
 fn max_abs<F: Real>(a: [F; 3]) -> F {
-    a.iter()
-        .fold(F::zero(), |m, x| if x.abs() > m { x.abs() } else { m })
+    a.iter().fold(F::zero(), |m, x| if x.abs() > m { x.abs() } else { m })
 }
 
 /// Badouel/Wald accelerated triangle: the plane and the edges are stored
@@ -173,12 +168,7 @@ fn gamma(n: f32) -> f32 {
 /// 0 < t < t_max are reported (t is conservatively required to exceed its
 /// rounding error bound). Returns Some((t, b0, b1, b2)) with barycentrics of
 /// v0, v1, v2.
-pub fn watertight_f32(
-    o: [f32; 3],
-    d: [f32; 3],
-    v: [[f32; 3]; 3],
-    t_max: f32,
-) -> Option<(f32, f32, f32, f32)> {
+pub fn watertight_f32(o: [f32; 3], d: [f32; 3], v: [[f32; 3]; 3], t_max: f32) -> Option<(f32, f32, f32, f32)> {
     // Ray space: origin at 0, the dominant direction axis becomes z. The
     // permutation is cyclic so handedness (and thus edge signs) is preserved.
     let kz = argmax_abs(d);
@@ -209,9 +199,7 @@ pub fn watertight_f32(
         // A 0.0 may be a tiny value lost to rounding. A product of two f32 is
         // exact in f64, so the f64 difference is rounded only once and has the
         // true sign.
-        let edge64 = |a: [f32; 3], b: [f32; 3]| {
-            (a[0] as f64 * b[1] as f64 - a[1] as f64 * b[0] as f64) as f32
-        };
+        let edge64 = |a: [f32; 3], b: [f32; 3]| (a[0] as f64 * b[1] as f64 - a[1] as f64 * b[0] as f64) as f32;
         e = [edge64(p[1], p[2]), edge64(p[2], p[0]), edge64(p[0], p[1])];
     }
     let any_neg = e.iter().any(|&x| x < 0.0);
@@ -248,8 +236,7 @@ pub fn watertight_f32(
     let delta_y = gamma(5.0) * (max_y + max_z);
     let delta_e = 2.0 * (gamma(2.0) * max_x * max_y + delta_y * max_x + delta_x * max_y);
     let max_e = max_abs(e);
-    let delta_t =
-        3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+    let delta_t = 3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
     (t > delta_t && t < t_max).then(|| (t, e[0] * inv_det, e[1] * inv_det, e[2] * inv_det))
 }
 
@@ -258,14 +245,7 @@ pub fn watertight_f32(
 /// Axes with an infinite `inv_d` (ray parallel to the slab) are decided by the
 /// origin's position, since (lo − o)·inv_d would be 0·∞ = NaN when o lies on
 /// the slab plane.
-pub fn ray_box<F: Real>(
-    o: [F; 3],
-    inv_d: [F; 3],
-    lo: [F; 3],
-    hi: [F; 3],
-    t_min: F,
-    t_max: F,
-) -> Option<(F, F)> {
+pub fn ray_box<F: Real>(o: [F; 3], inv_d: [F; 3], lo: [F; 3], hi: [F; 3], t_min: F, t_max: F) -> Option<(F, F)> {
     let (mut t0, mut t1) = (t_min, t_max);
     for k in 0..3 {
         if inv_d[k].abs() == F::infinity() {
@@ -552,11 +532,7 @@ mod tests {
             if !hit(t1) && !hit(t2) {
                 cracks += 1;
             }
-            let wald = |t| {
-                FloatTri::new(t)
-                    .and_then(|f| f.intersect(o, w, 0.0, INF32))
-                    .is_some()
-            };
+            let wald = |t| FloatTri::new(t).and_then(|f| f.intersect(o, w, 0.0, INF32)).is_some();
             if !wald(t1) && !wald(t2) {
                 wald_cracks += 1;
             }

@@ -89,7 +89,11 @@ impl Golden {
         let w = if w == 0 { 1 } else { w };
         let lim = (1i128 << (m_plus_c - 1)) - 1;
         // Truncating division is the same in i64 when 2^(F+C) fits (and skips __divti3).
-        let q = if self.f + self.c <= 62 { ((1i64 << (self.f + self.c)) / w) as i128 } else { (1i128 << (self.f + self.c)) / w as i128 };
+        let q = if self.f + self.c <= 62 {
+            ((1i64 << (self.f + self.c)) / w) as i128
+        } else {
+            (1i128 << (self.f + self.c)) / w as i128
+        };
         q.clamp(-lim, lim)
     }
 
@@ -146,10 +150,7 @@ impl Golden {
 
     /// Exit distance of the scene box (the ray origin is inside it).
     pub fn box_exit(&self, ray: &GridRay) -> i64 {
-        (0..3)
-            .map(|k| self.plane_t(ray, k, if ray.inv[k] < 0 { 0 } else { self.box_hi[k] }))
-            .min()
-            .unwrap_or(-1)
+        (0..3).map(|k| self.plane_t(ray, k, if ray.inv[k] < 0 { 0 } else { self.box_hi[k] })).min().unwrap_or(-1)
     }
 
     /// BIH traversal in the hardware FSM's order: near child first, far child pushed; every
@@ -404,7 +405,8 @@ impl FastScene {
         for node in &bih.nodes {
             nodes.push(match *node {
                 Node::Inner { axis, clip0, clip1, child } => {
-                    let ok = axis < 3 && (child as usize) + 1 < count && [clip0, clip1].iter().all(|c| (0..b).contains(c));
+                    let ok =
+                        axis < 3 && (child as usize) + 1 < count && [clip0, clip1].iter().all(|c| (0..b).contains(c));
                     ok.then_some(FastNode { clips: [clip0, clip1], link: child, kind: axis as u32 })?
                 }
                 Node::Leaf { first, count } => {
@@ -505,7 +507,9 @@ impl Golden {
                 let uv_max = 1u64.checked_shl(self.e + self.f).unwrap_or(u64::MAX);
                 let tris = &fs.tris[nd.link as usize..(nd.link + nd.kind - LEAF) as usize];
                 for ft in tris {
-                    let Some(h) = self.intersect_narrow(&ft.tri, nr, lo, best_t.min(self.t_sat - 1), uv_max) else { continue };
+                    let Some(h) = self.intersect_narrow(&ft.tri, nr, lo, best_t.min(self.t_sat - 1), uv_max) else {
+                        continue;
+                    };
                     if best.is_none_or(|b| (h.t, ft.id) < (b.t, b.tri)) {
                         best = Some(Hit { tri: ft.id, t: h.t, u: h.u, v: h.v });
                         (best_t, prune_above) = (h.t, prune_limit(h.t));
@@ -557,8 +561,19 @@ mod tests {
     /// Width sets at the edges of `narrow_widths` (n, m), with T, C and E drawn to fit.
     fn widths() -> impl Strategy<Value = Golden> {
         prop_oneof![Just((29u32, 32u32)), Just((40, 21)), Just((4, 8)), Just((30, 31)), Just((16, 16)), Just((33, 28))]
-            .prop_flat_map(|(n, m)| (Just(n), Just(m), 0..=m - 2, 0..=(64 - m).min(62 - n), 0..=(125 - n - (m - 1)).min(120)))
-            .prop_map(|(n, m, t, c, e)| Golden { n, f: m - 1, t, c, e, box_hi: [(1 << n) - 1; 3], t_sat: 1 << (n + 1), fast: None })
+            .prop_flat_map(|(n, m)| {
+                (Just(n), Just(m), 0..=m - 2, 0..=(64 - m).min(62 - n), 0..=(125 - n - (m - 1)).min(120))
+            })
+            .prop_map(|(n, m, t, c, e)| Golden {
+                n,
+                f: m - 1,
+                t,
+                c,
+                e,
+                box_hi: [(1 << n) - 1; 3],
+                t_sat: 1 << (n + 1),
+                fast: None,
+            })
     }
 
     proptest! {

@@ -143,12 +143,21 @@ impl NarrowRay {
 /// the box; false (and no call) unless the CPU has AVX-512 (F, DQ), F + C ≤ 50 (for the
 /// reciprocal) and the rays are eight, with finite origins and directions and no zero
 /// direction component.
-pub(crate) fn quantize_ray8(scene: &Scene, g: &Golden, rays: &[WorldRay], inside: &mut impl FnMut(usize, QuantizedRay)) -> bool {
+pub(crate) fn quantize_ray8(
+    scene: &Scene,
+    g: &Golden,
+    rays: &[WorldRay],
+    inside: &mut impl FnMut(usize, QuantizedRay),
+) -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
         let cpu = is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512dq");
-        if cpu && g.f + g.c <= 50 && rays.len() == 8 && rays.iter().all(|r| finite(&r.o) && finite(&r.d) && !r.d.contains(&0.0)) {
+        if cpu
+            && g.f + g.c <= 50
+            && rays.len() == 8
+            && rays.iter().all(|r| finite(&r.o) && finite(&r.d) && !r.d.contains(&0.0))
+        {
             // SAFETY: the CPU has AVX-512F and DQ (checked above).
             unsafe { avx512::quantize_ray8(scene, g, rays, inside) };
             return true;
@@ -171,7 +180,12 @@ mod avx512 {
     /// to a t ≥ 1). Rounding clamps to ±2^62 first, where `round_i64` and the clamp to the box
     /// agree; the reciprocal is `div_floor`'s f64 quotient, exact for 2^(F+C) ≤ 2^50.
     #[target_feature(enable = "avx512f,avx512dq")]
-    pub(super) fn quantize_ray8(scene: &Scene, g: &Golden, rays: &[WorldRay], inside: &mut impl FnMut(usize, QuantizedRay)) {
+    pub(super) fn quantize_ray8(
+        scene: &Scene,
+        g: &Golden,
+        rays: &[WorldRay],
+        inside: &mut impl FnMut(usize, QuantizedRay),
+    ) {
         let (mut org, mut dir) = ([[0.0; 8]; 3], [[0.0; 8]; 3]);
         for (l, r) in rays.iter().enumerate() {
             for k in 0..3 {
@@ -182,7 +196,8 @@ mod avx512 {
         let (org, d): ([__m512d; 3], [__m512d; 3]) = unsafe { std::mem::transmute((org, dir)) };
         let splat = _mm512_set1_pd;
         let (tf, hi_i) = (&scene.transform, scene.grid_box.hi);
-        let o: [__m512d; 3] = std::array::from_fn(|k| _mm512_mul_pd(_mm512_sub_pd(org[k], splat(tf.min[k])), splat(tf.scale)));
+        let o: [__m512d; 3] =
+            std::array::from_fn(|k| _mm512_mul_pd(_mm512_sub_pd(org[k], splat(tf.min[k])), splat(tf.scale)));
         let (mut t0, mut t1) = (splat(0.0), splat(f64::INFINITY));
         for k in 0..3 {
             let a = _mm512_div_pd(_mm512_sub_pd(splat(0.0), o[k]), d[k]);
@@ -196,17 +211,26 @@ mod avx512 {
             let i = _mm512_cvttpd_epi64(x);
             let frac = _mm512_sub_pd(x, _mm512_cvtepi64_pd(i));
             let up = _mm512_maskz_mov_epi64(_mm512_cmp_pd_mask::<_CMP_GE_OQ>(frac, splat(0.5)), _mm512_set1_epi64(1));
-            let down = _mm512_maskz_mov_epi64(_mm512_cmp_pd_mask::<_CMP_LE_OQ>(frac, splat(-0.5)), _mm512_set1_epi64(1));
+            let down =
+                _mm512_maskz_mov_epi64(_mm512_cmp_pd_mask::<_CMP_LE_OQ>(frac, splat(-0.5)), _mm512_set1_epi64(1));
             _mm512_sub_epi64(_mm512_add_epi64(i, up), down)
         };
-        let clamp = |x: __m512i, lo: i64, hi: i64| _mm512_min_epi64(_mm512_max_epi64(x, _mm512_set1_epi64(lo)), _mm512_set1_epi64(hi));
-        let origin: [__m512i; 3] = std::array::from_fn(|k| clamp(round(_mm512_add_pd(o[k], _mm512_mul_pd(t0, d[k]))), 0, hi_i[k]));
+        let clamp = |x: __m512i, lo: i64, hi: i64| {
+            _mm512_min_epi64(_mm512_max_epi64(x, _mm512_set1_epi64(lo)), _mm512_set1_epi64(hi))
+        };
+        let origin: [__m512i; 3] =
+            std::array::from_fn(|k| clamp(round(_mm512_add_pd(o[k], _mm512_mul_pd(t0, d[k]))), 0, hi_i[k]));
         let lim = (1i64 << g.f) - 1;
-        let w: [__m512i; 3] = std::array::from_fn(|k| clamp(round(_mm512_mul_pd(d[k], splat((1u64 << g.f) as f64))), -lim, lim));
+        let w: [__m512i; 3] =
+            std::array::from_fn(|k| clamp(round(_mm512_mul_pd(d[k], splat((1u64 << g.f) as f64))), -lim, lim));
         // reciprocal: ω = 0 as +1, trunc(2^s / ω) = sign(ω)·floor(2^s / |ω|), saturated.
         let (s, lim_inv) = (1i64 << (g.f + g.c), (1i64 << (g.f + g.c)) - 1);
         let inv: [__m512i; 3] = std::array::from_fn(|k| {
-            let w = _mm512_mask_mov_epi64(w[k], _mm512_cmpeq_epi64_mask(w[k], _mm512_setzero_si512()), _mm512_set1_epi64(1));
+            let w = _mm512_mask_mov_epi64(
+                w[k],
+                _mm512_cmpeq_epi64_mask(w[k], _mm512_setzero_si512()),
+                _mm512_set1_epi64(1),
+            );
             let a = _mm512_abs_epi64(w);
             let q = _mm512_cvttpd_epi64(_mm512_div_pd(splat(s as f64), _mm512_cvtepi64_pd(a)));
             let r = _mm512_sub_epi64(_mm512_set1_epi64(s), _mm512_mullo_epi64(q, a));
@@ -219,7 +243,8 @@ mod avx512 {
         let hits_box = !_mm512_cmp_pd_mask::<_CMP_GT_OQ>(t0, t1) & !(zero(w[0]) & zero(w[1]) & zero(w[2]));
         type Lanes = [[i64; 8]; 3];
         // SAFETY: as above, for i64 and f64 lanes.
-        let (origin, w, inv, t0): (Lanes, Lanes, Lanes, [f64; 8]) = unsafe { std::mem::transmute((origin, w, inv, t0)) };
+        let (origin, w, inv, t0): (Lanes, Lanes, Lanes, [f64; 8]) =
+            unsafe { std::mem::transmute((origin, w, inv, t0)) };
         for l in (0..8).filter(|l| hits_box >> l & 1 == 1) {
             let ray = GridRay { o: origin.map(|v| v[l]), w: w.map(|v| v[l]), inv: inv.map(|v| v[l] as i128) };
             inside(l, QuantizedRay { ray, t_offset: t0[l] });
@@ -272,7 +297,16 @@ mod tests {
 
     #[test]
     fn round_i64_edges() {
-        let big = [2f64.powi(52) + 1.0, 2f64.powi(63), -2f64.powi(63), f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e300, -1e300];
+        let big = [
+            2f64.powi(52) + 1.0,
+            2f64.powi(63),
+            -2f64.powi(63),
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            1e300,
+            -1e300,
+        ];
         for x in [0.0, -0.0, 0.5, -0.5, 0.49999999999999994].into_iter().chain(big) {
             assert_eq!(round_i64(x), x.round() as i64, "{x}");
         }
@@ -323,9 +357,14 @@ mod tests {
                     let o = std::array::from_fn(|k| {
                         let x = (1.0 + (rand() * (scene.grid_box.hi[k] - 2) as f64).floor()) + 0.5;
                         let w = tf.min[k] + x / tf.scale;
-                        [w, w.next_up(), w.next_down()].into_iter().find(|w| (w - tf.min[k]) * tf.scale == x).unwrap_or(w)
+                        [w, w.next_up(), w.next_down()]
+                            .into_iter()
+                            .find(|w| (w - tf.min[k]) * tf.scale == x)
+                            .unwrap_or(w)
                     });
-                    let d = std::array::from_fn(|_| ((rand() * (one - 2.0)).floor() + 0.5) / one * if rand() < 0.5 { -1.0 } else { 1.0 });
+                    let d = std::array::from_fn(|_| {
+                        ((rand() * (one - 2.0)).floor() + 0.5) / one * if rand() < 0.5 { -1.0 } else { 1.0 }
+                    });
                     WorldRay { o, d }
                 })
                 .collect();
@@ -334,7 +373,11 @@ mod tests {
                 continue;
             }
             for (ray, got) in rays.iter().zip(got) {
-                assert_eq!(got.map(|q| (q.ray, q.t_offset)), quantize_ray(&scene, &g, ray).map(|q| (q.ray, q.t_offset)), "{ray:?}");
+                assert_eq!(
+                    got.map(|q| (q.ray, q.t_offset)),
+                    quantize_ray(&scene, &g, ray).map(|q| (q.ray, q.t_offset)),
+                    "{ray:?}"
+                );
                 ties += tf.to_grid_f64(ray.o).iter().filter(|x| x.fract() == 0.5).count();
             }
         }

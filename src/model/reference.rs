@@ -43,7 +43,8 @@ impl<F: Real> FloatScene<F> {
         let tf = scene.transform;
         let unit = 1.0 / tf.scale;
         let world = |k: usize, g: f64| F::from_f64(g * unit + tf.min[k]);
-        let tris: Vec<Option<FloatTri<F>>> = scene.world.iter().map(|t| FloatTri::new(t.map(|v| v.map(F::from_f64)))).collect();
+        let tris: Vec<Option<FloatTri<F>>> =
+            scene.world.iter().map(|t| FloatTri::new(t.map(|v| v.map(F::from_f64)))).collect();
         let verts32 = scene.world.iter().map(|t| t.map(|v| v.map(|x| x as f32))).collect();
         let nodes = scene
             .bih
@@ -52,7 +53,12 @@ impl<F: Real> FloatScene<F> {
             .map(|n| match *n {
                 Node::Inner { axis, clip0, clip1, child } => {
                     let a = axis as usize;
-                    FNode::Inner { axis, clip0: world(a, clip0 as f64 + 1.0), clip1: world(a, clip1 as f64 - 1.0), child }
+                    FNode::Inner {
+                        axis,
+                        clip0: world(a, clip0 as f64 + 1.0),
+                        clip1: world(a, clip1 as f64 - 1.0),
+                        child,
+                    }
                 }
                 Node::Leaf { first, count } => FNode::Leaf { first, count },
             })
@@ -78,7 +84,8 @@ impl<F: Real> FloatScene<F> {
             FloatTest::Watertight => {
                 let o32 = o.map(|x| x.to_f64() as f32);
                 let d32 = d.map(|x| x.to_f64() as f32);
-                watertight_f32(o32, d32, self.verts32[id as usize], t_max.to_f64() as f32).map(|h| F::from_f64(h.0 as f64))
+                watertight_f32(o32, d32, self.verts32[id as usize], t_max.to_f64() as f32)
+                    .map(|h| F::from_f64(h.0 as f64))
             }
         }
     }
@@ -89,7 +96,9 @@ impl<F: Real> FloatScene<F> {
         let consider = |id: u32, best: &mut Option<(u32, F)>| {
             let t_max = best.map_or(F::max_value(), |b| b.1);
             // t_max is inclusive for the tie-break, so test against a slightly larger bound.
-            if let Some(t) = self.test_tri(id, o, d, if best.is_some() { t_max + t_max.abs() * F::from_f64(1e-12) } else { t_max }) {
+            if let Some(t) =
+                self.test_tri(id, o, d, if best.is_some() { t_max + t_max.abs() * F::from_f64(1e-12) } else { t_max })
+            {
                 if best.is_none_or(|b| t < b.1 || (t == b.1 && id < b.0)) {
                     *best = Some((id, t));
                 }
@@ -125,7 +134,8 @@ impl<F: Real> FloatScene<F> {
                     } else {
                         let d0 = (clip0 - o[a]) * inv[a];
                         let d1 = (clip1 - o[a]) * inv[a];
-                        let (near, far, near_end, far_start) = if d[a] > F::zero() { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
+                        let (near, far, near_end, far_start) =
+                            if d[a] > F::zero() { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
                         let near_max = if near_end < tmax { near_end } else { tmax };
                         let far_min = if far_start > tmin { far_start } else { tmin };
                         match (tmin <= near_max, far_min <= tmax) {

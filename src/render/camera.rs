@@ -55,7 +55,14 @@ impl Camera {
             // The Cornell Program of Computer Graphics' camera: 0.035 m focal length,
             // 0.025 m film, i.e. a 39.3° field of view, looking into the open side.
             let fov_deg = 2.0 * (0.0125f64 / 0.035).atan().to_degrees();
-            return Camera { eye: [278.0, 273.0, -800.0], at: [278.0, 273.0, 0.0], up: [0.0, 1.0, 0.0], fov_deg, width, height };
+            return Camera {
+                eye: [278.0, 273.0, -800.0],
+                at: [278.0, 273.0, 0.0],
+                up: [0.0, 1.0, 0.0],
+                fov_deg,
+                width,
+                height,
+            };
         }
         Camera::framing(scene, width, height)
     }

@@ -38,13 +38,17 @@ pub fn light_position(cam: &Camera) -> [f64; 3] {
 pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, progress: bool) -> Frame {
     let (w, h) = (cam.width, cam.height);
     let light = light_position(cam);
-    let normals: Vec<[f64; 3]> = scene.world.iter().map(|t| normalize(cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect();
+    let normals: Vec<[f64; 3]> =
+        scene.world.iter().map(|t| normalize(cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect();
     let bar = if progress && (w as u64) * (h as u64) >= 1 << 18 {
         indicatif::ProgressBar::new(h as u64)
     } else {
         indicatif::ProgressBar::hidden()
     };
-    bar.set_style(indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows ({eta})").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows ({eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
     bar.set_message("render");
     let start = std::time::Instant::now();
     let pixel_rays = cam.pixel_rays();

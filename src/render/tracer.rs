@@ -2,7 +2,9 @@
 
 use crate::model::float::Real;
 use crate::model::golden::{Golden, GridRay, Hit};
-use crate::model::ray::{NarrowRay, QuantizedRay, WorldRay, dot, normalize, quantize_direction, quantize_ray, quantize_ray8, sub};
+use crate::model::ray::{
+    NarrowRay, QuantizedRay, WorldRay, dot, normalize, quantize_direction, quantize_ray, quantize_ray8, sub,
+};
 use crate::model::reference::{FloatScene, FloatTest};
 use crate::scene::Scene;
 
@@ -142,7 +144,8 @@ pub struct FloatTracer<F: Real> {
 
 impl<F: Real> FloatTracer<F> {
     pub fn new(scene: &Scene, test: FloatTest) -> Self {
-        let normals = scene.world.iter().map(|t| normalize(crate::model::ray::cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect();
+        let normals =
+            scene.world.iter().map(|t| normalize(crate::model::ray::cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect();
         FloatTracer { fs: FloatScene::new(scene, test), eps: 4.0 / scene.transform.scale, normals }
     }
 }
@@ -370,7 +373,10 @@ mod packet {
                 sp += (take_first && second.2 != 0) as usize;
                 let k = if take_first { Mask::MAX } else { 0 };
                 (node, act) = if take_first { (first.0, first.2) } else { (second.0, second.2) };
-                iv = Interval { tmin: blend(k, second.1.tmin, first.1.tmin), tmax: blend(k, second.1.tmax, first.1.tmax) };
+                iv = Interval {
+                    tmin: blend(k, second.1.tmin, first.1.tmin),
+                    tmax: blend(k, second.1.tmax, first.1.tmax),
+                };
                 continue;
             } else if act != 0 {
                 let lo = max(lower_t(iv.tmin), one);
@@ -418,7 +424,9 @@ mod packet {
         }
         let (t, id, u, v) = (to_a(best_t), to_a(best_id), to_a(best_u), to_a(best_v));
         let shr = |x: i64| x.checked_shr(g.e).unwrap_or(0);
-        std::array::from_fn(|l| (id[l] != i64::MAX).then(|| Hit { tri: id[l] as u32, t: t[l], u: shr(u[l]), v: shr(v[l]) }))
+        std::array::from_fn(|l| {
+            (id[l] != i64::MAX).then(|| Hit { tri: id[l] as u32, t: t[l], u: shr(u[l]), v: shr(v[l]) })
+        })
     }
 }
 
@@ -481,7 +489,11 @@ mod tests {
                         let q = quantize_ray(&scene, &tracer.golden, ray);
                         let want = q.and_then(|q| tracer.golden.trace(&scene, &q.ray).0);
                         assert_eq!(got, want, "{name} {params:?}");
-                        assert_eq!(tracer.primary(ray).and_then(|h| h.grid).map(|g| g.1), want, "trace_fast, {name} {params:?}");
+                        assert_eq!(
+                            tracer.primary(ray).and_then(|h| h.grid).map(|g| g.1),
+                            want,
+                            "trace_fast, {name} {params:?}"
+                        );
                         hits += want.is_some() as u32;
                     }
                 }

@@ -22,14 +22,25 @@ pub enum Def {
     Bin(BinOp, SigId, SigId),
     Un(UnOp, SigId),
     /// `sel ? t : f` with a 1-bit `sel`.
-    Mux { sel: SigId, t: SigId, f: SigId },
+    Mux {
+        sel: SigId,
+        t: SigId,
+        f: SigId,
+    },
     /// Concatenation, most significant part first; unsigned.
     Concat(Vec<SigId>),
     /// A register clocked by the module clock. `reset` is a synchronous reset value (driven
     /// by the module's `rst` input); without `enable` it loads every cycle.
-    Reg { next: Option<SigId>, enable: Option<SigId>, reset: Option<u128> },
+    Reg {
+        next: Option<SigId>,
+        enable: Option<SigId>,
+        reset: Option<u128>,
+    },
     /// A synchronous ROM read (block RAM): the word at `addr`, one cycle later.
-    RomRead { rom: usize, addr: SigId },
+    RomRead {
+        rom: usize,
+        addr: SigId,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -59,25 +70,199 @@ pub struct Module {
 /// Names no emitted identifier may take (VHDL-93 and Verilog-2001 keywords, and the ports the
 /// printers add themselves).
 const RESERVED: &[&str] = &[
-    "abs", "access", "after", "alias", "all", "and", "architecture", "array", "assert", "assign", "attribute", "begin", "block", "body",
-    "buffer", "bus", "case", "component", "configuration", "constant", "default", "disconnect", "downto", "else", "elsif", "end", "entity",
-    "exit", "file", "for", "function", "generate", "generic", "group", "guarded", "if", "impure", "in", "inertial", "initial", "inout",
-    "input", "integer", "is", "label", "library", "linkage", "literal", "loop", "map", "mod", "module", "nand", "new", "next", "nor",
-    "not", "null", "of", "on", "open", "or", "others", "out", "output", "package", "parameter", "port", "postponed", "procedure",
-    "process", "pure", "range", "record", "reg", "register", "reject", "rem", "report", "return", "rol", "ror", "select", "severity",
-    "signal", "shared", "signed", "sla", "sll", "sra", "srl", "subtype", "then", "to", "transport", "type", "unaffected", "units",
-    "until", "unsigned", "use", "variable", "wait", "when", "while", "wire", "with", "xnor", "xor", "always", "endmodule", "integer",
-    "clk", "rst", "time", "event", "force", "release", "real", "tri", "edge", "posedge", "negedge", "table", "endtable",
-    "primitive", "endprimitive", "specify", "endspecify", "task", "endtask", "endfunction", "endcase", "endgenerate", "casex",
-    "casez", "defparam", "deassign", "disable", "forever", "fork", "join", "genvar", "localparam", "repeat", "supply0",
-    "supply1", "tri0", "tri1", "triand", "trior", "trireg", "wand", "wor", "buf", "bufif0", "bufif1", "notif0", "notif1",
-    "pullup", "pulldown", "cmos", "nmos", "pmos", "rcmos", "rnmos", "rpmos", "tran", "scalared", "vectored", "small",
-    "medium", "large", "strong0", "strong1", "weak0", "weak1", "highz0", "highz1", "pull0", "pull1", "macromodule",
+    "abs",
+    "access",
+    "after",
+    "alias",
+    "all",
+    "and",
+    "architecture",
+    "array",
+    "assert",
+    "assign",
+    "attribute",
+    "begin",
+    "block",
+    "body",
+    "buffer",
+    "bus",
+    "case",
+    "component",
+    "configuration",
+    "constant",
+    "default",
+    "disconnect",
+    "downto",
+    "else",
+    "elsif",
+    "end",
+    "entity",
+    "exit",
+    "file",
+    "for",
+    "function",
+    "generate",
+    "generic",
+    "group",
+    "guarded",
+    "if",
+    "impure",
+    "in",
+    "inertial",
+    "initial",
+    "inout",
+    "input",
+    "integer",
+    "is",
+    "label",
+    "library",
+    "linkage",
+    "literal",
+    "loop",
+    "map",
+    "mod",
+    "module",
+    "nand",
+    "new",
+    "next",
+    "nor",
+    "not",
+    "null",
+    "of",
+    "on",
+    "open",
+    "or",
+    "others",
+    "out",
+    "output",
+    "package",
+    "parameter",
+    "port",
+    "postponed",
+    "procedure",
+    "process",
+    "pure",
+    "range",
+    "record",
+    "reg",
+    "register",
+    "reject",
+    "rem",
+    "report",
+    "return",
+    "rol",
+    "ror",
+    "select",
+    "severity",
+    "signal",
+    "shared",
+    "signed",
+    "sla",
+    "sll",
+    "sra",
+    "srl",
+    "subtype",
+    "then",
+    "to",
+    "transport",
+    "type",
+    "unaffected",
+    "units",
+    "until",
+    "unsigned",
+    "use",
+    "variable",
+    "wait",
+    "when",
+    "while",
+    "wire",
+    "with",
+    "xnor",
+    "xor",
+    "always",
+    "endmodule",
+    "integer",
+    "clk",
+    "rst",
+    "time",
+    "event",
+    "force",
+    "release",
+    "real",
+    "tri",
+    "edge",
+    "posedge",
+    "negedge",
+    "table",
+    "endtable",
+    "primitive",
+    "endprimitive",
+    "specify",
+    "endspecify",
+    "task",
+    "endtask",
+    "endfunction",
+    "endcase",
+    "endgenerate",
+    "casex",
+    "casez",
+    "defparam",
+    "deassign",
+    "disable",
+    "forever",
+    "fork",
+    "join",
+    "genvar",
+    "localparam",
+    "repeat",
+    "supply0",
+    "supply1",
+    "tri0",
+    "tri1",
+    "triand",
+    "trior",
+    "trireg",
+    "wand",
+    "wor",
+    "buf",
+    "bufif0",
+    "bufif1",
+    "notif0",
+    "notif1",
+    "pullup",
+    "pulldown",
+    "cmos",
+    "nmos",
+    "pmos",
+    "rcmos",
+    "rnmos",
+    "rpmos",
+    "tran",
+    "scalared",
+    "vectored",
+    "small",
+    "medium",
+    "large",
+    "strong0",
+    "strong1",
+    "weak0",
+    "weak1",
+    "highz0",
+    "highz1",
+    "pull0",
+    "pull1",
+    "macromodule",
 ];
 
 impl Module {
     pub fn new(name: &str) -> Module {
-        Module { name: name.to_string(), signals: Vec::new(), inputs: Vec::new(), outputs: Vec::new(), roms: Vec::new() }
+        Module {
+            name: name.to_string(),
+            signals: Vec::new(),
+            inputs: Vec::new(),
+            outputs: Vec::new(),
+            roms: Vec::new(),
+        }
     }
 
     pub fn sig(&self, id: SigId) -> &Signal {
@@ -91,7 +276,8 @@ impl Module {
     /// A readable, unique identifier legal in both languages: lower case, [a-z0-9_], starting
     /// with a letter, no double or trailing underscore, not a keyword.
     fn unique_name(&self, base: &str) -> String {
-        let mut s: String = base.to_ascii_lowercase().chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
+        let mut s: String =
+            base.to_ascii_lowercase().chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
         while s.contains("__") {
             s = s.replace("__", "_");
         }
@@ -102,7 +288,11 @@ impl Module {
         if RESERVED.contains(&s.as_str()) {
             s.push_str("_s");
         }
-        let taken = |n: &str| self.signals.iter().any(|x| x.name == n) || self.outputs.iter().any(|x| x.0 == n) || self.roms.iter().any(|x| x.name == n);
+        let taken = |n: &str| {
+            self.signals.iter().any(|x| x.name == n)
+                || self.outputs.iter().any(|x| x.0 == n)
+                || self.roms.iter().any(|x| x.name == n)
+        };
         if !taken(&s) {
             return s;
         }
@@ -190,7 +380,13 @@ impl Module {
         let w = self.roms[rom].width;
         // The printers pad the ROM to a power of two; the address covers exactly that.
         let bits = super::emit::rom_addr_bits(self.roms[rom].words.len());
-        assert_eq!(addr.ty, Ty::u(bits), "{}: {name}: a ROM of {} words takes a {bits}-bit unsigned address", self.name, self.roms[rom].words.len());
+        assert_eq!(
+            addr.ty,
+            Ty::u(bits),
+            "{}: {name}: a ROM of {} words takes a {bits}-bit unsigned address",
+            self.name,
+            self.roms[rom].words.len()
+        );
         self.push(name, Ty::u(w), Def::RomRead { rom, addr: addr.id })
     }
 

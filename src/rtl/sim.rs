@@ -55,10 +55,20 @@ impl Sim {
             match &s.def {
                 Def::Input => {}
                 Def::Const(v) => vals[i] = *v,
-                Def::Bin(op, a, b) => comb.push(Op::Bin { op: *op, dst: i, a: ix(*a), b: ix(*b), ta: tys[ix(*a)], tb: tys[ix(*b)], tr: s.ty }),
+                Def::Bin(op, a, b) => comb.push(Op::Bin {
+                    op: *op,
+                    dst: i,
+                    a: ix(*a),
+                    b: ix(*b),
+                    ta: tys[ix(*a)],
+                    tb: tys[ix(*b)],
+                    tr: s.ty,
+                }),
                 Def::Un(op, a) => comb.push(Op::Un { op: *op, dst: i, a: ix(*a), ta: tys[ix(*a)], tr: s.ty }),
                 Def::Mux { sel, t, f } => comb.push(Op::Mux { dst: i, sel: ix(*sel), t: ix(*t), f: ix(*f) }),
-                Def::Concat(parts) => comb.push(Op::Concat { dst: i, parts: parts.iter().map(|p| (ix(*p), tys[ix(*p)].width)).collect() }),
+                Def::Concat(parts) => {
+                    comb.push(Op::Concat { dst: i, parts: parts.iter().map(|p| (ix(*p), tys[ix(*p)].width)).collect() })
+                }
                 Def::Reg { next, enable, reset } => {
                     let next = ix(next.expect("checked"));
                     regs.push(RegUpdate { dst: i, next, enable: enable.map(ix), reset: *reset });

@@ -79,7 +79,10 @@ pub enum UnOp {
     /// Shift right by a constant: arithmetic for signed, logical for unsigned.
     Shr(u32),
     /// Bits [lsb, lsb + width) as an unsigned value.
-    Slice { lsb: u32, width: u32 },
+    Slice {
+        lsb: u32,
+        width: u32,
+    },
     /// To `width` bits: sign- or zero-extend by the operand's signedness, or keep the low bits.
     Resize(u32),
     /// Reinterpret the bits with the other signedness.
@@ -221,7 +224,14 @@ mod tests {
     fn wide_values() {
         let t = Ty::s(128);
         assert_eq!(t.value(u128::MAX), -1);
-        let p = eval_bin(BinOp::Mul, Ty::s(64), Ty::s(64).wrap(-3), Ty::s(64), Ty::s(64).wrap(i64::MAX as i128), Ty::s(128));
+        let p = eval_bin(
+            BinOp::Mul,
+            Ty::s(64),
+            Ty::s(64).wrap(-3),
+            Ty::s(64),
+            Ty::s(64).wrap(i64::MAX as i128),
+            Ty::s(128),
+        );
         assert_eq!(Ty::s(128).value(p), -3 * i64::MAX as i128);
         assert!(bin_ty(BinOp::Mul, Ty::s(64), Ty::s(65)).is_err());
         assert!(bin_ty(BinOp::Add, Ty::s(8), Ty::u(8)).is_err());

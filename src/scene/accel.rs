@@ -56,11 +56,7 @@ pub fn max_edge_ratio(v: &[GridVertex; 3]) -> Option<(i128, i128)> {
     if n[r] == 0 {
         return None;
     }
-    let a = [p, q]
-        .iter()
-        .flat_map(|&k| [1, 2].map(|i| (v[i][k] - v[0][k]).abs() as i128))
-        .max()
-        .unwrap_or(0);
+    let a = [p, q].iter().flat_map(|&k| [1, 2].map(|i| (v[i][k] - v[0][k]).abs() as i128)).max().unwrap_or(0);
     Some((a, n[r].abs()))
 }
 

@@ -152,7 +152,14 @@ mod tests {
     use proptest::prelude::*;
 
     /// Collects (triangles under node, inner-node depth of each leaf) and checks clip planes.
-    fn check(bih: &Bih, bounds: &[IBox], at: usize, depth: usize, seen: &mut Vec<u32>, max_depth: &mut usize) -> Vec<u32> {
+    fn check(
+        bih: &Bih,
+        bounds: &[IBox],
+        at: usize,
+        depth: usize,
+        seen: &mut Vec<u32>,
+        max_depth: &mut usize,
+    ) -> Vec<u32> {
         match bih.nodes[at] {
             Node::Leaf { first, count } => {
                 *max_depth = (*max_depth).max(depth);

@@ -53,11 +53,7 @@ fn scale(a: V3, s: f64) -> V3 {
 }
 
 fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 fn normalize(a: V3) -> V3 {
@@ -66,10 +62,7 @@ fn normalize(a: V3) -> V3 {
 
 /// True if two vertices coincide or the area is exactly zero in f64.
 fn is_degenerate(t: &Tri) -> bool {
-    t[0] == t[1]
-        || t[1] == t[2]
-        || t[0] == t[2]
-        || cross(sub(t[1], t[0]), sub(t[2], t[0])) == [0.0; 3]
+    t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || cross(sub(t[1], t[0]), sub(t[2], t[0])) == [0.0; 3]
 }
 
 /// Appends the quad `v0 v1 v2 v3` as the triangles (v0,v1,v2) and (v0,v2,v3).
@@ -117,13 +110,7 @@ fn z_up_to_y_up([x, y, z]: V3) -> V3 {
 /// rounding). It is symmetric under swapping (a, s) with (b, t), exact at the
 /// end points, and exactly `a` where `a` and `b` agree.
 fn blend(a: V3, b: V3, s: f64, t: f64) -> V3 {
-    from_fn(|k| {
-        if a[k] == b[k] {
-            a[k]
-        } else {
-            s * a[k] + t * b[k]
-        }
-    })
+    from_fn(|k| if a[k] == b[k] { a[k] } else { s * a[k] + t * b[k] })
 }
 
 /// Point at parameter `i / n` on a cubic Bezier curve, by de Casteljau's
@@ -217,17 +204,11 @@ fn jackstraws() -> Vec<Tri> {
         // and cross near the middle.
         let centre: V3 = from_fn(|k| 0.5 * (1.0 - axis[k].abs()) * rng.range(-1.0, 1.0));
         let (e1, e2) = perpendicular_basis(axis);
-        let ends = [
-            sub(centre, scale(axis, STICK_HALF_LENGTH)),
-            add(centre, scale(axis, STICK_HALF_LENGTH)),
-        ];
+        let ends = [sub(centre, scale(axis, STICK_HALF_LENGTH)), add(centre, scale(axis, STICK_HALF_LENGTH))];
         let ring: Vec<V3> = (0..STICK_SEGMENTS)
             .map(|s| {
                 let theta = TAU * s as f64 / STICK_SEGMENTS as f64;
-                add(
-                    scale(e1, STICK_RADIUS * theta.cos()),
-                    scale(e2, STICK_RADIUS * theta.sin()),
-                )
+                add(scale(e1, STICK_RADIUS * theta.cos()), scale(e2, STICK_RADIUS * theta.sin()))
             })
             .collect();
         for s in 0..STICK_SEGMENTS {
@@ -277,8 +258,7 @@ fn random() -> Vec<Tri> {
     let mut tris = Vec::with_capacity(RANDOM_TRIANGLES);
     while tris.len() < RANDOM_TRIANGLES {
         let centre: V3 = from_fn(|_| rng.next_f64());
-        let tri: Tri =
-            from_fn(|_| from_fn(|k| centre[k] + rng.range(-RANDOM_HALF_SIZE, RANDOM_HALF_SIZE)));
+        let tri: Tri = from_fn(|_| from_fn(|k| centre[k] + rng.range(-RANDOM_HALF_SIZE, RANDOM_HALF_SIZE)));
         // A degenerate draw is practically impossible, but the count must stay exact.
         if !is_degenerate(&tri) {
             tris.push(tri);
@@ -525,10 +505,7 @@ mod tests {
     fn all_triangles_finite_and_non_degenerate() {
         for name in BUILTIN_NAMES {
             for (i, t) in scene(name).iter().enumerate() {
-                assert!(
-                    t.iter().flatten().all(|c| c.is_finite()),
-                    "{name} #{i}: {t:?}"
-                );
+                assert!(t.iter().flatten().all(|c| c.is_finite()), "{name} #{i}: {t:?}");
                 assert!(!is_degenerate(t), "{name} #{i} is degenerate: {t:?}");
             }
         }
@@ -539,13 +516,7 @@ mod tests {
         for name in BUILTIN_NAMES {
             let (a, b) = (scene(name), scene(name));
             assert_eq!(a.len(), b.len(), "{name}");
-            let bits = |s: &[Tri]| {
-                s.iter()
-                    .flatten()
-                    .flatten()
-                    .map(|c| c.to_bits())
-                    .collect::<Vec<_>>()
-            };
+            let bits = |s: &[Tri]| s.iter().flatten().flatten().map(|c| c.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&a), bits(&b), "{name}");
         }
     }
@@ -577,23 +548,11 @@ mod tests {
     #[test]
     fn teapot_data_has_its_symmetries() {
         // The bottom faces down, so its patches turn the other way round.
-        for (first, sign) in [
-            (0, 1.0),
-            (4, 1.0),
-            (8, 1.0),
-            (20, 1.0),
-            (24, 1.0),
-            (28, -1.0),
-        ] {
+        for (first, sign) in [(0, 1.0), (4, 1.0), (8, 1.0), (20, 1.0), (24, 1.0), (28, -1.0)] {
             for k in 1..4 {
                 let prev = teapot_patch(&TEAPOT_PATCHES[first + k - 1]);
                 let turned = prev.map(|[x, y, z]| [sign * y, -sign * x, z]);
-                assert_eq!(
-                    teapot_patch(&TEAPOT_PATCHES[first + k]),
-                    turned,
-                    "patch {}",
-                    first + k
-                );
+                assert_eq!(teapot_patch(&TEAPOT_PATCHES[first + k]), turned, "patch {}", first + k);
             }
         }
         for first in [12, 14, 16, 18] {
@@ -602,12 +561,7 @@ mod tests {
                 let [x, y, z] = a[4 * (i / 4) + 3 - i % 4];
                 [x, -y, z]
             });
-            assert_eq!(
-                teapot_patch(&TEAPOT_PATCHES[first + 1]),
-                mirrored,
-                "patch {}",
-                first + 1
-            );
+            assert_eq!(teapot_patch(&TEAPOT_PATCHES[first + 1]), mirrored, "patch {}", first + 1);
         }
     }
 
@@ -656,10 +610,7 @@ mod tests {
                 .map(|e| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt());
             let longest = lengths.iter().cloned().fold(0.0, f64::max);
             let shortest = lengths.iter().cloned().fold(f64::INFINITY, f64::min);
-            assert!(
-                (longest - 2.0).abs() < 1e-3 && shortest < 1e-4,
-                "{lengths:?}"
-            );
+            assert!((longest - 2.0).abs() < 1e-3 && shortest < 1e-4, "{lengths:?}");
         }
     }
 
@@ -695,9 +646,6 @@ mod tests {
         assert_close(hi, [556.0, 548.8, 559.2], 0.5, "cornell max");
         // Triangles 4 and 5 are the light.
         assert!(tris[4..6].iter().flatten().all(|v| v[1] == 548.8));
-        assert_eq!(
-            bbox(&tris[4..6]),
-            ([213.0, 548.8, 227.0], [343.0, 548.8, 332.0])
-        );
+        assert_eq!(bbox(&tris[4..6]), ([213.0, 548.8, 227.0], [343.0, 548.8, 332.0]));
     }
 }

@@ -120,7 +120,10 @@ impl Scene {
         }
         counts.stored = tris.len();
         if tris.is_empty() {
-            return Err(Error::new(name, format!("all {} triangles are degenerate on the {}-bit grid", world.len(), params.n)));
+            return Err(Error::new(
+                name,
+                format!("all {} triangles are degenerate on the {}-bit grid", world.len(), params.n),
+            ));
         }
         let grid_box = IBox::of_points(&grid_tris.iter().flatten().copied().collect::<Vec<_>>());
         let grid_box = IBox { lo: [0; 3], hi: grid_box.hi.map(|h| h + GUARD) };
@@ -151,7 +154,10 @@ impl Scene {
             }
             SceneSource::Builtin(name) => {
                 let tris = builtin::builtin_scene(name).ok_or_else(|| {
-                    Error::param("builtin", format!("unknown scene '{name}'; known: {}", builtin::BUILTIN_NAMES.join(", ")))
+                    Error::param(
+                        "builtin",
+                        format!("unknown scene '{name}'; known: {}", builtin::BUILTIN_NAMES.join(", ")),
+                    )
                 })?;
                 Scene::build(name, tris, params)
             }

@@ -14,17 +14,12 @@ pub fn load_obj(path: &Path) -> Result<Vec<Tri>> {
         let line = 1 + bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
         return Err(Error::file(path, format!("line {line}: not valid UTF-8 text")));
     }
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     // tobj reports malformed input as errors, but we do not let a parser panic take the
     // process down either: a panic here becomes the same one-line error.
-    let loaded = quietly_catch_unwind(|| tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    }));
+    let loaded = quietly_catch_unwind(|| {
+        tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| Err(tobj::LoadError::OpenFileFailed))
+    });
     let (models, _materials) = match loaded {
         Some(Ok(x)) => x,
         Some(Err(e)) => return Err(Error::file(path, describe_tobj_error(&e))),
@@ -36,7 +31,17 @@ pub fn load_obj(path: &Path) -> Result<Vec<Tri>> {
         let pos = &mesh.positions;
         for (i, c) in pos.chunks(3).enumerate() {
             if c.iter().any(|x| !x.is_finite()) {
-                return Err(Error::file(path, format!("vertex {} of object '{}' has a non-finite coordinate ({}, {}, {})", i + 1, model.name, c[0], c[1], c[2])));
+                return Err(Error::file(
+                    path,
+                    format!(
+                        "vertex {} of object '{}' has a non-finite coordinate ({}, {}, {})",
+                        i + 1,
+                        model.name,
+                        c[0],
+                        c[1],
+                        c[2]
+                    ),
+                ));
             }
         }
         let vertex = |k: u32| -> Result<[f64; 3]> {

@@ -73,13 +73,23 @@ pub fn layouts(scene: &Scene) -> [Layout; 3] {
     );
     let node_bits = addr_bits(scene.bih.nodes.len());
     let leaf_bits = addr_bits(scene.bih.leaf_tris.len().max(1));
-    let max_count = scene.bih.nodes.iter().map(|x| if let Node::Leaf { count, .. } = x { *count as usize } else { 0 }).max().unwrap_or(0);
+    let max_count = scene
+        .bih
+        .nodes
+        .iter()
+        .map(|x| if let Node::Leaf { count, .. } = x { *count as usize } else { 0 })
+        .max()
+        .unwrap_or(0);
     let count_bits = value_bits(max_count);
     // Inner and leaf nodes share one word; the leaf fields overlay clip0/clip1/child.
     let inner_bits = 2 * n + node_bits;
     let leaf_fields = leaf_bits + count_bits;
     let pad = inner_bits.max(leaf_fields);
-    let mut node = Layout::build("node", scene.bih.nodes.len(), &[("axis", 2, false), ("clip0", n, false), ("clip1", n, false), ("child", node_bits, false)]);
+    let mut node = Layout::build(
+        "node",
+        scene.bih.nodes.len(),
+        &[("axis", 2, false), ("clip0", n, false), ("clip1", n, false), ("child", node_bits, false)],
+    );
     node.fields.push(Field { name: "first", lsb: 2, width: leaf_bits, signed: false });
     node.fields.push(Field { name: "count", lsb: 2 + leaf_bits, width: count_bits, signed: false });
     node.width = 2 + pad;
@@ -140,7 +150,18 @@ pub fn words(scene: &Scene) -> [(Layout, Vec<Word>); 3] {
         .iter()
         .map(|t| {
             let mut w = Word::zero(tri_l.width);
-            for (name, v) in [("r", t.r as i64), ("pp", t.pp), ("pq", t.pq), ("d", t.d), ("np", t.np), ("nq", t.nq), ("e1p", t.e1p), ("e1q", t.e1q), ("e2p", t.e2p), ("e2q", t.e2q)] {
+            for (name, v) in [
+                ("r", t.r as i64),
+                ("pp", t.pp),
+                ("pq", t.pq),
+                ("d", t.d),
+                ("np", t.np),
+                ("nq", t.nq),
+                ("e1p", t.e1p),
+                ("e1q", t.e1q),
+                ("e2p", t.e2p),
+                ("e2q", t.e2q),
+            ] {
                 w.set(tri_l.field(name), v as i128);
             }
             w
@@ -154,7 +175,12 @@ pub fn words(scene: &Scene) -> [(Layout, Vec<Word>); 3] {
             let mut w = Word::zero(node_l.width);
             match *nd {
                 Node::Inner { axis, clip0, clip1, child } => {
-                    for (name, v) in [("axis", axis as i128), ("clip0", clip0 as i128), ("clip1", clip1 as i128), ("child", child as i128)] {
+                    for (name, v) in [
+                        ("axis", axis as i128),
+                        ("clip0", clip0 as i128),
+                        ("clip1", clip1 as i128),
+                        ("child", child as i128),
+                    ] {
                         w.set(node_l.field(name), v);
                     }
                 }
@@ -184,7 +210,8 @@ pub fn words(scene: &Scene) -> [(Layout, Vec<Word>); 3] {
 }
 
 pub fn readmemh(layout: &Layout, words: &[Word]) -> String {
-    let mut s = format!("// fxrt {} ROM: {} words of {} bits, see docs/ROM-LAYOUT.md\n", layout.rom, words.len(), layout.width);
+    let mut s =
+        format!("// fxrt {} ROM: {} words of {} bits, see docs/ROM-LAYOUT.md\n", layout.rom, words.len(), layout.width);
     for w in words {
         s.push_str(&w.hex(layout.width));
         s.push('\n');
@@ -193,7 +220,12 @@ pub fn readmemh(layout: &Layout, words: &[Word]) -> String {
 }
 
 pub fn coe(layout: &Layout, words: &[Word]) -> String {
-    let mut s = format!("; fxrt {} ROM: {} words of {} bits\nmemory_initialization_radix=16;\nmemory_initialization_vector=\n", layout.rom, words.len(), layout.width);
+    let mut s = format!(
+        "; fxrt {} ROM: {} words of {} bits\nmemory_initialization_radix=16;\nmemory_initialization_vector=\n",
+        layout.rom,
+        words.len(),
+        layout.width
+    );
     for (i, w) in words.iter().enumerate() {
         let end = if i + 1 == words.len() { ";" } else { "," };
         let _ = writeln!(s, "{}{end}", w.hex(layout.width));
@@ -205,7 +237,11 @@ pub fn coe(layout: &Layout, words: &[Word]) -> String {
 /// Words are written as bit strings, so any width is exact (x"…" needs multiples of 4).
 pub fn vhdl_package(scene: &Scene, roms: &[(Layout, Vec<Word>)]) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "-- fxrt scene ROMs for '{}' (n={}, m={}, E={}); generated, do not edit.", scene.name, scene.params.n, scene.params.m, scene.edge_shift);
+    let _ = writeln!(
+        s,
+        "-- fxrt scene ROMs for '{}' (n={}, m={}, E={}); generated, do not edit.",
+        scene.name, scene.params.n, scene.params.m, scene.edge_shift
+    );
     s.push_str("library ieee;\nuse ieee.std_logic_1164.all;\n\npackage fxrt_scene_pkg is\n");
     for (l, words) in roms {
         let up = l.rom.to_uppercase();
@@ -215,10 +251,19 @@ pub fn vhdl_package(scene: &Scene, roms: &[(Layout, Vec<Word>)]) -> String {
             let _ = writeln!(s, "  constant {up}_{}_LSB : natural := {};", f.name.to_uppercase(), f.lsb);
             let _ = writeln!(s, "  constant {up}_{}_WIDTH : natural := {};", f.name.to_uppercase(), f.width);
         }
-        let _ = writeln!(s, "  type {}_rom_t is array (0 to {}) of std_logic_vector({} downto 0);", l.rom, words.len() - 1, l.width - 1);
+        let _ = writeln!(
+            s,
+            "  type {}_rom_t is array (0 to {}) of std_logic_vector({} downto 0);",
+            l.rom,
+            words.len() - 1,
+            l.width - 1
+        );
         let _ = writeln!(s, "  constant {up}_ROM : {}_rom_t := (", l.rom);
         for (i, w) in words.iter().enumerate() {
-            let bits: String = (0..l.width).rev().map(|b| if (w.0[(b / 64) as usize] >> (b % 64)) & 1 == 1 { '1' } else { '0' }).collect();
+            let bits: String = (0..l.width)
+                .rev()
+                .map(|b| if (w.0[(b / 64) as usize] >> (b % 64)) & 1 == 1 { '1' } else { '0' })
+                .collect();
             let end = if i + 1 == words.len() { "" } else { "," };
             let _ = writeln!(s, "    {i} => \"{bits}\"{end}");
         }

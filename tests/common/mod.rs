@@ -9,14 +9,19 @@ use std::path::PathBuf;
 /// `../shared/scenes` beside the checkout, when it is there.
 pub fn shared_scenes() -> Option<Vec<PathBuf>> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir).ok()?.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "obj")).collect();
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
     v.sort();
     Some(v)
 }
 
 /// Every built-in scene, plus every shared OBJ (or a note that they were skipped).
 pub fn all_scenes(params: &Params) -> Vec<Scene> {
-    let mut out: Vec<Scene> = BUILTIN_NAMES.iter().map(|n| Scene::load(&SceneSource::Builtin(n.to_string()), params).unwrap()).collect();
+    let mut out: Vec<Scene> =
+        BUILTIN_NAMES.iter().map(|n| Scene::load(&SceneSource::Builtin(n.to_string()), params).unwrap()).collect();
     match shared_scenes() {
         Some(paths) => out.extend(paths.into_iter().map(|p| Scene::load(&SceneSource::Obj(p), params).unwrap())),
         None => say("skipped: ../shared/scenes is not there; only built-in scenes were tested"),

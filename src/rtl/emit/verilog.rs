@@ -21,7 +21,11 @@ fn extend(a: &str, t: Ty, w: u32) -> String {
     if w == t.width {
         return a.to_string();
     }
-    let fill = if t.signed { format!("{{{}{{{a}[{}]}}}}", w - t.width, t.width - 1) } else { format!("{{{}{{1'b0}}}}", w - t.width) };
+    let fill = if t.signed {
+        format!("{{{}{{{a}[{}]}}}}", w - t.width, t.width - 1)
+    } else {
+        format!("{{{}{{1'b0}}}}", w - t.width)
+    };
     if t.signed { format!("$signed({{{fill}, {a}}})") } else { format!("{{{fill}, {a}}}") }
 }
 
@@ -43,7 +47,11 @@ pub fn print(m: &Module) -> String {
         let depth = rom_depth(r.words.len());
         let _ = writeln!(s, "  reg [{}:0] {} [0:{}];", r.width - 1, r.name, depth - 1);
         let _ = writeln!(s, "  integer {}_i;\n  initial begin", r.name);
-        let _ = writeln!(s, "    for ({0}_i = 0; {0}_i < {1}; {0}_i = {0}_i + 1) {0}[{0}_i] = {2}'h0;", r.name, depth, r.width);
+        let _ = writeln!(
+            s,
+            "    for ({0}_i = 0; {0}_i < {1}; {0}_i = {0}_i + 1) {0}[{0}_i] = {2}'h0;",
+            r.name, depth, r.width
+        );
         for (i, w) in r.words.iter().enumerate() {
             if *w != 0 {
                 let _ = writeln!(s, "    {}[{i}] = {}'h{};", r.name, r.width, hex_string(*w, r.width));
@@ -83,7 +91,9 @@ pub fn print(m: &Module) -> String {
                     BinOp::And => format!("{a} & {b}"),
                     BinOp::Or => format!("{a} | {b}"),
                     BinOp::Xor => format!("{a} ^ {b}"),
-                    BinOp::Mul => format!("{} * {}", extend(a, ty(*ia), sig.ty.width), extend(b, ty(*ib), sig.ty.width)),
+                    BinOp::Mul => {
+                        format!("{} * {}", extend(a, ty(*ia), sig.ty.width), extend(b, ty(*ib), sig.ty.width))
+                    }
                     BinOp::Eq => format!("{a} == {b}"),
                     BinOp::Ne => format!("{a} != {b}"),
                     BinOp::Lt => format!("{a} < {b}"),
@@ -129,7 +139,8 @@ pub fn print(m: &Module) -> String {
                     };
                     match reset {
                         Some(v) => {
-                            let _ = writeln!(s, "    if (rst) {} <= {};\n    else {load}", sig.name, literal(sig.ty, *v));
+                            let _ =
+                                writeln!(s, "    if (rst) {} <= {};\n    else {load}", sig.name, literal(sig.ty, *v));
                         }
                         None => {
                             let _ = writeln!(s, "    {load}");

@@ -48,7 +48,13 @@ pub fn print(m: &Module) -> String {
             }
             // Registers power up at their reset value (0 without one), as in the simulator.
             Def::Reg { reset, .. } => {
-                let _ = writeln!(s, "  signal {} : {} := {};", sig.name, vtype(sig.ty), literal(sig.ty, reset.unwrap_or(0)));
+                let _ = writeln!(
+                    s,
+                    "  signal {} : {} := {};",
+                    sig.name,
+                    vtype(sig.ty),
+                    literal(sig.ty, reset.unwrap_or(0))
+                );
             }
             Def::RomRead { .. } => {
                 let _ = writeln!(s, "  signal {} : {} := (others => '0');", sig.name, vtype(sig.ty));
@@ -106,7 +112,8 @@ pub fn print(m: &Module) -> String {
     for (p, i) in &m.outputs {
         let _ = writeln!(s, "  {p} <= {};", name(*i));
     }
-    let state: Vec<&crate::rtl::netlist::Signal> = m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
+    let state: Vec<&crate::rtl::netlist::Signal> =
+        m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
     if !state.is_empty() {
         s.push_str("\n  clocked : process (clk)\n  begin\n    if rising_edge(clk) then\n");
         for sig in state {
@@ -114,12 +121,20 @@ pub fn print(m: &Module) -> String {
                 Def::Reg { next, enable, reset } => {
                     let next = name(next.expect("checked"));
                     let load = match enable {
-                        Some(e) => format!("if {} = \"1\" then\n        {} <= {next};\n      end if;", name(*e), sig.name),
+                        Some(e) => {
+                            format!("if {} = \"1\" then\n        {} <= {next};\n      end if;", name(*e), sig.name)
+                        }
                         None => format!("{} <= {next};", sig.name),
                     };
                     match reset {
                         Some(v) => {
-                            let _ = writeln!(s, "      if rst = '1' then\n        {} <= {};\n      else\n        {}\n      end if;", sig.name, literal(sig.ty, *v), load.replace("\n", "\n  "));
+                            let _ = writeln!(
+                                s,
+                                "      if rst = '1' then\n        {} <= {};\n      else\n        {}\n      end if;",
+                                sig.name,
+                                literal(sig.ty, *v),
+                                load.replace("\n", "\n  ")
+                            );
                         }
                         None => {
                             let _ = writeln!(s, "      {load}");
