@@ -154,3 +154,33 @@ fn bad_input_is_exit_2_with_one_line_and_no_output() {
     assert_rejected(&["render", "--builtin", "teapot", "--edge-shift", "-3", "--png", png_s], "--edge-shift", &png);
     assert_rejected(&["render", "--builtin", "teapot", "--eye", "1,2", "--png", png_s], "--eye", &png);
 }
+
+#[test]
+fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hdl");
+    // 2n + m = 124 is a valid model, but ω·np would need 2m + 1 = 129 bits.
+    let o = fxrt(&["gen", "--builtin", "random", "--n", "30", "--m", "64", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--m") && stderr(&o).contains("128"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let o = fxrt(&["gen", "--builtin", "random", "--div-bits", "3", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!out.exists());
+    // A good set writes both languages and a manifest per core.
+    let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("fxrt_intersect_n16_m16_t0_e4.json")).unwrap()).unwrap();
+    assert_eq!(manifest["latency_cycles"], 25);
+    assert!(out.join("fxrt_intersect_n16_m16_t0_e4.vhd").exists() && out.join("fxrt_intersect_n16_m16_t0_e4.v").exists());
+}
+
+#[test]
+fn test_command_reports_and_fails_on_nothing_to_run() {
+    let o = fxrt(&["test", "--builtin", "cornell", "--vectors", "3000"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(text.lines().last(), Some("3000 passed, 0 failed"));
+    let o = fxrt(&["test", "--vectors", "0"]);
+    assert_eq!(o.status.code(), Some(2));
+}
