@@ -74,6 +74,14 @@ fn all_ops() -> Module {
     let addr = m.slice("addr", d, 0, 6);
     let q = m.rom_read("rom_q", rom, addr);
     out(&mut m, "o_rom", q);
+    // A RAM written from the inputs and read back (read-first on the same address).
+    let ram = m.ram("stack", 7, (0..10u128).collect());
+    let waddr = m.slice("waddr", c, 0, 4);
+    let raddr = m.slice("raddr", d, 0, 4);
+    let wdata = m.un("wdata", UnOp::AsUnsigned, d);
+    m.ram_write(ram, sel, waddr, wdata);
+    let rq = m.rom_read("stack_q", ram, raddr);
+    out(&mut m, "o_ram", rq);
     m
 }
 

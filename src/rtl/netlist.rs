@@ -54,7 +54,11 @@ pub struct Signal {
 pub struct Rom {
     pub name: String,
     pub width: u32,
+    /// Initial contents (the whole contents of a ROM).
     pub words: Vec<u128>,
+    /// A RAM's synchronous write port: (write enable, address, data). Reads see the old word
+    /// in the cycle of a write to the same address (read-first, as block RAM does).
+    pub write: Option<(SigId, SigId, SigId)>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -372,8 +376,25 @@ impl Module {
     pub fn rom(&mut self, name: &str, width: u32, words: Vec<u128>) -> usize {
         let name = self.unique_name(name);
         assert!(!words.is_empty());
-        self.roms.push(Rom { name, width, words });
+        self.roms.push(Rom { name, width, words, write: None });
         self.roms.len() - 1
+    }
+
+    /// A RAM: a ROM with a synchronous write port (`ram_write`), read with `rom_read`.
+    pub fn ram(&mut self, name: &str, width: u32, init: Vec<u128>) -> usize {
+        self.rom(name, width, init)
+    }
+
+    pub fn ram_write(&mut self, mem: usize, we: Sig, addr: Sig, data: Sig) {
+        let bits = super::emit::rom_addr_bits(self.roms[mem].words.len());
+        assert_eq!(we.ty, Ty::BIT, "{}: write enable must be 1 bit", self.name);
+        assert_eq!(addr.ty, Ty::u(bits), "{}: RAM {} takes a {bits}-bit address", self.name, self.roms[mem].name);
+        assert_eq!(data.ty, Ty::u(self.roms[mem].width), "{}: RAM {} data type", self.name, self.roms[mem].name);
+        assert!(self.roms[mem].write.is_none(), "{}: RAM {} has one write port", self.name, self.roms[mem].name);
+        // Padded to the power of two the printers use, so every address is a real word.
+        let depth = super::emit::rom_depth(self.roms[mem].words.len());
+        self.roms[mem].words.resize(depth, 0);
+        self.roms[mem].write = Some((we.id, addr.id, data.id));
     }
 
     pub fn rom_read(&mut self, name: &str, rom: usize, addr: Sig) -> Sig {

@@ -36,6 +36,8 @@ pub struct Sim {
     regs: Vec<RegUpdate>,
     rom_reads: Vec<RomUpdate>,
     roms: Vec<Vec<u128>>,
+    /// RAM write ports: (memory, write enable, address, data) slots.
+    writes: Vec<(usize, usize, usize, usize)>,
     /// Scratch for the two-phase register update, kept to avoid allocation per cycle.
     next: Vec<u128>,
     /// The `rst` input of the module.
@@ -80,8 +82,9 @@ impl Sim {
             }
         }
         let roms = m.roms.iter().map(|r| r.words.clone()).collect();
+        let writes = m.roms.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, ix(we), ix(a), ix(d)))).collect();
         let next = vec![0; regs.len() + rom_reads.len()];
-        let mut sim = Sim { vals, tys, comb, regs, rom_reads, roms, next, reset: false, cycles: 0 };
+        let mut sim = Sim { vals, tys, comb, regs, rom_reads, roms, writes, next, reset: false, cycles: 0 };
         sim.eval();
         sim
     }
@@ -133,6 +136,14 @@ impl Sim {
             let words = &self.roms[r.rom];
             // Out-of-range addresses read 0, like an unloaded 2-state block RAM word.
             self.next[nr + k] = usize::try_from(v[r.addr]).ok().and_then(|a| words.get(a)).copied().unwrap_or(0);
+        }
+        // Writes after the reads: a read of the written address sees the old word.
+        for &(mem, we, addr, data) in &self.writes {
+            if v[we] & 1 == 1 {
+                if let Some(w) = usize::try_from(v[addr]).ok().and_then(|a| self.roms[mem].get_mut(a)) {
+                    *w = v[data];
+                }
+            }
         }
         for (k, r) in self.regs.iter().enumerate() {
             self.vals[r.dst] = self.next[k];

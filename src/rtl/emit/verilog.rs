@@ -127,8 +127,14 @@ pub fn print(m: &Module) -> String {
         let _ = writeln!(s, "  assign {p} = {};", name(*i));
     }
     let state: Vec<_> = m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
-    if !state.is_empty() {
+    let has_writes = m.roms.iter().any(|r| r.write.is_some());
+    if !state.is_empty() || has_writes {
         s.push_str("  always @(posedge clk) begin\n");
+        for r in &m.roms {
+            if let Some((we, addr, data)) = r.write {
+                let _ = writeln!(s, "    if ({}) {}[{}] <= {};", name(we), r.name, name(addr), name(data));
+            }
+        }
         for sig in state {
             match &sig.def {
                 Def::Reg { next, enable, reset } => {

@@ -34,7 +34,9 @@ pub fn print(m: &Module) -> String {
     for r in &m.roms {
         let depth = rom_depth(r.words.len());
         let _ = writeln!(s, "  type {}_t is array (0 to {}) of unsigned({} downto 0);", r.name, depth - 1, r.width - 1);
-        let _ = writeln!(s, "  constant {} : {}_t := (", r.name, r.name);
+        // A RAM is a signal (written in the clocked process), a ROM a constant.
+        let kind = if r.write.is_some() { "signal" } else { "constant" };
+        let _ = writeln!(s, "  {kind} {} : {}_t := (", r.name, r.name);
         for (i, w) in r.words.iter().enumerate() {
             let _ = writeln!(s, "    {i} => \"{}\",", bit_string(*w, r.width));
         }
@@ -114,8 +116,14 @@ pub fn print(m: &Module) -> String {
     }
     let state: Vec<&crate::rtl::netlist::Signal> =
         m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
-    if !state.is_empty() {
+    let has_writes = m.roms.iter().any(|r| r.write.is_some());
+    if !state.is_empty() || has_writes {
         s.push_str("\n  clocked : process (clk)\n  begin\n    if rising_edge(clk) then\n");
+        for r in &m.roms {
+            if let Some((we, addr, data)) = r.write {
+                let _ = writeln!(s, "      if {} = \"1\" then\n        {}(to_integer({})) <= {};\n      end if;", name(we), r.name, name(addr), name(data));
+            }
+        }
         for sig in state {
             match &sig.def {
                 Def::Reg { next, enable, reset } => {
