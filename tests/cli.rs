@@ -170,9 +170,12 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     // A good set writes both languages and a manifest per core.
     let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("fxrt_intersect_n16_m16_t0_e4.json")).unwrap()).unwrap();
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("fxrt_intersect_n16_m16_t0_e4.json")).unwrap()).unwrap();
     assert_eq!(manifest["latency_cycles"], 25);
-    assert!(out.join("fxrt_intersect_n16_m16_t0_e4.vhd").exists() && out.join("fxrt_intersect_n16_m16_t0_e4.v").exists());
+    assert!(
+        out.join("fxrt_intersect_n16_m16_t0_e4.vhd").exists() && out.join("fxrt_intersect_n16_m16_t0_e4.v").exists()
+    );
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `fxrt test`: the intersection pipeline against the golden model, in the Rust simulator or
 //! in an HDL simulator through a generated self-checking testbench.
 
-use super::simulators::Simulator;
+use super::simulators::{RunResult, Simulator};
 use super::testbench::{Stimulus, record, render};
 use super::vectors::Vector;
 use crate::cores::intersect::{IntersectParams, expected_outputs, intersect_core, pack_inputs};
@@ -77,25 +77,8 @@ pub fn run_hdl(sim_kind: Simulator, p: &IntersectParams, vectors: &[Vector], dir
         return Err(Error::new(sim_kind.name(), "is not installed (scripts/install-deps.sh installs it)"));
     }
     let module = intersect_core(p);
-    let transcript = record(&module, stimuli(&module, p.latency(), vectors));
-    let files = render(&module, &transcript);
-    let name = &module.name;
-    let io = |e: std::io::Error| Error::file(dir, e.to_string());
-    std::fs::create_dir_all(dir).map_err(io)?;
-    let (design, tb) = match sim_kind {
-        Simulator::Ghdl => ((format!("{name}.vhd"), vhdl::print(&module)), ("tb.vhd", &files.vhdl_tb)),
-        _ => ((format!("{name}.v"), verilog::print(&module)), ("tb.v", &files.verilog_tb)),
-    };
-    for (file, text) in [
-        (design.0.as_str(), design.1.as_str()),
-        (tb.0, tb.1.as_str()),
-        ("vectors.txt", files.vectors_txt.as_str()),
-        ("vectors.hex", files.vectors_hex.as_str()),
-    ] {
-        std::fs::write(dir.join(file), text).map_err(io)?;
-    }
-    let (passed, failed) =
-        sim_kind.run(dir, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim_kind.name(), e))?;
+    let r = simulate_hdl(sim_kind, &module, p.latency(), vectors, dir)?;
+    let (passed, failed) = (r.passed, r.failed);
     Ok(Outcome { passed, failed })
 }
 
@@ -130,24 +113,7 @@ pub fn bench_sims(p: &IntersectParams, vectors: &[Vector], ghdl_vectors: usize, 
         }
         let vectors = if sim == Simulator::Ghdl { &vectors[..ghdl_vectors.min(vectors.len())] } else { vectors };
         let cycles = (vectors.len() + p.latency() as usize) as u64;
-        let transcript = record(&module, stimuli(&module, p.latency(), vectors));
-        let files = render(&module, &transcript);
-        let d = dir.join(sim.name());
-        let io = |e: std::io::Error| Error::file(&d, e.to_string());
-        std::fs::create_dir_all(&d).map_err(io)?;
-        let (design, tb) = match sim {
-            Simulator::Ghdl => ((format!("{}.vhd", module.name), vhdl::print(&module)), ("tb.vhd", &files.vhdl_tb)),
-            _ => ((format!("{}.v", module.name), verilog::print(&module)), ("tb.v", &files.verilog_tb)),
-        };
-        for (file, text) in [
-            (design.0.as_str(), design.1.as_str()),
-            (tb.0, tb.1.as_str()),
-            ("vectors.txt", files.vectors_txt.as_str()),
-            ("vectors.hex", files.vectors_hex.as_str()),
-        ] {
-            std::fs::write(d.join(file), text).map_err(io)?;
-        }
-        let r = sim.run_timed(&d, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim.name(), e))?;
+        let r = simulate_hdl(sim, &module, p.latency(), vectors, &dir.join(sim.name()))?;
         out.push(SimSpeed {
             simulator: sim.name(),
             cycles,
@@ -157,4 +123,26 @@ pub fn bench_sims(p: &IntersectParams, vectors: &[Vector], ghdl_vectors: usize, 
         });
     }
     Ok(out)
+}
+
+/// Records the Rust transcript of `vectors`, writes the design in the simulator's language,
+/// the testbench and the vectors into `dir`, and runs the testbench there.
+fn simulate_hdl(sim: Simulator, module: &Module, latency: u32, vectors: &[Vector], dir: &Path) -> Result<RunResult> {
+    let transcript = record(module, stimuli(module, latency, vectors));
+    let files = render(module, &transcript);
+    let io = |e: std::io::Error| Error::file(dir, e.to_string());
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let (design, tb) = match sim {
+        Simulator::Ghdl => ((format!("{}.vhd", module.name), vhdl::print(module)), ("tb.vhd", &files.vhdl_tb)),
+        _ => ((format!("{}.v", module.name), verilog::print(module)), ("tb.v", &files.verilog_tb)),
+    };
+    for (file, text) in [
+        (design.0.as_str(), design.1.as_str()),
+        (tb.0, tb.1.as_str()),
+        ("vectors.txt", files.vectors_txt.as_str()),
+        ("vectors.hex", files.vectors_hex.as_str()),
+    ] {
+        std::fs::write(dir.join(file), text).map_err(io)?;
+    }
+    sim.run_timed(dir, &[design.0.as_str(), tb.0], &files.tb_name).map_err(|e| Error::new(sim.name(), e))
 }

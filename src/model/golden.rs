@@ -6,7 +6,7 @@ use crate::model::ray::NarrowRay;
 use crate::params::Params;
 use crate::scene::Scene;
 use crate::scene::accel::AccelTri;
-use crate::scene::bih::Node;
+use crate::scene::bih::{Node, Step, inner_step};
 use std::mem::MaybeUninit;
 use std::sync::Arc;
 
@@ -178,28 +178,16 @@ impl Golden {
                         let a = axis as usize;
                         let d0 = self.plane_t(ray, a, clip0);
                         let d1 = self.plane_t(ray, a, clip1);
-                        // Positive direction: left (below clip0) is near. Negative: right.
-                        let (near, far, near_end, far_start) =
-                            if ray.inv[a] >= 0 { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
-                        let near_max = tmax.min(near_end);
-                        let far_min = tmin.max(far_start);
-                        match (tmin <= near_max, far_min <= tmax) {
-                            (true, true) => {
+                        match inner_step(child, ray.inv[a] >= 0, d0, d1, tmin, tmax) {
+                            Step::Both { near, near_max, far, far_min } => {
                                 stack[sp].write((far, far_min, tmax));
                                 sp += 1;
                                 stats.max_stack = stats.max_stack.max(sp as u32);
-                                node = near;
-                                tmax = near_max;
+                                (node, tmax) = (near, near_max);
                             }
-                            (true, false) => {
-                                node = near;
-                                tmax = near_max;
-                            }
-                            (false, true) => {
-                                node = far;
-                                tmin = far_min;
-                            }
-                            (false, false) => go_pop = true,
+                            Step::Near(near, near_max) => (node, tmax) = (near, near_max),
+                            Step::Far(far, far_min) => (node, tmin) = (far, far_min),
+                            Step::Neither => go_pop = true,
                         }
                     }
                     Node::Leaf { first, count } => {

@@ -9,7 +9,7 @@
 
 use super::float::{FloatTri, Real, watertight_f32};
 use crate::scene::Scene;
-use crate::scene::bih::Node;
+use crate::scene::bih::{Node, Step, inner_step};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FloatTest {
@@ -134,25 +134,14 @@ impl<F: Real> FloatScene<F> {
                     } else {
                         let d0 = (clip0 - o[a]) * inv[a];
                         let d1 = (clip1 - o[a]) * inv[a];
-                        let (near, far, near_end, far_start) =
-                            if d[a] > F::zero() { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
-                        let near_max = if near_end < tmax { near_end } else { tmax };
-                        let far_min = if far_start > tmin { far_start } else { tmin };
-                        match (tmin <= near_max, far_min <= tmax) {
-                            (true, true) => {
+                        match inner_step(child, d[a] > F::zero(), d0, d1, tmin, tmax) {
+                            Step::Both { near, near_max, far, far_min } => {
                                 stack.push((far, far_min, tmax));
-                                node = near;
-                                tmax = near_max;
+                                (node, tmax) = (near, near_max);
                             }
-                            (true, false) => {
-                                node = near;
-                                tmax = near_max;
-                            }
-                            (false, true) => {
-                                node = far;
-                                tmin = far_min;
-                            }
-                            (false, false) => pop = true,
+                            Step::Near(near, near_max) => (node, tmax) = (near, near_max),
+                            Step::Far(far, far_min) => (node, tmin) = (far, far_min),
+                            Step::Neither => pop = true,
                         }
                     }
                 }

@@ -82,7 +82,12 @@ impl Sim {
             }
         }
         let roms = m.roms.iter().map(|r| r.words.clone()).collect();
-        let writes = m.roms.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, ix(we), ix(a), ix(d)))).collect();
+        let writes = m
+            .roms
+            .iter()
+            .enumerate()
+            .filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, ix(we), ix(a), ix(d))))
+            .collect();
         let next = vec![0; regs.len() + rom_reads.len()];
         let mut sim = Sim { vals, tys, comb, regs, rom_reads, roms, writes, next, reset: false, cycles: 0 };
         sim.eval();

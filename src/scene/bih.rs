@@ -13,6 +13,41 @@ pub enum Node {
     Leaf { first: u32, count: u32 },
 }
 
+/// What traversal does at an inner node (seed 001 table 3.1: inner → node, push or pop).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step<T> {
+    /// Enter `near` with tmax = `near_max`; push (`far`, `far_min`, old tmax).
+    Both {
+        near: u32,
+        near_max: T,
+        far: u32,
+        far_min: T,
+    },
+    /// Enter only the near child, with tmax lowered to the second field.
+    Near(u32, T),
+    /// Enter only the far child, with tmin raised to the second field.
+    Far(u32, T),
+    Neither,
+}
+
+/// The child decision shared by the golden model and the float references: with the ray
+/// going up the axis (`positive`) the left child (ending at d0 = distance to clip0) is near,
+/// otherwise the right one (ending at d1). `T` is i64 in the golden model, f32/f64 in the
+/// references.
+#[inline(always)]
+pub fn inner_step<T: PartialOrd + Copy>(child: u32, positive: bool, d0: T, d1: T, tmin: T, tmax: T) -> Step<T> {
+    let (near, far, near_end, far_start) =
+        if positive { (child, child + 1, d0, d1) } else { (child + 1, child, d1, d0) };
+    let near_max = if near_end < tmax { near_end } else { tmax };
+    let far_min = if far_start > tmin { far_start } else { tmin };
+    match (tmin <= near_max, far_min <= tmax) {
+        (true, true) => Step::Both { near, near_max, far, far_min },
+        (true, false) => Step::Near(near, near_max),
+        (false, true) => Step::Far(far, far_min),
+        (false, false) => Step::Neither,
+    }
+}
+
 /// Integer axis-aligned box, inclusive bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct IBox {

@@ -121,7 +121,14 @@ pub fn print(m: &Module) -> String {
         s.push_str("\n  clocked : process (clk)\n  begin\n    if rising_edge(clk) then\n");
         for r in &m.roms {
             if let Some((we, addr, data)) = r.write {
-                let _ = writeln!(s, "      if {} = \"1\" then\n        {}(to_integer({})) <= {};\n      end if;", name(we), r.name, name(addr), name(data));
+                let _ = writeln!(
+                    s,
+                    "      if {} = \"1\" then\n        {}(to_integer({})) <= {};\n      end if;",
+                    name(we),
+                    r.name,
+                    name(addr),
+                    name(data)
+                );
             }
         }
         for sig in state {
