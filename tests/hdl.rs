@@ -54,6 +54,16 @@ fn rust_simulator_matches_golden_on_a_million_vectors_at_defaults() {
 }
 
 #[test]
+fn cycle_and_batch_engines_both_match_golden() {
+    use fxrt::flow::check::{Engine, run_rust_with};
+    let (p, v) = setup(ODD, 20_000);
+    for engine in [Engine::Cycle, Engine::Batch] {
+        let (o, _) = run_rust_with(engine, &p, &v);
+        assert_eq!((o.passed, o.failed), (20_000, 0), "{engine:?}");
+    }
+}
+
+#[test]
 fn rust_simulator_matches_golden_at_stress_widths() {
     for params in [SMALL, ODD, WIDE] {
         let (p, v) = setup(params, 100_000);
@@ -111,15 +121,24 @@ fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
         }
     };
     let name = p.name();
-    if let Some(o) = run("ghdl", &["--synth", "--std=93c", "--out=none", &format!("{name}.vhd"), "-e", &name]) {
+    // The pipeline instantiates the divider: each module is in its own file, sub-modules first.
+    let module = fxrt::cores::intersect::intersect_core(&p);
+    let files = |ext| fxrt::rtl::emit::design_files(&module, ext).into_iter().map(|f| f.0).collect::<Vec<_>>();
+    let (vhd, v) = (files("vhd"), files("v"));
+    assert_eq!(vhd.len(), 2, "{vhd:?}");
+    let mut args = vec!["--synth", "--std=93c", "--out=none"];
+    args.extend(vhd.iter().map(|s| s.as_str()));
+    args.extend(["-e", &name]);
+    if let Some(o) = run("ghdl", &args) {
         assert!(o.status.success(), "ghdl --synth: {}", String::from_utf8_lossy(&o.stderr));
     }
-    if let Some(o) = run("verilator", &["--lint-only", "-Wall", &format!("{name}.v")]) {
+    let mut args = vec!["--lint-only", "-Wall", "--top-module", &name];
+    args.extend(v.iter().map(|s| s.as_str()));
+    if let Some(o) = run("verilator", &args) {
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success() && !err.contains("%Warning"), "verilator lint: {err}");
     }
     if run("yosys", &["-V"]).is_some() {
-        let module = fxrt::cores::intersect::intersect_core(&p);
         let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
         // Four products ahead of the divider, two after it, four for u and v: all on DSP48E.
         assert!(area.dsp48e >= 10, "{area:?}");

@@ -3,8 +3,8 @@
 //! simulator that is not installed is reported as skipped.
 
 use fxrt::flow::simulators::Simulator;
-use fxrt::flow::testbench::{Stimulus, record, render};
-use fxrt::rtl::emit::{verilog, vhdl};
+use fxrt::flow::testbench::{Stimulus, bench_files, record};
+use fxrt::rtl::emit::{design_files, verilog, vhdl};
 use fxrt::rtl::{BinOp, Module, Ty, UnOp};
 use std::io::Write;
 
@@ -82,6 +82,33 @@ fn all_ops() -> Module {
     m.ram_write(ram, sel, waddr, wdata);
     let rq = m.rom_read("stack_q", ram, raddr);
     out(&mut m, "o_ram", rq);
+    // Two instances of one sub-module; the first reads the second's register through a wire
+    // driven after both exist (feedback that is legal because it passes a register).
+    let sub = std::rc::Rc::new(sub_module());
+    let fb = m.wire("feedback", Ty::u(7));
+    let first = m.instance("u_first", &sub, &[c, fb]);
+    let second = m.instance("u_second", &sub, &[first[0], d]);
+    m.drive(fb, second[2]);
+    out(&mut m, "o_first", first[0]);
+    out(&mut m, "o_second_sel", second[1]);
+    m
+}
+
+/// A sub-module with a `case`, a register and a combinational path from input to output.
+fn sub_module() -> Module {
+    let mut m = Module::new("ops_sub");
+    let x = m.input("x", Ty::u(7));
+    let y = m.input("y", Ty::u(7));
+    let sel = m.slice("sel", x, 0, 2);
+    let k = m.konst("k", Ty::u(7), 99);
+    let xy = m.bin("xy", BinOp::Xor, x, y);
+    let q = m.reg("q", Ty::u(7), Some(3));
+    m.connect(q, xy, None);
+    let picked = m.case("picked", sel, &[(0, x), (1, y), (3, k)], q);
+    m.output("picked", picked);
+    let direct = m.bin("direct", BinOp::Add, x, k);
+    m.output("direct", direct);
+    m.output("q", q);
     m
 }
 
@@ -110,26 +137,20 @@ fn stimuli(n: usize) -> Vec<Stimulus> {
 fn rust_ghdl_iverilog_and_verilator_agree_on_every_operator() {
     let m = all_ops();
     let t = record(&m, stimuli(400));
-    let files = render(&m, &t);
-    // Kept under target/ so a failure can be inspected (and rerun by hand).
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("rtl_cross_ops");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.as_path().join("ops_check.vhd"), vhdl::print(&m)).unwrap();
-    std::fs::write(dir.as_path().join("ops_check.v"), verilog::print(&m)).unwrap();
-    std::fs::write(dir.as_path().join("tb.vhd"), &files.vhdl_tb).unwrap();
-    std::fs::write(dir.as_path().join("tb.v"), &files.verilog_tb).unwrap();
-    std::fs::write(dir.as_path().join("vectors.txt"), &files.vectors_txt).unwrap();
-    std::fs::write(dir.as_path().join("vectors.hex"), &files.vectors_hex).unwrap();
     let mut ran = 0;
     for sim in Simulator::ALL {
         if !sim.available() {
             let _ = writeln!(std::io::stderr().lock(), "skipped: {} is not installed", sim.name());
             continue;
         }
-        let sources: &[&str] =
-            if sim == Simulator::Ghdl { &["ops_check.vhd", "tb.vhd"] } else { &["ops_check.v", "tb.v"] };
-        let (passed, failed) = sim.run(dir.as_path(), sources, &files.tb_name).unwrap_or_else(|e| panic!("{e}"));
+        // Kept under target/ so a failure can be inspected (and rerun by hand).
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("rtl_cross_{}", sim.name()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, text) in bench_files(&m, &t, sim) {
+            std::fs::write(dir.join(file), text).unwrap();
+        }
+        let (passed, failed) = sim.run(&dir, &m).unwrap_or_else(|e| panic!("{e}"));
         eprintln!("{}: {passed} passed, {failed} failed", sim.name());
         assert_eq!((passed, failed), (400, 0), "{}", sim.name());
         ran += 1;
@@ -142,7 +163,8 @@ fn printers_are_deterministic_and_lint_clean() {
     let m = all_ops();
     assert_eq!(vhdl::print(&m), vhdl::print(&all_ops()));
     assert_eq!(verilog::print(&m), verilog::print(&all_ops()));
-    let v = verilog::print(&m);
+    let files = design_files(&m, "v");
+    let v: String = files.iter().map(|f| f.1.as_str()).collect();
     assert!(
         !v.contains('$') || v.matches('$').count() == v.matches("$signed").count() + v.matches("$unsigned").count()
     );
@@ -151,9 +173,11 @@ fn printers_are_deterministic_and_lint_clean() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("ops_check.v"), &v).unwrap();
+    for (file, text) in &files {
+        std::fs::write(dir.path().join(file), text).unwrap();
+    }
     let out = std::process::Command::new("verilator")
-        .args(["--lint-only", "-Wall", "ops_check.v"])
+        .args(["--lint-only", "-Wall", "--top-module", "ops_check", "ops_sub.v", "ops_check.v"])
         .current_dir(dir.path())
         .output()
         .unwrap();

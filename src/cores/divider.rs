@@ -12,15 +12,11 @@
 
 use crate::rtl::{BinOp, Module, Sig, Ty, UnOp};
 
-/// Signals carried unchanged beside the division, delayed by the same number of stages.
-pub type Sidecar = Vec<Sig>;
-
 pub struct DividerOut {
     /// floor(|num| / |den|), n + 1 bits unsigned.
     pub t: Sig,
     /// 1 when t is a valid distance (no error).
     pub ok: Sig,
-    pub sidecar: Sidecar,
 }
 
 /// Latency in clock cycles of `divider_stages` for grid bits `n` and `bits_per_stage`
@@ -29,14 +25,9 @@ pub fn latency(n: u32, bits_per_stage: u32) -> u32 {
     1 + (n + 1).div_ceil(bits_per_stage)
 }
 
-fn delay_all(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Sidecar {
-    sigs.iter().enumerate().map(|(i, s)| m.delay(&format!("{prefix}_{i}"), *s)).collect()
-}
-
-/// Appends the divider to `m`. `num` and `den` are signed; `sidecar` travels alongside.
-/// `bits_per_stage` quotient bits (1 or 2) are computed between two pipeline registers: 2
+/// Appends the divider to `m`. `num` and `den` are signed. `bits_per_stage` quotient bits (1 or 2) are computed between two pipeline registers: 2
 /// halves the registers and the latency at the price of two subtractors in series.
-pub fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den: Sig, sidecar: &[Sig]) -> DividerOut {
+fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den: Sig) -> DividerOut {
     assert!((1..=2).contains(&bits_per_stage));
     assert!(num.ty.signed && den.ty.signed);
     let (wn, wd) = (num.ty.width, den.ty.width);
@@ -60,7 +51,6 @@ pub fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den
     let a_r = m.delay("div1_a", a);
     let b_r = m.delay("div1_b", b);
     let err_r = m.delay("div1_err", err);
-    let side = delay_all(m, "div1_side", sidecar);
 
     // The overflow test: hi = a >> (n+1) must be below b.
     let hi_w = wn.saturating_sub(qbits).max(1);
@@ -78,7 +68,7 @@ pub fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den
     // Quotient bits n … 0, one per stage; stage k consumes bit (n − k) of lo.
     let mut p = p0;
     let mut q = m.konst("div_q0", Ty::u(qbits), 0);
-    let (mut b_s, mut lo_s, mut err_s, mut side_s) = (b_r, lo, err2, side);
+    let (mut b_s, mut lo_s, mut err_s) = (b_r, lo, err2);
     let b_w = m.resize("div_b_w", b_s, wd + 1);
     let mut b_w = b_w;
     for k in 0..qbits {
@@ -104,8 +94,7 @@ pub fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den
             let ok = m.bin("div_ok_c", BinOp::Xor, bad, one);
             let t = m.delay("div_t", qn);
             let ok = m.delay("div_ok", ok);
-            let sidecar = delay_all(m, &format!("div{}_side", k + 2), &side_s);
-            return DividerOut { t, ok, sidecar };
+            return DividerOut { t, ok };
         }
         if (k + 1) % bits_per_stage != 0 {
             // The next quotient bit is computed in the same clock cycle.
@@ -118,7 +107,6 @@ pub fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den
         b_w = m.resize(&format!("div{}_bw", k + 2), b_s, wd + 1);
         lo_s = m.delay(&format!("div{}_lo", k + 2), lo_s);
         err_s = m.delay(&format!("div{}_err", k + 2), err_s);
-        side_s = delay_all(m, &format!("div{}_side", k + 2), &side_s);
     }
     unreachable!("the loop returns at its last stage")
 }
@@ -129,7 +117,7 @@ pub fn divider_core(n: u32, bits_per_stage: u32, num_width: u32, den_width: u32)
     let mut m = Module::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}{suffix}"));
     let num = m.input("num", Ty::s(num_width));
     let den = m.input("den", Ty::s(den_width));
-    let out = divider_stages(&mut m, n, bits_per_stage, num, den, &[]);
+    let out = divider_stages(&mut m, n, bits_per_stage, num, den);
     m.output("t", out.t);
     m.output("ok", out.ok);
     m

@@ -3,7 +3,8 @@
 //! bit-identical to `Golden::intersect` for the same quantised inputs (docs/ARITHMETIC.md §4).
 //! When there is no hit, t, u and v read 0.
 
-use super::divider::{self, divider_stages};
+use super::divider::{self, divider_core};
+use std::rc::Rc;
 use crate::rtl::{BinOp, Module, Sig, Ty, UnOp};
 use serde::Serialize;
 
@@ -64,6 +65,11 @@ impl IntersectParams {
     }
 
     /// Input register, products, numerator/denominator, divider, t·ω, k, e·k, u/v and test.
+    /// The divider this pipeline instantiates (operands shortened by T).
+    pub fn divider(&self) -> Module {
+        divider_core(self.n, self.div_bits, self.num_width() - self.t, self.den_width() - self.t)
+    }
+
     pub fn latency(&self) -> u32 {
         3 + divider::latency(self.n, self.div_bits) + 4
     }
@@ -105,10 +111,21 @@ fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
 }
 
 /// A pipeline register for each signal, named after it with the stage's prefix.
+/// The stage prefix of a previous stage register (`s3_`, `dv12_`) is replaced, not stacked.
 fn stage(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Vec<Sig> {
     sigs.iter()
         .map(|s| {
-            let name = format!("{prefix}_{}", m.sig(s.id).name);
+            let old = &m.sig(s.id).name;
+            let base = match old.split_once('_') {
+                Some((p, rest))
+                    if p.trim_end_matches(|c: char| c.is_ascii_digit()).len() < p.len()
+                        && p.starts_with(|c: char| c.is_ascii_alphabetic()) =>
+                {
+                    rest
+                }
+                _ => old.as_str(),
+            };
+            let name = format!("{prefix}_{base}");
             m.delay(&name, *s)
         })
         .collect()
@@ -203,13 +220,18 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
     let den_r = m.delay("s3_den", den_t);
     let side: Vec<Sig> = stage(&mut m, "s3", &[valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
     // The divider, with everything else riding along.
-    let dv = divider_stages(&mut m, n, p.div_bits, num_r, den_r, &side);
-    let [valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = dv.sidecar[..] else { unreachable!() };
+    let div = Rc::new(p.divider());
+    let [dv_t, dv_ok] = m.instance("u_div", &div, &[num_r, den_r])[..] else { unreachable!() };
+    let mut side = side;
+    for k in 1..=divider::latency(n, p.div_bits) {
+        side = stage(&mut m, &format!("dv{k}"), &side);
+    }
+    let [valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = side[..] else { unreachable!() };
     // Stage D+1: t·ω_p, t·ω_q (t as signed n+2 bits).
-    let t_s = as_signed_wider(&mut m, "t_s", dv.t);
+    let t_s = as_signed_wider(&mut m, "t_s", dv_t);
     let tp = m.mul("t_wp", t_s, w_p);
     let tq = m.mul("t_wq", t_s, w_q);
-    let x1: Vec<Sig> = stage(&mut m, "x1", &[tp, tq, dv.t, dv.ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q]);
+    let x1: Vec<Sig> = stage(&mut m, "x1", &[tp, tq, dv_t, dv_ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q]);
     let [tp, tq, t, ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q] = x1[..] else { unreachable!() };
     // Stage D+2: kp = (O_p − pp) + rnd(t·ω_p, F), kq likewise (n+3 bits).
     let tp_r = shr_round(&mut m, "tp_rounded", tp, f);

@@ -1,8 +1,8 @@
 //! `fxrt gen`: the cores' HDL and their manifests.
 
-use crate::cores::divider::{self, divider_core};
+use crate::cores::divider;
 use crate::cores::intersect::{IntersectParams, intersect_core};
-use crate::rtl::emit::{verilog, vhdl};
+use crate::rtl::emit;
 use crate::rtl::netlist::Module;
 use serde_json::{Value, json};
 
@@ -21,14 +21,18 @@ pub fn manifest(m: &Module, latency: u32, params: Value) -> Value {
         "latency_cycles": latency,
         "params": params,
         "ports": ports,
-        "registers": m.signals.iter().filter(|s| matches!(s.def, crate::rtl::netlist::Def::Reg { .. })).map(|s| s.ty.width as u64).sum::<u64>(),
+        "register_bits": m.register_bits(),
+        "files": {
+            "vhdl": emit::design_files(m, "vhd").into_iter().map(|f| f.0).collect::<Vec<_>>(),
+            "verilog": emit::design_files(m, "v").into_iter().map(|f| f.0).collect::<Vec<_>>(),
+        },
     })
 }
 
 /// Every core for one parameter set: (module, latency, manifest parameters).
 pub fn cores(p: &IntersectParams) -> Vec<(Module, u32, Value)> {
     let ip = intersect_core(p);
-    let div = divider_core(p.n, p.div_bits, p.num_width() - p.t, p.den_width() - p.t);
+    let div = p.divider();
     vec![
         (ip, p.latency(), serde_json::to_value(p).unwrap_or(Value::Null)),
         (
@@ -43,11 +47,14 @@ pub fn cores(p: &IntersectParams) -> Vec<(Module, u32, Value)> {
 pub fn files(p: &IntersectParams, vhdl_out: bool, verilog_out: bool) -> Vec<(String, String)> {
     let mut out = Vec::new();
     for (m, lat, params) in cores(p) {
-        if vhdl_out {
-            out.push((format!("{}.vhd", m.name), vhdl::print(&m)));
-        }
-        if verilog_out {
-            out.push((format!("{}.v", m.name), verilog::print(&m)));
+        // A module shared by two cores (the divider) is written once.
+        let mut push = |(name, text): (String, String)| {
+            if !out.iter().any(|(n, _)| *n == name) {
+                out.push((name, text));
+            }
+        };
+        for ext in [("vhd", vhdl_out), ("v", verilog_out)].iter().filter(|e| e.1).map(|e| e.0) {
+            emit::design_files(&m, ext).into_iter().for_each(&mut push);
         }
         let text = serde_json::to_string_pretty(&manifest(&m, lat, params)).unwrap_or_default() + "\n";
         out.push((format!("{}.json", m.name), text));

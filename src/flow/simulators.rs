@@ -1,6 +1,7 @@
 //! The external simulators, as one table (after MyHDL's `registerSimulator`): how to tell
 //! whether each is installed, and how to compile and run a testbench directory with it.
 
+use crate::rtl::Module;
 use std::path::Path;
 use std::process::Command;
 
@@ -36,51 +37,44 @@ impl Simulator {
         Command::new(self.program()).arg(flag).output().is_ok_and(|o| o.status.success())
     }
 
-    /// Compiles and runs the testbench `tb` in `dir`, whose HDL files are `sources` (design
-    /// first). Returns (passed, failed) from the testbench's closing line.
-    pub fn run(self, dir: &Path, sources: &[&str], tb: &str) -> Result<(u64, u64), String> {
-        self.run_timed(dir, sources, tb).map(|r| (r.passed, r.failed))
+    /// Compiles and runs, in `dir`, the files `testbench::bench_files` wrote there for `m`.
+    /// Returns (passed, failed) from the testbench's closing line.
+    pub fn run(self, dir: &Path, m: &Module) -> Result<(u64, u64), String> {
+        self.run_timed(dir, m).map(|r| (r.passed, r.failed))
     }
 
-    /// Like `run`, also timing the simulation step alone (not the compilation).
-    pub fn run_timed(self, dir: &Path, sources: &[&str], tb: &str) -> Result<RunResult, String> {
+    /// Like `run`, also timing the simulation: the Verilator harness times its clock loop
+    /// itself; the others are timed as the whole simulation process (not the compilation).
+    pub fn run_timed(self, dir: &Path, m: &Module) -> Result<RunResult, String> {
+        let ext = if self == Simulator::Ghdl { "vhd" } else { "v" };
+        let design: Vec<String> = m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
+        let tb = super::testbench::tb_name(m);
+        let words = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<String>>();
         let steps: Vec<Vec<String>> = match self {
             Simulator::Ghdl => {
-                let std = "--std=93c".to_string();
-                let mut analyse = vec!["ghdl".into(), "-a".into(), std.clone(), "--workdir=.".into()];
-                analyse.extend(sources.iter().map(|s| s.to_string()));
+                let mut analyse = words(&["ghdl", "-a", "--std=93c", "--workdir=."]);
+                analyse.extend(design);
+                analyse.push("tb.vhd".into());
                 vec![
                     analyse,
-                    vec!["ghdl".into(), "-e".into(), std.clone(), "--workdir=.".into(), tb.into()],
-                    vec!["ghdl".into(), "-r".into(), std, "--workdir=.".into(), tb.into()],
+                    words(&["ghdl", "-e", "--std=93c", "--workdir=.", &tb]),
+                    words(&["ghdl", "-r", "--std=93c", "--workdir=.", &tb]),
                 ]
             }
             Simulator::Iverilog => {
-                let mut compile =
-                    vec!["iverilog".into(), "-g2005".into(), "-o".into(), "tb.vvp".into(), "-s".into(), tb.into()];
-                compile.extend(sources.iter().map(|s| s.to_string()));
-                vec![compile, vec!["vvp".into(), "-n".into(), "tb.vvp".into()]]
+                let mut compile = words(&["iverilog", "-g2005", "-o", "tb.vvp", "-s", &tb]);
+                compile.extend(design);
+                compile.push("tb.v".into());
+                vec![compile, words(&["vvp", "-n", "tb.vvp"])]
             }
             Simulator::Verilator => {
-                let mut build: Vec<String> = [
-                    "verilator",
-                    "--binary",
-                    "--timing",
-                    "-j",
-                    "2",
-                    "-Wno-fatal",
-                    "-Wno-lint",
-                    "-Wno-style",
-                    "--top-module",
-                    tb,
-                    "-o",
-                    "tbsim",
-                ]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-                build.extend(sources.iter().map(|s| s.to_string()));
-                vec![build, vec!["./obj_dir/tbsim".into()]]
+                let mut build = words(&[
+                    "verilator", "--cc", "--exe", "--build", "-O3", "-j", "2", "-Wno-fatal", "-Wno-lint", "-Wno-style",
+                    "--top-module", &m.name, "-o", "harness",
+                ]);
+                build.extend(design);
+                build.push("harness.cpp".into());
+                vec![build, words(&["./obj_dir/harness"])]
             }
         };
         let mut last = String::new();
@@ -105,6 +99,9 @@ impl Simulator {
         }
         let (passed, failed) =
             parse_summary(&last).ok_or_else(|| format!("{}: no 'N passed, N failed' line in:\n{last}", self.name()))?;
+        if let Some(s) = last.lines().find_map(|l| l.strip_prefix("simulation seconds ")) {
+            seconds = s.trim().parse().unwrap_or(seconds);
+        }
         Ok(RunResult { passed, failed, seconds })
     }
 }

@@ -1,7 +1,7 @@
 //! `fxrt synth`: Virtex-5 area estimates from yosys `synth_xilinx -family xc5v`.
 
 use crate::error::{Error, Result};
-use crate::rtl::emit::verilog;
+use crate::rtl::emit;
 use crate::rtl::netlist::Module;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -51,10 +51,17 @@ pub fn area_from_stat(module: &str, stat: &serde_json::Value) -> Area {
 pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     std::fs::create_dir_all(dir).map_err(io)?;
-    let file = format!("{}.v", m.name);
-    std::fs::write(dir.join(&file), verilog::print(m)).map_err(io)?;
-    let script =
-        format!("read_verilog {file}; synth_xilinx -family xc5v -top {}; tee -q -o stat.json stat -json", m.name);
+    let files = emit::design_files(m, "v");
+    for (file, text) in &files {
+        std::fs::write(dir.join(file), text).map_err(io)?;
+    }
+    let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).collect();
+    // -flatten: one area figure for the whole hierarchy.
+    let script = format!(
+        "read_verilog {}; synth_xilinx -family xc5v -flatten -top {}; tee -q -o stat.json stat -json",
+        names.join(" "),
+        m.name
+    );
     let out = Command::new("yosys")
         .args(["-q", "-l", "yosys.log", "-p", &script])
         .current_dir(dir)

@@ -5,10 +5,12 @@
 use crate::rtl::netlist::{Module, SigId};
 use crate::rtl::sim::Sim;
 use crate::rtl::width::Ty;
+use super::simulators::Simulator;
 use askama::Template;
 
 pub struct Port {
     pub name: String,
+    pub ty: Ty,
     pub width: u32,
     /// VHDL type, e.g. `signed(31 downto 0)`.
     pub vtype: String,
@@ -44,6 +46,24 @@ struct VerilogTb<'a> {
     outputs: &'a [Port],
     total_width: u32,
     count: usize,
+}
+
+/// A port as the C++ harness sees it: its 32-bit words at `offset` in a clock's line.
+pub struct CppPort {
+    pub name: String,
+    pub words: u32,
+    pub offset: u32,
+}
+
+#[derive(Template)]
+#[template(path = "verilator_harness.cpp", escape = "none")]
+struct VerilatorHarness<'a> {
+    module: &'a str,
+    vectors: &'a str,
+    has_reset: bool,
+    stride: u32,
+    inputs: &'a [CppPort],
+    outputs: &'a [CppPort],
 }
 
 /// One clock's stimulus: the reset input and every data input, in `Module::inputs` order.
@@ -82,6 +102,7 @@ fn ports(m: &Module, ids: &[(String, SigId)], mut lsb: u32) -> (Vec<Port>, u32) 
         let t = m.sig(*id).ty;
         v.push(Port {
             name: name.clone(),
+            ty: t,
             width: t.width,
             vtype: format!("{}({} downto 0)", if t.signed { "signed" } else { "unsigned" }, t.width - 1),
             kind: if t.signed { "signed" } else { "unsigned" },
@@ -95,53 +116,80 @@ fn ports(m: &Module, ids: &[(String, SigId)], mut lsb: u32) -> (Vec<Port>, u32) 
     (v, lsb)
 }
 
-/// The rendered files of a testbench: (file name, contents).
-pub struct TestbenchFiles {
-    pub vhdl_tb: String,
-    pub verilog_tb: String,
-    pub vectors_txt: String,
-    pub vectors_hex: String,
-    pub tb_name: String,
+/// Everything one simulator needs in its directory: the design in its language (one file per
+/// module), its testbench and its vectors, as (file name, contents).
+pub fn bench_files(m: &Module, t: &Transcript, sim: Simulator) -> Vec<(String, String)> {
+    let mut files = crate::rtl::emit::design_files(m, if sim == Simulator::Ghdl { "vhd" } else { "v" });
+    files.extend(match sim {
+        Simulator::Ghdl => render_vhdl(m, t),
+        Simulator::Iverilog => render_verilog(m, t),
+        Simulator::Verilator => render_harness(m, t),
+    });
+    files
 }
 
-pub fn render(m: &Module, t: &Transcript) -> TestbenchFiles {
-    let tb_name = format!("{}_tb", m.name);
-    let in_ids: Vec<(String, SigId)> = m.inputs.iter().map(|&i| (m.sig(i).name.clone(), i)).collect();
-    // Verilog vector word, most significant first: [rst] inputs… outputs…
+/// Name of the testbench entity/module for `m` (GHDL and Icarus elaborate it).
+pub fn tb_name(m: &Module) -> String {
+    format!("{}_tb", m.name)
+}
+
+/// Input ports in `Module::inputs` order.
+fn input_ids(m: &Module) -> Vec<(String, SigId)> {
+    m.inputs.iter().map(|&i| (m.sig(i).name.clone(), i)).collect()
+}
+
+/// The VHDL testbench (textio) and `vectors.txt`: one line per clock of bit strings.
+fn render_vhdl(m: &Module, t: &Transcript) -> Vec<(String, String)> {
     let (outputs, after_out) = ports(m, &m.outputs, 0);
-    let (inputs, after_in) = ports(m, &in_ids, after_out);
+    let (inputs, _) = ports(m, &input_ids(m), after_out);
     let has_reset = m.has_reset();
-    let total_width = after_in + has_reset as u32;
-    let out_tys: Vec<Ty> = m.outputs.iter().map(|(_, i)| m.sig(*i).ty).collect();
-    let in_tys: Vec<Ty> = m.inputs.iter().map(|&i| m.sig(i).ty).collect();
     let mut txt = String::new();
-    let mut hex = String::new();
     for (st, out) in t.stimuli.iter().zip(&t.outputs) {
         let mut fields: Vec<String> = Vec::new();
-        let mut word = num_word::Word::default();
         if has_reset {
             fields.push(if st.reset { "1".into() } else { "0".into() });
-            word.push(st.reset as u128, 1);
         }
-        for (ty, v) in in_tys.iter().zip(&st.inputs) {
-            fields.push(crate::rtl::emit::bit_string(ty.wrap(*v), ty.width));
-            word.push(ty.wrap(*v), ty.width);
+        for (p, v) in inputs.iter().zip(&st.inputs) {
+            fields.push(crate::rtl::emit::bit_string(p.ty.wrap(*v), p.width));
         }
-        for (ty, v) in out_tys.iter().zip(out) {
-            fields.push(crate::rtl::emit::bit_string(*v, ty.width));
-            word.push(*v, ty.width);
+        for (p, v) in outputs.iter().zip(out) {
+            fields.push(crate::rtl::emit::bit_string(*v, p.width));
         }
         txt.push_str(&fields.join(" "));
         txt.push('\n');
+    }
+    let tb = tb_name(m);
+    let text = VhdlTb { tb: &tb, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
+        .render()
+        .expect("testbench template renders");
+    vec![("tb.vhd".into(), text + "\n"), ("vectors.txt".into(), txt)]
+}
+
+/// The Verilog testbench and `vectors.hex`: one `$readmemh` word per clock.
+fn render_verilog(m: &Module, t: &Transcript) -> Vec<(String, String)> {
+    // Vector word, most significant first: [rst] inputs… outputs…
+    let (outputs, after_out) = ports(m, &m.outputs, 0);
+    let (inputs, after_in) = ports(m, &input_ids(m), after_out);
+    let has_reset = m.has_reset();
+    let total_width = after_in + has_reset as u32;
+    let mut hex = String::new();
+    for (st, out) in t.stimuli.iter().zip(&t.outputs) {
+        let mut word = num_word::Word::default();
+        if has_reset {
+            word.push(st.reset as u128, 1);
+        }
+        for (p, v) in inputs.iter().zip(&st.inputs) {
+            word.push(p.ty.wrap(*v), p.width);
+        }
+        for (p, v) in outputs.iter().zip(out) {
+            word.push(*v, p.width);
+        }
         hex.push_str(&word.hex(total_width));
         hex.push('\n');
     }
-    let vhdl_tb =
-        VhdlTb { tb: &tb_name, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
-            .render()
-            .expect("testbench template renders");
-    let verilog_tb = VerilogTb {
-        tb: &tb_name,
+    let tb = tb_name(m);
+    let text = VerilogTb {
+        tb: &tb,
         module: &m.name,
         vectors: "vectors.hex",
         has_reset,
@@ -153,13 +201,58 @@ pub fn render(m: &Module, t: &Transcript) -> TestbenchFiles {
     }
     .render()
     .expect("testbench template renders");
-    TestbenchFiles {
-        vhdl_tb: vhdl_tb + "\n",
-        verilog_tb: verilog_tb + "\n",
-        vectors_txt: txt,
-        vectors_hex: hex,
-        tb_name,
+    vec![("tb.v".into(), text + "\n"), ("vectors.hex".into(), hex)]
+}
+
+/// The Verilator harness: ports as 32-bit words, one line of words per clock.
+fn render_harness(m: &Module, t: &Transcript) -> Vec<(String, String)> {
+    let has_reset = m.has_reset();
+    let mut offset = has_reset as u32;
+    let mut layout = |ids: Vec<(String, Ty)>| -> Vec<CppPort> {
+        ids.into_iter()
+            .map(|(name, ty)| {
+                let p = CppPort { name, words: ty.width.div_ceil(32), offset };
+                offset += p.words;
+                p
+            })
+            .collect()
+    };
+    let inputs = layout(m.inputs.iter().map(|&i| (m.sig(i).name.clone(), m.sig(i).ty)).collect());
+    let outputs = layout(m.outputs.iter().map(|(n, i)| (n.clone(), m.sig(*i).ty)).collect());
+    let stride = offset;
+    let in_tys: Vec<Ty> = m.inputs.iter().map(|&i| m.sig(i).ty).collect();
+    let out_tys: Vec<Ty> = m.outputs.iter().map(|(_, i)| m.sig(*i).ty).collect();
+    let mut text = String::new();
+    let push = |v: u128, w: u32, line: &mut Vec<String>| {
+        for k in 0..w.div_ceil(32) {
+            line.push(format!("{:x}", (v >> (32 * k)) as u32));
+        }
+    };
+    for (st, out) in t.stimuli.iter().zip(&t.outputs) {
+        let mut line = Vec::with_capacity(stride as usize);
+        if has_reset {
+            line.push(if st.reset { "1".into() } else { "0".into() });
+        }
+        for (ty, v) in in_tys.iter().zip(&st.inputs) {
+            push(ty.wrap(*v), ty.width, &mut line);
+        }
+        for (ty, v) in out_tys.iter().zip(out) {
+            push(*v, ty.width, &mut line);
+        }
+        text.push_str(&line.join(" "));
+        text.push('\n');
     }
+    let cpp = VerilatorHarness {
+        module: &m.name,
+        vectors: "vectors.words",
+        has_reset,
+        stride,
+        inputs: &inputs,
+        outputs: &outputs,
+    }
+    .render()
+    .expect("harness template renders");
+    vec![("harness.cpp".into(), cpp + "\n"), ("vectors.words".into(), text)]
 }
 
 /// A wide word built field by field, most significant first.

@@ -2,7 +2,10 @@
 //! VHDL and Verilog printers, so the three cannot disagree on a width or a sign.
 
 pub mod emit;
+pub mod names;
 pub mod netlist;
+pub mod batch;
+pub mod flatten;
 pub mod sim;
 pub mod width;
 

@@ -1,11 +1,14 @@
-//! The netlist: a module is a list of signals in SSA form (every signal has exactly one
-//! definition, and combinational definitions only refer to signals created before them), plus
-//! ROMs. Registers and ROM reads are the only state. Widths come from `width.rs`.
+//! The netlist: a module is a list of signals, each with exactly one definition, plus ROMs
+//! and instances of other modules. Combinational definitions refer to signals created before
+//! them, except through a `Wire`, which is declared first and driven later (feedback, as from
+//! a state machine's next-state logic). Registers, ROM reads and RAM writes are the only
+//! state. Widths come from `width.rs`.
 
+use super::names;
 use super::width::{BinOp, Ty, UnOp, bin_ty, un_ty};
-use serde::Serialize;
+use std::rc::Rc;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SigId(pub u32);
 
 /// A handle to a signal: its id and type.
@@ -15,7 +18,7 @@ pub struct Sig {
     pub ty: Ty,
 }
 
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Def {
     Input,
     Const(u128),
@@ -27,8 +30,21 @@ pub enum Def {
         t: SigId,
         f: SigId,
     },
+    /// A case selection: the arm whose value equals `sel`, else `default`.
+    Case {
+        sel: SigId,
+        arms: Vec<(u128, SigId)>,
+        default: SigId,
+    },
     /// Concatenation, most significant part first; unsigned.
     Concat(Vec<SigId>),
+    /// A named copy of a signal given later with `drive` (forward references).
+    Wire(Option<SigId>),
+    /// Output `port` of instance `inst` (an index into `Module::instances`).
+    InstOut {
+        inst: usize,
+        port: usize,
+    },
     /// A register clocked by the module clock. `reset` is a synchronous reset value (driven
     /// by the module's `rst` input); without `enable` it loads every cycle.
     Reg {
@@ -43,14 +59,54 @@ pub enum Def {
     },
 }
 
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+impl Def {
+    /// Signals this definition reads in the same clock cycle (its combinational inputs).
+    pub fn comb_inputs(&self) -> Vec<SigId> {
+        match self {
+            Def::Bin(_, a, b) => vec![*a, *b],
+            Def::Un(_, a) => vec![*a],
+            Def::Mux { sel, t, f } => vec![*sel, *t, *f],
+            Def::Case { sel, arms, default } => {
+                let mut v = vec![*sel, *default];
+                v.extend(arms.iter().map(|a| a.1));
+                v
+            }
+            Def::Concat(parts) => parts.clone(),
+            Def::Wire(d) => d.iter().copied().collect(),
+            Def::Input | Def::Const(_) | Def::InstOut { .. } | Def::Reg { .. } | Def::RomRead { .. } => Vec::new(),
+        }
+    }
+
+    /// The same definition with every signal reference passed through `f`.
+    pub fn map_ids(&self, f: impl Fn(SigId) -> SigId) -> Def {
+        match self {
+            Def::Input => Def::Input,
+            Def::Const(v) => Def::Const(*v),
+            Def::Bin(op, a, b) => Def::Bin(*op, f(*a), f(*b)),
+            Def::Un(op, a) => Def::Un(*op, f(*a)),
+            Def::Mux { sel, t, f: e } => Def::Mux { sel: f(*sel), t: f(*t), f: f(*e) },
+            Def::Case { sel, arms, default } => Def::Case {
+                sel: f(*sel),
+                arms: arms.iter().map(|(v, a)| (*v, f(*a))).collect(),
+                default: f(*default),
+            },
+            Def::Concat(parts) => Def::Concat(parts.iter().map(|p| f(*p)).collect()),
+            Def::Wire(d) => Def::Wire(d.map(&f)),
+            Def::InstOut { inst, port } => Def::InstOut { inst: *inst, port: *port },
+            Def::Reg { next, enable, reset } => Def::Reg { next: next.map(&f), enable: enable.map(&f), reset: *reset },
+            Def::RomRead { rom, addr } => Def::RomRead { rom: *rom, addr: f(*addr) },
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Signal {
     pub name: String,
     pub ty: Ty,
     pub def: Def,
 }
 
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Rom {
     pub name: String,
     pub width: u32,
@@ -61,7 +117,16 @@ pub struct Rom {
     pub write: Option<(SigId, SigId, SigId)>,
 }
 
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+/// An instance of another module: `inputs[i]` drives the sub-module's i-th input port; its
+/// outputs are this module's `InstOut` signals. Clock and reset are passed through.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Instance {
+    pub name: String,
+    pub module: Rc<Module>,
+    pub inputs: Vec<SigId>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Module {
     pub name: String,
     pub signals: Vec<Signal>,
@@ -69,194 +134,8 @@ pub struct Module {
     /// Output ports: (port name, driving signal).
     pub outputs: Vec<(String, SigId)>,
     pub roms: Vec<Rom>,
+    pub instances: Vec<Instance>,
 }
-
-/// Names no emitted identifier may take (VHDL-93 and Verilog-2001 keywords, and the ports the
-/// printers add themselves).
-const RESERVED: &[&str] = &[
-    "abs",
-    "access",
-    "after",
-    "alias",
-    "all",
-    "and",
-    "architecture",
-    "array",
-    "assert",
-    "assign",
-    "attribute",
-    "begin",
-    "block",
-    "body",
-    "buffer",
-    "bus",
-    "case",
-    "component",
-    "configuration",
-    "constant",
-    "default",
-    "disconnect",
-    "downto",
-    "else",
-    "elsif",
-    "end",
-    "entity",
-    "exit",
-    "file",
-    "for",
-    "function",
-    "generate",
-    "generic",
-    "group",
-    "guarded",
-    "if",
-    "impure",
-    "in",
-    "inertial",
-    "initial",
-    "inout",
-    "input",
-    "integer",
-    "is",
-    "label",
-    "library",
-    "linkage",
-    "literal",
-    "loop",
-    "map",
-    "mod",
-    "module",
-    "nand",
-    "new",
-    "next",
-    "nor",
-    "not",
-    "null",
-    "of",
-    "on",
-    "open",
-    "or",
-    "others",
-    "out",
-    "output",
-    "package",
-    "parameter",
-    "port",
-    "postponed",
-    "procedure",
-    "process",
-    "pure",
-    "range",
-    "record",
-    "reg",
-    "register",
-    "reject",
-    "rem",
-    "report",
-    "return",
-    "rol",
-    "ror",
-    "select",
-    "severity",
-    "signal",
-    "shared",
-    "signed",
-    "sla",
-    "sll",
-    "sra",
-    "srl",
-    "subtype",
-    "then",
-    "to",
-    "transport",
-    "type",
-    "unaffected",
-    "units",
-    "until",
-    "unsigned",
-    "use",
-    "variable",
-    "wait",
-    "when",
-    "while",
-    "wire",
-    "with",
-    "xnor",
-    "xor",
-    "always",
-    "endmodule",
-    "integer",
-    "clk",
-    "rst",
-    "time",
-    "event",
-    "force",
-    "release",
-    "real",
-    "tri",
-    "edge",
-    "posedge",
-    "negedge",
-    "table",
-    "endtable",
-    "primitive",
-    "endprimitive",
-    "specify",
-    "endspecify",
-    "task",
-    "endtask",
-    "endfunction",
-    "endcase",
-    "endgenerate",
-    "casex",
-    "casez",
-    "defparam",
-    "deassign",
-    "disable",
-    "forever",
-    "fork",
-    "join",
-    "genvar",
-    "localparam",
-    "repeat",
-    "supply0",
-    "supply1",
-    "tri0",
-    "tri1",
-    "triand",
-    "trior",
-    "trireg",
-    "wand",
-    "wor",
-    "buf",
-    "bufif0",
-    "bufif1",
-    "notif0",
-    "notif1",
-    "pullup",
-    "pulldown",
-    "cmos",
-    "nmos",
-    "pmos",
-    "rcmos",
-    "rnmos",
-    "rpmos",
-    "tran",
-    "scalared",
-    "vectored",
-    "small",
-    "medium",
-    "large",
-    "strong0",
-    "strong1",
-    "weak0",
-    "weak1",
-    "highz0",
-    "highz1",
-    "pull0",
-    "pull1",
-    "macromodule",
-];
 
 impl Module {
     pub fn new(name: &str) -> Module {
@@ -266,6 +145,7 @@ impl Module {
             inputs: Vec::new(),
             outputs: Vec::new(),
             roms: Vec::new(),
+            instances: Vec::new(),
         }
     }
 
@@ -277,25 +157,15 @@ impl Module {
         Sig { id, ty: self.sig(id).ty }
     }
 
-    /// A readable, unique identifier legal in both languages: lower case, [a-z0-9_], starting
-    /// with a letter, no double or trailing underscore, not a keyword.
+    /// A readable identifier legal in both languages (see `names::legal`), unique among this
+    /// module's signals, ports, memories and instance labels.
     fn unique_name(&self, base: &str) -> String {
-        let mut s: String =
-            base.to_ascii_lowercase().chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
-        while s.contains("__") {
-            s = s.replace("__", "_");
-        }
-        let mut s = s.trim_matches('_').to_string();
-        if s.is_empty() || !s.starts_with(|c: char| c.is_ascii_alphabetic()) {
-            s = format!("s_{s}");
-        }
-        if RESERVED.contains(&s.as_str()) {
-            s.push_str("_s");
-        }
+        let s = names::legal(base);
         let taken = |n: &str| {
             self.signals.iter().any(|x| x.name == n)
                 || self.outputs.iter().any(|x| x.0 == n)
                 || self.roms.iter().any(|x| x.name == n)
+                || self.instances.iter().any(|x| x.name == n)
         };
         if !taken(&s) {
             return s;
@@ -416,19 +286,94 @@ impl Module {
         self.outputs.push((name, sig.id));
     }
 
-    /// Whether any register has a synchronous reset (the module then has an `rst` input).
+    /// Whether any register here or in an instance has a synchronous reset (the module then
+    /// has an `rst` input).
     pub fn has_reset(&self) -> bool {
         self.signals.iter().any(|s| matches!(s.def, Def::Reg { reset: Some(_), .. }))
+            || self.instances.iter().any(|i| i.module.has_reset())
     }
 
-    /// Checks that every register is connected; printers and the simulator call it first.
+    /// Register bits, instances included.
+    pub fn register_bits(&self) -> u64 {
+        let own: u64 =
+            self.signals.iter().filter(|s| matches!(s.def, Def::Reg { .. })).map(|s| s.ty.width as u64).sum();
+        own + self.instances.iter().map(|i| i.module.register_bits()).sum::<u64>()
+    }
+
+    /// Checks that every register and wire is driven; printers and the simulator call it first.
     pub fn check(&self) -> Result<(), String> {
         for s in &self.signals {
-            if let Def::Reg { next: None, .. } = s.def {
-                return Err(format!("{}: register {} has no input", self.name, s.name));
+            match s.def {
+                Def::Reg { next: None, .. } => return Err(format!("{}: register {} has no input", self.name, s.name)),
+                Def::Wire(None) => return Err(format!("{}: wire {} is not driven", self.name, s.name)),
+                _ => {}
             }
         }
         Ok(())
+    }
+
+    /// A signal driven later by `drive`: for feedback that is not through a register.
+    pub fn wire(&mut self, name: &str, ty: Ty) -> Sig {
+        self.push(name, ty, Def::Wire(None))
+    }
+
+    pub fn drive(&mut self, wire: Sig, src: Sig) {
+        assert_eq!(wire.ty, src.ty, "{}: wire {} driver type", self.name, self.sig(wire.id).name);
+        match &mut self.signals[wire.id.0 as usize].def {
+            Def::Wire(d @ None) => *d = Some(src.id),
+            _ => panic!("{}: drive on a non-wire or twice", self.name),
+        }
+    }
+
+    /// `arms[i].1` when `sel` equals `arms[i].0`, else `default` (a `case`/`with select`).
+    pub fn case(&mut self, name: &str, sel: Sig, arms: &[(u128, Sig)], default: Sig) -> Sig {
+        for (v, a) in arms {
+            assert_eq!(a.ty, default.ty, "{}: {name}: case arms must have one type", self.name);
+            assert!(sel.ty.width >= 128 || *v >> sel.ty.width == 0, "{}: {name}: arm {v} wider than select", self.name);
+        }
+        let mut seen: Vec<u128> = arms.iter().map(|a| a.0).collect();
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), arms.len(), "{}: {name}: repeated case arm", self.name);
+        let arms = arms.iter().map(|(v, a)| (*v, a.id)).collect();
+        self.push(name, default.ty, Def::Case { sel: sel.id, arms, default: default.id })
+    }
+
+    /// Instantiates `sub` with its inputs driven by `inputs` (in port order); returns its
+    /// outputs as signals of this module, named `{label}_{port}`.
+    pub fn instance(&mut self, label: &str, sub: &Rc<Module>, inputs: &[Sig]) -> Vec<Sig> {
+        assert_eq!(inputs.len(), sub.inputs.len(), "{}: {label}: {} takes {} inputs", self.name, sub.name, sub.inputs.len());
+        for (s, &p) in inputs.iter().zip(&sub.inputs) {
+            let port = sub.sig(p);
+            assert_eq!(s.ty, port.ty, "{}: {label}: input {} of {} type", self.name, port.name, sub.name);
+        }
+        let name = self.unique_name(label);
+        let inst = self.instances.len();
+        self.instances.push(Instance { name: name.clone(), module: sub.clone(), inputs: inputs.iter().map(|s| s.id).collect() });
+        (0..sub.outputs.len())
+            .map(|port| {
+                let (pname, pid) = &sub.outputs[port];
+                let ty = sub.sig(*pid).ty;
+                self.push(&format!("{name}_{pname}"), ty, Def::InstOut { inst, port })
+            })
+            .collect()
+    }
+
+    /// This module and every module it instantiates, each once, sub-modules before their
+    /// users (the order to compile them in). Two different modules may not share a name.
+    pub fn hierarchy(&self) -> Vec<&Module> {
+        fn visit<'a>(m: &'a Module, out: &mut Vec<&'a Module>) {
+            for i in &m.instances {
+                visit(&i.module, out);
+            }
+            match out.iter().find(|x| x.name == m.name) {
+                Some(x) => assert!(*x == m, "two different modules are named {}", m.name),
+                None => out.push(m),
+            }
+        }
+        let mut out = Vec::new();
+        visit(self, &mut out);
+        out
     }
 
     // Short forms used by the cores.

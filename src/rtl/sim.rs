@@ -1,8 +1,8 @@
-//! The cycle-accurate simulator: a module compiled once to a flat list of operations over
-//! u128 slots (one per signal), evaluated in creation order — which is a topological order,
-//! because combinational signals only refer to earlier ones. No allocation per cycle.
+//! The cycle-accurate simulator: a module (with its instances) flattened once to a list of
+//! operations over u128 slots, in topological order (`flatten.rs`). No allocation per cycle.
 
-use super::netlist::{Def, Module, Sig};
+use super::flatten::flatten;
+use super::netlist::{Def, Module, Sig, SigId};
 use super::width::{BinOp, Ty, UnOp, eval_bin, eval_un};
 
 #[derive(Clone, Debug)]
@@ -10,6 +10,7 @@ enum Op {
     Bin { op: BinOp, dst: usize, a: usize, b: usize, ta: Ty, tb: Ty, tr: Ty },
     Un { op: UnOp, dst: usize, a: usize, ta: Ty, tr: Ty },
     Mux { dst: usize, sel: usize, t: usize, f: usize },
+    Case { dst: usize, sel: usize, arms: Vec<(u128, usize)>, default: usize },
     Concat { dst: usize, parts: Vec<(usize, u32)> },
 }
 
@@ -32,6 +33,8 @@ struct RomUpdate {
 pub struct Sim {
     vals: Vec<u128>,
     tys: Vec<Ty>,
+    /// Slot of each top-module signal.
+    top: Vec<usize>,
     comb: Vec<Op>,
     regs: Vec<RegUpdate>,
     rom_reads: Vec<RomUpdate>,
@@ -47,30 +50,14 @@ pub struct Sim {
 
 impl Sim {
     pub fn new(m: &Module) -> Sim {
-        m.check().unwrap_or_else(|e| panic!("{e}"));
-        let n = m.signals.len();
-        let mut vals = vec![0u128; n];
-        let tys: Vec<Ty> = m.signals.iter().map(|s| s.ty).collect();
-        let (mut comb, mut regs, mut rom_reads) = (Vec::new(), Vec::new(), Vec::new());
-        let ix = |id: super::netlist::SigId| id.0 as usize;
-        for (i, s) in m.signals.iter().enumerate() {
-            match &s.def {
-                Def::Input => {}
+        let flat = flatten(m);
+        let tys = flat.tys;
+        let mut vals = vec![0u128; tys.len()];
+        let (mut regs, mut rom_reads) = (Vec::new(), Vec::new());
+        let ix = |id: SigId| id.0 as usize;
+        for (i, def) in flat.defs.iter().enumerate() {
+            match def {
                 Def::Const(v) => vals[i] = *v,
-                Def::Bin(op, a, b) => comb.push(Op::Bin {
-                    op: *op,
-                    dst: i,
-                    a: ix(*a),
-                    b: ix(*b),
-                    ta: tys[ix(*a)],
-                    tb: tys[ix(*b)],
-                    tr: s.ty,
-                }),
-                Def::Un(op, a) => comb.push(Op::Un { op: *op, dst: i, a: ix(*a), ta: tys[ix(*a)], tr: s.ty }),
-                Def::Mux { sel, t, f } => comb.push(Op::Mux { dst: i, sel: ix(*sel), t: ix(*t), f: ix(*f) }),
-                Def::Concat(parts) => {
-                    comb.push(Op::Concat { dst: i, parts: parts.iter().map(|p| (ix(*p), tys[ix(*p)].width)).collect() })
-                }
                 Def::Reg { next, enable, reset } => {
                     let next = ix(next.expect("checked"));
                     regs.push(RegUpdate { dst: i, next, enable: enable.map(ix), reset: *reset });
@@ -79,29 +66,48 @@ impl Sim {
                     }
                 }
                 Def::RomRead { rom, addr } => rom_reads.push(RomUpdate { dst: i, addr: ix(*addr), rom: *rom }),
+                _ => {}
             }
         }
-        let roms = m.roms.iter().map(|r| r.words.clone()).collect();
-        let writes = m
-            .roms
+        let comb = flat
+            .comb_order
             .iter()
-            .enumerate()
-            .filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, ix(we), ix(a), ix(d))))
+            .map(|&i| match &flat.defs[i] {
+                Def::Bin(op, a, b) => {
+                    Op::Bin { op: *op, dst: i, a: ix(*a), b: ix(*b), ta: tys[ix(*a)], tb: tys[ix(*b)], tr: tys[i] }
+                }
+                Def::Un(op, a) => Op::Un { op: *op, dst: i, a: ix(*a), ta: tys[ix(*a)], tr: tys[i] },
+                Def::Mux { sel, t, f } => Op::Mux { dst: i, sel: ix(*sel), t: ix(*t), f: ix(*f) },
+                Def::Case { sel, arms, default } => Op::Case {
+                    dst: i,
+                    sel: ix(*sel),
+                    arms: arms.iter().map(|(v, a)| (*v, ix(*a))).collect(),
+                    default: ix(*default),
+                },
+                Def::Concat(parts) => {
+                    Op::Concat { dst: i, parts: parts.iter().map(|p| (ix(*p), tys[ix(*p)].width)).collect() }
+                }
+                other => unreachable!("not combinational: {other:?}"),
+            })
             .collect();
+        let roms = flat.mems.iter().map(|r| r.words.clone()).collect();
+        let writes = flat.mems.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, we, a, d))).collect();
         let next = vec![0; regs.len() + rom_reads.len()];
-        let mut sim = Sim { vals, tys, comb, regs, rom_reads, roms, writes, next, reset: false, cycles: 0 };
+        let mut sim =
+            Sim { vals, tys, top: flat.top, comb, regs, rom_reads, roms, writes, next, reset: false, cycles: 0 };
         sim.eval();
         sim
     }
 
     pub fn set(&mut self, s: Sig, value: i128) {
-        let ty = self.tys[s.id.0 as usize];
+        let i = self.top[s.id.0 as usize];
+        let ty = self.tys[i];
         debug_assert!(ty.fits(value) || ty.fits(value - (1i128 << ty.width.min(126))), "value {value} for {ty:?}");
-        self.vals[s.id.0 as usize] = ty.wrap(value);
+        self.vals[i] = ty.wrap(value);
     }
 
     pub fn get(&self, s: Sig) -> i128 {
-        let i = s.id.0 as usize;
+        let i = self.top[s.id.0 as usize];
         self.tys[i].value(self.vals[i])
     }
 
@@ -113,6 +119,10 @@ impl Sim {
                 Op::Bin { op, dst, a, b, ta, tb, tr } => v[dst] = eval_bin(op, ta, v[a], tb, v[b], tr),
                 Op::Un { op, dst, a, ta, tr } => v[dst] = eval_un(op, ta, v[a], tr),
                 Op::Mux { dst, sel, t, f } => v[dst] = if v[sel] & 1 == 1 { v[t] } else { v[f] },
+                Op::Case { dst, sel, ref arms, default } => {
+                    let s = v[sel];
+                    v[dst] = v[arms.iter().find(|a| a.0 == s).map_or(default, |a| a.1)];
+                }
                 Op::Concat { dst, ref parts } => {
                     let mut acc = 0u128;
                     for &(p, w) in parts {

@@ -26,3 +26,10 @@ pub fn hex_string(v: u128, w: u32) -> String {
     let digits = w.div_ceil(4) as usize;
     format!("{v:0digits$x}")
 }
+
+/// The HDL files of a design in one language: one file per module, sub-modules first (the
+/// order to compile them in). `ext` is "vhd" or "v".
+pub fn design_files(top: &crate::rtl::Module, ext: &str) -> Vec<(String, String)> {
+    let print = if ext == "vhd" { vhdl::print } else { verilog::print };
+    top.hierarchy().into_iter().map(|m| (format!("{}.{ext}", m.name), print(m))).collect()
+}

@@ -74,7 +74,11 @@ pub fn print(m: &Module) -> String {
             Def::RomRead { .. } => {
                 let _ = writeln!(s, "  reg {} {} = {};", decl(sig.ty), sig.name, literal(sig.ty, 0));
             }
-            Def::Bin(..) | Def::Un(..) | Def::Mux { .. } | Def::Concat(_) => {
+            // A case is a combinational `always` block, so its target is a `reg`.
+            Def::Case { .. } => {
+                let _ = writeln!(s, "  reg {} {};", decl(sig.ty), sig.name);
+            }
+            Def::Bin(..) | Def::Un(..) | Def::Mux { .. } | Def::Concat(_) | Def::Wire(_) | Def::InstOut { .. } => {
                 let _ = writeln!(s, "  wire {} {};", decl(sig.ty), sig.name);
             }
         }
@@ -82,7 +86,17 @@ pub fn print(m: &Module) -> String {
     s.push_str("  /* verilator lint_on UNUSEDSIGNAL */\n");
     for sig in &m.signals {
         let expr = match &sig.def {
-            Def::Input | Def::Const(_) | Def::Reg { .. } | Def::RomRead { .. } => continue,
+            Def::Input | Def::Const(_) | Def::Reg { .. } | Def::RomRead { .. } | Def::InstOut { .. } => continue,
+            Def::Wire(d) => name(d.expect("checked")).to_string(),
+            Def::Case { sel, arms, default } => {
+                let w = ty(*sel).width;
+                let _ = writeln!(s, "  always @* begin\n    case ({})", name(*sel));
+                for (v, a) in arms {
+                    let _ = writeln!(s, "      {}: {} = {};", literal(Ty::u(w), *v), sig.name, name(*a));
+                }
+                let _ = writeln!(s, "      default: {} = {};\n    endcase\n  end", sig.name, name(*default));
+                continue;
+            }
             Def::Bin(op, ia, ib) => {
                 let (a, b) = (name(*ia), name(*ib));
                 match op {
@@ -125,6 +139,20 @@ pub fn print(m: &Module) -> String {
     }
     for (p, i) in &m.outputs {
         let _ = writeln!(s, "  assign {p} = {};", name(*i));
+    }
+    for (k, inst) in m.instances.iter().enumerate() {
+        let sub = &inst.module;
+        let mut map = vec![".clk(clk)".to_string()];
+        if sub.has_reset() {
+            map.push(".rst(rst)".into());
+        }
+        map.extend(sub.inputs.iter().zip(&inst.inputs).map(|(p, a)| format!(".{}({})", sub.sig(*p).name, name(*a))));
+        let outs = m.signals.iter().filter_map(|x| match x.def {
+            Def::InstOut { inst: i, port } if i == k => Some(format!(".{}({})", sub.outputs[port].0, x.name)),
+            _ => None,
+        });
+        map.extend(outs);
+        let _ = writeln!(s, "  {} {} (\n    {}\n  );", sub.name, inst.name, map.join(",\n    "));
     }
     let state: Vec<_> = m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
     let has_writes = m.roms.iter().any(|r| r.write.is_some());
