@@ -36,6 +36,40 @@ pub enum Command {
     Test(TestArgs),
     /// Virtex-5 area of the cores from yosys (LUT, FF, DSP48E, BRAM), as JSON.
     Synth(SynthArgs),
+    /// Run a whole frame through the generated ray tracing core and compare every pixel.
+    Sim(SimArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct SimArgs {
+    #[command(flatten)]
+    pub scene: SceneChoice,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Where the core runs.
+    #[arg(long, value_enum, default_value = "rust")]
+    pub sim: FrameSim,
+    /// Write W·H little-endian i32: input triangle number per pixel, −1 for a miss (as `render`).
+    #[arg(long)]
+    pub ids: Option<PathBuf>,
+    /// Write the binary hit/miss picture the core produced (seed 001 figure 3.7).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Build folder for an HDL simulation. Default: target/fxrt-sim/SIM.
+    #[arg(long)]
+    pub build: Option<PathBuf>,
+    /// Quotient bits per divider stage: 1 or 2.
+    #[arg(long = "div-bits", default_value_t = 1)]
+    pub div_bits: u32,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FrameSim {
+    Rust,
+    Ghdl,
+    Verilator,
 }
 
 #[derive(Args, Debug)]

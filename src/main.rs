@@ -1,6 +1,7 @@
 use clap::Parser;
 use fxrt::cli::{
-    BenchArgs, Cli, Command, CompareArgs, GenArgs, Lang, RenderArgs, SceneArgs, SimChoice, SynthArgs, TestArgs,
+    BenchArgs, Cli, Command, CompareArgs, FrameSim, GenArgs, Lang, RenderArgs, SceneArgs, SimArgs, SimChoice,
+    SynthArgs, TestArgs,
 };
 use fxrt::cores::intersect::IntersectParams;
 use fxrt::error::{Error, Result};
@@ -30,6 +31,11 @@ fn main() -> ExitCode {
         Some(Command::Bench(a)) => run_bench(a),
         Some(Command::Gen(a)) => run_gen(a),
         Some(Command::Synth(a)) => run_synth(a),
+        Some(Command::Sim(a)) => match run_sim(a) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(1),
+            Err(e) => Err(e),
+        },
         Some(Command::Test(a)) => match run_test(a) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
@@ -287,4 +293,54 @@ fn run_synth(a: SynthArgs) -> Result<()> {
         serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "params": p, "cores": cores, "thesis": thesis })
     );
     Ok(())
+}
+
+/// `fxrt sim`: a frame through the generated core; true when every pixel matched.
+fn run_sim(a: SimArgs) -> Result<bool> {
+    use fxrt::flow::frame;
+    let params = a.params.params()?;
+    let scene = Scene::load(&a.scene.source(), &params)?;
+    let cam = a.camera.camera(&scene)?;
+    let (w, h) = (cam.width, cam.height);
+    let id_width = rom::addr_bits((w * h) as usize);
+    let p = fxrt::cores::top::CoreParams::new(&scene, id_width, a.div_bits);
+    p.check()?;
+    let rays = frame::frame_rays(&scene, &cam);
+    let start = std::time::Instant::now();
+    let (results, stats) = match a.sim {
+        FrameSim::Rust => {
+            let bar = frame::progress_bar(rays.len() as u64, "rust");
+            let r = frame::simulate_rust(&p, &scene, &rays, &|n| bar.set_position(n));
+            bar.finish_and_clear();
+            r
+        }
+        hdl => {
+            let sim = if hdl == FrameSim::Ghdl { Simulator::Ghdl } else { Simulator::Verilator };
+            let dir = a.build.clone().unwrap_or_else(|| std::path::PathBuf::from("target/fxrt-sim").join(sim.name()));
+            fxrt::flow::frame::simulate_hdl(sim, &p, &scene, &rays, &dir)?
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let mismatches = frame::mismatches(&scene, &rays, &results);
+    let ids = frame::ids_image(&scene, w, h, &results);
+    let mut files = Vec::new();
+    if let Some(path) = &a.png {
+        files.push((path.clone(), frame::binary_png(w, h, &ids)));
+    }
+    if let Some(path) = &a.ids {
+        files.push((path.clone(), ids.iter().flat_map(|i| i.to_le_bytes()).collect()));
+    }
+    fxrt::io::write_all_atomic(&files)?;
+    println!(
+        "{}",
+        serde_json::json!({
+            "scene": scene.name, "simulator": format!("{:?}", a.sim).to_lowercase(), "size": format!("{w}x{h}"),
+            "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
+            "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
+            "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
+            "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
+            "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
+        })
+    );
+    Ok(mismatches == 0)
 }

@@ -4,9 +4,9 @@
 //! When there is no hit, t, u and v read 0.
 
 use super::divider::{self, divider_core};
-use std::rc::Rc;
 use crate::rtl::{BinOp, Module, Sig, Ty, UnOp};
 use serde::Serialize;
+use std::rc::Rc;
 
 /// The widths of one parameter set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -64,12 +64,12 @@ impl IntersectParams {
         Ok(())
     }
 
-    /// Input register, products, numerator/denominator, divider, t·ω, k, e·k, u/v and test.
     /// The divider this pipeline instantiates (operands shortened by T).
     pub fn divider(&self) -> Module {
         divider_core(self.n, self.div_bits, self.num_width() - self.t, self.den_width() - self.t)
     }
 
+    /// Input register, products, numerator/denominator, divider, t·ω, k, e·k, u/v and test.
     pub fn latency(&self) -> u32 {
         3 + divider::latency(self.n, self.div_bits) + 4
     }
@@ -100,18 +100,13 @@ pub fn input_ports(p: &IntersectParams) -> Vec<(&'static str, Ty)> {
     ]
 }
 
-/// Picks component 0, 1 or 2 of `v` by the 2-bit select `sel` (a 3-way mux).
-fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
-    let one = m.konst(&format!("{name}_k1"), Ty::u(2), 1);
-    let two = m.konst(&format!("{name}_k2"), Ty::u(2), 2);
-    let is1 = m.bin(&format!("{name}_is1"), BinOp::Eq, sel, one);
-    let is2 = m.bin(&format!("{name}_is2"), BinOp::Eq, sel, two);
-    let a = m.mux(&format!("{name}_a"), is1, v[1], v[0]);
-    m.mux(name, is2, v[2], a)
+/// v[sel] for a 2-bit axis number (3 picks v[0]; it never occurs).
+pub(crate) fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
+    m.case(name, sel, &[(1, v[1]), (2, v[2])], v[0])
 }
 
-/// A pipeline register for each signal, named after it with the stage's prefix.
-/// The stage prefix of a previous stage register (`s3_`, `dv12_`) is replaced, not stacked.
+/// A pipeline register for each signal, named after it with the stage's prefix (a previous
+/// stage's prefix, such as `s3_` or `dv12_`, is replaced, not stacked).
 fn stage(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Vec<Sig> {
     sigs.iter()
         .map(|s| {
@@ -151,7 +146,7 @@ fn shr_round(m: &mut Module, name: &str, x: Sig, s: u32) -> Sig {
     m.shr(name, y, s)
 }
 
-fn as_signed_wider(m: &mut Module, name: &str, x: Sig) -> Sig {
+pub(crate) fn as_signed_wider(m: &mut Module, name: &str, x: Sig) -> Sig {
     let w = m.resize(&format!("{name}_w"), x, x.ty.width + 1);
     m.un(name, UnOp::AsSigned, w)
 }

@@ -3,3 +3,6 @@
 
 pub mod divider;
 pub mod intersect;
+pub mod traverse;
+pub mod closest;
+pub mod top;

@@ -173,6 +173,7 @@ impl Golden {
             let mut go_pop = visitor.prune(tmin);
             if !go_pop {
                 stats.nodes += 1;
+                visitor.node(node);
                 match nodes[node as usize] {
                     Node::Inner { axis, clip0, clip1, child } => {
                         let a = axis as usize;
@@ -278,6 +279,8 @@ pub trait Visitor {
     fn prune(&self, _tmin: i64) -> bool {
         false
     }
+    /// Called on every node visit, before its children or triangles.
+    fn node(&mut self, _node: u32) {}
 }
 
 struct Closest<'a> {

@@ -1,0 +1,183 @@
+//! The whole ray tracing core for one scene: ray stream in, closest hits out.
+//!
+//! ```text
+//! ray_valid/ready, id, o, ω, 1/ω ─► traversal ─► leaf ROM ─► triangle ROMs ─► intersection ─► closest hit ─► res_*
+//!                                  (FSM, node ROM, stack RAM)                 pipeline
+//! ```
+//!
+//! The traversal emits one leaf entry per clock; the triangle ROMs add one cycle; the ray's
+//! origin and direction come straight from the traversal's and the top's ray registers, which
+//! hold still until the next ray is accepted — always after the ray's end token, so at least
+//! two cycles after its last triangle entered the ROMs. The triangle table is wider than a
+//! signal may be (5 + 3n + 6m bits), so it is split into ROMs of whole fields, ≤ 128 bits each,
+//! all read at the same address.
+
+use super::closest::{TagLayout, closest_core};
+use super::intersect::{IntersectParams, intersect_core};
+use super::traverse::{TraverseParams, field, traverse_core, word_bits};
+use crate::model::golden::GridRay;
+use crate::rtl::emit::rom_addr_bits;
+use crate::rtl::width::MAX_WIDTH;
+use crate::rtl::{Module, Sig, Ty};
+use crate::scene::Scene;
+use crate::scene::rom::{self, Field};
+use std::rc::Rc;
+
+#[derive(Clone, Debug)]
+pub struct CoreParams {
+    pub isect: IntersectParams,
+    pub trav: TraverseParams,
+    pub tag: TagLayout,
+}
+
+impl CoreParams {
+    pub fn new(scene: &Scene, id_width: u32, div_bits: u32) -> CoreParams {
+        let trav = TraverseParams::new(scene, id_width);
+        let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
+        let p = &scene.params;
+        let isect =
+            IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits };
+        CoreParams { isect, trav, tag }
+    }
+    /// Rejects what the RTL layer cannot hold, naming the parameter to change.
+    pub fn check(&self) -> crate::error::Result<()> {
+        self.isect.check()?;
+        let w = self.trav.n + 1 + self.trav.inv_width();
+        if w > MAX_WIDTH {
+            return Err(crate::error::Error::param(
+                "c",
+                format!("the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Cycles from a leaf entry leaving the traversal FSM to its result in the closest-hit
+    /// unit: leaf ROM, triangle ROM, the pipeline.
+    pub fn stream_latency(&self) -> u32 {
+        2 + self.isect.latency()
+    }
+}
+
+/// Consecutive triangle fields grouped into words of at most 128 bits.
+pub fn tri_rom_groups(fields: &[Field]) -> Vec<Vec<Field>> {
+    let mut groups: Vec<Vec<Field>> = Vec::new();
+    for f in fields {
+        match groups.last_mut() {
+            Some(g) if g.iter().map(|x| x.width).sum::<u32>() + f.width <= MAX_WIDTH => g.push(f.clone()),
+            _ => groups.push(vec![f.clone()]),
+        }
+    }
+    groups
+}
+
+/// Input ports of the core in order, with types.
+pub fn core_inputs(p: &CoreParams) -> Vec<(&'static str, Ty)> {
+    let (n, m, iw) = (p.isect.n, p.isect.m, p.trav.inv_width());
+    let mut v = vec![("ray_valid", Ty::BIT), ("ray_id", Ty::u(p.trav.id_width))];
+    v.extend([("ox", Ty::u(n)), ("oy", Ty::u(n)), ("oz", Ty::u(n))]);
+    v.extend([("wx", Ty::s(m)), ("wy", Ty::s(m)), ("wz", Ty::s(m))]);
+    v.extend([("invx", Ty::s(iw)), ("invy", Ty::s(iw)), ("invz", Ty::s(iw))]);
+    v
+}
+
+/// The input values of one ray (valid = 1), in `core_inputs` order.
+pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
+    let mut v = vec![1, id as i128];
+    v.extend(ray.o.iter().map(|&x| x as i128));
+    v.extend(ray.w.iter().map(|&x| x as i128));
+    v.extend(ray.inv.iter().copied());
+    v
+}
+
+pub fn core_module(p: &CoreParams, scene: &Scene) -> Module {
+    let mut m = Module::new("fxrt_core");
+    let ins: Vec<Sig> = core_inputs(p).iter().map(|(name, ty)| m.input(name, *ty)).collect();
+    let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!() };
+    let trav = Rc::new(traverse_core(&p.trav, scene));
+    let t = m.instance("u_traverse", &trav, &[ray_valid, ray_id, ox, oy, oz, ix, iy, iz]);
+    let out = |name: &str| trav.outputs.iter().position(|o| o.0 == name).map(|i| t[i]).expect("traversal port");
+    let (ready, emit_valid, emit_end, emit_tri, emit_tmin, emit_id) = (
+        out("ray_ready"),
+        out("emit_valid"),
+        out("emit_end"),
+        out("emit_tri"),
+        out("emit_tmin"),
+        out("emit_id"),
+    );
+    let cur_o = [out("cur_ox"), out("cur_oy"), out("cur_oz")];
+
+    // The direction, latched when the traversal accepts the ray.
+    let accept = m.and("accept", ray_valid, ready);
+    let w: Vec<Sig> = [("wx_r", wx), ("wy_r", wy), ("wz_r", wz)]
+        .iter()
+        .map(|(name, s)| {
+            let r = m.reg(name, s.ty, None);
+            m.connect(r, *s, Some(accept));
+            r
+        })
+        .collect();
+
+    // Triangle ROMs at the emitted triangle number; the tag and valid wait the same cycle.
+    let [(tri_l, tri_words), _, _] = rom::words(scene);
+    let addr_bits = rom_addr_bits(tri_words.len());
+    let addr = m.resize("tri_addr", emit_tri, addr_bits);
+    let mut tri_fields: Vec<Sig> = Vec::new();
+    for (k, group) in tri_rom_groups(&tri_l.fields).iter().enumerate() {
+        let lsb = group[0].lsb;
+        let width: u32 = group.iter().map(|f| f.width).sum();
+        let words = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
+        let rom = m.rom(&format!("tri_rom_{k}"), width, words);
+        let word = m.rom_read(&format!("tri_word_{k}"), rom, addr);
+        for f in group {
+            tri_fields.push(field(&mut m, &format!("tri_{}", f.name), word, f, lsb));
+        }
+    }
+    let tri_w = m.resize("tag_tri", emit_tri, p.tag.tri_bits);
+    let tri_tmin = m.concat("tag_tri_tmin", &[emit_tmin, tri_w]);
+    let payload = p.tag.payload();
+    let tri_tmin = m.resize("tag_tri_tmin_w", tri_tmin, payload);
+    let id_w = m.resize("tag_id", emit_id, payload);
+    let payload_sig = m.mux("tag_payload", emit_end, id_w, tri_tmin);
+    let tag = m.concat("tag", &[emit_end, payload_sig]);
+    let valid_d = m.delay("pipe_valid", emit_valid);
+    let tag_d = m.delay("pipe_tag", tag);
+
+    let isect = Rc::new(intersect_core(&p.isect));
+    let mut pipe_in = vec![valid_d, tag_d, cur_o[0], cur_o[1], cur_o[2], w[0], w[1], w[2]];
+    pipe_in.extend(tri_fields);
+    let r = m.instance("u_intersect", &isect, &pipe_in);
+    let closest = Rc::new(closest_core(p.tag, p.isect.n, p.isect.m));
+    let res = m.instance("u_closest", &closest, &r);
+    m.output("ray_ready", ready);
+    for (k, (name, _)) in closest.outputs.iter().enumerate() {
+        m.output(name, res[k]);
+    }
+    // Observation ports for `fxrt sim`: a triangle entering the pipeline, the stack depth.
+    let end_d = m.bit("pipe_end", tag_d, payload);
+    let not_end = m.not("pipe_not_end", end_d);
+    let busy = m.and("pipe_busy", valid_d, not_end);
+    m.output("busy", busy);
+    m.output("stack_depth", out("stack_depth"));
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
+    use crate::params::Params;
+    use crate::render::camera::Camera;
+    use crate::scene::SceneSource;
+
+    #[test]
+    fn a_small_frame_matches_the_golden_model() {
+        let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
+        let p = CoreParams::new(&scene, 16, 1);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
+        let (results, stats) = simulate_rust(&p, &scene, &rays, &|_| {});
+        assert_eq!(mismatches(&scene, &rays, &results), 0);
+        assert!(results.iter().filter(|r| r.1.is_some()).count() > 20);
+        assert!(stats.busy_cycles > 0 && stats.max_stack_depth > 0, "{stats:?}");
+    }
+}
