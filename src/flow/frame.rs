@@ -3,6 +3,10 @@
 //! order and are compared with the golden model's `trace_fast`, pixel by pixel.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
+use crate::error::{Error, Result};
+use crate::flow::simulators::{Bench, Simulator};
+use crate::flow::testbench::{Stream, parse_results, stream_files};
+use std::path::Path;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
 use crate::render::camera::Camera;
@@ -79,10 +83,12 @@ pub fn simulate_rust(p: &CoreParams, scene: &Scene, rays: &[PixelRay], progress:
         }
         sim.eval();
         let fire = values.is_some() && sim.get(ready) == 1;
-        stats.busy_cycles += sim.get(busy) as u64;
-        stats.max_stack_depth = stats.max_stack_depth.max(sim.get(depth) as u32);
         sim.tick();
         stats.cycles += 1;
+        // Observed after the edge, as the testbenches do (Verilator's timing mode does not
+        // show these before it).
+        stats.busy_cycles += sim.get(busy) as u64;
+        stats.max_stack_depth = stats.max_stack_depth.max(sim.get(depth) as u32);
         next += fire as usize;
         if sim.get(res[0]) == 1 {
             let hit = (sim.get(res[2]) == 1).then(|| Hit {
@@ -144,13 +150,66 @@ pub fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-/// Streams `rays` through the core's HDL in `sim` (a generated stream testbench).
+/// Outputs a stream testbench checks and writes back, in order.
+pub const RESULT_PORTS: [&str; 6] = ["res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"];
+
+/// A result as the values of `RESULT_PORTS`.
+fn result_row(id: u64, hit: Option<Hit>) -> Vec<i128> {
+    match hit {
+        Some(h) => vec![id as i128, 1, h.tri as i128, h.t as i128, h.u as i128, h.v as i128],
+        None => vec![id as i128, 0, 0, 0, 0, 0],
+    }
+}
+
+/// Streams `rays` through the core's HDL in `sim` with a generated stream testbench, which
+/// checks every result against the golden model and writes what the core produced; those
+/// results (not the golden ones) are returned.
 pub fn simulate_hdl(
-    _sim: crate::flow::simulators::Simulator,
-    _p: &CoreParams,
-    _scene: &Scene,
-    _rays: &[PixelRay],
-    _dir: &std::path::Path,
-) -> crate::error::Result<(Vec<CoreResult>, CoreStats)> {
-    Err(crate::error::Error::new("sim", "HDL frame simulation is not built yet"))
+    sim: Simulator,
+    p: &CoreParams,
+    scene: &Scene,
+    rays: &[PixelRay],
+    dir: &Path,
+) -> Result<(Vec<CoreResult>, CoreStats)> {
+    if !sim.available() {
+        return Err(Error::new(sim.name(), "is not installed (scripts/install-deps.sh installs it)"));
+    }
+    if rays.is_empty() {
+        return Ok((Vec::new(), CoreStats::default()));
+    }
+    let m = core_module(p, scene);
+    let g = Golden::new(scene);
+    let inputs: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
+    let expected: Vec<Vec<i128>> =
+        rays.iter().map(|r| result_row(r.pixel as u64, g.trace_fast(scene, &r.ray).0)).collect();
+    // Generous: the slowest built-in scene needs ~15,000 cycles per ray.
+    let max_cycles = 100_000 * rays.len() as u64 + 10_000;
+    let stream = Stream { rays: &inputs, expected: &expected, checked: &RESULT_PORTS, max_cycles };
+    let io = |e: std::io::Error| Error::file(dir, e.to_string());
+    std::fs::create_dir_all(dir).map_err(io)?;
+    for (file, text) in stream_files(&m, &stream, sim) {
+        std::fs::write(dir.join(file), text).map_err(io)?;
+    }
+    let (_, out) = sim.run_bench(dir, &m, Bench::Stream).map_err(|e| Error::new(sim.name(), e))?;
+    let text = std::fs::read_to_string(dir.join("results.txt")).map_err(io)?;
+    let rows = parse_results(&m, &RESULT_PORTS, &text).map_err(|e| Error::file(&dir.join("results.txt"), e))?;
+    let results = rows
+        .iter()
+        .map(|r| {
+            let hit = (r[1] == 1).then(|| Hit { tri: r[2] as u32, t: r[3] as i64, u: r[4] as i64, v: r[5] as i64 });
+            (r[0] as u64, hit)
+        })
+        .collect();
+    // "cycles C busy B stack S", wherever the simulator put it on its line.
+    let stats_line = out.lines().find_map(|l| l.find("cycles ").map(|i| &l[i..]));
+    let nums: Vec<u64> = stats_line
+        .unwrap_or("")
+        .split_whitespace()
+        .filter_map(|w| w.trim_end_matches(|c: char| !c.is_ascii_digit()).parse().ok())
+        .collect();
+    let [cycles, busy_cycles, stack] = nums[..] else {
+        return Err(Error::new(sim.name(), format!("no 'cycles … busy … stack …' line in:\n{out}")));
+    };
+    let stats = CoreStats { cycles, rays: rays.len() as u64, busy_cycles, max_stack_depth: stack as u32 };
+    Ok((results, stats))
 }

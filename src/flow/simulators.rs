@@ -46,6 +46,12 @@ impl Simulator {
     /// Like `run`, also timing the simulation: the Verilator harness times its clock loop
     /// itself; the others are timed as the whole simulation process (not the compilation).
     pub fn run_timed(self, dir: &Path, m: &Module) -> Result<RunResult, String> {
+        self.run_bench(dir, m, Bench::Vectors).map(|(r, _)| r)
+    }
+
+    /// Runs the testbench of kind `bench` (its files already in `dir`); also returns the
+    /// simulator's whole output, for the lines a stream testbench prints.
+    pub fn run_bench(self, dir: &Path, m: &Module, bench: Bench) -> Result<(RunResult, String), String> {
         let ext = if self == Simulator::Ghdl { "vhd" } else { "v" };
         let design: Vec<String> = m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
         let tb = super::testbench::tb_name(m);
@@ -66,6 +72,16 @@ impl Simulator {
                 compile.extend(design);
                 compile.push("tb.v".into());
                 vec![compile, words(&["vvp", "-n", "tb.vvp"])]
+            }
+            Simulator::Verilator if bench == Bench::Stream => {
+                // The stream testbench is Verilog with delays: Verilator's --binary --timing.
+                let mut build = words(&[
+                    "verilator", "--binary", "--timing", "-O3", "-j", "2", "-Wno-fatal", "-Wno-lint", "-Wno-style",
+                    "--top-module", &tb, "-o", "tbsim",
+                ]);
+                build.extend(design);
+                build.push("tb.v".into());
+                vec![build, words(&["./obj_dir/tbsim"])]
             }
             Simulator::Verilator => {
                 let mut build = words(&[
@@ -102,8 +118,15 @@ impl Simulator {
         if let Some(s) = last.lines().find_map(|l| l.strip_prefix("simulation seconds ")) {
             seconds = s.trim().parse().unwrap_or(seconds);
         }
-        Ok(RunResult { passed, failed, seconds })
+        Ok((RunResult { passed, failed, seconds }, last))
     }
+}
+
+/// The two kinds of testbench: fixed-latency vectors, or a ray stream with ready/valid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bench {
+    Vectors,
+    Stream,
 }
 
 /// A testbench run: its counts and the seconds the simulation step took.

@@ -66,6 +66,135 @@ struct VerilatorHarness<'a> {
     outputs: &'a [CppPort],
 }
 
+#[derive(Template)]
+#[template(path = "stream_tb.vhd")]
+struct VhdlStreamTb<'a> {
+    tb: &'a str,
+    module: &'a str,
+    rays: &'a str,
+    expected: &'a str,
+    results: &'a str,
+    has_reset: bool,
+    inputs: &'a [Port],
+    outputs: &'a [Port],
+    checked: &'a [Port],
+    count: usize,
+    max_cycles: u64,
+}
+
+#[derive(Template)]
+#[template(path = "stream_tb.v")]
+struct VerilogStreamTb<'a> {
+    tb: &'a str,
+    module: &'a str,
+    rays: &'a str,
+    expected: &'a str,
+    results: &'a str,
+    has_reset: bool,
+    inputs: &'a [Port],
+    outputs: &'a [Port],
+    checked: &'a [Port],
+    ray_width: u32,
+    result_width: u32,
+    count: usize,
+    max_cycles: u64,
+}
+
+/// A stream testbench's data: the inputs of each ray (every input port but `ray_valid`, in
+/// port order) and the expected values of the `checked` outputs for each, in order.
+pub struct Stream<'a> {
+    pub rays: &'a [Vec<i128>],
+    pub expected: &'a [Vec<i128>],
+    pub checked: &'a [&'a str],
+    pub max_cycles: u64,
+}
+
+/// The stream testbench for GHDL (VHDL) or Icarus/Verilator (Verilog), with its data files
+/// and the design; the testbench writes `results.txt`, one line of checked outputs per ray.
+pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, String)> {
+    let in_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid").collect();
+    let checked_ids: Vec<(String, SigId)> =
+        s.checked.iter().map(|c| m.outputs.iter().find(|o| o.0 == *c).expect("checked output").clone()).collect();
+    let (inputs, ray_width) = ports(m, &in_ids, 0);
+    let (checked, result_width) = ports(m, &checked_ids, 0);
+    let (outputs, _) = ports(m, &m.outputs, 0);
+    let tb = tb_name(m);
+    let (rays, expected, results) = ("rays.txt", "expected.txt", "results.txt");
+    let has_reset = m.has_reset();
+    let mut files = crate::rtl::emit::design_files(m, if sim == Simulator::Ghdl { "vhd" } else { "v" });
+    let lines = |rows: &[Vec<i128>], ports: &[Port], width: u32, vhdl: bool| -> String {
+        let mut text = String::new();
+        for row in rows {
+            if vhdl {
+                let f: Vec<String> =
+                    ports.iter().zip(row).map(|(p, v)| crate::rtl::emit::bit_string(p.ty.wrap(*v), p.width)).collect();
+                text.push_str(&f.join(" "));
+            } else {
+                let mut word = num_word::Word::default();
+                ports.iter().zip(row).for_each(|(p, v)| word.push(p.ty.wrap(*v), p.width));
+                text.push_str(&word.hex(width));
+            }
+            text.push('\n');
+        }
+        text
+    };
+    let vhdl = sim == Simulator::Ghdl;
+    files.push((rays.into(), lines(s.rays, &inputs, ray_width, vhdl)));
+    files.push((expected.into(), lines(s.expected, &checked, result_width, vhdl)));
+    let count = s.rays.len();
+    let text = if vhdl {
+        VhdlStreamTb { tb: &tb, module: &m.name, rays, expected, results, has_reset, inputs: &inputs, outputs: &outputs, checked: &checked, count, max_cycles: s.max_cycles }
+            .render()
+    } else {
+        VerilogStreamTb {
+            tb: &tb,
+            module: &m.name,
+            rays,
+            expected,
+            results,
+            has_reset,
+            inputs: &inputs,
+            outputs: &outputs,
+            checked: &checked,
+            ray_width,
+            result_width,
+            count,
+            max_cycles: s.max_cycles,
+        }
+        .render()
+    };
+    let name = if vhdl { "tb.vhd" } else { "tb.v" };
+    files.push((name.into(), text.expect("testbench template renders") + "\n"));
+    files
+}
+
+/// Parses a stream testbench's `results.txt`: each line's binary fields as values of the
+/// checked outputs' types.
+pub fn parse_results(m: &Module, checked: &[&str], text: &str) -> Result<Vec<Vec<i128>>, String> {
+    let tys: Vec<Ty> = checked
+        .iter()
+        .map(|c| m.outputs.iter().find(|o| o.0 == *c).map(|o| m.sig(o.1).ty).ok_or(format!("no output {c}")))
+        .collect::<Result<_, _>>()?;
+    text.lines()
+        .enumerate()
+        .map(|(i, line)| {
+            let fields: Vec<&str> = line.split_whitespace().collect();
+            if fields.len() != tys.len() {
+                return Err(format!("results line {}: {} fields, expected {}", i + 1, fields.len(), tys.len()));
+            }
+            fields
+                .iter()
+                .zip(&tys)
+                .map(|(f, ty)| {
+                    u128::from_str_radix(f, 2)
+                        .map(|bits| ty.value(bits))
+                        .map_err(|_| format!("results line {}: '{f}' is not binary", i + 1))
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// One clock's stimulus: the reset input and every data input, in `Module::inputs` order.
 #[derive(Clone, Debug)]
 pub struct Stimulus {
