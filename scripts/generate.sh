@@ -8,4 +8,4 @@ cargo build --release --quiet
 bin="${CARGO_TARGET_DIR:-target}/release/fxrt"
 rm -rf "$out/scene" "$out/hdl"
 "$bin" scene --builtin teapot --out "$out/scene" >/dev/null
-"$bin" gen --builtin teapot --out "$out/hdl" >/dev/null
+"$bin" gen --scene "$out/scene" --out "$out/hdl" --ise >/dev/null

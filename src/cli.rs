@@ -91,18 +91,34 @@ pub struct SynthArgs {
 
 #[derive(Args, Debug)]
 pub struct GenArgs {
-    /// The scene whose edge shift E the pipeline is built for (with --edge-shift auto).
+    /// The scene the core is built for: its ROMs, box and edge shift E.
     #[command(flatten)]
     pub scene: SceneChoice,
+    /// A folder written by `fxrt scene`: build the core from its scene.json and ROM images
+    /// (the parameters are the ones stored there).
+    #[arg(long = "scene", value_name = "DIR", conflicts_with_all = ["scene", "builtin"])]
+    pub scene_dir: Option<PathBuf>,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
     /// Languages to write.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "vhdl,verilog")]
     pub lang: Vec<Lang>,
-    /// Width of the tag passed through the intersection pipeline.
-    #[command(flatten)]
-    pub hw: HwArgs,
+    /// Also write an ISE project script (xtclsh) and a UCF for the XC5VLX110T-1FF1136.
+    #[arg(long)]
+    pub ise: bool,
+    /// Clock constraint of the UCF, MHz.
+    #[arg(long = "clock-mhz", default_value_t = 100.0)]
+    pub clock_mhz: f64,
+    /// Width of the ray id port (rays in flight are numbered modulo 2^width).
+    #[arg(long = "ray-id-width", default_value_t = 20)]
+    pub ray_id_width: u32,
+    /// Block RAM the ROMs may use, kilobits (default: the XC5VLX110T's 148 × 36 Kb).
+    #[arg(long = "bram-kbits", default_value_t = 5328)]
+    pub bram_kbits: u64,
+    /// Quotient bits per divider stage: 1 or 2.
+    #[arg(long = "div-bits", default_value_t = 1)]
+    pub div_bits: u32,
     #[command(flatten)]
     pub params: ParamArgs,
 }

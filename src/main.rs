@@ -220,16 +220,37 @@ fn intersect_params(params: &fxrt::params::Params, scene: &Scene, hw: &fxrt::cli
 }
 
 fn run_gen(a: GenArgs) -> Result<()> {
-    let params = a.params.params()?;
-    let scene = Scene::load(&a.scene.source(), &params)?;
-    let p = intersect_params(&params, &scene, &a.hw)?;
-    let files: Vec<(std::path::PathBuf, Vec<u8>)> =
-        fxrt::flow::generate::files(&p, a.lang.contains(&Lang::Vhdl), a.lang.contains(&Lang::Verilog))
-            .into_iter()
-            .map(|(n, t)| (a.out.join(n), t.into_bytes()))
-            .collect();
+    let roms = match &a.scene_dir {
+        Some(dir) => fxrt::scene::images::SceneRoms::load(dir)?,
+        None => fxrt::scene::images::SceneRoms::of(&Scene::load(&a.scene.source(), &a.params.params()?)?),
+    };
+    if !(1..=64).contains(&a.ray_id_width) {
+        return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", a.ray_id_width)));
+    }
+    if !(a.clock_mhz > 0.0 && a.clock_mhz <= 1000.0) {
+        return Err(Error::param("clock-mhz", format!("{} is out of range: must be in (0, 1000]", a.clock_mhz)));
+    }
+    let p = fxrt::cores::top::CoreParams::new(&roms, a.ray_id_width, a.div_bits);
+    p.check()?;
+    p.check_device(&roms, a.bram_kbits)?;
+    let o = fxrt::flow::generate::GenOptions {
+        vhdl: a.lang.contains(&Lang::Vhdl),
+        verilog: a.lang.contains(&Lang::Verilog),
+        ise: a.ise,
+        clock_mhz: a.clock_mhz,
+    };
+    let files: Vec<(std::path::PathBuf, Vec<u8>)> = fxrt::flow::generate::core_files(&p, &roms, o)
+        .into_iter()
+        .map(|(n, t)| (a.out.join(n), t.into_bytes()))
+        .collect();
     fxrt::io::write_all_atomic(&files)?;
-    println!("{} (latency {} cycles) and its divider written to {}", p.name(), p.latency(), a.out.display());
+    println!(
+        "fxrt_core for {} ({} triangles; intersection pipeline {} cycles) written to {}",
+        roms.name,
+        roms.tri_count(),
+        p.isect.latency(),
+        a.out.display()
+    );
     Ok(())
 }
 
@@ -303,14 +324,15 @@ fn run_sim(a: SimArgs) -> Result<bool> {
     let cam = a.camera.camera(&scene)?;
     let (w, h) = (cam.width, cam.height);
     let id_width = rom::addr_bits((w * h) as usize);
-    let p = fxrt::cores::top::CoreParams::new(&scene, id_width, a.div_bits);
+    let roms = fxrt::scene::images::SceneRoms::of(&scene);
+    let p = fxrt::cores::top::CoreParams::new(&roms, id_width, a.div_bits);
     p.check()?;
     let rays = frame::frame_rays(&scene, &cam);
     let start = std::time::Instant::now();
     let (results, stats) = match a.sim {
         FrameSim::Rust => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
-            let r = frame::simulate_rust(&p, &scene, &rays, &|n| bar.set_position(n));
+            let r = frame::simulate_rust(&p, &roms, &rays, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
         }

@@ -167,15 +167,38 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let o = fxrt(&["gen", "--builtin", "random", "--div-bits", "3", "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(!out.exists());
-    // A good set writes both languages and a manifest per core.
-    let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--out", out.to_str().unwrap()]);
+    // A good set writes the whole core in both languages and a manifest per core.
+    let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--ise", "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // random: 2,000 triangles (11 bits) + leaf distance (n + 2 = 18 bits) + end flag.
+    let name = "fxrt_intersect_n16_m16_t0_e4_tag30";
     let manifest: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("fxrt_intersect_n16_m16_t0_e4.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(out.join(format!("{name}.json"))).unwrap()).unwrap();
     assert_eq!(manifest["latency_cycles"], 25);
-    assert!(
-        out.join("fxrt_intersect_n16_m16_t0_e4.vhd").exists() && out.join("fxrt_intersect_n16_m16_t0_e4.v").exists()
-    );
+    let core: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("fxrt_core.json")).unwrap()).unwrap();
+    let files = core["files"]["vhdl"].as_array().unwrap();
+    assert_eq!(files.last().unwrap(), "fxrt_core.vhd");
+    for f in files.iter().chain(core["files"]["verilog"].as_array().unwrap()) {
+        assert!(out.join(f.as_str().unwrap()).exists(), "{f}");
+    }
+    let tcl = std::fs::read_to_string(out.join("fxrt_core.tcl")).unwrap();
+    assert!(tcl.contains("xc5vlx110t") && tcl.contains(&format!("xfile add \"{name}.vhd\"")), "{tcl}");
+    assert!(out.join("fxrt_core.ucf").exists());
+    // A scene folder from `fxrt scene` gives the same core as the scene itself.
+    let rom = dir.path().join("rom");
+    let o = fxrt(&["scene", "--builtin", "random", "--n", "16", "--m", "16", "--out", rom.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let again = dir.path().join("again");
+    let o = fxrt(&["gen", "--scene", rom.to_str().unwrap(), "--ise", "--out", again.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["fxrt_core.vhd", "fxrt_core.v", "fxrt_traverse.vhd", "fxrt_core.json"] {
+        assert_eq!(std::fs::read(out.join(f)).unwrap(), std::fs::read(again.join(f)).unwrap(), "{f}");
+    }
+    // A scene too large for the block RAM allowed is refused, naming the option.
+    let small = dir.path().join("small");
+    let o = fxrt(&["gen", "--builtin", "random", "--bram-kbits", "64", "--out", small.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--bram-kbits") && !small.exists(), "{}", stderr(&o));
 }
 
 #[test]

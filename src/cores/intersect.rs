@@ -34,7 +34,7 @@ impl IntersectParams {
     }
     pub fn name(&self) -> String {
         let r4 = if self.div_bits == 2 { "_r4" } else { "" };
-        format!("fxrt_intersect_n{}_m{}_t{}_e{}{r4}", self.n, self.m, self.t, self.e)
+        format!("fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}", self.n, self.m, self.t, self.e, self.tag_width)
     }
     /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
     /// parameter to change.

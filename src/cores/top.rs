@@ -19,8 +19,8 @@ use crate::model::golden::GridRay;
 use crate::rtl::emit::rom_addr_bits;
 use crate::rtl::width::MAX_WIDTH;
 use crate::rtl::{Module, Sig, Ty};
-use crate::scene::Scene;
-use crate::scene::rom::{self, Field};
+use crate::scene::images::SceneRoms;
+use crate::scene::rom::Field;
 use std::rc::Rc;
 
 #[derive(Clone, Debug)]
@@ -31,7 +31,7 @@ pub struct CoreParams {
 }
 
 impl CoreParams {
-    pub fn new(scene: &Scene, id_width: u32, div_bits: u32) -> CoreParams {
+    pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32) -> CoreParams {
         let trav = TraverseParams::new(scene, id_width);
         let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
         let p = &scene.params;
@@ -47,6 +47,29 @@ impl CoreParams {
             return Err(crate::error::Error::param(
                 "c",
                 format!("the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM (each ROM rounded up
+    /// to a power-of-two depth, as the printers emit it).
+    pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
+        let bits = |(l, w): &(crate::scene::rom::Layout, Vec<crate::scene::rom::Word>)| {
+            l.width as u64 * crate::rtl::emit::rom_depth(w.len()) as u64
+        };
+        let stack = (self.trav.n as u64 * 2 + 6 + 32) * self.trav.stack_depth as u64;
+        let total = bits(&scene.tri) + bits(&scene.node) + bits(&scene.leaf) + stack;
+        if total > bram_kbits * 1024 {
+            return Err(crate::error::Error::param(
+                "bram-kbits",
+                format!(
+                    "scene {} needs {} Kb of ROM and stack, more than the {bram_kbits} Kb of block RAM allowed \
+                     (the XC5VLX110T has 5328): use a smaller scene, a smaller --n/--m, or raise --bram-kbits \
+                     for a larger device",
+                    scene.name,
+                    total.div_ceil(1024)
+                ),
             ));
         }
         Ok(())
@@ -90,7 +113,7 @@ pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
     v
 }
 
-pub fn core_module(p: &CoreParams, scene: &Scene) -> Module {
+pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let mut m = Module::new("fxrt_core");
     let ins: Vec<Sig> = core_inputs(p).iter().map(|(name, ty)| m.input(name, *ty)).collect();
     let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!() };
@@ -119,7 +142,7 @@ pub fn core_module(p: &CoreParams, scene: &Scene) -> Module {
         .collect();
 
     // Triangle ROMs at the emitted triangle number; the tag and valid wait the same cycle.
-    let [(tri_l, tri_words), _, _] = rom::words(scene);
+    let (tri_l, tri_words) = &scene.tri;
     let addr_bits = rom_addr_bits(tri_words.len());
     let addr = m.resize("tri_addr", emit_tri, addr_bits);
     let mut tri_fields: Vec<Sig> = Vec::new();
@@ -168,14 +191,15 @@ mod tests {
     use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
     use crate::params::Params;
     use crate::render::camera::Camera;
-    use crate::scene::SceneSource;
+    use crate::scene::{Scene, SceneSource};
 
     #[test]
     fn a_small_frame_matches_the_golden_model() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
-        let p = CoreParams::new(&scene, 16, 1);
+        let roms = SceneRoms::of(&scene);
+        let p = CoreParams::new(&roms, 16, 1);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
-        let (results, stats) = simulate_rust(&p, &scene, &rays, &|_| {});
+        let (results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
         assert_eq!(mismatches(&scene, &rays, &results), 0);
         assert!(results.iter().filter(|r| r.1.is_some()).count() > 20);
         assert!(stats.busy_cycles > 0 && stats.max_stack_depth > 0, "{stats:?}");

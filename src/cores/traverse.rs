@@ -22,7 +22,7 @@
 use super::intersect::{as_signed_wider, pick};
 use crate::rtl::emit::rom_addr_bits;
 use crate::rtl::{Module, Sig, Ty, UnOp};
-use crate::scene::Scene;
+use crate::scene::images::SceneRoms;
 use crate::scene::rom::{self, Field, Layout, Word};
 
 pub const IDLE: i128 = 0;
@@ -46,7 +46,7 @@ pub struct TraverseParams {
 }
 
 impl TraverseParams {
-    pub fn new(scene: &Scene, id_width: u32) -> TraverseParams {
+    pub fn new(scene: &SceneRoms, id_width: u32) -> TraverseParams {
         let p = &scene.params;
         TraverseParams {
             n: p.n,
@@ -54,8 +54,8 @@ impl TraverseParams {
             c: p.c,
             id_width,
             stack_depth: p.stack_depth,
-            box_hi: scene.grid_box.hi,
-            tri_bits: rom::addr_bits(scene.tris.len()),
+            box_hi: scene.box_hi,
+            tri_bits: rom::addr_bits(scene.tri_count()),
         }
     }
     /// Reciprocal directions: m + C bits.
@@ -90,8 +90,8 @@ pub fn field(m: &mut Module, name: &str, word: Sig, f: &Field, word_lsb: u32) ->
 }
 
 /// Ports of the unit, in order: inputs, then outputs.
-pub fn traverse_core(p: &TraverseParams, scene: &Scene) -> Module {
-    let [_, (node_l, node_words), (leaf_l, leaf_words)] = rom::words(scene);
+pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
+    let ((node_l, node_words), (leaf_l, leaf_words)) = (&scene.node, &scene.leaf);
     let mut m = Module::new("fxrt_traverse");
     let (n, dist) = (p.n, p.dist_ty());
     let ray_valid = m.input("ray_valid", Ty::BIT);
@@ -140,12 +140,12 @@ pub fn traverse_core(p: &TraverseParams, scene: &Scene) -> Module {
     let node_rom = m.rom("node_rom", node_l.width, node_words.iter().map(|w| word_bits(w, 0, node_l.width)).collect());
     let word = m.rom_read("node_word", node_rom, node_next);
     let nf = |m: &mut Module, name: &str, l: &Layout| field(m, &format!("nw_{name}"), word, l.field(name), 0);
-    let w_axis = nf(&mut m, "axis", &node_l);
-    let w_clip0 = nf(&mut m, "clip0", &node_l);
-    let w_clip1 = nf(&mut m, "clip1", &node_l);
-    let w_child = nf(&mut m, "child", &node_l);
-    let w_first = nf(&mut m, "first", &node_l);
-    let w_count = nf(&mut m, "count", &node_l);
+    let w_axis = nf(&mut m, "axis", node_l);
+    let w_clip0 = nf(&mut m, "clip0", node_l);
+    let w_clip1 = nf(&mut m, "clip1", node_l);
+    let w_child = nf(&mut m, "child", node_l);
+    let w_first = nf(&mut m, "first", node_l);
+    let w_count = nf(&mut m, "count", node_l);
     let w_leaf = m.eq_k("nw_is_leaf", w_axis, 3);
 
     // Registers of the inner-node step.
@@ -364,6 +364,7 @@ mod tests {
     use crate::params::Params;
     use crate::render::camera::Camera;
     use crate::rtl::sim::Sim;
+    use crate::scene::images::SceneRoms;
     use crate::scene::{Scene, SceneSource};
 
     /// What a traversal did: node visits and (triangle, leaf tmin) emissions, in order.
@@ -420,7 +421,8 @@ mod tests {
         for (name, params) in [("teapot", Params::default()), ("cornell", Params { n: 20, m: 20, ..Params::default() })] {
             let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
             let g = Golden::new(&scene);
-            let m = traverse_core(&TraverseParams::new(&scene, 16), &scene);
+            let roms = SceneRoms::of(&scene);
+            let m = traverse_core(&TraverseParams::new(&roms, 16), &roms);
             let mut sim = Sim::new(&m);
             let cam = Camera::default_for(&scene, 24, 24);
             let mut rays = 0;

@@ -13,6 +13,7 @@ use crate::render::camera::Camera;
 use crate::rtl::Module;
 use crate::rtl::sim::Sim;
 use crate::scene::Scene;
+use crate::scene::images::SceneRoms;
 use serde::Serialize;
 
 /// A ray of the frame: its pixel (row-major) and its grid form.
@@ -66,7 +67,12 @@ fn port(m: &Module, name: &str) -> crate::rtl::Sig {
 
 /// Streams `rays` through the core in the Rust cycle simulator. `progress` is called with the
 /// number of results so far, now and then.
-pub fn simulate_rust(p: &CoreParams, scene: &Scene, rays: &[PixelRay], progress: &dyn Fn(u64)) -> (Vec<CoreResult>, CoreStats) {
+pub fn simulate_rust(
+    p: &CoreParams,
+    scene: &SceneRoms,
+    rays: &[PixelRay],
+    progress: &dyn Fn(u64),
+) -> (Vec<CoreResult>, CoreStats) {
     let m = core_module(p, scene);
     let mut sim = Sim::new(&m);
     let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
@@ -171,13 +177,14 @@ pub fn simulate_hdl(
     rays: &[PixelRay],
     dir: &Path,
 ) -> Result<(Vec<CoreResult>, CoreStats)> {
+    let roms = SceneRoms::of(scene);
     if !sim.available() {
         return Err(Error::new(sim.name(), "is not installed (scripts/install-deps.sh installs it)"));
     }
     if rays.is_empty() {
         return Ok((Vec::new(), CoreStats::default()));
     }
-    let m = core_module(p, scene);
+    let m = core_module(p, &roms);
     let g = Golden::new(scene);
     let inputs: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
     let expected: Vec<Vec<i128>> =

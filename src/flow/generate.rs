@@ -1,13 +1,17 @@
-//! `fxrt gen`: the cores' HDL and their manifests.
+//! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files.
 
 use crate::cores::divider;
 use crate::cores::intersect::{IntersectParams, intersect_core};
+use crate::cores::top::{CoreParams, core_module};
 use crate::rtl::emit;
 use crate::rtl::netlist::Module;
+use crate::scene::images::SceneRoms;
+use askama::Template;
 use serde_json::{Value, json};
 
-/// The JSON manifest written beside a core's HDL.
-pub fn manifest(m: &Module, latency: u32, params: Value) -> Value {
+/// The JSON manifest written beside a core's HDL. `latency` is None for the whole core, whose
+/// results come after a number of cycles that depends on the ray.
+pub fn manifest(m: &Module, latency: Option<u32>, params: Value) -> Value {
     let port = |name: &str, dir: &str, ty: crate::rtl::Ty| json!({ "name": name, "direction": dir, "width": ty.width, "signed": ty.signed });
     let mut ports = vec![json!({ "name": "clk", "direction": "in", "width": 1, "signed": false })];
     if m.has_reset() {
@@ -15,6 +19,7 @@ pub fn manifest(m: &Module, latency: u32, params: Value) -> Value {
     }
     ports.extend(m.inputs.iter().map(|&i| port(&m.sig(i).name, "in", m.sig(i).ty)));
     ports.extend(m.outputs.iter().map(|(n, i)| port(n, "out", m.sig(*i).ty)));
+    let names = |ext: &str| m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect::<Vec<_>>();
     json!({
         "name": m.name,
         "generator": format!("fxrt {}", env!("CARGO_PKG_VERSION")),
@@ -22,42 +27,95 @@ pub fn manifest(m: &Module, latency: u32, params: Value) -> Value {
         "params": params,
         "ports": ports,
         "register_bits": m.register_bits(),
-        "files": {
-            "vhdl": emit::design_files(m, "vhd").into_iter().map(|f| f.0).collect::<Vec<_>>(),
-            "verilog": emit::design_files(m, "v").into_iter().map(|f| f.0).collect::<Vec<_>>(),
-        },
+        "files": { "vhdl": names("vhd"), "verilog": names("v") },
     })
 }
 
-/// Every core for one parameter set: (module, latency, manifest parameters).
-pub fn cores(p: &IntersectParams) -> Vec<(Module, u32, Value)> {
+/// The intersection pipeline and its divider for one parameter set: (module, latency,
+/// manifest parameters).
+pub fn cores(p: &IntersectParams) -> Vec<(Module, Option<u32>, Value)> {
     let ip = intersect_core(p);
     let div = p.divider();
     vec![
-        (ip, p.latency(), serde_json::to_value(p).unwrap_or(Value::Null)),
+        (ip, Some(p.latency()), serde_json::to_value(p).unwrap_or(Value::Null)),
         (
             div,
-            divider::latency(p.n, p.div_bits),
+            Some(divider::latency(p.n, p.div_bits)),
             json!({ "n": p.n, "bits_per_stage": p.div_bits, "num_width": p.num_width() - p.t, "den_width": p.den_width() - p.t }),
         ),
     ]
 }
 
-/// (file name, contents) of everything `fxrt gen` writes.
-pub fn files(p: &IntersectParams, vhdl_out: bool, verilog_out: bool) -> Vec<(String, String)> {
-    let mut out = Vec::new();
-    for (m, lat, params) in cores(p) {
-        // A module shared by two cores (the divider) is written once.
-        let mut push = |(name, text): (String, String)| {
-            if !out.iter().any(|(n, _)| *n == name) {
-                out.push((name, text));
+/// What `fxrt gen` writes besides the HDL.
+#[derive(Clone, Copy, Debug)]
+pub struct GenOptions {
+    pub vhdl: bool,
+    pub verilog: bool,
+    /// ISE project script and UCF for the XC5VLX110T.
+    pub ise: bool,
+    pub clock_mhz: f64,
+}
+
+#[derive(Template)]
+#[template(path = "ise_project.tcl", escape = "none")]
+struct IseProject<'a> {
+    top: &'a str,
+    scene: &'a str,
+    language: &'a str,
+    files: &'a [String],
+}
+
+#[derive(Template)]
+#[template(path = "board.ucf", escape = "none")]
+struct BoardUcf<'a> {
+    top: &'a str,
+    period_ns: String,
+}
+
+/// (file name, contents) of every module of `cores` in the chosen languages (each module
+/// once), a manifest per core, and the ISE files for the first core when asked.
+fn write_set(cores: &[(Module, Option<u32>, Value)], o: GenOptions, scene: &str) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for (m, lat, params) in cores {
+        for ext in [("vhd", o.vhdl), ("v", o.verilog)].iter().filter(|e| e.1).map(|e| e.0) {
+            for (name, text) in emit::design_files(m, ext) {
+                if !out.iter().any(|(n, _)| *n == name) {
+                    out.push((name, text));
+                }
             }
-        };
-        for ext in [("vhd", vhdl_out), ("v", verilog_out)].iter().filter(|e| e.1).map(|e| e.0) {
-            emit::design_files(&m, ext).into_iter().for_each(&mut push);
         }
-        let text = serde_json::to_string_pretty(&manifest(&m, lat, params)).unwrap_or_default() + "\n";
+        let text = serde_json::to_string_pretty(&manifest(m, *lat, params.clone())).unwrap_or_default() + "\n";
         out.push((format!("{}.json", m.name), text));
     }
+    if let (true, Some((top, _, _))) = (o.ise, cores.first()) {
+        let (language, ext) = if o.vhdl { ("VHDL", "vhd") } else { ("Verilog", "v") };
+        let files: Vec<String> = top.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
+        let tcl = IseProject { top: &top.name, scene, language, files: &files }.render().expect("ISE template renders");
+        out.push((format!("{}.tcl", top.name), tcl + "\n"));
+        let period_ns = format!("{:.3}", 1000.0 / o.clock_mhz);
+        let ucf = BoardUcf { top: &top.name, period_ns }.render().expect("UCF template renders");
+        out.push((format!("{}.ucf", top.name), ucf + "\n"));
+    }
     out
+}
+
+/// The pipeline cores alone (intersection pipeline and divider).
+pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, String)> {
+    write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, clock_mhz: 100.0 }, "")
+}
+
+/// The whole ray tracing core for a scene, with manifests for it and for each of its cores.
+pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions) -> Vec<(String, String)> {
+    let top = core_module(p, roms);
+    let core_params = json!({
+        "scene": roms.name,
+        "triangles": roms.tri_count(),
+        "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "c": p.trav.c, "e": p.isect.e,
+        "stack_depth": p.trav.stack_depth, "ray_id_width": p.trav.id_width, "div_bits": p.isect.div_bits,
+        "intersection_latency_cycles": p.isect.latency(),
+        "leaf_entry_to_result_cycles": p.stream_latency() + 1,
+    });
+    let mut set = vec![(top, None, core_params)];
+    set.extend(cores(&p.isect));
+    write_set(&set, o, &roms.name)
 }

@@ -2,6 +2,7 @@
 
 pub mod accel;
 pub mod bih;
+pub mod images;
 pub mod builtin;
 pub mod obj;
 pub mod report;

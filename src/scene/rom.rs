@@ -128,6 +128,15 @@ impl Word {
         }
         if f.signed && (v >> (f.width - 1)) & 1 == 1 { v - (1i128 << f.width) } else { v }
     }
+    /// The word of hex digits `s` (most significant first), as `hex` writes it.
+    pub fn from_hex(s: &str) -> Option<Word> {
+        let mut w = Word(vec![0; (4 * s.len()).div_ceil(64).max(1)]);
+        for (k, c) in s.chars().rev().enumerate() {
+            let nib = c.to_digit(16)? as u64;
+            w.0[k / 16] |= nib << (4 * (k % 16));
+        }
+        Some(w)
+    }
     /// Hex digits, most significant first, exactly ceil(width / 4) of them.
     pub fn hex(&self, width: u32) -> String {
         let digits = width.div_ceil(4);
