@@ -188,7 +188,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
+    use crate::flow::frame::{frame_rays, mismatches, simulate_rust, simulate_rust_cycle};
     use crate::params::Params;
     use crate::render::camera::Camera;
     use crate::scene::{Scene, SceneSource};
@@ -203,5 +203,13 @@ mod tests {
         assert_eq!(mismatches(&scene, &rays, &results), 0);
         assert!(results.iter().filter(|r| r.1.is_some()).count() > 20);
         assert!(stats.busy_cycles > 0 && stats.max_stack_depth > 0, "{stats:?}");
+        // The batched engine (ray source in the netlist) and the cycle engine (ports driven
+        // like a testbench) agree on every result and every count.
+        let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &|_| {});
+        assert_eq!(cycle_results, results);
+        assert_eq!(
+            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth),
+            (stats.cycles, stats.busy_cycles, stats.max_stack_depth)
+        );
     }
 }

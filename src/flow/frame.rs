@@ -10,8 +10,9 @@ use std::path::Path;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
 use crate::render::camera::Camera;
-use crate::rtl::Module;
+use crate::rtl::batch::BatchSim;
 use crate::rtl::sim::Sim;
+use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
 use serde::Serialize;
@@ -65,9 +66,104 @@ fn port(m: &Module, name: &str) -> crate::rtl::Sig {
     m.handle(id.unwrap_or_else(|| panic!("{}: no port {name}", m.name)))
 }
 
-/// Streams `rays` through the core in the Rust cycle simulator. `progress` is called with the
-/// number of results so far, now and then.
+/// The core with its ray source in one netlist, so the batched simulator can run it: one ROM
+/// per ray field holding every ray, a ray counter that advances when the core takes a ray, and
+/// the core. The ROMs are read at the counter's next value, so a ray is on the core's inputs
+/// in the cycle after the counter reaches it; the source starts one cycle late for that.
+pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Module {
+    let mut m = Module::new("fxrt_frame");
+    let count = rays.len().max(1);
+    let bits = crate::rtl::emit::rom_addr_bits(count + 1);
+    let idx = m.reg("ray_index", Ty::u(bits), Some(0));
+    let started = m.reg("started", Ty::BIT, Some(0));
+    let one_bit = m.konst("one", Ty::BIT, 1);
+    m.connect(started, one_bit, None);
+    let last = m.konst("ray_count", idx.ty, rays.len() as i128);
+    let more = m.lt("more", idx, last);
+    let valid = m.and("valid", started, more);
+    let ready = m.wire("ready", Ty::BIT);
+    let fire = m.and("fire", valid, ready);
+    let one = m.konst("index_one", idx.ty, 1);
+    let inc = m.add("index_inc", idx, one);
+    let idx_next = m.mux("index_next", fire, inc, idx);
+    m.connect(idx, idx_next, None);
+    let addr = m.resize("ray_addr", idx_next, crate::rtl::emit::rom_addr_bits(count));
+    let values: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)).collect();
+    let mut ins = vec![valid];
+    for (k, (name, ty)) in core_inputs(p).iter().enumerate().skip(1) {
+        let words = values.iter().map(|v| ty.wrap(v[k])).collect::<Vec<u128>>();
+        let words = if words.is_empty() { vec![0] } else { words };
+        let rom = m.rom(&format!("rays_{name}"), ty.width, words);
+        let raw = m.rom_read(&format!("ray_{name}"), rom, addr);
+        ins.push(if ty.signed { m.un(&format!("ray_{name}_s"), crate::rtl::UnOp::AsSigned, raw) } else { raw });
+    }
+    let core = std::rc::Rc::new(core_module(p, scene));
+    let outs = m.instance("u_core", &core, &ins);
+    let pos = |name: &str| core.outputs.iter().position(|o| o.0 == name).expect("core port");
+    m.drive(ready, outs[pos("ray_ready")]);
+    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth"] {
+        m.output(name, outs[pos(name)]);
+    }
+    m
+}
+
+/// Streams `rays` through the core in the batched Rust simulator (`rtl::batch`), with the ray
+/// source in the netlist (`frame_harness`). The same results and counts as `simulate_rust_cycle`
+/// and the HDL testbenches, several times faster. `progress` gets the number of results now
+/// and then.
 pub fn simulate_rust(
+    p: &CoreParams,
+    scene: &SceneRoms,
+    rays: &[PixelRay],
+    progress: &dyn Fn(u64),
+) -> (Vec<CoreResult>, CoreStats) {
+    if rays.is_empty() {
+        return (Vec::new(), CoreStats::default());
+    }
+    let m = frame_harness(p, scene, rays);
+    let mut sim = BatchSim::new(&m, 256).expect("the frame harness has no inputs");
+    let mut stats = CoreStats { rays: rays.len() as u64, ..Default::default() };
+    let mut results: Vec<CoreResult> = Vec::with_capacity(rays.len());
+    let mut row = [0i128; 9];
+    let mut finished: Option<u64> = None;
+    let mut cycles = 0u64;
+    while finished.is_none() {
+        sim.advance(
+            1 << 16,
+            |_, _| 0,
+            |c, k, v| {
+                row[k] = v;
+                if k + 1 < row.len() || finished.is_some() {
+                    return;
+                }
+                // Cycle c of the harness is cycle c − 1 of a testbench driving the core directly.
+                cycles = c as u64;
+                stats.busy_cycles += row[7] as u64;
+                stats.max_stack_depth = stats.max_stack_depth.max(row[8] as u32);
+                if row[0] == 1 {
+                    let hit = (row[2] == 1).then(|| Hit {
+                        tri: row[3] as u32,
+                        t: row[4] as i64,
+                        u: row[5] as i64,
+                        v: row[6] as i64,
+                    });
+                    results.push((row[1] as u64, hit));
+                    if results.len() == rays.len() {
+                        finished = Some(c as u64);
+                    }
+                }
+            },
+        );
+        progress(results.len() as u64);
+        assert!(cycles < 1 << 40, "the core stopped producing results");
+    }
+    stats.cycles = finished.unwrap_or(cycles);
+    (results, stats)
+}
+
+/// `simulate_rust` in the cycle simulator (`rtl::sim`), driving the core's ports directly as
+/// the HDL testbenches do. `progress` gets the number of results now and then.
+pub fn simulate_rust_cycle(
     p: &CoreParams,
     scene: &SceneRoms,
     rays: &[PixelRay],
@@ -219,4 +315,36 @@ pub fn simulate_hdl(
     };
     let stats = CoreStats { cycles, rays: rays.len() as u64, busy_cycles, max_stack_depth: stack as u32 };
     Ok((results, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+    use crate::scene::SceneSource;
+
+    /// The frame harness in both engines, output by output, clock by clock.
+    #[test]
+    fn harness_runs_alike_in_both_engines() {
+        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() }).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let p = CoreParams::new(&roms, 8, 1);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 6));
+        let m = frame_harness(&p, &roms, &rays);
+        let outs: Vec<_> = m.outputs.iter().map(|(_, i)| m.handle(*i)).collect();
+        let cycles = 1500;
+        let mut sim = Sim::new(&m);
+        let want: Vec<Vec<i128>> = (0..cycles)
+            .map(|_| {
+                sim.tick();
+                outs.iter().map(|o| sim.get(*o)).collect()
+            })
+            .collect();
+        let mut got = vec![vec![0i128; outs.len()]; cycles];
+        BatchSim::new(&m, 64).unwrap().run(cycles, |_, _| 0, |c, k, v| got[c][k] = v);
+        for c in 0..cycles {
+            assert_eq!(got[c], want[c], "cycle {c}: {:?}", m.outputs.iter().map(|o| &o.0).collect::<Vec<_>>());
+        }
+        assert!(want.iter().filter(|r| r[0] == 1).count() == rays.len());
+    }
 }

@@ -55,7 +55,7 @@ pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
     for (file, text) in &files {
         std::fs::write(dir.join(file), text).map_err(io)?;
     }
-    let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).collect();
+    let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| emit::is_source(f)).collect();
     // -flatten: one area figure for the whole hierarchy.
     let script = format!(
         "read_verilog {}; synth_xilinx -family xc5v -flatten -top {}; tee -q -o stat.json stat -json",

@@ -28,8 +28,22 @@ pub fn hex_string(v: u128, w: u32) -> String {
 }
 
 /// The HDL files of a design in one language: one file per module, sub-modules first (the
-/// order to compile them in). `ext` is "vhd" or "v".
+/// order to compile them in), and for Verilog each module's `$readmemh` memory files after it.
+/// `ext` is "vhd" or "v".
 pub fn design_files(top: &crate::rtl::Module, ext: &str) -> Vec<(String, String)> {
-    let print = if ext == "vhd" { vhdl::print } else { verilog::print };
-    top.hierarchy().into_iter().map(|m| (format!("{}.{ext}", m.name), print(m))).collect()
+    let mut out = Vec::new();
+    for m in top.hierarchy() {
+        if ext == "vhd" {
+            out.push((format!("{}.vhd", m.name), vhdl::print(m)));
+        } else {
+            out.push((format!("{}.v", m.name), verilog::print(m)));
+            out.extend(verilog::mem_files(m));
+        }
+    }
+    out
+}
+
+/// Whether a file of `design_files` is HDL source (not memory contents).
+pub fn is_source(file: &str) -> bool {
+    file.ends_with(".v") || file.ends_with(".vhd")
 }

@@ -29,6 +29,27 @@ fn extend(a: &str, t: Ty, w: u32) -> String {
     if t.signed { format!("$signed({{{fill}, {a}}})") } else { format!("{{{fill}, {a}}}") }
 }
 
+/// The `$readmemh` file of memory `rom` of module `m`.
+pub fn mem_file(m: &Module, rom: &str) -> String {
+    format!("{}_{rom}.hex", m.name)
+}
+
+/// The contents of every memory of `m` as `$readmemh` files, padded with zero words to the
+/// printed depth: (file name, text).
+pub fn mem_files(m: &Module) -> Vec<(String, String)> {
+    m.roms
+        .iter()
+        .map(|r| {
+            let mut text = String::with_capacity(rom_depth(r.words.len()) * (r.width as usize / 4 + 2));
+            for k in 0..rom_depth(r.words.len()) {
+                text.push_str(&hex_string(r.words.get(k).copied().unwrap_or(0), r.width));
+                text.push('\n');
+            }
+            (mem_file(m, &r.name), text)
+        })
+        .collect()
+}
+
 pub fn print(m: &Module) -> String {
     m.check().unwrap_or_else(|e| panic!("{e}"));
     let name = |id: SigId| m.sig(id).name.as_str();
@@ -43,21 +64,12 @@ pub fn print(m: &Module) -> String {
     ports.extend(m.inputs.iter().map(|&i| format!("  input wire {} {}", decl(ty(i)), name(i))));
     ports.extend(m.outputs.iter().map(|(p, i)| format!("  output wire {} {p}", decl(ty(*i)))));
     let _ = writeln!(s, "module {} (\n{}\n);", m.name, ports.join(",\n"));
+    // Memories load their contents with $readmemh from a file beside the module (`mem_files`):
+    // a statement per word makes large ROMs slow to parse (yosys: minutes per 10,000 words).
     for r in &m.roms {
         let depth = rom_depth(r.words.len());
         let _ = writeln!(s, "  reg [{}:0] {} [0:{}];", r.width - 1, r.name, depth - 1);
-        let _ = writeln!(s, "  integer {}_i;\n  initial begin", r.name);
-        let _ = writeln!(
-            s,
-            "    for ({0}_i = 0; {0}_i < {1}; {0}_i = {0}_i + 1) {0}[{0}_i] = {2}'h0;",
-            r.name, depth, r.width
-        );
-        for (i, w) in r.words.iter().enumerate() {
-            if *w != 0 {
-                let _ = writeln!(s, "    {}[{i}] = {}'h{};", r.name, r.width, hex_string(*w, r.width));
-            }
-        }
-        s.push_str("  end\n");
+        let _ = writeln!(s, "  initial $readmemh(\"{}\", {});", mem_file(m, &r.name), r.name);
     }
     // A netlist may use only some bits of a signal (a slice of a product): that is intended,
     // so Verilator's unused-signal lint is off for the internal declarations only.
