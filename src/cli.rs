@@ -74,7 +74,7 @@ pub enum FrameSim {
 
 #[derive(Args, Debug)]
 pub struct SynthArgs {
-    /// The scene whose edge shift E the pipeline is built for (with --edge-shift auto).
+    /// The scene the whole core holds in its ROMs (and whose E the pipeline uses).
     #[command(flatten)]
     pub scene: SceneChoice,
     /// Target family; only Virtex-5 (xc5v) is supported.

@@ -302,16 +302,21 @@ fn run_synth(a: SynthArgs) -> Result<()> {
     let params = a.params.params()?;
     let scene = Scene::load(&a.scene.source(), &params)?;
     let p = intersect_params(&params, &scene, &a.hw)?;
+    let roms = fxrt::scene::images::SceneRoms::of(&scene);
+    let core = fxrt::cores::top::CoreParams::new(&roms, 20, a.hw.div_bits);
+    core.check()?;
     let build = a.build.clone().unwrap_or_else(|| std::path::PathBuf::from("target/fxrt-synth"));
     let mut cores = Vec::new();
-    for (m, latency, _) in fxrt::flow::generate::cores(&p) {
+    let mut set = vec![(fxrt::cores::top::core_module(&core, &roms), None)];
+    set.extend(fxrt::flow::generate::cores(&p).into_iter().map(|(m, lat, _)| (m, lat)));
+    for (m, latency) in set {
         let area = fxrt::flow::synth::synth_xc5v(&m, &build.join(&m.name))?;
         cores.push(serde_json::json!({ "latency_cycles": latency, "area": area }));
     }
     let thesis = serde_json::json!({ "note": "whole design of seed 001 table 3.2 (BIH + intersection + ray generator), XST", "luts": 5278, "registers": 3274, "dsp48e": 52, "bram18": 22 });
     println!(
         "{}",
-        serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "params": p, "cores": cores, "thesis": thesis })
+        serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "scene": scene.name, "params": p, "cores": cores, "thesis": thesis })
     );
     Ok(())
 }
@@ -361,6 +366,7 @@ fn run_sim(a: SimArgs) -> Result<bool> {
             "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
             "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
             "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
+            "state_cycles": fxrt::cores::traverse::STATE_NAMES.iter().zip(&stats.state_cycles).map(|(n, c)| (n.to_string(), serde_json::json!(*c))).collect::<serde_json::Map<String, serde_json::Value>>(),
             "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
         })
     );

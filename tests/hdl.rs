@@ -148,3 +148,52 @@ fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
         assert!(area.luts > 500 && area.ffs > 500, "{area:?}");
     }
 }
+
+/// The whole core (traversal, ROMs, pipeline, closest hit) of a small scene: `ghdl --synth`
+/// accepts it, Verilator's lint is silent, and yosys maps it to Virtex-5 with block RAMs.
+#[test]
+fn whole_core_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
+    use fxrt::cores::top::{CoreParams, core_module};
+    use fxrt::scene::images::SceneRoms;
+    let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &SMALL).unwrap();
+    let roms = SceneRoms::of(&scene);
+    let p = CoreParams::new(&roms, 12, 1);
+    let module = core_module(&p, &roms);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("whole_core_tools");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut sources = std::collections::HashMap::new();
+    for ext in ["vhd", "v"] {
+        let files = fxrt::rtl::emit::design_files(&module, ext);
+        for (name, text) in &files {
+            std::fs::write(dir.join(name), text).unwrap();
+        }
+        let names: Vec<String> = files.into_iter().map(|f| f.0).filter(|f| fxrt::rtl::emit::is_source(f)).collect();
+        assert_eq!(names.last().map(String::as_str), Some(if ext == "v" { "fxrt_core.v" } else { "fxrt_core.vhd" }));
+        sources.insert(ext, names);
+    }
+    let run = |prog: &str, args: &[&str]| -> Option<std::process::Output> {
+        match std::process::Command::new(prog).args(args).current_dir(&dir).output() {
+            Ok(o) => Some(o),
+            Err(_) => {
+                common::say(&format!("skipped: {prog} is not installed"));
+                None
+            }
+        }
+    };
+    let mut args = vec!["--synth", "--std=93c", "--out=none"];
+    args.extend(sources["vhd"].iter().map(String::as_str));
+    args.extend(["-e", "fxrt_core"]);
+    if let Some(o) = run("ghdl", &args) {
+        assert!(o.status.success(), "ghdl --synth: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    let mut args = vec!["--lint-only", "-Wall", "--top-module", "fxrt_core"];
+    args.extend(sources["v"].iter().map(String::as_str));
+    if let Some(o) = run("verilator", &args) {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success() && !err.contains("%Warning"), "verilator lint: {err}");
+    }
+    if run("yosys", &["-V"]).is_some() {
+        let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
+        assert!(area.dsp48e >= 10 && area.bram18 >= 1, "{area:?}");
+    }
+}

@@ -23,7 +23,8 @@ module fxrt_core (
   output wire [31:0] res_u,
   output wire [31:0] res_v,
   output wire [0:0] busy,
-  output wire [5:0] stack_depth
+  output wire [5:0] stack_depth,
+  output wire [2:0] fsm_state
 );
   reg [123:0] tri_rom_0 [0:8191];
   initial $readmemh("fxrt_core_tri_rom_0.hex", tri_rom_0);
@@ -44,6 +45,7 @@ module fxrt_core (
   wire [0:0] u_traverse_visit;
   wire [12:0] u_traverse_visit_node;
   wire [5:0] u_traverse_stack_depth;
+  wire [2:0] u_traverse_fsm_state;
   wire [0:0] accept;
   reg signed [31:0] wx_r = 32'sh00000000;
   reg signed [31:0] wy_r = 32'sh00000000;
@@ -126,6 +128,7 @@ module fxrt_core (
   assign res_v = u_closest_res_v;
   assign busy = pipe_busy;
   assign stack_depth = u_traverse_stack_depth;
+  assign fsm_state = u_traverse_fsm_state;
   fxrt_traverse u_traverse (
     .clk(clk),
     .rst(rst),
@@ -148,7 +151,8 @@ module fxrt_core (
     .cur_oz(u_traverse_cur_oz),
     .visit(u_traverse_visit),
     .visit_node(u_traverse_visit_node),
-    .stack_depth(u_traverse_stack_depth)
+    .stack_depth(u_traverse_stack_depth),
+    .fsm_state(u_traverse_fsm_state)
   );
   fxrt_intersect_n29_m32_t0_e18_tag45 u_intersect (
     .clk(clk),

@@ -27,7 +27,8 @@ entity fxrt_core is
     res_u : out unsigned(31 downto 0);
     res_v : out unsigned(31 downto 0);
     busy : out unsigned(0 downto 0);
-    stack_depth : out unsigned(5 downto 0)
+    stack_depth : out unsigned(5 downto 0);
+    fsm_state : out unsigned(2 downto 0)
   );
 end entity fxrt_core;
 
@@ -55,7 +56,8 @@ architecture rtl of fxrt_core is
       cur_oz : out unsigned(28 downto 0);
       visit : out unsigned(0 downto 0);
       visit_node : out unsigned(12 downto 0);
-      stack_depth : out unsigned(5 downto 0)
+      stack_depth : out unsigned(5 downto 0);
+      fsm_state : out unsigned(2 downto 0)
     );
   end component;
   component fxrt_intersect_n29_m32_t0_e18_tag45 is
@@ -19087,6 +19089,7 @@ architecture rtl of fxrt_core is
   signal u_traverse_visit : unsigned(0 downto 0);
   signal u_traverse_visit_node : unsigned(12 downto 0);
   signal u_traverse_stack_depth : unsigned(5 downto 0);
+  signal u_traverse_fsm_state : unsigned(2 downto 0);
   signal accept : unsigned(0 downto 0);
   signal wx_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal wy_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -19169,6 +19172,7 @@ begin
   res_v <= u_closest_res_v;
   busy <= pipe_busy;
   stack_depth <= u_traverse_stack_depth;
+  fsm_state <= u_traverse_fsm_state;
 
   u_traverse : fxrt_traverse
     port map (
@@ -19193,7 +19197,8 @@ begin
       cur_oz => u_traverse_cur_oz,
       visit => u_traverse_visit,
       visit_node => u_traverse_visit_node,
-      stack_depth => u_traverse_stack_depth
+      stack_depth => u_traverse_stack_depth,
+      fsm_state => u_traverse_fsm_state
     );
 
   u_intersect : fxrt_intersect_n29_m32_t0_e18_tag45

@@ -22,7 +22,8 @@ module fxrt_traverse (
   output wire [28:0] cur_oz,
   output wire [0:0] visit,
   output wire [12:0] visit_node,
-  output wire [5:0] stack_depth
+  output wire [5:0] stack_depth,
+  output wire [2:0] fsm_state
 );
   reg [72:0] node_rom [0:8191];
   initial $readmemh("fxrt_traverse_node_rom.hex", node_rom);
@@ -378,6 +379,7 @@ module fxrt_traverse (
   assign visit = in_node;
   assign visit_node = node;
   assign stack_depth = sp;
+  assign fsm_state = state;
   always @(posedge clk) begin
     if (push) stack[sp_addr] <= push_entry;
     if (rst) state <= 3'h0;

@@ -26,7 +26,8 @@ entity fxrt_traverse is
     cur_oz : out unsigned(28 downto 0);
     visit : out unsigned(0 downto 0);
     visit_node : out unsigned(12 downto 0);
-    stack_depth : out unsigned(5 downto 0)
+    stack_depth : out unsigned(5 downto 0);
+    fsm_state : out unsigned(2 downto 0)
   );
 end entity fxrt_traverse;
 
@@ -11106,6 +11107,7 @@ begin
   visit <= in_node;
   visit_node <= node;
   stack_depth <= sp;
+  fsm_state <= state;
 
   clocked : process (clk)
   begin

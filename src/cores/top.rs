@@ -182,6 +182,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let busy = m.and("pipe_busy", valid_d, not_end);
     m.output("busy", busy);
     m.output("stack_depth", out("stack_depth"));
+    m.output("fsm_state", out("fsm_state"));
     m
 }
 
@@ -208,8 +209,9 @@ mod tests {
         let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &|_| {});
         assert_eq!(cycle_results, results);
         assert_eq!(
-            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth),
-            (stats.cycles, stats.busy_cycles, stats.max_stack_depth)
+            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth, &cycle_stats.state_cycles),
+            (stats.cycles, stats.busy_cycles, stats.max_stack_depth, &stats.state_cycles)
         );
+        assert_eq!(stats.state_cycles.iter().sum::<u64>(), stats.cycles);
     }
 }

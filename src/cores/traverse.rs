@@ -353,8 +353,12 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     m.output("visit", in_node);
     m.output("visit_node", node);
     m.output("stack_depth", sp);
+    m.output("fsm_state", state);
     m
 }
+
+/// State names by number, for statistics.
+pub const STATE_NAMES: [&str; 7] = ["idle", "aabb", "node", "inner", "leaf", "pop", "done"];
 
 #[cfg(test)]
 mod tests {

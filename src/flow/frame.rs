@@ -49,6 +49,9 @@ pub struct CoreStats {
     /// Cycles in which a triangle entered the intersection pipeline.
     pub busy_cycles: u64,
     pub max_stack_depth: u32,
+    /// Cycles the traversal FSM spent in each state (`traverse::STATE_NAMES`); the Rust
+    /// simulators count them, the HDL testbenches do not.
+    pub state_cycles: Vec<u64>,
 }
 
 impl CoreStats {
@@ -101,7 +104,7 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Mo
     let outs = m.instance("u_core", &core, &ins);
     let pos = |name: &str| core.outputs.iter().position(|o| o.0 == name).expect("core port");
     m.drive(ready, outs[pos("ray_ready")]);
-    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth"] {
+    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"] {
         m.output(name, outs[pos(name)]);
     }
     m
@@ -124,7 +127,8 @@ pub fn simulate_rust(
     let mut sim = BatchSim::new(&m, 256).expect("the frame harness has no inputs");
     let mut stats = CoreStats { rays: rays.len() as u64, ..Default::default() };
     let mut results: Vec<CoreResult> = Vec::with_capacity(rays.len());
-    let mut row = [0i128; 9];
+    let mut row = [0i128; 10];
+    stats.state_cycles = vec![0; 8];
     let mut finished: Option<u64> = None;
     let mut cycles = 0u64;
     while finished.is_none() {
@@ -140,6 +144,10 @@ pub fn simulate_rust(
                 cycles = c as u64;
                 stats.busy_cycles += row[7] as u64;
                 stats.max_stack_depth = stats.max_stack_depth.max(row[8] as u32);
+                // The harness's cycle 0 precedes the testbench's first cycle.
+                if c > 0 {
+                    stats.state_cycles[row[9] as usize & 7] += 1;
+                }
                 if row[0] == 1 {
                     let hit = (row[2] == 1).then(|| Hit {
                         tri: row[3] as u32,
@@ -172,9 +180,9 @@ pub fn simulate_rust_cycle(
     let m = core_module(p, scene);
     let mut sim = Sim::new(&m);
     let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
-    let [ready, busy, depth] = ["ray_ready", "busy", "stack_depth"].map(|n| port(&m, n));
+    let [ready, busy, depth, state] = ["ray_ready", "busy", "stack_depth", "fsm_state"].map(|n| port(&m, n));
     let res: Vec<_> = ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
-    let mut stats = CoreStats { rays: rays.len() as u64, ..Default::default() };
+    let mut stats = CoreStats { rays: rays.len() as u64, state_cycles: vec![0; 8], ..Default::default() };
     let mut results = Vec::with_capacity(rays.len());
     let mut next = 0;
     let idle = vec![0i128; ins.len()];
@@ -191,6 +199,7 @@ pub fn simulate_rust_cycle(
         // show these before it).
         stats.busy_cycles += sim.get(busy) as u64;
         stats.max_stack_depth = stats.max_stack_depth.max(sim.get(depth) as u32);
+        stats.state_cycles[sim.get(state) as usize & 7] += 1;
         next += fire as usize;
         if sim.get(res[0]) == 1 {
             let hit = (sim.get(res[2]) == 1).then(|| Hit {
@@ -313,7 +322,7 @@ pub fn simulate_hdl(
     let [cycles, busy_cycles, stack] = nums[..] else {
         return Err(Error::new(sim.name(), format!("no 'cycles … busy … stack …' line in:\n{out}")));
     };
-    let stats = CoreStats { cycles, rays: rays.len() as u64, busy_cycles, max_stack_depth: stack as u32 };
+    let stats = CoreStats { cycles, rays: rays.len() as u64, busy_cycles, max_stack_depth: stack as u32, state_cycles: Vec::new() };
     Ok((results, stats))
 }
 

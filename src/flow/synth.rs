@@ -20,6 +20,8 @@ pub struct Area {
     pub dsp48e: u64,
     /// Block RAMs (RAMB18 count; a RAMB36 counts as 2).
     pub bram18: u64,
+    /// Distributed-RAM cells (RAM32M and the like: LUTs used as small RAMs).
+    pub lutram_cells: u64,
     pub carry4: u64,
     /// Every cell type yosys reported.
     pub cells: BTreeMap<String, u64>,
@@ -39,6 +41,7 @@ pub fn area_from_stat(module: &str, stat: &serde_json::Value) -> Area {
                 k if k.starts_with("DSP48") => a.dsp48e += n,
                 k if k.starts_with("RAMB36") => a.bram18 += 2 * n,
                 k if k.starts_with("RAMB18") => a.bram18 += n,
+                k if k.starts_with("RAM32") || k.starts_with("RAM64") || k.starts_with("RAM128") => a.lutram_cells += n,
                 "CARRY4" => a.carry4 += n,
                 _ => {}
             }
@@ -80,8 +83,8 @@ pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
 mod tests {
     #[test]
     fn counts_cells_by_kind() {
-        let stat = serde_json::json!({ "design": { "num_cells_by_type": { "LUT2": 3, "LUT6": 4, "FDRE": 5, "FDSE": 1, "DSP48E": 2, "RAMB36E1": 1, "SRLC32E": 7, "CARRY4": 9, "IBUF": 3 } } });
+        let stat = serde_json::json!({ "design": { "num_cells_by_type": { "LUT2": 3, "LUT6": 4, "FDRE": 5, "FDSE": 1, "DSP48E": 2, "RAMB36E1": 1, "SRLC32E": 7, "CARRY4": 9, "IBUF": 3, "RAM32M": 2 } } });
         let a = super::area_from_stat("x", &stat);
-        assert_eq!((a.luts, a.ffs, a.dsp48e, a.bram18, a.srl_luts, a.carry4), (7, 6, 2, 2, 7, 9));
+        assert_eq!((a.luts, a.ffs, a.dsp48e, a.bram18, a.srl_luts, a.carry4, a.lutram_cells), (7, 6, 2, 2, 7, 9, 2));
     }
 }
