@@ -73,7 +73,10 @@ fn hdl_frame(sim: Simulator, size: u32) -> Option<(Scene, Vec<i32>)> {
     assert_eq!(mismatches(&s, &rays, &results), 0);
     // The HDL's cycle count and statistics equal the Rust simulator's.
     let (_, rust) = simulate_rust(&p, &roms, &rays, &|_| {});
-    assert_eq!((stats.cycles, stats.busy_cycles, stats.max_stack_depth), (rust.cycles, rust.busy_cycles, rust.max_stack_depth));
+    assert_eq!(
+        (stats.cycles, stats.busy_cycles, stats.max_stack_depth),
+        (rust.cycles, rust.busy_cycles, rust.max_stack_depth)
+    );
     Some((s, ids_image(&scene("teapot"), size, size, &results)))
 }
 

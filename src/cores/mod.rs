@@ -1,8 +1,8 @@
 //! Hardware cores: each builds its netlist from the parameters; its golden twin lives in
 //! `model/`.
 
+pub mod closest;
 pub mod divider;
 pub mod intersect;
-pub mod traverse;
-pub mod closest;
 pub mod top;
+pub mod traverse;

@@ -35,8 +35,7 @@ impl CoreParams {
         let trav = TraverseParams::new(scene, id_width);
         let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
         let p = &scene.params;
-        let isect =
-            IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits };
+        let isect = IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits };
         CoreParams { isect, trav, tag }
     }
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
@@ -46,7 +45,9 @@ impl CoreParams {
         if w > MAX_WIDTH {
             return Err(crate::error::Error::param(
                 "c",
-                format!("the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"),
+                format!(
+                    "the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"
+                ),
             ));
         }
         Ok(())
@@ -120,14 +121,8 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let trav = Rc::new(traverse_core(&p.trav, scene));
     let t = m.instance("u_traverse", &trav, &[ray_valid, ray_id, ox, oy, oz, ix, iy, iz]);
     let out = |name: &str| trav.outputs.iter().position(|o| o.0 == name).map(|i| t[i]).expect("traversal port");
-    let (ready, emit_valid, emit_end, emit_tri, emit_tmin, emit_id) = (
-        out("ray_ready"),
-        out("emit_valid"),
-        out("emit_end"),
-        out("emit_tri"),
-        out("emit_tmin"),
-        out("emit_id"),
-    );
+    let (ready, emit_valid, emit_end, emit_tri, emit_tmin, emit_id) =
+        (out("ray_ready"), out("emit_valid"), out("emit_end"), out("emit_tri"), out("emit_tmin"), out("emit_id"));
     let cur_o = [out("cur_ox"), out("cur_oy"), out("cur_oz")];
 
     // The direction, latched when the traversal accepts the ray.

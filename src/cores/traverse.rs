@@ -422,7 +422,8 @@ mod tests {
     /// visits and the same triangle stream as `Golden::walk`, ray after ray in one simulation.
     #[test]
     fn visits_what_the_golden_walk_visits_in_its_order() {
-        for (name, params) in [("teapot", Params::default()), ("cornell", Params { n: 20, m: 20, ..Params::default() })] {
+        for (name, params) in [("teapot", Params::default()), ("cornell", Params { n: 20, m: 20, ..Params::default() })]
+        {
             let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
             let g = Golden::new(&scene);
             let roms = SceneRoms::of(&scene);

@@ -6,8 +6,8 @@ use super::testbench::{Stimulus, bench_files, record};
 use super::vectors::Vector;
 use crate::cores::intersect::{IntersectParams, expected_outputs, intersect_core, pack_inputs};
 use crate::error::{Error, Result};
-use crate::rtl::netlist::Module;
 use crate::rtl::batch::BatchSim;
+use crate::rtl::netlist::Module;
 use crate::rtl::sim::Sim;
 use std::path::Path;
 

@@ -6,7 +6,6 @@ use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::error::{Error, Result};
 use crate::flow::simulators::{Bench, Simulator};
 use crate::flow::testbench::{Stream, parse_results, stream_files};
-use std::path::Path;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
 use crate::render::camera::Camera;
@@ -16,6 +15,7 @@ use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
 use serde::Serialize;
+use std::path::Path;
 
 /// A ray of the frame: its pixel (row-major) and its grid form.
 #[derive(Clone, Copy, Debug)]
@@ -104,7 +104,9 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Mo
     let outs = m.instance("u_core", &core, &ins);
     let pos = |name: &str| core.outputs.iter().position(|o| o.0 == name).expect("core port");
     m.drive(ready, outs[pos("ray_ready")]);
-    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"] {
+    for name in
+        ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"]
+    {
         m.output(name, outs[pos(name)]);
     }
     m
@@ -181,7 +183,8 @@ pub fn simulate_rust_cycle(
     let mut sim = Sim::new(&m);
     let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
     let [ready, busy, depth, state] = ["ray_ready", "busy", "stack_depth", "fsm_state"].map(|n| port(&m, n));
-    let res: Vec<_> = ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
+    let res: Vec<_> =
+        ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
     let mut stats = CoreStats { rays: rays.len() as u64, state_cycles: vec![0; 8], ..Default::default() };
     let mut results = Vec::with_capacity(rays.len());
     let mut next = 0;
@@ -322,7 +325,13 @@ pub fn simulate_hdl(
     let [cycles, busy_cycles, stack] = nums[..] else {
         return Err(Error::new(sim.name(), format!("no 'cycles … busy … stack …' line in:\n{out}")));
     };
-    let stats = CoreStats { cycles, rays: rays.len() as u64, busy_cycles, max_stack_depth: stack as u32, state_cycles: Vec::new() };
+    let stats = CoreStats {
+        cycles,
+        rays: rays.len() as u64,
+        busy_cycles,
+        max_stack_depth: stack as u32,
+        state_cycles: Vec::new(),
+    };
     Ok((results, stats))
 }
 
@@ -335,7 +344,8 @@ mod tests {
     /// The frame harness in both engines, output by output, clock by clock.
     #[test]
     fn harness_runs_alike_in_both_engines() {
-        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() }).unwrap();
+        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() })
+            .unwrap();
         let roms = SceneRoms::of(&scene);
         let p = CoreParams::new(&roms, 8, 1);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 6));

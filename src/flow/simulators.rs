@@ -76,8 +76,19 @@ impl Simulator {
             Simulator::Verilator if bench == Bench::Stream => {
                 // The stream testbench is Verilog with delays: Verilator's --binary --timing.
                 let mut build = words(&[
-                    "verilator", "--binary", "--timing", "-O3", "-j", "2", "-Wno-fatal", "-Wno-lint", "-Wno-style",
-                    "--top-module", &tb, "-o", "tbsim",
+                    "verilator",
+                    "--binary",
+                    "--timing",
+                    "-O3",
+                    "-j",
+                    "2",
+                    "-Wno-fatal",
+                    "-Wno-lint",
+                    "-Wno-style",
+                    "--top-module",
+                    &tb,
+                    "-o",
+                    "tbsim",
                 ]);
                 build.extend(design);
                 build.push("tb.v".into());
@@ -85,8 +96,20 @@ impl Simulator {
             }
             Simulator::Verilator => {
                 let mut build = words(&[
-                    "verilator", "--cc", "--exe", "--build", "-O3", "-j", "2", "-Wno-fatal", "-Wno-lint", "-Wno-style",
-                    "--top-module", &m.name, "-o", "harness",
+                    "verilator",
+                    "--cc",
+                    "--exe",
+                    "--build",
+                    "-O3",
+                    "-j",
+                    "2",
+                    "-Wno-fatal",
+                    "-Wno-lint",
+                    "-Wno-style",
+                    "--top-module",
+                    &m.name,
+                    "-o",
+                    "harness",
                 ]);
                 build.extend(design);
                 build.push("harness.cpp".into());

@@ -2,10 +2,10 @@
 //! input vectors, and the askama templates in `testbenches/` turn them into a VHDL and a
 //! Verilog testbench that apply the same inputs to the generated HDL and compare.
 
+use super::simulators::Simulator;
 use crate::rtl::netlist::{Module, SigId};
 use crate::rtl::sim::Sim;
 use crate::rtl::width::Ty;
-use super::simulators::Simulator;
 use askama::Template;
 
 pub struct Port {
@@ -143,8 +143,20 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     files.push((expected.into(), lines(s.expected, &checked, result_width, vhdl)));
     let count = s.rays.len();
     let text = if vhdl {
-        VhdlStreamTb { tb: &tb, module: &m.name, rays, expected, results, has_reset, inputs: &inputs, outputs: &outputs, checked: &checked, count, max_cycles: s.max_cycles }
-            .render()
+        VhdlStreamTb {
+            tb: &tb,
+            module: &m.name,
+            rays,
+            expected,
+            results,
+            has_reset,
+            inputs: &inputs,
+            outputs: &outputs,
+            checked: &checked,
+            count,
+            max_cycles: s.max_cycles,
+        }
+        .render()
     } else {
         VerilogStreamTb {
             tb: &tb,
@@ -288,9 +300,10 @@ fn render_vhdl(m: &Module, t: &Transcript) -> Vec<(String, String)> {
         txt.push('\n');
     }
     let tb = tb_name(m);
-    let text = VhdlTb { tb: &tb, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
-        .render()
-        .expect("testbench template renders");
+    let text =
+        VhdlTb { tb: &tb, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
+            .render()
+            .expect("testbench template renders");
     vec![("tb.vhd".into(), text + "\n"), ("vectors.txt".into(), txt)]
 }
 

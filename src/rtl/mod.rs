@@ -1,11 +1,11 @@
 //! The runtime-width RTL description: one netlist drives the cycle-accurate simulator and the
 //! VHDL and Verilog printers, so the three cannot disagree on a width or a sign.
 
+pub mod batch;
 pub mod emit;
+pub mod flatten;
 pub mod names;
 pub mod netlist;
-pub mod batch;
-pub mod flatten;
 pub mod sim;
 pub mod width;
 

@@ -85,11 +85,9 @@ impl Def {
             Def::Bin(op, a, b) => Def::Bin(*op, f(*a), f(*b)),
             Def::Un(op, a) => Def::Un(*op, f(*a)),
             Def::Mux { sel, t, f: e } => Def::Mux { sel: f(*sel), t: f(*t), f: f(*e) },
-            Def::Case { sel, arms, default } => Def::Case {
-                sel: f(*sel),
-                arms: arms.iter().map(|(v, a)| (*v, f(*a))).collect(),
-                default: f(*default),
-            },
+            Def::Case { sel, arms, default } => {
+                Def::Case { sel: f(*sel), arms: arms.iter().map(|(v, a)| (*v, f(*a))).collect(), default: f(*default) }
+            }
             Def::Concat(parts) => Def::Concat(parts.iter().map(|p| f(*p)).collect()),
             Def::Wire(d) => Def::Wire(d.map(&f)),
             Def::InstOut { inst, port } => Def::InstOut { inst: *inst, port: *port },
@@ -342,14 +340,25 @@ impl Module {
     /// Instantiates `sub` with its inputs driven by `inputs` (in port order); returns its
     /// outputs as signals of this module, named `{label}_{port}`.
     pub fn instance(&mut self, label: &str, sub: &Rc<Module>, inputs: &[Sig]) -> Vec<Sig> {
-        assert_eq!(inputs.len(), sub.inputs.len(), "{}: {label}: {} takes {} inputs", self.name, sub.name, sub.inputs.len());
+        assert_eq!(
+            inputs.len(),
+            sub.inputs.len(),
+            "{}: {label}: {} takes {} inputs",
+            self.name,
+            sub.name,
+            sub.inputs.len()
+        );
         for (s, &p) in inputs.iter().zip(&sub.inputs) {
             let port = sub.sig(p);
             assert_eq!(s.ty, port.ty, "{}: {label}: input {} of {} type", self.name, port.name, sub.name);
         }
         let name = self.unique_name(label);
         let inst = self.instances.len();
-        self.instances.push(Instance { name: name.clone(), module: sub.clone(), inputs: inputs.iter().map(|s| s.id).collect() });
+        self.instances.push(Instance {
+            name: name.clone(),
+            module: sub.clone(),
+            inputs: inputs.iter().map(|s| s.id).collect(),
+        });
         (0..sub.outputs.len())
             .map(|port| {
                 let (pname, pid) = &sub.outputs[port];

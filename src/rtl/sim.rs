@@ -91,7 +91,8 @@ impl Sim {
             })
             .collect();
         let roms = flat.mems.iter().map(|r| r.words.clone()).collect();
-        let writes = flat.mems.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, we, a, d))).collect();
+        let writes =
+            flat.mems.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, we, a, d))).collect();
         let next = vec![0; regs.len() + rom_reads.len()];
         let mut sim =
             Sim { vals, tys, top: flat.top, comb, regs, rom_reads, roms, writes, next, reset: false, cycles: 0 };

@@ -118,9 +118,9 @@ impl SceneRoms {
                 .enumerate()
                 .map(|(i, x)| {
                     let x = x.trim();
-                    Word::from_hex(x).filter(|_| x.len() == digits).ok_or_else(|| {
-                        Error::file(&hex, format!("word {}: '{x}' is not {digits} hex digits", i + 1))
-                    })
+                    Word::from_hex(x)
+                        .filter(|_| x.len() == digits)
+                        .ok_or_else(|| Error::file(&hex, format!("word {}: '{x}' is not {digits} hex digits", i + 1)))
                 })
                 .collect::<Result<Vec<Word>>>()?;
             if words.is_empty() {
@@ -136,14 +136,6 @@ impl SceneRoms {
         let leaf = images.pop().expect("three images");
         let node = images.pop().expect("three images");
         let tri = images.pop().expect("three images");
-        Ok(SceneRoms {
-            name: j.scene,
-            params,
-            edge_shift: j.edge_shift_used,
-            box_hi: j.grid_box_hi,
-            tri,
-            node,
-            leaf,
-        })
+        Ok(SceneRoms { name: j.scene, params, edge_shift: j.edge_shift_used, box_hi: j.grid_box_hi, tri, node, leaf })
     }
 }

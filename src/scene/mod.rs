@@ -2,8 +2,8 @@
 
 pub mod accel;
 pub mod bih;
-pub mod images;
 pub mod builtin;
+pub mod images;
 pub mod obj;
 pub mod report;
 pub mod rom;

@@ -76,7 +76,9 @@ pub fn eval_bits(def: &Def, tys: &[Ty], b: &[u128], tr: Ty) -> u128 {
         }
         // comb_inputs order: sel, default, arms…
         Def::Case { arms, .. } => arms.iter().position(|a| a.0 == b[0]).map_or(b[1], |k| b[2 + k]),
-        Def::Concat(_) => tys.iter().zip(b).fold(0u128, |acc, (t, v)| if t.width >= 128 { *v } else { (acc << t.width) | v }),
+        Def::Concat(_) => {
+            tys.iter().zip(b).fold(0u128, |acc, (t, v)| if t.width >= 128 { *v } else { (acc << t.width) | v })
+        }
         other => unreachable!("not combinational: {other:?}"),
     }
 }
@@ -141,7 +143,6 @@ pub fn narrow_kernel(def: &Def, tr: Ty, s: &[&[i64]], o: &mut [i64]) -> bool {
     true
 }
 
-
 /// One definition on extended values (operands in `comb_inputs` order).
 pub fn eval_value(def: &Def, tys: &[Ty], v: &[i128], tr: Ty) -> i128 {
     if tys.iter().chain([&tr]).any(|t| t.width == 128 && !t.signed) {
@@ -187,7 +188,10 @@ pub fn eval_value(def: &Def, tys: &[Ty], v: &[i128], tr: Ty) -> i128 {
         // comb_inputs order: sel, default, arms…; a select is narrower than 128 bits.
         Def::Case { arms, .. } => arms.iter().position(|a| a.0 as i128 == v[0]).map_or(v[1], |k| v[2 + k]),
         Def::Concat(_) => {
-            let bits = tys.iter().zip(v).fold(0u128, |acc, (t, x)| if t.width >= 128 { t.wrap(*x) } else { (acc << t.width) | t.wrap(*x) });
+            let bits = tys
+                .iter()
+                .zip(v)
+                .fold(0u128, |acc, (t, x)| if t.width >= 128 { t.wrap(*x) } else { (acc << t.width) | t.wrap(*x) });
             tr.value(bits)
         }
         other => unreachable!("not combinational: {other:?}"),

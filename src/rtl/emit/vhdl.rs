@@ -43,7 +43,8 @@ pub fn print(m: &Module) -> String {
     for inst in &m.instances {
         if !declared.contains(&inst.module.name.as_str()) {
             declared.push(&inst.module.name);
-            let _ = writeln!(s, "  component {} is\n{}  end component;", inst.module.name, port_clause(&inst.module, 4));
+            let _ =
+                writeln!(s, "  component {} is\n{}  end component;", inst.module.name, port_clause(&inst.module, 4));
         }
     }
     for r in &m.roms {
@@ -158,7 +159,8 @@ pub fn print(m: &Module) -> String {
             _ => None,
         });
         map.extend(outs);
-        let _ = writeln!(s, "\n  {} : {}\n    port map (\n      {}\n    );", inst.name, sub.name, map.join(",\n      "));
+        let _ =
+            writeln!(s, "\n  {} : {}\n    port map (\n      {}\n    );", inst.name, sub.name, map.join(",\n      "));
     }
     let state: Vec<&crate::rtl::netlist::Signal> =
         m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
