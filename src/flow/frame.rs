@@ -151,13 +151,7 @@ pub fn simulate_rust(
                     stats.state_cycles[row[9] as usize & 7] += 1;
                 }
                 if row[0] == 1 {
-                    let hit = (row[2] == 1).then(|| Hit {
-                        tri: row[3] as u32,
-                        t: row[4] as i64,
-                        u: row[5] as i64,
-                        v: row[6] as i64,
-                    });
-                    results.push((row[1] as u64, hit));
+                    results.push(core_result(&row[1..7]));
                     if results.len() == rays.len() {
                         finished = Some(c as u64);
                     }
@@ -205,13 +199,8 @@ pub fn simulate_rust_cycle(
         stats.state_cycles[sim.get(state) as usize & 7] += 1;
         next += fire as usize;
         if sim.get(res[0]) == 1 {
-            let hit = (sim.get(res[2]) == 1).then(|| Hit {
-                tri: sim.get(res[3]) as u32,
-                t: sim.get(res[4]) as i64,
-                u: sim.get(res[5]) as i64,
-                v: sim.get(res[6]) as i64,
-            });
-            results.push((sim.get(res[1]) as u64, hit));
+            let row: Vec<i128> = res[1..].iter().map(|s| sim.get(*s)).collect();
+            results.push(core_result(&row));
             if results.len() % 256 == 0 {
                 progress(results.len() as u64);
             }
@@ -267,6 +256,12 @@ pub fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
 /// Outputs a stream testbench checks and writes back, in order.
 pub const RESULT_PORTS: [&str; 6] = ["res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"];
 
+/// A result from the values of `RESULT_PORTS`.
+fn core_result(r: &[i128]) -> CoreResult {
+    let hit = (r[1] == 1).then(|| Hit { tri: r[2] as u32, t: r[3] as i64, u: r[4] as i64, v: r[5] as i64 });
+    (r[0] as u64, hit)
+}
+
 /// A result as the values of `RESULT_PORTS`.
 fn result_row(id: u64, hit: Option<Hit>) -> Vec<i128> {
     match hit {
@@ -308,13 +303,7 @@ pub fn simulate_hdl(
     let (_, out) = sim.run_bench(dir, &m, Bench::Stream).map_err(|e| Error::new(sim.name(), e))?;
     let text = std::fs::read_to_string(dir.join("results.txt")).map_err(io)?;
     let rows = parse_results(&m, &RESULT_PORTS, &text).map_err(|e| Error::file(&dir.join("results.txt"), e))?;
-    let results = rows
-        .iter()
-        .map(|r| {
-            let hit = (r[1] == 1).then(|| Hit { tri: r[2] as u32, t: r[3] as i64, u: r[4] as i64, v: r[5] as i64 });
-            (r[0] as u64, hit)
-        })
-        .collect();
+    let results = rows.iter().map(|r| core_result(r)).collect();
     // "cycles C busy B stack S", wherever the simulator put it on its line.
     let stats_line = out.lines().find_map(|l| l.find("cycles ").map(|i| &l[i..]));
     let nums: Vec<u64> = stats_line

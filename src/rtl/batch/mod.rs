@@ -363,15 +363,21 @@ impl BatchSim {
         }
     }
 
+    /// The word of memory `mem` at the address `addr` holds in lane c, as a value of slot
+    /// `dst`'s type; out-of-range addresses read 0, as in `Sim`.
+    fn read_mem(&self, mem: usize, addr: Tap, c: usize, dst: usize) -> i128 {
+        let a = self.lane(addr, c);
+        let bits = usize::try_from(a).ok().and_then(|a| self.mems[mem].get(a)).copied().unwrap_or(0);
+        self.tys[dst].value(bits)
+    }
+
     fn step(&mut self, i: usize, lanes: usize) {
         let step = std::mem::replace(&mut self.steps[i], Step::Group(Group::default()));
         match &step {
             Step::Lanes(op) => self.eval_lanes(op, lanes),
             Step::Lookup { dst, mem, addr } => {
                 for c in 0..lanes {
-                    let a = self.lane(*addr, c);
-                    let bits = usize::try_from(a).ok().and_then(|a| self.mems[*mem].get(a)).copied().unwrap_or(0);
-                    let v = self.tys[*dst].value(bits);
+                    let v = self.read_mem(*mem, *addr, c, *dst);
                     self.set(*dst, c, v);
                 }
             }
@@ -402,9 +408,7 @@ impl BatchSim {
             self.set(op.dst, c, v);
         }
         for &(dst, mem, addr) in &g.lookups {
-            let a = self.lane(addr, c);
-            let bits = usize::try_from(a).ok().and_then(|a| self.mems[mem].get(a)).copied().unwrap_or(0);
-            let v = self.tys[dst].value(bits);
+            let v = self.read_mem(mem, addr, c, dst);
             self.set(dst, c, v);
         }
         for r in &g.regs {
@@ -413,9 +417,7 @@ impl BatchSim {
             self.set(r.dst, c + 1, v);
         }
         for &(dst, mem, addr) in &g.reads {
-            let a = self.lane(addr, c);
-            let bits = usize::try_from(a).ok().and_then(|a| self.mems[mem].get(a)).copied().unwrap_or(0);
-            let v = self.tys[dst].value(bits);
+            let v = self.read_mem(mem, addr, c, dst);
             self.set(dst, c + 1, v);
         }
         for &(mem, we, addr, data) in &g.writes {
