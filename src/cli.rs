@@ -61,6 +61,9 @@ pub struct SimArgs {
     /// Quotient bits per divider stage: 1 or 2.
     #[arg(long = "div-bits", default_value_t = 1)]
     pub div_bits: u32,
+    /// Use the on-chip pinhole ray generator (camera inside the scene box) instead of host rays.
+    #[arg(long)]
+    pub raygen: bool,
     #[command(flatten)]
     pub params: ParamArgs,
 }
@@ -119,6 +122,12 @@ pub struct GenArgs {
     /// Quotient bits per divider stage: 1 or 2.
     #[arg(long = "div-bits", default_value_t = 1)]
     pub div_bits: u32,
+    /// Build `fxrt_core_raygen`: the core fed by an on-chip pinhole ray generator for the
+    /// camera given by --eye/--at/--up/--fov/--size (the eye must be inside the scene box).
+    #[arg(long)]
+    pub raygen: bool,
+    #[command(flatten)]
+    pub camera: CameraArgs,
     #[command(flatten)]
     pub params: ParamArgs,
 }

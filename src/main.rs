@@ -220,15 +220,31 @@ fn intersect_params(params: &fxrt::params::Params, scene: &Scene, hw: &fxrt::cli
 }
 
 fn run_gen(a: GenArgs) -> Result<()> {
-    let roms = match &a.scene_dir {
-        Some(dir) => fxrt::scene::images::SceneRoms::load(dir)?,
-        None => fxrt::scene::images::SceneRoms::of(&Scene::load(&a.scene.source(), &a.params.params()?)?),
+    let (roms, raygen) = match &a.scene_dir {
+        Some(_) if a.raygen => {
+            return Err(Error::param("raygen", "needs the scene itself (an OBJ or --builtin), not --scene DIR"));
+        }
+        Some(dir) => (fxrt::scene::images::SceneRoms::load(dir)?, None),
+        None => {
+            let scene = Scene::load(&a.scene.source(), &a.params.params()?)?;
+            let raygen = if a.raygen { Some(ray_generator(&scene, &a.camera)?) } else { None };
+            (fxrt::scene::images::SceneRoms::of(&scene), raygen)
+        }
     };
     if !(1..=64).contains(&a.ray_id_width) {
         return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", a.ray_id_width)));
     }
     if !(a.clock_mhz > 0.0 && a.clock_mhz <= 1000.0) {
         return Err(Error::param("clock-mhz", format!("{} is out of range: must be in (0, 1000]", a.clock_mhz)));
+    }
+    if let Some(g) = &raygen {
+        let pixels = g.width as u64 * g.height as u64;
+        if a.ray_id_width < 64 && pixels > 1u64 << a.ray_id_width {
+            return Err(Error::param(
+                "ray-id-width",
+                format!("{} bits cannot number the {pixels} pixels of --size", a.ray_id_width),
+            ));
+        }
     }
     let p = fxrt::cores::top::CoreParams::new(&roms, a.ray_id_width, a.div_bits);
     p.check()?;
@@ -239,13 +255,14 @@ fn run_gen(a: GenArgs) -> Result<()> {
         ise: a.ise,
         clock_mhz: a.clock_mhz,
     };
-    let files: Vec<(std::path::PathBuf, Vec<u8>)> = fxrt::flow::generate::core_files(&p, &roms, o)
+    let files: Vec<(std::path::PathBuf, Vec<u8>)> = fxrt::flow::generate::core_files(&p, &roms, o, raygen.as_ref())
         .into_iter()
         .map(|(n, t)| (a.out.join(n), t.into_bytes()))
         .collect();
     fxrt::io::write_all_atomic(&files)?;
     println!(
-        "fxrt_core for {} ({} triangles; intersection pipeline {} cycles) written to {}",
+        "{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",
+        if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" },
         roms.name,
         roms.tri_count(),
         p.isect.latency(),
@@ -332,16 +349,31 @@ fn run_sim(a: SimArgs) -> Result<bool> {
     let roms = fxrt::scene::images::SceneRoms::of(&scene);
     let p = fxrt::cores::top::CoreParams::new(&roms, id_width, a.div_bits);
     p.check()?;
-    let rays = frame::frame_rays(&scene, &cam);
+    let raygen = if a.raygen { Some(ray_generator(&scene, &a.camera)?) } else { None };
+    let rays = match &raygen {
+        Some(g) => {
+            let golden = fxrt::model::golden::Golden::new(&scene);
+            (0..w * h).map(|i| frame::PixelRay { pixel: i, ray: g.ray(&golden, i % w, i / w) }).collect()
+        }
+        None => frame::frame_rays(&scene, &cam),
+    };
     let start = std::time::Instant::now();
-    let (results, stats) = match a.sim {
-        FrameSim::Rust => {
+    let (results, stats) = match (a.sim, &raygen) {
+        (FrameSim::Rust, Some(g)) => {
+            let bar = frame::progress_bar(rays.len() as u64, "rust");
+            let m = fxrt::cores::top::core_with_raygen(&p, &roms, g);
+            let r = frame::collect_batched(&m, rays.len(), 0, &|n| bar.set_position(n));
+            bar.finish_and_clear();
+            r
+        }
+        (_, Some(_)) => return Err(Error::param("raygen", "runs in the Rust simulator only (--sim rust)")),
+        (FrameSim::Rust, None) => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
             let r = frame::simulate_rust(&p, &roms, &rays, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
         }
-        hdl => {
+        (hdl, None) => {
             let sim = if hdl == FrameSim::Ghdl { Simulator::Ghdl } else { Simulator::Verilator };
             let dir = a.build.clone().unwrap_or_else(|| std::path::PathBuf::from("target/fxrt-sim").join(sim.name()));
             fxrt::flow::frame::simulate_hdl(sim, &p, &scene, &rays, &dir)?
@@ -371,4 +403,10 @@ fn run_sim(a: SimArgs) -> Result<bool> {
         })
     );
     Ok(mismatches == 0)
+}
+
+/// The on-chip ray generator for a camera (inside the scene box).
+fn ray_generator(scene: &Scene, camera: &fxrt::cli::CameraArgs) -> Result<fxrt::model::raygen::RayGen> {
+    let cam = camera.camera(scene)?;
+    fxrt::model::raygen::RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
 }

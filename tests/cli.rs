@@ -210,3 +210,40 @@ fn test_command_reports_and_fails_on_nothing_to_run() {
     let o = fxrt(&["test", "--vectors", "0"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn sim_command_checks_every_pixel_and_writes_render_ids() {
+    let dir = tempfile::tempdir().unwrap();
+    let (sim_ids, render_ids) = (dir.path().join("sim.ids"), dir.path().join("render.ids"));
+    let o = fxrt(&["sim", "--builtin", "cornell", "--size", "24x20", "--ids", sim_ids.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(line["all_pixels_match"], true);
+    assert!(line["cycles_per_ray"].as_f64().unwrap() > 10.0);
+    let o = fxrt(&["render", "--builtin", "cornell", "--size", "24x20", "--ids", render_ids.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&sim_ids).unwrap(), std::fs::read(&render_ids).unwrap());
+    // The on-chip ray generator, from inside the box.
+    let o = fxrt(&[
+        "sim",
+        "--builtin",
+        "cornell",
+        "--raygen",
+        "--eye",
+        "278,273,60",
+        "--at",
+        "300,250,559",
+        "--size",
+        "16x16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((line["all_pixels_match"].as_bool(), line["rays"].as_u64()), (Some(true), Some(256)));
+    // Refused: a generator camera outside the box, the generator in an HDL simulator.
+    let o = fxrt(&["sim", "--builtin", "cornell", "--raygen", "--size", "8x8"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--eye") && stderr(&o).contains("inside the scene box"), "{}", stderr(&o));
+    let o = fxrt(&["sim", "--raygen", "--sim", "ghdl", "--eye", "0,1,0", "--at", "1,1,0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
+}

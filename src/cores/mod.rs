@@ -4,5 +4,6 @@
 pub mod closest;
 pub mod divider;
 pub mod intersect;
+pub mod raygen;
 pub mod top;
 pub mod traverse;

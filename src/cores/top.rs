@@ -181,6 +181,25 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     m
 }
 
+/// The core fed by the on-chip ray generator instead of the ray port (the thesis's demo):
+/// no inputs but the clock and reset; the same result and observation outputs.
+pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::raygen::RayGen) -> Module {
+    let mut m = Module::new("fxrt_core_raygen");
+    let generator = Rc::new(super::raygen::raygen_core(g, p.isect.n, p.isect.m, p.trav.c, p.trav.id_width));
+    let ready = m.wire("ready", Ty::BIT);
+    let rays = m.instance("u_raygen", &generator, &[ready]);
+    let core = Rc::new(core_module(p, scene));
+    let outs = m.instance("u_core", &core, &rays);
+    for (k, (name, _)) in core.outputs.iter().enumerate() {
+        if name == "ray_ready" {
+            m.drive(ready, outs[k]);
+        } else {
+            m.output(name, outs[k]);
+        }
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -125,12 +125,22 @@ pub fn simulate_rust(
     if rays.is_empty() {
         return (Vec::new(), CoreStats::default());
     }
-    let m = frame_harness(p, scene, rays);
-    let mut sim = BatchSim::new(&m, 256).expect("the frame harness has no inputs");
-    let mut stats = CoreStats { rays: rays.len() as u64, ..Default::default() };
-    let mut results: Vec<CoreResult> = Vec::with_capacity(rays.len());
-    let mut row = [0i128; 10];
-    stats.state_cycles = vec![0; 8];
+    // Cycle c of the harness is cycle c − 1 of a testbench driving the core directly.
+    collect_batched(&frame_harness(p, scene, rays), rays.len(), 1, progress)
+}
+
+/// Runs a design without inputs whose outputs are the core's results and observations (the
+/// frame harness, or the core with its ray generator) in the batched simulator until `count`
+/// results came out. The first `skip` cycles are not counted.
+pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u64)) -> (Vec<CoreResult>, CoreStats) {
+    let names =
+        ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"];
+    let order: Vec<usize> =
+        names.iter().map(|n| m.outputs.iter().position(|o| o.0 == *n).expect("a core output")).collect();
+    let mut sim = BatchSim::new(m, 256).expect("a design without inputs");
+    let mut stats = CoreStats { rays: count as u64, state_cycles: vec![0; 8], ..Default::default() };
+    let mut results: Vec<CoreResult> = Vec::with_capacity(count);
+    let mut all = vec![0i128; m.outputs.len()];
     let mut finished: Option<u64> = None;
     let mut cycles = 0u64;
     while finished.is_none() {
@@ -138,22 +148,19 @@ pub fn simulate_rust(
             1 << 16,
             |_, _| 0,
             |c, k, v| {
-                row[k] = v;
-                if k + 1 < row.len() || finished.is_some() {
+                all[k] = v;
+                if k + 1 < all.len() || finished.is_some() || (c as u64) < skip {
                     return;
                 }
-                // Cycle c of the harness is cycle c − 1 of a testbench driving the core directly.
-                cycles = c as u64;
+                let row: Vec<i128> = order.iter().map(|&i| all[i]).collect();
+                cycles = c as u64 + 1 - skip;
                 stats.busy_cycles += row[7] as u64;
                 stats.max_stack_depth = stats.max_stack_depth.max(row[8] as u32);
-                // The harness's cycle 0 precedes the testbench's first cycle.
-                if c > 0 {
-                    stats.state_cycles[row[9] as usize & 7] += 1;
-                }
+                stats.state_cycles[row[9] as usize & 7] += 1;
                 if row[0] == 1 {
                     results.push(core_result(&row[1..7]));
-                    if results.len() == rays.len() {
-                        finished = Some(c as u64);
+                    if results.len() == count {
+                        finished = Some(cycles);
                     }
                 }
             },

@@ -2,7 +2,8 @@
 
 use crate::cores::divider;
 use crate::cores::intersect::{IntersectParams, intersect_core};
-use crate::cores::top::{CoreParams, core_module};
+use crate::cores::top::{CoreParams, core_module, core_with_raygen};
+use crate::model::raygen::RayGen;
 use crate::rtl::emit;
 use crate::rtl::netlist::Module;
 use crate::scene::images::SceneRoms;
@@ -104,9 +105,13 @@ pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, Str
     write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, clock_mhz: 100.0 }, "")
 }
 
-/// The whole ray tracing core for a scene, with manifests for it and for each of its cores.
-pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions) -> Vec<(String, String)> {
-    let top = core_module(p, roms);
+/// The whole ray tracing core for a scene (fed by the on-chip ray generator when `raygen` is
+/// given), with manifests for it and for each of its cores.
+pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions, raygen: Option<&RayGen>) -> Vec<(String, String)> {
+    let top = match raygen {
+        Some(g) => core_with_raygen(p, roms, g),
+        None => core_module(p, roms),
+    };
     let core_params = json!({
         "scene": roms.name,
         "triangles": roms.tri_count(),

@@ -3,4 +3,5 @@
 pub mod float;
 pub mod golden;
 pub mod ray;
+pub mod raygen;
 pub mod reference;

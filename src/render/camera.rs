@@ -93,6 +93,14 @@ pub struct PixelRays {
 }
 
 impl PixelRays {
+    /// f + sx·r + sy·u for the pixel position (px, py) (pixel centres at integer + 0.5).
+    pub fn unnormalized(&self, px: f64, py: f64) -> [f64; 3] {
+        let (w, h, tan) = (self.w, self.h, self.tan);
+        let sx = (2.0 * (px + 0.5) / w - 1.0) * tan * w / h;
+        let sy = (1.0 - 2.0 * (py + 0.5) / h) * tan;
+        std::array::from_fn(|k| self.f[k] + sx * self.r[k] + sy * self.u[k])
+    }
+
     #[inline]
     pub fn ray(&self, px: u32, py: u32) -> WorldRay {
         let (w, h, tan) = (self.w, self.h, self.tan);
