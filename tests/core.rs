@@ -53,6 +53,12 @@ fn rust_cornell_thin_random_128() {
 }
 
 #[test]
+fn rust_teapot_fine_128() {
+    // 57,360 triangles: the 50k+ scene.
+    rust_frame("teapot-fine", 128);
+}
+
+#[test]
 fn rust_jackstraws_128() {
     // ~15,000 cycles per ray (seed 001's stress test for a BIH): 180 M clock cycles.
     rust_frame("jackstraws", 128);
