@@ -38,6 +38,123 @@ pub enum Command {
     Synth(SynthArgs),
     /// Run a whole frame through the generated ray tracing core and compare every pixel.
     Sim(SimArgs),
+    /// Image error and hardware cost over lists of n, m, T, C and E (`sweep merge` joins shards).
+    Sweep(SweepArgs),
+}
+
+/// `fxrt sweep`: every parameter takes a list (`12,16,20`), a range (`20..29`, inclusive) or a
+/// range with a step (`0..24:8`), mixed freely.
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct SweepArgs {
+    #[command(subcommand)]
+    pub action: Option<SweepAction>,
+    /// OBJ files to sweep (before the built-ins).
+    pub scenes: Vec<PathBuf>,
+    /// Built-in scenes: teapot, teapot-fine, jackstraws, thin, random, cornell (comma-separated
+    /// or repeated). Default: teapot, when no OBJ file is named either.
+    #[arg(long, value_delimiter = ',')]
+    pub builtin: Vec<String>,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Vertex grid bits n (4..=40).
+    #[arg(long, default_value = "29")]
+    pub n: String,
+    /// Fixed-point bits m (8..=64).
+    #[arg(long, default_value = "32")]
+    pub m: String,
+    /// Division precision drop T (0..=m−2).
+    #[arg(long, default_value = "0")]
+    pub t: String,
+    /// Reciprocal-direction extra bits C.
+    #[arg(long, default_value = "16")]
+    pub c: String,
+    /// Edge shift E: 'auto' and/or values.
+    #[arg(long = "edge-shift", default_value = "auto")]
+    pub edge_shift: String,
+    /// Largest number of triangles in a BIH leaf (one value).
+    #[arg(long = "leaf-size", default_value_t = 4)]
+    pub leaf_size: u32,
+    /// Hardware traversal stack entries (one value).
+    #[arg(long = "stack-depth", default_value_t = 32)]
+    pub stack_depth: u32,
+    /// Vary one parameter at a time around the base set (each at its default if listed,
+    /// else its first value), like the thesis's figures, instead of the cross product.
+    #[arg(long = "one-at-a-time")]
+    pub one_at_a_time: bool,
+    /// Also synthesise each configuration's core with yosys for Virtex-5 (slow).
+    #[arg(long)]
+    pub synth: bool,
+    /// Output folder (it also caches finished configurations for reruns).
+    #[arg(long, required_unless_present = "action")]
+    pub out: Option<PathBuf>,
+    /// Compute only shard I of N: the configurations whose index mod N is I − 1.
+    #[arg(long, value_parser = crate::flow::sweep::Shard::parse)]
+    pub shard: Option<crate::flow::sweep::Shard>,
+    /// Write a Slurm job-array script, a merge job and a GNU parallel command list into
+    /// OUT/slurm instead of running.
+    #[arg(long = "emit-slurm")]
+    pub emit_slurm: bool,
+    /// Shards for --emit-slurm.
+    #[arg(long, default_value_t = 8)]
+    pub shards: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+impl SweepArgs {
+    /// The sweep the arguments describe; every list is checked here, before anything runs.
+    pub fn spec(&self) -> Result<crate::flow::sweep::SweepSpec> {
+        use crate::flow::sweep::{CameraSpec, SceneSpec, SweepSpec, axis};
+        let mut scenes: Vec<SceneSpec> = self.scenes.iter().cloned().map(SceneSpec::Obj).collect();
+        scenes.extend(self.builtin.iter().map(|b| SceneSpec::Builtin(b.trim().to_string())));
+        if scenes.is_empty() {
+            scenes.push(SceneSpec::Builtin("teapot".into()));
+        }
+        let (width, height) = self.camera.size;
+        if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
+            return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
+        }
+        let single = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
+        single.validate()?;
+        Ok(SweepSpec {
+            scenes,
+            camera: CameraSpec {
+                eye: self.camera.eye,
+                at: self.camera.at,
+                up: self.camera.up,
+                fov: self.camera.fov,
+                width,
+                height,
+            },
+            n: axis::parse_u32_list("n", &self.n)?,
+            m: axis::parse_u32_list("m", &self.m)?,
+            t: axis::parse_u32_list("t", &self.t)?,
+            c: axis::parse_u32_list("c", &self.c)?,
+            edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
+            leaf_size: self.leaf_size,
+            stack_depth: self.stack_depth,
+            one_at_a_time: self.one_at_a_time,
+            synth: self.synth,
+        })
+    }
+}
+
+#[derive(Subcommand, Debug)]
+pub enum SweepAction {
+    /// Join the folders of a sweep's shards into one.
+    Merge(SweepMergeArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct SweepMergeArgs {
+    /// The shard folders.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 #[derive(Args, Debug)]

@@ -1,7 +1,7 @@
 use clap::Parser;
 use fxrt::cli::{
     BenchArgs, Cli, Command, CompareArgs, FrameSim, GenArgs, Lang, RenderArgs, SceneArgs, SimArgs, SimChoice,
-    SynthArgs, TestArgs,
+    SweepAction, SweepArgs, SynthArgs, TestArgs,
 };
 use fxrt::cores::intersect::IntersectParams;
 use fxrt::error::{Error, Result};
@@ -31,6 +31,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(a)) => run_bench(a),
         Some(Command::Gen(a)) => run_gen(a),
         Some(Command::Synth(a)) => run_synth(a),
+        Some(Command::Sweep(a)) => run_sweep(a),
         Some(Command::Sim(a)) => match run_sim(a) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
@@ -409,4 +410,76 @@ fn run_sim(a: SimArgs) -> Result<bool> {
 fn ray_generator(scene: &Scene, camera: &fxrt::cli::CameraArgs) -> Result<fxrt::model::raygen::RayGen> {
     let cam = camera.camera(scene)?;
     fxrt::model::raygen::RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
+}
+
+fn run_sweep(a: SweepArgs) -> Result<()> {
+    use fxrt::flow::sweep::{report, run};
+    if let Some(SweepAction::Merge(m)) = &a.action {
+        let dirs: Vec<&std::path::Path> = m.dirs.iter().map(|d| d.as_path()).collect();
+        let rows = run::merge(&dirs, &m.out)?;
+        println!("merged {} folders: {rows} configurations into {}", dirs.len(), m.out.display());
+        return Ok(());
+    }
+    let spec = a.spec()?;
+    let plan = spec.plan()?;
+    let out = a.out.clone().expect("clap requires --out without a subcommand");
+    let pool = thread_pool(a.threads)?;
+    if a.emit_slurm {
+        if a.shard.is_some() {
+            return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
+        }
+        if a.shards == 0 || a.shards as usize > plan.configs.len() {
+            return Err(Error::param(
+                "shards",
+                format!("{} is out of range: must be 1..={} (the configurations)", a.shards, plan.configs.len()),
+            ));
+        }
+        let abs = |p: &std::path::Path| std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()));
+        let mut spec = spec.clone();
+        for s in &mut spec.scenes {
+            if let fxrt::flow::sweep::SceneSpec::Obj(p) = s {
+                *p = abs(p)?;
+            }
+        }
+        let exe = std::env::current_exe().map_err(|e| Error::new("fxrt", format!("cannot find its own path: {e}")))?;
+        let cpus = a.threads.unwrap_or(4) as u32;
+        let files = report::slurm_files(&exe, &spec, &abs(&out)?, a.shards, cpus)?;
+        for (name, text, executable) in &files {
+            let path = out.join("slurm").join(name);
+            fxrt::io::write_atomic(&path, text.as_bytes())?;
+            #[cfg(unix)]
+            if *executable {
+                use std::os::unix::fs::PermissionsExt;
+                let _ = std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755));
+            }
+        }
+        println!(
+            "{} configurations in {} shards: submit with {}/slurm/submit.sh (Slurm) or run {}/slurm/parallel.sh (GNU parallel)",
+            plan.configs.len(),
+            a.shards,
+            out.display(),
+            out.display()
+        );
+        return Ok(());
+    }
+    let scenes = pool.install(|| run::load_scenes(&spec))?;
+    eprintln!(
+        "sweep: {} configurations ({} parameter sets × {} scenes){}{}",
+        plan.configs.len(),
+        plan.sets.len(),
+        spec.scenes.len(),
+        a.shard.map(|s| format!(", shard {s}")).unwrap_or_default(),
+        if plan.skipped.is_empty() { String::new() } else { format!(", {} invalid sets skipped", plan.skipped.len()) }
+    );
+    let start = std::time::Instant::now();
+    let summary = pool.install(|| run::run(&spec, &plan, &scenes, &out, a.shard, true))?;
+    println!(
+        "{} computed, {} from the cache, {} incomplete, in {:.1} s: {}",
+        summary.computed,
+        summary.cached,
+        summary.failed,
+        start.elapsed().as_secs_f64(),
+        out.join("report.md").display()
+    );
+    Ok(())
 }

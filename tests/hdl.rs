@@ -145,6 +145,8 @@ fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
         let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
         // Four products ahead of the divider, two after it, four for u and v: all on DSP48E.
         assert!(area.dsp48e >= 10, "{area:?}");
+        // The sweeps' DSP48E estimate is what yosys does.
+        assert_eq!(area.dsp48e, fxrt::cores::cost::dsp48e_estimate(&module) as u64);
         assert!(area.luts > 500 && area.ffs > 500, "{area:?}");
     }
 }
@@ -169,6 +171,7 @@ fn whole_core_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
         let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
         // A small scene's ROMs fit distributed RAM; the teapot's map to block RAM (docs/CORE.md).
         assert!(area.dsp48e >= 10 && area.bram18 + area.lutram_cells > 0, "{area:?}");
+        assert_eq!(area.dsp48e, fxrt::cores::cost::dsp48e_estimate(&module) as u64);
     } else {
         common::say("skipped: yosys is not installed");
     }

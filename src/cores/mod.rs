@@ -2,6 +2,7 @@
 //! `model/`.
 
 pub mod closest;
+pub mod cost;
 pub mod divider;
 pub mod intersect;
 pub mod raygen;

@@ -4,6 +4,7 @@ pub mod check;
 pub mod frame;
 pub mod generate;
 pub mod simulators;
+pub mod sweep;
 pub mod synth;
 pub mod testbench;
 pub mod vectors;

@@ -17,7 +17,7 @@ pub struct Frame {
     /// Input triangle number per pixel, −1 for a miss.
     pub ids: Vec<i32>,
     /// World-space distance from the eye, +inf for a miss.
-    pub depth: Vec<f32>,
+    pub depth: Vec<f64>,
     /// Brightness in [0, 1] for the picture.
     pub shade: Vec<f32>,
     pub rays: u64,
@@ -52,11 +52,11 @@ pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, pro
     bar.set_message("render");
     let start = std::time::Instant::now();
     let pixel_rays = cam.pixel_rays();
-    let rows: Vec<Vec<(i32, f32, f32, u8)>> = (0..h)
+    let rows: Vec<Vec<(i32, f64, f32, u8)>> = (0..h)
         .into_par_iter()
         .map(|py| {
             let rays: Vec<_> = (0..w).map(|px| pixel_rays.ray(px, py)).collect();
-            let mut row = vec![(-1, f32::INFINITY, -1.0, 1); w as usize];
+            let mut row = vec![(-1, f64::INFINITY, -1.0, 1); w as usize];
             tracer.primary_row(&rays, &mut |px, hit| {
                 let (ray, n) = (&rays[px], normals[hit.id as usize]);
                 let (brightness, traced) = if shade {
@@ -67,7 +67,7 @@ pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, pro
                 } else {
                     (0.12 + 0.88 * dot(n, ray.d).abs(), 1)
                 };
-                row[px] = (hit.id as i32, hit.dist as f32, brightness as f32, traced);
+                row[px] = (hit.id as i32, hit.dist, brightness as f32, traced);
             });
             bar.inc(1);
             row
@@ -92,7 +92,7 @@ impl Frame {
         self.ids.iter().flat_map(|x| x.to_le_bytes()).collect()
     }
     pub fn depth_bytes(&self) -> Vec<u8> {
-        self.depth.iter().flat_map(|x| x.to_le_bytes()).collect()
+        self.depth.iter().flat_map(|&x| (x as f32).to_le_bytes()).collect()
     }
     /// An 8-bit RGB PNG: warm grey surfaces, a dark blue-grey background.
     pub fn png_bytes(&self) -> Vec<u8> {

@@ -37,7 +37,7 @@ impl GridTransform {
     }
 }
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct TriangleCounts {
     pub input: usize,
     pub degenerate: usize,

@@ -1,0 +1,289 @@
+//! One configuration: the golden model's frame against the f64 reference, the triangle counts,
+//! and the hardware cost (estimated, or from yosys with `--synth`).
+
+use super::{CameraSpec, Config, SceneSpec, params_label};
+use crate::cores::cost::{CoreCost, core_cost};
+use crate::cores::top::{CoreParams, core_module};
+use crate::error::{Error, Result};
+use crate::flow::synth::synth_xc5v;
+use crate::params::Params;
+use crate::render::camera::Camera;
+use crate::render::tracer::{ModelKind, make_tracer};
+use crate::render::{Frame, encode_png, render};
+use crate::scene::images::SceneRoms;
+use crate::scene::{Scene, Tri, TriangleCounts, builtin, obj};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Both models hit, different triangles, and the distances differ by more than this fraction:
+/// a different surface, not a neighbour sharing the edge the ray passes through.
+pub const OTHER_SURFACE_REL: f64 = 1e-3;
+
+/// Bump when a row's meaning changes: old cache entries then no longer match.
+pub const ROW_FORMAT: u32 = 1;
+
+/// A scene loaded once for the whole sweep, with the frames every configuration is compared to.
+pub struct SceneCtx {
+    pub label: String,
+    /// Identifies the scene's content: a hash of the OBJ file, or the built-in's name.
+    pub fingerprint: String,
+    pub world: Vec<Tri>,
+    pub camera: Camera,
+    /// The scene at the default parameters (with the sweep's leaf size and stack depth).
+    defaults: Scene,
+    reference: OnceLock<Frame>,
+    default_ids: OnceLock<Vec<i32>>,
+}
+
+impl SceneCtx {
+    /// Loads and checks the scene; errors name the file and the problem.
+    pub fn load(
+        spec: &SceneSpec,
+        label: String,
+        cam: &CameraSpec,
+        leaf_size: u32,
+        stack_depth: u32,
+    ) -> Result<SceneCtx> {
+        let (name, world, fingerprint) = match spec {
+            SceneSpec::Builtin(b) => {
+                let world = builtin::builtin_scene(b).ok_or_else(|| {
+                    Error::param(
+                        "builtin",
+                        format!("unknown scene '{b}'; known: {}", builtin::BUILTIN_NAMES.join(", ")),
+                    )
+                })?;
+                (b.clone(), world, format!("builtin:{b}"))
+            }
+            SceneSpec::Obj(p) => {
+                let bytes = std::fs::read(p).map_err(|e| Error::file(p, format!("cannot read: {e}")))?;
+                (p.display().to_string(), obj::load_obj(p)?, format!("obj:{:x}", Sha256::digest(&bytes)))
+            }
+        };
+        let params = Params { leaf_size, stack_depth, ..Params::default() };
+        let defaults = Scene::build(&name, world.clone(), &params)?;
+        let mut camera = Camera::default_for(&defaults, cam.width, cam.height);
+        if let Some(e) = cam.eye {
+            camera.eye = e;
+        }
+        if let Some(a) = cam.at {
+            camera.at = a;
+        }
+        camera.up = cam.up;
+        camera.fov_deg = cam.fov;
+        camera.validate().map_err(|(opt, msg)| Error::param(opt, msg))?;
+        Ok(SceneCtx {
+            label,
+            fingerprint,
+            world,
+            camera,
+            defaults,
+            reference: OnceLock::new(),
+            default_ids: OnceLock::new(),
+        })
+    }
+
+    /// The f64 reference frame (independent of the swept parameters).
+    pub fn reference(&self) -> &Frame {
+        self.reference.get_or_init(|| {
+            let tracer = make_tracer(&self.defaults, ModelKind::F64);
+            render(&self.defaults, tracer.as_ref(), &self.camera, false, false)
+        })
+    }
+
+    /// The golden model's triangle ids at the default parameters.
+    pub fn default_ids(&self) -> &[i32] {
+        self.default_ids.get_or_init(|| {
+            let tracer = make_tracer(&self.defaults, ModelKind::Golden);
+            render(&self.defaults, tracer.as_ref(), &self.camera, false, false).ids
+        })
+    }
+
+    /// The cache key of `params` on this scene: everything the row depends on.
+    pub fn key(&self, params: &Params, synth: bool) -> String {
+        let c = &self.camera;
+        let text = serde_json::json!({
+            "fxrt": env!("CARGO_PKG_VERSION"),
+            "row_format": ROW_FORMAT,
+            "scene": self.fingerprint,
+            "camera": [c.eye, c.at, c.up, [c.fov_deg, c.width as f64, c.height as f64]],
+            "params": params,
+            "synth": synth,
+        })
+        .to_string();
+        format!("{:x}", Sha256::digest(text.as_bytes()))[..20].to_string()
+    }
+}
+
+/// How the golden model's frame differs from the f64 reference.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Quality {
+    pub rays: u64,
+    /// Pixels the reference hits.
+    pub ref_hits: u64,
+    pub hits: u64,
+    pub false_misses: u64,
+    pub false_hits: u64,
+    /// Both hit, different triangles (neighbours sharing an edge included).
+    pub other_triangle: u64,
+    /// Of those, the ones whose distances differ by more than `OTHER_SURFACE_REL`.
+    pub other_surface: u64,
+    /// false misses + false hits + other surface: the pixels that show something wrong.
+    pub wrong_pixels: u64,
+    /// Pixels whose triangle differs from the golden image at the default parameters.
+    pub diff_vs_default: u64,
+    /// Relative error of the distance where both hit the same triangle: mean and max.
+    pub t_rel_mean: f64,
+    pub t_rel_max: f64,
+    pub triangles: TriangleCounts,
+}
+
+/// What synthesis reported (with `--synth`).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SynthArea {
+    pub luts: u64,
+    pub srl_luts: u64,
+    pub ffs: u64,
+    pub dsp48e: u64,
+    pub bram18: u64,
+}
+
+/// One configuration's results: a row of results.csv.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub index: usize,
+    pub key: String,
+    pub scene: String,
+    pub params: Params,
+    /// The edge shift used (`auto` resolved).
+    pub e_used: Option<u32>,
+    pub quality: Option<Quality>,
+    pub cost: Option<CoreCost>,
+    pub synth: Option<SynthArea>,
+    /// Why part of the row is missing.
+    pub error: Option<String>,
+}
+
+impl Row {
+    /// The image files of this row, relative to the sweep folder.
+    pub fn image_paths(&self) -> (String, String) {
+        let base = format!("images/{}/{}", self.scene, params_label(&self.params));
+        (format!("{base}.png"), format!("{base}_errors.png"))
+    }
+    /// The DSP48E count to rank by: synthesis if it ran, else the estimate.
+    pub fn dsp48e(&self) -> Option<u64> {
+        self.synth.as_ref().map(|s| s.dsp48e).or(self.cost.as_ref().map(|c| c.dsp48e_est as u64))
+    }
+}
+
+/// A row and its two pictures (PNG bytes; empty when the scene could not be built).
+pub struct Evaluated {
+    pub row: Row,
+    pub render_png: Vec<u8>,
+    pub errors_png: Vec<u8>,
+}
+
+pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, synth_dir: Option<&Path>) -> Evaluated {
+    let mut row = Row {
+        index: cfg.index,
+        key,
+        scene: ctx.label.clone(),
+        params: cfg.params,
+        e_used: None,
+        quality: None,
+        cost: None,
+        synth: None,
+        error: None,
+    };
+    let scene = match Scene::build(&ctx.label, ctx.world.clone(), &cfg.params) {
+        Ok(s) => s,
+        Err(e) => {
+            row.error = Some(e.message);
+            return Evaluated { row, render_png: vec![], errors_png: vec![] };
+        }
+    };
+    row.e_used = Some(scene.edge_shift);
+    let tracer = make_tracer(&scene, ModelKind::Golden);
+    let frame = render(&scene, tracer.as_ref(), &ctx.camera, false, false);
+    let reference = ctx.reference();
+    let mut q = quality(&frame, reference, ctx.default_ids());
+    q.triangles = scene.counts;
+    row.quality = Some(q);
+    let roms = SceneRoms::of(&scene);
+    match core_cost(&roms) {
+        Ok(c) => row.cost = Some(c),
+        Err(e) => row.error = Some(e.to_string()),
+    }
+    if let (Some(dir), Some(_)) = (synth_dir, &row.cost) {
+        let core = core_module(&CoreParams::new(&roms, 20, 1), &roms);
+        match synth_xc5v(&core, &dir.join(&row.key)) {
+            Ok(a) => {
+                row.synth = Some(SynthArea {
+                    luts: a.luts,
+                    srl_luts: a.srl_luts,
+                    ffs: a.ffs,
+                    dsp48e: a.dsp48e,
+                    bram18: a.bram18,
+                })
+            }
+            Err(e) => row.error = Some(e.to_string()),
+        }
+    }
+    let render_png = frame.png_bytes();
+    let errors_png = errors_png(&frame, reference);
+    Evaluated { row, render_png, errors_png }
+}
+
+/// Pixel-by-pixel comparison with the reference and with the default-parameter image.
+pub fn quality(golden: &Frame, reference: &Frame, default_ids: &[i32]) -> Quality {
+    let mut q = Quality { rays: golden.ids.len() as u64, ..Default::default() };
+    let (mut t_sum, mut t_count) = (0.0, 0u64);
+    for i in 0..golden.ids.len() {
+        let (g, r) = (golden.ids[i], reference.ids[i]);
+        q.ref_hits += (r >= 0) as u64;
+        q.hits += (g >= 0) as u64;
+        q.diff_vs_default += (g != default_ids[i]) as u64;
+        match (g >= 0, r >= 0) {
+            (true, false) => q.false_hits += 1,
+            (false, true) => q.false_misses += 1,
+            (true, true) => {
+                let rel = (golden.depth[i] - reference.depth[i]).abs() / reference.depth[i];
+                if g != r {
+                    q.other_triangle += 1;
+                    q.other_surface += (rel > OTHER_SURFACE_REL) as u64;
+                } else {
+                    t_sum += rel;
+                    t_count += 1;
+                    q.t_rel_max = q.t_rel_max.max(rel);
+                }
+            }
+            (false, false) => {}
+        }
+    }
+    q.wrong_pixels = q.false_misses + q.false_hits + q.other_surface;
+    q.t_rel_mean = if t_count == 0 { 0.0 } else { t_sum / t_count as f64 };
+    q
+}
+
+/// The render in grey with what is wrong in colour: false hits red, false misses blue,
+/// other surfaces magenta.
+pub fn errors_png(golden: &Frame, reference: &Frame) -> Vec<u8> {
+    let mut rgb = Vec::with_capacity(golden.ids.len() * 3);
+    for i in 0..golden.ids.len() {
+        let (g, r) = (golden.ids[i], reference.ids[i]);
+        let grey = if golden.shade[i] < 0.0 { 30 } else { (40.0 + 150.0 * golden.shade[i].clamp(0.0, 1.0)) as u8 };
+        let px = match (g >= 0, r >= 0) {
+            (true, false) => [235, 40, 40],
+            (false, true) => [40, 110, 255],
+            (true, true)
+                if g != r && (golden.depth[i] - reference.depth[i]).abs() / reference.depth[i] > OTHER_SURFACE_REL =>
+            {
+                [230, 40, 230]
+            }
+            _ => [grey; 3],
+        };
+        rgb.extend_from_slice(&px);
+    }
+    encode_png(golden.width, golden.height, &rgb)
+}

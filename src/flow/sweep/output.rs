@@ -1,0 +1,205 @@
+//! The sweep folder: results.json / results.csv, the cache of finished configurations, and the
+//! images copied out of it.
+//!
+//! ```text
+//! DIR/results.json  results.csv  report.md
+//! DIR/images/SCENE/LABEL.png, LABEL_errors.png
+//! DIR/grids/SCENE_PARAM.png    DIR/plots/*.png
+//! DIR/cache/KEY.json, KEY.png, KEY_errors.png   (every configuration ever finished here)
+//! ```
+
+use super::eval::{Evaluated, Row};
+use super::{Skipped, SweepSpec};
+use crate::error::{Error, Result};
+use crate::io::write_atomic;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// results.json: the spec, the plan's size and every finished row, in index order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Results {
+    pub fxrt: String,
+    pub spec: SweepSpec,
+    /// Configurations in the whole sweep (all shards).
+    pub configurations: usize,
+    /// `I/N` for a shard's folder; absent for a whole sweep.
+    pub shard: Option<String>,
+    pub skipped: Vec<Skipped>,
+    pub rows: Vec<Row>,
+}
+
+fn cache_files(dir: &Path, key: &str) -> [PathBuf; 3] {
+    let c = dir.join("cache");
+    [c.join(format!("{key}.json")), c.join(format!("{key}.png")), c.join(format!("{key}_errors.png"))]
+}
+
+/// A finished configuration from the cache, renumbered for this sweep; None if absent or
+/// unreadable (it is then computed again).
+pub fn load_cached(dir: &Path, key: &str, index: usize, scene: &str) -> Option<Row> {
+    let [json, png, errors] = cache_files(dir, key);
+    let mut row: Row = serde_json::from_slice(&std::fs::read(json).ok()?).ok()?;
+    if row.key != key || (row.quality.is_some() && !(png.is_file() && errors.is_file())) {
+        return None;
+    }
+    row.index = index;
+    row.scene = scene.to_string();
+    Some(row)
+}
+
+/// Stores a finished configuration; the row last, so a row in the cache has its images.
+pub fn store_cached(dir: &Path, e: &Evaluated) -> Result<()> {
+    let [json, png, errors] = cache_files(dir, &e.row.key);
+    if !e.render_png.is_empty() {
+        write_atomic(&png, &e.render_png)?;
+        write_atomic(&errors, &e.errors_png)?;
+    }
+    write_atomic(&json, &serde_json::to_vec_pretty(&e.row).expect("rows serialise"))
+}
+
+/// Copies a row's cache entry from one sweep folder to another (merging shards).
+pub fn copy_cached(from: &Path, to: &Path, key: &str) -> Result<()> {
+    for (src, dst) in cache_files(from, key).iter().zip(cache_files(to, key)) {
+        if src.is_file() {
+            let bytes = std::fs::read(src).map_err(|e| Error::file(src, format!("cannot read: {e}")))?;
+            write_atomic(&dst, &bytes)?;
+        }
+    }
+    Ok(())
+}
+
+/// The render and error images of a row, from the cache.
+pub fn cached_images(dir: &Path, key: &str) -> Result<(Vec<u8>, Vec<u8>)> {
+    let [_, png, errors] = cache_files(dir, key);
+    let read = |p: &Path| std::fs::read(p).map_err(|e| Error::file(p, format!("cannot read: {e}")));
+    Ok((read(&png)?, read(&errors)?))
+}
+
+pub fn read_results(dir: &Path) -> Result<Results> {
+    let path = dir.join("results.json");
+    let bytes = std::fs::read(&path).map_err(|e| Error::file(&path, format!("cannot read: {e}")))?;
+    serde_json::from_slice(&bytes).map_err(|e| Error::file(&path, format!("not a fxrt sweep result: {e}")))
+}
+
+/// The columns of results.csv.
+pub const CSV_COLUMNS: &[&str] = &[
+    "index",
+    "scene",
+    "n",
+    "m",
+    "edge_shift",
+    "e_used",
+    "t",
+    "c",
+    "leaf_size",
+    "stack_depth",
+    "rays",
+    "ref_hits",
+    "hits",
+    "false_misses",
+    "false_hits",
+    "other_triangle",
+    "other_surface",
+    "wrong_pixels",
+    "wrong_rate",
+    "diff_vs_default",
+    "t_rel_mean",
+    "t_rel_max",
+    "tris_input",
+    "tris_degenerate",
+    "tris_clamped",
+    "tris_stored",
+    "div_latency",
+    "isect_latency",
+    "rom_bits",
+    "dsp48e_est",
+    "register_bits",
+    "luts",
+    "srl_luts",
+    "ffs",
+    "dsp48e",
+    "bram18",
+    "image",
+    "error",
+    "key",
+];
+
+fn csv_record(r: &Row) -> Vec<String> {
+    let opt = |v: Option<String>| v.unwrap_or_default();
+    let p = &r.params;
+    let mut rec = vec![
+        r.index.to_string(),
+        r.scene.clone(),
+        p.n.to_string(),
+        p.m.to_string(),
+        p.edge_shift.to_string(),
+        opt(r.e_used.map(|e| e.to_string())),
+        p.t.to_string(),
+        p.c.to_string(),
+        p.leaf_size.to_string(),
+        p.stack_depth.to_string(),
+    ];
+    let q = r.quality.as_ref();
+    let qf = |f: &dyn Fn(&super::eval::Quality) -> String| opt(q.map(f));
+    rec.extend([
+        qf(&|q| q.rays.to_string()),
+        qf(&|q| q.ref_hits.to_string()),
+        qf(&|q| q.hits.to_string()),
+        qf(&|q| q.false_misses.to_string()),
+        qf(&|q| q.false_hits.to_string()),
+        qf(&|q| q.other_triangle.to_string()),
+        qf(&|q| q.other_surface.to_string()),
+        qf(&|q| q.wrong_pixels.to_string()),
+        qf(&|q| (q.wrong_pixels as f64 / q.rays.max(1) as f64).to_string()),
+        qf(&|q| q.diff_vs_default.to_string()),
+        qf(&|q| q.t_rel_mean.to_string()),
+        qf(&|q| q.t_rel_max.to_string()),
+        qf(&|q| q.triangles.input.to_string()),
+        qf(&|q| q.triangles.degenerate.to_string()),
+        qf(&|q| q.triangles.clamped.to_string()),
+        qf(&|q| q.triangles.stored.to_string()),
+    ]);
+    let c = r.cost.as_ref();
+    rec.extend([
+        opt(c.map(|c| c.div_latency.to_string())),
+        opt(c.map(|c| c.isect_latency.to_string())),
+        opt(c.map(|c| c.rom_bits.to_string())),
+        opt(c.map(|c| c.dsp48e_est.to_string())),
+        opt(c.map(|c| c.register_bits.to_string())),
+    ]);
+    let s = r.synth.as_ref();
+    rec.extend([
+        opt(s.map(|s| s.luts.to_string())),
+        opt(s.map(|s| s.srl_luts.to_string())),
+        opt(s.map(|s| s.ffs.to_string())),
+        opt(s.map(|s| s.dsp48e.to_string())),
+        opt(s.map(|s| s.bram18.to_string())),
+        if r.quality.is_some() { r.image_paths().0 } else { String::new() },
+        opt(r.error.clone()),
+        r.key.clone(),
+    ]);
+    rec
+}
+
+pub fn csv_bytes(rows: &[Row]) -> Vec<u8> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    // Writing into a Vec cannot fail.
+    w.write_record(CSV_COLUMNS).expect("csv into memory");
+    for r in rows {
+        w.write_record(csv_record(r)).expect("csv into memory");
+    }
+    w.into_inner().expect("csv into memory")
+}
+
+/// Writes results.json, results.csv and the images of every row (from the cache).
+pub fn write_tables_and_images(dir: &Path, results: &Results) -> Result<()> {
+    for r in results.rows.iter().filter(|r| r.quality.is_some()) {
+        let (png, errors) = cached_images(dir, &r.key)?;
+        let (p, e) = r.image_paths();
+        write_atomic(&dir.join(p), &png)?;
+        write_atomic(&dir.join(e), &errors)?;
+    }
+    write_atomic(&dir.join("results.csv"), &csv_bytes(&results.rows))?;
+    let mut json = serde_json::to_vec_pretty(results).expect("results serialise");
+    json.push(b'\n');
+    write_atomic(&dir.join("results.json"), &json)
+}

@@ -1,0 +1,179 @@
+//! Plots (plotters, PNG): wrong pixels against each swept parameter, and against DSP48E with
+//! the Pareto front. Text uses DejaVu Sans compiled in, so no system font is needed.
+
+use super::grid::series;
+use super::output::Results;
+use super::summary::{pareto_front, set_summaries};
+use super::{Axis, Plan, params_label};
+use crate::error::{Error, Result};
+use crate::io::write_atomic;
+use crate::render::encode_png;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// The font family name plots and grids draw with.
+pub const FONT: &str = "fxrt-sans";
+
+pub fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The font is compiled in and known to be valid.
+        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular())
+            .unwrap_or_else(|_| panic!("the embedded DejaVu Sans is a valid font"));
+    });
+}
+
+const W: u32 = 900;
+const H: u32 = 560;
+/// Where a count of 0 is drawn on the logarithmic axes.
+const ZERO: f64 = 0.5;
+
+fn plot_err(e: impl std::fmt::Display) -> Error {
+    Error::new("sweep plot", e.to_string())
+}
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Writes plots/error_PARAM.png per swept parameter and plots/pareto_dsp48e.png.
+pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
+    register_font();
+    let mut written = Vec::new();
+    for axis in results.spec.swept_axes() {
+        let rel = format!("plots/error_{}.png", axis.name());
+        write_atomic(&dir.join(&rel), &error_plot(results, plan, axis)?)?;
+        written.push(rel);
+    }
+    if !set_summaries(results).is_empty() {
+        let rel = "plots/pareto_dsp48e.png".to_string();
+        write_atomic(&dir.join(&rel), &pareto_plot(results)?)?;
+        written.push(rel);
+    }
+    Ok(written)
+}
+
+fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
+    let values = results.spec.values(axis);
+    let labels = super::run::scene_labels(&results.spec.scenes);
+    let lines: Vec<(String, Vec<(i32, f64)>)> = labels
+        .iter()
+        .map(|scene| {
+            let pts = series(results, plan, scene, axis)
+                .into_iter()
+                .filter_map(|r| {
+                    let x = values.iter().position(|v| *v == axis.value(&r.params))? as i32;
+                    Some((x, (r.quality.as_ref()?.wrong_pixels as f64).max(ZERO)))
+                })
+                .collect::<Vec<_>>();
+            (scene.clone(), pts)
+        })
+        .collect();
+    let top = lines.iter().flat_map(|l| l.1.iter().map(|p| p.1)).fold(10.0, f64::max) * 2.0;
+    let mut rgb = vec![255u8; (W * H * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area();
+        let others = Axis::ALL
+            .into_iter()
+            .filter(|&a| a != axis)
+            .map(|a| format!("{}={}", a.symbol(), a.value(&plan.base)))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let mut chart = ChartBuilder::on(&root)
+            .caption(format!("Wrong pixels against {} ({others})", axis.symbol()), (FONT, 20))
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-0.5f64..(values.len() as f64 - 0.5), (ZERO..top).log_scale())
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc(axis.symbol())
+            .y_desc("wrong pixels vs f64 (0 drawn at 0.5)")
+            .x_labels(values.len())
+            .x_label_formatter(&|x| {
+                let i = x.round();
+                if (x - i).abs() < 1e-6 && i >= 0.0 {
+                    values.get(i as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(plot_err)?;
+        for (i, (scene, pts)) in lines.iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            let pts: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (x as f64, y)).collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                .map_err(plot_err)?
+                .label(scene.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled()))).map_err(plot_err)?;
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FONT, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(plot_err)?;
+        root.present().map_err(plot_err)?;
+    }
+    Ok(encode_png(W, H, &rgb))
+}
+
+fn pareto_plot(results: &Results) -> Result<Vec<u8>> {
+    let sets = set_summaries(results);
+    let front = pareto_front(&sets);
+    let y = |w: u64| (w as f64).max(ZERO);
+    let x_max = sets.iter().map(|s| s.dsp48e).max().unwrap_or(1) as f64 * 1.1 + 1.0;
+    let y_top = sets.iter().map(|s| y(s.wrong)).fold(10.0, f64::max) * 2.0;
+    let source = if sets.iter().all(|s| s.dsp_from_synth) { "yosys" } else { "estimated" };
+    let mut rgb = vec![255u8; (W * H * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area();
+        let mut chart = ChartBuilder::on(&root)
+            .caption(format!("Wrong pixels (all scenes) against DSP48E ({source}); Pareto front in red"), (FONT, 20))
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0f64..x_max, (ZERO..y_top).log_scale())
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("DSP48E slices")
+            .y_desc("wrong pixels vs f64 (0 drawn at 0.5)")
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(plot_err)?;
+        let grey = RGBColor(150, 150, 150);
+        chart
+            .draw_series(sets.iter().map(|s| Circle::new((s.dsp48e as f64, y(s.wrong)), 4, grey.filled())))
+            .map_err(plot_err)?;
+        let red = RGBColor(214, 39, 40);
+        let pts: Vec<(f64, f64)> = front.iter().map(|&i| (sets[i].dsp48e as f64, y(sets[i].wrong))).collect();
+        chart.draw_series(LineSeries::new(pts.clone(), red.stroke_width(2))).map_err(plot_err)?;
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 5, red.filled()))).map_err(plot_err)?;
+        chart
+            .draw_series(front.iter().map(|&i| {
+                let s = &sets[i];
+                Text::new(
+                    params_label(&s.params),
+                    (s.dsp48e as f64, y(s.wrong) * 1.25),
+                    (FONT, 12).into_font().color(&BLACK),
+                )
+            }))
+            .map_err(plot_err)?;
+        root.present().map_err(plot_err)?;
+    }
+    Ok(encode_png(W, H, &rgb))
+}

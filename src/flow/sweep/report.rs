@@ -1,0 +1,274 @@
+//! report.md (the findings, the Pareto front, the plots and grids, every row), and the Slurm /
+//! GNU parallel scripts of `--emit-slurm`. Both are askama templates in `hdl/`.
+
+use super::eval::OTHER_SURFACE_REL;
+use super::output::Results;
+use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summaries};
+use super::{Plan, SceneSpec, SweepSpec};
+use crate::error::{Error, Result};
+use crate::io::write_atomic;
+use crate::params::Params;
+use askama::Template;
+use std::path::Path;
+
+#[derive(Template)]
+#[template(path = "sweep_report.md", escape = "none")]
+struct Report {
+    title: String,
+    version: String,
+    width: u32,
+    height: u32,
+    other_surface: f64,
+    dsp_source: &'static str,
+    scenes: String,
+    mode: &'static str,
+    lists: Vec<(&'static str, String)>,
+    configurations: usize,
+    sets: usize,
+    scene_count: usize,
+    findings: Vec<String>,
+    pareto: Vec<[String; 7]>,
+    plots: Vec<String>,
+    grids: Vec<String>,
+    rows: Vec<Vec<String>>,
+    skipped: Vec<String>,
+}
+
+fn list<T: ToString>(v: &[T]) -> String {
+    v.iter().map(T::to_string).collect::<Vec<_>>().join(", ")
+}
+
+fn set_text(p: &Params) -> String {
+    format!("n={} m={} E={} T={} C={}", p.n, p.m, p.edge_shift, p.t, p.c)
+}
+
+fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
+    let mut out = Vec::new();
+    let defaults =
+        Params { leaf_size: results.spec.leaf_size, stack_depth: results.spec.stack_depth, ..Params::default() };
+    let default_set = sets.iter().find(|s| s.params == defaults);
+    match cheapest_same_image(sets) {
+        Some(s) => out.push(format!(
+            "Fewest DSP48E with the same image as the defaults on every scene: {} — {} DSP48E and {} register \
+             bits{}, pipeline latency {}.",
+            set_text(&s.params),
+            s.dsp48e,
+            s.register_bits,
+            default_set.map(|d| format!(" (defaults: {} and {})", d.dsp48e, d.register_bits)).unwrap_or_default(),
+            s.isect_latency
+        )),
+        None => out.push("No swept parameter set gives the defaults' image on every scene.".into()),
+    }
+    for r in results.rows.iter().filter(|r| r.params == defaults) {
+        if let Some(q) = &r.quality {
+            out.push(format!(
+                "{} at the defaults: {} wrong pixels of {} ({} false misses, {} false hits, {} other surface).",
+                r.scene, q.wrong_pixels, q.rays, q.false_misses, q.false_hits, q.other_surface
+            ));
+        }
+    }
+    if let Some(worst) = sets.iter().max_by_key(|s| (s.wrong, std::cmp::Reverse(s.dsp48e))) {
+        out.push(format!(
+            "Most wrong pixels: {} — {} of {} rays ({:.3} %).",
+            set_text(&worst.params),
+            worst.wrong,
+            worst.rays,
+            100.0 * worst.wrong as f64 / worst.rays.max(1) as f64
+        ));
+    }
+    let failed = results.rows.iter().filter(|r| r.error.is_some()).count();
+    if failed > 0 {
+        out.push(format!("{failed} configurations could not be evaluated completely; see the note column."));
+    }
+    out
+}
+
+fn row_cells(r: &super::eval::Row) -> Vec<String> {
+    let p = &r.params;
+    let e = match r.e_used {
+        Some(e) if p.edge_shift.to_string() == "auto" => format!("auto ({e})"),
+        _ => p.edge_shift.to_string(),
+    };
+    let mut v = vec![r.scene.clone(), p.n.to_string(), p.m.to_string(), e, p.t.to_string(), p.c.to_string()];
+    match &r.quality {
+        Some(q) => v.extend([
+            q.wrong_pixels.to_string(),
+            q.false_misses.to_string(),
+            q.false_hits.to_string(),
+            q.other_surface.to_string(),
+            q.diff_vs_default.to_string(),
+            format!("{:.2e}", q.t_rel_max),
+            q.triangles.degenerate.to_string(),
+            q.triangles.clamped.to_string(),
+        ]),
+        None => v.extend(std::iter::repeat_n(String::new(), 8)),
+    }
+    v.push(r.dsp48e().map(|d| d.to_string()).unwrap_or_default());
+    v.push(r.cost.as_ref().map(|c| c.register_bits.to_string()).unwrap_or_default());
+    v.push(r.cost.as_ref().map(|c| c.isect_latency.to_string()).unwrap_or_default());
+    v.push(r.error.clone().unwrap_or_default().replace('|', "/"));
+    v
+}
+
+/// Writes report.md.
+pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String], plots: &[String]) -> Result<()> {
+    let spec = &results.spec;
+    let sets = set_summaries(results);
+    let pareto = pareto_front(&sets)
+        .into_iter()
+        .map(|i| {
+            let s = &sets[i];
+            [
+                set_text(&s.params),
+                s.dsp48e.to_string(),
+                s.wrong.to_string(),
+                s.diff.to_string(),
+                s.isect_latency.to_string(),
+                s.register_bits.to_string(),
+                s.rom_bits.to_string(),
+            ]
+        })
+        .collect();
+    let labels = super::run::scene_labels(&spec.scenes);
+    let report = Report {
+        title: labels.join(", "),
+        version: results.fxrt.clone(),
+        width: spec.camera.width,
+        height: spec.camera.height,
+        other_surface: OTHER_SURFACE_REL,
+        dsp_source: if spec.synth { "yosys synth_xilinx -family xc5v" } else { "estimated from the multipliers" },
+        scenes: labels.join(", "),
+        mode: if spec.one_at_a_time { "one parameter at a time around the base set" } else { "cross product" },
+        lists: vec![
+            ("n", list(&spec.n)),
+            ("m", list(&spec.m)),
+            ("E (edge shift)", list(&spec.edge_shift)),
+            ("T", list(&spec.t)),
+            ("C", list(&spec.c)),
+            ("base set", set_text(&plan.base)),
+        ],
+        configurations: results.rows.len(),
+        sets: plan.sets.len(),
+        scene_count: spec.scenes.len(),
+        findings: findings(results, &sets),
+        pareto,
+        plots: plots.to_vec(),
+        grids: grids.to_vec(),
+        rows: results.rows.iter().map(row_cells).collect(),
+        skipped: plan.skipped.iter().map(|s| format!("{}: {}", set_text(&s.params), s.reason)).collect(),
+    };
+    let text = report.render().map_err(|e| Error::new("sweep report", e.to_string()))?;
+    write_atomic(&dir.join("report.md"), text.as_bytes())
+}
+
+/// Quotes a word for a POSIX shell when it needs it.
+pub fn shell_quote(s: &str) -> String {
+    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "_./,:=+-@%".contains(c)) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// The command line that reproduces `spec` (without --out, --shard, --threads).
+pub fn sweep_command(exe: &Path, spec: &SweepSpec) -> Vec<String> {
+    let mut v = vec![exe.display().to_string(), "sweep".into()];
+    let builtins: Vec<&str> = spec
+        .scenes
+        .iter()
+        .filter_map(|s| match s {
+            SceneSpec::Builtin(b) => Some(b.as_str()),
+            SceneSpec::Obj(_) => None,
+        })
+        .collect();
+    for s in &spec.scenes {
+        if let SceneSpec::Obj(p) = s {
+            v.push(p.display().to_string());
+        }
+    }
+    if !builtins.is_empty() {
+        v.extend(["--builtin".into(), builtins.join(",")]);
+    }
+    let c = &spec.camera;
+    let vec3 = |x: [f64; 3]| format!("{},{},{}", x[0], x[1], x[2]);
+    if let Some(e) = c.eye {
+        v.extend(["--eye".into(), vec3(e)]);
+    }
+    if let Some(a) = c.at {
+        v.extend(["--at".into(), vec3(a)]);
+    }
+    v.extend(["--up".into(), vec3(c.up), "--fov".into(), c.fov.to_string()]);
+    v.extend(["--size".into(), format!("{}x{}", c.width, c.height)]);
+    let join = |x: &[u32]| x.iter().map(u32::to_string).collect::<Vec<_>>().join(",");
+    v.extend(["--n".into(), join(&spec.n), "--m".into(), join(&spec.m), "--t".into(), join(&spec.t)]);
+    v.extend(["--c".into(), join(&spec.c), "--edge-shift".into(), list(&spec.edge_shift).replace(", ", ",")]);
+    v.extend(["--leaf-size".into(), spec.leaf_size.to_string()]);
+    v.extend(["--stack-depth".into(), spec.stack_depth.to_string()]);
+    if spec.one_at_a_time {
+        v.push("--one-at-a-time".into());
+    }
+    if spec.synth {
+        v.push("--synth".into());
+    }
+    v
+}
+
+#[derive(Template)]
+#[template(path = "sweep.slurm", escape = "none")]
+struct SlurmArray<'a> {
+    shards: u32,
+    cpus: u32,
+    out: &'a str,
+    command: &'a str,
+}
+
+#[derive(Template)]
+#[template(path = "sweep_merge.slurm", escape = "none")]
+struct SlurmMerge<'a> {
+    shards: u32,
+    out: &'a str,
+    merge: &'a str,
+}
+
+#[derive(Template)]
+#[template(path = "sweep_submit.sh", escape = "none")]
+struct SlurmSubmit<'a> {
+    shards: u32,
+    out: &'a str,
+}
+
+#[derive(Template)]
+#[template(path = "sweep_parallel.sh", escape = "none")]
+struct Parallel<'a> {
+    shards: u32,
+    cpus: u32,
+    merge: &'a str,
+}
+
+/// The files of `--emit-slurm`: (name, contents, executable), to go into DIR/slurm/.
+pub fn slurm_files(
+    exe: &Path,
+    spec: &SweepSpec,
+    out: &Path,
+    shards: u32,
+    cpus: u32,
+) -> Result<Vec<(String, String, bool)>> {
+    let render = |t: &dyn askama::DynTemplate| t.dyn_render().map_err(|e| Error::new("emit-slurm", e.to_string()));
+    let quote = |v: &[String]| v.iter().map(|s| shell_quote(s)).collect::<Vec<_>>().join(" ");
+    let command = quote(&sweep_command(exe, spec));
+    let out_s = shell_quote(&out.display().to_string());
+    let shard_dirs: Vec<String> =
+        (1..=shards).map(|i| shell_quote(&out.join(format!("shard-{i}")).display().to_string())).collect();
+    let merge =
+        format!("{} sweep merge {} --out {out_s}", shell_quote(&exe.display().to_string()), shard_dirs.join(" "));
+    let commands: String = (1..=shards)
+        .map(|i| format!("{command} --threads {cpus} --shard {i}/{shards} --out {}\n", shard_dirs[i as usize - 1]))
+        .collect();
+    Ok(vec![
+        ("sweep.slurm".into(), render(&SlurmArray { shards, cpus, out: &out_s, command: &command })?, false),
+        ("merge.slurm".into(), render(&SlurmMerge { shards, out: &out_s, merge: &merge })?, false),
+        ("submit.sh".into(), render(&SlurmSubmit { shards, out: &out_s })?, true),
+        ("parallel.sh".into(), render(&Parallel { shards, cpus, merge: &merge })?, true),
+        ("commands.txt".into(), commands, false),
+    ])
+}

@@ -1,0 +1,153 @@
+//! Running a sweep (or a shard of one) and merging shards.
+
+use super::eval::{Row, SceneCtx, evaluate};
+use super::output::{Results, copy_cached, load_cached, read_results, store_cached, write_tables_and_images};
+use super::{Plan, SceneSpec, Shard, SweepSpec};
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Labels for the scenes: built-in names and OBJ file stems, numbered where two coincide.
+pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
+    let base: Vec<String> = scenes
+        .iter()
+        .map(|s| match s {
+            SceneSpec::Builtin(b) => b.clone(),
+            SceneSpec::Obj(p) => p.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or("scene".into()),
+        })
+        .map(|l| l.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect())
+        .collect();
+    base.iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let same = base.iter().filter(|x| *x == l).count();
+            if same > 1 { format!("{l}-{}", 1 + base[..i].iter().filter(|x| *x == l).count()) } else { l.clone() }
+        })
+        .collect()
+}
+
+/// What a run did, for the summary line.
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct RunSummary {
+    pub computed: usize,
+    pub cached: usize,
+    pub failed: usize,
+}
+
+/// Loads and checks every scene of the sweep (before anything is written).
+pub fn load_scenes(spec: &SweepSpec) -> Result<Vec<SceneCtx>> {
+    let labels = scene_labels(&spec.scenes);
+    spec.scenes
+        .iter()
+        .zip(labels)
+        .map(|(s, l)| SceneCtx::load(s, l, &spec.camera, spec.leaf_size, spec.stack_depth))
+        .collect()
+}
+
+/// Evaluates this shard's configurations (cached ones are read back) and writes every
+/// output into `out`.
+pub fn run(
+    spec: &SweepSpec,
+    plan: &Plan,
+    scenes: &[SceneCtx],
+    out: &Path,
+    shard: Option<Shard>,
+    progress: bool,
+) -> Result<RunSummary> {
+    let mine: Vec<_> = plan.configs.iter().filter(|c| shard.is_none_or(|s| s.takes(c.index))).collect();
+    let bar = if progress { indicatif::ProgressBar::new(mine.len() as u64) } else { indicatif::ProgressBar::hidden() };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} configurations ({eta}) {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let synth_dir = spec.synth.then(|| out.join("synth"));
+    let results: Vec<Result<(Row, bool)>> = mine
+        .par_iter()
+        .map(|cfg| {
+            let ctx = &scenes[cfg.scene];
+            let key = ctx.key(&cfg.params, spec.synth);
+            let done = match load_cached(out, &key, cfg.index, &ctx.label) {
+                Some(row) => Ok((row, true)),
+                None => {
+                    let e = evaluate(ctx, cfg, key, synth_dir.as_deref());
+                    store_cached(out, &e).map(|()| (e.row, false))
+                }
+            };
+            bar.inc(1);
+            done
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut rows = Vec::with_capacity(results.len());
+    let mut summary = RunSummary::default();
+    for r in results {
+        let (row, cached) = r?;
+        summary.failed += row.error.is_some() as usize;
+        if cached {
+            summary.cached += 1
+        } else {
+            summary.computed += 1
+        }
+        rows.push(row);
+    }
+    let results = Results {
+        fxrt: env!("CARGO_PKG_VERSION").to_string(),
+        spec: spec.clone(),
+        configurations: plan.configs.len(),
+        shard: shard.map(|s| s.to_string()),
+        skipped: plan.skipped.clone(),
+        rows,
+    };
+    write_all(out, &results, plan)?;
+    Ok(summary)
+}
+
+/// Every output of a sweep folder, from its results and cache alone.
+fn write_all(out: &Path, results: &Results, plan: &Plan) -> Result<()> {
+    write_tables_and_images(out, results)?;
+    let grids = super::grid::write_grids(out, results, plan)?;
+    let plots = super::plots::write_plots(out, results, plan)?;
+    super::report::write_report(out, results, plan, &grids, &plots)
+}
+
+/// Joins shard folders into `out`: the same spec everywhere, every configuration exactly once.
+pub fn merge(dirs: &[&Path], out: &Path) -> Result<usize> {
+    let mut first: Option<Results> = None;
+    let mut rows: BTreeMap<usize, (Row, &Path)> = BTreeMap::new();
+    for &dir in dirs {
+        let r = read_results(dir)?;
+        if let Some(f) = &first
+            && (f.spec != r.spec || f.fxrt != r.fxrt)
+        {
+            return Err(Error::file(
+                dir,
+                "is a different sweep (its spec or fxrt version differs from the first folder's)",
+            ));
+        }
+        for row in &r.rows {
+            if rows.insert(row.index, (row.clone(), dir)).is_some() {
+                return Err(Error::file(dir, format!("configuration {} is in two of the merged folders", row.index)));
+            }
+        }
+        first.get_or_insert(r);
+    }
+    let Some(first) = first else { return Err(Error::new("sweep merge", "no folders to merge")) };
+    let plan = first.spec.plan()?;
+    let missing: Vec<String> =
+        (0..plan.configs.len()).filter(|i| !rows.contains_key(i)).take(8).map(|i| i.to_string()).collect();
+    if !missing.is_empty() {
+        return Err(Error::new(
+            "sweep merge",
+            format!("configurations {} … are in none of the folders: is a shard missing?", missing.join(", ")),
+        ));
+    }
+    for (row, dir) in rows.values() {
+        if *dir != out {
+            copy_cached(dir, out, &row.key)?;
+        }
+    }
+    let results = Results { shard: None, rows: rows.into_values().map(|(r, _)| r).collect(), ..first };
+    write_all(out, &results, &plan)?;
+    Ok(results.rows.len())
+}

@@ -1,0 +1,130 @@
+use super::eval::quality;
+use super::report::{shell_quote, sweep_command};
+use super::run::scene_labels;
+use super::*;
+use crate::render::Frame;
+
+fn spec() -> SweepSpec {
+    SweepSpec {
+        scenes: vec![SceneSpec::Builtin("teapot".into()), SceneSpec::Builtin("cornell".into())],
+        camera: CameraSpec { eye: None, at: None, up: [0.0, 1.0, 0.0], fov: 45.0, width: 16, height: 16 },
+        n: vec![29],
+        m: vec![12, 32],
+        t: vec![0, 24],
+        c: vec![16],
+        edge_shift: vec![EdgeShift::Auto, EdgeShift::Fixed(10)],
+        leaf_size: 4,
+        stack_depth: 32,
+        one_at_a_time: false,
+        synth: false,
+    }
+}
+
+#[test]
+fn cross_product_skips_sets_that_are_invalid_together() {
+    let plan = spec().plan().unwrap();
+    // m = 12 allows T ≤ 10: the two (m = 12, T = 24) sets are skipped, and say why.
+    assert_eq!(plan.sets.len(), 6);
+    assert_eq!(plan.skipped.len(), 2);
+    assert!(plan.skipped.iter().all(|s| s.params.m == 12 && s.params.t == 24 && s.reason.starts_with("--t: 24")));
+    assert_eq!(plan.configs.len(), 12);
+    // Scenes vary fastest; indices are positions.
+    assert!(plan.configs.iter().enumerate().all(|(i, c)| c.index == i && c.scene == i % 2));
+    assert_eq!(plan.configs[2].params, Params { m: 12, edge_shift: EdgeShift::Fixed(10), ..Params::default() });
+}
+
+#[test]
+fn no_valid_set_is_an_error_before_anything_runs() {
+    let s = SweepSpec { m: vec![12], t: vec![24], ..spec() };
+    assert!(s.plan().unwrap_err().to_string().contains("no valid parameter set"));
+    let s = SweepSpec { scenes: vec![], ..spec() };
+    assert!(s.plan().is_err());
+}
+
+#[test]
+fn one_at_a_time_varies_each_parameter_around_the_base() {
+    let s = SweepSpec { one_at_a_time: true, n: vec![20, 24], m: vec![16, 32], t: vec![0, 8], ..spec() };
+    let plan = s.plan().unwrap();
+    // n is not at its default 29 in the list: the base takes the list's first value.
+    assert_eq!(plan.base, Params { n: 20, ..Params::default() });
+    let base = plan.base;
+    let expected = vec![
+        base,
+        Params { n: 24, ..base },
+        Params { m: 16, ..base },
+        Params { edge_shift: EdgeShift::Fixed(10), ..base },
+        Params { t: 8, ..base },
+    ];
+    assert_eq!(plan.sets, expected);
+}
+
+#[test]
+fn shards_partition_the_configurations() {
+    let plan = spec().plan().unwrap();
+    let shards: Vec<Shard> = (1..=3).map(|i| Shard::parse(&format!("{i}/3")).unwrap()).collect();
+    for c in &plan.configs {
+        assert_eq!(shards.iter().filter(|s| s.takes(c.index)).count(), 1);
+    }
+    assert!(Shard::parse("0/3").is_err() && Shard::parse("4/3").is_err() && Shard::parse("1/0").is_err());
+    assert!(Shard::parse("2").is_err());
+}
+
+#[test]
+fn labels_are_unique_and_file_safe() {
+    let scenes = vec![
+        SceneSpec::Obj("a/teapot.obj".into()),
+        SceneSpec::Obj("b/teapot.obj".into()),
+        SceneSpec::Obj("my scene.obj".into()),
+        SceneSpec::Builtin("cornell".into()),
+    ];
+    assert_eq!(scene_labels(&scenes), vec!["teapot-1", "teapot-2", "my_scene", "cornell"]);
+    assert_eq!(params_label(&Params::default()), "n29_m32_eauto_t0_c16");
+    assert_eq!(params_label(&Params { leaf_size: 2, ..Params::default() }), "n29_m32_eauto_t0_c16_l2");
+}
+
+#[test]
+fn the_emitted_command_describes_the_same_sweep() {
+    use clap::Parser;
+    let mut s = spec();
+    s.scenes.insert(0, SceneSpec::Obj("/data/my scene.obj".into()));
+    s.camera.eye = Some([1.5, -2.0, 1e-3]);
+    s.one_at_a_time = true;
+    let args = sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    let mut argv = args.clone();
+    argv.extend(["--out".into(), "x".into()]);
+    let cli = crate::cli::Cli::try_parse_from(argv.iter().skip(0)).unwrap();
+    let Some(crate::cli::Command::Sweep(a)) = cli.command else { panic!("not a sweep") };
+    assert_eq!(a.spec().unwrap(), s);
+    assert_eq!(shell_quote("/data/my scene.obj"), "'/data/my scene.obj'");
+    assert_eq!(shell_quote("it's"), r"'it'\''s'");
+    assert_eq!(shell_quote("--n"), "--n");
+}
+
+fn frame(ids: &[i32], depth: &[f64]) -> Frame {
+    Frame {
+        width: ids.len() as u32,
+        height: 1,
+        ids: ids.to_vec(),
+        depth: depth.to_vec(),
+        shade: vec![0.5; ids.len()],
+        rays: ids.len() as u64,
+        hits: 0,
+        seconds: 0.0,
+    }
+}
+
+#[test]
+fn quality_sorts_pixels_into_kinds_of_error() {
+    let inf = f64::INFINITY;
+    let reference = frame(&[1, 2, -1, 3, 4, 5], &[10.0, 10.0, inf, 10.0, 10.0, 10.0]);
+    // pixel 1: false miss; 2: false hit; 3: neighbour (same distance); 4: other surface;
+    // 5: same triangle, t off by 1e-4.
+    let golden = frame(&[1, -1, 7, 8, 9, 5], &[10.0, inf, 3.0, 10.000001, 12.0, 10.001]);
+    let q = quality(&golden, &reference, &[1, 2, -1, 3, 4, 5]);
+    assert_eq!((q.false_misses, q.false_hits, q.other_triangle, q.other_surface), (1, 1, 2, 1));
+    assert_eq!(q.wrong_pixels, 3);
+    assert_eq!(q.diff_vs_default, 4);
+    assert_eq!((q.ref_hits, q.hits, q.rays), (5, 5, 6));
+    assert!((q.t_rel_max - 1e-4).abs() < 1e-12);
+    assert!((q.t_rel_mean - 0.5e-4).abs() < 1e-12);
+}

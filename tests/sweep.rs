@@ -1,0 +1,237 @@
+//! `fxrt sweep` as a user runs it: bad lists, a sweep of 120 configurations, shards merged
+//! byte for byte, the cache, the Slurm / GNU parallel scripts, and the thesis's findings.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn fxrt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fxrt")).args(args).output().expect("fxrt runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Every file under `dir` (relative path → bytes).
+fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                out.insert(p.strip_prefix(root).unwrap().to_path_buf(), std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
+}
+
+fn rows(dir: &Path) -> Vec<BTreeMap<String, String>> {
+    let mut r = csv::Reader::from_path(dir.join("results.csv")).unwrap();
+    let headers = r.headers().unwrap().clone();
+    r.records()
+        .map(|rec| headers.iter().map(String::from).zip(rec.unwrap().iter().map(String::from)).collect())
+        .collect()
+}
+
+#[test]
+fn bad_lists_exit_2_with_one_line_before_anything_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let bad_obj = dir.path().join("bad.obj");
+    std::fs::write(&bad_obj, "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    for (args, expect) in [
+        (vec!["--n", "29..20"], "--n: '29..20' is reversed"),
+        (vec!["--m", ""], "--m: '' has an empty item"),
+        (vec!["--t", "0..70:8"], "--t: 64 (in '0..70:8') is out of range"),
+        (vec!["--edge-shift", "auto,x"], "--edge-shift: 'x'"),
+        (vec!["--m", "12", "--t", "24"], "sweep: no valid parameter set"),
+        (vec!["--builtin", "nosuch"], "--builtin: unknown scene 'nosuch'"),
+        (vec![bad_obj.to_str().unwrap()], "bad.obj"),
+        (vec!["--shard", "4/3"], "--shard"),
+    ] {
+        let mut a = vec!["sweep", "--size", "8x8", "--out", out.to_str().unwrap()];
+        a.extend(args.iter());
+        let o = fxrt(&a);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(expect), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote output");
+    }
+    // Merging an incomplete set of shards names the gap.
+    let spec = ["sweep", "--size", "8x8", "--m", "16,32", "--builtin", "thin"];
+    let shard1 = dir.path().join("s1");
+    let o = fxrt(&[&spec[..], &["--shard", "1/2", "--out", shard1.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = fxrt(&["sweep", "merge", shard1.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("is a shard missing"), "{}", text(&o.stderr));
+}
+
+/// `--m 12,16,20..32:4 --t 0..24:8 --c C` over teapot and cornell at 48×48, then `extra`.
+fn sweep(c: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["sweep", "--builtin", "teapot,cornell", "--size", "48x48", "--m", "12,16,20..32:4"];
+    args.extend(["--t", "0..24:8", "--c", c]);
+    args.extend(extra);
+    let o = fxrt(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    o
+}
+
+/// 6 m × 4 T × 3 C parameter sets over two scenes: shards merge to the unsharded folder byte
+/// for byte, and a rerun computes only what is new.
+#[test]
+fn a_two_scene_sweep_its_shards_and_its_cache() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let o = sweep("4,8,16", &["--out", whole.to_str().unwrap()]);
+    let rows = rows(&whole);
+    // T ≤ m − 2: m = 12 takes T ∈ {0, 8}, m = 16 too, m = 20 and 24 not T = 24, so 6 of the
+    // 24 (m, T) pairs are skipped: 18 pairs × 3 C = 54 sets.
+    assert_eq!(rows.len(), 2 * 54, "{}", text(&o.stdout));
+    assert!(text(&o.stdout).starts_with(&format!("{} computed, 0 from the cache", rows.len())));
+    let report = std::fs::read_to_string(whole.join("report.md")).unwrap();
+    assert!(report.contains("18 parameter sets skipped") && report.contains("--t: 24 must be at most m−2"));
+    for file in ["plots/error_m.png", "plots/error_t.png", "plots/pareto_dsp48e.png", "grids/teapot_c.png"] {
+        assert!(report.contains(&format!("({file})")), "{file} not in the report");
+        let bytes = std::fs::read(whole.join(file)).unwrap();
+        let info = png::Decoder::new(std::io::Cursor::new(bytes)).read_info().unwrap().info().clone();
+        assert!(info.width > 200 && info.height > 100, "{file}");
+    }
+    for r in &rows {
+        assert!(whole.join(&r["image"]).is_file(), "{}", r["image"]);
+        assert_eq!(r["rays"], "2304");
+        let parts: u64 =
+            ["false_misses", "false_hits", "other_surface"].iter().map(|k| r[*k].parse::<u64>().unwrap()).sum();
+        assert_eq!(parts.to_string(), r["wrong_pixels"]);
+    }
+
+    let shard_dirs: Vec<PathBuf> = (1..=3).map(|i| dir.path().join(format!("shard{i}"))).collect();
+    for (i, d) in shard_dirs.iter().enumerate() {
+        sweep("4,8,16", &["--shard", &format!("{}/3", i + 1), "--out", d.to_str().unwrap()]);
+        assert_eq!(self::rows(d).len(), rows.len() / 3);
+    }
+    let merged = dir.path().join("merged");
+    let mut args = vec!["sweep", "merge"];
+    args.extend(shard_dirs.iter().map(|d| d.to_str().unwrap()));
+    args.extend(["--out", merged.to_str().unwrap()]);
+    let o = fxrt(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (a, b) = (tree(&whole), tree(&merged));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (k, v) in &a {
+        assert!(b[k] == *v, "{} differs between the whole sweep and the merged shards", k.display());
+    }
+
+    // A rerun reads everything from the cache and writes the same files; a longer list
+    // computes only what is new.
+    let o = sweep("4,8,16", &["--out", whole.to_str().unwrap()]);
+    assert!(text(&o.stdout).starts_with(&format!("0 computed, {} from the cache", rows.len())));
+    assert!(tree(&whole) == a);
+    let o = sweep("4,6,8,16", &["--out", whole.to_str().unwrap()]);
+    let new = rows.len() / 3;
+    assert!(
+        text(&o.stdout).starts_with(&format!("{new} computed, {} from the cache", rows.len())),
+        "{}",
+        text(&o.stdout)
+    );
+}
+
+#[test]
+fn emitted_scripts_run_the_shards_and_the_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cluster");
+    let small = ["sweep", "--builtin", "thin,cornell", "--size", "16x16", "--m", "16,24,32", "--one-at-a-time"];
+    let o = fxrt(
+        &[&small[..], &["--emit-slurm", "--shards", "2", "--threads", "1", "--out", out.to_str().unwrap()]].concat(),
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let slurm = std::fs::read_to_string(out.join("slurm/sweep.slurm")).unwrap();
+    assert!(slurm.contains("#SBATCH --array=1-2") && slurm.contains("--shard \"${SLURM_ARRAY_TASK_ID}/2\""));
+    let submit = std::fs::read_to_string(out.join("slurm/submit.sh")).unwrap();
+    assert!(submit.contains("--dependency=afterok:"));
+    // Run what GNU parallel would run, then the merge, with the shell.
+    let commands = std::fs::read_to_string(out.join("slurm/commands.txt")).unwrap();
+    assert_eq!(commands.lines().count(), 2);
+    for line in commands.lines() {
+        let o = Command::new("sh").args(["-c", line]).output().unwrap();
+        assert!(o.status.success(), "{line}: {}", text(&o.stderr));
+    }
+    let merge = std::fs::read_to_string(out.join("slurm/merge.slurm")).unwrap();
+    let merge_line = merge.lines().last().unwrap();
+    let o = Command::new("sh").args(["-c", merge_line]).output().unwrap();
+    assert!(o.status.success(), "{merge_line}: {}", text(&o.stderr));
+    // The same as running the sweep in one go.
+    let direct = dir.path().join("direct");
+    let o = fxrt(&[&small[..], &["--out", direct.to_str().unwrap()]].concat());
+    assert!(o.status.success());
+    let merged = out.join("results.csv");
+    assert_eq!(std::fs::read(merged).unwrap(), std::fs::read(direct.join("results.csv")).unwrap());
+}
+
+/// Seed 001 §2.1 figures 2.7–2.9 and seed 003's edge shift, with this project's numbers
+/// (docs/SWEEPS.md has the full tables at 256²).
+#[test]
+fn the_thesis_findings_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("figures");
+    let o = fxrt(&[
+        "sweep",
+        "--builtin",
+        "teapot,jackstraws",
+        "--size",
+        "128x128",
+        "--n",
+        "24,29",
+        "--m",
+        "8,12,16,24,32",
+        "--t",
+        "0,8,16,24",
+        "--c",
+        "0,4,8,16",
+        "--one-at-a-time",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let rows = rows(&out);
+    let wrong = |scene: &str, set: &[(&str, &str)]| -> u64 {
+        let defaults = [("n", "29"), ("m", "32"), ("t", "0"), ("c", "16"), ("edge_shift", "auto")];
+        let r = rows
+            .iter()
+            .find(|r| {
+                r["scene"] == scene
+                    && defaults
+                        .iter()
+                        .all(|(k, d)| r[*k] == set.iter().find(|(sk, _)| sk == k).map(|(_, v)| *v).unwrap_or(d))
+            })
+            .unwrap_or_else(|| panic!("{scene} {set:?} not in the sweep"));
+        r["wrong_pixels"].parse().unwrap()
+    };
+    // Figure 2.7: a moderate m already renders the teapot correctly; small m does not.
+    assert_eq!(wrong("teapot", &[]), 0);
+    assert!(wrong("teapot", &[("m", "24")]) == 0);
+    assert!(wrong("teapot", &[("m", "16")]) <= 10);
+    assert!(wrong("teapot", &[("m", "8")]) > 500);
+    // Figure 2.8: T = 24 is unacceptable, small T is harmless.
+    assert!(wrong("teapot", &[("t", "8")]) <= 1);
+    assert!(wrong("teapot", &[("t", "24")]) > 200);
+    // Figure 2.9: too small a C culls what the ray does hit.
+    assert!(wrong("teapot", &[("c", "0")]) > 200);
+    assert!(wrong("teapot", &[("c", "8")]) <= 1);
+    // Seed 003: E = 10 breaks jackstraws on a 24-bit grid, the adaptive E (8 there) does not.
+    let out = dir.path().join("edge");
+    let args = ["sweep", "--builtin", "jackstraws", "--size", "128x128", "--n", "24", "--edge-shift", "auto,10"];
+    let o = fxrt(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let e = self::rows(&out);
+    let (auto, ten) = (&e[0], &e[1]);
+    assert_eq!((auto["edge_shift"].as_str(), auto["e_used"].as_str(), ten["edge_shift"].as_str()), ("auto", "8", "10"));
+    assert_eq!(auto["wrong_pixels"], "0");
+    assert!(ten["wrong_pixels"].parse::<u64>().unwrap() > 200 && ten["tris_clamped"].parse::<u64>().unwrap() > 1000);
+}
