@@ -90,7 +90,7 @@ pub fn fit(x: i64, sh: u32, signed: bool) -> i64 {
 }
 
 /// The all-narrow loops. Returns false for what it does not cover (the caller falls back).
-pub fn narrow_kernel(def: &Def, tr: Ty, s: &[&[i64]], o: &mut [i64]) -> bool {
+pub fn narrow_kernel(def: &Def, tys: &[Ty], tr: Ty, s: &[&[i64]], o: &mut [i64]) -> bool {
     let (sh, sg) = (64 - tr.width, tr.signed);
     macro_rules! lanes {
         (|$a:ident| $e:expr) => {{
@@ -136,6 +136,24 @@ pub fn narrow_kernel(def: &Def, tr: Ty, s: &[&[i64]], o: &mut [i64]) -> bool {
             let (sel, t, f) = (s[0], s[1], s[2]);
             for (((o, &c), &x), &y) in o.iter_mut().zip(sel).zip(t).zip(f) {
                 *o = if c != 0 { x } else { y };
+            }
+        }
+        // Operands: sel, default, arms…; an unsigned selector's value is its bit pattern.
+        Def::Case { arms, .. } if !tys[0].signed => {
+            for (c, o) in o.iter_mut().enumerate() {
+                let sel = s[0][c] as u64 as u128;
+                *o = arms.iter().position(|a| a.0 == sel).map_or(s[1][c], |k| s[2 + k][c]);
+            }
+        }
+        // Unsigned parts of at most 64 bits in all: shift and or.
+        Def::Concat(_) if !tr.signed => {
+            for (c, o) in o.iter_mut().enumerate() {
+                let mut acc = 0u64;
+                for (t, src) in tys.iter().zip(s) {
+                    let part = (src[c] as u64) & (u64::MAX >> (64 - t.width));
+                    acc = if t.width >= 64 { part } else { (acc << t.width) | part };
+                }
+                *o = acc as i64;
             }
         }
         _ => return false,

@@ -448,7 +448,9 @@ impl BatchSim {
             })
             .collect();
         let done = match (&mut out, narrow) {
-            (Buf::Narrow(o), Some(srcs)) => narrow_kernel(&op.def, self.tys[op.dst], &srcs, &mut o[h..h + lanes]),
+            (Buf::Narrow(o), Some(srcs)) => {
+                narrow_kernel(&op.def, &op.src_tys, self.tys[op.dst], &srcs, &mut o[h..h + lanes])
+            }
             _ => false,
         };
         if !done {
@@ -476,8 +478,12 @@ impl BatchSim {
         r.clear();
         r.resize(lanes, 0);
         if !wide_kernel(&op.def, &src_tys, tr, ins, r) {
+            // One operand buffer for all lanes: no allocation per lane.
+            let mut bits = vec![0u128; src_tys.len()];
             for c in 0..lanes {
-                let bits: Vec<u128> = src_tys.iter().enumerate().map(|(k, ty)| ty.wrap(ins[k][c])).collect();
+                for (k, ty) in src_tys.iter().enumerate() {
+                    bits[k] = ty.wrap(ins[k][c]);
+                }
                 r[c] = tr.value(eval_bits(&op.def, &src_tys, &bits, tr));
             }
         }
