@@ -32,15 +32,6 @@ fn plot_err(e: impl std::fmt::Display) -> Error {
     Error::new("sweep plot", e.to_string())
 }
 
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(23, 190, 207),
-];
-
 /// Writes plots/error_PARAM.png per swept parameter and plots/pareto_dsp48e.png.
 pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
     register_font();
@@ -109,7 +100,7 @@ fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
             .draw()
             .map_err(plot_err)?;
         for (i, (scene, pts)) in lines.iter().enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
+            let color = Palette99::pick(i).to_rgba();
             let pts: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (x as f64, y)).collect();
             chart
                 .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
@@ -120,6 +111,7 @@ fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
         }
         chart
             .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
             .label_font((FONT, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)

@@ -92,7 +92,7 @@ fn the_emitted_command_describes_the_same_sweep() {
     let args = sweep_command(std::path::Path::new("/opt/fxrt"), &s);
     let mut argv = args.clone();
     argv.extend(["--out".into(), "x".into()]);
-    let cli = crate::cli::Cli::try_parse_from(argv.iter().skip(0)).unwrap();
+    let cli = crate::cli::Cli::try_parse_from(argv.iter()).unwrap();
     let Some(crate::cli::Command::Sweep(a)) = cli.command else { panic!("not a sweep") };
     assert_eq!(a.spec().unwrap(), s);
     assert_eq!(shell_quote("/data/my scene.obj"), "'/data/my scene.obj'");
