@@ -85,6 +85,11 @@ pub struct SweepArgs {
     /// Also synthesise each configuration's core with yosys for Virtex-5 (slow).
     #[arg(long)]
     pub synth: bool,
+    /// Also run each configuration's frame through the whole core in the Rust simulator:
+    /// cycles per ray, pipeline fill, stack depth, and every pixel against the golden model
+    /// (slow; use small sizes).
+    #[arg(long = "core-sim")]
+    pub core_sim: bool,
     /// Output folder (it also caches finished configurations for reruns).
     #[arg(long, required_unless_present = "action")]
     pub out: Option<PathBuf>,
@@ -137,6 +142,7 @@ impl SweepArgs {
             stack_depth: self.stack_depth,
             one_at_a_time: self.one_at_a_time,
             synth: self.synth,
+            core_sim: self.core_sim,
         })
     }
 }

@@ -31,7 +31,11 @@ fn main() -> ExitCode {
         Some(Command::Bench(a)) => run_bench(a),
         Some(Command::Gen(a)) => run_gen(a),
         Some(Command::Synth(a)) => run_synth(a),
-        Some(Command::Sweep(a)) => run_sweep(a),
+        Some(Command::Sweep(a)) => match run_sweep(a) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(1),
+            Err(e) => Err(e),
+        },
         Some(Command::Sim(a)) => match run_sim(a) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
@@ -412,13 +416,14 @@ fn ray_generator(scene: &Scene, camera: &fxrt::cli::CameraArgs) -> Result<fxrt::
     fxrt::model::raygen::RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
 }
 
-fn run_sweep(a: SweepArgs) -> Result<()> {
+/// Ok(false): the simulated core disagreed with the golden model somewhere (`--core-sim`).
+fn run_sweep(a: SweepArgs) -> Result<bool> {
     use fxrt::flow::sweep::{report, run};
     if let Some(SweepAction::Merge(m)) = &a.action {
         let dirs: Vec<&std::path::Path> = m.dirs.iter().map(|d| d.as_path()).collect();
         let rows = run::merge(&dirs, &m.out)?;
         println!("merged {} folders: {rows} configurations into {}", dirs.len(), m.out.display());
-        return Ok(());
+        return Ok(true);
     }
     let spec = a.spec()?;
     let plan = spec.plan()?;
@@ -460,7 +465,7 @@ fn run_sweep(a: SweepArgs) -> Result<()> {
             out.display(),
             out.display()
         );
-        return Ok(());
+        return Ok(true);
     }
     let scenes = pool.install(|| run::load_scenes(&spec))?;
     eprintln!(
@@ -481,5 +486,8 @@ fn run_sweep(a: SweepArgs) -> Result<()> {
         start.elapsed().as_secs_f64(),
         out.join("report.md").display()
     );
-    Ok(())
+    if summary.mismatches > 0 {
+        eprintln!("fxrt: the simulated core disagreed with the golden model on {} rays", summary.mismatches);
+    }
+    Ok(summary.mismatches == 0)
 }

@@ -235,3 +235,23 @@ fn the_thesis_findings_hold() {
     assert_eq!(auto["wrong_pixels"], "0");
     assert!(ten["wrong_pixels"].parse::<u64>().unwrap() > 200 && ten["tris_clamped"].parse::<u64>().unwrap() > 1000);
 }
+
+/// `--core-sim`: every configuration's frame through the whole core in the Rust simulator,
+/// every ray checked against the golden model, cycles per ray reported.
+#[test]
+fn core_simulation_in_a_sweep_agrees_with_the_golden_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("core");
+    let args = ["sweep", "--builtin", "cornell,thin", "--size", "24x24", "--m", "16,32", "--t", "0,12", "--core-sim"];
+    let o = fxrt(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let rows = rows(&out);
+    assert_eq!(rows.len(), 8);
+    for r in &rows {
+        assert_eq!(r["core_mismatches"], "0", "{r:?}");
+        assert!(r["cycles_per_ray"].parse::<f64>().unwrap() > 5.0, "{r:?}");
+        assert!(r["max_stack_depth"].parse::<u32>().unwrap() >= 1 || r["scene"] == "thin", "{r:?}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("The whole core ran 8 configurations' frames in the Rust simulator: 0 rays disagreed"));
+}

@@ -5,6 +5,7 @@ use super::{CameraSpec, Config, SceneSpec, params_label};
 use crate::cores::cost::{CoreCost, core_cost};
 use crate::cores::top::{CoreParams, core_module};
 use crate::error::{Error, Result};
+use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
 use crate::flow::synth::synth_xc5v;
 use crate::params::Params;
 use crate::render::camera::Camera;
@@ -14,7 +15,6 @@ use crate::scene::images::SceneRoms;
 use crate::scene::{Scene, Tri, TriangleCounts, builtin, obj};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::path::Path;
 use std::sync::OnceLock;
 
 /// Both models hit, different triangles, and the distances differ by more than this fraction:
@@ -101,7 +101,7 @@ impl SceneCtx {
     }
 
     /// The cache key of `params` on this scene: everything the row depends on.
-    pub fn key(&self, params: &Params, synth: bool) -> String {
+    pub fn key(&self, params: &Params, synth: bool, core_sim: bool) -> String {
         let c = &self.camera;
         let text = serde_json::json!({
             "fxrt": env!("CARGO_PKG_VERSION"),
@@ -110,6 +110,7 @@ impl SceneCtx {
             "camera": [c.eye, c.at, c.up, [c.fov_deg, c.width as f64, c.height as f64]],
             "params": params,
             "synth": synth,
+            "core_sim": core_sim,
         })
         .to_string();
         format!("{:x}", Sha256::digest(text.as_bytes()))[..20].to_string()
@@ -149,6 +150,17 @@ pub struct SynthArea {
     pub bram18: u64,
 }
 
+/// The whole core running the frame in the Rust simulator (with `--core-sim`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CoreRun {
+    pub cycles_per_ray: f64,
+    /// Cycles in which a triangle entered the pipeline, per cycle.
+    pub fill: f64,
+    pub max_stack_depth: u64,
+    /// Rays whose result differs from the golden model's (must be 0).
+    pub mismatches: u64,
+}
+
 /// One configuration's results: a row of results.csv.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Row {
@@ -161,6 +173,7 @@ pub struct Row {
     pub quality: Option<Quality>,
     pub cost: Option<CoreCost>,
     pub synth: Option<SynthArea>,
+    pub core: Option<CoreRun>,
     /// Why part of the row is missing.
     pub error: Option<String>,
 }
@@ -184,7 +197,15 @@ pub struct Evaluated {
     pub errors_png: Vec<u8>,
 }
 
-pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, synth_dir: Option<&Path>) -> Evaluated {
+/// What to do besides the image comparison and the estimated cost.
+#[derive(Clone, Debug, Default)]
+pub struct Extras {
+    /// Synthesise with yosys, in DIR/KEY.
+    pub synth_dir: Option<std::path::PathBuf>,
+    pub core_sim: bool,
+}
+
+pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> Evaluated {
     let mut row = Row {
         index: cfg.index,
         key,
@@ -194,6 +215,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, synth_dir: Option<&Pa
         quality: None,
         cost: None,
         synth: None,
+        core: None,
         error: None,
     };
     let scene = match Scene::build(&ctx.label, ctx.world.clone(), &cfg.params) {
@@ -215,8 +237,23 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, synth_dir: Option<&Pa
         Ok(c) => row.cost = Some(c),
         Err(e) => row.error = Some(e.to_string()),
     }
-    if let (Some(dir), Some(_)) = (synth_dir, &row.cost) {
-        let core = core_module(&CoreParams::new(&roms, 20, 1), &roms);
+    let core_params = CoreParams::new(&roms, 20, 1);
+    if let (true, Some(_)) = (extras.core_sim, &row.cost) {
+        let rays = frame_rays(&scene, &ctx.camera);
+        let (results, stats) = simulate_rust(&core_params, &roms, &rays, &|_| {});
+        let run = CoreRun {
+            cycles_per_ray: stats.cycles_per_ray(),
+            fill: stats.fill(),
+            max_stack_depth: stats.max_stack_depth as u64,
+            mismatches: mismatches(&scene, &rays, &results),
+        };
+        if run.mismatches > 0 {
+            row.error = Some(format!("the core disagrees with the golden model on {} rays", run.mismatches));
+        }
+        row.core = Some(run);
+    }
+    if let (Some(dir), Some(_)) = (&extras.synth_dir, &row.cost) {
+        let core = core_module(&core_params, &roms);
         match synth_xc5v(&core, &dir.join(&row.key)) {
             Ok(a) => {
                 row.synth = Some(SynthArea {

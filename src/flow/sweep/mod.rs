@@ -65,6 +65,8 @@ pub struct SweepSpec {
     pub one_at_a_time: bool,
     /// Also synthesise every configuration's core with yosys.
     pub synth: bool,
+    /// Also run every configuration's frame through the whole core in the Rust simulator.
+    pub core_sim: bool,
 }
 
 /// The swept parameters, in the order configurations vary them (last fastest).

@@ -76,6 +76,19 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
             100.0 * worst.wrong as f64 / worst.rays.max(1) as f64
         ));
     }
+    let runs: Vec<&super::eval::CoreRun> = results.rows.iter().filter_map(|r| r.core.as_ref()).collect();
+    if !runs.is_empty() {
+        let bad: u64 = runs.iter().map(|k| k.mismatches).sum();
+        let cpr = |f: fn(f64, f64) -> f64, init: f64| runs.iter().map(|k| k.cycles_per_ray).fold(init, f);
+        out.push(format!(
+            "The whole core ran {} configurations' frames in the Rust simulator: {} rays disagreed with the \
+             golden model; {:.1} to {:.1} cycles per ray.",
+            runs.len(),
+            bad,
+            cpr(f64::min, f64::INFINITY),
+            cpr(f64::max, 0.0)
+        ));
+    }
     let failed = results.rows.iter().filter(|r| r.error.is_some()).count();
     if failed > 0 {
         out.push(format!("{failed} configurations could not be evaluated completely; see the note column."));
@@ -106,6 +119,7 @@ fn row_cells(r: &super::eval::Row) -> Vec<String> {
     v.push(r.dsp48e().map(|d| d.to_string()).unwrap_or_default());
     v.push(r.cost.as_ref().map(|c| c.register_bits.to_string()).unwrap_or_default());
     v.push(r.cost.as_ref().map(|c| c.isect_latency.to_string()).unwrap_or_default());
+    v.push(r.core.as_ref().map(|k| format!("{:.1}", k.cycles_per_ray)).unwrap_or_default());
     v.push(r.error.clone().unwrap_or_default().replace('|', "/"));
     v
 }
@@ -209,6 +223,9 @@ pub fn sweep_command(exe: &Path, spec: &SweepSpec) -> Vec<String> {
     }
     if spec.synth {
         v.push("--synth".into());
+    }
+    if spec.core_sim {
+        v.push("--core-sim".into());
     }
     v
 }

@@ -1,6 +1,6 @@
 //! Running a sweep (or a shard of one) and merging shards.
 
-use super::eval::{Row, SceneCtx, evaluate};
+use super::eval::{Extras, Row, SceneCtx, evaluate};
 use super::output::{Results, copy_cached, load_cached, read_results, store_cached, write_tables_and_images};
 use super::{Plan, SceneSpec, Shard, SweepSpec};
 use crate::error::{Error, Result};
@@ -33,6 +33,8 @@ pub struct RunSummary {
     pub computed: usize,
     pub cached: usize,
     pub failed: usize,
+    /// Rays on which the simulated core disagreed with the golden model (`--core-sim`).
+    pub mismatches: u64,
 }
 
 /// Loads and checks every scene of the sweep (before anything is written).
@@ -61,16 +63,16 @@ pub fn run(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} configurations ({eta}) {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let synth_dir = spec.synth.then(|| out.join("synth"));
+    let extras = Extras { synth_dir: spec.synth.then(|| out.join("synth")), core_sim: spec.core_sim };
     let results: Vec<Result<(Row, bool)>> = mine
         .par_iter()
         .map(|cfg| {
             let ctx = &scenes[cfg.scene];
-            let key = ctx.key(&cfg.params, spec.synth);
+            let key = ctx.key(&cfg.params, spec.synth, spec.core_sim);
             let done = match load_cached(out, &key, cfg.index, &ctx.label) {
                 Some(row) => Ok((row, true)),
                 None => {
-                    let e = evaluate(ctx, cfg, key, synth_dir.as_deref());
+                    let e = evaluate(ctx, cfg, key, &extras);
                     store_cached(out, &e).map(|()| (e.row, false))
                 }
             };
@@ -84,6 +86,7 @@ pub fn run(
     for r in results {
         let (row, cached) = r?;
         summary.failed += row.error.is_some() as usize;
+        summary.mismatches += row.core.as_ref().map_or(0, |k| k.mismatches);
         if cached {
             summary.cached += 1
         } else {

@@ -17,6 +17,7 @@ fn spec() -> SweepSpec {
         stack_depth: 32,
         one_at_a_time: false,
         synth: false,
+        core_sim: false,
     }
 }
 
@@ -89,6 +90,7 @@ fn the_emitted_command_describes_the_same_sweep() {
     s.scenes.insert(0, SceneSpec::Obj("/data/my scene.obj".into()));
     s.camera.eye = Some([1.5, -2.0, 1e-3]);
     s.one_at_a_time = true;
+    s.core_sim = true;
     let args = sweep_command(std::path::Path::new("/opt/fxrt"), &s);
     let mut argv = args.clone();
     argv.extend(["--out".into(), "x".into()]);
