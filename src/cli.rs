@@ -93,6 +93,10 @@ pub struct SweepArgs {
     /// Output folder (it also caches finished configurations for reruns).
     #[arg(long, required_unless_present = "action")]
     pub out: Option<PathBuf>,
+    /// Cache folder for finished configurations. Default: OUT/cache. Shards of one sweep may
+    /// share one (writes are atomic), so a rerun with other lists or shard counts reuses all.
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
     /// Compute only shard I of N: the configurations whose index mod N is I − 1.
     #[arg(long, value_parser = crate::flow::sweep::Shard::parse)]
     pub shard: Option<crate::flow::sweep::Shard>,
@@ -100,7 +104,7 @@ pub struct SweepArgs {
     /// OUT/slurm instead of running.
     #[arg(long = "emit-slurm")]
     pub emit_slurm: bool,
-    /// Shards for --emit-slurm.
+    /// Shards for --emit-slurm (at most 1000, Slurm's default array limit).
     #[arg(long, default_value_t = 8)]
     pub shards: u32,
     /// Worker threads (default: all cores).
@@ -112,7 +116,12 @@ impl SweepArgs {
     /// The sweep the arguments describe; every list is checked here, before anything runs.
     pub fn spec(&self) -> Result<crate::flow::sweep::SweepSpec> {
         use crate::flow::sweep::{CameraSpec, SceneSpec, SweepSpec, axis};
-        let mut scenes: Vec<SceneSpec> = self.scenes.iter().cloned().map(SceneSpec::Obj).collect();
+        // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
+        // sweep as a run from here.
+        let mut scenes = Vec::new();
+        for p in &self.scenes {
+            scenes.push(SceneSpec::Obj(std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()))?));
+        }
         scenes.extend(self.builtin.iter().map(|b| SceneSpec::Builtin(b.trim().to_string())));
         if scenes.is_empty() {
             scenes.push(SceneSpec::Builtin("teapot".into()));
@@ -161,6 +170,10 @@ pub struct SweepMergeArgs {
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
+    /// Cache folder the shards shared (where a shard folder has no cache of its own), and
+    /// the merged sweep's cache. Default: OUT/cache.
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]

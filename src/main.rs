@@ -421,7 +421,7 @@ fn run_sweep(a: SweepArgs) -> Result<bool> {
     use fxrt::flow::sweep::{report, run};
     if let Some(SweepAction::Merge(m)) = &a.action {
         let dirs: Vec<&std::path::Path> = m.dirs.iter().map(|d| d.as_path()).collect();
-        let rows = run::merge(&dirs, &m.out)?;
+        let rows = run::merge(&dirs, &m.out, m.cache.as_deref())?;
         println!("merged {} folders: {rows} configurations into {}", dirs.len(), m.out.display());
         return Ok(true);
     }
@@ -429,26 +429,24 @@ fn run_sweep(a: SweepArgs) -> Result<bool> {
     let plan = spec.plan()?;
     let out = a.out.clone().expect("clap requires --out without a subcommand");
     let pool = thread_pool(a.threads)?;
+    // Every scene is loaded and checked before anything is written, scripts included.
+    let scenes = pool.install(|| run::load_scenes(&spec))?;
     if a.emit_slurm {
         if a.shard.is_some() {
             return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
         }
-        if a.shards == 0 || a.shards as usize > plan.configs.len() {
+        let most = plan.configs.len().min(1000);
+        if a.shards == 0 || a.shards as usize > most {
             return Err(Error::param(
                 "shards",
-                format!("{} is out of range: must be 1..={} (the configurations)", a.shards, plan.configs.len()),
+                format!("{} is out of range: must be 1..={most} (configurations, and Slurm's array limit)", a.shards),
             ));
         }
         let abs = |p: &std::path::Path| std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()));
-        let mut spec = spec.clone();
-        for s in &mut spec.scenes {
-            if let fxrt::flow::sweep::SceneSpec::Obj(p) = s {
-                *p = abs(p)?;
-            }
-        }
         let exe = std::env::current_exe().map_err(|e| Error::new("fxrt", format!("cannot find its own path: {e}")))?;
         let cpus = a.threads.unwrap_or(4) as u32;
-        let files = report::slurm_files(&exe, &spec, &abs(&out)?, a.shards, cpus)?;
+        let cache = a.cache.clone().unwrap_or_else(|| out.join("cache"));
+        let files = report::slurm_files(&exe, &spec, &abs(&out)?, &abs(&cache)?, a.shards, cpus)?;
         for (name, text, executable) in &files {
             let path = out.join("slurm").join(name);
             fxrt::io::write_atomic(&path, text.as_bytes())?;
@@ -467,7 +465,6 @@ fn run_sweep(a: SweepArgs) -> Result<bool> {
         );
         return Ok(true);
     }
-    let scenes = pool.install(|| run::load_scenes(&spec))?;
     eprintln!(
         "sweep: {} configurations ({} parameter sets × {} scenes){}{}",
         plan.configs.len(),
@@ -477,7 +474,8 @@ fn run_sweep(a: SweepArgs) -> Result<bool> {
         if plan.skipped.is_empty() { String::new() } else { format!(", {} invalid sets skipped", plan.skipped.len()) }
     );
     let start = std::time::Instant::now();
-    let summary = pool.install(|| run::run(&spec, &plan, &scenes, &out, a.shard, true))?;
+    let cache = a.cache.clone().unwrap_or_else(|| out.join("cache"));
+    let summary = pool.install(|| run::run(&spec, &plan, &scenes, &out, &cache, a.shard, true))?;
     println!(
         "{} computed, {} from the cache, {} incomplete, in {:.1} s: {}",
         summary.computed,

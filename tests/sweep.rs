@@ -47,12 +47,14 @@ fn bad_lists_exit_2_with_one_line_before_anything_runs() {
     for (args, expect) in [
         (vec!["--n", "29..20"], "--n: '29..20' is reversed"),
         (vec!["--m", ""], "--m: '' has an empty item"),
-        (vec!["--t", "0..70:8"], "--t: 64 (in '0..70:8') is out of range"),
+        (vec!["--t", "0..70:8"], "--t: 70 (in '0..70:8') is out of range"),
         (vec!["--edge-shift", "auto,x"], "--edge-shift: 'x'"),
         (vec!["--m", "12", "--t", "24"], "sweep: no valid parameter set"),
         (vec!["--builtin", "nosuch"], "--builtin: unknown scene 'nosuch'"),
         (vec![bad_obj.to_str().unwrap()], "bad.obj"),
         (vec!["--shard", "4/3"], "--shard"),
+        (vec!["--builtin", "nosuch", "--emit-slurm"], "--builtin: unknown scene 'nosuch'"),
+        (vec!["--m", "8,12", "--t", "7", "--one-at-a-time"], "the base set of --one-at-a-time is invalid"),
     ] {
         let mut a = vec!["sweep", "--size", "8x8", "--out", out.to_str().unwrap()];
         a.extend(args.iter());
@@ -172,6 +174,19 @@ fn emitted_scripts_run_the_shards_and_the_merge() {
     assert!(o.status.success());
     let merged = out.join("results.csv");
     assert_eq!(std::fs::read(merged).unwrap(), std::fs::read(direct.join("results.csv")).unwrap());
+    // The shards share OUT/cache: one more m value over three shards computes only its two
+    // configurations, wherever they land.
+    let more = ["sweep", "--builtin", "thin,cornell", "--size", "16x16", "--m", "16,20,24,32", "--one-at-a-time"];
+    let o = fxrt(&[&more[..], &["--emit-slurm", "--shards", "3", "--out", out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let commands = std::fs::read_to_string(out.join("slurm/commands.txt")).unwrap();
+    let mut computed = 0;
+    for line in commands.lines() {
+        let o = Command::new("sh").args(["-c", line]).output().unwrap();
+        assert!(o.status.success(), "{line}: {}", text(&o.stderr));
+        computed += text(&o.stdout).split(' ').next().unwrap().parse::<u32>().unwrap();
+    }
+    assert_eq!(computed, 2);
 }
 
 /// Seed 001 §2.1 figures 2.7–2.9 and seed 003's edge shift, with this project's numbers

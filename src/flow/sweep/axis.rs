@@ -15,10 +15,7 @@ pub fn parse_u32_list(name: &str, text: &str) -> Result<Vec<u32>> {
         if item.is_empty() {
             return Err(err(format!("'{text}' has an empty item: write values or ranges like 8,10..12")));
         }
-        for v in expand_item(item).map_err(err)? {
-            if v < lo || v > hi {
-                return Err(err(format!("{v} (in '{item}') is out of range: must be {lo}..={hi}")));
-            }
+        for v in expand_item(item, lo, hi).map_err(err)? {
             if !out.contains(&v) {
                 out.push(v);
             }
@@ -45,13 +42,17 @@ pub fn parse_edge_shift_list(text: &str) -> Result<Vec<EdgeShift>> {
     Ok(out)
 }
 
-/// One item: `V`, `A..B` or `A..B:S` (inclusive). Errors say what is wrong with the item.
-fn expand_item(item: &str) -> std::result::Result<Vec<u32>, String> {
+/// One item: `V`, `A..B` or `A..B:S` (inclusive), every value in lo..=hi. Errors say what is
+/// wrong with the item; the bounds are checked before a range is expanded.
+fn expand_item(item: &str, lo: u32, hi: u32) -> std::result::Result<Vec<u32>, String> {
+    let in_range = |v: u32| {
+        if v < lo || v > hi { Err(format!("{v} (in '{item}') is out of range: must be {lo}..={hi}")) } else { Ok(v) }
+    };
     let number = |s: &str| -> std::result::Result<u32, String> {
         s.trim().parse::<u32>().map_err(|_| format!("'{s}' (in '{item}') is not a non-negative integer"))
     };
     let Some((a, rest)) = item.split_once("..") else {
-        return Ok(vec![number(item)?]);
+        return Ok(vec![in_range(number(item)?)?]);
     };
     let rest = rest.strip_prefix('=').unwrap_or(rest);
     let (b, step) = match rest.split_once(':') {
@@ -59,6 +60,8 @@ fn expand_item(item: &str) -> std::result::Result<Vec<u32>, String> {
         None => (rest, 1),
     };
     let (a, b) = (number(a)?, number(b)?);
+    in_range(a)?;
+    in_range(b)?;
     if step == 0 {
         return Err(format!("'{item}' has step 0"));
     }
@@ -94,6 +97,9 @@ mod tests {
         assert!(parse_u32_list("m", "12,,16").unwrap_err().to_string().contains("empty item"));
         assert!(parse_u32_list("t", "0..8:0").unwrap_err().to_string().contains("step 0"));
         assert!(parse_u32_list("c", "x").unwrap_err().to_string().contains("not a non-negative integer"));
+        // Checked before expanding: no four-billion-element list.
+        let e = parse_u32_list("t", "0..4000000000").unwrap_err().to_string();
+        assert_eq!(e, "--t: 4000000000 (in '0..4000000000') is out of range: must be 0..=62");
         assert!(parse_edge_shift_list("auto,200").unwrap_err().to_string().starts_with("--edge-shift: 200"));
     }
 }

@@ -184,9 +184,10 @@ impl Row {
         let base = format!("images/{}/{}", self.scene, params_label(&self.params));
         (format!("{base}.png"), format!("{base}_errors.png"))
     }
-    /// The DSP48E count to rank by: synthesis if it ran, else the estimate.
-    pub fn dsp48e(&self) -> Option<u64> {
-        self.synth.as_ref().map(|s| s.dsp48e).or(self.cost.as_ref().map(|c| c.dsp48e_est as u64))
+    /// The DSP48E count to rank by: yosys's when the sweep synthesises (None if it failed
+    /// here), else the estimate.
+    pub fn dsp48e(&self, synth: bool) -> Option<u64> {
+        if synth { self.synth.as_ref().map(|s| s.dsp48e) } else { self.cost.as_ref().map(|c| c.dsp48e_est as u64) }
     }
 }
 
@@ -237,7 +238,9 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         Ok(c) => row.cost = Some(c),
         Err(e) => row.error = Some(e.to_string()),
     }
-    let core_params = CoreParams::new(&roms, 20, 1);
+    // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
+    let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
+    let core_params = CoreParams::new(&roms, id_width, 1);
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
         let (results, stats) = simulate_rust(&core_params, &roms, &rays, &|_| {});
@@ -272,6 +275,18 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     Evaluated { row, render_png, errors_png }
 }
 
+/// |golden − reference| / reference, finite even where the reference distance is 0.
+fn rel_diff(golden: f64, reference: f64) -> f64 {
+    let d = (golden - reference).abs();
+    if reference > 0.0 {
+        d / reference
+    } else if d == 0.0 {
+        0.0
+    } else {
+        1.0
+    }
+}
+
 /// Pixel-by-pixel comparison with the reference and with the default-parameter image.
 pub fn quality(golden: &Frame, reference: &Frame, default_ids: &[i32]) -> Quality {
     let mut q = Quality { rays: golden.ids.len() as u64, ..Default::default() };
@@ -285,7 +300,7 @@ pub fn quality(golden: &Frame, reference: &Frame, default_ids: &[i32]) -> Qualit
             (true, false) => q.false_hits += 1,
             (false, true) => q.false_misses += 1,
             (true, true) => {
-                let rel = (golden.depth[i] - reference.depth[i]).abs() / reference.depth[i];
+                let rel = rel_diff(golden.depth[i], reference.depth[i]);
                 if g != r {
                     q.other_triangle += 1;
                     q.other_surface += (rel > OTHER_SURFACE_REL) as u64;
@@ -313,9 +328,7 @@ pub fn errors_png(golden: &Frame, reference: &Frame) -> Vec<u8> {
         let px = match (g >= 0, r >= 0) {
             (true, false) => [235, 40, 40],
             (false, true) => [40, 110, 255],
-            (true, true)
-                if g != r && (golden.depth[i] - reference.depth[i]).abs() / reference.depth[i] > OTHER_SURFACE_REL =>
-            {
+            (true, true) if g != r && rel_diff(golden.depth[i], reference.depth[i]) > OTHER_SURFACE_REL => {
                 [230, 40, 230]
             }
             _ => [grey; 3],

@@ -33,7 +33,7 @@ pub fn series<'a>(results: &'a Results, plan: &Plan, scene: &str, axis: Axis) ->
 }
 
 /// Writes grids/SCENE_PARAM.png for every scene and swept parameter; returns their paths.
-pub fn write_grids(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
+pub fn write_grids(dir: &Path, cache: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
     let mut written = Vec::new();
     for scene in super::run::scene_labels(&results.spec.scenes) {
         for axis in results.spec.swept_axes() {
@@ -41,7 +41,7 @@ pub fn write_grids(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<Str
             if rows.len() < 2 {
                 continue;
             }
-            let png = grid_png(dir, &scene, axis, &rows)?;
+            let png = grid_png(cache, &scene, axis, &rows)?;
             let rel = format!("grids/{scene}_{}.png", axis.name());
             write_atomic(&dir.join(&rel), &png)?;
             written.push(rel);
@@ -92,12 +92,12 @@ fn shrink(t: Tile) -> Tile {
     Tile { w, h, rgb }
 }
 
-fn grid_png(dir: &Path, scene: &str, axis: Axis, rows: &[&Row]) -> Result<Vec<u8>> {
+fn grid_png(cache: &Path, scene: &str, axis: Axis, rows: &[&Row]) -> Result<Vec<u8>> {
     let mut tiles = Vec::new();
     for r in rows {
         tiles.push(match r.quality {
             Some(_) => {
-                let (png, errors) = cached_images(dir, &r.key)?;
+                let (png, errors) = cached_images(cache, &r.key)?;
                 Some((decode(&png, &r.key)?, decode(&errors, &r.key)?))
             }
             None => None,

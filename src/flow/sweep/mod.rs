@@ -114,6 +114,9 @@ impl Axis {
     }
 }
 
+/// More configurations than any sweep should hold in one plan (a shard still plans them all).
+pub const MAX_CONFIGURATIONS: usize = 1_000_000;
+
 /// One configuration: a parameter set applied to one scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Config {
@@ -156,6 +159,7 @@ impl SweepSpec {
         Axis::ALL.into_iter().filter(|&a| self.values(a).len() > 1).collect()
     }
 
+    /// Each parameter at its default if its list holds it, else the list's first value.
     pub fn base(&self) -> Params {
         let d = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
         let pick = |list: &[u32], default: u32| if list.contains(&default) { default } else { list[0] };
@@ -169,39 +173,30 @@ impl SweepSpec {
         }
     }
 
-    /// Every parameter set the lists describe, in a fixed order, without repeats.
+    /// Every parameter set the lists describe, in a fixed order, without repeats (the lists
+    /// themselves hold no repeats, so only one-at-a-time can produce one: the base).
     fn parameter_sets(&self) -> Vec<Params> {
         let base = self.base();
         let mut sets: Vec<Params> = Vec::new();
-        let mut push = |p: Params| {
-            if !sets.contains(&p) {
-                sets.push(p);
-            }
-        };
         if self.one_at_a_time {
-            push(base);
-            for &n in &self.n {
-                push(Params { n, ..base });
-            }
-            for &m in &self.m {
-                push(Params { m, ..base });
-            }
-            for &edge_shift in &self.edge_shift {
-                push(Params { edge_shift, ..base });
-            }
-            for &t in &self.t {
-                push(Params { t, ..base });
-            }
-            for &c in &self.c {
-                push(Params { c, ..base });
-            }
+            sets.push(base);
+            let mut push = |p: Params| {
+                if p != base {
+                    sets.push(p);
+                }
+            };
+            self.n.iter().for_each(|&n| push(Params { n, ..base }));
+            self.m.iter().for_each(|&m| push(Params { m, ..base }));
+            self.edge_shift.iter().for_each(|&edge_shift| push(Params { edge_shift, ..base }));
+            self.t.iter().for_each(|&t| push(Params { t, ..base }));
+            self.c.iter().for_each(|&c| push(Params { c, ..base }));
         } else {
             for &n in &self.n {
                 for &m in &self.m {
                     for &edge_shift in &self.edge_shift {
                         for &t in &self.t {
                             for &c in &self.c {
-                                push(Params { n, m, edge_shift, t, c, ..base });
+                                sets.push(Params { n, m, edge_shift, t, c, ..base });
                             }
                         }
                     }
@@ -211,10 +206,35 @@ impl SweepSpec {
         sets
     }
 
+    /// How many parameter sets the lists describe.
+    fn set_count(&self) -> u128 {
+        let lens = [self.n.len(), self.m.len(), self.edge_shift.len(), self.t.len(), self.c.len()];
+        if self.one_at_a_time {
+            1 + lens.iter().map(|&l| l as u128).sum::<u128>()
+        } else {
+            lens.iter().map(|&l| l as u128).product()
+        }
+    }
+
     /// Expands the lists; fails (before anything runs) if no configuration is valid.
     pub fn plan(&self) -> Result<Plan> {
         if self.scenes.is_empty() {
             return Err(Error::new("sweep", "no scene: name OBJ files or --builtin scenes"));
+        }
+        for axis in Axis::ALL {
+            if self.values(axis).is_empty() {
+                return Err(Error::param(axis.name(), "the list is empty"));
+            }
+        }
+        let configurations = self.set_count() * self.scenes.len() as u128;
+        if configurations > MAX_CONFIGURATIONS as u128 {
+            return Err(Error::new(
+                "sweep",
+                format!(
+                    "{configurations} configurations is more than {MAX_CONFIGURATIONS}: shorten the lists or use \
+                     --one-at-a-time"
+                ),
+            ));
         }
         let (mut sets, mut skipped) = (Vec::new(), Vec::new());
         for p in self.parameter_sets() {
@@ -227,6 +247,17 @@ impl SweepSpec {
             let why = skipped.first().map(|s| s.reason.clone()).unwrap_or_default();
             return Err(Error::new("sweep", format!("no valid parameter set in the lists (e.g. {why})")));
         }
+        // The base set anchors one-at-a-time sweeps, grids and plots: it must be valid.
+        let mut base = self.base();
+        if let Err(e) = base.validate() {
+            if self.one_at_a_time {
+                return Err(Error::new(
+                    "sweep",
+                    format!("the base set of --one-at-a-time is invalid ({e}): list a valid value first"),
+                ));
+            }
+            base = sets[0];
+        }
         let configs = sets
             .iter()
             .enumerate()
@@ -234,7 +265,7 @@ impl SweepSpec {
                 (0..self.scenes.len()).map(move |s| Config { index: i * self.scenes.len() + s, scene: s, params })
             })
             .collect();
-        Ok(Plan { base: self.base(), sets, configs, skipped })
+        Ok(Plan { base, sets, configs, skipped })
     }
 }
 

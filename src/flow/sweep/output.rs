@@ -5,7 +5,8 @@
 //! DIR/results.json  results.csv  report.md
 //! DIR/images/SCENE/LABEL.png, LABEL_errors.png
 //! DIR/grids/SCENE_PARAM.png    DIR/plots/*.png
-//! DIR/cache/KEY.json, KEY.png, KEY_errors.png   (every configuration ever finished here)
+//! DIR/cache/KEY.json, KEY.png, KEY_errors.png   (every configuration ever finished here;
+//!                                               `--cache` may put it elsewhere, e.g. shared by shards)
 //! ```
 
 use super::eval::{Evaluated, Row};
@@ -28,17 +29,23 @@ pub struct Results {
     pub rows: Vec<Row>,
 }
 
-fn cache_files(dir: &Path, key: &str) -> [PathBuf; 3] {
-    let c = dir.join("cache");
-    [c.join(format!("{key}.json")), c.join(format!("{key}.png")), c.join(format!("{key}_errors.png"))]
+/// The files of one cache entry in the cache folder `cache`.
+fn cache_files(cache: &Path, key: &str) -> [PathBuf; 3] {
+    [cache.join(format!("{key}.json")), cache.join(format!("{key}.png")), cache.join(format!("{key}_errors.png"))]
 }
 
-/// A finished configuration from the cache, renumbered for this sweep; None if absent or
-/// unreadable (it is then computed again).
+/// Whether `cache` holds the entry `key`.
+pub fn has_cached(cache: &Path, key: &str) -> bool {
+    cache_files(cache, key)[0].is_file()
+}
+
+/// A finished configuration from the cache, renumbered for this sweep; None if absent,
+/// unreadable or incomplete (it is then computed again: a missing yosys may be installed
+/// since).
 pub fn load_cached(dir: &Path, key: &str, index: usize, scene: &str) -> Option<Row> {
     let [json, png, errors] = cache_files(dir, key);
     let mut row: Row = serde_json::from_slice(&std::fs::read(json).ok()?).ok()?;
-    if row.key != key || (row.quality.is_some() && !(png.is_file() && errors.is_file())) {
+    if row.key != key || row.error.is_some() || (row.quality.is_some() && !(png.is_file() && errors.is_file())) {
         return None;
     }
     row.index = index;
@@ -56,7 +63,7 @@ pub fn store_cached(dir: &Path, e: &Evaluated) -> Result<()> {
     write_atomic(&json, &serde_json::to_vec_pretty(&e.row).expect("rows serialise"))
 }
 
-/// Copies a row's cache entry from one sweep folder to another (merging shards).
+/// Copies a cache entry from one cache folder to another (merging shards).
 pub fn copy_cached(from: &Path, to: &Path, key: &str) -> Result<()> {
     for (src, dst) in cache_files(from, key).iter().zip(cache_files(to, key)) {
         if src.is_file() {
@@ -199,9 +206,9 @@ pub fn csv_bytes(rows: &[Row]) -> Vec<u8> {
 }
 
 /// Writes results.json, results.csv and the images of every row (from the cache).
-pub fn write_tables_and_images(dir: &Path, results: &Results) -> Result<()> {
+pub fn write_tables_and_images(dir: &Path, cache: &Path, results: &Results) -> Result<()> {
     for r in results.rows.iter().filter(|r| r.quality.is_some()) {
-        let (png, errors) = cached_images(dir, &r.key)?;
+        let (png, errors) = cached_images(cache, &r.key)?;
         let (p, e) = r.image_paths();
         write_atomic(&dir.join(p), &png)?;
         write_atomic(&dir.join(e), &errors)?;

@@ -128,7 +128,7 @@ fn pareto_plot(results: &Results) -> Result<Vec<u8>> {
     let y = |w: u64| (w as f64).max(ZERO);
     let x_max = sets.iter().map(|s| s.dsp48e).max().unwrap_or(1) as f64 * 1.1 + 1.0;
     let y_top = sets.iter().map(|s| y(s.wrong)).fold(10.0, f64::max) * 2.0;
-    let source = if sets.iter().all(|s| s.dsp_from_synth) { "yosys" } else { "estimated" };
+    let source = if results.spec.synth { "yosys" } else { "estimated" };
     let mut rgb = vec![255u8; (W * H * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area();

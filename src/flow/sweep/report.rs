@@ -116,7 +116,7 @@ fn row_cells(r: &super::eval::Row) -> Vec<String> {
         ]),
         None => v.extend(std::iter::repeat_n(String::new(), 8)),
     }
-    v.push(r.dsp48e().map(|d| d.to_string()).unwrap_or_default());
+    v.push(r.dsp48e(r.synth.is_some()).map(|d| d.to_string()).unwrap_or_default());
     v.push(r.cost.as_ref().map(|c| c.register_bits.to_string()).unwrap_or_default());
     v.push(r.cost.as_ref().map(|c| c.isect_latency.to_string()).unwrap_or_default());
     v.push(r.core.as_ref().map(|k| format!("{:.1}", k.cycles_per_ray)).unwrap_or_default());
@@ -236,6 +236,8 @@ struct SlurmArray<'a> {
     shards: u32,
     cpus: u32,
     out: &'a str,
+    /// The log folder for #SBATCH --output, where % starts a Slurm pattern.
+    log_dir: &'a str,
     command: &'a str,
 }
 
@@ -244,6 +246,7 @@ struct SlurmArray<'a> {
 struct SlurmMerge<'a> {
     shards: u32,
     out: &'a str,
+    log_dir: &'a str,
     merge: &'a str,
 }
 
@@ -262,28 +265,40 @@ struct Parallel<'a> {
     merge: &'a str,
 }
 
-/// The files of `--emit-slurm`: (name, contents, executable), to go into DIR/slurm/.
+/// The files of `--emit-slurm`: (name, contents, executable), to go into OUT/slurm/. Every
+/// shard and the merge use the cache folder `cache`.
 pub fn slurm_files(
     exe: &Path,
     spec: &SweepSpec,
     out: &Path,
+    cache: &Path,
     shards: u32,
     cpus: u32,
 ) -> Result<Vec<(String, String, bool)>> {
     let render = |t: &dyn askama::DynTemplate| t.dyn_render().map_err(|e| Error::new("emit-slurm", e.to_string()));
     let quote = |v: &[String]| v.iter().map(|s| shell_quote(s)).collect::<Vec<_>>().join(" ");
-    let command = quote(&sweep_command(exe, spec));
+    let cache_s = shell_quote(&cache.display().to_string());
+    let command = format!("{} --cache {cache_s}", quote(&sweep_command(exe, spec)));
     let out_s = shell_quote(&out.display().to_string());
+    // In #SBATCH --output a % starts a file-name pattern.
+    let log_dir = out.join("slurm").display().to_string().replace('%', "%%");
     let shard_dirs: Vec<String> =
         (1..=shards).map(|i| shell_quote(&out.join(format!("shard-{i}")).display().to_string())).collect();
-    let merge =
-        format!("{} sweep merge {} --out {out_s}", shell_quote(&exe.display().to_string()), shard_dirs.join(" "));
+    let merge = format!(
+        "{} sweep merge {} --out {out_s} --cache {cache_s}",
+        shell_quote(&exe.display().to_string()),
+        shard_dirs.join(" ")
+    );
     let commands: String = (1..=shards)
         .map(|i| format!("{command} --threads {cpus} --shard {i}/{shards} --out {}\n", shard_dirs[i as usize - 1]))
         .collect();
     Ok(vec![
-        ("sweep.slurm".into(), render(&SlurmArray { shards, cpus, out: &out_s, command: &command })?, false),
-        ("merge.slurm".into(), render(&SlurmMerge { shards, out: &out_s, merge: &merge })?, false),
+        (
+            "sweep.slurm".into(),
+            render(&SlurmArray { shards, cpus, out: &out_s, log_dir: &log_dir, command: &command })?,
+            false,
+        ),
+        ("merge.slurm".into(), render(&SlurmMerge { shards, out: &out_s, log_dir: &log_dir, merge: &merge })?, false),
         ("submit.sh".into(), render(&SlurmSubmit { shards, out: &out_s })?, true),
         ("parallel.sh".into(), render(&Parallel { shards, cpus, merge: &merge })?, true),
         ("commands.txt".into(), commands, false),

@@ -1,14 +1,17 @@
 //! Running a sweep (or a shard of one) and merging shards.
 
 use super::eval::{Extras, Row, SceneCtx, evaluate};
-use super::output::{Results, copy_cached, load_cached, read_results, store_cached, write_tables_and_images};
+use super::output::{
+    Results, copy_cached, has_cached, load_cached, read_results, store_cached, write_tables_and_images,
+};
 use super::{Plan, SceneSpec, Shard, SweepSpec};
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Labels for the scenes: built-in names and OBJ file stems, numbered where two coincide.
+/// Labels for the scenes: built-in names and OBJ file stems, numbered where two coincide
+/// (and numbered further while a number collides with another scene's name).
 pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
     let base: Vec<String> = scenes
         .iter()
@@ -18,13 +21,18 @@ pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
         })
         .map(|l| l.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect())
         .collect();
-    base.iter()
-        .enumerate()
-        .map(|(i, l)| {
-            let same = base.iter().filter(|x| *x == l).count();
-            if same > 1 { format!("{l}-{}", 1 + base[..i].iter().filter(|x| *x == l).count()) } else { l.clone() }
-        })
-        .collect()
+    let mut out: Vec<String> = Vec::new();
+    for (i, l) in base.iter().enumerate() {
+        let shared = base.iter().filter(|x| *x == l).count() > 1;
+        let mut k = 1 + base[..i].iter().filter(|x| *x == l).count();
+        let mut label = if shared { format!("{l}-{k}") } else { l.clone() };
+        while out.contains(&label) || (shared && base.contains(&label)) {
+            k += 1;
+            label = format!("{l}-{k}");
+        }
+        out.push(label);
+    }
+    out
 }
 
 /// What a run did, for the summary line.
@@ -47,13 +55,14 @@ pub fn load_scenes(spec: &SweepSpec) -> Result<Vec<SceneCtx>> {
         .collect()
 }
 
-/// Evaluates this shard's configurations (cached ones are read back) and writes every
-/// output into `out`.
+/// Evaluates this shard's configurations (those in the cache folder `cache` are read back)
+/// and writes every output into `out`.
 pub fn run(
     spec: &SweepSpec,
     plan: &Plan,
     scenes: &[SceneCtx],
     out: &Path,
+    cache: &Path,
     shard: Option<Shard>,
     progress: bool,
 ) -> Result<RunSummary> {
@@ -69,11 +78,11 @@ pub fn run(
         .map(|cfg| {
             let ctx = &scenes[cfg.scene];
             let key = ctx.key(&cfg.params, spec.synth, spec.core_sim);
-            let done = match load_cached(out, &key, cfg.index, &ctx.label) {
+            let done = match load_cached(cache, &key, cfg.index, &ctx.label) {
                 Some(row) => Ok((row, true)),
                 None => {
                     let e = evaluate(ctx, cfg, key, &extras);
-                    store_cached(out, &e).map(|()| (e.row, false))
+                    store_cached(cache, &e).map(|()| (e.row, false))
                 }
             };
             bar.inc(1);
@@ -102,20 +111,22 @@ pub fn run(
         skipped: plan.skipped.clone(),
         rows,
     };
-    write_all(out, &results, plan)?;
+    write_all(out, cache, &results, plan)?;
     Ok(summary)
 }
 
 /// Every output of a sweep folder, from its results and cache alone.
-fn write_all(out: &Path, results: &Results, plan: &Plan) -> Result<()> {
-    write_tables_and_images(out, results)?;
-    let grids = super::grid::write_grids(out, results, plan)?;
+fn write_all(out: &Path, cache: &Path, results: &Results, plan: &Plan) -> Result<()> {
+    write_tables_and_images(out, cache, results)?;
+    let grids = super::grid::write_grids(out, cache, results, plan)?;
     let plots = super::plots::write_plots(out, results, plan)?;
     super::report::write_report(out, results, plan, &grids, &plots)
 }
 
 /// Joins shard folders into `out`: the same spec everywhere, every configuration exactly once.
-pub fn merge(dirs: &[&Path], out: &Path) -> Result<usize> {
+/// Each row's cache entry is taken from its shard's `cache` folder, else from `cache`, and
+/// ends up in `cache` (default: `out/cache`).
+pub fn merge(dirs: &[&Path], out: &Path, cache: Option<&Path>) -> Result<usize> {
     let mut first: Option<Results> = None;
     let mut rows: BTreeMap<usize, (Row, &Path)> = BTreeMap::new();
     for &dir in dirs {
@@ -145,12 +156,18 @@ pub fn merge(dirs: &[&Path], out: &Path) -> Result<usize> {
             format!("configurations {} … are in none of the folders: is a shard missing?", missing.join(", ")),
         ));
     }
+    let target = cache.map(Path::to_path_buf).unwrap_or_else(|| out.join("cache"));
     for (row, dir) in rows.values() {
-        if *dir != out {
-            copy_cached(dir, out, &row.key)?;
+        let own = dir.join("cache");
+        let source = if has_cached(&own, &row.key) { own } else { target.clone() };
+        if !has_cached(&source, &row.key) {
+            return Err(Error::file(dir, format!("configuration {} has no cache entry: pass --cache", row.index)));
+        }
+        if std::path::absolute(&source).ok() != std::path::absolute(&target).ok() {
+            copy_cached(&source, &target, &row.key)?;
         }
     }
     let results = Results { shard: None, rows: rows.into_values().map(|(r, _)| r).collect(), ..first };
-    write_all(out, &results, &plan)?;
+    write_all(out, &target, &results, &plan)?;
     Ok(results.rows.len())
 }

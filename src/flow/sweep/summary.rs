@@ -25,7 +25,7 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
     let scenes = results.spec.scenes.len();
     let mut out: Vec<SetSummary> = Vec::new();
     for r in &results.rows {
-        let (Some(q), Some(c), Some(dsp)) = (&r.quality, &r.cost, r.dsp48e()) else { continue };
+        let (Some(q), Some(c), Some(dsp)) = (&r.quality, &r.cost, r.dsp48e(results.spec.synth)) else { continue };
         let s = match out.iter_mut().find(|s| s.params == r.params) {
             Some(s) => s,
             None => {
@@ -35,7 +35,7 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
                     diff: 0,
                     rays: 0,
                     dsp48e: 0,
-                    dsp_from_synth: r.synth.is_some(),
+                    dsp_from_synth: results.spec.synth,
                     isect_latency: c.isect_latency,
                     rom_bits: 0,
                     register_bits: 0,
@@ -51,7 +51,11 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
         s.register_bits = s.register_bits.max(c.register_bits);
     }
     let complete = |s: &SetSummary| {
-        results.rows.iter().filter(|r| r.params == s.params && r.quality.is_some() && r.cost.is_some()).count()
+        results
+            .rows
+            .iter()
+            .filter(|r| r.params == s.params && r.quality.is_some() && r.dsp48e(results.spec.synth).is_some())
+            .count()
             == scenes
     };
     out.into_iter().filter(complete).collect()

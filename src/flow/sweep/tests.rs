@@ -79,6 +79,12 @@ fn labels_are_unique_and_file_safe() {
         SceneSpec::Builtin("cornell".into()),
     ];
     assert_eq!(scene_labels(&scenes), vec!["teapot-1", "teapot-2", "my_scene", "cornell"]);
+    let scenes = vec![
+        SceneSpec::Obj("a/teapot.obj".into()),
+        SceneSpec::Obj("b/teapot.obj".into()),
+        SceneSpec::Obj("teapot-1.obj".into()),
+    ];
+    assert_eq!(scene_labels(&scenes), vec!["teapot-2", "teapot-3", "teapot-1"]);
     assert_eq!(params_label(&Params::default()), "n29_m32_eauto_t0_c16");
     assert_eq!(params_label(&Params { leaf_size: 2, ..Params::default() }), "n29_m32_eauto_t0_c16_l2");
 }
@@ -129,4 +135,25 @@ fn quality_sorts_pixels_into_kinds_of_error() {
     assert_eq!((q.ref_hits, q.hits, q.rays), (5, 5, 6));
     assert!((q.t_rel_max - 1e-4).abs() < 1e-12);
     assert!((q.t_rel_mean - 0.5e-4).abs() < 1e-12);
+}
+
+#[test]
+fn the_base_set_must_be_valid_and_plans_have_a_size_limit() {
+    // m = 8 allows T ≤ 6: one at a time around (m = 8, T = 7) is refused...
+    let s = SweepSpec { m: vec![8, 12], t: vec![7], one_at_a_time: true, ..spec() };
+    assert!(matches!(s.plan(), Err(e) if e.to_string().contains("the base set of --one-at-a-time is invalid")));
+    // ...a cross product takes its first valid set as the base for grids and plots.
+    let s = SweepSpec { one_at_a_time: false, ..s };
+    let plan = s.plan().unwrap();
+    assert_eq!((plan.base.m, plan.base.t), (12, 7));
+    let s = SweepSpec {
+        n: (4..=40).collect(),
+        m: (8..=64).collect(),
+        t: (0..=62).collect(),
+        c: (0..=64).collect(),
+        ..spec()
+    };
+    assert!(matches!(s.plan(), Err(e) if e.to_string().contains("is more than 1000000")));
+    let s = SweepSpec { c: vec![], ..spec() };
+    assert_eq!(s.plan().unwrap_err().to_string(), "--c: the list is empty");
 }
