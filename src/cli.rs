@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::params::{EdgeShift, Params};
-use crate::render::camera::Camera;
+use crate::render::camera::{Camera, CameraSpec};
 use crate::render::tracer::ModelKind;
 use crate::scene::SceneSource;
 use clap::{Args, Parser, Subcommand};
@@ -115,7 +115,7 @@ pub struct SweepArgs {
 impl SweepArgs {
     /// The sweep the arguments describe; every list is checked here, before anything runs.
     pub fn spec(&self) -> Result<crate::flow::sweep::SweepSpec> {
-        use crate::flow::sweep::{CameraSpec, SceneSpec, SweepSpec, axis};
+        use crate::flow::sweep::{SceneSpec, SweepSpec, axis};
         // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
         // sweep as a run from here.
         let mut scenes = Vec::new();
@@ -126,7 +126,6 @@ impl SweepArgs {
         if scenes.is_empty() {
             scenes.push(SceneSpec::Builtin("teapot".into()));
         }
-        let (width, height) = self.camera.size;
         if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
             return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
         }
@@ -134,14 +133,7 @@ impl SweepArgs {
         single.validate()?;
         Ok(SweepSpec {
             scenes,
-            camera: CameraSpec {
-                eye: self.camera.eye,
-                at: self.camera.at,
-                up: self.camera.up,
-                fov: self.camera.fov,
-                width,
-                height,
-            },
+            camera: self.camera.spec(),
             n: axis::parse_u32_list("n", &self.n)?,
             m: axis::parse_u32_list("m", &self.m)?,
             t: axis::parse_u32_list("t", &self.t)?,
@@ -398,19 +390,12 @@ pub struct CameraArgs {
 }
 
 impl CameraArgs {
+    pub fn spec(&self) -> CameraSpec {
+        let (width, height) = self.size;
+        CameraSpec { eye: self.eye, at: self.at, up: self.up, fov: self.fov, width, height }
+    }
     pub fn camera(&self, scene: &crate::scene::Scene) -> Result<Camera> {
-        let (w, h) = self.size;
-        let mut cam = Camera::default_for(scene, w, h);
-        if let Some(e) = self.eye {
-            cam.eye = e;
-        }
-        if let Some(a) = self.at {
-            cam.at = a;
-        }
-        cam.up = self.up;
-        cam.fov_deg = self.fov;
-        cam.validate().map_err(|(opt, msg)| Error::param(opt, msg))?;
-        Ok(cam)
+        self.spec().camera(scene)
     }
 }
 

@@ -5,6 +5,35 @@
 
 use crate::model::ray::{WorldRay, cross, normalize, sub};
 use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+
+/// A camera as the user gives it; what is not given is chosen per scene (`Camera::default_for`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CameraSpec {
+    pub eye: Option<[f64; 3]>,
+    pub at: Option<[f64; 3]>,
+    pub up: [f64; 3],
+    pub fov: f64,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl CameraSpec {
+    /// The camera for `scene`; errors name the option at fault.
+    pub fn camera(&self, scene: &Scene) -> crate::error::Result<Camera> {
+        let mut cam = Camera::default_for(scene, self.width, self.height);
+        if let Some(e) = self.eye {
+            cam.eye = e;
+        }
+        if let Some(a) = self.at {
+            cam.at = a;
+        }
+        cam.up = self.up;
+        cam.fov_deg = self.fov;
+        cam.validate().map_err(|(opt, msg)| crate::error::Error::param(opt, msg))?;
+        Ok(cam)
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

@@ -23,6 +23,13 @@ pub const BUILTIN_DESCRIPTIONS: &[&str] = &[
     "the Utah teapot tessellated three times finer: 57,360 triangles (a 50k+ scene)",
 ];
 
+/// `builtin_scene`, or the error naming the known scenes.
+pub fn load(name: &str) -> crate::error::Result<Vec<Tri>> {
+    builtin_scene(name).ok_or_else(|| {
+        crate::error::Error::param("builtin", format!("unknown scene '{name}'; known: {}", BUILTIN_NAMES.join(", ")))
+    })
+}
+
 /// The triangles of a built-in scene, numbered in the returned order; None for an unknown name.
 pub fn builtin_scene(name: &str) -> Option<Vec<Tri>> {
     let tris = match name {

@@ -154,12 +154,7 @@ impl Scene {
                 Scene::build(&path.display().to_string(), tris, params)
             }
             SceneSource::Builtin(name) => {
-                let tris = builtin::builtin_scene(name).ok_or_else(|| {
-                    Error::param(
-                        "builtin",
-                        format!("unknown scene '{name}'; known: {}", builtin::BUILTIN_NAMES.join(", ")),
-                    )
-                })?;
+                let tris = builtin::load(name)?;
                 Scene::build(name, tris, params)
             }
         }

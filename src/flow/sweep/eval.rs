@@ -48,12 +48,7 @@ impl SceneCtx {
     ) -> Result<SceneCtx> {
         let (name, world, fingerprint) = match spec {
             SceneSpec::Builtin(b) => {
-                let world = builtin::builtin_scene(b).ok_or_else(|| {
-                    Error::param(
-                        "builtin",
-                        format!("unknown scene '{b}'; known: {}", builtin::BUILTIN_NAMES.join(", ")),
-                    )
-                })?;
+                let world = builtin::load(b)?;
                 (b.clone(), world, format!("builtin:{b}"))
             }
             SceneSpec::Obj(p) => {
@@ -63,16 +58,7 @@ impl SceneCtx {
         };
         let params = Params { leaf_size, stack_depth, ..Params::default() };
         let defaults = Scene::build(&name, world.clone(), &params)?;
-        let mut camera = Camera::default_for(&defaults, cam.width, cam.height);
-        if let Some(e) = cam.eye {
-            camera.eye = e;
-        }
-        if let Some(a) = cam.at {
-            camera.at = a;
-        }
-        camera.up = cam.up;
-        camera.fov_deg = cam.fov;
-        camera.validate().map_err(|(opt, msg)| Error::param(opt, msg))?;
+        let camera = cam.camera(&defaults)?;
         Ok(SceneCtx {
             label,
             fingerprint,

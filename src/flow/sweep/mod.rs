@@ -18,6 +18,7 @@ pub mod summary;
 
 use crate::error::{Error, Result};
 use crate::params::{EdgeShift, Params};
+pub use crate::render::camera::CameraSpec;
 use crate::scene::SceneSource;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -37,17 +38,6 @@ impl SceneSpec {
             SceneSpec::Obj(p) => SceneSource::Obj(p.clone()),
         }
     }
-}
-
-/// The camera as given; what is not given is chosen per scene (`Camera::default_for`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CameraSpec {
-    pub eye: Option<[f64; 3]>,
-    pub at: Option<[f64; 3]>,
-    pub up: [f64; 3],
-    pub fov: f64,
-    pub width: u32,
-    pub height: u32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
