@@ -38,7 +38,8 @@ pub enum Command {
     Synth(SynthArgs),
     /// Run a whole frame through the generated ray tracing core and compare every pixel.
     Sim(SimArgs),
-    /// Image error and hardware cost over lists of n, m, T, C and E (`sweep merge` joins shards).
+    /// Image error and hardware cost over lists of n, m, T, C and E: each takes values
+    /// `12,16`, ranges `20..29` (inclusive) or steps `0..24:8`; `sweep merge` joins shards.
     Sweep(SweepArgs),
 }
 
