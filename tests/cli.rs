@@ -247,3 +247,75 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
+
+/// `fxrt gen --scene DIR` wires the hardware from scene.json's layouts: a layout that is not
+/// the one fxrt writes (here two fields swapped) is refused, not turned into wrong hardware.
+#[test]
+fn gen_refuses_a_scene_folder_with_a_foreign_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene");
+    let o = fxrt(&["scene", "--builtin", "thin", "--out", scene.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let path = scene.join("scene.json");
+    let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let tri = j["roms"].as_array_mut().unwrap().iter_mut().find(|r| r["rom"] == "tri").unwrap();
+    let fields = tri["fields"].as_array_mut().unwrap();
+    let (a, b) = (fields[4]["name"].clone(), fields[5]["name"].clone());
+    fields[4]["name"] = b;
+    fields[5]["name"] = a;
+    std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
+    let out = dir.path().join("hdl");
+    let o = fxrt(&["gen", "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the tri ROM layout is not the one fxrt writes"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+/// A one-pixel frame steps in neither direction: any field of view the camera takes works.
+#[test]
+fn ray_generator_takes_a_one_pixel_frame_with_a_wide_fov() {
+    let o = fxrt(&[
+        "sim",
+        "--builtin",
+        "cornell",
+        "--raygen",
+        "--eye",
+        "278,273,60",
+        "--at",
+        "300,250,559",
+        "--size",
+        "1x1",
+        "--fov",
+        "130",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"all_pixels_match\":true"));
+}
+
+/// One triangle, one leaf-table word and a one-entry stack: one-word memories get a real
+/// second word, so GHDL never reads out of range (it stops the simulation if it does).
+#[test]
+fn one_word_memories_simulate_in_ghdl() {
+    if Command::new("ghdl").arg("--version").output().is_err() {
+        eprintln!("skipped: ghdl is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("one.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let build = dir.path().join("build");
+    let o = fxrt(&[
+        "sim",
+        obj.to_str().unwrap(),
+        "--size",
+        "4x4",
+        "--stack-depth",
+        "1",
+        "--sim",
+        "ghdl",
+        "--build",
+        build.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"all_pixels_match\":true"));
+}

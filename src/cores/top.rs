@@ -59,7 +59,8 @@ impl CoreParams {
         let bits = |(l, w): &(crate::scene::rom::Layout, Vec<crate::scene::rom::Word>)| {
             l.width as u64 * crate::rtl::emit::rom_depth(w.len()) as u64
         };
-        let stack = (self.trav.n as u64 * 2 + 6 + 32) * self.trav.stack_depth as u64;
+        let stack =
+            (self.trav.n as u64 * 2 + 6 + 32) * crate::rtl::emit::rom_depth(self.trav.stack_depth as usize) as u64;
         let total = bits(&scene.tri) + bits(&scene.node) + bits(&scene.leaf) + stack;
         if total > bram_kbits * 1024 {
             return Err(crate::error::Error::param(

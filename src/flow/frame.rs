@@ -299,8 +299,9 @@ pub fn simulate_hdl(
     let inputs: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
     let expected: Vec<Vec<i128>> =
         rays.iter().map(|r| result_row(r.pixel as u64, g.trace_fast(scene, &r.ray).0)).collect();
-    // Generous: the slowest built-in scene needs ~15,000 cycles per ray.
-    let max_cycles = 100_000 * rays.len() as u64 + 10_000;
+    // Generous: the slowest built-in scene needs ~15,000 cycles per ray. Capped to what the
+    // testbenches' 32-bit integers hold (GHDL would wrap it, Verilator refuses it).
+    let max_cycles = (100_000 * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
     let stream = Stream { rays: &inputs, expected: &expected, checked: &RESULT_PORTS, max_cycles };
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     std::fs::create_dir_all(dir).map_err(io)?;

@@ -41,8 +41,10 @@ impl RayGen {
             let g = RayGen {
                 eye,
                 d0: std::array::from_fn(|k| (s * a[k]).round() as i64),
-                dx: std::array::from_fn(|k| (s * (b[k] - a[k])).round() as i64),
-                dy: std::array::from_fn(|k| (s * (c[k] - a[k])).round() as i64),
+                // A one-pixel-wide (high) frame never steps in x (y): its step stays 0, and
+                // with it the constant's width.
+                dx: std::array::from_fn(|k| if w > 1 { (s * (b[k] - a[k])).round() as i64 } else { 0 }),
+                dy: std::array::from_fn(|k| if h > 1 { (s * (c[k] - a[k])).round() as i64 } else { 0 }),
                 width: cam.width,
                 height: cam.height,
             };

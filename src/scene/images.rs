@@ -133,6 +133,31 @@ impl SceneRoms {
             };
             images.push((Layout { rom: rom_name, width: l.width, depth: words.len(), fields }, words));
         }
+        // The hardware is wired from these layouts: they must be exactly the ones fxrt writes
+        // for these parameters and table sizes (a reordered or resized field is an error).
+        let count_bits = images[1].0.fields.iter().find(|f| f.name == "count").map_or(0, |f| f.width);
+        let expected = rom::layouts_for(
+            params.n,
+            params.m,
+            images[0].1.len(),
+            images[1].1.len(),
+            images[2].1.len(),
+            count_bits.max(1),
+        );
+        for ((got, _), want) in images.iter().zip(&expected) {
+            if got.width != want.width || got.fields != want.fields {
+                return Err(Error::file(
+                    &json_path,
+                    format!(
+                        "the {} ROM layout is not the one fxrt writes for n = {}, m = {} and {} words",
+                        got.rom, params.n, params.m, got.depth
+                    ),
+                ));
+            }
+        }
+        if j.grid_box_hi.iter().any(|&h| h < 0 || h >= 1i64 << params.n) {
+            return Err(Error::file(&json_path, format!("grid_box_hi does not fit {} bits", params.n)));
+        }
         let leaf = images.pop().expect("three images");
         let node = images.pop().expect("three images");
         let tri = images.pop().expect("three images");

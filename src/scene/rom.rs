@@ -54,10 +54,29 @@ pub fn value_bits(v: usize) -> u32 {
 
 /// The three layouts for a scene; widths depend on n, m and the scene's table sizes.
 pub fn layouts(scene: &Scene) -> [Layout; 3] {
-    let (n, m) = (scene.params.n, scene.params.m);
+    let max_count = scene
+        .bih
+        .nodes
+        .iter()
+        .map(|x| if let Node::Leaf { count, .. } = x { *count as usize } else { 0 })
+        .max()
+        .unwrap_or(0);
+    layouts_for(
+        scene.params.n,
+        scene.params.m,
+        scene.tris.len(),
+        scene.bih.nodes.len(),
+        scene.bih.leaf_tris.len().max(1),
+        value_bits(max_count),
+    )
+}
+
+/// The layouts for `tris` triangles, `nodes` BIH nodes and `leaf_entries` leaf-table words,
+/// with `count_bits` bits for a leaf's triangle count.
+pub fn layouts_for(n: u32, m: u32, tris: usize, nodes: usize, leaf_entries: usize, count_bits: u32) -> [Layout; 3] {
     let tri = Layout::build(
         "tri",
-        scene.tris.len(),
+        tris,
         &[
             ("r", 2, false),
             ("pp", n, false),
@@ -71,29 +90,21 @@ pub fn layouts(scene: &Scene) -> [Layout; 3] {
             ("e2q", m, true),
         ],
     );
-    let node_bits = addr_bits(scene.bih.nodes.len());
-    let leaf_bits = addr_bits(scene.bih.leaf_tris.len().max(1));
-    let max_count = scene
-        .bih
-        .nodes
-        .iter()
-        .map(|x| if let Node::Leaf { count, .. } = x { *count as usize } else { 0 })
-        .max()
-        .unwrap_or(0);
-    let count_bits = value_bits(max_count);
+    let node_bits = addr_bits(nodes);
+    let leaf_bits = addr_bits(leaf_entries);
     // Inner and leaf nodes share one word; the leaf fields overlay clip0/clip1/child.
     let inner_bits = 2 * n + node_bits;
     let leaf_fields = leaf_bits + count_bits;
     let pad = inner_bits.max(leaf_fields);
     let mut node = Layout::build(
         "node",
-        scene.bih.nodes.len(),
+        nodes,
         &[("axis", 2, false), ("clip0", n, false), ("clip1", n, false), ("child", node_bits, false)],
     );
     node.fields.push(Field { name: "first", lsb: 2, width: leaf_bits, signed: false });
     node.fields.push(Field { name: "count", lsb: 2 + leaf_bits, width: count_bits, signed: false });
     node.width = 2 + pad;
-    let leaf = Layout::build("leaf", scene.bih.leaf_tris.len().max(1), &[("tri", addr_bits(scene.tris.len()), false)]);
+    let leaf = Layout::build("leaf", leaf_entries, &[("tri", addr_bits(tris), false)]);
     [tri, node, leaf]
 }
 
