@@ -61,10 +61,7 @@ pub fn core_cost(roms: &SceneRoms) -> crate::error::Result<CoreCost> {
     let p = CoreParams::new(roms, 20, 1);
     p.check()?;
     let core = core_module(&p, roms);
-    let rom_bits = [&roms.tri, &roms.node, &roms.leaf]
-        .iter()
-        .map(|(l, w)| l.width as u64 * crate::rtl::emit::rom_depth(w.len()) as u64)
-        .sum();
+    let rom_bits = roms.rom_bits();
     Ok(CoreCost {
         div_latency: crate::cores::divider::latency(p.isect.n, 1),
         isect_latency: p.isect.latency(),

@@ -56,12 +56,9 @@ impl CoreParams {
     /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM (each ROM rounded up
     /// to a power-of-two depth, as the printers emit it).
     pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
-        let bits = |(l, w): &(crate::scene::rom::Layout, Vec<crate::scene::rom::Word>)| {
-            l.width as u64 * crate::rtl::emit::rom_depth(w.len()) as u64
-        };
         let stack =
             (self.trav.n as u64 * 2 + 6 + 32) * crate::rtl::emit::rom_depth(self.trav.stack_depth as usize) as u64;
-        let total = bits(&scene.tri) + bits(&scene.node) + bits(&scene.leaf) + stack;
+        let total = scene.rom_bits() + stack;
         if total > bram_kbits * 1024 {
             return Err(crate::error::Error::param(
                 "bram-kbits",

@@ -77,6 +77,14 @@ impl SceneRoms {
         self.tri.1.len()
     }
 
+    /// Bits of the three ROMs as printed (each rounded up to a power-of-two depth).
+    pub fn rom_bits(&self) -> u64 {
+        [&self.tri, &self.node, &self.leaf]
+            .iter()
+            .map(|(l, w)| l.width as u64 * crate::rtl::emit::rom_depth(w.len()) as u64)
+            .sum()
+    }
+
     /// Reads scene.json and tri.hex, node.hex, leaf.hex from `dir`.
     pub fn load(dir: &Path) -> Result<SceneRoms> {
         let json_path = dir.join("scene.json");
