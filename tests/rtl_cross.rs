@@ -66,6 +66,9 @@ fn all_ops() -> Module {
     // Registers: a plain pipeline stage, one with enable and reset, and a ROM read.
     let r1 = m.delay("r1", ak);
     out(&mut m, "o_r1", r1);
+    // A delay line: a shift register of five words.
+    let dl = m.delay_line("tag_late", wide, 5);
+    out(&mut m, "o_tag_late", dl);
     let acc = m.reg("acc", Ty::u(7), Some(5));
     let accn = m.add("acc_next", acc, c);
     m.connect(acc, accn, Some(sel));

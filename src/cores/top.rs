@@ -16,11 +16,11 @@ use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
 use super::traverse::{TraverseParams, field, traverse_core, word_bits};
 use crate::model::golden::GridRay;
-use crate::rtl::emit::rom_addr_bits;
 use crate::rtl::width::MAX_WIDTH;
 use crate::rtl::{Module, Sig, Ty};
 use crate::scene::images::SceneRoms;
 use crate::scene::rom::Field;
+use crate::scene::rom::rom_addr_bits;
 use std::rc::Rc;
 
 #[derive(Clone, Debug)]
@@ -57,7 +57,7 @@ impl CoreParams {
     /// to a power-of-two depth, as the printers emit it).
     pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
         let stack =
-            (self.trav.n as u64 * 2 + 6 + 32) * crate::rtl::emit::rom_depth(self.trav.stack_depth as usize) as u64;
+            (self.trav.n as u64 * 2 + 6 + 32) * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64;
         let total = scene.rom_bits() + stack;
         if total > bram_kbits * 1024 {
             return Err(crate::error::Error::param(

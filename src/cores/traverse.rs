@@ -20,9 +20,9 @@
 //! cycle the FSM enters `node`. One plane-distance unit (one multiplier) serves all states.
 
 use super::intersect::{as_signed_wider, pick};
-use crate::rtl::emit::rom_addr_bits;
 use crate::rtl::{Module, Sig, Ty, UnOp};
 use crate::scene::images::SceneRoms;
+use crate::scene::rom::rom_addr_bits;
 use crate::scene::rom::{self, Field, Layout, Word};
 
 pub const IDLE: i128 = 0;

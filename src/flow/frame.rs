@@ -76,7 +76,7 @@ fn port(m: &Module, name: &str) -> crate::rtl::Sig {
 pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Module {
     let mut m = Module::new("fxrt_frame");
     let count = rays.len().max(1);
-    let bits = crate::rtl::emit::rom_addr_bits(count + 1);
+    let bits = crate::scene::rom::rom_addr_bits(count + 1);
     let idx = m.reg("ray_index", Ty::u(bits), Some(0));
     let started = m.reg("started", Ty::BIT, Some(0));
     let one_bit = m.konst("one", Ty::BIT, 1);
@@ -90,7 +90,7 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Mo
     let inc = m.add("index_inc", idx, one);
     let idx_next = m.mux("index_next", fire, inc, idx);
     m.connect(idx, idx_next, None);
-    let addr = m.resize("ray_addr", idx_next, crate::rtl::emit::rom_addr_bits(count));
+    let addr = m.resize("ray_addr", idx_next, crate::scene::rom::rom_addr_bits(count));
     let values: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)).collect();
     let mut ins = vec![valid];
     for (k, (name, ty)) in core_inputs(p).iter().enumerate().skip(1) {

@@ -74,6 +74,16 @@ impl Builder {
                 }
                 Def::Wire(d) => Global::Alias(g(d.expect("checked")).0 as usize),
                 Def::RomRead { rom, addr } => Global::Real(Def::RomRead { rom: mem_base + rom, addr: g(*addr) }, s.ty),
+                // A chain of plain registers: depth − 1 new signals, the last one this signal.
+                Def::DelayLine { src, depth } => {
+                    let mut prev = g(*src);
+                    for _ in 1..*depth {
+                        let reg = Def::Reg { next: Some(prev), enable: None, reset: None };
+                        self.signals.push(Global::Real(reg, s.ty));
+                        prev = SigId((self.signals.len() - 1) as u32);
+                    }
+                    Global::Real(Def::Reg { next: Some(prev), enable: None, reset: None }, s.ty)
+                }
                 other => Global::Real(other.map_ids(g), s.ty),
             };
         }

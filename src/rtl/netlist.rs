@@ -57,6 +57,12 @@ pub enum Def {
         rom: usize,
         addr: SigId,
     },
+    /// `src` delayed by `depth` ≥ 1 clock cycles: a shift register with no enable or reset (a
+    /// tag riding beside a pipeline). Printed as one array, simulated as `depth` registers.
+    DelayLine {
+        src: SigId,
+        depth: u32,
+    },
 }
 
 impl Def {
@@ -73,7 +79,12 @@ impl Def {
             }
             Def::Concat(parts) => parts.clone(),
             Def::Wire(d) => d.iter().copied().collect(),
-            Def::Input | Def::Const(_) | Def::InstOut { .. } | Def::Reg { .. } | Def::RomRead { .. } => Vec::new(),
+            Def::Input
+            | Def::Const(_)
+            | Def::InstOut { .. }
+            | Def::Reg { .. }
+            | Def::RomRead { .. }
+            | Def::DelayLine { .. } => Vec::new(),
         }
     }
 
@@ -93,6 +104,7 @@ impl Def {
             Def::InstOut { inst, port } => Def::InstOut { inst: *inst, port: *port },
             Def::Reg { next, enable, reset } => Def::Reg { next: next.map(&f), enable: enable.map(&f), reset: *reset },
             Def::RomRead { rom, addr } => Def::RomRead { rom: *rom, addr: f(*addr) },
+            Def::DelayLine { src, depth } => Def::DelayLine { src: f(*src), depth: *depth },
         }
     }
 }
@@ -102,6 +114,28 @@ pub struct Signal {
     pub name: String,
     pub ty: Ty,
     pub def: Def,
+    /// The block (pipeline stage, state machine) this signal belongs to, an index into
+    /// `Module::blocks`: it changes only how the printers lay the design out and comment it.
+    pub block: Option<usize>,
+}
+
+/// A named part of a module, for the printers: the signals of a pipeline stage or a state
+/// machine are printed together, in their own process, under a comment.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Block {
+    pub name: String,
+    /// One line saying what the block does (printed as a comment).
+    pub doc: String,
+    pub kind: BlockKind,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BlockKind {
+    /// A pipeline stage: its registers load together every clock.
+    Stage,
+    /// A state machine: `state` is its state register; state k (k = its encoding) is named
+    /// `states[k]`.
+    Fsm { state: SigId, states: Vec<String> },
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -133,6 +167,9 @@ pub struct Module {
     pub outputs: Vec<(String, SigId)>,
     pub roms: Vec<Rom>,
     pub instances: Vec<Instance>,
+    pub blocks: Vec<Block>,
+    /// The block new signals are put in (`begin_block` … `end_block`).
+    pub current_block: Option<usize>,
 }
 
 impl Module {
@@ -144,7 +181,21 @@ impl Module {
             outputs: Vec::new(),
             roms: Vec::new(),
             instances: Vec::new(),
+            blocks: Vec::new(),
+            current_block: None,
         }
+    }
+
+    /// Opens a block: signals created until `end_block` belong to it. Returns its index.
+    pub fn begin_block(&mut self, name: &str, doc: &str, kind: BlockKind) -> usize {
+        assert!(self.current_block.is_none(), "{}: block {name} opened inside another", self.name);
+        self.blocks.push(Block { name: names::legal(name), doc: doc.to_string(), kind });
+        self.current_block = Some(self.blocks.len() - 1);
+        self.blocks.len() - 1
+    }
+
+    pub fn end_block(&mut self) {
+        self.current_block = None;
     }
 
     pub fn sig(&self, id: SigId) -> &Signal {
@@ -174,7 +225,7 @@ impl Module {
     fn push(&mut self, name: &str, ty: Ty, def: Def) -> Sig {
         let name = self.unique_name(name);
         let id = SigId(self.signals.len() as u32);
-        self.signals.push(Signal { name, ty, def });
+        self.signals.push(Signal { name, ty, def, block: self.current_block });
         Sig { id, ty }
     }
 
@@ -241,6 +292,15 @@ impl Module {
         r
     }
 
+    /// `src` delayed by `depth` clock cycles (`src` itself for 0; a register for 1).
+    pub fn delay_line(&mut self, name: &str, src: Sig, depth: u32) -> Sig {
+        match depth {
+            0 => src,
+            1 => self.delay(name, src),
+            _ => self.push(name, src.ty, Def::DelayLine { src: src.id, depth }),
+        }
+    }
+
     pub fn rom(&mut self, name: &str, width: u32, words: Vec<u128>) -> usize {
         let name = self.unique_name(name);
         assert!(!words.is_empty());
@@ -254,13 +314,13 @@ impl Module {
     }
 
     pub fn ram_write(&mut self, mem: usize, we: Sig, addr: Sig, data: Sig) {
-        let bits = super::emit::rom_addr_bits(self.roms[mem].words.len());
+        let bits = crate::scene::rom::rom_addr_bits(self.roms[mem].words.len());
         assert_eq!(we.ty, Ty::BIT, "{}: write enable must be 1 bit", self.name);
         assert_eq!(addr.ty, Ty::u(bits), "{}: RAM {} takes a {bits}-bit address", self.name, self.roms[mem].name);
         assert_eq!(data.ty, Ty::u(self.roms[mem].width), "{}: RAM {} data type", self.name, self.roms[mem].name);
         assert!(self.roms[mem].write.is_none(), "{}: RAM {} has one write port", self.name, self.roms[mem].name);
         // Padded to the power of two the printers use, so every address is a real word.
-        let depth = super::emit::rom_depth(self.roms[mem].words.len());
+        let depth = crate::scene::rom::rom_depth(self.roms[mem].words.len());
         self.roms[mem].words.resize(depth, 0);
         self.roms[mem].write = Some((we.id, addr.id, data.id));
     }
@@ -268,7 +328,7 @@ impl Module {
     pub fn rom_read(&mut self, name: &str, rom: usize, addr: Sig) -> Sig {
         let w = self.roms[rom].width;
         // The printers pad the ROM to a power of two; the address covers exactly that.
-        let bits = super::emit::rom_addr_bits(self.roms[rom].words.len());
+        let bits = crate::scene::rom::rom_addr_bits(self.roms[rom].words.len());
         assert_eq!(
             addr.ty,
             Ty::u(bits),
@@ -293,8 +353,15 @@ impl Module {
 
     /// Register bits, instances included.
     pub fn register_bits(&self) -> u64 {
-        let own: u64 =
-            self.signals.iter().filter(|s| matches!(s.def, Def::Reg { .. })).map(|s| s.ty.width as u64).sum();
+        let own: u64 = self
+            .signals
+            .iter()
+            .map(|s| match s.def {
+                Def::Reg { .. } => s.ty.width as u64,
+                Def::DelayLine { depth, .. } => s.ty.width as u64 * depth as u64,
+                _ => 0,
+            })
+            .sum();
         own + self.instances.iter().map(|i| i.module.register_bits()).sum::<u64>()
     }
 

@@ -81,7 +81,7 @@ impl SceneRoms {
     pub fn rom_bits(&self) -> u64 {
         [&self.tri, &self.node, &self.leaf]
             .iter()
-            .map(|(l, w)| l.width as u64 * crate::rtl::emit::rom_depth(w.len()) as u64)
+            .map(|(l, w)| l.width as u64 * crate::scene::rom::rom_depth(w.len()) as u64)
             .sum()
     }
 

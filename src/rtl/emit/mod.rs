@@ -5,17 +5,7 @@
 pub mod verilog;
 pub mod vhdl;
 
-/// ROM depth as printed: the next power of two (at least 2, as the address has at least one
-/// bit), padded with zero words, so every address of the port is in range (the simulator
-/// reads 0 beyond the end too).
-pub fn rom_depth(words: usize) -> usize {
-    words.next_power_of_two().max(2)
-}
-
-/// Bits needed to address a ROM of `words` words.
-pub fn rom_addr_bits(words: usize) -> u32 {
-    rom_depth(words).trailing_zeros().max(1)
-}
+use crate::scene::rom::rom_depth;
 
 /// The bits of `v` as a string of width `w`, most significant first.
 pub fn bit_string(v: u128, w: u32) -> String {
@@ -47,16 +37,4 @@ pub fn design_files(top: &crate::rtl::Module, ext: &str) -> Vec<(String, String)
 /// Whether a file of `design_files` is HDL source (not memory contents).
 pub fn is_source(file: &str) -> bool {
     file.ends_with(".v") || file.ends_with(".vhd")
-}
-
-#[cfg(test)]
-mod tests {
-    /// A one-word memory still has a one-bit address, so it is printed with two words.
-    #[test]
-    fn every_address_is_a_word() {
-        for words in [1usize, 2, 3, 4, 5, 1000] {
-            assert_eq!(super::rom_depth(words), 1 << super::rom_addr_bits(words), "{words}");
-            assert!(super::rom_depth(words) >= words);
-        }
-    }
 }

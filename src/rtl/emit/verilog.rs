@@ -86,6 +86,18 @@ pub fn print(m: &Module) -> String {
             Def::RomRead { .. } => {
                 let _ = writeln!(s, "  reg {} {} = {};", decl(sig.ty), sig.name, literal(sig.ty, 0));
             }
+            // A shift register: an array of `depth` words powering up at 0, the output its last.
+            Def::DelayLine { depth, .. } => {
+                let n = &sig.name;
+                let _ = writeln!(s, "  reg {} {n}_sr [1:{depth}];", decl(sig.ty));
+                let _ = writeln!(s, "  integer {n}_i;");
+                let _ = writeln!(
+                    s,
+                    "  initial for ({n}_i = 1; {n}_i <= {depth}; {n}_i = {n}_i + 1) {n}_sr[{n}_i] = {};",
+                    literal(sig.ty, 0)
+                );
+                let _ = writeln!(s, "  wire {} {n};", decl(sig.ty));
+            }
             // A case is a combinational `always` block, so its target is a `reg`.
             Def::Case { .. } => {
                 let _ = writeln!(s, "  reg {} {};", decl(sig.ty), sig.name);
@@ -100,6 +112,7 @@ pub fn print(m: &Module) -> String {
         let expr = match &sig.def {
             Def::Input | Def::Const(_) | Def::Reg { .. } | Def::RomRead { .. } | Def::InstOut { .. } => continue,
             Def::Wire(d) => name(d.expect("checked")).to_string(),
+            Def::DelayLine { depth, .. } => format!("{}_sr[{depth}]", sig.name),
             Def::Case { sel, arms, default } => {
                 let w = ty(*sel).width;
                 let _ = writeln!(s, "  always @* begin\n    case ({})", name(*sel));
@@ -166,7 +179,11 @@ pub fn print(m: &Module) -> String {
         map.extend(outs);
         let _ = writeln!(s, "  {} {} (\n    {}\n  );", sub.name, inst.name, map.join(",\n    "));
     }
-    let state: Vec<_> = m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
+    let state: Vec<_> = m
+        .signals
+        .iter()
+        .filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. } | Def::DelayLine { .. }))
+        .collect();
     let has_writes = m.roms.iter().any(|r| r.write.is_some());
     if !state.is_empty() || has_writes {
         s.push_str("  always @(posedge clk) begin\n");
@@ -195,6 +212,14 @@ pub fn print(m: &Module) -> String {
                 }
                 Def::RomRead { rom, addr } => {
                     let _ = writeln!(s, "    {} <= {}[{}];", sig.name, m.roms[*rom].name, name(*addr));
+                }
+                Def::DelayLine { src, depth } => {
+                    let n = &sig.name;
+                    let _ = writeln!(
+                        s,
+                        "    for ({n}_i = {depth}; {n}_i > 1; {n}_i = {n}_i - 1) {n}_sr[{n}_i] <= {n}_sr[{n}_i - 1];\n    {n}_sr[1] <= {};",
+                        name(*src)
+                    );
                 }
                 _ => unreachable!("filtered to state"),
             }

@@ -77,6 +77,12 @@ pub fn print(m: &Module) -> String {
             Def::RomRead { .. } => {
                 let _ = writeln!(s, "  signal {} : {} := (others => '0');", sig.name, vtype(sig.ty));
             }
+            // A shift register: an array of `depth` words, the output its last.
+            Def::DelayLine { depth, .. } => {
+                let _ = writeln!(s, "  type {}_sr_t is array (1 to {depth}) of {};", sig.name, vtype(sig.ty));
+                let _ = writeln!(s, "  signal {}_sr : {}_sr_t := (others => (others => '0'));", sig.name, sig.name);
+                let _ = writeln!(s, "  signal {} : {};", sig.name, vtype(sig.ty));
+            }
             Def::Bin(..)
             | Def::Un(..)
             | Def::Mux { .. }
@@ -93,6 +99,7 @@ pub fn print(m: &Module) -> String {
         let expr = match &sig.def {
             Def::Input | Def::Const(_) | Def::Reg { .. } | Def::RomRead { .. } | Def::InstOut { .. } => continue,
             Def::Wire(d) => name(d.expect("checked")).to_string(),
+            Def::DelayLine { depth, .. } => format!("{}_sr({depth})", sig.name),
             Def::Case { sel, arms, default } => {
                 // A selected signal assignment: VHDL-93's concurrent `case`.
                 let w = ty(*sel).width;
@@ -162,8 +169,11 @@ pub fn print(m: &Module) -> String {
         let _ =
             writeln!(s, "\n  {} : {}\n    port map (\n      {}\n    );", inst.name, sub.name, map.join(",\n      "));
     }
-    let state: Vec<&crate::rtl::netlist::Signal> =
-        m.signals.iter().filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. })).collect();
+    let state: Vec<&crate::rtl::netlist::Signal> = m
+        .signals
+        .iter()
+        .filter(|x| matches!(x.def, Def::Reg { .. } | Def::RomRead { .. } | Def::DelayLine { .. }))
+        .collect();
     let has_writes = m.roms.iter().any(|r| r.write.is_some());
     if !state.is_empty() || has_writes {
         s.push_str("\n  clocked : process (clk)\n  begin\n    if rising_edge(clk) then\n");
@@ -206,6 +216,15 @@ pub fn print(m: &Module) -> String {
                 }
                 Def::RomRead { rom, addr } => {
                     let _ = writeln!(s, "      {} <= {}(to_integer({}));", sig.name, m.roms[*rom].name, name(*addr));
+                }
+                Def::DelayLine { src, depth } => {
+                    let _ = writeln!(
+                        s,
+                        "      {n}_sr(2 to {depth}) <= {n}_sr(1 to {});\n      {n}_sr(1) <= {};",
+                        depth - 1,
+                        name(*src),
+                        n = sig.name
+                    );
                 }
                 _ => unreachable!("filtered to state"),
             }
