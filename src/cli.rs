@@ -2,8 +2,8 @@
 //! validated into the library's types before anything runs or any file is written.
 
 use crate::error::{Error, Result};
+use crate::model::camera::{Camera, CameraSpec};
 use crate::params::{EdgeShift, Params};
-use crate::render::camera::{Camera, CameraSpec};
 use crate::render::tracer::ModelKind;
 use crate::scene::SceneSource;
 use clap::{Args, Parser, Subcommand};

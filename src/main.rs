@@ -154,7 +154,7 @@ fn run_bench(a: BenchArgs) -> Result<()> {
     }
     let pool = thread_pool(Some(a.threads))?;
     let scene = Scene::load(&scene::SceneSource::Builtin("teapot".into()), &fxrt::params::Params::default())?;
-    let cam = render::camera::Camera::default_for(&scene, a.size.0, a.size.1);
+    let cam = fxrt::model::camera::Camera::default_for(&scene, a.size.0, a.size.1);
     let golden = tracer::make_tracer(&scene, tracer::ModelKind::Golden);
     let mut best = f64::INFINITY;
     let mut rays = 0;

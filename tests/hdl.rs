@@ -161,7 +161,7 @@ fn whole_core_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
     let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &SMALL).unwrap();
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::new(&roms, 12, 1);
-    let mut cam = fxrt::render::camera::Camera::default_for(&scene, 32, 24);
+    let mut cam = fxrt::model::camera::Camera::default_for(&scene, 32, 24);
     cam.eye = [278.0, 273.0, 60.0];
     let generator = fxrt::model::raygen::RayGen::new(&scene, &cam).unwrap();
     lint_and_ghdl_synth(&core_with_raygen(&p, &roms, &generator), "whole_core_raygen_tools");

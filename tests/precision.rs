@@ -3,10 +3,10 @@
 
 mod common;
 
+use fxrt::model::camera::Camera;
 use fxrt::model::golden::Golden;
 use fxrt::model::ray::{dot, quantize_ray};
 use fxrt::params::Params;
-use fxrt::render::camera::Camera;
 use fxrt::render::tracer::{GoldenTracer, ModelKind, make_tracer};
 use fxrt::render::{compare, render};
 

@@ -2,9 +2,9 @@
 //! triangles their traversal visits, and edge cases. Expected results come from
 //! `Golden::intersect`; the generated HDL must reproduce them bit for bit.
 
+use crate::model::camera::Camera;
 use crate::model::golden::{Golden, GridRay, TriHit};
 use crate::model::ray::{quantize_direction, quantize_ray};
-use crate::render::camera::Camera;
 use crate::rng::SplitMix64;
 use crate::scene::Scene;
 use crate::scene::accel::AccelTri;

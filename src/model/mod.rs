@@ -1,5 +1,6 @@
 //! The models: the bit-exact golden integer model and the float references it is measured by.
 
+pub mod camera;
 pub mod float;
 pub mod golden;
 pub mod ray;

@@ -319,7 +319,7 @@ mod tests {
     fn quantize_ray8_is_quantize_ray() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
         let g = Golden::new(&scene);
-        let (lo, hi) = crate::render::camera::world_bounds(&scene);
+        let (lo, hi) = crate::model::camera::world_bounds(&scene);
         let mut seed = 3u64;
         let mut rand = move || {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);

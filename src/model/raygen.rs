@@ -6,8 +6,8 @@
 //! arithmetic allows: t is then measured in units of |d| ≥ its largest component. The
 //! reciprocals are `Golden::reciprocal`'s. `cores::raygen` computes exactly this.
 
+use super::camera::Camera;
 use super::golden::{Golden, GridRay};
-use crate::render::camera::Camera;
 use crate::scene::Scene;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

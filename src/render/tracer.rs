@@ -445,8 +445,8 @@ mod packet {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::camera::Camera;
     use crate::params::Params;
-    use crate::render::camera::Camera;
     use crate::scene::SceneSource;
     use crate::scene::builtin::BUILTIN_NAMES;
 
@@ -474,7 +474,7 @@ mod tests {
                 let tracer = GoldenTracer::new(&scene);
                 assert!(tracer.golden.fast_scene(&scene).is_some(), "{name}: the i64 path should apply");
                 let cam = Camera::default_for(&scene, 48, 48);
-                let (lo, hi) = crate::render::camera::world_bounds(&scene);
+                let (lo, hi) = crate::model::camera::world_bounds(&scene);
                 let pixels = cam.pixel_rays();
                 let mut hits = 0;
                 for py in 0..cam.height {

@@ -18,7 +18,7 @@ pub mod summary;
 
 use crate::error::{Error, Result};
 use crate::params::{EdgeShift, Params};
-pub use crate::render::camera::CameraSpec;
+pub use crate::model::camera::CameraSpec;
 use crate::scene::SceneSource;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;

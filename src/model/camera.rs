@@ -1,5 +1,5 @@
-//! The pinhole camera of `fxrt render`, exactly as the issue specifies it: fov is vertical in
-//! degrees, py = 0 is the top row, and
+//! The pinhole camera of `fxrt render` and of the on-chip ray generator, as the issue
+//! specifies it: fov is vertical in degrees, py = 0 is the top row, and
 //! sx = (2(px+0.5)/W − 1)·tan(fov/2)·W/H, sy = (1 − 2(py+0.5)/H)·tan(fov/2),
 //! f = norm(at − eye), r = norm(f × up), u = r × f, dir = norm(f + sx·r + sy·u).
 
