@@ -6,6 +6,7 @@ pub mod emit;
 pub mod flatten;
 pub mod names;
 pub mod netlist;
+pub mod random;
 pub mod sim;
 pub mod width;
 

@@ -1,7 +1,8 @@
 //! Emitted identifiers: legal in VHDL-93 and Verilog-2001 at once, readable, stable.
 
-/// Names no emitted identifier may take: VHDL-93 and Verilog-2001 keywords, and the ports the
-/// printers add themselves (`clk`, `rst`).
+/// Names no emitted identifier may take: VHDL-93 and Verilog-2001 keywords, the names of
+/// the library functions and types the VHDL printer calls (a signal named `resize` hides
+/// numeric_std's `resize`), and the ports the printers add themselves (`clk`, `rst`).
 const RESERVED: &str = "
 abs access after alias all always and architecture array assert assign attribute begin block body
 buf buffer bufif0 bufif1 bus case casex casez clk cmos component configuration constant deassign
@@ -15,7 +16,10 @@ range rcmos real record reg register reject release rem repeat report return rnm
 scalared select severity shared signal signed sla sll small specify sra srl strong0 strong1 subtype
 supply0 supply1 table task then time to tran transport tri tri0 tri1 triand trior trireg type
 unaffected units unsigned until use variable vectored wait wand weak0 weak1 when while wire with wor
-xnor xor";
+xnor xor
+ieee std work numeric_std std_logic_1164 std_logic std_logic_vector std_ulogic boolean natural
+resize shift_left shift_right rotate_left rotate_right to_integer to_signed to_unsigned
+rising_edge falling_edge";
 
 pub fn is_reserved(s: &str) -> bool {
     RESERVED.split_whitespace().any(|w| w == s)

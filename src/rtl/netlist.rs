@@ -5,7 +5,7 @@
 //! state. Widths come from `width.rs`.
 
 use super::names;
-use super::width::{BinOp, Ty, UnOp, bin_ty, un_ty};
+use super::width::{BinOp, Ty, UnOp, bin_ty, case_arm, eval_bin, eval_concat, eval_mux, eval_un, un_ty};
 use std::rc::Rc;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -85,6 +85,27 @@ impl Def {
             | Def::Reg { .. }
             | Def::RomRead { .. }
             | Def::DelayLine { .. } => Vec::new(),
+        }
+    }
+
+    /// The value of a combinational definition from its operands' bit patterns (in
+    /// `comb_inputs` order, with their types) and the result type: the meaning of every
+    /// operator, by the rules of `width.rs`.
+    pub fn eval(&self, tys: &[Ty], bits: &[u128], tr: Ty) -> u128 {
+        match self {
+            Def::Bin(op, ..) => eval_bin(*op, tys[0], bits[0], tys[1], bits[1], tr),
+            Def::Un(op, _) => eval_un(*op, tys[0], bits[0], tr),
+            Def::Mux { .. } => eval_mux(bits[0], bits[1], bits[2]),
+            // comb_inputs order: sel, default, arms…
+            Def::Case { arms, .. } => case_arm(bits[0], arms.iter().map(|a| a.0)).map_or(bits[1], |k| bits[2 + k]),
+            Def::Concat(_) => eval_concat(tys.iter().map(|t| t.width).zip(bits.iter().copied())),
+            Def::Wire(_) => bits[0],
+            Def::Input
+            | Def::Const(_)
+            | Def::InstOut { .. }
+            | Def::Reg { .. }
+            | Def::RomRead { .. }
+            | Def::DelayLine { .. } => panic!("not combinational: {self:?}"),
         }
     }
 

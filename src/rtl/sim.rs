@@ -3,7 +3,7 @@
 
 use super::flatten::flatten;
 use super::netlist::{Def, Module, Sig, SigId};
-use super::width::{BinOp, Ty, UnOp, eval_bin, eval_un};
+use super::width::{BinOp, Ty, UnOp, case_arm, eval_bin, eval_concat, eval_mux, eval_un};
 
 #[derive(Clone, Debug)]
 enum Op {
@@ -119,18 +119,11 @@ impl Sim {
             match *op {
                 Op::Bin { op, dst, a, b, ta, tb, tr } => v[dst] = eval_bin(op, ta, v[a], tb, v[b], tr),
                 Op::Un { op, dst, a, ta, tr } => v[dst] = eval_un(op, ta, v[a], tr),
-                Op::Mux { dst, sel, t, f } => v[dst] = if v[sel] & 1 == 1 { v[t] } else { v[f] },
+                Op::Mux { dst, sel, t, f } => v[dst] = eval_mux(v[sel], v[t], v[f]),
                 Op::Case { dst, sel, ref arms, default } => {
-                    let s = v[sel];
-                    v[dst] = v[arms.iter().find(|a| a.0 == s).map_or(default, |a| a.1)];
+                    v[dst] = v[case_arm(v[sel], arms.iter().map(|a| a.0)).map_or(default, |k| arms[k].1)];
                 }
-                Op::Concat { dst, ref parts } => {
-                    let mut acc = 0u128;
-                    for &(p, w) in parts {
-                        acc = if w >= 128 { v[p] } else { (acc << w) | v[p] };
-                    }
-                    v[dst] = acc;
-                }
+                Op::Concat { dst, ref parts } => v[dst] = eval_concat(parts.iter().map(|&(p, w)| (w, v[p]))),
             }
         }
     }

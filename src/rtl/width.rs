@@ -1,5 +1,8 @@
 //! Width and sign rules, written once. The builder asks these functions for the type of every
-//! node, the simulator and constant folding use `eval`, and the printers never compute a width.
+//! node; the value of every operator is defined here (`eval_bin`, `eval_un`, `eval_mux`,
+//! `case_arm`, `eval_concat`, gathered per netlist node by `Def::eval`), which the cycle
+//! simulator and constant folding call and the batched simulator's specialised kernels are
+//! checked against (tests/rtl_agree.rs); the printers never compute a width.
 //!
 //! Values are bit patterns in a u128, masked to their width; a signed value is two's
 //! complement. Operators that grow their result have their own names (`Mul` gives wa + wb
@@ -180,6 +183,27 @@ pub fn eval_un(op: UnOp, ta: Ty, a: u128, tr: Ty) -> u128 {
         Resize(_) => tr.wrap(ta.value(a)),
         AsSigned | AsUnsigned => a,
     }
+}
+
+/// A 2-way mux: `t` when bit 0 of `sel` is 1.
+#[inline]
+pub fn eval_mux(sel: u128, t: u128, f: u128) -> u128 {
+    if sel & 1 == 1 { t } else { f }
+}
+
+/// The arm a `case` takes: the first whose pattern equals the selector's **bit pattern**
+/// (whatever the selector's signedness: a signed 2-bit −1 is pattern 3), else None (the
+/// default). VHDL's `with … select` on bit strings and Verilog's `case` on sized literals
+/// compare the same way.
+#[inline]
+pub fn case_arm(sel_bits: u128, mut patterns: impl Iterator<Item = u128>) -> Option<usize> {
+    patterns.position(|p| p == sel_bits)
+}
+
+/// A concatenation of (width, bits) parts, most significant first; unsigned.
+#[inline]
+pub fn eval_concat(parts: impl Iterator<Item = (u32, u128)>) -> u128 {
+    parts.fold(0u128, |acc, (w, v)| if w >= 128 { v } else { (acc << w) | v })
 }
 
 #[cfg(test)]

@@ -1,11 +1,12 @@
 //! The evaluation kernels of the batched simulator, on extended integers (a value of type t
 //! held as its two's-complement integer): i64 loops for signals up to 64 bits, i128 loops
-//! beyond, a per-value form for state machines, and the bit-pattern form through `width.rs`
-//! for everything else. Unsigned 64- and 128-bit values do not fit their lanes as extended
+//! beyond, a per-value form for state machines, and `Def::eval` (the definition, on bit
+//! patterns) for everything else. The kernels are checked against `Def::eval` on random
+//! netlists (tests/rtl_agree.rs). Unsigned 64- and 128-bit values do not fit their lanes as extended
 //! integers and always take the wider or the general path.
 
 use crate::rtl::netlist::Def;
-use crate::rtl::width::{BinOp, Ty, UnOp, eval_bin, eval_un};
+use crate::rtl::width::{BinOp, Ty, UnOp};
 
 /// `x` wrapped to a type of 128 − `sh` bits as an extended integer.
 #[inline(always)]
@@ -60,27 +61,6 @@ pub fn wide_kernel(def: &Def, tys: &[Ty], tr: Ty, s: &[Vec<i128>], o: &mut [i128
         _ => return false,
     }
     true
-}
-
-/// One definition on bit patterns (operands in `comb_inputs` order), by the shared rules.
-pub fn eval_bits(def: &Def, tys: &[Ty], b: &[u128], tr: Ty) -> u128 {
-    match def {
-        Def::Bin(op, ..) => eval_bin(*op, tys[0], b[0], tys[1], b[1], tr),
-        Def::Un(op, _) => eval_un(*op, tys[0], b[0], tr),
-        Def::Mux { .. } => {
-            if b[0] & 1 == 1 {
-                b[1]
-            } else {
-                b[2]
-            }
-        }
-        // comb_inputs order: sel, default, arms…
-        Def::Case { arms, .. } => arms.iter().position(|a| a.0 == b[0]).map_or(b[1], |k| b[2 + k]),
-        Def::Concat(_) => {
-            tys.iter().zip(b).fold(0u128, |acc, (t, v)| if t.width >= 128 { *v } else { (acc << t.width) | v })
-        }
-        other => unreachable!("not combinational: {other:?}"),
-    }
 }
 
 /// `x` wrapped to `t` as an extended integer (t.width ≤ 64).
@@ -138,10 +118,12 @@ pub fn narrow_kernel(def: &Def, tys: &[Ty], tr: Ty, s: &[&[i64]], o: &mut [i64])
                 *o = if c != 0 { x } else { y };
             }
         }
-        // Operands: sel, default, arms…; an unsigned selector's value is its bit pattern.
-        Def::Case { arms, .. } if !tys[0].signed => {
+        // Operands: sel, default, arms…; arms match the selector's bit pattern, also when it
+        // is signed (a signed 2-bit −1 is pattern 3).
+        Def::Case { arms, .. } => {
+            let mask = u64::MAX >> (64 - tys[0].width);
             for (c, o) in o.iter_mut().enumerate() {
-                let sel = s[0][c] as u64 as u128;
+                let sel = (s[0][c] as u64 & mask) as u128;
                 *o = arms.iter().position(|a| a.0 == sel).map_or(s[1][c], |k| s[2 + k][c]);
             }
         }
@@ -165,7 +147,7 @@ pub fn narrow_kernel(def: &Def, tys: &[Ty], tr: Ty, s: &[&[i64]], o: &mut [i64])
 pub fn eval_value(def: &Def, tys: &[Ty], v: &[i128], tr: Ty) -> i128 {
     if tys.iter().chain([&tr]).any(|t| t.width == 128 && !t.signed) {
         let bits: Vec<u128> = tys.iter().zip(v).map(|(t, x)| t.wrap(*x)).collect();
-        return tr.value(eval_bits(def, tys, &bits, tr));
+        return tr.value(def.eval(tys, &bits, tr));
     }
     let (sh, sg) = (128 - tr.width, tr.signed);
     match def {
@@ -203,8 +185,11 @@ pub fn eval_value(def: &Def, tys: &[Ty], v: &[i128], tr: Ty) -> i128 {
                 v[2]
             }
         }
-        // comb_inputs order: sel, default, arms…; a select is narrower than 128 bits.
-        Def::Case { arms, .. } => arms.iter().position(|a| a.0 as i128 == v[0]).map_or(v[1], |k| v[2 + k]),
+        // comb_inputs order: sel, default, arms…; arms match the selector's bit pattern.
+        Def::Case { arms, .. } => {
+            let sel = tys[0].wrap(v[0]);
+            arms.iter().position(|a| a.0 == sel).map_or(v[1], |k| v[2 + k])
+        }
         Def::Concat(_) => {
             let bits = tys
                 .iter()

@@ -22,7 +22,7 @@ mod kernels;
 use super::flatten::flatten;
 use super::netlist::{Def, Module, SigId};
 use super::width::Ty;
-use kernels::{eval_bits, eval_value, narrow_kernel, wide_kernel};
+use kernels::{eval_value, narrow_kernel, wide_kernel};
 
 /// A signal reference: a slot with a buffer, read `delay` cycles late.
 #[derive(Clone, Copy, Debug)]
@@ -484,7 +484,7 @@ impl BatchSim {
                 for (k, ty) in src_tys.iter().enumerate() {
                     bits[k] = ty.wrap(ins[k][c]);
                 }
-                r[c] = tr.value(eval_bits(&op.def, &src_tys, &bits, tr));
+                r[c] = tr.value(op.def.eval(&src_tys, &bits, tr));
             }
         }
         let h = self.hist[op.dst];
