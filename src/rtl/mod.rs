@@ -2,10 +2,13 @@
 //! VHDL and Verilog printers, so the three cannot disagree on a width or a sign.
 
 pub mod batch;
+pub mod build;
 pub mod emit;
 pub mod flatten;
+pub mod fsm;
 pub mod names;
 pub mod netlist;
+pub mod pipeline;
 pub mod random;
 pub mod sim;
 pub mod width;

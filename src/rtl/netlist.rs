@@ -250,6 +250,13 @@ impl Module {
         Sig { id, ty }
     }
 
+    /// Renames a signal (the name made legal and unique).
+    pub fn rename(&mut self, id: SigId, name: &str) {
+        self.signals[id.0 as usize].name.clear();
+        let n = self.unique_name(name);
+        self.signals[id.0 as usize].name = n;
+    }
+
     pub fn input(&mut self, name: &str, ty: Ty) -> Sig {
         let s = self.push(name, ty, Def::Input);
         self.inputs.push(s.id);

@@ -1,0 +1,416 @@
+//! The typed builder: signal handles with operators over the same netlist. A core reads like
+//! the circuit it is — `(plane - o).xmul(inv) >> c`, `tmin.le(near_max)` — while every type
+//! still comes from `width.rs`. Operators that keep the width (`+ - & | ^ ! <<k >>k`, wrapping
+//! like the hardware) use Rust's operators; the ones that grow have their own names (`xmul`,
+//! `xsigned`, `resize`), so growth is always visible. Integer operands are constants typed from
+//! the other operand. Nodes get deterministic, readable names from their operands
+//! (`tmin_lt_tmax`), or a numbered one when that would be long; `name()` gives the name a
+//! person wants. Two constant operands fold into a constant by `Def::eval`.
+
+use super::netlist::{Def, Module, Sig};
+use super::width::{BinOp, Ty, UnOp, bin_ty, un_ty};
+use std::cell::{Cell, RefCell};
+use std::ops;
+use std::rc::Rc;
+
+/// Builds one module. Handles borrow it, so operators need no `&mut`.
+pub struct Builder {
+    m: RefCell<Module>,
+    counter: Cell<u32>,
+}
+
+/// A signal handle: the signal and the builder it belongs to.
+#[derive(Clone, Copy)]
+pub struct S<'b> {
+    pub b: &'b Builder,
+    pub sig: Sig,
+}
+
+impl std::fmt::Debug for S<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {:?}", self.b.name_of(self.sig), self.sig.ty)
+    }
+}
+
+/// Longest operand-derived name; longer ones become `{op}_{k}`.
+const NAME_MAX: usize = 24;
+
+impl Builder {
+    pub fn new(name: &str) -> Builder {
+        Builder { m: RefCell::new(Module::new(name)), counter: Cell::new(0) }
+    }
+
+    /// The finished module (checked: every register and wire is driven).
+    pub fn finish(self) -> Module {
+        let m = self.m.into_inner();
+        m.check().unwrap_or_else(|e| panic!("{e}"));
+        m
+    }
+
+    /// Direct access to the netlist, for what the handles do not cover.
+    pub fn with<R>(&self, f: impl FnOnce(&mut Module) -> R) -> R {
+        f(&mut self.m.borrow_mut())
+    }
+
+    pub fn s(&self, sig: Sig) -> S<'_> {
+        S { b: self, sig }
+    }
+
+    pub fn name_of(&self, s: Sig) -> String {
+        self.m.borrow().sig(s.id).name.clone()
+    }
+
+    /// A name from operand names, or `{op}_{k}` when that would be long.
+    fn auto(&self, op: &str, parts: &[&str]) -> String {
+        let joined = parts.join(&format!("_{op}_"));
+        if !parts.is_empty() && joined.len() <= NAME_MAX {
+            return if parts.len() == 1 { format!("{op}_{joined}") } else { joined };
+        }
+        let k = self.counter.get();
+        self.counter.set(k + 1);
+        format!("{op}_{k}")
+    }
+
+    pub fn input(&self, name: &str, ty: Ty) -> S<'_> {
+        self.s(self.m.borrow_mut().input(name, ty))
+    }
+
+    pub fn output(&self, name: &str, s: S<'_>) {
+        self.m.borrow_mut().output(name, s.sig);
+    }
+
+    /// A constant of type `ty`, named after its value.
+    pub fn konst(&self, ty: Ty, v: i128) -> S<'_> {
+        let name = if v < 0 { format!("k_m{}", v.unsigned_abs()) } else { format!("k_{v}") };
+        self.s(self.m.borrow_mut().konst(&name, ty, v))
+    }
+
+    /// A register of type `ty` (with a synchronous reset value, or none). Its input is given
+    /// by `next`, `next_when`, or a state machine.
+    pub fn reg(&self, name: &str, ty: Ty, reset: Option<i128>) -> S<'_> {
+        self.s(self.m.borrow_mut().reg(name, ty, reset))
+    }
+
+    /// A wire, driven later with `drive` (combinational feedback).
+    pub fn wire(&self, name: &str, ty: Ty) -> S<'_> {
+        self.s(self.m.borrow_mut().wire(name, ty))
+    }
+
+    pub fn drive(&self, wire: S<'_>, src: S<'_>) {
+        self.m.borrow_mut().drive(wire.sig, src.sig);
+    }
+
+    /// `reg` loads `next` every clock.
+    pub fn next(&self, reg: S<'_>, next: S<'_>) {
+        self.m.borrow_mut().connect(reg.sig, next.sig, None);
+    }
+
+    /// `reg` loads `next` in the clocks where `enable` is 1.
+    pub fn next_when(&self, reg: S<'_>, enable: S<'_>, next: S<'_>) {
+        self.m.borrow_mut().connect(reg.sig, next.sig, Some(enable.sig));
+    }
+
+    /// `x` one clock later, in a register named `name`.
+    pub fn delay(&self, name: &str, x: S<'_>) -> S<'_> {
+        self.s(self.m.borrow_mut().delay(name, x.sig))
+    }
+
+    /// `x` `depth` clocks later (a shift register).
+    pub fn delay_line(&self, name: &str, x: S<'_>, depth: u32) -> S<'_> {
+        self.s(self.m.borrow_mut().delay_line(name, x.sig, depth))
+    }
+
+    /// `sel ? t : f`; `sel` is one bit.
+    pub fn mux<'b>(&'b self, sel: S<'b>, t: S<'b>, f: S<'b>) -> S<'b> {
+        let name = self.auto("mux", &[&self.name_of(sel.sig)]);
+        self.s(self.m.borrow_mut().mux(&name, sel.sig, t.sig, f.sig))
+    }
+
+    /// The arm whose pattern equals `sel`'s bits, else `default`.
+    pub fn case<'b>(&'b self, sel: S<'b>, arms: &[(u128, S<'b>)], default: S<'b>) -> S<'b> {
+        let name = self.auto("case", &[&self.name_of(sel.sig)]);
+        let arms: Vec<(u128, Sig)> = arms.iter().map(|(v, s)| (*v, s.sig)).collect();
+        self.s(self.m.borrow_mut().case(&name, sel.sig, &arms, default.sig))
+    }
+
+    /// Concatenation, most significant first; unsigned.
+    pub fn cat<'b>(&'b self, parts: &[S<'b>]) -> S<'b> {
+        let sigs: Vec<Sig> = parts.iter().map(|p| p.sig).collect();
+        let name = self.auto("cat", &[]);
+        self.s(self.m.borrow_mut().concat(&name, &sigs))
+    }
+
+    /// `v[sel]` for a 2-bit axis number (3 picks `v[0]`; it never occurs).
+    pub fn pick<'b>(&'b self, sel: S<'b>, v: [S<'b>; 3]) -> S<'b> {
+        self.case(sel, &[(1, v[1]), (2, v[2])], v[0])
+    }
+
+    pub fn rom(&self, name: &str, width: u32, words: Vec<u128>) -> usize {
+        self.m.borrow_mut().rom(name, width, words)
+    }
+
+    pub fn ram(&self, name: &str, width: u32, init: Vec<u128>) -> usize {
+        self.m.borrow_mut().ram(name, width, init)
+    }
+
+    pub fn ram_write(&self, mem: usize, we: S<'_>, addr: S<'_>, data: S<'_>) {
+        self.m.borrow_mut().ram_write(mem, we.sig, addr.sig, data.sig);
+    }
+
+    /// The word of memory `mem` at `addr`, one clock later.
+    pub fn read(&self, name: &str, mem: usize, addr: S<'_>) -> S<'_> {
+        self.s(self.m.borrow_mut().rom_read(name, mem, addr.sig))
+    }
+
+    /// Instantiates `sub`; its outputs by port name.
+    pub fn instance<'b>(&'b self, label: &str, sub: &Rc<Module>, inputs: &[S<'b>]) -> Ports<'b> {
+        let ins: Vec<Sig> = inputs.iter().map(|s| s.sig).collect();
+        let outs = self.m.borrow_mut().instance(label, sub, &ins);
+        Ports {
+            names: sub.outputs.iter().map(|o| o.0.clone()).collect(),
+            sigs: outs.into_iter().map(|s| self.s(s)).collect(),
+        }
+    }
+
+    fn bin<'b>(&'b self, op: BinOp, a: S<'b>, b: S<'b>, sym: &str) -> S<'b> {
+        let ty = bin_ty(op, a.sig.ty, b.sig.ty).unwrap_or_else(|e| panic!("{}: {op:?}: {e}", self.m.borrow().name));
+        if let Some(k) = self.fold(&Def::Bin(op, a.sig.id, b.sig.id), &[a.sig, b.sig], ty) {
+            return k;
+        }
+        let name = self.auto(sym, &[&self.name_of(a.sig), &self.name_of(b.sig)]);
+        self.s(self.m.borrow_mut().bin(&name, op, a.sig, b.sig))
+    }
+
+    fn un<'b>(&'b self, op: UnOp, a: S<'b>, sym: &str) -> S<'b> {
+        let ty = un_ty(op, a.sig.ty).unwrap_or_else(|e| panic!("{}: {op:?}: {e}", self.m.borrow().name));
+        if let Some(k) = self.fold(&Def::Un(op, a.sig.id), &[a.sig], ty) {
+            return k;
+        }
+        let name = self.auto(sym, &[&self.name_of(a.sig)]);
+        self.s(self.m.borrow_mut().un(&name, op, a.sig))
+    }
+
+    /// Constant folding: an operator on constants is the constant `Def::eval` gives.
+    fn fold(&self, def: &Def, ops: &[Sig], ty: Ty) -> Option<S<'_>> {
+        let bits: Option<Vec<u128>> = {
+            let m = self.m.borrow();
+            ops.iter().map(|s| if let Def::Const(v) = m.sig(s.id).def { Some(v) } else { None }).collect()
+        };
+        let tys: Vec<Ty> = ops.iter().map(|s| s.ty).collect();
+        let v = def.eval(&tys, &bits?, ty);
+        // An unsigned 128-bit constant above i128::MAX cannot be written as an i128.
+        if !ty.signed && ty.width == 128 && v >> 127 == 1 {
+            return None;
+        }
+        Some(self.konst(ty, ty.value(v)))
+    }
+}
+
+/// The outputs of an instance, by port name.
+pub struct Ports<'b> {
+    names: Vec<String>,
+    sigs: Vec<S<'b>>,
+}
+
+impl<'b> Ports<'b> {
+    pub fn get(&self, port: &str) -> S<'b> {
+        let k = self.names.iter().position(|n| n == port).unwrap_or_else(|| panic!("no output port {port}"));
+        self.sigs[k]
+    }
+    pub fn all(&self) -> &[S<'b>] {
+        &self.sigs
+    }
+}
+
+impl<'b> S<'b> {
+    pub fn ty(self) -> Ty {
+        self.sig.ty
+    }
+    pub fn width(self) -> u32 {
+        self.sig.ty.width
+    }
+
+    /// Gives the signal the name a person wants (made unique and legal).
+    pub fn name(self, name: &str) -> S<'b> {
+        self.b.with(|m| m.rename(self.sig.id, name));
+        self
+    }
+
+    /// A constant of this signal's type.
+    pub fn k(self, v: i128) -> S<'b> {
+        self.b.konst(self.sig.ty, v)
+    }
+
+    /// To `w` bits: sign- or zero-extended by signedness, or the low bits kept.
+    pub fn resize(self, w: u32) -> S<'b> {
+        if w == self.width() { self } else { self.b.un(UnOp::Resize(w), self, "rs") }
+    }
+    /// Bits [lsb, lsb + w) as unsigned.
+    pub fn slice(self, lsb: u32, w: u32) -> S<'b> {
+        if lsb == 0 && w == self.width() && !self.ty().signed {
+            return self;
+        }
+        self.b.un(UnOp::Slice { lsb, width: w }, self, "bits")
+    }
+    pub fn bit(self, i: u32) -> S<'b> {
+        self.slice(i, 1)
+    }
+    /// The sign bit.
+    pub fn msb(self) -> S<'b> {
+        self.bit(self.width() - 1)
+    }
+    /// The same bits read as signed / unsigned.
+    pub fn signed(self) -> S<'b> {
+        if self.ty().signed { self } else { self.b.un(UnOp::AsSigned, self, "s") }
+    }
+    pub fn unsigned(self) -> S<'b> {
+        if self.ty().signed { self.b.un(UnOp::AsUnsigned, self, "u") } else { self }
+    }
+    /// An unsigned value as signed, one bit wider (its value unchanged).
+    pub fn xsigned(self) -> S<'b> {
+        assert!(!self.ty().signed, "xsigned of a signed value");
+        self.resize(self.width() + 1).signed()
+    }
+    /// The full product: wa + wb bits.
+    pub fn xmul(self, o: S<'b>) -> S<'b> {
+        self.b.bin(BinOp::Mul, self, o, "x")
+    }
+    pub fn eq(self, o: impl Operand<'b>) -> S<'b> {
+        let o = o.as_sig(self);
+        self.b.bin(BinOp::Eq, self, o, "eq")
+    }
+    pub fn ne(self, o: impl Operand<'b>) -> S<'b> {
+        let o = o.as_sig(self);
+        self.b.bin(BinOp::Ne, self, o, "ne")
+    }
+    pub fn lt(self, o: impl Operand<'b>) -> S<'b> {
+        let o = o.as_sig(self);
+        self.b.bin(BinOp::Lt, self, o, "lt")
+    }
+    pub fn le(self, o: impl Operand<'b>) -> S<'b> {
+        let o = o.as_sig(self);
+        self.b.bin(BinOp::Le, self, o, "le")
+    }
+    pub fn gt(self, o: impl Operand<'b>) -> S<'b> {
+        let o = o.as_sig(self);
+        self.b.bin(BinOp::Lt, o, self, "lt")
+    }
+    pub fn ge(self, o: impl Operand<'b>) -> S<'b> {
+        let o = o.as_sig(self);
+        self.b.bin(BinOp::Le, o, self, "le")
+    }
+    /// `self ? t : f` for a one-bit `self` (`f` may be an integer, typed from `t`).
+    pub fn select(self, t: S<'b>, f: impl Operand<'b>) -> S<'b> {
+        let f = f.as_sig(t);
+        self.b.mux(self, t, f)
+    }
+    /// The smaller / larger of two signals of one type (ties take `self`).
+    pub fn min(self, o: S<'b>) -> S<'b> {
+        o.lt(self).select(o, self)
+    }
+    pub fn max(self, o: S<'b>) -> S<'b> {
+        self.lt(o).select(o, self)
+    }
+}
+
+/// A right operand: a signal, or an integer constant typed from the other operand.
+pub trait Operand<'b> {
+    fn as_sig(self, like: S<'b>) -> S<'b>;
+}
+
+impl<'b> Operand<'b> for S<'b> {
+    fn as_sig(self, _: S<'b>) -> S<'b> {
+        self
+    }
+}
+
+impl<'b> Operand<'b> for i128 {
+    fn as_sig(self, like: S<'b>) -> S<'b> {
+        like.k(self)
+    }
+}
+
+macro_rules! binop {
+    ($tr:ident, $f:ident, $op:expr, $sym:literal) => {
+        impl<'b, R: Operand<'b>> ops::$tr<R> for S<'b> {
+            type Output = S<'b>;
+            fn $f(self, o: R) -> S<'b> {
+                let o = o.as_sig(self);
+                self.b.bin($op, self, o, $sym)
+            }
+        }
+    };
+}
+binop!(Add, add, BinOp::Add, "plus");
+binop!(Sub, sub, BinOp::Sub, "minus");
+binop!(BitAnd, bitand, BinOp::And, "and");
+binop!(BitOr, bitor, BinOp::Or, "or");
+binop!(BitXor, bitxor, BinOp::Xor, "xor");
+
+impl<'b> ops::Not for S<'b> {
+    type Output = S<'b>;
+    fn not(self) -> S<'b> {
+        self.b.un(UnOp::Not, self, "not")
+    }
+}
+impl<'b> ops::Neg for S<'b> {
+    type Output = S<'b>;
+    fn neg(self) -> S<'b> {
+        self.b.un(UnOp::Neg, self, "neg")
+    }
+}
+/// Shift left by a constant, at the same width (bits shifted out are lost).
+impl<'b> ops::Shl<u32> for S<'b> {
+    type Output = S<'b>;
+    fn shl(self, k: u32) -> S<'b> {
+        if k == 0 { self } else { self.b.un(UnOp::Shl(k), self, "shl") }
+    }
+}
+/// Shift right by a constant: arithmetic when signed, logical when unsigned.
+impl<'b> ops::Shr<u32> for S<'b> {
+    type Output = S<'b>;
+    fn shr(self, k: u32) -> S<'b> {
+        if k == 0 { self } else { self.b.un(UnOp::Shr(k), self, "shr") }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rtl::sim::Sim;
+
+    #[test]
+    fn operators_build_typed_nodes_with_readable_names() {
+        let b = Builder::new("t");
+        let x = b.input("x", Ty::s(8));
+        let y = b.input("y", Ty::s(8));
+        let lt = x.lt(y);
+        assert_eq!(lt.ty(), Ty::BIT);
+        assert_eq!(b.name_of(lt.sig), "x_lt_y");
+        let p = x.xmul(y);
+        assert_eq!(p.ty(), Ty::s(16));
+        let z = ((x + 3) >> 1).name("half");
+        assert_eq!(b.name_of(z.sig), "half");
+        let o = lt.select(x, y);
+        b.output("o", o);
+        b.output("z", z);
+        b.output("p", p);
+        let m = b.finish();
+        let mut sim = Sim::new(&m);
+        let h = |i: usize| m.handle(m.inputs[i]);
+        let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+        sim.set(h(0), -7);
+        sim.set(h(1), 100);
+        sim.eval();
+        assert_eq!(sim.get(out("o")), -7);
+        assert_eq!(sim.get(out("z")), -2);
+        assert_eq!(sim.get(out("p")), -700);
+    }
+
+    #[test]
+    fn constants_fold() {
+        let b = Builder::new("t");
+        let k = b.konst(Ty::s(8), 100) + 100;
+        assert!(matches!(b.with(|m| m.sig(k.sig.id).def.clone()), Def::Const(v) if Ty::s(8).value(v) == -56));
+    }
+}

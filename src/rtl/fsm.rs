@@ -1,0 +1,332 @@
+//! The state-machine construct. The states are an enum (`states!`), whose order is the
+//! encoding; width, encoding and names are derived from it once and used by the netlist, the
+//! printers (named state constants, comments) and the simulators' per-state statistics.
+//! Each state's whole behaviour is one block:
+//!
+//! ```text
+//! fsm.state(St::Pop, |s| {
+//!     s.when(sp_empty, |s| s.goto(St::Done)).otherwise(|s| {
+//!         s.set(node, top_node);
+//!         s.goto(St::Node);
+//!     });
+//! });
+//! ```
+//!
+//! Assignments take effect at the clock edge; within a state they apply in program order and
+//! the last one whose conditions hold wins; a register not assigned in a clock holds its value.
+//! `finish` builds each register's next value as a `case` on the state (one arm per state
+//! that assigns it) and refuses a machine with a state that has no block.
+
+use super::build::{Builder, S};
+use super::netlist::BlockKind;
+use super::width::Ty;
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+
+/// An enum usable as the states of a machine: `ALL` in encoding order, and names.
+pub trait States: Copy + Eq + std::fmt::Debug + 'static {
+    const ALL: &'static [Self];
+    fn name(self) -> &'static str;
+    /// The state's encoding: its position in `ALL`.
+    fn code(self) -> u128 {
+        Self::ALL.iter().position(|&s| s == self).expect("a state of ALL") as u128
+    }
+    /// Bits of the state register.
+    fn width() -> u32 {
+        crate::scene::rom::value_bits(Self::ALL.len().saturating_sub(1))
+    }
+    fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|s| s.name()).collect()
+    }
+}
+
+/// Declares a states enum: `states! { pub enum St { Idle = "idle", Busy = "busy" } }`.
+#[macro_export]
+macro_rules! states {
+    ($(#[$meta:meta])* $vis:vis enum $name:ident { $($(#[$vm:meta])* $v:ident = $label:literal),+ $(,)? }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        $vis enum $name { $($(#[$vm])* $v),+ }
+        impl $crate::rtl::fsm::States for $name {
+            const ALL: &'static [Self] = &[$($name::$v),+];
+            fn name(self) -> &'static str {
+                match self { $($name::$v => $label),+ }
+            }
+        }
+    };
+}
+
+/// One assignment: under these conditions (all 1), in this state, `target` gets `value`.
+struct Assign {
+    state: u128,
+    conds: Vec<usize>,
+    value: usize,
+}
+
+/// A memory write: in this state, under these conditions, `mem[addr] <= data`.
+struct Write {
+    state: u128,
+    conds: Vec<usize>,
+    addr: usize,
+    data: usize,
+}
+
+#[derive(Default)]
+struct Record<'b> {
+    /// Signals referred to by index (handles are not `Ord`).
+    sigs: Vec<S<'b>>,
+    /// Per register (by its signal index), the assignments in program order.
+    assigns: BTreeMap<usize, Vec<Assign>>,
+    writes: BTreeMap<usize, Vec<Write>>,
+    defined: Vec<u128>,
+}
+
+impl<'b> Record<'b> {
+    fn idx(&mut self, s: S<'b>) -> usize {
+        match self.sigs.iter().position(|x| x.sig == s.sig) {
+            Some(i) => i,
+            None => {
+                self.sigs.push(s);
+                self.sigs.len() - 1
+            }
+        }
+    }
+}
+
+pub struct Fsm<'b, St: States> {
+    b: &'b Builder,
+    state: S<'b>,
+    block: usize,
+    rec: RefCell<Record<'b>>,
+    is: RefCell<BTreeMap<u128, S<'b>>>,
+    _st: std::marker::PhantomData<St>,
+}
+
+/// The body of one state: assignments, conditions, transitions.
+pub struct StateCtx<'f, 'b, St: States> {
+    fsm: &'f Fsm<'b, St>,
+    state: u128,
+    conds: Vec<usize>,
+}
+
+/// Returned by `when`: the branch taken when the condition is 0.
+pub struct Otherwise<'c, 'f, 'b, St: States> {
+    ctx: &'c mut StateCtx<'f, 'b, St>,
+    cond: S<'b>,
+}
+
+impl<'b, St: States> Fsm<'b, St> {
+    /// A state machine whose state register `name` powers up and resets to `init`. `doc` is
+    /// one line saying what it does.
+    pub fn new(b: &'b Builder, name: &str, doc: &str, init: St) -> Fsm<'b, St> {
+        let ty = Ty::u(St::width());
+        let state = b.reg(name, ty, Some(init.code() as i128));
+        let states = St::names().iter().map(|s| s.to_string()).collect();
+        let block = b.with(|m| {
+            let k = m.begin_block(name, doc, BlockKind::Fsm { state: state.sig.id, states });
+            m.end_block();
+            k
+        });
+        let rec = Record { sigs: Vec::new(), assigns: BTreeMap::new(), writes: BTreeMap::new(), defined: Vec::new() };
+        Fsm { b, state, block, rec: RefCell::new(rec), is: RefCell::new(BTreeMap::new()), _st: Default::default() }
+    }
+
+    /// The state register.
+    pub fn state_reg(&self) -> S<'b> {
+        self.state
+    }
+
+    /// 1 while the machine is in `st`.
+    pub fn is(&self, st: St) -> S<'b> {
+        if let Some(s) = self.is.borrow().get(&st.code()) {
+            return *s;
+        }
+        let s = self.state.eq(st.code() as i128).name(&format!("in_{}", st.name()));
+        self.is.borrow_mut().insert(st.code(), s);
+        s
+    }
+
+    /// The whole behaviour of state `st`.
+    pub fn state(&self, st: St, body: impl FnOnce(&mut StateCtx<'_, 'b, St>)) {
+        {
+            let mut rec = self.rec.borrow_mut();
+            assert!(!rec.defined.contains(&st.code()), "state {} has two blocks", st.name());
+            rec.defined.push(st.code());
+        }
+        let mut ctx = StateCtx { fsm: self, state: st.code(), conds: Vec::new() };
+        body(&mut ctx);
+    }
+
+    /// Builds every assigned register's next value and the memory write ports. Panics (a bug
+    /// in the core) when a state has no block.
+    pub fn finish(self) {
+        let b = self.b;
+        let rec = std::mem::take(&mut *self.rec.borrow_mut());
+        for st in St::ALL {
+            assert!(
+                rec.defined.contains(&st.code()),
+                "state {} of {} has no block",
+                st.name(),
+                b.name_of(self.state.sig)
+            );
+        }
+        b.with(|m| m.current_block = Some(self.block));
+        let is = |code: u128| self.is(St::ALL[code as usize]);
+        let all = |conds: &[usize]| -> Option<S<'b>> { conds.iter().map(|&c| rec.sigs[c]).reduce(|a, c| a & c) };
+        for (&target, list) in &rec.assigns {
+            let reg = rec.sigs[target];
+            // Per state, the assignments in order: the last one that applies wins.
+            let mut arms: Vec<(u128, S<'b>)> = Vec::new();
+            for st in St::ALL.iter().map(|s| s.code()) {
+                let mine: Vec<&Assign> = list.iter().filter(|a| a.state == st).collect();
+                if mine.is_empty() {
+                    continue;
+                }
+                let mut v = reg;
+                for a in mine {
+                    let value = rec.sigs[a.value];
+                    v = match all(&a.conds) {
+                        None => value,
+                        Some(c) => c.select(value, v),
+                    };
+                }
+                arms.push((st, v));
+            }
+            let next = match arms.as_slice() {
+                [(st, v)] => is(*st).select(*v, reg),
+                _ => b.case(self.state, &arms, reg),
+            };
+            b.next(reg, next.name(&format!("{}_next", b.name_of(reg.sig))));
+        }
+        for (&mem, list) in &rec.writes {
+            let when: Vec<S<'b>> = list
+                .iter()
+                .map(|w| match all(&w.conds) {
+                    None => is(w.state),
+                    Some(c) => is(w.state) & c,
+                })
+                .collect();
+            let we = when.iter().copied().reduce(|a, c| a | c).expect("a write");
+            let (mut addr, mut data) = (rec.sigs[list[0].addr], rec.sigs[list[0].data]);
+            for (w, c) in list.iter().zip(&when).skip(1) {
+                addr = c.select(rec.sigs[w.addr], addr);
+                data = c.select(rec.sigs[w.data], data);
+            }
+            b.ram_write(mem, we, addr, data);
+        }
+        b.with(|m| m.end_block());
+    }
+}
+
+impl<'f, 'b, St: States> StateCtx<'f, 'b, St> {
+    /// `reg` gets `value` at the clock edge (unless a later assignment in this state applies).
+    pub fn set(&mut self, reg: S<'b>, value: S<'b>) {
+        assert_eq!(reg.ty(), value.ty(), "{}: assignment of another type", reg.b.name_of(reg.sig));
+        let mut rec = self.fsm.rec.borrow_mut();
+        let (target, value) = (rec.idx(reg), rec.idx(value));
+        rec.assigns.entry(target).or_default().push(Assign { state: self.state, conds: self.conds.clone(), value });
+    }
+
+    /// `reg` gets the constant `v`.
+    pub fn set_k(&mut self, reg: S<'b>, v: i128) {
+        self.set(reg, reg.k(v));
+    }
+
+    /// The next state.
+    pub fn goto(&mut self, st: St) {
+        let k = self.fsm.state.k(st.code() as i128).name(&format!("st_{}", st.name()));
+        self.set(self.fsm.state, k);
+    }
+
+    /// Writes `data` to memory `mem` at `addr` at the clock edge.
+    pub fn write(&mut self, mem: usize, addr: S<'b>, data: S<'b>) {
+        let mut rec = self.fsm.rec.borrow_mut();
+        let (addr, data) = (rec.idx(addr), rec.idx(data));
+        let w = Write { state: self.state, conds: self.conds.clone(), addr, data };
+        rec.writes.entry(mem).or_default().push(w);
+    }
+
+    /// Runs `body` under the condition `cond` (nested conditions combine).
+    pub fn when<'c>(&'c mut self, cond: S<'b>, body: impl FnOnce(&mut Self)) -> Otherwise<'c, 'f, 'b, St> {
+        assert_eq!(cond.ty(), Ty::BIT, "a condition is one bit");
+        let k = self.fsm.rec.borrow_mut().idx(cond);
+        self.conds.push(k);
+        body(self);
+        self.conds.pop();
+        Otherwise { ctx: self, cond }
+    }
+}
+
+impl<'f, 'b, St: States> Otherwise<'_, 'f, 'b, St> {
+    /// Runs `body` when the `when` condition is 0.
+    pub fn otherwise(self, body: impl FnOnce(&mut StateCtx<'f, 'b, St>)) {
+        let not = !self.cond;
+        let k = self.ctx.fsm.rec.borrow_mut().idx(not);
+        self.ctx.conds.push(k);
+        body(self.ctx);
+        self.ctx.conds.pop();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rtl::sim::Sim;
+
+    crate::states! {
+        enum Light { Red = "red", Green = "green", Yellow = "yellow" }
+    }
+
+    /// A counter-driven traffic light: each state's behaviour in one block, the last
+    /// assignment winning, unassigned registers holding.
+    #[test]
+    fn a_machine_steps_through_its_states() {
+        let b = Builder::new("light");
+        let go = b.input("go", Ty::BIT);
+        let count = b.reg("count", Ty::u(4), Some(0));
+        let seen = b.reg("seen", Ty::u(4), Some(0));
+        let fsm = Fsm::new(&b, "light", "a traffic light", Light::Red);
+        fsm.state(Light::Red, |s| {
+            s.when(go, |s| {
+                s.set_k(count, 0);
+                s.goto(Light::Green);
+            });
+        });
+        fsm.state(Light::Green, |s| {
+            s.set(count, count + 1);
+            s.when(count.eq(2), |s| s.goto(Light::Yellow)).otherwise(|s| s.set(seen, seen + 1));
+        });
+        fsm.state(Light::Yellow, |s| {
+            s.set_k(count, 9);
+            s.set_k(count, 7); // the last assignment wins
+            s.goto(Light::Red);
+        });
+        let state = fsm.state_reg();
+        fsm.finish();
+        b.output("o_state", state);
+        b.output("o_count", count);
+        b.output("o_seen", seen);
+        let m = b.finish();
+        let mut sim = Sim::new(&m);
+        let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+        sim.set(m.handle(m.inputs[0]), 1);
+        let mut trace = Vec::new();
+        for _ in 0..6 {
+            sim.tick();
+            trace.push((sim.get(out("o_state")), sim.get(out("o_count")), sim.get(out("o_seen"))));
+        }
+        assert_eq!(trace, [(1, 0, 0), (1, 1, 1), (1, 2, 2), (2, 3, 2), (0, 7, 2), (1, 0, 2)]);
+        assert_eq!(Light::width(), 2);
+        assert_eq!(Light::Yellow.code(), 2);
+    }
+
+    #[test]
+    #[should_panic(expected = "state yellow")]
+    fn a_state_without_a_block_is_refused() {
+        let b = Builder::new("light");
+        let fsm = Fsm::new(&b, "light", "", Light::Red);
+        fsm.state(Light::Red, |s| s.goto(Light::Green));
+        fsm.state(Light::Green, |s| s.goto(Light::Red));
+        fsm.finish();
+    }
+}
