@@ -4,7 +4,9 @@
 //! When there is no hit, t, u and v read 0.
 
 use super::divider::{self, divider_core};
-use crate::rtl::{BinOp, Module, Sig, Ty, UnOp};
+use crate::rtl::build::{Builder, S};
+use crate::rtl::pipeline::{Pipeline, Policy};
+use crate::rtl::{Module, Sig, Ty, UnOp};
 use serde::Serialize;
 use std::rc::Rc;
 
@@ -105,189 +107,174 @@ pub(crate) fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
     m.case(name, sel, &[(1, v[1]), (2, v[2])], v[0])
 }
 
-/// A pipeline register for each signal, named after it with the stage's prefix (a previous
-/// stage's prefix, such as `s3_` or `dv12_`, is replaced, not stacked).
-fn stage(m: &mut Module, prefix: &str, sigs: &[Sig]) -> Vec<Sig> {
-    sigs.iter()
-        .map(|s| {
-            let old = &m.sig(s.id).name;
-            let base = match old.split_once('_') {
-                Some((p, rest))
-                    if p.trim_end_matches(|c: char| c.is_ascii_digit()).len() < p.len()
-                        && p.starts_with(|c: char| c.is_ascii_alphabetic()) =>
-                {
-                    rest
-                }
-                _ => old.as_str(),
-            };
-            let name = format!("{prefix}_{base}");
-            m.delay(&name, *s)
-        })
-        .collect()
-}
-
-/// (a + 1) mod 3 for a 2-bit axis number.
-fn next_axis(m: &mut Module, name: &str, a: Sig) -> Sig {
-    let zero = m.konst(&format!("{name}_zero"), Ty::u(2), 0);
-    let one = m.konst(&format!("{name}_one"), Ty::u(2), 1);
-    let two = m.konst(&format!("{name}_two"), Ty::u(2), 2);
-    let wraps = m.bin(&format!("{name}_wraps"), BinOp::Eq, a, two);
-    let inc = m.add(&format!("{name}_inc"), a, one);
-    m.mux(name, wraps, zero, inc)
-}
-
-/// round(x / 2^s): (x + 2^(s−1)) >> s, at x's width.
-fn shr_round(m: &mut Module, name: &str, x: Sig, s: u32) -> Sig {
-    if s == 0 {
-        return x;
-    }
-    let half = m.konst(&format!("{name}_half"), x.ty, 1i128 << (s - 1));
-    let y = m.add(&format!("{name}_biased"), x, half);
-    m.shr(name, y, s)
-}
-
 pub(crate) fn as_signed_wider(m: &mut Module, name: &str, x: Sig) -> Sig {
     let w = m.resize(&format!("{name}_w"), x, x.ty.width + 1);
     m.un(name, UnOp::AsSigned, w)
 }
 
+/// (a + 1) mod 3 for a 2-bit axis number.
+fn next_axis(a: S<'_>) -> S<'_> {
+    a.eq(2).select(a.k(0), a + 1)
+}
+
+/// round(x / 2^s): (x + 2^(s−1)) >> s, at x's width.
+fn shr_round(x: S<'_>, s: u32) -> S<'_> {
+    if s == 0 { x } else { (x + (1i128 << (s - 1))) >> s }
+}
+
+crate::bundle! {
+    /// The ports, registered.
+    struct Inputs { valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q }
+}
+crate::bundle! {
+    /// After the permutation by r: the products of the plane test and the k bases.
+    struct Products { onp, onq, wnp, wnq, dmo, w_r, kp0, kq0 }
+}
+crate::bundle! {
+    /// The divider's operands, T low bits dropped.
+    struct Quotient { num, den }
+}
+crate::bundle! {
+    /// t·ω_p and t·ω_q.
+    struct Moved { tp, tq }
+}
+crate::bundle! {
+    /// The hit point's coordinates relative to the triangle's first vertex.
+    struct Point { kp, kq }
+}
+crate::bundle! {
+    /// The four barycentric products.
+    struct Bary { a1, a2, b1, b2 }
+}
+crate::bundle! {
+    /// The result ports.
+    struct Outcome { valid_out, tag_out, hit, t, u, v }
+}
+
 pub fn intersect_core(p: &IntersectParams) -> Module {
-    let (n, mm, f) = (p.n, p.m, p.f());
-    let mut m = Module::new(&p.name());
-    let ins: Vec<Sig> = input_ports(p).iter().map(|(name, ty)| m.input(name, *ty)).collect();
-    // Stage 1: register the inputs.
-    let r = stage(&mut m, "s1", &ins);
-    let [valid, tag, ox, oy, oz, wx, wy, wz, rr, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = r[..] else { unreachable!() };
-    // Permute by r: (r, p, q) = (r, r+1 mod 3, r+2 mod 3).
-    let (o, w) = ([ox, oy, oz], [wx, wy, wz]);
-    let sel_p = next_axis(&mut m, "perm_p", rr);
-    let sel_q = next_axis(&mut m, "perm_q", sel_p);
-    let o_r = pick(&mut m, "o_r", rr, o);
-    let o_p = pick(&mut m, "o_p", sel_p, o);
-    let o_q = pick(&mut m, "o_q", sel_q, o);
-    let w_r = pick(&mut m, "w_r", rr, w);
-    let w_p = pick(&mut m, "w_p", sel_p, w);
-    let w_q = pick(&mut m, "w_q", sel_q, w);
-    // Origin components as signed n+1 bits, so they multiply with signed normals.
-    let o_p_s = as_signed_wider(&mut m, "o_p_s", o_p);
-    let o_q_s = as_signed_wider(&mut m, "o_q_s", o_q);
-    let o_r_s = as_signed_wider(&mut m, "o_r_s", o_r);
-    let pp_s = as_signed_wider(&mut m, "pp_s", pp);
-    let pq_s = as_signed_wider(&mut m, "pq_s", pq);
-    // Stage 2: the four products, d − O_r, and the k bases O_p − pp, O_q − pq.
-    let onp = m.mul("o_p_np", o_p_s, np);
-    let onq = m.mul("o_q_nq", o_q_s, nq);
-    let wnp = m.mul("w_p_np", w_p, np);
-    let wnq = m.mul("w_q_nq", w_q, nq);
-    let d_w = m.resize("d_w", d, n + 4);
-    let o_r_w = m.resize("o_r_w", o_r_s, n + 4);
-    let dmo = m.sub("d_minus_or", d_w, o_r_w);
-    let kp0 = m.sub("kp_base", o_p_s, pp_s);
-    let kq0 = m.sub("kq_base", o_q_s, pq_s);
-    let s2: Vec<Sig> =
-        stage(&mut m, "s2", &[onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
-    let [onp, onq, wnp, wnq, dmo, w_r, valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = s2[..] else {
-        unreachable!()
-    };
-    // Stage 3: num = ((d − O_r) << F) − O_p·np − O_q·nq, den = ω_r + rnd(ω_p·np + ω_q·nq, F).
-    let wn = p.num_width();
-    let dmo_w = m.resize("num_dmo", dmo, wn);
-    let dmo_sh = m.shl("num_dmo_shifted", dmo_w, f);
-    let onp_w = m.resize("num_onp", onp, wn);
-    let onq_w = m.resize("num_onq", onq, wn);
-    let num_a = m.sub("num_a", dmo_sh, onp_w);
-    let num = m.sub("num", num_a, onq_w);
-    let wsum_w = 2 * mm + 1;
-    let wnp_w = m.resize("den_wnp", wnp, wsum_w);
-    let wnq_w = m.resize("den_wnq", wnq, wsum_w);
-    let wsum = m.add("den_sum", wnp_w, wnq_w);
-    let wsum_r = shr_round(&mut m, "den_sum_rounded", wsum, f);
-    let wd = p.den_width();
-    let wsum_n = m.resize("den_sum_narrow", wsum_r, wd);
-    let w_r_w = m.resize("den_wr", w_r, wd);
-    let den = m.add("den", w_r_w, wsum_n);
-    // Division precision T: drop the T low bits of both (wiring only).
-    let num_t = m.shr("num_t", num, p.t);
-    let num_t = m.resize("num_short", num_t, wn - p.t);
-    let den_t = m.shr("den_t", den, p.t);
-    let den_t = m.resize("den_short", den_t, wd - p.t);
-    let num_r = m.delay("s3_num", num_t);
-    let den_r = m.delay("s3_den", den_t);
-    let side: Vec<Sig> = stage(&mut m, "s3", &[valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q]);
-    // The divider, with everything else riding along.
-    let div = Rc::new(p.divider());
-    let [dv_t, dv_ok] = m.instance("u_div", &div, &[num_r, den_r])[..] else { unreachable!() };
-    let mut side = side;
-    for k in 1..=divider::latency(n, p.div_bits) {
-        side = stage(&mut m, &format!("dv{k}"), &side);
-    }
-    let [valid, tag, kp0, kq0, w_p, w_q, e1p, e1q, e2p, e2q] = side[..] else { unreachable!() };
-    // Stage D+1: t·ω_p, t·ω_q (t as signed n+2 bits).
-    let t_s = as_signed_wider(&mut m, "t_s", dv_t);
-    let tp = m.mul("t_wp", t_s, w_p);
-    let tq = m.mul("t_wq", t_s, w_q);
-    let x1: Vec<Sig> = stage(&mut m, "x1", &[tp, tq, dv_t, dv_ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q]);
-    let [tp, tq, t, ok, valid, tag, kp0, kq0, e1p, e1q, e2p, e2q] = x1[..] else { unreachable!() };
-    // Stage D+2: kp = (O_p − pp) + rnd(t·ω_p, F), kq likewise (n+3 bits).
-    let tp_r = shr_round(&mut m, "tp_rounded", tp, f);
-    let tq_r = shr_round(&mut m, "tq_rounded", tq, f);
-    let kw = n + 3;
-    let tp_n = m.resize("tp_narrow", tp_r, kw);
-    let tq_n = m.resize("tq_narrow", tq_r, kw);
-    let kp0_w = m.resize("kp_base_w", kp0, kw);
-    let kq0_w = m.resize("kq_base_w", kq0, kw);
-    let kp = m.add("kp", kp0_w, tp_n);
-    let kq = m.add("kq", kq0_w, tq_n);
-    let x2: Vec<Sig> = stage(&mut m, "x2", &[kp, kq, t, ok, valid, tag, e1p, e1q, e2p, e2q]);
-    let [kp, kq, t, ok, valid, tag, e1p, e1q, e2p, e2q] = x2[..] else { unreachable!() };
-    // Stage D+3: the four barycentric products.
-    let a1 = m.mul("e1p_kq", e1p, kq);
-    let a2 = m.mul("e1q_kp", e1q, kp);
-    let b1 = m.mul("e2q_kp", e2q, kp);
-    let b2 = m.mul("e2p_kq", e2p, kq);
-    let x3: Vec<Sig> = stage(&mut m, "x3", &[a1, a2, b1, b2, t, ok, valid, tag]);
-    let [a1, a2, b1, b2, t, ok, valid, tag] = x3[..] else { unreachable!() };
-    // Stage D+4: u, v, the hit test, outputs zeroed on a miss.
-    let uw = (mm + kw + 1).max(p.e + f + 2);
-    let a1w = m.resize("u_a", a1, uw);
-    let a2w = m.resize("u_b", a2, uw);
-    let b1w = m.resize("v_a", b1, uw);
-    let b2w = m.resize("v_b", b2, uw);
-    let u = m.sub("u", a1w, a2w);
-    let v = m.sub("v", b1w, b2w);
-    let uv = m.add("u_plus_v", u, v);
-    let zero = m.konst("uv_zero", Ty::s(uw), 0);
-    let limit = m.konst("uv_limit", Ty::s(uw), 1i128 << (p.e + f));
-    let u_neg = m.bin("u_neg", BinOp::Lt, u, zero);
-    let v_neg = m.bin("v_neg", BinOp::Lt, v, zero);
-    let over = m.bin("uv_over", BinOp::Lt, limit, uv);
-    let bad1 = m.bin("bary_bad_a", BinOp::Or, u_neg, v_neg);
-    let bad = m.bin("bary_bad", BinOp::Or, bad1, over);
-    let one = m.konst("hit_one", Ty::BIT, 1);
-    let inside = m.bin("bary_inside", BinOp::Xor, bad, one);
-    let hit = m.bin("hit_c", BinOp::And, inside, ok);
-    let u_out = scaled_out(&mut m, "u_out", u, p.e, mm);
-    let v_out = scaled_out(&mut m, "v_out", v, p.e, mm);
-    let t_zero = m.konst("t_zero", t.ty, 0);
-    let uv_zero = m.konst("uvo_zero", Ty::u(mm), 0);
-    let t_o = m.mux("t_c", hit, t, t_zero);
-    let u_o = m.mux("u_c", hit, u_out, uv_zero);
-    let v_o = m.mux("v_c", hit, v_out, uv_zero);
-    for (name, s) in [("valid_out", valid), ("tag_out", tag), ("hit", hit), ("t", t_o), ("u", u_o), ("v", v_o)] {
-        let r = m.delay(&format!("q_{name}"), s);
-        m.output(name, r);
-    }
+    let (m, latency) = intersect_core_with(p, Policy::default());
+    debug_assert_eq!(latency, p.latency(), "latency formula and stages disagree");
     m
 }
 
-/// u >> E as m bits unsigned (a hit has u in [0, 2^(E+F)], so the result is in [0, 2^F]).
-fn scaled_out(m: &mut Module, name: &str, u: Sig, e: u32, mm: u32) -> Sig {
-    if e >= u.ty.width - 1 {
-        return m.konst(name, Ty::u(mm), 0);
+/// The pipeline with the stages `policy` merges left unregistered (the same results, less
+/// latency), and its latency counted from the stages.
+pub fn intersect_core_with(p: &IntersectParams, policy: Policy) -> (Module, u32) {
+    let (n, mm, f) = (p.n, p.m, p.f());
+    let b = Builder::new(&p.name());
+    let ins: Vec<S> = input_ports(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
+    let pipe = Pipeline::new(&b, policy);
+    let [valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = ins[..] else {
+        unreachable!("input_ports has 18 ports")
+    };
+    let x = pipe.stage(
+        "inputs",
+        "register the inputs",
+        Inputs { valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q },
+    );
+    // Permute by r: (r, p, q) = (r, r+1 mod 3, r+2 mod 3).
+    let sel_p = next_axis(x.r).name("perm_p");
+    let sel_q = next_axis(sel_p).name("perm_q");
+    let (o, w) = ([x.ox, x.oy, x.oz], [x.wx, x.wy, x.wz]);
+    let o_r = b.pick(x.r, o).name("o_r");
+    let o_p = b.pick(sel_p, o).name("o_p");
+    let o_q = b.pick(sel_q, o).name("o_q");
+    let w_r = b.pick(x.r, w).name("w_r");
+    let w_p = b.pick(sel_p, w).name("w_p");
+    let w_q = b.pick(sel_q, w).name("w_q");
+    // Origin components as signed n+1 bits, so they multiply with signed normals.
+    let (o_p_s, o_q_s) = (o_p.xsigned(), o_q.xsigned());
+    let prod = pipe.stage(
+        "products",
+        "O_p·np, O_q·nq, ω_p·np, ω_q·nq; d − O_r; O_p − pp, O_q − pq",
+        Products {
+            onp: o_p_s.xmul(x.np),
+            onq: o_q_s.xmul(x.nq),
+            wnp: w_p.xmul(x.np),
+            wnq: w_q.xmul(x.nq),
+            dmo: x.d.resize(n + 4) - o_r.xsigned().resize(n + 4),
+            w_r,
+            kp0: o_p_s - x.pp.xsigned(),
+            kq0: o_q_s - x.pq.xsigned(),
+        },
+    );
+    // num = ((d − O_r) << F) − O_p·np − O_q·nq, den = ω_r + rnd(ω_p·np + ω_q·nq, F).
+    let (wn, wd) = (p.num_width(), p.den_width());
+    let num = ((prod.dmo.resize(wn) << f) - prod.onp.resize(wn) - prod.onq.resize(wn)).name("num");
+    let wsum = prod.wnp.resize(2 * mm + 1) + prod.wnq.resize(2 * mm + 1);
+    let den = (prod.w_r.resize(wd) + shr_round(wsum, f).resize(wd)).name("den");
+    // Division precision T: drop the T low bits of both (wiring only).
+    let q = pipe.stage(
+        "quotient",
+        "numerator and rounded denominator, T bits dropped",
+        Quotient { num: (num >> p.t).resize(wn - p.t), den: (den >> p.t).resize(wd - p.t) },
+    );
+    pipe.advance(divider::latency(n, p.div_bits));
+    let div = b.instance("u_div", &Rc::new(p.divider()), &[q.num, q.den]);
+    let (t, ok) = (div.get("t"), div.get("ok"));
+    // t·ω_p, t·ω_q (t as signed n+2 bits).
+    let t_s = t.xsigned();
+    let mv = pipe.stage("moved", "t·ω_p, t·ω_q", Moved { tp: t_s.xmul(pipe.now(w_p)), tq: t_s.xmul(pipe.now(w_q)) });
+    // kp = (O_p − pp) + rnd(t·ω_p, F), kq likewise (n+3 bits).
+    let kw = n + 3;
+    let pt = pipe.stage(
+        "point",
+        "kp, kq: the hit point relative to the first vertex",
+        Point {
+            kp: pipe.now(prod.kp0).resize(kw) + shr_round(mv.tp, f).resize(kw),
+            kq: pipe.now(prod.kq0).resize(kw) + shr_round(mv.tq, f).resize(kw),
+        },
+    );
+    let bary = pipe.stage(
+        "bary",
+        "e1p·kq, e1q·kp, e2q·kp, e2p·kq",
+        Bary {
+            a1: pipe.now(x.e1p).xmul(pt.kq),
+            a2: pipe.now(x.e1q).xmul(pt.kp),
+            b1: pipe.now(x.e2q).xmul(pt.kp),
+            b2: pipe.now(x.e2p).xmul(pt.kq),
+        },
+    );
+    // u, v, the hit test, outputs zeroed on a miss.
+    let uw = (mm + kw + 1).max(p.e + f + 2);
+    let u = (bary.a1.resize(uw) - bary.a2.resize(uw)).name("u");
+    let v = (bary.b1.resize(uw) - bary.b2.resize(uw)).name("v");
+    let over = u.k(1i128 << (p.e + f)).lt(u + v);
+    let inside = !(u.lt(0) | v.lt(0) | over);
+    let hit = (inside & pipe.now(ok)).name("hit_c");
+    let t_now = pipe.now(t);
+    let res = pipe.stage(
+        "result",
+        "the barycentric test; t, u, v zeroed on a miss",
+        Outcome {
+            valid_out: pipe.now(x.valid),
+            tag_out: pipe.now(x.tag),
+            hit,
+            t: hit.select(t_now, 0),
+            u: hit.select(scaled_out(u, p.e, mm), 0),
+            v: hit.select(scaled_out(v, p.e, mm), 0),
+        },
+    );
+    let latency = pipe.finish();
+    for (name, s) in [
+        ("valid_out", res.valid_out),
+        ("tag_out", res.tag_out),
+        ("hit", res.hit),
+        ("t", res.t),
+        ("u", res.u),
+        ("v", res.v),
+    ] {
+        b.output(name, s);
     }
-    let sh = m.shr(&format!("{name}_shifted"), u, e);
-    let low = m.resize(&format!("{name}_low"), sh, mm);
-    m.un(name, UnOp::AsUnsigned, low)
+    (b.finish(), latency)
+}
+
+/// u >> E as m bits unsigned (a hit has u in [0, 2^(E+F)], so the result is in [0, 2^F]).
+fn scaled_out(u: S<'_>, e: u32, mm: u32) -> S<'_> {
+    if e >= u.width() - 1 {
+        return u.b.konst(Ty::u(mm), 0);
+    }
+    (u >> e).resize(mm).unsigned()
 }
 
 /// The input vector of one (ray, triangle) pair, in `input_ports` order.
@@ -319,14 +306,18 @@ mod tests {
     /// Random rays against random triangles of a built-in scene, through the Rust simulation
     /// of the pipeline, against the golden model.
     fn check(params: Params, div_bits: u32, count: usize) -> usize {
+        check_with(params, div_bits, count, Policy::default())
+    }
+
+    fn check_with(params: Params, div_bits: u32, count: usize, policy: Policy) -> usize {
         let scene = Scene::load(&crate::scene::SceneSource::Builtin("random".into()), &params).unwrap();
         let g = Golden::new(&scene);
         let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 24, div_bits };
-        let module = intersect_core(&p);
+        let (module, lat) = intersect_core_with(&p, policy);
         let mut sim = Sim::new(&module);
         let ins: Vec<_> = module.inputs.iter().map(|&i| module.handle(i)).collect();
         let outs: Vec<_> = module.outputs.iter().map(|(_, i)| module.handle(*i)).collect();
-        let lat = p.latency() as usize;
+        let lat = lat as usize;
         let mut rng = 0x1234_5678_9abc_def1u64;
         let mut next = move || {
             rng ^= rng << 13;
@@ -386,6 +377,16 @@ mod tests {
             assert_eq!(hits, check(params, 2, 3000));
             assert!(hits > 1000 && hits < 2900, "{hits} hits of 3000 with {params:?}: both outcomes must be exercised");
         }
+    }
+
+    /// Register boundaries move by a parameter, not by editing the core: two stages merged,
+    /// two cycles less latency, the same results.
+    #[test]
+    fn merged_stages_keep_every_result() {
+        let merge = Policy { merge: vec!["moved".into(), "bary".into()] };
+        let p = IntersectParams { n: 29, m: 32, t: 0, e: 18, tag_width: 24, div_bits: 1 };
+        assert_eq!(intersect_core_with(&p, merge.clone()).1, p.latency() - 2);
+        assert_eq!(check_with(Params::default(), 1, 2000, merge), check(Params::default(), 1, 2000));
     }
 
     #[test]

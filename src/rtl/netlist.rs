@@ -367,8 +367,20 @@ impl Module {
         self.push(name, Ty::u(w), Def::RomRead { rom, addr: addr.id })
     }
 
+    /// An output port named exactly `name` (made legal): a port name is an interface, so an
+    /// internal signal that has the name already is renamed instead.
     pub fn output(&mut self, name: &str, sig: Sig) {
-        let name = self.unique_name(name);
+        let name = names::legal(name);
+        let port_taken = self.outputs.iter().any(|o| o.0 == name)
+            || self.inputs.iter().any(|&i| self.sig(i).name == name)
+            || self.roms.iter().any(|r| r.name == name)
+            || self.instances.iter().any(|i| i.name == name);
+        assert!(!port_taken, "{}: port {name} is taken", self.name);
+        if let Some(k) = self.signals.iter().position(|x| x.name == name) {
+            self.signals[k].name.clear();
+            let renamed = self.unique_name(&format!("{name}_i"));
+            self.signals[k].name = renamed;
+        }
         self.outputs.push((name, sig.id));
     }
 
