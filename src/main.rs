@@ -403,7 +403,7 @@ fn run_sim(a: SimArgs) -> Result<bool> {
             "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
             "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
             "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
-            "state_cycles": fxrt::cores::traverse::STATE_NAMES.iter().zip(&stats.state_cycles).map(|(n, c)| (n.to_string(), serde_json::json!(*c))).collect::<serde_json::Map<String, serde_json::Value>>(),
+            "state_cycles": stats.named_state_cycles().into_iter().map(|(n, c)| (n.to_string(), serde_json::json!(c))).collect::<serde_json::Map<String, serde_json::Value>>(),
             "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
         })
     );

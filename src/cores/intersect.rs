@@ -102,11 +102,6 @@ pub fn input_ports(p: &IntersectParams) -> Vec<(&'static str, Ty)> {
     ]
 }
 
-/// v[sel] for a 2-bit axis number (3 picks v[0]; it never occurs).
-pub(crate) fn pick(m: &mut Module, name: &str, sel: Sig, v: [Sig; 3]) -> Sig {
-    m.case(name, sel, &[(1, v[1]), (2, v[2])], v[0])
-}
-
 pub(crate) fn as_signed_wider(m: &mut Module, name: &str, x: Sig) -> Sig {
     let w = m.resize(&format!("{name}_w"), x, x.ty.width + 1);
     m.un(name, UnOp::AsSigned, w)

@@ -16,8 +16,9 @@ use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
 use super::traverse::{TraverseParams, field, traverse_core, word_bits};
 use crate::model::golden::GridRay;
+use crate::rtl::build::{Builder, S};
 use crate::rtl::width::MAX_WIDTH;
-use crate::rtl::{Module, Sig, Ty};
+use crate::rtl::{Module, Ty};
 use crate::scene::images::SceneRoms;
 use crate::scene::rom::Field;
 use crate::scene::rom::rom_addr_bits;
@@ -113,70 +114,54 @@ pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
 }
 
 pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
-    let mut m = Module::new("fxrt_core");
-    let ins: Vec<Sig> = core_inputs(p).iter().map(|(name, ty)| m.input(name, *ty)).collect();
-    let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!() };
-    let trav = Rc::new(traverse_core(&p.trav, scene));
-    let t = m.instance("u_traverse", &trav, &[ray_valid, ray_id, ox, oy, oz, ix, iy, iz]);
-    let out = |name: &str| trav.outputs.iter().position(|o| o.0 == name).map(|i| t[i]).expect("traversal port");
-    let (ready, emit_valid, emit_end, emit_tri, emit_tmin, emit_id) =
-        (out("ray_ready"), out("emit_valid"), out("emit_end"), out("emit_tri"), out("emit_tmin"), out("emit_id"));
-    let cur_o = [out("cur_ox"), out("cur_oy"), out("cur_oz")];
+    let b = Builder::new("fxrt_core");
+    let ins: Vec<S> = core_inputs(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
+    let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!("11 ray ports") };
+    let trav =
+        b.instance("u_traverse", &Rc::new(traverse_core(&p.trav, scene)), &[ray_valid, ray_id, ox, oy, oz, ix, iy, iz]);
+    let (ready, emit_end, emit_tri) = (trav.get("ray_ready"), trav.get("emit_end"), trav.get("emit_tri"));
 
     // The direction, latched when the traversal accepts the ray.
-    let accept = m.and("accept", ray_valid, ready);
-    let w: Vec<Sig> = [("wx_r", wx), ("wy_r", wy), ("wz_r", wz)]
-        .iter()
-        .map(|(name, s)| {
-            let r = m.reg(name, s.ty, None);
-            m.connect(r, *s, Some(accept));
-            r
-        })
-        .collect();
+    let accept = (ray_valid & ready).name("accept");
+    let w = [("wx_r", wx), ("wy_r", wy), ("wz_r", wz)].map(|(name, s)| {
+        let r = b.reg(name, s.ty(), None);
+        b.next_when(r, accept, s);
+        r
+    });
 
     // Triangle ROMs at the emitted triangle number; the tag and valid wait the same cycle.
     let (tri_l, tri_words) = &scene.tri;
-    let addr_bits = rom_addr_bits(tri_words.len());
-    let addr = m.resize("tri_addr", emit_tri, addr_bits);
-    let mut tri_fields: Vec<Sig> = Vec::new();
+    let addr = emit_tri.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
+    let mut tri_fields: Vec<S> = Vec::new();
     for (k, group) in tri_rom_groups(&tri_l.fields).iter().enumerate() {
         let lsb = group[0].lsb;
         let width: u32 = group.iter().map(|f| f.width).sum();
-        let words = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
-        let rom = m.rom(&format!("tri_rom_{k}"), width, words);
-        let word = m.rom_read(&format!("tri_word_{k}"), rom, addr);
-        for f in group {
-            tri_fields.push(field(&mut m, &format!("tri_{}", f.name), word, f, lsb));
-        }
+        let rom = b.rom(&format!("tri_rom_{k}"), width, tri_words.iter().map(|w| word_bits(w, lsb, width)).collect());
+        let word = b.read(&format!("tri_word_{k}"), rom, addr);
+        tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
     }
-    let tri_w = m.resize("tag_tri", emit_tri, p.tag.tri_bits);
-    let tri_tmin = m.concat("tag_tri_tmin", &[emit_tmin, tri_w]);
+    // The tag: the end flag on top of the ray id (end token) or the leaf tmin and triangle.
     let payload = p.tag.payload();
-    let tri_tmin = m.resize("tag_tri_tmin_w", tri_tmin, payload);
-    let id_w = m.resize("tag_id", emit_id, payload);
-    let payload_sig = m.mux("tag_payload", emit_end, id_w, tri_tmin);
-    let tag = m.concat("tag", &[emit_end, payload_sig]);
-    let valid_d = m.delay("pipe_valid", emit_valid);
-    let tag_d = m.delay("pipe_tag", tag);
+    let tri_tmin = b.cat(&[trav.get("emit_tmin"), emit_tri.resize(p.tag.tri_bits)]).resize(payload);
+    let tag = b.cat(&[emit_end, emit_end.select(trav.get("emit_id").resize(payload), tri_tmin)]).name("tag");
+    let valid_d = b.delay("pipe_valid", trav.get("emit_valid"));
+    let tag_d = b.delay("pipe_tag", tag);
 
-    let isect = Rc::new(intersect_core(&p.isect));
-    let mut pipe_in = vec![valid_d, tag_d, cur_o[0], cur_o[1], cur_o[2], w[0], w[1], w[2]];
+    let mut pipe_in = vec![valid_d, tag_d, trav.get("cur_ox"), trav.get("cur_oy"), trav.get("cur_oz")];
+    pipe_in.extend(w);
     pipe_in.extend(tri_fields);
-    let r = m.instance("u_intersect", &isect, &pipe_in);
+    let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
     let closest = Rc::new(closest_core(p.tag, p.isect.n, p.isect.m));
-    let res = m.instance("u_closest", &closest, &r);
-    m.output("ray_ready", ready);
-    for (k, (name, _)) in closest.outputs.iter().enumerate() {
-        m.output(name, res[k]);
+    let res = b.instance("u_closest", &closest, r.all());
+    b.output("ray_ready", ready);
+    for (name, _) in &closest.outputs {
+        b.output(name, res.get(name));
     }
     // Observation ports for `fxrt sim`: a triangle entering the pipeline, the stack depth.
-    let end_d = m.bit("pipe_end", tag_d, payload);
-    let not_end = m.not("pipe_not_end", end_d);
-    let busy = m.and("pipe_busy", valid_d, not_end);
-    m.output("busy", busy);
-    m.output("stack_depth", out("stack_depth"));
-    m.output("fsm_state", out("fsm_state"));
-    m
+    b.output("busy", (valid_d & !tag_d.bit(payload)).name("pipe_busy"));
+    b.output("stack_depth", trav.get("stack_depth"));
+    b.output("fsm_state", trav.get("fsm_state"));
+    b.finish()
 }
 
 /// The core fed by the on-chip ray generator instead of the ray port (the thesis's demo):

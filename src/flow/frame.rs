@@ -3,6 +3,7 @@
 //! order and are compared with the golden model's `trace_fast`, pixel by pixel.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
+use crate::cores::traverse::TravState;
 use crate::error::{Error, Result};
 use crate::flow::simulators::{Bench, Simulator};
 use crate::flow::testbench::{Stream, parse_results, stream_files};
@@ -10,6 +11,7 @@ use crate::model::camera::Camera;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
 use crate::rtl::batch::BatchSim;
+use crate::rtl::fsm::States;
 use crate::rtl::sim::Sim;
 use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
@@ -49,12 +51,26 @@ pub struct CoreStats {
     /// Cycles in which a triangle entered the intersection pipeline.
     pub busy_cycles: u64,
     pub max_stack_depth: u32,
-    /// Cycles the traversal FSM spent in each state (`traverse::STATE_NAMES`); the Rust
+    /// Cycles the traversal FSM spent in each state, by encoding (`TravState`); the Rust
     /// simulators count them, the HDL testbenches do not.
     pub state_cycles: Vec<u64>,
 }
 
 impl CoreStats {
+    fn new(rays: u64) -> CoreStats {
+        CoreStats { rays, state_cycles: vec![0; TravState::ALL.len()], ..Default::default() }
+    }
+
+    /// One cycle in the state with encoding `code` (the `fsm_state` port).
+    fn count_state(&mut self, code: i128) {
+        self.state_cycles[code as usize] += 1;
+    }
+
+    /// Cycles per state, by the state's name.
+    pub fn named_state_cycles(&self) -> Vec<(&'static str, u64)> {
+        TravState::ALL.iter().map(|s| s.name()).zip(self.state_cycles.iter().copied()).collect()
+    }
+
     pub fn cycles_per_ray(&self) -> f64 {
         self.cycles as f64 / self.rays.max(1) as f64
     }
@@ -138,7 +154,7 @@ pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u6
     let order: Vec<usize> =
         names.iter().map(|n| m.outputs.iter().position(|o| o.0 == *n).expect("a core output")).collect();
     let mut sim = BatchSim::new(m, 256).expect("a design without inputs");
-    let mut stats = CoreStats { rays: count as u64, state_cycles: vec![0; 8], ..Default::default() };
+    let mut stats = CoreStats::new(count as u64);
     let mut results: Vec<CoreResult> = Vec::with_capacity(count);
     let mut all = vec![0i128; m.outputs.len()];
     let mut finished: Option<u64> = None;
@@ -156,7 +172,7 @@ pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u6
                 cycles = c as u64 + 1 - skip;
                 stats.busy_cycles += row[7] as u64;
                 stats.max_stack_depth = stats.max_stack_depth.max(row[8] as u32);
-                stats.state_cycles[row[9] as usize & 7] += 1;
+                stats.count_state(row[9]);
                 if row[0] == 1 {
                     results.push(core_result(&row[1..7]));
                     if results.len() == count {
@@ -186,7 +202,7 @@ pub fn simulate_rust_cycle(
     let [ready, busy, depth, state] = ["ray_ready", "busy", "stack_depth", "fsm_state"].map(|n| port(&m, n));
     let res: Vec<_> =
         ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
-    let mut stats = CoreStats { rays: rays.len() as u64, state_cycles: vec![0; 8], ..Default::default() };
+    let mut stats = CoreStats::new(rays.len() as u64);
     let mut results = Vec::with_capacity(rays.len());
     let mut next = 0;
     let idle = vec![0i128; ins.len()];
@@ -203,7 +219,7 @@ pub fn simulate_rust_cycle(
         // show these before it).
         stats.busy_cycles += sim.get(busy) as u64;
         stats.max_stack_depth = stats.max_stack_depth.max(sim.get(depth) as u32);
-        stats.state_cycles[sim.get(state) as usize & 7] += 1;
+        stats.count_state(sim.get(state));
         next += fire as usize;
         if sim.get(res[0]) == 1 {
             let row: Vec<i128> = res[1..].iter().map(|s| sim.get(*s)).collect();

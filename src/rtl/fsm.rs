@@ -157,9 +157,10 @@ impl<'b, St: States> Fsm<'b, St> {
         body(&mut ctx);
     }
 
-    /// Builds every assigned register's next value and the memory write ports. Panics (a bug
-    /// in the core) when a state has no block.
-    pub fn finish(self) {
+    /// Builds every assigned register's next value and the memory write ports; returns the
+    /// next values (for logic that must see a register's next value, such as a memory
+    /// addressed one clock ahead). Panics (a bug in the core) when a state has no block.
+    pub fn finish(self) -> Nexts<'b> {
         let b = self.b;
         let rec = std::mem::take(&mut *self.rec.borrow_mut());
         for st in St::ALL {
@@ -173,6 +174,7 @@ impl<'b, St: States> Fsm<'b, St> {
         b.with(|m| m.current_block = Some(self.block));
         let is = |code: u128| self.is(St::ALL[code as usize]);
         let all = |conds: &[usize]| -> Option<S<'b>> { conds.iter().map(|&c| rec.sigs[c]).reduce(|a, c| a & c) };
+        let mut nexts = Nexts(BTreeMap::new());
         for (&target, list) in &rec.assigns {
             let reg = rec.sigs[target];
             // Per state, the assignments in order: the last one that applies wins.
@@ -196,7 +198,9 @@ impl<'b, St: States> Fsm<'b, St> {
                 [(st, v)] => is(*st).select(*v, reg),
                 _ => b.case(self.state, &arms, reg),
             };
-            b.next(reg, next.name(&format!("{}_next", b.name_of(reg.sig))));
+            let next = next.name(&format!("{}_next", b.name_of(reg.sig)));
+            b.next(reg, next);
+            nexts.0.insert(reg.sig.id.0, next);
         }
         for (&mem, list) in &rec.writes {
             let when: Vec<S<'b>> = list
@@ -215,6 +219,16 @@ impl<'b, St: States> Fsm<'b, St> {
             b.ram_write(mem, we, addr, data);
         }
         b.with(|m| m.end_block());
+        nexts
+    }
+}
+
+/// The next values of a machine's registers.
+pub struct Nexts<'b>(BTreeMap<u32, S<'b>>);
+
+impl<'b> Nexts<'b> {
+    pub fn of(&self, reg: S<'b>) -> S<'b> {
+        *self.0.get(&reg.sig.id.0).expect("a register the machine assigns")
     }
 }
 
