@@ -7,133 +7,117 @@
 //! takes the ray; then the next pixel), `done` (after the last pixel).
 
 use crate::model::raygen::RayGen;
-use crate::rtl::{Module, Ty, UnOp};
+use crate::rtl::build::Builder;
+use crate::rtl::fsm::Fsm;
+use crate::rtl::{Module, Ty};
+use crate::scene::rom::value_bits;
 
-const DIV: i128 = 0;
-const FULL: i128 = 1;
-const DONE: i128 = 2;
+crate::states! {
+    /// The generator's states, in encoding order.
+    pub enum GenState {
+        /// The reciprocals of the current pixel's direction.
+        Div = "div",
+        /// `ray_valid` until the core takes the ray.
+        Full = "full",
+        /// After the last pixel.
+        Done = "done",
+    }
+}
 
 /// Ports: `ready` in; `ray_valid`, `ray_id`, `ox oy oz`, `wx wy wz`, `invx invy invz` out (the
 /// core's ray inputs, in `top::core_inputs` order).
 pub fn raygen_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Module {
-    let mut m = Module::new("fxrt_raygen");
+    use GenState::*;
+    let b = Builder::new("fxrt_raygen");
     let f = m_bits - 1;
     let qbits = f + c + 1;
-    let ready = m.input("ready", Ty::BIT);
-    let state = m.reg("state", Ty::u(2), Some(DIV));
-    let in_div = m.eq_k("in_div", state, DIV);
-    let in_full = m.eq_k("in_full", state, FULL);
-    let take = m.and("take", in_full, ready);
+    let ready = b.input("ready", Ty::BIT);
+    let fsm = Fsm::new(&b, "state", "pinhole rays, pixel after pixel", Div);
 
     // Pixel counters and the direction, stepped when a ray is taken.
-    let xw = crate::scene::rom::value_bits(g.width as usize);
-    let yw = crate::scene::rom::value_bits(g.height as usize);
-    let px = m.reg("px", Ty::u(xw), Some(0));
-    let py = m.reg("py", Ty::u(yw), Some(0));
-    let id = m.reg("pixel", Ty::u(id_width), Some(0));
-    let last_x = m.eq_k("last_x", px, g.width as i128 - 1);
-    let last_y = m.eq_k("last_y", py, g.height as i128 - 1);
-    let last = m.and("last_pixel", last_x, last_y);
-    let one_x = m.konst("one_x", px.ty, 1);
-    let one_y = m.konst("one_y", py.ty, 1);
-    let one_id = m.konst("one_id", id.ty, 1);
-    let zero_x = m.konst("zero_x", px.ty, 0);
-    let px_inc = m.add("px_inc", px, one_x);
-    let py_inc = m.add("py_inc", py, one_y);
-    let id_inc = m.add("pixel_inc", id, one_id);
-    let px_next = m.mux("px_next", last_x, zero_x, px_inc);
-    m.connect(px, px_next, Some(take));
-    let row_end = m.and("row_end", take, last_x);
-    m.connect(py, py_inc, Some(row_end));
-    m.connect(id, id_inc, Some(take));
+    let px = b.reg("px", Ty::u(value_bits(g.width as usize)), Some(0));
+    let py = b.reg("py", Ty::u(value_bits(g.height as usize)), Some(0));
+    let id = b.reg("pixel", Ty::u(id_width), Some(0));
+    let last_x = px.eq(g.width as i128 - 1).name("last_x");
+    let last = (last_x & py.eq(g.height as i128 - 1)).name("last_pixel");
     // Directions in m + 2 bits, so no step in or just past the frame wraps.
     let dw = Ty::s(m_bits + 2);
-    let mut w_out = Vec::new();
-    for k in 0..3 {
-        let a = ["x", "y", "z"][k];
-        let dx = m.konst(&format!("dx_{a}"), dw, g.dx[k] as i128);
-        let dy = m.konst(&format!("dy_{a}"), dw, g.dy[k] as i128);
-        let row = m.reg(&format!("row_{a}"), dw, Some(g.d0[k] as i128));
-        let d = m.reg(&format!("d_{a}"), dw, Some(g.d0[k] as i128));
-        let row_next = m.add(&format!("row_next_{a}"), row, dy);
-        m.connect(row, row_next, Some(row_end));
-        let d_step = m.add(&format!("d_step_{a}"), d, dx);
-        let d_next = m.mux(&format!("d_next_{a}"), last_x, row_next, d_step);
-        m.connect(d, d_next, Some(take));
-        w_out.push(m.resize(&format!("w_{a}"), d, m_bits));
-    }
+    let axes = ["x", "y", "z"];
+    let row = [0, 1, 2].map(|k| b.reg(&format!("row_{}", axes[k]), dw, Some(g.d0[k] as i128)));
+    let d = [0, 1, 2].map(|k| b.reg(&format!("d_{}", axes[k]), dw, Some(g.d0[k] as i128)));
+    let row_next = [0, 1, 2].map(|k| row[k] + g.dy[k] as i128);
+    let w_out = d.map(|d| d.resize(m_bits));
 
-    // Three restoring dividers: q = floor(2^(F+C) / |w|), |w| = 1 for w = 0.
-    let count = m.reg("div_count", Ty::u(crate::scene::rom::value_bits(qbits as usize)), Some(0));
-    let one_c = m.konst("count_one", count.ty, 1);
-    let count_inc = m.add("count_inc", count, one_c);
-    let zero_c = m.konst("count_zero", count.ty, 0);
-    let div_last = m.eq_k("div_last", count, qbits as i128 - 1);
-    let count_next = m.mux("count_next", in_div, count_inc, zero_c);
-    m.connect(count, count_next, None);
-    let first_bit = m.eq_k("first_bit", count, 0);
+    // Three restoring dividers: q = floor(2^(F+C) / |w|), |w| = 1 for w = 0; one quotient bit
+    // per clock, the numerator's only 1 (its top bit) shifted in first.
+    let count = b.reg("div_count", Ty::u(value_bits(qbits as usize)), Some(0));
+    let first_bit = count.eq(0).name("first_bit");
     let lim = (1i128 << (m_bits + c - 1)) - 1;
+    let rem = axes.map(|a| b.reg(&format!("rem_{a}"), Ty::u(f + 2), Some(0)));
+    let quot = axes.map(|a| b.reg(&format!("quot_{a}"), Ty::u(qbits), Some(0)));
+    let mut steps = Vec::new();
     let mut inv_out = Vec::new();
-    for (k, w) in w_out.iter().enumerate() {
-        let a = ["x", "y", "z"][k];
-        let zero_w = m.konst(&format!("zero_w_{a}"), w.ty, 0);
-        let neg = m.lt(&format!("neg_{a}"), *w, zero_w);
-        let is_zero = m.equals(&format!("w0_{a}"), *w, zero_w);
-        let minus = m.un(&format!("minus_{a}"), UnOp::Neg, *w);
-        let mag_s = m.mux(&format!("mag_s_{a}"), neg, minus, *w);
-        let mag = m.un(&format!("mag_{a}"), UnOp::AsUnsigned, mag_s);
-        let mag = m.resize(&format!("mag_w_{a}"), mag, f + 2);
-        let one_m = m.konst(&format!("one_m_{a}"), mag.ty, 1);
-        let b = m.mux(&format!("b_{a}"), is_zero, one_m, mag);
-        let r = m.reg(&format!("rem_{a}"), Ty::u(f + 2), Some(0));
-        let q = m.reg(&format!("quot_{a}"), Ty::u(qbits), Some(0));
-        // Shift in the numerator's only 1 (its top bit) first, zeros after.
-        let zero_r = m.konst(&format!("zero_r_{a}"), r.ty, 0);
-        let r_in = m.mux(&format!("r_in_{a}"), first_bit, zero_r, r);
-        let r2 = m.shl(&format!("r2_{a}"), r_in, 1);
-        let bit = m.resize(&format!("bit_{a}"), first_bit, f + 2);
-        let r3 = m.add(&format!("r3_{a}"), r2, bit);
-        let ge = m.le(&format!("ge_{a}"), b, r3);
-        let diff = m.sub(&format!("diff_{a}"), r3, b);
-        let r_next = m.mux(&format!("r_next_{a}"), ge, diff, r3);
-        m.connect(r, r_next, Some(in_div));
-        let zero_q = m.konst(&format!("zero_q_{a}"), q.ty, 0);
-        let q_in = m.mux(&format!("q_in_{a}"), first_bit, zero_q, q);
-        let q2 = m.shl(&format!("q2_{a}"), q_in, 1);
-        let ge_w = m.resize(&format!("ge_w_{a}"), ge, qbits);
-        let q_next = m.add(&format!("q_next_{a}"), q2, ge_w);
-        m.connect(q, q_next, Some(in_div));
+    for k in 0..3 {
+        let w = w_out[k];
+        let neg = w.lt(0).name(&format!("neg_{}", axes[k]));
+        let mag = neg.select(-w, w).unsigned().resize(f + 2);
+        let divisor = w.eq(0).select(mag.k(1), mag).name(&format!("b_{}", axes[k]));
+        let r3 = (first_bit.select(rem[k].k(0), rem[k]) << 1) + first_bit.resize(f + 2);
+        let ge = divisor.le(r3);
+        let r_next = ge.select(r3 - divisor, r3);
+        let q_next = (first_bit.select(quot[k].k(0), quot[k]) << 1) + ge.resize(qbits);
+        steps.push((r_next, q_next));
         // Saturate to the m + C-bit range, then the sign.
-        let lim_q = m.konst(&format!("lim_{a}"), q.ty, lim);
-        let over = m.lt(&format!("over_{a}"), lim_q, q);
-        let q_sat = m.mux(&format!("q_sat_{a}"), over, lim_q, q);
-        let q_s = m.resize(&format!("q_s_{a}"), q_sat, m_bits + c);
-        let q_s = m.un(&format!("q_signed_{a}"), UnOp::AsSigned, q_s);
-        let q_neg = m.un(&format!("q_neg_{a}"), UnOp::Neg, q_s);
-        inv_out.push(m.mux(&format!("inv_{a}"), neg, q_neg, q_s));
+        let q = quot[k];
+        let q_s = q.gt(lim).select(q.k(lim), q).resize(m_bits + c).signed();
+        inv_out.push(neg.select(-q_s, q_s).name(&format!("inv_{}", axes[k])));
     }
 
-    let k = |m: &mut Module, name: &str, v: i128| m.konst(name, Ty::u(2), v);
-    let (s_div, s_full, s_done) = (k(&mut m, "st_div", DIV), k(&mut m, "st_full", FULL), k(&mut m, "st_done", DONE));
-    let from_div = m.mux("from_div", div_last, s_full, s_div);
-    let after = m.mux("after_take", last, s_done, s_div);
-    let from_full = m.mux("from_full", ready, after, s_full);
-    let state_next = m.case("state_next", state, &[(DIV as u128, from_div), (FULL as u128, from_full)], s_done);
-    m.connect(state, state_next, None);
+    fsm.state(Div, |s| {
+        s.set(count, count + 1);
+        for k in 0..3 {
+            s.set(rem[k], steps[k].0);
+            s.set(quot[k], steps[k].1);
+        }
+        s.when(count.eq(qbits as i128 - 1), |s| s.goto(Full));
+    });
+    fsm.state(Full, |s| {
+        s.set_k(count, 0);
+        s.when(ready, |s| {
+            s.set(id, id + 1);
+            s.when(last_x, |s| {
+                s.set_k(px, 0);
+                s.set(py, py + 1);
+                for k in 0..3 {
+                    s.set(row[k], row_next[k]);
+                    s.set(d[k], row_next[k]);
+                }
+            })
+            .otherwise(|s| {
+                s.set(px, px + 1);
+                for k in 0..3 {
+                    s.set(d[k], d[k] + g.dx[k] as i128);
+                }
+            });
+            s.when(last, |s| s.goto(Done)).otherwise(|s| s.goto(Div));
+        });
+    });
+    fsm.state(Done, |s| s.set_k(count, 0));
+    let in_full = fsm.is(Full);
+    fsm.finish();
 
-    m.output("ray_valid", in_full);
-    m.output("ray_id", id);
+    b.output("ray_valid", in_full);
+    b.output("ray_id", id);
     for (k, name) in ["ox", "oy", "oz"].iter().enumerate() {
-        let o = m.konst(&format!("eye_{name}"), Ty::u(n), g.eye[k] as i128);
-        m.output(name, o);
+        b.output(name, b.konst(Ty::u(n), g.eye[k] as i128).name(&format!("eye_{name}")));
     }
-    for (name, w) in ["wx", "wy", "wz"].iter().zip(&w_out) {
-        m.output(name, *w);
+    for (name, w) in ["wx", "wy", "wz"].iter().zip(w_out) {
+        b.output(name, w);
     }
-    for (name, inv) in ["invx", "invy", "invz"].iter().zip(&inv_out) {
-        m.output(name, *inv);
+    for (name, inv) in ["invx", "invy", "invz"].iter().zip(inv_out) {
+        b.output(name, inv);
     }
-    m
+    b.finish()
 }
 
 #[cfg(test)]
