@@ -6,7 +6,7 @@
 use super::divider::{self, divider_core};
 use crate::rtl::build::{Builder, S};
 use crate::rtl::pipeline::{Pipeline, Policy};
-use crate::rtl::{Module, Sig, Ty, UnOp};
+use crate::rtl::{Module, Ty};
 use serde::Serialize;
 use std::rc::Rc;
 
@@ -100,11 +100,6 @@ pub fn input_ports(p: &IntersectParams) -> Vec<(&'static str, Ty)> {
         ("e2p", Ty::s(m)),
         ("e2q", Ty::s(m)),
     ]
-}
-
-pub(crate) fn as_signed_wider(m: &mut Module, name: &str, x: Sig) -> Sig {
-    let w = m.resize(&format!("{name}_w"), x, x.ty.width + 1);
-    m.un(name, UnOp::AsSigned, w)
 }
 
 /// (a + 1) mod 3 for a 2-bit axis number.
