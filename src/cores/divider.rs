@@ -10,14 +10,9 @@
 //! then n + 1 quotient stages; the first also makes the overflow test, the last also forms
 //! the result flag. With two quotient bits per stage: 1 + ⌈(n + 1)/2⌉.
 
-use crate::rtl::{BinOp, Module, Sig, Ty, UnOp};
-
-pub struct DividerOut {
-    /// floor(|num| / |den|), n + 1 bits unsigned.
-    pub t: Sig,
-    /// 1 when t is a valid distance (no error).
-    pub ok: Sig,
-}
+use crate::rtl::build::Builder;
+use crate::rtl::pipeline::{Pipeline, Policy};
+use crate::rtl::{Module, Ty};
 
 /// Latency in clock cycles of `divider_stages` for grid bits `n` and `bits_per_stage`
 /// quotient bits computed between two registers.
@@ -25,102 +20,72 @@ pub fn latency(n: u32, bits_per_stage: u32) -> u32 {
     1 + (n + 1).div_ceil(bits_per_stage)
 }
 
-/// Appends the divider to `m`. `num` and `den` are signed. `bits_per_stage` quotient bits (1 or 2) are computed between two pipeline registers: 2
-/// halves the registers and the latency at the price of two subtractors in series.
-fn divider_stages(m: &mut Module, n: u32, bits_per_stage: u32, num: Sig, den: Sig) -> DividerOut {
-    assert!((1..=2).contains(&bits_per_stage));
-    assert!(num.ty.signed && den.ty.signed);
-    let (wn, wd) = (num.ty.width, den.ty.width);
-    let qbits = n + 1;
-    // Stage 1: signs, zero tests, magnitudes (|x| of an s(w) value fits u(w)).
-    let zero_n = m.konst("div_zero_n", num.ty, 0);
-    let zero_d = m.konst("div_zero_d", den.ty, 0);
-    let n_neg = m.bin("div_num_neg", BinOp::Lt, num, zero_n);
-    let d_neg = m.bin("div_den_neg", BinOp::Lt, den, zero_d);
-    let n_zero = m.bin("div_num_zero", BinOp::Eq, num, zero_n);
-    let d_zero = m.bin("div_den_zero", BinOp::Eq, den, zero_d);
-    let sign_diff = m.bin("div_sign_diff", BinOp::Xor, n_neg, d_neg);
-    let e1 = m.bin("div_err_a", BinOp::Or, n_zero, d_zero);
-    let err = m.bin("div_err_b", BinOp::Or, e1, sign_diff);
-    let num_neg = m.un("div_num_negated", UnOp::Neg, num);
-    let num_abs_s = m.mux("div_num_abs_s", n_neg, num_neg, num);
-    let a = m.un("div_a", UnOp::AsUnsigned, num_abs_s);
-    let den_neg = m.un("div_den_negated", UnOp::Neg, den);
-    let den_abs_s = m.mux("div_den_abs_s", d_neg, den_neg, den);
-    let b = m.un("div_b", UnOp::AsUnsigned, den_abs_s);
-    let a_r = m.delay("div1_a", a);
-    let b_r = m.delay("div1_b", b);
-    let err_r = m.delay("div1_err", err);
-
-    // The overflow test: hi = a >> (n+1) must be below b.
-    let hi_w = wn.saturating_sub(qbits).max(1);
-    let hi = if wn > qbits { m.slice("div_hi", a_r, qbits, wn - qbits) } else { m.konst("div_hi", Ty::u(1), 0) };
-    let lo = m.resize("div_lo", a_r, qbits.min(wn));
-    let lo = m.resize("div_lo_full", lo, qbits);
-    let cw = hi_w.max(wd);
-    let hi_c = m.resize("div_hi_c", hi, cw);
-    let b_c = m.resize("div_b_c", b_r, cw);
-    let overflow = m.bin("div_overflow", BinOp::Le, b_c, hi_c);
-    let err2 = m.bin("div_err_c", BinOp::Or, err_r, overflow);
-    // The partial remainder is < b whenever there is no overflow, so wd bits hold it.
-    let p0 = m.resize("div_p0", hi, wd);
-
-    // Quotient bits n … 0, one per stage; stage k consumes bit (n − k) of lo.
-    let mut p = p0;
-    let mut q = m.konst("div_q0", Ty::u(qbits), 0);
-    let (mut b_s, mut lo_s, mut err_s) = (b_r, lo, err2);
-    let b_w = m.resize("div_b_w", b_s, wd + 1);
-    let mut b_w = b_w;
-    for k in 0..qbits {
-        let bit_ix = qbits - 1 - k;
-        let bit = m.bit(&format!("div{k}_in"), lo_s, bit_ix);
-        let p_w = m.resize(&format!("div{k}_pw"), p, wd + 1);
-        let p2 = m.shl(&format!("div{k}_p2"), p_w, 1);
-        let bit_w = m.resize(&format!("div{k}_bw"), bit, wd + 1);
-        let p3 = m.bin(&format!("div{k}_p3"), BinOp::Or, p2, bit_w);
-        let ge = m.bin(&format!("div{k}_ge"), BinOp::Le, b_w, p3);
-        let diff = m.sub(&format!("div{k}_diff"), p3, b_w);
-        let pn = m.mux(&format!("div{k}_pn"), ge, diff, p3);
-        let pn = m.resize(&format!("div{k}_rem"), pn, wd);
-        let q2 = m.shl(&format!("div{k}_q2"), q, 1);
-        let ge_w = m.resize(&format!("div{k}_gew"), ge, qbits);
-        let qn = m.bin(&format!("div{k}_qn"), BinOp::Or, q2, ge_w);
-        if k + 1 == qbits {
-            // Last stage: register the quotient and the result flag.
-            let zero_q = m.konst("div_zero_q", Ty::u(qbits), 0);
-            let q_zero = m.bin("div_q_zero", BinOp::Eq, qn, zero_q);
-            let bad = m.bin("div_bad", BinOp::Or, err_s, q_zero);
-            let one = m.konst("div_one", Ty::BIT, 1);
-            let ok = m.bin("div_ok_c", BinOp::Xor, bad, one);
-            let t = m.delay("div_t", qn);
-            let ok = m.delay("div_ok", ok);
-            return DividerOut { t, ok };
-        }
-        if (k + 1) % bits_per_stage != 0 {
-            // The next quotient bit is computed in the same clock cycle.
-            (p, q) = (pn, qn);
-            continue;
-        }
-        p = m.delay(&format!("div{}_p", k + 2), pn);
-        q = m.delay(&format!("div{}_q", k + 2), qn);
-        b_s = m.delay(&format!("div{}_b", k + 2), b_s);
-        b_w = m.resize(&format!("div{}_bw", k + 2), b_s, wd + 1);
-        lo_s = m.delay(&format!("div{}_lo", k + 2), lo_s);
-        err_s = m.delay(&format!("div{}_err", k + 2), err_s);
-    }
-    unreachable!("the loop returns at its last stage")
+crate::bundle! {
+    /// Magnitudes of the operands and the error of their signs.
+    struct Operands { a, b, err }
+}
+crate::bundle! {
+    /// The partial remainder and the quotient bits so far.
+    struct Partial { p, q }
+}
+crate::bundle! {
+    /// The result ports.
+    struct Quotient { t, ok }
 }
 
-/// The divider as a standalone core: ports num, den → t, ok.
+/// The divider as a standalone core: ports num, den (signed) → t (n + 1 bits), ok.
+/// `bits_per_stage` quotient bits (1 or 2) are computed between two pipeline registers: 2
+/// halves the registers and the latency at the price of two subtractors in series — the same
+/// description, with every other quotient stage merged by the pipeline policy.
 pub fn divider_core(n: u32, bits_per_stage: u32, num_width: u32, den_width: u32) -> Module {
+    assert!((1..=2).contains(&bits_per_stage));
     let suffix = if bits_per_stage == 2 { "_r4" } else { "" };
-    let mut m = Module::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}{suffix}"));
-    let num = m.input("num", Ty::s(num_width));
-    let den = m.input("den", Ty::s(den_width));
-    let out = divider_stages(&mut m, n, bits_per_stage, num, den);
-    m.output("t", out.t);
-    m.output("ok", out.ok);
-    m
+    let b = Builder::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}{suffix}"));
+    let (wn, wd) = (num_width, den_width);
+    let num = b.input("num", Ty::s(wn));
+    let den = b.input("den", Ty::s(wd));
+    let qbits = n + 1;
+    let merge = (0..qbits - 1).filter(|k| (k + 1) % bits_per_stage != 0).map(|k| format!("q{k}")).collect();
+    let pipe = Pipeline::new(&b, Policy { merge });
+    // Signs, zero tests, magnitudes (|x| of an s(w) value fits u(w)).
+    let (n_neg, d_neg) = (num.lt(0).name("num_neg"), den.lt(0).name("den_neg"));
+    let ops = pipe.stage(
+        "operands",
+        "signs, zero tests, magnitudes",
+        Operands {
+            a: n_neg.select(-num, num).unsigned(),
+            b: d_neg.select(-den, den).unsigned(),
+            err: num.eq(0) | den.eq(0) | (n_neg ^ d_neg),
+        },
+    );
+    // The overflow test: hi = a >> (n+1) must be below b. Without overflow the partial
+    // remainder stays below b, so wd bits hold it.
+    let hi = if wn > qbits { ops.a.slice(qbits, wn - qbits) } else { b.konst(Ty::u(1), 0) };
+    let lo = ops.a.resize(qbits.min(wn)).resize(qbits).name("lo");
+    let cw = hi.width().max(wd);
+    let err = (ops.err | ops.b.resize(cw).le(hi.resize(cw))).name("err");
+    let mut part = Partial { p: hi.resize(wd), q: b.konst(Ty::u(qbits), 0) };
+    let mut result = None;
+    // Quotient bits n … 0; step k shifts in bit n − k of lo and subtracts b if it can.
+    for k in 0..qbits {
+        let bw = pipe.now(ops.b).resize(wd + 1);
+        let p3 = (part.p.resize(wd + 1) << 1) | pipe.now(lo).bit(qbits - 1 - k).resize(wd + 1);
+        let ge = bw.le(p3).name(&format!("ge{k}"));
+        let p_next = ge.select(p3 - bw, p3).resize(wd);
+        let q_next = (part.q << 1) | ge.resize(qbits);
+        if k + 1 < qbits {
+            part = pipe.stage(&format!("q{k}"), "one quotient bit", Partial { p: p_next, q: q_next });
+            continue;
+        }
+        let ok = !(pipe.now(err) | q_next.eq(0));
+        result = Some(pipe.stage("result", "the quotient and its result flag", Quotient { t: q_next, ok }));
+    }
+    let out = result.expect("n + 1 ≥ 1 quotient bits");
+    let lat = pipe.finish();
+    debug_assert_eq!(lat, latency(n, bits_per_stage));
+    b.output("t", out.t);
+    b.output("ok", out.ok);
+    b.finish()
 }
 
 #[cfg(test)]

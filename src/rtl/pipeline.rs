@@ -91,8 +91,16 @@ impl<'b> Pipeline<'b> {
         if let Some(s) = self.delayed.borrow().get(&key) {
             return *s;
         }
+        // Extend the longest copy made so far, so a signal read at many stages costs one
+        // register per stage, not one line per reader.
+        let (base, from) = self
+            .delayed
+            .borrow()
+            .range((x.sig.id.0, 0)..(x.sig.id.0, d))
+            .next_back()
+            .map_or((x, 0), |(k, s)| (*s, k.1));
         let name = format!("{}_d{d}", self.b.name_of(x.sig));
-        let s = self.b.delay_line(&name, x, d);
+        let s = self.b.delay_line(&name, base, d - from);
         self.delayed.borrow_mut().insert(key, s);
         s
     }
