@@ -17,8 +17,8 @@ pub mod run;
 pub mod summary;
 
 use crate::error::{Error, Result};
-use crate::params::{EdgeShift, Params};
 pub use crate::model::camera::CameraSpec;
+use crate::params::{EdgeShift, Params};
 use crate::scene::SceneSource;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
