@@ -4,9 +4,9 @@
 mod common;
 
 use fxrt::model::camera::Camera;
-use fxrt::model::golden::Golden;
 use fxrt::model::ray::{dot, quantize_ray};
 use fxrt::params::Params;
+use fxrt::render::fast::FastGolden;
 use fxrt::render::tracer::{GoldenTracer, ModelKind, make_tracer};
 use fxrt::render::{compare, render};
 
@@ -29,7 +29,7 @@ fn secondary_rays_never_hit_their_own_triangle() {
     let params = Params::default();
     for scene in common::all_scenes(&params) {
         let tracer = GoldenTracer::new(&scene);
-        let g = &tracer.golden;
+        let g = &tracer.fast.golden;
         let cam = Camera::default_for(&scene, 128, 128);
         let (mut spawned, mut self_hits) = (0u64, 0u64);
         for py in 0..cam.height {
@@ -67,15 +67,16 @@ fn early_out_gives_the_hardware_traversal_answer_bit_for_bit() {
         Params { n: 23, m: 27, t: 5, ..Params::default() },
     ] {
         for scene in common::all_scenes(&params).into_iter().take(5) {
-            let g = Golden::new(&scene);
+            let fast = FastGolden::new(&scene);
+            let g = &fast.golden;
             let cam = Camera::default_for(&scene, 96, 96);
             let mut hits = 0;
             for py in 0..cam.height {
                 for px in 0..cam.width {
-                    let Some(q) = quantize_ray(&scene, &g, &cam.ray(px, py)) else { continue };
+                    let Some(q) = quantize_ray(&scene, g, &cam.ray(px, py)) else { continue };
                     let (full, fs) = g.trace(&scene, &q.ray);
-                    let (fast, es) = g.trace_fast(&scene, &q.ray);
-                    assert_eq!(full, fast, "{} pixel {px},{py}", scene.name);
+                    let (quick, es) = fast.trace(&q.ray);
+                    assert_eq!(full, quick, "{} pixel {px},{py}", scene.name);
                     assert!(es.tri_tests <= fs.tri_tests);
                     hits += full.is_some() as u32;
                 }

@@ -1,10 +1,12 @@
-//! One netlist, four simulators: a module using every operator is simulated in Rust, and its
-//! VHDL and Verilog run under GHDL, Icarus and Verilator against the Rust transcript. Each
-//! simulator that is not installed is reported as skipped.
+//! One netlist, four simulators: a module using every operator, a pipeline-stage block, a
+//! state-machine block and delay lines is simulated in Rust, and its VHDL and Verilog run under
+//! GHDL, Icarus and Verilator against the Rust transcript; both languages also pass Verilator's
+//! lint, `ghdl --synth` and yosys. Each tool that is not installed is reported as skipped.
 
 use fxrt::flow::simulators::Simulator;
 use fxrt::flow::testbench::{Stimulus, bench_files, record};
 use fxrt::rtl::emit::{design_files, verilog, vhdl};
+use fxrt::rtl::netlist::BlockKind;
 use fxrt::rtl::{BinOp, Module, Ty, UnOp};
 use std::io::Write;
 
@@ -63,12 +65,21 @@ fn all_ops() -> Module {
     out(&mut m, "o_cat", cat);
     let k = m.konst("k", Ty::s(13), -1234);
     let ak = m.add("a_plus_k", a, k);
-    // Registers: a plain pipeline stage, one with enable and reset, and a ROM read.
+    // Registers: a pipeline stage (a block: its own process), one with enable and reset, and a
+    // ROM read.
+    m.begin_block("s1", "the sum and its tag, registered", BlockKind::Stage);
     let r1 = m.delay("r1", ak);
-    out(&mut m, "o_r1", r1);
-    // A delay line: a shift register of five words.
+    // A delay line in the stage: a shift register of five words.
     let dl = m.delay_line("tag_late", wide, 5);
+    let r1_low = m.slice("r1_low", r1, 0, 4);
+    m.end_block();
+    out(&mut m, "o_r1", r1);
+    out(&mut m, "o_r1_low", r1_low);
     out(&mut m, "o_tag_late", dl);
+    // A delay line in no block, of a one-bit signal.
+    let sel_late = m.delay_line("sel_late", sel, 3);
+    out(&mut m, "o_sel_late", sel_late);
+    state_machine(&mut m, sel, c, d);
     let acc = m.reg("acc", Ty::u(7), Some(5));
     let accn = m.add("acc_next", acc, c);
     m.connect(acc, accn, Some(sel));
@@ -95,6 +106,30 @@ fn all_ops() -> Module {
     out(&mut m, "o_first", first[0]);
     out(&mut m, "o_second_sel", second[1]);
     m
+}
+
+/// A state-machine block: idle → (sel) run → (c < d) hold → done → idle, a counter of the
+/// cycles spent in `run`, and a flag compared against the state.
+fn state_machine(m: &mut Module, go: fxrt::rtl::Sig, c: fxrt::rtl::Sig, d: fxrt::rtl::Sig) {
+    let names: Vec<String> = ["idle", "run", "hold", "done"].iter().map(|s| s.to_string()).collect();
+    let b = m.begin_block("ctl", "a small controller", BlockKind::Stage);
+    let t = Ty::u(2);
+    let state = m.reg("state", t, Some(0));
+    m.blocks[b].kind = BlockKind::Fsm { state: state.id, states: names };
+    let k: Vec<_> = (0..4).map(|v| m.konst(&format!("to_{v}"), t, v)).collect();
+    let from_idle = m.mux("from_idle", go, k[1], k[0]);
+    let lt = m.lt("c_lt_d", c, d);
+    let from_run = m.mux("from_run", lt, k[2], k[1]);
+    let next = m.case("state_next", state, &[(0, from_idle), (1, from_run), (2, k[3])], k[0]);
+    m.connect(state, next, None);
+    let in_run = m.eq_k("in_run", state, 1);
+    let count = m.reg("count", Ty::u(5), Some(0));
+    let one = m.konst("one", Ty::u(5), 1);
+    let inc = m.add("count_inc", count, one);
+    m.connect(count, inc, Some(in_run));
+    m.end_block();
+    m.output("o_state", state);
+    m.output("o_count", count);
 }
 
 /// A sub-module with a `case`, a register and a combinational path from input to output.
@@ -168,6 +203,33 @@ fn printers_are_deterministic_and_lint_clean() {
     assert_eq!(verilog::print(&m), verilog::print(&all_ops()));
     let files = design_files(&m, "v");
     let v: String = files.iter().filter(|f| f.0.ends_with(".v")).map(|f| f.1.as_str()).collect();
+    let vhd = vhdl::print(&m);
+    // A process per block and one for the registers in no block; the states by name.
+    for text in ["regs : process (clk)", "s1_regs : process (clk)", "ctl_regs : process (clk)"] {
+        assert!(vhd.contains(text), "{text}\n{vhd}");
+    }
+    for text in
+        ["constant st_idle : unsigned(1 downto 0) := \"00\";", "constant to_3 : unsigned(1 downto 0) := st_done;"]
+    {
+        assert!(vhd.contains(text), "{text}\n{vhd}");
+    }
+    assert!(vhd.contains("-- stage s1: the sum and its tag, registered"), "{vhd}");
+    assert!(vhd.contains("from_idle when st_idle,"), "{vhd}");
+    for text in [
+        "always @(posedge clk) begin : ctl_regs",
+        "// state machine ctl: a small controller",
+        "st_run: state_next = from_run;",
+    ] {
+        assert!(v.contains(text), "{text}\n{v}");
+    }
+    // Shift registers, not unrolled chains.
+    assert!(vhd.contains("tag_late_sr(2 to 5) <= tag_late_sr(1 to 4);"), "{vhd}");
+    // Waivers are local: one declaration each, with the reason beside it.
+    for (k, line) in v.lines().enumerate().filter(|l| l.1.contains("lint_off")) {
+        assert!(line.contains("*/  // "), "line {k}: {line}");
+        let on = v.lines().skip(k + 1).position(|l| l.contains("lint_on")).expect("lint_on");
+        assert!(on <= 4, "line {k}: a waiver over {on} lines");
+    }
     // No `$` in any emitted name: the only `$` are the system functions the printer uses.
     let system = ["$signed", "$unsigned", "$readmemh"].iter().map(|s| v.matches(s).count()).sum::<usize>();
     assert_eq!(v.matches('$').count(), system);
@@ -187,4 +249,32 @@ fn printers_are_deterministic_and_lint_clean() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && !text.contains("%Warning"), "{text}");
+}
+
+/// `ghdl --synth` takes the VHDL and yosys synthesises the Verilog (shift registers, the
+/// state machine, memories), each skipped when not installed.
+#[test]
+fn both_languages_synthesise() {
+    let m = all_ops();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("rtl_cross_synth");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for ext in ["vhd", "v"] {
+        for (file, text) in design_files(&m, ext) {
+            std::fs::write(dir.join(file), text).unwrap();
+        }
+    }
+    let run = |prog: &str, args: &[&str]| match std::process::Command::new(prog).args(args).current_dir(&dir).output() {
+        Ok(o) => assert!(
+            o.status.success(),
+            "{prog}: {}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        ),
+        Err(_) => {
+            let _ = writeln!(std::io::stderr().lock(), "skipped: {prog} is not installed");
+        }
+    };
+    run("ghdl", &["--synth", "--std=93c", "--out=none", "ops_sub.vhd", "ops_check.vhd", "-e", "ops_check"]);
+    run("yosys", &["-q", "-p", "read_verilog ops_sub.v ops_check.v; synth -top ops_check"]);
 }

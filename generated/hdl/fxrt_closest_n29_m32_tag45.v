@@ -17,7 +17,7 @@ module fxrt_closest_n29_m32_tag45 (
   output wire [31:0] res_u,
   output wire [31:0] res_v
 );
-  /* verilator lint_off UNUSEDSIGNAL */
+
   wire [0:0] end_s;
   wire [12:0] tri_s;
   wire [30:0] tmin;
@@ -70,7 +70,7 @@ module fxrt_closest_n29_m32_tag45 (
   wire [31:0] v_zero = 32'h00000000;
   wire [31:0] v_masked;
   reg [31:0] res_v_r = 32'h00000000;
-  /* verilator lint_on UNUSEDSIGNAL */
+
   assign end_s = tag[44];
   assign tri_s = tag[12:0];
   assign tmin = tag[43:13];
@@ -104,14 +104,8 @@ module fxrt_closest_n29_m32_tag45 (
   assign t_masked = best_valid ? best_t : t_zero;
   assign u_masked = best_valid ? best_u : u_zero;
   assign v_masked = best_valid ? best_v : v_zero;
-  assign res_valid = res_valid_r;
-  assign res_hit = res_hit_r;
-  assign res_id = res_id_r;
-  assign res_tri = res_tri_r;
-  assign res_t = res_t_r;
-  assign res_u = res_u_r;
-  assign res_v = res_v_r;
-  always @(posedge clk) begin
+
+  always @(posedge clk) begin : regs
     if (rst) best_valid <= 1'h0;
     else best_valid <= best_valid_next;
     if (take) best_t <= t;
@@ -127,5 +121,13 @@ module fxrt_closest_n29_m32_tag45 (
     if (finish) res_u_r <= u_masked;
     if (finish) res_v_r <= v_masked;
   end
+
+  assign res_valid = res_valid_r;
+  assign res_hit = res_hit_r;
+  assign res_id = res_id_r;
+  assign res_tri = res_tri_r;
+  assign res_t = res_t_r;
+  assign res_u = res_u_r;
+  assign res_v = res_v_r;
 endmodule
 `default_nettype wire

@@ -24,6 +24,7 @@ entity fxrt_closest_n29_m32_tag45 is
 end entity fxrt_closest_n29_m32_tag45;
 
 architecture rtl of fxrt_closest_n29_m32_tag45 is
+
   signal end_s : unsigned(0 downto 0);
   signal tri_s : unsigned(12 downto 0);
   signal tmin : unsigned(30 downto 0);
@@ -77,6 +78,7 @@ architecture rtl of fxrt_closest_n29_m32_tag45 is
   signal v_masked : unsigned(31 downto 0);
   signal res_v_r : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 begin
+
   end_s <= unsigned(tag(44 downto 44));
   tri_s <= unsigned(tag(12 downto 0));
   tmin <= unsigned(tag(43 downto 13));
@@ -110,15 +112,8 @@ begin
   t_masked <= best_t when best_valid = "1" else t_zero;
   u_masked <= best_u when best_valid = "1" else u_zero;
   v_masked <= best_v when best_valid = "1" else v_zero;
-  res_valid <= res_valid_r;
-  res_hit <= res_hit_r;
-  res_id <= res_id_r;
-  res_tri <= res_tri_r;
-  res_t <= res_t_r;
-  res_u <= res_u_r;
-  res_v <= res_v_r;
 
-  clocked : process (clk)
+  regs : process (clk)
   begin
     if rising_edge(clk) then
       if rst = '1' then
@@ -162,5 +157,13 @@ begin
         res_v_r <= v_masked;
       end if;
     end if;
-  end process;
+  end process regs;
+
+  res_valid <= res_valid_r;
+  res_hit <= res_hit_r;
+  res_id <= res_id_r;
+  res_tri <= res_tri_r;
+  res_t <= res_t_r;
+  res_u <= res_u_r;
+  res_v <= res_v_r;
 end architecture rtl;

@@ -26,13 +26,16 @@ module fxrt_core (
   output wire [5:0] stack_depth,
   output wire [2:0] fsm_state
 );
+
   reg [123:0] tri_rom_0 [0:8191];
   initial $readmemh("fxrt_core_tri_rom_0.hex", tri_rom_0);
+
   reg [127:0] tri_rom_1 [0:8191];
   initial $readmemh("fxrt_core_tri_rom_1.hex", tri_rom_1);
+
   reg [31:0] tri_rom_2 [0:8191];
   initial $readmemh("fxrt_core_tri_rom_2.hex", tri_rom_2);
-  /* verilator lint_off UNUSEDSIGNAL */
+
   wire [0:0] u_traverse_ray_ready;
   wire [0:0] u_traverse_emit_valid;
   wire [0:0] u_traverse_emit_end;
@@ -42,8 +45,12 @@ module fxrt_core (
   wire [28:0] u_traverse_cur_ox;
   wire [28:0] u_traverse_cur_oy;
   wire [28:0] u_traverse_cur_oz;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [0:0] u_traverse_visit;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [12:0] u_traverse_visit_node;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [5:0] u_traverse_stack_depth;
   wire [2:0] u_traverse_fsm_state;
   wire [0:0] accept;
@@ -92,7 +99,7 @@ module fxrt_core (
   wire [0:0] pipe_end;
   wire [0:0] pipe_not_end;
   wire [0:0] pipe_busy;
-  /* verilator lint_on UNUSEDSIGNAL */
+
   assign accept = ray_valid & u_traverse_ray_ready;
   assign tri_r = tri_word_0[1:0];
   assign tri_pp = tri_word_0[30:2];
@@ -118,17 +125,18 @@ module fxrt_core (
   assign pipe_end = pipe_tag[44];
   assign pipe_not_end = ~pipe_end;
   assign pipe_busy = pipe_valid & pipe_not_end;
-  assign ray_ready = u_traverse_ray_ready;
-  assign res_valid = u_closest_res_valid;
-  assign res_hit = u_closest_res_hit;
-  assign res_id = u_closest_res_id;
-  assign res_tri = u_closest_res_tri;
-  assign res_t = u_closest_res_t;
-  assign res_u = u_closest_res_u;
-  assign res_v = u_closest_res_v;
-  assign busy = pipe_busy;
-  assign stack_depth = u_traverse_stack_depth;
-  assign fsm_state = u_traverse_fsm_state;
+
+  always @(posedge clk) begin : regs
+    if (accept) wx_r <= wx;
+    if (accept) wy_r <= wy;
+    if (accept) wz_r <= wz;
+    tri_word_0 <= tri_rom_0[u_traverse_emit_tri];
+    tri_word_1 <= tri_rom_1[u_traverse_emit_tri];
+    tri_word_2 <= tri_rom_2[u_traverse_emit_tri];
+    pipe_valid <= u_traverse_emit_valid;
+    pipe_tag <= tag;
+  end
+
   fxrt_traverse u_traverse (
     .clk(clk),
     .rst(rst),
@@ -154,6 +162,7 @@ module fxrt_core (
     .stack_depth(u_traverse_stack_depth),
     .fsm_state(u_traverse_fsm_state)
   );
+
   fxrt_intersect_n29_m32_t0_e18_tag45 u_intersect (
     .clk(clk),
     .valid(pipe_valid),
@@ -181,6 +190,7 @@ module fxrt_core (
     .u_1(u_intersect_u_1),
     .v_1(u_intersect_v_1)
   );
+
   fxrt_closest_n29_m32_tag45 u_closest (
     .clk(clk),
     .rst(rst),
@@ -198,15 +208,17 @@ module fxrt_core (
     .res_u(u_closest_res_u),
     .res_v(u_closest_res_v)
   );
-  always @(posedge clk) begin
-    if (accept) wx_r <= wx;
-    if (accept) wy_r <= wy;
-    if (accept) wz_r <= wz;
-    tri_word_0 <= tri_rom_0[u_traverse_emit_tri];
-    tri_word_1 <= tri_rom_1[u_traverse_emit_tri];
-    tri_word_2 <= tri_rom_2[u_traverse_emit_tri];
-    pipe_valid <= u_traverse_emit_valid;
-    pipe_tag <= tag;
-  end
+
+  assign ray_ready = u_traverse_ray_ready;
+  assign res_valid = u_closest_res_valid;
+  assign res_hit = u_closest_res_hit;
+  assign res_id = u_closest_res_id;
+  assign res_tri = u_closest_res_tri;
+  assign res_t = u_closest_res_t;
+  assign res_u = u_closest_res_u;
+  assign res_v = u_closest_res_v;
+  assign busy = pipe_busy;
+  assign stack_depth = u_traverse_stack_depth;
+  assign fsm_state = u_traverse_fsm_state;
 endmodule
 `default_nettype wire

@@ -108,6 +108,7 @@ architecture rtl of fxrt_core is
       res_v : out unsigned(31 downto 0)
     );
   end component;
+
   type tri_rom_0_t is array (0 to 8191) of unsigned(123 downto 0);
   constant tri_rom_0 : tri_rom_0_t := (
     0 => "0011001011010110101111011001001000011011011001111101000011100011010011111001001111000110011100101111101111110001000010100100",
@@ -6431,6 +6432,7 @@ architecture rtl of fxrt_core is
     6318 => "1110101111100001001010100001000000010111000010110110111100101001010110010101100011010101100110000010100010011011101110001000",
     6319 => "1110101111100001001011000011110100010111000010110110111100110000010110010101100011010101100110000010100010011011101110001000",
     others => (others => '0'));
+
   type tri_rom_1_t is array (0 to 8191) of unsigned(127 downto 0);
   constant tri_rom_1 : tri_rom_1_t := (
     0 => "00000001110001001011000111101010000000000000000000000000000000000000000111000100101100011110101000001010000011000011101101000001",
@@ -12754,6 +12756,7 @@ architecture rtl of fxrt_core is
     6318 => "11111110010111011011101110000100111111111111010100110110010010101111111001011101101110111000010000001010000011000011101110001101",
     6319 => "00000000000000000000000000000000000100011110111010010111100111101111111001011100101111110100101000001010000011000011101111000000",
     others => (others => '0'));
+
   type tri_rom_2_t is array (0 to 8191) of unsigned(31 downto 0);
   constant tri_rom_2 : tri_rom_2_t := (
     0 => "00001011010110001111000111111001",
@@ -19077,6 +19080,7 @@ architecture rtl of fxrt_core is
     6318 => "00010001111000111100110111101000",
     6319 => "00010001111011101001011110011110",
     others => (others => '0'));
+
   signal u_traverse_ray_ready : unsigned(0 downto 0);
   signal u_traverse_emit_valid : unsigned(0 downto 0);
   signal u_traverse_emit_end : unsigned(0 downto 0);
@@ -19094,7 +19098,7 @@ architecture rtl of fxrt_core is
   signal wx_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal wy_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal wz_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal tri_word_0 : unsigned(123 downto 0) := (others => '0');
+  signal tri_word_0 : unsigned(123 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal tri_r : unsigned(1 downto 0);
   signal tri_pp : unsigned(28 downto 0);
   signal tri_pq : unsigned(28 downto 0);
@@ -19102,7 +19106,7 @@ architecture rtl of fxrt_core is
   signal tri_d_s : signed(31 downto 0);
   signal tri_np : unsigned(31 downto 0);
   signal tri_np_s : signed(31 downto 0);
-  signal tri_word_1 : unsigned(127 downto 0) := (others => '0');
+  signal tri_word_1 : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal tri_nq : unsigned(31 downto 0);
   signal tri_nq_s : signed(31 downto 0);
   signal tri_e1p : unsigned(31 downto 0);
@@ -19111,7 +19115,7 @@ architecture rtl of fxrt_core is
   signal tri_e1q_s : signed(31 downto 0);
   signal tri_e2p : unsigned(31 downto 0);
   signal tri_e2p_s : signed(31 downto 0);
-  signal tri_word_2 : unsigned(31 downto 0) := (others => '0');
+  signal tri_word_2 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal tri_e2q : unsigned(31 downto 0);
   signal tri_e2q_s : signed(31 downto 0);
   signal tag_tri_tmin : unsigned(43 downto 0);
@@ -19137,6 +19141,7 @@ architecture rtl of fxrt_core is
   signal pipe_not_end : unsigned(0 downto 0);
   signal pipe_busy : unsigned(0 downto 0);
 begin
+
   accept <= ray_valid and u_traverse_ray_ready;
   tri_r <= unsigned(tri_word_0(1 downto 0));
   tri_pp <= unsigned(tri_word_0(30 downto 2));
@@ -19162,17 +19167,26 @@ begin
   pipe_end <= unsigned(pipe_tag(44 downto 44));
   pipe_not_end <= not pipe_end;
   pipe_busy <= pipe_valid and pipe_not_end;
-  ray_ready <= u_traverse_ray_ready;
-  res_valid <= u_closest_res_valid;
-  res_hit <= u_closest_res_hit;
-  res_id <= u_closest_res_id;
-  res_tri <= u_closest_res_tri;
-  res_t <= u_closest_res_t;
-  res_u <= u_closest_res_u;
-  res_v <= u_closest_res_v;
-  busy <= pipe_busy;
-  stack_depth <= u_traverse_stack_depth;
-  fsm_state <= u_traverse_fsm_state;
+
+  regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if accept = "1" then
+        wx_r <= wx;
+      end if;
+      if accept = "1" then
+        wy_r <= wy;
+      end if;
+      if accept = "1" then
+        wz_r <= wz;
+      end if;
+      tri_word_0 <= tri_rom_0(to_integer(u_traverse_emit_tri));
+      tri_word_1 <= tri_rom_1(to_integer(u_traverse_emit_tri));
+      tri_word_2 <= tri_rom_2(to_integer(u_traverse_emit_tri));
+      pipe_valid <= u_traverse_emit_valid;
+      pipe_tag <= tag;
+    end if;
+  end process regs;
 
   u_traverse : fxrt_traverse
     port map (
@@ -19249,23 +19263,15 @@ begin
       res_v => u_closest_res_v
     );
 
-  clocked : process (clk)
-  begin
-    if rising_edge(clk) then
-      if accept = "1" then
-        wx_r <= wx;
-      end if;
-      if accept = "1" then
-        wy_r <= wy;
-      end if;
-      if accept = "1" then
-        wz_r <= wz;
-      end if;
-      tri_word_0 <= tri_rom_0(to_integer(u_traverse_emit_tri));
-      tri_word_1 <= tri_rom_1(to_integer(u_traverse_emit_tri));
-      tri_word_2 <= tri_rom_2(to_integer(u_traverse_emit_tri));
-      pipe_valid <= u_traverse_emit_valid;
-      pipe_tag <= tag;
-    end if;
-  end process;
+  ray_ready <= u_traverse_ray_ready;
+  res_valid <= u_closest_res_valid;
+  res_hit <= u_closest_res_hit;
+  res_id <= u_closest_res_id;
+  res_tri <= u_closest_res_tri;
+  res_t <= u_closest_res_t;
+  res_u <= u_closest_res_u;
+  res_v <= u_closest_res_v;
+  busy <= pipe_busy;
+  stack_depth <= u_traverse_stack_depth;
+  fsm_state <= u_traverse_fsm_state;
 end architecture rtl;

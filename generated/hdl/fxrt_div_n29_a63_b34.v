@@ -7,7 +7,7 @@ module fxrt_div_n29_a63_b34 (
   output wire [29:0] t,
   output wire [0:0] ok
 );
-  /* verilator lint_off UNUSEDSIGNAL */
+
   wire signed [62:0] div_zero_n = 63'sh0000000000000000;
   wire signed [33:0] div_zero_d = 34'sh000000000;
   wire [0:0] div_num_neg;
@@ -41,7 +41,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div0_p3;
   wire [0:0] div0_ge;
   wire [34:0] div0_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div0_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div0_rem;
   wire [29:0] div0_q2;
   wire [29:0] div0_gew;
@@ -59,7 +61,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div1_p3;
   wire [0:0] div1_ge;
   wire [34:0] div1_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div1_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div1_rem;
   wire [29:0] div1_q2;
   wire [29:0] div1_gew;
@@ -77,7 +81,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div2_p3;
   wire [0:0] div2_ge;
   wire [34:0] div2_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div2_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div2_rem;
   wire [29:0] div2_q2;
   wire [29:0] div2_gew;
@@ -95,7 +101,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div3_p3;
   wire [0:0] div3_ge;
   wire [34:0] div3_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div3_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div3_rem;
   wire [29:0] div3_q2;
   wire [29:0] div3_gew;
@@ -113,7 +121,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div4_p3;
   wire [0:0] div4_ge;
   wire [34:0] div4_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div4_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div4_rem;
   wire [29:0] div4_q2;
   wire [29:0] div4_gew;
@@ -131,7 +141,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div5_p3;
   wire [0:0] div5_ge;
   wire [34:0] div5_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div5_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div5_rem;
   wire [29:0] div5_q2;
   wire [29:0] div5_gew;
@@ -149,7 +161,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div6_p3;
   wire [0:0] div6_ge;
   wire [34:0] div6_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div6_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div6_rem;
   wire [29:0] div6_q2;
   wire [29:0] div6_gew;
@@ -167,7 +181,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div7_p3;
   wire [0:0] div7_ge;
   wire [34:0] div7_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div7_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div7_rem;
   wire [29:0] div7_q2;
   wire [29:0] div7_gew;
@@ -185,7 +201,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div8_p3;
   wire [0:0] div8_ge;
   wire [34:0] div8_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div8_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div8_rem;
   wire [29:0] div8_q2;
   wire [29:0] div8_gew;
@@ -203,7 +221,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div9_p3;
   wire [0:0] div9_ge;
   wire [34:0] div9_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div9_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div9_rem;
   wire [29:0] div9_q2;
   wire [29:0] div9_gew;
@@ -221,7 +241,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div10_p3;
   wire [0:0] div10_ge;
   wire [34:0] div10_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div10_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div10_rem;
   wire [29:0] div10_q2;
   wire [29:0] div10_gew;
@@ -239,7 +261,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div11_p3;
   wire [0:0] div11_ge;
   wire [34:0] div11_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div11_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div11_rem;
   wire [29:0] div11_q2;
   wire [29:0] div11_gew;
@@ -257,7 +281,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div12_p3;
   wire [0:0] div12_ge;
   wire [34:0] div12_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div12_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div12_rem;
   wire [29:0] div12_q2;
   wire [29:0] div12_gew;
@@ -275,7 +301,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div13_p3;
   wire [0:0] div13_ge;
   wire [34:0] div13_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div13_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div13_rem;
   wire [29:0] div13_q2;
   wire [29:0] div13_gew;
@@ -293,7 +321,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div14_p3;
   wire [0:0] div14_ge;
   wire [34:0] div14_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div14_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div14_rem;
   wire [29:0] div14_q2;
   wire [29:0] div14_gew;
@@ -311,7 +341,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div15_p3;
   wire [0:0] div15_ge;
   wire [34:0] div15_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div15_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div15_rem;
   wire [29:0] div15_q2;
   wire [29:0] div15_gew;
@@ -329,7 +361,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div16_p3;
   wire [0:0] div16_ge;
   wire [34:0] div16_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div16_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div16_rem;
   wire [29:0] div16_q2;
   wire [29:0] div16_gew;
@@ -347,7 +381,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div17_p3;
   wire [0:0] div17_ge;
   wire [34:0] div17_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div17_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div17_rem;
   wire [29:0] div17_q2;
   wire [29:0] div17_gew;
@@ -365,7 +401,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div18_p3;
   wire [0:0] div18_ge;
   wire [34:0] div18_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div18_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div18_rem;
   wire [29:0] div18_q2;
   wire [29:0] div18_gew;
@@ -383,7 +421,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div19_p3;
   wire [0:0] div19_ge;
   wire [34:0] div19_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div19_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div19_rem;
   wire [29:0] div19_q2;
   wire [29:0] div19_gew;
@@ -401,7 +441,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div20_p3;
   wire [0:0] div20_ge;
   wire [34:0] div20_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div20_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div20_rem;
   wire [29:0] div20_q2;
   wire [29:0] div20_gew;
@@ -419,7 +461,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div21_p3;
   wire [0:0] div21_ge;
   wire [34:0] div21_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div21_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div21_rem;
   wire [29:0] div21_q2;
   wire [29:0] div21_gew;
@@ -437,7 +481,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div22_p3;
   wire [0:0] div22_ge;
   wire [34:0] div22_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div22_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div22_rem;
   wire [29:0] div22_q2;
   wire [29:0] div22_gew;
@@ -455,7 +501,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div23_p3;
   wire [0:0] div23_ge;
   wire [34:0] div23_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div23_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div23_rem;
   wire [29:0] div23_q2;
   wire [29:0] div23_gew;
@@ -473,7 +521,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div24_p3;
   wire [0:0] div24_ge;
   wire [34:0] div24_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div24_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div24_rem;
   wire [29:0] div24_q2;
   wire [29:0] div24_gew;
@@ -491,7 +541,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div25_p3;
   wire [0:0] div25_ge;
   wire [34:0] div25_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div25_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div25_rem;
   wire [29:0] div25_q2;
   wire [29:0] div25_gew;
@@ -509,7 +561,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div26_p3;
   wire [0:0] div26_ge;
   wire [34:0] div26_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div26_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div26_rem;
   wire [29:0] div26_q2;
   wire [29:0] div26_gew;
@@ -527,7 +581,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div27_p3;
   wire [0:0] div27_ge;
   wire [34:0] div27_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div27_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div27_rem;
   wire [29:0] div27_q2;
   wire [29:0] div27_gew;
@@ -545,7 +601,9 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div28_p3;
   wire [0:0] div28_ge;
   wire [34:0] div28_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div28_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] div28_rem;
   wire [29:0] div28_q2;
   wire [29:0] div28_gew;
@@ -554,7 +612,9 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] div30_q = 30'h00000000;
   reg [33:0] div30_b = 34'h000000000;
   wire [34:0] div30_bw;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 0 are read
   reg [29:0] div30_lo = 30'h00000000;
+  /* verilator lint_on UNUSEDSIGNAL */
   reg [0:0] div30_err = 1'h0;
   wire [0:0] div29_in;
   wire [34:0] div29_pw;
@@ -563,8 +623,12 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] div29_p3;
   wire [0:0] div29_ge;
   wire [34:0] div29_diff;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] div29_pn;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [33:0] div29_rem;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [29:0] div29_q2;
   wire [29:0] div29_gew;
   wire [29:0] div29_qn;
@@ -575,7 +639,7 @@ module fxrt_div_n29_a63_b34 (
   wire [0:0] div_ok_c;
   reg [29:0] div_t = 30'h00000000;
   reg [0:0] div_ok = 1'h0;
-  /* verilator lint_on UNUSEDSIGNAL */
+
   assign div_num_neg = num < div_zero_n;
   assign div_den_neg = den < div_zero_d;
   assign div_num_zero = num == div_zero_n;
@@ -988,9 +1052,8 @@ module fxrt_div_n29_a63_b34 (
   assign div_q_zero = div29_qn == div_zero_q;
   assign div_bad = div30_err | div_q_zero;
   assign div_ok_c = div_bad ^ div_one;
-  assign t = div_t;
-  assign ok = div_ok;
-  always @(posedge clk) begin
+
+  always @(posedge clk) begin : regs
     div1_a <= div_a;
     div1_b <= div_b;
     div1_err <= div_err_b;
@@ -1142,5 +1205,8 @@ module fxrt_div_n29_a63_b34 (
     div_t <= div29_qn;
     div_ok <= div_ok_c;
   end
+
+  assign t = div_t;
+  assign ok = div_ok;
 endmodule
 `default_nettype wire

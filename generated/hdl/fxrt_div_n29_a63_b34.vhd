@@ -14,6 +14,7 @@ entity fxrt_div_n29_a63_b34 is
 end entity fxrt_div_n29_a63_b34;
 
 architecture rtl of fxrt_div_n29_a63_b34 is
+
   constant div_zero_n : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
   constant div_zero_d : signed(33 downto 0) := signed'("0000000000000000000000000000000000");
   signal div_num_neg : unsigned(0 downto 0);
@@ -582,6 +583,7 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal div_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal div_ok : unsigned(0 downto 0) := unsigned'("0");
 begin
+
   div_num_neg <= "1" when num < div_zero_n else "0";
   div_den_neg <= "1" when den < div_zero_d else "0";
   div_num_zero <= "1" when num = div_zero_n else "0";
@@ -994,10 +996,8 @@ begin
   div_q_zero <= "1" when div29_qn = div_zero_q else "0";
   div_bad <= div30_err or div_q_zero;
   div_ok_c <= div_bad xor div_one;
-  t <= div_t;
-  ok <= div_ok;
 
-  clocked : process (clk)
+  regs : process (clk)
   begin
     if rising_edge(clk) then
       div1_a <= div_a;
@@ -1151,5 +1151,8 @@ begin
       div_t <= div29_qn;
       div_ok <= div_ok_c;
     end if;
-  end process;
+  end process regs;
+
+  t <= div_t;
+  ok <= div_ok;
 end architecture rtl;

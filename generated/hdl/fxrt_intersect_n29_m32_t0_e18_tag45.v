@@ -27,7 +27,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
   output wire [31:0] u_1,
   output wire [31:0] v_1
 );
-  /* verilator lint_off UNUSEDSIGNAL */
+
   reg [0:0] s1_valid = 1'h0;
   reg [44:0] s1_tag = 45'h000000000000;
   reg [28:0] s1_ox = 29'h00000000;
@@ -110,7 +110,9 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
   wire signed [64:0] den_sum;
   wire signed [64:0] den_sum_rounded_half = 65'sh00000000040000000;
   wire signed [64:0] den_sum_rounded_biased;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire signed [64:0] den_sum_rounded;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire signed [33:0] den_sum_narrow;
   wire signed [33:0] den_wr;
   wire signed [33:0] den;
@@ -456,10 +458,14 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
   reg signed [31:0] x1_e2q = 32'sh00000000;
   wire signed [62:0] tp_rounded_half = 63'sh0000000040000000;
   wire signed [62:0] tp_rounded_biased;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [62:0] tp_rounded;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire signed [62:0] tq_rounded_half = 63'sh0000000040000000;
   wire signed [62:0] tq_rounded_biased;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [62:0] tq_rounded;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] tp_narrow;
   wire signed [31:0] tq_narrow;
   wire signed [31:0] kp_base_w;
@@ -505,10 +511,14 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
   wire [0:0] hit_one = 1'h1;
   wire [0:0] bary_inside;
   wire [0:0] hit_c;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [64:0] u_out_shifted;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] u_out_low;
   wire [31:0] u_out;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [64:0] v_out_shifted;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] v_out_low;
   wire [31:0] v_out;
   wire [29:0] t_zero = 30'h00000000;
@@ -522,7 +532,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
   reg [29:0] q_t = 30'h00000000;
   reg [31:0] q_u = 32'h00000000;
   reg [31:0] q_v = 32'h00000000;
-  /* verilator lint_on UNUSEDSIGNAL */
+
   assign perm_p_wraps = s1_r == perm_p_two;
   assign perm_p_inc = s1_r + perm_p_one;
   assign perm_p = perm_p_wraps ? perm_p_zero : perm_p_inc;
@@ -645,20 +655,8 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
   assign t_c = hit_c ? x3_u_div_t : t_zero;
   assign u_c = hit_c ? u_out : uvo_zero;
   assign v_c = hit_c ? v_out : uvo_zero;
-  assign valid_out = q_valid_out;
-  assign tag_out = q_tag_out;
-  assign hit = q_hit;
-  assign t = q_t;
-  assign u_1 = q_u;
-  assign v_1 = q_v;
-  fxrt_div_n29_a63_b34 u_div (
-    .clk(clk),
-    .num(s3_num),
-    .den(s3_den),
-    .t(u_div_t),
-    .ok(u_div_ok)
-  );
-  always @(posedge clk) begin
+
+  always @(posedge clk) begin : regs
     s1_valid <= valid;
     s1_tag <= tag;
     s1_ox <= ox;
@@ -1052,5 +1050,20 @@ module fxrt_intersect_n29_m32_t0_e18_tag45 (
     q_u <= u_c;
     q_v <= v_c;
   end
+
+  fxrt_div_n29_a63_b34 u_div (
+    .clk(clk),
+    .num(s3_num),
+    .den(s3_den),
+    .t(u_div_t),
+    .ok(u_div_ok)
+  );
+
+  assign valid_out = q_valid_out;
+  assign tag_out = q_tag_out;
+  assign hit = q_hit;
+  assign t = q_t;
+  assign u_1 = q_u;
+  assign v_1 = q_v;
 endmodule
 `default_nettype wire

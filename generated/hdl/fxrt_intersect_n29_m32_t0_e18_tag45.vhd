@@ -43,6 +43,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45 is
       ok : out unsigned(0 downto 0)
     );
   end component;
+
   signal s1_valid : unsigned(0 downto 0) := unsigned'("0");
   signal s1_tag : unsigned(44 downto 0) := unsigned'("000000000000000000000000000000000000000000000");
   signal s1_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -538,6 +539,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45 is
   signal q_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal q_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 begin
+
   perm_p_wraps <= "1" when s1_r = perm_p_two else "0";
   perm_p_inc <= s1_r + perm_p_one;
   perm_p <= perm_p_zero when perm_p_wraps = "1" else perm_p_inc;
@@ -648,23 +650,8 @@ begin
   t_c <= x3_u_div_t when hit_c = "1" else t_zero;
   u_c <= u_out when hit_c = "1" else uvo_zero;
   v_c <= v_out when hit_c = "1" else uvo_zero;
-  valid_out <= q_valid_out;
-  tag_out <= q_tag_out;
-  hit <= q_hit;
-  t <= q_t;
-  u_1 <= q_u;
-  v_1 <= q_v;
 
-  u_div : fxrt_div_n29_a63_b34
-    port map (
-      clk => clk,
-      num => s3_num,
-      den => s3_den,
-      t => u_div_t,
-      ok => u_div_ok
-    );
-
-  clocked : process (clk)
+  regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_valid <= valid;
@@ -1060,5 +1047,21 @@ begin
       q_u <= u_c;
       q_v <= v_c;
     end if;
-  end process;
+  end process regs;
+
+  u_div : fxrt_div_n29_a63_b34
+    port map (
+      clk => clk,
+      num => s3_num,
+      den => s3_den,
+      t => u_div_t,
+      ok => u_div_ok
+    );
+
+  valid_out <= q_valid_out;
+  tag_out <= q_tag_out;
+  hit <= q_hit;
+  t <= q_t;
+  u_1 <= q_u;
+  v_1 <= q_v;
 end architecture rtl;

@@ -25,13 +25,16 @@ module fxrt_traverse (
   output wire [5:0] stack_depth,
   output wire [2:0] fsm_state
 );
+
   reg [72:0] node_rom [0:8191];
   initial $readmemh("fxrt_traverse_node_rom.hex", node_rom);
+
   reg [76:0] stack [0:31];
   initial $readmemh("fxrt_traverse_stack.hex", stack);
+
   reg [12:0] leaf_rom [0:8191];
   initial $readmemh("fxrt_traverse_leaf_rom.hex", leaf_rom);
-  /* verilator lint_off UNUSEDSIGNAL */
+
   reg [2:0] state = 3'h0;
   wire [2:0] in_idle_k = 3'h0;
   wire [0:0] in_idle;
@@ -77,7 +80,9 @@ module fxrt_traverse (
   wire [28:0] box_hi_1 = 29'h0faab179;
   wire [28:0] box_hi_2 = 29'h13e4f19b;
   wire [28:0] plane_zero = 29'h00000000;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
   reg signed [47:0] aabb_inv;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] aabb_neg;
   reg [28:0] aabb_hi;
   wire [28:0] aabb_plane;
@@ -99,7 +104,9 @@ module fxrt_traverse (
   wire [0:0] pu_below;
   wire [0:0] pu_above;
   wire signed [77:0] pu_clamp_a;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [77:0] pu_clamp;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] plane_t;
   wire [1:0] aabb_first_k = 2'h0;
   wire [0:0] aabb_first;
@@ -114,7 +121,9 @@ module fxrt_traverse (
   wire [1:0] aabb_k_inc;
   wire [1:0] aabb_zero = 2'h0;
   wire [1:0] aabb_k_next;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
   reg signed [47:0] inner_inv;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] inner_negative;
   wire [12:0] child_one = 13'h0001;
   wire [12:0] child_right;
@@ -205,11 +214,13 @@ module fxrt_traverse (
   wire [0:0] emit;
   reg [0:0] emit_r = 1'h0;
   reg [0:0] end_r = 1'h0;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 30:0 are read
   wire [31:0] tmin_u;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] tmin_w;
   reg [30:0] tmin_r = 31'h00000000;
   reg [19:0] id_r = 20'h00000;
-  /* verilator lint_on UNUSEDSIGNAL */
+
   assign in_idle = state == in_idle_k;
   assign in_aabb = state == in_aabb_k;
   assign in_node = state == in_node_k;
@@ -367,20 +378,8 @@ module fxrt_traverse (
   assign emit = in_leaf | in_done;
   assign tmin_u = $unsigned(tmin);
   assign tmin_w = tmin_u[30:0];
-  assign ray_ready = in_idle;
-  assign emit_valid = emit_r;
-  assign emit_end = end_r;
-  assign emit_tri = leaf_tri;
-  assign emit_tmin = tmin_r;
-  assign emit_id = id_r;
-  assign cur_ox = ox_r;
-  assign cur_oy = oy_r;
-  assign cur_oz = oz_r;
-  assign visit = in_node;
-  assign visit_node = node;
-  assign stack_depth = sp;
-  assign fsm_state = state;
-  always @(posedge clk) begin
+
+  always @(posedge clk) begin : regs
     if (push) stack[sp_addr] <= push_entry;
     if (rst) state <= 3'h0;
     else state <= state_next;
@@ -412,5 +411,19 @@ module fxrt_traverse (
     tmin_r <= tmin_w;
     id_r <= ray_id_r;
   end
+
+  assign ray_ready = in_idle;
+  assign emit_valid = emit_r;
+  assign emit_end = end_r;
+  assign emit_tri = leaf_tri;
+  assign emit_tmin = tmin_r;
+  assign emit_id = id_r;
+  assign cur_ox = ox_r;
+  assign cur_oy = oy_r;
+  assign cur_oz = oz_r;
+  assign visit = in_node;
+  assign visit_node = node;
+  assign stack_depth = sp;
+  assign fsm_state = state;
 endmodule
 `default_nettype wire

@@ -32,6 +32,7 @@ entity fxrt_traverse is
 end entity fxrt_traverse;
 
 architecture rtl of fxrt_traverse is
+
   type node_rom_t is array (0 to 8191) of unsigned(72 downto 0);
   constant node_rom : node_rom_t := (
     0 => "0000000000001011111000100101101110001000111000011011010000100101100111100",
@@ -4414,6 +4415,7 @@ architecture rtl of fxrt_traverse is
     4377 => "0000000000000000000000000000000000000000000000000000000100110001010101011",
     4378 => "0000000000000000000000000000000000000000000000000000000010110001010111011",
     others => (others => '0'));
+
   type stack_t is array (0 to 31) of unsigned(76 downto 0);
   signal stack : stack_t := (
     0 => "00000000000000000000000000000000000000000000000000000000000000000000000000000",
@@ -4449,6 +4451,7 @@ architecture rtl of fxrt_traverse is
     30 => "00000000000000000000000000000000000000000000000000000000000000000000000000000",
     31 => "00000000000000000000000000000000000000000000000000000000000000000000000000000",
     others => (others => '0'));
+
   type leaf_rom_t is array (0 to 8191) of unsigned(12 downto 0);
   constant leaf_rom : leaf_rom_t := (
     0 => "0011111101100",
@@ -10772,6 +10775,7 @@ architecture rtl of fxrt_traverse is
     6318 => "0111001011000",
     6319 => "0111001011001",
     others => (others => '0'));
+
   signal state : unsigned(2 downto 0) := unsigned'("000");
   constant in_idle_k : unsigned(2 downto 0) := unsigned'("000");
   signal in_idle : unsigned(0 downto 0);
@@ -10797,7 +10801,7 @@ architecture rtl of fxrt_traverse is
   signal invz_r : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal node : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal node_next : unsigned(12 downto 0);
-  signal node_word : unsigned(72 downto 0) := (others => '0');
+  signal node_word : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
   signal nw_axis : unsigned(1 downto 0);
   signal nw_clip0 : unsigned(28 downto 0);
   signal nw_clip1 : unsigned(28 downto 0);
@@ -10882,7 +10886,7 @@ architecture rtl of fxrt_traverse is
   constant sp_one : unsigned(5 downto 0) := unsigned'("000001");
   signal sp_dec : unsigned(5 downto 0);
   signal top_addr : unsigned(4 downto 0);
-  signal stack_top : unsigned(76 downto 0) := (others => '0');
+  signal stack_top : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal top_tmax_u : unsigned(31 downto 0);
   signal top_tmin_u : unsigned(31 downto 0);
   signal top_node : unsigned(12 downto 0);
@@ -10941,7 +10945,7 @@ architecture rtl of fxrt_traverse is
   signal from_leaf : unsigned(2 downto 0);
   signal from_pop : unsigned(2 downto 0);
   signal state_next : unsigned(2 downto 0);
-  signal leaf_tri : unsigned(12 downto 0) := (others => '0');
+  signal leaf_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal emit : unsigned(0 downto 0);
   signal emit_r : unsigned(0 downto 0) := unsigned'("0");
   signal end_r : unsigned(0 downto 0) := unsigned'("0");
@@ -10950,6 +10954,7 @@ architecture rtl of fxrt_traverse is
   signal tmin_r : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
   signal id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
 begin
+
   in_idle <= "1" when state = in_idle_k else "0";
   in_aabb <= "1" when state = in_aabb_k else "0";
   in_node <= "1" when state = in_node_k else "0";
@@ -11095,21 +11100,8 @@ begin
   emit <= in_leaf or in_done;
   tmin_u <= unsigned(tmin);
   tmin_w <= tmin_u(30 downto 0);
-  ray_ready <= in_idle;
-  emit_valid <= emit_r;
-  emit_end <= end_r;
-  emit_tri <= leaf_tri;
-  emit_tmin <= tmin_r;
-  emit_id <= id_r;
-  cur_ox <= ox_r;
-  cur_oy <= oy_r;
-  cur_oz <= oz_r;
-  visit <= in_node;
-  visit_node <= node;
-  stack_depth <= sp;
-  fsm_state <= state;
 
-  clocked : process (clk)
+  regs : process (clk)
   begin
     if rising_edge(clk) then
       if push = "1" then
@@ -11176,5 +11168,19 @@ begin
       tmin_r <= tmin_w;
       id_r <= ray_id_r;
     end if;
-  end process;
+  end process regs;
+
+  ray_ready <= in_idle;
+  emit_valid <= emit_r;
+  emit_end <= end_r;
+  emit_tri <= leaf_tri;
+  emit_tmin <= tmin_r;
+  emit_id <= id_r;
+  cur_ox <= ox_r;
+  cur_oy <= oy_r;
+  cur_oz <= oz_r;
+  visit <= in_node;
+  visit_node <= node;
+  stack_depth <= sp;
+  fsm_state <= state;
 end architecture rtl;

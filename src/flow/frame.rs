@@ -1,6 +1,6 @@
 //! Whole frames through the generated core (`fxrt sim`): every pixel's ray that reaches the
 //! scene box is streamed into the core in pixel order; the results come back in the same
-//! order and are compared with the golden model's `trace_fast`, pixel by pixel.
+//! order and are compared with the golden model's (`render::fast`), pixel by pixel.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::cores::traverse::TravState;
@@ -10,6 +10,7 @@ use crate::flow::testbench::{Stream, parse_results, stream_files};
 use crate::model::camera::Camera;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
+use crate::render::fast::FastGolden;
 use crate::rtl::batch::BatchSim;
 use crate::rtl::fsm::States;
 use crate::rtl::sim::Sim;
@@ -236,10 +237,10 @@ pub fn simulate_rust_cycle(
 /// Pixels whose core result differs from the golden model (id, triangle, t, u, v), and rays
 /// whose result is missing or out of order.
 pub fn mismatches(scene: &Scene, rays: &[PixelRay], results: &[CoreResult]) -> u64 {
-    let g = Golden::new(scene);
+    let g = FastGolden::new(scene);
     let mut bad = (rays.len() as u64).abs_diff(results.len() as u64);
     for (r, (id, hit)) in rays.iter().zip(results) {
-        let want = g.trace_fast(scene, &r.ray).0;
+        let want = g.trace(&r.ray).0;
         if *id != r.pixel as u64 || *hit != want {
             bad += 1;
         }
@@ -311,10 +312,9 @@ pub fn simulate_hdl(
         return Ok((Vec::new(), CoreStats::default()));
     }
     let m = core_module(p, &roms);
-    let g = Golden::new(scene);
+    let g = FastGolden::new(scene);
     let inputs: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
-    let expected: Vec<Vec<i128>> =
-        rays.iter().map(|r| result_row(r.pixel as u64, g.trace_fast(scene, &r.ray).0)).collect();
+    let expected: Vec<Vec<i128>> = rays.iter().map(|r| result_row(r.pixel as u64, g.trace(&r.ray).0)).collect();
     // Generous: the slowest built-in scene needs ~15,000 cycles per ray. Capped to what the
     // testbenches' 32-bit integers hold (GHDL would wrap it, Verilator refuses it).
     let max_cycles = (100_000 * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);

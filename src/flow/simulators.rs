@@ -37,7 +37,7 @@ impl Simulator {
         Command::new(self.program()).arg(flag).output().is_ok_and(|o| o.status.success())
     }
 
-    /// Compiles and runs, in `dir`, the files `testbench::bench_files` wrote there for `m`.
+    /// Compiles and runs, in `dir`, the testbench files (`testbench::bench_files`) for `m`.
     /// Returns (passed, failed) from the testbench's closing line.
     pub fn run(self, dir: &Path, m: &Module) -> Result<(u64, u64), String> {
         self.run_timed(dir, m).map(|r| (r.passed, r.failed))
@@ -54,7 +54,7 @@ impl Simulator {
     pub fn run_bench(self, dir: &Path, m: &Module, bench: Bench) -> Result<(RunResult, String), String> {
         let ext = if self == Simulator::Ghdl { "vhd" } else { "v" };
         let design: Vec<String> = m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
-        let tb = super::testbench::tb_name(m);
+        let tb = tb_name(m);
         let words = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<String>>();
         let steps: Vec<Vec<String>> = match self {
             Simulator::Ghdl => {
@@ -143,6 +143,12 @@ impl Simulator {
         }
         Ok((RunResult { passed, failed, seconds }, last))
     }
+}
+
+/// Name of the testbench entity/module for `m` (GHDL and Icarus elaborate it; the testbench
+/// generator names it so).
+pub fn tb_name(m: &Module) -> String {
+    format!("{}_tb", m.name)
 }
 
 /// The two kinds of testbench: fixed-latency vectors, or a ray stream with ready/valid.

@@ -1,8 +1,9 @@
 //! Self-checking testbenches: the Rust simulator produces the expected outputs for a list of
 //! input vectors, and the askama templates in `testbenches/` turn them into a VHDL and a
-//! Verilog testbench that apply the same inputs to the generated HDL and compare.
+//! Verilog testbench that apply the same inputs to the generated HDL and compare. Each kind of
+//! testbench is one struct for both languages: its template includes the language's file.
 
-use super::simulators::Simulator;
+use super::simulators::{Simulator, tb_name};
 use crate::rtl::netlist::{Module, SigId};
 use crate::rtl::sim::Sim;
 use crate::rtl::width::Ty;
@@ -23,20 +24,12 @@ pub struct Port {
     pub lsb: u32,
 }
 
+/// The vector testbench: `vector_tb.vhd` (GHDL) or `vector_tb.v` (Icarus). The vectors are
+/// one word per clock, most significant first: [rst] inputs… outputs… (`total_width` bits).
 #[derive(Template)]
-#[template(path = "vector_tb.vhd")]
-struct VhdlTb<'a> {
-    tb: &'a str,
-    module: &'a str,
-    vectors: &'a str,
-    has_reset: bool,
-    inputs: &'a [Port],
-    outputs: &'a [Port],
-}
-
-#[derive(Template)]
-#[template(path = "vector_tb.v")]
-struct VerilogTb<'a> {
+#[template(path = "vector_tb.tpl", escape = "none")]
+struct VectorTb<'a> {
+    vhdl: bool,
     tb: &'a str,
     module: &'a str,
     vectors: &'a str,
@@ -66,25 +59,11 @@ struct VerilatorHarness<'a> {
     outputs: &'a [CppPort],
 }
 
+/// The stream testbench: `stream_tb.vhd` (GHDL) or `stream_tb.v` (Icarus, Verilator).
 #[derive(Template)]
-#[template(path = "stream_tb.vhd")]
-struct VhdlStreamTb<'a> {
-    tb: &'a str,
-    module: &'a str,
-    rays: &'a str,
-    expected: &'a str,
-    results: &'a str,
-    has_reset: bool,
-    inputs: &'a [Port],
-    outputs: &'a [Port],
-    checked: &'a [Port],
-    count: usize,
-    max_cycles: u64,
-}
-
-#[derive(Template)]
-#[template(path = "stream_tb.v")]
-struct VerilogStreamTb<'a> {
+#[template(path = "stream_tb.tpl", escape = "none")]
+struct StreamTb<'a> {
+    vhdl: bool,
     tb: &'a str,
     module: &'a str,
     rays: &'a str,
@@ -118,66 +97,56 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     let (inputs, ray_width) = ports(m, &in_ids, 0);
     let (checked, result_width) = ports(m, &checked_ids, 0);
     let (outputs, _) = ports(m, &m.outputs, 0);
-    let tb = tb_name(m);
     let (rays, expected, results) = ("rays.txt", "expected.txt", "results.txt");
-    let has_reset = m.has_reset();
-    let mut files = crate::rtl::emit::design_files(m, if sim == Simulator::Ghdl { "vhd" } else { "v" });
-    let lines = |rows: &[Vec<i128>], ports: &[Port], width: u32, vhdl: bool| -> String {
-        let mut text = String::new();
-        for row in rows {
-            if vhdl {
-                let f: Vec<String> =
-                    ports.iter().zip(row).map(|(p, v)| crate::rtl::emit::bit_string(p.ty.wrap(*v), p.width)).collect();
-                text.push_str(&f.join(" "));
-            } else {
-                let mut word = num_word::Word::default();
-                ports.iter().zip(row).for_each(|(p, v)| word.push(p.ty.wrap(*v), p.width));
-                text.push_str(&word.hex(width));
-            }
-            text.push('\n');
-        }
-        text
-    };
     let vhdl = sim == Simulator::Ghdl;
-    files.push((rays.into(), lines(s.rays, &inputs, ray_width, vhdl)));
-    files.push((expected.into(), lines(s.expected, &checked, result_width, vhdl)));
-    let count = s.rays.len();
-    let text = if vhdl {
-        VhdlStreamTb {
-            tb: &tb,
-            module: &m.name,
-            rays,
-            expected,
-            results,
-            has_reset,
-            inputs: &inputs,
-            outputs: &outputs,
-            checked: &checked,
-            count,
-            max_cycles: s.max_cycles,
-        }
-        .render()
-    } else {
-        VerilogStreamTb {
-            tb: &tb,
-            module: &m.name,
-            rays,
-            expected,
-            results,
-            has_reset,
-            inputs: &inputs,
-            outputs: &outputs,
-            checked: &checked,
-            ray_width,
-            result_width,
-            count,
-            max_cycles: s.max_cycles,
-        }
-        .render()
+    let mut files = crate::rtl::emit::design_files(m, ext(vhdl));
+    let lines = |rows: &[Vec<i128>], ports: &[Port], width: u32| -> String {
+        let fields = |row: &Vec<i128>| -> Vec<(u128, u32)> {
+            ports.iter().zip(row).map(|(p, v)| (p.ty.wrap(*v), p.width)).collect()
+        };
+        rows.iter().map(|row| data_line(&fields(row), vhdl, width)).collect()
     };
-    let name = if vhdl { "tb.vhd" } else { "tb.v" };
-    files.push((name.into(), text.expect("testbench template renders") + "\n"));
+    files.push((rays.into(), lines(s.rays, &inputs, ray_width)));
+    files.push((expected.into(), lines(s.expected, &checked, result_width)));
+    let text = StreamTb {
+        vhdl,
+        tb: &tb_name(m),
+        module: &m.name,
+        rays,
+        expected,
+        results,
+        has_reset: m.has_reset(),
+        inputs: &inputs,
+        outputs: &outputs,
+        checked: &checked,
+        ray_width,
+        result_width,
+        count: s.rays.len(),
+        max_cycles: s.max_cycles,
+    }
+    .render();
+    files.push((format!("tb.{}", ext(vhdl)), text.expect("testbench template renders") + "\n"));
     files
+}
+
+/// The file extension of a language.
+fn ext(vhdl: bool) -> &'static str {
+    if vhdl { "vhd" } else { "v" }
+}
+
+/// One line of a data file, fields (value, width) most significant first: binary strings
+/// separated by spaces for VHDL (read with textio), one hex word of `width` bits for Verilog
+/// (`$readmemh`); with the newline.
+fn data_line(fields: &[(u128, u32)], vhdl: bool, width: u32) -> String {
+    let mut line = if vhdl {
+        fields.iter().map(|&(v, w)| crate::rtl::emit::bit_string(v, w)).collect::<Vec<_>>().join(" ")
+    } else {
+        let mut word = num_word::Word::default();
+        fields.iter().for_each(|&(v, w)| word.push(v, w));
+        word.hex(width)
+    };
+    line.push('\n');
+    line
 }
 
 /// Parses a stream testbench's `results.txt`: each line's binary fields as values of the
@@ -260,18 +229,13 @@ fn ports(m: &Module, ids: &[(String, SigId)], mut lsb: u32) -> (Vec<Port>, u32) 
 /// Everything one simulator needs in its directory: the design in its language (one file per
 /// module), its testbench and its vectors, as (file name, contents).
 pub fn bench_files(m: &Module, t: &Transcript, sim: Simulator) -> Vec<(String, String)> {
-    let mut files = crate::rtl::emit::design_files(m, if sim == Simulator::Ghdl { "vhd" } else { "v" });
+    let mut files = crate::rtl::emit::design_files(m, ext(sim == Simulator::Ghdl));
     files.extend(match sim {
-        Simulator::Ghdl => render_vhdl(m, t),
-        Simulator::Iverilog => render_verilog(m, t),
+        Simulator::Ghdl => render_vectors(m, t, true),
+        Simulator::Iverilog => render_vectors(m, t, false),
         Simulator::Verilator => render_harness(m, t),
     });
     files
-}
-
-/// Name of the testbench entity/module for `m` (GHDL and Icarus elaborate it).
-pub fn tb_name(m: &Module) -> String {
-    format!("{}_tb", m.name)
 }
 
 /// Input ports in `Module::inputs` order.
@@ -279,61 +243,27 @@ fn input_ids(m: &Module) -> Vec<(String, SigId)> {
     m.inputs.iter().map(|&i| (m.sig(i).name.clone(), i)).collect()
 }
 
-/// The VHDL testbench (textio) and `vectors.txt`: one line per clock of bit strings.
-fn render_vhdl(m: &Module, t: &Transcript) -> Vec<(String, String)> {
-    let (outputs, after_out) = ports(m, &m.outputs, 0);
-    let (inputs, _) = ports(m, &input_ids(m), after_out);
-    let has_reset = m.has_reset();
-    let mut txt = String::new();
-    for (st, out) in t.stimuli.iter().zip(&t.outputs) {
-        let mut fields: Vec<String> = Vec::new();
-        if has_reset {
-            fields.push(if st.reset { "1".into() } else { "0".into() });
-        }
-        for (p, v) in inputs.iter().zip(&st.inputs) {
-            fields.push(crate::rtl::emit::bit_string(p.ty.wrap(*v), p.width));
-        }
-        for (p, v) in outputs.iter().zip(out) {
-            fields.push(crate::rtl::emit::bit_string(*v, p.width));
-        }
-        txt.push_str(&fields.join(" "));
-        txt.push('\n');
-    }
-    let tb = tb_name(m);
-    let text =
-        VhdlTb { tb: &tb, module: &m.name, vectors: "vectors.txt", has_reset, inputs: &inputs, outputs: &outputs }
-            .render()
-            .expect("testbench template renders");
-    vec![("tb.vhd".into(), text + "\n"), ("vectors.txt".into(), txt)]
-}
-
-/// The Verilog testbench and `vectors.hex`: one `$readmemh` word per clock.
-fn render_verilog(m: &Module, t: &Transcript) -> Vec<(String, String)> {
-    // Vector word, most significant first: [rst] inputs… outputs…
+/// The vector testbench in VHDL with `vectors.txt` (a line of bit strings per clock), or in
+/// Verilog with `vectors.hex` (a `$readmemh` word per clock).
+fn render_vectors(m: &Module, t: &Transcript, vhdl: bool) -> Vec<(String, String)> {
     let (outputs, after_out) = ports(m, &m.outputs, 0);
     let (inputs, after_in) = ports(m, &input_ids(m), after_out);
     let has_reset = m.has_reset();
     let total_width = after_in + has_reset as u32;
-    let mut hex = String::new();
+    let mut data = String::new();
     for (st, out) in t.stimuli.iter().zip(&t.outputs) {
-        let mut word = num_word::Word::default();
-        if has_reset {
-            word.push(st.reset as u128, 1);
-        }
-        for (p, v) in inputs.iter().zip(&st.inputs) {
-            word.push(p.ty.wrap(*v), p.width);
-        }
-        for (p, v) in outputs.iter().zip(out) {
-            word.push(*v, p.width);
-        }
-        hex.push_str(&word.hex(total_width));
-        hex.push('\n');
+        let reset = has_reset.then_some((st.reset as u128, 1));
+        let ins = inputs.iter().zip(&st.inputs).map(|(p, v)| (p.ty.wrap(*v), p.width));
+        let outs = outputs.iter().zip(out).map(|(p, v)| (*v, p.width));
+        let fields: Vec<(u128, u32)> = reset.into_iter().chain(ins).chain(outs).collect();
+        data.push_str(&data_line(&fields, vhdl, total_width));
     }
-    let tb = tb_name(m);
-    let text = VerilogTb {
-        tb: &tb,
+    let vectors = if vhdl { "vectors.txt" } else { "vectors.hex" };
+    let text = VectorTb {
+        vhdl,
+        tb: &tb_name(m),
         module: &m.name,
-        vectors: "vectors.hex",
+        vectors,
         has_reset,
         reset_bit: total_width - 1,
         inputs: &inputs,
@@ -343,7 +273,7 @@ fn render_verilog(m: &Module, t: &Transcript) -> Vec<(String, String)> {
     }
     .render()
     .expect("testbench template renders");
-    vec![("tb.v".into(), text + "\n"), ("vectors.hex".into(), hex)]
+    vec![(format!("tb.{}", ext(vhdl)), text + "\n"), (vectors.into(), data)]
 }
 
 /// The Verilator harness: ports as 32-bit words, one line of words per clock.

@@ -1,6 +1,7 @@
 //! `fxrt render`: one primary ray per pixel through any of the models, in parallel.
 
 pub mod compare;
+pub mod fast;
 pub mod tracer;
 
 // The camera is pure geometry and lives in the model (the on-chip ray generator is built from

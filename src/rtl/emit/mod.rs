@@ -1,11 +1,34 @@
-//! The two printers. Both walk the same netlist with the same function list and match every
-//! definition exhaustively; they differ only in syntax. Neither computes a width: every type
-//! comes from the netlist.
+//! The two printers. `walk::print` is the one skeleton: it walks a module, matching every
+//! definition exhaustively, and asks a `walk::Printer` (`vhdl::Vhdl`, `verilog::Verilog`, the
+//! same function list) how each part is spelled; both write through one `CodeWriter`. Neither
+//! computes a width: every type comes from the netlist.
 
 pub mod verilog;
 pub mod vhdl;
+pub mod walk;
+pub mod writer;
 
+pub use walk::{Printer, print};
+pub use writer::CodeWriter;
+
+use crate::rtl::width::BinOp;
 use crate::scene::rom::rom_depth;
+
+/// The operator as Verilog (and C) spell it.
+pub fn symbol(op: BinOp) -> &'static str {
+    match op {
+        BinOp::Add => "+",
+        BinOp::Sub => "-",
+        BinOp::And => "&",
+        BinOp::Or => "|",
+        BinOp::Xor => "^",
+        BinOp::Mul => "*",
+        BinOp::Eq => "==",
+        BinOp::Ne => "!=",
+        BinOp::Lt => "<",
+        BinOp::Le => "<=",
+    }
+}
 
 /// The bits of `v` as a string of width `w`, most significant first.
 pub fn bit_string(v: u128, w: u32) -> String {
