@@ -17,6 +17,10 @@ use std::rc::Rc;
 pub struct Builder {
     m: RefCell<Module>,
     counter: Cell<u32>,
+    /// Signals whose name is only a number (`plus_7`), which a stage may name after its field.
+    numbered: RefCell<std::collections::BTreeSet<u32>>,
+    /// Constants made so far, by (type, bits): each value of a type is one signal.
+    konsts: RefCell<std::collections::BTreeMap<(u32, bool, u128), Sig>>,
 }
 
 /// A signal handle: the signal and the builder it belongs to.
@@ -37,7 +41,7 @@ const NAME_MAX: usize = 24;
 
 impl Builder {
     pub fn new(name: &str) -> Builder {
-        Builder { m: RefCell::new(Module::new(name)), counter: Cell::new(0) }
+        Builder { m: RefCell::new(Module::new(name)), counter: Cell::new(0), numbered: Default::default(), konsts: Default::default() }
     }
 
     /// The finished module (checked: every register and wire is driven).
@@ -68,7 +72,16 @@ impl Builder {
         }
         let k = self.counter.get();
         self.counter.set(k + 1);
+        // The next signal made gets this name: remember it as a numbered one.
+        let next = self.m.borrow().signals.len() as u32;
+        self.numbered.borrow_mut().insert(next);
         format!("{op}_{k}")
+    }
+
+    /// Whether a signal still has a numbered name (`plus_7`), not one from its operands or a
+    /// person.
+    pub fn is_numbered(&self, s: Sig) -> bool {
+        self.numbered.borrow().contains(&s.id.0)
     }
 
     pub fn input(&self, name: &str, ty: Ty) -> S<'_> {
@@ -79,10 +92,16 @@ impl Builder {
         self.m.borrow_mut().output(name, s.sig);
     }
 
-    /// A constant of type `ty`, named after its value.
+    /// A constant of type `ty`, named after its value (one signal per type and value).
     pub fn konst(&self, ty: Ty, v: i128) -> S<'_> {
+        let key = (ty.width, ty.signed, ty.wrap(v));
+        if let Some(&s) = self.konsts.borrow().get(&key) {
+            return self.s(s);
+        }
         let name = if v < 0 { format!("k_m{}", v.unsigned_abs()) } else { format!("k_{v}") };
-        self.s(self.m.borrow_mut().konst(&name, ty, v))
+        let s = self.m.borrow_mut().konst(&name, ty, v);
+        self.konsts.borrow_mut().insert(key, s);
+        self.s(s)
     }
 
     /// A register of type `ty` (with a synchronous reset value, or none). Its input is given
@@ -233,6 +252,7 @@ impl<'b> S<'b> {
     /// Gives the signal the name a person wants (made unique and legal).
     pub fn name(self, name: &str) -> S<'b> {
         self.b.with(|m| m.rename(self.sig.id, name));
+        self.b.numbered.borrow_mut().remove(&self.sig.id.0);
         self
     }
 

@@ -99,6 +99,8 @@ pub struct Fsm<'b, St: States> {
     block: usize,
     rec: RefCell<Record<'b>>,
     is: RefCell<BTreeMap<u128, S<'b>>>,
+    /// One constant per state (not shared with other logic), for comparisons and `goto`.
+    codes: Vec<S<'b>>,
     _st: std::marker::PhantomData<St>,
 }
 
@@ -127,8 +129,19 @@ impl<'b, St: States> Fsm<'b, St> {
             m.end_block();
             k
         });
-        let rec = Record { sigs: Vec::new(), assigns: BTreeMap::new(), writes: BTreeMap::new(), defined: Vec::new() };
-        Fsm { b, state, block, rec: RefCell::new(rec), is: RefCell::new(BTreeMap::new()), _st: Default::default() }
+        let codes = St::ALL
+            .iter()
+            .map(|s| b.s(b.with(|m| m.konst(&format!("{name}_{}", s.name()), ty, s.code() as i128))))
+            .collect();
+        Fsm {
+            b,
+            state,
+            block,
+            rec: RefCell::new(Record::default()),
+            is: RefCell::new(BTreeMap::new()),
+            codes,
+            _st: Default::default(),
+        }
     }
 
     /// The state register.
@@ -141,7 +154,7 @@ impl<'b, St: States> Fsm<'b, St> {
         if let Some(s) = self.is.borrow().get(&st.code()) {
             return *s;
         }
-        let s = self.state.eq(st.code() as i128).name(&format!("in_{}", st.name()));
+        let s = self.state.eq(self.codes[st.code() as usize]).name(&format!("in_{}", st.name()));
         self.is.borrow_mut().insert(st.code(), s);
         s
     }
@@ -177,6 +190,8 @@ impl<'b, St: States> Fsm<'b, St> {
         let mut nexts = Nexts(BTreeMap::new());
         for (&target, list) in &rec.assigns {
             let reg = rec.sigs[target];
+            // The machine's registers are printed in its process.
+            b.with(|m| m.set_block(reg.sig.id, self.block));
             // Per state, the assignments in order: the last one that applies wins.
             let mut arms: Vec<(u128, S<'b>)> = Vec::new();
             for st in St::ALL.iter().map(|s| s.code()) {
@@ -248,8 +263,7 @@ impl<'f, 'b, St: States> StateCtx<'f, 'b, St> {
 
     /// The next state.
     pub fn goto(&mut self, st: St) {
-        let k = self.fsm.state.k(st.code() as i128).name(&format!("st_{}", st.name()));
-        self.set(self.fsm.state, k);
+        self.set(self.fsm.state, self.fsm.codes[st.code() as usize]);
     }
 
     /// Writes `data` to memory `mem` at `addr` at the clock edge.

@@ -191,7 +191,13 @@ pub struct Module {
     pub blocks: Vec<Block>,
     /// The block new signals are put in (`begin_block` … `end_block`).
     pub current_block: Option<usize>,
+    /// Every identifier given out so far (signals, ports, memories, instances).
+    idents: std::collections::BTreeSet<String>,
 }
+
+/// Suffixes the printers derive identifiers with (a shift register's array, its type and loop
+/// index; a memory's type): no name may equal another name plus one of them.
+const DERIVED: [&str; 4] = ["_sr", "_sr_t", "_i", "_t"];
 
 impl Module {
     pub fn new(name: &str) -> Module {
@@ -204,6 +210,7 @@ impl Module {
             instances: Vec::new(),
             blocks: Vec::new(),
             current_block: None,
+            idents: std::collections::BTreeSet::new(),
         }
     }
 
@@ -219,6 +226,12 @@ impl Module {
         self.current_block = None;
     }
 
+    /// Puts a signal made earlier into a block (a state machine's registers, declared before
+    /// the machine that assigns them).
+    pub fn set_block(&mut self, id: SigId, block: usize) {
+        self.signals[id.0 as usize].block = Some(block);
+    }
+
     pub fn sig(&self, id: SigId) -> &Signal {
         &self.signals[id.0 as usize]
     }
@@ -229,18 +242,18 @@ impl Module {
 
     /// A readable identifier legal in both languages (see `names::legal`), unique among this
     /// module's signals, ports, memories and instance labels.
-    fn unique_name(&self, base: &str) -> String {
+    fn unique_name(&mut self, base: &str) -> String {
         let s = names::legal(base);
+        let idents = &self.idents;
         let taken = |n: &str| {
-            self.signals.iter().any(|x| x.name == n)
-                || self.outputs.iter().any(|x| x.0 == n)
-                || self.roms.iter().any(|x| x.name == n)
-                || self.instances.iter().any(|x| x.name == n)
+            idents.contains(n)
+                || DERIVED.iter().any(|sfx| {
+                    n.strip_suffix(sfx).is_some_and(|b| idents.contains(b)) || idents.contains(&format!("{n}{sfx}"))
+                })
         };
-        if !taken(&s) {
-            return s;
-        }
-        (1..).map(|i| format!("{s}_{i}")).find(|n| !taken(n)).unwrap_or(s)
+        let name = if taken(&s) { (1..).map(|i| format!("{s}_{i}")).find(|n| !taken(n)).unwrap_or(s) } else { s };
+        self.idents.insert(name.clone());
+        name
     }
 
     fn push(&mut self, name: &str, ty: Ty, def: Def) -> Sig {
@@ -252,7 +265,8 @@ impl Module {
 
     /// Renames a signal (the name made legal and unique).
     pub fn rename(&mut self, id: SigId, name: &str) {
-        self.signals[id.0 as usize].name.clear();
+        let old = std::mem::take(&mut self.signals[id.0 as usize].name);
+        self.idents.remove(&old);
         let n = self.unique_name(name);
         self.signals[id.0 as usize].name = n;
     }
@@ -377,10 +391,10 @@ impl Module {
             || self.instances.iter().any(|i| i.name == name);
         assert!(!port_taken, "{}: port {name} is taken", self.name);
         if let Some(k) = self.signals.iter().position(|x| x.name == name) {
-            self.signals[k].name.clear();
-            let renamed = self.unique_name(&format!("{name}_i"));
+            let renamed = self.unique_name(&format!("{name}_int"));
             self.signals[k].name = renamed;
         }
+        self.idents.insert(name.clone());
         self.outputs.push((name, sig.id));
     }
 

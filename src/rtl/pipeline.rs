@@ -62,7 +62,8 @@ pub struct Pipeline<'b> {
 impl<'b> Pipeline<'b> {
     /// A pipeline starting at stage 0 with the signals that exist now (its inputs).
     pub fn new(b: &'b Builder, policy: Policy) -> Pipeline<'b> {
-        b.with(|m| m.begin_block("s0", "inputs", BlockKind::Stage));
+        // The open block holds the logic feeding the next stage's registers; `stage` names it.
+        b.with(|m| m.begin_block("s1", "", BlockKind::Stage));
         Pipeline {
             b,
             policy,
@@ -109,18 +110,29 @@ impl<'b> Pipeline<'b> {
     /// register (named `s{k}_{field}`) unless the policy merges the stage named `name`. Returns
     /// the bundle as seen in the next stage.
     pub fn stage<B: Bundle<'b>>(&self, name: &str, doc: &str, bundle: B) -> B {
-        let aligned = bundle.map_fields(&mut |_, s| self.now(s));
+        let aligned = bundle.map_fields(&mut |field, s| {
+            let s = self.now(s);
+            // A field's logic with only a numbered name takes the field's name.
+            if self.b.is_numbered(s.sig) { s.name(field) } else { s }
+        });
         if self.policy.merge.iter().any(|m| m == name) {
             return aligned;
         }
         let k = self.stage.get() + 1;
         self.b.with(|m| {
-            m.end_block();
-            m.begin_block(&format!("s{k}_{name}"), doc, BlockKind::Stage);
+            let block = m.current_block.expect("a pipeline's block is open");
+            m.blocks[block].name = crate::rtl::names::legal(&format!("s{k}_{name}"));
+            m.blocks[block].doc = doc.to_string();
         });
+        // The registers are the first signals of stage k (and printed in this block).
         self.bounds.borrow_mut().push(self.next_id());
         self.stage.set(k);
-        aligned.map_fields(&mut |field, s| self.b.delay(&format!("s{k}_{field}"), s))
+        let registered = aligned.map_fields(&mut |field, s| self.b.delay(&format!("s{k}_{field}"), s));
+        self.b.with(|m| {
+            m.end_block();
+            m.begin_block(&format!("s{}", k + 1), "", BlockKind::Stage);
+        });
+        registered
     }
 
     /// An instance with its own `cycles` registers (a sub-module pipeline): its inputs must be
@@ -139,9 +151,14 @@ impl<'b> Pipeline<'b> {
         self.stage.get()
     }
 
-    /// Closes the last stage's block.
+    /// Closes the last block (the logic after the last stage's registers).
     pub fn finish(self) -> u32 {
-        self.b.with(|m| m.end_block());
+        self.b.with(|m| {
+            let block = m.current_block.expect("a pipeline's block is open");
+            m.blocks[block].name = crate::rtl::names::legal(&format!("s{}_out", self.stage.get()));
+            m.blocks[block].doc = "after the last stage".into();
+            m.end_block();
+        });
         self.stage.get()
     }
 }

@@ -174,6 +174,8 @@ fn declarations(m: &Module, cx: &Context, p: &impl Printer, w: &mut CodeWriter) 
             let unread = unread.as_deref();
             match &sig.def {
                 Def::Input => {}
+                // A state constant is written as the state's name.
+                Def::Const(v) if cx.state_name(id, *v).is_some() => {}
                 Def::Const(v) => p.declare(w, sig, Decl::Constant(&power_up(*v)), unread),
                 // Registers power up at their reset value (0 without one), as in the simulator.
                 Def::Reg { reset, .. } => p.declare(w, sig, Decl::Register(&power_up(reset.unwrap_or(0))), unread),
@@ -319,8 +321,13 @@ impl<'m> Context<'m> {
         cx
     }
 
-    fn name(&self, id: SigId) -> &'m str {
-        &self.m.sig(id).name
+    /// How signal `id` is written: its name, or for a constant that is a state of a machine
+    /// the state's name (such constants are not declared).
+    fn name(&self, id: SigId) -> &str {
+        match self.m.sig(id).def {
+            Def::Const(v) => self.state_name(id, v).unwrap_or(&self.m.sig(id).name),
+            _ => &self.m.sig(id).name,
+        }
     }
 
     /// The comment over a block's declarations and statements.
