@@ -588,6 +588,36 @@ mod tests {
         assert_eq!((dirs.len(), out, cache), (2, PathBuf::from("x"), None));
     }
 
+    /// The command line `--emit-slurm` writes for each shard describes the same sweep.
+    #[test]
+    fn the_emitted_sweep_command_describes_the_same_sweep() {
+        let spec = |args: &[&str]| {
+            let Command::Sweep(a) = command(args) else { panic!("not a sweep") };
+            a.spec().unwrap()
+        };
+        let s = spec(&[
+            "sweep",
+            "/data/my scene.obj",
+            "--builtin",
+            "teapot,cornell",
+            "--eye",
+            "1.5,-2,0.001",
+            "--m",
+            "12,32",
+            "--edge-shift",
+            "auto,8",
+            "--one-at-a-time",
+            "--core-sim",
+            "--out",
+            "x",
+        ]);
+        let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+        assert_eq!(argv[..2], ["/opt/fxrt", "sweep"]);
+        argv.extend(["--out".into(), "y".into()]);
+        let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
+        assert_eq!(spec(&argv), s);
+    }
+
     #[test]
     fn each_simulator_choice_maps_once() {
         assert_eq!(Simulation::from(SimChoice::Rust), Simulation::Rust);

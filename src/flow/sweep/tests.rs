@@ -1,6 +1,6 @@
 use super::eval::quality;
 use super::run::scene_labels;
-use super::slurm::{shell_quote, sweep_command};
+use super::slurm::shell_quote;
 use super::*;
 use crate::render::Frame;
 
@@ -90,19 +90,7 @@ fn labels_are_unique_and_file_safe() {
 }
 
 #[test]
-fn the_emitted_command_describes_the_same_sweep() {
-    use clap::Parser;
-    let mut s = spec();
-    s.scenes.insert(0, SceneSpec::Obj("/data/my scene.obj".into()));
-    s.camera.eye = Some([1.5, -2.0, 1e-3]);
-    s.one_at_a_time = true;
-    s.core_sim = true;
-    let args = sweep_command(std::path::Path::new("/opt/fxrt"), &s);
-    let mut argv = args.clone();
-    argv.extend(["--out".into(), "x".into()]);
-    let cli = crate::cli::Cli::try_parse_from(argv.iter()).unwrap();
-    let Some(crate::cli::Command::Sweep(a)) = cli.command else { panic!("not a sweep") };
-    assert_eq!(a.spec().unwrap(), s);
+fn words_are_quoted_for_the_shell_only_when_needed() {
     assert_eq!(shell_quote("/data/my scene.obj"), "'/data/my scene.obj'");
     assert_eq!(shell_quote("it's"), r"'it'\''s'");
     assert_eq!(shell_quote("--n"), "--n");
