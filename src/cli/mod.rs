@@ -1,11 +1,12 @@
-//! The command line, in two layers: clap structs parsed with no side effects, then
-//! validated into the library's types before anything runs or any file is written.
+//! The command line, in three layers: clap structs parsed with no side effects (here), each
+//! command's arguments validated into a configuration before anything runs or any file is
+//! written (`config`), and the commands run on those (`run`). `main.rs` only dispatches.
 
-use crate::error::{Error, Result};
-use crate::model::camera::{Camera, CameraSpec};
-use crate::params::{EdgeShift, Params};
+pub mod config;
+pub mod run;
+
+use crate::params::EdgeShift;
 use crate::render::tracer::ModelKind;
-use crate::scene::SceneSource;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -18,6 +19,23 @@ use std::path::PathBuf;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
+}
+
+impl Cli {
+    /// The command given, or the main job on the embedded default: render the teapot to
+    /// teapot.png.
+    pub fn command_or_default(self) -> Command {
+        self.command.unwrap_or_else(|| {
+            let job = Cli::parse_from(["fxrt", "render", "--png", "teapot.png", "--shade", "--size", "512x512"]);
+            job.command.expect("the default job is a command")
+        })
+    }
+}
+
+/// A clap error as one line, like every other input error (`--help` has the details).
+pub fn error_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ").to_string()
 }
 
 #[derive(Subcommand, Debug)]
@@ -111,42 +129,6 @@ pub struct SweepArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-}
-
-impl SweepArgs {
-    /// The sweep the arguments describe; every list is checked here, before anything runs.
-    pub fn spec(&self) -> Result<crate::flow::sweep::SweepSpec> {
-        use crate::flow::sweep::{SceneSpec, SweepSpec, axis};
-        // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
-        // sweep as a run from here.
-        let mut scenes = Vec::new();
-        for p in &self.scenes {
-            scenes.push(SceneSpec::Obj(std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()))?));
-        }
-        scenes.extend(self.builtin.iter().map(|b| SceneSpec::Builtin(b.trim().to_string())));
-        if scenes.is_empty() {
-            scenes.push(SceneSpec::Builtin("teapot".into()));
-        }
-        if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
-            return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
-        }
-        let single = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
-        single.validate()?;
-        Ok(SweepSpec {
-            scenes,
-            camera: self.camera.spec(),
-            n: axis::parse_u32_list("n", &self.n)?,
-            m: axis::parse_u32_list("m", &self.m)?,
-            t: axis::parse_u32_list("t", &self.t)?,
-            c: axis::parse_u32_list("c", &self.c)?,
-            edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
-            leaf_size: self.leaf_size,
-            stack_depth: self.stack_depth,
-            one_at_a_time: self.one_at_a_time,
-            synth: self.synth,
-            core_sim: self.core_sim,
-        })
-    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -262,7 +244,7 @@ pub struct GenArgs {
 }
 
 /// Choices of the hardware that do not change the arithmetic.
-#[derive(Args, Debug, Clone)]
+#[derive(Args, Debug, Clone, PartialEq, Eq)]
 pub struct HwArgs {
     /// Width of the tag passed through the intersection pipeline (1..=64).
     #[arg(long = "tag-width", default_value_t = 32)]
@@ -335,22 +317,6 @@ pub struct ParamArgs {
     pub stack_depth: u32,
 }
 
-impl ParamArgs {
-    pub fn params(&self) -> Result<Params> {
-        let p = Params {
-            n: self.n,
-            m: self.m,
-            edge_shift: self.edge_shift,
-            t: self.t,
-            c: self.c,
-            leaf_size: self.leaf_size,
-            stack_depth: self.stack_depth,
-        };
-        p.validate()?;
-        Ok(p)
-    }
-}
-
 #[derive(Args, Debug, Clone)]
 pub struct SceneChoice {
     /// An OBJ file (polygons are fan-triangulated, numbered in file order).
@@ -358,17 +324,6 @@ pub struct SceneChoice {
     /// A built-in scene instead of a file: teapot, jackstraws, thin, random, cornell.
     #[arg(long, conflicts_with = "scene")]
     pub builtin: Option<String>,
-}
-
-impl SceneChoice {
-    /// The embedded teapot when neither a file nor a built-in is named.
-    pub fn source(&self) -> SceneSource {
-        match (&self.scene, &self.builtin) {
-            (Some(p), _) => SceneSource::Obj(p.clone()),
-            (None, Some(b)) => SceneSource::Builtin(b.clone()),
-            (None, None) => SceneSource::Builtin("teapot".into()),
-        }
-    }
 }
 
 #[derive(Args, Debug, Clone)]
@@ -388,16 +343,6 @@ pub struct CameraArgs {
     /// Image size WxH.
     #[arg(long, value_parser = parse_size, default_value = "256x256")]
     pub size: (u32, u32),
-}
-
-impl CameraArgs {
-    pub fn spec(&self) -> CameraSpec {
-        let (width, height) = self.size;
-        CameraSpec { eye: self.eye, at: self.at, up: self.up, fov: self.fov, width, height }
-    }
-    pub fn camera(&self, scene: &crate::scene::Scene) -> Result<Camera> {
-        self.spec().camera(scene)
-    }
 }
 
 #[derive(Args, Debug)]
@@ -526,6 +471,14 @@ mod tests {
     }
 
     #[test]
+    fn a_parse_error_is_one_line_naming_the_option() {
+        let e = Cli::try_parse_from(["fxrt", "render", "--size", "0x4"]).unwrap_err();
+        let line = error_line(&e);
+        assert!(line.contains("--size") && line.contains("out of range"), "{line}");
+        assert!(!line.contains('\n') && !line.starts_with("error"), "{line}");
+    }
+
+    #[test]
     fn render_args_parse_without_side_effects() {
         let cli = Cli::try_parse_from([
             "fxrt",
@@ -541,7 +494,7 @@ mod tests {
         ])
         .unwrap();
         let Some(Command::Render(r)) = cli.command else { panic!("not render") };
-        assert_eq!(r.scene.source(), SceneSource::Builtin("cornell".into()));
+        assert_eq!(r.scene.source(), crate::scene::SceneSource::Builtin("cornell".into()));
         assert_eq!(r.camera.eye, Some([-1.0, 2.0, 3.0]));
         let p = r.params.params().unwrap();
         assert_eq!((p.n, p.edge_shift), (20, EdgeShift::Fixed(10)));

@@ -14,6 +14,7 @@ pub mod output;
 pub mod plots;
 pub mod report;
 pub mod run;
+pub mod slurm;
 pub mod summary;
 
 use crate::error::{Error, Result};

@@ -1,6 +1,6 @@
 use super::eval::quality;
-use super::report::{shell_quote, sweep_command};
 use super::run::scene_labels;
+use super::slurm::shell_quote;
 use super::*;
 use crate::render::Frame;
 
@@ -90,19 +90,7 @@ fn labels_are_unique_and_file_safe() {
 }
 
 #[test]
-fn the_emitted_command_describes_the_same_sweep() {
-    use clap::Parser;
-    let mut s = spec();
-    s.scenes.insert(0, SceneSpec::Obj("/data/my scene.obj".into()));
-    s.camera.eye = Some([1.5, -2.0, 1e-3]);
-    s.one_at_a_time = true;
-    s.core_sim = true;
-    let args = sweep_command(std::path::Path::new("/opt/fxrt"), &s);
-    let mut argv = args.clone();
-    argv.extend(["--out".into(), "x".into()]);
-    let cli = crate::cli::Cli::try_parse_from(argv.iter()).unwrap();
-    let Some(crate::cli::Command::Sweep(a)) = cli.command else { panic!("not a sweep") };
-    assert_eq!(a.spec().unwrap(), s);
+fn words_are_quoted_for_the_shell_only_when_needed() {
     assert_eq!(shell_quote("/data/my scene.obj"), "'/data/my scene.obj'");
     assert_eq!(shell_quote("it's"), r"'it'\''s'");
     assert_eq!(shell_quote("--n"), "--n");
@@ -156,4 +144,27 @@ fn the_base_set_must_be_valid_and_plans_have_a_size_limit() {
     assert!(matches!(s.plan(), Err(e) if e.to_string().contains("is more than 1000000")));
     let s = SweepSpec { c: vec![], ..spec() };
     assert_eq!(s.plan().unwrap_err().to_string(), "--c: the list is empty");
+}
+
+#[test]
+fn slurm_shards_are_checked_and_the_scripts_written() {
+    use super::slurm::{check_shards, emit};
+    assert!(check_shards(1, 1).is_ok() && check_shards(1000, 5000).is_ok());
+    assert_eq!(check_shards(0, 10).unwrap_err().subject, "--shards");
+    assert!(check_shards(11, 10).is_err(), "more shards than configurations");
+    assert!(check_shards(1001, 5000).is_err(), "Slurm's array limit");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sw");
+    assert!(emit(&spec(), 4, &out, &out.join("cache"), 5, 2).is_err());
+    assert!(!out.exists(), "nothing written for a refused shard count");
+    emit(&spec(), 4, &out, &out.join("cache"), 2, 3).unwrap();
+    let commands = std::fs::read_to_string(out.join("slurm/commands.txt")).unwrap();
+    assert_eq!(commands.lines().count(), 2);
+    assert!(commands.contains("--threads 3 --shard 2/2"), "{commands}");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = |f: &str| std::fs::metadata(out.join("slurm").join(f)).unwrap().permissions().mode();
+        assert!(mode("submit.sh") & 0o111 != 0 && mode("sweep.slurm") & 0o111 == 0);
+    }
 }

@@ -1,0 +1,637 @@
+//! Each command's arguments validated into what it runs on: ranges checked, defaults filled
+//! in, the command line's choices mapped to the library's types. Nothing here reads a file or
+//! writes one; what needs the scene (the camera's defaults, widths against the scene's E, the
+//! core's memories) is checked in `cli::run` as soon as the scene is loaded, still before
+//! anything is written.
+
+use super::{
+    BenchArgs, BenchWhat, CameraArgs, CompareArgs, FrameSim, GenArgs, HwArgs, Lang, ParamArgs, RenderArgs, SceneArgs,
+    SceneChoice, SimArgs, SimChoice, SweepAction, SweepArgs, SynthArgs, TestArgs,
+};
+use crate::error::{Error, Result};
+use crate::flow::simulators::Simulator;
+use crate::flow::sweep::{Plan, Shard, SweepSpec};
+use crate::model::camera::{Camera, CameraSpec};
+use crate::params::Params;
+use crate::render::tracer::ModelKind;
+use crate::scene::SceneSource;
+use std::path::PathBuf;
+
+/// Where a design runs: the Rust simulator or an HDL simulator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Simulation {
+    Rust,
+    Hdl(Simulator),
+}
+
+impl Simulation {
+    /// As the JSON of `fxrt sim` names it: rust, ghdl, iverilog, verilator.
+    pub fn name(self) -> &'static str {
+        match self {
+            Simulation::Rust => "rust",
+            Simulation::Hdl(s) => s.name(),
+        }
+    }
+
+    /// As the summary line of `fxrt test` names it.
+    pub fn title(self) -> &'static str {
+        match self {
+            Simulation::Rust => "Rust",
+            Simulation::Hdl(Simulator::Ghdl) => "Ghdl",
+            Simulation::Hdl(Simulator::Iverilog) => "Iverilog",
+            Simulation::Hdl(Simulator::Verilator) => "Verilator",
+        }
+    }
+
+    /// The build folder of an HDL run: `dir` if given, else `default_root`/SIMULATOR.
+    fn build_dir(self, dir: &Option<PathBuf>, default_root: &str) -> Option<PathBuf> {
+        match self {
+            Simulation::Rust => None,
+            Simulation::Hdl(s) => Some(dir.clone().unwrap_or_else(|| PathBuf::from(default_root).join(s.name()))),
+        }
+    }
+}
+
+impl From<SimChoice> for Simulation {
+    fn from(s: SimChoice) -> Self {
+        match s {
+            SimChoice::Rust => Simulation::Rust,
+            SimChoice::Ghdl => Simulation::Hdl(Simulator::Ghdl),
+            SimChoice::Iverilog => Simulation::Hdl(Simulator::Iverilog),
+            SimChoice::Verilator => Simulation::Hdl(Simulator::Verilator),
+        }
+    }
+}
+
+impl From<FrameSim> for Simulation {
+    fn from(s: FrameSim) -> Self {
+        match s {
+            FrameSim::Rust => Simulation::Rust,
+            FrameSim::Ghdl => Simulation::Hdl(Simulator::Ghdl),
+            FrameSim::Verilator => Simulation::Hdl(Simulator::Verilator),
+        }
+    }
+}
+
+/// Worker threads: None for all cores, else 1..=1024.
+pub fn threads(n: Option<usize>) -> Result<Option<usize>> {
+    match n {
+        Some(n) if n == 0 || n > 1024 => Err(Error::param("threads", format!("{n} is out of range: must be 1..=1024"))),
+        n => Ok(n),
+    }
+}
+
+/// Output files of a frame; none is written before everything is computed.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FrameFiles {
+    pub png: Option<PathBuf>,
+    pub ids: Option<PathBuf>,
+    pub depth: Option<PathBuf>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderConfig {
+    pub params: Params,
+    pub threads: Option<usize>,
+    pub scene: SceneSource,
+    pub camera: CameraSpec,
+    pub model: ModelKind,
+    pub shade: bool,
+    pub files: FrameFiles,
+}
+
+impl RenderArgs {
+    pub fn config(&self) -> Result<RenderConfig> {
+        Ok(RenderConfig {
+            params: self.params.params()?,
+            threads: threads(self.threads)?,
+            scene: self.scene.source(),
+            camera: self.camera.spec(),
+            model: self.model,
+            shade: self.shade,
+            files: FrameFiles { png: self.png.clone(), ids: self.ids.clone(), depth: self.depth.clone() },
+        })
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompareConfig {
+    pub params: Params,
+    pub threads: Option<usize>,
+    pub scene: SceneSource,
+    pub camera: CameraSpec,
+    pub against: ModelKind,
+}
+
+impl CompareArgs {
+    pub fn config(&self) -> Result<CompareConfig> {
+        Ok(CompareConfig {
+            params: self.params.params()?,
+            threads: threads(self.threads)?,
+            scene: self.scene.source(),
+            camera: self.camera.spec(),
+            against: self.against,
+        })
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneConfig {
+    pub params: Params,
+    pub scene: SceneSource,
+    pub out: PathBuf,
+    pub stats: bool,
+}
+
+impl SceneArgs {
+    pub fn config(&self) -> Result<SceneConfig> {
+        Ok(SceneConfig {
+            params: self.params.params()?,
+            scene: self.scene.source(),
+            out: self.out.clone(),
+            stats: self.stats,
+        })
+    }
+}
+
+/// `fxrt bench`: always the embedded teapot at the default parameters.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BenchConfig {
+    /// Golden-model render speed; the best of `repeat` (≥ 1) renders.
+    Render { width: u32, height: u32, threads: usize, repeat: u32 },
+    /// Simulator speed on `vectors` (≥ 1) intersection vectors, GHDL on a prefix.
+    Sim { vectors: usize, ghdl_vectors: usize },
+}
+
+impl BenchArgs {
+    pub fn config(&self) -> Result<BenchConfig> {
+        Ok(match self.what {
+            BenchWhat::Sim => BenchConfig::Sim { vectors: self.vectors.max(1), ghdl_vectors: self.ghdl_vectors },
+            BenchWhat::Render => {
+                threads(Some(self.threads))?;
+                let (width, height) = self.size;
+                BenchConfig::Render { width, height, threads: self.threads, repeat: self.repeat.max(1) }
+            }
+        })
+    }
+}
+
+/// Where `fxrt gen` takes its scene from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GenScene {
+    /// A folder written by `fxrt scene` (its parameters are the ones stored there).
+    Folder(PathBuf),
+    /// A scene quantised with `params`; with a camera when the core has the ray generator.
+    Scene { source: SceneSource, params: Params, raygen: Option<CameraSpec> },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenConfig {
+    pub scene: GenScene,
+    pub out: PathBuf,
+    pub vhdl: bool,
+    pub verilog: bool,
+    pub ise: bool,
+    pub clock_mhz: f64,
+    pub ray_id_width: u32,
+    pub bram_kbits: u64,
+    pub div_bits: u32,
+}
+
+impl GenArgs {
+    pub fn config(&self) -> Result<GenConfig> {
+        let scene = match &self.scene_dir {
+            Some(_) if self.raygen => {
+                return Err(Error::param("raygen", "needs the scene itself (an OBJ or --builtin), not --scene DIR"));
+            }
+            Some(dir) => GenScene::Folder(dir.clone()),
+            None => GenScene::Scene {
+                source: self.scene.source(),
+                params: self.params.params()?,
+                raygen: self.raygen.then(|| self.camera.spec()),
+            },
+        };
+        if !(1..=64).contains(&self.ray_id_width) {
+            return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", self.ray_id_width)));
+        }
+        if !(self.clock_mhz > 0.0 && self.clock_mhz <= 1000.0) {
+            return Err(Error::param("clock-mhz", format!("{} is out of range: must be in (0, 1000]", self.clock_mhz)));
+        }
+        Ok(GenConfig {
+            scene,
+            out: self.out.clone(),
+            vhdl: self.lang.contains(&Lang::Vhdl),
+            verilog: self.lang.contains(&Lang::Verilog),
+            ise: self.ise,
+            clock_mhz: self.clock_mhz,
+            ray_id_width: self.ray_id_width,
+            bram_kbits: self.bram_kbits,
+            div_bits: self.div_bits,
+        })
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TestConfig {
+    pub params: Params,
+    pub scene: SceneSource,
+    pub hw: HwArgs,
+    pub sim: Simulation,
+    /// Number of vectors, ≥ 1.
+    pub vectors: usize,
+    pub seed: u64,
+    /// The HDL build folder (None for the Rust simulator).
+    pub build: Option<PathBuf>,
+}
+
+impl TestArgs {
+    pub fn config(&self) -> Result<TestConfig> {
+        let params = self.params.params()?;
+        // The slow simulators get fewer vectors by default.
+        let vectors = self.vectors.unwrap_or(match self.sim {
+            SimChoice::Rust | SimChoice::Verilator => 100_000,
+            SimChoice::Iverilog => 20_000,
+            SimChoice::Ghdl => 2_000,
+        });
+        if vectors == 0 {
+            return Err(Error::param("vectors", "0: nothing would run"));
+        }
+        let sim = Simulation::from(self.sim);
+        Ok(TestConfig {
+            params,
+            scene: self.scene.source(),
+            hw: self.hw.clone(),
+            sim,
+            vectors,
+            seed: self.seed,
+            build: sim.build_dir(&self.build, "target/fxrt-test"),
+        })
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthConfig {
+    pub params: Params,
+    pub scene: SceneSource,
+    pub hw: HwArgs,
+    pub build: PathBuf,
+}
+
+impl SynthArgs {
+    pub fn config(&self) -> Result<SynthConfig> {
+        if self.family != "xc5v" {
+            return Err(Error::param("family", format!("'{}' is not supported: only xc5v (Virtex-5)", self.family)));
+        }
+        Ok(SynthConfig {
+            params: self.params.params()?,
+            scene: self.scene.source(),
+            hw: self.hw.clone(),
+            build: self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth")),
+        })
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimConfig {
+    pub params: Params,
+    pub scene: SceneSource,
+    pub camera: CameraSpec,
+    pub sim: Simulation,
+    /// Rays from the on-chip ray generator instead of the host (Rust simulator only).
+    pub raygen: bool,
+    pub div_bits: u32,
+    pub png: Option<PathBuf>,
+    pub ids: Option<PathBuf>,
+    /// The HDL build folder (None for the Rust simulator).
+    pub build: Option<PathBuf>,
+}
+
+impl SimArgs {
+    pub fn config(&self) -> Result<SimConfig> {
+        let params = self.params.params()?;
+        let sim = Simulation::from(self.sim);
+        if self.raygen && sim != Simulation::Rust {
+            return Err(Error::param("raygen", "runs in the Rust simulator only (--sim rust)"));
+        }
+        Ok(SimConfig {
+            params,
+            scene: self.scene.source(),
+            camera: self.camera.spec(),
+            sim,
+            raygen: self.raygen,
+            div_bits: self.div_bits,
+            png: self.png.clone(),
+            ids: self.ids.clone(),
+            build: sim.build_dir(&self.build, "target/fxrt-sim"),
+        })
+    }
+}
+
+/// `fxrt sweep`: join shards, or run (a shard of) a sweep, or write its Slurm scripts.
+#[derive(Debug)]
+pub enum SweepConfig {
+    Merge { dirs: Vec<PathBuf>, out: PathBuf, cache: Option<PathBuf> },
+    Run(SweepRun),
+}
+
+#[derive(Debug)]
+pub struct SweepRun {
+    pub spec: SweepSpec,
+    pub plan: Plan,
+    pub out: PathBuf,
+    /// Default: OUT/cache.
+    pub cache: PathBuf,
+    pub threads: Option<usize>,
+    pub shard: Option<Shard>,
+    /// `--emit-slurm`: the shard count and the threads (CPUs) of each shard, default 4.
+    pub slurm: Option<(u32, u32)>,
+}
+
+impl SweepArgs {
+    pub fn config(&self) -> Result<SweepConfig> {
+        if let Some(SweepAction::Merge(m)) = &self.action {
+            return Ok(SweepConfig::Merge { dirs: m.dirs.clone(), out: m.out.clone(), cache: m.cache.clone() });
+        }
+        let spec = self.spec()?;
+        let plan = spec.plan()?;
+        // clap requires --out without a subcommand; checked again so a hand-made SweepArgs
+        // gets an error rather than a panic.
+        let out = self.out.clone().ok_or_else(|| Error::param("out", "is required"))?;
+        let threads = threads(self.threads)?;
+        if self.emit_slurm && self.shard.is_some() {
+            return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
+        }
+        Ok(SweepConfig::Run(SweepRun {
+            cache: self.cache.clone().unwrap_or_else(|| out.join("cache")),
+            spec,
+            plan,
+            out,
+            threads,
+            shard: self.shard,
+            slurm: self.emit_slurm.then(|| (self.shards, self.threads.unwrap_or(4) as u32)),
+        }))
+    }
+
+    /// The sweep the arguments describe; every list is checked here, before anything runs.
+    pub fn spec(&self) -> Result<SweepSpec> {
+        use crate::flow::sweep::{SceneSpec, axis};
+        // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
+        // sweep as a run from here.
+        let mut scenes = Vec::new();
+        for p in &self.scenes {
+            scenes.push(SceneSpec::Obj(std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()))?));
+        }
+        scenes.extend(self.builtin.iter().map(|b| SceneSpec::Builtin(b.trim().to_string())));
+        if scenes.is_empty() {
+            scenes.push(SceneSpec::Builtin("teapot".into()));
+        }
+        if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
+            return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
+        }
+        let single = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
+        single.validate()?;
+        Ok(SweepSpec {
+            scenes,
+            camera: self.camera.spec(),
+            n: axis::parse_u32_list("n", &self.n)?,
+            m: axis::parse_u32_list("m", &self.m)?,
+            t: axis::parse_u32_list("t", &self.t)?,
+            c: axis::parse_u32_list("c", &self.c)?,
+            edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
+            leaf_size: self.leaf_size,
+            stack_depth: self.stack_depth,
+            one_at_a_time: self.one_at_a_time,
+            synth: self.synth,
+            core_sim: self.core_sim,
+        })
+    }
+}
+
+impl ParamArgs {
+    pub fn params(&self) -> Result<Params> {
+        let p = Params {
+            n: self.n,
+            m: self.m,
+            edge_shift: self.edge_shift,
+            t: self.t,
+            c: self.c,
+            leaf_size: self.leaf_size,
+            stack_depth: self.stack_depth,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+impl SceneChoice {
+    /// The embedded teapot when neither a file nor a built-in is named.
+    pub fn source(&self) -> SceneSource {
+        match (&self.scene, &self.builtin) {
+            (Some(p), _) => SceneSource::Obj(p.clone()),
+            (None, Some(b)) => SceneSource::Builtin(b.clone()),
+            (None, None) => SceneSource::Builtin("teapot".into()),
+        }
+    }
+}
+
+impl CameraArgs {
+    pub fn spec(&self) -> CameraSpec {
+        let (width, height) = self.size;
+        CameraSpec { eye: self.eye, at: self.at, up: self.up, fov: self.fov, width, height }
+    }
+    pub fn camera(&self, scene: &crate::scene::Scene) -> Result<Camera> {
+        self.spec().camera(scene)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+
+    fn command(args: &[&str]) -> Command {
+        Cli::try_parse_from(std::iter::once("fxrt").chain(args.iter().copied())).expect("parses").command_or_default()
+    }
+
+    /// `config` of any command, for what it refuses.
+    fn check(args: &[&str]) -> Result<()> {
+        match command(args) {
+            Command::Render(a) => a.config().map(drop),
+            Command::Scene(a) => a.config().map(drop),
+            Command::Compare(a) => a.config().map(drop),
+            Command::Bench(a) => a.config().map(drop),
+            Command::Gen(a) => a.config().map(drop),
+            Command::Test(a) => a.config().map(drop),
+            Command::Synth(a) => a.config().map(drop),
+            Command::Sim(a) => a.config().map(drop),
+            Command::Sweep(a) => a.config().map(drop),
+        }
+    }
+
+    fn refused(args: &[&str]) -> String {
+        check(args).expect_err("should be refused").subject
+    }
+
+    #[test]
+    fn threads_are_1_to_1024_or_all_cores() {
+        assert_eq!(threads(None), Ok(None));
+        assert_eq!(threads(Some(1024)), Ok(Some(1024)));
+        assert_eq!(threads(Some(0)).unwrap_err().subject, "--threads");
+        assert!(threads(Some(1025)).is_err());
+        for args in [&["render", "--threads", "0"][..], &["compare", "--threads", "2000"], &["bench", "--threads", "0"]]
+        {
+            assert_eq!(refused(args), "--threads", "{args:?}");
+        }
+        assert_eq!(refused(&["sweep", "--out", "x", "--threads", "0"]), "--threads");
+        // `bench sim` runs no thread pool.
+        assert!(check(&["bench", "sim", "--threads", "0"]).is_ok());
+    }
+
+    #[test]
+    fn the_default_job_renders_the_shaded_teapot() {
+        let Command::Render(a) = command(&[]) else { panic!("not a render") };
+        let c = a.config().unwrap();
+        assert_eq!(c.scene, SceneSource::Builtin("teapot".into()));
+        assert_eq!(c.files.png, Some(PathBuf::from("teapot.png")));
+        assert!(c.shade && c.files.ids.is_none());
+        assert_eq!((c.camera.width, c.camera.height), (512, 512));
+        assert_eq!(c.params, Params::default());
+    }
+
+    #[test]
+    fn bench_counts_at_least_one() {
+        let Command::Bench(a) = command(&["bench", "--repeat", "0", "--size", "64x32"]) else { panic!() };
+        assert_eq!(a.config(), Ok(BenchConfig::Render { width: 64, height: 32, threads: 1, repeat: 1 }));
+        let Command::Bench(a) = command(&["bench", "sim", "--vectors", "0"]) else { panic!() };
+        assert_eq!(a.config(), Ok(BenchConfig::Sim { vectors: 1, ghdl_vectors: 3000 }));
+    }
+
+    #[test]
+    fn gen_checks_its_ranges_and_the_scene_folder() {
+        assert_eq!(refused(&["gen", "--out", "x", "--scene", "rom", "--raygen"]), "--raygen");
+        for w in ["0", "65"] {
+            assert_eq!(refused(&["gen", "--out", "x", "--ray-id-width", w]), "--ray-id-width");
+        }
+        for mhz in ["0", "1000.5", "nan", "-5"] {
+            let arg = format!("--clock-mhz={mhz}");
+            assert_eq!(refused(&["gen", "--out", "x", &arg]), "--clock-mhz", "{mhz}");
+        }
+        assert_eq!(refused(&["gen", "--out", "x", "--n", "99"]), "--n");
+        // A scene folder brings its own parameters: the command line's are not used.
+        let Command::Gen(a) = command(&["gen", "--out", "x", "--scene", "rom", "--n", "99", "--lang", "vhdl"]) else {
+            panic!()
+        };
+        let c = a.config().unwrap();
+        assert_eq!(c.scene, GenScene::Folder("rom".into()));
+        assert!(c.vhdl && !c.verilog);
+        let Command::Gen(a) = command(&["gen", "--out", "x", "--raygen", "--eye", "1,2,3", "--clock-mhz", "1000"])
+        else {
+            panic!()
+        };
+        let GenScene::Scene { raygen: Some(cam), .. } = a.config().unwrap().scene else { panic!("no camera") };
+        assert_eq!(cam.eye, Some([1.0, 2.0, 3.0]));
+    }
+
+    #[test]
+    fn test_fills_in_vectors_and_build_folders_per_simulator() {
+        let config = |args: &[&str]| {
+            let Command::Test(a) = command(args) else { panic!() };
+            a.config().unwrap()
+        };
+        let c = config(&["test"]);
+        assert_eq!((c.sim, c.vectors, c.build), (Simulation::Rust, 100_000, None));
+        let c = config(&["test", "--sim", "ghdl"]);
+        assert_eq!((c.vectors, c.build), (2_000, Some(PathBuf::from("target/fxrt-test/ghdl"))));
+        assert_eq!(config(&["test", "--sim", "iverilog"]).vectors, 20_000);
+        let c = config(&["test", "--sim", "verilator", "--build", "b", "--vectors", "7"]);
+        assert_eq!((c.sim, c.vectors, c.build), (Simulation::Hdl(Simulator::Verilator), 7, Some("b".into())));
+        assert_eq!(refused(&["test", "--vectors", "0"]), "--vectors");
+        assert_eq!(refused(&["test", "--t", "40"]), "--t");
+    }
+
+    #[test]
+    fn sim_runs_the_ray_generator_in_rust_only() {
+        assert_eq!(refused(&["sim", "--raygen", "--sim", "ghdl"]), "--raygen");
+        assert_eq!(refused(&["sim", "--raygen", "--sim", "verilator"]), "--raygen");
+        assert!(check(&["sim", "--raygen"]).is_ok());
+        let Command::Sim(a) = command(&["sim", "--sim", "verilator"]) else { panic!() };
+        let c = a.config().unwrap();
+        assert_eq!((c.sim.name(), c.build), ("verilator", Some(PathBuf::from("target/fxrt-sim/verilator"))));
+    }
+
+    #[test]
+    fn synth_is_for_virtex_5() {
+        assert_eq!(refused(&["synth", "--family", "xc7"]), "--family");
+        let Command::Synth(a) = command(&["synth"]) else { panic!() };
+        assert_eq!(a.config().unwrap().build, PathBuf::from("target/fxrt-synth"));
+    }
+
+    #[test]
+    fn sweep_defaults_and_the_slurm_options() {
+        assert_eq!(refused(&["sweep", "--out", "x", "--emit-slurm", "--shard", "1/2"]), "--emit-slurm");
+        assert_eq!(refused(&["sweep", "--out", "x", "--fov", "180"]), "--fov");
+        let run = |args: &[&str]| {
+            let Command::Sweep(a) = command(args) else { panic!() };
+            match a.config().unwrap() {
+                SweepConfig::Run(r) => r,
+                SweepConfig::Merge { .. } => panic!("not a run"),
+            }
+        };
+        let r = run(&["sweep", "--out", "x", "--m", "16,32"]);
+        assert_eq!((r.cache, r.slurm, r.plan.configs.len()), (PathBuf::from("x/cache"), None, 2));
+        assert_eq!(run(&["sweep", "--out", "x", "--emit-slurm"]).slurm, Some((8, 4)));
+        let r = run(&["sweep", "--out", "x", "--emit-slurm", "--shards", "3", "--threads", "2", "--cache", "c"]);
+        assert_eq!((r.slurm, r.cache), (Some((3, 2)), PathBuf::from("c")));
+        let Command::Sweep(a) = command(&["sweep", "merge", "a", "b", "--out", "x"]) else { panic!() };
+        let SweepConfig::Merge { dirs, out, cache } = a.config().unwrap() else { panic!("not a merge") };
+        assert_eq!((dirs.len(), out, cache), (2, PathBuf::from("x"), None));
+    }
+
+    /// The command line `--emit-slurm` writes for each shard describes the same sweep.
+    #[test]
+    fn the_emitted_sweep_command_describes_the_same_sweep() {
+        let spec = |args: &[&str]| {
+            let Command::Sweep(a) = command(args) else { panic!("not a sweep") };
+            a.spec().unwrap()
+        };
+        let s = spec(&[
+            "sweep",
+            "/data/my scene.obj",
+            "--builtin",
+            "teapot,cornell",
+            "--eye",
+            "1.5,-2,0.001",
+            "--m",
+            "12,32",
+            "--edge-shift",
+            "auto,8",
+            "--one-at-a-time",
+            "--core-sim",
+            "--out",
+            "x",
+        ]);
+        let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+        assert_eq!(argv[..2], ["/opt/fxrt", "sweep"]);
+        argv.extend(["--out".into(), "y".into()]);
+        let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
+        assert_eq!(spec(&argv), s);
+    }
+
+    #[test]
+    fn each_simulator_choice_maps_once() {
+        assert_eq!(Simulation::from(SimChoice::Rust), Simulation::Rust);
+        assert_eq!(Simulation::from(FrameSim::Rust), Simulation::Rust);
+        for (choice, frame, sim) in [
+            (SimChoice::Ghdl, Some(FrameSim::Ghdl), Simulator::Ghdl),
+            (SimChoice::Iverilog, None, Simulator::Iverilog),
+            (SimChoice::Verilator, Some(FrameSim::Verilator), Simulator::Verilator),
+        ] {
+            assert_eq!(Simulation::from(choice), Simulation::Hdl(sim));
+            assert_eq!(frame.map(Simulation::from), frame.map(|_| Simulation::Hdl(sim)));
+            // The names printed before the mapping moved here: `{:?}` and its lower case.
+            assert_eq!(Simulation::from(choice).title(), format!("{choice:?}"));
+            assert_eq!(Simulation::from(choice).name(), format!("{choice:?}").to_lowercase());
+        }
+    }
+}

@@ -1,0 +1,378 @@
+//! Running each command on its validated configuration (`cli::config`). A command returns
+//! Ok(false) when it ran but found a mismatch (exit 1); every error is the user's input
+//! (exit 2, one line).
+
+use super::Command;
+use super::config::{
+    BenchConfig, CompareConfig, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation, SweepConfig,
+    SweepRun, SynthConfig, TestConfig,
+};
+use crate::cores::intersect::IntersectParams;
+use crate::error::{Error, Result};
+use crate::flow::sweep::{run as sweep, slurm};
+use crate::flow::{check, frame, generate, synth, vectors};
+use crate::model::camera::{Camera, CameraSpec};
+use crate::model::golden::Golden;
+use crate::model::raygen::RayGen;
+use crate::params::Params;
+use crate::render::{self, tracer};
+use crate::scene::images::SceneRoms;
+use crate::scene::{self, Scene, SceneSource, rom};
+use std::path::{Path, PathBuf};
+
+/// Runs `cmd`: Ok(true) when it succeeded, Ok(false) when it found a mismatch.
+pub fn run(cmd: Command) -> Result<bool> {
+    match cmd {
+        Command::Render(a) => render(&a.config()?).map(|()| true),
+        Command::Scene(a) => scene(&a.config()?).map(|()| true),
+        Command::Compare(a) => compare(&a.config()?).map(|()| true),
+        Command::Bench(a) => bench(&a.config()?).map(|()| true),
+        Command::Gen(a) => gen_core(&a.config()?).map(|()| true),
+        Command::Synth(a) => synth_cores(&a.config()?).map(|()| true),
+        Command::Sweep(a) => sweep_cmd(a.config()?),
+        Command::Sim(a) => sim(&a.config()?),
+        Command::Test(a) => test(&a.config()?),
+    }
+}
+
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        b = b.num_threads(n);
+    }
+    b.build().map_err(|e| Error::param("threads", e.to_string()))
+}
+
+pub fn render(c: &RenderConfig) -> Result<()> {
+    let pool = thread_pool(c.threads)?;
+    let scene = Scene::load(&c.scene, &c.params)?;
+    let cam = c.camera.camera(&scene)?;
+    let tracer = tracer::make_tracer(&scene, c.model);
+    let frame = pool.install(|| render::render(&scene, tracer.as_ref(), &cam, c.shade, true));
+    // Everything is computed before the first file is written.
+    let mut files = Vec::new();
+    if let Some(p) = &c.files.png {
+        files.push((p.clone(), frame.png_bytes()));
+    }
+    if let Some(p) = &c.files.ids {
+        files.push((p.clone(), frame.ids_bytes()));
+    }
+    if let Some(p) = &c.files.depth {
+        files.push((p.clone(), frame.depth_bytes()));
+    }
+    crate::io::write_all_atomic(&files)?;
+    println!(
+        "rays: {}, hits: {}, seconds: {:.3}, Mrays/s: {:.2}",
+        frame.rays,
+        frame.hits,
+        frame.seconds,
+        frame.rays as f64 / frame.seconds.max(1e-9) / 1e6
+    );
+    Ok(())
+}
+
+pub fn compare(c: &CompareConfig) -> Result<()> {
+    let pool = thread_pool(c.threads)?;
+    let scene = Scene::load(&c.scene, &c.params)?;
+    let cam = c.camera.camera(&scene)?;
+    let (g, r) = pool.install(|| {
+        let golden = tracer::make_tracer(&scene, tracer::ModelKind::Golden);
+        let reference = tracer::make_tracer(&scene, c.against);
+        (
+            render::render(&scene, golden.as_ref(), &cam, false, true),
+            render::render(&scene, reference.as_ref(), &cam, false, true),
+        )
+    });
+    let d = render::compare::compare(&g, &r);
+    println!(
+        "{}",
+        serde_json::json!({ "scene": scene.name, "against": format!("{:?}", c.against).to_lowercase(), "edge_shift": scene.edge_shift, "disagreement": d, "rate": d.rate() })
+    );
+    Ok(())
+}
+
+pub fn bench(c: &BenchConfig) -> Result<()> {
+    let params = Params::default();
+    let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params)?;
+    match *c {
+        BenchConfig::Sim { vectors, ghdl_vectors } => {
+            let p = intersect_params(&params, &scene, 32, 1)?;
+            let vectors = vectors::generate(&scene, vectors, 1);
+            let speeds = check::bench_sims(&p, &vectors, ghdl_vectors, Path::new("target/fxrt-bench"))?;
+            for s in &speeds {
+                println!(
+                    "{:>9}: {:>9} cycles in {:>7.3} s = {:>12.0} cycles/s{}",
+                    s.simulator,
+                    s.cycles,
+                    s.seconds,
+                    s.cycles_per_second,
+                    if s.all_passed { "" } else { "  (MISMATCHES)" }
+                );
+            }
+            let rate = |n: &str| speeds.iter().find(|s| s.simulator == n).map(|s| s.cycles_per_second);
+            if let (Some(r), Some(v)) = (rate("rust"), rate("verilator")) {
+                println!("rust / verilator = {:.2}", r / v);
+            }
+            if let (Some(r), Some(g)) = (rate("rust"), rate("ghdl")) {
+                println!("rust / ghdl = {:.1}", r / g);
+            }
+        }
+        BenchConfig::Render { width, height, threads, repeat } => {
+            let pool = thread_pool(Some(threads))?;
+            let cam = Camera::default_for(&scene, width, height);
+            let golden = tracer::make_tracer(&scene, tracer::ModelKind::Golden);
+            let (mut best, mut rays) = (f64::INFINITY, 0);
+            for _ in 0..repeat {
+                let f = pool.install(|| render::render(&scene, golden.as_ref(), &cam, false, false));
+                best = best.min(f.seconds);
+                rays = f.rays;
+            }
+            println!(
+                "teapot {width}x{height} golden primary rays, {threads} thread(s): best of {repeat}: {best:.3} s, {:.2} Mrays/s",
+                rays as f64 / best / 1e6
+            );
+        }
+    }
+    Ok(())
+}
+
+pub fn scene(c: &SceneConfig) -> Result<()> {
+    let scene = Scene::load(&c.scene, &c.params)?;
+    let roms = rom::words(&scene);
+    let mut files = Vec::new();
+    for (layout, words) in &roms {
+        let text = rom::readmemh(layout, words);
+        files.push((c.out.join(format!("{}.hex", layout.rom)), text.clone().into_bytes()));
+        files.push((c.out.join(format!("{}.mem", layout.rom)), text.into_bytes()));
+        files.push((c.out.join(format!("{}.coe", layout.rom)), rom::coe(layout, words).into_bytes()));
+    }
+    files.push((c.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).into_bytes()));
+    let json = scene::report::scene_json(&scene, &roms);
+    files.push((
+        c.out.join("scene.json"),
+        (serde_json::to_string_pretty(&json).unwrap_or_default() + "\n").into_bytes(),
+    ));
+    crate::io::write_all_atomic(&files)?;
+    if c.stats {
+        print!("{}", scene::report::stats_text(&scene));
+    }
+    println!(
+        "{}: {} triangles ({} degenerate, {} clamped), E = {}, {} BIH nodes, depth {}, written to {}",
+        scene.name,
+        scene.counts.stored,
+        scene.counts.degenerate,
+        scene.counts.clamped,
+        scene.edge_shift,
+        scene.bih_stats.nodes,
+        scene.bih_stats.depth,
+        c.out.display()
+    );
+    Ok(())
+}
+
+/// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
+fn intersect_params(params: &Params, scene: &Scene, tag_width: u32, div_bits: u32) -> Result<IntersectParams> {
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits };
+    p.check()?;
+    Ok(p)
+}
+
+/// The on-chip ray generator for a camera (inside the scene box).
+fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen> {
+    let cam = camera.camera(scene)?;
+    RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
+}
+
+pub fn gen_core(c: &GenConfig) -> Result<()> {
+    let (roms, raygen) = match &c.scene {
+        GenScene::Folder(dir) => (SceneRoms::load(dir)?, None),
+        GenScene::Scene { source, params, raygen } => {
+            let scene = Scene::load(source, params)?;
+            let raygen = raygen.as_ref().map(|cam| ray_generator(&scene, cam)).transpose()?;
+            (SceneRoms::of(&scene), raygen)
+        }
+    };
+    if let Some(g) = &raygen {
+        let pixels = g.width as u64 * g.height as u64;
+        if c.ray_id_width < 64 && pixels > 1u64 << c.ray_id_width {
+            return Err(Error::param(
+                "ray-id-width",
+                format!("{} bits cannot number the {pixels} pixels of --size", c.ray_id_width),
+            ));
+        }
+    }
+    let p = crate::cores::top::CoreParams::new(&roms, c.ray_id_width, c.div_bits);
+    p.check()?;
+    p.check_device(&roms, c.bram_kbits)?;
+    let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, clock_mhz: c.clock_mhz };
+    let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref())
+        .into_iter()
+        .map(|(n, t)| (c.out.join(n), t.into_bytes()))
+        .collect();
+    crate::io::write_all_atomic(&files)?;
+    println!(
+        "{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",
+        if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" },
+        roms.name,
+        roms.tri_count(),
+        p.isect.latency(),
+        c.out.display()
+    );
+    Ok(())
+}
+
+pub fn test(c: &TestConfig) -> Result<bool> {
+    let scene = Scene::load(&c.scene, &c.params)?;
+    let p = intersect_params(&c.params, &scene, c.hw.tag_width, c.hw.div_bits)?;
+    let vectors = vectors::generate(&scene, c.vectors, c.seed);
+    let hits = vectors.iter().filter(|v| v.expected.is_some()).count();
+    let start = std::time::Instant::now();
+    let (outcome, unit) = match (c.sim, &c.build) {
+        (Simulation::Hdl(sim), Some(dir)) => (check::run_hdl(sim, &p, &vectors, dir)?, "clock cycles"),
+        _ => (check::run_rust(&p, &vectors), "vectors"),
+    };
+    println!(
+        "{}: {} vectors ({} hits) from {}, latency {}, {} simulator, {:.1} s; counting {unit}",
+        p.name(),
+        vectors.len(),
+        hits,
+        scene.name,
+        p.latency(),
+        c.sim.title(),
+        start.elapsed().as_secs_f64()
+    );
+    println!("{} passed, {} failed", outcome.passed, outcome.failed);
+    Ok(outcome.failed == 0 && outcome.passed > 0)
+}
+
+pub fn synth_cores(c: &SynthConfig) -> Result<()> {
+    let scene = Scene::load(&c.scene, &c.params)?;
+    let p = intersect_params(&c.params, &scene, c.hw.tag_width, c.hw.div_bits)?;
+    let roms = SceneRoms::of(&scene);
+    let core = crate::cores::top::CoreParams::new(&roms, 20, c.hw.div_bits);
+    core.check()?;
+    let mut cores = Vec::new();
+    let mut set = vec![(crate::cores::top::core_module(&core, &roms), None)];
+    set.extend(generate::cores(&p).into_iter().map(|(m, lat, _)| (m, lat)));
+    for (m, latency) in set {
+        let area = synth::synth_xc5v(&m, &c.build.join(&m.name))?;
+        cores.push(serde_json::json!({ "latency_cycles": latency, "area": area }));
+    }
+    let thesis = serde_json::json!({ "note": "whole design of seed 001 table 3.2 (BIH + intersection + ray generator), XST", "luts": 5278, "registers": 3274, "dsp48e": 52, "bram18": 22 });
+    println!(
+        "{}",
+        serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "scene": scene.name, "params": p, "cores": cores, "thesis": thesis })
+    );
+    Ok(())
+}
+
+/// `fxrt sim`: a frame through the generated core; true when every pixel matched.
+pub fn sim(c: &SimConfig) -> Result<bool> {
+    let scene = Scene::load(&c.scene, &c.params)?;
+    let cam = c.camera.camera(&scene)?;
+    let (w, h) = (cam.width, cam.height);
+    let id_width = rom::addr_bits((w * h) as usize);
+    let roms = SceneRoms::of(&scene);
+    let p = crate::cores::top::CoreParams::new(&roms, id_width, c.div_bits);
+    p.check()?;
+    let raygen = if c.raygen { Some(ray_generator(&scene, &c.camera)?) } else { None };
+    let rays = match &raygen {
+        Some(g) => {
+            let golden = Golden::new(&scene);
+            (0..w * h).map(|i| frame::PixelRay { pixel: i, ray: g.ray(&golden, i % w, i / w) }).collect()
+        }
+        None => frame::frame_rays(&scene, &cam),
+    };
+    let start = std::time::Instant::now();
+    // `SimArgs::config` allows the ray generator in the Rust simulator only.
+    let (results, stats) = match (c.sim, &c.build, &raygen) {
+        (Simulation::Rust, _, Some(g)) => {
+            let bar = frame::progress_bar(rays.len() as u64, "rust");
+            let m = crate::cores::top::core_with_raygen(&p, &roms, g);
+            let r = frame::collect_batched(&m, rays.len(), 0, &|n| bar.set_position(n));
+            bar.finish_and_clear();
+            r
+        }
+        (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, dir)?,
+        _ => {
+            let bar = frame::progress_bar(rays.len() as u64, "rust");
+            let r = frame::simulate_rust(&p, &roms, &rays, &|n| bar.set_position(n));
+            bar.finish_and_clear();
+            r
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let mismatches = frame::mismatches(&scene, &rays, &results);
+    let ids = frame::ids_image(&scene, w, h, &results);
+    let mut files = Vec::new();
+    if let Some(path) = &c.png {
+        files.push((path.clone(), frame::binary_png(w, h, &ids)));
+    }
+    if let Some(path) = &c.ids {
+        files.push((path.clone(), ids.iter().flat_map(|i| i.to_le_bytes()).collect()));
+    }
+    crate::io::write_all_atomic(&files)?;
+    println!(
+        "{}",
+        serde_json::json!({
+            "scene": scene.name, "simulator": c.sim.name(), "size": format!("{w}x{h}"),
+            "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
+            "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
+            "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
+            "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
+            "state_cycles": stats.named_state_cycles().into_iter().map(|(n, c)| (n.to_string(), serde_json::json!(c))).collect::<serde_json::Map<String, serde_json::Value>>(),
+            "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
+        })
+    );
+    Ok(mismatches == 0)
+}
+
+/// Ok(false): the simulated core disagreed with the golden model somewhere (`--core-sim`).
+fn sweep_cmd(c: SweepConfig) -> Result<bool> {
+    let r = match c {
+        SweepConfig::Merge { dirs, out, cache } => {
+            let dirs: Vec<&Path> = dirs.iter().map(|d| d.as_path()).collect();
+            let rows = sweep::merge(&dirs, &out, cache.as_deref())?;
+            println!("merged {} folders: {rows} configurations into {}", dirs.len(), out.display());
+            return Ok(true);
+        }
+        SweepConfig::Run(r) => r,
+    };
+    let SweepRun { spec, plan, out, cache, threads, shard, slurm } = &r;
+    let pool = thread_pool(*threads)?;
+    // Every scene is loaded and checked before anything is written, scripts included.
+    let scenes = pool.install(|| sweep::load_scenes(spec))?;
+    if let Some((shards, cpus)) = *slurm {
+        slurm::emit(spec, plan.configs.len(), out, cache, shards, cpus)?;
+        println!(
+            "{} configurations in {} shards: submit with {}/slurm/submit.sh (Slurm) or run {}/slurm/parallel.sh (GNU parallel)",
+            plan.configs.len(),
+            shards,
+            out.display(),
+            out.display()
+        );
+        return Ok(true);
+    }
+    eprintln!(
+        "sweep: {} configurations ({} parameter sets × {} scenes){}{}",
+        plan.configs.len(),
+        plan.sets.len(),
+        spec.scenes.len(),
+        shard.map(|s| format!(", shard {s}")).unwrap_or_default(),
+        if plan.skipped.is_empty() { String::new() } else { format!(", {} invalid sets skipped", plan.skipped.len()) }
+    );
+    let start = std::time::Instant::now();
+    let summary = pool.install(|| sweep::run(spec, plan, &scenes, out, cache, *shard, true))?;
+    println!(
+        "{} computed, {} from the cache, {} incomplete, in {:.1} s: {}",
+        summary.computed,
+        summary.cached,
+        summary.failed,
+        start.elapsed().as_secs_f64(),
+        out.join("report.md").display()
+    );
+    if summary.mismatches > 0 {
+        eprintln!("fxrt: the simulated core disagreed with the golden model on {} rays", summary.mismatches);
+    }
+    Ok(summary.mismatches == 0)
+}
