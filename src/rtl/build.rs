@@ -295,29 +295,29 @@ impl<'b> S<'b> {
     pub fn xmul(self, o: S<'b>) -> S<'b> {
         self.b.bin(BinOp::Mul, self, o, "x")
     }
-    pub fn eq(self, o: impl Operand<'b>) -> S<'b> {
+    /// A comparison giving one bit; `swap` compares the other way round (`gt` is `lt` swapped).
+    fn compare(self, op: BinOp, o: impl Operand<'b>, swap: bool) -> S<'b> {
         let o = o.as_sig(self);
-        self.b.bin(BinOp::Eq, self, o, "eq")
+        let sym = format!("{op:?}").to_lowercase();
+        if swap { self.b.bin(op, o, self, &sym) } else { self.b.bin(op, self, o, &sym) }
+    }
+    pub fn eq(self, o: impl Operand<'b>) -> S<'b> {
+        self.compare(BinOp::Eq, o, false)
     }
     pub fn ne(self, o: impl Operand<'b>) -> S<'b> {
-        let o = o.as_sig(self);
-        self.b.bin(BinOp::Ne, self, o, "ne")
+        self.compare(BinOp::Ne, o, false)
     }
     pub fn lt(self, o: impl Operand<'b>) -> S<'b> {
-        let o = o.as_sig(self);
-        self.b.bin(BinOp::Lt, self, o, "lt")
+        self.compare(BinOp::Lt, o, false)
     }
     pub fn le(self, o: impl Operand<'b>) -> S<'b> {
-        let o = o.as_sig(self);
-        self.b.bin(BinOp::Le, self, o, "le")
+        self.compare(BinOp::Le, o, false)
     }
     pub fn gt(self, o: impl Operand<'b>) -> S<'b> {
-        let o = o.as_sig(self);
-        self.b.bin(BinOp::Lt, o, self, "lt")
+        self.compare(BinOp::Lt, o, true)
     }
     pub fn ge(self, o: impl Operand<'b>) -> S<'b> {
-        let o = o.as_sig(self);
-        self.b.bin(BinOp::Le, o, self, "le")
+        self.compare(BinOp::Le, o, true)
     }
     /// `self ? t : f` for a one-bit `self` (`f` may be an integer, typed from `t`).
     pub fn select(self, t: S<'b>, f: impl Operand<'b>) -> S<'b> {
