@@ -330,8 +330,13 @@ impl SimArgs {
 /// `fxrt sweep`: join shards, or run (a shard of) a sweep, or write its Slurm scripts.
 #[derive(Debug)]
 pub enum SweepConfig {
-    Merge { dirs: Vec<PathBuf>, out: PathBuf, cache: Option<PathBuf> },
-    Run(SweepRun),
+    Merge {
+        dirs: Vec<PathBuf>,
+        out: PathBuf,
+        cache: Option<PathBuf>,
+    },
+    /// Boxed: a plan is large beside a merge.
+    Run(Box<SweepRun>),
 }
 
 #[derive(Debug)]
@@ -361,7 +366,7 @@ impl SweepArgs {
         if self.emit_slurm && self.shard.is_some() {
             return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
         }
-        Ok(SweepConfig::Run(SweepRun {
+        Ok(SweepConfig::Run(Box::new(SweepRun {
             cache: self.cache.clone().unwrap_or_else(|| out.join("cache")),
             spec,
             plan,
@@ -369,7 +374,7 @@ impl SweepArgs {
             threads,
             shard: self.shard,
             slurm: self.emit_slurm.then(|| (self.shards, self.threads.unwrap_or(4) as u32)),
-        }))
+        })))
     }
 
     /// The sweep the arguments describe; every list is checked here, before anything runs.
