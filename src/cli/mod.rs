@@ -458,45 +458,4 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn parsers() {
-        assert_eq!(parse_vec3("1,-2.5,3").unwrap(), [1.0, -2.5, 3.0]);
-        assert!(parse_vec3("1,2").is_err());
-        assert!(parse_vec3("1,nan,2").is_err());
-        assert_eq!(parse_size("640x480").unwrap(), (640, 480));
-        assert!(parse_size("0x4").is_err());
-    }
-
-    #[test]
-    fn a_parse_error_is_one_line_naming_the_option() {
-        let e = Cli::try_parse_from(["fxrt", "render", "--size", "0x4"]).unwrap_err();
-        let line = error_line(&e);
-        assert!(line.contains("--size") && line.contains("out of range"), "{line}");
-        assert!(!line.contains('\n') && !line.starts_with("error"), "{line}");
-    }
-
-    #[test]
-    fn render_args_parse_without_side_effects() {
-        let cli = Cli::try_parse_from([
-            "fxrt",
-            "render",
-            "--builtin",
-            "cornell",
-            "--eye",
-            "-1,2,3",
-            "--n",
-            "20",
-            "--edge-shift",
-            "10",
-        ])
-        .unwrap();
-        let Some(Command::Render(r)) = cli.command else { panic!("not render") };
-        assert_eq!(r.scene.source(), crate::scene::SceneSource::Builtin("cornell".into()));
-        assert_eq!(r.camera.eye, Some([-1.0, 2.0, 3.0]));
-        let p = r.params.params().unwrap();
-        assert_eq!((p.n, p.edge_shift), (20, EdgeShift::Fixed(10)));
-    }
-}
+mod tests;

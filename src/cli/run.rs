@@ -338,7 +338,7 @@ fn sweep_cmd(c: SweepConfig) -> Result<bool> {
         }
         SweepConfig::Run(r) => r,
     };
-    let SweepRun { spec, plan, out, cache, threads, shard, slurm } = &r;
+    let SweepRun { spec, plan, out, cache, threads, shard, slurm } = &*r;
     let pool = thread_pool(*threads)?;
     // Every scene is loaded and checked before anything is written, scripts included.
     let scenes = pool.install(|| sweep::load_scenes(spec))?;

@@ -1,0 +1,231 @@
+//! The command line's parsers and each command's validation (`config`).
+
+use super::config::*;
+use super::*;
+use crate::error::Result;
+use crate::flow::simulators::Simulator;
+use crate::params::Params;
+use crate::scene::SceneSource;
+use clap::Parser;
+
+#[test]
+fn parsers() {
+    assert_eq!(parse_vec3("1,-2.5,3").unwrap(), [1.0, -2.5, 3.0]);
+    assert!(parse_vec3("1,2").is_err());
+    assert!(parse_vec3("1,nan,2").is_err());
+    assert_eq!(parse_size("640x480").unwrap(), (640, 480));
+    assert!(parse_size("0x4").is_err());
+}
+
+#[test]
+fn a_parse_error_is_one_line_naming_the_option() {
+    let e = Cli::try_parse_from(["fxrt", "render", "--size", "0x4"]).unwrap_err();
+    let line = error_line(&e);
+    assert!(line.contains("--size") && line.contains("out of range"), "{line}");
+    assert!(!line.contains('\n') && !line.starts_with("error"), "{line}");
+}
+
+#[test]
+fn render_args_parse_without_side_effects() {
+    let cli = Cli::try_parse_from([
+        "fxrt",
+        "render",
+        "--builtin",
+        "cornell",
+        "--eye",
+        "-1,2,3",
+        "--n",
+        "20",
+        "--edge-shift",
+        "10",
+    ])
+    .unwrap();
+    let Some(Command::Render(r)) = cli.command else { panic!("not render") };
+    assert_eq!(r.scene.source(), crate::scene::SceneSource::Builtin("cornell".into()));
+    assert_eq!(r.camera.eye, Some([-1.0, 2.0, 3.0]));
+    let p = r.params.params().unwrap();
+    assert_eq!((p.n, p.edge_shift), (20, EdgeShift::Fixed(10)));
+}
+
+fn command(args: &[&str]) -> Command {
+    Cli::try_parse_from(std::iter::once("fxrt").chain(args.iter().copied())).expect("parses").command_or_default()
+}
+
+/// `config` of any command, for what it refuses.
+fn check(args: &[&str]) -> Result<()> {
+    match command(args) {
+        Command::Render(a) => a.config().map(drop),
+        Command::Scene(a) => a.config().map(drop),
+        Command::Compare(a) => a.config().map(drop),
+        Command::Bench(a) => a.config().map(drop),
+        Command::Gen(a) => a.config().map(drop),
+        Command::Test(a) => a.config().map(drop),
+        Command::Synth(a) => a.config().map(drop),
+        Command::Sim(a) => a.config().map(drop),
+        Command::Sweep(a) => a.config().map(drop),
+    }
+}
+
+fn refused(args: &[&str]) -> String {
+    check(args).expect_err("should be refused").subject
+}
+
+#[test]
+fn threads_are_1_to_1024_or_all_cores() {
+    assert_eq!(threads(None), Ok(None));
+    assert_eq!(threads(Some(1024)), Ok(Some(1024)));
+    assert_eq!(threads(Some(0)).unwrap_err().subject, "--threads");
+    assert!(threads(Some(1025)).is_err());
+    for args in [&["render", "--threads", "0"][..], &["compare", "--threads", "2000"], &["bench", "--threads", "0"]] {
+        assert_eq!(refused(args), "--threads", "{args:?}");
+    }
+    assert_eq!(refused(&["sweep", "--out", "x", "--threads", "0"]), "--threads");
+    // `bench sim` runs no thread pool.
+    assert!(check(&["bench", "sim", "--threads", "0"]).is_ok());
+}
+
+#[test]
+fn the_default_job_renders_the_shaded_teapot() {
+    let Command::Render(a) = command(&[]) else { panic!("not a render") };
+    let c = a.config().unwrap();
+    assert_eq!(c.scene, SceneSource::Builtin("teapot".into()));
+    assert_eq!(c.files.png, Some(PathBuf::from("teapot.png")));
+    assert!(c.shade && c.files.ids.is_none());
+    assert_eq!((c.camera.width, c.camera.height), (512, 512));
+    assert_eq!(c.params, Params::default());
+}
+
+#[test]
+fn bench_counts_at_least_one() {
+    let Command::Bench(a) = command(&["bench", "--repeat", "0", "--size", "64x32"]) else { panic!() };
+    assert_eq!(a.config(), Ok(BenchConfig::Render { width: 64, height: 32, threads: 1, repeat: 1 }));
+    let Command::Bench(a) = command(&["bench", "sim", "--vectors", "0"]) else { panic!() };
+    assert_eq!(a.config(), Ok(BenchConfig::Sim { vectors: 1, ghdl_vectors: 3000 }));
+}
+
+#[test]
+fn gen_checks_its_ranges_and_the_scene_folder() {
+    assert_eq!(refused(&["gen", "--out", "x", "--scene", "rom", "--raygen"]), "--raygen");
+    for w in ["0", "65"] {
+        assert_eq!(refused(&["gen", "--out", "x", "--ray-id-width", w]), "--ray-id-width");
+    }
+    for mhz in ["0", "1000.5", "nan", "-5"] {
+        let arg = format!("--clock-mhz={mhz}");
+        assert_eq!(refused(&["gen", "--out", "x", &arg]), "--clock-mhz", "{mhz}");
+    }
+    assert_eq!(refused(&["gen", "--out", "x", "--n", "99"]), "--n");
+    // A scene folder brings its own parameters: the command line's are not used.
+    let Command::Gen(a) = command(&["gen", "--out", "x", "--scene", "rom", "--n", "99", "--lang", "vhdl"]) else {
+        panic!()
+    };
+    let c = a.config().unwrap();
+    assert_eq!(c.scene, GenScene::Folder("rom".into()));
+    assert!(c.vhdl && !c.verilog);
+    let Command::Gen(a) = command(&["gen", "--out", "x", "--raygen", "--eye", "1,2,3", "--clock-mhz", "1000"]) else {
+        panic!()
+    };
+    let GenScene::Scene { raygen: Some(cam), .. } = a.config().unwrap().scene else { panic!("no camera") };
+    assert_eq!(cam.eye, Some([1.0, 2.0, 3.0]));
+}
+
+#[test]
+fn test_fills_in_vectors_and_build_folders_per_simulator() {
+    let config = |args: &[&str]| {
+        let Command::Test(a) = command(args) else { panic!() };
+        a.config().unwrap()
+    };
+    let c = config(&["test"]);
+    assert_eq!((c.sim, c.vectors, c.build), (Simulation::Rust, 100_000, None));
+    let c = config(&["test", "--sim", "ghdl"]);
+    assert_eq!((c.vectors, c.build), (2_000, Some(PathBuf::from("target/fxrt-test/ghdl"))));
+    assert_eq!(config(&["test", "--sim", "iverilog"]).vectors, 20_000);
+    let c = config(&["test", "--sim", "verilator", "--build", "b", "--vectors", "7"]);
+    assert_eq!((c.sim, c.vectors, c.build), (Simulation::Hdl(Simulator::Verilator), 7, Some("b".into())));
+    assert_eq!(refused(&["test", "--vectors", "0"]), "--vectors");
+    assert_eq!(refused(&["test", "--t", "40"]), "--t");
+}
+
+#[test]
+fn sim_runs_the_ray_generator_in_rust_only() {
+    assert_eq!(refused(&["sim", "--raygen", "--sim", "ghdl"]), "--raygen");
+    assert_eq!(refused(&["sim", "--raygen", "--sim", "verilator"]), "--raygen");
+    assert!(check(&["sim", "--raygen"]).is_ok());
+    let Command::Sim(a) = command(&["sim", "--sim", "verilator"]) else { panic!() };
+    let c = a.config().unwrap();
+    assert_eq!((c.sim.name(), c.build), ("verilator", Some(PathBuf::from("target/fxrt-sim/verilator"))));
+}
+
+#[test]
+fn synth_is_for_virtex_5() {
+    assert_eq!(refused(&["synth", "--family", "xc7"]), "--family");
+    let Command::Synth(a) = command(&["synth"]) else { panic!() };
+    assert_eq!(a.config().unwrap().build, PathBuf::from("target/fxrt-synth"));
+}
+
+#[test]
+fn sweep_defaults_and_the_slurm_options() {
+    assert_eq!(refused(&["sweep", "--out", "x", "--emit-slurm", "--shard", "1/2"]), "--emit-slurm");
+    assert_eq!(refused(&["sweep", "--out", "x", "--fov", "180"]), "--fov");
+    let run = |args: &[&str]| {
+        let Command::Sweep(a) = command(args) else { panic!() };
+        match a.config().unwrap() {
+            SweepConfig::Run(r) => r,
+            SweepConfig::Merge { .. } => panic!("not a run"),
+        }
+    };
+    let r = run(&["sweep", "--out", "x", "--m", "16,32"]);
+    assert_eq!((r.cache, r.slurm, r.plan.configs.len()), (PathBuf::from("x/cache"), None, 2));
+    assert_eq!(run(&["sweep", "--out", "x", "--emit-slurm"]).slurm, Some((8, 4)));
+    let r = run(&["sweep", "--out", "x", "--emit-slurm", "--shards", "3", "--threads", "2", "--cache", "c"]);
+    assert_eq!((r.slurm, r.cache), (Some((3, 2)), PathBuf::from("c")));
+    let Command::Sweep(a) = command(&["sweep", "merge", "a", "b", "--out", "x"]) else { panic!() };
+    let SweepConfig::Merge { dirs, out, cache } = a.config().unwrap() else { panic!("not a merge") };
+    assert_eq!((dirs.len(), out, cache), (2, PathBuf::from("x"), None));
+}
+
+/// The command line `--emit-slurm` writes for each shard describes the same sweep.
+#[test]
+fn the_emitted_sweep_command_describes_the_same_sweep() {
+    let spec = |args: &[&str]| {
+        let Command::Sweep(a) = command(args) else { panic!("not a sweep") };
+        a.spec().unwrap()
+    };
+    let s = spec(&[
+        "sweep",
+        "/data/my scene.obj",
+        "--builtin",
+        "teapot,cornell",
+        "--eye",
+        "1.5,-2,0.001",
+        "--m",
+        "12,32",
+        "--edge-shift",
+        "auto,8",
+        "--one-at-a-time",
+        "--core-sim",
+        "--out",
+        "x",
+    ]);
+    let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    assert_eq!(argv[..2], ["/opt/fxrt", "sweep"]);
+    argv.extend(["--out".into(), "y".into()]);
+    let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
+    assert_eq!(spec(&argv), s);
+}
+
+#[test]
+fn each_simulator_choice_maps_once() {
+    assert_eq!(Simulation::from(SimChoice::Rust), Simulation::Rust);
+    assert_eq!(Simulation::from(FrameSim::Rust), Simulation::Rust);
+    for (choice, frame, sim) in [
+        (SimChoice::Ghdl, Some(FrameSim::Ghdl), Simulator::Ghdl),
+        (SimChoice::Iverilog, None, Simulator::Iverilog),
+        (SimChoice::Verilator, Some(FrameSim::Verilator), Simulator::Verilator),
+    ] {
+        assert_eq!(Simulation::from(choice), Simulation::Hdl(sim));
+        assert_eq!(frame.map(Simulation::from), frame.map(|_| Simulation::Hdl(sim)));
+        // The names printed before the mapping moved here: `{:?}` and its lower case.
+        assert_eq!(Simulation::from(choice).title(), format!("{choice:?}"));
+        assert_eq!(Simulation::from(choice).name(), format!("{choice:?}").to_lowercase());
+    }
+}
