@@ -5,36 +5,10 @@
 
 use fxrt::flow::simulators::Simulator;
 use fxrt::flow::testbench::{Stimulus, bench_files, record};
-use fxrt::rtl::batch::BatchSim;
-use fxrt::rtl::random::{Shape, random_inputs, random_module};
+use fxrt::rtl::random::{Shape, agree, random_inputs, random_module, sim_vs_batch};
 use fxrt::rtl::sim::Sim;
 use fxrt::rtl::{Module, Ty};
 use std::io::Write;
-
-/// Every output of every cycle from `Sim` and from `BatchSim` (with batch size `batch`); the
-/// first difference as text.
-fn compare(m: &Module, inputs: &[Vec<i128>], batch: usize) -> Result<(), String> {
-    let mut sim = Sim::new(m);
-    let ins: Vec<_> = m.inputs.iter().map(|&i| m.handle(i)).collect();
-    let outs: Vec<_> = m.outputs.iter().map(|(_, i)| m.handle(*i)).collect();
-    let mut want = Vec::new();
-    for cycle in inputs {
-        for (s, v) in ins.iter().zip(cycle) {
-            sim.set(*s, *v);
-        }
-        sim.tick();
-        want.push(outs.iter().map(|o| sim.get(*o)).collect::<Vec<_>>());
-    }
-    let mut b = BatchSim::new(m, batch).ok_or("BatchSim declined a design with registered outputs")?;
-    let mut got = vec![vec![0i128; outs.len()]; inputs.len()];
-    b.run(inputs.len(), |c, k| inputs[c][k], |c, k, v| got[c][k] = v);
-    for (c, (w, g)) in want.iter().zip(&got).enumerate() {
-        if w != g {
-            return Err(format!("cycle {c}: Sim {w:?}, BatchSim {g:?}"));
-        }
-    }
-    Ok(())
-}
 
 /// The divergence found in issue 10: a register `r: s(2)` with next value
 /// `case(r, [0 → −1, 3 → 1], default 0)`. Arm patterns are bit patterns of the selector, so
@@ -59,22 +33,14 @@ fn signed_case_selector_matches_arm_bit_patterns() {
         .collect();
     assert_eq!(seen, [1, 0, -1, 1, 0, -1]);
     for batch in [1, 4, 256] {
-        compare(&m, &vec![vec![]; 40], batch).unwrap_or_else(|e| panic!("batch {batch}: {e}"));
+        sim_vs_batch(&m, &vec![vec![]; 40], batch).unwrap_or_else(|e| panic!("batch {batch}: {e}"));
     }
 }
 
 #[test]
 fn cycle_and_batched_simulators_agree_on_10000_random_netlists() {
     let count: u64 = std::env::var("FXRT_AGREE_NETLISTS").ok().and_then(|s| s.parse().ok()).unwrap_or(10_000);
-    let mut failures = Vec::new();
-    for seed in 0..count {
-        let m = random_module(seed, Shape { max_width: 128, nodes: 14 });
-        let inputs = random_inputs(&m, seed, 24);
-        let batch = [1, 3, 7, 64][(seed % 4) as usize];
-        if let Err(e) = compare(&m, &inputs, batch) {
-            failures.push(format!("seed {seed} (batch {batch}): {e}"));
-        }
-    }
+    let failures = agree(0..count, &|| {});
     assert!(failures.is_empty(), "{} of {count} random netlists disagree; first: {}", failures.len(), failures[0]);
 }
 
@@ -88,7 +54,7 @@ fn hdl_simulators_agree_on_sampled_random_netlists() {
             continue;
         }
         for &seed in &seeds {
-            let m = random_module(seed, Shape { max_width: 64, nodes: 40 });
+            let m = random_module(seed, Shape { max_width: 128, nodes: 40 });
             let stimuli: Vec<Stimulus> = random_inputs(&m, seed, 120)
                 .into_iter()
                 .enumerate()

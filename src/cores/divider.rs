@@ -82,7 +82,7 @@ pub fn divider_core(n: u32, bits_per_stage: u32, num_width: u32, den_width: u32)
     }
     let out = result.expect("n + 1 ≥ 1 quotient bits");
     let lat = pipe.finish();
-    debug_assert_eq!(lat, latency(n, bits_per_stage));
+    assert_eq!(lat, latency(n, bits_per_stage), "latency formula and stages disagree");
     b.output("t", out.t);
     b.output("ok", out.ok);
     b.finish()

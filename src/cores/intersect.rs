@@ -143,7 +143,7 @@ crate::bundle! {
 
 pub fn intersect_core(p: &IntersectParams) -> Module {
     let (m, latency) = intersect_core_with(p, Policy::default());
-    debug_assert_eq!(latency, p.latency(), "latency formula and stages disagree");
+    assert_eq!(latency, p.latency(), "latency formula and stages disagree");
     m
 }
 
@@ -151,7 +151,9 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
 /// latency), and its latency counted from the stages.
 pub fn intersect_core_with(p: &IntersectParams, policy: Policy) -> (Module, u32) {
     let (n, mm, f) = (p.n, p.m, p.f());
-    let b = Builder::new(&p.name());
+    // Merged stages make another module: its name says which.
+    let merged: String = policy.merge.iter().map(|s| format!("_m{s}")).collect();
+    let b = Builder::new(&format!("{}{merged}", p.name()));
     let ins: Vec<S> = input_ports(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
     let pipe = Pipeline::new(&b, policy);
     let [valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = ins[..] else {
@@ -199,8 +201,7 @@ pub fn intersect_core_with(p: &IntersectParams, policy: Policy) -> (Module, u32)
         "numerator and rounded denominator, T bits dropped",
         Quotient { num: (num >> p.t).resize(wn - p.t), den: (den >> p.t).resize(wd - p.t) },
     );
-    pipe.advance(divider::latency(n, p.div_bits));
-    let div = b.instance("u_div", &Rc::new(p.divider()), &[q.num, q.den]);
+    let div = pipe.instance("u_div", &Rc::new(p.divider()), &[q.num, q.den], divider::latency(n, p.div_bits));
     let (t, ok) = (div.get("t"), div.get("ok"));
     // t·ω_p, t·ω_q (t as signed n+2 bits).
     let t_s = t.xsigned();

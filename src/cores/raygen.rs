@@ -109,7 +109,7 @@ pub fn raygen_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Mo
     b.output("ray_valid", in_full);
     b.output("ray_id", id);
     for (k, name) in ["ox", "oy", "oz"].iter().enumerate() {
-        b.output(name, b.konst(Ty::u(n), g.eye[k] as i128).name(&format!("eye_{name}")));
+        b.output(name, b.konst_named(&format!("eye_{name}"), Ty::u(n), g.eye[k] as i128));
     }
     for (name, w) in ["wx", "wy", "wz"].iter().zip(w_out) {
         b.output(name, w);
@@ -125,9 +125,9 @@ mod tests {
     use super::*;
     use crate::cores::top::{CoreParams, core_with_raygen};
     use crate::flow::frame::{PixelRay, collect_batched, mismatches};
+    use crate::model::camera::Camera;
     use crate::model::golden::Golden;
     use crate::params::Params;
-    use crate::render::camera::Camera;
     use crate::rtl::sim::Sim;
     use crate::scene::images::SceneRoms;
     use crate::scene::{Scene, SceneSource};

@@ -187,8 +187,8 @@ pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::ray
 mod tests {
     use super::*;
     use crate::flow::frame::{frame_rays, mismatches, simulate_rust, simulate_rust_cycle};
+    use crate::model::camera::Camera;
     use crate::params::Params;
-    use crate::render::camera::Camera;
     use crate::scene::{Scene, SceneSource};
 
     #[test]

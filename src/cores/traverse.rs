@@ -133,7 +133,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
 
     // The plane-distance unit: ((plane − O_axis) · inv_axis) >> C, clamped to [−1, 2^(n+1)].
     let (in_aabb, in_node) = (fsm.is(Aabb), fsm.is(Node));
-    let hi = [0, 1, 2].map(|k| b.konst(Ty::u(n), p.box_hi[k] as i128).name(&format!("box_hi_{k}")));
+    let hi = [0, 1, 2].map(|k| b.konst_named(&format!("box_hi_{k}"), Ty::u(n), p.box_hi[k] as i128));
     let aabb_neg = b.pick(aabb_k, inv).msb().name("aabb_neg");
     let aabb_plane = aabb_neg.select(hi[0].k(0), b.pick(aabb_k, hi)).name("aabb_plane");
     let pu_axis = in_aabb.select(aabb_k, in_node.select(w_axis, axis_r)).name("pu_axis");
@@ -271,10 +271,10 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::camera::Camera;
     use crate::model::golden::{Golden, GridRay, Visitor};
     use crate::model::ray::quantize_ray;
     use crate::params::Params;
-    use crate::render::camera::Camera;
     use crate::rtl::sim::Sim;
     use crate::scene::images::SceneRoms;
     use crate::scene::{Scene, SceneSource};

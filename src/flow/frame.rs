@@ -64,7 +64,10 @@ impl CoreStats {
 
     /// One cycle in the state with encoding `code` (the `fsm_state` port).
     fn count_state(&mut self, code: i128) {
-        self.state_cycles[code as usize] += 1;
+        // A code that is no state cannot occur (the machine leaves it at once); not counted.
+        if let Some(c) = usize::try_from(code).ok().and_then(|k| self.state_cycles.get_mut(k)) {
+            *c += 1;
+        }
     }
 
     /// Cycles per state, by the state's name.

@@ -4,10 +4,6 @@ pub mod compare;
 pub mod fast;
 pub mod tracer;
 
-// The camera is pure geometry and lives in the model (the on-chip ray generator is built from
-// it); this alias keeps `render::camera` paths in src/cores/ tests working until they move.
-pub use crate::model::camera;
-
 use crate::model::camera::Camera;
 use crate::model::ray::{cross, dot, normalize, sub};
 use crate::scene::Scene;

@@ -19,6 +19,8 @@ pub struct Builder {
     counter: Cell<u32>,
     /// Signals whose name is only a number (`plus_7`), which a stage may name after its field.
     numbered: RefCell<std::collections::BTreeSet<u32>>,
+    /// Signals the builder named (operator results): `name()` may rename these in place.
+    auto_named: RefCell<std::collections::BTreeSet<u32>>,
     /// Constants made so far, by (type, bits): each value of a type is one signal.
     konsts: RefCell<std::collections::BTreeMap<(u32, bool, u128), Sig>>,
 }
@@ -41,7 +43,13 @@ const NAME_MAX: usize = 24;
 
 impl Builder {
     pub fn new(name: &str) -> Builder {
-        Builder { m: RefCell::new(Module::new(name)), counter: Cell::new(0), numbered: Default::default(), konsts: Default::default() }
+        Builder {
+            m: RefCell::new(Module::new(name)),
+            counter: Cell::new(0),
+            numbered: Default::default(),
+            auto_named: Default::default(),
+            konsts: Default::default(),
+        }
     }
 
     /// The finished module (checked: every register and wire is driven).
@@ -66,14 +74,15 @@ impl Builder {
 
     /// A name from operand names, or `{op}_{k}` when that would be long.
     fn auto(&self, op: &str, parts: &[&str]) -> String {
+        // The next signal made gets this name.
+        let next = self.m.borrow().signals.len() as u32;
+        self.auto_named.borrow_mut().insert(next);
         let joined = parts.join(&format!("_{op}_"));
         if !parts.is_empty() && joined.len() <= NAME_MAX {
             return if parts.len() == 1 { format!("{op}_{joined}") } else { joined };
         }
         let k = self.counter.get();
         self.counter.set(k + 1);
-        // The next signal made gets this name: remember it as a numbered one.
-        let next = self.m.borrow().signals.len() as u32;
         self.numbered.borrow_mut().insert(next);
         format!("{op}_{k}")
     }
@@ -90,6 +99,11 @@ impl Builder {
 
     pub fn output(&self, name: &str, s: S<'_>) {
         self.m.borrow_mut().output(name, s.sig);
+    }
+
+    /// A constant with a name of its own (not shared with other users of its value).
+    pub fn konst_named(&self, name: &str, ty: Ty, v: i128) -> S<'_> {
+        self.s(self.m.borrow_mut().konst(name, ty, v))
     }
 
     /// A constant of type `ty`, named after its value (one signal per type and value).
@@ -217,10 +231,6 @@ impl Builder {
         };
         let tys: Vec<Ty> = ops.iter().map(|s| s.ty).collect();
         let v = def.eval(&tys, &bits?, ty);
-        // An unsigned 128-bit constant above i128::MAX cannot be written as an i128.
-        if !ty.signed && ty.width == 128 && v >> 127 == 1 {
-            return None;
-        }
         Some(self.konst(ty, ty.value(v)))
     }
 }
@@ -249,11 +259,23 @@ impl<'b> S<'b> {
         self.sig.ty.width
     }
 
-    /// Gives the signal the name a person wants (made unique and legal).
+    /// Gives the signal the name a person wants (made unique and legal). A node the builder
+    /// made and named is renamed in place; anything else — a port, a register, a shared
+    /// constant, the operand an identity operation handed back — keeps its name, and the
+    /// result is a named copy (a constant of its own, or a wire).
     pub fn name(self, name: &str) -> S<'b> {
-        self.b.with(|m| m.rename(self.sig.id, name));
-        self.b.numbered.borrow_mut().remove(&self.sig.id.0);
-        self
+        let b = self.b;
+        if b.auto_named.borrow_mut().remove(&self.sig.id.0) {
+            b.with(|m| m.rename(self.sig.id, name));
+            b.numbered.borrow_mut().remove(&self.sig.id.0);
+            return self;
+        }
+        if let super::netlist::Def::Const(v) = b.with(|m| m.sig(self.sig.id).def.clone()) {
+            return b.konst_named(name, self.ty(), self.ty().value(v));
+        }
+        let w = b.wire(name, self.ty());
+        b.drive(w, self);
+        w
     }
 
     /// A constant of this signal's type.
@@ -425,6 +447,23 @@ mod tests {
         assert_eq!(sim.get(out("o")), -7);
         assert_eq!(sim.get(out("z")), -2);
         assert_eq!(sim.get(out("p")), -700);
+    }
+
+    /// Naming never renames a port or a shared constant: an identity operation's result and a
+    /// shared constant get a named copy.
+    #[test]
+    fn naming_keeps_ports_and_shared_constants() {
+        let b = Builder::new("t");
+        let x = b.input("x", Ty::u(8));
+        let y = x.resize(8).name("y");
+        assert_eq!(b.name_of(x.sig), "x");
+        assert_eq!(b.name_of(y.sig), "y");
+        let k = b.konst(Ty::u(8), 5);
+        let limit = k.name("limit");
+        assert_ne!(k.sig, limit.sig);
+        assert_eq!(b.name_of((x + 5).sig), "x_plus_k_5");
+        let sum = (x + y).name("sum");
+        assert_eq!(b.name_of(sum.sig), "sum");
     }
 
     #[test]

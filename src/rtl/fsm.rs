@@ -56,19 +56,27 @@ macro_rules! states {
     };
 }
 
-/// One assignment: under these conditions (all 1), in this state, `target` gets `value`.
+/// A condition: a one-bit signal (by index) and the value it must have.
+type Cond = (usize, bool);
+
+/// One assignment: under these conditions, in this state, `target` gets `value`.
 struct Assign {
     state: u128,
-    conds: Vec<usize>,
+    conds: Vec<Cond>,
     value: usize,
 }
 
 /// A memory write: in this state, under these conditions, `mem[addr] <= data`.
 struct Write {
     state: u128,
-    conds: Vec<usize>,
+    conds: Vec<Cond>,
     addr: usize,
     data: usize,
+}
+
+/// Whether two condition lists can never hold together (one says c, the other not c).
+fn exclusive(a: &[Cond], b: &[Cond]) -> bool {
+    a.iter().any(|&(c, p)| b.contains(&(c, !p)))
 }
 
 #[derive(Default)]
@@ -101,6 +109,7 @@ pub struct Fsm<'b, St: States> {
     is: RefCell<BTreeMap<u128, S<'b>>>,
     /// One constant per state (not shared with other logic), for comparisons and `goto`.
     codes: Vec<S<'b>>,
+    init: St,
     _st: std::marker::PhantomData<St>,
 }
 
@@ -108,13 +117,13 @@ pub struct Fsm<'b, St: States> {
 pub struct StateCtx<'f, 'b, St: States> {
     fsm: &'f Fsm<'b, St>,
     state: u128,
-    conds: Vec<usize>,
+    conds: Vec<Cond>,
 }
 
 /// Returned by `when`: the branch taken when the condition is 0.
 pub struct Otherwise<'c, 'f, 'b, St: States> {
     ctx: &'c mut StateCtx<'f, 'b, St>,
-    cond: S<'b>,
+    cond: usize,
 }
 
 impl<'b, St: States> Fsm<'b, St> {
@@ -124,9 +133,11 @@ impl<'b, St: States> Fsm<'b, St> {
         let ty = Ty::u(St::width());
         let state = b.reg(name, ty, Some(init.code() as i128));
         let states = St::names().iter().map(|s| s.to_string()).collect();
+        // A machine may be built while a pipeline's block is open: that block stays open.
         let block = b.with(|m| {
+            let open = m.current_block.take();
             let k = m.begin_block(name, doc, BlockKind::Fsm { state: state.sig.id, states });
-            m.end_block();
+            m.current_block = open;
             k
         });
         let codes = St::ALL
@@ -140,6 +151,7 @@ impl<'b, St: States> Fsm<'b, St> {
             rec: RefCell::new(Record::default()),
             is: RefCell::new(BTreeMap::new()),
             codes,
+            init,
             _st: Default::default(),
         }
     }
@@ -184,19 +196,34 @@ impl<'b, St: States> Fsm<'b, St> {
                 b.name_of(self.state.sig)
             );
         }
-        b.with(|m| m.current_block = Some(self.block));
+        let open = b.with(|m| m.current_block.replace(self.block));
         let is = |code: u128| self.is(St::ALL[code as usize]);
-        let all = |conds: &[usize]| -> Option<S<'b>> { conds.iter().map(|&c| rec.sigs[c]).reduce(|a, c| a & c) };
+        let nots: RefCell<BTreeMap<usize, S<'b>>> = RefCell::new(BTreeMap::new());
+        let lit = |(c, p): Cond| -> S<'b> {
+            if p {
+                return rec.sigs[c];
+            }
+            *nots.borrow_mut().entry(c).or_insert_with(|| !rec.sigs[c])
+        };
+        let all = |conds: &[Cond]| -> Option<S<'b>> { conds.iter().map(|&c| lit(c)).reduce(|a, c| a & c) };
         let mut nexts = Nexts(BTreeMap::new());
-        for (&target, list) in &rec.assigns {
+        let mut targets: Vec<usize> = rec.assigns.keys().copied().collect();
+        let state_ix = rec.sigs.iter().position(|s| s.sig == self.state.sig);
+        if state_ix.is_none() {
+            panic!("{}: a machine that never leaves its first state", b.name_of(self.state.sig));
+        }
+        targets.sort_unstable();
+        for target in targets {
+            let list = &rec.assigns[&target];
             let reg = rec.sigs[target];
+            let is_state = Some(target) == state_ix;
             // The machine's registers are printed in its process.
             b.with(|m| m.set_block(reg.sig.id, self.block));
             // Per state, the assignments in order: the last one that applies wins.
             let mut arms: Vec<(u128, S<'b>)> = Vec::new();
             for st in St::ALL.iter().map(|s| s.code()) {
                 let mine: Vec<&Assign> = list.iter().filter(|a| a.state == st).collect();
-                if mine.is_empty() {
+                if mine.is_empty() && !is_state {
                     continue;
                 }
                 let mut v = reg;
@@ -210,7 +237,11 @@ impl<'b, St: States> Fsm<'b, St> {
                 arms.push((st, v));
             }
             let next = match arms.as_slice() {
-                [(st, v)] => is(*st).select(*v, reg),
+                [(st, v)] if !is_state => is(*st).select(*v, reg),
+                // The state register has an arm for every state; a code that is no state (the
+                // encoding's spare values) returns to the initial state, so an upset cannot
+                // lock the machine.
+                _ if is_state => b.case(self.state, &arms, self.codes[self.init.code() as usize]),
                 _ => b.case(self.state, &arms, reg),
             };
             let next = next.name(&format!("{}_next", b.name_of(reg.sig)));
@@ -218,6 +249,16 @@ impl<'b, St: States> Fsm<'b, St> {
             nexts.0.insert(reg.sig.id.0, next);
         }
         for (&mem, list) in &rec.writes {
+            for (i, x) in list.iter().enumerate() {
+                for y in &list[i + 1..] {
+                    assert!(
+                        x.state != y.state || exclusive(&x.conds, &y.conds),
+                        "{}: two writes to one memory in state {} that can happen together (a memory has one write port)",
+                        b.name_of(self.state.sig),
+                        St::ALL[x.state as usize].name()
+                    );
+                }
+            }
             let when: Vec<S<'b>> = list
                 .iter()
                 .map(|w| match all(&w.conds) {
@@ -233,7 +274,7 @@ impl<'b, St: States> Fsm<'b, St> {
             }
             b.ram_write(mem, we, addr, data);
         }
-        b.with(|m| m.end_block());
+        b.with(|m| m.current_block = open);
         nexts
     }
 }
@@ -278,19 +319,17 @@ impl<'f, 'b, St: States> StateCtx<'f, 'b, St> {
     pub fn when<'c>(&'c mut self, cond: S<'b>, body: impl FnOnce(&mut Self)) -> Otherwise<'c, 'f, 'b, St> {
         assert_eq!(cond.ty(), Ty::BIT, "a condition is one bit");
         let k = self.fsm.rec.borrow_mut().idx(cond);
-        self.conds.push(k);
+        self.conds.push((k, true));
         body(self);
         self.conds.pop();
-        Otherwise { ctx: self, cond }
+        Otherwise { ctx: self, cond: k }
     }
 }
 
 impl<'f, 'b, St: States> Otherwise<'_, 'f, 'b, St> {
     /// Runs `body` when the `when` condition is 0.
     pub fn otherwise(self, body: impl FnOnce(&mut StateCtx<'f, 'b, St>)) {
-        let not = !self.cond;
-        let k = self.ctx.fsm.rec.borrow_mut().idx(not);
-        self.ctx.conds.push(k);
+        self.ctx.conds.push((self.cond, false));
         body(self.ctx);
         self.ctx.conds.pop();
     }
@@ -346,6 +385,51 @@ mod tests {
         assert_eq!(trace, [(1, 0, 0), (1, 1, 1), (1, 2, 2), (2, 3, 2), (0, 7, 2), (1, 0, 2)]);
         assert_eq!(Light::width(), 2);
         assert_eq!(Light::Yellow.code(), 2);
+    }
+
+    crate::states! {
+        enum Three { A = "a", B = "b", C = "c" }
+    }
+
+    /// A spare code of the encoding (3 of 2 bits) returns to the initial state; a state
+    /// without a `goto` stays.
+    #[test]
+    fn a_spare_state_code_returns_to_the_initial_state() {
+        let b = Builder::new("spare");
+        let fsm = Fsm::new(&b, "st", "", Three::B);
+        fsm.state(Three::A, |s| s.goto(Three::C));
+        fsm.state(Three::B, |s| s.goto(Three::A));
+        fsm.state(Three::C, |_| {});
+        let state = fsm.state_reg().sig.id;
+        fsm.finish();
+        b.output("o_state", b.s(b.with(|m| m.handle(state))));
+        let m = b.finish();
+        let mut sim = Sim::new(&m);
+        sim.set(m.handle(state), 3);
+        let seen: Vec<i128> = (0..4)
+            .map(|_| {
+                sim.tick();
+                sim.get(m.handle(state))
+            })
+            .collect();
+        assert_eq!(seen, [1, 0, 2, 2]);
+    }
+
+    #[test]
+    #[should_panic(expected = "one write port")]
+    fn two_writes_that_can_happen_together_are_refused() {
+        let b = Builder::new("writes");
+        let go = b.input("go", Ty::BIT);
+        let mem = b.ram("mem", 4, vec![0; 2]);
+        let fsm = Fsm::new(&b, "st", "", Three::A);
+        fsm.state(Three::A, |s| {
+            s.when(go, |s| s.write(mem, go, go.resize(4))).otherwise(|s| s.write(mem, go, go.resize(4)));
+            s.write(mem, go, go.resize(4));
+            s.goto(Three::B);
+        });
+        fsm.state(Three::B, |_| {});
+        fsm.state(Three::C, |_| {});
+        fsm.finish();
     }
 
     #[test]

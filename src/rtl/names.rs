@@ -19,7 +19,14 @@ unaffected units unsigned until use variable vectored wait wand weak0 weak1 when
 xnor xor
 ieee std work numeric_std std_logic_1164 std_logic std_logic_vector std_ulogic boolean natural
 resize shift_left shift_right rotate_left rotate_right to_integer to_signed to_unsigned
-rising_edge falling_edge";
+rising_edge falling_edge
+automatic cell config design endconfig incdir include instance liblist noshowcancelled
+pulsestyle_ondetect pulsestyle_onevent showcancelled specparam realtime ifnone tranif0 tranif1
+rtran rtranif0 rtranif1 uwire
+logic bit byte int shortint longint string unique priority local const static void enum struct
+union typedef class extends package import export interface modport program property sequence
+assert assume cover bind chandle final foreach inside new null ref return this var virtual
+wildcard with alias always_comb always_ff always_latch break continue do iff";
 
 pub fn is_reserved(s: &str) -> bool {
     RESERVED.split_whitespace().any(|w| w == s)
@@ -34,7 +41,9 @@ pub fn legal(base: &str) -> String {
         s = s.replace("__", "_");
     }
     let mut s = s.trim_matches('_').to_string();
-    if s.is_empty() || !s.starts_with(|c: char| c.is_ascii_alphabetic()) {
+    if s.is_empty() {
+        s = "s".to_string();
+    } else if !s.starts_with(|c: char| c.is_ascii_alphabetic()) {
         s = format!("s_{s}");
     }
     if is_reserved(&s) {

@@ -210,7 +210,8 @@ impl Module {
             instances: Vec::new(),
             blocks: Vec::new(),
             current_block: None,
-            idents: std::collections::BTreeSet::new(),
+            // The module's own name is an identifier of its HDL too.
+            idents: [name.to_string()].into_iter().collect(),
         }
     }
 
@@ -272,13 +273,14 @@ impl Module {
     }
 
     pub fn input(&mut self, name: &str, ty: Ty) -> Sig {
+        assert!(!name.starts_with("tb_"), "{}: port {name}: tb_ names are the testbenches' own", self.name);
         let s = self.push(name, ty, Def::Input);
         self.inputs.push(s.id);
         s
     }
 
     pub fn konst(&mut self, name: &str, ty: Ty, value: i128) -> Sig {
-        assert!(ty.fits(value), "constant {name} = {value} does not fit {ty:?}");
+        assert!(ty.accepts(value), "constant {name} = {value} does not fit {ty:?}");
         self.push(name, ty, Def::Const(ty.wrap(value)))
     }
 
@@ -307,13 +309,14 @@ impl Module {
     /// Declares a register; its input is given later with `connect`.
     pub fn reg(&mut self, name: &str, ty: Ty, reset: Option<i128>) -> Sig {
         let reset = reset.map(|v| {
-            assert!(ty.fits(v), "{}: {name}: reset value {v} does not fit", self.name);
+            assert!(ty.accepts(v), "{}: {name}: reset value {v} does not fit", self.name);
             ty.wrap(v)
         });
         self.push(name, ty, Def::Reg { next: None, enable: None, reset })
     }
 
     pub fn connect(&mut self, reg: Sig, next: Sig, enable: Option<Sig>) {
+        let reg_name = self.sig(reg.id).name.clone();
         assert_eq!(reg.ty, next.ty, "{}: register {} input type", self.name, self.sig(reg.id).name);
         if let Some(e) = enable {
             assert_eq!(e.ty, Ty::BIT);
@@ -323,7 +326,7 @@ impl Module {
                 *n = Some(next.id);
                 *en = enable.map(|e| e.id);
             }
-            _ => panic!("{}: connect on a non-register or twice", self.name),
+            _ => panic!("{}: register {reg_name} is driven twice (or is no register)", self.name),
         }
     }
 
@@ -385,16 +388,27 @@ impl Module {
     /// internal signal that has the name already is renamed instead.
     pub fn output(&mut self, name: &str, sig: Sig) {
         let name = names::legal(name);
+        assert!(!name.starts_with("tb_"), "{}: port {name}: tb_ names are the testbenches' own", self.name);
         let port_taken = self.outputs.iter().any(|o| o.0 == name)
             || self.inputs.iter().any(|&i| self.sig(i).name == name)
             || self.roms.iter().any(|r| r.name == name)
             || self.instances.iter().any(|i| i.name == name);
         assert!(!port_taken, "{}: port {name} is taken", self.name);
-        if let Some(k) = self.signals.iter().position(|x| x.name == name) {
-            let renamed = self.unique_name(&format!("{name}_int"));
-            self.signals[k].name = renamed;
-        }
+        // Internal signals whose name, or a name the printers derive from it, is the port's.
+        let clashes: Vec<usize> = (0..self.signals.len())
+            .filter(|&k| {
+                let n = &self.signals[k].name;
+                !matches!(self.signals[k].def, Def::Input)
+                    && (*n == name
+                        || DERIVED.iter().any(|sfx| format!("{n}{sfx}") == name || format!("{name}{sfx}") == *n))
+            })
+            .collect();
         self.idents.insert(name.clone());
+        for k in clashes {
+            let old = std::mem::take(&mut self.signals[k].name);
+            self.idents.remove(&old);
+            self.signals[k].name = self.unique_name(&format!("{old}_int"));
+        }
         self.outputs.push((name, sig.id));
     }
 
@@ -474,6 +488,8 @@ impl Module {
             assert_eq!(s.ty, port.ty, "{}: {label}: input {} of {} type", self.name, port.name, sub.name);
         }
         let name = self.unique_name(label);
+        // The component's name is declared in this module's VHDL.
+        self.idents.insert(sub.name.clone());
         let inst = self.instances.len();
         self.instances.push(Instance {
             name: name.clone(),

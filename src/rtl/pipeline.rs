@@ -5,16 +5,18 @@
 //! along (valid bits, triangle fields) are never carried by hand and never miscounted. Each
 //! stage registers a **bundle**: a struct of named signals (`bundle!`), so fields are read by
 //! name, not position. The latency is the count of registered stages plus the latency of
-//! instances (`advance`).
+//! instances (`instance`).
 //!
 //! A stage can be left unregistered by name (`Policy::merge`): its logic then runs in the same
 //! clock as the next stage's, every later signal is aligned automatically and the latency drops
 //! by one, without touching the core's description — the hook for pipelining to a clock target.
 
-use super::build::{Builder, S};
+use super::build::{Builder, Ports, S};
 use super::netlist::BlockKind;
+use super::netlist::Module;
 use std::cell::{Cell, RefCell};
 use std::collections::BTreeMap;
+use std::rc::Rc;
 
 /// A struct of signals that a stage can register field by field.
 pub trait Bundle<'b>: Sized {
@@ -51,12 +53,14 @@ pub struct Pipeline<'b> {
     b: &'b Builder,
     policy: Policy,
     /// The first signal id of each stage after the first: a signal with id < bounds[0] is
-    /// produced in stage 0, etc. Equal bounds are instances' latency (`advance`).
+    /// produced in stage 0, etc. Equal bounds are instances' latency (`instance`).
     bounds: RefCell<Vec<u32>>,
     /// Delayed copies already made: (signal, delay) → copy.
     delayed: RefCell<BTreeMap<(u32, u32), S<'b>>>,
-    /// Stages passed (registered or advanced): the current stage number.
+    /// Stages passed (registered, or inside an instance): the current stage number.
     stage: Cell<u32>,
+    /// Every stage name seen, to check the policy's names against.
+    names: RefCell<Vec<String>>,
 }
 
 impl<'b> Pipeline<'b> {
@@ -70,6 +74,7 @@ impl<'b> Pipeline<'b> {
             bounds: RefCell::new(Vec::new()),
             delayed: RefCell::new(BTreeMap::new()),
             stage: Cell::new(0),
+            names: RefCell::new(Vec::new()),
         }
     }
 
@@ -84,6 +89,10 @@ impl<'b> Pipeline<'b> {
 
     /// `x` as seen in the current stage: delayed by the stages since it was produced.
     pub fn now(&self, x: S<'b>) -> S<'b> {
+        // A constant is the same in every stage.
+        if self.b.with(|m| matches!(m.sig(x.sig.id).def, super::netlist::Def::Const(_))) {
+            return x;
+        }
         let d = self.stage.get() - self.born(x);
         if d == 0 {
             return x;
@@ -110,6 +119,7 @@ impl<'b> Pipeline<'b> {
     /// register (named `s{k}_{field}`) unless the policy merges the stage named `name`. Returns
     /// the bundle as seen in the next stage.
     pub fn stage<B: Bundle<'b>>(&self, name: &str, doc: &str, bundle: B) -> B {
+        self.names.borrow_mut().push(name.to_string());
         let aligned = bundle.map_fields(&mut |field, s| {
             let s = self.now(s);
             // A field's logic with only a numbered name takes the field's name.
@@ -135,15 +145,16 @@ impl<'b> Pipeline<'b> {
         registered
     }
 
-    /// An instance with its own `cycles` registers (a sub-module pipeline): its inputs must be
-    /// aligned to the current stage with `now` before the call; outputs created after this call
-    /// belong to the stage `cycles` later.
-    pub fn advance(&self, cycles: u32) {
+    /// Instantiates `sub`, a pipeline of its own `cycles` registers deep: its inputs are
+    /// aligned to the current stage, and its outputs belong to the stage `cycles` later.
+    pub fn instance(&self, label: &str, sub: &Rc<Module>, inputs: &[S<'b>], cycles: u32) -> Ports<'b> {
+        let aligned: Vec<S<'b>> = inputs.iter().map(|&s| self.now(s)).collect();
         let id = self.next_id();
         for _ in 0..cycles {
             self.bounds.borrow_mut().push(id);
         }
         self.stage.set(self.stage.get() + cycles);
+        self.b.instance(label, sub, &aligned)
     }
 
     /// Clock cycles from the inputs to the current stage.
@@ -151,8 +162,12 @@ impl<'b> Pipeline<'b> {
         self.stage.get()
     }
 
-    /// Closes the last block (the logic after the last stage's registers).
+    /// Closes the last block (the logic after the last stage's registers). Panics (a bug in
+    /// the core) when the policy names a stage that does not exist.
     pub fn finish(self) -> u32 {
+        for m in &self.policy.merge {
+            assert!(self.names.borrow().contains(m), "the pipeline has no stage {m} to merge");
+        }
         self.b.with(|m| {
             let block = m.current_block.expect("a pipeline's block is open");
             m.blocks[block].name = crate::rtl::names::legal(&format!("s{}_out", self.stage.get()));

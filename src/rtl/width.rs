@@ -56,6 +56,11 @@ impl Ty {
         let (lo, hi) = self.range();
         v >= lo && v <= hi
     }
+    /// Whether `v` can be given for a value of this type: in range, or for an unsigned
+    /// 128-bit type any i128, read as its bit pattern (the top values are no i128).
+    pub fn accepts(&self, v: i128) -> bool {
+        self.fits(v) || (!self.signed && self.width == 128)
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -167,6 +172,9 @@ pub fn eval_bin(op: BinOp, ta: Ty, a: u128, tb: Ty, b: u128, tr: Ty) -> u128 {
         Mul => tr.wrap(va.wrapping_mul(vb)),
         Eq => (a == b) as u128,
         Ne => (a != b) as u128,
+        // An unsigned 128-bit value with its top bit set is no i128: compare the bit patterns.
+        Lt if !ta.signed => (a < b) as u128,
+        Le if !ta.signed => (a <= b) as u128,
         Lt => (va < vb) as u128,
         Le => (va <= vb) as u128,
     }
@@ -178,6 +186,8 @@ pub fn eval_un(op: UnOp, ta: Ty, a: u128, tr: Ty) -> u128 {
         Not => !a & ta.mask(),
         Neg => tr.wrap(ta.value(a).wrapping_neg()),
         Shl(k) => (a << k) & ta.mask(),
+        // Logical for unsigned (on the bit pattern, so at 128 bits too), arithmetic for signed.
+        Shr(k) if !ta.signed => a >> k,
         Shr(k) => tr.wrap(ta.value(a) >> k),
         Slice { lsb, width } => (a >> lsb) & Ty::u(width).mask(),
         Resize(_) => tr.wrap(ta.value(a)),
@@ -241,6 +251,22 @@ mod tests {
                 assert_eq!(un(UnOp::Resize(5)), a & 0x1F);
                 assert_eq!(un(UnOp::Slice { lsb: 3, width: 4 }), (a >> 3) & 0xF);
             }
+        }
+    }
+
+    /// Unsigned values with the top bit set compare and shift as unsigned at every width,
+    /// 128 included.
+    #[test]
+    fn unsigned_top_bit() {
+        for w in [8u32, 63, 64, 65, 127, 128] {
+            let t = Ty::u(w);
+            let top = 1u128 << (w - 1);
+            assert_eq!(eval_bin(BinOp::Lt, t, 1, t, top, Ty::BIT), 1, "{w}");
+            assert_eq!(eval_bin(BinOp::Le, t, top, t, 1, Ty::BIT), 0, "{w}");
+            assert_eq!(eval_un(UnOp::Shr(1), t, top, t), top >> 1, "{w}");
+            let s = Ty::s(w);
+            assert_eq!(eval_bin(BinOp::Lt, s, top, s, 1, Ty::BIT), 1, "{w} signed");
+            assert_eq!(eval_un(UnOp::Shr(1), s, top, s), top | (top >> 1), "{w} signed");
         }
     }
 

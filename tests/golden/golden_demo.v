@@ -33,13 +33,9 @@ module golden_demo (
 
   // state machine ctl: waits for go
   reg [1:0] state = st_idle;
-  wire [1:0] go_idle = st_idle;
-  wire [1:0] go_busy = st_busy;
-  wire [1:0] go_done = st_done;
   wire [1:0] from_idle;
   wire [1:0] from_busy;
   reg [1:0] state_next;
-  wire [1:0] is_done_k = st_done;
   wire [0:0] is_done;
 
   // not in a stage or state machine
@@ -60,16 +56,16 @@ module golden_demo (
   end
 
   // state machine ctl: waits for go
-  assign from_idle = go ? go_busy : go_idle;
-  assign from_busy = go ? go_busy : go_done;
+  assign from_idle = go ? st_busy : st_idle;
+  assign from_busy = go ? st_busy : st_done;
   always @* begin
     case (state)
       st_idle: state_next = from_idle;
       st_busy: state_next = from_busy;
-      default: state_next = go_idle;
+      default: state_next = st_idle;
     endcase
   end
-  assign is_done = state == is_done_k;
+  assign is_done = state == st_done;
 
   always @(posedge clk) begin : ctl_regs
     if (rst) state <= st_idle;

@@ -35,13 +35,9 @@ architecture rtl of golden_demo is
 
   -- state machine ctl: waits for go
   signal state : unsigned(1 downto 0) := st_idle;
-  constant go_idle : unsigned(1 downto 0) := st_idle;
-  constant go_busy : unsigned(1 downto 0) := st_busy;
-  constant go_done : unsigned(1 downto 0) := st_done;
   signal from_idle : unsigned(1 downto 0);
   signal from_busy : unsigned(1 downto 0);
   signal state_next : unsigned(1 downto 0);
-  constant is_done_k : unsigned(1 downto 0) := st_done;
   signal is_done : unsigned(0 downto 0);
 begin
 
@@ -68,14 +64,14 @@ begin
   end process square_regs;
 
   -- state machine ctl: waits for go
-  from_idle <= go_busy when go = "1" else go_idle;
-  from_busy <= go_busy when go = "1" else go_done;
+  from_idle <= st_busy when go = "1" else st_idle;
+  from_busy <= st_busy when go = "1" else st_done;
   with state select
     state_next <=
       from_idle when st_idle,
       from_busy when st_busy,
-      go_idle when others;
-  is_done <= "1" when state = is_done_k else "0";
+      st_idle when others;
+  is_done <= "1" when state = st_done else "0";
 
   ctl_regs : process (clk)
   begin
