@@ -13,12 +13,13 @@ module {{ tb }};
 {%- for p in outputs %}
   wire {{ p.decl }} {{ p.name }};
 {%- endfor %}
-  reg [{{ total_width - 1 }}:0] vectors [0:{{ count - 1 }}];
-  reg [{{ total_width - 1 }}:0] v;
-  integer i;
-  integer passed;
-  integer failed;
-  reg ok;
+  // The testbench's own names start with tb_ (no port of a design does).
+  reg [{{ total_width - 1 }}:0] tb_vectors [0:{{ count - 1 }}];
+  reg [{{ total_width - 1 }}:0] tb_word;
+  integer tb_i;
+  integer tb_passed;
+  integer tb_failed;
+  reg tb_ok;
 
   {{ module }} dut (
     .clk(clk){% if has_reset %},
@@ -28,32 +29,32 @@ module {{ tb }};
   );
 
   initial begin
-    $readmemh("{{ vectors }}", vectors);
-    passed = 0;
-    failed = 0;
-    for (i = 0; i < {{ count }}; i = i + 1) begin
-      v = vectors[i];
+    $readmemh("{{ vectors }}", tb_vectors);
+    tb_passed = 0;
+    tb_failed = 0;
+    for (tb_i = 0; tb_i < {{ count }}; tb_i = tb_i + 1) begin
+      tb_word = tb_vectors[tb_i];
 {%- if has_reset %}
-      rst = v[{{ reset_bit }}];
+      rst = tb_word[{{ reset_bit }}];
 {%- endif %}
 {%- for p in inputs %}
-      {{ p.name }} = v[{{ p.msb }}:{{ p.lsb }}];
+      {{ p.name }} = tb_word[{{ p.msb }}:{{ p.lsb }}];
 {%- endfor %}
       #1 clk = 1'b1;
       #1 clk = 1'b0;
       #1;
-      ok = 1'b1;
+      tb_ok = 1'b1;
 {%- for p in outputs %}
-      if ({{ p.name }} !== v[{{ p.msb }}:{{ p.lsb }}]) begin
-        ok = 1'b0;
-        if (failed < 10) $display("cycle %0d: {{ p.name }} differs", i);
+      if ({{ p.name }} !== tb_word[{{ p.msb }}:{{ p.lsb }}]) begin
+        tb_ok = 1'b0;
+        if (tb_failed < 10) $display("cycle %0d: {{ p.name }} differs", tb_i);
       end
 {%- endfor %}
-      if (ok) passed = passed + 1;
-      else failed = failed + 1;
+      if (tb_ok) tb_passed = tb_passed + 1;
+      else tb_failed = tb_failed + 1;
     end
-    $display("%0d passed, %0d failed", passed, failed);
-    if (failed != 0 || passed == 0) $fatal(1, "mismatches");
+    $display("%0d passed, %0d failed", tb_passed, tb_failed);
+    if (tb_failed != 0 || tb_passed == 0) $fatal(1, "mismatches");
     $finish;
   end
 endmodule

@@ -29,56 +29,57 @@ begin
     );
 
   stimulus : process
-    file vectors : text open read_mode is "{{ vectors }}";
-    variable l : line;
+    -- The testbench's own names start with tb_ (no port of a design does).
+    file tb_vectors : text open read_mode is "{{ vectors }}";
+    variable tb_line : line;
 {%- if has_reset %}
-    variable v_rst : bit_vector(0 downto 0);
+    variable tb_in_rst : bit_vector(0 downto 0);
 {%- endif %}
 {%- for p in inputs %}
-    variable v_{{ p.name }} : bit_vector({{ p.width - 1 }} downto 0);
+    variable tb_in_{{ p.name }} : bit_vector({{ p.width - 1 }} downto 0);
 {%- endfor %}
 {%- for p in outputs %}
-    variable e_{{ p.name }} : bit_vector({{ p.width - 1 }} downto 0);
+    variable tb_want_{{ p.name }} : bit_vector({{ p.width - 1 }} downto 0);
 {%- endfor %}
-    variable ok : boolean;
-    variable passed, failed, cycle : natural := 0;
+    variable tb_ok : boolean;
+    variable tb_passed, tb_failed, tb_cycle : natural := 0;
   begin
-    while not endfile(vectors) loop
-      readline(vectors, l);
+    while not endfile(tb_vectors) loop
+      readline(tb_vectors, tb_line);
 {%- if has_reset %}
-      read(l, v_rst);
-      rst <= to_stdulogic(v_rst(0));
+      read(tb_line, tb_in_rst);
+      rst <= to_stdulogic(tb_in_rst(0));
 {%- endif %}
 {%- for p in inputs %}
-      read(l, v_{{ p.name }});
-      {{ p.name }} <= {{ p.kind }}(to_stdlogicvector(v_{{ p.name }}));
+      read(tb_line, tb_in_{{ p.name }});
+      {{ p.name }} <= {{ p.kind }}(to_stdlogicvector(tb_in_{{ p.name }}));
 {%- endfor %}
 {%- for p in outputs %}
-      read(l, e_{{ p.name }});
+      read(tb_line, tb_want_{{ p.name }});
 {%- endfor %}
       wait for 1 ns;
       clk <= '1';
       wait for 1 ns;
       clk <= '0';
       wait for 1 ns;
-      ok := true;
+      tb_ok := true;
 {%- for p in outputs %}
-      if std_logic_vector({{ p.name }}) /= to_stdlogicvector(e_{{ p.name }}) then
-        ok := false;
-        if failed < 10 then
-          report "cycle " & integer'image(cycle) & ": {{ p.name }} differs" severity warning;
+      if std_logic_vector({{ p.name }}) /= to_stdlogicvector(tb_want_{{ p.name }}) then
+        tb_ok := false;
+        if tb_failed < 10 then
+          report "cycle " & integer'image(tb_cycle) & ": {{ p.name }} differs" severity warning;
         end if;
       end if;
 {%- endfor %}
-      if ok then
-        passed := passed + 1;
+      if tb_ok then
+        tb_passed := tb_passed + 1;
       else
-        failed := failed + 1;
+        tb_failed := tb_failed + 1;
       end if;
-      cycle := cycle + 1;
+      tb_cycle := tb_cycle + 1;
     end loop;
-    report integer'image(passed) & " passed, " & integer'image(failed) & " failed" severity note;
-    assert failed = 0 and passed > 0 report "mismatches" severity failure;
+    report integer'image(tb_passed) & " passed, " & integer'image(tb_failed) & " failed" severity note;
+    assert tb_failed = 0 and tb_passed > 0 report "mismatches" severity failure;
     wait;
   end process stimulus;
 end architecture sim;

@@ -161,12 +161,15 @@ pub enum BenchConfig {
     Render { width: u32, height: u32, threads: usize, repeat: u32 },
     /// Simulator speed on `vectors` (≥ 1) intersection vectors, GHDL on a prefix.
     Sim { vectors: usize, ghdl_vectors: usize },
+    /// The agreement property on `netlists` (≥ 1) random netlists.
+    Agree { netlists: u64 },
 }
 
 impl BenchArgs {
     pub fn config(&self) -> Result<BenchConfig> {
         Ok(match self.what {
             BenchWhat::Sim => BenchConfig::Sim { vectors: self.vectors.max(1), ghdl_vectors: self.ghdl_vectors },
+            BenchWhat::Agree => BenchConfig::Agree { netlists: self.netlists.max(1) },
             BenchWhat::Render => {
                 threads(Some(self.threads))?;
                 let (width, height) = self.size;

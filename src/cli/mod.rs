@@ -408,6 +408,9 @@ pub enum BenchWhat {
     Render,
     /// Simulator speed on the intersection pipeline: Rust, Verilator and GHDL, cycles/s.
     Sim,
+    /// The agreement property at length: `--netlists` random netlists, cycle simulator
+    /// against batched simulator, every output of every cycle (exit 1 on a difference).
+    Agree,
 }
 
 #[derive(Args, Debug)]
@@ -421,6 +424,9 @@ pub struct BenchArgs {
     /// How many of those vectors GHDL runs.
     #[arg(long = "ghdl-vectors", default_value_t = 3000)]
     pub ghdl_vectors: usize,
+    /// Random netlists for `bench agree` (seeds 0 … N − 1; the test suite runs 10,000).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub netlists: u64,
     /// Image size WxH.
     #[arg(long, value_parser = parse_size, default_value = "1024x1024")]
     pub size: (u32, u32),

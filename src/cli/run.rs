@@ -26,7 +26,7 @@ pub fn run(cmd: Command) -> Result<bool> {
         Command::Render(a) => render(&a.config()?).map(|()| true),
         Command::Scene(a) => scene(&a.config()?).map(|()| true),
         Command::Compare(a) => compare(&a.config()?).map(|()| true),
-        Command::Bench(a) => bench(&a.config()?).map(|()| true),
+        Command::Bench(a) => bench(&a.config()?),
         Command::Gen(a) => gen_core(&a.config()?).map(|()| true),
         Command::Synth(a) => synth_cores(&a.config()?).map(|()| true),
         Command::Sweep(a) => sweep_cmd(a.config()?),
@@ -91,7 +91,28 @@ pub fn compare(c: &CompareConfig) -> Result<()> {
     Ok(())
 }
 
-pub fn bench(c: &BenchConfig) -> Result<()> {
+/// The agreement property on `netlists` random netlists with a progress bar; prints
+/// `N passed, N failed` and the first differences.
+fn bench_agree(netlists: u64) -> bool {
+    let bar = indicatif::ProgressBar::new(netlists);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("netlists [{bar:40}] {pos}/{len} ({eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let failures = crate::rtl::random::agree(0..netlists, &|| bar.inc(1));
+    bar.finish_and_clear();
+    for f in failures.iter().take(10) {
+        eprintln!("{f}");
+    }
+    println!("agree: {} passed, {} failed", netlists - failures.len() as u64, failures.len());
+    failures.is_empty()
+}
+
+/// Runs a benchmark; false when `bench agree` found a difference.
+pub fn bench(c: &BenchConfig) -> Result<bool> {
+    if let BenchConfig::Agree { netlists } = *c {
+        return Ok(bench_agree(netlists));
+    }
     let params = Params::default();
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params)?;
     match *c {
@@ -132,8 +153,9 @@ pub fn bench(c: &BenchConfig) -> Result<()> {
                 rays as f64 / best / 1e6
             );
         }
+        BenchConfig::Agree { .. } => unreachable!("answered above"),
     }
-    Ok(())
+    Ok(true)
 }
 
 pub fn scene(c: &SceneConfig) -> Result<()> {
