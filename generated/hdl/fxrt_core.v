@@ -57,38 +57,38 @@ module fxrt_core (
   reg signed [31:0] wx_r = 32'sh00000000;
   reg signed [31:0] wy_r = 32'sh00000000;
   reg signed [31:0] wz_r = 32'sh00000000;
+  wire [12:0] tri_addr;
   reg [123:0] tri_word_0 = 124'h0000000000000000000000000000000;
   wire [1:0] tri_r;
   wire [28:0] tri_pp;
   wire [28:0] tri_pq;
-  wire [31:0] tri_d;
-  wire signed [31:0] tri_d_s;
-  wire [31:0] tri_np;
-  wire signed [31:0] tri_np_s;
+  wire [31:0] bits_tri_word_0;
+  wire signed [31:0] tri_d;
+  wire [31:0] bits_tri_word_0_1;
+  wire signed [31:0] tri_np;
   reg [127:0] tri_word_1 = 128'h00000000000000000000000000000000;
-  wire [31:0] tri_nq;
-  wire signed [31:0] tri_nq_s;
-  wire [31:0] tri_e1p;
-  wire signed [31:0] tri_e1p_s;
-  wire [31:0] tri_e1q;
-  wire signed [31:0] tri_e1q_s;
-  wire [31:0] tri_e2p;
-  wire signed [31:0] tri_e2p_s;
+  wire [31:0] bits_tri_word_1;
+  wire signed [31:0] tri_nq;
+  wire [31:0] bits_tri_word_1_1;
+  wire signed [31:0] tri_e1p;
+  wire [31:0] bits_tri_word_1_2;
+  wire signed [31:0] tri_e1q;
+  wire [31:0] bits_tri_word_1_3;
+  wire signed [31:0] tri_e2p;
   reg [31:0] tri_word_2 = 32'h00000000;
-  wire [31:0] tri_e2q;
-  wire signed [31:0] tri_e2q_s;
-  wire [43:0] tag_tri_tmin;
-  wire [43:0] tag_id;
-  wire [43:0] tag_payload;
+  wire signed [31:0] tri_e2q;
+  wire [43:0] cat_1;
+  wire [43:0] rs_u_traverse_emit_id;
+  wire [43:0] mux_u_traverse_emit_end;
   wire [44:0] tag;
   reg [0:0] pipe_valid = 1'h0;
   reg [44:0] pipe_tag = 45'h000000000000;
   wire [0:0] u_intersect_valid_out;
   wire [44:0] u_intersect_tag_out;
   wire [0:0] u_intersect_hit;
-  wire [29:0] u_intersect_t;
-  wire [31:0] u_intersect_u_1;
-  wire [31:0] u_intersect_v_1;
+  wire [29:0] u_intersect_t_1;
+  wire [31:0] u_intersect_u;
+  wire [31:0] u_intersect_v;
   wire [0:0] u_closest_res_valid;
   wire [0:0] u_closest_res_hit;
   wire [19:0] u_closest_res_id;
@@ -96,43 +96,43 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] pipe_end;
-  wire [0:0] pipe_not_end;
+  wire [0:0] bits_pipe_tag;
+  wire [0:0] not_bits_pipe_tag;
   wire [0:0] pipe_busy;
 
   assign accept = ray_valid & u_traverse_ray_ready;
+  assign tri_addr = u_traverse_emit_tri;
   assign tri_r = tri_word_0[1:0];
   assign tri_pp = tri_word_0[30:2];
   assign tri_pq = tri_word_0[59:31];
-  assign tri_d = tri_word_0[91:60];
-  assign tri_d_s = $signed(tri_d);
-  assign tri_np = tri_word_0[123:92];
-  assign tri_np_s = $signed(tri_np);
-  assign tri_nq = tri_word_1[31:0];
-  assign tri_nq_s = $signed(tri_nq);
-  assign tri_e1p = tri_word_1[63:32];
-  assign tri_e1p_s = $signed(tri_e1p);
-  assign tri_e1q = tri_word_1[95:64];
-  assign tri_e1q_s = $signed(tri_e1q);
-  assign tri_e2p = tri_word_1[127:96];
-  assign tri_e2p_s = $signed(tri_e2p);
-  assign tri_e2q = tri_word_2[31:0];
-  assign tri_e2q_s = $signed(tri_e2q);
-  assign tag_tri_tmin = {u_traverse_emit_tmin, u_traverse_emit_tri};
-  assign tag_id = {{24{1'b0}}, u_traverse_emit_id};
-  assign tag_payload = u_traverse_emit_end ? tag_id : tag_tri_tmin;
-  assign tag = {u_traverse_emit_end, tag_payload};
-  assign pipe_end = pipe_tag[44];
-  assign pipe_not_end = ~pipe_end;
-  assign pipe_busy = pipe_valid & pipe_not_end;
+  assign bits_tri_word_0 = tri_word_0[91:60];
+  assign tri_d = $signed(bits_tri_word_0);
+  assign bits_tri_word_0_1 = tri_word_0[123:92];
+  assign tri_np = $signed(bits_tri_word_0_1);
+  assign bits_tri_word_1 = tri_word_1[31:0];
+  assign tri_nq = $signed(bits_tri_word_1);
+  assign bits_tri_word_1_1 = tri_word_1[63:32];
+  assign tri_e1p = $signed(bits_tri_word_1_1);
+  assign bits_tri_word_1_2 = tri_word_1[95:64];
+  assign tri_e1q = $signed(bits_tri_word_1_2);
+  assign bits_tri_word_1_3 = tri_word_1[127:96];
+  assign tri_e2p = $signed(bits_tri_word_1_3);
+  assign tri_e2q = $signed(tri_word_2);
+  assign cat_1 = {u_traverse_emit_tmin, u_traverse_emit_tri};
+  assign rs_u_traverse_emit_id = {{24{1'b0}}, u_traverse_emit_id};
+  assign mux_u_traverse_emit_end = u_traverse_emit_end ? rs_u_traverse_emit_id : cat_1;
+  assign tag = {u_traverse_emit_end, mux_u_traverse_emit_end};
+  assign bits_pipe_tag = pipe_tag[44];
+  assign not_bits_pipe_tag = ~bits_pipe_tag;
+  assign pipe_busy = pipe_valid & not_bits_pipe_tag;
 
   always @(posedge clk) begin : regs
     if (accept) wx_r <= wx;
     if (accept) wy_r <= wy;
     if (accept) wz_r <= wz;
-    tri_word_0 <= tri_rom_0[u_traverse_emit_tri];
-    tri_word_1 <= tri_rom_1[u_traverse_emit_tri];
-    tri_word_2 <= tri_rom_2[u_traverse_emit_tri];
+    tri_word_0 <= tri_rom_0[tri_addr];
+    tri_word_1 <= tri_rom_1[tri_addr];
+    tri_word_2 <= tri_rom_2[tri_addr];
     pipe_valid <= u_traverse_emit_valid;
     pipe_tag <= tag;
   end
@@ -176,19 +176,19 @@ module fxrt_core (
     .r(tri_r),
     .pp(tri_pp),
     .pq(tri_pq),
-    .d(tri_d_s),
-    .np(tri_np_s),
-    .nq(tri_nq_s),
-    .e1p(tri_e1p_s),
-    .e1q(tri_e1q_s),
-    .e2p(tri_e2p_s),
-    .e2q(tri_e2q_s),
+    .d(tri_d),
+    .np(tri_np),
+    .nq(tri_nq),
+    .e1p(tri_e1p),
+    .e1q(tri_e1q),
+    .e2p(tri_e2p),
+    .e2q(tri_e2q),
     .valid_out(u_intersect_valid_out),
     .tag_out(u_intersect_tag_out),
     .hit(u_intersect_hit),
-    .t(u_intersect_t),
-    .u_1(u_intersect_u_1),
-    .v_1(u_intersect_v_1)
+    .t(u_intersect_t_1),
+    .u(u_intersect_u),
+    .v(u_intersect_v)
   );
 
   fxrt_closest_n29_m32_tag45 u_closest (
@@ -197,9 +197,9 @@ module fxrt_core (
     .valid(u_intersect_valid_out),
     .tag(u_intersect_tag_out),
     .hit(u_intersect_hit),
-    .t(u_intersect_t),
-    .u(u_intersect_u_1),
-    .v(u_intersect_v_1),
+    .t(u_intersect_t_1),
+    .u(u_intersect_u),
+    .v(u_intersect_v),
     .res_valid(u_closest_res_valid),
     .res_hit(u_closest_res_hit),
     .res_id(u_closest_res_id),

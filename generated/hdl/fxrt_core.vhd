@@ -85,8 +85,8 @@ architecture rtl of fxrt_core is
       tag_out : out unsigned(44 downto 0);
       hit : out unsigned(0 downto 0);
       t : out unsigned(29 downto 0);
-      u_1 : out unsigned(31 downto 0);
-      v_1 : out unsigned(31 downto 0)
+      u : out unsigned(31 downto 0);
+      v : out unsigned(31 downto 0)
     );
   end component;
   component fxrt_closest_n29_m32_tag45 is
@@ -19098,38 +19098,38 @@ architecture rtl of fxrt_core is
   signal wx_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal wy_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal wz_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal tri_addr : unsigned(12 downto 0);
   signal tri_word_0 : unsigned(123 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal tri_r : unsigned(1 downto 0);
   signal tri_pp : unsigned(28 downto 0);
   signal tri_pq : unsigned(28 downto 0);
-  signal tri_d : unsigned(31 downto 0);
-  signal tri_d_s : signed(31 downto 0);
-  signal tri_np : unsigned(31 downto 0);
-  signal tri_np_s : signed(31 downto 0);
+  signal bits_tri_word_0 : unsigned(31 downto 0);
+  signal tri_d : signed(31 downto 0);
+  signal bits_tri_word_0_1 : unsigned(31 downto 0);
+  signal tri_np : signed(31 downto 0);
   signal tri_word_1 : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
-  signal tri_nq : unsigned(31 downto 0);
-  signal tri_nq_s : signed(31 downto 0);
-  signal tri_e1p : unsigned(31 downto 0);
-  signal tri_e1p_s : signed(31 downto 0);
-  signal tri_e1q : unsigned(31 downto 0);
-  signal tri_e1q_s : signed(31 downto 0);
-  signal tri_e2p : unsigned(31 downto 0);
-  signal tri_e2p_s : signed(31 downto 0);
+  signal bits_tri_word_1 : unsigned(31 downto 0);
+  signal tri_nq : signed(31 downto 0);
+  signal bits_tri_word_1_1 : unsigned(31 downto 0);
+  signal tri_e1p : signed(31 downto 0);
+  signal bits_tri_word_1_2 : unsigned(31 downto 0);
+  signal tri_e1q : signed(31 downto 0);
+  signal bits_tri_word_1_3 : unsigned(31 downto 0);
+  signal tri_e2p : signed(31 downto 0);
   signal tri_word_2 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal tri_e2q : unsigned(31 downto 0);
-  signal tri_e2q_s : signed(31 downto 0);
-  signal tag_tri_tmin : unsigned(43 downto 0);
-  signal tag_id : unsigned(43 downto 0);
-  signal tag_payload : unsigned(43 downto 0);
+  signal tri_e2q : signed(31 downto 0);
+  signal cat_1 : unsigned(43 downto 0);
+  signal rs_u_traverse_emit_id : unsigned(43 downto 0);
+  signal mux_u_traverse_emit_end : unsigned(43 downto 0);
   signal tag : unsigned(44 downto 0);
   signal pipe_valid : unsigned(0 downto 0) := unsigned'("0");
   signal pipe_tag : unsigned(44 downto 0) := unsigned'("000000000000000000000000000000000000000000000");
   signal u_intersect_valid_out : unsigned(0 downto 0);
   signal u_intersect_tag_out : unsigned(44 downto 0);
   signal u_intersect_hit : unsigned(0 downto 0);
-  signal u_intersect_t : unsigned(29 downto 0);
-  signal u_intersect_u_1 : unsigned(31 downto 0);
-  signal u_intersect_v_1 : unsigned(31 downto 0);
+  signal u_intersect_t_1 : unsigned(29 downto 0);
+  signal u_intersect_u : unsigned(31 downto 0);
+  signal u_intersect_v : unsigned(31 downto 0);
   signal u_closest_res_valid : unsigned(0 downto 0);
   signal u_closest_res_hit : unsigned(0 downto 0);
   signal u_closest_res_id : unsigned(19 downto 0);
@@ -19137,36 +19137,36 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal pipe_end : unsigned(0 downto 0);
-  signal pipe_not_end : unsigned(0 downto 0);
+  signal bits_pipe_tag : unsigned(0 downto 0);
+  signal not_bits_pipe_tag : unsigned(0 downto 0);
   signal pipe_busy : unsigned(0 downto 0);
 begin
 
   accept <= ray_valid and u_traverse_ray_ready;
+  tri_addr <= u_traverse_emit_tri;
   tri_r <= unsigned(tri_word_0(1 downto 0));
   tri_pp <= unsigned(tri_word_0(30 downto 2));
   tri_pq <= unsigned(tri_word_0(59 downto 31));
-  tri_d <= unsigned(tri_word_0(91 downto 60));
-  tri_d_s <= signed(tri_d);
-  tri_np <= unsigned(tri_word_0(123 downto 92));
-  tri_np_s <= signed(tri_np);
-  tri_nq <= unsigned(tri_word_1(31 downto 0));
-  tri_nq_s <= signed(tri_nq);
-  tri_e1p <= unsigned(tri_word_1(63 downto 32));
-  tri_e1p_s <= signed(tri_e1p);
-  tri_e1q <= unsigned(tri_word_1(95 downto 64));
-  tri_e1q_s <= signed(tri_e1q);
-  tri_e2p <= unsigned(tri_word_1(127 downto 96));
-  tri_e2p_s <= signed(tri_e2p);
-  tri_e2q <= unsigned(tri_word_2(31 downto 0));
-  tri_e2q_s <= signed(tri_e2q);
-  tag_tri_tmin <= unsigned(std_logic_vector'(std_logic_vector(u_traverse_emit_tmin) & std_logic_vector(u_traverse_emit_tri)));
-  tag_id <= resize(u_traverse_emit_id, 44);
-  tag_payload <= tag_id when u_traverse_emit_end = "1" else tag_tri_tmin;
-  tag <= unsigned(std_logic_vector'(std_logic_vector(u_traverse_emit_end) & std_logic_vector(tag_payload)));
-  pipe_end <= unsigned(pipe_tag(44 downto 44));
-  pipe_not_end <= not pipe_end;
-  pipe_busy <= pipe_valid and pipe_not_end;
+  bits_tri_word_0 <= unsigned(tri_word_0(91 downto 60));
+  tri_d <= signed(bits_tri_word_0);
+  bits_tri_word_0_1 <= unsigned(tri_word_0(123 downto 92));
+  tri_np <= signed(bits_tri_word_0_1);
+  bits_tri_word_1 <= unsigned(tri_word_1(31 downto 0));
+  tri_nq <= signed(bits_tri_word_1);
+  bits_tri_word_1_1 <= unsigned(tri_word_1(63 downto 32));
+  tri_e1p <= signed(bits_tri_word_1_1);
+  bits_tri_word_1_2 <= unsigned(tri_word_1(95 downto 64));
+  tri_e1q <= signed(bits_tri_word_1_2);
+  bits_tri_word_1_3 <= unsigned(tri_word_1(127 downto 96));
+  tri_e2p <= signed(bits_tri_word_1_3);
+  tri_e2q <= signed(tri_word_2);
+  cat_1 <= unsigned(std_logic_vector'(std_logic_vector(u_traverse_emit_tmin) & std_logic_vector(u_traverse_emit_tri)));
+  rs_u_traverse_emit_id <= resize(u_traverse_emit_id, 44);
+  mux_u_traverse_emit_end <= rs_u_traverse_emit_id when u_traverse_emit_end = "1" else cat_1;
+  tag <= unsigned(std_logic_vector'(std_logic_vector(u_traverse_emit_end) & std_logic_vector(mux_u_traverse_emit_end)));
+  bits_pipe_tag <= unsigned(pipe_tag(44 downto 44));
+  not_bits_pipe_tag <= not bits_pipe_tag;
+  pipe_busy <= pipe_valid and not_bits_pipe_tag;
 
   regs : process (clk)
   begin
@@ -19180,9 +19180,9 @@ begin
       if accept = "1" then
         wz_r <= wz;
       end if;
-      tri_word_0 <= tri_rom_0(to_integer(u_traverse_emit_tri));
-      tri_word_1 <= tri_rom_1(to_integer(u_traverse_emit_tri));
-      tri_word_2 <= tri_rom_2(to_integer(u_traverse_emit_tri));
+      tri_word_0 <= tri_rom_0(to_integer(tri_addr));
+      tri_word_1 <= tri_rom_1(to_integer(tri_addr));
+      tri_word_2 <= tri_rom_2(to_integer(tri_addr));
       pipe_valid <= u_traverse_emit_valid;
       pipe_tag <= tag;
     end if;
@@ -19229,19 +19229,19 @@ begin
       r => tri_r,
       pp => tri_pp,
       pq => tri_pq,
-      d => tri_d_s,
-      np => tri_np_s,
-      nq => tri_nq_s,
-      e1p => tri_e1p_s,
-      e1q => tri_e1q_s,
-      e2p => tri_e2p_s,
-      e2q => tri_e2q_s,
+      d => tri_d,
+      np => tri_np,
+      nq => tri_nq,
+      e1p => tri_e1p,
+      e1q => tri_e1q,
+      e2p => tri_e2p,
+      e2q => tri_e2q,
       valid_out => u_intersect_valid_out,
       tag_out => u_intersect_tag_out,
       hit => u_intersect_hit,
-      t => u_intersect_t,
-      u_1 => u_intersect_u_1,
-      v_1 => u_intersect_v_1
+      t => u_intersect_t_1,
+      u => u_intersect_u,
+      v => u_intersect_v
     );
 
   u_closest : fxrt_closest_n29_m32_tag45
@@ -19251,9 +19251,9 @@ begin
       valid => u_intersect_valid_out,
       tag => u_intersect_tag_out,
       hit => u_intersect_hit,
-      t => u_intersect_t,
-      u => u_intersect_u_1,
-      v => u_intersect_v_1,
+      t => u_intersect_t_1,
+      u => u_intersect_u,
+      v => u_intersect_v,
       res_valid => u_closest_res_valid,
       res_hit => u_closest_res_hit,
       res_id => u_closest_res_id,

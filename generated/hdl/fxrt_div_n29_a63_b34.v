@@ -8,1205 +8,1367 @@ module fxrt_div_n29_a63_b34 (
   output wire [0:0] ok
 );
 
-  wire signed [62:0] div_zero_n = 63'sh0000000000000000;
-  wire signed [33:0] div_zero_d = 34'sh000000000;
-  wire [0:0] div_num_neg;
-  wire [0:0] div_den_neg;
-  wire [0:0] div_num_zero;
-  wire [0:0] div_den_zero;
-  wire [0:0] div_sign_diff;
-  wire [0:0] div_err_a;
-  wire [0:0] div_err_b;
-  wire signed [62:0] div_num_negated;
-  wire signed [62:0] div_num_abs_s;
-  wire [62:0] div_a;
-  wire signed [33:0] div_den_negated;
-  wire signed [33:0] div_den_abs_s;
-  wire [33:0] div_b;
-  reg [62:0] div1_a = 63'h0000000000000000;
-  reg [33:0] div1_b = 34'h000000000;
-  reg [0:0] div1_err = 1'h0;
-  wire [32:0] div_hi;
-  wire [29:0] div_lo;
-  wire [33:0] div_hi_c;
-  wire [0:0] div_overflow;
-  wire [0:0] div_err_c;
-  wire [33:0] div_p0;
-  wire [29:0] div_q0 = 30'h00000000;
-  wire [34:0] div_b_w;
-  wire [0:0] div0_in;
-  wire [34:0] div0_pw;
-  wire [34:0] div0_p2;
-  wire [34:0] div0_bw;
-  wire [34:0] div0_p3;
-  wire [0:0] div0_ge;
-  wire [34:0] div0_diff;
+  // not in a stage or state machine
+
+  // stage s1_operands: signs, zero tests, magnitudes
+  wire signed [62:0] k_0 = 63'sh0000000000000000;
+  wire [0:0] num_neg;
+  wire signed [33:0] k_0_1 = 34'sh000000000;
+  wire [0:0] den_neg;
+  wire signed [62:0] neg_num;
+  wire signed [62:0] mux_num_neg;
+  wire [62:0] u_mux_num_neg;
+  wire signed [33:0] neg_den;
+  wire signed [33:0] mux_den_neg;
+  wire [33:0] u_mux_den_neg;
+  wire [0:0] num_eq_k_0;
+  wire [0:0] den_eq_k_0_1;
+  wire [0:0] or_0;
+  wire [0:0] num_neg_xor_den_neg;
+  wire [0:0] err;
+  reg [62:0] s1_a = 63'h0000000000000000;
+  reg [33:0] s1_b = 34'h000000000;
+  reg [0:0] s1_err = 1'h0;
+
+  // stage s2_q0: one quotient bit
+  wire [32:0] bits_s1_a;
+  wire [29:0] lo;
+  wire [33:0] rs_bits_s1_a;
+  wire [0:0] s1_b_le_rs_bits_s1_a;
+  wire [0:0] err_1;
+  wire [33:0] rs_bits_s1_a_1;
+  wire [29:0] k_0_2 = 30'h00000000;
+  wire [34:0] rs_s1_b;
+  wire [34:0] rs_rs_bits_s1_a_1;
+  wire [34:0] shl_rs_rs_bits_s1_a_1;
+  wire [0:0] bits_lo;
+  wire [34:0] rs_bits_lo;
+  wire [34:0] or_3;
+  wire [0:0] ge0;
+  wire [34:0] or_3_minus_rs_s1_b;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div0_pn;
+  wire [34:0] mux_ge0;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div0_rem;
-  wire [29:0] div0_q2;
-  wire [29:0] div0_gew;
-  wire [29:0] div0_qn;
-  reg [33:0] div2_p = 34'h000000000;
-  reg [29:0] div2_q = 30'h00000000;
-  reg [33:0] div2_b = 34'h000000000;
-  wire [34:0] div2_bw;
-  reg [29:0] div2_lo = 30'h00000000;
-  reg [0:0] div2_err = 1'h0;
-  wire [0:0] div1_in;
-  wire [34:0] div1_pw;
-  wire [34:0] div1_p2;
-  wire [34:0] div1_bw;
-  wire [34:0] div1_p3;
-  wire [0:0] div1_ge;
-  wire [34:0] div1_diff;
+  wire [33:0] rs_mux_ge0;
+  wire [29:0] rs_ge0;
+  wire [29:0] k_0_2_or_rs_ge0;
+  reg [33:0] s2_p = 34'h000000000;
+  reg [29:0] s2_q = 30'h00000000;
+
+  // stage s3_q1: one quotient bit
+  reg [33:0] s1_b_d1 = 34'h000000000;
+  wire [34:0] rs_s1_b_d1;
+  wire [34:0] rs_s2_p;
+  wire [34:0] shl_rs_s2_p;
+  reg [29:0] lo_d1 = 30'h00000000;
+  wire [0:0] bits_lo_d1;
+  wire [34:0] rs_bits_lo_d1;
+  wire [34:0] or_4;
+  wire [0:0] ge1;
+  wire [34:0] or_4_minus_rs_s1_b_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div1_pn;
+  wire [34:0] mux_ge1;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div1_rem;
-  wire [29:0] div1_q2;
-  wire [29:0] div1_gew;
-  wire [29:0] div1_qn;
-  reg [33:0] div3_p = 34'h000000000;
-  reg [29:0] div3_q = 30'h00000000;
-  reg [33:0] div3_b = 34'h000000000;
-  wire [34:0] div3_bw;
-  reg [29:0] div3_lo = 30'h00000000;
-  reg [0:0] div3_err = 1'h0;
-  wire [0:0] div2_in;
-  wire [34:0] div2_pw;
-  wire [34:0] div2_p2;
-  wire [34:0] div2_bw_1;
-  wire [34:0] div2_p3;
-  wire [0:0] div2_ge;
-  wire [34:0] div2_diff;
+  wire [33:0] rs_mux_ge1;
+  wire [29:0] shl_s2_q;
+  wire [29:0] rs_ge1;
+  wire [29:0] shl_s2_q_or_rs_ge1;
+  reg [33:0] s3_p = 34'h000000000;
+  reg [29:0] s3_q = 30'h00000000;
+
+  // stage s4_q2: one quotient bit
+  reg [33:0] s1_b_d2 = 34'h000000000;
+  wire [34:0] rs_s1_b_d2;
+  wire [34:0] rs_s3_p;
+  wire [34:0] shl_rs_s3_p;
+  reg [29:0] lo_d2 = 30'h00000000;
+  wire [0:0] bits_lo_d2;
+  wire [34:0] rs_bits_lo_d2;
+  wire [34:0] or_5;
+  wire [0:0] ge2;
+  wire [34:0] or_5_minus_rs_s1_b_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div2_pn;
+  wire [34:0] mux_ge2;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div2_rem;
-  wire [29:0] div2_q2;
-  wire [29:0] div2_gew;
-  wire [29:0] div2_qn;
-  reg [33:0] div4_p = 34'h000000000;
-  reg [29:0] div4_q = 30'h00000000;
-  reg [33:0] div4_b = 34'h000000000;
-  wire [34:0] div4_bw;
-  reg [29:0] div4_lo = 30'h00000000;
-  reg [0:0] div4_err = 1'h0;
-  wire [0:0] div3_in;
-  wire [34:0] div3_pw;
-  wire [34:0] div3_p2;
-  wire [34:0] div3_bw_1;
-  wire [34:0] div3_p3;
-  wire [0:0] div3_ge;
-  wire [34:0] div3_diff;
+  wire [33:0] rs_mux_ge2;
+  wire [29:0] shl_s3_q;
+  wire [29:0] rs_ge2;
+  wire [29:0] shl_s3_q_or_rs_ge2;
+  reg [33:0] s4_p = 34'h000000000;
+  reg [29:0] s4_q = 30'h00000000;
+
+  // stage s5_q3: one quotient bit
+  reg [33:0] s1_b_d3 = 34'h000000000;
+  wire [34:0] rs_s1_b_d3;
+  wire [34:0] rs_s4_p;
+  wire [34:0] shl_rs_s4_p;
+  reg [29:0] lo_d3 = 30'h00000000;
+  wire [0:0] bits_lo_d3;
+  wire [34:0] rs_bits_lo_d3;
+  wire [34:0] or_6;
+  wire [0:0] ge3;
+  wire [34:0] or_6_minus_rs_s1_b_d3;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div3_pn;
+  wire [34:0] mux_ge3;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div3_rem;
-  wire [29:0] div3_q2;
-  wire [29:0] div3_gew;
-  wire [29:0] div3_qn;
-  reg [33:0] div5_p = 34'h000000000;
-  reg [29:0] div5_q = 30'h00000000;
-  reg [33:0] div5_b = 34'h000000000;
-  wire [34:0] div5_bw;
-  reg [29:0] div5_lo = 30'h00000000;
-  reg [0:0] div5_err = 1'h0;
-  wire [0:0] div4_in;
-  wire [34:0] div4_pw;
-  wire [34:0] div4_p2;
-  wire [34:0] div4_bw_1;
-  wire [34:0] div4_p3;
-  wire [0:0] div4_ge;
-  wire [34:0] div4_diff;
+  wire [33:0] rs_mux_ge3;
+  wire [29:0] shl_s4_q;
+  wire [29:0] rs_ge3;
+  wire [29:0] shl_s4_q_or_rs_ge3;
+  reg [33:0] s5_p = 34'h000000000;
+  reg [29:0] s5_q = 30'h00000000;
+
+  // stage s6_q4: one quotient bit
+  reg [33:0] s1_b_d4 = 34'h000000000;
+  wire [34:0] rs_s1_b_d4;
+  wire [34:0] rs_s5_p;
+  wire [34:0] shl_rs_s5_p;
+  reg [29:0] lo_d4 = 30'h00000000;
+  wire [0:0] bits_lo_d4;
+  wire [34:0] rs_bits_lo_d4;
+  wire [34:0] or_7;
+  wire [0:0] ge4;
+  wire [34:0] or_7_minus_rs_s1_b_d4;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div4_pn;
+  wire [34:0] mux_ge4;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div4_rem;
-  wire [29:0] div4_q2;
-  wire [29:0] div4_gew;
-  wire [29:0] div4_qn;
-  reg [33:0] div6_p = 34'h000000000;
-  reg [29:0] div6_q = 30'h00000000;
-  reg [33:0] div6_b = 34'h000000000;
-  wire [34:0] div6_bw;
-  reg [29:0] div6_lo = 30'h00000000;
-  reg [0:0] div6_err = 1'h0;
-  wire [0:0] div5_in;
-  wire [34:0] div5_pw;
-  wire [34:0] div5_p2;
-  wire [34:0] div5_bw_1;
-  wire [34:0] div5_p3;
-  wire [0:0] div5_ge;
-  wire [34:0] div5_diff;
+  wire [33:0] rs_mux_ge4;
+  wire [29:0] shl_s5_q;
+  wire [29:0] rs_ge4;
+  wire [29:0] shl_s5_q_or_rs_ge4;
+  reg [33:0] s6_p = 34'h000000000;
+  reg [29:0] s6_q = 30'h00000000;
+
+  // stage s7_q5: one quotient bit
+  reg [33:0] s1_b_d5 = 34'h000000000;
+  wire [34:0] rs_s1_b_d5;
+  wire [34:0] rs_s6_p;
+  wire [34:0] shl_rs_s6_p;
+  reg [29:0] lo_d5 = 30'h00000000;
+  wire [0:0] bits_lo_d5;
+  wire [34:0] rs_bits_lo_d5;
+  wire [34:0] or_8;
+  wire [0:0] ge5;
+  wire [34:0] or_8_minus_rs_s1_b_d5;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div5_pn;
+  wire [34:0] mux_ge5;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div5_rem;
-  wire [29:0] div5_q2;
-  wire [29:0] div5_gew;
-  wire [29:0] div5_qn;
-  reg [33:0] div7_p = 34'h000000000;
-  reg [29:0] div7_q = 30'h00000000;
-  reg [33:0] div7_b = 34'h000000000;
-  wire [34:0] div7_bw;
-  reg [29:0] div7_lo = 30'h00000000;
-  reg [0:0] div7_err = 1'h0;
-  wire [0:0] div6_in;
-  wire [34:0] div6_pw;
-  wire [34:0] div6_p2;
-  wire [34:0] div6_bw_1;
-  wire [34:0] div6_p3;
-  wire [0:0] div6_ge;
-  wire [34:0] div6_diff;
+  wire [33:0] rs_mux_ge5;
+  wire [29:0] shl_s6_q;
+  wire [29:0] rs_ge5;
+  wire [29:0] shl_s6_q_or_rs_ge5;
+  reg [33:0] s7_p = 34'h000000000;
+  reg [29:0] s7_q = 30'h00000000;
+
+  // stage s8_q6: one quotient bit
+  reg [33:0] s1_b_d6 = 34'h000000000;
+  wire [34:0] rs_s1_b_d6;
+  wire [34:0] rs_s7_p;
+  wire [34:0] shl_rs_s7_p;
+  reg [29:0] lo_d6 = 30'h00000000;
+  wire [0:0] bits_lo_d6;
+  wire [34:0] rs_bits_lo_d6;
+  wire [34:0] or_9;
+  wire [0:0] ge6;
+  wire [34:0] or_9_minus_rs_s1_b_d6;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div6_pn;
+  wire [34:0] mux_ge6;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div6_rem;
-  wire [29:0] div6_q2;
-  wire [29:0] div6_gew;
-  wire [29:0] div6_qn;
-  reg [33:0] div8_p = 34'h000000000;
-  reg [29:0] div8_q = 30'h00000000;
-  reg [33:0] div8_b = 34'h000000000;
-  wire [34:0] div8_bw;
-  reg [29:0] div8_lo = 30'h00000000;
-  reg [0:0] div8_err = 1'h0;
-  wire [0:0] div7_in;
-  wire [34:0] div7_pw;
-  wire [34:0] div7_p2;
-  wire [34:0] div7_bw_1;
-  wire [34:0] div7_p3;
-  wire [0:0] div7_ge;
-  wire [34:0] div7_diff;
+  wire [33:0] rs_mux_ge6;
+  wire [29:0] shl_s7_q;
+  wire [29:0] rs_ge6;
+  wire [29:0] shl_s7_q_or_rs_ge6;
+  reg [33:0] s8_p = 34'h000000000;
+  reg [29:0] s8_q = 30'h00000000;
+
+  // stage s9_q7: one quotient bit
+  reg [33:0] s1_b_d7 = 34'h000000000;
+  wire [34:0] rs_s1_b_d7;
+  wire [34:0] rs_s8_p;
+  wire [34:0] shl_rs_s8_p;
+  reg [29:0] lo_d7 = 30'h00000000;
+  wire [0:0] bits_lo_d7;
+  wire [34:0] rs_bits_lo_d7;
+  wire [34:0] or_10;
+  wire [0:0] ge7;
+  wire [34:0] or_10_minus_rs_s1_b_d7;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div7_pn;
+  wire [34:0] mux_ge7;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div7_rem;
-  wire [29:0] div7_q2;
-  wire [29:0] div7_gew;
-  wire [29:0] div7_qn;
-  reg [33:0] div9_p = 34'h000000000;
-  reg [29:0] div9_q = 30'h00000000;
-  reg [33:0] div9_b = 34'h000000000;
-  wire [34:0] div9_bw;
-  reg [29:0] div9_lo = 30'h00000000;
-  reg [0:0] div9_err = 1'h0;
-  wire [0:0] div8_in;
-  wire [34:0] div8_pw;
-  wire [34:0] div8_p2;
-  wire [34:0] div8_bw_1;
-  wire [34:0] div8_p3;
-  wire [0:0] div8_ge;
-  wire [34:0] div8_diff;
+  wire [33:0] rs_mux_ge7;
+  wire [29:0] shl_s8_q;
+  wire [29:0] rs_ge7;
+  wire [29:0] shl_s8_q_or_rs_ge7;
+  reg [33:0] s9_p = 34'h000000000;
+  reg [29:0] s9_q = 30'h00000000;
+
+  // stage s10_q8: one quotient bit
+  reg [33:0] s1_b_d8 = 34'h000000000;
+  wire [34:0] rs_s1_b_d8;
+  wire [34:0] rs_s9_p;
+  wire [34:0] shl_rs_s9_p;
+  reg [29:0] lo_d8 = 30'h00000000;
+  wire [0:0] bits_lo_d8;
+  wire [34:0] rs_bits_lo_d8;
+  wire [34:0] or_11;
+  wire [0:0] ge8;
+  wire [34:0] or_11_minus_rs_s1_b_d8;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div8_pn;
+  wire [34:0] mux_ge8;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div8_rem;
-  wire [29:0] div8_q2;
-  wire [29:0] div8_gew;
-  wire [29:0] div8_qn;
-  reg [33:0] div10_p = 34'h000000000;
-  reg [29:0] div10_q = 30'h00000000;
-  reg [33:0] div10_b = 34'h000000000;
-  wire [34:0] div10_bw;
-  reg [29:0] div10_lo = 30'h00000000;
-  reg [0:0] div10_err = 1'h0;
-  wire [0:0] div9_in;
-  wire [34:0] div9_pw;
-  wire [34:0] div9_p2;
-  wire [34:0] div9_bw_1;
-  wire [34:0] div9_p3;
-  wire [0:0] div9_ge;
-  wire [34:0] div9_diff;
+  wire [33:0] rs_mux_ge8;
+  wire [29:0] shl_s9_q;
+  wire [29:0] rs_ge8;
+  wire [29:0] shl_s9_q_or_rs_ge8;
+  reg [33:0] s10_p = 34'h000000000;
+  reg [29:0] s10_q = 30'h00000000;
+
+  // stage s11_q9: one quotient bit
+  reg [33:0] s1_b_d9 = 34'h000000000;
+  wire [34:0] rs_s1_b_d9;
+  wire [34:0] rs_s10_p;
+  wire [34:0] shl_rs_s10_p;
+  reg [29:0] lo_d9 = 30'h00000000;
+  wire [0:0] bits_lo_d9;
+  wire [34:0] rs_bits_lo_d9;
+  wire [34:0] or_12;
+  wire [0:0] ge9;
+  wire [34:0] or_12_minus_rs_s1_b_d9;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div9_pn;
+  wire [34:0] mux_ge9;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div9_rem;
-  wire [29:0] div9_q2;
-  wire [29:0] div9_gew;
-  wire [29:0] div9_qn;
-  reg [33:0] div11_p = 34'h000000000;
-  reg [29:0] div11_q = 30'h00000000;
-  reg [33:0] div11_b = 34'h000000000;
-  wire [34:0] div11_bw;
-  reg [29:0] div11_lo = 30'h00000000;
-  reg [0:0] div11_err = 1'h0;
-  wire [0:0] div10_in;
-  wire [34:0] div10_pw;
-  wire [34:0] div10_p2;
-  wire [34:0] div10_bw_1;
-  wire [34:0] div10_p3;
-  wire [0:0] div10_ge;
-  wire [34:0] div10_diff;
+  wire [33:0] rs_mux_ge9;
+  wire [29:0] shl_s10_q;
+  wire [29:0] rs_ge9;
+  wire [29:0] shl_s10_q_or_rs_ge9;
+  reg [33:0] s11_p = 34'h000000000;
+  reg [29:0] s11_q = 30'h00000000;
+
+  // stage s12_q10: one quotient bit
+  reg [33:0] s1_b_d10 = 34'h000000000;
+  wire [34:0] rs_s1_b_d10;
+  wire [34:0] rs_s11_p;
+  wire [34:0] shl_rs_s11_p;
+  reg [29:0] lo_d10 = 30'h00000000;
+  wire [0:0] bits_lo_d10;
+  wire [34:0] rs_bits_lo_d10;
+  wire [34:0] or_13;
+  wire [0:0] ge10;
+  wire [34:0] or_13_minus_rs_s1_b_d10;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div10_pn;
+  wire [34:0] mux_ge10;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div10_rem;
-  wire [29:0] div10_q2;
-  wire [29:0] div10_gew;
-  wire [29:0] div10_qn;
-  reg [33:0] div12_p = 34'h000000000;
-  reg [29:0] div12_q = 30'h00000000;
-  reg [33:0] div12_b = 34'h000000000;
-  wire [34:0] div12_bw;
-  reg [29:0] div12_lo = 30'h00000000;
-  reg [0:0] div12_err = 1'h0;
-  wire [0:0] div11_in;
-  wire [34:0] div11_pw;
-  wire [34:0] div11_p2;
-  wire [34:0] div11_bw_1;
-  wire [34:0] div11_p3;
-  wire [0:0] div11_ge;
-  wire [34:0] div11_diff;
+  wire [33:0] rs_mux_ge10;
+  wire [29:0] shl_s11_q;
+  wire [29:0] rs_ge10;
+  wire [29:0] shl_s11_q_or_rs_ge10;
+  reg [33:0] s12_p = 34'h000000000;
+  reg [29:0] s12_q = 30'h00000000;
+
+  // stage s13_q11: one quotient bit
+  reg [33:0] s1_b_d11 = 34'h000000000;
+  wire [34:0] rs_s1_b_d11;
+  wire [34:0] rs_s12_p;
+  wire [34:0] shl_rs_s12_p;
+  reg [29:0] lo_d11 = 30'h00000000;
+  wire [0:0] bits_lo_d11;
+  wire [34:0] rs_bits_lo_d11;
+  wire [34:0] or_14;
+  wire [0:0] ge11;
+  wire [34:0] or_14_minus_rs_s1_b_d11;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div11_pn;
+  wire [34:0] mux_ge11;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div11_rem;
-  wire [29:0] div11_q2;
-  wire [29:0] div11_gew;
-  wire [29:0] div11_qn;
-  reg [33:0] div13_p = 34'h000000000;
-  reg [29:0] div13_q = 30'h00000000;
-  reg [33:0] div13_b = 34'h000000000;
-  wire [34:0] div13_bw;
-  reg [29:0] div13_lo = 30'h00000000;
-  reg [0:0] div13_err = 1'h0;
-  wire [0:0] div12_in;
-  wire [34:0] div12_pw;
-  wire [34:0] div12_p2;
-  wire [34:0] div12_bw_1;
-  wire [34:0] div12_p3;
-  wire [0:0] div12_ge;
-  wire [34:0] div12_diff;
+  wire [33:0] rs_mux_ge11;
+  wire [29:0] shl_s12_q;
+  wire [29:0] rs_ge11;
+  wire [29:0] shl_s12_q_or_rs_ge11;
+  reg [33:0] s13_p = 34'h000000000;
+  reg [29:0] s13_q = 30'h00000000;
+
+  // stage s14_q12: one quotient bit
+  reg [33:0] s1_b_d12 = 34'h000000000;
+  wire [34:0] rs_s1_b_d12;
+  wire [34:0] rs_s13_p;
+  wire [34:0] shl_rs_s13_p;
+  reg [29:0] lo_d12 = 30'h00000000;
+  wire [0:0] bits_lo_d12;
+  wire [34:0] rs_bits_lo_d12;
+  wire [34:0] or_15;
+  wire [0:0] ge12;
+  wire [34:0] or_15_minus_rs_s1_b_d12;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div12_pn;
+  wire [34:0] mux_ge12;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div12_rem;
-  wire [29:0] div12_q2;
-  wire [29:0] div12_gew;
-  wire [29:0] div12_qn;
-  reg [33:0] div14_p = 34'h000000000;
-  reg [29:0] div14_q = 30'h00000000;
-  reg [33:0] div14_b = 34'h000000000;
-  wire [34:0] div14_bw;
-  reg [29:0] div14_lo = 30'h00000000;
-  reg [0:0] div14_err = 1'h0;
-  wire [0:0] div13_in;
-  wire [34:0] div13_pw;
-  wire [34:0] div13_p2;
-  wire [34:0] div13_bw_1;
-  wire [34:0] div13_p3;
-  wire [0:0] div13_ge;
-  wire [34:0] div13_diff;
+  wire [33:0] rs_mux_ge12;
+  wire [29:0] shl_s13_q;
+  wire [29:0] rs_ge12;
+  wire [29:0] shl_s13_q_or_rs_ge12;
+  reg [33:0] s14_p = 34'h000000000;
+  reg [29:0] s14_q = 30'h00000000;
+
+  // stage s15_q13: one quotient bit
+  reg [33:0] s1_b_d13 = 34'h000000000;
+  wire [34:0] rs_s1_b_d13;
+  wire [34:0] rs_s14_p;
+  wire [34:0] shl_rs_s14_p;
+  reg [29:0] lo_d13 = 30'h00000000;
+  wire [0:0] bits_lo_d13;
+  wire [34:0] rs_bits_lo_d13;
+  wire [34:0] or_16;
+  wire [0:0] ge13;
+  wire [34:0] or_16_minus_rs_s1_b_d13;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div13_pn;
+  wire [34:0] mux_ge13;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div13_rem;
-  wire [29:0] div13_q2;
-  wire [29:0] div13_gew;
-  wire [29:0] div13_qn;
-  reg [33:0] div15_p = 34'h000000000;
-  reg [29:0] div15_q = 30'h00000000;
-  reg [33:0] div15_b = 34'h000000000;
-  wire [34:0] div15_bw;
-  reg [29:0] div15_lo = 30'h00000000;
-  reg [0:0] div15_err = 1'h0;
-  wire [0:0] div14_in;
-  wire [34:0] div14_pw;
-  wire [34:0] div14_p2;
-  wire [34:0] div14_bw_1;
-  wire [34:0] div14_p3;
-  wire [0:0] div14_ge;
-  wire [34:0] div14_diff;
+  wire [33:0] rs_mux_ge13;
+  wire [29:0] shl_s14_q;
+  wire [29:0] rs_ge13;
+  wire [29:0] shl_s14_q_or_rs_ge13;
+  reg [33:0] s15_p = 34'h000000000;
+  reg [29:0] s15_q = 30'h00000000;
+
+  // stage s16_q14: one quotient bit
+  reg [33:0] s1_b_d14 = 34'h000000000;
+  wire [34:0] rs_s1_b_d14;
+  wire [34:0] rs_s15_p;
+  wire [34:0] shl_rs_s15_p;
+  reg [29:0] lo_d14 = 30'h00000000;
+  wire [0:0] bits_lo_d14;
+  wire [34:0] rs_bits_lo_d14;
+  wire [34:0] or_17;
+  wire [0:0] ge14;
+  wire [34:0] or_17_minus_rs_s1_b_d14;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div14_pn;
+  wire [34:0] mux_ge14;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div14_rem;
-  wire [29:0] div14_q2;
-  wire [29:0] div14_gew;
-  wire [29:0] div14_qn;
-  reg [33:0] div16_p = 34'h000000000;
-  reg [29:0] div16_q = 30'h00000000;
-  reg [33:0] div16_b = 34'h000000000;
-  wire [34:0] div16_bw;
-  reg [29:0] div16_lo = 30'h00000000;
-  reg [0:0] div16_err = 1'h0;
-  wire [0:0] div15_in;
-  wire [34:0] div15_pw;
-  wire [34:0] div15_p2;
-  wire [34:0] div15_bw_1;
-  wire [34:0] div15_p3;
-  wire [0:0] div15_ge;
-  wire [34:0] div15_diff;
+  wire [33:0] rs_mux_ge14;
+  wire [29:0] shl_s15_q;
+  wire [29:0] rs_ge14;
+  wire [29:0] shl_s15_q_or_rs_ge14;
+  reg [33:0] s16_p = 34'h000000000;
+  reg [29:0] s16_q = 30'h00000000;
+
+  // stage s17_q15: one quotient bit
+  reg [33:0] s1_b_d15 = 34'h000000000;
+  wire [34:0] rs_s1_b_d15;
+  wire [34:0] rs_s16_p;
+  wire [34:0] shl_rs_s16_p;
+  reg [29:0] lo_d15 = 30'h00000000;
+  wire [0:0] bits_lo_d15;
+  wire [34:0] rs_bits_lo_d15;
+  wire [34:0] or_18;
+  wire [0:0] ge15;
+  wire [34:0] or_18_minus_rs_s1_b_d15;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div15_pn;
+  wire [34:0] mux_ge15;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div15_rem;
-  wire [29:0] div15_q2;
-  wire [29:0] div15_gew;
-  wire [29:0] div15_qn;
-  reg [33:0] div17_p = 34'h000000000;
-  reg [29:0] div17_q = 30'h00000000;
-  reg [33:0] div17_b = 34'h000000000;
-  wire [34:0] div17_bw;
-  reg [29:0] div17_lo = 30'h00000000;
-  reg [0:0] div17_err = 1'h0;
-  wire [0:0] div16_in;
-  wire [34:0] div16_pw;
-  wire [34:0] div16_p2;
-  wire [34:0] div16_bw_1;
-  wire [34:0] div16_p3;
-  wire [0:0] div16_ge;
-  wire [34:0] div16_diff;
+  wire [33:0] rs_mux_ge15;
+  wire [29:0] shl_s16_q;
+  wire [29:0] rs_ge15;
+  wire [29:0] shl_s16_q_or_rs_ge15;
+  reg [33:0] s17_p = 34'h000000000;
+  reg [29:0] s17_q = 30'h00000000;
+
+  // stage s18_q16: one quotient bit
+  reg [33:0] s1_b_d16 = 34'h000000000;
+  wire [34:0] rs_s1_b_d16;
+  wire [34:0] rs_s17_p;
+  wire [34:0] shl_rs_s17_p;
+  reg [29:0] lo_d16 = 30'h00000000;
+  wire [0:0] bits_lo_d16;
+  wire [34:0] rs_bits_lo_d16;
+  wire [34:0] or_19;
+  wire [0:0] ge16;
+  wire [34:0] or_19_minus_rs_s1_b_d16;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div16_pn;
+  wire [34:0] mux_ge16;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div16_rem;
-  wire [29:0] div16_q2;
-  wire [29:0] div16_gew;
-  wire [29:0] div16_qn;
-  reg [33:0] div18_p = 34'h000000000;
-  reg [29:0] div18_q = 30'h00000000;
-  reg [33:0] div18_b = 34'h000000000;
-  wire [34:0] div18_bw;
-  reg [29:0] div18_lo = 30'h00000000;
-  reg [0:0] div18_err = 1'h0;
-  wire [0:0] div17_in;
-  wire [34:0] div17_pw;
-  wire [34:0] div17_p2;
-  wire [34:0] div17_bw_1;
-  wire [34:0] div17_p3;
-  wire [0:0] div17_ge;
-  wire [34:0] div17_diff;
+  wire [33:0] rs_mux_ge16;
+  wire [29:0] shl_s17_q;
+  wire [29:0] rs_ge16;
+  wire [29:0] shl_s17_q_or_rs_ge16;
+  reg [33:0] s18_p = 34'h000000000;
+  reg [29:0] s18_q = 30'h00000000;
+
+  // stage s19_q17: one quotient bit
+  reg [33:0] s1_b_d17 = 34'h000000000;
+  wire [34:0] rs_s1_b_d17;
+  wire [34:0] rs_s18_p;
+  wire [34:0] shl_rs_s18_p;
+  reg [29:0] lo_d17 = 30'h00000000;
+  wire [0:0] bits_lo_d17;
+  wire [34:0] rs_bits_lo_d17;
+  wire [34:0] or_20;
+  wire [0:0] ge17;
+  wire [34:0] or_20_minus_rs_s1_b_d17;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div17_pn;
+  wire [34:0] mux_ge17;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div17_rem;
-  wire [29:0] div17_q2;
-  wire [29:0] div17_gew;
-  wire [29:0] div17_qn;
-  reg [33:0] div19_p = 34'h000000000;
-  reg [29:0] div19_q = 30'h00000000;
-  reg [33:0] div19_b = 34'h000000000;
-  wire [34:0] div19_bw;
-  reg [29:0] div19_lo = 30'h00000000;
-  reg [0:0] div19_err = 1'h0;
-  wire [0:0] div18_in;
-  wire [34:0] div18_pw;
-  wire [34:0] div18_p2;
-  wire [34:0] div18_bw_1;
-  wire [34:0] div18_p3;
-  wire [0:0] div18_ge;
-  wire [34:0] div18_diff;
+  wire [33:0] rs_mux_ge17;
+  wire [29:0] shl_s18_q;
+  wire [29:0] rs_ge17;
+  wire [29:0] shl_s18_q_or_rs_ge17;
+  reg [33:0] s19_p = 34'h000000000;
+  reg [29:0] s19_q = 30'h00000000;
+
+  // stage s20_q18: one quotient bit
+  reg [33:0] s1_b_d18 = 34'h000000000;
+  wire [34:0] rs_s1_b_d18;
+  wire [34:0] rs_s19_p;
+  wire [34:0] shl_rs_s19_p;
+  reg [29:0] lo_d18 = 30'h00000000;
+  wire [0:0] bits_lo_d18;
+  wire [34:0] rs_bits_lo_d18;
+  wire [34:0] or_21;
+  wire [0:0] ge18;
+  wire [34:0] or_21_minus_rs_s1_b_d18;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div18_pn;
+  wire [34:0] mux_ge18;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div18_rem;
-  wire [29:0] div18_q2;
-  wire [29:0] div18_gew;
-  wire [29:0] div18_qn;
-  reg [33:0] div20_p = 34'h000000000;
-  reg [29:0] div20_q = 30'h00000000;
-  reg [33:0] div20_b = 34'h000000000;
-  wire [34:0] div20_bw;
-  reg [29:0] div20_lo = 30'h00000000;
-  reg [0:0] div20_err = 1'h0;
-  wire [0:0] div19_in;
-  wire [34:0] div19_pw;
-  wire [34:0] div19_p2;
-  wire [34:0] div19_bw_1;
-  wire [34:0] div19_p3;
-  wire [0:0] div19_ge;
-  wire [34:0] div19_diff;
+  wire [33:0] rs_mux_ge18;
+  wire [29:0] shl_s19_q;
+  wire [29:0] rs_ge18;
+  wire [29:0] shl_s19_q_or_rs_ge18;
+  reg [33:0] s20_p = 34'h000000000;
+  reg [29:0] s20_q = 30'h00000000;
+
+  // stage s21_q19: one quotient bit
+  reg [33:0] s1_b_d19 = 34'h000000000;
+  wire [34:0] rs_s1_b_d19;
+  wire [34:0] rs_s20_p;
+  wire [34:0] shl_rs_s20_p;
+  reg [29:0] lo_d19 = 30'h00000000;
+  wire [0:0] bits_lo_d19;
+  wire [34:0] rs_bits_lo_d19;
+  wire [34:0] or_22;
+  wire [0:0] ge19;
+  wire [34:0] or_22_minus_rs_s1_b_d19;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div19_pn;
+  wire [34:0] mux_ge19;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div19_rem;
-  wire [29:0] div19_q2;
-  wire [29:0] div19_gew;
-  wire [29:0] div19_qn;
-  reg [33:0] div21_p = 34'h000000000;
-  reg [29:0] div21_q = 30'h00000000;
-  reg [33:0] div21_b = 34'h000000000;
-  wire [34:0] div21_bw;
-  reg [29:0] div21_lo = 30'h00000000;
-  reg [0:0] div21_err = 1'h0;
-  wire [0:0] div20_in;
-  wire [34:0] div20_pw;
-  wire [34:0] div20_p2;
-  wire [34:0] div20_bw_1;
-  wire [34:0] div20_p3;
-  wire [0:0] div20_ge;
-  wire [34:0] div20_diff;
+  wire [33:0] rs_mux_ge19;
+  wire [29:0] shl_s20_q;
+  wire [29:0] rs_ge19;
+  wire [29:0] shl_s20_q_or_rs_ge19;
+  reg [33:0] s21_p = 34'h000000000;
+  reg [29:0] s21_q = 30'h00000000;
+
+  // stage s22_q20: one quotient bit
+  reg [33:0] s1_b_d20 = 34'h000000000;
+  wire [34:0] rs_s1_b_d20;
+  wire [34:0] rs_s21_p;
+  wire [34:0] shl_rs_s21_p;
+  reg [29:0] lo_d20 = 30'h00000000;
+  wire [0:0] bits_lo_d20;
+  wire [34:0] rs_bits_lo_d20;
+  wire [34:0] or_23;
+  wire [0:0] ge20;
+  wire [34:0] or_23_minus_rs_s1_b_d20;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div20_pn;
+  wire [34:0] mux_ge20;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div20_rem;
-  wire [29:0] div20_q2;
-  wire [29:0] div20_gew;
-  wire [29:0] div20_qn;
-  reg [33:0] div22_p = 34'h000000000;
-  reg [29:0] div22_q = 30'h00000000;
-  reg [33:0] div22_b = 34'h000000000;
-  wire [34:0] div22_bw;
-  reg [29:0] div22_lo = 30'h00000000;
-  reg [0:0] div22_err = 1'h0;
-  wire [0:0] div21_in;
-  wire [34:0] div21_pw;
-  wire [34:0] div21_p2;
-  wire [34:0] div21_bw_1;
-  wire [34:0] div21_p3;
-  wire [0:0] div21_ge;
-  wire [34:0] div21_diff;
+  wire [33:0] rs_mux_ge20;
+  wire [29:0] shl_s21_q;
+  wire [29:0] rs_ge20;
+  wire [29:0] shl_s21_q_or_rs_ge20;
+  reg [33:0] s22_p = 34'h000000000;
+  reg [29:0] s22_q = 30'h00000000;
+
+  // stage s23_q21: one quotient bit
+  reg [33:0] s1_b_d21 = 34'h000000000;
+  wire [34:0] rs_s1_b_d21;
+  wire [34:0] rs_s22_p;
+  wire [34:0] shl_rs_s22_p;
+  reg [29:0] lo_d21 = 30'h00000000;
+  wire [0:0] bits_lo_d21;
+  wire [34:0] rs_bits_lo_d21;
+  wire [34:0] or_24;
+  wire [0:0] ge21;
+  wire [34:0] or_24_minus_rs_s1_b_d21;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div21_pn;
+  wire [34:0] mux_ge21;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div21_rem;
-  wire [29:0] div21_q2;
-  wire [29:0] div21_gew;
-  wire [29:0] div21_qn;
-  reg [33:0] div23_p = 34'h000000000;
-  reg [29:0] div23_q = 30'h00000000;
-  reg [33:0] div23_b = 34'h000000000;
-  wire [34:0] div23_bw;
-  reg [29:0] div23_lo = 30'h00000000;
-  reg [0:0] div23_err = 1'h0;
-  wire [0:0] div22_in;
-  wire [34:0] div22_pw;
-  wire [34:0] div22_p2;
-  wire [34:0] div22_bw_1;
-  wire [34:0] div22_p3;
-  wire [0:0] div22_ge;
-  wire [34:0] div22_diff;
+  wire [33:0] rs_mux_ge21;
+  wire [29:0] shl_s22_q;
+  wire [29:0] rs_ge21;
+  wire [29:0] shl_s22_q_or_rs_ge21;
+  reg [33:0] s23_p = 34'h000000000;
+  reg [29:0] s23_q = 30'h00000000;
+
+  // stage s24_q22: one quotient bit
+  reg [33:0] s1_b_d22 = 34'h000000000;
+  wire [34:0] rs_s1_b_d22;
+  wire [34:0] rs_s23_p;
+  wire [34:0] shl_rs_s23_p;
+  reg [29:0] lo_d22 = 30'h00000000;
+  wire [0:0] bits_lo_d22;
+  wire [34:0] rs_bits_lo_d22;
+  wire [34:0] or_25;
+  wire [0:0] ge22;
+  wire [34:0] or_25_minus_rs_s1_b_d22;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div22_pn;
+  wire [34:0] mux_ge22;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div22_rem;
-  wire [29:0] div22_q2;
-  wire [29:0] div22_gew;
-  wire [29:0] div22_qn;
-  reg [33:0] div24_p = 34'h000000000;
-  reg [29:0] div24_q = 30'h00000000;
-  reg [33:0] div24_b = 34'h000000000;
-  wire [34:0] div24_bw;
-  reg [29:0] div24_lo = 30'h00000000;
-  reg [0:0] div24_err = 1'h0;
-  wire [0:0] div23_in;
-  wire [34:0] div23_pw;
-  wire [34:0] div23_p2;
-  wire [34:0] div23_bw_1;
-  wire [34:0] div23_p3;
-  wire [0:0] div23_ge;
-  wire [34:0] div23_diff;
+  wire [33:0] rs_mux_ge22;
+  wire [29:0] shl_s23_q;
+  wire [29:0] rs_ge22;
+  wire [29:0] shl_s23_q_or_rs_ge22;
+  reg [33:0] s24_p = 34'h000000000;
+  reg [29:0] s24_q = 30'h00000000;
+
+  // stage s25_q23: one quotient bit
+  reg [33:0] s1_b_d23 = 34'h000000000;
+  wire [34:0] rs_s1_b_d23;
+  wire [34:0] rs_s24_p;
+  wire [34:0] shl_rs_s24_p;
+  reg [29:0] lo_d23 = 30'h00000000;
+  wire [0:0] bits_lo_d23;
+  wire [34:0] rs_bits_lo_d23;
+  wire [34:0] or_26;
+  wire [0:0] ge23;
+  wire [34:0] or_26_minus_rs_s1_b_d23;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div23_pn;
+  wire [34:0] mux_ge23;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div23_rem;
-  wire [29:0] div23_q2;
-  wire [29:0] div23_gew;
-  wire [29:0] div23_qn;
-  reg [33:0] div25_p = 34'h000000000;
-  reg [29:0] div25_q = 30'h00000000;
-  reg [33:0] div25_b = 34'h000000000;
-  wire [34:0] div25_bw;
-  reg [29:0] div25_lo = 30'h00000000;
-  reg [0:0] div25_err = 1'h0;
-  wire [0:0] div24_in;
-  wire [34:0] div24_pw;
-  wire [34:0] div24_p2;
-  wire [34:0] div24_bw_1;
-  wire [34:0] div24_p3;
-  wire [0:0] div24_ge;
-  wire [34:0] div24_diff;
+  wire [33:0] rs_mux_ge23;
+  wire [29:0] shl_s24_q;
+  wire [29:0] rs_ge23;
+  wire [29:0] shl_s24_q_or_rs_ge23;
+  reg [33:0] s25_p = 34'h000000000;
+  reg [29:0] s25_q = 30'h00000000;
+
+  // stage s26_q24: one quotient bit
+  reg [33:0] s1_b_d24 = 34'h000000000;
+  wire [34:0] rs_s1_b_d24;
+  wire [34:0] rs_s25_p;
+  wire [34:0] shl_rs_s25_p;
+  reg [29:0] lo_d24 = 30'h00000000;
+  wire [0:0] bits_lo_d24;
+  wire [34:0] rs_bits_lo_d24;
+  wire [34:0] or_27;
+  wire [0:0] ge24;
+  wire [34:0] or_27_minus_rs_s1_b_d24;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div24_pn;
+  wire [34:0] mux_ge24;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div24_rem;
-  wire [29:0] div24_q2;
-  wire [29:0] div24_gew;
-  wire [29:0] div24_qn;
-  reg [33:0] div26_p = 34'h000000000;
-  reg [29:0] div26_q = 30'h00000000;
-  reg [33:0] div26_b = 34'h000000000;
-  wire [34:0] div26_bw;
-  reg [29:0] div26_lo = 30'h00000000;
-  reg [0:0] div26_err = 1'h0;
-  wire [0:0] div25_in;
-  wire [34:0] div25_pw;
-  wire [34:0] div25_p2;
-  wire [34:0] div25_bw_1;
-  wire [34:0] div25_p3;
-  wire [0:0] div25_ge;
-  wire [34:0] div25_diff;
+  wire [33:0] rs_mux_ge24;
+  wire [29:0] shl_s25_q;
+  wire [29:0] rs_ge24;
+  wire [29:0] shl_s25_q_or_rs_ge24;
+  reg [33:0] s26_p = 34'h000000000;
+  reg [29:0] s26_q = 30'h00000000;
+
+  // stage s27_q25: one quotient bit
+  reg [33:0] s1_b_d25 = 34'h000000000;
+  wire [34:0] rs_s1_b_d25;
+  wire [34:0] rs_s26_p;
+  wire [34:0] shl_rs_s26_p;
+  reg [29:0] lo_d25 = 30'h00000000;
+  wire [0:0] bits_lo_d25;
+  wire [34:0] rs_bits_lo_d25;
+  wire [34:0] or_28;
+  wire [0:0] ge25;
+  wire [34:0] or_28_minus_rs_s1_b_d25;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div25_pn;
+  wire [34:0] mux_ge25;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div25_rem;
-  wire [29:0] div25_q2;
-  wire [29:0] div25_gew;
-  wire [29:0] div25_qn;
-  reg [33:0] div27_p = 34'h000000000;
-  reg [29:0] div27_q = 30'h00000000;
-  reg [33:0] div27_b = 34'h000000000;
-  wire [34:0] div27_bw;
-  reg [29:0] div27_lo = 30'h00000000;
-  reg [0:0] div27_err = 1'h0;
-  wire [0:0] div26_in;
-  wire [34:0] div26_pw;
-  wire [34:0] div26_p2;
-  wire [34:0] div26_bw_1;
-  wire [34:0] div26_p3;
-  wire [0:0] div26_ge;
-  wire [34:0] div26_diff;
+  wire [33:0] rs_mux_ge25;
+  wire [29:0] shl_s26_q;
+  wire [29:0] rs_ge25;
+  wire [29:0] shl_s26_q_or_rs_ge25;
+  reg [33:0] s27_p = 34'h000000000;
+  reg [29:0] s27_q = 30'h00000000;
+
+  // stage s28_q26: one quotient bit
+  reg [33:0] s1_b_d26 = 34'h000000000;
+  wire [34:0] rs_s1_b_d26;
+  wire [34:0] rs_s27_p;
+  wire [34:0] shl_rs_s27_p;
+  reg [29:0] lo_d26 = 30'h00000000;
+  wire [0:0] bits_lo_d26;
+  wire [34:0] rs_bits_lo_d26;
+  wire [34:0] or_29;
+  wire [0:0] ge26;
+  wire [34:0] or_29_minus_rs_s1_b_d26;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div26_pn;
+  wire [34:0] mux_ge26;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div26_rem;
-  wire [29:0] div26_q2;
-  wire [29:0] div26_gew;
-  wire [29:0] div26_qn;
-  reg [33:0] div28_p = 34'h000000000;
-  reg [29:0] div28_q = 30'h00000000;
-  reg [33:0] div28_b = 34'h000000000;
-  wire [34:0] div28_bw;
-  reg [29:0] div28_lo = 30'h00000000;
-  reg [0:0] div28_err = 1'h0;
-  wire [0:0] div27_in;
-  wire [34:0] div27_pw;
-  wire [34:0] div27_p2;
-  wire [34:0] div27_bw_1;
-  wire [34:0] div27_p3;
-  wire [0:0] div27_ge;
-  wire [34:0] div27_diff;
+  wire [33:0] rs_mux_ge26;
+  wire [29:0] shl_s27_q;
+  wire [29:0] rs_ge26;
+  wire [29:0] shl_s27_q_or_rs_ge26;
+  reg [33:0] s28_p = 34'h000000000;
+  reg [29:0] s28_q = 30'h00000000;
+
+  // stage s29_q27: one quotient bit
+  reg [33:0] s1_b_d27 = 34'h000000000;
+  wire [34:0] rs_s1_b_d27;
+  wire [34:0] rs_s28_p;
+  wire [34:0] shl_rs_s28_p;
+  reg [29:0] lo_d27 = 30'h00000000;
+  wire [0:0] bits_lo_d27;
+  wire [34:0] rs_bits_lo_d27;
+  wire [34:0] or_30;
+  wire [0:0] ge27;
+  wire [34:0] or_30_minus_rs_s1_b_d27;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div27_pn;
+  wire [34:0] mux_ge27;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div27_rem;
-  wire [29:0] div27_q2;
-  wire [29:0] div27_gew;
-  wire [29:0] div27_qn;
-  reg [33:0] div29_p = 34'h000000000;
-  reg [29:0] div29_q = 30'h00000000;
-  reg [33:0] div29_b = 34'h000000000;
-  wire [34:0] div29_bw;
-  reg [29:0] div29_lo = 30'h00000000;
-  reg [0:0] div29_err = 1'h0;
-  wire [0:0] div28_in;
-  wire [34:0] div28_pw;
-  wire [34:0] div28_p2;
-  wire [34:0] div28_bw_1;
-  wire [34:0] div28_p3;
-  wire [0:0] div28_ge;
-  wire [34:0] div28_diff;
+  wire [33:0] rs_mux_ge27;
+  wire [29:0] shl_s28_q;
+  wire [29:0] rs_ge27;
+  wire [29:0] shl_s28_q_or_rs_ge27;
+  reg [33:0] s29_p = 34'h000000000;
+  reg [29:0] s29_q = 30'h00000000;
+
+  // stage s30_q28: one quotient bit
+  reg [33:0] s1_b_d28 = 34'h000000000;
+  wire [34:0] rs_s1_b_d28;
+  wire [34:0] rs_s29_p;
+  wire [34:0] shl_rs_s29_p;
+  reg [29:0] lo_d28 = 30'h00000000;
+  wire [0:0] bits_lo_d28;
+  wire [34:0] rs_bits_lo_d28;
+  wire [34:0] or_31;
+  wire [0:0] ge28;
+  wire [34:0] or_31_minus_rs_s1_b_d28;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div28_pn;
+  wire [34:0] mux_ge28;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] div28_rem;
-  wire [29:0] div28_q2;
-  wire [29:0] div28_gew;
-  wire [29:0] div28_qn;
-  reg [33:0] div30_p = 34'h000000000;
-  reg [29:0] div30_q = 30'h00000000;
-  reg [33:0] div30_b = 34'h000000000;
-  wire [34:0] div30_bw;
+  wire [33:0] rs_mux_ge28;
+  wire [29:0] shl_s29_q;
+  wire [29:0] rs_ge28;
+  wire [29:0] shl_s29_q_or_rs_ge28;
+  reg [33:0] s30_p = 34'h000000000;
+  reg [29:0] s30_q = 30'h00000000;
+
+  // stage s31_result: the quotient and its result flag
+  reg [33:0] s1_b_d29 = 34'h000000000;
+  wire [34:0] rs_s1_b_d29;
+  wire [34:0] rs_s30_p;
+  wire [34:0] shl_rs_s30_p;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 0 are read
-  reg [29:0] div30_lo = 30'h00000000;
+  reg [29:0] lo_d29 = 30'h00000000;
   /* verilator lint_on UNUSEDSIGNAL */
-  reg [0:0] div30_err = 1'h0;
-  wire [0:0] div29_in;
-  wire [34:0] div29_pw;
-  wire [34:0] div29_p2;
-  wire [34:0] div29_bw_1;
-  wire [34:0] div29_p3;
-  wire [0:0] div29_ge;
-  wire [34:0] div29_diff;
+  wire [0:0] bits_lo_d29;
+  wire [34:0] rs_bits_lo_d29;
+  wire [34:0] or_32;
+  wire [0:0] ge29;
+  wire [34:0] or_32_minus_rs_s1_b_d29;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] div29_pn;
+  wire [34:0] mux_ge29;
   /* verilator lint_on UNUSEDSIGNAL */
   /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [33:0] div29_rem;
+  wire [33:0] rs_mux_ge29;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] div29_q2;
-  wire [29:0] div29_gew;
-  wire [29:0] div29_qn;
-  wire [29:0] div_zero_q = 30'h00000000;
-  wire [0:0] div_q_zero;
-  wire [0:0] div_bad;
-  wire [0:0] div_one = 1'h1;
-  wire [0:0] div_ok_c;
-  reg [29:0] div_t = 30'h00000000;
-  reg [0:0] div_ok = 1'h0;
+  wire [29:0] shl_s30_q;
+  wire [29:0] rs_ge29;
+  wire [29:0] shl_s30_q_or_rs_ge29;
+  (* mem2reg *) reg [0:0] err_1_d29_sr [1:29];
+  integer err_1_d29_i;
+  initial for (err_1_d29_i = 1; err_1_d29_i <= 29; err_1_d29_i = err_1_d29_i + 1) err_1_d29_sr[err_1_d29_i] = 1'h0;
+  wire [0:0] err_1_d29;
+  wire [0:0] eq_33;
+  wire [0:0] err_1_d29_or_eq_33;
+  wire [0:0] not_err_1_d29_or_eq_33;
+  reg [29:0] s31_t = 30'h00000000;
+  reg [0:0] s31_ok = 1'h0;
 
-  assign div_num_neg = num < div_zero_n;
-  assign div_den_neg = den < div_zero_d;
-  assign div_num_zero = num == div_zero_n;
-  assign div_den_zero = den == div_zero_d;
-  assign div_sign_diff = div_num_neg ^ div_den_neg;
-  assign div_err_a = div_num_zero | div_den_zero;
-  assign div_err_b = div_err_a | div_sign_diff;
-  assign div_num_negated = -num;
-  assign div_num_abs_s = div_num_neg ? div_num_negated : num;
-  assign div_a = $unsigned(div_num_abs_s);
-  assign div_den_negated = -den;
-  assign div_den_abs_s = div_den_neg ? div_den_negated : den;
-  assign div_b = $unsigned(div_den_abs_s);
-  assign div_hi = div1_a[62:30];
-  assign div_lo = div1_a[29:0];
-  assign div_hi_c = {{1{1'b0}}, div_hi};
-  assign div_overflow = div1_b <= div_hi_c;
-  assign div_err_c = div1_err | div_overflow;
-  assign div_p0 = {{1{1'b0}}, div_hi};
-  assign div_b_w = {{1{1'b0}}, div1_b};
-  assign div0_in = div_lo[29];
-  assign div0_pw = {{1{1'b0}}, div_p0};
-  assign div0_p2 = div0_pw <<< 1;
-  assign div0_bw = {{34{1'b0}}, div0_in};
-  assign div0_p3 = div0_p2 | div0_bw;
-  assign div0_ge = div_b_w <= div0_p3;
-  assign div0_diff = div0_p3 - div_b_w;
-  assign div0_pn = div0_ge ? div0_diff : div0_p3;
-  assign div0_rem = div0_pn[33:0];
-  assign div0_q2 = div_q0 <<< 1;
-  assign div0_gew = {{29{1'b0}}, div0_ge};
-  assign div0_qn = div0_q2 | div0_gew;
-  assign div2_bw = {{1{1'b0}}, div2_b};
-  assign div1_in = div2_lo[28];
-  assign div1_pw = {{1{1'b0}}, div2_p};
-  assign div1_p2 = div1_pw <<< 1;
-  assign div1_bw = {{34{1'b0}}, div1_in};
-  assign div1_p3 = div1_p2 | div1_bw;
-  assign div1_ge = div2_bw <= div1_p3;
-  assign div1_diff = div1_p3 - div2_bw;
-  assign div1_pn = div1_ge ? div1_diff : div1_p3;
-  assign div1_rem = div1_pn[33:0];
-  assign div1_q2 = div2_q <<< 1;
-  assign div1_gew = {{29{1'b0}}, div1_ge};
-  assign div1_qn = div1_q2 | div1_gew;
-  assign div3_bw = {{1{1'b0}}, div3_b};
-  assign div2_in = div3_lo[27];
-  assign div2_pw = {{1{1'b0}}, div3_p};
-  assign div2_p2 = div2_pw <<< 1;
-  assign div2_bw_1 = {{34{1'b0}}, div2_in};
-  assign div2_p3 = div2_p2 | div2_bw_1;
-  assign div2_ge = div3_bw <= div2_p3;
-  assign div2_diff = div2_p3 - div3_bw;
-  assign div2_pn = div2_ge ? div2_diff : div2_p3;
-  assign div2_rem = div2_pn[33:0];
-  assign div2_q2 = div3_q <<< 1;
-  assign div2_gew = {{29{1'b0}}, div2_ge};
-  assign div2_qn = div2_q2 | div2_gew;
-  assign div4_bw = {{1{1'b0}}, div4_b};
-  assign div3_in = div4_lo[26];
-  assign div3_pw = {{1{1'b0}}, div4_p};
-  assign div3_p2 = div3_pw <<< 1;
-  assign div3_bw_1 = {{34{1'b0}}, div3_in};
-  assign div3_p3 = div3_p2 | div3_bw_1;
-  assign div3_ge = div4_bw <= div3_p3;
-  assign div3_diff = div3_p3 - div4_bw;
-  assign div3_pn = div3_ge ? div3_diff : div3_p3;
-  assign div3_rem = div3_pn[33:0];
-  assign div3_q2 = div4_q <<< 1;
-  assign div3_gew = {{29{1'b0}}, div3_ge};
-  assign div3_qn = div3_q2 | div3_gew;
-  assign div5_bw = {{1{1'b0}}, div5_b};
-  assign div4_in = div5_lo[25];
-  assign div4_pw = {{1{1'b0}}, div5_p};
-  assign div4_p2 = div4_pw <<< 1;
-  assign div4_bw_1 = {{34{1'b0}}, div4_in};
-  assign div4_p3 = div4_p2 | div4_bw_1;
-  assign div4_ge = div5_bw <= div4_p3;
-  assign div4_diff = div4_p3 - div5_bw;
-  assign div4_pn = div4_ge ? div4_diff : div4_p3;
-  assign div4_rem = div4_pn[33:0];
-  assign div4_q2 = div5_q <<< 1;
-  assign div4_gew = {{29{1'b0}}, div4_ge};
-  assign div4_qn = div4_q2 | div4_gew;
-  assign div6_bw = {{1{1'b0}}, div6_b};
-  assign div5_in = div6_lo[24];
-  assign div5_pw = {{1{1'b0}}, div6_p};
-  assign div5_p2 = div5_pw <<< 1;
-  assign div5_bw_1 = {{34{1'b0}}, div5_in};
-  assign div5_p3 = div5_p2 | div5_bw_1;
-  assign div5_ge = div6_bw <= div5_p3;
-  assign div5_diff = div5_p3 - div6_bw;
-  assign div5_pn = div5_ge ? div5_diff : div5_p3;
-  assign div5_rem = div5_pn[33:0];
-  assign div5_q2 = div6_q <<< 1;
-  assign div5_gew = {{29{1'b0}}, div5_ge};
-  assign div5_qn = div5_q2 | div5_gew;
-  assign div7_bw = {{1{1'b0}}, div7_b};
-  assign div6_in = div7_lo[23];
-  assign div6_pw = {{1{1'b0}}, div7_p};
-  assign div6_p2 = div6_pw <<< 1;
-  assign div6_bw_1 = {{34{1'b0}}, div6_in};
-  assign div6_p3 = div6_p2 | div6_bw_1;
-  assign div6_ge = div7_bw <= div6_p3;
-  assign div6_diff = div6_p3 - div7_bw;
-  assign div6_pn = div6_ge ? div6_diff : div6_p3;
-  assign div6_rem = div6_pn[33:0];
-  assign div6_q2 = div7_q <<< 1;
-  assign div6_gew = {{29{1'b0}}, div6_ge};
-  assign div6_qn = div6_q2 | div6_gew;
-  assign div8_bw = {{1{1'b0}}, div8_b};
-  assign div7_in = div8_lo[22];
-  assign div7_pw = {{1{1'b0}}, div8_p};
-  assign div7_p2 = div7_pw <<< 1;
-  assign div7_bw_1 = {{34{1'b0}}, div7_in};
-  assign div7_p3 = div7_p2 | div7_bw_1;
-  assign div7_ge = div8_bw <= div7_p3;
-  assign div7_diff = div7_p3 - div8_bw;
-  assign div7_pn = div7_ge ? div7_diff : div7_p3;
-  assign div7_rem = div7_pn[33:0];
-  assign div7_q2 = div8_q <<< 1;
-  assign div7_gew = {{29{1'b0}}, div7_ge};
-  assign div7_qn = div7_q2 | div7_gew;
-  assign div9_bw = {{1{1'b0}}, div9_b};
-  assign div8_in = div9_lo[21];
-  assign div8_pw = {{1{1'b0}}, div9_p};
-  assign div8_p2 = div8_pw <<< 1;
-  assign div8_bw_1 = {{34{1'b0}}, div8_in};
-  assign div8_p3 = div8_p2 | div8_bw_1;
-  assign div8_ge = div9_bw <= div8_p3;
-  assign div8_diff = div8_p3 - div9_bw;
-  assign div8_pn = div8_ge ? div8_diff : div8_p3;
-  assign div8_rem = div8_pn[33:0];
-  assign div8_q2 = div9_q <<< 1;
-  assign div8_gew = {{29{1'b0}}, div8_ge};
-  assign div8_qn = div8_q2 | div8_gew;
-  assign div10_bw = {{1{1'b0}}, div10_b};
-  assign div9_in = div10_lo[20];
-  assign div9_pw = {{1{1'b0}}, div10_p};
-  assign div9_p2 = div9_pw <<< 1;
-  assign div9_bw_1 = {{34{1'b0}}, div9_in};
-  assign div9_p3 = div9_p2 | div9_bw_1;
-  assign div9_ge = div10_bw <= div9_p3;
-  assign div9_diff = div9_p3 - div10_bw;
-  assign div9_pn = div9_ge ? div9_diff : div9_p3;
-  assign div9_rem = div9_pn[33:0];
-  assign div9_q2 = div10_q <<< 1;
-  assign div9_gew = {{29{1'b0}}, div9_ge};
-  assign div9_qn = div9_q2 | div9_gew;
-  assign div11_bw = {{1{1'b0}}, div11_b};
-  assign div10_in = div11_lo[19];
-  assign div10_pw = {{1{1'b0}}, div11_p};
-  assign div10_p2 = div10_pw <<< 1;
-  assign div10_bw_1 = {{34{1'b0}}, div10_in};
-  assign div10_p3 = div10_p2 | div10_bw_1;
-  assign div10_ge = div11_bw <= div10_p3;
-  assign div10_diff = div10_p3 - div11_bw;
-  assign div10_pn = div10_ge ? div10_diff : div10_p3;
-  assign div10_rem = div10_pn[33:0];
-  assign div10_q2 = div11_q <<< 1;
-  assign div10_gew = {{29{1'b0}}, div10_ge};
-  assign div10_qn = div10_q2 | div10_gew;
-  assign div12_bw = {{1{1'b0}}, div12_b};
-  assign div11_in = div12_lo[18];
-  assign div11_pw = {{1{1'b0}}, div12_p};
-  assign div11_p2 = div11_pw <<< 1;
-  assign div11_bw_1 = {{34{1'b0}}, div11_in};
-  assign div11_p3 = div11_p2 | div11_bw_1;
-  assign div11_ge = div12_bw <= div11_p3;
-  assign div11_diff = div11_p3 - div12_bw;
-  assign div11_pn = div11_ge ? div11_diff : div11_p3;
-  assign div11_rem = div11_pn[33:0];
-  assign div11_q2 = div12_q <<< 1;
-  assign div11_gew = {{29{1'b0}}, div11_ge};
-  assign div11_qn = div11_q2 | div11_gew;
-  assign div13_bw = {{1{1'b0}}, div13_b};
-  assign div12_in = div13_lo[17];
-  assign div12_pw = {{1{1'b0}}, div13_p};
-  assign div12_p2 = div12_pw <<< 1;
-  assign div12_bw_1 = {{34{1'b0}}, div12_in};
-  assign div12_p3 = div12_p2 | div12_bw_1;
-  assign div12_ge = div13_bw <= div12_p3;
-  assign div12_diff = div12_p3 - div13_bw;
-  assign div12_pn = div12_ge ? div12_diff : div12_p3;
-  assign div12_rem = div12_pn[33:0];
-  assign div12_q2 = div13_q <<< 1;
-  assign div12_gew = {{29{1'b0}}, div12_ge};
-  assign div12_qn = div12_q2 | div12_gew;
-  assign div14_bw = {{1{1'b0}}, div14_b};
-  assign div13_in = div14_lo[16];
-  assign div13_pw = {{1{1'b0}}, div14_p};
-  assign div13_p2 = div13_pw <<< 1;
-  assign div13_bw_1 = {{34{1'b0}}, div13_in};
-  assign div13_p3 = div13_p2 | div13_bw_1;
-  assign div13_ge = div14_bw <= div13_p3;
-  assign div13_diff = div13_p3 - div14_bw;
-  assign div13_pn = div13_ge ? div13_diff : div13_p3;
-  assign div13_rem = div13_pn[33:0];
-  assign div13_q2 = div14_q <<< 1;
-  assign div13_gew = {{29{1'b0}}, div13_ge};
-  assign div13_qn = div13_q2 | div13_gew;
-  assign div15_bw = {{1{1'b0}}, div15_b};
-  assign div14_in = div15_lo[15];
-  assign div14_pw = {{1{1'b0}}, div15_p};
-  assign div14_p2 = div14_pw <<< 1;
-  assign div14_bw_1 = {{34{1'b0}}, div14_in};
-  assign div14_p3 = div14_p2 | div14_bw_1;
-  assign div14_ge = div15_bw <= div14_p3;
-  assign div14_diff = div14_p3 - div15_bw;
-  assign div14_pn = div14_ge ? div14_diff : div14_p3;
-  assign div14_rem = div14_pn[33:0];
-  assign div14_q2 = div15_q <<< 1;
-  assign div14_gew = {{29{1'b0}}, div14_ge};
-  assign div14_qn = div14_q2 | div14_gew;
-  assign div16_bw = {{1{1'b0}}, div16_b};
-  assign div15_in = div16_lo[14];
-  assign div15_pw = {{1{1'b0}}, div16_p};
-  assign div15_p2 = div15_pw <<< 1;
-  assign div15_bw_1 = {{34{1'b0}}, div15_in};
-  assign div15_p3 = div15_p2 | div15_bw_1;
-  assign div15_ge = div16_bw <= div15_p3;
-  assign div15_diff = div15_p3 - div16_bw;
-  assign div15_pn = div15_ge ? div15_diff : div15_p3;
-  assign div15_rem = div15_pn[33:0];
-  assign div15_q2 = div16_q <<< 1;
-  assign div15_gew = {{29{1'b0}}, div15_ge};
-  assign div15_qn = div15_q2 | div15_gew;
-  assign div17_bw = {{1{1'b0}}, div17_b};
-  assign div16_in = div17_lo[13];
-  assign div16_pw = {{1{1'b0}}, div17_p};
-  assign div16_p2 = div16_pw <<< 1;
-  assign div16_bw_1 = {{34{1'b0}}, div16_in};
-  assign div16_p3 = div16_p2 | div16_bw_1;
-  assign div16_ge = div17_bw <= div16_p3;
-  assign div16_diff = div16_p3 - div17_bw;
-  assign div16_pn = div16_ge ? div16_diff : div16_p3;
-  assign div16_rem = div16_pn[33:0];
-  assign div16_q2 = div17_q <<< 1;
-  assign div16_gew = {{29{1'b0}}, div16_ge};
-  assign div16_qn = div16_q2 | div16_gew;
-  assign div18_bw = {{1{1'b0}}, div18_b};
-  assign div17_in = div18_lo[12];
-  assign div17_pw = {{1{1'b0}}, div18_p};
-  assign div17_p2 = div17_pw <<< 1;
-  assign div17_bw_1 = {{34{1'b0}}, div17_in};
-  assign div17_p3 = div17_p2 | div17_bw_1;
-  assign div17_ge = div18_bw <= div17_p3;
-  assign div17_diff = div17_p3 - div18_bw;
-  assign div17_pn = div17_ge ? div17_diff : div17_p3;
-  assign div17_rem = div17_pn[33:0];
-  assign div17_q2 = div18_q <<< 1;
-  assign div17_gew = {{29{1'b0}}, div17_ge};
-  assign div17_qn = div17_q2 | div17_gew;
-  assign div19_bw = {{1{1'b0}}, div19_b};
-  assign div18_in = div19_lo[11];
-  assign div18_pw = {{1{1'b0}}, div19_p};
-  assign div18_p2 = div18_pw <<< 1;
-  assign div18_bw_1 = {{34{1'b0}}, div18_in};
-  assign div18_p3 = div18_p2 | div18_bw_1;
-  assign div18_ge = div19_bw <= div18_p3;
-  assign div18_diff = div18_p3 - div19_bw;
-  assign div18_pn = div18_ge ? div18_diff : div18_p3;
-  assign div18_rem = div18_pn[33:0];
-  assign div18_q2 = div19_q <<< 1;
-  assign div18_gew = {{29{1'b0}}, div18_ge};
-  assign div18_qn = div18_q2 | div18_gew;
-  assign div20_bw = {{1{1'b0}}, div20_b};
-  assign div19_in = div20_lo[10];
-  assign div19_pw = {{1{1'b0}}, div20_p};
-  assign div19_p2 = div19_pw <<< 1;
-  assign div19_bw_1 = {{34{1'b0}}, div19_in};
-  assign div19_p3 = div19_p2 | div19_bw_1;
-  assign div19_ge = div20_bw <= div19_p3;
-  assign div19_diff = div19_p3 - div20_bw;
-  assign div19_pn = div19_ge ? div19_diff : div19_p3;
-  assign div19_rem = div19_pn[33:0];
-  assign div19_q2 = div20_q <<< 1;
-  assign div19_gew = {{29{1'b0}}, div19_ge};
-  assign div19_qn = div19_q2 | div19_gew;
-  assign div21_bw = {{1{1'b0}}, div21_b};
-  assign div20_in = div21_lo[9];
-  assign div20_pw = {{1{1'b0}}, div21_p};
-  assign div20_p2 = div20_pw <<< 1;
-  assign div20_bw_1 = {{34{1'b0}}, div20_in};
-  assign div20_p3 = div20_p2 | div20_bw_1;
-  assign div20_ge = div21_bw <= div20_p3;
-  assign div20_diff = div20_p3 - div21_bw;
-  assign div20_pn = div20_ge ? div20_diff : div20_p3;
-  assign div20_rem = div20_pn[33:0];
-  assign div20_q2 = div21_q <<< 1;
-  assign div20_gew = {{29{1'b0}}, div20_ge};
-  assign div20_qn = div20_q2 | div20_gew;
-  assign div22_bw = {{1{1'b0}}, div22_b};
-  assign div21_in = div22_lo[8];
-  assign div21_pw = {{1{1'b0}}, div22_p};
-  assign div21_p2 = div21_pw <<< 1;
-  assign div21_bw_1 = {{34{1'b0}}, div21_in};
-  assign div21_p3 = div21_p2 | div21_bw_1;
-  assign div21_ge = div22_bw <= div21_p3;
-  assign div21_diff = div21_p3 - div22_bw;
-  assign div21_pn = div21_ge ? div21_diff : div21_p3;
-  assign div21_rem = div21_pn[33:0];
-  assign div21_q2 = div22_q <<< 1;
-  assign div21_gew = {{29{1'b0}}, div21_ge};
-  assign div21_qn = div21_q2 | div21_gew;
-  assign div23_bw = {{1{1'b0}}, div23_b};
-  assign div22_in = div23_lo[7];
-  assign div22_pw = {{1{1'b0}}, div23_p};
-  assign div22_p2 = div22_pw <<< 1;
-  assign div22_bw_1 = {{34{1'b0}}, div22_in};
-  assign div22_p3 = div22_p2 | div22_bw_1;
-  assign div22_ge = div23_bw <= div22_p3;
-  assign div22_diff = div22_p3 - div23_bw;
-  assign div22_pn = div22_ge ? div22_diff : div22_p3;
-  assign div22_rem = div22_pn[33:0];
-  assign div22_q2 = div23_q <<< 1;
-  assign div22_gew = {{29{1'b0}}, div22_ge};
-  assign div22_qn = div22_q2 | div22_gew;
-  assign div24_bw = {{1{1'b0}}, div24_b};
-  assign div23_in = div24_lo[6];
-  assign div23_pw = {{1{1'b0}}, div24_p};
-  assign div23_p2 = div23_pw <<< 1;
-  assign div23_bw_1 = {{34{1'b0}}, div23_in};
-  assign div23_p3 = div23_p2 | div23_bw_1;
-  assign div23_ge = div24_bw <= div23_p3;
-  assign div23_diff = div23_p3 - div24_bw;
-  assign div23_pn = div23_ge ? div23_diff : div23_p3;
-  assign div23_rem = div23_pn[33:0];
-  assign div23_q2 = div24_q <<< 1;
-  assign div23_gew = {{29{1'b0}}, div23_ge};
-  assign div23_qn = div23_q2 | div23_gew;
-  assign div25_bw = {{1{1'b0}}, div25_b};
-  assign div24_in = div25_lo[5];
-  assign div24_pw = {{1{1'b0}}, div25_p};
-  assign div24_p2 = div24_pw <<< 1;
-  assign div24_bw_1 = {{34{1'b0}}, div24_in};
-  assign div24_p3 = div24_p2 | div24_bw_1;
-  assign div24_ge = div25_bw <= div24_p3;
-  assign div24_diff = div24_p3 - div25_bw;
-  assign div24_pn = div24_ge ? div24_diff : div24_p3;
-  assign div24_rem = div24_pn[33:0];
-  assign div24_q2 = div25_q <<< 1;
-  assign div24_gew = {{29{1'b0}}, div24_ge};
-  assign div24_qn = div24_q2 | div24_gew;
-  assign div26_bw = {{1{1'b0}}, div26_b};
-  assign div25_in = div26_lo[4];
-  assign div25_pw = {{1{1'b0}}, div26_p};
-  assign div25_p2 = div25_pw <<< 1;
-  assign div25_bw_1 = {{34{1'b0}}, div25_in};
-  assign div25_p3 = div25_p2 | div25_bw_1;
-  assign div25_ge = div26_bw <= div25_p3;
-  assign div25_diff = div25_p3 - div26_bw;
-  assign div25_pn = div25_ge ? div25_diff : div25_p3;
-  assign div25_rem = div25_pn[33:0];
-  assign div25_q2 = div26_q <<< 1;
-  assign div25_gew = {{29{1'b0}}, div25_ge};
-  assign div25_qn = div25_q2 | div25_gew;
-  assign div27_bw = {{1{1'b0}}, div27_b};
-  assign div26_in = div27_lo[3];
-  assign div26_pw = {{1{1'b0}}, div27_p};
-  assign div26_p2 = div26_pw <<< 1;
-  assign div26_bw_1 = {{34{1'b0}}, div26_in};
-  assign div26_p3 = div26_p2 | div26_bw_1;
-  assign div26_ge = div27_bw <= div26_p3;
-  assign div26_diff = div26_p3 - div27_bw;
-  assign div26_pn = div26_ge ? div26_diff : div26_p3;
-  assign div26_rem = div26_pn[33:0];
-  assign div26_q2 = div27_q <<< 1;
-  assign div26_gew = {{29{1'b0}}, div26_ge};
-  assign div26_qn = div26_q2 | div26_gew;
-  assign div28_bw = {{1{1'b0}}, div28_b};
-  assign div27_in = div28_lo[2];
-  assign div27_pw = {{1{1'b0}}, div28_p};
-  assign div27_p2 = div27_pw <<< 1;
-  assign div27_bw_1 = {{34{1'b0}}, div27_in};
-  assign div27_p3 = div27_p2 | div27_bw_1;
-  assign div27_ge = div28_bw <= div27_p3;
-  assign div27_diff = div27_p3 - div28_bw;
-  assign div27_pn = div27_ge ? div27_diff : div27_p3;
-  assign div27_rem = div27_pn[33:0];
-  assign div27_q2 = div28_q <<< 1;
-  assign div27_gew = {{29{1'b0}}, div27_ge};
-  assign div27_qn = div27_q2 | div27_gew;
-  assign div29_bw = {{1{1'b0}}, div29_b};
-  assign div28_in = div29_lo[1];
-  assign div28_pw = {{1{1'b0}}, div29_p};
-  assign div28_p2 = div28_pw <<< 1;
-  assign div28_bw_1 = {{34{1'b0}}, div28_in};
-  assign div28_p3 = div28_p2 | div28_bw_1;
-  assign div28_ge = div29_bw <= div28_p3;
-  assign div28_diff = div28_p3 - div29_bw;
-  assign div28_pn = div28_ge ? div28_diff : div28_p3;
-  assign div28_rem = div28_pn[33:0];
-  assign div28_q2 = div29_q <<< 1;
-  assign div28_gew = {{29{1'b0}}, div28_ge};
-  assign div28_qn = div28_q2 | div28_gew;
-  assign div30_bw = {{1{1'b0}}, div30_b};
-  assign div29_in = div30_lo[0];
-  assign div29_pw = {{1{1'b0}}, div30_p};
-  assign div29_p2 = div29_pw <<< 1;
-  assign div29_bw_1 = {{34{1'b0}}, div29_in};
-  assign div29_p3 = div29_p2 | div29_bw_1;
-  assign div29_ge = div30_bw <= div29_p3;
-  assign div29_diff = div29_p3 - div30_bw;
-  assign div29_pn = div29_ge ? div29_diff : div29_p3;
-  assign div29_rem = div29_pn[33:0];
-  assign div29_q2 = div30_q <<< 1;
-  assign div29_gew = {{29{1'b0}}, div29_ge};
-  assign div29_qn = div29_q2 | div29_gew;
-  assign div_q_zero = div29_qn == div_zero_q;
-  assign div_bad = div30_err | div_q_zero;
-  assign div_ok_c = div_bad ^ div_one;
+  // not in a stage or state machine
 
-  always @(posedge clk) begin : regs
-    div1_a <= div_a;
-    div1_b <= div_b;
-    div1_err <= div_err_b;
-    div2_p <= div0_rem;
-    div2_q <= div0_qn;
-    div2_b <= div1_b;
-    div2_lo <= div_lo;
-    div2_err <= div_err_c;
-    div3_p <= div1_rem;
-    div3_q <= div1_qn;
-    div3_b <= div2_b;
-    div3_lo <= div2_lo;
-    div3_err <= div2_err;
-    div4_p <= div2_rem;
-    div4_q <= div2_qn;
-    div4_b <= div3_b;
-    div4_lo <= div3_lo;
-    div4_err <= div3_err;
-    div5_p <= div3_rem;
-    div5_q <= div3_qn;
-    div5_b <= div4_b;
-    div5_lo <= div4_lo;
-    div5_err <= div4_err;
-    div6_p <= div4_rem;
-    div6_q <= div4_qn;
-    div6_b <= div5_b;
-    div6_lo <= div5_lo;
-    div6_err <= div5_err;
-    div7_p <= div5_rem;
-    div7_q <= div5_qn;
-    div7_b <= div6_b;
-    div7_lo <= div6_lo;
-    div7_err <= div6_err;
-    div8_p <= div6_rem;
-    div8_q <= div6_qn;
-    div8_b <= div7_b;
-    div8_lo <= div7_lo;
-    div8_err <= div7_err;
-    div9_p <= div7_rem;
-    div9_q <= div7_qn;
-    div9_b <= div8_b;
-    div9_lo <= div8_lo;
-    div9_err <= div8_err;
-    div10_p <= div8_rem;
-    div10_q <= div8_qn;
-    div10_b <= div9_b;
-    div10_lo <= div9_lo;
-    div10_err <= div9_err;
-    div11_p <= div9_rem;
-    div11_q <= div9_qn;
-    div11_b <= div10_b;
-    div11_lo <= div10_lo;
-    div11_err <= div10_err;
-    div12_p <= div10_rem;
-    div12_q <= div10_qn;
-    div12_b <= div11_b;
-    div12_lo <= div11_lo;
-    div12_err <= div11_err;
-    div13_p <= div11_rem;
-    div13_q <= div11_qn;
-    div13_b <= div12_b;
-    div13_lo <= div12_lo;
-    div13_err <= div12_err;
-    div14_p <= div12_rem;
-    div14_q <= div12_qn;
-    div14_b <= div13_b;
-    div14_lo <= div13_lo;
-    div14_err <= div13_err;
-    div15_p <= div13_rem;
-    div15_q <= div13_qn;
-    div15_b <= div14_b;
-    div15_lo <= div14_lo;
-    div15_err <= div14_err;
-    div16_p <= div14_rem;
-    div16_q <= div14_qn;
-    div16_b <= div15_b;
-    div16_lo <= div15_lo;
-    div16_err <= div15_err;
-    div17_p <= div15_rem;
-    div17_q <= div15_qn;
-    div17_b <= div16_b;
-    div17_lo <= div16_lo;
-    div17_err <= div16_err;
-    div18_p <= div16_rem;
-    div18_q <= div16_qn;
-    div18_b <= div17_b;
-    div18_lo <= div17_lo;
-    div18_err <= div17_err;
-    div19_p <= div17_rem;
-    div19_q <= div17_qn;
-    div19_b <= div18_b;
-    div19_lo <= div18_lo;
-    div19_err <= div18_err;
-    div20_p <= div18_rem;
-    div20_q <= div18_qn;
-    div20_b <= div19_b;
-    div20_lo <= div19_lo;
-    div20_err <= div19_err;
-    div21_p <= div19_rem;
-    div21_q <= div19_qn;
-    div21_b <= div20_b;
-    div21_lo <= div20_lo;
-    div21_err <= div20_err;
-    div22_p <= div20_rem;
-    div22_q <= div20_qn;
-    div22_b <= div21_b;
-    div22_lo <= div21_lo;
-    div22_err <= div21_err;
-    div23_p <= div21_rem;
-    div23_q <= div21_qn;
-    div23_b <= div22_b;
-    div23_lo <= div22_lo;
-    div23_err <= div22_err;
-    div24_p <= div22_rem;
-    div24_q <= div22_qn;
-    div24_b <= div23_b;
-    div24_lo <= div23_lo;
-    div24_err <= div23_err;
-    div25_p <= div23_rem;
-    div25_q <= div23_qn;
-    div25_b <= div24_b;
-    div25_lo <= div24_lo;
-    div25_err <= div24_err;
-    div26_p <= div24_rem;
-    div26_q <= div24_qn;
-    div26_b <= div25_b;
-    div26_lo <= div25_lo;
-    div26_err <= div25_err;
-    div27_p <= div25_rem;
-    div27_q <= div25_qn;
-    div27_b <= div26_b;
-    div27_lo <= div26_lo;
-    div27_err <= div26_err;
-    div28_p <= div26_rem;
-    div28_q <= div26_qn;
-    div28_b <= div27_b;
-    div28_lo <= div27_lo;
-    div28_err <= div27_err;
-    div29_p <= div27_rem;
-    div29_q <= div27_qn;
-    div29_b <= div28_b;
-    div29_lo <= div28_lo;
-    div29_err <= div28_err;
-    div30_p <= div28_rem;
-    div30_q <= div28_qn;
-    div30_b <= div29_b;
-    div30_lo <= div29_lo;
-    div30_err <= div29_err;
-    div_t <= div29_qn;
-    div_ok <= div_ok_c;
+  // stage s1_operands: signs, zero tests, magnitudes
+  assign num_neg = num < k_0;
+  assign den_neg = den < k_0_1;
+  assign neg_num = -num;
+  assign mux_num_neg = num_neg ? neg_num : num;
+  assign u_mux_num_neg = $unsigned(mux_num_neg);
+  assign neg_den = -den;
+  assign mux_den_neg = den_neg ? neg_den : den;
+  assign u_mux_den_neg = $unsigned(mux_den_neg);
+  assign num_eq_k_0 = num == k_0;
+  assign den_eq_k_0_1 = den == k_0_1;
+  assign or_0 = num_eq_k_0 | den_eq_k_0_1;
+  assign num_neg_xor_den_neg = num_neg ^ den_neg;
+  assign err = or_0 | num_neg_xor_den_neg;
+
+  always @(posedge clk) begin : s1_operands_regs
+    s1_a <= u_mux_num_neg;
+    s1_b <= u_mux_den_neg;
+    s1_err <= err;
   end
 
-  assign t = div_t;
-  assign ok = div_ok;
+  // stage s2_q0: one quotient bit
+  assign bits_s1_a = s1_a[62:30];
+  assign lo = s1_a[29:0];
+  assign rs_bits_s1_a = {{1{1'b0}}, bits_s1_a};
+  assign s1_b_le_rs_bits_s1_a = s1_b <= rs_bits_s1_a;
+  assign err_1 = s1_err | s1_b_le_rs_bits_s1_a;
+  assign rs_bits_s1_a_1 = {{1{1'b0}}, bits_s1_a};
+  assign rs_s1_b = {{1{1'b0}}, s1_b};
+  assign rs_rs_bits_s1_a_1 = {{1{1'b0}}, rs_bits_s1_a_1};
+  assign shl_rs_rs_bits_s1_a_1 = rs_rs_bits_s1_a_1 <<< 1;
+  assign bits_lo = lo[29];
+  assign rs_bits_lo = {{34{1'b0}}, bits_lo};
+  assign or_3 = shl_rs_rs_bits_s1_a_1 | rs_bits_lo;
+  assign ge0 = rs_s1_b <= or_3;
+  assign or_3_minus_rs_s1_b = or_3 - rs_s1_b;
+  assign mux_ge0 = ge0 ? or_3_minus_rs_s1_b : or_3;
+  assign rs_mux_ge0 = mux_ge0[33:0];
+  assign rs_ge0 = {{29{1'b0}}, ge0};
+  assign k_0_2_or_rs_ge0 = k_0_2 | rs_ge0;
+
+  always @(posedge clk) begin : s2_q0_regs
+    s2_p <= rs_mux_ge0;
+    s2_q <= k_0_2_or_rs_ge0;
+  end
+
+  // stage s3_q1: one quotient bit
+  assign rs_s1_b_d1 = {{1{1'b0}}, s1_b_d1};
+  assign rs_s2_p = {{1{1'b0}}, s2_p};
+  assign shl_rs_s2_p = rs_s2_p <<< 1;
+  assign bits_lo_d1 = lo_d1[28];
+  assign rs_bits_lo_d1 = {{34{1'b0}}, bits_lo_d1};
+  assign or_4 = shl_rs_s2_p | rs_bits_lo_d1;
+  assign ge1 = rs_s1_b_d1 <= or_4;
+  assign or_4_minus_rs_s1_b_d1 = or_4 - rs_s1_b_d1;
+  assign mux_ge1 = ge1 ? or_4_minus_rs_s1_b_d1 : or_4;
+  assign rs_mux_ge1 = mux_ge1[33:0];
+  assign shl_s2_q = s2_q <<< 1;
+  assign rs_ge1 = {{29{1'b0}}, ge1};
+  assign shl_s2_q_or_rs_ge1 = shl_s2_q | rs_ge1;
+
+  always @(posedge clk) begin : s3_q1_regs
+    s1_b_d1 <= s1_b;
+    lo_d1 <= lo;
+    s3_p <= rs_mux_ge1;
+    s3_q <= shl_s2_q_or_rs_ge1;
+  end
+
+  // stage s4_q2: one quotient bit
+  assign rs_s1_b_d2 = {{1{1'b0}}, s1_b_d2};
+  assign rs_s3_p = {{1{1'b0}}, s3_p};
+  assign shl_rs_s3_p = rs_s3_p <<< 1;
+  assign bits_lo_d2 = lo_d2[27];
+  assign rs_bits_lo_d2 = {{34{1'b0}}, bits_lo_d2};
+  assign or_5 = shl_rs_s3_p | rs_bits_lo_d2;
+  assign ge2 = rs_s1_b_d2 <= or_5;
+  assign or_5_minus_rs_s1_b_d2 = or_5 - rs_s1_b_d2;
+  assign mux_ge2 = ge2 ? or_5_minus_rs_s1_b_d2 : or_5;
+  assign rs_mux_ge2 = mux_ge2[33:0];
+  assign shl_s3_q = s3_q <<< 1;
+  assign rs_ge2 = {{29{1'b0}}, ge2};
+  assign shl_s3_q_or_rs_ge2 = shl_s3_q | rs_ge2;
+
+  always @(posedge clk) begin : s4_q2_regs
+    s1_b_d2 <= s1_b_d1;
+    lo_d2 <= lo_d1;
+    s4_p <= rs_mux_ge2;
+    s4_q <= shl_s3_q_or_rs_ge2;
+  end
+
+  // stage s5_q3: one quotient bit
+  assign rs_s1_b_d3 = {{1{1'b0}}, s1_b_d3};
+  assign rs_s4_p = {{1{1'b0}}, s4_p};
+  assign shl_rs_s4_p = rs_s4_p <<< 1;
+  assign bits_lo_d3 = lo_d3[26];
+  assign rs_bits_lo_d3 = {{34{1'b0}}, bits_lo_d3};
+  assign or_6 = shl_rs_s4_p | rs_bits_lo_d3;
+  assign ge3 = rs_s1_b_d3 <= or_6;
+  assign or_6_minus_rs_s1_b_d3 = or_6 - rs_s1_b_d3;
+  assign mux_ge3 = ge3 ? or_6_minus_rs_s1_b_d3 : or_6;
+  assign rs_mux_ge3 = mux_ge3[33:0];
+  assign shl_s4_q = s4_q <<< 1;
+  assign rs_ge3 = {{29{1'b0}}, ge3};
+  assign shl_s4_q_or_rs_ge3 = shl_s4_q | rs_ge3;
+
+  always @(posedge clk) begin : s5_q3_regs
+    s1_b_d3 <= s1_b_d2;
+    lo_d3 <= lo_d2;
+    s5_p <= rs_mux_ge3;
+    s5_q <= shl_s4_q_or_rs_ge3;
+  end
+
+  // stage s6_q4: one quotient bit
+  assign rs_s1_b_d4 = {{1{1'b0}}, s1_b_d4};
+  assign rs_s5_p = {{1{1'b0}}, s5_p};
+  assign shl_rs_s5_p = rs_s5_p <<< 1;
+  assign bits_lo_d4 = lo_d4[25];
+  assign rs_bits_lo_d4 = {{34{1'b0}}, bits_lo_d4};
+  assign or_7 = shl_rs_s5_p | rs_bits_lo_d4;
+  assign ge4 = rs_s1_b_d4 <= or_7;
+  assign or_7_minus_rs_s1_b_d4 = or_7 - rs_s1_b_d4;
+  assign mux_ge4 = ge4 ? or_7_minus_rs_s1_b_d4 : or_7;
+  assign rs_mux_ge4 = mux_ge4[33:0];
+  assign shl_s5_q = s5_q <<< 1;
+  assign rs_ge4 = {{29{1'b0}}, ge4};
+  assign shl_s5_q_or_rs_ge4 = shl_s5_q | rs_ge4;
+
+  always @(posedge clk) begin : s6_q4_regs
+    s1_b_d4 <= s1_b_d3;
+    lo_d4 <= lo_d3;
+    s6_p <= rs_mux_ge4;
+    s6_q <= shl_s5_q_or_rs_ge4;
+  end
+
+  // stage s7_q5: one quotient bit
+  assign rs_s1_b_d5 = {{1{1'b0}}, s1_b_d5};
+  assign rs_s6_p = {{1{1'b0}}, s6_p};
+  assign shl_rs_s6_p = rs_s6_p <<< 1;
+  assign bits_lo_d5 = lo_d5[24];
+  assign rs_bits_lo_d5 = {{34{1'b0}}, bits_lo_d5};
+  assign or_8 = shl_rs_s6_p | rs_bits_lo_d5;
+  assign ge5 = rs_s1_b_d5 <= or_8;
+  assign or_8_minus_rs_s1_b_d5 = or_8 - rs_s1_b_d5;
+  assign mux_ge5 = ge5 ? or_8_minus_rs_s1_b_d5 : or_8;
+  assign rs_mux_ge5 = mux_ge5[33:0];
+  assign shl_s6_q = s6_q <<< 1;
+  assign rs_ge5 = {{29{1'b0}}, ge5};
+  assign shl_s6_q_or_rs_ge5 = shl_s6_q | rs_ge5;
+
+  always @(posedge clk) begin : s7_q5_regs
+    s1_b_d5 <= s1_b_d4;
+    lo_d5 <= lo_d4;
+    s7_p <= rs_mux_ge5;
+    s7_q <= shl_s6_q_or_rs_ge5;
+  end
+
+  // stage s8_q6: one quotient bit
+  assign rs_s1_b_d6 = {{1{1'b0}}, s1_b_d6};
+  assign rs_s7_p = {{1{1'b0}}, s7_p};
+  assign shl_rs_s7_p = rs_s7_p <<< 1;
+  assign bits_lo_d6 = lo_d6[23];
+  assign rs_bits_lo_d6 = {{34{1'b0}}, bits_lo_d6};
+  assign or_9 = shl_rs_s7_p | rs_bits_lo_d6;
+  assign ge6 = rs_s1_b_d6 <= or_9;
+  assign or_9_minus_rs_s1_b_d6 = or_9 - rs_s1_b_d6;
+  assign mux_ge6 = ge6 ? or_9_minus_rs_s1_b_d6 : or_9;
+  assign rs_mux_ge6 = mux_ge6[33:0];
+  assign shl_s7_q = s7_q <<< 1;
+  assign rs_ge6 = {{29{1'b0}}, ge6};
+  assign shl_s7_q_or_rs_ge6 = shl_s7_q | rs_ge6;
+
+  always @(posedge clk) begin : s8_q6_regs
+    s1_b_d6 <= s1_b_d5;
+    lo_d6 <= lo_d5;
+    s8_p <= rs_mux_ge6;
+    s8_q <= shl_s7_q_or_rs_ge6;
+  end
+
+  // stage s9_q7: one quotient bit
+  assign rs_s1_b_d7 = {{1{1'b0}}, s1_b_d7};
+  assign rs_s8_p = {{1{1'b0}}, s8_p};
+  assign shl_rs_s8_p = rs_s8_p <<< 1;
+  assign bits_lo_d7 = lo_d7[22];
+  assign rs_bits_lo_d7 = {{34{1'b0}}, bits_lo_d7};
+  assign or_10 = shl_rs_s8_p | rs_bits_lo_d7;
+  assign ge7 = rs_s1_b_d7 <= or_10;
+  assign or_10_minus_rs_s1_b_d7 = or_10 - rs_s1_b_d7;
+  assign mux_ge7 = ge7 ? or_10_minus_rs_s1_b_d7 : or_10;
+  assign rs_mux_ge7 = mux_ge7[33:0];
+  assign shl_s8_q = s8_q <<< 1;
+  assign rs_ge7 = {{29{1'b0}}, ge7};
+  assign shl_s8_q_or_rs_ge7 = shl_s8_q | rs_ge7;
+
+  always @(posedge clk) begin : s9_q7_regs
+    s1_b_d7 <= s1_b_d6;
+    lo_d7 <= lo_d6;
+    s9_p <= rs_mux_ge7;
+    s9_q <= shl_s8_q_or_rs_ge7;
+  end
+
+  // stage s10_q8: one quotient bit
+  assign rs_s1_b_d8 = {{1{1'b0}}, s1_b_d8};
+  assign rs_s9_p = {{1{1'b0}}, s9_p};
+  assign shl_rs_s9_p = rs_s9_p <<< 1;
+  assign bits_lo_d8 = lo_d8[21];
+  assign rs_bits_lo_d8 = {{34{1'b0}}, bits_lo_d8};
+  assign or_11 = shl_rs_s9_p | rs_bits_lo_d8;
+  assign ge8 = rs_s1_b_d8 <= or_11;
+  assign or_11_minus_rs_s1_b_d8 = or_11 - rs_s1_b_d8;
+  assign mux_ge8 = ge8 ? or_11_minus_rs_s1_b_d8 : or_11;
+  assign rs_mux_ge8 = mux_ge8[33:0];
+  assign shl_s9_q = s9_q <<< 1;
+  assign rs_ge8 = {{29{1'b0}}, ge8};
+  assign shl_s9_q_or_rs_ge8 = shl_s9_q | rs_ge8;
+
+  always @(posedge clk) begin : s10_q8_regs
+    s1_b_d8 <= s1_b_d7;
+    lo_d8 <= lo_d7;
+    s10_p <= rs_mux_ge8;
+    s10_q <= shl_s9_q_or_rs_ge8;
+  end
+
+  // stage s11_q9: one quotient bit
+  assign rs_s1_b_d9 = {{1{1'b0}}, s1_b_d9};
+  assign rs_s10_p = {{1{1'b0}}, s10_p};
+  assign shl_rs_s10_p = rs_s10_p <<< 1;
+  assign bits_lo_d9 = lo_d9[20];
+  assign rs_bits_lo_d9 = {{34{1'b0}}, bits_lo_d9};
+  assign or_12 = shl_rs_s10_p | rs_bits_lo_d9;
+  assign ge9 = rs_s1_b_d9 <= or_12;
+  assign or_12_minus_rs_s1_b_d9 = or_12 - rs_s1_b_d9;
+  assign mux_ge9 = ge9 ? or_12_minus_rs_s1_b_d9 : or_12;
+  assign rs_mux_ge9 = mux_ge9[33:0];
+  assign shl_s10_q = s10_q <<< 1;
+  assign rs_ge9 = {{29{1'b0}}, ge9};
+  assign shl_s10_q_or_rs_ge9 = shl_s10_q | rs_ge9;
+
+  always @(posedge clk) begin : s11_q9_regs
+    s1_b_d9 <= s1_b_d8;
+    lo_d9 <= lo_d8;
+    s11_p <= rs_mux_ge9;
+    s11_q <= shl_s10_q_or_rs_ge9;
+  end
+
+  // stage s12_q10: one quotient bit
+  assign rs_s1_b_d10 = {{1{1'b0}}, s1_b_d10};
+  assign rs_s11_p = {{1{1'b0}}, s11_p};
+  assign shl_rs_s11_p = rs_s11_p <<< 1;
+  assign bits_lo_d10 = lo_d10[19];
+  assign rs_bits_lo_d10 = {{34{1'b0}}, bits_lo_d10};
+  assign or_13 = shl_rs_s11_p | rs_bits_lo_d10;
+  assign ge10 = rs_s1_b_d10 <= or_13;
+  assign or_13_minus_rs_s1_b_d10 = or_13 - rs_s1_b_d10;
+  assign mux_ge10 = ge10 ? or_13_minus_rs_s1_b_d10 : or_13;
+  assign rs_mux_ge10 = mux_ge10[33:0];
+  assign shl_s11_q = s11_q <<< 1;
+  assign rs_ge10 = {{29{1'b0}}, ge10};
+  assign shl_s11_q_or_rs_ge10 = shl_s11_q | rs_ge10;
+
+  always @(posedge clk) begin : s12_q10_regs
+    s1_b_d10 <= s1_b_d9;
+    lo_d10 <= lo_d9;
+    s12_p <= rs_mux_ge10;
+    s12_q <= shl_s11_q_or_rs_ge10;
+  end
+
+  // stage s13_q11: one quotient bit
+  assign rs_s1_b_d11 = {{1{1'b0}}, s1_b_d11};
+  assign rs_s12_p = {{1{1'b0}}, s12_p};
+  assign shl_rs_s12_p = rs_s12_p <<< 1;
+  assign bits_lo_d11 = lo_d11[18];
+  assign rs_bits_lo_d11 = {{34{1'b0}}, bits_lo_d11};
+  assign or_14 = shl_rs_s12_p | rs_bits_lo_d11;
+  assign ge11 = rs_s1_b_d11 <= or_14;
+  assign or_14_minus_rs_s1_b_d11 = or_14 - rs_s1_b_d11;
+  assign mux_ge11 = ge11 ? or_14_minus_rs_s1_b_d11 : or_14;
+  assign rs_mux_ge11 = mux_ge11[33:0];
+  assign shl_s12_q = s12_q <<< 1;
+  assign rs_ge11 = {{29{1'b0}}, ge11};
+  assign shl_s12_q_or_rs_ge11 = shl_s12_q | rs_ge11;
+
+  always @(posedge clk) begin : s13_q11_regs
+    s1_b_d11 <= s1_b_d10;
+    lo_d11 <= lo_d10;
+    s13_p <= rs_mux_ge11;
+    s13_q <= shl_s12_q_or_rs_ge11;
+  end
+
+  // stage s14_q12: one quotient bit
+  assign rs_s1_b_d12 = {{1{1'b0}}, s1_b_d12};
+  assign rs_s13_p = {{1{1'b0}}, s13_p};
+  assign shl_rs_s13_p = rs_s13_p <<< 1;
+  assign bits_lo_d12 = lo_d12[17];
+  assign rs_bits_lo_d12 = {{34{1'b0}}, bits_lo_d12};
+  assign or_15 = shl_rs_s13_p | rs_bits_lo_d12;
+  assign ge12 = rs_s1_b_d12 <= or_15;
+  assign or_15_minus_rs_s1_b_d12 = or_15 - rs_s1_b_d12;
+  assign mux_ge12 = ge12 ? or_15_minus_rs_s1_b_d12 : or_15;
+  assign rs_mux_ge12 = mux_ge12[33:0];
+  assign shl_s13_q = s13_q <<< 1;
+  assign rs_ge12 = {{29{1'b0}}, ge12};
+  assign shl_s13_q_or_rs_ge12 = shl_s13_q | rs_ge12;
+
+  always @(posedge clk) begin : s14_q12_regs
+    s1_b_d12 <= s1_b_d11;
+    lo_d12 <= lo_d11;
+    s14_p <= rs_mux_ge12;
+    s14_q <= shl_s13_q_or_rs_ge12;
+  end
+
+  // stage s15_q13: one quotient bit
+  assign rs_s1_b_d13 = {{1{1'b0}}, s1_b_d13};
+  assign rs_s14_p = {{1{1'b0}}, s14_p};
+  assign shl_rs_s14_p = rs_s14_p <<< 1;
+  assign bits_lo_d13 = lo_d13[16];
+  assign rs_bits_lo_d13 = {{34{1'b0}}, bits_lo_d13};
+  assign or_16 = shl_rs_s14_p | rs_bits_lo_d13;
+  assign ge13 = rs_s1_b_d13 <= or_16;
+  assign or_16_minus_rs_s1_b_d13 = or_16 - rs_s1_b_d13;
+  assign mux_ge13 = ge13 ? or_16_minus_rs_s1_b_d13 : or_16;
+  assign rs_mux_ge13 = mux_ge13[33:0];
+  assign shl_s14_q = s14_q <<< 1;
+  assign rs_ge13 = {{29{1'b0}}, ge13};
+  assign shl_s14_q_or_rs_ge13 = shl_s14_q | rs_ge13;
+
+  always @(posedge clk) begin : s15_q13_regs
+    s1_b_d13 <= s1_b_d12;
+    lo_d13 <= lo_d12;
+    s15_p <= rs_mux_ge13;
+    s15_q <= shl_s14_q_or_rs_ge13;
+  end
+
+  // stage s16_q14: one quotient bit
+  assign rs_s1_b_d14 = {{1{1'b0}}, s1_b_d14};
+  assign rs_s15_p = {{1{1'b0}}, s15_p};
+  assign shl_rs_s15_p = rs_s15_p <<< 1;
+  assign bits_lo_d14 = lo_d14[15];
+  assign rs_bits_lo_d14 = {{34{1'b0}}, bits_lo_d14};
+  assign or_17 = shl_rs_s15_p | rs_bits_lo_d14;
+  assign ge14 = rs_s1_b_d14 <= or_17;
+  assign or_17_minus_rs_s1_b_d14 = or_17 - rs_s1_b_d14;
+  assign mux_ge14 = ge14 ? or_17_minus_rs_s1_b_d14 : or_17;
+  assign rs_mux_ge14 = mux_ge14[33:0];
+  assign shl_s15_q = s15_q <<< 1;
+  assign rs_ge14 = {{29{1'b0}}, ge14};
+  assign shl_s15_q_or_rs_ge14 = shl_s15_q | rs_ge14;
+
+  always @(posedge clk) begin : s16_q14_regs
+    s1_b_d14 <= s1_b_d13;
+    lo_d14 <= lo_d13;
+    s16_p <= rs_mux_ge14;
+    s16_q <= shl_s15_q_or_rs_ge14;
+  end
+
+  // stage s17_q15: one quotient bit
+  assign rs_s1_b_d15 = {{1{1'b0}}, s1_b_d15};
+  assign rs_s16_p = {{1{1'b0}}, s16_p};
+  assign shl_rs_s16_p = rs_s16_p <<< 1;
+  assign bits_lo_d15 = lo_d15[14];
+  assign rs_bits_lo_d15 = {{34{1'b0}}, bits_lo_d15};
+  assign or_18 = shl_rs_s16_p | rs_bits_lo_d15;
+  assign ge15 = rs_s1_b_d15 <= or_18;
+  assign or_18_minus_rs_s1_b_d15 = or_18 - rs_s1_b_d15;
+  assign mux_ge15 = ge15 ? or_18_minus_rs_s1_b_d15 : or_18;
+  assign rs_mux_ge15 = mux_ge15[33:0];
+  assign shl_s16_q = s16_q <<< 1;
+  assign rs_ge15 = {{29{1'b0}}, ge15};
+  assign shl_s16_q_or_rs_ge15 = shl_s16_q | rs_ge15;
+
+  always @(posedge clk) begin : s17_q15_regs
+    s1_b_d15 <= s1_b_d14;
+    lo_d15 <= lo_d14;
+    s17_p <= rs_mux_ge15;
+    s17_q <= shl_s16_q_or_rs_ge15;
+  end
+
+  // stage s18_q16: one quotient bit
+  assign rs_s1_b_d16 = {{1{1'b0}}, s1_b_d16};
+  assign rs_s17_p = {{1{1'b0}}, s17_p};
+  assign shl_rs_s17_p = rs_s17_p <<< 1;
+  assign bits_lo_d16 = lo_d16[13];
+  assign rs_bits_lo_d16 = {{34{1'b0}}, bits_lo_d16};
+  assign or_19 = shl_rs_s17_p | rs_bits_lo_d16;
+  assign ge16 = rs_s1_b_d16 <= or_19;
+  assign or_19_minus_rs_s1_b_d16 = or_19 - rs_s1_b_d16;
+  assign mux_ge16 = ge16 ? or_19_minus_rs_s1_b_d16 : or_19;
+  assign rs_mux_ge16 = mux_ge16[33:0];
+  assign shl_s17_q = s17_q <<< 1;
+  assign rs_ge16 = {{29{1'b0}}, ge16};
+  assign shl_s17_q_or_rs_ge16 = shl_s17_q | rs_ge16;
+
+  always @(posedge clk) begin : s18_q16_regs
+    s1_b_d16 <= s1_b_d15;
+    lo_d16 <= lo_d15;
+    s18_p <= rs_mux_ge16;
+    s18_q <= shl_s17_q_or_rs_ge16;
+  end
+
+  // stage s19_q17: one quotient bit
+  assign rs_s1_b_d17 = {{1{1'b0}}, s1_b_d17};
+  assign rs_s18_p = {{1{1'b0}}, s18_p};
+  assign shl_rs_s18_p = rs_s18_p <<< 1;
+  assign bits_lo_d17 = lo_d17[12];
+  assign rs_bits_lo_d17 = {{34{1'b0}}, bits_lo_d17};
+  assign or_20 = shl_rs_s18_p | rs_bits_lo_d17;
+  assign ge17 = rs_s1_b_d17 <= or_20;
+  assign or_20_minus_rs_s1_b_d17 = or_20 - rs_s1_b_d17;
+  assign mux_ge17 = ge17 ? or_20_minus_rs_s1_b_d17 : or_20;
+  assign rs_mux_ge17 = mux_ge17[33:0];
+  assign shl_s18_q = s18_q <<< 1;
+  assign rs_ge17 = {{29{1'b0}}, ge17};
+  assign shl_s18_q_or_rs_ge17 = shl_s18_q | rs_ge17;
+
+  always @(posedge clk) begin : s19_q17_regs
+    s1_b_d17 <= s1_b_d16;
+    lo_d17 <= lo_d16;
+    s19_p <= rs_mux_ge17;
+    s19_q <= shl_s18_q_or_rs_ge17;
+  end
+
+  // stage s20_q18: one quotient bit
+  assign rs_s1_b_d18 = {{1{1'b0}}, s1_b_d18};
+  assign rs_s19_p = {{1{1'b0}}, s19_p};
+  assign shl_rs_s19_p = rs_s19_p <<< 1;
+  assign bits_lo_d18 = lo_d18[11];
+  assign rs_bits_lo_d18 = {{34{1'b0}}, bits_lo_d18};
+  assign or_21 = shl_rs_s19_p | rs_bits_lo_d18;
+  assign ge18 = rs_s1_b_d18 <= or_21;
+  assign or_21_minus_rs_s1_b_d18 = or_21 - rs_s1_b_d18;
+  assign mux_ge18 = ge18 ? or_21_minus_rs_s1_b_d18 : or_21;
+  assign rs_mux_ge18 = mux_ge18[33:0];
+  assign shl_s19_q = s19_q <<< 1;
+  assign rs_ge18 = {{29{1'b0}}, ge18};
+  assign shl_s19_q_or_rs_ge18 = shl_s19_q | rs_ge18;
+
+  always @(posedge clk) begin : s20_q18_regs
+    s1_b_d18 <= s1_b_d17;
+    lo_d18 <= lo_d17;
+    s20_p <= rs_mux_ge18;
+    s20_q <= shl_s19_q_or_rs_ge18;
+  end
+
+  // stage s21_q19: one quotient bit
+  assign rs_s1_b_d19 = {{1{1'b0}}, s1_b_d19};
+  assign rs_s20_p = {{1{1'b0}}, s20_p};
+  assign shl_rs_s20_p = rs_s20_p <<< 1;
+  assign bits_lo_d19 = lo_d19[10];
+  assign rs_bits_lo_d19 = {{34{1'b0}}, bits_lo_d19};
+  assign or_22 = shl_rs_s20_p | rs_bits_lo_d19;
+  assign ge19 = rs_s1_b_d19 <= or_22;
+  assign or_22_minus_rs_s1_b_d19 = or_22 - rs_s1_b_d19;
+  assign mux_ge19 = ge19 ? or_22_minus_rs_s1_b_d19 : or_22;
+  assign rs_mux_ge19 = mux_ge19[33:0];
+  assign shl_s20_q = s20_q <<< 1;
+  assign rs_ge19 = {{29{1'b0}}, ge19};
+  assign shl_s20_q_or_rs_ge19 = shl_s20_q | rs_ge19;
+
+  always @(posedge clk) begin : s21_q19_regs
+    s1_b_d19 <= s1_b_d18;
+    lo_d19 <= lo_d18;
+    s21_p <= rs_mux_ge19;
+    s21_q <= shl_s20_q_or_rs_ge19;
+  end
+
+  // stage s22_q20: one quotient bit
+  assign rs_s1_b_d20 = {{1{1'b0}}, s1_b_d20};
+  assign rs_s21_p = {{1{1'b0}}, s21_p};
+  assign shl_rs_s21_p = rs_s21_p <<< 1;
+  assign bits_lo_d20 = lo_d20[9];
+  assign rs_bits_lo_d20 = {{34{1'b0}}, bits_lo_d20};
+  assign or_23 = shl_rs_s21_p | rs_bits_lo_d20;
+  assign ge20 = rs_s1_b_d20 <= or_23;
+  assign or_23_minus_rs_s1_b_d20 = or_23 - rs_s1_b_d20;
+  assign mux_ge20 = ge20 ? or_23_minus_rs_s1_b_d20 : or_23;
+  assign rs_mux_ge20 = mux_ge20[33:0];
+  assign shl_s21_q = s21_q <<< 1;
+  assign rs_ge20 = {{29{1'b0}}, ge20};
+  assign shl_s21_q_or_rs_ge20 = shl_s21_q | rs_ge20;
+
+  always @(posedge clk) begin : s22_q20_regs
+    s1_b_d20 <= s1_b_d19;
+    lo_d20 <= lo_d19;
+    s22_p <= rs_mux_ge20;
+    s22_q <= shl_s21_q_or_rs_ge20;
+  end
+
+  // stage s23_q21: one quotient bit
+  assign rs_s1_b_d21 = {{1{1'b0}}, s1_b_d21};
+  assign rs_s22_p = {{1{1'b0}}, s22_p};
+  assign shl_rs_s22_p = rs_s22_p <<< 1;
+  assign bits_lo_d21 = lo_d21[8];
+  assign rs_bits_lo_d21 = {{34{1'b0}}, bits_lo_d21};
+  assign or_24 = shl_rs_s22_p | rs_bits_lo_d21;
+  assign ge21 = rs_s1_b_d21 <= or_24;
+  assign or_24_minus_rs_s1_b_d21 = or_24 - rs_s1_b_d21;
+  assign mux_ge21 = ge21 ? or_24_minus_rs_s1_b_d21 : or_24;
+  assign rs_mux_ge21 = mux_ge21[33:0];
+  assign shl_s22_q = s22_q <<< 1;
+  assign rs_ge21 = {{29{1'b0}}, ge21};
+  assign shl_s22_q_or_rs_ge21 = shl_s22_q | rs_ge21;
+
+  always @(posedge clk) begin : s23_q21_regs
+    s1_b_d21 <= s1_b_d20;
+    lo_d21 <= lo_d20;
+    s23_p <= rs_mux_ge21;
+    s23_q <= shl_s22_q_or_rs_ge21;
+  end
+
+  // stage s24_q22: one quotient bit
+  assign rs_s1_b_d22 = {{1{1'b0}}, s1_b_d22};
+  assign rs_s23_p = {{1{1'b0}}, s23_p};
+  assign shl_rs_s23_p = rs_s23_p <<< 1;
+  assign bits_lo_d22 = lo_d22[7];
+  assign rs_bits_lo_d22 = {{34{1'b0}}, bits_lo_d22};
+  assign or_25 = shl_rs_s23_p | rs_bits_lo_d22;
+  assign ge22 = rs_s1_b_d22 <= or_25;
+  assign or_25_minus_rs_s1_b_d22 = or_25 - rs_s1_b_d22;
+  assign mux_ge22 = ge22 ? or_25_minus_rs_s1_b_d22 : or_25;
+  assign rs_mux_ge22 = mux_ge22[33:0];
+  assign shl_s23_q = s23_q <<< 1;
+  assign rs_ge22 = {{29{1'b0}}, ge22};
+  assign shl_s23_q_or_rs_ge22 = shl_s23_q | rs_ge22;
+
+  always @(posedge clk) begin : s24_q22_regs
+    s1_b_d22 <= s1_b_d21;
+    lo_d22 <= lo_d21;
+    s24_p <= rs_mux_ge22;
+    s24_q <= shl_s23_q_or_rs_ge22;
+  end
+
+  // stage s25_q23: one quotient bit
+  assign rs_s1_b_d23 = {{1{1'b0}}, s1_b_d23};
+  assign rs_s24_p = {{1{1'b0}}, s24_p};
+  assign shl_rs_s24_p = rs_s24_p <<< 1;
+  assign bits_lo_d23 = lo_d23[6];
+  assign rs_bits_lo_d23 = {{34{1'b0}}, bits_lo_d23};
+  assign or_26 = shl_rs_s24_p | rs_bits_lo_d23;
+  assign ge23 = rs_s1_b_d23 <= or_26;
+  assign or_26_minus_rs_s1_b_d23 = or_26 - rs_s1_b_d23;
+  assign mux_ge23 = ge23 ? or_26_minus_rs_s1_b_d23 : or_26;
+  assign rs_mux_ge23 = mux_ge23[33:0];
+  assign shl_s24_q = s24_q <<< 1;
+  assign rs_ge23 = {{29{1'b0}}, ge23};
+  assign shl_s24_q_or_rs_ge23 = shl_s24_q | rs_ge23;
+
+  always @(posedge clk) begin : s25_q23_regs
+    s1_b_d23 <= s1_b_d22;
+    lo_d23 <= lo_d22;
+    s25_p <= rs_mux_ge23;
+    s25_q <= shl_s24_q_or_rs_ge23;
+  end
+
+  // stage s26_q24: one quotient bit
+  assign rs_s1_b_d24 = {{1{1'b0}}, s1_b_d24};
+  assign rs_s25_p = {{1{1'b0}}, s25_p};
+  assign shl_rs_s25_p = rs_s25_p <<< 1;
+  assign bits_lo_d24 = lo_d24[5];
+  assign rs_bits_lo_d24 = {{34{1'b0}}, bits_lo_d24};
+  assign or_27 = shl_rs_s25_p | rs_bits_lo_d24;
+  assign ge24 = rs_s1_b_d24 <= or_27;
+  assign or_27_minus_rs_s1_b_d24 = or_27 - rs_s1_b_d24;
+  assign mux_ge24 = ge24 ? or_27_minus_rs_s1_b_d24 : or_27;
+  assign rs_mux_ge24 = mux_ge24[33:0];
+  assign shl_s25_q = s25_q <<< 1;
+  assign rs_ge24 = {{29{1'b0}}, ge24};
+  assign shl_s25_q_or_rs_ge24 = shl_s25_q | rs_ge24;
+
+  always @(posedge clk) begin : s26_q24_regs
+    s1_b_d24 <= s1_b_d23;
+    lo_d24 <= lo_d23;
+    s26_p <= rs_mux_ge24;
+    s26_q <= shl_s25_q_or_rs_ge24;
+  end
+
+  // stage s27_q25: one quotient bit
+  assign rs_s1_b_d25 = {{1{1'b0}}, s1_b_d25};
+  assign rs_s26_p = {{1{1'b0}}, s26_p};
+  assign shl_rs_s26_p = rs_s26_p <<< 1;
+  assign bits_lo_d25 = lo_d25[4];
+  assign rs_bits_lo_d25 = {{34{1'b0}}, bits_lo_d25};
+  assign or_28 = shl_rs_s26_p | rs_bits_lo_d25;
+  assign ge25 = rs_s1_b_d25 <= or_28;
+  assign or_28_minus_rs_s1_b_d25 = or_28 - rs_s1_b_d25;
+  assign mux_ge25 = ge25 ? or_28_minus_rs_s1_b_d25 : or_28;
+  assign rs_mux_ge25 = mux_ge25[33:0];
+  assign shl_s26_q = s26_q <<< 1;
+  assign rs_ge25 = {{29{1'b0}}, ge25};
+  assign shl_s26_q_or_rs_ge25 = shl_s26_q | rs_ge25;
+
+  always @(posedge clk) begin : s27_q25_regs
+    s1_b_d25 <= s1_b_d24;
+    lo_d25 <= lo_d24;
+    s27_p <= rs_mux_ge25;
+    s27_q <= shl_s26_q_or_rs_ge25;
+  end
+
+  // stage s28_q26: one quotient bit
+  assign rs_s1_b_d26 = {{1{1'b0}}, s1_b_d26};
+  assign rs_s27_p = {{1{1'b0}}, s27_p};
+  assign shl_rs_s27_p = rs_s27_p <<< 1;
+  assign bits_lo_d26 = lo_d26[3];
+  assign rs_bits_lo_d26 = {{34{1'b0}}, bits_lo_d26};
+  assign or_29 = shl_rs_s27_p | rs_bits_lo_d26;
+  assign ge26 = rs_s1_b_d26 <= or_29;
+  assign or_29_minus_rs_s1_b_d26 = or_29 - rs_s1_b_d26;
+  assign mux_ge26 = ge26 ? or_29_minus_rs_s1_b_d26 : or_29;
+  assign rs_mux_ge26 = mux_ge26[33:0];
+  assign shl_s27_q = s27_q <<< 1;
+  assign rs_ge26 = {{29{1'b0}}, ge26};
+  assign shl_s27_q_or_rs_ge26 = shl_s27_q | rs_ge26;
+
+  always @(posedge clk) begin : s28_q26_regs
+    s1_b_d26 <= s1_b_d25;
+    lo_d26 <= lo_d25;
+    s28_p <= rs_mux_ge26;
+    s28_q <= shl_s27_q_or_rs_ge26;
+  end
+
+  // stage s29_q27: one quotient bit
+  assign rs_s1_b_d27 = {{1{1'b0}}, s1_b_d27};
+  assign rs_s28_p = {{1{1'b0}}, s28_p};
+  assign shl_rs_s28_p = rs_s28_p <<< 1;
+  assign bits_lo_d27 = lo_d27[2];
+  assign rs_bits_lo_d27 = {{34{1'b0}}, bits_lo_d27};
+  assign or_30 = shl_rs_s28_p | rs_bits_lo_d27;
+  assign ge27 = rs_s1_b_d27 <= or_30;
+  assign or_30_minus_rs_s1_b_d27 = or_30 - rs_s1_b_d27;
+  assign mux_ge27 = ge27 ? or_30_minus_rs_s1_b_d27 : or_30;
+  assign rs_mux_ge27 = mux_ge27[33:0];
+  assign shl_s28_q = s28_q <<< 1;
+  assign rs_ge27 = {{29{1'b0}}, ge27};
+  assign shl_s28_q_or_rs_ge27 = shl_s28_q | rs_ge27;
+
+  always @(posedge clk) begin : s29_q27_regs
+    s1_b_d27 <= s1_b_d26;
+    lo_d27 <= lo_d26;
+    s29_p <= rs_mux_ge27;
+    s29_q <= shl_s28_q_or_rs_ge27;
+  end
+
+  // stage s30_q28: one quotient bit
+  assign rs_s1_b_d28 = {{1{1'b0}}, s1_b_d28};
+  assign rs_s29_p = {{1{1'b0}}, s29_p};
+  assign shl_rs_s29_p = rs_s29_p <<< 1;
+  assign bits_lo_d28 = lo_d28[1];
+  assign rs_bits_lo_d28 = {{34{1'b0}}, bits_lo_d28};
+  assign or_31 = shl_rs_s29_p | rs_bits_lo_d28;
+  assign ge28 = rs_s1_b_d28 <= or_31;
+  assign or_31_minus_rs_s1_b_d28 = or_31 - rs_s1_b_d28;
+  assign mux_ge28 = ge28 ? or_31_minus_rs_s1_b_d28 : or_31;
+  assign rs_mux_ge28 = mux_ge28[33:0];
+  assign shl_s29_q = s29_q <<< 1;
+  assign rs_ge28 = {{29{1'b0}}, ge28};
+  assign shl_s29_q_or_rs_ge28 = shl_s29_q | rs_ge28;
+
+  always @(posedge clk) begin : s30_q28_regs
+    s1_b_d28 <= s1_b_d27;
+    lo_d28 <= lo_d27;
+    s30_p <= rs_mux_ge28;
+    s30_q <= shl_s29_q_or_rs_ge28;
+  end
+
+  // stage s31_result: the quotient and its result flag
+  assign rs_s1_b_d29 = {{1{1'b0}}, s1_b_d29};
+  assign rs_s30_p = {{1{1'b0}}, s30_p};
+  assign shl_rs_s30_p = rs_s30_p <<< 1;
+  assign bits_lo_d29 = lo_d29[0];
+  assign rs_bits_lo_d29 = {{34{1'b0}}, bits_lo_d29};
+  assign or_32 = shl_rs_s30_p | rs_bits_lo_d29;
+  assign ge29 = rs_s1_b_d29 <= or_32;
+  assign or_32_minus_rs_s1_b_d29 = or_32 - rs_s1_b_d29;
+  assign mux_ge29 = ge29 ? or_32_minus_rs_s1_b_d29 : or_32;
+  assign rs_mux_ge29 = mux_ge29[33:0];
+  assign shl_s30_q = s30_q <<< 1;
+  assign rs_ge29 = {{29{1'b0}}, ge29};
+  assign shl_s30_q_or_rs_ge29 = shl_s30_q | rs_ge29;
+  assign err_1_d29 = err_1_d29_sr[29];
+  assign eq_33 = shl_s30_q_or_rs_ge29 == k_0_2;
+  assign err_1_d29_or_eq_33 = err_1_d29 | eq_33;
+  assign not_err_1_d29_or_eq_33 = ~err_1_d29_or_eq_33;
+
+  always @(posedge clk) begin : s31_result_regs
+    s1_b_d29 <= s1_b_d28;
+    lo_d29 <= lo_d28;
+    for (err_1_d29_i = 29; err_1_d29_i > 1; err_1_d29_i = err_1_d29_i - 1)
+      err_1_d29_sr[err_1_d29_i] <= err_1_d29_sr[err_1_d29_i - 1];
+    err_1_d29_sr[1] <= err_1;
+    s31_t <= shl_s30_q_or_rs_ge29;
+    s31_ok <= not_err_1_d29_or_eq_33;
+  end
+
+  assign t = s31_t;
+  assign ok = s31_ok;
 endmodule
 `default_nettype wire

@@ -15,1144 +15,1394 @@ end entity fxrt_div_n29_a63_b34;
 
 architecture rtl of fxrt_div_n29_a63_b34 is
 
-  constant div_zero_n : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
-  constant div_zero_d : signed(33 downto 0) := signed'("0000000000000000000000000000000000");
-  signal div_num_neg : unsigned(0 downto 0);
-  signal div_den_neg : unsigned(0 downto 0);
-  signal div_num_zero : unsigned(0 downto 0);
-  signal div_den_zero : unsigned(0 downto 0);
-  signal div_sign_diff : unsigned(0 downto 0);
-  signal div_err_a : unsigned(0 downto 0);
-  signal div_err_b : unsigned(0 downto 0);
-  signal div_num_negated : signed(62 downto 0);
-  signal div_num_abs_s : signed(62 downto 0);
-  signal div_a : unsigned(62 downto 0);
-  signal div_den_negated : signed(33 downto 0);
-  signal div_den_abs_s : signed(33 downto 0);
-  signal div_b : unsigned(33 downto 0);
-  signal div1_a : unsigned(62 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000");
-  signal div1_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div1_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div_hi : unsigned(32 downto 0);
-  signal div_lo : unsigned(29 downto 0);
-  signal div_hi_c : unsigned(33 downto 0);
-  signal div_overflow : unsigned(0 downto 0);
-  signal div_err_c : unsigned(0 downto 0);
-  signal div_p0 : unsigned(33 downto 0);
-  constant div_q0 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div_b_w : unsigned(34 downto 0);
-  signal div0_in : unsigned(0 downto 0);
-  signal div0_pw : unsigned(34 downto 0);
-  signal div0_p2 : unsigned(34 downto 0);
-  signal div0_bw : unsigned(34 downto 0);
-  signal div0_p3 : unsigned(34 downto 0);
-  signal div0_ge : unsigned(0 downto 0);
-  signal div0_diff : unsigned(34 downto 0);
-  signal div0_pn : unsigned(34 downto 0);
-  signal div0_rem : unsigned(33 downto 0);
-  signal div0_q2 : unsigned(29 downto 0);
-  signal div0_gew : unsigned(29 downto 0);
-  signal div0_qn : unsigned(29 downto 0);
-  signal div2_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div2_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div2_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div2_bw : unsigned(34 downto 0);
-  signal div2_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div2_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div1_in : unsigned(0 downto 0);
-  signal div1_pw : unsigned(34 downto 0);
-  signal div1_p2 : unsigned(34 downto 0);
-  signal div1_bw : unsigned(34 downto 0);
-  signal div1_p3 : unsigned(34 downto 0);
-  signal div1_ge : unsigned(0 downto 0);
-  signal div1_diff : unsigned(34 downto 0);
-  signal div1_pn : unsigned(34 downto 0);
-  signal div1_rem : unsigned(33 downto 0);
-  signal div1_q2 : unsigned(29 downto 0);
-  signal div1_gew : unsigned(29 downto 0);
-  signal div1_qn : unsigned(29 downto 0);
-  signal div3_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div3_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div3_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div3_bw : unsigned(34 downto 0);
-  signal div3_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div3_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div2_in : unsigned(0 downto 0);
-  signal div2_pw : unsigned(34 downto 0);
-  signal div2_p2 : unsigned(34 downto 0);
-  signal div2_bw_1 : unsigned(34 downto 0);
-  signal div2_p3 : unsigned(34 downto 0);
-  signal div2_ge : unsigned(0 downto 0);
-  signal div2_diff : unsigned(34 downto 0);
-  signal div2_pn : unsigned(34 downto 0);
-  signal div2_rem : unsigned(33 downto 0);
-  signal div2_q2 : unsigned(29 downto 0);
-  signal div2_gew : unsigned(29 downto 0);
-  signal div2_qn : unsigned(29 downto 0);
-  signal div4_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div4_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div4_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div4_bw : unsigned(34 downto 0);
-  signal div4_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div4_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div3_in : unsigned(0 downto 0);
-  signal div3_pw : unsigned(34 downto 0);
-  signal div3_p2 : unsigned(34 downto 0);
-  signal div3_bw_1 : unsigned(34 downto 0);
-  signal div3_p3 : unsigned(34 downto 0);
-  signal div3_ge : unsigned(0 downto 0);
-  signal div3_diff : unsigned(34 downto 0);
-  signal div3_pn : unsigned(34 downto 0);
-  signal div3_rem : unsigned(33 downto 0);
-  signal div3_q2 : unsigned(29 downto 0);
-  signal div3_gew : unsigned(29 downto 0);
-  signal div3_qn : unsigned(29 downto 0);
-  signal div5_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div5_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div5_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div5_bw : unsigned(34 downto 0);
-  signal div5_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div5_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div4_in : unsigned(0 downto 0);
-  signal div4_pw : unsigned(34 downto 0);
-  signal div4_p2 : unsigned(34 downto 0);
-  signal div4_bw_1 : unsigned(34 downto 0);
-  signal div4_p3 : unsigned(34 downto 0);
-  signal div4_ge : unsigned(0 downto 0);
-  signal div4_diff : unsigned(34 downto 0);
-  signal div4_pn : unsigned(34 downto 0);
-  signal div4_rem : unsigned(33 downto 0);
-  signal div4_q2 : unsigned(29 downto 0);
-  signal div4_gew : unsigned(29 downto 0);
-  signal div4_qn : unsigned(29 downto 0);
-  signal div6_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div6_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div6_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div6_bw : unsigned(34 downto 0);
-  signal div6_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div6_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div5_in : unsigned(0 downto 0);
-  signal div5_pw : unsigned(34 downto 0);
-  signal div5_p2 : unsigned(34 downto 0);
-  signal div5_bw_1 : unsigned(34 downto 0);
-  signal div5_p3 : unsigned(34 downto 0);
-  signal div5_ge : unsigned(0 downto 0);
-  signal div5_diff : unsigned(34 downto 0);
-  signal div5_pn : unsigned(34 downto 0);
-  signal div5_rem : unsigned(33 downto 0);
-  signal div5_q2 : unsigned(29 downto 0);
-  signal div5_gew : unsigned(29 downto 0);
-  signal div5_qn : unsigned(29 downto 0);
-  signal div7_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div7_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div7_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div7_bw : unsigned(34 downto 0);
-  signal div7_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div7_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div6_in : unsigned(0 downto 0);
-  signal div6_pw : unsigned(34 downto 0);
-  signal div6_p2 : unsigned(34 downto 0);
-  signal div6_bw_1 : unsigned(34 downto 0);
-  signal div6_p3 : unsigned(34 downto 0);
-  signal div6_ge : unsigned(0 downto 0);
-  signal div6_diff : unsigned(34 downto 0);
-  signal div6_pn : unsigned(34 downto 0);
-  signal div6_rem : unsigned(33 downto 0);
-  signal div6_q2 : unsigned(29 downto 0);
-  signal div6_gew : unsigned(29 downto 0);
-  signal div6_qn : unsigned(29 downto 0);
-  signal div8_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div8_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div8_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div8_bw : unsigned(34 downto 0);
-  signal div8_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div8_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div7_in : unsigned(0 downto 0);
-  signal div7_pw : unsigned(34 downto 0);
-  signal div7_p2 : unsigned(34 downto 0);
-  signal div7_bw_1 : unsigned(34 downto 0);
-  signal div7_p3 : unsigned(34 downto 0);
-  signal div7_ge : unsigned(0 downto 0);
-  signal div7_diff : unsigned(34 downto 0);
-  signal div7_pn : unsigned(34 downto 0);
-  signal div7_rem : unsigned(33 downto 0);
-  signal div7_q2 : unsigned(29 downto 0);
-  signal div7_gew : unsigned(29 downto 0);
-  signal div7_qn : unsigned(29 downto 0);
-  signal div9_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div9_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div9_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div9_bw : unsigned(34 downto 0);
-  signal div9_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div9_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div8_in : unsigned(0 downto 0);
-  signal div8_pw : unsigned(34 downto 0);
-  signal div8_p2 : unsigned(34 downto 0);
-  signal div8_bw_1 : unsigned(34 downto 0);
-  signal div8_p3 : unsigned(34 downto 0);
-  signal div8_ge : unsigned(0 downto 0);
-  signal div8_diff : unsigned(34 downto 0);
-  signal div8_pn : unsigned(34 downto 0);
-  signal div8_rem : unsigned(33 downto 0);
-  signal div8_q2 : unsigned(29 downto 0);
-  signal div8_gew : unsigned(29 downto 0);
-  signal div8_qn : unsigned(29 downto 0);
-  signal div10_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div10_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div10_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div10_bw : unsigned(34 downto 0);
-  signal div10_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div10_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div9_in : unsigned(0 downto 0);
-  signal div9_pw : unsigned(34 downto 0);
-  signal div9_p2 : unsigned(34 downto 0);
-  signal div9_bw_1 : unsigned(34 downto 0);
-  signal div9_p3 : unsigned(34 downto 0);
-  signal div9_ge : unsigned(0 downto 0);
-  signal div9_diff : unsigned(34 downto 0);
-  signal div9_pn : unsigned(34 downto 0);
-  signal div9_rem : unsigned(33 downto 0);
-  signal div9_q2 : unsigned(29 downto 0);
-  signal div9_gew : unsigned(29 downto 0);
-  signal div9_qn : unsigned(29 downto 0);
-  signal div11_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div11_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div11_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div11_bw : unsigned(34 downto 0);
-  signal div11_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div11_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div10_in : unsigned(0 downto 0);
-  signal div10_pw : unsigned(34 downto 0);
-  signal div10_p2 : unsigned(34 downto 0);
-  signal div10_bw_1 : unsigned(34 downto 0);
-  signal div10_p3 : unsigned(34 downto 0);
-  signal div10_ge : unsigned(0 downto 0);
-  signal div10_diff : unsigned(34 downto 0);
-  signal div10_pn : unsigned(34 downto 0);
-  signal div10_rem : unsigned(33 downto 0);
-  signal div10_q2 : unsigned(29 downto 0);
-  signal div10_gew : unsigned(29 downto 0);
-  signal div10_qn : unsigned(29 downto 0);
-  signal div12_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div12_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div12_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div12_bw : unsigned(34 downto 0);
-  signal div12_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div12_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div11_in : unsigned(0 downto 0);
-  signal div11_pw : unsigned(34 downto 0);
-  signal div11_p2 : unsigned(34 downto 0);
-  signal div11_bw_1 : unsigned(34 downto 0);
-  signal div11_p3 : unsigned(34 downto 0);
-  signal div11_ge : unsigned(0 downto 0);
-  signal div11_diff : unsigned(34 downto 0);
-  signal div11_pn : unsigned(34 downto 0);
-  signal div11_rem : unsigned(33 downto 0);
-  signal div11_q2 : unsigned(29 downto 0);
-  signal div11_gew : unsigned(29 downto 0);
-  signal div11_qn : unsigned(29 downto 0);
-  signal div13_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div13_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div13_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div13_bw : unsigned(34 downto 0);
-  signal div13_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div13_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div12_in : unsigned(0 downto 0);
-  signal div12_pw : unsigned(34 downto 0);
-  signal div12_p2 : unsigned(34 downto 0);
-  signal div12_bw_1 : unsigned(34 downto 0);
-  signal div12_p3 : unsigned(34 downto 0);
-  signal div12_ge : unsigned(0 downto 0);
-  signal div12_diff : unsigned(34 downto 0);
-  signal div12_pn : unsigned(34 downto 0);
-  signal div12_rem : unsigned(33 downto 0);
-  signal div12_q2 : unsigned(29 downto 0);
-  signal div12_gew : unsigned(29 downto 0);
-  signal div12_qn : unsigned(29 downto 0);
-  signal div14_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div14_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div14_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div14_bw : unsigned(34 downto 0);
-  signal div14_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div14_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div13_in : unsigned(0 downto 0);
-  signal div13_pw : unsigned(34 downto 0);
-  signal div13_p2 : unsigned(34 downto 0);
-  signal div13_bw_1 : unsigned(34 downto 0);
-  signal div13_p3 : unsigned(34 downto 0);
-  signal div13_ge : unsigned(0 downto 0);
-  signal div13_diff : unsigned(34 downto 0);
-  signal div13_pn : unsigned(34 downto 0);
-  signal div13_rem : unsigned(33 downto 0);
-  signal div13_q2 : unsigned(29 downto 0);
-  signal div13_gew : unsigned(29 downto 0);
-  signal div13_qn : unsigned(29 downto 0);
-  signal div15_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div15_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div15_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div15_bw : unsigned(34 downto 0);
-  signal div15_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div15_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div14_in : unsigned(0 downto 0);
-  signal div14_pw : unsigned(34 downto 0);
-  signal div14_p2 : unsigned(34 downto 0);
-  signal div14_bw_1 : unsigned(34 downto 0);
-  signal div14_p3 : unsigned(34 downto 0);
-  signal div14_ge : unsigned(0 downto 0);
-  signal div14_diff : unsigned(34 downto 0);
-  signal div14_pn : unsigned(34 downto 0);
-  signal div14_rem : unsigned(33 downto 0);
-  signal div14_q2 : unsigned(29 downto 0);
-  signal div14_gew : unsigned(29 downto 0);
-  signal div14_qn : unsigned(29 downto 0);
-  signal div16_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div16_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div16_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div16_bw : unsigned(34 downto 0);
-  signal div16_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div16_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div15_in : unsigned(0 downto 0);
-  signal div15_pw : unsigned(34 downto 0);
-  signal div15_p2 : unsigned(34 downto 0);
-  signal div15_bw_1 : unsigned(34 downto 0);
-  signal div15_p3 : unsigned(34 downto 0);
-  signal div15_ge : unsigned(0 downto 0);
-  signal div15_diff : unsigned(34 downto 0);
-  signal div15_pn : unsigned(34 downto 0);
-  signal div15_rem : unsigned(33 downto 0);
-  signal div15_q2 : unsigned(29 downto 0);
-  signal div15_gew : unsigned(29 downto 0);
-  signal div15_qn : unsigned(29 downto 0);
-  signal div17_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div17_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div17_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div17_bw : unsigned(34 downto 0);
-  signal div17_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div17_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div16_in : unsigned(0 downto 0);
-  signal div16_pw : unsigned(34 downto 0);
-  signal div16_p2 : unsigned(34 downto 0);
-  signal div16_bw_1 : unsigned(34 downto 0);
-  signal div16_p3 : unsigned(34 downto 0);
-  signal div16_ge : unsigned(0 downto 0);
-  signal div16_diff : unsigned(34 downto 0);
-  signal div16_pn : unsigned(34 downto 0);
-  signal div16_rem : unsigned(33 downto 0);
-  signal div16_q2 : unsigned(29 downto 0);
-  signal div16_gew : unsigned(29 downto 0);
-  signal div16_qn : unsigned(29 downto 0);
-  signal div18_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div18_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div18_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div18_bw : unsigned(34 downto 0);
-  signal div18_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div18_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div17_in : unsigned(0 downto 0);
-  signal div17_pw : unsigned(34 downto 0);
-  signal div17_p2 : unsigned(34 downto 0);
-  signal div17_bw_1 : unsigned(34 downto 0);
-  signal div17_p3 : unsigned(34 downto 0);
-  signal div17_ge : unsigned(0 downto 0);
-  signal div17_diff : unsigned(34 downto 0);
-  signal div17_pn : unsigned(34 downto 0);
-  signal div17_rem : unsigned(33 downto 0);
-  signal div17_q2 : unsigned(29 downto 0);
-  signal div17_gew : unsigned(29 downto 0);
-  signal div17_qn : unsigned(29 downto 0);
-  signal div19_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div19_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div19_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div19_bw : unsigned(34 downto 0);
-  signal div19_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div19_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div18_in : unsigned(0 downto 0);
-  signal div18_pw : unsigned(34 downto 0);
-  signal div18_p2 : unsigned(34 downto 0);
-  signal div18_bw_1 : unsigned(34 downto 0);
-  signal div18_p3 : unsigned(34 downto 0);
-  signal div18_ge : unsigned(0 downto 0);
-  signal div18_diff : unsigned(34 downto 0);
-  signal div18_pn : unsigned(34 downto 0);
-  signal div18_rem : unsigned(33 downto 0);
-  signal div18_q2 : unsigned(29 downto 0);
-  signal div18_gew : unsigned(29 downto 0);
-  signal div18_qn : unsigned(29 downto 0);
-  signal div20_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div20_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div20_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div20_bw : unsigned(34 downto 0);
-  signal div20_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div20_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div19_in : unsigned(0 downto 0);
-  signal div19_pw : unsigned(34 downto 0);
-  signal div19_p2 : unsigned(34 downto 0);
-  signal div19_bw_1 : unsigned(34 downto 0);
-  signal div19_p3 : unsigned(34 downto 0);
-  signal div19_ge : unsigned(0 downto 0);
-  signal div19_diff : unsigned(34 downto 0);
-  signal div19_pn : unsigned(34 downto 0);
-  signal div19_rem : unsigned(33 downto 0);
-  signal div19_q2 : unsigned(29 downto 0);
-  signal div19_gew : unsigned(29 downto 0);
-  signal div19_qn : unsigned(29 downto 0);
-  signal div21_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div21_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div21_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div21_bw : unsigned(34 downto 0);
-  signal div21_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div21_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div20_in : unsigned(0 downto 0);
-  signal div20_pw : unsigned(34 downto 0);
-  signal div20_p2 : unsigned(34 downto 0);
-  signal div20_bw_1 : unsigned(34 downto 0);
-  signal div20_p3 : unsigned(34 downto 0);
-  signal div20_ge : unsigned(0 downto 0);
-  signal div20_diff : unsigned(34 downto 0);
-  signal div20_pn : unsigned(34 downto 0);
-  signal div20_rem : unsigned(33 downto 0);
-  signal div20_q2 : unsigned(29 downto 0);
-  signal div20_gew : unsigned(29 downto 0);
-  signal div20_qn : unsigned(29 downto 0);
-  signal div22_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div22_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div22_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div22_bw : unsigned(34 downto 0);
-  signal div22_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div22_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div21_in : unsigned(0 downto 0);
-  signal div21_pw : unsigned(34 downto 0);
-  signal div21_p2 : unsigned(34 downto 0);
-  signal div21_bw_1 : unsigned(34 downto 0);
-  signal div21_p3 : unsigned(34 downto 0);
-  signal div21_ge : unsigned(0 downto 0);
-  signal div21_diff : unsigned(34 downto 0);
-  signal div21_pn : unsigned(34 downto 0);
-  signal div21_rem : unsigned(33 downto 0);
-  signal div21_q2 : unsigned(29 downto 0);
-  signal div21_gew : unsigned(29 downto 0);
-  signal div21_qn : unsigned(29 downto 0);
-  signal div23_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div23_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div23_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div23_bw : unsigned(34 downto 0);
-  signal div23_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div23_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div22_in : unsigned(0 downto 0);
-  signal div22_pw : unsigned(34 downto 0);
-  signal div22_p2 : unsigned(34 downto 0);
-  signal div22_bw_1 : unsigned(34 downto 0);
-  signal div22_p3 : unsigned(34 downto 0);
-  signal div22_ge : unsigned(0 downto 0);
-  signal div22_diff : unsigned(34 downto 0);
-  signal div22_pn : unsigned(34 downto 0);
-  signal div22_rem : unsigned(33 downto 0);
-  signal div22_q2 : unsigned(29 downto 0);
-  signal div22_gew : unsigned(29 downto 0);
-  signal div22_qn : unsigned(29 downto 0);
-  signal div24_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div24_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div24_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div24_bw : unsigned(34 downto 0);
-  signal div24_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div24_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div23_in : unsigned(0 downto 0);
-  signal div23_pw : unsigned(34 downto 0);
-  signal div23_p2 : unsigned(34 downto 0);
-  signal div23_bw_1 : unsigned(34 downto 0);
-  signal div23_p3 : unsigned(34 downto 0);
-  signal div23_ge : unsigned(0 downto 0);
-  signal div23_diff : unsigned(34 downto 0);
-  signal div23_pn : unsigned(34 downto 0);
-  signal div23_rem : unsigned(33 downto 0);
-  signal div23_q2 : unsigned(29 downto 0);
-  signal div23_gew : unsigned(29 downto 0);
-  signal div23_qn : unsigned(29 downto 0);
-  signal div25_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div25_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div25_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div25_bw : unsigned(34 downto 0);
-  signal div25_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div25_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div24_in : unsigned(0 downto 0);
-  signal div24_pw : unsigned(34 downto 0);
-  signal div24_p2 : unsigned(34 downto 0);
-  signal div24_bw_1 : unsigned(34 downto 0);
-  signal div24_p3 : unsigned(34 downto 0);
-  signal div24_ge : unsigned(0 downto 0);
-  signal div24_diff : unsigned(34 downto 0);
-  signal div24_pn : unsigned(34 downto 0);
-  signal div24_rem : unsigned(33 downto 0);
-  signal div24_q2 : unsigned(29 downto 0);
-  signal div24_gew : unsigned(29 downto 0);
-  signal div24_qn : unsigned(29 downto 0);
-  signal div26_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div26_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div26_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div26_bw : unsigned(34 downto 0);
-  signal div26_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div26_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div25_in : unsigned(0 downto 0);
-  signal div25_pw : unsigned(34 downto 0);
-  signal div25_p2 : unsigned(34 downto 0);
-  signal div25_bw_1 : unsigned(34 downto 0);
-  signal div25_p3 : unsigned(34 downto 0);
-  signal div25_ge : unsigned(0 downto 0);
-  signal div25_diff : unsigned(34 downto 0);
-  signal div25_pn : unsigned(34 downto 0);
-  signal div25_rem : unsigned(33 downto 0);
-  signal div25_q2 : unsigned(29 downto 0);
-  signal div25_gew : unsigned(29 downto 0);
-  signal div25_qn : unsigned(29 downto 0);
-  signal div27_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div27_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div27_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div27_bw : unsigned(34 downto 0);
-  signal div27_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div27_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div26_in : unsigned(0 downto 0);
-  signal div26_pw : unsigned(34 downto 0);
-  signal div26_p2 : unsigned(34 downto 0);
-  signal div26_bw_1 : unsigned(34 downto 0);
-  signal div26_p3 : unsigned(34 downto 0);
-  signal div26_ge : unsigned(0 downto 0);
-  signal div26_diff : unsigned(34 downto 0);
-  signal div26_pn : unsigned(34 downto 0);
-  signal div26_rem : unsigned(33 downto 0);
-  signal div26_q2 : unsigned(29 downto 0);
-  signal div26_gew : unsigned(29 downto 0);
-  signal div26_qn : unsigned(29 downto 0);
-  signal div28_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div28_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div28_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div28_bw : unsigned(34 downto 0);
-  signal div28_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div28_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div27_in : unsigned(0 downto 0);
-  signal div27_pw : unsigned(34 downto 0);
-  signal div27_p2 : unsigned(34 downto 0);
-  signal div27_bw_1 : unsigned(34 downto 0);
-  signal div27_p3 : unsigned(34 downto 0);
-  signal div27_ge : unsigned(0 downto 0);
-  signal div27_diff : unsigned(34 downto 0);
-  signal div27_pn : unsigned(34 downto 0);
-  signal div27_rem : unsigned(33 downto 0);
-  signal div27_q2 : unsigned(29 downto 0);
-  signal div27_gew : unsigned(29 downto 0);
-  signal div27_qn : unsigned(29 downto 0);
-  signal div29_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div29_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div29_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div29_bw : unsigned(34 downto 0);
-  signal div29_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div29_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div28_in : unsigned(0 downto 0);
-  signal div28_pw : unsigned(34 downto 0);
-  signal div28_p2 : unsigned(34 downto 0);
-  signal div28_bw_1 : unsigned(34 downto 0);
-  signal div28_p3 : unsigned(34 downto 0);
-  signal div28_ge : unsigned(0 downto 0);
-  signal div28_diff : unsigned(34 downto 0);
-  signal div28_pn : unsigned(34 downto 0);
-  signal div28_rem : unsigned(33 downto 0);
-  signal div28_q2 : unsigned(29 downto 0);
-  signal div28_gew : unsigned(29 downto 0);
-  signal div28_qn : unsigned(29 downto 0);
-  signal div30_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div30_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div30_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
-  signal div30_bw : unsigned(34 downto 0);
-  signal div30_lo : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div30_err : unsigned(0 downto 0) := unsigned'("0");
-  signal div29_in : unsigned(0 downto 0);
-  signal div29_pw : unsigned(34 downto 0);
-  signal div29_p2 : unsigned(34 downto 0);
-  signal div29_bw_1 : unsigned(34 downto 0);
-  signal div29_p3 : unsigned(34 downto 0);
-  signal div29_ge : unsigned(0 downto 0);
-  signal div29_diff : unsigned(34 downto 0);
-  signal div29_pn : unsigned(34 downto 0);
-  signal div29_rem : unsigned(33 downto 0);
-  signal div29_q2 : unsigned(29 downto 0);
-  signal div29_gew : unsigned(29 downto 0);
-  signal div29_qn : unsigned(29 downto 0);
-  constant div_zero_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div_q_zero : unsigned(0 downto 0);
-  signal div_bad : unsigned(0 downto 0);
-  constant div_one : unsigned(0 downto 0) := unsigned'("1");
-  signal div_ok_c : unsigned(0 downto 0);
-  signal div_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal div_ok : unsigned(0 downto 0) := unsigned'("0");
+  -- not in a stage or state machine
+
+  -- stage s1_operands: signs, zero tests, magnitudes
+  constant k_0 : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal num_neg : unsigned(0 downto 0);
+  constant k_0_1 : signed(33 downto 0) := signed'("0000000000000000000000000000000000");
+  signal den_neg : unsigned(0 downto 0);
+  signal neg_num : signed(62 downto 0);
+  signal mux_num_neg : signed(62 downto 0);
+  signal u_mux_num_neg : unsigned(62 downto 0);
+  signal neg_den : signed(33 downto 0);
+  signal mux_den_neg : signed(33 downto 0);
+  signal u_mux_den_neg : unsigned(33 downto 0);
+  signal num_eq_k_0 : unsigned(0 downto 0);
+  signal den_eq_k_0_1 : unsigned(0 downto 0);
+  signal or_0 : unsigned(0 downto 0);
+  signal num_neg_xor_den_neg : unsigned(0 downto 0);
+  signal err : unsigned(0 downto 0);
+  signal s1_a : unsigned(62 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s1_b : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s1_err : unsigned(0 downto 0) := unsigned'("0");
+
+  -- stage s2_q0: one quotient bit
+  signal bits_s1_a : unsigned(32 downto 0);
+  signal lo : unsigned(29 downto 0);
+  signal rs_bits_s1_a : unsigned(33 downto 0);
+  signal s1_b_le_rs_bits_s1_a : unsigned(0 downto 0);
+  signal err_1 : unsigned(0 downto 0);
+  signal rs_bits_s1_a_1 : unsigned(33 downto 0);
+  constant k_0_2 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal rs_s1_b : unsigned(34 downto 0);
+  signal rs_rs_bits_s1_a_1 : unsigned(34 downto 0);
+  signal shl_rs_rs_bits_s1_a_1 : unsigned(34 downto 0);
+  signal bits_lo : unsigned(0 downto 0);
+  signal rs_bits_lo : unsigned(34 downto 0);
+  signal or_3 : unsigned(34 downto 0);
+  signal ge0 : unsigned(0 downto 0);
+  signal or_3_minus_rs_s1_b : unsigned(34 downto 0);
+  signal mux_ge0 : unsigned(34 downto 0);
+  signal rs_mux_ge0 : unsigned(33 downto 0);
+  signal rs_ge0 : unsigned(29 downto 0);
+  signal k_0_2_or_rs_ge0 : unsigned(29 downto 0);
+  signal s2_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s2_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s3_q1: one quotient bit
+  signal s1_b_d1 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d1 : unsigned(34 downto 0);
+  signal rs_s2_p : unsigned(34 downto 0);
+  signal shl_rs_s2_p : unsigned(34 downto 0);
+  signal lo_d1 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d1 : unsigned(0 downto 0);
+  signal rs_bits_lo_d1 : unsigned(34 downto 0);
+  signal or_4 : unsigned(34 downto 0);
+  signal ge1 : unsigned(0 downto 0);
+  signal or_4_minus_rs_s1_b_d1 : unsigned(34 downto 0);
+  signal mux_ge1 : unsigned(34 downto 0);
+  signal rs_mux_ge1 : unsigned(33 downto 0);
+  signal shl_s2_q : unsigned(29 downto 0);
+  signal rs_ge1 : unsigned(29 downto 0);
+  signal shl_s2_q_or_rs_ge1 : unsigned(29 downto 0);
+  signal s3_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s3_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s4_q2: one quotient bit
+  signal s1_b_d2 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d2 : unsigned(34 downto 0);
+  signal rs_s3_p : unsigned(34 downto 0);
+  signal shl_rs_s3_p : unsigned(34 downto 0);
+  signal lo_d2 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d2 : unsigned(0 downto 0);
+  signal rs_bits_lo_d2 : unsigned(34 downto 0);
+  signal or_5 : unsigned(34 downto 0);
+  signal ge2 : unsigned(0 downto 0);
+  signal or_5_minus_rs_s1_b_d2 : unsigned(34 downto 0);
+  signal mux_ge2 : unsigned(34 downto 0);
+  signal rs_mux_ge2 : unsigned(33 downto 0);
+  signal shl_s3_q : unsigned(29 downto 0);
+  signal rs_ge2 : unsigned(29 downto 0);
+  signal shl_s3_q_or_rs_ge2 : unsigned(29 downto 0);
+  signal s4_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s4_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s5_q3: one quotient bit
+  signal s1_b_d3 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d3 : unsigned(34 downto 0);
+  signal rs_s4_p : unsigned(34 downto 0);
+  signal shl_rs_s4_p : unsigned(34 downto 0);
+  signal lo_d3 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d3 : unsigned(0 downto 0);
+  signal rs_bits_lo_d3 : unsigned(34 downto 0);
+  signal or_6 : unsigned(34 downto 0);
+  signal ge3 : unsigned(0 downto 0);
+  signal or_6_minus_rs_s1_b_d3 : unsigned(34 downto 0);
+  signal mux_ge3 : unsigned(34 downto 0);
+  signal rs_mux_ge3 : unsigned(33 downto 0);
+  signal shl_s4_q : unsigned(29 downto 0);
+  signal rs_ge3 : unsigned(29 downto 0);
+  signal shl_s4_q_or_rs_ge3 : unsigned(29 downto 0);
+  signal s5_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s5_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s6_q4: one quotient bit
+  signal s1_b_d4 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d4 : unsigned(34 downto 0);
+  signal rs_s5_p : unsigned(34 downto 0);
+  signal shl_rs_s5_p : unsigned(34 downto 0);
+  signal lo_d4 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d4 : unsigned(0 downto 0);
+  signal rs_bits_lo_d4 : unsigned(34 downto 0);
+  signal or_7 : unsigned(34 downto 0);
+  signal ge4 : unsigned(0 downto 0);
+  signal or_7_minus_rs_s1_b_d4 : unsigned(34 downto 0);
+  signal mux_ge4 : unsigned(34 downto 0);
+  signal rs_mux_ge4 : unsigned(33 downto 0);
+  signal shl_s5_q : unsigned(29 downto 0);
+  signal rs_ge4 : unsigned(29 downto 0);
+  signal shl_s5_q_or_rs_ge4 : unsigned(29 downto 0);
+  signal s6_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s6_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s7_q5: one quotient bit
+  signal s1_b_d5 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d5 : unsigned(34 downto 0);
+  signal rs_s6_p : unsigned(34 downto 0);
+  signal shl_rs_s6_p : unsigned(34 downto 0);
+  signal lo_d5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d5 : unsigned(0 downto 0);
+  signal rs_bits_lo_d5 : unsigned(34 downto 0);
+  signal or_8 : unsigned(34 downto 0);
+  signal ge5 : unsigned(0 downto 0);
+  signal or_8_minus_rs_s1_b_d5 : unsigned(34 downto 0);
+  signal mux_ge5 : unsigned(34 downto 0);
+  signal rs_mux_ge5 : unsigned(33 downto 0);
+  signal shl_s6_q : unsigned(29 downto 0);
+  signal rs_ge5 : unsigned(29 downto 0);
+  signal shl_s6_q_or_rs_ge5 : unsigned(29 downto 0);
+  signal s7_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s7_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s8_q6: one quotient bit
+  signal s1_b_d6 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d6 : unsigned(34 downto 0);
+  signal rs_s7_p : unsigned(34 downto 0);
+  signal shl_rs_s7_p : unsigned(34 downto 0);
+  signal lo_d6 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d6 : unsigned(0 downto 0);
+  signal rs_bits_lo_d6 : unsigned(34 downto 0);
+  signal or_9 : unsigned(34 downto 0);
+  signal ge6 : unsigned(0 downto 0);
+  signal or_9_minus_rs_s1_b_d6 : unsigned(34 downto 0);
+  signal mux_ge6 : unsigned(34 downto 0);
+  signal rs_mux_ge6 : unsigned(33 downto 0);
+  signal shl_s7_q : unsigned(29 downto 0);
+  signal rs_ge6 : unsigned(29 downto 0);
+  signal shl_s7_q_or_rs_ge6 : unsigned(29 downto 0);
+  signal s8_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s8_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s9_q7: one quotient bit
+  signal s1_b_d7 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d7 : unsigned(34 downto 0);
+  signal rs_s8_p : unsigned(34 downto 0);
+  signal shl_rs_s8_p : unsigned(34 downto 0);
+  signal lo_d7 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d7 : unsigned(0 downto 0);
+  signal rs_bits_lo_d7 : unsigned(34 downto 0);
+  signal or_10 : unsigned(34 downto 0);
+  signal ge7 : unsigned(0 downto 0);
+  signal or_10_minus_rs_s1_b_d7 : unsigned(34 downto 0);
+  signal mux_ge7 : unsigned(34 downto 0);
+  signal rs_mux_ge7 : unsigned(33 downto 0);
+  signal shl_s8_q : unsigned(29 downto 0);
+  signal rs_ge7 : unsigned(29 downto 0);
+  signal shl_s8_q_or_rs_ge7 : unsigned(29 downto 0);
+  signal s9_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s9_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s10_q8: one quotient bit
+  signal s1_b_d8 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d8 : unsigned(34 downto 0);
+  signal rs_s9_p : unsigned(34 downto 0);
+  signal shl_rs_s9_p : unsigned(34 downto 0);
+  signal lo_d8 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d8 : unsigned(0 downto 0);
+  signal rs_bits_lo_d8 : unsigned(34 downto 0);
+  signal or_11 : unsigned(34 downto 0);
+  signal ge8 : unsigned(0 downto 0);
+  signal or_11_minus_rs_s1_b_d8 : unsigned(34 downto 0);
+  signal mux_ge8 : unsigned(34 downto 0);
+  signal rs_mux_ge8 : unsigned(33 downto 0);
+  signal shl_s9_q : unsigned(29 downto 0);
+  signal rs_ge8 : unsigned(29 downto 0);
+  signal shl_s9_q_or_rs_ge8 : unsigned(29 downto 0);
+  signal s10_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s10_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s11_q9: one quotient bit
+  signal s1_b_d9 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d9 : unsigned(34 downto 0);
+  signal rs_s10_p : unsigned(34 downto 0);
+  signal shl_rs_s10_p : unsigned(34 downto 0);
+  signal lo_d9 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d9 : unsigned(0 downto 0);
+  signal rs_bits_lo_d9 : unsigned(34 downto 0);
+  signal or_12 : unsigned(34 downto 0);
+  signal ge9 : unsigned(0 downto 0);
+  signal or_12_minus_rs_s1_b_d9 : unsigned(34 downto 0);
+  signal mux_ge9 : unsigned(34 downto 0);
+  signal rs_mux_ge9 : unsigned(33 downto 0);
+  signal shl_s10_q : unsigned(29 downto 0);
+  signal rs_ge9 : unsigned(29 downto 0);
+  signal shl_s10_q_or_rs_ge9 : unsigned(29 downto 0);
+  signal s11_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s11_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s12_q10: one quotient bit
+  signal s1_b_d10 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d10 : unsigned(34 downto 0);
+  signal rs_s11_p : unsigned(34 downto 0);
+  signal shl_rs_s11_p : unsigned(34 downto 0);
+  signal lo_d10 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d10 : unsigned(0 downto 0);
+  signal rs_bits_lo_d10 : unsigned(34 downto 0);
+  signal or_13 : unsigned(34 downto 0);
+  signal ge10 : unsigned(0 downto 0);
+  signal or_13_minus_rs_s1_b_d10 : unsigned(34 downto 0);
+  signal mux_ge10 : unsigned(34 downto 0);
+  signal rs_mux_ge10 : unsigned(33 downto 0);
+  signal shl_s11_q : unsigned(29 downto 0);
+  signal rs_ge10 : unsigned(29 downto 0);
+  signal shl_s11_q_or_rs_ge10 : unsigned(29 downto 0);
+  signal s12_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s12_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s13_q11: one quotient bit
+  signal s1_b_d11 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d11 : unsigned(34 downto 0);
+  signal rs_s12_p : unsigned(34 downto 0);
+  signal shl_rs_s12_p : unsigned(34 downto 0);
+  signal lo_d11 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d11 : unsigned(0 downto 0);
+  signal rs_bits_lo_d11 : unsigned(34 downto 0);
+  signal or_14 : unsigned(34 downto 0);
+  signal ge11 : unsigned(0 downto 0);
+  signal or_14_minus_rs_s1_b_d11 : unsigned(34 downto 0);
+  signal mux_ge11 : unsigned(34 downto 0);
+  signal rs_mux_ge11 : unsigned(33 downto 0);
+  signal shl_s12_q : unsigned(29 downto 0);
+  signal rs_ge11 : unsigned(29 downto 0);
+  signal shl_s12_q_or_rs_ge11 : unsigned(29 downto 0);
+  signal s13_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s13_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s14_q12: one quotient bit
+  signal s1_b_d12 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d12 : unsigned(34 downto 0);
+  signal rs_s13_p : unsigned(34 downto 0);
+  signal shl_rs_s13_p : unsigned(34 downto 0);
+  signal lo_d12 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d12 : unsigned(0 downto 0);
+  signal rs_bits_lo_d12 : unsigned(34 downto 0);
+  signal or_15 : unsigned(34 downto 0);
+  signal ge12 : unsigned(0 downto 0);
+  signal or_15_minus_rs_s1_b_d12 : unsigned(34 downto 0);
+  signal mux_ge12 : unsigned(34 downto 0);
+  signal rs_mux_ge12 : unsigned(33 downto 0);
+  signal shl_s13_q : unsigned(29 downto 0);
+  signal rs_ge12 : unsigned(29 downto 0);
+  signal shl_s13_q_or_rs_ge12 : unsigned(29 downto 0);
+  signal s14_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s14_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s15_q13: one quotient bit
+  signal s1_b_d13 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d13 : unsigned(34 downto 0);
+  signal rs_s14_p : unsigned(34 downto 0);
+  signal shl_rs_s14_p : unsigned(34 downto 0);
+  signal lo_d13 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d13 : unsigned(0 downto 0);
+  signal rs_bits_lo_d13 : unsigned(34 downto 0);
+  signal or_16 : unsigned(34 downto 0);
+  signal ge13 : unsigned(0 downto 0);
+  signal or_16_minus_rs_s1_b_d13 : unsigned(34 downto 0);
+  signal mux_ge13 : unsigned(34 downto 0);
+  signal rs_mux_ge13 : unsigned(33 downto 0);
+  signal shl_s14_q : unsigned(29 downto 0);
+  signal rs_ge13 : unsigned(29 downto 0);
+  signal shl_s14_q_or_rs_ge13 : unsigned(29 downto 0);
+  signal s15_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s15_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s16_q14: one quotient bit
+  signal s1_b_d14 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d14 : unsigned(34 downto 0);
+  signal rs_s15_p : unsigned(34 downto 0);
+  signal shl_rs_s15_p : unsigned(34 downto 0);
+  signal lo_d14 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d14 : unsigned(0 downto 0);
+  signal rs_bits_lo_d14 : unsigned(34 downto 0);
+  signal or_17 : unsigned(34 downto 0);
+  signal ge14 : unsigned(0 downto 0);
+  signal or_17_minus_rs_s1_b_d14 : unsigned(34 downto 0);
+  signal mux_ge14 : unsigned(34 downto 0);
+  signal rs_mux_ge14 : unsigned(33 downto 0);
+  signal shl_s15_q : unsigned(29 downto 0);
+  signal rs_ge14 : unsigned(29 downto 0);
+  signal shl_s15_q_or_rs_ge14 : unsigned(29 downto 0);
+  signal s16_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s16_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s17_q15: one quotient bit
+  signal s1_b_d15 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d15 : unsigned(34 downto 0);
+  signal rs_s16_p : unsigned(34 downto 0);
+  signal shl_rs_s16_p : unsigned(34 downto 0);
+  signal lo_d15 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d15 : unsigned(0 downto 0);
+  signal rs_bits_lo_d15 : unsigned(34 downto 0);
+  signal or_18 : unsigned(34 downto 0);
+  signal ge15 : unsigned(0 downto 0);
+  signal or_18_minus_rs_s1_b_d15 : unsigned(34 downto 0);
+  signal mux_ge15 : unsigned(34 downto 0);
+  signal rs_mux_ge15 : unsigned(33 downto 0);
+  signal shl_s16_q : unsigned(29 downto 0);
+  signal rs_ge15 : unsigned(29 downto 0);
+  signal shl_s16_q_or_rs_ge15 : unsigned(29 downto 0);
+  signal s17_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s17_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s18_q16: one quotient bit
+  signal s1_b_d16 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d16 : unsigned(34 downto 0);
+  signal rs_s17_p : unsigned(34 downto 0);
+  signal shl_rs_s17_p : unsigned(34 downto 0);
+  signal lo_d16 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d16 : unsigned(0 downto 0);
+  signal rs_bits_lo_d16 : unsigned(34 downto 0);
+  signal or_19 : unsigned(34 downto 0);
+  signal ge16 : unsigned(0 downto 0);
+  signal or_19_minus_rs_s1_b_d16 : unsigned(34 downto 0);
+  signal mux_ge16 : unsigned(34 downto 0);
+  signal rs_mux_ge16 : unsigned(33 downto 0);
+  signal shl_s17_q : unsigned(29 downto 0);
+  signal rs_ge16 : unsigned(29 downto 0);
+  signal shl_s17_q_or_rs_ge16 : unsigned(29 downto 0);
+  signal s18_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s18_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s19_q17: one quotient bit
+  signal s1_b_d17 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d17 : unsigned(34 downto 0);
+  signal rs_s18_p : unsigned(34 downto 0);
+  signal shl_rs_s18_p : unsigned(34 downto 0);
+  signal lo_d17 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d17 : unsigned(0 downto 0);
+  signal rs_bits_lo_d17 : unsigned(34 downto 0);
+  signal or_20 : unsigned(34 downto 0);
+  signal ge17 : unsigned(0 downto 0);
+  signal or_20_minus_rs_s1_b_d17 : unsigned(34 downto 0);
+  signal mux_ge17 : unsigned(34 downto 0);
+  signal rs_mux_ge17 : unsigned(33 downto 0);
+  signal shl_s18_q : unsigned(29 downto 0);
+  signal rs_ge17 : unsigned(29 downto 0);
+  signal shl_s18_q_or_rs_ge17 : unsigned(29 downto 0);
+  signal s19_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s19_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s20_q18: one quotient bit
+  signal s1_b_d18 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d18 : unsigned(34 downto 0);
+  signal rs_s19_p : unsigned(34 downto 0);
+  signal shl_rs_s19_p : unsigned(34 downto 0);
+  signal lo_d18 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d18 : unsigned(0 downto 0);
+  signal rs_bits_lo_d18 : unsigned(34 downto 0);
+  signal or_21 : unsigned(34 downto 0);
+  signal ge18 : unsigned(0 downto 0);
+  signal or_21_minus_rs_s1_b_d18 : unsigned(34 downto 0);
+  signal mux_ge18 : unsigned(34 downto 0);
+  signal rs_mux_ge18 : unsigned(33 downto 0);
+  signal shl_s19_q : unsigned(29 downto 0);
+  signal rs_ge18 : unsigned(29 downto 0);
+  signal shl_s19_q_or_rs_ge18 : unsigned(29 downto 0);
+  signal s20_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s20_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s21_q19: one quotient bit
+  signal s1_b_d19 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d19 : unsigned(34 downto 0);
+  signal rs_s20_p : unsigned(34 downto 0);
+  signal shl_rs_s20_p : unsigned(34 downto 0);
+  signal lo_d19 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d19 : unsigned(0 downto 0);
+  signal rs_bits_lo_d19 : unsigned(34 downto 0);
+  signal or_22 : unsigned(34 downto 0);
+  signal ge19 : unsigned(0 downto 0);
+  signal or_22_minus_rs_s1_b_d19 : unsigned(34 downto 0);
+  signal mux_ge19 : unsigned(34 downto 0);
+  signal rs_mux_ge19 : unsigned(33 downto 0);
+  signal shl_s20_q : unsigned(29 downto 0);
+  signal rs_ge19 : unsigned(29 downto 0);
+  signal shl_s20_q_or_rs_ge19 : unsigned(29 downto 0);
+  signal s21_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s21_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s22_q20: one quotient bit
+  signal s1_b_d20 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d20 : unsigned(34 downto 0);
+  signal rs_s21_p : unsigned(34 downto 0);
+  signal shl_rs_s21_p : unsigned(34 downto 0);
+  signal lo_d20 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d20 : unsigned(0 downto 0);
+  signal rs_bits_lo_d20 : unsigned(34 downto 0);
+  signal or_23 : unsigned(34 downto 0);
+  signal ge20 : unsigned(0 downto 0);
+  signal or_23_minus_rs_s1_b_d20 : unsigned(34 downto 0);
+  signal mux_ge20 : unsigned(34 downto 0);
+  signal rs_mux_ge20 : unsigned(33 downto 0);
+  signal shl_s21_q : unsigned(29 downto 0);
+  signal rs_ge20 : unsigned(29 downto 0);
+  signal shl_s21_q_or_rs_ge20 : unsigned(29 downto 0);
+  signal s22_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s22_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s23_q21: one quotient bit
+  signal s1_b_d21 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d21 : unsigned(34 downto 0);
+  signal rs_s22_p : unsigned(34 downto 0);
+  signal shl_rs_s22_p : unsigned(34 downto 0);
+  signal lo_d21 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d21 : unsigned(0 downto 0);
+  signal rs_bits_lo_d21 : unsigned(34 downto 0);
+  signal or_24 : unsigned(34 downto 0);
+  signal ge21 : unsigned(0 downto 0);
+  signal or_24_minus_rs_s1_b_d21 : unsigned(34 downto 0);
+  signal mux_ge21 : unsigned(34 downto 0);
+  signal rs_mux_ge21 : unsigned(33 downto 0);
+  signal shl_s22_q : unsigned(29 downto 0);
+  signal rs_ge21 : unsigned(29 downto 0);
+  signal shl_s22_q_or_rs_ge21 : unsigned(29 downto 0);
+  signal s23_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s23_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s24_q22: one quotient bit
+  signal s1_b_d22 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d22 : unsigned(34 downto 0);
+  signal rs_s23_p : unsigned(34 downto 0);
+  signal shl_rs_s23_p : unsigned(34 downto 0);
+  signal lo_d22 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d22 : unsigned(0 downto 0);
+  signal rs_bits_lo_d22 : unsigned(34 downto 0);
+  signal or_25 : unsigned(34 downto 0);
+  signal ge22 : unsigned(0 downto 0);
+  signal or_25_minus_rs_s1_b_d22 : unsigned(34 downto 0);
+  signal mux_ge22 : unsigned(34 downto 0);
+  signal rs_mux_ge22 : unsigned(33 downto 0);
+  signal shl_s23_q : unsigned(29 downto 0);
+  signal rs_ge22 : unsigned(29 downto 0);
+  signal shl_s23_q_or_rs_ge22 : unsigned(29 downto 0);
+  signal s24_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s24_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s25_q23: one quotient bit
+  signal s1_b_d23 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d23 : unsigned(34 downto 0);
+  signal rs_s24_p : unsigned(34 downto 0);
+  signal shl_rs_s24_p : unsigned(34 downto 0);
+  signal lo_d23 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d23 : unsigned(0 downto 0);
+  signal rs_bits_lo_d23 : unsigned(34 downto 0);
+  signal or_26 : unsigned(34 downto 0);
+  signal ge23 : unsigned(0 downto 0);
+  signal or_26_minus_rs_s1_b_d23 : unsigned(34 downto 0);
+  signal mux_ge23 : unsigned(34 downto 0);
+  signal rs_mux_ge23 : unsigned(33 downto 0);
+  signal shl_s24_q : unsigned(29 downto 0);
+  signal rs_ge23 : unsigned(29 downto 0);
+  signal shl_s24_q_or_rs_ge23 : unsigned(29 downto 0);
+  signal s25_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s25_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s26_q24: one quotient bit
+  signal s1_b_d24 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d24 : unsigned(34 downto 0);
+  signal rs_s25_p : unsigned(34 downto 0);
+  signal shl_rs_s25_p : unsigned(34 downto 0);
+  signal lo_d24 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d24 : unsigned(0 downto 0);
+  signal rs_bits_lo_d24 : unsigned(34 downto 0);
+  signal or_27 : unsigned(34 downto 0);
+  signal ge24 : unsigned(0 downto 0);
+  signal or_27_minus_rs_s1_b_d24 : unsigned(34 downto 0);
+  signal mux_ge24 : unsigned(34 downto 0);
+  signal rs_mux_ge24 : unsigned(33 downto 0);
+  signal shl_s25_q : unsigned(29 downto 0);
+  signal rs_ge24 : unsigned(29 downto 0);
+  signal shl_s25_q_or_rs_ge24 : unsigned(29 downto 0);
+  signal s26_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s26_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s27_q25: one quotient bit
+  signal s1_b_d25 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d25 : unsigned(34 downto 0);
+  signal rs_s26_p : unsigned(34 downto 0);
+  signal shl_rs_s26_p : unsigned(34 downto 0);
+  signal lo_d25 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d25 : unsigned(0 downto 0);
+  signal rs_bits_lo_d25 : unsigned(34 downto 0);
+  signal or_28 : unsigned(34 downto 0);
+  signal ge25 : unsigned(0 downto 0);
+  signal or_28_minus_rs_s1_b_d25 : unsigned(34 downto 0);
+  signal mux_ge25 : unsigned(34 downto 0);
+  signal rs_mux_ge25 : unsigned(33 downto 0);
+  signal shl_s26_q : unsigned(29 downto 0);
+  signal rs_ge25 : unsigned(29 downto 0);
+  signal shl_s26_q_or_rs_ge25 : unsigned(29 downto 0);
+  signal s27_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s27_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s28_q26: one quotient bit
+  signal s1_b_d26 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d26 : unsigned(34 downto 0);
+  signal rs_s27_p : unsigned(34 downto 0);
+  signal shl_rs_s27_p : unsigned(34 downto 0);
+  signal lo_d26 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d26 : unsigned(0 downto 0);
+  signal rs_bits_lo_d26 : unsigned(34 downto 0);
+  signal or_29 : unsigned(34 downto 0);
+  signal ge26 : unsigned(0 downto 0);
+  signal or_29_minus_rs_s1_b_d26 : unsigned(34 downto 0);
+  signal mux_ge26 : unsigned(34 downto 0);
+  signal rs_mux_ge26 : unsigned(33 downto 0);
+  signal shl_s27_q : unsigned(29 downto 0);
+  signal rs_ge26 : unsigned(29 downto 0);
+  signal shl_s27_q_or_rs_ge26 : unsigned(29 downto 0);
+  signal s28_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s28_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s29_q27: one quotient bit
+  signal s1_b_d27 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d27 : unsigned(34 downto 0);
+  signal rs_s28_p : unsigned(34 downto 0);
+  signal shl_rs_s28_p : unsigned(34 downto 0);
+  signal lo_d27 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d27 : unsigned(0 downto 0);
+  signal rs_bits_lo_d27 : unsigned(34 downto 0);
+  signal or_30 : unsigned(34 downto 0);
+  signal ge27 : unsigned(0 downto 0);
+  signal or_30_minus_rs_s1_b_d27 : unsigned(34 downto 0);
+  signal mux_ge27 : unsigned(34 downto 0);
+  signal rs_mux_ge27 : unsigned(33 downto 0);
+  signal shl_s28_q : unsigned(29 downto 0);
+  signal rs_ge27 : unsigned(29 downto 0);
+  signal shl_s28_q_or_rs_ge27 : unsigned(29 downto 0);
+  signal s29_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s29_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s30_q28: one quotient bit
+  signal s1_b_d28 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d28 : unsigned(34 downto 0);
+  signal rs_s29_p : unsigned(34 downto 0);
+  signal shl_rs_s29_p : unsigned(34 downto 0);
+  signal lo_d28 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d28 : unsigned(0 downto 0);
+  signal rs_bits_lo_d28 : unsigned(34 downto 0);
+  signal or_31 : unsigned(34 downto 0);
+  signal ge28 : unsigned(0 downto 0);
+  signal or_31_minus_rs_s1_b_d28 : unsigned(34 downto 0);
+  signal mux_ge28 : unsigned(34 downto 0);
+  signal rs_mux_ge28 : unsigned(33 downto 0);
+  signal shl_s29_q : unsigned(29 downto 0);
+  signal rs_ge28 : unsigned(29 downto 0);
+  signal shl_s29_q_or_rs_ge28 : unsigned(29 downto 0);
+  signal s30_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal s30_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+
+  -- stage s31_result: the quotient and its result flag
+  signal s1_b_d29 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal rs_s1_b_d29 : unsigned(34 downto 0);
+  signal rs_s30_p : unsigned(34 downto 0);
+  signal shl_rs_s30_p : unsigned(34 downto 0);
+  signal lo_d29 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal bits_lo_d29 : unsigned(0 downto 0);
+  signal rs_bits_lo_d29 : unsigned(34 downto 0);
+  signal or_32 : unsigned(34 downto 0);
+  signal ge29 : unsigned(0 downto 0);
+  signal or_32_minus_rs_s1_b_d29 : unsigned(34 downto 0);
+  signal mux_ge29 : unsigned(34 downto 0);
+  signal rs_mux_ge29 : unsigned(33 downto 0);
+  signal shl_s30_q : unsigned(29 downto 0);
+  signal rs_ge29 : unsigned(29 downto 0);
+  signal shl_s30_q_or_rs_ge29 : unsigned(29 downto 0);
+  type err_1_d29_sr_t is array (1 to 29) of unsigned(0 downto 0);
+  signal err_1_d29_sr : err_1_d29_sr_t := (others => (others => '0'));
+  signal err_1_d29 : unsigned(0 downto 0);
+  signal eq_33 : unsigned(0 downto 0);
+  signal err_1_d29_or_eq_33 : unsigned(0 downto 0);
+  signal not_err_1_d29_or_eq_33 : unsigned(0 downto 0);
+  signal s31_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s31_ok : unsigned(0 downto 0) := unsigned'("0");
 begin
 
-  div_num_neg <= "1" when num < div_zero_n else "0";
-  div_den_neg <= "1" when den < div_zero_d else "0";
-  div_num_zero <= "1" when num = div_zero_n else "0";
-  div_den_zero <= "1" when den = div_zero_d else "0";
-  div_sign_diff <= div_num_neg xor div_den_neg;
-  div_err_a <= div_num_zero or div_den_zero;
-  div_err_b <= div_err_a or div_sign_diff;
-  div_num_negated <= -num;
-  div_num_abs_s <= div_num_negated when div_num_neg = "1" else num;
-  div_a <= unsigned(div_num_abs_s);
-  div_den_negated <= -den;
-  div_den_abs_s <= div_den_negated when div_den_neg = "1" else den;
-  div_b <= unsigned(div_den_abs_s);
-  div_hi <= unsigned(div1_a(62 downto 30));
-  div_lo <= div1_a(29 downto 0);
-  div_hi_c <= resize(div_hi, 34);
-  div_overflow <= "1" when div1_b <= div_hi_c else "0";
-  div_err_c <= div1_err or div_overflow;
-  div_p0 <= resize(div_hi, 34);
-  div_b_w <= resize(div1_b, 35);
-  div0_in <= unsigned(div_lo(29 downto 29));
-  div0_pw <= resize(div_p0, 35);
-  div0_p2 <= shift_left(div0_pw, 1);
-  div0_bw <= resize(div0_in, 35);
-  div0_p3 <= div0_p2 or div0_bw;
-  div0_ge <= "1" when div_b_w <= div0_p3 else "0";
-  div0_diff <= div0_p3 - div_b_w;
-  div0_pn <= div0_diff when div0_ge = "1" else div0_p3;
-  div0_rem <= div0_pn(33 downto 0);
-  div0_q2 <= shift_left(div_q0, 1);
-  div0_gew <= resize(div0_ge, 30);
-  div0_qn <= div0_q2 or div0_gew;
-  div2_bw <= resize(div2_b, 35);
-  div1_in <= unsigned(div2_lo(28 downto 28));
-  div1_pw <= resize(div2_p, 35);
-  div1_p2 <= shift_left(div1_pw, 1);
-  div1_bw <= resize(div1_in, 35);
-  div1_p3 <= div1_p2 or div1_bw;
-  div1_ge <= "1" when div2_bw <= div1_p3 else "0";
-  div1_diff <= div1_p3 - div2_bw;
-  div1_pn <= div1_diff when div1_ge = "1" else div1_p3;
-  div1_rem <= div1_pn(33 downto 0);
-  div1_q2 <= shift_left(div2_q, 1);
-  div1_gew <= resize(div1_ge, 30);
-  div1_qn <= div1_q2 or div1_gew;
-  div3_bw <= resize(div3_b, 35);
-  div2_in <= unsigned(div3_lo(27 downto 27));
-  div2_pw <= resize(div3_p, 35);
-  div2_p2 <= shift_left(div2_pw, 1);
-  div2_bw_1 <= resize(div2_in, 35);
-  div2_p3 <= div2_p2 or div2_bw_1;
-  div2_ge <= "1" when div3_bw <= div2_p3 else "0";
-  div2_diff <= div2_p3 - div3_bw;
-  div2_pn <= div2_diff when div2_ge = "1" else div2_p3;
-  div2_rem <= div2_pn(33 downto 0);
-  div2_q2 <= shift_left(div3_q, 1);
-  div2_gew <= resize(div2_ge, 30);
-  div2_qn <= div2_q2 or div2_gew;
-  div4_bw <= resize(div4_b, 35);
-  div3_in <= unsigned(div4_lo(26 downto 26));
-  div3_pw <= resize(div4_p, 35);
-  div3_p2 <= shift_left(div3_pw, 1);
-  div3_bw_1 <= resize(div3_in, 35);
-  div3_p3 <= div3_p2 or div3_bw_1;
-  div3_ge <= "1" when div4_bw <= div3_p3 else "0";
-  div3_diff <= div3_p3 - div4_bw;
-  div3_pn <= div3_diff when div3_ge = "1" else div3_p3;
-  div3_rem <= div3_pn(33 downto 0);
-  div3_q2 <= shift_left(div4_q, 1);
-  div3_gew <= resize(div3_ge, 30);
-  div3_qn <= div3_q2 or div3_gew;
-  div5_bw <= resize(div5_b, 35);
-  div4_in <= unsigned(div5_lo(25 downto 25));
-  div4_pw <= resize(div5_p, 35);
-  div4_p2 <= shift_left(div4_pw, 1);
-  div4_bw_1 <= resize(div4_in, 35);
-  div4_p3 <= div4_p2 or div4_bw_1;
-  div4_ge <= "1" when div5_bw <= div4_p3 else "0";
-  div4_diff <= div4_p3 - div5_bw;
-  div4_pn <= div4_diff when div4_ge = "1" else div4_p3;
-  div4_rem <= div4_pn(33 downto 0);
-  div4_q2 <= shift_left(div5_q, 1);
-  div4_gew <= resize(div4_ge, 30);
-  div4_qn <= div4_q2 or div4_gew;
-  div6_bw <= resize(div6_b, 35);
-  div5_in <= unsigned(div6_lo(24 downto 24));
-  div5_pw <= resize(div6_p, 35);
-  div5_p2 <= shift_left(div5_pw, 1);
-  div5_bw_1 <= resize(div5_in, 35);
-  div5_p3 <= div5_p2 or div5_bw_1;
-  div5_ge <= "1" when div6_bw <= div5_p3 else "0";
-  div5_diff <= div5_p3 - div6_bw;
-  div5_pn <= div5_diff when div5_ge = "1" else div5_p3;
-  div5_rem <= div5_pn(33 downto 0);
-  div5_q2 <= shift_left(div6_q, 1);
-  div5_gew <= resize(div5_ge, 30);
-  div5_qn <= div5_q2 or div5_gew;
-  div7_bw <= resize(div7_b, 35);
-  div6_in <= unsigned(div7_lo(23 downto 23));
-  div6_pw <= resize(div7_p, 35);
-  div6_p2 <= shift_left(div6_pw, 1);
-  div6_bw_1 <= resize(div6_in, 35);
-  div6_p3 <= div6_p2 or div6_bw_1;
-  div6_ge <= "1" when div7_bw <= div6_p3 else "0";
-  div6_diff <= div6_p3 - div7_bw;
-  div6_pn <= div6_diff when div6_ge = "1" else div6_p3;
-  div6_rem <= div6_pn(33 downto 0);
-  div6_q2 <= shift_left(div7_q, 1);
-  div6_gew <= resize(div6_ge, 30);
-  div6_qn <= div6_q2 or div6_gew;
-  div8_bw <= resize(div8_b, 35);
-  div7_in <= unsigned(div8_lo(22 downto 22));
-  div7_pw <= resize(div8_p, 35);
-  div7_p2 <= shift_left(div7_pw, 1);
-  div7_bw_1 <= resize(div7_in, 35);
-  div7_p3 <= div7_p2 or div7_bw_1;
-  div7_ge <= "1" when div8_bw <= div7_p3 else "0";
-  div7_diff <= div7_p3 - div8_bw;
-  div7_pn <= div7_diff when div7_ge = "1" else div7_p3;
-  div7_rem <= div7_pn(33 downto 0);
-  div7_q2 <= shift_left(div8_q, 1);
-  div7_gew <= resize(div7_ge, 30);
-  div7_qn <= div7_q2 or div7_gew;
-  div9_bw <= resize(div9_b, 35);
-  div8_in <= unsigned(div9_lo(21 downto 21));
-  div8_pw <= resize(div9_p, 35);
-  div8_p2 <= shift_left(div8_pw, 1);
-  div8_bw_1 <= resize(div8_in, 35);
-  div8_p3 <= div8_p2 or div8_bw_1;
-  div8_ge <= "1" when div9_bw <= div8_p3 else "0";
-  div8_diff <= div8_p3 - div9_bw;
-  div8_pn <= div8_diff when div8_ge = "1" else div8_p3;
-  div8_rem <= div8_pn(33 downto 0);
-  div8_q2 <= shift_left(div9_q, 1);
-  div8_gew <= resize(div8_ge, 30);
-  div8_qn <= div8_q2 or div8_gew;
-  div10_bw <= resize(div10_b, 35);
-  div9_in <= unsigned(div10_lo(20 downto 20));
-  div9_pw <= resize(div10_p, 35);
-  div9_p2 <= shift_left(div9_pw, 1);
-  div9_bw_1 <= resize(div9_in, 35);
-  div9_p3 <= div9_p2 or div9_bw_1;
-  div9_ge <= "1" when div10_bw <= div9_p3 else "0";
-  div9_diff <= div9_p3 - div10_bw;
-  div9_pn <= div9_diff when div9_ge = "1" else div9_p3;
-  div9_rem <= div9_pn(33 downto 0);
-  div9_q2 <= shift_left(div10_q, 1);
-  div9_gew <= resize(div9_ge, 30);
-  div9_qn <= div9_q2 or div9_gew;
-  div11_bw <= resize(div11_b, 35);
-  div10_in <= unsigned(div11_lo(19 downto 19));
-  div10_pw <= resize(div11_p, 35);
-  div10_p2 <= shift_left(div10_pw, 1);
-  div10_bw_1 <= resize(div10_in, 35);
-  div10_p3 <= div10_p2 or div10_bw_1;
-  div10_ge <= "1" when div11_bw <= div10_p3 else "0";
-  div10_diff <= div10_p3 - div11_bw;
-  div10_pn <= div10_diff when div10_ge = "1" else div10_p3;
-  div10_rem <= div10_pn(33 downto 0);
-  div10_q2 <= shift_left(div11_q, 1);
-  div10_gew <= resize(div10_ge, 30);
-  div10_qn <= div10_q2 or div10_gew;
-  div12_bw <= resize(div12_b, 35);
-  div11_in <= unsigned(div12_lo(18 downto 18));
-  div11_pw <= resize(div12_p, 35);
-  div11_p2 <= shift_left(div11_pw, 1);
-  div11_bw_1 <= resize(div11_in, 35);
-  div11_p3 <= div11_p2 or div11_bw_1;
-  div11_ge <= "1" when div12_bw <= div11_p3 else "0";
-  div11_diff <= div11_p3 - div12_bw;
-  div11_pn <= div11_diff when div11_ge = "1" else div11_p3;
-  div11_rem <= div11_pn(33 downto 0);
-  div11_q2 <= shift_left(div12_q, 1);
-  div11_gew <= resize(div11_ge, 30);
-  div11_qn <= div11_q2 or div11_gew;
-  div13_bw <= resize(div13_b, 35);
-  div12_in <= unsigned(div13_lo(17 downto 17));
-  div12_pw <= resize(div13_p, 35);
-  div12_p2 <= shift_left(div12_pw, 1);
-  div12_bw_1 <= resize(div12_in, 35);
-  div12_p3 <= div12_p2 or div12_bw_1;
-  div12_ge <= "1" when div13_bw <= div12_p3 else "0";
-  div12_diff <= div12_p3 - div13_bw;
-  div12_pn <= div12_diff when div12_ge = "1" else div12_p3;
-  div12_rem <= div12_pn(33 downto 0);
-  div12_q2 <= shift_left(div13_q, 1);
-  div12_gew <= resize(div12_ge, 30);
-  div12_qn <= div12_q2 or div12_gew;
-  div14_bw <= resize(div14_b, 35);
-  div13_in <= unsigned(div14_lo(16 downto 16));
-  div13_pw <= resize(div14_p, 35);
-  div13_p2 <= shift_left(div13_pw, 1);
-  div13_bw_1 <= resize(div13_in, 35);
-  div13_p3 <= div13_p2 or div13_bw_1;
-  div13_ge <= "1" when div14_bw <= div13_p3 else "0";
-  div13_diff <= div13_p3 - div14_bw;
-  div13_pn <= div13_diff when div13_ge = "1" else div13_p3;
-  div13_rem <= div13_pn(33 downto 0);
-  div13_q2 <= shift_left(div14_q, 1);
-  div13_gew <= resize(div13_ge, 30);
-  div13_qn <= div13_q2 or div13_gew;
-  div15_bw <= resize(div15_b, 35);
-  div14_in <= unsigned(div15_lo(15 downto 15));
-  div14_pw <= resize(div15_p, 35);
-  div14_p2 <= shift_left(div14_pw, 1);
-  div14_bw_1 <= resize(div14_in, 35);
-  div14_p3 <= div14_p2 or div14_bw_1;
-  div14_ge <= "1" when div15_bw <= div14_p3 else "0";
-  div14_diff <= div14_p3 - div15_bw;
-  div14_pn <= div14_diff when div14_ge = "1" else div14_p3;
-  div14_rem <= div14_pn(33 downto 0);
-  div14_q2 <= shift_left(div15_q, 1);
-  div14_gew <= resize(div14_ge, 30);
-  div14_qn <= div14_q2 or div14_gew;
-  div16_bw <= resize(div16_b, 35);
-  div15_in <= unsigned(div16_lo(14 downto 14));
-  div15_pw <= resize(div16_p, 35);
-  div15_p2 <= shift_left(div15_pw, 1);
-  div15_bw_1 <= resize(div15_in, 35);
-  div15_p3 <= div15_p2 or div15_bw_1;
-  div15_ge <= "1" when div16_bw <= div15_p3 else "0";
-  div15_diff <= div15_p3 - div16_bw;
-  div15_pn <= div15_diff when div15_ge = "1" else div15_p3;
-  div15_rem <= div15_pn(33 downto 0);
-  div15_q2 <= shift_left(div16_q, 1);
-  div15_gew <= resize(div15_ge, 30);
-  div15_qn <= div15_q2 or div15_gew;
-  div17_bw <= resize(div17_b, 35);
-  div16_in <= unsigned(div17_lo(13 downto 13));
-  div16_pw <= resize(div17_p, 35);
-  div16_p2 <= shift_left(div16_pw, 1);
-  div16_bw_1 <= resize(div16_in, 35);
-  div16_p3 <= div16_p2 or div16_bw_1;
-  div16_ge <= "1" when div17_bw <= div16_p3 else "0";
-  div16_diff <= div16_p3 - div17_bw;
-  div16_pn <= div16_diff when div16_ge = "1" else div16_p3;
-  div16_rem <= div16_pn(33 downto 0);
-  div16_q2 <= shift_left(div17_q, 1);
-  div16_gew <= resize(div16_ge, 30);
-  div16_qn <= div16_q2 or div16_gew;
-  div18_bw <= resize(div18_b, 35);
-  div17_in <= unsigned(div18_lo(12 downto 12));
-  div17_pw <= resize(div18_p, 35);
-  div17_p2 <= shift_left(div17_pw, 1);
-  div17_bw_1 <= resize(div17_in, 35);
-  div17_p3 <= div17_p2 or div17_bw_1;
-  div17_ge <= "1" when div18_bw <= div17_p3 else "0";
-  div17_diff <= div17_p3 - div18_bw;
-  div17_pn <= div17_diff when div17_ge = "1" else div17_p3;
-  div17_rem <= div17_pn(33 downto 0);
-  div17_q2 <= shift_left(div18_q, 1);
-  div17_gew <= resize(div17_ge, 30);
-  div17_qn <= div17_q2 or div17_gew;
-  div19_bw <= resize(div19_b, 35);
-  div18_in <= unsigned(div19_lo(11 downto 11));
-  div18_pw <= resize(div19_p, 35);
-  div18_p2 <= shift_left(div18_pw, 1);
-  div18_bw_1 <= resize(div18_in, 35);
-  div18_p3 <= div18_p2 or div18_bw_1;
-  div18_ge <= "1" when div19_bw <= div18_p3 else "0";
-  div18_diff <= div18_p3 - div19_bw;
-  div18_pn <= div18_diff when div18_ge = "1" else div18_p3;
-  div18_rem <= div18_pn(33 downto 0);
-  div18_q2 <= shift_left(div19_q, 1);
-  div18_gew <= resize(div18_ge, 30);
-  div18_qn <= div18_q2 or div18_gew;
-  div20_bw <= resize(div20_b, 35);
-  div19_in <= unsigned(div20_lo(10 downto 10));
-  div19_pw <= resize(div20_p, 35);
-  div19_p2 <= shift_left(div19_pw, 1);
-  div19_bw_1 <= resize(div19_in, 35);
-  div19_p3 <= div19_p2 or div19_bw_1;
-  div19_ge <= "1" when div20_bw <= div19_p3 else "0";
-  div19_diff <= div19_p3 - div20_bw;
-  div19_pn <= div19_diff when div19_ge = "1" else div19_p3;
-  div19_rem <= div19_pn(33 downto 0);
-  div19_q2 <= shift_left(div20_q, 1);
-  div19_gew <= resize(div19_ge, 30);
-  div19_qn <= div19_q2 or div19_gew;
-  div21_bw <= resize(div21_b, 35);
-  div20_in <= unsigned(div21_lo(9 downto 9));
-  div20_pw <= resize(div21_p, 35);
-  div20_p2 <= shift_left(div20_pw, 1);
-  div20_bw_1 <= resize(div20_in, 35);
-  div20_p3 <= div20_p2 or div20_bw_1;
-  div20_ge <= "1" when div21_bw <= div20_p3 else "0";
-  div20_diff <= div20_p3 - div21_bw;
-  div20_pn <= div20_diff when div20_ge = "1" else div20_p3;
-  div20_rem <= div20_pn(33 downto 0);
-  div20_q2 <= shift_left(div21_q, 1);
-  div20_gew <= resize(div20_ge, 30);
-  div20_qn <= div20_q2 or div20_gew;
-  div22_bw <= resize(div22_b, 35);
-  div21_in <= unsigned(div22_lo(8 downto 8));
-  div21_pw <= resize(div22_p, 35);
-  div21_p2 <= shift_left(div21_pw, 1);
-  div21_bw_1 <= resize(div21_in, 35);
-  div21_p3 <= div21_p2 or div21_bw_1;
-  div21_ge <= "1" when div22_bw <= div21_p3 else "0";
-  div21_diff <= div21_p3 - div22_bw;
-  div21_pn <= div21_diff when div21_ge = "1" else div21_p3;
-  div21_rem <= div21_pn(33 downto 0);
-  div21_q2 <= shift_left(div22_q, 1);
-  div21_gew <= resize(div21_ge, 30);
-  div21_qn <= div21_q2 or div21_gew;
-  div23_bw <= resize(div23_b, 35);
-  div22_in <= unsigned(div23_lo(7 downto 7));
-  div22_pw <= resize(div23_p, 35);
-  div22_p2 <= shift_left(div22_pw, 1);
-  div22_bw_1 <= resize(div22_in, 35);
-  div22_p3 <= div22_p2 or div22_bw_1;
-  div22_ge <= "1" when div23_bw <= div22_p3 else "0";
-  div22_diff <= div22_p3 - div23_bw;
-  div22_pn <= div22_diff when div22_ge = "1" else div22_p3;
-  div22_rem <= div22_pn(33 downto 0);
-  div22_q2 <= shift_left(div23_q, 1);
-  div22_gew <= resize(div22_ge, 30);
-  div22_qn <= div22_q2 or div22_gew;
-  div24_bw <= resize(div24_b, 35);
-  div23_in <= unsigned(div24_lo(6 downto 6));
-  div23_pw <= resize(div24_p, 35);
-  div23_p2 <= shift_left(div23_pw, 1);
-  div23_bw_1 <= resize(div23_in, 35);
-  div23_p3 <= div23_p2 or div23_bw_1;
-  div23_ge <= "1" when div24_bw <= div23_p3 else "0";
-  div23_diff <= div23_p3 - div24_bw;
-  div23_pn <= div23_diff when div23_ge = "1" else div23_p3;
-  div23_rem <= div23_pn(33 downto 0);
-  div23_q2 <= shift_left(div24_q, 1);
-  div23_gew <= resize(div23_ge, 30);
-  div23_qn <= div23_q2 or div23_gew;
-  div25_bw <= resize(div25_b, 35);
-  div24_in <= unsigned(div25_lo(5 downto 5));
-  div24_pw <= resize(div25_p, 35);
-  div24_p2 <= shift_left(div24_pw, 1);
-  div24_bw_1 <= resize(div24_in, 35);
-  div24_p3 <= div24_p2 or div24_bw_1;
-  div24_ge <= "1" when div25_bw <= div24_p3 else "0";
-  div24_diff <= div24_p3 - div25_bw;
-  div24_pn <= div24_diff when div24_ge = "1" else div24_p3;
-  div24_rem <= div24_pn(33 downto 0);
-  div24_q2 <= shift_left(div25_q, 1);
-  div24_gew <= resize(div24_ge, 30);
-  div24_qn <= div24_q2 or div24_gew;
-  div26_bw <= resize(div26_b, 35);
-  div25_in <= unsigned(div26_lo(4 downto 4));
-  div25_pw <= resize(div26_p, 35);
-  div25_p2 <= shift_left(div25_pw, 1);
-  div25_bw_1 <= resize(div25_in, 35);
-  div25_p3 <= div25_p2 or div25_bw_1;
-  div25_ge <= "1" when div26_bw <= div25_p3 else "0";
-  div25_diff <= div25_p3 - div26_bw;
-  div25_pn <= div25_diff when div25_ge = "1" else div25_p3;
-  div25_rem <= div25_pn(33 downto 0);
-  div25_q2 <= shift_left(div26_q, 1);
-  div25_gew <= resize(div25_ge, 30);
-  div25_qn <= div25_q2 or div25_gew;
-  div27_bw <= resize(div27_b, 35);
-  div26_in <= unsigned(div27_lo(3 downto 3));
-  div26_pw <= resize(div27_p, 35);
-  div26_p2 <= shift_left(div26_pw, 1);
-  div26_bw_1 <= resize(div26_in, 35);
-  div26_p3 <= div26_p2 or div26_bw_1;
-  div26_ge <= "1" when div27_bw <= div26_p3 else "0";
-  div26_diff <= div26_p3 - div27_bw;
-  div26_pn <= div26_diff when div26_ge = "1" else div26_p3;
-  div26_rem <= div26_pn(33 downto 0);
-  div26_q2 <= shift_left(div27_q, 1);
-  div26_gew <= resize(div26_ge, 30);
-  div26_qn <= div26_q2 or div26_gew;
-  div28_bw <= resize(div28_b, 35);
-  div27_in <= unsigned(div28_lo(2 downto 2));
-  div27_pw <= resize(div28_p, 35);
-  div27_p2 <= shift_left(div27_pw, 1);
-  div27_bw_1 <= resize(div27_in, 35);
-  div27_p3 <= div27_p2 or div27_bw_1;
-  div27_ge <= "1" when div28_bw <= div27_p3 else "0";
-  div27_diff <= div27_p3 - div28_bw;
-  div27_pn <= div27_diff when div27_ge = "1" else div27_p3;
-  div27_rem <= div27_pn(33 downto 0);
-  div27_q2 <= shift_left(div28_q, 1);
-  div27_gew <= resize(div27_ge, 30);
-  div27_qn <= div27_q2 or div27_gew;
-  div29_bw <= resize(div29_b, 35);
-  div28_in <= unsigned(div29_lo(1 downto 1));
-  div28_pw <= resize(div29_p, 35);
-  div28_p2 <= shift_left(div28_pw, 1);
-  div28_bw_1 <= resize(div28_in, 35);
-  div28_p3 <= div28_p2 or div28_bw_1;
-  div28_ge <= "1" when div29_bw <= div28_p3 else "0";
-  div28_diff <= div28_p3 - div29_bw;
-  div28_pn <= div28_diff when div28_ge = "1" else div28_p3;
-  div28_rem <= div28_pn(33 downto 0);
-  div28_q2 <= shift_left(div29_q, 1);
-  div28_gew <= resize(div28_ge, 30);
-  div28_qn <= div28_q2 or div28_gew;
-  div30_bw <= resize(div30_b, 35);
-  div29_in <= unsigned(div30_lo(0 downto 0));
-  div29_pw <= resize(div30_p, 35);
-  div29_p2 <= shift_left(div29_pw, 1);
-  div29_bw_1 <= resize(div29_in, 35);
-  div29_p3 <= div29_p2 or div29_bw_1;
-  div29_ge <= "1" when div30_bw <= div29_p3 else "0";
-  div29_diff <= div29_p3 - div30_bw;
-  div29_pn <= div29_diff when div29_ge = "1" else div29_p3;
-  div29_rem <= div29_pn(33 downto 0);
-  div29_q2 <= shift_left(div30_q, 1);
-  div29_gew <= resize(div29_ge, 30);
-  div29_qn <= div29_q2 or div29_gew;
-  div_q_zero <= "1" when div29_qn = div_zero_q else "0";
-  div_bad <= div30_err or div_q_zero;
-  div_ok_c <= div_bad xor div_one;
+  -- not in a stage or state machine
 
-  regs : process (clk)
+  -- stage s1_operands: signs, zero tests, magnitudes
+  num_neg <= "1" when num < k_0 else "0";
+  den_neg <= "1" when den < k_0_1 else "0";
+  neg_num <= -num;
+  mux_num_neg <= neg_num when num_neg = "1" else num;
+  u_mux_num_neg <= unsigned(mux_num_neg);
+  neg_den <= -den;
+  mux_den_neg <= neg_den when den_neg = "1" else den;
+  u_mux_den_neg <= unsigned(mux_den_neg);
+  num_eq_k_0 <= "1" when num = k_0 else "0";
+  den_eq_k_0_1 <= "1" when den = k_0_1 else "0";
+  or_0 <= num_eq_k_0 or den_eq_k_0_1;
+  num_neg_xor_den_neg <= num_neg xor den_neg;
+  err <= or_0 or num_neg_xor_den_neg;
+
+  s1_operands_regs : process (clk)
   begin
     if rising_edge(clk) then
-      div1_a <= div_a;
-      div1_b <= div_b;
-      div1_err <= div_err_b;
-      div2_p <= div0_rem;
-      div2_q <= div0_qn;
-      div2_b <= div1_b;
-      div2_lo <= div_lo;
-      div2_err <= div_err_c;
-      div3_p <= div1_rem;
-      div3_q <= div1_qn;
-      div3_b <= div2_b;
-      div3_lo <= div2_lo;
-      div3_err <= div2_err;
-      div4_p <= div2_rem;
-      div4_q <= div2_qn;
-      div4_b <= div3_b;
-      div4_lo <= div3_lo;
-      div4_err <= div3_err;
-      div5_p <= div3_rem;
-      div5_q <= div3_qn;
-      div5_b <= div4_b;
-      div5_lo <= div4_lo;
-      div5_err <= div4_err;
-      div6_p <= div4_rem;
-      div6_q <= div4_qn;
-      div6_b <= div5_b;
-      div6_lo <= div5_lo;
-      div6_err <= div5_err;
-      div7_p <= div5_rem;
-      div7_q <= div5_qn;
-      div7_b <= div6_b;
-      div7_lo <= div6_lo;
-      div7_err <= div6_err;
-      div8_p <= div6_rem;
-      div8_q <= div6_qn;
-      div8_b <= div7_b;
-      div8_lo <= div7_lo;
-      div8_err <= div7_err;
-      div9_p <= div7_rem;
-      div9_q <= div7_qn;
-      div9_b <= div8_b;
-      div9_lo <= div8_lo;
-      div9_err <= div8_err;
-      div10_p <= div8_rem;
-      div10_q <= div8_qn;
-      div10_b <= div9_b;
-      div10_lo <= div9_lo;
-      div10_err <= div9_err;
-      div11_p <= div9_rem;
-      div11_q <= div9_qn;
-      div11_b <= div10_b;
-      div11_lo <= div10_lo;
-      div11_err <= div10_err;
-      div12_p <= div10_rem;
-      div12_q <= div10_qn;
-      div12_b <= div11_b;
-      div12_lo <= div11_lo;
-      div12_err <= div11_err;
-      div13_p <= div11_rem;
-      div13_q <= div11_qn;
-      div13_b <= div12_b;
-      div13_lo <= div12_lo;
-      div13_err <= div12_err;
-      div14_p <= div12_rem;
-      div14_q <= div12_qn;
-      div14_b <= div13_b;
-      div14_lo <= div13_lo;
-      div14_err <= div13_err;
-      div15_p <= div13_rem;
-      div15_q <= div13_qn;
-      div15_b <= div14_b;
-      div15_lo <= div14_lo;
-      div15_err <= div14_err;
-      div16_p <= div14_rem;
-      div16_q <= div14_qn;
-      div16_b <= div15_b;
-      div16_lo <= div15_lo;
-      div16_err <= div15_err;
-      div17_p <= div15_rem;
-      div17_q <= div15_qn;
-      div17_b <= div16_b;
-      div17_lo <= div16_lo;
-      div17_err <= div16_err;
-      div18_p <= div16_rem;
-      div18_q <= div16_qn;
-      div18_b <= div17_b;
-      div18_lo <= div17_lo;
-      div18_err <= div17_err;
-      div19_p <= div17_rem;
-      div19_q <= div17_qn;
-      div19_b <= div18_b;
-      div19_lo <= div18_lo;
-      div19_err <= div18_err;
-      div20_p <= div18_rem;
-      div20_q <= div18_qn;
-      div20_b <= div19_b;
-      div20_lo <= div19_lo;
-      div20_err <= div19_err;
-      div21_p <= div19_rem;
-      div21_q <= div19_qn;
-      div21_b <= div20_b;
-      div21_lo <= div20_lo;
-      div21_err <= div20_err;
-      div22_p <= div20_rem;
-      div22_q <= div20_qn;
-      div22_b <= div21_b;
-      div22_lo <= div21_lo;
-      div22_err <= div21_err;
-      div23_p <= div21_rem;
-      div23_q <= div21_qn;
-      div23_b <= div22_b;
-      div23_lo <= div22_lo;
-      div23_err <= div22_err;
-      div24_p <= div22_rem;
-      div24_q <= div22_qn;
-      div24_b <= div23_b;
-      div24_lo <= div23_lo;
-      div24_err <= div23_err;
-      div25_p <= div23_rem;
-      div25_q <= div23_qn;
-      div25_b <= div24_b;
-      div25_lo <= div24_lo;
-      div25_err <= div24_err;
-      div26_p <= div24_rem;
-      div26_q <= div24_qn;
-      div26_b <= div25_b;
-      div26_lo <= div25_lo;
-      div26_err <= div25_err;
-      div27_p <= div25_rem;
-      div27_q <= div25_qn;
-      div27_b <= div26_b;
-      div27_lo <= div26_lo;
-      div27_err <= div26_err;
-      div28_p <= div26_rem;
-      div28_q <= div26_qn;
-      div28_b <= div27_b;
-      div28_lo <= div27_lo;
-      div28_err <= div27_err;
-      div29_p <= div27_rem;
-      div29_q <= div27_qn;
-      div29_b <= div28_b;
-      div29_lo <= div28_lo;
-      div29_err <= div28_err;
-      div30_p <= div28_rem;
-      div30_q <= div28_qn;
-      div30_b <= div29_b;
-      div30_lo <= div29_lo;
-      div30_err <= div29_err;
-      div_t <= div29_qn;
-      div_ok <= div_ok_c;
+      s1_a <= u_mux_num_neg;
+      s1_b <= u_mux_den_neg;
+      s1_err <= err;
     end if;
-  end process regs;
+  end process s1_operands_regs;
 
-  t <= div_t;
-  ok <= div_ok;
+  -- stage s2_q0: one quotient bit
+  bits_s1_a <= unsigned(s1_a(62 downto 30));
+  lo <= s1_a(29 downto 0);
+  rs_bits_s1_a <= resize(bits_s1_a, 34);
+  s1_b_le_rs_bits_s1_a <= "1" when s1_b <= rs_bits_s1_a else "0";
+  err_1 <= s1_err or s1_b_le_rs_bits_s1_a;
+  rs_bits_s1_a_1 <= resize(bits_s1_a, 34);
+  rs_s1_b <= resize(s1_b, 35);
+  rs_rs_bits_s1_a_1 <= resize(rs_bits_s1_a_1, 35);
+  shl_rs_rs_bits_s1_a_1 <= shift_left(rs_rs_bits_s1_a_1, 1);
+  bits_lo <= unsigned(lo(29 downto 29));
+  rs_bits_lo <= resize(bits_lo, 35);
+  or_3 <= shl_rs_rs_bits_s1_a_1 or rs_bits_lo;
+  ge0 <= "1" when rs_s1_b <= or_3 else "0";
+  or_3_minus_rs_s1_b <= or_3 - rs_s1_b;
+  mux_ge0 <= or_3_minus_rs_s1_b when ge0 = "1" else or_3;
+  rs_mux_ge0 <= mux_ge0(33 downto 0);
+  rs_ge0 <= resize(ge0, 30);
+  k_0_2_or_rs_ge0 <= k_0_2 or rs_ge0;
+
+  s2_q0_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s2_p <= rs_mux_ge0;
+      s2_q <= k_0_2_or_rs_ge0;
+    end if;
+  end process s2_q0_regs;
+
+  -- stage s3_q1: one quotient bit
+  rs_s1_b_d1 <= resize(s1_b_d1, 35);
+  rs_s2_p <= resize(s2_p, 35);
+  shl_rs_s2_p <= shift_left(rs_s2_p, 1);
+  bits_lo_d1 <= unsigned(lo_d1(28 downto 28));
+  rs_bits_lo_d1 <= resize(bits_lo_d1, 35);
+  or_4 <= shl_rs_s2_p or rs_bits_lo_d1;
+  ge1 <= "1" when rs_s1_b_d1 <= or_4 else "0";
+  or_4_minus_rs_s1_b_d1 <= or_4 - rs_s1_b_d1;
+  mux_ge1 <= or_4_minus_rs_s1_b_d1 when ge1 = "1" else or_4;
+  rs_mux_ge1 <= mux_ge1(33 downto 0);
+  shl_s2_q <= shift_left(s2_q, 1);
+  rs_ge1 <= resize(ge1, 30);
+  shl_s2_q_or_rs_ge1 <= shl_s2_q or rs_ge1;
+
+  s3_q1_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d1 <= s1_b;
+      lo_d1 <= lo;
+      s3_p <= rs_mux_ge1;
+      s3_q <= shl_s2_q_or_rs_ge1;
+    end if;
+  end process s3_q1_regs;
+
+  -- stage s4_q2: one quotient bit
+  rs_s1_b_d2 <= resize(s1_b_d2, 35);
+  rs_s3_p <= resize(s3_p, 35);
+  shl_rs_s3_p <= shift_left(rs_s3_p, 1);
+  bits_lo_d2 <= unsigned(lo_d2(27 downto 27));
+  rs_bits_lo_d2 <= resize(bits_lo_d2, 35);
+  or_5 <= shl_rs_s3_p or rs_bits_lo_d2;
+  ge2 <= "1" when rs_s1_b_d2 <= or_5 else "0";
+  or_5_minus_rs_s1_b_d2 <= or_5 - rs_s1_b_d2;
+  mux_ge2 <= or_5_minus_rs_s1_b_d2 when ge2 = "1" else or_5;
+  rs_mux_ge2 <= mux_ge2(33 downto 0);
+  shl_s3_q <= shift_left(s3_q, 1);
+  rs_ge2 <= resize(ge2, 30);
+  shl_s3_q_or_rs_ge2 <= shl_s3_q or rs_ge2;
+
+  s4_q2_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d2 <= s1_b_d1;
+      lo_d2 <= lo_d1;
+      s4_p <= rs_mux_ge2;
+      s4_q <= shl_s3_q_or_rs_ge2;
+    end if;
+  end process s4_q2_regs;
+
+  -- stage s5_q3: one quotient bit
+  rs_s1_b_d3 <= resize(s1_b_d3, 35);
+  rs_s4_p <= resize(s4_p, 35);
+  shl_rs_s4_p <= shift_left(rs_s4_p, 1);
+  bits_lo_d3 <= unsigned(lo_d3(26 downto 26));
+  rs_bits_lo_d3 <= resize(bits_lo_d3, 35);
+  or_6 <= shl_rs_s4_p or rs_bits_lo_d3;
+  ge3 <= "1" when rs_s1_b_d3 <= or_6 else "0";
+  or_6_minus_rs_s1_b_d3 <= or_6 - rs_s1_b_d3;
+  mux_ge3 <= or_6_minus_rs_s1_b_d3 when ge3 = "1" else or_6;
+  rs_mux_ge3 <= mux_ge3(33 downto 0);
+  shl_s4_q <= shift_left(s4_q, 1);
+  rs_ge3 <= resize(ge3, 30);
+  shl_s4_q_or_rs_ge3 <= shl_s4_q or rs_ge3;
+
+  s5_q3_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d3 <= s1_b_d2;
+      lo_d3 <= lo_d2;
+      s5_p <= rs_mux_ge3;
+      s5_q <= shl_s4_q_or_rs_ge3;
+    end if;
+  end process s5_q3_regs;
+
+  -- stage s6_q4: one quotient bit
+  rs_s1_b_d4 <= resize(s1_b_d4, 35);
+  rs_s5_p <= resize(s5_p, 35);
+  shl_rs_s5_p <= shift_left(rs_s5_p, 1);
+  bits_lo_d4 <= unsigned(lo_d4(25 downto 25));
+  rs_bits_lo_d4 <= resize(bits_lo_d4, 35);
+  or_7 <= shl_rs_s5_p or rs_bits_lo_d4;
+  ge4 <= "1" when rs_s1_b_d4 <= or_7 else "0";
+  or_7_minus_rs_s1_b_d4 <= or_7 - rs_s1_b_d4;
+  mux_ge4 <= or_7_minus_rs_s1_b_d4 when ge4 = "1" else or_7;
+  rs_mux_ge4 <= mux_ge4(33 downto 0);
+  shl_s5_q <= shift_left(s5_q, 1);
+  rs_ge4 <= resize(ge4, 30);
+  shl_s5_q_or_rs_ge4 <= shl_s5_q or rs_ge4;
+
+  s6_q4_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d4 <= s1_b_d3;
+      lo_d4 <= lo_d3;
+      s6_p <= rs_mux_ge4;
+      s6_q <= shl_s5_q_or_rs_ge4;
+    end if;
+  end process s6_q4_regs;
+
+  -- stage s7_q5: one quotient bit
+  rs_s1_b_d5 <= resize(s1_b_d5, 35);
+  rs_s6_p <= resize(s6_p, 35);
+  shl_rs_s6_p <= shift_left(rs_s6_p, 1);
+  bits_lo_d5 <= unsigned(lo_d5(24 downto 24));
+  rs_bits_lo_d5 <= resize(bits_lo_d5, 35);
+  or_8 <= shl_rs_s6_p or rs_bits_lo_d5;
+  ge5 <= "1" when rs_s1_b_d5 <= or_8 else "0";
+  or_8_minus_rs_s1_b_d5 <= or_8 - rs_s1_b_d5;
+  mux_ge5 <= or_8_minus_rs_s1_b_d5 when ge5 = "1" else or_8;
+  rs_mux_ge5 <= mux_ge5(33 downto 0);
+  shl_s6_q <= shift_left(s6_q, 1);
+  rs_ge5 <= resize(ge5, 30);
+  shl_s6_q_or_rs_ge5 <= shl_s6_q or rs_ge5;
+
+  s7_q5_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d5 <= s1_b_d4;
+      lo_d5 <= lo_d4;
+      s7_p <= rs_mux_ge5;
+      s7_q <= shl_s6_q_or_rs_ge5;
+    end if;
+  end process s7_q5_regs;
+
+  -- stage s8_q6: one quotient bit
+  rs_s1_b_d6 <= resize(s1_b_d6, 35);
+  rs_s7_p <= resize(s7_p, 35);
+  shl_rs_s7_p <= shift_left(rs_s7_p, 1);
+  bits_lo_d6 <= unsigned(lo_d6(23 downto 23));
+  rs_bits_lo_d6 <= resize(bits_lo_d6, 35);
+  or_9 <= shl_rs_s7_p or rs_bits_lo_d6;
+  ge6 <= "1" when rs_s1_b_d6 <= or_9 else "0";
+  or_9_minus_rs_s1_b_d6 <= or_9 - rs_s1_b_d6;
+  mux_ge6 <= or_9_minus_rs_s1_b_d6 when ge6 = "1" else or_9;
+  rs_mux_ge6 <= mux_ge6(33 downto 0);
+  shl_s7_q <= shift_left(s7_q, 1);
+  rs_ge6 <= resize(ge6, 30);
+  shl_s7_q_or_rs_ge6 <= shl_s7_q or rs_ge6;
+
+  s8_q6_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d6 <= s1_b_d5;
+      lo_d6 <= lo_d5;
+      s8_p <= rs_mux_ge6;
+      s8_q <= shl_s7_q_or_rs_ge6;
+    end if;
+  end process s8_q6_regs;
+
+  -- stage s9_q7: one quotient bit
+  rs_s1_b_d7 <= resize(s1_b_d7, 35);
+  rs_s8_p <= resize(s8_p, 35);
+  shl_rs_s8_p <= shift_left(rs_s8_p, 1);
+  bits_lo_d7 <= unsigned(lo_d7(22 downto 22));
+  rs_bits_lo_d7 <= resize(bits_lo_d7, 35);
+  or_10 <= shl_rs_s8_p or rs_bits_lo_d7;
+  ge7 <= "1" when rs_s1_b_d7 <= or_10 else "0";
+  or_10_minus_rs_s1_b_d7 <= or_10 - rs_s1_b_d7;
+  mux_ge7 <= or_10_minus_rs_s1_b_d7 when ge7 = "1" else or_10;
+  rs_mux_ge7 <= mux_ge7(33 downto 0);
+  shl_s8_q <= shift_left(s8_q, 1);
+  rs_ge7 <= resize(ge7, 30);
+  shl_s8_q_or_rs_ge7 <= shl_s8_q or rs_ge7;
+
+  s9_q7_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d7 <= s1_b_d6;
+      lo_d7 <= lo_d6;
+      s9_p <= rs_mux_ge7;
+      s9_q <= shl_s8_q_or_rs_ge7;
+    end if;
+  end process s9_q7_regs;
+
+  -- stage s10_q8: one quotient bit
+  rs_s1_b_d8 <= resize(s1_b_d8, 35);
+  rs_s9_p <= resize(s9_p, 35);
+  shl_rs_s9_p <= shift_left(rs_s9_p, 1);
+  bits_lo_d8 <= unsigned(lo_d8(21 downto 21));
+  rs_bits_lo_d8 <= resize(bits_lo_d8, 35);
+  or_11 <= shl_rs_s9_p or rs_bits_lo_d8;
+  ge8 <= "1" when rs_s1_b_d8 <= or_11 else "0";
+  or_11_minus_rs_s1_b_d8 <= or_11 - rs_s1_b_d8;
+  mux_ge8 <= or_11_minus_rs_s1_b_d8 when ge8 = "1" else or_11;
+  rs_mux_ge8 <= mux_ge8(33 downto 0);
+  shl_s9_q <= shift_left(s9_q, 1);
+  rs_ge8 <= resize(ge8, 30);
+  shl_s9_q_or_rs_ge8 <= shl_s9_q or rs_ge8;
+
+  s10_q8_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d8 <= s1_b_d7;
+      lo_d8 <= lo_d7;
+      s10_p <= rs_mux_ge8;
+      s10_q <= shl_s9_q_or_rs_ge8;
+    end if;
+  end process s10_q8_regs;
+
+  -- stage s11_q9: one quotient bit
+  rs_s1_b_d9 <= resize(s1_b_d9, 35);
+  rs_s10_p <= resize(s10_p, 35);
+  shl_rs_s10_p <= shift_left(rs_s10_p, 1);
+  bits_lo_d9 <= unsigned(lo_d9(20 downto 20));
+  rs_bits_lo_d9 <= resize(bits_lo_d9, 35);
+  or_12 <= shl_rs_s10_p or rs_bits_lo_d9;
+  ge9 <= "1" when rs_s1_b_d9 <= or_12 else "0";
+  or_12_minus_rs_s1_b_d9 <= or_12 - rs_s1_b_d9;
+  mux_ge9 <= or_12_minus_rs_s1_b_d9 when ge9 = "1" else or_12;
+  rs_mux_ge9 <= mux_ge9(33 downto 0);
+  shl_s10_q <= shift_left(s10_q, 1);
+  rs_ge9 <= resize(ge9, 30);
+  shl_s10_q_or_rs_ge9 <= shl_s10_q or rs_ge9;
+
+  s11_q9_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d9 <= s1_b_d8;
+      lo_d9 <= lo_d8;
+      s11_p <= rs_mux_ge9;
+      s11_q <= shl_s10_q_or_rs_ge9;
+    end if;
+  end process s11_q9_regs;
+
+  -- stage s12_q10: one quotient bit
+  rs_s1_b_d10 <= resize(s1_b_d10, 35);
+  rs_s11_p <= resize(s11_p, 35);
+  shl_rs_s11_p <= shift_left(rs_s11_p, 1);
+  bits_lo_d10 <= unsigned(lo_d10(19 downto 19));
+  rs_bits_lo_d10 <= resize(bits_lo_d10, 35);
+  or_13 <= shl_rs_s11_p or rs_bits_lo_d10;
+  ge10 <= "1" when rs_s1_b_d10 <= or_13 else "0";
+  or_13_minus_rs_s1_b_d10 <= or_13 - rs_s1_b_d10;
+  mux_ge10 <= or_13_minus_rs_s1_b_d10 when ge10 = "1" else or_13;
+  rs_mux_ge10 <= mux_ge10(33 downto 0);
+  shl_s11_q <= shift_left(s11_q, 1);
+  rs_ge10 <= resize(ge10, 30);
+  shl_s11_q_or_rs_ge10 <= shl_s11_q or rs_ge10;
+
+  s12_q10_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d10 <= s1_b_d9;
+      lo_d10 <= lo_d9;
+      s12_p <= rs_mux_ge10;
+      s12_q <= shl_s11_q_or_rs_ge10;
+    end if;
+  end process s12_q10_regs;
+
+  -- stage s13_q11: one quotient bit
+  rs_s1_b_d11 <= resize(s1_b_d11, 35);
+  rs_s12_p <= resize(s12_p, 35);
+  shl_rs_s12_p <= shift_left(rs_s12_p, 1);
+  bits_lo_d11 <= unsigned(lo_d11(18 downto 18));
+  rs_bits_lo_d11 <= resize(bits_lo_d11, 35);
+  or_14 <= shl_rs_s12_p or rs_bits_lo_d11;
+  ge11 <= "1" when rs_s1_b_d11 <= or_14 else "0";
+  or_14_minus_rs_s1_b_d11 <= or_14 - rs_s1_b_d11;
+  mux_ge11 <= or_14_minus_rs_s1_b_d11 when ge11 = "1" else or_14;
+  rs_mux_ge11 <= mux_ge11(33 downto 0);
+  shl_s12_q <= shift_left(s12_q, 1);
+  rs_ge11 <= resize(ge11, 30);
+  shl_s12_q_or_rs_ge11 <= shl_s12_q or rs_ge11;
+
+  s13_q11_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d11 <= s1_b_d10;
+      lo_d11 <= lo_d10;
+      s13_p <= rs_mux_ge11;
+      s13_q <= shl_s12_q_or_rs_ge11;
+    end if;
+  end process s13_q11_regs;
+
+  -- stage s14_q12: one quotient bit
+  rs_s1_b_d12 <= resize(s1_b_d12, 35);
+  rs_s13_p <= resize(s13_p, 35);
+  shl_rs_s13_p <= shift_left(rs_s13_p, 1);
+  bits_lo_d12 <= unsigned(lo_d12(17 downto 17));
+  rs_bits_lo_d12 <= resize(bits_lo_d12, 35);
+  or_15 <= shl_rs_s13_p or rs_bits_lo_d12;
+  ge12 <= "1" when rs_s1_b_d12 <= or_15 else "0";
+  or_15_minus_rs_s1_b_d12 <= or_15 - rs_s1_b_d12;
+  mux_ge12 <= or_15_minus_rs_s1_b_d12 when ge12 = "1" else or_15;
+  rs_mux_ge12 <= mux_ge12(33 downto 0);
+  shl_s13_q <= shift_left(s13_q, 1);
+  rs_ge12 <= resize(ge12, 30);
+  shl_s13_q_or_rs_ge12 <= shl_s13_q or rs_ge12;
+
+  s14_q12_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d12 <= s1_b_d11;
+      lo_d12 <= lo_d11;
+      s14_p <= rs_mux_ge12;
+      s14_q <= shl_s13_q_or_rs_ge12;
+    end if;
+  end process s14_q12_regs;
+
+  -- stage s15_q13: one quotient bit
+  rs_s1_b_d13 <= resize(s1_b_d13, 35);
+  rs_s14_p <= resize(s14_p, 35);
+  shl_rs_s14_p <= shift_left(rs_s14_p, 1);
+  bits_lo_d13 <= unsigned(lo_d13(16 downto 16));
+  rs_bits_lo_d13 <= resize(bits_lo_d13, 35);
+  or_16 <= shl_rs_s14_p or rs_bits_lo_d13;
+  ge13 <= "1" when rs_s1_b_d13 <= or_16 else "0";
+  or_16_minus_rs_s1_b_d13 <= or_16 - rs_s1_b_d13;
+  mux_ge13 <= or_16_minus_rs_s1_b_d13 when ge13 = "1" else or_16;
+  rs_mux_ge13 <= mux_ge13(33 downto 0);
+  shl_s14_q <= shift_left(s14_q, 1);
+  rs_ge13 <= resize(ge13, 30);
+  shl_s14_q_or_rs_ge13 <= shl_s14_q or rs_ge13;
+
+  s15_q13_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d13 <= s1_b_d12;
+      lo_d13 <= lo_d12;
+      s15_p <= rs_mux_ge13;
+      s15_q <= shl_s14_q_or_rs_ge13;
+    end if;
+  end process s15_q13_regs;
+
+  -- stage s16_q14: one quotient bit
+  rs_s1_b_d14 <= resize(s1_b_d14, 35);
+  rs_s15_p <= resize(s15_p, 35);
+  shl_rs_s15_p <= shift_left(rs_s15_p, 1);
+  bits_lo_d14 <= unsigned(lo_d14(15 downto 15));
+  rs_bits_lo_d14 <= resize(bits_lo_d14, 35);
+  or_17 <= shl_rs_s15_p or rs_bits_lo_d14;
+  ge14 <= "1" when rs_s1_b_d14 <= or_17 else "0";
+  or_17_minus_rs_s1_b_d14 <= or_17 - rs_s1_b_d14;
+  mux_ge14 <= or_17_minus_rs_s1_b_d14 when ge14 = "1" else or_17;
+  rs_mux_ge14 <= mux_ge14(33 downto 0);
+  shl_s15_q <= shift_left(s15_q, 1);
+  rs_ge14 <= resize(ge14, 30);
+  shl_s15_q_or_rs_ge14 <= shl_s15_q or rs_ge14;
+
+  s16_q14_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d14 <= s1_b_d13;
+      lo_d14 <= lo_d13;
+      s16_p <= rs_mux_ge14;
+      s16_q <= shl_s15_q_or_rs_ge14;
+    end if;
+  end process s16_q14_regs;
+
+  -- stage s17_q15: one quotient bit
+  rs_s1_b_d15 <= resize(s1_b_d15, 35);
+  rs_s16_p <= resize(s16_p, 35);
+  shl_rs_s16_p <= shift_left(rs_s16_p, 1);
+  bits_lo_d15 <= unsigned(lo_d15(14 downto 14));
+  rs_bits_lo_d15 <= resize(bits_lo_d15, 35);
+  or_18 <= shl_rs_s16_p or rs_bits_lo_d15;
+  ge15 <= "1" when rs_s1_b_d15 <= or_18 else "0";
+  or_18_minus_rs_s1_b_d15 <= or_18 - rs_s1_b_d15;
+  mux_ge15 <= or_18_minus_rs_s1_b_d15 when ge15 = "1" else or_18;
+  rs_mux_ge15 <= mux_ge15(33 downto 0);
+  shl_s16_q <= shift_left(s16_q, 1);
+  rs_ge15 <= resize(ge15, 30);
+  shl_s16_q_or_rs_ge15 <= shl_s16_q or rs_ge15;
+
+  s17_q15_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d15 <= s1_b_d14;
+      lo_d15 <= lo_d14;
+      s17_p <= rs_mux_ge15;
+      s17_q <= shl_s16_q_or_rs_ge15;
+    end if;
+  end process s17_q15_regs;
+
+  -- stage s18_q16: one quotient bit
+  rs_s1_b_d16 <= resize(s1_b_d16, 35);
+  rs_s17_p <= resize(s17_p, 35);
+  shl_rs_s17_p <= shift_left(rs_s17_p, 1);
+  bits_lo_d16 <= unsigned(lo_d16(13 downto 13));
+  rs_bits_lo_d16 <= resize(bits_lo_d16, 35);
+  or_19 <= shl_rs_s17_p or rs_bits_lo_d16;
+  ge16 <= "1" when rs_s1_b_d16 <= or_19 else "0";
+  or_19_minus_rs_s1_b_d16 <= or_19 - rs_s1_b_d16;
+  mux_ge16 <= or_19_minus_rs_s1_b_d16 when ge16 = "1" else or_19;
+  rs_mux_ge16 <= mux_ge16(33 downto 0);
+  shl_s17_q <= shift_left(s17_q, 1);
+  rs_ge16 <= resize(ge16, 30);
+  shl_s17_q_or_rs_ge16 <= shl_s17_q or rs_ge16;
+
+  s18_q16_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d16 <= s1_b_d15;
+      lo_d16 <= lo_d15;
+      s18_p <= rs_mux_ge16;
+      s18_q <= shl_s17_q_or_rs_ge16;
+    end if;
+  end process s18_q16_regs;
+
+  -- stage s19_q17: one quotient bit
+  rs_s1_b_d17 <= resize(s1_b_d17, 35);
+  rs_s18_p <= resize(s18_p, 35);
+  shl_rs_s18_p <= shift_left(rs_s18_p, 1);
+  bits_lo_d17 <= unsigned(lo_d17(12 downto 12));
+  rs_bits_lo_d17 <= resize(bits_lo_d17, 35);
+  or_20 <= shl_rs_s18_p or rs_bits_lo_d17;
+  ge17 <= "1" when rs_s1_b_d17 <= or_20 else "0";
+  or_20_minus_rs_s1_b_d17 <= or_20 - rs_s1_b_d17;
+  mux_ge17 <= or_20_minus_rs_s1_b_d17 when ge17 = "1" else or_20;
+  rs_mux_ge17 <= mux_ge17(33 downto 0);
+  shl_s18_q <= shift_left(s18_q, 1);
+  rs_ge17 <= resize(ge17, 30);
+  shl_s18_q_or_rs_ge17 <= shl_s18_q or rs_ge17;
+
+  s19_q17_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d17 <= s1_b_d16;
+      lo_d17 <= lo_d16;
+      s19_p <= rs_mux_ge17;
+      s19_q <= shl_s18_q_or_rs_ge17;
+    end if;
+  end process s19_q17_regs;
+
+  -- stage s20_q18: one quotient bit
+  rs_s1_b_d18 <= resize(s1_b_d18, 35);
+  rs_s19_p <= resize(s19_p, 35);
+  shl_rs_s19_p <= shift_left(rs_s19_p, 1);
+  bits_lo_d18 <= unsigned(lo_d18(11 downto 11));
+  rs_bits_lo_d18 <= resize(bits_lo_d18, 35);
+  or_21 <= shl_rs_s19_p or rs_bits_lo_d18;
+  ge18 <= "1" when rs_s1_b_d18 <= or_21 else "0";
+  or_21_minus_rs_s1_b_d18 <= or_21 - rs_s1_b_d18;
+  mux_ge18 <= or_21_minus_rs_s1_b_d18 when ge18 = "1" else or_21;
+  rs_mux_ge18 <= mux_ge18(33 downto 0);
+  shl_s19_q <= shift_left(s19_q, 1);
+  rs_ge18 <= resize(ge18, 30);
+  shl_s19_q_or_rs_ge18 <= shl_s19_q or rs_ge18;
+
+  s20_q18_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d18 <= s1_b_d17;
+      lo_d18 <= lo_d17;
+      s20_p <= rs_mux_ge18;
+      s20_q <= shl_s19_q_or_rs_ge18;
+    end if;
+  end process s20_q18_regs;
+
+  -- stage s21_q19: one quotient bit
+  rs_s1_b_d19 <= resize(s1_b_d19, 35);
+  rs_s20_p <= resize(s20_p, 35);
+  shl_rs_s20_p <= shift_left(rs_s20_p, 1);
+  bits_lo_d19 <= unsigned(lo_d19(10 downto 10));
+  rs_bits_lo_d19 <= resize(bits_lo_d19, 35);
+  or_22 <= shl_rs_s20_p or rs_bits_lo_d19;
+  ge19 <= "1" when rs_s1_b_d19 <= or_22 else "0";
+  or_22_minus_rs_s1_b_d19 <= or_22 - rs_s1_b_d19;
+  mux_ge19 <= or_22_minus_rs_s1_b_d19 when ge19 = "1" else or_22;
+  rs_mux_ge19 <= mux_ge19(33 downto 0);
+  shl_s20_q <= shift_left(s20_q, 1);
+  rs_ge19 <= resize(ge19, 30);
+  shl_s20_q_or_rs_ge19 <= shl_s20_q or rs_ge19;
+
+  s21_q19_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d19 <= s1_b_d18;
+      lo_d19 <= lo_d18;
+      s21_p <= rs_mux_ge19;
+      s21_q <= shl_s20_q_or_rs_ge19;
+    end if;
+  end process s21_q19_regs;
+
+  -- stage s22_q20: one quotient bit
+  rs_s1_b_d20 <= resize(s1_b_d20, 35);
+  rs_s21_p <= resize(s21_p, 35);
+  shl_rs_s21_p <= shift_left(rs_s21_p, 1);
+  bits_lo_d20 <= unsigned(lo_d20(9 downto 9));
+  rs_bits_lo_d20 <= resize(bits_lo_d20, 35);
+  or_23 <= shl_rs_s21_p or rs_bits_lo_d20;
+  ge20 <= "1" when rs_s1_b_d20 <= or_23 else "0";
+  or_23_minus_rs_s1_b_d20 <= or_23 - rs_s1_b_d20;
+  mux_ge20 <= or_23_minus_rs_s1_b_d20 when ge20 = "1" else or_23;
+  rs_mux_ge20 <= mux_ge20(33 downto 0);
+  shl_s21_q <= shift_left(s21_q, 1);
+  rs_ge20 <= resize(ge20, 30);
+  shl_s21_q_or_rs_ge20 <= shl_s21_q or rs_ge20;
+
+  s22_q20_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d20 <= s1_b_d19;
+      lo_d20 <= lo_d19;
+      s22_p <= rs_mux_ge20;
+      s22_q <= shl_s21_q_or_rs_ge20;
+    end if;
+  end process s22_q20_regs;
+
+  -- stage s23_q21: one quotient bit
+  rs_s1_b_d21 <= resize(s1_b_d21, 35);
+  rs_s22_p <= resize(s22_p, 35);
+  shl_rs_s22_p <= shift_left(rs_s22_p, 1);
+  bits_lo_d21 <= unsigned(lo_d21(8 downto 8));
+  rs_bits_lo_d21 <= resize(bits_lo_d21, 35);
+  or_24 <= shl_rs_s22_p or rs_bits_lo_d21;
+  ge21 <= "1" when rs_s1_b_d21 <= or_24 else "0";
+  or_24_minus_rs_s1_b_d21 <= or_24 - rs_s1_b_d21;
+  mux_ge21 <= or_24_minus_rs_s1_b_d21 when ge21 = "1" else or_24;
+  rs_mux_ge21 <= mux_ge21(33 downto 0);
+  shl_s22_q <= shift_left(s22_q, 1);
+  rs_ge21 <= resize(ge21, 30);
+  shl_s22_q_or_rs_ge21 <= shl_s22_q or rs_ge21;
+
+  s23_q21_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d21 <= s1_b_d20;
+      lo_d21 <= lo_d20;
+      s23_p <= rs_mux_ge21;
+      s23_q <= shl_s22_q_or_rs_ge21;
+    end if;
+  end process s23_q21_regs;
+
+  -- stage s24_q22: one quotient bit
+  rs_s1_b_d22 <= resize(s1_b_d22, 35);
+  rs_s23_p <= resize(s23_p, 35);
+  shl_rs_s23_p <= shift_left(rs_s23_p, 1);
+  bits_lo_d22 <= unsigned(lo_d22(7 downto 7));
+  rs_bits_lo_d22 <= resize(bits_lo_d22, 35);
+  or_25 <= shl_rs_s23_p or rs_bits_lo_d22;
+  ge22 <= "1" when rs_s1_b_d22 <= or_25 else "0";
+  or_25_minus_rs_s1_b_d22 <= or_25 - rs_s1_b_d22;
+  mux_ge22 <= or_25_minus_rs_s1_b_d22 when ge22 = "1" else or_25;
+  rs_mux_ge22 <= mux_ge22(33 downto 0);
+  shl_s23_q <= shift_left(s23_q, 1);
+  rs_ge22 <= resize(ge22, 30);
+  shl_s23_q_or_rs_ge22 <= shl_s23_q or rs_ge22;
+
+  s24_q22_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d22 <= s1_b_d21;
+      lo_d22 <= lo_d21;
+      s24_p <= rs_mux_ge22;
+      s24_q <= shl_s23_q_or_rs_ge22;
+    end if;
+  end process s24_q22_regs;
+
+  -- stage s25_q23: one quotient bit
+  rs_s1_b_d23 <= resize(s1_b_d23, 35);
+  rs_s24_p <= resize(s24_p, 35);
+  shl_rs_s24_p <= shift_left(rs_s24_p, 1);
+  bits_lo_d23 <= unsigned(lo_d23(6 downto 6));
+  rs_bits_lo_d23 <= resize(bits_lo_d23, 35);
+  or_26 <= shl_rs_s24_p or rs_bits_lo_d23;
+  ge23 <= "1" when rs_s1_b_d23 <= or_26 else "0";
+  or_26_minus_rs_s1_b_d23 <= or_26 - rs_s1_b_d23;
+  mux_ge23 <= or_26_minus_rs_s1_b_d23 when ge23 = "1" else or_26;
+  rs_mux_ge23 <= mux_ge23(33 downto 0);
+  shl_s24_q <= shift_left(s24_q, 1);
+  rs_ge23 <= resize(ge23, 30);
+  shl_s24_q_or_rs_ge23 <= shl_s24_q or rs_ge23;
+
+  s25_q23_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d23 <= s1_b_d22;
+      lo_d23 <= lo_d22;
+      s25_p <= rs_mux_ge23;
+      s25_q <= shl_s24_q_or_rs_ge23;
+    end if;
+  end process s25_q23_regs;
+
+  -- stage s26_q24: one quotient bit
+  rs_s1_b_d24 <= resize(s1_b_d24, 35);
+  rs_s25_p <= resize(s25_p, 35);
+  shl_rs_s25_p <= shift_left(rs_s25_p, 1);
+  bits_lo_d24 <= unsigned(lo_d24(5 downto 5));
+  rs_bits_lo_d24 <= resize(bits_lo_d24, 35);
+  or_27 <= shl_rs_s25_p or rs_bits_lo_d24;
+  ge24 <= "1" when rs_s1_b_d24 <= or_27 else "0";
+  or_27_minus_rs_s1_b_d24 <= or_27 - rs_s1_b_d24;
+  mux_ge24 <= or_27_minus_rs_s1_b_d24 when ge24 = "1" else or_27;
+  rs_mux_ge24 <= mux_ge24(33 downto 0);
+  shl_s25_q <= shift_left(s25_q, 1);
+  rs_ge24 <= resize(ge24, 30);
+  shl_s25_q_or_rs_ge24 <= shl_s25_q or rs_ge24;
+
+  s26_q24_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d24 <= s1_b_d23;
+      lo_d24 <= lo_d23;
+      s26_p <= rs_mux_ge24;
+      s26_q <= shl_s25_q_or_rs_ge24;
+    end if;
+  end process s26_q24_regs;
+
+  -- stage s27_q25: one quotient bit
+  rs_s1_b_d25 <= resize(s1_b_d25, 35);
+  rs_s26_p <= resize(s26_p, 35);
+  shl_rs_s26_p <= shift_left(rs_s26_p, 1);
+  bits_lo_d25 <= unsigned(lo_d25(4 downto 4));
+  rs_bits_lo_d25 <= resize(bits_lo_d25, 35);
+  or_28 <= shl_rs_s26_p or rs_bits_lo_d25;
+  ge25 <= "1" when rs_s1_b_d25 <= or_28 else "0";
+  or_28_minus_rs_s1_b_d25 <= or_28 - rs_s1_b_d25;
+  mux_ge25 <= or_28_minus_rs_s1_b_d25 when ge25 = "1" else or_28;
+  rs_mux_ge25 <= mux_ge25(33 downto 0);
+  shl_s26_q <= shift_left(s26_q, 1);
+  rs_ge25 <= resize(ge25, 30);
+  shl_s26_q_or_rs_ge25 <= shl_s26_q or rs_ge25;
+
+  s27_q25_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d25 <= s1_b_d24;
+      lo_d25 <= lo_d24;
+      s27_p <= rs_mux_ge25;
+      s27_q <= shl_s26_q_or_rs_ge25;
+    end if;
+  end process s27_q25_regs;
+
+  -- stage s28_q26: one quotient bit
+  rs_s1_b_d26 <= resize(s1_b_d26, 35);
+  rs_s27_p <= resize(s27_p, 35);
+  shl_rs_s27_p <= shift_left(rs_s27_p, 1);
+  bits_lo_d26 <= unsigned(lo_d26(3 downto 3));
+  rs_bits_lo_d26 <= resize(bits_lo_d26, 35);
+  or_29 <= shl_rs_s27_p or rs_bits_lo_d26;
+  ge26 <= "1" when rs_s1_b_d26 <= or_29 else "0";
+  or_29_minus_rs_s1_b_d26 <= or_29 - rs_s1_b_d26;
+  mux_ge26 <= or_29_minus_rs_s1_b_d26 when ge26 = "1" else or_29;
+  rs_mux_ge26 <= mux_ge26(33 downto 0);
+  shl_s27_q <= shift_left(s27_q, 1);
+  rs_ge26 <= resize(ge26, 30);
+  shl_s27_q_or_rs_ge26 <= shl_s27_q or rs_ge26;
+
+  s28_q26_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d26 <= s1_b_d25;
+      lo_d26 <= lo_d25;
+      s28_p <= rs_mux_ge26;
+      s28_q <= shl_s27_q_or_rs_ge26;
+    end if;
+  end process s28_q26_regs;
+
+  -- stage s29_q27: one quotient bit
+  rs_s1_b_d27 <= resize(s1_b_d27, 35);
+  rs_s28_p <= resize(s28_p, 35);
+  shl_rs_s28_p <= shift_left(rs_s28_p, 1);
+  bits_lo_d27 <= unsigned(lo_d27(2 downto 2));
+  rs_bits_lo_d27 <= resize(bits_lo_d27, 35);
+  or_30 <= shl_rs_s28_p or rs_bits_lo_d27;
+  ge27 <= "1" when rs_s1_b_d27 <= or_30 else "0";
+  or_30_minus_rs_s1_b_d27 <= or_30 - rs_s1_b_d27;
+  mux_ge27 <= or_30_minus_rs_s1_b_d27 when ge27 = "1" else or_30;
+  rs_mux_ge27 <= mux_ge27(33 downto 0);
+  shl_s28_q <= shift_left(s28_q, 1);
+  rs_ge27 <= resize(ge27, 30);
+  shl_s28_q_or_rs_ge27 <= shl_s28_q or rs_ge27;
+
+  s29_q27_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d27 <= s1_b_d26;
+      lo_d27 <= lo_d26;
+      s29_p <= rs_mux_ge27;
+      s29_q <= shl_s28_q_or_rs_ge27;
+    end if;
+  end process s29_q27_regs;
+
+  -- stage s30_q28: one quotient bit
+  rs_s1_b_d28 <= resize(s1_b_d28, 35);
+  rs_s29_p <= resize(s29_p, 35);
+  shl_rs_s29_p <= shift_left(rs_s29_p, 1);
+  bits_lo_d28 <= unsigned(lo_d28(1 downto 1));
+  rs_bits_lo_d28 <= resize(bits_lo_d28, 35);
+  or_31 <= shl_rs_s29_p or rs_bits_lo_d28;
+  ge28 <= "1" when rs_s1_b_d28 <= or_31 else "0";
+  or_31_minus_rs_s1_b_d28 <= or_31 - rs_s1_b_d28;
+  mux_ge28 <= or_31_minus_rs_s1_b_d28 when ge28 = "1" else or_31;
+  rs_mux_ge28 <= mux_ge28(33 downto 0);
+  shl_s29_q <= shift_left(s29_q, 1);
+  rs_ge28 <= resize(ge28, 30);
+  shl_s29_q_or_rs_ge28 <= shl_s29_q or rs_ge28;
+
+  s30_q28_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d28 <= s1_b_d27;
+      lo_d28 <= lo_d27;
+      s30_p <= rs_mux_ge28;
+      s30_q <= shl_s29_q_or_rs_ge28;
+    end if;
+  end process s30_q28_regs;
+
+  -- stage s31_result: the quotient and its result flag
+  rs_s1_b_d29 <= resize(s1_b_d29, 35);
+  rs_s30_p <= resize(s30_p, 35);
+  shl_rs_s30_p <= shift_left(rs_s30_p, 1);
+  bits_lo_d29 <= unsigned(lo_d29(0 downto 0));
+  rs_bits_lo_d29 <= resize(bits_lo_d29, 35);
+  or_32 <= shl_rs_s30_p or rs_bits_lo_d29;
+  ge29 <= "1" when rs_s1_b_d29 <= or_32 else "0";
+  or_32_minus_rs_s1_b_d29 <= or_32 - rs_s1_b_d29;
+  mux_ge29 <= or_32_minus_rs_s1_b_d29 when ge29 = "1" else or_32;
+  rs_mux_ge29 <= mux_ge29(33 downto 0);
+  shl_s30_q <= shift_left(s30_q, 1);
+  rs_ge29 <= resize(ge29, 30);
+  shl_s30_q_or_rs_ge29 <= shl_s30_q or rs_ge29;
+  err_1_d29 <= err_1_d29_sr(29);
+  eq_33 <= "1" when shl_s30_q_or_rs_ge29 = k_0_2 else "0";
+  err_1_d29_or_eq_33 <= err_1_d29 or eq_33;
+  not_err_1_d29_or_eq_33 <= not err_1_d29_or_eq_33;
+
+  s31_result_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_b_d29 <= s1_b_d28;
+      lo_d29 <= lo_d28;
+      err_1_d29_sr(2 to 29) <= err_1_d29_sr(1 to 28);
+      err_1_d29_sr(1) <= err_1;
+      s31_t <= shl_s30_q_or_rs_ge29;
+      s31_ok <= not_err_1_d29_or_eq_33;
+    end if;
+  end process s31_result_regs;
+
+  t <= s31_t;
+  ok <= s31_ok;
 end architecture rtl;

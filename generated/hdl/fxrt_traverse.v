@@ -35,22 +35,130 @@ module fxrt_traverse (
   reg [12:0] leaf_rom [0:8191];
   initial $readmemh("fxrt_traverse_leaf_rom.hex", leaf_rom);
 
-  reg [2:0] state = 3'h0;
-  wire [2:0] in_idle_k = 3'h0;
-  wire [0:0] in_idle;
-  wire [2:0] in_aabb_k = 3'h1;
+  // states of state
+  localparam [2:0] st_idle = 3'h0;
+  localparam [2:0] st_aabb = 3'h1;
+  localparam [2:0] st_node = 3'h2;
+  localparam [2:0] st_inner = 3'h3;
+  localparam [2:0] st_leaf = 3'h4;
+  localparam [2:0] st_pop = 3'h5;
+  localparam [2:0] st_done = 3'h6;
+
+  // not in a stage or state machine
+  wire [12:0] node_addr;
+  reg [72:0] node_word = 73'h0000000000000000000;
+  wire [1:0] nw_axis;
+  wire [28:0] nw_clip0;
+  wire [28:0] nw_clip1;
+  wire [12:0] nw_child;
+  wire [12:0] nw_first;
+  wire [2:0] nw_count;
+  wire [1:0] k_3 = 2'h3;
+  wire [0:0] nw_is_leaf;
   wire [0:0] in_aabb;
-  wire [2:0] in_node_k = 3'h2;
   wire [0:0] in_node;
-  wire [2:0] in_inner_k = 3'h3;
-  wire [0:0] in_inner;
-  wire [2:0] in_leaf_k = 3'h4;
+  wire [28:0] box_hi_0 = 29'h1fffffff;
+  wire [28:0] box_hi_1 = 29'h0faab179;
+  wire [28:0] box_hi_2 = 29'h13e4f19b;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
+  reg signed [47:0] case_aabb_k;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] aabb_neg;
+  wire [28:0] k_0 = 29'h00000000;
+  reg [28:0] case_aabb_k_1;
+  wire [28:0] aabb_plane;
+  wire [1:0] mux_in_node;
+  wire [1:0] pu_axis;
+  wire [28:0] mux_in_node_1;
+  wire [28:0] pu_plane;
+  wire [29:0] rs_pu_plane;
+  wire signed [29:0] s_rs_pu_plane;
+  reg [28:0] case_pu_axis;
+  wire [29:0] rs_case_pu_axis;
+  wire signed [29:0] s_rs_case_pu_axis;
+  wire signed [29:0] pu_delta;
+  reg signed [47:0] case_pu_axis_1;
+  wire signed [77:0] x_1;
+  wire signed [77:0] pu_shifted;
+  wire signed [77:0] k_1073741824 = 78'sh00000000000040000000;
+  wire [0:0] lt_2;
+  wire signed [77:0] k_m1 = 78'sh3fffffffffffffffffff;
+  wire [0:0] pu_shifted_lt_k_m1;
+  wire signed [77:0] mux_pu_shifted_lt_k_m1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
+  wire signed [77:0] mux_lt_2;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire signed [31:0] plane_t;
+  wire [1:0] k_2 = 2'h2;
+  wire [0:0] aabb_last;
+  wire [1:0] k_0_1 = 2'h0;
+  wire [0:0] aabb_k_eq_k_0_1;
+  wire [0:0] plane_t_lt_tmax;
+  wire [0:0] or_3;
+  wire signed [31:0] aabb_tmax;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
+  reg signed [47:0] case_axis_r;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] inner_negative;
+  wire [12:0] k_1 = 13'h0001;
+  wire [12:0] child_r_plus_k_1;
+  wire [12:0] near;
+  wire [12:0] far;
+  wire signed [31:0] near_end;
+  wire signed [31:0] far_start;
+  wire [0:0] tmax_lt_near_end;
+  wire signed [31:0] near_max;
+  wire [0:0] tmin_lt_far_start;
+  wire signed [31:0] far_min;
+  wire [0:0] go_near;
+  wire [0:0] go_far;
+  wire [31:0] u_far_min;
+  wire [31:0] u_tmax;
+  wire [76:0] push_entry;
+  wire [5:0] k_1_1 = 6'h01;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 4:0 are read
+  wire [5:0] sp_minus_k_1_1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [4:0] rs_sp_minus_k_1_1;
+  reg [76:0] stack_top = 77'h00000000000000000000;
+  wire [31:0] bits_stack_top;
+  wire signed [31:0] top_tmax;
+  wire [31:0] bits_stack_top_1;
+  wire signed [31:0] top_tmin;
+  wire [12:0] top_node;
+  wire [1:0] k_1_2 = 2'h1;
+  wire [1:0] aabb_k_plus_k_1_2;
+  wire signed [31:0] k_0_2 = 32'sh00000000;
+  wire [12:0] k_0_3 = 13'h0000;
+  wire [0:0] aabb_tmax_lt_k_0_2;
+  wire [2:0] k_0_4 = 3'h0;
+  wire [0:0] nw_count_eq_k_0_4;
+  wire [0:0] go_near_and_go_far;
+  wire [4:0] rs_sp;
+  wire [5:0] sp_plus_k_1_1;
+  wire [12:0] leaf_ptr_plus_k_1;
+  wire [2:0] k_1_3 = 3'h1;
+  wire [2:0] leaf_left_minus_k_1_3;
+  wire [0:0] leaf_left_eq_k_1_3;
+  wire [5:0] k_0_5 = 6'h00;
+  wire [0:0] sp_eq_k_0_5;
+  wire [5:0] sp_minus_k_1_1_1;
+  wire [0:0] in_idle;
   wire [0:0] in_leaf;
-  wire [2:0] in_pop_k = 3'h5;
-  wire [0:0] in_pop;
-  wire [2:0] in_done_k = 3'h6;
   wire [0:0] in_done;
-  wire [0:0] accept;
+  reg [12:0] leaf_tri = 13'h0000;
+  wire [0:0] in_leaf_or_in_done;
+  reg [0:0] emit_r = 1'h0;
+  reg [0:0] end_r = 1'h0;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 30:0 are read
+  wire [31:0] u_tmin;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [30:0] rs_u_tmin;
+  reg [30:0] tmin_r = 31'h00000000;
+  reg [19:0] id_r = 20'h00000;
+
+  // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
+  reg [2:0] state = st_idle;
   reg [19:0] ray_id_r = 20'h00000;
   reg [28:0] ox_r = 29'h00000000;
   reg [28:0] oy_r = 29'h00000000;
@@ -59,16 +167,6 @@ module fxrt_traverse (
   reg signed [47:0] invy_r = 48'sh000000000000;
   reg signed [47:0] invz_r = 48'sh000000000000;
   reg [12:0] node = 13'h0000;
-  wire [12:0] node_next;
-  reg [72:0] node_word = 73'h0000000000000000000;
-  wire [1:0] nw_axis;
-  wire [28:0] nw_clip0;
-  wire [28:0] nw_clip1;
-  wire [12:0] nw_child;
-  wire [12:0] nw_first;
-  wire [2:0] nw_count;
-  wire [1:0] nw_is_leaf_k = 2'h3;
-  wire [0:0] nw_is_leaf;
   reg [1:0] axis_r = 2'h0;
   reg [28:0] clip1_r = 29'h00000000;
   reg [12:0] child_r = 13'h0000;
@@ -76,340 +174,353 @@ module fxrt_traverse (
   reg [1:0] aabb_k = 2'h0;
   reg signed [31:0] tmin = 32'sh00000000;
   reg signed [31:0] tmax = 32'sh00000000;
-  wire [28:0] box_hi_0 = 29'h1fffffff;
-  wire [28:0] box_hi_1 = 29'h0faab179;
-  wire [28:0] box_hi_2 = 29'h13e4f19b;
-  wire [28:0] plane_zero = 29'h00000000;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
-  reg signed [47:0] aabb_inv;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] aabb_neg;
-  reg [28:0] aabb_hi;
-  wire [28:0] aabb_plane;
-  wire [1:0] pu_axis_a;
-  wire [1:0] pu_axis;
-  wire [28:0] pu_plane_a;
-  wire [28:0] pu_plane;
-  reg [28:0] pu_o;
-  reg signed [47:0] pu_inv;
-  wire [29:0] pu_plane_s_w;
-  wire signed [29:0] pu_plane_s;
-  wire [29:0] pu_o_s_w;
-  wire signed [29:0] pu_o_s;
-  wire signed [29:0] pu_delta;
-  wire signed [77:0] pu_prod;
-  wire signed [77:0] pu_shifted;
-  wire signed [77:0] pu_minus1 = 78'sh3fffffffffffffffffff;
-  wire signed [77:0] pu_sat = 78'sh00000000000040000000;
-  wire [0:0] pu_below;
-  wire [0:0] pu_above;
-  wire signed [77:0] pu_clamp_a;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [77:0] pu_clamp;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [31:0] plane_t;
-  wire [1:0] aabb_first_k = 2'h0;
-  wire [0:0] aabb_first;
-  wire [1:0] aabb_last_k = 2'h2;
-  wire [0:0] aabb_last;
-  wire [0:0] aabb_lower;
-  wire [0:0] aabb_take;
-  wire signed [31:0] aabb_tmax;
-  wire signed [31:0] dist_zero = 32'sh00000000;
-  wire [0:0] aabb_miss;
-  wire [1:0] aabb_one = 2'h1;
-  wire [1:0] aabb_k_inc;
-  wire [1:0] aabb_zero = 2'h0;
-  wire [1:0] aabb_k_next;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
-  reg signed [47:0] inner_inv;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] inner_negative;
-  wire [12:0] child_one = 13'h0001;
-  wire [12:0] child_right;
-  wire [12:0] near;
-  wire [12:0] far;
-  wire signed [31:0] near_end;
-  wire signed [31:0] far_start;
-  wire [0:0] near_end_lt;
-  wire signed [31:0] near_max;
-  wire [0:0] far_start_gt;
-  wire signed [31:0] far_min;
-  wire [0:0] go_near;
-  wire [0:0] go_far;
-  wire [0:0] go_both;
-  wire [0:0] push;
-  wire [0:0] not_near;
-  wire [0:0] far_only;
-  wire [0:0] to_near;
-  wire [0:0] to_far;
   reg [5:0] sp = 6'h00;
-  wire [31:0] push_far_min;
-  wire [31:0] push_tmax;
-  wire [76:0] push_entry;
-  wire [4:0] sp_addr;
-  wire [5:0] sp_one = 6'h01;
-  wire [5:0] sp_dec;
-  wire [4:0] top_addr;
-  reg [76:0] stack_top = 77'h00000000000000000000;
-  wire [31:0] top_tmax_u;
-  wire [31:0] top_tmin_u;
-  wire [12:0] top_node;
-  wire signed [31:0] top_tmax;
-  wire signed [31:0] top_tmin;
-  wire [5:0] sp_empty_k = 6'h00;
-  wire [0:0] sp_empty;
-  wire [0:0] sp_nonempty;
-  wire [0:0] popping;
-  wire [5:0] sp_inc;
-  wire [5:0] sp_a;
-  wire [5:0] sp_next;
   reg [12:0] leaf_ptr = 13'h0000;
   reg [2:0] leaf_left = 3'h0;
-  wire [12:0] leaf_one = 13'h0001;
-  wire [12:0] leaf_ptr_inc;
-  wire [0:0] enter_leaf;
-  wire [12:0] leaf_ptr_a;
-  wire [12:0] leaf_ptr_next;
-  wire [2:0] left_one = 3'h1;
-  wire [2:0] left_dec;
-  wire [2:0] left_a;
-  wire [2:0] left_next;
-  wire [2:0] leaf_last_k = 3'h1;
-  wire [0:0] leaf_last;
-  wire [2:0] leaf_empty_k = 3'h0;
-  wire [0:0] leaf_empty;
-  wire [0:0] nw_inner;
-  wire [0:0] latch_inner;
-  wire [0:0] aabb_end;
-  wire signed [31:0] tmin_a;
-  wire signed [31:0] tmin_b;
-  wire signed [31:0] tmin_next;
-  wire signed [31:0] tmax_a;
-  wire signed [31:0] tmax_b;
-  wire signed [31:0] tmax_next;
-  wire [12:0] node_zero = 13'h0000;
-  wire [12:0] node_a;
-  wire [12:0] node_b;
-  wire [12:0] node_c;
-  wire [12:0] node_d;
-  wire [2:0] st_idle = 3'h0;
-  wire [2:0] st_aabb = 3'h1;
-  wire [2:0] st_node = 3'h2;
-  wire [2:0] st_inner = 3'h3;
-  wire [2:0] st_leaf = 3'h4;
-  wire [2:0] st_pop = 3'h5;
-  wire [2:0] st_done = 3'h6;
-  wire [2:0] from_idle;
-  wire [2:0] aabb_go;
-  wire [2:0] from_aabb;
-  wire [2:0] leaf_go;
-  wire [2:0] from_node;
-  wire [0:0] any_child;
-  wire [2:0] from_inner;
-  wire [2:0] from_leaf;
-  wire [2:0] from_pop;
+  reg [1:0] aabb_k_next;
+  wire [19:0] mux_ray_valid;
+  wire [19:0] ray_id_r_next;
+  wire [28:0] mux_ray_valid_1;
+  wire [28:0] ox_r_next;
+  wire signed [47:0] mux_ray_valid_2;
+  wire signed [47:0] invx_r_next;
+  wire [28:0] mux_ray_valid_3;
+  wire [28:0] oy_r_next;
+  wire signed [47:0] mux_ray_valid_4;
+  wire signed [47:0] invy_r_next;
+  wire [28:0] mux_ray_valid_5;
+  wire [28:0] oz_r_next;
+  wire signed [47:0] mux_ray_valid_6;
+  wire signed [47:0] invz_r_next;
+  wire [2:0] mux_ray_valid_7;
+  wire [0:0] and_5;
+  wire [2:0] mux_and_5;
+  wire [0:0] not_aabb_tmax_lt_k_0_2;
+  wire [0:0] and_6;
+  wire [2:0] mux_and_6;
+  wire [0:0] and_7;
+  wire [2:0] mux_and_7;
+  wire [0:0] not_nw_count_eq_k_0_4;
+  wire [0:0] and_8;
+  wire [2:0] mux_and_8;
+  wire [0:0] not_nw_is_leaf;
+  wire [2:0] mux_not_nw_is_leaf;
+  wire [2:0] mux_go_near;
+  wire [0:0] not_go_near;
+  wire [0:0] not_go_near_and_go_far;
+  wire [2:0] mux_not_go_near_and_go_far;
+  wire [0:0] not_go_far;
+  wire [0:0] and_9;
+  wire [2:0] mux_and_9;
+  wire [2:0] mux_leaf_left_eq_k_1_3;
+  wire [2:0] mux_sp_eq_k_0_5;
+  wire [0:0] not_sp_eq_k_0_5;
+  wire [2:0] mux_not_sp_eq_k_0_5;
   reg [2:0] state_next;
-  reg [12:0] leaf_tri = 13'h0000;
-  wire [0:0] emit;
-  reg [0:0] emit_r = 1'h0;
-  reg [0:0] end_r = 1'h0;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 30:0 are read
-  wire [31:0] tmin_u;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [30:0] tmin_w;
-  reg [30:0] tmin_r = 31'h00000000;
-  reg [19:0] id_r = 20'h00000;
+  wire signed [31:0] mux_go_near_1;
+  wire signed [31:0] mux_not_sp_eq_k_0_5_1;
+  reg signed [31:0] tmax_next;
+  wire signed [31:0] mux_aabb_last;
+  wire [0:0] not_go_near_and_go_far_1;
+  wire signed [31:0] mux_not_go_near_and_go_far_1;
+  wire signed [31:0] mux_not_sp_eq_k_0_5_2;
+  reg signed [31:0] tmin_next;
+  wire [12:0] mux_aabb_last_1;
+  wire [12:0] mux_go_near_2;
+  wire [0:0] not_go_near_and_go_far_2;
+  wire [12:0] mux_not_go_near_and_go_far_2;
+  wire [12:0] mux_not_sp_eq_k_0_5_3;
+  reg [12:0] node_next;
+  wire [12:0] mux_nw_is_leaf;
+  reg [12:0] leaf_ptr_next;
+  wire [2:0] mux_nw_is_leaf_1;
+  reg [2:0] leaf_left_next;
+  wire [1:0] mux_not_nw_is_leaf_1;
+  wire [1:0] axis_r_next;
+  wire [28:0] mux_not_nw_is_leaf_2;
+  wire [28:0] clip1_r_next;
+  wire [12:0] mux_not_nw_is_leaf_3;
+  wire [12:0] child_r_next;
+  wire signed [31:0] mux_not_nw_is_leaf_4;
+  wire signed [31:0] d0_r_next;
+  wire [5:0] mux_go_near_and_go_far;
+  wire [5:0] mux_not_sp_eq_k_0_5_4;
+  reg [5:0] sp_next;
+  wire [0:0] in_inner;
+  wire [0:0] and_10;
 
-  assign in_idle = state == in_idle_k;
-  assign in_aabb = state == in_aabb_k;
-  assign in_node = state == in_node_k;
-  assign in_inner = state == in_inner_k;
-  assign in_leaf = state == in_leaf_k;
-  assign in_pop = state == in_pop_k;
-  assign in_done = state == in_done_k;
-  assign accept = in_idle & ray_valid;
-  assign node_next = node_d;
+  // not in a stage or state machine
+  assign node_addr = node_next;
   assign nw_axis = node_word[1:0];
   assign nw_clip0 = node_word[30:2];
   assign nw_clip1 = node_word[59:31];
   assign nw_child = node_word[72:60];
   assign nw_first = node_word[14:2];
   assign nw_count = node_word[17:15];
-  assign nw_is_leaf = nw_axis == nw_is_leaf_k;
+  assign nw_is_leaf = nw_axis == k_3;
+  assign in_aabb = state == st_aabb;
+  assign in_node = state == st_node;
   always @* begin
     case (aabb_k)
-      2'h1: aabb_inv = invy_r;
-      2'h2: aabb_inv = invz_r;
-      default: aabb_inv = invx_r;
+      2'h1: case_aabb_k = invy_r;
+      2'h2: case_aabb_k = invz_r;
+      default: case_aabb_k = invx_r;
     endcase
   end
-  assign aabb_neg = aabb_inv[47];
+  assign aabb_neg = case_aabb_k[47];
   always @* begin
     case (aabb_k)
-      2'h1: aabb_hi = box_hi_1;
-      2'h2: aabb_hi = box_hi_2;
-      default: aabb_hi = box_hi_0;
+      2'h1: case_aabb_k_1 = box_hi_1;
+      2'h2: case_aabb_k_1 = box_hi_2;
+      default: case_aabb_k_1 = box_hi_0;
     endcase
   end
-  assign aabb_plane = aabb_neg ? plane_zero : aabb_hi;
-  assign pu_axis_a = in_node ? nw_axis : axis_r;
-  assign pu_axis = in_aabb ? aabb_k : pu_axis_a;
-  assign pu_plane_a = in_node ? nw_clip0 : clip1_r;
-  assign pu_plane = in_aabb ? aabb_plane : pu_plane_a;
+  assign aabb_plane = aabb_neg ? k_0 : case_aabb_k_1;
+  assign mux_in_node = in_node ? nw_axis : axis_r;
+  assign pu_axis = in_aabb ? aabb_k : mux_in_node;
+  assign mux_in_node_1 = in_node ? nw_clip0 : clip1_r;
+  assign pu_plane = in_aabb ? aabb_plane : mux_in_node_1;
+  assign rs_pu_plane = {{1{1'b0}}, pu_plane};
+  assign s_rs_pu_plane = $signed(rs_pu_plane);
   always @* begin
     case (pu_axis)
-      2'h1: pu_o = oy_r;
-      2'h2: pu_o = oz_r;
-      default: pu_o = ox_r;
+      2'h1: case_pu_axis = oy_r;
+      2'h2: case_pu_axis = oz_r;
+      default: case_pu_axis = ox_r;
     endcase
   end
+  assign rs_case_pu_axis = {{1{1'b0}}, case_pu_axis};
+  assign s_rs_case_pu_axis = $signed(rs_case_pu_axis);
+  assign pu_delta = s_rs_pu_plane - s_rs_case_pu_axis;
   always @* begin
     case (pu_axis)
-      2'h1: pu_inv = invy_r;
-      2'h2: pu_inv = invz_r;
-      default: pu_inv = invx_r;
+      2'h1: case_pu_axis_1 = invy_r;
+      2'h2: case_pu_axis_1 = invz_r;
+      default: case_pu_axis_1 = invx_r;
     endcase
   end
-  assign pu_plane_s_w = {{1{1'b0}}, pu_plane};
-  assign pu_plane_s = $signed(pu_plane_s_w);
-  assign pu_o_s_w = {{1{1'b0}}, pu_o};
-  assign pu_o_s = $signed(pu_o_s_w);
-  assign pu_delta = pu_plane_s - pu_o_s;
-  assign pu_prod = $signed({{48{pu_delta[29]}}, pu_delta}) * $signed({{30{pu_inv[47]}}, pu_inv});
-  assign pu_shifted = pu_prod >>> 16;
-  assign pu_below = pu_shifted < pu_minus1;
-  assign pu_above = pu_sat < pu_shifted;
-  assign pu_clamp_a = pu_below ? pu_minus1 : pu_shifted;
-  assign pu_clamp = pu_above ? pu_sat : pu_clamp_a;
-  assign plane_t = $signed(pu_clamp[31:0]);
-  assign aabb_first = aabb_k == aabb_first_k;
-  assign aabb_last = aabb_k == aabb_last_k;
-  assign aabb_lower = plane_t < tmax;
-  assign aabb_take = aabb_first | aabb_lower;
-  assign aabb_tmax = aabb_take ? plane_t : tmax;
-  assign aabb_miss = aabb_tmax < dist_zero;
-  assign aabb_k_inc = aabb_k + aabb_one;
-  assign aabb_k_next = in_aabb ? aabb_k_inc : aabb_zero;
+  assign x_1 = $signed({{48{pu_delta[29]}}, pu_delta}) * $signed({{30{case_pu_axis_1[47]}}, case_pu_axis_1});
+  assign pu_shifted = x_1 >>> 16;
+  assign lt_2 = k_1073741824 < pu_shifted;
+  assign pu_shifted_lt_k_m1 = pu_shifted < k_m1;
+  assign mux_pu_shifted_lt_k_m1 = pu_shifted_lt_k_m1 ? k_m1 : pu_shifted;
+  assign mux_lt_2 = lt_2 ? k_1073741824 : mux_pu_shifted_lt_k_m1;
+  assign plane_t = $signed(mux_lt_2[31:0]);
+  assign aabb_last = aabb_k == k_2;
+  assign aabb_k_eq_k_0_1 = aabb_k == k_0_1;
+  assign plane_t_lt_tmax = plane_t < tmax;
+  assign or_3 = aabb_k_eq_k_0_1 | plane_t_lt_tmax;
+  assign aabb_tmax = or_3 ? plane_t : tmax;
   always @* begin
     case (axis_r)
-      2'h1: inner_inv = invy_r;
-      2'h2: inner_inv = invz_r;
-      default: inner_inv = invx_r;
+      2'h1: case_axis_r = invy_r;
+      2'h2: case_axis_r = invz_r;
+      default: case_axis_r = invx_r;
     endcase
   end
-  assign inner_negative = inner_inv[47];
-  assign child_right = child_r + child_one;
-  assign near = inner_negative ? child_right : child_r;
-  assign far = inner_negative ? child_r : child_right;
+  assign inner_negative = case_axis_r[47];
+  assign child_r_plus_k_1 = child_r + k_1;
+  assign near = inner_negative ? child_r_plus_k_1 : child_r;
+  assign far = inner_negative ? child_r : child_r_plus_k_1;
   assign near_end = inner_negative ? plane_t : d0_r;
   assign far_start = inner_negative ? d0_r : plane_t;
-  assign near_end_lt = near_end < tmax;
-  assign near_max = near_end_lt ? near_end : tmax;
-  assign far_start_gt = tmin < far_start;
-  assign far_min = far_start_gt ? far_start : tmin;
+  assign tmax_lt_near_end = tmax < near_end;
+  assign near_max = tmax_lt_near_end ? tmax : near_end;
+  assign tmin_lt_far_start = tmin < far_start;
+  assign far_min = tmin_lt_far_start ? far_start : tmin;
   assign go_near = tmin <= near_max;
   assign go_far = far_min <= tmax;
-  assign go_both = go_near & go_far;
-  assign push = in_inner & go_both;
-  assign not_near = ~go_near;
-  assign far_only = not_near & go_far;
-  assign to_near = in_inner & go_near;
-  assign to_far = in_inner & far_only;
-  assign push_far_min = $unsigned(far_min);
-  assign push_tmax = $unsigned(tmax);
-  assign push_entry = {far, push_far_min, push_tmax};
-  assign sp_addr = sp[4:0];
-  assign sp_dec = sp - sp_one;
-  assign top_addr = sp_dec[4:0];
-  assign top_tmax_u = stack_top[31:0];
-  assign top_tmin_u = stack_top[63:32];
+  assign u_far_min = $unsigned(far_min);
+  assign u_tmax = $unsigned(tmax);
+  assign push_entry = {far, u_far_min, u_tmax};
+  assign sp_minus_k_1_1 = sp - k_1_1;
+  assign rs_sp_minus_k_1_1 = sp_minus_k_1_1[4:0];
+  assign bits_stack_top = stack_top[31:0];
+  assign top_tmax = $signed(bits_stack_top);
+  assign bits_stack_top_1 = stack_top[63:32];
+  assign top_tmin = $signed(bits_stack_top_1);
   assign top_node = stack_top[76:64];
-  assign top_tmax = $signed(top_tmax_u);
-  assign top_tmin = $signed(top_tmin_u);
-  assign sp_empty = sp == sp_empty_k;
-  assign sp_nonempty = ~sp_empty;
-  assign popping = in_pop & sp_nonempty;
-  assign sp_inc = sp + sp_one;
-  assign sp_a = push ? sp_inc : sp;
-  assign sp_next = popping ? sp_dec : sp_a;
-  assign leaf_ptr_inc = leaf_ptr + leaf_one;
-  assign enter_leaf = in_node & nw_is_leaf;
-  assign leaf_ptr_a = in_leaf ? leaf_ptr_inc : leaf_ptr;
-  assign leaf_ptr_next = enter_leaf ? nw_first : leaf_ptr_a;
-  assign left_dec = leaf_left - left_one;
-  assign left_a = in_leaf ? left_dec : leaf_left;
-  assign left_next = enter_leaf ? nw_count : left_a;
-  assign leaf_last = leaf_left == leaf_last_k;
-  assign leaf_empty = nw_count == leaf_empty_k;
-  assign nw_inner = ~nw_is_leaf;
-  assign latch_inner = in_node & nw_inner;
-  assign aabb_end = in_aabb & aabb_last;
-  assign tmin_a = to_far ? far_min : tmin;
-  assign tmin_b = popping ? top_tmin : tmin_a;
-  assign tmin_next = aabb_end ? dist_zero : tmin_b;
-  assign tmax_a = to_near ? near_max : tmax;
-  assign tmax_b = popping ? top_tmax : tmax_a;
-  assign tmax_next = in_aabb ? aabb_tmax : tmax_b;
-  assign node_a = to_near ? near : node;
-  assign node_b = to_far ? far : node_a;
-  assign node_c = popping ? top_node : node_b;
-  assign node_d = aabb_end ? node_zero : node_c;
-  assign from_idle = ray_valid ? st_aabb : st_idle;
-  assign aabb_go = aabb_miss ? st_done : st_node;
-  assign from_aabb = aabb_last ? aabb_go : st_aabb;
-  assign leaf_go = leaf_empty ? st_pop : st_leaf;
-  assign from_node = nw_is_leaf ? leaf_go : st_inner;
-  assign any_child = go_near | go_far;
-  assign from_inner = any_child ? st_node : st_pop;
-  assign from_leaf = leaf_last ? st_pop : st_leaf;
-  assign from_pop = sp_empty ? st_done : st_node;
+  assign aabb_k_plus_k_1_2 = aabb_k + k_1_2;
+  assign aabb_tmax_lt_k_0_2 = aabb_tmax < k_0_2;
+  assign nw_count_eq_k_0_4 = nw_count == k_0_4;
+  assign go_near_and_go_far = go_near & go_far;
+  assign rs_sp = sp[4:0];
+  assign sp_plus_k_1_1 = sp + k_1_1;
+  assign leaf_ptr_plus_k_1 = leaf_ptr + k_1;
+  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
+  assign leaf_left_eq_k_1_3 = leaf_left == k_1_3;
+  assign sp_eq_k_0_5 = sp == k_0_5;
+  assign sp_minus_k_1_1_1 = sp - k_1_1;
+  assign in_idle = state == st_idle;
+  assign in_leaf = state == st_leaf;
+  assign in_done = state == st_done;
+  assign in_leaf_or_in_done = in_leaf | in_done;
+  assign u_tmin = $unsigned(tmin);
+  assign rs_u_tmin = u_tmin[30:0];
+
+  always @(posedge clk) begin : regs
+    if (and_10) stack[rs_sp] <= push_entry;
+    node_word <= node_rom[node_addr];
+    stack_top <= stack[rs_sp_minus_k_1_1];
+    leaf_tri <= leaf_rom[leaf_ptr];
+    emit_r <= in_leaf_or_in_done;
+    end_r <= in_done;
+    tmin_r <= rs_u_tmin;
+    id_r <= ray_id_r;
+  end
+
+  // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
   always @* begin
     case (state)
-      3'h0: state_next = from_idle;
-      3'h1: state_next = from_aabb;
-      3'h2: state_next = from_node;
-      3'h3: state_next = from_inner;
-      3'h4: state_next = from_leaf;
-      3'h5: state_next = from_pop;
+      st_idle: aabb_k_next = k_0_1;
+      st_aabb: aabb_k_next = aabb_k_plus_k_1_2;
+      default: aabb_k_next = aabb_k;
+    endcase
+  end
+  assign mux_ray_valid = ray_valid ? ray_id : ray_id_r;
+  assign ray_id_r_next = in_idle ? mux_ray_valid : ray_id_r;
+  assign mux_ray_valid_1 = ray_valid ? ox : ox_r;
+  assign ox_r_next = in_idle ? mux_ray_valid_1 : ox_r;
+  assign mux_ray_valid_2 = ray_valid ? invx : invx_r;
+  assign invx_r_next = in_idle ? mux_ray_valid_2 : invx_r;
+  assign mux_ray_valid_3 = ray_valid ? oy : oy_r;
+  assign oy_r_next = in_idle ? mux_ray_valid_3 : oy_r;
+  assign mux_ray_valid_4 = ray_valid ? invy : invy_r;
+  assign invy_r_next = in_idle ? mux_ray_valid_4 : invy_r;
+  assign mux_ray_valid_5 = ray_valid ? oz : oz_r;
+  assign oz_r_next = in_idle ? mux_ray_valid_5 : oz_r;
+  assign mux_ray_valid_6 = ray_valid ? invz : invz_r;
+  assign invz_r_next = in_idle ? mux_ray_valid_6 : invz_r;
+  assign mux_ray_valid_7 = ray_valid ? st_aabb : state;
+  assign and_5 = aabb_last & aabb_tmax_lt_k_0_2;
+  assign mux_and_5 = and_5 ? st_done : state;
+  assign not_aabb_tmax_lt_k_0_2 = ~aabb_tmax_lt_k_0_2;
+  assign and_6 = aabb_last & not_aabb_tmax_lt_k_0_2;
+  assign mux_and_6 = and_6 ? st_node : mux_and_5;
+  assign and_7 = nw_is_leaf & nw_count_eq_k_0_4;
+  assign mux_and_7 = and_7 ? st_pop : state;
+  assign not_nw_count_eq_k_0_4 = ~nw_count_eq_k_0_4;
+  assign and_8 = nw_is_leaf & not_nw_count_eq_k_0_4;
+  assign mux_and_8 = and_8 ? st_leaf : mux_and_7;
+  assign not_nw_is_leaf = ~nw_is_leaf;
+  assign mux_not_nw_is_leaf = not_nw_is_leaf ? st_inner : mux_and_8;
+  assign mux_go_near = go_near ? st_node : state;
+  assign not_go_near = ~go_near;
+  assign not_go_near_and_go_far = not_go_near & go_far;
+  assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? st_node : mux_go_near;
+  assign not_go_far = ~go_far;
+  assign and_9 = not_go_near & not_go_far;
+  assign mux_and_9 = and_9 ? st_pop : mux_not_go_near_and_go_far;
+  assign mux_leaf_left_eq_k_1_3 = leaf_left_eq_k_1_3 ? st_pop : state;
+  assign mux_sp_eq_k_0_5 = sp_eq_k_0_5 ? st_done : state;
+  assign not_sp_eq_k_0_5 = ~sp_eq_k_0_5;
+  assign mux_not_sp_eq_k_0_5 = not_sp_eq_k_0_5 ? st_node : mux_sp_eq_k_0_5;
+  always @* begin
+    case (state)
+      st_idle: state_next = mux_ray_valid_7;
+      st_aabb: state_next = mux_and_6;
+      st_node: state_next = mux_not_nw_is_leaf;
+      st_inner: state_next = mux_and_9;
+      st_leaf: state_next = mux_leaf_left_eq_k_1_3;
+      st_pop: state_next = mux_not_sp_eq_k_0_5;
+      st_done: state_next = st_idle;
       default: state_next = st_idle;
     endcase
   end
-  assign emit = in_leaf | in_done;
-  assign tmin_u = $unsigned(tmin);
-  assign tmin_w = tmin_u[30:0];
+  assign mux_go_near_1 = go_near ? near_max : tmax;
+  assign mux_not_sp_eq_k_0_5_1 = not_sp_eq_k_0_5 ? top_tmax : tmax;
+  always @* begin
+    case (state)
+      st_aabb: tmax_next = aabb_tmax;
+      st_inner: tmax_next = mux_go_near_1;
+      st_pop: tmax_next = mux_not_sp_eq_k_0_5_1;
+      default: tmax_next = tmax;
+    endcase
+  end
+  assign mux_aabb_last = aabb_last ? k_0_2 : tmin;
+  assign not_go_near_and_go_far_1 = not_go_near & go_far;
+  assign mux_not_go_near_and_go_far_1 = not_go_near_and_go_far_1 ? far_min : tmin;
+  assign mux_not_sp_eq_k_0_5_2 = not_sp_eq_k_0_5 ? top_tmin : tmin;
+  always @* begin
+    case (state)
+      st_aabb: tmin_next = mux_aabb_last;
+      st_inner: tmin_next = mux_not_go_near_and_go_far_1;
+      st_pop: tmin_next = mux_not_sp_eq_k_0_5_2;
+      default: tmin_next = tmin;
+    endcase
+  end
+  assign mux_aabb_last_1 = aabb_last ? k_0_3 : node;
+  assign mux_go_near_2 = go_near ? near : node;
+  assign not_go_near_and_go_far_2 = not_go_near & go_far;
+  assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? far : mux_go_near_2;
+  assign mux_not_sp_eq_k_0_5_3 = not_sp_eq_k_0_5 ? top_node : node;
+  always @* begin
+    case (state)
+      st_aabb: node_next = mux_aabb_last_1;
+      st_inner: node_next = mux_not_go_near_and_go_far_2;
+      st_pop: node_next = mux_not_sp_eq_k_0_5_3;
+      default: node_next = node;
+    endcase
+  end
+  assign mux_nw_is_leaf = nw_is_leaf ? nw_first : leaf_ptr;
+  always @* begin
+    case (state)
+      st_node: leaf_ptr_next = mux_nw_is_leaf;
+      st_leaf: leaf_ptr_next = leaf_ptr_plus_k_1;
+      default: leaf_ptr_next = leaf_ptr;
+    endcase
+  end
+  assign mux_nw_is_leaf_1 = nw_is_leaf ? nw_count : leaf_left;
+  always @* begin
+    case (state)
+      st_node: leaf_left_next = mux_nw_is_leaf_1;
+      st_leaf: leaf_left_next = leaf_left_minus_k_1_3;
+      default: leaf_left_next = leaf_left;
+    endcase
+  end
+  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf ? nw_axis : axis_r;
+  assign axis_r_next = in_node ? mux_not_nw_is_leaf_1 : axis_r;
+  assign mux_not_nw_is_leaf_2 = not_nw_is_leaf ? nw_clip1 : clip1_r;
+  assign clip1_r_next = in_node ? mux_not_nw_is_leaf_2 : clip1_r;
+  assign mux_not_nw_is_leaf_3 = not_nw_is_leaf ? nw_child : child_r;
+  assign child_r_next = in_node ? mux_not_nw_is_leaf_3 : child_r;
+  assign mux_not_nw_is_leaf_4 = not_nw_is_leaf ? plane_t : d0_r;
+  assign d0_r_next = in_node ? mux_not_nw_is_leaf_4 : d0_r;
+  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_1 : sp;
+  assign mux_not_sp_eq_k_0_5_4 = not_sp_eq_k_0_5 ? sp_minus_k_1_1_1 : sp;
+  always @* begin
+    case (state)
+      st_inner: sp_next = mux_go_near_and_go_far;
+      st_pop: sp_next = mux_not_sp_eq_k_0_5_4;
+      default: sp_next = sp;
+    endcase
+  end
+  assign in_inner = state == st_inner;
+  assign and_10 = in_inner & go_near_and_go_far;
 
-  always @(posedge clk) begin : regs
-    if (push) stack[sp_addr] <= push_entry;
-    if (rst) state <= 3'h0;
+  always @(posedge clk) begin : state_regs
+    if (rst) state <= st_idle;
     else state <= state_next;
-    if (accept) ray_id_r <= ray_id;
-    if (accept) ox_r <= ox;
-    if (accept) oy_r <= oy;
-    if (accept) oz_r <= oz;
-    if (accept) invx_r <= invx;
-    if (accept) invy_r <= invy;
-    if (accept) invz_r <= invz;
+    ray_id_r <= ray_id_r_next;
+    ox_r <= ox_r_next;
+    oy_r <= oy_r_next;
+    oz_r <= oz_r_next;
+    invx_r <= invx_r_next;
+    invy_r <= invy_r_next;
+    invz_r <= invz_r_next;
     if (rst) node <= 13'h0000;
     else node <= node_next;
-    node_word <= node_rom[node_next];
-    if (latch_inner) axis_r <= nw_axis;
-    if (latch_inner) clip1_r <= nw_clip1;
-    if (latch_inner) child_r <= nw_child;
-    if (latch_inner) d0_r <= plane_t;
+    axis_r <= axis_r_next;
+    clip1_r <= clip1_r_next;
+    child_r <= child_r_next;
+    d0_r <= d0_r_next;
     aabb_k <= aabb_k_next;
     tmin <= tmin_next;
     tmax <= tmax_next;
     if (rst) sp <= 6'h00;
     else sp <= sp_next;
-    stack_top <= stack[top_addr];
     leaf_ptr <= leaf_ptr_next;
-    leaf_left <= left_next;
-    leaf_tri <= leaf_rom[leaf_ptr];
-    emit_r <= emit;
-    end_r <= in_done;
-    tmin_r <= tmin_w;
-    id_r <= ray_id_r;
+    leaf_left <= leaf_left_next;
   end
 
   assign ray_ready = in_idle;

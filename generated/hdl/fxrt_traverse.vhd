@@ -10776,22 +10776,120 @@ architecture rtl of fxrt_traverse is
     6319 => "0111001011001",
     others => (others => '0'));
 
-  signal state : unsigned(2 downto 0) := unsigned'("000");
-  constant in_idle_k : unsigned(2 downto 0) := unsigned'("000");
-  signal in_idle : unsigned(0 downto 0);
-  constant in_aabb_k : unsigned(2 downto 0) := unsigned'("001");
+  -- states of state
+  constant st_idle : unsigned(2 downto 0) := "000";
+  constant st_aabb : unsigned(2 downto 0) := "001";
+  constant st_node : unsigned(2 downto 0) := "010";
+  constant st_inner : unsigned(2 downto 0) := "011";
+  constant st_leaf : unsigned(2 downto 0) := "100";
+  constant st_pop : unsigned(2 downto 0) := "101";
+  constant st_done : unsigned(2 downto 0) := "110";
+
+  -- not in a stage or state machine
+  signal node_addr : unsigned(12 downto 0);
+  signal node_word : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal nw_axis : unsigned(1 downto 0);
+  signal nw_clip0 : unsigned(28 downto 0);
+  signal nw_clip1 : unsigned(28 downto 0);
+  signal nw_child : unsigned(12 downto 0);
+  signal nw_first : unsigned(12 downto 0);
+  signal nw_count : unsigned(2 downto 0);
+  constant k_3 : unsigned(1 downto 0) := unsigned'("11");
+  signal nw_is_leaf : unsigned(0 downto 0);
   signal in_aabb : unsigned(0 downto 0);
-  constant in_node_k : unsigned(2 downto 0) := unsigned'("010");
   signal in_node : unsigned(0 downto 0);
-  constant in_inner_k : unsigned(2 downto 0) := unsigned'("011");
-  signal in_inner : unsigned(0 downto 0);
-  constant in_leaf_k : unsigned(2 downto 0) := unsigned'("100");
+  constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
+  constant box_hi_1 : unsigned(28 downto 0) := unsigned'("01111101010101011000101111001");
+  constant box_hi_2 : unsigned(28 downto 0) := unsigned'("10011111001001111000110011011");
+  signal case_aabb_k : signed(47 downto 0);
+  signal aabb_neg : unsigned(0 downto 0);
+  constant k_0 : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal case_aabb_k_1 : unsigned(28 downto 0);
+  signal aabb_plane : unsigned(28 downto 0);
+  signal mux_in_node : unsigned(1 downto 0);
+  signal pu_axis : unsigned(1 downto 0);
+  signal mux_in_node_1 : unsigned(28 downto 0);
+  signal pu_plane : unsigned(28 downto 0);
+  signal rs_pu_plane : unsigned(29 downto 0);
+  signal s_rs_pu_plane : signed(29 downto 0);
+  signal case_pu_axis : unsigned(28 downto 0);
+  signal rs_case_pu_axis : unsigned(29 downto 0);
+  signal s_rs_case_pu_axis : signed(29 downto 0);
+  signal pu_delta : signed(29 downto 0);
+  signal case_pu_axis_1 : signed(47 downto 0);
+  signal x_1 : signed(77 downto 0);
+  signal pu_shifted : signed(77 downto 0);
+  constant k_1073741824 : signed(77 downto 0) := signed'("000000000000000000000000000000000000000000000001000000000000000000000000000000");
+  signal lt_2 : unsigned(0 downto 0);
+  constant k_m1 : signed(77 downto 0) := signed'("111111111111111111111111111111111111111111111111111111111111111111111111111111");
+  signal pu_shifted_lt_k_m1 : unsigned(0 downto 0);
+  signal mux_pu_shifted_lt_k_m1 : signed(77 downto 0);
+  signal mux_lt_2 : signed(77 downto 0);
+  signal plane_t : signed(31 downto 0);
+  constant k_2 : unsigned(1 downto 0) := unsigned'("10");
+  signal aabb_last : unsigned(0 downto 0);
+  constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
+  signal aabb_k_eq_k_0_1 : unsigned(0 downto 0);
+  signal plane_t_lt_tmax : unsigned(0 downto 0);
+  signal or_3 : unsigned(0 downto 0);
+  signal aabb_tmax : signed(31 downto 0);
+  signal case_axis_r : signed(47 downto 0);
+  signal inner_negative : unsigned(0 downto 0);
+  constant k_1 : unsigned(12 downto 0) := unsigned'("0000000000001");
+  signal child_r_plus_k_1 : unsigned(12 downto 0);
+  signal near : unsigned(12 downto 0);
+  signal far : unsigned(12 downto 0);
+  signal near_end : signed(31 downto 0);
+  signal far_start : signed(31 downto 0);
+  signal tmax_lt_near_end : unsigned(0 downto 0);
+  signal near_max : signed(31 downto 0);
+  signal tmin_lt_far_start : unsigned(0 downto 0);
+  signal far_min : signed(31 downto 0);
+  signal go_near : unsigned(0 downto 0);
+  signal go_far : unsigned(0 downto 0);
+  signal u_far_min : unsigned(31 downto 0);
+  signal u_tmax : unsigned(31 downto 0);
+  signal push_entry : unsigned(76 downto 0);
+  constant k_1_1 : unsigned(5 downto 0) := unsigned'("000001");
+  signal sp_minus_k_1_1 : unsigned(5 downto 0);
+  signal rs_sp_minus_k_1_1 : unsigned(4 downto 0);
+  signal stack_top : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal bits_stack_top : unsigned(31 downto 0);
+  signal top_tmax : signed(31 downto 0);
+  signal bits_stack_top_1 : unsigned(31 downto 0);
+  signal top_tmin : signed(31 downto 0);
+  signal top_node : unsigned(12 downto 0);
+  constant k_1_2 : unsigned(1 downto 0) := unsigned'("01");
+  signal aabb_k_plus_k_1_2 : unsigned(1 downto 0);
+  constant k_0_2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  constant k_0_3 : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal aabb_tmax_lt_k_0_2 : unsigned(0 downto 0);
+  constant k_0_4 : unsigned(2 downto 0) := unsigned'("000");
+  signal nw_count_eq_k_0_4 : unsigned(0 downto 0);
+  signal go_near_and_go_far : unsigned(0 downto 0);
+  signal rs_sp : unsigned(4 downto 0);
+  signal sp_plus_k_1_1 : unsigned(5 downto 0);
+  signal leaf_ptr_plus_k_1 : unsigned(12 downto 0);
+  constant k_1_3 : unsigned(2 downto 0) := unsigned'("001");
+  signal leaf_left_minus_k_1_3 : unsigned(2 downto 0);
+  signal leaf_left_eq_k_1_3 : unsigned(0 downto 0);
+  constant k_0_5 : unsigned(5 downto 0) := unsigned'("000000");
+  signal sp_eq_k_0_5 : unsigned(0 downto 0);
+  signal sp_minus_k_1_1_1 : unsigned(5 downto 0);
+  signal in_idle : unsigned(0 downto 0);
   signal in_leaf : unsigned(0 downto 0);
-  constant in_pop_k : unsigned(2 downto 0) := unsigned'("101");
-  signal in_pop : unsigned(0 downto 0);
-  constant in_done_k : unsigned(2 downto 0) := unsigned'("110");
   signal in_done : unsigned(0 downto 0);
-  signal accept : unsigned(0 downto 0);
+  signal leaf_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal in_leaf_or_in_done : unsigned(0 downto 0);
+  signal emit_r : unsigned(0 downto 0) := unsigned'("0");
+  signal end_r : unsigned(0 downto 0) := unsigned'("0");
+  signal u_tmin : unsigned(31 downto 0);
+  signal rs_u_tmin : unsigned(30 downto 0);
+  signal tmin_r : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
+
+  -- state machine state: BIH traversal: one ray at a time, one leaf entry per clock
+  signal state : unsigned(2 downto 0) := st_idle;
   signal ray_id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal ox_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal oy_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -10800,16 +10898,6 @@ architecture rtl of fxrt_traverse is
   signal invy_r : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal invz_r : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal node : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal node_next : unsigned(12 downto 0);
-  signal node_word : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
-  signal nw_axis : unsigned(1 downto 0);
-  signal nw_clip0 : unsigned(28 downto 0);
-  signal nw_clip1 : unsigned(28 downto 0);
-  signal nw_child : unsigned(12 downto 0);
-  signal nw_first : unsigned(12 downto 0);
-  signal nw_count : unsigned(2 downto 0);
-  constant nw_is_leaf_k : unsigned(1 downto 0) := unsigned'("11");
-  signal nw_is_leaf : unsigned(0 downto 0);
   signal axis_r : unsigned(1 downto 0) := unsigned'("00");
   signal clip1_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal child_r : unsigned(12 downto 0) := unsigned'("0000000000000");
@@ -10817,340 +10905,334 @@ architecture rtl of fxrt_traverse is
   signal aabb_k : unsigned(1 downto 0) := unsigned'("00");
   signal tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
-  constant box_hi_1 : unsigned(28 downto 0) := unsigned'("01111101010101011000101111001");
-  constant box_hi_2 : unsigned(28 downto 0) := unsigned'("10011111001001111000110011011");
-  constant plane_zero : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
-  signal aabb_inv : signed(47 downto 0);
-  signal aabb_neg : unsigned(0 downto 0);
-  signal aabb_hi : unsigned(28 downto 0);
-  signal aabb_plane : unsigned(28 downto 0);
-  signal pu_axis_a : unsigned(1 downto 0);
-  signal pu_axis : unsigned(1 downto 0);
-  signal pu_plane_a : unsigned(28 downto 0);
-  signal pu_plane : unsigned(28 downto 0);
-  signal pu_o : unsigned(28 downto 0);
-  signal pu_inv : signed(47 downto 0);
-  signal pu_plane_s_w : unsigned(29 downto 0);
-  signal pu_plane_s : signed(29 downto 0);
-  signal pu_o_s_w : unsigned(29 downto 0);
-  signal pu_o_s : signed(29 downto 0);
-  signal pu_delta : signed(29 downto 0);
-  signal pu_prod : signed(77 downto 0);
-  signal pu_shifted : signed(77 downto 0);
-  constant pu_minus1 : signed(77 downto 0) := signed'("111111111111111111111111111111111111111111111111111111111111111111111111111111");
-  constant pu_sat : signed(77 downto 0) := signed'("000000000000000000000000000000000000000000000001000000000000000000000000000000");
-  signal pu_below : unsigned(0 downto 0);
-  signal pu_above : unsigned(0 downto 0);
-  signal pu_clamp_a : signed(77 downto 0);
-  signal pu_clamp : signed(77 downto 0);
-  signal plane_t : signed(31 downto 0);
-  constant aabb_first_k : unsigned(1 downto 0) := unsigned'("00");
-  signal aabb_first : unsigned(0 downto 0);
-  constant aabb_last_k : unsigned(1 downto 0) := unsigned'("10");
-  signal aabb_last : unsigned(0 downto 0);
-  signal aabb_lower : unsigned(0 downto 0);
-  signal aabb_take : unsigned(0 downto 0);
-  signal aabb_tmax : signed(31 downto 0);
-  constant dist_zero : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal aabb_miss : unsigned(0 downto 0);
-  constant aabb_one : unsigned(1 downto 0) := unsigned'("01");
-  signal aabb_k_inc : unsigned(1 downto 0);
-  constant aabb_zero : unsigned(1 downto 0) := unsigned'("00");
-  signal aabb_k_next : unsigned(1 downto 0);
-  signal inner_inv : signed(47 downto 0);
-  signal inner_negative : unsigned(0 downto 0);
-  constant child_one : unsigned(12 downto 0) := unsigned'("0000000000001");
-  signal child_right : unsigned(12 downto 0);
-  signal near : unsigned(12 downto 0);
-  signal far : unsigned(12 downto 0);
-  signal near_end : signed(31 downto 0);
-  signal far_start : signed(31 downto 0);
-  signal near_end_lt : unsigned(0 downto 0);
-  signal near_max : signed(31 downto 0);
-  signal far_start_gt : unsigned(0 downto 0);
-  signal far_min : signed(31 downto 0);
-  signal go_near : unsigned(0 downto 0);
-  signal go_far : unsigned(0 downto 0);
-  signal go_both : unsigned(0 downto 0);
-  signal push : unsigned(0 downto 0);
-  signal not_near : unsigned(0 downto 0);
-  signal far_only : unsigned(0 downto 0);
-  signal to_near : unsigned(0 downto 0);
-  signal to_far : unsigned(0 downto 0);
   signal sp : unsigned(5 downto 0) := unsigned'("000000");
-  signal push_far_min : unsigned(31 downto 0);
-  signal push_tmax : unsigned(31 downto 0);
-  signal push_entry : unsigned(76 downto 0);
-  signal sp_addr : unsigned(4 downto 0);
-  constant sp_one : unsigned(5 downto 0) := unsigned'("000001");
-  signal sp_dec : unsigned(5 downto 0);
-  signal top_addr : unsigned(4 downto 0);
-  signal stack_top : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
-  signal top_tmax_u : unsigned(31 downto 0);
-  signal top_tmin_u : unsigned(31 downto 0);
-  signal top_node : unsigned(12 downto 0);
-  signal top_tmax : signed(31 downto 0);
-  signal top_tmin : signed(31 downto 0);
-  constant sp_empty_k : unsigned(5 downto 0) := unsigned'("000000");
-  signal sp_empty : unsigned(0 downto 0);
-  signal sp_nonempty : unsigned(0 downto 0);
-  signal popping : unsigned(0 downto 0);
-  signal sp_inc : unsigned(5 downto 0);
-  signal sp_a : unsigned(5 downto 0);
-  signal sp_next : unsigned(5 downto 0);
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal leaf_left : unsigned(2 downto 0) := unsigned'("000");
-  constant leaf_one : unsigned(12 downto 0) := unsigned'("0000000000001");
-  signal leaf_ptr_inc : unsigned(12 downto 0);
-  signal enter_leaf : unsigned(0 downto 0);
-  signal leaf_ptr_a : unsigned(12 downto 0);
-  signal leaf_ptr_next : unsigned(12 downto 0);
-  constant left_one : unsigned(2 downto 0) := unsigned'("001");
-  signal left_dec : unsigned(2 downto 0);
-  signal left_a : unsigned(2 downto 0);
-  signal left_next : unsigned(2 downto 0);
-  constant leaf_last_k : unsigned(2 downto 0) := unsigned'("001");
-  signal leaf_last : unsigned(0 downto 0);
-  constant leaf_empty_k : unsigned(2 downto 0) := unsigned'("000");
-  signal leaf_empty : unsigned(0 downto 0);
-  signal nw_inner : unsigned(0 downto 0);
-  signal latch_inner : unsigned(0 downto 0);
-  signal aabb_end : unsigned(0 downto 0);
-  signal tmin_a : signed(31 downto 0);
-  signal tmin_b : signed(31 downto 0);
-  signal tmin_next : signed(31 downto 0);
-  signal tmax_a : signed(31 downto 0);
-  signal tmax_b : signed(31 downto 0);
-  signal tmax_next : signed(31 downto 0);
-  constant node_zero : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal node_a : unsigned(12 downto 0);
-  signal node_b : unsigned(12 downto 0);
-  signal node_c : unsigned(12 downto 0);
-  signal node_d : unsigned(12 downto 0);
-  constant st_idle : unsigned(2 downto 0) := unsigned'("000");
-  constant st_aabb : unsigned(2 downto 0) := unsigned'("001");
-  constant st_node : unsigned(2 downto 0) := unsigned'("010");
-  constant st_inner : unsigned(2 downto 0) := unsigned'("011");
-  constant st_leaf : unsigned(2 downto 0) := unsigned'("100");
-  constant st_pop : unsigned(2 downto 0) := unsigned'("101");
-  constant st_done : unsigned(2 downto 0) := unsigned'("110");
-  signal from_idle : unsigned(2 downto 0);
-  signal aabb_go : unsigned(2 downto 0);
-  signal from_aabb : unsigned(2 downto 0);
-  signal leaf_go : unsigned(2 downto 0);
-  signal from_node : unsigned(2 downto 0);
-  signal any_child : unsigned(0 downto 0);
-  signal from_inner : unsigned(2 downto 0);
-  signal from_leaf : unsigned(2 downto 0);
-  signal from_pop : unsigned(2 downto 0);
+  signal aabb_k_next : unsigned(1 downto 0);
+  signal mux_ray_valid : unsigned(19 downto 0);
+  signal ray_id_r_next : unsigned(19 downto 0);
+  signal mux_ray_valid_1 : unsigned(28 downto 0);
+  signal ox_r_next : unsigned(28 downto 0);
+  signal mux_ray_valid_2 : signed(47 downto 0);
+  signal invx_r_next : signed(47 downto 0);
+  signal mux_ray_valid_3 : unsigned(28 downto 0);
+  signal oy_r_next : unsigned(28 downto 0);
+  signal mux_ray_valid_4 : signed(47 downto 0);
+  signal invy_r_next : signed(47 downto 0);
+  signal mux_ray_valid_5 : unsigned(28 downto 0);
+  signal oz_r_next : unsigned(28 downto 0);
+  signal mux_ray_valid_6 : signed(47 downto 0);
+  signal invz_r_next : signed(47 downto 0);
+  signal mux_ray_valid_7 : unsigned(2 downto 0);
+  signal and_5 : unsigned(0 downto 0);
+  signal mux_and_5 : unsigned(2 downto 0);
+  signal not_aabb_tmax_lt_k_0_2 : unsigned(0 downto 0);
+  signal and_6 : unsigned(0 downto 0);
+  signal mux_and_6 : unsigned(2 downto 0);
+  signal and_7 : unsigned(0 downto 0);
+  signal mux_and_7 : unsigned(2 downto 0);
+  signal not_nw_count_eq_k_0_4 : unsigned(0 downto 0);
+  signal and_8 : unsigned(0 downto 0);
+  signal mux_and_8 : unsigned(2 downto 0);
+  signal not_nw_is_leaf : unsigned(0 downto 0);
+  signal mux_not_nw_is_leaf : unsigned(2 downto 0);
+  signal mux_go_near : unsigned(2 downto 0);
+  signal not_go_near : unsigned(0 downto 0);
+  signal not_go_near_and_go_far : unsigned(0 downto 0);
+  signal mux_not_go_near_and_go_far : unsigned(2 downto 0);
+  signal not_go_far : unsigned(0 downto 0);
+  signal and_9 : unsigned(0 downto 0);
+  signal mux_and_9 : unsigned(2 downto 0);
+  signal mux_leaf_left_eq_k_1_3 : unsigned(2 downto 0);
+  signal mux_sp_eq_k_0_5 : unsigned(2 downto 0);
+  signal not_sp_eq_k_0_5 : unsigned(0 downto 0);
+  signal mux_not_sp_eq_k_0_5 : unsigned(2 downto 0);
   signal state_next : unsigned(2 downto 0);
-  signal leaf_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal emit : unsigned(0 downto 0);
-  signal emit_r : unsigned(0 downto 0) := unsigned'("0");
-  signal end_r : unsigned(0 downto 0) := unsigned'("0");
-  signal tmin_u : unsigned(31 downto 0);
-  signal tmin_w : unsigned(30 downto 0);
-  signal tmin_r : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
-  signal id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
+  signal mux_go_near_1 : signed(31 downto 0);
+  signal mux_not_sp_eq_k_0_5_1 : signed(31 downto 0);
+  signal tmax_next : signed(31 downto 0);
+  signal mux_aabb_last : signed(31 downto 0);
+  signal not_go_near_and_go_far_1 : unsigned(0 downto 0);
+  signal mux_not_go_near_and_go_far_1 : signed(31 downto 0);
+  signal mux_not_sp_eq_k_0_5_2 : signed(31 downto 0);
+  signal tmin_next : signed(31 downto 0);
+  signal mux_aabb_last_1 : unsigned(12 downto 0);
+  signal mux_go_near_2 : unsigned(12 downto 0);
+  signal not_go_near_and_go_far_2 : unsigned(0 downto 0);
+  signal mux_not_go_near_and_go_far_2 : unsigned(12 downto 0);
+  signal mux_not_sp_eq_k_0_5_3 : unsigned(12 downto 0);
+  signal node_next : unsigned(12 downto 0);
+  signal mux_nw_is_leaf : unsigned(12 downto 0);
+  signal leaf_ptr_next : unsigned(12 downto 0);
+  signal mux_nw_is_leaf_1 : unsigned(2 downto 0);
+  signal leaf_left_next : unsigned(2 downto 0);
+  signal mux_not_nw_is_leaf_1 : unsigned(1 downto 0);
+  signal axis_r_next : unsigned(1 downto 0);
+  signal mux_not_nw_is_leaf_2 : unsigned(28 downto 0);
+  signal clip1_r_next : unsigned(28 downto 0);
+  signal mux_not_nw_is_leaf_3 : unsigned(12 downto 0);
+  signal child_r_next : unsigned(12 downto 0);
+  signal mux_not_nw_is_leaf_4 : signed(31 downto 0);
+  signal d0_r_next : signed(31 downto 0);
+  signal mux_go_near_and_go_far : unsigned(5 downto 0);
+  signal mux_not_sp_eq_k_0_5_4 : unsigned(5 downto 0);
+  signal sp_next : unsigned(5 downto 0);
+  signal in_inner : unsigned(0 downto 0);
+  signal and_10 : unsigned(0 downto 0);
 begin
 
-  in_idle <= "1" when state = in_idle_k else "0";
-  in_aabb <= "1" when state = in_aabb_k else "0";
-  in_node <= "1" when state = in_node_k else "0";
-  in_inner <= "1" when state = in_inner_k else "0";
-  in_leaf <= "1" when state = in_leaf_k else "0";
-  in_pop <= "1" when state = in_pop_k else "0";
-  in_done <= "1" when state = in_done_k else "0";
-  accept <= in_idle and ray_valid;
-  node_next <= node_d;
+  -- not in a stage or state machine
+  node_addr <= node_next;
   nw_axis <= unsigned(node_word(1 downto 0));
   nw_clip0 <= unsigned(node_word(30 downto 2));
   nw_clip1 <= unsigned(node_word(59 downto 31));
   nw_child <= unsigned(node_word(72 downto 60));
   nw_first <= unsigned(node_word(14 downto 2));
   nw_count <= unsigned(node_word(17 downto 15));
-  nw_is_leaf <= "1" when nw_axis = nw_is_leaf_k else "0";
+  nw_is_leaf <= "1" when nw_axis = k_3 else "0";
+  in_aabb <= "1" when state = st_aabb else "0";
+  in_node <= "1" when state = st_node else "0";
   with aabb_k select
-    aabb_inv <=
+    case_aabb_k <=
       invy_r when "01",
       invz_r when "10",
       invx_r when others;
-  aabb_neg <= unsigned(aabb_inv(47 downto 47));
+  aabb_neg <= unsigned(case_aabb_k(47 downto 47));
   with aabb_k select
-    aabb_hi <=
+    case_aabb_k_1 <=
       box_hi_1 when "01",
       box_hi_2 when "10",
       box_hi_0 when others;
-  aabb_plane <= plane_zero when aabb_neg = "1" else aabb_hi;
-  pu_axis_a <= nw_axis when in_node = "1" else axis_r;
-  pu_axis <= aabb_k when in_aabb = "1" else pu_axis_a;
-  pu_plane_a <= nw_clip0 when in_node = "1" else clip1_r;
-  pu_plane <= aabb_plane when in_aabb = "1" else pu_plane_a;
+  aabb_plane <= k_0 when aabb_neg = "1" else case_aabb_k_1;
+  mux_in_node <= nw_axis when in_node = "1" else axis_r;
+  pu_axis <= aabb_k when in_aabb = "1" else mux_in_node;
+  mux_in_node_1 <= nw_clip0 when in_node = "1" else clip1_r;
+  pu_plane <= aabb_plane when in_aabb = "1" else mux_in_node_1;
+  rs_pu_plane <= resize(pu_plane, 30);
+  s_rs_pu_plane <= signed(rs_pu_plane);
   with pu_axis select
-    pu_o <=
+    case_pu_axis <=
       oy_r when "01",
       oz_r when "10",
       ox_r when others;
+  rs_case_pu_axis <= resize(case_pu_axis, 30);
+  s_rs_case_pu_axis <= signed(rs_case_pu_axis);
+  pu_delta <= s_rs_pu_plane - s_rs_case_pu_axis;
   with pu_axis select
-    pu_inv <=
+    case_pu_axis_1 <=
       invy_r when "01",
       invz_r when "10",
       invx_r when others;
-  pu_plane_s_w <= resize(pu_plane, 30);
-  pu_plane_s <= signed(pu_plane_s_w);
-  pu_o_s_w <= resize(pu_o, 30);
-  pu_o_s <= signed(pu_o_s_w);
-  pu_delta <= pu_plane_s - pu_o_s;
-  pu_prod <= pu_delta * pu_inv;
-  pu_shifted <= shift_right(pu_prod, 16);
-  pu_below <= "1" when pu_shifted < pu_minus1 else "0";
-  pu_above <= "1" when pu_sat < pu_shifted else "0";
-  pu_clamp_a <= pu_minus1 when pu_below = "1" else pu_shifted;
-  pu_clamp <= pu_sat when pu_above = "1" else pu_clamp_a;
-  plane_t <= pu_clamp(31 downto 0);
-  aabb_first <= "1" when aabb_k = aabb_first_k else "0";
-  aabb_last <= "1" when aabb_k = aabb_last_k else "0";
-  aabb_lower <= "1" when plane_t < tmax else "0";
-  aabb_take <= aabb_first or aabb_lower;
-  aabb_tmax <= plane_t when aabb_take = "1" else tmax;
-  aabb_miss <= "1" when aabb_tmax < dist_zero else "0";
-  aabb_k_inc <= aabb_k + aabb_one;
-  aabb_k_next <= aabb_k_inc when in_aabb = "1" else aabb_zero;
+  x_1 <= pu_delta * case_pu_axis_1;
+  pu_shifted <= shift_right(x_1, 16);
+  lt_2 <= "1" when k_1073741824 < pu_shifted else "0";
+  pu_shifted_lt_k_m1 <= "1" when pu_shifted < k_m1 else "0";
+  mux_pu_shifted_lt_k_m1 <= k_m1 when pu_shifted_lt_k_m1 = "1" else pu_shifted;
+  mux_lt_2 <= k_1073741824 when lt_2 = "1" else mux_pu_shifted_lt_k_m1;
+  plane_t <= mux_lt_2(31 downto 0);
+  aabb_last <= "1" when aabb_k = k_2 else "0";
+  aabb_k_eq_k_0_1 <= "1" when aabb_k = k_0_1 else "0";
+  plane_t_lt_tmax <= "1" when plane_t < tmax else "0";
+  or_3 <= aabb_k_eq_k_0_1 or plane_t_lt_tmax;
+  aabb_tmax <= plane_t when or_3 = "1" else tmax;
   with axis_r select
-    inner_inv <=
+    case_axis_r <=
       invy_r when "01",
       invz_r when "10",
       invx_r when others;
-  inner_negative <= unsigned(inner_inv(47 downto 47));
-  child_right <= child_r + child_one;
-  near <= child_right when inner_negative = "1" else child_r;
-  far <= child_r when inner_negative = "1" else child_right;
+  inner_negative <= unsigned(case_axis_r(47 downto 47));
+  child_r_plus_k_1 <= child_r + k_1;
+  near <= child_r_plus_k_1 when inner_negative = "1" else child_r;
+  far <= child_r when inner_negative = "1" else child_r_plus_k_1;
   near_end <= plane_t when inner_negative = "1" else d0_r;
   far_start <= d0_r when inner_negative = "1" else plane_t;
-  near_end_lt <= "1" when near_end < tmax else "0";
-  near_max <= near_end when near_end_lt = "1" else tmax;
-  far_start_gt <= "1" when tmin < far_start else "0";
-  far_min <= far_start when far_start_gt = "1" else tmin;
+  tmax_lt_near_end <= "1" when tmax < near_end else "0";
+  near_max <= tmax when tmax_lt_near_end = "1" else near_end;
+  tmin_lt_far_start <= "1" when tmin < far_start else "0";
+  far_min <= far_start when tmin_lt_far_start = "1" else tmin;
   go_near <= "1" when tmin <= near_max else "0";
   go_far <= "1" when far_min <= tmax else "0";
-  go_both <= go_near and go_far;
-  push <= in_inner and go_both;
-  not_near <= not go_near;
-  far_only <= not_near and go_far;
-  to_near <= in_inner and go_near;
-  to_far <= in_inner and far_only;
-  push_far_min <= unsigned(far_min);
-  push_tmax <= unsigned(tmax);
-  push_entry <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(push_far_min) & std_logic_vector(push_tmax)));
-  sp_addr <= sp(4 downto 0);
-  sp_dec <= sp - sp_one;
-  top_addr <= sp_dec(4 downto 0);
-  top_tmax_u <= unsigned(stack_top(31 downto 0));
-  top_tmin_u <= unsigned(stack_top(63 downto 32));
+  u_far_min <= unsigned(far_min);
+  u_tmax <= unsigned(tmax);
+  push_entry <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_tmax)));
+  sp_minus_k_1_1 <= sp - k_1_1;
+  rs_sp_minus_k_1_1 <= sp_minus_k_1_1(4 downto 0);
+  bits_stack_top <= unsigned(stack_top(31 downto 0));
+  top_tmax <= signed(bits_stack_top);
+  bits_stack_top_1 <= unsigned(stack_top(63 downto 32));
+  top_tmin <= signed(bits_stack_top_1);
   top_node <= unsigned(stack_top(76 downto 64));
-  top_tmax <= signed(top_tmax_u);
-  top_tmin <= signed(top_tmin_u);
-  sp_empty <= "1" when sp = sp_empty_k else "0";
-  sp_nonempty <= not sp_empty;
-  popping <= in_pop and sp_nonempty;
-  sp_inc <= sp + sp_one;
-  sp_a <= sp_inc when push = "1" else sp;
-  sp_next <= sp_dec when popping = "1" else sp_a;
-  leaf_ptr_inc <= leaf_ptr + leaf_one;
-  enter_leaf <= in_node and nw_is_leaf;
-  leaf_ptr_a <= leaf_ptr_inc when in_leaf = "1" else leaf_ptr;
-  leaf_ptr_next <= nw_first when enter_leaf = "1" else leaf_ptr_a;
-  left_dec <= leaf_left - left_one;
-  left_a <= left_dec when in_leaf = "1" else leaf_left;
-  left_next <= nw_count when enter_leaf = "1" else left_a;
-  leaf_last <= "1" when leaf_left = leaf_last_k else "0";
-  leaf_empty <= "1" when nw_count = leaf_empty_k else "0";
-  nw_inner <= not nw_is_leaf;
-  latch_inner <= in_node and nw_inner;
-  aabb_end <= in_aabb and aabb_last;
-  tmin_a <= far_min when to_far = "1" else tmin;
-  tmin_b <= top_tmin when popping = "1" else tmin_a;
-  tmin_next <= dist_zero when aabb_end = "1" else tmin_b;
-  tmax_a <= near_max when to_near = "1" else tmax;
-  tmax_b <= top_tmax when popping = "1" else tmax_a;
-  tmax_next <= aabb_tmax when in_aabb = "1" else tmax_b;
-  node_a <= near when to_near = "1" else node;
-  node_b <= far when to_far = "1" else node_a;
-  node_c <= top_node when popping = "1" else node_b;
-  node_d <= node_zero when aabb_end = "1" else node_c;
-  from_idle <= st_aabb when ray_valid = "1" else st_idle;
-  aabb_go <= st_done when aabb_miss = "1" else st_node;
-  from_aabb <= aabb_go when aabb_last = "1" else st_aabb;
-  leaf_go <= st_pop when leaf_empty = "1" else st_leaf;
-  from_node <= leaf_go when nw_is_leaf = "1" else st_inner;
-  any_child <= go_near or go_far;
-  from_inner <= st_node when any_child = "1" else st_pop;
-  from_leaf <= st_pop when leaf_last = "1" else st_leaf;
-  from_pop <= st_done when sp_empty = "1" else st_node;
-  with state select
-    state_next <=
-      from_idle when "000",
-      from_aabb when "001",
-      from_node when "010",
-      from_inner when "011",
-      from_leaf when "100",
-      from_pop when "101",
-      st_idle when others;
-  emit <= in_leaf or in_done;
-  tmin_u <= unsigned(tmin);
-  tmin_w <= tmin_u(30 downto 0);
+  aabb_k_plus_k_1_2 <= aabb_k + k_1_2;
+  aabb_tmax_lt_k_0_2 <= "1" when aabb_tmax < k_0_2 else "0";
+  nw_count_eq_k_0_4 <= "1" when nw_count = k_0_4 else "0";
+  go_near_and_go_far <= go_near and go_far;
+  rs_sp <= sp(4 downto 0);
+  sp_plus_k_1_1 <= sp + k_1_1;
+  leaf_ptr_plus_k_1 <= leaf_ptr + k_1;
+  leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
+  leaf_left_eq_k_1_3 <= "1" when leaf_left = k_1_3 else "0";
+  sp_eq_k_0_5 <= "1" when sp = k_0_5 else "0";
+  sp_minus_k_1_1_1 <= sp - k_1_1;
+  in_idle <= "1" when state = st_idle else "0";
+  in_leaf <= "1" when state = st_leaf else "0";
+  in_done <= "1" when state = st_done else "0";
+  in_leaf_or_in_done <= in_leaf or in_done;
+  u_tmin <= unsigned(tmin);
+  rs_u_tmin <= u_tmin(30 downto 0);
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if push = "1" then
-        stack(to_integer(sp_addr)) <= push_entry;
+      if and_10 = "1" then
+        stack(to_integer(rs_sp)) <= push_entry;
       end if;
+      node_word <= node_rom(to_integer(node_addr));
+      stack_top <= stack(to_integer(rs_sp_minus_k_1_1));
+      leaf_tri <= leaf_rom(to_integer(leaf_ptr));
+      emit_r <= in_leaf_or_in_done;
+      end_r <= in_done;
+      tmin_r <= rs_u_tmin;
+      id_r <= ray_id_r;
+    end if;
+  end process regs;
+
+  -- state machine state: BIH traversal: one ray at a time, one leaf entry per clock
+  with state select
+    aabb_k_next <=
+      k_0_1 when st_idle,
+      aabb_k_plus_k_1_2 when st_aabb,
+      aabb_k when others;
+  mux_ray_valid <= ray_id when ray_valid = "1" else ray_id_r;
+  ray_id_r_next <= mux_ray_valid when in_idle = "1" else ray_id_r;
+  mux_ray_valid_1 <= ox when ray_valid = "1" else ox_r;
+  ox_r_next <= mux_ray_valid_1 when in_idle = "1" else ox_r;
+  mux_ray_valid_2 <= invx when ray_valid = "1" else invx_r;
+  invx_r_next <= mux_ray_valid_2 when in_idle = "1" else invx_r;
+  mux_ray_valid_3 <= oy when ray_valid = "1" else oy_r;
+  oy_r_next <= mux_ray_valid_3 when in_idle = "1" else oy_r;
+  mux_ray_valid_4 <= invy when ray_valid = "1" else invy_r;
+  invy_r_next <= mux_ray_valid_4 when in_idle = "1" else invy_r;
+  mux_ray_valid_5 <= oz when ray_valid = "1" else oz_r;
+  oz_r_next <= mux_ray_valid_5 when in_idle = "1" else oz_r;
+  mux_ray_valid_6 <= invz when ray_valid = "1" else invz_r;
+  invz_r_next <= mux_ray_valid_6 when in_idle = "1" else invz_r;
+  mux_ray_valid_7 <= st_aabb when ray_valid = "1" else state;
+  and_5 <= aabb_last and aabb_tmax_lt_k_0_2;
+  mux_and_5 <= st_done when and_5 = "1" else state;
+  not_aabb_tmax_lt_k_0_2 <= not aabb_tmax_lt_k_0_2;
+  and_6 <= aabb_last and not_aabb_tmax_lt_k_0_2;
+  mux_and_6 <= st_node when and_6 = "1" else mux_and_5;
+  and_7 <= nw_is_leaf and nw_count_eq_k_0_4;
+  mux_and_7 <= st_pop when and_7 = "1" else state;
+  not_nw_count_eq_k_0_4 <= not nw_count_eq_k_0_4;
+  and_8 <= nw_is_leaf and not_nw_count_eq_k_0_4;
+  mux_and_8 <= st_leaf when and_8 = "1" else mux_and_7;
+  not_nw_is_leaf <= not nw_is_leaf;
+  mux_not_nw_is_leaf <= st_inner when not_nw_is_leaf = "1" else mux_and_8;
+  mux_go_near <= st_node when go_near = "1" else state;
+  not_go_near <= not go_near;
+  not_go_near_and_go_far <= not_go_near and go_far;
+  mux_not_go_near_and_go_far <= st_node when not_go_near_and_go_far = "1" else mux_go_near;
+  not_go_far <= not go_far;
+  and_9 <= not_go_near and not_go_far;
+  mux_and_9 <= st_pop when and_9 = "1" else mux_not_go_near_and_go_far;
+  mux_leaf_left_eq_k_1_3 <= st_pop when leaf_left_eq_k_1_3 = "1" else state;
+  mux_sp_eq_k_0_5 <= st_done when sp_eq_k_0_5 = "1" else state;
+  not_sp_eq_k_0_5 <= not sp_eq_k_0_5;
+  mux_not_sp_eq_k_0_5 <= st_node when not_sp_eq_k_0_5 = "1" else mux_sp_eq_k_0_5;
+  with state select
+    state_next <=
+      mux_ray_valid_7 when st_idle,
+      mux_and_6 when st_aabb,
+      mux_not_nw_is_leaf when st_node,
+      mux_and_9 when st_inner,
+      mux_leaf_left_eq_k_1_3 when st_leaf,
+      mux_not_sp_eq_k_0_5 when st_pop,
+      st_idle when st_done,
+      st_idle when others;
+  mux_go_near_1 <= near_max when go_near = "1" else tmax;
+  mux_not_sp_eq_k_0_5_1 <= top_tmax when not_sp_eq_k_0_5 = "1" else tmax;
+  with state select
+    tmax_next <=
+      aabb_tmax when st_aabb,
+      mux_go_near_1 when st_inner,
+      mux_not_sp_eq_k_0_5_1 when st_pop,
+      tmax when others;
+  mux_aabb_last <= k_0_2 when aabb_last = "1" else tmin;
+  not_go_near_and_go_far_1 <= not_go_near and go_far;
+  mux_not_go_near_and_go_far_1 <= far_min when not_go_near_and_go_far_1 = "1" else tmin;
+  mux_not_sp_eq_k_0_5_2 <= top_tmin when not_sp_eq_k_0_5 = "1" else tmin;
+  with state select
+    tmin_next <=
+      mux_aabb_last when st_aabb,
+      mux_not_go_near_and_go_far_1 when st_inner,
+      mux_not_sp_eq_k_0_5_2 when st_pop,
+      tmin when others;
+  mux_aabb_last_1 <= k_0_3 when aabb_last = "1" else node;
+  mux_go_near_2 <= near when go_near = "1" else node;
+  not_go_near_and_go_far_2 <= not_go_near and go_far;
+  mux_not_go_near_and_go_far_2 <= far when not_go_near_and_go_far_2 = "1" else mux_go_near_2;
+  mux_not_sp_eq_k_0_5_3 <= top_node when not_sp_eq_k_0_5 = "1" else node;
+  with state select
+    node_next <=
+      mux_aabb_last_1 when st_aabb,
+      mux_not_go_near_and_go_far_2 when st_inner,
+      mux_not_sp_eq_k_0_5_3 when st_pop,
+      node when others;
+  mux_nw_is_leaf <= nw_first when nw_is_leaf = "1" else leaf_ptr;
+  with state select
+    leaf_ptr_next <=
+      mux_nw_is_leaf when st_node,
+      leaf_ptr_plus_k_1 when st_leaf,
+      leaf_ptr when others;
+  mux_nw_is_leaf_1 <= nw_count when nw_is_leaf = "1" else leaf_left;
+  with state select
+    leaf_left_next <=
+      mux_nw_is_leaf_1 when st_node,
+      leaf_left_minus_k_1_3 when st_leaf,
+      leaf_left when others;
+  mux_not_nw_is_leaf_1 <= nw_axis when not_nw_is_leaf = "1" else axis_r;
+  axis_r_next <= mux_not_nw_is_leaf_1 when in_node = "1" else axis_r;
+  mux_not_nw_is_leaf_2 <= nw_clip1 when not_nw_is_leaf = "1" else clip1_r;
+  clip1_r_next <= mux_not_nw_is_leaf_2 when in_node = "1" else clip1_r;
+  mux_not_nw_is_leaf_3 <= nw_child when not_nw_is_leaf = "1" else child_r;
+  child_r_next <= mux_not_nw_is_leaf_3 when in_node = "1" else child_r;
+  mux_not_nw_is_leaf_4 <= plane_t when not_nw_is_leaf = "1" else d0_r;
+  d0_r_next <= mux_not_nw_is_leaf_4 when in_node = "1" else d0_r;
+  mux_go_near_and_go_far <= sp_plus_k_1_1 when go_near_and_go_far = "1" else sp;
+  mux_not_sp_eq_k_0_5_4 <= sp_minus_k_1_1_1 when not_sp_eq_k_0_5 = "1" else sp;
+  with state select
+    sp_next <=
+      mux_go_near_and_go_far when st_inner,
+      mux_not_sp_eq_k_0_5_4 when st_pop,
+      sp when others;
+  in_inner <= "1" when state = st_inner else "0";
+  and_10 <= in_inner and go_near_and_go_far;
+
+  state_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       if rst = '1' then
-        state <= unsigned'("000");
+        state <= st_idle;
       else
         state <= state_next;
       end if;
-      if accept = "1" then
-        ray_id_r <= ray_id;
-      end if;
-      if accept = "1" then
-        ox_r <= ox;
-      end if;
-      if accept = "1" then
-        oy_r <= oy;
-      end if;
-      if accept = "1" then
-        oz_r <= oz;
-      end if;
-      if accept = "1" then
-        invx_r <= invx;
-      end if;
-      if accept = "1" then
-        invy_r <= invy;
-      end if;
-      if accept = "1" then
-        invz_r <= invz;
-      end if;
+      ray_id_r <= ray_id_r_next;
+      ox_r <= ox_r_next;
+      oy_r <= oy_r_next;
+      oz_r <= oz_r_next;
+      invx_r <= invx_r_next;
+      invy_r <= invy_r_next;
+      invz_r <= invz_r_next;
       if rst = '1' then
         node <= unsigned'("0000000000000");
       else
         node <= node_next;
       end if;
-      node_word <= node_rom(to_integer(node_next));
-      if latch_inner = "1" then
-        axis_r <= nw_axis;
-      end if;
-      if latch_inner = "1" then
-        clip1_r <= nw_clip1;
-      end if;
-      if latch_inner = "1" then
-        child_r <= nw_child;
-      end if;
-      if latch_inner = "1" then
-        d0_r <= plane_t;
-      end if;
+      axis_r <= axis_r_next;
+      clip1_r <= clip1_r_next;
+      child_r <= child_r_next;
+      d0_r <= d0_r_next;
       aabb_k <= aabb_k_next;
       tmin <= tmin_next;
       tmax <= tmax_next;
@@ -11159,16 +11241,10 @@ begin
       else
         sp <= sp_next;
       end if;
-      stack_top <= stack(to_integer(top_addr));
       leaf_ptr <= leaf_ptr_next;
-      leaf_left <= left_next;
-      leaf_tri <= leaf_rom(to_integer(leaf_ptr));
-      emit_r <= emit;
-      end_r <= in_done;
-      tmin_r <= tmin_w;
-      id_r <= ray_id_r;
+      leaf_left <= leaf_left_next;
     end if;
-  end process regs;
+  end process state_regs;
 
   ray_ready <= in_idle;
   emit_valid <= emit_r;
