@@ -14,6 +14,9 @@
 //!
 //! Assignments take effect at the clock edge; within a state they apply in program order and
 //! the last one whose conditions hold wins; a register not assigned in a clock holds its value.
+//! Every condition and value reads the registers as they are before the edge (as in a VHDL
+//! process with signals): `s.set(count, count + 1)` followed by `s.when(count.eq(2), …)` tests
+//! the old count.
 //! `finish` builds each register's next value as a `case` on the state (one arm per state
 //! that assigns it) and refuses a machine with a state that has no block.
 
