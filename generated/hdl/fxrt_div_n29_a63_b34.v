@@ -49,9 +49,9 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge0;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge0;
+  wire [33:0] rem0;
   wire [29:0] rs_ge0;
-  wire [29:0] k_0_2_or_rs_ge0;
+  wire [29:0] quot0;
   reg [33:0] s2_p = 34'h000000000;
   reg [29:0] s2_q = 30'h00000000;
 
@@ -69,10 +69,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge1;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge1;
+  wire [33:0] rem1;
   wire [29:0] shl_s2_q;
   wire [29:0] rs_ge1;
-  wire [29:0] shl_s2_q_or_rs_ge1;
+  wire [29:0] quot1;
   reg [33:0] s3_p = 34'h000000000;
   reg [29:0] s3_q = 30'h00000000;
 
@@ -90,10 +90,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge2;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge2;
+  wire [33:0] rem2;
   wire [29:0] shl_s3_q;
   wire [29:0] rs_ge2;
-  wire [29:0] shl_s3_q_or_rs_ge2;
+  wire [29:0] quot2;
   reg [33:0] s4_p = 34'h000000000;
   reg [29:0] s4_q = 30'h00000000;
 
@@ -111,10 +111,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge3;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge3;
+  wire [33:0] rem3;
   wire [29:0] shl_s4_q;
   wire [29:0] rs_ge3;
-  wire [29:0] shl_s4_q_or_rs_ge3;
+  wire [29:0] quot3;
   reg [33:0] s5_p = 34'h000000000;
   reg [29:0] s5_q = 30'h00000000;
 
@@ -132,10 +132,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge4;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge4;
+  wire [33:0] rem4;
   wire [29:0] shl_s5_q;
   wire [29:0] rs_ge4;
-  wire [29:0] shl_s5_q_or_rs_ge4;
+  wire [29:0] quot4;
   reg [33:0] s6_p = 34'h000000000;
   reg [29:0] s6_q = 30'h00000000;
 
@@ -153,10 +153,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge5;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge5;
+  wire [33:0] rem5;
   wire [29:0] shl_s6_q;
   wire [29:0] rs_ge5;
-  wire [29:0] shl_s6_q_or_rs_ge5;
+  wire [29:0] quot5;
   reg [33:0] s7_p = 34'h000000000;
   reg [29:0] s7_q = 30'h00000000;
 
@@ -174,10 +174,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge6;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge6;
+  wire [33:0] rem6;
   wire [29:0] shl_s7_q;
   wire [29:0] rs_ge6;
-  wire [29:0] shl_s7_q_or_rs_ge6;
+  wire [29:0] quot6;
   reg [33:0] s8_p = 34'h000000000;
   reg [29:0] s8_q = 30'h00000000;
 
@@ -195,10 +195,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge7;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge7;
+  wire [33:0] rem7;
   wire [29:0] shl_s8_q;
   wire [29:0] rs_ge7;
-  wire [29:0] shl_s8_q_or_rs_ge7;
+  wire [29:0] quot7;
   reg [33:0] s9_p = 34'h000000000;
   reg [29:0] s9_q = 30'h00000000;
 
@@ -216,10 +216,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge8;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge8;
+  wire [33:0] rem8;
   wire [29:0] shl_s9_q;
   wire [29:0] rs_ge8;
-  wire [29:0] shl_s9_q_or_rs_ge8;
+  wire [29:0] quot8;
   reg [33:0] s10_p = 34'h000000000;
   reg [29:0] s10_q = 30'h00000000;
 
@@ -237,10 +237,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge9;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge9;
+  wire [33:0] rem9;
   wire [29:0] shl_s10_q;
   wire [29:0] rs_ge9;
-  wire [29:0] shl_s10_q_or_rs_ge9;
+  wire [29:0] quot9;
   reg [33:0] s11_p = 34'h000000000;
   reg [29:0] s11_q = 30'h00000000;
 
@@ -258,10 +258,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge10;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge10;
+  wire [33:0] rem10;
   wire [29:0] shl_s11_q;
   wire [29:0] rs_ge10;
-  wire [29:0] shl_s11_q_or_rs_ge10;
+  wire [29:0] quot10;
   reg [33:0] s12_p = 34'h000000000;
   reg [29:0] s12_q = 30'h00000000;
 
@@ -279,10 +279,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge11;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge11;
+  wire [33:0] rem11;
   wire [29:0] shl_s12_q;
   wire [29:0] rs_ge11;
-  wire [29:0] shl_s12_q_or_rs_ge11;
+  wire [29:0] quot11;
   reg [33:0] s13_p = 34'h000000000;
   reg [29:0] s13_q = 30'h00000000;
 
@@ -300,10 +300,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge12;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge12;
+  wire [33:0] rem12;
   wire [29:0] shl_s13_q;
   wire [29:0] rs_ge12;
-  wire [29:0] shl_s13_q_or_rs_ge12;
+  wire [29:0] quot12;
   reg [33:0] s14_p = 34'h000000000;
   reg [29:0] s14_q = 30'h00000000;
 
@@ -321,10 +321,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge13;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge13;
+  wire [33:0] rem13;
   wire [29:0] shl_s14_q;
   wire [29:0] rs_ge13;
-  wire [29:0] shl_s14_q_or_rs_ge13;
+  wire [29:0] quot13;
   reg [33:0] s15_p = 34'h000000000;
   reg [29:0] s15_q = 30'h00000000;
 
@@ -342,10 +342,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge14;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge14;
+  wire [33:0] rem14;
   wire [29:0] shl_s15_q;
   wire [29:0] rs_ge14;
-  wire [29:0] shl_s15_q_or_rs_ge14;
+  wire [29:0] quot14;
   reg [33:0] s16_p = 34'h000000000;
   reg [29:0] s16_q = 30'h00000000;
 
@@ -363,10 +363,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge15;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge15;
+  wire [33:0] rem15;
   wire [29:0] shl_s16_q;
   wire [29:0] rs_ge15;
-  wire [29:0] shl_s16_q_or_rs_ge15;
+  wire [29:0] quot15;
   reg [33:0] s17_p = 34'h000000000;
   reg [29:0] s17_q = 30'h00000000;
 
@@ -384,10 +384,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge16;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge16;
+  wire [33:0] rem16;
   wire [29:0] shl_s17_q;
   wire [29:0] rs_ge16;
-  wire [29:0] shl_s17_q_or_rs_ge16;
+  wire [29:0] quot16;
   reg [33:0] s18_p = 34'h000000000;
   reg [29:0] s18_q = 30'h00000000;
 
@@ -405,10 +405,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge17;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge17;
+  wire [33:0] rem17;
   wire [29:0] shl_s18_q;
   wire [29:0] rs_ge17;
-  wire [29:0] shl_s18_q_or_rs_ge17;
+  wire [29:0] quot17;
   reg [33:0] s19_p = 34'h000000000;
   reg [29:0] s19_q = 30'h00000000;
 
@@ -426,10 +426,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge18;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge18;
+  wire [33:0] rem18;
   wire [29:0] shl_s19_q;
   wire [29:0] rs_ge18;
-  wire [29:0] shl_s19_q_or_rs_ge18;
+  wire [29:0] quot18;
   reg [33:0] s20_p = 34'h000000000;
   reg [29:0] s20_q = 30'h00000000;
 
@@ -447,10 +447,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge19;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge19;
+  wire [33:0] rem19;
   wire [29:0] shl_s20_q;
   wire [29:0] rs_ge19;
-  wire [29:0] shl_s20_q_or_rs_ge19;
+  wire [29:0] quot19;
   reg [33:0] s21_p = 34'h000000000;
   reg [29:0] s21_q = 30'h00000000;
 
@@ -468,10 +468,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge20;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge20;
+  wire [33:0] rem20;
   wire [29:0] shl_s21_q;
   wire [29:0] rs_ge20;
-  wire [29:0] shl_s21_q_or_rs_ge20;
+  wire [29:0] quot20;
   reg [33:0] s22_p = 34'h000000000;
   reg [29:0] s22_q = 30'h00000000;
 
@@ -489,10 +489,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge21;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge21;
+  wire [33:0] rem21;
   wire [29:0] shl_s22_q;
   wire [29:0] rs_ge21;
-  wire [29:0] shl_s22_q_or_rs_ge21;
+  wire [29:0] quot21;
   reg [33:0] s23_p = 34'h000000000;
   reg [29:0] s23_q = 30'h00000000;
 
@@ -510,10 +510,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge22;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge22;
+  wire [33:0] rem22;
   wire [29:0] shl_s23_q;
   wire [29:0] rs_ge22;
-  wire [29:0] shl_s23_q_or_rs_ge22;
+  wire [29:0] quot22;
   reg [33:0] s24_p = 34'h000000000;
   reg [29:0] s24_q = 30'h00000000;
 
@@ -531,10 +531,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge23;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge23;
+  wire [33:0] rem23;
   wire [29:0] shl_s24_q;
   wire [29:0] rs_ge23;
-  wire [29:0] shl_s24_q_or_rs_ge23;
+  wire [29:0] quot23;
   reg [33:0] s25_p = 34'h000000000;
   reg [29:0] s25_q = 30'h00000000;
 
@@ -552,10 +552,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge24;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge24;
+  wire [33:0] rem24;
   wire [29:0] shl_s25_q;
   wire [29:0] rs_ge24;
-  wire [29:0] shl_s25_q_or_rs_ge24;
+  wire [29:0] quot24;
   reg [33:0] s26_p = 34'h000000000;
   reg [29:0] s26_q = 30'h00000000;
 
@@ -573,10 +573,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge25;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge25;
+  wire [33:0] rem25;
   wire [29:0] shl_s26_q;
   wire [29:0] rs_ge25;
-  wire [29:0] shl_s26_q_or_rs_ge25;
+  wire [29:0] quot25;
   reg [33:0] s27_p = 34'h000000000;
   reg [29:0] s27_q = 30'h00000000;
 
@@ -594,10 +594,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge26;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge26;
+  wire [33:0] rem26;
   wire [29:0] shl_s27_q;
   wire [29:0] rs_ge26;
-  wire [29:0] shl_s27_q_or_rs_ge26;
+  wire [29:0] quot26;
   reg [33:0] s28_p = 34'h000000000;
   reg [29:0] s28_q = 30'h00000000;
 
@@ -615,10 +615,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge27;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge27;
+  wire [33:0] rem27;
   wire [29:0] shl_s28_q;
   wire [29:0] rs_ge27;
-  wire [29:0] shl_s28_q_or_rs_ge27;
+  wire [29:0] quot27;
   reg [33:0] s29_p = 34'h000000000;
   reg [29:0] s29_q = 30'h00000000;
 
@@ -636,10 +636,10 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
   wire [34:0] mux_ge28;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] rs_mux_ge28;
+  wire [33:0] rem28;
   wire [29:0] shl_s29_q;
   wire [29:0] rs_ge28;
-  wire [29:0] shl_s29_q_or_rs_ge28;
+  wire [29:0] quot28;
   reg [33:0] s30_p = 34'h000000000;
   reg [29:0] s30_q = 30'h00000000;
 
@@ -660,18 +660,18 @@ module fxrt_div_n29_a63_b34 (
   wire [34:0] mux_ge29;
   /* verilator lint_on UNUSEDSIGNAL */
   /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [33:0] rs_mux_ge29;
+  wire [33:0] rem29;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [29:0] shl_s30_q;
   wire [29:0] rs_ge29;
-  wire [29:0] shl_s30_q_or_rs_ge29;
+  wire [29:0] quot29;
   (* mem2reg *) reg [0:0] err_1_d29_sr [1:29];
   integer err_1_d29_i;
   initial for (err_1_d29_i = 1; err_1_d29_i <= 29; err_1_d29_i = err_1_d29_i + 1) err_1_d29_sr[err_1_d29_i] = 1'h0;
   wire [0:0] err_1_d29;
-  wire [0:0] eq_33;
-  wire [0:0] err_1_d29_or_eq_33;
-  wire [0:0] not_err_1_d29_or_eq_33;
+  wire [0:0] quot29_eq_k_0_2;
+  wire [0:0] or_33;
+  wire [0:0] not_or_33;
   reg [29:0] s31_t = 30'h00000000;
   reg [0:0] s31_ok = 1'h0;
 
@@ -714,13 +714,13 @@ module fxrt_div_n29_a63_b34 (
   assign ge0 = rs_s1_b <= or_3;
   assign or_3_minus_rs_s1_b = or_3 - rs_s1_b;
   assign mux_ge0 = ge0 ? or_3_minus_rs_s1_b : or_3;
-  assign rs_mux_ge0 = mux_ge0[33:0];
+  assign rem0 = mux_ge0[33:0];
   assign rs_ge0 = {{29{1'b0}}, ge0};
-  assign k_0_2_or_rs_ge0 = k_0_2 | rs_ge0;
+  assign quot0 = k_0_2 | rs_ge0;
 
   always @(posedge clk) begin : s2_q0_regs
-    s2_p <= rs_mux_ge0;
-    s2_q <= k_0_2_or_rs_ge0;
+    s2_p <= rem0;
+    s2_q <= quot0;
   end
 
   // stage s3_q1: one quotient bit
@@ -733,16 +733,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge1 = rs_s1_b_d1 <= or_4;
   assign or_4_minus_rs_s1_b_d1 = or_4 - rs_s1_b_d1;
   assign mux_ge1 = ge1 ? or_4_minus_rs_s1_b_d1 : or_4;
-  assign rs_mux_ge1 = mux_ge1[33:0];
+  assign rem1 = mux_ge1[33:0];
   assign shl_s2_q = s2_q <<< 1;
   assign rs_ge1 = {{29{1'b0}}, ge1};
-  assign shl_s2_q_or_rs_ge1 = shl_s2_q | rs_ge1;
+  assign quot1 = shl_s2_q | rs_ge1;
 
   always @(posedge clk) begin : s3_q1_regs
     s1_b_d1 <= s1_b;
     lo_d1 <= lo;
-    s3_p <= rs_mux_ge1;
-    s3_q <= shl_s2_q_or_rs_ge1;
+    s3_p <= rem1;
+    s3_q <= quot1;
   end
 
   // stage s4_q2: one quotient bit
@@ -755,16 +755,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge2 = rs_s1_b_d2 <= or_5;
   assign or_5_minus_rs_s1_b_d2 = or_5 - rs_s1_b_d2;
   assign mux_ge2 = ge2 ? or_5_minus_rs_s1_b_d2 : or_5;
-  assign rs_mux_ge2 = mux_ge2[33:0];
+  assign rem2 = mux_ge2[33:0];
   assign shl_s3_q = s3_q <<< 1;
   assign rs_ge2 = {{29{1'b0}}, ge2};
-  assign shl_s3_q_or_rs_ge2 = shl_s3_q | rs_ge2;
+  assign quot2 = shl_s3_q | rs_ge2;
 
   always @(posedge clk) begin : s4_q2_regs
     s1_b_d2 <= s1_b_d1;
     lo_d2 <= lo_d1;
-    s4_p <= rs_mux_ge2;
-    s4_q <= shl_s3_q_or_rs_ge2;
+    s4_p <= rem2;
+    s4_q <= quot2;
   end
 
   // stage s5_q3: one quotient bit
@@ -777,16 +777,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge3 = rs_s1_b_d3 <= or_6;
   assign or_6_minus_rs_s1_b_d3 = or_6 - rs_s1_b_d3;
   assign mux_ge3 = ge3 ? or_6_minus_rs_s1_b_d3 : or_6;
-  assign rs_mux_ge3 = mux_ge3[33:0];
+  assign rem3 = mux_ge3[33:0];
   assign shl_s4_q = s4_q <<< 1;
   assign rs_ge3 = {{29{1'b0}}, ge3};
-  assign shl_s4_q_or_rs_ge3 = shl_s4_q | rs_ge3;
+  assign quot3 = shl_s4_q | rs_ge3;
 
   always @(posedge clk) begin : s5_q3_regs
     s1_b_d3 <= s1_b_d2;
     lo_d3 <= lo_d2;
-    s5_p <= rs_mux_ge3;
-    s5_q <= shl_s4_q_or_rs_ge3;
+    s5_p <= rem3;
+    s5_q <= quot3;
   end
 
   // stage s6_q4: one quotient bit
@@ -799,16 +799,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge4 = rs_s1_b_d4 <= or_7;
   assign or_7_minus_rs_s1_b_d4 = or_7 - rs_s1_b_d4;
   assign mux_ge4 = ge4 ? or_7_minus_rs_s1_b_d4 : or_7;
-  assign rs_mux_ge4 = mux_ge4[33:0];
+  assign rem4 = mux_ge4[33:0];
   assign shl_s5_q = s5_q <<< 1;
   assign rs_ge4 = {{29{1'b0}}, ge4};
-  assign shl_s5_q_or_rs_ge4 = shl_s5_q | rs_ge4;
+  assign quot4 = shl_s5_q | rs_ge4;
 
   always @(posedge clk) begin : s6_q4_regs
     s1_b_d4 <= s1_b_d3;
     lo_d4 <= lo_d3;
-    s6_p <= rs_mux_ge4;
-    s6_q <= shl_s5_q_or_rs_ge4;
+    s6_p <= rem4;
+    s6_q <= quot4;
   end
 
   // stage s7_q5: one quotient bit
@@ -821,16 +821,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge5 = rs_s1_b_d5 <= or_8;
   assign or_8_minus_rs_s1_b_d5 = or_8 - rs_s1_b_d5;
   assign mux_ge5 = ge5 ? or_8_minus_rs_s1_b_d5 : or_8;
-  assign rs_mux_ge5 = mux_ge5[33:0];
+  assign rem5 = mux_ge5[33:0];
   assign shl_s6_q = s6_q <<< 1;
   assign rs_ge5 = {{29{1'b0}}, ge5};
-  assign shl_s6_q_or_rs_ge5 = shl_s6_q | rs_ge5;
+  assign quot5 = shl_s6_q | rs_ge5;
 
   always @(posedge clk) begin : s7_q5_regs
     s1_b_d5 <= s1_b_d4;
     lo_d5 <= lo_d4;
-    s7_p <= rs_mux_ge5;
-    s7_q <= shl_s6_q_or_rs_ge5;
+    s7_p <= rem5;
+    s7_q <= quot5;
   end
 
   // stage s8_q6: one quotient bit
@@ -843,16 +843,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge6 = rs_s1_b_d6 <= or_9;
   assign or_9_minus_rs_s1_b_d6 = or_9 - rs_s1_b_d6;
   assign mux_ge6 = ge6 ? or_9_minus_rs_s1_b_d6 : or_9;
-  assign rs_mux_ge6 = mux_ge6[33:0];
+  assign rem6 = mux_ge6[33:0];
   assign shl_s7_q = s7_q <<< 1;
   assign rs_ge6 = {{29{1'b0}}, ge6};
-  assign shl_s7_q_or_rs_ge6 = shl_s7_q | rs_ge6;
+  assign quot6 = shl_s7_q | rs_ge6;
 
   always @(posedge clk) begin : s8_q6_regs
     s1_b_d6 <= s1_b_d5;
     lo_d6 <= lo_d5;
-    s8_p <= rs_mux_ge6;
-    s8_q <= shl_s7_q_or_rs_ge6;
+    s8_p <= rem6;
+    s8_q <= quot6;
   end
 
   // stage s9_q7: one quotient bit
@@ -865,16 +865,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge7 = rs_s1_b_d7 <= or_10;
   assign or_10_minus_rs_s1_b_d7 = or_10 - rs_s1_b_d7;
   assign mux_ge7 = ge7 ? or_10_minus_rs_s1_b_d7 : or_10;
-  assign rs_mux_ge7 = mux_ge7[33:0];
+  assign rem7 = mux_ge7[33:0];
   assign shl_s8_q = s8_q <<< 1;
   assign rs_ge7 = {{29{1'b0}}, ge7};
-  assign shl_s8_q_or_rs_ge7 = shl_s8_q | rs_ge7;
+  assign quot7 = shl_s8_q | rs_ge7;
 
   always @(posedge clk) begin : s9_q7_regs
     s1_b_d7 <= s1_b_d6;
     lo_d7 <= lo_d6;
-    s9_p <= rs_mux_ge7;
-    s9_q <= shl_s8_q_or_rs_ge7;
+    s9_p <= rem7;
+    s9_q <= quot7;
   end
 
   // stage s10_q8: one quotient bit
@@ -887,16 +887,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge8 = rs_s1_b_d8 <= or_11;
   assign or_11_minus_rs_s1_b_d8 = or_11 - rs_s1_b_d8;
   assign mux_ge8 = ge8 ? or_11_minus_rs_s1_b_d8 : or_11;
-  assign rs_mux_ge8 = mux_ge8[33:0];
+  assign rem8 = mux_ge8[33:0];
   assign shl_s9_q = s9_q <<< 1;
   assign rs_ge8 = {{29{1'b0}}, ge8};
-  assign shl_s9_q_or_rs_ge8 = shl_s9_q | rs_ge8;
+  assign quot8 = shl_s9_q | rs_ge8;
 
   always @(posedge clk) begin : s10_q8_regs
     s1_b_d8 <= s1_b_d7;
     lo_d8 <= lo_d7;
-    s10_p <= rs_mux_ge8;
-    s10_q <= shl_s9_q_or_rs_ge8;
+    s10_p <= rem8;
+    s10_q <= quot8;
   end
 
   // stage s11_q9: one quotient bit
@@ -909,16 +909,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge9 = rs_s1_b_d9 <= or_12;
   assign or_12_minus_rs_s1_b_d9 = or_12 - rs_s1_b_d9;
   assign mux_ge9 = ge9 ? or_12_minus_rs_s1_b_d9 : or_12;
-  assign rs_mux_ge9 = mux_ge9[33:0];
+  assign rem9 = mux_ge9[33:0];
   assign shl_s10_q = s10_q <<< 1;
   assign rs_ge9 = {{29{1'b0}}, ge9};
-  assign shl_s10_q_or_rs_ge9 = shl_s10_q | rs_ge9;
+  assign quot9 = shl_s10_q | rs_ge9;
 
   always @(posedge clk) begin : s11_q9_regs
     s1_b_d9 <= s1_b_d8;
     lo_d9 <= lo_d8;
-    s11_p <= rs_mux_ge9;
-    s11_q <= shl_s10_q_or_rs_ge9;
+    s11_p <= rem9;
+    s11_q <= quot9;
   end
 
   // stage s12_q10: one quotient bit
@@ -931,16 +931,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge10 = rs_s1_b_d10 <= or_13;
   assign or_13_minus_rs_s1_b_d10 = or_13 - rs_s1_b_d10;
   assign mux_ge10 = ge10 ? or_13_minus_rs_s1_b_d10 : or_13;
-  assign rs_mux_ge10 = mux_ge10[33:0];
+  assign rem10 = mux_ge10[33:0];
   assign shl_s11_q = s11_q <<< 1;
   assign rs_ge10 = {{29{1'b0}}, ge10};
-  assign shl_s11_q_or_rs_ge10 = shl_s11_q | rs_ge10;
+  assign quot10 = shl_s11_q | rs_ge10;
 
   always @(posedge clk) begin : s12_q10_regs
     s1_b_d10 <= s1_b_d9;
     lo_d10 <= lo_d9;
-    s12_p <= rs_mux_ge10;
-    s12_q <= shl_s11_q_or_rs_ge10;
+    s12_p <= rem10;
+    s12_q <= quot10;
   end
 
   // stage s13_q11: one quotient bit
@@ -953,16 +953,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge11 = rs_s1_b_d11 <= or_14;
   assign or_14_minus_rs_s1_b_d11 = or_14 - rs_s1_b_d11;
   assign mux_ge11 = ge11 ? or_14_minus_rs_s1_b_d11 : or_14;
-  assign rs_mux_ge11 = mux_ge11[33:0];
+  assign rem11 = mux_ge11[33:0];
   assign shl_s12_q = s12_q <<< 1;
   assign rs_ge11 = {{29{1'b0}}, ge11};
-  assign shl_s12_q_or_rs_ge11 = shl_s12_q | rs_ge11;
+  assign quot11 = shl_s12_q | rs_ge11;
 
   always @(posedge clk) begin : s13_q11_regs
     s1_b_d11 <= s1_b_d10;
     lo_d11 <= lo_d10;
-    s13_p <= rs_mux_ge11;
-    s13_q <= shl_s12_q_or_rs_ge11;
+    s13_p <= rem11;
+    s13_q <= quot11;
   end
 
   // stage s14_q12: one quotient bit
@@ -975,16 +975,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge12 = rs_s1_b_d12 <= or_15;
   assign or_15_minus_rs_s1_b_d12 = or_15 - rs_s1_b_d12;
   assign mux_ge12 = ge12 ? or_15_minus_rs_s1_b_d12 : or_15;
-  assign rs_mux_ge12 = mux_ge12[33:0];
+  assign rem12 = mux_ge12[33:0];
   assign shl_s13_q = s13_q <<< 1;
   assign rs_ge12 = {{29{1'b0}}, ge12};
-  assign shl_s13_q_or_rs_ge12 = shl_s13_q | rs_ge12;
+  assign quot12 = shl_s13_q | rs_ge12;
 
   always @(posedge clk) begin : s14_q12_regs
     s1_b_d12 <= s1_b_d11;
     lo_d12 <= lo_d11;
-    s14_p <= rs_mux_ge12;
-    s14_q <= shl_s13_q_or_rs_ge12;
+    s14_p <= rem12;
+    s14_q <= quot12;
   end
 
   // stage s15_q13: one quotient bit
@@ -997,16 +997,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge13 = rs_s1_b_d13 <= or_16;
   assign or_16_minus_rs_s1_b_d13 = or_16 - rs_s1_b_d13;
   assign mux_ge13 = ge13 ? or_16_minus_rs_s1_b_d13 : or_16;
-  assign rs_mux_ge13 = mux_ge13[33:0];
+  assign rem13 = mux_ge13[33:0];
   assign shl_s14_q = s14_q <<< 1;
   assign rs_ge13 = {{29{1'b0}}, ge13};
-  assign shl_s14_q_or_rs_ge13 = shl_s14_q | rs_ge13;
+  assign quot13 = shl_s14_q | rs_ge13;
 
   always @(posedge clk) begin : s15_q13_regs
     s1_b_d13 <= s1_b_d12;
     lo_d13 <= lo_d12;
-    s15_p <= rs_mux_ge13;
-    s15_q <= shl_s14_q_or_rs_ge13;
+    s15_p <= rem13;
+    s15_q <= quot13;
   end
 
   // stage s16_q14: one quotient bit
@@ -1019,16 +1019,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge14 = rs_s1_b_d14 <= or_17;
   assign or_17_minus_rs_s1_b_d14 = or_17 - rs_s1_b_d14;
   assign mux_ge14 = ge14 ? or_17_minus_rs_s1_b_d14 : or_17;
-  assign rs_mux_ge14 = mux_ge14[33:0];
+  assign rem14 = mux_ge14[33:0];
   assign shl_s15_q = s15_q <<< 1;
   assign rs_ge14 = {{29{1'b0}}, ge14};
-  assign shl_s15_q_or_rs_ge14 = shl_s15_q | rs_ge14;
+  assign quot14 = shl_s15_q | rs_ge14;
 
   always @(posedge clk) begin : s16_q14_regs
     s1_b_d14 <= s1_b_d13;
     lo_d14 <= lo_d13;
-    s16_p <= rs_mux_ge14;
-    s16_q <= shl_s15_q_or_rs_ge14;
+    s16_p <= rem14;
+    s16_q <= quot14;
   end
 
   // stage s17_q15: one quotient bit
@@ -1041,16 +1041,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge15 = rs_s1_b_d15 <= or_18;
   assign or_18_minus_rs_s1_b_d15 = or_18 - rs_s1_b_d15;
   assign mux_ge15 = ge15 ? or_18_minus_rs_s1_b_d15 : or_18;
-  assign rs_mux_ge15 = mux_ge15[33:0];
+  assign rem15 = mux_ge15[33:0];
   assign shl_s16_q = s16_q <<< 1;
   assign rs_ge15 = {{29{1'b0}}, ge15};
-  assign shl_s16_q_or_rs_ge15 = shl_s16_q | rs_ge15;
+  assign quot15 = shl_s16_q | rs_ge15;
 
   always @(posedge clk) begin : s17_q15_regs
     s1_b_d15 <= s1_b_d14;
     lo_d15 <= lo_d14;
-    s17_p <= rs_mux_ge15;
-    s17_q <= shl_s16_q_or_rs_ge15;
+    s17_p <= rem15;
+    s17_q <= quot15;
   end
 
   // stage s18_q16: one quotient bit
@@ -1063,16 +1063,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge16 = rs_s1_b_d16 <= or_19;
   assign or_19_minus_rs_s1_b_d16 = or_19 - rs_s1_b_d16;
   assign mux_ge16 = ge16 ? or_19_minus_rs_s1_b_d16 : or_19;
-  assign rs_mux_ge16 = mux_ge16[33:0];
+  assign rem16 = mux_ge16[33:0];
   assign shl_s17_q = s17_q <<< 1;
   assign rs_ge16 = {{29{1'b0}}, ge16};
-  assign shl_s17_q_or_rs_ge16 = shl_s17_q | rs_ge16;
+  assign quot16 = shl_s17_q | rs_ge16;
 
   always @(posedge clk) begin : s18_q16_regs
     s1_b_d16 <= s1_b_d15;
     lo_d16 <= lo_d15;
-    s18_p <= rs_mux_ge16;
-    s18_q <= shl_s17_q_or_rs_ge16;
+    s18_p <= rem16;
+    s18_q <= quot16;
   end
 
   // stage s19_q17: one quotient bit
@@ -1085,16 +1085,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge17 = rs_s1_b_d17 <= or_20;
   assign or_20_minus_rs_s1_b_d17 = or_20 - rs_s1_b_d17;
   assign mux_ge17 = ge17 ? or_20_minus_rs_s1_b_d17 : or_20;
-  assign rs_mux_ge17 = mux_ge17[33:0];
+  assign rem17 = mux_ge17[33:0];
   assign shl_s18_q = s18_q <<< 1;
   assign rs_ge17 = {{29{1'b0}}, ge17};
-  assign shl_s18_q_or_rs_ge17 = shl_s18_q | rs_ge17;
+  assign quot17 = shl_s18_q | rs_ge17;
 
   always @(posedge clk) begin : s19_q17_regs
     s1_b_d17 <= s1_b_d16;
     lo_d17 <= lo_d16;
-    s19_p <= rs_mux_ge17;
-    s19_q <= shl_s18_q_or_rs_ge17;
+    s19_p <= rem17;
+    s19_q <= quot17;
   end
 
   // stage s20_q18: one quotient bit
@@ -1107,16 +1107,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge18 = rs_s1_b_d18 <= or_21;
   assign or_21_minus_rs_s1_b_d18 = or_21 - rs_s1_b_d18;
   assign mux_ge18 = ge18 ? or_21_minus_rs_s1_b_d18 : or_21;
-  assign rs_mux_ge18 = mux_ge18[33:0];
+  assign rem18 = mux_ge18[33:0];
   assign shl_s19_q = s19_q <<< 1;
   assign rs_ge18 = {{29{1'b0}}, ge18};
-  assign shl_s19_q_or_rs_ge18 = shl_s19_q | rs_ge18;
+  assign quot18 = shl_s19_q | rs_ge18;
 
   always @(posedge clk) begin : s20_q18_regs
     s1_b_d18 <= s1_b_d17;
     lo_d18 <= lo_d17;
-    s20_p <= rs_mux_ge18;
-    s20_q <= shl_s19_q_or_rs_ge18;
+    s20_p <= rem18;
+    s20_q <= quot18;
   end
 
   // stage s21_q19: one quotient bit
@@ -1129,16 +1129,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge19 = rs_s1_b_d19 <= or_22;
   assign or_22_minus_rs_s1_b_d19 = or_22 - rs_s1_b_d19;
   assign mux_ge19 = ge19 ? or_22_minus_rs_s1_b_d19 : or_22;
-  assign rs_mux_ge19 = mux_ge19[33:0];
+  assign rem19 = mux_ge19[33:0];
   assign shl_s20_q = s20_q <<< 1;
   assign rs_ge19 = {{29{1'b0}}, ge19};
-  assign shl_s20_q_or_rs_ge19 = shl_s20_q | rs_ge19;
+  assign quot19 = shl_s20_q | rs_ge19;
 
   always @(posedge clk) begin : s21_q19_regs
     s1_b_d19 <= s1_b_d18;
     lo_d19 <= lo_d18;
-    s21_p <= rs_mux_ge19;
-    s21_q <= shl_s20_q_or_rs_ge19;
+    s21_p <= rem19;
+    s21_q <= quot19;
   end
 
   // stage s22_q20: one quotient bit
@@ -1151,16 +1151,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge20 = rs_s1_b_d20 <= or_23;
   assign or_23_minus_rs_s1_b_d20 = or_23 - rs_s1_b_d20;
   assign mux_ge20 = ge20 ? or_23_minus_rs_s1_b_d20 : or_23;
-  assign rs_mux_ge20 = mux_ge20[33:0];
+  assign rem20 = mux_ge20[33:0];
   assign shl_s21_q = s21_q <<< 1;
   assign rs_ge20 = {{29{1'b0}}, ge20};
-  assign shl_s21_q_or_rs_ge20 = shl_s21_q | rs_ge20;
+  assign quot20 = shl_s21_q | rs_ge20;
 
   always @(posedge clk) begin : s22_q20_regs
     s1_b_d20 <= s1_b_d19;
     lo_d20 <= lo_d19;
-    s22_p <= rs_mux_ge20;
-    s22_q <= shl_s21_q_or_rs_ge20;
+    s22_p <= rem20;
+    s22_q <= quot20;
   end
 
   // stage s23_q21: one quotient bit
@@ -1173,16 +1173,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge21 = rs_s1_b_d21 <= or_24;
   assign or_24_minus_rs_s1_b_d21 = or_24 - rs_s1_b_d21;
   assign mux_ge21 = ge21 ? or_24_minus_rs_s1_b_d21 : or_24;
-  assign rs_mux_ge21 = mux_ge21[33:0];
+  assign rem21 = mux_ge21[33:0];
   assign shl_s22_q = s22_q <<< 1;
   assign rs_ge21 = {{29{1'b0}}, ge21};
-  assign shl_s22_q_or_rs_ge21 = shl_s22_q | rs_ge21;
+  assign quot21 = shl_s22_q | rs_ge21;
 
   always @(posedge clk) begin : s23_q21_regs
     s1_b_d21 <= s1_b_d20;
     lo_d21 <= lo_d20;
-    s23_p <= rs_mux_ge21;
-    s23_q <= shl_s22_q_or_rs_ge21;
+    s23_p <= rem21;
+    s23_q <= quot21;
   end
 
   // stage s24_q22: one quotient bit
@@ -1195,16 +1195,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge22 = rs_s1_b_d22 <= or_25;
   assign or_25_minus_rs_s1_b_d22 = or_25 - rs_s1_b_d22;
   assign mux_ge22 = ge22 ? or_25_minus_rs_s1_b_d22 : or_25;
-  assign rs_mux_ge22 = mux_ge22[33:0];
+  assign rem22 = mux_ge22[33:0];
   assign shl_s23_q = s23_q <<< 1;
   assign rs_ge22 = {{29{1'b0}}, ge22};
-  assign shl_s23_q_or_rs_ge22 = shl_s23_q | rs_ge22;
+  assign quot22 = shl_s23_q | rs_ge22;
 
   always @(posedge clk) begin : s24_q22_regs
     s1_b_d22 <= s1_b_d21;
     lo_d22 <= lo_d21;
-    s24_p <= rs_mux_ge22;
-    s24_q <= shl_s23_q_or_rs_ge22;
+    s24_p <= rem22;
+    s24_q <= quot22;
   end
 
   // stage s25_q23: one quotient bit
@@ -1217,16 +1217,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge23 = rs_s1_b_d23 <= or_26;
   assign or_26_minus_rs_s1_b_d23 = or_26 - rs_s1_b_d23;
   assign mux_ge23 = ge23 ? or_26_minus_rs_s1_b_d23 : or_26;
-  assign rs_mux_ge23 = mux_ge23[33:0];
+  assign rem23 = mux_ge23[33:0];
   assign shl_s24_q = s24_q <<< 1;
   assign rs_ge23 = {{29{1'b0}}, ge23};
-  assign shl_s24_q_or_rs_ge23 = shl_s24_q | rs_ge23;
+  assign quot23 = shl_s24_q | rs_ge23;
 
   always @(posedge clk) begin : s25_q23_regs
     s1_b_d23 <= s1_b_d22;
     lo_d23 <= lo_d22;
-    s25_p <= rs_mux_ge23;
-    s25_q <= shl_s24_q_or_rs_ge23;
+    s25_p <= rem23;
+    s25_q <= quot23;
   end
 
   // stage s26_q24: one quotient bit
@@ -1239,16 +1239,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge24 = rs_s1_b_d24 <= or_27;
   assign or_27_minus_rs_s1_b_d24 = or_27 - rs_s1_b_d24;
   assign mux_ge24 = ge24 ? or_27_minus_rs_s1_b_d24 : or_27;
-  assign rs_mux_ge24 = mux_ge24[33:0];
+  assign rem24 = mux_ge24[33:0];
   assign shl_s25_q = s25_q <<< 1;
   assign rs_ge24 = {{29{1'b0}}, ge24};
-  assign shl_s25_q_or_rs_ge24 = shl_s25_q | rs_ge24;
+  assign quot24 = shl_s25_q | rs_ge24;
 
   always @(posedge clk) begin : s26_q24_regs
     s1_b_d24 <= s1_b_d23;
     lo_d24 <= lo_d23;
-    s26_p <= rs_mux_ge24;
-    s26_q <= shl_s25_q_or_rs_ge24;
+    s26_p <= rem24;
+    s26_q <= quot24;
   end
 
   // stage s27_q25: one quotient bit
@@ -1261,16 +1261,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge25 = rs_s1_b_d25 <= or_28;
   assign or_28_minus_rs_s1_b_d25 = or_28 - rs_s1_b_d25;
   assign mux_ge25 = ge25 ? or_28_minus_rs_s1_b_d25 : or_28;
-  assign rs_mux_ge25 = mux_ge25[33:0];
+  assign rem25 = mux_ge25[33:0];
   assign shl_s26_q = s26_q <<< 1;
   assign rs_ge25 = {{29{1'b0}}, ge25};
-  assign shl_s26_q_or_rs_ge25 = shl_s26_q | rs_ge25;
+  assign quot25 = shl_s26_q | rs_ge25;
 
   always @(posedge clk) begin : s27_q25_regs
     s1_b_d25 <= s1_b_d24;
     lo_d25 <= lo_d24;
-    s27_p <= rs_mux_ge25;
-    s27_q <= shl_s26_q_or_rs_ge25;
+    s27_p <= rem25;
+    s27_q <= quot25;
   end
 
   // stage s28_q26: one quotient bit
@@ -1283,16 +1283,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge26 = rs_s1_b_d26 <= or_29;
   assign or_29_minus_rs_s1_b_d26 = or_29 - rs_s1_b_d26;
   assign mux_ge26 = ge26 ? or_29_minus_rs_s1_b_d26 : or_29;
-  assign rs_mux_ge26 = mux_ge26[33:0];
+  assign rem26 = mux_ge26[33:0];
   assign shl_s27_q = s27_q <<< 1;
   assign rs_ge26 = {{29{1'b0}}, ge26};
-  assign shl_s27_q_or_rs_ge26 = shl_s27_q | rs_ge26;
+  assign quot26 = shl_s27_q | rs_ge26;
 
   always @(posedge clk) begin : s28_q26_regs
     s1_b_d26 <= s1_b_d25;
     lo_d26 <= lo_d25;
-    s28_p <= rs_mux_ge26;
-    s28_q <= shl_s27_q_or_rs_ge26;
+    s28_p <= rem26;
+    s28_q <= quot26;
   end
 
   // stage s29_q27: one quotient bit
@@ -1305,16 +1305,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge27 = rs_s1_b_d27 <= or_30;
   assign or_30_minus_rs_s1_b_d27 = or_30 - rs_s1_b_d27;
   assign mux_ge27 = ge27 ? or_30_minus_rs_s1_b_d27 : or_30;
-  assign rs_mux_ge27 = mux_ge27[33:0];
+  assign rem27 = mux_ge27[33:0];
   assign shl_s28_q = s28_q <<< 1;
   assign rs_ge27 = {{29{1'b0}}, ge27};
-  assign shl_s28_q_or_rs_ge27 = shl_s28_q | rs_ge27;
+  assign quot27 = shl_s28_q | rs_ge27;
 
   always @(posedge clk) begin : s29_q27_regs
     s1_b_d27 <= s1_b_d26;
     lo_d27 <= lo_d26;
-    s29_p <= rs_mux_ge27;
-    s29_q <= shl_s28_q_or_rs_ge27;
+    s29_p <= rem27;
+    s29_q <= quot27;
   end
 
   // stage s30_q28: one quotient bit
@@ -1327,16 +1327,16 @@ module fxrt_div_n29_a63_b34 (
   assign ge28 = rs_s1_b_d28 <= or_31;
   assign or_31_minus_rs_s1_b_d28 = or_31 - rs_s1_b_d28;
   assign mux_ge28 = ge28 ? or_31_minus_rs_s1_b_d28 : or_31;
-  assign rs_mux_ge28 = mux_ge28[33:0];
+  assign rem28 = mux_ge28[33:0];
   assign shl_s29_q = s29_q <<< 1;
   assign rs_ge28 = {{29{1'b0}}, ge28};
-  assign shl_s29_q_or_rs_ge28 = shl_s29_q | rs_ge28;
+  assign quot28 = shl_s29_q | rs_ge28;
 
   always @(posedge clk) begin : s30_q28_regs
     s1_b_d28 <= s1_b_d27;
     lo_d28 <= lo_d27;
-    s30_p <= rs_mux_ge28;
-    s30_q <= shl_s29_q_or_rs_ge28;
+    s30_p <= rem28;
+    s30_q <= quot28;
   end
 
   // stage s31_result: the quotient and its result flag
@@ -1349,14 +1349,14 @@ module fxrt_div_n29_a63_b34 (
   assign ge29 = rs_s1_b_d29 <= or_32;
   assign or_32_minus_rs_s1_b_d29 = or_32 - rs_s1_b_d29;
   assign mux_ge29 = ge29 ? or_32_minus_rs_s1_b_d29 : or_32;
-  assign rs_mux_ge29 = mux_ge29[33:0];
+  assign rem29 = mux_ge29[33:0];
   assign shl_s30_q = s30_q <<< 1;
   assign rs_ge29 = {{29{1'b0}}, ge29};
-  assign shl_s30_q_or_rs_ge29 = shl_s30_q | rs_ge29;
+  assign quot29 = shl_s30_q | rs_ge29;
   assign err_1_d29 = err_1_d29_sr[29];
-  assign eq_33 = shl_s30_q_or_rs_ge29 == k_0_2;
-  assign err_1_d29_or_eq_33 = err_1_d29 | eq_33;
-  assign not_err_1_d29_or_eq_33 = ~err_1_d29_or_eq_33;
+  assign quot29_eq_k_0_2 = quot29 == k_0_2;
+  assign or_33 = err_1_d29 | quot29_eq_k_0_2;
+  assign not_or_33 = ~or_33;
 
   always @(posedge clk) begin : s31_result_regs
     s1_b_d29 <= s1_b_d28;
@@ -1364,8 +1364,8 @@ module fxrt_div_n29_a63_b34 (
     for (err_1_d29_i = 29; err_1_d29_i > 1; err_1_d29_i = err_1_d29_i - 1)
       err_1_d29_sr[err_1_d29_i] <= err_1_d29_sr[err_1_d29_i - 1];
     err_1_d29_sr[1] <= err_1;
-    s31_t <= shl_s30_q_or_rs_ge29;
-    s31_ok <= not_err_1_d29_or_eq_33;
+    s31_t <= quot29;
+    s31_ok <= not_or_33;
   end
 
   assign t = s31_t;

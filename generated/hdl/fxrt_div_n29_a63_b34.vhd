@@ -54,9 +54,9 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge0 : unsigned(0 downto 0);
   signal or_3_minus_rs_s1_b : unsigned(34 downto 0);
   signal mux_ge0 : unsigned(34 downto 0);
-  signal rs_mux_ge0 : unsigned(33 downto 0);
+  signal rem0 : unsigned(33 downto 0);
   signal rs_ge0 : unsigned(29 downto 0);
-  signal k_0_2_or_rs_ge0 : unsigned(29 downto 0);
+  signal quot0 : unsigned(29 downto 0);
   signal s2_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s2_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -72,10 +72,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge1 : unsigned(0 downto 0);
   signal or_4_minus_rs_s1_b_d1 : unsigned(34 downto 0);
   signal mux_ge1 : unsigned(34 downto 0);
-  signal rs_mux_ge1 : unsigned(33 downto 0);
+  signal rem1 : unsigned(33 downto 0);
   signal shl_s2_q : unsigned(29 downto 0);
   signal rs_ge1 : unsigned(29 downto 0);
-  signal shl_s2_q_or_rs_ge1 : unsigned(29 downto 0);
+  signal quot1 : unsigned(29 downto 0);
   signal s3_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s3_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -91,10 +91,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge2 : unsigned(0 downto 0);
   signal or_5_minus_rs_s1_b_d2 : unsigned(34 downto 0);
   signal mux_ge2 : unsigned(34 downto 0);
-  signal rs_mux_ge2 : unsigned(33 downto 0);
+  signal rem2 : unsigned(33 downto 0);
   signal shl_s3_q : unsigned(29 downto 0);
   signal rs_ge2 : unsigned(29 downto 0);
-  signal shl_s3_q_or_rs_ge2 : unsigned(29 downto 0);
+  signal quot2 : unsigned(29 downto 0);
   signal s4_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s4_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -110,10 +110,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge3 : unsigned(0 downto 0);
   signal or_6_minus_rs_s1_b_d3 : unsigned(34 downto 0);
   signal mux_ge3 : unsigned(34 downto 0);
-  signal rs_mux_ge3 : unsigned(33 downto 0);
+  signal rem3 : unsigned(33 downto 0);
   signal shl_s4_q : unsigned(29 downto 0);
   signal rs_ge3 : unsigned(29 downto 0);
-  signal shl_s4_q_or_rs_ge3 : unsigned(29 downto 0);
+  signal quot3 : unsigned(29 downto 0);
   signal s5_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s5_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -129,10 +129,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge4 : unsigned(0 downto 0);
   signal or_7_minus_rs_s1_b_d4 : unsigned(34 downto 0);
   signal mux_ge4 : unsigned(34 downto 0);
-  signal rs_mux_ge4 : unsigned(33 downto 0);
+  signal rem4 : unsigned(33 downto 0);
   signal shl_s5_q : unsigned(29 downto 0);
   signal rs_ge4 : unsigned(29 downto 0);
-  signal shl_s5_q_or_rs_ge4 : unsigned(29 downto 0);
+  signal quot4 : unsigned(29 downto 0);
   signal s6_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s6_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -148,10 +148,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge5 : unsigned(0 downto 0);
   signal or_8_minus_rs_s1_b_d5 : unsigned(34 downto 0);
   signal mux_ge5 : unsigned(34 downto 0);
-  signal rs_mux_ge5 : unsigned(33 downto 0);
+  signal rem5 : unsigned(33 downto 0);
   signal shl_s6_q : unsigned(29 downto 0);
   signal rs_ge5 : unsigned(29 downto 0);
-  signal shl_s6_q_or_rs_ge5 : unsigned(29 downto 0);
+  signal quot5 : unsigned(29 downto 0);
   signal s7_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s7_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -167,10 +167,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge6 : unsigned(0 downto 0);
   signal or_9_minus_rs_s1_b_d6 : unsigned(34 downto 0);
   signal mux_ge6 : unsigned(34 downto 0);
-  signal rs_mux_ge6 : unsigned(33 downto 0);
+  signal rem6 : unsigned(33 downto 0);
   signal shl_s7_q : unsigned(29 downto 0);
   signal rs_ge6 : unsigned(29 downto 0);
-  signal shl_s7_q_or_rs_ge6 : unsigned(29 downto 0);
+  signal quot6 : unsigned(29 downto 0);
   signal s8_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s8_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -186,10 +186,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge7 : unsigned(0 downto 0);
   signal or_10_minus_rs_s1_b_d7 : unsigned(34 downto 0);
   signal mux_ge7 : unsigned(34 downto 0);
-  signal rs_mux_ge7 : unsigned(33 downto 0);
+  signal rem7 : unsigned(33 downto 0);
   signal shl_s8_q : unsigned(29 downto 0);
   signal rs_ge7 : unsigned(29 downto 0);
-  signal shl_s8_q_or_rs_ge7 : unsigned(29 downto 0);
+  signal quot7 : unsigned(29 downto 0);
   signal s9_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s9_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -205,10 +205,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge8 : unsigned(0 downto 0);
   signal or_11_minus_rs_s1_b_d8 : unsigned(34 downto 0);
   signal mux_ge8 : unsigned(34 downto 0);
-  signal rs_mux_ge8 : unsigned(33 downto 0);
+  signal rem8 : unsigned(33 downto 0);
   signal shl_s9_q : unsigned(29 downto 0);
   signal rs_ge8 : unsigned(29 downto 0);
-  signal shl_s9_q_or_rs_ge8 : unsigned(29 downto 0);
+  signal quot8 : unsigned(29 downto 0);
   signal s10_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s10_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -224,10 +224,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge9 : unsigned(0 downto 0);
   signal or_12_minus_rs_s1_b_d9 : unsigned(34 downto 0);
   signal mux_ge9 : unsigned(34 downto 0);
-  signal rs_mux_ge9 : unsigned(33 downto 0);
+  signal rem9 : unsigned(33 downto 0);
   signal shl_s10_q : unsigned(29 downto 0);
   signal rs_ge9 : unsigned(29 downto 0);
-  signal shl_s10_q_or_rs_ge9 : unsigned(29 downto 0);
+  signal quot9 : unsigned(29 downto 0);
   signal s11_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s11_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -243,10 +243,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge10 : unsigned(0 downto 0);
   signal or_13_minus_rs_s1_b_d10 : unsigned(34 downto 0);
   signal mux_ge10 : unsigned(34 downto 0);
-  signal rs_mux_ge10 : unsigned(33 downto 0);
+  signal rem10 : unsigned(33 downto 0);
   signal shl_s11_q : unsigned(29 downto 0);
   signal rs_ge10 : unsigned(29 downto 0);
-  signal shl_s11_q_or_rs_ge10 : unsigned(29 downto 0);
+  signal quot10 : unsigned(29 downto 0);
   signal s12_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s12_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -262,10 +262,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge11 : unsigned(0 downto 0);
   signal or_14_minus_rs_s1_b_d11 : unsigned(34 downto 0);
   signal mux_ge11 : unsigned(34 downto 0);
-  signal rs_mux_ge11 : unsigned(33 downto 0);
+  signal rem11 : unsigned(33 downto 0);
   signal shl_s12_q : unsigned(29 downto 0);
   signal rs_ge11 : unsigned(29 downto 0);
-  signal shl_s12_q_or_rs_ge11 : unsigned(29 downto 0);
+  signal quot11 : unsigned(29 downto 0);
   signal s13_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s13_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -281,10 +281,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge12 : unsigned(0 downto 0);
   signal or_15_minus_rs_s1_b_d12 : unsigned(34 downto 0);
   signal mux_ge12 : unsigned(34 downto 0);
-  signal rs_mux_ge12 : unsigned(33 downto 0);
+  signal rem12 : unsigned(33 downto 0);
   signal shl_s13_q : unsigned(29 downto 0);
   signal rs_ge12 : unsigned(29 downto 0);
-  signal shl_s13_q_or_rs_ge12 : unsigned(29 downto 0);
+  signal quot12 : unsigned(29 downto 0);
   signal s14_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s14_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -300,10 +300,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge13 : unsigned(0 downto 0);
   signal or_16_minus_rs_s1_b_d13 : unsigned(34 downto 0);
   signal mux_ge13 : unsigned(34 downto 0);
-  signal rs_mux_ge13 : unsigned(33 downto 0);
+  signal rem13 : unsigned(33 downto 0);
   signal shl_s14_q : unsigned(29 downto 0);
   signal rs_ge13 : unsigned(29 downto 0);
-  signal shl_s14_q_or_rs_ge13 : unsigned(29 downto 0);
+  signal quot13 : unsigned(29 downto 0);
   signal s15_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s15_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -319,10 +319,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge14 : unsigned(0 downto 0);
   signal or_17_minus_rs_s1_b_d14 : unsigned(34 downto 0);
   signal mux_ge14 : unsigned(34 downto 0);
-  signal rs_mux_ge14 : unsigned(33 downto 0);
+  signal rem14 : unsigned(33 downto 0);
   signal shl_s15_q : unsigned(29 downto 0);
   signal rs_ge14 : unsigned(29 downto 0);
-  signal shl_s15_q_or_rs_ge14 : unsigned(29 downto 0);
+  signal quot14 : unsigned(29 downto 0);
   signal s16_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s16_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -338,10 +338,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge15 : unsigned(0 downto 0);
   signal or_18_minus_rs_s1_b_d15 : unsigned(34 downto 0);
   signal mux_ge15 : unsigned(34 downto 0);
-  signal rs_mux_ge15 : unsigned(33 downto 0);
+  signal rem15 : unsigned(33 downto 0);
   signal shl_s16_q : unsigned(29 downto 0);
   signal rs_ge15 : unsigned(29 downto 0);
-  signal shl_s16_q_or_rs_ge15 : unsigned(29 downto 0);
+  signal quot15 : unsigned(29 downto 0);
   signal s17_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s17_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -357,10 +357,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge16 : unsigned(0 downto 0);
   signal or_19_minus_rs_s1_b_d16 : unsigned(34 downto 0);
   signal mux_ge16 : unsigned(34 downto 0);
-  signal rs_mux_ge16 : unsigned(33 downto 0);
+  signal rem16 : unsigned(33 downto 0);
   signal shl_s17_q : unsigned(29 downto 0);
   signal rs_ge16 : unsigned(29 downto 0);
-  signal shl_s17_q_or_rs_ge16 : unsigned(29 downto 0);
+  signal quot16 : unsigned(29 downto 0);
   signal s18_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s18_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -376,10 +376,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge17 : unsigned(0 downto 0);
   signal or_20_minus_rs_s1_b_d17 : unsigned(34 downto 0);
   signal mux_ge17 : unsigned(34 downto 0);
-  signal rs_mux_ge17 : unsigned(33 downto 0);
+  signal rem17 : unsigned(33 downto 0);
   signal shl_s18_q : unsigned(29 downto 0);
   signal rs_ge17 : unsigned(29 downto 0);
-  signal shl_s18_q_or_rs_ge17 : unsigned(29 downto 0);
+  signal quot17 : unsigned(29 downto 0);
   signal s19_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s19_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -395,10 +395,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge18 : unsigned(0 downto 0);
   signal or_21_minus_rs_s1_b_d18 : unsigned(34 downto 0);
   signal mux_ge18 : unsigned(34 downto 0);
-  signal rs_mux_ge18 : unsigned(33 downto 0);
+  signal rem18 : unsigned(33 downto 0);
   signal shl_s19_q : unsigned(29 downto 0);
   signal rs_ge18 : unsigned(29 downto 0);
-  signal shl_s19_q_or_rs_ge18 : unsigned(29 downto 0);
+  signal quot18 : unsigned(29 downto 0);
   signal s20_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s20_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -414,10 +414,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge19 : unsigned(0 downto 0);
   signal or_22_minus_rs_s1_b_d19 : unsigned(34 downto 0);
   signal mux_ge19 : unsigned(34 downto 0);
-  signal rs_mux_ge19 : unsigned(33 downto 0);
+  signal rem19 : unsigned(33 downto 0);
   signal shl_s20_q : unsigned(29 downto 0);
   signal rs_ge19 : unsigned(29 downto 0);
-  signal shl_s20_q_or_rs_ge19 : unsigned(29 downto 0);
+  signal quot19 : unsigned(29 downto 0);
   signal s21_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s21_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -433,10 +433,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge20 : unsigned(0 downto 0);
   signal or_23_minus_rs_s1_b_d20 : unsigned(34 downto 0);
   signal mux_ge20 : unsigned(34 downto 0);
-  signal rs_mux_ge20 : unsigned(33 downto 0);
+  signal rem20 : unsigned(33 downto 0);
   signal shl_s21_q : unsigned(29 downto 0);
   signal rs_ge20 : unsigned(29 downto 0);
-  signal shl_s21_q_or_rs_ge20 : unsigned(29 downto 0);
+  signal quot20 : unsigned(29 downto 0);
   signal s22_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s22_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -452,10 +452,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge21 : unsigned(0 downto 0);
   signal or_24_minus_rs_s1_b_d21 : unsigned(34 downto 0);
   signal mux_ge21 : unsigned(34 downto 0);
-  signal rs_mux_ge21 : unsigned(33 downto 0);
+  signal rem21 : unsigned(33 downto 0);
   signal shl_s22_q : unsigned(29 downto 0);
   signal rs_ge21 : unsigned(29 downto 0);
-  signal shl_s22_q_or_rs_ge21 : unsigned(29 downto 0);
+  signal quot21 : unsigned(29 downto 0);
   signal s23_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s23_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -471,10 +471,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge22 : unsigned(0 downto 0);
   signal or_25_minus_rs_s1_b_d22 : unsigned(34 downto 0);
   signal mux_ge22 : unsigned(34 downto 0);
-  signal rs_mux_ge22 : unsigned(33 downto 0);
+  signal rem22 : unsigned(33 downto 0);
   signal shl_s23_q : unsigned(29 downto 0);
   signal rs_ge22 : unsigned(29 downto 0);
-  signal shl_s23_q_or_rs_ge22 : unsigned(29 downto 0);
+  signal quot22 : unsigned(29 downto 0);
   signal s24_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s24_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -490,10 +490,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge23 : unsigned(0 downto 0);
   signal or_26_minus_rs_s1_b_d23 : unsigned(34 downto 0);
   signal mux_ge23 : unsigned(34 downto 0);
-  signal rs_mux_ge23 : unsigned(33 downto 0);
+  signal rem23 : unsigned(33 downto 0);
   signal shl_s24_q : unsigned(29 downto 0);
   signal rs_ge23 : unsigned(29 downto 0);
-  signal shl_s24_q_or_rs_ge23 : unsigned(29 downto 0);
+  signal quot23 : unsigned(29 downto 0);
   signal s25_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s25_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -509,10 +509,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge24 : unsigned(0 downto 0);
   signal or_27_minus_rs_s1_b_d24 : unsigned(34 downto 0);
   signal mux_ge24 : unsigned(34 downto 0);
-  signal rs_mux_ge24 : unsigned(33 downto 0);
+  signal rem24 : unsigned(33 downto 0);
   signal shl_s25_q : unsigned(29 downto 0);
   signal rs_ge24 : unsigned(29 downto 0);
-  signal shl_s25_q_or_rs_ge24 : unsigned(29 downto 0);
+  signal quot24 : unsigned(29 downto 0);
   signal s26_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s26_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -528,10 +528,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge25 : unsigned(0 downto 0);
   signal or_28_minus_rs_s1_b_d25 : unsigned(34 downto 0);
   signal mux_ge25 : unsigned(34 downto 0);
-  signal rs_mux_ge25 : unsigned(33 downto 0);
+  signal rem25 : unsigned(33 downto 0);
   signal shl_s26_q : unsigned(29 downto 0);
   signal rs_ge25 : unsigned(29 downto 0);
-  signal shl_s26_q_or_rs_ge25 : unsigned(29 downto 0);
+  signal quot25 : unsigned(29 downto 0);
   signal s27_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s27_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -547,10 +547,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge26 : unsigned(0 downto 0);
   signal or_29_minus_rs_s1_b_d26 : unsigned(34 downto 0);
   signal mux_ge26 : unsigned(34 downto 0);
-  signal rs_mux_ge26 : unsigned(33 downto 0);
+  signal rem26 : unsigned(33 downto 0);
   signal shl_s27_q : unsigned(29 downto 0);
   signal rs_ge26 : unsigned(29 downto 0);
-  signal shl_s27_q_or_rs_ge26 : unsigned(29 downto 0);
+  signal quot26 : unsigned(29 downto 0);
   signal s28_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s28_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -566,10 +566,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge27 : unsigned(0 downto 0);
   signal or_30_minus_rs_s1_b_d27 : unsigned(34 downto 0);
   signal mux_ge27 : unsigned(34 downto 0);
-  signal rs_mux_ge27 : unsigned(33 downto 0);
+  signal rem27 : unsigned(33 downto 0);
   signal shl_s28_q : unsigned(29 downto 0);
   signal rs_ge27 : unsigned(29 downto 0);
-  signal shl_s28_q_or_rs_ge27 : unsigned(29 downto 0);
+  signal quot27 : unsigned(29 downto 0);
   signal s29_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s29_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -585,10 +585,10 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge28 : unsigned(0 downto 0);
   signal or_31_minus_rs_s1_b_d28 : unsigned(34 downto 0);
   signal mux_ge28 : unsigned(34 downto 0);
-  signal rs_mux_ge28 : unsigned(33 downto 0);
+  signal rem28 : unsigned(33 downto 0);
   signal shl_s29_q : unsigned(29 downto 0);
   signal rs_ge28 : unsigned(29 downto 0);
-  signal shl_s29_q_or_rs_ge28 : unsigned(29 downto 0);
+  signal quot28 : unsigned(29 downto 0);
   signal s30_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s30_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
 
@@ -604,16 +604,16 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   signal ge29 : unsigned(0 downto 0);
   signal or_32_minus_rs_s1_b_d29 : unsigned(34 downto 0);
   signal mux_ge29 : unsigned(34 downto 0);
-  signal rs_mux_ge29 : unsigned(33 downto 0);
+  signal rem29 : unsigned(33 downto 0);
   signal shl_s30_q : unsigned(29 downto 0);
   signal rs_ge29 : unsigned(29 downto 0);
-  signal shl_s30_q_or_rs_ge29 : unsigned(29 downto 0);
+  signal quot29 : unsigned(29 downto 0);
   type err_1_d29_sr_t is array (1 to 29) of unsigned(0 downto 0);
   signal err_1_d29_sr : err_1_d29_sr_t := (others => (others => '0'));
   signal err_1_d29 : unsigned(0 downto 0);
-  signal eq_33 : unsigned(0 downto 0);
-  signal err_1_d29_or_eq_33 : unsigned(0 downto 0);
-  signal not_err_1_d29_or_eq_33 : unsigned(0 downto 0);
+  signal quot29_eq_k_0_2 : unsigned(0 downto 0);
+  signal or_33 : unsigned(0 downto 0);
+  signal not_or_33 : unsigned(0 downto 0);
   signal s31_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal s31_ok : unsigned(0 downto 0) := unsigned'("0");
 begin
@@ -660,15 +660,15 @@ begin
   ge0 <= "1" when rs_s1_b <= or_3 else "0";
   or_3_minus_rs_s1_b <= or_3 - rs_s1_b;
   mux_ge0 <= or_3_minus_rs_s1_b when ge0 = "1" else or_3;
-  rs_mux_ge0 <= mux_ge0(33 downto 0);
+  rem0 <= mux_ge0(33 downto 0);
   rs_ge0 <= resize(ge0, 30);
-  k_0_2_or_rs_ge0 <= k_0_2 or rs_ge0;
+  quot0 <= k_0_2 or rs_ge0;
 
   s2_q0_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s2_p <= rs_mux_ge0;
-      s2_q <= k_0_2_or_rs_ge0;
+      s2_p <= rem0;
+      s2_q <= quot0;
     end if;
   end process s2_q0_regs;
 
@@ -682,18 +682,18 @@ begin
   ge1 <= "1" when rs_s1_b_d1 <= or_4 else "0";
   or_4_minus_rs_s1_b_d1 <= or_4 - rs_s1_b_d1;
   mux_ge1 <= or_4_minus_rs_s1_b_d1 when ge1 = "1" else or_4;
-  rs_mux_ge1 <= mux_ge1(33 downto 0);
+  rem1 <= mux_ge1(33 downto 0);
   shl_s2_q <= shift_left(s2_q, 1);
   rs_ge1 <= resize(ge1, 30);
-  shl_s2_q_or_rs_ge1 <= shl_s2_q or rs_ge1;
+  quot1 <= shl_s2_q or rs_ge1;
 
   s3_q1_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d1 <= s1_b;
       lo_d1 <= lo;
-      s3_p <= rs_mux_ge1;
-      s3_q <= shl_s2_q_or_rs_ge1;
+      s3_p <= rem1;
+      s3_q <= quot1;
     end if;
   end process s3_q1_regs;
 
@@ -707,18 +707,18 @@ begin
   ge2 <= "1" when rs_s1_b_d2 <= or_5 else "0";
   or_5_minus_rs_s1_b_d2 <= or_5 - rs_s1_b_d2;
   mux_ge2 <= or_5_minus_rs_s1_b_d2 when ge2 = "1" else or_5;
-  rs_mux_ge2 <= mux_ge2(33 downto 0);
+  rem2 <= mux_ge2(33 downto 0);
   shl_s3_q <= shift_left(s3_q, 1);
   rs_ge2 <= resize(ge2, 30);
-  shl_s3_q_or_rs_ge2 <= shl_s3_q or rs_ge2;
+  quot2 <= shl_s3_q or rs_ge2;
 
   s4_q2_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d2 <= s1_b_d1;
       lo_d2 <= lo_d1;
-      s4_p <= rs_mux_ge2;
-      s4_q <= shl_s3_q_or_rs_ge2;
+      s4_p <= rem2;
+      s4_q <= quot2;
     end if;
   end process s4_q2_regs;
 
@@ -732,18 +732,18 @@ begin
   ge3 <= "1" when rs_s1_b_d3 <= or_6 else "0";
   or_6_minus_rs_s1_b_d3 <= or_6 - rs_s1_b_d3;
   mux_ge3 <= or_6_minus_rs_s1_b_d3 when ge3 = "1" else or_6;
-  rs_mux_ge3 <= mux_ge3(33 downto 0);
+  rem3 <= mux_ge3(33 downto 0);
   shl_s4_q <= shift_left(s4_q, 1);
   rs_ge3 <= resize(ge3, 30);
-  shl_s4_q_or_rs_ge3 <= shl_s4_q or rs_ge3;
+  quot3 <= shl_s4_q or rs_ge3;
 
   s5_q3_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d3 <= s1_b_d2;
       lo_d3 <= lo_d2;
-      s5_p <= rs_mux_ge3;
-      s5_q <= shl_s4_q_or_rs_ge3;
+      s5_p <= rem3;
+      s5_q <= quot3;
     end if;
   end process s5_q3_regs;
 
@@ -757,18 +757,18 @@ begin
   ge4 <= "1" when rs_s1_b_d4 <= or_7 else "0";
   or_7_minus_rs_s1_b_d4 <= or_7 - rs_s1_b_d4;
   mux_ge4 <= or_7_minus_rs_s1_b_d4 when ge4 = "1" else or_7;
-  rs_mux_ge4 <= mux_ge4(33 downto 0);
+  rem4 <= mux_ge4(33 downto 0);
   shl_s5_q <= shift_left(s5_q, 1);
   rs_ge4 <= resize(ge4, 30);
-  shl_s5_q_or_rs_ge4 <= shl_s5_q or rs_ge4;
+  quot4 <= shl_s5_q or rs_ge4;
 
   s6_q4_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d4 <= s1_b_d3;
       lo_d4 <= lo_d3;
-      s6_p <= rs_mux_ge4;
-      s6_q <= shl_s5_q_or_rs_ge4;
+      s6_p <= rem4;
+      s6_q <= quot4;
     end if;
   end process s6_q4_regs;
 
@@ -782,18 +782,18 @@ begin
   ge5 <= "1" when rs_s1_b_d5 <= or_8 else "0";
   or_8_minus_rs_s1_b_d5 <= or_8 - rs_s1_b_d5;
   mux_ge5 <= or_8_minus_rs_s1_b_d5 when ge5 = "1" else or_8;
-  rs_mux_ge5 <= mux_ge5(33 downto 0);
+  rem5 <= mux_ge5(33 downto 0);
   shl_s6_q <= shift_left(s6_q, 1);
   rs_ge5 <= resize(ge5, 30);
-  shl_s6_q_or_rs_ge5 <= shl_s6_q or rs_ge5;
+  quot5 <= shl_s6_q or rs_ge5;
 
   s7_q5_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d5 <= s1_b_d4;
       lo_d5 <= lo_d4;
-      s7_p <= rs_mux_ge5;
-      s7_q <= shl_s6_q_or_rs_ge5;
+      s7_p <= rem5;
+      s7_q <= quot5;
     end if;
   end process s7_q5_regs;
 
@@ -807,18 +807,18 @@ begin
   ge6 <= "1" when rs_s1_b_d6 <= or_9 else "0";
   or_9_minus_rs_s1_b_d6 <= or_9 - rs_s1_b_d6;
   mux_ge6 <= or_9_minus_rs_s1_b_d6 when ge6 = "1" else or_9;
-  rs_mux_ge6 <= mux_ge6(33 downto 0);
+  rem6 <= mux_ge6(33 downto 0);
   shl_s7_q <= shift_left(s7_q, 1);
   rs_ge6 <= resize(ge6, 30);
-  shl_s7_q_or_rs_ge6 <= shl_s7_q or rs_ge6;
+  quot6 <= shl_s7_q or rs_ge6;
 
   s8_q6_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d6 <= s1_b_d5;
       lo_d6 <= lo_d5;
-      s8_p <= rs_mux_ge6;
-      s8_q <= shl_s7_q_or_rs_ge6;
+      s8_p <= rem6;
+      s8_q <= quot6;
     end if;
   end process s8_q6_regs;
 
@@ -832,18 +832,18 @@ begin
   ge7 <= "1" when rs_s1_b_d7 <= or_10 else "0";
   or_10_minus_rs_s1_b_d7 <= or_10 - rs_s1_b_d7;
   mux_ge7 <= or_10_minus_rs_s1_b_d7 when ge7 = "1" else or_10;
-  rs_mux_ge7 <= mux_ge7(33 downto 0);
+  rem7 <= mux_ge7(33 downto 0);
   shl_s8_q <= shift_left(s8_q, 1);
   rs_ge7 <= resize(ge7, 30);
-  shl_s8_q_or_rs_ge7 <= shl_s8_q or rs_ge7;
+  quot7 <= shl_s8_q or rs_ge7;
 
   s9_q7_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d7 <= s1_b_d6;
       lo_d7 <= lo_d6;
-      s9_p <= rs_mux_ge7;
-      s9_q <= shl_s8_q_or_rs_ge7;
+      s9_p <= rem7;
+      s9_q <= quot7;
     end if;
   end process s9_q7_regs;
 
@@ -857,18 +857,18 @@ begin
   ge8 <= "1" when rs_s1_b_d8 <= or_11 else "0";
   or_11_minus_rs_s1_b_d8 <= or_11 - rs_s1_b_d8;
   mux_ge8 <= or_11_minus_rs_s1_b_d8 when ge8 = "1" else or_11;
-  rs_mux_ge8 <= mux_ge8(33 downto 0);
+  rem8 <= mux_ge8(33 downto 0);
   shl_s9_q <= shift_left(s9_q, 1);
   rs_ge8 <= resize(ge8, 30);
-  shl_s9_q_or_rs_ge8 <= shl_s9_q or rs_ge8;
+  quot8 <= shl_s9_q or rs_ge8;
 
   s10_q8_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d8 <= s1_b_d7;
       lo_d8 <= lo_d7;
-      s10_p <= rs_mux_ge8;
-      s10_q <= shl_s9_q_or_rs_ge8;
+      s10_p <= rem8;
+      s10_q <= quot8;
     end if;
   end process s10_q8_regs;
 
@@ -882,18 +882,18 @@ begin
   ge9 <= "1" when rs_s1_b_d9 <= or_12 else "0";
   or_12_minus_rs_s1_b_d9 <= or_12 - rs_s1_b_d9;
   mux_ge9 <= or_12_minus_rs_s1_b_d9 when ge9 = "1" else or_12;
-  rs_mux_ge9 <= mux_ge9(33 downto 0);
+  rem9 <= mux_ge9(33 downto 0);
   shl_s10_q <= shift_left(s10_q, 1);
   rs_ge9 <= resize(ge9, 30);
-  shl_s10_q_or_rs_ge9 <= shl_s10_q or rs_ge9;
+  quot9 <= shl_s10_q or rs_ge9;
 
   s11_q9_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d9 <= s1_b_d8;
       lo_d9 <= lo_d8;
-      s11_p <= rs_mux_ge9;
-      s11_q <= shl_s10_q_or_rs_ge9;
+      s11_p <= rem9;
+      s11_q <= quot9;
     end if;
   end process s11_q9_regs;
 
@@ -907,18 +907,18 @@ begin
   ge10 <= "1" when rs_s1_b_d10 <= or_13 else "0";
   or_13_minus_rs_s1_b_d10 <= or_13 - rs_s1_b_d10;
   mux_ge10 <= or_13_minus_rs_s1_b_d10 when ge10 = "1" else or_13;
-  rs_mux_ge10 <= mux_ge10(33 downto 0);
+  rem10 <= mux_ge10(33 downto 0);
   shl_s11_q <= shift_left(s11_q, 1);
   rs_ge10 <= resize(ge10, 30);
-  shl_s11_q_or_rs_ge10 <= shl_s11_q or rs_ge10;
+  quot10 <= shl_s11_q or rs_ge10;
 
   s12_q10_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d10 <= s1_b_d9;
       lo_d10 <= lo_d9;
-      s12_p <= rs_mux_ge10;
-      s12_q <= shl_s11_q_or_rs_ge10;
+      s12_p <= rem10;
+      s12_q <= quot10;
     end if;
   end process s12_q10_regs;
 
@@ -932,18 +932,18 @@ begin
   ge11 <= "1" when rs_s1_b_d11 <= or_14 else "0";
   or_14_minus_rs_s1_b_d11 <= or_14 - rs_s1_b_d11;
   mux_ge11 <= or_14_minus_rs_s1_b_d11 when ge11 = "1" else or_14;
-  rs_mux_ge11 <= mux_ge11(33 downto 0);
+  rem11 <= mux_ge11(33 downto 0);
   shl_s12_q <= shift_left(s12_q, 1);
   rs_ge11 <= resize(ge11, 30);
-  shl_s12_q_or_rs_ge11 <= shl_s12_q or rs_ge11;
+  quot11 <= shl_s12_q or rs_ge11;
 
   s13_q11_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d11 <= s1_b_d10;
       lo_d11 <= lo_d10;
-      s13_p <= rs_mux_ge11;
-      s13_q <= shl_s12_q_or_rs_ge11;
+      s13_p <= rem11;
+      s13_q <= quot11;
     end if;
   end process s13_q11_regs;
 
@@ -957,18 +957,18 @@ begin
   ge12 <= "1" when rs_s1_b_d12 <= or_15 else "0";
   or_15_minus_rs_s1_b_d12 <= or_15 - rs_s1_b_d12;
   mux_ge12 <= or_15_minus_rs_s1_b_d12 when ge12 = "1" else or_15;
-  rs_mux_ge12 <= mux_ge12(33 downto 0);
+  rem12 <= mux_ge12(33 downto 0);
   shl_s13_q <= shift_left(s13_q, 1);
   rs_ge12 <= resize(ge12, 30);
-  shl_s13_q_or_rs_ge12 <= shl_s13_q or rs_ge12;
+  quot12 <= shl_s13_q or rs_ge12;
 
   s14_q12_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d12 <= s1_b_d11;
       lo_d12 <= lo_d11;
-      s14_p <= rs_mux_ge12;
-      s14_q <= shl_s13_q_or_rs_ge12;
+      s14_p <= rem12;
+      s14_q <= quot12;
     end if;
   end process s14_q12_regs;
 
@@ -982,18 +982,18 @@ begin
   ge13 <= "1" when rs_s1_b_d13 <= or_16 else "0";
   or_16_minus_rs_s1_b_d13 <= or_16 - rs_s1_b_d13;
   mux_ge13 <= or_16_minus_rs_s1_b_d13 when ge13 = "1" else or_16;
-  rs_mux_ge13 <= mux_ge13(33 downto 0);
+  rem13 <= mux_ge13(33 downto 0);
   shl_s14_q <= shift_left(s14_q, 1);
   rs_ge13 <= resize(ge13, 30);
-  shl_s14_q_or_rs_ge13 <= shl_s14_q or rs_ge13;
+  quot13 <= shl_s14_q or rs_ge13;
 
   s15_q13_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d13 <= s1_b_d12;
       lo_d13 <= lo_d12;
-      s15_p <= rs_mux_ge13;
-      s15_q <= shl_s14_q_or_rs_ge13;
+      s15_p <= rem13;
+      s15_q <= quot13;
     end if;
   end process s15_q13_regs;
 
@@ -1007,18 +1007,18 @@ begin
   ge14 <= "1" when rs_s1_b_d14 <= or_17 else "0";
   or_17_minus_rs_s1_b_d14 <= or_17 - rs_s1_b_d14;
   mux_ge14 <= or_17_minus_rs_s1_b_d14 when ge14 = "1" else or_17;
-  rs_mux_ge14 <= mux_ge14(33 downto 0);
+  rem14 <= mux_ge14(33 downto 0);
   shl_s15_q <= shift_left(s15_q, 1);
   rs_ge14 <= resize(ge14, 30);
-  shl_s15_q_or_rs_ge14 <= shl_s15_q or rs_ge14;
+  quot14 <= shl_s15_q or rs_ge14;
 
   s16_q14_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d14 <= s1_b_d13;
       lo_d14 <= lo_d13;
-      s16_p <= rs_mux_ge14;
-      s16_q <= shl_s15_q_or_rs_ge14;
+      s16_p <= rem14;
+      s16_q <= quot14;
     end if;
   end process s16_q14_regs;
 
@@ -1032,18 +1032,18 @@ begin
   ge15 <= "1" when rs_s1_b_d15 <= or_18 else "0";
   or_18_minus_rs_s1_b_d15 <= or_18 - rs_s1_b_d15;
   mux_ge15 <= or_18_minus_rs_s1_b_d15 when ge15 = "1" else or_18;
-  rs_mux_ge15 <= mux_ge15(33 downto 0);
+  rem15 <= mux_ge15(33 downto 0);
   shl_s16_q <= shift_left(s16_q, 1);
   rs_ge15 <= resize(ge15, 30);
-  shl_s16_q_or_rs_ge15 <= shl_s16_q or rs_ge15;
+  quot15 <= shl_s16_q or rs_ge15;
 
   s17_q15_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d15 <= s1_b_d14;
       lo_d15 <= lo_d14;
-      s17_p <= rs_mux_ge15;
-      s17_q <= shl_s16_q_or_rs_ge15;
+      s17_p <= rem15;
+      s17_q <= quot15;
     end if;
   end process s17_q15_regs;
 
@@ -1057,18 +1057,18 @@ begin
   ge16 <= "1" when rs_s1_b_d16 <= or_19 else "0";
   or_19_minus_rs_s1_b_d16 <= or_19 - rs_s1_b_d16;
   mux_ge16 <= or_19_minus_rs_s1_b_d16 when ge16 = "1" else or_19;
-  rs_mux_ge16 <= mux_ge16(33 downto 0);
+  rem16 <= mux_ge16(33 downto 0);
   shl_s17_q <= shift_left(s17_q, 1);
   rs_ge16 <= resize(ge16, 30);
-  shl_s17_q_or_rs_ge16 <= shl_s17_q or rs_ge16;
+  quot16 <= shl_s17_q or rs_ge16;
 
   s18_q16_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d16 <= s1_b_d15;
       lo_d16 <= lo_d15;
-      s18_p <= rs_mux_ge16;
-      s18_q <= shl_s17_q_or_rs_ge16;
+      s18_p <= rem16;
+      s18_q <= quot16;
     end if;
   end process s18_q16_regs;
 
@@ -1082,18 +1082,18 @@ begin
   ge17 <= "1" when rs_s1_b_d17 <= or_20 else "0";
   or_20_minus_rs_s1_b_d17 <= or_20 - rs_s1_b_d17;
   mux_ge17 <= or_20_minus_rs_s1_b_d17 when ge17 = "1" else or_20;
-  rs_mux_ge17 <= mux_ge17(33 downto 0);
+  rem17 <= mux_ge17(33 downto 0);
   shl_s18_q <= shift_left(s18_q, 1);
   rs_ge17 <= resize(ge17, 30);
-  shl_s18_q_or_rs_ge17 <= shl_s18_q or rs_ge17;
+  quot17 <= shl_s18_q or rs_ge17;
 
   s19_q17_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d17 <= s1_b_d16;
       lo_d17 <= lo_d16;
-      s19_p <= rs_mux_ge17;
-      s19_q <= shl_s18_q_or_rs_ge17;
+      s19_p <= rem17;
+      s19_q <= quot17;
     end if;
   end process s19_q17_regs;
 
@@ -1107,18 +1107,18 @@ begin
   ge18 <= "1" when rs_s1_b_d18 <= or_21 else "0";
   or_21_minus_rs_s1_b_d18 <= or_21 - rs_s1_b_d18;
   mux_ge18 <= or_21_minus_rs_s1_b_d18 when ge18 = "1" else or_21;
-  rs_mux_ge18 <= mux_ge18(33 downto 0);
+  rem18 <= mux_ge18(33 downto 0);
   shl_s19_q <= shift_left(s19_q, 1);
   rs_ge18 <= resize(ge18, 30);
-  shl_s19_q_or_rs_ge18 <= shl_s19_q or rs_ge18;
+  quot18 <= shl_s19_q or rs_ge18;
 
   s20_q18_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d18 <= s1_b_d17;
       lo_d18 <= lo_d17;
-      s20_p <= rs_mux_ge18;
-      s20_q <= shl_s19_q_or_rs_ge18;
+      s20_p <= rem18;
+      s20_q <= quot18;
     end if;
   end process s20_q18_regs;
 
@@ -1132,18 +1132,18 @@ begin
   ge19 <= "1" when rs_s1_b_d19 <= or_22 else "0";
   or_22_minus_rs_s1_b_d19 <= or_22 - rs_s1_b_d19;
   mux_ge19 <= or_22_minus_rs_s1_b_d19 when ge19 = "1" else or_22;
-  rs_mux_ge19 <= mux_ge19(33 downto 0);
+  rem19 <= mux_ge19(33 downto 0);
   shl_s20_q <= shift_left(s20_q, 1);
   rs_ge19 <= resize(ge19, 30);
-  shl_s20_q_or_rs_ge19 <= shl_s20_q or rs_ge19;
+  quot19 <= shl_s20_q or rs_ge19;
 
   s21_q19_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d19 <= s1_b_d18;
       lo_d19 <= lo_d18;
-      s21_p <= rs_mux_ge19;
-      s21_q <= shl_s20_q_or_rs_ge19;
+      s21_p <= rem19;
+      s21_q <= quot19;
     end if;
   end process s21_q19_regs;
 
@@ -1157,18 +1157,18 @@ begin
   ge20 <= "1" when rs_s1_b_d20 <= or_23 else "0";
   or_23_minus_rs_s1_b_d20 <= or_23 - rs_s1_b_d20;
   mux_ge20 <= or_23_minus_rs_s1_b_d20 when ge20 = "1" else or_23;
-  rs_mux_ge20 <= mux_ge20(33 downto 0);
+  rem20 <= mux_ge20(33 downto 0);
   shl_s21_q <= shift_left(s21_q, 1);
   rs_ge20 <= resize(ge20, 30);
-  shl_s21_q_or_rs_ge20 <= shl_s21_q or rs_ge20;
+  quot20 <= shl_s21_q or rs_ge20;
 
   s22_q20_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d20 <= s1_b_d19;
       lo_d20 <= lo_d19;
-      s22_p <= rs_mux_ge20;
-      s22_q <= shl_s21_q_or_rs_ge20;
+      s22_p <= rem20;
+      s22_q <= quot20;
     end if;
   end process s22_q20_regs;
 
@@ -1182,18 +1182,18 @@ begin
   ge21 <= "1" when rs_s1_b_d21 <= or_24 else "0";
   or_24_minus_rs_s1_b_d21 <= or_24 - rs_s1_b_d21;
   mux_ge21 <= or_24_minus_rs_s1_b_d21 when ge21 = "1" else or_24;
-  rs_mux_ge21 <= mux_ge21(33 downto 0);
+  rem21 <= mux_ge21(33 downto 0);
   shl_s22_q <= shift_left(s22_q, 1);
   rs_ge21 <= resize(ge21, 30);
-  shl_s22_q_or_rs_ge21 <= shl_s22_q or rs_ge21;
+  quot21 <= shl_s22_q or rs_ge21;
 
   s23_q21_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d21 <= s1_b_d20;
       lo_d21 <= lo_d20;
-      s23_p <= rs_mux_ge21;
-      s23_q <= shl_s22_q_or_rs_ge21;
+      s23_p <= rem21;
+      s23_q <= quot21;
     end if;
   end process s23_q21_regs;
 
@@ -1207,18 +1207,18 @@ begin
   ge22 <= "1" when rs_s1_b_d22 <= or_25 else "0";
   or_25_minus_rs_s1_b_d22 <= or_25 - rs_s1_b_d22;
   mux_ge22 <= or_25_minus_rs_s1_b_d22 when ge22 = "1" else or_25;
-  rs_mux_ge22 <= mux_ge22(33 downto 0);
+  rem22 <= mux_ge22(33 downto 0);
   shl_s23_q <= shift_left(s23_q, 1);
   rs_ge22 <= resize(ge22, 30);
-  shl_s23_q_or_rs_ge22 <= shl_s23_q or rs_ge22;
+  quot22 <= shl_s23_q or rs_ge22;
 
   s24_q22_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d22 <= s1_b_d21;
       lo_d22 <= lo_d21;
-      s24_p <= rs_mux_ge22;
-      s24_q <= shl_s23_q_or_rs_ge22;
+      s24_p <= rem22;
+      s24_q <= quot22;
     end if;
   end process s24_q22_regs;
 
@@ -1232,18 +1232,18 @@ begin
   ge23 <= "1" when rs_s1_b_d23 <= or_26 else "0";
   or_26_minus_rs_s1_b_d23 <= or_26 - rs_s1_b_d23;
   mux_ge23 <= or_26_minus_rs_s1_b_d23 when ge23 = "1" else or_26;
-  rs_mux_ge23 <= mux_ge23(33 downto 0);
+  rem23 <= mux_ge23(33 downto 0);
   shl_s24_q <= shift_left(s24_q, 1);
   rs_ge23 <= resize(ge23, 30);
-  shl_s24_q_or_rs_ge23 <= shl_s24_q or rs_ge23;
+  quot23 <= shl_s24_q or rs_ge23;
 
   s25_q23_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d23 <= s1_b_d22;
       lo_d23 <= lo_d22;
-      s25_p <= rs_mux_ge23;
-      s25_q <= shl_s24_q_or_rs_ge23;
+      s25_p <= rem23;
+      s25_q <= quot23;
     end if;
   end process s25_q23_regs;
 
@@ -1257,18 +1257,18 @@ begin
   ge24 <= "1" when rs_s1_b_d24 <= or_27 else "0";
   or_27_minus_rs_s1_b_d24 <= or_27 - rs_s1_b_d24;
   mux_ge24 <= or_27_minus_rs_s1_b_d24 when ge24 = "1" else or_27;
-  rs_mux_ge24 <= mux_ge24(33 downto 0);
+  rem24 <= mux_ge24(33 downto 0);
   shl_s25_q <= shift_left(s25_q, 1);
   rs_ge24 <= resize(ge24, 30);
-  shl_s25_q_or_rs_ge24 <= shl_s25_q or rs_ge24;
+  quot24 <= shl_s25_q or rs_ge24;
 
   s26_q24_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d24 <= s1_b_d23;
       lo_d24 <= lo_d23;
-      s26_p <= rs_mux_ge24;
-      s26_q <= shl_s25_q_or_rs_ge24;
+      s26_p <= rem24;
+      s26_q <= quot24;
     end if;
   end process s26_q24_regs;
 
@@ -1282,18 +1282,18 @@ begin
   ge25 <= "1" when rs_s1_b_d25 <= or_28 else "0";
   or_28_minus_rs_s1_b_d25 <= or_28 - rs_s1_b_d25;
   mux_ge25 <= or_28_minus_rs_s1_b_d25 when ge25 = "1" else or_28;
-  rs_mux_ge25 <= mux_ge25(33 downto 0);
+  rem25 <= mux_ge25(33 downto 0);
   shl_s26_q <= shift_left(s26_q, 1);
   rs_ge25 <= resize(ge25, 30);
-  shl_s26_q_or_rs_ge25 <= shl_s26_q or rs_ge25;
+  quot25 <= shl_s26_q or rs_ge25;
 
   s27_q25_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d25 <= s1_b_d24;
       lo_d25 <= lo_d24;
-      s27_p <= rs_mux_ge25;
-      s27_q <= shl_s26_q_or_rs_ge25;
+      s27_p <= rem25;
+      s27_q <= quot25;
     end if;
   end process s27_q25_regs;
 
@@ -1307,18 +1307,18 @@ begin
   ge26 <= "1" when rs_s1_b_d26 <= or_29 else "0";
   or_29_minus_rs_s1_b_d26 <= or_29 - rs_s1_b_d26;
   mux_ge26 <= or_29_minus_rs_s1_b_d26 when ge26 = "1" else or_29;
-  rs_mux_ge26 <= mux_ge26(33 downto 0);
+  rem26 <= mux_ge26(33 downto 0);
   shl_s27_q <= shift_left(s27_q, 1);
   rs_ge26 <= resize(ge26, 30);
-  shl_s27_q_or_rs_ge26 <= shl_s27_q or rs_ge26;
+  quot26 <= shl_s27_q or rs_ge26;
 
   s28_q26_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d26 <= s1_b_d25;
       lo_d26 <= lo_d25;
-      s28_p <= rs_mux_ge26;
-      s28_q <= shl_s27_q_or_rs_ge26;
+      s28_p <= rem26;
+      s28_q <= quot26;
     end if;
   end process s28_q26_regs;
 
@@ -1332,18 +1332,18 @@ begin
   ge27 <= "1" when rs_s1_b_d27 <= or_30 else "0";
   or_30_minus_rs_s1_b_d27 <= or_30 - rs_s1_b_d27;
   mux_ge27 <= or_30_minus_rs_s1_b_d27 when ge27 = "1" else or_30;
-  rs_mux_ge27 <= mux_ge27(33 downto 0);
+  rem27 <= mux_ge27(33 downto 0);
   shl_s28_q <= shift_left(s28_q, 1);
   rs_ge27 <= resize(ge27, 30);
-  shl_s28_q_or_rs_ge27 <= shl_s28_q or rs_ge27;
+  quot27 <= shl_s28_q or rs_ge27;
 
   s29_q27_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d27 <= s1_b_d26;
       lo_d27 <= lo_d26;
-      s29_p <= rs_mux_ge27;
-      s29_q <= shl_s28_q_or_rs_ge27;
+      s29_p <= rem27;
+      s29_q <= quot27;
     end if;
   end process s29_q27_regs;
 
@@ -1357,18 +1357,18 @@ begin
   ge28 <= "1" when rs_s1_b_d28 <= or_31 else "0";
   or_31_minus_rs_s1_b_d28 <= or_31 - rs_s1_b_d28;
   mux_ge28 <= or_31_minus_rs_s1_b_d28 when ge28 = "1" else or_31;
-  rs_mux_ge28 <= mux_ge28(33 downto 0);
+  rem28 <= mux_ge28(33 downto 0);
   shl_s29_q <= shift_left(s29_q, 1);
   rs_ge28 <= resize(ge28, 30);
-  shl_s29_q_or_rs_ge28 <= shl_s29_q or rs_ge28;
+  quot28 <= shl_s29_q or rs_ge28;
 
   s30_q28_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d28 <= s1_b_d27;
       lo_d28 <= lo_d27;
-      s30_p <= rs_mux_ge28;
-      s30_q <= shl_s29_q_or_rs_ge28;
+      s30_p <= rem28;
+      s30_q <= quot28;
     end if;
   end process s30_q28_regs;
 
@@ -1382,14 +1382,14 @@ begin
   ge29 <= "1" when rs_s1_b_d29 <= or_32 else "0";
   or_32_minus_rs_s1_b_d29 <= or_32 - rs_s1_b_d29;
   mux_ge29 <= or_32_minus_rs_s1_b_d29 when ge29 = "1" else or_32;
-  rs_mux_ge29 <= mux_ge29(33 downto 0);
+  rem29 <= mux_ge29(33 downto 0);
   shl_s30_q <= shift_left(s30_q, 1);
   rs_ge29 <= resize(ge29, 30);
-  shl_s30_q_or_rs_ge29 <= shl_s30_q or rs_ge29;
+  quot29 <= shl_s30_q or rs_ge29;
   err_1_d29 <= err_1_d29_sr(29);
-  eq_33 <= "1" when shl_s30_q_or_rs_ge29 = k_0_2 else "0";
-  err_1_d29_or_eq_33 <= err_1_d29 or eq_33;
-  not_err_1_d29_or_eq_33 <= not err_1_d29_or_eq_33;
+  quot29_eq_k_0_2 <= "1" when quot29 = k_0_2 else "0";
+  or_33 <= err_1_d29 or quot29_eq_k_0_2;
+  not_or_33 <= not or_33;
 
   s31_result_regs : process (clk)
   begin
@@ -1398,8 +1398,8 @@ begin
       lo_d29 <= lo_d28;
       err_1_d29_sr(2 to 29) <= err_1_d29_sr(1 to 28);
       err_1_d29_sr(1) <= err_1;
-      s31_t <= shl_s30_q_or_rs_ge29;
-      s31_ok <= not_err_1_d29_or_eq_33;
+      s31_t <= quot29;
+      s31_ok <= not_or_33;
     end if;
   end process s31_result_regs;
 

