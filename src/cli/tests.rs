@@ -156,7 +156,7 @@ fn sim_runs_the_ray_generator_in_rust_only() {
 }
 
 #[test]
-fn synth_is_for_virtex_5() {
+fn synth_defaults_to_virtex_5_and_refuses_other_families() {
     assert_eq!(refused(&["synth", "--family", "xc7"]), "--family");
     let Command::Synth(a) = command(&["synth"]) else { panic!() };
     assert_eq!(a.config().unwrap().build, PathBuf::from("target/fxrt-synth"));
