@@ -286,6 +286,8 @@ pub struct SynthConfig {
 pub enum Family {
     /// Virtex-5 area from Debian's yosys.
     Xc5v,
+    /// 7-series (Artix-7) area from Debian's yosys, a second reference.
+    Xc7,
     /// LFE5U-85F place and route: the clock constraint, nextpnr's seed and the modules.
     Ecp5 { target_mhz: f64, seed: u64, modules: Vec<String> },
 }
@@ -297,6 +299,7 @@ impl SynthArgs {
     pub fn config(&self) -> Result<SynthConfig> {
         let family = match self.family.as_str() {
             "xc5v" => Family::Xc5v,
+            "xc7" => Family::Xc7,
             "ecp5" => {
                 if !(self.target_mhz.is_finite() && self.target_mhz > 0.0 && self.target_mhz <= 1000.0) {
                     return Err(Error::param(
@@ -312,7 +315,9 @@ impl SynthArgs {
                 }
                 Family::Ecp5 { target_mhz: self.target_mhz, seed: self.seed, modules: self.modules.clone() }
             }
-            other => return Err(Error::param("family", format!("'{other}' is not supported: use xc5v or ecp5"))),
+            other => {
+                return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));
+            }
         };
         Ok(SynthConfig {
             params: self.params.params()?,

@@ -198,9 +198,9 @@ pub struct SynthArgs {
     /// The scene the whole core holds in its ROMs (and whose E the pipeline uses).
     #[command(flatten)]
     pub scene: SceneChoice,
-    /// Target family: xc5v (Virtex-5 area from Debian's yosys) or ecp5 (LFE5U-85F place and
-    /// route with yosys and nextpnr-ecp5 from the project's .venv: Fmax, critical path,
-    /// resources).
+    /// Target family: xc5v (Virtex-5 area from Debian's yosys), xc7 (7-series area, the same
+    /// way) or ecp5 (LFE5U-85F place and route with yosys and nextpnr-ecp5 from the project's
+    /// .venv: Fmax, critical path, resources).
     #[arg(long, default_value = "xc5v")]
     pub family: String,
     /// ecp5: the clock constraint given to nextpnr, MHz.

@@ -276,17 +276,18 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
     }
+    let family = if c.family == Family::Xc7 { "xc7" } else { "xc5v" };
     let mut cores = Vec::new();
     let mut set = vec![(crate::cores::top::core_module(&core, &roms), None)];
     set.extend(generate::cores(&p).into_iter().map(|(m, lat, _)| (m, lat)));
     for (m, latency) in set {
-        let area = synth::synth_xc5v(&m, &c.build.join(&m.name))?;
+        let area = synth::synth_xilinx(&m, family, &c.build.join(&m.name))?;
         cores.push(serde_json::json!({ "latency_cycles": latency, "area": area }));
     }
     let thesis = serde_json::json!({ "note": "whole design of seed 001 table 3.2 (BIH + intersection + ray generator), XST", "luts": 5278, "registers": 3274, "dsp48e": 52, "bram18": 22 });
     println!(
         "{}",
-        serde_json::json!({ "family": "xc5v", "tool": "yosys synth_xilinx", "scene": scene.name, "params": p, "cores": cores, "thesis": thesis })
+        serde_json::json!({ "family": family, "tool": "yosys synth_xilinx", "scene": scene.name, "params": p, "cores": cores, "thesis": thesis })
     );
     Ok(())
 }

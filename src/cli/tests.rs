@@ -157,9 +157,12 @@ fn sim_runs_the_ray_generator_in_rust_only() {
 
 #[test]
 fn synth_defaults_to_virtex_5_and_refuses_other_families() {
-    assert_eq!(refused(&["synth", "--family", "xc7"]), "--family");
+    assert_eq!(refused(&["synth", "--family", "xc4"]), "--family");
     let Command::Synth(a) = command(&["synth"]) else { panic!() };
-    assert_eq!(a.config().unwrap().build, PathBuf::from("target/fxrt-synth"));
+    let c = a.config().unwrap();
+    assert_eq!((c.build, c.family), (PathBuf::from("target/fxrt-synth"), Family::Xc5v));
+    let Command::Synth(a) = command(&["synth", "--family", "xc7"]) else { panic!() };
+    assert_eq!(a.config().unwrap().family, Family::Xc7);
 }
 
 #[test]
@@ -240,7 +243,7 @@ fn synth_ecp5_options_are_checked() {
     assert_eq!(c.family, Family::Ecp5 { target_mhz: 150.0, seed: 1, modules: vec!["divider".into(), "core".into()] });
     assert_eq!(refused(&["synth", "--family", "ecp5", "--modules", "divider,alu"]), "--modules");
     assert_eq!(refused(&["synth", "--family", "ecp5", "--target-mhz", "0"]), "--target-mhz");
-    assert_eq!(refused(&["synth", "--family", "xc7"]), "--family");
+    assert_eq!(refused(&["synth", "--family", "xc4"]), "--family");
 }
 
 #[test]

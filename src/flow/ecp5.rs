@@ -239,7 +239,8 @@ fn ours(name: &str) -> String {
     if name.starts_with('$') {
         return String::new();
     }
-    let cut = ["_CCU2C", "_LUT4", "_TRELLIS", "_L6MUX", "_PFUMX", "_MULT18", "_DP16KD", "_ALU54", "$"]
+    // Mapping suffixes (upper case; the netlist's names are lower case), block-RAM pins included.
+    let cut = ["_CCU2C", "_LUT4", "_TRELLIS", "_L6MUX", "_PFUMX", "_MULT18", "_DP16KD", "_ALU54", "_DO", "_DI", "$"]
         .iter()
         .filter_map(|m| name.find(m))
         .min()
@@ -325,6 +326,8 @@ mod tests {
         assert_eq!(ours("u_dut.bits_lo_d10_CCU2C_B0_COUT$CCU2_FCI_INT"), "u_dut.bits_lo_d10");
         assert_eq!(ours("$nextpnr_CCU2C_67$CIN"), "");
         assert_eq!(ours("u_dut.rs_s1_b_d10[0]"), "u_dut.rs_s1_b_d10[0]");
+        assert_eq!(ours("u_dut.node_rom.0.8_DOA2[0]"), "u_dut.node_rom.0.8");
+        assert_eq!(ours("u_dut.stack.0.8_DI_2"), "u_dut.stack.0.8");
         assert!((t.critical_path.delay_ns - 6.7).abs() < 1e-9);
     }
 }

@@ -1,4 +1,5 @@
-//! `fxrt synth`: Virtex-5 area estimates from yosys `synth_xilinx -family xc5v`.
+//! `fxrt synth`: Xilinx area estimates from yosys `synth_xilinx` — Virtex-5 (`xc5v`, the
+//! thesis's device) and 7-series (`xc7`, e.g. an Artix-7 100T) as a second reference.
 
 use crate::error::{Error, Result};
 use crate::rtl::emit;
@@ -52,6 +53,11 @@ pub fn area_from_stat(module: &str, stat: &serde_json::Value) -> Area {
 
 /// Synthesises `m` for Virtex-5 in `dir` (kept for inspection) and returns its area.
 pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
+    synth_xilinx(m, "xc5v", dir)
+}
+
+/// Synthesises `m` with `synth_xilinx -family FAMILY` (xc5v or xc7) in `dir`.
+pub fn synth_xilinx(m: &Module, family: &str, dir: &Path) -> Result<Area> {
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     std::fs::create_dir_all(dir).map_err(io)?;
     let files = emit::design_files(m, "v");
@@ -61,7 +67,7 @@ pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
     let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| emit::is_source(f)).collect();
     // -flatten: one area figure for the whole hierarchy.
     let script = format!(
-        "read_verilog {}; synth_xilinx -family xc5v -flatten -top {}; tee -q -o stat.json stat -json",
+        "read_verilog {}; synth_xilinx -family {family} -flatten -top {}; tee -q -o stat.json stat -json",
         names.join(" "),
         m.name
     );
