@@ -547,20 +547,11 @@ impl Module {
     pub fn bit(&mut self, name: &str, a: Sig, i: u32) -> Sig {
         self.slice(name, a, i, 1)
     }
-    pub fn equals(&mut self, name: &str, a: Sig, b: Sig) -> Sig {
-        self.bin(name, BinOp::Eq, a, b)
-    }
     pub fn lt(&mut self, name: &str, a: Sig, b: Sig) -> Sig {
         self.bin(name, BinOp::Lt, a, b)
     }
-    pub fn le(&mut self, name: &str, a: Sig, b: Sig) -> Sig {
-        self.bin(name, BinOp::Le, a, b)
-    }
     pub fn and(&mut self, name: &str, a: Sig, b: Sig) -> Sig {
         self.bin(name, BinOp::And, a, b)
-    }
-    pub fn or(&mut self, name: &str, a: Sig, b: Sig) -> Sig {
-        self.bin(name, BinOp::Or, a, b)
     }
     pub fn not(&mut self, name: &str, a: Sig) -> Sig {
         self.un(name, UnOp::Not, a)
@@ -568,6 +559,6 @@ impl Module {
     /// `a` equal to the constant `v` (of `a`'s type).
     pub fn eq_k(&mut self, name: &str, a: Sig, v: i128) -> Sig {
         let k = self.konst(&format!("{name}_k"), a.ty, v);
-        self.equals(name, a, k)
+        self.bin(name, BinOp::Eq, a, k)
     }
 }

@@ -64,7 +64,7 @@ impl Gen<'_> {
             2 => 1u128 << (t.width - 1),
             _ => bits,
         };
-        self.m.konst("k", t, value_of(t, bits))
+        self.m.konst("k", t, t.value(bits))
     }
 
     fn node(&mut self) -> Sig {
@@ -147,12 +147,6 @@ impl Gen<'_> {
     }
 }
 
-/// The integer of a bit pattern (for an unsigned 128-bit type with the top bit set, the i128
-/// with that pattern, which `Ty::accepts`).
-fn value_of(t: Ty, bits: u128) -> i128 {
-    t.value(bits)
-}
-
 /// A random module of the given shape, the same for the same seed.
 pub fn random_module(seed: u64, shape: Shape) -> Module {
     random_named("agree", seed, shape, true)
@@ -172,7 +166,7 @@ fn random_named(name: &str, seed: u64, shape: Shape, nested: bool) -> Module {
     let mut regs = Vec::new();
     for _ in 0..1 + g.r.below(3) {
         let t = g.ty();
-        let reset = if g.r.below(2) == 0 { Some(value_of(t, g.r.next_u64() as u128 & t.mask())) } else { None };
+        let reset = if g.r.below(2) == 0 { Some(t.value(g.r.next_u64() as u128 & t.mask())) } else { None };
         let r = g.m.reg("state", t, reset);
         regs.push(r);
         g.pool.push(r);
@@ -272,7 +266,7 @@ pub fn random_inputs(m: &Module, seed: u64, cycles: usize) -> Vec<Vec<i128>> {
                         2 => 1u128 << (t.width - 1),
                         _ => ((r.next_u64() as u128) << 64 | r.next_u64() as u128) & t.mask(),
                     };
-                    value_of(t, bits)
+                    t.value(bits)
                 })
                 .collect()
         })
