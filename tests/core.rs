@@ -24,7 +24,7 @@ fn rust_frame(name: &str, size: u32) {
     let s = scene(name);
     let roms = SceneRoms::of(&s);
     let cam = Camera::default_for(&s, size, size);
-    let p = CoreParams::new(&roms, 16, 1);
+    let p = CoreParams::new(&roms, 16, 1, fxrt::cores::clock::DEFAULT_TARGET_MHZ);
     let rays = frame_rays(&s, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
     assert_eq!(mismatches(&s, &rays, &results), 0, "{name}");
@@ -72,7 +72,7 @@ fn hdl_frame(sim: Simulator, size: u32) -> Option<(Scene, Vec<i32>)> {
     let s = scene("teapot");
     let roms = SceneRoms::of(&s);
     let cam = Camera::default_for(&s, size, size);
-    let p = CoreParams::new(&roms, 16, 1);
+    let p = CoreParams::new(&roms, 16, 1, fxrt::cores::clock::DEFAULT_TARGET_MHZ);
     let rays = frame_rays(&s, &cam);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("frame_{}", sim.name()));
     let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &dir).unwrap_or_else(|e| panic!("{e}"));

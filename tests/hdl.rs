@@ -17,7 +17,7 @@ fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::flow::vect
 
 fn setup_bits(params: Params, div_bits: u32, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 20, div_bits };
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 20, div_bits, target_mhz: fxrt::cores::clock::DEFAULT_TARGET_MHZ };
     p.check().unwrap();
     let v = generate(&scene, count, 7);
     let hits = v.iter().filter(|x| x.expected.is_some()).count();
@@ -160,7 +160,7 @@ fn whole_core_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
     use fxrt::scene::images::SceneRoms;
     let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &SMALL).unwrap();
     let roms = SceneRoms::of(&scene);
-    let p = CoreParams::new(&roms, 12, 1);
+    let p = CoreParams::new(&roms, 12, 1, fxrt::cores::clock::DEFAULT_TARGET_MHZ);
     let mut cam = fxrt::model::camera::Camera::default_for(&scene, 32, 24);
     cam.eye = [278.0, 273.0, 60.0];
     let generator = fxrt::model::raygen::RayGen::new(&scene, &cam).unwrap();

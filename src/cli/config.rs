@@ -195,7 +195,7 @@ pub struct GenConfig {
     pub vhdl: bool,
     pub verilog: bool,
     pub ise: bool,
-    pub clock_mhz: f64,
+    pub target_mhz: u32,
     pub ray_id_width: u32,
     pub bram_kbits: u64,
     pub div_bits: u32,
@@ -217,16 +217,14 @@ impl GenArgs {
         if !(1..=64).contains(&self.ray_id_width) {
             return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", self.ray_id_width)));
         }
-        if !(self.clock_mhz > 0.0 && self.clock_mhz <= 1000.0) {
-            return Err(Error::param("clock-mhz", format!("{} is out of range: must be in (0, 1000]", self.clock_mhz)));
-        }
+        crate::cores::clock::ClockTarget(self.target_mhz).check()?;
         Ok(GenConfig {
             scene,
             out: self.out.clone(),
             vhdl: self.lang.contains(&Lang::Vhdl),
             verilog: self.lang.contains(&Lang::Verilog),
             ise: self.ise,
-            clock_mhz: self.clock_mhz,
+            target_mhz: self.target_mhz,
             ray_id_width: self.ray_id_width,
             bram_kbits: self.bram_kbits,
             div_bits: self.div_bits,
@@ -301,19 +299,14 @@ impl SynthArgs {
             "xc5v" => Family::Xc5v,
             "xc7" => Family::Xc7,
             "ecp5" => {
-                if !(self.target_mhz.is_finite() && self.target_mhz > 0.0 && self.target_mhz <= 1000.0) {
-                    return Err(Error::param(
-                        "target-mhz",
-                        format!("{} is out of range: must be in (0, 1000]", self.target_mhz),
-                    ));
-                }
+                crate::cores::clock::ClockTarget(self.hw.target_mhz).check()?;
                 if let Some(bad) = self.modules.iter().find(|m| !ECP5_MODULES.contains(&m.as_str())) {
                     return Err(Error::param(
                         "modules",
                         format!("'{bad}' is not a module: use {}", ECP5_MODULES.join(", ")),
                     ));
                 }
-                Family::Ecp5 { target_mhz: self.target_mhz, seed: self.seed, modules: self.modules.clone() }
+                Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seed: self.seed, modules: self.modules.clone() }
             }
             other => {
                 return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));
@@ -338,6 +331,7 @@ pub struct SimConfig {
     /// Rays from the on-chip ray generator instead of the host (Rust simulator only).
     pub raygen: bool,
     pub div_bits: u32,
+    pub target_mhz: u32,
     pub png: Option<PathBuf>,
     pub ids: Option<PathBuf>,
     /// The HDL build folder (None for the Rust simulator).
@@ -374,6 +368,7 @@ impl SimArgs {
             sim,
             raygen: self.raygen,
             div_bits: self.div_bits,
+            target_mhz: self.target_mhz,
             png: self.png.clone(),
             ids: self.ids.clone(),
             build: sim.build_dir(&self.build, "target/fxrt-sim"),

@@ -172,6 +172,9 @@ pub struct SimArgs {
     /// Quotient bits per divider stage: 1 or 2.
     #[arg(long = "div-bits", default_value_t = 1)]
     pub div_bits: u32,
+    /// The clock the cores are pipelined for, MHz (50..=400): it sets their latencies.
+    #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
+    pub target_mhz: u32,
     /// Use the on-chip pinhole ray generator (camera inside the scene box) instead of host rays.
     #[arg(long)]
     pub raygen: bool,
@@ -203,9 +206,6 @@ pub struct SynthArgs {
     /// .venv: Fmax, critical path, resources).
     #[arg(long, default_value = "xc5v")]
     pub family: String,
-    /// ecp5: the clock constraint given to nextpnr, MHz.
-    #[arg(long = "target-mhz", default_value_t = 100.0)]
-    pub target_mhz: f64,
     /// ecp5: nextpnr's placement seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -240,9 +240,9 @@ pub struct GenArgs {
     /// Also write an ISE project script (xtclsh) and a UCF for the XC5VLX110T-1FF1136.
     #[arg(long)]
     pub ise: bool,
-    /// Clock constraint of the UCF, MHz.
-    #[arg(long = "clock-mhz", default_value_t = 100.0)]
-    pub clock_mhz: f64,
+    /// The clock the cores are pipelined for, MHz (50..=400); also the ISE UCF's constraint.
+    #[arg(long = "target-mhz", alias = "clock-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
+    pub target_mhz: u32,
     /// Width of the ray id port (rays in flight are numbered modulo 2^width).
     #[arg(long = "ray-id-width", default_value_t = 20)]
     pub ray_id_width: u32,
@@ -271,6 +271,10 @@ pub struct HwArgs {
     /// Quotient bits per divider stage: 1 (latency n + 2) or 2 (latency 1 + ⌈(n+1)/2⌉).
     #[arg(long = "div-bits", default_value_t = 1)]
     pub div_bits: u32,
+    /// The clock the cores are pipelined for, MHz (50..=400); `synth --family ecp5` also
+    /// constrains nextpnr to it.
+    #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
+    pub target_mhz: u32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -7,6 +7,7 @@ use super::config::{
     BenchConfig, CompareConfig, Family, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation,
     SweepConfig, SweepRun, SynthConfig, TestConfig,
 };
+use super::HwArgs;
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};
@@ -117,7 +118,8 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params)?;
     match *c {
         BenchConfig::Sim { vectors, ghdl_vectors } => {
-            let p = intersect_params(&params, &scene, 32, 1)?;
+            let hw = HwArgs { tag_width: 32, div_bits: 1, target_mhz: crate::cores::clock::DEFAULT_TARGET_MHZ };
+            let p = intersect_params(&params, &scene, &hw)?;
             let vectors = vectors::generate(&scene, vectors, 1);
             let speeds = check::bench_sims(&p, &vectors, ghdl_vectors, Path::new("target/fxrt-bench"))?;
             for s in &speeds {
@@ -193,8 +195,9 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
 }
 
 /// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
-fn intersect_params(params: &Params, scene: &Scene, tag_width: u32, div_bits: u32) -> Result<IntersectParams> {
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits };
+fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<IntersectParams> {
+    let (tag_width, div_bits, target_mhz) = (hw.tag_width, hw.div_bits, hw.target_mhz);
+    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits, target_mhz };
     p.check()?;
     Ok(p)
 }
@@ -223,10 +226,10 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
             ));
         }
     }
-    let p = crate::cores::top::CoreParams::new(&roms, c.ray_id_width, c.div_bits);
+    let p = crate::cores::top::CoreParams::new(&roms, c.ray_id_width, c.div_bits, c.target_mhz);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
-    let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, clock_mhz: c.clock_mhz };
+    let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, clock_mhz: c.target_mhz as f64 };
     let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref())
         .into_iter()
         .map(|(n, t)| (c.out.join(n), t.into_bytes()))
@@ -245,7 +248,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
 
 pub fn test(c: &TestConfig) -> Result<bool> {
     let scene = Scene::load(&c.scene, &c.params)?;
-    let p = intersect_params(&c.params, &scene, c.hw.tag_width, c.hw.div_bits)?;
+    let p = intersect_params(&c.params, &scene, &c.hw)?;
     let vectors = vectors::generate(&scene, c.vectors, c.seed);
     let hits = vectors.iter().filter(|v| v.expected.is_some()).count();
     let start = std::time::Instant::now();
@@ -269,9 +272,9 @@ pub fn test(c: &TestConfig) -> Result<bool> {
 
 pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let scene = Scene::load(&c.scene, &c.params)?;
-    let p = intersect_params(&c.params, &scene, c.hw.tag_width, c.hw.div_bits)?;
+    let p = intersect_params(&c.params, &scene, &c.hw)?;
     let roms = SceneRoms::of(&scene);
-    let core = crate::cores::top::CoreParams::new(&roms, 20, c.hw.div_bits);
+    let core = crate::cores::top::CoreParams::new(&roms, 20, c.hw.div_bits, c.hw.target_mhz);
     core.check()?;
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
@@ -317,7 +320,10 @@ fn synth_ecp5(
             "divider" => (p.divider(), Some(divider::latency(p.n, p.div_bits))),
             "intersect" => (intersect::intersect_core(p), Some(p.latency())),
             "traverse" => (traverse::traverse_core(&core.trav, roms), None),
-            "closest" => (closest::closest_core(core.tag, p.n, p.m), Some(1)),
+            "closest" => (
+                closest::closest_core(core.tag, p.n, p.m, p.target()),
+                Some(1 + closest::input_latency(p.target())),
+            ),
             _ => (top::core_module(core, roms), None),
         };
         eprintln!("ecp5: placing and routing {} (minutes for the larger modules)", m.name);
@@ -336,7 +342,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let (w, h) = (cam.width, cam.height);
     let id_width = rom::addr_bits((w * h) as usize);
     let roms = SceneRoms::of(&scene);
-    let p = crate::cores::top::CoreParams::new(&roms, id_width, c.div_bits);
+    let p = crate::cores::top::CoreParams::new(&roms, id_width, c.div_bits, c.target_mhz);
     p.check()?;
     let raygen = if c.raygen { Some(ray_generator(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {

@@ -7,6 +7,7 @@
 //! The pipeline tag: bits [0, tri_bits) the triangle number, then n + 2 bits of leaf entry
 //! distance, then the end flag on top; an end token carries the ray id in the low bits.
 
+use super::clock::ClockTarget;
 use crate::rtl::build::Builder;
 use crate::rtl::{Module, Ty};
 
@@ -26,10 +27,22 @@ impl TagLayout {
     }
 }
 
+/// Whether the closest-hit unit registers its input stream (and the acceptance test) before
+/// comparing with the best hit: from this clock target up (`ClockTarget::splits`).
+pub const STAGED_FROM_MHZ: u32 = 126;
+
+/// Cycles from a pipeline result to the unit's accumulator: 1 when staged for the target.
+pub fn input_latency(target: ClockTarget) -> u32 {
+    target.splits(STAGED_FROM_MHZ) as u32
+}
+
 /// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) → res_valid, res_id, res_hit,
-/// res_tri, res_t, res_u, res_v (t, u, v and tri read 0 for a miss).
-pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32) -> Module {
-    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}", tag.width()));
+/// res_tri, res_t, res_u, res_v (t, u, v and tri read 0 for a miss), `input_latency` + 1
+/// cycles after the end token.
+pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) -> Module {
+    let staged = input_latency(target) == 1;
+    let suffix = if staged { "_r1" } else { "" };
+    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}{suffix}", tag.width()));
     let valid = b.input("valid", Ty::BIT);
     let tag_in = b.input("tag", Ty::u(tag.width()));
     let hit = b.input("hit", Ty::BIT);
@@ -46,6 +59,11 @@ pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32) -> Module {
     let tmin_d = tmin.xsigned().resize(dist);
     let lower = ((tmin_d - (tmin_d >> 6)) - 8).name("lower_t");
     let accepted = (!t.xsigned().resize(dist).lt(lower)).name("accepted");
+    // Staged: the stream and the acceptance test registered, so the accumulator's compare
+    // starts from registers (a result arrives one cycle later; nothing else changes).
+    let reg = |name: &str, x| if staged { b.delay(&format!("in_{name}"), x) } else { x };
+    let (valid, end, hit, accepted) = (reg("valid", valid), reg("end", end), reg("hit", hit), reg("accepted", accepted));
+    let (tri, id, t, u, v) = (reg("tri", tri), reg("id", id), reg("t", t), reg("u", u), reg("v", v));
 
     // The best accepted hit of the ray in flight.
     let best_valid = b.reg("best_valid", Ty::BIT, Some(0));

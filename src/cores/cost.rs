@@ -58,7 +58,7 @@ pub struct CoreCost {
 
 /// The cost of the whole core built for `roms` (ray id width 20, one quotient bit per stage).
 pub fn core_cost(roms: &SceneRoms) -> crate::error::Result<CoreCost> {
-    let p = CoreParams::new(roms, 20, 1);
+    let p = CoreParams::new(roms, 20, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
     p.check()?;
     let core = core_module(&p, roms);
     let rom_bits = roms.rom_bits();

@@ -70,9 +70,12 @@ pub fn divider_core(n: u32, bits_per_stage: u32, num_width: u32, den_width: u32)
     for k in 0..qbits {
         let bw = pipe.now(ops.b).resize(wd + 1);
         let p3 = (part.p.resize(wd + 1) << 1) | pipe.now(lo).bit(qbits - 1 - k).resize(wd + 1);
-        let ge = bw.le(p3).name(&format!("ge{k}"));
+        // One subtraction: its sign is the comparison, so a stage is one carry chain and a
+        // select rather than a comparator and a subtractor side by side.
+        let diff = (p3.xsigned() - bw.xsigned()).name(&format!("diff{k}"));
+        let ge = (!diff.msb()).name(&format!("ge{k}"));
         // Named, so timing reports name the stage (`rem7`, `quot7`).
-        let p_next = ge.select(p3 - bw, p3).resize(wd).name(&format!("rem{k}"));
+        let p_next = ge.select(diff.slice(0, wd), p3.resize(wd)).name(&format!("rem{k}"));
         let q_next = ((part.q << 1) | ge.resize(qbits)).name(&format!("quot{k}"));
         if k + 1 < qbits {
             part = pipe.stage(&format!("q{k}"), "one quotient bit", Partial { p: p_next, q: q_next });

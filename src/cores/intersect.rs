@@ -3,7 +3,9 @@
 //! bit-identical to `Golden::intersect` for the same quantised inputs (docs/ARITHMETIC.md §4).
 //! When there is no hit, t, u and v read 0.
 
+use super::clock::ClockTarget;
 use super::divider::{self, divider_core};
+use super::mul::pipe_muls;
 use crate::rtl::build::{Builder, S};
 use crate::rtl::pipeline::{Pipeline, Policy};
 use crate::rtl::{Module, Ty};
@@ -21,6 +23,8 @@ pub struct IntersectParams {
     pub tag_width: u32,
     /// Quotient bits per divider stage: 1, or 2 for half the divider latency.
     pub div_bits: u32,
+    /// The clock the pipeline is built for, MHz (`clock::ClockTarget`).
+    pub target_mhz: u32,
 }
 
 impl IntersectParams {
@@ -36,7 +40,10 @@ impl IntersectParams {
     }
     pub fn name(&self) -> String {
         let r4 = if self.div_bits == 2 { "_r4" } else { "" };
-        format!("fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}", self.n, self.m, self.t, self.e, self.tag_width)
+        format!(
+            "fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}_c{}",
+            self.n, self.m, self.t, self.e, self.tag_width, self.target_mhz
+        )
     }
     /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
     /// parameter to change.
@@ -60,6 +67,7 @@ impl IntersectParams {
         if !(1..=2).contains(&self.div_bits) {
             return Err(Error::param("div-bits", format!("{} is out of range: must be 1 or 2", self.div_bits)));
         }
+        self.target().check()?;
         if self.tag_width == 0 || self.tag_width > 64 {
             return Err(Error::param("tag-width", format!("{} is out of range: must be 1..=64", self.tag_width)));
         }
@@ -71,9 +79,13 @@ impl IntersectParams {
         divider_core(self.n, self.div_bits, self.num_width() - self.t, self.den_width() - self.t)
     }
 
-    /// Input register, products, numerator/denominator, divider, t·ω, k, e·k, u/v and test.
+    pub fn target(&self) -> ClockTarget {
+        ClockTarget(self.target_mhz)
+    }
+
+    /// Clock cycles from an input to its result, counted from the stages the target keeps.
     pub fn latency(&self) -> u32 {
-        3 + divider::latency(self.n, self.div_bits) + 4
+        intersect_core_with(self, Policy::default()).1
     }
 }
 
@@ -121,6 +133,26 @@ crate::bundle! {
     struct Products { onp, onq, wnp, wnq, dmo, w_r, kp0, kq0 }
 }
 crate::bundle! {
+    /// The ray's components permuted by r.
+    struct Permuted { o_r, o_p, o_q, w_r, w_p, w_q }
+}
+crate::bundle! {
+    /// The numerator's first subtraction and the ω sum.
+    struct Partial { num1, onq, wsum, w_r }
+}
+crate::bundle! {
+    /// The numerator and the rounded ω sum.
+    struct Rounded { num, wr }
+}
+crate::bundle! {
+    /// The barycentric coordinates.
+    struct Uv { u, v }
+}
+crate::bundle! {
+    /// The parts of the inside test.
+    struct Test { over, neg }
+}
+crate::bundle! {
     /// The divider's operands, T low bits dropped.
     struct Quotient { num, den }
 }
@@ -142,20 +174,38 @@ crate::bundle! {
 }
 
 pub fn intersect_core(p: &IntersectParams) -> Module {
-    let (m, latency) = intersect_core_with(p, Policy::default());
-    assert_eq!(latency, p.latency(), "latency formula and stages disagree");
-    m
+    intersect_core_with(p, Policy::default()).0
 }
 
-/// The pipeline with the stages `policy` merges left unregistered (the same results, less
-/// latency), and its latency counted from the stages.
-pub fn intersect_core_with(p: &IntersectParams, policy: Policy) -> (Module, u32) {
+/// Stages that only split a chain of logic, with the lowest target that registers them
+/// (`ClockTarget::splits`); below it they are merged into the next stage.
+const SPLIT_STAGES: [(&str, u32); 6] =
+    [("permute", 151), ("numerator", 126), ("rounded", 126), ("uv", 126), ("test", 176), ("quotient_in", 176)];
+
+/// The stages `p`'s clock target leaves unregistered.
+fn target_policy(p: &IntersectParams) -> Vec<String> {
+    let tgt = p.target();
+    let mut merge: Vec<String> =
+        SPLIT_STAGES.iter().filter(|(_, from)| !tgt.splits(*from)).map(|(s, _)| s.to_string()).collect();
+    // Split products end in registers of their own: the stage after them would only repeat them.
+    if tgt.mul_style() != super::mul::MulStyle::COMBINATIONAL {
+        merge.extend(["products", "moved", "bary"].map(String::from));
+    }
+    merge
+}
+
+/// The pipeline with the stages `extra` merges left unregistered besides those the clock
+/// target merges (the same results, less latency), and its latency counted from the stages.
+pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) {
     let (n, mm, f) = (p.n, p.m, p.f());
     // Merged stages make another module: its name says which.
-    let merged: String = policy.merge.iter().map(|s| format!("_m{s}")).collect();
+    let merged: String = extra.merge.iter().map(|s| format!("_m{s}")).collect();
     let b = Builder::new(&format!("{}{merged}", p.name()));
     let ins: Vec<S> = input_ports(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
-    let pipe = Pipeline::new(&b, policy);
+    let mut merge = target_policy(p);
+    merge.extend(extra.merge);
+    let pipe = Pipeline::new(&b, Policy { merge });
+    let style = p.target().mul_style();
     let [valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = ins[..] else {
         unreachable!("input_ports has 18 ports")
     };
@@ -168,72 +218,107 @@ pub fn intersect_core_with(p: &IntersectParams, policy: Policy) -> (Module, u32)
     let sel_p = next_axis(x.r).name("perm_p");
     let sel_q = next_axis(sel_p).name("perm_q");
     let (o, w) = ([x.ox, x.oy, x.oz], [x.wx, x.wy, x.wz]);
-    let o_r = b.pick(x.r, o).name("o_r");
-    let o_p = b.pick(sel_p, o).name("o_p");
-    let o_q = b.pick(sel_q, o).name("o_q");
-    let w_r = b.pick(x.r, w).name("w_r");
-    let w_p = b.pick(sel_p, w).name("w_p");
-    let w_q = b.pick(sel_q, w).name("w_q");
+    let pm = pipe.stage(
+        "permute",
+        "the ray permuted by r, so the products' operands come from registers",
+        Permuted {
+            o_r: b.pick(x.r, o).name("o_r"),
+            o_p: b.pick(sel_p, o).name("o_p"),
+            o_q: b.pick(sel_q, o).name("o_q"),
+            w_r: b.pick(x.r, w).name("w_r"),
+            w_p: b.pick(sel_p, w).name("w_p"),
+            w_q: b.pick(sel_q, w).name("w_q"),
+        },
+    );
     // Origin components as signed n+1 bits, so they multiply with signed normals.
-    let (o_p_s, o_q_s) = (o_p.xsigned(), o_q.xsigned());
+    let (o_p_s, o_q_s) = (pm.o_p.xsigned(), pm.o_q.xsigned());
+    let (dmo, kp0, kq0) = (
+        (pipe.now(x.d).resize(n + 4) - pm.o_r.xsigned().resize(n + 4)).name("dmo"),
+        (o_p_s - pipe.now(x.pp).xsigned()).name("kp0"),
+        (o_q_s - pipe.now(x.pq).xsigned()).name("kq0"),
+    );
+    let [onp, onq, wnp, wnq] = pipe_muls(
+        &pipe,
+        "u_plane_products",
+        &[(o_p_s, pipe.now(x.np)), (o_q_s, pipe.now(x.nq)), (pm.w_p, pipe.now(x.np)), (pm.w_q, pipe.now(x.nq))],
+        style,
+    )[..] else {
+        unreachable!("four products")
+    };
     let prod = pipe.stage(
         "products",
         "O_p·np, O_q·nq, ω_p·np, ω_q·nq; d − O_r; O_p − pp, O_q − pq",
-        Products {
-            onp: o_p_s.xmul(x.np),
-            onq: o_q_s.xmul(x.nq),
-            wnp: w_p.xmul(x.np),
-            wnq: w_q.xmul(x.nq),
-            dmo: x.d.resize(n + 4) - o_r.xsigned().resize(n + 4),
-            w_r,
-            kp0: o_p_s - x.pp.xsigned(),
-            kq0: o_q_s - x.pq.xsigned(),
+        Products { onp, onq, wnp, wnq, dmo, w_r: pm.w_r, kp0, kq0 },
+    );
+    // num = ((d − O_r) << F) − O_p·np − O_q·nq, den = ω_r + rnd(ω_p·np + ω_q·nq, F): one
+    // subtraction and the ω sum first, so no stage has two carry chains in series.
+    let (wn, wd) = (p.num_width(), p.den_width());
+    let part = pipe.stage(
+        "numerator",
+        "(d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq",
+        Partial {
+            num1: ((prod.dmo.resize(wn) << f) - prod.onp.resize(wn)).name("num1"),
+            onq: prod.onq,
+            wsum: (prod.wnp.resize(2 * mm + 1) + prod.wnq.resize(2 * mm + 1)).name("wsum"),
+            w_r: prod.w_r,
         },
     );
-    // num = ((d − O_r) << F) − O_p·np − O_q·nq, den = ω_r + rnd(ω_p·np + ω_q·nq, F).
-    let (wn, wd) = (p.num_width(), p.den_width());
-    let num = ((prod.dmo.resize(wn) << f) - prod.onp.resize(wn) - prod.onq.resize(wn)).name("num");
-    let wsum = prod.wnp.resize(2 * mm + 1) + prod.wnq.resize(2 * mm + 1);
-    let den = (prod.w_r.resize(wd) + shr_round(wsum, f).resize(wd)).name("den");
+    let num = (part.num1 - part.onq.resize(wn)).name("num");
+    let rounded = pipe.stage("quotient_in", "the ω sum rounded", Rounded { num, wr: shr_round(part.wsum, f) });
+    let den = (pipe.now(part.w_r).resize(wd) + rounded.wr.resize(wd)).name("den");
     // Division precision T: drop the T low bits of both (wiring only).
     let q = pipe.stage(
         "quotient",
         "numerator and rounded denominator, T bits dropped",
-        Quotient { num: (num >> p.t).resize(wn - p.t), den: (den >> p.t).resize(wd - p.t) },
+        Quotient { num: (rounded.num >> p.t).resize(wn - p.t), den: (den >> p.t).resize(wd - p.t) },
     );
     let div = pipe.instance("u_div", &Rc::new(p.divider()), &[q.num, q.den], divider::latency(n, p.div_bits));
     let (t, ok) = (div.get("t"), div.get("ok"));
     // t·ω_p, t·ω_q (t as signed n+2 bits).
     let t_s = t.xsigned();
-    let mv = pipe.stage("moved", "t·ω_p, t·ω_q", Moved { tp: t_s.xmul(pipe.now(w_p)), tq: t_s.xmul(pipe.now(w_q)) });
+    let [tp, tq] = pipe_muls(&pipe, "u_moved_products", &[(t_s, pm.w_p), (t_s, pm.w_q)], style)[..] else {
+        unreachable!("two products")
+    };
+    let mv = pipe.stage("moved", "t·ω_p, t·ω_q", Moved { tp, tq });
+    let rd = pipe.stage("rounded", "rnd(t·ω_p, F), rnd(t·ω_q, F)", Moved { tp: shr_round(mv.tp, f), tq: shr_round(mv.tq, f) });
     // kp = (O_p − pp) + rnd(t·ω_p, F), kq likewise (n+3 bits).
     let kw = n + 3;
     let pt = pipe.stage(
         "point",
         "kp, kq: the hit point relative to the first vertex",
         Point {
-            kp: pipe.now(prod.kp0).resize(kw) + shr_round(mv.tp, f).resize(kw),
-            kq: pipe.now(prod.kq0).resize(kw) + shr_round(mv.tq, f).resize(kw),
+            kp: pipe.now(prod.kp0).resize(kw) + rd.tp.resize(kw),
+            kq: pipe.now(prod.kq0).resize(kw) + rd.tq.resize(kw),
         },
     );
-    let bary = pipe.stage(
-        "bary",
-        "e1p·kq, e1q·kp, e2q·kp, e2p·kq",
-        Bary {
-            a1: pipe.now(x.e1p).xmul(pt.kq),
-            a2: pipe.now(x.e1q).xmul(pt.kp),
-            b1: pipe.now(x.e2q).xmul(pt.kp),
-            b2: pipe.now(x.e2p).xmul(pt.kq),
-        },
-    );
+    let [a1, a2, b1, b2] = pipe_muls(
+        &pipe,
+        "u_bary_products",
+        &[(pipe.now(x.e1p), pt.kq), (pipe.now(x.e1q), pt.kp), (pipe.now(x.e2q), pt.kp), (pipe.now(x.e2p), pt.kq)],
+        style,
+    )[..] else {
+        unreachable!("four products")
+    };
+    let bary = pipe.stage("bary", "e1p·kq, e1q·kp, e2q·kp, e2p·kq", Bary { a1, a2, b1, b2 });
     // u, v, the hit test, outputs zeroed on a miss.
     let uw = (mm + kw + 1).max(p.e + f + 2);
-    let u = (bary.a1.resize(uw) - bary.a2.resize(uw)).name("u");
-    let v = (bary.b1.resize(uw) - bary.b2.resize(uw)).name("v");
-    let over = u.k(1i128 << (p.e + f)).lt(u + v);
-    let inside = !(u.lt(0) | v.lt(0) | over);
+    let uv = pipe.stage(
+        "uv",
+        "the barycentric coordinates u, v",
+        Uv { u: (bary.a1.resize(uw) - bary.a2.resize(uw)).name("u"), v: (bary.b1.resize(uw) - bary.b2.resize(uw)).name("v") },
+    );
+    let tested = pipe.stage(
+        "test",
+        "u + v against its limit; the signs",
+        Test {
+            over: uv.u.k(1i128 << (p.e + f)).lt(uv.u + uv.v).name("over"),
+            neg: (uv.u.lt(0) | uv.v.lt(0)).name("negative"),
+        },
+    );
+    let inside = !(tested.neg | tested.over);
     let hit = (inside & pipe.now(ok)).name("hit_c");
     let t_now = pipe.now(t);
+    let (u, v) = (pipe.now(uv.u), pipe.now(uv.v));
     let res = pipe.stage(
         "result",
         "the barycentric test; t, u, v zeroed on a miss",
@@ -296,14 +381,14 @@ mod tests {
 
     /// Random rays against random triangles of a built-in scene, through the Rust simulation
     /// of the pipeline, against the golden model.
-    fn check(params: Params, div_bits: u32, count: usize) -> usize {
-        check_with(params, div_bits, count, Policy::default())
+    fn check(params: Params, div_bits: u32, target_mhz: u32, count: usize) -> usize {
+        check_with(params, div_bits, target_mhz, count, Policy::default())
     }
 
-    fn check_with(params: Params, div_bits: u32, count: usize, policy: Policy) -> usize {
+    fn check_with(params: Params, div_bits: u32, target_mhz: u32, count: usize, policy: Policy) -> usize {
         let scene = Scene::load(&crate::scene::SceneSource::Builtin("random".into()), &params).unwrap();
         let g = Golden::new(&scene);
-        let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 24, div_bits };
+        let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 24, div_bits, target_mhz };
         let (module, lat) = intersect_core_with(&p, policy);
         let mut sim = Sim::new(&module);
         let ins: Vec<_> = module.inputs.iter().map(|&i| module.handle(i)).collect();
@@ -364,8 +449,8 @@ mod tests {
             Params { n: 23, m: 27, t: 5, ..Params::default() },
             Params { n: 32, m: 40, ..Params::default() },
         ] {
-            let hits = check(params, 1, 3000);
-            assert_eq!(hits, check(params, 2, 3000));
+            let hits = check(params, 1, 150, 3000);
+            assert_eq!(hits, check(params, 2, 150, 3000));
             assert!(hits > 1000 && hits < 2900, "{hits} hits of 3000 with {params:?}: both outcomes must be exercised");
         }
     }
@@ -375,14 +460,30 @@ mod tests {
     #[test]
     fn merged_stages_keep_every_result() {
         let merge = Policy { merge: vec!["moved".into(), "bary".into()] };
-        let p = IntersectParams { n: 29, m: 32, t: 0, e: 18, tag_width: 24, div_bits: 1 };
+        let p = IntersectParams { n: 29, m: 32, t: 0, e: 18, tag_width: 24, div_bits: 1, target_mhz: 75 };
         assert_eq!(intersect_core_with(&p, merge.clone()).1, p.latency() - 2);
-        assert_eq!(check_with(Params::default(), 1, 2000, merge), check(Params::default(), 1, 2000));
+        assert_eq!(check_with(Params::default(), 1, 75, 2000, merge), check(Params::default(), 1, 75, 2000));
+    }
+
+    /// Every clock target builds the same arithmetic: only the latency moves, and a higher
+    /// target never has less of it.
+    #[test]
+    fn every_clock_target_gives_the_same_results() {
+        let params = Params { n: 20, m: 24, t: 2, ..Params::default() };
+        let want = check(params, 1, 75, 1500);
+        let mut last = 0;
+        for mhz in [75, 100, 150, 200, 250] {
+            assert_eq!(check(params, 1, mhz, 1500), want, "{mhz} MHz");
+            let p = IntersectParams { n: 20, m: 24, t: 2, e: 10, tag_width: 8, div_bits: 1, target_mhz: mhz };
+            assert!(p.latency() >= last, "{mhz} MHz: latency {} after {last}", p.latency());
+            last = p.latency();
+        }
     }
 
     #[test]
     fn latency_at_the_thesis_setting_is_within_41() {
-        let p = IntersectParams { n: 29, m: 32, t: 0, e: 10, tag_width: 8, div_bits: 1 };
+        // One-clock products, as the thesis's pipeline has them.
+        let p = IntersectParams { n: 29, m: 32, t: 0, e: 10, tag_width: 8, div_bits: 1, target_mhz: 75 };
         assert!(p.latency() <= 41, "{}", p.latency());
     }
 }

@@ -178,7 +178,7 @@ mod tests {
         let g = Golden::new(&scene);
         let rg = RayGen::new(&scene, &cam).unwrap();
         let roms = SceneRoms::of(&scene);
-        let p = CoreParams::new(&roms, 8, 1);
+        let p = CoreParams::new(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
         let rays: Vec<PixelRay> = (0..cam.width * cam.height)
             .map(|i| PixelRay { pixel: i, ray: rg.ray(&g, i % cam.width, i / cam.width) })
             .collect();

@@ -32,11 +32,11 @@ pub struct CoreParams {
 }
 
 impl CoreParams {
-    pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32) -> CoreParams {
+    pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32, target_mhz: u32) -> CoreParams {
         let trav = TraverseParams::new(scene, id_width);
         let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
         let p = &scene.params;
-        let isect = IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits };
+        let isect = IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits, target_mhz };
         CoreParams { isect, trav, tag }
     }
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
@@ -76,9 +76,9 @@ impl CoreParams {
     }
 
     /// Cycles from a leaf entry leaving the traversal FSM to its result in the closest-hit
-    /// unit: leaf ROM, triangle ROM, the pipeline.
+    /// unit's accumulator: leaf ROM, triangle ROM, the pipeline, the unit's input stage.
     pub fn stream_latency(&self) -> u32 {
-        2 + self.isect.latency()
+        2 + self.isect.latency() + super::closest::input_latency(self.isect.target())
     }
 }
 
@@ -151,7 +151,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     pipe_in.extend(w);
     pipe_in.extend(tri_fields);
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
-    let closest = Rc::new(closest_core(p.tag, p.isect.n, p.isect.m));
+    let closest = Rc::new(closest_core(p.tag, p.isect.n, p.isect.m, p.isect.target()));
     let res = b.instance("u_closest", &closest, r.all());
     b.output("ray_ready", ready);
     for (name, _) in &closest.outputs {
@@ -195,7 +195,7 @@ mod tests {
     fn a_small_frame_matches_the_golden_model() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
         let roms = SceneRoms::of(&scene);
-        let p = CoreParams::new(&roms, 16, 1);
+        let p = CoreParams::new(&roms, 16, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
         let (results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
         assert_eq!(mismatches(&scene, &rays, &results), 0);

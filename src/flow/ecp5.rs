@@ -103,11 +103,29 @@ pub struct CriticalPath {
     pub delay_ns: f64,
 }
 
-/// The wrapper around `m`: `din` → shift register → `m`'s inputs; `m`'s outputs → XOR → `dout`.
+/// Registers between the `din` pin and the shift register, and after the output register
+/// before `dout`: the pad sits wherever the placer puts it, and a route across the die from
+/// a pad to the design would otherwise be timed as the design's critical path.
+pub const PIN_REGS: (u32, u32) = (3, 2);
+
+/// Register levels and registers of the wrapper's XOR tree over `bits` output bits (four
+/// per level).
+pub fn xor_tree(bits: u32) -> (u32, u32) {
+    let (mut n, mut levels, mut regs) = (bits.max(1), 0, 0);
+    while n > 1 {
+        n = n.div_ceil(4);
+        levels += 1;
+        regs += n;
+    }
+    (levels, regs)
+}
+
+/// The wrapper around `m`: `din` → pin registers → shift register → `m`'s inputs; `m`'s
+/// outputs → XOR tree (a register per level) → register → pin registers → `dout`.
 pub fn wrapper(m: &Rc<Module>) -> Module {
     let b = Builder::new(&format!("{}_ecp5_wrap", m.name));
     let din = b.input("din", Ty::BIT);
-    let mut prev = din;
+    let mut prev = b.delay_line("din_pipe", din, PIN_REGS.0);
     let mut ins: Vec<S> = Vec::new();
     for (k, &i) in m.inputs.iter().enumerate() {
         let ty = m.sig(i).ty;
@@ -118,16 +136,27 @@ pub fn wrapper(m: &Rc<Module>) -> Module {
         ins.push(if ty.signed { r.signed() } else { r });
     }
     let ports = b.instance("u_dut", m, &ins);
-    let mut parity: Option<S> = None;
-    for &out in ports.all() {
-        for bit in 0..out.width() {
-            let x = out.bit(bit);
-            parity = Some(parity.map_or(x, |p| p ^ x));
-        }
+    // Every output bit, reduced four at a time with a register after each level: a
+    // one-clock XOR of a hundred bits would be the critical path of a fast module.
+    let mut bits: Vec<S> = ports.all().iter().flat_map(|&o| (0..o.width()).map(move |k| o.bit(k))).collect();
+    if bits.is_empty() {
+        bits.push(din);
     }
-    let parity = parity.unwrap_or(din);
+    let mut level = 0;
+    while bits.len() > 1 {
+        bits = bits
+            .chunks(4)
+            .enumerate()
+            .map(|(i, c)| {
+                let x = c[1..].iter().fold(c[0], |acc, &y| acc ^ y);
+                b.delay(&format!("xor{level}_{i}"), x)
+            })
+            .collect();
+        level += 1;
+    }
+    let parity = bits[0];
     let dout = b.delay("dout_r", parity);
-    b.output("dout", dout);
+    b.output("dout", b.delay_line("dout_pipe", dout, PIN_REGS.1));
     b.finish()
 }
 
@@ -144,13 +173,28 @@ pub fn place_and_route(
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     std::fs::create_dir_all(dir).map_err(io)?;
     let top = wrapper(&Rc::new(m.clone()));
-    let wrapper_ff: u64 = m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1;
+    let pins = (PIN_REGS.0 + PIN_REGS.1) as u64;
+    let out_bits: u32 = m.outputs.iter().map(|o| m.sig(o.1).ty.width).sum();
+    let wrapper_ff: u64 =
+        m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
     let files = emit::design_files(&top, "v");
     for (file, text) in &files {
+        // Split multipliers' pieces become DSP blocks with their registers inside.
+        let text = super::ecp5_dsp::dsp_regs_of(file)
+            .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
+            .unwrap_or_else(|| text.clone());
         std::fs::write(dir.join(file), text).map_err(io)?;
     }
     let sources: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| emit::is_source(f)).collect();
-    let script = format!("read_verilog {}; synth_ecp5 -top {} -json design.json", sources.join(" "), top.name);
+    // Flattened and read back as RTLIL before synthesis: a MULT18X18D with parameters inside a
+    // sub-module otherwise makes yosys re-derive the flattened top from its Verilog, which
+    // then misses the sub-module it no longer holds.
+    let script = format!(
+        "read_verilog {}; hierarchy -top {top}; proc; flatten; write_rtlil flat.il; design -reset; \
+         read_rtlil flat.il; synth_ecp5 -top {top} -json design.json",
+        sources.join(" "),
+        top = top.name
+    );
     run(&tools.yosys, &["-q", "-l", "yosys.log", "-p", &script], dir, "yosys.log")?;
     let (freq, seed_s) = (format!("{target_mhz}"), seed.to_string());
     let args = [
@@ -293,15 +337,21 @@ mod tests {
         let (din, dout) = (w.handle(w.inputs[0]), w.handle(w.outputs[0].1));
         let (mut in0, mut in1, mut o_r) = (0u32, 0u32, 0u32);
         let mut rng = crate::rng::SplitMix64(7);
+        let out_delay = (PIN_REGS.1 + xor_tree(4).0) as usize;
+        let (mut pin_in, mut pin_out) = (vec![0u32; PIN_REGS.0 as usize], vec![0u32; out_delay]);
         for cycle in 0..200 {
             let bit = (rng.next_u64() & 1) as u32;
             sim.set(din, bit as i128);
             sim.tick();
-            // The model: every register loads from the values before the edge.
+            // The model: every register loads from the values before the edge; the pin
+            // registers are plain delays.
+            pin_in.push(bit);
+            let shifted_in = pin_in.remove(0);
             let x = if in0 & 4 != 0 { in0 as i32 - 8 } else { in0 as i32 };
-            let want = o_r.count_ones() & 1;
+            pin_out.push(o_r.count_ones() & 1);
+            let want = pin_out.remove(0);
             let next_o = ((x + in1 as i32) & 15) as u32;
-            (in1, in0, o_r) = (((in1 << 1) | (in0 >> 2)) & 3, ((in0 << 1) | bit) & 7, next_o);
+            (in1, in0, o_r) = (((in1 << 1) | (in0 >> 2)) & 3, ((in0 << 1) | shifted_in) & 7, next_o);
             assert_eq!(sim.get(dout), want as i128, "cycle {cycle}");
         }
     }

@@ -363,7 +363,7 @@ mod tests {
         let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() })
             .unwrap();
         let roms = SceneRoms::of(&scene);
-        let p = CoreParams::new(&roms, 8, 1);
+        let p = CoreParams::new(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 6));
         let m = frame_harness(&p, &roms, &rays);
         let outs: Vec<_> = m.outputs.iter().map(|(_, i)| m.handle(*i)).collect();

@@ -102,7 +102,7 @@ fn write_set(cores: &[(Module, Option<u32>, Value)], o: GenOptions, scene: &str)
 
 /// The pipeline cores alone (intersection pipeline and divider).
 pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, String)> {
-    write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, clock_mhz: 100.0 }, "")
+    write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, clock_mhz: p.target_mhz as f64 }, "")
 }
 
 /// The whole ray tracing core for a scene (fed by the on-chip ray generator when `raygen` is
@@ -116,7 +116,7 @@ pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions, raygen: Optio
         "scene": roms.name,
         "triangles": roms.tri_count(),
         "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "c": p.trav.c, "e": p.isect.e,
-        "stack_depth": p.trav.stack_depth, "ray_id_width": p.trav.id_width, "div_bits": p.isect.div_bits,
+        "stack_depth": p.trav.stack_depth, "ray_id_width": p.trav.id_width, "div_bits": p.isect.div_bits, "target_mhz": p.isect.target_mhz,
         "intersection_latency_cycles": p.isect.latency(),
         "leaf_entry_to_result_cycles": p.stream_latency() + 1,
     });

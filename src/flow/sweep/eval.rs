@@ -226,7 +226,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     }
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
-    let core_params = CoreParams::new(&roms, id_width, 1);
+    let core_params = CoreParams::new(&roms, id_width, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
         let (results, stats) = simulate_rust(&core_params, &roms, &rays, &|_| {});
