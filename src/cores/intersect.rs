@@ -150,7 +150,7 @@ crate::bundle! {
 }
 crate::bundle! {
     /// The parts of the inside test.
-    struct Test { over, neg }
+    struct Test { sum, neg }
 }
 crate::bundle! {
     /// The divider's operands, T low bits dropped.
@@ -180,7 +180,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
 /// Stages that only split a chain of logic, with the lowest target that registers them
 /// (`ClockTarget::splits`); below it they are merged into the next stage.
 const SPLIT_STAGES: [(&str, u32); 6] =
-    [("permute", 151), ("numerator", 126), ("rounded", 126), ("uv", 126), ("test", 176), ("quotient_in", 176)];
+    [("permute", 151), ("numerator", 126), ("quotient_in", 126), ("rounded", 126), ("uv", 126), ("test", 126)];
 
 /// The stages `p`'s clock target leaves unregistered.
 fn target_policy(p: &IntersectParams) -> Vec<String> {
@@ -307,15 +307,17 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
         "the barycentric coordinates u, v",
         Uv { u: (bary.a1.resize(uw) - bary.a2.resize(uw)).name("u"), v: (bary.b1.resize(uw) - bary.b2.resize(uw)).name("v") },
     );
+    // u + v, one bit wider so it cannot wrap; its comparison with the limit in the next stage.
     let tested = pipe.stage(
         "test",
-        "u + v against its limit; the signs",
+        "u + v; the signs",
         Test {
-            over: uv.u.k(1i128 << (p.e + f)).lt(uv.u + uv.v).name("over"),
+            sum: (uv.u.resize(uw + 1) + uv.v.resize(uw + 1)).name("uv_sum"),
             neg: (uv.u.lt(0) | uv.v.lt(0)).name("negative"),
         },
     );
-    let inside = !(tested.neg | tested.over);
+    let over = tested.sum.k(1i128 << (p.e + f)).lt(tested.sum).name("over");
+    let inside = !(tested.neg | over);
     let hit = (inside & pipe.now(ok)).name("hit_c");
     let t_now = pipe.now(t);
     let (u, v) = (pipe.now(uv.u), pipe.now(uv.v));
