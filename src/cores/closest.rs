@@ -31,17 +31,17 @@ impl TagLayout {
 /// comparing with the best hit: from this clock target up (`ClockTarget::splits`).
 pub const STAGED_FROM_MHZ: u32 = 126;
 
-/// Cycles from a pipeline result to the unit's accumulator: 1 when staged for the target.
+/// Cycles from a pipeline result to the unit's accumulator: 2 when staged for the target.
 pub fn input_latency(target: ClockTarget) -> u32 {
-    target.splits(STAGED_FROM_MHZ) as u32
+    2 * target.splits(STAGED_FROM_MHZ) as u32
 }
 
 /// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) → res_valid, res_id, res_hit,
 /// res_tri, res_t, res_u, res_v (t, u, v and tri read 0 for a miss), `input_latency` + 1
 /// cycles after the end token.
 pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) -> Module {
-    let staged = input_latency(target) == 1;
-    let suffix = if staged { "_r1" } else { "" };
+    let staged = input_latency(target) > 0;
+    let suffix = if staged { "_r2" } else { "" };
     let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}{suffix}", tag.width()));
     let valid = b.input("valid", Ty::BIT);
     let tag_in = b.input("tag", Ty::u(tag.width()));
@@ -54,16 +54,21 @@ pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) ->
     let tmin = tag_in.slice(tag.tri_bits, tag.tmin_bits).name("tmin");
     let id = tag_in.slice(0, tag.id_bits).name("id");
 
-    // lower_t(tmin) = tmin − tmin/64 − 8, and t, both signed n + 3 bits.
+    // lower_t(tmin) = tmin − tmin/64 − 8, and t, both signed n + 3 bits. A hit is accepted
+    // when t ≥ lower_t, i.e. when t + 8 ≥ tmin − tmin/64: two subtractions side by side, then
+    // one comparison, rather than three carry chains in series.
     let dist = n + 3;
     let tmin_d = tmin.xsigned().resize(dist);
-    let lower = ((tmin_d - (tmin_d >> 6)) - 8).name("lower_t");
-    let accepted = (!t.xsigned().resize(dist).lt(lower)).name("accepted");
-    // Staged: the stream and the acceptance test registered, so the accumulator's compare
-    // starts from registers (a result arrives one cycle later; nothing else changes).
-    let reg = |name: &str, x| if staged { b.delay(&format!("in_{name}"), x) } else { x };
-    let (valid, end, hit, accepted) = (reg("valid", valid), reg("end", end), reg("hit", hit), reg("accepted", accepted));
-    let (tri, id, t, u, v) = (reg("tri", tri), reg("id", id), reg("t", t), reg("u", u), reg("v", v));
+    let x = (tmin_d - (tmin_d >> 6)).name("tmin_less");
+    let t8 = (t.xsigned().resize(dist) + 8).name("t_plus_8");
+    // Staged: two register levels, (x, t + 8) and then the acceptance bit, so the
+    // accumulator's compare starts from registers (a result arrives two cycles later;
+    // nothing else changes).
+    let reg = |name: &str, x, k: u32| if staged { b.delay_line(&format!("in_{name}"), x, k) } else { x };
+    let (x, t8) = (reg("tmin_less", x, 1), reg("t_plus_8", t8, 1));
+    let accepted = reg("accepted", (!t8.lt(x)).name("accepted"), 1);
+    let (valid, end, hit) = (reg("valid", valid, 2), reg("end", end, 2), reg("hit", hit, 2));
+    let (tri, id, t, u, v) = (reg("tri", tri, 2), reg("id", id, 2), reg("t", t, 2), reg("u", u, 2), reg("v", v, 2));
 
     // The best accepted hit of the ray in flight.
     let best_valid = b.reg("best_valid", Ty::BIT, Some(0));
