@@ -5,6 +5,7 @@ pub mod closest;
 pub mod cost;
 pub mod divider;
 pub mod intersect;
+pub mod plane;
 pub mod raygen;
 pub mod top;
 pub mod traverse;
