@@ -7,10 +7,12 @@
 //!
 //! The traversal emits one leaf entry per clock; the triangle ROMs add one cycle; the ray's
 //! origin and direction come straight from the traversal's and the top's ray registers, which
-//! hold still until the next ray is accepted — always after the ray's end token, so at least
-//! two cycles after its last triangle entered the ROMs. The triangle table is wider than a
-//! signal may be (5 + 3n + 6m bits), so it is split into ROMs of whole fields, ≤ 128 bits each,
-//! all read at the same address.
+//! hold still until the next ray is accepted — always after the ray's end token: the last
+//! triangle number reaches the ROMs two cycles after its `leaf` cycle (leaf ROM and its
+//! register), and pop, done and idle put the accepting edge one cycle after that, the edge at
+//! which the pipeline's input register takes that triangle with the old ray. The triangle
+//! table is wider than a signal may be (5 + 3n + 6m bits), so it is split into ROMs of whole
+//! fields, ≤ 128 bits each, all read at the same address.
 
 use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};

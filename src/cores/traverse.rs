@@ -3,11 +3,11 @@
 //! in exactly the order of `Golden::walk` (near child first, far child pushed, no early out).
 //! The node and leaf ROMs and the stack RAM are synchronous block memories.
 //!
-//! Pipelined for the clock: every register-to-register path is a block-RAM read into
-//! registers (or into a small decision: the leaf test), one mux level and one adder or
-//! compare, or the multiplier alone. So the node ROM is addressed by the `node` register
-//! itself (its word is out one cycle after the register changes) and its word is only
-//! captured; the plane distances come from a pipelined unit (`plane.rs`, L = 3 + product
+//! Pipelined for the clock: every register-to-register path is a block-RAM read into a
+//! register, one mux level and one adder or compare (or a few LUTs of decision), or the
+//! multiplier alone. So the node ROM is addressed by the `node` register itself and its word
+//! goes straight into a register (mem[node] two cycles after `node` last changed), as does the
+//! leaf ROM's; the plane distances come from a pipelined unit (`plane.rs`, L = 3 + product
 //! stages clocks from issue to result; L = 4 by default); and the child decision takes a
 //! compare cycle and an act cycle. States and their cost (one cycle each unless noted):
 //! - `idle`: `ray_ready`; a valid ray is latched (node 0, tmin 0 and tmax = 2^(n+1) too).
@@ -15,11 +15,13 @@
 //! - `box` (L cycles): waits for the three distances; tmax = min as they arrive. A ray that
 //!   misses the box (a distance < 0) goes to `done`, else to `node` (node 0's word was read
 //!   while waiting).
-//! - `fetch`: the node ROM reads the new address; only after a step that enters the far child
-//!   alone, or a pop after an empty leaf. The near child is addressed during `dist` and the
-//!   stack top in the cycle before `pop`, so those words are ready without one.
-//! - `node` (1 per node visit): the node word is on the ROM output. A leaf loads its first
-//!   entry and count; an inner node's fields are latched and d0 (clip0) is issued.
+//! - `fetch`: waits until the word register holds the new node's word: 2 cycles after a step
+//!   that enters the far child alone, 1 after a pop that follows a step or a one-entry leaf, 2
+//!   after a pop that follows an empty leaf. The near child is addressed during `dist`
+//!   and the stack top during `leaf`, so descending near and popping after a leaf of two or
+//!   more entries need none.
+//! - `node` (1 per node visit): the node word is in its register. A leaf loads its first entry
+//!   and count; an inner node's fields are latched and d0 (clip0) is issued.
 //! - `clip1` (1 per inner node): d1 (clip1) is issued; the ray's sign on the axis latched.
 //! - `dist` (L per inner node): waits for d0, then d1; when d1 arrives, near_end/far_start are
 //!   chosen and compared with tmin and tmax (registered).
@@ -31,8 +33,9 @@
 //!   ray is complete when the token leaves the in-order pipeline.
 //!
 //! An inner node costs node + clip1 + L + step = 3 + L = 7 cycles (2 before the unit was
-//! pipelined; a far-only step adds a fetch), a leaf node + count, a pop 1, a ray's overhead
-//! idle + aabb + box + done = 5 + L.
+//! pipelined; a far-only step adds 2 fetch cycles), a leaf node + count, a pop 1 (+ its
+//! fetch), a ray's overhead idle + aabb + box + done = 5 + L. Emission is two cycles behind
+//! `leaf` (the leaf ROM and its register).
 
 use super::plane::{PRODUCT_STAGES, PlaneIssue, plane_unit};
 use crate::rtl::build::{Builder, S};
@@ -134,12 +137,16 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let o = ["ox_r", "oy_r", "oz_r"].map(|name| b.reg(name, Ty::u(n), None));
     let inv = ["invx_r", "invy_r", "invz_r"].map(|name| b.reg(name, Ty::s(p.inv_width()), None));
 
-    // Node ROM, addressed by the node register itself: its word is on the ROM output one
-    // cycle after the register last changed (`fetch` waits that cycle).
+    // Node ROM, addressed by the node register itself, its word registered before any logic
+    // sees it (a block RAM's clock-to-out leaves no room for logic in the same clock): the
+    // word register holds mem[node] when node has held its value for the two cycles before.
+    // `node_settled` (node unchanged since the last cycle) tells `fetch` the word will be
+    // there in the next cycle.
     let node_bits = rom_addr_bits(node_words.len());
     let node = b.reg("node", Ty::u(node_bits), Some(0));
     let node_rom = b.rom("node_rom", node_l.width, node_words.iter().map(|w| word_bits(w, 0, node_l.width)).collect());
-    let word = b.read("node_word", node_rom, node);
+    let word = b.delay("node_word_r", b.read("node_word", node_rom, node));
+    let node_settled = node.eq(b.delay("node_d1", node)).name("node_settled");
     let nf = |name: &str| field(&format!("nw_{name}"), word, node_l.field(name), 0);
     let (w_axis, w_clip0, w_clip1, w_child, w_first, w_count) =
         (nf("axis"), nf("clip0"), nf("clip1"), nf("child"), nf("first"), nf("count"));
@@ -214,10 +221,12 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let leaf_bits = rom_addr_bits(leaf_words.len());
     let leaf_ptr = b.reg("leaf_ptr", Ty::u(leaf_bits), None);
     let left = b.reg("leaf_left", w_count.ty(), None);
-    // Whether `node` was loaded from the stack top the cycle before `pop` (so its word is on
-    // the ROM output after `pop` without a `fetch`). The top is read at sp − 1 one cycle late,
-    // so it is current in `leaf` and `step`, not in a `node` right after a push.
+    // Whether `node` has held the stack top since two cycles before `node` follows `pop` (so
+    // the word register has it without a `fetch`): `leaf` loads the top every cycle, so a
+    // leaf of two or more entries has. The top is read at sp − 1 one cycle late, so it is
+    // current in `leaf` and `step`, not in a `node` right after a push.
     let popped_ahead = b.reg("popped_ahead", Ty::BIT, None);
+    let was_leaf = b.delay("was_leaf", fsm.is(Leaf));
 
     fsm.state(Idle, |s| {
         s.set_k(aabb_k, 0);
@@ -247,7 +256,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
             s.when(box_miss, |s| s.goto(Done)).otherwise(|s| s.goto(Node));
         });
     });
-    fsm.state(Fetch, |s| s.goto(Node));
+    fsm.state(Fetch, |s| {
+        s.when(node_settled, |s| s.goto(Node));
+    });
     fsm.state(Node, |s| {
         s.when(w_leaf, |s| {
             s.set(leaf_ptr, w_first.resize(leaf_bits));
@@ -302,7 +313,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
             })
             .otherwise(|s| {
                 s.set(node, top_node);
-                s.set_k(popped_ahead, 1);
+                s.set_k(popped_ahead, 0);
                 s.goto(Pop);
             });
         });
@@ -310,9 +321,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     fsm.state(Leaf, |s| {
         s.set(leaf_ptr, leaf_ptr + 1);
         s.set(left, left - 1);
+        s.set(node, top_node);
         s.when(left.eq(1), |s| {
-            s.set(node, top_node);
-            s.set_k(popped_ahead, 1);
+            s.set(popped_ahead, was_leaf);
             s.goto(Pop);
         });
     });
@@ -330,15 +341,17 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let state = fsm.state_reg();
     fsm.finish();
 
-    // Emission, one cycle behind the FSM so it lines up with the leaf ROM's output.
+    // Emission, two cycles behind the FSM so it lines up with the leaf ROM's registered
+    // output (the triangle number addresses the triangle ROMs: no block RAM output drives
+    // another block RAM's address directly).
     let leaf_rom = b.rom("leaf_rom", leaf_l.width, leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect());
-    let tri = b.read("leaf_tri", leaf_rom, leaf_ptr);
+    let tri = b.delay("leaf_tri_r", b.read("leaf_tri", leaf_rom, leaf_ptr));
     b.output("ray_ready", in_idle);
-    b.output("emit_valid", b.delay("emit_r", in_leaf | in_done));
-    b.output("emit_end", b.delay("end_r", in_done));
+    b.output("emit_valid", b.delay_line("emit_r", in_leaf | in_done, 2));
+    b.output("emit_end", b.delay_line("end_r", in_done, 2));
     b.output("emit_tri", tri.resize(p.tri_bits));
-    b.output("emit_tmin", b.delay("tmin_r", tmin.unsigned().resize(p.tmin_width())));
-    b.output("emit_id", b.delay("id_r", id_r));
+    b.output("emit_tmin", b.delay_line("tmin_r", tmin.unsigned().resize(p.tmin_width()), 2));
+    b.output("emit_id", b.delay_line("id_r", id_r, 2));
     for (name, s) in ["cur_ox", "cur_oy", "cur_oz"].iter().zip(o) {
         b.output(name, s);
     }
