@@ -50,6 +50,9 @@ module fxrt_traverse (
 
   // not in a stage or state machine
   reg [72:0] node_word = 73'h0000000000000000000;
+  reg [72:0] node_word_r = 73'h0000000000000000000;
+  reg [12:0] node_d1 = 13'h0000;
+  wire [0:0] node_settled;
   wire [1:0] nw_axis;
   wire [28:0] nw_clip0;
   wire [28:0] nw_clip1;
@@ -146,6 +149,8 @@ module fxrt_traverse (
   wire [31:0] bits_stack_top_1;
   wire signed [31:0] top_tmin;
   wire [12:0] top_node;
+  wire [0:0] in_leaf;
+  reg [0:0] was_leaf = 1'h0;
   wire [1:0] k_0_1 = 2'h0;
   wire [12:0] k_0_2 = 13'h0000;
   wire signed [31:0] k_0_3 = 32'sh00000000;
@@ -167,27 +172,38 @@ module fxrt_traverse (
   wire [0:0] go_near_and_go_far;
   wire [4:0] rs_sp;
   wire [5:0] sp_plus_k_1_1;
-  wire [0:0] k_1_3 = 1'h1;
   wire [12:0] leaf_ptr_plus_k_1;
-  wire [2:0] k_1_4 = 3'h1;
-  wire [2:0] leaf_left_minus_k_1_4;
-  wire [0:0] leaf_left_eq_k_1_4;
+  wire [2:0] k_1_3 = 3'h1;
+  wire [2:0] leaf_left_minus_k_1_3;
+  wire [0:0] leaf_left_eq_k_1_3;
   wire [5:0] k_0_6 = 6'h00;
   wire [0:0] sp_eq_k_0_6;
   wire [5:0] sp_minus_k_1_1_1;
   wire [0:0] in_idle;
-  wire [0:0] in_leaf;
   wire [0:0] in_done;
   reg [12:0] leaf_tri = 13'h0000;
+  reg [12:0] leaf_tri_r = 13'h0000;
   wire [0:0] in_leaf_or_in_done;
-  reg [0:0] emit_r = 1'h0;
-  reg [0:0] end_r = 1'h0;
+  (* mem2reg *) reg [0:0] emit_r_sr [1:2];
+  integer emit_r_i;
+  initial for (emit_r_i = 1; emit_r_i <= 2; emit_r_i = emit_r_i + 1) emit_r_sr[emit_r_i] = 1'h0;
+  wire [0:0] emit_r;
+  (* mem2reg *) reg [0:0] end_r_sr [1:2];
+  integer end_r_i;
+  initial for (end_r_i = 1; end_r_i <= 2; end_r_i = end_r_i + 1) end_r_sr[end_r_i] = 1'h0;
+  wire [0:0] end_r;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 30:0 are read
   wire [31:0] u_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_tmin;
-  reg [30:0] tmin_r = 31'h00000000;
-  reg [19:0] id_r = 20'h00000;
+  (* mem2reg *) reg [30:0] tmin_r_sr [1:2];
+  integer tmin_r_i;
+  initial for (tmin_r_i = 1; tmin_r_i <= 2; tmin_r_i = tmin_r_i + 1) tmin_r_sr[tmin_r_i] = 31'h00000000;
+  wire [30:0] tmin_r;
+  (* mem2reg *) reg [19:0] id_r_sr [1:2];
+  integer id_r_i;
+  initial for (id_r_i = 1; id_r_i <= 2; id_r_i = id_r_i + 1) id_r_sr[id_r_i] = 20'h00000;
+  wire [19:0] id_r;
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
   reg [3:0] state = st_idle;
@@ -227,7 +243,6 @@ module fxrt_traverse (
   wire [0:0] not_go_far;
   wire [0:0] and_11;
   wire [12:0] mux_and_11;
-  wire [12:0] mux_leaf_left_eq_k_1_4;
   wire [0:0] not_sp_eq_k_0_6;
   wire [12:0] mux_not_sp_eq_k_0_6;
   reg [12:0] node_next;
@@ -262,6 +277,7 @@ module fxrt_traverse (
   wire [0:0] not_box_miss;
   wire [0:0] and_12;
   wire [3:0] mux_and_12;
+  wire [3:0] mux_node_settled;
   wire [0:0] and_13;
   wire [3:0] mux_and_13;
   wire [0:0] not_nw_count_eq_k_0_5;
@@ -275,7 +291,7 @@ module fxrt_traverse (
   wire [3:0] mux_not_go_near_and_go_far_2;
   wire [0:0] and_15;
   wire [3:0] mux_and_15;
-  wire [3:0] mux_leaf_left_eq_k_1_4_1;
+  wire [3:0] mux_leaf_left_eq_k_1_3;
   wire [3:0] mux_sp_eq_k_0_6;
   wire [0:0] and_16;
   wire [3:0] mux_and_16;
@@ -290,7 +306,7 @@ module fxrt_traverse (
   wire [0:0] mux_nw_is_leaf_2;
   wire [0:0] and_18;
   wire [0:0] mux_and_18;
-  wire [0:0] mux_leaf_left_eq_k_1_4_2;
+  wire [0:0] mux_leaf_left_eq_k_1_3_1;
   reg [0:0] popped_ahead_next;
   wire [1:0] mux_not_nw_is_leaf_1_1;
   wire [1:0] axis_r_next;
@@ -324,12 +340,13 @@ module fxrt_traverse (
   wire [0:0] and_19;
 
   // not in a stage or state machine
-  assign nw_axis = node_word[1:0];
-  assign nw_clip0 = node_word[30:2];
-  assign nw_clip1 = node_word[59:31];
-  assign nw_child = node_word[72:60];
-  assign nw_first = node_word[14:2];
-  assign nw_count = node_word[17:15];
+  assign node_settled = node == node_d1;
+  assign nw_axis = node_word_r[1:0];
+  assign nw_clip0 = node_word_r[30:2];
+  assign nw_clip1 = node_word_r[59:31];
+  assign nw_child = node_word_r[72:60];
+  assign nw_first = node_word_r[14:2];
+  assign nw_count = node_word_r[17:15];
   assign nw_is_leaf = nw_axis == k_3;
   assign in_aabb = state == st_aabb;
   assign in_node = state == st_node;
@@ -413,6 +430,7 @@ module fxrt_traverse (
   assign bits_stack_top_1 = stack_top[63:32];
   assign top_tmin = $signed(bits_stack_top_1);
   assign top_node = stack_top[76:64];
+  assign in_leaf = state == st_leaf;
   assign aabb_k_plus_k_1_2 = aabb_k + k_1_2;
   assign nw_count_eq_k_0_5 = nw_count == k_0_5;
   assign tmin_le_tmax_1 = tmin <= tmax;
@@ -432,20 +450,25 @@ module fxrt_traverse (
   assign rs_sp = sp[4:0];
   assign sp_plus_k_1_1 = sp + k_1_1;
   assign leaf_ptr_plus_k_1 = leaf_ptr + k_1;
-  assign leaf_left_minus_k_1_4 = leaf_left - k_1_4;
-  assign leaf_left_eq_k_1_4 = leaf_left == k_1_4;
+  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
+  assign leaf_left_eq_k_1_3 = leaf_left == k_1_3;
   assign sp_eq_k_0_6 = sp == k_0_6;
   assign sp_minus_k_1_1_1 = sp - k_1_1;
   assign in_idle = state == st_idle;
-  assign in_leaf = state == st_leaf;
   assign in_done = state == st_done;
   assign in_leaf_or_in_done = in_leaf | in_done;
+  assign emit_r = emit_r_sr[2];
+  assign end_r = end_r_sr[2];
   assign u_tmin = $unsigned(tmin);
   assign rs_u_tmin = u_tmin[30:0];
+  assign tmin_r = tmin_r_sr[2];
+  assign id_r = id_r_sr[2];
 
   always @(posedge clk) begin : regs
     if (and_19) stack[rs_sp] <= push_entry;
     node_word <= node_rom[node];
+    node_word_r <= node_word;
+    node_d1 <= node;
     pu_sel_valid <= pu_issue;
     pu_sel_last <= pu_issue_last;
     pu_sel_plane <= pu_issue_plane;
@@ -461,11 +484,21 @@ module fxrt_traverse (
     plane_t_valid <= pu_product_valid;
     plane_t_last <= pu_product_last;
     stack_top <= stack[rs_sp_minus_k_1_1];
+    was_leaf <= in_leaf;
     leaf_tri <= leaf_rom[leaf_ptr];
-    emit_r <= in_leaf_or_in_done;
-    end_r <= in_done;
-    tmin_r <= rs_u_tmin;
-    id_r <= ray_id_r;
+    leaf_tri_r <= leaf_tri;
+    for (emit_r_i = 2; emit_r_i > 1; emit_r_i = emit_r_i - 1)
+      emit_r_sr[emit_r_i] <= emit_r_sr[emit_r_i - 1];
+    emit_r_sr[1] <= in_leaf_or_in_done;
+    for (end_r_i = 2; end_r_i > 1; end_r_i = end_r_i - 1)
+      end_r_sr[end_r_i] <= end_r_sr[end_r_i - 1];
+    end_r_sr[1] <= in_done;
+    for (tmin_r_i = 2; tmin_r_i > 1; tmin_r_i = tmin_r_i - 1)
+      tmin_r_sr[tmin_r_i] <= tmin_r_sr[tmin_r_i - 1];
+    tmin_r_sr[1] <= rs_u_tmin;
+    for (id_r_i = 2; id_r_i > 1; id_r_i = id_r_i - 1)
+      id_r_sr[id_r_i] <= id_r_sr[id_r_i - 1];
+    id_r_sr[1] <= ray_id_r;
   end
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
@@ -482,7 +515,6 @@ module fxrt_traverse (
   assign not_go_far = ~go_far;
   assign and_11 = not_go_near & not_go_far;
   assign mux_and_11 = and_11 ? top_node : mux_not_go_near_and_go_far;
-  assign mux_leaf_left_eq_k_1_4 = leaf_left_eq_k_1_4 ? top_node : node;
   assign not_sp_eq_k_0_6 = ~sp_eq_k_0_6;
   assign mux_not_sp_eq_k_0_6 = not_sp_eq_k_0_6 ? top_node : node;
   always @* begin
@@ -490,7 +522,7 @@ module fxrt_traverse (
       st_idle: node_next = k_0_2;
       st_dist: node_next = near;
       st_step: node_next = mux_and_11;
-      st_leaf: node_next = mux_leaf_left_eq_k_1_4;
+      st_leaf: node_next = top_node;
       st_pop: node_next = mux_not_sp_eq_k_0_6;
       default: node_next = node;
     endcase
@@ -547,6 +579,7 @@ module fxrt_traverse (
   assign not_box_miss = ~box_miss;
   assign and_12 = d1_arrives & not_box_miss;
   assign mux_and_12 = and_12 ? st_node : mux_d1_arrives_and_box_miss;
+  assign mux_node_settled = node_settled ? st_node : state;
   assign and_13 = nw_is_leaf & nw_count_eq_k_0_5;
   assign mux_and_13 = and_13 ? st_pop : state;
   assign not_nw_count_eq_k_0_5 = ~nw_count_eq_k_0_5;
@@ -560,7 +593,7 @@ module fxrt_traverse (
   assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near_1;
   assign and_15 = not_go_near & not_go_far;
   assign mux_and_15 = and_15 ? st_pop : mux_not_go_near_and_go_far_2;
-  assign mux_leaf_left_eq_k_1_4_1 = leaf_left_eq_k_1_4 ? st_pop : state;
+  assign mux_leaf_left_eq_k_1_3 = leaf_left_eq_k_1_3 ? st_pop : state;
   assign mux_sp_eq_k_0_6 = sp_eq_k_0_6 ? st_done : state;
   assign and_16 = not_sp_eq_k_0_6 & popped_ahead;
   assign mux_and_16 = and_16 ? st_node : mux_sp_eq_k_0_6;
@@ -572,12 +605,12 @@ module fxrt_traverse (
       st_idle: state_next = mux_ray_valid_7;
       st_aabb: state_next = mux_aabb_last;
       st_box: state_next = mux_and_12;
-      st_fetch: state_next = st_node;
+      st_fetch: state_next = mux_node_settled;
       st_node: state_next = mux_not_nw_is_leaf_1;
       st_clip1: state_next = st_dist;
       st_dist: state_next = mux_d1_arrives;
       st_step: state_next = mux_and_15;
-      st_leaf: state_next = mux_leaf_left_eq_k_1_4_1;
+      st_leaf: state_next = mux_leaf_left_eq_k_1_3;
       st_pop: state_next = mux_and_17;
       st_done: state_next = st_idle;
       default: state_next = st_idle;
@@ -595,19 +628,19 @@ module fxrt_traverse (
   always @* begin
     case (state)
       st_node: leaf_left_next = mux_nw_is_leaf_1;
-      st_leaf: leaf_left_next = leaf_left_minus_k_1_4;
+      st_leaf: leaf_left_next = leaf_left_minus_k_1_3;
       default: leaf_left_next = leaf_left;
     endcase
   end
   assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_4 : popped_ahead;
   assign and_18 = not_go_near & not_go_far;
-  assign mux_and_18 = and_18 ? k_1_3 : popped_ahead;
-  assign mux_leaf_left_eq_k_1_4_2 = leaf_left_eq_k_1_4 ? k_1_3 : popped_ahead;
+  assign mux_and_18 = and_18 ? k_0_4 : popped_ahead;
+  assign mux_leaf_left_eq_k_1_3_1 = leaf_left_eq_k_1_3 ? was_leaf : popped_ahead;
   always @* begin
     case (state)
       st_node: popped_ahead_next = mux_nw_is_leaf_2;
       st_step: popped_ahead_next = mux_and_18;
-      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_4_2;
+      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_3_1;
       default: popped_ahead_next = popped_ahead;
     endcase
   end
@@ -687,7 +720,7 @@ module fxrt_traverse (
   assign ray_ready = in_idle;
   assign emit_valid = emit_r;
   assign emit_end = end_r;
-  assign emit_tri = leaf_tri;
+  assign emit_tri = leaf_tri_r;
   assign emit_tmin = tmin_r;
   assign emit_id = id_r;
   assign cur_ox = ox_r;

@@ -10791,6 +10791,9 @@ architecture rtl of fxrt_traverse is
 
   -- not in a stage or state machine
   signal node_word : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal node_word_r : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal node_d1 : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal node_settled : unsigned(0 downto 0);
   signal nw_axis : unsigned(1 downto 0);
   signal nw_clip0 : unsigned(28 downto 0);
   signal nw_clip1 : unsigned(28 downto 0);
@@ -10881,6 +10884,8 @@ architecture rtl of fxrt_traverse is
   signal bits_stack_top_1 : unsigned(31 downto 0);
   signal top_tmin : signed(31 downto 0);
   signal top_node : unsigned(12 downto 0);
+  signal in_leaf : unsigned(0 downto 0);
+  signal was_leaf : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
   constant k_0_2 : unsigned(12 downto 0) := unsigned'("0000000000000");
   constant k_0_3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -10900,25 +10905,32 @@ architecture rtl of fxrt_traverse is
   signal go_near_and_go_far : unsigned(0 downto 0);
   signal rs_sp : unsigned(4 downto 0);
   signal sp_plus_k_1_1 : unsigned(5 downto 0);
-  constant k_1_3 : unsigned(0 downto 0) := unsigned'("1");
   signal leaf_ptr_plus_k_1 : unsigned(12 downto 0);
-  constant k_1_4 : unsigned(2 downto 0) := unsigned'("001");
-  signal leaf_left_minus_k_1_4 : unsigned(2 downto 0);
-  signal leaf_left_eq_k_1_4 : unsigned(0 downto 0);
+  constant k_1_3 : unsigned(2 downto 0) := unsigned'("001");
+  signal leaf_left_minus_k_1_3 : unsigned(2 downto 0);
+  signal leaf_left_eq_k_1_3 : unsigned(0 downto 0);
   constant k_0_6 : unsigned(5 downto 0) := unsigned'("000000");
   signal sp_eq_k_0_6 : unsigned(0 downto 0);
   signal sp_minus_k_1_1_1 : unsigned(5 downto 0);
   signal in_idle : unsigned(0 downto 0);
-  signal in_leaf : unsigned(0 downto 0);
   signal in_done : unsigned(0 downto 0);
   signal leaf_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal leaf_tri_r : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal in_leaf_or_in_done : unsigned(0 downto 0);
-  signal emit_r : unsigned(0 downto 0) := unsigned'("0");
-  signal end_r : unsigned(0 downto 0) := unsigned'("0");
+  type emit_r_sr_t is array (1 to 2) of unsigned(0 downto 0);
+  signal emit_r_sr : emit_r_sr_t := (others => (others => '0'));
+  signal emit_r : unsigned(0 downto 0);
+  type end_r_sr_t is array (1 to 2) of unsigned(0 downto 0);
+  signal end_r_sr : end_r_sr_t := (others => (others => '0'));
+  signal end_r : unsigned(0 downto 0);
   signal u_tmin : unsigned(31 downto 0);
   signal rs_u_tmin : unsigned(30 downto 0);
-  signal tmin_r : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
-  signal id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
+  type tmin_r_sr_t is array (1 to 2) of unsigned(30 downto 0);
+  signal tmin_r_sr : tmin_r_sr_t := (others => (others => '0'));
+  signal tmin_r : unsigned(30 downto 0);
+  type id_r_sr_t is array (1 to 2) of unsigned(19 downto 0);
+  signal id_r_sr : id_r_sr_t := (others => (others => '0'));
+  signal id_r : unsigned(19 downto 0);
 
   -- state machine state: BIH traversal: one ray at a time, one leaf entry per clock
   signal state : unsigned(3 downto 0) := st_idle;
@@ -10958,7 +10970,6 @@ architecture rtl of fxrt_traverse is
   signal not_go_far : unsigned(0 downto 0);
   signal and_11 : unsigned(0 downto 0);
   signal mux_and_11 : unsigned(12 downto 0);
-  signal mux_leaf_left_eq_k_1_4 : unsigned(12 downto 0);
   signal not_sp_eq_k_0_6 : unsigned(0 downto 0);
   signal mux_not_sp_eq_k_0_6 : unsigned(12 downto 0);
   signal node_next : unsigned(12 downto 0);
@@ -10993,6 +11004,7 @@ architecture rtl of fxrt_traverse is
   signal not_box_miss : unsigned(0 downto 0);
   signal and_12 : unsigned(0 downto 0);
   signal mux_and_12 : unsigned(3 downto 0);
+  signal mux_node_settled : unsigned(3 downto 0);
   signal and_13 : unsigned(0 downto 0);
   signal mux_and_13 : unsigned(3 downto 0);
   signal not_nw_count_eq_k_0_5 : unsigned(0 downto 0);
@@ -11006,7 +11018,7 @@ architecture rtl of fxrt_traverse is
   signal mux_not_go_near_and_go_far_2 : unsigned(3 downto 0);
   signal and_15 : unsigned(0 downto 0);
   signal mux_and_15 : unsigned(3 downto 0);
-  signal mux_leaf_left_eq_k_1_4_1 : unsigned(3 downto 0);
+  signal mux_leaf_left_eq_k_1_3 : unsigned(3 downto 0);
   signal mux_sp_eq_k_0_6 : unsigned(3 downto 0);
   signal and_16 : unsigned(0 downto 0);
   signal mux_and_16 : unsigned(3 downto 0);
@@ -11021,7 +11033,7 @@ architecture rtl of fxrt_traverse is
   signal mux_nw_is_leaf_2 : unsigned(0 downto 0);
   signal and_18 : unsigned(0 downto 0);
   signal mux_and_18 : unsigned(0 downto 0);
-  signal mux_leaf_left_eq_k_1_4_2 : unsigned(0 downto 0);
+  signal mux_leaf_left_eq_k_1_3_1 : unsigned(0 downto 0);
   signal popped_ahead_next : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1_1 : unsigned(1 downto 0);
   signal axis_r_next : unsigned(1 downto 0);
@@ -11056,12 +11068,13 @@ architecture rtl of fxrt_traverse is
 begin
 
   -- not in a stage or state machine
-  nw_axis <= unsigned(node_word(1 downto 0));
-  nw_clip0 <= unsigned(node_word(30 downto 2));
-  nw_clip1 <= unsigned(node_word(59 downto 31));
-  nw_child <= unsigned(node_word(72 downto 60));
-  nw_first <= unsigned(node_word(14 downto 2));
-  nw_count <= unsigned(node_word(17 downto 15));
+  node_settled <= "1" when node = node_d1 else "0";
+  nw_axis <= unsigned(node_word_r(1 downto 0));
+  nw_clip0 <= unsigned(node_word_r(30 downto 2));
+  nw_clip1 <= unsigned(node_word_r(59 downto 31));
+  nw_child <= unsigned(node_word_r(72 downto 60));
+  nw_first <= unsigned(node_word_r(14 downto 2));
+  nw_count <= unsigned(node_word_r(17 downto 15));
   nw_is_leaf <= "1" when nw_axis = k_3 else "0";
   in_aabb <= "1" when state = st_aabb else "0";
   in_node <= "1" when state = st_node else "0";
@@ -11137,6 +11150,7 @@ begin
   bits_stack_top_1 <= unsigned(stack_top(63 downto 32));
   top_tmin <= signed(bits_stack_top_1);
   top_node <= unsigned(stack_top(76 downto 64));
+  in_leaf <= "1" when state = st_leaf else "0";
   aabb_k_plus_k_1_2 <= aabb_k + k_1_2;
   nw_count_eq_k_0_5 <= "1" when nw_count = k_0_5 else "0";
   tmin_le_tmax_1 <= "1" when tmin <= tmax else "0";
@@ -11154,16 +11168,19 @@ begin
   rs_sp <= sp(4 downto 0);
   sp_plus_k_1_1 <= sp + k_1_1;
   leaf_ptr_plus_k_1 <= leaf_ptr + k_1;
-  leaf_left_minus_k_1_4 <= leaf_left - k_1_4;
-  leaf_left_eq_k_1_4 <= "1" when leaf_left = k_1_4 else "0";
+  leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
+  leaf_left_eq_k_1_3 <= "1" when leaf_left = k_1_3 else "0";
   sp_eq_k_0_6 <= "1" when sp = k_0_6 else "0";
   sp_minus_k_1_1_1 <= sp - k_1_1;
   in_idle <= "1" when state = st_idle else "0";
-  in_leaf <= "1" when state = st_leaf else "0";
   in_done <= "1" when state = st_done else "0";
   in_leaf_or_in_done <= in_leaf or in_done;
+  emit_r <= emit_r_sr(2);
+  end_r <= end_r_sr(2);
   u_tmin <= unsigned(tmin);
   rs_u_tmin <= u_tmin(30 downto 0);
+  tmin_r <= tmin_r_sr(2);
+  id_r <= id_r_sr(2);
 
   regs : process (clk)
   begin
@@ -11172,6 +11189,8 @@ begin
         stack(to_integer(rs_sp)) <= push_entry;
       end if;
       node_word <= node_rom(to_integer(node));
+      node_word_r <= node_word;
+      node_d1 <= node;
       pu_sel_valid <= pu_issue;
       pu_sel_last <= pu_issue_last;
       pu_sel_plane <= pu_issue_plane;
@@ -11187,11 +11206,17 @@ begin
       plane_t_valid <= pu_product_valid;
       plane_t_last <= pu_product_last;
       stack_top <= stack(to_integer(rs_sp_minus_k_1_1));
+      was_leaf <= in_leaf;
       leaf_tri <= leaf_rom(to_integer(leaf_ptr));
-      emit_r <= in_leaf_or_in_done;
-      end_r <= in_done;
-      tmin_r <= rs_u_tmin;
-      id_r <= ray_id_r;
+      leaf_tri_r <= leaf_tri;
+      emit_r_sr(2 to 2) <= emit_r_sr(1 to 1);
+      emit_r_sr(1) <= in_leaf_or_in_done;
+      end_r_sr(2 to 2) <= end_r_sr(1 to 1);
+      end_r_sr(1) <= in_done;
+      tmin_r_sr(2 to 2) <= tmin_r_sr(1 to 1);
+      tmin_r_sr(1) <= rs_u_tmin;
+      id_r_sr(2 to 2) <= id_r_sr(1 to 1);
+      id_r_sr(1) <= ray_id_r;
     end if;
   end process regs;
 
@@ -11207,7 +11232,6 @@ begin
   not_go_far <= not go_far;
   and_11 <= not_go_near and not_go_far;
   mux_and_11 <= top_node when and_11 = "1" else mux_not_go_near_and_go_far;
-  mux_leaf_left_eq_k_1_4 <= top_node when leaf_left_eq_k_1_4 = "1" else node;
   not_sp_eq_k_0_6 <= not sp_eq_k_0_6;
   mux_not_sp_eq_k_0_6 <= top_node when not_sp_eq_k_0_6 = "1" else node;
   with state select
@@ -11215,7 +11239,7 @@ begin
       k_0_2 when st_idle,
       near when st_dist,
       mux_and_11 when st_step,
-      mux_leaf_left_eq_k_1_4 when st_leaf,
+      top_node when st_leaf,
       mux_not_sp_eq_k_0_6 when st_pop,
       node when others;
   not_go_near_and_go_far_1 <= not_go_near and go_far;
@@ -11264,6 +11288,7 @@ begin
   not_box_miss <= not box_miss;
   and_12 <= d1_arrives and not_box_miss;
   mux_and_12 <= st_node when and_12 = "1" else mux_d1_arrives_and_box_miss;
+  mux_node_settled <= st_node when node_settled = "1" else state;
   and_13 <= nw_is_leaf and nw_count_eq_k_0_5;
   mux_and_13 <= st_pop when and_13 = "1" else state;
   not_nw_count_eq_k_0_5 <= not nw_count_eq_k_0_5;
@@ -11277,7 +11302,7 @@ begin
   mux_not_go_near_and_go_far_2 <= st_fetch when not_go_near_and_go_far_2 = "1" else mux_go_near_1;
   and_15 <= not_go_near and not_go_far;
   mux_and_15 <= st_pop when and_15 = "1" else mux_not_go_near_and_go_far_2;
-  mux_leaf_left_eq_k_1_4_1 <= st_pop when leaf_left_eq_k_1_4 = "1" else state;
+  mux_leaf_left_eq_k_1_3 <= st_pop when leaf_left_eq_k_1_3 = "1" else state;
   mux_sp_eq_k_0_6 <= st_done when sp_eq_k_0_6 = "1" else state;
   and_16 <= not_sp_eq_k_0_6 and popped_ahead;
   mux_and_16 <= st_node when and_16 = "1" else mux_sp_eq_k_0_6;
@@ -11289,12 +11314,12 @@ begin
       mux_ray_valid_7 when st_idle,
       mux_aabb_last when st_aabb,
       mux_and_12 when st_box,
-      st_node when st_fetch,
+      mux_node_settled when st_fetch,
       mux_not_nw_is_leaf_1 when st_node,
       st_dist when st_clip1,
       mux_d1_arrives when st_dist,
       mux_and_15 when st_step,
-      mux_leaf_left_eq_k_1_4_1 when st_leaf,
+      mux_leaf_left_eq_k_1_3 when st_leaf,
       mux_and_17 when st_pop,
       st_idle when st_done,
       st_idle when others;
@@ -11308,17 +11333,17 @@ begin
   with state select
     leaf_left_next <=
       mux_nw_is_leaf_1 when st_node,
-      leaf_left_minus_k_1_4 when st_leaf,
+      leaf_left_minus_k_1_3 when st_leaf,
       leaf_left when others;
   mux_nw_is_leaf_2 <= k_0_4 when nw_is_leaf = "1" else popped_ahead;
   and_18 <= not_go_near and not_go_far;
-  mux_and_18 <= k_1_3 when and_18 = "1" else popped_ahead;
-  mux_leaf_left_eq_k_1_4_2 <= k_1_3 when leaf_left_eq_k_1_4 = "1" else popped_ahead;
+  mux_and_18 <= k_0_4 when and_18 = "1" else popped_ahead;
+  mux_leaf_left_eq_k_1_3_1 <= was_leaf when leaf_left_eq_k_1_3 = "1" else popped_ahead;
   with state select
     popped_ahead_next <=
       mux_nw_is_leaf_2 when st_node,
       mux_and_18 when st_step,
-      mux_leaf_left_eq_k_1_4_2 when st_leaf,
+      mux_leaf_left_eq_k_1_3_1 when st_leaf,
       popped_ahead when others;
   mux_not_nw_is_leaf_1_1 <= nw_axis when not_nw_is_leaf_1 = "1" else axis_r;
   axis_r_next <= mux_not_nw_is_leaf_1_1 when in_node = "1" else axis_r;
@@ -11406,7 +11431,7 @@ begin
   ray_ready <= in_idle;
   emit_valid <= emit_r;
   emit_end <= end_r;
-  emit_tri <= leaf_tri;
+  emit_tri <= leaf_tri_r;
   emit_tmin <= tmin_r;
   emit_id <= id_r;
   cur_ox <= ox_r;
