@@ -160,8 +160,8 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let tmin = b.reg("tmin", dist, None);
     let tmax = b.reg("tmax", dist, None);
 
-    // The plane-distance unit. The select puts the ROM's fields last, so a word passes one
-    // mux level before the unit's first register.
+    // The plane-distance unit. The select puts the node word's fields last, so they pass one
+    // mux level between the word register and the unit's first register.
     let (in_aabb, in_node, in_clip1) = (fsm.is(Aabb), fsm.is(Node), fsm.is(Clip1));
     let hi = [0, 1, 2].map(|k| b.konst_named(&format!("box_hi_{k}"), Ty::u(n), p.box_hi[k] as i128));
     let aabb_neg = b.pick(aabb_k, inv).msb().name("aabb_neg");
