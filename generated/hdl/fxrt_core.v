@@ -24,7 +24,7 @@ module fxrt_core (
   output wire [31:0] res_v,
   output wire [0:0] busy,
   output wire [5:0] stack_depth,
-  output wire [2:0] fsm_state
+  output wire [3:0] fsm_state
 );
 
   reg [123:0] tri_rom_0 [0:8191];
@@ -52,7 +52,7 @@ module fxrt_core (
   wire [12:0] u_traverse_visit_node;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [5:0] u_traverse_stack_depth;
-  wire [2:0] u_traverse_fsm_state;
+  wire [3:0] u_traverse_fsm_state;
   wire [0:0] accept;
   reg signed [31:0] wx_r = 32'sh00000000;
   reg signed [31:0] wy_r = 32'sh00000000;

@@ -28,7 +28,7 @@ entity fxrt_core is
     res_v : out unsigned(31 downto 0);
     busy : out unsigned(0 downto 0);
     stack_depth : out unsigned(5 downto 0);
-    fsm_state : out unsigned(2 downto 0)
+    fsm_state : out unsigned(3 downto 0)
   );
 end entity fxrt_core;
 
@@ -57,7 +57,7 @@ architecture rtl of fxrt_core is
       visit : out unsigned(0 downto 0);
       visit_node : out unsigned(12 downto 0);
       stack_depth : out unsigned(5 downto 0);
-      fsm_state : out unsigned(2 downto 0)
+      fsm_state : out unsigned(3 downto 0)
     );
   end component;
   component fxrt_intersect_n29_m32_t0_e18_tag45 is
@@ -19093,7 +19093,7 @@ architecture rtl of fxrt_core is
   signal u_traverse_visit : unsigned(0 downto 0);
   signal u_traverse_visit_node : unsigned(12 downto 0);
   signal u_traverse_stack_depth : unsigned(5 downto 0);
-  signal u_traverse_fsm_state : unsigned(2 downto 0);
+  signal u_traverse_fsm_state : unsigned(3 downto 0);
   signal accept : unsigned(0 downto 0);
   signal wx_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal wy_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");

@@ -23,7 +23,7 @@ module fxrt_traverse (
   output wire [0:0] visit,
   output wire [12:0] visit_node,
   output wire [5:0] stack_depth,
-  output wire [2:0] fsm_state
+  output wire [3:0] fsm_state
 );
 
   reg [72:0] node_rom [0:8191];
@@ -36,17 +36,23 @@ module fxrt_traverse (
   initial $readmemh("fxrt_traverse_leaf_rom.hex", leaf_rom);
 
   // states of state
-  localparam [2:0] st_idle = 3'h0;
-  localparam [2:0] st_aabb = 3'h1;
-  localparam [2:0] st_node = 3'h2;
-  localparam [2:0] st_inner = 3'h3;
-  localparam [2:0] st_leaf = 3'h4;
-  localparam [2:0] st_pop = 3'h5;
-  localparam [2:0] st_done = 3'h6;
+  localparam [3:0] st_idle = 4'h0;
+  localparam [3:0] st_aabb = 4'h1;
+  localparam [3:0] st_box = 4'h2;
+  localparam [3:0] st_fetch = 4'h3;
+  localparam [3:0] st_node = 4'h4;
+  localparam [3:0] st_clip1 = 4'h5;
+  localparam [3:0] st_dist = 4'h6;
+  localparam [3:0] st_step = 4'h7;
+  localparam [3:0] st_leaf = 4'h8;
+  localparam [3:0] st_pop = 4'h9;
+  localparam [3:0] st_done = 4'ha;
 
   // not in a stage or state machine
-  wire [12:0] node_addr;
   reg [72:0] node_word = 73'h0000000000000000000;
+  reg [72:0] node_word_r = 73'h0000000000000000000;
+  reg [12:0] node_d1 = 13'h0000;
+  wire [0:0] node_settled;
   wire [1:0] nw_axis;
   wire [28:0] nw_clip0;
   wire [28:0] nw_clip1;
@@ -57,6 +63,7 @@ module fxrt_traverse (
   wire [0:0] nw_is_leaf;
   wire [0:0] in_aabb;
   wire [0:0] in_node;
+  wire [0:0] in_clip1;
   wire [28:0] box_hi_0 = 29'h1fffffff;
   wire [28:0] box_hi_1 = 29'h0faab179;
   wire [28:0] box_hi_2 = 29'h13e4f19b;
@@ -67,48 +74,64 @@ module fxrt_traverse (
   wire [28:0] k_0 = 29'h00000000;
   reg [28:0] case_aabb_k_1;
   wire [28:0] aabb_plane;
-  wire [1:0] mux_in_node;
-  wire [1:0] pu_axis;
-  wire [28:0] mux_in_node_1;
-  wire [28:0] pu_plane;
-  wire [29:0] rs_pu_plane;
-  wire signed [29:0] s_rs_pu_plane;
-  reg [28:0] case_pu_axis;
-  wire [29:0] rs_case_pu_axis;
-  wire signed [29:0] s_rs_case_pu_axis;
-  wire signed [29:0] pu_delta;
-  reg signed [47:0] case_pu_axis_1;
-  wire signed [77:0] x_1;
+  wire [1:0] k_2 = 2'h2;
+  wire [0:0] aabb_last;
+  wire [0:0] in_aabb_or_in_clip1;
+  wire [0:0] not_nw_is_leaf;
+  wire [0:0] and_0;
+  wire [0:0] pu_issue;
+  wire [0:0] in_aabb_and_aabb_last;
+  wire [0:0] pu_issue_last;
+  wire [28:0] mux_in_aabb;
+  wire [28:0] pu_issue_plane;
+  wire [1:0] mux_in_aabb_1;
+  wire [1:0] pu_issue_axis;
+  reg [0:0] pu_sel_valid = 1'h0;
+  reg [0:0] pu_sel_last = 1'h0;
+  reg [28:0] pu_sel_plane = 29'h00000000;
+  reg [1:0] pu_sel_axis = 2'h0;
+  wire [29:0] rs_pu_sel_plane;
+  wire signed [29:0] s_rs_pu_sel_plane;
+  reg [28:0] case_pu_sel_axis;
+  wire [29:0] rs_case_pu_sel_axis;
+  wire signed [29:0] s_rs_case_pu_sel_axis;
+  wire signed [29:0] pu_diff;
+  reg signed [29:0] pu_delta = 30'sh00000000;
+  reg signed [47:0] pu_inv_axis;
+  reg signed [47:0] pu_inv = 48'sh000000000000;
+  reg [0:0] pu_delta_valid = 1'h0;
+  reg [0:0] pu_delta_last = 1'h0;
+  wire signed [77:0] pu_mul;
+  reg signed [77:0] pu_product = 78'sh00000000000000000000;
+  reg [0:0] pu_product_valid = 1'h0;
+  reg [0:0] pu_product_last = 1'h0;
   wire signed [77:0] pu_shifted;
   wire signed [77:0] k_1073741824 = 78'sh00000000000040000000;
-  wire [0:0] lt_2;
+  wire [0:0] lt_4;
   wire signed [77:0] k_m1 = 78'sh3fffffffffffffffffff;
   wire [0:0] pu_shifted_lt_k_m1;
   wire signed [77:0] mux_pu_shifted_lt_k_m1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [77:0] mux_lt_2;
+  wire signed [77:0] mux_lt_4;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [31:0] plane_t;
-  wire [1:0] k_2 = 2'h2;
-  wire [0:0] aabb_last;
-  wire [1:0] k_0_1 = 2'h0;
-  wire [0:0] aabb_k_eq_k_0_1;
+  wire signed [31:0] pu_clamped;
+  reg signed [31:0] plane_t = 32'sh00000000;
+  reg [0:0] plane_t_valid = 1'h0;
+  reg [0:0] plane_t_last = 1'h0;
+  wire [0:0] not_plane_t_last;
+  wire [0:0] d0_arrives;
+  wire [0:0] d1_arrives;
   wire [0:0] plane_t_lt_tmax;
-  wire [0:0] or_3;
-  wire signed [31:0] aabb_tmax;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
-  reg signed [47:0] case_axis_r;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] inner_negative;
+  wire signed [31:0] box_tmax;
+  wire [0:0] bits_plane_t;
+  wire [0:0] box_miss;
+  wire signed [31:0] near_end;
+  wire signed [31:0] far_start;
   wire [12:0] k_1 = 13'h0001;
   wire [12:0] child_r_plus_k_1;
   wire [12:0] near;
   wire [12:0] far;
-  wire signed [31:0] near_end;
-  wire signed [31:0] far_start;
-  wire [0:0] tmax_lt_near_end;
   wire signed [31:0] near_max;
-  wire [0:0] tmin_lt_far_start;
   wire signed [31:0] far_min;
   wire [0:0] go_near;
   wire [0:0] go_far;
@@ -126,13 +149,26 @@ module fxrt_traverse (
   wire [31:0] bits_stack_top_1;
   wire signed [31:0] top_tmin;
   wire [12:0] top_node;
+  wire [0:0] in_leaf;
+  reg [0:0] was_leaf = 1'h0;
+  wire [1:0] k_0_1 = 2'h0;
+  wire [12:0] k_0_2 = 13'h0000;
+  wire signed [31:0] k_0_3 = 32'sh00000000;
+  wire signed [31:0] k_1073741824_1 = 32'sh40000000;
+  wire [0:0] k_0_4 = 1'h0;
   wire [1:0] k_1_2 = 2'h1;
   wire [1:0] aabb_k_plus_k_1_2;
-  wire signed [31:0] k_0_2 = 32'sh00000000;
-  wire [12:0] k_0_3 = 13'h0000;
-  wire [0:0] aabb_tmax_lt_k_0_2;
-  wire [2:0] k_0_4 = 3'h0;
-  wire [0:0] nw_count_eq_k_0_4;
+  wire [2:0] k_0_5 = 3'h0;
+  wire [0:0] nw_count_eq_k_0_5;
+  wire [0:0] tmin_le_tmax_1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
+  reg signed [47:0] case_axis_r;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_case_axis_r;
+  wire [0:0] near_end_lt_tmax;
+  wire [0:0] tmin_lt_far_start;
+  wire [0:0] tmin_le_near_end;
+  wire [0:0] far_start_le_tmax;
   wire [0:0] go_near_and_go_far;
   wire [4:0] rs_sp;
   wire [5:0] sp_plus_k_1_1;
@@ -140,25 +176,37 @@ module fxrt_traverse (
   wire [2:0] k_1_3 = 3'h1;
   wire [2:0] leaf_left_minus_k_1_3;
   wire [0:0] leaf_left_eq_k_1_3;
-  wire [5:0] k_0_5 = 6'h00;
-  wire [0:0] sp_eq_k_0_5;
+  wire [5:0] k_0_6 = 6'h00;
+  wire [0:0] sp_eq_k_0_6;
   wire [5:0] sp_minus_k_1_1_1;
   wire [0:0] in_idle;
-  wire [0:0] in_leaf;
   wire [0:0] in_done;
   reg [12:0] leaf_tri = 13'h0000;
+  reg [12:0] leaf_tri_r = 13'h0000;
   wire [0:0] in_leaf_or_in_done;
-  reg [0:0] emit_r = 1'h0;
-  reg [0:0] end_r = 1'h0;
+  (* mem2reg *) reg [0:0] emit_r_sr [1:2];
+  integer emit_r_i;
+  initial for (emit_r_i = 1; emit_r_i <= 2; emit_r_i = emit_r_i + 1) emit_r_sr[emit_r_i] = 1'h0;
+  wire [0:0] emit_r;
+  (* mem2reg *) reg [0:0] end_r_sr [1:2];
+  integer end_r_i;
+  initial for (end_r_i = 1; end_r_i <= 2; end_r_i = end_r_i + 1) end_r_sr[end_r_i] = 1'h0;
+  wire [0:0] end_r;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 30:0 are read
   wire [31:0] u_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_tmin;
-  reg [30:0] tmin_r = 31'h00000000;
-  reg [19:0] id_r = 20'h00000;
+  (* mem2reg *) reg [30:0] tmin_r_sr [1:2];
+  integer tmin_r_i;
+  initial for (tmin_r_i = 1; tmin_r_i <= 2; tmin_r_i = tmin_r_i + 1) tmin_r_sr[tmin_r_i] = 31'h00000000;
+  wire [30:0] tmin_r;
+  (* mem2reg *) reg [19:0] id_r_sr [1:2];
+  integer id_r_i;
+  initial for (id_r_i = 1; id_r_i <= 2; id_r_i = id_r_i + 1) id_r_sr[id_r_i] = 20'h00000;
+  wire [19:0] id_r;
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
-  reg [2:0] state = st_idle;
+  reg [3:0] state = st_idle;
   reg [19:0] ray_id_r = 20'h00000;
   reg [28:0] ox_r = 29'h00000000;
   reg [28:0] oy_r = 29'h00000000;
@@ -170,14 +218,44 @@ module fxrt_traverse (
   reg [1:0] axis_r = 2'h0;
   reg [28:0] clip1_r = 29'h00000000;
   reg [12:0] child_r = 13'h0000;
-  reg signed [31:0] d0_r = 32'sh00000000;
   reg [1:0] aabb_k = 2'h0;
   reg signed [31:0] tmin = 32'sh00000000;
   reg signed [31:0] tmax = 32'sh00000000;
+  reg [0:0] box_missed = 1'h0;
+  reg [0:0] negative = 1'h0;
+  reg signed [31:0] d0_r = 32'sh00000000;
+  reg [0:0] tmin_le_tmax = 1'h0;
+  reg [0:0] near_lt_tmax = 1'h0;
+  reg [0:0] far_gt_tmin = 1'h0;
+  reg [0:0] tmin_le_near = 1'h0;
+  reg [0:0] far_le_tmax = 1'h0;
+  reg signed [31:0] near_end_r = 32'sh00000000;
+  reg signed [31:0] far_start_r = 32'sh00000000;
+  reg [12:0] far_r = 13'h0000;
   reg [5:0] sp = 6'h00;
   reg [12:0] leaf_ptr = 13'h0000;
   reg [2:0] leaf_left = 3'h0;
+  reg [0:0] popped_ahead = 1'h0;
   reg [1:0] aabb_k_next;
+  wire [0:0] not_go_near;
+  wire [0:0] not_go_near_and_go_far;
+  wire [12:0] mux_not_go_near_and_go_far;
+  wire [0:0] not_go_far;
+  wire [0:0] and_11;
+  wire [12:0] mux_and_11;
+  wire [0:0] not_sp_eq_k_0_6;
+  wire [12:0] mux_not_sp_eq_k_0_6;
+  reg [12:0] node_next;
+  wire [0:0] not_go_near_and_go_far_1;
+  wire signed [31:0] mux_not_go_near_and_go_far_1;
+  wire signed [31:0] mux_not_sp_eq_k_0_6_1;
+  reg signed [31:0] tmin_next;
+  wire signed [31:0] mux_plane_t_valid;
+  wire signed [31:0] mux_go_near;
+  wire signed [31:0] mux_not_sp_eq_k_0_6_2;
+  reg signed [31:0] tmax_next;
+  wire [0:0] mux_plane_t_valid_1;
+  reg [0:0] box_missed_next;
   wire [19:0] mux_ray_valid;
   wire [19:0] ray_id_r_next;
   wire [28:0] mux_ray_valid_1;
@@ -192,74 +270,87 @@ module fxrt_traverse (
   wire [28:0] oz_r_next;
   wire signed [47:0] mux_ray_valid_6;
   wire signed [47:0] invz_r_next;
-  wire [2:0] mux_ray_valid_7;
-  wire [0:0] and_5;
-  wire [2:0] mux_and_5;
-  wire [0:0] not_aabb_tmax_lt_k_0_2;
-  wire [0:0] and_6;
-  wire [2:0] mux_and_6;
-  wire [0:0] and_7;
-  wire [2:0] mux_and_7;
-  wire [0:0] not_nw_count_eq_k_0_4;
-  wire [0:0] and_8;
-  wire [2:0] mux_and_8;
-  wire [0:0] not_nw_is_leaf;
-  wire [2:0] mux_not_nw_is_leaf;
-  wire [2:0] mux_go_near;
-  wire [0:0] not_go_near;
-  wire [0:0] not_go_near_and_go_far;
-  wire [2:0] mux_not_go_near_and_go_far;
-  wire [0:0] not_go_far;
-  wire [0:0] and_9;
-  wire [2:0] mux_and_9;
-  wire [2:0] mux_leaf_left_eq_k_1_3;
-  wire [2:0] mux_sp_eq_k_0_5;
-  wire [0:0] not_sp_eq_k_0_5;
-  wire [2:0] mux_not_sp_eq_k_0_5;
-  reg [2:0] state_next;
-  wire signed [31:0] mux_go_near_1;
-  wire signed [31:0] mux_not_sp_eq_k_0_5_1;
-  reg signed [31:0] tmax_next;
-  wire signed [31:0] mux_aabb_last;
-  wire [0:0] not_go_near_and_go_far_1;
-  wire signed [31:0] mux_not_go_near_and_go_far_1;
-  wire signed [31:0] mux_not_sp_eq_k_0_5_2;
-  reg signed [31:0] tmin_next;
-  wire [12:0] mux_aabb_last_1;
-  wire [12:0] mux_go_near_2;
+  wire [3:0] mux_ray_valid_7;
+  wire [3:0] mux_aabb_last;
+  wire [0:0] d1_arrives_and_box_miss;
+  wire [3:0] mux_d1_arrives_and_box_miss;
+  wire [0:0] not_box_miss;
+  wire [0:0] and_12;
+  wire [3:0] mux_and_12;
+  wire [3:0] mux_node_settled;
+  wire [0:0] and_13;
+  wire [3:0] mux_and_13;
+  wire [0:0] not_nw_count_eq_k_0_5;
+  wire [0:0] and_14;
+  wire [3:0] mux_and_14;
+  wire [0:0] not_nw_is_leaf_1;
+  wire [3:0] mux_not_nw_is_leaf_1;
+  wire [3:0] mux_d1_arrives;
+  wire [3:0] mux_go_near_1;
   wire [0:0] not_go_near_and_go_far_2;
-  wire [12:0] mux_not_go_near_and_go_far_2;
-  wire [12:0] mux_not_sp_eq_k_0_5_3;
-  reg [12:0] node_next;
+  wire [3:0] mux_not_go_near_and_go_far_2;
+  wire [0:0] and_15;
+  wire [3:0] mux_and_15;
+  wire [3:0] mux_leaf_left_eq_k_1_3;
+  wire [3:0] mux_sp_eq_k_0_6;
+  wire [0:0] and_16;
+  wire [3:0] mux_and_16;
+  wire [0:0] not_popped_ahead;
+  wire [0:0] and_17;
+  wire [3:0] mux_and_17;
+  reg [3:0] state_next;
   wire [12:0] mux_nw_is_leaf;
   reg [12:0] leaf_ptr_next;
   wire [2:0] mux_nw_is_leaf_1;
   reg [2:0] leaf_left_next;
-  wire [1:0] mux_not_nw_is_leaf_1;
+  wire [0:0] mux_nw_is_leaf_2;
+  wire [0:0] and_18;
+  wire [0:0] mux_and_18;
+  wire [0:0] mux_leaf_left_eq_k_1_3_1;
+  reg [0:0] popped_ahead_next;
+  wire [1:0] mux_not_nw_is_leaf_1_1;
   wire [1:0] axis_r_next;
-  wire [28:0] mux_not_nw_is_leaf_2;
+  wire [28:0] mux_not_nw_is_leaf_1_2;
   wire [28:0] clip1_r_next;
-  wire [12:0] mux_not_nw_is_leaf_3;
+  wire [12:0] mux_not_nw_is_leaf_1_3;
   wire [12:0] child_r_next;
-  wire signed [31:0] mux_not_nw_is_leaf_4;
+  wire [0:0] mux_not_nw_is_leaf_1_4;
+  wire [0:0] tmin_le_tmax_next;
+  wire [0:0] negative_next;
+  wire [0:0] in_dist;
+  wire [12:0] far_r_next;
+  wire signed [31:0] mux_d0_arrives;
   wire signed [31:0] d0_r_next;
+  wire signed [31:0] mux_d1_arrives_1;
+  wire signed [31:0] near_end_r_next;
+  wire signed [31:0] mux_d1_arrives_2;
+  wire signed [31:0] far_start_r_next;
+  wire [0:0] mux_d1_arrives_3;
+  wire [0:0] near_lt_tmax_next;
+  wire [0:0] mux_d1_arrives_4;
+  wire [0:0] far_gt_tmin_next;
+  wire [0:0] mux_d1_arrives_5;
+  wire [0:0] tmin_le_near_next;
+  wire [0:0] mux_d1_arrives_6;
+  wire [0:0] far_le_tmax_next;
   wire [5:0] mux_go_near_and_go_far;
-  wire [5:0] mux_not_sp_eq_k_0_5_4;
+  wire [5:0] mux_not_sp_eq_k_0_6_3;
   reg [5:0] sp_next;
-  wire [0:0] in_inner;
-  wire [0:0] and_10;
+  wire [0:0] in_step;
+  wire [0:0] and_19;
 
   // not in a stage or state machine
-  assign node_addr = node_next;
-  assign nw_axis = node_word[1:0];
-  assign nw_clip0 = node_word[30:2];
-  assign nw_clip1 = node_word[59:31];
-  assign nw_child = node_word[72:60];
-  assign nw_first = node_word[14:2];
-  assign nw_count = node_word[17:15];
+  assign node_settled = node == node_d1;
+  assign nw_axis = node_word_r[1:0];
+  assign nw_clip0 = node_word_r[30:2];
+  assign nw_clip1 = node_word_r[59:31];
+  assign nw_child = node_word_r[72:60];
+  assign nw_first = node_word_r[14:2];
+  assign nw_count = node_word_r[17:15];
   assign nw_is_leaf = nw_axis == k_3;
   assign in_aabb = state == st_aabb;
   assign in_node = state == st_node;
+  assign in_clip1 = state == st_clip1;
   always @* begin
     case (aabb_k)
       2'h1: case_aabb_k = invy_r;
@@ -276,63 +367,62 @@ module fxrt_traverse (
     endcase
   end
   assign aabb_plane = aabb_neg ? k_0 : case_aabb_k_1;
-  assign mux_in_node = in_node ? nw_axis : axis_r;
-  assign pu_axis = in_aabb ? aabb_k : mux_in_node;
-  assign mux_in_node_1 = in_node ? nw_clip0 : clip1_r;
-  assign pu_plane = in_aabb ? aabb_plane : mux_in_node_1;
-  assign rs_pu_plane = {{1{1'b0}}, pu_plane};
-  assign s_rs_pu_plane = $signed(rs_pu_plane);
+  assign aabb_last = aabb_k == k_2;
+  assign in_aabb_or_in_clip1 = in_aabb | in_clip1;
+  assign not_nw_is_leaf = ~nw_is_leaf;
+  assign and_0 = in_node & not_nw_is_leaf;
+  assign pu_issue = in_aabb_or_in_clip1 | and_0;
+  assign in_aabb_and_aabb_last = in_aabb & aabb_last;
+  assign pu_issue_last = in_clip1 | in_aabb_and_aabb_last;
+  assign mux_in_aabb = in_aabb ? aabb_plane : clip1_r;
+  assign pu_issue_plane = in_node ? nw_clip0 : mux_in_aabb;
+  assign mux_in_aabb_1 = in_aabb ? aabb_k : axis_r;
+  assign pu_issue_axis = in_node ? nw_axis : mux_in_aabb_1;
+  assign rs_pu_sel_plane = {{1{1'b0}}, pu_sel_plane};
+  assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
   always @* begin
-    case (pu_axis)
-      2'h1: case_pu_axis = oy_r;
-      2'h2: case_pu_axis = oz_r;
-      default: case_pu_axis = ox_r;
+    case (pu_sel_axis)
+      2'h1: case_pu_sel_axis = oy_r;
+      2'h2: case_pu_sel_axis = oz_r;
+      default: case_pu_sel_axis = ox_r;
     endcase
   end
-  assign rs_case_pu_axis = {{1{1'b0}}, case_pu_axis};
-  assign s_rs_case_pu_axis = $signed(rs_case_pu_axis);
-  assign pu_delta = s_rs_pu_plane - s_rs_case_pu_axis;
+  assign rs_case_pu_sel_axis = {{1{1'b0}}, case_pu_sel_axis};
+  assign s_rs_case_pu_sel_axis = $signed(rs_case_pu_sel_axis);
+  assign pu_diff = s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
   always @* begin
-    case (pu_axis)
-      2'h1: case_pu_axis_1 = invy_r;
-      2'h2: case_pu_axis_1 = invz_r;
-      default: case_pu_axis_1 = invx_r;
+    case (pu_sel_axis)
+      2'h1: pu_inv_axis = invy_r;
+      2'h2: pu_inv_axis = invz_r;
+      default: pu_inv_axis = invx_r;
     endcase
   end
-  assign x_1 = $signed({{48{pu_delta[29]}}, pu_delta}) * $signed({{30{case_pu_axis_1[47]}}, case_pu_axis_1});
-  assign pu_shifted = x_1 >>> 16;
-  assign lt_2 = k_1073741824 < pu_shifted;
+  assign pu_mul = $signed({{48{pu_delta[29]}}, pu_delta}) * $signed({{30{pu_inv[47]}}, pu_inv});
+  assign pu_shifted = pu_product >>> 16;
+  assign lt_4 = k_1073741824 < pu_shifted;
   assign pu_shifted_lt_k_m1 = pu_shifted < k_m1;
   assign mux_pu_shifted_lt_k_m1 = pu_shifted_lt_k_m1 ? k_m1 : pu_shifted;
-  assign mux_lt_2 = lt_2 ? k_1073741824 : mux_pu_shifted_lt_k_m1;
-  assign plane_t = $signed(mux_lt_2[31:0]);
-  assign aabb_last = aabb_k == k_2;
-  assign aabb_k_eq_k_0_1 = aabb_k == k_0_1;
+  assign mux_lt_4 = lt_4 ? k_1073741824 : mux_pu_shifted_lt_k_m1;
+  assign pu_clamped = $signed(mux_lt_4[31:0]);
+  assign not_plane_t_last = ~plane_t_last;
+  assign d0_arrives = plane_t_valid & not_plane_t_last;
+  assign d1_arrives = plane_t_valid & plane_t_last;
   assign plane_t_lt_tmax = plane_t < tmax;
-  assign or_3 = aabb_k_eq_k_0_1 | plane_t_lt_tmax;
-  assign aabb_tmax = or_3 ? plane_t : tmax;
-  always @* begin
-    case (axis_r)
-      2'h1: case_axis_r = invy_r;
-      2'h2: case_axis_r = invz_r;
-      default: case_axis_r = invx_r;
-    endcase
-  end
-  assign inner_negative = case_axis_r[47];
+  assign box_tmax = plane_t_lt_tmax ? plane_t : tmax;
+  assign bits_plane_t = plane_t[31];
+  assign box_miss = box_missed | bits_plane_t;
+  assign near_end = negative ? plane_t : d0_r;
+  assign far_start = negative ? d0_r : plane_t;
   assign child_r_plus_k_1 = child_r + k_1;
-  assign near = inner_negative ? child_r_plus_k_1 : child_r;
-  assign far = inner_negative ? child_r : child_r_plus_k_1;
-  assign near_end = inner_negative ? plane_t : d0_r;
-  assign far_start = inner_negative ? d0_r : plane_t;
-  assign tmax_lt_near_end = tmax < near_end;
-  assign near_max = tmax_lt_near_end ? tmax : near_end;
-  assign tmin_lt_far_start = tmin < far_start;
-  assign far_min = tmin_lt_far_start ? far_start : tmin;
-  assign go_near = tmin <= near_max;
-  assign go_far = far_min <= tmax;
+  assign near = negative ? child_r_plus_k_1 : child_r;
+  assign far = negative ? child_r : child_r_plus_k_1;
+  assign near_max = near_lt_tmax ? near_end_r : tmax;
+  assign far_min = far_gt_tmin ? far_start_r : tmin;
+  assign go_near = tmin_le_near & tmin_le_tmax;
+  assign go_far = far_le_tmax & tmin_le_tmax;
   assign u_far_min = $unsigned(far_min);
   assign u_tmax = $unsigned(tmax);
-  assign push_entry = {far, u_far_min, u_tmax};
+  assign push_entry = {far_r, u_far_min, u_tmax};
   assign sp_minus_k_1_1 = sp - k_1_1;
   assign rs_sp_minus_k_1_1 = sp_minus_k_1_1[4:0];
   assign bits_stack_top = stack_top[31:0];
@@ -340,33 +430,75 @@ module fxrt_traverse (
   assign bits_stack_top_1 = stack_top[63:32];
   assign top_tmin = $signed(bits_stack_top_1);
   assign top_node = stack_top[76:64];
+  assign in_leaf = state == st_leaf;
   assign aabb_k_plus_k_1_2 = aabb_k + k_1_2;
-  assign aabb_tmax_lt_k_0_2 = aabb_tmax < k_0_2;
-  assign nw_count_eq_k_0_4 = nw_count == k_0_4;
+  assign nw_count_eq_k_0_5 = nw_count == k_0_5;
+  assign tmin_le_tmax_1 = tmin <= tmax;
+  always @* begin
+    case (axis_r)
+      2'h1: case_axis_r = invy_r;
+      2'h2: case_axis_r = invz_r;
+      default: case_axis_r = invx_r;
+    endcase
+  end
+  assign bits_case_axis_r = case_axis_r[47];
+  assign near_end_lt_tmax = near_end < tmax;
+  assign tmin_lt_far_start = tmin < far_start;
+  assign tmin_le_near_end = tmin <= near_end;
+  assign far_start_le_tmax = far_start <= tmax;
   assign go_near_and_go_far = go_near & go_far;
   assign rs_sp = sp[4:0];
   assign sp_plus_k_1_1 = sp + k_1_1;
   assign leaf_ptr_plus_k_1 = leaf_ptr + k_1;
   assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
   assign leaf_left_eq_k_1_3 = leaf_left == k_1_3;
-  assign sp_eq_k_0_5 = sp == k_0_5;
+  assign sp_eq_k_0_6 = sp == k_0_6;
   assign sp_minus_k_1_1_1 = sp - k_1_1;
   assign in_idle = state == st_idle;
-  assign in_leaf = state == st_leaf;
   assign in_done = state == st_done;
   assign in_leaf_or_in_done = in_leaf | in_done;
+  assign emit_r = emit_r_sr[2];
+  assign end_r = end_r_sr[2];
   assign u_tmin = $unsigned(tmin);
   assign rs_u_tmin = u_tmin[30:0];
+  assign tmin_r = tmin_r_sr[2];
+  assign id_r = id_r_sr[2];
 
   always @(posedge clk) begin : regs
-    if (and_10) stack[rs_sp] <= push_entry;
-    node_word <= node_rom[node_addr];
+    if (and_19) stack[rs_sp] <= push_entry;
+    node_word <= node_rom[node];
+    node_word_r <= node_word;
+    node_d1 <= node;
+    pu_sel_valid <= pu_issue;
+    pu_sel_last <= pu_issue_last;
+    pu_sel_plane <= pu_issue_plane;
+    pu_sel_axis <= pu_issue_axis;
+    pu_delta <= pu_diff;
+    pu_inv <= pu_inv_axis;
+    pu_delta_valid <= pu_sel_valid;
+    pu_delta_last <= pu_sel_last;
+    pu_product <= pu_mul;
+    pu_product_valid <= pu_delta_valid;
+    pu_product_last <= pu_delta_last;
+    plane_t <= pu_clamped;
+    plane_t_valid <= pu_product_valid;
+    plane_t_last <= pu_product_last;
     stack_top <= stack[rs_sp_minus_k_1_1];
+    was_leaf <= in_leaf;
     leaf_tri <= leaf_rom[leaf_ptr];
-    emit_r <= in_leaf_or_in_done;
-    end_r <= in_done;
-    tmin_r <= rs_u_tmin;
-    id_r <= ray_id_r;
+    leaf_tri_r <= leaf_tri;
+    for (emit_r_i = 2; emit_r_i > 1; emit_r_i = emit_r_i - 1)
+      emit_r_sr[emit_r_i] <= emit_r_sr[emit_r_i - 1];
+    emit_r_sr[1] <= in_leaf_or_in_done;
+    for (end_r_i = 2; end_r_i > 1; end_r_i = end_r_i - 1)
+      end_r_sr[end_r_i] <= end_r_sr[end_r_i - 1];
+    end_r_sr[1] <= in_done;
+    for (tmin_r_i = 2; tmin_r_i > 1; tmin_r_i = tmin_r_i - 1)
+      tmin_r_sr[tmin_r_i] <= tmin_r_sr[tmin_r_i - 1];
+    tmin_r_sr[1] <= rs_u_tmin;
+    for (id_r_i = 2; id_r_i > 1; id_r_i = id_r_i - 1)
+      id_r_sr[id_r_i] <= id_r_sr[id_r_i - 1];
+    id_r_sr[1] <= ray_id_r;
   end
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
@@ -375,6 +507,55 @@ module fxrt_traverse (
       st_idle: aabb_k_next = k_0_1;
       st_aabb: aabb_k_next = aabb_k_plus_k_1_2;
       default: aabb_k_next = aabb_k;
+    endcase
+  end
+  assign not_go_near = ~go_near;
+  assign not_go_near_and_go_far = not_go_near & go_far;
+  assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? far_r : node;
+  assign not_go_far = ~go_far;
+  assign and_11 = not_go_near & not_go_far;
+  assign mux_and_11 = and_11 ? top_node : mux_not_go_near_and_go_far;
+  assign not_sp_eq_k_0_6 = ~sp_eq_k_0_6;
+  assign mux_not_sp_eq_k_0_6 = not_sp_eq_k_0_6 ? top_node : node;
+  always @* begin
+    case (state)
+      st_idle: node_next = k_0_2;
+      st_dist: node_next = near;
+      st_step: node_next = mux_and_11;
+      st_leaf: node_next = top_node;
+      st_pop: node_next = mux_not_sp_eq_k_0_6;
+      default: node_next = node;
+    endcase
+  end
+  assign not_go_near_and_go_far_1 = not_go_near & go_far;
+  assign mux_not_go_near_and_go_far_1 = not_go_near_and_go_far_1 ? far_min : tmin;
+  assign mux_not_sp_eq_k_0_6_1 = not_sp_eq_k_0_6 ? top_tmin : tmin;
+  always @* begin
+    case (state)
+      st_idle: tmin_next = k_0_3;
+      st_step: tmin_next = mux_not_go_near_and_go_far_1;
+      st_pop: tmin_next = mux_not_sp_eq_k_0_6_1;
+      default: tmin_next = tmin;
+    endcase
+  end
+  assign mux_plane_t_valid = plane_t_valid ? box_tmax : tmax;
+  assign mux_go_near = go_near ? near_max : tmax;
+  assign mux_not_sp_eq_k_0_6_2 = not_sp_eq_k_0_6 ? top_tmax : tmax;
+  always @* begin
+    case (state)
+      st_idle: tmax_next = k_1073741824_1;
+      st_box: tmax_next = mux_plane_t_valid;
+      st_step: tmax_next = mux_go_near;
+      st_pop: tmax_next = mux_not_sp_eq_k_0_6_2;
+      default: tmax_next = tmax;
+    endcase
+  end
+  assign mux_plane_t_valid_1 = plane_t_valid ? box_miss : box_missed;
+  always @* begin
+    case (state)
+      st_idle: box_missed_next = k_0_4;
+      st_box: box_missed_next = mux_plane_t_valid_1;
+      default: box_missed_next = box_missed;
     endcase
   end
   assign mux_ray_valid = ray_valid ? ray_id : ray_id_r;
@@ -392,74 +573,47 @@ module fxrt_traverse (
   assign mux_ray_valid_6 = ray_valid ? invz : invz_r;
   assign invz_r_next = in_idle ? mux_ray_valid_6 : invz_r;
   assign mux_ray_valid_7 = ray_valid ? st_aabb : state;
-  assign and_5 = aabb_last & aabb_tmax_lt_k_0_2;
-  assign mux_and_5 = and_5 ? st_done : state;
-  assign not_aabb_tmax_lt_k_0_2 = ~aabb_tmax_lt_k_0_2;
-  assign and_6 = aabb_last & not_aabb_tmax_lt_k_0_2;
-  assign mux_and_6 = and_6 ? st_node : mux_and_5;
-  assign and_7 = nw_is_leaf & nw_count_eq_k_0_4;
-  assign mux_and_7 = and_7 ? st_pop : state;
-  assign not_nw_count_eq_k_0_4 = ~nw_count_eq_k_0_4;
-  assign and_8 = nw_is_leaf & not_nw_count_eq_k_0_4;
-  assign mux_and_8 = and_8 ? st_leaf : mux_and_7;
-  assign not_nw_is_leaf = ~nw_is_leaf;
-  assign mux_not_nw_is_leaf = not_nw_is_leaf ? st_inner : mux_and_8;
-  assign mux_go_near = go_near ? st_node : state;
-  assign not_go_near = ~go_near;
-  assign not_go_near_and_go_far = not_go_near & go_far;
-  assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? st_node : mux_go_near;
-  assign not_go_far = ~go_far;
-  assign and_9 = not_go_near & not_go_far;
-  assign mux_and_9 = and_9 ? st_pop : mux_not_go_near_and_go_far;
+  assign mux_aabb_last = aabb_last ? st_box : state;
+  assign d1_arrives_and_box_miss = d1_arrives & box_miss;
+  assign mux_d1_arrives_and_box_miss = d1_arrives_and_box_miss ? st_done : state;
+  assign not_box_miss = ~box_miss;
+  assign and_12 = d1_arrives & not_box_miss;
+  assign mux_and_12 = and_12 ? st_node : mux_d1_arrives_and_box_miss;
+  assign mux_node_settled = node_settled ? st_node : state;
+  assign and_13 = nw_is_leaf & nw_count_eq_k_0_5;
+  assign mux_and_13 = and_13 ? st_pop : state;
+  assign not_nw_count_eq_k_0_5 = ~nw_count_eq_k_0_5;
+  assign and_14 = nw_is_leaf & not_nw_count_eq_k_0_5;
+  assign mux_and_14 = and_14 ? st_leaf : mux_and_13;
+  assign not_nw_is_leaf_1 = ~nw_is_leaf;
+  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_14;
+  assign mux_d1_arrives = d1_arrives ? st_step : state;
+  assign mux_go_near_1 = go_near ? st_node : state;
+  assign not_go_near_and_go_far_2 = not_go_near & go_far;
+  assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near_1;
+  assign and_15 = not_go_near & not_go_far;
+  assign mux_and_15 = and_15 ? st_pop : mux_not_go_near_and_go_far_2;
   assign mux_leaf_left_eq_k_1_3 = leaf_left_eq_k_1_3 ? st_pop : state;
-  assign mux_sp_eq_k_0_5 = sp_eq_k_0_5 ? st_done : state;
-  assign not_sp_eq_k_0_5 = ~sp_eq_k_0_5;
-  assign mux_not_sp_eq_k_0_5 = not_sp_eq_k_0_5 ? st_node : mux_sp_eq_k_0_5;
+  assign mux_sp_eq_k_0_6 = sp_eq_k_0_6 ? st_done : state;
+  assign and_16 = not_sp_eq_k_0_6 & popped_ahead;
+  assign mux_and_16 = and_16 ? st_node : mux_sp_eq_k_0_6;
+  assign not_popped_ahead = ~popped_ahead;
+  assign and_17 = not_sp_eq_k_0_6 & not_popped_ahead;
+  assign mux_and_17 = and_17 ? st_fetch : mux_and_16;
   always @* begin
     case (state)
       st_idle: state_next = mux_ray_valid_7;
-      st_aabb: state_next = mux_and_6;
-      st_node: state_next = mux_not_nw_is_leaf;
-      st_inner: state_next = mux_and_9;
+      st_aabb: state_next = mux_aabb_last;
+      st_box: state_next = mux_and_12;
+      st_fetch: state_next = mux_node_settled;
+      st_node: state_next = mux_not_nw_is_leaf_1;
+      st_clip1: state_next = st_dist;
+      st_dist: state_next = mux_d1_arrives;
+      st_step: state_next = mux_and_15;
       st_leaf: state_next = mux_leaf_left_eq_k_1_3;
-      st_pop: state_next = mux_not_sp_eq_k_0_5;
+      st_pop: state_next = mux_and_17;
       st_done: state_next = st_idle;
       default: state_next = st_idle;
-    endcase
-  end
-  assign mux_go_near_1 = go_near ? near_max : tmax;
-  assign mux_not_sp_eq_k_0_5_1 = not_sp_eq_k_0_5 ? top_tmax : tmax;
-  always @* begin
-    case (state)
-      st_aabb: tmax_next = aabb_tmax;
-      st_inner: tmax_next = mux_go_near_1;
-      st_pop: tmax_next = mux_not_sp_eq_k_0_5_1;
-      default: tmax_next = tmax;
-    endcase
-  end
-  assign mux_aabb_last = aabb_last ? k_0_2 : tmin;
-  assign not_go_near_and_go_far_1 = not_go_near & go_far;
-  assign mux_not_go_near_and_go_far_1 = not_go_near_and_go_far_1 ? far_min : tmin;
-  assign mux_not_sp_eq_k_0_5_2 = not_sp_eq_k_0_5 ? top_tmin : tmin;
-  always @* begin
-    case (state)
-      st_aabb: tmin_next = mux_aabb_last;
-      st_inner: tmin_next = mux_not_go_near_and_go_far_1;
-      st_pop: tmin_next = mux_not_sp_eq_k_0_5_2;
-      default: tmin_next = tmin;
-    endcase
-  end
-  assign mux_aabb_last_1 = aabb_last ? k_0_3 : node;
-  assign mux_go_near_2 = go_near ? near : node;
-  assign not_go_near_and_go_far_2 = not_go_near & go_far;
-  assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? far : mux_go_near_2;
-  assign mux_not_sp_eq_k_0_5_3 = not_sp_eq_k_0_5 ? top_node : node;
-  always @* begin
-    case (state)
-      st_aabb: node_next = mux_aabb_last_1;
-      st_inner: node_next = mux_not_go_near_and_go_far_2;
-      st_pop: node_next = mux_not_sp_eq_k_0_5_3;
-      default: node_next = node;
     endcase
   end
   assign mux_nw_is_leaf = nw_is_leaf ? nw_first : leaf_ptr;
@@ -478,25 +632,54 @@ module fxrt_traverse (
       default: leaf_left_next = leaf_left;
     endcase
   end
-  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf ? nw_axis : axis_r;
-  assign axis_r_next = in_node ? mux_not_nw_is_leaf_1 : axis_r;
-  assign mux_not_nw_is_leaf_2 = not_nw_is_leaf ? nw_clip1 : clip1_r;
-  assign clip1_r_next = in_node ? mux_not_nw_is_leaf_2 : clip1_r;
-  assign mux_not_nw_is_leaf_3 = not_nw_is_leaf ? nw_child : child_r;
-  assign child_r_next = in_node ? mux_not_nw_is_leaf_3 : child_r;
-  assign mux_not_nw_is_leaf_4 = not_nw_is_leaf ? plane_t : d0_r;
-  assign d0_r_next = in_node ? mux_not_nw_is_leaf_4 : d0_r;
-  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_1 : sp;
-  assign mux_not_sp_eq_k_0_5_4 = not_sp_eq_k_0_5 ? sp_minus_k_1_1_1 : sp;
+  assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_4 : popped_ahead;
+  assign and_18 = not_go_near & not_go_far;
+  assign mux_and_18 = and_18 ? k_0_4 : popped_ahead;
+  assign mux_leaf_left_eq_k_1_3_1 = leaf_left_eq_k_1_3 ? was_leaf : popped_ahead;
   always @* begin
     case (state)
-      st_inner: sp_next = mux_go_near_and_go_far;
-      st_pop: sp_next = mux_not_sp_eq_k_0_5_4;
+      st_node: popped_ahead_next = mux_nw_is_leaf_2;
+      st_step: popped_ahead_next = mux_and_18;
+      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_3_1;
+      default: popped_ahead_next = popped_ahead;
+    endcase
+  end
+  assign mux_not_nw_is_leaf_1_1 = not_nw_is_leaf_1 ? nw_axis : axis_r;
+  assign axis_r_next = in_node ? mux_not_nw_is_leaf_1_1 : axis_r;
+  assign mux_not_nw_is_leaf_1_2 = not_nw_is_leaf_1 ? nw_clip1 : clip1_r;
+  assign clip1_r_next = in_node ? mux_not_nw_is_leaf_1_2 : clip1_r;
+  assign mux_not_nw_is_leaf_1_3 = not_nw_is_leaf_1 ? nw_child : child_r;
+  assign child_r_next = in_node ? mux_not_nw_is_leaf_1_3 : child_r;
+  assign mux_not_nw_is_leaf_1_4 = not_nw_is_leaf_1 ? tmin_le_tmax_1 : tmin_le_tmax;
+  assign tmin_le_tmax_next = in_node ? mux_not_nw_is_leaf_1_4 : tmin_le_tmax;
+  assign negative_next = in_clip1 ? bits_case_axis_r : negative;
+  assign in_dist = state == st_dist;
+  assign far_r_next = in_dist ? far : far_r;
+  assign mux_d0_arrives = d0_arrives ? plane_t : d0_r;
+  assign d0_r_next = in_dist ? mux_d0_arrives : d0_r;
+  assign mux_d1_arrives_1 = d1_arrives ? near_end : near_end_r;
+  assign near_end_r_next = in_dist ? mux_d1_arrives_1 : near_end_r;
+  assign mux_d1_arrives_2 = d1_arrives ? far_start : far_start_r;
+  assign far_start_r_next = in_dist ? mux_d1_arrives_2 : far_start_r;
+  assign mux_d1_arrives_3 = d1_arrives ? near_end_lt_tmax : near_lt_tmax;
+  assign near_lt_tmax_next = in_dist ? mux_d1_arrives_3 : near_lt_tmax;
+  assign mux_d1_arrives_4 = d1_arrives ? tmin_lt_far_start : far_gt_tmin;
+  assign far_gt_tmin_next = in_dist ? mux_d1_arrives_4 : far_gt_tmin;
+  assign mux_d1_arrives_5 = d1_arrives ? tmin_le_near_end : tmin_le_near;
+  assign tmin_le_near_next = in_dist ? mux_d1_arrives_5 : tmin_le_near;
+  assign mux_d1_arrives_6 = d1_arrives ? far_start_le_tmax : far_le_tmax;
+  assign far_le_tmax_next = in_dist ? mux_d1_arrives_6 : far_le_tmax;
+  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_1 : sp;
+  assign mux_not_sp_eq_k_0_6_3 = not_sp_eq_k_0_6 ? sp_minus_k_1_1_1 : sp;
+  always @* begin
+    case (state)
+      st_step: sp_next = mux_go_near_and_go_far;
+      st_pop: sp_next = mux_not_sp_eq_k_0_6_3;
       default: sp_next = sp;
     endcase
   end
-  assign in_inner = state == st_inner;
-  assign and_10 = in_inner & go_near_and_go_far;
+  assign in_step = state == st_step;
+  assign and_19 = in_step & go_near_and_go_far;
 
   always @(posedge clk) begin : state_regs
     if (rst) state <= st_idle;
@@ -513,20 +696,31 @@ module fxrt_traverse (
     axis_r <= axis_r_next;
     clip1_r <= clip1_r_next;
     child_r <= child_r_next;
-    d0_r <= d0_r_next;
     aabb_k <= aabb_k_next;
     tmin <= tmin_next;
     tmax <= tmax_next;
+    box_missed <= box_missed_next;
+    negative <= negative_next;
+    d0_r <= d0_r_next;
+    tmin_le_tmax <= tmin_le_tmax_next;
+    near_lt_tmax <= near_lt_tmax_next;
+    far_gt_tmin <= far_gt_tmin_next;
+    tmin_le_near <= tmin_le_near_next;
+    far_le_tmax <= far_le_tmax_next;
+    near_end_r <= near_end_r_next;
+    far_start_r <= far_start_r_next;
+    far_r <= far_r_next;
     if (rst) sp <= 6'h00;
     else sp <= sp_next;
     leaf_ptr <= leaf_ptr_next;
     leaf_left <= leaf_left_next;
+    popped_ahead <= popped_ahead_next;
   end
 
   assign ray_ready = in_idle;
   assign emit_valid = emit_r;
   assign emit_end = end_r;
-  assign emit_tri = leaf_tri;
+  assign emit_tri = leaf_tri_r;
   assign emit_tmin = tmin_r;
   assign emit_id = id_r;
   assign cur_ox = ox_r;

@@ -27,7 +27,7 @@ entity fxrt_traverse is
     visit : out unsigned(0 downto 0);
     visit_node : out unsigned(12 downto 0);
     stack_depth : out unsigned(5 downto 0);
-    fsm_state : out unsigned(2 downto 0)
+    fsm_state : out unsigned(3 downto 0)
   );
 end entity fxrt_traverse;
 
@@ -10777,17 +10777,23 @@ architecture rtl of fxrt_traverse is
     others => (others => '0'));
 
   -- states of state
-  constant st_idle : unsigned(2 downto 0) := "000";
-  constant st_aabb : unsigned(2 downto 0) := "001";
-  constant st_node : unsigned(2 downto 0) := "010";
-  constant st_inner : unsigned(2 downto 0) := "011";
-  constant st_leaf : unsigned(2 downto 0) := "100";
-  constant st_pop : unsigned(2 downto 0) := "101";
-  constant st_done : unsigned(2 downto 0) := "110";
+  constant st_idle : unsigned(3 downto 0) := "0000";
+  constant st_aabb : unsigned(3 downto 0) := "0001";
+  constant st_box : unsigned(3 downto 0) := "0010";
+  constant st_fetch : unsigned(3 downto 0) := "0011";
+  constant st_node : unsigned(3 downto 0) := "0100";
+  constant st_clip1 : unsigned(3 downto 0) := "0101";
+  constant st_dist : unsigned(3 downto 0) := "0110";
+  constant st_step : unsigned(3 downto 0) := "0111";
+  constant st_leaf : unsigned(3 downto 0) := "1000";
+  constant st_pop : unsigned(3 downto 0) := "1001";
+  constant st_done : unsigned(3 downto 0) := "1010";
 
   -- not in a stage or state machine
-  signal node_addr : unsigned(12 downto 0);
   signal node_word : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal node_word_r : unsigned(72 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal node_d1 : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal node_settled : unsigned(0 downto 0);
   signal nw_axis : unsigned(1 downto 0);
   signal nw_clip0 : unsigned(28 downto 0);
   signal nw_clip1 : unsigned(28 downto 0);
@@ -10798,6 +10804,7 @@ architecture rtl of fxrt_traverse is
   signal nw_is_leaf : unsigned(0 downto 0);
   signal in_aabb : unsigned(0 downto 0);
   signal in_node : unsigned(0 downto 0);
+  signal in_clip1 : unsigned(0 downto 0);
   constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
   constant box_hi_1 : unsigned(28 downto 0) := unsigned'("01111101010101011000101111001");
   constant box_hi_2 : unsigned(28 downto 0) := unsigned'("10011111001001111000110011011");
@@ -10806,44 +10813,62 @@ architecture rtl of fxrt_traverse is
   constant k_0 : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal case_aabb_k_1 : unsigned(28 downto 0);
   signal aabb_plane : unsigned(28 downto 0);
-  signal mux_in_node : unsigned(1 downto 0);
-  signal pu_axis : unsigned(1 downto 0);
-  signal mux_in_node_1 : unsigned(28 downto 0);
-  signal pu_plane : unsigned(28 downto 0);
-  signal rs_pu_plane : unsigned(29 downto 0);
-  signal s_rs_pu_plane : signed(29 downto 0);
-  signal case_pu_axis : unsigned(28 downto 0);
-  signal rs_case_pu_axis : unsigned(29 downto 0);
-  signal s_rs_case_pu_axis : signed(29 downto 0);
-  signal pu_delta : signed(29 downto 0);
-  signal case_pu_axis_1 : signed(47 downto 0);
-  signal x_1 : signed(77 downto 0);
+  constant k_2 : unsigned(1 downto 0) := unsigned'("10");
+  signal aabb_last : unsigned(0 downto 0);
+  signal in_aabb_or_in_clip1 : unsigned(0 downto 0);
+  signal not_nw_is_leaf : unsigned(0 downto 0);
+  signal and_0 : unsigned(0 downto 0);
+  signal pu_issue : unsigned(0 downto 0);
+  signal in_aabb_and_aabb_last : unsigned(0 downto 0);
+  signal pu_issue_last : unsigned(0 downto 0);
+  signal mux_in_aabb : unsigned(28 downto 0);
+  signal pu_issue_plane : unsigned(28 downto 0);
+  signal mux_in_aabb_1 : unsigned(1 downto 0);
+  signal pu_issue_axis : unsigned(1 downto 0);
+  signal pu_sel_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_sel_last : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_sel_plane : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal pu_sel_axis : unsigned(1 downto 0) := unsigned'("00");
+  signal rs_pu_sel_plane : unsigned(29 downto 0);
+  signal s_rs_pu_sel_plane : signed(29 downto 0);
+  signal case_pu_sel_axis : unsigned(28 downto 0);
+  signal rs_case_pu_sel_axis : unsigned(29 downto 0);
+  signal s_rs_case_pu_sel_axis : signed(29 downto 0);
+  signal pu_diff : signed(29 downto 0);
+  signal pu_delta : signed(29 downto 0) := signed'("000000000000000000000000000000");
+  signal pu_inv_axis : signed(47 downto 0);
+  signal pu_inv : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal pu_delta_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_delta_last : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_mul : signed(77 downto 0);
+  signal pu_product : signed(77 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal pu_product_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_last : unsigned(0 downto 0) := unsigned'("0");
   signal pu_shifted : signed(77 downto 0);
   constant k_1073741824 : signed(77 downto 0) := signed'("000000000000000000000000000000000000000000000001000000000000000000000000000000");
-  signal lt_2 : unsigned(0 downto 0);
+  signal lt_4 : unsigned(0 downto 0);
   constant k_m1 : signed(77 downto 0) := signed'("111111111111111111111111111111111111111111111111111111111111111111111111111111");
   signal pu_shifted_lt_k_m1 : unsigned(0 downto 0);
   signal mux_pu_shifted_lt_k_m1 : signed(77 downto 0);
-  signal mux_lt_2 : signed(77 downto 0);
-  signal plane_t : signed(31 downto 0);
-  constant k_2 : unsigned(1 downto 0) := unsigned'("10");
-  signal aabb_last : unsigned(0 downto 0);
-  constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
-  signal aabb_k_eq_k_0_1 : unsigned(0 downto 0);
+  signal mux_lt_4 : signed(77 downto 0);
+  signal pu_clamped : signed(31 downto 0);
+  signal plane_t : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal plane_t_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal plane_t_last : unsigned(0 downto 0) := unsigned'("0");
+  signal not_plane_t_last : unsigned(0 downto 0);
+  signal d0_arrives : unsigned(0 downto 0);
+  signal d1_arrives : unsigned(0 downto 0);
   signal plane_t_lt_tmax : unsigned(0 downto 0);
-  signal or_3 : unsigned(0 downto 0);
-  signal aabb_tmax : signed(31 downto 0);
-  signal case_axis_r : signed(47 downto 0);
-  signal inner_negative : unsigned(0 downto 0);
+  signal box_tmax : signed(31 downto 0);
+  signal bits_plane_t : unsigned(0 downto 0);
+  signal box_miss : unsigned(0 downto 0);
+  signal near_end : signed(31 downto 0);
+  signal far_start : signed(31 downto 0);
   constant k_1 : unsigned(12 downto 0) := unsigned'("0000000000001");
   signal child_r_plus_k_1 : unsigned(12 downto 0);
   signal near : unsigned(12 downto 0);
   signal far : unsigned(12 downto 0);
-  signal near_end : signed(31 downto 0);
-  signal far_start : signed(31 downto 0);
-  signal tmax_lt_near_end : unsigned(0 downto 0);
   signal near_max : signed(31 downto 0);
-  signal tmin_lt_far_start : unsigned(0 downto 0);
   signal far_min : signed(31 downto 0);
   signal go_near : unsigned(0 downto 0);
   signal go_far : unsigned(0 downto 0);
@@ -10859,13 +10884,24 @@ architecture rtl of fxrt_traverse is
   signal bits_stack_top_1 : unsigned(31 downto 0);
   signal top_tmin : signed(31 downto 0);
   signal top_node : unsigned(12 downto 0);
+  signal in_leaf : unsigned(0 downto 0);
+  signal was_leaf : unsigned(0 downto 0) := unsigned'("0");
+  constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
+  constant k_0_2 : unsigned(12 downto 0) := unsigned'("0000000000000");
+  constant k_0_3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  constant k_1073741824_1 : signed(31 downto 0) := signed'("01000000000000000000000000000000");
+  constant k_0_4 : unsigned(0 downto 0) := unsigned'("0");
   constant k_1_2 : unsigned(1 downto 0) := unsigned'("01");
   signal aabb_k_plus_k_1_2 : unsigned(1 downto 0);
-  constant k_0_2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  constant k_0_3 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal aabb_tmax_lt_k_0_2 : unsigned(0 downto 0);
-  constant k_0_4 : unsigned(2 downto 0) := unsigned'("000");
-  signal nw_count_eq_k_0_4 : unsigned(0 downto 0);
+  constant k_0_5 : unsigned(2 downto 0) := unsigned'("000");
+  signal nw_count_eq_k_0_5 : unsigned(0 downto 0);
+  signal tmin_le_tmax_1 : unsigned(0 downto 0);
+  signal case_axis_r : signed(47 downto 0);
+  signal bits_case_axis_r : unsigned(0 downto 0);
+  signal near_end_lt_tmax : unsigned(0 downto 0);
+  signal tmin_lt_far_start : unsigned(0 downto 0);
+  signal tmin_le_near_end : unsigned(0 downto 0);
+  signal far_start_le_tmax : unsigned(0 downto 0);
   signal go_near_and_go_far : unsigned(0 downto 0);
   signal rs_sp : unsigned(4 downto 0);
   signal sp_plus_k_1_1 : unsigned(5 downto 0);
@@ -10873,23 +10909,31 @@ architecture rtl of fxrt_traverse is
   constant k_1_3 : unsigned(2 downto 0) := unsigned'("001");
   signal leaf_left_minus_k_1_3 : unsigned(2 downto 0);
   signal leaf_left_eq_k_1_3 : unsigned(0 downto 0);
-  constant k_0_5 : unsigned(5 downto 0) := unsigned'("000000");
-  signal sp_eq_k_0_5 : unsigned(0 downto 0);
+  constant k_0_6 : unsigned(5 downto 0) := unsigned'("000000");
+  signal sp_eq_k_0_6 : unsigned(0 downto 0);
   signal sp_minus_k_1_1_1 : unsigned(5 downto 0);
   signal in_idle : unsigned(0 downto 0);
-  signal in_leaf : unsigned(0 downto 0);
   signal in_done : unsigned(0 downto 0);
   signal leaf_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal leaf_tri_r : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal in_leaf_or_in_done : unsigned(0 downto 0);
-  signal emit_r : unsigned(0 downto 0) := unsigned'("0");
-  signal end_r : unsigned(0 downto 0) := unsigned'("0");
+  type emit_r_sr_t is array (1 to 2) of unsigned(0 downto 0);
+  signal emit_r_sr : emit_r_sr_t := (others => (others => '0'));
+  signal emit_r : unsigned(0 downto 0);
+  type end_r_sr_t is array (1 to 2) of unsigned(0 downto 0);
+  signal end_r_sr : end_r_sr_t := (others => (others => '0'));
+  signal end_r : unsigned(0 downto 0);
   signal u_tmin : unsigned(31 downto 0);
   signal rs_u_tmin : unsigned(30 downto 0);
-  signal tmin_r : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
-  signal id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
+  type tmin_r_sr_t is array (1 to 2) of unsigned(30 downto 0);
+  signal tmin_r_sr : tmin_r_sr_t := (others => (others => '0'));
+  signal tmin_r : unsigned(30 downto 0);
+  type id_r_sr_t is array (1 to 2) of unsigned(19 downto 0);
+  signal id_r_sr : id_r_sr_t := (others => (others => '0'));
+  signal id_r : unsigned(19 downto 0);
 
   -- state machine state: BIH traversal: one ray at a time, one leaf entry per clock
-  signal state : unsigned(2 downto 0) := st_idle;
+  signal state : unsigned(3 downto 0) := st_idle;
   signal ray_id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal ox_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal oy_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -10901,14 +10945,44 @@ architecture rtl of fxrt_traverse is
   signal axis_r : unsigned(1 downto 0) := unsigned'("00");
   signal clip1_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal child_r : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal d0_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal aabb_k : unsigned(1 downto 0) := unsigned'("00");
   signal tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal box_missed : unsigned(0 downto 0) := unsigned'("0");
+  signal negative : unsigned(0 downto 0) := unsigned'("0");
+  signal d0_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
+  signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
+  signal far_gt_tmin : unsigned(0 downto 0) := unsigned'("0");
+  signal tmin_le_near : unsigned(0 downto 0) := unsigned'("0");
+  signal far_le_tmax : unsigned(0 downto 0) := unsigned'("0");
+  signal near_end_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal far_start_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal far_r : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal sp : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal leaf_left : unsigned(2 downto 0) := unsigned'("000");
+  signal popped_ahead : unsigned(0 downto 0) := unsigned'("0");
   signal aabb_k_next : unsigned(1 downto 0);
+  signal not_go_near : unsigned(0 downto 0);
+  signal not_go_near_and_go_far : unsigned(0 downto 0);
+  signal mux_not_go_near_and_go_far : unsigned(12 downto 0);
+  signal not_go_far : unsigned(0 downto 0);
+  signal and_11 : unsigned(0 downto 0);
+  signal mux_and_11 : unsigned(12 downto 0);
+  signal not_sp_eq_k_0_6 : unsigned(0 downto 0);
+  signal mux_not_sp_eq_k_0_6 : unsigned(12 downto 0);
+  signal node_next : unsigned(12 downto 0);
+  signal not_go_near_and_go_far_1 : unsigned(0 downto 0);
+  signal mux_not_go_near_and_go_far_1 : signed(31 downto 0);
+  signal mux_not_sp_eq_k_0_6_1 : signed(31 downto 0);
+  signal tmin_next : signed(31 downto 0);
+  signal mux_plane_t_valid : signed(31 downto 0);
+  signal mux_go_near : signed(31 downto 0);
+  signal mux_not_sp_eq_k_0_6_2 : signed(31 downto 0);
+  signal tmax_next : signed(31 downto 0);
+  signal mux_plane_t_valid_1 : unsigned(0 downto 0);
+  signal box_missed_next : unsigned(0 downto 0);
   signal mux_ray_valid : unsigned(19 downto 0);
   signal ray_id_r_next : unsigned(19 downto 0);
   signal mux_ray_valid_1 : unsigned(28 downto 0);
@@ -10923,75 +10997,88 @@ architecture rtl of fxrt_traverse is
   signal oz_r_next : unsigned(28 downto 0);
   signal mux_ray_valid_6 : signed(47 downto 0);
   signal invz_r_next : signed(47 downto 0);
-  signal mux_ray_valid_7 : unsigned(2 downto 0);
-  signal and_5 : unsigned(0 downto 0);
-  signal mux_and_5 : unsigned(2 downto 0);
-  signal not_aabb_tmax_lt_k_0_2 : unsigned(0 downto 0);
-  signal and_6 : unsigned(0 downto 0);
-  signal mux_and_6 : unsigned(2 downto 0);
-  signal and_7 : unsigned(0 downto 0);
-  signal mux_and_7 : unsigned(2 downto 0);
-  signal not_nw_count_eq_k_0_4 : unsigned(0 downto 0);
-  signal and_8 : unsigned(0 downto 0);
-  signal mux_and_8 : unsigned(2 downto 0);
-  signal not_nw_is_leaf : unsigned(0 downto 0);
-  signal mux_not_nw_is_leaf : unsigned(2 downto 0);
-  signal mux_go_near : unsigned(2 downto 0);
-  signal not_go_near : unsigned(0 downto 0);
-  signal not_go_near_and_go_far : unsigned(0 downto 0);
-  signal mux_not_go_near_and_go_far : unsigned(2 downto 0);
-  signal not_go_far : unsigned(0 downto 0);
-  signal and_9 : unsigned(0 downto 0);
-  signal mux_and_9 : unsigned(2 downto 0);
-  signal mux_leaf_left_eq_k_1_3 : unsigned(2 downto 0);
-  signal mux_sp_eq_k_0_5 : unsigned(2 downto 0);
-  signal not_sp_eq_k_0_5 : unsigned(0 downto 0);
-  signal mux_not_sp_eq_k_0_5 : unsigned(2 downto 0);
-  signal state_next : unsigned(2 downto 0);
-  signal mux_go_near_1 : signed(31 downto 0);
-  signal mux_not_sp_eq_k_0_5_1 : signed(31 downto 0);
-  signal tmax_next : signed(31 downto 0);
-  signal mux_aabb_last : signed(31 downto 0);
-  signal not_go_near_and_go_far_1 : unsigned(0 downto 0);
-  signal mux_not_go_near_and_go_far_1 : signed(31 downto 0);
-  signal mux_not_sp_eq_k_0_5_2 : signed(31 downto 0);
-  signal tmin_next : signed(31 downto 0);
-  signal mux_aabb_last_1 : unsigned(12 downto 0);
-  signal mux_go_near_2 : unsigned(12 downto 0);
+  signal mux_ray_valid_7 : unsigned(3 downto 0);
+  signal mux_aabb_last : unsigned(3 downto 0);
+  signal d1_arrives_and_box_miss : unsigned(0 downto 0);
+  signal mux_d1_arrives_and_box_miss : unsigned(3 downto 0);
+  signal not_box_miss : unsigned(0 downto 0);
+  signal and_12 : unsigned(0 downto 0);
+  signal mux_and_12 : unsigned(3 downto 0);
+  signal mux_node_settled : unsigned(3 downto 0);
+  signal and_13 : unsigned(0 downto 0);
+  signal mux_and_13 : unsigned(3 downto 0);
+  signal not_nw_count_eq_k_0_5 : unsigned(0 downto 0);
+  signal and_14 : unsigned(0 downto 0);
+  signal mux_and_14 : unsigned(3 downto 0);
+  signal not_nw_is_leaf_1 : unsigned(0 downto 0);
+  signal mux_not_nw_is_leaf_1 : unsigned(3 downto 0);
+  signal mux_d1_arrives : unsigned(3 downto 0);
+  signal mux_go_near_1 : unsigned(3 downto 0);
   signal not_go_near_and_go_far_2 : unsigned(0 downto 0);
-  signal mux_not_go_near_and_go_far_2 : unsigned(12 downto 0);
-  signal mux_not_sp_eq_k_0_5_3 : unsigned(12 downto 0);
-  signal node_next : unsigned(12 downto 0);
+  signal mux_not_go_near_and_go_far_2 : unsigned(3 downto 0);
+  signal and_15 : unsigned(0 downto 0);
+  signal mux_and_15 : unsigned(3 downto 0);
+  signal mux_leaf_left_eq_k_1_3 : unsigned(3 downto 0);
+  signal mux_sp_eq_k_0_6 : unsigned(3 downto 0);
+  signal and_16 : unsigned(0 downto 0);
+  signal mux_and_16 : unsigned(3 downto 0);
+  signal not_popped_ahead : unsigned(0 downto 0);
+  signal and_17 : unsigned(0 downto 0);
+  signal mux_and_17 : unsigned(3 downto 0);
+  signal state_next : unsigned(3 downto 0);
   signal mux_nw_is_leaf : unsigned(12 downto 0);
   signal leaf_ptr_next : unsigned(12 downto 0);
   signal mux_nw_is_leaf_1 : unsigned(2 downto 0);
   signal leaf_left_next : unsigned(2 downto 0);
-  signal mux_not_nw_is_leaf_1 : unsigned(1 downto 0);
+  signal mux_nw_is_leaf_2 : unsigned(0 downto 0);
+  signal and_18 : unsigned(0 downto 0);
+  signal mux_and_18 : unsigned(0 downto 0);
+  signal mux_leaf_left_eq_k_1_3_1 : unsigned(0 downto 0);
+  signal popped_ahead_next : unsigned(0 downto 0);
+  signal mux_not_nw_is_leaf_1_1 : unsigned(1 downto 0);
   signal axis_r_next : unsigned(1 downto 0);
-  signal mux_not_nw_is_leaf_2 : unsigned(28 downto 0);
+  signal mux_not_nw_is_leaf_1_2 : unsigned(28 downto 0);
   signal clip1_r_next : unsigned(28 downto 0);
-  signal mux_not_nw_is_leaf_3 : unsigned(12 downto 0);
+  signal mux_not_nw_is_leaf_1_3 : unsigned(12 downto 0);
   signal child_r_next : unsigned(12 downto 0);
-  signal mux_not_nw_is_leaf_4 : signed(31 downto 0);
+  signal mux_not_nw_is_leaf_1_4 : unsigned(0 downto 0);
+  signal tmin_le_tmax_next : unsigned(0 downto 0);
+  signal negative_next : unsigned(0 downto 0);
+  signal in_dist : unsigned(0 downto 0);
+  signal far_r_next : unsigned(12 downto 0);
+  signal mux_d0_arrives : signed(31 downto 0);
   signal d0_r_next : signed(31 downto 0);
+  signal mux_d1_arrives_1 : signed(31 downto 0);
+  signal near_end_r_next : signed(31 downto 0);
+  signal mux_d1_arrives_2 : signed(31 downto 0);
+  signal far_start_r_next : signed(31 downto 0);
+  signal mux_d1_arrives_3 : unsigned(0 downto 0);
+  signal near_lt_tmax_next : unsigned(0 downto 0);
+  signal mux_d1_arrives_4 : unsigned(0 downto 0);
+  signal far_gt_tmin_next : unsigned(0 downto 0);
+  signal mux_d1_arrives_5 : unsigned(0 downto 0);
+  signal tmin_le_near_next : unsigned(0 downto 0);
+  signal mux_d1_arrives_6 : unsigned(0 downto 0);
+  signal far_le_tmax_next : unsigned(0 downto 0);
   signal mux_go_near_and_go_far : unsigned(5 downto 0);
-  signal mux_not_sp_eq_k_0_5_4 : unsigned(5 downto 0);
+  signal mux_not_sp_eq_k_0_6_3 : unsigned(5 downto 0);
   signal sp_next : unsigned(5 downto 0);
-  signal in_inner : unsigned(0 downto 0);
-  signal and_10 : unsigned(0 downto 0);
+  signal in_step : unsigned(0 downto 0);
+  signal and_19 : unsigned(0 downto 0);
 begin
 
   -- not in a stage or state machine
-  node_addr <= node_next;
-  nw_axis <= unsigned(node_word(1 downto 0));
-  nw_clip0 <= unsigned(node_word(30 downto 2));
-  nw_clip1 <= unsigned(node_word(59 downto 31));
-  nw_child <= unsigned(node_word(72 downto 60));
-  nw_first <= unsigned(node_word(14 downto 2));
-  nw_count <= unsigned(node_word(17 downto 15));
+  node_settled <= "1" when node = node_d1 else "0";
+  nw_axis <= unsigned(node_word_r(1 downto 0));
+  nw_clip0 <= unsigned(node_word_r(30 downto 2));
+  nw_clip1 <= unsigned(node_word_r(59 downto 31));
+  nw_child <= unsigned(node_word_r(72 downto 60));
+  nw_first <= unsigned(node_word_r(14 downto 2));
+  nw_count <= unsigned(node_word_r(17 downto 15));
   nw_is_leaf <= "1" when nw_axis = k_3 else "0";
   in_aabb <= "1" when state = st_aabb else "0";
   in_node <= "1" when state = st_node else "0";
+  in_clip1 <= "1" when state = st_clip1 else "0";
   with aabb_k select
     case_aabb_k <=
       invy_r when "01",
@@ -11004,57 +11091,58 @@ begin
       box_hi_2 when "10",
       box_hi_0 when others;
   aabb_plane <= k_0 when aabb_neg = "1" else case_aabb_k_1;
-  mux_in_node <= nw_axis when in_node = "1" else axis_r;
-  pu_axis <= aabb_k when in_aabb = "1" else mux_in_node;
-  mux_in_node_1 <= nw_clip0 when in_node = "1" else clip1_r;
-  pu_plane <= aabb_plane when in_aabb = "1" else mux_in_node_1;
-  rs_pu_plane <= resize(pu_plane, 30);
-  s_rs_pu_plane <= signed(rs_pu_plane);
-  with pu_axis select
-    case_pu_axis <=
+  aabb_last <= "1" when aabb_k = k_2 else "0";
+  in_aabb_or_in_clip1 <= in_aabb or in_clip1;
+  not_nw_is_leaf <= not nw_is_leaf;
+  and_0 <= in_node and not_nw_is_leaf;
+  pu_issue <= in_aabb_or_in_clip1 or and_0;
+  in_aabb_and_aabb_last <= in_aabb and aabb_last;
+  pu_issue_last <= in_clip1 or in_aabb_and_aabb_last;
+  mux_in_aabb <= aabb_plane when in_aabb = "1" else clip1_r;
+  pu_issue_plane <= nw_clip0 when in_node = "1" else mux_in_aabb;
+  mux_in_aabb_1 <= aabb_k when in_aabb = "1" else axis_r;
+  pu_issue_axis <= nw_axis when in_node = "1" else mux_in_aabb_1;
+  rs_pu_sel_plane <= resize(pu_sel_plane, 30);
+  s_rs_pu_sel_plane <= signed(rs_pu_sel_plane);
+  with pu_sel_axis select
+    case_pu_sel_axis <=
       oy_r when "01",
       oz_r when "10",
       ox_r when others;
-  rs_case_pu_axis <= resize(case_pu_axis, 30);
-  s_rs_case_pu_axis <= signed(rs_case_pu_axis);
-  pu_delta <= s_rs_pu_plane - s_rs_case_pu_axis;
-  with pu_axis select
-    case_pu_axis_1 <=
+  rs_case_pu_sel_axis <= resize(case_pu_sel_axis, 30);
+  s_rs_case_pu_sel_axis <= signed(rs_case_pu_sel_axis);
+  pu_diff <= s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
+  with pu_sel_axis select
+    pu_inv_axis <=
       invy_r when "01",
       invz_r when "10",
       invx_r when others;
-  x_1 <= pu_delta * case_pu_axis_1;
-  pu_shifted <= shift_right(x_1, 16);
-  lt_2 <= "1" when k_1073741824 < pu_shifted else "0";
+  pu_mul <= pu_delta * pu_inv;
+  pu_shifted <= shift_right(pu_product, 16);
+  lt_4 <= "1" when k_1073741824 < pu_shifted else "0";
   pu_shifted_lt_k_m1 <= "1" when pu_shifted < k_m1 else "0";
   mux_pu_shifted_lt_k_m1 <= k_m1 when pu_shifted_lt_k_m1 = "1" else pu_shifted;
-  mux_lt_2 <= k_1073741824 when lt_2 = "1" else mux_pu_shifted_lt_k_m1;
-  plane_t <= mux_lt_2(31 downto 0);
-  aabb_last <= "1" when aabb_k = k_2 else "0";
-  aabb_k_eq_k_0_1 <= "1" when aabb_k = k_0_1 else "0";
+  mux_lt_4 <= k_1073741824 when lt_4 = "1" else mux_pu_shifted_lt_k_m1;
+  pu_clamped <= mux_lt_4(31 downto 0);
+  not_plane_t_last <= not plane_t_last;
+  d0_arrives <= plane_t_valid and not_plane_t_last;
+  d1_arrives <= plane_t_valid and plane_t_last;
   plane_t_lt_tmax <= "1" when plane_t < tmax else "0";
-  or_3 <= aabb_k_eq_k_0_1 or plane_t_lt_tmax;
-  aabb_tmax <= plane_t when or_3 = "1" else tmax;
-  with axis_r select
-    case_axis_r <=
-      invy_r when "01",
-      invz_r when "10",
-      invx_r when others;
-  inner_negative <= unsigned(case_axis_r(47 downto 47));
+  box_tmax <= plane_t when plane_t_lt_tmax = "1" else tmax;
+  bits_plane_t <= unsigned(plane_t(31 downto 31));
+  box_miss <= box_missed or bits_plane_t;
+  near_end <= plane_t when negative = "1" else d0_r;
+  far_start <= d0_r when negative = "1" else plane_t;
   child_r_plus_k_1 <= child_r + k_1;
-  near <= child_r_plus_k_1 when inner_negative = "1" else child_r;
-  far <= child_r when inner_negative = "1" else child_r_plus_k_1;
-  near_end <= plane_t when inner_negative = "1" else d0_r;
-  far_start <= d0_r when inner_negative = "1" else plane_t;
-  tmax_lt_near_end <= "1" when tmax < near_end else "0";
-  near_max <= tmax when tmax_lt_near_end = "1" else near_end;
-  tmin_lt_far_start <= "1" when tmin < far_start else "0";
-  far_min <= far_start when tmin_lt_far_start = "1" else tmin;
-  go_near <= "1" when tmin <= near_max else "0";
-  go_far <= "1" when far_min <= tmax else "0";
+  near <= child_r_plus_k_1 when negative = "1" else child_r;
+  far <= child_r when negative = "1" else child_r_plus_k_1;
+  near_max <= near_end_r when near_lt_tmax = "1" else tmax;
+  far_min <= far_start_r when far_gt_tmin = "1" else tmin;
+  go_near <= tmin_le_near and tmin_le_tmax;
+  go_far <= far_le_tmax and tmin_le_tmax;
   u_far_min <= unsigned(far_min);
   u_tmax <= unsigned(tmax);
-  push_entry <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_tmax)));
+  push_entry <= unsigned(std_logic_vector'(std_logic_vector(far_r) & std_logic_vector(u_far_min) & std_logic_vector(u_tmax)));
   sp_minus_k_1_1 <= sp - k_1_1;
   rs_sp_minus_k_1_1 <= sp_minus_k_1_1(4 downto 0);
   bits_stack_top <= unsigned(stack_top(31 downto 0));
@@ -11062,37 +11150,73 @@ begin
   bits_stack_top_1 <= unsigned(stack_top(63 downto 32));
   top_tmin <= signed(bits_stack_top_1);
   top_node <= unsigned(stack_top(76 downto 64));
+  in_leaf <= "1" when state = st_leaf else "0";
   aabb_k_plus_k_1_2 <= aabb_k + k_1_2;
-  aabb_tmax_lt_k_0_2 <= "1" when aabb_tmax < k_0_2 else "0";
-  nw_count_eq_k_0_4 <= "1" when nw_count = k_0_4 else "0";
+  nw_count_eq_k_0_5 <= "1" when nw_count = k_0_5 else "0";
+  tmin_le_tmax_1 <= "1" when tmin <= tmax else "0";
+  with axis_r select
+    case_axis_r <=
+      invy_r when "01",
+      invz_r when "10",
+      invx_r when others;
+  bits_case_axis_r <= unsigned(case_axis_r(47 downto 47));
+  near_end_lt_tmax <= "1" when near_end < tmax else "0";
+  tmin_lt_far_start <= "1" when tmin < far_start else "0";
+  tmin_le_near_end <= "1" when tmin <= near_end else "0";
+  far_start_le_tmax <= "1" when far_start <= tmax else "0";
   go_near_and_go_far <= go_near and go_far;
   rs_sp <= sp(4 downto 0);
   sp_plus_k_1_1 <= sp + k_1_1;
   leaf_ptr_plus_k_1 <= leaf_ptr + k_1;
   leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
   leaf_left_eq_k_1_3 <= "1" when leaf_left = k_1_3 else "0";
-  sp_eq_k_0_5 <= "1" when sp = k_0_5 else "0";
+  sp_eq_k_0_6 <= "1" when sp = k_0_6 else "0";
   sp_minus_k_1_1_1 <= sp - k_1_1;
   in_idle <= "1" when state = st_idle else "0";
-  in_leaf <= "1" when state = st_leaf else "0";
   in_done <= "1" when state = st_done else "0";
   in_leaf_or_in_done <= in_leaf or in_done;
+  emit_r <= emit_r_sr(2);
+  end_r <= end_r_sr(2);
   u_tmin <= unsigned(tmin);
   rs_u_tmin <= u_tmin(30 downto 0);
+  tmin_r <= tmin_r_sr(2);
+  id_r <= id_r_sr(2);
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if and_10 = "1" then
+      if and_19 = "1" then
         stack(to_integer(rs_sp)) <= push_entry;
       end if;
-      node_word <= node_rom(to_integer(node_addr));
+      node_word <= node_rom(to_integer(node));
+      node_word_r <= node_word;
+      node_d1 <= node;
+      pu_sel_valid <= pu_issue;
+      pu_sel_last <= pu_issue_last;
+      pu_sel_plane <= pu_issue_plane;
+      pu_sel_axis <= pu_issue_axis;
+      pu_delta <= pu_diff;
+      pu_inv <= pu_inv_axis;
+      pu_delta_valid <= pu_sel_valid;
+      pu_delta_last <= pu_sel_last;
+      pu_product <= pu_mul;
+      pu_product_valid <= pu_delta_valid;
+      pu_product_last <= pu_delta_last;
+      plane_t <= pu_clamped;
+      plane_t_valid <= pu_product_valid;
+      plane_t_last <= pu_product_last;
       stack_top <= stack(to_integer(rs_sp_minus_k_1_1));
+      was_leaf <= in_leaf;
       leaf_tri <= leaf_rom(to_integer(leaf_ptr));
-      emit_r <= in_leaf_or_in_done;
-      end_r <= in_done;
-      tmin_r <= rs_u_tmin;
-      id_r <= ray_id_r;
+      leaf_tri_r <= leaf_tri;
+      emit_r_sr(2 to 2) <= emit_r_sr(1 to 1);
+      emit_r_sr(1) <= in_leaf_or_in_done;
+      end_r_sr(2 to 2) <= end_r_sr(1 to 1);
+      end_r_sr(1) <= in_done;
+      tmin_r_sr(2 to 2) <= tmin_r_sr(1 to 1);
+      tmin_r_sr(1) <= rs_u_tmin;
+      id_r_sr(2 to 2) <= id_r_sr(1 to 1);
+      id_r_sr(1) <= ray_id_r;
     end if;
   end process regs;
 
@@ -11102,6 +11226,47 @@ begin
       k_0_1 when st_idle,
       aabb_k_plus_k_1_2 when st_aabb,
       aabb_k when others;
+  not_go_near <= not go_near;
+  not_go_near_and_go_far <= not_go_near and go_far;
+  mux_not_go_near_and_go_far <= far_r when not_go_near_and_go_far = "1" else node;
+  not_go_far <= not go_far;
+  and_11 <= not_go_near and not_go_far;
+  mux_and_11 <= top_node when and_11 = "1" else mux_not_go_near_and_go_far;
+  not_sp_eq_k_0_6 <= not sp_eq_k_0_6;
+  mux_not_sp_eq_k_0_6 <= top_node when not_sp_eq_k_0_6 = "1" else node;
+  with state select
+    node_next <=
+      k_0_2 when st_idle,
+      near when st_dist,
+      mux_and_11 when st_step,
+      top_node when st_leaf,
+      mux_not_sp_eq_k_0_6 when st_pop,
+      node when others;
+  not_go_near_and_go_far_1 <= not_go_near and go_far;
+  mux_not_go_near_and_go_far_1 <= far_min when not_go_near_and_go_far_1 = "1" else tmin;
+  mux_not_sp_eq_k_0_6_1 <= top_tmin when not_sp_eq_k_0_6 = "1" else tmin;
+  with state select
+    tmin_next <=
+      k_0_3 when st_idle,
+      mux_not_go_near_and_go_far_1 when st_step,
+      mux_not_sp_eq_k_0_6_1 when st_pop,
+      tmin when others;
+  mux_plane_t_valid <= box_tmax when plane_t_valid = "1" else tmax;
+  mux_go_near <= near_max when go_near = "1" else tmax;
+  mux_not_sp_eq_k_0_6_2 <= top_tmax when not_sp_eq_k_0_6 = "1" else tmax;
+  with state select
+    tmax_next <=
+      k_1073741824_1 when st_idle,
+      mux_plane_t_valid when st_box,
+      mux_go_near when st_step,
+      mux_not_sp_eq_k_0_6_2 when st_pop,
+      tmax when others;
+  mux_plane_t_valid_1 <= box_miss when plane_t_valid = "1" else box_missed;
+  with state select
+    box_missed_next <=
+      k_0_4 when st_idle,
+      mux_plane_t_valid_1 when st_box,
+      box_missed when others;
   mux_ray_valid <= ray_id when ray_valid = "1" else ray_id_r;
   ray_id_r_next <= mux_ray_valid when in_idle = "1" else ray_id_r;
   mux_ray_valid_1 <= ox when ray_valid = "1" else ox_r;
@@ -11117,68 +11282,47 @@ begin
   mux_ray_valid_6 <= invz when ray_valid = "1" else invz_r;
   invz_r_next <= mux_ray_valid_6 when in_idle = "1" else invz_r;
   mux_ray_valid_7 <= st_aabb when ray_valid = "1" else state;
-  and_5 <= aabb_last and aabb_tmax_lt_k_0_2;
-  mux_and_5 <= st_done when and_5 = "1" else state;
-  not_aabb_tmax_lt_k_0_2 <= not aabb_tmax_lt_k_0_2;
-  and_6 <= aabb_last and not_aabb_tmax_lt_k_0_2;
-  mux_and_6 <= st_node when and_6 = "1" else mux_and_5;
-  and_7 <= nw_is_leaf and nw_count_eq_k_0_4;
-  mux_and_7 <= st_pop when and_7 = "1" else state;
-  not_nw_count_eq_k_0_4 <= not nw_count_eq_k_0_4;
-  and_8 <= nw_is_leaf and not_nw_count_eq_k_0_4;
-  mux_and_8 <= st_leaf when and_8 = "1" else mux_and_7;
-  not_nw_is_leaf <= not nw_is_leaf;
-  mux_not_nw_is_leaf <= st_inner when not_nw_is_leaf = "1" else mux_and_8;
-  mux_go_near <= st_node when go_near = "1" else state;
-  not_go_near <= not go_near;
-  not_go_near_and_go_far <= not_go_near and go_far;
-  mux_not_go_near_and_go_far <= st_node when not_go_near_and_go_far = "1" else mux_go_near;
-  not_go_far <= not go_far;
-  and_9 <= not_go_near and not_go_far;
-  mux_and_9 <= st_pop when and_9 = "1" else mux_not_go_near_and_go_far;
+  mux_aabb_last <= st_box when aabb_last = "1" else state;
+  d1_arrives_and_box_miss <= d1_arrives and box_miss;
+  mux_d1_arrives_and_box_miss <= st_done when d1_arrives_and_box_miss = "1" else state;
+  not_box_miss <= not box_miss;
+  and_12 <= d1_arrives and not_box_miss;
+  mux_and_12 <= st_node when and_12 = "1" else mux_d1_arrives_and_box_miss;
+  mux_node_settled <= st_node when node_settled = "1" else state;
+  and_13 <= nw_is_leaf and nw_count_eq_k_0_5;
+  mux_and_13 <= st_pop when and_13 = "1" else state;
+  not_nw_count_eq_k_0_5 <= not nw_count_eq_k_0_5;
+  and_14 <= nw_is_leaf and not_nw_count_eq_k_0_5;
+  mux_and_14 <= st_leaf when and_14 = "1" else mux_and_13;
+  not_nw_is_leaf_1 <= not nw_is_leaf;
+  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_14;
+  mux_d1_arrives <= st_step when d1_arrives = "1" else state;
+  mux_go_near_1 <= st_node when go_near = "1" else state;
+  not_go_near_and_go_far_2 <= not_go_near and go_far;
+  mux_not_go_near_and_go_far_2 <= st_fetch when not_go_near_and_go_far_2 = "1" else mux_go_near_1;
+  and_15 <= not_go_near and not_go_far;
+  mux_and_15 <= st_pop when and_15 = "1" else mux_not_go_near_and_go_far_2;
   mux_leaf_left_eq_k_1_3 <= st_pop when leaf_left_eq_k_1_3 = "1" else state;
-  mux_sp_eq_k_0_5 <= st_done when sp_eq_k_0_5 = "1" else state;
-  not_sp_eq_k_0_5 <= not sp_eq_k_0_5;
-  mux_not_sp_eq_k_0_5 <= st_node when not_sp_eq_k_0_5 = "1" else mux_sp_eq_k_0_5;
+  mux_sp_eq_k_0_6 <= st_done when sp_eq_k_0_6 = "1" else state;
+  and_16 <= not_sp_eq_k_0_6 and popped_ahead;
+  mux_and_16 <= st_node when and_16 = "1" else mux_sp_eq_k_0_6;
+  not_popped_ahead <= not popped_ahead;
+  and_17 <= not_sp_eq_k_0_6 and not_popped_ahead;
+  mux_and_17 <= st_fetch when and_17 = "1" else mux_and_16;
   with state select
     state_next <=
       mux_ray_valid_7 when st_idle,
-      mux_and_6 when st_aabb,
-      mux_not_nw_is_leaf when st_node,
-      mux_and_9 when st_inner,
+      mux_aabb_last when st_aabb,
+      mux_and_12 when st_box,
+      mux_node_settled when st_fetch,
+      mux_not_nw_is_leaf_1 when st_node,
+      st_dist when st_clip1,
+      mux_d1_arrives when st_dist,
+      mux_and_15 when st_step,
       mux_leaf_left_eq_k_1_3 when st_leaf,
-      mux_not_sp_eq_k_0_5 when st_pop,
+      mux_and_17 when st_pop,
       st_idle when st_done,
       st_idle when others;
-  mux_go_near_1 <= near_max when go_near = "1" else tmax;
-  mux_not_sp_eq_k_0_5_1 <= top_tmax when not_sp_eq_k_0_5 = "1" else tmax;
-  with state select
-    tmax_next <=
-      aabb_tmax when st_aabb,
-      mux_go_near_1 when st_inner,
-      mux_not_sp_eq_k_0_5_1 when st_pop,
-      tmax when others;
-  mux_aabb_last <= k_0_2 when aabb_last = "1" else tmin;
-  not_go_near_and_go_far_1 <= not_go_near and go_far;
-  mux_not_go_near_and_go_far_1 <= far_min when not_go_near_and_go_far_1 = "1" else tmin;
-  mux_not_sp_eq_k_0_5_2 <= top_tmin when not_sp_eq_k_0_5 = "1" else tmin;
-  with state select
-    tmin_next <=
-      mux_aabb_last when st_aabb,
-      mux_not_go_near_and_go_far_1 when st_inner,
-      mux_not_sp_eq_k_0_5_2 when st_pop,
-      tmin when others;
-  mux_aabb_last_1 <= k_0_3 when aabb_last = "1" else node;
-  mux_go_near_2 <= near when go_near = "1" else node;
-  not_go_near_and_go_far_2 <= not_go_near and go_far;
-  mux_not_go_near_and_go_far_2 <= far when not_go_near_and_go_far_2 = "1" else mux_go_near_2;
-  mux_not_sp_eq_k_0_5_3 <= top_node when not_sp_eq_k_0_5 = "1" else node;
-  with state select
-    node_next <=
-      mux_aabb_last_1 when st_aabb,
-      mux_not_go_near_and_go_far_2 when st_inner,
-      mux_not_sp_eq_k_0_5_3 when st_pop,
-      node when others;
   mux_nw_is_leaf <= nw_first when nw_is_leaf = "1" else leaf_ptr;
   with state select
     leaf_ptr_next <=
@@ -11191,23 +11335,50 @@ begin
       mux_nw_is_leaf_1 when st_node,
       leaf_left_minus_k_1_3 when st_leaf,
       leaf_left when others;
-  mux_not_nw_is_leaf_1 <= nw_axis when not_nw_is_leaf = "1" else axis_r;
-  axis_r_next <= mux_not_nw_is_leaf_1 when in_node = "1" else axis_r;
-  mux_not_nw_is_leaf_2 <= nw_clip1 when not_nw_is_leaf = "1" else clip1_r;
-  clip1_r_next <= mux_not_nw_is_leaf_2 when in_node = "1" else clip1_r;
-  mux_not_nw_is_leaf_3 <= nw_child when not_nw_is_leaf = "1" else child_r;
-  child_r_next <= mux_not_nw_is_leaf_3 when in_node = "1" else child_r;
-  mux_not_nw_is_leaf_4 <= plane_t when not_nw_is_leaf = "1" else d0_r;
-  d0_r_next <= mux_not_nw_is_leaf_4 when in_node = "1" else d0_r;
+  mux_nw_is_leaf_2 <= k_0_4 when nw_is_leaf = "1" else popped_ahead;
+  and_18 <= not_go_near and not_go_far;
+  mux_and_18 <= k_0_4 when and_18 = "1" else popped_ahead;
+  mux_leaf_left_eq_k_1_3_1 <= was_leaf when leaf_left_eq_k_1_3 = "1" else popped_ahead;
+  with state select
+    popped_ahead_next <=
+      mux_nw_is_leaf_2 when st_node,
+      mux_and_18 when st_step,
+      mux_leaf_left_eq_k_1_3_1 when st_leaf,
+      popped_ahead when others;
+  mux_not_nw_is_leaf_1_1 <= nw_axis when not_nw_is_leaf_1 = "1" else axis_r;
+  axis_r_next <= mux_not_nw_is_leaf_1_1 when in_node = "1" else axis_r;
+  mux_not_nw_is_leaf_1_2 <= nw_clip1 when not_nw_is_leaf_1 = "1" else clip1_r;
+  clip1_r_next <= mux_not_nw_is_leaf_1_2 when in_node = "1" else clip1_r;
+  mux_not_nw_is_leaf_1_3 <= nw_child when not_nw_is_leaf_1 = "1" else child_r;
+  child_r_next <= mux_not_nw_is_leaf_1_3 when in_node = "1" else child_r;
+  mux_not_nw_is_leaf_1_4 <= tmin_le_tmax_1 when not_nw_is_leaf_1 = "1" else tmin_le_tmax;
+  tmin_le_tmax_next <= mux_not_nw_is_leaf_1_4 when in_node = "1" else tmin_le_tmax;
+  negative_next <= bits_case_axis_r when in_clip1 = "1" else negative;
+  in_dist <= "1" when state = st_dist else "0";
+  far_r_next <= far when in_dist = "1" else far_r;
+  mux_d0_arrives <= plane_t when d0_arrives = "1" else d0_r;
+  d0_r_next <= mux_d0_arrives when in_dist = "1" else d0_r;
+  mux_d1_arrives_1 <= near_end when d1_arrives = "1" else near_end_r;
+  near_end_r_next <= mux_d1_arrives_1 when in_dist = "1" else near_end_r;
+  mux_d1_arrives_2 <= far_start when d1_arrives = "1" else far_start_r;
+  far_start_r_next <= mux_d1_arrives_2 when in_dist = "1" else far_start_r;
+  mux_d1_arrives_3 <= near_end_lt_tmax when d1_arrives = "1" else near_lt_tmax;
+  near_lt_tmax_next <= mux_d1_arrives_3 when in_dist = "1" else near_lt_tmax;
+  mux_d1_arrives_4 <= tmin_lt_far_start when d1_arrives = "1" else far_gt_tmin;
+  far_gt_tmin_next <= mux_d1_arrives_4 when in_dist = "1" else far_gt_tmin;
+  mux_d1_arrives_5 <= tmin_le_near_end when d1_arrives = "1" else tmin_le_near;
+  tmin_le_near_next <= mux_d1_arrives_5 when in_dist = "1" else tmin_le_near;
+  mux_d1_arrives_6 <= far_start_le_tmax when d1_arrives = "1" else far_le_tmax;
+  far_le_tmax_next <= mux_d1_arrives_6 when in_dist = "1" else far_le_tmax;
   mux_go_near_and_go_far <= sp_plus_k_1_1 when go_near_and_go_far = "1" else sp;
-  mux_not_sp_eq_k_0_5_4 <= sp_minus_k_1_1_1 when not_sp_eq_k_0_5 = "1" else sp;
+  mux_not_sp_eq_k_0_6_3 <= sp_minus_k_1_1_1 when not_sp_eq_k_0_6 = "1" else sp;
   with state select
     sp_next <=
-      mux_go_near_and_go_far when st_inner,
-      mux_not_sp_eq_k_0_5_4 when st_pop,
+      mux_go_near_and_go_far when st_step,
+      mux_not_sp_eq_k_0_6_3 when st_pop,
       sp when others;
-  in_inner <= "1" when state = st_inner else "0";
-  and_10 <= in_inner and go_near_and_go_far;
+  in_step <= "1" when state = st_step else "0";
+  and_19 <= in_step and go_near_and_go_far;
 
   state_regs : process (clk)
   begin
@@ -11232,10 +11403,20 @@ begin
       axis_r <= axis_r_next;
       clip1_r <= clip1_r_next;
       child_r <= child_r_next;
-      d0_r <= d0_r_next;
       aabb_k <= aabb_k_next;
       tmin <= tmin_next;
       tmax <= tmax_next;
+      box_missed <= box_missed_next;
+      negative <= negative_next;
+      d0_r <= d0_r_next;
+      tmin_le_tmax <= tmin_le_tmax_next;
+      near_lt_tmax <= near_lt_tmax_next;
+      far_gt_tmin <= far_gt_tmin_next;
+      tmin_le_near <= tmin_le_near_next;
+      far_le_tmax <= far_le_tmax_next;
+      near_end_r <= near_end_r_next;
+      far_start_r <= far_start_r_next;
+      far_r <= far_r_next;
       if rst = '1' then
         sp <= unsigned'("000000");
       else
@@ -11243,13 +11424,14 @@ begin
       end if;
       leaf_ptr <= leaf_ptr_next;
       leaf_left <= leaf_left_next;
+      popped_ahead <= popped_ahead_next;
     end if;
   end process state_regs;
 
   ray_ready <= in_idle;
   emit_valid <= emit_r;
   emit_end <= end_r;
-  emit_tri <= leaf_tri;
+  emit_tri <= leaf_tri_r;
   emit_tmin <= tmin_r;
   emit_id <= id_r;
   cur_ox <= ox_r;

@@ -7,6 +7,7 @@ pub mod cost;
 pub mod divider;
 pub mod intersect;
 pub mod mul;
+pub mod plane;
 pub mod raygen;
 pub mod top;
 pub mod traverse;

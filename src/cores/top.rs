@@ -7,10 +7,12 @@
 //!
 //! The traversal emits one leaf entry per clock; the triangle ROMs add one cycle; the ray's
 //! origin and direction come straight from the traversal's and the top's ray registers, which
-//! hold still until the next ray is accepted — always after the ray's end token, so at least
-//! two cycles after its last triangle entered the ROMs. The triangle table is wider than a
-//! signal may be (5 + 3n + 6m bits), so it is split into ROMs of whole fields, ≤ 128 bits each,
-//! all read at the same address.
+//! hold still until the next ray is accepted — always after the ray's end token: the last
+//! triangle number reaches the ROMs two cycles after its `leaf` cycle (leaf ROM and its
+//! register), and pop, done and idle put the accepting edge one cycle after that, the edge at
+//! which the pipeline's input register takes that triangle with the old ray. The triangle
+//! table is wider than a signal may be (5 + 3n + 6m bits), so it is split into ROMs of whole
+//! fields, ≤ 128 bits each, all read at the same address.
 
 use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
@@ -33,7 +35,7 @@ pub struct CoreParams {
 
 impl CoreParams {
     pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32, target_mhz: u32) -> CoreParams {
-        let trav = TraverseParams::new(scene, id_width);
+        let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz));
         let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
         let p = &scene.params;
         let isect = IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits, target_mhz };

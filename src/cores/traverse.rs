@@ -3,22 +3,43 @@
 //! in exactly the order of `Golden::walk` (near child first, far child pushed, no early out).
 //! The node and leaf ROMs and the stack RAM are synchronous block memories.
 //!
-//! States (one cycle each unless noted):
-//! - `idle`: `ray_ready`; a valid ray is latched.
-//! - `aabb` (3 cycles, one axis each): the scene-box exit distance tmax; a ray that misses the
-//!   box (tmax < 0) goes straight to `done`, else node 0 with tmin = 0.
-//! - `node`: the node word is on the ROM output. A leaf loads its first entry and count; an
-//!   inner node latches its fields and computes d0, the distance to clip0.
-//! - `inner`: d1 to clip1, then `bih::inner_step`'s decision: push the far child and enter the
-//!   near one, enter one child, or pop.
+//! Pipelined for the clock: every register-to-register path is a block-RAM read into a
+//! register, one mux level and one adder or compare (or a few LUTs of decision), or the
+//! multiplier alone. So the node ROM is addressed by the `node` register itself and its word
+//! goes straight into a register (mem[node] two cycles after `node` last changed), as does the
+//! leaf ROM's; the plane distances come from a pipelined unit (`plane.rs`, L = 3 + product
+//! stages clocks from issue to result; L = 4 by default); and the child decision takes a
+//! compare cycle and an act cycle. States and their cost (one cycle each unless noted):
+//! - `idle`: `ray_ready`; a valid ray is latched (node 0, tmin 0 and tmax = 2^(n+1) too).
+//! - `aabb` (3 cycles): the exit distance of one scene-box axis per cycle is issued.
+//! - `box` (L cycles): waits for the three distances; tmax = min as they arrive. A ray that
+//!   misses the box (a distance < 0) goes to `done`, else to `node` (node 0's word was read
+//!   while waiting).
+//! - `fetch`: waits until the word register holds the new node's word: 2 cycles after a step
+//!   that enters the far child alone, 1 after a pop that follows a step or a one-entry leaf, 2
+//!   after a pop that follows an empty leaf. The near child is addressed during `dist`
+//!   and the stack top during `leaf`, so descending near and popping after a leaf of two or
+//!   more entries need none.
+//! - `node` (1 per node visit): the node word is in its register. A leaf loads its first entry
+//!   and count; an inner node's fields are latched and d0 (clip0) is issued.
+//! - `clip1` (1 per inner node): d1 (clip1) is issued; the ray's sign on the axis latched.
+//! - `dist` (L per inner node): waits for d0, then d1; when d1 arrives, near_end/far_start are
+//!   chosen and compared with tmin and tmax (registered).
+//! - `step` (1 per inner node): `bih::inner_step`'s decision from the registered compares:
+//!   push the far child and enter the near one, enter one child, or pop.
 //! - `leaf` (count cycles): one leaf entry per clock.
 //! - `pop`: the top of the stack (always read ahead) is loaded, or `done` when it is empty.
 //! - `done`: an end token follows the ray's last triangle, so the closest-hit unit knows the
 //!   ray is complete when the token leaves the in-order pipeline.
 //!
-//! The node ROM is addressed by the node register's next value, so its word is ready in the
-//! cycle the FSM enters `node`. One plane-distance unit (one multiplier) serves all states.
+//! An inner node costs node + clip1 + L + step = 3 + L = 7 cycles (2 before the unit was
+//! pipelined; a far-only step adds 2 fetch cycles), a leaf node + count, a pop 1 (+ its
+//! fetch), a ray's overhead idle + aabb + box + done = 5 + L. Emission is two cycles behind
+//! `leaf` (the leaf ROM and its register).
 
+use super::clock::ClockTarget;
+use super::mul::MulStyle;
+use super::plane::{PlaneIssue, plane_unit};
 use crate::rtl::build::{Builder, S};
 use crate::rtl::fsm::Fsm;
 use crate::rtl::{Module, Ty};
@@ -30,8 +51,12 @@ crate::states! {
     pub enum TravState {
         Idle = "idle",
         Aabb = "aabb",
+        Box = "box",
+        Fetch = "fetch",
         Node = "node",
-        Inner = "inner",
+        Clip1 = "clip1",
+        Dist = "dist",
+        Step = "step",
         Leaf = "leaf",
         Pop = "pop",
         Done = "done",
@@ -48,10 +73,12 @@ pub struct TraverseParams {
     pub stack_depth: u32,
     pub box_hi: [i64; 3],
     pub tri_bits: u32,
+    /// How the plane-distance product is built (`plane::plane_product`): the clock target's.
+    pub product: MulStyle,
 }
 
 impl TraverseParams {
-    pub fn new(scene: &SceneRoms, id_width: u32) -> TraverseParams {
+    pub fn new(scene: &SceneRoms, id_width: u32, target: ClockTarget) -> TraverseParams {
         let p = &scene.params;
         TraverseParams {
             n: p.n,
@@ -61,6 +88,7 @@ impl TraverseParams {
             stack_depth: p.stack_depth,
             box_hi: scene.box_hi,
             tri_bits: rom::addr_bits(scene.tri_count()),
+            product: target.mul_style(),
         }
     }
     /// Reciprocal directions: m + C bits.
@@ -111,60 +139,81 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let o = ["ox_r", "oy_r", "oz_r"].map(|name| b.reg(name, Ty::u(n), None));
     let inv = ["invx_r", "invy_r", "invz_r"].map(|name| b.reg(name, Ty::s(p.inv_width()), None));
 
-    // Node ROM, addressed by the node register's next value, so its word is ready in `node`.
+    // Node ROM, addressed by the node register itself, its word registered before any logic
+    // sees it (a block RAM's clock-to-out leaves no room for logic in the same clock): the
+    // word register holds mem[node] when node has held its value for the two cycles before.
+    // `node_settled` (node unchanged since the last cycle) tells `fetch` the word will be
+    // there in the next cycle.
     let node_bits = rom_addr_bits(node_words.len());
     let node = b.reg("node", Ty::u(node_bits), Some(0));
-    let node_next = b.wire("node_addr", node.ty());
     let node_rom = b.rom("node_rom", node_l.width, node_words.iter().map(|w| word_bits(w, 0, node_l.width)).collect());
-    let word = b.read("node_word", node_rom, node_next);
+    let word = b.delay("node_word_r", b.read("node_word", node_rom, node));
+    let node_settled = node.eq(b.delay("node_d1", node)).name("node_settled");
     let nf = |name: &str| field(&format!("nw_{name}"), word, node_l.field(name), 0);
     let (w_axis, w_clip0, w_clip1, w_child, w_first, w_count) =
         (nf("axis"), nf("clip0"), nf("clip1"), nf("child"), nf("first"), nf("count"));
     let w_leaf = w_axis.eq(3).name("nw_is_leaf");
 
-    // Registers of the inner-node step and the ray interval.
+    // The inner node's fields and the ray interval.
     let axis_r = b.reg("axis_r", Ty::u(2), None);
     let clip1_r = b.reg("clip1_r", Ty::u(n), None);
     let child_r = b.reg("child_r", w_child.ty(), None);
-    let d0_r = b.reg("d0_r", dist, None);
     let aabb_k = b.reg("aabb_k", Ty::u(2), None);
     let tmin = b.reg("tmin", dist, None);
     let tmax = b.reg("tmax", dist, None);
 
-    // The plane-distance unit: ((plane − O_axis) · inv_axis) >> C, clamped to [−1, 2^(n+1)].
-    let (in_aabb, in_node) = (fsm.is(Aabb), fsm.is(Node));
+    // The plane-distance unit. The select puts the node word's fields last, so they pass one
+    // mux level between the word register and the unit's first register.
+    let (in_aabb, in_node, in_clip1) = (fsm.is(Aabb), fsm.is(Node), fsm.is(Clip1));
     let hi = [0, 1, 2].map(|k| b.konst_named(&format!("box_hi_{k}"), Ty::u(n), p.box_hi[k] as i128));
     let aabb_neg = b.pick(aabb_k, inv).msb().name("aabb_neg");
     let aabb_plane = aabb_neg.select(hi[0].k(0), b.pick(aabb_k, hi)).name("aabb_plane");
-    let pu_axis = in_aabb.select(aabb_k, in_node.select(w_axis, axis_r)).name("pu_axis");
-    let pu_plane = in_aabb.select(aabb_plane, in_node.select(w_clip0, clip1_r)).name("pu_plane");
-    let delta = (pu_plane.xsigned() - b.pick(pu_axis, o).xsigned()).name("pu_delta");
-    let shifted = (delta.xmul(b.pick(pu_axis, inv)) >> p.c).name("pu_shifted");
-    let t_sat = shifted.k(1i128 << (n + 1));
-    let clamped = shifted.gt(t_sat).select(t_sat, shifted.lt(-1).select(shifted.k(-1), shifted));
-    let plane_t = clamped.resize(dist.width).name("plane_t");
-
-    // aabb: tmax = min over the axes; the ray misses the box when it ends below 0.
     let aabb_last = aabb_k.eq(2).name("aabb_last");
-    let aabb_tmax = (aabb_k.eq(0) | plane_t.lt(tmax)).select(plane_t, tmax).name("aabb_tmax");
+    let issue = PlaneIssue {
+        valid: (in_aabb | in_clip1 | (in_node & !w_leaf)).name("pu_issue"),
+        last: (in_clip1 | (in_aabb & aabb_last)).name("pu_issue_last"),
+        plane: in_node.select(w_clip0, in_aabb.select(aabb_plane, clip1_r)).name("pu_issue_plane"),
+        axis: in_node.select(w_axis, in_aabb.select(aabb_k, axis_r)).name("pu_issue_axis"),
+    };
+    let pu = plane_unit(&b, n, p.c, o, inv, issue, p.product);
+    let (plane_t, d0_arrives, d1_arrives) =
+        (pu.t, (pu.valid & !pu.last).name("d0_arrives"), (pu.valid & pu.last).name("d1_arrives"));
 
-    // inner: bih::inner_step with d0 (registered) and d1 (this cycle).
-    let negative = b.pick(axis_r, inv).msb().name("inner_negative");
-    let child_b = child_r + 1;
-    let near = negative.select(child_b, child_r).name("near");
-    let far = negative.select(child_r, child_b).name("far");
+    // box: tmax = min as the axes arrive (it starts at the clamp's ceiling 2^(n+1), which
+    // min leaves alone); the box is missed when any distance is negative, i.e. the min is.
+    let box_tmax = plane_t.lt(tmax).select(plane_t, tmax).name("box_tmax");
+    let missed = b.reg("box_missed", Ty::BIT, None);
+    let box_miss = (missed | plane_t.msb()).name("box_miss");
+
+    // dist: bih::inner_step's compares, registered when d1 arrives. tmin ≤ min(near_end, tmax)
+    // and max(tmin, far_start) ≤ tmax are each a compare with the new distance and tmin ≤ tmax
+    // (registered in `node`), so no min or max feeds a compare.
+    let negative = b.reg("negative", Ty::BIT, None);
+    let d0_r = b.reg("d0_r", dist, None);
     let near_end = negative.select(plane_t, d0_r).name("near_end");
     let far_start = negative.select(d0_r, plane_t).name("far_start");
-    let near_max = near_end.min(tmax).name("near_max");
-    let far_min = tmin.max(far_start).name("far_min");
-    let go_near = tmin.le(near_max).name("go_near");
-    let go_far = far_min.le(tmax).name("go_far");
+    let reg_bit = |name: &str| b.reg(name, Ty::BIT, None);
+    let (tmin_le_tmax, near_lt_tmax, far_gt_tmin) =
+        (reg_bit("tmin_le_tmax"), reg_bit("near_lt_tmax"), reg_bit("far_gt_tmin"));
+    let (tmin_le_near, far_le_tmax) = (reg_bit("tmin_le_near"), reg_bit("far_le_tmax"));
+    let near_end_r = b.reg("near_end_r", dist, None);
+    let far_start_r = b.reg("far_start_r", dist, None);
+    let far_r = b.reg("far_r", Ty::u(node_bits), None);
+    let child_b = child_r + 1;
+    let near = negative.select(child_b, child_r).resize(node_bits).name("near");
+    let far = negative.select(child_r, child_b).resize(node_bits).name("far");
+
+    // step: the decision from registered bits; near_max and far_min are muxes.
+    let near_max = near_lt_tmax.select(near_end_r, tmax).name("near_max");
+    let far_min = far_gt_tmin.select(far_start_r, tmin).name("far_min");
+    let go_near = (tmin_le_near & tmin_le_tmax).name("go_near");
+    let go_far = (far_le_tmax & tmin_le_tmax).name("go_far");
 
     // Stack entries (far node, far_min, tmax); the top (sp − 1) is always read ahead.
     let sp = b.reg("sp", Ty::u(p.sp_width()), Some(0));
     let stack_bits = rom_addr_bits(p.stack_depth as usize);
     let stack = b.ram("stack", node_bits + 2 * dist.width, vec![0; p.stack_depth as usize]);
-    let entry = b.cat(&[far.resize(node_bits), far_min.unsigned(), tmax.unsigned()]).name("push_entry");
+    let entry = b.cat(&[far_r, far_min.unsigned(), tmax.unsigned()]).name("push_entry");
     let top = b.read("stack_top", stack, (sp - 1).resize(stack_bits));
     let top_tmax = top.slice(0, dist.width).signed().name("top_tmax");
     let top_tmin = top.slice(dist.width, dist.width).signed().name("top_tmin");
@@ -174,9 +223,19 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let leaf_bits = rom_addr_bits(leaf_words.len());
     let leaf_ptr = b.reg("leaf_ptr", Ty::u(leaf_bits), None);
     let left = b.reg("leaf_left", w_count.ty(), None);
+    // Whether `node` has held the stack top since two cycles before `node` follows `pop` (so
+    // the word register has it without a `fetch`): `leaf` loads the top every cycle, so a
+    // leaf of two or more entries has. The top is read at sp − 1 one cycle late, so it is
+    // current in `leaf` and `step`, not in a `node` right after a push.
+    let popped_ahead = b.reg("popped_ahead", Ty::BIT, None);
+    let was_leaf = b.delay("was_leaf", fsm.is(Leaf));
 
     fsm.state(Idle, |s| {
         s.set_k(aabb_k, 0);
+        s.set_k(node, 0);
+        s.set_k(tmin, 0);
+        s.set_k(tmax, 1i128 << (n + 1));
+        s.set_k(missed, 0);
         s.when(ray_valid, |s| {
             s.set(id_r, ray_id);
             for k in 0..3 {
@@ -187,51 +246,88 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         });
     });
     fsm.state(Aabb, |s| {
-        s.set(tmax, aabb_tmax);
         s.set(aabb_k, aabb_k + 1);
-        s.when(aabb_last, |s| {
-            s.set_k(tmin, 0);
-            s.set_k(node, 0);
-            s.when(aabb_tmax.lt(0), |s| s.goto(Done)).otherwise(|s| s.goto(Node));
+        s.when(aabb_last, |s| s.goto(Box));
+    });
+    fsm.state(Box, |s| {
+        s.when(pu.valid, |s| {
+            s.set(tmax, box_tmax);
+            s.set(missed, box_miss);
         });
+        s.when(d1_arrives, |s| {
+            s.when(box_miss, |s| s.goto(Done)).otherwise(|s| s.goto(Node));
+        });
+    });
+    fsm.state(Fetch, |s| {
+        s.when(node_settled, |s| s.goto(Node));
     });
     fsm.state(Node, |s| {
         s.when(w_leaf, |s| {
             s.set(leaf_ptr, w_first.resize(leaf_bits));
             s.set(left, w_count);
+            s.set_k(popped_ahead, 0);
             s.when(w_count.eq(0), |s| s.goto(Pop)).otherwise(|s| s.goto(Leaf));
         })
         .otherwise(|s| {
+            // d0 is issued this cycle (the unit's select reads the word).
             s.set(axis_r, w_axis);
             s.set(clip1_r, w_clip1);
             s.set(child_r, w_child);
-            s.set(d0_r, plane_t);
-            s.goto(Inner);
+            s.set(tmin_le_tmax, tmin.le(tmax));
+            s.goto(Clip1);
         });
     });
-    fsm.state(Inner, |s| {
+    fsm.state(Clip1, |s| {
+        // d1 is issued this cycle.
+        s.set(negative, b.pick(axis_r, inv).msb());
+        s.goto(Dist);
+    });
+    fsm.state(Dist, |s| {
+        // The near child is the likely next node: addressing the ROM with it now has its word
+        // ready when `step` enters it, so only a far-only step pays a `fetch`.
+        s.set(node, near);
+        s.set(far_r, far);
+        s.when(d0_arrives, |s| s.set(d0_r, plane_t));
+        s.when(d1_arrives, |s| {
+            s.set(near_end_r, near_end);
+            s.set(far_start_r, far_start);
+            s.set(near_lt_tmax, near_end.lt(tmax));
+            s.set(far_gt_tmin, far_start.gt(tmin));
+            s.set(tmin_le_near, tmin.le(near_end));
+            s.set(far_le_tmax, far_start.le(tmax));
+            s.goto(Step);
+        });
+    });
+    fsm.state(Step, |s| {
         s.when(go_near & go_far, |s| {
             s.write(stack, sp.resize(stack_bits), entry);
             s.set(sp, sp + 1);
         });
         s.when(go_near, |s| {
             s.set(tmax, near_max);
-            s.set(node, near.resize(node_bits));
             s.goto(Node);
         })
         .otherwise(|s| {
             s.when(go_far, |s| {
                 s.set(tmin, far_min);
-                s.set(node, far.resize(node_bits));
-                s.goto(Node);
+                s.set(node, far_r);
+                s.goto(Fetch);
             })
-            .otherwise(|s| s.goto(Pop));
+            .otherwise(|s| {
+                s.set(node, top_node);
+                s.set_k(popped_ahead, 0);
+                s.goto(Pop);
+            });
         });
     });
     fsm.state(Leaf, |s| {
         s.set(leaf_ptr, leaf_ptr + 1);
         s.set(left, left - 1);
-        s.when(left.eq(1), |s| s.goto(Pop));
+        s.set(node, top_node);
+        s.when(left.eq(1), |s| {
+            s.set(popped_ahead, was_leaf);
+            s.goto(Pop);
+        });
     });
     fsm.state(Pop, |s| {
         s.when(sp.eq(0), |s| s.goto(Done)).otherwise(|s| {
@@ -239,24 +335,25 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
             s.set(tmin, top_tmin);
             s.set(tmax, top_tmax);
             s.set(node, top_node);
-            s.goto(Node);
+            s.when(popped_ahead, |s| s.goto(Node)).otherwise(|s| s.goto(Fetch));
         });
     });
     fsm.state(Done, |s| s.goto(Idle));
     let (in_idle, in_leaf, in_done) = (fsm.is(Idle), fsm.is(Leaf), fsm.is(Done));
     let state = fsm.state_reg();
-    let nexts = fsm.finish();
-    b.drive(node_next, nexts.of(node));
+    fsm.finish();
 
-    // Emission, one cycle behind the FSM so it lines up with the leaf ROM's output.
+    // Emission, two cycles behind the FSM so it lines up with the leaf ROM's registered
+    // output (the triangle number addresses the triangle ROMs: no block RAM output drives
+    // another block RAM's address directly).
     let leaf_rom = b.rom("leaf_rom", leaf_l.width, leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect());
-    let tri = b.read("leaf_tri", leaf_rom, leaf_ptr);
+    let tri = b.delay("leaf_tri_r", b.read("leaf_tri", leaf_rom, leaf_ptr));
     b.output("ray_ready", in_idle);
-    b.output("emit_valid", b.delay("emit_r", in_leaf | in_done));
-    b.output("emit_end", b.delay("end_r", in_done));
+    b.output("emit_valid", b.delay_line("emit_r", in_leaf | in_done, 2));
+    b.output("emit_end", b.delay_line("end_r", in_done, 2));
     b.output("emit_tri", tri.resize(p.tri_bits));
-    b.output("emit_tmin", b.delay("tmin_r", tmin.unsigned().resize(p.tmin_width())));
-    b.output("emit_id", b.delay("id_r", id_r));
+    b.output("emit_tmin", b.delay_line("tmin_r", tmin.unsigned().resize(p.tmin_width()), 2));
+    b.output("emit_id", b.delay_line("id_r", id_r, 2));
     for (name, s) in ["cur_ox", "cur_oy", "cur_oz"].iter().zip(o) {
         b.output(name, s);
     }
@@ -327,15 +424,17 @@ mod tests {
     }
 
     /// Every ray of a small frame (hits, misses, grazing rays) through the FSM: the same node
-    /// visits and the same triangle stream as `Golden::walk`, ray after ray in one simulation.
+    /// visits and the same triangle stream as `Golden::walk`, ray after ray in one simulation;
+    /// at three clock targets (products of latency 1 to 6), which the machine follows by the
+    /// unit's valid bits.
     #[test]
     fn visits_what_the_golden_walk_visits_in_its_order() {
-        for (name, params) in [("teapot", Params::default()), ("cornell", Params { n: 20, m: 20, ..Params::default() })]
-        {
+        let cornell = Params { n: 20, m: 20, ..Params::default() };
+        for (name, params, mhz) in [("teapot", Params::default(), 150), ("cornell", cornell, 75), ("cornell", cornell, 250)] {
             let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
             let g = Golden::new(&scene);
             let roms = SceneRoms::of(&scene);
-            let m = traverse_core(&TraverseParams::new(&roms, 16), &roms);
+            let m = traverse_core(&TraverseParams::new(&roms, 16, ClockTarget(mhz)), &roms);
             let mut sim = Sim::new(&m);
             let cam = Camera::default_for(&scene, 24, 24);
             let mut rays = 0;
@@ -345,7 +444,7 @@ mod tests {
                     let mut want = Trace::default();
                     want.max_stack = g.walk(&scene, &q.ray, &mut want).max_stack;
                     let got = run(&m, &mut sim, &q.ray, (py * 24 + px) as u64);
-                    assert_eq!(got, want, "{name} pixel {px},{py}");
+                    assert_eq!(got, want, "{name} at {mhz} MHz pixel {px},{py}");
                     rays += 1;
                 }
             }

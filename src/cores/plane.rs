@@ -1,0 +1,95 @@
+//! The traversal unit's plane-distance unit (golden twin `Golden::plane_t`):
+//! ((P − O_axis) · inv_axis) >> C, clamped to [−1, 2^(n+1)], pipelined so that every
+//! register-to-register path holds one mux level and one adder, or the multiplier alone.
+//!
+//! Stages, one clock each; a distance issued in cycle c is on `t` in cycle c + `latency`:
+//! 1. select: the issuing state's plane (n bits) and axis (2 bits), with a valid and a last
+//!    bit. The traversal builds the select so that a node ROM field passes one mux level at
+//!    most before this register.
+//! 2. delta: P − O_axis (n + 1 bits, signed) and inv_axis (m + C bits) — the axis mux and one
+//!    subtractor.
+//! 3. product: `plane_product`, its own number of stages (the clock target's `MulStyle`: 1
+//!    for one multiplier between two registers, more for DSP pieces and an adder tree).
+//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (two compares with
+//!    constants and a mux), registered.
+//!
+//! The valid and last bits ride along in shift registers of the same depth, so a state
+//! machine waits for results by their valid bit and never counts the latency itself: a
+//! deeper multiplier changes `latency`, not the machine.
+
+use super::mul::{MulStyle, group_latency, mul_core};
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, S};
+use std::rc::Rc;
+
+/// The product delta · inv (n + 1 by m + C bits, signed, full width) and its latency in
+/// clocks, built as the clock target's `MulStyle` says (`cores::mul`): one multiplier
+/// between two registers when combinational (latency 1), else DSP-sized pieces with their
+/// registers and a registered adder tree.
+pub fn plane_product<'b>(b: &'b Builder, delta: S<'b>, inv: S<'b>, style: MulStyle) -> (S<'b>, u32) {
+    if style == MulStyle::COMBINATIONAL {
+        return (b.delay("pu_product", delta.xmul(inv).name("pu_mul")), 1);
+    }
+    let ops = [(delta.ty(), inv.ty())];
+    let m = Rc::new(mul_core(&ops, style));
+    (b.instance("u_plane_product", &m, &[delta, inv]).get("p0").name("pu_product"), group_latency(&ops, style))
+}
+
+/// What a state issues to the unit in a cycle: combinational signals, registered by stage 1.
+pub struct PlaneIssue<'b> {
+    /// A distance is issued this cycle.
+    pub valid: S<'b>,
+    /// It is the last of a group (d1 of an inner node, the third axis of the scene box).
+    pub last: S<'b>,
+    /// The plane, n bits unsigned.
+    pub plane: S<'b>,
+    /// The axis, 2 bits (3 never occurs).
+    pub axis: S<'b>,
+}
+
+/// The unit's result: registered, `latency` clocks after the issue.
+pub struct PlaneResult<'b> {
+    /// The clamped distance, signed n + 3 bits.
+    pub t: S<'b>,
+    pub valid: S<'b>,
+    pub last: S<'b>,
+    pub latency: u32,
+}
+
+/// The unit for a ray whose origin `o` (n bits each) and reciprocal direction `inv` (m + C
+/// bits, signed) stay in their registers while distances are issued; `product` is the style
+/// `plane_product` builds.
+pub fn plane_unit<'b>(
+    b: &'b Builder,
+    n: u32,
+    c: u32,
+    o: [S<'b>; 3],
+    inv: [S<'b>; 3],
+    issue: PlaneIssue<'b>,
+    product: MulStyle,
+) -> PlaneResult<'b> {
+    // 1. select
+    let valid = b.delay("pu_sel_valid", issue.valid);
+    let last = b.delay("pu_sel_last", issue.last);
+    let plane = b.delay("pu_sel_plane", issue.plane);
+    let axis = b.delay("pu_sel_axis", issue.axis);
+    // 2. delta: P − O never leaves ±(2^n − 1), so n + 1 signed bits hold it.
+    let delta = b.delay("pu_delta", (plane.xsigned() - b.pick(axis, o).xsigned()).name("pu_diff"));
+    let inv_a = b.delay("pu_inv", b.pick(axis, inv).name("pu_inv_axis"));
+    let (valid, last) = (b.delay("pu_delta_valid", valid), b.delay("pu_delta_last", last));
+    // 3. product
+    let (product, product_latency) = plane_product(b, delta, inv_a, product);
+    let valid = b.delay_line("pu_product_valid", valid, product_latency);
+    let last = b.delay_line("pu_product_last", last, product_latency);
+    // 4. clamp
+    let shifted = (product >> c).name("pu_shifted");
+    let t_sat = shifted.k(1i128 << (n + 1));
+    let clamped = shifted.gt(t_sat).select(t_sat, shifted.lt(-1).select(shifted.k(-1), shifted));
+    let t = b.delay("plane_t", clamped.resize(Ty::s(n + 3).width).name("pu_clamped"));
+    PlaneResult {
+        t,
+        valid: b.delay("plane_t_valid", valid),
+        last: b.delay("plane_t_last", last),
+        latency: 3 + product_latency,
+    }
+}
