@@ -163,7 +163,7 @@ module fxrt_core (
     .fsm_state(u_traverse_fsm_state)
   );
 
-  fxrt_intersect_n29_m32_t0_e18_tag45 u_intersect (
+  fxrt_intersect_n29_m32_t0_e18_tag45_c150 u_intersect (
     .clk(clk),
     .valid(pipe_valid),
     .tag(pipe_tag),
@@ -191,7 +191,7 @@ module fxrt_core (
     .v(u_intersect_v)
   );
 
-  fxrt_closest_n29_m32_tag45 u_closest (
+  fxrt_closest_n29_m32_tag45_r2 u_closest (
     .clk(clk),
     .rst(rst),
     .valid(u_intersect_valid_out),

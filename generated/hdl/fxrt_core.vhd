@@ -60,7 +60,7 @@ architecture rtl of fxrt_core is
       fsm_state : out unsigned(3 downto 0)
     );
   end component;
-  component fxrt_intersect_n29_m32_t0_e18_tag45 is
+  component fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
     port (
       clk : in std_logic;
       valid : in unsigned(0 downto 0);
@@ -89,7 +89,7 @@ architecture rtl of fxrt_core is
       v : out unsigned(31 downto 0)
     );
   end component;
-  component fxrt_closest_n29_m32_tag45 is
+  component fxrt_closest_n29_m32_tag45_r2 is
     port (
       clk : in std_logic;
       rst : in std_logic;
@@ -19215,7 +19215,7 @@ begin
       fsm_state => u_traverse_fsm_state
     );
 
-  u_intersect : fxrt_intersect_n29_m32_t0_e18_tag45
+  u_intersect : fxrt_intersect_n29_m32_t0_e18_tag45_c150
     port map (
       clk => clk,
       valid => pipe_valid,
@@ -19244,7 +19244,7 @@ begin
       v => u_intersect_v
     );
 
-  u_closest : fxrt_closest_n29_m32_tag45
+  u_closest : fxrt_closest_n29_m32_tag45_r2
     port map (
       clk => clk,
       rst => rst,

@@ -44,11 +44,17 @@ module fxrt_div_n29_a63_b34 (
   wire [0:0] bits_lo;
   wire [34:0] rs_bits_lo;
   wire [34:0] or_3;
-  wire [0:0] ge0;
-  wire [34:0] or_3_minus_rs_s1_b;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge0;
+  wire [35:0] rs_or_3;
+  wire signed [35:0] s_rs_or_3;
+  wire [35:0] rs_rs_s1_b;
+  wire signed [35:0] s_rs_rs_s1_b;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff0;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff0;
+  wire [0:0] ge0;
+  wire [33:0] bits_diff0_1;
+  wire [33:0] rs_or_3_1;
   wire [33:0] rem0;
   wire [29:0] rs_ge0;
   wire [29:0] quot0;
@@ -63,12 +69,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d1 = 30'h00000000;
   wire [0:0] bits_lo_d1;
   wire [34:0] rs_bits_lo_d1;
-  wire [34:0] or_4;
-  wire [0:0] ge1;
-  wire [34:0] or_4_minus_rs_s1_b_d1;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge1;
+  wire [34:0] or_5;
+  wire [35:0] rs_or_5;
+  wire signed [35:0] s_rs_or_5;
+  wire [35:0] rs_rs_s1_b_d1;
+  wire signed [35:0] s_rs_rs_s1_b_d1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff1;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff1;
+  wire [0:0] ge1;
+  wire [33:0] bits_diff1_1;
+  wire [33:0] rs_or_5_1;
   wire [33:0] rem1;
   wire [29:0] shl_s2_q;
   wire [29:0] rs_ge1;
@@ -84,12 +96,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d2 = 30'h00000000;
   wire [0:0] bits_lo_d2;
   wire [34:0] rs_bits_lo_d2;
-  wire [34:0] or_5;
-  wire [0:0] ge2;
-  wire [34:0] or_5_minus_rs_s1_b_d2;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge2;
+  wire [34:0] or_7;
+  wire [35:0] rs_or_7;
+  wire signed [35:0] s_rs_or_7;
+  wire [35:0] rs_rs_s1_b_d2;
+  wire signed [35:0] s_rs_rs_s1_b_d2;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff2;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff2;
+  wire [0:0] ge2;
+  wire [33:0] bits_diff2_1;
+  wire [33:0] rs_or_7_1;
   wire [33:0] rem2;
   wire [29:0] shl_s3_q;
   wire [29:0] rs_ge2;
@@ -105,12 +123,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d3 = 30'h00000000;
   wire [0:0] bits_lo_d3;
   wire [34:0] rs_bits_lo_d3;
-  wire [34:0] or_6;
-  wire [0:0] ge3;
-  wire [34:0] or_6_minus_rs_s1_b_d3;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge3;
+  wire [34:0] or_9;
+  wire [35:0] rs_or_9;
+  wire signed [35:0] s_rs_or_9;
+  wire [35:0] rs_rs_s1_b_d3;
+  wire signed [35:0] s_rs_rs_s1_b_d3;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff3;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff3;
+  wire [0:0] ge3;
+  wire [33:0] bits_diff3_1;
+  wire [33:0] rs_or_9_1;
   wire [33:0] rem3;
   wire [29:0] shl_s4_q;
   wire [29:0] rs_ge3;
@@ -126,12 +150,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d4 = 30'h00000000;
   wire [0:0] bits_lo_d4;
   wire [34:0] rs_bits_lo_d4;
-  wire [34:0] or_7;
-  wire [0:0] ge4;
-  wire [34:0] or_7_minus_rs_s1_b_d4;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge4;
+  wire [34:0] or_11;
+  wire [35:0] rs_or_11;
+  wire signed [35:0] s_rs_or_11;
+  wire [35:0] rs_rs_s1_b_d4;
+  wire signed [35:0] s_rs_rs_s1_b_d4;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff4;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff4;
+  wire [0:0] ge4;
+  wire [33:0] bits_diff4_1;
+  wire [33:0] rs_or_11_1;
   wire [33:0] rem4;
   wire [29:0] shl_s5_q;
   wire [29:0] rs_ge4;
@@ -147,12 +177,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d5 = 30'h00000000;
   wire [0:0] bits_lo_d5;
   wire [34:0] rs_bits_lo_d5;
-  wire [34:0] or_8;
-  wire [0:0] ge5;
-  wire [34:0] or_8_minus_rs_s1_b_d5;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge5;
+  wire [34:0] or_13;
+  wire [35:0] rs_or_13;
+  wire signed [35:0] s_rs_or_13;
+  wire [35:0] rs_rs_s1_b_d5;
+  wire signed [35:0] s_rs_rs_s1_b_d5;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff5;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff5;
+  wire [0:0] ge5;
+  wire [33:0] bits_diff5_1;
+  wire [33:0] rs_or_13_1;
   wire [33:0] rem5;
   wire [29:0] shl_s6_q;
   wire [29:0] rs_ge5;
@@ -168,12 +204,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d6 = 30'h00000000;
   wire [0:0] bits_lo_d6;
   wire [34:0] rs_bits_lo_d6;
-  wire [34:0] or_9;
-  wire [0:0] ge6;
-  wire [34:0] or_9_minus_rs_s1_b_d6;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge6;
+  wire [34:0] or_15;
+  wire [35:0] rs_or_15;
+  wire signed [35:0] s_rs_or_15;
+  wire [35:0] rs_rs_s1_b_d6;
+  wire signed [35:0] s_rs_rs_s1_b_d6;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff6;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff6;
+  wire [0:0] ge6;
+  wire [33:0] bits_diff6_1;
+  wire [33:0] rs_or_15_1;
   wire [33:0] rem6;
   wire [29:0] shl_s7_q;
   wire [29:0] rs_ge6;
@@ -189,12 +231,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d7 = 30'h00000000;
   wire [0:0] bits_lo_d7;
   wire [34:0] rs_bits_lo_d7;
-  wire [34:0] or_10;
-  wire [0:0] ge7;
-  wire [34:0] or_10_minus_rs_s1_b_d7;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge7;
+  wire [34:0] or_17;
+  wire [35:0] rs_or_17;
+  wire signed [35:0] s_rs_or_17;
+  wire [35:0] rs_rs_s1_b_d7;
+  wire signed [35:0] s_rs_rs_s1_b_d7;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff7;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff7;
+  wire [0:0] ge7;
+  wire [33:0] bits_diff7_1;
+  wire [33:0] rs_or_17_1;
   wire [33:0] rem7;
   wire [29:0] shl_s8_q;
   wire [29:0] rs_ge7;
@@ -210,12 +258,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d8 = 30'h00000000;
   wire [0:0] bits_lo_d8;
   wire [34:0] rs_bits_lo_d8;
-  wire [34:0] or_11;
-  wire [0:0] ge8;
-  wire [34:0] or_11_minus_rs_s1_b_d8;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge8;
+  wire [34:0] or_19;
+  wire [35:0] rs_or_19;
+  wire signed [35:0] s_rs_or_19;
+  wire [35:0] rs_rs_s1_b_d8;
+  wire signed [35:0] s_rs_rs_s1_b_d8;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff8;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff8;
+  wire [0:0] ge8;
+  wire [33:0] bits_diff8_1;
+  wire [33:0] rs_or_19_1;
   wire [33:0] rem8;
   wire [29:0] shl_s9_q;
   wire [29:0] rs_ge8;
@@ -231,12 +285,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d9 = 30'h00000000;
   wire [0:0] bits_lo_d9;
   wire [34:0] rs_bits_lo_d9;
-  wire [34:0] or_12;
-  wire [0:0] ge9;
-  wire [34:0] or_12_minus_rs_s1_b_d9;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge9;
+  wire [34:0] or_21;
+  wire [35:0] rs_or_21;
+  wire signed [35:0] s_rs_or_21;
+  wire [35:0] rs_rs_s1_b_d9;
+  wire signed [35:0] s_rs_rs_s1_b_d9;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff9;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff9;
+  wire [0:0] ge9;
+  wire [33:0] bits_diff9_1;
+  wire [33:0] rs_or_21_1;
   wire [33:0] rem9;
   wire [29:0] shl_s10_q;
   wire [29:0] rs_ge9;
@@ -252,12 +312,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d10 = 30'h00000000;
   wire [0:0] bits_lo_d10;
   wire [34:0] rs_bits_lo_d10;
-  wire [34:0] or_13;
-  wire [0:0] ge10;
-  wire [34:0] or_13_minus_rs_s1_b_d10;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge10;
+  wire [34:0] or_23;
+  wire [35:0] rs_or_23;
+  wire signed [35:0] s_rs_or_23;
+  wire [35:0] rs_rs_s1_b_d10;
+  wire signed [35:0] s_rs_rs_s1_b_d10;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff10;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff10;
+  wire [0:0] ge10;
+  wire [33:0] bits_diff10_1;
+  wire [33:0] rs_or_23_1;
   wire [33:0] rem10;
   wire [29:0] shl_s11_q;
   wire [29:0] rs_ge10;
@@ -273,12 +339,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d11 = 30'h00000000;
   wire [0:0] bits_lo_d11;
   wire [34:0] rs_bits_lo_d11;
-  wire [34:0] or_14;
-  wire [0:0] ge11;
-  wire [34:0] or_14_minus_rs_s1_b_d11;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge11;
+  wire [34:0] or_25;
+  wire [35:0] rs_or_25;
+  wire signed [35:0] s_rs_or_25;
+  wire [35:0] rs_rs_s1_b_d11;
+  wire signed [35:0] s_rs_rs_s1_b_d11;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff11;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff11;
+  wire [0:0] ge11;
+  wire [33:0] bits_diff11_1;
+  wire [33:0] rs_or_25_1;
   wire [33:0] rem11;
   wire [29:0] shl_s12_q;
   wire [29:0] rs_ge11;
@@ -294,12 +366,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d12 = 30'h00000000;
   wire [0:0] bits_lo_d12;
   wire [34:0] rs_bits_lo_d12;
-  wire [34:0] or_15;
-  wire [0:0] ge12;
-  wire [34:0] or_15_minus_rs_s1_b_d12;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge12;
+  wire [34:0] or_27;
+  wire [35:0] rs_or_27;
+  wire signed [35:0] s_rs_or_27;
+  wire [35:0] rs_rs_s1_b_d12;
+  wire signed [35:0] s_rs_rs_s1_b_d12;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff12;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff12;
+  wire [0:0] ge12;
+  wire [33:0] bits_diff12_1;
+  wire [33:0] rs_or_27_1;
   wire [33:0] rem12;
   wire [29:0] shl_s13_q;
   wire [29:0] rs_ge12;
@@ -315,12 +393,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d13 = 30'h00000000;
   wire [0:0] bits_lo_d13;
   wire [34:0] rs_bits_lo_d13;
-  wire [34:0] or_16;
-  wire [0:0] ge13;
-  wire [34:0] or_16_minus_rs_s1_b_d13;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge13;
+  wire [34:0] or_29;
+  wire [35:0] rs_or_29;
+  wire signed [35:0] s_rs_or_29;
+  wire [35:0] rs_rs_s1_b_d13;
+  wire signed [35:0] s_rs_rs_s1_b_d13;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff13;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff13;
+  wire [0:0] ge13;
+  wire [33:0] bits_diff13_1;
+  wire [33:0] rs_or_29_1;
   wire [33:0] rem13;
   wire [29:0] shl_s14_q;
   wire [29:0] rs_ge13;
@@ -336,12 +420,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d14 = 30'h00000000;
   wire [0:0] bits_lo_d14;
   wire [34:0] rs_bits_lo_d14;
-  wire [34:0] or_17;
-  wire [0:0] ge14;
-  wire [34:0] or_17_minus_rs_s1_b_d14;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge14;
+  wire [34:0] or_31;
+  wire [35:0] rs_or_31;
+  wire signed [35:0] s_rs_or_31;
+  wire [35:0] rs_rs_s1_b_d14;
+  wire signed [35:0] s_rs_rs_s1_b_d14;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff14;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff14;
+  wire [0:0] ge14;
+  wire [33:0] bits_diff14_1;
+  wire [33:0] rs_or_31_1;
   wire [33:0] rem14;
   wire [29:0] shl_s15_q;
   wire [29:0] rs_ge14;
@@ -357,12 +447,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d15 = 30'h00000000;
   wire [0:0] bits_lo_d15;
   wire [34:0] rs_bits_lo_d15;
-  wire [34:0] or_18;
-  wire [0:0] ge15;
-  wire [34:0] or_18_minus_rs_s1_b_d15;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge15;
+  wire [34:0] or_33;
+  wire [35:0] rs_or_33;
+  wire signed [35:0] s_rs_or_33;
+  wire [35:0] rs_rs_s1_b_d15;
+  wire signed [35:0] s_rs_rs_s1_b_d15;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff15;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff15;
+  wire [0:0] ge15;
+  wire [33:0] bits_diff15_1;
+  wire [33:0] rs_or_33_1;
   wire [33:0] rem15;
   wire [29:0] shl_s16_q;
   wire [29:0] rs_ge15;
@@ -378,12 +474,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d16 = 30'h00000000;
   wire [0:0] bits_lo_d16;
   wire [34:0] rs_bits_lo_d16;
-  wire [34:0] or_19;
-  wire [0:0] ge16;
-  wire [34:0] or_19_minus_rs_s1_b_d16;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge16;
+  wire [34:0] or_35;
+  wire [35:0] rs_or_35;
+  wire signed [35:0] s_rs_or_35;
+  wire [35:0] rs_rs_s1_b_d16;
+  wire signed [35:0] s_rs_rs_s1_b_d16;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff16;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff16;
+  wire [0:0] ge16;
+  wire [33:0] bits_diff16_1;
+  wire [33:0] rs_or_35_1;
   wire [33:0] rem16;
   wire [29:0] shl_s17_q;
   wire [29:0] rs_ge16;
@@ -399,12 +501,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d17 = 30'h00000000;
   wire [0:0] bits_lo_d17;
   wire [34:0] rs_bits_lo_d17;
-  wire [34:0] or_20;
-  wire [0:0] ge17;
-  wire [34:0] or_20_minus_rs_s1_b_d17;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge17;
+  wire [34:0] or_37;
+  wire [35:0] rs_or_37;
+  wire signed [35:0] s_rs_or_37;
+  wire [35:0] rs_rs_s1_b_d17;
+  wire signed [35:0] s_rs_rs_s1_b_d17;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff17;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff17;
+  wire [0:0] ge17;
+  wire [33:0] bits_diff17_1;
+  wire [33:0] rs_or_37_1;
   wire [33:0] rem17;
   wire [29:0] shl_s18_q;
   wire [29:0] rs_ge17;
@@ -420,12 +528,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d18 = 30'h00000000;
   wire [0:0] bits_lo_d18;
   wire [34:0] rs_bits_lo_d18;
-  wire [34:0] or_21;
-  wire [0:0] ge18;
-  wire [34:0] or_21_minus_rs_s1_b_d18;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge18;
+  wire [34:0] or_39;
+  wire [35:0] rs_or_39;
+  wire signed [35:0] s_rs_or_39;
+  wire [35:0] rs_rs_s1_b_d18;
+  wire signed [35:0] s_rs_rs_s1_b_d18;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff18;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff18;
+  wire [0:0] ge18;
+  wire [33:0] bits_diff18_1;
+  wire [33:0] rs_or_39_1;
   wire [33:0] rem18;
   wire [29:0] shl_s19_q;
   wire [29:0] rs_ge18;
@@ -441,12 +555,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d19 = 30'h00000000;
   wire [0:0] bits_lo_d19;
   wire [34:0] rs_bits_lo_d19;
-  wire [34:0] or_22;
-  wire [0:0] ge19;
-  wire [34:0] or_22_minus_rs_s1_b_d19;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge19;
+  wire [34:0] or_41;
+  wire [35:0] rs_or_41;
+  wire signed [35:0] s_rs_or_41;
+  wire [35:0] rs_rs_s1_b_d19;
+  wire signed [35:0] s_rs_rs_s1_b_d19;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff19;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff19;
+  wire [0:0] ge19;
+  wire [33:0] bits_diff19_1;
+  wire [33:0] rs_or_41_1;
   wire [33:0] rem19;
   wire [29:0] shl_s20_q;
   wire [29:0] rs_ge19;
@@ -462,12 +582,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d20 = 30'h00000000;
   wire [0:0] bits_lo_d20;
   wire [34:0] rs_bits_lo_d20;
-  wire [34:0] or_23;
-  wire [0:0] ge20;
-  wire [34:0] or_23_minus_rs_s1_b_d20;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge20;
+  wire [34:0] or_43;
+  wire [35:0] rs_or_43;
+  wire signed [35:0] s_rs_or_43;
+  wire [35:0] rs_rs_s1_b_d20;
+  wire signed [35:0] s_rs_rs_s1_b_d20;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff20;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff20;
+  wire [0:0] ge20;
+  wire [33:0] bits_diff20_1;
+  wire [33:0] rs_or_43_1;
   wire [33:0] rem20;
   wire [29:0] shl_s21_q;
   wire [29:0] rs_ge20;
@@ -483,12 +609,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d21 = 30'h00000000;
   wire [0:0] bits_lo_d21;
   wire [34:0] rs_bits_lo_d21;
-  wire [34:0] or_24;
-  wire [0:0] ge21;
-  wire [34:0] or_24_minus_rs_s1_b_d21;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge21;
+  wire [34:0] or_45;
+  wire [35:0] rs_or_45;
+  wire signed [35:0] s_rs_or_45;
+  wire [35:0] rs_rs_s1_b_d21;
+  wire signed [35:0] s_rs_rs_s1_b_d21;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff21;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff21;
+  wire [0:0] ge21;
+  wire [33:0] bits_diff21_1;
+  wire [33:0] rs_or_45_1;
   wire [33:0] rem21;
   wire [29:0] shl_s22_q;
   wire [29:0] rs_ge21;
@@ -504,12 +636,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d22 = 30'h00000000;
   wire [0:0] bits_lo_d22;
   wire [34:0] rs_bits_lo_d22;
-  wire [34:0] or_25;
-  wire [0:0] ge22;
-  wire [34:0] or_25_minus_rs_s1_b_d22;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge22;
+  wire [34:0] or_47;
+  wire [35:0] rs_or_47;
+  wire signed [35:0] s_rs_or_47;
+  wire [35:0] rs_rs_s1_b_d22;
+  wire signed [35:0] s_rs_rs_s1_b_d22;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff22;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff22;
+  wire [0:0] ge22;
+  wire [33:0] bits_diff22_1;
+  wire [33:0] rs_or_47_1;
   wire [33:0] rem22;
   wire [29:0] shl_s23_q;
   wire [29:0] rs_ge22;
@@ -525,12 +663,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d23 = 30'h00000000;
   wire [0:0] bits_lo_d23;
   wire [34:0] rs_bits_lo_d23;
-  wire [34:0] or_26;
-  wire [0:0] ge23;
-  wire [34:0] or_26_minus_rs_s1_b_d23;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge23;
+  wire [34:0] or_49;
+  wire [35:0] rs_or_49;
+  wire signed [35:0] s_rs_or_49;
+  wire [35:0] rs_rs_s1_b_d23;
+  wire signed [35:0] s_rs_rs_s1_b_d23;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff23;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff23;
+  wire [0:0] ge23;
+  wire [33:0] bits_diff23_1;
+  wire [33:0] rs_or_49_1;
   wire [33:0] rem23;
   wire [29:0] shl_s24_q;
   wire [29:0] rs_ge23;
@@ -546,12 +690,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d24 = 30'h00000000;
   wire [0:0] bits_lo_d24;
   wire [34:0] rs_bits_lo_d24;
-  wire [34:0] or_27;
-  wire [0:0] ge24;
-  wire [34:0] or_27_minus_rs_s1_b_d24;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge24;
+  wire [34:0] or_51;
+  wire [35:0] rs_or_51;
+  wire signed [35:0] s_rs_or_51;
+  wire [35:0] rs_rs_s1_b_d24;
+  wire signed [35:0] s_rs_rs_s1_b_d24;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff24;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff24;
+  wire [0:0] ge24;
+  wire [33:0] bits_diff24_1;
+  wire [33:0] rs_or_51_1;
   wire [33:0] rem24;
   wire [29:0] shl_s25_q;
   wire [29:0] rs_ge24;
@@ -567,12 +717,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d25 = 30'h00000000;
   wire [0:0] bits_lo_d25;
   wire [34:0] rs_bits_lo_d25;
-  wire [34:0] or_28;
-  wire [0:0] ge25;
-  wire [34:0] or_28_minus_rs_s1_b_d25;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge25;
+  wire [34:0] or_53;
+  wire [35:0] rs_or_53;
+  wire signed [35:0] s_rs_or_53;
+  wire [35:0] rs_rs_s1_b_d25;
+  wire signed [35:0] s_rs_rs_s1_b_d25;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff25;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff25;
+  wire [0:0] ge25;
+  wire [33:0] bits_diff25_1;
+  wire [33:0] rs_or_53_1;
   wire [33:0] rem25;
   wire [29:0] shl_s26_q;
   wire [29:0] rs_ge25;
@@ -588,12 +744,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d26 = 30'h00000000;
   wire [0:0] bits_lo_d26;
   wire [34:0] rs_bits_lo_d26;
-  wire [34:0] or_29;
-  wire [0:0] ge26;
-  wire [34:0] or_29_minus_rs_s1_b_d26;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge26;
+  wire [34:0] or_55;
+  wire [35:0] rs_or_55;
+  wire signed [35:0] s_rs_or_55;
+  wire [35:0] rs_rs_s1_b_d26;
+  wire signed [35:0] s_rs_rs_s1_b_d26;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff26;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff26;
+  wire [0:0] ge26;
+  wire [33:0] bits_diff26_1;
+  wire [33:0] rs_or_55_1;
   wire [33:0] rem26;
   wire [29:0] shl_s27_q;
   wire [29:0] rs_ge26;
@@ -609,12 +771,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d27 = 30'h00000000;
   wire [0:0] bits_lo_d27;
   wire [34:0] rs_bits_lo_d27;
-  wire [34:0] or_30;
-  wire [0:0] ge27;
-  wire [34:0] or_30_minus_rs_s1_b_d27;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge27;
+  wire [34:0] or_57;
+  wire [35:0] rs_or_57;
+  wire signed [35:0] s_rs_or_57;
+  wire [35:0] rs_rs_s1_b_d27;
+  wire signed [35:0] s_rs_rs_s1_b_d27;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff27;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff27;
+  wire [0:0] ge27;
+  wire [33:0] bits_diff27_1;
+  wire [33:0] rs_or_57_1;
   wire [33:0] rem27;
   wire [29:0] shl_s28_q;
   wire [29:0] rs_ge27;
@@ -630,12 +798,18 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d28 = 30'h00000000;
   wire [0:0] bits_lo_d28;
   wire [34:0] rs_bits_lo_d28;
-  wire [34:0] or_31;
-  wire [0:0] ge28;
-  wire [34:0] or_31_minus_rs_s1_b_d28;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge28;
+  wire [34:0] or_59;
+  wire [35:0] rs_or_59;
+  wire signed [35:0] s_rs_or_59;
+  wire [35:0] rs_rs_s1_b_d28;
+  wire signed [35:0] s_rs_rs_s1_b_d28;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff28;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff28;
+  wire [0:0] ge28;
+  wire [33:0] bits_diff28_1;
+  wire [33:0] rs_or_59_1;
   wire [33:0] rem28;
   wire [29:0] shl_s29_q;
   wire [29:0] rs_ge28;
@@ -653,12 +827,18 @@ module fxrt_div_n29_a63_b34 (
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_lo_d29;
   wire [34:0] rs_bits_lo_d29;
-  wire [34:0] or_32;
-  wire [0:0] ge29;
-  wire [34:0] or_32_minus_rs_s1_b_d29;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  wire [34:0] mux_ge29;
+  wire [34:0] or_61;
+  wire [35:0] rs_or_61;
+  wire signed [35:0] s_rs_or_61;
+  wire [35:0] rs_rs_s1_b_d29;
+  wire signed [35:0] s_rs_rs_s1_b_d29;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
+  wire signed [35:0] diff29;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diff29;
+  wire [0:0] ge29;
+  wire [33:0] bits_diff29_1;
+  wire [33:0] rs_or_61_1;
   /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [33:0] rem29;
   /* verilator lint_on UNUSEDSIGNAL */
@@ -670,8 +850,8 @@ module fxrt_div_n29_a63_b34 (
   initial for (err_1_d29_i = 1; err_1_d29_i <= 29; err_1_d29_i = err_1_d29_i + 1) err_1_d29_sr[err_1_d29_i] = 1'h0;
   wire [0:0] err_1_d29;
   wire [0:0] quot29_eq_k_0_2;
-  wire [0:0] or_33;
-  wire [0:0] not_or_33;
+  wire [0:0] or_63;
+  wire [0:0] not_or_63;
   reg [29:0] s31_t = 30'h00000000;
   reg [0:0] s31_ok = 1'h0;
 
@@ -711,10 +891,16 @@ module fxrt_div_n29_a63_b34 (
   assign bits_lo = lo[29];
   assign rs_bits_lo = {{34{1'b0}}, bits_lo};
   assign or_3 = shl_rs_rs_bits_s1_a_1 | rs_bits_lo;
-  assign ge0 = rs_s1_b <= or_3;
-  assign or_3_minus_rs_s1_b = or_3 - rs_s1_b;
-  assign mux_ge0 = ge0 ? or_3_minus_rs_s1_b : or_3;
-  assign rem0 = mux_ge0[33:0];
+  assign rs_or_3 = {{1{1'b0}}, or_3};
+  assign s_rs_or_3 = $signed(rs_or_3);
+  assign rs_rs_s1_b = {{1{1'b0}}, rs_s1_b};
+  assign s_rs_rs_s1_b = $signed(rs_rs_s1_b);
+  assign diff0 = s_rs_or_3 - s_rs_rs_s1_b;
+  assign bits_diff0 = diff0[35];
+  assign ge0 = ~bits_diff0;
+  assign bits_diff0_1 = diff0[33:0];
+  assign rs_or_3_1 = or_3[33:0];
+  assign rem0 = ge0 ? bits_diff0_1 : rs_or_3_1;
   assign rs_ge0 = {{29{1'b0}}, ge0};
   assign quot0 = k_0_2 | rs_ge0;
 
@@ -729,11 +915,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s2_p = rs_s2_p <<< 1;
   assign bits_lo_d1 = lo_d1[28];
   assign rs_bits_lo_d1 = {{34{1'b0}}, bits_lo_d1};
-  assign or_4 = shl_rs_s2_p | rs_bits_lo_d1;
-  assign ge1 = rs_s1_b_d1 <= or_4;
-  assign or_4_minus_rs_s1_b_d1 = or_4 - rs_s1_b_d1;
-  assign mux_ge1 = ge1 ? or_4_minus_rs_s1_b_d1 : or_4;
-  assign rem1 = mux_ge1[33:0];
+  assign or_5 = shl_rs_s2_p | rs_bits_lo_d1;
+  assign rs_or_5 = {{1{1'b0}}, or_5};
+  assign s_rs_or_5 = $signed(rs_or_5);
+  assign rs_rs_s1_b_d1 = {{1{1'b0}}, rs_s1_b_d1};
+  assign s_rs_rs_s1_b_d1 = $signed(rs_rs_s1_b_d1);
+  assign diff1 = s_rs_or_5 - s_rs_rs_s1_b_d1;
+  assign bits_diff1 = diff1[35];
+  assign ge1 = ~bits_diff1;
+  assign bits_diff1_1 = diff1[33:0];
+  assign rs_or_5_1 = or_5[33:0];
+  assign rem1 = ge1 ? bits_diff1_1 : rs_or_5_1;
   assign shl_s2_q = s2_q <<< 1;
   assign rs_ge1 = {{29{1'b0}}, ge1};
   assign quot1 = shl_s2_q | rs_ge1;
@@ -751,11 +943,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s3_p = rs_s3_p <<< 1;
   assign bits_lo_d2 = lo_d2[27];
   assign rs_bits_lo_d2 = {{34{1'b0}}, bits_lo_d2};
-  assign or_5 = shl_rs_s3_p | rs_bits_lo_d2;
-  assign ge2 = rs_s1_b_d2 <= or_5;
-  assign or_5_minus_rs_s1_b_d2 = or_5 - rs_s1_b_d2;
-  assign mux_ge2 = ge2 ? or_5_minus_rs_s1_b_d2 : or_5;
-  assign rem2 = mux_ge2[33:0];
+  assign or_7 = shl_rs_s3_p | rs_bits_lo_d2;
+  assign rs_or_7 = {{1{1'b0}}, or_7};
+  assign s_rs_or_7 = $signed(rs_or_7);
+  assign rs_rs_s1_b_d2 = {{1{1'b0}}, rs_s1_b_d2};
+  assign s_rs_rs_s1_b_d2 = $signed(rs_rs_s1_b_d2);
+  assign diff2 = s_rs_or_7 - s_rs_rs_s1_b_d2;
+  assign bits_diff2 = diff2[35];
+  assign ge2 = ~bits_diff2;
+  assign bits_diff2_1 = diff2[33:0];
+  assign rs_or_7_1 = or_7[33:0];
+  assign rem2 = ge2 ? bits_diff2_1 : rs_or_7_1;
   assign shl_s3_q = s3_q <<< 1;
   assign rs_ge2 = {{29{1'b0}}, ge2};
   assign quot2 = shl_s3_q | rs_ge2;
@@ -773,11 +971,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s4_p = rs_s4_p <<< 1;
   assign bits_lo_d3 = lo_d3[26];
   assign rs_bits_lo_d3 = {{34{1'b0}}, bits_lo_d3};
-  assign or_6 = shl_rs_s4_p | rs_bits_lo_d3;
-  assign ge3 = rs_s1_b_d3 <= or_6;
-  assign or_6_minus_rs_s1_b_d3 = or_6 - rs_s1_b_d3;
-  assign mux_ge3 = ge3 ? or_6_minus_rs_s1_b_d3 : or_6;
-  assign rem3 = mux_ge3[33:0];
+  assign or_9 = shl_rs_s4_p | rs_bits_lo_d3;
+  assign rs_or_9 = {{1{1'b0}}, or_9};
+  assign s_rs_or_9 = $signed(rs_or_9);
+  assign rs_rs_s1_b_d3 = {{1{1'b0}}, rs_s1_b_d3};
+  assign s_rs_rs_s1_b_d3 = $signed(rs_rs_s1_b_d3);
+  assign diff3 = s_rs_or_9 - s_rs_rs_s1_b_d3;
+  assign bits_diff3 = diff3[35];
+  assign ge3 = ~bits_diff3;
+  assign bits_diff3_1 = diff3[33:0];
+  assign rs_or_9_1 = or_9[33:0];
+  assign rem3 = ge3 ? bits_diff3_1 : rs_or_9_1;
   assign shl_s4_q = s4_q <<< 1;
   assign rs_ge3 = {{29{1'b0}}, ge3};
   assign quot3 = shl_s4_q | rs_ge3;
@@ -795,11 +999,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s5_p = rs_s5_p <<< 1;
   assign bits_lo_d4 = lo_d4[25];
   assign rs_bits_lo_d4 = {{34{1'b0}}, bits_lo_d4};
-  assign or_7 = shl_rs_s5_p | rs_bits_lo_d4;
-  assign ge4 = rs_s1_b_d4 <= or_7;
-  assign or_7_minus_rs_s1_b_d4 = or_7 - rs_s1_b_d4;
-  assign mux_ge4 = ge4 ? or_7_minus_rs_s1_b_d4 : or_7;
-  assign rem4 = mux_ge4[33:0];
+  assign or_11 = shl_rs_s5_p | rs_bits_lo_d4;
+  assign rs_or_11 = {{1{1'b0}}, or_11};
+  assign s_rs_or_11 = $signed(rs_or_11);
+  assign rs_rs_s1_b_d4 = {{1{1'b0}}, rs_s1_b_d4};
+  assign s_rs_rs_s1_b_d4 = $signed(rs_rs_s1_b_d4);
+  assign diff4 = s_rs_or_11 - s_rs_rs_s1_b_d4;
+  assign bits_diff4 = diff4[35];
+  assign ge4 = ~bits_diff4;
+  assign bits_diff4_1 = diff4[33:0];
+  assign rs_or_11_1 = or_11[33:0];
+  assign rem4 = ge4 ? bits_diff4_1 : rs_or_11_1;
   assign shl_s5_q = s5_q <<< 1;
   assign rs_ge4 = {{29{1'b0}}, ge4};
   assign quot4 = shl_s5_q | rs_ge4;
@@ -817,11 +1027,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s6_p = rs_s6_p <<< 1;
   assign bits_lo_d5 = lo_d5[24];
   assign rs_bits_lo_d5 = {{34{1'b0}}, bits_lo_d5};
-  assign or_8 = shl_rs_s6_p | rs_bits_lo_d5;
-  assign ge5 = rs_s1_b_d5 <= or_8;
-  assign or_8_minus_rs_s1_b_d5 = or_8 - rs_s1_b_d5;
-  assign mux_ge5 = ge5 ? or_8_minus_rs_s1_b_d5 : or_8;
-  assign rem5 = mux_ge5[33:0];
+  assign or_13 = shl_rs_s6_p | rs_bits_lo_d5;
+  assign rs_or_13 = {{1{1'b0}}, or_13};
+  assign s_rs_or_13 = $signed(rs_or_13);
+  assign rs_rs_s1_b_d5 = {{1{1'b0}}, rs_s1_b_d5};
+  assign s_rs_rs_s1_b_d5 = $signed(rs_rs_s1_b_d5);
+  assign diff5 = s_rs_or_13 - s_rs_rs_s1_b_d5;
+  assign bits_diff5 = diff5[35];
+  assign ge5 = ~bits_diff5;
+  assign bits_diff5_1 = diff5[33:0];
+  assign rs_or_13_1 = or_13[33:0];
+  assign rem5 = ge5 ? bits_diff5_1 : rs_or_13_1;
   assign shl_s6_q = s6_q <<< 1;
   assign rs_ge5 = {{29{1'b0}}, ge5};
   assign quot5 = shl_s6_q | rs_ge5;
@@ -839,11 +1055,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s7_p = rs_s7_p <<< 1;
   assign bits_lo_d6 = lo_d6[23];
   assign rs_bits_lo_d6 = {{34{1'b0}}, bits_lo_d6};
-  assign or_9 = shl_rs_s7_p | rs_bits_lo_d6;
-  assign ge6 = rs_s1_b_d6 <= or_9;
-  assign or_9_minus_rs_s1_b_d6 = or_9 - rs_s1_b_d6;
-  assign mux_ge6 = ge6 ? or_9_minus_rs_s1_b_d6 : or_9;
-  assign rem6 = mux_ge6[33:0];
+  assign or_15 = shl_rs_s7_p | rs_bits_lo_d6;
+  assign rs_or_15 = {{1{1'b0}}, or_15};
+  assign s_rs_or_15 = $signed(rs_or_15);
+  assign rs_rs_s1_b_d6 = {{1{1'b0}}, rs_s1_b_d6};
+  assign s_rs_rs_s1_b_d6 = $signed(rs_rs_s1_b_d6);
+  assign diff6 = s_rs_or_15 - s_rs_rs_s1_b_d6;
+  assign bits_diff6 = diff6[35];
+  assign ge6 = ~bits_diff6;
+  assign bits_diff6_1 = diff6[33:0];
+  assign rs_or_15_1 = or_15[33:0];
+  assign rem6 = ge6 ? bits_diff6_1 : rs_or_15_1;
   assign shl_s7_q = s7_q <<< 1;
   assign rs_ge6 = {{29{1'b0}}, ge6};
   assign quot6 = shl_s7_q | rs_ge6;
@@ -861,11 +1083,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s8_p = rs_s8_p <<< 1;
   assign bits_lo_d7 = lo_d7[22];
   assign rs_bits_lo_d7 = {{34{1'b0}}, bits_lo_d7};
-  assign or_10 = shl_rs_s8_p | rs_bits_lo_d7;
-  assign ge7 = rs_s1_b_d7 <= or_10;
-  assign or_10_minus_rs_s1_b_d7 = or_10 - rs_s1_b_d7;
-  assign mux_ge7 = ge7 ? or_10_minus_rs_s1_b_d7 : or_10;
-  assign rem7 = mux_ge7[33:0];
+  assign or_17 = shl_rs_s8_p | rs_bits_lo_d7;
+  assign rs_or_17 = {{1{1'b0}}, or_17};
+  assign s_rs_or_17 = $signed(rs_or_17);
+  assign rs_rs_s1_b_d7 = {{1{1'b0}}, rs_s1_b_d7};
+  assign s_rs_rs_s1_b_d7 = $signed(rs_rs_s1_b_d7);
+  assign diff7 = s_rs_or_17 - s_rs_rs_s1_b_d7;
+  assign bits_diff7 = diff7[35];
+  assign ge7 = ~bits_diff7;
+  assign bits_diff7_1 = diff7[33:0];
+  assign rs_or_17_1 = or_17[33:0];
+  assign rem7 = ge7 ? bits_diff7_1 : rs_or_17_1;
   assign shl_s8_q = s8_q <<< 1;
   assign rs_ge7 = {{29{1'b0}}, ge7};
   assign quot7 = shl_s8_q | rs_ge7;
@@ -883,11 +1111,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s9_p = rs_s9_p <<< 1;
   assign bits_lo_d8 = lo_d8[21];
   assign rs_bits_lo_d8 = {{34{1'b0}}, bits_lo_d8};
-  assign or_11 = shl_rs_s9_p | rs_bits_lo_d8;
-  assign ge8 = rs_s1_b_d8 <= or_11;
-  assign or_11_minus_rs_s1_b_d8 = or_11 - rs_s1_b_d8;
-  assign mux_ge8 = ge8 ? or_11_minus_rs_s1_b_d8 : or_11;
-  assign rem8 = mux_ge8[33:0];
+  assign or_19 = shl_rs_s9_p | rs_bits_lo_d8;
+  assign rs_or_19 = {{1{1'b0}}, or_19};
+  assign s_rs_or_19 = $signed(rs_or_19);
+  assign rs_rs_s1_b_d8 = {{1{1'b0}}, rs_s1_b_d8};
+  assign s_rs_rs_s1_b_d8 = $signed(rs_rs_s1_b_d8);
+  assign diff8 = s_rs_or_19 - s_rs_rs_s1_b_d8;
+  assign bits_diff8 = diff8[35];
+  assign ge8 = ~bits_diff8;
+  assign bits_diff8_1 = diff8[33:0];
+  assign rs_or_19_1 = or_19[33:0];
+  assign rem8 = ge8 ? bits_diff8_1 : rs_or_19_1;
   assign shl_s9_q = s9_q <<< 1;
   assign rs_ge8 = {{29{1'b0}}, ge8};
   assign quot8 = shl_s9_q | rs_ge8;
@@ -905,11 +1139,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s10_p = rs_s10_p <<< 1;
   assign bits_lo_d9 = lo_d9[20];
   assign rs_bits_lo_d9 = {{34{1'b0}}, bits_lo_d9};
-  assign or_12 = shl_rs_s10_p | rs_bits_lo_d9;
-  assign ge9 = rs_s1_b_d9 <= or_12;
-  assign or_12_minus_rs_s1_b_d9 = or_12 - rs_s1_b_d9;
-  assign mux_ge9 = ge9 ? or_12_minus_rs_s1_b_d9 : or_12;
-  assign rem9 = mux_ge9[33:0];
+  assign or_21 = shl_rs_s10_p | rs_bits_lo_d9;
+  assign rs_or_21 = {{1{1'b0}}, or_21};
+  assign s_rs_or_21 = $signed(rs_or_21);
+  assign rs_rs_s1_b_d9 = {{1{1'b0}}, rs_s1_b_d9};
+  assign s_rs_rs_s1_b_d9 = $signed(rs_rs_s1_b_d9);
+  assign diff9 = s_rs_or_21 - s_rs_rs_s1_b_d9;
+  assign bits_diff9 = diff9[35];
+  assign ge9 = ~bits_diff9;
+  assign bits_diff9_1 = diff9[33:0];
+  assign rs_or_21_1 = or_21[33:0];
+  assign rem9 = ge9 ? bits_diff9_1 : rs_or_21_1;
   assign shl_s10_q = s10_q <<< 1;
   assign rs_ge9 = {{29{1'b0}}, ge9};
   assign quot9 = shl_s10_q | rs_ge9;
@@ -927,11 +1167,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s11_p = rs_s11_p <<< 1;
   assign bits_lo_d10 = lo_d10[19];
   assign rs_bits_lo_d10 = {{34{1'b0}}, bits_lo_d10};
-  assign or_13 = shl_rs_s11_p | rs_bits_lo_d10;
-  assign ge10 = rs_s1_b_d10 <= or_13;
-  assign or_13_minus_rs_s1_b_d10 = or_13 - rs_s1_b_d10;
-  assign mux_ge10 = ge10 ? or_13_minus_rs_s1_b_d10 : or_13;
-  assign rem10 = mux_ge10[33:0];
+  assign or_23 = shl_rs_s11_p | rs_bits_lo_d10;
+  assign rs_or_23 = {{1{1'b0}}, or_23};
+  assign s_rs_or_23 = $signed(rs_or_23);
+  assign rs_rs_s1_b_d10 = {{1{1'b0}}, rs_s1_b_d10};
+  assign s_rs_rs_s1_b_d10 = $signed(rs_rs_s1_b_d10);
+  assign diff10 = s_rs_or_23 - s_rs_rs_s1_b_d10;
+  assign bits_diff10 = diff10[35];
+  assign ge10 = ~bits_diff10;
+  assign bits_diff10_1 = diff10[33:0];
+  assign rs_or_23_1 = or_23[33:0];
+  assign rem10 = ge10 ? bits_diff10_1 : rs_or_23_1;
   assign shl_s11_q = s11_q <<< 1;
   assign rs_ge10 = {{29{1'b0}}, ge10};
   assign quot10 = shl_s11_q | rs_ge10;
@@ -949,11 +1195,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s12_p = rs_s12_p <<< 1;
   assign bits_lo_d11 = lo_d11[18];
   assign rs_bits_lo_d11 = {{34{1'b0}}, bits_lo_d11};
-  assign or_14 = shl_rs_s12_p | rs_bits_lo_d11;
-  assign ge11 = rs_s1_b_d11 <= or_14;
-  assign or_14_minus_rs_s1_b_d11 = or_14 - rs_s1_b_d11;
-  assign mux_ge11 = ge11 ? or_14_minus_rs_s1_b_d11 : or_14;
-  assign rem11 = mux_ge11[33:0];
+  assign or_25 = shl_rs_s12_p | rs_bits_lo_d11;
+  assign rs_or_25 = {{1{1'b0}}, or_25};
+  assign s_rs_or_25 = $signed(rs_or_25);
+  assign rs_rs_s1_b_d11 = {{1{1'b0}}, rs_s1_b_d11};
+  assign s_rs_rs_s1_b_d11 = $signed(rs_rs_s1_b_d11);
+  assign diff11 = s_rs_or_25 - s_rs_rs_s1_b_d11;
+  assign bits_diff11 = diff11[35];
+  assign ge11 = ~bits_diff11;
+  assign bits_diff11_1 = diff11[33:0];
+  assign rs_or_25_1 = or_25[33:0];
+  assign rem11 = ge11 ? bits_diff11_1 : rs_or_25_1;
   assign shl_s12_q = s12_q <<< 1;
   assign rs_ge11 = {{29{1'b0}}, ge11};
   assign quot11 = shl_s12_q | rs_ge11;
@@ -971,11 +1223,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s13_p = rs_s13_p <<< 1;
   assign bits_lo_d12 = lo_d12[17];
   assign rs_bits_lo_d12 = {{34{1'b0}}, bits_lo_d12};
-  assign or_15 = shl_rs_s13_p | rs_bits_lo_d12;
-  assign ge12 = rs_s1_b_d12 <= or_15;
-  assign or_15_minus_rs_s1_b_d12 = or_15 - rs_s1_b_d12;
-  assign mux_ge12 = ge12 ? or_15_minus_rs_s1_b_d12 : or_15;
-  assign rem12 = mux_ge12[33:0];
+  assign or_27 = shl_rs_s13_p | rs_bits_lo_d12;
+  assign rs_or_27 = {{1{1'b0}}, or_27};
+  assign s_rs_or_27 = $signed(rs_or_27);
+  assign rs_rs_s1_b_d12 = {{1{1'b0}}, rs_s1_b_d12};
+  assign s_rs_rs_s1_b_d12 = $signed(rs_rs_s1_b_d12);
+  assign diff12 = s_rs_or_27 - s_rs_rs_s1_b_d12;
+  assign bits_diff12 = diff12[35];
+  assign ge12 = ~bits_diff12;
+  assign bits_diff12_1 = diff12[33:0];
+  assign rs_or_27_1 = or_27[33:0];
+  assign rem12 = ge12 ? bits_diff12_1 : rs_or_27_1;
   assign shl_s13_q = s13_q <<< 1;
   assign rs_ge12 = {{29{1'b0}}, ge12};
   assign quot12 = shl_s13_q | rs_ge12;
@@ -993,11 +1251,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s14_p = rs_s14_p <<< 1;
   assign bits_lo_d13 = lo_d13[16];
   assign rs_bits_lo_d13 = {{34{1'b0}}, bits_lo_d13};
-  assign or_16 = shl_rs_s14_p | rs_bits_lo_d13;
-  assign ge13 = rs_s1_b_d13 <= or_16;
-  assign or_16_minus_rs_s1_b_d13 = or_16 - rs_s1_b_d13;
-  assign mux_ge13 = ge13 ? or_16_minus_rs_s1_b_d13 : or_16;
-  assign rem13 = mux_ge13[33:0];
+  assign or_29 = shl_rs_s14_p | rs_bits_lo_d13;
+  assign rs_or_29 = {{1{1'b0}}, or_29};
+  assign s_rs_or_29 = $signed(rs_or_29);
+  assign rs_rs_s1_b_d13 = {{1{1'b0}}, rs_s1_b_d13};
+  assign s_rs_rs_s1_b_d13 = $signed(rs_rs_s1_b_d13);
+  assign diff13 = s_rs_or_29 - s_rs_rs_s1_b_d13;
+  assign bits_diff13 = diff13[35];
+  assign ge13 = ~bits_diff13;
+  assign bits_diff13_1 = diff13[33:0];
+  assign rs_or_29_1 = or_29[33:0];
+  assign rem13 = ge13 ? bits_diff13_1 : rs_or_29_1;
   assign shl_s14_q = s14_q <<< 1;
   assign rs_ge13 = {{29{1'b0}}, ge13};
   assign quot13 = shl_s14_q | rs_ge13;
@@ -1015,11 +1279,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s15_p = rs_s15_p <<< 1;
   assign bits_lo_d14 = lo_d14[15];
   assign rs_bits_lo_d14 = {{34{1'b0}}, bits_lo_d14};
-  assign or_17 = shl_rs_s15_p | rs_bits_lo_d14;
-  assign ge14 = rs_s1_b_d14 <= or_17;
-  assign or_17_minus_rs_s1_b_d14 = or_17 - rs_s1_b_d14;
-  assign mux_ge14 = ge14 ? or_17_minus_rs_s1_b_d14 : or_17;
-  assign rem14 = mux_ge14[33:0];
+  assign or_31 = shl_rs_s15_p | rs_bits_lo_d14;
+  assign rs_or_31 = {{1{1'b0}}, or_31};
+  assign s_rs_or_31 = $signed(rs_or_31);
+  assign rs_rs_s1_b_d14 = {{1{1'b0}}, rs_s1_b_d14};
+  assign s_rs_rs_s1_b_d14 = $signed(rs_rs_s1_b_d14);
+  assign diff14 = s_rs_or_31 - s_rs_rs_s1_b_d14;
+  assign bits_diff14 = diff14[35];
+  assign ge14 = ~bits_diff14;
+  assign bits_diff14_1 = diff14[33:0];
+  assign rs_or_31_1 = or_31[33:0];
+  assign rem14 = ge14 ? bits_diff14_1 : rs_or_31_1;
   assign shl_s15_q = s15_q <<< 1;
   assign rs_ge14 = {{29{1'b0}}, ge14};
   assign quot14 = shl_s15_q | rs_ge14;
@@ -1037,11 +1307,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s16_p = rs_s16_p <<< 1;
   assign bits_lo_d15 = lo_d15[14];
   assign rs_bits_lo_d15 = {{34{1'b0}}, bits_lo_d15};
-  assign or_18 = shl_rs_s16_p | rs_bits_lo_d15;
-  assign ge15 = rs_s1_b_d15 <= or_18;
-  assign or_18_minus_rs_s1_b_d15 = or_18 - rs_s1_b_d15;
-  assign mux_ge15 = ge15 ? or_18_minus_rs_s1_b_d15 : or_18;
-  assign rem15 = mux_ge15[33:0];
+  assign or_33 = shl_rs_s16_p | rs_bits_lo_d15;
+  assign rs_or_33 = {{1{1'b0}}, or_33};
+  assign s_rs_or_33 = $signed(rs_or_33);
+  assign rs_rs_s1_b_d15 = {{1{1'b0}}, rs_s1_b_d15};
+  assign s_rs_rs_s1_b_d15 = $signed(rs_rs_s1_b_d15);
+  assign diff15 = s_rs_or_33 - s_rs_rs_s1_b_d15;
+  assign bits_diff15 = diff15[35];
+  assign ge15 = ~bits_diff15;
+  assign bits_diff15_1 = diff15[33:0];
+  assign rs_or_33_1 = or_33[33:0];
+  assign rem15 = ge15 ? bits_diff15_1 : rs_or_33_1;
   assign shl_s16_q = s16_q <<< 1;
   assign rs_ge15 = {{29{1'b0}}, ge15};
   assign quot15 = shl_s16_q | rs_ge15;
@@ -1059,11 +1335,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s17_p = rs_s17_p <<< 1;
   assign bits_lo_d16 = lo_d16[13];
   assign rs_bits_lo_d16 = {{34{1'b0}}, bits_lo_d16};
-  assign or_19 = shl_rs_s17_p | rs_bits_lo_d16;
-  assign ge16 = rs_s1_b_d16 <= or_19;
-  assign or_19_minus_rs_s1_b_d16 = or_19 - rs_s1_b_d16;
-  assign mux_ge16 = ge16 ? or_19_minus_rs_s1_b_d16 : or_19;
-  assign rem16 = mux_ge16[33:0];
+  assign or_35 = shl_rs_s17_p | rs_bits_lo_d16;
+  assign rs_or_35 = {{1{1'b0}}, or_35};
+  assign s_rs_or_35 = $signed(rs_or_35);
+  assign rs_rs_s1_b_d16 = {{1{1'b0}}, rs_s1_b_d16};
+  assign s_rs_rs_s1_b_d16 = $signed(rs_rs_s1_b_d16);
+  assign diff16 = s_rs_or_35 - s_rs_rs_s1_b_d16;
+  assign bits_diff16 = diff16[35];
+  assign ge16 = ~bits_diff16;
+  assign bits_diff16_1 = diff16[33:0];
+  assign rs_or_35_1 = or_35[33:0];
+  assign rem16 = ge16 ? bits_diff16_1 : rs_or_35_1;
   assign shl_s17_q = s17_q <<< 1;
   assign rs_ge16 = {{29{1'b0}}, ge16};
   assign quot16 = shl_s17_q | rs_ge16;
@@ -1081,11 +1363,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s18_p = rs_s18_p <<< 1;
   assign bits_lo_d17 = lo_d17[12];
   assign rs_bits_lo_d17 = {{34{1'b0}}, bits_lo_d17};
-  assign or_20 = shl_rs_s18_p | rs_bits_lo_d17;
-  assign ge17 = rs_s1_b_d17 <= or_20;
-  assign or_20_minus_rs_s1_b_d17 = or_20 - rs_s1_b_d17;
-  assign mux_ge17 = ge17 ? or_20_minus_rs_s1_b_d17 : or_20;
-  assign rem17 = mux_ge17[33:0];
+  assign or_37 = shl_rs_s18_p | rs_bits_lo_d17;
+  assign rs_or_37 = {{1{1'b0}}, or_37};
+  assign s_rs_or_37 = $signed(rs_or_37);
+  assign rs_rs_s1_b_d17 = {{1{1'b0}}, rs_s1_b_d17};
+  assign s_rs_rs_s1_b_d17 = $signed(rs_rs_s1_b_d17);
+  assign diff17 = s_rs_or_37 - s_rs_rs_s1_b_d17;
+  assign bits_diff17 = diff17[35];
+  assign ge17 = ~bits_diff17;
+  assign bits_diff17_1 = diff17[33:0];
+  assign rs_or_37_1 = or_37[33:0];
+  assign rem17 = ge17 ? bits_diff17_1 : rs_or_37_1;
   assign shl_s18_q = s18_q <<< 1;
   assign rs_ge17 = {{29{1'b0}}, ge17};
   assign quot17 = shl_s18_q | rs_ge17;
@@ -1103,11 +1391,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s19_p = rs_s19_p <<< 1;
   assign bits_lo_d18 = lo_d18[11];
   assign rs_bits_lo_d18 = {{34{1'b0}}, bits_lo_d18};
-  assign or_21 = shl_rs_s19_p | rs_bits_lo_d18;
-  assign ge18 = rs_s1_b_d18 <= or_21;
-  assign or_21_minus_rs_s1_b_d18 = or_21 - rs_s1_b_d18;
-  assign mux_ge18 = ge18 ? or_21_minus_rs_s1_b_d18 : or_21;
-  assign rem18 = mux_ge18[33:0];
+  assign or_39 = shl_rs_s19_p | rs_bits_lo_d18;
+  assign rs_or_39 = {{1{1'b0}}, or_39};
+  assign s_rs_or_39 = $signed(rs_or_39);
+  assign rs_rs_s1_b_d18 = {{1{1'b0}}, rs_s1_b_d18};
+  assign s_rs_rs_s1_b_d18 = $signed(rs_rs_s1_b_d18);
+  assign diff18 = s_rs_or_39 - s_rs_rs_s1_b_d18;
+  assign bits_diff18 = diff18[35];
+  assign ge18 = ~bits_diff18;
+  assign bits_diff18_1 = diff18[33:0];
+  assign rs_or_39_1 = or_39[33:0];
+  assign rem18 = ge18 ? bits_diff18_1 : rs_or_39_1;
   assign shl_s19_q = s19_q <<< 1;
   assign rs_ge18 = {{29{1'b0}}, ge18};
   assign quot18 = shl_s19_q | rs_ge18;
@@ -1125,11 +1419,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s20_p = rs_s20_p <<< 1;
   assign bits_lo_d19 = lo_d19[10];
   assign rs_bits_lo_d19 = {{34{1'b0}}, bits_lo_d19};
-  assign or_22 = shl_rs_s20_p | rs_bits_lo_d19;
-  assign ge19 = rs_s1_b_d19 <= or_22;
-  assign or_22_minus_rs_s1_b_d19 = or_22 - rs_s1_b_d19;
-  assign mux_ge19 = ge19 ? or_22_minus_rs_s1_b_d19 : or_22;
-  assign rem19 = mux_ge19[33:0];
+  assign or_41 = shl_rs_s20_p | rs_bits_lo_d19;
+  assign rs_or_41 = {{1{1'b0}}, or_41};
+  assign s_rs_or_41 = $signed(rs_or_41);
+  assign rs_rs_s1_b_d19 = {{1{1'b0}}, rs_s1_b_d19};
+  assign s_rs_rs_s1_b_d19 = $signed(rs_rs_s1_b_d19);
+  assign diff19 = s_rs_or_41 - s_rs_rs_s1_b_d19;
+  assign bits_diff19 = diff19[35];
+  assign ge19 = ~bits_diff19;
+  assign bits_diff19_1 = diff19[33:0];
+  assign rs_or_41_1 = or_41[33:0];
+  assign rem19 = ge19 ? bits_diff19_1 : rs_or_41_1;
   assign shl_s20_q = s20_q <<< 1;
   assign rs_ge19 = {{29{1'b0}}, ge19};
   assign quot19 = shl_s20_q | rs_ge19;
@@ -1147,11 +1447,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s21_p = rs_s21_p <<< 1;
   assign bits_lo_d20 = lo_d20[9];
   assign rs_bits_lo_d20 = {{34{1'b0}}, bits_lo_d20};
-  assign or_23 = shl_rs_s21_p | rs_bits_lo_d20;
-  assign ge20 = rs_s1_b_d20 <= or_23;
-  assign or_23_minus_rs_s1_b_d20 = or_23 - rs_s1_b_d20;
-  assign mux_ge20 = ge20 ? or_23_minus_rs_s1_b_d20 : or_23;
-  assign rem20 = mux_ge20[33:0];
+  assign or_43 = shl_rs_s21_p | rs_bits_lo_d20;
+  assign rs_or_43 = {{1{1'b0}}, or_43};
+  assign s_rs_or_43 = $signed(rs_or_43);
+  assign rs_rs_s1_b_d20 = {{1{1'b0}}, rs_s1_b_d20};
+  assign s_rs_rs_s1_b_d20 = $signed(rs_rs_s1_b_d20);
+  assign diff20 = s_rs_or_43 - s_rs_rs_s1_b_d20;
+  assign bits_diff20 = diff20[35];
+  assign ge20 = ~bits_diff20;
+  assign bits_diff20_1 = diff20[33:0];
+  assign rs_or_43_1 = or_43[33:0];
+  assign rem20 = ge20 ? bits_diff20_1 : rs_or_43_1;
   assign shl_s21_q = s21_q <<< 1;
   assign rs_ge20 = {{29{1'b0}}, ge20};
   assign quot20 = shl_s21_q | rs_ge20;
@@ -1169,11 +1475,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s22_p = rs_s22_p <<< 1;
   assign bits_lo_d21 = lo_d21[8];
   assign rs_bits_lo_d21 = {{34{1'b0}}, bits_lo_d21};
-  assign or_24 = shl_rs_s22_p | rs_bits_lo_d21;
-  assign ge21 = rs_s1_b_d21 <= or_24;
-  assign or_24_minus_rs_s1_b_d21 = or_24 - rs_s1_b_d21;
-  assign mux_ge21 = ge21 ? or_24_minus_rs_s1_b_d21 : or_24;
-  assign rem21 = mux_ge21[33:0];
+  assign or_45 = shl_rs_s22_p | rs_bits_lo_d21;
+  assign rs_or_45 = {{1{1'b0}}, or_45};
+  assign s_rs_or_45 = $signed(rs_or_45);
+  assign rs_rs_s1_b_d21 = {{1{1'b0}}, rs_s1_b_d21};
+  assign s_rs_rs_s1_b_d21 = $signed(rs_rs_s1_b_d21);
+  assign diff21 = s_rs_or_45 - s_rs_rs_s1_b_d21;
+  assign bits_diff21 = diff21[35];
+  assign ge21 = ~bits_diff21;
+  assign bits_diff21_1 = diff21[33:0];
+  assign rs_or_45_1 = or_45[33:0];
+  assign rem21 = ge21 ? bits_diff21_1 : rs_or_45_1;
   assign shl_s22_q = s22_q <<< 1;
   assign rs_ge21 = {{29{1'b0}}, ge21};
   assign quot21 = shl_s22_q | rs_ge21;
@@ -1191,11 +1503,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s23_p = rs_s23_p <<< 1;
   assign bits_lo_d22 = lo_d22[7];
   assign rs_bits_lo_d22 = {{34{1'b0}}, bits_lo_d22};
-  assign or_25 = shl_rs_s23_p | rs_bits_lo_d22;
-  assign ge22 = rs_s1_b_d22 <= or_25;
-  assign or_25_minus_rs_s1_b_d22 = or_25 - rs_s1_b_d22;
-  assign mux_ge22 = ge22 ? or_25_minus_rs_s1_b_d22 : or_25;
-  assign rem22 = mux_ge22[33:0];
+  assign or_47 = shl_rs_s23_p | rs_bits_lo_d22;
+  assign rs_or_47 = {{1{1'b0}}, or_47};
+  assign s_rs_or_47 = $signed(rs_or_47);
+  assign rs_rs_s1_b_d22 = {{1{1'b0}}, rs_s1_b_d22};
+  assign s_rs_rs_s1_b_d22 = $signed(rs_rs_s1_b_d22);
+  assign diff22 = s_rs_or_47 - s_rs_rs_s1_b_d22;
+  assign bits_diff22 = diff22[35];
+  assign ge22 = ~bits_diff22;
+  assign bits_diff22_1 = diff22[33:0];
+  assign rs_or_47_1 = or_47[33:0];
+  assign rem22 = ge22 ? bits_diff22_1 : rs_or_47_1;
   assign shl_s23_q = s23_q <<< 1;
   assign rs_ge22 = {{29{1'b0}}, ge22};
   assign quot22 = shl_s23_q | rs_ge22;
@@ -1213,11 +1531,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s24_p = rs_s24_p <<< 1;
   assign bits_lo_d23 = lo_d23[6];
   assign rs_bits_lo_d23 = {{34{1'b0}}, bits_lo_d23};
-  assign or_26 = shl_rs_s24_p | rs_bits_lo_d23;
-  assign ge23 = rs_s1_b_d23 <= or_26;
-  assign or_26_minus_rs_s1_b_d23 = or_26 - rs_s1_b_d23;
-  assign mux_ge23 = ge23 ? or_26_minus_rs_s1_b_d23 : or_26;
-  assign rem23 = mux_ge23[33:0];
+  assign or_49 = shl_rs_s24_p | rs_bits_lo_d23;
+  assign rs_or_49 = {{1{1'b0}}, or_49};
+  assign s_rs_or_49 = $signed(rs_or_49);
+  assign rs_rs_s1_b_d23 = {{1{1'b0}}, rs_s1_b_d23};
+  assign s_rs_rs_s1_b_d23 = $signed(rs_rs_s1_b_d23);
+  assign diff23 = s_rs_or_49 - s_rs_rs_s1_b_d23;
+  assign bits_diff23 = diff23[35];
+  assign ge23 = ~bits_diff23;
+  assign bits_diff23_1 = diff23[33:0];
+  assign rs_or_49_1 = or_49[33:0];
+  assign rem23 = ge23 ? bits_diff23_1 : rs_or_49_1;
   assign shl_s24_q = s24_q <<< 1;
   assign rs_ge23 = {{29{1'b0}}, ge23};
   assign quot23 = shl_s24_q | rs_ge23;
@@ -1235,11 +1559,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s25_p = rs_s25_p <<< 1;
   assign bits_lo_d24 = lo_d24[5];
   assign rs_bits_lo_d24 = {{34{1'b0}}, bits_lo_d24};
-  assign or_27 = shl_rs_s25_p | rs_bits_lo_d24;
-  assign ge24 = rs_s1_b_d24 <= or_27;
-  assign or_27_minus_rs_s1_b_d24 = or_27 - rs_s1_b_d24;
-  assign mux_ge24 = ge24 ? or_27_minus_rs_s1_b_d24 : or_27;
-  assign rem24 = mux_ge24[33:0];
+  assign or_51 = shl_rs_s25_p | rs_bits_lo_d24;
+  assign rs_or_51 = {{1{1'b0}}, or_51};
+  assign s_rs_or_51 = $signed(rs_or_51);
+  assign rs_rs_s1_b_d24 = {{1{1'b0}}, rs_s1_b_d24};
+  assign s_rs_rs_s1_b_d24 = $signed(rs_rs_s1_b_d24);
+  assign diff24 = s_rs_or_51 - s_rs_rs_s1_b_d24;
+  assign bits_diff24 = diff24[35];
+  assign ge24 = ~bits_diff24;
+  assign bits_diff24_1 = diff24[33:0];
+  assign rs_or_51_1 = or_51[33:0];
+  assign rem24 = ge24 ? bits_diff24_1 : rs_or_51_1;
   assign shl_s25_q = s25_q <<< 1;
   assign rs_ge24 = {{29{1'b0}}, ge24};
   assign quot24 = shl_s25_q | rs_ge24;
@@ -1257,11 +1587,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s26_p = rs_s26_p <<< 1;
   assign bits_lo_d25 = lo_d25[4];
   assign rs_bits_lo_d25 = {{34{1'b0}}, bits_lo_d25};
-  assign or_28 = shl_rs_s26_p | rs_bits_lo_d25;
-  assign ge25 = rs_s1_b_d25 <= or_28;
-  assign or_28_minus_rs_s1_b_d25 = or_28 - rs_s1_b_d25;
-  assign mux_ge25 = ge25 ? or_28_minus_rs_s1_b_d25 : or_28;
-  assign rem25 = mux_ge25[33:0];
+  assign or_53 = shl_rs_s26_p | rs_bits_lo_d25;
+  assign rs_or_53 = {{1{1'b0}}, or_53};
+  assign s_rs_or_53 = $signed(rs_or_53);
+  assign rs_rs_s1_b_d25 = {{1{1'b0}}, rs_s1_b_d25};
+  assign s_rs_rs_s1_b_d25 = $signed(rs_rs_s1_b_d25);
+  assign diff25 = s_rs_or_53 - s_rs_rs_s1_b_d25;
+  assign bits_diff25 = diff25[35];
+  assign ge25 = ~bits_diff25;
+  assign bits_diff25_1 = diff25[33:0];
+  assign rs_or_53_1 = or_53[33:0];
+  assign rem25 = ge25 ? bits_diff25_1 : rs_or_53_1;
   assign shl_s26_q = s26_q <<< 1;
   assign rs_ge25 = {{29{1'b0}}, ge25};
   assign quot25 = shl_s26_q | rs_ge25;
@@ -1279,11 +1615,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s27_p = rs_s27_p <<< 1;
   assign bits_lo_d26 = lo_d26[3];
   assign rs_bits_lo_d26 = {{34{1'b0}}, bits_lo_d26};
-  assign or_29 = shl_rs_s27_p | rs_bits_lo_d26;
-  assign ge26 = rs_s1_b_d26 <= or_29;
-  assign or_29_minus_rs_s1_b_d26 = or_29 - rs_s1_b_d26;
-  assign mux_ge26 = ge26 ? or_29_minus_rs_s1_b_d26 : or_29;
-  assign rem26 = mux_ge26[33:0];
+  assign or_55 = shl_rs_s27_p | rs_bits_lo_d26;
+  assign rs_or_55 = {{1{1'b0}}, or_55};
+  assign s_rs_or_55 = $signed(rs_or_55);
+  assign rs_rs_s1_b_d26 = {{1{1'b0}}, rs_s1_b_d26};
+  assign s_rs_rs_s1_b_d26 = $signed(rs_rs_s1_b_d26);
+  assign diff26 = s_rs_or_55 - s_rs_rs_s1_b_d26;
+  assign bits_diff26 = diff26[35];
+  assign ge26 = ~bits_diff26;
+  assign bits_diff26_1 = diff26[33:0];
+  assign rs_or_55_1 = or_55[33:0];
+  assign rem26 = ge26 ? bits_diff26_1 : rs_or_55_1;
   assign shl_s27_q = s27_q <<< 1;
   assign rs_ge26 = {{29{1'b0}}, ge26};
   assign quot26 = shl_s27_q | rs_ge26;
@@ -1301,11 +1643,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s28_p = rs_s28_p <<< 1;
   assign bits_lo_d27 = lo_d27[2];
   assign rs_bits_lo_d27 = {{34{1'b0}}, bits_lo_d27};
-  assign or_30 = shl_rs_s28_p | rs_bits_lo_d27;
-  assign ge27 = rs_s1_b_d27 <= or_30;
-  assign or_30_minus_rs_s1_b_d27 = or_30 - rs_s1_b_d27;
-  assign mux_ge27 = ge27 ? or_30_minus_rs_s1_b_d27 : or_30;
-  assign rem27 = mux_ge27[33:0];
+  assign or_57 = shl_rs_s28_p | rs_bits_lo_d27;
+  assign rs_or_57 = {{1{1'b0}}, or_57};
+  assign s_rs_or_57 = $signed(rs_or_57);
+  assign rs_rs_s1_b_d27 = {{1{1'b0}}, rs_s1_b_d27};
+  assign s_rs_rs_s1_b_d27 = $signed(rs_rs_s1_b_d27);
+  assign diff27 = s_rs_or_57 - s_rs_rs_s1_b_d27;
+  assign bits_diff27 = diff27[35];
+  assign ge27 = ~bits_diff27;
+  assign bits_diff27_1 = diff27[33:0];
+  assign rs_or_57_1 = or_57[33:0];
+  assign rem27 = ge27 ? bits_diff27_1 : rs_or_57_1;
   assign shl_s28_q = s28_q <<< 1;
   assign rs_ge27 = {{29{1'b0}}, ge27};
   assign quot27 = shl_s28_q | rs_ge27;
@@ -1323,11 +1671,17 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s29_p = rs_s29_p <<< 1;
   assign bits_lo_d28 = lo_d28[1];
   assign rs_bits_lo_d28 = {{34{1'b0}}, bits_lo_d28};
-  assign or_31 = shl_rs_s29_p | rs_bits_lo_d28;
-  assign ge28 = rs_s1_b_d28 <= or_31;
-  assign or_31_minus_rs_s1_b_d28 = or_31 - rs_s1_b_d28;
-  assign mux_ge28 = ge28 ? or_31_minus_rs_s1_b_d28 : or_31;
-  assign rem28 = mux_ge28[33:0];
+  assign or_59 = shl_rs_s29_p | rs_bits_lo_d28;
+  assign rs_or_59 = {{1{1'b0}}, or_59};
+  assign s_rs_or_59 = $signed(rs_or_59);
+  assign rs_rs_s1_b_d28 = {{1{1'b0}}, rs_s1_b_d28};
+  assign s_rs_rs_s1_b_d28 = $signed(rs_rs_s1_b_d28);
+  assign diff28 = s_rs_or_59 - s_rs_rs_s1_b_d28;
+  assign bits_diff28 = diff28[35];
+  assign ge28 = ~bits_diff28;
+  assign bits_diff28_1 = diff28[33:0];
+  assign rs_or_59_1 = or_59[33:0];
+  assign rem28 = ge28 ? bits_diff28_1 : rs_or_59_1;
   assign shl_s29_q = s29_q <<< 1;
   assign rs_ge28 = {{29{1'b0}}, ge28};
   assign quot28 = shl_s29_q | rs_ge28;
@@ -1345,18 +1699,24 @@ module fxrt_div_n29_a63_b34 (
   assign shl_rs_s30_p = rs_s30_p <<< 1;
   assign bits_lo_d29 = lo_d29[0];
   assign rs_bits_lo_d29 = {{34{1'b0}}, bits_lo_d29};
-  assign or_32 = shl_rs_s30_p | rs_bits_lo_d29;
-  assign ge29 = rs_s1_b_d29 <= or_32;
-  assign or_32_minus_rs_s1_b_d29 = or_32 - rs_s1_b_d29;
-  assign mux_ge29 = ge29 ? or_32_minus_rs_s1_b_d29 : or_32;
-  assign rem29 = mux_ge29[33:0];
+  assign or_61 = shl_rs_s30_p | rs_bits_lo_d29;
+  assign rs_or_61 = {{1{1'b0}}, or_61};
+  assign s_rs_or_61 = $signed(rs_or_61);
+  assign rs_rs_s1_b_d29 = {{1{1'b0}}, rs_s1_b_d29};
+  assign s_rs_rs_s1_b_d29 = $signed(rs_rs_s1_b_d29);
+  assign diff29 = s_rs_or_61 - s_rs_rs_s1_b_d29;
+  assign bits_diff29 = diff29[35];
+  assign ge29 = ~bits_diff29;
+  assign bits_diff29_1 = diff29[33:0];
+  assign rs_or_61_1 = or_61[33:0];
+  assign rem29 = ge29 ? bits_diff29_1 : rs_or_61_1;
   assign shl_s30_q = s30_q <<< 1;
   assign rs_ge29 = {{29{1'b0}}, ge29};
   assign quot29 = shl_s30_q | rs_ge29;
   assign err_1_d29 = err_1_d29_sr[29];
   assign quot29_eq_k_0_2 = quot29 == k_0_2;
-  assign or_33 = err_1_d29 | quot29_eq_k_0_2;
-  assign not_or_33 = ~or_33;
+  assign or_63 = err_1_d29 | quot29_eq_k_0_2;
+  assign not_or_63 = ~or_63;
 
   always @(posedge clk) begin : s31_result_regs
     s1_b_d29 <= s1_b_d28;
@@ -1365,7 +1725,7 @@ module fxrt_div_n29_a63_b34 (
       err_1_d29_sr[err_1_d29_i] <= err_1_d29_sr[err_1_d29_i - 1];
     err_1_d29_sr[1] <= err_1;
     s31_t <= quot29;
-    s31_ok <= not_or_33;
+    s31_ok <= not_or_63;
   end
 
   assign t = s31_t;

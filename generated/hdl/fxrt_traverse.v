@@ -101,10 +101,16 @@ module fxrt_traverse (
   reg signed [47:0] pu_inv = 48'sh000000000000;
   reg [0:0] pu_delta_valid = 1'h0;
   reg [0:0] pu_delta_last = 1'h0;
-  wire signed [77:0] pu_mul;
-  reg signed [77:0] pu_product = 78'sh00000000000000000000;
-  reg [0:0] pu_product_valid = 1'h0;
-  reg [0:0] pu_product_last = 1'h0;
+  wire signed [77:0] u_plane_product_p0;
+  wire signed [77:0] pu_product;
+  (* mem2reg *) reg [0:0] pu_product_valid_sr [1:6];
+  integer pu_product_valid_i;
+  initial for (pu_product_valid_i = 1; pu_product_valid_i <= 6; pu_product_valid_i = pu_product_valid_i + 1) pu_product_valid_sr[pu_product_valid_i] = 1'h0;
+  wire [0:0] pu_product_valid;
+  (* mem2reg *) reg [0:0] pu_product_last_sr [1:6];
+  integer pu_product_last_i;
+  initial for (pu_product_last_i = 1; pu_product_last_i <= 6; pu_product_last_i = pu_product_last_i + 1) pu_product_last_sr[pu_product_last_i] = 1'h0;
+  wire [0:0] pu_product_last;
   wire signed [77:0] pu_shifted;
   wire signed [77:0] k_1073741824 = 78'sh00000000000040000000;
   wire [0:0] lt_4;
@@ -397,7 +403,9 @@ module fxrt_traverse (
       default: pu_inv_axis = invx_r;
     endcase
   end
-  assign pu_mul = $signed({{48{pu_delta[29]}}, pu_delta}) * $signed({{30{pu_inv[47]}}, pu_inv});
+  assign pu_product = u_plane_product_p0;
+  assign pu_product_valid = pu_product_valid_sr[6];
+  assign pu_product_last = pu_product_last_sr[6];
   assign pu_shifted = pu_product >>> 16;
   assign lt_4 = k_1073741824 < pu_shifted;
   assign pu_shifted_lt_k_m1 = pu_shifted < k_m1;
@@ -477,9 +485,12 @@ module fxrt_traverse (
     pu_inv <= pu_inv_axis;
     pu_delta_valid <= pu_sel_valid;
     pu_delta_last <= pu_sel_last;
-    pu_product <= pu_mul;
-    pu_product_valid <= pu_delta_valid;
-    pu_product_last <= pu_delta_last;
+    for (pu_product_valid_i = 6; pu_product_valid_i > 1; pu_product_valid_i = pu_product_valid_i - 1)
+      pu_product_valid_sr[pu_product_valid_i] <= pu_product_valid_sr[pu_product_valid_i - 1];
+    pu_product_valid_sr[1] <= pu_delta_valid;
+    for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
+      pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
+    pu_product_last_sr[1] <= pu_delta_last;
     plane_t <= pu_clamped;
     plane_t_valid <= pu_product_valid;
     plane_t_last <= pu_product_last;
@@ -716,6 +727,13 @@ module fxrt_traverse (
     leaf_left <= leaf_left_next;
     popped_ahead <= popped_ahead_next;
   end
+
+  fxrt_mul_s30xs48_d3l1 u_plane_product (
+    .clk(clk),
+    .a0(pu_delta),
+    .b0(pu_inv),
+    .p0(u_plane_product_p0)
+  );
 
   assign ray_ready = in_idle;
   assign emit_valid = emit_r;

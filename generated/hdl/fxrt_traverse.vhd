@@ -32,6 +32,14 @@ entity fxrt_traverse is
 end entity fxrt_traverse;
 
 architecture rtl of fxrt_traverse is
+  component fxrt_mul_s30xs48_d3l1 is
+    port (
+      clk : in std_logic;
+      a0 : in signed(29 downto 0);
+      b0 : in signed(47 downto 0);
+      p0 : out signed(77 downto 0)
+    );
+  end component;
 
   type node_rom_t is array (0 to 8191) of unsigned(72 downto 0);
   constant node_rom : node_rom_t := (
@@ -10840,10 +10848,14 @@ architecture rtl of fxrt_traverse is
   signal pu_inv : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal pu_delta_valid : unsigned(0 downto 0) := unsigned'("0");
   signal pu_delta_last : unsigned(0 downto 0) := unsigned'("0");
-  signal pu_mul : signed(77 downto 0);
-  signal pu_product : signed(77 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000000000000000000");
-  signal pu_product_valid : unsigned(0 downto 0) := unsigned'("0");
-  signal pu_product_last : unsigned(0 downto 0) := unsigned'("0");
+  signal u_plane_product_p0 : signed(77 downto 0);
+  signal pu_product : signed(77 downto 0);
+  type pu_product_valid_sr_t is array (1 to 6) of unsigned(0 downto 0);
+  signal pu_product_valid_sr : pu_product_valid_sr_t := (others => (others => '0'));
+  signal pu_product_valid : unsigned(0 downto 0);
+  type pu_product_last_sr_t is array (1 to 6) of unsigned(0 downto 0);
+  signal pu_product_last_sr : pu_product_last_sr_t := (others => (others => '0'));
+  signal pu_product_last : unsigned(0 downto 0);
   signal pu_shifted : signed(77 downto 0);
   constant k_1073741824 : signed(77 downto 0) := signed'("000000000000000000000000000000000000000000000001000000000000000000000000000000");
   signal lt_4 : unsigned(0 downto 0);
@@ -11117,7 +11129,9 @@ begin
       invy_r when "01",
       invz_r when "10",
       invx_r when others;
-  pu_mul <= pu_delta * pu_inv;
+  pu_product <= u_plane_product_p0;
+  pu_product_valid <= pu_product_valid_sr(6);
+  pu_product_last <= pu_product_last_sr(6);
   pu_shifted <= shift_right(pu_product, 16);
   lt_4 <= "1" when k_1073741824 < pu_shifted else "0";
   pu_shifted_lt_k_m1 <= "1" when pu_shifted < k_m1 else "0";
@@ -11199,9 +11213,10 @@ begin
       pu_inv <= pu_inv_axis;
       pu_delta_valid <= pu_sel_valid;
       pu_delta_last <= pu_sel_last;
-      pu_product <= pu_mul;
-      pu_product_valid <= pu_delta_valid;
-      pu_product_last <= pu_delta_last;
+      pu_product_valid_sr(2 to 6) <= pu_product_valid_sr(1 to 5);
+      pu_product_valid_sr(1) <= pu_delta_valid;
+      pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
+      pu_product_last_sr(1) <= pu_delta_last;
       plane_t <= pu_clamped;
       plane_t_valid <= pu_product_valid;
       plane_t_last <= pu_product_last;
@@ -11427,6 +11442,14 @@ begin
       popped_ahead <= popped_ahead_next;
     end if;
   end process state_regs;
+
+  u_plane_product : fxrt_mul_s30xs48_d3l1
+    port map (
+      clk => clk,
+      a0 => pu_delta,
+      b0 => pu_inv,
+      p0 => u_plane_product_p0
+    );
 
   ray_ready <= in_idle;
   emit_valid <= emit_r;
