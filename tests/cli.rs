@@ -171,10 +171,21 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--ise", "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     // random: 2,000 triangles (11 bits) + leaf distance (n + 2 = 18 bits) + end flag.
-    let name = "fxrt_intersect_n16_m16_t0_e4_tag30";
+    // Built for the default clock target, 150 MHz: its name, manifest and UCF say so.
+    let name = "fxrt_intersect_n16_m16_t0_e4_tag30_c150";
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join(format!("{name}.json"))).unwrap()).unwrap();
-    assert_eq!(manifest["latency_cycles"], 25);
+    assert_eq!((manifest["latency_cycles"].clone(), manifest["params"]["target_mhz"].clone()), (38.into(), 150.into()));
+    let ucf = std::fs::read_to_string(out.join("fxrt_core.ucf")).unwrap();
+    assert!(ucf.contains("PERIOD \"clk\" 6.667 ns"), "{ucf}");
+    // At 75 MHz the products take one clock: the thesis-like pipeline, 13 cycles shorter.
+    let slow = dir.path().join("slow");
+    let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--ise", "--target-mhz", "75", "--out", slow.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let slow_manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(slow.join("fxrt_intersect_n16_m16_t0_e4_tag30_c75.json")).unwrap()).unwrap();
+    assert_eq!(slow_manifest["latency_cycles"], 25);
+    assert!(std::fs::read_to_string(slow.join("fxrt_core.ucf")).unwrap().contains("13.333 ns"));
     let core: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("fxrt_core.json")).unwrap()).unwrap();
     let files = core["files"]["vhdl"].as_array().unwrap();
     assert_eq!(files.last().unwrap(), "fxrt_core.vhd");
