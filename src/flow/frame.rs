@@ -318,7 +318,7 @@ pub fn simulate_hdl(
     let g = FastGolden::new(scene);
     let inputs: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
     let expected: Vec<Vec<i128>> = rays.iter().map(|r| result_row(r.pixel as u64, g.trace(&r.ray).0)).collect();
-    // Generous: the slowest built-in scene needs ~15,000 cycles per ray. Capped to what the
+    // Generous: the slowest built-in scene needs ~28,000 cycles per ray. Capped to what the
     // testbenches' 32-bit integers hold (GHDL would wrap it, Verilator refuses it).
     let max_cycles = (100_000 * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
     let stream = Stream { rays: &inputs, expected: &expected, checked: &RESULT_PORTS, max_cycles };
