@@ -128,7 +128,12 @@ fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
         all.filter(|f| fxrt::rtl::emit::is_source(f)).collect::<Vec<_>>()
     };
     let (vhd, v) = (files("vhd"), files("v"));
-    assert_eq!(vhd.len(), 2, "{vhd:?}");
+    // The divider, the split multipliers and their DSP piece come first, the pipeline last.
+    assert_eq!(vhd.len(), module.hierarchy().len(), "{vhd:?}");
+    assert_eq!(vhd.last(), Some(&format!("{name}.vhd")), "{vhd:?}");
+    for sub in [format!("{}.vhd", p.divider().name), "fxrt_dsp18_r3.vhd".into()] {
+        assert!(vhd.contains(&sub), "{sub} in {vhd:?}");
+    }
     let mut args = vec!["--synth", "--std=93c", "--out=none"];
     args.extend(vhd.iter().map(|s| s.as_str()));
     args.extend(["-e", &name]);
