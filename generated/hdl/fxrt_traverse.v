@@ -171,10 +171,18 @@ module fxrt_traverse (
   reg signed [47:0] case_axis_r;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_case_axis_r;
-  wire [0:0] near_end_lt_tmax;
-  wire [0:0] tmin_lt_far_start;
-  wire [0:0] tmin_le_near_end;
-  wire [0:0] far_start_le_tmax;
+  wire [0:0] plane_t_lt_tmax_1;
+  wire [0:0] d0_r_lt_tmax;
+  wire [0:0] mux_negative;
+  wire [0:0] tmin_lt_d0_r;
+  wire [0:0] tmin_lt_plane_t;
+  wire [0:0] mux_negative_1;
+  wire [0:0] tmin_le_plane_t;
+  wire [0:0] tmin_le_d0_r;
+  wire [0:0] mux_negative_2;
+  wire [0:0] d0_r_le_tmax;
+  wire [0:0] plane_t_le_tmax;
+  wire [0:0] mux_negative_3;
   wire [0:0] go_near_and_go_far;
   wire [4:0] rs_sp;
   wire [5:0] sp_plus_k_1_1;
@@ -450,10 +458,18 @@ module fxrt_traverse (
     endcase
   end
   assign bits_case_axis_r = case_axis_r[47];
-  assign near_end_lt_tmax = near_end < tmax;
-  assign tmin_lt_far_start = tmin < far_start;
-  assign tmin_le_near_end = tmin <= near_end;
-  assign far_start_le_tmax = far_start <= tmax;
+  assign plane_t_lt_tmax_1 = plane_t < tmax;
+  assign d0_r_lt_tmax = d0_r < tmax;
+  assign mux_negative = negative ? plane_t_lt_tmax_1 : d0_r_lt_tmax;
+  assign tmin_lt_d0_r = tmin < d0_r;
+  assign tmin_lt_plane_t = tmin < plane_t;
+  assign mux_negative_1 = negative ? tmin_lt_d0_r : tmin_lt_plane_t;
+  assign tmin_le_plane_t = tmin <= plane_t;
+  assign tmin_le_d0_r = tmin <= d0_r;
+  assign mux_negative_2 = negative ? tmin_le_plane_t : tmin_le_d0_r;
+  assign d0_r_le_tmax = d0_r <= tmax;
+  assign plane_t_le_tmax = plane_t <= tmax;
+  assign mux_negative_3 = negative ? d0_r_le_tmax : plane_t_le_tmax;
   assign go_near_and_go_far = go_near & go_far;
   assign rs_sp = sp[4:0];
   assign sp_plus_k_1_1 = sp + k_1_1;
@@ -672,13 +688,13 @@ module fxrt_traverse (
   assign near_end_r_next = in_dist ? mux_d1_arrives_1 : near_end_r;
   assign mux_d1_arrives_2 = d1_arrives ? far_start : far_start_r;
   assign far_start_r_next = in_dist ? mux_d1_arrives_2 : far_start_r;
-  assign mux_d1_arrives_3 = d1_arrives ? near_end_lt_tmax : near_lt_tmax;
+  assign mux_d1_arrives_3 = d1_arrives ? mux_negative : near_lt_tmax;
   assign near_lt_tmax_next = in_dist ? mux_d1_arrives_3 : near_lt_tmax;
-  assign mux_d1_arrives_4 = d1_arrives ? tmin_lt_far_start : far_gt_tmin;
+  assign mux_d1_arrives_4 = d1_arrives ? mux_negative_1 : far_gt_tmin;
   assign far_gt_tmin_next = in_dist ? mux_d1_arrives_4 : far_gt_tmin;
-  assign mux_d1_arrives_5 = d1_arrives ? tmin_le_near_end : tmin_le_near;
+  assign mux_d1_arrives_5 = d1_arrives ? mux_negative_2 : tmin_le_near;
   assign tmin_le_near_next = in_dist ? mux_d1_arrives_5 : tmin_le_near;
-  assign mux_d1_arrives_6 = d1_arrives ? far_start_le_tmax : far_le_tmax;
+  assign mux_d1_arrives_6 = d1_arrives ? mux_negative_3 : far_le_tmax;
   assign far_le_tmax_next = in_dist ? mux_d1_arrives_6 : far_le_tmax;
   assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_1 : sp;
   assign mux_not_sp_eq_k_0_6_3 = not_sp_eq_k_0_6 ? sp_minus_k_1_1_1 : sp;

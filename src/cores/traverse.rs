@@ -291,10 +291,13 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         s.when(d1_arrives, |s| {
             s.set(near_end_r, near_end);
             s.set(far_start_r, far_start);
-            s.set(near_lt_tmax, near_end.lt(tmax));
-            s.set(far_gt_tmin, far_start.gt(tmin));
-            s.set(tmin_le_near, tmin.le(near_end));
-            s.set(far_le_tmax, far_start.le(tmax));
+            // Each compare made with both candidates (the arriving distance and d0, both
+            // registers) and the result selected by `negative`: no mux ahead of a carry chain.
+            let by_sign = |on_plane, on_d0| negative.select(on_plane, on_d0);
+            s.set(near_lt_tmax, by_sign(plane_t.lt(tmax), d0_r.lt(tmax)));
+            s.set(far_gt_tmin, by_sign(d0_r.gt(tmin), plane_t.gt(tmin)));
+            s.set(tmin_le_near, by_sign(tmin.le(plane_t), tmin.le(d0_r)));
+            s.set(far_le_tmax, by_sign(d0_r.le(tmax), plane_t.le(tmax)));
             s.goto(Step);
         });
     });
