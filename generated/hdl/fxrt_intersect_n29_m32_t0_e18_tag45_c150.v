@@ -553,7 +553,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
     s56_v <= mux_s55_hit_2;
   end
 
-  fxrt_mul_s30xs32_s30xs32_s32xs32_s32xs32_d3l1 u_plane_products (
+  fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1 u_plane_products (
     .clk(clk),
     .a0(s_rs_o_p),
     .b0(s1_np),
@@ -577,7 +577,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
     .ok(u_div_ok)
   );
 
-  fxrt_mul_s31xs32_s31xs32_d3l1 u_moved_products (
+  fxrt_muls_s31xs32_s31xs32_d3l1 u_moved_products (
     .clk(clk),
     .a0(s_rs_u_div_t_1),
     .b0(w_p_d39),
@@ -587,7 +587,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
     .p1(u_moved_products_p1)
   );
 
-  fxrt_mul_s32xs32_s32xs32_s32xs32_s32xs32_d3l1 u_bary_products (
+  fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1 u_bary_products (
     .clk(clk),
     .a0(s1_e1p_d46),
     .b0(s47_kq),

@@ -34,7 +34,7 @@ entity fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
 end entity fxrt_intersect_n29_m32_t0_e18_tag45_c150;
 
 architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
-  component fxrt_mul_s30xs32_s30xs32_s32xs32_s32xs32_d3l1 is
+  component fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1 is
     port (
       clk : in std_logic;
       a0 : in signed(29 downto 0);
@@ -60,7 +60,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
       ok : out unsigned(0 downto 0)
     );
   end component;
-  component fxrt_mul_s31xs32_s31xs32_d3l1 is
+  component fxrt_muls_s31xs32_s31xs32_d3l1 is
     port (
       clk : in std_logic;
       a0 : in signed(30 downto 0);
@@ -71,7 +71,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
       p1 : out signed(62 downto 0)
     );
   end component;
-  component fxrt_mul_s32xs32_s32xs32_s32xs32_s32xs32_d3l1 is
+  component fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1 is
     port (
       clk : in std_logic;
       a0 : in signed(31 downto 0);
@@ -587,7 +587,7 @@ begin
     end if;
   end process s56_result_regs;
 
-  u_plane_products : fxrt_mul_s30xs32_s30xs32_s32xs32_s32xs32_d3l1
+  u_plane_products : fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1
     port map (
       clk => clk,
       a0 => s_rs_o_p,
@@ -613,7 +613,7 @@ begin
       ok => u_div_ok
     );
 
-  u_moved_products : fxrt_mul_s31xs32_s31xs32_d3l1
+  u_moved_products : fxrt_muls_s31xs32_s31xs32_d3l1
     port map (
       clk => clk,
       a0 => s_rs_u_div_t_1,
@@ -624,7 +624,7 @@ begin
       p1 => u_moved_products_p1
     );
 
-  u_bary_products : fxrt_mul_s32xs32_s32xs32_s32xs32_s32xs32_d3l1
+  u_bary_products : fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1
     port map (
       clk => clk,
       a0 => s1_e1p_d46,

@@ -2,204 +2,204 @@
 `default_nettype none
 module fxrt_mul_s30xs48_d3l1 (
   input wire clk,
-  input wire signed [29:0] a0,
-  input wire signed [47:0] b0,
-  output wire signed [77:0] p0
+  input wire signed [29:0] a,
+  input wire signed [47:0] b,
+  output wire signed [77:0] p
 );
 
-  wire [16:0] bits_a0;
-  wire [17:0] rs_bits_a0;
-  wire signed [17:0] a0_l0;
-  wire [12:0] bits_a0_1;
-  wire signed [12:0] s_bits_a0_1;
-  wire signed [17:0] a0_l1;
-  wire [16:0] bits_b0;
-  wire [17:0] rs_bits_b0;
-  wire signed [17:0] b0_l0;
-  wire [16:0] bits_b0_1;
-  wire [17:0] rs_bits_b0_1;
-  wire signed [17:0] b0_l1;
-  wire [13:0] bits_b0_2;
-  wire signed [13:0] s_bits_b0_2;
-  wire signed [17:0] b0_l2;
-  wire signed [35:0] u_m0_piece00_p;
-  wire signed [35:0] m0_piece00;
-  wire signed [35:0] u_m0_piece01_p;
-  wire signed [35:0] m0_piece01;
-  wire signed [35:0] u_m0_piece10_p;
-  wire signed [35:0] m0_piece10;
-  wire signed [35:0] u_m0_piece02_p;
-  wire signed [35:0] m0_piece02;
-  wire signed [35:0] u_m0_piece11_p;
-  wire signed [35:0] m0_piece11;
-  wire signed [35:0] u_m0_piece12_p;
+  wire [16:0] bits_a;
+  wire [17:0] rs_bits_a;
+  wire signed [17:0] a_l0;
+  wire [12:0] bits_a_1;
+  wire signed [12:0] s_bits_a_1;
+  wire signed [17:0] a_l1;
+  wire [16:0] bits_b;
+  wire [17:0] rs_bits_b;
+  wire signed [17:0] b_l0;
+  wire [16:0] bits_b_1;
+  wire [17:0] rs_bits_b_1;
+  wire signed [17:0] b_l1;
+  wire [13:0] bits_b_2;
+  wire signed [13:0] s_bits_b_2;
+  wire signed [17:0] b_l2;
+  wire signed [35:0] u_piece00_p;
+  wire signed [35:0] piece00;
+  wire signed [35:0] u_piece01_p;
+  wire signed [35:0] piece01;
+  wire signed [35:0] u_piece10_p;
+  wire signed [35:0] piece10;
+  wire signed [35:0] u_piece02_p;
+  wire signed [35:0] piece02;
+  wire signed [35:0] u_piece11_p;
+  wire signed [35:0] piece11;
+  wire signed [35:0] u_piece12_p;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 27:0 are read
-  wire signed [35:0] m0_piece12;
+  wire signed [35:0] piece12;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [35:0] shr_m0_piece00;
-  wire signed [36:0] rs_shr_m0_piece00;
-  wire signed [36:0] rs_m0_piece01;
+  wire signed [35:0] shr_piece00;
+  wire signed [36:0] rs_shr_piece00;
+  wire signed [36:0] rs_piece01;
   wire signed [36:0] plus_0;
-  wire [16:0] bits_m0_piece00;
+  wire [16:0] bits_piece00;
   wire [53:0] cat_1;
-  wire signed [53:0] m0_sum0_0;
-  wire signed [35:0] shr_m0_piece10;
-  wire signed [36:0] rs_shr_m0_piece10;
-  wire signed [36:0] rs_m0_piece02;
+  wire signed [53:0] sum0_0;
+  wire signed [35:0] shr_piece10;
+  wire signed [36:0] rs_shr_piece10;
+  wire signed [36:0] rs_piece02;
   wire signed [36:0] plus_2;
-  wire [16:0] bits_m0_piece10;
+  wire [16:0] bits_piece10;
   wire [53:0] cat_3;
-  wire signed [53:0] m0_sum0_1;
+  wire signed [53:0] sum0_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 27:0 are read
-  wire signed [35:0] shr_m0_piece11;
+  wire signed [35:0] shr_piece11;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [27:0] bits_shr_m0_piece11;
-  wire signed [27:0] s_bits_shr_m0_piece11;
-  wire [27:0] bits_m0_piece12;
-  wire signed [27:0] s_bits_m0_piece12;
+  wire [27:0] bits_shr_piece11;
+  wire signed [27:0] s_bits_shr_piece11;
+  wire [27:0] bits_piece12;
+  wire signed [27:0] s_bits_piece12;
   wire signed [27:0] plus_4;
-  wire [16:0] bits_m0_piece11;
+  wire [16:0] bits_piece11;
   wire [44:0] cat_5;
-  wire signed [44:0] m0_sum0_2;
-  reg signed [53:0] m0_sum1_0_r = 54'sh00000000000000;
-  reg signed [53:0] m0_sum1_1_r = 54'sh00000000000000;
-  reg signed [44:0] m0_sum1_2_r = 45'sh000000000000;
-  wire signed [53:0] shr_m0_sum1_0_r;
-  wire signed [54:0] rs_shr_m0_sum1_0_r;
-  wire signed [54:0] rs_m0_sum1_1_r;
+  wire signed [44:0] sum0_2;
+  reg signed [53:0] sum1_0_r = 54'sh00000000000000;
+  reg signed [53:0] sum1_1_r = 54'sh00000000000000;
+  reg signed [44:0] sum1_2_r = 45'sh000000000000;
+  wire signed [53:0] shr_sum1_0_r;
+  wire signed [54:0] rs_shr_sum1_0_r;
+  wire signed [54:0] rs_sum1_1_r;
   wire signed [54:0] plus_6;
-  wire [16:0] bits_m0_sum1_0_r;
+  wire [16:0] bits_sum1_0_r;
   wire [71:0] cat_7;
-  wire signed [71:0] m0_sum1_0;
-  reg signed [71:0] m0_sum2_0_r = 72'sh000000000000000000;
-  reg signed [44:0] m0_sum2_1_r = 45'sh000000000000;
+  wire signed [71:0] sum1_0;
+  reg signed [71:0] sum2_0_r = 72'sh000000000000000000;
+  reg signed [44:0] sum2_1_r = 45'sh000000000000;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 44:0 are read
-  wire signed [71:0] shr_m0_sum2_0_r;
+  wire signed [71:0] shr_sum2_0_r;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [44:0] bits_shr_m0_sum2_0_r;
-  wire signed [44:0] s_bits_shr_m0_sum2_0_r;
+  wire [44:0] bits_shr_sum2_0_r;
+  wire signed [44:0] s_bits_shr_sum2_0_r;
   wire signed [44:0] plus_8;
-  wire [33:0] bits_m0_sum2_0_r;
+  wire [33:0] bits_sum2_0_r;
   wire [78:0] cat_9;
-  wire signed [78:0] m0_sum2_0;
+  wire signed [78:0] sum2_0;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 77:0 are read
-  reg signed [78:0] m0_sum3_0_r = 79'sh00000000000000000000;
+  reg signed [78:0] sum3_0_r = 79'sh00000000000000000000;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [77:0] bits_m0_sum3_0_r;
-  wire signed [77:0] s_bits_m0_sum3_0_r;
+  wire [77:0] bits_sum3_0_r;
+  wire signed [77:0] s_bits_sum3_0_r;
 
-  assign bits_a0 = a0[16:0];
-  assign rs_bits_a0 = {{1{1'b0}}, bits_a0};
-  assign a0_l0 = $signed(rs_bits_a0);
-  assign bits_a0_1 = a0[29:17];
-  assign s_bits_a0_1 = $signed(bits_a0_1);
-  assign a0_l1 = $signed({{5{s_bits_a0_1[12]}}, s_bits_a0_1});
-  assign bits_b0 = b0[16:0];
-  assign rs_bits_b0 = {{1{1'b0}}, bits_b0};
-  assign b0_l0 = $signed(rs_bits_b0);
-  assign bits_b0_1 = b0[33:17];
-  assign rs_bits_b0_1 = {{1{1'b0}}, bits_b0_1};
-  assign b0_l1 = $signed(rs_bits_b0_1);
-  assign bits_b0_2 = b0[47:34];
-  assign s_bits_b0_2 = $signed(bits_b0_2);
-  assign b0_l2 = $signed({{4{s_bits_b0_2[13]}}, s_bits_b0_2});
-  assign m0_piece00 = u_m0_piece00_p;
-  assign m0_piece01 = u_m0_piece01_p;
-  assign m0_piece10 = u_m0_piece10_p;
-  assign m0_piece02 = u_m0_piece02_p;
-  assign m0_piece11 = u_m0_piece11_p;
-  assign m0_piece12 = u_m0_piece12_p;
-  assign shr_m0_piece00 = m0_piece00 >>> 17;
-  assign rs_shr_m0_piece00 = $signed({{1{shr_m0_piece00[35]}}, shr_m0_piece00});
-  assign rs_m0_piece01 = $signed({{1{m0_piece01[35]}}, m0_piece01});
-  assign plus_0 = rs_shr_m0_piece00 + rs_m0_piece01;
-  assign bits_m0_piece00 = m0_piece00[16:0];
-  assign cat_1 = {plus_0, bits_m0_piece00};
-  assign m0_sum0_0 = $signed(cat_1);
-  assign shr_m0_piece10 = m0_piece10 >>> 17;
-  assign rs_shr_m0_piece10 = $signed({{1{shr_m0_piece10[35]}}, shr_m0_piece10});
-  assign rs_m0_piece02 = $signed({{1{m0_piece02[35]}}, m0_piece02});
-  assign plus_2 = rs_shr_m0_piece10 + rs_m0_piece02;
-  assign bits_m0_piece10 = m0_piece10[16:0];
-  assign cat_3 = {plus_2, bits_m0_piece10};
-  assign m0_sum0_1 = $signed(cat_3);
-  assign shr_m0_piece11 = m0_piece11 >>> 17;
-  assign bits_shr_m0_piece11 = shr_m0_piece11[27:0];
-  assign s_bits_shr_m0_piece11 = $signed(bits_shr_m0_piece11);
-  assign bits_m0_piece12 = m0_piece12[27:0];
-  assign s_bits_m0_piece12 = $signed(bits_m0_piece12);
-  assign plus_4 = s_bits_shr_m0_piece11 + s_bits_m0_piece12;
-  assign bits_m0_piece11 = m0_piece11[16:0];
-  assign cat_5 = {plus_4, bits_m0_piece11};
-  assign m0_sum0_2 = $signed(cat_5);
-  assign shr_m0_sum1_0_r = m0_sum1_0_r >>> 17;
-  assign rs_shr_m0_sum1_0_r = $signed({{1{shr_m0_sum1_0_r[53]}}, shr_m0_sum1_0_r});
-  assign rs_m0_sum1_1_r = $signed({{1{m0_sum1_1_r[53]}}, m0_sum1_1_r});
-  assign plus_6 = rs_shr_m0_sum1_0_r + rs_m0_sum1_1_r;
-  assign bits_m0_sum1_0_r = m0_sum1_0_r[16:0];
-  assign cat_7 = {plus_6, bits_m0_sum1_0_r};
-  assign m0_sum1_0 = $signed(cat_7);
-  assign shr_m0_sum2_0_r = m0_sum2_0_r >>> 34;
-  assign bits_shr_m0_sum2_0_r = shr_m0_sum2_0_r[44:0];
-  assign s_bits_shr_m0_sum2_0_r = $signed(bits_shr_m0_sum2_0_r);
-  assign plus_8 = s_bits_shr_m0_sum2_0_r + m0_sum2_1_r;
-  assign bits_m0_sum2_0_r = m0_sum2_0_r[33:0];
-  assign cat_9 = {plus_8, bits_m0_sum2_0_r};
-  assign m0_sum2_0 = $signed(cat_9);
-  assign bits_m0_sum3_0_r = m0_sum3_0_r[77:0];
-  assign s_bits_m0_sum3_0_r = $signed(bits_m0_sum3_0_r);
+  assign bits_a = a[16:0];
+  assign rs_bits_a = {{1{1'b0}}, bits_a};
+  assign a_l0 = $signed(rs_bits_a);
+  assign bits_a_1 = a[29:17];
+  assign s_bits_a_1 = $signed(bits_a_1);
+  assign a_l1 = $signed({{5{s_bits_a_1[12]}}, s_bits_a_1});
+  assign bits_b = b[16:0];
+  assign rs_bits_b = {{1{1'b0}}, bits_b};
+  assign b_l0 = $signed(rs_bits_b);
+  assign bits_b_1 = b[33:17];
+  assign rs_bits_b_1 = {{1{1'b0}}, bits_b_1};
+  assign b_l1 = $signed(rs_bits_b_1);
+  assign bits_b_2 = b[47:34];
+  assign s_bits_b_2 = $signed(bits_b_2);
+  assign b_l2 = $signed({{4{s_bits_b_2[13]}}, s_bits_b_2});
+  assign piece00 = u_piece00_p;
+  assign piece01 = u_piece01_p;
+  assign piece10 = u_piece10_p;
+  assign piece02 = u_piece02_p;
+  assign piece11 = u_piece11_p;
+  assign piece12 = u_piece12_p;
+  assign shr_piece00 = piece00 >>> 17;
+  assign rs_shr_piece00 = $signed({{1{shr_piece00[35]}}, shr_piece00});
+  assign rs_piece01 = $signed({{1{piece01[35]}}, piece01});
+  assign plus_0 = rs_shr_piece00 + rs_piece01;
+  assign bits_piece00 = piece00[16:0];
+  assign cat_1 = {plus_0, bits_piece00};
+  assign sum0_0 = $signed(cat_1);
+  assign shr_piece10 = piece10 >>> 17;
+  assign rs_shr_piece10 = $signed({{1{shr_piece10[35]}}, shr_piece10});
+  assign rs_piece02 = $signed({{1{piece02[35]}}, piece02});
+  assign plus_2 = rs_shr_piece10 + rs_piece02;
+  assign bits_piece10 = piece10[16:0];
+  assign cat_3 = {plus_2, bits_piece10};
+  assign sum0_1 = $signed(cat_3);
+  assign shr_piece11 = piece11 >>> 17;
+  assign bits_shr_piece11 = shr_piece11[27:0];
+  assign s_bits_shr_piece11 = $signed(bits_shr_piece11);
+  assign bits_piece12 = piece12[27:0];
+  assign s_bits_piece12 = $signed(bits_piece12);
+  assign plus_4 = s_bits_shr_piece11 + s_bits_piece12;
+  assign bits_piece11 = piece11[16:0];
+  assign cat_5 = {plus_4, bits_piece11};
+  assign sum0_2 = $signed(cat_5);
+  assign shr_sum1_0_r = sum1_0_r >>> 17;
+  assign rs_shr_sum1_0_r = $signed({{1{shr_sum1_0_r[53]}}, shr_sum1_0_r});
+  assign rs_sum1_1_r = $signed({{1{sum1_1_r[53]}}, sum1_1_r});
+  assign plus_6 = rs_shr_sum1_0_r + rs_sum1_1_r;
+  assign bits_sum1_0_r = sum1_0_r[16:0];
+  assign cat_7 = {plus_6, bits_sum1_0_r};
+  assign sum1_0 = $signed(cat_7);
+  assign shr_sum2_0_r = sum2_0_r >>> 34;
+  assign bits_shr_sum2_0_r = shr_sum2_0_r[44:0];
+  assign s_bits_shr_sum2_0_r = $signed(bits_shr_sum2_0_r);
+  assign plus_8 = s_bits_shr_sum2_0_r + sum2_1_r;
+  assign bits_sum2_0_r = sum2_0_r[33:0];
+  assign cat_9 = {plus_8, bits_sum2_0_r};
+  assign sum2_0 = $signed(cat_9);
+  assign bits_sum3_0_r = sum3_0_r[77:0];
+  assign s_bits_sum3_0_r = $signed(bits_sum3_0_r);
 
   always @(posedge clk) begin : regs
-    m0_sum1_0_r <= m0_sum0_0;
-    m0_sum1_1_r <= m0_sum0_1;
-    m0_sum1_2_r <= m0_sum0_2;
-    m0_sum2_0_r <= m0_sum1_0;
-    m0_sum2_1_r <= m0_sum1_2_r;
-    m0_sum3_0_r <= m0_sum2_0;
+    sum1_0_r <= sum0_0;
+    sum1_1_r <= sum0_1;
+    sum1_2_r <= sum0_2;
+    sum2_0_r <= sum1_0;
+    sum2_1_r <= sum1_2_r;
+    sum3_0_r <= sum2_0;
   end
 
-  fxrt_dsp18_r3 u_m0_piece00 (
+  fxrt_dsp18_r3 u_piece00 (
     .clk(clk),
-    .a(a0_l0),
-    .b(b0_l0),
-    .p(u_m0_piece00_p)
+    .a(a_l0),
+    .b(b_l0),
+    .p(u_piece00_p)
   );
 
-  fxrt_dsp18_r3 u_m0_piece01 (
+  fxrt_dsp18_r3 u_piece01 (
     .clk(clk),
-    .a(a0_l0),
-    .b(b0_l1),
-    .p(u_m0_piece01_p)
+    .a(a_l0),
+    .b(b_l1),
+    .p(u_piece01_p)
   );
 
-  fxrt_dsp18_r3 u_m0_piece10 (
+  fxrt_dsp18_r3 u_piece10 (
     .clk(clk),
-    .a(a0_l1),
-    .b(b0_l0),
-    .p(u_m0_piece10_p)
+    .a(a_l1),
+    .b(b_l0),
+    .p(u_piece10_p)
   );
 
-  fxrt_dsp18_r3 u_m0_piece02 (
+  fxrt_dsp18_r3 u_piece02 (
     .clk(clk),
-    .a(a0_l0),
-    .b(b0_l2),
-    .p(u_m0_piece02_p)
+    .a(a_l0),
+    .b(b_l2),
+    .p(u_piece02_p)
   );
 
-  fxrt_dsp18_r3 u_m0_piece11 (
+  fxrt_dsp18_r3 u_piece11 (
     .clk(clk),
-    .a(a0_l1),
-    .b(b0_l1),
-    .p(u_m0_piece11_p)
+    .a(a_l1),
+    .b(b_l1),
+    .p(u_piece11_p)
   );
 
-  fxrt_dsp18_r3 u_m0_piece12 (
+  fxrt_dsp18_r3 u_piece12 (
     .clk(clk),
-    .a(a0_l1),
-    .b(b0_l2),
-    .p(u_m0_piece12_p)
+    .a(a_l1),
+    .b(b_l2),
+    .p(u_piece12_p)
   );
 
-  assign p0 = s_bits_m0_sum3_0_r;
+  assign p = s_bits_sum3_0_r;
 endmodule
 `default_nettype wire

@@ -6,9 +6,9 @@ use ieee.numeric_std.all;
 entity fxrt_mul_s30xs48_d3l1 is
   port (
     clk : in std_logic;
-    a0 : in signed(29 downto 0);
-    b0 : in signed(47 downto 0);
-    p0 : out signed(77 downto 0)
+    a : in signed(29 downto 0);
+    b : in signed(47 downto 0);
+    p : out signed(77 downto 0)
   );
 end entity fxrt_mul_s30xs48_d3l1;
 
@@ -22,200 +22,200 @@ architecture rtl of fxrt_mul_s30xs48_d3l1 is
     );
   end component;
 
-  signal bits_a0 : unsigned(16 downto 0);
-  signal rs_bits_a0 : unsigned(17 downto 0);
-  signal a0_l0 : signed(17 downto 0);
-  signal bits_a0_1 : unsigned(12 downto 0);
-  signal s_bits_a0_1 : signed(12 downto 0);
-  signal a0_l1 : signed(17 downto 0);
-  signal bits_b0 : unsigned(16 downto 0);
-  signal rs_bits_b0 : unsigned(17 downto 0);
-  signal b0_l0 : signed(17 downto 0);
-  signal bits_b0_1 : unsigned(16 downto 0);
-  signal rs_bits_b0_1 : unsigned(17 downto 0);
-  signal b0_l1 : signed(17 downto 0);
-  signal bits_b0_2 : unsigned(13 downto 0);
-  signal s_bits_b0_2 : signed(13 downto 0);
-  signal b0_l2 : signed(17 downto 0);
-  signal u_m0_piece00_p : signed(35 downto 0);
-  signal m0_piece00 : signed(35 downto 0);
-  signal u_m0_piece01_p : signed(35 downto 0);
-  signal m0_piece01 : signed(35 downto 0);
-  signal u_m0_piece10_p : signed(35 downto 0);
-  signal m0_piece10 : signed(35 downto 0);
-  signal u_m0_piece02_p : signed(35 downto 0);
-  signal m0_piece02 : signed(35 downto 0);
-  signal u_m0_piece11_p : signed(35 downto 0);
-  signal m0_piece11 : signed(35 downto 0);
-  signal u_m0_piece12_p : signed(35 downto 0);
-  signal m0_piece12 : signed(35 downto 0);
-  signal shr_m0_piece00 : signed(35 downto 0);
-  signal rs_shr_m0_piece00 : signed(36 downto 0);
-  signal rs_m0_piece01 : signed(36 downto 0);
+  signal bits_a : unsigned(16 downto 0);
+  signal rs_bits_a : unsigned(17 downto 0);
+  signal a_l0 : signed(17 downto 0);
+  signal bits_a_1 : unsigned(12 downto 0);
+  signal s_bits_a_1 : signed(12 downto 0);
+  signal a_l1 : signed(17 downto 0);
+  signal bits_b : unsigned(16 downto 0);
+  signal rs_bits_b : unsigned(17 downto 0);
+  signal b_l0 : signed(17 downto 0);
+  signal bits_b_1 : unsigned(16 downto 0);
+  signal rs_bits_b_1 : unsigned(17 downto 0);
+  signal b_l1 : signed(17 downto 0);
+  signal bits_b_2 : unsigned(13 downto 0);
+  signal s_bits_b_2 : signed(13 downto 0);
+  signal b_l2 : signed(17 downto 0);
+  signal u_piece00_p : signed(35 downto 0);
+  signal piece00 : signed(35 downto 0);
+  signal u_piece01_p : signed(35 downto 0);
+  signal piece01 : signed(35 downto 0);
+  signal u_piece10_p : signed(35 downto 0);
+  signal piece10 : signed(35 downto 0);
+  signal u_piece02_p : signed(35 downto 0);
+  signal piece02 : signed(35 downto 0);
+  signal u_piece11_p : signed(35 downto 0);
+  signal piece11 : signed(35 downto 0);
+  signal u_piece12_p : signed(35 downto 0);
+  signal piece12 : signed(35 downto 0);
+  signal shr_piece00 : signed(35 downto 0);
+  signal rs_shr_piece00 : signed(36 downto 0);
+  signal rs_piece01 : signed(36 downto 0);
   signal plus_0 : signed(36 downto 0);
-  signal bits_m0_piece00 : unsigned(16 downto 0);
+  signal bits_piece00 : unsigned(16 downto 0);
   signal cat_1 : unsigned(53 downto 0);
-  signal m0_sum0_0 : signed(53 downto 0);
-  signal shr_m0_piece10 : signed(35 downto 0);
-  signal rs_shr_m0_piece10 : signed(36 downto 0);
-  signal rs_m0_piece02 : signed(36 downto 0);
+  signal sum0_0 : signed(53 downto 0);
+  signal shr_piece10 : signed(35 downto 0);
+  signal rs_shr_piece10 : signed(36 downto 0);
+  signal rs_piece02 : signed(36 downto 0);
   signal plus_2 : signed(36 downto 0);
-  signal bits_m0_piece10 : unsigned(16 downto 0);
+  signal bits_piece10 : unsigned(16 downto 0);
   signal cat_3 : unsigned(53 downto 0);
-  signal m0_sum0_1 : signed(53 downto 0);
-  signal shr_m0_piece11 : signed(35 downto 0);
-  signal bits_shr_m0_piece11 : unsigned(27 downto 0);
-  signal s_bits_shr_m0_piece11 : signed(27 downto 0);
-  signal bits_m0_piece12 : unsigned(27 downto 0);
-  signal s_bits_m0_piece12 : signed(27 downto 0);
+  signal sum0_1 : signed(53 downto 0);
+  signal shr_piece11 : signed(35 downto 0);
+  signal bits_shr_piece11 : unsigned(27 downto 0);
+  signal s_bits_shr_piece11 : signed(27 downto 0);
+  signal bits_piece12 : unsigned(27 downto 0);
+  signal s_bits_piece12 : signed(27 downto 0);
   signal plus_4 : signed(27 downto 0);
-  signal bits_m0_piece11 : unsigned(16 downto 0);
+  signal bits_piece11 : unsigned(16 downto 0);
   signal cat_5 : unsigned(44 downto 0);
-  signal m0_sum0_2 : signed(44 downto 0);
-  signal m0_sum1_0_r : signed(53 downto 0) := signed'("000000000000000000000000000000000000000000000000000000");
-  signal m0_sum1_1_r : signed(53 downto 0) := signed'("000000000000000000000000000000000000000000000000000000");
-  signal m0_sum1_2_r : signed(44 downto 0) := signed'("000000000000000000000000000000000000000000000");
-  signal shr_m0_sum1_0_r : signed(53 downto 0);
-  signal rs_shr_m0_sum1_0_r : signed(54 downto 0);
-  signal rs_m0_sum1_1_r : signed(54 downto 0);
+  signal sum0_2 : signed(44 downto 0);
+  signal sum1_0_r : signed(53 downto 0) := signed'("000000000000000000000000000000000000000000000000000000");
+  signal sum1_1_r : signed(53 downto 0) := signed'("000000000000000000000000000000000000000000000000000000");
+  signal sum1_2_r : signed(44 downto 0) := signed'("000000000000000000000000000000000000000000000");
+  signal shr_sum1_0_r : signed(53 downto 0);
+  signal rs_shr_sum1_0_r : signed(54 downto 0);
+  signal rs_sum1_1_r : signed(54 downto 0);
   signal plus_6 : signed(54 downto 0);
-  signal bits_m0_sum1_0_r : unsigned(16 downto 0);
+  signal bits_sum1_0_r : unsigned(16 downto 0);
   signal cat_7 : unsigned(71 downto 0);
-  signal m0_sum1_0 : signed(71 downto 0);
-  signal m0_sum2_0_r : signed(71 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000000000000");
-  signal m0_sum2_1_r : signed(44 downto 0) := signed'("000000000000000000000000000000000000000000000");
-  signal shr_m0_sum2_0_r : signed(71 downto 0);
-  signal bits_shr_m0_sum2_0_r : unsigned(44 downto 0);
-  signal s_bits_shr_m0_sum2_0_r : signed(44 downto 0);
+  signal sum1_0 : signed(71 downto 0);
+  signal sum2_0_r : signed(71 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal sum2_1_r : signed(44 downto 0) := signed'("000000000000000000000000000000000000000000000");
+  signal shr_sum2_0_r : signed(71 downto 0);
+  signal bits_shr_sum2_0_r : unsigned(44 downto 0);
+  signal s_bits_shr_sum2_0_r : signed(44 downto 0);
   signal plus_8 : signed(44 downto 0);
-  signal bits_m0_sum2_0_r : unsigned(33 downto 0);
+  signal bits_sum2_0_r : unsigned(33 downto 0);
   signal cat_9 : unsigned(78 downto 0);
-  signal m0_sum2_0 : signed(78 downto 0);
-  signal m0_sum3_0_r : signed(78 downto 0) := signed'("0000000000000000000000000000000000000000000000000000000000000000000000000000000");
-  signal bits_m0_sum3_0_r : unsigned(77 downto 0);
-  signal s_bits_m0_sum3_0_r : signed(77 downto 0);
+  signal sum2_0 : signed(78 downto 0);
+  signal sum3_0_r : signed(78 downto 0) := signed'("0000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal bits_sum3_0_r : unsigned(77 downto 0);
+  signal s_bits_sum3_0_r : signed(77 downto 0);
 begin
 
-  bits_a0 <= unsigned(a0(16 downto 0));
-  rs_bits_a0 <= resize(bits_a0, 18);
-  a0_l0 <= signed(rs_bits_a0);
-  bits_a0_1 <= unsigned(a0(29 downto 17));
-  s_bits_a0_1 <= signed(bits_a0_1);
-  a0_l1 <= resize(s_bits_a0_1, 18);
-  bits_b0 <= unsigned(b0(16 downto 0));
-  rs_bits_b0 <= resize(bits_b0, 18);
-  b0_l0 <= signed(rs_bits_b0);
-  bits_b0_1 <= unsigned(b0(33 downto 17));
-  rs_bits_b0_1 <= resize(bits_b0_1, 18);
-  b0_l1 <= signed(rs_bits_b0_1);
-  bits_b0_2 <= unsigned(b0(47 downto 34));
-  s_bits_b0_2 <= signed(bits_b0_2);
-  b0_l2 <= resize(s_bits_b0_2, 18);
-  m0_piece00 <= u_m0_piece00_p;
-  m0_piece01 <= u_m0_piece01_p;
-  m0_piece10 <= u_m0_piece10_p;
-  m0_piece02 <= u_m0_piece02_p;
-  m0_piece11 <= u_m0_piece11_p;
-  m0_piece12 <= u_m0_piece12_p;
-  shr_m0_piece00 <= shift_right(m0_piece00, 17);
-  rs_shr_m0_piece00 <= resize(shr_m0_piece00, 37);
-  rs_m0_piece01 <= resize(m0_piece01, 37);
-  plus_0 <= rs_shr_m0_piece00 + rs_m0_piece01;
-  bits_m0_piece00 <= unsigned(m0_piece00(16 downto 0));
-  cat_1 <= unsigned(std_logic_vector'(std_logic_vector(plus_0) & std_logic_vector(bits_m0_piece00)));
-  m0_sum0_0 <= signed(cat_1);
-  shr_m0_piece10 <= shift_right(m0_piece10, 17);
-  rs_shr_m0_piece10 <= resize(shr_m0_piece10, 37);
-  rs_m0_piece02 <= resize(m0_piece02, 37);
-  plus_2 <= rs_shr_m0_piece10 + rs_m0_piece02;
-  bits_m0_piece10 <= unsigned(m0_piece10(16 downto 0));
-  cat_3 <= unsigned(std_logic_vector'(std_logic_vector(plus_2) & std_logic_vector(bits_m0_piece10)));
-  m0_sum0_1 <= signed(cat_3);
-  shr_m0_piece11 <= shift_right(m0_piece11, 17);
-  bits_shr_m0_piece11 <= unsigned(shr_m0_piece11(27 downto 0));
-  s_bits_shr_m0_piece11 <= signed(bits_shr_m0_piece11);
-  bits_m0_piece12 <= unsigned(m0_piece12(27 downto 0));
-  s_bits_m0_piece12 <= signed(bits_m0_piece12);
-  plus_4 <= s_bits_shr_m0_piece11 + s_bits_m0_piece12;
-  bits_m0_piece11 <= unsigned(m0_piece11(16 downto 0));
-  cat_5 <= unsigned(std_logic_vector'(std_logic_vector(plus_4) & std_logic_vector(bits_m0_piece11)));
-  m0_sum0_2 <= signed(cat_5);
-  shr_m0_sum1_0_r <= shift_right(m0_sum1_0_r, 17);
-  rs_shr_m0_sum1_0_r <= resize(shr_m0_sum1_0_r, 55);
-  rs_m0_sum1_1_r <= resize(m0_sum1_1_r, 55);
-  plus_6 <= rs_shr_m0_sum1_0_r + rs_m0_sum1_1_r;
-  bits_m0_sum1_0_r <= unsigned(m0_sum1_0_r(16 downto 0));
-  cat_7 <= unsigned(std_logic_vector'(std_logic_vector(plus_6) & std_logic_vector(bits_m0_sum1_0_r)));
-  m0_sum1_0 <= signed(cat_7);
-  shr_m0_sum2_0_r <= shift_right(m0_sum2_0_r, 34);
-  bits_shr_m0_sum2_0_r <= unsigned(shr_m0_sum2_0_r(44 downto 0));
-  s_bits_shr_m0_sum2_0_r <= signed(bits_shr_m0_sum2_0_r);
-  plus_8 <= s_bits_shr_m0_sum2_0_r + m0_sum2_1_r;
-  bits_m0_sum2_0_r <= unsigned(m0_sum2_0_r(33 downto 0));
-  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(plus_8) & std_logic_vector(bits_m0_sum2_0_r)));
-  m0_sum2_0 <= signed(cat_9);
-  bits_m0_sum3_0_r <= unsigned(m0_sum3_0_r(77 downto 0));
-  s_bits_m0_sum3_0_r <= signed(bits_m0_sum3_0_r);
+  bits_a <= unsigned(a(16 downto 0));
+  rs_bits_a <= resize(bits_a, 18);
+  a_l0 <= signed(rs_bits_a);
+  bits_a_1 <= unsigned(a(29 downto 17));
+  s_bits_a_1 <= signed(bits_a_1);
+  a_l1 <= resize(s_bits_a_1, 18);
+  bits_b <= unsigned(b(16 downto 0));
+  rs_bits_b <= resize(bits_b, 18);
+  b_l0 <= signed(rs_bits_b);
+  bits_b_1 <= unsigned(b(33 downto 17));
+  rs_bits_b_1 <= resize(bits_b_1, 18);
+  b_l1 <= signed(rs_bits_b_1);
+  bits_b_2 <= unsigned(b(47 downto 34));
+  s_bits_b_2 <= signed(bits_b_2);
+  b_l2 <= resize(s_bits_b_2, 18);
+  piece00 <= u_piece00_p;
+  piece01 <= u_piece01_p;
+  piece10 <= u_piece10_p;
+  piece02 <= u_piece02_p;
+  piece11 <= u_piece11_p;
+  piece12 <= u_piece12_p;
+  shr_piece00 <= shift_right(piece00, 17);
+  rs_shr_piece00 <= resize(shr_piece00, 37);
+  rs_piece01 <= resize(piece01, 37);
+  plus_0 <= rs_shr_piece00 + rs_piece01;
+  bits_piece00 <= unsigned(piece00(16 downto 0));
+  cat_1 <= unsigned(std_logic_vector'(std_logic_vector(plus_0) & std_logic_vector(bits_piece00)));
+  sum0_0 <= signed(cat_1);
+  shr_piece10 <= shift_right(piece10, 17);
+  rs_shr_piece10 <= resize(shr_piece10, 37);
+  rs_piece02 <= resize(piece02, 37);
+  plus_2 <= rs_shr_piece10 + rs_piece02;
+  bits_piece10 <= unsigned(piece10(16 downto 0));
+  cat_3 <= unsigned(std_logic_vector'(std_logic_vector(plus_2) & std_logic_vector(bits_piece10)));
+  sum0_1 <= signed(cat_3);
+  shr_piece11 <= shift_right(piece11, 17);
+  bits_shr_piece11 <= unsigned(shr_piece11(27 downto 0));
+  s_bits_shr_piece11 <= signed(bits_shr_piece11);
+  bits_piece12 <= unsigned(piece12(27 downto 0));
+  s_bits_piece12 <= signed(bits_piece12);
+  plus_4 <= s_bits_shr_piece11 + s_bits_piece12;
+  bits_piece11 <= unsigned(piece11(16 downto 0));
+  cat_5 <= unsigned(std_logic_vector'(std_logic_vector(plus_4) & std_logic_vector(bits_piece11)));
+  sum0_2 <= signed(cat_5);
+  shr_sum1_0_r <= shift_right(sum1_0_r, 17);
+  rs_shr_sum1_0_r <= resize(shr_sum1_0_r, 55);
+  rs_sum1_1_r <= resize(sum1_1_r, 55);
+  plus_6 <= rs_shr_sum1_0_r + rs_sum1_1_r;
+  bits_sum1_0_r <= unsigned(sum1_0_r(16 downto 0));
+  cat_7 <= unsigned(std_logic_vector'(std_logic_vector(plus_6) & std_logic_vector(bits_sum1_0_r)));
+  sum1_0 <= signed(cat_7);
+  shr_sum2_0_r <= shift_right(sum2_0_r, 34);
+  bits_shr_sum2_0_r <= unsigned(shr_sum2_0_r(44 downto 0));
+  s_bits_shr_sum2_0_r <= signed(bits_shr_sum2_0_r);
+  plus_8 <= s_bits_shr_sum2_0_r + sum2_1_r;
+  bits_sum2_0_r <= unsigned(sum2_0_r(33 downto 0));
+  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(plus_8) & std_logic_vector(bits_sum2_0_r)));
+  sum2_0 <= signed(cat_9);
+  bits_sum3_0_r <= unsigned(sum3_0_r(77 downto 0));
+  s_bits_sum3_0_r <= signed(bits_sum3_0_r);
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      m0_sum1_0_r <= m0_sum0_0;
-      m0_sum1_1_r <= m0_sum0_1;
-      m0_sum1_2_r <= m0_sum0_2;
-      m0_sum2_0_r <= m0_sum1_0;
-      m0_sum2_1_r <= m0_sum1_2_r;
-      m0_sum3_0_r <= m0_sum2_0;
+      sum1_0_r <= sum0_0;
+      sum1_1_r <= sum0_1;
+      sum1_2_r <= sum0_2;
+      sum2_0_r <= sum1_0;
+      sum2_1_r <= sum1_2_r;
+      sum3_0_r <= sum2_0;
     end if;
   end process regs;
 
-  u_m0_piece00 : fxrt_dsp18_r3
+  u_piece00 : fxrt_dsp18_r3
     port map (
       clk => clk,
-      a => a0_l0,
-      b => b0_l0,
-      p => u_m0_piece00_p
+      a => a_l0,
+      b => b_l0,
+      p => u_piece00_p
     );
 
-  u_m0_piece01 : fxrt_dsp18_r3
+  u_piece01 : fxrt_dsp18_r3
     port map (
       clk => clk,
-      a => a0_l0,
-      b => b0_l1,
-      p => u_m0_piece01_p
+      a => a_l0,
+      b => b_l1,
+      p => u_piece01_p
     );
 
-  u_m0_piece10 : fxrt_dsp18_r3
+  u_piece10 : fxrt_dsp18_r3
     port map (
       clk => clk,
-      a => a0_l1,
-      b => b0_l0,
-      p => u_m0_piece10_p
+      a => a_l1,
+      b => b_l0,
+      p => u_piece10_p
     );
 
-  u_m0_piece02 : fxrt_dsp18_r3
+  u_piece02 : fxrt_dsp18_r3
     port map (
       clk => clk,
-      a => a0_l0,
-      b => b0_l2,
-      p => u_m0_piece02_p
+      a => a_l0,
+      b => b_l2,
+      p => u_piece02_p
     );
 
-  u_m0_piece11 : fxrt_dsp18_r3
+  u_piece11 : fxrt_dsp18_r3
     port map (
       clk => clk,
-      a => a0_l1,
-      b => b0_l1,
-      p => u_m0_piece11_p
+      a => a_l1,
+      b => b_l1,
+      p => u_piece11_p
     );
 
-  u_m0_piece12 : fxrt_dsp18_r3
+  u_piece12 : fxrt_dsp18_r3
     port map (
       clk => clk,
-      a => a0_l1,
-      b => b0_l2,
-      p => u_m0_piece12_p
+      a => a_l1,
+      b => b_l2,
+      p => u_piece12_p
     );
 
-  p0 <= s_bits_m0_sum3_0_r;
+  p <= s_bits_sum3_0_r;
 end architecture rtl;

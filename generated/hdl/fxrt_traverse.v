@@ -101,7 +101,7 @@ module fxrt_traverse (
   reg signed [47:0] pu_inv = 48'sh000000000000;
   reg [0:0] pu_delta_valid = 1'h0;
   reg [0:0] pu_delta_last = 1'h0;
-  wire signed [77:0] u_plane_product_p0;
+  wire signed [77:0] u_plane_product_p;
   wire signed [77:0] pu_product;
   (* mem2reg *) reg [0:0] pu_product_valid_sr [1:6];
   integer pu_product_valid_i;
@@ -411,7 +411,7 @@ module fxrt_traverse (
       default: pu_inv_axis = invx_r;
     endcase
   end
-  assign pu_product = u_plane_product_p0;
+  assign pu_product = u_plane_product_p;
   assign pu_product_valid = pu_product_valid_sr[6];
   assign pu_product_last = pu_product_last_sr[6];
   assign pu_shifted = pu_product >>> 16;
@@ -746,9 +746,9 @@ module fxrt_traverse (
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
     .clk(clk),
-    .a0(pu_delta),
-    .b0(pu_inv),
-    .p0(u_plane_product_p0)
+    .a(pu_delta),
+    .b(pu_inv),
+    .p(u_plane_product_p)
   );
 
   assign ray_ready = in_idle;

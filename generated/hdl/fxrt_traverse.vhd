@@ -35,9 +35,9 @@ architecture rtl of fxrt_traverse is
   component fxrt_mul_s30xs48_d3l1 is
     port (
       clk : in std_logic;
-      a0 : in signed(29 downto 0);
-      b0 : in signed(47 downto 0);
-      p0 : out signed(77 downto 0)
+      a : in signed(29 downto 0);
+      b : in signed(47 downto 0);
+      p : out signed(77 downto 0)
     );
   end component;
 
@@ -10848,7 +10848,7 @@ architecture rtl of fxrt_traverse is
   signal pu_inv : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal pu_delta_valid : unsigned(0 downto 0) := unsigned'("0");
   signal pu_delta_last : unsigned(0 downto 0) := unsigned'("0");
-  signal u_plane_product_p0 : signed(77 downto 0);
+  signal u_plane_product_p : signed(77 downto 0);
   signal pu_product : signed(77 downto 0);
   type pu_product_valid_sr_t is array (1 to 6) of unsigned(0 downto 0);
   signal pu_product_valid_sr : pu_product_valid_sr_t := (others => (others => '0'));
@@ -11137,7 +11137,7 @@ begin
       invy_r when "01",
       invz_r when "10",
       invx_r when others;
-  pu_product <= u_plane_product_p0;
+  pu_product <= u_plane_product_p;
   pu_product_valid <= pu_product_valid_sr(6);
   pu_product_last <= pu_product_last_sr(6);
   pu_shifted <= shift_right(pu_product, 16);
@@ -11462,9 +11462,9 @@ begin
   u_plane_product : fxrt_mul_s30xs48_d3l1
     port map (
       clk => clk,
-      a0 => pu_delta,
-      b0 => pu_inv,
-      p0 => u_plane_product_p0
+      a => pu_delta,
+      b => pu_inv,
+      p => u_plane_product_p
     );
 
   ray_ready <= in_idle;

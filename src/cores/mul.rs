@@ -77,23 +77,46 @@ pub fn dsp18_core(regs: u32) -> Module {
     b.finish()
 }
 
-/// Multipliers side by side as one module: ports a0, b0, a1, b1, … → p0, p1, … (each the
-/// full product, `xmul`'s type), all `group_latency` cycles later (a product with fewer
-/// stages is delayed to match, so a pipeline stage can take them together). Named by operand
-/// types and style, so equal groups share one module.
-pub fn mul_core(ops: &[(Ty, Ty)], style: MulStyle) -> Module {
+/// One product as a module: ports a, b → p (the full product, `xmul`'s type), `latency`
+/// cycles later. Named by operand types and style, so equal products share one module.
+pub fn product_core(a: Ty, bt: Ty, style: MulStyle) -> Module {
+    assert_eq!(a.signed, bt.signed, "a product's operands have one signedness");
+    // Partial sums need one bit more than the product.
+    assert!(a.width + bt.width < crate::rtl::width::MAX_WIDTH, "a split product needs < 128 bits");
+    let b = Builder::new(&format!("fxrt_mul_{}_d{}l{}", kind(a, bt), style.dsp_regs, style.levels_per_stage));
+    let (x, y) = (b.input("a", a), b.input("b", bt));
+    let p = if style.split() { split_product(&b, x, y, style) } else { x.xmul(y) };
+    b.output("p", p);
+    b.finish()
+}
+
+/// `s30xs48`: the operand types of a product, for module names.
+fn kind(a: Ty, b: Ty) -> String {
     let sgn = |t: Ty| if t.signed { "s" } else { "u" };
-    let kinds: Vec<String> = ops.iter().map(|(a, b)| format!("{}{}x{}{}", sgn(*a), a.width, sgn(*b), b.width)).collect();
-    let b = Builder::new(&format!("fxrt_mul_{}_d{}l{}", kinds.join("_"), style.dsp_regs, style.levels_per_stage));
+    format!("{}{}x{}{}", sgn(a), a.width, sgn(b), b.width)
+}
+
+/// Multipliers side by side as one module: ports a0, b0, a1, b1, … → p0, p1, …, all
+/// `group_latency` cycles later — a `product_core` instance each (one module per distinct
+/// product), a product with fewer stages delayed to match, so a pipeline stage can take them
+/// together.
+pub fn mul_core(ops: &[(Ty, Ty)], style: MulStyle) -> Module {
+    let kinds: Vec<String> = ops.iter().map(|&(a, b)| kind(a, b)).collect();
+    let b = Builder::new(&format!("fxrt_muls_{}_d{}l{}", kinds.join("_"), style.dsp_regs, style.levels_per_stage));
     let lat = group_latency(ops, style);
-    let ins: Vec<(S, S)> =
-        ops.iter().enumerate().map(|(k, (ta, tb))| (b.input(&format!("a{k}"), *ta), b.input(&format!("b{k}"), *tb))).collect();
-    for (k, &(x, y)) in ins.iter().enumerate() {
-        assert_eq!(x.ty().signed, y.ty().signed, "a product's operands have one signedness");
-        // Partial sums need one bit more than the product.
-        assert!(x.width() + y.width() < crate::rtl::width::MAX_WIDTH, "a split product needs < 128 bits");
-        let p = if style.split() { split_product(&b, x, y, style, &format!("m{k}_")) } else { x.xmul(y) };
-        let own = latency(x.ty(), y.ty(), style);
+    let mut cores: Vec<((Ty, Ty), Rc<Module>)> = Vec::new();
+    for (k, &(ta, tb)) in ops.iter().enumerate() {
+        let (x, y) = (b.input(&format!("a{k}"), ta), b.input(&format!("b{k}"), tb));
+        let core = match cores.iter().find(|c| c.0 == (ta, tb)) {
+            Some(c) => c.1.clone(),
+            None => {
+                let c = Rc::new(product_core(ta, tb, style));
+                cores.push(((ta, tb), c.clone()));
+                c
+            }
+        };
+        let p = b.instance(&format!("u_m{k}"), &core, &[x, y]).get("p");
+        let own = latency(ta, tb, style);
         let p = if lat > own { b.delay_line(&format!("p{k}_pad"), p, lat - own) } else { p };
         b.output(&format!("p{k}"), p);
     }
@@ -146,7 +169,7 @@ fn add_terms<'b>(lo: Term<'b>, hi: Term<'b>, total: u32, name: &str) -> Term<'b>
     Term { s: s.name(name), off: lo.off }
 }
 
-fn split_product<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, style: MulStyle, pre: &str) -> S<'b> {
+fn split_product<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, style: MulStyle) -> S<'b> {
     let width = x.width() + y.width();
     let dsp = Rc::new(dsp18_core(style.dsp_regs));
     let (xl, yl) = (limbs_of(x), limbs_of(y));
@@ -157,8 +180,8 @@ fn split_product<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, style: MulStyle, pre: &
     let mut terms: Vec<Term> = pieces
         .iter()
         .map(|&(k, i, j)| {
-            let p = b.instance(&format!("u_{pre}piece{i}{j}"), &dsp, &[xl[i], yl[j]]).get("p");
-            Term { s: p.name(&format!("{pre}piece{i}{j}")), off: k * LIMB }
+            let p = b.instance(&format!("u_piece{i}{j}"), &dsp, &[xl[i], yl[j]]).get("p");
+            Term { s: p.name(&format!("piece{i}{j}")), off: k * LIMB }
         })
         .collect();
     let mut level = 0;
@@ -166,7 +189,7 @@ fn split_product<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, style: MulStyle, pre: &
         let next: Vec<Term> = terms
             .chunks(2)
             .enumerate()
-            .map(|(i, c)| if c.len() == 2 { add_terms(c[0], c[1], width + 1, &format!("{pre}sum{level}_{i}")) } else { c[0] })
+            .map(|(i, c)| if c.len() == 2 { add_terms(c[0], c[1], width + 1, &format!("sum{level}_{i}")) } else { c[0] })
             .collect();
         level += 1;
         let last = next.len() == 1;
@@ -174,7 +197,7 @@ fn split_product<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, style: MulStyle, pre: &
         terms = if register {
             next.iter()
                 .enumerate()
-                .map(|(i, t)| Term { s: b.delay(&format!("{pre}sum{level}_{i}_r"), t.s), off: t.off })
+                .map(|(i, t)| Term { s: b.delay(&format!("sum{level}_{i}_r"), t.s), off: t.off })
                 .collect()
         } else {
             next

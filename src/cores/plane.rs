@@ -17,7 +17,7 @@
 //! machine waits for results by their valid bit and never counts the latency itself: a
 //! deeper multiplier changes `latency`, not the machine.
 
-use super::mul::{MulStyle, group_latency, mul_core};
+use super::mul::{MulStyle, latency, product_core};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 use std::rc::Rc;
@@ -30,9 +30,8 @@ pub fn plane_product<'b>(b: &'b Builder, delta: S<'b>, inv: S<'b>, style: MulSty
     if style == MulStyle::COMBINATIONAL {
         return (b.delay("pu_product", delta.xmul(inv).name("pu_mul")), 1);
     }
-    let ops = [(delta.ty(), inv.ty())];
-    let m = Rc::new(mul_core(&ops, style));
-    (b.instance("u_plane_product", &m, &[delta, inv]).get("p0").name("pu_product"), group_latency(&ops, style))
+    let m = Rc::new(product_core(delta.ty(), inv.ty(), style));
+    (b.instance("u_plane_product", &m, &[delta, inv]).get("p").name("pu_product"), latency(delta.ty(), inv.ty(), style))
 }
 
 /// What a state issues to the unit in a cycle: combinational signals, registered by stage 1.
