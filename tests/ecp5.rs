@@ -2,7 +2,7 @@
 //! .venv): a divider, whose Fmax must clear a floor. The full runs are `fxrt synth --family
 //! ecp5`, a bench command (minutes per module). Skipped, saying so, when the tools are missing.
 
-use fxrt::cores::divider::{divider_core, latency};
+use fxrt::cores::divider::{DividerShape, divider_core};
 use fxrt::flow::ecp5::{Tools, place_and_route};
 use std::io::Write;
 
@@ -13,10 +13,11 @@ fn a_small_divider_places_and_routes_above_the_floor() {
         return;
     };
     // n = 8: nine quotient stages on an 18-bit dividend and a 10-bit divisor, about a minute.
-    let m = divider_core(8, 1, 18, 10);
+    let m = divider_core(8, DividerShape::plain(1), 18, 10);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("ecp5_divider");
     let _ = std::fs::remove_dir_all(&dir);
-    let t = place_and_route(&tools, &m, Some(latency(8, 1)), 100.0, 1, &dir).unwrap_or_else(|e| panic!("{e}"));
+    let t = place_and_route(&tools, &m, Some(DividerShape::plain(1).latency(8)), 100.0, 1, &dir)
+        .unwrap_or_else(|e| panic!("{e}"));
     eprintln!("{}: {:.1} MHz, {} LUT4, {} FF, path {:?}", t.module, t.fmax_mhz, t.lut4, t.ff, t.critical_path.nets);
     // A stage is a 10-bit compare and subtract: about 160 MHz at speed grade 6 (measured
     // 2026-11-23: see docs/TIMING.md); the floor leaves room for placement seeds.

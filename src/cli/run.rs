@@ -307,7 +307,7 @@ fn synth_ecp5(
     modules: &[String],
     scene: &str,
 ) -> Result<()> {
-    use crate::cores::{closest, divider, intersect, top, traverse};
+    use crate::cores::{closest, intersect, top, traverse};
     let tools = crate::flow::ecp5::Tools::find().ok_or_else(|| {
         Error::new(
             "ecp5",
@@ -317,7 +317,7 @@ fn synth_ecp5(
     let mut timings = Vec::new();
     for name in modules {
         let (m, latency) = match name.as_str() {
-            "divider" => (p.divider(), Some(divider::latency(p.n, p.div_bits))),
+            "divider" => (p.divider(), Some(p.div_latency())),
             "intersect" => (intersect::intersect_core(p), Some(p.latency())),
             "traverse" => (traverse::traverse_core(&core.trav, roms), None),
             "closest" => (

@@ -63,7 +63,7 @@ pub fn core_cost(roms: &SceneRoms) -> crate::error::Result<CoreCost> {
     let core = core_module(&p, roms);
     let rom_bits = roms.rom_bits();
     Ok(CoreCost {
-        div_latency: crate::cores::divider::latency(p.isect.n, 1),
+        div_latency: p.isect.div_latency(),
         isect_latency: p.isect.latency(),
         rom_bits,
         dsp48e_est: dsp48e_estimate(&core),

@@ -9,15 +9,65 @@
 //! can. Latency n + 2 (the thesis's divider: n + 3): one stage for the magnitudes and signs,
 //! then n + 1 quotient stages; the first also makes the overflow test, the last also forms
 //! the result flag. With two quotient bits per stage: 1 + ⌈(n + 1)/2⌉.
+//!
+//! **Lookahead** (`StageForm::Lookahead`, targets from `LOOKAHEAD_FROM_MHZ`): a stage is then
+//! one carry chain and one LUT. A plain stage ends with its sign selecting the next
+//! remainder — the sign leaves the carry chain and is routed to every bit's mux, about a
+//! third of the clock at 170 MHz. The lookahead stage keeps both candidates of the remainder
+//! (`diff` if the last subtraction was taken, `p` if not) and the last sign in registers,
+//! subtracts b from both in two chains side by side, and selects afterwards with the
+//! *registered* sign, whose fan-out is routed while the chains settle. Twice the
+//! subtractors, the same number of quotient stages. The magnitudes are then negated over two
+//! stages (`sub_low`, `sub_high`) and the result flag gets a stage of its own: two more cycles.
 
-use crate::rtl::build::Builder;
+use crate::rtl::build::{Builder, S};
 use crate::rtl::pipeline::{Pipeline, Policy};
 use crate::rtl::{Module, Ty};
 
-/// Latency in clock cycles of `divider_stages` for grid bits `n` and `bits_per_stage`
-/// quotient bits computed between two registers.
-pub fn latency(n: u32, bits_per_stage: u32) -> u32 {
-    1 + (n + 1).div_ceil(bits_per_stage)
+/// The lowest clock target (MHz) that gets the lookahead stage: a plain stage measured
+/// 172 MHz on the ECP5 (docs/TIMING.md).
+pub const LOOKAHEAD_FROM_MHZ: u32 = 176;
+
+/// How a quotient bit is built (module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StageForm {
+    /// One subtraction, its sign selects the next remainder.
+    Plain,
+    /// Both candidate remainders subtracted, the registered sign selects.
+    Lookahead,
+}
+
+/// The divider's shape: quotient bits per pipeline stage and how a bit is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DividerShape {
+    /// 1, or 2 for half the latency (two subtractions in series).
+    pub bits_per_stage: u32,
+    pub form: StageForm,
+}
+
+impl DividerShape {
+    /// The shape a clock target gets.
+    pub fn for_target(bits_per_stage: u32, target: crate::cores::clock::ClockTarget) -> DividerShape {
+        let form = if target.splits(LOOKAHEAD_FROM_MHZ) { StageForm::Lookahead } else { StageForm::Plain };
+        DividerShape { bits_per_stage, form }
+    }
+
+    pub fn plain(bits_per_stage: u32) -> DividerShape {
+        DividerShape { bits_per_stage, form: StageForm::Plain }
+    }
+
+    /// Latency in clock cycles for grid bits `n`: the operand stage, the quotient stages
+    /// and, with lookahead, the negations' high halves and the result flag.
+    pub fn latency(self, n: u32) -> u32 {
+        let extra = if self.form == StageForm::Plain { 0 } else { 2 };
+        1 + extra + (n + 1).div_ceil(self.bits_per_stage)
+    }
+
+    fn suffix(self) -> String {
+        let r4 = if self.bits_per_stage == 2 { "_r4" } else { "" };
+        let form = if self.form == StageForm::Lookahead { "_la" } else { "" };
+        format!("{r4}{form}")
+    }
 }
 
 crate::bundle! {
@@ -25,71 +75,158 @@ crate::bundle! {
     struct Operands { a, b, err }
 }
 crate::bundle! {
+    /// Lookahead: the operands with the low halves of their negations made.
+    struct HalfNegated { num, den, a_lo, a_borrow, b_lo, b_borrow, err }
+}
+crate::bundle! {
     /// The partial remainder and the quotient bits so far.
     struct Partial { p, q }
+}
+crate::bundle! {
+    /// The remainder is `diff` if `ge` (the last subtraction was taken), else `p` (in the
+    /// plain form always `p`).
+    struct Candidates { ge, diff, p, q }
 }
 crate::bundle! {
     /// The result ports.
     struct Quotient { t, ok }
 }
 
+/// x − y on unsigned operands of one width, the low `h` bits only: (those bits of the
+/// difference, the borrow out of them). `sub_high` finishes it after a register.
+fn sub_low<'b>(x: S<'b>, y: S<'b>, h: u32) -> (S<'b>, S<'b>) {
+    let d = x.slice(0, h).xsigned() - y.slice(0, h).xsigned();
+    (d.slice(0, h), d.msb())
+}
+
+/// The high part of x − y given the low part's borrow: the signed difference
+/// x[h..] − y[h..] − borrow, times two (its bits from 1 up, its sign the msb). The borrow
+/// enters as an extra low bit, (2·xh) − (2·yh + borrow), so this is one carry chain.
+fn sub_high<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, h: u32, borrow: S<'b>) -> S<'b> {
+    let k = x.width() - h;
+    let xh = b.cat(&[x.slice(h, k), b.konst(Ty::BIT, 0)]);
+    let yh = b.cat(&[y.slice(h, k), borrow]);
+    xh.xsigned() - yh.xsigned()
+}
+
+/// |x| of an s(w) value as u(w), its negation's low half `lo` (with `borrow`) made a stage
+/// earlier (`sub_low`).
+fn magnitude_high<'b>(b: &'b Builder, x: S<'b>, lo: S<'b>, borrow: S<'b>) -> S<'b> {
+    let w = x.width();
+    let h = lo.width();
+    let neg_hi = sub_high(b, b.konst(Ty::u(w), 0), x.unsigned(), h, borrow).slice(1, w - h);
+    x.msb().select(b.cat(&[neg_hi, lo]), x.unsigned())
+}
+
 /// The divider as a standalone core: ports num, den (signed) → t (n + 1 bits), ok.
-/// `bits_per_stage` quotient bits (1 or 2) are computed between two pipeline registers: 2
-/// halves the registers and the latency at the price of two subtractors in series — the same
-/// description, with every other quotient stage merged by the pipeline policy.
-pub fn divider_core(n: u32, bits_per_stage: u32, num_width: u32, den_width: u32) -> Module {
-    assert!((1..=2).contains(&bits_per_stage));
-    let suffix = if bits_per_stage == 2 { "_r4" } else { "" };
-    let b = Builder::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}{suffix}"));
-    let (wn, wd) = (num_width, den_width);
+/// With two quotient bits per stage every other quotient stage is merged by the pipeline
+/// policy (the same description).
+pub fn divider_core(n: u32, shape: DividerShape, num_width: u32, den_width: u32) -> Module {
+    assert!((1..=2).contains(&shape.bits_per_stage));
+    let b = Builder::new(&format!("fxrt_div_n{n}_a{num_width}_b{den_width}{}", shape.suffix()));
+    divider_body(&b, n, shape, num_width, den_width);
+    b.finish()
+}
+
+fn divider_body<'b>(b: &'b Builder, n: u32, shape: DividerShape, wn: u32, wd: u32) {
+    let form = shape.form;
     let num = b.input("num", Ty::s(wn));
     let den = b.input("den", Ty::s(wd));
     let qbits = n + 1;
-    let merge = (0..qbits - 1).filter(|k| (k + 1) % bits_per_stage != 0).map(|k| format!("q{k}")).collect();
-    let pipe = Pipeline::new(&b, Policy { merge });
+    let merge = (0..qbits - 1).filter(|k| (k + 1) % shape.bits_per_stage != 0).map(|k| format!("q{k}")).collect();
+    let pipe = Pipeline::new(b, Policy { merge });
     // Signs, zero tests, magnitudes (|x| of an s(w) value fits u(w)).
     let (n_neg, d_neg) = (num.lt(0).name("num_neg"), den.lt(0).name("den_neg"));
-    let ops = pipe.stage(
-        "operands",
-        "signs, zero tests, magnitudes",
-        Operands {
-            a: n_neg.select(-num, num).unsigned(),
-            b: d_neg.select(-den, den).unsigned(),
-            err: num.eq(0) | den.eq(0) | (n_neg ^ d_neg),
-        },
-    );
+    let err = num.eq(0) | den.eq(0) | (n_neg ^ d_neg);
+    let ops = if form == StageForm::Plain {
+        let a = n_neg.select(-num, num).unsigned();
+        pipe.stage(
+            "operands",
+            "signs, zero tests, magnitudes",
+            Operands { a, b: d_neg.select(-den, den).unsigned(), err },
+        )
+    } else {
+        let zero = |w| b.konst(Ty::u(w), 0);
+        let (a_lo, a_borrow) = sub_low(zero(wn), num.unsigned(), wn / 2);
+        let (b_lo, b_borrow) = sub_low(zero(wd), den.unsigned(), wd / 2);
+        let h = pipe.stage(
+            "operands_lo",
+            "signs, zero tests, the low halves of the negations",
+            HalfNegated { num, den, a_lo, a_borrow, b_lo, b_borrow, err },
+        );
+        let (a, b_mag) = (magnitude_high(b, h.num, h.a_lo, h.a_borrow), magnitude_high(b, h.den, h.b_lo, h.b_borrow));
+        pipe.stage("operands", "magnitudes", Operands { a, b: b_mag, err: h.err })
+    };
     // The overflow test: hi = a >> (n+1) must be below b. Without overflow the partial
-    // remainder stays below b, so wd bits hold it.
+    // remainder stays below b, so wd bits hold it. b ≤ hi is the sign of hi − b (one carry
+    // chain and its top bit; yosys maps `<=` to a chain and a 6-input function), kept apart
+    // from the sign errors until the result.
     let hi = if wn > qbits { ops.a.slice(qbits, wn - qbits) } else { b.konst(Ty::u(1), 0) };
     let lo = ops.a.resize(qbits.min(wn)).resize(qbits).name("lo");
     let cw = hi.width().max(wd);
-    let err = (ops.err | ops.b.resize(cw).le(hi.resize(cw))).name("err");
-    let mut part = Partial { p: hi.resize(wd), q: b.konst(Ty::u(qbits), 0) };
+    let overflow = (!(hi.resize(cw).xsigned() - ops.b.resize(cw).xsigned()).msb()).name("overflow");
+    let err = |pipe: &Pipeline<'b>| pipe.now(ops.err) | pipe.now(overflow);
+    let mut part = Candidates {
+        ge: b.konst(Ty::BIT, 0),
+        diff: b.konst(Ty::u(wd), 0),
+        p: hi.resize(wd),
+        q: b.konst(Ty::u(qbits), 0),
+    };
     let mut result = None;
     // Quotient bits n … 0; step k shifts in bit n − k of lo and subtracts b if it can.
     for k in 0..qbits {
         let bw = pipe.now(ops.b).resize(wd + 1);
-        let p3 = (part.p.resize(wd + 1) << 1) | pipe.now(lo).bit(qbits - 1 - k).resize(wd + 1);
-        // One subtraction: its sign is the comparison, so a stage is one carry chain and a
-        // select rather than a comparator and a subtractor side by side.
-        let diff = (p3.xsigned() - bw.xsigned()).name(&format!("diff{k}"));
-        let ge = (!diff.msb()).name(&format!("ge{k}"));
-        // Named, so timing reports name the stage (`rem7`, `quot7`).
-        let p_next = ge.select(diff.slice(0, wd), p3.resize(wd)).name(&format!("rem{k}"));
+        let bit = pipe.now(lo).bit(qbits - 1 - k).resize(wd + 1);
+        let shifted = |r: S<'b>| -> S<'b> { (r.resize(wd + 1) << 1) | bit };
+        // One subtraction per candidate: its sign is the comparison, so a stage is one carry
+        // chain and a select rather than a comparator and a subtractor side by side.
+        let subtract = |p3: S<'b>, tag: &str| -> (S<'b>, S<'b>) {
+            let d = (p3.xsigned() - bw.xsigned()).name(&format!("diff{tag}{k}"));
+            (d.slice(0, wd), (!d.msb()).name(&format!("ge{tag}{k}")))
+        };
+        let p3_k = shifted(part.p);
+        let (d_k, ge_k) = subtract(p3_k, "k");
+        // Lookahead from the second bit on: both candidates (taken, kept) are subtracted and
+        // the registered sign selects.
+        let (p3, diff, ge) = if form == StageForm::Lookahead && k > 0 {
+            let p3_t = shifted(part.diff);
+            let (d_t, ge_t) = subtract(p3_t, "t");
+            let sel = |t: S<'b>, f: S<'b>| -> S<'b> { part.ge.select(t, f) };
+            (sel(p3_t, p3_k), sel(d_t, d_k), sel(ge_t, ge_k))
+        } else {
+            (p3_k, d_k, ge_k)
+        };
+        // q = 0 afterwards iff it was 0 before and this bit is 0: the zero test of the last
+        // plain stage then runs beside its chain instead of after it.
+        let q_was_zero = part.q.eq(0);
         let q_next = ((part.q << 1) | ge.resize(qbits)).name(&format!("quot{k}"));
-        if k + 1 < qbits {
-            part = pipe.stage(&format!("q{k}"), "one quotient bit", Partial { p: p_next, q: q_next });
-            continue;
+        if k + 1 == qbits && form == StageForm::Plain {
+            let ok = !(err(&pipe) | (q_was_zero & !ge));
+            result = Some(pipe.stage("result", "the quotient and its result flag", Quotient { t: q_next, ok }));
+            break;
         }
-        let ok = !(pipe.now(err) | q_next.eq(0));
-        result = Some(pipe.stage("result", "the quotient and its result flag", Quotient { t: q_next, ok }));
+        // Named, so timing reports name the stage (`rem7`, `quot7`).
+        part = if form == StageForm::Plain {
+            let p = ge.select(diff, p3.resize(wd)).name(&format!("rem{k}"));
+            let next = pipe.stage(&format!("q{k}"), "one quotient bit", Partial { p, q: q_next });
+            Candidates { p: next.p, q: next.q, ..part }
+        } else {
+            let (diff, p) = (diff.name(&format!("rem{k}")), p3.resize(wd).name(&format!("kept{k}")));
+            pipe.stage(&format!("q{k}"), "one quotient bit", Candidates { ge, diff, p, q: q_next })
+        };
+        if k + 1 == qbits {
+            // The last quotient bit is registered beside its chain and the flag made in a
+            // clock of its own: the flag's register sits by the outputs, far from the chain
+            // (a 2.4 ns route measured at 250 MHz).
+            let ok = !(err(&pipe) | part.q.eq(0));
+            result = Some(pipe.stage("result", "the result flag", Quotient { t: part.q, ok }));
+        }
     }
     let out = result.expect("n + 1 ≥ 1 quotient bits");
     let lat = pipe.finish();
-    assert_eq!(lat, latency(n, bits_per_stage), "latency formula and stages disagree");
+    assert_eq!(lat, shape.latency(n), "latency formula and stages disagree");
     b.output("t", out.t);
     b.output("ok", out.ok);
-    b.finish()
 }
 
 #[cfg(test)]
@@ -111,16 +248,18 @@ mod tests {
     }
 
     fn check(n: u32, wn: u32, wd: u32, cases: &[(i128, i128)]) {
-        check_bps(n, 1, wn, wd, cases);
-        check_bps(n, 2, wn, wd, cases);
+        use StageForm::*;
+        for (bits_per_stage, form) in [(1, Plain), (2, Plain), (1, Lookahead), (2, Lookahead)] {
+            check_shape(n, DividerShape { bits_per_stage, form }, wn, wd, cases);
+        }
     }
 
-    fn check_bps(n: u32, bps: u32, wn: u32, wd: u32, cases: &[(i128, i128)]) {
-        let m = divider_core(n, bps, wn, wd);
+    fn check_shape(n: u32, shape: DividerShape, wn: u32, wd: u32, cases: &[(i128, i128)]) {
+        let m = divider_core(n, shape, wn, wd);
         let mut sim = Sim::new(&m);
         let (num, den) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
         let (t, ok) = (m.handle(m.outputs[0].1), m.handle(m.outputs[1].1));
-        let lat = latency(n, bps) as usize;
+        let lat = shape.latency(n) as usize;
         let mut got = Vec::new();
         for i in 0..cases.len() + lat {
             let (a, b) = cases.get(i).copied().unwrap_or((0, 0));
@@ -132,7 +271,7 @@ mod tests {
             }
         }
         for (i, &(a, b)) in cases.iter().enumerate() {
-            assert_eq!(got[i], divide(n, a, b), "n={n} bits/stage {bps}: {a}/{b}");
+            assert_eq!(got[i], divide(n, a, b), "n={n} {shape:?}: {a}/{b}");
         }
     }
 

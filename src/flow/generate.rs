@@ -1,6 +1,5 @@
 //! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files.
 
-use crate::cores::divider;
 use crate::cores::intersect::{IntersectParams, intersect_core};
 use crate::cores::top::{CoreParams, core_module, core_with_raygen};
 use crate::model::raygen::RayGen;
@@ -41,7 +40,7 @@ pub fn cores(p: &IntersectParams) -> Vec<(Module, Option<u32>, Value)> {
         (ip, Some(p.latency()), serde_json::to_value(p).unwrap_or(Value::Null)),
         (
             div,
-            Some(divider::latency(p.n, p.div_bits)),
+            Some(p.div_latency()),
             json!({ "n": p.n, "bits_per_stage": p.div_bits, "num_width": p.num_width() - p.t, "den_width": p.den_width() - p.t }),
         ),
     ]
