@@ -4,7 +4,7 @@
 //! When there is no hit, t, u and v read 0.
 
 use super::clock::ClockTarget;
-use super::divider::{self, divider_core};
+use super::divider::{DividerShape, divider_core};
 use super::mul::pipe_muls;
 use crate::rtl::build::{Builder, S};
 use crate::rtl::pipeline::{Pipeline, Policy};
@@ -76,7 +76,17 @@ impl IntersectParams {
 
     /// The divider this pipeline instantiates (operands shortened by T).
     pub fn divider(&self) -> Module {
-        divider_core(self.n, self.div_bits, self.num_width() - self.t, self.den_width() - self.t)
+        divider_core(self.n, self.div_shape(), self.num_width() - self.t, self.den_width() - self.t)
+    }
+
+    /// How the divider is built for the clock target (`divider` module documentation).
+    pub fn div_shape(&self) -> DividerShape {
+        DividerShape::for_target(self.div_bits, self.target())
+    }
+
+    /// The divider's latency.
+    pub fn div_latency(&self) -> u32 {
+        self.div_shape().latency(self.n)
     }
 
     pub fn target(&self) -> ClockTarget {
@@ -112,6 +122,17 @@ pub fn input_ports(p: &IntersectParams) -> Vec<(&'static str, Ty)> {
         ("e2p", Ty::s(m)),
         ("e2q", Ty::s(m)),
     ]
+}
+
+/// x > 2^k for a non-negative x (any type; the sign bit of a signed x must be 0) without a
+/// carry chain: x >> k ≥ 2, or x >> k = 1 with low bits left — LUT levels where the compare
+/// was a 65-bit chain (7.1 ns with its routing at 200 MHz).
+pub fn above_power_of_two(x: S<'_>, k: u32) -> S<'_> {
+    let w = x.width();
+    assert!(k + 1 < w, "2^{k} does not fit below the top bit of {w}");
+    let high = x.slice(k + 1, w - k - 1);
+    let low_left = if k == 0 { x.b.konst(Ty::BIT, 0) } else { x.slice(0, k).ne(0) };
+    high.ne(0) | (x.bit(k) & low_left)
 }
 
 /// (a + 1) mod 3 for a 2-bit axis number.
@@ -157,6 +178,10 @@ crate::bundle! {
     struct Test { sum, neg }
 }
 crate::bundle! {
+    /// u + v above the limit; u or v negative.
+    struct Limit { over, neg }
+}
+crate::bundle! {
     /// The divider's operands, T low bits dropped.
     struct Quotient { num, den }
 }
@@ -185,7 +210,7 @@ pub fn intersect_core(p: &IntersectParams) -> Module {
 /// (`ClockTarget::splits`); below it they are merged into the next stage.
 /// Measured: at 100 MHz with these merged the u/v, u + v, limit and hit logic made one
 /// 13.2 ns clock (75.6 MHz), so every two-chain stage splits from 76 MHz.
-const SPLIT_STAGES: [(&str, u32); 7] = [
+const SPLIT_STAGES: [(&str, u32); 8] = [
     ("permute", 151),
     ("numerator", 76),
     ("quotient_in", 76),
@@ -193,6 +218,8 @@ const SPLIT_STAGES: [(&str, u32); 7] = [
     ("uv", 76),
     ("test", 76),
     ("hit", 76),
+    // The limit's OR tree and the hit bit made 5 LUT levels, 6.3 ns (157.6 MHz at 200).
+    ("limit", 176),
 ];
 
 /// The stages `p`'s clock target leaves unregistered.
@@ -285,7 +312,7 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
         "numerator and rounded denominator, T bits dropped",
         Quotient { num: (rounded.num >> p.t).resize(wn - p.t), den: (den >> p.t).resize(wd - p.t) },
     );
-    let div = pipe.instance("u_div", &Rc::new(p.divider()), &[q.num, q.den], divider::latency(n, p.div_bits));
+    let div = pipe.instance("u_div", &Rc::new(p.divider()), &[q.num, q.den], p.div_latency());
     let (t, ok) = (div.get("t"), div.get("ok"));
     // t·ω_p, t·ω_q (t as signed n+2 bits).
     let t_s = t.xsigned();
@@ -293,7 +320,11 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
         unreachable!("two products")
     };
     let mv = pipe.stage("moved", "t·ω_p, t·ω_q", Moved { tp, tq });
-    let rd = pipe.stage("rounded", "rnd(t·ω_p, F), rnd(t·ω_q, F)", Moved { tp: shr_round(mv.tp, f), tq: shr_round(mv.tq, f) });
+    let rd = pipe.stage(
+        "rounded",
+        "rnd(t·ω_p, F), rnd(t·ω_q, F)",
+        Moved { tp: shr_round(mv.tp, f), tq: shr_round(mv.tq, f) },
+    );
     // kp = (O_p − pp) + rnd(t·ω_p, F), kq likewise (n+3 bits).
     let kw = n + 3;
     let pt = pipe.stage(
@@ -318,7 +349,10 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
     let uv = pipe.stage(
         "uv",
         "the barycentric coordinates u, v",
-        Uv { u: (bary.a1.resize(uw) - bary.a2.resize(uw)).name("u"), v: (bary.b1.resize(uw) - bary.b2.resize(uw)).name("v") },
+        Uv {
+            u: (bary.a1.resize(uw) - bary.a2.resize(uw)).name("u"),
+            v: (bary.b1.resize(uw) - bary.b2.resize(uw)).name("v"),
+        },
     );
     // u + v, one bit wider so it cannot wrap; its comparison with the limit in the next stage.
     let tested = pipe.stage(
@@ -329,8 +363,10 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
             neg: (uv.u.lt(0) | uv.v.lt(0)).name("negative"),
         },
     );
-    let over = tested.sum.k(1i128 << (p.e + f)).lt(tested.sum).name("over");
-    let inside = !(tested.neg | over);
+    // u + v > 2^(E+F), only read when u, v ≥ 0 (so the sum is non-negative).
+    let over = above_power_of_two(tested.sum, p.e + f).name("over");
+    let limit = pipe.stage("limit", "u + v above the limit", Limit { over, neg: tested.neg });
+    let inside = !(limit.neg | limit.over);
     // The hit bit registered before it selects ~100 output bits: the compare's carry chain
     // and that fan-out were one clock at 150 MHz (138.3 MHz measured).
     let hit = pipe.stage("hit", "the hit bit", HitBit { hit: (inside & pipe.now(ok)).name("hit_c") }).hit;
@@ -396,6 +432,29 @@ mod tests {
     use crate::rtl::sim::Sim;
     use crate::scene::Scene;
 
+    /// The hit test's limit without a carry chain equals `x > 2^k` at and around the power
+    /// of two (where random rays almost never land: u + v = 2^(E+F) is a hit on an edge).
+    #[test]
+    fn above_power_of_two_is_the_compare() {
+        for (w, k) in [(8, 0), (8, 3), (8, 6), (66, 49), (20, 18)] {
+            let b = Builder::new("limit");
+            let x = b.input("x", Ty::u(w));
+            b.output("over", above_power_of_two(x, k));
+            let m = b.finish();
+            let mut sim = Sim::new(&m);
+            let (xi, o) = (m.handle(m.inputs[0]), m.handle(m.outputs[0].1));
+            let p = 1i128 << k;
+            let top = 1i128 << (w - 1);
+            let mut values = vec![0, 1, p - 1, p, p + 1, 2 * p - 1, 2 * p, 2 * p + 1, p + (p >> 1), top - 1];
+            values.extend((0..200).map(|i: i128| (i * 0x9E37_79B9_7F4A_7C15) % top));
+            for v in values.into_iter().filter(|&v| (0..top).contains(&v)) {
+                sim.set(xi, v);
+                sim.eval();
+                assert_eq!(sim.get(o) == 1, v > p, "w {w}, k {k}, x {v}");
+            }
+        }
+    }
+
     /// Random rays against random triangles of a built-in scene, through the Rust simulation
     /// of the pipeline, against the golden model.
     fn check(params: Params, div_bits: u32, target_mhz: u32, count: usize) -> usize {
@@ -405,7 +464,15 @@ mod tests {
     fn check_with(params: Params, div_bits: u32, target_mhz: u32, count: usize, policy: Policy) -> usize {
         let scene = Scene::load(&crate::scene::SceneSource::Builtin("random".into()), &params).unwrap();
         let g = Golden::new(&scene);
-        let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 24, div_bits, target_mhz };
+        let p = IntersectParams {
+            n: params.n,
+            m: params.m,
+            t: params.t,
+            e: scene.edge_shift,
+            tag_width: 24,
+            div_bits,
+            target_mhz,
+        };
         let (module, lat) = intersect_core_with(&p, policy);
         let mut sim = Sim::new(&module);
         let ins: Vec<_> = module.inputs.iter().map(|&i| module.handle(i)).collect();
