@@ -290,8 +290,8 @@ pub enum Family {
     Ecp5 { target_mhz: f64, seed: u64, modules: Vec<String> },
 }
 
-/// The modules `synth --family ecp5` can place and route.
-pub const ECP5_MODULES: [&str; 5] = ["divider", "intersect", "traverse", "closest", "core"];
+/// The modules `synth --family ecp5` (and `sweep --synth --family ecp5`) can place and route.
+pub use crate::flow::ecp5::MODULES as ECP5_MODULES;
 
 impl SynthArgs {
     pub fn config(&self) -> Result<SynthConfig> {
@@ -300,12 +300,7 @@ impl SynthArgs {
             "xc7" => Family::Xc7,
             "ecp5" => {
                 crate::cores::clock::ClockTarget(self.hw.target_mhz).check()?;
-                if let Some(bad) = self.modules.iter().find(|m| !ECP5_MODULES.contains(&m.as_str())) {
-                    return Err(Error::param(
-                        "modules",
-                        format!("'{bad}' is not a module: use {}", ECP5_MODULES.join(", ")),
-                    ));
-                }
+                crate::flow::ecp5::check_modules(&self.modules)?;
                 Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seed: self.seed, modules: self.modules.clone() }
             }
             other => {
@@ -347,11 +342,8 @@ pub fn fmax_of(path: &std::path::Path) -> Result<f64> {
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::file(path, e.to_string()))?;
     let modules =
         v["modules"].as_array().ok_or_else(|| Error::file(path, "no \"modules\": not a synth --family ecp5 JSON"))?;
-    let fmax = |m: &serde_json::Value| m["fmax_mhz"].as_f64().filter(|f| *f > 0.0);
-    let core = modules.iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
-    core.and_then(fmax)
-        .or_else(|| modules.iter().filter_map(fmax).reduce(f64::min))
-        .ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
+    let placed = modules.iter().map(|m| (m["module"].as_str().unwrap_or(""), m["fmax_mhz"].as_f64().unwrap_or(0.0)));
+    crate::flow::ecp5::core_clock(placed).ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
 }
 
 impl SimArgs {

