@@ -444,6 +444,7 @@ impl SweepArgs {
         }
         let single = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
         single.validate()?;
+        crate::cores::clock::ClockTarget(self.target_mhz).check()?;
         Ok(SweepSpec {
             scenes,
             camera: self.camera.spec(),
@@ -457,7 +458,30 @@ impl SweepArgs {
             one_at_a_time: self.one_at_a_time,
             synth: self.synth,
             core_sim: self.core_sim,
+            target_mhz: self.target_mhz,
+            ecp5: self.ecp5()?,
         })
+    }
+
+    /// `--family` and the options of ecp5 alone: the modules in `ECP5_MODULES` order, each
+    /// once.
+    fn ecp5(&self) -> Result<Option<crate::flow::sweep::Ecp5Choice>> {
+        let family = self.family.as_deref().unwrap_or("xc5v");
+        match family {
+            "ecp5" if !self.synth => Err(Error::param("family", "ecp5 places and routes with --synth: add --synth")),
+            "ecp5" => {
+                let given = self.modules.clone().unwrap_or_else(|| vec!["core".into()]);
+                crate::flow::ecp5::check_modules(&given)?;
+                let modules = ECP5_MODULES.iter().filter(|m| given.iter().any(|g| g == *m)).map(|m| m.to_string());
+                Ok(Some(crate::flow::sweep::Ecp5Choice { modules: modules.collect(), seed: self.seed.unwrap_or(1) }))
+            }
+            "xc5v" if self.seed.is_some() => Err(Error::param("seed", "is nextpnr's: only with --family ecp5")),
+            "xc5v" if self.modules.is_some() => {
+                Err(Error::param("modules", "are placed and routed only with --family ecp5"))
+            }
+            "xc5v" => Ok(None),
+            other => Err(Error::param("family", format!("'{other}' is not a sweep family: use xc5v or ecp5"))),
+        }
     }
 }
 

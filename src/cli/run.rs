@@ -3,11 +3,11 @@
 //! (exit 2, one line).
 
 use super::Command;
+use super::HwArgs;
 use super::config::{
     BenchConfig, CompareConfig, Family, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation,
     SweepConfig, SweepRun, SynthConfig, TestConfig,
 };
-use super::HwArgs;
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};
@@ -197,7 +197,8 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
 /// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
 fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<IntersectParams> {
     let (tag_width, div_bits, target_mhz) = (hw.tag_width, hw.div_bits, hw.target_mhz);
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits, target_mhz };
+    let p =
+        IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits, target_mhz };
     p.check()?;
     Ok(p)
 }

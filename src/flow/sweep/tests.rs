@@ -18,6 +18,8 @@ fn spec() -> SweepSpec {
         one_at_a_time: false,
         synth: false,
         core_sim: false,
+        target_mhz: 150,
+        ecp5: None,
     }
 }
 
