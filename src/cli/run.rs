@@ -412,6 +412,10 @@ fn sweep_cmd(c: SweepConfig) -> Result<bool> {
         );
         return Ok(true);
     }
+    // Refused before the first line of output (sweep::run checks again for other callers).
+    if spec.ecp5.is_some() {
+        crate::flow::ecp5::Tools::require()?;
+    }
     eprintln!(
         "sweep: {} configurations ({} parameter sets × {} scenes){}{}",
         plan.configs.len(),

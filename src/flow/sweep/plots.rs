@@ -79,15 +79,8 @@ fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
     let lines: Vec<Line> =
         labels.iter().map(|scene| (scene.clone(), points(results, plan, scene, axis, &wrong))).collect();
     let top = lines.iter().flat_map(|l| l.1.iter().map(|p| p.1)).fold(10.0, f64::max) * 2.0;
-    let chart = AxisChart {
-        title: format!("Wrong pixels against {} ({})", axis.symbol(), others_text(plan, axis)),
-        y_desc: "wrong pixels vs f64 (0 drawn at 0.5)",
-        values: results.spec.values(axis),
-        axis,
-        lines,
-        level: None,
-    };
-    axis_chart(&chart, (ZERO..top).log_scale())
+    let chart = AxisChart::new(results, plan, axis, "Wrong pixels", "wrong pixels vs f64 (0 drawn at 0.5)");
+    axis_chart(&AxisChart { lines, ..chart }, (ZERO..top).log_scale())
 }
 
 /// plots/fmax_PARAM.png: each placed module's Fmax along `axis`, per scene, and the target.
@@ -101,25 +94,8 @@ fn fmax_plot(results: &Results, plan: &Plan, axis: Axis, modules: &[String]) -> 
     }
     let target = results.spec.target_mhz as f64;
     let top = lines.iter().flat_map(|l| l.1.iter().map(|p| p.1)).fold(target, f64::max) * 1.15;
-    let chart = AxisChart {
-        title: format!("ECP5 Fmax against {} ({})", axis.symbol(), others_text(plan, axis)),
-        y_desc: "Fmax, MHz (LFE5U-85F, speed 6)",
-        values: results.spec.values(axis),
-        axis,
-        lines,
-        level: Some((format!("target {target} MHz"), target)),
-    };
-    axis_chart(&chart, 0f64..top)
-}
-
-/// The base set's other parameters, for a caption: `n=29 m=32 …`.
-fn others_text(plan: &Plan, axis: Axis) -> String {
-    Axis::ALL
-        .into_iter()
-        .filter(|&a| a != axis)
-        .map(|a| format!("{}={}", a.symbol(), a.value(&plan.base)))
-        .collect::<Vec<_>>()
-        .join(" ")
+    let chart = AxisChart::new(results, plan, axis, "ECP5 Fmax", "Fmax, MHz (LFE5U-85F, speed 6)");
+    axis_chart(&AxisChart { lines, level: Some((format!("target {target} MHz"), target)), ..chart }, 0f64..top)
 }
 
 /// A legend and its points: (position in the axis's list, y).
@@ -134,6 +110,20 @@ struct AxisChart<'a> {
     lines: Vec<Line>,
     /// A horizontal line with its legend.
     level: Option<(String, f64)>,
+}
+
+impl<'a> AxisChart<'a> {
+    /// "`what` against P (the base set's other parameters)", no lines yet.
+    fn new(results: &Results, plan: &Plan, axis: Axis, what: &str, y_desc: &'a str) -> AxisChart<'a> {
+        let others = Axis::ALL
+            .into_iter()
+            .filter(|&a| a != axis)
+            .map(|a| format!("{}={}", a.symbol(), a.value(&plan.base)))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let title = format!("{what} against {} ({others})", axis.symbol());
+        AxisChart { title, y_desc, values: results.spec.values(axis), axis, lines: Vec::new(), level: None }
+    }
 }
 
 fn axis_chart<Y>(c: &AxisChart, y_range: Y) -> Result<Vec<u8>>
