@@ -1,6 +1,8 @@
 //! `fxrt sweep` as a user runs it: bad lists, a sweep of 120 configurations, shards merged
 //! byte for byte, the cache, the Slurm / GNU parallel scripts, and the thesis's findings.
 
+mod common;
+use common::sweep_rows as rows;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -28,14 +30,6 @@ fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     let mut out = BTreeMap::new();
     walk(dir, dir, &mut out);
     out
-}
-
-fn rows(dir: &Path) -> Vec<BTreeMap<String, String>> {
-    let mut r = csv::Reader::from_path(dir.join("results.csv")).unwrap();
-    let headers = r.headers().unwrap().clone();
-    r.records()
-        .map(|rec| headers.iter().map(String::from).zip(rec.unwrap().iter().map(String::from)).collect())
-        .collect()
 }
 
 #[test]

@@ -290,8 +290,8 @@ pub enum Family {
     Ecp5 { target_mhz: f64, seed: u64, modules: Vec<String> },
 }
 
-/// The modules `synth --family ecp5` can place and route.
-pub const ECP5_MODULES: [&str; 5] = ["divider", "intersect", "traverse", "closest", "core"];
+/// The modules `synth --family ecp5` (and `sweep --synth --family ecp5`) can place and route.
+pub use crate::flow::ecp5::MODULES as ECP5_MODULES;
 
 impl SynthArgs {
     pub fn config(&self) -> Result<SynthConfig> {
@@ -300,12 +300,7 @@ impl SynthArgs {
             "xc7" => Family::Xc7,
             "ecp5" => {
                 crate::cores::clock::ClockTarget(self.hw.target_mhz).check()?;
-                if let Some(bad) = self.modules.iter().find(|m| !ECP5_MODULES.contains(&m.as_str())) {
-                    return Err(Error::param(
-                        "modules",
-                        format!("'{bad}' is not a module: use {}", ECP5_MODULES.join(", ")),
-                    ));
-                }
+                crate::flow::ecp5::check_modules(&self.modules)?;
                 Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seed: self.seed, modules: self.modules.clone() }
             }
             other => {
@@ -347,11 +342,8 @@ pub fn fmax_of(path: &std::path::Path) -> Result<f64> {
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::file(path, e.to_string()))?;
     let modules =
         v["modules"].as_array().ok_or_else(|| Error::file(path, "no \"modules\": not a synth --family ecp5 JSON"))?;
-    let fmax = |m: &serde_json::Value| m["fmax_mhz"].as_f64().filter(|f| *f > 0.0);
-    let core = modules.iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
-    core.and_then(fmax)
-        .or_else(|| modules.iter().filter_map(fmax).reduce(f64::min))
-        .ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
+    let placed = modules.iter().map(|m| (m["module"].as_str().unwrap_or(""), m["fmax_mhz"].as_f64().unwrap_or(0.0)));
+    crate::flow::ecp5::core_clock(placed).ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
 }
 
 impl SimArgs {
@@ -452,6 +444,7 @@ impl SweepArgs {
         }
         let single = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
         single.validate()?;
+        crate::cores::clock::ClockTarget(self.target_mhz).check()?;
         Ok(SweepSpec {
             scenes,
             camera: self.camera.spec(),
@@ -465,7 +458,30 @@ impl SweepArgs {
             one_at_a_time: self.one_at_a_time,
             synth: self.synth,
             core_sim: self.core_sim,
+            target_mhz: self.target_mhz,
+            ecp5: self.ecp5()?,
         })
+    }
+
+    /// `--family` and the options of ecp5 alone: the modules in `ECP5_MODULES` order, each
+    /// once.
+    fn ecp5(&self) -> Result<Option<crate::flow::sweep::Ecp5Choice>> {
+        let family = self.family.as_deref().unwrap_or("xc5v");
+        match family {
+            "ecp5" if !self.synth => Err(Error::param("family", "ecp5 places and routes with --synth: add --synth")),
+            "ecp5" => {
+                let given = self.modules.clone().unwrap_or_else(|| vec!["core".into()]);
+                crate::flow::ecp5::check_modules(&given)?;
+                let modules = ECP5_MODULES.iter().filter(|m| given.iter().any(|g| g == *m)).map(|m| m.to_string());
+                Ok(Some(crate::flow::sweep::Ecp5Choice { modules: modules.collect(), seed: self.seed.unwrap_or(1) }))
+            }
+            "xc5v" if self.seed.is_some() => Err(Error::param("seed", "is nextpnr's: only with --family ecp5")),
+            "xc5v" if self.modules.is_some() => {
+                Err(Error::param("modules", "are placed and routed only with --family ecp5"))
+            }
+            "xc5v" => Ok(None),
+            other => Err(Error::param("family", format!("'{other}' is not a sweep family: use xc5v or ecp5"))),
+        }
     }
 }
 

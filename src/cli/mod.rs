@@ -104,6 +104,23 @@ pub struct SweepArgs {
     /// Also synthesise each configuration's core with yosys for Virtex-5 (slow).
     #[arg(long)]
     pub synth: bool,
+    /// With --synth: xc5v (Virtex-5 area from Debian's yosys; the default) or ecp5 (each
+    /// configuration's --modules placed and routed on the LFE5U-85F with yosys and
+    /// nextpnr-ecp5 from the project's .venv: Fmax, critical path, resources).
+    #[arg(long)]
+    pub family: Option<String>,
+    /// The clock the cores are pipelined for, MHz (50..=400): it sets their latencies; with
+    /// --family ecp5 also nextpnr's constraint.
+    #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
+    pub target_mhz: u32,
+    /// --family ecp5: nextpnr's placement seed (default 1).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// --family ecp5: which modules of each configuration's core to place and route (the
+    /// whole core takes minutes to a quarter of an hour): any of divider, intersect,
+    /// traverse, closest, core. Default: core.
+    #[arg(long, value_delimiter = ',')]
+    pub modules: Option<Vec<String>>,
     /// Also run each configuration's frame through the whole core in the Rust simulator:
     /// cycles per ray, pipeline fill, stack depth, and every pixel against the golden model
     /// (slow; use small sizes).

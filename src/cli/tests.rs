@@ -263,3 +263,45 @@ fn sim_takes_a_clock_or_a_measured_fmax() {
     std::fs::write(&json, "{}").unwrap();
     assert!(fmax_of(&json).is_err());
 }
+
+/// `sweep --synth --family ecp5`: its options, refused alone or out of range, and the modules
+/// in the one order the columns use.
+#[test]
+fn sweep_ecp5_options_are_checked() {
+    let spec = |args: &[&str]| {
+        let Command::Sweep(a) = command(args) else { panic!("not a sweep") };
+        a.spec().unwrap()
+    };
+    let s = spec(&["sweep", "--out", "x"]);
+    assert_eq!((s.target_mhz, &s.ecp5), (crate::cores::clock::DEFAULT_TARGET_MHZ, &None));
+    assert!(!s.xc5v_synth());
+    assert!(spec(&["sweep", "--out", "x", "--synth", "--family", "xc5v"]).xc5v_synth());
+    let s = spec(&["sweep", "--out", "x", "--synth", "--family", "ecp5"]);
+    assert_eq!(s.ecp5, Some(crate::flow::sweep::Ecp5Choice { modules: vec!["core".into()], seed: 1 }));
+    assert!(!s.xc5v_synth(), "no Virtex-5 area in an ecp5 sweep");
+    let args = ["sweep", "--out", "x", "--synth", "--family", "ecp5", "--modules", "core,divider,core", "--seed", "7"];
+    let s = spec(&[&args[..], &["--target-mhz", "100"]].concat());
+    assert_eq!(
+        s.ecp5,
+        Some(crate::flow::sweep::Ecp5Choice { modules: vec!["divider".into(), "core".into()], seed: 7 })
+    );
+    assert_eq!(s.target_mhz, 100);
+    for (args, subject) in [
+        (&["--family", "ecp5"][..], "--family"),
+        (&["--synth", "--family", "xc7"], "--family"),
+        (&["--synth", "--family", "ecp5", "--modules", "core,alu"], "--modules"),
+        (&["--synth", "--family", "ecp5", "--modules", ""], "--modules"),
+        (&["--synth", "--seed", "3"], "--seed"),
+        (&["--modules", "core"], "--modules"),
+        (&["--target-mhz", "49"], "--target-mhz"),
+        (&["--synth", "--family", "ecp5", "--target-mhz", "401"], "--target-mhz"),
+    ] {
+        assert_eq!(refused(&[&["sweep", "--out", "x"][..], args].concat()), subject, "{args:?}");
+    }
+    // What --emit-slurm writes for each shard describes the same ecp5 sweep.
+    let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    argv.extend(["--out".into(), "y".into()]);
+    let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
+    assert_eq!(spec(&argv), s);
+    assert!(argv.join(" ").contains("--target-mhz 100 --family ecp5 --seed 7 --modules divider,core"), "{argv:?}");
+}

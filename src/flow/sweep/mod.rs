@@ -12,6 +12,7 @@ pub mod eval;
 pub mod grid;
 pub mod output;
 pub mod plots;
+pub mod pnr;
 pub mod report;
 pub mod run;
 pub mod slurm;
@@ -58,6 +59,29 @@ pub struct SweepSpec {
     pub synth: bool,
     /// Also run every configuration's frame through the whole core in the Rust simulator.
     pub core_sim: bool,
+    /// The clock the cores are pipelined for, MHz (`--target-mhz`; absent from results.json
+    /// at the default, so older sweeps read back the same).
+    #[serde(default = "default_target_mhz", skip_serializing_if = "is_default_target_mhz")]
+    pub target_mhz: u32,
+    /// `--synth --family ecp5`: place and route on the LFE5U-85F instead of Virtex-5 area.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ecp5: Option<Ecp5Choice>,
+}
+
+fn default_target_mhz() -> u32 {
+    crate::cores::clock::DEFAULT_TARGET_MHZ
+}
+
+fn is_default_target_mhz(mhz: &u32) -> bool {
+    *mhz == default_target_mhz()
+}
+
+/// What `sweep --synth --family ecp5` places and routes, and with which placement seed.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Ecp5Choice {
+    /// Names of `flow::ecp5::MODULES`, in that order.
+    pub modules: Vec<String>,
+    pub seed: u64,
 }
 
 /// The swept parameters, in the order configurations vary them (last fastest).
@@ -134,6 +158,11 @@ pub struct Plan {
 }
 
 impl SweepSpec {
+    /// Whether rows carry yosys's Virtex-5 area (`--synth`, family xc5v).
+    pub fn xc5v_synth(&self) -> bool {
+        self.synth && self.ecp5.is_none()
+    }
+
     /// The values of `axis` as text, in the order given.
     pub fn values(&self, axis: Axis) -> Vec<String> {
         match axis {

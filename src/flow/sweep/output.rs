@@ -195,12 +195,24 @@ fn csv_record(r: &Row) -> Vec<String> {
     rec
 }
 
-pub fn csv_bytes(rows: &[Row]) -> Vec<u8> {
+/// The last columns (image, error, key): the ECP5 columns of `--family ecp5` come before them.
+const TAIL: usize = 3;
+
+/// `fields` with `extra` inserted before the last `TAIL`.
+fn with_extra(mut fields: Vec<String>, extra: Vec<String>) -> Vec<String> {
+    let at = fields.len() - TAIL;
+    fields.splice(at..at, extra);
+    fields
+}
+
+/// results.csv: `CSV_COLUMNS`, with `pnr::csv_columns` before the last three.
+pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
     let mut w = csv::Writer::from_writer(Vec::new());
     // Writing into a Vec cannot fail.
-    w.write_record(CSV_COLUMNS).expect("csv into memory");
+    let header = CSV_COLUMNS.iter().map(|c| c.to_string()).collect();
+    w.write_record(with_extra(header, super::pnr::csv_columns(spec))).expect("csv into memory");
     for r in rows {
-        w.write_record(csv_record(r)).expect("csv into memory");
+        w.write_record(with_extra(csv_record(r), super::pnr::csv_cells(spec, r))).expect("csv into memory");
     }
     w.into_inner().expect("csv into memory")
 }
@@ -213,7 +225,7 @@ pub fn write_tables_and_images(dir: &Path, cache: &Path, results: &Results) -> R
         write_atomic(&dir.join(p), &png)?;
         write_atomic(&dir.join(e), &errors)?;
     }
-    write_atomic(&dir.join("results.csv"), &csv_bytes(&results.rows))?;
+    write_atomic(&dir.join("results.csv"), &csv_bytes(&results.spec, &results.rows))?;
     let mut json = serde_json::to_vec_pretty(results).expect("results serialise");
     json.push(b'\n');
     write_atomic(&dir.join("results.json"), &json)

@@ -1,6 +1,8 @@
 //! Plots (plotters, PNG): wrong pixels against each swept parameter, and against DSP48E with
-//! the Pareto front. Text uses DejaVu Sans compiled in, so no system font is needed.
+//! the Pareto front; with `--family ecp5`, Fmax against each swept parameter. Text uses
+//! DejaVu Sans compiled in, so no system font is needed.
 
+use super::eval::Row;
 use super::grid::series;
 use super::output::Results;
 use super::summary::{pareto_front, set_summaries};
@@ -8,6 +10,7 @@ use super::{Axis, Plan, params_label};
 use crate::error::{Error, Result};
 use crate::io::write_atomic;
 use crate::render::encode_png;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -32,7 +35,11 @@ fn plot_err(e: impl std::fmt::Display) -> Error {
     Error::new("sweep plot", e.to_string())
 }
 
-/// Writes plots/error_PARAM.png per swept parameter and plots/pareto_dsp48e.png.
+/// Where the Fmax plots of `--family ecp5` go: plots/fmax_PARAM.png.
+pub const FMAX_PLOTS: &str = "plots/fmax_";
+
+/// Writes plots/error_PARAM.png per swept parameter, with `--family ecp5` plots/fmax_PARAM.png
+/// per swept parameter, and plots/pareto_dsp48e.png.
 pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
     register_font();
     let mut written = Vec::new();
@@ -40,6 +47,13 @@ pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<Str
         let rel = format!("plots/error_{}.png", axis.name());
         write_atomic(&dir.join(&rel), &error_plot(results, plan, axis)?)?;
         written.push(rel);
+    }
+    if let Some(e) = &results.spec.ecp5 {
+        for axis in results.spec.swept_axes() {
+            let rel = format!("{FMAX_PLOTS}{}.png", axis.name());
+            write_atomic(&dir.join(&rel), &fmax_plot(results, plan, axis, &e.modules)?)?;
+            written.push(rel);
+        }
     }
     if !set_summaries(results).is_empty() {
         let rel = "plots/pareto_dsp48e.png".to_string();
@@ -49,43 +63,89 @@ pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<Str
     Ok(written)
 }
 
-fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
+/// The points of one scene along `axis`: (position in the axis's list, y) for each row where
+/// `y` gives a value.
+fn points(results: &Results, plan: &Plan, scene: &str, axis: Axis, y: &dyn Fn(&Row) -> Option<f64>) -> Vec<(i32, f64)> {
     let values = results.spec.values(axis);
+    series(results, plan, scene, axis)
+        .into_iter()
+        .filter_map(|r| Some((values.iter().position(|v| *v == axis.value(&r.params))? as i32, y(r)?)))
+        .collect()
+}
+
+fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
     let labels = super::run::scene_labels(&results.spec.scenes);
-    let lines: Vec<(String, Vec<(i32, f64)>)> = labels
-        .iter()
-        .map(|scene| {
-            let pts = series(results, plan, scene, axis)
-                .into_iter()
-                .filter_map(|r| {
-                    let x = values.iter().position(|v| *v == axis.value(&r.params))? as i32;
-                    Some((x, (r.quality.as_ref()?.wrong_pixels as f64).max(ZERO)))
-                })
-                .collect::<Vec<_>>();
-            (scene.clone(), pts)
-        })
-        .collect();
+    let wrong = |r: &Row| Some((r.quality.as_ref()?.wrong_pixels as f64).max(ZERO));
+    let lines: Vec<Line> =
+        labels.iter().map(|scene| (scene.clone(), points(results, plan, scene, axis, &wrong))).collect();
     let top = lines.iter().flat_map(|l| l.1.iter().map(|p| p.1)).fold(10.0, f64::max) * 2.0;
-    let mut rgb = vec![255u8; (W * H * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area();
+    let chart = AxisChart::new(results, plan, axis, "Wrong pixels", "wrong pixels vs f64 (0 drawn at 0.5)");
+    axis_chart(&AxisChart { lines, ..chart }, (ZERO..top).log_scale())
+}
+
+/// plots/fmax_PARAM.png: each placed module's Fmax along `axis`, per scene, and the target.
+fn fmax_plot(results: &Results, plan: &Plan, axis: Axis, modules: &[String]) -> Result<Vec<u8>> {
+    let mut lines: Vec<Line> = Vec::new();
+    for scene in super::run::scene_labels(&results.spec.scenes) {
+        for kind in modules {
+            let fmax = |r: &Row| r.ecp5.iter().find(|p| &p.kind == kind).map(|p| p.timing.fmax_mhz);
+            lines.push((format!("{scene} · {kind}"), points(results, plan, &scene, axis, &fmax)));
+        }
+    }
+    let target = results.spec.target_mhz as f64;
+    let top = lines.iter().flat_map(|l| l.1.iter().map(|p| p.1)).fold(target, f64::max) * 1.15;
+    let chart = AxisChart::new(results, plan, axis, "ECP5 Fmax", "Fmax, MHz (LFE5U-85F, speed 6)");
+    axis_chart(&AxisChart { lines, level: Some((format!("target {target} MHz"), target)), ..chart }, 0f64..top)
+}
+
+/// A legend and its points: (position in the axis's list, y).
+type Line = (String, Vec<(i32, f64)>);
+
+/// A plot of lines along one swept parameter.
+struct AxisChart<'a> {
+    title: String,
+    y_desc: &'a str,
+    values: Vec<String>,
+    axis: Axis,
+    lines: Vec<Line>,
+    /// A horizontal line with its legend.
+    level: Option<(String, f64)>,
+}
+
+impl<'a> AxisChart<'a> {
+    /// "`what` against P (the base set's other parameters)", no lines yet.
+    fn new(results: &Results, plan: &Plan, axis: Axis, what: &str, y_desc: &'a str) -> AxisChart<'a> {
         let others = Axis::ALL
             .into_iter()
             .filter(|&a| a != axis)
             .map(|a| format!("{}={}", a.symbol(), a.value(&plan.base)))
             .collect::<Vec<_>>()
             .join(" ");
+        let title = format!("{what} against {} ({others})", axis.symbol());
+        AxisChart { title, y_desc, values: results.spec.values(axis), axis, lines: Vec::new(), level: None }
+    }
+}
+
+fn axis_chart<Y>(c: &AxisChart, y_range: Y) -> Result<Vec<u8>>
+where
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let values = &c.values;
+    let mut rgb = vec![255u8; (W * H * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area();
         let mut chart = ChartBuilder::on(&root)
-            .caption(format!("Wrong pixels against {} ({others})", axis.symbol()), (FONT, 20))
+            .caption(&c.title, (FONT, 20))
             .margin(14)
             .x_label_area_size(44)
             .y_label_area_size(70)
-            .build_cartesian_2d(-0.5f64..(values.len() as f64 - 0.5), (ZERO..top).log_scale())
+            .build_cartesian_2d(-0.5f64..(values.len() as f64 - 0.5), y_range)
             .map_err(plot_err)?;
         chart
             .configure_mesh()
-            .x_desc(axis.symbol())
-            .y_desc("wrong pixels vs f64 (0 drawn at 0.5)")
+            .x_desc(c.axis.symbol())
+            .y_desc(c.y_desc)
             .x_labels(values.len())
             .x_label_formatter(&|x| {
                 let i = x.round();
@@ -99,13 +159,23 @@ fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
             .axis_desc_style((FONT, 15))
             .draw()
             .map_err(plot_err)?;
-        for (i, (scene, pts)) in lines.iter().enumerate() {
+        if let Some((label, y)) = &c.level {
+            // Darker and wider than the mesh line it may lie on.
+            let grey = RGBColor(90, 90, 90);
+            let ends = vec![(-0.5, *y), (values.len() as f64 - 0.5, *y)];
+            chart
+                .draw_series(LineSeries::new(ends, grey.stroke_width(3)))
+                .map_err(plot_err)?
+                .label(label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], grey.stroke_width(3)));
+        }
+        for (i, (label, pts)) in c.lines.iter().enumerate() {
             let color = Palette99::pick(i).to_rgba();
             let pts: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (x as f64, y)).collect();
             chart
                 .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
                 .map_err(plot_err)?
-                .label(scene.clone())
+                .label(label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
             chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled()))).map_err(plot_err)?;
         }
@@ -128,7 +198,7 @@ fn pareto_plot(results: &Results) -> Result<Vec<u8>> {
     let y = |w: u64| (w as f64).max(ZERO);
     let x_max = sets.iter().map(|s| s.dsp48e).max().unwrap_or(1) as f64 * 1.1 + 1.0;
     let y_top = sets.iter().map(|s| y(s.wrong)).fold(10.0, f64::max) * 2.0;
-    let source = if results.spec.synth { "yosys" } else { "estimated" };
+    let source = if results.spec.xc5v_synth() { "yosys" } else { "estimated" };
     let mut rgb = vec![255u8; (W * H * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (W, H)).into_drawing_area();

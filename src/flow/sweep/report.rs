@@ -4,6 +4,7 @@
 use super::Plan;
 use super::eval::OTHER_SURFACE_REL;
 use super::output::Results;
+use super::plots::FMAX_PLOTS;
 use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summaries};
 use crate::error::{Error, Result};
 use crate::io::write_atomic;
@@ -32,6 +33,9 @@ struct Report {
     grids: Vec<String>,
     rows: Vec<Vec<String>>,
     skipped: Vec<String>,
+    ecp5_setup: String,
+    ecp5_rows: Vec<Vec<String>>,
+    fmax_plots: Vec<String>,
 }
 
 pub(super) fn list<T: ToString>(v: &[T]) -> String {
@@ -89,6 +93,7 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
             cpr(f64::max, 0.0)
         ));
     }
+    out.extend(super::pnr::findings(results));
     let failed = results.rows.iter().filter(|r| r.error.is_some()).count();
     if failed > 0 {
         out.push(format!("{failed} configurations could not be evaluated completely; see the note column."));
@@ -150,7 +155,11 @@ pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String]
         width: spec.camera.width,
         height: spec.camera.height,
         other_surface: OTHER_SURFACE_REL,
-        dsp_source: if spec.synth { "yosys synth_xilinx -family xc5v" } else { "estimated from the multipliers" },
+        dsp_source: if spec.xc5v_synth() {
+            "yosys synth_xilinx -family xc5v"
+        } else {
+            "estimated from the multipliers"
+        },
         scenes: labels.join(", "),
         mode: if spec.one_at_a_time { "one parameter at a time around the base set" } else { "cross product" },
         lists: vec![
@@ -166,10 +175,13 @@ pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String]
         scene_count: spec.scenes.len(),
         findings: findings(results, &sets),
         pareto,
-        plots: plots.to_vec(),
+        plots: plots.iter().filter(|p| !p.starts_with(FMAX_PLOTS)).cloned().collect(),
         grids: grids.to_vec(),
         rows: results.rows.iter().map(row_cells).collect(),
         skipped: plan.skipped.iter().map(|s| format!("{}: {}", set_text(&s.params), s.reason)).collect(),
+        ecp5_setup: super::pnr::setup_text(results),
+        ecp5_rows: super::pnr::report_rows(results),
+        fmax_plots: plots.iter().filter(|p| p.starts_with(FMAX_PLOTS)).cloned().collect(),
     };
     let text = report.render().map_err(|e| Error::new("sweep report", e.to_string()))?;
     write_atomic(&dir.join("report.md"), text.as_bytes())

@@ -4,8 +4,10 @@ use super::eval::{Extras, Row, SceneCtx, evaluate};
 use super::output::{
     Results, copy_cached, has_cached, load_cached, read_results, store_cached, write_tables_and_images,
 };
+use super::pnr::Pnr;
 use super::{Plan, SceneSpec, Shard, SweepSpec};
 use crate::error::{Error, Result};
+use crate::flow::ecp5::Tools;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -72,12 +74,27 @@ pub fn run(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} configurations ({eta}) {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let extras = Extras { synth_dir: spec.synth.then(|| out.join("synth")), core_sim: spec.core_sim };
+    // The ECP5 tools are checked before anything is written.
+    let pnr = match &spec.ecp5 {
+        Some(choice) if spec.synth => Some(Pnr {
+            tools: Tools::require()?,
+            choice: choice.clone(),
+            target_mhz: spec.target_mhz,
+            dir: out.join("synth"),
+        }),
+        _ => None,
+    };
+    let extras = Extras {
+        synth_dir: spec.xc5v_synth().then(|| out.join("synth")),
+        core_sim: spec.core_sim,
+        target_mhz: spec.target_mhz,
+        pnr,
+    };
     let results: Vec<Result<(Row, bool)>> = mine
         .par_iter()
         .map(|cfg| {
             let ctx = &scenes[cfg.scene];
-            let key = ctx.key(&cfg.params, spec.synth, spec.core_sim);
+            let key = ctx.key(&cfg.params, spec);
             let done = match load_cached(cache, &key, cfg.index, &ctx.label) {
                 Some(row) => Ok((row, true)),
                 None => {

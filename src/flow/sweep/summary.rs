@@ -25,7 +25,9 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
     let scenes = results.spec.scenes.len();
     let mut out: Vec<SetSummary> = Vec::new();
     for r in &results.rows {
-        let (Some(q), Some(c), Some(dsp)) = (&r.quality, &r.cost, r.dsp48e(results.spec.synth)) else { continue };
+        let (Some(q), Some(c), Some(dsp)) = (&r.quality, &r.cost, r.dsp48e(results.spec.xc5v_synth())) else {
+            continue;
+        };
         let s = match out.iter_mut().find(|s| s.params == r.params) {
             Some(s) => s,
             None => {
@@ -35,7 +37,7 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
                     diff: 0,
                     rays: 0,
                     dsp48e: 0,
-                    dsp_from_synth: results.spec.synth,
+                    dsp_from_synth: results.spec.xc5v_synth(),
                     isect_latency: c.isect_latency,
                     rom_bits: 0,
                     register_bits: 0,
@@ -54,7 +56,7 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
         results
             .rows
             .iter()
-            .filter(|r| r.params == s.params && r.quality.is_some() && r.dsp48e(results.spec.synth).is_some())
+            .filter(|r| r.params == s.params && r.quality.is_some() && r.dsp48e(results.spec.xc5v_synth()).is_some())
             .count()
             == scenes
     };

@@ -18,6 +18,8 @@ fn spec() -> SweepSpec {
         one_at_a_time: false,
         synth: false,
         core_sim: false,
+        target_mhz: 150,
+        ecp5: None,
     }
 }
 
@@ -167,4 +169,116 @@ fn slurm_shards_are_checked_and_the_scripts_written() {
         let mode = |f: &str| std::fs::metadata(out.join("slurm").join(f)).unwrap().permissions().mode();
         assert!(mode("submit.sh") & 0o111 != 0 && mode("sweep.slurm") & 0o111 == 0);
     }
+}
+
+/// Rows of one sweep are reused only by a sweep that would compute the same: the family, the
+/// ECP5 modules and seed, and the clock target are in the key; a sweep without them keeps the
+/// key it always had, and its results.json does not mention them.
+#[test]
+fn cache_keys_tell_families_seeds_and_targets_apart() {
+    let ctx = eval::SceneCtx::load(&SceneSpec::Builtin("thin".into()), "thin".into(), &spec().camera, 4, 32).unwrap();
+    let p = Params::default();
+    let xc5v = SweepSpec { synth: true, ..spec() };
+    let ecp5 = SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["core".into()], seed: 1 }), ..xc5v.clone() };
+    let keys = [
+        ctx.key(&p, &spec()),
+        ctx.key(&p, &xc5v),
+        ctx.key(&p, &ecp5),
+        ctx.key(&p, &SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["core".into()], seed: 2 }), ..ecp5.clone() }),
+        ctx.key(&p, &SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["divider".into()], seed: 1 }), ..ecp5.clone() }),
+        ctx.key(&p, &SweepSpec { target_mhz: 100, ..ecp5.clone() }),
+        ctx.key(&p, &SweepSpec { target_mhz: 100, ..xc5v.clone() }),
+        ctx.key(&p, &SweepSpec { target_mhz: 100, ..spec() }),
+    ];
+    let distinct: std::collections::BTreeSet<&String> = keys.iter().collect();
+    assert_eq!(distinct.len(), keys.len(), "{keys:?}");
+    // The key of a sweep without the new options is the one it had before them.
+    let c = &ctx.camera;
+    let before = serde_json::json!({
+        "fxrt": env!("CARGO_PKG_VERSION"), "row_format": eval::ROW_FORMAT, "scene": "builtin:thin",
+        "camera": [c.eye, c.at, c.up, [c.fov_deg, c.width as f64, c.height as f64]],
+        "params": p, "synth": true, "core_sim": false,
+    });
+    use sha2::Digest;
+    assert_eq!(keys[1], format!("{:x}", sha2::Sha256::digest(before.to_string().as_bytes()))[..20]);
+    let json = serde_json::to_string(&xc5v).unwrap();
+    assert!(!json.contains("target_mhz") && !json.contains("ecp5"), "{json}");
+    assert_eq!(serde_json::from_str::<SweepSpec>(&json).unwrap(), xc5v);
+    let ecp5 = SweepSpec { target_mhz: 100, ..ecp5 };
+    assert_eq!(serde_json::from_str::<SweepSpec>(&serde_json::to_string(&ecp5).unwrap()).unwrap(), ecp5);
+}
+
+/// A row with placed modules: its cells sit under the columns named after the module, before
+/// image, error and key, in the spec's module order; a module that did not place leaves its
+/// cells empty. Without ecp5 the columns are the ones they were.
+#[test]
+fn ecp5_columns_follow_the_modules() {
+    use super::eval::Row;
+    use super::pnr::{FIELDS, PlacedModule};
+    use crate::flow::ecp5::{CriticalPath, Timing};
+    let timing = |module: &str, fmax: f64, latency: Option<u32>| Timing {
+        module: module.into(),
+        device: "LFE5U-85F".into(),
+        package: "CABGA381".into(),
+        speed_grade: 6,
+        target_mhz: 150.0,
+        fmax_mhz: fmax,
+        critical_path: CriticalPath { start: "u_dut.a".into(), end: "u_dut.b".into(), nets: vec![], delay_ns: 7.5 },
+        lut4: 100,
+        ff: 90,
+        mult18: 2,
+        dp16kd: 1,
+        wrapper_ff: 9,
+        latency_cycles: latency,
+        yosys: "Yosys".into(),
+        nextpnr: "nextpnr".into(),
+        seed: 1,
+    };
+    let modules = vec!["divider".to_string(), "intersect".into(), "core".into()];
+    let s = SweepSpec { synth: true, core_sim: true, ecp5: Some(Ecp5Choice { modules, seed: 1 }), ..spec() };
+    let row = Row {
+        index: 0,
+        key: "k".into(),
+        scene: "thin".into(),
+        params: Params::default(),
+        e_used: None,
+        quality: None,
+        cost: None,
+        synth: None,
+        core: Some(eval::CoreRun { cycles_per_ray: 130.0, fill: 0.3, max_stack_depth: 4, mismatches: 0 }),
+        ecp5: vec![
+            PlacedModule { kind: "divider".into(), timing: timing("fxrt_div", 172.1, Some(31)) },
+            PlacedModule { kind: "core".into(), timing: timing("fxrt_core", 113.3, None) },
+        ],
+        mrays_per_s_at_fmax: None,
+        error: None,
+    };
+    assert_eq!(super::pnr::clock(&row), Some(113.3), "the whole core's Fmax, not the slowest module's");
+    let bytes = output::csv_bytes(&s, std::slice::from_ref(&row));
+    let mut r = csv::Reader::from_reader(bytes.as_slice());
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    let cells: Vec<String> = r.records().next().unwrap().unwrap().iter().map(String::from).collect();
+    let at = |name: &str| cells[header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no {name}"))].clone();
+    assert_eq!(header.len(), output::CSV_COLUMNS.len() + 3 * FIELDS.len() + 1);
+    assert_eq!(header[header.len() - 4..], ["mrays_per_s_at_fmax", "image", "error", "key"]);
+    assert_eq!(header[header.len() - 5], "core_path_ns");
+    assert_eq!(
+        (at("divider_fmax_mhz"), at("divider_latency"), at("core_fmax_mhz")),
+        ("172.1".into(), "31".into(), "113.3".into())
+    );
+    assert_eq!(
+        (at("core_latency"), at("intersect_fmax_mhz"), at("core_path_end")),
+        ("".into(), "".into(), "u_dut.b".into())
+    );
+    assert_eq!(
+        (at("core_lut4"), at("core_ff"), at("core_wrapper_ff"), at("core_mult18"), at("core_dp16kd")),
+        ("100".into(), "90".into(), "9".into(), "2".into(), "1".into())
+    );
+    assert_eq!(at("key"), "k");
+    // A row read back from the cache is the row.
+    let back: Row = serde_json::from_slice(&serde_json::to_vec(&row).unwrap()).unwrap();
+    assert_eq!(back, row);
+    let plain = output::csv_bytes(&SweepSpec { ecp5: None, ..s }, &[row]);
+    let first = String::from_utf8(plain).unwrap().lines().next().unwrap().to_string();
+    assert_eq!(first, output::CSV_COLUMNS.join(","));
 }
