@@ -291,12 +291,13 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
 }
 
 /// `cost` (`core_cost`'s, at the default clock target) with what the clock target changes:
-/// the intersection pipeline's latency, the registers and the multipliers' pieces. The
-/// divider's latency and the ROMs do not depend on it.
+/// the divider's and the intersection pipeline's latencies, the registers and the
+/// multipliers' pieces. The ROMs do not depend on it.
 fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32) -> CoreCost {
     let p = CoreParams::new(roms, 20, 1, target_mhz);
     let core = core_module(&p, roms);
     CoreCost {
+        div_latency: p.isect.div_latency(),
         isect_latency: p.isect.latency(),
         dsp48e_est: dsp48e_estimate(&core),
         register_bits: core.register_bits(),
