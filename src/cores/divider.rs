@@ -17,8 +17,9 @@
 //! (`diff` if the last subtraction was taken, `p` if not) and the last sign in registers,
 //! subtracts b from both in two chains side by side, and selects afterwards with the
 //! *registered* sign, whose fan-out is routed while the chains settle. Twice the
-//! subtractors, the same number of quotient stages. The magnitudes are then negated over two
-//! stages (`sub_low`, `sub_high`) and the result flag gets a stage of its own: two more cycles.
+//! subtractors, the same number of quotient stages. The magnitudes then take two stages (the
+//! negations, then the select by the sign) and the result flag one of its own: two more
+//! cycles.
 
 use crate::rtl::build::{Builder, S};
 use crate::rtl::pipeline::{Pipeline, Policy};
@@ -57,7 +58,7 @@ impl DividerShape {
     }
 
     /// Latency in clock cycles for grid bits `n`: the operand stage, the quotient stages
-    /// and, with lookahead, the negations' high halves and the result flag.
+    /// and, with lookahead, the negations' stage and the result flag's.
     pub fn latency(self, n: u32) -> u32 {
         let extra = if self.form == StageForm::Plain { 0 } else { 2 };
         1 + extra + (n + 1).div_ceil(self.bits_per_stage)
@@ -75,8 +76,8 @@ crate::bundle! {
     struct Operands { a, b, err }
 }
 crate::bundle! {
-    /// Lookahead: the operands with the low halves of their negations made.
-    struct HalfNegated { num, den, a_lo, a_borrow, b_lo, b_borrow, err }
+    /// Lookahead: the operands and their negations.
+    struct Negated { num, den, neg_num, neg_den, err }
 }
 crate::bundle! {
     /// The partial remainder and the quotient bits so far.
@@ -90,32 +91,6 @@ crate::bundle! {
 crate::bundle! {
     /// The result ports.
     struct Quotient { t, ok }
-}
-
-/// x − y on unsigned operands of one width, the low `h` bits only: (those bits of the
-/// difference, the borrow out of them). `sub_high` finishes it after a register.
-fn sub_low<'b>(x: S<'b>, y: S<'b>, h: u32) -> (S<'b>, S<'b>) {
-    let d = x.slice(0, h).xsigned() - y.slice(0, h).xsigned();
-    (d.slice(0, h), d.msb())
-}
-
-/// The high part of x − y given the low part's borrow: the signed difference
-/// x[h..] − y[h..] − borrow, times two (its bits from 1 up, its sign the msb). The borrow
-/// enters as an extra low bit, (2·xh) − (2·yh + borrow), so this is one carry chain.
-fn sub_high<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, h: u32, borrow: S<'b>) -> S<'b> {
-    let k = x.width() - h;
-    let xh = b.cat(&[x.slice(h, k), b.konst(Ty::BIT, 0)]);
-    let yh = b.cat(&[y.slice(h, k), borrow]);
-    xh.xsigned() - yh.xsigned()
-}
-
-/// |x| of an s(w) value as u(w), its negation's low half `lo` (with `borrow`) made a stage
-/// earlier (`sub_low`).
-fn magnitude_high<'b>(b: &'b Builder, x: S<'b>, lo: S<'b>, borrow: S<'b>) -> S<'b> {
-    let w = x.width();
-    let h = lo.width();
-    let neg_hi = sub_high(b, b.konst(Ty::u(w), 0), x.unsigned(), h, borrow).slice(1, w - h);
-    x.msb().select(b.cat(&[neg_hi, lo]), x.unsigned())
 }
 
 /// The divider as a standalone core: ports num, den (signed) → t (n + 1 bits), ok.
@@ -146,15 +121,12 @@ fn divider_body<'b>(b: &'b Builder, n: u32, shape: DividerShape, wn: u32, wd: u3
             Operands { a, b: d_neg.select(-den, den).unsigned(), err },
         )
     } else {
-        let zero = |w| b.konst(Ty::u(w), 0);
-        let (a_lo, a_borrow) = sub_low(zero(wn), num.unsigned(), wn / 2);
-        let (b_lo, b_borrow) = sub_low(zero(wd), den.unsigned(), wd / 2);
-        let h = pipe.stage(
-            "operands_lo",
-            "signs, zero tests, the low halves of the negations",
-            HalfNegated { num, den, a_lo, a_borrow, b_lo, b_borrow, err },
-        );
-        let (a, b_mag) = (magnitude_high(b, h.num, h.a_lo, h.a_borrow), magnitude_high(b, h.den, h.b_lo, h.b_borrow));
+        // Each negation one carry chain between registers, the select by the sign after
+        // another: with the select behind the 63-bit chain the operand stage was the slowest.
+        let (neg_num, neg_den) = ((-num).unsigned(), (-den).unsigned());
+        let h = pipe.stage("negations", "signs, zero tests, both operands negated", Negated { num, den, neg_num, neg_den, err });
+        let magnitude = |x: S<'b>, neg: S<'b>| -> S<'b> { x.msb().select(neg, x.unsigned()) };
+        let (a, b_mag) = (magnitude(h.num, h.neg_num), magnitude(h.den, h.neg_den));
         pipe.stage("operands", "magnitudes", Operands { a, b: b_mag, err: h.err })
     };
     // The overflow test: hi = a >> (n+1) must be below b. Without overflow the partial
