@@ -43,16 +43,19 @@ pub fn brom_module(name: &str, width: u32, words: Vec<u128>, cycles: u32) -> Mod
     let addr = b.input("addr", Ty::u(rom_addr_bits(words.len())));
     let mem = b.rom("mem", width, words);
     let word = b.read("word", mem, addr);
-    b.output("data", b.delay_line("data_r", word, cycles - 1));
+    // Plain registers, not a delay line (which a synthesis tool may map to shift-register
+    // LUTs): the first is the block's output register, the second a fabric flip-flop.
+    let mut data = b.delay("data_r", word);
+    if cycles == 3 {
+        data = b.delay("data_rr", data);
+    }
+    b.output("data", data);
     b.finish()
 }
 
-/// The clocks of a block ROM module's read (its output is a register, or a delay line).
+/// The clocks of a block ROM module's read: the synchronous read and its registers.
 pub fn brom_cycles(m: &Module) -> u32 {
-    match m.sig(m.outputs[0].1).def {
-        crate::rtl::netlist::Def::DelayLine { depth, .. } => depth + 1,
-        _ => 2,
-    }
+    1 + m.signals.iter().filter(|s| matches!(s.def, crate::rtl::netlist::Def::Reg { .. })).count() as u32
 }
 
 /// In `b`: the block ROM `name` read at `addr` (instance `label`); its word `cycles` clocks
