@@ -214,32 +214,37 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // dist: bih::inner_step's compares. tmin ≤ min(near_end, tmax) and max(tmin, far_start) ≤
     // tmax are each a compare with the new distance and tmin ≤ tmax, so no min or max feeds a
     // compare. Each compare is made with both candidates for near_end and far_start (the
-    // arriving distance and d0) into a register of its own that loads every cycle: a carry
-    // chain straight into a flip-flop, with no select and no state-machine enable behind it
-    // (those made the 9 ns path that held the unit near 111 MHz). `step`, the cycle after d1
-    // arrives, reads the pair the arriving distance made and selects by the ray's sign on the
-    // axis. Every compare is a strict less-than: x ≤ tmax is x < tmax + 1 and tmin ≤ x is
-    // tmin − 1 < x, with tmax + 1 and tmin − 1 in registers of their own (tmin and tmax hold
-    // still from `node` to `step`, so the copies are current long before the compares are
-    // used). A ≤ made by yosys shares the subtraction of the < with the same operands and adds
-    // an equality over its 32 result bits (measured: 8.3 ns, 120 MHz).
+    // arriving distance and d0, both registers), and the pair selected by the ray's sign (a
+    // register since `clip1`) and ANDed with tmin ≤ tmax (registered) in one LUT into a
+    // register that loads every cycle: a carry chain and one LUT, with no state-machine enable
+    // (that made the 9 ns path that held the unit near 111 MHz). `step`, the cycle after d1
+    // arrives, reads the registers the arriving distance made: the state machine's conditions
+    // go_near and go_far are flip-flops (with the sign select in `step` instead, the state
+    // logic ran through the compares' corner of the die and back: 8.4 ns in the whole teapot
+    // core). Every compare is a strict less-than: x ≤ tmax is x < tmax + 1 and tmin ≤ x is
+    // tmin − 1 < x, with tmax + 1, tmin − 1 and tmin ≤ tmax in registers of their own, which
+    // load every cycle (tmin and tmax hold still from `node` to `step`, so they are current
+    // long before d1 arrives). A ≤ made by yosys shares the subtraction of the < with the same
+    // operands and adds an equality over its 32 result bits (measured: 8.3 ns, 120 MHz).
     let negative = b.reg("negative", Ty::BIT, None);
     let d0_r = b.reg("d0_r", dist, None);
     let near_end = negative.select(plane_t, d0_r).name("near_end");
     let far_start = negative.select(d0_r, plane_t).name("far_start");
     let tmax_p1 = b.delay("tmax_p1", (tmax + 1).name("tmax_plus_1"));
     let tmin_m1 = b.delay("tmin_m1", (tmin - 1).name("tmin_minus_1"));
-    let cmp = |name: &str, x: S| b.delay(name, x.name(&format!("{name}_c")));
-    let (plane_lt_tmax, d0_lt_tmax) = (cmp("plane_lt_tmax", plane_t.lt(tmax)), cmp("d0_lt_tmax", d0_r.lt(tmax)));
-    let (plane_gt_tmin, d0_gt_tmin) = (cmp("plane_gt_tmin", tmin.lt(plane_t)), cmp("d0_gt_tmin", tmin.lt(d0_r)));
-    let (tmin_le_plane, tmin_le_d0) = (cmp("tmin_le_plane", tmin_m1.lt(plane_t)), cmp("tmin_le_d0", tmin_m1.lt(d0_r)));
-    let (plane_le_tmax, d0_le_tmax) = (cmp("plane_le_tmax", plane_t.lt(tmax_p1)), cmp("d0_le_tmax", d0_r.lt(tmax_p1)));
-    let tmin_le_tmax = cmp("tmin_le_tmax", tmin.lt(tmax_p1));
-    let by_sign = |name: &str, on_plane, on_d0| negative.select(on_plane, on_d0).name(name);
-    let near_lt_tmax = by_sign("near_lt_tmax", plane_lt_tmax, d0_lt_tmax);
-    let far_gt_tmin = by_sign("far_gt_tmin", d0_gt_tmin, plane_gt_tmin);
-    let tmin_le_near = by_sign("tmin_le_near", tmin_le_plane, tmin_le_d0);
-    let far_le_tmax = by_sign("far_le_tmax", d0_le_tmax, plane_le_tmax);
+    let tmin_le_tmax = b.delay("tmin_le_tmax", tmin.lt(tmax_p1).name("tmin_le_tmax_c"));
+    // A compare of each candidate, selected by the sign: (on the arriving distance, on d0).
+    fn pick_by<'b>(negative: S<'b>, name: &str, on_plane: S<'b>, on_d0: S<'b>) -> S<'b> {
+        negative.select(on_plane.name(&format!("{name}_plane")), on_d0.name(&format!("{name}_d0"))).name(name)
+    }
+    let by_sign = |name: &str, on_plane, on_d0| pick_by(negative, name, on_plane, on_d0);
+    let reg = |name: &str, x: S| b.delay(name, x.name(&format!("{name}_c")));
+    let near_lt_tmax = reg("near_lt_tmax", by_sign("near_lt", plane_t.lt(tmax), d0_r.lt(tmax)));
+    let far_gt_tmin = reg("far_gt_tmin", by_sign("far_gt", tmin.lt(d0_r), tmin.lt(plane_t)));
+    let tmin_le_near = by_sign("tmin_le_near", tmin_m1.lt(plane_t), tmin_m1.lt(d0_r));
+    let far_le_tmax = by_sign("far_le_tmax", d0_r.lt(tmax_p1), plane_t.lt(tmax_p1));
+    let go_near = reg("go_near", tmin_le_near & tmin_le_tmax);
+    let go_far = reg("go_far", far_le_tmax & tmin_le_tmax);
     let near_end_r = b.reg("near_end_r", dist, None);
     let far_start_r = b.reg("far_start_r", dist, None);
     let far_r = b.reg("far_r", Ty::u(node_bits), None);
@@ -250,8 +255,6 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // step: the decision from registered bits; near_max and far_min are muxes.
     let near_max = near_lt_tmax.select(near_end_r, tmax).name("near_max");
     let far_min = far_gt_tmin.select(far_start_r, tmin).name("far_min");
-    let go_near = (tmin_le_near & tmin_le_tmax).name("go_near");
-    let go_far = (far_le_tmax & tmin_le_tmax).name("go_far");
 
     // Stack entries (far node, far_min, tmax); the top (sp − 1) is always read ahead.
     let sp = b.reg("sp", Ty::u(p.sp_width()), Some(0));
