@@ -137,6 +137,7 @@ module fxrt_traverse (
   /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] pu_clamped;
   reg signed [31:0] plane_t = 32'sh00000000;
+  reg signed [31:0] plane_t_of_last = 32'sh00000000;
   reg [0:0] plane_t_valid = 1'h0;
   reg [0:0] plane_t_last = 1'h0;
   wire [0:0] not_plane_t_last;
@@ -292,8 +293,8 @@ module fxrt_traverse (
   wire [0:0] not_go_near_and_go_far;
   wire [12:0] mux_not_go_near_and_go_far;
   wire [0:0] not_go_far;
-  wire [0:0] and_16;
-  wire [12:0] mux_and_16;
+  wire [0:0] and_18;
+  wire [12:0] mux_and_18;
   wire [0:0] not_sp_empty;
   wire [12:0] mux_not_sp_empty;
   reg [12:0] node_next;
@@ -322,26 +323,26 @@ module fxrt_traverse (
   wire [0:0] not_box_miss;
   wire [3:0] mux_not_box_miss;
   wire [3:0] mux_node_settled;
-  wire [0:0] and_17;
-  wire [3:0] mux_and_17;
+  wire [0:0] and_19;
+  wire [3:0] mux_and_19;
   wire [0:0] not_nw_count_eq_k_0_7;
-  wire [0:0] and_18;
-  wire [3:0] mux_and_18;
+  wire [0:0] and_20;
+  wire [3:0] mux_and_20;
   wire [0:0] not_nw_is_leaf_1;
   wire [3:0] mux_not_nw_is_leaf_1;
   wire [3:0] mux_d1_arrives_1;
   wire [3:0] mux_go_near;
   wire [0:0] not_go_near_and_go_far_2;
   wire [3:0] mux_not_go_near_and_go_far_2;
-  wire [0:0] and_19;
-  wire [3:0] mux_and_19;
-  wire [3:0] mux_leaf_left_eq_k_1_4;
-  wire [3:0] mux_sp_empty;
-  wire [0:0] and_20;
-  wire [3:0] mux_and_20;
-  wire [0:0] not_popped_ahead;
   wire [0:0] and_21;
   wire [3:0] mux_and_21;
+  wire [3:0] mux_leaf_left_eq_k_1_4;
+  wire [3:0] mux_sp_empty;
+  wire [0:0] and_22;
+  wire [3:0] mux_and_22;
+  wire [0:0] not_popped_ahead;
+  wire [0:0] and_23;
+  wire [3:0] mux_and_23;
   reg [3:0] state_next;
   wire signed [31:0] mux_go_near_1;
   wire signed [31:0] mux_not_sp_empty_2;
@@ -351,8 +352,8 @@ module fxrt_traverse (
   wire [2:0] mux_nw_is_leaf_1;
   reg [2:0] leaf_left_next;
   wire [0:0] mux_nw_is_leaf_2;
-  wire [0:0] and_22;
-  wire [0:0] mux_and_22;
+  wire [0:0] and_24;
+  wire [0:0] mux_and_24;
   wire [0:0] mux_leaf_left_eq_k_1_4_1;
   reg [0:0] popped_ahead_next;
   wire [1:0] mux_not_nw_is_leaf_1_1;
@@ -374,7 +375,7 @@ module fxrt_traverse (
   wire [5:0] mux_not_sp_empty_3;
   reg [5:0] sp_next;
   wire [0:0] in_step;
-  wire [0:0] and_23;
+  wire [0:0] and_25;
 
   // not in a stage or state machine
   assign node_eq_node_d1 = node == node_d1;
@@ -471,24 +472,24 @@ module fxrt_traverse (
   assign or_12 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
   assign box_miss = or_12 | bits_box_d3;
-  assign near_end = negative ? plane_t : d0_r;
-  assign far_start = negative ? d0_r : plane_t;
+  assign near_end = negative ? plane_t_of_last : d0_r;
+  assign far_start = negative ? d0_r : plane_t_of_last;
   assign tmax_plus_1 = tmax + k_1;
   assign tmin_minus_1 = tmin - k_1;
   assign tmin_le_tmax_c = tmin < tmax_p1;
-  assign near_lt_plane = plane_t < tmax;
+  assign near_lt_plane = plane_t_of_last < tmax;
   assign near_lt_d0 = d0_r < tmax;
   assign near_lt = negative ? near_lt_plane : near_lt_d0;
   assign near_lt_tmax_c = near_lt;
   assign far_gt_plane = tmin < d0_r;
-  assign far_gt_d0 = tmin < plane_t;
+  assign far_gt_d0 = tmin < plane_t_of_last;
   assign far_gt = negative ? far_gt_plane : far_gt_d0;
   assign far_gt_tmin_c = far_gt;
-  assign tmin_le_near_plane = tmin_m1 < plane_t;
+  assign tmin_le_near_plane = tmin_m1 < plane_t_of_last;
   assign tmin_le_near_d0 = tmin_m1 < d0_r;
   assign tmin_le_near = negative ? tmin_le_near_plane : tmin_le_near_d0;
   assign far_le_tmax_plane = d0_r < tmax_p1;
-  assign far_le_tmax_d0 = plane_t < tmax_p1;
+  assign far_le_tmax_d0 = plane_t_of_last < tmax_p1;
   assign far_le_tmax = negative ? far_le_tmax_plane : far_le_tmax_d0;
   assign go_near_c = tmin_le_near & tmin_le_tmax;
   assign go_far_c = far_le_tmax & tmin_le_tmax;
@@ -539,7 +540,7 @@ module fxrt_traverse (
   assign id_r = id_r_sr[3];
 
   always @(posedge clk) begin : regs
-    if (and_23) stack[rs_sp] <= push_entry;
+    if (and_25) stack[rs_sp] <= push_entry;
     node_d1 <= node;
     for (node_d2_i = 2; node_d2_i > 1; node_d2_i = node_d2_i - 1)
       node_d2_sr[node_d2_i] <= node_d2_sr[node_d2_i - 1];
@@ -559,6 +560,7 @@ module fxrt_traverse (
       pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
     pu_product_last_sr[1] <= pu_delta_last;
     plane_t <= pu_clamped;
+    if (pu_product_last) plane_t_of_last <= pu_clamped;
     plane_t_valid <= pu_product_valid;
     plane_t_last <= pu_product_last;
     box_d1 <= plane_t;
@@ -606,15 +608,15 @@ module fxrt_traverse (
   assign not_go_near_and_go_far = not_go_near & go_far;
   assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? far_r : node;
   assign not_go_far = ~go_far;
-  assign and_16 = not_go_near & not_go_far;
-  assign mux_and_16 = and_16 ? top_node : mux_not_go_near_and_go_far;
+  assign and_18 = not_go_near & not_go_far;
+  assign mux_and_18 = and_18 ? top_node : mux_not_go_near_and_go_far;
   assign not_sp_empty = ~sp_empty;
   assign mux_not_sp_empty = not_sp_empty ? top_node : node;
   always @* begin
     case (state)
       st_idle: node_next = k_0_4;
       st_dist: node_next = near;
-      st_step: node_next = mux_and_16;
+      st_step: node_next = mux_and_18;
       st_leaf: node_next = top_node;
       st_pop: node_next = mux_not_sp_empty;
       default: node_next = node;
@@ -652,26 +654,26 @@ module fxrt_traverse (
   assign not_box_miss = ~box_miss;
   assign mux_not_box_miss = not_box_miss ? st_node : mux_box_miss;
   assign mux_node_settled = node_settled ? st_node : state;
-  assign and_17 = nw_is_leaf & nw_count_eq_k_0_7;
-  assign mux_and_17 = and_17 ? st_pop : state;
+  assign and_19 = nw_is_leaf & nw_count_eq_k_0_7;
+  assign mux_and_19 = and_19 ? st_pop : state;
   assign not_nw_count_eq_k_0_7 = ~nw_count_eq_k_0_7;
-  assign and_18 = nw_is_leaf & not_nw_count_eq_k_0_7;
-  assign mux_and_18 = and_18 ? st_leaf : mux_and_17;
+  assign and_20 = nw_is_leaf & not_nw_count_eq_k_0_7;
+  assign mux_and_20 = and_20 ? st_leaf : mux_and_19;
   assign not_nw_is_leaf_1 = ~nw_is_leaf;
-  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_18;
+  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_20;
   assign mux_d1_arrives_1 = d1_arrives ? st_step : state;
   assign mux_go_near = go_near ? st_node : state;
   assign not_go_near_and_go_far_2 = not_go_near & go_far;
   assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near;
-  assign and_19 = not_go_near & not_go_far;
-  assign mux_and_19 = and_19 ? st_pop : mux_not_go_near_and_go_far_2;
+  assign and_21 = not_go_near & not_go_far;
+  assign mux_and_21 = and_21 ? st_pop : mux_not_go_near_and_go_far_2;
   assign mux_leaf_left_eq_k_1_4 = leaf_left_eq_k_1_4 ? st_pop : state;
   assign mux_sp_empty = sp_empty ? st_done : state;
-  assign and_20 = not_sp_empty & popped_ahead;
-  assign mux_and_20 = and_20 ? st_node : mux_sp_empty;
+  assign and_22 = not_sp_empty & popped_ahead;
+  assign mux_and_22 = and_22 ? st_node : mux_sp_empty;
   assign not_popped_ahead = ~popped_ahead;
-  assign and_21 = not_sp_empty & not_popped_ahead;
-  assign mux_and_21 = and_21 ? st_fetch : mux_and_20;
+  assign and_23 = not_sp_empty & not_popped_ahead;
+  assign mux_and_23 = and_23 ? st_fetch : mux_and_22;
   always @* begin
     case (state)
       st_idle: state_next = mux_ray_valid_7;
@@ -682,9 +684,9 @@ module fxrt_traverse (
       st_node: state_next = mux_not_nw_is_leaf_1;
       st_clip1: state_next = st_dist;
       st_dist: state_next = mux_d1_arrives_1;
-      st_step: state_next = mux_and_19;
+      st_step: state_next = mux_and_21;
       st_leaf: state_next = mux_leaf_left_eq_k_1_4;
-      st_pop: state_next = mux_and_21;
+      st_pop: state_next = mux_and_23;
       st_done: state_next = st_idle;
       default: state_next = st_idle;
     endcase
@@ -716,13 +718,13 @@ module fxrt_traverse (
     endcase
   end
   assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_6 : popped_ahead;
-  assign and_22 = not_go_near & not_go_far;
-  assign mux_and_22 = and_22 ? k_0_6 : popped_ahead;
+  assign and_24 = not_go_near & not_go_far;
+  assign mux_and_24 = and_24 ? k_0_6 : popped_ahead;
   assign mux_leaf_left_eq_k_1_4_1 = leaf_left_eq_k_1_4 ? was_leaf : popped_ahead;
   always @* begin
     case (state)
       st_node: popped_ahead_next = mux_nw_is_leaf_2;
-      st_step: popped_ahead_next = mux_and_22;
+      st_step: popped_ahead_next = mux_and_24;
       st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_4_1;
       default: popped_ahead_next = popped_ahead;
     endcase
@@ -752,7 +754,7 @@ module fxrt_traverse (
     endcase
   end
   assign in_step = state == st_step;
-  assign and_23 = in_step & go_near_and_go_far;
+  assign and_25 = in_step & go_near_and_go_far;
 
   always @(posedge clk) begin : state_regs
     if (rst) state <= st_idle;

@@ -190,6 +190,7 @@ architecture rtl of fxrt_traverse is
   signal mux_pu_above : signed(61 downto 0);
   signal pu_clamped : signed(31 downto 0);
   signal plane_t : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal plane_t_of_last : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal plane_t_valid : unsigned(0 downto 0) := unsigned'("0");
   signal plane_t_last : unsigned(0 downto 0) := unsigned'("0");
   signal not_plane_t_last : unsigned(0 downto 0);
@@ -334,8 +335,8 @@ architecture rtl of fxrt_traverse is
   signal not_go_near_and_go_far : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far : unsigned(12 downto 0);
   signal not_go_far : unsigned(0 downto 0);
-  signal and_16 : unsigned(0 downto 0);
-  signal mux_and_16 : unsigned(12 downto 0);
+  signal and_18 : unsigned(0 downto 0);
+  signal mux_and_18 : unsigned(12 downto 0);
   signal not_sp_empty : unsigned(0 downto 0);
   signal mux_not_sp_empty : unsigned(12 downto 0);
   signal node_next : unsigned(12 downto 0);
@@ -364,26 +365,26 @@ architecture rtl of fxrt_traverse is
   signal not_box_miss : unsigned(0 downto 0);
   signal mux_not_box_miss : unsigned(3 downto 0);
   signal mux_node_settled : unsigned(3 downto 0);
-  signal and_17 : unsigned(0 downto 0);
-  signal mux_and_17 : unsigned(3 downto 0);
+  signal and_19 : unsigned(0 downto 0);
+  signal mux_and_19 : unsigned(3 downto 0);
   signal not_nw_count_eq_k_0_7 : unsigned(0 downto 0);
-  signal and_18 : unsigned(0 downto 0);
-  signal mux_and_18 : unsigned(3 downto 0);
+  signal and_20 : unsigned(0 downto 0);
+  signal mux_and_20 : unsigned(3 downto 0);
   signal not_nw_is_leaf_1 : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1 : unsigned(3 downto 0);
   signal mux_d1_arrives_1 : unsigned(3 downto 0);
   signal mux_go_near : unsigned(3 downto 0);
   signal not_go_near_and_go_far_2 : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far_2 : unsigned(3 downto 0);
-  signal and_19 : unsigned(0 downto 0);
-  signal mux_and_19 : unsigned(3 downto 0);
-  signal mux_leaf_left_eq_k_1_4 : unsigned(3 downto 0);
-  signal mux_sp_empty : unsigned(3 downto 0);
-  signal and_20 : unsigned(0 downto 0);
-  signal mux_and_20 : unsigned(3 downto 0);
-  signal not_popped_ahead : unsigned(0 downto 0);
   signal and_21 : unsigned(0 downto 0);
   signal mux_and_21 : unsigned(3 downto 0);
+  signal mux_leaf_left_eq_k_1_4 : unsigned(3 downto 0);
+  signal mux_sp_empty : unsigned(3 downto 0);
+  signal and_22 : unsigned(0 downto 0);
+  signal mux_and_22 : unsigned(3 downto 0);
+  signal not_popped_ahead : unsigned(0 downto 0);
+  signal and_23 : unsigned(0 downto 0);
+  signal mux_and_23 : unsigned(3 downto 0);
   signal state_next : unsigned(3 downto 0);
   signal mux_go_near_1 : signed(31 downto 0);
   signal mux_not_sp_empty_2 : signed(31 downto 0);
@@ -393,8 +394,8 @@ architecture rtl of fxrt_traverse is
   signal mux_nw_is_leaf_1 : unsigned(2 downto 0);
   signal leaf_left_next : unsigned(2 downto 0);
   signal mux_nw_is_leaf_2 : unsigned(0 downto 0);
-  signal and_22 : unsigned(0 downto 0);
-  signal mux_and_22 : unsigned(0 downto 0);
+  signal and_24 : unsigned(0 downto 0);
+  signal mux_and_24 : unsigned(0 downto 0);
   signal mux_leaf_left_eq_k_1_4_1 : unsigned(0 downto 0);
   signal popped_ahead_next : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1_1 : unsigned(1 downto 0);
@@ -416,7 +417,7 @@ architecture rtl of fxrt_traverse is
   signal mux_not_sp_empty_3 : unsigned(5 downto 0);
   signal sp_next : unsigned(5 downto 0);
   signal in_step : unsigned(0 downto 0);
-  signal and_23 : unsigned(0 downto 0);
+  signal and_25 : unsigned(0 downto 0);
 begin
 
   -- not in a stage or state machine
@@ -506,24 +507,24 @@ begin
   or_12 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
   box_miss <= or_12 or bits_box_d3;
-  near_end <= plane_t when negative = "1" else d0_r;
-  far_start <= d0_r when negative = "1" else plane_t;
+  near_end <= plane_t_of_last when negative = "1" else d0_r;
+  far_start <= d0_r when negative = "1" else plane_t_of_last;
   tmax_plus_1 <= tmax + k_1;
   tmin_minus_1 <= tmin - k_1;
   tmin_le_tmax_c <= "1" when tmin < tmax_p1 else "0";
-  near_lt_plane <= "1" when plane_t < tmax else "0";
+  near_lt_plane <= "1" when plane_t_of_last < tmax else "0";
   near_lt_d0 <= "1" when d0_r < tmax else "0";
   near_lt <= near_lt_plane when negative = "1" else near_lt_d0;
   near_lt_tmax_c <= near_lt;
   far_gt_plane <= "1" when tmin < d0_r else "0";
-  far_gt_d0 <= "1" when tmin < plane_t else "0";
+  far_gt_d0 <= "1" when tmin < plane_t_of_last else "0";
   far_gt <= far_gt_plane when negative = "1" else far_gt_d0;
   far_gt_tmin_c <= far_gt;
-  tmin_le_near_plane <= "1" when tmin_m1 < plane_t else "0";
+  tmin_le_near_plane <= "1" when tmin_m1 < plane_t_of_last else "0";
   tmin_le_near_d0 <= "1" when tmin_m1 < d0_r else "0";
   tmin_le_near <= tmin_le_near_plane when negative = "1" else tmin_le_near_d0;
   far_le_tmax_plane <= "1" when d0_r < tmax_p1 else "0";
-  far_le_tmax_d0 <= "1" when plane_t < tmax_p1 else "0";
+  far_le_tmax_d0 <= "1" when plane_t_of_last < tmax_p1 else "0";
   far_le_tmax <= far_le_tmax_plane when negative = "1" else far_le_tmax_d0;
   go_near_c <= tmin_le_near and tmin_le_tmax;
   go_far_c <= far_le_tmax and tmin_le_tmax;
@@ -574,7 +575,7 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if and_23 = "1" then
+      if and_25 = "1" then
         stack(to_integer(rs_sp)) <= push_entry;
       end if;
       node_d1 <= node;
@@ -593,6 +594,9 @@ begin
       pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
       pu_product_last_sr(1) <= pu_delta_last;
       plane_t <= pu_clamped;
+      if pu_product_last = "1" then
+        plane_t_of_last <= pu_clamped;
+      end if;
       plane_t_valid <= pu_product_valid;
       plane_t_last <= pu_product_last;
       box_d1 <= plane_t;
@@ -634,15 +638,15 @@ begin
   not_go_near_and_go_far <= not_go_near and go_far;
   mux_not_go_near_and_go_far <= far_r when not_go_near_and_go_far = "1" else node;
   not_go_far <= not go_far;
-  and_16 <= not_go_near and not_go_far;
-  mux_and_16 <= top_node when and_16 = "1" else mux_not_go_near_and_go_far;
+  and_18 <= not_go_near and not_go_far;
+  mux_and_18 <= top_node when and_18 = "1" else mux_not_go_near_and_go_far;
   not_sp_empty <= not sp_empty;
   mux_not_sp_empty <= top_node when not_sp_empty = "1" else node;
   with state select
     node_next <=
       k_0_4 when st_idle,
       near when st_dist,
-      mux_and_16 when st_step,
+      mux_and_18 when st_step,
       top_node when st_leaf,
       mux_not_sp_empty when st_pop,
       node when others;
@@ -676,26 +680,26 @@ begin
   not_box_miss <= not box_miss;
   mux_not_box_miss <= st_node when not_box_miss = "1" else mux_box_miss;
   mux_node_settled <= st_node when node_settled = "1" else state;
-  and_17 <= nw_is_leaf and nw_count_eq_k_0_7;
-  mux_and_17 <= st_pop when and_17 = "1" else state;
+  and_19 <= nw_is_leaf and nw_count_eq_k_0_7;
+  mux_and_19 <= st_pop when and_19 = "1" else state;
   not_nw_count_eq_k_0_7 <= not nw_count_eq_k_0_7;
-  and_18 <= nw_is_leaf and not_nw_count_eq_k_0_7;
-  mux_and_18 <= st_leaf when and_18 = "1" else mux_and_17;
+  and_20 <= nw_is_leaf and not_nw_count_eq_k_0_7;
+  mux_and_20 <= st_leaf when and_20 = "1" else mux_and_19;
   not_nw_is_leaf_1 <= not nw_is_leaf;
-  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_18;
+  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_20;
   mux_d1_arrives_1 <= st_step when d1_arrives = "1" else state;
   mux_go_near <= st_node when go_near = "1" else state;
   not_go_near_and_go_far_2 <= not_go_near and go_far;
   mux_not_go_near_and_go_far_2 <= st_fetch when not_go_near_and_go_far_2 = "1" else mux_go_near;
-  and_19 <= not_go_near and not_go_far;
-  mux_and_19 <= st_pop when and_19 = "1" else mux_not_go_near_and_go_far_2;
+  and_21 <= not_go_near and not_go_far;
+  mux_and_21 <= st_pop when and_21 = "1" else mux_not_go_near_and_go_far_2;
   mux_leaf_left_eq_k_1_4 <= st_pop when leaf_left_eq_k_1_4 = "1" else state;
   mux_sp_empty <= st_done when sp_empty = "1" else state;
-  and_20 <= not_sp_empty and popped_ahead;
-  mux_and_20 <= st_node when and_20 = "1" else mux_sp_empty;
+  and_22 <= not_sp_empty and popped_ahead;
+  mux_and_22 <= st_node when and_22 = "1" else mux_sp_empty;
   not_popped_ahead <= not popped_ahead;
-  and_21 <= not_sp_empty and not_popped_ahead;
-  mux_and_21 <= st_fetch when and_21 = "1" else mux_and_20;
+  and_23 <= not_sp_empty and not_popped_ahead;
+  mux_and_23 <= st_fetch when and_23 = "1" else mux_and_22;
   with state select
     state_next <=
       mux_ray_valid_7 when st_idle,
@@ -706,9 +710,9 @@ begin
       mux_not_nw_is_leaf_1 when st_node,
       st_dist when st_clip1,
       mux_d1_arrives_1 when st_dist,
-      mux_and_19 when st_step,
+      mux_and_21 when st_step,
       mux_leaf_left_eq_k_1_4 when st_leaf,
-      mux_and_21 when st_pop,
+      mux_and_23 when st_pop,
       st_idle when st_done,
       st_idle when others;
   mux_go_near_1 <= near_max when go_near = "1" else tmax;
@@ -732,13 +736,13 @@ begin
       leaf_left_minus_k_1_4 when st_leaf,
       leaf_left when others;
   mux_nw_is_leaf_2 <= k_0_6 when nw_is_leaf = "1" else popped_ahead;
-  and_22 <= not_go_near and not_go_far;
-  mux_and_22 <= k_0_6 when and_22 = "1" else popped_ahead;
+  and_24 <= not_go_near and not_go_far;
+  mux_and_24 <= k_0_6 when and_24 = "1" else popped_ahead;
   mux_leaf_left_eq_k_1_4_1 <= was_leaf when leaf_left_eq_k_1_4 = "1" else popped_ahead;
   with state select
     popped_ahead_next <=
       mux_nw_is_leaf_2 when st_node,
-      mux_and_22 when st_step,
+      mux_and_24 when st_step,
       mux_leaf_left_eq_k_1_4_1 when st_leaf,
       popped_ahead when others;
   mux_not_nw_is_leaf_1_1 <= nw_axis when not_nw_is_leaf_1 = "1" else axis_r;
@@ -764,7 +768,7 @@ begin
       mux_not_sp_empty_3 when st_pop,
       sp when others;
   in_step <= "1" when state = st_step else "0";
-  and_23 <= in_step and go_near_and_go_far;
+  and_25 <= in_step and go_near_and_go_far;
 
   state_regs : process (clk)
   begin

@@ -50,6 +50,8 @@ pub struct PlaneIssue<'b> {
 pub struct PlaneResult<'b> {
     /// The clamped distance, signed n + 3 bits.
     pub t: S<'b>,
+    /// `t` when `last` is 1 (the same register value then), held otherwise.
+    pub t_last: S<'b>,
     pub valid: S<'b>,
     pub last: S<'b>,
     pub latency: u32,
@@ -93,9 +95,16 @@ pub fn plane_unit<'b>(
     let above = (!shifted.msb() & (above_bits | (shifted.bit(k) & shifted.slice(0, k).ne(0)))).name("pu_above");
     let t_sat = shifted.k(1i128 << k);
     let clamped = above.select(t_sat, below.select(shifted.k(-1), shifted));
-    let t = b.delay("plane_t", clamped.resize(Ty::s(n + 3).width).name("pu_clamped"));
+    let clamped = clamped.resize(Ty::s(n + 3).width).name("pu_clamped");
+    let t = b.delay("plane_t", clamped);
+    // The same distance in a register that loads only with a group's last one: a copy for the
+    // traversal's decision compares, so `t` does not fan out to every compare (yosys merges two
+    // equal registers, not two with different enables).
+    let t_last = b.reg("plane_t_of_last", t.ty(), None);
+    b.next_when(t_last, last, clamped);
     PlaneResult {
         t,
+        t_last,
         valid: b.delay("plane_t_valid", valid),
         last: b.delay("plane_t_last", last),
         latency: 3 + product_latency,
