@@ -61,9 +61,6 @@ module fxrt_traverse (
   wire [2:0] nw_count;
   wire [1:0] k_3 = 2'h3;
   wire [0:0] nw_is_leaf;
-  wire [0:0] in_aabb;
-  wire [0:0] in_node;
-  wire [0:0] in_clip1;
   wire [28:0] box_hi_0 = 29'h1fffffff;
   wire [28:0] box_hi_1 = 29'h0faab179;
   wire [28:0] box_hi_2 = 29'h13e4f19b;
@@ -208,7 +205,6 @@ module fxrt_traverse (
   wire [31:0] bits_stack_top_1;
   wire signed [31:0] top_tmin;
   wire [12:0] top_node;
-  wire [0:0] in_leaf;
   reg [0:0] was_leaf1 = 1'h0;
   (* mem2reg *) reg [0:0] was_leaf2_sr [1:2];
   integer was_leaf2_i;
@@ -238,8 +234,6 @@ module fxrt_traverse (
   wire [2:0] leaf_left_minus_k_1_4;
   wire [0:0] leaf_left_eq_k_1_4;
   wire [5:0] sp_minus_k_1_2_1;
-  wire [0:0] in_idle;
-  wire [0:0] in_done;
   wire [12:0] u_leaf_rom_data;
   wire [0:0] in_leaf_or_in_done;
   (* mem2reg *) reg [0:0] emit_r_sr [1:3];
@@ -279,6 +273,9 @@ module fxrt_traverse (
   reg [1:0] aabb_k = 2'h0;
   reg signed [31:0] tmin = 32'sh00000000;
   reg signed [31:0] tmax = 32'sh00000000;
+  reg [0:0] in_aabb = 1'h0;
+  reg [0:0] in_node = 1'h0;
+  reg [0:0] in_clip1 = 1'h0;
   reg [0:0] negative = 1'h0;
   reg signed [31:0] d0_r = 32'sh00000000;
   reg signed [31:0] near_end_r = 32'sh00000000;
@@ -288,6 +285,9 @@ module fxrt_traverse (
   reg [12:0] leaf_ptr = 13'h0000;
   reg [2:0] leaf_left = 3'h0;
   reg [0:0] popped_ahead = 1'h0;
+  reg [0:0] in_leaf = 1'h0;
+  reg [0:0] in_idle = 1'h1;
+  reg [0:0] in_done = 1'h0;
   reg [1:0] aabb_k_next;
   wire [0:0] not_go_near;
   wire [0:0] not_go_near_and_go_far;
@@ -363,7 +363,7 @@ module fxrt_traverse (
   wire [12:0] mux_not_nw_is_leaf_1_3;
   wire [12:0] child_r_next;
   wire [0:0] negative_next;
-  wire [0:0] in_dist;
+  reg [0:0] in_dist = 1'h0;
   wire [12:0] far_r_next;
   wire signed [31:0] mux_d0_arrives;
   wire signed [31:0] d0_r_next;
@@ -374,8 +374,16 @@ module fxrt_traverse (
   wire [5:0] mux_go_near_and_go_far;
   wire [5:0] mux_not_sp_empty_3;
   reg [5:0] sp_next;
-  wire [0:0] in_step;
+  reg [0:0] in_step = 1'h0;
   wire [0:0] and_25;
+  wire [0:0] in_idle_next;
+  wire [0:0] in_aabb_next;
+  wire [0:0] in_node_next;
+  wire [0:0] in_clip1_next;
+  wire [0:0] in_dist_next;
+  wire [0:0] in_step_next;
+  wire [0:0] in_leaf_next;
+  wire [0:0] in_done_next;
 
   // not in a stage or state machine
   assign node_eq_node_d1 = node == node_d1;
@@ -389,9 +397,6 @@ module fxrt_traverse (
   assign nw_first = u_node_rom_data[14:2];
   assign nw_count = u_node_rom_data[17:15];
   assign nw_is_leaf = nw_axis == k_3;
-  assign in_aabb = state == st_aabb;
-  assign in_node = state == st_node;
-  assign in_clip1 = state == st_clip1;
   always @* begin
     case (aabb_k)
       2'h1: case_aabb_k = invy_r;
@@ -508,7 +513,6 @@ module fxrt_traverse (
   assign bits_stack_top_1 = stack_top[63:32];
   assign top_tmin = $signed(bits_stack_top_1);
   assign top_node = stack_top[76:64];
-  assign in_leaf = state == st_leaf;
   assign was_leaf2 = was_leaf2_sr[2];
   assign was_leaf = was_leaf1 & was_leaf2;
   assign sp_is_zero = sp == k_0_2;
@@ -529,8 +533,6 @@ module fxrt_traverse (
   assign leaf_left_minus_k_1_4 = leaf_left - k_1_4;
   assign leaf_left_eq_k_1_4 = leaf_left == k_1_4;
   assign sp_minus_k_1_2_1 = sp - k_1_2;
-  assign in_idle = state == st_idle;
-  assign in_done = state == st_done;
   assign in_leaf_or_in_done = in_leaf | in_done;
   assign emit_r = emit_r_sr[3];
   assign end_r = end_r_sr[3];
@@ -736,7 +738,6 @@ module fxrt_traverse (
   assign mux_not_nw_is_leaf_1_3 = not_nw_is_leaf_1 ? nw_child : child_r;
   assign child_r_next = in_node ? mux_not_nw_is_leaf_1_3 : child_r;
   assign negative_next = in_clip1 ? bits_case_axis_r : negative;
-  assign in_dist = state == st_dist;
   assign far_r_next = in_dist ? far : far_r;
   assign mux_d0_arrives = d0_arrives ? plane_t : d0_r;
   assign d0_r_next = in_dist ? mux_d0_arrives : d0_r;
@@ -753,8 +754,15 @@ module fxrt_traverse (
       default: sp_next = sp;
     endcase
   end
-  assign in_step = state == st_step;
   assign and_25 = in_step & go_near_and_go_far;
+  assign in_idle_next = state_next == st_idle;
+  assign in_aabb_next = state_next == st_aabb;
+  assign in_node_next = state_next == st_node;
+  assign in_clip1_next = state_next == st_clip1;
+  assign in_dist_next = state_next == st_dist;
+  assign in_step_next = state_next == st_step;
+  assign in_leaf_next = state_next == st_leaf;
+  assign in_done_next = state_next == st_done;
 
   always @(posedge clk) begin : state_regs
     if (rst) state <= st_idle;
@@ -774,6 +782,12 @@ module fxrt_traverse (
     aabb_k <= aabb_k_next;
     tmin <= tmin_next;
     tmax <= tmax_next;
+    if (rst) in_aabb <= 1'h0;
+    else in_aabb <= in_aabb_next;
+    if (rst) in_node <= 1'h0;
+    else in_node <= in_node_next;
+    if (rst) in_clip1 <= 1'h0;
+    else in_clip1 <= in_clip1_next;
     negative <= negative_next;
     d0_r <= d0_r_next;
     near_end_r <= near_end_r_next;
@@ -784,6 +798,16 @@ module fxrt_traverse (
     leaf_ptr <= leaf_ptr_next;
     leaf_left <= leaf_left_next;
     popped_ahead <= popped_ahead_next;
+    if (rst) in_leaf <= 1'h0;
+    else in_leaf <= in_leaf_next;
+    if (rst) in_idle <= 1'h1;
+    else in_idle <= in_idle_next;
+    if (rst) in_done <= 1'h0;
+    else in_done <= in_done_next;
+    if (rst) in_dist <= 1'h0;
+    else in_dist <= in_dist_next;
+    if (rst) in_step <= 1'h0;
+    else in_step <= in_step_next;
   end
 
   fxrt_brom_node u_node_rom (

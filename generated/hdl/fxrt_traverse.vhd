@@ -122,9 +122,6 @@ architecture rtl of fxrt_traverse is
   signal nw_count : unsigned(2 downto 0);
   constant k_3 : unsigned(1 downto 0) := unsigned'("11");
   signal nw_is_leaf : unsigned(0 downto 0);
-  signal in_aabb : unsigned(0 downto 0);
-  signal in_node : unsigned(0 downto 0);
-  signal in_clip1 : unsigned(0 downto 0);
   constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
   constant box_hi_1 : unsigned(28 downto 0) := unsigned'("01111101010101011000101111001");
   constant box_hi_2 : unsigned(28 downto 0) := unsigned'("10011111001001111000110011011");
@@ -259,7 +256,6 @@ architecture rtl of fxrt_traverse is
   signal bits_stack_top_1 : unsigned(31 downto 0);
   signal top_tmin : signed(31 downto 0);
   signal top_node : unsigned(12 downto 0);
-  signal in_leaf : unsigned(0 downto 0);
   signal was_leaf1 : unsigned(0 downto 0) := unsigned'("0");
   type was_leaf2_sr_t is array (1 to 2) of unsigned(0 downto 0);
   signal was_leaf2_sr : was_leaf2_sr_t := (others => (others => '0'));
@@ -286,8 +282,6 @@ architecture rtl of fxrt_traverse is
   signal leaf_left_minus_k_1_4 : unsigned(2 downto 0);
   signal leaf_left_eq_k_1_4 : unsigned(0 downto 0);
   signal sp_minus_k_1_2_1 : unsigned(5 downto 0);
-  signal in_idle : unsigned(0 downto 0);
-  signal in_done : unsigned(0 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   signal in_leaf_or_in_done : unsigned(0 downto 0);
   type emit_r_sr_t is array (1 to 3) of unsigned(0 downto 0);
@@ -321,6 +315,9 @@ architecture rtl of fxrt_traverse is
   signal aabb_k : unsigned(1 downto 0) := unsigned'("00");
   signal tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal in_aabb : unsigned(0 downto 0) := unsigned'("0");
+  signal in_node : unsigned(0 downto 0) := unsigned'("0");
+  signal in_clip1 : unsigned(0 downto 0) := unsigned'("0");
   signal negative : unsigned(0 downto 0) := unsigned'("0");
   signal d0_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal near_end_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -330,6 +327,9 @@ architecture rtl of fxrt_traverse is
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal leaf_left : unsigned(2 downto 0) := unsigned'("000");
   signal popped_ahead : unsigned(0 downto 0) := unsigned'("0");
+  signal in_leaf : unsigned(0 downto 0) := unsigned'("0");
+  signal in_idle : unsigned(0 downto 0) := unsigned'("1");
+  signal in_done : unsigned(0 downto 0) := unsigned'("0");
   signal aabb_k_next : unsigned(1 downto 0);
   signal not_go_near : unsigned(0 downto 0);
   signal not_go_near_and_go_far : unsigned(0 downto 0);
@@ -405,7 +405,7 @@ architecture rtl of fxrt_traverse is
   signal mux_not_nw_is_leaf_1_3 : unsigned(12 downto 0);
   signal child_r_next : unsigned(12 downto 0);
   signal negative_next : unsigned(0 downto 0);
-  signal in_dist : unsigned(0 downto 0);
+  signal in_dist : unsigned(0 downto 0) := unsigned'("0");
   signal far_r_next : unsigned(12 downto 0);
   signal mux_d0_arrives : signed(31 downto 0);
   signal d0_r_next : signed(31 downto 0);
@@ -416,8 +416,16 @@ architecture rtl of fxrt_traverse is
   signal mux_go_near_and_go_far : unsigned(5 downto 0);
   signal mux_not_sp_empty_3 : unsigned(5 downto 0);
   signal sp_next : unsigned(5 downto 0);
-  signal in_step : unsigned(0 downto 0);
+  signal in_step : unsigned(0 downto 0) := unsigned'("0");
   signal and_25 : unsigned(0 downto 0);
+  signal in_idle_next : unsigned(0 downto 0);
+  signal in_aabb_next : unsigned(0 downto 0);
+  signal in_node_next : unsigned(0 downto 0);
+  signal in_clip1_next : unsigned(0 downto 0);
+  signal in_dist_next : unsigned(0 downto 0);
+  signal in_step_next : unsigned(0 downto 0);
+  signal in_leaf_next : unsigned(0 downto 0);
+  signal in_done_next : unsigned(0 downto 0);
 begin
 
   -- not in a stage or state machine
@@ -432,9 +440,6 @@ begin
   nw_first <= unsigned(u_node_rom_data(14 downto 2));
   nw_count <= unsigned(u_node_rom_data(17 downto 15));
   nw_is_leaf <= "1" when nw_axis = k_3 else "0";
-  in_aabb <= "1" when state = st_aabb else "0";
-  in_node <= "1" when state = st_node else "0";
-  in_clip1 <= "1" when state = st_clip1 else "0";
   with aabb_k select
     case_aabb_k <=
       invy_r when "01",
@@ -543,7 +548,6 @@ begin
   bits_stack_top_1 <= unsigned(stack_top(63 downto 32));
   top_tmin <= signed(bits_stack_top_1);
   top_node <= unsigned(stack_top(76 downto 64));
-  in_leaf <= "1" when state = st_leaf else "0";
   was_leaf2 <= was_leaf2_sr(2);
   was_leaf <= was_leaf1 and was_leaf2;
   sp_is_zero <= "1" when sp = k_0_2 else "0";
@@ -562,8 +566,6 @@ begin
   leaf_left_minus_k_1_4 <= leaf_left - k_1_4;
   leaf_left_eq_k_1_4 <= "1" when leaf_left = k_1_4 else "0";
   sp_minus_k_1_2_1 <= sp - k_1_2;
-  in_idle <= "1" when state = st_idle else "0";
-  in_done <= "1" when state = st_done else "0";
   in_leaf_or_in_done <= in_leaf or in_done;
   emit_r <= emit_r_sr(3);
   end_r <= end_r_sr(3);
@@ -752,7 +754,6 @@ begin
   mux_not_nw_is_leaf_1_3 <= nw_child when not_nw_is_leaf_1 = "1" else child_r;
   child_r_next <= mux_not_nw_is_leaf_1_3 when in_node = "1" else child_r;
   negative_next <= bits_case_axis_r when in_clip1 = "1" else negative;
-  in_dist <= "1" when state = st_dist else "0";
   far_r_next <= far when in_dist = "1" else far_r;
   mux_d0_arrives <= plane_t when d0_arrives = "1" else d0_r;
   d0_r_next <= mux_d0_arrives when in_dist = "1" else d0_r;
@@ -767,8 +768,15 @@ begin
       mux_go_near_and_go_far when st_step,
       mux_not_sp_empty_3 when st_pop,
       sp when others;
-  in_step <= "1" when state = st_step else "0";
   and_25 <= in_step and go_near_and_go_far;
+  in_idle_next <= "1" when state_next = st_idle else "0";
+  in_aabb_next <= "1" when state_next = st_aabb else "0";
+  in_node_next <= "1" when state_next = st_node else "0";
+  in_clip1_next <= "1" when state_next = st_clip1 else "0";
+  in_dist_next <= "1" when state_next = st_dist else "0";
+  in_step_next <= "1" when state_next = st_step else "0";
+  in_leaf_next <= "1" when state_next = st_leaf else "0";
+  in_done_next <= "1" when state_next = st_done else "0";
 
   state_regs : process (clk)
   begin
@@ -796,6 +804,21 @@ begin
       aabb_k <= aabb_k_next;
       tmin <= tmin_next;
       tmax <= tmax_next;
+      if rst = '1' then
+        in_aabb <= unsigned'("0");
+      else
+        in_aabb <= in_aabb_next;
+      end if;
+      if rst = '1' then
+        in_node <= unsigned'("0");
+      else
+        in_node <= in_node_next;
+      end if;
+      if rst = '1' then
+        in_clip1 <= unsigned'("0");
+      else
+        in_clip1 <= in_clip1_next;
+      end if;
       negative <= negative_next;
       d0_r <= d0_r_next;
       near_end_r <= near_end_r_next;
@@ -809,6 +832,31 @@ begin
       leaf_ptr <= leaf_ptr_next;
       leaf_left <= leaf_left_next;
       popped_ahead <= popped_ahead_next;
+      if rst = '1' then
+        in_leaf <= unsigned'("0");
+      else
+        in_leaf <= in_leaf_next;
+      end if;
+      if rst = '1' then
+        in_idle <= unsigned'("1");
+      else
+        in_idle <= in_idle_next;
+      end if;
+      if rst = '1' then
+        in_done <= unsigned'("0");
+      else
+        in_done <= in_done_next;
+      end if;
+      if rst = '1' then
+        in_dist <= unsigned'("0");
+      else
+        in_dist <= in_dist_next;
+      end if;
+      if rst = '1' then
+        in_step <= unsigned'("0");
+      else
+        in_step <= in_step_next;
+      end if;
     end if;
   end process state_regs;
 
