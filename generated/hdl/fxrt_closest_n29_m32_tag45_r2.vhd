@@ -40,18 +40,18 @@ architecture rtl of fxrt_closest_n29_m32_tag45_r2 is
   signal t_plus_8 : signed(31 downto 0);
   signal in_tmin_less : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal in_t_plus_8 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal in_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal in_end : unsigned(0 downto 0) := unsigned'("0");
+  signal in_hit : unsigned(0 downto 0) := unsigned'("0");
   signal lt_1 : unsigned(0 downto 0);
   signal accepted : unsigned(0 downto 0);
-  signal in_accepted : unsigned(0 downto 0) := unsigned'("0");
-  type in_valid_sr_t is array (1 to 2) of unsigned(0 downto 0);
-  signal in_valid_sr : in_valid_sr_t := (others => (others => '0'));
-  signal in_valid : unsigned(0 downto 0);
-  type in_end_sr_t is array (1 to 2) of unsigned(0 downto 0);
-  signal in_end_sr : in_end_sr_t := (others => (others => '0'));
-  signal in_end : unsigned(0 downto 0);
-  type in_hit_sr_t is array (1 to 2) of unsigned(0 downto 0);
-  signal in_hit_sr : in_hit_sr_t := (others => (others => '0'));
-  signal in_hit : unsigned(0 downto 0);
+  signal not_in_end : unsigned(0 downto 0);
+  signal in_valid_and_not_in_end : unsigned(0 downto 0);
+  signal and_2 : unsigned(0 downto 0);
+  signal candidate_c : unsigned(0 downto 0);
+  signal in_candidate : unsigned(0 downto 0) := unsigned'("0");
+  signal finish_c : unsigned(0 downto 0);
+  signal in_finish : unsigned(0 downto 0) := unsigned'("0");
   type in_tri_sr_t is array (1 to 2) of unsigned(12 downto 0);
   signal in_tri_sr : in_tri_sr_t := (others => (others => '0'));
   signal in_tri : unsigned(12 downto 0);
@@ -72,23 +72,16 @@ architecture rtl of fxrt_closest_n29_m32_tag45_r2 is
   signal best_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal best_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal best_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal in_t_lt_best_t : unsigned(0 downto 0);
-  signal in_t_eq_best_t : unsigned(0 downto 0);
-  signal in_tri_lt_best_tri : unsigned(0 downto 0);
-  signal and_2 : unsigned(0 downto 0);
+  signal cat_3 : unsigned(42 downto 0);
+  signal cat_4 : unsigned(42 downto 0);
   signal closer : unsigned(0 downto 0);
   signal not_best_valid : unsigned(0 downto 0);
   signal better : unsigned(0 downto 0);
-  signal not_in_end : unsigned(0 downto 0);
-  signal in_valid_and_not_in_end : unsigned(0 downto 0);
-  signal and_3 : unsigned(0 downto 0);
-  signal and_3_and_in_accepted : unsigned(0 downto 0);
   signal take : unsigned(0 downto 0);
-  signal finish : unsigned(0 downto 0);
   constant k_0 : unsigned(0 downto 0) := unsigned'("0");
   constant k_1 : unsigned(0 downto 0) := unsigned'("1");
   signal mux_take : unsigned(0 downto 0);
-  signal mux_finish : unsigned(0 downto 0);
+  signal mux_in_finish : unsigned(0 downto 0);
   signal res_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal res_hit_r : unsigned(0 downto 0) := unsigned'("0");
   signal res_id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
@@ -119,29 +112,24 @@ begin
   t_plus_8 <= rs_s_rs_t + k_8;
   lt_1 <= "1" when in_t_plus_8 < in_tmin_less else "0";
   accepted <= not lt_1;
-  in_valid <= in_valid_sr(2);
-  in_end <= in_end_sr(2);
-  in_hit <= in_hit_sr(2);
+  not_in_end <= not in_end;
+  in_valid_and_not_in_end <= in_valid and not_in_end;
+  and_2 <= in_valid_and_not_in_end and in_hit;
+  candidate_c <= and_2 and accepted;
+  finish_c <= in_valid and in_end;
   in_tri <= in_tri_sr(2);
   in_id <= in_id_sr(2);
   in_t <= in_t_sr(2);
   in_u <= in_u_sr(2);
   in_v <= in_v_sr(2);
-  in_t_lt_best_t <= "1" when in_t < best_t else "0";
-  in_t_eq_best_t <= "1" when in_t = best_t else "0";
-  in_tri_lt_best_tri <= "1" when in_tri < best_tri else "0";
-  and_2 <= in_t_eq_best_t and in_tri_lt_best_tri;
-  closer <= in_t_lt_best_t or and_2;
+  cat_3 <= unsigned(std_logic_vector'(std_logic_vector(in_t) & std_logic_vector(in_tri)));
+  cat_4 <= unsigned(std_logic_vector'(std_logic_vector(best_t) & std_logic_vector(best_tri)));
+  closer <= "1" when cat_3 < cat_4 else "0";
   not_best_valid <= not best_valid;
   better <= not_best_valid or closer;
-  not_in_end <= not in_end;
-  in_valid_and_not_in_end <= in_valid and not_in_end;
-  and_3 <= in_valid_and_not_in_end and in_hit;
-  and_3_and_in_accepted <= and_3 and in_accepted;
-  take <= and_3_and_in_accepted and better;
-  finish <= in_valid and in_end;
+  take <= in_candidate and better;
   mux_take <= k_1 when take = "1" else best_valid;
-  mux_finish <= k_0 when finish = "1" else mux_take;
+  mux_in_finish <= k_0 when in_finish = "1" else mux_take;
   mux_best_valid <= best_tri when best_valid = "1" else k_0_1;
   mux_best_valid_1 <= best_t when best_valid = "1" else k_0_2;
   mux_best_valid_2 <= best_u when best_valid = "1" else k_0_3;
@@ -152,13 +140,11 @@ begin
     if rising_edge(clk) then
       in_tmin_less <= tmin_less;
       in_t_plus_8 <= t_plus_8;
-      in_accepted <= accepted;
-      in_valid_sr(2 to 2) <= in_valid_sr(1 to 1);
-      in_valid_sr(1) <= valid;
-      in_end_sr(2 to 2) <= in_end_sr(1 to 1);
-      in_end_sr(1) <= end_s;
-      in_hit_sr(2 to 2) <= in_hit_sr(1 to 1);
-      in_hit_sr(1) <= hit;
+      in_valid <= valid;
+      in_end <= end_s;
+      in_hit <= hit;
+      in_candidate <= candidate_c;
+      in_finish <= finish_c;
       in_tri_sr(2 to 2) <= in_tri_sr(1 to 1);
       in_tri_sr(1) <= tri_s;
       in_id_sr(2 to 2) <= in_id_sr(1 to 1);
@@ -172,7 +158,7 @@ begin
       if rst = '1' then
         best_valid <= unsigned'("0");
       else
-        best_valid <= mux_finish;
+        best_valid <= mux_in_finish;
       end if;
       if take = "1" then
         best_t <= in_t;
@@ -189,24 +175,24 @@ begin
       if rst = '1' then
         res_valid_r <= unsigned'("0");
       else
-        res_valid_r <= finish;
+        res_valid_r <= in_finish;
       end if;
-      if finish = "1" then
+      if in_finish = "1" then
         res_hit_r <= best_valid;
       end if;
-      if finish = "1" then
+      if in_finish = "1" then
         res_id_r <= in_id;
       end if;
-      if finish = "1" then
+      if in_finish = "1" then
         res_tri_r <= mux_best_valid;
       end if;
-      if finish = "1" then
+      if in_finish = "1" then
         res_t_r <= mux_best_valid_1;
       end if;
-      if finish = "1" then
+      if in_finish = "1" then
         res_u_r <= mux_best_valid_2;
       end if;
-      if finish = "1" then
+      if in_finish = "1" then
         res_v_r <= mux_best_valid_3;
       end if;
     end if;

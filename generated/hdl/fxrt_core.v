@@ -27,15 +27,6 @@ module fxrt_core (
   output wire [3:0] fsm_state
 );
 
-  reg [123:0] tri_rom_0 [0:8191];
-  initial $readmemh("fxrt_core_tri_rom_0.hex", tri_rom_0);
-
-  reg [127:0] tri_rom_1 [0:8191];
-  initial $readmemh("fxrt_core_tri_rom_1.hex", tri_rom_1);
-
-  reg [31:0] tri_rom_2 [0:8191];
-  initial $readmemh("fxrt_core_tri_rom_2.hex", tri_rom_2);
-
   wire [0:0] u_traverse_ray_ready;
   wire [0:0] u_traverse_emit_valid;
   wire [0:0] u_traverse_emit_end;
@@ -58,31 +49,61 @@ module fxrt_core (
   reg signed [31:0] wy_r = 32'sh00000000;
   reg signed [31:0] wz_r = 32'sh00000000;
   wire [12:0] tri_addr;
-  reg [123:0] tri_word_0 = 124'h0000000000000000000000000000000;
+  wire [123:0] u_tri_rom_0_data;
   wire [1:0] tri_r;
   wire [28:0] tri_pp;
   wire [28:0] tri_pq;
-  wire [31:0] bits_tri_word_0;
+  wire [31:0] bits_u_tri_rom_0_data;
   wire signed [31:0] tri_d;
-  wire [31:0] bits_tri_word_0_1;
+  wire [31:0] bits_u_tri_rom_0_data_1;
   wire signed [31:0] tri_np;
-  reg [127:0] tri_word_1 = 128'h00000000000000000000000000000000;
-  wire [31:0] bits_tri_word_1;
+  wire [127:0] u_tri_rom_1_data;
+  wire [31:0] bits_u_tri_rom_1_data;
   wire signed [31:0] tri_nq;
-  wire [31:0] bits_tri_word_1_1;
+  wire [31:0] bits_u_tri_rom_1_data_1;
   wire signed [31:0] tri_e1p;
-  wire [31:0] bits_tri_word_1_2;
+  wire [31:0] bits_u_tri_rom_1_data_2;
   wire signed [31:0] tri_e1q;
-  wire [31:0] bits_tri_word_1_3;
+  wire [31:0] bits_u_tri_rom_1_data_3;
   wire signed [31:0] tri_e2p;
-  reg [31:0] tri_word_2 = 32'h00000000;
+  wire [31:0] u_tri_rom_2_data;
   wire signed [31:0] tri_e2q;
   wire [43:0] cat_1;
   wire [43:0] rs_u_traverse_emit_id;
   wire [43:0] mux_u_traverse_emit_end;
   wire [44:0] tag;
-  reg [0:0] pipe_valid = 1'h0;
-  reg [44:0] pipe_tag = 45'h000000000000;
+  (* mem2reg *) reg [0:0] pipe_valid_sr [1:3];
+  integer pipe_valid_i;
+  initial for (pipe_valid_i = 1; pipe_valid_i <= 3; pipe_valid_i = pipe_valid_i + 1) pipe_valid_sr[pipe_valid_i] = 1'h0;
+  wire [0:0] pipe_valid;
+  (* mem2reg *) reg [44:0] pipe_tag_sr [1:3];
+  integer pipe_tag_i;
+  initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 45'h000000000000;
+  wire [44:0] pipe_tag;
+  (* mem2reg *) reg [28:0] pipe_cur_ox_sr [1:3];
+  integer pipe_cur_ox_i;
+  initial for (pipe_cur_ox_i = 1; pipe_cur_ox_i <= 3; pipe_cur_ox_i = pipe_cur_ox_i + 1) pipe_cur_ox_sr[pipe_cur_ox_i] = 29'h00000000;
+  wire [28:0] pipe_cur_ox;
+  (* mem2reg *) reg [28:0] pipe_cur_oy_sr [1:3];
+  integer pipe_cur_oy_i;
+  initial for (pipe_cur_oy_i = 1; pipe_cur_oy_i <= 3; pipe_cur_oy_i = pipe_cur_oy_i + 1) pipe_cur_oy_sr[pipe_cur_oy_i] = 29'h00000000;
+  wire [28:0] pipe_cur_oy;
+  (* mem2reg *) reg [28:0] pipe_cur_oz_sr [1:3];
+  integer pipe_cur_oz_i;
+  initial for (pipe_cur_oz_i = 1; pipe_cur_oz_i <= 3; pipe_cur_oz_i = pipe_cur_oz_i + 1) pipe_cur_oz_sr[pipe_cur_oz_i] = 29'h00000000;
+  wire [28:0] pipe_cur_oz;
+  (* mem2reg *) reg signed [31:0] pipe_wx_sr [1:3];
+  integer pipe_wx_i;
+  initial for (pipe_wx_i = 1; pipe_wx_i <= 3; pipe_wx_i = pipe_wx_i + 1) pipe_wx_sr[pipe_wx_i] = 32'sh00000000;
+  wire signed [31:0] pipe_wx;
+  (* mem2reg *) reg signed [31:0] pipe_wy_sr [1:3];
+  integer pipe_wy_i;
+  initial for (pipe_wy_i = 1; pipe_wy_i <= 3; pipe_wy_i = pipe_wy_i + 1) pipe_wy_sr[pipe_wy_i] = 32'sh00000000;
+  wire signed [31:0] pipe_wy;
+  (* mem2reg *) reg signed [31:0] pipe_wz_sr [1:3];
+  integer pipe_wz_i;
+  initial for (pipe_wz_i = 1; pipe_wz_i <= 3; pipe_wz_i = pipe_wz_i + 1) pipe_wz_sr[pipe_wz_i] = 32'sh00000000;
+  wire signed [31:0] pipe_wz;
   wire [0:0] u_intersect_valid_out;
   wire [44:0] u_intersect_tag_out;
   wire [0:0] u_intersect_hit;
@@ -102,26 +123,34 @@ module fxrt_core (
 
   assign accept = ray_valid & u_traverse_ray_ready;
   assign tri_addr = u_traverse_emit_tri;
-  assign tri_r = tri_word_0[1:0];
-  assign tri_pp = tri_word_0[30:2];
-  assign tri_pq = tri_word_0[59:31];
-  assign bits_tri_word_0 = tri_word_0[91:60];
-  assign tri_d = $signed(bits_tri_word_0);
-  assign bits_tri_word_0_1 = tri_word_0[123:92];
-  assign tri_np = $signed(bits_tri_word_0_1);
-  assign bits_tri_word_1 = tri_word_1[31:0];
-  assign tri_nq = $signed(bits_tri_word_1);
-  assign bits_tri_word_1_1 = tri_word_1[63:32];
-  assign tri_e1p = $signed(bits_tri_word_1_1);
-  assign bits_tri_word_1_2 = tri_word_1[95:64];
-  assign tri_e1q = $signed(bits_tri_word_1_2);
-  assign bits_tri_word_1_3 = tri_word_1[127:96];
-  assign tri_e2p = $signed(bits_tri_word_1_3);
-  assign tri_e2q = $signed(tri_word_2);
+  assign tri_r = u_tri_rom_0_data[1:0];
+  assign tri_pp = u_tri_rom_0_data[30:2];
+  assign tri_pq = u_tri_rom_0_data[59:31];
+  assign bits_u_tri_rom_0_data = u_tri_rom_0_data[91:60];
+  assign tri_d = $signed(bits_u_tri_rom_0_data);
+  assign bits_u_tri_rom_0_data_1 = u_tri_rom_0_data[123:92];
+  assign tri_np = $signed(bits_u_tri_rom_0_data_1);
+  assign bits_u_tri_rom_1_data = u_tri_rom_1_data[31:0];
+  assign tri_nq = $signed(bits_u_tri_rom_1_data);
+  assign bits_u_tri_rom_1_data_1 = u_tri_rom_1_data[63:32];
+  assign tri_e1p = $signed(bits_u_tri_rom_1_data_1);
+  assign bits_u_tri_rom_1_data_2 = u_tri_rom_1_data[95:64];
+  assign tri_e1q = $signed(bits_u_tri_rom_1_data_2);
+  assign bits_u_tri_rom_1_data_3 = u_tri_rom_1_data[127:96];
+  assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
+  assign tri_e2q = $signed(u_tri_rom_2_data);
   assign cat_1 = {u_traverse_emit_tmin, u_traverse_emit_tri};
   assign rs_u_traverse_emit_id = {{24{1'b0}}, u_traverse_emit_id};
   assign mux_u_traverse_emit_end = u_traverse_emit_end ? rs_u_traverse_emit_id : cat_1;
   assign tag = {u_traverse_emit_end, mux_u_traverse_emit_end};
+  assign pipe_valid = pipe_valid_sr[3];
+  assign pipe_tag = pipe_tag_sr[3];
+  assign pipe_cur_ox = pipe_cur_ox_sr[3];
+  assign pipe_cur_oy = pipe_cur_oy_sr[3];
+  assign pipe_cur_oz = pipe_cur_oz_sr[3];
+  assign pipe_wx = pipe_wx_sr[3];
+  assign pipe_wy = pipe_wy_sr[3];
+  assign pipe_wz = pipe_wz_sr[3];
   assign bits_pipe_tag = pipe_tag[44];
   assign not_bits_pipe_tag = ~bits_pipe_tag;
   assign pipe_busy = pipe_valid & not_bits_pipe_tag;
@@ -130,11 +159,30 @@ module fxrt_core (
     if (accept) wx_r <= wx;
     if (accept) wy_r <= wy;
     if (accept) wz_r <= wz;
-    tri_word_0 <= tri_rom_0[tri_addr];
-    tri_word_1 <= tri_rom_1[tri_addr];
-    tri_word_2 <= tri_rom_2[tri_addr];
-    pipe_valid <= u_traverse_emit_valid;
-    pipe_tag <= tag;
+    for (pipe_valid_i = 3; pipe_valid_i > 1; pipe_valid_i = pipe_valid_i - 1)
+      pipe_valid_sr[pipe_valid_i] <= pipe_valid_sr[pipe_valid_i - 1];
+    pipe_valid_sr[1] <= u_traverse_emit_valid;
+    for (pipe_tag_i = 3; pipe_tag_i > 1; pipe_tag_i = pipe_tag_i - 1)
+      pipe_tag_sr[pipe_tag_i] <= pipe_tag_sr[pipe_tag_i - 1];
+    pipe_tag_sr[1] <= tag;
+    for (pipe_cur_ox_i = 3; pipe_cur_ox_i > 1; pipe_cur_ox_i = pipe_cur_ox_i - 1)
+      pipe_cur_ox_sr[pipe_cur_ox_i] <= pipe_cur_ox_sr[pipe_cur_ox_i - 1];
+    pipe_cur_ox_sr[1] <= u_traverse_cur_ox;
+    for (pipe_cur_oy_i = 3; pipe_cur_oy_i > 1; pipe_cur_oy_i = pipe_cur_oy_i - 1)
+      pipe_cur_oy_sr[pipe_cur_oy_i] <= pipe_cur_oy_sr[pipe_cur_oy_i - 1];
+    pipe_cur_oy_sr[1] <= u_traverse_cur_oy;
+    for (pipe_cur_oz_i = 3; pipe_cur_oz_i > 1; pipe_cur_oz_i = pipe_cur_oz_i - 1)
+      pipe_cur_oz_sr[pipe_cur_oz_i] <= pipe_cur_oz_sr[pipe_cur_oz_i - 1];
+    pipe_cur_oz_sr[1] <= u_traverse_cur_oz;
+    for (pipe_wx_i = 3; pipe_wx_i > 1; pipe_wx_i = pipe_wx_i - 1)
+      pipe_wx_sr[pipe_wx_i] <= pipe_wx_sr[pipe_wx_i - 1];
+    pipe_wx_sr[1] <= wx_r;
+    for (pipe_wy_i = 3; pipe_wy_i > 1; pipe_wy_i = pipe_wy_i - 1)
+      pipe_wy_sr[pipe_wy_i] <= pipe_wy_sr[pipe_wy_i - 1];
+    pipe_wy_sr[1] <= wy_r;
+    for (pipe_wz_i = 3; pipe_wz_i > 1; pipe_wz_i = pipe_wz_i - 1)
+      pipe_wz_sr[pipe_wz_i] <= pipe_wz_sr[pipe_wz_i - 1];
+    pipe_wz_sr[1] <= wz_r;
   end
 
   fxrt_traverse u_traverse (
@@ -163,16 +211,34 @@ module fxrt_core (
     .fsm_state(u_traverse_fsm_state)
   );
 
+  fxrt_brom_tri_0 u_tri_rom_0 (
+    .clk(clk),
+    .addr(tri_addr),
+    .data(u_tri_rom_0_data)
+  );
+
+  fxrt_brom_tri_1 u_tri_rom_1 (
+    .clk(clk),
+    .addr(tri_addr),
+    .data(u_tri_rom_1_data)
+  );
+
+  fxrt_brom_tri_2 u_tri_rom_2 (
+    .clk(clk),
+    .addr(tri_addr),
+    .data(u_tri_rom_2_data)
+  );
+
   fxrt_intersect_n29_m32_t0_e18_tag45_c150 u_intersect (
     .clk(clk),
     .valid(pipe_valid),
     .tag(pipe_tag),
-    .ox(u_traverse_cur_ox),
-    .oy(u_traverse_cur_oy),
-    .oz(u_traverse_cur_oz),
-    .wx(wx_r),
-    .wy(wy_r),
-    .wz(wz_r),
+    .ox(pipe_cur_ox),
+    .oy(pipe_cur_oy),
+    .oz(pipe_cur_oz),
+    .wx(pipe_wx),
+    .wy(pipe_wy),
+    .wz(pipe_wz),
     .r(tri_r),
     .pp(tri_pp),
     .pq(tri_pq),

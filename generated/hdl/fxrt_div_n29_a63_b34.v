@@ -15,17 +15,17 @@ module fxrt_div_n29_a63_b34 (
   wire [0:0] num_neg;
   wire signed [33:0] k_0_1 = 34'sh000000000;
   wire [0:0] den_neg;
+  wire [0:0] num_eq_k_0;
+  wire [0:0] den_eq_k_0_1;
+  wire [0:0] or_0;
+  wire [0:0] num_neg_xor_den_neg;
+  wire [0:0] err;
   wire signed [62:0] neg_num;
   wire signed [62:0] mux_num_neg;
   wire [62:0] u_mux_num_neg;
   wire signed [33:0] neg_den;
   wire signed [33:0] mux_den_neg;
   wire [33:0] u_mux_den_neg;
-  wire [0:0] num_eq_k_0;
-  wire [0:0] den_eq_k_0_1;
-  wire [0:0] or_0;
-  wire [0:0] num_neg_xor_den_neg;
-  wire [0:0] err;
   reg [62:0] s1_a = 63'h0000000000000000;
   reg [33:0] s1_b = 34'h000000000;
   reg [0:0] s1_err = 1'h0;
@@ -34,824 +34,929 @@ module fxrt_div_n29_a63_b34 (
   wire [32:0] bits_s1_a;
   wire [29:0] lo;
   wire [33:0] rs_bits_s1_a;
-  wire [0:0] s1_b_le_rs_bits_s1_a;
-  wire [0:0] err_1;
-  wire [33:0] rs_bits_s1_a_1;
-  wire [29:0] k_0_2 = 30'h00000000;
+  wire [34:0] rs_rs_bits_s1_a;
+  wire signed [34:0] s_rs_rs_bits_s1_a;
   wire [34:0] rs_s1_b;
-  wire [34:0] rs_rs_bits_s1_a_1;
-  wire [34:0] shl_rs_rs_bits_s1_a_1;
+  wire signed [34:0] s_rs_s1_b;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 34 are read
+  wire signed [34:0] minus_2;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_minus_2;
+  wire [0:0] overflow;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] k_0_2 = 1'h0;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [33:0] k_0_3 = 34'h000000000;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [33:0] rs_bits_s1_a_1;
+  wire [29:0] k_0_4 = 30'h00000000;
+  wire [34:0] rs_s1_b_1;
   wire [0:0] bits_lo;
   wire [34:0] rs_bits_lo;
+  wire [34:0] rs_rs_bits_s1_a_1;
+  wire [34:0] shl_rs_rs_bits_s1_a_1;
   wire [34:0] or_3;
   wire [35:0] rs_or_3;
   wire signed [35:0] s_rs_or_3;
-  wire [35:0] rs_rs_s1_b;
-  wire signed [35:0] s_rs_rs_s1_b;
+  wire [35:0] rs_rs_s1_b_1;
+  wire signed [35:0] s_rs_rs_s1_b_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff0;
+  wire signed [35:0] diffk0;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff0;
-  wire [0:0] ge0;
-  wire [33:0] bits_diff0_1;
+  wire [33:0] bits_diffk0;
+  wire [0:0] bits_diffk0_1;
+  wire [0:0] gek0;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] k_1 = 1'h1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] rs_gek0;
+  wire [29:0] quot0;
   wire [33:0] rs_or_3_1;
   wire [33:0] rem0;
-  wire [29:0] rs_ge0;
-  wire [29:0] quot0;
   reg [33:0] s2_p = 34'h000000000;
   reg [29:0] s2_q = 30'h00000000;
 
   // stage s3_q1: one quotient bit
   reg [33:0] s1_b_d1 = 34'h000000000;
   wire [34:0] rs_s1_b_d1;
-  wire [34:0] rs_s2_p;
-  wire [34:0] shl_rs_s2_p;
   reg [29:0] lo_d1 = 30'h00000000;
   wire [0:0] bits_lo_d1;
   wire [34:0] rs_bits_lo_d1;
+  wire [34:0] rs_s2_p;
+  wire [34:0] shl_rs_s2_p;
   wire [34:0] or_5;
   wire [35:0] rs_or_5;
   wire signed [35:0] s_rs_or_5;
   wire [35:0] rs_rs_s1_b_d1;
   wire signed [35:0] s_rs_rs_s1_b_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff1;
+  wire signed [35:0] diffk1;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff1;
-  wire [0:0] ge1;
-  wire [33:0] bits_diff1_1;
+  wire [33:0] bits_diffk1;
+  wire [0:0] bits_diffk1_1;
+  wire [0:0] gek1;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s2_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s2_q;
+  wire [29:0] rs_gek1;
+  wire [29:0] quot1;
   wire [33:0] rs_or_5_1;
   wire [33:0] rem1;
-  wire [29:0] shl_s2_q;
-  wire [29:0] rs_ge1;
-  wire [29:0] quot1;
   reg [33:0] s3_p = 34'h000000000;
   reg [29:0] s3_q = 30'h00000000;
 
   // stage s4_q2: one quotient bit
   reg [33:0] s1_b_d2 = 34'h000000000;
   wire [34:0] rs_s1_b_d2;
-  wire [34:0] rs_s3_p;
-  wire [34:0] shl_rs_s3_p;
   reg [29:0] lo_d2 = 30'h00000000;
   wire [0:0] bits_lo_d2;
   wire [34:0] rs_bits_lo_d2;
+  wire [34:0] rs_s3_p;
+  wire [34:0] shl_rs_s3_p;
   wire [34:0] or_7;
   wire [35:0] rs_or_7;
   wire signed [35:0] s_rs_or_7;
   wire [35:0] rs_rs_s1_b_d2;
   wire signed [35:0] s_rs_rs_s1_b_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff2;
+  wire signed [35:0] diffk2;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff2;
-  wire [0:0] ge2;
-  wire [33:0] bits_diff2_1;
+  wire [33:0] bits_diffk2;
+  wire [0:0] bits_diffk2_1;
+  wire [0:0] gek2;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s3_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s3_q;
+  wire [29:0] rs_gek2;
+  wire [29:0] quot2;
   wire [33:0] rs_or_7_1;
   wire [33:0] rem2;
-  wire [29:0] shl_s3_q;
-  wire [29:0] rs_ge2;
-  wire [29:0] quot2;
   reg [33:0] s4_p = 34'h000000000;
   reg [29:0] s4_q = 30'h00000000;
 
   // stage s5_q3: one quotient bit
   reg [33:0] s1_b_d3 = 34'h000000000;
   wire [34:0] rs_s1_b_d3;
-  wire [34:0] rs_s4_p;
-  wire [34:0] shl_rs_s4_p;
   reg [29:0] lo_d3 = 30'h00000000;
   wire [0:0] bits_lo_d3;
   wire [34:0] rs_bits_lo_d3;
+  wire [34:0] rs_s4_p;
+  wire [34:0] shl_rs_s4_p;
   wire [34:0] or_9;
   wire [35:0] rs_or_9;
   wire signed [35:0] s_rs_or_9;
   wire [35:0] rs_rs_s1_b_d3;
   wire signed [35:0] s_rs_rs_s1_b_d3;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff3;
+  wire signed [35:0] diffk3;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff3;
-  wire [0:0] ge3;
-  wire [33:0] bits_diff3_1;
+  wire [33:0] bits_diffk3;
+  wire [0:0] bits_diffk3_1;
+  wire [0:0] gek3;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s4_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s4_q;
+  wire [29:0] rs_gek3;
+  wire [29:0] quot3;
   wire [33:0] rs_or_9_1;
   wire [33:0] rem3;
-  wire [29:0] shl_s4_q;
-  wire [29:0] rs_ge3;
-  wire [29:0] quot3;
   reg [33:0] s5_p = 34'h000000000;
   reg [29:0] s5_q = 30'h00000000;
 
   // stage s6_q4: one quotient bit
   reg [33:0] s1_b_d4 = 34'h000000000;
   wire [34:0] rs_s1_b_d4;
-  wire [34:0] rs_s5_p;
-  wire [34:0] shl_rs_s5_p;
   reg [29:0] lo_d4 = 30'h00000000;
   wire [0:0] bits_lo_d4;
   wire [34:0] rs_bits_lo_d4;
+  wire [34:0] rs_s5_p;
+  wire [34:0] shl_rs_s5_p;
   wire [34:0] or_11;
   wire [35:0] rs_or_11;
   wire signed [35:0] s_rs_or_11;
   wire [35:0] rs_rs_s1_b_d4;
   wire signed [35:0] s_rs_rs_s1_b_d4;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff4;
+  wire signed [35:0] diffk4;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff4;
-  wire [0:0] ge4;
-  wire [33:0] bits_diff4_1;
+  wire [33:0] bits_diffk4;
+  wire [0:0] bits_diffk4_1;
+  wire [0:0] gek4;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s5_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s5_q;
+  wire [29:0] rs_gek4;
+  wire [29:0] quot4;
   wire [33:0] rs_or_11_1;
   wire [33:0] rem4;
-  wire [29:0] shl_s5_q;
-  wire [29:0] rs_ge4;
-  wire [29:0] quot4;
   reg [33:0] s6_p = 34'h000000000;
   reg [29:0] s6_q = 30'h00000000;
 
   // stage s7_q5: one quotient bit
   reg [33:0] s1_b_d5 = 34'h000000000;
   wire [34:0] rs_s1_b_d5;
-  wire [34:0] rs_s6_p;
-  wire [34:0] shl_rs_s6_p;
   reg [29:0] lo_d5 = 30'h00000000;
   wire [0:0] bits_lo_d5;
   wire [34:0] rs_bits_lo_d5;
+  wire [34:0] rs_s6_p;
+  wire [34:0] shl_rs_s6_p;
   wire [34:0] or_13;
   wire [35:0] rs_or_13;
   wire signed [35:0] s_rs_or_13;
   wire [35:0] rs_rs_s1_b_d5;
   wire signed [35:0] s_rs_rs_s1_b_d5;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff5;
+  wire signed [35:0] diffk5;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff5;
-  wire [0:0] ge5;
-  wire [33:0] bits_diff5_1;
+  wire [33:0] bits_diffk5;
+  wire [0:0] bits_diffk5_1;
+  wire [0:0] gek5;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s6_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s6_q;
+  wire [29:0] rs_gek5;
+  wire [29:0] quot5;
   wire [33:0] rs_or_13_1;
   wire [33:0] rem5;
-  wire [29:0] shl_s6_q;
-  wire [29:0] rs_ge5;
-  wire [29:0] quot5;
   reg [33:0] s7_p = 34'h000000000;
   reg [29:0] s7_q = 30'h00000000;
 
   // stage s8_q6: one quotient bit
   reg [33:0] s1_b_d6 = 34'h000000000;
   wire [34:0] rs_s1_b_d6;
-  wire [34:0] rs_s7_p;
-  wire [34:0] shl_rs_s7_p;
   reg [29:0] lo_d6 = 30'h00000000;
   wire [0:0] bits_lo_d6;
   wire [34:0] rs_bits_lo_d6;
+  wire [34:0] rs_s7_p;
+  wire [34:0] shl_rs_s7_p;
   wire [34:0] or_15;
   wire [35:0] rs_or_15;
   wire signed [35:0] s_rs_or_15;
   wire [35:0] rs_rs_s1_b_d6;
   wire signed [35:0] s_rs_rs_s1_b_d6;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff6;
+  wire signed [35:0] diffk6;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff6;
-  wire [0:0] ge6;
-  wire [33:0] bits_diff6_1;
+  wire [33:0] bits_diffk6;
+  wire [0:0] bits_diffk6_1;
+  wire [0:0] gek6;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s7_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s7_q;
+  wire [29:0] rs_gek6;
+  wire [29:0] quot6;
   wire [33:0] rs_or_15_1;
   wire [33:0] rem6;
-  wire [29:0] shl_s7_q;
-  wire [29:0] rs_ge6;
-  wire [29:0] quot6;
   reg [33:0] s8_p = 34'h000000000;
   reg [29:0] s8_q = 30'h00000000;
 
   // stage s9_q7: one quotient bit
   reg [33:0] s1_b_d7 = 34'h000000000;
   wire [34:0] rs_s1_b_d7;
-  wire [34:0] rs_s8_p;
-  wire [34:0] shl_rs_s8_p;
   reg [29:0] lo_d7 = 30'h00000000;
   wire [0:0] bits_lo_d7;
   wire [34:0] rs_bits_lo_d7;
+  wire [34:0] rs_s8_p;
+  wire [34:0] shl_rs_s8_p;
   wire [34:0] or_17;
   wire [35:0] rs_or_17;
   wire signed [35:0] s_rs_or_17;
   wire [35:0] rs_rs_s1_b_d7;
   wire signed [35:0] s_rs_rs_s1_b_d7;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff7;
+  wire signed [35:0] diffk7;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff7;
-  wire [0:0] ge7;
-  wire [33:0] bits_diff7_1;
+  wire [33:0] bits_diffk7;
+  wire [0:0] bits_diffk7_1;
+  wire [0:0] gek7;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s8_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s8_q;
+  wire [29:0] rs_gek7;
+  wire [29:0] quot7;
   wire [33:0] rs_or_17_1;
   wire [33:0] rem7;
-  wire [29:0] shl_s8_q;
-  wire [29:0] rs_ge7;
-  wire [29:0] quot7;
   reg [33:0] s9_p = 34'h000000000;
   reg [29:0] s9_q = 30'h00000000;
 
   // stage s10_q8: one quotient bit
   reg [33:0] s1_b_d8 = 34'h000000000;
   wire [34:0] rs_s1_b_d8;
-  wire [34:0] rs_s9_p;
-  wire [34:0] shl_rs_s9_p;
   reg [29:0] lo_d8 = 30'h00000000;
   wire [0:0] bits_lo_d8;
   wire [34:0] rs_bits_lo_d8;
+  wire [34:0] rs_s9_p;
+  wire [34:0] shl_rs_s9_p;
   wire [34:0] or_19;
   wire [35:0] rs_or_19;
   wire signed [35:0] s_rs_or_19;
   wire [35:0] rs_rs_s1_b_d8;
   wire signed [35:0] s_rs_rs_s1_b_d8;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff8;
+  wire signed [35:0] diffk8;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff8;
-  wire [0:0] ge8;
-  wire [33:0] bits_diff8_1;
+  wire [33:0] bits_diffk8;
+  wire [0:0] bits_diffk8_1;
+  wire [0:0] gek8;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s9_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s9_q;
+  wire [29:0] rs_gek8;
+  wire [29:0] quot8;
   wire [33:0] rs_or_19_1;
   wire [33:0] rem8;
-  wire [29:0] shl_s9_q;
-  wire [29:0] rs_ge8;
-  wire [29:0] quot8;
   reg [33:0] s10_p = 34'h000000000;
   reg [29:0] s10_q = 30'h00000000;
 
   // stage s11_q9: one quotient bit
   reg [33:0] s1_b_d9 = 34'h000000000;
   wire [34:0] rs_s1_b_d9;
-  wire [34:0] rs_s10_p;
-  wire [34:0] shl_rs_s10_p;
   reg [29:0] lo_d9 = 30'h00000000;
   wire [0:0] bits_lo_d9;
   wire [34:0] rs_bits_lo_d9;
+  wire [34:0] rs_s10_p;
+  wire [34:0] shl_rs_s10_p;
   wire [34:0] or_21;
   wire [35:0] rs_or_21;
   wire signed [35:0] s_rs_or_21;
   wire [35:0] rs_rs_s1_b_d9;
   wire signed [35:0] s_rs_rs_s1_b_d9;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff9;
+  wire signed [35:0] diffk9;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff9;
-  wire [0:0] ge9;
-  wire [33:0] bits_diff9_1;
+  wire [33:0] bits_diffk9;
+  wire [0:0] bits_diffk9_1;
+  wire [0:0] gek9;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s10_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s10_q;
+  wire [29:0] rs_gek9;
+  wire [29:0] quot9;
   wire [33:0] rs_or_21_1;
   wire [33:0] rem9;
-  wire [29:0] shl_s10_q;
-  wire [29:0] rs_ge9;
-  wire [29:0] quot9;
   reg [33:0] s11_p = 34'h000000000;
   reg [29:0] s11_q = 30'h00000000;
 
   // stage s12_q10: one quotient bit
   reg [33:0] s1_b_d10 = 34'h000000000;
   wire [34:0] rs_s1_b_d10;
-  wire [34:0] rs_s11_p;
-  wire [34:0] shl_rs_s11_p;
   reg [29:0] lo_d10 = 30'h00000000;
   wire [0:0] bits_lo_d10;
   wire [34:0] rs_bits_lo_d10;
+  wire [34:0] rs_s11_p;
+  wire [34:0] shl_rs_s11_p;
   wire [34:0] or_23;
   wire [35:0] rs_or_23;
   wire signed [35:0] s_rs_or_23;
   wire [35:0] rs_rs_s1_b_d10;
   wire signed [35:0] s_rs_rs_s1_b_d10;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff10;
+  wire signed [35:0] diffk10;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff10;
-  wire [0:0] ge10;
-  wire [33:0] bits_diff10_1;
+  wire [33:0] bits_diffk10;
+  wire [0:0] bits_diffk10_1;
+  wire [0:0] gek10;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s11_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s11_q;
+  wire [29:0] rs_gek10;
+  wire [29:0] quot10;
   wire [33:0] rs_or_23_1;
   wire [33:0] rem10;
-  wire [29:0] shl_s11_q;
-  wire [29:0] rs_ge10;
-  wire [29:0] quot10;
   reg [33:0] s12_p = 34'h000000000;
   reg [29:0] s12_q = 30'h00000000;
 
   // stage s13_q11: one quotient bit
   reg [33:0] s1_b_d11 = 34'h000000000;
   wire [34:0] rs_s1_b_d11;
-  wire [34:0] rs_s12_p;
-  wire [34:0] shl_rs_s12_p;
   reg [29:0] lo_d11 = 30'h00000000;
   wire [0:0] bits_lo_d11;
   wire [34:0] rs_bits_lo_d11;
+  wire [34:0] rs_s12_p;
+  wire [34:0] shl_rs_s12_p;
   wire [34:0] or_25;
   wire [35:0] rs_or_25;
   wire signed [35:0] s_rs_or_25;
   wire [35:0] rs_rs_s1_b_d11;
   wire signed [35:0] s_rs_rs_s1_b_d11;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff11;
+  wire signed [35:0] diffk11;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff11;
-  wire [0:0] ge11;
-  wire [33:0] bits_diff11_1;
+  wire [33:0] bits_diffk11;
+  wire [0:0] bits_diffk11_1;
+  wire [0:0] gek11;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s12_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s12_q;
+  wire [29:0] rs_gek11;
+  wire [29:0] quot11;
   wire [33:0] rs_or_25_1;
   wire [33:0] rem11;
-  wire [29:0] shl_s12_q;
-  wire [29:0] rs_ge11;
-  wire [29:0] quot11;
   reg [33:0] s13_p = 34'h000000000;
   reg [29:0] s13_q = 30'h00000000;
 
   // stage s14_q12: one quotient bit
   reg [33:0] s1_b_d12 = 34'h000000000;
   wire [34:0] rs_s1_b_d12;
-  wire [34:0] rs_s13_p;
-  wire [34:0] shl_rs_s13_p;
   reg [29:0] lo_d12 = 30'h00000000;
   wire [0:0] bits_lo_d12;
   wire [34:0] rs_bits_lo_d12;
+  wire [34:0] rs_s13_p;
+  wire [34:0] shl_rs_s13_p;
   wire [34:0] or_27;
   wire [35:0] rs_or_27;
   wire signed [35:0] s_rs_or_27;
   wire [35:0] rs_rs_s1_b_d12;
   wire signed [35:0] s_rs_rs_s1_b_d12;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff12;
+  wire signed [35:0] diffk12;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff12;
-  wire [0:0] ge12;
-  wire [33:0] bits_diff12_1;
+  wire [33:0] bits_diffk12;
+  wire [0:0] bits_diffk12_1;
+  wire [0:0] gek12;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s13_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s13_q;
+  wire [29:0] rs_gek12;
+  wire [29:0] quot12;
   wire [33:0] rs_or_27_1;
   wire [33:0] rem12;
-  wire [29:0] shl_s13_q;
-  wire [29:0] rs_ge12;
-  wire [29:0] quot12;
   reg [33:0] s14_p = 34'h000000000;
   reg [29:0] s14_q = 30'h00000000;
 
   // stage s15_q13: one quotient bit
   reg [33:0] s1_b_d13 = 34'h000000000;
   wire [34:0] rs_s1_b_d13;
-  wire [34:0] rs_s14_p;
-  wire [34:0] shl_rs_s14_p;
   reg [29:0] lo_d13 = 30'h00000000;
   wire [0:0] bits_lo_d13;
   wire [34:0] rs_bits_lo_d13;
+  wire [34:0] rs_s14_p;
+  wire [34:0] shl_rs_s14_p;
   wire [34:0] or_29;
   wire [35:0] rs_or_29;
   wire signed [35:0] s_rs_or_29;
   wire [35:0] rs_rs_s1_b_d13;
   wire signed [35:0] s_rs_rs_s1_b_d13;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff13;
+  wire signed [35:0] diffk13;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff13;
-  wire [0:0] ge13;
-  wire [33:0] bits_diff13_1;
+  wire [33:0] bits_diffk13;
+  wire [0:0] bits_diffk13_1;
+  wire [0:0] gek13;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s14_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s14_q;
+  wire [29:0] rs_gek13;
+  wire [29:0] quot13;
   wire [33:0] rs_or_29_1;
   wire [33:0] rem13;
-  wire [29:0] shl_s14_q;
-  wire [29:0] rs_ge13;
-  wire [29:0] quot13;
   reg [33:0] s15_p = 34'h000000000;
   reg [29:0] s15_q = 30'h00000000;
 
   // stage s16_q14: one quotient bit
   reg [33:0] s1_b_d14 = 34'h000000000;
   wire [34:0] rs_s1_b_d14;
-  wire [34:0] rs_s15_p;
-  wire [34:0] shl_rs_s15_p;
   reg [29:0] lo_d14 = 30'h00000000;
   wire [0:0] bits_lo_d14;
   wire [34:0] rs_bits_lo_d14;
+  wire [34:0] rs_s15_p;
+  wire [34:0] shl_rs_s15_p;
   wire [34:0] or_31;
   wire [35:0] rs_or_31;
   wire signed [35:0] s_rs_or_31;
   wire [35:0] rs_rs_s1_b_d14;
   wire signed [35:0] s_rs_rs_s1_b_d14;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff14;
+  wire signed [35:0] diffk14;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff14;
-  wire [0:0] ge14;
-  wire [33:0] bits_diff14_1;
+  wire [33:0] bits_diffk14;
+  wire [0:0] bits_diffk14_1;
+  wire [0:0] gek14;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s15_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s15_q;
+  wire [29:0] rs_gek14;
+  wire [29:0] quot14;
   wire [33:0] rs_or_31_1;
   wire [33:0] rem14;
-  wire [29:0] shl_s15_q;
-  wire [29:0] rs_ge14;
-  wire [29:0] quot14;
   reg [33:0] s16_p = 34'h000000000;
   reg [29:0] s16_q = 30'h00000000;
 
   // stage s17_q15: one quotient bit
   reg [33:0] s1_b_d15 = 34'h000000000;
   wire [34:0] rs_s1_b_d15;
-  wire [34:0] rs_s16_p;
-  wire [34:0] shl_rs_s16_p;
   reg [29:0] lo_d15 = 30'h00000000;
   wire [0:0] bits_lo_d15;
   wire [34:0] rs_bits_lo_d15;
+  wire [34:0] rs_s16_p;
+  wire [34:0] shl_rs_s16_p;
   wire [34:0] or_33;
   wire [35:0] rs_or_33;
   wire signed [35:0] s_rs_or_33;
   wire [35:0] rs_rs_s1_b_d15;
   wire signed [35:0] s_rs_rs_s1_b_d15;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff15;
+  wire signed [35:0] diffk15;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff15;
-  wire [0:0] ge15;
-  wire [33:0] bits_diff15_1;
+  wire [33:0] bits_diffk15;
+  wire [0:0] bits_diffk15_1;
+  wire [0:0] gek15;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s16_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s16_q;
+  wire [29:0] rs_gek15;
+  wire [29:0] quot15;
   wire [33:0] rs_or_33_1;
   wire [33:0] rem15;
-  wire [29:0] shl_s16_q;
-  wire [29:0] rs_ge15;
-  wire [29:0] quot15;
   reg [33:0] s17_p = 34'h000000000;
   reg [29:0] s17_q = 30'h00000000;
 
   // stage s18_q16: one quotient bit
   reg [33:0] s1_b_d16 = 34'h000000000;
   wire [34:0] rs_s1_b_d16;
-  wire [34:0] rs_s17_p;
-  wire [34:0] shl_rs_s17_p;
   reg [29:0] lo_d16 = 30'h00000000;
   wire [0:0] bits_lo_d16;
   wire [34:0] rs_bits_lo_d16;
+  wire [34:0] rs_s17_p;
+  wire [34:0] shl_rs_s17_p;
   wire [34:0] or_35;
   wire [35:0] rs_or_35;
   wire signed [35:0] s_rs_or_35;
   wire [35:0] rs_rs_s1_b_d16;
   wire signed [35:0] s_rs_rs_s1_b_d16;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff16;
+  wire signed [35:0] diffk16;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff16;
-  wire [0:0] ge16;
-  wire [33:0] bits_diff16_1;
+  wire [33:0] bits_diffk16;
+  wire [0:0] bits_diffk16_1;
+  wire [0:0] gek16;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s17_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s17_q;
+  wire [29:0] rs_gek16;
+  wire [29:0] quot16;
   wire [33:0] rs_or_35_1;
   wire [33:0] rem16;
-  wire [29:0] shl_s17_q;
-  wire [29:0] rs_ge16;
-  wire [29:0] quot16;
   reg [33:0] s18_p = 34'h000000000;
   reg [29:0] s18_q = 30'h00000000;
 
   // stage s19_q17: one quotient bit
   reg [33:0] s1_b_d17 = 34'h000000000;
   wire [34:0] rs_s1_b_d17;
-  wire [34:0] rs_s18_p;
-  wire [34:0] shl_rs_s18_p;
   reg [29:0] lo_d17 = 30'h00000000;
   wire [0:0] bits_lo_d17;
   wire [34:0] rs_bits_lo_d17;
+  wire [34:0] rs_s18_p;
+  wire [34:0] shl_rs_s18_p;
   wire [34:0] or_37;
   wire [35:0] rs_or_37;
   wire signed [35:0] s_rs_or_37;
   wire [35:0] rs_rs_s1_b_d17;
   wire signed [35:0] s_rs_rs_s1_b_d17;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff17;
+  wire signed [35:0] diffk17;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff17;
-  wire [0:0] ge17;
-  wire [33:0] bits_diff17_1;
+  wire [33:0] bits_diffk17;
+  wire [0:0] bits_diffk17_1;
+  wire [0:0] gek17;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s18_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s18_q;
+  wire [29:0] rs_gek17;
+  wire [29:0] quot17;
   wire [33:0] rs_or_37_1;
   wire [33:0] rem17;
-  wire [29:0] shl_s18_q;
-  wire [29:0] rs_ge17;
-  wire [29:0] quot17;
   reg [33:0] s19_p = 34'h000000000;
   reg [29:0] s19_q = 30'h00000000;
 
   // stage s20_q18: one quotient bit
   reg [33:0] s1_b_d18 = 34'h000000000;
   wire [34:0] rs_s1_b_d18;
-  wire [34:0] rs_s19_p;
-  wire [34:0] shl_rs_s19_p;
   reg [29:0] lo_d18 = 30'h00000000;
   wire [0:0] bits_lo_d18;
   wire [34:0] rs_bits_lo_d18;
+  wire [34:0] rs_s19_p;
+  wire [34:0] shl_rs_s19_p;
   wire [34:0] or_39;
   wire [35:0] rs_or_39;
   wire signed [35:0] s_rs_or_39;
   wire [35:0] rs_rs_s1_b_d18;
   wire signed [35:0] s_rs_rs_s1_b_d18;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff18;
+  wire signed [35:0] diffk18;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff18;
-  wire [0:0] ge18;
-  wire [33:0] bits_diff18_1;
+  wire [33:0] bits_diffk18;
+  wire [0:0] bits_diffk18_1;
+  wire [0:0] gek18;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s19_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s19_q;
+  wire [29:0] rs_gek18;
+  wire [29:0] quot18;
   wire [33:0] rs_or_39_1;
   wire [33:0] rem18;
-  wire [29:0] shl_s19_q;
-  wire [29:0] rs_ge18;
-  wire [29:0] quot18;
   reg [33:0] s20_p = 34'h000000000;
   reg [29:0] s20_q = 30'h00000000;
 
   // stage s21_q19: one quotient bit
   reg [33:0] s1_b_d19 = 34'h000000000;
   wire [34:0] rs_s1_b_d19;
-  wire [34:0] rs_s20_p;
-  wire [34:0] shl_rs_s20_p;
   reg [29:0] lo_d19 = 30'h00000000;
   wire [0:0] bits_lo_d19;
   wire [34:0] rs_bits_lo_d19;
+  wire [34:0] rs_s20_p;
+  wire [34:0] shl_rs_s20_p;
   wire [34:0] or_41;
   wire [35:0] rs_or_41;
   wire signed [35:0] s_rs_or_41;
   wire [35:0] rs_rs_s1_b_d19;
   wire signed [35:0] s_rs_rs_s1_b_d19;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff19;
+  wire signed [35:0] diffk19;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff19;
-  wire [0:0] ge19;
-  wire [33:0] bits_diff19_1;
+  wire [33:0] bits_diffk19;
+  wire [0:0] bits_diffk19_1;
+  wire [0:0] gek19;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s20_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s20_q;
+  wire [29:0] rs_gek19;
+  wire [29:0] quot19;
   wire [33:0] rs_or_41_1;
   wire [33:0] rem19;
-  wire [29:0] shl_s20_q;
-  wire [29:0] rs_ge19;
-  wire [29:0] quot19;
   reg [33:0] s21_p = 34'h000000000;
   reg [29:0] s21_q = 30'h00000000;
 
   // stage s22_q20: one quotient bit
   reg [33:0] s1_b_d20 = 34'h000000000;
   wire [34:0] rs_s1_b_d20;
-  wire [34:0] rs_s21_p;
-  wire [34:0] shl_rs_s21_p;
   reg [29:0] lo_d20 = 30'h00000000;
   wire [0:0] bits_lo_d20;
   wire [34:0] rs_bits_lo_d20;
+  wire [34:0] rs_s21_p;
+  wire [34:0] shl_rs_s21_p;
   wire [34:0] or_43;
   wire [35:0] rs_or_43;
   wire signed [35:0] s_rs_or_43;
   wire [35:0] rs_rs_s1_b_d20;
   wire signed [35:0] s_rs_rs_s1_b_d20;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff20;
+  wire signed [35:0] diffk20;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff20;
-  wire [0:0] ge20;
-  wire [33:0] bits_diff20_1;
+  wire [33:0] bits_diffk20;
+  wire [0:0] bits_diffk20_1;
+  wire [0:0] gek20;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s21_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s21_q;
+  wire [29:0] rs_gek20;
+  wire [29:0] quot20;
   wire [33:0] rs_or_43_1;
   wire [33:0] rem20;
-  wire [29:0] shl_s21_q;
-  wire [29:0] rs_ge20;
-  wire [29:0] quot20;
   reg [33:0] s22_p = 34'h000000000;
   reg [29:0] s22_q = 30'h00000000;
 
   // stage s23_q21: one quotient bit
   reg [33:0] s1_b_d21 = 34'h000000000;
   wire [34:0] rs_s1_b_d21;
-  wire [34:0] rs_s22_p;
-  wire [34:0] shl_rs_s22_p;
   reg [29:0] lo_d21 = 30'h00000000;
   wire [0:0] bits_lo_d21;
   wire [34:0] rs_bits_lo_d21;
+  wire [34:0] rs_s22_p;
+  wire [34:0] shl_rs_s22_p;
   wire [34:0] or_45;
   wire [35:0] rs_or_45;
   wire signed [35:0] s_rs_or_45;
   wire [35:0] rs_rs_s1_b_d21;
   wire signed [35:0] s_rs_rs_s1_b_d21;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff21;
+  wire signed [35:0] diffk21;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff21;
-  wire [0:0] ge21;
-  wire [33:0] bits_diff21_1;
+  wire [33:0] bits_diffk21;
+  wire [0:0] bits_diffk21_1;
+  wire [0:0] gek21;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s22_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s22_q;
+  wire [29:0] rs_gek21;
+  wire [29:0] quot21;
   wire [33:0] rs_or_45_1;
   wire [33:0] rem21;
-  wire [29:0] shl_s22_q;
-  wire [29:0] rs_ge21;
-  wire [29:0] quot21;
   reg [33:0] s23_p = 34'h000000000;
   reg [29:0] s23_q = 30'h00000000;
 
   // stage s24_q22: one quotient bit
   reg [33:0] s1_b_d22 = 34'h000000000;
   wire [34:0] rs_s1_b_d22;
-  wire [34:0] rs_s23_p;
-  wire [34:0] shl_rs_s23_p;
   reg [29:0] lo_d22 = 30'h00000000;
   wire [0:0] bits_lo_d22;
   wire [34:0] rs_bits_lo_d22;
+  wire [34:0] rs_s23_p;
+  wire [34:0] shl_rs_s23_p;
   wire [34:0] or_47;
   wire [35:0] rs_or_47;
   wire signed [35:0] s_rs_or_47;
   wire [35:0] rs_rs_s1_b_d22;
   wire signed [35:0] s_rs_rs_s1_b_d22;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff22;
+  wire signed [35:0] diffk22;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff22;
-  wire [0:0] ge22;
-  wire [33:0] bits_diff22_1;
+  wire [33:0] bits_diffk22;
+  wire [0:0] bits_diffk22_1;
+  wire [0:0] gek22;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s23_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s23_q;
+  wire [29:0] rs_gek22;
+  wire [29:0] quot22;
   wire [33:0] rs_or_47_1;
   wire [33:0] rem22;
-  wire [29:0] shl_s23_q;
-  wire [29:0] rs_ge22;
-  wire [29:0] quot22;
   reg [33:0] s24_p = 34'h000000000;
   reg [29:0] s24_q = 30'h00000000;
 
   // stage s25_q23: one quotient bit
   reg [33:0] s1_b_d23 = 34'h000000000;
   wire [34:0] rs_s1_b_d23;
-  wire [34:0] rs_s24_p;
-  wire [34:0] shl_rs_s24_p;
   reg [29:0] lo_d23 = 30'h00000000;
   wire [0:0] bits_lo_d23;
   wire [34:0] rs_bits_lo_d23;
+  wire [34:0] rs_s24_p;
+  wire [34:0] shl_rs_s24_p;
   wire [34:0] or_49;
   wire [35:0] rs_or_49;
   wire signed [35:0] s_rs_or_49;
   wire [35:0] rs_rs_s1_b_d23;
   wire signed [35:0] s_rs_rs_s1_b_d23;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff23;
+  wire signed [35:0] diffk23;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff23;
-  wire [0:0] ge23;
-  wire [33:0] bits_diff23_1;
+  wire [33:0] bits_diffk23;
+  wire [0:0] bits_diffk23_1;
+  wire [0:0] gek23;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s24_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s24_q;
+  wire [29:0] rs_gek23;
+  wire [29:0] quot23;
   wire [33:0] rs_or_49_1;
   wire [33:0] rem23;
-  wire [29:0] shl_s24_q;
-  wire [29:0] rs_ge23;
-  wire [29:0] quot23;
   reg [33:0] s25_p = 34'h000000000;
   reg [29:0] s25_q = 30'h00000000;
 
   // stage s26_q24: one quotient bit
   reg [33:0] s1_b_d24 = 34'h000000000;
   wire [34:0] rs_s1_b_d24;
-  wire [34:0] rs_s25_p;
-  wire [34:0] shl_rs_s25_p;
   reg [29:0] lo_d24 = 30'h00000000;
   wire [0:0] bits_lo_d24;
   wire [34:0] rs_bits_lo_d24;
+  wire [34:0] rs_s25_p;
+  wire [34:0] shl_rs_s25_p;
   wire [34:0] or_51;
   wire [35:0] rs_or_51;
   wire signed [35:0] s_rs_or_51;
   wire [35:0] rs_rs_s1_b_d24;
   wire signed [35:0] s_rs_rs_s1_b_d24;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff24;
+  wire signed [35:0] diffk24;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff24;
-  wire [0:0] ge24;
-  wire [33:0] bits_diff24_1;
+  wire [33:0] bits_diffk24;
+  wire [0:0] bits_diffk24_1;
+  wire [0:0] gek24;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s25_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s25_q;
+  wire [29:0] rs_gek24;
+  wire [29:0] quot24;
   wire [33:0] rs_or_51_1;
   wire [33:0] rem24;
-  wire [29:0] shl_s25_q;
-  wire [29:0] rs_ge24;
-  wire [29:0] quot24;
   reg [33:0] s26_p = 34'h000000000;
   reg [29:0] s26_q = 30'h00000000;
 
   // stage s27_q25: one quotient bit
   reg [33:0] s1_b_d25 = 34'h000000000;
   wire [34:0] rs_s1_b_d25;
-  wire [34:0] rs_s26_p;
-  wire [34:0] shl_rs_s26_p;
   reg [29:0] lo_d25 = 30'h00000000;
   wire [0:0] bits_lo_d25;
   wire [34:0] rs_bits_lo_d25;
+  wire [34:0] rs_s26_p;
+  wire [34:0] shl_rs_s26_p;
   wire [34:0] or_53;
   wire [35:0] rs_or_53;
   wire signed [35:0] s_rs_or_53;
   wire [35:0] rs_rs_s1_b_d25;
   wire signed [35:0] s_rs_rs_s1_b_d25;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff25;
+  wire signed [35:0] diffk25;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff25;
-  wire [0:0] ge25;
-  wire [33:0] bits_diff25_1;
+  wire [33:0] bits_diffk25;
+  wire [0:0] bits_diffk25_1;
+  wire [0:0] gek25;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s26_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s26_q;
+  wire [29:0] rs_gek25;
+  wire [29:0] quot25;
   wire [33:0] rs_or_53_1;
   wire [33:0] rem25;
-  wire [29:0] shl_s26_q;
-  wire [29:0] rs_ge25;
-  wire [29:0] quot25;
   reg [33:0] s27_p = 34'h000000000;
   reg [29:0] s27_q = 30'h00000000;
 
   // stage s28_q26: one quotient bit
   reg [33:0] s1_b_d26 = 34'h000000000;
   wire [34:0] rs_s1_b_d26;
-  wire [34:0] rs_s27_p;
-  wire [34:0] shl_rs_s27_p;
   reg [29:0] lo_d26 = 30'h00000000;
   wire [0:0] bits_lo_d26;
   wire [34:0] rs_bits_lo_d26;
+  wire [34:0] rs_s27_p;
+  wire [34:0] shl_rs_s27_p;
   wire [34:0] or_55;
   wire [35:0] rs_or_55;
   wire signed [35:0] s_rs_or_55;
   wire [35:0] rs_rs_s1_b_d26;
   wire signed [35:0] s_rs_rs_s1_b_d26;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff26;
+  wire signed [35:0] diffk26;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff26;
-  wire [0:0] ge26;
-  wire [33:0] bits_diff26_1;
+  wire [33:0] bits_diffk26;
+  wire [0:0] bits_diffk26_1;
+  wire [0:0] gek26;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s27_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s27_q;
+  wire [29:0] rs_gek26;
+  wire [29:0] quot26;
   wire [33:0] rs_or_55_1;
   wire [33:0] rem26;
-  wire [29:0] shl_s27_q;
-  wire [29:0] rs_ge26;
-  wire [29:0] quot26;
   reg [33:0] s28_p = 34'h000000000;
   reg [29:0] s28_q = 30'h00000000;
 
   // stage s29_q27: one quotient bit
   reg [33:0] s1_b_d27 = 34'h000000000;
   wire [34:0] rs_s1_b_d27;
-  wire [34:0] rs_s28_p;
-  wire [34:0] shl_rs_s28_p;
   reg [29:0] lo_d27 = 30'h00000000;
   wire [0:0] bits_lo_d27;
   wire [34:0] rs_bits_lo_d27;
+  wire [34:0] rs_s28_p;
+  wire [34:0] shl_rs_s28_p;
   wire [34:0] or_57;
   wire [35:0] rs_or_57;
   wire signed [35:0] s_rs_or_57;
   wire [35:0] rs_rs_s1_b_d27;
   wire signed [35:0] s_rs_rs_s1_b_d27;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff27;
+  wire signed [35:0] diffk27;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff27;
-  wire [0:0] ge27;
-  wire [33:0] bits_diff27_1;
+  wire [33:0] bits_diffk27;
+  wire [0:0] bits_diffk27_1;
+  wire [0:0] gek27;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s28_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s28_q;
+  wire [29:0] rs_gek27;
+  wire [29:0] quot27;
   wire [33:0] rs_or_57_1;
   wire [33:0] rem27;
-  wire [29:0] shl_s28_q;
-  wire [29:0] rs_ge27;
-  wire [29:0] quot27;
   reg [33:0] s29_p = 34'h000000000;
   reg [29:0] s29_q = 30'h00000000;
 
   // stage s30_q28: one quotient bit
   reg [33:0] s1_b_d28 = 34'h000000000;
   wire [34:0] rs_s1_b_d28;
-  wire [34:0] rs_s29_p;
-  wire [34:0] shl_rs_s29_p;
   reg [29:0] lo_d28 = 30'h00000000;
   wire [0:0] bits_lo_d28;
   wire [34:0] rs_bits_lo_d28;
+  wire [34:0] rs_s29_p;
+  wire [34:0] shl_rs_s29_p;
   wire [34:0] or_59;
   wire [35:0] rs_or_59;
   wire signed [35:0] s_rs_or_59;
   wire [35:0] rs_rs_s1_b_d28;
   wire signed [35:0] s_rs_rs_s1_b_d28;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff28;
+  wire signed [35:0] diffk28;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff28;
-  wire [0:0] ge28;
-  wire [33:0] bits_diff28_1;
+  wire [33:0] bits_diffk28;
+  wire [0:0] bits_diffk28_1;
+  wire [0:0] gek28;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [0:0] s29_q_eq_k_0_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [29:0] shl_s29_q;
+  wire [29:0] rs_gek28;
+  wire [29:0] quot28;
   wire [33:0] rs_or_59_1;
   wire [33:0] rem28;
-  wire [29:0] shl_s29_q;
-  wire [29:0] rs_ge28;
-  wire [29:0] quot28;
   reg [33:0] s30_p = 34'h000000000;
   reg [29:0] s30_q = 30'h00000000;
 
   // stage s31_result: the quotient and its result flag
   reg [33:0] s1_b_d29 = 34'h000000000;
   wire [34:0] rs_s1_b_d29;
-  wire [34:0] rs_s30_p;
-  wire [34:0] shl_rs_s30_p;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 0 are read
   reg [29:0] lo_d29 = 30'h00000000;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_lo_d29;
   wire [34:0] rs_bits_lo_d29;
+  wire [34:0] rs_s30_p;
+  wire [34:0] shl_rs_s30_p;
   wire [34:0] or_61;
   wire [35:0] rs_or_61;
   wire signed [35:0] s_rs_or_61;
   wire [35:0] rs_rs_s1_b_d29;
   wire signed [35:0] s_rs_rs_s1_b_d29;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diff29;
+  wire signed [35:0] diffk29;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diff29;
-  wire [0:0] ge29;
-  wire [33:0] bits_diff29_1;
-  wire [33:0] rs_or_61_1;
   /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [33:0] rem29;
+  wire [33:0] bits_diffk29;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] bits_diffk29_1;
+  wire [0:0] gek29;
+  wire [0:0] s30_q_eq_k_0_4;
   wire [29:0] shl_s30_q;
-  wire [29:0] rs_ge29;
+  wire [29:0] rs_gek29;
   wire [29:0] quot29;
-  (* mem2reg *) reg [0:0] err_1_d29_sr [1:29];
-  integer err_1_d29_i;
-  initial for (err_1_d29_i = 1; err_1_d29_i <= 29; err_1_d29_i = err_1_d29_i + 1) err_1_d29_sr[err_1_d29_i] = 1'h0;
-  wire [0:0] err_1_d29;
-  wire [0:0] quot29_eq_k_0_2;
+  (* mem2reg *) reg [0:0] s1_err_d29_sr [1:29];
+  integer s1_err_d29_i;
+  initial for (s1_err_d29_i = 1; s1_err_d29_i <= 29; s1_err_d29_i = s1_err_d29_i + 1) s1_err_d29_sr[s1_err_d29_i] = 1'h0;
+  wire [0:0] s1_err_d29;
+  (* mem2reg *) reg [0:0] overflow_d29_sr [1:29];
+  integer overflow_d29_i;
+  initial for (overflow_d29_i = 1; overflow_d29_i <= 29; overflow_d29_i = overflow_d29_i + 1) overflow_d29_sr[overflow_d29_i] = 1'h0;
+  wire [0:0] overflow_d29;
   wire [0:0] or_63;
-  wire [0:0] not_or_63;
+  wire [0:0] not_gek29;
+  wire [0:0] and_64;
+  wire [0:0] or_63_or_and_64;
+  wire [0:0] not_or_63_or_and_64;
   reg [29:0] s31_t = 30'h00000000;
   reg [0:0] s31_ok = 1'h0;
 
@@ -860,17 +965,17 @@ module fxrt_div_n29_a63_b34 (
   // stage s1_operands: signs, zero tests, magnitudes
   assign num_neg = num < k_0;
   assign den_neg = den < k_0_1;
+  assign num_eq_k_0 = num == k_0;
+  assign den_eq_k_0_1 = den == k_0_1;
+  assign or_0 = num_eq_k_0 | den_eq_k_0_1;
+  assign num_neg_xor_den_neg = num_neg ^ den_neg;
+  assign err = or_0 | num_neg_xor_den_neg;
   assign neg_num = -num;
   assign mux_num_neg = num_neg ? neg_num : num;
   assign u_mux_num_neg = $unsigned(mux_num_neg);
   assign neg_den = -den;
   assign mux_den_neg = den_neg ? neg_den : den;
   assign u_mux_den_neg = $unsigned(mux_den_neg);
-  assign num_eq_k_0 = num == k_0;
-  assign den_eq_k_0_1 = den == k_0_1;
-  assign or_0 = num_eq_k_0 | den_eq_k_0_1;
-  assign num_neg_xor_den_neg = num_neg ^ den_neg;
-  assign err = or_0 | num_neg_xor_den_neg;
 
   always @(posedge clk) begin : s1_operands_regs
     s1_a <= u_mux_num_neg;
@@ -882,27 +987,32 @@ module fxrt_div_n29_a63_b34 (
   assign bits_s1_a = s1_a[62:30];
   assign lo = s1_a[29:0];
   assign rs_bits_s1_a = {{1{1'b0}}, bits_s1_a};
-  assign s1_b_le_rs_bits_s1_a = s1_b <= rs_bits_s1_a;
-  assign err_1 = s1_err | s1_b_le_rs_bits_s1_a;
-  assign rs_bits_s1_a_1 = {{1{1'b0}}, bits_s1_a};
+  assign rs_rs_bits_s1_a = {{1{1'b0}}, rs_bits_s1_a};
+  assign s_rs_rs_bits_s1_a = $signed(rs_rs_bits_s1_a);
   assign rs_s1_b = {{1{1'b0}}, s1_b};
-  assign rs_rs_bits_s1_a_1 = {{1{1'b0}}, rs_bits_s1_a_1};
-  assign shl_rs_rs_bits_s1_a_1 = rs_rs_bits_s1_a_1 <<< 1;
+  assign s_rs_s1_b = $signed(rs_s1_b);
+  assign minus_2 = s_rs_rs_bits_s1_a - s_rs_s1_b;
+  assign bits_minus_2 = minus_2[34];
+  assign overflow = ~bits_minus_2;
+  assign rs_bits_s1_a_1 = {{1{1'b0}}, bits_s1_a};
+  assign rs_s1_b_1 = {{1{1'b0}}, s1_b};
   assign bits_lo = lo[29];
   assign rs_bits_lo = {{34{1'b0}}, bits_lo};
+  assign rs_rs_bits_s1_a_1 = {{1{1'b0}}, rs_bits_s1_a_1};
+  assign shl_rs_rs_bits_s1_a_1 = rs_rs_bits_s1_a_1 <<< 1;
   assign or_3 = shl_rs_rs_bits_s1_a_1 | rs_bits_lo;
   assign rs_or_3 = {{1{1'b0}}, or_3};
   assign s_rs_or_3 = $signed(rs_or_3);
-  assign rs_rs_s1_b = {{1{1'b0}}, rs_s1_b};
-  assign s_rs_rs_s1_b = $signed(rs_rs_s1_b);
-  assign diff0 = s_rs_or_3 - s_rs_rs_s1_b;
-  assign bits_diff0 = diff0[35];
-  assign ge0 = ~bits_diff0;
-  assign bits_diff0_1 = diff0[33:0];
+  assign rs_rs_s1_b_1 = {{1{1'b0}}, rs_s1_b_1};
+  assign s_rs_rs_s1_b_1 = $signed(rs_rs_s1_b_1);
+  assign diffk0 = s_rs_or_3 - s_rs_rs_s1_b_1;
+  assign bits_diffk0 = diffk0[33:0];
+  assign bits_diffk0_1 = diffk0[35];
+  assign gek0 = ~bits_diffk0_1;
+  assign rs_gek0 = {{29{1'b0}}, gek0};
+  assign quot0 = k_0_4 | rs_gek0;
   assign rs_or_3_1 = or_3[33:0];
-  assign rem0 = ge0 ? bits_diff0_1 : rs_or_3_1;
-  assign rs_ge0 = {{29{1'b0}}, ge0};
-  assign quot0 = k_0_2 | rs_ge0;
+  assign rem0 = gek0 ? bits_diffk0 : rs_or_3_1;
 
   always @(posedge clk) begin : s2_q0_regs
     s2_p <= rem0;
@@ -911,24 +1021,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s3_q1: one quotient bit
   assign rs_s1_b_d1 = {{1{1'b0}}, s1_b_d1};
-  assign rs_s2_p = {{1{1'b0}}, s2_p};
-  assign shl_rs_s2_p = rs_s2_p <<< 1;
   assign bits_lo_d1 = lo_d1[28];
   assign rs_bits_lo_d1 = {{34{1'b0}}, bits_lo_d1};
+  assign rs_s2_p = {{1{1'b0}}, s2_p};
+  assign shl_rs_s2_p = rs_s2_p <<< 1;
   assign or_5 = shl_rs_s2_p | rs_bits_lo_d1;
   assign rs_or_5 = {{1{1'b0}}, or_5};
   assign s_rs_or_5 = $signed(rs_or_5);
   assign rs_rs_s1_b_d1 = {{1{1'b0}}, rs_s1_b_d1};
   assign s_rs_rs_s1_b_d1 = $signed(rs_rs_s1_b_d1);
-  assign diff1 = s_rs_or_5 - s_rs_rs_s1_b_d1;
-  assign bits_diff1 = diff1[35];
-  assign ge1 = ~bits_diff1;
-  assign bits_diff1_1 = diff1[33:0];
-  assign rs_or_5_1 = or_5[33:0];
-  assign rem1 = ge1 ? bits_diff1_1 : rs_or_5_1;
+  assign diffk1 = s_rs_or_5 - s_rs_rs_s1_b_d1;
+  assign bits_diffk1 = diffk1[33:0];
+  assign bits_diffk1_1 = diffk1[35];
+  assign gek1 = ~bits_diffk1_1;
+  assign s2_q_eq_k_0_4 = s2_q == k_0_4;
   assign shl_s2_q = s2_q <<< 1;
-  assign rs_ge1 = {{29{1'b0}}, ge1};
-  assign quot1 = shl_s2_q | rs_ge1;
+  assign rs_gek1 = {{29{1'b0}}, gek1};
+  assign quot1 = shl_s2_q | rs_gek1;
+  assign rs_or_5_1 = or_5[33:0];
+  assign rem1 = gek1 ? bits_diffk1 : rs_or_5_1;
 
   always @(posedge clk) begin : s3_q1_regs
     s1_b_d1 <= s1_b;
@@ -939,24 +1050,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s4_q2: one quotient bit
   assign rs_s1_b_d2 = {{1{1'b0}}, s1_b_d2};
-  assign rs_s3_p = {{1{1'b0}}, s3_p};
-  assign shl_rs_s3_p = rs_s3_p <<< 1;
   assign bits_lo_d2 = lo_d2[27];
   assign rs_bits_lo_d2 = {{34{1'b0}}, bits_lo_d2};
+  assign rs_s3_p = {{1{1'b0}}, s3_p};
+  assign shl_rs_s3_p = rs_s3_p <<< 1;
   assign or_7 = shl_rs_s3_p | rs_bits_lo_d2;
   assign rs_or_7 = {{1{1'b0}}, or_7};
   assign s_rs_or_7 = $signed(rs_or_7);
   assign rs_rs_s1_b_d2 = {{1{1'b0}}, rs_s1_b_d2};
   assign s_rs_rs_s1_b_d2 = $signed(rs_rs_s1_b_d2);
-  assign diff2 = s_rs_or_7 - s_rs_rs_s1_b_d2;
-  assign bits_diff2 = diff2[35];
-  assign ge2 = ~bits_diff2;
-  assign bits_diff2_1 = diff2[33:0];
-  assign rs_or_7_1 = or_7[33:0];
-  assign rem2 = ge2 ? bits_diff2_1 : rs_or_7_1;
+  assign diffk2 = s_rs_or_7 - s_rs_rs_s1_b_d2;
+  assign bits_diffk2 = diffk2[33:0];
+  assign bits_diffk2_1 = diffk2[35];
+  assign gek2 = ~bits_diffk2_1;
+  assign s3_q_eq_k_0_4 = s3_q == k_0_4;
   assign shl_s3_q = s3_q <<< 1;
-  assign rs_ge2 = {{29{1'b0}}, ge2};
-  assign quot2 = shl_s3_q | rs_ge2;
+  assign rs_gek2 = {{29{1'b0}}, gek2};
+  assign quot2 = shl_s3_q | rs_gek2;
+  assign rs_or_7_1 = or_7[33:0];
+  assign rem2 = gek2 ? bits_diffk2 : rs_or_7_1;
 
   always @(posedge clk) begin : s4_q2_regs
     s1_b_d2 <= s1_b_d1;
@@ -967,24 +1079,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s5_q3: one quotient bit
   assign rs_s1_b_d3 = {{1{1'b0}}, s1_b_d3};
-  assign rs_s4_p = {{1{1'b0}}, s4_p};
-  assign shl_rs_s4_p = rs_s4_p <<< 1;
   assign bits_lo_d3 = lo_d3[26];
   assign rs_bits_lo_d3 = {{34{1'b0}}, bits_lo_d3};
+  assign rs_s4_p = {{1{1'b0}}, s4_p};
+  assign shl_rs_s4_p = rs_s4_p <<< 1;
   assign or_9 = shl_rs_s4_p | rs_bits_lo_d3;
   assign rs_or_9 = {{1{1'b0}}, or_9};
   assign s_rs_or_9 = $signed(rs_or_9);
   assign rs_rs_s1_b_d3 = {{1{1'b0}}, rs_s1_b_d3};
   assign s_rs_rs_s1_b_d3 = $signed(rs_rs_s1_b_d3);
-  assign diff3 = s_rs_or_9 - s_rs_rs_s1_b_d3;
-  assign bits_diff3 = diff3[35];
-  assign ge3 = ~bits_diff3;
-  assign bits_diff3_1 = diff3[33:0];
-  assign rs_or_9_1 = or_9[33:0];
-  assign rem3 = ge3 ? bits_diff3_1 : rs_or_9_1;
+  assign diffk3 = s_rs_or_9 - s_rs_rs_s1_b_d3;
+  assign bits_diffk3 = diffk3[33:0];
+  assign bits_diffk3_1 = diffk3[35];
+  assign gek3 = ~bits_diffk3_1;
+  assign s4_q_eq_k_0_4 = s4_q == k_0_4;
   assign shl_s4_q = s4_q <<< 1;
-  assign rs_ge3 = {{29{1'b0}}, ge3};
-  assign quot3 = shl_s4_q | rs_ge3;
+  assign rs_gek3 = {{29{1'b0}}, gek3};
+  assign quot3 = shl_s4_q | rs_gek3;
+  assign rs_or_9_1 = or_9[33:0];
+  assign rem3 = gek3 ? bits_diffk3 : rs_or_9_1;
 
   always @(posedge clk) begin : s5_q3_regs
     s1_b_d3 <= s1_b_d2;
@@ -995,24 +1108,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s6_q4: one quotient bit
   assign rs_s1_b_d4 = {{1{1'b0}}, s1_b_d4};
-  assign rs_s5_p = {{1{1'b0}}, s5_p};
-  assign shl_rs_s5_p = rs_s5_p <<< 1;
   assign bits_lo_d4 = lo_d4[25];
   assign rs_bits_lo_d4 = {{34{1'b0}}, bits_lo_d4};
+  assign rs_s5_p = {{1{1'b0}}, s5_p};
+  assign shl_rs_s5_p = rs_s5_p <<< 1;
   assign or_11 = shl_rs_s5_p | rs_bits_lo_d4;
   assign rs_or_11 = {{1{1'b0}}, or_11};
   assign s_rs_or_11 = $signed(rs_or_11);
   assign rs_rs_s1_b_d4 = {{1{1'b0}}, rs_s1_b_d4};
   assign s_rs_rs_s1_b_d4 = $signed(rs_rs_s1_b_d4);
-  assign diff4 = s_rs_or_11 - s_rs_rs_s1_b_d4;
-  assign bits_diff4 = diff4[35];
-  assign ge4 = ~bits_diff4;
-  assign bits_diff4_1 = diff4[33:0];
-  assign rs_or_11_1 = or_11[33:0];
-  assign rem4 = ge4 ? bits_diff4_1 : rs_or_11_1;
+  assign diffk4 = s_rs_or_11 - s_rs_rs_s1_b_d4;
+  assign bits_diffk4 = diffk4[33:0];
+  assign bits_diffk4_1 = diffk4[35];
+  assign gek4 = ~bits_diffk4_1;
+  assign s5_q_eq_k_0_4 = s5_q == k_0_4;
   assign shl_s5_q = s5_q <<< 1;
-  assign rs_ge4 = {{29{1'b0}}, ge4};
-  assign quot4 = shl_s5_q | rs_ge4;
+  assign rs_gek4 = {{29{1'b0}}, gek4};
+  assign quot4 = shl_s5_q | rs_gek4;
+  assign rs_or_11_1 = or_11[33:0];
+  assign rem4 = gek4 ? bits_diffk4 : rs_or_11_1;
 
   always @(posedge clk) begin : s6_q4_regs
     s1_b_d4 <= s1_b_d3;
@@ -1023,24 +1137,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s7_q5: one quotient bit
   assign rs_s1_b_d5 = {{1{1'b0}}, s1_b_d5};
-  assign rs_s6_p = {{1{1'b0}}, s6_p};
-  assign shl_rs_s6_p = rs_s6_p <<< 1;
   assign bits_lo_d5 = lo_d5[24];
   assign rs_bits_lo_d5 = {{34{1'b0}}, bits_lo_d5};
+  assign rs_s6_p = {{1{1'b0}}, s6_p};
+  assign shl_rs_s6_p = rs_s6_p <<< 1;
   assign or_13 = shl_rs_s6_p | rs_bits_lo_d5;
   assign rs_or_13 = {{1{1'b0}}, or_13};
   assign s_rs_or_13 = $signed(rs_or_13);
   assign rs_rs_s1_b_d5 = {{1{1'b0}}, rs_s1_b_d5};
   assign s_rs_rs_s1_b_d5 = $signed(rs_rs_s1_b_d5);
-  assign diff5 = s_rs_or_13 - s_rs_rs_s1_b_d5;
-  assign bits_diff5 = diff5[35];
-  assign ge5 = ~bits_diff5;
-  assign bits_diff5_1 = diff5[33:0];
-  assign rs_or_13_1 = or_13[33:0];
-  assign rem5 = ge5 ? bits_diff5_1 : rs_or_13_1;
+  assign diffk5 = s_rs_or_13 - s_rs_rs_s1_b_d5;
+  assign bits_diffk5 = diffk5[33:0];
+  assign bits_diffk5_1 = diffk5[35];
+  assign gek5 = ~bits_diffk5_1;
+  assign s6_q_eq_k_0_4 = s6_q == k_0_4;
   assign shl_s6_q = s6_q <<< 1;
-  assign rs_ge5 = {{29{1'b0}}, ge5};
-  assign quot5 = shl_s6_q | rs_ge5;
+  assign rs_gek5 = {{29{1'b0}}, gek5};
+  assign quot5 = shl_s6_q | rs_gek5;
+  assign rs_or_13_1 = or_13[33:0];
+  assign rem5 = gek5 ? bits_diffk5 : rs_or_13_1;
 
   always @(posedge clk) begin : s7_q5_regs
     s1_b_d5 <= s1_b_d4;
@@ -1051,24 +1166,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s8_q6: one quotient bit
   assign rs_s1_b_d6 = {{1{1'b0}}, s1_b_d6};
-  assign rs_s7_p = {{1{1'b0}}, s7_p};
-  assign shl_rs_s7_p = rs_s7_p <<< 1;
   assign bits_lo_d6 = lo_d6[23];
   assign rs_bits_lo_d6 = {{34{1'b0}}, bits_lo_d6};
+  assign rs_s7_p = {{1{1'b0}}, s7_p};
+  assign shl_rs_s7_p = rs_s7_p <<< 1;
   assign or_15 = shl_rs_s7_p | rs_bits_lo_d6;
   assign rs_or_15 = {{1{1'b0}}, or_15};
   assign s_rs_or_15 = $signed(rs_or_15);
   assign rs_rs_s1_b_d6 = {{1{1'b0}}, rs_s1_b_d6};
   assign s_rs_rs_s1_b_d6 = $signed(rs_rs_s1_b_d6);
-  assign diff6 = s_rs_or_15 - s_rs_rs_s1_b_d6;
-  assign bits_diff6 = diff6[35];
-  assign ge6 = ~bits_diff6;
-  assign bits_diff6_1 = diff6[33:0];
-  assign rs_or_15_1 = or_15[33:0];
-  assign rem6 = ge6 ? bits_diff6_1 : rs_or_15_1;
+  assign diffk6 = s_rs_or_15 - s_rs_rs_s1_b_d6;
+  assign bits_diffk6 = diffk6[33:0];
+  assign bits_diffk6_1 = diffk6[35];
+  assign gek6 = ~bits_diffk6_1;
+  assign s7_q_eq_k_0_4 = s7_q == k_0_4;
   assign shl_s7_q = s7_q <<< 1;
-  assign rs_ge6 = {{29{1'b0}}, ge6};
-  assign quot6 = shl_s7_q | rs_ge6;
+  assign rs_gek6 = {{29{1'b0}}, gek6};
+  assign quot6 = shl_s7_q | rs_gek6;
+  assign rs_or_15_1 = or_15[33:0];
+  assign rem6 = gek6 ? bits_diffk6 : rs_or_15_1;
 
   always @(posedge clk) begin : s8_q6_regs
     s1_b_d6 <= s1_b_d5;
@@ -1079,24 +1195,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s9_q7: one quotient bit
   assign rs_s1_b_d7 = {{1{1'b0}}, s1_b_d7};
-  assign rs_s8_p = {{1{1'b0}}, s8_p};
-  assign shl_rs_s8_p = rs_s8_p <<< 1;
   assign bits_lo_d7 = lo_d7[22];
   assign rs_bits_lo_d7 = {{34{1'b0}}, bits_lo_d7};
+  assign rs_s8_p = {{1{1'b0}}, s8_p};
+  assign shl_rs_s8_p = rs_s8_p <<< 1;
   assign or_17 = shl_rs_s8_p | rs_bits_lo_d7;
   assign rs_or_17 = {{1{1'b0}}, or_17};
   assign s_rs_or_17 = $signed(rs_or_17);
   assign rs_rs_s1_b_d7 = {{1{1'b0}}, rs_s1_b_d7};
   assign s_rs_rs_s1_b_d7 = $signed(rs_rs_s1_b_d7);
-  assign diff7 = s_rs_or_17 - s_rs_rs_s1_b_d7;
-  assign bits_diff7 = diff7[35];
-  assign ge7 = ~bits_diff7;
-  assign bits_diff7_1 = diff7[33:0];
-  assign rs_or_17_1 = or_17[33:0];
-  assign rem7 = ge7 ? bits_diff7_1 : rs_or_17_1;
+  assign diffk7 = s_rs_or_17 - s_rs_rs_s1_b_d7;
+  assign bits_diffk7 = diffk7[33:0];
+  assign bits_diffk7_1 = diffk7[35];
+  assign gek7 = ~bits_diffk7_1;
+  assign s8_q_eq_k_0_4 = s8_q == k_0_4;
   assign shl_s8_q = s8_q <<< 1;
-  assign rs_ge7 = {{29{1'b0}}, ge7};
-  assign quot7 = shl_s8_q | rs_ge7;
+  assign rs_gek7 = {{29{1'b0}}, gek7};
+  assign quot7 = shl_s8_q | rs_gek7;
+  assign rs_or_17_1 = or_17[33:0];
+  assign rem7 = gek7 ? bits_diffk7 : rs_or_17_1;
 
   always @(posedge clk) begin : s9_q7_regs
     s1_b_d7 <= s1_b_d6;
@@ -1107,24 +1224,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s10_q8: one quotient bit
   assign rs_s1_b_d8 = {{1{1'b0}}, s1_b_d8};
-  assign rs_s9_p = {{1{1'b0}}, s9_p};
-  assign shl_rs_s9_p = rs_s9_p <<< 1;
   assign bits_lo_d8 = lo_d8[21];
   assign rs_bits_lo_d8 = {{34{1'b0}}, bits_lo_d8};
+  assign rs_s9_p = {{1{1'b0}}, s9_p};
+  assign shl_rs_s9_p = rs_s9_p <<< 1;
   assign or_19 = shl_rs_s9_p | rs_bits_lo_d8;
   assign rs_or_19 = {{1{1'b0}}, or_19};
   assign s_rs_or_19 = $signed(rs_or_19);
   assign rs_rs_s1_b_d8 = {{1{1'b0}}, rs_s1_b_d8};
   assign s_rs_rs_s1_b_d8 = $signed(rs_rs_s1_b_d8);
-  assign diff8 = s_rs_or_19 - s_rs_rs_s1_b_d8;
-  assign bits_diff8 = diff8[35];
-  assign ge8 = ~bits_diff8;
-  assign bits_diff8_1 = diff8[33:0];
-  assign rs_or_19_1 = or_19[33:0];
-  assign rem8 = ge8 ? bits_diff8_1 : rs_or_19_1;
+  assign diffk8 = s_rs_or_19 - s_rs_rs_s1_b_d8;
+  assign bits_diffk8 = diffk8[33:0];
+  assign bits_diffk8_1 = diffk8[35];
+  assign gek8 = ~bits_diffk8_1;
+  assign s9_q_eq_k_0_4 = s9_q == k_0_4;
   assign shl_s9_q = s9_q <<< 1;
-  assign rs_ge8 = {{29{1'b0}}, ge8};
-  assign quot8 = shl_s9_q | rs_ge8;
+  assign rs_gek8 = {{29{1'b0}}, gek8};
+  assign quot8 = shl_s9_q | rs_gek8;
+  assign rs_or_19_1 = or_19[33:0];
+  assign rem8 = gek8 ? bits_diffk8 : rs_or_19_1;
 
   always @(posedge clk) begin : s10_q8_regs
     s1_b_d8 <= s1_b_d7;
@@ -1135,24 +1253,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s11_q9: one quotient bit
   assign rs_s1_b_d9 = {{1{1'b0}}, s1_b_d9};
-  assign rs_s10_p = {{1{1'b0}}, s10_p};
-  assign shl_rs_s10_p = rs_s10_p <<< 1;
   assign bits_lo_d9 = lo_d9[20];
   assign rs_bits_lo_d9 = {{34{1'b0}}, bits_lo_d9};
+  assign rs_s10_p = {{1{1'b0}}, s10_p};
+  assign shl_rs_s10_p = rs_s10_p <<< 1;
   assign or_21 = shl_rs_s10_p | rs_bits_lo_d9;
   assign rs_or_21 = {{1{1'b0}}, or_21};
   assign s_rs_or_21 = $signed(rs_or_21);
   assign rs_rs_s1_b_d9 = {{1{1'b0}}, rs_s1_b_d9};
   assign s_rs_rs_s1_b_d9 = $signed(rs_rs_s1_b_d9);
-  assign diff9 = s_rs_or_21 - s_rs_rs_s1_b_d9;
-  assign bits_diff9 = diff9[35];
-  assign ge9 = ~bits_diff9;
-  assign bits_diff9_1 = diff9[33:0];
-  assign rs_or_21_1 = or_21[33:0];
-  assign rem9 = ge9 ? bits_diff9_1 : rs_or_21_1;
+  assign diffk9 = s_rs_or_21 - s_rs_rs_s1_b_d9;
+  assign bits_diffk9 = diffk9[33:0];
+  assign bits_diffk9_1 = diffk9[35];
+  assign gek9 = ~bits_diffk9_1;
+  assign s10_q_eq_k_0_4 = s10_q == k_0_4;
   assign shl_s10_q = s10_q <<< 1;
-  assign rs_ge9 = {{29{1'b0}}, ge9};
-  assign quot9 = shl_s10_q | rs_ge9;
+  assign rs_gek9 = {{29{1'b0}}, gek9};
+  assign quot9 = shl_s10_q | rs_gek9;
+  assign rs_or_21_1 = or_21[33:0];
+  assign rem9 = gek9 ? bits_diffk9 : rs_or_21_1;
 
   always @(posedge clk) begin : s11_q9_regs
     s1_b_d9 <= s1_b_d8;
@@ -1163,24 +1282,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s12_q10: one quotient bit
   assign rs_s1_b_d10 = {{1{1'b0}}, s1_b_d10};
-  assign rs_s11_p = {{1{1'b0}}, s11_p};
-  assign shl_rs_s11_p = rs_s11_p <<< 1;
   assign bits_lo_d10 = lo_d10[19];
   assign rs_bits_lo_d10 = {{34{1'b0}}, bits_lo_d10};
+  assign rs_s11_p = {{1{1'b0}}, s11_p};
+  assign shl_rs_s11_p = rs_s11_p <<< 1;
   assign or_23 = shl_rs_s11_p | rs_bits_lo_d10;
   assign rs_or_23 = {{1{1'b0}}, or_23};
   assign s_rs_or_23 = $signed(rs_or_23);
   assign rs_rs_s1_b_d10 = {{1{1'b0}}, rs_s1_b_d10};
   assign s_rs_rs_s1_b_d10 = $signed(rs_rs_s1_b_d10);
-  assign diff10 = s_rs_or_23 - s_rs_rs_s1_b_d10;
-  assign bits_diff10 = diff10[35];
-  assign ge10 = ~bits_diff10;
-  assign bits_diff10_1 = diff10[33:0];
-  assign rs_or_23_1 = or_23[33:0];
-  assign rem10 = ge10 ? bits_diff10_1 : rs_or_23_1;
+  assign diffk10 = s_rs_or_23 - s_rs_rs_s1_b_d10;
+  assign bits_diffk10 = diffk10[33:0];
+  assign bits_diffk10_1 = diffk10[35];
+  assign gek10 = ~bits_diffk10_1;
+  assign s11_q_eq_k_0_4 = s11_q == k_0_4;
   assign shl_s11_q = s11_q <<< 1;
-  assign rs_ge10 = {{29{1'b0}}, ge10};
-  assign quot10 = shl_s11_q | rs_ge10;
+  assign rs_gek10 = {{29{1'b0}}, gek10};
+  assign quot10 = shl_s11_q | rs_gek10;
+  assign rs_or_23_1 = or_23[33:0];
+  assign rem10 = gek10 ? bits_diffk10 : rs_or_23_1;
 
   always @(posedge clk) begin : s12_q10_regs
     s1_b_d10 <= s1_b_d9;
@@ -1191,24 +1311,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s13_q11: one quotient bit
   assign rs_s1_b_d11 = {{1{1'b0}}, s1_b_d11};
-  assign rs_s12_p = {{1{1'b0}}, s12_p};
-  assign shl_rs_s12_p = rs_s12_p <<< 1;
   assign bits_lo_d11 = lo_d11[18];
   assign rs_bits_lo_d11 = {{34{1'b0}}, bits_lo_d11};
+  assign rs_s12_p = {{1{1'b0}}, s12_p};
+  assign shl_rs_s12_p = rs_s12_p <<< 1;
   assign or_25 = shl_rs_s12_p | rs_bits_lo_d11;
   assign rs_or_25 = {{1{1'b0}}, or_25};
   assign s_rs_or_25 = $signed(rs_or_25);
   assign rs_rs_s1_b_d11 = {{1{1'b0}}, rs_s1_b_d11};
   assign s_rs_rs_s1_b_d11 = $signed(rs_rs_s1_b_d11);
-  assign diff11 = s_rs_or_25 - s_rs_rs_s1_b_d11;
-  assign bits_diff11 = diff11[35];
-  assign ge11 = ~bits_diff11;
-  assign bits_diff11_1 = diff11[33:0];
-  assign rs_or_25_1 = or_25[33:0];
-  assign rem11 = ge11 ? bits_diff11_1 : rs_or_25_1;
+  assign diffk11 = s_rs_or_25 - s_rs_rs_s1_b_d11;
+  assign bits_diffk11 = diffk11[33:0];
+  assign bits_diffk11_1 = diffk11[35];
+  assign gek11 = ~bits_diffk11_1;
+  assign s12_q_eq_k_0_4 = s12_q == k_0_4;
   assign shl_s12_q = s12_q <<< 1;
-  assign rs_ge11 = {{29{1'b0}}, ge11};
-  assign quot11 = shl_s12_q | rs_ge11;
+  assign rs_gek11 = {{29{1'b0}}, gek11};
+  assign quot11 = shl_s12_q | rs_gek11;
+  assign rs_or_25_1 = or_25[33:0];
+  assign rem11 = gek11 ? bits_diffk11 : rs_or_25_1;
 
   always @(posedge clk) begin : s13_q11_regs
     s1_b_d11 <= s1_b_d10;
@@ -1219,24 +1340,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s14_q12: one quotient bit
   assign rs_s1_b_d12 = {{1{1'b0}}, s1_b_d12};
-  assign rs_s13_p = {{1{1'b0}}, s13_p};
-  assign shl_rs_s13_p = rs_s13_p <<< 1;
   assign bits_lo_d12 = lo_d12[17];
   assign rs_bits_lo_d12 = {{34{1'b0}}, bits_lo_d12};
+  assign rs_s13_p = {{1{1'b0}}, s13_p};
+  assign shl_rs_s13_p = rs_s13_p <<< 1;
   assign or_27 = shl_rs_s13_p | rs_bits_lo_d12;
   assign rs_or_27 = {{1{1'b0}}, or_27};
   assign s_rs_or_27 = $signed(rs_or_27);
   assign rs_rs_s1_b_d12 = {{1{1'b0}}, rs_s1_b_d12};
   assign s_rs_rs_s1_b_d12 = $signed(rs_rs_s1_b_d12);
-  assign diff12 = s_rs_or_27 - s_rs_rs_s1_b_d12;
-  assign bits_diff12 = diff12[35];
-  assign ge12 = ~bits_diff12;
-  assign bits_diff12_1 = diff12[33:0];
-  assign rs_or_27_1 = or_27[33:0];
-  assign rem12 = ge12 ? bits_diff12_1 : rs_or_27_1;
+  assign diffk12 = s_rs_or_27 - s_rs_rs_s1_b_d12;
+  assign bits_diffk12 = diffk12[33:0];
+  assign bits_diffk12_1 = diffk12[35];
+  assign gek12 = ~bits_diffk12_1;
+  assign s13_q_eq_k_0_4 = s13_q == k_0_4;
   assign shl_s13_q = s13_q <<< 1;
-  assign rs_ge12 = {{29{1'b0}}, ge12};
-  assign quot12 = shl_s13_q | rs_ge12;
+  assign rs_gek12 = {{29{1'b0}}, gek12};
+  assign quot12 = shl_s13_q | rs_gek12;
+  assign rs_or_27_1 = or_27[33:0];
+  assign rem12 = gek12 ? bits_diffk12 : rs_or_27_1;
 
   always @(posedge clk) begin : s14_q12_regs
     s1_b_d12 <= s1_b_d11;
@@ -1247,24 +1369,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s15_q13: one quotient bit
   assign rs_s1_b_d13 = {{1{1'b0}}, s1_b_d13};
-  assign rs_s14_p = {{1{1'b0}}, s14_p};
-  assign shl_rs_s14_p = rs_s14_p <<< 1;
   assign bits_lo_d13 = lo_d13[16];
   assign rs_bits_lo_d13 = {{34{1'b0}}, bits_lo_d13};
+  assign rs_s14_p = {{1{1'b0}}, s14_p};
+  assign shl_rs_s14_p = rs_s14_p <<< 1;
   assign or_29 = shl_rs_s14_p | rs_bits_lo_d13;
   assign rs_or_29 = {{1{1'b0}}, or_29};
   assign s_rs_or_29 = $signed(rs_or_29);
   assign rs_rs_s1_b_d13 = {{1{1'b0}}, rs_s1_b_d13};
   assign s_rs_rs_s1_b_d13 = $signed(rs_rs_s1_b_d13);
-  assign diff13 = s_rs_or_29 - s_rs_rs_s1_b_d13;
-  assign bits_diff13 = diff13[35];
-  assign ge13 = ~bits_diff13;
-  assign bits_diff13_1 = diff13[33:0];
-  assign rs_or_29_1 = or_29[33:0];
-  assign rem13 = ge13 ? bits_diff13_1 : rs_or_29_1;
+  assign diffk13 = s_rs_or_29 - s_rs_rs_s1_b_d13;
+  assign bits_diffk13 = diffk13[33:0];
+  assign bits_diffk13_1 = diffk13[35];
+  assign gek13 = ~bits_diffk13_1;
+  assign s14_q_eq_k_0_4 = s14_q == k_0_4;
   assign shl_s14_q = s14_q <<< 1;
-  assign rs_ge13 = {{29{1'b0}}, ge13};
-  assign quot13 = shl_s14_q | rs_ge13;
+  assign rs_gek13 = {{29{1'b0}}, gek13};
+  assign quot13 = shl_s14_q | rs_gek13;
+  assign rs_or_29_1 = or_29[33:0];
+  assign rem13 = gek13 ? bits_diffk13 : rs_or_29_1;
 
   always @(posedge clk) begin : s15_q13_regs
     s1_b_d13 <= s1_b_d12;
@@ -1275,24 +1398,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s16_q14: one quotient bit
   assign rs_s1_b_d14 = {{1{1'b0}}, s1_b_d14};
-  assign rs_s15_p = {{1{1'b0}}, s15_p};
-  assign shl_rs_s15_p = rs_s15_p <<< 1;
   assign bits_lo_d14 = lo_d14[15];
   assign rs_bits_lo_d14 = {{34{1'b0}}, bits_lo_d14};
+  assign rs_s15_p = {{1{1'b0}}, s15_p};
+  assign shl_rs_s15_p = rs_s15_p <<< 1;
   assign or_31 = shl_rs_s15_p | rs_bits_lo_d14;
   assign rs_or_31 = {{1{1'b0}}, or_31};
   assign s_rs_or_31 = $signed(rs_or_31);
   assign rs_rs_s1_b_d14 = {{1{1'b0}}, rs_s1_b_d14};
   assign s_rs_rs_s1_b_d14 = $signed(rs_rs_s1_b_d14);
-  assign diff14 = s_rs_or_31 - s_rs_rs_s1_b_d14;
-  assign bits_diff14 = diff14[35];
-  assign ge14 = ~bits_diff14;
-  assign bits_diff14_1 = diff14[33:0];
-  assign rs_or_31_1 = or_31[33:0];
-  assign rem14 = ge14 ? bits_diff14_1 : rs_or_31_1;
+  assign diffk14 = s_rs_or_31 - s_rs_rs_s1_b_d14;
+  assign bits_diffk14 = diffk14[33:0];
+  assign bits_diffk14_1 = diffk14[35];
+  assign gek14 = ~bits_diffk14_1;
+  assign s15_q_eq_k_0_4 = s15_q == k_0_4;
   assign shl_s15_q = s15_q <<< 1;
-  assign rs_ge14 = {{29{1'b0}}, ge14};
-  assign quot14 = shl_s15_q | rs_ge14;
+  assign rs_gek14 = {{29{1'b0}}, gek14};
+  assign quot14 = shl_s15_q | rs_gek14;
+  assign rs_or_31_1 = or_31[33:0];
+  assign rem14 = gek14 ? bits_diffk14 : rs_or_31_1;
 
   always @(posedge clk) begin : s16_q14_regs
     s1_b_d14 <= s1_b_d13;
@@ -1303,24 +1427,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s17_q15: one quotient bit
   assign rs_s1_b_d15 = {{1{1'b0}}, s1_b_d15};
-  assign rs_s16_p = {{1{1'b0}}, s16_p};
-  assign shl_rs_s16_p = rs_s16_p <<< 1;
   assign bits_lo_d15 = lo_d15[14];
   assign rs_bits_lo_d15 = {{34{1'b0}}, bits_lo_d15};
+  assign rs_s16_p = {{1{1'b0}}, s16_p};
+  assign shl_rs_s16_p = rs_s16_p <<< 1;
   assign or_33 = shl_rs_s16_p | rs_bits_lo_d15;
   assign rs_or_33 = {{1{1'b0}}, or_33};
   assign s_rs_or_33 = $signed(rs_or_33);
   assign rs_rs_s1_b_d15 = {{1{1'b0}}, rs_s1_b_d15};
   assign s_rs_rs_s1_b_d15 = $signed(rs_rs_s1_b_d15);
-  assign diff15 = s_rs_or_33 - s_rs_rs_s1_b_d15;
-  assign bits_diff15 = diff15[35];
-  assign ge15 = ~bits_diff15;
-  assign bits_diff15_1 = diff15[33:0];
-  assign rs_or_33_1 = or_33[33:0];
-  assign rem15 = ge15 ? bits_diff15_1 : rs_or_33_1;
+  assign diffk15 = s_rs_or_33 - s_rs_rs_s1_b_d15;
+  assign bits_diffk15 = diffk15[33:0];
+  assign bits_diffk15_1 = diffk15[35];
+  assign gek15 = ~bits_diffk15_1;
+  assign s16_q_eq_k_0_4 = s16_q == k_0_4;
   assign shl_s16_q = s16_q <<< 1;
-  assign rs_ge15 = {{29{1'b0}}, ge15};
-  assign quot15 = shl_s16_q | rs_ge15;
+  assign rs_gek15 = {{29{1'b0}}, gek15};
+  assign quot15 = shl_s16_q | rs_gek15;
+  assign rs_or_33_1 = or_33[33:0];
+  assign rem15 = gek15 ? bits_diffk15 : rs_or_33_1;
 
   always @(posedge clk) begin : s17_q15_regs
     s1_b_d15 <= s1_b_d14;
@@ -1331,24 +1456,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s18_q16: one quotient bit
   assign rs_s1_b_d16 = {{1{1'b0}}, s1_b_d16};
-  assign rs_s17_p = {{1{1'b0}}, s17_p};
-  assign shl_rs_s17_p = rs_s17_p <<< 1;
   assign bits_lo_d16 = lo_d16[13];
   assign rs_bits_lo_d16 = {{34{1'b0}}, bits_lo_d16};
+  assign rs_s17_p = {{1{1'b0}}, s17_p};
+  assign shl_rs_s17_p = rs_s17_p <<< 1;
   assign or_35 = shl_rs_s17_p | rs_bits_lo_d16;
   assign rs_or_35 = {{1{1'b0}}, or_35};
   assign s_rs_or_35 = $signed(rs_or_35);
   assign rs_rs_s1_b_d16 = {{1{1'b0}}, rs_s1_b_d16};
   assign s_rs_rs_s1_b_d16 = $signed(rs_rs_s1_b_d16);
-  assign diff16 = s_rs_or_35 - s_rs_rs_s1_b_d16;
-  assign bits_diff16 = diff16[35];
-  assign ge16 = ~bits_diff16;
-  assign bits_diff16_1 = diff16[33:0];
-  assign rs_or_35_1 = or_35[33:0];
-  assign rem16 = ge16 ? bits_diff16_1 : rs_or_35_1;
+  assign diffk16 = s_rs_or_35 - s_rs_rs_s1_b_d16;
+  assign bits_diffk16 = diffk16[33:0];
+  assign bits_diffk16_1 = diffk16[35];
+  assign gek16 = ~bits_diffk16_1;
+  assign s17_q_eq_k_0_4 = s17_q == k_0_4;
   assign shl_s17_q = s17_q <<< 1;
-  assign rs_ge16 = {{29{1'b0}}, ge16};
-  assign quot16 = shl_s17_q | rs_ge16;
+  assign rs_gek16 = {{29{1'b0}}, gek16};
+  assign quot16 = shl_s17_q | rs_gek16;
+  assign rs_or_35_1 = or_35[33:0];
+  assign rem16 = gek16 ? bits_diffk16 : rs_or_35_1;
 
   always @(posedge clk) begin : s18_q16_regs
     s1_b_d16 <= s1_b_d15;
@@ -1359,24 +1485,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s19_q17: one quotient bit
   assign rs_s1_b_d17 = {{1{1'b0}}, s1_b_d17};
-  assign rs_s18_p = {{1{1'b0}}, s18_p};
-  assign shl_rs_s18_p = rs_s18_p <<< 1;
   assign bits_lo_d17 = lo_d17[12];
   assign rs_bits_lo_d17 = {{34{1'b0}}, bits_lo_d17};
+  assign rs_s18_p = {{1{1'b0}}, s18_p};
+  assign shl_rs_s18_p = rs_s18_p <<< 1;
   assign or_37 = shl_rs_s18_p | rs_bits_lo_d17;
   assign rs_or_37 = {{1{1'b0}}, or_37};
   assign s_rs_or_37 = $signed(rs_or_37);
   assign rs_rs_s1_b_d17 = {{1{1'b0}}, rs_s1_b_d17};
   assign s_rs_rs_s1_b_d17 = $signed(rs_rs_s1_b_d17);
-  assign diff17 = s_rs_or_37 - s_rs_rs_s1_b_d17;
-  assign bits_diff17 = diff17[35];
-  assign ge17 = ~bits_diff17;
-  assign bits_diff17_1 = diff17[33:0];
-  assign rs_or_37_1 = or_37[33:0];
-  assign rem17 = ge17 ? bits_diff17_1 : rs_or_37_1;
+  assign diffk17 = s_rs_or_37 - s_rs_rs_s1_b_d17;
+  assign bits_diffk17 = diffk17[33:0];
+  assign bits_diffk17_1 = diffk17[35];
+  assign gek17 = ~bits_diffk17_1;
+  assign s18_q_eq_k_0_4 = s18_q == k_0_4;
   assign shl_s18_q = s18_q <<< 1;
-  assign rs_ge17 = {{29{1'b0}}, ge17};
-  assign quot17 = shl_s18_q | rs_ge17;
+  assign rs_gek17 = {{29{1'b0}}, gek17};
+  assign quot17 = shl_s18_q | rs_gek17;
+  assign rs_or_37_1 = or_37[33:0];
+  assign rem17 = gek17 ? bits_diffk17 : rs_or_37_1;
 
   always @(posedge clk) begin : s19_q17_regs
     s1_b_d17 <= s1_b_d16;
@@ -1387,24 +1514,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s20_q18: one quotient bit
   assign rs_s1_b_d18 = {{1{1'b0}}, s1_b_d18};
-  assign rs_s19_p = {{1{1'b0}}, s19_p};
-  assign shl_rs_s19_p = rs_s19_p <<< 1;
   assign bits_lo_d18 = lo_d18[11];
   assign rs_bits_lo_d18 = {{34{1'b0}}, bits_lo_d18};
+  assign rs_s19_p = {{1{1'b0}}, s19_p};
+  assign shl_rs_s19_p = rs_s19_p <<< 1;
   assign or_39 = shl_rs_s19_p | rs_bits_lo_d18;
   assign rs_or_39 = {{1{1'b0}}, or_39};
   assign s_rs_or_39 = $signed(rs_or_39);
   assign rs_rs_s1_b_d18 = {{1{1'b0}}, rs_s1_b_d18};
   assign s_rs_rs_s1_b_d18 = $signed(rs_rs_s1_b_d18);
-  assign diff18 = s_rs_or_39 - s_rs_rs_s1_b_d18;
-  assign bits_diff18 = diff18[35];
-  assign ge18 = ~bits_diff18;
-  assign bits_diff18_1 = diff18[33:0];
-  assign rs_or_39_1 = or_39[33:0];
-  assign rem18 = ge18 ? bits_diff18_1 : rs_or_39_1;
+  assign diffk18 = s_rs_or_39 - s_rs_rs_s1_b_d18;
+  assign bits_diffk18 = diffk18[33:0];
+  assign bits_diffk18_1 = diffk18[35];
+  assign gek18 = ~bits_diffk18_1;
+  assign s19_q_eq_k_0_4 = s19_q == k_0_4;
   assign shl_s19_q = s19_q <<< 1;
-  assign rs_ge18 = {{29{1'b0}}, ge18};
-  assign quot18 = shl_s19_q | rs_ge18;
+  assign rs_gek18 = {{29{1'b0}}, gek18};
+  assign quot18 = shl_s19_q | rs_gek18;
+  assign rs_or_39_1 = or_39[33:0];
+  assign rem18 = gek18 ? bits_diffk18 : rs_or_39_1;
 
   always @(posedge clk) begin : s20_q18_regs
     s1_b_d18 <= s1_b_d17;
@@ -1415,24 +1543,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s21_q19: one quotient bit
   assign rs_s1_b_d19 = {{1{1'b0}}, s1_b_d19};
-  assign rs_s20_p = {{1{1'b0}}, s20_p};
-  assign shl_rs_s20_p = rs_s20_p <<< 1;
   assign bits_lo_d19 = lo_d19[10];
   assign rs_bits_lo_d19 = {{34{1'b0}}, bits_lo_d19};
+  assign rs_s20_p = {{1{1'b0}}, s20_p};
+  assign shl_rs_s20_p = rs_s20_p <<< 1;
   assign or_41 = shl_rs_s20_p | rs_bits_lo_d19;
   assign rs_or_41 = {{1{1'b0}}, or_41};
   assign s_rs_or_41 = $signed(rs_or_41);
   assign rs_rs_s1_b_d19 = {{1{1'b0}}, rs_s1_b_d19};
   assign s_rs_rs_s1_b_d19 = $signed(rs_rs_s1_b_d19);
-  assign diff19 = s_rs_or_41 - s_rs_rs_s1_b_d19;
-  assign bits_diff19 = diff19[35];
-  assign ge19 = ~bits_diff19;
-  assign bits_diff19_1 = diff19[33:0];
-  assign rs_or_41_1 = or_41[33:0];
-  assign rem19 = ge19 ? bits_diff19_1 : rs_or_41_1;
+  assign diffk19 = s_rs_or_41 - s_rs_rs_s1_b_d19;
+  assign bits_diffk19 = diffk19[33:0];
+  assign bits_diffk19_1 = diffk19[35];
+  assign gek19 = ~bits_diffk19_1;
+  assign s20_q_eq_k_0_4 = s20_q == k_0_4;
   assign shl_s20_q = s20_q <<< 1;
-  assign rs_ge19 = {{29{1'b0}}, ge19};
-  assign quot19 = shl_s20_q | rs_ge19;
+  assign rs_gek19 = {{29{1'b0}}, gek19};
+  assign quot19 = shl_s20_q | rs_gek19;
+  assign rs_or_41_1 = or_41[33:0];
+  assign rem19 = gek19 ? bits_diffk19 : rs_or_41_1;
 
   always @(posedge clk) begin : s21_q19_regs
     s1_b_d19 <= s1_b_d18;
@@ -1443,24 +1572,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s22_q20: one quotient bit
   assign rs_s1_b_d20 = {{1{1'b0}}, s1_b_d20};
-  assign rs_s21_p = {{1{1'b0}}, s21_p};
-  assign shl_rs_s21_p = rs_s21_p <<< 1;
   assign bits_lo_d20 = lo_d20[9];
   assign rs_bits_lo_d20 = {{34{1'b0}}, bits_lo_d20};
+  assign rs_s21_p = {{1{1'b0}}, s21_p};
+  assign shl_rs_s21_p = rs_s21_p <<< 1;
   assign or_43 = shl_rs_s21_p | rs_bits_lo_d20;
   assign rs_or_43 = {{1{1'b0}}, or_43};
   assign s_rs_or_43 = $signed(rs_or_43);
   assign rs_rs_s1_b_d20 = {{1{1'b0}}, rs_s1_b_d20};
   assign s_rs_rs_s1_b_d20 = $signed(rs_rs_s1_b_d20);
-  assign diff20 = s_rs_or_43 - s_rs_rs_s1_b_d20;
-  assign bits_diff20 = diff20[35];
-  assign ge20 = ~bits_diff20;
-  assign bits_diff20_1 = diff20[33:0];
-  assign rs_or_43_1 = or_43[33:0];
-  assign rem20 = ge20 ? bits_diff20_1 : rs_or_43_1;
+  assign diffk20 = s_rs_or_43 - s_rs_rs_s1_b_d20;
+  assign bits_diffk20 = diffk20[33:0];
+  assign bits_diffk20_1 = diffk20[35];
+  assign gek20 = ~bits_diffk20_1;
+  assign s21_q_eq_k_0_4 = s21_q == k_0_4;
   assign shl_s21_q = s21_q <<< 1;
-  assign rs_ge20 = {{29{1'b0}}, ge20};
-  assign quot20 = shl_s21_q | rs_ge20;
+  assign rs_gek20 = {{29{1'b0}}, gek20};
+  assign quot20 = shl_s21_q | rs_gek20;
+  assign rs_or_43_1 = or_43[33:0];
+  assign rem20 = gek20 ? bits_diffk20 : rs_or_43_1;
 
   always @(posedge clk) begin : s22_q20_regs
     s1_b_d20 <= s1_b_d19;
@@ -1471,24 +1601,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s23_q21: one quotient bit
   assign rs_s1_b_d21 = {{1{1'b0}}, s1_b_d21};
-  assign rs_s22_p = {{1{1'b0}}, s22_p};
-  assign shl_rs_s22_p = rs_s22_p <<< 1;
   assign bits_lo_d21 = lo_d21[8];
   assign rs_bits_lo_d21 = {{34{1'b0}}, bits_lo_d21};
+  assign rs_s22_p = {{1{1'b0}}, s22_p};
+  assign shl_rs_s22_p = rs_s22_p <<< 1;
   assign or_45 = shl_rs_s22_p | rs_bits_lo_d21;
   assign rs_or_45 = {{1{1'b0}}, or_45};
   assign s_rs_or_45 = $signed(rs_or_45);
   assign rs_rs_s1_b_d21 = {{1{1'b0}}, rs_s1_b_d21};
   assign s_rs_rs_s1_b_d21 = $signed(rs_rs_s1_b_d21);
-  assign diff21 = s_rs_or_45 - s_rs_rs_s1_b_d21;
-  assign bits_diff21 = diff21[35];
-  assign ge21 = ~bits_diff21;
-  assign bits_diff21_1 = diff21[33:0];
-  assign rs_or_45_1 = or_45[33:0];
-  assign rem21 = ge21 ? bits_diff21_1 : rs_or_45_1;
+  assign diffk21 = s_rs_or_45 - s_rs_rs_s1_b_d21;
+  assign bits_diffk21 = diffk21[33:0];
+  assign bits_diffk21_1 = diffk21[35];
+  assign gek21 = ~bits_diffk21_1;
+  assign s22_q_eq_k_0_4 = s22_q == k_0_4;
   assign shl_s22_q = s22_q <<< 1;
-  assign rs_ge21 = {{29{1'b0}}, ge21};
-  assign quot21 = shl_s22_q | rs_ge21;
+  assign rs_gek21 = {{29{1'b0}}, gek21};
+  assign quot21 = shl_s22_q | rs_gek21;
+  assign rs_or_45_1 = or_45[33:0];
+  assign rem21 = gek21 ? bits_diffk21 : rs_or_45_1;
 
   always @(posedge clk) begin : s23_q21_regs
     s1_b_d21 <= s1_b_d20;
@@ -1499,24 +1630,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s24_q22: one quotient bit
   assign rs_s1_b_d22 = {{1{1'b0}}, s1_b_d22};
-  assign rs_s23_p = {{1{1'b0}}, s23_p};
-  assign shl_rs_s23_p = rs_s23_p <<< 1;
   assign bits_lo_d22 = lo_d22[7];
   assign rs_bits_lo_d22 = {{34{1'b0}}, bits_lo_d22};
+  assign rs_s23_p = {{1{1'b0}}, s23_p};
+  assign shl_rs_s23_p = rs_s23_p <<< 1;
   assign or_47 = shl_rs_s23_p | rs_bits_lo_d22;
   assign rs_or_47 = {{1{1'b0}}, or_47};
   assign s_rs_or_47 = $signed(rs_or_47);
   assign rs_rs_s1_b_d22 = {{1{1'b0}}, rs_s1_b_d22};
   assign s_rs_rs_s1_b_d22 = $signed(rs_rs_s1_b_d22);
-  assign diff22 = s_rs_or_47 - s_rs_rs_s1_b_d22;
-  assign bits_diff22 = diff22[35];
-  assign ge22 = ~bits_diff22;
-  assign bits_diff22_1 = diff22[33:0];
-  assign rs_or_47_1 = or_47[33:0];
-  assign rem22 = ge22 ? bits_diff22_1 : rs_or_47_1;
+  assign diffk22 = s_rs_or_47 - s_rs_rs_s1_b_d22;
+  assign bits_diffk22 = diffk22[33:0];
+  assign bits_diffk22_1 = diffk22[35];
+  assign gek22 = ~bits_diffk22_1;
+  assign s23_q_eq_k_0_4 = s23_q == k_0_4;
   assign shl_s23_q = s23_q <<< 1;
-  assign rs_ge22 = {{29{1'b0}}, ge22};
-  assign quot22 = shl_s23_q | rs_ge22;
+  assign rs_gek22 = {{29{1'b0}}, gek22};
+  assign quot22 = shl_s23_q | rs_gek22;
+  assign rs_or_47_1 = or_47[33:0];
+  assign rem22 = gek22 ? bits_diffk22 : rs_or_47_1;
 
   always @(posedge clk) begin : s24_q22_regs
     s1_b_d22 <= s1_b_d21;
@@ -1527,24 +1659,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s25_q23: one quotient bit
   assign rs_s1_b_d23 = {{1{1'b0}}, s1_b_d23};
-  assign rs_s24_p = {{1{1'b0}}, s24_p};
-  assign shl_rs_s24_p = rs_s24_p <<< 1;
   assign bits_lo_d23 = lo_d23[6];
   assign rs_bits_lo_d23 = {{34{1'b0}}, bits_lo_d23};
+  assign rs_s24_p = {{1{1'b0}}, s24_p};
+  assign shl_rs_s24_p = rs_s24_p <<< 1;
   assign or_49 = shl_rs_s24_p | rs_bits_lo_d23;
   assign rs_or_49 = {{1{1'b0}}, or_49};
   assign s_rs_or_49 = $signed(rs_or_49);
   assign rs_rs_s1_b_d23 = {{1{1'b0}}, rs_s1_b_d23};
   assign s_rs_rs_s1_b_d23 = $signed(rs_rs_s1_b_d23);
-  assign diff23 = s_rs_or_49 - s_rs_rs_s1_b_d23;
-  assign bits_diff23 = diff23[35];
-  assign ge23 = ~bits_diff23;
-  assign bits_diff23_1 = diff23[33:0];
-  assign rs_or_49_1 = or_49[33:0];
-  assign rem23 = ge23 ? bits_diff23_1 : rs_or_49_1;
+  assign diffk23 = s_rs_or_49 - s_rs_rs_s1_b_d23;
+  assign bits_diffk23 = diffk23[33:0];
+  assign bits_diffk23_1 = diffk23[35];
+  assign gek23 = ~bits_diffk23_1;
+  assign s24_q_eq_k_0_4 = s24_q == k_0_4;
   assign shl_s24_q = s24_q <<< 1;
-  assign rs_ge23 = {{29{1'b0}}, ge23};
-  assign quot23 = shl_s24_q | rs_ge23;
+  assign rs_gek23 = {{29{1'b0}}, gek23};
+  assign quot23 = shl_s24_q | rs_gek23;
+  assign rs_or_49_1 = or_49[33:0];
+  assign rem23 = gek23 ? bits_diffk23 : rs_or_49_1;
 
   always @(posedge clk) begin : s25_q23_regs
     s1_b_d23 <= s1_b_d22;
@@ -1555,24 +1688,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s26_q24: one quotient bit
   assign rs_s1_b_d24 = {{1{1'b0}}, s1_b_d24};
-  assign rs_s25_p = {{1{1'b0}}, s25_p};
-  assign shl_rs_s25_p = rs_s25_p <<< 1;
   assign bits_lo_d24 = lo_d24[5];
   assign rs_bits_lo_d24 = {{34{1'b0}}, bits_lo_d24};
+  assign rs_s25_p = {{1{1'b0}}, s25_p};
+  assign shl_rs_s25_p = rs_s25_p <<< 1;
   assign or_51 = shl_rs_s25_p | rs_bits_lo_d24;
   assign rs_or_51 = {{1{1'b0}}, or_51};
   assign s_rs_or_51 = $signed(rs_or_51);
   assign rs_rs_s1_b_d24 = {{1{1'b0}}, rs_s1_b_d24};
   assign s_rs_rs_s1_b_d24 = $signed(rs_rs_s1_b_d24);
-  assign diff24 = s_rs_or_51 - s_rs_rs_s1_b_d24;
-  assign bits_diff24 = diff24[35];
-  assign ge24 = ~bits_diff24;
-  assign bits_diff24_1 = diff24[33:0];
-  assign rs_or_51_1 = or_51[33:0];
-  assign rem24 = ge24 ? bits_diff24_1 : rs_or_51_1;
+  assign diffk24 = s_rs_or_51 - s_rs_rs_s1_b_d24;
+  assign bits_diffk24 = diffk24[33:0];
+  assign bits_diffk24_1 = diffk24[35];
+  assign gek24 = ~bits_diffk24_1;
+  assign s25_q_eq_k_0_4 = s25_q == k_0_4;
   assign shl_s25_q = s25_q <<< 1;
-  assign rs_ge24 = {{29{1'b0}}, ge24};
-  assign quot24 = shl_s25_q | rs_ge24;
+  assign rs_gek24 = {{29{1'b0}}, gek24};
+  assign quot24 = shl_s25_q | rs_gek24;
+  assign rs_or_51_1 = or_51[33:0];
+  assign rem24 = gek24 ? bits_diffk24 : rs_or_51_1;
 
   always @(posedge clk) begin : s26_q24_regs
     s1_b_d24 <= s1_b_d23;
@@ -1583,24 +1717,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s27_q25: one quotient bit
   assign rs_s1_b_d25 = {{1{1'b0}}, s1_b_d25};
-  assign rs_s26_p = {{1{1'b0}}, s26_p};
-  assign shl_rs_s26_p = rs_s26_p <<< 1;
   assign bits_lo_d25 = lo_d25[4];
   assign rs_bits_lo_d25 = {{34{1'b0}}, bits_lo_d25};
+  assign rs_s26_p = {{1{1'b0}}, s26_p};
+  assign shl_rs_s26_p = rs_s26_p <<< 1;
   assign or_53 = shl_rs_s26_p | rs_bits_lo_d25;
   assign rs_or_53 = {{1{1'b0}}, or_53};
   assign s_rs_or_53 = $signed(rs_or_53);
   assign rs_rs_s1_b_d25 = {{1{1'b0}}, rs_s1_b_d25};
   assign s_rs_rs_s1_b_d25 = $signed(rs_rs_s1_b_d25);
-  assign diff25 = s_rs_or_53 - s_rs_rs_s1_b_d25;
-  assign bits_diff25 = diff25[35];
-  assign ge25 = ~bits_diff25;
-  assign bits_diff25_1 = diff25[33:0];
-  assign rs_or_53_1 = or_53[33:0];
-  assign rem25 = ge25 ? bits_diff25_1 : rs_or_53_1;
+  assign diffk25 = s_rs_or_53 - s_rs_rs_s1_b_d25;
+  assign bits_diffk25 = diffk25[33:0];
+  assign bits_diffk25_1 = diffk25[35];
+  assign gek25 = ~bits_diffk25_1;
+  assign s26_q_eq_k_0_4 = s26_q == k_0_4;
   assign shl_s26_q = s26_q <<< 1;
-  assign rs_ge25 = {{29{1'b0}}, ge25};
-  assign quot25 = shl_s26_q | rs_ge25;
+  assign rs_gek25 = {{29{1'b0}}, gek25};
+  assign quot25 = shl_s26_q | rs_gek25;
+  assign rs_or_53_1 = or_53[33:0];
+  assign rem25 = gek25 ? bits_diffk25 : rs_or_53_1;
 
   always @(posedge clk) begin : s27_q25_regs
     s1_b_d25 <= s1_b_d24;
@@ -1611,24 +1746,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s28_q26: one quotient bit
   assign rs_s1_b_d26 = {{1{1'b0}}, s1_b_d26};
-  assign rs_s27_p = {{1{1'b0}}, s27_p};
-  assign shl_rs_s27_p = rs_s27_p <<< 1;
   assign bits_lo_d26 = lo_d26[3];
   assign rs_bits_lo_d26 = {{34{1'b0}}, bits_lo_d26};
+  assign rs_s27_p = {{1{1'b0}}, s27_p};
+  assign shl_rs_s27_p = rs_s27_p <<< 1;
   assign or_55 = shl_rs_s27_p | rs_bits_lo_d26;
   assign rs_or_55 = {{1{1'b0}}, or_55};
   assign s_rs_or_55 = $signed(rs_or_55);
   assign rs_rs_s1_b_d26 = {{1{1'b0}}, rs_s1_b_d26};
   assign s_rs_rs_s1_b_d26 = $signed(rs_rs_s1_b_d26);
-  assign diff26 = s_rs_or_55 - s_rs_rs_s1_b_d26;
-  assign bits_diff26 = diff26[35];
-  assign ge26 = ~bits_diff26;
-  assign bits_diff26_1 = diff26[33:0];
-  assign rs_or_55_1 = or_55[33:0];
-  assign rem26 = ge26 ? bits_diff26_1 : rs_or_55_1;
+  assign diffk26 = s_rs_or_55 - s_rs_rs_s1_b_d26;
+  assign bits_diffk26 = diffk26[33:0];
+  assign bits_diffk26_1 = diffk26[35];
+  assign gek26 = ~bits_diffk26_1;
+  assign s27_q_eq_k_0_4 = s27_q == k_0_4;
   assign shl_s27_q = s27_q <<< 1;
-  assign rs_ge26 = {{29{1'b0}}, ge26};
-  assign quot26 = shl_s27_q | rs_ge26;
+  assign rs_gek26 = {{29{1'b0}}, gek26};
+  assign quot26 = shl_s27_q | rs_gek26;
+  assign rs_or_55_1 = or_55[33:0];
+  assign rem26 = gek26 ? bits_diffk26 : rs_or_55_1;
 
   always @(posedge clk) begin : s28_q26_regs
     s1_b_d26 <= s1_b_d25;
@@ -1639,24 +1775,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s29_q27: one quotient bit
   assign rs_s1_b_d27 = {{1{1'b0}}, s1_b_d27};
-  assign rs_s28_p = {{1{1'b0}}, s28_p};
-  assign shl_rs_s28_p = rs_s28_p <<< 1;
   assign bits_lo_d27 = lo_d27[2];
   assign rs_bits_lo_d27 = {{34{1'b0}}, bits_lo_d27};
+  assign rs_s28_p = {{1{1'b0}}, s28_p};
+  assign shl_rs_s28_p = rs_s28_p <<< 1;
   assign or_57 = shl_rs_s28_p | rs_bits_lo_d27;
   assign rs_or_57 = {{1{1'b0}}, or_57};
   assign s_rs_or_57 = $signed(rs_or_57);
   assign rs_rs_s1_b_d27 = {{1{1'b0}}, rs_s1_b_d27};
   assign s_rs_rs_s1_b_d27 = $signed(rs_rs_s1_b_d27);
-  assign diff27 = s_rs_or_57 - s_rs_rs_s1_b_d27;
-  assign bits_diff27 = diff27[35];
-  assign ge27 = ~bits_diff27;
-  assign bits_diff27_1 = diff27[33:0];
-  assign rs_or_57_1 = or_57[33:0];
-  assign rem27 = ge27 ? bits_diff27_1 : rs_or_57_1;
+  assign diffk27 = s_rs_or_57 - s_rs_rs_s1_b_d27;
+  assign bits_diffk27 = diffk27[33:0];
+  assign bits_diffk27_1 = diffk27[35];
+  assign gek27 = ~bits_diffk27_1;
+  assign s28_q_eq_k_0_4 = s28_q == k_0_4;
   assign shl_s28_q = s28_q <<< 1;
-  assign rs_ge27 = {{29{1'b0}}, ge27};
-  assign quot27 = shl_s28_q | rs_ge27;
+  assign rs_gek27 = {{29{1'b0}}, gek27};
+  assign quot27 = shl_s28_q | rs_gek27;
+  assign rs_or_57_1 = or_57[33:0];
+  assign rem27 = gek27 ? bits_diffk27 : rs_or_57_1;
 
   always @(posedge clk) begin : s29_q27_regs
     s1_b_d27 <= s1_b_d26;
@@ -1667,24 +1804,25 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s30_q28: one quotient bit
   assign rs_s1_b_d28 = {{1{1'b0}}, s1_b_d28};
-  assign rs_s29_p = {{1{1'b0}}, s29_p};
-  assign shl_rs_s29_p = rs_s29_p <<< 1;
   assign bits_lo_d28 = lo_d28[1];
   assign rs_bits_lo_d28 = {{34{1'b0}}, bits_lo_d28};
+  assign rs_s29_p = {{1{1'b0}}, s29_p};
+  assign shl_rs_s29_p = rs_s29_p <<< 1;
   assign or_59 = shl_rs_s29_p | rs_bits_lo_d28;
   assign rs_or_59 = {{1{1'b0}}, or_59};
   assign s_rs_or_59 = $signed(rs_or_59);
   assign rs_rs_s1_b_d28 = {{1{1'b0}}, rs_s1_b_d28};
   assign s_rs_rs_s1_b_d28 = $signed(rs_rs_s1_b_d28);
-  assign diff28 = s_rs_or_59 - s_rs_rs_s1_b_d28;
-  assign bits_diff28 = diff28[35];
-  assign ge28 = ~bits_diff28;
-  assign bits_diff28_1 = diff28[33:0];
-  assign rs_or_59_1 = or_59[33:0];
-  assign rem28 = ge28 ? bits_diff28_1 : rs_or_59_1;
+  assign diffk28 = s_rs_or_59 - s_rs_rs_s1_b_d28;
+  assign bits_diffk28 = diffk28[33:0];
+  assign bits_diffk28_1 = diffk28[35];
+  assign gek28 = ~bits_diffk28_1;
+  assign s29_q_eq_k_0_4 = s29_q == k_0_4;
   assign shl_s29_q = s29_q <<< 1;
-  assign rs_ge28 = {{29{1'b0}}, ge28};
-  assign quot28 = shl_s29_q | rs_ge28;
+  assign rs_gek28 = {{29{1'b0}}, gek28};
+  assign quot28 = shl_s29_q | rs_gek28;
+  assign rs_or_59_1 = or_59[33:0];
+  assign rem28 = gek28 ? bits_diffk28 : rs_or_59_1;
 
   always @(posedge clk) begin : s30_q28_regs
     s1_b_d28 <= s1_b_d27;
@@ -1695,37 +1833,42 @@ module fxrt_div_n29_a63_b34 (
 
   // stage s31_result: the quotient and its result flag
   assign rs_s1_b_d29 = {{1{1'b0}}, s1_b_d29};
-  assign rs_s30_p = {{1{1'b0}}, s30_p};
-  assign shl_rs_s30_p = rs_s30_p <<< 1;
   assign bits_lo_d29 = lo_d29[0];
   assign rs_bits_lo_d29 = {{34{1'b0}}, bits_lo_d29};
+  assign rs_s30_p = {{1{1'b0}}, s30_p};
+  assign shl_rs_s30_p = rs_s30_p <<< 1;
   assign or_61 = shl_rs_s30_p | rs_bits_lo_d29;
   assign rs_or_61 = {{1{1'b0}}, or_61};
   assign s_rs_or_61 = $signed(rs_or_61);
   assign rs_rs_s1_b_d29 = {{1{1'b0}}, rs_s1_b_d29};
   assign s_rs_rs_s1_b_d29 = $signed(rs_rs_s1_b_d29);
-  assign diff29 = s_rs_or_61 - s_rs_rs_s1_b_d29;
-  assign bits_diff29 = diff29[35];
-  assign ge29 = ~bits_diff29;
-  assign bits_diff29_1 = diff29[33:0];
-  assign rs_or_61_1 = or_61[33:0];
-  assign rem29 = ge29 ? bits_diff29_1 : rs_or_61_1;
+  assign diffk29 = s_rs_or_61 - s_rs_rs_s1_b_d29;
+  assign bits_diffk29 = diffk29[33:0];
+  assign bits_diffk29_1 = diffk29[35];
+  assign gek29 = ~bits_diffk29_1;
+  assign s30_q_eq_k_0_4 = s30_q == k_0_4;
   assign shl_s30_q = s30_q <<< 1;
-  assign rs_ge29 = {{29{1'b0}}, ge29};
-  assign quot29 = shl_s30_q | rs_ge29;
-  assign err_1_d29 = err_1_d29_sr[29];
-  assign quot29_eq_k_0_2 = quot29 == k_0_2;
-  assign or_63 = err_1_d29 | quot29_eq_k_0_2;
-  assign not_or_63 = ~or_63;
+  assign rs_gek29 = {{29{1'b0}}, gek29};
+  assign quot29 = shl_s30_q | rs_gek29;
+  assign s1_err_d29 = s1_err_d29_sr[29];
+  assign overflow_d29 = overflow_d29_sr[29];
+  assign or_63 = s1_err_d29 | overflow_d29;
+  assign not_gek29 = ~gek29;
+  assign and_64 = s30_q_eq_k_0_4 & not_gek29;
+  assign or_63_or_and_64 = or_63 | and_64;
+  assign not_or_63_or_and_64 = ~or_63_or_and_64;
 
   always @(posedge clk) begin : s31_result_regs
     s1_b_d29 <= s1_b_d28;
     lo_d29 <= lo_d28;
-    for (err_1_d29_i = 29; err_1_d29_i > 1; err_1_d29_i = err_1_d29_i - 1)
-      err_1_d29_sr[err_1_d29_i] <= err_1_d29_sr[err_1_d29_i - 1];
-    err_1_d29_sr[1] <= err_1;
+    for (s1_err_d29_i = 29; s1_err_d29_i > 1; s1_err_d29_i = s1_err_d29_i - 1)
+      s1_err_d29_sr[s1_err_d29_i] <= s1_err_d29_sr[s1_err_d29_i - 1];
+    s1_err_d29_sr[1] <= s1_err;
+    for (overflow_d29_i = 29; overflow_d29_i > 1; overflow_d29_i = overflow_d29_i - 1)
+      overflow_d29_sr[overflow_d29_i] <= overflow_d29_sr[overflow_d29_i - 1];
+    overflow_d29_sr[1] <= overflow;
     s31_t <= quot29;
-    s31_ok <= not_or_63;
+    s31_ok <= not_or_63_or_and_64;
   end
 
   assign t = s31_t;

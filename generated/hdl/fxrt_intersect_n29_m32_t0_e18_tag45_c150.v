@@ -219,7 +219,14 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   reg [0:0] s54_neg = 1'h0;
 
   // stage s55_hit: the hit bit
-  wire signed [65:0] k_562949953421312 = 66'sh00002000000000000;
+  wire [15:0] bits_s54_sum;
+  wire [48:0] bits_s54_sum_1;
+  wire [48:0] k_0_2 = 49'h0000000000000;
+  wire [0:0] bits_s54_sum_1_ne_k_0_2;
+  wire [15:0] k_0_3 = 16'h0000;
+  wire [0:0] bits_s54_sum_ne_k_0_3;
+  wire [0:0] bits_s54_sum_2;
+  wire [0:0] and_14;
   wire [0:0] over;
   wire [0:0] s54_neg_or_over;
   wire [0:0] not_s54_neg_or_over;
@@ -251,14 +258,14 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   integer s1_tag_d54_i;
   initial for (s1_tag_d54_i = 1; s1_tag_d54_i <= 54; s1_tag_d54_i = s1_tag_d54_i + 1) s1_tag_d54_sr[s1_tag_d54_i] = 45'h000000000000;
   wire [44:0] s1_tag_d54;
-  wire [29:0] k_0_2 = 30'h00000000;
+  wire [29:0] k_0_4 = 30'h00000000;
   wire [29:0] mux_s55_hit;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [64:0] shr_s53_u_d2;
   /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] rs_shr_s53_u_d2;
   wire [31:0] u_rs_shr_s53_u_d2;
-  wire [31:0] k_0_3 = 32'h00000000;
+  wire [31:0] k_0_5 = 32'h00000000;
   wire [31:0] mux_s55_hit_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [64:0] shr_s53_v_d2;
@@ -500,7 +507,13 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   end
 
   // stage s55_hit: the hit bit
-  assign over = k_562949953421312 < s54_sum;
+  assign bits_s54_sum = s54_sum[65:50];
+  assign bits_s54_sum_1 = s54_sum[48:0];
+  assign bits_s54_sum_1_ne_k_0_2 = bits_s54_sum_1 != k_0_2;
+  assign bits_s54_sum_ne_k_0_3 = bits_s54_sum != k_0_3;
+  assign bits_s54_sum_2 = s54_sum[49];
+  assign and_14 = bits_s54_sum_2 & bits_s54_sum_1_ne_k_0_2;
+  assign over = bits_s54_sum_ne_k_0_3 | and_14;
   assign s54_neg_or_over = s54_neg | over;
   assign not_s54_neg_or_over = ~s54_neg_or_over;
   assign u_div_ok_d14 = u_div_ok_d14_sr[14];
@@ -519,15 +532,15 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   assign s53_v_d2 = s53_v_d2_sr[2];
   assign s1_valid_d54 = s1_valid_d54_sr[54];
   assign s1_tag_d54 = s1_tag_d54_sr[54];
-  assign mux_s55_hit = s55_hit ? u_div_t_1_d15 : k_0_2;
+  assign mux_s55_hit = s55_hit ? u_div_t_1_d15 : k_0_4;
   assign shr_s53_u_d2 = s53_u_d2 >>> 18;
   assign rs_shr_s53_u_d2 = $signed(shr_s53_u_d2[31:0]);
   assign u_rs_shr_s53_u_d2 = $unsigned(rs_shr_s53_u_d2);
-  assign mux_s55_hit_1 = s55_hit ? u_rs_shr_s53_u_d2 : k_0_3;
+  assign mux_s55_hit_1 = s55_hit ? u_rs_shr_s53_u_d2 : k_0_5;
   assign shr_s53_v_d2 = s53_v_d2 >>> 18;
   assign rs_shr_s53_v_d2 = $signed(shr_s53_v_d2[31:0]);
   assign u_rs_shr_s53_v_d2 = $unsigned(rs_shr_s53_v_d2);
-  assign mux_s55_hit_2 = s55_hit ? u_rs_shr_s53_v_d2 : k_0_3;
+  assign mux_s55_hit_2 = s55_hit ? u_rs_shr_s53_v_d2 : k_0_5;
 
   always @(posedge clk) begin : s56_result_regs
     for (u_div_t_1_d15_i = 15; u_div_t_1_d15_i > 1; u_div_t_1_d15_i = u_div_t_1_d15_i - 1)

@@ -262,7 +262,14 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
   signal s54_neg : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s55_hit: the hit bit
-  constant k_562949953421312 : signed(65 downto 0) := signed'("000000000000000010000000000000000000000000000000000000000000000000");
+  signal bits_s54_sum : unsigned(15 downto 0);
+  signal bits_s54_sum_1 : unsigned(48 downto 0);
+  constant k_0_2 : unsigned(48 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000");
+  signal bits_s54_sum_1_ne_k_0_2 : unsigned(0 downto 0);
+  constant k_0_3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal bits_s54_sum_ne_k_0_3 : unsigned(0 downto 0);
+  signal bits_s54_sum_2 : unsigned(0 downto 0);
+  signal and_14 : unsigned(0 downto 0);
   signal over : unsigned(0 downto 0);
   signal s54_neg_or_over : unsigned(0 downto 0);
   signal not_s54_neg_or_over : unsigned(0 downto 0);
@@ -288,12 +295,12 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
   type s1_tag_d54_sr_t is array (1 to 54) of unsigned(44 downto 0);
   signal s1_tag_d54_sr : s1_tag_d54_sr_t := (others => (others => '0'));
   signal s1_tag_d54 : unsigned(44 downto 0);
-  constant k_0_2 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  constant k_0_4 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal mux_s55_hit : unsigned(29 downto 0);
   signal shr_s53_u_d2 : signed(64 downto 0);
   signal rs_shr_s53_u_d2 : signed(31 downto 0);
   signal u_rs_shr_s53_u_d2 : unsigned(31 downto 0);
-  constant k_0_3 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  constant k_0_5 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal mux_s55_hit_1 : unsigned(31 downto 0);
   signal shr_s53_v_d2 : signed(64 downto 0);
   signal rs_shr_s53_v_d2 : signed(31 downto 0);
@@ -534,7 +541,13 @@ begin
   end process s54_test_regs;
 
   -- stage s55_hit: the hit bit
-  over <= "1" when k_562949953421312 < s54_sum else "0";
+  bits_s54_sum <= unsigned(s54_sum(65 downto 50));
+  bits_s54_sum_1 <= unsigned(s54_sum(48 downto 0));
+  bits_s54_sum_1_ne_k_0_2 <= "1" when bits_s54_sum_1 /= k_0_2 else "0";
+  bits_s54_sum_ne_k_0_3 <= "1" when bits_s54_sum /= k_0_3 else "0";
+  bits_s54_sum_2 <= unsigned(s54_sum(49 downto 49));
+  and_14 <= bits_s54_sum_2 and bits_s54_sum_1_ne_k_0_2;
+  over <= bits_s54_sum_ne_k_0_3 or and_14;
   s54_neg_or_over <= s54_neg or over;
   not_s54_neg_or_over <= not s54_neg_or_over;
   u_div_ok_d14 <= u_div_ok_d14_sr(14);
@@ -555,15 +568,15 @@ begin
   s53_v_d2 <= s53_v_d2_sr(2);
   s1_valid_d54 <= s1_valid_d54_sr(54);
   s1_tag_d54 <= s1_tag_d54_sr(54);
-  mux_s55_hit <= u_div_t_1_d15 when s55_hit = "1" else k_0_2;
+  mux_s55_hit <= u_div_t_1_d15 when s55_hit = "1" else k_0_4;
   shr_s53_u_d2 <= shift_right(s53_u_d2, 18);
   rs_shr_s53_u_d2 <= shr_s53_u_d2(31 downto 0);
   u_rs_shr_s53_u_d2 <= unsigned(rs_shr_s53_u_d2);
-  mux_s55_hit_1 <= u_rs_shr_s53_u_d2 when s55_hit = "1" else k_0_3;
+  mux_s55_hit_1 <= u_rs_shr_s53_u_d2 when s55_hit = "1" else k_0_5;
   shr_s53_v_d2 <= shift_right(s53_v_d2, 18);
   rs_shr_s53_v_d2 <= shr_s53_v_d2(31 downto 0);
   u_rs_shr_s53_v_d2 <= unsigned(rs_shr_s53_v_d2);
-  mux_s55_hit_2 <= u_rs_shr_s53_v_d2 when s55_hit = "1" else k_0_3;
+  mux_s55_hit_2 <= u_rs_shr_s53_v_d2 when s55_hit = "1" else k_0_5;
 
   s56_result_regs : process (clk)
   begin

@@ -26,32 +26,32 @@ module fxrt_traverse (
   output wire [3:0] fsm_state
 );
 
-  reg [72:0] node_rom [0:8191];
-  initial $readmemh("fxrt_traverse_node_rom.hex", node_rom);
-
   reg [76:0] stack [0:31];
   initial $readmemh("fxrt_traverse_stack.hex", stack);
-
-  reg [12:0] leaf_rom [0:8191];
-  initial $readmemh("fxrt_traverse_leaf_rom.hex", leaf_rom);
 
   // states of state
   localparam [3:0] st_idle = 4'h0;
   localparam [3:0] st_aabb = 4'h1;
   localparam [3:0] st_box = 4'h2;
-  localparam [3:0] st_fetch = 4'h3;
-  localparam [3:0] st_node = 4'h4;
-  localparam [3:0] st_clip1 = 4'h5;
-  localparam [3:0] st_dist = 4'h6;
-  localparam [3:0] st_step = 4'h7;
-  localparam [3:0] st_leaf = 4'h8;
-  localparam [3:0] st_pop = 4'h9;
-  localparam [3:0] st_done = 4'ha;
+  localparam [3:0] st_boxmin = 4'h3;
+  localparam [3:0] st_fetch = 4'h4;
+  localparam [3:0] st_node = 4'h5;
+  localparam [3:0] st_clip1 = 4'h6;
+  localparam [3:0] st_dist = 4'h7;
+  localparam [3:0] st_step = 4'h8;
+  localparam [3:0] st_leaf = 4'h9;
+  localparam [3:0] st_pop = 4'ha;
+  localparam [3:0] st_done = 4'hb;
 
   // not in a stage or state machine
-  reg [72:0] node_word = 73'h0000000000000000000;
-  reg [72:0] node_word_r = 73'h0000000000000000000;
+  wire [72:0] u_node_rom_data;
   reg [12:0] node_d1 = 13'h0000;
+  wire [0:0] node_eq_node_d1;
+  (* mem2reg *) reg [12:0] node_d2_sr [1:2];
+  integer node_d2_i;
+  initial for (node_d2_i = 1; node_d2_i <= 2; node_d2_i = node_d2_i + 1) node_d2_sr[node_d2_i] = 13'h0000;
+  wire [12:0] node_d2;
+  wire [0:0] node_eq_node_d2;
   wire [0:0] node_settled;
   wire [1:0] nw_axis;
   wire [28:0] nw_clip0;
@@ -61,9 +61,6 @@ module fxrt_traverse (
   wire [2:0] nw_count;
   wire [1:0] k_3 = 2'h3;
   wire [0:0] nw_is_leaf;
-  wire [0:0] in_aabb;
-  wire [0:0] in_node;
-  wire [0:0] in_clip1;
   wire [28:0] box_hi_0 = 29'h1fffffff;
   wire [28:0] box_hi_1 = 29'h0faab179;
   wire [28:0] box_hi_2 = 29'h13e4f19b;
@@ -78,7 +75,7 @@ module fxrt_traverse (
   wire [0:0] aabb_last;
   wire [0:0] in_aabb_or_in_clip1;
   wire [0:0] not_nw_is_leaf;
-  wire [0:0] and_0;
+  wire [0:0] and_1;
   wire [0:0] pu_issue;
   wire [0:0] in_aabb_and_aabb_last;
   wire [0:0] pu_issue_last;
@@ -102,7 +99,9 @@ module fxrt_traverse (
   reg [0:0] pu_delta_valid = 1'h0;
   reg [0:0] pu_delta_last = 1'h0;
   wire signed [77:0] u_plane_product_p;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 77:16 are read
   wire signed [77:0] pu_product;
+  /* verilator lint_on UNUSEDSIGNAL */
   (* mem2reg *) reg [0:0] pu_product_valid_sr [1:6];
   integer pu_product_valid_i;
   initial for (pu_product_valid_i = 1; pu_product_valid_i <= 6; pu_product_valid_i = pu_product_valid_i + 1) pu_product_valid_sr[pu_product_valid_i] = 1'h0;
@@ -111,112 +110,151 @@ module fxrt_traverse (
   integer pu_product_last_i;
   initial for (pu_product_last_i = 1; pu_product_last_i <= 6; pu_product_last_i = pu_product_last_i + 1) pu_product_last_sr[pu_product_last_i] = 1'h0;
   wire [0:0] pu_product_last;
-  wire signed [77:0] pu_shifted;
-  wire signed [77:0] k_1073741824 = 78'sh00000000000040000000;
-  wire [0:0] lt_4;
-  wire signed [77:0] k_m1 = 78'sh3fffffffffffffffffff;
-  wire [0:0] pu_shifted_lt_k_m1;
-  wire signed [77:0] mux_pu_shifted_lt_k_m1;
+  wire [61:0] bits_pu_product;
+  wire signed [61:0] pu_shifted;
+  wire [0:0] bits_pu_shifted;
+  wire signed [61:0] k_m1 = 62'sh3fffffffffffffff;
+  wire [0:0] pu_shifted_ne_k_m1;
+  wire [0:0] pu_below;
+  wire [29:0] bits_pu_shifted_1;
+  wire [29:0] k_0_1 = 30'h00000000;
+  wire [0:0] ne_6;
+  wire [0:0] bits_pu_shifted_2;
+  wire [0:0] not_bits_pu_shifted_2;
+  wire [0:0] bits_pu_shifted_3;
+  wire [29:0] bits_pu_shifted_4;
+  wire [0:0] ne_7;
+  wire [0:0] and_8;
+  wire [0:0] ne_6_or_and_8;
+  wire [0:0] pu_above;
+  wire signed [61:0] k_1073741824 = 62'sh0000000040000000;
+  wire signed [61:0] mux_pu_below;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [77:0] mux_lt_4;
+  wire signed [61:0] mux_pu_above;
   /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] pu_clamped;
   reg signed [31:0] plane_t = 32'sh00000000;
+  reg signed [31:0] plane_t_of_last = 32'sh00000000;
   reg [0:0] plane_t_valid = 1'h0;
   reg [0:0] plane_t_last = 1'h0;
   wire [0:0] not_plane_t_last;
   wire [0:0] d0_arrives;
   wire [0:0] d1_arrives;
-  wire [0:0] plane_t_lt_tmax;
+  reg signed [31:0] box_d1 = 32'sh00000000;
+  reg signed [31:0] box_d2 = 32'sh00000000;
+  reg signed [31:0] box_d3 = 32'sh00000000;
+  wire [0:0] box_lt1_c;
+  reg [0:0] box_lt1 = 1'h0;
+  wire [0:0] box_lt2_c;
+  reg [0:0] box_lt2 = 1'h0;
+  reg [0:0] box_lt1_d = 1'h0;
+  wire [0:0] box_lt1_and_box_lt2;
+  wire signed [31:0] mux_box_lt1_d;
   wire signed [31:0] box_tmax;
-  wire [0:0] bits_plane_t;
+  wire [0:0] bits_box_d1;
+  wire [0:0] bits_box_d2;
+  wire [0:0] or_12;
+  wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire signed [31:0] near_end;
   wire signed [31:0] far_start;
-  wire [12:0] k_1 = 13'h0001;
-  wire [12:0] child_r_plus_k_1;
+  wire signed [31:0] k_1 = 32'sh00000001;
+  wire signed [31:0] tmax_plus_1;
+  reg signed [31:0] tmax_p1 = 32'sh00000000;
+  wire signed [31:0] tmin_minus_1;
+  reg signed [31:0] tmin_m1 = 32'sh00000000;
+  wire [0:0] tmin_le_tmax_c;
+  reg [0:0] tmin_le_tmax = 1'h0;
+  wire [0:0] near_lt_plane;
+  wire [0:0] near_lt_d0;
+  wire [0:0] near_lt;
+  wire [0:0] near_lt_tmax_c;
+  reg [0:0] near_lt_tmax = 1'h0;
+  wire [0:0] far_gt_plane;
+  wire [0:0] far_gt_d0;
+  wire [0:0] far_gt;
+  wire [0:0] far_gt_tmin_c;
+  reg [0:0] far_gt_tmin = 1'h0;
+  wire [0:0] tmin_le_near_plane;
+  wire [0:0] tmin_le_near_d0;
+  wire [0:0] tmin_le_near;
+  wire [0:0] far_le_tmax_plane;
+  wire [0:0] far_le_tmax_d0;
+  wire [0:0] far_le_tmax;
+  wire [0:0] go_near_c;
+  reg [0:0] go_near = 1'h0;
+  wire [0:0] go_far_c;
+  reg [0:0] go_far = 1'h0;
+  wire [12:0] k_1_1 = 13'h0001;
+  wire [12:0] child_r_plus_k_1_1;
   wire [12:0] near;
   wire [12:0] far;
   wire signed [31:0] near_max;
   wire signed [31:0] far_min;
-  wire [0:0] go_near;
-  wire [0:0] go_far;
   wire [31:0] u_far_min;
   wire [31:0] u_tmax;
   wire [76:0] push_entry;
-  wire [5:0] k_1_1 = 6'h01;
+  wire [5:0] k_1_2 = 6'h01;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 4:0 are read
-  wire [5:0] sp_minus_k_1_1;
+  wire [5:0] sp_minus_k_1_2;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [4:0] rs_sp_minus_k_1_1;
+  wire [4:0] rs_sp_minus_k_1_2;
   reg [76:0] stack_top = 77'h00000000000000000000;
   wire [31:0] bits_stack_top;
   wire signed [31:0] top_tmax;
   wire [31:0] bits_stack_top_1;
   wire signed [31:0] top_tmin;
   wire [12:0] top_node;
-  wire [0:0] in_leaf;
-  reg [0:0] was_leaf = 1'h0;
-  wire [1:0] k_0_1 = 2'h0;
-  wire [12:0] k_0_2 = 13'h0000;
-  wire signed [31:0] k_0_3 = 32'sh00000000;
-  wire signed [31:0] k_1073741824_1 = 32'sh40000000;
-  wire [0:0] k_0_4 = 1'h0;
-  wire [1:0] k_1_2 = 2'h1;
-  wire [1:0] aabb_k_plus_k_1_2;
-  wire [2:0] k_0_5 = 3'h0;
-  wire [0:0] nw_count_eq_k_0_5;
-  wire [0:0] tmin_le_tmax_1;
+  reg [0:0] was_leaf1 = 1'h0;
+  (* mem2reg *) reg [0:0] was_leaf2_sr [1:2];
+  integer was_leaf2_i;
+  initial for (was_leaf2_i = 1; was_leaf2_i <= 2; was_leaf2_i = was_leaf2_i + 1) was_leaf2_sr[was_leaf2_i] = 1'h0;
+  wire [0:0] was_leaf2;
+  wire [0:0] was_leaf;
+  wire [5:0] k_0_2 = 6'h00;
+  wire [0:0] sp_is_zero;
+  reg [0:0] sp_empty = 1'h0;
+  wire [1:0] k_0_3 = 2'h0;
+  wire [12:0] k_0_4 = 13'h0000;
+  wire signed [31:0] k_0_5 = 32'sh00000000;
+  wire [1:0] k_1_3 = 2'h1;
+  wire [1:0] aabb_k_plus_k_1_3;
+  wire [0:0] k_0_6 = 1'h0;
+  wire [2:0] k_0_7 = 3'h0;
+  wire [0:0] nw_count_eq_k_0_7;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
   reg signed [47:0] case_axis_r;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_case_axis_r;
-  wire [0:0] plane_t_lt_tmax_1;
-  wire [0:0] d0_r_lt_tmax;
-  wire [0:0] mux_negative;
-  wire [0:0] tmin_lt_d0_r;
-  wire [0:0] tmin_lt_plane_t;
-  wire [0:0] mux_negative_1;
-  wire [0:0] tmin_le_plane_t;
-  wire [0:0] tmin_le_d0_r;
-  wire [0:0] mux_negative_2;
-  wire [0:0] d0_r_le_tmax;
-  wire [0:0] plane_t_le_tmax;
-  wire [0:0] mux_negative_3;
   wire [0:0] go_near_and_go_far;
   wire [4:0] rs_sp;
-  wire [5:0] sp_plus_k_1_1;
-  wire [12:0] leaf_ptr_plus_k_1;
-  wire [2:0] k_1_3 = 3'h1;
-  wire [2:0] leaf_left_minus_k_1_3;
-  wire [0:0] leaf_left_eq_k_1_3;
-  wire [5:0] k_0_6 = 6'h00;
-  wire [0:0] sp_eq_k_0_6;
-  wire [5:0] sp_minus_k_1_1_1;
-  wire [0:0] in_idle;
-  wire [0:0] in_done;
-  reg [12:0] leaf_tri = 13'h0000;
-  reg [12:0] leaf_tri_r = 13'h0000;
+  wire [5:0] sp_plus_k_1_2;
+  wire [12:0] leaf_ptr_plus_k_1_1;
+  wire [2:0] k_1_4 = 3'h1;
+  wire [2:0] leaf_left_minus_k_1_4;
+  wire [0:0] leaf_left_eq_k_1_4;
+  wire [5:0] sp_minus_k_1_2_1;
+  wire [12:0] u_leaf_rom_data;
   wire [0:0] in_leaf_or_in_done;
-  (* mem2reg *) reg [0:0] emit_r_sr [1:2];
+  (* mem2reg *) reg [0:0] emit_r_sr [1:3];
   integer emit_r_i;
-  initial for (emit_r_i = 1; emit_r_i <= 2; emit_r_i = emit_r_i + 1) emit_r_sr[emit_r_i] = 1'h0;
+  initial for (emit_r_i = 1; emit_r_i <= 3; emit_r_i = emit_r_i + 1) emit_r_sr[emit_r_i] = 1'h0;
   wire [0:0] emit_r;
-  (* mem2reg *) reg [0:0] end_r_sr [1:2];
+  (* mem2reg *) reg [0:0] end_r_sr [1:3];
   integer end_r_i;
-  initial for (end_r_i = 1; end_r_i <= 2; end_r_i = end_r_i + 1) end_r_sr[end_r_i] = 1'h0;
+  initial for (end_r_i = 1; end_r_i <= 3; end_r_i = end_r_i + 1) end_r_sr[end_r_i] = 1'h0;
   wire [0:0] end_r;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 30:0 are read
   wire [31:0] u_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_tmin;
-  (* mem2reg *) reg [30:0] tmin_r_sr [1:2];
+  (* mem2reg *) reg [30:0] tmin_r_sr [1:3];
   integer tmin_r_i;
-  initial for (tmin_r_i = 1; tmin_r_i <= 2; tmin_r_i = tmin_r_i + 1) tmin_r_sr[tmin_r_i] = 31'h00000000;
+  initial for (tmin_r_i = 1; tmin_r_i <= 3; tmin_r_i = tmin_r_i + 1) tmin_r_sr[tmin_r_i] = 31'h00000000;
   wire [30:0] tmin_r;
-  (* mem2reg *) reg [19:0] id_r_sr [1:2];
+  (* mem2reg *) reg [19:0] id_r_sr [1:3];
   integer id_r_i;
-  initial for (id_r_i = 1; id_r_i <= 2; id_r_i = id_r_i + 1) id_r_sr[id_r_i] = 20'h00000;
+  initial for (id_r_i = 1; id_r_i <= 3; id_r_i = id_r_i + 1) id_r_sr[id_r_i] = 20'h00000;
   wire [19:0] id_r;
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
@@ -235,14 +273,11 @@ module fxrt_traverse (
   reg [1:0] aabb_k = 2'h0;
   reg signed [31:0] tmin = 32'sh00000000;
   reg signed [31:0] tmax = 32'sh00000000;
-  reg [0:0] box_missed = 1'h0;
+  reg [0:0] in_aabb = 1'h0;
+  reg [0:0] in_node = 1'h0;
+  reg [0:0] in_clip1 = 1'h0;
   reg [0:0] negative = 1'h0;
   reg signed [31:0] d0_r = 32'sh00000000;
-  reg [0:0] tmin_le_tmax = 1'h0;
-  reg [0:0] near_lt_tmax = 1'h0;
-  reg [0:0] far_gt_tmin = 1'h0;
-  reg [0:0] tmin_le_near = 1'h0;
-  reg [0:0] far_le_tmax = 1'h0;
   reg signed [31:0] near_end_r = 32'sh00000000;
   reg signed [31:0] far_start_r = 32'sh00000000;
   reg [12:0] far_r = 13'h0000;
@@ -250,26 +285,23 @@ module fxrt_traverse (
   reg [12:0] leaf_ptr = 13'h0000;
   reg [2:0] leaf_left = 3'h0;
   reg [0:0] popped_ahead = 1'h0;
+  reg [0:0] in_leaf = 1'h0;
+  reg [0:0] in_idle = 1'h1;
+  reg [0:0] in_done = 1'h0;
   reg [1:0] aabb_k_next;
   wire [0:0] not_go_near;
   wire [0:0] not_go_near_and_go_far;
   wire [12:0] mux_not_go_near_and_go_far;
   wire [0:0] not_go_far;
-  wire [0:0] and_11;
-  wire [12:0] mux_and_11;
-  wire [0:0] not_sp_eq_k_0_6;
-  wire [12:0] mux_not_sp_eq_k_0_6;
+  wire [0:0] and_18;
+  wire [12:0] mux_and_18;
+  wire [0:0] not_sp_empty;
+  wire [12:0] mux_not_sp_empty;
   reg [12:0] node_next;
   wire [0:0] not_go_near_and_go_far_1;
   wire signed [31:0] mux_not_go_near_and_go_far_1;
-  wire signed [31:0] mux_not_sp_eq_k_0_6_1;
+  wire signed [31:0] mux_not_sp_empty_1;
   reg signed [31:0] tmin_next;
-  wire signed [31:0] mux_plane_t_valid;
-  wire signed [31:0] mux_go_near;
-  wire signed [31:0] mux_not_sp_eq_k_0_6_2;
-  reg signed [31:0] tmax_next;
-  wire [0:0] mux_plane_t_valid_1;
-  reg [0:0] box_missed_next;
   wire [19:0] mux_ray_valid;
   wire [19:0] ray_id_r_next;
   wire [28:0] mux_ray_valid_1;
@@ -286,41 +318,43 @@ module fxrt_traverse (
   wire signed [47:0] invz_r_next;
   wire [3:0] mux_ray_valid_7;
   wire [3:0] mux_aabb_last;
-  wire [0:0] d1_arrives_and_box_miss;
-  wire [3:0] mux_d1_arrives_and_box_miss;
+  wire [3:0] mux_d1_arrives;
+  wire [3:0] mux_box_miss;
   wire [0:0] not_box_miss;
-  wire [0:0] and_12;
-  wire [3:0] mux_and_12;
+  wire [3:0] mux_not_box_miss;
   wire [3:0] mux_node_settled;
-  wire [0:0] and_13;
-  wire [3:0] mux_and_13;
-  wire [0:0] not_nw_count_eq_k_0_5;
-  wire [0:0] and_14;
-  wire [3:0] mux_and_14;
+  wire [0:0] and_19;
+  wire [3:0] mux_and_19;
+  wire [0:0] not_nw_count_eq_k_0_7;
+  wire [0:0] and_20;
+  wire [3:0] mux_and_20;
   wire [0:0] not_nw_is_leaf_1;
   wire [3:0] mux_not_nw_is_leaf_1;
-  wire [3:0] mux_d1_arrives;
-  wire [3:0] mux_go_near_1;
+  wire [3:0] mux_d1_arrives_1;
+  wire [3:0] mux_go_near;
   wire [0:0] not_go_near_and_go_far_2;
   wire [3:0] mux_not_go_near_and_go_far_2;
-  wire [0:0] and_15;
-  wire [3:0] mux_and_15;
-  wire [3:0] mux_leaf_left_eq_k_1_3;
-  wire [3:0] mux_sp_eq_k_0_6;
-  wire [0:0] and_16;
-  wire [3:0] mux_and_16;
+  wire [0:0] and_21;
+  wire [3:0] mux_and_21;
+  wire [3:0] mux_leaf_left_eq_k_1_4;
+  wire [3:0] mux_sp_empty;
+  wire [0:0] and_22;
+  wire [3:0] mux_and_22;
   wire [0:0] not_popped_ahead;
-  wire [0:0] and_17;
-  wire [3:0] mux_and_17;
+  wire [0:0] and_23;
+  wire [3:0] mux_and_23;
   reg [3:0] state_next;
+  wire signed [31:0] mux_go_near_1;
+  wire signed [31:0] mux_not_sp_empty_2;
+  reg signed [31:0] tmax_next;
   wire [12:0] mux_nw_is_leaf;
   reg [12:0] leaf_ptr_next;
   wire [2:0] mux_nw_is_leaf_1;
   reg [2:0] leaf_left_next;
   wire [0:0] mux_nw_is_leaf_2;
-  wire [0:0] and_18;
-  wire [0:0] mux_and_18;
-  wire [0:0] mux_leaf_left_eq_k_1_3_1;
+  wire [0:0] and_24;
+  wire [0:0] mux_and_24;
+  wire [0:0] mux_leaf_left_eq_k_1_4_1;
   reg [0:0] popped_ahead_next;
   wire [1:0] mux_not_nw_is_leaf_1_1;
   wire [1:0] axis_r_next;
@@ -328,43 +362,41 @@ module fxrt_traverse (
   wire [28:0] clip1_r_next;
   wire [12:0] mux_not_nw_is_leaf_1_3;
   wire [12:0] child_r_next;
-  wire [0:0] mux_not_nw_is_leaf_1_4;
-  wire [0:0] tmin_le_tmax_next;
   wire [0:0] negative_next;
-  wire [0:0] in_dist;
+  reg [0:0] in_dist = 1'h0;
   wire [12:0] far_r_next;
   wire signed [31:0] mux_d0_arrives;
   wire signed [31:0] d0_r_next;
-  wire signed [31:0] mux_d1_arrives_1;
-  wire signed [31:0] near_end_r_next;
   wire signed [31:0] mux_d1_arrives_2;
+  wire signed [31:0] near_end_r_next;
+  wire signed [31:0] mux_d1_arrives_3;
   wire signed [31:0] far_start_r_next;
-  wire [0:0] mux_d1_arrives_3;
-  wire [0:0] near_lt_tmax_next;
-  wire [0:0] mux_d1_arrives_4;
-  wire [0:0] far_gt_tmin_next;
-  wire [0:0] mux_d1_arrives_5;
-  wire [0:0] tmin_le_near_next;
-  wire [0:0] mux_d1_arrives_6;
-  wire [0:0] far_le_tmax_next;
   wire [5:0] mux_go_near_and_go_far;
-  wire [5:0] mux_not_sp_eq_k_0_6_3;
+  wire [5:0] mux_not_sp_empty_3;
   reg [5:0] sp_next;
-  wire [0:0] in_step;
-  wire [0:0] and_19;
+  reg [0:0] in_step = 1'h0;
+  wire [0:0] and_25;
+  wire [0:0] in_idle_next;
+  wire [0:0] in_aabb_next;
+  wire [0:0] in_node_next;
+  wire [0:0] in_clip1_next;
+  wire [0:0] in_dist_next;
+  wire [0:0] in_step_next;
+  wire [0:0] in_leaf_next;
+  wire [0:0] in_done_next;
 
   // not in a stage or state machine
-  assign node_settled = node == node_d1;
-  assign nw_axis = node_word_r[1:0];
-  assign nw_clip0 = node_word_r[30:2];
-  assign nw_clip1 = node_word_r[59:31];
-  assign nw_child = node_word_r[72:60];
-  assign nw_first = node_word_r[14:2];
-  assign nw_count = node_word_r[17:15];
+  assign node_eq_node_d1 = node == node_d1;
+  assign node_d2 = node_d2_sr[2];
+  assign node_eq_node_d2 = node == node_d2;
+  assign node_settled = node_eq_node_d1 & node_eq_node_d2;
+  assign nw_axis = u_node_rom_data[1:0];
+  assign nw_clip0 = u_node_rom_data[30:2];
+  assign nw_clip1 = u_node_rom_data[59:31];
+  assign nw_child = u_node_rom_data[72:60];
+  assign nw_first = u_node_rom_data[14:2];
+  assign nw_count = u_node_rom_data[17:15];
   assign nw_is_leaf = nw_axis == k_3;
-  assign in_aabb = state == st_aabb;
-  assign in_node = state == st_node;
-  assign in_clip1 = state == st_clip1;
   always @* begin
     case (aabb_k)
       2'h1: case_aabb_k = invy_r;
@@ -384,8 +416,8 @@ module fxrt_traverse (
   assign aabb_last = aabb_k == k_2;
   assign in_aabb_or_in_clip1 = in_aabb | in_clip1;
   assign not_nw_is_leaf = ~nw_is_leaf;
-  assign and_0 = in_node & not_nw_is_leaf;
-  assign pu_issue = in_aabb_or_in_clip1 | and_0;
+  assign and_1 = in_node & not_nw_is_leaf;
+  assign pu_issue = in_aabb_or_in_clip1 | and_1;
   assign in_aabb_and_aabb_last = in_aabb & aabb_last;
   assign pu_issue_last = in_clip1 | in_aabb_and_aabb_last;
   assign mux_in_aabb = in_aabb ? aabb_plane : clip1_r;
@@ -414,42 +446,78 @@ module fxrt_traverse (
   assign pu_product = u_plane_product_p;
   assign pu_product_valid = pu_product_valid_sr[6];
   assign pu_product_last = pu_product_last_sr[6];
-  assign pu_shifted = pu_product >>> 16;
-  assign lt_4 = k_1073741824 < pu_shifted;
-  assign pu_shifted_lt_k_m1 = pu_shifted < k_m1;
-  assign mux_pu_shifted_lt_k_m1 = pu_shifted_lt_k_m1 ? k_m1 : pu_shifted;
-  assign mux_lt_4 = lt_4 ? k_1073741824 : mux_pu_shifted_lt_k_m1;
-  assign pu_clamped = $signed(mux_lt_4[31:0]);
+  assign bits_pu_product = pu_product[77:16];
+  assign pu_shifted = $signed(bits_pu_product);
+  assign bits_pu_shifted = pu_shifted[61];
+  assign pu_shifted_ne_k_m1 = pu_shifted != k_m1;
+  assign pu_below = bits_pu_shifted & pu_shifted_ne_k_m1;
+  assign bits_pu_shifted_1 = pu_shifted[60:31];
+  assign ne_6 = bits_pu_shifted_1 != k_0_1;
+  assign bits_pu_shifted_2 = pu_shifted[61];
+  assign not_bits_pu_shifted_2 = ~bits_pu_shifted_2;
+  assign bits_pu_shifted_3 = pu_shifted[30];
+  assign bits_pu_shifted_4 = pu_shifted[29:0];
+  assign ne_7 = bits_pu_shifted_4 != k_0_1;
+  assign and_8 = bits_pu_shifted_3 & ne_7;
+  assign ne_6_or_and_8 = ne_6 | and_8;
+  assign pu_above = not_bits_pu_shifted_2 & ne_6_or_and_8;
+  assign mux_pu_below = pu_below ? k_m1 : pu_shifted;
+  assign mux_pu_above = pu_above ? k_1073741824 : mux_pu_below;
+  assign pu_clamped = $signed(mux_pu_above[31:0]);
   assign not_plane_t_last = ~plane_t_last;
   assign d0_arrives = plane_t_valid & not_plane_t_last;
   assign d1_arrives = plane_t_valid & plane_t_last;
-  assign plane_t_lt_tmax = plane_t < tmax;
-  assign box_tmax = plane_t_lt_tmax ? plane_t : tmax;
-  assign bits_plane_t = plane_t[31];
-  assign box_miss = box_missed | bits_plane_t;
-  assign near_end = negative ? plane_t : d0_r;
-  assign far_start = negative ? d0_r : plane_t;
-  assign child_r_plus_k_1 = child_r + k_1;
-  assign near = negative ? child_r_plus_k_1 : child_r;
-  assign far = negative ? child_r : child_r_plus_k_1;
+  assign box_lt1_c = plane_t < box_d1;
+  assign box_lt2_c = plane_t < box_d2;
+  assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
+  assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
+  assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
+  assign bits_box_d1 = box_d1[31];
+  assign bits_box_d2 = box_d2[31];
+  assign or_12 = bits_box_d1 | bits_box_d2;
+  assign bits_box_d3 = box_d3[31];
+  assign box_miss = or_12 | bits_box_d3;
+  assign near_end = negative ? plane_t_of_last : d0_r;
+  assign far_start = negative ? d0_r : plane_t_of_last;
+  assign tmax_plus_1 = tmax + k_1;
+  assign tmin_minus_1 = tmin - k_1;
+  assign tmin_le_tmax_c = tmin < tmax_p1;
+  assign near_lt_plane = plane_t_of_last < tmax;
+  assign near_lt_d0 = d0_r < tmax;
+  assign near_lt = negative ? near_lt_plane : near_lt_d0;
+  assign near_lt_tmax_c = near_lt;
+  assign far_gt_plane = tmin < d0_r;
+  assign far_gt_d0 = tmin < plane_t_of_last;
+  assign far_gt = negative ? far_gt_plane : far_gt_d0;
+  assign far_gt_tmin_c = far_gt;
+  assign tmin_le_near_plane = tmin_m1 < plane_t_of_last;
+  assign tmin_le_near_d0 = tmin_m1 < d0_r;
+  assign tmin_le_near = negative ? tmin_le_near_plane : tmin_le_near_d0;
+  assign far_le_tmax_plane = d0_r < tmax_p1;
+  assign far_le_tmax_d0 = plane_t_of_last < tmax_p1;
+  assign far_le_tmax = negative ? far_le_tmax_plane : far_le_tmax_d0;
+  assign go_near_c = tmin_le_near & tmin_le_tmax;
+  assign go_far_c = far_le_tmax & tmin_le_tmax;
+  assign child_r_plus_k_1_1 = child_r + k_1_1;
+  assign near = negative ? child_r_plus_k_1_1 : child_r;
+  assign far = negative ? child_r : child_r_plus_k_1_1;
   assign near_max = near_lt_tmax ? near_end_r : tmax;
   assign far_min = far_gt_tmin ? far_start_r : tmin;
-  assign go_near = tmin_le_near & tmin_le_tmax;
-  assign go_far = far_le_tmax & tmin_le_tmax;
   assign u_far_min = $unsigned(far_min);
   assign u_tmax = $unsigned(tmax);
   assign push_entry = {far_r, u_far_min, u_tmax};
-  assign sp_minus_k_1_1 = sp - k_1_1;
-  assign rs_sp_minus_k_1_1 = sp_minus_k_1_1[4:0];
+  assign sp_minus_k_1_2 = sp - k_1_2;
+  assign rs_sp_minus_k_1_2 = sp_minus_k_1_2[4:0];
   assign bits_stack_top = stack_top[31:0];
   assign top_tmax = $signed(bits_stack_top);
   assign bits_stack_top_1 = stack_top[63:32];
   assign top_tmin = $signed(bits_stack_top_1);
   assign top_node = stack_top[76:64];
-  assign in_leaf = state == st_leaf;
-  assign aabb_k_plus_k_1_2 = aabb_k + k_1_2;
-  assign nw_count_eq_k_0_5 = nw_count == k_0_5;
-  assign tmin_le_tmax_1 = tmin <= tmax;
+  assign was_leaf2 = was_leaf2_sr[2];
+  assign was_leaf = was_leaf1 & was_leaf2;
+  assign sp_is_zero = sp == k_0_2;
+  assign aabb_k_plus_k_1_3 = aabb_k + k_1_3;
+  assign nw_count_eq_k_0_7 = nw_count == k_0_7;
   always @* begin
     case (axis_r)
       2'h1: case_axis_r = invy_r;
@@ -458,41 +526,27 @@ module fxrt_traverse (
     endcase
   end
   assign bits_case_axis_r = case_axis_r[47];
-  assign plane_t_lt_tmax_1 = plane_t < tmax;
-  assign d0_r_lt_tmax = d0_r < tmax;
-  assign mux_negative = negative ? plane_t_lt_tmax_1 : d0_r_lt_tmax;
-  assign tmin_lt_d0_r = tmin < d0_r;
-  assign tmin_lt_plane_t = tmin < plane_t;
-  assign mux_negative_1 = negative ? tmin_lt_d0_r : tmin_lt_plane_t;
-  assign tmin_le_plane_t = tmin <= plane_t;
-  assign tmin_le_d0_r = tmin <= d0_r;
-  assign mux_negative_2 = negative ? tmin_le_plane_t : tmin_le_d0_r;
-  assign d0_r_le_tmax = d0_r <= tmax;
-  assign plane_t_le_tmax = plane_t <= tmax;
-  assign mux_negative_3 = negative ? d0_r_le_tmax : plane_t_le_tmax;
   assign go_near_and_go_far = go_near & go_far;
   assign rs_sp = sp[4:0];
-  assign sp_plus_k_1_1 = sp + k_1_1;
-  assign leaf_ptr_plus_k_1 = leaf_ptr + k_1;
-  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
-  assign leaf_left_eq_k_1_3 = leaf_left == k_1_3;
-  assign sp_eq_k_0_6 = sp == k_0_6;
-  assign sp_minus_k_1_1_1 = sp - k_1_1;
-  assign in_idle = state == st_idle;
-  assign in_done = state == st_done;
+  assign sp_plus_k_1_2 = sp + k_1_2;
+  assign leaf_ptr_plus_k_1_1 = leaf_ptr + k_1_1;
+  assign leaf_left_minus_k_1_4 = leaf_left - k_1_4;
+  assign leaf_left_eq_k_1_4 = leaf_left == k_1_4;
+  assign sp_minus_k_1_2_1 = sp - k_1_2;
   assign in_leaf_or_in_done = in_leaf | in_done;
-  assign emit_r = emit_r_sr[2];
-  assign end_r = end_r_sr[2];
+  assign emit_r = emit_r_sr[3];
+  assign end_r = end_r_sr[3];
   assign u_tmin = $unsigned(tmin);
   assign rs_u_tmin = u_tmin[30:0];
-  assign tmin_r = tmin_r_sr[2];
-  assign id_r = id_r_sr[2];
+  assign tmin_r = tmin_r_sr[3];
+  assign id_r = id_r_sr[3];
 
   always @(posedge clk) begin : regs
-    if (and_19) stack[rs_sp] <= push_entry;
-    node_word <= node_rom[node];
-    node_word_r <= node_word;
+    if (and_25) stack[rs_sp] <= push_entry;
     node_d1 <= node;
+    for (node_d2_i = 2; node_d2_i > 1; node_d2_i = node_d2_i - 1)
+      node_d2_sr[node_d2_i] <= node_d2_sr[node_d2_i - 1];
+    node_d2_sr[1] <= node;
     pu_sel_valid <= pu_issue;
     pu_sel_last <= pu_issue_last;
     pu_sel_plane <= pu_issue_plane;
@@ -508,22 +562,38 @@ module fxrt_traverse (
       pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
     pu_product_last_sr[1] <= pu_delta_last;
     plane_t <= pu_clamped;
+    if (pu_product_last) plane_t_of_last <= pu_clamped;
     plane_t_valid <= pu_product_valid;
     plane_t_last <= pu_product_last;
-    stack_top <= stack[rs_sp_minus_k_1_1];
-    was_leaf <= in_leaf;
-    leaf_tri <= leaf_rom[leaf_ptr];
-    leaf_tri_r <= leaf_tri;
-    for (emit_r_i = 2; emit_r_i > 1; emit_r_i = emit_r_i - 1)
+    box_d1 <= plane_t;
+    box_d2 <= box_d1;
+    box_d3 <= box_d2;
+    box_lt1 <= box_lt1_c;
+    box_lt2 <= box_lt2_c;
+    box_lt1_d <= box_lt1;
+    tmax_p1 <= tmax_plus_1;
+    tmin_m1 <= tmin_minus_1;
+    tmin_le_tmax <= tmin_le_tmax_c;
+    near_lt_tmax <= near_lt_tmax_c;
+    far_gt_tmin <= far_gt_tmin_c;
+    go_near <= go_near_c;
+    go_far <= go_far_c;
+    stack_top <= stack[rs_sp_minus_k_1_2];
+    was_leaf1 <= in_leaf;
+    for (was_leaf2_i = 2; was_leaf2_i > 1; was_leaf2_i = was_leaf2_i - 1)
+      was_leaf2_sr[was_leaf2_i] <= was_leaf2_sr[was_leaf2_i - 1];
+    was_leaf2_sr[1] <= in_leaf;
+    sp_empty <= sp_is_zero;
+    for (emit_r_i = 3; emit_r_i > 1; emit_r_i = emit_r_i - 1)
       emit_r_sr[emit_r_i] <= emit_r_sr[emit_r_i - 1];
     emit_r_sr[1] <= in_leaf_or_in_done;
-    for (end_r_i = 2; end_r_i > 1; end_r_i = end_r_i - 1)
+    for (end_r_i = 3; end_r_i > 1; end_r_i = end_r_i - 1)
       end_r_sr[end_r_i] <= end_r_sr[end_r_i - 1];
     end_r_sr[1] <= in_done;
-    for (tmin_r_i = 2; tmin_r_i > 1; tmin_r_i = tmin_r_i - 1)
+    for (tmin_r_i = 3; tmin_r_i > 1; tmin_r_i = tmin_r_i - 1)
       tmin_r_sr[tmin_r_i] <= tmin_r_sr[tmin_r_i - 1];
     tmin_r_sr[1] <= rs_u_tmin;
-    for (id_r_i = 2; id_r_i > 1; id_r_i = id_r_i - 1)
+    for (id_r_i = 3; id_r_i > 1; id_r_i = id_r_i - 1)
       id_r_sr[id_r_i] <= id_r_sr[id_r_i - 1];
     id_r_sr[1] <= ray_id_r;
   end
@@ -531,8 +601,8 @@ module fxrt_traverse (
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
   always @* begin
     case (state)
-      st_idle: aabb_k_next = k_0_1;
-      st_aabb: aabb_k_next = aabb_k_plus_k_1_2;
+      st_idle: aabb_k_next = k_0_3;
+      st_aabb: aabb_k_next = aabb_k_plus_k_1_3;
       default: aabb_k_next = aabb_k;
     endcase
   end
@@ -540,49 +610,29 @@ module fxrt_traverse (
   assign not_go_near_and_go_far = not_go_near & go_far;
   assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? far_r : node;
   assign not_go_far = ~go_far;
-  assign and_11 = not_go_near & not_go_far;
-  assign mux_and_11 = and_11 ? top_node : mux_not_go_near_and_go_far;
-  assign not_sp_eq_k_0_6 = ~sp_eq_k_0_6;
-  assign mux_not_sp_eq_k_0_6 = not_sp_eq_k_0_6 ? top_node : node;
+  assign and_18 = not_go_near & not_go_far;
+  assign mux_and_18 = and_18 ? top_node : mux_not_go_near_and_go_far;
+  assign not_sp_empty = ~sp_empty;
+  assign mux_not_sp_empty = not_sp_empty ? top_node : node;
   always @* begin
     case (state)
-      st_idle: node_next = k_0_2;
+      st_idle: node_next = k_0_4;
       st_dist: node_next = near;
-      st_step: node_next = mux_and_11;
+      st_step: node_next = mux_and_18;
       st_leaf: node_next = top_node;
-      st_pop: node_next = mux_not_sp_eq_k_0_6;
+      st_pop: node_next = mux_not_sp_empty;
       default: node_next = node;
     endcase
   end
   assign not_go_near_and_go_far_1 = not_go_near & go_far;
   assign mux_not_go_near_and_go_far_1 = not_go_near_and_go_far_1 ? far_min : tmin;
-  assign mux_not_sp_eq_k_0_6_1 = not_sp_eq_k_0_6 ? top_tmin : tmin;
+  assign mux_not_sp_empty_1 = not_sp_empty ? top_tmin : tmin;
   always @* begin
     case (state)
-      st_idle: tmin_next = k_0_3;
+      st_idle: tmin_next = k_0_5;
       st_step: tmin_next = mux_not_go_near_and_go_far_1;
-      st_pop: tmin_next = mux_not_sp_eq_k_0_6_1;
+      st_pop: tmin_next = mux_not_sp_empty_1;
       default: tmin_next = tmin;
-    endcase
-  end
-  assign mux_plane_t_valid = plane_t_valid ? box_tmax : tmax;
-  assign mux_go_near = go_near ? near_max : tmax;
-  assign mux_not_sp_eq_k_0_6_2 = not_sp_eq_k_0_6 ? top_tmax : tmax;
-  always @* begin
-    case (state)
-      st_idle: tmax_next = k_1073741824_1;
-      st_box: tmax_next = mux_plane_t_valid;
-      st_step: tmax_next = mux_go_near;
-      st_pop: tmax_next = mux_not_sp_eq_k_0_6_2;
-      default: tmax_next = tmax;
-    endcase
-  end
-  assign mux_plane_t_valid_1 = plane_t_valid ? box_miss : box_missed;
-  always @* begin
-    case (state)
-      st_idle: box_missed_next = k_0_4;
-      st_box: box_missed_next = mux_plane_t_valid_1;
-      default: box_missed_next = box_missed;
     endcase
   end
   assign mux_ray_valid = ray_valid ? ray_id : ray_id_r;
@@ -601,53 +651,63 @@ module fxrt_traverse (
   assign invz_r_next = in_idle ? mux_ray_valid_6 : invz_r;
   assign mux_ray_valid_7 = ray_valid ? st_aabb : state;
   assign mux_aabb_last = aabb_last ? st_box : state;
-  assign d1_arrives_and_box_miss = d1_arrives & box_miss;
-  assign mux_d1_arrives_and_box_miss = d1_arrives_and_box_miss ? st_done : state;
+  assign mux_d1_arrives = d1_arrives ? st_boxmin : state;
+  assign mux_box_miss = box_miss ? st_done : state;
   assign not_box_miss = ~box_miss;
-  assign and_12 = d1_arrives & not_box_miss;
-  assign mux_and_12 = and_12 ? st_node : mux_d1_arrives_and_box_miss;
+  assign mux_not_box_miss = not_box_miss ? st_node : mux_box_miss;
   assign mux_node_settled = node_settled ? st_node : state;
-  assign and_13 = nw_is_leaf & nw_count_eq_k_0_5;
-  assign mux_and_13 = and_13 ? st_pop : state;
-  assign not_nw_count_eq_k_0_5 = ~nw_count_eq_k_0_5;
-  assign and_14 = nw_is_leaf & not_nw_count_eq_k_0_5;
-  assign mux_and_14 = and_14 ? st_leaf : mux_and_13;
+  assign and_19 = nw_is_leaf & nw_count_eq_k_0_7;
+  assign mux_and_19 = and_19 ? st_pop : state;
+  assign not_nw_count_eq_k_0_7 = ~nw_count_eq_k_0_7;
+  assign and_20 = nw_is_leaf & not_nw_count_eq_k_0_7;
+  assign mux_and_20 = and_20 ? st_leaf : mux_and_19;
   assign not_nw_is_leaf_1 = ~nw_is_leaf;
-  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_14;
-  assign mux_d1_arrives = d1_arrives ? st_step : state;
-  assign mux_go_near_1 = go_near ? st_node : state;
+  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_20;
+  assign mux_d1_arrives_1 = d1_arrives ? st_step : state;
+  assign mux_go_near = go_near ? st_node : state;
   assign not_go_near_and_go_far_2 = not_go_near & go_far;
-  assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near_1;
-  assign and_15 = not_go_near & not_go_far;
-  assign mux_and_15 = and_15 ? st_pop : mux_not_go_near_and_go_far_2;
-  assign mux_leaf_left_eq_k_1_3 = leaf_left_eq_k_1_3 ? st_pop : state;
-  assign mux_sp_eq_k_0_6 = sp_eq_k_0_6 ? st_done : state;
-  assign and_16 = not_sp_eq_k_0_6 & popped_ahead;
-  assign mux_and_16 = and_16 ? st_node : mux_sp_eq_k_0_6;
+  assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near;
+  assign and_21 = not_go_near & not_go_far;
+  assign mux_and_21 = and_21 ? st_pop : mux_not_go_near_and_go_far_2;
+  assign mux_leaf_left_eq_k_1_4 = leaf_left_eq_k_1_4 ? st_pop : state;
+  assign mux_sp_empty = sp_empty ? st_done : state;
+  assign and_22 = not_sp_empty & popped_ahead;
+  assign mux_and_22 = and_22 ? st_node : mux_sp_empty;
   assign not_popped_ahead = ~popped_ahead;
-  assign and_17 = not_sp_eq_k_0_6 & not_popped_ahead;
-  assign mux_and_17 = and_17 ? st_fetch : mux_and_16;
+  assign and_23 = not_sp_empty & not_popped_ahead;
+  assign mux_and_23 = and_23 ? st_fetch : mux_and_22;
   always @* begin
     case (state)
       st_idle: state_next = mux_ray_valid_7;
       st_aabb: state_next = mux_aabb_last;
-      st_box: state_next = mux_and_12;
+      st_box: state_next = mux_d1_arrives;
+      st_boxmin: state_next = mux_not_box_miss;
       st_fetch: state_next = mux_node_settled;
       st_node: state_next = mux_not_nw_is_leaf_1;
       st_clip1: state_next = st_dist;
-      st_dist: state_next = mux_d1_arrives;
-      st_step: state_next = mux_and_15;
-      st_leaf: state_next = mux_leaf_left_eq_k_1_3;
-      st_pop: state_next = mux_and_17;
+      st_dist: state_next = mux_d1_arrives_1;
+      st_step: state_next = mux_and_21;
+      st_leaf: state_next = mux_leaf_left_eq_k_1_4;
+      st_pop: state_next = mux_and_23;
       st_done: state_next = st_idle;
       default: state_next = st_idle;
+    endcase
+  end
+  assign mux_go_near_1 = go_near ? near_max : tmax;
+  assign mux_not_sp_empty_2 = not_sp_empty ? top_tmax : tmax;
+  always @* begin
+    case (state)
+      st_boxmin: tmax_next = box_tmax;
+      st_step: tmax_next = mux_go_near_1;
+      st_pop: tmax_next = mux_not_sp_empty_2;
+      default: tmax_next = tmax;
     endcase
   end
   assign mux_nw_is_leaf = nw_is_leaf ? nw_first : leaf_ptr;
   always @* begin
     case (state)
       st_node: leaf_ptr_next = mux_nw_is_leaf;
-      st_leaf: leaf_ptr_next = leaf_ptr_plus_k_1;
+      st_leaf: leaf_ptr_next = leaf_ptr_plus_k_1_1;
       default: leaf_ptr_next = leaf_ptr;
     endcase
   end
@@ -655,19 +715,19 @@ module fxrt_traverse (
   always @* begin
     case (state)
       st_node: leaf_left_next = mux_nw_is_leaf_1;
-      st_leaf: leaf_left_next = leaf_left_minus_k_1_3;
+      st_leaf: leaf_left_next = leaf_left_minus_k_1_4;
       default: leaf_left_next = leaf_left;
     endcase
   end
-  assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_4 : popped_ahead;
-  assign and_18 = not_go_near & not_go_far;
-  assign mux_and_18 = and_18 ? k_0_4 : popped_ahead;
-  assign mux_leaf_left_eq_k_1_3_1 = leaf_left_eq_k_1_3 ? was_leaf : popped_ahead;
+  assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_6 : popped_ahead;
+  assign and_24 = not_go_near & not_go_far;
+  assign mux_and_24 = and_24 ? k_0_6 : popped_ahead;
+  assign mux_leaf_left_eq_k_1_4_1 = leaf_left_eq_k_1_4 ? was_leaf : popped_ahead;
   always @* begin
     case (state)
       st_node: popped_ahead_next = mux_nw_is_leaf_2;
-      st_step: popped_ahead_next = mux_and_18;
-      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_3_1;
+      st_step: popped_ahead_next = mux_and_24;
+      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_4_1;
       default: popped_ahead_next = popped_ahead;
     endcase
   end
@@ -677,36 +737,32 @@ module fxrt_traverse (
   assign clip1_r_next = in_node ? mux_not_nw_is_leaf_1_2 : clip1_r;
   assign mux_not_nw_is_leaf_1_3 = not_nw_is_leaf_1 ? nw_child : child_r;
   assign child_r_next = in_node ? mux_not_nw_is_leaf_1_3 : child_r;
-  assign mux_not_nw_is_leaf_1_4 = not_nw_is_leaf_1 ? tmin_le_tmax_1 : tmin_le_tmax;
-  assign tmin_le_tmax_next = in_node ? mux_not_nw_is_leaf_1_4 : tmin_le_tmax;
   assign negative_next = in_clip1 ? bits_case_axis_r : negative;
-  assign in_dist = state == st_dist;
   assign far_r_next = in_dist ? far : far_r;
   assign mux_d0_arrives = d0_arrives ? plane_t : d0_r;
   assign d0_r_next = in_dist ? mux_d0_arrives : d0_r;
-  assign mux_d1_arrives_1 = d1_arrives ? near_end : near_end_r;
-  assign near_end_r_next = in_dist ? mux_d1_arrives_1 : near_end_r;
-  assign mux_d1_arrives_2 = d1_arrives ? far_start : far_start_r;
-  assign far_start_r_next = in_dist ? mux_d1_arrives_2 : far_start_r;
-  assign mux_d1_arrives_3 = d1_arrives ? mux_negative : near_lt_tmax;
-  assign near_lt_tmax_next = in_dist ? mux_d1_arrives_3 : near_lt_tmax;
-  assign mux_d1_arrives_4 = d1_arrives ? mux_negative_1 : far_gt_tmin;
-  assign far_gt_tmin_next = in_dist ? mux_d1_arrives_4 : far_gt_tmin;
-  assign mux_d1_arrives_5 = d1_arrives ? mux_negative_2 : tmin_le_near;
-  assign tmin_le_near_next = in_dist ? mux_d1_arrives_5 : tmin_le_near;
-  assign mux_d1_arrives_6 = d1_arrives ? mux_negative_3 : far_le_tmax;
-  assign far_le_tmax_next = in_dist ? mux_d1_arrives_6 : far_le_tmax;
-  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_1 : sp;
-  assign mux_not_sp_eq_k_0_6_3 = not_sp_eq_k_0_6 ? sp_minus_k_1_1_1 : sp;
+  assign mux_d1_arrives_2 = d1_arrives ? near_end : near_end_r;
+  assign near_end_r_next = in_dist ? mux_d1_arrives_2 : near_end_r;
+  assign mux_d1_arrives_3 = d1_arrives ? far_start : far_start_r;
+  assign far_start_r_next = in_dist ? mux_d1_arrives_3 : far_start_r;
+  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_2 : sp;
+  assign mux_not_sp_empty_3 = not_sp_empty ? sp_minus_k_1_2_1 : sp;
   always @* begin
     case (state)
       st_step: sp_next = mux_go_near_and_go_far;
-      st_pop: sp_next = mux_not_sp_eq_k_0_6_3;
+      st_pop: sp_next = mux_not_sp_empty_3;
       default: sp_next = sp;
     endcase
   end
-  assign in_step = state == st_step;
-  assign and_19 = in_step & go_near_and_go_far;
+  assign and_25 = in_step & go_near_and_go_far;
+  assign in_idle_next = state_next == st_idle;
+  assign in_aabb_next = state_next == st_aabb;
+  assign in_node_next = state_next == st_node;
+  assign in_clip1_next = state_next == st_clip1;
+  assign in_dist_next = state_next == st_dist;
+  assign in_step_next = state_next == st_step;
+  assign in_leaf_next = state_next == st_leaf;
+  assign in_done_next = state_next == st_done;
 
   always @(posedge clk) begin : state_regs
     if (rst) state <= st_idle;
@@ -726,14 +782,14 @@ module fxrt_traverse (
     aabb_k <= aabb_k_next;
     tmin <= tmin_next;
     tmax <= tmax_next;
-    box_missed <= box_missed_next;
+    if (rst) in_aabb <= 1'h0;
+    else in_aabb <= in_aabb_next;
+    if (rst) in_node <= 1'h0;
+    else in_node <= in_node_next;
+    if (rst) in_clip1 <= 1'h0;
+    else in_clip1 <= in_clip1_next;
     negative <= negative_next;
     d0_r <= d0_r_next;
-    tmin_le_tmax <= tmin_le_tmax_next;
-    near_lt_tmax <= near_lt_tmax_next;
-    far_gt_tmin <= far_gt_tmin_next;
-    tmin_le_near <= tmin_le_near_next;
-    far_le_tmax <= far_le_tmax_next;
     near_end_r <= near_end_r_next;
     far_start_r <= far_start_r_next;
     far_r <= far_r_next;
@@ -742,7 +798,23 @@ module fxrt_traverse (
     leaf_ptr <= leaf_ptr_next;
     leaf_left <= leaf_left_next;
     popped_ahead <= popped_ahead_next;
+    if (rst) in_leaf <= 1'h0;
+    else in_leaf <= in_leaf_next;
+    if (rst) in_idle <= 1'h1;
+    else in_idle <= in_idle_next;
+    if (rst) in_done <= 1'h0;
+    else in_done <= in_done_next;
+    if (rst) in_dist <= 1'h0;
+    else in_dist <= in_dist_next;
+    if (rst) in_step <= 1'h0;
+    else in_step <= in_step_next;
   end
+
+  fxrt_brom_node u_node_rom (
+    .clk(clk),
+    .addr(node),
+    .data(u_node_rom_data)
+  );
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
     .clk(clk),
@@ -751,10 +823,16 @@ module fxrt_traverse (
     .p(u_plane_product_p)
   );
 
+  fxrt_brom_leaf u_leaf_rom (
+    .clk(clk),
+    .addr(leaf_ptr),
+    .data(u_leaf_rom_data)
+  );
+
   assign ray_ready = in_idle;
   assign emit_valid = emit_r;
   assign emit_end = end_r;
-  assign emit_tri = leaf_tri_r;
+  assign emit_tri = u_leaf_rom_data;
   assign emit_tmin = tmin_r;
   assign emit_id = id_r;
   assign cur_ox = ox_r;

@@ -63,23 +63,28 @@ pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) ->
     let t8 = (t.xsigned().resize(dist) + 8).name("t_plus_8");
     // Staged: two register levels, (x, t + 8) and then the acceptance bit, so the
     // accumulator's compare starts from registers (a result arrives two cycles later;
-    // nothing else changes).
+    // nothing else changes). The bits that do not depend on the best hit (a valid hit, not an
+    // end token, accepted) are ANDed into one `candidate` register on the way.
     let reg = |name: &str, x, k: u32| if staged { b.delay_line(&format!("in_{name}"), x, k) } else { x };
     let (x, t8) = (reg("tmin_less", x, 1), reg("t_plus_8", t8, 1));
-    let accepted = reg("accepted", (!t8.lt(x)).name("accepted"), 1);
-    let (valid, end, hit) = (reg("valid", valid, 2), reg("end", end, 2), reg("hit", hit, 2));
+    let (valid1, end1, hit1) = (reg("valid", valid, 1), reg("end", end, 1), reg("hit", hit, 1));
+    let accepted = (!t8.lt(x)).name("accepted");
+    let candidate = reg("candidate", (valid1 & !end1 & hit1 & accepted).name("candidate_c"), 1);
+    let finish = reg("finish", (valid1 & end1).name("finish_c"), 1);
     let (tri, id, t, u, v) = (reg("tri", tri, 2), reg("id", id, 2), reg("t", t, 2), reg("u", u, 2), reg("v", v, 2));
 
-    // The best accepted hit of the ray in flight.
+    // The best accepted hit of the ray in flight. Closer means (t, tri) < (best_t, best_tri)
+    // in lexicographic order (equal t: the smaller triangle number wins), which is one
+    // unsigned compare of the concatenations: one carry chain in the accumulator's loop
+    // instead of a compare, an equality and a second compare side by side.
     let best_valid = b.reg("best_valid", Ty::BIT, Some(0));
     let best_t = b.reg("best_t", t.ty(), None);
     let best_tri = b.reg("best_tri", tri.ty(), None);
     let best_u = b.reg("best_u", u.ty(), None);
     let best_v = b.reg("best_v", v.ty(), None);
-    let closer = (t.lt(best_t) | (t.eq(best_t) & tri.lt(best_tri))).name("closer");
+    let closer = b.cat(&[t, tri]).lt(b.cat(&[best_t, best_tri])).name("closer");
     let better = (!best_valid | closer).name("better");
-    let take = (valid & !end & hit & accepted & better).name("take");
-    let finish = (valid & end).name("finish");
+    let take = (candidate & better).name("take");
     for (r, x) in [(best_t, t), (best_tri, tri), (best_u, u), (best_v, v)] {
         b.next_when(r, take, x);
     }

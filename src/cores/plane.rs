@@ -10,8 +10,8 @@
 //!    subtractor.
 //! 3. product: `plane_product`, its own number of stages (the clock target's `MulStyle`: 1
 //!    for one multiplier between two registers, more for DSP pieces and an adder tree).
-//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (two compares with
-//!    constants and a mux), registered.
+//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (two bit reductions and a
+//!    mux), registered.
 //!
 //! The valid and last bits ride along in shift registers of the same depth, so a state
 //! machine waits for results by their valid bit and never counts the latency itself: a
@@ -50,6 +50,8 @@ pub struct PlaneIssue<'b> {
 pub struct PlaneResult<'b> {
     /// The clamped distance, signed n + 3 bits.
     pub t: S<'b>,
+    /// `t` when `last` is 1 (the same register value then), held otherwise.
+    pub t_last: S<'b>,
     pub valid: S<'b>,
     pub last: S<'b>,
     pub latency: u32,
@@ -80,13 +82,29 @@ pub fn plane_unit<'b>(
     let (product, product_latency) = plane_product(b, delta, inv_a, product);
     let valid = b.delay_line("pu_product_valid", valid, product_latency);
     let last = b.delay_line("pu_product_last", last, product_latency);
-    // 4. clamp
-    let shifted = (product >> c).name("pu_shifted");
-    let t_sat = shifted.k(1i128 << (n + 1));
-    let clamped = shifted.gt(t_sat).select(t_sat, shifted.lt(-1).select(shifted.k(-1), shifted));
-    let t = b.delay("plane_t", clamped.resize(Ty::s(n + 3).width).name("pu_clamped"));
+    // 4. clamp. The two range tests are bit reductions, not compares with constants: yosys
+    // builds those as two carry chains of the shifted product's full width (62 bits by
+    // default), and with the select they made a 9 ns stage. With s = product >> C:
+    // s < −1 ⟺ s is negative and not all ones; s > 2^(n+1) ⟺ s is non-negative and has a bit
+    // set above bit n + 1, or bit n + 1 and one below it.
+    let w = product.width() - c;
+    let shifted = product.slice(c, w).signed().name("pu_shifted");
+    let k = n + 1;
+    let below = (shifted.msb() & shifted.ne(-1)).name("pu_below");
+    let above_bits = shifted.slice(k + 1, w - 1 - (k + 1)).ne(0);
+    let above = (!shifted.msb() & (above_bits | (shifted.bit(k) & shifted.slice(0, k).ne(0)))).name("pu_above");
+    let t_sat = shifted.k(1i128 << k);
+    let clamped = above.select(t_sat, below.select(shifted.k(-1), shifted));
+    let clamped = clamped.resize(Ty::s(n + 3).width).name("pu_clamped");
+    let t = b.delay("plane_t", clamped);
+    // The same distance in a register that loads only with a group's last one: a copy for the
+    // traversal's decision compares, so `t` does not fan out to every compare (yosys merges two
+    // equal registers, not two with different enables).
+    let t_last = b.reg("plane_t_of_last", t.ty(), None);
+    b.next_when(t_last, last, clamped);
     PlaneResult {
         t,
+        t_last,
         valid: b.delay("plane_t_valid", valid),
         last: b.delay("plane_t_last", last),
         latency: 3 + product_latency,

@@ -5,15 +5,18 @@
 //!                                  (FSM, node ROM, stack RAM)                 pipeline
 //! ```
 //!
-//! The traversal emits one leaf entry per clock; the triangle ROMs add one cycle; the ray's
-//! origin and direction come straight from the traversal's and the top's ray registers, which
-//! hold still until the next ray is accepted — always after the ray's end token: the last
-//! triangle number reaches the ROMs two cycles after its `leaf` cycle (leaf ROM and its
-//! register), and pop, done and idle put the accepting edge one cycle after that, the edge at
-//! which the pipeline's input register takes that triangle with the old ray. The triangle
-//! table is wider than a signal may be (5 + 3n + 6m bits), so it is split into ROMs of whole
-//! fields, ≤ 128 bits each, all read at the same address.
+//! The traversal emits one leaf entry per clock, two or three cycles after its `leaf` cycle
+//! (the leaf ROM); the triangle ROMs add two or three more (`brom.rs`: three for block RAM,
+//! whose fabric register follows the block's output register). The ray's origin and direction
+//! come from the traversal's and the top's ray registers, which hold still until the next ray
+//! is accepted — always after the ray's end token — through `ray_delay` more registers each:
+//! pop, done and idle put the accepting edge three cycles after the last `leaf` cycle, and the
+//! pipeline's input register takes that triangle's word leaf + triangle ROM cycles after it,
+//! when only the delayed copy still holds the old ray.
+//! The triangle table is wider than a signal may be (5 + 3n + 6m bits), so it is split into
+//! ROMs of whole fields, ≤ 128 bits each, all read at the same address.
 
+use super::brom::brom;
 use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
 use super::traverse::{TraverseParams, field, traverse_core, word_bits};
@@ -31,6 +34,8 @@ pub struct CoreParams {
     pub isect: IntersectParams,
     pub trav: TraverseParams,
     pub tag: TagLayout,
+    /// Clocks of a triangle ROM read (`brom::read_cycles`).
+    pub tri_rom_cycles: u32,
 }
 
 impl CoreParams {
@@ -38,9 +43,26 @@ impl CoreParams {
         let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz));
         let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
         let p = &scene.params;
-        let isect = IntersectParams { n: p.n, m: p.m, t: p.t, e: scene.edge_shift, tag_width: tag.width(), div_bits, target_mhz };
-        CoreParams { isect, trav, tag }
+        let isect = IntersectParams {
+            n: p.n,
+            m: p.m,
+            t: p.t,
+            e: scene.edge_shift,
+            tag_width: tag.width(),
+            div_bits,
+            target_mhz,
+        };
+        CoreParams { isect, trav, tag, tri_rom_cycles: super::brom::read_cycles(scene.tri.1.len()) }
     }
+    /// Cycles the ray's origin and direction are delayed on their way into the pipeline: its
+    /// input register takes a ray's last triangle leaf_rom_cycles + tri_rom_cycles edges after
+    /// the triangle's `leaf` cycle, and the next ray is accepted 3 edges after it at the
+    /// earliest (pop, done, idle), so the ray registers may have changed that many cycles
+    /// before.
+    pub fn ray_delay(&self) -> u32 {
+        self.trav.leaf_rom_cycles + self.tri_rom_cycles - 3
+    }
+
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
     pub fn check(&self) -> crate::error::Result<()> {
         self.isect.check()?;
@@ -78,9 +100,12 @@ impl CoreParams {
     }
 
     /// Cycles from a leaf entry leaving the traversal FSM to its result in the closest-hit
-    /// unit's accumulator: leaf ROM, triangle ROM, the pipeline, the unit's input stage.
+    /// unit's accumulator: leaf ROM, triangle ROMs, the pipeline, the unit's input stage.
     pub fn stream_latency(&self) -> u32 {
-        2 + self.isect.latency() + super::closest::input_latency(self.isect.target())
+        self.trav.leaf_rom_cycles
+            + self.tri_rom_cycles
+            + self.isect.latency()
+            + super::closest::input_latency(self.isect.target())
     }
 }
 
@@ -131,25 +156,33 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
         r
     });
 
-    // Triangle ROMs at the emitted triangle number; the tag and valid wait the same cycle.
+    // Triangle ROMs at the emitted triangle number: block ROMs (`brom.rs`), the word two
+    // cycles later; the tag and valid wait the same two cycles.
     let (tri_l, tri_words) = &scene.tri;
     let addr = emit_tri.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
     let mut tri_fields: Vec<S> = Vec::new();
     for (k, group) in tri_rom_groups(&tri_l.fields).iter().enumerate() {
         let lsb = group[0].lsb;
         let width: u32 = group.iter().map(|f| f.width).sum();
-        let rom = b.rom(&format!("tri_rom_{k}"), width, tri_words.iter().map(|w| word_bits(w, lsb, width)).collect());
-        let word = b.read(&format!("tri_word_{k}"), rom, addr);
+        let image = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
+        let word = brom(&b, &format!("u_tri_rom_{k}"), &format!("tri_{k}"), width, image, addr, p.tri_rom_cycles);
         tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
     }
     // The tag: the end flag on top of the ray id (end token) or the leaf tmin and triangle.
     let payload = p.tag.payload();
     let tri_tmin = b.cat(&[trav.get("emit_tmin"), emit_tri.resize(p.tag.tri_bits)]).resize(payload);
     let tag = b.cat(&[emit_end, emit_end.select(trav.get("emit_id").resize(payload), tri_tmin)]).name("tag");
-    let valid_d = b.delay("pipe_valid", trav.get("emit_valid"));
-    let tag_d = b.delay("pipe_tag", tag);
+    let valid_d = b.delay_line("pipe_valid", trav.get("emit_valid"), p.tri_rom_cycles);
+    let tag_d = b.delay_line("pipe_tag", tag, p.tri_rom_cycles);
+    // The ray `ray_delay` cycles late, in step with the triangle words: the pipeline's input
+    // register takes the ray's last triangle after the next ray's accept (see the module
+    // comment), so it must still see the old origin and direction then.
+    let cur_o =
+        ["cur_ox", "cur_oy", "cur_oz"].map(|name| b.delay_line(&format!("pipe_{name}"), trav.get(name), p.ray_delay()));
+    let w = [0, 1, 2].map(|k| b.delay_line(&format!("pipe_w{}", ["x", "y", "z"][k]), w[k], p.ray_delay()));
 
-    let mut pipe_in = vec![valid_d, tag_d, trav.get("cur_ox"), trav.get("cur_oy"), trav.get("cur_oz")];
+    let mut pipe_in = vec![valid_d, tag_d];
+    pipe_in.extend(cur_o);
     pipe_in.extend(w);
     pipe_in.extend(tri_fields);
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);

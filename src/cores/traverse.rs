@@ -6,15 +6,16 @@
 //! Pipelined for the clock: every register-to-register path is a block-RAM read into a
 //! register, one mux level and one adder or compare (or a few LUTs of decision), or the
 //! multiplier alone. So the node ROM is addressed by the `node` register itself and its word
-//! goes straight into a register (mem[node] two cycles after `node` last changed), as does the
-//! leaf ROM's; the plane distances come from a pipelined unit (`plane.rs`, L = 3 + product
-//! stages clocks from issue to result; L = 4 by default); and the child decision takes a
-//! compare cycle and an act cycle. States and their cost (one cycle each unless noted):
-//! - `idle`: `ray_ready`; a valid ray is latched (node 0, tmin 0 and tmax = 2^(n+1) too).
+//! goes straight into registers (a block ROM, `brom.rs`: mem[node] two or three cycles after
+//! `node` last changed), as does the leaf ROM's; the plane distances come from a pipelined
+//! unit (`plane.rs`, L = 3 + product stages clocks from issue to result; L = 9 at the default
+//! 150 MHz); and the child decision takes a compare cycle and an act cycle. States and their
+//! cost (one cycle each unless noted):
+//! - `idle`: `ray_ready`; a valid ray is latched (node 0 and tmin 0 too).
 //! - `aabb` (3 cycles): the exit distance of one scene-box axis per cycle is issued.
-//! - `box` (L cycles): waits for the three distances; tmax = min as they arrive. A ray that
-//!   misses the box (a distance < 0) goes to `done`, else to `node` (node 0's word was read
-//!   while waiting).
+//! - `box` (L cycles): waits for the three distances, registering them and their compares.
+//! - `boxmin`: tmax = their min. A ray that misses the box (a distance < 0) goes to `done`,
+//!   else to `node` (node 0's word was read while waiting).
 //! - `fetch`: waits until the word register holds the new node's word: 2 cycles after a step
 //!   that enters the far child alone, 1 after a pop that follows a step or a one-entry leaf, 2
 //!   after a pop that follows an empty leaf. The near child is addressed during `dist`
@@ -24,19 +25,21 @@
 //!   and count; an inner node's fields are latched and d0 (clip0) is issued.
 //! - `clip1` (1 per inner node): d1 (clip1) is issued; the ray's sign on the axis latched.
 //! - `dist` (L per inner node): waits for d0, then d1; when d1 arrives, near_end/far_start are
-//!   chosen and compared with tmin and tmax (registered).
-//! - `step` (1 per inner node): `bih::inner_step`'s decision from the registered compares:
-//!   push the far child and enter the near one, enter one child, or pop.
+//!   chosen, and both candidates compared with tmin and tmax (registered).
+//! - `step` (1 per inner node): `bih::inner_step`'s decision from the registered compares,
+//!   selected by the ray's sign: push the far child and enter the near one, enter one child,
+//!   or pop.
 //! - `leaf` (count cycles): one leaf entry per clock.
 //! - `pop`: the top of the stack (always read ahead) is loaded, or `done` when it is empty.
 //! - `done`: an end token follows the ray's last triangle, so the closest-hit unit knows the
 //!   ray is complete when the token leaves the in-order pipeline.
 //!
-//! An inner node costs node + clip1 + L + step = 3 + L = 7 cycles (2 before the unit was
-//! pipelined; a far-only step adds 2 fetch cycles), a leaf node + count, a pop 1 (+ its
-//! fetch), a ray's overhead idle + aabb + box + done = 5 + L. Emission is two cycles behind
-//! `leaf` (the leaf ROM and its register).
+//! An inner node costs node + clip1 + L + step = 3 + L cycles (12 by default; 2 before the
+//! unit was pipelined; a far-only step adds the node ROM's 2 or 3 read clocks of `fetch`), a
+//! leaf node + count, a pop 1 (+ its fetch), a ray's overhead idle + aabb + box + boxmin +
+//! done = 6 + L. Emission is the leaf ROM's 2 or 3 read clocks behind `leaf`.
 
+use super::brom::{brom, read_cycles};
 use super::clock::ClockTarget;
 use super::mul::MulStyle;
 use super::plane::{PlaneIssue, plane_unit};
@@ -52,6 +55,7 @@ crate::states! {
         Idle = "idle",
         Aabb = "aabb",
         Box = "box",
+        BoxMin = "boxmin",
         Fetch = "fetch",
         Node = "node",
         Clip1 = "clip1",
@@ -75,6 +79,11 @@ pub struct TraverseParams {
     pub tri_bits: u32,
     /// How the plane-distance product is built (`plane::plane_product`): the clock target's.
     pub product: MulStyle,
+    /// Clocks of a node ROM read and of a leaf ROM read (`brom::read_cycles`: 3 for block RAM,
+    /// whose fabric register the placer puts between the blocks spread over the die and the
+    /// logic; 2 for LUTs). The emitted triangle stream is `leaf_rom_cycles` behind `leaf`.
+    pub node_rom_cycles: u32,
+    pub leaf_rom_cycles: u32,
 }
 
 impl TraverseParams {
@@ -89,6 +98,8 @@ impl TraverseParams {
             box_hi: scene.box_hi,
             tri_bits: rom::addr_bits(scene.tri_count()),
             product: target.mul_style(),
+            node_rom_cycles: read_cycles(scene.node.1.len()),
+            leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
         }
     }
     /// Reciprocal directions: m + C bits.
@@ -140,15 +151,20 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let inv = ["invx_r", "invy_r", "invz_r"].map(|name| b.reg(name, Ty::s(p.inv_width()), None));
 
     // Node ROM, addressed by the node register itself, its word registered before any logic
-    // sees it (a block RAM's clock-to-out leaves no room for logic in the same clock): the
-    // word register holds mem[node] when node has held its value for the two cycles before.
-    // `node_settled` (node unchanged since the last cycle) tells `fetch` the word will be
-    // there in the next cycle.
+    // sees it (a block RAM's clock-to-out leaves no room for logic in the same clock): a block
+    // ROM (`brom.rs`) of `node_rom_cycles` clocks, whose word holds mem[node] when node has
+    // held its value for the `node_rom_cycles` cycles before. `node_settled` (node unchanged
+    // over the last node_rom_cycles − 1 cycles) tells `fetch` the word will be there in the
+    // next cycle.
     let node_bits = rom_addr_bits(node_words.len());
     let node = b.reg("node", Ty::u(node_bits), Some(0));
-    let node_rom = b.rom("node_rom", node_l.width, node_words.iter().map(|w| word_bits(w, 0, node_l.width)).collect());
-    let word = b.delay("node_word_r", b.read("node_word", node_rom, node));
-    let node_settled = node.eq(b.delay("node_d1", node)).name("node_settled");
+    let node_image = node_words.iter().map(|w| word_bits(w, 0, node_l.width)).collect();
+    let word = brom(&b, "u_node_rom", "node", node_l.width, node_image, node, p.node_rom_cycles);
+    let node_settled = (1..p.node_rom_cycles)
+        .map(|k| node.eq(b.delay_line(&format!("node_d{k}"), node, k)))
+        .reduce(|a, c| a & c)
+        .expect("a ROM of two clocks or more")
+        .name("node_settled");
     let nf = |name: &str| field(&format!("nw_{name}"), word, node_l.field(name), 0);
     let (w_axis, w_clip0, w_clip1, w_child, w_first, w_count) =
         (nf("axis"), nf("clip0"), nf("clip1"), nf("child"), nf("first"), nf("count"));
@@ -179,23 +195,60 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let (plane_t, d0_arrives, d1_arrives) =
         (pu.t, (pu.valid & !pu.last).name("d0_arrives"), (pu.valid & pu.last).name("d1_arrives"));
 
-    // box: tmax = min as the axes arrive (it starts at the clamp's ceiling 2^(n+1), which
-    // min leaves alone); the box is missed when any distance is negative, i.e. the min is.
-    let box_tmax = plane_t.lt(tmax).select(plane_t, tmax).name("box_tmax");
-    let missed = b.reg("box_missed", Ty::BIT, None);
-    let box_miss = (missed | plane_t.msb()).name("box_miss");
+    // box and boxmin: tmax = the least of the three exit distances (each at most the clamp's
+    // ceiling 2^(n+1), where the walk starts tmax); the box is missed when one of them is
+    // negative. The three arrive in consecutive cycles; the last two and the one before are
+    // in `box_d1`..`box_d3` in the cycle after (`boxmin`), and so are their compares, each a
+    // carry chain into a flip-flop (a running min would be a compare, a select and the state
+    // machine's mux in one cycle, 9.4 ns). All of these load every cycle.
+    let box_d1 = b.delay("box_d1", plane_t);
+    let box_d2 = b.delay("box_d2", box_d1);
+    let box_d3 = b.delay("box_d3", box_d2);
+    let box_lt1 = b.delay("box_lt1", plane_t.lt(box_d1).name("box_lt1_c"));
+    let box_lt2 = b.delay("box_lt2", plane_t.lt(box_d2).name("box_lt2_c"));
+    let box_lt1_d = b.delay("box_lt1_d", box_lt1);
+    // In boxmin: c = box_d1, b = box_d2, a = box_d3; c < b is box_lt1, c < a box_lt2, b < a
+    // box_lt1_d.
+    let box_tmax = (box_lt1 & box_lt2).select(box_d1, box_lt1_d.select(box_d2, box_d3)).name("box_tmax");
+    let box_miss = (box_d1.msb() | box_d2.msb() | box_d3.msb()).name("box_miss");
 
-    // dist: bih::inner_step's compares, registered when d1 arrives. tmin ≤ min(near_end, tmax)
-    // and max(tmin, far_start) ≤ tmax are each a compare with the new distance and tmin ≤ tmax
-    // (registered in `node`), so no min or max feeds a compare.
+    // dist: bih::inner_step's compares. tmin ≤ min(near_end, tmax) and max(tmin, far_start) ≤
+    // tmax are each a compare with the new distance and tmin ≤ tmax, so no min or max feeds a
+    // compare. Each compare is made with both candidates for near_end and far_start (the
+    // arriving distance and d0, both registers), and the pair selected by the ray's sign (a
+    // register since `clip1`) and ANDed with tmin ≤ tmax (registered) in one LUT into a
+    // register that loads every cycle: a carry chain and one LUT, with no state-machine enable
+    // (that made the 9 ns path that held the unit near 111 MHz). `step`, the cycle after d1
+    // arrives, reads the registers the arriving distance made: the state machine's conditions
+    // go_near and go_far are flip-flops (with the sign select in `step` instead, the state
+    // logic ran through the compares' corner of the die and back: 8.4 ns in the whole teapot
+    // core). Every compare is a strict less-than: x ≤ tmax is x < tmax + 1 and tmin ≤ x is
+    // tmin − 1 < x, with tmax + 1, tmin − 1 and tmin ≤ tmax in registers of their own, which
+    // load every cycle (tmin and tmax hold still from `node` to `step`, so they are current
+    // long before d1 arrives). A ≤ made by yosys shares the subtraction of the < with the same
+    // operands and adds an equality over its 32 result bits (measured: 8.3 ns, 120 MHz).
     let negative = b.reg("negative", Ty::BIT, None);
     let d0_r = b.reg("d0_r", dist, None);
-    let near_end = negative.select(plane_t, d0_r).name("near_end");
-    let far_start = negative.select(d0_r, plane_t).name("far_start");
-    let reg_bit = |name: &str| b.reg(name, Ty::BIT, None);
-    let (tmin_le_tmax, near_lt_tmax, far_gt_tmin) =
-        (reg_bit("tmin_le_tmax"), reg_bit("near_lt_tmax"), reg_bit("far_gt_tmin"));
-    let (tmin_le_near, far_le_tmax) = (reg_bit("tmin_le_near"), reg_bit("far_le_tmax"));
+    // The arriving d1 from the plane unit's copy for the last distance of a group (the fan-out
+    // of plane_t split between the box and d0 on one side and the decision on the other).
+    let d1 = pu.t_last;
+    let near_end = negative.select(d1, d0_r).name("near_end");
+    let far_start = negative.select(d0_r, d1).name("far_start");
+    let tmax_p1 = b.delay("tmax_p1", (tmax + 1).name("tmax_plus_1"));
+    let tmin_m1 = b.delay("tmin_m1", (tmin - 1).name("tmin_minus_1"));
+    let tmin_le_tmax = b.delay("tmin_le_tmax", tmin.lt(tmax_p1).name("tmin_le_tmax_c"));
+    // A compare of each candidate, selected by the sign: (on the arriving distance, on d0).
+    fn pick_by<'b>(negative: S<'b>, name: &str, on_plane: S<'b>, on_d0: S<'b>) -> S<'b> {
+        negative.select(on_plane.name(&format!("{name}_plane")), on_d0.name(&format!("{name}_d0"))).name(name)
+    }
+    let by_sign = |name: &str, on_plane, on_d0| pick_by(negative, name, on_plane, on_d0);
+    let reg = |name: &str, x: S| b.delay(name, x.name(&format!("{name}_c")));
+    let near_lt_tmax = reg("near_lt_tmax", by_sign("near_lt", d1.lt(tmax), d0_r.lt(tmax)));
+    let far_gt_tmin = reg("far_gt_tmin", by_sign("far_gt", tmin.lt(d0_r), tmin.lt(d1)));
+    let tmin_le_near = by_sign("tmin_le_near", tmin_m1.lt(d1), tmin_m1.lt(d0_r));
+    let far_le_tmax = by_sign("far_le_tmax", d0_r.lt(tmax_p1), d1.lt(tmax_p1));
+    let go_near = reg("go_near", tmin_le_near & tmin_le_tmax);
+    let go_far = reg("go_far", far_le_tmax & tmin_le_tmax);
     let near_end_r = b.reg("near_end_r", dist, None);
     let far_start_r = b.reg("far_start_r", dist, None);
     let far_r = b.reg("far_r", Ty::u(node_bits), None);
@@ -206,8 +259,6 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // step: the decision from registered bits; near_max and far_min are muxes.
     let near_max = near_lt_tmax.select(near_end_r, tmax).name("near_max");
     let far_min = far_gt_tmin.select(far_start_r, tmin).name("far_min");
-    let go_near = (tmin_le_near & tmin_le_tmax).name("go_near");
-    let go_far = (far_le_tmax & tmin_le_tmax).name("go_far");
 
     // Stack entries (far node, far_min, tmax); the top (sp − 1) is always read ahead.
     let sp = b.reg("sp", Ty::u(p.sp_width()), Some(0));
@@ -223,19 +274,23 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let leaf_bits = rom_addr_bits(leaf_words.len());
     let leaf_ptr = b.reg("leaf_ptr", Ty::u(leaf_bits), None);
     let left = b.reg("leaf_left", w_count.ty(), None);
-    // Whether `node` has held the stack top since two cycles before `node` follows `pop` (so
-    // the word register has it without a `fetch`): `leaf` loads the top every cycle, so a
-    // leaf of two or more entries has. The top is read at sp − 1 one cycle late, so it is
-    // current in `leaf` and `step`, not in a `node` right after a push.
+    // Whether `node` has held the stack top since `node_rom_cycles` cycles before `node`
+    // follows `pop` (so the word is there without a `fetch`): `leaf` loads the top every
+    // cycle, so a leaf of `node_rom_cycles` or more entries has. The top is read at sp − 1 one
+    // cycle late, so it is current in `leaf` and `step`, not in a `node` right after a push.
     let popped_ahead = b.reg("popped_ahead", Ty::BIT, None);
-    let was_leaf = b.delay("was_leaf", fsm.is(Leaf));
+    let was_leaf = (1..p.node_rom_cycles)
+        .map(|k| b.delay_line(&format!("was_leaf{k}"), fsm.is(Leaf), k))
+        .reduce(|a, c| a & c)
+        .expect("a ROM of two clocks or more")
+        .name("was_leaf");
+    // Whether the stack is empty, registered: `pop` never follows a cycle that changed sp.
+    let sp_empty = b.delay("sp_empty", sp.eq(0).name("sp_is_zero"));
 
     fsm.state(Idle, |s| {
         s.set_k(aabb_k, 0);
         s.set_k(node, 0);
         s.set_k(tmin, 0);
-        s.set_k(tmax, 1i128 << (n + 1));
-        s.set_k(missed, 0);
         s.when(ray_valid, |s| {
             s.set(id_r, ray_id);
             for k in 0..3 {
@@ -250,13 +305,11 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         s.when(aabb_last, |s| s.goto(Box));
     });
     fsm.state(Box, |s| {
-        s.when(pu.valid, |s| {
-            s.set(tmax, box_tmax);
-            s.set(missed, box_miss);
-        });
-        s.when(d1_arrives, |s| {
-            s.when(box_miss, |s| s.goto(Done)).otherwise(|s| s.goto(Node));
-        });
+        s.when(d1_arrives, |s| s.goto(BoxMin));
+    });
+    fsm.state(BoxMin, |s| {
+        s.set(tmax, box_tmax);
+        s.when(box_miss, |s| s.goto(Done)).otherwise(|s| s.goto(Node));
     });
     fsm.state(Fetch, |s| {
         s.when(node_settled, |s| s.goto(Node));
@@ -273,7 +326,6 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
             s.set(axis_r, w_axis);
             s.set(clip1_r, w_clip1);
             s.set(child_r, w_child);
-            s.set(tmin_le_tmax, tmin.le(tmax));
             s.goto(Clip1);
         });
     });
@@ -289,15 +341,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         s.set(far_r, far);
         s.when(d0_arrives, |s| s.set(d0_r, plane_t));
         s.when(d1_arrives, |s| {
+            // The compares are registered every cycle: in `step` they hold this cycle's.
             s.set(near_end_r, near_end);
             s.set(far_start_r, far_start);
-            // Each compare made with both candidates (the arriving distance and d0, both
-            // registers) and the result selected by `negative`: no mux ahead of a carry chain.
-            let by_sign = |on_plane, on_d0| negative.select(on_plane, on_d0);
-            s.set(near_lt_tmax, by_sign(plane_t.lt(tmax), d0_r.lt(tmax)));
-            s.set(far_gt_tmin, by_sign(d0_r.gt(tmin), plane_t.gt(tmin)));
-            s.set(tmin_le_near, by_sign(tmin.le(plane_t), tmin.le(d0_r)));
-            s.set(far_le_tmax, by_sign(d0_r.le(tmax), plane_t.le(tmax)));
             s.goto(Step);
         });
     });
@@ -333,7 +379,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         });
     });
     fsm.state(Pop, |s| {
-        s.when(sp.eq(0), |s| s.goto(Done)).otherwise(|s| {
+        s.when(sp_empty, |s| s.goto(Done)).otherwise(|s| {
             s.set(sp, sp - 1);
             s.set(tmin, top_tmin);
             s.set(tmax, top_tmax);
@@ -346,17 +392,16 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let state = fsm.state_reg();
     fsm.finish();
 
-    // Emission, two cycles behind the FSM so it lines up with the leaf ROM's registered
-    // output (the triangle number addresses the triangle ROMs: no block RAM output drives
-    // another block RAM's address directly).
-    let leaf_rom = b.rom("leaf_rom", leaf_l.width, leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect());
-    let tri = b.delay("leaf_tri_r", b.read("leaf_tri", leaf_rom, leaf_ptr));
+    // Emission, `leaf_rom_cycles` behind the FSM so it lines up with the leaf ROM's word (a block
+    // ROM), which addresses the triangle ROMs.
+    let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
+    let tri = brom(&b, "u_leaf_rom", "leaf", leaf_l.width, leaf_image, leaf_ptr, p.leaf_rom_cycles);
     b.output("ray_ready", in_idle);
-    b.output("emit_valid", b.delay_line("emit_r", in_leaf | in_done, 2));
-    b.output("emit_end", b.delay_line("end_r", in_done, 2));
+    b.output("emit_valid", b.delay_line("emit_r", in_leaf | in_done, p.leaf_rom_cycles));
+    b.output("emit_end", b.delay_line("end_r", in_done, p.leaf_rom_cycles));
     b.output("emit_tri", tri.resize(p.tri_bits));
-    b.output("emit_tmin", b.delay_line("tmin_r", tmin.unsigned().resize(p.tmin_width()), 2));
-    b.output("emit_id", b.delay_line("id_r", id_r, 2));
+    b.output("emit_tmin", b.delay_line("tmin_r", tmin.unsigned().resize(p.tmin_width()), p.leaf_rom_cycles));
+    b.output("emit_id", b.delay_line("id_r", id_r, p.leaf_rom_cycles));
     for (name, s) in ["cur_ox", "cur_oy", "cur_oz"].iter().zip(o) {
         b.output(name, s);
     }
@@ -433,7 +478,9 @@ mod tests {
     #[test]
     fn visits_what_the_golden_walk_visits_in_its_order() {
         let cornell = Params { n: 20, m: 20, ..Params::default() };
-        for (name, params, mhz) in [("teapot", Params::default(), 150), ("cornell", cornell, 75), ("cornell", cornell, 250)] {
+        for (name, params, mhz) in
+            [("teapot", Params::default(), 150), ("cornell", cornell, 75), ("cornell", cornell, 250)]
+        {
             let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
             let g = Golden::new(&scene);
             let roms = SceneRoms::of(&scene);

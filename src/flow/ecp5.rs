@@ -239,10 +239,17 @@ pub fn place_and_route(
     let wrapper_ff: u64 =
         m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
     let files = emit::design_files(&top, "v");
+    let hierarchy = top.hierarchy();
+    let brom_of = |file: &str| {
+        let name = file.strip_suffix(".v").filter(|n| n.starts_with(crate::cores::brom::BROM_PREFIX))?;
+        hierarchy.iter().find(|m| m.name == name).copied()
+    };
     for (file, text) in &files {
-        // Split multipliers' pieces become DSP blocks with their registers inside.
+        // Split multipliers' pieces become DSP blocks with their registers inside, block ROMs
+        // DP16KDs with their output register.
         let text = super::ecp5_dsp::dsp_regs_of(file)
             .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
+            .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
             .unwrap_or_else(|| text.clone());
         std::fs::write(dir.join(file), text).map_err(io)?;
     }

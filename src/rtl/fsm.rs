@@ -18,7 +18,8 @@
 //! process with signals): `s.set(count, count + 1)` followed by `s.when(count.eq(2), …)` tests
 //! the old count.
 //! `finish` builds each register's next value as a `case` on the state (one arm per state
-//! that assigns it) and refuses a machine with a state that has no block.
+//! that assigns it) and refuses a machine with a state that has no block. `is(state)` is a
+//! one-hot flag register beside the binary state register (its value is the state compare's).
 
 use super::build::{Builder, S};
 use super::netlist::BlockKind;
@@ -164,12 +165,17 @@ impl<'b, St: States> Fsm<'b, St> {
         self.state
     }
 
-    /// 1 while the machine is in `st`.
+    /// 1 while the machine is in `st`: a flip-flop of its own (a one-hot flag beside the
+    /// binary state register), loaded with "the next state is `st`" and reset and powered up
+    /// with the state, so it equals state = st in every cycle. Conditions and enables then
+    /// start from a flip-flop instead of a decode of the state bits: in a large design the
+    /// decode put four or five LUTs and their routing between the state register and every
+    /// enable (the traversal in the whole core: 8.3 ns, docs/TIMING.md).
     pub fn is(&self, st: St) -> S<'b> {
         if let Some(s) = self.is.borrow().get(&st.code()) {
             return *s;
         }
-        let s = self.state.eq(self.codes[st.code() as usize]).name(&format!("in_{}", st.name()));
+        let s = self.b.reg(&format!("in_{}", st.name()), Ty::BIT, Some(i128::from(st == self.init)));
         self.is.borrow_mut().insert(st.code(), s);
         s
     }
@@ -276,6 +282,12 @@ impl<'b, St: States> Fsm<'b, St> {
                 data = c.select(rec.sigs[w.data], data);
             }
             b.ram_write(mem, we, addr, data);
+        }
+        // The state flags: each loads "the next state is its state".
+        let state_next = nexts.of(self.state);
+        for (&code, &flag) in self.is.borrow().iter() {
+            b.with(|m| m.set_block(flag.sig.id, self.block));
+            b.next(flag, state_next.eq(self.codes[code as usize]).name(&format!("{}_next", b.name_of(flag.sig))));
         }
         b.with(|m| m.current_block = open);
         nexts

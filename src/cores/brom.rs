@@ -1,0 +1,104 @@
+//! Block ROMs read over two or three clocks: `data` is the word at `addr` `cycles` clocks
+//! after `addr` (a synchronous read, then one or two more registers with no logic between).
+//!
+//! Every ROM of the scene (node, leaf, the triangle words) is one of these modules. The pair of
+//! registers is what a block RAM with its output register does, and a block RAM without it is
+//! too slow for the clock: nextpnr gives an ECP5 DP16KD 5.6 ns from clock to data without
+//! its output register (`REGMODE = NOREG`), so even a ROM word going straight into a fabric
+//! register missed 150 MHz once routed (the teapot's traversal unit, 91.8 MHz). Yosys never
+//! infers `REGMODE = OUTREG` (yosys issue 5814: the output register is only available by
+//! instantiating the primitive), so `fxrt synth --family ecp5` replaces the body of each
+//! module named `fxrt_brom_…` by DP16KD primitives with their output register
+//! (`flow::ecp5_bram`), the way it places the multiplier pieces in MULT18X18Ds. The generated
+//! HDL stays portable, and every simulator runs it as written here.
+//!
+//! A third clock is a fabric register after the block's output register: a design of many
+//! blocks spreads them over the die, and the route from a block to the logic it feeds was
+//! measured at up to 5.7 ns (the teapot's node ROM, 37 blocks, 134.9 MHz with two clocks), so
+//! the block's word first goes into a flip-flop the placer can put between the two.
+
+use crate::rtl::build::{Builder, S};
+use crate::rtl::{Module, Ty};
+use crate::scene::rom::rom_addr_bits;
+use std::rc::Rc;
+
+/// The name prefix of block ROM modules (the ECP5 flow recognises them by it).
+pub const BROM_PREFIX: &str = "fxrt_brom_";
+
+/// ROMs of at least this many words are block RAM; smaller ones are LUTs (yosys 0.70 makes a
+/// 73-bit ROM of 64 words of LUTs and one of 128 words of DP16KDs).
+pub const BLOCK_WORDS: usize = 128;
+
+/// The clocks a ROM of `words` words is read in: 3 for block RAM (the fabric register after the
+/// block), 2 for a LUT ROM (its read register and one more, as close as any logic).
+pub fn read_cycles(words: usize) -> u32 {
+    if words >= BLOCK_WORDS { 3 } else { 2 }
+}
+
+/// The ROM `fxrt_brom_{name}` of `width`-bit words: ports `addr` (the ROM's address bits) →
+/// `data`, `cycles` (2 or 3) clocks later.
+pub fn brom_module(name: &str, width: u32, words: Vec<u128>, cycles: u32) -> Module {
+    assert!((2..=3).contains(&cycles), "a block ROM reads in 2 or 3 clocks");
+    let b = Builder::new(&format!("{BROM_PREFIX}{name}"));
+    let addr = b.input("addr", Ty::u(rom_addr_bits(words.len())));
+    let mem = b.rom("mem", width, words);
+    let word = b.read("word", mem, addr);
+    // Plain registers, not a delay line (which a synthesis tool may map to shift-register
+    // LUTs): the first is the block's output register, the second a fabric flip-flop.
+    let mut data = b.delay("data_r", word);
+    if cycles == 3 {
+        data = b.delay("data_rr", data);
+    }
+    b.output("data", data);
+    b.finish()
+}
+
+/// The clocks of a block ROM module's read: the synchronous read and its registers.
+pub fn brom_cycles(m: &Module) -> u32 {
+    1 + m.signals.iter().filter(|s| matches!(s.def, crate::rtl::netlist::Def::Reg { .. })).count() as u32
+}
+
+/// In `b`: the block ROM `name` read at `addr` (instance `label`); its word `cycles` clocks
+/// later.
+pub fn brom<'b>(
+    b: &'b Builder,
+    label: &str,
+    name: &str,
+    width: u32,
+    words: Vec<u128>,
+    addr: S<'b>,
+    cycles: u32,
+) -> S<'b> {
+    let m = Rc::new(brom_module(name, width, words, cycles));
+    b.instance(label, &m, &[addr]).get("data")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rtl::sim::Sim;
+
+    /// The word at an address is on `data` `cycles` clocks after the address.
+    #[test]
+    fn reads_over_two_or_three_clocks() {
+        for cycles in [2, 3] {
+            let words: Vec<u128> = (0..5).map(|k| 100 + k).collect();
+            let m = brom_module("t", 8, words, cycles);
+            assert_eq!((m.name.as_str(), brom_cycles(&m)), ("fxrt_brom_t", cycles));
+            let mut sim = Sim::new(&m);
+            let (addr, data) = (m.handle(m.inputs[0]), m.handle(m.outputs[0].1));
+            let seq = [3, 1, 4, 0, 2, 2, 1];
+            let mut got = Vec::new();
+            for &a in &seq {
+                sim.set(addr, a);
+                sim.tick();
+                got.push(sim.get(data));
+            }
+            // After edge k + 1, data is the word at the address of edge k + 2 − cycles.
+            let c = cycles as usize;
+            for k in c - 1..seq.len() {
+                assert_eq!(got[k], 100 + seq[k + 1 - c] as i128, "{cycles} clocks, edge {}", k + 1);
+            }
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! The block ROMs (`cores::brom`, modules `fxrt_brom_…`) as ECP5 DP16KD primitives with their
+//! output register, for place and route only.
+//!
+//! Yosys maps a ROM to DP16KD with `REGMODE = NOREG` and never absorbs a second register into
+//! the block's output register (yosys issue 5814: only by instantiating the primitive), and
+//! nextpnr times a DP16KD without it at 5.6 ns from clock to data: a ROM word going straight
+//! into a register missed 150 MHz (the teapot's traversal, 91.8 MHz). So `fxrt synth --family
+//! ecp5` replaces the body of each block ROM module by DP16KDs in `REGMODE_A = "OUTREG"` —
+//! the module's read register and output register are the block's own — the way
+//! `ecp5_dsp` puts multiplier pieces in MULT18X18Ds. The ports and the cycle behaviour are the
+//! generated module's, which every simulator checks.
+//!
+//! Each DP16KD holds the whole depth of the ROM at the widest data width that covers it
+//! (1K×18, 2K×9, 4K×4, 8K×2, 16K×1), so the ROM is a row of blocks side by side with no
+//! multiplexer after them: the teapot's 4,379 nodes of 73 bits are 37 blocks of 8K×2, its
+//! 6,320 triangles of 284 bits 142. ROMs deeper than 16K words, and ROMs of fewer than
+//! `MIN_WORDS` words (yosys makes those of LUTs), are left as yosys infers them.
+//!
+//! The initial contents follow yosys's own DP16KD mapping (`share/lattice/brams_map_16kd.v`
+//! with `memory_libmap`): the block is 1,024 rows of 18 bits, INITVAL_00 … INITVAL_3F hold 16
+//! rows each in 20-bit slots; a 9- or 18-bit word sits in consecutive row bits, a 1-, 2- or
+//! 4-bit word in the 16 data bits of a row (bits 0–7 and 9–16, not the ninth bits). The port's
+//! address is on ADA13 down to ADA(log2(16K / depth)). A test checks that these INITVALs and
+//! connections are what yosys itself infers for the same ROM at each width.
+
+use crate::rtl::netlist::Module;
+use std::fmt::Write;
+
+/// Block ROMs of fewer words stay as yosys infers them: LUTs.
+pub const MIN_WORDS: usize = crate::cores::brom::BLOCK_WORDS;
+
+/// (data width, depth) of the DP16KD configurations, widest first.
+pub const CONFIGS: [(u32, usize); 5] = [(18, 1024), (9, 2048), (4, 4096), (2, 8192), (1, 16384)];
+
+/// The widest configuration holding `depth` words, if any.
+pub fn config(depth: usize) -> Option<(u32, usize)> {
+    CONFIGS.iter().copied().find(|&(_, d)| d >= depth)
+}
+
+/// The 64 INITVAL parameters (320 bits each, as hex) of the block holding bits [lsb, lsb + w)
+/// of each word, in data width `w`.
+pub fn initvals(words: &[u128], lsb: u32, w: u32) -> Vec<String> {
+    let mut bits = vec![false; 64 * 320];
+    for (a, &word) in words.iter().enumerate() {
+        for b in 0..w {
+            if lsb + b >= 128 || (word >> (lsb + b)) & 1 == 0 {
+                continue;
+            }
+            let k = a * w as usize + b as usize;
+            let (row, col) = if w >= 9 { (k / 18, k % 18) } else { (k / 16, k % 16 + usize::from(k % 16 >= 8)) };
+            bits[(row / 16) * 320 + (row % 16) * 20 + col] = true;
+        }
+    }
+    bits.chunks(320)
+        .map(|c| {
+            (0..80)
+                .rev()
+                .map(|d| {
+                    let nibble = (0..4).fold(0u32, |acc, i| acc | (u32::from(c[d * 4 + i]) << i));
+                    char::from_digit(nibble, 16).expect("a nibble")
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The block ROM module `m` (`cores::brom::brom_module`) as DP16KDs (and a fabric register
+/// after them when it reads in three clocks), or None when it stays as
+/// yosys infers it. `generated` is its printed Verilog; its port list is kept.
+pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
+    let rom = m.roms.first()?;
+    let depth = crate::scene::rom::rom_depth(rom.words.len());
+    if rom.words.len() < MIN_WORDS {
+        return None;
+    }
+    let (w, cfg_depth) = config(depth)?;
+    let abits = crate::scene::rom::rom_addr_bits(rom.words.len());
+    let shift = (16384 / cfg_depth).trailing_zeros();
+    let end = generated.find("\n);\n")? + 4;
+    let mut v = String::from(&generated[..end]);
+    v.push_str("\n  // DP16KD blocks with their output register (fxrt synth --family ecp5, flow::ecp5_bram).\n");
+    let blocks = rom.width.div_ceil(w);
+    let _ = writeln!(v, "  wire [{}:0] dout;", blocks * w - 1);
+    for j in 0..blocks {
+        let _ = writeln!(v, "  DP16KD #(");
+        for (i, init) in initvals(&rom.words, j * w, w).iter().enumerate() {
+            let _ = writeln!(v, "    .INITVAL_{i:02X}(320'h{init}),");
+        }
+        let _ = writeln!(
+            v,
+            "    .DATA_WIDTH_A({w}), .DATA_WIDTH_B(18), .REGMODE_A(\"OUTREG\"), .REGMODE_B(\"NOREG\"),\n    \
+             .RESETMODE(\"SYNC\"), .ASYNC_RESET_RELEASE(\"SYNC\"), .CSDECODE_A(\"0b000\"), .CSDECODE_B(\"0b000\"),\n    \
+             .WRITEMODE_A(\"NORMAL\"), .WRITEMODE_B(\"NORMAL\"), .GSR(\"DISABLED\")\n  ) u_bram{j} ("
+        );
+        let ada: Vec<String> = (0..14u32)
+            .map(|p| match p.checked_sub(shift) {
+                Some(i) if i < abits => format!(".ADA{p}(addr[{i}])"),
+                _ => format!(".ADA{p}(1'b0)"),
+            })
+            .collect();
+        let _ = writeln!(v, "    {},", ada.join(", "));
+        let zeros = |pin: &str, n| (0..n).map(|i| format!(".{pin}{i}(1'b0)")).collect::<Vec<_>>().join(", ");
+        let _ = writeln!(v, "    {},", zeros("DIA", 18));
+        let _ = writeln!(v, "    {},", zeros("DIB", 18));
+        let _ = writeln!(v, "    {},", zeros("ADB", 14));
+        let dout: Vec<String> = (0..w).map(|i| format!(".DOA{i}(dout[{}])", j * w + i)).collect();
+        let _ = writeln!(v, "    {},", dout.join(", "));
+        v.push_str("    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(1'b0), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n");
+        v.push_str("    .CLKB(1'b0), .CEB(1'b0), .OCEB(1'b0), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+        v.push_str("  );\n");
+    }
+    if crate::cores::brom::brom_cycles(m) == 3 {
+        // The third clock: a fabric register after the block's output register.
+        let _ = writeln!(
+            v,
+            "  reg [{0}:0] dout_q = {1}'h0;\n  always @(posedge clk) dout_q <= dout[{0}:0];",
+            rom.width - 1,
+            rom.width
+        );
+        v.push_str("  assign data = dout_q;\n");
+    } else {
+        let _ = writeln!(v, "  assign data = dout[{}:0];", rom.width - 1);
+    }
+    v.push_str("endmodule\n");
+    Some(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cores::brom::brom_module;
+    use crate::rtl::emit;
+
+    #[test]
+    fn widest_configuration_without_a_multiplexer() {
+        assert_eq!(config(1000), Some((18, 1024)));
+        assert_eq!(config(4379), Some((2, 8192)));
+        assert_eq!(config(8192), Some((2, 8192)));
+        assert_eq!(config(8193), Some((1, 16384)));
+        assert_eq!(config(16385), None);
+    }
+
+    /// The substitute keeps the ports, uses one block per w bits, the output register, and
+    /// no fabric register.
+    #[test]
+    fn a_rom_becomes_dp16kds_with_their_output_register() {
+        let words: Vec<u128> = (0..3000u128).map(|k| k * 2_654_435_761 % (1 << 20)).collect();
+        let m = brom_module("t", 20, words, 2);
+        let files = emit::design_files(&m, "v");
+        let (_, text) = files.iter().find(|(n, _)| n == "fxrt_brom_t.v").expect("the module's file");
+        let v = dp16kd_rom(text, &m).expect("a DP16KD ROM");
+        assert!(v.starts_with(&text[..text.find("\n);\n").unwrap()]));
+        assert_eq!(v.matches("DP16KD #(").count(), 5, "4K×4 blocks for 20 bits");
+        assert!(v.contains(".DATA_WIDTH_A(4)") && v.contains(".REGMODE_A(\"OUTREG\")"));
+        assert!(v.contains(".ADA2(addr[0])") && v.contains(".ADA13(addr[11])") && v.contains(".ADA1(1'b0)"));
+        assert!(!v.contains("always") && !v.contains("readmem"));
+        let m3 = brom_module("t", 20, (0..3000).collect(), 3);
+        let files = emit::design_files(&m3, "v");
+        let v3 = dp16kd_rom(&files.iter().find(|(n, _)| n == "fxrt_brom_t.v").unwrap().1, &m3).unwrap();
+        assert!(v3.contains("always @(posedge clk) dout_q <= dout[19:0];") && v3.contains("assign data = dout_q;"));
+        // Too small: left to yosys.
+        let small = brom_module("s", 8, vec![1; 100], 2);
+        let files = emit::design_files(&small, "v");
+        assert!(dp16kd_rom(&files.iter().find(|(n, _)| n == "fxrt_brom_s.v").unwrap().1, &small).is_none());
+    }
+
+    /// Bit k = a·w + b of a narrow block skips the ninth bits of each 18-bit row.
+    #[test]
+    fn init_layout() {
+        let mut words = vec![0u128; 16384];
+        words[8] = 1; // k = 8 at width 1: row 0, column 9
+        words[16] = 1; // k = 16: row 1, column 0 → bit 20
+        let iv = initvals(&words, 0, 1);
+        assert!(iv[0].ends_with(&format!("{:020x}", (1u128 << 20) | (1 << 9))), "{}", iv[0]);
+        let mut words = vec![0u128; 1024];
+        words[1] = 1 << 17; // width 18: word 1 bit 17 → row 1, column 17 → bit 37
+        let iv = initvals(&words, 0, 18);
+        assert!(iv[0].ends_with(&format!("{:020x}", 1u128 << 37)), "{}", iv[0]);
+    }
+}
