@@ -360,13 +360,16 @@ fn ours(name: &str) -> String {
     name[..cut].to_string()
 }
 
-/// The longest path of the report (nextpnr lists the critical path of each clock pair).
+/// The longest register-to-register path of the report: nextpnr lists the critical path of
+/// each clock pair, and the pads' paths (`<async>`, the wrapper's `din` and `dout`) do not
+/// bound Fmax — a fast module's longest path would otherwise be its output pin's.
 fn critical_path(r: &serde_json::Value) -> CriticalPath {
     let Some(paths) = r["critical_paths"].as_array() else { return CriticalPath::default() };
     let delay = |p: &serde_json::Value| -> f64 {
         p["path"].as_array().map_or(0.0, |s| s.iter().filter_map(|x| x["delay"].as_f64()).sum())
     };
-    let Some(worst) = paths.iter().max_by(|a, b| delay(a).total_cmp(&delay(b))) else {
+    let clocked = |p: &&serde_json::Value| ["from", "to"].iter().all(|e| p[*e].as_str().is_some_and(|c| c != "<async>"));
+    let Some(worst) = paths.iter().filter(clocked).max_by(|a, b| delay(a).total_cmp(&delay(b))) else {
         return CriticalPath::default();
     };
     let steps = worst["path"].as_array().cloned().unwrap_or_default();
@@ -434,7 +437,11 @@ mod tests {
                 { "type": "clk-to-q", "delay": 0.5, "from": { "cell": "a_ff" }, "to": { "cell": "a_ff" } },
                 { "type": "routing", "delay": 1.3, "net": "u_dut.a", "from": { "cell": "a_ff" }, "to": { "cell": "m" } },
                 { "type": "logic", "delay": 3.9, "from": { "cell": "m" }, "to": { "cell": "m" } },
-                { "type": "routing", "delay": 1.0, "net": "u_dut.p", "from": { "cell": "m" }, "to": { "cell": "p_ff" } } ] } ]
+                { "type": "routing", "delay": 1.0, "net": "u_dut.p", "from": { "cell": "m" }, "to": { "cell": "p_ff" } } ] },
+              // The output pad's path is longer but does not bound the clock.
+              { "from": "clk", "to": "<async>", "path": [
+                { "type": "clk-to-q", "delay": 0.5, "from": { "cell": "dout_ff" }, "to": { "cell": "dout_ff" } },
+                { "type": "routing", "delay": 7.0, "net": "dout", "from": { "cell": "dout_ff" }, "to": { "cell": "dout" } } ] } ]
         });
         let t = timing_from_report(&r, "dut", 100.0, Some(3), 9, 1, "y".into(), "n".into());
         assert_eq!((t.fmax_mhz, t.lut4, t.ff, t.mult18, t.dp16kd), (143.69, 12, 65, 1, 0));
