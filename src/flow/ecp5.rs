@@ -246,9 +246,11 @@ pub fn place_and_route(
     };
     for (file, text) in &files {
         // Split multipliers' pieces become DSP blocks with their registers inside, block ROMs
-        // DP16KDs with their output register.
+        // DP16KDs with their output register, the divider's steps carry chains that add or
+        // subtract in their own LUTs.
         let text = super::ecp5_dsp::dsp_regs_of(file)
             .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
+            .or_else(|| super::ecp5_carry::addsub_width_of(file).and_then(|w| super::ecp5_carry::ccu2c_addsub(text, w)))
             .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
             .unwrap_or_else(|| text.clone());
         std::fs::write(dir.join(file), text).map_err(io)?;

@@ -3,6 +3,7 @@
 pub mod check;
 pub mod ecp5;
 pub mod ecp5_bram;
+pub mod ecp5_carry;
 pub mod ecp5_dsp;
 pub mod frame;
 pub mod generate;
