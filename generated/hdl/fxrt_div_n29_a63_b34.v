@@ -33,889 +33,589 @@ module fxrt_div_n29_a63_b34 (
   // stage s2_q0: one quotient bit
   wire [32:0] bits_s1_a;
   wire [29:0] lo;
-  wire [33:0] rs_bits_s1_a;
-  wire [34:0] rs_rs_bits_s1_a;
-  wire signed [34:0] s_rs_rs_bits_s1_a;
+  wire [34:0] rs_bits_s1_a;
   wire [34:0] rs_s1_b;
-  wire signed [34:0] s_rs_s1_b;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 34 are read
-  wire signed [34:0] minus_2;
+  wire [0:0] k_1 = 1'h1;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  wire [33:0] u_overflow_diff;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_minus_2;
+  wire [0:0] u_overflow_ge;
   wire [0:0] overflow;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] k_0_2 = 1'h0;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [33:0] k_0_3 = 34'h000000000;
-  /* verilator lint_on UNUSEDSIGNAL */
   wire [33:0] rs_bits_s1_a_1;
-  wire [29:0] k_0_4 = 30'h00000000;
+  wire [29:0] k_0_2 = 30'h00000000;
   wire [34:0] rs_s1_b_1;
   wire [0:0] bits_lo;
-  wire [34:0] rs_bits_lo;
-  wire [34:0] rs_rs_bits_s1_a_1;
-  wire [34:0] shl_rs_rs_bits_s1_a_1;
-  wire [34:0] or_3;
-  wire [35:0] rs_or_3;
-  wire signed [35:0] s_rs_or_3;
-  wire [35:0] rs_rs_s1_b_1;
-  wire signed [35:0] s_rs_rs_s1_b_1;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk0;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk0;
-  wire [0:0] bits_diffk0_1;
-  wire [0:0] gek0;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] k_1 = 1'h1;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] rs_gek0;
-  wire [29:0] quot0;
-  wire [33:0] rs_or_3_1;
+  wire [34:0] cat_2;
+  wire [33:0] u_step0_diff;
+  wire [0:0] u_step0_ge;
   wire [33:0] rem0;
-  reg [33:0] s2_p = 34'h000000000;
+  wire [0:0] ge0;
+  wire [29:0] rs_ge0;
+  wire [29:0] quot0;
+  reg [0:0] s2_ge = 1'h0;
+  reg [33:0] s2_r = 34'h000000000;
   reg [29:0] s2_q = 30'h00000000;
+  reg [0:0] s2_zero = 1'h0;
 
   // stage s3_q1: one quotient bit
   reg [33:0] s1_b_d1 = 34'h000000000;
   wire [34:0] rs_s1_b_d1;
   reg [29:0] lo_d1 = 30'h00000000;
   wire [0:0] bits_lo_d1;
-  wire [34:0] rs_bits_lo_d1;
-  wire [34:0] rs_s2_p;
-  wire [34:0] shl_rs_s2_p;
-  wire [34:0] or_5;
-  wire [35:0] rs_or_5;
-  wire signed [35:0] s_rs_or_5;
-  wire [35:0] rs_rs_s1_b_d1;
-  wire signed [35:0] s_rs_rs_s1_b_d1;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk1;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk1;
-  wire [0:0] bits_diffk1_1;
-  wire [0:0] gek1;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s2_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s2_q;
-  wire [29:0] rs_gek1;
-  wire [29:0] quot1;
-  wire [33:0] rs_or_5_1;
+  wire [34:0] cat_3;
+  wire [33:0] u_step1_diff;
+  wire [0:0] u_step1_ge;
   wire [33:0] rem1;
-  reg [33:0] s3_p = 34'h000000000;
+  wire [0:0] ge1;
+  wire [0:0] not_s2_ge;
+  wire [0:0] zero1;
+  wire [29:0] shl_s2_q;
+  wire [29:0] rs_ge1;
+  wire [29:0] quot1;
+  reg [0:0] s3_ge = 1'h0;
+  reg [33:0] s3_r = 34'h000000000;
   reg [29:0] s3_q = 30'h00000000;
+  reg [0:0] s3_zero = 1'h0;
 
   // stage s4_q2: one quotient bit
   reg [33:0] s1_b_d2 = 34'h000000000;
   wire [34:0] rs_s1_b_d2;
   reg [29:0] lo_d2 = 30'h00000000;
   wire [0:0] bits_lo_d2;
-  wire [34:0] rs_bits_lo_d2;
-  wire [34:0] rs_s3_p;
-  wire [34:0] shl_rs_s3_p;
-  wire [34:0] or_7;
-  wire [35:0] rs_or_7;
-  wire signed [35:0] s_rs_or_7;
-  wire [35:0] rs_rs_s1_b_d2;
-  wire signed [35:0] s_rs_rs_s1_b_d2;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk2;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk2;
-  wire [0:0] bits_diffk2_1;
-  wire [0:0] gek2;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s3_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s3_q;
-  wire [29:0] rs_gek2;
-  wire [29:0] quot2;
-  wire [33:0] rs_or_7_1;
+  wire [34:0] cat_4;
+  wire [33:0] u_step2_diff;
+  wire [0:0] u_step2_ge;
   wire [33:0] rem2;
-  reg [33:0] s4_p = 34'h000000000;
+  wire [0:0] ge2;
+  wire [0:0] not_s3_ge;
+  wire [0:0] zero2;
+  wire [29:0] shl_s3_q;
+  wire [29:0] rs_ge2;
+  wire [29:0] quot2;
+  reg [0:0] s4_ge = 1'h0;
+  reg [33:0] s4_r = 34'h000000000;
   reg [29:0] s4_q = 30'h00000000;
+  reg [0:0] s4_zero = 1'h0;
 
   // stage s5_q3: one quotient bit
   reg [33:0] s1_b_d3 = 34'h000000000;
   wire [34:0] rs_s1_b_d3;
   reg [29:0] lo_d3 = 30'h00000000;
   wire [0:0] bits_lo_d3;
-  wire [34:0] rs_bits_lo_d3;
-  wire [34:0] rs_s4_p;
-  wire [34:0] shl_rs_s4_p;
-  wire [34:0] or_9;
-  wire [35:0] rs_or_9;
-  wire signed [35:0] s_rs_or_9;
-  wire [35:0] rs_rs_s1_b_d3;
-  wire signed [35:0] s_rs_rs_s1_b_d3;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk3;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk3;
-  wire [0:0] bits_diffk3_1;
-  wire [0:0] gek3;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s4_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s4_q;
-  wire [29:0] rs_gek3;
-  wire [29:0] quot3;
-  wire [33:0] rs_or_9_1;
+  wire [34:0] cat_5;
+  wire [33:0] u_step3_diff;
+  wire [0:0] u_step3_ge;
   wire [33:0] rem3;
-  reg [33:0] s5_p = 34'h000000000;
+  wire [0:0] ge3;
+  wire [0:0] not_s4_ge;
+  wire [0:0] zero3;
+  wire [29:0] shl_s4_q;
+  wire [29:0] rs_ge3;
+  wire [29:0] quot3;
+  reg [0:0] s5_ge = 1'h0;
+  reg [33:0] s5_r = 34'h000000000;
   reg [29:0] s5_q = 30'h00000000;
+  reg [0:0] s5_zero = 1'h0;
 
   // stage s6_q4: one quotient bit
   reg [33:0] s1_b_d4 = 34'h000000000;
   wire [34:0] rs_s1_b_d4;
   reg [29:0] lo_d4 = 30'h00000000;
   wire [0:0] bits_lo_d4;
-  wire [34:0] rs_bits_lo_d4;
-  wire [34:0] rs_s5_p;
-  wire [34:0] shl_rs_s5_p;
-  wire [34:0] or_11;
-  wire [35:0] rs_or_11;
-  wire signed [35:0] s_rs_or_11;
-  wire [35:0] rs_rs_s1_b_d4;
-  wire signed [35:0] s_rs_rs_s1_b_d4;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk4;
-  wire [0:0] bits_diffk4_1;
-  wire [0:0] gek4;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s5_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s5_q;
-  wire [29:0] rs_gek4;
-  wire [29:0] quot4;
-  wire [33:0] rs_or_11_1;
+  wire [34:0] cat_6;
+  wire [33:0] u_step4_diff;
+  wire [0:0] u_step4_ge;
   wire [33:0] rem4;
-  reg [33:0] s6_p = 34'h000000000;
+  wire [0:0] ge4;
+  wire [0:0] not_s5_ge;
+  wire [0:0] zero4;
+  wire [29:0] shl_s5_q;
+  wire [29:0] rs_ge4;
+  wire [29:0] quot4;
+  reg [0:0] s6_ge = 1'h0;
+  reg [33:0] s6_r = 34'h000000000;
   reg [29:0] s6_q = 30'h00000000;
+  reg [0:0] s6_zero = 1'h0;
 
   // stage s7_q5: one quotient bit
   reg [33:0] s1_b_d5 = 34'h000000000;
   wire [34:0] rs_s1_b_d5;
   reg [29:0] lo_d5 = 30'h00000000;
   wire [0:0] bits_lo_d5;
-  wire [34:0] rs_bits_lo_d5;
-  wire [34:0] rs_s6_p;
-  wire [34:0] shl_rs_s6_p;
-  wire [34:0] or_13;
-  wire [35:0] rs_or_13;
-  wire signed [35:0] s_rs_or_13;
-  wire [35:0] rs_rs_s1_b_d5;
-  wire signed [35:0] s_rs_rs_s1_b_d5;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk5;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk5;
-  wire [0:0] bits_diffk5_1;
-  wire [0:0] gek5;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s6_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s6_q;
-  wire [29:0] rs_gek5;
-  wire [29:0] quot5;
-  wire [33:0] rs_or_13_1;
+  wire [34:0] cat_7;
+  wire [33:0] u_step5_diff;
+  wire [0:0] u_step5_ge;
   wire [33:0] rem5;
-  reg [33:0] s7_p = 34'h000000000;
+  wire [0:0] ge5;
+  wire [0:0] not_s6_ge;
+  wire [0:0] zero5;
+  wire [29:0] shl_s6_q;
+  wire [29:0] rs_ge5;
+  wire [29:0] quot5;
+  reg [0:0] s7_ge = 1'h0;
+  reg [33:0] s7_r = 34'h000000000;
   reg [29:0] s7_q = 30'h00000000;
+  reg [0:0] s7_zero = 1'h0;
 
   // stage s8_q6: one quotient bit
   reg [33:0] s1_b_d6 = 34'h000000000;
   wire [34:0] rs_s1_b_d6;
   reg [29:0] lo_d6 = 30'h00000000;
   wire [0:0] bits_lo_d6;
-  wire [34:0] rs_bits_lo_d6;
-  wire [34:0] rs_s7_p;
-  wire [34:0] shl_rs_s7_p;
-  wire [34:0] or_15;
-  wire [35:0] rs_or_15;
-  wire signed [35:0] s_rs_or_15;
-  wire [35:0] rs_rs_s1_b_d6;
-  wire signed [35:0] s_rs_rs_s1_b_d6;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk6;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk6;
-  wire [0:0] bits_diffk6_1;
-  wire [0:0] gek6;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s7_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s7_q;
-  wire [29:0] rs_gek6;
-  wire [29:0] quot6;
-  wire [33:0] rs_or_15_1;
+  wire [34:0] cat_8;
+  wire [33:0] u_step6_diff;
+  wire [0:0] u_step6_ge;
   wire [33:0] rem6;
-  reg [33:0] s8_p = 34'h000000000;
+  wire [0:0] ge6;
+  wire [0:0] not_s7_ge;
+  wire [0:0] zero6;
+  wire [29:0] shl_s7_q;
+  wire [29:0] rs_ge6;
+  wire [29:0] quot6;
+  reg [0:0] s8_ge = 1'h0;
+  reg [33:0] s8_r = 34'h000000000;
   reg [29:0] s8_q = 30'h00000000;
+  reg [0:0] s8_zero = 1'h0;
 
   // stage s9_q7: one quotient bit
   reg [33:0] s1_b_d7 = 34'h000000000;
   wire [34:0] rs_s1_b_d7;
   reg [29:0] lo_d7 = 30'h00000000;
   wire [0:0] bits_lo_d7;
-  wire [34:0] rs_bits_lo_d7;
-  wire [34:0] rs_s8_p;
-  wire [34:0] shl_rs_s8_p;
-  wire [34:0] or_17;
-  wire [35:0] rs_or_17;
-  wire signed [35:0] s_rs_or_17;
-  wire [35:0] rs_rs_s1_b_d7;
-  wire signed [35:0] s_rs_rs_s1_b_d7;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk7;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk7;
-  wire [0:0] bits_diffk7_1;
-  wire [0:0] gek7;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s8_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s8_q;
-  wire [29:0] rs_gek7;
-  wire [29:0] quot7;
-  wire [33:0] rs_or_17_1;
+  wire [34:0] cat_9;
+  wire [33:0] u_step7_diff;
+  wire [0:0] u_step7_ge;
   wire [33:0] rem7;
-  reg [33:0] s9_p = 34'h000000000;
+  wire [0:0] ge7;
+  wire [0:0] not_s8_ge;
+  wire [0:0] zero7;
+  wire [29:0] shl_s8_q;
+  wire [29:0] rs_ge7;
+  wire [29:0] quot7;
+  reg [0:0] s9_ge = 1'h0;
+  reg [33:0] s9_r = 34'h000000000;
   reg [29:0] s9_q = 30'h00000000;
+  reg [0:0] s9_zero = 1'h0;
 
   // stage s10_q8: one quotient bit
   reg [33:0] s1_b_d8 = 34'h000000000;
   wire [34:0] rs_s1_b_d8;
   reg [29:0] lo_d8 = 30'h00000000;
   wire [0:0] bits_lo_d8;
-  wire [34:0] rs_bits_lo_d8;
-  wire [34:0] rs_s9_p;
-  wire [34:0] shl_rs_s9_p;
-  wire [34:0] or_19;
-  wire [35:0] rs_or_19;
-  wire signed [35:0] s_rs_or_19;
-  wire [35:0] rs_rs_s1_b_d8;
-  wire signed [35:0] s_rs_rs_s1_b_d8;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk8;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk8;
-  wire [0:0] bits_diffk8_1;
-  wire [0:0] gek8;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s9_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s9_q;
-  wire [29:0] rs_gek8;
-  wire [29:0] quot8;
-  wire [33:0] rs_or_19_1;
+  wire [34:0] cat_10;
+  wire [33:0] u_step8_diff;
+  wire [0:0] u_step8_ge;
   wire [33:0] rem8;
-  reg [33:0] s10_p = 34'h000000000;
+  wire [0:0] ge8;
+  wire [0:0] not_s9_ge;
+  wire [0:0] zero8;
+  wire [29:0] shl_s9_q;
+  wire [29:0] rs_ge8;
+  wire [29:0] quot8;
+  reg [0:0] s10_ge = 1'h0;
+  reg [33:0] s10_r = 34'h000000000;
   reg [29:0] s10_q = 30'h00000000;
+  reg [0:0] s10_zero = 1'h0;
 
   // stage s11_q9: one quotient bit
   reg [33:0] s1_b_d9 = 34'h000000000;
   wire [34:0] rs_s1_b_d9;
   reg [29:0] lo_d9 = 30'h00000000;
   wire [0:0] bits_lo_d9;
-  wire [34:0] rs_bits_lo_d9;
-  wire [34:0] rs_s10_p;
-  wire [34:0] shl_rs_s10_p;
-  wire [34:0] or_21;
-  wire [35:0] rs_or_21;
-  wire signed [35:0] s_rs_or_21;
-  wire [35:0] rs_rs_s1_b_d9;
-  wire signed [35:0] s_rs_rs_s1_b_d9;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk9;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk9;
-  wire [0:0] bits_diffk9_1;
-  wire [0:0] gek9;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s10_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s10_q;
-  wire [29:0] rs_gek9;
-  wire [29:0] quot9;
-  wire [33:0] rs_or_21_1;
+  wire [34:0] cat_11;
+  wire [33:0] u_step9_diff;
+  wire [0:0] u_step9_ge;
   wire [33:0] rem9;
-  reg [33:0] s11_p = 34'h000000000;
+  wire [0:0] ge9;
+  wire [0:0] not_s10_ge;
+  wire [0:0] zero9;
+  wire [29:0] shl_s10_q;
+  wire [29:0] rs_ge9;
+  wire [29:0] quot9;
+  reg [0:0] s11_ge = 1'h0;
+  reg [33:0] s11_r = 34'h000000000;
   reg [29:0] s11_q = 30'h00000000;
+  reg [0:0] s11_zero = 1'h0;
 
   // stage s12_q10: one quotient bit
   reg [33:0] s1_b_d10 = 34'h000000000;
   wire [34:0] rs_s1_b_d10;
   reg [29:0] lo_d10 = 30'h00000000;
   wire [0:0] bits_lo_d10;
-  wire [34:0] rs_bits_lo_d10;
-  wire [34:0] rs_s11_p;
-  wire [34:0] shl_rs_s11_p;
-  wire [34:0] or_23;
-  wire [35:0] rs_or_23;
-  wire signed [35:0] s_rs_or_23;
-  wire [35:0] rs_rs_s1_b_d10;
-  wire signed [35:0] s_rs_rs_s1_b_d10;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk10;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk10;
-  wire [0:0] bits_diffk10_1;
-  wire [0:0] gek10;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s11_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s11_q;
-  wire [29:0] rs_gek10;
-  wire [29:0] quot10;
-  wire [33:0] rs_or_23_1;
+  wire [34:0] cat_12;
+  wire [33:0] u_step10_diff;
+  wire [0:0] u_step10_ge;
   wire [33:0] rem10;
-  reg [33:0] s12_p = 34'h000000000;
+  wire [0:0] ge10;
+  wire [0:0] not_s11_ge;
+  wire [0:0] zero10;
+  wire [29:0] shl_s11_q;
+  wire [29:0] rs_ge10;
+  wire [29:0] quot10;
+  reg [0:0] s12_ge = 1'h0;
+  reg [33:0] s12_r = 34'h000000000;
   reg [29:0] s12_q = 30'h00000000;
+  reg [0:0] s12_zero = 1'h0;
 
   // stage s13_q11: one quotient bit
   reg [33:0] s1_b_d11 = 34'h000000000;
   wire [34:0] rs_s1_b_d11;
   reg [29:0] lo_d11 = 30'h00000000;
   wire [0:0] bits_lo_d11;
-  wire [34:0] rs_bits_lo_d11;
-  wire [34:0] rs_s12_p;
-  wire [34:0] shl_rs_s12_p;
-  wire [34:0] or_25;
-  wire [35:0] rs_or_25;
-  wire signed [35:0] s_rs_or_25;
-  wire [35:0] rs_rs_s1_b_d11;
-  wire signed [35:0] s_rs_rs_s1_b_d11;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk11;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk11;
-  wire [0:0] bits_diffk11_1;
-  wire [0:0] gek11;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s12_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s12_q;
-  wire [29:0] rs_gek11;
-  wire [29:0] quot11;
-  wire [33:0] rs_or_25_1;
+  wire [34:0] cat_13;
+  wire [33:0] u_step11_diff;
+  wire [0:0] u_step11_ge;
   wire [33:0] rem11;
-  reg [33:0] s13_p = 34'h000000000;
+  wire [0:0] ge11;
+  wire [0:0] not_s12_ge;
+  wire [0:0] zero11;
+  wire [29:0] shl_s12_q;
+  wire [29:0] rs_ge11;
+  wire [29:0] quot11;
+  reg [0:0] s13_ge = 1'h0;
+  reg [33:0] s13_r = 34'h000000000;
   reg [29:0] s13_q = 30'h00000000;
+  reg [0:0] s13_zero = 1'h0;
 
   // stage s14_q12: one quotient bit
   reg [33:0] s1_b_d12 = 34'h000000000;
   wire [34:0] rs_s1_b_d12;
   reg [29:0] lo_d12 = 30'h00000000;
   wire [0:0] bits_lo_d12;
-  wire [34:0] rs_bits_lo_d12;
-  wire [34:0] rs_s13_p;
-  wire [34:0] shl_rs_s13_p;
-  wire [34:0] or_27;
-  wire [35:0] rs_or_27;
-  wire signed [35:0] s_rs_or_27;
-  wire [35:0] rs_rs_s1_b_d12;
-  wire signed [35:0] s_rs_rs_s1_b_d12;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk12;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk12;
-  wire [0:0] bits_diffk12_1;
-  wire [0:0] gek12;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s13_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s13_q;
-  wire [29:0] rs_gek12;
-  wire [29:0] quot12;
-  wire [33:0] rs_or_27_1;
+  wire [34:0] cat_14;
+  wire [33:0] u_step12_diff;
+  wire [0:0] u_step12_ge;
   wire [33:0] rem12;
-  reg [33:0] s14_p = 34'h000000000;
+  wire [0:0] ge12;
+  wire [0:0] not_s13_ge;
+  wire [0:0] zero12;
+  wire [29:0] shl_s13_q;
+  wire [29:0] rs_ge12;
+  wire [29:0] quot12;
+  reg [0:0] s14_ge = 1'h0;
+  reg [33:0] s14_r = 34'h000000000;
   reg [29:0] s14_q = 30'h00000000;
+  reg [0:0] s14_zero = 1'h0;
 
   // stage s15_q13: one quotient bit
   reg [33:0] s1_b_d13 = 34'h000000000;
   wire [34:0] rs_s1_b_d13;
   reg [29:0] lo_d13 = 30'h00000000;
   wire [0:0] bits_lo_d13;
-  wire [34:0] rs_bits_lo_d13;
-  wire [34:0] rs_s14_p;
-  wire [34:0] shl_rs_s14_p;
-  wire [34:0] or_29;
-  wire [35:0] rs_or_29;
-  wire signed [35:0] s_rs_or_29;
-  wire [35:0] rs_rs_s1_b_d13;
-  wire signed [35:0] s_rs_rs_s1_b_d13;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk13;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk13;
-  wire [0:0] bits_diffk13_1;
-  wire [0:0] gek13;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s14_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s14_q;
-  wire [29:0] rs_gek13;
-  wire [29:0] quot13;
-  wire [33:0] rs_or_29_1;
+  wire [34:0] cat_15;
+  wire [33:0] u_step13_diff;
+  wire [0:0] u_step13_ge;
   wire [33:0] rem13;
-  reg [33:0] s15_p = 34'h000000000;
+  wire [0:0] ge13;
+  wire [0:0] not_s14_ge;
+  wire [0:0] zero13;
+  wire [29:0] shl_s14_q;
+  wire [29:0] rs_ge13;
+  wire [29:0] quot13;
+  reg [0:0] s15_ge = 1'h0;
+  reg [33:0] s15_r = 34'h000000000;
   reg [29:0] s15_q = 30'h00000000;
+  reg [0:0] s15_zero = 1'h0;
 
   // stage s16_q14: one quotient bit
   reg [33:0] s1_b_d14 = 34'h000000000;
   wire [34:0] rs_s1_b_d14;
   reg [29:0] lo_d14 = 30'h00000000;
   wire [0:0] bits_lo_d14;
-  wire [34:0] rs_bits_lo_d14;
-  wire [34:0] rs_s15_p;
-  wire [34:0] shl_rs_s15_p;
-  wire [34:0] or_31;
-  wire [35:0] rs_or_31;
-  wire signed [35:0] s_rs_or_31;
-  wire [35:0] rs_rs_s1_b_d14;
-  wire signed [35:0] s_rs_rs_s1_b_d14;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk14;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk14;
-  wire [0:0] bits_diffk14_1;
-  wire [0:0] gek14;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s15_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s15_q;
-  wire [29:0] rs_gek14;
-  wire [29:0] quot14;
-  wire [33:0] rs_or_31_1;
+  wire [34:0] cat_16;
+  wire [33:0] u_step14_diff;
+  wire [0:0] u_step14_ge;
   wire [33:0] rem14;
-  reg [33:0] s16_p = 34'h000000000;
+  wire [0:0] ge14;
+  wire [0:0] not_s15_ge;
+  wire [0:0] zero14;
+  wire [29:0] shl_s15_q;
+  wire [29:0] rs_ge14;
+  wire [29:0] quot14;
+  reg [0:0] s16_ge = 1'h0;
+  reg [33:0] s16_r = 34'h000000000;
   reg [29:0] s16_q = 30'h00000000;
+  reg [0:0] s16_zero = 1'h0;
 
   // stage s17_q15: one quotient bit
   reg [33:0] s1_b_d15 = 34'h000000000;
   wire [34:0] rs_s1_b_d15;
   reg [29:0] lo_d15 = 30'h00000000;
   wire [0:0] bits_lo_d15;
-  wire [34:0] rs_bits_lo_d15;
-  wire [34:0] rs_s16_p;
-  wire [34:0] shl_rs_s16_p;
-  wire [34:0] or_33;
-  wire [35:0] rs_or_33;
-  wire signed [35:0] s_rs_or_33;
-  wire [35:0] rs_rs_s1_b_d15;
-  wire signed [35:0] s_rs_rs_s1_b_d15;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk15;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk15;
-  wire [0:0] bits_diffk15_1;
-  wire [0:0] gek15;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s16_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s16_q;
-  wire [29:0] rs_gek15;
-  wire [29:0] quot15;
-  wire [33:0] rs_or_33_1;
+  wire [34:0] cat_17;
+  wire [33:0] u_step15_diff;
+  wire [0:0] u_step15_ge;
   wire [33:0] rem15;
-  reg [33:0] s17_p = 34'h000000000;
+  wire [0:0] ge15;
+  wire [0:0] not_s16_ge;
+  wire [0:0] zero15;
+  wire [29:0] shl_s16_q;
+  wire [29:0] rs_ge15;
+  wire [29:0] quot15;
+  reg [0:0] s17_ge = 1'h0;
+  reg [33:0] s17_r = 34'h000000000;
   reg [29:0] s17_q = 30'h00000000;
+  reg [0:0] s17_zero = 1'h0;
 
   // stage s18_q16: one quotient bit
   reg [33:0] s1_b_d16 = 34'h000000000;
   wire [34:0] rs_s1_b_d16;
   reg [29:0] lo_d16 = 30'h00000000;
   wire [0:0] bits_lo_d16;
-  wire [34:0] rs_bits_lo_d16;
-  wire [34:0] rs_s17_p;
-  wire [34:0] shl_rs_s17_p;
-  wire [34:0] or_35;
-  wire [35:0] rs_or_35;
-  wire signed [35:0] s_rs_or_35;
-  wire [35:0] rs_rs_s1_b_d16;
-  wire signed [35:0] s_rs_rs_s1_b_d16;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk16;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk16;
-  wire [0:0] bits_diffk16_1;
-  wire [0:0] gek16;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s17_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s17_q;
-  wire [29:0] rs_gek16;
-  wire [29:0] quot16;
-  wire [33:0] rs_or_35_1;
+  wire [34:0] cat_18;
+  wire [33:0] u_step16_diff;
+  wire [0:0] u_step16_ge;
   wire [33:0] rem16;
-  reg [33:0] s18_p = 34'h000000000;
+  wire [0:0] ge16;
+  wire [0:0] not_s17_ge;
+  wire [0:0] zero16;
+  wire [29:0] shl_s17_q;
+  wire [29:0] rs_ge16;
+  wire [29:0] quot16;
+  reg [0:0] s18_ge = 1'h0;
+  reg [33:0] s18_r = 34'h000000000;
   reg [29:0] s18_q = 30'h00000000;
+  reg [0:0] s18_zero = 1'h0;
 
   // stage s19_q17: one quotient bit
   reg [33:0] s1_b_d17 = 34'h000000000;
   wire [34:0] rs_s1_b_d17;
   reg [29:0] lo_d17 = 30'h00000000;
   wire [0:0] bits_lo_d17;
-  wire [34:0] rs_bits_lo_d17;
-  wire [34:0] rs_s18_p;
-  wire [34:0] shl_rs_s18_p;
-  wire [34:0] or_37;
-  wire [35:0] rs_or_37;
-  wire signed [35:0] s_rs_or_37;
-  wire [35:0] rs_rs_s1_b_d17;
-  wire signed [35:0] s_rs_rs_s1_b_d17;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk17;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk17;
-  wire [0:0] bits_diffk17_1;
-  wire [0:0] gek17;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s18_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s18_q;
-  wire [29:0] rs_gek17;
-  wire [29:0] quot17;
-  wire [33:0] rs_or_37_1;
+  wire [34:0] cat_19;
+  wire [33:0] u_step17_diff;
+  wire [0:0] u_step17_ge;
   wire [33:0] rem17;
-  reg [33:0] s19_p = 34'h000000000;
+  wire [0:0] ge17;
+  wire [0:0] not_s18_ge;
+  wire [0:0] zero17;
+  wire [29:0] shl_s18_q;
+  wire [29:0] rs_ge17;
+  wire [29:0] quot17;
+  reg [0:0] s19_ge = 1'h0;
+  reg [33:0] s19_r = 34'h000000000;
   reg [29:0] s19_q = 30'h00000000;
+  reg [0:0] s19_zero = 1'h0;
 
   // stage s20_q18: one quotient bit
   reg [33:0] s1_b_d18 = 34'h000000000;
   wire [34:0] rs_s1_b_d18;
   reg [29:0] lo_d18 = 30'h00000000;
   wire [0:0] bits_lo_d18;
-  wire [34:0] rs_bits_lo_d18;
-  wire [34:0] rs_s19_p;
-  wire [34:0] shl_rs_s19_p;
-  wire [34:0] or_39;
-  wire [35:0] rs_or_39;
-  wire signed [35:0] s_rs_or_39;
-  wire [35:0] rs_rs_s1_b_d18;
-  wire signed [35:0] s_rs_rs_s1_b_d18;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk18;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk18;
-  wire [0:0] bits_diffk18_1;
-  wire [0:0] gek18;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s19_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s19_q;
-  wire [29:0] rs_gek18;
-  wire [29:0] quot18;
-  wire [33:0] rs_or_39_1;
+  wire [34:0] cat_20;
+  wire [33:0] u_step18_diff;
+  wire [0:0] u_step18_ge;
   wire [33:0] rem18;
-  reg [33:0] s20_p = 34'h000000000;
+  wire [0:0] ge18;
+  wire [0:0] not_s19_ge;
+  wire [0:0] zero18;
+  wire [29:0] shl_s19_q;
+  wire [29:0] rs_ge18;
+  wire [29:0] quot18;
+  reg [0:0] s20_ge = 1'h0;
+  reg [33:0] s20_r = 34'h000000000;
   reg [29:0] s20_q = 30'h00000000;
+  reg [0:0] s20_zero = 1'h0;
 
   // stage s21_q19: one quotient bit
   reg [33:0] s1_b_d19 = 34'h000000000;
   wire [34:0] rs_s1_b_d19;
   reg [29:0] lo_d19 = 30'h00000000;
   wire [0:0] bits_lo_d19;
-  wire [34:0] rs_bits_lo_d19;
-  wire [34:0] rs_s20_p;
-  wire [34:0] shl_rs_s20_p;
-  wire [34:0] or_41;
-  wire [35:0] rs_or_41;
-  wire signed [35:0] s_rs_or_41;
-  wire [35:0] rs_rs_s1_b_d19;
-  wire signed [35:0] s_rs_rs_s1_b_d19;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk19;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk19;
-  wire [0:0] bits_diffk19_1;
-  wire [0:0] gek19;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s20_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s20_q;
-  wire [29:0] rs_gek19;
-  wire [29:0] quot19;
-  wire [33:0] rs_or_41_1;
+  wire [34:0] cat_21;
+  wire [33:0] u_step19_diff;
+  wire [0:0] u_step19_ge;
   wire [33:0] rem19;
-  reg [33:0] s21_p = 34'h000000000;
+  wire [0:0] ge19;
+  wire [0:0] not_s20_ge;
+  wire [0:0] zero19;
+  wire [29:0] shl_s20_q;
+  wire [29:0] rs_ge19;
+  wire [29:0] quot19;
+  reg [0:0] s21_ge = 1'h0;
+  reg [33:0] s21_r = 34'h000000000;
   reg [29:0] s21_q = 30'h00000000;
+  reg [0:0] s21_zero = 1'h0;
 
   // stage s22_q20: one quotient bit
   reg [33:0] s1_b_d20 = 34'h000000000;
   wire [34:0] rs_s1_b_d20;
   reg [29:0] lo_d20 = 30'h00000000;
   wire [0:0] bits_lo_d20;
-  wire [34:0] rs_bits_lo_d20;
-  wire [34:0] rs_s21_p;
-  wire [34:0] shl_rs_s21_p;
-  wire [34:0] or_43;
-  wire [35:0] rs_or_43;
-  wire signed [35:0] s_rs_or_43;
-  wire [35:0] rs_rs_s1_b_d20;
-  wire signed [35:0] s_rs_rs_s1_b_d20;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk20;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk20;
-  wire [0:0] bits_diffk20_1;
-  wire [0:0] gek20;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s21_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s21_q;
-  wire [29:0] rs_gek20;
-  wire [29:0] quot20;
-  wire [33:0] rs_or_43_1;
+  wire [34:0] cat_22;
+  wire [33:0] u_step20_diff;
+  wire [0:0] u_step20_ge;
   wire [33:0] rem20;
-  reg [33:0] s22_p = 34'h000000000;
+  wire [0:0] ge20;
+  wire [0:0] not_s21_ge;
+  wire [0:0] zero20;
+  wire [29:0] shl_s21_q;
+  wire [29:0] rs_ge20;
+  wire [29:0] quot20;
+  reg [0:0] s22_ge = 1'h0;
+  reg [33:0] s22_r = 34'h000000000;
   reg [29:0] s22_q = 30'h00000000;
+  reg [0:0] s22_zero = 1'h0;
 
   // stage s23_q21: one quotient bit
   reg [33:0] s1_b_d21 = 34'h000000000;
   wire [34:0] rs_s1_b_d21;
   reg [29:0] lo_d21 = 30'h00000000;
   wire [0:0] bits_lo_d21;
-  wire [34:0] rs_bits_lo_d21;
-  wire [34:0] rs_s22_p;
-  wire [34:0] shl_rs_s22_p;
-  wire [34:0] or_45;
-  wire [35:0] rs_or_45;
-  wire signed [35:0] s_rs_or_45;
-  wire [35:0] rs_rs_s1_b_d21;
-  wire signed [35:0] s_rs_rs_s1_b_d21;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk21;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk21;
-  wire [0:0] bits_diffk21_1;
-  wire [0:0] gek21;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s22_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s22_q;
-  wire [29:0] rs_gek21;
-  wire [29:0] quot21;
-  wire [33:0] rs_or_45_1;
+  wire [34:0] cat_23;
+  wire [33:0] u_step21_diff;
+  wire [0:0] u_step21_ge;
   wire [33:0] rem21;
-  reg [33:0] s23_p = 34'h000000000;
+  wire [0:0] ge21;
+  wire [0:0] not_s22_ge;
+  wire [0:0] zero21;
+  wire [29:0] shl_s22_q;
+  wire [29:0] rs_ge21;
+  wire [29:0] quot21;
+  reg [0:0] s23_ge = 1'h0;
+  reg [33:0] s23_r = 34'h000000000;
   reg [29:0] s23_q = 30'h00000000;
+  reg [0:0] s23_zero = 1'h0;
 
   // stage s24_q22: one quotient bit
   reg [33:0] s1_b_d22 = 34'h000000000;
   wire [34:0] rs_s1_b_d22;
   reg [29:0] lo_d22 = 30'h00000000;
   wire [0:0] bits_lo_d22;
-  wire [34:0] rs_bits_lo_d22;
-  wire [34:0] rs_s23_p;
-  wire [34:0] shl_rs_s23_p;
-  wire [34:0] or_47;
-  wire [35:0] rs_or_47;
-  wire signed [35:0] s_rs_or_47;
-  wire [35:0] rs_rs_s1_b_d22;
-  wire signed [35:0] s_rs_rs_s1_b_d22;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk22;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk22;
-  wire [0:0] bits_diffk22_1;
-  wire [0:0] gek22;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s23_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s23_q;
-  wire [29:0] rs_gek22;
-  wire [29:0] quot22;
-  wire [33:0] rs_or_47_1;
+  wire [34:0] cat_24;
+  wire [33:0] u_step22_diff;
+  wire [0:0] u_step22_ge;
   wire [33:0] rem22;
-  reg [33:0] s24_p = 34'h000000000;
+  wire [0:0] ge22;
+  wire [0:0] not_s23_ge;
+  wire [0:0] zero22;
+  wire [29:0] shl_s23_q;
+  wire [29:0] rs_ge22;
+  wire [29:0] quot22;
+  reg [0:0] s24_ge = 1'h0;
+  reg [33:0] s24_r = 34'h000000000;
   reg [29:0] s24_q = 30'h00000000;
+  reg [0:0] s24_zero = 1'h0;
 
   // stage s25_q23: one quotient bit
   reg [33:0] s1_b_d23 = 34'h000000000;
   wire [34:0] rs_s1_b_d23;
   reg [29:0] lo_d23 = 30'h00000000;
   wire [0:0] bits_lo_d23;
-  wire [34:0] rs_bits_lo_d23;
-  wire [34:0] rs_s24_p;
-  wire [34:0] shl_rs_s24_p;
-  wire [34:0] or_49;
-  wire [35:0] rs_or_49;
-  wire signed [35:0] s_rs_or_49;
-  wire [35:0] rs_rs_s1_b_d23;
-  wire signed [35:0] s_rs_rs_s1_b_d23;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk23;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk23;
-  wire [0:0] bits_diffk23_1;
-  wire [0:0] gek23;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s24_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s24_q;
-  wire [29:0] rs_gek23;
-  wire [29:0] quot23;
-  wire [33:0] rs_or_49_1;
+  wire [34:0] cat_25;
+  wire [33:0] u_step23_diff;
+  wire [0:0] u_step23_ge;
   wire [33:0] rem23;
-  reg [33:0] s25_p = 34'h000000000;
+  wire [0:0] ge23;
+  wire [0:0] not_s24_ge;
+  wire [0:0] zero23;
+  wire [29:0] shl_s24_q;
+  wire [29:0] rs_ge23;
+  wire [29:0] quot23;
+  reg [0:0] s25_ge = 1'h0;
+  reg [33:0] s25_r = 34'h000000000;
   reg [29:0] s25_q = 30'h00000000;
+  reg [0:0] s25_zero = 1'h0;
 
   // stage s26_q24: one quotient bit
   reg [33:0] s1_b_d24 = 34'h000000000;
   wire [34:0] rs_s1_b_d24;
   reg [29:0] lo_d24 = 30'h00000000;
   wire [0:0] bits_lo_d24;
-  wire [34:0] rs_bits_lo_d24;
-  wire [34:0] rs_s25_p;
-  wire [34:0] shl_rs_s25_p;
-  wire [34:0] or_51;
-  wire [35:0] rs_or_51;
-  wire signed [35:0] s_rs_or_51;
-  wire [35:0] rs_rs_s1_b_d24;
-  wire signed [35:0] s_rs_rs_s1_b_d24;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk24;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk24;
-  wire [0:0] bits_diffk24_1;
-  wire [0:0] gek24;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s25_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s25_q;
-  wire [29:0] rs_gek24;
-  wire [29:0] quot24;
-  wire [33:0] rs_or_51_1;
+  wire [34:0] cat_26;
+  wire [33:0] u_step24_diff;
+  wire [0:0] u_step24_ge;
   wire [33:0] rem24;
-  reg [33:0] s26_p = 34'h000000000;
+  wire [0:0] ge24;
+  wire [0:0] not_s25_ge;
+  wire [0:0] zero24;
+  wire [29:0] shl_s25_q;
+  wire [29:0] rs_ge24;
+  wire [29:0] quot24;
+  reg [0:0] s26_ge = 1'h0;
+  reg [33:0] s26_r = 34'h000000000;
   reg [29:0] s26_q = 30'h00000000;
+  reg [0:0] s26_zero = 1'h0;
 
   // stage s27_q25: one quotient bit
   reg [33:0] s1_b_d25 = 34'h000000000;
   wire [34:0] rs_s1_b_d25;
   reg [29:0] lo_d25 = 30'h00000000;
   wire [0:0] bits_lo_d25;
-  wire [34:0] rs_bits_lo_d25;
-  wire [34:0] rs_s26_p;
-  wire [34:0] shl_rs_s26_p;
-  wire [34:0] or_53;
-  wire [35:0] rs_or_53;
-  wire signed [35:0] s_rs_or_53;
-  wire [35:0] rs_rs_s1_b_d25;
-  wire signed [35:0] s_rs_rs_s1_b_d25;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk25;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk25;
-  wire [0:0] bits_diffk25_1;
-  wire [0:0] gek25;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s26_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s26_q;
-  wire [29:0] rs_gek25;
-  wire [29:0] quot25;
-  wire [33:0] rs_or_53_1;
+  wire [34:0] cat_27;
+  wire [33:0] u_step25_diff;
+  wire [0:0] u_step25_ge;
   wire [33:0] rem25;
-  reg [33:0] s27_p = 34'h000000000;
+  wire [0:0] ge25;
+  wire [0:0] not_s26_ge;
+  wire [0:0] zero25;
+  wire [29:0] shl_s26_q;
+  wire [29:0] rs_ge25;
+  wire [29:0] quot25;
+  reg [0:0] s27_ge = 1'h0;
+  reg [33:0] s27_r = 34'h000000000;
   reg [29:0] s27_q = 30'h00000000;
+  reg [0:0] s27_zero = 1'h0;
 
   // stage s28_q26: one quotient bit
   reg [33:0] s1_b_d26 = 34'h000000000;
   wire [34:0] rs_s1_b_d26;
   reg [29:0] lo_d26 = 30'h00000000;
   wire [0:0] bits_lo_d26;
-  wire [34:0] rs_bits_lo_d26;
-  wire [34:0] rs_s27_p;
-  wire [34:0] shl_rs_s27_p;
-  wire [34:0] or_55;
-  wire [35:0] rs_or_55;
-  wire signed [35:0] s_rs_or_55;
-  wire [35:0] rs_rs_s1_b_d26;
-  wire signed [35:0] s_rs_rs_s1_b_d26;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk26;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk26;
-  wire [0:0] bits_diffk26_1;
-  wire [0:0] gek26;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s27_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s27_q;
-  wire [29:0] rs_gek26;
-  wire [29:0] quot26;
-  wire [33:0] rs_or_55_1;
+  wire [34:0] cat_28;
+  wire [33:0] u_step26_diff;
+  wire [0:0] u_step26_ge;
   wire [33:0] rem26;
-  reg [33:0] s28_p = 34'h000000000;
+  wire [0:0] ge26;
+  wire [0:0] not_s27_ge;
+  wire [0:0] zero26;
+  wire [29:0] shl_s27_q;
+  wire [29:0] rs_ge26;
+  wire [29:0] quot26;
+  reg [0:0] s28_ge = 1'h0;
+  reg [33:0] s28_r = 34'h000000000;
   reg [29:0] s28_q = 30'h00000000;
+  reg [0:0] s28_zero = 1'h0;
 
   // stage s29_q27: one quotient bit
   reg [33:0] s1_b_d27 = 34'h000000000;
   wire [34:0] rs_s1_b_d27;
   reg [29:0] lo_d27 = 30'h00000000;
   wire [0:0] bits_lo_d27;
-  wire [34:0] rs_bits_lo_d27;
-  wire [34:0] rs_s28_p;
-  wire [34:0] shl_rs_s28_p;
-  wire [34:0] or_57;
-  wire [35:0] rs_or_57;
-  wire signed [35:0] s_rs_or_57;
-  wire [35:0] rs_rs_s1_b_d27;
-  wire signed [35:0] s_rs_rs_s1_b_d27;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk27;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk27;
-  wire [0:0] bits_diffk27_1;
-  wire [0:0] gek27;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s28_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s28_q;
-  wire [29:0] rs_gek27;
-  wire [29:0] quot27;
-  wire [33:0] rs_or_57_1;
+  wire [34:0] cat_29;
+  wire [33:0] u_step27_diff;
+  wire [0:0] u_step27_ge;
   wire [33:0] rem27;
-  reg [33:0] s29_p = 34'h000000000;
+  wire [0:0] ge27;
+  wire [0:0] not_s28_ge;
+  wire [0:0] zero27;
+  wire [29:0] shl_s28_q;
+  wire [29:0] rs_ge27;
+  wire [29:0] quot27;
+  reg [0:0] s29_ge = 1'h0;
+  reg [33:0] s29_r = 34'h000000000;
   reg [29:0] s29_q = 30'h00000000;
+  reg [0:0] s29_zero = 1'h0;
 
   // stage s30_q28: one quotient bit
   reg [33:0] s1_b_d28 = 34'h000000000;
   wire [34:0] rs_s1_b_d28;
   reg [29:0] lo_d28 = 30'h00000000;
   wire [0:0] bits_lo_d28;
-  wire [34:0] rs_bits_lo_d28;
-  wire [34:0] rs_s29_p;
-  wire [34:0] shl_rs_s29_p;
-  wire [34:0] or_59;
-  wire [35:0] rs_or_59;
-  wire signed [35:0] s_rs_or_59;
-  wire [35:0] rs_rs_s1_b_d28;
-  wire signed [35:0] s_rs_rs_s1_b_d28;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk28;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [33:0] bits_diffk28;
-  wire [0:0] bits_diffk28_1;
-  wire [0:0] gek28;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] s29_q_eq_k_0_4;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [29:0] shl_s29_q;
-  wire [29:0] rs_gek28;
-  wire [29:0] quot28;
-  wire [33:0] rs_or_59_1;
+  wire [34:0] cat_30;
+  wire [33:0] u_step28_diff;
+  wire [0:0] u_step28_ge;
   wire [33:0] rem28;
-  reg [33:0] s30_p = 34'h000000000;
+  wire [0:0] ge28;
+  wire [0:0] not_s29_ge;
+  wire [0:0] zero28;
+  wire [29:0] shl_s29_q;
+  wire [29:0] rs_ge28;
+  wire [29:0] quot28;
+  reg [0:0] s30_ge = 1'h0;
+  reg [33:0] s30_r = 34'h000000000;
   reg [29:0] s30_q = 30'h00000000;
+  reg [0:0] s30_zero = 1'h0;
 
   // stage s31_result: the quotient and its result flag
   reg [33:0] s1_b_d29 = 34'h000000000;
@@ -924,25 +624,17 @@ module fxrt_div_n29_a63_b34 (
   reg [29:0] lo_d29 = 30'h00000000;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_lo_d29;
-  wire [34:0] rs_bits_lo_d29;
-  wire [34:0] rs_s30_p;
-  wire [34:0] shl_rs_s30_p;
-  wire [34:0] or_61;
-  wire [35:0] rs_or_61;
-  wire signed [35:0] s_rs_or_61;
-  wire [35:0] rs_rs_s1_b_d29;
-  wire signed [35:0] s_rs_rs_s1_b_d29;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 35, 33:0 are read
-  wire signed [35:0] diffk29;
-  /* verilator lint_on UNUSEDSIGNAL */
+  wire [34:0] cat_31;
+  wire [33:0] u_step29_diff;
+  wire [0:0] u_step29_ge;
   /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [33:0] bits_diffk29;
+  wire [33:0] rem29;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_diffk29_1;
-  wire [0:0] gek29;
-  wire [0:0] s30_q_eq_k_0_4;
+  wire [0:0] ge29;
+  wire [0:0] not_s30_ge;
+  wire [0:0] zero29;
   wire [29:0] shl_s30_q;
-  wire [29:0] rs_gek29;
+  wire [29:0] rs_ge29;
   wire [29:0] quot29;
   (* mem2reg *) reg [0:0] s1_err_d29_sr [1:29];
   integer s1_err_d29_i;
@@ -952,11 +644,11 @@ module fxrt_div_n29_a63_b34 (
   integer overflow_d29_i;
   initial for (overflow_d29_i = 1; overflow_d29_i <= 29; overflow_d29_i = overflow_d29_i + 1) overflow_d29_sr[overflow_d29_i] = 1'h0;
   wire [0:0] overflow_d29;
-  wire [0:0] or_63;
-  wire [0:0] not_gek29;
-  wire [0:0] and_64;
-  wire [0:0] or_63_or_and_64;
-  wire [0:0] not_or_63_or_and_64;
+  wire [0:0] or_32;
+  wire [0:0] not_ge29;
+  wire [0:0] zero29_and_not_ge29;
+  wire [0:0] or_33;
+  wire [0:0] not_or_33;
   reg [29:0] s31_t = 30'h00000000;
   reg [0:0] s31_ok = 1'h0;
 
@@ -986,877 +678,631 @@ module fxrt_div_n29_a63_b34 (
   // stage s2_q0: one quotient bit
   assign bits_s1_a = s1_a[62:30];
   assign lo = s1_a[29:0];
-  assign rs_bits_s1_a = {{1{1'b0}}, bits_s1_a};
-  assign rs_rs_bits_s1_a = {{1{1'b0}}, rs_bits_s1_a};
-  assign s_rs_rs_bits_s1_a = $signed(rs_rs_bits_s1_a);
+  assign rs_bits_s1_a = {{2{1'b0}}, bits_s1_a};
   assign rs_s1_b = {{1{1'b0}}, s1_b};
-  assign s_rs_s1_b = $signed(rs_s1_b);
-  assign minus_2 = s_rs_rs_bits_s1_a - s_rs_s1_b;
-  assign bits_minus_2 = minus_2[34];
-  assign overflow = ~bits_minus_2;
+  assign overflow = u_overflow_ge;
   assign rs_bits_s1_a_1 = {{1{1'b0}}, bits_s1_a};
   assign rs_s1_b_1 = {{1{1'b0}}, s1_b};
   assign bits_lo = lo[29];
-  assign rs_bits_lo = {{34{1'b0}}, bits_lo};
-  assign rs_rs_bits_s1_a_1 = {{1{1'b0}}, rs_bits_s1_a_1};
-  assign shl_rs_rs_bits_s1_a_1 = rs_rs_bits_s1_a_1 <<< 1;
-  assign or_3 = shl_rs_rs_bits_s1_a_1 | rs_bits_lo;
-  assign rs_or_3 = {{1{1'b0}}, or_3};
-  assign s_rs_or_3 = $signed(rs_or_3);
-  assign rs_rs_s1_b_1 = {{1{1'b0}}, rs_s1_b_1};
-  assign s_rs_rs_s1_b_1 = $signed(rs_rs_s1_b_1);
-  assign diffk0 = s_rs_or_3 - s_rs_rs_s1_b_1;
-  assign bits_diffk0 = diffk0[33:0];
-  assign bits_diffk0_1 = diffk0[35];
-  assign gek0 = ~bits_diffk0_1;
-  assign rs_gek0 = {{29{1'b0}}, gek0};
-  assign quot0 = k_0_4 | rs_gek0;
-  assign rs_or_3_1 = or_3[33:0];
-  assign rem0 = gek0 ? bits_diffk0 : rs_or_3_1;
+  assign cat_2 = {rs_bits_s1_a_1, bits_lo};
+  assign rem0 = u_step0_diff;
+  assign ge0 = u_step0_ge;
+  assign rs_ge0 = {{29{1'b0}}, ge0};
+  assign quot0 = k_0_2 | rs_ge0;
 
   always @(posedge clk) begin : s2_q0_regs
-    s2_p <= rem0;
+    s2_ge <= ge0;
+    s2_r <= rem0;
     s2_q <= quot0;
+    s2_zero <= k_1;
   end
 
   // stage s3_q1: one quotient bit
   assign rs_s1_b_d1 = {{1{1'b0}}, s1_b_d1};
   assign bits_lo_d1 = lo_d1[28];
-  assign rs_bits_lo_d1 = {{34{1'b0}}, bits_lo_d1};
-  assign rs_s2_p = {{1{1'b0}}, s2_p};
-  assign shl_rs_s2_p = rs_s2_p <<< 1;
-  assign or_5 = shl_rs_s2_p | rs_bits_lo_d1;
-  assign rs_or_5 = {{1{1'b0}}, or_5};
-  assign s_rs_or_5 = $signed(rs_or_5);
-  assign rs_rs_s1_b_d1 = {{1{1'b0}}, rs_s1_b_d1};
-  assign s_rs_rs_s1_b_d1 = $signed(rs_rs_s1_b_d1);
-  assign diffk1 = s_rs_or_5 - s_rs_rs_s1_b_d1;
-  assign bits_diffk1 = diffk1[33:0];
-  assign bits_diffk1_1 = diffk1[35];
-  assign gek1 = ~bits_diffk1_1;
-  assign s2_q_eq_k_0_4 = s2_q == k_0_4;
+  assign cat_3 = {s2_r, bits_lo_d1};
+  assign rem1 = u_step1_diff;
+  assign ge1 = u_step1_ge;
+  assign not_s2_ge = ~s2_ge;
+  assign zero1 = s2_zero & not_s2_ge;
   assign shl_s2_q = s2_q <<< 1;
-  assign rs_gek1 = {{29{1'b0}}, gek1};
-  assign quot1 = shl_s2_q | rs_gek1;
-  assign rs_or_5_1 = or_5[33:0];
-  assign rem1 = gek1 ? bits_diffk1 : rs_or_5_1;
+  assign rs_ge1 = {{29{1'b0}}, ge1};
+  assign quot1 = shl_s2_q | rs_ge1;
 
   always @(posedge clk) begin : s3_q1_regs
     s1_b_d1 <= s1_b;
     lo_d1 <= lo;
-    s3_p <= rem1;
+    s3_ge <= ge1;
+    s3_r <= rem1;
     s3_q <= quot1;
+    s3_zero <= zero1;
   end
 
   // stage s4_q2: one quotient bit
   assign rs_s1_b_d2 = {{1{1'b0}}, s1_b_d2};
   assign bits_lo_d2 = lo_d2[27];
-  assign rs_bits_lo_d2 = {{34{1'b0}}, bits_lo_d2};
-  assign rs_s3_p = {{1{1'b0}}, s3_p};
-  assign shl_rs_s3_p = rs_s3_p <<< 1;
-  assign or_7 = shl_rs_s3_p | rs_bits_lo_d2;
-  assign rs_or_7 = {{1{1'b0}}, or_7};
-  assign s_rs_or_7 = $signed(rs_or_7);
-  assign rs_rs_s1_b_d2 = {{1{1'b0}}, rs_s1_b_d2};
-  assign s_rs_rs_s1_b_d2 = $signed(rs_rs_s1_b_d2);
-  assign diffk2 = s_rs_or_7 - s_rs_rs_s1_b_d2;
-  assign bits_diffk2 = diffk2[33:0];
-  assign bits_diffk2_1 = diffk2[35];
-  assign gek2 = ~bits_diffk2_1;
-  assign s3_q_eq_k_0_4 = s3_q == k_0_4;
+  assign cat_4 = {s3_r, bits_lo_d2};
+  assign rem2 = u_step2_diff;
+  assign ge2 = u_step2_ge;
+  assign not_s3_ge = ~s3_ge;
+  assign zero2 = s3_zero & not_s3_ge;
   assign shl_s3_q = s3_q <<< 1;
-  assign rs_gek2 = {{29{1'b0}}, gek2};
-  assign quot2 = shl_s3_q | rs_gek2;
-  assign rs_or_7_1 = or_7[33:0];
-  assign rem2 = gek2 ? bits_diffk2 : rs_or_7_1;
+  assign rs_ge2 = {{29{1'b0}}, ge2};
+  assign quot2 = shl_s3_q | rs_ge2;
 
   always @(posedge clk) begin : s4_q2_regs
     s1_b_d2 <= s1_b_d1;
     lo_d2 <= lo_d1;
-    s4_p <= rem2;
+    s4_ge <= ge2;
+    s4_r <= rem2;
     s4_q <= quot2;
+    s4_zero <= zero2;
   end
 
   // stage s5_q3: one quotient bit
   assign rs_s1_b_d3 = {{1{1'b0}}, s1_b_d3};
   assign bits_lo_d3 = lo_d3[26];
-  assign rs_bits_lo_d3 = {{34{1'b0}}, bits_lo_d3};
-  assign rs_s4_p = {{1{1'b0}}, s4_p};
-  assign shl_rs_s4_p = rs_s4_p <<< 1;
-  assign or_9 = shl_rs_s4_p | rs_bits_lo_d3;
-  assign rs_or_9 = {{1{1'b0}}, or_9};
-  assign s_rs_or_9 = $signed(rs_or_9);
-  assign rs_rs_s1_b_d3 = {{1{1'b0}}, rs_s1_b_d3};
-  assign s_rs_rs_s1_b_d3 = $signed(rs_rs_s1_b_d3);
-  assign diffk3 = s_rs_or_9 - s_rs_rs_s1_b_d3;
-  assign bits_diffk3 = diffk3[33:0];
-  assign bits_diffk3_1 = diffk3[35];
-  assign gek3 = ~bits_diffk3_1;
-  assign s4_q_eq_k_0_4 = s4_q == k_0_4;
+  assign cat_5 = {s4_r, bits_lo_d3};
+  assign rem3 = u_step3_diff;
+  assign ge3 = u_step3_ge;
+  assign not_s4_ge = ~s4_ge;
+  assign zero3 = s4_zero & not_s4_ge;
   assign shl_s4_q = s4_q <<< 1;
-  assign rs_gek3 = {{29{1'b0}}, gek3};
-  assign quot3 = shl_s4_q | rs_gek3;
-  assign rs_or_9_1 = or_9[33:0];
-  assign rem3 = gek3 ? bits_diffk3 : rs_or_9_1;
+  assign rs_ge3 = {{29{1'b0}}, ge3};
+  assign quot3 = shl_s4_q | rs_ge3;
 
   always @(posedge clk) begin : s5_q3_regs
     s1_b_d3 <= s1_b_d2;
     lo_d3 <= lo_d2;
-    s5_p <= rem3;
+    s5_ge <= ge3;
+    s5_r <= rem3;
     s5_q <= quot3;
+    s5_zero <= zero3;
   end
 
   // stage s6_q4: one quotient bit
   assign rs_s1_b_d4 = {{1{1'b0}}, s1_b_d4};
   assign bits_lo_d4 = lo_d4[25];
-  assign rs_bits_lo_d4 = {{34{1'b0}}, bits_lo_d4};
-  assign rs_s5_p = {{1{1'b0}}, s5_p};
-  assign shl_rs_s5_p = rs_s5_p <<< 1;
-  assign or_11 = shl_rs_s5_p | rs_bits_lo_d4;
-  assign rs_or_11 = {{1{1'b0}}, or_11};
-  assign s_rs_or_11 = $signed(rs_or_11);
-  assign rs_rs_s1_b_d4 = {{1{1'b0}}, rs_s1_b_d4};
-  assign s_rs_rs_s1_b_d4 = $signed(rs_rs_s1_b_d4);
-  assign diffk4 = s_rs_or_11 - s_rs_rs_s1_b_d4;
-  assign bits_diffk4 = diffk4[33:0];
-  assign bits_diffk4_1 = diffk4[35];
-  assign gek4 = ~bits_diffk4_1;
-  assign s5_q_eq_k_0_4 = s5_q == k_0_4;
+  assign cat_6 = {s5_r, bits_lo_d4};
+  assign rem4 = u_step4_diff;
+  assign ge4 = u_step4_ge;
+  assign not_s5_ge = ~s5_ge;
+  assign zero4 = s5_zero & not_s5_ge;
   assign shl_s5_q = s5_q <<< 1;
-  assign rs_gek4 = {{29{1'b0}}, gek4};
-  assign quot4 = shl_s5_q | rs_gek4;
-  assign rs_or_11_1 = or_11[33:0];
-  assign rem4 = gek4 ? bits_diffk4 : rs_or_11_1;
+  assign rs_ge4 = {{29{1'b0}}, ge4};
+  assign quot4 = shl_s5_q | rs_ge4;
 
   always @(posedge clk) begin : s6_q4_regs
     s1_b_d4 <= s1_b_d3;
     lo_d4 <= lo_d3;
-    s6_p <= rem4;
+    s6_ge <= ge4;
+    s6_r <= rem4;
     s6_q <= quot4;
+    s6_zero <= zero4;
   end
 
   // stage s7_q5: one quotient bit
   assign rs_s1_b_d5 = {{1{1'b0}}, s1_b_d5};
   assign bits_lo_d5 = lo_d5[24];
-  assign rs_bits_lo_d5 = {{34{1'b0}}, bits_lo_d5};
-  assign rs_s6_p = {{1{1'b0}}, s6_p};
-  assign shl_rs_s6_p = rs_s6_p <<< 1;
-  assign or_13 = shl_rs_s6_p | rs_bits_lo_d5;
-  assign rs_or_13 = {{1{1'b0}}, or_13};
-  assign s_rs_or_13 = $signed(rs_or_13);
-  assign rs_rs_s1_b_d5 = {{1{1'b0}}, rs_s1_b_d5};
-  assign s_rs_rs_s1_b_d5 = $signed(rs_rs_s1_b_d5);
-  assign diffk5 = s_rs_or_13 - s_rs_rs_s1_b_d5;
-  assign bits_diffk5 = diffk5[33:0];
-  assign bits_diffk5_1 = diffk5[35];
-  assign gek5 = ~bits_diffk5_1;
-  assign s6_q_eq_k_0_4 = s6_q == k_0_4;
+  assign cat_7 = {s6_r, bits_lo_d5};
+  assign rem5 = u_step5_diff;
+  assign ge5 = u_step5_ge;
+  assign not_s6_ge = ~s6_ge;
+  assign zero5 = s6_zero & not_s6_ge;
   assign shl_s6_q = s6_q <<< 1;
-  assign rs_gek5 = {{29{1'b0}}, gek5};
-  assign quot5 = shl_s6_q | rs_gek5;
-  assign rs_or_13_1 = or_13[33:0];
-  assign rem5 = gek5 ? bits_diffk5 : rs_or_13_1;
+  assign rs_ge5 = {{29{1'b0}}, ge5};
+  assign quot5 = shl_s6_q | rs_ge5;
 
   always @(posedge clk) begin : s7_q5_regs
     s1_b_d5 <= s1_b_d4;
     lo_d5 <= lo_d4;
-    s7_p <= rem5;
+    s7_ge <= ge5;
+    s7_r <= rem5;
     s7_q <= quot5;
+    s7_zero <= zero5;
   end
 
   // stage s8_q6: one quotient bit
   assign rs_s1_b_d6 = {{1{1'b0}}, s1_b_d6};
   assign bits_lo_d6 = lo_d6[23];
-  assign rs_bits_lo_d6 = {{34{1'b0}}, bits_lo_d6};
-  assign rs_s7_p = {{1{1'b0}}, s7_p};
-  assign shl_rs_s7_p = rs_s7_p <<< 1;
-  assign or_15 = shl_rs_s7_p | rs_bits_lo_d6;
-  assign rs_or_15 = {{1{1'b0}}, or_15};
-  assign s_rs_or_15 = $signed(rs_or_15);
-  assign rs_rs_s1_b_d6 = {{1{1'b0}}, rs_s1_b_d6};
-  assign s_rs_rs_s1_b_d6 = $signed(rs_rs_s1_b_d6);
-  assign diffk6 = s_rs_or_15 - s_rs_rs_s1_b_d6;
-  assign bits_diffk6 = diffk6[33:0];
-  assign bits_diffk6_1 = diffk6[35];
-  assign gek6 = ~bits_diffk6_1;
-  assign s7_q_eq_k_0_4 = s7_q == k_0_4;
+  assign cat_8 = {s7_r, bits_lo_d6};
+  assign rem6 = u_step6_diff;
+  assign ge6 = u_step6_ge;
+  assign not_s7_ge = ~s7_ge;
+  assign zero6 = s7_zero & not_s7_ge;
   assign shl_s7_q = s7_q <<< 1;
-  assign rs_gek6 = {{29{1'b0}}, gek6};
-  assign quot6 = shl_s7_q | rs_gek6;
-  assign rs_or_15_1 = or_15[33:0];
-  assign rem6 = gek6 ? bits_diffk6 : rs_or_15_1;
+  assign rs_ge6 = {{29{1'b0}}, ge6};
+  assign quot6 = shl_s7_q | rs_ge6;
 
   always @(posedge clk) begin : s8_q6_regs
     s1_b_d6 <= s1_b_d5;
     lo_d6 <= lo_d5;
-    s8_p <= rem6;
+    s8_ge <= ge6;
+    s8_r <= rem6;
     s8_q <= quot6;
+    s8_zero <= zero6;
   end
 
   // stage s9_q7: one quotient bit
   assign rs_s1_b_d7 = {{1{1'b0}}, s1_b_d7};
   assign bits_lo_d7 = lo_d7[22];
-  assign rs_bits_lo_d7 = {{34{1'b0}}, bits_lo_d7};
-  assign rs_s8_p = {{1{1'b0}}, s8_p};
-  assign shl_rs_s8_p = rs_s8_p <<< 1;
-  assign or_17 = shl_rs_s8_p | rs_bits_lo_d7;
-  assign rs_or_17 = {{1{1'b0}}, or_17};
-  assign s_rs_or_17 = $signed(rs_or_17);
-  assign rs_rs_s1_b_d7 = {{1{1'b0}}, rs_s1_b_d7};
-  assign s_rs_rs_s1_b_d7 = $signed(rs_rs_s1_b_d7);
-  assign diffk7 = s_rs_or_17 - s_rs_rs_s1_b_d7;
-  assign bits_diffk7 = diffk7[33:0];
-  assign bits_diffk7_1 = diffk7[35];
-  assign gek7 = ~bits_diffk7_1;
-  assign s8_q_eq_k_0_4 = s8_q == k_0_4;
+  assign cat_9 = {s8_r, bits_lo_d7};
+  assign rem7 = u_step7_diff;
+  assign ge7 = u_step7_ge;
+  assign not_s8_ge = ~s8_ge;
+  assign zero7 = s8_zero & not_s8_ge;
   assign shl_s8_q = s8_q <<< 1;
-  assign rs_gek7 = {{29{1'b0}}, gek7};
-  assign quot7 = shl_s8_q | rs_gek7;
-  assign rs_or_17_1 = or_17[33:0];
-  assign rem7 = gek7 ? bits_diffk7 : rs_or_17_1;
+  assign rs_ge7 = {{29{1'b0}}, ge7};
+  assign quot7 = shl_s8_q | rs_ge7;
 
   always @(posedge clk) begin : s9_q7_regs
     s1_b_d7 <= s1_b_d6;
     lo_d7 <= lo_d6;
-    s9_p <= rem7;
+    s9_ge <= ge7;
+    s9_r <= rem7;
     s9_q <= quot7;
+    s9_zero <= zero7;
   end
 
   // stage s10_q8: one quotient bit
   assign rs_s1_b_d8 = {{1{1'b0}}, s1_b_d8};
   assign bits_lo_d8 = lo_d8[21];
-  assign rs_bits_lo_d8 = {{34{1'b0}}, bits_lo_d8};
-  assign rs_s9_p = {{1{1'b0}}, s9_p};
-  assign shl_rs_s9_p = rs_s9_p <<< 1;
-  assign or_19 = shl_rs_s9_p | rs_bits_lo_d8;
-  assign rs_or_19 = {{1{1'b0}}, or_19};
-  assign s_rs_or_19 = $signed(rs_or_19);
-  assign rs_rs_s1_b_d8 = {{1{1'b0}}, rs_s1_b_d8};
-  assign s_rs_rs_s1_b_d8 = $signed(rs_rs_s1_b_d8);
-  assign diffk8 = s_rs_or_19 - s_rs_rs_s1_b_d8;
-  assign bits_diffk8 = diffk8[33:0];
-  assign bits_diffk8_1 = diffk8[35];
-  assign gek8 = ~bits_diffk8_1;
-  assign s9_q_eq_k_0_4 = s9_q == k_0_4;
+  assign cat_10 = {s9_r, bits_lo_d8};
+  assign rem8 = u_step8_diff;
+  assign ge8 = u_step8_ge;
+  assign not_s9_ge = ~s9_ge;
+  assign zero8 = s9_zero & not_s9_ge;
   assign shl_s9_q = s9_q <<< 1;
-  assign rs_gek8 = {{29{1'b0}}, gek8};
-  assign quot8 = shl_s9_q | rs_gek8;
-  assign rs_or_19_1 = or_19[33:0];
-  assign rem8 = gek8 ? bits_diffk8 : rs_or_19_1;
+  assign rs_ge8 = {{29{1'b0}}, ge8};
+  assign quot8 = shl_s9_q | rs_ge8;
 
   always @(posedge clk) begin : s10_q8_regs
     s1_b_d8 <= s1_b_d7;
     lo_d8 <= lo_d7;
-    s10_p <= rem8;
+    s10_ge <= ge8;
+    s10_r <= rem8;
     s10_q <= quot8;
+    s10_zero <= zero8;
   end
 
   // stage s11_q9: one quotient bit
   assign rs_s1_b_d9 = {{1{1'b0}}, s1_b_d9};
   assign bits_lo_d9 = lo_d9[20];
-  assign rs_bits_lo_d9 = {{34{1'b0}}, bits_lo_d9};
-  assign rs_s10_p = {{1{1'b0}}, s10_p};
-  assign shl_rs_s10_p = rs_s10_p <<< 1;
-  assign or_21 = shl_rs_s10_p | rs_bits_lo_d9;
-  assign rs_or_21 = {{1{1'b0}}, or_21};
-  assign s_rs_or_21 = $signed(rs_or_21);
-  assign rs_rs_s1_b_d9 = {{1{1'b0}}, rs_s1_b_d9};
-  assign s_rs_rs_s1_b_d9 = $signed(rs_rs_s1_b_d9);
-  assign diffk9 = s_rs_or_21 - s_rs_rs_s1_b_d9;
-  assign bits_diffk9 = diffk9[33:0];
-  assign bits_diffk9_1 = diffk9[35];
-  assign gek9 = ~bits_diffk9_1;
-  assign s10_q_eq_k_0_4 = s10_q == k_0_4;
+  assign cat_11 = {s10_r, bits_lo_d9};
+  assign rem9 = u_step9_diff;
+  assign ge9 = u_step9_ge;
+  assign not_s10_ge = ~s10_ge;
+  assign zero9 = s10_zero & not_s10_ge;
   assign shl_s10_q = s10_q <<< 1;
-  assign rs_gek9 = {{29{1'b0}}, gek9};
-  assign quot9 = shl_s10_q | rs_gek9;
-  assign rs_or_21_1 = or_21[33:0];
-  assign rem9 = gek9 ? bits_diffk9 : rs_or_21_1;
+  assign rs_ge9 = {{29{1'b0}}, ge9};
+  assign quot9 = shl_s10_q | rs_ge9;
 
   always @(posedge clk) begin : s11_q9_regs
     s1_b_d9 <= s1_b_d8;
     lo_d9 <= lo_d8;
-    s11_p <= rem9;
+    s11_ge <= ge9;
+    s11_r <= rem9;
     s11_q <= quot9;
+    s11_zero <= zero9;
   end
 
   // stage s12_q10: one quotient bit
   assign rs_s1_b_d10 = {{1{1'b0}}, s1_b_d10};
   assign bits_lo_d10 = lo_d10[19];
-  assign rs_bits_lo_d10 = {{34{1'b0}}, bits_lo_d10};
-  assign rs_s11_p = {{1{1'b0}}, s11_p};
-  assign shl_rs_s11_p = rs_s11_p <<< 1;
-  assign or_23 = shl_rs_s11_p | rs_bits_lo_d10;
-  assign rs_or_23 = {{1{1'b0}}, or_23};
-  assign s_rs_or_23 = $signed(rs_or_23);
-  assign rs_rs_s1_b_d10 = {{1{1'b0}}, rs_s1_b_d10};
-  assign s_rs_rs_s1_b_d10 = $signed(rs_rs_s1_b_d10);
-  assign diffk10 = s_rs_or_23 - s_rs_rs_s1_b_d10;
-  assign bits_diffk10 = diffk10[33:0];
-  assign bits_diffk10_1 = diffk10[35];
-  assign gek10 = ~bits_diffk10_1;
-  assign s11_q_eq_k_0_4 = s11_q == k_0_4;
+  assign cat_12 = {s11_r, bits_lo_d10};
+  assign rem10 = u_step10_diff;
+  assign ge10 = u_step10_ge;
+  assign not_s11_ge = ~s11_ge;
+  assign zero10 = s11_zero & not_s11_ge;
   assign shl_s11_q = s11_q <<< 1;
-  assign rs_gek10 = {{29{1'b0}}, gek10};
-  assign quot10 = shl_s11_q | rs_gek10;
-  assign rs_or_23_1 = or_23[33:0];
-  assign rem10 = gek10 ? bits_diffk10 : rs_or_23_1;
+  assign rs_ge10 = {{29{1'b0}}, ge10};
+  assign quot10 = shl_s11_q | rs_ge10;
 
   always @(posedge clk) begin : s12_q10_regs
     s1_b_d10 <= s1_b_d9;
     lo_d10 <= lo_d9;
-    s12_p <= rem10;
+    s12_ge <= ge10;
+    s12_r <= rem10;
     s12_q <= quot10;
+    s12_zero <= zero10;
   end
 
   // stage s13_q11: one quotient bit
   assign rs_s1_b_d11 = {{1{1'b0}}, s1_b_d11};
   assign bits_lo_d11 = lo_d11[18];
-  assign rs_bits_lo_d11 = {{34{1'b0}}, bits_lo_d11};
-  assign rs_s12_p = {{1{1'b0}}, s12_p};
-  assign shl_rs_s12_p = rs_s12_p <<< 1;
-  assign or_25 = shl_rs_s12_p | rs_bits_lo_d11;
-  assign rs_or_25 = {{1{1'b0}}, or_25};
-  assign s_rs_or_25 = $signed(rs_or_25);
-  assign rs_rs_s1_b_d11 = {{1{1'b0}}, rs_s1_b_d11};
-  assign s_rs_rs_s1_b_d11 = $signed(rs_rs_s1_b_d11);
-  assign diffk11 = s_rs_or_25 - s_rs_rs_s1_b_d11;
-  assign bits_diffk11 = diffk11[33:0];
-  assign bits_diffk11_1 = diffk11[35];
-  assign gek11 = ~bits_diffk11_1;
-  assign s12_q_eq_k_0_4 = s12_q == k_0_4;
+  assign cat_13 = {s12_r, bits_lo_d11};
+  assign rem11 = u_step11_diff;
+  assign ge11 = u_step11_ge;
+  assign not_s12_ge = ~s12_ge;
+  assign zero11 = s12_zero & not_s12_ge;
   assign shl_s12_q = s12_q <<< 1;
-  assign rs_gek11 = {{29{1'b0}}, gek11};
-  assign quot11 = shl_s12_q | rs_gek11;
-  assign rs_or_25_1 = or_25[33:0];
-  assign rem11 = gek11 ? bits_diffk11 : rs_or_25_1;
+  assign rs_ge11 = {{29{1'b0}}, ge11};
+  assign quot11 = shl_s12_q | rs_ge11;
 
   always @(posedge clk) begin : s13_q11_regs
     s1_b_d11 <= s1_b_d10;
     lo_d11 <= lo_d10;
-    s13_p <= rem11;
+    s13_ge <= ge11;
+    s13_r <= rem11;
     s13_q <= quot11;
+    s13_zero <= zero11;
   end
 
   // stage s14_q12: one quotient bit
   assign rs_s1_b_d12 = {{1{1'b0}}, s1_b_d12};
   assign bits_lo_d12 = lo_d12[17];
-  assign rs_bits_lo_d12 = {{34{1'b0}}, bits_lo_d12};
-  assign rs_s13_p = {{1{1'b0}}, s13_p};
-  assign shl_rs_s13_p = rs_s13_p <<< 1;
-  assign or_27 = shl_rs_s13_p | rs_bits_lo_d12;
-  assign rs_or_27 = {{1{1'b0}}, or_27};
-  assign s_rs_or_27 = $signed(rs_or_27);
-  assign rs_rs_s1_b_d12 = {{1{1'b0}}, rs_s1_b_d12};
-  assign s_rs_rs_s1_b_d12 = $signed(rs_rs_s1_b_d12);
-  assign diffk12 = s_rs_or_27 - s_rs_rs_s1_b_d12;
-  assign bits_diffk12 = diffk12[33:0];
-  assign bits_diffk12_1 = diffk12[35];
-  assign gek12 = ~bits_diffk12_1;
-  assign s13_q_eq_k_0_4 = s13_q == k_0_4;
+  assign cat_14 = {s13_r, bits_lo_d12};
+  assign rem12 = u_step12_diff;
+  assign ge12 = u_step12_ge;
+  assign not_s13_ge = ~s13_ge;
+  assign zero12 = s13_zero & not_s13_ge;
   assign shl_s13_q = s13_q <<< 1;
-  assign rs_gek12 = {{29{1'b0}}, gek12};
-  assign quot12 = shl_s13_q | rs_gek12;
-  assign rs_or_27_1 = or_27[33:0];
-  assign rem12 = gek12 ? bits_diffk12 : rs_or_27_1;
+  assign rs_ge12 = {{29{1'b0}}, ge12};
+  assign quot12 = shl_s13_q | rs_ge12;
 
   always @(posedge clk) begin : s14_q12_regs
     s1_b_d12 <= s1_b_d11;
     lo_d12 <= lo_d11;
-    s14_p <= rem12;
+    s14_ge <= ge12;
+    s14_r <= rem12;
     s14_q <= quot12;
+    s14_zero <= zero12;
   end
 
   // stage s15_q13: one quotient bit
   assign rs_s1_b_d13 = {{1{1'b0}}, s1_b_d13};
   assign bits_lo_d13 = lo_d13[16];
-  assign rs_bits_lo_d13 = {{34{1'b0}}, bits_lo_d13};
-  assign rs_s14_p = {{1{1'b0}}, s14_p};
-  assign shl_rs_s14_p = rs_s14_p <<< 1;
-  assign or_29 = shl_rs_s14_p | rs_bits_lo_d13;
-  assign rs_or_29 = {{1{1'b0}}, or_29};
-  assign s_rs_or_29 = $signed(rs_or_29);
-  assign rs_rs_s1_b_d13 = {{1{1'b0}}, rs_s1_b_d13};
-  assign s_rs_rs_s1_b_d13 = $signed(rs_rs_s1_b_d13);
-  assign diffk13 = s_rs_or_29 - s_rs_rs_s1_b_d13;
-  assign bits_diffk13 = diffk13[33:0];
-  assign bits_diffk13_1 = diffk13[35];
-  assign gek13 = ~bits_diffk13_1;
-  assign s14_q_eq_k_0_4 = s14_q == k_0_4;
+  assign cat_15 = {s14_r, bits_lo_d13};
+  assign rem13 = u_step13_diff;
+  assign ge13 = u_step13_ge;
+  assign not_s14_ge = ~s14_ge;
+  assign zero13 = s14_zero & not_s14_ge;
   assign shl_s14_q = s14_q <<< 1;
-  assign rs_gek13 = {{29{1'b0}}, gek13};
-  assign quot13 = shl_s14_q | rs_gek13;
-  assign rs_or_29_1 = or_29[33:0];
-  assign rem13 = gek13 ? bits_diffk13 : rs_or_29_1;
+  assign rs_ge13 = {{29{1'b0}}, ge13};
+  assign quot13 = shl_s14_q | rs_ge13;
 
   always @(posedge clk) begin : s15_q13_regs
     s1_b_d13 <= s1_b_d12;
     lo_d13 <= lo_d12;
-    s15_p <= rem13;
+    s15_ge <= ge13;
+    s15_r <= rem13;
     s15_q <= quot13;
+    s15_zero <= zero13;
   end
 
   // stage s16_q14: one quotient bit
   assign rs_s1_b_d14 = {{1{1'b0}}, s1_b_d14};
   assign bits_lo_d14 = lo_d14[15];
-  assign rs_bits_lo_d14 = {{34{1'b0}}, bits_lo_d14};
-  assign rs_s15_p = {{1{1'b0}}, s15_p};
-  assign shl_rs_s15_p = rs_s15_p <<< 1;
-  assign or_31 = shl_rs_s15_p | rs_bits_lo_d14;
-  assign rs_or_31 = {{1{1'b0}}, or_31};
-  assign s_rs_or_31 = $signed(rs_or_31);
-  assign rs_rs_s1_b_d14 = {{1{1'b0}}, rs_s1_b_d14};
-  assign s_rs_rs_s1_b_d14 = $signed(rs_rs_s1_b_d14);
-  assign diffk14 = s_rs_or_31 - s_rs_rs_s1_b_d14;
-  assign bits_diffk14 = diffk14[33:0];
-  assign bits_diffk14_1 = diffk14[35];
-  assign gek14 = ~bits_diffk14_1;
-  assign s15_q_eq_k_0_4 = s15_q == k_0_4;
+  assign cat_16 = {s15_r, bits_lo_d14};
+  assign rem14 = u_step14_diff;
+  assign ge14 = u_step14_ge;
+  assign not_s15_ge = ~s15_ge;
+  assign zero14 = s15_zero & not_s15_ge;
   assign shl_s15_q = s15_q <<< 1;
-  assign rs_gek14 = {{29{1'b0}}, gek14};
-  assign quot14 = shl_s15_q | rs_gek14;
-  assign rs_or_31_1 = or_31[33:0];
-  assign rem14 = gek14 ? bits_diffk14 : rs_or_31_1;
+  assign rs_ge14 = {{29{1'b0}}, ge14};
+  assign quot14 = shl_s15_q | rs_ge14;
 
   always @(posedge clk) begin : s16_q14_regs
     s1_b_d14 <= s1_b_d13;
     lo_d14 <= lo_d13;
-    s16_p <= rem14;
+    s16_ge <= ge14;
+    s16_r <= rem14;
     s16_q <= quot14;
+    s16_zero <= zero14;
   end
 
   // stage s17_q15: one quotient bit
   assign rs_s1_b_d15 = {{1{1'b0}}, s1_b_d15};
   assign bits_lo_d15 = lo_d15[14];
-  assign rs_bits_lo_d15 = {{34{1'b0}}, bits_lo_d15};
-  assign rs_s16_p = {{1{1'b0}}, s16_p};
-  assign shl_rs_s16_p = rs_s16_p <<< 1;
-  assign or_33 = shl_rs_s16_p | rs_bits_lo_d15;
-  assign rs_or_33 = {{1{1'b0}}, or_33};
-  assign s_rs_or_33 = $signed(rs_or_33);
-  assign rs_rs_s1_b_d15 = {{1{1'b0}}, rs_s1_b_d15};
-  assign s_rs_rs_s1_b_d15 = $signed(rs_rs_s1_b_d15);
-  assign diffk15 = s_rs_or_33 - s_rs_rs_s1_b_d15;
-  assign bits_diffk15 = diffk15[33:0];
-  assign bits_diffk15_1 = diffk15[35];
-  assign gek15 = ~bits_diffk15_1;
-  assign s16_q_eq_k_0_4 = s16_q == k_0_4;
+  assign cat_17 = {s16_r, bits_lo_d15};
+  assign rem15 = u_step15_diff;
+  assign ge15 = u_step15_ge;
+  assign not_s16_ge = ~s16_ge;
+  assign zero15 = s16_zero & not_s16_ge;
   assign shl_s16_q = s16_q <<< 1;
-  assign rs_gek15 = {{29{1'b0}}, gek15};
-  assign quot15 = shl_s16_q | rs_gek15;
-  assign rs_or_33_1 = or_33[33:0];
-  assign rem15 = gek15 ? bits_diffk15 : rs_or_33_1;
+  assign rs_ge15 = {{29{1'b0}}, ge15};
+  assign quot15 = shl_s16_q | rs_ge15;
 
   always @(posedge clk) begin : s17_q15_regs
     s1_b_d15 <= s1_b_d14;
     lo_d15 <= lo_d14;
-    s17_p <= rem15;
+    s17_ge <= ge15;
+    s17_r <= rem15;
     s17_q <= quot15;
+    s17_zero <= zero15;
   end
 
   // stage s18_q16: one quotient bit
   assign rs_s1_b_d16 = {{1{1'b0}}, s1_b_d16};
   assign bits_lo_d16 = lo_d16[13];
-  assign rs_bits_lo_d16 = {{34{1'b0}}, bits_lo_d16};
-  assign rs_s17_p = {{1{1'b0}}, s17_p};
-  assign shl_rs_s17_p = rs_s17_p <<< 1;
-  assign or_35 = shl_rs_s17_p | rs_bits_lo_d16;
-  assign rs_or_35 = {{1{1'b0}}, or_35};
-  assign s_rs_or_35 = $signed(rs_or_35);
-  assign rs_rs_s1_b_d16 = {{1{1'b0}}, rs_s1_b_d16};
-  assign s_rs_rs_s1_b_d16 = $signed(rs_rs_s1_b_d16);
-  assign diffk16 = s_rs_or_35 - s_rs_rs_s1_b_d16;
-  assign bits_diffk16 = diffk16[33:0];
-  assign bits_diffk16_1 = diffk16[35];
-  assign gek16 = ~bits_diffk16_1;
-  assign s17_q_eq_k_0_4 = s17_q == k_0_4;
+  assign cat_18 = {s17_r, bits_lo_d16};
+  assign rem16 = u_step16_diff;
+  assign ge16 = u_step16_ge;
+  assign not_s17_ge = ~s17_ge;
+  assign zero16 = s17_zero & not_s17_ge;
   assign shl_s17_q = s17_q <<< 1;
-  assign rs_gek16 = {{29{1'b0}}, gek16};
-  assign quot16 = shl_s17_q | rs_gek16;
-  assign rs_or_35_1 = or_35[33:0];
-  assign rem16 = gek16 ? bits_diffk16 : rs_or_35_1;
+  assign rs_ge16 = {{29{1'b0}}, ge16};
+  assign quot16 = shl_s17_q | rs_ge16;
 
   always @(posedge clk) begin : s18_q16_regs
     s1_b_d16 <= s1_b_d15;
     lo_d16 <= lo_d15;
-    s18_p <= rem16;
+    s18_ge <= ge16;
+    s18_r <= rem16;
     s18_q <= quot16;
+    s18_zero <= zero16;
   end
 
   // stage s19_q17: one quotient bit
   assign rs_s1_b_d17 = {{1{1'b0}}, s1_b_d17};
   assign bits_lo_d17 = lo_d17[12];
-  assign rs_bits_lo_d17 = {{34{1'b0}}, bits_lo_d17};
-  assign rs_s18_p = {{1{1'b0}}, s18_p};
-  assign shl_rs_s18_p = rs_s18_p <<< 1;
-  assign or_37 = shl_rs_s18_p | rs_bits_lo_d17;
-  assign rs_or_37 = {{1{1'b0}}, or_37};
-  assign s_rs_or_37 = $signed(rs_or_37);
-  assign rs_rs_s1_b_d17 = {{1{1'b0}}, rs_s1_b_d17};
-  assign s_rs_rs_s1_b_d17 = $signed(rs_rs_s1_b_d17);
-  assign diffk17 = s_rs_or_37 - s_rs_rs_s1_b_d17;
-  assign bits_diffk17 = diffk17[33:0];
-  assign bits_diffk17_1 = diffk17[35];
-  assign gek17 = ~bits_diffk17_1;
-  assign s18_q_eq_k_0_4 = s18_q == k_0_4;
+  assign cat_19 = {s18_r, bits_lo_d17};
+  assign rem17 = u_step17_diff;
+  assign ge17 = u_step17_ge;
+  assign not_s18_ge = ~s18_ge;
+  assign zero17 = s18_zero & not_s18_ge;
   assign shl_s18_q = s18_q <<< 1;
-  assign rs_gek17 = {{29{1'b0}}, gek17};
-  assign quot17 = shl_s18_q | rs_gek17;
-  assign rs_or_37_1 = or_37[33:0];
-  assign rem17 = gek17 ? bits_diffk17 : rs_or_37_1;
+  assign rs_ge17 = {{29{1'b0}}, ge17};
+  assign quot17 = shl_s18_q | rs_ge17;
 
   always @(posedge clk) begin : s19_q17_regs
     s1_b_d17 <= s1_b_d16;
     lo_d17 <= lo_d16;
-    s19_p <= rem17;
+    s19_ge <= ge17;
+    s19_r <= rem17;
     s19_q <= quot17;
+    s19_zero <= zero17;
   end
 
   // stage s20_q18: one quotient bit
   assign rs_s1_b_d18 = {{1{1'b0}}, s1_b_d18};
   assign bits_lo_d18 = lo_d18[11];
-  assign rs_bits_lo_d18 = {{34{1'b0}}, bits_lo_d18};
-  assign rs_s19_p = {{1{1'b0}}, s19_p};
-  assign shl_rs_s19_p = rs_s19_p <<< 1;
-  assign or_39 = shl_rs_s19_p | rs_bits_lo_d18;
-  assign rs_or_39 = {{1{1'b0}}, or_39};
-  assign s_rs_or_39 = $signed(rs_or_39);
-  assign rs_rs_s1_b_d18 = {{1{1'b0}}, rs_s1_b_d18};
-  assign s_rs_rs_s1_b_d18 = $signed(rs_rs_s1_b_d18);
-  assign diffk18 = s_rs_or_39 - s_rs_rs_s1_b_d18;
-  assign bits_diffk18 = diffk18[33:0];
-  assign bits_diffk18_1 = diffk18[35];
-  assign gek18 = ~bits_diffk18_1;
-  assign s19_q_eq_k_0_4 = s19_q == k_0_4;
+  assign cat_20 = {s19_r, bits_lo_d18};
+  assign rem18 = u_step18_diff;
+  assign ge18 = u_step18_ge;
+  assign not_s19_ge = ~s19_ge;
+  assign zero18 = s19_zero & not_s19_ge;
   assign shl_s19_q = s19_q <<< 1;
-  assign rs_gek18 = {{29{1'b0}}, gek18};
-  assign quot18 = shl_s19_q | rs_gek18;
-  assign rs_or_39_1 = or_39[33:0];
-  assign rem18 = gek18 ? bits_diffk18 : rs_or_39_1;
+  assign rs_ge18 = {{29{1'b0}}, ge18};
+  assign quot18 = shl_s19_q | rs_ge18;
 
   always @(posedge clk) begin : s20_q18_regs
     s1_b_d18 <= s1_b_d17;
     lo_d18 <= lo_d17;
-    s20_p <= rem18;
+    s20_ge <= ge18;
+    s20_r <= rem18;
     s20_q <= quot18;
+    s20_zero <= zero18;
   end
 
   // stage s21_q19: one quotient bit
   assign rs_s1_b_d19 = {{1{1'b0}}, s1_b_d19};
   assign bits_lo_d19 = lo_d19[10];
-  assign rs_bits_lo_d19 = {{34{1'b0}}, bits_lo_d19};
-  assign rs_s20_p = {{1{1'b0}}, s20_p};
-  assign shl_rs_s20_p = rs_s20_p <<< 1;
-  assign or_41 = shl_rs_s20_p | rs_bits_lo_d19;
-  assign rs_or_41 = {{1{1'b0}}, or_41};
-  assign s_rs_or_41 = $signed(rs_or_41);
-  assign rs_rs_s1_b_d19 = {{1{1'b0}}, rs_s1_b_d19};
-  assign s_rs_rs_s1_b_d19 = $signed(rs_rs_s1_b_d19);
-  assign diffk19 = s_rs_or_41 - s_rs_rs_s1_b_d19;
-  assign bits_diffk19 = diffk19[33:0];
-  assign bits_diffk19_1 = diffk19[35];
-  assign gek19 = ~bits_diffk19_1;
-  assign s20_q_eq_k_0_4 = s20_q == k_0_4;
+  assign cat_21 = {s20_r, bits_lo_d19};
+  assign rem19 = u_step19_diff;
+  assign ge19 = u_step19_ge;
+  assign not_s20_ge = ~s20_ge;
+  assign zero19 = s20_zero & not_s20_ge;
   assign shl_s20_q = s20_q <<< 1;
-  assign rs_gek19 = {{29{1'b0}}, gek19};
-  assign quot19 = shl_s20_q | rs_gek19;
-  assign rs_or_41_1 = or_41[33:0];
-  assign rem19 = gek19 ? bits_diffk19 : rs_or_41_1;
+  assign rs_ge19 = {{29{1'b0}}, ge19};
+  assign quot19 = shl_s20_q | rs_ge19;
 
   always @(posedge clk) begin : s21_q19_regs
     s1_b_d19 <= s1_b_d18;
     lo_d19 <= lo_d18;
-    s21_p <= rem19;
+    s21_ge <= ge19;
+    s21_r <= rem19;
     s21_q <= quot19;
+    s21_zero <= zero19;
   end
 
   // stage s22_q20: one quotient bit
   assign rs_s1_b_d20 = {{1{1'b0}}, s1_b_d20};
   assign bits_lo_d20 = lo_d20[9];
-  assign rs_bits_lo_d20 = {{34{1'b0}}, bits_lo_d20};
-  assign rs_s21_p = {{1{1'b0}}, s21_p};
-  assign shl_rs_s21_p = rs_s21_p <<< 1;
-  assign or_43 = shl_rs_s21_p | rs_bits_lo_d20;
-  assign rs_or_43 = {{1{1'b0}}, or_43};
-  assign s_rs_or_43 = $signed(rs_or_43);
-  assign rs_rs_s1_b_d20 = {{1{1'b0}}, rs_s1_b_d20};
-  assign s_rs_rs_s1_b_d20 = $signed(rs_rs_s1_b_d20);
-  assign diffk20 = s_rs_or_43 - s_rs_rs_s1_b_d20;
-  assign bits_diffk20 = diffk20[33:0];
-  assign bits_diffk20_1 = diffk20[35];
-  assign gek20 = ~bits_diffk20_1;
-  assign s21_q_eq_k_0_4 = s21_q == k_0_4;
+  assign cat_22 = {s21_r, bits_lo_d20};
+  assign rem20 = u_step20_diff;
+  assign ge20 = u_step20_ge;
+  assign not_s21_ge = ~s21_ge;
+  assign zero20 = s21_zero & not_s21_ge;
   assign shl_s21_q = s21_q <<< 1;
-  assign rs_gek20 = {{29{1'b0}}, gek20};
-  assign quot20 = shl_s21_q | rs_gek20;
-  assign rs_or_43_1 = or_43[33:0];
-  assign rem20 = gek20 ? bits_diffk20 : rs_or_43_1;
+  assign rs_ge20 = {{29{1'b0}}, ge20};
+  assign quot20 = shl_s21_q | rs_ge20;
 
   always @(posedge clk) begin : s22_q20_regs
     s1_b_d20 <= s1_b_d19;
     lo_d20 <= lo_d19;
-    s22_p <= rem20;
+    s22_ge <= ge20;
+    s22_r <= rem20;
     s22_q <= quot20;
+    s22_zero <= zero20;
   end
 
   // stage s23_q21: one quotient bit
   assign rs_s1_b_d21 = {{1{1'b0}}, s1_b_d21};
   assign bits_lo_d21 = lo_d21[8];
-  assign rs_bits_lo_d21 = {{34{1'b0}}, bits_lo_d21};
-  assign rs_s22_p = {{1{1'b0}}, s22_p};
-  assign shl_rs_s22_p = rs_s22_p <<< 1;
-  assign or_45 = shl_rs_s22_p | rs_bits_lo_d21;
-  assign rs_or_45 = {{1{1'b0}}, or_45};
-  assign s_rs_or_45 = $signed(rs_or_45);
-  assign rs_rs_s1_b_d21 = {{1{1'b0}}, rs_s1_b_d21};
-  assign s_rs_rs_s1_b_d21 = $signed(rs_rs_s1_b_d21);
-  assign diffk21 = s_rs_or_45 - s_rs_rs_s1_b_d21;
-  assign bits_diffk21 = diffk21[33:0];
-  assign bits_diffk21_1 = diffk21[35];
-  assign gek21 = ~bits_diffk21_1;
-  assign s22_q_eq_k_0_4 = s22_q == k_0_4;
+  assign cat_23 = {s22_r, bits_lo_d21};
+  assign rem21 = u_step21_diff;
+  assign ge21 = u_step21_ge;
+  assign not_s22_ge = ~s22_ge;
+  assign zero21 = s22_zero & not_s22_ge;
   assign shl_s22_q = s22_q <<< 1;
-  assign rs_gek21 = {{29{1'b0}}, gek21};
-  assign quot21 = shl_s22_q | rs_gek21;
-  assign rs_or_45_1 = or_45[33:0];
-  assign rem21 = gek21 ? bits_diffk21 : rs_or_45_1;
+  assign rs_ge21 = {{29{1'b0}}, ge21};
+  assign quot21 = shl_s22_q | rs_ge21;
 
   always @(posedge clk) begin : s23_q21_regs
     s1_b_d21 <= s1_b_d20;
     lo_d21 <= lo_d20;
-    s23_p <= rem21;
+    s23_ge <= ge21;
+    s23_r <= rem21;
     s23_q <= quot21;
+    s23_zero <= zero21;
   end
 
   // stage s24_q22: one quotient bit
   assign rs_s1_b_d22 = {{1{1'b0}}, s1_b_d22};
   assign bits_lo_d22 = lo_d22[7];
-  assign rs_bits_lo_d22 = {{34{1'b0}}, bits_lo_d22};
-  assign rs_s23_p = {{1{1'b0}}, s23_p};
-  assign shl_rs_s23_p = rs_s23_p <<< 1;
-  assign or_47 = shl_rs_s23_p | rs_bits_lo_d22;
-  assign rs_or_47 = {{1{1'b0}}, or_47};
-  assign s_rs_or_47 = $signed(rs_or_47);
-  assign rs_rs_s1_b_d22 = {{1{1'b0}}, rs_s1_b_d22};
-  assign s_rs_rs_s1_b_d22 = $signed(rs_rs_s1_b_d22);
-  assign diffk22 = s_rs_or_47 - s_rs_rs_s1_b_d22;
-  assign bits_diffk22 = diffk22[33:0];
-  assign bits_diffk22_1 = diffk22[35];
-  assign gek22 = ~bits_diffk22_1;
-  assign s23_q_eq_k_0_4 = s23_q == k_0_4;
+  assign cat_24 = {s23_r, bits_lo_d22};
+  assign rem22 = u_step22_diff;
+  assign ge22 = u_step22_ge;
+  assign not_s23_ge = ~s23_ge;
+  assign zero22 = s23_zero & not_s23_ge;
   assign shl_s23_q = s23_q <<< 1;
-  assign rs_gek22 = {{29{1'b0}}, gek22};
-  assign quot22 = shl_s23_q | rs_gek22;
-  assign rs_or_47_1 = or_47[33:0];
-  assign rem22 = gek22 ? bits_diffk22 : rs_or_47_1;
+  assign rs_ge22 = {{29{1'b0}}, ge22};
+  assign quot22 = shl_s23_q | rs_ge22;
 
   always @(posedge clk) begin : s24_q22_regs
     s1_b_d22 <= s1_b_d21;
     lo_d22 <= lo_d21;
-    s24_p <= rem22;
+    s24_ge <= ge22;
+    s24_r <= rem22;
     s24_q <= quot22;
+    s24_zero <= zero22;
   end
 
   // stage s25_q23: one quotient bit
   assign rs_s1_b_d23 = {{1{1'b0}}, s1_b_d23};
   assign bits_lo_d23 = lo_d23[6];
-  assign rs_bits_lo_d23 = {{34{1'b0}}, bits_lo_d23};
-  assign rs_s24_p = {{1{1'b0}}, s24_p};
-  assign shl_rs_s24_p = rs_s24_p <<< 1;
-  assign or_49 = shl_rs_s24_p | rs_bits_lo_d23;
-  assign rs_or_49 = {{1{1'b0}}, or_49};
-  assign s_rs_or_49 = $signed(rs_or_49);
-  assign rs_rs_s1_b_d23 = {{1{1'b0}}, rs_s1_b_d23};
-  assign s_rs_rs_s1_b_d23 = $signed(rs_rs_s1_b_d23);
-  assign diffk23 = s_rs_or_49 - s_rs_rs_s1_b_d23;
-  assign bits_diffk23 = diffk23[33:0];
-  assign bits_diffk23_1 = diffk23[35];
-  assign gek23 = ~bits_diffk23_1;
-  assign s24_q_eq_k_0_4 = s24_q == k_0_4;
+  assign cat_25 = {s24_r, bits_lo_d23};
+  assign rem23 = u_step23_diff;
+  assign ge23 = u_step23_ge;
+  assign not_s24_ge = ~s24_ge;
+  assign zero23 = s24_zero & not_s24_ge;
   assign shl_s24_q = s24_q <<< 1;
-  assign rs_gek23 = {{29{1'b0}}, gek23};
-  assign quot23 = shl_s24_q | rs_gek23;
-  assign rs_or_49_1 = or_49[33:0];
-  assign rem23 = gek23 ? bits_diffk23 : rs_or_49_1;
+  assign rs_ge23 = {{29{1'b0}}, ge23};
+  assign quot23 = shl_s24_q | rs_ge23;
 
   always @(posedge clk) begin : s25_q23_regs
     s1_b_d23 <= s1_b_d22;
     lo_d23 <= lo_d22;
-    s25_p <= rem23;
+    s25_ge <= ge23;
+    s25_r <= rem23;
     s25_q <= quot23;
+    s25_zero <= zero23;
   end
 
   // stage s26_q24: one quotient bit
   assign rs_s1_b_d24 = {{1{1'b0}}, s1_b_d24};
   assign bits_lo_d24 = lo_d24[5];
-  assign rs_bits_lo_d24 = {{34{1'b0}}, bits_lo_d24};
-  assign rs_s25_p = {{1{1'b0}}, s25_p};
-  assign shl_rs_s25_p = rs_s25_p <<< 1;
-  assign or_51 = shl_rs_s25_p | rs_bits_lo_d24;
-  assign rs_or_51 = {{1{1'b0}}, or_51};
-  assign s_rs_or_51 = $signed(rs_or_51);
-  assign rs_rs_s1_b_d24 = {{1{1'b0}}, rs_s1_b_d24};
-  assign s_rs_rs_s1_b_d24 = $signed(rs_rs_s1_b_d24);
-  assign diffk24 = s_rs_or_51 - s_rs_rs_s1_b_d24;
-  assign bits_diffk24 = diffk24[33:0];
-  assign bits_diffk24_1 = diffk24[35];
-  assign gek24 = ~bits_diffk24_1;
-  assign s25_q_eq_k_0_4 = s25_q == k_0_4;
+  assign cat_26 = {s25_r, bits_lo_d24};
+  assign rem24 = u_step24_diff;
+  assign ge24 = u_step24_ge;
+  assign not_s25_ge = ~s25_ge;
+  assign zero24 = s25_zero & not_s25_ge;
   assign shl_s25_q = s25_q <<< 1;
-  assign rs_gek24 = {{29{1'b0}}, gek24};
-  assign quot24 = shl_s25_q | rs_gek24;
-  assign rs_or_51_1 = or_51[33:0];
-  assign rem24 = gek24 ? bits_diffk24 : rs_or_51_1;
+  assign rs_ge24 = {{29{1'b0}}, ge24};
+  assign quot24 = shl_s25_q | rs_ge24;
 
   always @(posedge clk) begin : s26_q24_regs
     s1_b_d24 <= s1_b_d23;
     lo_d24 <= lo_d23;
-    s26_p <= rem24;
+    s26_ge <= ge24;
+    s26_r <= rem24;
     s26_q <= quot24;
+    s26_zero <= zero24;
   end
 
   // stage s27_q25: one quotient bit
   assign rs_s1_b_d25 = {{1{1'b0}}, s1_b_d25};
   assign bits_lo_d25 = lo_d25[4];
-  assign rs_bits_lo_d25 = {{34{1'b0}}, bits_lo_d25};
-  assign rs_s26_p = {{1{1'b0}}, s26_p};
-  assign shl_rs_s26_p = rs_s26_p <<< 1;
-  assign or_53 = shl_rs_s26_p | rs_bits_lo_d25;
-  assign rs_or_53 = {{1{1'b0}}, or_53};
-  assign s_rs_or_53 = $signed(rs_or_53);
-  assign rs_rs_s1_b_d25 = {{1{1'b0}}, rs_s1_b_d25};
-  assign s_rs_rs_s1_b_d25 = $signed(rs_rs_s1_b_d25);
-  assign diffk25 = s_rs_or_53 - s_rs_rs_s1_b_d25;
-  assign bits_diffk25 = diffk25[33:0];
-  assign bits_diffk25_1 = diffk25[35];
-  assign gek25 = ~bits_diffk25_1;
-  assign s26_q_eq_k_0_4 = s26_q == k_0_4;
+  assign cat_27 = {s26_r, bits_lo_d25};
+  assign rem25 = u_step25_diff;
+  assign ge25 = u_step25_ge;
+  assign not_s26_ge = ~s26_ge;
+  assign zero25 = s26_zero & not_s26_ge;
   assign shl_s26_q = s26_q <<< 1;
-  assign rs_gek25 = {{29{1'b0}}, gek25};
-  assign quot25 = shl_s26_q | rs_gek25;
-  assign rs_or_53_1 = or_53[33:0];
-  assign rem25 = gek25 ? bits_diffk25 : rs_or_53_1;
+  assign rs_ge25 = {{29{1'b0}}, ge25};
+  assign quot25 = shl_s26_q | rs_ge25;
 
   always @(posedge clk) begin : s27_q25_regs
     s1_b_d25 <= s1_b_d24;
     lo_d25 <= lo_d24;
-    s27_p <= rem25;
+    s27_ge <= ge25;
+    s27_r <= rem25;
     s27_q <= quot25;
+    s27_zero <= zero25;
   end
 
   // stage s28_q26: one quotient bit
   assign rs_s1_b_d26 = {{1{1'b0}}, s1_b_d26};
   assign bits_lo_d26 = lo_d26[3];
-  assign rs_bits_lo_d26 = {{34{1'b0}}, bits_lo_d26};
-  assign rs_s27_p = {{1{1'b0}}, s27_p};
-  assign shl_rs_s27_p = rs_s27_p <<< 1;
-  assign or_55 = shl_rs_s27_p | rs_bits_lo_d26;
-  assign rs_or_55 = {{1{1'b0}}, or_55};
-  assign s_rs_or_55 = $signed(rs_or_55);
-  assign rs_rs_s1_b_d26 = {{1{1'b0}}, rs_s1_b_d26};
-  assign s_rs_rs_s1_b_d26 = $signed(rs_rs_s1_b_d26);
-  assign diffk26 = s_rs_or_55 - s_rs_rs_s1_b_d26;
-  assign bits_diffk26 = diffk26[33:0];
-  assign bits_diffk26_1 = diffk26[35];
-  assign gek26 = ~bits_diffk26_1;
-  assign s27_q_eq_k_0_4 = s27_q == k_0_4;
+  assign cat_28 = {s27_r, bits_lo_d26};
+  assign rem26 = u_step26_diff;
+  assign ge26 = u_step26_ge;
+  assign not_s27_ge = ~s27_ge;
+  assign zero26 = s27_zero & not_s27_ge;
   assign shl_s27_q = s27_q <<< 1;
-  assign rs_gek26 = {{29{1'b0}}, gek26};
-  assign quot26 = shl_s27_q | rs_gek26;
-  assign rs_or_55_1 = or_55[33:0];
-  assign rem26 = gek26 ? bits_diffk26 : rs_or_55_1;
+  assign rs_ge26 = {{29{1'b0}}, ge26};
+  assign quot26 = shl_s27_q | rs_ge26;
 
   always @(posedge clk) begin : s28_q26_regs
     s1_b_d26 <= s1_b_d25;
     lo_d26 <= lo_d25;
-    s28_p <= rem26;
+    s28_ge <= ge26;
+    s28_r <= rem26;
     s28_q <= quot26;
+    s28_zero <= zero26;
   end
 
   // stage s29_q27: one quotient bit
   assign rs_s1_b_d27 = {{1{1'b0}}, s1_b_d27};
   assign bits_lo_d27 = lo_d27[2];
-  assign rs_bits_lo_d27 = {{34{1'b0}}, bits_lo_d27};
-  assign rs_s28_p = {{1{1'b0}}, s28_p};
-  assign shl_rs_s28_p = rs_s28_p <<< 1;
-  assign or_57 = shl_rs_s28_p | rs_bits_lo_d27;
-  assign rs_or_57 = {{1{1'b0}}, or_57};
-  assign s_rs_or_57 = $signed(rs_or_57);
-  assign rs_rs_s1_b_d27 = {{1{1'b0}}, rs_s1_b_d27};
-  assign s_rs_rs_s1_b_d27 = $signed(rs_rs_s1_b_d27);
-  assign diffk27 = s_rs_or_57 - s_rs_rs_s1_b_d27;
-  assign bits_diffk27 = diffk27[33:0];
-  assign bits_diffk27_1 = diffk27[35];
-  assign gek27 = ~bits_diffk27_1;
-  assign s28_q_eq_k_0_4 = s28_q == k_0_4;
+  assign cat_29 = {s28_r, bits_lo_d27};
+  assign rem27 = u_step27_diff;
+  assign ge27 = u_step27_ge;
+  assign not_s28_ge = ~s28_ge;
+  assign zero27 = s28_zero & not_s28_ge;
   assign shl_s28_q = s28_q <<< 1;
-  assign rs_gek27 = {{29{1'b0}}, gek27};
-  assign quot27 = shl_s28_q | rs_gek27;
-  assign rs_or_57_1 = or_57[33:0];
-  assign rem27 = gek27 ? bits_diffk27 : rs_or_57_1;
+  assign rs_ge27 = {{29{1'b0}}, ge27};
+  assign quot27 = shl_s28_q | rs_ge27;
 
   always @(posedge clk) begin : s29_q27_regs
     s1_b_d27 <= s1_b_d26;
     lo_d27 <= lo_d26;
-    s29_p <= rem27;
+    s29_ge <= ge27;
+    s29_r <= rem27;
     s29_q <= quot27;
+    s29_zero <= zero27;
   end
 
   // stage s30_q28: one quotient bit
   assign rs_s1_b_d28 = {{1{1'b0}}, s1_b_d28};
   assign bits_lo_d28 = lo_d28[1];
-  assign rs_bits_lo_d28 = {{34{1'b0}}, bits_lo_d28};
-  assign rs_s29_p = {{1{1'b0}}, s29_p};
-  assign shl_rs_s29_p = rs_s29_p <<< 1;
-  assign or_59 = shl_rs_s29_p | rs_bits_lo_d28;
-  assign rs_or_59 = {{1{1'b0}}, or_59};
-  assign s_rs_or_59 = $signed(rs_or_59);
-  assign rs_rs_s1_b_d28 = {{1{1'b0}}, rs_s1_b_d28};
-  assign s_rs_rs_s1_b_d28 = $signed(rs_rs_s1_b_d28);
-  assign diffk28 = s_rs_or_59 - s_rs_rs_s1_b_d28;
-  assign bits_diffk28 = diffk28[33:0];
-  assign bits_diffk28_1 = diffk28[35];
-  assign gek28 = ~bits_diffk28_1;
-  assign s29_q_eq_k_0_4 = s29_q == k_0_4;
+  assign cat_30 = {s29_r, bits_lo_d28};
+  assign rem28 = u_step28_diff;
+  assign ge28 = u_step28_ge;
+  assign not_s29_ge = ~s29_ge;
+  assign zero28 = s29_zero & not_s29_ge;
   assign shl_s29_q = s29_q <<< 1;
-  assign rs_gek28 = {{29{1'b0}}, gek28};
-  assign quot28 = shl_s29_q | rs_gek28;
-  assign rs_or_59_1 = or_59[33:0];
-  assign rem28 = gek28 ? bits_diffk28 : rs_or_59_1;
+  assign rs_ge28 = {{29{1'b0}}, ge28};
+  assign quot28 = shl_s29_q | rs_ge28;
 
   always @(posedge clk) begin : s30_q28_regs
     s1_b_d28 <= s1_b_d27;
     lo_d28 <= lo_d27;
-    s30_p <= rem28;
+    s30_ge <= ge28;
+    s30_r <= rem28;
     s30_q <= quot28;
+    s30_zero <= zero28;
   end
 
   // stage s31_result: the quotient and its result flag
   assign rs_s1_b_d29 = {{1{1'b0}}, s1_b_d29};
   assign bits_lo_d29 = lo_d29[0];
-  assign rs_bits_lo_d29 = {{34{1'b0}}, bits_lo_d29};
-  assign rs_s30_p = {{1{1'b0}}, s30_p};
-  assign shl_rs_s30_p = rs_s30_p <<< 1;
-  assign or_61 = shl_rs_s30_p | rs_bits_lo_d29;
-  assign rs_or_61 = {{1{1'b0}}, or_61};
-  assign s_rs_or_61 = $signed(rs_or_61);
-  assign rs_rs_s1_b_d29 = {{1{1'b0}}, rs_s1_b_d29};
-  assign s_rs_rs_s1_b_d29 = $signed(rs_rs_s1_b_d29);
-  assign diffk29 = s_rs_or_61 - s_rs_rs_s1_b_d29;
-  assign bits_diffk29 = diffk29[33:0];
-  assign bits_diffk29_1 = diffk29[35];
-  assign gek29 = ~bits_diffk29_1;
-  assign s30_q_eq_k_0_4 = s30_q == k_0_4;
+  assign cat_31 = {s30_r, bits_lo_d29};
+  assign rem29 = u_step29_diff;
+  assign ge29 = u_step29_ge;
+  assign not_s30_ge = ~s30_ge;
+  assign zero29 = s30_zero & not_s30_ge;
   assign shl_s30_q = s30_q <<< 1;
-  assign rs_gek29 = {{29{1'b0}}, gek29};
-  assign quot29 = shl_s30_q | rs_gek29;
+  assign rs_ge29 = {{29{1'b0}}, ge29};
+  assign quot29 = shl_s30_q | rs_ge29;
   assign s1_err_d29 = s1_err_d29_sr[29];
   assign overflow_d29 = overflow_d29_sr[29];
-  assign or_63 = s1_err_d29 | overflow_d29;
-  assign not_gek29 = ~gek29;
-  assign and_64 = s30_q_eq_k_0_4 & not_gek29;
-  assign or_63_or_and_64 = or_63 | and_64;
-  assign not_or_63_or_and_64 = ~or_63_or_and_64;
+  assign or_32 = s1_err_d29 | overflow_d29;
+  assign not_ge29 = ~ge29;
+  assign zero29_and_not_ge29 = zero29 & not_ge29;
+  assign or_33 = or_32 | zero29_and_not_ge29;
+  assign not_or_33 = ~or_33;
 
   always @(posedge clk) begin : s31_result_regs
     s1_b_d29 <= s1_b_d28;
@@ -1868,8 +1314,287 @@ module fxrt_div_n29_a63_b34 (
       overflow_d29_sr[overflow_d29_i] <= overflow_d29_sr[overflow_d29_i - 1];
     overflow_d29_sr[1] <= overflow;
     s31_t <= quot29;
-    s31_ok <= not_or_63_or_and_64;
+    s31_ok <= not_or_33;
   end
+
+  fxrt_addsub_w35 u_overflow (
+    .clk(clk),
+    .a(rs_bits_s1_a),
+    .b(rs_s1_b),
+    .sub(k_1),
+    .diff(u_overflow_diff),
+    .ge(u_overflow_ge)
+  );
+
+  fxrt_addsub_w35 u_step0 (
+    .clk(clk),
+    .a(cat_2),
+    .b(rs_s1_b_1),
+    .sub(k_1),
+    .diff(u_step0_diff),
+    .ge(u_step0_ge)
+  );
+
+  fxrt_addsub_w35 u_step1 (
+    .clk(clk),
+    .a(cat_3),
+    .b(rs_s1_b_d1),
+    .sub(s2_ge),
+    .diff(u_step1_diff),
+    .ge(u_step1_ge)
+  );
+
+  fxrt_addsub_w35 u_step2 (
+    .clk(clk),
+    .a(cat_4),
+    .b(rs_s1_b_d2),
+    .sub(s3_ge),
+    .diff(u_step2_diff),
+    .ge(u_step2_ge)
+  );
+
+  fxrt_addsub_w35 u_step3 (
+    .clk(clk),
+    .a(cat_5),
+    .b(rs_s1_b_d3),
+    .sub(s4_ge),
+    .diff(u_step3_diff),
+    .ge(u_step3_ge)
+  );
+
+  fxrt_addsub_w35 u_step4 (
+    .clk(clk),
+    .a(cat_6),
+    .b(rs_s1_b_d4),
+    .sub(s5_ge),
+    .diff(u_step4_diff),
+    .ge(u_step4_ge)
+  );
+
+  fxrt_addsub_w35 u_step5 (
+    .clk(clk),
+    .a(cat_7),
+    .b(rs_s1_b_d5),
+    .sub(s6_ge),
+    .diff(u_step5_diff),
+    .ge(u_step5_ge)
+  );
+
+  fxrt_addsub_w35 u_step6 (
+    .clk(clk),
+    .a(cat_8),
+    .b(rs_s1_b_d6),
+    .sub(s7_ge),
+    .diff(u_step6_diff),
+    .ge(u_step6_ge)
+  );
+
+  fxrt_addsub_w35 u_step7 (
+    .clk(clk),
+    .a(cat_9),
+    .b(rs_s1_b_d7),
+    .sub(s8_ge),
+    .diff(u_step7_diff),
+    .ge(u_step7_ge)
+  );
+
+  fxrt_addsub_w35 u_step8 (
+    .clk(clk),
+    .a(cat_10),
+    .b(rs_s1_b_d8),
+    .sub(s9_ge),
+    .diff(u_step8_diff),
+    .ge(u_step8_ge)
+  );
+
+  fxrt_addsub_w35 u_step9 (
+    .clk(clk),
+    .a(cat_11),
+    .b(rs_s1_b_d9),
+    .sub(s10_ge),
+    .diff(u_step9_diff),
+    .ge(u_step9_ge)
+  );
+
+  fxrt_addsub_w35 u_step10 (
+    .clk(clk),
+    .a(cat_12),
+    .b(rs_s1_b_d10),
+    .sub(s11_ge),
+    .diff(u_step10_diff),
+    .ge(u_step10_ge)
+  );
+
+  fxrt_addsub_w35 u_step11 (
+    .clk(clk),
+    .a(cat_13),
+    .b(rs_s1_b_d11),
+    .sub(s12_ge),
+    .diff(u_step11_diff),
+    .ge(u_step11_ge)
+  );
+
+  fxrt_addsub_w35 u_step12 (
+    .clk(clk),
+    .a(cat_14),
+    .b(rs_s1_b_d12),
+    .sub(s13_ge),
+    .diff(u_step12_diff),
+    .ge(u_step12_ge)
+  );
+
+  fxrt_addsub_w35 u_step13 (
+    .clk(clk),
+    .a(cat_15),
+    .b(rs_s1_b_d13),
+    .sub(s14_ge),
+    .diff(u_step13_diff),
+    .ge(u_step13_ge)
+  );
+
+  fxrt_addsub_w35 u_step14 (
+    .clk(clk),
+    .a(cat_16),
+    .b(rs_s1_b_d14),
+    .sub(s15_ge),
+    .diff(u_step14_diff),
+    .ge(u_step14_ge)
+  );
+
+  fxrt_addsub_w35 u_step15 (
+    .clk(clk),
+    .a(cat_17),
+    .b(rs_s1_b_d15),
+    .sub(s16_ge),
+    .diff(u_step15_diff),
+    .ge(u_step15_ge)
+  );
+
+  fxrt_addsub_w35 u_step16 (
+    .clk(clk),
+    .a(cat_18),
+    .b(rs_s1_b_d16),
+    .sub(s17_ge),
+    .diff(u_step16_diff),
+    .ge(u_step16_ge)
+  );
+
+  fxrt_addsub_w35 u_step17 (
+    .clk(clk),
+    .a(cat_19),
+    .b(rs_s1_b_d17),
+    .sub(s18_ge),
+    .diff(u_step17_diff),
+    .ge(u_step17_ge)
+  );
+
+  fxrt_addsub_w35 u_step18 (
+    .clk(clk),
+    .a(cat_20),
+    .b(rs_s1_b_d18),
+    .sub(s19_ge),
+    .diff(u_step18_diff),
+    .ge(u_step18_ge)
+  );
+
+  fxrt_addsub_w35 u_step19 (
+    .clk(clk),
+    .a(cat_21),
+    .b(rs_s1_b_d19),
+    .sub(s20_ge),
+    .diff(u_step19_diff),
+    .ge(u_step19_ge)
+  );
+
+  fxrt_addsub_w35 u_step20 (
+    .clk(clk),
+    .a(cat_22),
+    .b(rs_s1_b_d20),
+    .sub(s21_ge),
+    .diff(u_step20_diff),
+    .ge(u_step20_ge)
+  );
+
+  fxrt_addsub_w35 u_step21 (
+    .clk(clk),
+    .a(cat_23),
+    .b(rs_s1_b_d21),
+    .sub(s22_ge),
+    .diff(u_step21_diff),
+    .ge(u_step21_ge)
+  );
+
+  fxrt_addsub_w35 u_step22 (
+    .clk(clk),
+    .a(cat_24),
+    .b(rs_s1_b_d22),
+    .sub(s23_ge),
+    .diff(u_step22_diff),
+    .ge(u_step22_ge)
+  );
+
+  fxrt_addsub_w35 u_step23 (
+    .clk(clk),
+    .a(cat_25),
+    .b(rs_s1_b_d23),
+    .sub(s24_ge),
+    .diff(u_step23_diff),
+    .ge(u_step23_ge)
+  );
+
+  fxrt_addsub_w35 u_step24 (
+    .clk(clk),
+    .a(cat_26),
+    .b(rs_s1_b_d24),
+    .sub(s25_ge),
+    .diff(u_step24_diff),
+    .ge(u_step24_ge)
+  );
+
+  fxrt_addsub_w35 u_step25 (
+    .clk(clk),
+    .a(cat_27),
+    .b(rs_s1_b_d25),
+    .sub(s26_ge),
+    .diff(u_step25_diff),
+    .ge(u_step25_ge)
+  );
+
+  fxrt_addsub_w35 u_step26 (
+    .clk(clk),
+    .a(cat_28),
+    .b(rs_s1_b_d26),
+    .sub(s27_ge),
+    .diff(u_step26_diff),
+    .ge(u_step26_ge)
+  );
+
+  fxrt_addsub_w35 u_step27 (
+    .clk(clk),
+    .a(cat_29),
+    .b(rs_s1_b_d27),
+    .sub(s28_ge),
+    .diff(u_step27_diff),
+    .ge(u_step27_ge)
+  );
+
+  fxrt_addsub_w35 u_step28 (
+    .clk(clk),
+    .a(cat_30),
+    .b(rs_s1_b_d28),
+    .sub(s29_ge),
+    .diff(u_step28_diff),
+    .ge(u_step28_ge)
+  );
+
+  fxrt_addsub_w35 u_step29 (
+    .clk(clk),
+    .a(cat_31),
+    .b(rs_s1_b_d29),
+    .sub(s30_ge),
+    .diff(u_step29_diff),
+    .ge(u_step29_ge)
+  );
 
   assign t = s31_t;
   assign ok = s31_ok;

@@ -14,6 +14,16 @@ entity fxrt_div_n29_a63_b34 is
 end entity fxrt_div_n29_a63_b34;
 
 architecture rtl of fxrt_div_n29_a63_b34 is
+  component fxrt_addsub_w35 is
+    port (
+      clk : in std_logic;
+      a : in unsigned(34 downto 0);
+      b : in unsigned(34 downto 0);
+      sub : in unsigned(0 downto 0);
+      diff : out unsigned(33 downto 0);
+      ge : out unsigned(0 downto 0)
+    );
+  end component;
 
   -- not in a stage or state machine
 
@@ -40,788 +50,602 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   -- stage s2_q0: one quotient bit
   signal bits_s1_a : unsigned(32 downto 0);
   signal lo : unsigned(29 downto 0);
-  signal rs_bits_s1_a : unsigned(33 downto 0);
-  signal rs_rs_bits_s1_a : unsigned(34 downto 0);
-  signal s_rs_rs_bits_s1_a : signed(34 downto 0);
+  signal rs_bits_s1_a : unsigned(34 downto 0);
   signal rs_s1_b : unsigned(34 downto 0);
-  signal s_rs_s1_b : signed(34 downto 0);
-  signal minus_2 : signed(34 downto 0);
-  signal bits_minus_2 : unsigned(0 downto 0);
+  constant k_1 : unsigned(0 downto 0) := unsigned'("1");
+  signal u_overflow_diff : unsigned(33 downto 0);
+  signal u_overflow_ge : unsigned(0 downto 0);
   signal overflow : unsigned(0 downto 0);
-  constant k_0_2 : unsigned(0 downto 0) := unsigned'("0");
-  constant k_0_3 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_bits_s1_a_1 : unsigned(33 downto 0);
-  constant k_0_4 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  constant k_0_2 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal rs_s1_b_1 : unsigned(34 downto 0);
   signal bits_lo : unsigned(0 downto 0);
-  signal rs_bits_lo : unsigned(34 downto 0);
-  signal rs_rs_bits_s1_a_1 : unsigned(34 downto 0);
-  signal shl_rs_rs_bits_s1_a_1 : unsigned(34 downto 0);
-  signal or_3 : unsigned(34 downto 0);
-  signal rs_or_3 : unsigned(35 downto 0);
-  signal s_rs_or_3 : signed(35 downto 0);
-  signal rs_rs_s1_b_1 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_1 : signed(35 downto 0);
-  signal diffk0 : signed(35 downto 0);
-  signal bits_diffk0 : unsigned(33 downto 0);
-  signal bits_diffk0_1 : unsigned(0 downto 0);
-  signal gek0 : unsigned(0 downto 0);
-  constant k_1 : unsigned(0 downto 0) := unsigned'("1");
-  signal rs_gek0 : unsigned(29 downto 0);
-  signal quot0 : unsigned(29 downto 0);
-  signal rs_or_3_1 : unsigned(33 downto 0);
+  signal cat_2 : unsigned(34 downto 0);
+  signal u_step0_diff : unsigned(33 downto 0);
+  signal u_step0_ge : unsigned(0 downto 0);
   signal rem0 : unsigned(33 downto 0);
-  signal s2_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge0 : unsigned(0 downto 0);
+  signal rs_ge0 : unsigned(29 downto 0);
+  signal quot0 : unsigned(29 downto 0);
+  signal s2_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s2_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s2_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s2_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s3_q1: one quotient bit
   signal s1_b_d1 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d1 : unsigned(34 downto 0);
   signal lo_d1 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d1 : unsigned(0 downto 0);
-  signal rs_bits_lo_d1 : unsigned(34 downto 0);
-  signal rs_s2_p : unsigned(34 downto 0);
-  signal shl_rs_s2_p : unsigned(34 downto 0);
-  signal or_5 : unsigned(34 downto 0);
-  signal rs_or_5 : unsigned(35 downto 0);
-  signal s_rs_or_5 : signed(35 downto 0);
-  signal rs_rs_s1_b_d1 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d1 : signed(35 downto 0);
-  signal diffk1 : signed(35 downto 0);
-  signal bits_diffk1 : unsigned(33 downto 0);
-  signal bits_diffk1_1 : unsigned(0 downto 0);
-  signal gek1 : unsigned(0 downto 0);
-  signal s2_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s2_q : unsigned(29 downto 0);
-  signal rs_gek1 : unsigned(29 downto 0);
-  signal quot1 : unsigned(29 downto 0);
-  signal rs_or_5_1 : unsigned(33 downto 0);
+  signal cat_3 : unsigned(34 downto 0);
+  signal u_step1_diff : unsigned(33 downto 0);
+  signal u_step1_ge : unsigned(0 downto 0);
   signal rem1 : unsigned(33 downto 0);
-  signal s3_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge1 : unsigned(0 downto 0);
+  signal not_s2_ge : unsigned(0 downto 0);
+  signal zero1 : unsigned(0 downto 0);
+  signal shl_s2_q : unsigned(29 downto 0);
+  signal rs_ge1 : unsigned(29 downto 0);
+  signal quot1 : unsigned(29 downto 0);
+  signal s3_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s3_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s3_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s3_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s4_q2: one quotient bit
   signal s1_b_d2 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d2 : unsigned(34 downto 0);
   signal lo_d2 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d2 : unsigned(0 downto 0);
-  signal rs_bits_lo_d2 : unsigned(34 downto 0);
-  signal rs_s3_p : unsigned(34 downto 0);
-  signal shl_rs_s3_p : unsigned(34 downto 0);
-  signal or_7 : unsigned(34 downto 0);
-  signal rs_or_7 : unsigned(35 downto 0);
-  signal s_rs_or_7 : signed(35 downto 0);
-  signal rs_rs_s1_b_d2 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d2 : signed(35 downto 0);
-  signal diffk2 : signed(35 downto 0);
-  signal bits_diffk2 : unsigned(33 downto 0);
-  signal bits_diffk2_1 : unsigned(0 downto 0);
-  signal gek2 : unsigned(0 downto 0);
-  signal s3_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s3_q : unsigned(29 downto 0);
-  signal rs_gek2 : unsigned(29 downto 0);
-  signal quot2 : unsigned(29 downto 0);
-  signal rs_or_7_1 : unsigned(33 downto 0);
+  signal cat_4 : unsigned(34 downto 0);
+  signal u_step2_diff : unsigned(33 downto 0);
+  signal u_step2_ge : unsigned(0 downto 0);
   signal rem2 : unsigned(33 downto 0);
-  signal s4_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge2 : unsigned(0 downto 0);
+  signal not_s3_ge : unsigned(0 downto 0);
+  signal zero2 : unsigned(0 downto 0);
+  signal shl_s3_q : unsigned(29 downto 0);
+  signal rs_ge2 : unsigned(29 downto 0);
+  signal quot2 : unsigned(29 downto 0);
+  signal s4_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s4_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s4_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s4_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s5_q3: one quotient bit
   signal s1_b_d3 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d3 : unsigned(34 downto 0);
   signal lo_d3 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d3 : unsigned(0 downto 0);
-  signal rs_bits_lo_d3 : unsigned(34 downto 0);
-  signal rs_s4_p : unsigned(34 downto 0);
-  signal shl_rs_s4_p : unsigned(34 downto 0);
-  signal or_9 : unsigned(34 downto 0);
-  signal rs_or_9 : unsigned(35 downto 0);
-  signal s_rs_or_9 : signed(35 downto 0);
-  signal rs_rs_s1_b_d3 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d3 : signed(35 downto 0);
-  signal diffk3 : signed(35 downto 0);
-  signal bits_diffk3 : unsigned(33 downto 0);
-  signal bits_diffk3_1 : unsigned(0 downto 0);
-  signal gek3 : unsigned(0 downto 0);
-  signal s4_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s4_q : unsigned(29 downto 0);
-  signal rs_gek3 : unsigned(29 downto 0);
-  signal quot3 : unsigned(29 downto 0);
-  signal rs_or_9_1 : unsigned(33 downto 0);
+  signal cat_5 : unsigned(34 downto 0);
+  signal u_step3_diff : unsigned(33 downto 0);
+  signal u_step3_ge : unsigned(0 downto 0);
   signal rem3 : unsigned(33 downto 0);
-  signal s5_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge3 : unsigned(0 downto 0);
+  signal not_s4_ge : unsigned(0 downto 0);
+  signal zero3 : unsigned(0 downto 0);
+  signal shl_s4_q : unsigned(29 downto 0);
+  signal rs_ge3 : unsigned(29 downto 0);
+  signal quot3 : unsigned(29 downto 0);
+  signal s5_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s5_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s5_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s5_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s6_q4: one quotient bit
   signal s1_b_d4 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d4 : unsigned(34 downto 0);
   signal lo_d4 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d4 : unsigned(0 downto 0);
-  signal rs_bits_lo_d4 : unsigned(34 downto 0);
-  signal rs_s5_p : unsigned(34 downto 0);
-  signal shl_rs_s5_p : unsigned(34 downto 0);
-  signal or_11 : unsigned(34 downto 0);
-  signal rs_or_11 : unsigned(35 downto 0);
-  signal s_rs_or_11 : signed(35 downto 0);
-  signal rs_rs_s1_b_d4 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d4 : signed(35 downto 0);
-  signal diffk4 : signed(35 downto 0);
-  signal bits_diffk4 : unsigned(33 downto 0);
-  signal bits_diffk4_1 : unsigned(0 downto 0);
-  signal gek4 : unsigned(0 downto 0);
-  signal s5_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s5_q : unsigned(29 downto 0);
-  signal rs_gek4 : unsigned(29 downto 0);
-  signal quot4 : unsigned(29 downto 0);
-  signal rs_or_11_1 : unsigned(33 downto 0);
+  signal cat_6 : unsigned(34 downto 0);
+  signal u_step4_diff : unsigned(33 downto 0);
+  signal u_step4_ge : unsigned(0 downto 0);
   signal rem4 : unsigned(33 downto 0);
-  signal s6_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge4 : unsigned(0 downto 0);
+  signal not_s5_ge : unsigned(0 downto 0);
+  signal zero4 : unsigned(0 downto 0);
+  signal shl_s5_q : unsigned(29 downto 0);
+  signal rs_ge4 : unsigned(29 downto 0);
+  signal quot4 : unsigned(29 downto 0);
+  signal s6_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s6_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s6_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s6_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s7_q5: one quotient bit
   signal s1_b_d5 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d5 : unsigned(34 downto 0);
   signal lo_d5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d5 : unsigned(0 downto 0);
-  signal rs_bits_lo_d5 : unsigned(34 downto 0);
-  signal rs_s6_p : unsigned(34 downto 0);
-  signal shl_rs_s6_p : unsigned(34 downto 0);
-  signal or_13 : unsigned(34 downto 0);
-  signal rs_or_13 : unsigned(35 downto 0);
-  signal s_rs_or_13 : signed(35 downto 0);
-  signal rs_rs_s1_b_d5 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d5 : signed(35 downto 0);
-  signal diffk5 : signed(35 downto 0);
-  signal bits_diffk5 : unsigned(33 downto 0);
-  signal bits_diffk5_1 : unsigned(0 downto 0);
-  signal gek5 : unsigned(0 downto 0);
-  signal s6_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s6_q : unsigned(29 downto 0);
-  signal rs_gek5 : unsigned(29 downto 0);
-  signal quot5 : unsigned(29 downto 0);
-  signal rs_or_13_1 : unsigned(33 downto 0);
+  signal cat_7 : unsigned(34 downto 0);
+  signal u_step5_diff : unsigned(33 downto 0);
+  signal u_step5_ge : unsigned(0 downto 0);
   signal rem5 : unsigned(33 downto 0);
-  signal s7_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge5 : unsigned(0 downto 0);
+  signal not_s6_ge : unsigned(0 downto 0);
+  signal zero5 : unsigned(0 downto 0);
+  signal shl_s6_q : unsigned(29 downto 0);
+  signal rs_ge5 : unsigned(29 downto 0);
+  signal quot5 : unsigned(29 downto 0);
+  signal s7_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s7_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s7_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s7_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s8_q6: one quotient bit
   signal s1_b_d6 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d6 : unsigned(34 downto 0);
   signal lo_d6 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d6 : unsigned(0 downto 0);
-  signal rs_bits_lo_d6 : unsigned(34 downto 0);
-  signal rs_s7_p : unsigned(34 downto 0);
-  signal shl_rs_s7_p : unsigned(34 downto 0);
-  signal or_15 : unsigned(34 downto 0);
-  signal rs_or_15 : unsigned(35 downto 0);
-  signal s_rs_or_15 : signed(35 downto 0);
-  signal rs_rs_s1_b_d6 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d6 : signed(35 downto 0);
-  signal diffk6 : signed(35 downto 0);
-  signal bits_diffk6 : unsigned(33 downto 0);
-  signal bits_diffk6_1 : unsigned(0 downto 0);
-  signal gek6 : unsigned(0 downto 0);
-  signal s7_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s7_q : unsigned(29 downto 0);
-  signal rs_gek6 : unsigned(29 downto 0);
-  signal quot6 : unsigned(29 downto 0);
-  signal rs_or_15_1 : unsigned(33 downto 0);
+  signal cat_8 : unsigned(34 downto 0);
+  signal u_step6_diff : unsigned(33 downto 0);
+  signal u_step6_ge : unsigned(0 downto 0);
   signal rem6 : unsigned(33 downto 0);
-  signal s8_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge6 : unsigned(0 downto 0);
+  signal not_s7_ge : unsigned(0 downto 0);
+  signal zero6 : unsigned(0 downto 0);
+  signal shl_s7_q : unsigned(29 downto 0);
+  signal rs_ge6 : unsigned(29 downto 0);
+  signal quot6 : unsigned(29 downto 0);
+  signal s8_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s8_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s8_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s8_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s9_q7: one quotient bit
   signal s1_b_d7 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d7 : unsigned(34 downto 0);
   signal lo_d7 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d7 : unsigned(0 downto 0);
-  signal rs_bits_lo_d7 : unsigned(34 downto 0);
-  signal rs_s8_p : unsigned(34 downto 0);
-  signal shl_rs_s8_p : unsigned(34 downto 0);
-  signal or_17 : unsigned(34 downto 0);
-  signal rs_or_17 : unsigned(35 downto 0);
-  signal s_rs_or_17 : signed(35 downto 0);
-  signal rs_rs_s1_b_d7 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d7 : signed(35 downto 0);
-  signal diffk7 : signed(35 downto 0);
-  signal bits_diffk7 : unsigned(33 downto 0);
-  signal bits_diffk7_1 : unsigned(0 downto 0);
-  signal gek7 : unsigned(0 downto 0);
-  signal s8_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s8_q : unsigned(29 downto 0);
-  signal rs_gek7 : unsigned(29 downto 0);
-  signal quot7 : unsigned(29 downto 0);
-  signal rs_or_17_1 : unsigned(33 downto 0);
+  signal cat_9 : unsigned(34 downto 0);
+  signal u_step7_diff : unsigned(33 downto 0);
+  signal u_step7_ge : unsigned(0 downto 0);
   signal rem7 : unsigned(33 downto 0);
-  signal s9_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge7 : unsigned(0 downto 0);
+  signal not_s8_ge : unsigned(0 downto 0);
+  signal zero7 : unsigned(0 downto 0);
+  signal shl_s8_q : unsigned(29 downto 0);
+  signal rs_ge7 : unsigned(29 downto 0);
+  signal quot7 : unsigned(29 downto 0);
+  signal s9_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s9_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s9_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s9_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s10_q8: one quotient bit
   signal s1_b_d8 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d8 : unsigned(34 downto 0);
   signal lo_d8 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d8 : unsigned(0 downto 0);
-  signal rs_bits_lo_d8 : unsigned(34 downto 0);
-  signal rs_s9_p : unsigned(34 downto 0);
-  signal shl_rs_s9_p : unsigned(34 downto 0);
-  signal or_19 : unsigned(34 downto 0);
-  signal rs_or_19 : unsigned(35 downto 0);
-  signal s_rs_or_19 : signed(35 downto 0);
-  signal rs_rs_s1_b_d8 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d8 : signed(35 downto 0);
-  signal diffk8 : signed(35 downto 0);
-  signal bits_diffk8 : unsigned(33 downto 0);
-  signal bits_diffk8_1 : unsigned(0 downto 0);
-  signal gek8 : unsigned(0 downto 0);
-  signal s9_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s9_q : unsigned(29 downto 0);
-  signal rs_gek8 : unsigned(29 downto 0);
-  signal quot8 : unsigned(29 downto 0);
-  signal rs_or_19_1 : unsigned(33 downto 0);
+  signal cat_10 : unsigned(34 downto 0);
+  signal u_step8_diff : unsigned(33 downto 0);
+  signal u_step8_ge : unsigned(0 downto 0);
   signal rem8 : unsigned(33 downto 0);
-  signal s10_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge8 : unsigned(0 downto 0);
+  signal not_s9_ge : unsigned(0 downto 0);
+  signal zero8 : unsigned(0 downto 0);
+  signal shl_s9_q : unsigned(29 downto 0);
+  signal rs_ge8 : unsigned(29 downto 0);
+  signal quot8 : unsigned(29 downto 0);
+  signal s10_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s10_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s10_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s10_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s11_q9: one quotient bit
   signal s1_b_d9 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d9 : unsigned(34 downto 0);
   signal lo_d9 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d9 : unsigned(0 downto 0);
-  signal rs_bits_lo_d9 : unsigned(34 downto 0);
-  signal rs_s10_p : unsigned(34 downto 0);
-  signal shl_rs_s10_p : unsigned(34 downto 0);
-  signal or_21 : unsigned(34 downto 0);
-  signal rs_or_21 : unsigned(35 downto 0);
-  signal s_rs_or_21 : signed(35 downto 0);
-  signal rs_rs_s1_b_d9 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d9 : signed(35 downto 0);
-  signal diffk9 : signed(35 downto 0);
-  signal bits_diffk9 : unsigned(33 downto 0);
-  signal bits_diffk9_1 : unsigned(0 downto 0);
-  signal gek9 : unsigned(0 downto 0);
-  signal s10_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s10_q : unsigned(29 downto 0);
-  signal rs_gek9 : unsigned(29 downto 0);
-  signal quot9 : unsigned(29 downto 0);
-  signal rs_or_21_1 : unsigned(33 downto 0);
+  signal cat_11 : unsigned(34 downto 0);
+  signal u_step9_diff : unsigned(33 downto 0);
+  signal u_step9_ge : unsigned(0 downto 0);
   signal rem9 : unsigned(33 downto 0);
-  signal s11_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge9 : unsigned(0 downto 0);
+  signal not_s10_ge : unsigned(0 downto 0);
+  signal zero9 : unsigned(0 downto 0);
+  signal shl_s10_q : unsigned(29 downto 0);
+  signal rs_ge9 : unsigned(29 downto 0);
+  signal quot9 : unsigned(29 downto 0);
+  signal s11_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s11_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s11_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s11_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s12_q10: one quotient bit
   signal s1_b_d10 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d10 : unsigned(34 downto 0);
   signal lo_d10 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d10 : unsigned(0 downto 0);
-  signal rs_bits_lo_d10 : unsigned(34 downto 0);
-  signal rs_s11_p : unsigned(34 downto 0);
-  signal shl_rs_s11_p : unsigned(34 downto 0);
-  signal or_23 : unsigned(34 downto 0);
-  signal rs_or_23 : unsigned(35 downto 0);
-  signal s_rs_or_23 : signed(35 downto 0);
-  signal rs_rs_s1_b_d10 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d10 : signed(35 downto 0);
-  signal diffk10 : signed(35 downto 0);
-  signal bits_diffk10 : unsigned(33 downto 0);
-  signal bits_diffk10_1 : unsigned(0 downto 0);
-  signal gek10 : unsigned(0 downto 0);
-  signal s11_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s11_q : unsigned(29 downto 0);
-  signal rs_gek10 : unsigned(29 downto 0);
-  signal quot10 : unsigned(29 downto 0);
-  signal rs_or_23_1 : unsigned(33 downto 0);
+  signal cat_12 : unsigned(34 downto 0);
+  signal u_step10_diff : unsigned(33 downto 0);
+  signal u_step10_ge : unsigned(0 downto 0);
   signal rem10 : unsigned(33 downto 0);
-  signal s12_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge10 : unsigned(0 downto 0);
+  signal not_s11_ge : unsigned(0 downto 0);
+  signal zero10 : unsigned(0 downto 0);
+  signal shl_s11_q : unsigned(29 downto 0);
+  signal rs_ge10 : unsigned(29 downto 0);
+  signal quot10 : unsigned(29 downto 0);
+  signal s12_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s12_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s12_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s12_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s13_q11: one quotient bit
   signal s1_b_d11 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d11 : unsigned(34 downto 0);
   signal lo_d11 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d11 : unsigned(0 downto 0);
-  signal rs_bits_lo_d11 : unsigned(34 downto 0);
-  signal rs_s12_p : unsigned(34 downto 0);
-  signal shl_rs_s12_p : unsigned(34 downto 0);
-  signal or_25 : unsigned(34 downto 0);
-  signal rs_or_25 : unsigned(35 downto 0);
-  signal s_rs_or_25 : signed(35 downto 0);
-  signal rs_rs_s1_b_d11 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d11 : signed(35 downto 0);
-  signal diffk11 : signed(35 downto 0);
-  signal bits_diffk11 : unsigned(33 downto 0);
-  signal bits_diffk11_1 : unsigned(0 downto 0);
-  signal gek11 : unsigned(0 downto 0);
-  signal s12_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s12_q : unsigned(29 downto 0);
-  signal rs_gek11 : unsigned(29 downto 0);
-  signal quot11 : unsigned(29 downto 0);
-  signal rs_or_25_1 : unsigned(33 downto 0);
+  signal cat_13 : unsigned(34 downto 0);
+  signal u_step11_diff : unsigned(33 downto 0);
+  signal u_step11_ge : unsigned(0 downto 0);
   signal rem11 : unsigned(33 downto 0);
-  signal s13_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge11 : unsigned(0 downto 0);
+  signal not_s12_ge : unsigned(0 downto 0);
+  signal zero11 : unsigned(0 downto 0);
+  signal shl_s12_q : unsigned(29 downto 0);
+  signal rs_ge11 : unsigned(29 downto 0);
+  signal quot11 : unsigned(29 downto 0);
+  signal s13_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s13_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s13_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s13_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s14_q12: one quotient bit
   signal s1_b_d12 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d12 : unsigned(34 downto 0);
   signal lo_d12 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d12 : unsigned(0 downto 0);
-  signal rs_bits_lo_d12 : unsigned(34 downto 0);
-  signal rs_s13_p : unsigned(34 downto 0);
-  signal shl_rs_s13_p : unsigned(34 downto 0);
-  signal or_27 : unsigned(34 downto 0);
-  signal rs_or_27 : unsigned(35 downto 0);
-  signal s_rs_or_27 : signed(35 downto 0);
-  signal rs_rs_s1_b_d12 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d12 : signed(35 downto 0);
-  signal diffk12 : signed(35 downto 0);
-  signal bits_diffk12 : unsigned(33 downto 0);
-  signal bits_diffk12_1 : unsigned(0 downto 0);
-  signal gek12 : unsigned(0 downto 0);
-  signal s13_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s13_q : unsigned(29 downto 0);
-  signal rs_gek12 : unsigned(29 downto 0);
-  signal quot12 : unsigned(29 downto 0);
-  signal rs_or_27_1 : unsigned(33 downto 0);
+  signal cat_14 : unsigned(34 downto 0);
+  signal u_step12_diff : unsigned(33 downto 0);
+  signal u_step12_ge : unsigned(0 downto 0);
   signal rem12 : unsigned(33 downto 0);
-  signal s14_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge12 : unsigned(0 downto 0);
+  signal not_s13_ge : unsigned(0 downto 0);
+  signal zero12 : unsigned(0 downto 0);
+  signal shl_s13_q : unsigned(29 downto 0);
+  signal rs_ge12 : unsigned(29 downto 0);
+  signal quot12 : unsigned(29 downto 0);
+  signal s14_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s14_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s14_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s14_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s15_q13: one quotient bit
   signal s1_b_d13 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d13 : unsigned(34 downto 0);
   signal lo_d13 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d13 : unsigned(0 downto 0);
-  signal rs_bits_lo_d13 : unsigned(34 downto 0);
-  signal rs_s14_p : unsigned(34 downto 0);
-  signal shl_rs_s14_p : unsigned(34 downto 0);
-  signal or_29 : unsigned(34 downto 0);
-  signal rs_or_29 : unsigned(35 downto 0);
-  signal s_rs_or_29 : signed(35 downto 0);
-  signal rs_rs_s1_b_d13 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d13 : signed(35 downto 0);
-  signal diffk13 : signed(35 downto 0);
-  signal bits_diffk13 : unsigned(33 downto 0);
-  signal bits_diffk13_1 : unsigned(0 downto 0);
-  signal gek13 : unsigned(0 downto 0);
-  signal s14_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s14_q : unsigned(29 downto 0);
-  signal rs_gek13 : unsigned(29 downto 0);
-  signal quot13 : unsigned(29 downto 0);
-  signal rs_or_29_1 : unsigned(33 downto 0);
+  signal cat_15 : unsigned(34 downto 0);
+  signal u_step13_diff : unsigned(33 downto 0);
+  signal u_step13_ge : unsigned(0 downto 0);
   signal rem13 : unsigned(33 downto 0);
-  signal s15_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge13 : unsigned(0 downto 0);
+  signal not_s14_ge : unsigned(0 downto 0);
+  signal zero13 : unsigned(0 downto 0);
+  signal shl_s14_q : unsigned(29 downto 0);
+  signal rs_ge13 : unsigned(29 downto 0);
+  signal quot13 : unsigned(29 downto 0);
+  signal s15_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s15_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s15_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s15_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s16_q14: one quotient bit
   signal s1_b_d14 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d14 : unsigned(34 downto 0);
   signal lo_d14 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d14 : unsigned(0 downto 0);
-  signal rs_bits_lo_d14 : unsigned(34 downto 0);
-  signal rs_s15_p : unsigned(34 downto 0);
-  signal shl_rs_s15_p : unsigned(34 downto 0);
-  signal or_31 : unsigned(34 downto 0);
-  signal rs_or_31 : unsigned(35 downto 0);
-  signal s_rs_or_31 : signed(35 downto 0);
-  signal rs_rs_s1_b_d14 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d14 : signed(35 downto 0);
-  signal diffk14 : signed(35 downto 0);
-  signal bits_diffk14 : unsigned(33 downto 0);
-  signal bits_diffk14_1 : unsigned(0 downto 0);
-  signal gek14 : unsigned(0 downto 0);
-  signal s15_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s15_q : unsigned(29 downto 0);
-  signal rs_gek14 : unsigned(29 downto 0);
-  signal quot14 : unsigned(29 downto 0);
-  signal rs_or_31_1 : unsigned(33 downto 0);
+  signal cat_16 : unsigned(34 downto 0);
+  signal u_step14_diff : unsigned(33 downto 0);
+  signal u_step14_ge : unsigned(0 downto 0);
   signal rem14 : unsigned(33 downto 0);
-  signal s16_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge14 : unsigned(0 downto 0);
+  signal not_s15_ge : unsigned(0 downto 0);
+  signal zero14 : unsigned(0 downto 0);
+  signal shl_s15_q : unsigned(29 downto 0);
+  signal rs_ge14 : unsigned(29 downto 0);
+  signal quot14 : unsigned(29 downto 0);
+  signal s16_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s16_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s16_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s16_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s17_q15: one quotient bit
   signal s1_b_d15 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d15 : unsigned(34 downto 0);
   signal lo_d15 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d15 : unsigned(0 downto 0);
-  signal rs_bits_lo_d15 : unsigned(34 downto 0);
-  signal rs_s16_p : unsigned(34 downto 0);
-  signal shl_rs_s16_p : unsigned(34 downto 0);
-  signal or_33 : unsigned(34 downto 0);
-  signal rs_or_33 : unsigned(35 downto 0);
-  signal s_rs_or_33 : signed(35 downto 0);
-  signal rs_rs_s1_b_d15 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d15 : signed(35 downto 0);
-  signal diffk15 : signed(35 downto 0);
-  signal bits_diffk15 : unsigned(33 downto 0);
-  signal bits_diffk15_1 : unsigned(0 downto 0);
-  signal gek15 : unsigned(0 downto 0);
-  signal s16_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s16_q : unsigned(29 downto 0);
-  signal rs_gek15 : unsigned(29 downto 0);
-  signal quot15 : unsigned(29 downto 0);
-  signal rs_or_33_1 : unsigned(33 downto 0);
+  signal cat_17 : unsigned(34 downto 0);
+  signal u_step15_diff : unsigned(33 downto 0);
+  signal u_step15_ge : unsigned(0 downto 0);
   signal rem15 : unsigned(33 downto 0);
-  signal s17_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge15 : unsigned(0 downto 0);
+  signal not_s16_ge : unsigned(0 downto 0);
+  signal zero15 : unsigned(0 downto 0);
+  signal shl_s16_q : unsigned(29 downto 0);
+  signal rs_ge15 : unsigned(29 downto 0);
+  signal quot15 : unsigned(29 downto 0);
+  signal s17_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s17_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s17_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s17_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s18_q16: one quotient bit
   signal s1_b_d16 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d16 : unsigned(34 downto 0);
   signal lo_d16 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d16 : unsigned(0 downto 0);
-  signal rs_bits_lo_d16 : unsigned(34 downto 0);
-  signal rs_s17_p : unsigned(34 downto 0);
-  signal shl_rs_s17_p : unsigned(34 downto 0);
-  signal or_35 : unsigned(34 downto 0);
-  signal rs_or_35 : unsigned(35 downto 0);
-  signal s_rs_or_35 : signed(35 downto 0);
-  signal rs_rs_s1_b_d16 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d16 : signed(35 downto 0);
-  signal diffk16 : signed(35 downto 0);
-  signal bits_diffk16 : unsigned(33 downto 0);
-  signal bits_diffk16_1 : unsigned(0 downto 0);
-  signal gek16 : unsigned(0 downto 0);
-  signal s17_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s17_q : unsigned(29 downto 0);
-  signal rs_gek16 : unsigned(29 downto 0);
-  signal quot16 : unsigned(29 downto 0);
-  signal rs_or_35_1 : unsigned(33 downto 0);
+  signal cat_18 : unsigned(34 downto 0);
+  signal u_step16_diff : unsigned(33 downto 0);
+  signal u_step16_ge : unsigned(0 downto 0);
   signal rem16 : unsigned(33 downto 0);
-  signal s18_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge16 : unsigned(0 downto 0);
+  signal not_s17_ge : unsigned(0 downto 0);
+  signal zero16 : unsigned(0 downto 0);
+  signal shl_s17_q : unsigned(29 downto 0);
+  signal rs_ge16 : unsigned(29 downto 0);
+  signal quot16 : unsigned(29 downto 0);
+  signal s18_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s18_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s18_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s18_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s19_q17: one quotient bit
   signal s1_b_d17 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d17 : unsigned(34 downto 0);
   signal lo_d17 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d17 : unsigned(0 downto 0);
-  signal rs_bits_lo_d17 : unsigned(34 downto 0);
-  signal rs_s18_p : unsigned(34 downto 0);
-  signal shl_rs_s18_p : unsigned(34 downto 0);
-  signal or_37 : unsigned(34 downto 0);
-  signal rs_or_37 : unsigned(35 downto 0);
-  signal s_rs_or_37 : signed(35 downto 0);
-  signal rs_rs_s1_b_d17 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d17 : signed(35 downto 0);
-  signal diffk17 : signed(35 downto 0);
-  signal bits_diffk17 : unsigned(33 downto 0);
-  signal bits_diffk17_1 : unsigned(0 downto 0);
-  signal gek17 : unsigned(0 downto 0);
-  signal s18_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s18_q : unsigned(29 downto 0);
-  signal rs_gek17 : unsigned(29 downto 0);
-  signal quot17 : unsigned(29 downto 0);
-  signal rs_or_37_1 : unsigned(33 downto 0);
+  signal cat_19 : unsigned(34 downto 0);
+  signal u_step17_diff : unsigned(33 downto 0);
+  signal u_step17_ge : unsigned(0 downto 0);
   signal rem17 : unsigned(33 downto 0);
-  signal s19_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge17 : unsigned(0 downto 0);
+  signal not_s18_ge : unsigned(0 downto 0);
+  signal zero17 : unsigned(0 downto 0);
+  signal shl_s18_q : unsigned(29 downto 0);
+  signal rs_ge17 : unsigned(29 downto 0);
+  signal quot17 : unsigned(29 downto 0);
+  signal s19_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s19_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s19_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s19_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s20_q18: one quotient bit
   signal s1_b_d18 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d18 : unsigned(34 downto 0);
   signal lo_d18 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d18 : unsigned(0 downto 0);
-  signal rs_bits_lo_d18 : unsigned(34 downto 0);
-  signal rs_s19_p : unsigned(34 downto 0);
-  signal shl_rs_s19_p : unsigned(34 downto 0);
-  signal or_39 : unsigned(34 downto 0);
-  signal rs_or_39 : unsigned(35 downto 0);
-  signal s_rs_or_39 : signed(35 downto 0);
-  signal rs_rs_s1_b_d18 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d18 : signed(35 downto 0);
-  signal diffk18 : signed(35 downto 0);
-  signal bits_diffk18 : unsigned(33 downto 0);
-  signal bits_diffk18_1 : unsigned(0 downto 0);
-  signal gek18 : unsigned(0 downto 0);
-  signal s19_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s19_q : unsigned(29 downto 0);
-  signal rs_gek18 : unsigned(29 downto 0);
-  signal quot18 : unsigned(29 downto 0);
-  signal rs_or_39_1 : unsigned(33 downto 0);
+  signal cat_20 : unsigned(34 downto 0);
+  signal u_step18_diff : unsigned(33 downto 0);
+  signal u_step18_ge : unsigned(0 downto 0);
   signal rem18 : unsigned(33 downto 0);
-  signal s20_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge18 : unsigned(0 downto 0);
+  signal not_s19_ge : unsigned(0 downto 0);
+  signal zero18 : unsigned(0 downto 0);
+  signal shl_s19_q : unsigned(29 downto 0);
+  signal rs_ge18 : unsigned(29 downto 0);
+  signal quot18 : unsigned(29 downto 0);
+  signal s20_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s20_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s20_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s20_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s21_q19: one quotient bit
   signal s1_b_d19 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d19 : unsigned(34 downto 0);
   signal lo_d19 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d19 : unsigned(0 downto 0);
-  signal rs_bits_lo_d19 : unsigned(34 downto 0);
-  signal rs_s20_p : unsigned(34 downto 0);
-  signal shl_rs_s20_p : unsigned(34 downto 0);
-  signal or_41 : unsigned(34 downto 0);
-  signal rs_or_41 : unsigned(35 downto 0);
-  signal s_rs_or_41 : signed(35 downto 0);
-  signal rs_rs_s1_b_d19 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d19 : signed(35 downto 0);
-  signal diffk19 : signed(35 downto 0);
-  signal bits_diffk19 : unsigned(33 downto 0);
-  signal bits_diffk19_1 : unsigned(0 downto 0);
-  signal gek19 : unsigned(0 downto 0);
-  signal s20_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s20_q : unsigned(29 downto 0);
-  signal rs_gek19 : unsigned(29 downto 0);
-  signal quot19 : unsigned(29 downto 0);
-  signal rs_or_41_1 : unsigned(33 downto 0);
+  signal cat_21 : unsigned(34 downto 0);
+  signal u_step19_diff : unsigned(33 downto 0);
+  signal u_step19_ge : unsigned(0 downto 0);
   signal rem19 : unsigned(33 downto 0);
-  signal s21_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge19 : unsigned(0 downto 0);
+  signal not_s20_ge : unsigned(0 downto 0);
+  signal zero19 : unsigned(0 downto 0);
+  signal shl_s20_q : unsigned(29 downto 0);
+  signal rs_ge19 : unsigned(29 downto 0);
+  signal quot19 : unsigned(29 downto 0);
+  signal s21_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s21_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s21_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s21_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s22_q20: one quotient bit
   signal s1_b_d20 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d20 : unsigned(34 downto 0);
   signal lo_d20 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d20 : unsigned(0 downto 0);
-  signal rs_bits_lo_d20 : unsigned(34 downto 0);
-  signal rs_s21_p : unsigned(34 downto 0);
-  signal shl_rs_s21_p : unsigned(34 downto 0);
-  signal or_43 : unsigned(34 downto 0);
-  signal rs_or_43 : unsigned(35 downto 0);
-  signal s_rs_or_43 : signed(35 downto 0);
-  signal rs_rs_s1_b_d20 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d20 : signed(35 downto 0);
-  signal diffk20 : signed(35 downto 0);
-  signal bits_diffk20 : unsigned(33 downto 0);
-  signal bits_diffk20_1 : unsigned(0 downto 0);
-  signal gek20 : unsigned(0 downto 0);
-  signal s21_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s21_q : unsigned(29 downto 0);
-  signal rs_gek20 : unsigned(29 downto 0);
-  signal quot20 : unsigned(29 downto 0);
-  signal rs_or_43_1 : unsigned(33 downto 0);
+  signal cat_22 : unsigned(34 downto 0);
+  signal u_step20_diff : unsigned(33 downto 0);
+  signal u_step20_ge : unsigned(0 downto 0);
   signal rem20 : unsigned(33 downto 0);
-  signal s22_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge20 : unsigned(0 downto 0);
+  signal not_s21_ge : unsigned(0 downto 0);
+  signal zero20 : unsigned(0 downto 0);
+  signal shl_s21_q : unsigned(29 downto 0);
+  signal rs_ge20 : unsigned(29 downto 0);
+  signal quot20 : unsigned(29 downto 0);
+  signal s22_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s22_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s22_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s22_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s23_q21: one quotient bit
   signal s1_b_d21 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d21 : unsigned(34 downto 0);
   signal lo_d21 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d21 : unsigned(0 downto 0);
-  signal rs_bits_lo_d21 : unsigned(34 downto 0);
-  signal rs_s22_p : unsigned(34 downto 0);
-  signal shl_rs_s22_p : unsigned(34 downto 0);
-  signal or_45 : unsigned(34 downto 0);
-  signal rs_or_45 : unsigned(35 downto 0);
-  signal s_rs_or_45 : signed(35 downto 0);
-  signal rs_rs_s1_b_d21 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d21 : signed(35 downto 0);
-  signal diffk21 : signed(35 downto 0);
-  signal bits_diffk21 : unsigned(33 downto 0);
-  signal bits_diffk21_1 : unsigned(0 downto 0);
-  signal gek21 : unsigned(0 downto 0);
-  signal s22_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s22_q : unsigned(29 downto 0);
-  signal rs_gek21 : unsigned(29 downto 0);
-  signal quot21 : unsigned(29 downto 0);
-  signal rs_or_45_1 : unsigned(33 downto 0);
+  signal cat_23 : unsigned(34 downto 0);
+  signal u_step21_diff : unsigned(33 downto 0);
+  signal u_step21_ge : unsigned(0 downto 0);
   signal rem21 : unsigned(33 downto 0);
-  signal s23_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge21 : unsigned(0 downto 0);
+  signal not_s22_ge : unsigned(0 downto 0);
+  signal zero21 : unsigned(0 downto 0);
+  signal shl_s22_q : unsigned(29 downto 0);
+  signal rs_ge21 : unsigned(29 downto 0);
+  signal quot21 : unsigned(29 downto 0);
+  signal s23_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s23_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s23_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s23_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s24_q22: one quotient bit
   signal s1_b_d22 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d22 : unsigned(34 downto 0);
   signal lo_d22 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d22 : unsigned(0 downto 0);
-  signal rs_bits_lo_d22 : unsigned(34 downto 0);
-  signal rs_s23_p : unsigned(34 downto 0);
-  signal shl_rs_s23_p : unsigned(34 downto 0);
-  signal or_47 : unsigned(34 downto 0);
-  signal rs_or_47 : unsigned(35 downto 0);
-  signal s_rs_or_47 : signed(35 downto 0);
-  signal rs_rs_s1_b_d22 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d22 : signed(35 downto 0);
-  signal diffk22 : signed(35 downto 0);
-  signal bits_diffk22 : unsigned(33 downto 0);
-  signal bits_diffk22_1 : unsigned(0 downto 0);
-  signal gek22 : unsigned(0 downto 0);
-  signal s23_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s23_q : unsigned(29 downto 0);
-  signal rs_gek22 : unsigned(29 downto 0);
-  signal quot22 : unsigned(29 downto 0);
-  signal rs_or_47_1 : unsigned(33 downto 0);
+  signal cat_24 : unsigned(34 downto 0);
+  signal u_step22_diff : unsigned(33 downto 0);
+  signal u_step22_ge : unsigned(0 downto 0);
   signal rem22 : unsigned(33 downto 0);
-  signal s24_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge22 : unsigned(0 downto 0);
+  signal not_s23_ge : unsigned(0 downto 0);
+  signal zero22 : unsigned(0 downto 0);
+  signal shl_s23_q : unsigned(29 downto 0);
+  signal rs_ge22 : unsigned(29 downto 0);
+  signal quot22 : unsigned(29 downto 0);
+  signal s24_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s24_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s24_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s24_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s25_q23: one quotient bit
   signal s1_b_d23 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d23 : unsigned(34 downto 0);
   signal lo_d23 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d23 : unsigned(0 downto 0);
-  signal rs_bits_lo_d23 : unsigned(34 downto 0);
-  signal rs_s24_p : unsigned(34 downto 0);
-  signal shl_rs_s24_p : unsigned(34 downto 0);
-  signal or_49 : unsigned(34 downto 0);
-  signal rs_or_49 : unsigned(35 downto 0);
-  signal s_rs_or_49 : signed(35 downto 0);
-  signal rs_rs_s1_b_d23 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d23 : signed(35 downto 0);
-  signal diffk23 : signed(35 downto 0);
-  signal bits_diffk23 : unsigned(33 downto 0);
-  signal bits_diffk23_1 : unsigned(0 downto 0);
-  signal gek23 : unsigned(0 downto 0);
-  signal s24_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s24_q : unsigned(29 downto 0);
-  signal rs_gek23 : unsigned(29 downto 0);
-  signal quot23 : unsigned(29 downto 0);
-  signal rs_or_49_1 : unsigned(33 downto 0);
+  signal cat_25 : unsigned(34 downto 0);
+  signal u_step23_diff : unsigned(33 downto 0);
+  signal u_step23_ge : unsigned(0 downto 0);
   signal rem23 : unsigned(33 downto 0);
-  signal s25_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge23 : unsigned(0 downto 0);
+  signal not_s24_ge : unsigned(0 downto 0);
+  signal zero23 : unsigned(0 downto 0);
+  signal shl_s24_q : unsigned(29 downto 0);
+  signal rs_ge23 : unsigned(29 downto 0);
+  signal quot23 : unsigned(29 downto 0);
+  signal s25_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s25_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s25_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s25_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s26_q24: one quotient bit
   signal s1_b_d24 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d24 : unsigned(34 downto 0);
   signal lo_d24 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d24 : unsigned(0 downto 0);
-  signal rs_bits_lo_d24 : unsigned(34 downto 0);
-  signal rs_s25_p : unsigned(34 downto 0);
-  signal shl_rs_s25_p : unsigned(34 downto 0);
-  signal or_51 : unsigned(34 downto 0);
-  signal rs_or_51 : unsigned(35 downto 0);
-  signal s_rs_or_51 : signed(35 downto 0);
-  signal rs_rs_s1_b_d24 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d24 : signed(35 downto 0);
-  signal diffk24 : signed(35 downto 0);
-  signal bits_diffk24 : unsigned(33 downto 0);
-  signal bits_diffk24_1 : unsigned(0 downto 0);
-  signal gek24 : unsigned(0 downto 0);
-  signal s25_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s25_q : unsigned(29 downto 0);
-  signal rs_gek24 : unsigned(29 downto 0);
-  signal quot24 : unsigned(29 downto 0);
-  signal rs_or_51_1 : unsigned(33 downto 0);
+  signal cat_26 : unsigned(34 downto 0);
+  signal u_step24_diff : unsigned(33 downto 0);
+  signal u_step24_ge : unsigned(0 downto 0);
   signal rem24 : unsigned(33 downto 0);
-  signal s26_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge24 : unsigned(0 downto 0);
+  signal not_s25_ge : unsigned(0 downto 0);
+  signal zero24 : unsigned(0 downto 0);
+  signal shl_s25_q : unsigned(29 downto 0);
+  signal rs_ge24 : unsigned(29 downto 0);
+  signal quot24 : unsigned(29 downto 0);
+  signal s26_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s26_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s26_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s26_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s27_q25: one quotient bit
   signal s1_b_d25 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d25 : unsigned(34 downto 0);
   signal lo_d25 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d25 : unsigned(0 downto 0);
-  signal rs_bits_lo_d25 : unsigned(34 downto 0);
-  signal rs_s26_p : unsigned(34 downto 0);
-  signal shl_rs_s26_p : unsigned(34 downto 0);
-  signal or_53 : unsigned(34 downto 0);
-  signal rs_or_53 : unsigned(35 downto 0);
-  signal s_rs_or_53 : signed(35 downto 0);
-  signal rs_rs_s1_b_d25 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d25 : signed(35 downto 0);
-  signal diffk25 : signed(35 downto 0);
-  signal bits_diffk25 : unsigned(33 downto 0);
-  signal bits_diffk25_1 : unsigned(0 downto 0);
-  signal gek25 : unsigned(0 downto 0);
-  signal s26_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s26_q : unsigned(29 downto 0);
-  signal rs_gek25 : unsigned(29 downto 0);
-  signal quot25 : unsigned(29 downto 0);
-  signal rs_or_53_1 : unsigned(33 downto 0);
+  signal cat_27 : unsigned(34 downto 0);
+  signal u_step25_diff : unsigned(33 downto 0);
+  signal u_step25_ge : unsigned(0 downto 0);
   signal rem25 : unsigned(33 downto 0);
-  signal s27_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge25 : unsigned(0 downto 0);
+  signal not_s26_ge : unsigned(0 downto 0);
+  signal zero25 : unsigned(0 downto 0);
+  signal shl_s26_q : unsigned(29 downto 0);
+  signal rs_ge25 : unsigned(29 downto 0);
+  signal quot25 : unsigned(29 downto 0);
+  signal s27_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s27_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s27_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s27_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s28_q26: one quotient bit
   signal s1_b_d26 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d26 : unsigned(34 downto 0);
   signal lo_d26 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d26 : unsigned(0 downto 0);
-  signal rs_bits_lo_d26 : unsigned(34 downto 0);
-  signal rs_s27_p : unsigned(34 downto 0);
-  signal shl_rs_s27_p : unsigned(34 downto 0);
-  signal or_55 : unsigned(34 downto 0);
-  signal rs_or_55 : unsigned(35 downto 0);
-  signal s_rs_or_55 : signed(35 downto 0);
-  signal rs_rs_s1_b_d26 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d26 : signed(35 downto 0);
-  signal diffk26 : signed(35 downto 0);
-  signal bits_diffk26 : unsigned(33 downto 0);
-  signal bits_diffk26_1 : unsigned(0 downto 0);
-  signal gek26 : unsigned(0 downto 0);
-  signal s27_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s27_q : unsigned(29 downto 0);
-  signal rs_gek26 : unsigned(29 downto 0);
-  signal quot26 : unsigned(29 downto 0);
-  signal rs_or_55_1 : unsigned(33 downto 0);
+  signal cat_28 : unsigned(34 downto 0);
+  signal u_step26_diff : unsigned(33 downto 0);
+  signal u_step26_ge : unsigned(0 downto 0);
   signal rem26 : unsigned(33 downto 0);
-  signal s28_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge26 : unsigned(0 downto 0);
+  signal not_s27_ge : unsigned(0 downto 0);
+  signal zero26 : unsigned(0 downto 0);
+  signal shl_s27_q : unsigned(29 downto 0);
+  signal rs_ge26 : unsigned(29 downto 0);
+  signal quot26 : unsigned(29 downto 0);
+  signal s28_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s28_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s28_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s28_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s29_q27: one quotient bit
   signal s1_b_d27 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d27 : unsigned(34 downto 0);
   signal lo_d27 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d27 : unsigned(0 downto 0);
-  signal rs_bits_lo_d27 : unsigned(34 downto 0);
-  signal rs_s28_p : unsigned(34 downto 0);
-  signal shl_rs_s28_p : unsigned(34 downto 0);
-  signal or_57 : unsigned(34 downto 0);
-  signal rs_or_57 : unsigned(35 downto 0);
-  signal s_rs_or_57 : signed(35 downto 0);
-  signal rs_rs_s1_b_d27 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d27 : signed(35 downto 0);
-  signal diffk27 : signed(35 downto 0);
-  signal bits_diffk27 : unsigned(33 downto 0);
-  signal bits_diffk27_1 : unsigned(0 downto 0);
-  signal gek27 : unsigned(0 downto 0);
-  signal s28_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s28_q : unsigned(29 downto 0);
-  signal rs_gek27 : unsigned(29 downto 0);
-  signal quot27 : unsigned(29 downto 0);
-  signal rs_or_57_1 : unsigned(33 downto 0);
+  signal cat_29 : unsigned(34 downto 0);
+  signal u_step27_diff : unsigned(33 downto 0);
+  signal u_step27_ge : unsigned(0 downto 0);
   signal rem27 : unsigned(33 downto 0);
-  signal s29_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge27 : unsigned(0 downto 0);
+  signal not_s28_ge : unsigned(0 downto 0);
+  signal zero27 : unsigned(0 downto 0);
+  signal shl_s28_q : unsigned(29 downto 0);
+  signal rs_ge27 : unsigned(29 downto 0);
+  signal quot27 : unsigned(29 downto 0);
+  signal s29_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s29_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s29_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s29_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s30_q28: one quotient bit
   signal s1_b_d28 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d28 : unsigned(34 downto 0);
   signal lo_d28 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d28 : unsigned(0 downto 0);
-  signal rs_bits_lo_d28 : unsigned(34 downto 0);
-  signal rs_s29_p : unsigned(34 downto 0);
-  signal shl_rs_s29_p : unsigned(34 downto 0);
-  signal or_59 : unsigned(34 downto 0);
-  signal rs_or_59 : unsigned(35 downto 0);
-  signal s_rs_or_59 : signed(35 downto 0);
-  signal rs_rs_s1_b_d28 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d28 : signed(35 downto 0);
-  signal diffk28 : signed(35 downto 0);
-  signal bits_diffk28 : unsigned(33 downto 0);
-  signal bits_diffk28_1 : unsigned(0 downto 0);
-  signal gek28 : unsigned(0 downto 0);
-  signal s29_q_eq_k_0_4 : unsigned(0 downto 0);
-  signal shl_s29_q : unsigned(29 downto 0);
-  signal rs_gek28 : unsigned(29 downto 0);
-  signal quot28 : unsigned(29 downto 0);
-  signal rs_or_59_1 : unsigned(33 downto 0);
+  signal cat_30 : unsigned(34 downto 0);
+  signal u_step28_diff : unsigned(33 downto 0);
+  signal u_step28_ge : unsigned(0 downto 0);
   signal rem28 : unsigned(33 downto 0);
-  signal s30_p : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
+  signal ge28 : unsigned(0 downto 0);
+  signal not_s29_ge : unsigned(0 downto 0);
+  signal zero28 : unsigned(0 downto 0);
+  signal shl_s29_q : unsigned(29 downto 0);
+  signal rs_ge28 : unsigned(29 downto 0);
+  signal quot28 : unsigned(29 downto 0);
+  signal s30_ge : unsigned(0 downto 0) := unsigned'("0");
+  signal s30_r : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal s30_q : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s30_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s31_result: the quotient and its result flag
   signal s1_b_d29 : unsigned(33 downto 0) := unsigned'("0000000000000000000000000000000000");
   signal rs_s1_b_d29 : unsigned(34 downto 0);
   signal lo_d29 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal bits_lo_d29 : unsigned(0 downto 0);
-  signal rs_bits_lo_d29 : unsigned(34 downto 0);
-  signal rs_s30_p : unsigned(34 downto 0);
-  signal shl_rs_s30_p : unsigned(34 downto 0);
-  signal or_61 : unsigned(34 downto 0);
-  signal rs_or_61 : unsigned(35 downto 0);
-  signal s_rs_or_61 : signed(35 downto 0);
-  signal rs_rs_s1_b_d29 : unsigned(35 downto 0);
-  signal s_rs_rs_s1_b_d29 : signed(35 downto 0);
-  signal diffk29 : signed(35 downto 0);
-  signal bits_diffk29 : unsigned(33 downto 0);
-  signal bits_diffk29_1 : unsigned(0 downto 0);
-  signal gek29 : unsigned(0 downto 0);
-  signal s30_q_eq_k_0_4 : unsigned(0 downto 0);
+  signal cat_31 : unsigned(34 downto 0);
+  signal u_step29_diff : unsigned(33 downto 0);
+  signal u_step29_ge : unsigned(0 downto 0);
+  signal rem29 : unsigned(33 downto 0);
+  signal ge29 : unsigned(0 downto 0);
+  signal not_s30_ge : unsigned(0 downto 0);
+  signal zero29 : unsigned(0 downto 0);
   signal shl_s30_q : unsigned(29 downto 0);
-  signal rs_gek29 : unsigned(29 downto 0);
+  signal rs_ge29 : unsigned(29 downto 0);
   signal quot29 : unsigned(29 downto 0);
   type s1_err_d29_sr_t is array (1 to 29) of unsigned(0 downto 0);
   signal s1_err_d29_sr : s1_err_d29_sr_t := (others => (others => '0'));
@@ -829,11 +653,11 @@ architecture rtl of fxrt_div_n29_a63_b34 is
   type overflow_d29_sr_t is array (1 to 29) of unsigned(0 downto 0);
   signal overflow_d29_sr : overflow_d29_sr_t := (others => (others => '0'));
   signal overflow_d29 : unsigned(0 downto 0);
-  signal or_63 : unsigned(0 downto 0);
-  signal not_gek29 : unsigned(0 downto 0);
-  signal and_64 : unsigned(0 downto 0);
-  signal or_63_or_and_64 : unsigned(0 downto 0);
-  signal not_or_63_or_and_64 : unsigned(0 downto 0);
+  signal or_32 : unsigned(0 downto 0);
+  signal not_ge29 : unsigned(0 downto 0);
+  signal zero29_and_not_ge29 : unsigned(0 downto 0);
+  signal or_33 : unsigned(0 downto 0);
+  signal not_or_33 : unsigned(0 downto 0);
   signal s31_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal s31_ok : unsigned(0 downto 0) := unsigned'("0");
 begin
@@ -867,964 +691,718 @@ begin
   -- stage s2_q0: one quotient bit
   bits_s1_a <= unsigned(s1_a(62 downto 30));
   lo <= s1_a(29 downto 0);
-  rs_bits_s1_a <= resize(bits_s1_a, 34);
-  rs_rs_bits_s1_a <= resize(rs_bits_s1_a, 35);
-  s_rs_rs_bits_s1_a <= signed(rs_rs_bits_s1_a);
+  rs_bits_s1_a <= resize(bits_s1_a, 35);
   rs_s1_b <= resize(s1_b, 35);
-  s_rs_s1_b <= signed(rs_s1_b);
-  minus_2 <= s_rs_rs_bits_s1_a - s_rs_s1_b;
-  bits_minus_2 <= unsigned(minus_2(34 downto 34));
-  overflow <= not bits_minus_2;
+  overflow <= u_overflow_ge;
   rs_bits_s1_a_1 <= resize(bits_s1_a, 34);
   rs_s1_b_1 <= resize(s1_b, 35);
   bits_lo <= unsigned(lo(29 downto 29));
-  rs_bits_lo <= resize(bits_lo, 35);
-  rs_rs_bits_s1_a_1 <= resize(rs_bits_s1_a_1, 35);
-  shl_rs_rs_bits_s1_a_1 <= shift_left(rs_rs_bits_s1_a_1, 1);
-  or_3 <= shl_rs_rs_bits_s1_a_1 or rs_bits_lo;
-  rs_or_3 <= resize(or_3, 36);
-  s_rs_or_3 <= signed(rs_or_3);
-  rs_rs_s1_b_1 <= resize(rs_s1_b_1, 36);
-  s_rs_rs_s1_b_1 <= signed(rs_rs_s1_b_1);
-  diffk0 <= s_rs_or_3 - s_rs_rs_s1_b_1;
-  bits_diffk0 <= unsigned(diffk0(33 downto 0));
-  bits_diffk0_1 <= unsigned(diffk0(35 downto 35));
-  gek0 <= not bits_diffk0_1;
-  rs_gek0 <= resize(gek0, 30);
-  quot0 <= k_0_4 or rs_gek0;
-  rs_or_3_1 <= or_3(33 downto 0);
-  rem0 <= bits_diffk0 when gek0 = "1" else rs_or_3_1;
+  cat_2 <= unsigned(std_logic_vector'(std_logic_vector(rs_bits_s1_a_1) & std_logic_vector(bits_lo)));
+  rem0 <= u_step0_diff;
+  ge0 <= u_step0_ge;
+  rs_ge0 <= resize(ge0, 30);
+  quot0 <= k_0_2 or rs_ge0;
 
   s2_q0_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s2_p <= rem0;
+      s2_ge <= ge0;
+      s2_r <= rem0;
       s2_q <= quot0;
+      s2_zero <= k_1;
     end if;
   end process s2_q0_regs;
 
   -- stage s3_q1: one quotient bit
   rs_s1_b_d1 <= resize(s1_b_d1, 35);
   bits_lo_d1 <= unsigned(lo_d1(28 downto 28));
-  rs_bits_lo_d1 <= resize(bits_lo_d1, 35);
-  rs_s2_p <= resize(s2_p, 35);
-  shl_rs_s2_p <= shift_left(rs_s2_p, 1);
-  or_5 <= shl_rs_s2_p or rs_bits_lo_d1;
-  rs_or_5 <= resize(or_5, 36);
-  s_rs_or_5 <= signed(rs_or_5);
-  rs_rs_s1_b_d1 <= resize(rs_s1_b_d1, 36);
-  s_rs_rs_s1_b_d1 <= signed(rs_rs_s1_b_d1);
-  diffk1 <= s_rs_or_5 - s_rs_rs_s1_b_d1;
-  bits_diffk1 <= unsigned(diffk1(33 downto 0));
-  bits_diffk1_1 <= unsigned(diffk1(35 downto 35));
-  gek1 <= not bits_diffk1_1;
-  s2_q_eq_k_0_4 <= "1" when s2_q = k_0_4 else "0";
+  cat_3 <= unsigned(std_logic_vector'(std_logic_vector(s2_r) & std_logic_vector(bits_lo_d1)));
+  rem1 <= u_step1_diff;
+  ge1 <= u_step1_ge;
+  not_s2_ge <= not s2_ge;
+  zero1 <= s2_zero and not_s2_ge;
   shl_s2_q <= shift_left(s2_q, 1);
-  rs_gek1 <= resize(gek1, 30);
-  quot1 <= shl_s2_q or rs_gek1;
-  rs_or_5_1 <= or_5(33 downto 0);
-  rem1 <= bits_diffk1 when gek1 = "1" else rs_or_5_1;
+  rs_ge1 <= resize(ge1, 30);
+  quot1 <= shl_s2_q or rs_ge1;
 
   s3_q1_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d1 <= s1_b;
       lo_d1 <= lo;
-      s3_p <= rem1;
+      s3_ge <= ge1;
+      s3_r <= rem1;
       s3_q <= quot1;
+      s3_zero <= zero1;
     end if;
   end process s3_q1_regs;
 
   -- stage s4_q2: one quotient bit
   rs_s1_b_d2 <= resize(s1_b_d2, 35);
   bits_lo_d2 <= unsigned(lo_d2(27 downto 27));
-  rs_bits_lo_d2 <= resize(bits_lo_d2, 35);
-  rs_s3_p <= resize(s3_p, 35);
-  shl_rs_s3_p <= shift_left(rs_s3_p, 1);
-  or_7 <= shl_rs_s3_p or rs_bits_lo_d2;
-  rs_or_7 <= resize(or_7, 36);
-  s_rs_or_7 <= signed(rs_or_7);
-  rs_rs_s1_b_d2 <= resize(rs_s1_b_d2, 36);
-  s_rs_rs_s1_b_d2 <= signed(rs_rs_s1_b_d2);
-  diffk2 <= s_rs_or_7 - s_rs_rs_s1_b_d2;
-  bits_diffk2 <= unsigned(diffk2(33 downto 0));
-  bits_diffk2_1 <= unsigned(diffk2(35 downto 35));
-  gek2 <= not bits_diffk2_1;
-  s3_q_eq_k_0_4 <= "1" when s3_q = k_0_4 else "0";
+  cat_4 <= unsigned(std_logic_vector'(std_logic_vector(s3_r) & std_logic_vector(bits_lo_d2)));
+  rem2 <= u_step2_diff;
+  ge2 <= u_step2_ge;
+  not_s3_ge <= not s3_ge;
+  zero2 <= s3_zero and not_s3_ge;
   shl_s3_q <= shift_left(s3_q, 1);
-  rs_gek2 <= resize(gek2, 30);
-  quot2 <= shl_s3_q or rs_gek2;
-  rs_or_7_1 <= or_7(33 downto 0);
-  rem2 <= bits_diffk2 when gek2 = "1" else rs_or_7_1;
+  rs_ge2 <= resize(ge2, 30);
+  quot2 <= shl_s3_q or rs_ge2;
 
   s4_q2_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d2 <= s1_b_d1;
       lo_d2 <= lo_d1;
-      s4_p <= rem2;
+      s4_ge <= ge2;
+      s4_r <= rem2;
       s4_q <= quot2;
+      s4_zero <= zero2;
     end if;
   end process s4_q2_regs;
 
   -- stage s5_q3: one quotient bit
   rs_s1_b_d3 <= resize(s1_b_d3, 35);
   bits_lo_d3 <= unsigned(lo_d3(26 downto 26));
-  rs_bits_lo_d3 <= resize(bits_lo_d3, 35);
-  rs_s4_p <= resize(s4_p, 35);
-  shl_rs_s4_p <= shift_left(rs_s4_p, 1);
-  or_9 <= shl_rs_s4_p or rs_bits_lo_d3;
-  rs_or_9 <= resize(or_9, 36);
-  s_rs_or_9 <= signed(rs_or_9);
-  rs_rs_s1_b_d3 <= resize(rs_s1_b_d3, 36);
-  s_rs_rs_s1_b_d3 <= signed(rs_rs_s1_b_d3);
-  diffk3 <= s_rs_or_9 - s_rs_rs_s1_b_d3;
-  bits_diffk3 <= unsigned(diffk3(33 downto 0));
-  bits_diffk3_1 <= unsigned(diffk3(35 downto 35));
-  gek3 <= not bits_diffk3_1;
-  s4_q_eq_k_0_4 <= "1" when s4_q = k_0_4 else "0";
+  cat_5 <= unsigned(std_logic_vector'(std_logic_vector(s4_r) & std_logic_vector(bits_lo_d3)));
+  rem3 <= u_step3_diff;
+  ge3 <= u_step3_ge;
+  not_s4_ge <= not s4_ge;
+  zero3 <= s4_zero and not_s4_ge;
   shl_s4_q <= shift_left(s4_q, 1);
-  rs_gek3 <= resize(gek3, 30);
-  quot3 <= shl_s4_q or rs_gek3;
-  rs_or_9_1 <= or_9(33 downto 0);
-  rem3 <= bits_diffk3 when gek3 = "1" else rs_or_9_1;
+  rs_ge3 <= resize(ge3, 30);
+  quot3 <= shl_s4_q or rs_ge3;
 
   s5_q3_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d3 <= s1_b_d2;
       lo_d3 <= lo_d2;
-      s5_p <= rem3;
+      s5_ge <= ge3;
+      s5_r <= rem3;
       s5_q <= quot3;
+      s5_zero <= zero3;
     end if;
   end process s5_q3_regs;
 
   -- stage s6_q4: one quotient bit
   rs_s1_b_d4 <= resize(s1_b_d4, 35);
   bits_lo_d4 <= unsigned(lo_d4(25 downto 25));
-  rs_bits_lo_d4 <= resize(bits_lo_d4, 35);
-  rs_s5_p <= resize(s5_p, 35);
-  shl_rs_s5_p <= shift_left(rs_s5_p, 1);
-  or_11 <= shl_rs_s5_p or rs_bits_lo_d4;
-  rs_or_11 <= resize(or_11, 36);
-  s_rs_or_11 <= signed(rs_or_11);
-  rs_rs_s1_b_d4 <= resize(rs_s1_b_d4, 36);
-  s_rs_rs_s1_b_d4 <= signed(rs_rs_s1_b_d4);
-  diffk4 <= s_rs_or_11 - s_rs_rs_s1_b_d4;
-  bits_diffk4 <= unsigned(diffk4(33 downto 0));
-  bits_diffk4_1 <= unsigned(diffk4(35 downto 35));
-  gek4 <= not bits_diffk4_1;
-  s5_q_eq_k_0_4 <= "1" when s5_q = k_0_4 else "0";
+  cat_6 <= unsigned(std_logic_vector'(std_logic_vector(s5_r) & std_logic_vector(bits_lo_d4)));
+  rem4 <= u_step4_diff;
+  ge4 <= u_step4_ge;
+  not_s5_ge <= not s5_ge;
+  zero4 <= s5_zero and not_s5_ge;
   shl_s5_q <= shift_left(s5_q, 1);
-  rs_gek4 <= resize(gek4, 30);
-  quot4 <= shl_s5_q or rs_gek4;
-  rs_or_11_1 <= or_11(33 downto 0);
-  rem4 <= bits_diffk4 when gek4 = "1" else rs_or_11_1;
+  rs_ge4 <= resize(ge4, 30);
+  quot4 <= shl_s5_q or rs_ge4;
 
   s6_q4_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d4 <= s1_b_d3;
       lo_d4 <= lo_d3;
-      s6_p <= rem4;
+      s6_ge <= ge4;
+      s6_r <= rem4;
       s6_q <= quot4;
+      s6_zero <= zero4;
     end if;
   end process s6_q4_regs;
 
   -- stage s7_q5: one quotient bit
   rs_s1_b_d5 <= resize(s1_b_d5, 35);
   bits_lo_d5 <= unsigned(lo_d5(24 downto 24));
-  rs_bits_lo_d5 <= resize(bits_lo_d5, 35);
-  rs_s6_p <= resize(s6_p, 35);
-  shl_rs_s6_p <= shift_left(rs_s6_p, 1);
-  or_13 <= shl_rs_s6_p or rs_bits_lo_d5;
-  rs_or_13 <= resize(or_13, 36);
-  s_rs_or_13 <= signed(rs_or_13);
-  rs_rs_s1_b_d5 <= resize(rs_s1_b_d5, 36);
-  s_rs_rs_s1_b_d5 <= signed(rs_rs_s1_b_d5);
-  diffk5 <= s_rs_or_13 - s_rs_rs_s1_b_d5;
-  bits_diffk5 <= unsigned(diffk5(33 downto 0));
-  bits_diffk5_1 <= unsigned(diffk5(35 downto 35));
-  gek5 <= not bits_diffk5_1;
-  s6_q_eq_k_0_4 <= "1" when s6_q = k_0_4 else "0";
+  cat_7 <= unsigned(std_logic_vector'(std_logic_vector(s6_r) & std_logic_vector(bits_lo_d5)));
+  rem5 <= u_step5_diff;
+  ge5 <= u_step5_ge;
+  not_s6_ge <= not s6_ge;
+  zero5 <= s6_zero and not_s6_ge;
   shl_s6_q <= shift_left(s6_q, 1);
-  rs_gek5 <= resize(gek5, 30);
-  quot5 <= shl_s6_q or rs_gek5;
-  rs_or_13_1 <= or_13(33 downto 0);
-  rem5 <= bits_diffk5 when gek5 = "1" else rs_or_13_1;
+  rs_ge5 <= resize(ge5, 30);
+  quot5 <= shl_s6_q or rs_ge5;
 
   s7_q5_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d5 <= s1_b_d4;
       lo_d5 <= lo_d4;
-      s7_p <= rem5;
+      s7_ge <= ge5;
+      s7_r <= rem5;
       s7_q <= quot5;
+      s7_zero <= zero5;
     end if;
   end process s7_q5_regs;
 
   -- stage s8_q6: one quotient bit
   rs_s1_b_d6 <= resize(s1_b_d6, 35);
   bits_lo_d6 <= unsigned(lo_d6(23 downto 23));
-  rs_bits_lo_d6 <= resize(bits_lo_d6, 35);
-  rs_s7_p <= resize(s7_p, 35);
-  shl_rs_s7_p <= shift_left(rs_s7_p, 1);
-  or_15 <= shl_rs_s7_p or rs_bits_lo_d6;
-  rs_or_15 <= resize(or_15, 36);
-  s_rs_or_15 <= signed(rs_or_15);
-  rs_rs_s1_b_d6 <= resize(rs_s1_b_d6, 36);
-  s_rs_rs_s1_b_d6 <= signed(rs_rs_s1_b_d6);
-  diffk6 <= s_rs_or_15 - s_rs_rs_s1_b_d6;
-  bits_diffk6 <= unsigned(diffk6(33 downto 0));
-  bits_diffk6_1 <= unsigned(diffk6(35 downto 35));
-  gek6 <= not bits_diffk6_1;
-  s7_q_eq_k_0_4 <= "1" when s7_q = k_0_4 else "0";
+  cat_8 <= unsigned(std_logic_vector'(std_logic_vector(s7_r) & std_logic_vector(bits_lo_d6)));
+  rem6 <= u_step6_diff;
+  ge6 <= u_step6_ge;
+  not_s7_ge <= not s7_ge;
+  zero6 <= s7_zero and not_s7_ge;
   shl_s7_q <= shift_left(s7_q, 1);
-  rs_gek6 <= resize(gek6, 30);
-  quot6 <= shl_s7_q or rs_gek6;
-  rs_or_15_1 <= or_15(33 downto 0);
-  rem6 <= bits_diffk6 when gek6 = "1" else rs_or_15_1;
+  rs_ge6 <= resize(ge6, 30);
+  quot6 <= shl_s7_q or rs_ge6;
 
   s8_q6_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d6 <= s1_b_d5;
       lo_d6 <= lo_d5;
-      s8_p <= rem6;
+      s8_ge <= ge6;
+      s8_r <= rem6;
       s8_q <= quot6;
+      s8_zero <= zero6;
     end if;
   end process s8_q6_regs;
 
   -- stage s9_q7: one quotient bit
   rs_s1_b_d7 <= resize(s1_b_d7, 35);
   bits_lo_d7 <= unsigned(lo_d7(22 downto 22));
-  rs_bits_lo_d7 <= resize(bits_lo_d7, 35);
-  rs_s8_p <= resize(s8_p, 35);
-  shl_rs_s8_p <= shift_left(rs_s8_p, 1);
-  or_17 <= shl_rs_s8_p or rs_bits_lo_d7;
-  rs_or_17 <= resize(or_17, 36);
-  s_rs_or_17 <= signed(rs_or_17);
-  rs_rs_s1_b_d7 <= resize(rs_s1_b_d7, 36);
-  s_rs_rs_s1_b_d7 <= signed(rs_rs_s1_b_d7);
-  diffk7 <= s_rs_or_17 - s_rs_rs_s1_b_d7;
-  bits_diffk7 <= unsigned(diffk7(33 downto 0));
-  bits_diffk7_1 <= unsigned(diffk7(35 downto 35));
-  gek7 <= not bits_diffk7_1;
-  s8_q_eq_k_0_4 <= "1" when s8_q = k_0_4 else "0";
+  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(s8_r) & std_logic_vector(bits_lo_d7)));
+  rem7 <= u_step7_diff;
+  ge7 <= u_step7_ge;
+  not_s8_ge <= not s8_ge;
+  zero7 <= s8_zero and not_s8_ge;
   shl_s8_q <= shift_left(s8_q, 1);
-  rs_gek7 <= resize(gek7, 30);
-  quot7 <= shl_s8_q or rs_gek7;
-  rs_or_17_1 <= or_17(33 downto 0);
-  rem7 <= bits_diffk7 when gek7 = "1" else rs_or_17_1;
+  rs_ge7 <= resize(ge7, 30);
+  quot7 <= shl_s8_q or rs_ge7;
 
   s9_q7_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d7 <= s1_b_d6;
       lo_d7 <= lo_d6;
-      s9_p <= rem7;
+      s9_ge <= ge7;
+      s9_r <= rem7;
       s9_q <= quot7;
+      s9_zero <= zero7;
     end if;
   end process s9_q7_regs;
 
   -- stage s10_q8: one quotient bit
   rs_s1_b_d8 <= resize(s1_b_d8, 35);
   bits_lo_d8 <= unsigned(lo_d8(21 downto 21));
-  rs_bits_lo_d8 <= resize(bits_lo_d8, 35);
-  rs_s9_p <= resize(s9_p, 35);
-  shl_rs_s9_p <= shift_left(rs_s9_p, 1);
-  or_19 <= shl_rs_s9_p or rs_bits_lo_d8;
-  rs_or_19 <= resize(or_19, 36);
-  s_rs_or_19 <= signed(rs_or_19);
-  rs_rs_s1_b_d8 <= resize(rs_s1_b_d8, 36);
-  s_rs_rs_s1_b_d8 <= signed(rs_rs_s1_b_d8);
-  diffk8 <= s_rs_or_19 - s_rs_rs_s1_b_d8;
-  bits_diffk8 <= unsigned(diffk8(33 downto 0));
-  bits_diffk8_1 <= unsigned(diffk8(35 downto 35));
-  gek8 <= not bits_diffk8_1;
-  s9_q_eq_k_0_4 <= "1" when s9_q = k_0_4 else "0";
+  cat_10 <= unsigned(std_logic_vector'(std_logic_vector(s9_r) & std_logic_vector(bits_lo_d8)));
+  rem8 <= u_step8_diff;
+  ge8 <= u_step8_ge;
+  not_s9_ge <= not s9_ge;
+  zero8 <= s9_zero and not_s9_ge;
   shl_s9_q <= shift_left(s9_q, 1);
-  rs_gek8 <= resize(gek8, 30);
-  quot8 <= shl_s9_q or rs_gek8;
-  rs_or_19_1 <= or_19(33 downto 0);
-  rem8 <= bits_diffk8 when gek8 = "1" else rs_or_19_1;
+  rs_ge8 <= resize(ge8, 30);
+  quot8 <= shl_s9_q or rs_ge8;
 
   s10_q8_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d8 <= s1_b_d7;
       lo_d8 <= lo_d7;
-      s10_p <= rem8;
+      s10_ge <= ge8;
+      s10_r <= rem8;
       s10_q <= quot8;
+      s10_zero <= zero8;
     end if;
   end process s10_q8_regs;
 
   -- stage s11_q9: one quotient bit
   rs_s1_b_d9 <= resize(s1_b_d9, 35);
   bits_lo_d9 <= unsigned(lo_d9(20 downto 20));
-  rs_bits_lo_d9 <= resize(bits_lo_d9, 35);
-  rs_s10_p <= resize(s10_p, 35);
-  shl_rs_s10_p <= shift_left(rs_s10_p, 1);
-  or_21 <= shl_rs_s10_p or rs_bits_lo_d9;
-  rs_or_21 <= resize(or_21, 36);
-  s_rs_or_21 <= signed(rs_or_21);
-  rs_rs_s1_b_d9 <= resize(rs_s1_b_d9, 36);
-  s_rs_rs_s1_b_d9 <= signed(rs_rs_s1_b_d9);
-  diffk9 <= s_rs_or_21 - s_rs_rs_s1_b_d9;
-  bits_diffk9 <= unsigned(diffk9(33 downto 0));
-  bits_diffk9_1 <= unsigned(diffk9(35 downto 35));
-  gek9 <= not bits_diffk9_1;
-  s10_q_eq_k_0_4 <= "1" when s10_q = k_0_4 else "0";
+  cat_11 <= unsigned(std_logic_vector'(std_logic_vector(s10_r) & std_logic_vector(bits_lo_d9)));
+  rem9 <= u_step9_diff;
+  ge9 <= u_step9_ge;
+  not_s10_ge <= not s10_ge;
+  zero9 <= s10_zero and not_s10_ge;
   shl_s10_q <= shift_left(s10_q, 1);
-  rs_gek9 <= resize(gek9, 30);
-  quot9 <= shl_s10_q or rs_gek9;
-  rs_or_21_1 <= or_21(33 downto 0);
-  rem9 <= bits_diffk9 when gek9 = "1" else rs_or_21_1;
+  rs_ge9 <= resize(ge9, 30);
+  quot9 <= shl_s10_q or rs_ge9;
 
   s11_q9_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d9 <= s1_b_d8;
       lo_d9 <= lo_d8;
-      s11_p <= rem9;
+      s11_ge <= ge9;
+      s11_r <= rem9;
       s11_q <= quot9;
+      s11_zero <= zero9;
     end if;
   end process s11_q9_regs;
 
   -- stage s12_q10: one quotient bit
   rs_s1_b_d10 <= resize(s1_b_d10, 35);
   bits_lo_d10 <= unsigned(lo_d10(19 downto 19));
-  rs_bits_lo_d10 <= resize(bits_lo_d10, 35);
-  rs_s11_p <= resize(s11_p, 35);
-  shl_rs_s11_p <= shift_left(rs_s11_p, 1);
-  or_23 <= shl_rs_s11_p or rs_bits_lo_d10;
-  rs_or_23 <= resize(or_23, 36);
-  s_rs_or_23 <= signed(rs_or_23);
-  rs_rs_s1_b_d10 <= resize(rs_s1_b_d10, 36);
-  s_rs_rs_s1_b_d10 <= signed(rs_rs_s1_b_d10);
-  diffk10 <= s_rs_or_23 - s_rs_rs_s1_b_d10;
-  bits_diffk10 <= unsigned(diffk10(33 downto 0));
-  bits_diffk10_1 <= unsigned(diffk10(35 downto 35));
-  gek10 <= not bits_diffk10_1;
-  s11_q_eq_k_0_4 <= "1" when s11_q = k_0_4 else "0";
+  cat_12 <= unsigned(std_logic_vector'(std_logic_vector(s11_r) & std_logic_vector(bits_lo_d10)));
+  rem10 <= u_step10_diff;
+  ge10 <= u_step10_ge;
+  not_s11_ge <= not s11_ge;
+  zero10 <= s11_zero and not_s11_ge;
   shl_s11_q <= shift_left(s11_q, 1);
-  rs_gek10 <= resize(gek10, 30);
-  quot10 <= shl_s11_q or rs_gek10;
-  rs_or_23_1 <= or_23(33 downto 0);
-  rem10 <= bits_diffk10 when gek10 = "1" else rs_or_23_1;
+  rs_ge10 <= resize(ge10, 30);
+  quot10 <= shl_s11_q or rs_ge10;
 
   s12_q10_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d10 <= s1_b_d9;
       lo_d10 <= lo_d9;
-      s12_p <= rem10;
+      s12_ge <= ge10;
+      s12_r <= rem10;
       s12_q <= quot10;
+      s12_zero <= zero10;
     end if;
   end process s12_q10_regs;
 
   -- stage s13_q11: one quotient bit
   rs_s1_b_d11 <= resize(s1_b_d11, 35);
   bits_lo_d11 <= unsigned(lo_d11(18 downto 18));
-  rs_bits_lo_d11 <= resize(bits_lo_d11, 35);
-  rs_s12_p <= resize(s12_p, 35);
-  shl_rs_s12_p <= shift_left(rs_s12_p, 1);
-  or_25 <= shl_rs_s12_p or rs_bits_lo_d11;
-  rs_or_25 <= resize(or_25, 36);
-  s_rs_or_25 <= signed(rs_or_25);
-  rs_rs_s1_b_d11 <= resize(rs_s1_b_d11, 36);
-  s_rs_rs_s1_b_d11 <= signed(rs_rs_s1_b_d11);
-  diffk11 <= s_rs_or_25 - s_rs_rs_s1_b_d11;
-  bits_diffk11 <= unsigned(diffk11(33 downto 0));
-  bits_diffk11_1 <= unsigned(diffk11(35 downto 35));
-  gek11 <= not bits_diffk11_1;
-  s12_q_eq_k_0_4 <= "1" when s12_q = k_0_4 else "0";
+  cat_13 <= unsigned(std_logic_vector'(std_logic_vector(s12_r) & std_logic_vector(bits_lo_d11)));
+  rem11 <= u_step11_diff;
+  ge11 <= u_step11_ge;
+  not_s12_ge <= not s12_ge;
+  zero11 <= s12_zero and not_s12_ge;
   shl_s12_q <= shift_left(s12_q, 1);
-  rs_gek11 <= resize(gek11, 30);
-  quot11 <= shl_s12_q or rs_gek11;
-  rs_or_25_1 <= or_25(33 downto 0);
-  rem11 <= bits_diffk11 when gek11 = "1" else rs_or_25_1;
+  rs_ge11 <= resize(ge11, 30);
+  quot11 <= shl_s12_q or rs_ge11;
 
   s13_q11_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d11 <= s1_b_d10;
       lo_d11 <= lo_d10;
-      s13_p <= rem11;
+      s13_ge <= ge11;
+      s13_r <= rem11;
       s13_q <= quot11;
+      s13_zero <= zero11;
     end if;
   end process s13_q11_regs;
 
   -- stage s14_q12: one quotient bit
   rs_s1_b_d12 <= resize(s1_b_d12, 35);
   bits_lo_d12 <= unsigned(lo_d12(17 downto 17));
-  rs_bits_lo_d12 <= resize(bits_lo_d12, 35);
-  rs_s13_p <= resize(s13_p, 35);
-  shl_rs_s13_p <= shift_left(rs_s13_p, 1);
-  or_27 <= shl_rs_s13_p or rs_bits_lo_d12;
-  rs_or_27 <= resize(or_27, 36);
-  s_rs_or_27 <= signed(rs_or_27);
-  rs_rs_s1_b_d12 <= resize(rs_s1_b_d12, 36);
-  s_rs_rs_s1_b_d12 <= signed(rs_rs_s1_b_d12);
-  diffk12 <= s_rs_or_27 - s_rs_rs_s1_b_d12;
-  bits_diffk12 <= unsigned(diffk12(33 downto 0));
-  bits_diffk12_1 <= unsigned(diffk12(35 downto 35));
-  gek12 <= not bits_diffk12_1;
-  s13_q_eq_k_0_4 <= "1" when s13_q = k_0_4 else "0";
+  cat_14 <= unsigned(std_logic_vector'(std_logic_vector(s13_r) & std_logic_vector(bits_lo_d12)));
+  rem12 <= u_step12_diff;
+  ge12 <= u_step12_ge;
+  not_s13_ge <= not s13_ge;
+  zero12 <= s13_zero and not_s13_ge;
   shl_s13_q <= shift_left(s13_q, 1);
-  rs_gek12 <= resize(gek12, 30);
-  quot12 <= shl_s13_q or rs_gek12;
-  rs_or_27_1 <= or_27(33 downto 0);
-  rem12 <= bits_diffk12 when gek12 = "1" else rs_or_27_1;
+  rs_ge12 <= resize(ge12, 30);
+  quot12 <= shl_s13_q or rs_ge12;
 
   s14_q12_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d12 <= s1_b_d11;
       lo_d12 <= lo_d11;
-      s14_p <= rem12;
+      s14_ge <= ge12;
+      s14_r <= rem12;
       s14_q <= quot12;
+      s14_zero <= zero12;
     end if;
   end process s14_q12_regs;
 
   -- stage s15_q13: one quotient bit
   rs_s1_b_d13 <= resize(s1_b_d13, 35);
   bits_lo_d13 <= unsigned(lo_d13(16 downto 16));
-  rs_bits_lo_d13 <= resize(bits_lo_d13, 35);
-  rs_s14_p <= resize(s14_p, 35);
-  shl_rs_s14_p <= shift_left(rs_s14_p, 1);
-  or_29 <= shl_rs_s14_p or rs_bits_lo_d13;
-  rs_or_29 <= resize(or_29, 36);
-  s_rs_or_29 <= signed(rs_or_29);
-  rs_rs_s1_b_d13 <= resize(rs_s1_b_d13, 36);
-  s_rs_rs_s1_b_d13 <= signed(rs_rs_s1_b_d13);
-  diffk13 <= s_rs_or_29 - s_rs_rs_s1_b_d13;
-  bits_diffk13 <= unsigned(diffk13(33 downto 0));
-  bits_diffk13_1 <= unsigned(diffk13(35 downto 35));
-  gek13 <= not bits_diffk13_1;
-  s14_q_eq_k_0_4 <= "1" when s14_q = k_0_4 else "0";
+  cat_15 <= unsigned(std_logic_vector'(std_logic_vector(s14_r) & std_logic_vector(bits_lo_d13)));
+  rem13 <= u_step13_diff;
+  ge13 <= u_step13_ge;
+  not_s14_ge <= not s14_ge;
+  zero13 <= s14_zero and not_s14_ge;
   shl_s14_q <= shift_left(s14_q, 1);
-  rs_gek13 <= resize(gek13, 30);
-  quot13 <= shl_s14_q or rs_gek13;
-  rs_or_29_1 <= or_29(33 downto 0);
-  rem13 <= bits_diffk13 when gek13 = "1" else rs_or_29_1;
+  rs_ge13 <= resize(ge13, 30);
+  quot13 <= shl_s14_q or rs_ge13;
 
   s15_q13_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d13 <= s1_b_d12;
       lo_d13 <= lo_d12;
-      s15_p <= rem13;
+      s15_ge <= ge13;
+      s15_r <= rem13;
       s15_q <= quot13;
+      s15_zero <= zero13;
     end if;
   end process s15_q13_regs;
 
   -- stage s16_q14: one quotient bit
   rs_s1_b_d14 <= resize(s1_b_d14, 35);
   bits_lo_d14 <= unsigned(lo_d14(15 downto 15));
-  rs_bits_lo_d14 <= resize(bits_lo_d14, 35);
-  rs_s15_p <= resize(s15_p, 35);
-  shl_rs_s15_p <= shift_left(rs_s15_p, 1);
-  or_31 <= shl_rs_s15_p or rs_bits_lo_d14;
-  rs_or_31 <= resize(or_31, 36);
-  s_rs_or_31 <= signed(rs_or_31);
-  rs_rs_s1_b_d14 <= resize(rs_s1_b_d14, 36);
-  s_rs_rs_s1_b_d14 <= signed(rs_rs_s1_b_d14);
-  diffk14 <= s_rs_or_31 - s_rs_rs_s1_b_d14;
-  bits_diffk14 <= unsigned(diffk14(33 downto 0));
-  bits_diffk14_1 <= unsigned(diffk14(35 downto 35));
-  gek14 <= not bits_diffk14_1;
-  s15_q_eq_k_0_4 <= "1" when s15_q = k_0_4 else "0";
+  cat_16 <= unsigned(std_logic_vector'(std_logic_vector(s15_r) & std_logic_vector(bits_lo_d14)));
+  rem14 <= u_step14_diff;
+  ge14 <= u_step14_ge;
+  not_s15_ge <= not s15_ge;
+  zero14 <= s15_zero and not_s15_ge;
   shl_s15_q <= shift_left(s15_q, 1);
-  rs_gek14 <= resize(gek14, 30);
-  quot14 <= shl_s15_q or rs_gek14;
-  rs_or_31_1 <= or_31(33 downto 0);
-  rem14 <= bits_diffk14 when gek14 = "1" else rs_or_31_1;
+  rs_ge14 <= resize(ge14, 30);
+  quot14 <= shl_s15_q or rs_ge14;
 
   s16_q14_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d14 <= s1_b_d13;
       lo_d14 <= lo_d13;
-      s16_p <= rem14;
+      s16_ge <= ge14;
+      s16_r <= rem14;
       s16_q <= quot14;
+      s16_zero <= zero14;
     end if;
   end process s16_q14_regs;
 
   -- stage s17_q15: one quotient bit
   rs_s1_b_d15 <= resize(s1_b_d15, 35);
   bits_lo_d15 <= unsigned(lo_d15(14 downto 14));
-  rs_bits_lo_d15 <= resize(bits_lo_d15, 35);
-  rs_s16_p <= resize(s16_p, 35);
-  shl_rs_s16_p <= shift_left(rs_s16_p, 1);
-  or_33 <= shl_rs_s16_p or rs_bits_lo_d15;
-  rs_or_33 <= resize(or_33, 36);
-  s_rs_or_33 <= signed(rs_or_33);
-  rs_rs_s1_b_d15 <= resize(rs_s1_b_d15, 36);
-  s_rs_rs_s1_b_d15 <= signed(rs_rs_s1_b_d15);
-  diffk15 <= s_rs_or_33 - s_rs_rs_s1_b_d15;
-  bits_diffk15 <= unsigned(diffk15(33 downto 0));
-  bits_diffk15_1 <= unsigned(diffk15(35 downto 35));
-  gek15 <= not bits_diffk15_1;
-  s16_q_eq_k_0_4 <= "1" when s16_q = k_0_4 else "0";
+  cat_17 <= unsigned(std_logic_vector'(std_logic_vector(s16_r) & std_logic_vector(bits_lo_d15)));
+  rem15 <= u_step15_diff;
+  ge15 <= u_step15_ge;
+  not_s16_ge <= not s16_ge;
+  zero15 <= s16_zero and not_s16_ge;
   shl_s16_q <= shift_left(s16_q, 1);
-  rs_gek15 <= resize(gek15, 30);
-  quot15 <= shl_s16_q or rs_gek15;
-  rs_or_33_1 <= or_33(33 downto 0);
-  rem15 <= bits_diffk15 when gek15 = "1" else rs_or_33_1;
+  rs_ge15 <= resize(ge15, 30);
+  quot15 <= shl_s16_q or rs_ge15;
 
   s17_q15_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d15 <= s1_b_d14;
       lo_d15 <= lo_d14;
-      s17_p <= rem15;
+      s17_ge <= ge15;
+      s17_r <= rem15;
       s17_q <= quot15;
+      s17_zero <= zero15;
     end if;
   end process s17_q15_regs;
 
   -- stage s18_q16: one quotient bit
   rs_s1_b_d16 <= resize(s1_b_d16, 35);
   bits_lo_d16 <= unsigned(lo_d16(13 downto 13));
-  rs_bits_lo_d16 <= resize(bits_lo_d16, 35);
-  rs_s17_p <= resize(s17_p, 35);
-  shl_rs_s17_p <= shift_left(rs_s17_p, 1);
-  or_35 <= shl_rs_s17_p or rs_bits_lo_d16;
-  rs_or_35 <= resize(or_35, 36);
-  s_rs_or_35 <= signed(rs_or_35);
-  rs_rs_s1_b_d16 <= resize(rs_s1_b_d16, 36);
-  s_rs_rs_s1_b_d16 <= signed(rs_rs_s1_b_d16);
-  diffk16 <= s_rs_or_35 - s_rs_rs_s1_b_d16;
-  bits_diffk16 <= unsigned(diffk16(33 downto 0));
-  bits_diffk16_1 <= unsigned(diffk16(35 downto 35));
-  gek16 <= not bits_diffk16_1;
-  s17_q_eq_k_0_4 <= "1" when s17_q = k_0_4 else "0";
+  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(s17_r) & std_logic_vector(bits_lo_d16)));
+  rem16 <= u_step16_diff;
+  ge16 <= u_step16_ge;
+  not_s17_ge <= not s17_ge;
+  zero16 <= s17_zero and not_s17_ge;
   shl_s17_q <= shift_left(s17_q, 1);
-  rs_gek16 <= resize(gek16, 30);
-  quot16 <= shl_s17_q or rs_gek16;
-  rs_or_35_1 <= or_35(33 downto 0);
-  rem16 <= bits_diffk16 when gek16 = "1" else rs_or_35_1;
+  rs_ge16 <= resize(ge16, 30);
+  quot16 <= shl_s17_q or rs_ge16;
 
   s18_q16_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d16 <= s1_b_d15;
       lo_d16 <= lo_d15;
-      s18_p <= rem16;
+      s18_ge <= ge16;
+      s18_r <= rem16;
       s18_q <= quot16;
+      s18_zero <= zero16;
     end if;
   end process s18_q16_regs;
 
   -- stage s19_q17: one quotient bit
   rs_s1_b_d17 <= resize(s1_b_d17, 35);
   bits_lo_d17 <= unsigned(lo_d17(12 downto 12));
-  rs_bits_lo_d17 <= resize(bits_lo_d17, 35);
-  rs_s18_p <= resize(s18_p, 35);
-  shl_rs_s18_p <= shift_left(rs_s18_p, 1);
-  or_37 <= shl_rs_s18_p or rs_bits_lo_d17;
-  rs_or_37 <= resize(or_37, 36);
-  s_rs_or_37 <= signed(rs_or_37);
-  rs_rs_s1_b_d17 <= resize(rs_s1_b_d17, 36);
-  s_rs_rs_s1_b_d17 <= signed(rs_rs_s1_b_d17);
-  diffk17 <= s_rs_or_37 - s_rs_rs_s1_b_d17;
-  bits_diffk17 <= unsigned(diffk17(33 downto 0));
-  bits_diffk17_1 <= unsigned(diffk17(35 downto 35));
-  gek17 <= not bits_diffk17_1;
-  s18_q_eq_k_0_4 <= "1" when s18_q = k_0_4 else "0";
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(s18_r) & std_logic_vector(bits_lo_d17)));
+  rem17 <= u_step17_diff;
+  ge17 <= u_step17_ge;
+  not_s18_ge <= not s18_ge;
+  zero17 <= s18_zero and not_s18_ge;
   shl_s18_q <= shift_left(s18_q, 1);
-  rs_gek17 <= resize(gek17, 30);
-  quot17 <= shl_s18_q or rs_gek17;
-  rs_or_37_1 <= or_37(33 downto 0);
-  rem17 <= bits_diffk17 when gek17 = "1" else rs_or_37_1;
+  rs_ge17 <= resize(ge17, 30);
+  quot17 <= shl_s18_q or rs_ge17;
 
   s19_q17_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d17 <= s1_b_d16;
       lo_d17 <= lo_d16;
-      s19_p <= rem17;
+      s19_ge <= ge17;
+      s19_r <= rem17;
       s19_q <= quot17;
+      s19_zero <= zero17;
     end if;
   end process s19_q17_regs;
 
   -- stage s20_q18: one quotient bit
   rs_s1_b_d18 <= resize(s1_b_d18, 35);
   bits_lo_d18 <= unsigned(lo_d18(11 downto 11));
-  rs_bits_lo_d18 <= resize(bits_lo_d18, 35);
-  rs_s19_p <= resize(s19_p, 35);
-  shl_rs_s19_p <= shift_left(rs_s19_p, 1);
-  or_39 <= shl_rs_s19_p or rs_bits_lo_d18;
-  rs_or_39 <= resize(or_39, 36);
-  s_rs_or_39 <= signed(rs_or_39);
-  rs_rs_s1_b_d18 <= resize(rs_s1_b_d18, 36);
-  s_rs_rs_s1_b_d18 <= signed(rs_rs_s1_b_d18);
-  diffk18 <= s_rs_or_39 - s_rs_rs_s1_b_d18;
-  bits_diffk18 <= unsigned(diffk18(33 downto 0));
-  bits_diffk18_1 <= unsigned(diffk18(35 downto 35));
-  gek18 <= not bits_diffk18_1;
-  s19_q_eq_k_0_4 <= "1" when s19_q = k_0_4 else "0";
+  cat_20 <= unsigned(std_logic_vector'(std_logic_vector(s19_r) & std_logic_vector(bits_lo_d18)));
+  rem18 <= u_step18_diff;
+  ge18 <= u_step18_ge;
+  not_s19_ge <= not s19_ge;
+  zero18 <= s19_zero and not_s19_ge;
   shl_s19_q <= shift_left(s19_q, 1);
-  rs_gek18 <= resize(gek18, 30);
-  quot18 <= shl_s19_q or rs_gek18;
-  rs_or_39_1 <= or_39(33 downto 0);
-  rem18 <= bits_diffk18 when gek18 = "1" else rs_or_39_1;
+  rs_ge18 <= resize(ge18, 30);
+  quot18 <= shl_s19_q or rs_ge18;
 
   s20_q18_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d18 <= s1_b_d17;
       lo_d18 <= lo_d17;
-      s20_p <= rem18;
+      s20_ge <= ge18;
+      s20_r <= rem18;
       s20_q <= quot18;
+      s20_zero <= zero18;
     end if;
   end process s20_q18_regs;
 
   -- stage s21_q19: one quotient bit
   rs_s1_b_d19 <= resize(s1_b_d19, 35);
   bits_lo_d19 <= unsigned(lo_d19(10 downto 10));
-  rs_bits_lo_d19 <= resize(bits_lo_d19, 35);
-  rs_s20_p <= resize(s20_p, 35);
-  shl_rs_s20_p <= shift_left(rs_s20_p, 1);
-  or_41 <= shl_rs_s20_p or rs_bits_lo_d19;
-  rs_or_41 <= resize(or_41, 36);
-  s_rs_or_41 <= signed(rs_or_41);
-  rs_rs_s1_b_d19 <= resize(rs_s1_b_d19, 36);
-  s_rs_rs_s1_b_d19 <= signed(rs_rs_s1_b_d19);
-  diffk19 <= s_rs_or_41 - s_rs_rs_s1_b_d19;
-  bits_diffk19 <= unsigned(diffk19(33 downto 0));
-  bits_diffk19_1 <= unsigned(diffk19(35 downto 35));
-  gek19 <= not bits_diffk19_1;
-  s20_q_eq_k_0_4 <= "1" when s20_q = k_0_4 else "0";
+  cat_21 <= unsigned(std_logic_vector'(std_logic_vector(s20_r) & std_logic_vector(bits_lo_d19)));
+  rem19 <= u_step19_diff;
+  ge19 <= u_step19_ge;
+  not_s20_ge <= not s20_ge;
+  zero19 <= s20_zero and not_s20_ge;
   shl_s20_q <= shift_left(s20_q, 1);
-  rs_gek19 <= resize(gek19, 30);
-  quot19 <= shl_s20_q or rs_gek19;
-  rs_or_41_1 <= or_41(33 downto 0);
-  rem19 <= bits_diffk19 when gek19 = "1" else rs_or_41_1;
+  rs_ge19 <= resize(ge19, 30);
+  quot19 <= shl_s20_q or rs_ge19;
 
   s21_q19_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d19 <= s1_b_d18;
       lo_d19 <= lo_d18;
-      s21_p <= rem19;
+      s21_ge <= ge19;
+      s21_r <= rem19;
       s21_q <= quot19;
+      s21_zero <= zero19;
     end if;
   end process s21_q19_regs;
 
   -- stage s22_q20: one quotient bit
   rs_s1_b_d20 <= resize(s1_b_d20, 35);
   bits_lo_d20 <= unsigned(lo_d20(9 downto 9));
-  rs_bits_lo_d20 <= resize(bits_lo_d20, 35);
-  rs_s21_p <= resize(s21_p, 35);
-  shl_rs_s21_p <= shift_left(rs_s21_p, 1);
-  or_43 <= shl_rs_s21_p or rs_bits_lo_d20;
-  rs_or_43 <= resize(or_43, 36);
-  s_rs_or_43 <= signed(rs_or_43);
-  rs_rs_s1_b_d20 <= resize(rs_s1_b_d20, 36);
-  s_rs_rs_s1_b_d20 <= signed(rs_rs_s1_b_d20);
-  diffk20 <= s_rs_or_43 - s_rs_rs_s1_b_d20;
-  bits_diffk20 <= unsigned(diffk20(33 downto 0));
-  bits_diffk20_1 <= unsigned(diffk20(35 downto 35));
-  gek20 <= not bits_diffk20_1;
-  s21_q_eq_k_0_4 <= "1" when s21_q = k_0_4 else "0";
+  cat_22 <= unsigned(std_logic_vector'(std_logic_vector(s21_r) & std_logic_vector(bits_lo_d20)));
+  rem20 <= u_step20_diff;
+  ge20 <= u_step20_ge;
+  not_s21_ge <= not s21_ge;
+  zero20 <= s21_zero and not_s21_ge;
   shl_s21_q <= shift_left(s21_q, 1);
-  rs_gek20 <= resize(gek20, 30);
-  quot20 <= shl_s21_q or rs_gek20;
-  rs_or_43_1 <= or_43(33 downto 0);
-  rem20 <= bits_diffk20 when gek20 = "1" else rs_or_43_1;
+  rs_ge20 <= resize(ge20, 30);
+  quot20 <= shl_s21_q or rs_ge20;
 
   s22_q20_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d20 <= s1_b_d19;
       lo_d20 <= lo_d19;
-      s22_p <= rem20;
+      s22_ge <= ge20;
+      s22_r <= rem20;
       s22_q <= quot20;
+      s22_zero <= zero20;
     end if;
   end process s22_q20_regs;
 
   -- stage s23_q21: one quotient bit
   rs_s1_b_d21 <= resize(s1_b_d21, 35);
   bits_lo_d21 <= unsigned(lo_d21(8 downto 8));
-  rs_bits_lo_d21 <= resize(bits_lo_d21, 35);
-  rs_s22_p <= resize(s22_p, 35);
-  shl_rs_s22_p <= shift_left(rs_s22_p, 1);
-  or_45 <= shl_rs_s22_p or rs_bits_lo_d21;
-  rs_or_45 <= resize(or_45, 36);
-  s_rs_or_45 <= signed(rs_or_45);
-  rs_rs_s1_b_d21 <= resize(rs_s1_b_d21, 36);
-  s_rs_rs_s1_b_d21 <= signed(rs_rs_s1_b_d21);
-  diffk21 <= s_rs_or_45 - s_rs_rs_s1_b_d21;
-  bits_diffk21 <= unsigned(diffk21(33 downto 0));
-  bits_diffk21_1 <= unsigned(diffk21(35 downto 35));
-  gek21 <= not bits_diffk21_1;
-  s22_q_eq_k_0_4 <= "1" when s22_q = k_0_4 else "0";
+  cat_23 <= unsigned(std_logic_vector'(std_logic_vector(s22_r) & std_logic_vector(bits_lo_d21)));
+  rem21 <= u_step21_diff;
+  ge21 <= u_step21_ge;
+  not_s22_ge <= not s22_ge;
+  zero21 <= s22_zero and not_s22_ge;
   shl_s22_q <= shift_left(s22_q, 1);
-  rs_gek21 <= resize(gek21, 30);
-  quot21 <= shl_s22_q or rs_gek21;
-  rs_or_45_1 <= or_45(33 downto 0);
-  rem21 <= bits_diffk21 when gek21 = "1" else rs_or_45_1;
+  rs_ge21 <= resize(ge21, 30);
+  quot21 <= shl_s22_q or rs_ge21;
 
   s23_q21_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d21 <= s1_b_d20;
       lo_d21 <= lo_d20;
-      s23_p <= rem21;
+      s23_ge <= ge21;
+      s23_r <= rem21;
       s23_q <= quot21;
+      s23_zero <= zero21;
     end if;
   end process s23_q21_regs;
 
   -- stage s24_q22: one quotient bit
   rs_s1_b_d22 <= resize(s1_b_d22, 35);
   bits_lo_d22 <= unsigned(lo_d22(7 downto 7));
-  rs_bits_lo_d22 <= resize(bits_lo_d22, 35);
-  rs_s23_p <= resize(s23_p, 35);
-  shl_rs_s23_p <= shift_left(rs_s23_p, 1);
-  or_47 <= shl_rs_s23_p or rs_bits_lo_d22;
-  rs_or_47 <= resize(or_47, 36);
-  s_rs_or_47 <= signed(rs_or_47);
-  rs_rs_s1_b_d22 <= resize(rs_s1_b_d22, 36);
-  s_rs_rs_s1_b_d22 <= signed(rs_rs_s1_b_d22);
-  diffk22 <= s_rs_or_47 - s_rs_rs_s1_b_d22;
-  bits_diffk22 <= unsigned(diffk22(33 downto 0));
-  bits_diffk22_1 <= unsigned(diffk22(35 downto 35));
-  gek22 <= not bits_diffk22_1;
-  s23_q_eq_k_0_4 <= "1" when s23_q = k_0_4 else "0";
+  cat_24 <= unsigned(std_logic_vector'(std_logic_vector(s23_r) & std_logic_vector(bits_lo_d22)));
+  rem22 <= u_step22_diff;
+  ge22 <= u_step22_ge;
+  not_s23_ge <= not s23_ge;
+  zero22 <= s23_zero and not_s23_ge;
   shl_s23_q <= shift_left(s23_q, 1);
-  rs_gek22 <= resize(gek22, 30);
-  quot22 <= shl_s23_q or rs_gek22;
-  rs_or_47_1 <= or_47(33 downto 0);
-  rem22 <= bits_diffk22 when gek22 = "1" else rs_or_47_1;
+  rs_ge22 <= resize(ge22, 30);
+  quot22 <= shl_s23_q or rs_ge22;
 
   s24_q22_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d22 <= s1_b_d21;
       lo_d22 <= lo_d21;
-      s24_p <= rem22;
+      s24_ge <= ge22;
+      s24_r <= rem22;
       s24_q <= quot22;
+      s24_zero <= zero22;
     end if;
   end process s24_q22_regs;
 
   -- stage s25_q23: one quotient bit
   rs_s1_b_d23 <= resize(s1_b_d23, 35);
   bits_lo_d23 <= unsigned(lo_d23(6 downto 6));
-  rs_bits_lo_d23 <= resize(bits_lo_d23, 35);
-  rs_s24_p <= resize(s24_p, 35);
-  shl_rs_s24_p <= shift_left(rs_s24_p, 1);
-  or_49 <= shl_rs_s24_p or rs_bits_lo_d23;
-  rs_or_49 <= resize(or_49, 36);
-  s_rs_or_49 <= signed(rs_or_49);
-  rs_rs_s1_b_d23 <= resize(rs_s1_b_d23, 36);
-  s_rs_rs_s1_b_d23 <= signed(rs_rs_s1_b_d23);
-  diffk23 <= s_rs_or_49 - s_rs_rs_s1_b_d23;
-  bits_diffk23 <= unsigned(diffk23(33 downto 0));
-  bits_diffk23_1 <= unsigned(diffk23(35 downto 35));
-  gek23 <= not bits_diffk23_1;
-  s24_q_eq_k_0_4 <= "1" when s24_q = k_0_4 else "0";
+  cat_25 <= unsigned(std_logic_vector'(std_logic_vector(s24_r) & std_logic_vector(bits_lo_d23)));
+  rem23 <= u_step23_diff;
+  ge23 <= u_step23_ge;
+  not_s24_ge <= not s24_ge;
+  zero23 <= s24_zero and not_s24_ge;
   shl_s24_q <= shift_left(s24_q, 1);
-  rs_gek23 <= resize(gek23, 30);
-  quot23 <= shl_s24_q or rs_gek23;
-  rs_or_49_1 <= or_49(33 downto 0);
-  rem23 <= bits_diffk23 when gek23 = "1" else rs_or_49_1;
+  rs_ge23 <= resize(ge23, 30);
+  quot23 <= shl_s24_q or rs_ge23;
 
   s25_q23_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d23 <= s1_b_d22;
       lo_d23 <= lo_d22;
-      s25_p <= rem23;
+      s25_ge <= ge23;
+      s25_r <= rem23;
       s25_q <= quot23;
+      s25_zero <= zero23;
     end if;
   end process s25_q23_regs;
 
   -- stage s26_q24: one quotient bit
   rs_s1_b_d24 <= resize(s1_b_d24, 35);
   bits_lo_d24 <= unsigned(lo_d24(5 downto 5));
-  rs_bits_lo_d24 <= resize(bits_lo_d24, 35);
-  rs_s25_p <= resize(s25_p, 35);
-  shl_rs_s25_p <= shift_left(rs_s25_p, 1);
-  or_51 <= shl_rs_s25_p or rs_bits_lo_d24;
-  rs_or_51 <= resize(or_51, 36);
-  s_rs_or_51 <= signed(rs_or_51);
-  rs_rs_s1_b_d24 <= resize(rs_s1_b_d24, 36);
-  s_rs_rs_s1_b_d24 <= signed(rs_rs_s1_b_d24);
-  diffk24 <= s_rs_or_51 - s_rs_rs_s1_b_d24;
-  bits_diffk24 <= unsigned(diffk24(33 downto 0));
-  bits_diffk24_1 <= unsigned(diffk24(35 downto 35));
-  gek24 <= not bits_diffk24_1;
-  s25_q_eq_k_0_4 <= "1" when s25_q = k_0_4 else "0";
+  cat_26 <= unsigned(std_logic_vector'(std_logic_vector(s25_r) & std_logic_vector(bits_lo_d24)));
+  rem24 <= u_step24_diff;
+  ge24 <= u_step24_ge;
+  not_s25_ge <= not s25_ge;
+  zero24 <= s25_zero and not_s25_ge;
   shl_s25_q <= shift_left(s25_q, 1);
-  rs_gek24 <= resize(gek24, 30);
-  quot24 <= shl_s25_q or rs_gek24;
-  rs_or_51_1 <= or_51(33 downto 0);
-  rem24 <= bits_diffk24 when gek24 = "1" else rs_or_51_1;
+  rs_ge24 <= resize(ge24, 30);
+  quot24 <= shl_s25_q or rs_ge24;
 
   s26_q24_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d24 <= s1_b_d23;
       lo_d24 <= lo_d23;
-      s26_p <= rem24;
+      s26_ge <= ge24;
+      s26_r <= rem24;
       s26_q <= quot24;
+      s26_zero <= zero24;
     end if;
   end process s26_q24_regs;
 
   -- stage s27_q25: one quotient bit
   rs_s1_b_d25 <= resize(s1_b_d25, 35);
   bits_lo_d25 <= unsigned(lo_d25(4 downto 4));
-  rs_bits_lo_d25 <= resize(bits_lo_d25, 35);
-  rs_s26_p <= resize(s26_p, 35);
-  shl_rs_s26_p <= shift_left(rs_s26_p, 1);
-  or_53 <= shl_rs_s26_p or rs_bits_lo_d25;
-  rs_or_53 <= resize(or_53, 36);
-  s_rs_or_53 <= signed(rs_or_53);
-  rs_rs_s1_b_d25 <= resize(rs_s1_b_d25, 36);
-  s_rs_rs_s1_b_d25 <= signed(rs_rs_s1_b_d25);
-  diffk25 <= s_rs_or_53 - s_rs_rs_s1_b_d25;
-  bits_diffk25 <= unsigned(diffk25(33 downto 0));
-  bits_diffk25_1 <= unsigned(diffk25(35 downto 35));
-  gek25 <= not bits_diffk25_1;
-  s26_q_eq_k_0_4 <= "1" when s26_q = k_0_4 else "0";
+  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(s26_r) & std_logic_vector(bits_lo_d25)));
+  rem25 <= u_step25_diff;
+  ge25 <= u_step25_ge;
+  not_s26_ge <= not s26_ge;
+  zero25 <= s26_zero and not_s26_ge;
   shl_s26_q <= shift_left(s26_q, 1);
-  rs_gek25 <= resize(gek25, 30);
-  quot25 <= shl_s26_q or rs_gek25;
-  rs_or_53_1 <= or_53(33 downto 0);
-  rem25 <= bits_diffk25 when gek25 = "1" else rs_or_53_1;
+  rs_ge25 <= resize(ge25, 30);
+  quot25 <= shl_s26_q or rs_ge25;
 
   s27_q25_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d25 <= s1_b_d24;
       lo_d25 <= lo_d24;
-      s27_p <= rem25;
+      s27_ge <= ge25;
+      s27_r <= rem25;
       s27_q <= quot25;
+      s27_zero <= zero25;
     end if;
   end process s27_q25_regs;
 
   -- stage s28_q26: one quotient bit
   rs_s1_b_d26 <= resize(s1_b_d26, 35);
   bits_lo_d26 <= unsigned(lo_d26(3 downto 3));
-  rs_bits_lo_d26 <= resize(bits_lo_d26, 35);
-  rs_s27_p <= resize(s27_p, 35);
-  shl_rs_s27_p <= shift_left(rs_s27_p, 1);
-  or_55 <= shl_rs_s27_p or rs_bits_lo_d26;
-  rs_or_55 <= resize(or_55, 36);
-  s_rs_or_55 <= signed(rs_or_55);
-  rs_rs_s1_b_d26 <= resize(rs_s1_b_d26, 36);
-  s_rs_rs_s1_b_d26 <= signed(rs_rs_s1_b_d26);
-  diffk26 <= s_rs_or_55 - s_rs_rs_s1_b_d26;
-  bits_diffk26 <= unsigned(diffk26(33 downto 0));
-  bits_diffk26_1 <= unsigned(diffk26(35 downto 35));
-  gek26 <= not bits_diffk26_1;
-  s27_q_eq_k_0_4 <= "1" when s27_q = k_0_4 else "0";
+  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(s27_r) & std_logic_vector(bits_lo_d26)));
+  rem26 <= u_step26_diff;
+  ge26 <= u_step26_ge;
+  not_s27_ge <= not s27_ge;
+  zero26 <= s27_zero and not_s27_ge;
   shl_s27_q <= shift_left(s27_q, 1);
-  rs_gek26 <= resize(gek26, 30);
-  quot26 <= shl_s27_q or rs_gek26;
-  rs_or_55_1 <= or_55(33 downto 0);
-  rem26 <= bits_diffk26 when gek26 = "1" else rs_or_55_1;
+  rs_ge26 <= resize(ge26, 30);
+  quot26 <= shl_s27_q or rs_ge26;
 
   s28_q26_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d26 <= s1_b_d25;
       lo_d26 <= lo_d25;
-      s28_p <= rem26;
+      s28_ge <= ge26;
+      s28_r <= rem26;
       s28_q <= quot26;
+      s28_zero <= zero26;
     end if;
   end process s28_q26_regs;
 
   -- stage s29_q27: one quotient bit
   rs_s1_b_d27 <= resize(s1_b_d27, 35);
   bits_lo_d27 <= unsigned(lo_d27(2 downto 2));
-  rs_bits_lo_d27 <= resize(bits_lo_d27, 35);
-  rs_s28_p <= resize(s28_p, 35);
-  shl_rs_s28_p <= shift_left(rs_s28_p, 1);
-  or_57 <= shl_rs_s28_p or rs_bits_lo_d27;
-  rs_or_57 <= resize(or_57, 36);
-  s_rs_or_57 <= signed(rs_or_57);
-  rs_rs_s1_b_d27 <= resize(rs_s1_b_d27, 36);
-  s_rs_rs_s1_b_d27 <= signed(rs_rs_s1_b_d27);
-  diffk27 <= s_rs_or_57 - s_rs_rs_s1_b_d27;
-  bits_diffk27 <= unsigned(diffk27(33 downto 0));
-  bits_diffk27_1 <= unsigned(diffk27(35 downto 35));
-  gek27 <= not bits_diffk27_1;
-  s28_q_eq_k_0_4 <= "1" when s28_q = k_0_4 else "0";
+  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(s28_r) & std_logic_vector(bits_lo_d27)));
+  rem27 <= u_step27_diff;
+  ge27 <= u_step27_ge;
+  not_s28_ge <= not s28_ge;
+  zero27 <= s28_zero and not_s28_ge;
   shl_s28_q <= shift_left(s28_q, 1);
-  rs_gek27 <= resize(gek27, 30);
-  quot27 <= shl_s28_q or rs_gek27;
-  rs_or_57_1 <= or_57(33 downto 0);
-  rem27 <= bits_diffk27 when gek27 = "1" else rs_or_57_1;
+  rs_ge27 <= resize(ge27, 30);
+  quot27 <= shl_s28_q or rs_ge27;
 
   s29_q27_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d27 <= s1_b_d26;
       lo_d27 <= lo_d26;
-      s29_p <= rem27;
+      s29_ge <= ge27;
+      s29_r <= rem27;
       s29_q <= quot27;
+      s29_zero <= zero27;
     end if;
   end process s29_q27_regs;
 
   -- stage s30_q28: one quotient bit
   rs_s1_b_d28 <= resize(s1_b_d28, 35);
   bits_lo_d28 <= unsigned(lo_d28(1 downto 1));
-  rs_bits_lo_d28 <= resize(bits_lo_d28, 35);
-  rs_s29_p <= resize(s29_p, 35);
-  shl_rs_s29_p <= shift_left(rs_s29_p, 1);
-  or_59 <= shl_rs_s29_p or rs_bits_lo_d28;
-  rs_or_59 <= resize(or_59, 36);
-  s_rs_or_59 <= signed(rs_or_59);
-  rs_rs_s1_b_d28 <= resize(rs_s1_b_d28, 36);
-  s_rs_rs_s1_b_d28 <= signed(rs_rs_s1_b_d28);
-  diffk28 <= s_rs_or_59 - s_rs_rs_s1_b_d28;
-  bits_diffk28 <= unsigned(diffk28(33 downto 0));
-  bits_diffk28_1 <= unsigned(diffk28(35 downto 35));
-  gek28 <= not bits_diffk28_1;
-  s29_q_eq_k_0_4 <= "1" when s29_q = k_0_4 else "0";
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(s29_r) & std_logic_vector(bits_lo_d28)));
+  rem28 <= u_step28_diff;
+  ge28 <= u_step28_ge;
+  not_s29_ge <= not s29_ge;
+  zero28 <= s29_zero and not_s29_ge;
   shl_s29_q <= shift_left(s29_q, 1);
-  rs_gek28 <= resize(gek28, 30);
-  quot28 <= shl_s29_q or rs_gek28;
-  rs_or_59_1 <= or_59(33 downto 0);
-  rem28 <= bits_diffk28 when gek28 = "1" else rs_or_59_1;
+  rs_ge28 <= resize(ge28, 30);
+  quot28 <= shl_s29_q or rs_ge28;
 
   s30_q28_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_b_d28 <= s1_b_d27;
       lo_d28 <= lo_d27;
-      s30_p <= rem28;
+      s30_ge <= ge28;
+      s30_r <= rem28;
       s30_q <= quot28;
+      s30_zero <= zero28;
     end if;
   end process s30_q28_regs;
 
   -- stage s31_result: the quotient and its result flag
   rs_s1_b_d29 <= resize(s1_b_d29, 35);
   bits_lo_d29 <= unsigned(lo_d29(0 downto 0));
-  rs_bits_lo_d29 <= resize(bits_lo_d29, 35);
-  rs_s30_p <= resize(s30_p, 35);
-  shl_rs_s30_p <= shift_left(rs_s30_p, 1);
-  or_61 <= shl_rs_s30_p or rs_bits_lo_d29;
-  rs_or_61 <= resize(or_61, 36);
-  s_rs_or_61 <= signed(rs_or_61);
-  rs_rs_s1_b_d29 <= resize(rs_s1_b_d29, 36);
-  s_rs_rs_s1_b_d29 <= signed(rs_rs_s1_b_d29);
-  diffk29 <= s_rs_or_61 - s_rs_rs_s1_b_d29;
-  bits_diffk29 <= unsigned(diffk29(33 downto 0));
-  bits_diffk29_1 <= unsigned(diffk29(35 downto 35));
-  gek29 <= not bits_diffk29_1;
-  s30_q_eq_k_0_4 <= "1" when s30_q = k_0_4 else "0";
+  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(s30_r) & std_logic_vector(bits_lo_d29)));
+  rem29 <= u_step29_diff;
+  ge29 <= u_step29_ge;
+  not_s30_ge <= not s30_ge;
+  zero29 <= s30_zero and not_s30_ge;
   shl_s30_q <= shift_left(s30_q, 1);
-  rs_gek29 <= resize(gek29, 30);
-  quot29 <= shl_s30_q or rs_gek29;
+  rs_ge29 <= resize(ge29, 30);
+  quot29 <= shl_s30_q or rs_ge29;
   s1_err_d29 <= s1_err_d29_sr(29);
   overflow_d29 <= overflow_d29_sr(29);
-  or_63 <= s1_err_d29 or overflow_d29;
-  not_gek29 <= not gek29;
-  and_64 <= s30_q_eq_k_0_4 and not_gek29;
-  or_63_or_and_64 <= or_63 or and_64;
-  not_or_63_or_and_64 <= not or_63_or_and_64;
+  or_32 <= s1_err_d29 or overflow_d29;
+  not_ge29 <= not ge29;
+  zero29_and_not_ge29 <= zero29 and not_ge29;
+  or_33 <= or_32 or zero29_and_not_ge29;
+  not_or_33 <= not or_33;
 
   s31_result_regs : process (clk)
   begin
@@ -1836,9 +1414,319 @@ begin
       overflow_d29_sr(2 to 29) <= overflow_d29_sr(1 to 28);
       overflow_d29_sr(1) <= overflow;
       s31_t <= quot29;
-      s31_ok <= not_or_63_or_and_64;
+      s31_ok <= not_or_33;
     end if;
   end process s31_result_regs;
+
+  u_overflow : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => rs_bits_s1_a,
+      b => rs_s1_b,
+      sub => k_1,
+      diff => u_overflow_diff,
+      ge => u_overflow_ge
+    );
+
+  u_step0 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_2,
+      b => rs_s1_b_1,
+      sub => k_1,
+      diff => u_step0_diff,
+      ge => u_step0_ge
+    );
+
+  u_step1 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_3,
+      b => rs_s1_b_d1,
+      sub => s2_ge,
+      diff => u_step1_diff,
+      ge => u_step1_ge
+    );
+
+  u_step2 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_4,
+      b => rs_s1_b_d2,
+      sub => s3_ge,
+      diff => u_step2_diff,
+      ge => u_step2_ge
+    );
+
+  u_step3 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_5,
+      b => rs_s1_b_d3,
+      sub => s4_ge,
+      diff => u_step3_diff,
+      ge => u_step3_ge
+    );
+
+  u_step4 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_6,
+      b => rs_s1_b_d4,
+      sub => s5_ge,
+      diff => u_step4_diff,
+      ge => u_step4_ge
+    );
+
+  u_step5 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_7,
+      b => rs_s1_b_d5,
+      sub => s6_ge,
+      diff => u_step5_diff,
+      ge => u_step5_ge
+    );
+
+  u_step6 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_8,
+      b => rs_s1_b_d6,
+      sub => s7_ge,
+      diff => u_step6_diff,
+      ge => u_step6_ge
+    );
+
+  u_step7 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_9,
+      b => rs_s1_b_d7,
+      sub => s8_ge,
+      diff => u_step7_diff,
+      ge => u_step7_ge
+    );
+
+  u_step8 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_10,
+      b => rs_s1_b_d8,
+      sub => s9_ge,
+      diff => u_step8_diff,
+      ge => u_step8_ge
+    );
+
+  u_step9 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_11,
+      b => rs_s1_b_d9,
+      sub => s10_ge,
+      diff => u_step9_diff,
+      ge => u_step9_ge
+    );
+
+  u_step10 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_12,
+      b => rs_s1_b_d10,
+      sub => s11_ge,
+      diff => u_step10_diff,
+      ge => u_step10_ge
+    );
+
+  u_step11 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_13,
+      b => rs_s1_b_d11,
+      sub => s12_ge,
+      diff => u_step11_diff,
+      ge => u_step11_ge
+    );
+
+  u_step12 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_14,
+      b => rs_s1_b_d12,
+      sub => s13_ge,
+      diff => u_step12_diff,
+      ge => u_step12_ge
+    );
+
+  u_step13 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_15,
+      b => rs_s1_b_d13,
+      sub => s14_ge,
+      diff => u_step13_diff,
+      ge => u_step13_ge
+    );
+
+  u_step14 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_16,
+      b => rs_s1_b_d14,
+      sub => s15_ge,
+      diff => u_step14_diff,
+      ge => u_step14_ge
+    );
+
+  u_step15 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_17,
+      b => rs_s1_b_d15,
+      sub => s16_ge,
+      diff => u_step15_diff,
+      ge => u_step15_ge
+    );
+
+  u_step16 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_18,
+      b => rs_s1_b_d16,
+      sub => s17_ge,
+      diff => u_step16_diff,
+      ge => u_step16_ge
+    );
+
+  u_step17 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_19,
+      b => rs_s1_b_d17,
+      sub => s18_ge,
+      diff => u_step17_diff,
+      ge => u_step17_ge
+    );
+
+  u_step18 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_20,
+      b => rs_s1_b_d18,
+      sub => s19_ge,
+      diff => u_step18_diff,
+      ge => u_step18_ge
+    );
+
+  u_step19 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_21,
+      b => rs_s1_b_d19,
+      sub => s20_ge,
+      diff => u_step19_diff,
+      ge => u_step19_ge
+    );
+
+  u_step20 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_22,
+      b => rs_s1_b_d20,
+      sub => s21_ge,
+      diff => u_step20_diff,
+      ge => u_step20_ge
+    );
+
+  u_step21 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_23,
+      b => rs_s1_b_d21,
+      sub => s22_ge,
+      diff => u_step21_diff,
+      ge => u_step21_ge
+    );
+
+  u_step22 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_24,
+      b => rs_s1_b_d22,
+      sub => s23_ge,
+      diff => u_step22_diff,
+      ge => u_step22_ge
+    );
+
+  u_step23 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_25,
+      b => rs_s1_b_d23,
+      sub => s24_ge,
+      diff => u_step23_diff,
+      ge => u_step23_ge
+    );
+
+  u_step24 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_26,
+      b => rs_s1_b_d24,
+      sub => s25_ge,
+      diff => u_step24_diff,
+      ge => u_step24_ge
+    );
+
+  u_step25 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_27,
+      b => rs_s1_b_d25,
+      sub => s26_ge,
+      diff => u_step25_diff,
+      ge => u_step25_ge
+    );
+
+  u_step26 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_28,
+      b => rs_s1_b_d26,
+      sub => s27_ge,
+      diff => u_step26_diff,
+      ge => u_step26_ge
+    );
+
+  u_step27 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_29,
+      b => rs_s1_b_d27,
+      sub => s28_ge,
+      diff => u_step27_diff,
+      ge => u_step27_ge
+    );
+
+  u_step28 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_30,
+      b => rs_s1_b_d28,
+      sub => s29_ge,
+      diff => u_step28_diff,
+      ge => u_step28_ge
+    );
+
+  u_step29 : fxrt_addsub_w35
+    port map (
+      clk => clk,
+      a => cat_31,
+      b => rs_s1_b_d29,
+      sub => s30_ge,
+      diff => u_step29_diff,
+      ge => u_step29_ge
+    );
 
   t <= s31_t;
   ok <= s31_ok;

@@ -207,26 +207,71 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   reg signed [64:0] s53_u = 65'sh00000000000000000;
   reg signed [64:0] s53_v = 65'sh00000000000000000;
 
-  // stage s54_test: u + v; the signs
-  wire signed [65:0] rs_s53_u;
-  wire signed [65:0] rs_s53_v;
-  wire signed [65:0] uv_sum;
+  // stage s54_test: u + v as two short sums; the signs
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 64:49 are read
+  wire [64:0] u_s53_u;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [15:0] bits_u_s53_u;
+  wire [16:0] rs_bits_u_s53_u;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 64:49 are read
+  wire [64:0] u_s53_v;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [15:0] bits_u_s53_v;
+  wire [16:0] rs_bits_u_s53_v;
+  wire [16:0] uv_sum_high;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 48:0 are read
+  wire [64:0] u_s53_u_1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [48:0] bits_u_s53_u_1;
+  wire [49:0] rs_bits_u_s53_u_1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 48:0 are read
+  wire [64:0] u_s53_v_1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [48:0] bits_u_s53_v_1;
+  wire [49:0] rs_bits_u_s53_v_1;
+  wire [49:0] uv_sum_low;
   wire signed [64:0] k_0_1 = 65'sh00000000000000000;
   wire [0:0] s53_u_lt_k_0_1;
   wire [0:0] s53_v_lt_k_0_1;
   wire [0:0] negative;
-  reg signed [65:0] s54_sum = 66'sh00000000000000000;
+  reg [16:0] s54_hs = 17'h00000;
+  reg [49:0] s54_ls = 50'h0000000000000;
   reg [0:0] s54_neg = 1'h0;
 
   // stage s55_hit: the hit bit
-  wire [15:0] bits_s54_sum;
-  wire [48:0] bits_s54_sum_1;
-  wire [48:0] k_0_2 = 49'h0000000000000;
-  wire [0:0] bits_s54_sum_1_ne_k_0_2;
-  wire [15:0] k_0_3 = 16'h0000;
-  wire [0:0] bits_s54_sum_ne_k_0_3;
-  wire [0:0] bits_s54_sum_2;
-  wire [0:0] and_14;
+  wire [15:0] bits_s54_hs;
+  wire [7:0] bits_bits_s54_hs;
+  wire [7:0] k_0_2 = 8'h00;
+  wire [0:0] ne_16;
+  wire [7:0] bits_bits_s54_hs_1;
+  wire [0:0] ne_17;
+  wire [1:0] high;
+  wire [0:0] bits_s54_hs_1;
+  wire [0:0] bits_s54_ls;
+  wire [48:0] bits_s54_ls_1;
+  wire [0:0] bits_bits_s54_ls_1;
+  wire [0:0] k_0_3 = 1'h0;
+  wire [0:0] ne_19;
+  wire [7:0] bits_bits_s54_ls_1_1;
+  wire [0:0] ne_20;
+  wire [7:0] bits_bits_s54_ls_1_2;
+  wire [0:0] ne_21;
+  wire [7:0] bits_bits_s54_ls_1_3;
+  wire [0:0] ne_22;
+  wire [7:0] bits_bits_s54_ls_1_4;
+  wire [0:0] ne_23;
+  wire [7:0] bits_bits_s54_ls_1_5;
+  wire [0:0] ne_24;
+  wire [7:0] bits_bits_s54_ls_1_6;
+  wire [0:0] ne_25;
+  wire [6:0] low;
+  wire [6:0] k_0_4 = 7'h00;
+  wire [0:0] low_ne_k_0_4;
+  wire [0:0] high_ne_k_0;
+  wire [0:0] or_27;
+  wire [0:0] bits_s54_hs_1_and_or_27;
+  wire [0:0] or_28;
+  wire [0:0] and_29;
   wire [0:0] over;
   wire [0:0] s54_neg_or_over;
   wire [0:0] not_s54_neg_or_over;
@@ -258,14 +303,14 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   integer s1_tag_d54_i;
   initial for (s1_tag_d54_i = 1; s1_tag_d54_i <= 54; s1_tag_d54_i = s1_tag_d54_i + 1) s1_tag_d54_sr[s1_tag_d54_i] = 45'h000000000000;
   wire [44:0] s1_tag_d54;
-  wire [29:0] k_0_4 = 30'h00000000;
+  wire [29:0] k_0_5 = 30'h00000000;
   wire [29:0] mux_s55_hit;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [64:0] shr_s53_u_d2;
   /* verilator lint_on UNUSEDSIGNAL */
   wire signed [31:0] rs_shr_s53_u_d2;
   wire [31:0] u_rs_shr_s53_u_d2;
-  wire [31:0] k_0_5 = 32'h00000000;
+  wire [31:0] k_0_6 = 32'h00000000;
   wire [31:0] mux_s55_hit_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [64:0] shr_s53_v_d2;
@@ -493,27 +538,63 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
     s53_v <= v_int;
   end
 
-  // stage s54_test: u + v; the signs
-  assign rs_s53_u = $signed({{1{s53_u[64]}}, s53_u});
-  assign rs_s53_v = $signed({{1{s53_v[64]}}, s53_v});
-  assign uv_sum = rs_s53_u + rs_s53_v;
+  // stage s54_test: u + v as two short sums; the signs
+  assign u_s53_u = $unsigned(s53_u);
+  assign bits_u_s53_u = u_s53_u[64:49];
+  assign rs_bits_u_s53_u = {{1{1'b0}}, bits_u_s53_u};
+  assign u_s53_v = $unsigned(s53_v);
+  assign bits_u_s53_v = u_s53_v[64:49];
+  assign rs_bits_u_s53_v = {{1{1'b0}}, bits_u_s53_v};
+  assign uv_sum_high = rs_bits_u_s53_u + rs_bits_u_s53_v;
+  assign u_s53_u_1 = $unsigned(s53_u);
+  assign bits_u_s53_u_1 = u_s53_u_1[48:0];
+  assign rs_bits_u_s53_u_1 = {{1{1'b0}}, bits_u_s53_u_1};
+  assign u_s53_v_1 = $unsigned(s53_v);
+  assign bits_u_s53_v_1 = u_s53_v_1[48:0];
+  assign rs_bits_u_s53_v_1 = {{1{1'b0}}, bits_u_s53_v_1};
+  assign uv_sum_low = rs_bits_u_s53_u_1 + rs_bits_u_s53_v_1;
   assign s53_u_lt_k_0_1 = s53_u < k_0_1;
   assign s53_v_lt_k_0_1 = s53_v < k_0_1;
   assign negative = s53_u_lt_k_0_1 | s53_v_lt_k_0_1;
 
   always @(posedge clk) begin : s54_test_regs
-    s54_sum <= uv_sum;
+    s54_hs <= uv_sum_high;
+    s54_ls <= uv_sum_low;
     s54_neg <= negative;
   end
 
   // stage s55_hit: the hit bit
-  assign bits_s54_sum = s54_sum[65:50];
-  assign bits_s54_sum_1 = s54_sum[48:0];
-  assign bits_s54_sum_1_ne_k_0_2 = bits_s54_sum_1 != k_0_2;
-  assign bits_s54_sum_ne_k_0_3 = bits_s54_sum != k_0_3;
-  assign bits_s54_sum_2 = s54_sum[49];
-  assign and_14 = bits_s54_sum_2 & bits_s54_sum_1_ne_k_0_2;
-  assign over = bits_s54_sum_ne_k_0_3 | and_14;
+  assign bits_s54_hs = s54_hs[16:1];
+  assign bits_bits_s54_hs = bits_s54_hs[15:8];
+  assign ne_16 = bits_bits_s54_hs != k_0_2;
+  assign bits_bits_s54_hs_1 = bits_s54_hs[7:0];
+  assign ne_17 = bits_bits_s54_hs_1 != k_0_2;
+  assign high = {ne_16, ne_17};
+  assign bits_s54_hs_1 = s54_hs[0];
+  assign bits_s54_ls = s54_ls[49];
+  assign bits_s54_ls_1 = s54_ls[48:0];
+  assign bits_bits_s54_ls_1 = bits_s54_ls_1[48];
+  assign ne_19 = bits_bits_s54_ls_1 != k_0_3;
+  assign bits_bits_s54_ls_1_1 = bits_s54_ls_1[47:40];
+  assign ne_20 = bits_bits_s54_ls_1_1 != k_0_2;
+  assign bits_bits_s54_ls_1_2 = bits_s54_ls_1[39:32];
+  assign ne_21 = bits_bits_s54_ls_1_2 != k_0_2;
+  assign bits_bits_s54_ls_1_3 = bits_s54_ls_1[31:24];
+  assign ne_22 = bits_bits_s54_ls_1_3 != k_0_2;
+  assign bits_bits_s54_ls_1_4 = bits_s54_ls_1[23:16];
+  assign ne_23 = bits_bits_s54_ls_1_4 != k_0_2;
+  assign bits_bits_s54_ls_1_5 = bits_s54_ls_1[15:8];
+  assign ne_24 = bits_bits_s54_ls_1_5 != k_0_2;
+  assign bits_bits_s54_ls_1_6 = bits_s54_ls_1[7:0];
+  assign ne_25 = bits_bits_s54_ls_1_6 != k_0_2;
+  assign low = {ne_19, ne_20, ne_21, ne_22, ne_23, ne_24, ne_25};
+  assign low_ne_k_0_4 = low != k_0_4;
+  assign high_ne_k_0 = high != k_0;
+  assign or_27 = bits_s54_ls | low_ne_k_0_4;
+  assign bits_s54_hs_1_and_or_27 = bits_s54_hs_1 & or_27;
+  assign or_28 = high_ne_k_0 | bits_s54_hs_1_and_or_27;
+  assign and_29 = bits_s54_ls & low_ne_k_0_4;
+  assign over = or_28 | and_29;
   assign s54_neg_or_over = s54_neg | over;
   assign not_s54_neg_or_over = ~s54_neg_or_over;
   assign u_div_ok_d14 = u_div_ok_d14_sr[14];
@@ -532,15 +613,15 @@ module fxrt_intersect_n29_m32_t0_e18_tag45_c150 (
   assign s53_v_d2 = s53_v_d2_sr[2];
   assign s1_valid_d54 = s1_valid_d54_sr[54];
   assign s1_tag_d54 = s1_tag_d54_sr[54];
-  assign mux_s55_hit = s55_hit ? u_div_t_1_d15 : k_0_4;
+  assign mux_s55_hit = s55_hit ? u_div_t_1_d15 : k_0_5;
   assign shr_s53_u_d2 = s53_u_d2 >>> 18;
   assign rs_shr_s53_u_d2 = $signed(shr_s53_u_d2[31:0]);
   assign u_rs_shr_s53_u_d2 = $unsigned(rs_shr_s53_u_d2);
-  assign mux_s55_hit_1 = s55_hit ? u_rs_shr_s53_u_d2 : k_0_5;
+  assign mux_s55_hit_1 = s55_hit ? u_rs_shr_s53_u_d2 : k_0_6;
   assign shr_s53_v_d2 = s53_v_d2 >>> 18;
   assign rs_shr_s53_v_d2 = $signed(shr_s53_v_d2[31:0]);
   assign u_rs_shr_s53_v_d2 = $unsigned(rs_shr_s53_v_d2);
-  assign mux_s55_hit_2 = s55_hit ? u_rs_shr_s53_v_d2 : k_0_5;
+  assign mux_s55_hit_2 = s55_hit ? u_rs_shr_s53_v_d2 : k_0_6;
 
   always @(posedge clk) begin : s56_result_regs
     for (u_div_t_1_d15_i = 15; u_div_t_1_d15_i > 1; u_div_t_1_d15_i = u_div_t_1_d15_i - 1)

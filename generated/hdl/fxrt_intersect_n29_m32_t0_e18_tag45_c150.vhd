@@ -250,26 +250,63 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
   signal s53_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
   signal s53_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s54_test: u + v; the signs
-  signal rs_s53_u : signed(65 downto 0);
-  signal rs_s53_v : signed(65 downto 0);
-  signal uv_sum : signed(65 downto 0);
+  -- stage s54_test: u + v as two short sums; the signs
+  signal u_s53_u : unsigned(64 downto 0);
+  signal bits_u_s53_u : unsigned(15 downto 0);
+  signal rs_bits_u_s53_u : unsigned(16 downto 0);
+  signal u_s53_v : unsigned(64 downto 0);
+  signal bits_u_s53_v : unsigned(15 downto 0);
+  signal rs_bits_u_s53_v : unsigned(16 downto 0);
+  signal uv_sum_high : unsigned(16 downto 0);
+  signal u_s53_u_1 : unsigned(64 downto 0);
+  signal bits_u_s53_u_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s53_u_1 : unsigned(49 downto 0);
+  signal u_s53_v_1 : unsigned(64 downto 0);
+  signal bits_u_s53_v_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s53_v_1 : unsigned(49 downto 0);
+  signal uv_sum_low : unsigned(49 downto 0);
   constant k_0_1 : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
   signal s53_u_lt_k_0_1 : unsigned(0 downto 0);
   signal s53_v_lt_k_0_1 : unsigned(0 downto 0);
   signal negative : unsigned(0 downto 0);
-  signal s54_sum : signed(65 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000000");
+  signal s54_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
+  signal s54_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
   signal s54_neg : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s55_hit: the hit bit
-  signal bits_s54_sum : unsigned(15 downto 0);
-  signal bits_s54_sum_1 : unsigned(48 downto 0);
-  constant k_0_2 : unsigned(48 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000");
-  signal bits_s54_sum_1_ne_k_0_2 : unsigned(0 downto 0);
-  constant k_0_3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
-  signal bits_s54_sum_ne_k_0_3 : unsigned(0 downto 0);
-  signal bits_s54_sum_2 : unsigned(0 downto 0);
-  signal and_14 : unsigned(0 downto 0);
+  signal bits_s54_hs : unsigned(15 downto 0);
+  signal bits_bits_s54_hs : unsigned(7 downto 0);
+  constant k_0_2 : unsigned(7 downto 0) := unsigned'("00000000");
+  signal ne_16 : unsigned(0 downto 0);
+  signal bits_bits_s54_hs_1 : unsigned(7 downto 0);
+  signal ne_17 : unsigned(0 downto 0);
+  signal high : unsigned(1 downto 0);
+  signal bits_s54_hs_1 : unsigned(0 downto 0);
+  signal bits_s54_ls : unsigned(0 downto 0);
+  signal bits_s54_ls_1 : unsigned(48 downto 0);
+  signal bits_bits_s54_ls_1 : unsigned(0 downto 0);
+  constant k_0_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal ne_19 : unsigned(0 downto 0);
+  signal bits_bits_s54_ls_1_1 : unsigned(7 downto 0);
+  signal ne_20 : unsigned(0 downto 0);
+  signal bits_bits_s54_ls_1_2 : unsigned(7 downto 0);
+  signal ne_21 : unsigned(0 downto 0);
+  signal bits_bits_s54_ls_1_3 : unsigned(7 downto 0);
+  signal ne_22 : unsigned(0 downto 0);
+  signal bits_bits_s54_ls_1_4 : unsigned(7 downto 0);
+  signal ne_23 : unsigned(0 downto 0);
+  signal bits_bits_s54_ls_1_5 : unsigned(7 downto 0);
+  signal ne_24 : unsigned(0 downto 0);
+  signal bits_bits_s54_ls_1_6 : unsigned(7 downto 0);
+  signal ne_25 : unsigned(0 downto 0);
+  signal low : unsigned(6 downto 0);
+  constant k_0_4 : unsigned(6 downto 0) := unsigned'("0000000");
+  signal low_ne_k_0_4 : unsigned(0 downto 0);
+  signal high_ne_k_0 : unsigned(0 downto 0);
+  signal or_27 : unsigned(0 downto 0);
+  signal bits_s54_hs_1_and_or_27 : unsigned(0 downto 0);
+  signal or_28 : unsigned(0 downto 0);
+  signal and_29 : unsigned(0 downto 0);
   signal over : unsigned(0 downto 0);
   signal s54_neg_or_over : unsigned(0 downto 0);
   signal not_s54_neg_or_over : unsigned(0 downto 0);
@@ -295,12 +332,12 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
   type s1_tag_d54_sr_t is array (1 to 54) of unsigned(44 downto 0);
   signal s1_tag_d54_sr : s1_tag_d54_sr_t := (others => (others => '0'));
   signal s1_tag_d54 : unsigned(44 downto 0);
-  constant k_0_4 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  constant k_0_5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal mux_s55_hit : unsigned(29 downto 0);
   signal shr_s53_u_d2 : signed(64 downto 0);
   signal rs_shr_s53_u_d2 : signed(31 downto 0);
   signal u_rs_shr_s53_u_d2 : unsigned(31 downto 0);
-  constant k_0_5 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  constant k_0_6 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal mux_s55_hit_1 : unsigned(31 downto 0);
   signal shr_s53_v_d2 : signed(64 downto 0);
   signal rs_shr_s53_v_d2 : signed(31 downto 0);
@@ -524,10 +561,21 @@ begin
     end if;
   end process s53_uv_regs;
 
-  -- stage s54_test: u + v; the signs
-  rs_s53_u <= resize(s53_u, 66);
-  rs_s53_v <= resize(s53_v, 66);
-  uv_sum <= rs_s53_u + rs_s53_v;
+  -- stage s54_test: u + v as two short sums; the signs
+  u_s53_u <= unsigned(s53_u);
+  bits_u_s53_u <= unsigned(u_s53_u(64 downto 49));
+  rs_bits_u_s53_u <= resize(bits_u_s53_u, 17);
+  u_s53_v <= unsigned(s53_v);
+  bits_u_s53_v <= unsigned(u_s53_v(64 downto 49));
+  rs_bits_u_s53_v <= resize(bits_u_s53_v, 17);
+  uv_sum_high <= rs_bits_u_s53_u + rs_bits_u_s53_v;
+  u_s53_u_1 <= unsigned(s53_u);
+  bits_u_s53_u_1 <= unsigned(u_s53_u_1(48 downto 0));
+  rs_bits_u_s53_u_1 <= resize(bits_u_s53_u_1, 50);
+  u_s53_v_1 <= unsigned(s53_v);
+  bits_u_s53_v_1 <= unsigned(u_s53_v_1(48 downto 0));
+  rs_bits_u_s53_v_1 <= resize(bits_u_s53_v_1, 50);
+  uv_sum_low <= rs_bits_u_s53_u_1 + rs_bits_u_s53_v_1;
   s53_u_lt_k_0_1 <= "1" when s53_u < k_0_1 else "0";
   s53_v_lt_k_0_1 <= "1" when s53_v < k_0_1 else "0";
   negative <= s53_u_lt_k_0_1 or s53_v_lt_k_0_1;
@@ -535,19 +583,44 @@ begin
   s54_test_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s54_sum <= uv_sum;
+      s54_hs <= uv_sum_high;
+      s54_ls <= uv_sum_low;
       s54_neg <= negative;
     end if;
   end process s54_test_regs;
 
   -- stage s55_hit: the hit bit
-  bits_s54_sum <= unsigned(s54_sum(65 downto 50));
-  bits_s54_sum_1 <= unsigned(s54_sum(48 downto 0));
-  bits_s54_sum_1_ne_k_0_2 <= "1" when bits_s54_sum_1 /= k_0_2 else "0";
-  bits_s54_sum_ne_k_0_3 <= "1" when bits_s54_sum /= k_0_3 else "0";
-  bits_s54_sum_2 <= unsigned(s54_sum(49 downto 49));
-  and_14 <= bits_s54_sum_2 and bits_s54_sum_1_ne_k_0_2;
-  over <= bits_s54_sum_ne_k_0_3 or and_14;
+  bits_s54_hs <= unsigned(s54_hs(16 downto 1));
+  bits_bits_s54_hs <= unsigned(bits_s54_hs(15 downto 8));
+  ne_16 <= "1" when bits_bits_s54_hs /= k_0_2 else "0";
+  bits_bits_s54_hs_1 <= unsigned(bits_s54_hs(7 downto 0));
+  ne_17 <= "1" when bits_bits_s54_hs_1 /= k_0_2 else "0";
+  high <= unsigned(std_logic_vector'(std_logic_vector(ne_16) & std_logic_vector(ne_17)));
+  bits_s54_hs_1 <= unsigned(s54_hs(0 downto 0));
+  bits_s54_ls <= unsigned(s54_ls(49 downto 49));
+  bits_s54_ls_1 <= unsigned(s54_ls(48 downto 0));
+  bits_bits_s54_ls_1 <= unsigned(bits_s54_ls_1(48 downto 48));
+  ne_19 <= "1" when bits_bits_s54_ls_1 /= k_0_3 else "0";
+  bits_bits_s54_ls_1_1 <= unsigned(bits_s54_ls_1(47 downto 40));
+  ne_20 <= "1" when bits_bits_s54_ls_1_1 /= k_0_2 else "0";
+  bits_bits_s54_ls_1_2 <= unsigned(bits_s54_ls_1(39 downto 32));
+  ne_21 <= "1" when bits_bits_s54_ls_1_2 /= k_0_2 else "0";
+  bits_bits_s54_ls_1_3 <= unsigned(bits_s54_ls_1(31 downto 24));
+  ne_22 <= "1" when bits_bits_s54_ls_1_3 /= k_0_2 else "0";
+  bits_bits_s54_ls_1_4 <= unsigned(bits_s54_ls_1(23 downto 16));
+  ne_23 <= "1" when bits_bits_s54_ls_1_4 /= k_0_2 else "0";
+  bits_bits_s54_ls_1_5 <= unsigned(bits_s54_ls_1(15 downto 8));
+  ne_24 <= "1" when bits_bits_s54_ls_1_5 /= k_0_2 else "0";
+  bits_bits_s54_ls_1_6 <= unsigned(bits_s54_ls_1(7 downto 0));
+  ne_25 <= "1" when bits_bits_s54_ls_1_6 /= k_0_2 else "0";
+  low <= unsigned(std_logic_vector'(std_logic_vector(ne_19) & std_logic_vector(ne_20) & std_logic_vector(ne_21) & std_logic_vector(ne_22) & std_logic_vector(ne_23) & std_logic_vector(ne_24) & std_logic_vector(ne_25)));
+  low_ne_k_0_4 <= "1" when low /= k_0_4 else "0";
+  high_ne_k_0 <= "1" when high /= k_0 else "0";
+  or_27 <= bits_s54_ls or low_ne_k_0_4;
+  bits_s54_hs_1_and_or_27 <= bits_s54_hs_1 and or_27;
+  or_28 <= high_ne_k_0 or bits_s54_hs_1_and_or_27;
+  and_29 <= bits_s54_ls and low_ne_k_0_4;
+  over <= or_28 or and_29;
   s54_neg_or_over <= s54_neg or over;
   not_s54_neg_or_over <= not s54_neg_or_over;
   u_div_ok_d14 <= u_div_ok_d14_sr(14);
@@ -568,15 +641,15 @@ begin
   s53_v_d2 <= s53_v_d2_sr(2);
   s1_valid_d54 <= s1_valid_d54_sr(54);
   s1_tag_d54 <= s1_tag_d54_sr(54);
-  mux_s55_hit <= u_div_t_1_d15 when s55_hit = "1" else k_0_4;
+  mux_s55_hit <= u_div_t_1_d15 when s55_hit = "1" else k_0_5;
   shr_s53_u_d2 <= shift_right(s53_u_d2, 18);
   rs_shr_s53_u_d2 <= shr_s53_u_d2(31 downto 0);
   u_rs_shr_s53_u_d2 <= unsigned(rs_shr_s53_u_d2);
-  mux_s55_hit_1 <= u_rs_shr_s53_u_d2 when s55_hit = "1" else k_0_5;
+  mux_s55_hit_1 <= u_rs_shr_s53_u_d2 when s55_hit = "1" else k_0_6;
   shr_s53_v_d2 <= shift_right(s53_v_d2, 18);
   rs_shr_s53_v_d2 <= shr_s53_v_d2(31 downto 0);
   u_rs_shr_s53_v_d2 <= unsigned(rs_shr_s53_v_d2);
-  mux_s55_hit_2 <= u_rs_shr_s53_v_d2 when s55_hit = "1" else k_0_5;
+  mux_s55_hit_2 <= u_rs_shr_s53_v_d2 when s55_hit = "1" else k_0_6;
 
   s56_result_regs : process (clk)
   begin

@@ -24,7 +24,7 @@
 //! the select by the sign) and the result flag one of its own (its register sits by the
 //! outputs, far from the last chain): two more cycles.
 
-use crate::rtl::build::{Builder, S};
+use crate::rtl::build::Builder;
 use crate::rtl::pipeline::{Pipeline, Policy};
 use crate::rtl::{Module, Ty};
 use std::rc::Rc;
@@ -154,13 +154,8 @@ fn divider_body<'b>(b: &'b Builder, n: u32, shape: DividerShape, wn: u32, wd: u3
         let neg_den = (-den).unsigned();
         // The zero tests as ORs of bytes registered here and combined in the next stage: a
         // 63-bit test in one clock was the slowest path at 250 MHz (5.1 ns).
-        let nonzero_bytes = |x: S<'b>| -> S<'b> {
-            let (x, w) = (x.unsigned(), x.width());
-            let bytes: Vec<S<'b>> = (0..w.div_ceil(8)).map(|i| x.slice(8 * i, 8.min(w - 8 * i)).ne(0)).collect();
-            b.cat(&bytes)
-        };
         // lo's bytes on their own: lo = 0 is also the negation's carry.
-        let (lo_nz, hi_nz, den_nz, sign_err) = (nonzero_bytes(lo_x), nonzero_bytes(hi_x), nonzero_bytes(den), n_neg ^ d_neg);
+        let (lo_nz, hi_nz, den_nz, sign_err) = (lo_x.nonzero_bytes(), hi_x.nonzero_bytes(), den.nonzero_bytes(), n_neg ^ d_neg);
         let h = pipe.stage(
             "negations",
             "signs, zero tests by bytes, both operands negated",

@@ -23,7 +23,9 @@ pub const LIMB: u32 = 17;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct MulStyle {
     /// Registers around each 18×18 piece: 0 none; 1 the inputs; 2 inputs and output; 3 inputs,
-    /// output and one more after it (where a DSP block has its pipeline register).
+    /// output and one more after it (where a DSP block has its pipeline register); 4 also a
+    /// fabric register after the block, where the adder tree picks the piece up (the route
+    /// from the DSP column to the tree is then a clock of its own).
     pub dsp_regs: u32,
     /// Adder-tree levels between two registers when the pieces are summed (the last level is
     /// always followed by one); 0 leaves the whole sum combinational.
@@ -63,12 +65,12 @@ pub fn latency(a: Ty, b: Ty, style: MulStyle) -> u32 {
 /// One 18×18 signed piece with `regs` registers (see `MulStyle::dsp_regs`): ports a, b
 /// (signed 18 bits) → p (signed 36 bits), `regs` cycles later.
 pub fn dsp18_core(regs: u32) -> Module {
-    assert!(regs <= 3, "a DSP piece has at most 3 register levels");
+    assert!(regs <= 4, "a DSP piece has at most 4 register levels");
     let b = Builder::new(&format!("fxrt_dsp18_r{regs}"));
     let (x, y) = (b.input("a", Ty::s(LIMB + 1)), b.input("b", Ty::s(LIMB + 1)));
     let (x, y) = if regs >= 1 { (b.delay("a_r", x), b.delay("b_r", y)) } else { (x, y) };
     let mut p = x.xmul(y).name("prod");
-    for (k, name) in ["p_r", "p_rr"].iter().enumerate() {
+    for (k, name) in ["p_r", "p_rr", "p_land"].iter().enumerate() {
         if regs >= k as u32 + 2 {
             p = b.delay(name, p);
         }
@@ -264,12 +266,13 @@ mod tests {
         }
     }
 
-    const STYLES: [MulStyle; 5] = [
+    const STYLES: [MulStyle; 6] = [
         MulStyle::COMBINATIONAL,
         MulStyle { dsp_regs: 0, levels_per_stage: 1 },
         MulStyle { dsp_regs: 2, levels_per_stage: 0 },
         MulStyle { dsp_regs: 2, levels_per_stage: 2 },
         MulStyle { dsp_regs: 3, levels_per_stage: 1 },
+        MulStyle { dsp_regs: 4, levels_per_stage: 1 },
     ];
 
     proptest! {

@@ -329,6 +329,14 @@ impl<'b> S<'b> {
     pub fn ne(self, o: impl Operand<'b>) -> S<'b> {
         self.compare(BinOp::Ne, o, false)
     }
+    /// One bit per byte from the bottom (the last may be shorter): whether it is non-zero.
+    /// A wide zero test cut where a register can go: each byte's OR is two LUT levels, and
+    /// `x ≠ 0` is the OR of the result.
+    pub fn nonzero_bytes(self) -> S<'b> {
+        let (x, w) = (self.unsigned(), self.width());
+        let bytes: Vec<S<'b>> = (0..w.div_ceil(8)).rev().map(|i| x.slice(8 * i, 8.min(w - 8 * i)).ne(0)).collect();
+        self.b.cat(&bytes)
+    }
     pub fn lt(self, o: impl Operand<'b>) -> S<'b> {
         self.compare(BinOp::Lt, o, false)
     }
