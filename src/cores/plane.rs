@@ -52,6 +52,9 @@ pub struct PlaneResult<'b> {
     pub t: S<'b>,
     /// `t` when `last` is 1 (the same register value then), held otherwise.
     pub t_last: S<'b>,
+    /// `t` when it is valid and `last` is 0 (a group's first distance: d0 of an inner node),
+    /// held otherwise: d0 until the next node's d0, the cycle d1 arrives included.
+    pub t_first: S<'b>,
     pub valid: S<'b>,
     pub last: S<'b>,
     pub latency: u32,
@@ -102,9 +105,15 @@ pub fn plane_unit<'b>(
     // equal registers, not two with different enables).
     let t_last = b.reg("plane_t_of_last", t.ty(), None);
     b.next_when(t_last, last, clamped);
+    // And one for the first distance of a group (d0), which holds it while d1 arrives: the
+    // traversal compares d0 from it the cycle it arrives, so its results are registered when d1
+    // comes (a third load enable, so yosys keeps the three apart).
+    let t_first = b.reg("plane_t_of_first", t.ty(), None);
+    b.next_when(t_first, (valid & !last).name("pu_first"), clamped);
     PlaneResult {
         t,
         t_last,
+        t_first,
         valid: b.delay("plane_t_valid", valid),
         last: b.delay("plane_t_last", last),
         latency: 3 + product_latency,
