@@ -112,22 +112,14 @@ module fxrt_traverse (
   wire [0:0] pu_product_last;
   wire [61:0] bits_pu_product;
   wire signed [61:0] pu_shifted;
-  wire [0:0] bits_pu_shifted;
-  wire signed [61:0] k_m1 = 62'sh3fffffffffffffff;
-  wire [0:0] pu_shifted_ne_k_m1;
   wire [0:0] pu_below;
-  wire [29:0] bits_pu_shifted_1;
-  wire [29:0] k_0_1 = 30'h00000000;
-  wire [0:0] ne_6;
-  wire [0:0] bits_pu_shifted_2;
-  wire [0:0] not_bits_pu_shifted_2;
-  wire [0:0] bits_pu_shifted_3;
-  wire [29:0] bits_pu_shifted_4;
-  wire [0:0] ne_7;
-  wire [0:0] and_8;
-  wire [0:0] ne_6_or_and_8;
+  wire [0:0] not_pu_below;
+  wire [30:0] bits_pu_shifted;
+  wire [30:0] k_0_1 = 31'h00000000;
+  wire [0:0] bits_pu_shifted_ne_k_0_1;
   wire [0:0] pu_above;
   wire signed [61:0] k_1073741824 = 62'sh0000000040000000;
+  wire signed [61:0] k_m1 = 62'sh3fffffffffffffff;
   wire signed [61:0] mux_pu_below;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
   wire signed [61:0] mux_pu_above;
@@ -147,14 +139,14 @@ module fxrt_traverse (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_box_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_12;
+  wire signed [32:0] minus_8;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt1_c;
   reg [0:0] box_lt1 = 1'h0;
   wire signed [32:0] rs_plane_t_1;
   wire signed [32:0] rs_box_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_13;
+  wire signed [32:0] minus_9;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt2_c;
   reg [0:0] box_lt2 = 1'h0;
@@ -164,7 +156,7 @@ module fxrt_traverse (
   wire signed [31:0] box_tmax;
   wire [0:0] bits_box_d1;
   wire [0:0] bits_box_d2;
-  wire [0:0] or_14;
+  wire [0:0] or_10;
   wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire signed [31:0] near_end;
@@ -198,27 +190,27 @@ module fxrt_traverse (
   wire signed [32:0] rs_plane_t_of_first;
   wire signed [32:0] rs_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_15;
+  wire signed [32:0] minus_11;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below_c;
   reg [0:0] d0_below = 1'h0;
   wire signed [32:0] rs_d0_lo;
   wire signed [32:0] rs_plane_t_of_first_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_16;
+  wire signed [32:0] minus_12;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_above_c;
   reg [0:0] d0_above = 1'h0;
   wire signed [32:0] rs_plane_t_of_last;
   wire signed [32:0] rs_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_17;
+  wire signed [32:0] minus_13;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
   wire signed [32:0] rs_d1_lo;
   wire signed [32:0] rs_plane_t_of_last_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_18;
+  wire signed [32:0] minus_14;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
@@ -339,8 +331,8 @@ module fxrt_traverse (
   wire [0:0] not_go_near_and_go_far;
   wire [12:0] mux_not_go_near_and_go_far;
   wire [0:0] not_go_far;
-  wire [0:0] and_20;
-  wire [12:0] mux_and_20;
+  wire [0:0] and_16;
+  wire [12:0] mux_and_16;
   wire [0:0] not_sp_empty;
   wire [12:0] mux_not_sp_empty;
   reg [12:0] node_next;
@@ -369,26 +361,26 @@ module fxrt_traverse (
   wire [0:0] not_box_miss;
   wire [3:0] mux_not_box_miss;
   wire [3:0] mux_node_settled;
-  wire [0:0] and_21;
-  wire [3:0] mux_and_21;
+  wire [0:0] and_17;
+  wire [3:0] mux_and_17;
   wire [0:0] not_nw_count_eq_k_0_7;
-  wire [0:0] and_22;
-  wire [3:0] mux_and_22;
+  wire [0:0] and_18;
+  wire [3:0] mux_and_18;
   wire [0:0] not_nw_is_leaf_1;
   wire [3:0] mux_not_nw_is_leaf_1;
   wire [3:0] mux_d1_arrives_1;
   wire [3:0] mux_go_near;
   wire [0:0] not_go_near_and_go_far_2;
   wire [3:0] mux_not_go_near_and_go_far_2;
-  wire [0:0] and_23;
-  wire [3:0] mux_and_23;
+  wire [0:0] and_19;
+  wire [3:0] mux_and_19;
   wire [3:0] mux_leaf_left_eq_k_1_4;
   wire [3:0] mux_sp_empty;
-  wire [0:0] and_24;
-  wire [3:0] mux_and_24;
+  wire [0:0] and_20;
+  wire [3:0] mux_and_20;
   wire [0:0] not_popped_ahead;
-  wire [0:0] and_25;
-  wire [3:0] mux_and_25;
+  wire [0:0] and_21;
+  wire [3:0] mux_and_21;
   reg [3:0] state_next;
   wire signed [31:0] mux_go_near_1;
   wire signed [31:0] mux_not_sp_empty_2;
@@ -398,8 +390,8 @@ module fxrt_traverse (
   wire [2:0] mux_nw_is_leaf_1;
   reg [2:0] leaf_left_next;
   wire [0:0] mux_nw_is_leaf_2;
-  wire [0:0] and_26;
-  wire [0:0] mux_and_26;
+  wire [0:0] and_22;
+  wire [0:0] mux_and_22;
   wire [0:0] mux_leaf_left_eq_k_1_4_1;
   reg [0:0] popped_ahead_next;
   wire [1:0] mux_not_nw_is_leaf_1_1;
@@ -422,7 +414,7 @@ module fxrt_traverse (
   wire [4:0] mux_not_sp_empty_4;
   reg [4:0] stack_top_addr_next;
   reg [0:0] in_step = 1'h0;
-  wire [0:0] and_27;
+  wire [0:0] and_23;
   wire [0:0] in_idle_next;
   wire [0:0] in_aabb_next;
   wire [0:0] in_node_next;
@@ -495,19 +487,11 @@ module fxrt_traverse (
   assign pu_product_last = pu_product_last_sr[6];
   assign bits_pu_product = pu_product[77:16];
   assign pu_shifted = $signed(bits_pu_product);
-  assign bits_pu_shifted = pu_shifted[61];
-  assign pu_shifted_ne_k_m1 = pu_shifted != k_m1;
-  assign pu_below = bits_pu_shifted & pu_shifted_ne_k_m1;
-  assign bits_pu_shifted_1 = pu_shifted[60:31];
-  assign ne_6 = bits_pu_shifted_1 != k_0_1;
-  assign bits_pu_shifted_2 = pu_shifted[61];
-  assign not_bits_pu_shifted_2 = ~bits_pu_shifted_2;
-  assign bits_pu_shifted_3 = pu_shifted[30];
-  assign bits_pu_shifted_4 = pu_shifted[29:0];
-  assign ne_7 = bits_pu_shifted_4 != k_0_1;
-  assign and_8 = bits_pu_shifted_3 & ne_7;
-  assign ne_6_or_and_8 = ne_6 | and_8;
-  assign pu_above = not_bits_pu_shifted_2 & ne_6_or_and_8;
+  assign pu_below = pu_shifted[61];
+  assign not_pu_below = ~pu_below;
+  assign bits_pu_shifted = pu_shifted[60:30];
+  assign bits_pu_shifted_ne_k_0_1 = bits_pu_shifted != k_0_1;
+  assign pu_above = not_pu_below & bits_pu_shifted_ne_k_0_1;
   assign mux_pu_below = pu_below ? k_m1 : pu_shifted;
   assign mux_pu_above = pu_above ? k_1073741824 : mux_pu_below;
   assign pu_clamped = $signed(mux_pu_above[31:0]);
@@ -516,20 +500,20 @@ module fxrt_traverse (
   assign d1_arrives = plane_t_valid & plane_t_last;
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
-  assign minus_12 = rs_plane_t - rs_box_d1;
-  assign box_lt1_c = minus_12[32];
+  assign minus_8 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_8[32];
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
-  assign minus_13 = rs_plane_t_1 - rs_box_d2;
-  assign box_lt2_c = minus_13[32];
+  assign minus_9 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_9[32];
   assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
   assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
   assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
   assign bits_box_d1 = box_d1[31];
   assign bits_box_d2 = box_d2[31];
-  assign or_14 = bits_box_d1 | bits_box_d2;
+  assign or_10 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_14 | bits_box_d3;
+  assign box_miss = or_10 | bits_box_d3;
   assign near_end = negative ? plane_t_of_last : plane_t_of_first;
   assign far_start = negative ? plane_t_of_first : plane_t_of_last;
   assign tmax_plus_1 = tmax + k_1;
@@ -548,20 +532,20 @@ module fxrt_traverse (
   assign d1_lo_c = tmin_le_tmax ? mux_negative_3 : k_2147483647;
   assign rs_plane_t_of_first = $signed({{1{plane_t_of_first[31]}}, plane_t_of_first});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_15 = rs_plane_t_of_first - rs_d0_hi;
-  assign d0_below_c = minus_15[32];
+  assign minus_11 = rs_plane_t_of_first - rs_d0_hi;
+  assign d0_below_c = minus_11[32];
   assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
   assign rs_plane_t_of_first_1 = $signed({{1{plane_t_of_first[31]}}, plane_t_of_first});
-  assign minus_16 = rs_d0_lo - rs_plane_t_of_first_1;
-  assign d0_above_c = minus_16[32];
+  assign minus_12 = rs_d0_lo - rs_plane_t_of_first_1;
+  assign d0_above_c = minus_12[32];
   assign rs_plane_t_of_last = $signed({{1{plane_t_of_last[31]}}, plane_t_of_last});
   assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_17 = rs_plane_t_of_last - rs_d1_hi;
-  assign d1_below = minus_17[32];
+  assign minus_13 = rs_plane_t_of_last - rs_d1_hi;
+  assign d1_below = minus_13[32];
   assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
   assign rs_plane_t_of_last_1 = $signed({{1{plane_t_of_last[31]}}, plane_t_of_last});
-  assign minus_18 = rs_d1_lo - rs_plane_t_of_last_1;
-  assign d1_above = minus_18[32];
+  assign minus_14 = rs_d1_lo - rs_plane_t_of_last_1;
+  assign d1_above = minus_14[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
   assign go_near_c = negative ? d1_above : d0_above;
@@ -611,7 +595,7 @@ module fxrt_traverse (
   assign id_r = id_r_sr[3];
 
   always @(posedge clk) begin : regs
-    if (and_27) stack[rs_sp] <= push_entry;
+    if (and_23) stack[rs_sp] <= push_entry;
     node_d1 <= node;
     for (node_d2_i = 2; node_d2_i > 1; node_d2_i = node_d2_i - 1)
       node_d2_sr[node_d2_i] <= node_d2_sr[node_d2_i - 1];
@@ -686,15 +670,15 @@ module fxrt_traverse (
   assign not_go_near_and_go_far = not_go_near & go_far;
   assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? far_r : node;
   assign not_go_far = ~go_far;
-  assign and_20 = not_go_near & not_go_far;
-  assign mux_and_20 = and_20 ? top_node : mux_not_go_near_and_go_far;
+  assign and_16 = not_go_near & not_go_far;
+  assign mux_and_16 = and_16 ? top_node : mux_not_go_near_and_go_far;
   assign not_sp_empty = ~sp_empty;
   assign mux_not_sp_empty = not_sp_empty ? top_node : node;
   always @* begin
     case (state)
       st_idle: node_next = k_0_4;
       st_dist: node_next = near;
-      st_step: node_next = mux_and_20;
+      st_step: node_next = mux_and_16;
       st_leaf: node_next = top_node;
       st_pop: node_next = mux_not_sp_empty;
       default: node_next = node;
@@ -732,26 +716,26 @@ module fxrt_traverse (
   assign not_box_miss = ~box_miss;
   assign mux_not_box_miss = not_box_miss ? st_node : mux_box_miss;
   assign mux_node_settled = node_settled ? st_node : state;
-  assign and_21 = nw_is_leaf & nw_count_eq_k_0_7;
-  assign mux_and_21 = and_21 ? st_pop : state;
+  assign and_17 = nw_is_leaf & nw_count_eq_k_0_7;
+  assign mux_and_17 = and_17 ? st_pop : state;
   assign not_nw_count_eq_k_0_7 = ~nw_count_eq_k_0_7;
-  assign and_22 = nw_is_leaf & not_nw_count_eq_k_0_7;
-  assign mux_and_22 = and_22 ? st_leaf : mux_and_21;
+  assign and_18 = nw_is_leaf & not_nw_count_eq_k_0_7;
+  assign mux_and_18 = and_18 ? st_leaf : mux_and_17;
   assign not_nw_is_leaf_1 = ~nw_is_leaf;
-  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_22;
+  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_18;
   assign mux_d1_arrives_1 = d1_arrives ? st_step : state;
   assign mux_go_near = go_near ? st_node : state;
   assign not_go_near_and_go_far_2 = not_go_near & go_far;
   assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near;
-  assign and_23 = not_go_near & not_go_far;
-  assign mux_and_23 = and_23 ? st_pop : mux_not_go_near_and_go_far_2;
+  assign and_19 = not_go_near & not_go_far;
+  assign mux_and_19 = and_19 ? st_pop : mux_not_go_near_and_go_far_2;
   assign mux_leaf_left_eq_k_1_4 = leaf_left_eq_k_1_4 ? st_pop : state;
   assign mux_sp_empty = sp_empty ? st_done : state;
-  assign and_24 = not_sp_empty & popped_ahead;
-  assign mux_and_24 = and_24 ? st_node : mux_sp_empty;
+  assign and_20 = not_sp_empty & popped_ahead;
+  assign mux_and_20 = and_20 ? st_node : mux_sp_empty;
   assign not_popped_ahead = ~popped_ahead;
-  assign and_25 = not_sp_empty & not_popped_ahead;
-  assign mux_and_25 = and_25 ? st_fetch : mux_and_24;
+  assign and_21 = not_sp_empty & not_popped_ahead;
+  assign mux_and_21 = and_21 ? st_fetch : mux_and_20;
   always @* begin
     case (state)
       st_idle: state_next = mux_ray_valid_7;
@@ -762,9 +746,9 @@ module fxrt_traverse (
       st_node: state_next = mux_not_nw_is_leaf_1;
       st_clip1: state_next = st_dist;
       st_dist: state_next = mux_d1_arrives_1;
-      st_step: state_next = mux_and_23;
+      st_step: state_next = mux_and_19;
       st_leaf: state_next = mux_leaf_left_eq_k_1_4;
-      st_pop: state_next = mux_and_25;
+      st_pop: state_next = mux_and_21;
       st_done: state_next = st_idle;
       default: state_next = st_idle;
     endcase
@@ -796,13 +780,13 @@ module fxrt_traverse (
     endcase
   end
   assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_6 : popped_ahead;
-  assign and_26 = not_go_near & not_go_far;
-  assign mux_and_26 = and_26 ? k_0_6 : popped_ahead;
+  assign and_22 = not_go_near & not_go_far;
+  assign mux_and_22 = and_22 ? k_0_6 : popped_ahead;
   assign mux_leaf_left_eq_k_1_4_1 = leaf_left_eq_k_1_4 ? was_leaf : popped_ahead;
   always @* begin
     case (state)
       st_node: popped_ahead_next = mux_nw_is_leaf_2;
-      st_step: popped_ahead_next = mux_and_26;
+      st_step: popped_ahead_next = mux_and_22;
       st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_4_1;
       default: popped_ahead_next = popped_ahead;
     endcase
@@ -837,7 +821,7 @@ module fxrt_traverse (
       default: stack_top_addr_next = stack_top_addr;
     endcase
   end
-  assign and_27 = in_step & go_near_and_go_far;
+  assign and_23 = in_step & go_near_and_go_far;
   assign in_idle_next = state_next == st_idle;
   assign in_aabb_next = state_next == st_aabb;
   assign in_node_next = state_next == st_node;

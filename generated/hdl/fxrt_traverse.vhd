@@ -167,22 +167,14 @@ architecture rtl of fxrt_traverse is
   signal pu_product_last : unsigned(0 downto 0);
   signal bits_pu_product : unsigned(61 downto 0);
   signal pu_shifted : signed(61 downto 0);
-  signal bits_pu_shifted : unsigned(0 downto 0);
-  constant k_m1 : signed(61 downto 0) := signed'("11111111111111111111111111111111111111111111111111111111111111");
-  signal pu_shifted_ne_k_m1 : unsigned(0 downto 0);
   signal pu_below : unsigned(0 downto 0);
-  signal bits_pu_shifted_1 : unsigned(29 downto 0);
-  constant k_0_1 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal ne_6 : unsigned(0 downto 0);
-  signal bits_pu_shifted_2 : unsigned(0 downto 0);
-  signal not_bits_pu_shifted_2 : unsigned(0 downto 0);
-  signal bits_pu_shifted_3 : unsigned(0 downto 0);
-  signal bits_pu_shifted_4 : unsigned(29 downto 0);
-  signal ne_7 : unsigned(0 downto 0);
-  signal and_8 : unsigned(0 downto 0);
-  signal ne_6_or_and_8 : unsigned(0 downto 0);
+  signal not_pu_below : unsigned(0 downto 0);
+  signal bits_pu_shifted : unsigned(30 downto 0);
+  constant k_0_1 : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal bits_pu_shifted_ne_k_0_1 : unsigned(0 downto 0);
   signal pu_above : unsigned(0 downto 0);
   constant k_1073741824 : signed(61 downto 0) := signed'("00000000000000000000000000000001000000000000000000000000000000");
+  constant k_m1 : signed(61 downto 0) := signed'("11111111111111111111111111111111111111111111111111111111111111");
   signal mux_pu_below : signed(61 downto 0);
   signal mux_pu_above : signed(61 downto 0);
   signal pu_clamped : signed(31 downto 0);
@@ -199,12 +191,12 @@ architecture rtl of fxrt_traverse is
   signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_plane_t : signed(32 downto 0);
   signal rs_box_d1 : signed(32 downto 0);
-  signal minus_12 : signed(32 downto 0);
+  signal minus_8 : signed(32 downto 0);
   signal box_lt1_c : unsigned(0 downto 0);
   signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
   signal rs_plane_t_1 : signed(32 downto 0);
   signal rs_box_d2 : signed(32 downto 0);
-  signal minus_13 : signed(32 downto 0);
+  signal minus_9 : signed(32 downto 0);
   signal box_lt2_c : unsigned(0 downto 0);
   signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
   signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
@@ -213,7 +205,7 @@ architecture rtl of fxrt_traverse is
   signal box_tmax : signed(31 downto 0);
   signal bits_box_d1 : unsigned(0 downto 0);
   signal bits_box_d2 : unsigned(0 downto 0);
-  signal or_14 : unsigned(0 downto 0);
+  signal or_10 : unsigned(0 downto 0);
   signal bits_box_d3 : unsigned(0 downto 0);
   signal box_miss : unsigned(0 downto 0);
   signal near_end : signed(31 downto 0);
@@ -244,21 +236,21 @@ architecture rtl of fxrt_traverse is
   signal d1_lo : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_plane_t_of_first : signed(32 downto 0);
   signal rs_d0_hi : signed(32 downto 0);
-  signal minus_15 : signed(32 downto 0);
+  signal minus_11 : signed(32 downto 0);
   signal d0_below_c : unsigned(0 downto 0);
   signal d0_below : unsigned(0 downto 0) := unsigned'("0");
   signal rs_d0_lo : signed(32 downto 0);
   signal rs_plane_t_of_first_1 : signed(32 downto 0);
-  signal minus_16 : signed(32 downto 0);
+  signal minus_12 : signed(32 downto 0);
   signal d0_above_c : unsigned(0 downto 0);
   signal d0_above : unsigned(0 downto 0) := unsigned'("0");
   signal rs_plane_t_of_last : signed(32 downto 0);
   signal rs_d1_hi : signed(32 downto 0);
-  signal minus_17 : signed(32 downto 0);
+  signal minus_13 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
   signal rs_d1_lo : signed(32 downto 0);
   signal rs_plane_t_of_last_1 : signed(32 downto 0);
-  signal minus_18 : signed(32 downto 0);
+  signal minus_14 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
@@ -367,8 +359,8 @@ architecture rtl of fxrt_traverse is
   signal not_go_near_and_go_far : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far : unsigned(12 downto 0);
   signal not_go_far : unsigned(0 downto 0);
-  signal and_20 : unsigned(0 downto 0);
-  signal mux_and_20 : unsigned(12 downto 0);
+  signal and_16 : unsigned(0 downto 0);
+  signal mux_and_16 : unsigned(12 downto 0);
   signal not_sp_empty : unsigned(0 downto 0);
   signal mux_not_sp_empty : unsigned(12 downto 0);
   signal node_next : unsigned(12 downto 0);
@@ -397,26 +389,26 @@ architecture rtl of fxrt_traverse is
   signal not_box_miss : unsigned(0 downto 0);
   signal mux_not_box_miss : unsigned(3 downto 0);
   signal mux_node_settled : unsigned(3 downto 0);
-  signal and_21 : unsigned(0 downto 0);
-  signal mux_and_21 : unsigned(3 downto 0);
+  signal and_17 : unsigned(0 downto 0);
+  signal mux_and_17 : unsigned(3 downto 0);
   signal not_nw_count_eq_k_0_7 : unsigned(0 downto 0);
-  signal and_22 : unsigned(0 downto 0);
-  signal mux_and_22 : unsigned(3 downto 0);
+  signal and_18 : unsigned(0 downto 0);
+  signal mux_and_18 : unsigned(3 downto 0);
   signal not_nw_is_leaf_1 : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1 : unsigned(3 downto 0);
   signal mux_d1_arrives_1 : unsigned(3 downto 0);
   signal mux_go_near : unsigned(3 downto 0);
   signal not_go_near_and_go_far_2 : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far_2 : unsigned(3 downto 0);
-  signal and_23 : unsigned(0 downto 0);
-  signal mux_and_23 : unsigned(3 downto 0);
+  signal and_19 : unsigned(0 downto 0);
+  signal mux_and_19 : unsigned(3 downto 0);
   signal mux_leaf_left_eq_k_1_4 : unsigned(3 downto 0);
   signal mux_sp_empty : unsigned(3 downto 0);
-  signal and_24 : unsigned(0 downto 0);
-  signal mux_and_24 : unsigned(3 downto 0);
+  signal and_20 : unsigned(0 downto 0);
+  signal mux_and_20 : unsigned(3 downto 0);
   signal not_popped_ahead : unsigned(0 downto 0);
-  signal and_25 : unsigned(0 downto 0);
-  signal mux_and_25 : unsigned(3 downto 0);
+  signal and_21 : unsigned(0 downto 0);
+  signal mux_and_21 : unsigned(3 downto 0);
   signal state_next : unsigned(3 downto 0);
   signal mux_go_near_1 : signed(31 downto 0);
   signal mux_not_sp_empty_2 : signed(31 downto 0);
@@ -426,8 +418,8 @@ architecture rtl of fxrt_traverse is
   signal mux_nw_is_leaf_1 : unsigned(2 downto 0);
   signal leaf_left_next : unsigned(2 downto 0);
   signal mux_nw_is_leaf_2 : unsigned(0 downto 0);
-  signal and_26 : unsigned(0 downto 0);
-  signal mux_and_26 : unsigned(0 downto 0);
+  signal and_22 : unsigned(0 downto 0);
+  signal mux_and_22 : unsigned(0 downto 0);
   signal mux_leaf_left_eq_k_1_4_1 : unsigned(0 downto 0);
   signal popped_ahead_next : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1_1 : unsigned(1 downto 0);
@@ -450,7 +442,7 @@ architecture rtl of fxrt_traverse is
   signal mux_not_sp_empty_4 : unsigned(4 downto 0);
   signal stack_top_addr_next : unsigned(4 downto 0);
   signal in_step : unsigned(0 downto 0) := unsigned'("0");
-  signal and_27 : unsigned(0 downto 0);
+  signal and_23 : unsigned(0 downto 0);
   signal in_idle_next : unsigned(0 downto 0);
   signal in_aabb_next : unsigned(0 downto 0);
   signal in_node_next : unsigned(0 downto 0);
@@ -516,19 +508,11 @@ begin
   pu_product_last <= pu_product_last_sr(6);
   bits_pu_product <= unsigned(pu_product(77 downto 16));
   pu_shifted <= signed(bits_pu_product);
-  bits_pu_shifted <= unsigned(pu_shifted(61 downto 61));
-  pu_shifted_ne_k_m1 <= "1" when pu_shifted /= k_m1 else "0";
-  pu_below <= bits_pu_shifted and pu_shifted_ne_k_m1;
-  bits_pu_shifted_1 <= unsigned(pu_shifted(60 downto 31));
-  ne_6 <= "1" when bits_pu_shifted_1 /= k_0_1 else "0";
-  bits_pu_shifted_2 <= unsigned(pu_shifted(61 downto 61));
-  not_bits_pu_shifted_2 <= not bits_pu_shifted_2;
-  bits_pu_shifted_3 <= unsigned(pu_shifted(30 downto 30));
-  bits_pu_shifted_4 <= unsigned(pu_shifted(29 downto 0));
-  ne_7 <= "1" when bits_pu_shifted_4 /= k_0_1 else "0";
-  and_8 <= bits_pu_shifted_3 and ne_7;
-  ne_6_or_and_8 <= ne_6 or and_8;
-  pu_above <= not_bits_pu_shifted_2 and ne_6_or_and_8;
+  pu_below <= unsigned(pu_shifted(61 downto 61));
+  not_pu_below <= not pu_below;
+  bits_pu_shifted <= unsigned(pu_shifted(60 downto 30));
+  bits_pu_shifted_ne_k_0_1 <= "1" when bits_pu_shifted /= k_0_1 else "0";
+  pu_above <= not_pu_below and bits_pu_shifted_ne_k_0_1;
   mux_pu_below <= k_m1 when pu_below = "1" else pu_shifted;
   mux_pu_above <= k_1073741824 when pu_above = "1" else mux_pu_below;
   pu_clamped <= mux_pu_above(31 downto 0);
@@ -537,20 +521,20 @@ begin
   d1_arrives <= plane_t_valid and plane_t_last;
   rs_plane_t <= resize(plane_t, 33);
   rs_box_d1 <= resize(box_d1, 33);
-  minus_12 <= rs_plane_t - rs_box_d1;
-  box_lt1_c <= unsigned(minus_12(32 downto 32));
+  minus_8 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_8(32 downto 32));
   rs_plane_t_1 <= resize(plane_t, 33);
   rs_box_d2 <= resize(box_d2, 33);
-  minus_13 <= rs_plane_t_1 - rs_box_d2;
-  box_lt2_c <= unsigned(minus_13(32 downto 32));
+  minus_9 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_9(32 downto 32));
   box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
   mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
   box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
   bits_box_d1 <= unsigned(box_d1(31 downto 31));
   bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_14 <= bits_box_d1 or bits_box_d2;
+  or_10 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_14 or bits_box_d3;
+  box_miss <= or_10 or bits_box_d3;
   near_end <= plane_t_of_last when negative = "1" else plane_t_of_first;
   far_start <= plane_t_of_first when negative = "1" else plane_t_of_last;
   tmax_plus_1 <= tmax + k_1;
@@ -569,20 +553,20 @@ begin
   d1_lo_c <= mux_negative_3 when tmin_le_tmax = "1" else k_2147483647;
   rs_plane_t_of_first <= resize(plane_t_of_first, 33);
   rs_d0_hi <= resize(d0_hi, 33);
-  minus_15 <= rs_plane_t_of_first - rs_d0_hi;
-  d0_below_c <= unsigned(minus_15(32 downto 32));
+  minus_11 <= rs_plane_t_of_first - rs_d0_hi;
+  d0_below_c <= unsigned(minus_11(32 downto 32));
   rs_d0_lo <= resize(d0_lo, 33);
   rs_plane_t_of_first_1 <= resize(plane_t_of_first, 33);
-  minus_16 <= rs_d0_lo - rs_plane_t_of_first_1;
-  d0_above_c <= unsigned(minus_16(32 downto 32));
+  minus_12 <= rs_d0_lo - rs_plane_t_of_first_1;
+  d0_above_c <= unsigned(minus_12(32 downto 32));
   rs_plane_t_of_last <= resize(plane_t_of_last, 33);
   rs_d1_hi <= resize(d1_hi, 33);
-  minus_17 <= rs_plane_t_of_last - rs_d1_hi;
-  d1_below <= unsigned(minus_17(32 downto 32));
+  minus_13 <= rs_plane_t_of_last - rs_d1_hi;
+  d1_below <= unsigned(minus_13(32 downto 32));
   rs_d1_lo <= resize(d1_lo, 33);
   rs_plane_t_of_last_1 <= resize(plane_t_of_last, 33);
-  minus_18 <= rs_d1_lo - rs_plane_t_of_last_1;
-  d1_above <= unsigned(minus_18(32 downto 32));
+  minus_14 <= rs_d1_lo - rs_plane_t_of_last_1;
+  d1_above <= unsigned(minus_14(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
   go_near_c <= d1_above when negative = "1" else d0_above;
@@ -632,7 +616,7 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if and_27 = "1" then
+      if and_23 = "1" then
         stack(to_integer(rs_sp)) <= push_entry;
       end if;
       node_d1 <= node;
@@ -704,15 +688,15 @@ begin
   not_go_near_and_go_far <= not_go_near and go_far;
   mux_not_go_near_and_go_far <= far_r when not_go_near_and_go_far = "1" else node;
   not_go_far <= not go_far;
-  and_20 <= not_go_near and not_go_far;
-  mux_and_20 <= top_node when and_20 = "1" else mux_not_go_near_and_go_far;
+  and_16 <= not_go_near and not_go_far;
+  mux_and_16 <= top_node when and_16 = "1" else mux_not_go_near_and_go_far;
   not_sp_empty <= not sp_empty;
   mux_not_sp_empty <= top_node when not_sp_empty = "1" else node;
   with state select
     node_next <=
       k_0_4 when st_idle,
       near when st_dist,
-      mux_and_20 when st_step,
+      mux_and_16 when st_step,
       top_node when st_leaf,
       mux_not_sp_empty when st_pop,
       node when others;
@@ -746,26 +730,26 @@ begin
   not_box_miss <= not box_miss;
   mux_not_box_miss <= st_node when not_box_miss = "1" else mux_box_miss;
   mux_node_settled <= st_node when node_settled = "1" else state;
-  and_21 <= nw_is_leaf and nw_count_eq_k_0_7;
-  mux_and_21 <= st_pop when and_21 = "1" else state;
+  and_17 <= nw_is_leaf and nw_count_eq_k_0_7;
+  mux_and_17 <= st_pop when and_17 = "1" else state;
   not_nw_count_eq_k_0_7 <= not nw_count_eq_k_0_7;
-  and_22 <= nw_is_leaf and not_nw_count_eq_k_0_7;
-  mux_and_22 <= st_leaf when and_22 = "1" else mux_and_21;
+  and_18 <= nw_is_leaf and not_nw_count_eq_k_0_7;
+  mux_and_18 <= st_leaf when and_18 = "1" else mux_and_17;
   not_nw_is_leaf_1 <= not nw_is_leaf;
-  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_22;
+  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_18;
   mux_d1_arrives_1 <= st_step when d1_arrives = "1" else state;
   mux_go_near <= st_node when go_near = "1" else state;
   not_go_near_and_go_far_2 <= not_go_near and go_far;
   mux_not_go_near_and_go_far_2 <= st_fetch when not_go_near_and_go_far_2 = "1" else mux_go_near;
-  and_23 <= not_go_near and not_go_far;
-  mux_and_23 <= st_pop when and_23 = "1" else mux_not_go_near_and_go_far_2;
+  and_19 <= not_go_near and not_go_far;
+  mux_and_19 <= st_pop when and_19 = "1" else mux_not_go_near_and_go_far_2;
   mux_leaf_left_eq_k_1_4 <= st_pop when leaf_left_eq_k_1_4 = "1" else state;
   mux_sp_empty <= st_done when sp_empty = "1" else state;
-  and_24 <= not_sp_empty and popped_ahead;
-  mux_and_24 <= st_node when and_24 = "1" else mux_sp_empty;
+  and_20 <= not_sp_empty and popped_ahead;
+  mux_and_20 <= st_node when and_20 = "1" else mux_sp_empty;
   not_popped_ahead <= not popped_ahead;
-  and_25 <= not_sp_empty and not_popped_ahead;
-  mux_and_25 <= st_fetch when and_25 = "1" else mux_and_24;
+  and_21 <= not_sp_empty and not_popped_ahead;
+  mux_and_21 <= st_fetch when and_21 = "1" else mux_and_20;
   with state select
     state_next <=
       mux_ray_valid_7 when st_idle,
@@ -776,9 +760,9 @@ begin
       mux_not_nw_is_leaf_1 when st_node,
       st_dist when st_clip1,
       mux_d1_arrives_1 when st_dist,
-      mux_and_23 when st_step,
+      mux_and_19 when st_step,
       mux_leaf_left_eq_k_1_4 when st_leaf,
-      mux_and_25 when st_pop,
+      mux_and_21 when st_pop,
       st_idle when st_done,
       st_idle when others;
   mux_go_near_1 <= near_max when go_near = "1" else tmax;
@@ -802,13 +786,13 @@ begin
       leaf_left_minus_k_1_4 when st_leaf,
       leaf_left when others;
   mux_nw_is_leaf_2 <= k_0_6 when nw_is_leaf = "1" else popped_ahead;
-  and_26 <= not_go_near and not_go_far;
-  mux_and_26 <= k_0_6 when and_26 = "1" else popped_ahead;
+  and_22 <= not_go_near and not_go_far;
+  mux_and_22 <= k_0_6 when and_22 = "1" else popped_ahead;
   mux_leaf_left_eq_k_1_4_1 <= was_leaf when leaf_left_eq_k_1_4 = "1" else popped_ahead;
   with state select
     popped_ahead_next <=
       mux_nw_is_leaf_2 when st_node,
-      mux_and_26 when st_step,
+      mux_and_22 when st_step,
       mux_leaf_left_eq_k_1_4_1 when st_leaf,
       popped_ahead when others;
   mux_not_nw_is_leaf_1_1 <= nw_axis when not_nw_is_leaf_1 = "1" else axis_r;
@@ -837,7 +821,7 @@ begin
       mux_go_near_and_go_far_1 when st_step,
       mux_not_sp_empty_4 when st_pop,
       stack_top_addr when others;
-  and_27 <= in_step and go_near_and_go_far;
+  and_23 <= in_step and go_near_and_go_far;
   in_idle_next <= "1" when state_next = st_idle else "0";
   in_aabb_next <= "1" when state_next = st_aabb else "0";
   in_node_next <= "1" when state_next = st_node else "0";
