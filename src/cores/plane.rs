@@ -10,8 +10,11 @@
 //!    subtractor.
 //! 3. product: `plane_product`, its own number of stages (the clock target's `MulStyle`: 1
 //!    for one multiplier between two registers, more for DSP pieces and an adder tree).
-//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (two bit reductions and a
-//!    mux), registered.
+//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (the sign bit, one bit
+//!    reduction and a mux), registered. With a split product (a fast clock target) it takes
+//!    two clocks: the reduction is registered beside the distance's bits (4a, by the product,
+//!    which sits by the DSP blocks), and the mux (4b) is one LUT before the distance registers
+//!    (by their users): the route across the die between gets a clock of its own.
 //!
 //! The valid and last bits ride along in shift registers of the same depth, so a state
 //! machine waits for results by their valid bit and never counts the latency itself: a
@@ -82,6 +85,7 @@ pub fn plane_unit<'b>(
     let inv_a = b.delay("pu_inv", b.pick(axis, inv).name("pu_inv_axis"));
     let (valid, last) = (b.delay("pu_delta_valid", valid), b.delay("pu_delta_last", last));
     // 3. product
+    let product_style = product;
     let (product, product_latency) = plane_product(b, delta, inv_a, product);
     let valid = b.delay_line("pu_product_valid", valid, product_latency);
     let last = b.delay_line("pu_product_last", last, product_latency);
@@ -93,14 +97,31 @@ pub fn plane_unit<'b>(
     // (Testing s < −1 and s > 2^(n+1) exactly took two more reductions, over all of s and its
     // low n + 1 bits: the stage made the whole core's critical path, 7.5–8.6 ns, 5.4–7.1 ns of
     // it routing from the DSP column.)
+    // With a split product, 4a registers the tests and the n + 3 low bits (which hold s when
+    // neither test holds) by the product, and 4b muxes them by the users (in the whole Cornell
+    // core, the one-clock clamp spent 6.6 ns of 8.1 routing from the product's register at the
+    // die's edge to the distance registers in its middle).
     let w = product.width() - c;
     let shifted = product.slice(c, w).signed().name("pu_shifted");
     let k = n + 1;
     let below = shifted.msb().name("pu_below");
     let above = (!below & shifted.slice(k, w - 1 - k).ne(0)).name("pu_above");
-    let t_sat = shifted.k(1i128 << k);
-    let clamped = above.select(t_sat, below.select(shifted.k(-1), shifted));
-    let clamped = clamped.resize(Ty::s(n + 3).width).name("pu_clamped");
+    let dist_w = Ty::s(n + 3).width;
+    let low = shifted.resize(dist_w);
+    let split = product_style != MulStyle::COMBINATIONAL;
+    let (above, below, low, valid, last) = if split {
+        (
+            b.delay("pu_above_r", above),
+            b.delay("pu_below_r", below),
+            b.delay("pu_low_r", low),
+            b.delay("pu_clamp_valid", valid),
+            b.delay("pu_clamp_last", last),
+        )
+    } else {
+        (above, below, low, valid, last)
+    };
+    let t_sat = low.k(1i128 << k);
+    let clamped = above.select(t_sat, below.select(low.k(-1), low)).name("pu_clamped");
     let t = b.delay("plane_t", clamped);
     // The same distance in a register that loads only with a group's last one: a copy for the
     // traversal's decision compares, so `t` does not fan out to every compare (yosys merges two
@@ -118,6 +139,6 @@ pub fn plane_unit<'b>(
         t_first,
         valid: b.delay("plane_t_valid", valid),
         last: b.delay("plane_t_last", last),
-        latency: 3 + product_latency,
+        latency: 3 + product_latency + split as u32,
     }
 }
