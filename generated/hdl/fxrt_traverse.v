@@ -118,17 +118,20 @@ module fxrt_traverse (
   wire [30:0] k_0_1 = 31'h00000000;
   wire [0:0] bits_pu_shifted_ne_k_0_1;
   wire [0:0] pu_above;
-  wire signed [61:0] k_1073741824 = 62'sh0000000040000000;
-  wire signed [61:0] k_m1 = 62'sh3fffffffffffffff;
-  wire signed [61:0] mux_pu_below;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [61:0] mux_pu_above;
-  /* verilator lint_on UNUSEDSIGNAL */
+  wire signed [31:0] rs_pu_shifted;
+  reg [0:0] pu_above_r = 1'h0;
+  reg [0:0] pu_below_r = 1'h0;
+  reg signed [31:0] pu_low_r = 32'sh00000000;
+  reg [0:0] pu_clamp_valid = 1'h0;
+  reg [0:0] pu_clamp_last = 1'h0;
+  wire signed [31:0] k_1073741824 = 32'sh40000000;
+  wire signed [31:0] k_m1 = 32'shffffffff;
+  wire signed [31:0] mux_pu_below_r;
   wire signed [31:0] pu_clamped;
   reg signed [31:0] plane_t = 32'sh00000000;
   reg signed [31:0] plane_t_of_last = 32'sh00000000;
   reg signed [31:0] plane_t_of_first = 32'sh00000000;
-  wire [0:0] not_pu_product_last;
+  wire [0:0] not_pu_clamp_last;
   wire [0:0] pu_first;
   reg [0:0] plane_t_valid = 1'h0;
   reg [0:0] plane_t_last = 1'h0;
@@ -492,11 +495,11 @@ module fxrt_traverse (
   assign bits_pu_shifted = pu_shifted[60:30];
   assign bits_pu_shifted_ne_k_0_1 = bits_pu_shifted != k_0_1;
   assign pu_above = not_pu_below & bits_pu_shifted_ne_k_0_1;
-  assign mux_pu_below = pu_below ? k_m1 : pu_shifted;
-  assign mux_pu_above = pu_above ? k_1073741824 : mux_pu_below;
-  assign pu_clamped = $signed(mux_pu_above[31:0]);
-  assign not_pu_product_last = ~pu_product_last;
-  assign pu_first = pu_product_valid & not_pu_product_last;
+  assign rs_pu_shifted = $signed(pu_shifted[31:0]);
+  assign mux_pu_below_r = pu_below_r ? k_m1 : pu_low_r;
+  assign pu_clamped = pu_above_r ? k_1073741824 : mux_pu_below_r;
+  assign not_pu_clamp_last = ~pu_clamp_last;
+  assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign d1_arrives = plane_t_valid & plane_t_last;
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
@@ -614,11 +617,16 @@ module fxrt_traverse (
     for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
       pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
     pu_product_last_sr[1] <= pu_delta_last;
+    pu_above_r <= pu_above;
+    pu_below_r <= pu_below;
+    pu_low_r <= rs_pu_shifted;
+    pu_clamp_valid <= pu_product_valid;
+    pu_clamp_last <= pu_product_last;
     plane_t <= pu_clamped;
-    if (pu_product_last) plane_t_of_last <= pu_clamped;
+    if (pu_clamp_last) plane_t_of_last <= pu_clamped;
     if (pu_first) plane_t_of_first <= pu_clamped;
-    plane_t_valid <= pu_product_valid;
-    plane_t_last <= pu_product_last;
+    plane_t_valid <= pu_clamp_valid;
+    plane_t_last <= pu_clamp_last;
     box_d1 <= plane_t;
     box_d2 <= box_d1;
     box_d3 <= box_d2;

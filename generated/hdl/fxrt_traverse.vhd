@@ -173,15 +173,20 @@ architecture rtl of fxrt_traverse is
   constant k_0_1 : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
   signal bits_pu_shifted_ne_k_0_1 : unsigned(0 downto 0);
   signal pu_above : unsigned(0 downto 0);
-  constant k_1073741824 : signed(61 downto 0) := signed'("00000000000000000000000000000001000000000000000000000000000000");
-  constant k_m1 : signed(61 downto 0) := signed'("11111111111111111111111111111111111111111111111111111111111111");
-  signal mux_pu_below : signed(61 downto 0);
-  signal mux_pu_above : signed(61 downto 0);
+  signal rs_pu_shifted : signed(31 downto 0);
+  signal pu_above_r : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_below_r : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_low_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal pu_clamp_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_clamp_last : unsigned(0 downto 0) := unsigned'("0");
+  constant k_1073741824 : signed(31 downto 0) := signed'("01000000000000000000000000000000");
+  constant k_m1 : signed(31 downto 0) := signed'("11111111111111111111111111111111");
+  signal mux_pu_below_r : signed(31 downto 0);
   signal pu_clamped : signed(31 downto 0);
   signal plane_t : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal plane_t_of_last : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal plane_t_of_first : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal not_pu_product_last : unsigned(0 downto 0);
+  signal not_pu_clamp_last : unsigned(0 downto 0);
   signal pu_first : unsigned(0 downto 0);
   signal plane_t_valid : unsigned(0 downto 0) := unsigned'("0");
   signal plane_t_last : unsigned(0 downto 0) := unsigned'("0");
@@ -513,11 +518,11 @@ begin
   bits_pu_shifted <= unsigned(pu_shifted(60 downto 30));
   bits_pu_shifted_ne_k_0_1 <= "1" when bits_pu_shifted /= k_0_1 else "0";
   pu_above <= not_pu_below and bits_pu_shifted_ne_k_0_1;
-  mux_pu_below <= k_m1 when pu_below = "1" else pu_shifted;
-  mux_pu_above <= k_1073741824 when pu_above = "1" else mux_pu_below;
-  pu_clamped <= mux_pu_above(31 downto 0);
-  not_pu_product_last <= not pu_product_last;
-  pu_first <= pu_product_valid and not_pu_product_last;
+  rs_pu_shifted <= pu_shifted(31 downto 0);
+  mux_pu_below_r <= k_m1 when pu_below_r = "1" else pu_low_r;
+  pu_clamped <= k_1073741824 when pu_above_r = "1" else mux_pu_below_r;
+  not_pu_clamp_last <= not pu_clamp_last;
+  pu_first <= pu_clamp_valid and not_pu_clamp_last;
   d1_arrives <= plane_t_valid and plane_t_last;
   rs_plane_t <= resize(plane_t, 33);
   rs_box_d1 <= resize(box_d1, 33);
@@ -634,15 +639,20 @@ begin
       pu_product_valid_sr(1) <= pu_delta_valid;
       pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
       pu_product_last_sr(1) <= pu_delta_last;
+      pu_above_r <= pu_above;
+      pu_below_r <= pu_below;
+      pu_low_r <= rs_pu_shifted;
+      pu_clamp_valid <= pu_product_valid;
+      pu_clamp_last <= pu_product_last;
       plane_t <= pu_clamped;
-      if pu_product_last = "1" then
+      if pu_clamp_last = "1" then
         plane_t_of_last <= pu_clamped;
       end if;
       if pu_first = "1" then
         plane_t_of_first <= pu_clamped;
       end if;
-      plane_t_valid <= pu_product_valid;
-      plane_t_last <= pu_product_last;
+      plane_t_valid <= pu_clamp_valid;
+      plane_t_last <= pu_clamp_last;
       box_d1 <= plane_t;
       box_d2 <= box_d1;
       box_d3 <= box_d2;
