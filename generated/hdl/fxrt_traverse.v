@@ -329,7 +329,8 @@ module fxrt_traverse (
   reg [0:0] in_leaf = 1'h0;
   reg [0:0] in_idle = 1'h1;
   reg [0:0] in_done = 1'h0;
-  reg [1:0] aabb_k_next;
+  wire [1:0] mux_in_aabb_2;
+  wire [1:0] aabb_k_next;
   wire [0:0] not_go_near;
   wire [0:0] not_go_near_and_go_far;
   wire [12:0] mux_not_go_near_and_go_far;
@@ -338,11 +339,20 @@ module fxrt_traverse (
   wire [12:0] mux_and_16;
   wire [0:0] not_sp_empty;
   wire [12:0] mux_not_sp_empty;
-  reg [12:0] node_next;
+  reg [0:0] in_pop = 1'h0;
+  wire [12:0] mux_in_pop;
+  wire [12:0] mux_in_leaf;
+  reg [0:0] in_step = 1'h0;
+  wire [12:0] mux_in_step;
+  reg [0:0] in_dist = 1'h0;
+  wire [12:0] mux_in_dist;
+  wire [12:0] node_next;
   wire [0:0] not_go_near_and_go_far_1;
   wire signed [31:0] mux_not_go_near_and_go_far_1;
   wire signed [31:0] mux_not_sp_empty_1;
-  reg signed [31:0] tmin_next;
+  wire signed [31:0] mux_in_pop_1;
+  wire signed [31:0] mux_in_step_1;
+  wire signed [31:0] tmin_next;
   wire [19:0] mux_ray_valid;
   wire [19:0] ray_id_r_next;
   wire [28:0] mux_ray_valid_1;
@@ -387,16 +397,23 @@ module fxrt_traverse (
   reg [3:0] state_next;
   wire signed [31:0] mux_go_near_1;
   wire signed [31:0] mux_not_sp_empty_2;
-  reg signed [31:0] tmax_next;
+  wire signed [31:0] mux_in_pop_2;
+  wire signed [31:0] mux_in_step_2;
+  reg [0:0] in_boxmin = 1'h0;
+  wire signed [31:0] tmax_next;
   wire [12:0] mux_nw_is_leaf;
-  reg [12:0] leaf_ptr_next;
+  wire [12:0] mux_in_leaf_1;
+  wire [12:0] leaf_ptr_next;
   wire [2:0] mux_nw_is_leaf_1;
-  reg [2:0] leaf_left_next;
+  wire [2:0] mux_in_leaf_2;
+  wire [2:0] leaf_left_next;
   wire [0:0] mux_nw_is_leaf_2;
   wire [0:0] and_22;
   wire [0:0] mux_and_22;
   wire [0:0] mux_leaf_left_eq_k_1_4_1;
-  reg [0:0] popped_ahead_next;
+  wire [0:0] mux_in_leaf_3;
+  wire [0:0] mux_in_step_3;
+  wire [0:0] popped_ahead_next;
   wire [1:0] mux_not_nw_is_leaf_1_1;
   wire [1:0] axis_r_next;
   wire [28:0] mux_not_nw_is_leaf_1_2;
@@ -404,7 +421,6 @@ module fxrt_traverse (
   wire [12:0] mux_not_nw_is_leaf_1_3;
   wire [12:0] child_r_next;
   wire [0:0] negative_next;
-  reg [0:0] in_dist = 1'h0;
   wire [12:0] far_r_next;
   wire signed [31:0] mux_d1_arrives_2;
   wire signed [31:0] near_end_r_next;
@@ -412,19 +428,22 @@ module fxrt_traverse (
   wire signed [31:0] far_start_r_next;
   wire [5:0] mux_go_near_and_go_far;
   wire [5:0] mux_not_sp_empty_3;
-  reg [5:0] sp_next;
+  wire [5:0] mux_in_pop_3;
+  wire [5:0] sp_next;
   wire [4:0] mux_go_near_and_go_far_1;
   wire [4:0] mux_not_sp_empty_4;
-  reg [4:0] stack_top_addr_next;
-  reg [0:0] in_step = 1'h0;
+  wire [4:0] mux_in_pop_4;
+  wire [4:0] stack_top_addr_next;
   wire [0:0] and_23;
   wire [0:0] in_idle_next;
   wire [0:0] in_aabb_next;
+  wire [0:0] in_boxmin_next;
   wire [0:0] in_node_next;
   wire [0:0] in_clip1_next;
   wire [0:0] in_dist_next;
   wire [0:0] in_step_next;
   wire [0:0] in_leaf_next;
+  wire [0:0] in_pop_next;
   wire [0:0] in_done_next;
 
   // not in a stage or state machine
@@ -667,13 +686,8 @@ module fxrt_traverse (
   end
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
-  always @* begin
-    case (state)
-      st_idle: aabb_k_next = k_0_3;
-      st_aabb: aabb_k_next = aabb_k_plus_k_1_2;
-      default: aabb_k_next = aabb_k;
-    endcase
-  end
+  assign mux_in_aabb_2 = in_aabb ? aabb_k_plus_k_1_2 : aabb_k;
+  assign aabb_k_next = in_idle ? k_0_3 : mux_in_aabb_2;
   assign not_go_near = ~go_near;
   assign not_go_near_and_go_far = not_go_near & go_far;
   assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? far_r : node;
@@ -682,27 +696,17 @@ module fxrt_traverse (
   assign mux_and_16 = and_16 ? top_node : mux_not_go_near_and_go_far;
   assign not_sp_empty = ~sp_empty;
   assign mux_not_sp_empty = not_sp_empty ? top_node : node;
-  always @* begin
-    case (state)
-      st_idle: node_next = k_0_4;
-      st_dist: node_next = near;
-      st_step: node_next = mux_and_16;
-      st_leaf: node_next = top_node;
-      st_pop: node_next = mux_not_sp_empty;
-      default: node_next = node;
-    endcase
-  end
+  assign mux_in_pop = in_pop ? mux_not_sp_empty : node;
+  assign mux_in_leaf = in_leaf ? top_node : mux_in_pop;
+  assign mux_in_step = in_step ? mux_and_16 : mux_in_leaf;
+  assign mux_in_dist = in_dist ? near : mux_in_step;
+  assign node_next = in_idle ? k_0_4 : mux_in_dist;
   assign not_go_near_and_go_far_1 = not_go_near & go_far;
   assign mux_not_go_near_and_go_far_1 = not_go_near_and_go_far_1 ? far_min : tmin;
   assign mux_not_sp_empty_1 = not_sp_empty ? top_tmin : tmin;
-  always @* begin
-    case (state)
-      st_idle: tmin_next = k_0_5;
-      st_step: tmin_next = mux_not_go_near_and_go_far_1;
-      st_pop: tmin_next = mux_not_sp_empty_1;
-      default: tmin_next = tmin;
-    endcase
-  end
+  assign mux_in_pop_1 = in_pop ? mux_not_sp_empty_1 : tmin;
+  assign mux_in_step_1 = in_step ? mux_not_go_near_and_go_far_1 : mux_in_pop_1;
+  assign tmin_next = in_idle ? k_0_5 : mux_in_step_1;
   assign mux_ray_valid = ray_valid ? ray_id : ray_id_r;
   assign ray_id_r_next = in_idle ? mux_ray_valid : ray_id_r;
   assign mux_ray_valid_1 = ray_valid ? ox : ox_r;
@@ -763,42 +767,22 @@ module fxrt_traverse (
   end
   assign mux_go_near_1 = go_near ? near_max : tmax;
   assign mux_not_sp_empty_2 = not_sp_empty ? top_tmax : tmax;
-  always @* begin
-    case (state)
-      st_boxmin: tmax_next = box_tmax;
-      st_step: tmax_next = mux_go_near_1;
-      st_pop: tmax_next = mux_not_sp_empty_2;
-      default: tmax_next = tmax;
-    endcase
-  end
+  assign mux_in_pop_2 = in_pop ? mux_not_sp_empty_2 : tmax;
+  assign mux_in_step_2 = in_step ? mux_go_near_1 : mux_in_pop_2;
+  assign tmax_next = in_boxmin ? box_tmax : mux_in_step_2;
   assign mux_nw_is_leaf = nw_is_leaf ? nw_first : leaf_ptr;
-  always @* begin
-    case (state)
-      st_node: leaf_ptr_next = mux_nw_is_leaf;
-      st_leaf: leaf_ptr_next = leaf_ptr_plus_k_1_1;
-      default: leaf_ptr_next = leaf_ptr;
-    endcase
-  end
+  assign mux_in_leaf_1 = in_leaf ? leaf_ptr_plus_k_1_1 : leaf_ptr;
+  assign leaf_ptr_next = in_node ? mux_nw_is_leaf : mux_in_leaf_1;
   assign mux_nw_is_leaf_1 = nw_is_leaf ? nw_count : leaf_left;
-  always @* begin
-    case (state)
-      st_node: leaf_left_next = mux_nw_is_leaf_1;
-      st_leaf: leaf_left_next = leaf_left_minus_k_1_4;
-      default: leaf_left_next = leaf_left;
-    endcase
-  end
+  assign mux_in_leaf_2 = in_leaf ? leaf_left_minus_k_1_4 : leaf_left;
+  assign leaf_left_next = in_node ? mux_nw_is_leaf_1 : mux_in_leaf_2;
   assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_6 : popped_ahead;
   assign and_22 = not_go_near & not_go_far;
   assign mux_and_22 = and_22 ? k_0_6 : popped_ahead;
   assign mux_leaf_left_eq_k_1_4_1 = leaf_left_eq_k_1_4 ? was_leaf : popped_ahead;
-  always @* begin
-    case (state)
-      st_node: popped_ahead_next = mux_nw_is_leaf_2;
-      st_step: popped_ahead_next = mux_and_22;
-      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_4_1;
-      default: popped_ahead_next = popped_ahead;
-    endcase
-  end
+  assign mux_in_leaf_3 = in_leaf ? mux_leaf_left_eq_k_1_4_1 : popped_ahead;
+  assign mux_in_step_3 = in_step ? mux_and_22 : mux_in_leaf_3;
+  assign popped_ahead_next = in_node ? mux_nw_is_leaf_2 : mux_in_step_3;
   assign mux_not_nw_is_leaf_1_1 = not_nw_is_leaf_1 ? nw_axis : axis_r;
   assign axis_r_next = in_node ? mux_not_nw_is_leaf_1_1 : axis_r;
   assign mux_not_nw_is_leaf_1_2 = not_nw_is_leaf_1 ? nw_clip1 : clip1_r;
@@ -813,30 +797,22 @@ module fxrt_traverse (
   assign far_start_r_next = in_dist ? mux_d1_arrives_3 : far_start_r;
   assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_3 : sp;
   assign mux_not_sp_empty_3 = not_sp_empty ? sp_minus_k_1_3 : sp;
-  always @* begin
-    case (state)
-      st_step: sp_next = mux_go_near_and_go_far;
-      st_pop: sp_next = mux_not_sp_empty_3;
-      default: sp_next = sp;
-    endcase
-  end
+  assign mux_in_pop_3 = in_pop ? mux_not_sp_empty_3 : sp;
+  assign sp_next = in_step ? mux_go_near_and_go_far : mux_in_pop_3;
   assign mux_go_near_and_go_far_1 = go_near_and_go_far ? rs_sp_1 : stack_top_addr;
   assign mux_not_sp_empty_4 = not_sp_empty ? rs_sp_minus_k_2_1 : stack_top_addr;
-  always @* begin
-    case (state)
-      st_step: stack_top_addr_next = mux_go_near_and_go_far_1;
-      st_pop: stack_top_addr_next = mux_not_sp_empty_4;
-      default: stack_top_addr_next = stack_top_addr;
-    endcase
-  end
+  assign mux_in_pop_4 = in_pop ? mux_not_sp_empty_4 : stack_top_addr;
+  assign stack_top_addr_next = in_step ? mux_go_near_and_go_far_1 : mux_in_pop_4;
   assign and_23 = in_step & go_near_and_go_far;
   assign in_idle_next = state_next == st_idle;
   assign in_aabb_next = state_next == st_aabb;
+  assign in_boxmin_next = state_next == st_boxmin;
   assign in_node_next = state_next == st_node;
   assign in_clip1_next = state_next == st_clip1;
   assign in_dist_next = state_next == st_dist;
   assign in_step_next = state_next == st_step;
   assign in_leaf_next = state_next == st_leaf;
+  assign in_pop_next = state_next == st_pop;
   assign in_done_next = state_next == st_done;
 
   always @(posedge clk) begin : state_regs
@@ -880,10 +856,14 @@ module fxrt_traverse (
     else in_idle <= in_idle_next;
     if (rst) in_done <= 1'h0;
     else in_done <= in_done_next;
-    if (rst) in_dist <= 1'h0;
-    else in_dist <= in_dist_next;
+    if (rst) in_pop <= 1'h0;
+    else in_pop <= in_pop_next;
     if (rst) in_step <= 1'h0;
     else in_step <= in_step_next;
+    if (rst) in_dist <= 1'h0;
+    else in_dist <= in_dist_next;
+    if (rst) in_boxmin <= 1'h0;
+    else in_boxmin <= in_boxmin_next;
   end
 
   fxrt_brom_node u_node_rom (

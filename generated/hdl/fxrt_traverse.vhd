@@ -359,6 +359,7 @@ architecture rtl of fxrt_traverse is
   signal in_leaf : unsigned(0 downto 0) := unsigned'("0");
   signal in_idle : unsigned(0 downto 0) := unsigned'("1");
   signal in_done : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_aabb_2 : unsigned(1 downto 0);
   signal aabb_k_next : unsigned(1 downto 0);
   signal not_go_near : unsigned(0 downto 0);
   signal not_go_near_and_go_far : unsigned(0 downto 0);
@@ -368,10 +369,19 @@ architecture rtl of fxrt_traverse is
   signal mux_and_16 : unsigned(12 downto 0);
   signal not_sp_empty : unsigned(0 downto 0);
   signal mux_not_sp_empty : unsigned(12 downto 0);
+  signal in_pop : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_pop : unsigned(12 downto 0);
+  signal mux_in_leaf : unsigned(12 downto 0);
+  signal in_step : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_step : unsigned(12 downto 0);
+  signal in_dist : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_dist : unsigned(12 downto 0);
   signal node_next : unsigned(12 downto 0);
   signal not_go_near_and_go_far_1 : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far_1 : signed(31 downto 0);
   signal mux_not_sp_empty_1 : signed(31 downto 0);
+  signal mux_in_pop_1 : signed(31 downto 0);
+  signal mux_in_step_1 : signed(31 downto 0);
   signal tmin_next : signed(31 downto 0);
   signal mux_ray_valid : unsigned(19 downto 0);
   signal ray_id_r_next : unsigned(19 downto 0);
@@ -417,15 +427,22 @@ architecture rtl of fxrt_traverse is
   signal state_next : unsigned(3 downto 0);
   signal mux_go_near_1 : signed(31 downto 0);
   signal mux_not_sp_empty_2 : signed(31 downto 0);
+  signal mux_in_pop_2 : signed(31 downto 0);
+  signal mux_in_step_2 : signed(31 downto 0);
+  signal in_boxmin : unsigned(0 downto 0) := unsigned'("0");
   signal tmax_next : signed(31 downto 0);
   signal mux_nw_is_leaf : unsigned(12 downto 0);
+  signal mux_in_leaf_1 : unsigned(12 downto 0);
   signal leaf_ptr_next : unsigned(12 downto 0);
   signal mux_nw_is_leaf_1 : unsigned(2 downto 0);
+  signal mux_in_leaf_2 : unsigned(2 downto 0);
   signal leaf_left_next : unsigned(2 downto 0);
   signal mux_nw_is_leaf_2 : unsigned(0 downto 0);
   signal and_22 : unsigned(0 downto 0);
   signal mux_and_22 : unsigned(0 downto 0);
   signal mux_leaf_left_eq_k_1_4_1 : unsigned(0 downto 0);
+  signal mux_in_leaf_3 : unsigned(0 downto 0);
+  signal mux_in_step_3 : unsigned(0 downto 0);
   signal popped_ahead_next : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1_1 : unsigned(1 downto 0);
   signal axis_r_next : unsigned(1 downto 0);
@@ -434,7 +451,6 @@ architecture rtl of fxrt_traverse is
   signal mux_not_nw_is_leaf_1_3 : unsigned(12 downto 0);
   signal child_r_next : unsigned(12 downto 0);
   signal negative_next : unsigned(0 downto 0);
-  signal in_dist : unsigned(0 downto 0) := unsigned'("0");
   signal far_r_next : unsigned(12 downto 0);
   signal mux_d1_arrives_2 : signed(31 downto 0);
   signal near_end_r_next : signed(31 downto 0);
@@ -442,19 +458,22 @@ architecture rtl of fxrt_traverse is
   signal far_start_r_next : signed(31 downto 0);
   signal mux_go_near_and_go_far : unsigned(5 downto 0);
   signal mux_not_sp_empty_3 : unsigned(5 downto 0);
+  signal mux_in_pop_3 : unsigned(5 downto 0);
   signal sp_next : unsigned(5 downto 0);
   signal mux_go_near_and_go_far_1 : unsigned(4 downto 0);
   signal mux_not_sp_empty_4 : unsigned(4 downto 0);
+  signal mux_in_pop_4 : unsigned(4 downto 0);
   signal stack_top_addr_next : unsigned(4 downto 0);
-  signal in_step : unsigned(0 downto 0) := unsigned'("0");
   signal and_23 : unsigned(0 downto 0);
   signal in_idle_next : unsigned(0 downto 0);
   signal in_aabb_next : unsigned(0 downto 0);
+  signal in_boxmin_next : unsigned(0 downto 0);
   signal in_node_next : unsigned(0 downto 0);
   signal in_clip1_next : unsigned(0 downto 0);
   signal in_dist_next : unsigned(0 downto 0);
   signal in_step_next : unsigned(0 downto 0);
   signal in_leaf_next : unsigned(0 downto 0);
+  signal in_pop_next : unsigned(0 downto 0);
   signal in_done_next : unsigned(0 downto 0);
 begin
 
@@ -689,11 +708,8 @@ begin
   end process regs;
 
   -- state machine state: BIH traversal: one ray at a time, one leaf entry per clock
-  with state select
-    aabb_k_next <=
-      k_0_3 when st_idle,
-      aabb_k_plus_k_1_2 when st_aabb,
-      aabb_k when others;
+  mux_in_aabb_2 <= aabb_k_plus_k_1_2 when in_aabb = "1" else aabb_k;
+  aabb_k_next <= k_0_3 when in_idle = "1" else mux_in_aabb_2;
   not_go_near <= not go_near;
   not_go_near_and_go_far <= not_go_near and go_far;
   mux_not_go_near_and_go_far <= far_r when not_go_near_and_go_far = "1" else node;
@@ -702,23 +718,17 @@ begin
   mux_and_16 <= top_node when and_16 = "1" else mux_not_go_near_and_go_far;
   not_sp_empty <= not sp_empty;
   mux_not_sp_empty <= top_node when not_sp_empty = "1" else node;
-  with state select
-    node_next <=
-      k_0_4 when st_idle,
-      near when st_dist,
-      mux_and_16 when st_step,
-      top_node when st_leaf,
-      mux_not_sp_empty when st_pop,
-      node when others;
+  mux_in_pop <= mux_not_sp_empty when in_pop = "1" else node;
+  mux_in_leaf <= top_node when in_leaf = "1" else mux_in_pop;
+  mux_in_step <= mux_and_16 when in_step = "1" else mux_in_leaf;
+  mux_in_dist <= near when in_dist = "1" else mux_in_step;
+  node_next <= k_0_4 when in_idle = "1" else mux_in_dist;
   not_go_near_and_go_far_1 <= not_go_near and go_far;
   mux_not_go_near_and_go_far_1 <= far_min when not_go_near_and_go_far_1 = "1" else tmin;
   mux_not_sp_empty_1 <= top_tmin when not_sp_empty = "1" else tmin;
-  with state select
-    tmin_next <=
-      k_0_5 when st_idle,
-      mux_not_go_near_and_go_far_1 when st_step,
-      mux_not_sp_empty_1 when st_pop,
-      tmin when others;
+  mux_in_pop_1 <= mux_not_sp_empty_1 when in_pop = "1" else tmin;
+  mux_in_step_1 <= mux_not_go_near_and_go_far_1 when in_step = "1" else mux_in_pop_1;
+  tmin_next <= k_0_5 when in_idle = "1" else mux_in_step_1;
   mux_ray_valid <= ray_id when ray_valid = "1" else ray_id_r;
   ray_id_r_next <= mux_ray_valid when in_idle = "1" else ray_id_r;
   mux_ray_valid_1 <= ox when ray_valid = "1" else ox_r;
@@ -777,34 +787,22 @@ begin
       st_idle when others;
   mux_go_near_1 <= near_max when go_near = "1" else tmax;
   mux_not_sp_empty_2 <= top_tmax when not_sp_empty = "1" else tmax;
-  with state select
-    tmax_next <=
-      box_tmax when st_boxmin,
-      mux_go_near_1 when st_step,
-      mux_not_sp_empty_2 when st_pop,
-      tmax when others;
+  mux_in_pop_2 <= mux_not_sp_empty_2 when in_pop = "1" else tmax;
+  mux_in_step_2 <= mux_go_near_1 when in_step = "1" else mux_in_pop_2;
+  tmax_next <= box_tmax when in_boxmin = "1" else mux_in_step_2;
   mux_nw_is_leaf <= nw_first when nw_is_leaf = "1" else leaf_ptr;
-  with state select
-    leaf_ptr_next <=
-      mux_nw_is_leaf when st_node,
-      leaf_ptr_plus_k_1_1 when st_leaf,
-      leaf_ptr when others;
+  mux_in_leaf_1 <= leaf_ptr_plus_k_1_1 when in_leaf = "1" else leaf_ptr;
+  leaf_ptr_next <= mux_nw_is_leaf when in_node = "1" else mux_in_leaf_1;
   mux_nw_is_leaf_1 <= nw_count when nw_is_leaf = "1" else leaf_left;
-  with state select
-    leaf_left_next <=
-      mux_nw_is_leaf_1 when st_node,
-      leaf_left_minus_k_1_4 when st_leaf,
-      leaf_left when others;
+  mux_in_leaf_2 <= leaf_left_minus_k_1_4 when in_leaf = "1" else leaf_left;
+  leaf_left_next <= mux_nw_is_leaf_1 when in_node = "1" else mux_in_leaf_2;
   mux_nw_is_leaf_2 <= k_0_6 when nw_is_leaf = "1" else popped_ahead;
   and_22 <= not_go_near and not_go_far;
   mux_and_22 <= k_0_6 when and_22 = "1" else popped_ahead;
   mux_leaf_left_eq_k_1_4_1 <= was_leaf when leaf_left_eq_k_1_4 = "1" else popped_ahead;
-  with state select
-    popped_ahead_next <=
-      mux_nw_is_leaf_2 when st_node,
-      mux_and_22 when st_step,
-      mux_leaf_left_eq_k_1_4_1 when st_leaf,
-      popped_ahead when others;
+  mux_in_leaf_3 <= mux_leaf_left_eq_k_1_4_1 when in_leaf = "1" else popped_ahead;
+  mux_in_step_3 <= mux_and_22 when in_step = "1" else mux_in_leaf_3;
+  popped_ahead_next <= mux_nw_is_leaf_2 when in_node = "1" else mux_in_step_3;
   mux_not_nw_is_leaf_1_1 <= nw_axis when not_nw_is_leaf_1 = "1" else axis_r;
   axis_r_next <= mux_not_nw_is_leaf_1_1 when in_node = "1" else axis_r;
   mux_not_nw_is_leaf_1_2 <= nw_clip1 when not_nw_is_leaf_1 = "1" else clip1_r;
@@ -819,26 +817,22 @@ begin
   far_start_r_next <= mux_d1_arrives_3 when in_dist = "1" else far_start_r;
   mux_go_near_and_go_far <= sp_plus_k_1_3 when go_near_and_go_far = "1" else sp;
   mux_not_sp_empty_3 <= sp_minus_k_1_3 when not_sp_empty = "1" else sp;
-  with state select
-    sp_next <=
-      mux_go_near_and_go_far when st_step,
-      mux_not_sp_empty_3 when st_pop,
-      sp when others;
+  mux_in_pop_3 <= mux_not_sp_empty_3 when in_pop = "1" else sp;
+  sp_next <= mux_go_near_and_go_far when in_step = "1" else mux_in_pop_3;
   mux_go_near_and_go_far_1 <= rs_sp_1 when go_near_and_go_far = "1" else stack_top_addr;
   mux_not_sp_empty_4 <= rs_sp_minus_k_2_1 when not_sp_empty = "1" else stack_top_addr;
-  with state select
-    stack_top_addr_next <=
-      mux_go_near_and_go_far_1 when st_step,
-      mux_not_sp_empty_4 when st_pop,
-      stack_top_addr when others;
+  mux_in_pop_4 <= mux_not_sp_empty_4 when in_pop = "1" else stack_top_addr;
+  stack_top_addr_next <= mux_go_near_and_go_far_1 when in_step = "1" else mux_in_pop_4;
   and_23 <= in_step and go_near_and_go_far;
   in_idle_next <= "1" when state_next = st_idle else "0";
   in_aabb_next <= "1" when state_next = st_aabb else "0";
+  in_boxmin_next <= "1" when state_next = st_boxmin else "0";
   in_node_next <= "1" when state_next = st_node else "0";
   in_clip1_next <= "1" when state_next = st_clip1 else "0";
   in_dist_next <= "1" when state_next = st_dist else "0";
   in_step_next <= "1" when state_next = st_step else "0";
   in_leaf_next <= "1" when state_next = st_leaf else "0";
+  in_pop_next <= "1" when state_next = st_pop else "0";
   in_done_next <= "1" when state_next = st_done else "0";
 
   state_regs : process (clk)
@@ -915,14 +909,24 @@ begin
         in_done <= in_done_next;
       end if;
       if rst = '1' then
-        in_dist <= unsigned'("0");
+        in_pop <= unsigned'("0");
       else
-        in_dist <= in_dist_next;
+        in_pop <= in_pop_next;
       end if;
       if rst = '1' then
         in_step <= unsigned'("0");
       else
         in_step <= in_step_next;
+      end if;
+      if rst = '1' then
+        in_dist <= unsigned'("0");
+      else
+        in_dist <= in_dist_next;
+      end if;
+      if rst = '1' then
+        in_boxmin <= unsigned'("0");
+      else
+        in_boxmin <= in_boxmin_next;
       end if;
     end if;
   end process state_regs;
