@@ -8,8 +8,8 @@
 //! multiplier alone. So the node ROM is addressed by the `node` register itself and its word
 //! goes straight into registers (a block ROM, `brom.rs`: mem[node] two or three cycles after
 //! `node` last changed), as does the leaf ROM's; the plane distances come from a pipelined
-//! unit (`plane.rs`, L = 3 + product stages clocks from issue to result; L = 9 at the default
-//! 150 MHz); and the child decision takes a compare cycle and an act cycle. States and their
+//! unit (`plane.rs`, L = 3 + product stages clocks from issue to result, + 1 with a split
+//! product; L = 10 at the default 150 MHz); and the child decision takes a compare cycle and an act cycle. States and their
 //! cost (one cycle each unless noted):
 //! - `idle`: `ray_ready`; a valid ray is latched (node 0 and tmin 0 too).
 //! - `aabb` (3 cycles): the exit distance of one scene-box axis per cycle is issued.
@@ -35,7 +35,7 @@
 //! - `done`: an end token follows the ray's last triangle, so the closest-hit unit knows the
 //!   ray is complete when the token leaves the in-order pipeline.
 //!
-//! An inner node costs node + clip1 + L + step = 3 + L cycles (12 by default; 2 before the
+//! An inner node costs node + clip1 + L + step = 3 + L cycles (13 by default; 2 before the
 //! unit was pipelined; a far-only step adds the node ROM's 2 or 3 read clocks of `fetch`), a
 //! leaf node + count, a pop 1 (+ its fetch), a ray's overhead idle + aabb + box + boxmin +
 //! done = 6 + L. Emission is the leaf ROM's 2 or 3 read clocks behind `leaf`.
