@@ -43,13 +43,17 @@ architecture rtl of fxrt_closest_n29_m32_tag45_r2 is
   signal in_valid : unsigned(0 downto 0) := unsigned'("0");
   signal in_end : unsigned(0 downto 0) := unsigned'("0");
   signal in_hit : unsigned(0 downto 0) := unsigned'("0");
-  signal lt_1 : unsigned(0 downto 0);
+  signal rs_in_t_plus_8 : signed(32 downto 0);
+  signal rs_in_tmin_less : signed(32 downto 0);
+  signal minus_1 : signed(32 downto 0);
+  signal bits_minus_1 : unsigned(0 downto 0);
   signal accepted : unsigned(0 downto 0);
   signal not_in_end : unsigned(0 downto 0);
   signal in_valid_and_not_in_end : unsigned(0 downto 0);
   signal and_2 : unsigned(0 downto 0);
-  signal candidate_c : unsigned(0 downto 0);
-  signal in_candidate : unsigned(0 downto 0) := unsigned'("0");
+  signal and_2_and_accepted : unsigned(0 downto 0);
+  signal no_candidate_c : unsigned(0 downto 0);
+  signal in_no_candidate : unsigned(0 downto 0) := unsigned'("1");
   signal finish_c : unsigned(0 downto 0);
   signal in_finish : unsigned(0 downto 0) := unsigned'("0");
   type in_tri_sr_t is array (1 to 2) of unsigned(12 downto 0);
@@ -68,20 +72,23 @@ architecture rtl of fxrt_closest_n29_m32_tag45_r2 is
   signal in_v_sr : in_v_sr_t := (others => (others => '0'));
   signal in_v : unsigned(31 downto 0);
   signal best_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal best_empty : unsigned(0 downto 0) := unsigned'("1");
   signal best_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal best_tri : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal best_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal best_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal cat_3 : unsigned(42 downto 0);
-  signal cat_4 : unsigned(42 downto 0);
-  signal closer : unsigned(0 downto 0);
-  signal not_best_valid : unsigned(0 downto 0);
-  signal better : unsigned(0 downto 0);
-  signal take : unsigned(0 downto 0);
   constant k_0 : unsigned(0 downto 0) := unsigned'("0");
+  signal cat_3 : unsigned(44 downto 0);
+  signal cat_4 : unsigned(44 downto 0);
+  signal rs_cat_3 : unsigned(45 downto 0);
+  signal rs_cat_4 : unsigned(45 downto 0);
+  signal rs_cat_3_minus_rs_cat_4 : unsigned(45 downto 0);
+  signal take : unsigned(0 downto 0);
   constant k_1 : unsigned(0 downto 0) := unsigned'("1");
   signal mux_take : unsigned(0 downto 0);
   signal mux_in_finish : unsigned(0 downto 0);
+  signal mux_take_1 : unsigned(0 downto 0);
+  signal mux_in_finish_1 : unsigned(0 downto 0);
   signal res_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal res_hit_r : unsigned(0 downto 0) := unsigned'("0");
   signal res_id_r : unsigned(19 downto 0) := unsigned'("00000000000000000000");
@@ -110,26 +117,32 @@ begin
   s_rs_t <= signed(rs_t);
   rs_s_rs_t <= resize(s_rs_t, 32);
   t_plus_8 <= rs_s_rs_t + k_8;
-  lt_1 <= "1" when in_t_plus_8 < in_tmin_less else "0";
-  accepted <= not lt_1;
+  rs_in_t_plus_8 <= resize(in_t_plus_8, 33);
+  rs_in_tmin_less <= resize(in_tmin_less, 33);
+  minus_1 <= rs_in_t_plus_8 - rs_in_tmin_less;
+  bits_minus_1 <= unsigned(minus_1(32 downto 32));
+  accepted <= not bits_minus_1;
   not_in_end <= not in_end;
   in_valid_and_not_in_end <= in_valid and not_in_end;
   and_2 <= in_valid_and_not_in_end and in_hit;
-  candidate_c <= and_2 and accepted;
+  and_2_and_accepted <= and_2 and accepted;
+  no_candidate_c <= not and_2_and_accepted;
   finish_c <= in_valid and in_end;
   in_tri <= in_tri_sr(2);
   in_id <= in_id_sr(2);
   in_t <= in_t_sr(2);
   in_u <= in_u_sr(2);
   in_v <= in_v_sr(2);
-  cat_3 <= unsigned(std_logic_vector'(std_logic_vector(in_t) & std_logic_vector(in_tri)));
-  cat_4 <= unsigned(std_logic_vector'(std_logic_vector(best_t) & std_logic_vector(best_tri)));
-  closer <= "1" when cat_3 < cat_4 else "0";
-  not_best_valid <= not best_valid;
-  better <= not_best_valid or closer;
-  take <= in_candidate and better;
+  cat_3 <= unsigned(std_logic_vector'(std_logic_vector(in_no_candidate) & std_logic_vector(k_0) & std_logic_vector(in_t) & std_logic_vector(in_tri)));
+  cat_4 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(best_empty) & std_logic_vector(best_t) & std_logic_vector(best_tri)));
+  rs_cat_3 <= resize(cat_3, 46);
+  rs_cat_4 <= resize(cat_4, 46);
+  rs_cat_3_minus_rs_cat_4 <= rs_cat_3 - rs_cat_4;
+  take <= unsigned(rs_cat_3_minus_rs_cat_4(45 downto 45));
   mux_take <= k_1 when take = "1" else best_valid;
   mux_in_finish <= k_0 when in_finish = "1" else mux_take;
+  mux_take_1 <= k_0 when take = "1" else best_empty;
+  mux_in_finish_1 <= k_1 when in_finish = "1" else mux_take_1;
   mux_best_valid <= best_tri when best_valid = "1" else k_0_1;
   mux_best_valid_1 <= best_t when best_valid = "1" else k_0_2;
   mux_best_valid_2 <= best_u when best_valid = "1" else k_0_3;
@@ -143,7 +156,11 @@ begin
       in_valid <= valid;
       in_end <= end_s;
       in_hit <= hit;
-      in_candidate <= candidate_c;
+      if rst = '1' then
+        in_no_candidate <= unsigned'("1");
+      else
+        in_no_candidate <= no_candidate_c;
+      end if;
       in_finish <= finish_c;
       in_tri_sr(2 to 2) <= in_tri_sr(1 to 1);
       in_tri_sr(1) <= tri_s;
@@ -159,6 +176,11 @@ begin
         best_valid <= unsigned'("0");
       else
         best_valid <= mux_in_finish;
+      end if;
+      if rst = '1' then
+        best_empty <= unsigned'("1");
+      else
+        best_empty <= mux_in_finish_1;
       end if;
       if take = "1" then
         best_t <= in_t;

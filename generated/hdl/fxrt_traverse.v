@@ -112,39 +112,45 @@ module fxrt_traverse (
   wire [0:0] pu_product_last;
   wire [61:0] bits_pu_product;
   wire signed [61:0] pu_shifted;
-  wire [0:0] bits_pu_shifted;
-  wire signed [61:0] k_m1 = 62'sh3fffffffffffffff;
-  wire [0:0] pu_shifted_ne_k_m1;
   wire [0:0] pu_below;
-  wire [29:0] bits_pu_shifted_1;
-  wire [29:0] k_0_1 = 30'h00000000;
-  wire [0:0] ne_6;
-  wire [0:0] bits_pu_shifted_2;
-  wire [0:0] not_bits_pu_shifted_2;
-  wire [0:0] bits_pu_shifted_3;
-  wire [29:0] bits_pu_shifted_4;
-  wire [0:0] ne_7;
-  wire [0:0] and_8;
-  wire [0:0] ne_6_or_and_8;
+  wire [0:0] not_pu_below;
+  wire [30:0] bits_pu_shifted;
+  wire [30:0] k_0_1 = 31'h00000000;
+  wire [0:0] bits_pu_shifted_ne_k_0_1;
   wire [0:0] pu_above;
-  wire signed [61:0] k_1073741824 = 62'sh0000000040000000;
-  wire signed [61:0] mux_pu_below;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [61:0] mux_pu_above;
-  /* verilator lint_on UNUSEDSIGNAL */
+  wire signed [31:0] rs_pu_shifted;
+  reg [0:0] pu_above_r = 1'h0;
+  reg [0:0] pu_below_r = 1'h0;
+  reg signed [31:0] pu_low_r = 32'sh00000000;
+  reg [0:0] pu_clamp_valid = 1'h0;
+  reg [0:0] pu_clamp_last = 1'h0;
+  wire signed [31:0] k_1073741824 = 32'sh40000000;
+  wire signed [31:0] k_m1 = 32'shffffffff;
+  wire signed [31:0] mux_pu_below_r;
   wire signed [31:0] pu_clamped;
   reg signed [31:0] plane_t = 32'sh00000000;
   reg signed [31:0] plane_t_of_last = 32'sh00000000;
+  reg signed [31:0] plane_t_of_first = 32'sh00000000;
+  wire [0:0] not_pu_clamp_last;
+  wire [0:0] pu_first;
   reg [0:0] plane_t_valid = 1'h0;
   reg [0:0] plane_t_last = 1'h0;
-  wire [0:0] not_plane_t_last;
-  wire [0:0] d0_arrives;
   wire [0:0] d1_arrives;
   reg signed [31:0] box_d1 = 32'sh00000000;
   reg signed [31:0] box_d2 = 32'sh00000000;
   reg signed [31:0] box_d3 = 32'sh00000000;
+  wire signed [32:0] rs_plane_t;
+  wire signed [32:0] rs_box_d1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_8;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt1_c;
   reg [0:0] box_lt1 = 1'h0;
+  wire signed [32:0] rs_plane_t_1;
+  wire signed [32:0] rs_box_d2;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_9;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt2_c;
   reg [0:0] box_lt2 = 1'h0;
   reg [0:0] box_lt1_d = 1'h0;
@@ -153,7 +159,7 @@ module fxrt_traverse (
   wire signed [31:0] box_tmax;
   wire [0:0] bits_box_d1;
   wire [0:0] bits_box_d2;
-  wire [0:0] or_12;
+  wire [0:0] or_10;
   wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire signed [31:0] near_end;
@@ -163,24 +169,57 @@ module fxrt_traverse (
   reg signed [31:0] tmax_p1 = 32'sh00000000;
   wire signed [31:0] tmin_minus_1;
   reg signed [31:0] tmin_m1 = 32'sh00000000;
+  wire signed [32:0] rs_tmin;
+  wire signed [32:0] rs_tmax_p1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] rs_tmin_minus_rs_tmax_p1;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
-  wire [0:0] near_lt_plane;
-  wire [0:0] near_lt_d0;
-  wire [0:0] near_lt;
+  wire signed [31:0] k_m2147483648 = 32'sh80000000;
+  wire signed [31:0] k_2147483647 = 32'sh7fffffff;
+  wire signed [31:0] mux_negative;
+  wire signed [31:0] d0_hi_c;
+  reg signed [31:0] d0_hi = 32'sh00000000;
+  wire signed [31:0] mux_negative_1;
+  wire signed [31:0] d0_lo_c;
+  reg signed [31:0] d0_lo = 32'sh00000000;
+  wire signed [31:0] mux_negative_2;
+  wire signed [31:0] d1_hi_c;
+  reg signed [31:0] d1_hi = 32'sh00000000;
+  wire signed [31:0] mux_negative_3;
+  wire signed [31:0] d1_lo_c;
+  reg signed [31:0] d1_lo = 32'sh00000000;
+  wire signed [32:0] rs_plane_t_of_first;
+  wire signed [32:0] rs_d0_hi;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_11;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] d0_below_c;
+  reg [0:0] d0_below = 1'h0;
+  wire signed [32:0] rs_d0_lo;
+  wire signed [32:0] rs_plane_t_of_first_1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_12;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] d0_above_c;
+  reg [0:0] d0_above = 1'h0;
+  wire signed [32:0] rs_plane_t_of_last;
+  wire signed [32:0] rs_d1_hi;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_13;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] d1_below;
+  wire signed [32:0] rs_d1_lo;
+  wire signed [32:0] rs_plane_t_of_last_1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_14;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
   reg [0:0] near_lt_tmax = 1'h0;
-  wire [0:0] far_gt_plane;
-  wire [0:0] far_gt_d0;
-  wire [0:0] far_gt;
   wire [0:0] far_gt_tmin_c;
   reg [0:0] far_gt_tmin = 1'h0;
-  wire [0:0] tmin_le_near_plane;
-  wire [0:0] tmin_le_near_d0;
-  wire [0:0] tmin_le_near;
-  wire [0:0] far_le_tmax_plane;
-  wire [0:0] far_le_tmax_d0;
-  wire [0:0] far_le_tmax;
   wire [0:0] go_near_c;
   reg [0:0] go_near = 1'h0;
   wire [0:0] go_far_c;
@@ -194,11 +233,6 @@ module fxrt_traverse (
   wire [31:0] u_far_min;
   wire [31:0] u_tmax;
   wire [76:0] push_entry;
-  wire [5:0] k_1_2 = 6'h01;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 4:0 are read
-  wire [5:0] sp_minus_k_1_2;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [4:0] rs_sp_minus_k_1_2;
   reg [76:0] stack_top = 77'h00000000000000000000;
   wire [31:0] bits_stack_top;
   wire signed [31:0] top_tmax;
@@ -217,8 +251,8 @@ module fxrt_traverse (
   wire [1:0] k_0_3 = 2'h0;
   wire [12:0] k_0_4 = 13'h0000;
   wire signed [31:0] k_0_5 = 32'sh00000000;
-  wire [1:0] k_1_3 = 2'h1;
-  wire [1:0] aabb_k_plus_k_1_3;
+  wire [1:0] k_1_2 = 2'h1;
+  wire [1:0] aabb_k_plus_k_1_2;
   wire [0:0] k_0_6 = 1'h0;
   wire [2:0] k_0_7 = 3'h0;
   wire [0:0] nw_count_eq_k_0_7;
@@ -228,12 +262,19 @@ module fxrt_traverse (
   wire [0:0] bits_case_axis_r;
   wire [0:0] go_near_and_go_far;
   wire [4:0] rs_sp;
-  wire [5:0] sp_plus_k_1_2;
+  wire [5:0] k_1_3 = 6'h01;
+  wire [5:0] sp_plus_k_1_3;
+  wire [4:0] rs_sp_1;
   wire [12:0] leaf_ptr_plus_k_1_1;
   wire [2:0] k_1_4 = 3'h1;
   wire [2:0] leaf_left_minus_k_1_4;
   wire [0:0] leaf_left_eq_k_1_4;
-  wire [5:0] sp_minus_k_1_2_1;
+  wire [5:0] sp_minus_k_1_3;
+  wire [5:0] k_2_1 = 6'h02;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 4:0 are read
+  wire [5:0] sp_minus_k_2_1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [4:0] rs_sp_minus_k_2_1;
   wire [12:0] u_leaf_rom_data;
   wire [0:0] in_leaf_or_in_done;
   (* mem2reg *) reg [0:0] emit_r_sr [1:3];
@@ -277,31 +318,41 @@ module fxrt_traverse (
   reg [0:0] in_node = 1'h0;
   reg [0:0] in_clip1 = 1'h0;
   reg [0:0] negative = 1'h0;
-  reg signed [31:0] d0_r = 32'sh00000000;
   reg signed [31:0] near_end_r = 32'sh00000000;
   reg signed [31:0] far_start_r = 32'sh00000000;
   reg [12:0] far_r = 13'h0000;
   reg [5:0] sp = 6'h00;
+  reg [4:0] stack_top_addr = 5'h1f;
   reg [12:0] leaf_ptr = 13'h0000;
   reg [2:0] leaf_left = 3'h0;
   reg [0:0] popped_ahead = 1'h0;
   reg [0:0] in_leaf = 1'h0;
   reg [0:0] in_idle = 1'h1;
   reg [0:0] in_done = 1'h0;
-  reg [1:0] aabb_k_next;
+  wire [1:0] mux_in_aabb_2;
+  wire [1:0] aabb_k_next;
   wire [0:0] not_go_near;
   wire [0:0] not_go_near_and_go_far;
   wire [12:0] mux_not_go_near_and_go_far;
   wire [0:0] not_go_far;
-  wire [0:0] and_18;
-  wire [12:0] mux_and_18;
+  wire [0:0] and_16;
+  wire [12:0] mux_and_16;
   wire [0:0] not_sp_empty;
   wire [12:0] mux_not_sp_empty;
-  reg [12:0] node_next;
+  reg [0:0] in_pop = 1'h0;
+  wire [12:0] mux_in_pop;
+  wire [12:0] mux_in_leaf;
+  reg [0:0] in_step = 1'h0;
+  wire [12:0] mux_in_step;
+  reg [0:0] in_dist = 1'h0;
+  wire [12:0] mux_in_dist;
+  wire [12:0] node_next;
   wire [0:0] not_go_near_and_go_far_1;
   wire signed [31:0] mux_not_go_near_and_go_far_1;
   wire signed [31:0] mux_not_sp_empty_1;
-  reg signed [31:0] tmin_next;
+  wire signed [31:0] mux_in_pop_1;
+  wire signed [31:0] mux_in_step_1;
+  wire signed [31:0] tmin_next;
   wire [19:0] mux_ray_valid;
   wire [19:0] ray_id_r_next;
   wire [28:0] mux_ray_valid_1;
@@ -323,39 +374,46 @@ module fxrt_traverse (
   wire [0:0] not_box_miss;
   wire [3:0] mux_not_box_miss;
   wire [3:0] mux_node_settled;
-  wire [0:0] and_19;
-  wire [3:0] mux_and_19;
+  wire [0:0] and_17;
+  wire [3:0] mux_and_17;
   wire [0:0] not_nw_count_eq_k_0_7;
-  wire [0:0] and_20;
-  wire [3:0] mux_and_20;
+  wire [0:0] and_18;
+  wire [3:0] mux_and_18;
   wire [0:0] not_nw_is_leaf_1;
   wire [3:0] mux_not_nw_is_leaf_1;
   wire [3:0] mux_d1_arrives_1;
   wire [3:0] mux_go_near;
   wire [0:0] not_go_near_and_go_far_2;
   wire [3:0] mux_not_go_near_and_go_far_2;
-  wire [0:0] and_21;
-  wire [3:0] mux_and_21;
+  wire [0:0] and_19;
+  wire [3:0] mux_and_19;
   wire [3:0] mux_leaf_left_eq_k_1_4;
   wire [3:0] mux_sp_empty;
-  wire [0:0] and_22;
-  wire [3:0] mux_and_22;
+  wire [0:0] and_20;
+  wire [3:0] mux_and_20;
   wire [0:0] not_popped_ahead;
-  wire [0:0] and_23;
-  wire [3:0] mux_and_23;
+  wire [0:0] and_21;
+  wire [3:0] mux_and_21;
   reg [3:0] state_next;
   wire signed [31:0] mux_go_near_1;
   wire signed [31:0] mux_not_sp_empty_2;
-  reg signed [31:0] tmax_next;
+  wire signed [31:0] mux_in_pop_2;
+  wire signed [31:0] mux_in_step_2;
+  reg [0:0] in_boxmin = 1'h0;
+  wire signed [31:0] tmax_next;
   wire [12:0] mux_nw_is_leaf;
-  reg [12:0] leaf_ptr_next;
+  wire [12:0] mux_in_leaf_1;
+  wire [12:0] leaf_ptr_next;
   wire [2:0] mux_nw_is_leaf_1;
-  reg [2:0] leaf_left_next;
+  wire [2:0] mux_in_leaf_2;
+  wire [2:0] leaf_left_next;
   wire [0:0] mux_nw_is_leaf_2;
-  wire [0:0] and_24;
-  wire [0:0] mux_and_24;
+  wire [0:0] and_22;
+  wire [0:0] mux_and_22;
   wire [0:0] mux_leaf_left_eq_k_1_4_1;
-  reg [0:0] popped_ahead_next;
+  wire [0:0] mux_in_leaf_3;
+  wire [0:0] mux_in_step_3;
+  wire [0:0] popped_ahead_next;
   wire [1:0] mux_not_nw_is_leaf_1_1;
   wire [1:0] axis_r_next;
   wire [28:0] mux_not_nw_is_leaf_1_2;
@@ -363,26 +421,29 @@ module fxrt_traverse (
   wire [12:0] mux_not_nw_is_leaf_1_3;
   wire [12:0] child_r_next;
   wire [0:0] negative_next;
-  reg [0:0] in_dist = 1'h0;
   wire [12:0] far_r_next;
-  wire signed [31:0] mux_d0_arrives;
-  wire signed [31:0] d0_r_next;
   wire signed [31:0] mux_d1_arrives_2;
   wire signed [31:0] near_end_r_next;
   wire signed [31:0] mux_d1_arrives_3;
   wire signed [31:0] far_start_r_next;
   wire [5:0] mux_go_near_and_go_far;
   wire [5:0] mux_not_sp_empty_3;
-  reg [5:0] sp_next;
-  reg [0:0] in_step = 1'h0;
-  wire [0:0] and_25;
+  wire [5:0] mux_in_pop_3;
+  wire [5:0] sp_next;
+  wire [4:0] mux_go_near_and_go_far_1;
+  wire [4:0] mux_not_sp_empty_4;
+  wire [4:0] mux_in_pop_4;
+  wire [4:0] stack_top_addr_next;
+  wire [0:0] and_23;
   wire [0:0] in_idle_next;
   wire [0:0] in_aabb_next;
+  wire [0:0] in_boxmin_next;
   wire [0:0] in_node_next;
   wire [0:0] in_clip1_next;
   wire [0:0] in_dist_next;
   wire [0:0] in_step_next;
   wire [0:0] in_leaf_next;
+  wire [0:0] in_pop_next;
   wire [0:0] in_done_next;
 
   // not in a stage or state machine
@@ -448,56 +509,69 @@ module fxrt_traverse (
   assign pu_product_last = pu_product_last_sr[6];
   assign bits_pu_product = pu_product[77:16];
   assign pu_shifted = $signed(bits_pu_product);
-  assign bits_pu_shifted = pu_shifted[61];
-  assign pu_shifted_ne_k_m1 = pu_shifted != k_m1;
-  assign pu_below = bits_pu_shifted & pu_shifted_ne_k_m1;
-  assign bits_pu_shifted_1 = pu_shifted[60:31];
-  assign ne_6 = bits_pu_shifted_1 != k_0_1;
-  assign bits_pu_shifted_2 = pu_shifted[61];
-  assign not_bits_pu_shifted_2 = ~bits_pu_shifted_2;
-  assign bits_pu_shifted_3 = pu_shifted[30];
-  assign bits_pu_shifted_4 = pu_shifted[29:0];
-  assign ne_7 = bits_pu_shifted_4 != k_0_1;
-  assign and_8 = bits_pu_shifted_3 & ne_7;
-  assign ne_6_or_and_8 = ne_6 | and_8;
-  assign pu_above = not_bits_pu_shifted_2 & ne_6_or_and_8;
-  assign mux_pu_below = pu_below ? k_m1 : pu_shifted;
-  assign mux_pu_above = pu_above ? k_1073741824 : mux_pu_below;
-  assign pu_clamped = $signed(mux_pu_above[31:0]);
-  assign not_plane_t_last = ~plane_t_last;
-  assign d0_arrives = plane_t_valid & not_plane_t_last;
+  assign pu_below = pu_shifted[61];
+  assign not_pu_below = ~pu_below;
+  assign bits_pu_shifted = pu_shifted[60:30];
+  assign bits_pu_shifted_ne_k_0_1 = bits_pu_shifted != k_0_1;
+  assign pu_above = not_pu_below & bits_pu_shifted_ne_k_0_1;
+  assign rs_pu_shifted = $signed(pu_shifted[31:0]);
+  assign mux_pu_below_r = pu_below_r ? k_m1 : pu_low_r;
+  assign pu_clamped = pu_above_r ? k_1073741824 : mux_pu_below_r;
+  assign not_pu_clamp_last = ~pu_clamp_last;
+  assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign d1_arrives = plane_t_valid & plane_t_last;
-  assign box_lt1_c = plane_t < box_d1;
-  assign box_lt2_c = plane_t < box_d2;
+  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
+  assign minus_8 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_8[32];
+  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
+  assign minus_9 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_9[32];
   assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
   assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
   assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
   assign bits_box_d1 = box_d1[31];
   assign bits_box_d2 = box_d2[31];
-  assign or_12 = bits_box_d1 | bits_box_d2;
+  assign or_10 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_12 | bits_box_d3;
-  assign near_end = negative ? plane_t_of_last : d0_r;
-  assign far_start = negative ? d0_r : plane_t_of_last;
+  assign box_miss = or_10 | bits_box_d3;
+  assign near_end = negative ? plane_t_of_last : plane_t_of_first;
+  assign far_start = negative ? plane_t_of_first : plane_t_of_last;
   assign tmax_plus_1 = tmax + k_1;
   assign tmin_minus_1 = tmin - k_1;
-  assign tmin_le_tmax_c = tmin < tmax_p1;
-  assign near_lt_plane = plane_t_of_last < tmax;
-  assign near_lt_d0 = d0_r < tmax;
-  assign near_lt = negative ? near_lt_plane : near_lt_d0;
-  assign near_lt_tmax_c = near_lt;
-  assign far_gt_plane = tmin < d0_r;
-  assign far_gt_d0 = tmin < plane_t_of_last;
-  assign far_gt = negative ? far_gt_plane : far_gt_d0;
-  assign far_gt_tmin_c = far_gt;
-  assign tmin_le_near_plane = tmin_m1 < plane_t_of_last;
-  assign tmin_le_near_d0 = tmin_m1 < d0_r;
-  assign tmin_le_near = negative ? tmin_le_near_plane : tmin_le_near_d0;
-  assign far_le_tmax_plane = d0_r < tmax_p1;
-  assign far_le_tmax_d0 = plane_t_of_last < tmax_p1;
-  assign far_le_tmax = negative ? far_le_tmax_plane : far_le_tmax_d0;
-  assign go_near_c = tmin_le_near & tmin_le_tmax;
-  assign go_far_c = far_le_tmax & tmin_le_tmax;
+  assign rs_tmin = $signed({{1{tmin[31]}}, tmin});
+  assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
+  assign rs_tmin_minus_rs_tmax_p1 = rs_tmin - rs_tmax_p1;
+  assign tmin_le_tmax_c = rs_tmin_minus_rs_tmax_p1[32];
+  assign mux_negative = negative ? tmax_p1 : tmax;
+  assign d0_hi_c = tmin_le_tmax ? mux_negative : k_m2147483648;
+  assign mux_negative_1 = negative ? tmin : tmin_m1;
+  assign d0_lo_c = tmin_le_tmax ? mux_negative_1 : k_2147483647;
+  assign mux_negative_2 = negative ? tmax : tmax_p1;
+  assign d1_hi_c = tmin_le_tmax ? mux_negative_2 : k_m2147483648;
+  assign mux_negative_3 = negative ? tmin_m1 : tmin;
+  assign d1_lo_c = tmin_le_tmax ? mux_negative_3 : k_2147483647;
+  assign rs_plane_t_of_first = $signed({{1{plane_t_of_first[31]}}, plane_t_of_first});
+  assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
+  assign minus_11 = rs_plane_t_of_first - rs_d0_hi;
+  assign d0_below_c = minus_11[32];
+  assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
+  assign rs_plane_t_of_first_1 = $signed({{1{plane_t_of_first[31]}}, plane_t_of_first});
+  assign minus_12 = rs_d0_lo - rs_plane_t_of_first_1;
+  assign d0_above_c = minus_12[32];
+  assign rs_plane_t_of_last = $signed({{1{plane_t_of_last[31]}}, plane_t_of_last});
+  assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
+  assign minus_13 = rs_plane_t_of_last - rs_d1_hi;
+  assign d1_below = minus_13[32];
+  assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
+  assign rs_plane_t_of_last_1 = $signed({{1{plane_t_of_last[31]}}, plane_t_of_last});
+  assign minus_14 = rs_d1_lo - rs_plane_t_of_last_1;
+  assign d1_above = minus_14[32];
+  assign near_lt_tmax_c = negative ? d1_below : d0_below;
+  assign far_gt_tmin_c = negative ? d0_above : d1_above;
+  assign go_near_c = negative ? d1_above : d0_above;
+  assign go_far_c = negative ? d0_below : d1_below;
   assign child_r_plus_k_1_1 = child_r + k_1_1;
   assign near = negative ? child_r_plus_k_1_1 : child_r;
   assign far = negative ? child_r : child_r_plus_k_1_1;
@@ -506,8 +580,6 @@ module fxrt_traverse (
   assign u_far_min = $unsigned(far_min);
   assign u_tmax = $unsigned(tmax);
   assign push_entry = {far_r, u_far_min, u_tmax};
-  assign sp_minus_k_1_2 = sp - k_1_2;
-  assign rs_sp_minus_k_1_2 = sp_minus_k_1_2[4:0];
   assign bits_stack_top = stack_top[31:0];
   assign top_tmax = $signed(bits_stack_top);
   assign bits_stack_top_1 = stack_top[63:32];
@@ -516,7 +588,7 @@ module fxrt_traverse (
   assign was_leaf2 = was_leaf2_sr[2];
   assign was_leaf = was_leaf1 & was_leaf2;
   assign sp_is_zero = sp == k_0_2;
-  assign aabb_k_plus_k_1_3 = aabb_k + k_1_3;
+  assign aabb_k_plus_k_1_2 = aabb_k + k_1_2;
   assign nw_count_eq_k_0_7 = nw_count == k_0_7;
   always @* begin
     case (axis_r)
@@ -528,11 +600,14 @@ module fxrt_traverse (
   assign bits_case_axis_r = case_axis_r[47];
   assign go_near_and_go_far = go_near & go_far;
   assign rs_sp = sp[4:0];
-  assign sp_plus_k_1_2 = sp + k_1_2;
+  assign sp_plus_k_1_3 = sp + k_1_3;
+  assign rs_sp_1 = sp[4:0];
   assign leaf_ptr_plus_k_1_1 = leaf_ptr + k_1_1;
   assign leaf_left_minus_k_1_4 = leaf_left - k_1_4;
   assign leaf_left_eq_k_1_4 = leaf_left == k_1_4;
-  assign sp_minus_k_1_2_1 = sp - k_1_2;
+  assign sp_minus_k_1_3 = sp - k_1_3;
+  assign sp_minus_k_2_1 = sp - k_2_1;
+  assign rs_sp_minus_k_2_1 = sp_minus_k_2_1[4:0];
   assign in_leaf_or_in_done = in_leaf | in_done;
   assign emit_r = emit_r_sr[3];
   assign end_r = end_r_sr[3];
@@ -542,7 +617,7 @@ module fxrt_traverse (
   assign id_r = id_r_sr[3];
 
   always @(posedge clk) begin : regs
-    if (and_25) stack[rs_sp] <= push_entry;
+    if (and_23) stack[rs_sp] <= push_entry;
     node_d1 <= node;
     for (node_d2_i = 2; node_d2_i > 1; node_d2_i = node_d2_i - 1)
       node_d2_sr[node_d2_i] <= node_d2_sr[node_d2_i - 1];
@@ -561,10 +636,16 @@ module fxrt_traverse (
     for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
       pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
     pu_product_last_sr[1] <= pu_delta_last;
+    pu_above_r <= pu_above;
+    pu_below_r <= pu_below;
+    pu_low_r <= rs_pu_shifted;
+    pu_clamp_valid <= pu_product_valid;
+    pu_clamp_last <= pu_product_last;
     plane_t <= pu_clamped;
-    if (pu_product_last) plane_t_of_last <= pu_clamped;
-    plane_t_valid <= pu_product_valid;
-    plane_t_last <= pu_product_last;
+    if (pu_clamp_last) plane_t_of_last <= pu_clamped;
+    if (pu_first) plane_t_of_first <= pu_clamped;
+    plane_t_valid <= pu_clamp_valid;
+    plane_t_last <= pu_clamp_last;
     box_d1 <= plane_t;
     box_d2 <= box_d1;
     box_d3 <= box_d2;
@@ -574,11 +655,17 @@ module fxrt_traverse (
     tmax_p1 <= tmax_plus_1;
     tmin_m1 <= tmin_minus_1;
     tmin_le_tmax <= tmin_le_tmax_c;
+    d0_hi <= d0_hi_c;
+    d0_lo <= d0_lo_c;
+    d1_hi <= d1_hi_c;
+    d1_lo <= d1_lo_c;
+    d0_below <= d0_below_c;
+    d0_above <= d0_above_c;
     near_lt_tmax <= near_lt_tmax_c;
     far_gt_tmin <= far_gt_tmin_c;
     go_near <= go_near_c;
     go_far <= go_far_c;
-    stack_top <= stack[rs_sp_minus_k_1_2];
+    stack_top <= stack[stack_top_addr];
     was_leaf1 <= in_leaf;
     for (was_leaf2_i = 2; was_leaf2_i > 1; was_leaf2_i = was_leaf2_i - 1)
       was_leaf2_sr[was_leaf2_i] <= was_leaf2_sr[was_leaf2_i - 1];
@@ -599,42 +686,27 @@ module fxrt_traverse (
   end
 
   // state machine state: BIH traversal: one ray at a time, one leaf entry per clock
-  always @* begin
-    case (state)
-      st_idle: aabb_k_next = k_0_3;
-      st_aabb: aabb_k_next = aabb_k_plus_k_1_3;
-      default: aabb_k_next = aabb_k;
-    endcase
-  end
+  assign mux_in_aabb_2 = in_aabb ? aabb_k_plus_k_1_2 : aabb_k;
+  assign aabb_k_next = in_idle ? k_0_3 : mux_in_aabb_2;
   assign not_go_near = ~go_near;
   assign not_go_near_and_go_far = not_go_near & go_far;
   assign mux_not_go_near_and_go_far = not_go_near_and_go_far ? far_r : node;
   assign not_go_far = ~go_far;
-  assign and_18 = not_go_near & not_go_far;
-  assign mux_and_18 = and_18 ? top_node : mux_not_go_near_and_go_far;
+  assign and_16 = not_go_near & not_go_far;
+  assign mux_and_16 = and_16 ? top_node : mux_not_go_near_and_go_far;
   assign not_sp_empty = ~sp_empty;
   assign mux_not_sp_empty = not_sp_empty ? top_node : node;
-  always @* begin
-    case (state)
-      st_idle: node_next = k_0_4;
-      st_dist: node_next = near;
-      st_step: node_next = mux_and_18;
-      st_leaf: node_next = top_node;
-      st_pop: node_next = mux_not_sp_empty;
-      default: node_next = node;
-    endcase
-  end
+  assign mux_in_pop = in_pop ? mux_not_sp_empty : node;
+  assign mux_in_leaf = in_leaf ? top_node : mux_in_pop;
+  assign mux_in_step = in_step ? mux_and_16 : mux_in_leaf;
+  assign mux_in_dist = in_dist ? near : mux_in_step;
+  assign node_next = in_idle ? k_0_4 : mux_in_dist;
   assign not_go_near_and_go_far_1 = not_go_near & go_far;
   assign mux_not_go_near_and_go_far_1 = not_go_near_and_go_far_1 ? far_min : tmin;
   assign mux_not_sp_empty_1 = not_sp_empty ? top_tmin : tmin;
-  always @* begin
-    case (state)
-      st_idle: tmin_next = k_0_5;
-      st_step: tmin_next = mux_not_go_near_and_go_far_1;
-      st_pop: tmin_next = mux_not_sp_empty_1;
-      default: tmin_next = tmin;
-    endcase
-  end
+  assign mux_in_pop_1 = in_pop ? mux_not_sp_empty_1 : tmin;
+  assign mux_in_step_1 = in_step ? mux_not_go_near_and_go_far_1 : mux_in_pop_1;
+  assign tmin_next = in_idle ? k_0_5 : mux_in_step_1;
   assign mux_ray_valid = ray_valid ? ray_id : ray_id_r;
   assign ray_id_r_next = in_idle ? mux_ray_valid : ray_id_r;
   assign mux_ray_valid_1 = ray_valid ? ox : ox_r;
@@ -656,26 +728,26 @@ module fxrt_traverse (
   assign not_box_miss = ~box_miss;
   assign mux_not_box_miss = not_box_miss ? st_node : mux_box_miss;
   assign mux_node_settled = node_settled ? st_node : state;
-  assign and_19 = nw_is_leaf & nw_count_eq_k_0_7;
-  assign mux_and_19 = and_19 ? st_pop : state;
+  assign and_17 = nw_is_leaf & nw_count_eq_k_0_7;
+  assign mux_and_17 = and_17 ? st_pop : state;
   assign not_nw_count_eq_k_0_7 = ~nw_count_eq_k_0_7;
-  assign and_20 = nw_is_leaf & not_nw_count_eq_k_0_7;
-  assign mux_and_20 = and_20 ? st_leaf : mux_and_19;
+  assign and_18 = nw_is_leaf & not_nw_count_eq_k_0_7;
+  assign mux_and_18 = and_18 ? st_leaf : mux_and_17;
   assign not_nw_is_leaf_1 = ~nw_is_leaf;
-  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_20;
+  assign mux_not_nw_is_leaf_1 = not_nw_is_leaf_1 ? st_clip1 : mux_and_18;
   assign mux_d1_arrives_1 = d1_arrives ? st_step : state;
   assign mux_go_near = go_near ? st_node : state;
   assign not_go_near_and_go_far_2 = not_go_near & go_far;
   assign mux_not_go_near_and_go_far_2 = not_go_near_and_go_far_2 ? st_fetch : mux_go_near;
-  assign and_21 = not_go_near & not_go_far;
-  assign mux_and_21 = and_21 ? st_pop : mux_not_go_near_and_go_far_2;
+  assign and_19 = not_go_near & not_go_far;
+  assign mux_and_19 = and_19 ? st_pop : mux_not_go_near_and_go_far_2;
   assign mux_leaf_left_eq_k_1_4 = leaf_left_eq_k_1_4 ? st_pop : state;
   assign mux_sp_empty = sp_empty ? st_done : state;
-  assign and_22 = not_sp_empty & popped_ahead;
-  assign mux_and_22 = and_22 ? st_node : mux_sp_empty;
+  assign and_20 = not_sp_empty & popped_ahead;
+  assign mux_and_20 = and_20 ? st_node : mux_sp_empty;
   assign not_popped_ahead = ~popped_ahead;
-  assign and_23 = not_sp_empty & not_popped_ahead;
-  assign mux_and_23 = and_23 ? st_fetch : mux_and_22;
+  assign and_21 = not_sp_empty & not_popped_ahead;
+  assign mux_and_21 = and_21 ? st_fetch : mux_and_20;
   always @* begin
     case (state)
       st_idle: state_next = mux_ray_valid_7;
@@ -686,51 +758,31 @@ module fxrt_traverse (
       st_node: state_next = mux_not_nw_is_leaf_1;
       st_clip1: state_next = st_dist;
       st_dist: state_next = mux_d1_arrives_1;
-      st_step: state_next = mux_and_21;
+      st_step: state_next = mux_and_19;
       st_leaf: state_next = mux_leaf_left_eq_k_1_4;
-      st_pop: state_next = mux_and_23;
+      st_pop: state_next = mux_and_21;
       st_done: state_next = st_idle;
       default: state_next = st_idle;
     endcase
   end
   assign mux_go_near_1 = go_near ? near_max : tmax;
   assign mux_not_sp_empty_2 = not_sp_empty ? top_tmax : tmax;
-  always @* begin
-    case (state)
-      st_boxmin: tmax_next = box_tmax;
-      st_step: tmax_next = mux_go_near_1;
-      st_pop: tmax_next = mux_not_sp_empty_2;
-      default: tmax_next = tmax;
-    endcase
-  end
+  assign mux_in_pop_2 = in_pop ? mux_not_sp_empty_2 : tmax;
+  assign mux_in_step_2 = in_step ? mux_go_near_1 : mux_in_pop_2;
+  assign tmax_next = in_boxmin ? box_tmax : mux_in_step_2;
   assign mux_nw_is_leaf = nw_is_leaf ? nw_first : leaf_ptr;
-  always @* begin
-    case (state)
-      st_node: leaf_ptr_next = mux_nw_is_leaf;
-      st_leaf: leaf_ptr_next = leaf_ptr_plus_k_1_1;
-      default: leaf_ptr_next = leaf_ptr;
-    endcase
-  end
+  assign mux_in_leaf_1 = in_leaf ? leaf_ptr_plus_k_1_1 : leaf_ptr;
+  assign leaf_ptr_next = in_node ? mux_nw_is_leaf : mux_in_leaf_1;
   assign mux_nw_is_leaf_1 = nw_is_leaf ? nw_count : leaf_left;
-  always @* begin
-    case (state)
-      st_node: leaf_left_next = mux_nw_is_leaf_1;
-      st_leaf: leaf_left_next = leaf_left_minus_k_1_4;
-      default: leaf_left_next = leaf_left;
-    endcase
-  end
+  assign mux_in_leaf_2 = in_leaf ? leaf_left_minus_k_1_4 : leaf_left;
+  assign leaf_left_next = in_node ? mux_nw_is_leaf_1 : mux_in_leaf_2;
   assign mux_nw_is_leaf_2 = nw_is_leaf ? k_0_6 : popped_ahead;
-  assign and_24 = not_go_near & not_go_far;
-  assign mux_and_24 = and_24 ? k_0_6 : popped_ahead;
+  assign and_22 = not_go_near & not_go_far;
+  assign mux_and_22 = and_22 ? k_0_6 : popped_ahead;
   assign mux_leaf_left_eq_k_1_4_1 = leaf_left_eq_k_1_4 ? was_leaf : popped_ahead;
-  always @* begin
-    case (state)
-      st_node: popped_ahead_next = mux_nw_is_leaf_2;
-      st_step: popped_ahead_next = mux_and_24;
-      st_leaf: popped_ahead_next = mux_leaf_left_eq_k_1_4_1;
-      default: popped_ahead_next = popped_ahead;
-    endcase
-  end
+  assign mux_in_leaf_3 = in_leaf ? mux_leaf_left_eq_k_1_4_1 : popped_ahead;
+  assign mux_in_step_3 = in_step ? mux_and_22 : mux_in_leaf_3;
+  assign popped_ahead_next = in_node ? mux_nw_is_leaf_2 : mux_in_step_3;
   assign mux_not_nw_is_leaf_1_1 = not_nw_is_leaf_1 ? nw_axis : axis_r;
   assign axis_r_next = in_node ? mux_not_nw_is_leaf_1_1 : axis_r;
   assign mux_not_nw_is_leaf_1_2 = not_nw_is_leaf_1 ? nw_clip1 : clip1_r;
@@ -739,29 +791,28 @@ module fxrt_traverse (
   assign child_r_next = in_node ? mux_not_nw_is_leaf_1_3 : child_r;
   assign negative_next = in_clip1 ? bits_case_axis_r : negative;
   assign far_r_next = in_dist ? far : far_r;
-  assign mux_d0_arrives = d0_arrives ? plane_t : d0_r;
-  assign d0_r_next = in_dist ? mux_d0_arrives : d0_r;
   assign mux_d1_arrives_2 = d1_arrives ? near_end : near_end_r;
   assign near_end_r_next = in_dist ? mux_d1_arrives_2 : near_end_r;
   assign mux_d1_arrives_3 = d1_arrives ? far_start : far_start_r;
   assign far_start_r_next = in_dist ? mux_d1_arrives_3 : far_start_r;
-  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_2 : sp;
-  assign mux_not_sp_empty_3 = not_sp_empty ? sp_minus_k_1_2_1 : sp;
-  always @* begin
-    case (state)
-      st_step: sp_next = mux_go_near_and_go_far;
-      st_pop: sp_next = mux_not_sp_empty_3;
-      default: sp_next = sp;
-    endcase
-  end
-  assign and_25 = in_step & go_near_and_go_far;
+  assign mux_go_near_and_go_far = go_near_and_go_far ? sp_plus_k_1_3 : sp;
+  assign mux_not_sp_empty_3 = not_sp_empty ? sp_minus_k_1_3 : sp;
+  assign mux_in_pop_3 = in_pop ? mux_not_sp_empty_3 : sp;
+  assign sp_next = in_step ? mux_go_near_and_go_far : mux_in_pop_3;
+  assign mux_go_near_and_go_far_1 = go_near_and_go_far ? rs_sp_1 : stack_top_addr;
+  assign mux_not_sp_empty_4 = not_sp_empty ? rs_sp_minus_k_2_1 : stack_top_addr;
+  assign mux_in_pop_4 = in_pop ? mux_not_sp_empty_4 : stack_top_addr;
+  assign stack_top_addr_next = in_step ? mux_go_near_and_go_far_1 : mux_in_pop_4;
+  assign and_23 = in_step & go_near_and_go_far;
   assign in_idle_next = state_next == st_idle;
   assign in_aabb_next = state_next == st_aabb;
+  assign in_boxmin_next = state_next == st_boxmin;
   assign in_node_next = state_next == st_node;
   assign in_clip1_next = state_next == st_clip1;
   assign in_dist_next = state_next == st_dist;
   assign in_step_next = state_next == st_step;
   assign in_leaf_next = state_next == st_leaf;
+  assign in_pop_next = state_next == st_pop;
   assign in_done_next = state_next == st_done;
 
   always @(posedge clk) begin : state_regs
@@ -789,12 +840,13 @@ module fxrt_traverse (
     if (rst) in_clip1 <= 1'h0;
     else in_clip1 <= in_clip1_next;
     negative <= negative_next;
-    d0_r <= d0_r_next;
     near_end_r <= near_end_r_next;
     far_start_r <= far_start_r_next;
     far_r <= far_r_next;
     if (rst) sp <= 6'h00;
     else sp <= sp_next;
+    if (rst) stack_top_addr <= 5'h1f;
+    else stack_top_addr <= stack_top_addr_next;
     leaf_ptr <= leaf_ptr_next;
     leaf_left <= leaf_left_next;
     popped_ahead <= popped_ahead_next;
@@ -804,10 +856,14 @@ module fxrt_traverse (
     else in_idle <= in_idle_next;
     if (rst) in_done <= 1'h0;
     else in_done <= in_done_next;
-    if (rst) in_dist <= 1'h0;
-    else in_dist <= in_dist_next;
+    if (rst) in_pop <= 1'h0;
+    else in_pop <= in_pop_next;
     if (rst) in_step <= 1'h0;
     else in_step <= in_step_next;
+    if (rst) in_dist <= 1'h0;
+    else in_dist <= in_dist_next;
+    if (rst) in_boxmin <= 1'h0;
+    else in_boxmin <= in_boxmin_next;
   end
 
   fxrt_brom_node u_node_rom (

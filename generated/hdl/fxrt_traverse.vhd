@@ -167,37 +167,41 @@ architecture rtl of fxrt_traverse is
   signal pu_product_last : unsigned(0 downto 0);
   signal bits_pu_product : unsigned(61 downto 0);
   signal pu_shifted : signed(61 downto 0);
-  signal bits_pu_shifted : unsigned(0 downto 0);
-  constant k_m1 : signed(61 downto 0) := signed'("11111111111111111111111111111111111111111111111111111111111111");
-  signal pu_shifted_ne_k_m1 : unsigned(0 downto 0);
   signal pu_below : unsigned(0 downto 0);
-  signal bits_pu_shifted_1 : unsigned(29 downto 0);
-  constant k_0_1 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal ne_6 : unsigned(0 downto 0);
-  signal bits_pu_shifted_2 : unsigned(0 downto 0);
-  signal not_bits_pu_shifted_2 : unsigned(0 downto 0);
-  signal bits_pu_shifted_3 : unsigned(0 downto 0);
-  signal bits_pu_shifted_4 : unsigned(29 downto 0);
-  signal ne_7 : unsigned(0 downto 0);
-  signal and_8 : unsigned(0 downto 0);
-  signal ne_6_or_and_8 : unsigned(0 downto 0);
+  signal not_pu_below : unsigned(0 downto 0);
+  signal bits_pu_shifted : unsigned(30 downto 0);
+  constant k_0_1 : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal bits_pu_shifted_ne_k_0_1 : unsigned(0 downto 0);
   signal pu_above : unsigned(0 downto 0);
-  constant k_1073741824 : signed(61 downto 0) := signed'("00000000000000000000000000000001000000000000000000000000000000");
-  signal mux_pu_below : signed(61 downto 0);
-  signal mux_pu_above : signed(61 downto 0);
+  signal rs_pu_shifted : signed(31 downto 0);
+  signal pu_above_r : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_below_r : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_low_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal pu_clamp_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_clamp_last : unsigned(0 downto 0) := unsigned'("0");
+  constant k_1073741824 : signed(31 downto 0) := signed'("01000000000000000000000000000000");
+  constant k_m1 : signed(31 downto 0) := signed'("11111111111111111111111111111111");
+  signal mux_pu_below_r : signed(31 downto 0);
   signal pu_clamped : signed(31 downto 0);
   signal plane_t : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal plane_t_of_last : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal plane_t_of_first : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal not_pu_clamp_last : unsigned(0 downto 0);
+  signal pu_first : unsigned(0 downto 0);
   signal plane_t_valid : unsigned(0 downto 0) := unsigned'("0");
   signal plane_t_last : unsigned(0 downto 0) := unsigned'("0");
-  signal not_plane_t_last : unsigned(0 downto 0);
-  signal d0_arrives : unsigned(0 downto 0);
   signal d1_arrives : unsigned(0 downto 0);
   signal box_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal box_d2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal rs_plane_t : signed(32 downto 0);
+  signal rs_box_d1 : signed(32 downto 0);
+  signal minus_8 : signed(32 downto 0);
   signal box_lt1_c : unsigned(0 downto 0);
   signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
+  signal rs_plane_t_1 : signed(32 downto 0);
+  signal rs_box_d2 : signed(32 downto 0);
+  signal minus_9 : signed(32 downto 0);
   signal box_lt2_c : unsigned(0 downto 0);
   signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
   signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
@@ -206,7 +210,7 @@ architecture rtl of fxrt_traverse is
   signal box_tmax : signed(31 downto 0);
   signal bits_box_d1 : unsigned(0 downto 0);
   signal bits_box_d2 : unsigned(0 downto 0);
-  signal or_12 : unsigned(0 downto 0);
+  signal or_10 : unsigned(0 downto 0);
   signal bits_box_d3 : unsigned(0 downto 0);
   signal box_miss : unsigned(0 downto 0);
   signal near_end : signed(31 downto 0);
@@ -216,24 +220,47 @@ architecture rtl of fxrt_traverse is
   signal tmax_p1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmin_minus_1 : signed(31 downto 0);
   signal tmin_m1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal rs_tmin : signed(32 downto 0);
+  signal rs_tmax_p1 : signed(32 downto 0);
+  signal rs_tmin_minus_rs_tmax_p1 : signed(32 downto 0);
   signal tmin_le_tmax_c : unsigned(0 downto 0);
   signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
-  signal near_lt_plane : unsigned(0 downto 0);
-  signal near_lt_d0 : unsigned(0 downto 0);
-  signal near_lt : unsigned(0 downto 0);
+  constant k_m2147483648 : signed(31 downto 0) := signed'("10000000000000000000000000000000");
+  constant k_2147483647 : signed(31 downto 0) := signed'("01111111111111111111111111111111");
+  signal mux_negative : signed(31 downto 0);
+  signal d0_hi_c : signed(31 downto 0);
+  signal d0_hi : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal mux_negative_1 : signed(31 downto 0);
+  signal d0_lo_c : signed(31 downto 0);
+  signal d0_lo : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal mux_negative_2 : signed(31 downto 0);
+  signal d1_hi_c : signed(31 downto 0);
+  signal d1_hi : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal mux_negative_3 : signed(31 downto 0);
+  signal d1_lo_c : signed(31 downto 0);
+  signal d1_lo : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal rs_plane_t_of_first : signed(32 downto 0);
+  signal rs_d0_hi : signed(32 downto 0);
+  signal minus_11 : signed(32 downto 0);
+  signal d0_below_c : unsigned(0 downto 0);
+  signal d0_below : unsigned(0 downto 0) := unsigned'("0");
+  signal rs_d0_lo : signed(32 downto 0);
+  signal rs_plane_t_of_first_1 : signed(32 downto 0);
+  signal minus_12 : signed(32 downto 0);
+  signal d0_above_c : unsigned(0 downto 0);
+  signal d0_above : unsigned(0 downto 0) := unsigned'("0");
+  signal rs_plane_t_of_last : signed(32 downto 0);
+  signal rs_d1_hi : signed(32 downto 0);
+  signal minus_13 : signed(32 downto 0);
+  signal d1_below : unsigned(0 downto 0);
+  signal rs_d1_lo : signed(32 downto 0);
+  signal rs_plane_t_of_last_1 : signed(32 downto 0);
+  signal minus_14 : signed(32 downto 0);
+  signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
-  signal far_gt_plane : unsigned(0 downto 0);
-  signal far_gt_d0 : unsigned(0 downto 0);
-  signal far_gt : unsigned(0 downto 0);
   signal far_gt_tmin_c : unsigned(0 downto 0);
   signal far_gt_tmin : unsigned(0 downto 0) := unsigned'("0");
-  signal tmin_le_near_plane : unsigned(0 downto 0);
-  signal tmin_le_near_d0 : unsigned(0 downto 0);
-  signal tmin_le_near : unsigned(0 downto 0);
-  signal far_le_tmax_plane : unsigned(0 downto 0);
-  signal far_le_tmax_d0 : unsigned(0 downto 0);
-  signal far_le_tmax : unsigned(0 downto 0);
   signal go_near_c : unsigned(0 downto 0);
   signal go_near : unsigned(0 downto 0) := unsigned'("0");
   signal go_far_c : unsigned(0 downto 0);
@@ -247,9 +274,6 @@ architecture rtl of fxrt_traverse is
   signal u_far_min : unsigned(31 downto 0);
   signal u_tmax : unsigned(31 downto 0);
   signal push_entry : unsigned(76 downto 0);
-  constant k_1_2 : unsigned(5 downto 0) := unsigned'("000001");
-  signal sp_minus_k_1_2 : unsigned(5 downto 0);
-  signal rs_sp_minus_k_1_2 : unsigned(4 downto 0);
   signal stack_top : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal bits_stack_top : unsigned(31 downto 0);
   signal top_tmax : signed(31 downto 0);
@@ -267,8 +291,8 @@ architecture rtl of fxrt_traverse is
   constant k_0_3 : unsigned(1 downto 0) := unsigned'("00");
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
   constant k_0_5 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  constant k_1_3 : unsigned(1 downto 0) := unsigned'("01");
-  signal aabb_k_plus_k_1_3 : unsigned(1 downto 0);
+  constant k_1_2 : unsigned(1 downto 0) := unsigned'("01");
+  signal aabb_k_plus_k_1_2 : unsigned(1 downto 0);
   constant k_0_6 : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_7 : unsigned(2 downto 0) := unsigned'("000");
   signal nw_count_eq_k_0_7 : unsigned(0 downto 0);
@@ -276,12 +300,17 @@ architecture rtl of fxrt_traverse is
   signal bits_case_axis_r : unsigned(0 downto 0);
   signal go_near_and_go_far : unsigned(0 downto 0);
   signal rs_sp : unsigned(4 downto 0);
-  signal sp_plus_k_1_2 : unsigned(5 downto 0);
+  constant k_1_3 : unsigned(5 downto 0) := unsigned'("000001");
+  signal sp_plus_k_1_3 : unsigned(5 downto 0);
+  signal rs_sp_1 : unsigned(4 downto 0);
   signal leaf_ptr_plus_k_1_1 : unsigned(12 downto 0);
   constant k_1_4 : unsigned(2 downto 0) := unsigned'("001");
   signal leaf_left_minus_k_1_4 : unsigned(2 downto 0);
   signal leaf_left_eq_k_1_4 : unsigned(0 downto 0);
-  signal sp_minus_k_1_2_1 : unsigned(5 downto 0);
+  signal sp_minus_k_1_3 : unsigned(5 downto 0);
+  constant k_2_1 : unsigned(5 downto 0) := unsigned'("000010");
+  signal sp_minus_k_2_1 : unsigned(5 downto 0);
+  signal rs_sp_minus_k_2_1 : unsigned(4 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   signal in_leaf_or_in_done : unsigned(0 downto 0);
   type emit_r_sr_t is array (1 to 3) of unsigned(0 downto 0);
@@ -319,30 +348,40 @@ architecture rtl of fxrt_traverse is
   signal in_node : unsigned(0 downto 0) := unsigned'("0");
   signal in_clip1 : unsigned(0 downto 0) := unsigned'("0");
   signal negative : unsigned(0 downto 0) := unsigned'("0");
-  signal d0_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal near_end_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal far_start_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal far_r : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal sp : unsigned(5 downto 0) := unsigned'("000000");
+  signal stack_top_addr : unsigned(4 downto 0) := unsigned'("11111");
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal leaf_left : unsigned(2 downto 0) := unsigned'("000");
   signal popped_ahead : unsigned(0 downto 0) := unsigned'("0");
   signal in_leaf : unsigned(0 downto 0) := unsigned'("0");
   signal in_idle : unsigned(0 downto 0) := unsigned'("1");
   signal in_done : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_aabb_2 : unsigned(1 downto 0);
   signal aabb_k_next : unsigned(1 downto 0);
   signal not_go_near : unsigned(0 downto 0);
   signal not_go_near_and_go_far : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far : unsigned(12 downto 0);
   signal not_go_far : unsigned(0 downto 0);
-  signal and_18 : unsigned(0 downto 0);
-  signal mux_and_18 : unsigned(12 downto 0);
+  signal and_16 : unsigned(0 downto 0);
+  signal mux_and_16 : unsigned(12 downto 0);
   signal not_sp_empty : unsigned(0 downto 0);
   signal mux_not_sp_empty : unsigned(12 downto 0);
+  signal in_pop : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_pop : unsigned(12 downto 0);
+  signal mux_in_leaf : unsigned(12 downto 0);
+  signal in_step : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_step : unsigned(12 downto 0);
+  signal in_dist : unsigned(0 downto 0) := unsigned'("0");
+  signal mux_in_dist : unsigned(12 downto 0);
   signal node_next : unsigned(12 downto 0);
   signal not_go_near_and_go_far_1 : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far_1 : signed(31 downto 0);
   signal mux_not_sp_empty_1 : signed(31 downto 0);
+  signal mux_in_pop_1 : signed(31 downto 0);
+  signal mux_in_step_1 : signed(31 downto 0);
   signal tmin_next : signed(31 downto 0);
   signal mux_ray_valid : unsigned(19 downto 0);
   signal ray_id_r_next : unsigned(19 downto 0);
@@ -365,38 +404,45 @@ architecture rtl of fxrt_traverse is
   signal not_box_miss : unsigned(0 downto 0);
   signal mux_not_box_miss : unsigned(3 downto 0);
   signal mux_node_settled : unsigned(3 downto 0);
-  signal and_19 : unsigned(0 downto 0);
-  signal mux_and_19 : unsigned(3 downto 0);
+  signal and_17 : unsigned(0 downto 0);
+  signal mux_and_17 : unsigned(3 downto 0);
   signal not_nw_count_eq_k_0_7 : unsigned(0 downto 0);
-  signal and_20 : unsigned(0 downto 0);
-  signal mux_and_20 : unsigned(3 downto 0);
+  signal and_18 : unsigned(0 downto 0);
+  signal mux_and_18 : unsigned(3 downto 0);
   signal not_nw_is_leaf_1 : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1 : unsigned(3 downto 0);
   signal mux_d1_arrives_1 : unsigned(3 downto 0);
   signal mux_go_near : unsigned(3 downto 0);
   signal not_go_near_and_go_far_2 : unsigned(0 downto 0);
   signal mux_not_go_near_and_go_far_2 : unsigned(3 downto 0);
-  signal and_21 : unsigned(0 downto 0);
-  signal mux_and_21 : unsigned(3 downto 0);
+  signal and_19 : unsigned(0 downto 0);
+  signal mux_and_19 : unsigned(3 downto 0);
   signal mux_leaf_left_eq_k_1_4 : unsigned(3 downto 0);
   signal mux_sp_empty : unsigned(3 downto 0);
-  signal and_22 : unsigned(0 downto 0);
-  signal mux_and_22 : unsigned(3 downto 0);
+  signal and_20 : unsigned(0 downto 0);
+  signal mux_and_20 : unsigned(3 downto 0);
   signal not_popped_ahead : unsigned(0 downto 0);
-  signal and_23 : unsigned(0 downto 0);
-  signal mux_and_23 : unsigned(3 downto 0);
+  signal and_21 : unsigned(0 downto 0);
+  signal mux_and_21 : unsigned(3 downto 0);
   signal state_next : unsigned(3 downto 0);
   signal mux_go_near_1 : signed(31 downto 0);
   signal mux_not_sp_empty_2 : signed(31 downto 0);
+  signal mux_in_pop_2 : signed(31 downto 0);
+  signal mux_in_step_2 : signed(31 downto 0);
+  signal in_boxmin : unsigned(0 downto 0) := unsigned'("0");
   signal tmax_next : signed(31 downto 0);
   signal mux_nw_is_leaf : unsigned(12 downto 0);
+  signal mux_in_leaf_1 : unsigned(12 downto 0);
   signal leaf_ptr_next : unsigned(12 downto 0);
   signal mux_nw_is_leaf_1 : unsigned(2 downto 0);
+  signal mux_in_leaf_2 : unsigned(2 downto 0);
   signal leaf_left_next : unsigned(2 downto 0);
   signal mux_nw_is_leaf_2 : unsigned(0 downto 0);
-  signal and_24 : unsigned(0 downto 0);
-  signal mux_and_24 : unsigned(0 downto 0);
+  signal and_22 : unsigned(0 downto 0);
+  signal mux_and_22 : unsigned(0 downto 0);
   signal mux_leaf_left_eq_k_1_4_1 : unsigned(0 downto 0);
+  signal mux_in_leaf_3 : unsigned(0 downto 0);
+  signal mux_in_step_3 : unsigned(0 downto 0);
   signal popped_ahead_next : unsigned(0 downto 0);
   signal mux_not_nw_is_leaf_1_1 : unsigned(1 downto 0);
   signal axis_r_next : unsigned(1 downto 0);
@@ -405,26 +451,29 @@ architecture rtl of fxrt_traverse is
   signal mux_not_nw_is_leaf_1_3 : unsigned(12 downto 0);
   signal child_r_next : unsigned(12 downto 0);
   signal negative_next : unsigned(0 downto 0);
-  signal in_dist : unsigned(0 downto 0) := unsigned'("0");
   signal far_r_next : unsigned(12 downto 0);
-  signal mux_d0_arrives : signed(31 downto 0);
-  signal d0_r_next : signed(31 downto 0);
   signal mux_d1_arrives_2 : signed(31 downto 0);
   signal near_end_r_next : signed(31 downto 0);
   signal mux_d1_arrives_3 : signed(31 downto 0);
   signal far_start_r_next : signed(31 downto 0);
   signal mux_go_near_and_go_far : unsigned(5 downto 0);
   signal mux_not_sp_empty_3 : unsigned(5 downto 0);
+  signal mux_in_pop_3 : unsigned(5 downto 0);
   signal sp_next : unsigned(5 downto 0);
-  signal in_step : unsigned(0 downto 0) := unsigned'("0");
-  signal and_25 : unsigned(0 downto 0);
+  signal mux_go_near_and_go_far_1 : unsigned(4 downto 0);
+  signal mux_not_sp_empty_4 : unsigned(4 downto 0);
+  signal mux_in_pop_4 : unsigned(4 downto 0);
+  signal stack_top_addr_next : unsigned(4 downto 0);
+  signal and_23 : unsigned(0 downto 0);
   signal in_idle_next : unsigned(0 downto 0);
   signal in_aabb_next : unsigned(0 downto 0);
+  signal in_boxmin_next : unsigned(0 downto 0);
   signal in_node_next : unsigned(0 downto 0);
   signal in_clip1_next : unsigned(0 downto 0);
   signal in_dist_next : unsigned(0 downto 0);
   signal in_step_next : unsigned(0 downto 0);
   signal in_leaf_next : unsigned(0 downto 0);
+  signal in_pop_next : unsigned(0 downto 0);
   signal in_done_next : unsigned(0 downto 0);
 begin
 
@@ -483,56 +532,69 @@ begin
   pu_product_last <= pu_product_last_sr(6);
   bits_pu_product <= unsigned(pu_product(77 downto 16));
   pu_shifted <= signed(bits_pu_product);
-  bits_pu_shifted <= unsigned(pu_shifted(61 downto 61));
-  pu_shifted_ne_k_m1 <= "1" when pu_shifted /= k_m1 else "0";
-  pu_below <= bits_pu_shifted and pu_shifted_ne_k_m1;
-  bits_pu_shifted_1 <= unsigned(pu_shifted(60 downto 31));
-  ne_6 <= "1" when bits_pu_shifted_1 /= k_0_1 else "0";
-  bits_pu_shifted_2 <= unsigned(pu_shifted(61 downto 61));
-  not_bits_pu_shifted_2 <= not bits_pu_shifted_2;
-  bits_pu_shifted_3 <= unsigned(pu_shifted(30 downto 30));
-  bits_pu_shifted_4 <= unsigned(pu_shifted(29 downto 0));
-  ne_7 <= "1" when bits_pu_shifted_4 /= k_0_1 else "0";
-  and_8 <= bits_pu_shifted_3 and ne_7;
-  ne_6_or_and_8 <= ne_6 or and_8;
-  pu_above <= not_bits_pu_shifted_2 and ne_6_or_and_8;
-  mux_pu_below <= k_m1 when pu_below = "1" else pu_shifted;
-  mux_pu_above <= k_1073741824 when pu_above = "1" else mux_pu_below;
-  pu_clamped <= mux_pu_above(31 downto 0);
-  not_plane_t_last <= not plane_t_last;
-  d0_arrives <= plane_t_valid and not_plane_t_last;
+  pu_below <= unsigned(pu_shifted(61 downto 61));
+  not_pu_below <= not pu_below;
+  bits_pu_shifted <= unsigned(pu_shifted(60 downto 30));
+  bits_pu_shifted_ne_k_0_1 <= "1" when bits_pu_shifted /= k_0_1 else "0";
+  pu_above <= not_pu_below and bits_pu_shifted_ne_k_0_1;
+  rs_pu_shifted <= pu_shifted(31 downto 0);
+  mux_pu_below_r <= k_m1 when pu_below_r = "1" else pu_low_r;
+  pu_clamped <= k_1073741824 when pu_above_r = "1" else mux_pu_below_r;
+  not_pu_clamp_last <= not pu_clamp_last;
+  pu_first <= pu_clamp_valid and not_pu_clamp_last;
   d1_arrives <= plane_t_valid and plane_t_last;
-  box_lt1_c <= "1" when plane_t < box_d1 else "0";
-  box_lt2_c <= "1" when plane_t < box_d2 else "0";
+  rs_plane_t <= resize(plane_t, 33);
+  rs_box_d1 <= resize(box_d1, 33);
+  minus_8 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_8(32 downto 32));
+  rs_plane_t_1 <= resize(plane_t, 33);
+  rs_box_d2 <= resize(box_d2, 33);
+  minus_9 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_9(32 downto 32));
   box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
   mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
   box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
   bits_box_d1 <= unsigned(box_d1(31 downto 31));
   bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_12 <= bits_box_d1 or bits_box_d2;
+  or_10 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_12 or bits_box_d3;
-  near_end <= plane_t_of_last when negative = "1" else d0_r;
-  far_start <= d0_r when negative = "1" else plane_t_of_last;
+  box_miss <= or_10 or bits_box_d3;
+  near_end <= plane_t_of_last when negative = "1" else plane_t_of_first;
+  far_start <= plane_t_of_first when negative = "1" else plane_t_of_last;
   tmax_plus_1 <= tmax + k_1;
   tmin_minus_1 <= tmin - k_1;
-  tmin_le_tmax_c <= "1" when tmin < tmax_p1 else "0";
-  near_lt_plane <= "1" when plane_t_of_last < tmax else "0";
-  near_lt_d0 <= "1" when d0_r < tmax else "0";
-  near_lt <= near_lt_plane when negative = "1" else near_lt_d0;
-  near_lt_tmax_c <= near_lt;
-  far_gt_plane <= "1" when tmin < d0_r else "0";
-  far_gt_d0 <= "1" when tmin < plane_t_of_last else "0";
-  far_gt <= far_gt_plane when negative = "1" else far_gt_d0;
-  far_gt_tmin_c <= far_gt;
-  tmin_le_near_plane <= "1" when tmin_m1 < plane_t_of_last else "0";
-  tmin_le_near_d0 <= "1" when tmin_m1 < d0_r else "0";
-  tmin_le_near <= tmin_le_near_plane when negative = "1" else tmin_le_near_d0;
-  far_le_tmax_plane <= "1" when d0_r < tmax_p1 else "0";
-  far_le_tmax_d0 <= "1" when plane_t_of_last < tmax_p1 else "0";
-  far_le_tmax <= far_le_tmax_plane when negative = "1" else far_le_tmax_d0;
-  go_near_c <= tmin_le_near and tmin_le_tmax;
-  go_far_c <= far_le_tmax and tmin_le_tmax;
+  rs_tmin <= resize(tmin, 33);
+  rs_tmax_p1 <= resize(tmax_p1, 33);
+  rs_tmin_minus_rs_tmax_p1 <= rs_tmin - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(rs_tmin_minus_rs_tmax_p1(32 downto 32));
+  mux_negative <= tmax_p1 when negative = "1" else tmax;
+  d0_hi_c <= mux_negative when tmin_le_tmax = "1" else k_m2147483648;
+  mux_negative_1 <= tmin when negative = "1" else tmin_m1;
+  d0_lo_c <= mux_negative_1 when tmin_le_tmax = "1" else k_2147483647;
+  mux_negative_2 <= tmax when negative = "1" else tmax_p1;
+  d1_hi_c <= mux_negative_2 when tmin_le_tmax = "1" else k_m2147483648;
+  mux_negative_3 <= tmin_m1 when negative = "1" else tmin;
+  d1_lo_c <= mux_negative_3 when tmin_le_tmax = "1" else k_2147483647;
+  rs_plane_t_of_first <= resize(plane_t_of_first, 33);
+  rs_d0_hi <= resize(d0_hi, 33);
+  minus_11 <= rs_plane_t_of_first - rs_d0_hi;
+  d0_below_c <= unsigned(minus_11(32 downto 32));
+  rs_d0_lo <= resize(d0_lo, 33);
+  rs_plane_t_of_first_1 <= resize(plane_t_of_first, 33);
+  minus_12 <= rs_d0_lo - rs_plane_t_of_first_1;
+  d0_above_c <= unsigned(minus_12(32 downto 32));
+  rs_plane_t_of_last <= resize(plane_t_of_last, 33);
+  rs_d1_hi <= resize(d1_hi, 33);
+  minus_13 <= rs_plane_t_of_last - rs_d1_hi;
+  d1_below <= unsigned(minus_13(32 downto 32));
+  rs_d1_lo <= resize(d1_lo, 33);
+  rs_plane_t_of_last_1 <= resize(plane_t_of_last, 33);
+  minus_14 <= rs_d1_lo - rs_plane_t_of_last_1;
+  d1_above <= unsigned(minus_14(32 downto 32));
+  near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
+  far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
+  go_near_c <= d1_above when negative = "1" else d0_above;
+  go_far_c <= d0_below when negative = "1" else d1_below;
   child_r_plus_k_1_1 <= child_r + k_1_1;
   near <= child_r_plus_k_1_1 when negative = "1" else child_r;
   far <= child_r when negative = "1" else child_r_plus_k_1_1;
@@ -541,8 +603,6 @@ begin
   u_far_min <= unsigned(far_min);
   u_tmax <= unsigned(tmax);
   push_entry <= unsigned(std_logic_vector'(std_logic_vector(far_r) & std_logic_vector(u_far_min) & std_logic_vector(u_tmax)));
-  sp_minus_k_1_2 <= sp - k_1_2;
-  rs_sp_minus_k_1_2 <= sp_minus_k_1_2(4 downto 0);
   bits_stack_top <= unsigned(stack_top(31 downto 0));
   top_tmax <= signed(bits_stack_top);
   bits_stack_top_1 <= unsigned(stack_top(63 downto 32));
@@ -551,7 +611,7 @@ begin
   was_leaf2 <= was_leaf2_sr(2);
   was_leaf <= was_leaf1 and was_leaf2;
   sp_is_zero <= "1" when sp = k_0_2 else "0";
-  aabb_k_plus_k_1_3 <= aabb_k + k_1_3;
+  aabb_k_plus_k_1_2 <= aabb_k + k_1_2;
   nw_count_eq_k_0_7 <= "1" when nw_count = k_0_7 else "0";
   with axis_r select
     case_axis_r <=
@@ -561,11 +621,14 @@ begin
   bits_case_axis_r <= unsigned(case_axis_r(47 downto 47));
   go_near_and_go_far <= go_near and go_far;
   rs_sp <= sp(4 downto 0);
-  sp_plus_k_1_2 <= sp + k_1_2;
+  sp_plus_k_1_3 <= sp + k_1_3;
+  rs_sp_1 <= sp(4 downto 0);
   leaf_ptr_plus_k_1_1 <= leaf_ptr + k_1_1;
   leaf_left_minus_k_1_4 <= leaf_left - k_1_4;
   leaf_left_eq_k_1_4 <= "1" when leaf_left = k_1_4 else "0";
-  sp_minus_k_1_2_1 <= sp - k_1_2;
+  sp_minus_k_1_3 <= sp - k_1_3;
+  sp_minus_k_2_1 <= sp - k_2_1;
+  rs_sp_minus_k_2_1 <= sp_minus_k_2_1(4 downto 0);
   in_leaf_or_in_done <= in_leaf or in_done;
   emit_r <= emit_r_sr(3);
   end_r <= end_r_sr(3);
@@ -577,7 +640,7 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if and_25 = "1" then
+      if and_23 = "1" then
         stack(to_integer(rs_sp)) <= push_entry;
       end if;
       node_d1 <= node;
@@ -595,12 +658,20 @@ begin
       pu_product_valid_sr(1) <= pu_delta_valid;
       pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
       pu_product_last_sr(1) <= pu_delta_last;
+      pu_above_r <= pu_above;
+      pu_below_r <= pu_below;
+      pu_low_r <= rs_pu_shifted;
+      pu_clamp_valid <= pu_product_valid;
+      pu_clamp_last <= pu_product_last;
       plane_t <= pu_clamped;
-      if pu_product_last = "1" then
+      if pu_clamp_last = "1" then
         plane_t_of_last <= pu_clamped;
       end if;
-      plane_t_valid <= pu_product_valid;
-      plane_t_last <= pu_product_last;
+      if pu_first = "1" then
+        plane_t_of_first <= pu_clamped;
+      end if;
+      plane_t_valid <= pu_clamp_valid;
+      plane_t_last <= pu_clamp_last;
       box_d1 <= plane_t;
       box_d2 <= box_d1;
       box_d3 <= box_d2;
@@ -610,11 +681,17 @@ begin
       tmax_p1 <= tmax_plus_1;
       tmin_m1 <= tmin_minus_1;
       tmin_le_tmax <= tmin_le_tmax_c;
+      d0_hi <= d0_hi_c;
+      d0_lo <= d0_lo_c;
+      d1_hi <= d1_hi_c;
+      d1_lo <= d1_lo_c;
+      d0_below <= d0_below_c;
+      d0_above <= d0_above_c;
       near_lt_tmax <= near_lt_tmax_c;
       far_gt_tmin <= far_gt_tmin_c;
       go_near <= go_near_c;
       go_far <= go_far_c;
-      stack_top <= stack(to_integer(rs_sp_minus_k_1_2));
+      stack_top <= stack(to_integer(stack_top_addr));
       was_leaf1 <= in_leaf;
       was_leaf2_sr(2 to 2) <= was_leaf2_sr(1 to 1);
       was_leaf2_sr(1) <= in_leaf;
@@ -631,36 +708,27 @@ begin
   end process regs;
 
   -- state machine state: BIH traversal: one ray at a time, one leaf entry per clock
-  with state select
-    aabb_k_next <=
-      k_0_3 when st_idle,
-      aabb_k_plus_k_1_3 when st_aabb,
-      aabb_k when others;
+  mux_in_aabb_2 <= aabb_k_plus_k_1_2 when in_aabb = "1" else aabb_k;
+  aabb_k_next <= k_0_3 when in_idle = "1" else mux_in_aabb_2;
   not_go_near <= not go_near;
   not_go_near_and_go_far <= not_go_near and go_far;
   mux_not_go_near_and_go_far <= far_r when not_go_near_and_go_far = "1" else node;
   not_go_far <= not go_far;
-  and_18 <= not_go_near and not_go_far;
-  mux_and_18 <= top_node when and_18 = "1" else mux_not_go_near_and_go_far;
+  and_16 <= not_go_near and not_go_far;
+  mux_and_16 <= top_node when and_16 = "1" else mux_not_go_near_and_go_far;
   not_sp_empty <= not sp_empty;
   mux_not_sp_empty <= top_node when not_sp_empty = "1" else node;
-  with state select
-    node_next <=
-      k_0_4 when st_idle,
-      near when st_dist,
-      mux_and_18 when st_step,
-      top_node when st_leaf,
-      mux_not_sp_empty when st_pop,
-      node when others;
+  mux_in_pop <= mux_not_sp_empty when in_pop = "1" else node;
+  mux_in_leaf <= top_node when in_leaf = "1" else mux_in_pop;
+  mux_in_step <= mux_and_16 when in_step = "1" else mux_in_leaf;
+  mux_in_dist <= near when in_dist = "1" else mux_in_step;
+  node_next <= k_0_4 when in_idle = "1" else mux_in_dist;
   not_go_near_and_go_far_1 <= not_go_near and go_far;
   mux_not_go_near_and_go_far_1 <= far_min when not_go_near_and_go_far_1 = "1" else tmin;
   mux_not_sp_empty_1 <= top_tmin when not_sp_empty = "1" else tmin;
-  with state select
-    tmin_next <=
-      k_0_5 when st_idle,
-      mux_not_go_near_and_go_far_1 when st_step,
-      mux_not_sp_empty_1 when st_pop,
-      tmin when others;
+  mux_in_pop_1 <= mux_not_sp_empty_1 when in_pop = "1" else tmin;
+  mux_in_step_1 <= mux_not_go_near_and_go_far_1 when in_step = "1" else mux_in_pop_1;
+  tmin_next <= k_0_5 when in_idle = "1" else mux_in_step_1;
   mux_ray_valid <= ray_id when ray_valid = "1" else ray_id_r;
   ray_id_r_next <= mux_ray_valid when in_idle = "1" else ray_id_r;
   mux_ray_valid_1 <= ox when ray_valid = "1" else ox_r;
@@ -682,26 +750,26 @@ begin
   not_box_miss <= not box_miss;
   mux_not_box_miss <= st_node when not_box_miss = "1" else mux_box_miss;
   mux_node_settled <= st_node when node_settled = "1" else state;
-  and_19 <= nw_is_leaf and nw_count_eq_k_0_7;
-  mux_and_19 <= st_pop when and_19 = "1" else state;
+  and_17 <= nw_is_leaf and nw_count_eq_k_0_7;
+  mux_and_17 <= st_pop when and_17 = "1" else state;
   not_nw_count_eq_k_0_7 <= not nw_count_eq_k_0_7;
-  and_20 <= nw_is_leaf and not_nw_count_eq_k_0_7;
-  mux_and_20 <= st_leaf when and_20 = "1" else mux_and_19;
+  and_18 <= nw_is_leaf and not_nw_count_eq_k_0_7;
+  mux_and_18 <= st_leaf when and_18 = "1" else mux_and_17;
   not_nw_is_leaf_1 <= not nw_is_leaf;
-  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_20;
+  mux_not_nw_is_leaf_1 <= st_clip1 when not_nw_is_leaf_1 = "1" else mux_and_18;
   mux_d1_arrives_1 <= st_step when d1_arrives = "1" else state;
   mux_go_near <= st_node when go_near = "1" else state;
   not_go_near_and_go_far_2 <= not_go_near and go_far;
   mux_not_go_near_and_go_far_2 <= st_fetch when not_go_near_and_go_far_2 = "1" else mux_go_near;
-  and_21 <= not_go_near and not_go_far;
-  mux_and_21 <= st_pop when and_21 = "1" else mux_not_go_near_and_go_far_2;
+  and_19 <= not_go_near and not_go_far;
+  mux_and_19 <= st_pop when and_19 = "1" else mux_not_go_near_and_go_far_2;
   mux_leaf_left_eq_k_1_4 <= st_pop when leaf_left_eq_k_1_4 = "1" else state;
   mux_sp_empty <= st_done when sp_empty = "1" else state;
-  and_22 <= not_sp_empty and popped_ahead;
-  mux_and_22 <= st_node when and_22 = "1" else mux_sp_empty;
+  and_20 <= not_sp_empty and popped_ahead;
+  mux_and_20 <= st_node when and_20 = "1" else mux_sp_empty;
   not_popped_ahead <= not popped_ahead;
-  and_23 <= not_sp_empty and not_popped_ahead;
-  mux_and_23 <= st_fetch when and_23 = "1" else mux_and_22;
+  and_21 <= not_sp_empty and not_popped_ahead;
+  mux_and_21 <= st_fetch when and_21 = "1" else mux_and_20;
   with state select
     state_next <=
       mux_ray_valid_7 when st_idle,
@@ -712,41 +780,29 @@ begin
       mux_not_nw_is_leaf_1 when st_node,
       st_dist when st_clip1,
       mux_d1_arrives_1 when st_dist,
-      mux_and_21 when st_step,
+      mux_and_19 when st_step,
       mux_leaf_left_eq_k_1_4 when st_leaf,
-      mux_and_23 when st_pop,
+      mux_and_21 when st_pop,
       st_idle when st_done,
       st_idle when others;
   mux_go_near_1 <= near_max when go_near = "1" else tmax;
   mux_not_sp_empty_2 <= top_tmax when not_sp_empty = "1" else tmax;
-  with state select
-    tmax_next <=
-      box_tmax when st_boxmin,
-      mux_go_near_1 when st_step,
-      mux_not_sp_empty_2 when st_pop,
-      tmax when others;
+  mux_in_pop_2 <= mux_not_sp_empty_2 when in_pop = "1" else tmax;
+  mux_in_step_2 <= mux_go_near_1 when in_step = "1" else mux_in_pop_2;
+  tmax_next <= box_tmax when in_boxmin = "1" else mux_in_step_2;
   mux_nw_is_leaf <= nw_first when nw_is_leaf = "1" else leaf_ptr;
-  with state select
-    leaf_ptr_next <=
-      mux_nw_is_leaf when st_node,
-      leaf_ptr_plus_k_1_1 when st_leaf,
-      leaf_ptr when others;
+  mux_in_leaf_1 <= leaf_ptr_plus_k_1_1 when in_leaf = "1" else leaf_ptr;
+  leaf_ptr_next <= mux_nw_is_leaf when in_node = "1" else mux_in_leaf_1;
   mux_nw_is_leaf_1 <= nw_count when nw_is_leaf = "1" else leaf_left;
-  with state select
-    leaf_left_next <=
-      mux_nw_is_leaf_1 when st_node,
-      leaf_left_minus_k_1_4 when st_leaf,
-      leaf_left when others;
+  mux_in_leaf_2 <= leaf_left_minus_k_1_4 when in_leaf = "1" else leaf_left;
+  leaf_left_next <= mux_nw_is_leaf_1 when in_node = "1" else mux_in_leaf_2;
   mux_nw_is_leaf_2 <= k_0_6 when nw_is_leaf = "1" else popped_ahead;
-  and_24 <= not_go_near and not_go_far;
-  mux_and_24 <= k_0_6 when and_24 = "1" else popped_ahead;
+  and_22 <= not_go_near and not_go_far;
+  mux_and_22 <= k_0_6 when and_22 = "1" else popped_ahead;
   mux_leaf_left_eq_k_1_4_1 <= was_leaf when leaf_left_eq_k_1_4 = "1" else popped_ahead;
-  with state select
-    popped_ahead_next <=
-      mux_nw_is_leaf_2 when st_node,
-      mux_and_24 when st_step,
-      mux_leaf_left_eq_k_1_4_1 when st_leaf,
-      popped_ahead when others;
+  mux_in_leaf_3 <= mux_leaf_left_eq_k_1_4_1 when in_leaf = "1" else popped_ahead;
+  mux_in_step_3 <= mux_and_22 when in_step = "1" else mux_in_leaf_3;
+  popped_ahead_next <= mux_nw_is_leaf_2 when in_node = "1" else mux_in_step_3;
   mux_not_nw_is_leaf_1_1 <= nw_axis when not_nw_is_leaf_1 = "1" else axis_r;
   axis_r_next <= mux_not_nw_is_leaf_1_1 when in_node = "1" else axis_r;
   mux_not_nw_is_leaf_1_2 <= nw_clip1 when not_nw_is_leaf_1 = "1" else clip1_r;
@@ -755,27 +811,28 @@ begin
   child_r_next <= mux_not_nw_is_leaf_1_3 when in_node = "1" else child_r;
   negative_next <= bits_case_axis_r when in_clip1 = "1" else negative;
   far_r_next <= far when in_dist = "1" else far_r;
-  mux_d0_arrives <= plane_t when d0_arrives = "1" else d0_r;
-  d0_r_next <= mux_d0_arrives when in_dist = "1" else d0_r;
   mux_d1_arrives_2 <= near_end when d1_arrives = "1" else near_end_r;
   near_end_r_next <= mux_d1_arrives_2 when in_dist = "1" else near_end_r;
   mux_d1_arrives_3 <= far_start when d1_arrives = "1" else far_start_r;
   far_start_r_next <= mux_d1_arrives_3 when in_dist = "1" else far_start_r;
-  mux_go_near_and_go_far <= sp_plus_k_1_2 when go_near_and_go_far = "1" else sp;
-  mux_not_sp_empty_3 <= sp_minus_k_1_2_1 when not_sp_empty = "1" else sp;
-  with state select
-    sp_next <=
-      mux_go_near_and_go_far when st_step,
-      mux_not_sp_empty_3 when st_pop,
-      sp when others;
-  and_25 <= in_step and go_near_and_go_far;
+  mux_go_near_and_go_far <= sp_plus_k_1_3 when go_near_and_go_far = "1" else sp;
+  mux_not_sp_empty_3 <= sp_minus_k_1_3 when not_sp_empty = "1" else sp;
+  mux_in_pop_3 <= mux_not_sp_empty_3 when in_pop = "1" else sp;
+  sp_next <= mux_go_near_and_go_far when in_step = "1" else mux_in_pop_3;
+  mux_go_near_and_go_far_1 <= rs_sp_1 when go_near_and_go_far = "1" else stack_top_addr;
+  mux_not_sp_empty_4 <= rs_sp_minus_k_2_1 when not_sp_empty = "1" else stack_top_addr;
+  mux_in_pop_4 <= mux_not_sp_empty_4 when in_pop = "1" else stack_top_addr;
+  stack_top_addr_next <= mux_go_near_and_go_far_1 when in_step = "1" else mux_in_pop_4;
+  and_23 <= in_step and go_near_and_go_far;
   in_idle_next <= "1" when state_next = st_idle else "0";
   in_aabb_next <= "1" when state_next = st_aabb else "0";
+  in_boxmin_next <= "1" when state_next = st_boxmin else "0";
   in_node_next <= "1" when state_next = st_node else "0";
   in_clip1_next <= "1" when state_next = st_clip1 else "0";
   in_dist_next <= "1" when state_next = st_dist else "0";
   in_step_next <= "1" when state_next = st_step else "0";
   in_leaf_next <= "1" when state_next = st_leaf else "0";
+  in_pop_next <= "1" when state_next = st_pop else "0";
   in_done_next <= "1" when state_next = st_done else "0";
 
   state_regs : process (clk)
@@ -820,7 +877,6 @@ begin
         in_clip1 <= in_clip1_next;
       end if;
       negative <= negative_next;
-      d0_r <= d0_r_next;
       near_end_r <= near_end_r_next;
       far_start_r <= far_start_r_next;
       far_r <= far_r_next;
@@ -828,6 +884,11 @@ begin
         sp <= unsigned'("000000");
       else
         sp <= sp_next;
+      end if;
+      if rst = '1' then
+        stack_top_addr <= unsigned'("11111");
+      else
+        stack_top_addr <= stack_top_addr_next;
       end if;
       leaf_ptr <= leaf_ptr_next;
       leaf_left <= leaf_left_next;
@@ -848,14 +909,24 @@ begin
         in_done <= in_done_next;
       end if;
       if rst = '1' then
-        in_dist <= unsigned'("0");
+        in_pop <= unsigned'("0");
       else
-        in_dist <= in_dist_next;
+        in_pop <= in_pop_next;
       end if;
       if rst = '1' then
         in_step <= unsigned'("0");
       else
         in_step <= in_step_next;
+      end if;
+      if rst = '1' then
+        in_dist <= unsigned'("0");
+      else
+        in_dist <= in_dist_next;
+      end if;
+      if rst = '1' then
+        in_boxmin <= unsigned'("0");
+      else
+        in_boxmin <= in_boxmin_next;
       end if;
     end if;
   end process state_regs;

@@ -8,6 +8,7 @@
 //! distance, then the end flag on top; an end token carries the ray id in the low bits.
 
 use super::clock::ClockTarget;
+use super::lt_chain;
 use crate::rtl::build::Builder;
 use crate::rtl::{Module, Ty};
 
@@ -68,27 +69,41 @@ pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) ->
     let reg = |name: &str, x, k: u32| if staged { b.delay_line(&format!("in_{name}"), x, k) } else { x };
     let (x, t8) = (reg("tmin_less", x, 1), reg("t_plus_8", t8, 1));
     let (valid1, end1, hit1) = (reg("valid", valid, 1), reg("end", end, 1), reg("hit", hit, 1));
-    let accepted = (!t8.lt(x)).name("accepted");
-    let candidate = reg("candidate", (valid1 & !end1 & hit1 & accepted).name("candidate_c"), 1);
+    let accepted = (!lt_chain(t8, x)).name("accepted");
+    // Held inverted, the accumulator's compare taking it as its top bit (below); staged, its
+    // register resets to 1 (no candidate), as the positive one started at 0.
+    let no_candidate = (!(valid1 & !end1 & hit1 & accepted)).name("no_candidate_c");
+    let no_candidate = if staged {
+        let r = b.reg("in_no_candidate", Ty::BIT, Some(1));
+        b.next(r, no_candidate);
+        r
+    } else {
+        no_candidate
+    };
     let finish = reg("finish", (valid1 & end1).name("finish_c"), 1);
     let (tri, id, t, u, v) = (reg("tri", tri, 2), reg("id", id, 2), reg("t", t, 2), reg("u", u, 2), reg("v", v, 2));
 
     // The best accepted hit of the ray in flight. Closer means (t, tri) < (best_t, best_tri)
     // in lexicographic order (equal t: the smaller triangle number wins), which is one
     // unsigned compare of the concatenations: one carry chain in the accumulator's loop
-    // instead of a compare, an equality and a second compare side by side.
+    // instead of a compare, an equality and a second compare side by side. The candidate bit
+    // and whether there is a best hit yet go in as two more bits on top, so the chain's last
+    // sum bit is `take` = candidate ∧ (no best hit ∨ closer) itself, the enable of the best-hit
+    // registers, with no LUT between (`lt_chain`): (¬candidate, 0, t, tri) < (0, no best,
+    // best_t, best_tri). `best_empty` is ¬best_valid in a register of its own.
     let best_valid = b.reg("best_valid", Ty::BIT, Some(0));
+    let best_empty = b.reg("best_empty", Ty::BIT, Some(1));
     let best_t = b.reg("best_t", t.ty(), None);
     let best_tri = b.reg("best_tri", tri.ty(), None);
     let best_u = b.reg("best_u", u.ty(), None);
     let best_v = b.reg("best_v", v.ty(), None);
-    let closer = b.cat(&[t, tri]).lt(b.cat(&[best_t, best_tri])).name("closer");
-    let better = (!best_valid | closer).name("better");
-    let take = (candidate & better).name("take");
+    let zero = b.konst(Ty::BIT, 0);
+    let take = lt_chain(b.cat(&[no_candidate, zero, t, tri]), b.cat(&[zero, best_empty, best_t, best_tri])).name("take");
     for (r, x) in [(best_t, t), (best_tri, tri), (best_u, u), (best_v, v)] {
         b.next_when(r, take, x);
     }
     b.next(best_valid, finish.select(best_valid.k(0), take.select(best_valid.k(1), best_valid)));
+    b.next(best_empty, finish.select(best_empty.k(1), take.select(best_empty.k(0), best_empty)));
 
     // The result registers, loaded by the end token; a miss reports zeros, so every output bit
     // is defined.

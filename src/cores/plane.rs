@@ -10,8 +10,11 @@
 //!    subtractor.
 //! 3. product: `plane_product`, its own number of stages (the clock target's `MulStyle`: 1
 //!    for one multiplier between two registers, more for DSP pieces and an adder tree).
-//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (two bit reductions and a
-//!    mux), registered.
+//! 4. clamp: the shift by C (wiring) and the clamp to [−1, 2^(n+1)] (the sign bit, one bit
+//!    reduction and a mux), registered. With a split product (a fast clock target) it takes
+//!    two clocks: the reduction is registered beside the distance's bits (4a, by the product,
+//!    which sits by the DSP blocks), and the mux (4b) is one LUT before the distance registers
+//!    (by their users): the route across the die between gets a clock of its own.
 //!
 //! The valid and last bits ride along in shift registers of the same depth, so a state
 //! machine waits for results by their valid bit and never counts the latency itself: a
@@ -52,6 +55,9 @@ pub struct PlaneResult<'b> {
     pub t: S<'b>,
     /// `t` when `last` is 1 (the same register value then), held otherwise.
     pub t_last: S<'b>,
+    /// `t` when it is valid and `last` is 0 (a group's first distance: d0 of an inner node),
+    /// held otherwise: d0 until the next node's d0, the cycle d1 arrives included.
+    pub t_first: S<'b>,
     pub valid: S<'b>,
     pub last: S<'b>,
     pub latency: u32,
@@ -79,34 +85,60 @@ pub fn plane_unit<'b>(
     let inv_a = b.delay("pu_inv", b.pick(axis, inv).name("pu_inv_axis"));
     let (valid, last) = (b.delay("pu_delta_valid", valid), b.delay("pu_delta_last", last));
     // 3. product
+    let product_style = product;
     let (product, product_latency) = plane_product(b, delta, inv_a, product);
     let valid = b.delay_line("pu_product_valid", valid, product_latency);
     let last = b.delay_line("pu_product_last", last, product_latency);
     // 4. clamp. The two range tests are bit reductions, not compares with constants: yosys
     // builds those as two carry chains of the shifted product's full width (62 bits by
-    // default), and with the select they made a 9 ns stage. With s = product >> C:
-    // s < −1 ⟺ s is negative and not all ones; s > 2^(n+1) ⟺ s is non-negative and has a bit
-    // set above bit n + 1, or bit n + 1 and one below it.
+    // default), and with the select they made a 9 ns stage. With s = product >> C, the clamp
+    // to [−1, 2^(n+1)] is: s negative → −1 (s = −1 is −1 either way), s ≥ 2^(n+1) → 2^(n+1)
+    // (s = 2^(n+1) is that either way): the sign bit and one OR over the bits from n + 1 up.
+    // (Testing s < −1 and s > 2^(n+1) exactly took two more reductions, over all of s and its
+    // low n + 1 bits: the stage made the whole core's critical path, 7.5–8.6 ns, 5.4–7.1 ns of
+    // it routing from the DSP column.)
+    // With a split product, 4a registers the tests and the n + 3 low bits (which hold s when
+    // neither test holds) by the product, and 4b muxes them by the users (in the whole Cornell
+    // core, the one-clock clamp spent 6.6 ns of 8.1 routing from the product's register at the
+    // die's edge to the distance registers in its middle).
     let w = product.width() - c;
     let shifted = product.slice(c, w).signed().name("pu_shifted");
     let k = n + 1;
-    let below = (shifted.msb() & shifted.ne(-1)).name("pu_below");
-    let above_bits = shifted.slice(k + 1, w - 1 - (k + 1)).ne(0);
-    let above = (!shifted.msb() & (above_bits | (shifted.bit(k) & shifted.slice(0, k).ne(0)))).name("pu_above");
-    let t_sat = shifted.k(1i128 << k);
-    let clamped = above.select(t_sat, below.select(shifted.k(-1), shifted));
-    let clamped = clamped.resize(Ty::s(n + 3).width).name("pu_clamped");
+    let below = shifted.msb().name("pu_below");
+    let above = (!below & shifted.slice(k, w - 1 - k).ne(0)).name("pu_above");
+    let dist_w = Ty::s(n + 3).width;
+    let low = shifted.resize(dist_w);
+    let split = product_style != MulStyle::COMBINATIONAL;
+    let (above, below, low, valid, last) = if split {
+        (
+            b.delay("pu_above_r", above),
+            b.delay("pu_below_r", below),
+            b.delay("pu_low_r", low),
+            b.delay("pu_clamp_valid", valid),
+            b.delay("pu_clamp_last", last),
+        )
+    } else {
+        (above, below, low, valid, last)
+    };
+    let t_sat = low.k(1i128 << k);
+    let clamped = above.select(t_sat, below.select(low.k(-1), low)).name("pu_clamped");
     let t = b.delay("plane_t", clamped);
     // The same distance in a register that loads only with a group's last one: a copy for the
     // traversal's decision compares, so `t` does not fan out to every compare (yosys merges two
     // equal registers, not two with different enables).
     let t_last = b.reg("plane_t_of_last", t.ty(), None);
     b.next_when(t_last, last, clamped);
+    // And one for the first distance of a group (d0), which holds it while d1 arrives: the
+    // traversal compares d0 from it the cycle it arrives, so its results are registered when d1
+    // comes (a third load enable, so yosys keeps the three apart).
+    let t_first = b.reg("plane_t_of_first", t.ty(), None);
+    b.next_when(t_first, (valid & !last).name("pu_first"), clamped);
     PlaneResult {
         t,
         t_last,
+        t_first,
         valid: b.delay("plane_t_valid", valid),
         last: b.delay("plane_t_last", last),
-        latency: 3 + product_latency,
+        latency: 3 + product_latency + split as u32,
     }
 }

@@ -8,8 +8,8 @@
 //! multiplier alone. So the node ROM is addressed by the `node` register itself and its word
 //! goes straight into registers (a block ROM, `brom.rs`: mem[node] two or three cycles after
 //! `node` last changed), as does the leaf ROM's; the plane distances come from a pipelined
-//! unit (`plane.rs`, L = 3 + product stages clocks from issue to result; L = 9 at the default
-//! 150 MHz); and the child decision takes a compare cycle and an act cycle. States and their
+//! unit (`plane.rs`, L = 3 + product stages clocks from issue to result, + 1 with a split
+//! product; L = 10 at the default 150 MHz); and the child decision takes a compare cycle and an act cycle. States and their
 //! cost (one cycle each unless noted):
 //! - `idle`: `ray_ready`; a valid ray is latched (node 0 and tmin 0 too).
 //! - `aabb` (3 cycles): the exit distance of one scene-box axis per cycle is issued.
@@ -24,8 +24,9 @@
 //! - `node` (1 per node visit): the node word is in its register. A leaf loads its first entry
 //!   and count; an inner node's fields are latched and d0 (clip0) is issued.
 //! - `clip1` (1 per inner node): d1 (clip1) is issued; the ray's sign on the axis latched.
-//! - `dist` (L per inner node): waits for d0, then d1; when d1 arrives, near_end/far_start are
-//!   chosen, and both candidates compared with tmin and tmax (registered).
+//! - `dist` (L per inner node): waits for d0, then d1. Each is compared, the cycle it arrives,
+//!   with the limits of its role (near_end or far_start, known from the sign); when d1
+//!   arrives, near_end/far_start are chosen and the decision bits registered.
 //! - `step` (1 per inner node): `bih::inner_step`'s decision from the registered compares,
 //!   selected by the ray's sign: push the far child and enter the near one, enter one child,
 //!   or pop.
@@ -34,13 +35,14 @@
 //! - `done`: an end token follows the ray's last triangle, so the closest-hit unit knows the
 //!   ray is complete when the token leaves the in-order pipeline.
 //!
-//! An inner node costs node + clip1 + L + step = 3 + L cycles (12 by default; 2 before the
+//! An inner node costs node + clip1 + L + step = 3 + L cycles (13 by default; 2 before the
 //! unit was pipelined; a far-only step adds the node ROM's 2 or 3 read clocks of `fetch`), a
 //! leaf node + count, a pop 1 (+ its fetch), a ray's overhead idle + aabb + box + boxmin +
 //! done = 6 + L. Emission is the leaf ROM's 2 or 3 read clocks behind `leaf`.
 
 use super::brom::{brom, read_cycles};
 use super::clock::ClockTarget;
+use super::lt_chain;
 use super::mul::MulStyle;
 use super::plane::{PlaneIssue, plane_unit};
 use crate::rtl::build::{Builder, S};
@@ -192,8 +194,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         axis: in_node.select(w_axis, in_aabb.select(aabb_k, axis_r)).name("pu_issue_axis"),
     };
     let pu = plane_unit(&b, n, p.c, o, inv, issue, p.product);
-    let (plane_t, d0_arrives, d1_arrives) =
-        (pu.t, (pu.valid & !pu.last).name("d0_arrives"), (pu.valid & pu.last).name("d1_arrives"));
+    let (plane_t, d1_arrives) = (pu.t, (pu.valid & pu.last).name("d1_arrives"));
 
     // box and boxmin: tmax = the least of the three exit distances (each at most the clamp's
     // ceiling 2^(n+1), where the walk starts tmax); the box is missed when one of them is
@@ -204,8 +205,8 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let box_d1 = b.delay("box_d1", plane_t);
     let box_d2 = b.delay("box_d2", box_d1);
     let box_d3 = b.delay("box_d3", box_d2);
-    let box_lt1 = b.delay("box_lt1", plane_t.lt(box_d1).name("box_lt1_c"));
-    let box_lt2 = b.delay("box_lt2", plane_t.lt(box_d2).name("box_lt2_c"));
+    let box_lt1 = b.delay("box_lt1", lt_chain(plane_t, box_d1).name("box_lt1_c"));
+    let box_lt2 = b.delay("box_lt2", lt_chain(plane_t, box_d2).name("box_lt2_c"));
     let box_lt1_d = b.delay("box_lt1_d", box_lt1);
     // In boxmin: c = box_d1, b = box_d2, a = box_d3; c < b is box_lt1, c < a box_lt2, b < a
     // box_lt1_d.
@@ -213,42 +214,61 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let box_miss = (box_d1.msb() | box_d2.msb() | box_d3.msb()).name("box_miss");
 
     // dist: bih::inner_step's compares. tmin ≤ min(near_end, tmax) and max(tmin, far_start) ≤
-    // tmax are each a compare with the new distance and tmin ≤ tmax, so no min or max feeds a
-    // compare. Each compare is made with both candidates for near_end and far_start (the
-    // arriving distance and d0, both registers), and the pair selected by the ray's sign (a
-    // register since `clip1`) and ANDed with tmin ≤ tmax (registered) in one LUT into a
-    // register that loads every cycle: a carry chain and one LUT, with no state-machine enable
-    // (that made the 9 ns path that held the unit near 111 MHz). `step`, the cycle after d1
-    // arrives, reads the registers the arriving distance made: the state machine's conditions
-    // go_near and go_far are flip-flops (with the sign select in `step` instead, the state
-    // logic ran through the compares' corner of the die and back: 8.4 ns in the whole teapot
-    // core). Every compare is a strict less-than: x ≤ tmax is x < tmax + 1 and tmin ≤ x is
-    // tmin − 1 < x, with tmax + 1, tmin − 1 and tmin ≤ tmax in registers of their own, which
-    // load every cycle (tmin and tmax hold still from `node` to `step`, so they are current
-    // long before d1 arrives). A ≤ made by yosys shares the subtraction of the < with the same
-    // operands and adds an equality over its 32 result bits (measured: 8.3 ns, 120 MHz).
+    // tmax are each a compare with one distance and tmin ≤ tmax, so no min or max feeds a
+    // compare; every compare is a strict less-than (x ≤ tmax is x < tmax + 1, tmin ≤ x is
+    // tmin − 1 < x). The ray's sign on the axis (`negative`, set in `clip1`) is known long
+    // before d0 arrives, so each distance's role is too: d0 is near_end when the sign is
+    // positive, far_start when negative, and d1 the other. So each distance is compared only
+    // with the limits of its role, two compares each instead of four, and the limits
+    // (`d0_hi` … `d1_lo`) are registers of their own chosen by the sign ahead of time, with
+    // tmin ≤ tmax folded in: when tmin > tmax every limit is one no distance passes (the most
+    // negative value as an upper limit, the most positive as a lower; distances lie in
+    // [−1, 2^(n+1)], limits in [−1, 2^(n+1) + 1], and the type holds ±2^(n+2)), so both
+    // decisions fail and the step pops, as `inner_step` does. The limits load every cycle; tmin
+    // and tmax hold still from `node` to `step`, so the limits are current 3 cycles after
+    // `node` (tmax → tmax + 1 → tmin ≤ tmax → limit), before d0 arrives (L ≥ 4 cycles).
+    // They also spare tmin and tmax the fan-out to the compares (yosys keeps them apart: they
+    // are other functions).
+    //
+    // d0 is compared from the plane unit's copy that holds a group's first distance, the cycle
+    // it arrives, into registers; d1 the cycle after, from the copy of the last. Each decision
+    // register then loads, every cycle, d1's compare or d0's registered one, by the sign: a
+    // carry chain and one LUT, and the state machine reads flip-flops (with the sign select in
+    // `step`, the state logic ran through the compares' corner of the die and back: 8.4 ns in
+    // the whole teapot core). Every compare is `lt_chain`: the sign of a difference one bit
+    // wider, the chain's last sum bit, no carry-out and no LUT after the chain.
+    assert!(pu.latency >= 4, "the decision limits need 3 cycles after node");
     let negative = b.reg("negative", Ty::BIT, None);
-    let d0_r = b.reg("d0_r", dist, None);
-    // The arriving d1 from the plane unit's copy for the last distance of a group (the fan-out
-    // of plane_t split between the box and d0 on one side and the decision on the other).
-    let d1 = pu.t_last;
-    let near_end = negative.select(d1, d0_r).name("near_end");
-    let far_start = negative.select(d0_r, d1).name("far_start");
+    let (d0, d1) = (pu.t_first, pu.t_last);
+    let near_end = negative.select(d1, d0).name("near_end");
+    let far_start = negative.select(d0, d1).name("far_start");
     let tmax_p1 = b.delay("tmax_p1", (tmax + 1).name("tmax_plus_1"));
     let tmin_m1 = b.delay("tmin_m1", (tmin - 1).name("tmin_minus_1"));
-    let tmin_le_tmax = b.delay("tmin_le_tmax", tmin.lt(tmax_p1).name("tmin_le_tmax_c"));
-    // A compare of each candidate, selected by the sign: (on the arriving distance, on d0).
-    fn pick_by<'b>(negative: S<'b>, name: &str, on_plane: S<'b>, on_d0: S<'b>) -> S<'b> {
-        negative.select(on_plane.name(&format!("{name}_plane")), on_d0.name(&format!("{name}_d0"))).name(name)
-    }
-    let by_sign = |name: &str, on_plane, on_d0| pick_by(negative, name, on_plane, on_d0);
-    let reg = |name: &str, x: S| b.delay(name, x.name(&format!("{name}_c")));
-    let near_lt_tmax = reg("near_lt_tmax", by_sign("near_lt", d1.lt(tmax), d0_r.lt(tmax)));
-    let far_gt_tmin = reg("far_gt_tmin", by_sign("far_gt", tmin.lt(d0_r), tmin.lt(d1)));
-    let tmin_le_near = by_sign("tmin_le_near", tmin_m1.lt(d1), tmin_m1.lt(d0_r));
-    let far_le_tmax = by_sign("far_le_tmax", d0_r.lt(tmax_p1), d1.lt(tmax_p1));
-    let go_near = reg("go_near", tmin_le_near & tmin_le_tmax);
-    let go_far = reg("go_far", far_le_tmax & tmin_le_tmax);
+    let tmin_le_tmax = b.delay("tmin_le_tmax", lt_chain(tmin, tmax_p1).name("tmin_le_tmax_c"));
+    let never_below = tmax.k(-(1i128 << (n + 2)));
+    let never_above = tmax.k((1i128 << (n + 2)) - 1);
+    let limit = |name: &str, if_negative: S, if_positive: S, never: S| {
+        let l = tmin_le_tmax.select(negative.select(if_negative, if_positive), never);
+        b.delay(name, l.name(&format!("{name}_c")))
+    };
+    // x < hi: near_end < tmax (near_lt_tmax) or far_start < tmax + 1 (far_le_tmax); lo < x:
+    // tmin − 1 < near_end (tmin_le_near) or tmin < far_start (far_gt_tmin).
+    let d0_hi = limit("d0_hi", tmax_p1, tmax, never_below);
+    let d0_lo = limit("d0_lo", tmin, tmin_m1, never_above);
+    let d1_hi = limit("d1_hi", tmax, tmax_p1, never_below);
+    let d1_lo = limit("d1_lo", tmin_m1, tmin, never_above);
+    let d0_below = b.delay("d0_below", lt_chain(d0, d0_hi).name("d0_below_c"));
+    let d0_above = b.delay("d0_above", lt_chain(d0_lo, d0).name("d0_above_c"));
+    let d1_below = lt_chain(d1, d1_hi).name("d1_below");
+    let d1_above = lt_chain(d1_lo, d1).name("d1_above");
+    // Registered the cycle d1 arrives, read in `step`: (negative: from d1, positive: from d0).
+    let reg = |name: &str, if_negative: S, if_positive: S| {
+        b.delay(name, negative.select(if_negative, if_positive).name(&format!("{name}_c")))
+    };
+    let near_lt_tmax = reg("near_lt_tmax", d1_below, d0_below);
+    let far_gt_tmin = reg("far_gt_tmin", d0_above, d1_above);
+    let go_near = reg("go_near", d1_above, d0_above);
+    let go_far = reg("go_far", d0_below, d1_below);
     let near_end_r = b.reg("near_end_r", dist, None);
     let far_start_r = b.reg("far_start_r", dist, None);
     let far_r = b.reg("far_r", Ty::u(node_bits), None);
@@ -265,7 +285,11 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let stack_bits = rom_addr_bits(p.stack_depth as usize);
     let stack = b.ram("stack", node_bits + 2 * dist.width, vec![0; p.stack_depth as usize]);
     let entry = b.cat(&[far_r, far_min.unsigned(), tmax.unsigned()]).name("push_entry");
-    let top = b.read("stack_top", stack, (sp - 1).resize(stack_bits));
+    // The read address sp − 1 in a register of its own, set wherever sp is (to the new sp − 1):
+    // an adder between sp and the LUT RAM's read address, spread over the die, made the
+    // whole Cornell core's critical path (7.3 ns, 5.4 ns of it routing).
+    let top_addr = b.reg("stack_top_addr", Ty::u(stack_bits), Some((1i128 << stack_bits) - 1));
+    let top = b.read("stack_top", stack, top_addr);
     let top_tmax = top.slice(0, dist.width).signed().name("top_tmax");
     let top_tmin = top.slice(dist.width, dist.width).signed().name("top_tmin");
     let top_node = top.slice(2 * dist.width, node_bits).name("top_node");
@@ -339,7 +363,6 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         // ready when `step` enters it, so only a far-only step pays a `fetch`.
         s.set(node, near);
         s.set(far_r, far);
-        s.when(d0_arrives, |s| s.set(d0_r, plane_t));
         s.when(d1_arrives, |s| {
             // The compares are registered every cycle: in `step` they hold this cycle's.
             s.set(near_end_r, near_end);
@@ -351,6 +374,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         s.when(go_near & go_far, |s| {
             s.write(stack, sp.resize(stack_bits), entry);
             s.set(sp, sp + 1);
+            s.set(top_addr, sp.resize(stack_bits));
         });
         s.when(go_near, |s| {
             s.set(tmax, near_max);
@@ -381,6 +405,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     fsm.state(Pop, |s| {
         s.when(sp_empty, |s| s.goto(Done)).otherwise(|s| {
             s.set(sp, sp - 1);
+            s.set(top_addr, (sp - 2).resize(stack_bits));
             s.set(tmin, top_tmin);
             s.set(tmax, top_tmax);
             s.set(node, top_node);

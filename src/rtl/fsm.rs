@@ -251,7 +251,11 @@ impl<'b, St: States> Fsm<'b, St> {
                 // encoding's spare values) returns to the initial state, so an upset cannot
                 // lock the machine.
                 _ if is_state => b.case(self.state, &arms, self.codes[self.init.code() as usize]),
-                _ => b.case(self.state, &arms, reg),
+                // Set in several states: selected by their flags (one at most is 1), not by a
+                // case on the binary state register, whose bits then fed every such register's
+                // enable from one place (the whole Cornell core: the state register → two LUTs
+                // → `node`'s enable, 7.0 ns, 5.8 of it routing).
+                _ => arms.iter().rev().fold(reg, |acc, &(st, v)| is(st).select(v, acc)),
             };
             let next = next.name(&format!("{}_next", b.name_of(reg.sig)));
             b.next(reg, next);
