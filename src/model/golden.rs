@@ -35,7 +35,10 @@ pub struct Hit {
 /// Per-ray traversal figures (what the hardware FSM would count).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalStats {
+    /// Nodes visited (inner steps and leaves), not counting culled entries.
     pub nodes: u32,
+    /// Node entries skipped by the visitor's `prune` (the early-out walk's culls).
+    pub culled: u32,
     pub tri_tests: u32,
     pub max_stack: u32,
 }
@@ -163,6 +166,7 @@ impl Golden {
         let nodes = &scene.bih.nodes;
         loop {
             let mut go_pop = visitor.prune(tmin);
+            stats.culled += go_pop as u32;
             if !go_pop {
                 stats.nodes += 1;
                 visitor.node(node);
@@ -222,6 +226,16 @@ impl Golden {
         let mut c = Closest::new(self, scene, ray);
         let stats = self.walk(scene, ray, &mut c);
         (c.best, stats)
+    }
+
+    /// The early-out walk the hardware makes (docs/ARITHMETIC.md §6): `walk` in the same order,
+    /// with every node entry (descent or pop) skipped when lower_t(its tmin) > the best t of
+    /// every triangle tested before it. The same answer as `trace`; its node, cull and
+    /// triangle counts are the hardware's.
+    pub fn trace_culled(&self, scene: &Scene, ray: &GridRay) -> (Option<Hit>, TraversalStats) {
+        let mut c = Culled(Closest::new(self, scene, ray));
+        let stats = self.walk(scene, ray, &mut c);
+        (c.0.best, stats)
     }
 
     /// The hit point rounded to the grid: h_k = O_k + round(t·ω_k / 2^F) (seed 001 §2.1.5).
@@ -287,6 +301,25 @@ impl Visitor for Closest<'_> {
                 self.best = Some(Hit { tri: i, t: h.t, u: h.u, v: h.v });
             }
         }
+    }
+}
+
+/// The visitor of `trace_culled`: `Closest`, skipping every node entered beyond
+/// lower_t⁻¹(best t) — no accepted hit below it can be nearer or equal (lower_t is monotone,
+/// tmin only grows down the tree).
+pub struct Culled<'a>(pub Closest<'a>);
+
+impl Visitor for Culled<'_> {
+    #[inline]
+    fn triangle(&mut self, tri: u32, leaf_tmin: i64) {
+        self.0.triangle(tri, leaf_tmin)
+    }
+    #[inline]
+    fn prune(&self, tmin: i64) -> bool {
+        self.0.best.is_some_and(|b| lower_t(tmin) > b.t)
+    }
+    fn node(&mut self, node: u32) {
+        self.0.node(node)
     }
 }
 

@@ -15,7 +15,7 @@ mod quantize8;
 pub(crate) use packet::LANES;
 pub(crate) use quantize8::quantize_ray8;
 
-use crate::model::golden::{Closest, Golden, GridRay, Hit, TraversalStats, TriHit, Visitor, lower_t};
+use crate::model::golden::{Golden, GridRay, Hit, TraversalStats, TriHit, lower_t};
 use crate::params::Params;
 use crate::scene::Scene;
 use crate::scene::accel::AccelTri;
@@ -44,9 +44,7 @@ impl<'a> FastGolden<'a> {
         if let (Some(fs), Some(nr)) = (&self.layout, NarrowRay::new(&self.golden, ray)) {
             return trace_narrow(&self.golden, fs, &nr);
         }
-        let mut c = EarlyOut(Closest::new(&self.golden, self.scene, ray));
-        let stats = self.golden.walk(self.scene, ray, &mut c);
-        (c.0.best, stats)
+        self.golden.trace_culled(self.scene, ray)
     }
 
     /// Whether the i64 path applies to the scene (a ray must also fit `NarrowRay`).
@@ -72,20 +70,6 @@ impl<'a> FastGolden<'a> {
             Some(fs) => packet::trace(&self.golden, fs, rays),
             None => unreachable!("packets implies a layout"),
         }
-    }
-}
-
-/// `trace`'s visitor, skipping every node entered beyond lower_t⁻¹(best t).
-struct EarlyOut<'a>(Closest<'a>);
-
-impl Visitor for EarlyOut<'_> {
-    #[inline]
-    fn triangle(&mut self, tri: u32, leaf_tmin: i64) {
-        self.0.triangle(tri, leaf_tmin)
-    }
-    #[inline]
-    fn prune(&self, tmin: i64) -> bool {
-        self.0.best.is_some_and(|b| lower_t(tmin) > b.t)
     }
 }
 
