@@ -199,6 +199,7 @@ pub struct GenConfig {
     pub ray_id_width: u32,
     pub bram_kbits: u64,
     pub div_bits: u32,
+    pub threads: super::ThreadArgs,
 }
 
 impl GenArgs {
@@ -228,6 +229,7 @@ impl GenArgs {
             ray_id_width: self.ray_id_width,
             bram_kbits: self.bram_kbits,
             div_bits: self.div_bits,
+            threads: self.threads,
         })
     }
 }
@@ -327,6 +329,7 @@ pub struct SimConfig {
     pub raygen: bool,
     pub div_bits: u32,
     pub target_mhz: u32,
+    pub threads: super::ThreadArgs,
     pub png: Option<PathBuf>,
     pub ids: Option<PathBuf>,
     /// The HDL build folder (None for the Rust simulator).
@@ -361,6 +364,7 @@ impl SimArgs {
             raygen: self.raygen,
             div_bits: self.div_bits,
             target_mhz: self.target_mhz,
+            threads: self.threads,
             png: self.png.clone(),
             ids: self.ids.clone(),
             build: sim.build_dir(&self.build, "target/fxrt-sim"),

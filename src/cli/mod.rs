@@ -192,6 +192,8 @@ pub struct SimArgs {
     /// The clock the cores are pipelined for, MHz (50..=400): it sets their latencies.
     #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
     /// Use the on-chip pinhole ray generator (camera inside the scene box) instead of host rays.
     #[arg(long)]
     pub raygen: bool,
@@ -260,6 +262,8 @@ pub struct GenArgs {
     /// The clock the cores are pipelined for, MHz (50..=400); also the ISE UCF's constraint.
     #[arg(long = "target-mhz", alias = "clock-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
     /// Width of the ray id port (rays in flight are numbered modulo 2^width).
     #[arg(long = "ray-id-width", default_value_t = 20)]
     pub ray_id_width: u32,
@@ -279,6 +283,17 @@ pub struct GenArgs {
     pub params: ParamArgs,
 }
 
+/// The core's ray slots and traversal units (docs/CORE.md): how many rays it holds at once.
+#[derive(Args, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ThreadArgs {
+    /// Ray slots per traversal unit: the rays each unit holds at once (1..=64).
+    #[arg(long, default_value_t = crate::cores::top::DEFAULT_SLOTS)]
+    pub slots: u32,
+    /// Traversal units feeding the one intersection pipeline (1..=4).
+    #[arg(long, default_value_t = crate::cores::top::DEFAULT_UNITS)]
+    pub units: u32,
+}
+
 /// Choices of the hardware that do not change the arithmetic.
 #[derive(Args, Debug, Clone, PartialEq, Eq)]
 pub struct HwArgs {
@@ -292,6 +307,8 @@ pub struct HwArgs {
     /// constrains nextpnr to it.
     #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -118,7 +118,15 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params)?;
     match *c {
         BenchConfig::Sim { vectors, ghdl_vectors } => {
-            let hw = HwArgs { tag_width: 32, div_bits: 1, target_mhz: crate::cores::clock::DEFAULT_TARGET_MHZ };
+            let hw = HwArgs {
+                tag_width: 32,
+                div_bits: 1,
+                target_mhz: crate::cores::clock::DEFAULT_TARGET_MHZ,
+                threads: super::ThreadArgs {
+                    slots: crate::cores::top::DEFAULT_SLOTS,
+                    units: crate::cores::top::DEFAULT_UNITS,
+                },
+            };
             let p = intersect_params(&params, &scene, &hw)?;
             let vectors = vectors::generate(&scene, vectors, 1);
             let speeds = check::bench_sims(&p, &vectors, ghdl_vectors, Path::new("target/fxrt-bench"))?;
@@ -227,7 +235,8 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
             ));
         }
     }
-    let p = crate::cores::top::CoreParams::new(&roms, c.ray_id_width, c.div_bits, c.target_mhz);
+    let t = c.threads;
+    let p = crate::cores::top::CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, clock_mhz: c.target_mhz as f64 };
@@ -275,7 +284,9 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let scene = Scene::load(&c.scene, &c.params)?;
     let p = intersect_params(&c.params, &scene, &c.hw)?;
     let roms = SceneRoms::of(&scene);
-    let core = crate::cores::top::CoreParams::new(&roms, 20, c.hw.div_bits, c.hw.target_mhz);
+    let t = c.hw.threads;
+    let core = crate::cores::top::CoreParams::with_slots(&roms, 20, c.hw.div_bits, c.hw.target_mhz, t.slots, t.units);
+    core.check()?;
     core.check()?;
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
@@ -328,7 +339,8 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let (w, h) = (cam.width, cam.height);
     let id_width = rom::addr_bits((w * h) as usize);
     let roms = SceneRoms::of(&scene);
-    let p = crate::cores::top::CoreParams::new(&roms, id_width, c.div_bits, c.target_mhz);
+    let t = c.threads;
+    let p = crate::cores::top::CoreParams::with_slots(&roms, id_width, c.div_bits, c.target_mhz, t.slots, t.units);
     p.check()?;
     let raygen = if c.raygen { Some(ray_generator(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {
@@ -344,7 +356,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         (Simulation::Rust, _, Some(g)) => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
             let m = crate::cores::top::core_with_raygen(&p, &roms, g);
-            let r = frame::collect_batched(&m, rays.len(), 0, &|n| bar.set_position(n));
+            let r = frame::collect_batched(&m, rays.len(), p.total_slots(), 0, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
         }
@@ -373,7 +385,11 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
         "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
         "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
-        "state_cycles": stats.named_state_cycles().into_iter().map(|(n, c)| (n.to_string(), serde_json::json!(c))).collect::<serde_json::Map<String, serde_json::Value>>(),
+        "rays_per_clock": (stats.rays_per_clock() * 1e5).round() / 1e5,
+        "triangle_tests_per_ray": (stats.triangle_tests_per_ray() * 100.0).round() / 100.0,
+        "node_steps_per_ray": (stats.node_steps_per_ray() * 100.0).round() / 100.0,
+        "slot_occupancy": (stats.slot_occupancy() * 10000.0).round() / 10000.0,
+        "slots": p.total_slots(), "units": p.units,
         "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
     });
     // Hardware speed: one ray per `cycles_per_ray` clocks (one ray in flight).

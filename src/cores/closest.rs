@@ -1,11 +1,21 @@
-//! The closest-hit unit: watches the intersection pipeline's output stream and keeps, for the
-//! ray in flight, the smallest (t, triangle number) among accepted hits — a hit is accepted
-//! only if t ≥ lower_t(leaf entry distance) (`golden::lower_t`). The traversal unit processes
-//! rays one after another and the pipeline keeps their order, so one accumulator suffices:
-//! when a ray's end token comes out, its result is emitted and the accumulator cleared.
+//! The closest-hit unit: watches the intersection pipeline's output stream and keeps, for every
+//! ray slot of the core, the smallest (t, triangle number) among accepted hits — a hit is
+//! accepted only if t ≥ lower_t(leaf entry distance) (`golden::lower_t`).
 //!
-//! The pipeline tag: bits [0, tri_bits) the triangle number, then n + 2 bits of leaf entry
-//! distance, then the end flag on top; an end token carries the ray id in the low bits.
+//! The leaf stream sends a leaf's triangles one after another (the arbiter switches between
+//! traversal units only between leaves), tagged with the ray's slot and flags for a leaf's first
+//! and last triangle. So one accumulator keeps the best of the leaf in flight; after its last
+//! triangle it is **merged** into the slot's best hit (a RAM indexed by slot, with a valid bit
+//! per slot), and the merge is reported back to the slot's traversal unit with the slot's new
+//! best t + 8 (the cull limit) and its stack pointer, which unparks the ray. A slot has at most
+//! one leaf in flight, so a merge never races another one for the same slot.
+//!
+//! When a ray's walk is done (`done_*`, from the traversal units' done queues), its best hit is
+//! read and sent out with the ray id (results leave in the order rays finish), the slot's valid
+//! bit is cleared and the slot is reported free.
+//!
+//! The pipeline tag, from bit 0: triangle number, leaf entry distance (n + 2 bits), the ray's
+//! stack pointer, its slot, then the leaf's first and last flags.
 
 use super::clock::ClockTarget;
 use super::lt_chain;
@@ -16,15 +26,13 @@ use crate::rtl::{Module, Ty};
 pub struct TagLayout {
     pub tri_bits: u32,
     pub tmin_bits: u32,
-    pub id_bits: u32,
+    pub sp_bits: u32,
+    pub slot_bits: u32,
 }
 
 impl TagLayout {
-    pub fn payload(&self) -> u32 {
-        (self.tri_bits + self.tmin_bits).max(self.id_bits)
-    }
     pub fn width(&self) -> u32 {
-        self.payload() + 1
+        self.tri_bits + self.tmin_bits + self.sp_bits + self.slot_bits + 2
     }
 }
 
@@ -37,42 +45,57 @@ pub fn input_latency(target: ClockTarget) -> u32 {
     2 * target.splits(STAGED_FROM_MHZ) as u32
 }
 
-/// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) → res_valid, res_id, res_hit,
-/// res_tri, res_t, res_u, res_v (t, u, v and tri read 0 for a miss), `input_latency` + 1
-/// cycles after the end token.
-pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) -> Module {
+/// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) from the pipeline; `id_we`, `id_slot`,
+/// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot` →
+/// `merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` (best t + 8, signed n + 3 bits),
+/// `merge_sp`; `free_valid`, `free_slot`; res_valid, res_id, res_hit, res_tri, res_t, res_u, res_v
+/// (t, u, v and tri read 0 for a miss), registered, two cycles after `done_valid`.
+pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u32, target: ClockTarget) -> Module {
     let staged = input_latency(target) > 0;
     let suffix = if staged { "_r2" } else { "" };
-    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}{suffix}", tag.width()));
+    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}_s{slots}{suffix}", tag.width()));
     let valid = b.input("valid", Ty::BIT);
     let tag_in = b.input("tag", Ty::u(tag.width()));
     let hit = b.input("hit", Ty::BIT);
     let t = b.input("t", Ty::u(n + 1));
     let u = b.input("u", Ty::u(m_bits));
     let v = b.input("v", Ty::u(m_bits));
-    let end = tag_in.bit(tag.payload()).name("end");
-    let tri = tag_in.slice(0, tag.tri_bits).name("tri");
-    let tmin = tag_in.slice(tag.tri_bits, tag.tmin_bits).name("tmin");
-    let id = tag_in.slice(0, tag.id_bits).name("id");
+    let slot_ty = Ty::u(tag.slot_bits);
+    let id_we = b.input("id_we", Ty::BIT);
+    let id_slot = b.input("id_slot", slot_ty);
+    let id_in = b.input("id", Ty::u(id_bits));
+    let done_valid = b.input("done_valid", Ty::BIT);
+    let done_slot = b.input("done_slot", slot_ty);
+    let mut at = 0;
+    let mut take = |w: u32| {
+        let s = tag_in.slice(at, w);
+        at += w;
+        s
+    };
+    let tri = take(tag.tri_bits).name("tri");
+    let tmin = take(tag.tmin_bits).name("tmin");
+    let sp = take(tag.sp_bits).name("sp");
+    let slot = take(tag.slot_bits).name("slot");
+    let first = take(1).name("first");
+    let last = take(1).name("last");
 
     // lower_t(tmin) = tmin − tmin/64 − 8, and t, both signed n + 3 bits. A hit is accepted
-    // when t ≥ lower_t, i.e. when t + 8 ≥ tmin − tmin/64: two subtractions side by side, then
-    // one comparison, rather than three carry chains in series.
+    // when t + 8 ≥ tmin − tmin/64: two subtractions side by side, then one comparison, rather
+    // than three carry chains in series.
     let dist = n + 3;
     let tmin_d = tmin.xsigned().resize(dist);
     let x = (tmin_d - (tmin_d >> 6)).name("tmin_less");
     let t8 = (t.xsigned().resize(dist) + 8).name("t_plus_8");
     // Staged: two register levels, (x, t + 8) and then the acceptance bit, so the
     // accumulator's compare starts from registers (a result arrives two cycles later;
-    // nothing else changes). The bits that do not depend on the best hit (a valid hit, not an
-    // end token, accepted) are ANDed into one `candidate` register on the way.
+    // nothing else changes).
     let reg = |name: &str, x, k: u32| if staged { b.delay_line(&format!("in_{name}"), x, k) } else { x };
     let (x, t8) = (reg("tmin_less", x, 1), reg("t_plus_8", t8, 1));
-    let (valid1, end1, hit1) = (reg("valid", valid, 1), reg("end", end, 1), reg("hit", hit, 1));
+    let (valid1, hit1) = (reg("valid", valid, 1), reg("hit", hit, 1));
     let accepted = (!lt_chain(t8, x)).name("accepted");
     // Held inverted, the accumulator's compare taking it as its top bit (below); staged, its
-    // register resets to 1 (no candidate), as the positive one started at 0.
-    let no_candidate = (!(valid1 & !end1 & hit1 & accepted)).name("no_candidate_c");
+    // register resets to 1 (no candidate).
+    let no_candidate = (!(valid1 & hit1 & accepted)).name("no_candidate_c");
     let no_candidate = if staged {
         let r = b.reg("in_no_candidate", Ty::BIT, Some(1));
         b.next(r, no_candidate);
@@ -80,44 +103,97 @@ pub fn closest_core(tag: TagLayout, n: u32, m_bits: u32, target: ClockTarget) ->
     } else {
         no_candidate
     };
-    let finish = reg("finish", (valid1 & end1).name("finish_c"), 1);
-    let (tri, id, t, u, v) = (reg("tri", tri, 2), reg("id", id, 2), reg("t", t, 2), reg("u", u, 2), reg("v", v, 2));
+    let (valid, first, last) = (reg("valid2", valid, 2), reg("first", first, 2), reg("last", last, 2));
+    let (tri, slot, sp) = (reg("tri", tri, 2), reg("slot", slot, 2), reg("sp", sp, 2));
+    let (t, u, v) = (reg("t", t, 2), reg("u", u, 2), reg("v", v, 2));
 
-    // The best accepted hit of the ray in flight. Closer means (t, tri) < (best_t, best_tri)
-    // in lexicographic order (equal t: the smaller triangle number wins), which is one
-    // unsigned compare of the concatenations: one carry chain in the accumulator's loop
-    // instead of a compare, an equality and a second compare side by side. The candidate bit
-    // and whether there is a best hit yet go in as two more bits on top, so the chain's last
-    // sum bit is `take` = candidate ∧ (no best hit ∨ closer) itself, the enable of the best-hit
-    // registers, with no LUT between (`lt_chain`): (¬candidate, 0, t, tri) < (0, no best,
-    // best_t, best_tri). `best_empty` is ¬best_valid in a register of its own.
-    let best_valid = b.reg("best_valid", Ty::BIT, Some(0));
-    let best_empty = b.reg("best_empty", Ty::BIT, Some(1));
-    let best_t = b.reg("best_t", t.ty(), None);
-    let best_tri = b.reg("best_tri", tri.ty(), None);
-    let best_u = b.reg("best_u", u.ty(), None);
-    let best_v = b.reg("best_v", v.ty(), None);
+    // The best accepted hit of the leaf in flight. Closer means (t, tri) < (best_t, best_tri)
+    // in lexicographic order (equal t: the smaller triangle number wins), one unsigned compare
+    // of the concatenations whose last sum bit is `take` (`lt_chain`): (¬candidate, 0, t, tri)
+    // < (0, empty, acc_t, acc_tri), where a leaf's first triangle sees an empty accumulator.
+    let acc_empty = b.reg("acc_empty", Ty::BIT, Some(1));
+    let acc_t = b.reg("acc_t", t.ty(), None);
+    let acc_tri = b.reg("acc_tri", tri.ty(), None);
+    let acc_u = b.reg("acc_u", u.ty(), None);
+    let acc_v = b.reg("acc_v", v.ty(), None);
     let zero = b.konst(Ty::BIT, 0);
-    let take = lt_chain(b.cat(&[no_candidate, zero, t, tri]), b.cat(&[zero, best_empty, best_t, best_tri])).name("take");
-    for (r, x) in [(best_t, t), (best_tri, tri), (best_u, u), (best_v, v)] {
+    let empty = (first | acc_empty).name("acc_empty_now");
+    let take = lt_chain(b.cat(&[no_candidate, zero, t, tri]), b.cat(&[zero, empty, acc_t, acc_tri])).name("take");
+    for (r, x) in [(acc_t, t), (acc_tri, tri), (acc_u, u), (acc_v, v)] {
         b.next_when(r, take, x);
     }
-    b.next(best_valid, finish.select(best_valid.k(0), take.select(best_valid.k(1), best_valid)));
-    b.next(best_empty, finish.select(best_empty.k(1), take.select(best_empty.k(0), best_empty)));
+    b.next(acc_empty, take.select(acc_empty.k(0), (valid & first).select(acc_empty.k(1), acc_empty)));
 
-    // The result registers, loaded by the end token; a miss reports zeros, so every output bit
-    // is defined.
+    // The slots' best hits: (t, tri) and (u, v) RAMs and a valid bit per slot.
+    let k = slots;
+    let tt_mem = b.ram("best_t_tri", t.width() + tri.width(), vec![0; k as usize]);
+    let uv_mem = b.ram("best_u_v", 2 * m_bits, vec![0; k as usize]);
+    let id_mem = b.ram("ray_ids", id_bits, vec![0; k as usize]);
+    b.ram_write(id_mem, id_we, id_slot, id_in);
+    let best_valid = b.reg("best_valid", Ty::u(k), Some(0));
+    let slot_bit = |s| b.case(s, &(0..k).map(|i| (i as u128, best_valid.bit(i))).collect::<Vec<_>>(), zero);
+
+    // The merge: fin (the cycle after a leaf's last triangle: the accumulator is final), M1
+    // (the leaf's best and the slot's, read at fin's address one clock before), M2 (the
+    // compare's result: write the slot's best, report the merge).
+    let fin = b.delay("fin", (valid & last).name("leaf_last"));
+    let fin_slot = b.delay("fin_slot", slot);
+    let fin_sp = b.delay("fin_sp", sp);
+    let st_tt = b.read("slot_t_tri", tt_mem, fin_slot);
+    let m1 = b.delay("m1", fin);
+    let m1_slot = b.delay("m1_slot", fin_slot);
+    let m1_sp = b.delay("m1_sp", fin_sp);
+    let m1_has = b.delay("m1_slot_has", slot_bit(fin_slot).name("fin_slot_has"));
+    let m1_empty = b.delay("m1_leaf_empty", acc_empty);
+    let m1_tt = b.delay("m1_t_tri", b.cat(&[acc_t, acc_tri]));
+    let m1_uv = b.delay("m1_u_v", b.cat(&[acc_u, acc_v]));
+    // The leaf's best replaces the slot's when (¬leaf hit, 0, leaf t, tri) < (0, ¬slot hit,
+    // slot t, tri): one chain again.
+    let better = lt_chain(b.cat(&[m1_empty, zero, m1_tt]), b.cat(&[zero, !m1_has, st_tt])).name("leaf_better");
+    let m2 = b.delay("m2", m1);
+    let m2_better = b.delay("m2_better", better);
+    let m2_hit = b.delay("m2_hit", (m1_has | !m1_empty).name("m1_hit"));
+    let m2_slot = b.delay("m2_slot", m1_slot);
+    let m2_sp = b.delay("m2_sp", m1_sp);
+    let m2_tt = b.delay("m2_t_tri", m1_tt);
+    let m2_uv = b.delay("m2_u_v", m1_uv);
+    let m2_slot_t = b.delay("m2_slot_t", st_tt.slice(tri.width(), t.width()));
+    let we = (m2 & m2_better).name("best_we");
+    b.ram_write(tt_mem, we, m2_slot, m2_tt);
+    b.ram_write(uv_mem, we, m2_slot, m2_uv);
+    let best_t = m2_better.select(m2_tt.slice(tri.width(), t.width()), m2_slot_t).name("merged_t");
+    let limit = (best_t.xsigned().resize(dist) + 8).name("merged_limit");
+    b.output("merge_valid", b.delay("merge_valid_r", m2));
+    b.output("merge_slot", b.delay("merge_slot_r", m2_slot));
+    b.output("merge_hit", b.delay("merge_hit_r", m2_hit));
+    b.output("merge_limit", b.delay("merge_limit_r", limit));
+    b.output("merge_sp", b.delay("merge_sp_r", m2_sp));
+
+    // A ray done: its best hit and id are read, then sent out; the slot is freed.
+    let d_tt = b.read("done_t_tri", tt_mem, done_slot);
+    let d_uv = b.read("done_u_v", uv_mem, done_slot);
+    let d_id = b.read("done_id", id_mem, done_slot);
+    let d1 = b.delay("d1", done_valid);
+    let d1_slot = b.delay("d1_slot", done_slot);
+    let d1_has = b.delay("d1_has", slot_bit(done_slot).name("done_slot_has"));
+    let none = b.konst(Ty::u(k), 0);
+    let set = we.select(super::onehot(m2_slot, k), none).name("best_set");
+    let clear = d1.select(super::onehot(d1_slot, k), none).name("best_clear");
+    b.next(best_valid, (best_valid & !clear) | set);
+    b.output("free_valid", b.delay("free_valid_r", d1));
+    b.output("free_slot", b.delay("free_slot_r", d1_slot));
+    let res = |name: &str, x, masked: bool| {
+        let x = if masked { d1_has.select(x, x.k(0)) } else { x };
+        b.output(&format!("res_{name}"), b.delay(&format!("res_{name}_r"), x.name(&format!("res_{name}_c"))));
+    };
     let res_valid = b.reg("res_valid_r", Ty::BIT, Some(0));
-    b.next(res_valid, finish);
+    b.next(res_valid, d1);
     b.output("res_valid", res_valid);
-    let res_hit = b.reg("res_hit_r", Ty::BIT, None);
-    b.next_when(res_hit, finish, best_valid);
-    b.output("res_hit", res_hit);
-    for (name, x) in [("id", id), ("tri", best_tri), ("t", best_t), ("u", best_u), ("v", best_v)] {
-        let masked = if name == "id" { x } else { best_valid.select(x, 0) };
-        let r = b.reg(&format!("res_{name}_r"), x.ty(), None);
-        b.next_when(r, finish, masked);
-        b.output(&format!("res_{name}"), r);
-    }
+    res("id", d_id, false);
+    res("hit", d1_has, false);
+    res("tri", d_tt.slice(0, tri.width()), true);
+    res("t", d_tt.slice(tri.width(), t.width()), true);
+    res("u", d_uv.slice(m_bits, m_bits), true);
+    res("v", d_uv.slice(0, m_bits), true);
     b.finish()
 }

@@ -6,6 +6,7 @@ pub mod clock;
 pub mod closest;
 pub mod cost;
 pub mod divider;
+pub mod fifo;
 pub mod intersect;
 pub mod mul;
 pub mod plane;
@@ -23,4 +24,36 @@ use crate::rtl::build::S;
 pub fn lt_chain<'b>(a: S<'b>, b: S<'b>) -> S<'b> {
     let w = a.width() + 1;
     (a.resize(w) - b.resize(w)).msb()
+}
+
+/// The `k`-bit one-hot decode of `x` (bit i set when x = i).
+pub fn onehot<'b>(x: S<'b>, k: u32) -> S<'b> {
+    let bits: Vec<S<'b>> = (0..k).rev().map(|i| x.eq(i as i128)).collect();
+    x.b.cat(&bits)
+}
+
+/// Whether any of `bits` is set, and the index of the lowest set one (`idx_bits` wide): a tree
+/// of log2(len) mux levels, not a priority chain.
+pub fn lowest_set<'b>(bits: &[S<'b>], idx_bits: u32) -> (S<'b>, S<'b>) {
+    let b = bits[0].b;
+    let zero = b.konst(crate::rtl::Ty::BIT, 0);
+    let mut level: Vec<(S<'b>, Option<S<'b>>)> = bits.iter().map(|&x| (x, None)).collect();
+    let len = bits.len().next_power_of_two().max(2);
+    level.resize(len, (zero, None));
+    while level.len() > 1 {
+        level = level
+            .chunks(2)
+            .map(|pair| {
+                let ((lo_any, lo_idx), (hi_any, hi_idx)) = (pair[0], pair[1]);
+                // The index below this level: the low half's when it has a set bit.
+                let idx = match (lo_idx, hi_idx) {
+                    (Some(l), Some(h)) => b.cat(&[!lo_any, lo_any.select(l, h)]),
+                    _ => !lo_any,
+                };
+                (lo_any | hi_any, Some(idx))
+            })
+            .collect();
+    }
+    let (any, idx) = level[0];
+    (any, idx.expect("two bits or more").resize(idx_bits))
 }

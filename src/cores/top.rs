@@ -1,25 +1,30 @@
-//! The whole ray tracing core for one scene: ray stream in, closest hits out.
+//! The whole ray tracing core for one scene: ray stream in, closest hits out (in the order
+//! rays finish, tagged with the ray id).
 //!
 //! ```text
-//! ray_valid/ready, id, o, ω, 1/ω ─► traversal ─► leaf ROM ─► triangle ROMs ─► intersection ─► closest hit ─► res_*
-//!                                  (FSM, node ROM, stack RAM)                 pipeline
+//! ray_valid/ready, id, o, ω, 1/ω ─► box exit ─► U traversal units (K ray slots each) ─► leaf queues
+//!      ┌──────────────────────────────────────────────── merge (unpark, cull limit) ◄─┐   │ arbiter
+//!      ▼                                                                              │   ▼
+//!  traversal units ── done queues ─► closest hit ─► res_*     leaf ROM ─► triangle ROMs ─► intersection pipeline
 //! ```
 //!
-//! The traversal emits one leaf entry per clock, two or three cycles after its `leaf` cycle
-//! (the leaf ROM); the triangle ROMs add two or three more (`brom.rs`: three for block RAM,
-//! whose fabric register follows the block's output register). The ray's origin and direction
-//! come from the traversal's and the top's ray registers, which hold still until the next ray
-//! is accepted — always after the ray's end token — through `ray_delay` more registers each:
-//! pop, done and idle put the accepting edge three cycles after the last `leaf` cycle, and the
-//! pipeline's input register takes that triangle's word leaf + triangle ROM cycles after it,
-//! when only the delayed copy still holds the old ray.
+//! A ray is accepted when the box-exit unit is free (one ray per 4 clocks: it issues the three
+//! exit distances of the scene box to a plane unit of its own) and the unit whose turn it is
+//! has a free slot; the ray's origin and reciprocal direction go into that unit's ray RAMs, its
+//! origin and direction into the core's ray RAMs (read for the intersection pipeline) and its
+//! id into the closest-hit unit's; the box exit follows through the unit's new-ray queue.
+//! The leaf stream takes whole leaves from the units' leaf queues in turn and sends one
+//! triangle per clock, tagged with the ray's slot, into the pipeline; the closest-hit unit keeps
+//! each slot's best hit and unparks the slot after each leaf (`closest.rs`).
 //! The triangle table is wider than a signal may be (5 + 3n + 6m bits), so it is split into
 //! ROMs of whole fields, ≤ 128 bits each, all read at the same address.
 
 use super::brom::brom;
 use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
+use super::plane::{PlaneIssue, plane_unit};
 use super::traverse::{TraverseParams, field, traverse_core, word_bits};
+use super::lt_chain;
 use crate::model::golden::GridRay;
 use crate::rtl::build::{Builder, S};
 use crate::rtl::width::MAX_WIDTH;
@@ -29,19 +34,43 @@ use crate::scene::rom::Field;
 use crate::scene::rom::rom_addr_bits;
 use std::rc::Rc;
 
+/// Ray slots per traversal unit and traversal units, by default (chosen by measurement:
+/// docs/CORE.md).
+pub const DEFAULT_SLOTS: u32 = 32;
+pub const DEFAULT_UNITS: u32 = 2;
+
 #[derive(Clone, Debug)]
 pub struct CoreParams {
     pub isect: IntersectParams,
     pub trav: TraverseParams,
     pub tag: TagLayout,
+    /// Traversal units feeding the one intersection pipeline.
+    pub units: u32,
     /// Clocks of a triangle ROM read (`brom::read_cycles`).
     pub tri_rom_cycles: u32,
 }
 
 impl CoreParams {
     pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32, target_mhz: u32) -> CoreParams {
-        let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz));
-        let tag = TagLayout { tri_bits: trav.tri_bits, tmin_bits: trav.tmin_width(), id_bits: id_width };
+        Self::with_slots(scene, id_width, div_bits, target_mhz, DEFAULT_SLOTS, DEFAULT_UNITS)
+    }
+
+    pub fn with_slots(
+        scene: &SceneRoms,
+        id_width: u32,
+        div_bits: u32,
+        target_mhz: u32,
+        slots: u32,
+        units: u32,
+    ) -> CoreParams {
+        let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
+        let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
+        let tag = TagLayout {
+            tri_bits: trav.tri_bits,
+            tmin_bits: trav.tmin_width(),
+            sp_bits: trav.sp_width(),
+            slot_bits: trav.slot_bits() + unit_bits,
+        };
         let p = &scene.params;
         let isect = IntersectParams {
             n: p.n,
@@ -52,15 +81,16 @@ impl CoreParams {
             div_bits,
             target_mhz,
         };
-        CoreParams { isect, trav, tag, tri_rom_cycles: super::brom::read_cycles(scene.tri.1.len()) }
+        CoreParams { isect, trav, tag, units, tri_rom_cycles: super::brom::read_cycles(scene.tri.1.len()) }
     }
-    /// Cycles the ray's origin and direction are delayed on their way into the pipeline: its
-    /// input register takes a ray's last triangle leaf_rom_cycles + tri_rom_cycles edges after
-    /// the triangle's `leaf` cycle, and the next ray is accepted 3 edges after it at the
-    /// earliest (pop, done, idle), so the ray registers may have changed that many cycles
-    /// before.
-    pub fn ray_delay(&self) -> u32 {
-        self.trav.leaf_rom_cycles + self.tri_rom_cycles - 3
+
+    /// Bits of a unit number within a global slot number (0 for one unit).
+    pub fn unit_bits(&self) -> u32 {
+        self.tag.slot_bits - self.trav.slot_bits()
+    }
+    /// Ray slots of the core.
+    pub fn total_slots(&self) -> u32 {
+        self.units << self.trav.slot_bits()
     }
 
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
@@ -75,22 +105,30 @@ impl CoreParams {
                 ),
             ));
         }
+        if !(1..=64).contains(&self.trav.slots) {
+            return Err(crate::error::Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
+        }
+        if !(1..=4).contains(&self.units) {
+            return Err(crate::error::Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
+        }
         Ok(())
     }
 
     /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM (each ROM rounded up
     /// to a power-of-two depth, as the printers emit it).
     pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
-        let stack =
-            (self.trav.n as u64 * 2 + 6 + 32) * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64;
+        let stack_word = self.trav.n as u64 * 2 + 6 + 32;
+        let stack = stack_word
+            * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64
+            * self.total_slots() as u64;
         let total = scene.rom_bits() + stack;
         if total > bram_kbits * 1024 {
             return Err(crate::error::Error::param(
                 "bram-kbits",
                 format!(
-                    "scene {} needs {} Kb of ROM and stack, more than the {bram_kbits} Kb of block RAM allowed \
-                     (the XC5VLX110T has 5328): use a smaller scene, a smaller --n/--m, or raise --bram-kbits \
-                     for a larger device",
+                    "scene {} needs {} Kb of ROM and stacks, more than the {bram_kbits} Kb of block RAM allowed \
+                     (the XC5VLX110T has 5328): use a smaller scene, a smaller --n/--m, fewer --slots/--units, \
+                     or raise --bram-kbits for a larger device",
                     scene.name,
                     total.div_ceil(1024)
                 ),
@@ -99,10 +137,10 @@ impl CoreParams {
         Ok(())
     }
 
-    /// Cycles from a leaf entry leaving the traversal FSM to its result in the closest-hit
-    /// unit's accumulator: leaf ROM, triangle ROMs, the pipeline, the unit's input stage.
+    /// Cycles from a leaf entry leaving its queue to its result in the closest-hit unit's
+    /// accumulator: leaf ROM, triangle ROMs, the pipeline, the unit's input stage.
     pub fn stream_latency(&self) -> u32 {
-        self.trav.leaf_rom_cycles
+        1 + self.trav.leaf_rom_cycles
             + self.tri_rom_cycles
             + self.isect.latency()
             + super::closest::input_latency(self.isect.target())
@@ -144,22 +182,170 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let b = Builder::new("fxrt_core");
     let ins: Vec<S> = core_inputs(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
     let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!("11 ray ports") };
-    let trav =
-        b.instance("u_traverse", &Rc::new(traverse_core(&p.trav, scene)), &[ray_valid, ray_id, ox, oy, oz, ix, iy, iz]);
-    let (ready, emit_end, emit_tri) = (trav.get("ray_ready"), trav.get("emit_end"), trav.get("emit_tri"));
+    let (n, units, sb, gb) = (p.isect.n, p.units, p.trav.slot_bits(), p.tag.slot_bits);
+    let ub = p.unit_bits();
+    let bit = Ty::BIT;
+    fn is_unit(slot: S<'_>, u: u32, sb: u32, ub: u32) -> S<'_> {
+        if ub == 0 { slot.k(0).resize(1).eq(0) } else { slot.slice(sb, ub).eq(u as i128) }
+    }
 
-    // The direction, latched when the traversal accepts the ray.
+    // Wires from the units (driven once they are instantiated).
+    let has_free: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_has_free"), bit)).collect();
+    let free_idx: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_free_slot"), Ty::u(sb))).collect();
+
+    // Acceptance: the box-exit unit takes a ray every 4 clocks (it issues three distances and
+    // its plane unit reads the ray one clock after the last issue), into the unit whose turn it
+    // is (`turn` moves on with every ray and every clock that unit is full).
+    let turn = b.reg("turn", Ty::u(ub.max(1)), Some(0));
+    let phase = b.reg("box_phase", Ty::u(2), Some(0));
+    let turn_free = if units == 1 { has_free[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, has_free[u as usize])).collect::<Vec<_>>(), b.konst(bit, 0)) };
+    let turn_slot = if units == 1 { free_idx[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, free_idx[u as usize])).collect::<Vec<_>>(), free_idx[0]) };
+    let ready = (phase.eq(0) & turn_free).name("ready_c");
     let accept = (ray_valid & ready).name("accept");
-    let w = [("wx_r", wx), ("wy_r", wy), ("wz_r", wz)].map(|(name, s)| {
-        let r = b.reg(name, s.ty(), None);
+    let gslot = if ub == 0 { turn_slot } else { b.cat(&[turn.resize(ub), turn_slot]) }.name("accept_slot");
+    let next_turn = (turn + 1).name("turn_plus_1");
+    let next_turn = if units.is_power_of_two() { next_turn } else { next_turn.eq(units as i128).select(turn.k(0), next_turn) };
+    b.next(turn, (accept | !turn_free).select(next_turn, turn));
+    b.next(phase, (accept | phase.ne(0)).select(phase + 1, phase));
+
+    // Box exit: the three exit distances of the scene box, one per clock, then their least.
+    let bo = [ox, oy, oz].map(|s| {
+        let r = b.reg(&format!("box_{}", b.name_of(s.sig)), s.ty(), None);
         b.next_when(r, accept, s);
         r
     });
+    let binv = [ix, iy, iz].map(|s| {
+        let r = b.reg(&format!("box_{}", b.name_of(s.sig)), s.ty(), None);
+        b.next_when(r, accept, s);
+        r
+    });
+    let box_slot = b.reg("box_slot", Ty::u(gb), None);
+    b.next_when(box_slot, accept, gslot);
+    let axis = (phase - 1).name("box_axis");
+    let hi = [0, 1, 2].map(|k| b.konst_named(&format!("box_hi_{k}"), Ty::u(n), p.trav.box_hi[k] as i128));
+    let neg = b.pick(axis, binv).msb().name("box_neg");
+    let issue = PlaneIssue {
+        valid: phase.ne(0).name("box_issue"),
+        last: phase.eq(3).name("box_issue_last"),
+        plane: neg.select(hi[0].k(0), b.pick(axis, hi)).name("box_plane"),
+        axis,
+    };
+    let pu = plane_unit(&b, n, p.trav.c, bo, binv, issue, p.trav.product);
+    let plane_t = pu.t;
+    let box_d1 = b.delay("box_d1", plane_t);
+    let box_d2 = b.delay("box_d2", box_d1);
+    let box_d3 = b.delay("box_d3", box_d2);
+    let box_lt1 = b.delay("box_lt1", lt_chain(plane_t, box_d1).name("box_lt1_c"));
+    let box_lt2 = b.delay("box_lt2", lt_chain(plane_t, box_d2).name("box_lt2_c"));
+    let box_lt1_d = b.delay("box_lt1_d", box_lt1);
+    let box_tmax = (box_lt1 & box_lt2).select(box_d1, box_lt1_d.select(box_d2, box_d3)).name("box_tmax");
+    let box_miss = (box_d1.msb() | box_d2.msb() | box_d3.msb()).name("box_miss");
+    let box_done = b.delay("box_done", (pu.valid & pu.last).name("box_last"));
+    let box_done_slot = b.delay_line("box_done_slot", box_slot, pu.latency + 1);
 
-    // Triangle ROMs at the emitted triangle number: block ROMs (`brom.rs`), the word two
-    // cycles later; the tag and valid wait the same two cycles.
+    // The traversal units.
+    let wire = |name: &str, ty: Ty| b.wire(name, ty);
+    let merge_valid = wire("merge_valid", bit);
+    let merge_slot = wire("merge_slot", Ty::u(gb));
+    let merge_hit = wire("merge_hit", bit);
+    let merge_limit = wire("merge_limit", p.trav.dist_ty());
+    let merge_sp = wire("merge_sp", Ty::u(p.trav.sp_width()));
+    let free_valid = wire("free_valid", bit);
+    let free_slot = wire("free_slot", Ty::u(gb));
+    let leaf_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_leaf_pop"), bit)).collect();
+    let done_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_done_pop"), bit)).collect();
+    let unit = Rc::new(traverse_core(&p.trav, scene));
+    let trav: Vec<_> = (0..units)
+        .map(|u| {
+            let mine = is_unit(gslot, u, sb, ub);
+            let we = (accept & mine).name(&format!("u{u}_alloc"));
+            let new_valid = (box_done & is_unit(box_done_slot, u, sb, ub)).name(&format!("u{u}_new"));
+            let mv = (merge_valid & is_unit(merge_slot, u, sb, ub)).name(&format!("u{u}_merge"));
+            let fv = (free_valid & is_unit(free_slot, u, sb, ub)).name(&format!("u{u}_free"));
+            let ins = [
+                we, turn_slot, ox, oy, oz, ix, iy, iz,
+                new_valid, box_done_slot.slice(0, sb), box_tmax, box_miss,
+                mv, merge_slot.slice(0, sb), merge_hit, merge_limit, merge_sp,
+                fv, free_slot.slice(0, sb), we, leaf_pop[u as usize], done_pop[u as usize],
+            ];
+            let t = b.instance(&format!("u_traverse_{u}"), &unit, &ins);
+            b.drive(has_free[u as usize], t.get("has_free"));
+            b.drive(free_idx[u as usize], t.get("free_slot_out"));
+            t
+        })
+        .collect();
+
+    // The core's ray RAMs (origin and direction, for the pipeline), by global slot.
+    let slots = p.total_slots() as usize;
+    let o_mem = b.ram("ray_o", 3 * n, vec![0; slots]);
+    b.ram_write(o_mem, accept, gslot, b.cat(&[oz, oy, ox]));
+    let w_mem = b.ram("ray_w", 3 * p.isect.m, vec![0; slots]);
+    b.ram_write(w_mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
+
+    // The leaf stream: the leaf in flight (slot, next entry, entries left, tmin, sp), and the
+    // next leaf taken, in turn, from a unit's queue when the last entry goes.
+    let tp = &p.trav;
+    let (leaf_l, leaf_words) = &scene.leaf;
+    let leaf_bits = rom_addr_bits(leaf_words.len());
+    let count_w = scene.node.0.field("count").width;
+    let cur_valid = b.reg("leaf_active", bit, Some(0));
+    let cur_slot = b.reg("leaf_slot", Ty::u(gb), None);
+    let cur_ptr = b.reg("leaf_ptr", Ty::u(leaf_bits), None);
+    let cur_left = b.reg("leaf_left", Ty::u(count_w), None);
+    let cur_tmin = b.reg("leaf_tmin", Ty::u(tp.tmin_width()), None);
+    let cur_sp = b.reg("leaf_sp", Ty::u(tp.sp_width()), None);
+    let cur_first = b.reg("leaf_first_entry", bit, None);
+    let last_entry = (cur_valid & cur_left.eq(1)).name("leaf_last_entry");
+    let can_take = (!cur_valid | last_entry).name("leaf_can_take");
+    let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
+    // Rotating priority: the unit after the last one served first.
+    let avail: Vec<S> = trav.iter().map(|t| t.get("leaf_valid")).collect();
+    let mut pick: Option<(S, S)> = None; // (any, unit)
+    for j in (0..units).rev() {
+        // Candidate j places after leaf_turn: unit (leaf_turn + 1 + j) mod units.
+        let cand = |u: u32| (u + 1 + j) % units;
+        let sel_any = if units == 1 { avail[0] } else { b.case(leaf_turn, &(0..units).map(|t| (t as u128, avail[cand(t) as usize])).collect::<Vec<_>>(), b.konst(bit, 0)) };
+        let sel_u = if units == 1 { b.konst(Ty::u(1), 0) } else { b.case(leaf_turn, &(0..units).map(|t| (t as u128, b.konst(Ty::u(ub), cand(t) as i128))).collect::<Vec<_>>(), b.konst(Ty::u(ub), 0)) };
+        pick = Some(match pick {
+            None => (sel_any, sel_u),
+            Some((any, u)) => (sel_any | any, sel_any.select(sel_u, u)),
+        });
+    }
+    let (any_leaf, pick_u) = pick.expect("one unit or more");
+    let take = (can_take & any_leaf).name("leaf_take");
+    for u in 0..units {
+        let me = if units == 1 { take } else { (take & pick_u.eq(u as i128)).name(&format!("u{u}_leaf_take")) };
+        b.drive(leaf_pop[u as usize], me);
+    }
+    if units > 1 {
+        b.next_when(leaf_turn, take, pick_u);
+    } else {
+        b.next(leaf_turn, leaf_turn);
+    }
+    let sel = |port: &str| {
+        let v: Vec<S> = trav.iter().map(|t| t.get(port)).collect();
+        if units == 1 { v[0] } else { b.case(pick_u, &(0..units).map(|u| (u as u128, v[u as usize])).collect::<Vec<_>>(), v[0]) }
+    };
+    let next_slot = if ub == 0 { sel("leaf_slot") } else { b.cat(&[pick_u, sel("leaf_slot")]) };
+    b.next(cur_valid, take | (cur_valid & !last_entry));
+    b.next(cur_slot, take.select(next_slot, cur_slot));
+    b.next(cur_ptr, take.select(sel("leaf_first"), cur_ptr + 1));
+    b.next(cur_left, take.select(sel("leaf_count"), cur_left - 1));
+    b.next(cur_tmin, take.select(sel("leaf_tmin"), cur_tmin));
+    b.next(cur_sp, take.select(sel("leaf_sp"), cur_sp));
+    b.next(cur_first, take);
+
+    // Emission: the leaf ROM at the entry, then the triangle ROMs at its word; the tag and the
+    // ray (read from the ray RAMs at the slot) wait alongside.
+    let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
+    let tri_num = brom(&b, "u_leaf_rom", "leaf", leaf_l.width, leaf_image, cur_ptr, tp.leaf_rom_cycles);
+    let lrc = tp.leaf_rom_cycles;
+    let tag = b.cat(&[last_entry, cur_first, cur_slot, cur_sp, cur_tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
+    let tag = b.delay_line("emit_tag", tag, lrc);
+    let tag = b.cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)]).name("emit_tag_tri");
+    let emit_valid = b.delay_line("emit_valid", cur_valid, lrc);
     let (tri_l, tri_words) = &scene.tri;
-    let addr = emit_tri.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
+    let addr = tri_num.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
     let mut tri_fields: Vec<S> = Vec::new();
     for (k, group) in tri_rom_groups(&tri_l.fields).iter().enumerate() {
         let lsb = group[0].lsb;
@@ -168,34 +354,66 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
         let word = brom(&b, &format!("u_tri_rom_{k}"), &format!("tri_{k}"), width, image, addr, p.tri_rom_cycles);
         tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
     }
-    // The tag: the end flag on top of the ray id (end token) or the leaf tmin and triangle.
-    let payload = p.tag.payload();
-    let tri_tmin = b.cat(&[trav.get("emit_tmin"), emit_tri.resize(p.tag.tri_bits)]).resize(payload);
-    let tag = b.cat(&[emit_end, emit_end.select(trav.get("emit_id").resize(payload), tri_tmin)]).name("tag");
-    let valid_d = b.delay_line("pipe_valid", trav.get("emit_valid"), p.tri_rom_cycles);
-    let tag_d = b.delay_line("pipe_tag", tag, p.tri_rom_cycles);
-    // The ray `ray_delay` cycles late, in step with the triangle words: the pipeline's input
-    // register takes the ray's last triangle after the next ray's accept (see the module
-    // comment), so it must still see the old origin and direction then.
-    let cur_o =
-        ["cur_ox", "cur_oy", "cur_oz"].map(|name| b.delay_line(&format!("pipe_{name}"), trav.get(name), p.ray_delay()));
-    let w = [0, 1, 2].map(|k| b.delay_line(&format!("pipe_w{}", ["x", "y", "z"][k]), w[k], p.ray_delay()));
-
+    let trc = p.tri_rom_cycles;
+    let valid_d = b.delay_line("pipe_valid", emit_valid, trc);
+    let tag_d = b.delay_line("pipe_tag", tag, trc);
+    // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
+    let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
+    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", o_mem, emit_slot), trc - 1);
+    let w_word = b.delay_line("pipe_w", b.read("ray_w_q", w_mem, emit_slot), trc - 1);
+    let m = p.isect.m;
     let mut pipe_in = vec![valid_d, tag_d];
-    pipe_in.extend(cur_o);
-    pipe_in.extend(w);
+    pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
+    pipe_in.extend((0..3).map(|a| w_word.slice(a * m, m).signed()));
     pipe_in.extend(tri_fields);
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
-    let closest = Rc::new(closest_core(p.tag, p.isect.n, p.isect.m, p.isect.target()));
-    let res = b.instance("u_closest", &closest, r.all());
+
+    // Rays done: taken from the units' done queues, lowest unit first (a ray finishes once).
+    let dv: Vec<S> = trav.iter().map(|t| t.get("done_valid")).collect();
+    let mut done_any = dv[0];
+    let mut done_slot = if ub == 0 { trav[0].get("done_slot") } else { b.cat(&[b.konst(Ty::u(ub), 0), trav[0].get("done_slot")]) };
+    b.drive(done_pop[0], dv[0]);
+    for u in 1..units as usize {
+        let mine = (dv[u] & !done_any).name(&format!("u{u}_done_take"));
+        b.drive(done_pop[u], mine);
+        done_slot = done_any.select(done_slot, b.cat(&[b.konst(Ty::u(ub), u as i128), trav[u].get("done_slot")]));
+        done_any = done_any | dv[u];
+    }
+    let closest = Rc::new(closest_core(p.tag, p.total_slots(), p.trav.id_width, n, m, p.isect.target()));
+    let mut cin: Vec<S> = r.all().to_vec();
+    cin.extend([accept, gslot, ray_id, done_any, done_slot]);
+    let res = b.instance("u_closest", &closest, &cin);
+    b.drive(merge_valid, res.get("merge_valid"));
+    b.drive(merge_slot, res.get("merge_slot"));
+    b.drive(merge_hit, res.get("merge_hit"));
+    b.drive(merge_limit, res.get("merge_limit"));
+    b.drive(merge_sp, res.get("merge_sp"));
+    b.drive(free_valid, res.get("free_valid"));
+    b.drive(free_slot, res.get("free_slot"));
+
     b.output("ray_ready", ready);
-    for (name, _) in &closest.outputs {
+    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"] {
         b.output(name, res.get(name));
     }
-    // Observation ports for `fxrt sim`: a triangle entering the pipeline, the stack depth.
-    b.output("busy", (valid_d & !tag_d.bit(payload)).name("pipe_busy"));
-    b.output("stack_depth", trav.get("stack_depth"));
-    b.output("fsm_state", trav.get("fsm_state"));
+    // Observation ports for `fxrt sim`: a triangle entering the pipeline, the deepest stack in
+    // the units' N stages, node visits and culls this clock, slots holding a ray.
+    b.output("busy", valid_d);
+    let sum = |port: &str, w: u32| {
+        trav.iter().map(|t| t.get(port).resize(w)).reduce(|a, c| a + c).expect("one unit or more")
+    };
+    let depth = trav.iter().map(|t| t.get("depth")).reduce(|a, c| a.max(c)).expect("one unit or more");
+    b.output("stack_depth", depth);
+    b.output("visits", sum("visit", 3).name("visits_c"));
+    b.output("culls", sum("cull", 3).name("culls_c"));
+    b.output("occupied", sum("occupied", gb + 1).name("occupied_c"));
+    // The walk of every slot (for the visit-order check): the slot a ray was accepted into, and
+    // each unit's node visits.
+    b.output("accept_slot", gslot);
+    for (u, t) in trav.iter().enumerate() {
+        b.output(&format!("visit{u}"), t.get("visit"));
+        b.output(&format!("visit{u}_slot"), t.get("visit_slot"));
+        b.output(&format!("visit{u}_node"), t.get("visit_node"));
+    }
     b.finish()
 }
 
@@ -232,18 +450,19 @@ mod tests {
         let roms = SceneRoms::of(&scene);
         let p = CoreParams::new(&roms, 16, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
-        let (results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
+        let (mut results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
+        results.sort_by_key(|r| r.0);
         assert_eq!(mismatches(&scene, &rays, &results), 0);
         assert!(results.iter().filter(|r| r.1.is_some()).count() > 20);
         assert!(stats.busy_cycles > 0 && stats.max_stack_depth > 0, "{stats:?}");
         // The batched engine (ray source in the netlist) and the cycle engine (ports driven
         // like a testbench) agree on every result and every count.
-        let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &|_| {});
+        let (mut cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &|_| {});
+        cycle_results.sort_by_key(|r| r.0);
         assert_eq!(cycle_results, results);
         assert_eq!(
-            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth, &cycle_stats.state_cycles),
-            (stats.cycles, stats.busy_cycles, stats.max_stack_depth, &stats.state_cycles)
+            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth, cycle_stats.visits),
+            (stats.cycles, stats.busy_cycles, stats.max_stack_depth, stats.visits)
         );
-        assert_eq!(stats.state_cycles.iter().sum::<u64>(), stats.cycles);
     }
 }

@@ -111,8 +111,8 @@ pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &
         "intersect" => (intersect::intersect_core(isect), Some(isect.latency())),
         "traverse" => (traverse::traverse_core(&core.trav, roms), None),
         "closest" => (
-            closest::closest_core(core.tag, isect.n, isect.m, isect.target()),
-            Some(1 + closest::input_latency(isect.target())),
+            closest::closest_core(core.tag, core.total_slots(), core.trav.id_width, isect.n, isect.m, isect.target()),
+            None,
         ),
         _ => (top::core_module(core, roms), None),
     }

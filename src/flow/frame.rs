@@ -3,7 +3,6 @@
 //! order and are compared with the golden model's (`render::fast`), pixel by pixel.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
-use crate::cores::traverse::TravState;
 use crate::error::{Error, Result};
 use crate::flow::simulators::{Bench, Simulator};
 use crate::flow::testbench::{Stream, parse_results, stream_files};
@@ -12,7 +11,6 @@ use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
 use crate::render::fast::FastGolden;
 use crate::rtl::batch::BatchSim;
-use crate::rtl::fsm::States;
 use crate::rtl::sim::Sim;
 use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
@@ -52,36 +50,55 @@ pub struct CoreStats {
     /// Cycles in which a triangle entered the intersection pipeline.
     pub busy_cycles: u64,
     pub max_stack_depth: u32,
-    /// Cycles the traversal FSM spent in each state, by encoding (`TravState`); the Rust
-    /// simulators count them, the HDL testbenches do not.
-    pub state_cycles: Vec<u64>,
+    /// Node visits and culled node entries of every traversal unit (the Rust simulators count
+    /// them, the HDL testbenches do not).
+    pub visits: u64,
+    pub culls: u64,
+    /// Sum over cycles of the slots holding a ray, and the core's slot count.
+    pub occupied_sum: u64,
+    pub slots: u64,
 }
 
 impl CoreStats {
-    fn new(rays: u64) -> CoreStats {
-        CoreStats { rays, state_cycles: vec![0; TravState::ALL.len()], ..Default::default() }
+    fn new(rays: u64, slots: u64) -> CoreStats {
+        CoreStats { rays, slots, ..Default::default() }
     }
 
-    /// One cycle in the state with encoding `code` (the `fsm_state` port).
-    fn count_state(&mut self, code: i128) {
-        // A code that is no state cannot occur (the machine leaves it at once); not counted.
-        if let Some(c) = usize::try_from(code).ok().and_then(|k| self.state_cycles.get_mut(k)) {
-            *c += 1;
-        }
-    }
-
-    /// Cycles per state, by the state's name.
-    pub fn named_state_cycles(&self) -> Vec<(&'static str, u64)> {
-        TravState::ALL.iter().map(|s| s.name()).zip(self.state_cycles.iter().copied()).collect()
+    /// One cycle's observation ports: triangle in the pipeline, stack depth, visits, culls,
+    /// occupied slots.
+    fn count(&mut self, row: &[i128]) {
+        self.busy_cycles += row[0] as u64;
+        self.max_stack_depth = self.max_stack_depth.max(row[1] as u32);
+        self.visits += row[2] as u64;
+        self.culls += row[3] as u64;
+        self.occupied_sum += row[4] as u64;
     }
 
     pub fn cycles_per_ray(&self) -> f64 {
         self.cycles as f64 / self.rays.max(1) as f64
     }
+    pub fn rays_per_clock(&self) -> f64 {
+        self.rays as f64 / self.cycles.max(1) as f64
+    }
     pub fn fill(&self) -> f64 {
         self.busy_cycles as f64 / self.cycles.max(1) as f64
     }
+    /// Triangles that entered the pipeline per ray.
+    pub fn triangle_tests_per_ray(&self) -> f64 {
+        self.busy_cycles as f64 / self.rays.max(1) as f64
+    }
+    /// Node steps (visits and culled entries) per ray.
+    pub fn node_steps_per_ray(&self) -> f64 {
+        (self.visits + self.culls) as f64 / self.rays.max(1) as f64
+    }
+    /// The mean fraction of the core's ray slots holding a ray.
+    pub fn slot_occupancy(&self) -> f64 {
+        self.occupied_sum as f64 / (self.cycles.max(1) * self.slots.max(1)) as f64
+    }
 }
+
+/// Observation ports of the core, in the order `CoreStats::count` reads them.
+pub const OBSERVED: [&str; 5] = ["busy", "stack_depth", "visits", "culls", "occupied"];
 
 fn port(m: &Module, name: &str) -> crate::rtl::Sig {
     let id = m.outputs.iter().find(|o| o.0 == name).map(|o| o.1);
@@ -124,9 +141,7 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Mo
     let outs = m.instance("u_core", &core, &ins);
     let pos = |name: &str| core.outputs.iter().position(|o| o.0 == name).expect("core port");
     m.drive(ready, outs[pos("ray_ready")]);
-    for name in
-        ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"]
-    {
+    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].into_iter().chain(OBSERVED) {
         m.output(name, outs[pos(name)]);
     }
     m
@@ -146,19 +161,23 @@ pub fn simulate_rust(
         return (Vec::new(), CoreStats::default());
     }
     // Cycle c of the harness is cycle c − 1 of a testbench driving the core directly.
-    collect_batched(&frame_harness(p, scene, rays), rays.len(), 1, progress)
+    collect_batched(&frame_harness(p, scene, rays), rays.len(), p.total_slots(), 1, progress)
 }
 
 /// Runs a design without inputs whose outputs are the core's results and observations (the
 /// frame harness, or the core with its ray generator) in the batched simulator until `count`
 /// results came out. The first `skip` cycles are not counted.
-pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u64)) -> (Vec<CoreResult>, CoreStats) {
-    let names =
-        ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"];
-    let order: Vec<usize> =
-        names.iter().map(|n| m.outputs.iter().position(|o| o.0 == *n).expect("a core output")).collect();
+pub fn collect_batched(
+    m: &Module,
+    count: usize,
+    slots: u32,
+    skip: u64,
+    progress: &dyn Fn(u64),
+) -> (Vec<CoreResult>, CoreStats) {
+    let names = ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].into_iter().chain(OBSERVED);
+    let order: Vec<usize> = names.map(|n| m.outputs.iter().position(|o| o.0 == n).expect("a core output")).collect();
     let mut sim = BatchSim::new(m, 256).expect("a design without inputs");
-    let mut stats = CoreStats::new(count as u64);
+    let mut stats = CoreStats::new(count as u64, slots as u64);
     let mut results: Vec<CoreResult> = Vec::with_capacity(count);
     let mut all = vec![0i128; m.outputs.len()];
     let mut finished: Option<u64> = None;
@@ -174,9 +193,7 @@ pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u6
                 }
                 let row: Vec<i128> = order.iter().map(|&i| all[i]).collect();
                 cycles = c as u64 + 1 - skip;
-                stats.busy_cycles += row[7] as u64;
-                stats.max_stack_depth = stats.max_stack_depth.max(row[8] as u32);
-                stats.count_state(row[9]);
+                stats.count(&row[7..]);
                 if row[0] == 1 {
                     results.push(core_result(&row[1..7]));
                     if results.len() == count {
@@ -203,10 +220,11 @@ pub fn simulate_rust_cycle(
     let m = core_module(p, scene);
     let mut sim = Sim::new(&m);
     let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
-    let [ready, busy, depth, state] = ["ray_ready", "busy", "stack_depth", "fsm_state"].map(|n| port(&m, n));
+    let ready = port(&m, "ray_ready");
+    let observed = OBSERVED.map(|n| port(&m, n));
     let res: Vec<_> =
         ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
-    let mut stats = CoreStats::new(rays.len() as u64);
+    let mut stats = CoreStats::new(rays.len() as u64, p.total_slots() as u64);
     let mut results = Vec::with_capacity(rays.len());
     let mut next = 0;
     let idle = vec![0i128; ins.len()];
@@ -221,9 +239,7 @@ pub fn simulate_rust_cycle(
         stats.cycles += 1;
         // Observed after the edge, as the testbenches do (Verilator's timing mode does not
         // show these before it).
-        stats.busy_cycles += sim.get(busy) as u64;
-        stats.max_stack_depth = stats.max_stack_depth.max(sim.get(depth) as u32);
-        stats.count_state(sim.get(state));
+        stats.count(&observed.map(|o| sim.get(o)));
         next += fire as usize;
         if sim.get(res[0]) == 1 {
             let row: Vec<i128> = res[1..].iter().map(|s| sim.get(*s)).collect();
@@ -346,7 +362,8 @@ pub fn simulate_hdl(
         rays: rays.len() as u64,
         busy_cycles,
         max_stack_depth: stack as u32,
-        state_cycles: Vec::new(),
+        slots: p.total_slots() as u64,
+        ..Default::default()
     };
     Ok((results, stats))
 }

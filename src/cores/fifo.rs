@@ -1,0 +1,95 @@
+//! A first-word-fall-through FIFO in a RAM: the queues between the traversal units, the leaf
+//! stream and the closest-hit unit (leaf entries, rays ready to enter a traversal ring, rays
+//! done). Every queue of the core holds at most one entry per ray slot, so a depth of the slot
+//! count never overflows and there is no `full` signal.
+//!
+//! `head` is the oldest entry whenever `nonempty` is 1; `pop` (only when nonempty) takes it, and
+//! the next one is on `head` in the next cycle. The RAM is read synchronously (read-first) at the
+//! next read pointer, so `head` is a RAM output register; an entry pushed into a queue that is
+//! empty (after this cycle's pop) is read in the same cycle it is written, which a read-first RAM
+//! answers with the old word, so it comes from a copy of the pushed word instead (`bypass`).
+
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, S};
+
+pub struct Fifo<'b> {
+    pub head: S<'b>,
+    pub nonempty: S<'b>,
+}
+
+/// A queue of `width`-bit entries, at least `depth` deep (a power of two).
+pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>, din: S<'b>, pop: S<'b>) -> Fifo<'b> {
+    let depth = depth.next_power_of_two().max(2);
+    let ab = depth.trailing_zeros();
+    let mem = b.ram(&format!("{name}_mem"), width, vec![0; depth as usize]);
+    let wr = b.reg(&format!("{name}_wr"), Ty::u(ab), Some(0));
+    let rd = b.reg(&format!("{name}_rd"), Ty::u(ab), Some(0));
+    let count = b.reg(&format!("{name}_count"), Ty::u(ab + 1), Some(0));
+    b.ram_write(mem, push, wr, din);
+    b.next(wr, push.select(wr + 1, wr));
+    let rd_next = pop.select(rd + 1, rd).name(&format!("{name}_rd_next"));
+    b.next(rd, rd_next);
+    let after_pop = (count - pop.resize(ab + 1)).name(&format!("{name}_after_pop"));
+    let count_next = (after_pop + push.resize(ab + 1)).name(&format!("{name}_count_next"));
+    b.next(count, count_next);
+    let q = b.read(&format!("{name}_q"), mem, rd_next);
+    let bypass = b.reg(&format!("{name}_bypass"), Ty::BIT, Some(0));
+    b.next(bypass, (push & after_pop.eq(0)).name(&format!("{name}_bypass_c")));
+    let din_r = b.reg(&format!("{name}_din_r"), din.ty(), None);
+    b.next_when(din_r, push, din);
+    let nonempty = b.reg(&format!("{name}_nonempty"), Ty::BIT, Some(0));
+    b.next(nonempty, count_next.ne(0));
+    Fifo { head: bypass.select(din_r, q).name(&format!("{name}_head")), nonempty }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rtl::sim::Sim;
+    use std::collections::VecDeque;
+
+    /// Random pushes and pops (pops only when nonempty) against a VecDeque, cycle by cycle,
+    /// including pushes into an empty queue while popping its last entry.
+    #[test]
+    fn behaves_like_a_queue() {
+        for depth in [2u32, 4, 16] {
+            let b = Builder::new("t");
+            let push = b.input("push", Ty::BIT);
+            let din = b.input("din", Ty::u(8));
+            let pop = b.input("pop", Ty::BIT);
+            let f = fifo(&b, "q", 8, depth, push, din, pop);
+            b.output("head", f.head);
+            b.output("nonempty", f.nonempty);
+            let m = b.finish();
+            let mut sim = Sim::new(&m);
+            let h = |i: usize| m.handle(m.inputs[i]);
+            let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+            let mut model = VecDeque::new();
+            let mut x = 12345u32;
+            let mut pushed = 0;
+            for cycle in 0..4000 {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                assert_eq!(sim.get(out("nonempty")) == 1, !model.is_empty(), "depth {depth} cycle {cycle}");
+                if let Some(&v) = model.front() {
+                    assert_eq!(sim.get(out("head")), v as i128, "depth {depth} cycle {cycle}");
+                }
+                let do_pop = !model.is_empty() && x & 3 != 0;
+                let do_push = model.len() - (do_pop as usize) < depth as usize && x & 12 != 0;
+                if do_pop {
+                    model.pop_front();
+                }
+                if do_push {
+                    model.push_back(pushed & 255);
+                }
+                sim.set(h(0), do_push as i128);
+                sim.set(h(1), (pushed & 255) as i128);
+                sim.set(h(2), do_pop as i128);
+                pushed += do_push as u32;
+                sim.tick();
+            }
+            assert!(pushed > 1000);
+        }
+    }
+}
