@@ -16,38 +16,305 @@ module fxrt_core (
   input wire signed [47:0] invz,
   output wire [0:0] ray_ready,
   output wire [0:0] res_valid,
-  output wire [0:0] res_hit,
   output wire [19:0] res_id,
+  output wire [0:0] res_hit,
   output wire [12:0] res_tri,
   output wire [29:0] res_t,
   output wire [31:0] res_u,
   output wire [31:0] res_v,
   output wire [0:0] busy,
   output wire [5:0] stack_depth,
-  output wire [3:0] fsm_state
+  output wire [2:0] visits,
+  output wire [2:0] culls,
+  output wire [6:0] occupied,
+  output wire [5:0] accept_slot,
+  output wire [0:0] visit0,
+  output wire [4:0] visit0_slot,
+  output wire [12:0] visit0_node,
+  output wire [0:0] visit1,
+  output wire [4:0] visit1_slot,
+  output wire [12:0] visit1_node
 );
 
-  wire [0:0] u_traverse_ray_ready;
-  wire [0:0] u_traverse_emit_valid;
-  wire [0:0] u_traverse_emit_end;
-  wire [12:0] u_traverse_emit_tri;
-  wire [30:0] u_traverse_emit_tmin;
-  wire [19:0] u_traverse_emit_id;
-  wire [28:0] u_traverse_cur_ox;
-  wire [28:0] u_traverse_cur_oy;
-  wire [28:0] u_traverse_cur_oz;
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [0:0] u_traverse_visit;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
-  wire [12:0] u_traverse_visit_node;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [5:0] u_traverse_stack_depth;
-  wire [3:0] u_traverse_fsm_state;
+  reg [86:0] ray_o [0:63];
+  initial $readmemh("fxrt_core_ray_o.hex", ray_o);
+
+  reg [95:0] ray_w [0:63];
+  initial $readmemh("fxrt_core_ray_w.hex", ray_w);
+
+  wire [0:0] u0_has_free;
+  wire [0:0] u1_has_free;
+  wire [4:0] u0_free_slot;
+  wire [4:0] u1_free_slot;
+  reg [0:0] turn = 1'h0;
+  reg [1:0] box_phase = 2'h0;
+  wire [0:0] k_0 = 1'h0;
+  reg [0:0] case_turn;
+  reg [4:0] case_turn_1;
+  wire [1:0] k_0_1 = 2'h0;
+  wire [0:0] box_phase_eq_k_0_1;
+  wire [0:0] ready_c;
   wire [0:0] accept;
-  reg signed [31:0] wx_r = 32'sh00000000;
-  reg signed [31:0] wy_r = 32'sh00000000;
-  reg signed [31:0] wz_r = 32'sh00000000;
+  wire [5:0] accept_slot_int;
+  wire [0:0] k_1 = 1'h1;
+  wire [0:0] turn_plus_1;
+  wire [0:0] not_case_turn;
+  wire [0:0] accept_or_not_case_turn;
+  wire [0:0] mux_accept_or_not_case_turn;
+  wire [0:0] box_phase_ne_k_0_1;
+  wire [0:0] or_2;
+  wire [1:0] k_1_1 = 2'h1;
+  wire [1:0] box_phase_plus_k_1_1;
+  wire [1:0] mux_or_2;
+  reg [28:0] box_ox = 29'h00000000;
+  reg [28:0] box_oy = 29'h00000000;
+  reg [28:0] box_oz = 29'h00000000;
+  reg signed [47:0] box_invx = 48'sh000000000000;
+  reg signed [47:0] box_invy = 48'sh000000000000;
+  reg signed [47:0] box_invz = 48'sh000000000000;
+  reg [5:0] box_slot = 6'h00;
+  wire [1:0] box_axis;
+  wire [28:0] box_hi_0 = 29'h1fffffff;
+  wire [28:0] box_hi_1 = 29'h0faab179;
+  wire [28:0] box_hi_2 = 29'h13e4f19b;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
+  reg signed [47:0] case_box_axis;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] box_neg;
+  wire [0:0] box_issue;
+  wire [1:0] k_3 = 2'h3;
+  wire [0:0] box_issue_last;
+  wire [28:0] k_0_2 = 29'h00000000;
+  reg [28:0] case_box_axis_1;
+  wire [28:0] box_plane;
+  reg [0:0] pu_sel_valid = 1'h0;
+  reg [0:0] pu_sel_last = 1'h0;
+  reg [28:0] pu_sel_plane = 29'h00000000;
+  reg [1:0] pu_sel_axis = 2'h0;
+  wire [29:0] rs_pu_sel_plane;
+  wire signed [29:0] s_rs_pu_sel_plane;
+  reg [28:0] case_pu_sel_axis;
+  wire [29:0] rs_case_pu_sel_axis;
+  wire signed [29:0] s_rs_case_pu_sel_axis;
+  wire signed [29:0] pu_diff;
+  reg signed [29:0] pu_delta = 30'sh00000000;
+  reg signed [47:0] pu_inv_axis;
+  reg signed [47:0] pu_inv = 48'sh000000000000;
+  reg [0:0] pu_delta_valid = 1'h0;
+  reg [0:0] pu_delta_last = 1'h0;
+  wire signed [77:0] u_plane_product_p;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 77:16 are read
+  wire signed [77:0] pu_product;
+  /* verilator lint_on UNUSEDSIGNAL */
+  (* mem2reg *) reg [0:0] pu_product_valid_sr [1:6];
+  integer pu_product_valid_i;
+  initial for (pu_product_valid_i = 1; pu_product_valid_i <= 6; pu_product_valid_i = pu_product_valid_i + 1) pu_product_valid_sr[pu_product_valid_i] = 1'h0;
+  wire [0:0] pu_product_valid;
+  (* mem2reg *) reg [0:0] pu_product_last_sr [1:6];
+  integer pu_product_last_i;
+  initial for (pu_product_last_i = 1; pu_product_last_i <= 6; pu_product_last_i = pu_product_last_i + 1) pu_product_last_sr[pu_product_last_i] = 1'h0;
+  wire [0:0] pu_product_last;
+  wire [61:0] bits_pu_product;
+  wire signed [61:0] pu_shifted;
+  wire [0:0] pu_below;
+  wire [0:0] not_pu_below;
+  wire [30:0] bits_pu_shifted;
+  wire [30:0] k_0_3 = 31'h00000000;
+  wire [0:0] bits_pu_shifted_ne_k_0_3;
+  wire [0:0] pu_above;
+  wire signed [31:0] rs_pu_shifted;
+  reg [0:0] pu_above_r = 1'h0;
+  reg [0:0] pu_below_r = 1'h0;
+  reg signed [31:0] pu_low_r = 32'sh00000000;
+  reg [0:0] pu_clamp_valid = 1'h0;
+  reg [0:0] pu_clamp_last = 1'h0;
+  wire signed [31:0] k_1073741824 = 32'sh40000000;
+  wire signed [31:0] k_m1 = 32'shffffffff;
+  wire signed [31:0] mux_pu_below_r;
+  wire signed [31:0] pu_clamped;
+  reg signed [31:0] plane_t = 32'sh00000000;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  reg signed [31:0] plane_t_of_last = 32'sh00000000;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  reg signed [31:0] plane_t_of_first = 32'sh00000000;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] not_pu_clamp_last;
+  wire [0:0] pu_first;
+  reg [0:0] plane_t_valid = 1'h0;
+  reg [0:0] plane_t_last = 1'h0;
+  reg signed [31:0] box_d1 = 32'sh00000000;
+  reg signed [31:0] box_d2 = 32'sh00000000;
+  reg signed [31:0] box_d3 = 32'sh00000000;
+  wire signed [32:0] rs_plane_t;
+  wire signed [32:0] rs_box_d1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_6;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] box_lt1_c;
+  reg [0:0] box_lt1 = 1'h0;
+  wire signed [32:0] rs_plane_t_1;
+  wire signed [32:0] rs_box_d2;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_7;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] box_lt2_c;
+  reg [0:0] box_lt2 = 1'h0;
+  reg [0:0] box_lt1_d = 1'h0;
+  wire [0:0] box_lt1_and_box_lt2;
+  wire signed [31:0] mux_box_lt1_d;
+  wire signed [31:0] box_tmax;
+  wire [0:0] bits_box_d1;
+  wire [0:0] bits_box_d2;
+  wire [0:0] or_8;
+  wire [0:0] bits_box_d3;
+  wire [0:0] box_miss;
+  wire [0:0] box_last;
+  reg [0:0] box_done = 1'h0;
+  (* mem2reg *) reg [5:0] box_done_slot_sr [1:11];
+  integer box_done_slot_i;
+  initial for (box_done_slot_i = 1; box_done_slot_i <= 11; box_done_slot_i = box_done_slot_i + 1) box_done_slot_sr[box_done_slot_i] = 6'h00;
+  wire [5:0] box_done_slot;
+  wire [0:0] merge_valid;
+  wire [5:0] merge_slot;
+  wire [0:0] merge_hit;
+  wire signed [31:0] merge_limit;
+  wire [5:0] merge_sp;
+  wire [0:0] free_valid;
+  wire [5:0] free_slot;
+  wire [0:0] u0_leaf_pop;
+  wire [0:0] u1_leaf_pop;
+  wire [0:0] u0_done_pop;
+  wire [0:0] u1_done_pop;
+  wire [72:0] u0_node_word;
+  wire [72:0] u1_node_word;
+  wire [0:0] bits_accept_slot;
+  wire [0:0] bits_accept_slot_eq_k_0;
+  wire [0:0] u0_alloc;
+  wire [0:0] bits_box_done_slot;
+  wire [0:0] eq_11;
+  wire [0:0] u0_new;
+  wire [0:0] bits_merge_slot;
+  wire [0:0] bits_merge_slot_eq_k_0;
+  wire [0:0] u0_merge;
+  wire [0:0] bits_free_slot;
+  wire [0:0] bits_free_slot_eq_k_0;
+  wire [0:0] u0_free;
+  wire [4:0] bits_box_done_slot_1;
+  wire [4:0] bits_merge_slot_1;
+  wire [4:0] bits_free_slot_1;
+  wire [12:0] u_traverse_0_node_addr;
+  wire [0:0] u_traverse_0_has_free;
+  wire [4:0] u_traverse_0_free_slot_out;
+  wire [0:0] u_traverse_0_leaf_valid;
+  wire [4:0] u_traverse_0_leaf_slot;
+  wire [12:0] u_traverse_0_leaf_first;
+  wire [2:0] u_traverse_0_leaf_count;
+  wire [30:0] u_traverse_0_leaf_tmin;
+  wire [5:0] u_traverse_0_leaf_sp;
+  wire [0:0] u_traverse_0_done_valid;
+  wire [4:0] u_traverse_0_done_slot;
+  wire [0:0] u_traverse_0_visit;
+  wire [4:0] u_traverse_0_visit_slot;
+  wire [12:0] u_traverse_0_visit_node;
+  wire [0:0] u_traverse_0_cull;
+  wire [5:0] u_traverse_0_depth;
+  wire [5:0] u_traverse_0_occupied;
+  wire [0:0] bits_accept_slot_1;
+  wire [0:0] eq_14;
+  wire [0:0] u1_alloc;
+  wire [0:0] bits_box_done_slot_2;
+  wire [0:0] eq_15;
+  wire [0:0] u1_new;
+  wire [0:0] bits_merge_slot_2;
+  wire [0:0] bits_merge_slot_2_eq_k_1;
+  wire [0:0] u1_merge;
+  wire [0:0] bits_free_slot_2;
+  wire [0:0] bits_free_slot_2_eq_k_1;
+  wire [0:0] u1_free;
+  wire [4:0] bits_box_done_slot_3;
+  wire [4:0] bits_merge_slot_3;
+  wire [4:0] bits_free_slot_3;
+  wire [12:0] u_traverse_1_node_addr;
+  wire [0:0] u_traverse_1_has_free;
+  wire [4:0] u_traverse_1_free_slot_out;
+  wire [0:0] u_traverse_1_leaf_valid;
+  wire [4:0] u_traverse_1_leaf_slot;
+  wire [12:0] u_traverse_1_leaf_first;
+  wire [2:0] u_traverse_1_leaf_count;
+  wire [30:0] u_traverse_1_leaf_tmin;
+  wire [5:0] u_traverse_1_leaf_sp;
+  wire [0:0] u_traverse_1_done_valid;
+  wire [4:0] u_traverse_1_done_slot;
+  wire [0:0] u_traverse_1_visit;
+  wire [4:0] u_traverse_1_visit_slot;
+  wire [12:0] u_traverse_1_visit_node;
+  wire [0:0] u_traverse_1_cull;
+  wire [5:0] u_traverse_1_depth;
+  wire [5:0] u_traverse_1_occupied;
+  wire [72:0] u_node_rom_0_data;
+  wire [72:0] u_node_rom_0_data_b;
+  wire [86:0] cat_18;
+  wire [31:0] u_wz;
+  wire [31:0] u_wy;
+  wire [31:0] u_wx;
+  wire [95:0] cat_19;
+  reg [0:0] leaf_active = 1'h0;
+  reg [5:0] leaf_slot = 6'h00;
+  reg [12:0] leaf_ptr = 13'h0000;
+  reg [2:0] leaf_left = 3'h0;
+  reg [30:0] leaf_tmin = 31'h00000000;
+  reg [5:0] leaf_sp = 6'h00;
+  reg [0:0] leaf_first_entry = 1'h0;
+  wire [2:0] k_1_2 = 3'h1;
+  wire [0:0] leaf_left_eq_k_1_2;
+  wire [0:0] leaf_last_entry;
+  wire [0:0] not_leaf_active;
+  wire [0:0] leaf_can_take;
+  reg [0:0] leaf_turn = 1'h0;
+  reg [0:0] case_leaf_turn;
+  reg [0:0] case_leaf_turn_1;
+  reg [0:0] case_leaf_turn_2;
+  reg [0:0] case_leaf_turn_3;
+  wire [0:0] or_22;
+  wire [0:0] mux_case_leaf_turn_2;
+  wire [0:0] leaf_take;
+  wire [0:0] eq_23;
+  wire [0:0] u0_leaf_take;
+  wire [0:0] eq_24;
+  wire [0:0] u1_leaf_take;
+  reg [4:0] case_mux_case_leaf_turn_2;
+  wire [5:0] cat_25;
+  wire [0:0] not_leaf_last_entry;
+  wire [0:0] and_26;
+  wire [0:0] leaf_take_or_and_26;
+  wire [5:0] mux_leaf_take;
+  reg [12:0] case_mux_case_leaf_turn_2_1;
+  wire [12:0] k_1_3 = 13'h0001;
+  wire [12:0] leaf_ptr_plus_k_1_3;
+  wire [12:0] mux_leaf_take_1;
+  reg [2:0] case_mux_case_leaf_turn_2_2;
+  wire [2:0] leaf_left_minus_k_1_2;
+  wire [2:0] mux_leaf_take_2;
+  reg [30:0] case_mux_case_leaf_turn_2_3;
+  wire [30:0] mux_leaf_take_3;
+  reg [5:0] case_mux_case_leaf_turn_2_4;
+  wire [5:0] mux_leaf_take_4;
+  wire [12:0] u_leaf_rom_data;
+  wire [12:0] k_0_4 = 13'h0000;
+  wire [57:0] cat_27;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 57:13 are read
+  (* mem2reg *) reg [57:0] emit_tag_sr [1:3];
+  integer emit_tag_i;
+  initial for (emit_tag_i = 1; emit_tag_i <= 3; emit_tag_i = emit_tag_i + 1) emit_tag_sr[emit_tag_i] = 58'h000000000000000;
+  wire [57:0] emit_tag;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [44:0] bits_emit_tag;
+  wire [57:0] emit_tag_tri;
+  (* mem2reg *) reg [0:0] emit_valid_sr [1:3];
+  integer emit_valid_i;
+  initial for (emit_valid_i = 1; emit_valid_i <= 3; emit_valid_i = emit_valid_i + 1) emit_valid_sr[emit_valid_i] = 1'h0;
+  wire [0:0] emit_valid;
   wire [12:0] tri_addr;
   wire [123:0] u_tri_rom_0_data;
   wire [1:0] tri_r;
@@ -68,61 +335,312 @@ module fxrt_core (
   wire signed [31:0] tri_e2p;
   wire [31:0] u_tri_rom_2_data;
   wire signed [31:0] tri_e2q;
-  wire [43:0] cat_1;
-  wire [43:0] rs_u_traverse_emit_id;
-  wire [43:0] mux_u_traverse_emit_end;
-  wire [44:0] tag;
   (* mem2reg *) reg [0:0] pipe_valid_sr [1:3];
   integer pipe_valid_i;
   initial for (pipe_valid_i = 1; pipe_valid_i <= 3; pipe_valid_i = pipe_valid_i + 1) pipe_valid_sr[pipe_valid_i] = 1'h0;
   wire [0:0] pipe_valid;
-  (* mem2reg *) reg [44:0] pipe_tag_sr [1:3];
+  (* mem2reg *) reg [57:0] pipe_tag_sr [1:3];
   integer pipe_tag_i;
-  initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 45'h000000000000;
-  wire [44:0] pipe_tag;
-  (* mem2reg *) reg [28:0] pipe_cur_ox_sr [1:3];
-  integer pipe_cur_ox_i;
-  initial for (pipe_cur_ox_i = 1; pipe_cur_ox_i <= 3; pipe_cur_ox_i = pipe_cur_ox_i + 1) pipe_cur_ox_sr[pipe_cur_ox_i] = 29'h00000000;
-  wire [28:0] pipe_cur_ox;
-  (* mem2reg *) reg [28:0] pipe_cur_oy_sr [1:3];
-  integer pipe_cur_oy_i;
-  initial for (pipe_cur_oy_i = 1; pipe_cur_oy_i <= 3; pipe_cur_oy_i = pipe_cur_oy_i + 1) pipe_cur_oy_sr[pipe_cur_oy_i] = 29'h00000000;
-  wire [28:0] pipe_cur_oy;
-  (* mem2reg *) reg [28:0] pipe_cur_oz_sr [1:3];
-  integer pipe_cur_oz_i;
-  initial for (pipe_cur_oz_i = 1; pipe_cur_oz_i <= 3; pipe_cur_oz_i = pipe_cur_oz_i + 1) pipe_cur_oz_sr[pipe_cur_oz_i] = 29'h00000000;
-  wire [28:0] pipe_cur_oz;
-  (* mem2reg *) reg signed [31:0] pipe_wx_sr [1:3];
-  integer pipe_wx_i;
-  initial for (pipe_wx_i = 1; pipe_wx_i <= 3; pipe_wx_i = pipe_wx_i + 1) pipe_wx_sr[pipe_wx_i] = 32'sh00000000;
-  wire signed [31:0] pipe_wx;
-  (* mem2reg *) reg signed [31:0] pipe_wy_sr [1:3];
-  integer pipe_wy_i;
-  initial for (pipe_wy_i = 1; pipe_wy_i <= 3; pipe_wy_i = pipe_wy_i + 1) pipe_wy_sr[pipe_wy_i] = 32'sh00000000;
-  wire signed [31:0] pipe_wy;
-  (* mem2reg *) reg signed [31:0] pipe_wz_sr [1:3];
-  integer pipe_wz_i;
-  initial for (pipe_wz_i = 1; pipe_wz_i <= 3; pipe_wz_i = pipe_wz_i + 1) pipe_wz_sr[pipe_wz_i] = 32'sh00000000;
-  wire signed [31:0] pipe_wz;
+  initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 58'h000000000000000;
+  wire [57:0] pipe_tag;
+  wire [5:0] bits_emit_tag_tri;
+  reg [86:0] ray_o_q = 87'h0000000000000000000000;
+  (* mem2reg *) reg [86:0] pipe_o_sr [1:2];
+  integer pipe_o_i;
+  initial for (pipe_o_i = 1; pipe_o_i <= 2; pipe_o_i = pipe_o_i + 1) pipe_o_sr[pipe_o_i] = 87'h0000000000000000000000;
+  wire [86:0] pipe_o;
+  reg [95:0] ray_w_q = 96'h000000000000000000000000;
+  (* mem2reg *) reg [95:0] pipe_w_sr [1:2];
+  integer pipe_w_i;
+  initial for (pipe_w_i = 1; pipe_w_i <= 2; pipe_w_i = pipe_w_i + 1) pipe_w_sr[pipe_w_i] = 96'h000000000000000000000000;
+  wire [95:0] pipe_w;
+  wire [28:0] bits_pipe_o;
+  wire [28:0] bits_pipe_o_1;
+  wire [28:0] bits_pipe_o_2;
+  wire [31:0] bits_pipe_w;
+  wire signed [31:0] s_bits_pipe_w;
+  wire [31:0] bits_pipe_w_1;
+  wire signed [31:0] s_bits_pipe_w_1;
+  wire [31:0] bits_pipe_w_2;
+  wire signed [31:0] s_bits_pipe_w_2;
   wire [0:0] u_intersect_valid_out;
-  wire [44:0] u_intersect_tag_out;
+  wire [57:0] u_intersect_tag_out;
   wire [0:0] u_intersect_hit;
   wire [29:0] u_intersect_t_1;
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
+  wire [5:0] cat_29;
+  wire [0:0] not_u_traverse_0_done_valid;
+  wire [0:0] u1_done_take;
+  wire [5:0] cat_31;
+  wire [5:0] mux_u_traverse_0_done_valid;
+  wire [0:0] or_32;
+  wire [0:0] u_closest_merge_valid;
+  wire [5:0] u_closest_merge_slot;
+  wire [0:0] u_closest_merge_hit;
+  wire signed [31:0] u_closest_merge_limit;
+  wire [5:0] u_closest_merge_sp;
+  wire [0:0] u_closest_free_valid;
+  wire [5:0] u_closest_free_slot;
   wire [0:0] u_closest_res_valid;
-  wire [0:0] u_closest_res_hit;
   wire [19:0] u_closest_res_id;
+  wire [0:0] u_closest_res_hit;
   wire [12:0] u_closest_res_tri;
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] bits_pipe_tag;
-  wire [0:0] not_bits_pipe_tag;
-  wire [0:0] pipe_busy;
+  wire [0:0] lt_33;
+  wire [5:0] mux_lt_33;
+  wire [2:0] rs_u_traverse_0_visit;
+  wire [2:0] rs_u_traverse_1_visit;
+  wire [2:0] visits_c;
+  wire [2:0] rs_u_traverse_0_cull;
+  wire [2:0] rs_u_traverse_1_cull;
+  wire [2:0] culls_c;
+  wire [6:0] rs_u_traverse_0_occupied;
+  wire [6:0] rs_u_traverse_1_occupied;
+  wire [6:0] occupied_c;
 
-  assign accept = ray_valid & u_traverse_ray_ready;
-  assign tri_addr = u_traverse_emit_tri;
+  assign u0_has_free = u_traverse_0_has_free;
+  assign u1_has_free = u_traverse_1_has_free;
+  assign u0_free_slot = u_traverse_0_free_slot_out;
+  assign u1_free_slot = u_traverse_1_free_slot_out;
+  always @* begin
+    case (turn)
+      1'h0: case_turn = u0_has_free;
+      1'h1: case_turn = u1_has_free;
+      default: case_turn = k_0;
+    endcase
+  end
+  always @* begin
+    case (turn)
+      1'h0: case_turn_1 = u0_free_slot;
+      1'h1: case_turn_1 = u1_free_slot;
+      default: case_turn_1 = u0_free_slot;
+    endcase
+  end
+  assign box_phase_eq_k_0_1 = box_phase == k_0_1;
+  assign ready_c = box_phase_eq_k_0_1 & case_turn;
+  assign accept = ray_valid & ready_c;
+  assign accept_slot_int = {turn, case_turn_1};
+  assign turn_plus_1 = turn + k_1;
+  assign not_case_turn = ~case_turn;
+  assign accept_or_not_case_turn = accept | not_case_turn;
+  assign mux_accept_or_not_case_turn = accept_or_not_case_turn ? turn_plus_1 : turn;
+  assign box_phase_ne_k_0_1 = box_phase != k_0_1;
+  assign or_2 = accept | box_phase_ne_k_0_1;
+  assign box_phase_plus_k_1_1 = box_phase + k_1_1;
+  assign mux_or_2 = or_2 ? box_phase_plus_k_1_1 : box_phase;
+  assign box_axis = box_phase - k_1_1;
+  always @* begin
+    case (box_axis)
+      2'h1: case_box_axis = box_invy;
+      2'h2: case_box_axis = box_invz;
+      default: case_box_axis = box_invx;
+    endcase
+  end
+  assign box_neg = case_box_axis[47];
+  assign box_issue = box_phase != k_0_1;
+  assign box_issue_last = box_phase == k_3;
+  always @* begin
+    case (box_axis)
+      2'h1: case_box_axis_1 = box_hi_1;
+      2'h2: case_box_axis_1 = box_hi_2;
+      default: case_box_axis_1 = box_hi_0;
+    endcase
+  end
+  assign box_plane = box_neg ? k_0_2 : case_box_axis_1;
+  assign rs_pu_sel_plane = {{1{1'b0}}, pu_sel_plane};
+  assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
+  always @* begin
+    case (pu_sel_axis)
+      2'h1: case_pu_sel_axis = box_oy;
+      2'h2: case_pu_sel_axis = box_oz;
+      default: case_pu_sel_axis = box_ox;
+    endcase
+  end
+  assign rs_case_pu_sel_axis = {{1{1'b0}}, case_pu_sel_axis};
+  assign s_rs_case_pu_sel_axis = $signed(rs_case_pu_sel_axis);
+  assign pu_diff = s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
+  always @* begin
+    case (pu_sel_axis)
+      2'h1: pu_inv_axis = box_invy;
+      2'h2: pu_inv_axis = box_invz;
+      default: pu_inv_axis = box_invx;
+    endcase
+  end
+  assign pu_product = u_plane_product_p;
+  assign pu_product_valid = pu_product_valid_sr[6];
+  assign pu_product_last = pu_product_last_sr[6];
+  assign bits_pu_product = pu_product[77:16];
+  assign pu_shifted = $signed(bits_pu_product);
+  assign pu_below = pu_shifted[61];
+  assign not_pu_below = ~pu_below;
+  assign bits_pu_shifted = pu_shifted[60:30];
+  assign bits_pu_shifted_ne_k_0_3 = bits_pu_shifted != k_0_3;
+  assign pu_above = not_pu_below & bits_pu_shifted_ne_k_0_3;
+  assign rs_pu_shifted = $signed(pu_shifted[31:0]);
+  assign mux_pu_below_r = pu_below_r ? k_m1 : pu_low_r;
+  assign pu_clamped = pu_above_r ? k_1073741824 : mux_pu_below_r;
+  assign not_pu_clamp_last = ~pu_clamp_last;
+  assign pu_first = pu_clamp_valid & not_pu_clamp_last;
+  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
+  assign minus_6 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_6[32];
+  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
+  assign minus_7 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_7[32];
+  assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
+  assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
+  assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
+  assign bits_box_d1 = box_d1[31];
+  assign bits_box_d2 = box_d2[31];
+  assign or_8 = bits_box_d1 | bits_box_d2;
+  assign bits_box_d3 = box_d3[31];
+  assign box_miss = or_8 | bits_box_d3;
+  assign box_last = plane_t_valid & plane_t_last;
+  assign box_done_slot = box_done_slot_sr[11];
+  assign merge_valid = u_closest_merge_valid;
+  assign merge_slot = u_closest_merge_slot;
+  assign merge_hit = u_closest_merge_hit;
+  assign merge_limit = u_closest_merge_limit;
+  assign merge_sp = u_closest_merge_sp;
+  assign free_valid = u_closest_free_valid;
+  assign free_slot = u_closest_free_slot;
+  assign u0_leaf_pop = u0_leaf_take;
+  assign u1_leaf_pop = u1_leaf_take;
+  assign u0_done_pop = u_traverse_0_done_valid;
+  assign u1_done_pop = u1_done_take;
+  assign u0_node_word = u_node_rom_0_data;
+  assign u1_node_word = u_node_rom_0_data_b;
+  assign bits_accept_slot = accept_slot_int[5];
+  assign bits_accept_slot_eq_k_0 = bits_accept_slot == k_0;
+  assign u0_alloc = accept & bits_accept_slot_eq_k_0;
+  assign bits_box_done_slot = box_done_slot[5];
+  assign eq_11 = bits_box_done_slot == k_0;
+  assign u0_new = box_done & eq_11;
+  assign bits_merge_slot = merge_slot[5];
+  assign bits_merge_slot_eq_k_0 = bits_merge_slot == k_0;
+  assign u0_merge = merge_valid & bits_merge_slot_eq_k_0;
+  assign bits_free_slot = free_slot[5];
+  assign bits_free_slot_eq_k_0 = bits_free_slot == k_0;
+  assign u0_free = free_valid & bits_free_slot_eq_k_0;
+  assign bits_box_done_slot_1 = box_done_slot[4:0];
+  assign bits_merge_slot_1 = merge_slot[4:0];
+  assign bits_free_slot_1 = free_slot[4:0];
+  assign bits_accept_slot_1 = accept_slot_int[5];
+  assign eq_14 = bits_accept_slot_1 == k_1;
+  assign u1_alloc = accept & eq_14;
+  assign bits_box_done_slot_2 = box_done_slot[5];
+  assign eq_15 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_15;
+  assign bits_merge_slot_2 = merge_slot[5];
+  assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
+  assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
+  assign bits_free_slot_2 = free_slot[5];
+  assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
+  assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
+  assign bits_box_done_slot_3 = box_done_slot[4:0];
+  assign bits_merge_slot_3 = merge_slot[4:0];
+  assign bits_free_slot_3 = free_slot[4:0];
+  assign cat_18 = {oz, oy, ox};
+  assign u_wz = $unsigned(wz);
+  assign u_wy = $unsigned(wy);
+  assign u_wx = $unsigned(wx);
+  assign cat_19 = {u_wz, u_wy, u_wx};
+  assign leaf_left_eq_k_1_2 = leaf_left == k_1_2;
+  assign leaf_last_entry = leaf_active & leaf_left_eq_k_1_2;
+  assign not_leaf_active = ~leaf_active;
+  assign leaf_can_take = not_leaf_active | leaf_last_entry;
+  always @* begin
+    case (leaf_turn)
+      1'h0: case_leaf_turn = u_traverse_0_leaf_valid;
+      1'h1: case_leaf_turn = u_traverse_1_leaf_valid;
+      default: case_leaf_turn = k_0;
+    endcase
+  end
+  always @* begin
+    case (leaf_turn)
+      1'h0: case_leaf_turn_1 = k_0;
+      1'h1: case_leaf_turn_1 = k_1;
+      default: case_leaf_turn_1 = k_0;
+    endcase
+  end
+  always @* begin
+    case (leaf_turn)
+      1'h0: case_leaf_turn_2 = u_traverse_1_leaf_valid;
+      1'h1: case_leaf_turn_2 = u_traverse_0_leaf_valid;
+      default: case_leaf_turn_2 = k_0;
+    endcase
+  end
+  always @* begin
+    case (leaf_turn)
+      1'h0: case_leaf_turn_3 = k_1;
+      1'h1: case_leaf_turn_3 = k_0;
+      default: case_leaf_turn_3 = k_0;
+    endcase
+  end
+  assign or_22 = case_leaf_turn_2 | case_leaf_turn;
+  assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
+  assign leaf_take = leaf_can_take & or_22;
+  assign eq_23 = mux_case_leaf_turn_2 == k_0;
+  assign u0_leaf_take = leaf_take & eq_23;
+  assign eq_24 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_24;
+  always @* begin
+    case (mux_case_leaf_turn_2)
+      1'h0: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
+      1'h1: case_mux_case_leaf_turn_2 = u_traverse_1_leaf_slot;
+      default: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
+    endcase
+  end
+  assign cat_25 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign not_leaf_last_entry = ~leaf_last_entry;
+  assign and_26 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_26 = leaf_take | and_26;
+  assign mux_leaf_take = leaf_take ? cat_25 : leaf_slot;
+  always @* begin
+    case (mux_case_leaf_turn_2)
+      1'h0: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
+      1'h1: case_mux_case_leaf_turn_2_1 = u_traverse_1_leaf_first;
+      default: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
+    endcase
+  end
+  assign leaf_ptr_plus_k_1_3 = leaf_ptr + k_1_3;
+  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_3;
+  always @* begin
+    case (mux_case_leaf_turn_2)
+      1'h0: case_mux_case_leaf_turn_2_2 = u_traverse_0_leaf_count;
+      1'h1: case_mux_case_leaf_turn_2_2 = u_traverse_1_leaf_count;
+      default: case_mux_case_leaf_turn_2_2 = u_traverse_0_leaf_count;
+    endcase
+  end
+  assign leaf_left_minus_k_1_2 = leaf_left - k_1_2;
+  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_2;
+  always @* begin
+    case (mux_case_leaf_turn_2)
+      1'h0: case_mux_case_leaf_turn_2_3 = u_traverse_0_leaf_tmin;
+      1'h1: case_mux_case_leaf_turn_2_3 = u_traverse_1_leaf_tmin;
+      default: case_mux_case_leaf_turn_2_3 = u_traverse_0_leaf_tmin;
+    endcase
+  end
+  assign mux_leaf_take_3 = leaf_take ? case_mux_case_leaf_turn_2_3 : leaf_tmin;
+  always @* begin
+    case (mux_case_leaf_turn_2)
+      1'h0: case_mux_case_leaf_turn_2_4 = u_traverse_0_leaf_sp;
+      1'h1: case_mux_case_leaf_turn_2_4 = u_traverse_1_leaf_sp;
+      default: case_mux_case_leaf_turn_2_4 = u_traverse_0_leaf_sp;
+    endcase
+  end
+  assign mux_leaf_take_4 = leaf_take ? case_mux_case_leaf_turn_2_4 : leaf_sp;
+  assign cat_27 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign emit_tag = emit_tag_sr[3];
+  assign bits_emit_tag = emit_tag[57:13];
+  assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
+  assign emit_valid = emit_valid_sr[3];
+  assign tri_addr = u_leaf_rom_data;
   assign tri_r = u_tri_rom_0_data[1:0];
   assign tri_pp = u_tri_rom_0_data[30:2];
   assign tri_pq = u_tri_rom_0_data[59:31];
@@ -139,76 +657,227 @@ module fxrt_core (
   assign bits_u_tri_rom_1_data_3 = u_tri_rom_1_data[127:96];
   assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
   assign tri_e2q = $signed(u_tri_rom_2_data);
-  assign cat_1 = {u_traverse_emit_tmin, u_traverse_emit_tri};
-  assign rs_u_traverse_emit_id = {{24{1'b0}}, u_traverse_emit_id};
-  assign mux_u_traverse_emit_end = u_traverse_emit_end ? rs_u_traverse_emit_id : cat_1;
-  assign tag = {u_traverse_emit_end, mux_u_traverse_emit_end};
   assign pipe_valid = pipe_valid_sr[3];
   assign pipe_tag = pipe_tag_sr[3];
-  assign pipe_cur_ox = pipe_cur_ox_sr[3];
-  assign pipe_cur_oy = pipe_cur_oy_sr[3];
-  assign pipe_cur_oz = pipe_cur_oz_sr[3];
-  assign pipe_wx = pipe_wx_sr[3];
-  assign pipe_wy = pipe_wy_sr[3];
-  assign pipe_wz = pipe_wz_sr[3];
-  assign bits_pipe_tag = pipe_tag[44];
-  assign not_bits_pipe_tag = ~bits_pipe_tag;
-  assign pipe_busy = pipe_valid & not_bits_pipe_tag;
+  assign bits_emit_tag_tri = emit_tag_tri[55:50];
+  assign pipe_o = pipe_o_sr[2];
+  assign pipe_w = pipe_w_sr[2];
+  assign bits_pipe_o = pipe_o[28:0];
+  assign bits_pipe_o_1 = pipe_o[57:29];
+  assign bits_pipe_o_2 = pipe_o[86:58];
+  assign bits_pipe_w = pipe_w[31:0];
+  assign s_bits_pipe_w = $signed(bits_pipe_w);
+  assign bits_pipe_w_1 = pipe_w[63:32];
+  assign s_bits_pipe_w_1 = $signed(bits_pipe_w_1);
+  assign bits_pipe_w_2 = pipe_w[95:64];
+  assign s_bits_pipe_w_2 = $signed(bits_pipe_w_2);
+  assign cat_29 = {k_0, u_traverse_0_done_slot};
+  assign not_u_traverse_0_done_valid = ~u_traverse_0_done_valid;
+  assign u1_done_take = u_traverse_1_done_valid & not_u_traverse_0_done_valid;
+  assign cat_31 = {k_1, u_traverse_1_done_slot};
+  assign mux_u_traverse_0_done_valid = u_traverse_0_done_valid ? cat_29 : cat_31;
+  assign or_32 = u_traverse_0_done_valid | u_traverse_1_done_valid;
+  assign lt_33 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_33 = lt_33 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
+  assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
+  assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
+  assign rs_u_traverse_0_cull = {{2{1'b0}}, u_traverse_0_cull};
+  assign rs_u_traverse_1_cull = {{2{1'b0}}, u_traverse_1_cull};
+  assign culls_c = rs_u_traverse_0_cull + rs_u_traverse_1_cull;
+  assign rs_u_traverse_0_occupied = {{1{1'b0}}, u_traverse_0_occupied};
+  assign rs_u_traverse_1_occupied = {{1{1'b0}}, u_traverse_1_occupied};
+  assign occupied_c = rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   always @(posedge clk) begin : regs
-    if (accept) wx_r <= wx;
-    if (accept) wy_r <= wy;
-    if (accept) wz_r <= wz;
+    if (accept) ray_o[accept_slot_int] <= cat_18;
+    if (accept) ray_w[accept_slot_int] <= cat_19;
+    if (rst) turn <= 1'h0;
+    else turn <= mux_accept_or_not_case_turn;
+    if (rst) box_phase <= 2'h0;
+    else box_phase <= mux_or_2;
+    if (accept) box_ox <= ox;
+    if (accept) box_oy <= oy;
+    if (accept) box_oz <= oz;
+    if (accept) box_invx <= invx;
+    if (accept) box_invy <= invy;
+    if (accept) box_invz <= invz;
+    if (accept) box_slot <= accept_slot_int;
+    pu_sel_valid <= box_issue;
+    pu_sel_last <= box_issue_last;
+    pu_sel_plane <= box_plane;
+    pu_sel_axis <= box_axis;
+    pu_delta <= pu_diff;
+    pu_inv <= pu_inv_axis;
+    pu_delta_valid <= pu_sel_valid;
+    pu_delta_last <= pu_sel_last;
+    for (pu_product_valid_i = 6; pu_product_valid_i > 1; pu_product_valid_i = pu_product_valid_i - 1)
+      pu_product_valid_sr[pu_product_valid_i] <= pu_product_valid_sr[pu_product_valid_i - 1];
+    pu_product_valid_sr[1] <= pu_delta_valid;
+    for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
+      pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
+    pu_product_last_sr[1] <= pu_delta_last;
+    pu_above_r <= pu_above;
+    pu_below_r <= pu_below;
+    pu_low_r <= rs_pu_shifted;
+    pu_clamp_valid <= pu_product_valid;
+    pu_clamp_last <= pu_product_last;
+    plane_t <= pu_clamped;
+    if (pu_clamp_last) plane_t_of_last <= pu_clamped;
+    if (pu_first) plane_t_of_first <= pu_clamped;
+    plane_t_valid <= pu_clamp_valid;
+    plane_t_last <= pu_clamp_last;
+    box_d1 <= plane_t;
+    box_d2 <= box_d1;
+    box_d3 <= box_d2;
+    box_lt1 <= box_lt1_c;
+    box_lt2 <= box_lt2_c;
+    box_lt1_d <= box_lt1;
+    box_done <= box_last;
+    for (box_done_slot_i = 11; box_done_slot_i > 1; box_done_slot_i = box_done_slot_i - 1)
+      box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
+    box_done_slot_sr[1] <= box_slot;
+    if (rst) leaf_active <= 1'h0;
+    else leaf_active <= leaf_take_or_and_26;
+    leaf_slot <= mux_leaf_take;
+    leaf_ptr <= mux_leaf_take_1;
+    leaf_left <= mux_leaf_take_2;
+    leaf_tmin <= mux_leaf_take_3;
+    leaf_sp <= mux_leaf_take_4;
+    leaf_first_entry <= leaf_take;
+    if (rst) leaf_turn <= 1'h0;
+    else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
+    for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
+      emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
+    emit_tag_sr[1] <= cat_27;
+    for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
+      emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
+    emit_valid_sr[1] <= leaf_active;
     for (pipe_valid_i = 3; pipe_valid_i > 1; pipe_valid_i = pipe_valid_i - 1)
       pipe_valid_sr[pipe_valid_i] <= pipe_valid_sr[pipe_valid_i - 1];
-    pipe_valid_sr[1] <= u_traverse_emit_valid;
+    pipe_valid_sr[1] <= emit_valid;
     for (pipe_tag_i = 3; pipe_tag_i > 1; pipe_tag_i = pipe_tag_i - 1)
       pipe_tag_sr[pipe_tag_i] <= pipe_tag_sr[pipe_tag_i - 1];
-    pipe_tag_sr[1] <= tag;
-    for (pipe_cur_ox_i = 3; pipe_cur_ox_i > 1; pipe_cur_ox_i = pipe_cur_ox_i - 1)
-      pipe_cur_ox_sr[pipe_cur_ox_i] <= pipe_cur_ox_sr[pipe_cur_ox_i - 1];
-    pipe_cur_ox_sr[1] <= u_traverse_cur_ox;
-    for (pipe_cur_oy_i = 3; pipe_cur_oy_i > 1; pipe_cur_oy_i = pipe_cur_oy_i - 1)
-      pipe_cur_oy_sr[pipe_cur_oy_i] <= pipe_cur_oy_sr[pipe_cur_oy_i - 1];
-    pipe_cur_oy_sr[1] <= u_traverse_cur_oy;
-    for (pipe_cur_oz_i = 3; pipe_cur_oz_i > 1; pipe_cur_oz_i = pipe_cur_oz_i - 1)
-      pipe_cur_oz_sr[pipe_cur_oz_i] <= pipe_cur_oz_sr[pipe_cur_oz_i - 1];
-    pipe_cur_oz_sr[1] <= u_traverse_cur_oz;
-    for (pipe_wx_i = 3; pipe_wx_i > 1; pipe_wx_i = pipe_wx_i - 1)
-      pipe_wx_sr[pipe_wx_i] <= pipe_wx_sr[pipe_wx_i - 1];
-    pipe_wx_sr[1] <= wx_r;
-    for (pipe_wy_i = 3; pipe_wy_i > 1; pipe_wy_i = pipe_wy_i - 1)
-      pipe_wy_sr[pipe_wy_i] <= pipe_wy_sr[pipe_wy_i - 1];
-    pipe_wy_sr[1] <= wy_r;
-    for (pipe_wz_i = 3; pipe_wz_i > 1; pipe_wz_i = pipe_wz_i - 1)
-      pipe_wz_sr[pipe_wz_i] <= pipe_wz_sr[pipe_wz_i - 1];
-    pipe_wz_sr[1] <= wz_r;
+    pipe_tag_sr[1] <= emit_tag_tri;
+    ray_o_q <= ray_o[bits_emit_tag_tri];
+    for (pipe_o_i = 2; pipe_o_i > 1; pipe_o_i = pipe_o_i - 1)
+      pipe_o_sr[pipe_o_i] <= pipe_o_sr[pipe_o_i - 1];
+    pipe_o_sr[1] <= ray_o_q;
+    ray_w_q <= ray_w[bits_emit_tag_tri];
+    for (pipe_w_i = 2; pipe_w_i > 1; pipe_w_i = pipe_w_i - 1)
+      pipe_w_sr[pipe_w_i] <= pipe_w_sr[pipe_w_i - 1];
+    pipe_w_sr[1] <= ray_w_q;
   end
 
-  fxrt_traverse u_traverse (
+  fxrt_mul_s30xs48_d3l1 u_plane_product (
+    .clk(clk),
+    .a(pu_delta),
+    .b(pu_inv),
+    .p(u_plane_product_p)
+  );
+
+  fxrt_traverse_k32 u_traverse_0 (
     .clk(clk),
     .rst(rst),
-    .ray_valid(ray_valid),
-    .ray_id(ray_id),
+    .ray_we(u0_alloc),
+    .ray_slot(case_turn_1),
     .ox(ox),
     .oy(oy),
     .oz(oz),
     .invx(invx),
     .invy(invy),
     .invz(invz),
-    .ray_ready(u_traverse_ray_ready),
-    .emit_valid(u_traverse_emit_valid),
-    .emit_end(u_traverse_emit_end),
-    .emit_tri(u_traverse_emit_tri),
-    .emit_tmin(u_traverse_emit_tmin),
-    .emit_id(u_traverse_emit_id),
-    .cur_ox(u_traverse_cur_ox),
-    .cur_oy(u_traverse_cur_oy),
-    .cur_oz(u_traverse_cur_oz),
-    .visit(u_traverse_visit),
-    .visit_node(u_traverse_visit_node),
-    .stack_depth(u_traverse_stack_depth),
-    .fsm_state(u_traverse_fsm_state)
+    .new_valid(u0_new),
+    .new_slot(bits_box_done_slot_1),
+    .new_tmax(box_tmax),
+    .new_miss(box_miss),
+    .merge_valid(u0_merge),
+    .merge_slot(bits_merge_slot_1),
+    .merge_hit(merge_hit),
+    .merge_limit(merge_limit),
+    .merge_sp(merge_sp),
+    .free_valid(u0_free),
+    .free_slot(bits_free_slot_1),
+    .alloc(u0_alloc),
+    .leaf_pop(u0_leaf_pop),
+    .done_pop(u0_done_pop),
+    .node_word(u0_node_word),
+    .node_addr(u_traverse_0_node_addr),
+    .has_free(u_traverse_0_has_free),
+    .free_slot_out(u_traverse_0_free_slot_out),
+    .leaf_valid(u_traverse_0_leaf_valid),
+    .leaf_slot(u_traverse_0_leaf_slot),
+    .leaf_first(u_traverse_0_leaf_first),
+    .leaf_count(u_traverse_0_leaf_count),
+    .leaf_tmin(u_traverse_0_leaf_tmin),
+    .leaf_sp(u_traverse_0_leaf_sp),
+    .done_valid(u_traverse_0_done_valid),
+    .done_slot(u_traverse_0_done_slot),
+    .visit(u_traverse_0_visit),
+    .visit_slot(u_traverse_0_visit_slot),
+    .visit_node(u_traverse_0_visit_node),
+    .cull(u_traverse_0_cull),
+    .depth(u_traverse_0_depth),
+    .occupied(u_traverse_0_occupied)
+  );
+
+  fxrt_traverse_k32 u_traverse_1 (
+    .clk(clk),
+    .rst(rst),
+    .ray_we(u1_alloc),
+    .ray_slot(case_turn_1),
+    .ox(ox),
+    .oy(oy),
+    .oz(oz),
+    .invx(invx),
+    .invy(invy),
+    .invz(invz),
+    .new_valid(u1_new),
+    .new_slot(bits_box_done_slot_3),
+    .new_tmax(box_tmax),
+    .new_miss(box_miss),
+    .merge_valid(u1_merge),
+    .merge_slot(bits_merge_slot_3),
+    .merge_hit(merge_hit),
+    .merge_limit(merge_limit),
+    .merge_sp(merge_sp),
+    .free_valid(u1_free),
+    .free_slot(bits_free_slot_3),
+    .alloc(u1_alloc),
+    .leaf_pop(u1_leaf_pop),
+    .done_pop(u1_done_pop),
+    .node_word(u1_node_word),
+    .node_addr(u_traverse_1_node_addr),
+    .has_free(u_traverse_1_has_free),
+    .free_slot_out(u_traverse_1_free_slot_out),
+    .leaf_valid(u_traverse_1_leaf_valid),
+    .leaf_slot(u_traverse_1_leaf_slot),
+    .leaf_first(u_traverse_1_leaf_first),
+    .leaf_count(u_traverse_1_leaf_count),
+    .leaf_tmin(u_traverse_1_leaf_tmin),
+    .leaf_sp(u_traverse_1_leaf_sp),
+    .done_valid(u_traverse_1_done_valid),
+    .done_slot(u_traverse_1_done_slot),
+    .visit(u_traverse_1_visit),
+    .visit_slot(u_traverse_1_visit_slot),
+    .visit_node(u_traverse_1_visit_node),
+    .cull(u_traverse_1_cull),
+    .depth(u_traverse_1_depth),
+    .occupied(u_traverse_1_occupied)
+  );
+
+  fxrt_brom_node_2p u_node_rom_0 (
+    .clk(clk),
+    .addr(u_traverse_0_node_addr),
+    .addr_b(u_traverse_1_node_addr),
+    .data(u_node_rom_0_data),
+    .data_b(u_node_rom_0_data_b)
+  );
+
+  fxrt_brom_leaf u_leaf_rom (
+    .clk(clk),
+    .addr(leaf_ptr),
+    .data(u_leaf_rom_data)
   );
 
   fxrt_brom_tri_0 u_tri_rom_0 (
@@ -229,16 +898,16 @@ module fxrt_core (
     .data(u_tri_rom_2_data)
   );
 
-  fxrt_intersect_n29_m32_t0_e18_tag45_c150 u_intersect (
+  fxrt_intersect_n29_m32_t0_e18_tag58_c150 u_intersect (
     .clk(clk),
     .valid(pipe_valid),
     .tag(pipe_tag),
-    .ox(pipe_cur_ox),
-    .oy(pipe_cur_oy),
-    .oz(pipe_cur_oz),
-    .wx(pipe_wx),
-    .wy(pipe_wy),
-    .wz(pipe_wz),
+    .ox(bits_pipe_o),
+    .oy(bits_pipe_o_1),
+    .oz(bits_pipe_o_2),
+    .wx(s_bits_pipe_w),
+    .wy(s_bits_pipe_w_1),
+    .wz(s_bits_pipe_w_2),
     .r(tri_r),
     .pp(tri_pp),
     .pq(tri_pq),
@@ -257,7 +926,7 @@ module fxrt_core (
     .v(u_intersect_v)
   );
 
-  fxrt_closest_n29_m32_tag45_r2 u_closest (
+  fxrt_closest_n29_m32_tag58_s64_r2 u_closest (
     .clk(clk),
     .rst(rst),
     .valid(u_intersect_valid_out),
@@ -266,25 +935,46 @@ module fxrt_core (
     .t(u_intersect_t_1),
     .u(u_intersect_u),
     .v(u_intersect_v),
+    .id_we(accept),
+    .id_slot(accept_slot_int),
+    .id(ray_id),
+    .done_valid(or_32),
+    .done_slot(mux_u_traverse_0_done_valid),
+    .merge_valid(u_closest_merge_valid),
+    .merge_slot(u_closest_merge_slot),
+    .merge_hit(u_closest_merge_hit),
+    .merge_limit(u_closest_merge_limit),
+    .merge_sp(u_closest_merge_sp),
+    .free_valid(u_closest_free_valid),
+    .free_slot(u_closest_free_slot),
     .res_valid(u_closest_res_valid),
-    .res_hit(u_closest_res_hit),
     .res_id(u_closest_res_id),
+    .res_hit(u_closest_res_hit),
     .res_tri(u_closest_res_tri),
     .res_t(u_closest_res_t),
     .res_u(u_closest_res_u),
     .res_v(u_closest_res_v)
   );
 
-  assign ray_ready = u_traverse_ray_ready;
+  assign ray_ready = ready_c;
   assign res_valid = u_closest_res_valid;
-  assign res_hit = u_closest_res_hit;
   assign res_id = u_closest_res_id;
+  assign res_hit = u_closest_res_hit;
   assign res_tri = u_closest_res_tri;
   assign res_t = u_closest_res_t;
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
-  assign busy = pipe_busy;
-  assign stack_depth = u_traverse_stack_depth;
-  assign fsm_state = u_traverse_fsm_state;
+  assign busy = pipe_valid;
+  assign stack_depth = mux_lt_33;
+  assign visits = visits_c;
+  assign culls = culls_c;
+  assign occupied = occupied_c;
+  assign accept_slot = accept_slot_int;
+  assign visit0 = u_traverse_0_visit;
+  assign visit0_slot = u_traverse_0_visit_slot;
+  assign visit0_node = u_traverse_0_visit_node;
+  assign visit1 = u_traverse_1_visit;
+  assign visit1_slot = u_traverse_1_visit_slot;
+  assign visit1_node = u_traverse_1_visit_node;
 endmodule
 `default_nettype wire

@@ -20,44 +20,96 @@ entity fxrt_core is
     invz : in signed(47 downto 0);
     ray_ready : out unsigned(0 downto 0);
     res_valid : out unsigned(0 downto 0);
-    res_hit : out unsigned(0 downto 0);
     res_id : out unsigned(19 downto 0);
+    res_hit : out unsigned(0 downto 0);
     res_tri : out unsigned(12 downto 0);
     res_t : out unsigned(29 downto 0);
     res_u : out unsigned(31 downto 0);
     res_v : out unsigned(31 downto 0);
     busy : out unsigned(0 downto 0);
     stack_depth : out unsigned(5 downto 0);
-    fsm_state : out unsigned(3 downto 0)
+    visits : out unsigned(2 downto 0);
+    culls : out unsigned(2 downto 0);
+    occupied : out unsigned(6 downto 0);
+    accept_slot : out unsigned(5 downto 0);
+    visit0 : out unsigned(0 downto 0);
+    visit0_slot : out unsigned(4 downto 0);
+    visit0_node : out unsigned(12 downto 0);
+    visit1 : out unsigned(0 downto 0);
+    visit1_slot : out unsigned(4 downto 0);
+    visit1_node : out unsigned(12 downto 0)
   );
 end entity fxrt_core;
 
 architecture rtl of fxrt_core is
-  component fxrt_traverse is
+  component fxrt_mul_s30xs48_d3l1 is
+    port (
+      clk : in std_logic;
+      a : in signed(29 downto 0);
+      b : in signed(47 downto 0);
+      p : out signed(77 downto 0)
+    );
+  end component;
+  component fxrt_traverse_k32 is
     port (
       clk : in std_logic;
       rst : in std_logic;
-      ray_valid : in unsigned(0 downto 0);
-      ray_id : in unsigned(19 downto 0);
+      ray_we : in unsigned(0 downto 0);
+      ray_slot : in unsigned(4 downto 0);
       ox : in unsigned(28 downto 0);
       oy : in unsigned(28 downto 0);
       oz : in unsigned(28 downto 0);
       invx : in signed(47 downto 0);
       invy : in signed(47 downto 0);
       invz : in signed(47 downto 0);
-      ray_ready : out unsigned(0 downto 0);
-      emit_valid : out unsigned(0 downto 0);
-      emit_end : out unsigned(0 downto 0);
-      emit_tri : out unsigned(12 downto 0);
-      emit_tmin : out unsigned(30 downto 0);
-      emit_id : out unsigned(19 downto 0);
-      cur_ox : out unsigned(28 downto 0);
-      cur_oy : out unsigned(28 downto 0);
-      cur_oz : out unsigned(28 downto 0);
+      new_valid : in unsigned(0 downto 0);
+      new_slot : in unsigned(4 downto 0);
+      new_tmax : in signed(31 downto 0);
+      new_miss : in unsigned(0 downto 0);
+      merge_valid : in unsigned(0 downto 0);
+      merge_slot : in unsigned(4 downto 0);
+      merge_hit : in unsigned(0 downto 0);
+      merge_limit : in signed(31 downto 0);
+      merge_sp : in unsigned(5 downto 0);
+      free_valid : in unsigned(0 downto 0);
+      free_slot : in unsigned(4 downto 0);
+      alloc : in unsigned(0 downto 0);
+      leaf_pop : in unsigned(0 downto 0);
+      done_pop : in unsigned(0 downto 0);
+      node_word : in unsigned(72 downto 0);
+      node_addr : out unsigned(12 downto 0);
+      has_free : out unsigned(0 downto 0);
+      free_slot_out : out unsigned(4 downto 0);
+      leaf_valid : out unsigned(0 downto 0);
+      leaf_slot : out unsigned(4 downto 0);
+      leaf_first : out unsigned(12 downto 0);
+      leaf_count : out unsigned(2 downto 0);
+      leaf_tmin : out unsigned(30 downto 0);
+      leaf_sp : out unsigned(5 downto 0);
+      done_valid : out unsigned(0 downto 0);
+      done_slot : out unsigned(4 downto 0);
       visit : out unsigned(0 downto 0);
+      visit_slot : out unsigned(4 downto 0);
       visit_node : out unsigned(12 downto 0);
-      stack_depth : out unsigned(5 downto 0);
-      fsm_state : out unsigned(3 downto 0)
+      cull : out unsigned(0 downto 0);
+      depth : out unsigned(5 downto 0);
+      occupied : out unsigned(5 downto 0)
+    );
+  end component;
+  component fxrt_brom_node_2p is
+    port (
+      clk : in std_logic;
+      addr : in unsigned(12 downto 0);
+      addr_b : in unsigned(12 downto 0);
+      data : out unsigned(72 downto 0);
+      data_b : out unsigned(72 downto 0)
+    );
+  end component;
+  component fxrt_brom_leaf is
+    port (
+      clk : in std_logic;
+      addr : in unsigned(12 downto 0);
+      data : out unsigned(12 downto 0)
     );
   end component;
   component fxrt_brom_tri_0 is
@@ -81,11 +133,11 @@ architecture rtl of fxrt_core is
       data : out unsigned(31 downto 0)
     );
   end component;
-  component fxrt_intersect_n29_m32_t0_e18_tag45_c150 is
+  component fxrt_intersect_n29_m32_t0_e18_tag58_c150 is
     port (
       clk : in std_logic;
       valid : in unsigned(0 downto 0);
-      tag : in unsigned(44 downto 0);
+      tag : in unsigned(57 downto 0);
       ox : in unsigned(28 downto 0);
       oy : in unsigned(28 downto 0);
       oz : in unsigned(28 downto 0);
@@ -103,26 +155,38 @@ architecture rtl of fxrt_core is
       e2p : in signed(31 downto 0);
       e2q : in signed(31 downto 0);
       valid_out : out unsigned(0 downto 0);
-      tag_out : out unsigned(44 downto 0);
+      tag_out : out unsigned(57 downto 0);
       hit : out unsigned(0 downto 0);
       t : out unsigned(29 downto 0);
       u : out unsigned(31 downto 0);
       v : out unsigned(31 downto 0)
     );
   end component;
-  component fxrt_closest_n29_m32_tag45_r2 is
+  component fxrt_closest_n29_m32_tag58_s64_r2 is
     port (
       clk : in std_logic;
       rst : in std_logic;
       valid : in unsigned(0 downto 0);
-      tag : in unsigned(44 downto 0);
+      tag : in unsigned(57 downto 0);
       hit : in unsigned(0 downto 0);
       t : in unsigned(29 downto 0);
       u : in unsigned(31 downto 0);
       v : in unsigned(31 downto 0);
+      id_we : in unsigned(0 downto 0);
+      id_slot : in unsigned(5 downto 0);
+      id : in unsigned(19 downto 0);
+      done_valid : in unsigned(0 downto 0);
+      done_slot : in unsigned(5 downto 0);
+      merge_valid : out unsigned(0 downto 0);
+      merge_slot : out unsigned(5 downto 0);
+      merge_hit : out unsigned(0 downto 0);
+      merge_limit : out signed(31 downto 0);
+      merge_sp : out unsigned(5 downto 0);
+      free_valid : out unsigned(0 downto 0);
+      free_slot : out unsigned(5 downto 0);
       res_valid : out unsigned(0 downto 0);
-      res_hit : out unsigned(0 downto 0);
       res_id : out unsigned(19 downto 0);
+      res_hit : out unsigned(0 downto 0);
       res_tri : out unsigned(12 downto 0);
       res_t : out unsigned(29 downto 0);
       res_u : out unsigned(31 downto 0);
@@ -130,23 +194,396 @@ architecture rtl of fxrt_core is
     );
   end component;
 
-  signal u_traverse_ray_ready : unsigned(0 downto 0);
-  signal u_traverse_emit_valid : unsigned(0 downto 0);
-  signal u_traverse_emit_end : unsigned(0 downto 0);
-  signal u_traverse_emit_tri : unsigned(12 downto 0);
-  signal u_traverse_emit_tmin : unsigned(30 downto 0);
-  signal u_traverse_emit_id : unsigned(19 downto 0);
-  signal u_traverse_cur_ox : unsigned(28 downto 0);
-  signal u_traverse_cur_oy : unsigned(28 downto 0);
-  signal u_traverse_cur_oz : unsigned(28 downto 0);
-  signal u_traverse_visit : unsigned(0 downto 0);
-  signal u_traverse_visit_node : unsigned(12 downto 0);
-  signal u_traverse_stack_depth : unsigned(5 downto 0);
-  signal u_traverse_fsm_state : unsigned(3 downto 0);
+  type ray_o_t is array (0 to 63) of unsigned(86 downto 0);
+  signal ray_o : ray_o_t := (
+    0 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    1 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    2 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    3 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    4 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    5 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    6 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    7 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    8 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    9 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    10 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    11 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    12 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    13 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    14 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    15 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    16 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    17 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    18 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    19 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    20 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    21 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    22 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    23 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    24 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    25 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    26 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    27 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    28 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    29 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    30 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    31 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    32 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    33 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    34 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    35 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    36 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    37 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    38 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    39 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    40 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    41 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    42 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    43 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    44 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    45 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    46 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    47 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    48 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    49 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    50 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    51 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    52 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    53 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    54 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    55 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    56 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    57 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    58 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    59 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    60 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    61 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    62 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    63 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    others => (others => '0'));
+
+  type ray_w_t is array (0 to 63) of unsigned(95 downto 0);
+  signal ray_w : ray_w_t := (
+    0 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    1 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    2 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    3 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    4 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    5 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    6 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    7 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    8 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    9 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    10 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    11 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    12 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    13 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    14 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    15 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    16 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    17 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    18 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    19 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    20 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    21 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    22 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    23 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    24 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    25 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    26 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    27 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    28 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    29 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    30 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    31 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    32 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    33 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    34 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    35 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    36 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    37 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    38 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    39 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    40 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    41 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    42 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    43 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    44 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    45 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    46 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    47 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    48 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    49 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    50 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    51 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    52 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    53 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    54 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    55 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    56 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    57 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    58 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    59 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    60 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    61 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    62 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    63 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    others => (others => '0'));
+
+  signal u0_has_free : unsigned(0 downto 0);
+  signal u1_has_free : unsigned(0 downto 0);
+  signal u0_free_slot : unsigned(4 downto 0);
+  signal u1_free_slot : unsigned(4 downto 0);
+  signal turn : unsigned(0 downto 0) := unsigned'("0");
+  signal box_phase : unsigned(1 downto 0) := unsigned'("00");
+  constant k_0 : unsigned(0 downto 0) := unsigned'("0");
+  signal case_turn : unsigned(0 downto 0);
+  signal case_turn_1 : unsigned(4 downto 0);
+  constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
+  signal box_phase_eq_k_0_1 : unsigned(0 downto 0);
+  signal ready_c : unsigned(0 downto 0);
   signal accept : unsigned(0 downto 0);
-  signal wx_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal wy_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal wz_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal accept_slot_int : unsigned(5 downto 0);
+  constant k_1 : unsigned(0 downto 0) := unsigned'("1");
+  signal turn_plus_1 : unsigned(0 downto 0);
+  signal not_case_turn : unsigned(0 downto 0);
+  signal accept_or_not_case_turn : unsigned(0 downto 0);
+  signal mux_accept_or_not_case_turn : unsigned(0 downto 0);
+  signal box_phase_ne_k_0_1 : unsigned(0 downto 0);
+  signal or_2 : unsigned(0 downto 0);
+  constant k_1_1 : unsigned(1 downto 0) := unsigned'("01");
+  signal box_phase_plus_k_1_1 : unsigned(1 downto 0);
+  signal mux_or_2 : unsigned(1 downto 0);
+  signal box_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal box_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal box_oz : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal box_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal box_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal box_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal box_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal box_axis : unsigned(1 downto 0);
+  constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
+  constant box_hi_1 : unsigned(28 downto 0) := unsigned'("01111101010101011000101111001");
+  constant box_hi_2 : unsigned(28 downto 0) := unsigned'("10011111001001111000110011011");
+  signal case_box_axis : signed(47 downto 0);
+  signal box_neg : unsigned(0 downto 0);
+  signal box_issue : unsigned(0 downto 0);
+  constant k_3 : unsigned(1 downto 0) := unsigned'("11");
+  signal box_issue_last : unsigned(0 downto 0);
+  constant k_0_2 : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal case_box_axis_1 : unsigned(28 downto 0);
+  signal box_plane : unsigned(28 downto 0);
+  signal pu_sel_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_sel_last : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_sel_plane : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal pu_sel_axis : unsigned(1 downto 0) := unsigned'("00");
+  signal rs_pu_sel_plane : unsigned(29 downto 0);
+  signal s_rs_pu_sel_plane : signed(29 downto 0);
+  signal case_pu_sel_axis : unsigned(28 downto 0);
+  signal rs_case_pu_sel_axis : unsigned(29 downto 0);
+  signal s_rs_case_pu_sel_axis : signed(29 downto 0);
+  signal pu_diff : signed(29 downto 0);
+  signal pu_delta : signed(29 downto 0) := signed'("000000000000000000000000000000");
+  signal pu_inv_axis : signed(47 downto 0);
+  signal pu_inv : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal pu_delta_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_delta_last : unsigned(0 downto 0) := unsigned'("0");
+  signal u_plane_product_p : signed(77 downto 0);
+  signal pu_product : signed(77 downto 0);
+  type pu_product_valid_sr_t is array (1 to 6) of unsigned(0 downto 0);
+  signal pu_product_valid_sr : pu_product_valid_sr_t := (others => (others => '0'));
+  signal pu_product_valid : unsigned(0 downto 0);
+  type pu_product_last_sr_t is array (1 to 6) of unsigned(0 downto 0);
+  signal pu_product_last_sr : pu_product_last_sr_t := (others => (others => '0'));
+  signal pu_product_last : unsigned(0 downto 0);
+  signal bits_pu_product : unsigned(61 downto 0);
+  signal pu_shifted : signed(61 downto 0);
+  signal pu_below : unsigned(0 downto 0);
+  signal not_pu_below : unsigned(0 downto 0);
+  signal bits_pu_shifted : unsigned(30 downto 0);
+  constant k_0_3 : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal bits_pu_shifted_ne_k_0_3 : unsigned(0 downto 0);
+  signal pu_above : unsigned(0 downto 0);
+  signal rs_pu_shifted : signed(31 downto 0);
+  signal pu_above_r : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_below_r : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_low_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal pu_clamp_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_clamp_last : unsigned(0 downto 0) := unsigned'("0");
+  constant k_1073741824 : signed(31 downto 0) := signed'("01000000000000000000000000000000");
+  constant k_m1 : signed(31 downto 0) := signed'("11111111111111111111111111111111");
+  signal mux_pu_below_r : signed(31 downto 0);
+  signal pu_clamped : signed(31 downto 0);
+  signal plane_t : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal plane_t_of_last : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal plane_t_of_first : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal not_pu_clamp_last : unsigned(0 downto 0);
+  signal pu_first : unsigned(0 downto 0);
+  signal plane_t_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal plane_t_last : unsigned(0 downto 0) := unsigned'("0");
+  signal box_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal box_d2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal rs_plane_t : signed(32 downto 0);
+  signal rs_box_d1 : signed(32 downto 0);
+  signal minus_6 : signed(32 downto 0);
+  signal box_lt1_c : unsigned(0 downto 0);
+  signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
+  signal rs_plane_t_1 : signed(32 downto 0);
+  signal rs_box_d2 : signed(32 downto 0);
+  signal minus_7 : signed(32 downto 0);
+  signal box_lt2_c : unsigned(0 downto 0);
+  signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
+  signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
+  signal box_lt1_and_box_lt2 : unsigned(0 downto 0);
+  signal mux_box_lt1_d : signed(31 downto 0);
+  signal box_tmax : signed(31 downto 0);
+  signal bits_box_d1 : unsigned(0 downto 0);
+  signal bits_box_d2 : unsigned(0 downto 0);
+  signal or_8 : unsigned(0 downto 0);
+  signal bits_box_d3 : unsigned(0 downto 0);
+  signal box_miss : unsigned(0 downto 0);
+  signal box_last : unsigned(0 downto 0);
+  signal box_done : unsigned(0 downto 0) := unsigned'("0");
+  type box_done_slot_sr_t is array (1 to 11) of unsigned(5 downto 0);
+  signal box_done_slot_sr : box_done_slot_sr_t := (others => (others => '0'));
+  signal box_done_slot : unsigned(5 downto 0);
+  signal merge_valid : unsigned(0 downto 0);
+  signal merge_slot : unsigned(5 downto 0);
+  signal merge_hit : unsigned(0 downto 0);
+  signal merge_limit : signed(31 downto 0);
+  signal merge_sp : unsigned(5 downto 0);
+  signal free_valid : unsigned(0 downto 0);
+  signal free_slot : unsigned(5 downto 0);
+  signal u0_leaf_pop : unsigned(0 downto 0);
+  signal u1_leaf_pop : unsigned(0 downto 0);
+  signal u0_done_pop : unsigned(0 downto 0);
+  signal u1_done_pop : unsigned(0 downto 0);
+  signal u0_node_word : unsigned(72 downto 0);
+  signal u1_node_word : unsigned(72 downto 0);
+  signal bits_accept_slot : unsigned(0 downto 0);
+  signal bits_accept_slot_eq_k_0 : unsigned(0 downto 0);
+  signal u0_alloc : unsigned(0 downto 0);
+  signal bits_box_done_slot : unsigned(0 downto 0);
+  signal eq_11 : unsigned(0 downto 0);
+  signal u0_new : unsigned(0 downto 0);
+  signal bits_merge_slot : unsigned(0 downto 0);
+  signal bits_merge_slot_eq_k_0 : unsigned(0 downto 0);
+  signal u0_merge : unsigned(0 downto 0);
+  signal bits_free_slot : unsigned(0 downto 0);
+  signal bits_free_slot_eq_k_0 : unsigned(0 downto 0);
+  signal u0_free : unsigned(0 downto 0);
+  signal bits_box_done_slot_1 : unsigned(4 downto 0);
+  signal bits_merge_slot_1 : unsigned(4 downto 0);
+  signal bits_free_slot_1 : unsigned(4 downto 0);
+  signal u_traverse_0_node_addr : unsigned(12 downto 0);
+  signal u_traverse_0_has_free : unsigned(0 downto 0);
+  signal u_traverse_0_free_slot_out : unsigned(4 downto 0);
+  signal u_traverse_0_leaf_valid : unsigned(0 downto 0);
+  signal u_traverse_0_leaf_slot : unsigned(4 downto 0);
+  signal u_traverse_0_leaf_first : unsigned(12 downto 0);
+  signal u_traverse_0_leaf_count : unsigned(2 downto 0);
+  signal u_traverse_0_leaf_tmin : unsigned(30 downto 0);
+  signal u_traverse_0_leaf_sp : unsigned(5 downto 0);
+  signal u_traverse_0_done_valid : unsigned(0 downto 0);
+  signal u_traverse_0_done_slot : unsigned(4 downto 0);
+  signal u_traverse_0_visit : unsigned(0 downto 0);
+  signal u_traverse_0_visit_slot : unsigned(4 downto 0);
+  signal u_traverse_0_visit_node : unsigned(12 downto 0);
+  signal u_traverse_0_cull : unsigned(0 downto 0);
+  signal u_traverse_0_depth : unsigned(5 downto 0);
+  signal u_traverse_0_occupied : unsigned(5 downto 0);
+  signal bits_accept_slot_1 : unsigned(0 downto 0);
+  signal eq_14 : unsigned(0 downto 0);
+  signal u1_alloc : unsigned(0 downto 0);
+  signal bits_box_done_slot_2 : unsigned(0 downto 0);
+  signal eq_15 : unsigned(0 downto 0);
+  signal u1_new : unsigned(0 downto 0);
+  signal bits_merge_slot_2 : unsigned(0 downto 0);
+  signal bits_merge_slot_2_eq_k_1 : unsigned(0 downto 0);
+  signal u1_merge : unsigned(0 downto 0);
+  signal bits_free_slot_2 : unsigned(0 downto 0);
+  signal bits_free_slot_2_eq_k_1 : unsigned(0 downto 0);
+  signal u1_free : unsigned(0 downto 0);
+  signal bits_box_done_slot_3 : unsigned(4 downto 0);
+  signal bits_merge_slot_3 : unsigned(4 downto 0);
+  signal bits_free_slot_3 : unsigned(4 downto 0);
+  signal u_traverse_1_node_addr : unsigned(12 downto 0);
+  signal u_traverse_1_has_free : unsigned(0 downto 0);
+  signal u_traverse_1_free_slot_out : unsigned(4 downto 0);
+  signal u_traverse_1_leaf_valid : unsigned(0 downto 0);
+  signal u_traverse_1_leaf_slot : unsigned(4 downto 0);
+  signal u_traverse_1_leaf_first : unsigned(12 downto 0);
+  signal u_traverse_1_leaf_count : unsigned(2 downto 0);
+  signal u_traverse_1_leaf_tmin : unsigned(30 downto 0);
+  signal u_traverse_1_leaf_sp : unsigned(5 downto 0);
+  signal u_traverse_1_done_valid : unsigned(0 downto 0);
+  signal u_traverse_1_done_slot : unsigned(4 downto 0);
+  signal u_traverse_1_visit : unsigned(0 downto 0);
+  signal u_traverse_1_visit_slot : unsigned(4 downto 0);
+  signal u_traverse_1_visit_node : unsigned(12 downto 0);
+  signal u_traverse_1_cull : unsigned(0 downto 0);
+  signal u_traverse_1_depth : unsigned(5 downto 0);
+  signal u_traverse_1_occupied : unsigned(5 downto 0);
+  signal u_node_rom_0_data : unsigned(72 downto 0);
+  signal u_node_rom_0_data_b : unsigned(72 downto 0);
+  signal cat_18 : unsigned(86 downto 0);
+  signal u_wz : unsigned(31 downto 0);
+  signal u_wy : unsigned(31 downto 0);
+  signal u_wx : unsigned(31 downto 0);
+  signal cat_19 : unsigned(95 downto 0);
+  signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
+  signal leaf_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal leaf_left : unsigned(2 downto 0) := unsigned'("000");
+  signal leaf_tmin : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal leaf_sp : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_first_entry : unsigned(0 downto 0) := unsigned'("0");
+  constant k_1_2 : unsigned(2 downto 0) := unsigned'("001");
+  signal leaf_left_eq_k_1_2 : unsigned(0 downto 0);
+  signal leaf_last_entry : unsigned(0 downto 0);
+  signal not_leaf_active : unsigned(0 downto 0);
+  signal leaf_can_take : unsigned(0 downto 0);
+  signal leaf_turn : unsigned(0 downto 0) := unsigned'("0");
+  signal case_leaf_turn : unsigned(0 downto 0);
+  signal case_leaf_turn_1 : unsigned(0 downto 0);
+  signal case_leaf_turn_2 : unsigned(0 downto 0);
+  signal case_leaf_turn_3 : unsigned(0 downto 0);
+  signal or_22 : unsigned(0 downto 0);
+  signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
+  signal leaf_take : unsigned(0 downto 0);
+  signal eq_23 : unsigned(0 downto 0);
+  signal u0_leaf_take : unsigned(0 downto 0);
+  signal eq_24 : unsigned(0 downto 0);
+  signal u1_leaf_take : unsigned(0 downto 0);
+  signal case_mux_case_leaf_turn_2 : unsigned(4 downto 0);
+  signal cat_25 : unsigned(5 downto 0);
+  signal not_leaf_last_entry : unsigned(0 downto 0);
+  signal and_26 : unsigned(0 downto 0);
+  signal leaf_take_or_and_26 : unsigned(0 downto 0);
+  signal mux_leaf_take : unsigned(5 downto 0);
+  signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
+  constant k_1_3 : unsigned(12 downto 0) := unsigned'("0000000000001");
+  signal leaf_ptr_plus_k_1_3 : unsigned(12 downto 0);
+  signal mux_leaf_take_1 : unsigned(12 downto 0);
+  signal case_mux_case_leaf_turn_2_2 : unsigned(2 downto 0);
+  signal leaf_left_minus_k_1_2 : unsigned(2 downto 0);
+  signal mux_leaf_take_2 : unsigned(2 downto 0);
+  signal case_mux_case_leaf_turn_2_3 : unsigned(30 downto 0);
+  signal mux_leaf_take_3 : unsigned(30 downto 0);
+  signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
+  signal mux_leaf_take_4 : unsigned(5 downto 0);
+  signal u_leaf_rom_data : unsigned(12 downto 0);
+  constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal cat_27 : unsigned(57 downto 0);
+  type emit_tag_sr_t is array (1 to 3) of unsigned(57 downto 0);
+  signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
+  signal emit_tag : unsigned(57 downto 0);
+  signal bits_emit_tag : unsigned(44 downto 0);
+  signal emit_tag_tri : unsigned(57 downto 0);
+  type emit_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
+  signal emit_valid_sr : emit_valid_sr_t := (others => (others => '0'));
+  signal emit_valid : unsigned(0 downto 0);
   signal tri_addr : unsigned(12 downto 0);
   signal u_tri_rom_0_data : unsigned(123 downto 0);
   signal tri_r : unsigned(1 downto 0);
@@ -167,54 +604,279 @@ architecture rtl of fxrt_core is
   signal tri_e2p : signed(31 downto 0);
   signal u_tri_rom_2_data : unsigned(31 downto 0);
   signal tri_e2q : signed(31 downto 0);
-  signal cat_1 : unsigned(43 downto 0);
-  signal rs_u_traverse_emit_id : unsigned(43 downto 0);
-  signal mux_u_traverse_emit_end : unsigned(43 downto 0);
-  signal tag : unsigned(44 downto 0);
   type pipe_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
   signal pipe_valid_sr : pipe_valid_sr_t := (others => (others => '0'));
   signal pipe_valid : unsigned(0 downto 0);
-  type pipe_tag_sr_t is array (1 to 3) of unsigned(44 downto 0);
+  type pipe_tag_sr_t is array (1 to 3) of unsigned(57 downto 0);
   signal pipe_tag_sr : pipe_tag_sr_t := (others => (others => '0'));
-  signal pipe_tag : unsigned(44 downto 0);
-  type pipe_cur_ox_sr_t is array (1 to 3) of unsigned(28 downto 0);
-  signal pipe_cur_ox_sr : pipe_cur_ox_sr_t := (others => (others => '0'));
-  signal pipe_cur_ox : unsigned(28 downto 0);
-  type pipe_cur_oy_sr_t is array (1 to 3) of unsigned(28 downto 0);
-  signal pipe_cur_oy_sr : pipe_cur_oy_sr_t := (others => (others => '0'));
-  signal pipe_cur_oy : unsigned(28 downto 0);
-  type pipe_cur_oz_sr_t is array (1 to 3) of unsigned(28 downto 0);
-  signal pipe_cur_oz_sr : pipe_cur_oz_sr_t := (others => (others => '0'));
-  signal pipe_cur_oz : unsigned(28 downto 0);
-  type pipe_wx_sr_t is array (1 to 3) of signed(31 downto 0);
-  signal pipe_wx_sr : pipe_wx_sr_t := (others => (others => '0'));
-  signal pipe_wx : signed(31 downto 0);
-  type pipe_wy_sr_t is array (1 to 3) of signed(31 downto 0);
-  signal pipe_wy_sr : pipe_wy_sr_t := (others => (others => '0'));
-  signal pipe_wy : signed(31 downto 0);
-  type pipe_wz_sr_t is array (1 to 3) of signed(31 downto 0);
-  signal pipe_wz_sr : pipe_wz_sr_t := (others => (others => '0'));
-  signal pipe_wz : signed(31 downto 0);
+  signal pipe_tag : unsigned(57 downto 0);
+  signal bits_emit_tag_tri : unsigned(5 downto 0);
+  signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  type pipe_o_sr_t is array (1 to 2) of unsigned(86 downto 0);
+  signal pipe_o_sr : pipe_o_sr_t := (others => (others => '0'));
+  signal pipe_o : unsigned(86 downto 0);
+  signal ray_w_q : unsigned(95 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  type pipe_w_sr_t is array (1 to 2) of unsigned(95 downto 0);
+  signal pipe_w_sr : pipe_w_sr_t := (others => (others => '0'));
+  signal pipe_w : unsigned(95 downto 0);
+  signal bits_pipe_o : unsigned(28 downto 0);
+  signal bits_pipe_o_1 : unsigned(28 downto 0);
+  signal bits_pipe_o_2 : unsigned(28 downto 0);
+  signal bits_pipe_w : unsigned(31 downto 0);
+  signal s_bits_pipe_w : signed(31 downto 0);
+  signal bits_pipe_w_1 : unsigned(31 downto 0);
+  signal s_bits_pipe_w_1 : signed(31 downto 0);
+  signal bits_pipe_w_2 : unsigned(31 downto 0);
+  signal s_bits_pipe_w_2 : signed(31 downto 0);
   signal u_intersect_valid_out : unsigned(0 downto 0);
-  signal u_intersect_tag_out : unsigned(44 downto 0);
+  signal u_intersect_tag_out : unsigned(57 downto 0);
   signal u_intersect_hit : unsigned(0 downto 0);
   signal u_intersect_t_1 : unsigned(29 downto 0);
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
+  signal cat_29 : unsigned(5 downto 0);
+  signal not_u_traverse_0_done_valid : unsigned(0 downto 0);
+  signal u1_done_take : unsigned(0 downto 0);
+  signal cat_31 : unsigned(5 downto 0);
+  signal mux_u_traverse_0_done_valid : unsigned(5 downto 0);
+  signal or_32 : unsigned(0 downto 0);
+  signal u_closest_merge_valid : unsigned(0 downto 0);
+  signal u_closest_merge_slot : unsigned(5 downto 0);
+  signal u_closest_merge_hit : unsigned(0 downto 0);
+  signal u_closest_merge_limit : signed(31 downto 0);
+  signal u_closest_merge_sp : unsigned(5 downto 0);
+  signal u_closest_free_valid : unsigned(0 downto 0);
+  signal u_closest_free_slot : unsigned(5 downto 0);
   signal u_closest_res_valid : unsigned(0 downto 0);
-  signal u_closest_res_hit : unsigned(0 downto 0);
   signal u_closest_res_id : unsigned(19 downto 0);
+  signal u_closest_res_hit : unsigned(0 downto 0);
   signal u_closest_res_tri : unsigned(12 downto 0);
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal bits_pipe_tag : unsigned(0 downto 0);
-  signal not_bits_pipe_tag : unsigned(0 downto 0);
-  signal pipe_busy : unsigned(0 downto 0);
+  signal lt_33 : unsigned(0 downto 0);
+  signal mux_lt_33 : unsigned(5 downto 0);
+  signal rs_u_traverse_0_visit : unsigned(2 downto 0);
+  signal rs_u_traverse_1_visit : unsigned(2 downto 0);
+  signal visits_c : unsigned(2 downto 0);
+  signal rs_u_traverse_0_cull : unsigned(2 downto 0);
+  signal rs_u_traverse_1_cull : unsigned(2 downto 0);
+  signal culls_c : unsigned(2 downto 0);
+  signal rs_u_traverse_0_occupied : unsigned(6 downto 0);
+  signal rs_u_traverse_1_occupied : unsigned(6 downto 0);
+  signal occupied_c : unsigned(6 downto 0);
 begin
 
-  accept <= ray_valid and u_traverse_ray_ready;
-  tri_addr <= u_traverse_emit_tri;
+  u0_has_free <= u_traverse_0_has_free;
+  u1_has_free <= u_traverse_1_has_free;
+  u0_free_slot <= u_traverse_0_free_slot_out;
+  u1_free_slot <= u_traverse_1_free_slot_out;
+  with turn select
+    case_turn <=
+      u0_has_free when "0",
+      u1_has_free when "1",
+      k_0 when others;
+  with turn select
+    case_turn_1 <=
+      u0_free_slot when "0",
+      u1_free_slot when "1",
+      u0_free_slot when others;
+  box_phase_eq_k_0_1 <= "1" when box_phase = k_0_1 else "0";
+  ready_c <= box_phase_eq_k_0_1 and case_turn;
+  accept <= ray_valid and ready_c;
+  accept_slot_int <= unsigned(std_logic_vector'(std_logic_vector(turn) & std_logic_vector(case_turn_1)));
+  turn_plus_1 <= turn + k_1;
+  not_case_turn <= not case_turn;
+  accept_or_not_case_turn <= accept or not_case_turn;
+  mux_accept_or_not_case_turn <= turn_plus_1 when accept_or_not_case_turn = "1" else turn;
+  box_phase_ne_k_0_1 <= "1" when box_phase /= k_0_1 else "0";
+  or_2 <= accept or box_phase_ne_k_0_1;
+  box_phase_plus_k_1_1 <= box_phase + k_1_1;
+  mux_or_2 <= box_phase_plus_k_1_1 when or_2 = "1" else box_phase;
+  box_axis <= box_phase - k_1_1;
+  with box_axis select
+    case_box_axis <=
+      box_invy when "01",
+      box_invz when "10",
+      box_invx when others;
+  box_neg <= unsigned(case_box_axis(47 downto 47));
+  box_issue <= "1" when box_phase /= k_0_1 else "0";
+  box_issue_last <= "1" when box_phase = k_3 else "0";
+  with box_axis select
+    case_box_axis_1 <=
+      box_hi_1 when "01",
+      box_hi_2 when "10",
+      box_hi_0 when others;
+  box_plane <= k_0_2 when box_neg = "1" else case_box_axis_1;
+  rs_pu_sel_plane <= resize(pu_sel_plane, 30);
+  s_rs_pu_sel_plane <= signed(rs_pu_sel_plane);
+  with pu_sel_axis select
+    case_pu_sel_axis <=
+      box_oy when "01",
+      box_oz when "10",
+      box_ox when others;
+  rs_case_pu_sel_axis <= resize(case_pu_sel_axis, 30);
+  s_rs_case_pu_sel_axis <= signed(rs_case_pu_sel_axis);
+  pu_diff <= s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
+  with pu_sel_axis select
+    pu_inv_axis <=
+      box_invy when "01",
+      box_invz when "10",
+      box_invx when others;
+  pu_product <= u_plane_product_p;
+  pu_product_valid <= pu_product_valid_sr(6);
+  pu_product_last <= pu_product_last_sr(6);
+  bits_pu_product <= unsigned(pu_product(77 downto 16));
+  pu_shifted <= signed(bits_pu_product);
+  pu_below <= unsigned(pu_shifted(61 downto 61));
+  not_pu_below <= not pu_below;
+  bits_pu_shifted <= unsigned(pu_shifted(60 downto 30));
+  bits_pu_shifted_ne_k_0_3 <= "1" when bits_pu_shifted /= k_0_3 else "0";
+  pu_above <= not_pu_below and bits_pu_shifted_ne_k_0_3;
+  rs_pu_shifted <= pu_shifted(31 downto 0);
+  mux_pu_below_r <= k_m1 when pu_below_r = "1" else pu_low_r;
+  pu_clamped <= k_1073741824 when pu_above_r = "1" else mux_pu_below_r;
+  not_pu_clamp_last <= not pu_clamp_last;
+  pu_first <= pu_clamp_valid and not_pu_clamp_last;
+  rs_plane_t <= resize(plane_t, 33);
+  rs_box_d1 <= resize(box_d1, 33);
+  minus_6 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_6(32 downto 32));
+  rs_plane_t_1 <= resize(plane_t, 33);
+  rs_box_d2 <= resize(box_d2, 33);
+  minus_7 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_7(32 downto 32));
+  box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
+  mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
+  box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
+  bits_box_d1 <= unsigned(box_d1(31 downto 31));
+  bits_box_d2 <= unsigned(box_d2(31 downto 31));
+  or_8 <= bits_box_d1 or bits_box_d2;
+  bits_box_d3 <= unsigned(box_d3(31 downto 31));
+  box_miss <= or_8 or bits_box_d3;
+  box_last <= plane_t_valid and plane_t_last;
+  box_done_slot <= box_done_slot_sr(11);
+  merge_valid <= u_closest_merge_valid;
+  merge_slot <= u_closest_merge_slot;
+  merge_hit <= u_closest_merge_hit;
+  merge_limit <= u_closest_merge_limit;
+  merge_sp <= u_closest_merge_sp;
+  free_valid <= u_closest_free_valid;
+  free_slot <= u_closest_free_slot;
+  u0_leaf_pop <= u0_leaf_take;
+  u1_leaf_pop <= u1_leaf_take;
+  u0_done_pop <= u_traverse_0_done_valid;
+  u1_done_pop <= u1_done_take;
+  u0_node_word <= u_node_rom_0_data;
+  u1_node_word <= u_node_rom_0_data_b;
+  bits_accept_slot <= unsigned(accept_slot_int(5 downto 5));
+  bits_accept_slot_eq_k_0 <= "1" when bits_accept_slot = k_0 else "0";
+  u0_alloc <= accept and bits_accept_slot_eq_k_0;
+  bits_box_done_slot <= unsigned(box_done_slot(5 downto 5));
+  eq_11 <= "1" when bits_box_done_slot = k_0 else "0";
+  u0_new <= box_done and eq_11;
+  bits_merge_slot <= unsigned(merge_slot(5 downto 5));
+  bits_merge_slot_eq_k_0 <= "1" when bits_merge_slot = k_0 else "0";
+  u0_merge <= merge_valid and bits_merge_slot_eq_k_0;
+  bits_free_slot <= unsigned(free_slot(5 downto 5));
+  bits_free_slot_eq_k_0 <= "1" when bits_free_slot = k_0 else "0";
+  u0_free <= free_valid and bits_free_slot_eq_k_0;
+  bits_box_done_slot_1 <= unsigned(box_done_slot(4 downto 0));
+  bits_merge_slot_1 <= unsigned(merge_slot(4 downto 0));
+  bits_free_slot_1 <= unsigned(free_slot(4 downto 0));
+  bits_accept_slot_1 <= unsigned(accept_slot_int(5 downto 5));
+  eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
+  u1_alloc <= accept and eq_14;
+  bits_box_done_slot_2 <= unsigned(box_done_slot(5 downto 5));
+  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_15;
+  bits_merge_slot_2 <= unsigned(merge_slot(5 downto 5));
+  bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
+  u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
+  bits_free_slot_2 <= unsigned(free_slot(5 downto 5));
+  bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
+  u1_free <= free_valid and bits_free_slot_2_eq_k_1;
+  bits_box_done_slot_3 <= unsigned(box_done_slot(4 downto 0));
+  bits_merge_slot_3 <= unsigned(merge_slot(4 downto 0));
+  bits_free_slot_3 <= unsigned(free_slot(4 downto 0));
+  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(oz) & std_logic_vector(oy) & std_logic_vector(ox)));
+  u_wz <= unsigned(wz);
+  u_wy <= unsigned(wy);
+  u_wx <= unsigned(wx);
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_wz) & std_logic_vector(u_wy) & std_logic_vector(u_wx)));
+  leaf_left_eq_k_1_2 <= "1" when leaf_left = k_1_2 else "0";
+  leaf_last_entry <= leaf_active and leaf_left_eq_k_1_2;
+  not_leaf_active <= not leaf_active;
+  leaf_can_take <= not_leaf_active or leaf_last_entry;
+  with leaf_turn select
+    case_leaf_turn <=
+      u_traverse_0_leaf_valid when "0",
+      u_traverse_1_leaf_valid when "1",
+      k_0 when others;
+  with leaf_turn select
+    case_leaf_turn_1 <=
+      k_0 when "0",
+      k_1 when "1",
+      k_0 when others;
+  with leaf_turn select
+    case_leaf_turn_2 <=
+      u_traverse_1_leaf_valid when "0",
+      u_traverse_0_leaf_valid when "1",
+      k_0 when others;
+  with leaf_turn select
+    case_leaf_turn_3 <=
+      k_1 when "0",
+      k_0 when "1",
+      k_0 when others;
+  or_22 <= case_leaf_turn_2 or case_leaf_turn;
+  mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
+  leaf_take <= leaf_can_take and or_22;
+  eq_23 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
+  u0_leaf_take <= leaf_take and eq_23;
+  eq_24 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_24;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2 <=
+      u_traverse_0_leaf_slot when "0",
+      u_traverse_1_leaf_slot when "1",
+      u_traverse_0_leaf_slot when others;
+  cat_25 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  not_leaf_last_entry <= not leaf_last_entry;
+  and_26 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_26 <= leaf_take or and_26;
+  mux_leaf_take <= cat_25 when leaf_take = "1" else leaf_slot;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_1 <=
+      u_traverse_0_leaf_first when "0",
+      u_traverse_1_leaf_first when "1",
+      u_traverse_0_leaf_first when others;
+  leaf_ptr_plus_k_1_3 <= leaf_ptr + k_1_3;
+  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_3;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_2 <=
+      u_traverse_0_leaf_count when "0",
+      u_traverse_1_leaf_count when "1",
+      u_traverse_0_leaf_count when others;
+  leaf_left_minus_k_1_2 <= leaf_left - k_1_2;
+  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_2;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_3 <=
+      u_traverse_0_leaf_tmin when "0",
+      u_traverse_1_leaf_tmin when "1",
+      u_traverse_0_leaf_tmin when others;
+  mux_leaf_take_3 <= case_mux_case_leaf_turn_2_3 when leaf_take = "1" else leaf_tmin;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_4 <=
+      u_traverse_0_leaf_sp when "0",
+      u_traverse_1_leaf_sp when "1",
+      u_traverse_0_leaf_sp when others;
+  mux_leaf_take_4 <= case_mux_case_leaf_turn_2_4 when leaf_take = "1" else leaf_sp;
+  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  emit_tag <= emit_tag_sr(3);
+  bits_emit_tag <= unsigned(emit_tag(57 downto 13));
+  emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
+  emit_valid <= emit_valid_sr(3);
+  tri_addr <= u_leaf_rom_data;
   tri_r <= unsigned(u_tri_rom_0_data(1 downto 0));
   tri_pp <= unsigned(u_tri_rom_0_data(30 downto 2));
   tri_pq <= unsigned(u_tri_rom_0_data(59 downto 31));
@@ -231,78 +893,260 @@ begin
   bits_u_tri_rom_1_data_3 <= unsigned(u_tri_rom_1_data(127 downto 96));
   tri_e2p <= signed(bits_u_tri_rom_1_data_3);
   tri_e2q <= signed(u_tri_rom_2_data);
-  cat_1 <= unsigned(std_logic_vector'(std_logic_vector(u_traverse_emit_tmin) & std_logic_vector(u_traverse_emit_tri)));
-  rs_u_traverse_emit_id <= resize(u_traverse_emit_id, 44);
-  mux_u_traverse_emit_end <= rs_u_traverse_emit_id when u_traverse_emit_end = "1" else cat_1;
-  tag <= unsigned(std_logic_vector'(std_logic_vector(u_traverse_emit_end) & std_logic_vector(mux_u_traverse_emit_end)));
   pipe_valid <= pipe_valid_sr(3);
   pipe_tag <= pipe_tag_sr(3);
-  pipe_cur_ox <= pipe_cur_ox_sr(3);
-  pipe_cur_oy <= pipe_cur_oy_sr(3);
-  pipe_cur_oz <= pipe_cur_oz_sr(3);
-  pipe_wx <= pipe_wx_sr(3);
-  pipe_wy <= pipe_wy_sr(3);
-  pipe_wz <= pipe_wz_sr(3);
-  bits_pipe_tag <= unsigned(pipe_tag(44 downto 44));
-  not_bits_pipe_tag <= not bits_pipe_tag;
-  pipe_busy <= pipe_valid and not_bits_pipe_tag;
+  bits_emit_tag_tri <= unsigned(emit_tag_tri(55 downto 50));
+  pipe_o <= pipe_o_sr(2);
+  pipe_w <= pipe_w_sr(2);
+  bits_pipe_o <= unsigned(pipe_o(28 downto 0));
+  bits_pipe_o_1 <= unsigned(pipe_o(57 downto 29));
+  bits_pipe_o_2 <= unsigned(pipe_o(86 downto 58));
+  bits_pipe_w <= unsigned(pipe_w(31 downto 0));
+  s_bits_pipe_w <= signed(bits_pipe_w);
+  bits_pipe_w_1 <= unsigned(pipe_w(63 downto 32));
+  s_bits_pipe_w_1 <= signed(bits_pipe_w_1);
+  bits_pipe_w_2 <= unsigned(pipe_w(95 downto 64));
+  s_bits_pipe_w_2 <= signed(bits_pipe_w_2);
+  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  not_u_traverse_0_done_valid <= not u_traverse_0_done_valid;
+  u1_done_take <= u_traverse_1_done_valid and not_u_traverse_0_done_valid;
+  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u_traverse_0_done_valid <= cat_29 when u_traverse_0_done_valid = "1" else cat_31;
+  or_32 <= u_traverse_0_done_valid or u_traverse_1_done_valid;
+  lt_33 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
+  mux_lt_33 <= u_traverse_1_depth when lt_33 = "1" else u_traverse_0_depth;
+  rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
+  rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
+  visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
+  rs_u_traverse_0_cull <= resize(u_traverse_0_cull, 3);
+  rs_u_traverse_1_cull <= resize(u_traverse_1_cull, 3);
+  culls_c <= rs_u_traverse_0_cull + rs_u_traverse_1_cull;
+  rs_u_traverse_0_occupied <= resize(u_traverse_0_occupied, 7);
+  rs_u_traverse_1_occupied <= resize(u_traverse_1_occupied, 7);
+  occupied_c <= rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
       if accept = "1" then
-        wx_r <= wx;
+        ray_o(to_integer(accept_slot_int)) <= cat_18;
       end if;
       if accept = "1" then
-        wy_r <= wy;
+        ray_w(to_integer(accept_slot_int)) <= cat_19;
+      end if;
+      if rst = '1' then
+        turn <= unsigned'("0");
+      else
+        turn <= mux_accept_or_not_case_turn;
+      end if;
+      if rst = '1' then
+        box_phase <= unsigned'("00");
+      else
+        box_phase <= mux_or_2;
       end if;
       if accept = "1" then
-        wz_r <= wz;
+        box_ox <= ox;
       end if;
+      if accept = "1" then
+        box_oy <= oy;
+      end if;
+      if accept = "1" then
+        box_oz <= oz;
+      end if;
+      if accept = "1" then
+        box_invx <= invx;
+      end if;
+      if accept = "1" then
+        box_invy <= invy;
+      end if;
+      if accept = "1" then
+        box_invz <= invz;
+      end if;
+      if accept = "1" then
+        box_slot <= accept_slot_int;
+      end if;
+      pu_sel_valid <= box_issue;
+      pu_sel_last <= box_issue_last;
+      pu_sel_plane <= box_plane;
+      pu_sel_axis <= box_axis;
+      pu_delta <= pu_diff;
+      pu_inv <= pu_inv_axis;
+      pu_delta_valid <= pu_sel_valid;
+      pu_delta_last <= pu_sel_last;
+      pu_product_valid_sr(2 to 6) <= pu_product_valid_sr(1 to 5);
+      pu_product_valid_sr(1) <= pu_delta_valid;
+      pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
+      pu_product_last_sr(1) <= pu_delta_last;
+      pu_above_r <= pu_above;
+      pu_below_r <= pu_below;
+      pu_low_r <= rs_pu_shifted;
+      pu_clamp_valid <= pu_product_valid;
+      pu_clamp_last <= pu_product_last;
+      plane_t <= pu_clamped;
+      if pu_clamp_last = "1" then
+        plane_t_of_last <= pu_clamped;
+      end if;
+      if pu_first = "1" then
+        plane_t_of_first <= pu_clamped;
+      end if;
+      plane_t_valid <= pu_clamp_valid;
+      plane_t_last <= pu_clamp_last;
+      box_d1 <= plane_t;
+      box_d2 <= box_d1;
+      box_d3 <= box_d2;
+      box_lt1 <= box_lt1_c;
+      box_lt2 <= box_lt2_c;
+      box_lt1_d <= box_lt1;
+      box_done <= box_last;
+      box_done_slot_sr(2 to 11) <= box_done_slot_sr(1 to 10);
+      box_done_slot_sr(1) <= box_slot;
+      if rst = '1' then
+        leaf_active <= unsigned'("0");
+      else
+        leaf_active <= leaf_take_or_and_26;
+      end if;
+      leaf_slot <= mux_leaf_take;
+      leaf_ptr <= mux_leaf_take_1;
+      leaf_left <= mux_leaf_take_2;
+      leaf_tmin <= mux_leaf_take_3;
+      leaf_sp <= mux_leaf_take_4;
+      leaf_first_entry <= leaf_take;
+      if rst = '1' then
+        leaf_turn <= unsigned'("0");
+      elsif leaf_take = "1" then
+        leaf_turn <= mux_case_leaf_turn_2;
+      end if;
+      emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
+      emit_tag_sr(1) <= cat_27;
+      emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
+      emit_valid_sr(1) <= leaf_active;
       pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
-      pipe_valid_sr(1) <= u_traverse_emit_valid;
+      pipe_valid_sr(1) <= emit_valid;
       pipe_tag_sr(2 to 3) <= pipe_tag_sr(1 to 2);
-      pipe_tag_sr(1) <= tag;
-      pipe_cur_ox_sr(2 to 3) <= pipe_cur_ox_sr(1 to 2);
-      pipe_cur_ox_sr(1) <= u_traverse_cur_ox;
-      pipe_cur_oy_sr(2 to 3) <= pipe_cur_oy_sr(1 to 2);
-      pipe_cur_oy_sr(1) <= u_traverse_cur_oy;
-      pipe_cur_oz_sr(2 to 3) <= pipe_cur_oz_sr(1 to 2);
-      pipe_cur_oz_sr(1) <= u_traverse_cur_oz;
-      pipe_wx_sr(2 to 3) <= pipe_wx_sr(1 to 2);
-      pipe_wx_sr(1) <= wx_r;
-      pipe_wy_sr(2 to 3) <= pipe_wy_sr(1 to 2);
-      pipe_wy_sr(1) <= wy_r;
-      pipe_wz_sr(2 to 3) <= pipe_wz_sr(1 to 2);
-      pipe_wz_sr(1) <= wz_r;
+      pipe_tag_sr(1) <= emit_tag_tri;
+      ray_o_q <= ray_o(to_integer(bits_emit_tag_tri));
+      pipe_o_sr(2 to 2) <= pipe_o_sr(1 to 1);
+      pipe_o_sr(1) <= ray_o_q;
+      ray_w_q <= ray_w(to_integer(bits_emit_tag_tri));
+      pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
+      pipe_w_sr(1) <= ray_w_q;
     end if;
   end process regs;
 
-  u_traverse : fxrt_traverse
+  u_plane_product : fxrt_mul_s30xs48_d3l1
+    port map (
+      clk => clk,
+      a => pu_delta,
+      b => pu_inv,
+      p => u_plane_product_p
+    );
+
+  u_traverse_0 : fxrt_traverse_k32
     port map (
       clk => clk,
       rst => rst,
-      ray_valid => ray_valid,
-      ray_id => ray_id,
+      ray_we => u0_alloc,
+      ray_slot => case_turn_1,
       ox => ox,
       oy => oy,
       oz => oz,
       invx => invx,
       invy => invy,
       invz => invz,
-      ray_ready => u_traverse_ray_ready,
-      emit_valid => u_traverse_emit_valid,
-      emit_end => u_traverse_emit_end,
-      emit_tri => u_traverse_emit_tri,
-      emit_tmin => u_traverse_emit_tmin,
-      emit_id => u_traverse_emit_id,
-      cur_ox => u_traverse_cur_ox,
-      cur_oy => u_traverse_cur_oy,
-      cur_oz => u_traverse_cur_oz,
-      visit => u_traverse_visit,
-      visit_node => u_traverse_visit_node,
-      stack_depth => u_traverse_stack_depth,
-      fsm_state => u_traverse_fsm_state
+      new_valid => u0_new,
+      new_slot => bits_box_done_slot_1,
+      new_tmax => box_tmax,
+      new_miss => box_miss,
+      merge_valid => u0_merge,
+      merge_slot => bits_merge_slot_1,
+      merge_hit => merge_hit,
+      merge_limit => merge_limit,
+      merge_sp => merge_sp,
+      free_valid => u0_free,
+      free_slot => bits_free_slot_1,
+      alloc => u0_alloc,
+      leaf_pop => u0_leaf_pop,
+      done_pop => u0_done_pop,
+      node_word => u0_node_word,
+      node_addr => u_traverse_0_node_addr,
+      has_free => u_traverse_0_has_free,
+      free_slot_out => u_traverse_0_free_slot_out,
+      leaf_valid => u_traverse_0_leaf_valid,
+      leaf_slot => u_traverse_0_leaf_slot,
+      leaf_first => u_traverse_0_leaf_first,
+      leaf_count => u_traverse_0_leaf_count,
+      leaf_tmin => u_traverse_0_leaf_tmin,
+      leaf_sp => u_traverse_0_leaf_sp,
+      done_valid => u_traverse_0_done_valid,
+      done_slot => u_traverse_0_done_slot,
+      visit => u_traverse_0_visit,
+      visit_slot => u_traverse_0_visit_slot,
+      visit_node => u_traverse_0_visit_node,
+      cull => u_traverse_0_cull,
+      depth => u_traverse_0_depth,
+      occupied => u_traverse_0_occupied
+    );
+
+  u_traverse_1 : fxrt_traverse_k32
+    port map (
+      clk => clk,
+      rst => rst,
+      ray_we => u1_alloc,
+      ray_slot => case_turn_1,
+      ox => ox,
+      oy => oy,
+      oz => oz,
+      invx => invx,
+      invy => invy,
+      invz => invz,
+      new_valid => u1_new,
+      new_slot => bits_box_done_slot_3,
+      new_tmax => box_tmax,
+      new_miss => box_miss,
+      merge_valid => u1_merge,
+      merge_slot => bits_merge_slot_3,
+      merge_hit => merge_hit,
+      merge_limit => merge_limit,
+      merge_sp => merge_sp,
+      free_valid => u1_free,
+      free_slot => bits_free_slot_3,
+      alloc => u1_alloc,
+      leaf_pop => u1_leaf_pop,
+      done_pop => u1_done_pop,
+      node_word => u1_node_word,
+      node_addr => u_traverse_1_node_addr,
+      has_free => u_traverse_1_has_free,
+      free_slot_out => u_traverse_1_free_slot_out,
+      leaf_valid => u_traverse_1_leaf_valid,
+      leaf_slot => u_traverse_1_leaf_slot,
+      leaf_first => u_traverse_1_leaf_first,
+      leaf_count => u_traverse_1_leaf_count,
+      leaf_tmin => u_traverse_1_leaf_tmin,
+      leaf_sp => u_traverse_1_leaf_sp,
+      done_valid => u_traverse_1_done_valid,
+      done_slot => u_traverse_1_done_slot,
+      visit => u_traverse_1_visit,
+      visit_slot => u_traverse_1_visit_slot,
+      visit_node => u_traverse_1_visit_node,
+      cull => u_traverse_1_cull,
+      depth => u_traverse_1_depth,
+      occupied => u_traverse_1_occupied
+    );
+
+  u_node_rom_0 : fxrt_brom_node_2p
+    port map (
+      clk => clk,
+      addr => u_traverse_0_node_addr,
+      addr_b => u_traverse_1_node_addr,
+      data => u_node_rom_0_data,
+      data_b => u_node_rom_0_data_b
+    );
+
+  u_leaf_rom : fxrt_brom_leaf
+    port map (
+      clk => clk,
+      addr => leaf_ptr,
+      data => u_leaf_rom_data
     );
 
   u_tri_rom_0 : fxrt_brom_tri_0
@@ -326,17 +1170,17 @@ begin
       data => u_tri_rom_2_data
     );
 
-  u_intersect : fxrt_intersect_n29_m32_t0_e18_tag45_c150
+  u_intersect : fxrt_intersect_n29_m32_t0_e18_tag58_c150
     port map (
       clk => clk,
       valid => pipe_valid,
       tag => pipe_tag,
-      ox => pipe_cur_ox,
-      oy => pipe_cur_oy,
-      oz => pipe_cur_oz,
-      wx => pipe_wx,
-      wy => pipe_wy,
-      wz => pipe_wz,
+      ox => bits_pipe_o,
+      oy => bits_pipe_o_1,
+      oz => bits_pipe_o_2,
+      wx => s_bits_pipe_w,
+      wy => s_bits_pipe_w_1,
+      wz => s_bits_pipe_w_2,
       r => tri_r,
       pp => tri_pp,
       pq => tri_pq,
@@ -355,7 +1199,7 @@ begin
       v => u_intersect_v
     );
 
-  u_closest : fxrt_closest_n29_m32_tag45_r2
+  u_closest : fxrt_closest_n29_m32_tag58_s64_r2
     port map (
       clk => clk,
       rst => rst,
@@ -365,24 +1209,45 @@ begin
       t => u_intersect_t_1,
       u => u_intersect_u,
       v => u_intersect_v,
+      id_we => accept,
+      id_slot => accept_slot_int,
+      id => ray_id,
+      done_valid => or_32,
+      done_slot => mux_u_traverse_0_done_valid,
+      merge_valid => u_closest_merge_valid,
+      merge_slot => u_closest_merge_slot,
+      merge_hit => u_closest_merge_hit,
+      merge_limit => u_closest_merge_limit,
+      merge_sp => u_closest_merge_sp,
+      free_valid => u_closest_free_valid,
+      free_slot => u_closest_free_slot,
       res_valid => u_closest_res_valid,
-      res_hit => u_closest_res_hit,
       res_id => u_closest_res_id,
+      res_hit => u_closest_res_hit,
       res_tri => u_closest_res_tri,
       res_t => u_closest_res_t,
       res_u => u_closest_res_u,
       res_v => u_closest_res_v
     );
 
-  ray_ready <= u_traverse_ray_ready;
+  ray_ready <= ready_c;
   res_valid <= u_closest_res_valid;
-  res_hit <= u_closest_res_hit;
   res_id <= u_closest_res_id;
+  res_hit <= u_closest_res_hit;
   res_tri <= u_closest_res_tri;
   res_t <= u_closest_res_t;
   res_u <= u_closest_res_u;
   res_v <= u_closest_res_v;
-  busy <= pipe_busy;
-  stack_depth <= u_traverse_stack_depth;
-  fsm_state <= u_traverse_fsm_state;
+  busy <= pipe_valid;
+  stack_depth <= mux_lt_33;
+  visits <= visits_c;
+  culls <= culls_c;
+  occupied <= occupied_c;
+  accept_slot <= accept_slot_int;
+  visit0 <= u_traverse_0_visit;
+  visit0_slot <= u_traverse_0_visit_slot;
+  visit0_node <= u_traverse_0_visit_node;
+  visit1 <= u_traverse_1_visit;
+  visit1_slot <= u_traverse_1_visit_slot;
+  visit1_node <= u_traverse_1_visit_node;
 end architecture rtl;

@@ -38,24 +38,38 @@ pub fn read_cycles(words: usize) -> u32 {
 /// The ROM `fxrt_brom_{name}` of `width`-bit words: ports `addr` (the ROM's address bits) →
 /// `data`, `cycles` (2 or 3) clocks later.
 pub fn brom_module(name: &str, width: u32, words: Vec<u128>, cycles: u32) -> Module {
+    brom_module_ports(name, width, words, cycles, 1)
+}
+
+/// The same with `ports` (1 or 2) read ports: `addr`, `data` and, for two, `addr_b`, `data_b`
+/// (a block RAM's second port: two traversal units share one node ROM), named
+/// `fxrt_brom_{name}_2p`.
+pub fn brom_module_ports(name: &str, width: u32, words: Vec<u128>, cycles: u32, ports: u32) -> Module {
     assert!((2..=3).contains(&cycles), "a block ROM reads in 2 or 3 clocks");
-    let b = Builder::new(&format!("{BROM_PREFIX}{name}"));
-    let addr = b.input("addr", Ty::u(rom_addr_bits(words.len())));
+    assert!((1..=2).contains(&ports), "a block ROM has one or two read ports");
+    let suffix = if ports == 2 { "_2p" } else { "" };
+    let b = Builder::new(&format!("{BROM_PREFIX}{name}{suffix}"));
+    let bits = rom_addr_bits(words.len());
+    let addrs: Vec<S> = ["addr", "addr_b"][..ports as usize].iter().map(|n| b.input(n, Ty::u(bits))).collect();
     let mem = b.rom("mem", width, words);
-    let word = b.read("word", mem, addr);
-    // Plain registers, not a delay line (which a synthesis tool may map to shift-register
-    // LUTs): the first is the block's output register, the second a fabric flip-flop.
-    let mut data = b.delay("data_r", word);
-    if cycles == 3 {
-        data = b.delay("data_rr", data);
+    for (k, addr) in addrs.into_iter().enumerate() {
+        let x = ["", "_b"][k];
+        let word = b.read(&format!("word{x}"), mem, addr);
+        // Plain registers, not a delay line (which a synthesis tool may map to shift-register
+        // LUTs): the first is the block's output register, the second a fabric flip-flop.
+        let mut data = b.delay(&format!("data{x}_r"), word);
+        if cycles == 3 {
+            data = b.delay(&format!("data{x}_rr"), data);
+        }
+        b.output(&format!("data{x}"), data);
     }
-    b.output("data", data);
     b.finish()
 }
 
 /// The clocks of a block ROM module's read: the synchronous read and its registers.
 pub fn brom_cycles(m: &Module) -> u32 {
-    1 + m.signals.iter().filter(|s| matches!(s.def, crate::rtl::netlist::Def::Reg { .. })).count() as u32
+    let regs = m.signals.iter().filter(|s| matches!(s.def, crate::rtl::netlist::Def::Reg { .. })).count() as u32;
+    1 + regs / m.outputs.len() as u32
 }
 
 /// In `b`: the block ROM `name` read at `addr` (instance `label`); its word `cycles` clocks
@@ -71,6 +85,23 @@ pub fn brom<'b>(
 ) -> S<'b> {
     let m = Rc::new(brom_module(name, width, words, cycles));
     b.instance(label, &m, &[addr]).get("data")
+}
+
+/// The two-port form: the words at `addr` and `addr_b`, `cycles` clocks later.
+#[allow(clippy::too_many_arguments)]
+pub fn brom2<'b>(
+    b: &'b Builder,
+    label: &str,
+    name: &str,
+    width: u32,
+    words: Vec<u128>,
+    addr: S<'b>,
+    addr_b: S<'b>,
+    cycles: u32,
+) -> (S<'b>, S<'b>) {
+    let m = Rc::new(brom_module_ports(name, width, words, cycles, 2));
+    let p = b.instance(label, &m, &[addr, addr_b]);
+    (p.get("data"), p.get("data_b"))
 }
 
 #[cfg(test)]
@@ -98,6 +129,31 @@ mod tests {
             let c = cycles as usize;
             for k in c - 1..seq.len() {
                 assert_eq!(got[k], 100 + seq[k + 1 - c] as i128, "{cycles} clocks, edge {}", k + 1);
+            }
+        }
+    }
+
+    /// The two-port form: each port reads its own address, `cycles` clocks later.
+    #[test]
+    fn two_ports_read_independently() {
+        for cycles in [2, 3] {
+            let m = brom_module_ports("t", 8, (0..6).map(|k| 50 + k).collect(), cycles, 2);
+            assert_eq!((m.name.as_str(), brom_cycles(&m)), ("fxrt_brom_t_2p", cycles));
+            let mut sim = Sim::new(&m);
+            let (a, b) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
+            let (da, db) = (m.handle(m.outputs[0].1), m.handle(m.outputs[1].1));
+            let seq = [(3, 5), (1, 0), (4, 4), (0, 2), (2, 1), (5, 3)];
+            let mut got = Vec::new();
+            for &(x, y) in &seq {
+                sim.set(a, x);
+                sim.set(b, y);
+                sim.tick();
+                got.push((sim.get(da), sim.get(db)));
+            }
+            let c = cycles as usize;
+            for k in c - 1..seq.len() {
+                let (x, y) = seq[k + 1 - c];
+                assert_eq!(got[k], (50 + x as i128, 50 + y as i128), "{cycles} clocks, edge {}", k + 1);
             }
         }
     }

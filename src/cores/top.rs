@@ -19,7 +19,7 @@
 //! The triangle table is wider than a signal may be (5 + 3n + 6m bits), so it is split into
 //! ROMs of whole fields, ≤ 128 bits each, all read at the same address.
 
-use super::brom::brom;
+use super::brom::{brom, brom2};
 use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
 use super::plane::{PlaneIssue, plane_unit};
@@ -255,6 +255,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let leaf_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_leaf_pop"), bit)).collect();
     let done_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_done_pop"), bit)).collect();
     let unit = Rc::new(traverse_core(&p.trav, scene));
+    let node_words: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_node_word"), Ty::u(scene.node.0.width))).collect();
     let trav: Vec<_> = (0..units)
         .map(|u| {
             let mine = is_unit(gslot, u, sb, ub);
@@ -267,6 +268,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
                 new_valid, box_done_slot.slice(0, sb), box_tmax, box_miss,
                 mv, merge_slot.slice(0, sb), merge_hit, merge_limit, merge_sp,
                 fv, free_slot.slice(0, sb), we, leaf_pop[u as usize], done_pop[u as usize],
+                node_words[u as usize],
             ];
             let t = b.instance(&format!("u_traverse_{u}"), &unit, &ins);
             b.drive(has_free[u as usize], t.get("has_free"));
@@ -274,6 +276,22 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
             t
         })
         .collect();
+    // The node ROM: one per two units, on a block RAM's two ports.
+    let (node_l, node_image) = (&scene.node.0, &scene.node.1);
+    let image: Vec<u128> = node_image.iter().map(|w| word_bits(w, 0, node_l.width)).collect();
+    for pair in 0..units.div_ceil(2) {
+        let (u0, u1) = (2 * pair as usize, 2 * pair as usize + 1);
+        let (label, nrc) = (format!("u_node_rom_{pair}"), p.trav.node_rom_cycles);
+        if u1 < units as usize {
+            let (a, c) = (trav[u0].get("node_addr"), trav[u1].get("node_addr"));
+            let (wa, wc) = brom2(&b, &label, "node", node_l.width, image.clone(), a, c, nrc);
+            b.drive(node_words[u0], wa);
+            b.drive(node_words[u1], wc);
+        } else {
+            let w = brom(&b, &label, "node", node_l.width, image.clone(), trav[u0].get("node_addr"), nrc);
+            b.drive(node_words[u0], w);
+        }
+    }
 
     // The core's ray RAMs (origin and direction, for the pipeline), by global slot.
     let slots = p.total_slots() as usize;

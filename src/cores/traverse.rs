@@ -32,7 +32,7 @@
 //! distance comes in through the new-ray queue (`new_*`). A slot is freed by the top when the
 //! ray's result has left the core (`free_*`), so a slot's best hit is never read after reuse.
 
-use super::brom::{brom, read_cycles};
+use super::brom::read_cycles;
 use super::clock::ClockTarget;
 use super::fifo::fifo;
 use super::mul::MulStyle;
@@ -132,7 +132,8 @@ struct Token<'b> {
 /// a new ray's box exit (`new_valid`, `new_slot`, `new_tmax`, `new_miss`), a leaf merged
 /// (`merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` = best t + 8, `merge_sp`), a slot
 /// freed (`free_valid`, `free_slot`), `alloc` (the top takes `free_slot_out`), `leaf_pop` and
-/// `done_pop` (the heads of the leaf and done queues are taken). Outputs: the lowest free slot
+/// `done_pop` (the heads of the leaf and done queues are taken), `node_word` (the node ROM's
+/// word at `node_addr`, `node_rom_cycles` after it). Outputs: `node_addr`, the lowest free slot
 /// (`has_free`, `free_slot_out`), the leaf queue's head (`leaf_valid`, `leaf_slot`, `leaf_first`,
 /// `leaf_count`, `leaf_tmin`, `leaf_sp`), the done queue's head (`done_valid`, `done_slot`), and
 /// observations: `visit` (a node visited in N, `visit_slot`, `visit_node`), `cull`, `depth`
@@ -167,6 +168,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let alloc = b.input("alloc", bit);
     let leaf_pop = b.input("leaf_pop", bit);
     let done_pop = b.input("done_pop", bit);
+    // The node ROM is the core's (two units share one through a block RAM's two ports): the
+    // unit sends the address in C and gets the word `node_rom_cycles` later, in N.
+    let word = b.input("node_word", Ty::u(node_l.width));
 
     // The ray RAMs: written when the top accepts a ray, read in N for the plane units.
     let o_mem = b.ram("ray_o", 3 * n, vec![0; k as usize]);
@@ -264,8 +268,6 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // C: the node ROM read, and the cull test: lower_t(tmin) > best t ⟺ tmin − tmin/64 >
     // best t + 8 (`golden::lower_t`), only when the slot has a best hit.
     let nrc = p.node_rom_cycles;
-    let node_image = node_words.iter().map(|w| word_bits(w, 0, node_l.width)).collect();
-    let word = brom(&b, "u_node_rom", "node", node_l.width, node_image, c.node, nrc);
     let limit_mem = b.ram("cull_limit", dist.width, vec![0; k as usize]);
     b.ram_write(limit_mem, (merge_valid & merge_hit).name("limit_we"), merge_slot, merge_limit.unsigned());
     let limit = b.read("limit_q", limit_mem, c.slot).signed();
@@ -382,6 +384,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     b.next(r.tmax, enter_near.select(near_max, g.tmax));
     b.next(r.sp, push.select(g.sp + 1, g.sp));
 
+    b.output("node_addr", c.node);
     b.output("has_free", (free_any_r & !just_alloc).name("has_free_c"));
     b.output("free_slot_out", free_idx_r);
     let lh = leafq.head;

@@ -80,7 +80,23 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
     let mut v = String::from(&generated[..end]);
     v.push_str("\n  // DP16KD blocks with their output register (fxrt synth --family ecp5, flow::ecp5_bram).\n");
     let blocks = rom.width.div_ceil(w);
+    // A two-port ROM (`brom_module_ports`) reads its second address on the block's port B.
+    let two = m.outputs.len() == 2;
     let _ = writeln!(v, "  wire [{}:0] dout;", blocks * w - 1);
+    if two {
+        let _ = writeln!(v, "  wire [{}:0] dout_b;", blocks * w - 1);
+    }
+    let (wb, regb) = if two { (w, "OUTREG") } else { (18, "NOREG") };
+    let zeros = |pin: &str, n| (0..n).map(|i| format!(".{pin}{i}(1'b0)")).collect::<Vec<_>>().join(", ");
+    let address = |pin: &str, addr: &str| -> String {
+        (0..14u32)
+            .map(|p| match p.checked_sub(shift) {
+                Some(i) if i < abits => format!(".{pin}{p}({addr}[{i}])"),
+                _ => format!(".{pin}{p}(1'b0)"),
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     for j in 0..blocks {
         let _ = writeln!(v, "  DP16KD #(");
         for (i, init) in initvals(&rom.words, j * w, w).iter().enumerate() {
@@ -88,38 +104,40 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
         }
         let _ = writeln!(
             v,
-            "    .DATA_WIDTH_A({w}), .DATA_WIDTH_B(18), .REGMODE_A(\"OUTREG\"), .REGMODE_B(\"NOREG\"),\n    \
+            "    .DATA_WIDTH_A({w}), .DATA_WIDTH_B({wb}), .REGMODE_A(\"OUTREG\"), .REGMODE_B(\"{regb}\"),\n    \
              .RESETMODE(\"SYNC\"), .ASYNC_RESET_RELEASE(\"SYNC\"), .CSDECODE_A(\"0b000\"), .CSDECODE_B(\"0b000\"),\n    \
              .WRITEMODE_A(\"NORMAL\"), .WRITEMODE_B(\"NORMAL\"), .GSR(\"DISABLED\")\n  ) u_bram{j} ("
         );
-        let ada: Vec<String> = (0..14u32)
-            .map(|p| match p.checked_sub(shift) {
-                Some(i) if i < abits => format!(".ADA{p}(addr[{i}])"),
-                _ => format!(".ADA{p}(1'b0)"),
-            })
-            .collect();
-        let _ = writeln!(v, "    {},", ada.join(", "));
-        let zeros = |pin: &str, n| (0..n).map(|i| format!(".{pin}{i}(1'b0)")).collect::<Vec<_>>().join(", ");
+        let _ = writeln!(v, "    {},", address("ADA", "addr"));
         let _ = writeln!(v, "    {},", zeros("DIA", 18));
         let _ = writeln!(v, "    {},", zeros("DIB", 18));
-        let _ = writeln!(v, "    {},", zeros("ADB", 14));
         let dout: Vec<String> = (0..w).map(|i| format!(".DOA{i}(dout[{}])", j * w + i)).collect();
         let _ = writeln!(v, "    {},", dout.join(", "));
         v.push_str("    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(1'b0), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n");
-        v.push_str("    .CLKB(1'b0), .CEB(1'b0), .OCEB(1'b0), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+        if two {
+            let _ = writeln!(v, "    {},", address("ADB", "addr_b"));
+            let dout: Vec<String> = (0..w).map(|i| format!(".DOB{i}(dout_b[{}])", j * w + i)).collect();
+            let _ = writeln!(v, "    {},", dout.join(", "));
+            v.push_str("    .CLKB(clk), .CEB(1'b1), .OCEB(1'b1), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+        } else {
+            let _ = writeln!(v, "    {},", zeros("ADB", 14));
+            v.push_str("    .CLKB(1'b0), .CEB(1'b0), .OCEB(1'b0), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+        }
         v.push_str("  );\n");
     }
-    if crate::cores::brom::brom_cycles(m) == 3 {
-        // The third clock: a fabric register after the block's output register.
-        let _ = writeln!(
-            v,
-            "  reg [{0}:0] dout_q = {1}'h0;\n  always @(posedge clk) dout_q <= dout[{0}:0];",
-            rom.width - 1,
-            rom.width
-        );
-        v.push_str("  assign data = dout_q;\n");
-    } else {
-        let _ = writeln!(v, "  assign data = dout[{}:0];", rom.width - 1);
+    for (x, out) in [("", "data"), ("_b", "data_b")][..m.outputs.len()].iter() {
+        if crate::cores::brom::brom_cycles(m) == 3 {
+            // The third clock: a fabric register after the block's output register.
+            let _ = writeln!(
+                v,
+                "  reg [{0}:0] dout{x}_q = {1}'h0;\n  always @(posedge clk) dout{x}_q <= dout{x}[{0}:0];",
+                rom.width - 1,
+                rom.width
+            );
+            let _ = writeln!(v, "  assign {out} = dout{x}_q;");
+        } else {
+            let _ = writeln!(v, "  assign {out} = dout{x}[{}:0];", rom.width - 1);
+        }
     }
     v.push_str("endmodule\n");
     Some(v)

@@ -118,6 +118,9 @@ pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions, raygen: Optio
         "stack_depth": p.trav.stack_depth, "ray_id_width": p.trav.id_width, "div_bits": p.isect.div_bits, "target_mhz": p.isect.target_mhz,
         "intersection_latency_cycles": p.isect.latency(),
         "leaf_entry_to_result_cycles": p.stream_latency() + 1,
+        "ray_slots_per_unit": p.trav.slots, "traversal_units": p.units,
+        "results_in_order": false,
+        "result_order": "rays finish out of order; every result carries its ray id (res_id)",
     });
     let mut set = vec![(top, None, core_params)];
     set.extend(cores(&p.isect));
