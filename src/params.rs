@@ -4,6 +4,7 @@
 //! (the integer type the model computes in), so the model never has to check for overflow.
 
 use crate::error::{Error, Result};
+pub use crate::scene::bih::Split as TreeSplit;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -53,11 +54,24 @@ pub struct Params {
     pub leaf_size: u32,
     /// Entries of the hardware traversal stack; bounds the BIH depth.
     pub stack_depth: u32,
+    /// How the BIH chooses its split planes. Absent from JSON when `middle`, the default, so
+    /// every scene.json, manifest and sweep cache key of the default reads as it always did.
+    #[serde(default, skip_serializing_if = "TreeSplit::is_middle")]
+    pub tree: TreeSplit,
 }
 
 impl Default for Params {
     fn default() -> Self {
-        Params { n: 29, m: 32, edge_shift: EdgeShift::Auto, t: 0, c: 16, leaf_size: 4, stack_depth: 32 }
+        Params {
+            n: 29,
+            m: 32,
+            edge_shift: EdgeShift::Auto,
+            t: 0,
+            c: 16,
+            leaf_size: 4,
+            stack_depth: 32,
+            tree: TreeSplit::Middle,
+        }
     }
 }
 
@@ -164,5 +178,19 @@ mod tests {
         assert_eq!("auto".parse::<EdgeShift>().unwrap(), EdgeShift::Auto);
         assert_eq!("10".parse::<EdgeShift>().unwrap(), EdgeShift::Fixed(10));
         assert!("-3".parse::<EdgeShift>().is_err());
+    }
+
+    #[test]
+    fn tree_parses_and_the_default_is_not_serialised() {
+        assert_eq!("middle".parse::<TreeSplit>().unwrap(), TreeSplit::Middle);
+        assert_eq!("SAH".parse::<TreeSplit>().unwrap(), TreeSplit::Sah);
+        assert!("median".parse::<TreeSplit>().is_err());
+        let d = serde_json::to_string(&Params::default()).unwrap();
+        assert!(!d.contains("tree"), "{d}");
+        assert_eq!(serde_json::from_str::<Params>(&d).unwrap(), Params::default());
+        let sah = Params { tree: TreeSplit::Sah, ..Params::default() };
+        let j = serde_json::to_string(&sah).unwrap();
+        assert!(j.ends_with(r#""tree":"sah"}"#), "{j}");
+        assert_eq!(serde_json::from_str::<Params>(&j).unwrap(), sah);
     }
 }

@@ -44,7 +44,7 @@ const SMALL: Params = Params { n: 16, m: 16, ..DEFAULTS };
 const ODD: Params = Params { n: 23, m: 27, t: 5, ..DEFAULTS };
 const WIDE: Params = Params { n: 32, m: 40, ..DEFAULTS };
 const DEFAULTS: Params =
-    Params { n: 29, m: 32, edge_shift: fxrt::params::EdgeShift::Auto, t: 0, c: 16, leaf_size: 4, stack_depth: 32 };
+    Params { n: 29, m: 32, edge_shift: fxrt::params::EdgeShift::Auto, t: 0, c: 16, leaf_size: 4, stack_depth: 32, tree: fxrt::params::TreeSplit::Middle };
 
 #[test]
 fn rust_simulator_matches_golden_on_a_million_vectors_at_defaults() {

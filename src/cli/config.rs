@@ -446,7 +446,8 @@ impl SweepArgs {
         if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
             return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
         }
-        let single = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
+        let single =
+            Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, tree: self.tree, ..Params::default() };
         single.validate()?;
         crate::cores::clock::ClockTarget(self.target_mhz).check()?;
         Ok(SweepSpec {
@@ -459,6 +460,7 @@ impl SweepArgs {
             edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
             leaf_size: self.leaf_size,
             stack_depth: self.stack_depth,
+            tree: self.tree,
             one_at_a_time: self.one_at_a_time,
             synth: self.synth,
             core_sim: self.core_sim,
@@ -499,6 +501,7 @@ impl ParamArgs {
             c: self.c,
             leaf_size: self.leaf_size,
             stack_depth: self.stack_depth,
+            tree: self.tree,
         };
         p.validate()?;
         Ok(p)

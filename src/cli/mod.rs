@@ -5,7 +5,7 @@
 pub mod config;
 pub mod run;
 
-use crate::params::EdgeShift;
+use crate::params::{EdgeShift, TreeSplit};
 use crate::render::tracer::ModelKind;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -97,6 +97,10 @@ pub struct SweepArgs {
     /// Hardware traversal stack entries (one value).
     #[arg(long = "stack-depth", default_value_t = 32)]
     pub stack_depth: u32,
+    /// The BIH's split planes: middle (the thesis's) or sah (binned surface-area heuristic);
+    /// one value.
+    #[arg(long, default_value = "middle")]
+    pub tree: TreeSplit,
     /// Vary one parameter at a time around the base set (each at its default if listed,
     /// else its first value), like the thesis's figures, instead of the cross product.
     #[arg(long = "one-at-a-time")]
@@ -372,6 +376,10 @@ pub struct ParamArgs {
     /// Hardware traversal stack entries; bounds the BIH depth.
     #[arg(long = "stack-depth", default_value_t = 32)]
     pub stack_depth: u32,
+    /// The BIH's split planes: middle (the thesis's: halve the box) or sah (binned
+    /// surface-area heuristic).
+    #[arg(long, default_value = "middle")]
+    pub tree: TreeSplit,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -305,3 +305,37 @@ fn sweep_ecp5_options_are_checked() {
     assert_eq!(spec(&argv), s);
     assert!(argv.join(" ").contains("--target-mhz 100 --family ecp5 --seed 7 --modules divider,core"), "{argv:?}");
 }
+
+/// `--tree` is accepted wherever the parameters are (and `sweep`, as one value), `middle` by
+/// default; a bad value is one line naming the option.
+#[test]
+fn every_command_with_parameters_takes_tree() {
+    use crate::params::TreeSplit;
+    let tree = |args: &[&str]| match command(args) {
+        Command::Render(a) => a.params.params().unwrap().tree,
+        Command::Scene(a) => a.params.params().unwrap().tree,
+        Command::Compare(a) => a.params.params().unwrap().tree,
+        Command::Gen(a) => a.params.params().unwrap().tree,
+        Command::Test(a) => a.params.params().unwrap().tree,
+        Command::Synth(a) => a.params.params().unwrap().tree,
+        Command::Sim(a) => a.params.params().unwrap().tree,
+        Command::Sweep(a) => a.spec().unwrap().defaults().tree,
+        Command::Bench(_) => panic!("bench takes no parameters"),
+    };
+    for cmd in ["render", "scene", "compare", "gen", "test", "synth", "sim", "sweep"] {
+        let out: &[&str] = if matches!(cmd, "sweep" | "scene" | "gen") { &["--out", "x"] } else { &[] };
+        assert_eq!(tree(&[&[cmd], out].concat()), TreeSplit::Middle, "{cmd}");
+        assert_eq!(tree(&[&[cmd, "--tree", "sah"], out].concat()), TreeSplit::Sah, "{cmd}");
+        assert_eq!(tree(&[&[cmd, "--tree", "middle"], out].concat()), TreeSplit::Middle, "{cmd}");
+        let e = Cli::try_parse_from([&["fxrt", cmd, "--tree", "median"], out].concat()).unwrap_err();
+        let line = error_line(&e);
+        assert!(line.contains("--tree") && line.contains("middle or sah"), "{cmd}: {line}");
+    }
+    // A sweep's shards are started with the same tree; the default adds nothing to the line.
+    let Command::Sweep(a) = command(&["sweep", "--tree", "sah", "--out", "x"]) else { panic!("not a sweep") };
+    let argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
+    assert!(argv.windows(2).any(|w| w == ["--tree", "sah"]), "{argv:?}");
+    let Command::Sweep(a) = command(&["sweep", "--out", "x"]) else { panic!("not a sweep") };
+    let argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
+    assert!(!argv.iter().any(|w| w == "--tree"), "{argv:?}");
+}

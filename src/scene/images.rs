@@ -5,7 +5,7 @@
 use super::Scene;
 use super::rom::{self, Field, Layout, Word};
 use crate::error::{Error, Result};
-use crate::params::{EdgeShift, Params};
+use crate::params::{EdgeShift, Params, TreeSplit};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -43,6 +43,8 @@ struct JsonParams {
     c: u32,
     leaf_size: u32,
     stack_depth: u32,
+    #[serde(default)]
+    tree: TreeSplit,
     edge_shift: serde_json::Value,
 }
 
@@ -95,8 +97,16 @@ impl SceneRoms {
             _ => EdgeShift::Auto,
         };
         let p = &j.params;
-        let params =
-            Params { n: p.n, m: p.m, edge_shift, t: p.t, c: p.c, leaf_size: p.leaf_size, stack_depth: p.stack_depth };
+        let params = Params {
+            n: p.n,
+            m: p.m,
+            edge_shift,
+            t: p.t,
+            c: p.c,
+            leaf_size: p.leaf_size,
+            stack_depth: p.stack_depth,
+            tree: p.tree,
+        };
         params.validate().map_err(|e| Error::file(&json_path, e.to_string()))?;
         let mut images = Vec::new();
         for name in ["tri", "node", "leaf"] {

@@ -41,13 +41,7 @@ pub struct SceneCtx {
 
 impl SceneCtx {
     /// Loads and checks the scene; errors name the file and the problem.
-    pub fn load(
-        spec: &SceneSpec,
-        label: String,
-        cam: &CameraSpec,
-        leaf_size: u32,
-        stack_depth: u32,
-    ) -> Result<SceneCtx> {
+    pub fn load(spec: &SceneSpec, label: String, cam: &CameraSpec, defaults: &Params) -> Result<SceneCtx> {
         let (name, world, fingerprint) = match spec {
             SceneSpec::Builtin(b) => {
                 let world = builtin::load(b)?;
@@ -58,8 +52,7 @@ impl SceneCtx {
                 (p.display().to_string(), obj::load_obj(p)?, format!("obj:{:x}", Sha256::digest(&bytes)))
             }
         };
-        let params = Params { leaf_size, stack_depth, ..Params::default() };
-        let defaults = Scene::build(&name, world.clone(), &params)?;
+        let defaults = Scene::build(&name, world.clone(), defaults)?;
         let camera = cam.camera(&defaults)?;
         Ok(SceneCtx {
             label,

@@ -20,7 +20,7 @@ pub mod summary;
 
 use crate::error::{Error, Result};
 pub use crate::model::camera::CameraSpec;
-use crate::params::{EdgeShift, Params};
+use crate::params::{EdgeShift, Params, TreeSplit};
 use crate::scene::SceneSource;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -53,6 +53,10 @@ pub struct SweepSpec {
     pub edge_shift: Vec<EdgeShift>,
     pub leaf_size: u32,
     pub stack_depth: u32,
+    /// The BIH's split (`--tree`; absent from results.json at the default, `middle`, so
+    /// older sweeps read back the same).
+    #[serde(default, skip_serializing_if = "TreeSplit::is_middle")]
+    pub tree: TreeSplit,
     /// Vary one parameter at a time around the base set instead of the cross product.
     pub one_at_a_time: bool,
     /// Also synthesise every configuration's core with yosys.
@@ -179,9 +183,15 @@ impl SweepSpec {
         Axis::ALL.into_iter().filter(|&a| self.values(a).len() > 1).collect()
     }
 
+    /// The default parameters with the sweep's single-valued ones: leaf size, stack depth
+    /// and tree.
+    pub fn defaults(&self) -> Params {
+        Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, tree: self.tree, ..Params::default() }
+    }
+
     /// Each parameter at its default if its list holds it, else the list's first value.
     pub fn base(&self) -> Params {
-        let d = Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, ..Params::default() };
+        let d = self.defaults();
         let pick = |list: &[u32], default: u32| if list.contains(&default) { default } else { list[0] };
         Params {
             n: pick(&self.n, d.n),
@@ -326,6 +336,9 @@ pub fn params_label(p: &Params) -> String {
     }
     if p.stack_depth != d.stack_depth {
         s += &format!("_s{}", p.stack_depth);
+    }
+    if p.tree != d.tree {
+        s += &format!("_{}", p.tree);
     }
     s
 }

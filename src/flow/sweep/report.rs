@@ -48,8 +48,7 @@ fn set_text(p: &Params) -> String {
 
 fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
     let mut out = Vec::new();
-    let defaults =
-        Params { leaf_size: results.spec.leaf_size, stack_depth: results.spec.stack_depth, ..Params::default() };
+    let defaults = results.spec.defaults();
     let default_set = sets.iter().find(|s| s.params == defaults);
     match cheapest_same_image(sets) {
         Some(s) => out.push(format!(

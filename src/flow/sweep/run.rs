@@ -50,11 +50,7 @@ pub struct RunSummary {
 /// Loads and checks every scene of the sweep (before anything is written).
 pub fn load_scenes(spec: &SweepSpec) -> Result<Vec<SceneCtx>> {
     let labels = scene_labels(&spec.scenes);
-    spec.scenes
-        .iter()
-        .zip(labels)
-        .map(|(s, l)| SceneCtx::load(s, l, &spec.camera, spec.leaf_size, spec.stack_depth))
-        .collect()
+    spec.scenes.iter().zip(labels).map(|(s, l)| SceneCtx::load(s, l, &spec.camera, &spec.defaults())).collect()
 }
 
 /// Evaluates this shard's configurations (those in the cache folder `cache` are read back)

@@ -15,6 +15,7 @@ fn spec() -> SweepSpec {
         edge_shift: vec![EdgeShift::Auto, EdgeShift::Fixed(10)],
         leaf_size: 4,
         stack_depth: 32,
+        tree: TreeSplit::Middle,
         one_at_a_time: false,
         synth: false,
         core_sim: false,
@@ -89,6 +90,7 @@ fn labels_are_unique_and_file_safe() {
     assert_eq!(scene_labels(&scenes), vec!["teapot-2", "teapot-3", "teapot-1"]);
     assert_eq!(params_label(&Params::default()), "n29_m32_eauto_t0_c16");
     assert_eq!(params_label(&Params { leaf_size: 2, ..Params::default() }), "n29_m32_eauto_t0_c16_l2");
+    assert_eq!(params_label(&Params { tree: TreeSplit::Sah, ..Params::default() }), "n29_m32_eauto_t0_c16_sah");
 }
 
 #[test]
@@ -176,7 +178,9 @@ fn slurm_shards_are_checked_and_the_scripts_written() {
 /// key it always had, and its results.json does not mention them.
 #[test]
 fn cache_keys_tell_families_seeds_and_targets_apart() {
-    let ctx = eval::SceneCtx::load(&SceneSpec::Builtin("thin".into()), "thin".into(), &spec().camera, 4, 32).unwrap();
+    let ctx =
+        eval::SceneCtx::load(&SceneSpec::Builtin("thin".into()), "thin".into(), &spec().camera, &Params::default())
+            .unwrap();
     let p = Params::default();
     let xc5v = SweepSpec { synth: true, ..spec() };
     let ecp5 = SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["core".into()], seed: 1 }), ..xc5v.clone() };
