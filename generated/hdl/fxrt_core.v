@@ -26,36 +26,36 @@ module fxrt_core (
   output wire [5:0] stack_depth,
   output wire [2:0] visits,
   output wire [2:0] culls,
-  output wire [6:0] occupied,
-  output wire [5:0] accept_slot,
+  output wire [7:0] occupied,
+  output wire [6:0] accept_slot,
   output wire [0:0] visit0,
-  output wire [4:0] visit0_slot,
+  output wire [5:0] visit0_slot,
   output wire [12:0] visit0_node,
   output wire [0:0] visit1,
-  output wire [4:0] visit1_slot,
+  output wire [5:0] visit1_slot,
   output wire [12:0] visit1_node
 );
 
-  reg [86:0] ray_o [0:63];
+  (* ram_style = "distributed" *) reg [86:0] ray_o [0:127];
   initial $readmemh("fxrt_core_ray_o.hex", ray_o);
 
-  reg [95:0] ray_w [0:63];
+  (* ram_style = "distributed" *) reg [95:0] ray_w [0:127];
   initial $readmemh("fxrt_core_ray_w.hex", ray_w);
 
   wire [0:0] u0_has_free;
   wire [0:0] u1_has_free;
-  wire [4:0] u0_free_slot;
-  wire [4:0] u1_free_slot;
+  wire [5:0] u0_free_slot;
+  wire [5:0] u1_free_slot;
   reg [0:0] turn = 1'h0;
   reg [1:0] box_phase = 2'h0;
   wire [0:0] k_0 = 1'h0;
   reg [0:0] case_turn;
-  reg [4:0] case_turn_1;
+  reg [5:0] case_turn_1;
   wire [1:0] k_0_1 = 2'h0;
   wire [0:0] box_phase_eq_k_0_1;
   wire [0:0] ready_c;
   wire [0:0] accept;
-  wire [5:0] accept_slot_int;
+  wire [6:0] accept_slot_int;
   wire [0:0] k_1 = 1'h1;
   wire [0:0] turn_plus_1;
   wire [0:0] not_case_turn;
@@ -72,7 +72,7 @@ module fxrt_core (
   reg signed [47:0] box_invx = 48'sh000000000000;
   reg signed [47:0] box_invy = 48'sh000000000000;
   reg signed [47:0] box_invz = 48'sh000000000000;
-  reg [5:0] box_slot = 6'h00;
+  reg [6:0] box_slot = 7'h00;
   wire [1:0] box_axis;
   wire [28:0] box_hi_0 = 29'h1fffffff;
   wire [28:0] box_hi_1 = 29'h0faab179;
@@ -171,17 +171,17 @@ module fxrt_core (
   wire [0:0] box_miss;
   wire [0:0] box_last;
   reg [0:0] box_done = 1'h0;
-  (* mem2reg *) reg [5:0] box_done_slot_sr [1:11];
+  (* mem2reg *) reg [6:0] box_done_slot_sr [1:11];
   integer box_done_slot_i;
-  initial for (box_done_slot_i = 1; box_done_slot_i <= 11; box_done_slot_i = box_done_slot_i + 1) box_done_slot_sr[box_done_slot_i] = 6'h00;
-  wire [5:0] box_done_slot;
+  initial for (box_done_slot_i = 1; box_done_slot_i <= 11; box_done_slot_i = box_done_slot_i + 1) box_done_slot_sr[box_done_slot_i] = 7'h00;
+  wire [6:0] box_done_slot;
   wire [0:0] merge_valid;
-  wire [5:0] merge_slot;
+  wire [6:0] merge_slot;
   wire [0:0] merge_hit;
   wire signed [31:0] merge_limit;
   wire [5:0] merge_sp;
   wire [0:0] free_valid;
-  wire [5:0] free_slot;
+  wire [6:0] free_slot;
   wire [0:0] u0_leaf_pop;
   wire [0:0] u1_leaf_pop;
   wire [0:0] u0_done_pop;
@@ -200,26 +200,26 @@ module fxrt_core (
   wire [0:0] bits_free_slot;
   wire [0:0] bits_free_slot_eq_k_0;
   wire [0:0] u0_free;
-  wire [4:0] bits_box_done_slot_1;
-  wire [4:0] bits_merge_slot_1;
-  wire [4:0] bits_free_slot_1;
+  wire [5:0] bits_box_done_slot_1;
+  wire [5:0] bits_merge_slot_1;
+  wire [5:0] bits_free_slot_1;
   wire [12:0] u_traverse_0_node_addr;
   wire [0:0] u_traverse_0_has_free;
-  wire [4:0] u_traverse_0_free_slot_out;
+  wire [5:0] u_traverse_0_free_slot_out;
   wire [0:0] u_traverse_0_leaf_valid;
-  wire [4:0] u_traverse_0_leaf_slot;
+  wire [5:0] u_traverse_0_leaf_slot;
   wire [12:0] u_traverse_0_leaf_first;
   wire [2:0] u_traverse_0_leaf_count;
   wire [30:0] u_traverse_0_leaf_tmin;
   wire [5:0] u_traverse_0_leaf_sp;
   wire [0:0] u_traverse_0_done_valid;
-  wire [4:0] u_traverse_0_done_slot;
+  wire [5:0] u_traverse_0_done_slot;
   wire [0:0] u_traverse_0_visit;
-  wire [4:0] u_traverse_0_visit_slot;
+  wire [5:0] u_traverse_0_visit_slot;
   wire [12:0] u_traverse_0_visit_node;
   wire [0:0] u_traverse_0_cull;
   wire [5:0] u_traverse_0_depth;
-  wire [5:0] u_traverse_0_occupied;
+  wire [6:0] u_traverse_0_occupied;
   wire [0:0] bits_accept_slot_1;
   wire [0:0] eq_14;
   wire [0:0] u1_alloc;
@@ -232,26 +232,26 @@ module fxrt_core (
   wire [0:0] bits_free_slot_2;
   wire [0:0] bits_free_slot_2_eq_k_1;
   wire [0:0] u1_free;
-  wire [4:0] bits_box_done_slot_3;
-  wire [4:0] bits_merge_slot_3;
-  wire [4:0] bits_free_slot_3;
+  wire [5:0] bits_box_done_slot_3;
+  wire [5:0] bits_merge_slot_3;
+  wire [5:0] bits_free_slot_3;
   wire [12:0] u_traverse_1_node_addr;
   wire [0:0] u_traverse_1_has_free;
-  wire [4:0] u_traverse_1_free_slot_out;
+  wire [5:0] u_traverse_1_free_slot_out;
   wire [0:0] u_traverse_1_leaf_valid;
-  wire [4:0] u_traverse_1_leaf_slot;
+  wire [5:0] u_traverse_1_leaf_slot;
   wire [12:0] u_traverse_1_leaf_first;
   wire [2:0] u_traverse_1_leaf_count;
   wire [30:0] u_traverse_1_leaf_tmin;
   wire [5:0] u_traverse_1_leaf_sp;
   wire [0:0] u_traverse_1_done_valid;
-  wire [4:0] u_traverse_1_done_slot;
+  wire [5:0] u_traverse_1_done_slot;
   wire [0:0] u_traverse_1_visit;
-  wire [4:0] u_traverse_1_visit_slot;
+  wire [5:0] u_traverse_1_visit_slot;
   wire [12:0] u_traverse_1_visit_node;
   wire [0:0] u_traverse_1_cull;
   wire [5:0] u_traverse_1_depth;
-  wire [5:0] u_traverse_1_occupied;
+  wire [6:0] u_traverse_1_occupied;
   wire [72:0] u_node_rom_0_data;
   wire [72:0] u_node_rom_0_data_b;
   wire [86:0] cat_18;
@@ -260,14 +260,13 @@ module fxrt_core (
   wire [31:0] u_wx;
   wire [95:0] cat_19;
   reg [0:0] leaf_active = 1'h0;
-  reg [5:0] leaf_slot = 6'h00;
+  reg [6:0] leaf_slot = 7'h00;
   reg [12:0] leaf_ptr = 13'h0000;
   reg [2:0] leaf_left = 3'h0;
   reg [30:0] leaf_tmin = 31'h00000000;
   reg [5:0] leaf_sp = 6'h00;
   reg [0:0] leaf_first_entry = 1'h0;
-  wire [2:0] k_1_2 = 3'h1;
-  wire [0:0] leaf_left_eq_k_1_2;
+  reg [0:0] leaf_last = 1'h0;
   wire [0:0] leaf_last_entry;
   wire [0:0] not_leaf_active;
   wire [0:0] leaf_can_take;
@@ -283,34 +282,40 @@ module fxrt_core (
   wire [0:0] u0_leaf_take;
   wire [0:0] eq_24;
   wire [0:0] u1_leaf_take;
-  reg [4:0] case_mux_case_leaf_turn_2;
-  wire [5:0] cat_25;
+  reg [5:0] case_mux_case_leaf_turn_2;
+  wire [6:0] cat_25;
   wire [0:0] not_leaf_last_entry;
   wire [0:0] and_26;
   wire [0:0] leaf_take_or_and_26;
-  wire [5:0] mux_leaf_take;
+  wire [6:0] mux_leaf_take;
   reg [12:0] case_mux_case_leaf_turn_2_1;
-  wire [12:0] k_1_3 = 13'h0001;
-  wire [12:0] leaf_ptr_plus_k_1_3;
+  wire [12:0] k_1_2 = 13'h0001;
+  wire [12:0] leaf_ptr_plus_k_1_2;
   wire [12:0] mux_leaf_take_1;
   reg [2:0] case_mux_case_leaf_turn_2_2;
-  wire [2:0] leaf_left_minus_k_1_2;
+  wire [2:0] k_1_3 = 3'h1;
+  wire [2:0] leaf_left_minus_k_1_3;
   wire [2:0] mux_leaf_take_2;
   reg [30:0] case_mux_case_leaf_turn_2_3;
   wire [30:0] mux_leaf_take_3;
   reg [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
+  reg [2:0] case_mux_case_leaf_turn_2_5;
+  wire [0:0] eq_27;
+  wire [2:0] k_2 = 3'h2;
+  wire [0:0] leaf_left_eq_k_2;
+  wire [0:0] mux_leaf_take_5;
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [57:0] cat_27;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 57:13 are read
-  (* mem2reg *) reg [57:0] emit_tag_sr [1:3];
+  wire [58:0] cat_28;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
+  (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
-  initial for (emit_tag_i = 1; emit_tag_i <= 3; emit_tag_i = emit_tag_i + 1) emit_tag_sr[emit_tag_i] = 58'h000000000000000;
-  wire [57:0] emit_tag;
+  initial for (emit_tag_i = 1; emit_tag_i <= 3; emit_tag_i = emit_tag_i + 1) emit_tag_sr[emit_tag_i] = 59'h000000000000000;
+  wire [58:0] emit_tag;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [44:0] bits_emit_tag;
-  wire [57:0] emit_tag_tri;
+  wire [45:0] bits_emit_tag;
+  wire [58:0] emit_tag_tri;
   (* mem2reg *) reg [0:0] emit_valid_sr [1:3];
   integer emit_valid_i;
   initial for (emit_valid_i = 1; emit_valid_i <= 3; emit_valid_i = emit_valid_i + 1) emit_valid_sr[emit_valid_i] = 1'h0;
@@ -339,11 +344,11 @@ module fxrt_core (
   integer pipe_valid_i;
   initial for (pipe_valid_i = 1; pipe_valid_i <= 3; pipe_valid_i = pipe_valid_i + 1) pipe_valid_sr[pipe_valid_i] = 1'h0;
   wire [0:0] pipe_valid;
-  (* mem2reg *) reg [57:0] pipe_tag_sr [1:3];
+  (* mem2reg *) reg [58:0] pipe_tag_sr [1:3];
   integer pipe_tag_i;
-  initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 58'h000000000000000;
-  wire [57:0] pipe_tag;
-  wire [5:0] bits_emit_tag_tri;
+  initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 59'h000000000000000;
+  wire [58:0] pipe_tag;
+  wire [6:0] bits_emit_tag_tri;
   reg [86:0] ray_o_q = 87'h0000000000000000000000;
   (* mem2reg *) reg [86:0] pipe_o_sr [1:2];
   integer pipe_o_i;
@@ -364,24 +369,24 @@ module fxrt_core (
   wire [31:0] bits_pipe_w_2;
   wire signed [31:0] s_bits_pipe_w_2;
   wire [0:0] u_intersect_valid_out;
-  wire [57:0] u_intersect_tag_out;
+  wire [58:0] u_intersect_tag_out;
   wire [0:0] u_intersect_hit;
   wire [29:0] u_intersect_t_1;
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
-  wire [5:0] cat_29;
+  wire [6:0] cat_30;
   wire [0:0] not_u_traverse_0_done_valid;
   wire [0:0] u1_done_take;
-  wire [5:0] cat_31;
-  wire [5:0] mux_u_traverse_0_done_valid;
-  wire [0:0] or_32;
+  wire [6:0] cat_32;
+  wire [6:0] mux_u_traverse_0_done_valid;
+  wire [0:0] or_33;
   wire [0:0] u_closest_merge_valid;
-  wire [5:0] u_closest_merge_slot;
+  wire [6:0] u_closest_merge_slot;
   wire [0:0] u_closest_merge_hit;
   wire signed [31:0] u_closest_merge_limit;
   wire [5:0] u_closest_merge_sp;
   wire [0:0] u_closest_free_valid;
-  wire [5:0] u_closest_free_slot;
+  wire [6:0] u_closest_free_slot;
   wire [0:0] u_closest_res_valid;
   wire [19:0] u_closest_res_id;
   wire [0:0] u_closest_res_hit;
@@ -389,17 +394,17 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_33;
-  wire [5:0] mux_lt_33;
+  wire [0:0] lt_34;
+  wire [5:0] mux_lt_34;
   wire [2:0] rs_u_traverse_0_visit;
   wire [2:0] rs_u_traverse_1_visit;
   wire [2:0] visits_c;
   wire [2:0] rs_u_traverse_0_cull;
   wire [2:0] rs_u_traverse_1_cull;
   wire [2:0] culls_c;
-  wire [6:0] rs_u_traverse_0_occupied;
-  wire [6:0] rs_u_traverse_1_occupied;
-  wire [6:0] occupied_c;
+  wire [7:0] rs_u_traverse_0_occupied;
+  wire [7:0] rs_u_traverse_1_occupied;
+  wire [7:0] occupied_c;
 
   assign u0_has_free = u_traverse_0_has_free;
   assign u1_has_free = u_traverse_1_has_free;
@@ -515,43 +520,42 @@ module fxrt_core (
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
-  assign bits_accept_slot = accept_slot_int[5];
+  assign bits_accept_slot = accept_slot_int[6];
   assign bits_accept_slot_eq_k_0 = bits_accept_slot == k_0;
   assign u0_alloc = accept & bits_accept_slot_eq_k_0;
-  assign bits_box_done_slot = box_done_slot[5];
+  assign bits_box_done_slot = box_done_slot[6];
   assign eq_11 = bits_box_done_slot == k_0;
   assign u0_new = box_done & eq_11;
-  assign bits_merge_slot = merge_slot[5];
+  assign bits_merge_slot = merge_slot[6];
   assign bits_merge_slot_eq_k_0 = bits_merge_slot == k_0;
   assign u0_merge = merge_valid & bits_merge_slot_eq_k_0;
-  assign bits_free_slot = free_slot[5];
+  assign bits_free_slot = free_slot[6];
   assign bits_free_slot_eq_k_0 = bits_free_slot == k_0;
   assign u0_free = free_valid & bits_free_slot_eq_k_0;
-  assign bits_box_done_slot_1 = box_done_slot[4:0];
-  assign bits_merge_slot_1 = merge_slot[4:0];
-  assign bits_free_slot_1 = free_slot[4:0];
-  assign bits_accept_slot_1 = accept_slot_int[5];
+  assign bits_box_done_slot_1 = box_done_slot[5:0];
+  assign bits_merge_slot_1 = merge_slot[5:0];
+  assign bits_free_slot_1 = free_slot[5:0];
+  assign bits_accept_slot_1 = accept_slot_int[6];
   assign eq_14 = bits_accept_slot_1 == k_1;
   assign u1_alloc = accept & eq_14;
-  assign bits_box_done_slot_2 = box_done_slot[5];
+  assign bits_box_done_slot_2 = box_done_slot[6];
   assign eq_15 = bits_box_done_slot_2 == k_1;
   assign u1_new = box_done & eq_15;
-  assign bits_merge_slot_2 = merge_slot[5];
+  assign bits_merge_slot_2 = merge_slot[6];
   assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
   assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
-  assign bits_free_slot_2 = free_slot[5];
+  assign bits_free_slot_2 = free_slot[6];
   assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
   assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
-  assign bits_box_done_slot_3 = box_done_slot[4:0];
-  assign bits_merge_slot_3 = merge_slot[4:0];
-  assign bits_free_slot_3 = free_slot[4:0];
+  assign bits_box_done_slot_3 = box_done_slot[5:0];
+  assign bits_merge_slot_3 = merge_slot[5:0];
+  assign bits_free_slot_3 = free_slot[5:0];
   assign cat_18 = {oz, oy, ox};
   assign u_wz = $unsigned(wz);
   assign u_wy = $unsigned(wy);
   assign u_wx = $unsigned(wx);
   assign cat_19 = {u_wz, u_wy, u_wx};
-  assign leaf_left_eq_k_1_2 = leaf_left == k_1_2;
-  assign leaf_last_entry = leaf_active & leaf_left_eq_k_1_2;
+  assign leaf_last_entry = leaf_active & leaf_last;
   assign not_leaf_active = ~leaf_active;
   assign leaf_can_take = not_leaf_active | leaf_last_entry;
   always @* begin
@@ -608,8 +612,8 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
     endcase
   end
-  assign leaf_ptr_plus_k_1_3 = leaf_ptr + k_1_3;
-  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_3;
+  assign leaf_ptr_plus_k_1_2 = leaf_ptr + k_1_2;
+  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_2;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_2 = u_traverse_0_leaf_count;
@@ -617,8 +621,8 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_2 = u_traverse_0_leaf_count;
     endcase
   end
-  assign leaf_left_minus_k_1_2 = leaf_left - k_1_2;
-  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_2;
+  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
+  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_3;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_3 = u_traverse_0_leaf_tmin;
@@ -635,9 +639,19 @@ module fxrt_core (
     endcase
   end
   assign mux_leaf_take_4 = leaf_take ? case_mux_case_leaf_turn_2_4 : leaf_sp;
-  assign cat_27 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  always @* begin
+    case (mux_case_leaf_turn_2)
+      1'h0: case_mux_case_leaf_turn_2_5 = u_traverse_0_leaf_count;
+      1'h1: case_mux_case_leaf_turn_2_5 = u_traverse_1_leaf_count;
+      default: case_mux_case_leaf_turn_2_5 = u_traverse_0_leaf_count;
+    endcase
+  end
+  assign eq_27 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign leaf_left_eq_k_2 = leaf_left == k_2;
+  assign mux_leaf_take_5 = leaf_take ? eq_27 : leaf_left_eq_k_2;
+  assign cat_28 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
-  assign bits_emit_tag = emit_tag[57:13];
+  assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
   assign emit_valid = emit_valid_sr[3];
   assign tri_addr = u_leaf_rom_data;
@@ -659,7 +673,7 @@ module fxrt_core (
   assign tri_e2q = $signed(u_tri_rom_2_data);
   assign pipe_valid = pipe_valid_sr[3];
   assign pipe_tag = pipe_tag_sr[3];
-  assign bits_emit_tag_tri = emit_tag_tri[55:50];
+  assign bits_emit_tag_tri = emit_tag_tri[56:50];
   assign pipe_o = pipe_o_sr[2];
   assign pipe_w = pipe_w_sr[2];
   assign bits_pipe_o = pipe_o[28:0];
@@ -671,14 +685,14 @@ module fxrt_core (
   assign s_bits_pipe_w_1 = $signed(bits_pipe_w_1);
   assign bits_pipe_w_2 = pipe_w[95:64];
   assign s_bits_pipe_w_2 = $signed(bits_pipe_w_2);
-  assign cat_29 = {k_0, u_traverse_0_done_slot};
+  assign cat_30 = {k_0, u_traverse_0_done_slot};
   assign not_u_traverse_0_done_valid = ~u_traverse_0_done_valid;
   assign u1_done_take = u_traverse_1_done_valid & not_u_traverse_0_done_valid;
-  assign cat_31 = {k_1, u_traverse_1_done_slot};
-  assign mux_u_traverse_0_done_valid = u_traverse_0_done_valid ? cat_29 : cat_31;
-  assign or_32 = u_traverse_0_done_valid | u_traverse_1_done_valid;
-  assign lt_33 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_33 = lt_33 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign cat_32 = {k_1, u_traverse_1_done_slot};
+  assign mux_u_traverse_0_done_valid = u_traverse_0_done_valid ? cat_30 : cat_32;
+  assign or_33 = u_traverse_0_done_valid | u_traverse_1_done_valid;
+  assign lt_34 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_34 = lt_34 ? u_traverse_1_depth : u_traverse_0_depth;
   assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
   assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
   assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -745,11 +759,12 @@ module fxrt_core (
     leaf_tmin <= mux_leaf_take_3;
     leaf_sp <= mux_leaf_take_4;
     leaf_first_entry <= leaf_take;
+    leaf_last <= mux_leaf_take_5;
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
-    emit_tag_sr[1] <= cat_27;
+    emit_tag_sr[1] <= cat_28;
     for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
       emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
     emit_valid_sr[1] <= leaf_active;
@@ -776,7 +791,7 @@ module fxrt_core (
     .p(u_plane_product_p)
   );
 
-  fxrt_traverse_k32 u_traverse_0 (
+  fxrt_traverse_k64 u_traverse_0 (
     .clk(clk),
     .rst(rst),
     .ray_we(u0_alloc),
@@ -821,7 +836,7 @@ module fxrt_core (
     .occupied(u_traverse_0_occupied)
   );
 
-  fxrt_traverse_k32 u_traverse_1 (
+  fxrt_traverse_k64 u_traverse_1 (
     .clk(clk),
     .rst(rst),
     .ray_we(u1_alloc),
@@ -898,7 +913,7 @@ module fxrt_core (
     .data(u_tri_rom_2_data)
   );
 
-  fxrt_intersect_n29_m32_t0_e18_tag58_c150 u_intersect (
+  fxrt_intersect_n29_m32_t0_e18_tag59_c150 u_intersect (
     .clk(clk),
     .valid(pipe_valid),
     .tag(pipe_tag),
@@ -926,7 +941,7 @@ module fxrt_core (
     .v(u_intersect_v)
   );
 
-  fxrt_closest_n29_m32_tag58_s64_r2 u_closest (
+  fxrt_closest_n29_m32_tag59_s128_r2 u_closest (
     .clk(clk),
     .rst(rst),
     .valid(u_intersect_valid_out),
@@ -938,7 +953,7 @@ module fxrt_core (
     .id_we(accept),
     .id_slot(accept_slot_int),
     .id(ray_id),
-    .done_valid(or_32),
+    .done_valid(or_33),
     .done_slot(mux_u_traverse_0_done_valid),
     .merge_valid(u_closest_merge_valid),
     .merge_slot(u_closest_merge_slot),
@@ -965,7 +980,7 @@ module fxrt_core (
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
   assign busy = pipe_valid;
-  assign stack_depth = mux_lt_33;
+  assign stack_depth = mux_lt_34;
   assign visits = visits_c;
   assign culls = culls_c;
   assign occupied = occupied_c;

@@ -30,13 +30,13 @@ entity fxrt_core is
     stack_depth : out unsigned(5 downto 0);
     visits : out unsigned(2 downto 0);
     culls : out unsigned(2 downto 0);
-    occupied : out unsigned(6 downto 0);
-    accept_slot : out unsigned(5 downto 0);
+    occupied : out unsigned(7 downto 0);
+    accept_slot : out unsigned(6 downto 0);
     visit0 : out unsigned(0 downto 0);
-    visit0_slot : out unsigned(4 downto 0);
+    visit0_slot : out unsigned(5 downto 0);
     visit0_node : out unsigned(12 downto 0);
     visit1 : out unsigned(0 downto 0);
-    visit1_slot : out unsigned(4 downto 0);
+    visit1_slot : out unsigned(5 downto 0);
     visit1_node : out unsigned(12 downto 0)
   );
 end entity fxrt_core;
@@ -50,12 +50,12 @@ architecture rtl of fxrt_core is
       p : out signed(77 downto 0)
     );
   end component;
-  component fxrt_traverse_k32 is
+  component fxrt_traverse_k64 is
     port (
       clk : in std_logic;
       rst : in std_logic;
       ray_we : in unsigned(0 downto 0);
-      ray_slot : in unsigned(4 downto 0);
+      ray_slot : in unsigned(5 downto 0);
       ox : in unsigned(28 downto 0);
       oy : in unsigned(28 downto 0);
       oz : in unsigned(28 downto 0);
@@ -63,37 +63,37 @@ architecture rtl of fxrt_core is
       invy : in signed(47 downto 0);
       invz : in signed(47 downto 0);
       new_valid : in unsigned(0 downto 0);
-      new_slot : in unsigned(4 downto 0);
+      new_slot : in unsigned(5 downto 0);
       new_tmax : in signed(31 downto 0);
       new_miss : in unsigned(0 downto 0);
       merge_valid : in unsigned(0 downto 0);
-      merge_slot : in unsigned(4 downto 0);
+      merge_slot : in unsigned(5 downto 0);
       merge_hit : in unsigned(0 downto 0);
       merge_limit : in signed(31 downto 0);
       merge_sp : in unsigned(5 downto 0);
       free_valid : in unsigned(0 downto 0);
-      free_slot : in unsigned(4 downto 0);
+      free_slot : in unsigned(5 downto 0);
       alloc : in unsigned(0 downto 0);
       leaf_pop : in unsigned(0 downto 0);
       done_pop : in unsigned(0 downto 0);
       node_word : in unsigned(72 downto 0);
       node_addr : out unsigned(12 downto 0);
       has_free : out unsigned(0 downto 0);
-      free_slot_out : out unsigned(4 downto 0);
+      free_slot_out : out unsigned(5 downto 0);
       leaf_valid : out unsigned(0 downto 0);
-      leaf_slot : out unsigned(4 downto 0);
+      leaf_slot : out unsigned(5 downto 0);
       leaf_first : out unsigned(12 downto 0);
       leaf_count : out unsigned(2 downto 0);
       leaf_tmin : out unsigned(30 downto 0);
       leaf_sp : out unsigned(5 downto 0);
       done_valid : out unsigned(0 downto 0);
-      done_slot : out unsigned(4 downto 0);
+      done_slot : out unsigned(5 downto 0);
       visit : out unsigned(0 downto 0);
-      visit_slot : out unsigned(4 downto 0);
+      visit_slot : out unsigned(5 downto 0);
       visit_node : out unsigned(12 downto 0);
       cull : out unsigned(0 downto 0);
       depth : out unsigned(5 downto 0);
-      occupied : out unsigned(5 downto 0)
+      occupied : out unsigned(6 downto 0)
     );
   end component;
   component fxrt_brom_node_2p is
@@ -133,11 +133,11 @@ architecture rtl of fxrt_core is
       data : out unsigned(31 downto 0)
     );
   end component;
-  component fxrt_intersect_n29_m32_t0_e18_tag58_c150 is
+  component fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
     port (
       clk : in std_logic;
       valid : in unsigned(0 downto 0);
-      tag : in unsigned(57 downto 0);
+      tag : in unsigned(58 downto 0);
       ox : in unsigned(28 downto 0);
       oy : in unsigned(28 downto 0);
       oz : in unsigned(28 downto 0);
@@ -155,35 +155,35 @@ architecture rtl of fxrt_core is
       e2p : in signed(31 downto 0);
       e2q : in signed(31 downto 0);
       valid_out : out unsigned(0 downto 0);
-      tag_out : out unsigned(57 downto 0);
+      tag_out : out unsigned(58 downto 0);
       hit : out unsigned(0 downto 0);
       t : out unsigned(29 downto 0);
       u : out unsigned(31 downto 0);
       v : out unsigned(31 downto 0)
     );
   end component;
-  component fxrt_closest_n29_m32_tag58_s64_r2 is
+  component fxrt_closest_n29_m32_tag59_s128_r2 is
     port (
       clk : in std_logic;
       rst : in std_logic;
       valid : in unsigned(0 downto 0);
-      tag : in unsigned(57 downto 0);
+      tag : in unsigned(58 downto 0);
       hit : in unsigned(0 downto 0);
       t : in unsigned(29 downto 0);
       u : in unsigned(31 downto 0);
       v : in unsigned(31 downto 0);
       id_we : in unsigned(0 downto 0);
-      id_slot : in unsigned(5 downto 0);
+      id_slot : in unsigned(6 downto 0);
       id : in unsigned(19 downto 0);
       done_valid : in unsigned(0 downto 0);
-      done_slot : in unsigned(5 downto 0);
+      done_slot : in unsigned(6 downto 0);
       merge_valid : out unsigned(0 downto 0);
-      merge_slot : out unsigned(5 downto 0);
+      merge_slot : out unsigned(6 downto 0);
       merge_hit : out unsigned(0 downto 0);
       merge_limit : out signed(31 downto 0);
       merge_sp : out unsigned(5 downto 0);
       free_valid : out unsigned(0 downto 0);
-      free_slot : out unsigned(5 downto 0);
+      free_slot : out unsigned(6 downto 0);
       res_valid : out unsigned(0 downto 0);
       res_id : out unsigned(19 downto 0);
       res_hit : out unsigned(0 downto 0);
@@ -194,7 +194,7 @@ architecture rtl of fxrt_core is
     );
   end component;
 
-  type ray_o_t is array (0 to 63) of unsigned(86 downto 0);
+  type ray_o_t is array (0 to 127) of unsigned(86 downto 0);
   signal ray_o : ray_o_t := (
     0 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     1 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
@@ -260,9 +260,73 @@ architecture rtl of fxrt_core is
     61 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     62 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     63 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    64 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    65 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    66 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    67 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    68 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    69 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    70 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    71 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    72 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    73 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    74 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    75 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    76 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    77 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    78 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    79 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    80 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    81 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    82 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    83 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    84 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    85 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    86 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    87 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    88 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    89 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    90 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    91 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    92 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    93 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    94 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    95 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    96 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    97 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    98 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    99 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    100 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    101 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    102 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    103 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    104 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    105 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    106 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    107 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    108 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    109 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    110 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    111 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    112 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    113 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    114 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    115 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    116 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    117 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    118 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    119 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    120 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    121 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    122 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    123 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    124 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    125 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    126 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    127 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     others => (others => '0'));
 
-  type ray_w_t is array (0 to 63) of unsigned(95 downto 0);
+  type ray_w_t is array (0 to 127) of unsigned(95 downto 0);
   signal ray_w : ray_w_t := (
     0 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     1 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
@@ -328,22 +392,86 @@ architecture rtl of fxrt_core is
     61 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     62 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     63 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    64 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    65 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    66 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    67 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    68 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    69 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    70 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    71 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    72 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    73 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    74 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    75 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    76 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    77 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    78 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    79 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    80 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    81 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    82 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    83 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    84 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    85 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    86 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    87 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    88 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    89 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    90 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    91 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    92 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    93 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    94 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    95 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    96 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    97 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    98 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    99 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    100 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    101 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    102 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    103 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    104 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    105 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    106 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    107 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    108 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    109 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    110 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    111 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    112 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    113 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    114 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    115 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    116 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    117 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    118 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    119 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    120 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    121 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    122 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    123 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    124 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    125 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    126 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    127 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     others => (others => '0'));
 
   signal u0_has_free : unsigned(0 downto 0);
   signal u1_has_free : unsigned(0 downto 0);
-  signal u0_free_slot : unsigned(4 downto 0);
-  signal u1_free_slot : unsigned(4 downto 0);
+  signal u0_free_slot : unsigned(5 downto 0);
+  signal u1_free_slot : unsigned(5 downto 0);
   signal turn : unsigned(0 downto 0) := unsigned'("0");
   signal box_phase : unsigned(1 downto 0) := unsigned'("00");
   constant k_0 : unsigned(0 downto 0) := unsigned'("0");
   signal case_turn : unsigned(0 downto 0);
-  signal case_turn_1 : unsigned(4 downto 0);
+  signal case_turn_1 : unsigned(5 downto 0);
   constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
   signal box_phase_eq_k_0_1 : unsigned(0 downto 0);
   signal ready_c : unsigned(0 downto 0);
   signal accept : unsigned(0 downto 0);
-  signal accept_slot_int : unsigned(5 downto 0);
+  signal accept_slot_int : unsigned(6 downto 0);
   constant k_1 : unsigned(0 downto 0) := unsigned'("1");
   signal turn_plus_1 : unsigned(0 downto 0);
   signal not_case_turn : unsigned(0 downto 0);
@@ -360,7 +488,7 @@ architecture rtl of fxrt_core is
   signal box_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal box_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal box_axis : unsigned(1 downto 0);
   constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
   constant box_hi_1 : unsigned(28 downto 0) := unsigned'("01111101010101011000101111001");
@@ -445,16 +573,16 @@ architecture rtl of fxrt_core is
   signal box_miss : unsigned(0 downto 0);
   signal box_last : unsigned(0 downto 0);
   signal box_done : unsigned(0 downto 0) := unsigned'("0");
-  type box_done_slot_sr_t is array (1 to 11) of unsigned(5 downto 0);
+  type box_done_slot_sr_t is array (1 to 11) of unsigned(6 downto 0);
   signal box_done_slot_sr : box_done_slot_sr_t := (others => (others => '0'));
-  signal box_done_slot : unsigned(5 downto 0);
+  signal box_done_slot : unsigned(6 downto 0);
   signal merge_valid : unsigned(0 downto 0);
-  signal merge_slot : unsigned(5 downto 0);
+  signal merge_slot : unsigned(6 downto 0);
   signal merge_hit : unsigned(0 downto 0);
   signal merge_limit : signed(31 downto 0);
   signal merge_sp : unsigned(5 downto 0);
   signal free_valid : unsigned(0 downto 0);
-  signal free_slot : unsigned(5 downto 0);
+  signal free_slot : unsigned(6 downto 0);
   signal u0_leaf_pop : unsigned(0 downto 0);
   signal u1_leaf_pop : unsigned(0 downto 0);
   signal u0_done_pop : unsigned(0 downto 0);
@@ -473,26 +601,26 @@ architecture rtl of fxrt_core is
   signal bits_free_slot : unsigned(0 downto 0);
   signal bits_free_slot_eq_k_0 : unsigned(0 downto 0);
   signal u0_free : unsigned(0 downto 0);
-  signal bits_box_done_slot_1 : unsigned(4 downto 0);
-  signal bits_merge_slot_1 : unsigned(4 downto 0);
-  signal bits_free_slot_1 : unsigned(4 downto 0);
+  signal bits_box_done_slot_1 : unsigned(5 downto 0);
+  signal bits_merge_slot_1 : unsigned(5 downto 0);
+  signal bits_free_slot_1 : unsigned(5 downto 0);
   signal u_traverse_0_node_addr : unsigned(12 downto 0);
   signal u_traverse_0_has_free : unsigned(0 downto 0);
-  signal u_traverse_0_free_slot_out : unsigned(4 downto 0);
+  signal u_traverse_0_free_slot_out : unsigned(5 downto 0);
   signal u_traverse_0_leaf_valid : unsigned(0 downto 0);
-  signal u_traverse_0_leaf_slot : unsigned(4 downto 0);
+  signal u_traverse_0_leaf_slot : unsigned(5 downto 0);
   signal u_traverse_0_leaf_first : unsigned(12 downto 0);
   signal u_traverse_0_leaf_count : unsigned(2 downto 0);
   signal u_traverse_0_leaf_tmin : unsigned(30 downto 0);
   signal u_traverse_0_leaf_sp : unsigned(5 downto 0);
   signal u_traverse_0_done_valid : unsigned(0 downto 0);
-  signal u_traverse_0_done_slot : unsigned(4 downto 0);
+  signal u_traverse_0_done_slot : unsigned(5 downto 0);
   signal u_traverse_0_visit : unsigned(0 downto 0);
-  signal u_traverse_0_visit_slot : unsigned(4 downto 0);
+  signal u_traverse_0_visit_slot : unsigned(5 downto 0);
   signal u_traverse_0_visit_node : unsigned(12 downto 0);
   signal u_traverse_0_cull : unsigned(0 downto 0);
   signal u_traverse_0_depth : unsigned(5 downto 0);
-  signal u_traverse_0_occupied : unsigned(5 downto 0);
+  signal u_traverse_0_occupied : unsigned(6 downto 0);
   signal bits_accept_slot_1 : unsigned(0 downto 0);
   signal eq_14 : unsigned(0 downto 0);
   signal u1_alloc : unsigned(0 downto 0);
@@ -505,26 +633,26 @@ architecture rtl of fxrt_core is
   signal bits_free_slot_2 : unsigned(0 downto 0);
   signal bits_free_slot_2_eq_k_1 : unsigned(0 downto 0);
   signal u1_free : unsigned(0 downto 0);
-  signal bits_box_done_slot_3 : unsigned(4 downto 0);
-  signal bits_merge_slot_3 : unsigned(4 downto 0);
-  signal bits_free_slot_3 : unsigned(4 downto 0);
+  signal bits_box_done_slot_3 : unsigned(5 downto 0);
+  signal bits_merge_slot_3 : unsigned(5 downto 0);
+  signal bits_free_slot_3 : unsigned(5 downto 0);
   signal u_traverse_1_node_addr : unsigned(12 downto 0);
   signal u_traverse_1_has_free : unsigned(0 downto 0);
-  signal u_traverse_1_free_slot_out : unsigned(4 downto 0);
+  signal u_traverse_1_free_slot_out : unsigned(5 downto 0);
   signal u_traverse_1_leaf_valid : unsigned(0 downto 0);
-  signal u_traverse_1_leaf_slot : unsigned(4 downto 0);
+  signal u_traverse_1_leaf_slot : unsigned(5 downto 0);
   signal u_traverse_1_leaf_first : unsigned(12 downto 0);
   signal u_traverse_1_leaf_count : unsigned(2 downto 0);
   signal u_traverse_1_leaf_tmin : unsigned(30 downto 0);
   signal u_traverse_1_leaf_sp : unsigned(5 downto 0);
   signal u_traverse_1_done_valid : unsigned(0 downto 0);
-  signal u_traverse_1_done_slot : unsigned(4 downto 0);
+  signal u_traverse_1_done_slot : unsigned(5 downto 0);
   signal u_traverse_1_visit : unsigned(0 downto 0);
-  signal u_traverse_1_visit_slot : unsigned(4 downto 0);
+  signal u_traverse_1_visit_slot : unsigned(5 downto 0);
   signal u_traverse_1_visit_node : unsigned(12 downto 0);
   signal u_traverse_1_cull : unsigned(0 downto 0);
   signal u_traverse_1_depth : unsigned(5 downto 0);
-  signal u_traverse_1_occupied : unsigned(5 downto 0);
+  signal u_traverse_1_occupied : unsigned(6 downto 0);
   signal u_node_rom_0_data : unsigned(72 downto 0);
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
   signal cat_18 : unsigned(86 downto 0);
@@ -533,14 +661,13 @@ architecture rtl of fxrt_core is
   signal u_wx : unsigned(31 downto 0);
   signal cat_19 : unsigned(95 downto 0);
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
-  signal leaf_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal leaf_left : unsigned(2 downto 0) := unsigned'("000");
   signal leaf_tmin : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
   signal leaf_sp : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_first_entry : unsigned(0 downto 0) := unsigned'("0");
-  constant k_1_2 : unsigned(2 downto 0) := unsigned'("001");
-  signal leaf_left_eq_k_1_2 : unsigned(0 downto 0);
+  signal leaf_last : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_last_entry : unsigned(0 downto 0);
   signal not_leaf_active : unsigned(0 downto 0);
   signal leaf_can_take : unsigned(0 downto 0);
@@ -556,31 +683,37 @@ architecture rtl of fxrt_core is
   signal u0_leaf_take : unsigned(0 downto 0);
   signal eq_24 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
-  signal case_mux_case_leaf_turn_2 : unsigned(4 downto 0);
-  signal cat_25 : unsigned(5 downto 0);
+  signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
+  signal cat_25 : unsigned(6 downto 0);
   signal not_leaf_last_entry : unsigned(0 downto 0);
   signal and_26 : unsigned(0 downto 0);
   signal leaf_take_or_and_26 : unsigned(0 downto 0);
-  signal mux_leaf_take : unsigned(5 downto 0);
+  signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
-  constant k_1_3 : unsigned(12 downto 0) := unsigned'("0000000000001");
-  signal leaf_ptr_plus_k_1_3 : unsigned(12 downto 0);
+  constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
+  signal leaf_ptr_plus_k_1_2 : unsigned(12 downto 0);
   signal mux_leaf_take_1 : unsigned(12 downto 0);
   signal case_mux_case_leaf_turn_2_2 : unsigned(2 downto 0);
-  signal leaf_left_minus_k_1_2 : unsigned(2 downto 0);
+  constant k_1_3 : unsigned(2 downto 0) := unsigned'("001");
+  signal leaf_left_minus_k_1_3 : unsigned(2 downto 0);
   signal mux_leaf_take_2 : unsigned(2 downto 0);
   signal case_mux_case_leaf_turn_2_3 : unsigned(30 downto 0);
   signal mux_leaf_take_3 : unsigned(30 downto 0);
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
+  signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
+  signal eq_27 : unsigned(0 downto 0);
+  constant k_2 : unsigned(2 downto 0) := unsigned'("010");
+  signal leaf_left_eq_k_2 : unsigned(0 downto 0);
+  signal mux_leaf_take_5 : unsigned(0 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_27 : unsigned(57 downto 0);
-  type emit_tag_sr_t is array (1 to 3) of unsigned(57 downto 0);
+  signal cat_28 : unsigned(58 downto 0);
+  type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
-  signal emit_tag : unsigned(57 downto 0);
-  signal bits_emit_tag : unsigned(44 downto 0);
-  signal emit_tag_tri : unsigned(57 downto 0);
+  signal emit_tag : unsigned(58 downto 0);
+  signal bits_emit_tag : unsigned(45 downto 0);
+  signal emit_tag_tri : unsigned(58 downto 0);
   type emit_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
   signal emit_valid_sr : emit_valid_sr_t := (others => (others => '0'));
   signal emit_valid : unsigned(0 downto 0);
@@ -607,10 +740,10 @@ architecture rtl of fxrt_core is
   type pipe_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
   signal pipe_valid_sr : pipe_valid_sr_t := (others => (others => '0'));
   signal pipe_valid : unsigned(0 downto 0);
-  type pipe_tag_sr_t is array (1 to 3) of unsigned(57 downto 0);
+  type pipe_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal pipe_tag_sr : pipe_tag_sr_t := (others => (others => '0'));
-  signal pipe_tag : unsigned(57 downto 0);
-  signal bits_emit_tag_tri : unsigned(5 downto 0);
+  signal pipe_tag : unsigned(58 downto 0);
+  signal bits_emit_tag_tri : unsigned(6 downto 0);
   signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   type pipe_o_sr_t is array (1 to 2) of unsigned(86 downto 0);
   signal pipe_o_sr : pipe_o_sr_t := (others => (others => '0'));
@@ -629,24 +762,24 @@ architecture rtl of fxrt_core is
   signal bits_pipe_w_2 : unsigned(31 downto 0);
   signal s_bits_pipe_w_2 : signed(31 downto 0);
   signal u_intersect_valid_out : unsigned(0 downto 0);
-  signal u_intersect_tag_out : unsigned(57 downto 0);
+  signal u_intersect_tag_out : unsigned(58 downto 0);
   signal u_intersect_hit : unsigned(0 downto 0);
   signal u_intersect_t_1 : unsigned(29 downto 0);
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
-  signal cat_29 : unsigned(5 downto 0);
+  signal cat_30 : unsigned(6 downto 0);
   signal not_u_traverse_0_done_valid : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_31 : unsigned(5 downto 0);
-  signal mux_u_traverse_0_done_valid : unsigned(5 downto 0);
-  signal or_32 : unsigned(0 downto 0);
+  signal cat_32 : unsigned(6 downto 0);
+  signal mux_u_traverse_0_done_valid : unsigned(6 downto 0);
+  signal or_33 : unsigned(0 downto 0);
   signal u_closest_merge_valid : unsigned(0 downto 0);
-  signal u_closest_merge_slot : unsigned(5 downto 0);
+  signal u_closest_merge_slot : unsigned(6 downto 0);
   signal u_closest_merge_hit : unsigned(0 downto 0);
   signal u_closest_merge_limit : signed(31 downto 0);
   signal u_closest_merge_sp : unsigned(5 downto 0);
   signal u_closest_free_valid : unsigned(0 downto 0);
-  signal u_closest_free_slot : unsigned(5 downto 0);
+  signal u_closest_free_slot : unsigned(6 downto 0);
   signal u_closest_res_valid : unsigned(0 downto 0);
   signal u_closest_res_id : unsigned(19 downto 0);
   signal u_closest_res_hit : unsigned(0 downto 0);
@@ -654,17 +787,17 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal lt_33 : unsigned(0 downto 0);
-  signal mux_lt_33 : unsigned(5 downto 0);
+  signal lt_34 : unsigned(0 downto 0);
+  signal mux_lt_34 : unsigned(5 downto 0);
   signal rs_u_traverse_0_visit : unsigned(2 downto 0);
   signal rs_u_traverse_1_visit : unsigned(2 downto 0);
   signal visits_c : unsigned(2 downto 0);
   signal rs_u_traverse_0_cull : unsigned(2 downto 0);
   signal rs_u_traverse_1_cull : unsigned(2 downto 0);
   signal culls_c : unsigned(2 downto 0);
-  signal rs_u_traverse_0_occupied : unsigned(6 downto 0);
-  signal rs_u_traverse_1_occupied : unsigned(6 downto 0);
-  signal occupied_c : unsigned(6 downto 0);
+  signal rs_u_traverse_0_occupied : unsigned(7 downto 0);
+  signal rs_u_traverse_1_occupied : unsigned(7 downto 0);
+  signal occupied_c : unsigned(7 downto 0);
 begin
 
   u0_has_free <= u_traverse_0_has_free;
@@ -769,43 +902,42 @@ begin
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
-  bits_accept_slot <= unsigned(accept_slot_int(5 downto 5));
+  bits_accept_slot <= unsigned(accept_slot_int(6 downto 6));
   bits_accept_slot_eq_k_0 <= "1" when bits_accept_slot = k_0 else "0";
   u0_alloc <= accept and bits_accept_slot_eq_k_0;
-  bits_box_done_slot <= unsigned(box_done_slot(5 downto 5));
+  bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
   eq_11 <= "1" when bits_box_done_slot = k_0 else "0";
   u0_new <= box_done and eq_11;
-  bits_merge_slot <= unsigned(merge_slot(5 downto 5));
+  bits_merge_slot <= unsigned(merge_slot(6 downto 6));
   bits_merge_slot_eq_k_0 <= "1" when bits_merge_slot = k_0 else "0";
   u0_merge <= merge_valid and bits_merge_slot_eq_k_0;
-  bits_free_slot <= unsigned(free_slot(5 downto 5));
+  bits_free_slot <= unsigned(free_slot(6 downto 6));
   bits_free_slot_eq_k_0 <= "1" when bits_free_slot = k_0 else "0";
   u0_free <= free_valid and bits_free_slot_eq_k_0;
-  bits_box_done_slot_1 <= unsigned(box_done_slot(4 downto 0));
-  bits_merge_slot_1 <= unsigned(merge_slot(4 downto 0));
-  bits_free_slot_1 <= unsigned(free_slot(4 downto 0));
-  bits_accept_slot_1 <= unsigned(accept_slot_int(5 downto 5));
+  bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
+  bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
+  bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
+  bits_accept_slot_1 <= unsigned(accept_slot_int(6 downto 6));
   eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
   u1_alloc <= accept and eq_14;
-  bits_box_done_slot_2 <= unsigned(box_done_slot(5 downto 5));
+  bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
   eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
   u1_new <= box_done and eq_15;
-  bits_merge_slot_2 <= unsigned(merge_slot(5 downto 5));
+  bits_merge_slot_2 <= unsigned(merge_slot(6 downto 6));
   bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
   u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
-  bits_free_slot_2 <= unsigned(free_slot(5 downto 5));
+  bits_free_slot_2 <= unsigned(free_slot(6 downto 6));
   bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
   u1_free <= free_valid and bits_free_slot_2_eq_k_1;
-  bits_box_done_slot_3 <= unsigned(box_done_slot(4 downto 0));
-  bits_merge_slot_3 <= unsigned(merge_slot(4 downto 0));
-  bits_free_slot_3 <= unsigned(free_slot(4 downto 0));
+  bits_box_done_slot_3 <= unsigned(box_done_slot(5 downto 0));
+  bits_merge_slot_3 <= unsigned(merge_slot(5 downto 0));
+  bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
   cat_18 <= unsigned(std_logic_vector'(std_logic_vector(oz) & std_logic_vector(oy) & std_logic_vector(ox)));
   u_wz <= unsigned(wz);
   u_wy <= unsigned(wy);
   u_wx <= unsigned(wx);
   cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_wz) & std_logic_vector(u_wy) & std_logic_vector(u_wx)));
-  leaf_left_eq_k_1_2 <= "1" when leaf_left = k_1_2 else "0";
-  leaf_last_entry <= leaf_active and leaf_left_eq_k_1_2;
+  leaf_last_entry <= leaf_active and leaf_last;
   not_leaf_active <= not leaf_active;
   leaf_can_take <= not_leaf_active or leaf_last_entry;
   with leaf_turn select
@@ -850,15 +982,15 @@ begin
       u_traverse_0_leaf_first when "0",
       u_traverse_1_leaf_first when "1",
       u_traverse_0_leaf_first when others;
-  leaf_ptr_plus_k_1_3 <= leaf_ptr + k_1_3;
-  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_3;
+  leaf_ptr_plus_k_1_2 <= leaf_ptr + k_1_2;
+  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_2;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_2 <=
       u_traverse_0_leaf_count when "0",
       u_traverse_1_leaf_count when "1",
       u_traverse_0_leaf_count when others;
-  leaf_left_minus_k_1_2 <= leaf_left - k_1_2;
-  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_2;
+  leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
+  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_3;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_3 <=
       u_traverse_0_leaf_tmin when "0",
@@ -871,9 +1003,17 @@ begin
       u_traverse_1_leaf_sp when "1",
       u_traverse_0_leaf_sp when others;
   mux_leaf_take_4 <= case_mux_case_leaf_turn_2_4 when leaf_take = "1" else leaf_sp;
-  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_5 <=
+      u_traverse_0_leaf_count when "0",
+      u_traverse_1_leaf_count when "1",
+      u_traverse_0_leaf_count when others;
+  eq_27 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
+  mux_leaf_take_5 <= eq_27 when leaf_take = "1" else leaf_left_eq_k_2;
+  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
-  bits_emit_tag <= unsigned(emit_tag(57 downto 13));
+  bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
   emit_valid <= emit_valid_sr(3);
   tri_addr <= u_leaf_rom_data;
@@ -895,7 +1035,7 @@ begin
   tri_e2q <= signed(u_tri_rom_2_data);
   pipe_valid <= pipe_valid_sr(3);
   pipe_tag <= pipe_tag_sr(3);
-  bits_emit_tag_tri <= unsigned(emit_tag_tri(55 downto 50));
+  bits_emit_tag_tri <= unsigned(emit_tag_tri(56 downto 50));
   pipe_o <= pipe_o_sr(2);
   pipe_w <= pipe_w_sr(2);
   bits_pipe_o <= unsigned(pipe_o(28 downto 0));
@@ -907,22 +1047,22 @@ begin
   s_bits_pipe_w_1 <= signed(bits_pipe_w_1);
   bits_pipe_w_2 <= unsigned(pipe_w(95 downto 64));
   s_bits_pipe_w_2 <= signed(bits_pipe_w_2);
-  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
   not_u_traverse_0_done_valid <= not u_traverse_0_done_valid;
   u1_done_take <= u_traverse_1_done_valid and not_u_traverse_0_done_valid;
-  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u_traverse_0_done_valid <= cat_29 when u_traverse_0_done_valid = "1" else cat_31;
-  or_32 <= u_traverse_0_done_valid or u_traverse_1_done_valid;
-  lt_33 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
-  mux_lt_33 <= u_traverse_1_depth when lt_33 = "1" else u_traverse_0_depth;
+  cat_32 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u_traverse_0_done_valid <= cat_30 when u_traverse_0_done_valid = "1" else cat_32;
+  or_33 <= u_traverse_0_done_valid or u_traverse_1_done_valid;
+  lt_34 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
+  mux_lt_34 <= u_traverse_1_depth when lt_34 = "1" else u_traverse_0_depth;
   rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
   rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
   visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
   rs_u_traverse_0_cull <= resize(u_traverse_0_cull, 3);
   rs_u_traverse_1_cull <= resize(u_traverse_1_cull, 3);
   culls_c <= rs_u_traverse_0_cull + rs_u_traverse_1_cull;
-  rs_u_traverse_0_occupied <= resize(u_traverse_0_occupied, 7);
-  rs_u_traverse_1_occupied <= resize(u_traverse_1_occupied, 7);
+  rs_u_traverse_0_occupied <= resize(u_traverse_0_occupied, 8);
+  rs_u_traverse_1_occupied <= resize(u_traverse_1_occupied, 8);
   occupied_c <= rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   regs : process (clk)
@@ -1011,13 +1151,14 @@ begin
       leaf_tmin <= mux_leaf_take_3;
       leaf_sp <= mux_leaf_take_4;
       leaf_first_entry <= leaf_take;
+      leaf_last <= mux_leaf_take_5;
       if rst = '1' then
         leaf_turn <= unsigned'("0");
       elsif leaf_take = "1" then
         leaf_turn <= mux_case_leaf_turn_2;
       end if;
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_27;
+      emit_tag_sr(1) <= cat_28;
       emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
       emit_valid_sr(1) <= leaf_active;
       pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
@@ -1041,7 +1182,7 @@ begin
       p => u_plane_product_p
     );
 
-  u_traverse_0 : fxrt_traverse_k32
+  u_traverse_0 : fxrt_traverse_k64
     port map (
       clk => clk,
       rst => rst,
@@ -1087,7 +1228,7 @@ begin
       occupied => u_traverse_0_occupied
     );
 
-  u_traverse_1 : fxrt_traverse_k32
+  u_traverse_1 : fxrt_traverse_k64
     port map (
       clk => clk,
       rst => rst,
@@ -1170,7 +1311,7 @@ begin
       data => u_tri_rom_2_data
     );
 
-  u_intersect : fxrt_intersect_n29_m32_t0_e18_tag58_c150
+  u_intersect : fxrt_intersect_n29_m32_t0_e18_tag59_c150
     port map (
       clk => clk,
       valid => pipe_valid,
@@ -1199,7 +1340,7 @@ begin
       v => u_intersect_v
     );
 
-  u_closest : fxrt_closest_n29_m32_tag58_s64_r2
+  u_closest : fxrt_closest_n29_m32_tag59_s128_r2
     port map (
       clk => clk,
       rst => rst,
@@ -1212,7 +1353,7 @@ begin
       id_we => accept,
       id_slot => accept_slot_int,
       id => ray_id,
-      done_valid => or_32,
+      done_valid => or_33,
       done_slot => mux_u_traverse_0_done_valid,
       merge_valid => u_closest_merge_valid,
       merge_slot => u_closest_merge_slot,
@@ -1239,7 +1380,7 @@ begin
   res_u <= u_closest_res_u;
   res_v <= u_closest_res_v;
   busy <= pipe_valid;
-  stack_depth <= mux_lt_33;
+  stack_depth <= mux_lt_34;
   visits <= visits_c;
   culls <= culls_c;
   occupied <= occupied_c;

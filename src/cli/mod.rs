@@ -99,7 +99,7 @@ pub struct SweepArgs {
     pub stack_depth: u32,
     /// The BIH's split planes: middle (the thesis's) or sah (binned surface-area heuristic);
     /// one value.
-    #[arg(long, default_value = "middle")]
+    #[arg(long, default_value = "sah")]
     pub tree: TreeSplit,
     /// Vary one parameter at a time around the base set (each at its default if listed,
     /// else its first value), like the thesis's figures, instead of the cross product.
@@ -378,7 +378,7 @@ pub struct ParamArgs {
     pub stack_depth: u32,
     /// The BIH's split planes: middle (the thesis's: halve the box) or sah (binned
     /// surface-area heuristic).
-    #[arg(long, default_value = "middle")]
+    #[arg(long, default_value = "sah")]
     pub tree: TreeSplit,
 }
 

@@ -356,7 +356,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         (Simulation::Rust, _, Some(g)) => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
             let m = crate::cores::top::core_with_raygen(&p, &roms, g);
-            let r = frame::collect_batched(&m, rays.len(), p.total_slots(), 0, &|n| bar.set_position(n));
+            let r = frame::collect_batched(&m, rays.len(), p.slot_count(), 0, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
         }
@@ -389,7 +389,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "triangle_tests_per_ray": (stats.triangle_tests_per_ray() * 100.0).round() / 100.0,
         "node_steps_per_ray": (stats.node_steps_per_ray() * 100.0).round() / 100.0,
         "slot_occupancy": (stats.slot_occupancy() * 10000.0).round() / 10000.0,
-        "slots": p.total_slots(), "units": p.units,
+        "slots": p.slot_count(), "units": p.units,
         "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
     });
     // Hardware speed: one ray per `cycles_per_ray` clocks (one ray in flight).

@@ -3,8 +3,10 @@
 //! done). Every queue of the core holds at most one entry per ray slot, so a depth of the slot
 //! count never overflows and there is no `full` signal.
 //!
-//! `head` is the oldest entry whenever `nonempty` is 1; `pop` (only when nonempty) takes it, and
-//! the next one is on `head` in the next cycle. The RAM is read synchronously (read-first) at the
+//! A push is registered before it reaches the queue (the producers are logic far away on the
+//! die, and the count's carry chain is the queue's own), so an entry pushed in cycle c is on
+//! `head` from cycle c + 2. `head` is the oldest entry whenever `nonempty` is 1; `pop` (only
+//! when nonempty) takes it, and the next one is on `head` in the next cycle. The RAM is read synchronously (read-first) at the
 //! next read pointer, so `head` is a RAM output register; an entry pushed into a queue that is
 //! empty (after this cycle's pop) is read in the same cycle it is written, which a read-first RAM
 //! answers with the old word, so it comes from a copy of the pushed word instead (`bypass`).
@@ -19,6 +21,8 @@ pub struct Fifo<'b> {
 
 /// A queue of `width`-bit entries, at least `depth` deep (a power of two).
 pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>, din: S<'b>, pop: S<'b>) -> Fifo<'b> {
+    let push = b.delay(&format!("{name}_push"), push);
+    let din = b.delay(&format!("{name}_din"), din);
     let depth = depth.next_power_of_two().max(2);
     let ab = depth.trailing_zeros();
     let mem = b.ram(&format!("{name}_mem"), width, vec![0; depth as usize]);
@@ -65,6 +69,7 @@ mod tests {
             let h = |i: usize| m.handle(m.inputs[i]);
             let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
             let mut model = VecDeque::new();
+            let mut in_flight = Vec::new();
             let mut x = 12345u32;
             let mut pushed = 0;
             for cycle in 0..4000 {
@@ -76,12 +81,14 @@ mod tests {
                     assert_eq!(sim.get(out("head")), v as i128, "depth {depth} cycle {cycle}");
                 }
                 let do_pop = !model.is_empty() && x & 3 != 0;
-                let do_push = model.len() - (do_pop as usize) < depth as usize && x & 12 != 0;
+                let do_push = model.len() + in_flight.len() - (do_pop as usize) < depth as usize && x & 12 != 0;
                 if do_pop {
                     model.pop_front();
                 }
+                // A push reaches the queue a clock later.
+                model.extend(in_flight.drain(..));
                 if do_push {
-                    model.push_back(pushed & 255);
+                    in_flight.push(pushed & 255);
                 }
                 sim.set(h(0), do_push as i128);
                 sim.set(h(1), (pushed & 255) as i128);

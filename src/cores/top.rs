@@ -36,7 +36,7 @@ use std::rc::Rc;
 
 /// Ray slots per traversal unit and traversal units, by default (chosen by measurement:
 /// docs/CORE.md).
-pub const DEFAULT_SLOTS: u32 = 32;
+pub const DEFAULT_SLOTS: u32 = 64;
 pub const DEFAULT_UNITS: u32 = 2;
 
 #[derive(Clone, Debug)]
@@ -88,9 +88,13 @@ impl CoreParams {
     pub fn unit_bits(&self) -> u32 {
         self.tag.slot_bits - self.trav.slot_bits()
     }
-    /// Ray slots of the core.
+    /// Global slot numbers of the core (unit bits above slot bits: a power of two per unit).
     pub fn total_slots(&self) -> u32 {
         self.units << self.trav.slot_bits()
+    }
+    /// Ray slots of the core: the rays it holds at once.
+    pub fn slot_count(&self) -> u32 {
+        self.units * self.trav.slots
     }
 
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
@@ -313,7 +317,9 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let cur_tmin = b.reg("leaf_tmin", Ty::u(tp.tmin_width()), None);
     let cur_sp = b.reg("leaf_sp", Ty::u(tp.sp_width()), None);
     let cur_first = b.reg("leaf_first_entry", bit, None);
-    let last_entry = (cur_valid & cur_left.eq(1)).name("leaf_last_entry");
+    // Whether the entry now sent is the leaf's last: a register of its own (left = 1 next).
+    let cur_last = b.reg("leaf_last", bit, None);
+    let last_entry = (cur_valid & cur_last).name("leaf_last_entry");
     let can_take = (!cur_valid | last_entry).name("leaf_can_take");
     let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
     // Rotating priority: the unit after the last one served first.
@@ -352,6 +358,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     b.next(cur_tmin, take.select(sel("leaf_tmin"), cur_tmin));
     b.next(cur_sp, take.select(sel("leaf_sp"), cur_sp));
     b.next(cur_first, take);
+    b.next(cur_last, take.select(sel("leaf_count").eq(1), cur_left.eq(2)));
 
     // Emission: the leaf ROM at the entry, then the triangle ROMs at its word; the tag and the
     // ray (read from the ray RAMs at the slot) wait alongside.

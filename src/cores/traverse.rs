@@ -214,13 +214,19 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let q_valid = b.delay("q_valid", take_unpark | take_new);
     let q_new = b.delay("q_new", take_new);
     let q_slot = b.delay("q_slot", take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb)));
-    let q_sp = b.delay("q_sp", unpark.head.slice(0, spw));
+    // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
+    let head_sp = unpark.head.slice(0, spw);
+    let q_sp = b.delay("q_sp", head_sp);
+    let q_sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
+    let q_sp_m1 = b.delay("q_sp_m1", head_sp - 1);
     let q_tmax = b.delay("q_tmax", newq.head.slice(1, dist.width).signed());
     let q_miss = b.delay("q_miss", newq.head.bit(0));
 
-    // R: the token back from G (a wire here, a register below).
+    // R: the token back from G (a wire here, a register below), with sp = 0 and sp − 1 made in G.
     let r_valid = b.reg("r_valid", bit, Some(0));
     let r_pop = b.reg("r_pop", bit, None);
+    let r_sp_zero = b.reg("r_sp_zero", bit, None);
+    let r_sp_m1 = b.reg("r_sp_m1", Ty::u(spw), None);
     let r = Token {
         valid: r_valid,
         slot: b.reg("r_slot", slot_ty, None),
@@ -236,18 +242,20 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let a_new = (!r_valid & q_new).name("a_new");
     let a_pop = r_valid.select(r_pop, !q_new).name("a_pop");
     let a_sp = r_valid.select(r.sp, q_new.select(q_sp.k(0), q_sp)).name("a_sp");
-    let a_done = (a_valid & ((a_pop & a_sp.eq(0)) | (a_new & q_miss))).name("a_done");
-    let a_from_stack = (a_pop & a_sp.ne(0)).name("a_from_stack");
+    let a_sp_zero = r_valid.select(r_sp_zero, q_new | q_sp_zero).name("a_sp_zero");
+    let a_sp_m1 = r_valid.select(r_sp_m1, q_sp_m1).name("a_sp_m1");
+    let a_done = (a_valid & ((a_pop & a_sp_zero) | (a_new & q_miss))).name("a_done");
+    let a_from_stack = (a_pop & !a_sp_zero).name("a_from_stack");
     let stack_bits = rom_addr_bits(p.stack_depth as usize);
     let stack = b.ram("stack", node_bits + 2 * dist.width, vec![0; (k as usize) << stack_bits]);
-    let top = b.read("stack_top", stack, b.cat(&[a_slot, (a_sp - 1).resize(stack_bits)]));
+    let top = b.read("stack_top", stack, b.cat(&[a_slot, a_sp_m1.resize(stack_bits)]));
     let bt = Token {
         valid: b.delay("b_valid", (a_valid & !a_done).name("a_live")),
         slot: b.delay("b_slot", a_slot),
         node: b.delay("b_node", r_valid.select(r.node, r.node.k(0))),
         tmin: b.delay("b_tmin", r_valid.select(r.tmin, r.tmin.k(0))),
         tmax: b.delay("b_tmax", r_valid.select(r.tmax, q_tmax)),
-        sp: b.delay("b_sp", a_from_stack.select(a_sp - 1, a_sp)),
+        sp: b.delay("b_sp", a_from_stack.select(a_sp_m1, a_sp)),
     };
     let b_from_stack = b.delay("b_from_stack", a_from_stack);
     let done = fifo(&b, "done_q", sb, k, a_done, a_slot, done_pop);
@@ -383,6 +391,8 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     b.next(r.tmin, enter_far.select(far_min, g.tmin));
     b.next(r.tmax, enter_near.select(near_max, g.tmax));
     b.next(r.sp, push.select(g.sp + 1, g.sp));
+    b.next(r_sp_zero, !push & g.sp.eq(0));
+    b.next(r_sp_m1, push.select(g.sp, g.sp - 1));
 
     b.output("node_addr", c.node);
     b.output("has_free", (free_any_r & !just_alloc).name("has_free_c"));

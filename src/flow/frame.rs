@@ -161,7 +161,7 @@ pub fn simulate_rust(
         return (Vec::new(), CoreStats::default());
     }
     // Cycle c of the harness is cycle c − 1 of a testbench driving the core directly.
-    collect_batched(&frame_harness(p, scene, rays), rays.len(), p.total_slots(), 1, progress)
+    collect_batched(&frame_harness(p, scene, rays), rays.len(), p.slot_count(), 1, progress)
 }
 
 /// Runs a design without inputs whose outputs are the core's results and observations (the
@@ -224,7 +224,7 @@ pub fn simulate_rust_cycle(
     let observed = OBSERVED.map(|n| port(&m, n));
     let res: Vec<_> =
         ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
-    let mut stats = CoreStats::new(rays.len() as u64, p.total_slots() as u64);
+    let mut stats = CoreStats::new(rays.len() as u64, p.slot_count() as u64);
     let mut results = Vec::with_capacity(rays.len());
     let mut next = 0;
     let idle = vec![0i128; ins.len()];
@@ -362,7 +362,7 @@ pub fn simulate_hdl(
         rays: rays.len() as u64,
         busy_cycles,
         max_stack_depth: stack as u32,
-        slots: p.total_slots() as u64,
+        slots: p.slot_count() as u64,
         ..Default::default()
     };
     Ok((results, stats))

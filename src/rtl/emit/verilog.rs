@@ -48,6 +48,9 @@ fn waived(w: &mut CodeWriter, rule: &str, why: Option<&str>, body: impl FnOnce(&
     }
 }
 
+/// RAMs of at most this many words are asked for in LUTs (`ram_style`).
+pub const DISTRIBUTED_WORDS: usize = 128;
+
 /// The `$readmemh` file of memory `rom` of module `m`.
 pub fn mem_file(m: &Module, rom: &str) -> String {
     format!("{}_{rom}.hex", m.name)
@@ -100,7 +103,12 @@ impl Printer for Verilog {
     /// Contents load with `$readmemh` from a file beside the module (`mem_files`): a statement
     /// per word makes large ROMs slow to parse (yosys: minutes per 10,000 words).
     fn memory(&self, w: &mut CodeWriter, m: &Module, r: &Rom) {
-        w.line(format!("reg [{}:0] {} [0:{}];", r.width - 1, r.name, rom_depth(r.words.len()) - 1));
+        // A small RAM (the per-slot memories and queues, `DISTRIBUTED_WORDS` words or fewer) is
+        // asked for in LUTs: yosys otherwise spends a block on each of them (8 DP16KDs the
+        // teapot's core did not have to spare); Xilinx tools read the same attribute.
+        let depth = rom_depth(r.words.len());
+        let style = if r.write.is_some() && depth <= DISTRIBUTED_WORDS { "(* ram_style = \"distributed\" *) " } else { "" };
+        w.line(format!("{style}reg [{}:0] {} [0:{}];", r.width - 1, r.name, depth - 1));
         w.line(format!("initial $readmemh(\"{}\", {});", mem_file(m, &r.name), r.name));
     }
 
