@@ -57,7 +57,7 @@ pub struct Params {
     /// How the BIH chooses its split planes (default SAH, chosen by measurement: DECISIONS 72).
     /// Absent from JSON when `middle`, so files written before the option existed (all of
     /// them middle-split) read back as they were.
-    #[serde(default, skip_serializing_if = "TreeSplit::is_middle")]
+    #[serde(default = "TreeSplit::absent", skip_serializing_if = "TreeSplit::is_middle")]
     pub tree: TreeSplit,
 }
 

@@ -324,7 +324,7 @@ fn every_command_with_parameters_takes_tree() {
     };
     for cmd in ["render", "scene", "compare", "gen", "test", "synth", "sim", "sweep"] {
         let out: &[&str] = if matches!(cmd, "sweep" | "scene" | "gen") { &["--out", "x"] } else { &[] };
-        assert_eq!(tree(&[&[cmd], out].concat()), TreeSplit::Middle, "{cmd}");
+        assert_eq!(tree(&[&[cmd], out].concat()), TreeSplit::Sah, "{cmd}");
         assert_eq!(tree(&[&[cmd, "--tree", "sah"], out].concat()), TreeSplit::Sah, "{cmd}");
         assert_eq!(tree(&[&[cmd, "--tree", "middle"], out].concat()), TreeSplit::Middle, "{cmd}");
         let e = Cli::try_parse_from([&["fxrt", cmd, "--tree", "median"], out].concat()).unwrap_err();
@@ -332,9 +332,9 @@ fn every_command_with_parameters_takes_tree() {
         assert!(line.contains("--tree") && line.contains("middle or sah"), "{cmd}: {line}");
     }
     // A sweep's shards are started with the same tree; the default adds nothing to the line.
-    let Command::Sweep(a) = command(&["sweep", "--tree", "sah", "--out", "x"]) else { panic!("not a sweep") };
+    let Command::Sweep(a) = command(&["sweep", "--tree", "middle", "--out", "x"]) else { panic!("not a sweep") };
     let argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
-    assert!(argv.windows(2).any(|w| w == ["--tree", "sah"]), "{argv:?}");
+    assert!(argv.windows(2).any(|w| w == ["--tree", "middle"]), "{argv:?}");
     let Command::Sweep(a) = command(&["sweep", "--out", "x"]) else { panic!("not a sweep") };
     let argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
     assert!(!argv.iter().any(|w| w == "--tree"), "{argv:?}");

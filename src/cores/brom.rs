@@ -87,6 +87,45 @@ pub fn brom<'b>(
     b.instance(label, &m, &[addr]).get("data")
 }
 
+/// The name prefix of block RAM modules (`bram_module`; the ECP5 flow recognises them by it).
+pub const BRAM_PREFIX: &str = "fxrt_bram_";
+
+/// The RAM `fxrt_bram_{name}` of `words` × `width` bits, zeros at power-up: a write port (`we`,
+/// `waddr`, `wdata`) and a read port (`raddr` → `data`, two clocks later: the block's read and
+/// its output register, read-first). A traversal unit's stack: a block RAM whose word went
+/// straight from the block into logic (no output register: 5.6 ns on the ECP5) would not make
+/// the clock; `fxrt synth --family ecp5` builds it of DP16KDs with their output register.
+pub fn bram_module(name: &str, width: u32, words: usize) -> Module {
+    let b = Builder::new(&format!("{BRAM_PREFIX}{name}"));
+    let bits = rom_addr_bits(words);
+    let we = b.input("we", Ty::BIT);
+    let waddr = b.input("waddr", Ty::u(bits));
+    let wdata = b.input("wdata", Ty::u(width));
+    let raddr = b.input("raddr", Ty::u(bits));
+    let mem = b.ram("mem", width, vec![0; words]);
+    b.ram_write(mem, we, waddr, wdata);
+    let word = b.read("word", mem, raddr);
+    b.output("data", b.delay("data_r", word));
+    b.finish()
+}
+
+/// In `b`: the RAM `name` (instance `label`); the word at `raddr` two clocks later.
+#[allow(clippy::too_many_arguments)]
+pub fn bram<'b>(
+    b: &'b Builder,
+    label: &str,
+    name: &str,
+    width: u32,
+    words: usize,
+    we: S<'b>,
+    waddr: S<'b>,
+    wdata: S<'b>,
+    raddr: S<'b>,
+) -> S<'b> {
+    let m = Rc::new(bram_module(name, width, words));
+    b.instance(label, &m, &[we, waddr, wdata, raddr]).get("data")
+}
+
 /// The two-port form: the words at `addr` and `addr_b`, `cycles` clocks later.
 #[allow(clippy::too_many_arguments)]
 pub fn brom2<'b>(

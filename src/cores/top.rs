@@ -323,7 +323,13 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let can_take = (!cur_valid | last_entry).name("leaf_can_take");
     let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
     // Rotating priority: the unit after the last one served first.
-    let avail: Vec<S> = trav.iter().map(|t| t.get("leaf_valid")).collect();
+    // A unit's queue pops a clock after it is taken from (`traverse_core`): not taken from again
+    // in that clock.
+    let avail: Vec<S> = trav
+        .iter()
+        .enumerate()
+        .map(|(u, t)| (t.get("leaf_valid") & !b.delay(&format!("u{u}_leaf_took"), leaf_pop[u])).name(&format!("u{u}_leaf_avail")))
+        .collect();
     let mut pick: Option<(S, S)> = None; // (any, unit)
     for j in (0..units).rev() {
         // Candidate j places after leaf_turn: unit (leaf_turn + 1 + j) mod units.
@@ -394,7 +400,11 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
 
     // Rays done: taken from the units' done queues, lowest unit first (a ray finishes once).
-    let dv: Vec<S> = trav.iter().map(|t| t.get("done_valid")).collect();
+    let dv: Vec<S> = trav
+        .iter()
+        .enumerate()
+        .map(|(u, t)| (t.get("done_valid") & !b.delay(&format!("u{u}_done_took"), done_pop[u])).name(&format!("u{u}_done_avail")))
+        .collect();
     let mut done_any = dv[0];
     let mut done_slot = if ub == 0 { trav[0].get("done_slot") } else { b.cat(&[b.konst(Ty::u(ub), 0), trav[0].get("done_slot")]) };
     b.drive(done_pop[0], dv[0]);

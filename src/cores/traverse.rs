@@ -32,7 +32,7 @@
 //! distance comes in through the new-ray queue (`new_*`). A slot is freed by the top when the
 //! ray's result has left the core (`free_*`), so a slot's best hit is never read after reuse.
 
-use super::brom::read_cycles;
+use super::brom::{bram, read_cycles};
 use super::clock::ClockTarget;
 use super::fifo::fifo;
 use super::mul::MulStyle;
@@ -132,7 +132,8 @@ struct Token<'b> {
 /// a new ray's box exit (`new_valid`, `new_slot`, `new_tmax`, `new_miss`), a leaf merged
 /// (`merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` = best t + 8, `merge_sp`), a slot
 /// freed (`free_valid`, `free_slot`), `alloc` (the top takes `free_slot_out`), `leaf_pop` and
-/// `done_pop` (the heads of the leaf and done queues are taken), `node_word` (the node ROM's
+/// `done_pop` (the heads of the leaf and done queues are taken; the pop takes effect a clock
+/// later, so the head is not taken again in the next clock), `node_word` (the node ROM's
 /// word at `node_addr`, `node_rom_cycles` after it). Outputs: `node_addr`, the lowest free slot
 /// (`has_free`, `free_slot_out`), the leaf queue's head (`leaf_valid`, `leaf_slot`, `leaf_first`,
 /// `leaf_count`, `leaf_tmin`, `leaf_sp`), the done queue's head (`done_valid`, `done_slot`), and
@@ -247,8 +248,13 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let a_done = (a_valid & ((a_pop & a_sp_zero) | (a_new & q_miss))).name("a_done");
     let a_from_stack = (a_pop & !a_sp_zero).name("a_from_stack");
     let stack_bits = rom_addr_bits(p.stack_depth as usize);
-    let stack = b.ram("stack", node_bits + 2 * dist.width, vec![0; (k as usize) << stack_bits]);
-    let top = b.read("stack_top", stack, b.cat(&[a_slot, a_sp_m1.resize(stack_bits)]));
+    // The stack: a block RAM read in two clocks (`brom::bram`), written in G.
+    let stack_w = node_bits + 2 * dist.width;
+    let stack_addr_ty = Ty::u(sb + stack_bits);
+    let (push_w, push_addr, push_data) =
+        (b.wire("stack_we", bit), b.wire("stack_waddr", stack_addr_ty), b.wire("stack_wdata", Ty::u(stack_w)));
+    let raddr = b.cat(&[a_slot, a_sp_m1.resize(stack_bits)]).name("stack_raddr");
+    let top = bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, (k as usize) << stack_bits, push_w, push_addr, push_data, raddr);
     let bt = Token {
         valid: b.delay("b_valid", (a_valid & !a_done).name("a_live")),
         slot: b.delay("b_slot", a_slot),
@@ -257,8 +263,19 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         tmax: b.delay("b_tmax", r_valid.select(r.tmax, q_tmax)),
         sp: b.delay("b_sp", a_from_stack.select(a_sp_m1, a_sp)),
     };
-    let b_from_stack = b.delay("b_from_stack", a_from_stack);
-    let done = fifo(&b, "done_q", sb, k, a_done, a_slot, done_pop);
+    let b_from_stack = b.delay_line("b_from_stack", a_from_stack, 2);
+    // B waits a clock for the stack word (the block's output register).
+    let bt = Token {
+        valid: b.delay("b2_valid", bt.valid),
+        slot: b.delay("b2_slot", bt.slot),
+        node: b.delay("b2_node", bt.node),
+        tmin: b.delay("b2_tmin", bt.tmin),
+        tmax: b.delay("b2_tmax", bt.tmax),
+        sp: b.delay("b2_sp", bt.sp),
+    };
+    // The top's pops arrive a clock late (registered here: the top's arbiter sits across the
+    // die), so it does not take from a queue again in the clock after it took.
+    let done = fifo(&b, "done_q", sb, k, a_done, a_slot, b.delay("done_pop_r", done_pop));
 
     // B: a popped entry (far node, far_min, tmax) from the stack word.
     let top_tmax = top.slice(0, dist.width).signed();
@@ -305,7 +322,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let is_inner = (visit & !w_leaf).name("is_inner");
     let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
     let leaf_in = b.cat(&[nt.slot, w_first.resize(leaf_bits), w_count, nt.tmin.unsigned().resize(p.tmin_width()), nt.sp]);
-    let leafq = fifo(&b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, leaf_pop);
+    let leafq = fifo(&b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.delay("leaf_pop_r", leaf_pop));
 
     // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
     // the units' second stage in N + 1).
@@ -383,7 +400,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let far_min = far_gt_tmin.select(far_start, g.tmin).name("far_min");
     let (enter_near, enter_far) = ((g_inner & go_near).name("enter_near"), (g_inner & !go_near & go_far).name("enter_far"));
     let push = (enter_near & go_far).name("push");
-    b.ram_write(stack, push, b.cat(&[g.slot, g.sp.resize(stack_bits)]), b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()]));
+    b.drive(push_w, push);
+    b.drive(push_addr, b.cat(&[g.slot, g.sp.resize(stack_bits)]));
+    b.drive(push_data, b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()]));
     b.next(r_valid, g.valid);
     b.next(r_pop, !(enter_near | enter_far));
     b.next(r.slot, g.slot);

@@ -240,10 +240,12 @@ pub fn place_and_route(
         m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
     let files = emit::design_files(&top, "v");
     let hierarchy = top.hierarchy();
-    let brom_of = |file: &str| {
-        let name = file.strip_suffix(".v").filter(|n| n.starts_with(crate::cores::brom::BROM_PREFIX))?;
+    let block_of = |file: &str, prefix: &str| {
+        let name = file.strip_suffix(".v").filter(|n| n.starts_with(prefix))?;
         hierarchy.iter().find(|m| m.name == name).copied()
     };
+    let brom_of = |file: &str| block_of(file, crate::cores::brom::BROM_PREFIX);
+    let bram_of = |file: &str| block_of(file, crate::cores::brom::BRAM_PREFIX);
     for (file, text) in &files {
         // Split multipliers' pieces become DSP blocks with their registers inside, block ROMs
         // DP16KDs with their output register, the divider's steps carry chains that add or
@@ -252,6 +254,7 @@ pub fn place_and_route(
             .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
             .or_else(|| super::ecp5_carry::addsub_width_of(file).and_then(|w| super::ecp5_carry::ccu2c_addsub(text, w)))
             .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
+            .or_else(|| bram_of(file).and_then(|m| super::ecp5_bram::dp16kd_ram(text, m)))
             .unwrap_or_else(|| text.clone());
         std::fs::write(dir.join(file), text).map_err(io)?;
     }

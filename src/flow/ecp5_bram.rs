@@ -143,6 +143,62 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
     Some(v)
 }
 
+/// The block RAM module `m` (`cores::brom::bram_module`, `fxrt_bram_…`) as DP16KDs: port A
+/// writes, port B reads with its output register (the module's second clock), or None when it
+/// stays as yosys infers it (too small or too deep). `generated` is its printed Verilog.
+pub fn dp16kd_ram(generated: &str, m: &Module) -> Option<String> {
+    let ram = m.roms.first()?;
+    let depth = crate::scene::rom::rom_depth(ram.words.len());
+    if ram.words.len() < MIN_WORDS {
+        return None;
+    }
+    let (w, cfg_depth) = config(depth)?;
+    let abits = crate::scene::rom::rom_addr_bits(ram.words.len());
+    let shift = (16384 / cfg_depth).trailing_zeros();
+    let end = generated.find("\n);\n")? + 4;
+    let mut v = String::from(&generated[..end]);
+    v.push_str("\n  // DP16KD blocks: port A writes, port B reads with its output register (flow::ecp5_bram).\n");
+    let blocks = ram.width.div_ceil(w);
+    let pad = blocks * w - ram.width;
+    let din = if pad == 0 { "wdata".to_string() } else { format!("{{{pad}'h0, wdata}}") };
+    let _ = writeln!(v, "  wire [{}:0] din = {din};", blocks * w - 1);
+    let _ = writeln!(v, "  wire [{}:0] dout;", blocks * w - 1);
+    // In the 18-bit configuration the two lowest address pins of a write port are its byte
+    // enables (yosys's brams_map_16kd.v does the same).
+    let address = |pin: &str, addr: &str, write: bool| -> String {
+        (0..14u32)
+            .map(|p| match p.checked_sub(shift) {
+                Some(i) if i < abits => format!(".{pin}{p}({addr}[{i}])"),
+                _ if write && w == 18 && p < 2 => format!(".{pin}{p}(1'b1)"),
+                _ => format!(".{pin}{p}(1'b0)"),
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    for j in 0..blocks {
+        let _ = writeln!(
+            v,
+            "  DP16KD #(\n    .DATA_WIDTH_A({w}), .DATA_WIDTH_B({w}), .REGMODE_A(\"NOREG\"), .REGMODE_B(\"OUTREG\"),\n    \
+             .RESETMODE(\"SYNC\"), .ASYNC_RESET_RELEASE(\"SYNC\"), .CSDECODE_A(\"0b000\"), .CSDECODE_B(\"0b000\"),\n    \
+             .WRITEMODE_A(\"NORMAL\"), .WRITEMODE_B(\"NORMAL\"), .GSR(\"DISABLED\")\n  ) u_bram{j} ("
+        );
+        let _ = writeln!(v, "    {},", address("ADA", "waddr", true));
+        let din: Vec<String> = (0..18).map(|i| if i < w { format!(".DIA{i}(din[{}])", j * w + i) } else { format!(".DIA{i}(1'b0)") }).collect();
+        let _ = writeln!(v, "    {},", din.join(", "));
+        v.push_str("    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(we), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n");
+        let _ = writeln!(v, "    {},", address("ADB", "raddr", false));
+        let zeros: Vec<String> = (0..18).map(|i| format!(".DIB{i}(1'b0)")).collect();
+        let _ = writeln!(v, "    {},", zeros.join(", "));
+        let dout: Vec<String> = (0..w).map(|i| format!(".DOB{i}(dout[{}])", j * w + i)).collect();
+        let _ = writeln!(v, "    {},", dout.join(", "));
+        v.push_str("    .CLKB(clk), .CEB(1'b1), .OCEB(1'b1), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+        v.push_str("  );\n");
+    }
+    let _ = writeln!(v, "  assign data = dout[{}:0];", ram.width - 1);
+    v.push_str("endmodule\n");
+    Some(v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,6 +236,24 @@ mod tests {
         let small = brom_module("s", 8, vec![1; 100], 2);
         let files = emit::design_files(&small, "v");
         assert!(dp16kd_rom(&files.iter().find(|(n, _)| n == "fxrt_brom_s.v").unwrap().1, &small).is_none());
+    }
+
+    /// A RAM writes on port A and reads on port B with its output register; in the 18-bit
+    /// configuration the write port's byte enables (the two lowest address pins) are on.
+    #[test]
+    fn a_ram_becomes_dp16kds_written_on_a_read_on_b() {
+        use crate::cores::brom::bram_module;
+        for (words, width, blocks, wide) in [(2048usize, 77u32, 9usize, false), (1024, 36, 2, true)] {
+            let m = bram_module("s", width, words);
+            let files = emit::design_files(&m, "v");
+            let v = dp16kd_ram(&files.iter().find(|(n, _)| n == "fxrt_bram_s.v").unwrap().1, &m).unwrap();
+            assert_eq!(v.matches("DP16KD #(").count(), blocks, "{words}×{width}");
+            assert!(v.contains(".REGMODE_B(\"OUTREG\")") && v.contains(".WEA(we)") && v.contains(".DOB0(dout[0])"));
+            assert!(v.contains("assign data = dout[") && !v.contains("always") && !v.contains("readmem"));
+            assert_eq!(v.contains(".ADA0(1'b1), .ADA1(1'b1)"), wide, "{words}×{width}");
+            assert!(v.contains(&format!(".ADB13(raddr[{}])", words.trailing_zeros() - 1)));
+        }
+        assert!(dp16kd_ram("", &bram_module("t", 8, 64)).is_none(), "small RAMs stay LUTs");
     }
 
     /// Bit k = a·w + b of a narrow block skips the ninth bits of each 18-bit row.

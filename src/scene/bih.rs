@@ -14,9 +14,10 @@ use std::str::FromStr;
 #[serde(rename_all = "lowercase")]
 pub enum Split {
     /// The thesis's: halve the split box on its longest axis (DECISIONS.md 11).
-    #[default]
     Middle,
-    /// Binned surface-area heuristic over the traversal's clipped boxes (DECISIONS.md 72).
+    /// Binned surface-area heuristic over the traversal's clipped boxes (DECISIONS.md 72): the
+    /// default, by measurement.
+    #[default]
     Sah,
 }
 
@@ -25,6 +26,11 @@ impl Split {
 
     pub fn is_middle(&self) -> bool {
         *self == Split::Middle
+    }
+
+    /// A JSON file without the field: written before the option existed, so middle-split.
+    pub fn absent() -> Split {
+        Split::Middle
     }
 }
 

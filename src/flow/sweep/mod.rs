@@ -53,9 +53,9 @@ pub struct SweepSpec {
     pub edge_shift: Vec<EdgeShift>,
     pub leaf_size: u32,
     pub stack_depth: u32,
-    /// The BIH's split (`--tree`; absent from results.json at the default, `middle`, so
-    /// older sweeps read back the same).
-    #[serde(default, skip_serializing_if = "TreeSplit::is_middle")]
+    /// The BIH's split (`--tree`; absent from results.json when `middle`, so older sweeps,
+    /// all middle-split, read back the same).
+    #[serde(default = "TreeSplit::absent", skip_serializing_if = "TreeSplit::is_middle")]
     pub tree: TreeSplit,
     /// Vary one parameter at a time around the base set instead of the cross product.
     pub one_at_a_time: bool,

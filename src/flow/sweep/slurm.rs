@@ -88,7 +88,7 @@ pub fn sweep_command(exe: &Path, spec: &SweepSpec) -> Vec<String> {
     v.extend(["--c".into(), join(&spec.c), "--edge-shift".into(), list(&spec.edge_shift).replace(", ", ",")]);
     v.extend(["--leaf-size".into(), spec.leaf_size.to_string()]);
     v.extend(["--stack-depth".into(), spec.stack_depth.to_string()]);
-    if !spec.tree.is_middle() {
+    if spec.tree != crate::params::TreeSplit::default() {
         v.extend(["--tree".into(), spec.tree.to_string()]);
     }
     if spec.one_at_a_time {

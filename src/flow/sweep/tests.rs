@@ -15,7 +15,7 @@ fn spec() -> SweepSpec {
         edge_shift: vec![EdgeShift::Auto, EdgeShift::Fixed(10)],
         leaf_size: 4,
         stack_depth: 32,
-        tree: TreeSplit::Middle,
+        tree: TreeSplit::Sah,
         one_at_a_time: false,
         synth: false,
         core_sim: false,
@@ -90,7 +90,7 @@ fn labels_are_unique_and_file_safe() {
     assert_eq!(scene_labels(&scenes), vec!["teapot-2", "teapot-3", "teapot-1"]);
     assert_eq!(params_label(&Params::default()), "n29_m32_eauto_t0_c16");
     assert_eq!(params_label(&Params { leaf_size: 2, ..Params::default() }), "n29_m32_eauto_t0_c16_l2");
-    assert_eq!(params_label(&Params { tree: TreeSplit::Sah, ..Params::default() }), "n29_m32_eauto_t0_c16_sah");
+    assert_eq!(params_label(&Params { tree: TreeSplit::Middle, ..Params::default() }), "n29_m32_eauto_t0_c16_middle");
 }
 
 #[test]
