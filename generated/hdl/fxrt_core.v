@@ -271,22 +271,28 @@ module fxrt_core (
   wire [0:0] not_leaf_active;
   wire [0:0] leaf_can_take;
   reg [0:0] leaf_turn = 1'h0;
+  reg [0:0] u0_leaf_took = 1'h0;
+  wire [0:0] not_u0_leaf_took;
+  wire [0:0] u0_leaf_avail;
+  reg [0:0] u1_leaf_took = 1'h0;
+  wire [0:0] not_u1_leaf_took;
+  wire [0:0] u1_leaf_avail;
   reg [0:0] case_leaf_turn;
   reg [0:0] case_leaf_turn_1;
   reg [0:0] case_leaf_turn_2;
   reg [0:0] case_leaf_turn_3;
-  wire [0:0] or_22;
+  wire [0:0] or_24;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_23;
+  wire [0:0] eq_25;
   wire [0:0] u0_leaf_take;
-  wire [0:0] eq_24;
+  wire [0:0] eq_26;
   wire [0:0] u1_leaf_take;
   reg [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_25;
+  wire [6:0] cat_27;
   wire [0:0] not_leaf_last_entry;
-  wire [0:0] and_26;
-  wire [0:0] leaf_take_or_and_26;
+  wire [0:0] and_28;
+  wire [0:0] leaf_take_or_and_28;
   wire [6:0] mux_leaf_take;
   reg [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
@@ -301,13 +307,13 @@ module fxrt_core (
   reg [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   reg [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_27;
+  wire [0:0] eq_29;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_28;
+  wire [58:0] cat_30;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -374,12 +380,18 @@ module fxrt_core (
   wire [29:0] u_intersect_t_1;
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
-  wire [6:0] cat_30;
-  wire [0:0] not_u_traverse_0_done_valid;
+  reg [0:0] u0_done_took = 1'h0;
+  wire [0:0] not_u0_done_took;
+  wire [0:0] u0_done_avail;
+  reg [0:0] u1_done_took = 1'h0;
+  wire [0:0] not_u1_done_took;
+  wire [0:0] u1_done_avail;
+  wire [6:0] cat_34;
+  wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_32;
-  wire [6:0] mux_u_traverse_0_done_valid;
-  wire [0:0] or_33;
+  wire [6:0] cat_36;
+  wire [6:0] mux_u0_done_avail;
+  wire [0:0] or_37;
   wire [0:0] u_closest_merge_valid;
   wire [6:0] u_closest_merge_slot;
   wire [0:0] u_closest_merge_hit;
@@ -394,8 +406,8 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_34;
-  wire [5:0] mux_lt_34;
+  wire [0:0] lt_38;
+  wire [5:0] mux_lt_38;
   wire [2:0] rs_u_traverse_0_visit;
   wire [2:0] rs_u_traverse_1_visit;
   wire [2:0] visits_c;
@@ -516,7 +528,7 @@ module fxrt_core (
   assign free_slot = u_closest_free_slot;
   assign u0_leaf_pop = u0_leaf_take;
   assign u1_leaf_pop = u1_leaf_take;
-  assign u0_done_pop = u_traverse_0_done_valid;
+  assign u0_done_pop = u0_done_avail;
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
@@ -558,10 +570,14 @@ module fxrt_core (
   assign leaf_last_entry = leaf_active & leaf_last;
   assign not_leaf_active = ~leaf_active;
   assign leaf_can_take = not_leaf_active | leaf_last_entry;
+  assign not_u0_leaf_took = ~u0_leaf_took;
+  assign u0_leaf_avail = u_traverse_0_leaf_valid & not_u0_leaf_took;
+  assign not_u1_leaf_took = ~u1_leaf_took;
+  assign u1_leaf_avail = u_traverse_1_leaf_valid & not_u1_leaf_took;
   always @* begin
     case (leaf_turn)
-      1'h0: case_leaf_turn = u_traverse_0_leaf_valid;
-      1'h1: case_leaf_turn = u_traverse_1_leaf_valid;
+      1'h0: case_leaf_turn = u0_leaf_avail;
+      1'h1: case_leaf_turn = u1_leaf_avail;
       default: case_leaf_turn = k_0;
     endcase
   end
@@ -574,8 +590,8 @@ module fxrt_core (
   end
   always @* begin
     case (leaf_turn)
-      1'h0: case_leaf_turn_2 = u_traverse_1_leaf_valid;
-      1'h1: case_leaf_turn_2 = u_traverse_0_leaf_valid;
+      1'h0: case_leaf_turn_2 = u1_leaf_avail;
+      1'h1: case_leaf_turn_2 = u0_leaf_avail;
       default: case_leaf_turn_2 = k_0;
     endcase
   end
@@ -586,13 +602,13 @@ module fxrt_core (
       default: case_leaf_turn_3 = k_0;
     endcase
   end
-  assign or_22 = case_leaf_turn_2 | case_leaf_turn;
+  assign or_24 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_22;
-  assign eq_23 = mux_case_leaf_turn_2 == k_0;
-  assign u0_leaf_take = leaf_take & eq_23;
-  assign eq_24 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_24;
+  assign leaf_take = leaf_can_take & or_24;
+  assign eq_25 = mux_case_leaf_turn_2 == k_0;
+  assign u0_leaf_take = leaf_take & eq_25;
+  assign eq_26 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_26;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
@@ -600,11 +616,11 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
     endcase
   end
-  assign cat_25 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_27 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_26 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_26 = leaf_take | and_26;
-  assign mux_leaf_take = leaf_take ? cat_25 : leaf_slot;
+  assign and_28 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_28 = leaf_take | and_28;
+  assign mux_leaf_take = leaf_take ? cat_27 : leaf_slot;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
@@ -646,10 +662,10 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_5 = u_traverse_0_leaf_count;
     endcase
   end
-  assign eq_27 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_29 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_27 : leaf_left_eq_k_2;
-  assign cat_28 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign mux_leaf_take_5 = leaf_take ? eq_29 : leaf_left_eq_k_2;
+  assign cat_30 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -685,14 +701,18 @@ module fxrt_core (
   assign s_bits_pipe_w_1 = $signed(bits_pipe_w_1);
   assign bits_pipe_w_2 = pipe_w[95:64];
   assign s_bits_pipe_w_2 = $signed(bits_pipe_w_2);
-  assign cat_30 = {k_0, u_traverse_0_done_slot};
-  assign not_u_traverse_0_done_valid = ~u_traverse_0_done_valid;
-  assign u1_done_take = u_traverse_1_done_valid & not_u_traverse_0_done_valid;
-  assign cat_32 = {k_1, u_traverse_1_done_slot};
-  assign mux_u_traverse_0_done_valid = u_traverse_0_done_valid ? cat_30 : cat_32;
-  assign or_33 = u_traverse_0_done_valid | u_traverse_1_done_valid;
-  assign lt_34 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_34 = lt_34 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign not_u0_done_took = ~u0_done_took;
+  assign u0_done_avail = u_traverse_0_done_valid & not_u0_done_took;
+  assign not_u1_done_took = ~u1_done_took;
+  assign u1_done_avail = u_traverse_1_done_valid & not_u1_done_took;
+  assign cat_34 = {k_0, u_traverse_0_done_slot};
+  assign not_u0_done_avail = ~u0_done_avail;
+  assign u1_done_take = u1_done_avail & not_u0_done_avail;
+  assign cat_36 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_34 : cat_36;
+  assign or_37 = u0_done_avail | u1_done_avail;
+  assign lt_38 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_38 = lt_38 ? u_traverse_1_depth : u_traverse_0_depth;
   assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
   assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
   assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -752,7 +772,7 @@ module fxrt_core (
       box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
     box_done_slot_sr[1] <= box_slot;
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_26;
+    else leaf_active <= leaf_take_or_and_28;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -762,9 +782,11 @@ module fxrt_core (
     leaf_last <= mux_leaf_take_5;
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
+    u0_leaf_took <= u0_leaf_pop;
+    u1_leaf_took <= u1_leaf_pop;
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
-    emit_tag_sr[1] <= cat_28;
+    emit_tag_sr[1] <= cat_30;
     for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
       emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
     emit_valid_sr[1] <= leaf_active;
@@ -782,6 +804,8 @@ module fxrt_core (
     for (pipe_w_i = 2; pipe_w_i > 1; pipe_w_i = pipe_w_i - 1)
       pipe_w_sr[pipe_w_i] <= pipe_w_sr[pipe_w_i - 1];
     pipe_w_sr[1] <= ray_w_q;
+    u0_done_took <= u0_done_pop;
+    u1_done_took <= u1_done_pop;
   end
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
@@ -953,8 +977,8 @@ module fxrt_core (
     .id_we(accept),
     .id_slot(accept_slot_int),
     .id(ray_id),
-    .done_valid(or_33),
-    .done_slot(mux_u_traverse_0_done_valid),
+    .done_valid(or_37),
+    .done_slot(mux_u0_done_avail),
     .merge_valid(u_closest_merge_valid),
     .merge_slot(u_closest_merge_slot),
     .merge_hit(u_closest_merge_hit),
@@ -980,7 +1004,7 @@ module fxrt_core (
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
   assign busy = pipe_valid;
-  assign stack_depth = mux_lt_34;
+  assign stack_depth = mux_lt_38;
   assign visits = visits_c;
   assign culls = culls_c;
   assign occupied = occupied_c;

@@ -672,22 +672,28 @@ architecture rtl of fxrt_core is
   signal not_leaf_active : unsigned(0 downto 0);
   signal leaf_can_take : unsigned(0 downto 0);
   signal leaf_turn : unsigned(0 downto 0) := unsigned'("0");
+  signal u0_leaf_took : unsigned(0 downto 0) := unsigned'("0");
+  signal not_u0_leaf_took : unsigned(0 downto 0);
+  signal u0_leaf_avail : unsigned(0 downto 0);
+  signal u1_leaf_took : unsigned(0 downto 0) := unsigned'("0");
+  signal not_u1_leaf_took : unsigned(0 downto 0);
+  signal u1_leaf_avail : unsigned(0 downto 0);
   signal case_leaf_turn : unsigned(0 downto 0);
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
   signal case_leaf_turn_3 : unsigned(0 downto 0);
-  signal or_22 : unsigned(0 downto 0);
+  signal or_24 : unsigned(0 downto 0);
   signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
   signal leaf_take : unsigned(0 downto 0);
-  signal eq_23 : unsigned(0 downto 0);
+  signal eq_25 : unsigned(0 downto 0);
   signal u0_leaf_take : unsigned(0 downto 0);
-  signal eq_24 : unsigned(0 downto 0);
+  signal eq_26 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
   signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_25 : unsigned(6 downto 0);
+  signal cat_27 : unsigned(6 downto 0);
   signal not_leaf_last_entry : unsigned(0 downto 0);
-  signal and_26 : unsigned(0 downto 0);
-  signal leaf_take_or_and_26 : unsigned(0 downto 0);
+  signal and_28 : unsigned(0 downto 0);
+  signal leaf_take_or_and_28 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
   constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
@@ -702,13 +708,13 @@ architecture rtl of fxrt_core is
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_27 : unsigned(0 downto 0);
+  signal eq_29 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_28 : unsigned(58 downto 0);
+  signal cat_30 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -767,12 +773,18 @@ architecture rtl of fxrt_core is
   signal u_intersect_t_1 : unsigned(29 downto 0);
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
-  signal cat_30 : unsigned(6 downto 0);
-  signal not_u_traverse_0_done_valid : unsigned(0 downto 0);
+  signal u0_done_took : unsigned(0 downto 0) := unsigned'("0");
+  signal not_u0_done_took : unsigned(0 downto 0);
+  signal u0_done_avail : unsigned(0 downto 0);
+  signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
+  signal not_u1_done_took : unsigned(0 downto 0);
+  signal u1_done_avail : unsigned(0 downto 0);
+  signal cat_34 : unsigned(6 downto 0);
+  signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_32 : unsigned(6 downto 0);
-  signal mux_u_traverse_0_done_valid : unsigned(6 downto 0);
-  signal or_33 : unsigned(0 downto 0);
+  signal cat_36 : unsigned(6 downto 0);
+  signal mux_u0_done_avail : unsigned(6 downto 0);
+  signal or_37 : unsigned(0 downto 0);
   signal u_closest_merge_valid : unsigned(0 downto 0);
   signal u_closest_merge_slot : unsigned(6 downto 0);
   signal u_closest_merge_hit : unsigned(0 downto 0);
@@ -787,8 +799,8 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal lt_34 : unsigned(0 downto 0);
-  signal mux_lt_34 : unsigned(5 downto 0);
+  signal lt_38 : unsigned(0 downto 0);
+  signal mux_lt_38 : unsigned(5 downto 0);
   signal rs_u_traverse_0_visit : unsigned(2 downto 0);
   signal rs_u_traverse_1_visit : unsigned(2 downto 0);
   signal visits_c : unsigned(2 downto 0);
@@ -898,7 +910,7 @@ begin
   free_slot <= u_closest_free_slot;
   u0_leaf_pop <= u0_leaf_take;
   u1_leaf_pop <= u1_leaf_take;
-  u0_done_pop <= u_traverse_0_done_valid;
+  u0_done_pop <= u0_done_avail;
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
@@ -940,10 +952,14 @@ begin
   leaf_last_entry <= leaf_active and leaf_last;
   not_leaf_active <= not leaf_active;
   leaf_can_take <= not_leaf_active or leaf_last_entry;
+  not_u0_leaf_took <= not u0_leaf_took;
+  u0_leaf_avail <= u_traverse_0_leaf_valid and not_u0_leaf_took;
+  not_u1_leaf_took <= not u1_leaf_took;
+  u1_leaf_avail <= u_traverse_1_leaf_valid and not_u1_leaf_took;
   with leaf_turn select
     case_leaf_turn <=
-      u_traverse_0_leaf_valid when "0",
-      u_traverse_1_leaf_valid when "1",
+      u0_leaf_avail when "0",
+      u1_leaf_avail when "1",
       k_0 when others;
   with leaf_turn select
     case_leaf_turn_1 <=
@@ -952,31 +968,31 @@ begin
       k_0 when others;
   with leaf_turn select
     case_leaf_turn_2 <=
-      u_traverse_1_leaf_valid when "0",
-      u_traverse_0_leaf_valid when "1",
+      u1_leaf_avail when "0",
+      u0_leaf_avail when "1",
       k_0 when others;
   with leaf_turn select
     case_leaf_turn_3 <=
       k_1 when "0",
       k_0 when "1",
       k_0 when others;
-  or_22 <= case_leaf_turn_2 or case_leaf_turn;
+  or_24 <= case_leaf_turn_2 or case_leaf_turn;
   mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_22;
-  eq_23 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
-  u0_leaf_take <= leaf_take and eq_23;
-  eq_24 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_24;
+  leaf_take <= leaf_can_take and or_24;
+  eq_25 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
+  u0_leaf_take <= leaf_take and eq_25;
+  eq_26 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_26;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
       u_traverse_0_leaf_slot when "0",
       u_traverse_1_leaf_slot when "1",
       u_traverse_0_leaf_slot when others;
-  cat_25 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_26 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_26 <= leaf_take or and_26;
-  mux_leaf_take <= cat_25 when leaf_take = "1" else leaf_slot;
+  and_28 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_28 <= leaf_take or and_28;
+  mux_leaf_take <= cat_27 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
       u_traverse_0_leaf_first when "0",
@@ -1008,10 +1024,10 @@ begin
       u_traverse_0_leaf_count when "0",
       u_traverse_1_leaf_count when "1",
       u_traverse_0_leaf_count when others;
-  eq_27 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  eq_29 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_27 when leaf_take = "1" else leaf_left_eq_k_2;
-  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  mux_leaf_take_5 <= eq_29 when leaf_take = "1" else leaf_left_eq_k_2;
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -1047,14 +1063,18 @@ begin
   s_bits_pipe_w_1 <= signed(bits_pipe_w_1);
   bits_pipe_w_2 <= unsigned(pipe_w(95 downto 64));
   s_bits_pipe_w_2 <= signed(bits_pipe_w_2);
-  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
-  not_u_traverse_0_done_valid <= not u_traverse_0_done_valid;
-  u1_done_take <= u_traverse_1_done_valid and not_u_traverse_0_done_valid;
-  cat_32 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u_traverse_0_done_valid <= cat_30 when u_traverse_0_done_valid = "1" else cat_32;
-  or_33 <= u_traverse_0_done_valid or u_traverse_1_done_valid;
-  lt_34 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
-  mux_lt_34 <= u_traverse_1_depth when lt_34 = "1" else u_traverse_0_depth;
+  not_u0_done_took <= not u0_done_took;
+  u0_done_avail <= u_traverse_0_done_valid and not_u0_done_took;
+  not_u1_done_took <= not u1_done_took;
+  u1_done_avail <= u_traverse_1_done_valid and not_u1_done_took;
+  cat_34 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  not_u0_done_avail <= not u0_done_avail;
+  u1_done_take <= u1_done_avail and not_u0_done_avail;
+  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_34 when u0_done_avail = "1" else cat_36;
+  or_37 <= u0_done_avail or u1_done_avail;
+  lt_38 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
+  mux_lt_38 <= u_traverse_1_depth when lt_38 = "1" else u_traverse_0_depth;
   rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
   rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
   visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -1143,7 +1163,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_26;
+        leaf_active <= leaf_take_or_and_28;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -1157,8 +1177,10 @@ begin
       elsif leaf_take = "1" then
         leaf_turn <= mux_case_leaf_turn_2;
       end if;
+      u0_leaf_took <= u0_leaf_pop;
+      u1_leaf_took <= u1_leaf_pop;
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_28;
+      emit_tag_sr(1) <= cat_30;
       emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
       emit_valid_sr(1) <= leaf_active;
       pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
@@ -1171,6 +1193,8 @@ begin
       ray_w_q <= ray_w(to_integer(bits_emit_tag_tri));
       pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
       pipe_w_sr(1) <= ray_w_q;
+      u0_done_took <= u0_done_pop;
+      u1_done_took <= u1_done_pop;
     end if;
   end process regs;
 
@@ -1353,8 +1377,8 @@ begin
       id_we => accept,
       id_slot => accept_slot_int,
       id => ray_id,
-      done_valid => or_33,
-      done_slot => mux_u_traverse_0_done_valid,
+      done_valid => or_37,
+      done_slot => mux_u0_done_avail,
       merge_valid => u_closest_merge_valid,
       merge_slot => u_closest_merge_slot,
       merge_hit => u_closest_merge_hit,
@@ -1380,7 +1404,7 @@ begin
   res_u <= u_closest_res_u;
   res_v <= u_closest_res_v;
   busy <= pipe_valid;
-  stack_depth <= mux_lt_34;
+  stack_depth <= mux_lt_38;
   visits <= visits_c;
   culls <= culls_c;
   occupied <= occupied_c;

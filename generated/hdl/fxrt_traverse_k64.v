@@ -63,9 +63,6 @@ module fxrt_traverse_k64 (
   (* ram_style = "distributed" *) reg [38:0] new_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_new_q_mem.hex", new_q_mem);
 
-  reg [76:0] stack [0:2047];
-  initial $readmemh("fxrt_traverse_k64_stack.hex", stack);
-
   (* ram_style = "distributed" *) reg [5:0] done_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_done_q_mem.hex", done_q_mem);
 
@@ -640,9 +637,12 @@ module fxrt_traverse_k64 (
   wire [0:0] a_done;
   wire [0:0] not_a_sp_zero;
   wire [0:0] a_from_stack;
+  wire [0:0] stack_we;
+  wire [10:0] stack_waddr;
+  wire [76:0] stack_wdata;
   wire [4:0] rs_a_sp_m1;
-  wire [10:0] cat_94;
-  reg [76:0] stack_top = 77'h00000000000000000000;
+  wire [10:0] stack_raddr;
+  wire [76:0] u_stack_data;
   wire [0:0] not_a_done;
   wire [0:0] a_live;
   reg [0:0] b_valid = 1'h0;
@@ -657,7 +657,17 @@ module fxrt_traverse_k64 (
   reg signed [31:0] b_tmax = 32'sh00000000;
   wire [5:0] mux_a_from_stack;
   reg [5:0] b_sp = 6'h00;
-  reg [0:0] b_from_stack = 1'h0;
+  (* mem2reg *) reg [0:0] b_from_stack_sr [1:2];
+  integer b_from_stack_i;
+  initial for (b_from_stack_i = 1; b_from_stack_i <= 2; b_from_stack_i = b_from_stack_i + 1) b_from_stack_sr[b_from_stack_i] = 1'h0;
+  wire [0:0] b_from_stack;
+  reg [0:0] b2_valid = 1'h0;
+  reg [5:0] b2_slot = 6'h00;
+  reg [12:0] b2_node = 13'h0000;
+  reg signed [31:0] b2_tmin = 32'sh00000000;
+  reg signed [31:0] b2_tmax = 32'sh00000000;
+  reg [5:0] b2_sp = 6'h00;
+  reg [0:0] done_pop_r = 1'h0;
   reg [0:0] done_q_push = 1'h0;
   reg [5:0] done_q_din = 6'h00;
   reg [5:0] done_q_wr = 6'h00;
@@ -667,7 +677,7 @@ module fxrt_traverse_k64 (
   wire [5:0] mux_done_q_push;
   wire [5:0] done_q_rd_plus_k_1;
   wire [5:0] done_q_rd_next;
-  wire [6:0] rs_done_pop;
+  wire [6:0] rs_done_pop_r;
   wire [6:0] done_q_after_pop;
   wire [6:0] rs_done_q_push;
   wire [6:0] done_q_count_next;
@@ -679,11 +689,11 @@ module fxrt_traverse_k64 (
   reg [0:0] done_q_nonempty = 1'h0;
   wire [0:0] ne_98;
   wire [5:0] done_q_head;
-  wire [31:0] bits_stack_top;
-  wire signed [31:0] s_bits_stack_top;
-  wire [31:0] bits_stack_top_1;
-  wire signed [31:0] s_bits_stack_top_1;
-  wire [12:0] bits_stack_top_2;
+  wire [31:0] bits_u_stack_data;
+  wire signed [31:0] s_bits_u_stack_data;
+  wire [31:0] bits_u_stack_data_1;
+  wire signed [31:0] s_bits_u_stack_data_1;
+  wire [12:0] bits_u_stack_data_2;
   reg [0:0] c_valid = 1'h0;
   reg [5:0] c_slot = 6'h00;
   wire [12:0] mux_b_from_stack;
@@ -958,6 +968,7 @@ module fxrt_traverse_k64 (
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_n_tmin;
   wire [58:0] cat_108;
+  reg [0:0] leaf_pop_r = 1'h0;
   reg [0:0] leaf_q_push = 1'h0;
   reg [58:0] leaf_q_din = 59'h000000000000000;
   reg [5:0] leaf_q_wr = 6'h00;
@@ -967,7 +978,7 @@ module fxrt_traverse_k64 (
   wire [5:0] mux_leaf_q_push;
   wire [5:0] leaf_q_rd_plus_k_1;
   wire [5:0] leaf_q_rd_next;
-  wire [6:0] rs_leaf_pop;
+  wire [6:0] rs_leaf_pop_r;
   wire [6:0] leaf_q_after_pop;
   wire [6:0] rs_leaf_q_push;
   wire [6:0] leaf_q_count_next;
@@ -1739,34 +1750,38 @@ module fxrt_traverse_k64 (
   assign a_done = a_valid & or_93;
   assign not_a_sp_zero = ~a_sp_zero;
   assign a_from_stack = a_pop & not_a_sp_zero;
+  assign stack_we = push;
+  assign stack_waddr = cat_127;
+  assign stack_wdata = cat_128;
   assign rs_a_sp_m1 = a_sp_m1[4:0];
-  assign cat_94 = {a_slot, rs_a_sp_m1};
+  assign stack_raddr = {a_slot, rs_a_sp_m1};
   assign not_a_done = ~a_done;
   assign a_live = a_valid & not_a_done;
   assign mux_r_valid = r_valid ? r_node : k_0_4;
   assign mux_r_valid_1 = r_valid ? r_tmin : k_0_5;
   assign mux_r_valid_2 = r_valid ? r_tmax : q_tmax;
   assign mux_a_from_stack = a_from_stack ? a_sp_m1 : a_sp;
+  assign b_from_stack = b_from_stack_sr[2];
   assign done_q_wr_plus_k_1 = done_q_wr + k_1;
   assign mux_done_q_push = done_q_push ? done_q_wr_plus_k_1 : done_q_wr;
   assign done_q_rd_plus_k_1 = done_q_rd + k_1;
-  assign done_q_rd_next = done_pop ? done_q_rd_plus_k_1 : done_q_rd;
-  assign rs_done_pop = {{6{1'b0}}, done_pop};
-  assign done_q_after_pop = done_q_count - rs_done_pop;
+  assign done_q_rd_next = done_pop_r ? done_q_rd_plus_k_1 : done_q_rd;
+  assign rs_done_pop_r = {{6{1'b0}}, done_pop_r};
+  assign done_q_after_pop = done_q_count - rs_done_pop_r;
   assign rs_done_q_push = {{6{1'b0}}, done_q_push};
   assign done_q_count_next = done_q_after_pop + rs_done_q_push;
   assign eq_97 = done_q_after_pop == k_0_3;
   assign done_q_bypass_c = done_q_push & eq_97;
   assign ne_98 = done_q_count_next != k_0_3;
   assign done_q_head = done_q_bypass ? done_q_din_r : done_q_q;
-  assign bits_stack_top = stack_top[31:0];
-  assign s_bits_stack_top = $signed(bits_stack_top);
-  assign bits_stack_top_1 = stack_top[63:32];
-  assign s_bits_stack_top_1 = $signed(bits_stack_top_1);
-  assign bits_stack_top_2 = stack_top[76:64];
-  assign mux_b_from_stack = b_from_stack ? bits_stack_top_2 : b_node;
-  assign mux_b_from_stack_1 = b_from_stack ? s_bits_stack_top_1 : b_tmin;
-  assign mux_b_from_stack_2 = b_from_stack ? s_bits_stack_top : b_tmax;
+  assign bits_u_stack_data = u_stack_data[31:0];
+  assign s_bits_u_stack_data = $signed(bits_u_stack_data);
+  assign bits_u_stack_data_1 = u_stack_data[63:32];
+  assign s_bits_u_stack_data_1 = $signed(bits_u_stack_data_1);
+  assign bits_u_stack_data_2 = u_stack_data[76:64];
+  assign mux_b_from_stack = b_from_stack ? bits_u_stack_data_2 : b2_node;
+  assign mux_b_from_stack_1 = b_from_stack ? s_bits_u_stack_data_1 : b2_tmin;
+  assign mux_b_from_stack_2 = b_from_stack ? s_bits_u_stack_data : b2_tmax;
   assign limit_we = merge_valid & merge_hit;
   assign u_merge_limit = $unsigned(merge_limit);
   assign s_limit_q = $signed(limit_q);
@@ -2073,9 +2088,9 @@ module fxrt_traverse_k64 (
   assign leaf_q_wr_plus_k_1 = leaf_q_wr + k_1;
   assign mux_leaf_q_push = leaf_q_push ? leaf_q_wr_plus_k_1 : leaf_q_wr;
   assign leaf_q_rd_plus_k_1 = leaf_q_rd + k_1;
-  assign leaf_q_rd_next = leaf_pop ? leaf_q_rd_plus_k_1 : leaf_q_rd;
-  assign rs_leaf_pop = {{6{1'b0}}, leaf_pop};
-  assign leaf_q_after_pop = leaf_q_count - rs_leaf_pop;
+  assign leaf_q_rd_next = leaf_pop_r ? leaf_q_rd_plus_k_1 : leaf_q_rd;
+  assign rs_leaf_pop_r = {{6{1'b0}}, leaf_pop_r};
+  assign leaf_q_after_pop = leaf_q_count - rs_leaf_pop_r;
   assign rs_leaf_q_push = {{6{1'b0}}, leaf_q_push};
   assign leaf_q_count_next = leaf_q_after_pop + rs_leaf_q_push;
   assign eq_111 = leaf_q_after_pop == k_0_3;
@@ -2265,7 +2280,6 @@ module fxrt_traverse_k64 (
     if (ray_we) ray_invz[ray_slot] <= u_invz;
     if (unpark_q_push) unpark_q_mem[unpark_q_wr] <= unpark_q_din;
     if (new_q_push) new_q_mem[new_q_wr] <= new_q_din;
-    if (push) stack[cat_127] <= cat_128;
     if (done_q_push) done_q_mem[done_q_wr] <= done_q_din;
     if (limit_we) cull_limit[merge_slot] <= u_merge_limit;
     if (leaf_q_push) leaf_q_mem[leaf_q_wr] <= leaf_q_din;
@@ -2325,14 +2339,22 @@ module fxrt_traverse_k64 (
     r_tmin <= mux_enter_far;
     r_tmax <= mux_enter_near_1;
     r_sp <= mux_push;
-    stack_top <= stack[cat_94];
     b_valid <= a_live;
     b_slot <= a_slot;
     b_node <= mux_r_valid;
     b_tmin <= mux_r_valid_1;
     b_tmax <= mux_r_valid_2;
     b_sp <= mux_a_from_stack;
-    b_from_stack <= a_from_stack;
+    for (b_from_stack_i = 2; b_from_stack_i > 1; b_from_stack_i = b_from_stack_i - 1)
+      b_from_stack_sr[b_from_stack_i] <= b_from_stack_sr[b_from_stack_i - 1];
+    b_from_stack_sr[1] <= a_from_stack;
+    b2_valid <= b_valid;
+    b2_slot <= b_slot;
+    b2_node <= b_node;
+    b2_tmin <= b_tmin;
+    b2_tmax <= b_tmax;
+    b2_sp <= b_sp;
+    done_pop_r <= done_pop;
     done_q_push <= a_done;
     done_q_din <= a_slot;
     if (rst) done_q_wr <= 6'h00;
@@ -2347,12 +2369,12 @@ module fxrt_traverse_k64 (
     if (done_q_push) done_q_din_r <= done_q_din;
     if (rst) done_q_nonempty <= 1'h0;
     else done_q_nonempty <= ne_98;
-    c_valid <= b_valid;
-    c_slot <= b_slot;
+    c_valid <= b2_valid;
+    c_slot <= b2_slot;
     c_node <= mux_b_from_stack;
     c_tmin <= mux_b_from_stack_1;
     c_tmax <= mux_b_from_stack_2;
-    c_sp <= b_sp;
+    c_sp <= b2_sp;
     limit_q <= cull_limit[c_slot];
     if (rst) has_best <= 64'h0000000000000000;
     else has_best <= and_105_or_best_set;
@@ -2378,6 +2400,7 @@ module fxrt_traverse_k64 (
     for (n_sp_i = 3; n_sp_i > 1; n_sp_i = n_sp_i - 1)
       n_sp_sr[n_sp_i] <= n_sp_sr[n_sp_i - 1];
     n_sp_sr[1] <= c_sp;
+    leaf_pop_r <= leaf_pop;
     leaf_q_push <= leaf_push;
     leaf_q_din <= cat_108;
     if (rst) leaf_q_wr <= 6'h00;
@@ -2511,6 +2534,15 @@ module fxrt_traverse_k64 (
     g_inner <= f_inner;
     g_negative <= negative;
   end
+
+  fxrt_bram_stack_w77 u_stack (
+    .clk(clk),
+    .we(stack_we),
+    .waddr(stack_waddr),
+    .wdata(stack_wdata),
+    .raddr(stack_raddr),
+    .data(u_stack_data)
+  );
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
     .clk(clk),

@@ -5,12 +5,13 @@
 //! pushed, a node entry skipped when lower_t(tmin) > the best t found so far.
 //!
 //! A ray is a **token** going round a ring of registers, one stage per clock (offsets from A;
-//! N = C + node ROM clocks, F = N + L, L the plane unit's latency):
+//! C = 3, N = C + node ROM clocks, F = N + L, L the plane unit's latency):
 //! - A: the token is the ring's returning one (R) or, when R is empty, one from the queues
 //!   (rays unparked after a leaf, new rays); a pop reads the slot's stack at sp − 1, a pop of
 //!   an empty stack or a ray that misses the scene box is **done** (its slot number goes to
 //!   the done queue) and leaves the ring.
-//! - B: a popped token takes (node, tmin, tmax) from the stack word.
+//! - B, B2: the stack is a block RAM read in two clocks (its output register); in B2 a popped
+//!   token takes (node, tmin, tmax) from the stack word.
 //! - C: the node ROM is addressed; the cull test's operands are read (the slot's best t + 8
 //!   from the limit RAM, whether it has a best hit; tmin − tmin/64).
 //! - N: the node word. A culled entry or an empty leaf goes on as a pop. A leaf with entries is
@@ -24,7 +25,7 @@
 //! - G: the decision: push the far child (stack[slot][sp]) and enter the near one, enter one
 //!   child, or pop. The token goes into R and is back at A in the next cycle.
 //!
-//! Ring length P = N + L + 2 clocks (17 at the default 150 MHz with block ROMs): a slot steps
+//! Ring length P = N + L + 2 clocks (18 at the default 150 MHz with block ROMs): a slot steps
 //! once per P clocks, so K ≥ P slots keep the ring full when no slot is parked.
 //!
 //! Slots: a free-slot bit vector; the top takes the lowest free slot (`alloc`) and writes the
