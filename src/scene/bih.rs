@@ -403,6 +403,19 @@ mod tests {
         }
     }
 
+    /// Every triangle reachable exactly once, inside its clip planes (`check`), the depth bound
+    /// kept and counted: the tree's depth.
+    fn walkable(bih: &Bih, stats: &BihStats, bounds: &[IBox], max_depth: usize) -> Result<usize, TestCaseError> {
+        let (mut seen, mut depth) = (Vec::new(), 0);
+        check(bih, bounds, 0, 0, &mut seen, &mut depth);
+        seen.sort_unstable();
+        prop_assert_eq!(seen, (0..bounds.len() as u32).collect::<Vec<_>>());
+        prop_assert!(depth <= max_depth);
+        prop_assert_eq!(depth, stats.depth);
+        prop_assert_eq!(stats.nodes, bih.nodes.len());
+        Ok(depth)
+    }
+
     proptest! {
         #[test]
         fn invariants(boxes in prop::collection::vec((0i64..1000, 0i64..1000, 0i64..1000, 0i64..60, 0i64..60, 0i64..60), 1..300),
@@ -410,14 +423,7 @@ mod tests {
             let bounds: Vec<IBox> = boxes.iter().map(|&(x, y, z, a, b, c)| IBox { lo: [x, y, z], hi: [x + a, y + b, z + c] }).collect();
             let scene = IBox { lo: [0; 3], hi: [1060; 3] };
             let (bih, stats) = build(&bounds, scene, leaf_size, max_depth, split);
-            let (mut seen, mut depth) = (Vec::new(), 0);
-            check(&bih, &bounds, 0, 0, &mut seen, &mut depth);
-            seen.sort_unstable();
-            // Every triangle is reachable, exactly once.
-            prop_assert_eq!(seen, (0..bounds.len() as u32).collect::<Vec<_>>());
-            prop_assert!(depth <= max_depth);
-            prop_assert_eq!(depth, stats.depth);
-            prop_assert_eq!(stats.nodes, bih.nodes.len());
+            walkable(&bih, &stats, &bounds, max_depth)?;
         }
     }
 
@@ -435,13 +441,7 @@ mod tests {
             }).collect();
             let scene = IBox { lo: [0; 3], hi: [4500; 3] };
             let (bih, stats) = build(&bounds, scene, leaf_size, max_depth, Split::Sah);
-            let (mut seen, mut depth) = (Vec::new(), 0);
-            check(&bih, &bounds, 0, 0, &mut seen, &mut depth);
-            seen.sort_unstable();
-            prop_assert_eq!(seen, (0..bounds.len() as u32).collect::<Vec<_>>());
-            prop_assert!(depth <= max_depth);
-            prop_assert_eq!(depth, stats.depth);
-            prop_assert_eq!(stats.nodes, bih.nodes.len());
+            let depth = walkable(&bih, &stats, &bounds, max_depth)?;
             prop_assert_eq!(stats.inner + stats.leaves, stats.nodes);
             if depth < max_depth {
                 let centroids_differ = |tris: &[u32]| tris.iter().any(|&t| {
