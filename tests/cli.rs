@@ -170,9 +170,10 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     // A good set writes the whole core in both languages and a manifest per core.
     let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--ise", "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    // random: 2,000 triangles (11 bits) + leaf distance (n + 2 = 18 bits) + end flag.
+    // random: 2,000 triangles (11 bits) + leaf distance (n + 2 = 18 bits) + stack pointer (6)
+    // + slot (64 slots × 2 units: 7) + a leaf's first and last flags.
     // Built for the default clock target, 150 MHz: its name, manifest and UCF say so.
-    let name = "fxrt_intersect_n16_m16_t0_e4_tag30_c150";
+    let name = "fxrt_intersect_n16_m16_t0_e4_tag44_c150";
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join(format!("{name}.json"))).unwrap()).unwrap();
     assert_eq!((manifest["latency_cycles"].clone(), manifest["params"]["target_mhz"].clone()), (38.into(), 150.into()));
@@ -183,10 +184,13 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--ise", "--target-mhz", "75", "--out", slow.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let slow_manifest: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(slow.join("fxrt_intersect_n16_m16_t0_e4_tag30_c75.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(slow.join("fxrt_intersect_n16_m16_t0_e4_tag44_c75.json")).unwrap()).unwrap();
     assert_eq!(slow_manifest["latency_cycles"], 25);
     assert!(std::fs::read_to_string(slow.join("fxrt_core.ucf")).unwrap().contains("13.333 ns"));
     let core: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("fxrt_core.json")).unwrap()).unwrap();
+    // Results leave in the order rays finish, and the manifest says so.
+    assert_eq!(core["params"]["results_in_order"], false, "{core}");
+    assert_eq!((core["params"]["ray_slots_per_unit"].clone(), core["params"]["traversal_units"].clone()), (64.into(), 2.into()));
     let files = core["files"]["vhdl"].as_array().unwrap();
     assert_eq!(files.last().unwrap(), "fxrt_core.vhd");
     for f in files.iter().chain(core["files"]["verilog"].as_array().unwrap()) {
@@ -202,7 +206,7 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let again = dir.path().join("again");
     let o = fxrt(&["gen", "--scene", rom.to_str().unwrap(), "--ise", "--out", again.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    for f in ["fxrt_core.vhd", "fxrt_core.v", "fxrt_traverse.vhd", "fxrt_core.json"] {
+    for f in ["fxrt_core.vhd", "fxrt_core.v", "fxrt_traverse_k64.vhd", "fxrt_core.json"] {
         assert_eq!(std::fs::read(out.join(f)).unwrap(), std::fs::read(again.join(f)).unwrap(), "{f}");
     }
     // A scene too large for the block RAM allowed is refused, naming the option.
@@ -230,7 +234,9 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(o.status.success(), "{}", stderr(&o));
     let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(line["all_pixels_match"], true);
-    assert!(line["cycles_per_ray"].as_f64().unwrap() > 10.0);
+    // The box-exit unit takes one ray per 4 clocks at most.
+    assert!(line["cycles_per_ray"].as_f64().unwrap() >= 4.0, "{line}");
+    assert!(line["triangle_tests_per_ray"].as_f64().unwrap() > 1.0, "{line}");
     let o = fxrt(&["render", "--builtin", "cornell", "--size", "24x20", "--ids", render_ids.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read(&sim_ids).unwrap(), std::fs::read(&render_ids).unwrap());
