@@ -5,6 +5,7 @@ pub mod ecp5;
 pub mod ecp5_bram;
 pub mod ecp5_carry;
 pub mod ecp5_dsp;
+pub mod feed;
 pub mod frame;
 pub mod generate;
 pub mod simulators;
