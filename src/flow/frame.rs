@@ -1,6 +1,8 @@
 //! Whole frames through the generated core (`fxrt sim`): every pixel's ray that reaches the
-//! scene box is streamed into the core in pixel order; the results come back in the same
-//! order and are compared with the golden model's (`render::fast`), pixel by pixel.
+//! scene box is streamed into the core in pixel order, and each result is matched by its ray
+//! id (the pixel number) to its ray and compared with the golden model's (`render::fast`),
+//! pixel by pixel: `mismatches` does not assume that results leave the core in the order the
+//! rays entered it.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::cores::traverse::TravState;
@@ -237,18 +239,29 @@ pub fn simulate_rust_cycle(
     (results, stats)
 }
 
-/// Pixels whose core result differs from the golden model (id, triangle, t, u, v), and rays
-/// whose result is missing or out of order.
+/// Rays and results that do not match, whatever order the results came in: each result is
+/// matched to the ray with its id (the pixel number) and counts once if it differs from the
+/// golden model's (triangle, t, u, v), if no ray has its id, or if an earlier result had the
+/// same id; each ray without a result counts once too. 0 means every ray got exactly one
+/// result and every result is right.
 pub fn mismatches(scene: &Scene, rays: &[PixelRay], results: &[CoreResult]) -> u64 {
     let g = FastGolden::new(scene);
-    let mut bad = (rays.len() as u64).abs_diff(results.len() as u64);
-    for (r, (id, hit)) in rays.iter().zip(results) {
-        let want = g.trace(&r.ray).0;
-        if *id != r.pixel as u64 || *hit != want {
-            bad += 1;
+    let by_id: std::collections::HashMap<u64, usize> =
+        rays.iter().enumerate().map(|(k, r)| (r.pixel as u64, k)).collect();
+    let mut seen = vec![false; rays.len()];
+    let mut bad = 0u64;
+    for (id, hit) in results {
+        match by_id.get(id) {
+            Some(&k) if !seen[k] => {
+                seen[k] = true;
+                bad += (*hit != g.trace(&rays[k].ray).0) as u64;
+            }
+            // A second result for a ray, or a result for no ray.
+            _ => bad += 1,
         }
     }
-    bad
+    // Two rays with one id: only one can be matched; the other counts as missing below.
+    bad + seen.iter().filter(|&&s| !s).count() as u64
 }
 
 /// W·H input triangle numbers (−1 for a miss) from the core's results, placed by the ray id
@@ -354,8 +367,13 @@ pub fn simulate_hdl(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::flow::feed::feed_order;
     use crate::params::Params;
     use crate::scene::SceneSource;
+
+    fn cornell(n: u32, m: u32) -> Scene {
+        Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n, m, ..Params::default() }).unwrap()
+    }
 
     /// The frame harness in both engines, output by output, clock by clock.
     #[test]
@@ -383,5 +401,52 @@ mod tests {
             assert_eq!(got[c], want[c], "cycle {c}: {:?}", m.outputs.iter().map(|o| &o.0).collect::<Vec<_>>());
         }
         assert!(want.iter().filter(|r| r[0] == 1).count() == rays.len());
+    }
+
+    /// Each ray's golden result, as the core would return it.
+    fn golden_results(scene: &Scene, rays: &[PixelRay]) -> Vec<CoreResult> {
+        let g = FastGolden::new(scene);
+        rays.iter().map(|r| (r.pixel as u64, g.trace(&r.ray).0)).collect()
+    }
+
+    /// Results are matched to rays by id: any order is right; a swapped, duplicated, missing
+    /// or unknown result is one mismatch each (a duplicate also leaves its ray's own result
+    /// missing).
+    #[test]
+    fn mismatches_match_results_to_rays_by_id() {
+        let scene = cornell(29, 32);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 12, 10));
+        let good = golden_results(&scene, &rays);
+        assert_eq!(mismatches(&scene, &rays, &good), 0);
+        // Any order.
+        let mut reversed = good.clone();
+        reversed.reverse();
+        assert_eq!(mismatches(&scene, &rays, &reversed), 0);
+        assert_eq!(mismatches(&scene, &feed_order(&rays, Some(9)), &good), 0);
+        // Two rays with different results: (a, hit of b) and (b, hit of a).
+        let (a, b) = (0..good.len())
+            .flat_map(|a| (a + 1..good.len()).map(move |b| (a, b)))
+            .find(|&(a, b)| good[a].1 != good[b].1)
+            .expect("rays with different results");
+        let mut swapped = good.clone();
+        (swapped[a].1, swapped[b].1) = (good[b].1, good[a].1);
+        assert_eq!(mismatches(&scene, &rays, &swapped), 2, "swapped hits");
+        // Ray b's result twice, ray a's never: the duplicate and the missing result.
+        let mut duplicated = good.clone();
+        duplicated[a] = good[b];
+        assert_eq!(mismatches(&scene, &rays, &duplicated), 2, "duplicate");
+        let mut dup_extra = good.clone();
+        dup_extra.push(good[b]);
+        assert_eq!(mismatches(&scene, &rays, &dup_extra), 1, "an extra copy");
+        let mut missing = good.clone();
+        missing.remove(a);
+        assert_eq!(mismatches(&scene, &rays, &missing), 1, "missing");
+        let mut unknown = good.clone();
+        unknown.push((12 * 10 + 5, None));
+        assert_eq!(mismatches(&scene, &rays, &unknown), 1, "unknown id");
+        let mut renamed = good.clone();
+        renamed[a].0 = 12 * 10 + 5;
+        assert_eq!(mismatches(&scene, &rays, &renamed), 2, "an unknown id instead of a's");
+        assert_eq!(mismatches(&scene, &rays, &[]), rays.len() as u64);
     }
 }
