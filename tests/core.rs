@@ -8,6 +8,7 @@
 mod common;
 
 use fxrt::cores::top::CoreParams;
+use fxrt::flow::feed::Stalls;
 use fxrt::flow::frame::{binary_png, frame_rays, ids_image, mismatches, simulate_hdl, simulate_rust};
 use fxrt::flow::simulators::Simulator;
 use fxrt::model::camera::Camera;
@@ -31,7 +32,7 @@ fn rust_frame(name: &str, size: u32, target_mhz: u32) {
     let cam = Camera::default_for(&s, size, size);
     let p = CoreParams::new(&roms, 16, 1, target_mhz);
     let rays = frame_rays(&s, &cam);
-    let (results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
+    let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(mismatches(&s, &rays, &results), 0, "{name}");
     let golden = render(&s, make_tracer(&s, ModelKind::Golden).as_ref(), &cam, false, false);
     assert_eq!(ids_image(&s, size, size, &results), golden.ids, "{name}");
@@ -84,7 +85,7 @@ fn hdl_frame(sim: Simulator, size: u32, target_mhz: u32) -> Option<(Scene, Vec<i
     let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &dir).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(mismatches(&s, &rays, &results), 0);
     // The HDL's cycle count and statistics equal the Rust simulator's.
-    let (_, rust) = simulate_rust(&p, &roms, &rays, &|_| {});
+    let (_, rust) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(
         (stats.cycles, stats.busy_cycles, stats.max_stack_depth),
         (rust.cycles, rust.busy_cycles, rust.max_stack_depth)

@@ -11,7 +11,7 @@ use super::config::{
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};
-use crate::flow::{check, frame, generate, synth, vectors};
+use crate::flow::{check, feed, frame, generate, synth, vectors};
 use crate::model::camera::{Camera, CameraSpec};
 use crate::model::golden::Golden;
 use crate::model::raygen::RayGen;
@@ -351,7 +351,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, dir)?,
         _ => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
-            let r = frame::simulate_rust(&p, &roms, &rays, &|n| bar.set_position(n));
+            let r = frame::simulate_rust(&p, &roms, &rays, &feed::Stalls::none(), &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
         }

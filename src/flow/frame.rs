@@ -1,12 +1,13 @@
 //! Whole frames through the generated core (`fxrt sim`): every pixel's ray that reaches the
-//! scene box is streamed into the core in pixel order, and each result is matched by its ray
-//! id (the pixel number) to its ray and compared with the golden model's (`render::fast`),
-//! pixel by pixel: `mismatches` does not assume that results leave the core in the order the
-//! rays entered it.
+//! scene box is streamed into the core — in pixel order, or shuffled and with random input
+//! stalls (`flow::feed`) — and each result is matched by its ray id (the pixel number) to its
+//! ray and compared with the golden model's (`render::fast`), pixel by pixel. Nothing assumes
+//! that results leave the core in the order the rays entered it.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::cores::traverse::TravState;
 use crate::error::{Error, Result};
+use crate::flow::feed::Stalls;
 use crate::flow::simulators::{Bench, Simulator};
 use crate::flow::testbench::{Stream, parse_results, stream_files};
 use crate::model::camera::Camera;
@@ -54,6 +55,8 @@ pub struct CoreStats {
     /// Cycles in which a triangle entered the intersection pipeline.
     pub busy_cycles: u64,
     pub max_stack_depth: u32,
+    /// Cycles the ray source held back although it had a ray (`Stalls`).
+    pub stall_cycles: u64,
     /// Cycles the traversal FSM spent in each state, by encoding (`TravState`); the Rust
     /// simulators count them, the HDL testbenches do not.
     pub state_cycles: Vec<u64>,
@@ -92,10 +95,13 @@ fn port(m: &Module, name: &str) -> crate::rtl::Sig {
 }
 
 /// The core with its ray source in one netlist, so the batched simulator can run it: one ROM
-/// per ray field holding every ray, a ray counter that advances when the core takes a ray, and
-/// the core. The ROMs are read at the counter's next value, so a ray is on the core's inputs
-/// in the cycle after the counter reaches it; the source starts one cycle late for that.
-pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Module {
+/// per ray field holding every ray (in the order given: the feed order), a ray counter that
+/// advances when the core takes a ray, and the core. The ROMs are read at the counter's next
+/// value, so a ray is on the core's inputs in the cycle after the counter reaches it; the
+/// source starts one cycle late for that. With `stalls`, a one-bit ROM of the stall pattern,
+/// read at a free-running cycle counter, holds `ray_valid` low on the pattern's cycles; the
+/// output `source_stall` is 1 in the cycle after one in which the source held back a ray.
+pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay], stalls: &Stalls) -> Module {
     let mut m = Module::new("fxrt_frame");
     let count = rays.len().max(1);
     let bits = crate::scene::rom::rom_addr_bits(count + 1);
@@ -105,7 +111,25 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Mo
     m.connect(started, one_bit, None);
     let last = m.konst("ray_count", idx.ty, rays.len() as i128);
     let more = m.lt("more", idx, last);
-    let valid = m.and("valid", started, more);
+    let offer = m.and("offer", started, more);
+    let (valid, stalled) = if stalls.is_none() {
+        (offer, None)
+    } else {
+        // Harness cycle h is the testbenches' cycle h − 1: the counter is h mod PERIOD, and
+        // the ROM's synchronous read shows pattern[(h − 1) mod PERIOD] in cycle h.
+        let cycle = m.reg("stall_cycle", Ty::u(Stalls::PERIOD_BITS), Some(0));
+        let cycle_one = m.konst("stall_cycle_one", cycle.ty, 1);
+        let cycle_inc = m.add("stall_cycle_inc", cycle, cycle_one);
+        m.connect(cycle, cycle_inc, None);
+        let words = stalls.period().into_iter().map(u128::from).collect();
+        let rom = m.rom("stall_pattern", 1, words);
+        let stall = m.rom_read("stall", rom, cycle);
+        let held = m.and("held", offer, stall);
+        let go = m.not("go", stall);
+        let stalled = m.reg("stalled", Ty::BIT, Some(0));
+        m.connect(stalled, held, None);
+        (m.and("valid", offer, go), Some(stalled))
+    };
     let ready = m.wire("ready", Ty::BIT);
     let fire = m.and("fire", valid, ready);
     let one = m.konst("index_one", idx.ty, 1);
@@ -131,34 +155,40 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay]) -> Mo
     {
         m.output(name, outs[pos(name)]);
     }
+    if let Some(s) = stalled {
+        m.output("source_stall", s);
+    }
     m
 }
 
-/// Streams `rays` through the core in the batched Rust simulator (`rtl::batch`), with the ray
-/// source in the netlist (`frame_harness`). The same results and counts as `simulate_rust_cycle`
-/// and the HDL testbenches, several times faster. `progress` gets the number of results now
-/// and then.
+/// Streams `rays` through the core in the batched Rust simulator (`rtl::batch`) in the order
+/// given, with the ray source in the netlist (`frame_harness`) holding back on the cycles of
+/// `stalls`. The same results, in the same order, and counts as `simulate_rust_cycle` and the
+/// HDL testbenches, several times faster. `progress` gets the number of results now and then.
 pub fn simulate_rust(
     p: &CoreParams,
     scene: &SceneRoms,
     rays: &[PixelRay],
+    stalls: &Stalls,
     progress: &dyn Fn(u64),
 ) -> (Vec<CoreResult>, CoreStats) {
     if rays.is_empty() {
         return (Vec::new(), CoreStats::default());
     }
     // Cycle c of the harness is cycle c − 1 of a testbench driving the core directly.
-    collect_batched(&frame_harness(p, scene, rays), rays.len(), 1, progress)
+    collect_batched(&frame_harness(p, scene, rays, stalls), rays.len(), 1, progress)
 }
 
 /// Runs a design without inputs whose outputs are the core's results and observations (the
 /// frame harness, or the core with its ray generator) in the batched simulator until `count`
-/// results came out. The first `skip` cycles are not counted.
+/// results came out, in the order they came out. The first `skip` cycles are not counted. An
+/// output `source_stall`, if the design has one, counts the source's stall cycles.
 pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u64)) -> (Vec<CoreResult>, CoreStats) {
     let names =
         ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v", "busy", "stack_depth", "fsm_state"];
     let order: Vec<usize> =
         names.iter().map(|n| m.outputs.iter().position(|o| o.0 == *n).expect("a core output")).collect();
+    let stall_out = m.outputs.iter().position(|o| o.0 == "source_stall");
     let mut sim = BatchSim::new(m, 256).expect("a design without inputs");
     let mut stats = CoreStats::new(count as u64);
     let mut results: Vec<CoreResult> = Vec::with_capacity(count);
@@ -179,6 +209,7 @@ pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u6
                 stats.busy_cycles += row[7] as u64;
                 stats.max_stack_depth = stats.max_stack_depth.max(row[8] as u32);
                 stats.count_state(row[9]);
+                stats.stall_cycles += stall_out.map_or(0, |i| all[i] as u64);
                 if row[0] == 1 {
                     results.push(core_result(&row[1..7]));
                     if results.len() == count {
@@ -195,11 +226,14 @@ pub fn collect_batched(m: &Module, count: usize, skip: u64, progress: &dyn Fn(u6
 }
 
 /// `simulate_rust` in the cycle simulator (`rtl::sim`), driving the core's ports directly as
-/// the HDL testbenches do. `progress` gets the number of results now and then.
+/// the HDL testbenches do: each cycle the next ray (in the order given) is on the ports, with
+/// `ray_valid` high unless `stalls` holds it back; results are returned in the order they came
+/// out. `progress` gets the number of results now and then.
 pub fn simulate_rust_cycle(
     p: &CoreParams,
     scene: &SceneRoms,
     rays: &[PixelRay],
+    stalls: &Stalls,
     progress: &dyn Fn(u64),
 ) -> (Vec<CoreResult>, CoreStats) {
     let m = core_module(p, scene);
@@ -213,14 +247,20 @@ pub fn simulate_rust_cycle(
     let mut next = 0;
     let idle = vec![0i128; ins.len()];
     while results.len() < rays.len() {
-        let values = rays.get(next).map(|r| ray_inputs(r.pixel as u64, &r.ray));
+        let mut values = rays.get(next).map(|r| ray_inputs(r.pixel as u64, &r.ray));
+        let stalled = values.is_some() && stalls.at(stats.cycles);
+        if let (true, Some(v)) = (stalled, values.as_mut()) {
+            // The ray stays on the data ports; only ray_valid drops.
+            v[0] = 0;
+        }
         for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&idle)) {
             sim.set(*s, *v);
         }
         sim.eval();
-        let fire = values.is_some() && sim.get(ready) == 1;
+        let fire = values.is_some() && !stalled && sim.get(ready) == 1;
         sim.tick();
         stats.cycles += 1;
+        stats.stall_cycles += stalled as u64;
         // Observed after the edge, as the testbenches do (Verilator's timing mode does not
         // show these before it).
         stats.busy_cycles += sim.get(busy) as u64;
@@ -359,6 +399,7 @@ pub fn simulate_hdl(
         rays: rays.len() as u64,
         busy_cycles,
         max_stack_depth: stack as u32,
+        stall_cycles: 0,
         state_cycles: Vec::new(),
     };
     Ok((results, stats))
@@ -367,27 +408,33 @@ pub fn simulate_hdl(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::feed::feed_order;
     use crate::params::Params;
     use crate::scene::SceneSource;
+
+    use crate::flow::feed::feed_order;
 
     fn cornell(n: u32, m: u32) -> Scene {
         Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n, m, ..Params::default() }).unwrap()
     }
 
-    /// The frame harness in both engines, output by output, clock by clock.
+    /// The frame harness in both engines, output by output, clock by clock: rays in pixel
+    /// order, and shuffled with the source stalling on 40 % of the cycles.
     #[test]
     fn harness_runs_alike_in_both_engines() {
-        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() })
-            .unwrap();
-        let roms = SceneRoms::of(&scene);
-        let p = CoreParams::new(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
+        let scene = cornell(16, 16);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 6));
-        let m = frame_harness(&p, &roms, &rays);
+        harness_alike(&scene, &rays, &Stalls::none());
+        harness_alike(&scene, &feed_order(&rays, Some(3)), &Stalls::random(40, 2));
+    }
+
+    fn harness_alike(scene: &Scene, rays: &[PixelRay], stalls: &Stalls) {
+        let roms = SceneRoms::of(scene);
+        let p = CoreParams::new(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
+        let m = frame_harness(&p, &roms, rays, stalls);
         let outs: Vec<_> = m.outputs.iter().map(|(_, i)| m.handle(*i)).collect();
         // Every ray finishes: about 140 cycles per ray on the Cornell box at the default target
-        // (docs/CORE.md), plus the pipeline.
-        let cycles = 5000;
+        // (docs/CORE.md), plus the pipeline and the stalls.
+        let cycles = 7000;
         let mut sim = Sim::new(&m);
         let want: Vec<Vec<i128>> = (0..cycles)
             .map(|_| {
@@ -448,5 +495,35 @@ mod tests {
         renamed[a].0 = 12 * 10 + 5;
         assert_eq!(mismatches(&scene, &rays, &renamed), 2, "an unknown id instead of a's");
         assert_eq!(mismatches(&scene, &rays, &[]), rays.len() as u64);
+    }
+
+    /// Shuffled rays and a stalling source, in both engines: the same results in the same
+    /// (arrival) order, the same counts; every result right; the rays really went in shuffled
+    /// and the stalls really cost cycles.
+    #[test]
+    fn shuffled_stalled_frames_run_alike_in_both_engines() {
+        let scene = cornell(29, 32);
+        let roms = SceneRoms::of(&scene);
+        let p = CoreParams::new(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 10, 8));
+        let fed = feed_order(&rays, Some(11));
+        let stalls = Stalls::random(40, 5);
+        let (results, stats) = simulate_rust(&p, &roms, &fed, &stalls, &|_| {});
+        let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &fed, &stalls, &|_| {});
+        assert_eq!(cycle_results, results);
+        assert_eq!(
+            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.stall_cycles, &cycle_stats.state_cycles),
+            (stats.cycles, stats.busy_cycles, stats.stall_cycles, &stats.state_cycles)
+        );
+        assert_eq!(mismatches(&scene, &rays, &results), 0);
+        let arrival: Vec<u64> = results.iter().map(|r| r.0).collect();
+        let mut sorted = arrival.clone();
+        sorted.sort();
+        assert_ne!(arrival, sorted, "the rays were fed shuffled");
+        let (_, plain) = simulate_rust(&p, &roms, &fed, &Stalls::none(), &|_| {});
+        assert_eq!(plain.stall_cycles, 0);
+        // About 40 % of the cycles in which rays remained.
+        assert!(stats.stall_cycles * 4 > stats.cycles, "{stats:?}");
+        assert!(stats.cycles > plain.cycles, "stalls cost cycles: {} vs {}", stats.cycles, plain.cycles);
     }
 }
