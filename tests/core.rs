@@ -82,7 +82,7 @@ fn hdl_frame(sim: Simulator, size: u32, target_mhz: u32) -> Option<(Scene, Vec<i
     let p = CoreParams::new(&roms, 16, 1, target_mhz);
     let rays = frame_rays(&s, &cam);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("frame_{}", sim.name()));
-    let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &dir).unwrap_or_else(|e| panic!("{e}"));
+    let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &Stalls::none(), &dir).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(mismatches(&s, &rays, &results), 0);
     // The HDL's cycle count and statistics equal the Rust simulator's.
     let (_, rust) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});

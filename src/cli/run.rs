@@ -348,7 +348,9 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             bar.finish_and_clear();
             r
         }
-        (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, dir)?,
+        (Simulation::Hdl(sim), Some(dir), None) => {
+            frame::simulate_hdl(sim, &p, &scene, &rays, &feed::Stalls::none(), dir)?
+        }
         _ => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
             let r = frame::simulate_rust(&p, &roms, &rays, &feed::Stalls::none(), &|n| bar.set_position(n));

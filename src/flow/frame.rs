@@ -350,56 +350,107 @@ fn result_row(id: u64, hit: Option<Hit>) -> Vec<i128> {
     }
 }
 
-/// Streams `rays` through the core's HDL in `sim` with a generated stream testbench, which
-/// checks every result against the golden model and writes what the core produced; those
-/// results (not the golden ones) are returned.
+/// What a stream testbench feeds and checks for a frame: the core, the rays' input values in
+/// feed order, the expected results by ray id, the stall pattern and a cycle limit. Public so a
+/// test can corrupt it and see the testbench fail.
+pub struct FrameStream {
+    pub core: Module,
+    /// Every input port but `ray_valid`, per ray, in feed order.
+    pub rays: Vec<Vec<i128>>,
+    /// The golden model's `RESULT_PORTS` values for ray id k at index k; None where no ray
+    /// has that id.
+    pub expected: Vec<Option<Vec<i128>>>,
+    pub stalls: Stalls,
+    pub max_cycles: u64,
+}
+
+/// The stream testbench's data for `rays` (in feed order) through the core.
+pub fn frame_stream(p: &CoreParams, scene: &Scene, rays: &[PixelRay], stalls: &Stalls) -> Result<FrameStream> {
+    let roms = SceneRoms::of(scene);
+    let core = core_module(p, &roms);
+    let id_width = p.trav.id_width;
+    let max_id = rays.iter().map(|r| r.pixel as u64).max().unwrap_or(0);
+    if id_width < 64 && max_id >> id_width != 0 {
+        return Err(Error::new("ray id", format!("pixel {max_id} does not fit the core's {id_width}-bit ray id")));
+    }
+    let g = FastGolden::new(scene);
+    let inputs = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
+    let mut expected = vec![None; max_id as usize + 1];
+    for r in rays {
+        expected[r.pixel as usize] = Some(result_row(r.pixel as u64, g.trace(&r.ray).0));
+    }
+    // Generous: the slowest built-in scene needs ~28,000 cycles per ray; with room for the
+    // source's stalls (a period holds at most 4,055 at 99 %). Capped to what the testbenches'
+    // 32-bit integers hold (GHDL would wrap it, Verilator refuses it).
+    let max_cycles =
+        ((100_000 + 100 * stalls.per_period() as u64) * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
+    Ok(FrameStream { core, rays: inputs, expected, stalls: stalls.clone(), max_cycles })
+}
+
+/// Streams `rays` (in the order given, with `stalls`) through the core's HDL in `sim` with a
+/// generated stream testbench, which checks every result by its ray id against the golden
+/// model and writes what the core produced; those results (not the golden ones) are returned
+/// in the order they came out.
 pub fn simulate_hdl(
     sim: Simulator,
     p: &CoreParams,
     scene: &Scene,
     rays: &[PixelRay],
+    stalls: &Stalls,
     dir: &Path,
 ) -> Result<(Vec<CoreResult>, CoreStats)> {
-    let roms = SceneRoms::of(scene);
     if !sim.available() {
         return Err(Error::new(sim.name(), "is not installed (scripts/install-deps.sh installs it)"));
     }
     if rays.is_empty() {
         return Ok((Vec::new(), CoreStats::default()));
     }
-    let m = core_module(p, &roms);
-    let g = FastGolden::new(scene);
-    let inputs: Vec<Vec<i128>> = rays.iter().map(|r| ray_inputs(r.pixel as u64, &r.ray)[1..].to_vec()).collect();
-    let expected: Vec<Vec<i128>> = rays.iter().map(|r| result_row(r.pixel as u64, g.trace(&r.ray).0)).collect();
-    // Generous: the slowest built-in scene needs ~28,000 cycles per ray. Capped to what the
-    // testbenches' 32-bit integers hold (GHDL would wrap it, Verilator refuses it).
-    let max_cycles = (100_000 * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
-    let stream = Stream { rays: &inputs, expected: &expected, checked: &RESULT_PORTS, max_cycles };
+    run_stream(sim, &frame_stream(p, scene, rays, stalls)?, dir)
+}
+
+/// Writes the stream testbench of `s` for `sim` into `dir`, runs it, and returns the results
+/// it wrote (in arrival order) and its counts. A testbench that finds a mismatch fails: Err,
+/// with the simulator's last lines (among them `N passed, M failed`).
+pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<CoreResult>, CoreStats)> {
+    let m = &s.core;
+    let stall_bits = (!s.stalls.is_none()).then(|| s.stalls.period());
+    let stream = Stream {
+        rays: &s.rays,
+        expected: &s.expected,
+        checked: &RESULT_PORTS,
+        id: "res_id",
+        stalls: stall_bits.as_deref(),
+        max_cycles: s.max_cycles,
+    };
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     std::fs::create_dir_all(dir).map_err(io)?;
-    for (file, text) in stream_files(&m, &stream, sim) {
+    for (file, text) in stream_files(m, &stream, sim) {
         std::fs::write(dir.join(file), text).map_err(io)?;
     }
-    let (_, out) = sim.run_bench(dir, &m, Bench::Stream).map_err(|e| Error::new(sim.name(), e))?;
+    let (_, out) = sim.run_bench(dir, m, Bench::Stream).map_err(|e| Error::new(sim.name(), e))?;
     let text = std::fs::read_to_string(dir.join("results.txt")).map_err(io)?;
-    let rows = parse_results(&m, &RESULT_PORTS, &text).map_err(|e| Error::file(&dir.join("results.txt"), e))?;
+    let rows = parse_results(m, &RESULT_PORTS, &text).map_err(|e| Error::file(&dir.join("results.txt"), e))?;
     let results = rows.iter().map(|r| core_result(r)).collect();
-    // "cycles C busy B stack S", wherever the simulator put it on its line.
-    let stats_line = out.lines().find_map(|l| l.find("cycles ").map(|i| &l[i..]));
-    let nums: Vec<u64> = stats_line
-        .unwrap_or("")
-        .split_whitespace()
-        .filter_map(|w| w.trim_end_matches(|c: char| !c.is_ascii_digit()).parse().ok())
-        .collect();
-    let [cycles, busy_cycles, stack] = nums[..] else {
+    // "cycles C busy B stack S" and "stalls N", wherever the simulator put them on their lines.
+    let numbers = |key: &str| -> Vec<u64> {
+        let line = out.lines().find_map(|l| l.find(key).map(|i| &l[i..]));
+        line.unwrap_or("")
+            .split_whitespace()
+            .filter_map(|w| w.trim_end_matches(|c: char| !c.is_ascii_digit()).parse().ok())
+            .collect()
+    };
+    let [cycles, busy_cycles, stack] = numbers("cycles ")[..] else {
         return Err(Error::new(sim.name(), format!("no 'cycles … busy … stack …' line in:\n{out}")));
+    };
+    let [stall_cycles] = numbers("stalls ")[..] else {
+        return Err(Error::new(sim.name(), format!("no 'stalls …' line in:\n{out}")));
     };
     let stats = CoreStats {
         cycles,
-        rays: rays.len() as u64,
+        rays: s.rays.len() as u64,
         busy_cycles,
         max_stack_depth: stack as u32,
-        stall_cycles: 0,
+        stall_cycles,
         state_cycles: Vec::new(),
     };
     Ok((results, stats))
