@@ -252,6 +252,37 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
 
+/// Shuffled rays and a stalling source: every pixel still right, the options in the JSON line,
+/// the same ids as `render`; bad values refused with one line naming the option.
+#[test]
+fn sim_feeds_rays_shuffled_and_stalled() {
+    let dir = tempfile::tempdir().unwrap();
+    let (sim_ids, render_ids) = (dir.path().join("sim.ids"), dir.path().join("render.ids"));
+    let size = ["--builtin", "cornell", "--size", "20x16"];
+    let feed = ["--shuffle-seed", "3", "--stall-percent", "25", "--ids", sim_ids.to_str().unwrap()];
+    let o = fxrt(&[&["sim"][..], &size, &feed].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((line["all_pixels_match"].as_bool(), line["mismatches"].as_u64()), (Some(true), Some(0)));
+    assert_eq!((line["shuffle_seed"].as_u64(), line["stall_percent"].as_u64()), (Some(3), Some(25)));
+    assert_eq!(line["stall_seed"].as_u64(), Some(1));
+    assert!(line["stall_cycles"].as_u64().unwrap() > 0, "{line}");
+    // Today's core keeps the order it was fed: shuffled, so not pixel order, but feed order.
+    assert_eq!(
+        (line["results_in_feed_order"].as_bool(), line["results_in_pixel_order"].as_bool()),
+        (Some(true), Some(false))
+    );
+    let o = fxrt(&[&["render"][..], &size, &["--ids", render_ids.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&sim_ids).unwrap(), std::fs::read(&render_ids).unwrap());
+    let png = dir.path().join("x.png");
+    let png_s = png.to_str().unwrap();
+    assert_rejected(&["sim", "--stall-percent", "100", "--png", png_s], "--stall-percent", &png);
+    assert_rejected(&["sim", "--stall-percent", "-5", "--png", png_s], "--stall-percent", &png);
+    assert_rejected(&["sim", "--stall-seed", "2", "--png", png_s], "--stall-seed", &png);
+    assert_rejected(&["sim", "--shuffle-seed", "x", "--png", png_s], "--shuffle-seed", &png);
+}
+
 /// `fxrt gen --scene DIR` wires the hardware from scene.json's layouts: a layout that is not
 /// the one fxrt writes (here two fields swapped) is refused, not turned into wrong hardware.
 #[test]

@@ -3,13 +3,20 @@
 //! scene, in Verilator on a 128² frame and in GHDL on a 16² frame, which also renders the
 //! binary teapot of seed 001 figure 3.7 — at two clock targets: the default (150 MHz: split
 //! products, every splitting stage registered) and 75 MHz (one-clock products, the thesis-like
-//! pipeline), which also keeps the two largest scenes' frames short.
+//! pipeline), which also keeps the two largest scenes' frames short. And with the rays fed
+//! shuffled and the source stalling at random, in every simulator: results are matched to rays
+//! by id, so a core that returns them out of order is checked the same way.
 
 mod common;
 
 use fxrt::cores::top::CoreParams;
-use fxrt::flow::frame::{binary_png, frame_rays, ids_image, mismatches, simulate_hdl, simulate_rust};
+use fxrt::flow::feed::{Stalls, feed_order};
+use fxrt::flow::frame::{
+    CoreResult, PixelRay, binary_png, frame_rays, frame_stream, ids_image, mismatches, run_stream, simulate_hdl,
+    simulate_rust,
+};
 use fxrt::flow::simulators::Simulator;
+use fxrt::flow::simulators::parse_summary;
 use fxrt::model::camera::Camera;
 use fxrt::params::Params;
 use fxrt::render::render;
@@ -31,7 +38,7 @@ fn rust_frame(name: &str, size: u32, target_mhz: u32) {
     let cam = Camera::default_for(&s, size, size);
     let p = CoreParams::new(&roms, 16, 1, target_mhz);
     let rays = frame_rays(&s, &cam);
-    let (results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
+    let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(mismatches(&s, &rays, &results), 0, "{name}");
     let golden = render(&s, make_tracer(&s, ModelKind::Golden).as_ref(), &cam, false, false);
     assert_eq!(ids_image(&s, size, size, &results), golden.ids, "{name}");
@@ -94,10 +101,10 @@ fn hdl_frame(sim: Simulator, size: u32, target_mhz: u32) -> Option<(Scene, Vec<i
     let p = CoreParams::new(&roms, 16, 1, target_mhz);
     let rays = frame_rays(&s, &cam);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("frame_{}", sim.name()));
-    let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &dir).unwrap_or_else(|e| panic!("{e}"));
+    let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &Stalls::none(), &dir).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(mismatches(&s, &rays, &results), 0);
     // The HDL's cycle count and statistics equal the Rust simulator's.
-    let (_, rust) = simulate_rust(&p, &roms, &rays, &|_| {});
+    let (_, rust) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(
         (stats.cycles, stats.busy_cycles, stats.max_stack_depth),
         (rust.cycles, rust.busy_cycles, rust.max_stack_depth)
@@ -121,4 +128,134 @@ fn ghdl_teapot_16_renders_the_binary_teapot() {
     let decoder = png::Decoder::new(std::io::Cursor::new(png));
     let info = decoder.read_info().unwrap().info().clone();
     assert_eq!((info.width, info.height), (16, 16));
+}
+
+/// Whether results came back in an order other than the pixels' (the ids not ascending).
+fn out_of_pixel_order(results: &[CoreResult]) -> bool {
+    results.windows(2).any(|w| w[0].0 > w[1].0)
+}
+
+/// Shuffled rays and a source that stalls on 30 % of the cycles, in the Rust simulator: every
+/// pixel as `fxrt render` has it, the results really came back out of pixel order, and the
+/// stalls really cost cycles.
+#[test]
+fn rust_frames_shuffled_and_stalled() {
+    for (name, size) in [("teapot", 32), ("cornell", 24)] {
+        let s = scene(name);
+        let roms = SceneRoms::of(&s);
+        let cam = Camera::default_for(&s, size, size);
+        let p = CoreParams::new(&roms, 16, 1, DEFAULT);
+        let pixel_order = frame_rays(&s, &cam);
+        let rays = feed_order(&pixel_order, Some(42));
+        let stalls = Stalls::random(30, 7);
+        let (results, stats) = simulate_rust(&p, &roms, &rays, &stalls, &|_| {});
+        // Matched by id: against the rays in pixel order, not in the order they went in.
+        assert_eq!(mismatches(&s, &pixel_order, &results), 0, "{name}");
+        let golden = render(&s, make_tracer(&s, ModelKind::Golden).as_ref(), &cam, false, false);
+        assert_eq!(ids_image(&s, size, size, &results), golden.ids, "{name}");
+        assert!(out_of_pixel_order(&results), "{name}: the rays were not shuffled");
+        let (_, unstalled) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
+        assert!(stats.stall_cycles > 0 && unstalled.stall_cycles == 0, "{name}: {stats:?}");
+        assert!(
+            stats.cycles > unstalled.cycles,
+            "{name}: {} cycles, {} without stalls",
+            stats.cycles,
+            unstalled.cycles
+        );
+        common::say(&format!(
+            "{name} {size}² shuffled, 30 % stalls: {} cycles ({} without stalls), {} stall cycles",
+            stats.cycles, unstalled.cycles, stats.stall_cycles
+        ));
+    }
+}
+
+/// A tiny teapot frame — its rays in pixel order, and shuffled — with stalls, and the core
+/// built for 75 MHz (short).
+fn tiny_shuffled() -> (fxrt::scene::Scene, CoreParams, Vec<PixelRay>, Vec<PixelRay>, Stalls) {
+    let s = scene("teapot");
+    let roms = SceneRoms::of(&s);
+    let p = CoreParams::new(&roms, 8, 1, 75);
+    let pixel_order = frame_rays(&s, &Camera::default_for(&s, 8, 8));
+    let rays = feed_order(&pixel_order, Some(3));
+    (s, p, pixel_order, rays, Stalls::random(35, 9))
+}
+
+/// The HDL stream testbenches with shuffled rays and a stalling source: they pass, their
+/// results come in the same order as the Rust simulator's and their counts — stall cycles
+/// too — are the same, so every simulator saw the same stream, cycle for cycle.
+#[test]
+fn hdl_frames_shuffled_and_stalled() {
+    let (s, p, pixel_order, rays, stalls) = tiny_shuffled();
+    let (rust, rust_stats) = simulate_rust(&p, &SceneRoms::of(&s), &rays, &stalls, &|_| {});
+    assert!(out_of_pixel_order(&rust) && rust_stats.stall_cycles > 0);
+    let check = |sim: Simulator| -> Result<(), String> {
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("shuffled_{}", sim.name()));
+        let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &stalls, &dir).map_err(|e| e.to_string())?;
+        let bad = mismatches(&s, &pixel_order, &results);
+        let counts = |c: &fxrt::flow::frame::CoreStats| (c.cycles, c.busy_cycles, c.max_stack_depth, c.stall_cycles);
+        match () {
+            _ if bad != 0 => Err(format!("{bad} mismatches")),
+            _ if results != rust => Err("results not in the Rust simulator's arrival order".into()),
+            _ if counts(&stats) != counts(&rust_stats) => {
+                Err(format!("counts {:?}, Rust {:?}", counts(&stats), counts(&rust_stats)))
+            }
+            _ => Ok(()),
+        }
+    };
+    let failures = each_simulator(&[Simulator::Iverilog, Simulator::Ghdl, Simulator::Verilator], check);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// `check` in every simulator that is installed (the others are skipped, said so): each
+/// simulator's failure, named.
+fn each_simulator(sims: &[Simulator], check: impl Fn(Simulator) -> Result<(), String>) -> Vec<String> {
+    let mut failures = Vec::new();
+    for &sim in sims {
+        if !sim.available() {
+            common::say(&format!("skipped: {} is not installed", sim.name()));
+            continue;
+        }
+        if let Err(e) = check(sim) {
+            failures.push(format!("{}: {e}", sim.name()));
+        }
+    }
+    failures
+}
+
+/// The stream testbench catches what it must, whatever the order: a wrong expected value, a
+/// result whose id no ray has, a second result for an id and an id left without a result —
+/// each one failure, named in its output.
+#[test]
+fn hdl_testbench_fails_on_corrupted_entries() {
+    let (s, p, _, rays, stalls) = tiny_shuffled();
+    let n = rays.len() as u64;
+    let mut fs = frame_stream(&p, &s, &rays, &stalls).unwrap();
+    let [x, y, a, b] = [0, 1, 2, 3].map(|k| rays[k].pixel as usize);
+    // x's expected v is off by one.
+    fs.expected[x].as_mut().unwrap()[5] ^= 1;
+    // y is no ray's id any more.
+    fs.expected[y] = None;
+    // Ray b is replaced by a copy of ray a: a second result for a (whichever comes second),
+    // none for b.
+    fs.rays[3] = fs.rays[2].clone();
+    let check = |sim: Simulator| -> Result<(), String> {
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("corrupted_{}", sim.name()));
+        let Err(err) = run_stream(sim, &fs, &dir) else { return Err("the testbench passed".into()) };
+        let err = err.message;
+        if parse_summary(&err) != Some((n - 3, 4)) {
+            return Err(format!("not {} passed, 4 failed: {err}", n - 3));
+        }
+        let lines = [
+            format!("ray id {x} differs"),
+            format!("no ray has id {y}"),
+            format!("a second result for ray id {a}"),
+            format!("ray id {b}: no result"),
+        ];
+        match lines.iter().find(|l| !err.contains(l.as_str())) {
+            Some(l) => Err(format!("no '{l}' in {err}")),
+            None => Ok(()),
+        }
+    };
+    let failures = each_simulator(&[Simulator::Iverilog, Simulator::Ghdl], check);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

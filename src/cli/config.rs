@@ -336,6 +336,10 @@ pub struct SimConfig {
     pub build: Option<PathBuf>,
     /// A clock for the hardware speed: (MHz, from a measured Fmax).
     pub clock: Option<(f64, bool)>,
+    /// Rays in this seed's random order (`feed::feed_order`); None: pixel order.
+    pub shuffle_seed: Option<u64>,
+    /// The source's stalls: (percent of cycles 1..=99, seed); None: it never stalls.
+    pub stalls: Option<(u32, u64)>,
 }
 
 /// The clock of a `fxrt synth --family ecp5` JSON: the whole core's Fmax, else the slowest
@@ -355,6 +359,23 @@ impl SimArgs {
         let sim = Simulation::from(self.sim);
         if self.raygen && sim != Simulation::Rust {
             return Err(Error::param("raygen", "runs in the Rust simulator only (--sim rust)"));
+        }
+        let max = crate::flow::feed::Stalls::MAX_PERCENT;
+        if self.stall_percent > max {
+            return Err(Error::param(
+                "stall-percent",
+                format!("{} is out of range: must be 0..={max} (at 100 no ray is ever offered)", self.stall_percent),
+            ));
+        }
+        if self.stall_seed.is_some() && self.stall_percent == 0 {
+            return Err(Error::param("stall-seed", "seeds the stalls of --stall-percent: add --stall-percent"));
+        }
+        // The ray generator feeds the core itself, in pixel order, whenever it is ready.
+        for (given, name) in [(self.shuffle_seed.is_some(), "shuffle-seed"), (self.stall_percent > 0, "stall-percent")]
+        {
+            if given && self.raygen {
+                return Err(Error::param(name, "feeds host rays: not with --raygen (the generator feeds the core)"));
+            }
         }
         Ok(SimConfig {
             params,
@@ -376,6 +397,8 @@ impl SimArgs {
                 (None, Some(path)) => Some((fmax_of(path)?, true)),
                 (None, None) => None,
             },
+            shuffle_seed: self.shuffle_seed,
+            stalls: (self.stall_percent > 0).then(|| (self.stall_percent, self.stall_seed.unwrap_or(1))),
         })
     }
 }

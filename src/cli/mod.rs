@@ -208,6 +208,17 @@ pub struct SimArgs {
     /// is the clock, reported as `mrays_per_s_at_fmax`.
     #[arg(long = "fmax-json", value_name = "FILE")]
     pub fmax_json: Option<PathBuf>,
+    /// Feed the rays in a random order, this seed's permutation, instead of pixel order
+    /// (results are matched to rays by id, in any order).
+    #[arg(long = "shuffle-seed", value_name = "SEED", allow_hyphen_values = true)]
+    pub shuffle_seed: Option<u64>,
+    /// Hold the ray source back (ray_valid low, rays left) on this percentage of cycles,
+    /// 0..=99, at random (seeded by --stall-seed).
+    #[arg(long = "stall-percent", value_name = "P", default_value_t = 0, allow_hyphen_values = true, value_parser = parse_percent)]
+    pub stall_percent: u32,
+    /// Seed of the stall pattern of --stall-percent.
+    #[arg(long = "stall-seed", value_name = "SEED", allow_hyphen_values = true)]
+    pub stall_seed: Option<u64>,
     #[command(flatten)]
     pub params: ParamArgs,
 }
@@ -516,6 +527,16 @@ fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {
         }
     }
     Ok(v)
+}
+
+/// A stall percentage: 0..=`Stalls::MAX_PERCENT`.
+fn parse_percent(s: &str) -> std::result::Result<u32, String> {
+    let max = crate::flow::feed::Stalls::MAX_PERCENT;
+    let p: u32 = s.trim().parse().map_err(|_| format!("'{s}' is not an integer 0..={max}"))?;
+    if p > max {
+        return Err(format!("{p} is out of range: must be 0..={max} (at 100 no ray is ever offered)"));
+    }
+    Ok(p)
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {

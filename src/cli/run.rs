@@ -11,7 +11,7 @@ use super::config::{
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};
-use crate::flow::{check, frame, generate, synth, vectors};
+use crate::flow::{check, feed, frame, generate, synth, vectors};
 use crate::model::camera::{Camera, CameraSpec};
 use crate::model::golden::Golden;
 use crate::model::raygen::RayGen;
@@ -348,8 +348,10 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             let golden = Golden::new(&scene);
             (0..w * h).map(|i| frame::PixelRay { pixel: i, ray: g.ray(&golden, i % w, i / w) }).collect()
         }
-        None => frame::frame_rays(&scene, &cam),
+        // Shuffled (or not) here, once: every simulator feeds the rays in this order.
+        None => feed::feed_order(&frame::frame_rays(&scene, &cam), c.shuffle_seed),
     };
+    let stalls = c.stalls.map_or_else(feed::Stalls::none, |(percent, seed)| feed::Stalls::random(percent, seed));
     let start = std::time::Instant::now();
     // `SimArgs::config` allows the ray generator in the Rust simulator only.
     let (results, stats) = match (c.sim, &c.build, &raygen) {
@@ -360,16 +362,19 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             bar.finish_and_clear();
             r
         }
-        (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, dir)?,
+        (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, &stalls, dir)?,
         _ => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
-            let r = frame::simulate_rust(&p, &roms, &rays, &|n| bar.set_position(n));
+            let r = frame::simulate_rust(&p, &roms, &rays, &stalls, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
         }
     };
     let seconds = start.elapsed().as_secs_f64();
     let mismatches = frame::mismatches(&scene, &rays, &results);
+    // Whether the results came back in the order the rays went in, and in pixel order.
+    let in_order = results.len() == rays.len() && results.iter().zip(&rays).all(|(r, ray)| r.0 == ray.pixel as u64);
+    let in_pixel_order = results.windows(2).all(|w| w[0].0 < w[1].0);
     let ids = frame::ids_image(&scene, w, h, &results);
     let mut files = Vec::new();
     if let Some(path) = &c.png {
@@ -391,6 +396,9 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "slot_occupancy": (stats.slot_occupancy() * 10000.0).round() / 10000.0,
         "slots": p.slot_count(), "units": p.units,
         "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
+        "shuffle_seed": c.shuffle_seed, "stall_percent": c.stalls.map_or(0, |s| s.0),
+        "stall_seed": c.stalls.map(|s| s.1), "stall_cycles": stats.stall_cycles,
+        "results_in_feed_order": in_order, "results_in_pixel_order": in_pixel_order,
     });
     // Hardware speed: one ray per `cycles_per_ray` clocks (one ray in flight).
     if let Some((mhz, measured)) = c.clock {

@@ -157,6 +157,32 @@ fn sim_runs_the_ray_generator_in_rust_only() {
 }
 
 #[test]
+fn sim_feed_options_are_checked() {
+    let config = |args: &[&str]| {
+        let Command::Sim(a) = command(args) else { panic!() };
+        a.config().unwrap()
+    };
+    let c = config(&["sim"]);
+    assert_eq!((c.shuffle_seed, c.stalls), (None, None));
+    let c = config(&["sim", "--shuffle-seed", "7", "--stall-percent", "25"]);
+    assert_eq!((c.shuffle_seed, c.stalls), (Some(7), Some((25, 1))));
+    let c = config(&["sim", "--stall-percent", "99", "--stall-seed", "3", "--sim", "ghdl"]);
+    assert_eq!(c.stalls, Some((99, 3)));
+    assert_eq!(config(&["sim", "--stall-percent", "0"]).stalls, None);
+    assert_eq!(parse_percent("99"), Ok(99));
+    assert!(parse_percent("100").is_err() && parse_percent("-5").is_err() && parse_percent("x").is_err());
+    assert_eq!(refused(&["sim", "--stall-seed", "3"]), "--stall-seed");
+    assert_eq!(refused(&["sim", "--raygen", "--shuffle-seed", "1"]), "--shuffle-seed");
+    assert_eq!(refused(&["sim", "--raygen", "--stall-percent", "10"]), "--stall-percent");
+    for bad in
+        [&["sim", "--shuffle-seed", "-1"][..], &["sim", "--stall-percent", "x"], &["sim", "--stall-percent", "100"]]
+    {
+        let e = Cli::try_parse_from(std::iter::once("fxrt").chain(bad.iter().copied())).unwrap_err();
+        assert!(error_line(&e).contains(bad[1]), "{}", error_line(&e));
+    }
+}
+
+#[test]
 fn synth_defaults_to_virtex_5_and_refuses_other_families() {
     assert_eq!(refused(&["synth", "--family", "xc4"]), "--family");
     let Command::Synth(a) = command(&["synth"]) else { panic!() };

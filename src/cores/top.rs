@@ -474,6 +474,7 @@ pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::ray
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::flow::feed::Stalls;
     use crate::flow::frame::{frame_rays, mismatches, simulate_rust, simulate_rust_cycle};
     use crate::model::camera::Camera;
     use crate::params::Params;
@@ -485,15 +486,13 @@ mod tests {
         let roms = SceneRoms::of(&scene);
         let p = CoreParams::new(&roms, 16, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
-        let (mut results, stats) = simulate_rust(&p, &roms, &rays, &|_| {});
-        results.sort_by_key(|r| r.0);
+        let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
         assert_eq!(mismatches(&scene, &rays, &results), 0);
         assert!(results.iter().filter(|r| r.1.is_some()).count() > 20);
         assert!(stats.busy_cycles > 0 && stats.max_stack_depth > 0, "{stats:?}");
         // The batched engine (ray source in the netlist) and the cycle engine (ports driven
         // like a testbench) agree on every result and every count.
-        let (mut cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &|_| {});
-        cycle_results.sort_by_key(|r| r.0);
+        let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &Stalls::none(), &|_| {});
         assert_eq!(cycle_results, results);
         assert_eq!(
             (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth, cycle_stats.visits),

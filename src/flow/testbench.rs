@@ -69,45 +69,79 @@ struct StreamTb<'a> {
     rays: &'a str,
     expected: &'a str,
     results: &'a str,
+    stalls: &'a str,
     has_reset: bool,
     inputs: &'a [Port],
     outputs: &'a [Port],
     checked: &'a [Port],
+    /// The checked output whose value is the result's id.
+    id: &'a str,
     ray_width: u32,
+    /// Bits of the checked outputs; an expected word has one more, on top: "a ray has this id".
     result_width: u32,
     count: usize,
+    /// Expected words: ids 0 … ids − 1.
+    ids: usize,
+    /// Entries of the stall pattern; 0: the source never stalls (no stall file).
+    stall_period: usize,
     max_cycles: u64,
 }
 
 /// A stream testbench's data: the inputs of each ray (every input port but `ray_valid`, in
-/// port order) and the expected values of the `checked` outputs for each, in order.
+/// port order) in the order the source offers them, and, indexed by id, the expected values of
+/// the `checked` outputs of the result with that id (the value of output `id`, one of them);
+/// None for an id no ray has. Results may come in any order.
 pub struct Stream<'a> {
     pub rays: &'a [Vec<i128>],
-    pub expected: &'a [Vec<i128>],
+    pub expected: &'a [Option<Vec<i128>>],
     pub checked: &'a [&'a str],
+    pub id: &'a str,
+    /// The source's stall pattern: it holds `ray_valid` low on cycle c if entry c mod len is
+    /// true (`flow::feed::Stalls`); None: never.
+    pub stalls: Option<&'a [bool]>,
     pub max_cycles: u64,
 }
 
 /// The stream testbench for GHDL (VHDL) or Icarus/Verilator (Verilog), with its data files
-/// and the design; the testbench writes `results.txt`, one line of checked outputs per ray.
+/// and the design. `rays.txt`: a ray per line in feed order; `expected.txt`: a line per id
+/// 0 … max: a 1 bit ("a ray has this id") then the expected checked outputs (zeros and a 0 bit
+/// for an id no ray has); `stalls.txt` (with stalls): a 0 or 1 per line, the pattern. Lines are
+/// binary strings, a field each, for VHDL, one hex word for Verilog (`$readmemh`; the stall
+/// bits are read with `$readmemb`). The testbench looks each result up by its id (a result
+/// for an unknown id, a second result for an id and an id without result each fail) and
+/// writes `results.txt`, one line of checked outputs per result, in arrival order.
 pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, String)> {
     let in_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid").collect();
     let checked_ids: Vec<(String, SigId)> =
         s.checked.iter().map(|c| m.outputs.iter().find(|o| o.0 == *c).expect("checked output").clone()).collect();
     let (inputs, ray_width) = ports(m, &in_ids, 0);
     let (checked, result_width) = ports(m, &checked_ids, 0);
+    let id = checked.iter().find(|p| p.name == s.id).expect("the id output is checked");
+    assert!(!id.ty.signed, "the id output is unsigned");
     let (outputs, _) = ports(m, &m.outputs, 0);
-    let (rays, expected, results) = ("rays.txt", "expected.txt", "results.txt");
+    let (rays, expected, results, stalls) = ("rays.txt", "expected.txt", "results.txt", "stalls.txt");
     let vhdl = sim == Simulator::Ghdl;
     let mut files = crate::rtl::emit::design_files(m, ext(vhdl));
-    let lines = |rows: &[Vec<i128>], ports: &[Port], width: u32| -> String {
-        let fields = |row: &Vec<i128>| -> Vec<(u128, u32)> {
-            ports.iter().zip(row).map(|(p, v)| (p.ty.wrap(*v), p.width)).collect()
-        };
-        rows.iter().map(|row| data_line(&fields(row), vhdl, width)).collect()
+    let fields = |row: &[i128], ports: &[Port]| -> Vec<(u128, u32)> {
+        ports.iter().zip(row).map(|(p, v)| (p.ty.wrap(*v), p.width)).collect()
     };
-    files.push((rays.into(), lines(s.rays, &inputs, ray_width)));
-    files.push((expected.into(), lines(s.expected, &checked, result_width)));
+    let ray_lines: String = s.rays.iter().map(|row| data_line(&fields(row, &inputs), vhdl, ray_width)).collect();
+    files.push((rays.into(), ray_lines));
+    let none = vec![0; checked.len()];
+    let expected_lines: String = s
+        .expected
+        .iter()
+        .map(|row| {
+            let known = (row.is_some() as u128, 1);
+            let line: Vec<(u128, u32)> =
+                std::iter::once(known).chain(fields(row.as_deref().unwrap_or(&none), &checked)).collect();
+            data_line(&line, vhdl, result_width + 1)
+        })
+        .collect();
+    files.push((expected.into(), expected_lines));
+    if let Some(bits) = s.stalls {
+        files.push((stalls.into(), bits.iter().map(|&b| if b { "1\n" } else { "0\n" }).collect()));
+    }
     let text = StreamTb {
         vhdl,
         tb: &tb_name(m),
@@ -115,13 +149,17 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
         rays,
         expected,
         results,
+        stalls,
         has_reset: m.has_reset(),
         inputs: &inputs,
         outputs: &outputs,
         checked: &checked,
+        id: s.id,
         ray_width,
         result_width,
         count: s.rays.len(),
+        ids: s.expected.len(),
+        stall_period: s.stalls.map_or(0, |b| b.len()),
         max_cycles: s.max_cycles,
     }
     .render();

@@ -7,6 +7,7 @@ use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
 use crate::cores::top::{CoreParams, core_module};
 use crate::error::{Error, Result};
+use crate::flow::feed::Stalls;
 use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
 use crate::flow::synth::synth_xc5v;
 use crate::model::camera::Camera;
@@ -248,7 +249,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     let core_params = CoreParams::new(&roms, id_width, 1, extras.target_mhz);
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
-        let (results, stats) = simulate_rust(&core_params, &roms, &rays, &|_| {});
+        let (results, stats) = simulate_rust(&core_params, &roms, &rays, &Stalls::none(), &|_| {});
         let run = CoreRun {
             cycles_per_ray: stats.cycles_per_ray(),
             fill: stats.fill(),
