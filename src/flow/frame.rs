@@ -591,8 +591,9 @@ mod tests {
         assert_ne!(arrival, sorted, "the rays were fed shuffled");
         let (_, plain) = simulate_rust(&p, &roms, &fed, &Stalls::none(), &|_| {});
         assert_eq!(plain.stall_cycles, 0);
-        // About 40 % of the cycles in which rays remained.
-        assert!(stats.stall_cycles * 4 > stats.cycles, "{stats:?}");
+        // About 40 % of the cycles in which rays remained, which are at least 4 per ray (the
+        // core takes one ray per 4 clocks at most): over 30 % of those.
+        assert!(stats.stall_cycles * 10 >= 3 * 4 * stats.rays, "{stats:?}");
         assert!(stats.cycles > plain.cycles, "stalls cost cycles: {} vs {}", stats.cycles, plain.cycles);
     }
 }
