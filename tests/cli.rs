@@ -267,10 +267,10 @@ fn sim_feeds_rays_shuffled_and_stalled() {
     assert_eq!((line["shuffle_seed"].as_u64(), line["stall_percent"].as_u64()), (Some(3), Some(25)));
     assert_eq!(line["stall_seed"].as_u64(), Some(1));
     assert!(line["stall_cycles"].as_u64().unwrap() > 0, "{line}");
-    // Today's core keeps the order it was fed: shuffled, so not pixel order, but feed order.
+    // The slot core returns results in the order rays finish: neither the feed's nor pixels'.
     assert_eq!(
         (line["results_in_feed_order"].as_bool(), line["results_in_pixel_order"].as_bool()),
-        (Some(true), Some(false))
+        (Some(false), Some(false))
     );
     let o = fxrt(&[&["render"][..], &size, &["--ids", render_ids.to_str().unwrap()]].concat());
     assert!(o.status.success(), "{}", stderr(&o));

@@ -48,6 +48,10 @@ module fxrt_core (
   wire [5:0] u1_free_slot;
   reg [0:0] turn = 1'h0;
   reg [1:0] box_phase = 2'h0;
+  reg [0:0] u0_has_free_r = 1'h1;
+  reg [0:0] u1_has_free_r = 1'h1;
+  reg [5:0] u0_free_slot_r = 6'h00;
+  reg [5:0] u1_free_slot_r = 6'h00;
   wire [0:0] k_0 = 1'h0;
   reg [0:0] case_turn;
   reg [5:0] case_turn_1;
@@ -392,6 +396,8 @@ module fxrt_core (
   wire [6:0] cat_36;
   wire [6:0] mux_u0_done_avail;
   wire [0:0] or_37;
+  reg [0:0] done_valid_r = 1'h0;
+  reg [6:0] done_slot_r = 7'h00;
   wire [0:0] u_closest_merge_valid;
   wire [6:0] u_closest_merge_slot;
   wire [0:0] u_closest_merge_hit;
@@ -424,16 +430,16 @@ module fxrt_core (
   assign u1_free_slot = u_traverse_1_free_slot_out;
   always @* begin
     case (turn)
-      1'h0: case_turn = u0_has_free;
-      1'h1: case_turn = u1_has_free;
+      1'h0: case_turn = u0_has_free_r;
+      1'h1: case_turn = u1_has_free_r;
       default: case_turn = k_0;
     endcase
   end
   always @* begin
     case (turn)
-      1'h0: case_turn_1 = u0_free_slot;
-      1'h1: case_turn_1 = u1_free_slot;
-      default: case_turn_1 = u0_free_slot;
+      1'h0: case_turn_1 = u0_free_slot_r;
+      1'h1: case_turn_1 = u1_free_slot_r;
+      default: case_turn_1 = u0_free_slot_r;
     endcase
   end
   assign box_phase_eq_k_0_1 = box_phase == k_0_1;
@@ -730,6 +736,14 @@ module fxrt_core (
     else turn <= mux_accept_or_not_case_turn;
     if (rst) box_phase <= 2'h0;
     else box_phase <= mux_or_2;
+    if (rst) u0_has_free_r <= 1'h1;
+    else u0_has_free_r <= u0_has_free;
+    if (rst) u1_has_free_r <= 1'h1;
+    else u1_has_free_r <= u1_has_free;
+    if (rst) u0_free_slot_r <= 6'h00;
+    else u0_free_slot_r <= u0_free_slot;
+    if (rst) u1_free_slot_r <= 6'h00;
+    else u1_free_slot_r <= u1_free_slot;
     if (accept) box_ox <= ox;
     if (accept) box_oy <= oy;
     if (accept) box_oz <= oz;
@@ -806,6 +820,8 @@ module fxrt_core (
     pipe_w_sr[1] <= ray_w_q;
     u0_done_took <= u0_done_pop;
     u1_done_took <= u1_done_pop;
+    done_valid_r <= or_37;
+    done_slot_r <= mux_u0_done_avail;
   end
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
@@ -977,8 +993,8 @@ module fxrt_core (
     .id_we(accept),
     .id_slot(accept_slot_int),
     .id(ray_id),
-    .done_valid(or_37),
-    .done_slot(mux_u0_done_avail),
+    .done_valid(done_valid_r),
+    .done_slot(done_slot_r),
     .merge_valid(u_closest_merge_valid),
     .merge_slot(u_closest_merge_slot),
     .merge_hit(u_closest_merge_hit),

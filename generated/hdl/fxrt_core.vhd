@@ -464,6 +464,10 @@ architecture rtl of fxrt_core is
   signal u1_free_slot : unsigned(5 downto 0);
   signal turn : unsigned(0 downto 0) := unsigned'("0");
   signal box_phase : unsigned(1 downto 0) := unsigned'("00");
+  signal u0_has_free_r : unsigned(0 downto 0) := unsigned'("1");
+  signal u1_has_free_r : unsigned(0 downto 0) := unsigned'("1");
+  signal u0_free_slot_r : unsigned(5 downto 0) := unsigned'("000000");
+  signal u1_free_slot_r : unsigned(5 downto 0) := unsigned'("000000");
   constant k_0 : unsigned(0 downto 0) := unsigned'("0");
   signal case_turn : unsigned(0 downto 0);
   signal case_turn_1 : unsigned(5 downto 0);
@@ -785,6 +789,8 @@ architecture rtl of fxrt_core is
   signal cat_36 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
   signal or_37 : unsigned(0 downto 0);
+  signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
+  signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal u_closest_merge_valid : unsigned(0 downto 0);
   signal u_closest_merge_slot : unsigned(6 downto 0);
   signal u_closest_merge_hit : unsigned(0 downto 0);
@@ -818,14 +824,14 @@ begin
   u1_free_slot <= u_traverse_1_free_slot_out;
   with turn select
     case_turn <=
-      u0_has_free when "0",
-      u1_has_free when "1",
+      u0_has_free_r when "0",
+      u1_has_free_r when "1",
       k_0 when others;
   with turn select
     case_turn_1 <=
-      u0_free_slot when "0",
-      u1_free_slot when "1",
-      u0_free_slot when others;
+      u0_free_slot_r when "0",
+      u1_free_slot_r when "1",
+      u0_free_slot_r when others;
   box_phase_eq_k_0_1 <= "1" when box_phase = k_0_1 else "0";
   ready_c <= box_phase_eq_k_0_1 and case_turn;
   accept <= ray_valid and ready_c;
@@ -1104,6 +1110,26 @@ begin
       else
         box_phase <= mux_or_2;
       end if;
+      if rst = '1' then
+        u0_has_free_r <= unsigned'("1");
+      else
+        u0_has_free_r <= u0_has_free;
+      end if;
+      if rst = '1' then
+        u1_has_free_r <= unsigned'("1");
+      else
+        u1_has_free_r <= u1_has_free;
+      end if;
+      if rst = '1' then
+        u0_free_slot_r <= unsigned'("000000");
+      else
+        u0_free_slot_r <= u0_free_slot;
+      end if;
+      if rst = '1' then
+        u1_free_slot_r <= unsigned'("000000");
+      else
+        u1_free_slot_r <= u1_free_slot;
+      end if;
       if accept = "1" then
         box_ox <= ox;
       end if;
@@ -1195,6 +1221,8 @@ begin
       pipe_w_sr(1) <= ray_w_q;
       u0_done_took <= u0_done_pop;
       u1_done_took <= u1_done_pop;
+      done_valid_r <= or_37;
+      done_slot_r <= mux_u0_done_avail;
     end if;
   end process regs;
 
@@ -1377,8 +1405,8 @@ begin
       id_we => accept,
       id_slot => accept_slot_int,
       id => ray_id,
-      done_valid => or_37,
-      done_slot => mux_u0_done_avail,
+      done_valid => done_valid_r,
+      done_slot => done_slot_r,
       merge_valid => u_closest_merge_valid,
       merge_slot => u_closest_merge_slot,
       merge_hit => u_closest_merge_hit,

@@ -194,14 +194,25 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     }
 
     // Wires from the units (driven once they are instantiated).
-    let has_free: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_has_free"), bit)).collect();
-    let free_idx: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_free_slot"), Ty::u(sb))).collect();
+    let has_free_w: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_has_free"), bit)).collect();
+    let free_idx_w: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_free_slot"), Ty::u(sb))).collect();
 
     // Acceptance: the box-exit unit takes a ray every 4 clocks (it issues three distances and
     // its plane unit reads the ray one clock after the last issue), into the unit whose turn it
     // is (`turn` moves on with every ray and every clock that unit is full).
     let turn = b.reg("turn", Ty::u(ub.max(1)), Some(0));
     let phase = b.reg("box_phase", Ty::u(2), Some(0));
+    // The units' free-slot outputs in registers of the top's own (the units sit across the die):
+    // a clock staler still, which the 4-clock cadence covers (a unit masks a slot it gave for a
+    // clock, and the next ray comes 4 clocks later).
+    // Reset as the units' registers are (all free, slot 0), so idling after reset changes nothing.
+    let copy = |name: String, x: S<'_>, reset: i128| {
+        let r = b.reg(&name, x.ty(), Some(reset));
+        b.next(r, x);
+        r
+    };
+    let has_free: Vec<S> = has_free_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_has_free_r"), x, 1)).collect();
+    let free_idx: Vec<S> = free_idx_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_free_slot_r"), x, 0)).collect();
     let turn_free = if units == 1 { has_free[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, has_free[u as usize])).collect::<Vec<_>>(), b.konst(bit, 0)) };
     let turn_slot = if units == 1 { free_idx[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, free_idx[u as usize])).collect::<Vec<_>>(), free_idx[0]) };
     let ready = (phase.eq(0) & turn_free).name("ready_c");
@@ -275,8 +286,8 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
                 node_words[u as usize],
             ];
             let t = b.instance(&format!("u_traverse_{u}"), &unit, &ins);
-            b.drive(has_free[u as usize], t.get("has_free"));
-            b.drive(free_idx[u as usize], t.get("free_slot_out"));
+            b.drive(has_free_w[u as usize], t.get("has_free"));
+            b.drive(free_idx_w[u as usize], t.get("free_slot_out"));
             t
         })
         .collect();
@@ -416,6 +427,9 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     }
     let closest = Rc::new(closest_core(p.tag, p.total_slots(), p.trav.id_width, n, m, p.isect.target()));
     let mut cin: Vec<S> = r.all().to_vec();
+    // Registered before the closest-hit unit, whose per-slot selects it drives (the units'
+    // queues sit across the die).
+    let (done_any, done_slot) = (b.delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
     cin.extend([accept, gslot, ray_id, done_any, done_slot]);
     let res = b.instance("u_closest", &closest, &cin);
     b.drive(merge_valid, res.get("merge_valid"));

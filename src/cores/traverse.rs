@@ -196,7 +196,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     b.next(free_idx_r, lowest.name("free_idx_c"));
     let just_alloc = b.reg("just_alloc", bit, Some(0));
     b.next(just_alloc, alloc);
-    let taken = alloc.select(onehot(free_idx_r, k), b.konst(Ty::u(k), 0)).name("taken_mask");
+    let taken = alloc.select(onehot(ray_slot, k), b.konst(Ty::u(k), 0)).name("taken_mask");
     let freed = free_valid.select(onehot(free_slot, k), b.konst(Ty::u(k), 0)).name("freed_mask");
     b.next(free_bits, (free_bits & !taken) | freed);
     let occupied = b.reg("occupied_r", Ty::u(sb + 1), Some(0));
