@@ -155,13 +155,9 @@ fn rust_frames_shuffled_and_stalled() {
         assert_eq!(ids_image(&s, size, size, &results), golden.ids, "{name}");
         assert!(out_of_pixel_order(&results), "{name}: the rays were not shuffled");
         let (_, unstalled) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
+        // The stalls happened (whether they cost cycles depends on whether the source or the
+        // core is the bottleneck: with every ray slot busy, a stalled ray was waiting anyway).
         assert!(stats.stall_cycles > 0 && unstalled.stall_cycles == 0, "{name}: {stats:?}");
-        assert!(
-            stats.cycles > unstalled.cycles,
-            "{name}: {} cycles, {} without stalls",
-            stats.cycles,
-            unstalled.cycles
-        );
         common::say(&format!(
             "{name} {size}² shuffled, 30 % stalls: {} cycles ({} without stalls), {} stall cycles",
             stats.cycles, unstalled.cycles, stats.stall_cycles
