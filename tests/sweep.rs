@@ -258,7 +258,8 @@ fn core_simulation_in_a_sweep_agrees_with_the_golden_model() {
     assert_eq!(rows.len(), 8);
     for r in &rows {
         assert_eq!(r["core_mismatches"], "0", "{r:?}");
-        assert!(r["cycles_per_ray"].parse::<f64>().unwrap() > 5.0, "{r:?}");
+        // The box-exit unit takes one ray per 4 clocks at most.
+        assert!(r["cycles_per_ray"].parse::<f64>().unwrap() >= 4.0, "{r:?}");
         assert!(r["max_stack_depth"].parse::<u32>().unwrap() >= 1 || r["scene"] == "thin", "{r:?}");
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();

@@ -112,7 +112,7 @@ pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &
         "traverse" => (traverse::traverse_core(&core.trav, roms), None),
         "closest" => (
             closest::closest_core(core.tag, core.total_slots(), core.trav.id_width, isect.n, isect.m, isect.target()),
-            None,
+            Some(1 + closest::input_latency(isect.target())),
         ),
         _ => (top::core_module(core, roms), None),
     }
