@@ -488,6 +488,8 @@ impl SweepArgs {
             synth: self.synth,
             core_sim: self.core_sim,
             target_mhz: self.target_mhz,
+            slots: self.core_shape.slots,
+            units: self.core_shape.units,
             ecp5: self.ecp5()?,
         })
     }

@@ -101,6 +101,9 @@ pub struct SweepArgs {
     /// one value.
     #[arg(long, default_value = "sah")]
     pub tree: TreeSplit,
+    /// The core's ray slots per traversal unit and traversal units (one value each).
+    #[command(flatten)]
+    pub core_shape: ThreadArgs,
     /// Vary one parameter at a time around the base set (each at its default if listed,
     /// else its first value), like the thesis's figures, instead of the cross product.
     #[arg(long = "one-at-a-time")]

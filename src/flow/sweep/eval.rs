@@ -5,7 +5,7 @@ use super::pnr::{PlacedModule, Pnr};
 use super::{CameraSpec, Config, SceneSpec, SweepSpec, params_label};
 use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
-use crate::cores::top::{CoreParams, core_module};
+use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module};
 use crate::error::{Error, Result};
 use crate::flow::feed::Stalls;
 use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
@@ -99,6 +99,10 @@ impl SceneCtx {
         });
         if spec.target_mhz != DEFAULT_TARGET_MHZ {
             text["target_mhz"] = spec.target_mhz.into();
+        }
+        if !spec.default_core_shape() {
+            text["slots"] = spec.slots.into();
+            text["units"] = spec.units.into();
         }
         if let (true, Some(e)) = (synth, &spec.ecp5) {
             text["family"] = "ecp5".into();
@@ -205,6 +209,9 @@ pub struct Extras {
     pub core_sim: bool,
     /// The clock the cores are built for, MHz.
     pub target_mhz: u32,
+    /// Ray slots per traversal unit, traversal units.
+    pub slots: u32,
+    pub units: u32,
     /// Place and route on the ECP5 (`--family ecp5`), in DIR/KEY/MODULE.
     pub pnr: Option<Pnr>,
 }
@@ -239,14 +246,17 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     q.triangles = scene.counts;
     row.quality = Some(q);
     let roms = SceneRoms::of(&scene);
+    let default_shape = (extras.slots, extras.units) == (DEFAULT_SLOTS, DEFAULT_UNITS);
     match core_cost(&roms) {
-        Ok(c) if extras.target_mhz != DEFAULT_TARGET_MHZ => row.cost = Some(cost_at(c, &roms, extras.target_mhz)),
+        Ok(c) if extras.target_mhz != DEFAULT_TARGET_MHZ || !default_shape => {
+            row.cost = Some(cost_at(c, &roms, extras))
+        }
         Ok(c) => row.cost = Some(c),
         Err(e) => row.error = Some(e.to_string()),
     }
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
-    let core_params = CoreParams::new(&roms, id_width, 1, extras.target_mhz);
+    let core_params = CoreParams::with_slots(&roms, id_width, 1, extras.target_mhz, extras.slots, extras.units);
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
         let (results, stats) = simulate_rust(&core_params, &roms, &rays, &Stalls::none(), &|_| {});
@@ -284,11 +294,11 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     Evaluated { row, render_png, errors_png }
 }
 
-/// `cost` (`core_cost`'s, at the default clock target) with what the clock target changes:
-/// the divider's and the intersection pipeline's latencies, the registers and the
-/// multipliers' pieces. The ROMs do not depend on it.
-fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32) -> CoreCost {
-    let p = CoreParams::new(roms, 20, 1, target_mhz);
+/// `cost` (`core_cost`'s, for the default core) with what the clock target and the core's
+/// shape change: the divider's and the intersection pipeline's latencies, the registers and
+/// the multipliers' pieces. The ROMs do not depend on them.
+fn cost_at(cost: CoreCost, roms: &SceneRoms, extras: &Extras) -> CoreCost {
+    let p = CoreParams::with_slots(roms, 20, 1, extras.target_mhz, extras.slots, extras.units);
     let core = core_module(&p, roms);
     CoreCost {
         div_latency: p.isect.div_latency(),

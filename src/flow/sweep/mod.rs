@@ -67,6 +67,12 @@ pub struct SweepSpec {
     /// at the default, so older sweeps read back the same).
     #[serde(default = "default_target_mhz", skip_serializing_if = "is_default_target_mhz")]
     pub target_mhz: u32,
+    /// Ray slots per traversal unit and traversal units of every core (`--slots`, `--units`;
+    /// absent from results.json at the defaults, so older sweeps read back the same).
+    #[serde(default = "default_slots", skip_serializing_if = "is_default_slots")]
+    pub slots: u32,
+    #[serde(default = "default_units", skip_serializing_if = "is_default_units")]
+    pub units: u32,
     /// `--synth --family ecp5`: place and route on the LFE5U-85F instead of Virtex-5 area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ecp5: Option<Ecp5Choice>,
@@ -78,6 +84,29 @@ fn default_target_mhz() -> u32 {
 
 fn is_default_target_mhz(mhz: &u32) -> bool {
     *mhz == default_target_mhz()
+}
+
+fn default_slots() -> u32 {
+    crate::cores::top::DEFAULT_SLOTS
+}
+
+fn is_default_slots(k: &u32) -> bool {
+    *k == default_slots()
+}
+
+fn default_units() -> u32 {
+    crate::cores::top::DEFAULT_UNITS
+}
+
+fn is_default_units(u: &u32) -> bool {
+    *u == default_units()
+}
+
+impl SweepSpec {
+    /// Whether the cores have the default ray slots and units.
+    pub fn default_core_shape(&self) -> bool {
+        is_default_slots(&self.slots) && is_default_units(&self.units)
+    }
 }
 
 /// What `sweep --synth --family ecp5` places and routes, and with which placement seed.

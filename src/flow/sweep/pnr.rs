@@ -109,8 +109,11 @@ pub fn setup_text(results: &Results) -> String {
     let first = results.rows.iter().flat_map(|r| r.ecp5.first()).next();
     let tools = first.map(|p| format!("; {}; {}", p.timing.yosys, p.timing.nextpnr)).unwrap_or_default();
     format!(
-        "{DEVICE} ({PACKAGE}, speed grade {SPEED}), clock target {} MHz, placement seed {}, modules {}{tools}",
+        "{DEVICE} ({PACKAGE}, speed grade {SPEED}), clock target {} MHz, {} ray slots × {} traversal units, \
+         placement seed {}, modules {}{tools}",
         results.spec.target_mhz,
+        results.spec.slots,
+        results.spec.units,
         e.seed,
         e.modules.join(", ")
     )

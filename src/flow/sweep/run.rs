@@ -84,6 +84,8 @@ pub fn run(
         synth_dir: spec.xc5v_synth().then(|| out.join("synth")),
         core_sim: spec.core_sim,
         target_mhz: spec.target_mhz,
+        slots: spec.slots,
+        units: spec.units,
         pnr,
     };
     let results: Vec<Result<(Row, bool)>> = mine

@@ -103,6 +103,9 @@ pub fn sweep_command(exe: &Path, spec: &SweepSpec) -> Vec<String> {
     if spec.target_mhz != crate::cores::clock::DEFAULT_TARGET_MHZ {
         v.extend(["--target-mhz".into(), spec.target_mhz.to_string()]);
     }
+    if !spec.default_core_shape() {
+        v.extend(["--slots".into(), spec.slots.to_string(), "--units".into(), spec.units.to_string()]);
+    }
     if let Some(e) = &spec.ecp5 {
         v.extend(["--family".into(), "ecp5".into(), "--seed".into(), e.seed.to_string()]);
         v.extend(["--modules".into(), e.modules.join(",")]);

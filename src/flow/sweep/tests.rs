@@ -20,6 +20,8 @@ fn spec() -> SweepSpec {
         synth: false,
         core_sim: false,
         target_mhz: 150,
+        slots: crate::cores::top::DEFAULT_SLOTS,
+        units: crate::cores::top::DEFAULT_UNITS,
         ecp5: None,
     }
 }
@@ -177,7 +179,7 @@ fn slurm_shards_are_checked_and_the_scripts_written() {
 /// ECP5 modules and seed, and the clock target are in the key; a sweep without them keeps the
 /// key it always had, and its results.json does not mention them.
 #[test]
-fn cache_keys_tell_families_seeds_and_targets_apart() {
+fn cache_keys_tell_families_seeds_targets_and_core_shapes_apart() {
     let ctx =
         eval::SceneCtx::load(&SceneSpec::Builtin("thin".into()), "thin".into(), &spec().camera, &Params::default())
             .unwrap();
@@ -193,6 +195,8 @@ fn cache_keys_tell_families_seeds_and_targets_apart() {
         ctx.key(&p, &SweepSpec { target_mhz: 100, ..ecp5.clone() }),
         ctx.key(&p, &SweepSpec { target_mhz: 100, ..xc5v.clone() }),
         ctx.key(&p, &SweepSpec { target_mhz: 100, ..spec() }),
+        ctx.key(&p, &SweepSpec { slots: 4, ..spec() }),
+        ctx.key(&p, &SweepSpec { units: 1, ..spec() }),
     ];
     let distinct: std::collections::BTreeSet<&String> = keys.iter().collect();
     assert_eq!(distinct.len(), keys.len(), "{keys:?}");
@@ -206,9 +210,9 @@ fn cache_keys_tell_families_seeds_and_targets_apart() {
     use sha2::Digest;
     assert_eq!(keys[1], format!("{:x}", sha2::Sha256::digest(before.to_string().as_bytes()))[..20]);
     let json = serde_json::to_string(&xc5v).unwrap();
-    assert!(!json.contains("target_mhz") && !json.contains("ecp5"), "{json}");
+    assert!(!["target_mhz", "ecp5", "slots", "units"].iter().any(|k| json.contains(k)), "{json}");
     assert_eq!(serde_json::from_str::<SweepSpec>(&json).unwrap(), xc5v);
-    let ecp5 = SweepSpec { target_mhz: 100, ..ecp5 };
+    let ecp5 = SweepSpec { target_mhz: 100, slots: 2, units: 1, ..ecp5 };
     assert_eq!(serde_json::from_str::<SweepSpec>(&serde_json::to_string(&ecp5).unwrap()).unwrap(), ecp5);
 }
 
