@@ -27,6 +27,8 @@ module fxrt_core (
   output wire [2:0] visits,
   output wire [2:0] culls,
   output wire [7:0] occupied,
+  output wire [0:0] accept,
+  output wire [19:0] accept_id,
   output wire [6:0] accept_slot,
   output wire [0:0] visit0,
   output wire [5:0] visit0_slot,
@@ -55,27 +57,57 @@ module fxrt_core (
   wire [0:0] k_0 = 1'h0;
   reg [0:0] case_turn;
   reg [5:0] case_turn_1;
+  reg [0:0] in_valid = 1'h0;
   wire [1:0] k_0_1 = 2'h0;
   wire [0:0] box_phase_eq_k_0_1;
-  wire [0:0] ready_c;
-  wire [0:0] accept;
-  wire [6:0] accept_slot_int;
+  wire [0:0] and_0;
+  wire [0:0] take;
+  wire [0:0] not_in_valid;
+  wire [0:0] port_ready;
+  wire [0:0] not_take;
+  wire [0:0] in_valid_and_not_take;
+  wire [0:0] or_1;
+  reg [19:0] in_ray_id = 20'h00000;
+  reg [28:0] in_ox = 29'h00000000;
+  reg [28:0] in_oy = 29'h00000000;
+  reg [28:0] in_oz = 29'h00000000;
+  reg signed [31:0] in_wx = 32'sh00000000;
+  reg signed [31:0] in_wy = 32'sh00000000;
+  reg signed [31:0] in_wz = 32'sh00000000;
+  reg signed [47:0] in_invx = 48'sh000000000000;
+  reg signed [47:0] in_invy = 48'sh000000000000;
+  reg signed [47:0] in_invz = 48'sh000000000000;
+  wire [6:0] take_slot;
   wire [0:0] k_1 = 1'h1;
   wire [0:0] turn_plus_1;
   wire [0:0] not_case_turn;
-  wire [0:0] accept_or_not_case_turn;
-  wire [0:0] mux_accept_or_not_case_turn;
+  wire [0:0] take_or_not_case_turn;
+  wire [0:0] mux_take_or_not_case_turn;
   wire [0:0] box_phase_ne_k_0_1;
-  wire [0:0] or_2;
+  wire [0:0] or_3;
   wire [1:0] k_1_1 = 2'h1;
   wire [1:0] box_phase_plus_k_1_1;
-  wire [1:0] mux_or_2;
-  reg [28:0] box_ox = 29'h00000000;
-  reg [28:0] box_oy = 29'h00000000;
-  reg [28:0] box_oz = 29'h00000000;
-  reg signed [47:0] box_invx = 48'sh000000000000;
-  reg signed [47:0] box_invy = 48'sh000000000000;
-  reg signed [47:0] box_invz = 48'sh000000000000;
+  wire [1:0] mux_or_3;
+  wire [0:0] box_idle;
+  reg [28:0] box_in_ox = 29'h00000000;
+  reg [28:0] box_in_oy = 29'h00000000;
+  reg [28:0] box_in_oz = 29'h00000000;
+  reg signed [47:0] box_in_invx = 48'sh000000000000;
+  reg signed [47:0] box_in_invy = 48'sh000000000000;
+  reg signed [47:0] box_in_invz = 48'sh000000000000;
+  reg [0:0] accept_int = 1'h0;
+  reg [6:0] accept_slot_int = 7'h00;
+  reg [19:0] acc_in_ray_id = 20'h00000;
+  reg [28:0] acc_in_ox = 29'h00000000;
+  reg [28:0] acc_in_oy = 29'h00000000;
+  reg [28:0] acc_in_oz = 29'h00000000;
+  reg signed [31:0] acc_in_wx = 32'sh00000000;
+  reg signed [31:0] acc_in_wy = 32'sh00000000;
+  reg signed [31:0] acc_in_wz = 32'sh00000000;
+  reg signed [47:0] acc_in_invx = 48'sh000000000000;
+  reg signed [47:0] acc_in_invy = 48'sh000000000000;
+  reg signed [47:0] acc_in_invz = 48'sh000000000000;
+  wire [5:0] bits_accept_slot;
   reg [6:0] box_slot = 7'h00;
   wire [1:0] box_axis;
   wire [28:0] box_hi_0 = 29'h1fffffff;
@@ -153,14 +185,14 @@ module fxrt_core (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_box_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_6;
+  wire signed [32:0] minus_7;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt1_c;
   reg [0:0] box_lt1 = 1'h0;
   wire signed [32:0] rs_plane_t_1;
   wire signed [32:0] rs_box_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_7;
+  wire signed [32:0] minus_8;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt2_c;
   reg [0:0] box_lt2 = 1'h0;
@@ -170,7 +202,7 @@ module fxrt_core (
   wire signed [31:0] box_tmax;
   wire [0:0] bits_box_d1;
   wire [0:0] bits_box_d2;
-  wire [0:0] or_8;
+  wire [0:0] or_9;
   wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire [0:0] box_last;
@@ -192,11 +224,11 @@ module fxrt_core (
   wire [0:0] u1_done_pop;
   wire [72:0] u0_node_word;
   wire [72:0] u1_node_word;
-  wire [0:0] bits_accept_slot;
-  wire [0:0] bits_accept_slot_eq_k_0;
+  wire [0:0] bits_accept_slot_1;
+  wire [0:0] eq_11;
   wire [0:0] u0_alloc;
   wire [0:0] bits_box_done_slot;
-  wire [0:0] eq_11;
+  wire [0:0] eq_12;
   wire [0:0] u0_new;
   wire [0:0] bits_merge_slot;
   wire [0:0] bits_merge_slot_eq_k_0;
@@ -224,11 +256,11 @@ module fxrt_core (
   wire [0:0] u_traverse_0_cull;
   wire [5:0] u_traverse_0_depth;
   wire [6:0] u_traverse_0_occupied;
-  wire [0:0] bits_accept_slot_1;
-  wire [0:0] eq_14;
+  wire [0:0] bits_accept_slot_2;
+  wire [0:0] eq_15;
   wire [0:0] u1_alloc;
   wire [0:0] bits_box_done_slot_2;
-  wire [0:0] eq_15;
+  wire [0:0] eq_16;
   wire [0:0] u1_new;
   wire [0:0] bits_merge_slot_2;
   wire [0:0] bits_merge_slot_2_eq_k_1;
@@ -258,11 +290,11 @@ module fxrt_core (
   wire [6:0] u_traverse_1_occupied;
   wire [72:0] u_node_rom_0_data;
   wire [72:0] u_node_rom_0_data_b;
-  wire [86:0] cat_18;
-  wire [31:0] u_wz;
-  wire [31:0] u_wy;
-  wire [31:0] u_wx;
-  wire [95:0] cat_19;
+  wire [86:0] cat_19;
+  wire [31:0] u_acc_in_wz;
+  wire [31:0] u_acc_in_wy;
+  wire [31:0] u_acc_in_wx;
+  wire [95:0] cat_20;
   reg [0:0] leaf_active = 1'h0;
   reg [6:0] leaf_slot = 7'h00;
   reg [12:0] leaf_ptr = 13'h0000;
@@ -285,18 +317,18 @@ module fxrt_core (
   reg [0:0] case_leaf_turn_1;
   reg [0:0] case_leaf_turn_2;
   reg [0:0] case_leaf_turn_3;
-  wire [0:0] or_24;
+  wire [0:0] or_25;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_25;
-  wire [0:0] u0_leaf_take;
   wire [0:0] eq_26;
+  wire [0:0] u0_leaf_take;
+  wire [0:0] eq_27;
   wire [0:0] u1_leaf_take;
   reg [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_27;
+  wire [6:0] cat_28;
   wire [0:0] not_leaf_last_entry;
-  wire [0:0] and_28;
-  wire [0:0] leaf_take_or_and_28;
+  wire [0:0] and_29;
+  wire [0:0] leaf_take_or_and_29;
   wire [6:0] mux_leaf_take;
   reg [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
@@ -311,13 +343,13 @@ module fxrt_core (
   reg [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   reg [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_29;
+  wire [0:0] eq_30;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_30;
+  wire [58:0] cat_31;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -390,12 +422,12 @@ module fxrt_core (
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_34;
+  wire [6:0] cat_35;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_36;
+  wire [6:0] cat_37;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_37;
+  wire [0:0] or_38;
   reg [0:0] done_valid_r = 1'h0;
   reg [6:0] done_slot_r = 7'h00;
   wire [0:0] u_closest_merge_valid;
@@ -412,8 +444,8 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_38;
-  wire [5:0] mux_lt_38;
+  wire [0:0] lt_39;
+  wire [5:0] mux_lt_39;
   wire [2:0] rs_u_traverse_0_visit;
   wire [2:0] rs_u_traverse_1_visit;
   wire [2:0] visits_c;
@@ -443,23 +475,30 @@ module fxrt_core (
     endcase
   end
   assign box_phase_eq_k_0_1 = box_phase == k_0_1;
-  assign ready_c = box_phase_eq_k_0_1 & case_turn;
-  assign accept = ray_valid & ready_c;
-  assign accept_slot_int = {turn, case_turn_1};
+  assign and_0 = in_valid & box_phase_eq_k_0_1;
+  assign take = and_0 & case_turn;
+  assign not_in_valid = ~in_valid;
+  assign port_ready = not_in_valid | take;
+  assign not_take = ~take;
+  assign in_valid_and_not_take = in_valid & not_take;
+  assign or_1 = ray_valid | in_valid_and_not_take;
+  assign take_slot = {turn, case_turn_1};
   assign turn_plus_1 = turn + k_1;
   assign not_case_turn = ~case_turn;
-  assign accept_or_not_case_turn = accept | not_case_turn;
-  assign mux_accept_or_not_case_turn = accept_or_not_case_turn ? turn_plus_1 : turn;
+  assign take_or_not_case_turn = take | not_case_turn;
+  assign mux_take_or_not_case_turn = take_or_not_case_turn ? turn_plus_1 : turn;
   assign box_phase_ne_k_0_1 = box_phase != k_0_1;
-  assign or_2 = accept | box_phase_ne_k_0_1;
+  assign or_3 = take | box_phase_ne_k_0_1;
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
-  assign mux_or_2 = or_2 ? box_phase_plus_k_1_1 : box_phase;
+  assign mux_or_3 = or_3 ? box_phase_plus_k_1_1 : box_phase;
+  assign box_idle = box_phase == k_0_1;
+  assign bits_accept_slot = accept_slot_int[5:0];
   assign box_axis = box_phase - k_1_1;
   always @* begin
     case (box_axis)
-      2'h1: case_box_axis = box_invy;
-      2'h2: case_box_axis = box_invz;
-      default: case_box_axis = box_invx;
+      2'h1: case_box_axis = box_in_invy;
+      2'h2: case_box_axis = box_in_invz;
+      default: case_box_axis = box_in_invx;
     endcase
   end
   assign box_neg = case_box_axis[47];
@@ -477,9 +516,9 @@ module fxrt_core (
   assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
   always @* begin
     case (pu_sel_axis)
-      2'h1: case_pu_sel_axis = box_oy;
-      2'h2: case_pu_sel_axis = box_oz;
-      default: case_pu_sel_axis = box_ox;
+      2'h1: case_pu_sel_axis = box_in_oy;
+      2'h2: case_pu_sel_axis = box_in_oz;
+      default: case_pu_sel_axis = box_in_ox;
     endcase
   end
   assign rs_case_pu_sel_axis = {{1{1'b0}}, case_pu_sel_axis};
@@ -487,9 +526,9 @@ module fxrt_core (
   assign pu_diff = s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
   always @* begin
     case (pu_sel_axis)
-      2'h1: pu_inv_axis = box_invy;
-      2'h2: pu_inv_axis = box_invz;
-      default: pu_inv_axis = box_invx;
+      2'h1: pu_inv_axis = box_in_invy;
+      2'h2: pu_inv_axis = box_in_invz;
+      default: pu_inv_axis = box_in_invx;
     endcase
   end
   assign pu_product = u_plane_product_p;
@@ -509,20 +548,20 @@ module fxrt_core (
   assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
-  assign minus_6 = rs_plane_t - rs_box_d1;
-  assign box_lt1_c = minus_6[32];
+  assign minus_7 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_7[32];
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
-  assign minus_7 = rs_plane_t_1 - rs_box_d2;
-  assign box_lt2_c = minus_7[32];
+  assign minus_8 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_8[32];
   assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
   assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
   assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
   assign bits_box_d1 = box_d1[31];
   assign bits_box_d2 = box_d2[31];
-  assign or_8 = bits_box_d1 | bits_box_d2;
+  assign or_9 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_8 | bits_box_d3;
+  assign box_miss = or_9 | bits_box_d3;
   assign box_last = plane_t_valid & plane_t_last;
   assign box_done_slot = box_done_slot_sr[11];
   assign merge_valid = u_closest_merge_valid;
@@ -538,12 +577,12 @@ module fxrt_core (
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
-  assign bits_accept_slot = accept_slot_int[6];
-  assign bits_accept_slot_eq_k_0 = bits_accept_slot == k_0;
-  assign u0_alloc = accept & bits_accept_slot_eq_k_0;
+  assign bits_accept_slot_1 = accept_slot_int[6];
+  assign eq_11 = bits_accept_slot_1 == k_0;
+  assign u0_alloc = accept_int & eq_11;
   assign bits_box_done_slot = box_done_slot[6];
-  assign eq_11 = bits_box_done_slot == k_0;
-  assign u0_new = box_done & eq_11;
+  assign eq_12 = bits_box_done_slot == k_0;
+  assign u0_new = box_done & eq_12;
   assign bits_merge_slot = merge_slot[6];
   assign bits_merge_slot_eq_k_0 = bits_merge_slot == k_0;
   assign u0_merge = merge_valid & bits_merge_slot_eq_k_0;
@@ -553,12 +592,12 @@ module fxrt_core (
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_merge_slot_1 = merge_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
-  assign bits_accept_slot_1 = accept_slot_int[6];
-  assign eq_14 = bits_accept_slot_1 == k_1;
-  assign u1_alloc = accept & eq_14;
+  assign bits_accept_slot_2 = accept_slot_int[6];
+  assign eq_15 = bits_accept_slot_2 == k_1;
+  assign u1_alloc = accept_int & eq_15;
   assign bits_box_done_slot_2 = box_done_slot[6];
-  assign eq_15 = bits_box_done_slot_2 == k_1;
-  assign u1_new = box_done & eq_15;
+  assign eq_16 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_16;
   assign bits_merge_slot_2 = merge_slot[6];
   assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
   assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
@@ -568,11 +607,11 @@ module fxrt_core (
   assign bits_box_done_slot_3 = box_done_slot[5:0];
   assign bits_merge_slot_3 = merge_slot[5:0];
   assign bits_free_slot_3 = free_slot[5:0];
-  assign cat_18 = {oz, oy, ox};
-  assign u_wz = $unsigned(wz);
-  assign u_wy = $unsigned(wy);
-  assign u_wx = $unsigned(wx);
-  assign cat_19 = {u_wz, u_wy, u_wx};
+  assign cat_19 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign u_acc_in_wz = $unsigned(acc_in_wz);
+  assign u_acc_in_wy = $unsigned(acc_in_wy);
+  assign u_acc_in_wx = $unsigned(acc_in_wx);
+  assign cat_20 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
   assign leaf_last_entry = leaf_active & leaf_last;
   assign not_leaf_active = ~leaf_active;
   assign leaf_can_take = not_leaf_active | leaf_last_entry;
@@ -608,13 +647,13 @@ module fxrt_core (
       default: case_leaf_turn_3 = k_0;
     endcase
   end
-  assign or_24 = case_leaf_turn_2 | case_leaf_turn;
+  assign or_25 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_24;
-  assign eq_25 = mux_case_leaf_turn_2 == k_0;
-  assign u0_leaf_take = leaf_take & eq_25;
-  assign eq_26 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_26;
+  assign leaf_take = leaf_can_take & or_25;
+  assign eq_26 = mux_case_leaf_turn_2 == k_0;
+  assign u0_leaf_take = leaf_take & eq_26;
+  assign eq_27 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_27;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
@@ -622,11 +661,11 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
     endcase
   end
-  assign cat_27 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_28 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_28 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_28 = leaf_take | and_28;
-  assign mux_leaf_take = leaf_take ? cat_27 : leaf_slot;
+  assign and_29 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_29 = leaf_take | and_29;
+  assign mux_leaf_take = leaf_take ? cat_28 : leaf_slot;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
@@ -668,10 +707,10 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_5 = u_traverse_0_leaf_count;
     endcase
   end
-  assign eq_29 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_30 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_29 : leaf_left_eq_k_2;
-  assign cat_30 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign mux_leaf_take_5 = leaf_take ? eq_30 : leaf_left_eq_k_2;
+  assign cat_31 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -711,14 +750,14 @@ module fxrt_core (
   assign u0_done_avail = u_traverse_0_done_valid & not_u0_done_took;
   assign not_u1_done_took = ~u1_done_took;
   assign u1_done_avail = u_traverse_1_done_valid & not_u1_done_took;
-  assign cat_34 = {k_0, u_traverse_0_done_slot};
+  assign cat_35 = {k_0, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_36 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_34 : cat_36;
-  assign or_37 = u0_done_avail | u1_done_avail;
-  assign lt_38 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_38 = lt_38 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign cat_37 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_35 : cat_37;
+  assign or_38 = u0_done_avail | u1_done_avail;
+  assign lt_39 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_39 = lt_39 ? u_traverse_1_depth : u_traverse_0_depth;
   assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
   assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
   assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -730,12 +769,12 @@ module fxrt_core (
   assign occupied_c = rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   always @(posedge clk) begin : regs
-    if (accept) ray_o[accept_slot_int] <= cat_18;
-    if (accept) ray_w[accept_slot_int] <= cat_19;
+    if (accept_int) ray_o[accept_slot_int] <= cat_19;
+    if (accept_int) ray_w[accept_slot_int] <= cat_20;
     if (rst) turn <= 1'h0;
-    else turn <= mux_accept_or_not_case_turn;
+    else turn <= mux_take_or_not_case_turn;
     if (rst) box_phase <= 2'h0;
-    else box_phase <= mux_or_2;
+    else box_phase <= mux_or_3;
     if (rst) u0_has_free_r <= 1'h1;
     else u0_has_free_r <= u0_has_free;
     if (rst) u1_has_free_r <= 1'h1;
@@ -744,13 +783,37 @@ module fxrt_core (
     else u0_free_slot_r <= u0_free_slot;
     if (rst) u1_free_slot_r <= 6'h00;
     else u1_free_slot_r <= u1_free_slot;
-    if (accept) box_ox <= ox;
-    if (accept) box_oy <= oy;
-    if (accept) box_oz <= oz;
-    if (accept) box_invx <= invx;
-    if (accept) box_invy <= invy;
-    if (accept) box_invz <= invz;
-    if (accept) box_slot <= accept_slot_int;
+    if (rst) in_valid <= 1'h0;
+    else in_valid <= or_1;
+    if (port_ready) in_ray_id <= ray_id;
+    if (port_ready) in_ox <= ox;
+    if (port_ready) in_oy <= oy;
+    if (port_ready) in_oz <= oz;
+    if (port_ready) in_wx <= wx;
+    if (port_ready) in_wy <= wy;
+    if (port_ready) in_wz <= wz;
+    if (port_ready) in_invx <= invx;
+    if (port_ready) in_invy <= invy;
+    if (port_ready) in_invz <= invz;
+    if (box_idle) box_in_ox <= in_ox;
+    if (box_idle) box_in_oy <= in_oy;
+    if (box_idle) box_in_oz <= in_oz;
+    if (box_idle) box_in_invx <= in_invx;
+    if (box_idle) box_in_invy <= in_invy;
+    if (box_idle) box_in_invz <= in_invz;
+    accept_int <= take;
+    accept_slot_int <= take_slot;
+    acc_in_ray_id <= in_ray_id;
+    acc_in_ox <= in_ox;
+    acc_in_oy <= in_oy;
+    acc_in_oz <= in_oz;
+    acc_in_wx <= in_wx;
+    acc_in_wy <= in_wy;
+    acc_in_wz <= in_wz;
+    acc_in_invx <= in_invx;
+    acc_in_invy <= in_invy;
+    acc_in_invz <= in_invz;
+    if (take) box_slot <= take_slot;
     pu_sel_valid <= box_issue;
     pu_sel_last <= box_issue_last;
     pu_sel_plane <= box_plane;
@@ -786,7 +849,7 @@ module fxrt_core (
       box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
     box_done_slot_sr[1] <= box_slot;
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_28;
+    else leaf_active <= leaf_take_or_and_29;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -800,7 +863,7 @@ module fxrt_core (
     u1_leaf_took <= u1_leaf_pop;
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
-    emit_tag_sr[1] <= cat_30;
+    emit_tag_sr[1] <= cat_31;
     for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
       emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
     emit_valid_sr[1] <= leaf_active;
@@ -820,7 +883,7 @@ module fxrt_core (
     pipe_w_sr[1] <= ray_w_q;
     u0_done_took <= u0_done_pop;
     u1_done_took <= u1_done_pop;
-    done_valid_r <= or_37;
+    done_valid_r <= or_38;
     done_slot_r <= mux_u0_done_avail;
   end
 
@@ -835,13 +898,13 @@ module fxrt_core (
     .clk(clk),
     .rst(rst),
     .ray_we(u0_alloc),
-    .ray_slot(case_turn_1),
-    .ox(ox),
-    .oy(oy),
-    .oz(oz),
-    .invx(invx),
-    .invy(invy),
-    .invz(invz),
+    .ray_slot(bits_accept_slot),
+    .ox(acc_in_ox),
+    .oy(acc_in_oy),
+    .oz(acc_in_oz),
+    .invx(acc_in_invx),
+    .invy(acc_in_invy),
+    .invz(acc_in_invz),
     .new_valid(u0_new),
     .new_slot(bits_box_done_slot_1),
     .new_tmax(box_tmax),
@@ -880,13 +943,13 @@ module fxrt_core (
     .clk(clk),
     .rst(rst),
     .ray_we(u1_alloc),
-    .ray_slot(case_turn_1),
-    .ox(ox),
-    .oy(oy),
-    .oz(oz),
-    .invx(invx),
-    .invy(invy),
-    .invz(invz),
+    .ray_slot(bits_accept_slot),
+    .ox(acc_in_ox),
+    .oy(acc_in_oy),
+    .oz(acc_in_oz),
+    .invx(acc_in_invx),
+    .invy(acc_in_invy),
+    .invz(acc_in_invz),
     .new_valid(u1_new),
     .new_slot(bits_box_done_slot_3),
     .new_tmax(box_tmax),
@@ -990,9 +1053,9 @@ module fxrt_core (
     .t(u_intersect_t_1),
     .u(u_intersect_u),
     .v(u_intersect_v),
-    .id_we(accept),
+    .id_we(accept_int),
     .id_slot(accept_slot_int),
-    .id(ray_id),
+    .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),
     .merge_valid(u_closest_merge_valid),
@@ -1011,7 +1074,7 @@ module fxrt_core (
     .res_v(u_closest_res_v)
   );
 
-  assign ray_ready = ready_c;
+  assign ray_ready = port_ready;
   assign res_valid = u_closest_res_valid;
   assign res_id = u_closest_res_id;
   assign res_hit = u_closest_res_hit;
@@ -1020,10 +1083,12 @@ module fxrt_core (
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
   assign busy = pipe_valid;
-  assign stack_depth = mux_lt_38;
+  assign stack_depth = mux_lt_39;
   assign visits = visits_c;
   assign culls = culls_c;
   assign occupied = occupied_c;
+  assign accept = accept_int;
+  assign accept_id = acc_in_ray_id;
   assign accept_slot = accept_slot_int;
   assign visit0 = u_traverse_0_visit;
   assign visit0_slot = u_traverse_0_visit_slot;

@@ -31,6 +31,8 @@ entity fxrt_core is
     visits : out unsigned(2 downto 0);
     culls : out unsigned(2 downto 0);
     occupied : out unsigned(7 downto 0);
+    accept : out unsigned(0 downto 0);
+    accept_id : out unsigned(19 downto 0);
     accept_slot : out unsigned(6 downto 0);
     visit0 : out unsigned(0 downto 0);
     visit0_slot : out unsigned(5 downto 0);
@@ -471,27 +473,57 @@ architecture rtl of fxrt_core is
   constant k_0 : unsigned(0 downto 0) := unsigned'("0");
   signal case_turn : unsigned(0 downto 0);
   signal case_turn_1 : unsigned(5 downto 0);
+  signal in_valid : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
   signal box_phase_eq_k_0_1 : unsigned(0 downto 0);
-  signal ready_c : unsigned(0 downto 0);
-  signal accept : unsigned(0 downto 0);
-  signal accept_slot_int : unsigned(6 downto 0);
+  signal and_0 : unsigned(0 downto 0);
+  signal take : unsigned(0 downto 0);
+  signal not_in_valid : unsigned(0 downto 0);
+  signal port_ready : unsigned(0 downto 0);
+  signal not_take : unsigned(0 downto 0);
+  signal in_valid_and_not_take : unsigned(0 downto 0);
+  signal or_1 : unsigned(0 downto 0);
+  signal in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
+  signal in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal in_oz : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal in_wx : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal in_wy : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal in_wz : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal take_slot : unsigned(6 downto 0);
   constant k_1 : unsigned(0 downto 0) := unsigned'("1");
   signal turn_plus_1 : unsigned(0 downto 0);
   signal not_case_turn : unsigned(0 downto 0);
-  signal accept_or_not_case_turn : unsigned(0 downto 0);
-  signal mux_accept_or_not_case_turn : unsigned(0 downto 0);
+  signal take_or_not_case_turn : unsigned(0 downto 0);
+  signal mux_take_or_not_case_turn : unsigned(0 downto 0);
   signal box_phase_ne_k_0_1 : unsigned(0 downto 0);
-  signal or_2 : unsigned(0 downto 0);
+  signal or_3 : unsigned(0 downto 0);
   constant k_1_1 : unsigned(1 downto 0) := unsigned'("01");
   signal box_phase_plus_k_1_1 : unsigned(1 downto 0);
-  signal mux_or_2 : unsigned(1 downto 0);
-  signal box_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
-  signal box_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
-  signal box_oz : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
-  signal box_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal box_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal box_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal mux_or_3 : unsigned(1 downto 0);
+  signal box_idle : unsigned(0 downto 0);
+  signal box_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal box_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal box_in_oz : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal box_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal box_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal box_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal accept_int : unsigned(0 downto 0) := unsigned'("0");
+  signal accept_slot_int : unsigned(6 downto 0) := unsigned'("0000000");
+  signal acc_in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
+  signal acc_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal acc_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal acc_in_oz : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal acc_in_wx : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal acc_in_wy : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal acc_in_wz : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal acc_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal acc_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal bits_accept_slot : unsigned(5 downto 0);
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal box_axis : unsigned(1 downto 0);
   constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
@@ -558,12 +590,12 @@ architecture rtl of fxrt_core is
   signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_plane_t : signed(32 downto 0);
   signal rs_box_d1 : signed(32 downto 0);
-  signal minus_6 : signed(32 downto 0);
+  signal minus_7 : signed(32 downto 0);
   signal box_lt1_c : unsigned(0 downto 0);
   signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
   signal rs_plane_t_1 : signed(32 downto 0);
   signal rs_box_d2 : signed(32 downto 0);
-  signal minus_7 : signed(32 downto 0);
+  signal minus_8 : signed(32 downto 0);
   signal box_lt2_c : unsigned(0 downto 0);
   signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
   signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
@@ -572,7 +604,7 @@ architecture rtl of fxrt_core is
   signal box_tmax : signed(31 downto 0);
   signal bits_box_d1 : unsigned(0 downto 0);
   signal bits_box_d2 : unsigned(0 downto 0);
-  signal or_8 : unsigned(0 downto 0);
+  signal or_9 : unsigned(0 downto 0);
   signal bits_box_d3 : unsigned(0 downto 0);
   signal box_miss : unsigned(0 downto 0);
   signal box_last : unsigned(0 downto 0);
@@ -593,11 +625,11 @@ architecture rtl of fxrt_core is
   signal u1_done_pop : unsigned(0 downto 0);
   signal u0_node_word : unsigned(72 downto 0);
   signal u1_node_word : unsigned(72 downto 0);
-  signal bits_accept_slot : unsigned(0 downto 0);
-  signal bits_accept_slot_eq_k_0 : unsigned(0 downto 0);
+  signal bits_accept_slot_1 : unsigned(0 downto 0);
+  signal eq_11 : unsigned(0 downto 0);
   signal u0_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot : unsigned(0 downto 0);
-  signal eq_11 : unsigned(0 downto 0);
+  signal eq_12 : unsigned(0 downto 0);
   signal u0_new : unsigned(0 downto 0);
   signal bits_merge_slot : unsigned(0 downto 0);
   signal bits_merge_slot_eq_k_0 : unsigned(0 downto 0);
@@ -625,11 +657,11 @@ architecture rtl of fxrt_core is
   signal u_traverse_0_cull : unsigned(0 downto 0);
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
-  signal bits_accept_slot_1 : unsigned(0 downto 0);
-  signal eq_14 : unsigned(0 downto 0);
+  signal bits_accept_slot_2 : unsigned(0 downto 0);
+  signal eq_15 : unsigned(0 downto 0);
   signal u1_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
-  signal eq_15 : unsigned(0 downto 0);
+  signal eq_16 : unsigned(0 downto 0);
   signal u1_new : unsigned(0 downto 0);
   signal bits_merge_slot_2 : unsigned(0 downto 0);
   signal bits_merge_slot_2_eq_k_1 : unsigned(0 downto 0);
@@ -659,11 +691,11 @@ architecture rtl of fxrt_core is
   signal u_traverse_1_occupied : unsigned(6 downto 0);
   signal u_node_rom_0_data : unsigned(72 downto 0);
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
-  signal cat_18 : unsigned(86 downto 0);
-  signal u_wz : unsigned(31 downto 0);
-  signal u_wy : unsigned(31 downto 0);
-  signal u_wx : unsigned(31 downto 0);
-  signal cat_19 : unsigned(95 downto 0);
+  signal cat_19 : unsigned(86 downto 0);
+  signal u_acc_in_wz : unsigned(31 downto 0);
+  signal u_acc_in_wy : unsigned(31 downto 0);
+  signal u_acc_in_wx : unsigned(31 downto 0);
+  signal cat_20 : unsigned(95 downto 0);
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
@@ -686,18 +718,18 @@ architecture rtl of fxrt_core is
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
   signal case_leaf_turn_3 : unsigned(0 downto 0);
-  signal or_24 : unsigned(0 downto 0);
+  signal or_25 : unsigned(0 downto 0);
   signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
   signal leaf_take : unsigned(0 downto 0);
-  signal eq_25 : unsigned(0 downto 0);
-  signal u0_leaf_take : unsigned(0 downto 0);
   signal eq_26 : unsigned(0 downto 0);
+  signal u0_leaf_take : unsigned(0 downto 0);
+  signal eq_27 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
   signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_27 : unsigned(6 downto 0);
+  signal cat_28 : unsigned(6 downto 0);
   signal not_leaf_last_entry : unsigned(0 downto 0);
-  signal and_28 : unsigned(0 downto 0);
-  signal leaf_take_or_and_28 : unsigned(0 downto 0);
+  signal and_29 : unsigned(0 downto 0);
+  signal leaf_take_or_and_29 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
   constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
@@ -712,13 +744,13 @@ architecture rtl of fxrt_core is
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_29 : unsigned(0 downto 0);
+  signal eq_30 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_30 : unsigned(58 downto 0);
+  signal cat_31 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -783,12 +815,12 @@ architecture rtl of fxrt_core is
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
-  signal cat_34 : unsigned(6 downto 0);
+  signal cat_35 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_36 : unsigned(6 downto 0);
+  signal cat_37 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
-  signal or_37 : unsigned(0 downto 0);
+  signal or_38 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal u_closest_merge_valid : unsigned(0 downto 0);
@@ -805,8 +837,8 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal lt_38 : unsigned(0 downto 0);
-  signal mux_lt_38 : unsigned(5 downto 0);
+  signal lt_39 : unsigned(0 downto 0);
+  signal mux_lt_39 : unsigned(5 downto 0);
   signal rs_u_traverse_0_visit : unsigned(2 downto 0);
   signal rs_u_traverse_1_visit : unsigned(2 downto 0);
   signal visits_c : unsigned(2 downto 0);
@@ -833,23 +865,30 @@ begin
       u1_free_slot_r when "1",
       u0_free_slot_r when others;
   box_phase_eq_k_0_1 <= "1" when box_phase = k_0_1 else "0";
-  ready_c <= box_phase_eq_k_0_1 and case_turn;
-  accept <= ray_valid and ready_c;
-  accept_slot_int <= unsigned(std_logic_vector'(std_logic_vector(turn) & std_logic_vector(case_turn_1)));
+  and_0 <= in_valid and box_phase_eq_k_0_1;
+  take <= and_0 and case_turn;
+  not_in_valid <= not in_valid;
+  port_ready <= not_in_valid or take;
+  not_take <= not take;
+  in_valid_and_not_take <= in_valid and not_take;
+  or_1 <= ray_valid or in_valid_and_not_take;
+  take_slot <= unsigned(std_logic_vector'(std_logic_vector(turn) & std_logic_vector(case_turn_1)));
   turn_plus_1 <= turn + k_1;
   not_case_turn <= not case_turn;
-  accept_or_not_case_turn <= accept or not_case_turn;
-  mux_accept_or_not_case_turn <= turn_plus_1 when accept_or_not_case_turn = "1" else turn;
+  take_or_not_case_turn <= take or not_case_turn;
+  mux_take_or_not_case_turn <= turn_plus_1 when take_or_not_case_turn = "1" else turn;
   box_phase_ne_k_0_1 <= "1" when box_phase /= k_0_1 else "0";
-  or_2 <= accept or box_phase_ne_k_0_1;
+  or_3 <= take or box_phase_ne_k_0_1;
   box_phase_plus_k_1_1 <= box_phase + k_1_1;
-  mux_or_2 <= box_phase_plus_k_1_1 when or_2 = "1" else box_phase;
+  mux_or_3 <= box_phase_plus_k_1_1 when or_3 = "1" else box_phase;
+  box_idle <= "1" when box_phase = k_0_1 else "0";
+  bits_accept_slot <= unsigned(accept_slot_int(5 downto 0));
   box_axis <= box_phase - k_1_1;
   with box_axis select
     case_box_axis <=
-      box_invy when "01",
-      box_invz when "10",
-      box_invx when others;
+      box_in_invy when "01",
+      box_in_invz when "10",
+      box_in_invx when others;
   box_neg <= unsigned(case_box_axis(47 downto 47));
   box_issue <= "1" when box_phase /= k_0_1 else "0";
   box_issue_last <= "1" when box_phase = k_3 else "0";
@@ -863,17 +902,17 @@ begin
   s_rs_pu_sel_plane <= signed(rs_pu_sel_plane);
   with pu_sel_axis select
     case_pu_sel_axis <=
-      box_oy when "01",
-      box_oz when "10",
-      box_ox when others;
+      box_in_oy when "01",
+      box_in_oz when "10",
+      box_in_ox when others;
   rs_case_pu_sel_axis <= resize(case_pu_sel_axis, 30);
   s_rs_case_pu_sel_axis <= signed(rs_case_pu_sel_axis);
   pu_diff <= s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
   with pu_sel_axis select
     pu_inv_axis <=
-      box_invy when "01",
-      box_invz when "10",
-      box_invx when others;
+      box_in_invy when "01",
+      box_in_invz when "10",
+      box_in_invx when others;
   pu_product <= u_plane_product_p;
   pu_product_valid <= pu_product_valid_sr(6);
   pu_product_last <= pu_product_last_sr(6);
@@ -891,20 +930,20 @@ begin
   pu_first <= pu_clamp_valid and not_pu_clamp_last;
   rs_plane_t <= resize(plane_t, 33);
   rs_box_d1 <= resize(box_d1, 33);
-  minus_6 <= rs_plane_t - rs_box_d1;
-  box_lt1_c <= unsigned(minus_6(32 downto 32));
+  minus_7 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_7(32 downto 32));
   rs_plane_t_1 <= resize(plane_t, 33);
   rs_box_d2 <= resize(box_d2, 33);
-  minus_7 <= rs_plane_t_1 - rs_box_d2;
-  box_lt2_c <= unsigned(minus_7(32 downto 32));
+  minus_8 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_8(32 downto 32));
   box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
   mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
   box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
   bits_box_d1 <= unsigned(box_d1(31 downto 31));
   bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_8 <= bits_box_d1 or bits_box_d2;
+  or_9 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_8 or bits_box_d3;
+  box_miss <= or_9 or bits_box_d3;
   box_last <= plane_t_valid and plane_t_last;
   box_done_slot <= box_done_slot_sr(11);
   merge_valid <= u_closest_merge_valid;
@@ -920,12 +959,12 @@ begin
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
-  bits_accept_slot <= unsigned(accept_slot_int(6 downto 6));
-  bits_accept_slot_eq_k_0 <= "1" when bits_accept_slot = k_0 else "0";
-  u0_alloc <= accept and bits_accept_slot_eq_k_0;
+  bits_accept_slot_1 <= unsigned(accept_slot_int(6 downto 6));
+  eq_11 <= "1" when bits_accept_slot_1 = k_0 else "0";
+  u0_alloc <= accept_int and eq_11;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
-  eq_11 <= "1" when bits_box_done_slot = k_0 else "0";
-  u0_new <= box_done and eq_11;
+  eq_12 <= "1" when bits_box_done_slot = k_0 else "0";
+  u0_new <= box_done and eq_12;
   bits_merge_slot <= unsigned(merge_slot(6 downto 6));
   bits_merge_slot_eq_k_0 <= "1" when bits_merge_slot = k_0 else "0";
   u0_merge <= merge_valid and bits_merge_slot_eq_k_0;
@@ -935,12 +974,12 @@ begin
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
-  bits_accept_slot_1 <= unsigned(accept_slot_int(6 downto 6));
-  eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
-  u1_alloc <= accept and eq_14;
+  bits_accept_slot_2 <= unsigned(accept_slot_int(6 downto 6));
+  eq_15 <= "1" when bits_accept_slot_2 = k_1 else "0";
+  u1_alloc <= accept_int and eq_15;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
-  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
-  u1_new <= box_done and eq_15;
+  eq_16 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_16;
   bits_merge_slot_2 <= unsigned(merge_slot(6 downto 6));
   bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
   u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
@@ -950,11 +989,11 @@ begin
   bits_box_done_slot_3 <= unsigned(box_done_slot(5 downto 0));
   bits_merge_slot_3 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
-  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(oz) & std_logic_vector(oy) & std_logic_vector(ox)));
-  u_wz <= unsigned(wz);
-  u_wy <= unsigned(wy);
-  u_wx <= unsigned(wx);
-  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_wz) & std_logic_vector(u_wy) & std_logic_vector(u_wx)));
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  u_acc_in_wz <= unsigned(acc_in_wz);
+  u_acc_in_wy <= unsigned(acc_in_wy);
+  u_acc_in_wx <= unsigned(acc_in_wx);
+  cat_20 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
   leaf_last_entry <= leaf_active and leaf_last;
   not_leaf_active <= not leaf_active;
   leaf_can_take <= not_leaf_active or leaf_last_entry;
@@ -982,23 +1021,23 @@ begin
       k_1 when "0",
       k_0 when "1",
       k_0 when others;
-  or_24 <= case_leaf_turn_2 or case_leaf_turn;
+  or_25 <= case_leaf_turn_2 or case_leaf_turn;
   mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_24;
-  eq_25 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
-  u0_leaf_take <= leaf_take and eq_25;
-  eq_26 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_26;
+  leaf_take <= leaf_can_take and or_25;
+  eq_26 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
+  u0_leaf_take <= leaf_take and eq_26;
+  eq_27 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_27;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
       u_traverse_0_leaf_slot when "0",
       u_traverse_1_leaf_slot when "1",
       u_traverse_0_leaf_slot when others;
-  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_28 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_28 <= leaf_take or and_28;
-  mux_leaf_take <= cat_27 when leaf_take = "1" else leaf_slot;
+  and_29 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_29 <= leaf_take or and_29;
+  mux_leaf_take <= cat_28 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
       u_traverse_0_leaf_first when "0",
@@ -1030,10 +1069,10 @@ begin
       u_traverse_0_leaf_count when "0",
       u_traverse_1_leaf_count when "1",
       u_traverse_0_leaf_count when others;
-  eq_29 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  eq_30 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_29 when leaf_take = "1" else leaf_left_eq_k_2;
-  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  mux_leaf_take_5 <= eq_30 when leaf_take = "1" else leaf_left_eq_k_2;
+  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -1073,14 +1112,14 @@ begin
   u0_done_avail <= u_traverse_0_done_valid and not_u0_done_took;
   not_u1_done_took <= not u1_done_took;
   u1_done_avail <= u_traverse_1_done_valid and not_u1_done_took;
-  cat_34 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  cat_35 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_34 when u0_done_avail = "1" else cat_36;
-  or_37 <= u0_done_avail or u1_done_avail;
-  lt_38 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
-  mux_lt_38 <= u_traverse_1_depth when lt_38 = "1" else u_traverse_0_depth;
+  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_35 when u0_done_avail = "1" else cat_37;
+  or_38 <= u0_done_avail or u1_done_avail;
+  lt_39 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
+  mux_lt_39 <= u_traverse_1_depth when lt_39 = "1" else u_traverse_0_depth;
   rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
   rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
   visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -1094,21 +1133,21 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if accept = "1" then
-        ray_o(to_integer(accept_slot_int)) <= cat_18;
+      if accept_int = "1" then
+        ray_o(to_integer(accept_slot_int)) <= cat_19;
       end if;
-      if accept = "1" then
-        ray_w(to_integer(accept_slot_int)) <= cat_19;
+      if accept_int = "1" then
+        ray_w(to_integer(accept_slot_int)) <= cat_20;
       end if;
       if rst = '1' then
         turn <= unsigned'("0");
       else
-        turn <= mux_accept_or_not_case_turn;
+        turn <= mux_take_or_not_case_turn;
       end if;
       if rst = '1' then
         box_phase <= unsigned'("00");
       else
-        box_phase <= mux_or_2;
+        box_phase <= mux_or_3;
       end if;
       if rst = '1' then
         u0_has_free_r <= unsigned'("1");
@@ -1130,26 +1169,73 @@ begin
       else
         u1_free_slot_r <= u1_free_slot;
       end if;
-      if accept = "1" then
-        box_ox <= ox;
+      if rst = '1' then
+        in_valid <= unsigned'("0");
+      else
+        in_valid <= or_1;
       end if;
-      if accept = "1" then
-        box_oy <= oy;
+      if port_ready = "1" then
+        in_ray_id <= ray_id;
       end if;
-      if accept = "1" then
-        box_oz <= oz;
+      if port_ready = "1" then
+        in_ox <= ox;
       end if;
-      if accept = "1" then
-        box_invx <= invx;
+      if port_ready = "1" then
+        in_oy <= oy;
       end if;
-      if accept = "1" then
-        box_invy <= invy;
+      if port_ready = "1" then
+        in_oz <= oz;
       end if;
-      if accept = "1" then
-        box_invz <= invz;
+      if port_ready = "1" then
+        in_wx <= wx;
       end if;
-      if accept = "1" then
-        box_slot <= accept_slot_int;
+      if port_ready = "1" then
+        in_wy <= wy;
+      end if;
+      if port_ready = "1" then
+        in_wz <= wz;
+      end if;
+      if port_ready = "1" then
+        in_invx <= invx;
+      end if;
+      if port_ready = "1" then
+        in_invy <= invy;
+      end if;
+      if port_ready = "1" then
+        in_invz <= invz;
+      end if;
+      if box_idle = "1" then
+        box_in_ox <= in_ox;
+      end if;
+      if box_idle = "1" then
+        box_in_oy <= in_oy;
+      end if;
+      if box_idle = "1" then
+        box_in_oz <= in_oz;
+      end if;
+      if box_idle = "1" then
+        box_in_invx <= in_invx;
+      end if;
+      if box_idle = "1" then
+        box_in_invy <= in_invy;
+      end if;
+      if box_idle = "1" then
+        box_in_invz <= in_invz;
+      end if;
+      accept_int <= take;
+      accept_slot_int <= take_slot;
+      acc_in_ray_id <= in_ray_id;
+      acc_in_ox <= in_ox;
+      acc_in_oy <= in_oy;
+      acc_in_oz <= in_oz;
+      acc_in_wx <= in_wx;
+      acc_in_wy <= in_wy;
+      acc_in_wz <= in_wz;
+      acc_in_invx <= in_invx;
+      acc_in_invy <= in_invy;
+      acc_in_invz <= in_invz;
+      if take = "1" then
+        box_slot <= take_slot;
       end if;
       pu_sel_valid <= box_issue;
       pu_sel_last <= box_issue_last;
@@ -1189,7 +1275,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_28;
+        leaf_active <= leaf_take_or_and_29;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -1206,7 +1292,7 @@ begin
       u0_leaf_took <= u0_leaf_pop;
       u1_leaf_took <= u1_leaf_pop;
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_30;
+      emit_tag_sr(1) <= cat_31;
       emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
       emit_valid_sr(1) <= leaf_active;
       pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
@@ -1221,7 +1307,7 @@ begin
       pipe_w_sr(1) <= ray_w_q;
       u0_done_took <= u0_done_pop;
       u1_done_took <= u1_done_pop;
-      done_valid_r <= or_37;
+      done_valid_r <= or_38;
       done_slot_r <= mux_u0_done_avail;
     end if;
   end process regs;
@@ -1239,13 +1325,13 @@ begin
       clk => clk,
       rst => rst,
       ray_we => u0_alloc,
-      ray_slot => case_turn_1,
-      ox => ox,
-      oy => oy,
-      oz => oz,
-      invx => invx,
-      invy => invy,
-      invz => invz,
+      ray_slot => bits_accept_slot,
+      ox => acc_in_ox,
+      oy => acc_in_oy,
+      oz => acc_in_oz,
+      invx => acc_in_invx,
+      invy => acc_in_invy,
+      invz => acc_in_invz,
       new_valid => u0_new,
       new_slot => bits_box_done_slot_1,
       new_tmax => box_tmax,
@@ -1285,13 +1371,13 @@ begin
       clk => clk,
       rst => rst,
       ray_we => u1_alloc,
-      ray_slot => case_turn_1,
-      ox => ox,
-      oy => oy,
-      oz => oz,
-      invx => invx,
-      invy => invy,
-      invz => invz,
+      ray_slot => bits_accept_slot,
+      ox => acc_in_ox,
+      oy => acc_in_oy,
+      oz => acc_in_oz,
+      invx => acc_in_invx,
+      invy => acc_in_invy,
+      invz => acc_in_invz,
       new_valid => u1_new,
       new_slot => bits_box_done_slot_3,
       new_tmax => box_tmax,
@@ -1402,9 +1488,9 @@ begin
       t => u_intersect_t_1,
       u => u_intersect_u,
       v => u_intersect_v,
-      id_we => accept,
+      id_we => accept_int,
       id_slot => accept_slot_int,
-      id => ray_id,
+      id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,
       merge_valid => u_closest_merge_valid,
@@ -1423,7 +1509,7 @@ begin
       res_v => u_closest_res_v
     );
 
-  ray_ready <= ready_c;
+  ray_ready <= port_ready;
   res_valid <= u_closest_res_valid;
   res_id <= u_closest_res_id;
   res_hit <= u_closest_res_hit;
@@ -1432,10 +1518,12 @@ begin
   res_u <= u_closest_res_u;
   res_v <= u_closest_res_v;
   busy <= pipe_valid;
-  stack_depth <= mux_lt_38;
+  stack_depth <= mux_lt_39;
   visits <= visits_c;
   culls <= culls_c;
   occupied <= occupied_c;
+  accept <= accept_int;
+  accept_id <= acc_in_ray_id;
   accept_slot <= accept_slot_int;
   visit0 <= u_traverse_0_visit;
   visit0_slot <= u_traverse_0_visit_slot;

@@ -215,27 +215,49 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let free_idx: Vec<S> = free_idx_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_free_slot_r"), x, 0)).collect();
     let turn_free = if units == 1 { has_free[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, has_free[u as usize])).collect::<Vec<_>>(), b.konst(bit, 0)) };
     let turn_slot = if units == 1 { free_idx[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, free_idx[u as usize])).collect::<Vec<_>>(), free_idx[0]) };
-    let ready = (phase.eq(0) & turn_free).name("ready_c");
-    let accept = (ray_valid & ready).name("accept");
-    let gslot = if ub == 0 { turn_slot } else { b.cat(&[turn.resize(ub), turn_slot]) }.name("accept_slot");
+    // The ray port's register: a ray waits in it for the box-exit unit and a slot. The port is
+    // ready when the register is empty or its ray is taken this clock (no path from ray_valid
+    // to ray_ready); the register loads whenever the port is ready.
+    let in_valid = b.reg("in_valid", bit, Some(0));
+    let take = (in_valid & phase.eq(0) & turn_free).name("take");
+    let port_ready = (!in_valid | take).name("port_ready");
+    b.next(in_valid, ray_valid | (in_valid & !take));
+    let hold = |s: S| {
+        let r = b.reg(&format!("in_{}", b.name_of(s.sig)), s.ty(), None);
+        b.next_when(r, port_ready, s);
+        r
+    };
+    let [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = [ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(hold);
+    let take_slot = if ub == 0 { turn_slot } else { b.cat(&[turn.resize(ub), turn_slot]) }.name("take_slot");
     let next_turn = (turn + 1).name("turn_plus_1");
     let next_turn = if units.is_power_of_two() { next_turn } else { next_turn.eq(units as i128).select(turn.k(0), next_turn) };
-    b.next(turn, (accept | !turn_free).select(next_turn, turn));
-    b.next(phase, (accept | phase.ne(0)).select(phase + 1, phase));
+    b.next(turn, (take | !turn_free).select(next_turn, turn));
+    b.next(phase, (take | phase.ne(0)).select(phase + 1, phase));
+    // The box-exit unit's operands load whenever it is idle: when a ray is taken they hold it.
+    let idle = phase.eq(0).name("box_idle");
+    let box_reg = |s: S| {
+        let r = b.reg(&format!("box_{}", b.name_of(s.sig)), s.ty(), None);
+        b.next_when(r, idle, s);
+        r
+    };
+    let bo = [ox, oy, oz].map(box_reg);
+    let binv = [ix, iy, iz].map(box_reg);
+    // The taken ray is written into the slot's RAMs a clock later, from registers of its own:
+    // `accept` drives the write enables of every ray RAM and the units' free bits, far across
+    // the die, so it leaves a register rather than the take decision's logic. The slot still
+    // reads as taken at the next take (4 clocks later at the earliest): the unit sees `alloc` a
+    // clock after the take and masks its free output the clock after (`just_alloc`), which the
+    // top's copies show 3 clocks after the take; a clock after that they show the new lowest
+    // free slot. (One clock more would still be safe, two would give a slot twice: the
+    // visit-order test fails then.)
+    let accept = b.delay("accept", take);
+    let gslot = b.delay("accept_slot", take_slot);
+    let [ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] =
+        [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(|s| b.delay(&format!("acc_{}", b.name_of(s.sig)), s));
+    let turn_slot = gslot.slice(0, sb);
 
-    // Box exit: the three exit distances of the scene box, one per clock, then their least.
-    let bo = [ox, oy, oz].map(|s| {
-        let r = b.reg(&format!("box_{}", b.name_of(s.sig)), s.ty(), None);
-        b.next_when(r, accept, s);
-        r
-    });
-    let binv = [ix, iy, iz].map(|s| {
-        let r = b.reg(&format!("box_{}", b.name_of(s.sig)), s.ty(), None);
-        b.next_when(r, accept, s);
-        r
-    });
     let box_slot = b.reg("box_slot", Ty::u(gb), None);
-    b.next_when(box_slot, accept, gslot);
+    b.next_when(box_slot, take, take_slot);
     let axis = (phase - 1).name("box_axis");
     let hi = [0, 1, 2].map(|k| b.konst_named(&format!("box_hi_{k}"), Ty::u(n), p.trav.box_hi[k] as i128));
     let neg = b.pick(axis, binv).msb().name("box_neg");
@@ -440,7 +462,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     b.drive(free_valid, res.get("free_valid"));
     b.drive(free_slot, res.get("free_slot"));
 
-    b.output("ray_ready", ready);
+    b.output("ray_ready", port_ready);
     for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"] {
         b.output(name, res.get(name));
     }
@@ -455,8 +477,10 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     b.output("visits", sum("visit", 3).name("visits_c"));
     b.output("culls", sum("cull", 3).name("culls_c"));
     b.output("occupied", sum("occupied", gb + 1).name("occupied_c"));
-    // The walk of every slot (for the visit-order check): the slot a ray was accepted into, and
-    // each unit's node visits.
+    // The walk of every slot (for the visit-order check): the ray written into a slot, and each
+    // unit's node visits.
+    b.output("accept", accept);
+    b.output("accept_id", ray_id);
     b.output("accept_slot", gslot);
     for (u, t) in trav.iter().enumerate() {
         b.output(&format!("visit{u}"), t.get("visit"));

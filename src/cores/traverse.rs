@@ -493,8 +493,8 @@ mod tests {
                 m.handle(id.or_else(|| m.inputs.iter().copied().find(|&i| m.sig(i).name == name)).unwrap())
             };
             let ins: Vec<_> = core_inputs(&p).iter().map(|(n, _)| port(n)).collect();
-            let (ready, slot_out, res_valid, res_id) =
-                (port("ray_ready"), port("accept_slot"), port("res_valid"), port("res_id"));
+            let (ready, res_valid, res_id) = (port("ray_ready"), port("res_valid"), port("res_id"));
+            let (accept, accept_id, slot_out) = (port("accept"), port("accept_id"), port("accept_slot"));
             let visit: Vec<_> = (0..units)
                 .map(|u| (port(&format!("visit{u}")), port(&format!("visit{u}_slot")), port(&format!("visit{u}_node"))))
                 .collect();
@@ -510,8 +510,10 @@ mod tests {
                 }
                 sim.eval();
                 if values.is_some() && sim.get(ready) == 1 {
-                    in_slot[sim.get(slot_out) as usize] = next;
                     next += 1;
+                }
+                if sim.get(accept) == 1 {
+                    in_slot[sim.get(slot_out) as usize] = sim.get(accept_id) as usize;
                 }
                 sim.tick();
                 for (u, &(v, s, node)) in visit.iter().enumerate() {
