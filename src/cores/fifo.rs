@@ -31,8 +31,13 @@ pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>,
     let count = b.reg(&format!("{name}_count"), Ty::u(ab + 1), Some(0));
     b.ram_write(mem, push, wr, din);
     b.next(wr, push.select(wr + 1, wr));
-    let rd_next = pop.select(rd + 1, rd).name(&format!("{name}_rd_next"));
+    // rd + 1 is kept in a register of its own, so the RAM's read address is a select between
+    // two registers rather than a carry chain: the address fans out to every LUT-RAM cell of a
+    // wide queue, spread over tens of columns.
+    let rd1 = b.reg(&format!("{name}_rd1"), Ty::u(ab), Some(1));
+    let rd_next = pop.select(rd1, rd).name(&format!("{name}_rd_next"));
     b.next(rd, rd_next);
+    b.next(rd1, pop.select(rd1 + 1, rd1));
     let after_pop = (count - pop.resize(ab + 1)).name(&format!("{name}_after_pop"));
     let count_next = (after_pop + push.resize(ab + 1)).name(&format!("{name}_count_next"));
     b.next(count, count_next);
