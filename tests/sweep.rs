@@ -43,6 +43,9 @@ fn bad_lists_exit_2_with_one_line_before_anything_runs() {
         (vec!["--m", ""], "--m: '' has an empty item"),
         (vec!["--t", "0..70:8"], "--t: 70 (in '0..70:8') is out of range"),
         (vec!["--edge-shift", "auto,x"], "--edge-shift: 'x'"),
+        (vec!["--slots", "2,65"], "--slots: 65 (in '65') is out of range: must be 1..=64"),
+        (vec!["--units", "1..5"], "--units: 5 (in '1..5') is out of range: must be 1..=4"),
+        (vec!["--leaf-size", "0,4"], "--leaf-size: 0 (in '0') is out of range: must be 1..=64"),
         (vec!["--m", "12", "--t", "24"], "sweep: no valid parameter set"),
         (vec!["--builtin", "nosuch"], "--builtin: unknown scene 'nosuch'"),
         (vec![bad_obj.to_str().unwrap()], "bad.obj"),
@@ -264,4 +267,62 @@ fn core_simulation_in_a_sweep_agrees_with_the_golden_model() {
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("The whole core ran 8 configurations' frames in the Rust simulator: 0 rays disagreed"));
+}
+
+/// `--slots` and `--units` as axes with `--core-sim`: a row per core shape carrying the
+/// simulated core's rays per clock, triangle tests and node steps per ray and slot occupancy,
+/// and throughput against area plotted and linked in the report (a few seconds).
+#[test]
+fn core_shapes_are_swept_and_throughput_is_plotted_against_area() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("shapes");
+    let args = ["sweep", "--builtin", "thin", "--size", "8x8", "--n", "10", "--m", "12", "--slots", "2,8"];
+    let args = [&args[..], &["--units", "1,2", "--core-sim", "--out", out.to_str().unwrap()]].concat();
+    let o = fxrt(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let rows = rows(&out);
+    let shapes: Vec<(&str, &str)> = rows.iter().map(|r| (r["slots"].as_str(), r["units"].as_str())).collect();
+    assert_eq!(shapes, [("2", "1"), ("2", "2"), ("8", "1"), ("8", "2")]);
+    let num = |r: &BTreeMap<String, String>, k: &str| -> f64 {
+        r[k].parse().unwrap_or_else(|_| panic!("{k} = '{}' is not a number", r[k]))
+    };
+    for r in &rows {
+        assert_eq!(r["core_mismatches"], "0", "{r:?}");
+        let (rpc, cpr) = (num(r, "rays_per_clock"), num(r, "cycles_per_ray"));
+        assert!((rpc * cpr - 1.0).abs() < 1e-9, "rays per clock {rpc} is not 1 / {cpr}");
+        assert!(num(r, "triangle_tests_per_ray") > 0.0 && num(r, "node_steps_per_ray") > 0.0, "{r:?}");
+        let occupancy = num(r, "slot_occupancy");
+        assert!(occupancy > 0.0 && occupancy <= 1.0, "{r:?}");
+    }
+    // More slots or more units do not lower rays per clock (beyond noise).
+    for a in &rows {
+        for b in &rows {
+            if num(a, "slots") <= num(b, "slots") && num(a, "units") <= num(b, "units") {
+                assert!(num(b, "rays_per_clock") >= 0.95 * num(a, "rays_per_clock"), "{a:?} vs {b:?}");
+            }
+        }
+    }
+    // The core's shape changes the cost estimate, not the image.
+    assert!(num(&rows[1], "dsp48e_est") > num(&rows[0], "dsp48e_est") && rows[0]["image"] == rows[3]["image"]);
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(
+        (&json["spec"]["slots"], &json["spec"]["units"]),
+        (&serde_json::json!([2, 8]), &serde_json::json!([1, 2]))
+    );
+    assert_eq!(json["rows"][2]["shape"], serde_json::json!({ "slots": 8, "units": 1 }));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## Throughput against area") && report.contains("| K (ray slots per unit) | 2, 8 |"));
+    for file in ["plots/throughput_dsp48e_est.png", "plots/throughput_register_bits.png"] {
+        assert!(report.contains(&format!("({file})")), "{file} not in the report");
+        let bytes = std::fs::read(out.join(file)).unwrap();
+        let info = png::Decoder::new(std::io::Cursor::new(bytes)).read_info().unwrap().info().clone();
+        assert!(info.width >= 800 && info.height >= 400, "{file}: {}×{}", info.width, info.height);
+    }
+    // Renders do not depend on the core's shape: no grid or error plot along K or U.
+    assert!(!out.join("grids/thin_slots.png").exists() && !out.join("plots/error_units.png").exists());
+    // A rerun takes every row from the cache and writes the same files.
+    let before = tree(&out);
+    let o = fxrt(&args);
+    assert!(text(&o.stdout).starts_with("0 computed, 4 from the cache"), "{}", text(&o.stdout));
+    assert!(tree(&out) == before);
 }

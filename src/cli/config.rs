@@ -469,8 +469,7 @@ impl SweepArgs {
         if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
             return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
         }
-        let single =
-            Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, tree: self.tree, ..Params::default() };
+        let single = Params { stack_depth: self.stack_depth, tree: self.tree, ..Params::default() };
         single.validate()?;
         crate::cores::clock::ClockTarget(self.target_mhz).check()?;
         Ok(SweepSpec {
@@ -481,15 +480,15 @@ impl SweepArgs {
             t: axis::parse_u32_list("t", &self.t)?,
             c: axis::parse_u32_list("c", &self.c)?,
             edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
-            leaf_size: self.leaf_size,
+            leaf_size: axis::parse_u32_list("leaf-size", &self.leaf_size)?,
             stack_depth: self.stack_depth,
             tree: self.tree,
             one_at_a_time: self.one_at_a_time,
             synth: self.synth,
             core_sim: self.core_sim,
             target_mhz: self.target_mhz,
-            slots: self.core_shape.slots,
-            units: self.core_shape.units,
+            slots: axis::parse_u32_list("slots", &self.slots)?,
+            units: axis::parse_u32_list("units", &self.units)?,
             ecp5: self.ecp5()?,
         })
     }

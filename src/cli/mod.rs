@@ -91,9 +91,9 @@ pub struct SweepArgs {
     /// Edge shift E: 'auto' and/or values.
     #[arg(long = "edge-shift", default_value = "auto")]
     pub edge_shift: String,
-    /// Largest number of triangles in a BIH leaf (one value).
-    #[arg(long = "leaf-size", default_value_t = 4)]
-    pub leaf_size: u32,
+    /// Largest number of triangles in a BIH leaf (1..=64).
+    #[arg(long = "leaf-size", default_value = "4")]
+    pub leaf_size: String,
     /// Hardware traversal stack entries (one value).
     #[arg(long = "stack-depth", default_value_t = 32)]
     pub stack_depth: u32,
@@ -101,9 +101,12 @@ pub struct SweepArgs {
     /// one value.
     #[arg(long, default_value = "sah")]
     pub tree: TreeSplit,
-    /// The core's ray slots per traversal unit and traversal units (one value each).
-    #[command(flatten)]
-    pub core_shape: ThreadArgs,
+    /// Ray slots per traversal unit K: the rays each unit holds at once (1..=64).
+    #[arg(long, default_value_t = crate::cores::top::DEFAULT_SLOTS.to_string())]
+    pub slots: String,
+    /// Traversal units U feeding the one intersection pipeline (1..=4).
+    #[arg(long, default_value_t = crate::cores::top::DEFAULT_UNITS.to_string())]
+    pub units: String,
     /// Vary one parameter at a time around the base set (each at its default if listed,
     /// else its first value), like the thesis's figures, instead of the cross product.
     #[arg(long = "one-at-a-time")]

@@ -243,6 +243,41 @@ fn the_emitted_sweep_command_describes_the_same_sweep() {
     assert_eq!(spec(&argv), s);
 }
 
+/// `--leaf-size`, `--slots` and `--units` take lists like the other axes, are checked against
+/// their ranges before anything runs (naming the option), and the emitted command line
+/// reproduces them.
+#[test]
+fn sweep_leaf_size_slots_and_units_take_lists() {
+    let spec = |args: &[&str]| {
+        let Command::Sweep(a) = command(args) else { panic!("not a sweep") };
+        a.spec()
+    };
+    let s = spec(&["sweep", "--out", "x", "--slots", "2,8..16:8", "--units", "1..2", "--leaf-size", "4,2,4"]).unwrap();
+    assert_eq!((&s.slots[..], &s.units[..], &s.leaf_size[..]), (&[2, 8, 16][..], &[1, 2][..], &[4, 2][..]));
+    assert_eq!(s.plan().unwrap().configs.len(), 3 * 2 * 2);
+    let d = spec(&["sweep", "--out", "x"]).unwrap();
+    assert_eq!((&d.slots[..], &d.units[..], &d.leaf_size[..]), (&[64][..], &[2][..], &[4][..]));
+    for (args, message) in [
+        (&["--slots", "2,65"][..], "--slots: 65 (in '65') is out of range: must be 1..=64"),
+        (&["--slots", "0..8:4"], "--slots: 0 (in '0..8:4') is out of range: must be 1..=64"),
+        (&["--units", "5"], "--units: 5 (in '5') is out of range: must be 1..=4"),
+        (&["--units", "2,,4"], "--units: '2,,4' has an empty item"),
+        (&["--leaf-size", "0,4"], "--leaf-size: 0 (in '0') is out of range: must be 1..=64"),
+        (&["--leaf-size", "8..4"], "--leaf-size: '8..4' is reversed: write 4..8"),
+    ] {
+        let e = check(&[&["sweep", "--out", "x"][..], args].concat()).expect_err("refused");
+        assert!(e.to_string().starts_with(message), "{args:?}: {e}");
+        assert_eq!(e.subject, args[0], "{args:?}");
+    }
+    // What --emit-slurm writes for each shard describes the same sweep.
+    let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    let line = argv.join(" ");
+    assert!(line.contains("--leaf-size 4,2") && line.contains("--slots 2,8,16 --units 1,2"), "{line}");
+    argv.extend(["--out".into(), "x".into()]);
+    let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
+    assert_eq!(spec(&argv).unwrap(), s);
+}
+
 #[test]
 fn each_simulator_choice_maps_once() {
     assert_eq!(Simulation::from(SimChoice::Rust), Simulation::Rust);

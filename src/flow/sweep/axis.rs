@@ -1,14 +1,19 @@
 //! The values one sweep parameter takes: `--n 20..29`, `--m 12,16,20`, `--t 0..24:8`,
-//! `--edge-shift auto,8..12:2`. Ranges are inclusive; `:STEP` sets the stride (default 1).
-//! Every value is checked against `params::RANGES` here, before anything runs.
+//! `--edge-shift auto,8..12:2`, `--slots 8..64:8`. Ranges are inclusive; `:STEP` sets the
+//! stride (default 1). Every value is checked against `params::RANGES` (the core's shape
+//! against `CORE_RANGES`) here, before anything runs.
 
 use crate::error::{Error, Result};
 use crate::params::{EdgeShift, RANGES};
 
-/// Parses a list of unsigned values and ranges for parameter `name` (as in `params::RANGES`),
-/// keeping the order given and dropping repeats.
+/// The core's shape (`CoreParams::check`'s limits): ray slots per traversal unit, traversal
+/// units.
+pub const CORE_RANGES: &[(&str, u32, u32)] = &[("slots", 1, 64), ("units", 1, 4)];
+
+/// Parses a list of unsigned values and ranges for parameter `name` (as in `params::RANGES`
+/// or `CORE_RANGES`), keeping the order given and dropping repeats.
 pub fn parse_u32_list(name: &str, text: &str) -> Result<Vec<u32>> {
-    let (_, lo, hi) = RANGES.iter().find(|r| r.0 == name).copied().expect("known parameter");
+    let (_, lo, hi) = RANGES.iter().chain(CORE_RANGES).find(|r| r.0 == name).copied().expect("known parameter");
     let err = |msg: String| Error::param(name, msg);
     let mut out: Vec<u32> = Vec::new();
     for item in text.split(',').map(str::trim) {

@@ -2,10 +2,10 @@
 //! and the hardware cost (estimated, or from yosys with `--synth`).
 
 use super::pnr::{PlacedModule, Pnr};
-use super::{CameraSpec, Config, SceneSpec, SweepSpec, params_label};
+use super::{CameraSpec, Config, CoreShape, SceneSpec, Set, SweepSpec, params_label};
 use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
-use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module};
+use crate::cores::top::{CoreParams, core_module};
 use crate::error::{Error, Result};
 use crate::flow::feed::Stalls;
 use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
@@ -24,8 +24,14 @@ use std::sync::OnceLock;
 /// a different surface, not a neighbour sharing the edge the ray passes through.
 pub const OTHER_SURFACE_REL: f64 = 1e-3;
 
-/// Bump when a row's meaning changes: old cache entries then no longer match.
-pub const ROW_FORMAT: u32 = 1;
+/// Bump when a row's meaning changes: old cache entries then no longer match. 2: rows of
+/// `--core-sim` carry rays per clock, triangle tests and node steps per ray and the slot
+/// occupancy, and rows their core's shape.
+pub const ROW_FORMAT: u32 = 2;
+
+/// The format of rows without `--core-sim`, whose keys it enters: they are what they were in
+/// format 1 (the shape is absent at the default), so their keys and caches stay.
+pub const PLAIN_ROW_FORMAT: u32 = 1;
 
 /// A scene loaded once for the whole sweep, with the frames every configuration is compared to.
 pub struct SceneCtx {
@@ -34,15 +40,29 @@ pub struct SceneCtx {
     pub fingerprint: String,
     pub world: Vec<Tri>,
     pub camera: Camera,
-    /// The scene at the default parameters (with the sweep's leaf size and stack depth).
+    /// The scene at the default parameters (with the sweep's stack depth and tree), one per
+    /// leaf size of the sweep, the base leaf size first.
+    leaves: Vec<LeafCtx>,
+}
+
+/// The scene at the default parameters with one leaf size, and its frames: a row is compared
+/// with the frames of its own leaf size, so what it says depends on its key alone.
+struct LeafCtx {
     defaults: Scene,
     reference: OnceLock<Frame>,
     default_ids: OnceLock<Vec<i32>>,
 }
 
 impl SceneCtx {
-    /// Loads and checks the scene; errors name the file and the problem.
-    pub fn load(spec: &SceneSpec, label: String, cam: &CameraSpec, defaults: &Params) -> Result<SceneCtx> {
+    /// Loads and checks the scene, built at `defaults` and at each other of `leaf_sizes`;
+    /// errors name the file and the problem.
+    pub fn load(
+        spec: &SceneSpec,
+        label: String,
+        cam: &CameraSpec,
+        defaults: &Params,
+        leaf_sizes: &[u32],
+    ) -> Result<SceneCtx> {
         let (name, world, fingerprint) = match spec {
             SceneSpec::Builtin(b) => {
                 let world = builtin::load(b)?;
@@ -53,44 +73,51 @@ impl SceneCtx {
                 (p.display().to_string(), obj::load_obj(p)?, format!("obj:{:x}", Sha256::digest(&bytes)))
             }
         };
-        let defaults = Scene::build(&name, world.clone(), defaults)?;
-        let camera = cam.camera(&defaults)?;
-        Ok(SceneCtx {
-            label,
-            fingerprint,
-            world,
-            camera,
-            defaults,
-            reference: OnceLock::new(),
-            default_ids: OnceLock::new(),
+        let mut leaves = Vec::new();
+        let others = leaf_sizes.iter().filter(|&&l| l != defaults.leaf_size);
+        for leaf_size in std::iter::once(defaults.leaf_size).chain(others.copied()) {
+            let p = Params { leaf_size, ..*defaults };
+            let defaults = Scene::build(&name, world.clone(), &p)?;
+            leaves.push(LeafCtx { defaults, reference: OnceLock::new(), default_ids: OnceLock::new() });
+        }
+        // The camera frames the scene's box, which the leaf size does not change.
+        let camera = cam.camera(&leaves[0].defaults)?;
+        Ok(SceneCtx { label, fingerprint, world, camera, leaves })
+    }
+
+    /// The default scene with `leaf_size` (the base leaf size's if the sweep has no such).
+    fn leaf(&self, leaf_size: u32) -> &LeafCtx {
+        self.leaves.iter().find(|l| l.defaults.params.leaf_size == leaf_size).unwrap_or(&self.leaves[0])
+    }
+
+    /// The f64 reference frame (independent of n, m, T, C and E) on the tree of `leaf_size`.
+    pub fn reference(&self, leaf_size: u32) -> &Frame {
+        let l = self.leaf(leaf_size);
+        l.reference.get_or_init(|| {
+            let tracer = make_tracer(&l.defaults, ModelKind::F64);
+            render(&l.defaults, tracer.as_ref(), &self.camera, false, false)
         })
     }
 
-    /// The f64 reference frame (independent of the swept parameters).
-    pub fn reference(&self) -> &Frame {
-        self.reference.get_or_init(|| {
-            let tracer = make_tracer(&self.defaults, ModelKind::F64);
-            render(&self.defaults, tracer.as_ref(), &self.camera, false, false)
+    /// The golden model's triangle ids at the default parameters with `leaf_size`.
+    pub fn default_ids(&self, leaf_size: u32) -> &[i32] {
+        let l = self.leaf(leaf_size);
+        l.default_ids.get_or_init(|| {
+            let tracer = make_tracer(&l.defaults, ModelKind::Golden);
+            render(&l.defaults, tracer.as_ref(), &self.camera, false, false).ids
         })
     }
 
-    /// The golden model's triangle ids at the default parameters.
-    pub fn default_ids(&self) -> &[i32] {
-        self.default_ids.get_or_init(|| {
-            let tracer = make_tracer(&self.defaults, ModelKind::Golden);
-            render(&self.defaults, tracer.as_ref(), &self.camera, false, false).ids
-        })
-    }
-
-    /// The cache key of `params` on this scene: everything the row depends on. The clock
-    /// target enters it when it is not the default, the ECP5 modules and seed with
-    /// `--family ecp5`: keys of sweeps without them are what they always were.
-    pub fn key(&self, params: &Params, spec: &SweepSpec) -> String {
+    /// The cache key of `params` with a core of `shape` on this scene: everything the row
+    /// depends on. The clock target enters it when it is not the default, the core's shape
+    /// when it is not the default, the ECP5 modules and seed with `--family ecp5`: keys of
+    /// sweeps without them are what they always were.
+    pub fn key(&self, params: &Params, shape: CoreShape, spec: &SweepSpec) -> String {
         let (synth, core_sim) = (spec.synth, spec.core_sim);
         let c = &self.camera;
         let mut text = serde_json::json!({
             "fxrt": env!("CARGO_PKG_VERSION"),
-            "row_format": ROW_FORMAT,
+            "row_format": if core_sim { ROW_FORMAT } else { PLAIN_ROW_FORMAT },
             "scene": self.fingerprint,
             "camera": [c.eye, c.at, c.up, [c.fov_deg, c.width as f64, c.height as f64]],
             "params": params,
@@ -100,9 +127,9 @@ impl SceneCtx {
         if spec.target_mhz != DEFAULT_TARGET_MHZ {
             text["target_mhz"] = spec.target_mhz.into();
         }
-        if !spec.default_core_shape() {
-            text["slots"] = spec.slots.into();
-            text["units"] = spec.units.into();
+        if !shape.is_default() {
+            text["slots"] = shape.slots.into();
+            text["units"] = shape.units.into();
         }
         if let (true, Some(e)) = (synth, &spec.ecp5) {
             text["family"] = "ecp5".into();
@@ -150,8 +177,16 @@ pub struct SynthArea {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CoreRun {
     pub cycles_per_ray: f64,
+    /// Rays per clock: 1 / `cycles_per_ray` (`fxrt sim`'s `rays_per_clock`).
+    pub rays_per_clock: f64,
     /// Cycles in which a triangle entered the pipeline, per cycle.
     pub fill: f64,
+    /// Triangles that entered the intersection pipeline, per ray.
+    pub triangle_tests_per_ray: f64,
+    /// Node visits and culled node entries of the traversal units, per ray.
+    pub node_steps_per_ray: f64,
+    /// The mean fraction of the core's ray slots holding a ray.
+    pub slot_occupancy: f64,
     pub max_stack_depth: u64,
     /// Rays whose result differs from the golden model's (must be 0).
     pub mismatches: u64,
@@ -164,6 +199,9 @@ pub struct Row {
     pub key: String,
     pub scene: String,
     pub params: Params,
+    /// The core's ray slots and units (absent at the default, as in rows before it was swept).
+    #[serde(default, skip_serializing_if = "CoreShape::is_default")]
+    pub shape: CoreShape,
     /// The edge shift used (`auto` resolved).
     pub e_used: Option<u32>,
     pub quality: Option<Quality>,
@@ -182,6 +220,10 @@ pub struct Row {
 }
 
 impl Row {
+    /// The row's parameters and core shape.
+    pub fn set(&self) -> Set {
+        Set { params: self.params, shape: self.shape }
+    }
     /// The image files of this row, relative to the sweep folder.
     pub fn image_paths(&self) -> (String, String) {
         let base = format!("images/{}/{}", self.scene, params_label(&self.params));
@@ -209,9 +251,6 @@ pub struct Extras {
     pub core_sim: bool,
     /// The clock the cores are built for, MHz.
     pub target_mhz: u32,
-    /// Ray slots per traversal unit, traversal units.
-    pub slots: u32,
-    pub units: u32,
     /// Place and route on the ECP5 (`--family ecp5`), in DIR/KEY/MODULE.
     pub pnr: Option<Pnr>,
 }
@@ -222,6 +261,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         key,
         scene: ctx.label.clone(),
         params: cfg.params,
+        shape: cfg.shape,
         e_used: None,
         quality: None,
         cost: None,
@@ -241,28 +281,32 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     row.e_used = Some(scene.edge_shift);
     let tracer = make_tracer(&scene, ModelKind::Golden);
     let frame = render(&scene, tracer.as_ref(), &ctx.camera, false, false);
-    let reference = ctx.reference();
-    let mut q = quality(&frame, reference, ctx.default_ids());
+    let reference = ctx.reference(cfg.params.leaf_size);
+    let mut q = quality(&frame, reference, ctx.default_ids(cfg.params.leaf_size));
     q.triangles = scene.counts;
     row.quality = Some(q);
     let roms = SceneRoms::of(&scene);
-    let default_shape = (extras.slots, extras.units) == (DEFAULT_SLOTS, DEFAULT_UNITS);
     match core_cost(&roms) {
-        Ok(c) if extras.target_mhz != DEFAULT_TARGET_MHZ || !default_shape => {
-            row.cost = Some(cost_at(c, &roms, extras))
+        Ok(c) if extras.target_mhz != DEFAULT_TARGET_MHZ || !cfg.shape.is_default() => {
+            row.cost = Some(cost_at(c, &roms, extras.target_mhz, cfg.shape))
         }
         Ok(c) => row.cost = Some(c),
         Err(e) => row.error = Some(e.to_string()),
     }
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
-    let core_params = CoreParams::with_slots(&roms, id_width, 1, extras.target_mhz, extras.slots, extras.units);
+    let (slots, units) = (cfg.shape.slots, cfg.shape.units);
+    let core_params = CoreParams::with_slots(&roms, id_width, 1, extras.target_mhz, slots, units);
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
         let (results, stats) = simulate_rust(&core_params, &roms, &rays, &Stalls::none(), &|_| {});
         let run = CoreRun {
             cycles_per_ray: stats.cycles_per_ray(),
+            rays_per_clock: stats.rays_per_clock(),
             fill: stats.fill(),
+            triangle_tests_per_ray: stats.triangle_tests_per_ray(),
+            node_steps_per_ray: stats.node_steps_per_ray(),
+            slot_occupancy: stats.slot_occupancy(),
             max_stack_depth: stats.max_stack_depth as u64,
             mismatches: mismatches(&scene, &rays, &results),
         };
@@ -297,8 +341,8 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
 /// `cost` (`core_cost`'s, for the default core) with what the clock target and the core's
 /// shape change: the divider's and the intersection pipeline's latencies, the registers and
 /// the multipliers' pieces. The ROMs do not depend on them.
-fn cost_at(cost: CoreCost, roms: &SceneRoms, extras: &Extras) -> CoreCost {
-    let p = CoreParams::with_slots(roms, 20, 1, extras.target_mhz, extras.slots, extras.units);
+fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32, shape: CoreShape) -> CoreCost {
+    let p = CoreParams::with_slots(roms, 20, 1, target_mhz, shape.slots, shape.units);
     let core = core_module(&p, roms);
     CoreCost {
         div_latency: p.isect.div_latency(),

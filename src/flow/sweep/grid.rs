@@ -26,17 +26,18 @@ pub fn series<'a>(results: &'a Results, plan: &Plan, scene: &str, axis: Axis) ->
     let mut rows: Vec<&Row> = results
         .rows
         .iter()
-        .filter(|r| r.scene == scene && others.iter().all(|a| a.value(&r.params) == a.value(&plan.base)))
+        .filter(|r| r.scene == scene && others.iter().all(|a| a.value(&r.set()) == a.value(&plan.base)))
         .collect();
-    rows.sort_by_key(|r| values.iter().position(|v| *v == axis.value(&r.params)));
+    rows.sort_by_key(|r| values.iter().position(|v| *v == axis.value(&r.set())));
     rows
 }
 
-/// Writes grids/SCENE_PARAM.png for every scene and swept parameter; returns their paths.
+/// Writes grids/SCENE_PARAM.png for every scene and swept parameter that can change the image
+/// (not the core's shape); returns their paths.
 pub fn write_grids(dir: &Path, cache: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
     let mut written = Vec::new();
     for scene in super::run::scene_labels(&results.spec.scenes) {
-        for axis in results.spec.swept_axes() {
+        for axis in results.spec.swept_axes().into_iter().filter(|a| a.changes_image()) {
             let rows = series(results, plan, &scene, axis);
             if rows.len() < 2 {
                 continue;
@@ -136,7 +137,7 @@ fn grid_png(cache: &Path, scene: &str, axis: Axis, rows: &[&Row]) -> Result<Vec<
         for (i, r) in rows.iter().enumerate() {
             let (x0, y0) = (GAP + (i % COLUMNS) as u32 * cell_w, TITLE_H + (i / COLUMNS) as u32 * cell_h);
             let y = y0 + 2 * th + GAP;
-            draw(format!("{} = {}", axis.symbol(), axis.value(&r.params)), x0, y, 15)?;
+            draw(format!("{} = {}", axis.symbol(), axis.value(&r.set())), x0, y, 15)?;
             let detail = match &r.quality {
                 Some(q) => format!("{} wrong px, {} differ", q.wrong_pixels, q.diff_vs_default),
                 None => "failed".to_string(),

@@ -1,5 +1,6 @@
-//! `fxrt sweep`: image error and hardware cost over lists of n, m, T, C and E, for one or more
-//! scenes (seed 001 figures 2.7–2.9, seed 003's edge shift).
+//! `fxrt sweep`: image error, hardware cost and throughput over lists of n, m, T, C, E, the
+//! BIH's leaf size and the core's ray slots K and traversal units U, for one or more scenes
+//! (seed 001 figures 2.7–2.9, seed 003's edge shift).
 //!
 //! A sweep is a `SweepSpec` (what the user asked for, independent of where it runs), expanded
 //! into a `Plan` (configurations numbered 0..N, and the parameter sets that are invalid
@@ -8,6 +9,7 @@
 //! function of (spec, rows) alone, so a merged sweep is byte-identical to an unsharded one.
 
 pub mod axis;
+pub mod compat;
 pub mod eval;
 pub mod grid;
 pub mod output;
@@ -17,11 +19,14 @@ pub mod report;
 pub mod run;
 pub mod slurm;
 pub mod summary;
+pub mod throughput;
 
+use crate::cores::top::{DEFAULT_SLOTS, DEFAULT_UNITS};
 use crate::error::{Error, Result};
 pub use crate::model::camera::CameraSpec;
 use crate::params::{EdgeShift, Params, TreeSplit};
 use crate::scene::SceneSource;
+use compat::{default_slots, default_units, is_default_slots, is_default_units, one_or_many};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -51,7 +56,10 @@ pub struct SweepSpec {
     pub t: Vec<u32>,
     pub c: Vec<u32>,
     pub edge_shift: Vec<EdgeShift>,
-    pub leaf_size: u32,
+    /// Largest triangles per BIH leaf (`--leaf-size`; one value is written as a number, as
+    /// before it became a list, and a number reads back as a list of one).
+    #[serde(with = "one_or_many")]
+    pub leaf_size: Vec<u32>,
     pub stack_depth: u32,
     /// The BIH's split (`--tree`; absent from results.json when `middle`, so older sweeps,
     /// all middle-split, read back the same).
@@ -67,12 +75,13 @@ pub struct SweepSpec {
     /// at the default, so older sweeps read back the same).
     #[serde(default = "default_target_mhz", skip_serializing_if = "is_default_target_mhz")]
     pub target_mhz: u32,
-    /// Ray slots per traversal unit and traversal units of every core (`--slots`, `--units`;
-    /// absent from results.json at the defaults, so older sweeps read back the same).
-    #[serde(default = "default_slots", skip_serializing_if = "is_default_slots")]
-    pub slots: u32,
-    #[serde(default = "default_units", skip_serializing_if = "is_default_units")]
-    pub units: u32,
+    /// Ray slots per traversal unit and traversal units of the cores (`--slots`, `--units`;
+    /// absent from results.json at the defaults, so older sweeps read back the same; one
+    /// value is written as a number, as before they became lists).
+    #[serde(default = "default_slots", skip_serializing_if = "is_default_slots", with = "one_or_many")]
+    pub slots: Vec<u32>,
+    #[serde(default = "default_units", skip_serializing_if = "is_default_units", with = "one_or_many")]
+    pub units: Vec<u32>,
     /// `--synth --family ecp5`: place and route on the LFE5U-85F instead of Virtex-5 area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ecp5: Option<Ecp5Choice>,
@@ -86,24 +95,8 @@ fn is_default_target_mhz(mhz: &u32) -> bool {
     *mhz == default_target_mhz()
 }
 
-fn default_slots() -> u32 {
-    crate::cores::top::DEFAULT_SLOTS
-}
-
-fn is_default_slots(k: &u32) -> bool {
-    *k == default_slots()
-}
-
-fn default_units() -> u32 {
-    crate::cores::top::DEFAULT_UNITS
-}
-
-fn is_default_units(u: &u32) -> bool {
-    *u == default_units()
-}
-
 impl SweepSpec {
-    /// Whether the cores have the default ray slots and units.
+    /// Whether every core has the default ray slots and units (`--slots`, `--units` not given).
     pub fn default_core_shape(&self) -> bool {
         is_default_slots(&self.slots) && is_default_units(&self.units)
     }
@@ -117,7 +110,8 @@ pub struct Ecp5Choice {
     pub seed: u64,
 }
 
-/// The swept parameters, in the order configurations vary them (last fastest).
+/// The swept parameters, in the order configurations vary them (last fastest): the
+/// arithmetic's, the BIH's leaf size, and the core's shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Axis {
@@ -126,10 +120,17 @@ pub enum Axis {
     EdgeShift,
     T,
     C,
+    LeafSize,
+    Slots,
+    Units,
 }
 
 impl Axis {
-    pub const ALL: [Axis; 5] = [Axis::N, Axis::M, Axis::EdgeShift, Axis::T, Axis::C];
+    pub const ALL: [Axis; 8] =
+        [Axis::N, Axis::M, Axis::EdgeShift, Axis::T, Axis::C, Axis::LeafSize, Axis::Slots, Axis::Units];
+    /// The axes sweeps had before the leaf size and the core's shape became lists: always
+    /// named in titles and labels; the others only when swept.
+    pub const ARITHMETIC: [Axis; 5] = [Axis::N, Axis::M, Axis::EdgeShift, Axis::T, Axis::C];
     /// The option name, as on the command line.
     pub fn name(self) -> &'static str {
         match self {
@@ -138,9 +139,12 @@ impl Axis {
             Axis::EdgeShift => "edge-shift",
             Axis::T => "t",
             Axis::C => "c",
+            Axis::LeafSize => "leaf-size",
+            Axis::Slots => "slots",
+            Axis::Units => "units",
         }
     }
-    /// The symbol the thesis uses.
+    /// The symbol the thesis uses (docs/CORE.md's K and U for the core's shape).
     pub fn symbol(self) -> &'static str {
         match self {
             Axis::N => "n",
@@ -148,33 +152,80 @@ impl Axis {
             Axis::EdgeShift => "E",
             Axis::T => "T",
             Axis::C => "C",
+            Axis::LeafSize => "leaf",
+            Axis::Slots => "K",
+            Axis::Units => "U",
         }
     }
-    /// This parameter of `p`, as text (`auto` for the adaptive edge shift).
-    pub fn value(self, p: &Params) -> String {
+    /// This parameter of `s`, as text (`auto` for the adaptive edge shift).
+    pub fn value(self, s: &Set) -> String {
+        let p = &s.params;
         match self {
             Axis::N => p.n.to_string(),
             Axis::M => p.m.to_string(),
             Axis::EdgeShift => p.edge_shift.to_string(),
             Axis::T => p.t.to_string(),
             Axis::C => p.c.to_string(),
+            Axis::LeafSize => p.leaf_size.to_string(),
+            Axis::Slots => s.shape.slots.to_string(),
+            Axis::Units => s.shape.units.to_string(),
         }
+    }
+    /// Whether the golden model's image can depend on this parameter (the core's shape
+    /// changes how fast the core computes it, not what).
+    pub fn changes_image(self) -> bool {
+        !matches!(self, Axis::Slots | Axis::Units)
     }
 }
 
 /// More configurations than any sweep should hold in one plan (a shard still plans them all).
 pub const MAX_CONFIGURATIONS: usize = 1_000_000;
 
-/// One configuration: a parameter set applied to one scene.
+/// The core's shape: ray slots per traversal unit (K) and traversal units (U), docs/CORE.md.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct CoreShape {
+    pub slots: u32,
+    pub units: u32,
+}
+
+impl Default for CoreShape {
+    fn default() -> Self {
+        CoreShape { slots: DEFAULT_SLOTS, units: DEFAULT_UNITS }
+    }
+}
+
+impl CoreShape {
+    pub fn is_default(&self) -> bool {
+        *self == CoreShape::default()
+    }
+}
+
+impl std::fmt::Display for CoreShape {
+    /// `K×U`, e.g. `64×2`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}×{}", self.slots, self.units)
+    }
+}
+
+/// A point of the sweep: the model's parameters and the core's shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Set {
+    pub params: Params,
+    pub shape: CoreShape,
+}
+
+/// One configuration: a set applied to one scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Config {
     /// Position in the whole sweep (shards keep it).
     pub index: usize,
     pub scene: usize,
     pub params: Params,
+    pub shape: CoreShape,
 }
 
-/// A parameter set of the lists whose values cannot be used together.
+/// A parameter set of the lists whose values cannot be used together (the core's shape is
+/// checked when the lists are read, so it never makes a set invalid).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Skipped {
     pub params: Params,
@@ -184,8 +235,8 @@ pub struct Skipped {
 #[derive(Debug)]
 pub struct Plan {
     /// The base set: each parameter at its default if the list holds it, else the list's first.
-    pub base: Params,
-    pub sets: Vec<Params>,
+    pub base: Set,
+    pub sets: Vec<Set>,
     pub configs: Vec<Config>,
     pub skipped: Vec<Skipped>,
 }
@@ -198,81 +249,107 @@ impl SweepSpec {
 
     /// The values of `axis` as text, in the order given.
     pub fn values(&self, axis: Axis) -> Vec<String> {
+        let text = |v: &[u32]| v.iter().map(u32::to_string).collect();
         match axis {
-            Axis::N => self.n.iter().map(u32::to_string).collect(),
-            Axis::M => self.m.iter().map(u32::to_string).collect(),
+            Axis::N => text(&self.n),
+            Axis::M => text(&self.m),
             Axis::EdgeShift => self.edge_shift.iter().map(EdgeShift::to_string).collect(),
-            Axis::T => self.t.iter().map(u32::to_string).collect(),
-            Axis::C => self.c.iter().map(u32::to_string).collect(),
+            Axis::T => text(&self.t),
+            Axis::C => text(&self.c),
+            Axis::LeafSize => text(&self.leaf_size),
+            Axis::Slots => text(&self.slots),
+            Axis::Units => text(&self.units),
         }
+    }
+
+    /// How many values `axis` takes.
+    fn len(&self, axis: Axis) -> usize {
+        self.values(axis).len()
+    }
+
+    /// `s` with `axis` at its `i`-th listed value.
+    fn with(&self, mut s: Set, axis: Axis, i: usize) -> Set {
+        let p = &mut s.params;
+        match axis {
+            Axis::N => p.n = self.n[i],
+            Axis::M => p.m = self.m[i],
+            Axis::EdgeShift => p.edge_shift = self.edge_shift[i],
+            Axis::T => p.t = self.t[i],
+            Axis::C => p.c = self.c[i],
+            Axis::LeafSize => p.leaf_size = self.leaf_size[i],
+            Axis::Slots => s.shape.slots = self.slots[i],
+            Axis::Units => s.shape.units = self.units[i],
+        }
+        s
     }
 
     /// The axes that take more than one value.
     pub fn swept_axes(&self) -> Vec<Axis> {
-        Axis::ALL.into_iter().filter(|&a| self.values(a).len() > 1).collect()
+        Axis::ALL.into_iter().filter(|&a| self.len(a) > 1).collect()
     }
 
-    /// The default parameters with the sweep's single-valued ones: leaf size, stack depth
-    /// and tree.
+    /// The axes titles and labels name: n, m, E, T, C always, the others when swept.
+    pub fn named_axes(&self) -> Vec<Axis> {
+        Axis::ALL.into_iter().filter(|&a| Axis::ARITHMETIC.contains(&a) || self.len(a) > 1).collect()
+    }
+
+    /// A set as text: `n=29 m=32 E=auto T=0 C=16`, then leaf, K and U where they are swept.
+    pub fn set_text(&self, s: &Set) -> String {
+        self.named_axes().into_iter().map(|a| format!("{}={}", a.symbol(), a.value(s))).collect::<Vec<_>>().join(" ")
+    }
+
+    /// Parameters as text, without the core's shape (for what the shape does not change,
+    /// such as a parameter set that is invalid).
+    pub fn params_text(&self, p: &Params) -> String {
+        let s = Set { params: *p, shape: CoreShape::default() };
+        let axes = self.named_axes().into_iter().filter(|a| a.changes_image());
+        axes.map(|a| format!("{}={}", a.symbol(), a.value(&s))).collect::<Vec<_>>().join(" ")
+    }
+
+    /// The default parameters with the sweep's single-valued ones (stack depth and tree) and
+    /// the base leaf size.
     pub fn defaults(&self) -> Params {
-        Params { leaf_size: self.leaf_size, stack_depth: self.stack_depth, tree: self.tree, ..Params::default() }
+        let d = Params::default();
+        let leaf_size = if self.leaf_size.contains(&d.leaf_size) { d.leaf_size } else { self.leaf_size[0] };
+        Params { leaf_size, stack_depth: self.stack_depth, tree: self.tree, ..d }
     }
 
     /// Each parameter at its default if its list holds it, else the list's first value.
-    pub fn base(&self) -> Params {
-        let d = self.defaults();
-        let pick = |list: &[u32], default: u32| if list.contains(&default) { default } else { list[0] };
-        Params {
-            n: pick(&self.n, d.n),
-            m: pick(&self.m, d.m),
-            t: pick(&self.t, d.t),
-            c: pick(&self.c, d.c),
-            edge_shift: if self.edge_shift.contains(&d.edge_shift) { d.edge_shift } else { self.edge_shift[0] },
-            ..d
-        }
+    pub fn base(&self) -> Set {
+        let d = Set { params: self.defaults(), shape: CoreShape::default() };
+        Axis::ALL.into_iter().fold(d, |s, a| {
+            let here = a.value(&d);
+            let i = self.values(a).iter().position(|v| *v == here).unwrap_or(0);
+            self.with(s, a, i)
+        })
     }
 
-    /// Every parameter set the lists describe, in a fixed order, without repeats (the lists
-    /// themselves hold no repeats, so only one-at-a-time can produce one: the base).
-    fn parameter_sets(&self) -> Vec<Params> {
+    /// Every set the lists describe, in a fixed order, without repeats (the lists themselves
+    /// hold no repeats, so only one-at-a-time can produce one: the base).
+    fn sets(&self) -> Vec<Set> {
         let base = self.base();
-        let mut sets: Vec<Params> = Vec::new();
+        let mut sets: Vec<Set> = vec![base];
         if self.one_at_a_time {
-            sets.push(base);
-            let mut push = |p: Params| {
-                if p != base {
-                    sets.push(p);
-                }
-            };
-            self.n.iter().for_each(|&n| push(Params { n, ..base }));
-            self.m.iter().for_each(|&m| push(Params { m, ..base }));
-            self.edge_shift.iter().for_each(|&edge_shift| push(Params { edge_shift, ..base }));
-            self.t.iter().for_each(|&t| push(Params { t, ..base }));
-            self.c.iter().for_each(|&c| push(Params { c, ..base }));
+            for a in Axis::ALL {
+                sets.extend((0..self.len(a)).map(|i| self.with(base, a, i)).filter(|s| *s != base));
+            }
         } else {
-            for &n in &self.n {
-                for &m in &self.m {
-                    for &edge_shift in &self.edge_shift {
-                        for &t in &self.t {
-                            for &c in &self.c {
-                                sets.push(Params { n, m, edge_shift, t, c, ..base });
-                            }
-                        }
-                    }
-                }
+            // The cross product, the last axis fastest.
+            for a in Axis::ALL {
+                sets = sets
+                    .iter()
+                    .flat_map(|&s| (0..self.len(a)).map(move |i| (s, i)))
+                    .map(|(s, i)| self.with(s, a, i))
+                    .collect();
             }
         }
         sets
     }
 
-    /// How many parameter sets the lists describe.
+    /// How many sets the lists describe.
     fn set_count(&self) -> u128 {
-        let lens = [self.n.len(), self.m.len(), self.edge_shift.len(), self.t.len(), self.c.len()];
-        if self.one_at_a_time {
-            1 + lens.iter().map(|&l| l as u128).sum::<u128>()
-        } else {
-            lens.iter().map(|&l| l as u128).product()
-        }
+        let lens = Axis::ALL.map(|a| self.len(a) as u128);
+        if self.one_at_a_time { 1 + lens.iter().sum::<u128>() } else { lens.iter().product() }
     }
 
     /// Expands the lists; fails (before anything runs) if no configuration is valid.
@@ -295,11 +372,13 @@ impl SweepSpec {
                 ),
             ));
         }
-        let (mut sets, mut skipped) = (Vec::new(), Vec::new());
-        for p in self.parameter_sets() {
-            match p.validate() {
-                Ok(()) => sets.push(p),
-                Err(e) => skipped.push(Skipped { params: p, reason: e.to_string() }),
+        let (mut sets, mut skipped) = (Vec::new(), Vec::<Skipped>::new());
+        for s in self.sets() {
+            match s.params.validate() {
+                Ok(()) => sets.push(s),
+                // A parameter set is listed once, however many core shapes it comes with.
+                Err(_) if skipped.iter().any(|k| k.params == s.params) => {}
+                Err(e) => skipped.push(Skipped { params: s.params, reason: e.to_string() }),
             }
         }
         if sets.is_empty() {
@@ -308,7 +387,7 @@ impl SweepSpec {
         }
         // The base set anchors one-at-a-time sweeps, grids and plots: it must be valid.
         let mut base = self.base();
-        if let Err(e) = base.validate() {
+        if let Err(e) = base.params.validate() {
             if self.one_at_a_time {
                 return Err(Error::new(
                     "sweep",
@@ -317,11 +396,12 @@ impl SweepSpec {
             }
             base = sets[0];
         }
+        let scenes = self.scenes.len();
         let configs = sets
             .iter()
             .enumerate()
-            .flat_map(|(i, &params)| {
-                (0..self.scenes.len()).map(move |s| Config { index: i * self.scenes.len() + s, scene: s, params })
+            .flat_map(|(i, s)| {
+                (0..scenes).map(move |k| Config { index: i * scenes + k, scene: k, params: s.params, shape: s.shape })
             })
             .collect();
         Ok(Plan { base, sets, configs, skipped })
@@ -370,6 +450,15 @@ pub fn params_label(p: &Params) -> String {
         s += &format!("_{}", p.tree);
     }
     s
+}
+
+/// `params_label` with the core's shape when it is not the default: `…_c16_k8_u1`.
+pub fn set_label(s: &Set) -> String {
+    let mut label = params_label(&s.params);
+    if !s.shape.is_default() {
+        label += &format!("_k{}_u{}", s.shape.slots, s.shape.units);
+    }
+    label
 }
 
 #[cfg(test)]

@@ -87,7 +87,8 @@ pub fn read_results(dir: &Path) -> Result<Results> {
     serde_json::from_slice(&bytes).map_err(|e| Error::file(&path, format!("not a fxrt sweep result: {e}")))
 }
 
-/// The columns of results.csv.
+/// The columns of results.csv in every sweep (`csv_columns` adds the core's shape after
+/// `stack_depth`, `CORE_COLUMNS` after `core_mismatches` and the ECP5 columns before the last three).
 pub const CSV_COLUMNS: &[&str] = &[
     "index",
     "scene",
@@ -133,6 +134,30 @@ pub const CSV_COLUMNS: &[&str] = &[
     "error",
     "key",
 ];
+
+/// Columns of the core's shape, after `stack_depth`, in sweeps whose `--slots` or `--units`
+/// are not the defaults.
+pub const SHAPE_COLUMNS: [&str; 2] = ["slots", "units"];
+
+/// Columns of `--core-sim` sweeps after `core_mismatches` (`fxrt sim`'s figures).
+pub const CORE_COLUMNS: [&str; 4] =
+    ["rays_per_clock", "triangle_tests_per_ray", "node_steps_per_ray", "slot_occupancy"];
+
+/// `fields` (one per `CSV_COLUMNS`) with the shape's and the core's cells where the sweep has
+/// those columns.
+fn with_optional(spec: &SweepSpec, mut fields: Vec<String>, shape: [String; 2], core: [String; 4]) -> Vec<String> {
+    let after = |c: &str| CSV_COLUMNS.iter().position(|x| *x == c).expect("a column of CSV_COLUMNS") + 1;
+    // The later columns first, so that the earlier position still holds.
+    if spec.core_sim {
+        let at = after("core_mismatches");
+        fields.splice(at..at, core);
+    }
+    if !spec.default_core_shape() {
+        let at = after("stack_depth");
+        fields.splice(at..at, shape);
+    }
+    fields
+}
 
 fn csv_record(r: &Row) -> Vec<String> {
     let opt = |v: Option<String>| v.unwrap_or_default();
@@ -205,14 +230,30 @@ fn with_extra(mut fields: Vec<String>, extra: Vec<String>) -> Vec<String> {
     fields
 }
 
-/// results.csv: `CSV_COLUMNS`, with `pnr::csv_columns` before the last three.
+/// The header of results.csv: `CSV_COLUMNS`, with `SHAPE_COLUMNS` and `CORE_COLUMNS` where the
+/// sweep has them and `pnr::csv_columns` before the last three.
+pub fn csv_columns(spec: &SweepSpec) -> Vec<String> {
+    let header = CSV_COLUMNS.iter().map(|c| c.to_string()).collect();
+    let fields = with_optional(spec, header, SHAPE_COLUMNS.map(String::from), CORE_COLUMNS.map(String::from));
+    with_extra(fields, super::pnr::csv_columns(spec))
+}
+
+/// results.csv: a line per row under `csv_columns`.
 pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
     let mut w = csv::Writer::from_writer(Vec::new());
     // Writing into a Vec cannot fail.
-    let header = CSV_COLUMNS.iter().map(|c| c.to_string()).collect();
-    w.write_record(with_extra(header, super::pnr::csv_columns(spec))).expect("csv into memory");
+    w.write_record(csv_columns(spec)).expect("csv into memory");
     for r in rows {
-        w.write_record(with_extra(csv_record(r), super::pnr::csv_cells(spec, r))).expect("csv into memory");
+        let shape = [r.shape.slots.to_string(), r.shape.units.to_string()];
+        let k = r.core.as_ref();
+        let core = [
+            k.map(|k| k.rays_per_clock.to_string()).unwrap_or_default(),
+            k.map(|k| k.triangle_tests_per_ray.to_string()).unwrap_or_default(),
+            k.map(|k| k.node_steps_per_ray.to_string()).unwrap_or_default(),
+            k.map(|k| k.slot_occupancy.to_string()).unwrap_or_default(),
+        ];
+        let fields = with_optional(spec, csv_record(r), shape, core);
+        w.write_record(with_extra(fields, super::pnr::csv_cells(spec, r))).expect("csv into memory");
     }
     w.into_inner().expect("csv into memory")
 }

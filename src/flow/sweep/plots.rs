@@ -1,12 +1,13 @@
-//! Plots (plotters, PNG): wrong pixels against each swept parameter, and against DSP48E with
-//! the Pareto front; with `--family ecp5`, Fmax against each swept parameter. Text uses
-//! DejaVu Sans compiled in, so no system font is needed.
+//! Plots (plotters, PNG): wrong pixels against each swept parameter that can change the image,
+//! and against DSP48E with the Pareto front; with `--family ecp5`, Fmax against each swept
+//! parameter; with `--core-sim`, throughput against area (`throughput.rs`). Text uses DejaVu
+//! Sans compiled in, so no system font is needed.
 
 use super::eval::Row;
 use super::grid::series;
 use super::output::Results;
 use super::summary::{pareto_front, set_summaries};
-use super::{Axis, Plan, params_label};
+use super::{Axis, Plan, set_label};
 use crate::error::{Error, Result};
 use crate::io::write_atomic;
 use crate::render::encode_png;
@@ -26,24 +27,25 @@ pub fn register_font() {
     });
 }
 
-const W: u32 = 900;
-const H: u32 = 560;
+pub(super) const W: u32 = 900;
+pub(super) const H: u32 = 560;
 /// Where a count of 0 is drawn on the logarithmic axes.
 const ZERO: f64 = 0.5;
 
-fn plot_err(e: impl std::fmt::Display) -> Error {
+pub(super) fn plot_err(e: impl std::fmt::Display) -> Error {
     Error::new("sweep plot", e.to_string())
 }
 
 /// Where the Fmax plots of `--family ecp5` go: plots/fmax_PARAM.png.
 pub const FMAX_PLOTS: &str = "plots/fmax_";
 
-/// Writes plots/error_PARAM.png per swept parameter, with `--family ecp5` plots/fmax_PARAM.png
-/// per swept parameter, and plots/pareto_dsp48e.png.
+/// Writes plots/error_PARAM.png per swept parameter that can change the image, with
+/// `--family ecp5` plots/fmax_PARAM.png per swept parameter, plots/pareto_dsp48e.png, and with
+/// `--core-sim` plots/throughput_AREA.png per area measure.
 pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
     register_font();
     let mut written = Vec::new();
-    for axis in results.spec.swept_axes() {
+    for axis in results.spec.swept_axes().into_iter().filter(|a| a.changes_image()) {
         let rel = format!("plots/error_{}.png", axis.name());
         write_atomic(&dir.join(&rel), &error_plot(results, plan, axis)?)?;
         written.push(rel);
@@ -60,6 +62,7 @@ pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<Str
         write_atomic(&dir.join(&rel), &pareto_plot(results)?)?;
         written.push(rel);
     }
+    written.extend(super::throughput::write_plots(dir, results)?);
     Ok(written)
 }
 
@@ -69,7 +72,7 @@ fn points(results: &Results, plan: &Plan, scene: &str, axis: Axis, y: &dyn Fn(&R
     let values = results.spec.values(axis);
     series(results, plan, scene, axis)
         .into_iter()
-        .filter_map(|r| Some((values.iter().position(|v| *v == axis.value(&r.params))? as i32, y(r)?)))
+        .filter_map(|r| Some((values.iter().position(|v| *v == axis.value(&r.set()))? as i32, y(r)?)))
         .collect()
 }
 
@@ -115,7 +118,9 @@ struct AxisChart<'a> {
 impl<'a> AxisChart<'a> {
     /// "`what` against P (the base set's other parameters)", no lines yet.
     fn new(results: &Results, plan: &Plan, axis: Axis, what: &str, y_desc: &'a str) -> AxisChart<'a> {
-        let others = Axis::ALL
+        let others = results
+            .spec
+            .named_axes()
             .into_iter()
             .filter(|&a| a != axis)
             .map(|a| format!("{}={}", a.symbol(), a.value(&plan.base)))
@@ -229,7 +234,7 @@ fn pareto_plot(results: &Results) -> Result<Vec<u8>> {
             .draw_series(front.iter().map(|&i| {
                 let s = &sets[i];
                 Text::new(
-                    params_label(&s.params),
+                    set_label(&s.set()),
                     (s.dsp48e as f64, y(s.wrong) * 1.25),
                     (FONT, 12).into_font().color(&BLACK),
                 )

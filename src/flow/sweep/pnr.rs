@@ -112,8 +112,8 @@ pub fn setup_text(results: &Results) -> String {
         "{DEVICE} ({PACKAGE}, speed grade {SPEED}), clock target {} MHz, {} ray slots × {} traversal units, \
          placement seed {}, modules {}{tools}",
         results.spec.target_mhz,
-        results.spec.slots,
-        results.spec.units,
+        super::report::list(&results.spec.slots),
+        super::report::list(&results.spec.units),
         e.seed,
         e.modules.join(", ")
     )
@@ -129,13 +129,12 @@ pub fn report_rows(results: &Results) -> Vec<Vec<String>> {
         let mut marked = false;
         for p in &r.ecp5 {
             let t = &p.timing;
-            let q = &r.params;
             let by_this = !marked && Some(t.fmax_mhz) == clock;
             marked |= by_this;
             let path = &t.critical_path;
             out.push(vec![
                 r.scene.clone(),
-                format!("n={} m={} E={} T={} C={}", q.n, q.m, q.edge_shift, q.t, q.c),
+                results.spec.set_text(&r.set()),
                 p.kind.clone(),
                 format!("{:.1}", t.fmax_mhz),
                 t.lut4.to_string(),
@@ -179,7 +178,7 @@ pub fn findings(results: &Results) -> Vec<String> {
             placed.len(),
             results.spec.target_mhz,
             lo.0.scene,
-            super::params_label(&lo.0.params),
+            super::set_label(&lo.0.set()),
             path_text(&lo.1.critical_path)
         ));
     }

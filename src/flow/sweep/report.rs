@@ -1,14 +1,14 @@
 //! report.md (the findings, the Pareto front, the plots and grids, every row), and the Slurm /
 //! GNU parallel scripts of `--emit-slurm`. Both are askama templates in `hdl/`.
 
-use super::Plan;
 use super::eval::OTHER_SURFACE_REL;
 use super::output::Results;
 use super::plots::FMAX_PLOTS;
 use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summaries};
+use super::throughput::THROUGHPUT_PLOTS;
+use super::{Axis, Plan, Set};
 use crate::error::{Error, Result};
 use crate::io::write_atomic;
-use crate::params::Params;
 use askama::Template;
 use std::path::Path;
 
@@ -31,30 +31,32 @@ struct Report {
     pareto: Vec<[String; 7]>,
     plots: Vec<String>,
     grids: Vec<String>,
+    /// The header of the table of all configurations.
+    head: Vec<String>,
     rows: Vec<Vec<String>>,
     skipped: Vec<String>,
     ecp5_setup: String,
     ecp5_rows: Vec<Vec<String>>,
     fmax_plots: Vec<String>,
+    throughput_plots: Vec<String>,
+    area_source: String,
 }
 
 pub(super) fn list<T: ToString>(v: &[T]) -> String {
     v.iter().map(T::to_string).collect::<Vec<_>>().join(", ")
 }
 
-fn set_text(p: &Params) -> String {
-    format!("n={} m={} E={} T={} C={}", p.n, p.m, p.edge_shift, p.t, p.c)
-}
-
 fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
     let mut out = Vec::new();
-    let defaults = results.spec.defaults();
-    let default_set = sets.iter().find(|s| s.params == defaults);
+    let spec = &results.spec;
+    let set_text = |s: &Set| spec.set_text(s);
+    let defaults = Set { params: spec.defaults(), shape: spec.base().shape };
+    let default_set = sets.iter().find(|s| s.set() == defaults);
     match cheapest_same_image(sets) {
         Some(s) => out.push(format!(
             "Fewest DSP48E with the same image as the defaults on every scene: {} — {} DSP48E and {} register \
              bits{}, pipeline latency {}.",
-            set_text(&s.params),
+            set_text(&s.set()),
             s.dsp48e,
             s.register_bits,
             default_set.map(|d| format!(" (defaults: {} and {})", d.dsp48e, d.register_bits)).unwrap_or_default(),
@@ -62,7 +64,7 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
         )),
         None => out.push("No swept parameter set gives the defaults' image on every scene.".into()),
     }
-    for r in results.rows.iter().filter(|r| r.params == defaults) {
+    for r in results.rows.iter().filter(|r| r.set() == defaults) {
         if let Some(q) = &r.quality {
             out.push(format!(
                 "{} at the defaults: {} wrong pixels of {} ({} false misses, {} false hits, {} other surface).",
@@ -73,7 +75,7 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
     if let Some(worst) = sets.iter().max_by_key(|s| (s.wrong, std::cmp::Reverse(s.dsp48e))) {
         out.push(format!(
             "Most wrong pixels: {} — {} of {} rays ({:.3} %).",
-            set_text(&worst.params),
+            set_text(&worst.set()),
             worst.wrong,
             worst.rays,
             100.0 * worst.wrong as f64 / worst.rays.max(1) as f64
@@ -92,6 +94,7 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
             cpr(f64::max, 0.0)
         ));
     }
+    out.extend(super::throughput::finding(results));
     out.extend(super::pnr::findings(results));
     let failed = results.rows.iter().filter(|r| r.error.is_some()).count();
     if failed > 0 {
@@ -100,13 +103,55 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
     out
 }
 
-fn row_cells(r: &super::eval::Row) -> Vec<String> {
+/// The parameter columns of the table of all configurations beyond n, m, E, T, C: the leaf
+/// size when it is swept, K and U when they are not the defaults.
+fn extra_axes(results: &Results) -> Vec<Axis> {
+    let spec = &results.spec;
+    let mut v = Vec::new();
+    if spec.leaf_size.len() > 1 {
+        v.push(Axis::LeafSize);
+    }
+    if !spec.default_core_shape() {
+        v.extend([Axis::Slots, Axis::Units]);
+    }
+    v
+}
+
+fn table_head(results: &Results) -> Vec<String> {
+    let mut head: Vec<String> = ["scene", "n", "m", "E (used)", "T", "C"].map(String::from).to_vec();
+    head.extend(extra_axes(results).iter().map(|a| a.symbol().to_string()));
+    head.extend(
+        [
+            "wrong px",
+            "false miss",
+            "false hit",
+            "other surface",
+            "differ",
+            "max rel. t error",
+            "degenerate",
+            "clamped",
+            "DSP48E",
+            "register bits",
+            "latency",
+            "cycles/ray",
+        ]
+        .map(String::from),
+    );
+    if results.spec.core_sim {
+        head.push("rays/clock".into());
+    }
+    head.push("note".into());
+    head
+}
+
+fn row_cells(results: &Results, r: &super::eval::Row) -> Vec<String> {
     let p = &r.params;
     let e = match r.e_used {
         Some(e) if p.edge_shift.to_string() == "auto" => format!("auto ({e})"),
         _ => p.edge_shift.to_string(),
     };
     let mut v = vec![r.scene.clone(), p.n.to_string(), p.m.to_string(), e, p.t.to_string(), p.c.to_string()];
+    v.extend(extra_axes(results).iter().map(|a| a.value(&r.set())));
     match &r.quality {
         Some(q) => v.extend([
             q.wrong_pixels.to_string(),
@@ -124,7 +169,32 @@ fn row_cells(r: &super::eval::Row) -> Vec<String> {
     v.push(r.cost.as_ref().map(|c| c.register_bits.to_string()).unwrap_or_default());
     v.push(r.cost.as_ref().map(|c| c.isect_latency.to_string()).unwrap_or_default());
     v.push(r.core.as_ref().map(|k| format!("{:.1}", k.cycles_per_ray)).unwrap_or_default());
+    if results.spec.core_sim {
+        v.push(r.core.as_ref().map(|k| format!("{:.4}", k.rays_per_clock)).unwrap_or_default());
+    }
     v.push(r.error.clone().unwrap_or_default().replace('|', "/"));
+    v
+}
+
+/// The table of the lists: n, m, E, T, C, then the leaf size when swept and K and U when not
+/// the defaults, and the base set.
+fn lists(results: &Results, plan: &Plan) -> Vec<(&'static str, String)> {
+    let spec = &results.spec;
+    let mut v = vec![
+        ("n", list(&spec.n)),
+        ("m", list(&spec.m)),
+        ("E (edge shift)", list(&spec.edge_shift)),
+        ("T", list(&spec.t)),
+        ("C", list(&spec.c)),
+    ];
+    if spec.leaf_size.len() > 1 {
+        v.push(("leaf size", list(&spec.leaf_size)));
+    }
+    if !spec.default_core_shape() {
+        v.push(("K (ray slots per unit)", list(&spec.slots)));
+        v.push(("U (traversal units)", list(&spec.units)));
+    }
+    v.push(("base set", spec.set_text(&plan.base)));
     v
 }
 
@@ -137,7 +207,7 @@ pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String]
         .map(|i| {
             let s = &sets[i];
             [
-                set_text(&s.params),
+                spec.set_text(&s.set()),
                 s.dsp48e.to_string(),
                 s.wrong.to_string(),
                 s.diff.to_string(),
@@ -161,26 +231,26 @@ pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String]
         },
         scenes: labels.join(", "),
         mode: if spec.one_at_a_time { "one parameter at a time around the base set" } else { "cross product" },
-        lists: vec![
-            ("n", list(&spec.n)),
-            ("m", list(&spec.m)),
-            ("E (edge shift)", list(&spec.edge_shift)),
-            ("T", list(&spec.t)),
-            ("C", list(&spec.c)),
-            ("base set", set_text(&plan.base)),
-        ],
+        lists: lists(results, plan),
         configurations: results.rows.len(),
         sets: plan.sets.len(),
         scene_count: spec.scenes.len(),
         findings: findings(results, &sets),
         pareto,
-        plots: plots.iter().filter(|p| !p.starts_with(FMAX_PLOTS)).cloned().collect(),
+        plots: plots
+            .iter()
+            .filter(|p| !p.starts_with(FMAX_PLOTS) && !p.starts_with(THROUGHPUT_PLOTS))
+            .cloned()
+            .collect(),
         grids: grids.to_vec(),
-        rows: results.rows.iter().map(row_cells).collect(),
-        skipped: plan.skipped.iter().map(|s| format!("{}: {}", set_text(&s.params), s.reason)).collect(),
+        head: table_head(results),
+        rows: results.rows.iter().map(|r| row_cells(results, r)).collect(),
+        skipped: plan.skipped.iter().map(|s| format!("{}: {}", spec.params_text(&s.params), s.reason)).collect(),
         ecp5_setup: super::pnr::setup_text(results),
         ecp5_rows: super::pnr::report_rows(results),
         fmax_plots: plots.iter().filter(|p| p.starts_with(FMAX_PLOTS)).cloned().collect(),
+        throughput_plots: plots.iter().filter(|p| p.starts_with(THROUGHPUT_PLOTS)).cloned().collect(),
+        area_source: super::throughput::source_text(results),
     };
     let text = report.render().map_err(|e| Error::new("sweep report", e.to_string()))?;
     write_atomic(&dir.join("report.md"), text.as_bytes())

@@ -50,7 +50,12 @@ pub struct RunSummary {
 /// Loads and checks every scene of the sweep (before anything is written).
 pub fn load_scenes(spec: &SweepSpec) -> Result<Vec<SceneCtx>> {
     let labels = scene_labels(&spec.scenes);
-    spec.scenes.iter().zip(labels).map(|(s, l)| SceneCtx::load(s, l, &spec.camera, &spec.defaults())).collect()
+    let defaults = spec.defaults();
+    spec.scenes
+        .iter()
+        .zip(labels)
+        .map(|(s, l)| SceneCtx::load(s, l, &spec.camera, &defaults, &spec.leaf_size))
+        .collect()
 }
 
 /// Evaluates this shard's configurations (those in the cache folder `cache` are read back)
@@ -84,17 +89,16 @@ pub fn run(
         synth_dir: spec.xc5v_synth().then(|| out.join("synth")),
         core_sim: spec.core_sim,
         target_mhz: spec.target_mhz,
-        slots: spec.slots,
-        units: spec.units,
         pnr,
     };
     let results: Vec<Result<(Row, bool)>> = mine
         .par_iter()
         .map(|cfg| {
             let ctx = &scenes[cfg.scene];
-            let key = ctx.key(&cfg.params, spec);
+            let key = ctx.key(&cfg.params, cfg.shape, spec);
             let done = match load_cached(cache, &key, cfg.index, &ctx.label) {
-                Some(row) => Ok((row, true)),
+                // The key holds the shape; rows cached before it was swept do not.
+                Some(row) => Ok((super::eval::Row { shape: cfg.shape, ..row }, true)),
                 None => {
                     let e = evaluate(ctx, cfg, key, &extras);
                     store_cached(cache, &e).map(|()| (e.row, false))

@@ -86,7 +86,7 @@ pub fn sweep_command(exe: &Path, spec: &SweepSpec) -> Vec<String> {
     let join = |x: &[u32]| x.iter().map(u32::to_string).collect::<Vec<_>>().join(",");
     v.extend(["--n".into(), join(&spec.n), "--m".into(), join(&spec.m), "--t".into(), join(&spec.t)]);
     v.extend(["--c".into(), join(&spec.c), "--edge-shift".into(), list(&spec.edge_shift).replace(", ", ",")]);
-    v.extend(["--leaf-size".into(), spec.leaf_size.to_string()]);
+    v.extend(["--leaf-size".into(), join(&spec.leaf_size)]);
     v.extend(["--stack-depth".into(), spec.stack_depth.to_string()]);
     if spec.tree != crate::params::TreeSplit::default() {
         v.extend(["--tree".into(), spec.tree.to_string()]);
@@ -104,7 +104,7 @@ pub fn sweep_command(exe: &Path, spec: &SweepSpec) -> Vec<String> {
         v.extend(["--target-mhz".into(), spec.target_mhz.to_string()]);
     }
     if !spec.default_core_shape() {
-        v.extend(["--slots".into(), spec.slots.to_string(), "--units".into(), spec.units.to_string()]);
+        v.extend(["--slots".into(), join(&spec.slots), "--units".into(), join(&spec.units)]);
     }
     if let Some(e) = &spec.ecp5 {
         v.extend(["--family".into(), "ecp5".into(), "--seed".into(), e.seed.to_string()]);

@@ -1,11 +1,14 @@
-//! Per parameter set, over all scenes: what it gets wrong and what it costs; the Pareto front.
+//! Per set (parameters and core shape), over all scenes: what it gets wrong and what it costs;
+//! the Pareto front.
 
 use super::output::Results;
+use super::{CoreShape, Set};
 use crate::params::Params;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SetSummary {
     pub params: Params,
+    pub shape: CoreShape,
     /// Wrong pixels (against f64), summed over the scenes.
     pub wrong: u64,
     /// Pixels differing from the default-parameter image, summed over the scenes.
@@ -28,11 +31,12 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
         let (Some(q), Some(c), Some(dsp)) = (&r.quality, &r.cost, r.dsp48e(results.spec.xc5v_synth())) else {
             continue;
         };
-        let s = match out.iter_mut().find(|s| s.params == r.params) {
+        let s = match out.iter_mut().find(|s| s.set() == r.set()) {
             Some(s) => s,
             None => {
                 out.push(SetSummary {
                     params: r.params,
+                    shape: r.shape,
                     wrong: 0,
                     diff: 0,
                     rays: 0,
@@ -56,11 +60,17 @@ pub fn set_summaries(results: &Results) -> Vec<SetSummary> {
         results
             .rows
             .iter()
-            .filter(|r| r.params == s.params && r.quality.is_some() && r.dsp48e(results.spec.xc5v_synth()).is_some())
+            .filter(|r| r.set() == s.set() && r.quality.is_some() && r.dsp48e(results.spec.xc5v_synth()).is_some())
             .count()
             == scenes
     };
     out.into_iter().filter(complete).collect()
+}
+
+impl SetSummary {
+    pub fn set(&self) -> Set {
+        Set { params: self.params, shape: self.shape }
+    }
 }
 
 /// Indices of the sets no other set beats on both DSP48E and wrong pixels (ties: the first),
@@ -92,6 +102,7 @@ mod tests {
     fn set(dsp: u64, wrong: u64, diff: u64) -> SetSummary {
         SetSummary {
             params: Params::default(),
+            shape: CoreShape::default(),
             wrong,
             diff,
             rays: 100,

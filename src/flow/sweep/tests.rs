@@ -13,15 +13,15 @@ fn spec() -> SweepSpec {
         t: vec![0, 24],
         c: vec![16],
         edge_shift: vec![EdgeShift::Auto, EdgeShift::Fixed(10)],
-        leaf_size: 4,
+        leaf_size: vec![4],
         stack_depth: 32,
         tree: TreeSplit::Sah,
         one_at_a_time: false,
         synth: false,
         core_sim: false,
         target_mhz: 150,
-        slots: crate::cores::top::DEFAULT_SLOTS,
-        units: crate::cores::top::DEFAULT_UNITS,
+        slots: vec![crate::cores::top::DEFAULT_SLOTS],
+        units: vec![crate::cores::top::DEFAULT_UNITS],
         ecp5: None,
     }
 }
@@ -52,8 +52,8 @@ fn one_at_a_time_varies_each_parameter_around_the_base() {
     let s = SweepSpec { one_at_a_time: true, n: vec![20, 24], m: vec![16, 32], t: vec![0, 8], ..spec() };
     let plan = s.plan().unwrap();
     // n is not at its default 29 in the list: the base takes the list's first value.
-    assert_eq!(plan.base, Params { n: 20, ..Params::default() });
-    let base = plan.base;
+    assert_eq!(plan.base, Set { params: Params { n: 20, ..Params::default() }, shape: CoreShape::default() });
+    let base = plan.base.params;
     let expected = vec![
         base,
         Params { n: 24, ..base },
@@ -61,7 +61,7 @@ fn one_at_a_time_varies_each_parameter_around_the_base() {
         Params { edge_shift: EdgeShift::Fixed(10), ..base },
         Params { t: 8, ..base },
     ];
-    assert_eq!(plan.sets, expected);
+    assert_eq!(plan.sets.iter().map(|s| s.params).collect::<Vec<_>>(), expected);
 }
 
 #[test]
@@ -139,7 +139,7 @@ fn the_base_set_must_be_valid_and_plans_have_a_size_limit() {
     // ...a cross product takes its first valid set as the base for grids and plots.
     let s = SweepSpec { one_at_a_time: false, ..s };
     let plan = s.plan().unwrap();
-    assert_eq!((plan.base.m, plan.base.t), (12, 7));
+    assert_eq!((plan.base.params.m, plan.base.params.t), (12, 7));
     let s = SweepSpec {
         n: (4..=40).collect(),
         m: (8..=64).collect(),
@@ -180,39 +180,60 @@ fn slurm_shards_are_checked_and_the_scripts_written() {
 /// key it always had, and its results.json does not mention them.
 #[test]
 fn cache_keys_tell_families_seeds_targets_and_core_shapes_apart() {
-    let ctx =
-        eval::SceneCtx::load(&SceneSpec::Builtin("thin".into()), "thin".into(), &spec().camera, &Params::default())
-            .unwrap();
+    let ctx = eval::SceneCtx::load(
+        &SceneSpec::Builtin("thin".into()),
+        "thin".into(),
+        &spec().camera,
+        &Params::default(),
+        &[4],
+    )
+    .unwrap();
     let p = Params::default();
+    let d = CoreShape::default();
     let xc5v = SweepSpec { synth: true, ..spec() };
     let ecp5 = SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["core".into()], seed: 1 }), ..xc5v.clone() };
     let keys = [
-        ctx.key(&p, &spec()),
-        ctx.key(&p, &xc5v),
-        ctx.key(&p, &ecp5),
-        ctx.key(&p, &SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["core".into()], seed: 2 }), ..ecp5.clone() }),
-        ctx.key(&p, &SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["divider".into()], seed: 1 }), ..ecp5.clone() }),
-        ctx.key(&p, &SweepSpec { target_mhz: 100, ..ecp5.clone() }),
-        ctx.key(&p, &SweepSpec { target_mhz: 100, ..xc5v.clone() }),
-        ctx.key(&p, &SweepSpec { target_mhz: 100, ..spec() }),
-        ctx.key(&p, &SweepSpec { slots: 4, ..spec() }),
-        ctx.key(&p, &SweepSpec { units: 1, ..spec() }),
+        ctx.key(&p, d, &spec()),
+        ctx.key(&p, d, &xc5v),
+        ctx.key(&p, d, &ecp5),
+        ctx.key(&p, d, &SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["core".into()], seed: 2 }), ..ecp5.clone() }),
+        ctx.key(
+            &p,
+            d,
+            &SweepSpec { ecp5: Some(Ecp5Choice { modules: vec!["divider".into()], seed: 1 }), ..ecp5.clone() },
+        ),
+        ctx.key(&p, d, &SweepSpec { target_mhz: 100, ..ecp5.clone() }),
+        ctx.key(&p, d, &SweepSpec { target_mhz: 100, ..xc5v.clone() }),
+        ctx.key(&p, d, &SweepSpec { target_mhz: 100, ..spec() }),
+        ctx.key(&p, CoreShape { slots: 4, ..d }, &spec()),
+        ctx.key(&p, CoreShape { units: 1, ..d }, &spec()),
     ];
     let distinct: std::collections::BTreeSet<&String> = keys.iter().collect();
     assert_eq!(distinct.len(), keys.len(), "{keys:?}");
-    // The key of a sweep without the new options is the one it had before them.
+    // The key of a sweep without the new options is the one it had before them: row format 1
+    // (rows without --core-sim are what they were), no shape, whatever the lists hold.
     let c = &ctx.camera;
-    let before = serde_json::json!({
-        "fxrt": env!("CARGO_PKG_VERSION"), "row_format": eval::ROW_FORMAT, "scene": "builtin:thin",
-        "camera": [c.eye, c.at, c.up, [c.fov_deg, c.width as f64, c.height as f64]],
-        "params": p, "synth": true, "core_sim": false,
-    });
-    use sha2::Digest;
-    assert_eq!(keys[1], format!("{:x}", sha2::Sha256::digest(before.to_string().as_bytes()))[..20]);
+    let before = |params: &Params, core_sim: bool| {
+        let text = serde_json::json!({
+            "fxrt": env!("CARGO_PKG_VERSION"), "row_format": 1, "scene": "builtin:thin",
+            "camera": [c.eye, c.at, c.up, [c.fov_deg, c.width as f64, c.height as f64]],
+            "params": params, "synth": true, "core_sim": core_sim,
+        });
+        use sha2::Digest;
+        format!("{:x}", sha2::Sha256::digest(text.to_string().as_bytes()))[..20].to_string()
+    };
+    assert_eq!(keys[1], before(&p, false));
+    let swept = SweepSpec { slots: vec![8, 64], units: vec![1, 2], leaf_size: vec![2, 4], ..xc5v.clone() };
+    assert_eq!(ctx.key(&p, d, &swept), keys[1], "the default shape in a sweep of shapes");
+    let leaf2 = Params { leaf_size: 2, ..p };
+    assert_eq!(ctx.key(&leaf2, d, &swept), before(&leaf2, false), "a leaf size as --leaf-size 2 had it");
+    // Rows of --core-sim gained figures (row format 2): their old cache entries do not match.
+    let core = SweepSpec { core_sim: true, ..xc5v.clone() };
+    assert_ne!(ctx.key(&p, d, &core), before(&p, true));
     let json = serde_json::to_string(&xc5v).unwrap();
     assert!(!["target_mhz", "ecp5", "slots", "units"].iter().any(|k| json.contains(k)), "{json}");
     assert_eq!(serde_json::from_str::<SweepSpec>(&json).unwrap(), xc5v);
-    let ecp5 = SweepSpec { target_mhz: 100, slots: 2, units: 1, ..ecp5 };
+    let ecp5 = SweepSpec { target_mhz: 100, slots: vec![2], units: vec![1], ..ecp5 };
     assert_eq!(serde_json::from_str::<SweepSpec>(&serde_json::to_string(&ecp5).unwrap()).unwrap(), ecp5);
 }
 
@@ -249,11 +270,21 @@ fn ecp5_columns_follow_the_modules() {
         key: "k".into(),
         scene: "thin".into(),
         params: Params::default(),
+        shape: CoreShape::default(),
         e_used: None,
         quality: None,
         cost: None,
         synth: None,
-        core: Some(eval::CoreRun { cycles_per_ray: 130.0, fill: 0.3, max_stack_depth: 4, mismatches: 0 }),
+        core: Some(eval::CoreRun {
+            cycles_per_ray: 130.0,
+            rays_per_clock: 1.0 / 130.0,
+            fill: 0.3,
+            triangle_tests_per_ray: 39.0,
+            node_steps_per_ray: 60.0,
+            slot_occupancy: 0.9,
+            max_stack_depth: 4,
+            mismatches: 0,
+        }),
         ecp5: vec![
             PlacedModule { kind: "divider".into(), timing: timing("fxrt_div", 172.1, Some(31)) },
             PlacedModule { kind: "core".into(), timing: timing("fxrt_core", 113.3, None) },
@@ -267,7 +298,7 @@ fn ecp5_columns_follow_the_modules() {
     let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
     let cells: Vec<String> = r.records().next().unwrap().unwrap().iter().map(String::from).collect();
     let at = |name: &str| cells[header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no {name}"))].clone();
-    assert_eq!(header.len(), output::CSV_COLUMNS.len() + 3 * FIELDS.len() + 1);
+    assert_eq!(header.len(), output::CSV_COLUMNS.len() + output::CORE_COLUMNS.len() + 3 * FIELDS.len() + 1);
     assert_eq!(header[header.len() - 4..], ["mrays_per_s_at_fmax", "image", "error", "key"]);
     assert_eq!(header[header.len() - 5], "core_path_ns");
     assert_eq!(
@@ -286,7 +317,78 @@ fn ecp5_columns_follow_the_modules() {
     // A row read back from the cache is the row.
     let back: Row = serde_json::from_slice(&serde_json::to_vec(&row).unwrap()).unwrap();
     assert_eq!(back, row);
-    let plain = output::csv_bytes(&SweepSpec { ecp5: None, ..s }, &[row]);
+    let plain = output::csv_bytes(&SweepSpec { ecp5: None, core_sim: false, ..s }, &[row]);
     let first = String::from_utf8(plain).unwrap().lines().next().unwrap().to_string();
     assert_eq!(first, output::CSV_COLUMNS.join(","));
+}
+
+/// Leaf size, ray slots and units are axes like n, m, E, T and C: in the cross product (the
+/// units fastest, scenes faster still) and one at a time around the base; a parameter set that
+/// is invalid is skipped once, whatever shapes come with it.
+#[test]
+fn leaf_size_slots_and_units_are_axes() {
+    let s = SweepSpec { leaf_size: vec![2, 4], slots: vec![8, 64], units: vec![1, 2, 4], ..spec() };
+    let plan = s.plan().unwrap();
+    // 6 valid (n, m, E, T, C) sets, as in the test above, × 2 leaf sizes × 2 × 3 shapes.
+    assert_eq!(plan.sets.len(), 6 * 2 * 2 * 3);
+    assert_eq!(plan.configs.len(), 2 * plan.sets.len());
+    assert_eq!(plan.skipped.len(), 2 * 2, "(m = 12, T = 24) at each leaf size, once for all shapes");
+    assert_eq!(s.swept_axes(), vec![Axis::M, Axis::EdgeShift, Axis::T, Axis::LeafSize, Axis::Slots, Axis::Units]);
+    let shapes: Vec<(u32, u32)> = plan.sets[..6].iter().map(|x| (x.shape.slots, x.shape.units)).collect();
+    assert_eq!(shapes, [(8, 1), (8, 2), (8, 4), (64, 1), (64, 2), (64, 4)]);
+    assert!(plan.sets[..6].iter().all(|x| x.params == Params { m: 12, leaf_size: 2, ..Params::default() }));
+    assert_eq!(plan.sets[6].params.leaf_size, 4);
+    let c = &plan.configs[3];
+    assert_eq!((c.index, c.scene, c.shape), (3, 1, CoreShape { slots: 8, units: 2 }));
+    // The base: each at its default where listed (leaf 4, K 64, U 2).
+    assert_eq!(plan.base.shape, CoreShape::default());
+    assert_eq!(plan.base.params.leaf_size, 4);
+    assert_eq!(s.set_text(&plan.base), "n=29 m=32 E=auto T=0 C=16 leaf=4 K=64 U=2");
+    assert_eq!(spec().set_text(&plan.base), "n=29 m=32 E=auto T=0 C=16", "only swept new axes are named");
+    // One at a time: the base, then each axis's other values in list order.
+    let one = SweepSpec { one_at_a_time: true, m: vec![32], t: vec![0], edge_shift: vec![EdgeShift::Auto], ..s };
+    let plan = one.plan().unwrap();
+    let base = plan.base;
+    let expected = vec![
+        base,
+        Set { params: Params { leaf_size: 2, ..base.params }, ..base },
+        Set { shape: CoreShape { slots: 8, units: 2 }, ..base },
+        Set { shape: CoreShape { slots: 64, units: 1 }, ..base },
+        Set { shape: CoreShape { slots: 64, units: 4 }, ..base },
+    ];
+    assert_eq!(plan.sets, expected);
+    assert_eq!(set_label(&expected[2]), "n29_m32_eauto_t0_c16_k8_u2");
+    // Lists without the default: the base takes the first value.
+    let s = SweepSpec { slots: vec![16, 8], units: vec![4], leaf_size: vec![8, 1], ..spec() };
+    let base = s.plan().unwrap().base;
+    assert_eq!((base.shape, base.params.leaf_size), (CoreShape { slots: 16, units: 4 }, 8));
+    let s = SweepSpec { slots: vec![], ..spec() };
+    assert_eq!(s.plan().unwrap_err().to_string(), "--slots: the list is empty");
+}
+
+/// A results.json spec written before the leaf size, slots and units became lists (leaf_size a
+/// number, slots and units absent, or numbers as the last single-valued build wrote them) reads
+/// back as the same sweep; a spec that does not sweep them writes what those builds wrote.
+#[test]
+fn specs_written_before_the_lists_read_back_the_same() {
+    let old = r#"{"scenes":[{"builtin":"thin"}],"camera":{"eye":null,"at":null,"up":[0.0,1.0,0.0],"fov":45.0,
+        "width":16,"height":16},"n":[29],"m":[12,32],"t":[0,24],"c":[16],"edge_shift":["auto",{"fixed":10}],
+        "leaf_size":2,"stack_depth":32,"one_at_a_time":false,"synth":false,"core_sim":true}"#;
+    let s: SweepSpec = serde_json::from_str(old).unwrap();
+    assert_eq!((s.leaf_size.clone(), s.slots.clone(), s.units.clone()), (vec![2], vec![64], vec![2]));
+    assert!(s.default_core_shape());
+    let written = serde_json::to_value(&s).unwrap();
+    assert_eq!(written["leaf_size"], serde_json::json!(2));
+    assert!(written.get("slots").is_none() && written.get("units").is_none());
+    assert_eq!(written, serde_json::from_str::<serde_json::Value>(old).unwrap());
+    let single = old.replace(r#""core_sim":true"#, r#""core_sim":true,"slots":4,"units":1"#);
+    let s: SweepSpec = serde_json::from_str(&single).unwrap();
+    assert_eq!((s.slots.clone(), s.units.clone()), (vec![4], vec![1]));
+    assert_eq!(serde_json::to_value(&s).unwrap(), serde_json::from_str::<serde_json::Value>(&single).unwrap());
+    // Lists are written as lists and read back.
+    let lists = SweepSpec { leaf_size: vec![2, 8], slots: vec![8, 64], units: vec![1, 2], ..s };
+    let text = serde_json::to_string(&lists).unwrap();
+    assert!(text.contains(r#""leaf_size":[2,8]"#) && text.contains(r#""slots":[8,64],"units":[1,2]"#), "{text}");
+    assert_eq!(serde_json::from_str::<SweepSpec>(&text).unwrap(), lists);
+    assert!(serde_json::from_str::<SweepSpec>(&old.replace(r#""leaf_size":2"#, r#""leaf_size":"2""#)).is_err());
 }
