@@ -149,6 +149,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_13;
   wire [0:0] bits_best_valid_14;
   wire [0:0] bits_best_valid_15;
+  wire [3:0] bits_in_slot;
+  reg [0:0] fin_has_g0_c;
+  reg [0:0] fin_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_16;
   wire [0:0] bits_best_valid_17;
   wire [0:0] bits_best_valid_18;
@@ -165,6 +168,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_29;
   wire [0:0] bits_best_valid_30;
   wire [0:0] bits_best_valid_31;
+  wire [3:0] bits_in_slot_1;
+  reg [0:0] fin_has_g1_c;
+  reg [0:0] fin_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_32;
   wire [0:0] bits_best_valid_33;
   wire [0:0] bits_best_valid_34;
@@ -181,6 +187,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_45;
   wire [0:0] bits_best_valid_46;
   wire [0:0] bits_best_valid_47;
+  wire [3:0] bits_in_slot_2;
+  reg [0:0] fin_has_g2_c;
+  reg [0:0] fin_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_48;
   wire [0:0] bits_best_valid_49;
   wire [0:0] bits_best_valid_50;
@@ -197,6 +206,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_61;
   wire [0:0] bits_best_valid_62;
   wire [0:0] bits_best_valid_63;
+  wire [3:0] bits_in_slot_3;
+  reg [0:0] fin_has_g3_c;
+  reg [0:0] fin_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_64;
   wire [0:0] bits_best_valid_65;
   wire [0:0] bits_best_valid_66;
@@ -213,6 +225,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_77;
   wire [0:0] bits_best_valid_78;
   wire [0:0] bits_best_valid_79;
+  wire [3:0] bits_in_slot_4;
+  reg [0:0] fin_has_g4_c;
+  reg [0:0] fin_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_80;
   wire [0:0] bits_best_valid_81;
   wire [0:0] bits_best_valid_82;
@@ -229,6 +244,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_93;
   wire [0:0] bits_best_valid_94;
   wire [0:0] bits_best_valid_95;
+  wire [3:0] bits_in_slot_5;
+  reg [0:0] fin_has_g5_c;
+  reg [0:0] fin_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_96;
   wire [0:0] bits_best_valid_97;
   wire [0:0] bits_best_valid_98;
@@ -245,6 +263,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_109;
   wire [0:0] bits_best_valid_110;
   wire [0:0] bits_best_valid_111;
+  wire [3:0] bits_in_slot_6;
+  reg [0:0] fin_has_g6_c;
+  reg [0:0] fin_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_112;
   wire [0:0] bits_best_valid_113;
   wire [0:0] bits_best_valid_114;
@@ -261,7 +282,11 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_125;
   wire [0:0] bits_best_valid_126;
   wire [0:0] bits_best_valid_127;
-  reg [0:0] fin_slot_has;
+  wire [3:0] bits_in_slot_7;
+  reg [0:0] fin_has_g7_c;
+  reg [0:0] fin_has_g7 = 1'h0;
+  wire [2:0] bits_fin_slot;
+  reg [0:0] fin_has_c;
   reg [0:0] m1_slot_has = 1'h0;
   reg [0:0] m1_leaf_empty = 1'h0;
   wire [42:0] cat_5;
@@ -300,6 +325,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   reg [0:0] merge_hit_r = 1'h0;
   reg signed [31:0] merge_limit_r = 32'sh00000000;
   reg [5:0] merge_sp_r = 6'h00;
+  reg [0:0] d0 = 1'h0;
+  reg [6:0] d0_slot = 7'h00;
   reg [42:0] done_t_tri = 43'h00000000000;
   reg [63:0] done_u_v = 64'h0000000000000000;
   reg [19:0] done_id = 20'h00000;
@@ -321,6 +348,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_141;
   wire [0:0] bits_best_valid_142;
   wire [0:0] bits_best_valid_143;
+  wire [3:0] bits_done_slot;
+  reg [0:0] done_has_g0_c;
+  reg [0:0] done_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_144;
   wire [0:0] bits_best_valid_145;
   wire [0:0] bits_best_valid_146;
@@ -337,6 +367,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_157;
   wire [0:0] bits_best_valid_158;
   wire [0:0] bits_best_valid_159;
+  wire [3:0] bits_done_slot_1;
+  reg [0:0] done_has_g1_c;
+  reg [0:0] done_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_160;
   wire [0:0] bits_best_valid_161;
   wire [0:0] bits_best_valid_162;
@@ -353,6 +386,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_173;
   wire [0:0] bits_best_valid_174;
   wire [0:0] bits_best_valid_175;
+  wire [3:0] bits_done_slot_2;
+  reg [0:0] done_has_g2_c;
+  reg [0:0] done_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_176;
   wire [0:0] bits_best_valid_177;
   wire [0:0] bits_best_valid_178;
@@ -369,6 +405,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_189;
   wire [0:0] bits_best_valid_190;
   wire [0:0] bits_best_valid_191;
+  wire [3:0] bits_done_slot_3;
+  reg [0:0] done_has_g3_c;
+  reg [0:0] done_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_192;
   wire [0:0] bits_best_valid_193;
   wire [0:0] bits_best_valid_194;
@@ -385,6 +424,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_205;
   wire [0:0] bits_best_valid_206;
   wire [0:0] bits_best_valid_207;
+  wire [3:0] bits_done_slot_4;
+  reg [0:0] done_has_g4_c;
+  reg [0:0] done_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_208;
   wire [0:0] bits_best_valid_209;
   wire [0:0] bits_best_valid_210;
@@ -401,6 +443,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_221;
   wire [0:0] bits_best_valid_222;
   wire [0:0] bits_best_valid_223;
+  wire [3:0] bits_done_slot_5;
+  reg [0:0] done_has_g5_c;
+  reg [0:0] done_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_224;
   wire [0:0] bits_best_valid_225;
   wire [0:0] bits_best_valid_226;
@@ -417,6 +462,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_237;
   wire [0:0] bits_best_valid_238;
   wire [0:0] bits_best_valid_239;
+  wire [3:0] bits_done_slot_6;
+  reg [0:0] done_has_g6_c;
+  reg [0:0] done_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_240;
   wire [0:0] bits_best_valid_241;
   wire [0:0] bits_best_valid_242;
@@ -433,7 +481,11 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_253;
   wire [0:0] bits_best_valid_254;
   wire [0:0] bits_best_valid_255;
-  reg [0:0] done_slot_has;
+  wire [3:0] bits_done_slot_7;
+  reg [0:0] done_has_g7_c;
+  reg [0:0] done_has_g7 = 1'h0;
+  wire [2:0] bits_d0_slot;
+  reg [0:0] done_has_c;
   reg [0:0] d1_has = 1'h0;
   wire [127:0] k_0_1 = 128'h00000000000000000000000000000000;
   wire [6:0] k_127 = 7'h7f;
@@ -908,6 +960,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_13 = best_valid[13];
   assign bits_best_valid_14 = best_valid[14];
   assign bits_best_valid_15 = best_valid[15];
+  assign bits_in_slot = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot)
+      4'h0: fin_has_g0_c = bits_best_valid;
+      4'h1: fin_has_g0_c = bits_best_valid_1;
+      4'h2: fin_has_g0_c = bits_best_valid_2;
+      4'h3: fin_has_g0_c = bits_best_valid_3;
+      4'h4: fin_has_g0_c = bits_best_valid_4;
+      4'h5: fin_has_g0_c = bits_best_valid_5;
+      4'h6: fin_has_g0_c = bits_best_valid_6;
+      4'h7: fin_has_g0_c = bits_best_valid_7;
+      4'h8: fin_has_g0_c = bits_best_valid_8;
+      4'h9: fin_has_g0_c = bits_best_valid_9;
+      4'ha: fin_has_g0_c = bits_best_valid_10;
+      4'hb: fin_has_g0_c = bits_best_valid_11;
+      4'hc: fin_has_g0_c = bits_best_valid_12;
+      4'hd: fin_has_g0_c = bits_best_valid_13;
+      4'he: fin_has_g0_c = bits_best_valid_14;
+      4'hf: fin_has_g0_c = bits_best_valid_15;
+      default: fin_has_g0_c = k_0;
+    endcase
+  end
   assign bits_best_valid_16 = best_valid[16];
   assign bits_best_valid_17 = best_valid[17];
   assign bits_best_valid_18 = best_valid[18];
@@ -924,6 +998,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_29 = best_valid[29];
   assign bits_best_valid_30 = best_valid[30];
   assign bits_best_valid_31 = best_valid[31];
+  assign bits_in_slot_1 = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot_1)
+      4'h0: fin_has_g1_c = bits_best_valid_16;
+      4'h1: fin_has_g1_c = bits_best_valid_17;
+      4'h2: fin_has_g1_c = bits_best_valid_18;
+      4'h3: fin_has_g1_c = bits_best_valid_19;
+      4'h4: fin_has_g1_c = bits_best_valid_20;
+      4'h5: fin_has_g1_c = bits_best_valid_21;
+      4'h6: fin_has_g1_c = bits_best_valid_22;
+      4'h7: fin_has_g1_c = bits_best_valid_23;
+      4'h8: fin_has_g1_c = bits_best_valid_24;
+      4'h9: fin_has_g1_c = bits_best_valid_25;
+      4'ha: fin_has_g1_c = bits_best_valid_26;
+      4'hb: fin_has_g1_c = bits_best_valid_27;
+      4'hc: fin_has_g1_c = bits_best_valid_28;
+      4'hd: fin_has_g1_c = bits_best_valid_29;
+      4'he: fin_has_g1_c = bits_best_valid_30;
+      4'hf: fin_has_g1_c = bits_best_valid_31;
+      default: fin_has_g1_c = k_0;
+    endcase
+  end
   assign bits_best_valid_32 = best_valid[32];
   assign bits_best_valid_33 = best_valid[33];
   assign bits_best_valid_34 = best_valid[34];
@@ -940,6 +1036,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_45 = best_valid[45];
   assign bits_best_valid_46 = best_valid[46];
   assign bits_best_valid_47 = best_valid[47];
+  assign bits_in_slot_2 = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot_2)
+      4'h0: fin_has_g2_c = bits_best_valid_32;
+      4'h1: fin_has_g2_c = bits_best_valid_33;
+      4'h2: fin_has_g2_c = bits_best_valid_34;
+      4'h3: fin_has_g2_c = bits_best_valid_35;
+      4'h4: fin_has_g2_c = bits_best_valid_36;
+      4'h5: fin_has_g2_c = bits_best_valid_37;
+      4'h6: fin_has_g2_c = bits_best_valid_38;
+      4'h7: fin_has_g2_c = bits_best_valid_39;
+      4'h8: fin_has_g2_c = bits_best_valid_40;
+      4'h9: fin_has_g2_c = bits_best_valid_41;
+      4'ha: fin_has_g2_c = bits_best_valid_42;
+      4'hb: fin_has_g2_c = bits_best_valid_43;
+      4'hc: fin_has_g2_c = bits_best_valid_44;
+      4'hd: fin_has_g2_c = bits_best_valid_45;
+      4'he: fin_has_g2_c = bits_best_valid_46;
+      4'hf: fin_has_g2_c = bits_best_valid_47;
+      default: fin_has_g2_c = k_0;
+    endcase
+  end
   assign bits_best_valid_48 = best_valid[48];
   assign bits_best_valid_49 = best_valid[49];
   assign bits_best_valid_50 = best_valid[50];
@@ -956,6 +1074,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_61 = best_valid[61];
   assign bits_best_valid_62 = best_valid[62];
   assign bits_best_valid_63 = best_valid[63];
+  assign bits_in_slot_3 = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot_3)
+      4'h0: fin_has_g3_c = bits_best_valid_48;
+      4'h1: fin_has_g3_c = bits_best_valid_49;
+      4'h2: fin_has_g3_c = bits_best_valid_50;
+      4'h3: fin_has_g3_c = bits_best_valid_51;
+      4'h4: fin_has_g3_c = bits_best_valid_52;
+      4'h5: fin_has_g3_c = bits_best_valid_53;
+      4'h6: fin_has_g3_c = bits_best_valid_54;
+      4'h7: fin_has_g3_c = bits_best_valid_55;
+      4'h8: fin_has_g3_c = bits_best_valid_56;
+      4'h9: fin_has_g3_c = bits_best_valid_57;
+      4'ha: fin_has_g3_c = bits_best_valid_58;
+      4'hb: fin_has_g3_c = bits_best_valid_59;
+      4'hc: fin_has_g3_c = bits_best_valid_60;
+      4'hd: fin_has_g3_c = bits_best_valid_61;
+      4'he: fin_has_g3_c = bits_best_valid_62;
+      4'hf: fin_has_g3_c = bits_best_valid_63;
+      default: fin_has_g3_c = k_0;
+    endcase
+  end
   assign bits_best_valid_64 = best_valid[64];
   assign bits_best_valid_65 = best_valid[65];
   assign bits_best_valid_66 = best_valid[66];
@@ -972,6 +1112,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_77 = best_valid[77];
   assign bits_best_valid_78 = best_valid[78];
   assign bits_best_valid_79 = best_valid[79];
+  assign bits_in_slot_4 = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot_4)
+      4'h0: fin_has_g4_c = bits_best_valid_64;
+      4'h1: fin_has_g4_c = bits_best_valid_65;
+      4'h2: fin_has_g4_c = bits_best_valid_66;
+      4'h3: fin_has_g4_c = bits_best_valid_67;
+      4'h4: fin_has_g4_c = bits_best_valid_68;
+      4'h5: fin_has_g4_c = bits_best_valid_69;
+      4'h6: fin_has_g4_c = bits_best_valid_70;
+      4'h7: fin_has_g4_c = bits_best_valid_71;
+      4'h8: fin_has_g4_c = bits_best_valid_72;
+      4'h9: fin_has_g4_c = bits_best_valid_73;
+      4'ha: fin_has_g4_c = bits_best_valid_74;
+      4'hb: fin_has_g4_c = bits_best_valid_75;
+      4'hc: fin_has_g4_c = bits_best_valid_76;
+      4'hd: fin_has_g4_c = bits_best_valid_77;
+      4'he: fin_has_g4_c = bits_best_valid_78;
+      4'hf: fin_has_g4_c = bits_best_valid_79;
+      default: fin_has_g4_c = k_0;
+    endcase
+  end
   assign bits_best_valid_80 = best_valid[80];
   assign bits_best_valid_81 = best_valid[81];
   assign bits_best_valid_82 = best_valid[82];
@@ -988,6 +1150,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_93 = best_valid[93];
   assign bits_best_valid_94 = best_valid[94];
   assign bits_best_valid_95 = best_valid[95];
+  assign bits_in_slot_5 = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot_5)
+      4'h0: fin_has_g5_c = bits_best_valid_80;
+      4'h1: fin_has_g5_c = bits_best_valid_81;
+      4'h2: fin_has_g5_c = bits_best_valid_82;
+      4'h3: fin_has_g5_c = bits_best_valid_83;
+      4'h4: fin_has_g5_c = bits_best_valid_84;
+      4'h5: fin_has_g5_c = bits_best_valid_85;
+      4'h6: fin_has_g5_c = bits_best_valid_86;
+      4'h7: fin_has_g5_c = bits_best_valid_87;
+      4'h8: fin_has_g5_c = bits_best_valid_88;
+      4'h9: fin_has_g5_c = bits_best_valid_89;
+      4'ha: fin_has_g5_c = bits_best_valid_90;
+      4'hb: fin_has_g5_c = bits_best_valid_91;
+      4'hc: fin_has_g5_c = bits_best_valid_92;
+      4'hd: fin_has_g5_c = bits_best_valid_93;
+      4'he: fin_has_g5_c = bits_best_valid_94;
+      4'hf: fin_has_g5_c = bits_best_valid_95;
+      default: fin_has_g5_c = k_0;
+    endcase
+  end
   assign bits_best_valid_96 = best_valid[96];
   assign bits_best_valid_97 = best_valid[97];
   assign bits_best_valid_98 = best_valid[98];
@@ -1004,6 +1188,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_109 = best_valid[109];
   assign bits_best_valid_110 = best_valid[110];
   assign bits_best_valid_111 = best_valid[111];
+  assign bits_in_slot_6 = in_slot[3:0];
+  always @* begin
+    case (bits_in_slot_6)
+      4'h0: fin_has_g6_c = bits_best_valid_96;
+      4'h1: fin_has_g6_c = bits_best_valid_97;
+      4'h2: fin_has_g6_c = bits_best_valid_98;
+      4'h3: fin_has_g6_c = bits_best_valid_99;
+      4'h4: fin_has_g6_c = bits_best_valid_100;
+      4'h5: fin_has_g6_c = bits_best_valid_101;
+      4'h6: fin_has_g6_c = bits_best_valid_102;
+      4'h7: fin_has_g6_c = bits_best_valid_103;
+      4'h8: fin_has_g6_c = bits_best_valid_104;
+      4'h9: fin_has_g6_c = bits_best_valid_105;
+      4'ha: fin_has_g6_c = bits_best_valid_106;
+      4'hb: fin_has_g6_c = bits_best_valid_107;
+      4'hc: fin_has_g6_c = bits_best_valid_108;
+      4'hd: fin_has_g6_c = bits_best_valid_109;
+      4'he: fin_has_g6_c = bits_best_valid_110;
+      4'hf: fin_has_g6_c = bits_best_valid_111;
+      default: fin_has_g6_c = k_0;
+    endcase
+  end
   assign bits_best_valid_112 = best_valid[112];
   assign bits_best_valid_113 = best_valid[113];
   assign bits_best_valid_114 = best_valid[114];
@@ -1020,137 +1226,40 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_125 = best_valid[125];
   assign bits_best_valid_126 = best_valid[126];
   assign bits_best_valid_127 = best_valid[127];
+  assign bits_in_slot_7 = in_slot[3:0];
   always @* begin
-    case (fin_slot)
-      7'h00: fin_slot_has = bits_best_valid;
-      7'h01: fin_slot_has = bits_best_valid_1;
-      7'h02: fin_slot_has = bits_best_valid_2;
-      7'h03: fin_slot_has = bits_best_valid_3;
-      7'h04: fin_slot_has = bits_best_valid_4;
-      7'h05: fin_slot_has = bits_best_valid_5;
-      7'h06: fin_slot_has = bits_best_valid_6;
-      7'h07: fin_slot_has = bits_best_valid_7;
-      7'h08: fin_slot_has = bits_best_valid_8;
-      7'h09: fin_slot_has = bits_best_valid_9;
-      7'h0a: fin_slot_has = bits_best_valid_10;
-      7'h0b: fin_slot_has = bits_best_valid_11;
-      7'h0c: fin_slot_has = bits_best_valid_12;
-      7'h0d: fin_slot_has = bits_best_valid_13;
-      7'h0e: fin_slot_has = bits_best_valid_14;
-      7'h0f: fin_slot_has = bits_best_valid_15;
-      7'h10: fin_slot_has = bits_best_valid_16;
-      7'h11: fin_slot_has = bits_best_valid_17;
-      7'h12: fin_slot_has = bits_best_valid_18;
-      7'h13: fin_slot_has = bits_best_valid_19;
-      7'h14: fin_slot_has = bits_best_valid_20;
-      7'h15: fin_slot_has = bits_best_valid_21;
-      7'h16: fin_slot_has = bits_best_valid_22;
-      7'h17: fin_slot_has = bits_best_valid_23;
-      7'h18: fin_slot_has = bits_best_valid_24;
-      7'h19: fin_slot_has = bits_best_valid_25;
-      7'h1a: fin_slot_has = bits_best_valid_26;
-      7'h1b: fin_slot_has = bits_best_valid_27;
-      7'h1c: fin_slot_has = bits_best_valid_28;
-      7'h1d: fin_slot_has = bits_best_valid_29;
-      7'h1e: fin_slot_has = bits_best_valid_30;
-      7'h1f: fin_slot_has = bits_best_valid_31;
-      7'h20: fin_slot_has = bits_best_valid_32;
-      7'h21: fin_slot_has = bits_best_valid_33;
-      7'h22: fin_slot_has = bits_best_valid_34;
-      7'h23: fin_slot_has = bits_best_valid_35;
-      7'h24: fin_slot_has = bits_best_valid_36;
-      7'h25: fin_slot_has = bits_best_valid_37;
-      7'h26: fin_slot_has = bits_best_valid_38;
-      7'h27: fin_slot_has = bits_best_valid_39;
-      7'h28: fin_slot_has = bits_best_valid_40;
-      7'h29: fin_slot_has = bits_best_valid_41;
-      7'h2a: fin_slot_has = bits_best_valid_42;
-      7'h2b: fin_slot_has = bits_best_valid_43;
-      7'h2c: fin_slot_has = bits_best_valid_44;
-      7'h2d: fin_slot_has = bits_best_valid_45;
-      7'h2e: fin_slot_has = bits_best_valid_46;
-      7'h2f: fin_slot_has = bits_best_valid_47;
-      7'h30: fin_slot_has = bits_best_valid_48;
-      7'h31: fin_slot_has = bits_best_valid_49;
-      7'h32: fin_slot_has = bits_best_valid_50;
-      7'h33: fin_slot_has = bits_best_valid_51;
-      7'h34: fin_slot_has = bits_best_valid_52;
-      7'h35: fin_slot_has = bits_best_valid_53;
-      7'h36: fin_slot_has = bits_best_valid_54;
-      7'h37: fin_slot_has = bits_best_valid_55;
-      7'h38: fin_slot_has = bits_best_valid_56;
-      7'h39: fin_slot_has = bits_best_valid_57;
-      7'h3a: fin_slot_has = bits_best_valid_58;
-      7'h3b: fin_slot_has = bits_best_valid_59;
-      7'h3c: fin_slot_has = bits_best_valid_60;
-      7'h3d: fin_slot_has = bits_best_valid_61;
-      7'h3e: fin_slot_has = bits_best_valid_62;
-      7'h3f: fin_slot_has = bits_best_valid_63;
-      7'h40: fin_slot_has = bits_best_valid_64;
-      7'h41: fin_slot_has = bits_best_valid_65;
-      7'h42: fin_slot_has = bits_best_valid_66;
-      7'h43: fin_slot_has = bits_best_valid_67;
-      7'h44: fin_slot_has = bits_best_valid_68;
-      7'h45: fin_slot_has = bits_best_valid_69;
-      7'h46: fin_slot_has = bits_best_valid_70;
-      7'h47: fin_slot_has = bits_best_valid_71;
-      7'h48: fin_slot_has = bits_best_valid_72;
-      7'h49: fin_slot_has = bits_best_valid_73;
-      7'h4a: fin_slot_has = bits_best_valid_74;
-      7'h4b: fin_slot_has = bits_best_valid_75;
-      7'h4c: fin_slot_has = bits_best_valid_76;
-      7'h4d: fin_slot_has = bits_best_valid_77;
-      7'h4e: fin_slot_has = bits_best_valid_78;
-      7'h4f: fin_slot_has = bits_best_valid_79;
-      7'h50: fin_slot_has = bits_best_valid_80;
-      7'h51: fin_slot_has = bits_best_valid_81;
-      7'h52: fin_slot_has = bits_best_valid_82;
-      7'h53: fin_slot_has = bits_best_valid_83;
-      7'h54: fin_slot_has = bits_best_valid_84;
-      7'h55: fin_slot_has = bits_best_valid_85;
-      7'h56: fin_slot_has = bits_best_valid_86;
-      7'h57: fin_slot_has = bits_best_valid_87;
-      7'h58: fin_slot_has = bits_best_valid_88;
-      7'h59: fin_slot_has = bits_best_valid_89;
-      7'h5a: fin_slot_has = bits_best_valid_90;
-      7'h5b: fin_slot_has = bits_best_valid_91;
-      7'h5c: fin_slot_has = bits_best_valid_92;
-      7'h5d: fin_slot_has = bits_best_valid_93;
-      7'h5e: fin_slot_has = bits_best_valid_94;
-      7'h5f: fin_slot_has = bits_best_valid_95;
-      7'h60: fin_slot_has = bits_best_valid_96;
-      7'h61: fin_slot_has = bits_best_valid_97;
-      7'h62: fin_slot_has = bits_best_valid_98;
-      7'h63: fin_slot_has = bits_best_valid_99;
-      7'h64: fin_slot_has = bits_best_valid_100;
-      7'h65: fin_slot_has = bits_best_valid_101;
-      7'h66: fin_slot_has = bits_best_valid_102;
-      7'h67: fin_slot_has = bits_best_valid_103;
-      7'h68: fin_slot_has = bits_best_valid_104;
-      7'h69: fin_slot_has = bits_best_valid_105;
-      7'h6a: fin_slot_has = bits_best_valid_106;
-      7'h6b: fin_slot_has = bits_best_valid_107;
-      7'h6c: fin_slot_has = bits_best_valid_108;
-      7'h6d: fin_slot_has = bits_best_valid_109;
-      7'h6e: fin_slot_has = bits_best_valid_110;
-      7'h6f: fin_slot_has = bits_best_valid_111;
-      7'h70: fin_slot_has = bits_best_valid_112;
-      7'h71: fin_slot_has = bits_best_valid_113;
-      7'h72: fin_slot_has = bits_best_valid_114;
-      7'h73: fin_slot_has = bits_best_valid_115;
-      7'h74: fin_slot_has = bits_best_valid_116;
-      7'h75: fin_slot_has = bits_best_valid_117;
-      7'h76: fin_slot_has = bits_best_valid_118;
-      7'h77: fin_slot_has = bits_best_valid_119;
-      7'h78: fin_slot_has = bits_best_valid_120;
-      7'h79: fin_slot_has = bits_best_valid_121;
-      7'h7a: fin_slot_has = bits_best_valid_122;
-      7'h7b: fin_slot_has = bits_best_valid_123;
-      7'h7c: fin_slot_has = bits_best_valid_124;
-      7'h7d: fin_slot_has = bits_best_valid_125;
-      7'h7e: fin_slot_has = bits_best_valid_126;
-      7'h7f: fin_slot_has = bits_best_valid_127;
-      default: fin_slot_has = k_0;
+    case (bits_in_slot_7)
+      4'h0: fin_has_g7_c = bits_best_valid_112;
+      4'h1: fin_has_g7_c = bits_best_valid_113;
+      4'h2: fin_has_g7_c = bits_best_valid_114;
+      4'h3: fin_has_g7_c = bits_best_valid_115;
+      4'h4: fin_has_g7_c = bits_best_valid_116;
+      4'h5: fin_has_g7_c = bits_best_valid_117;
+      4'h6: fin_has_g7_c = bits_best_valid_118;
+      4'h7: fin_has_g7_c = bits_best_valid_119;
+      4'h8: fin_has_g7_c = bits_best_valid_120;
+      4'h9: fin_has_g7_c = bits_best_valid_121;
+      4'ha: fin_has_g7_c = bits_best_valid_122;
+      4'hb: fin_has_g7_c = bits_best_valid_123;
+      4'hc: fin_has_g7_c = bits_best_valid_124;
+      4'hd: fin_has_g7_c = bits_best_valid_125;
+      4'he: fin_has_g7_c = bits_best_valid_126;
+      4'hf: fin_has_g7_c = bits_best_valid_127;
+      default: fin_has_g7_c = k_0;
+    endcase
+  end
+  assign bits_fin_slot = fin_slot[6:4];
+  always @* begin
+    case (bits_fin_slot)
+      3'h0: fin_has_c = fin_has_g0;
+      3'h1: fin_has_c = fin_has_g1;
+      3'h2: fin_has_c = fin_has_g2;
+      3'h3: fin_has_c = fin_has_g3;
+      3'h4: fin_has_c = fin_has_g4;
+      3'h5: fin_has_c = fin_has_g5;
+      3'h6: fin_has_c = fin_has_g6;
+      3'h7: fin_has_c = fin_has_g7;
+      default: fin_has_c = k_0;
     endcase
   end
   assign cat_5 = {acc_t, acc_tri};
@@ -1188,6 +1297,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_141 = best_valid[13];
   assign bits_best_valid_142 = best_valid[14];
   assign bits_best_valid_143 = best_valid[15];
+  assign bits_done_slot = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot)
+      4'h0: done_has_g0_c = bits_best_valid_128;
+      4'h1: done_has_g0_c = bits_best_valid_129;
+      4'h2: done_has_g0_c = bits_best_valid_130;
+      4'h3: done_has_g0_c = bits_best_valid_131;
+      4'h4: done_has_g0_c = bits_best_valid_132;
+      4'h5: done_has_g0_c = bits_best_valid_133;
+      4'h6: done_has_g0_c = bits_best_valid_134;
+      4'h7: done_has_g0_c = bits_best_valid_135;
+      4'h8: done_has_g0_c = bits_best_valid_136;
+      4'h9: done_has_g0_c = bits_best_valid_137;
+      4'ha: done_has_g0_c = bits_best_valid_138;
+      4'hb: done_has_g0_c = bits_best_valid_139;
+      4'hc: done_has_g0_c = bits_best_valid_140;
+      4'hd: done_has_g0_c = bits_best_valid_141;
+      4'he: done_has_g0_c = bits_best_valid_142;
+      4'hf: done_has_g0_c = bits_best_valid_143;
+      default: done_has_g0_c = k_0;
+    endcase
+  end
   assign bits_best_valid_144 = best_valid[16];
   assign bits_best_valid_145 = best_valid[17];
   assign bits_best_valid_146 = best_valid[18];
@@ -1204,6 +1335,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_157 = best_valid[29];
   assign bits_best_valid_158 = best_valid[30];
   assign bits_best_valid_159 = best_valid[31];
+  assign bits_done_slot_1 = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot_1)
+      4'h0: done_has_g1_c = bits_best_valid_144;
+      4'h1: done_has_g1_c = bits_best_valid_145;
+      4'h2: done_has_g1_c = bits_best_valid_146;
+      4'h3: done_has_g1_c = bits_best_valid_147;
+      4'h4: done_has_g1_c = bits_best_valid_148;
+      4'h5: done_has_g1_c = bits_best_valid_149;
+      4'h6: done_has_g1_c = bits_best_valid_150;
+      4'h7: done_has_g1_c = bits_best_valid_151;
+      4'h8: done_has_g1_c = bits_best_valid_152;
+      4'h9: done_has_g1_c = bits_best_valid_153;
+      4'ha: done_has_g1_c = bits_best_valid_154;
+      4'hb: done_has_g1_c = bits_best_valid_155;
+      4'hc: done_has_g1_c = bits_best_valid_156;
+      4'hd: done_has_g1_c = bits_best_valid_157;
+      4'he: done_has_g1_c = bits_best_valid_158;
+      4'hf: done_has_g1_c = bits_best_valid_159;
+      default: done_has_g1_c = k_0;
+    endcase
+  end
   assign bits_best_valid_160 = best_valid[32];
   assign bits_best_valid_161 = best_valid[33];
   assign bits_best_valid_162 = best_valid[34];
@@ -1220,6 +1373,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_173 = best_valid[45];
   assign bits_best_valid_174 = best_valid[46];
   assign bits_best_valid_175 = best_valid[47];
+  assign bits_done_slot_2 = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot_2)
+      4'h0: done_has_g2_c = bits_best_valid_160;
+      4'h1: done_has_g2_c = bits_best_valid_161;
+      4'h2: done_has_g2_c = bits_best_valid_162;
+      4'h3: done_has_g2_c = bits_best_valid_163;
+      4'h4: done_has_g2_c = bits_best_valid_164;
+      4'h5: done_has_g2_c = bits_best_valid_165;
+      4'h6: done_has_g2_c = bits_best_valid_166;
+      4'h7: done_has_g2_c = bits_best_valid_167;
+      4'h8: done_has_g2_c = bits_best_valid_168;
+      4'h9: done_has_g2_c = bits_best_valid_169;
+      4'ha: done_has_g2_c = bits_best_valid_170;
+      4'hb: done_has_g2_c = bits_best_valid_171;
+      4'hc: done_has_g2_c = bits_best_valid_172;
+      4'hd: done_has_g2_c = bits_best_valid_173;
+      4'he: done_has_g2_c = bits_best_valid_174;
+      4'hf: done_has_g2_c = bits_best_valid_175;
+      default: done_has_g2_c = k_0;
+    endcase
+  end
   assign bits_best_valid_176 = best_valid[48];
   assign bits_best_valid_177 = best_valid[49];
   assign bits_best_valid_178 = best_valid[50];
@@ -1236,6 +1411,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_189 = best_valid[61];
   assign bits_best_valid_190 = best_valid[62];
   assign bits_best_valid_191 = best_valid[63];
+  assign bits_done_slot_3 = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot_3)
+      4'h0: done_has_g3_c = bits_best_valid_176;
+      4'h1: done_has_g3_c = bits_best_valid_177;
+      4'h2: done_has_g3_c = bits_best_valid_178;
+      4'h3: done_has_g3_c = bits_best_valid_179;
+      4'h4: done_has_g3_c = bits_best_valid_180;
+      4'h5: done_has_g3_c = bits_best_valid_181;
+      4'h6: done_has_g3_c = bits_best_valid_182;
+      4'h7: done_has_g3_c = bits_best_valid_183;
+      4'h8: done_has_g3_c = bits_best_valid_184;
+      4'h9: done_has_g3_c = bits_best_valid_185;
+      4'ha: done_has_g3_c = bits_best_valid_186;
+      4'hb: done_has_g3_c = bits_best_valid_187;
+      4'hc: done_has_g3_c = bits_best_valid_188;
+      4'hd: done_has_g3_c = bits_best_valid_189;
+      4'he: done_has_g3_c = bits_best_valid_190;
+      4'hf: done_has_g3_c = bits_best_valid_191;
+      default: done_has_g3_c = k_0;
+    endcase
+  end
   assign bits_best_valid_192 = best_valid[64];
   assign bits_best_valid_193 = best_valid[65];
   assign bits_best_valid_194 = best_valid[66];
@@ -1252,6 +1449,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_205 = best_valid[77];
   assign bits_best_valid_206 = best_valid[78];
   assign bits_best_valid_207 = best_valid[79];
+  assign bits_done_slot_4 = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot_4)
+      4'h0: done_has_g4_c = bits_best_valid_192;
+      4'h1: done_has_g4_c = bits_best_valid_193;
+      4'h2: done_has_g4_c = bits_best_valid_194;
+      4'h3: done_has_g4_c = bits_best_valid_195;
+      4'h4: done_has_g4_c = bits_best_valid_196;
+      4'h5: done_has_g4_c = bits_best_valid_197;
+      4'h6: done_has_g4_c = bits_best_valid_198;
+      4'h7: done_has_g4_c = bits_best_valid_199;
+      4'h8: done_has_g4_c = bits_best_valid_200;
+      4'h9: done_has_g4_c = bits_best_valid_201;
+      4'ha: done_has_g4_c = bits_best_valid_202;
+      4'hb: done_has_g4_c = bits_best_valid_203;
+      4'hc: done_has_g4_c = bits_best_valid_204;
+      4'hd: done_has_g4_c = bits_best_valid_205;
+      4'he: done_has_g4_c = bits_best_valid_206;
+      4'hf: done_has_g4_c = bits_best_valid_207;
+      default: done_has_g4_c = k_0;
+    endcase
+  end
   assign bits_best_valid_208 = best_valid[80];
   assign bits_best_valid_209 = best_valid[81];
   assign bits_best_valid_210 = best_valid[82];
@@ -1268,6 +1487,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_221 = best_valid[93];
   assign bits_best_valid_222 = best_valid[94];
   assign bits_best_valid_223 = best_valid[95];
+  assign bits_done_slot_5 = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot_5)
+      4'h0: done_has_g5_c = bits_best_valid_208;
+      4'h1: done_has_g5_c = bits_best_valid_209;
+      4'h2: done_has_g5_c = bits_best_valid_210;
+      4'h3: done_has_g5_c = bits_best_valid_211;
+      4'h4: done_has_g5_c = bits_best_valid_212;
+      4'h5: done_has_g5_c = bits_best_valid_213;
+      4'h6: done_has_g5_c = bits_best_valid_214;
+      4'h7: done_has_g5_c = bits_best_valid_215;
+      4'h8: done_has_g5_c = bits_best_valid_216;
+      4'h9: done_has_g5_c = bits_best_valid_217;
+      4'ha: done_has_g5_c = bits_best_valid_218;
+      4'hb: done_has_g5_c = bits_best_valid_219;
+      4'hc: done_has_g5_c = bits_best_valid_220;
+      4'hd: done_has_g5_c = bits_best_valid_221;
+      4'he: done_has_g5_c = bits_best_valid_222;
+      4'hf: done_has_g5_c = bits_best_valid_223;
+      default: done_has_g5_c = k_0;
+    endcase
+  end
   assign bits_best_valid_224 = best_valid[96];
   assign bits_best_valid_225 = best_valid[97];
   assign bits_best_valid_226 = best_valid[98];
@@ -1284,6 +1525,28 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_237 = best_valid[109];
   assign bits_best_valid_238 = best_valid[110];
   assign bits_best_valid_239 = best_valid[111];
+  assign bits_done_slot_6 = done_slot[3:0];
+  always @* begin
+    case (bits_done_slot_6)
+      4'h0: done_has_g6_c = bits_best_valid_224;
+      4'h1: done_has_g6_c = bits_best_valid_225;
+      4'h2: done_has_g6_c = bits_best_valid_226;
+      4'h3: done_has_g6_c = bits_best_valid_227;
+      4'h4: done_has_g6_c = bits_best_valid_228;
+      4'h5: done_has_g6_c = bits_best_valid_229;
+      4'h6: done_has_g6_c = bits_best_valid_230;
+      4'h7: done_has_g6_c = bits_best_valid_231;
+      4'h8: done_has_g6_c = bits_best_valid_232;
+      4'h9: done_has_g6_c = bits_best_valid_233;
+      4'ha: done_has_g6_c = bits_best_valid_234;
+      4'hb: done_has_g6_c = bits_best_valid_235;
+      4'hc: done_has_g6_c = bits_best_valid_236;
+      4'hd: done_has_g6_c = bits_best_valid_237;
+      4'he: done_has_g6_c = bits_best_valid_238;
+      4'hf: done_has_g6_c = bits_best_valid_239;
+      default: done_has_g6_c = k_0;
+    endcase
+  end
   assign bits_best_valid_240 = best_valid[112];
   assign bits_best_valid_241 = best_valid[113];
   assign bits_best_valid_242 = best_valid[114];
@@ -1300,137 +1563,40 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_253 = best_valid[125];
   assign bits_best_valid_254 = best_valid[126];
   assign bits_best_valid_255 = best_valid[127];
+  assign bits_done_slot_7 = done_slot[3:0];
   always @* begin
-    case (done_slot)
-      7'h00: done_slot_has = bits_best_valid_128;
-      7'h01: done_slot_has = bits_best_valid_129;
-      7'h02: done_slot_has = bits_best_valid_130;
-      7'h03: done_slot_has = bits_best_valid_131;
-      7'h04: done_slot_has = bits_best_valid_132;
-      7'h05: done_slot_has = bits_best_valid_133;
-      7'h06: done_slot_has = bits_best_valid_134;
-      7'h07: done_slot_has = bits_best_valid_135;
-      7'h08: done_slot_has = bits_best_valid_136;
-      7'h09: done_slot_has = bits_best_valid_137;
-      7'h0a: done_slot_has = bits_best_valid_138;
-      7'h0b: done_slot_has = bits_best_valid_139;
-      7'h0c: done_slot_has = bits_best_valid_140;
-      7'h0d: done_slot_has = bits_best_valid_141;
-      7'h0e: done_slot_has = bits_best_valid_142;
-      7'h0f: done_slot_has = bits_best_valid_143;
-      7'h10: done_slot_has = bits_best_valid_144;
-      7'h11: done_slot_has = bits_best_valid_145;
-      7'h12: done_slot_has = bits_best_valid_146;
-      7'h13: done_slot_has = bits_best_valid_147;
-      7'h14: done_slot_has = bits_best_valid_148;
-      7'h15: done_slot_has = bits_best_valid_149;
-      7'h16: done_slot_has = bits_best_valid_150;
-      7'h17: done_slot_has = bits_best_valid_151;
-      7'h18: done_slot_has = bits_best_valid_152;
-      7'h19: done_slot_has = bits_best_valid_153;
-      7'h1a: done_slot_has = bits_best_valid_154;
-      7'h1b: done_slot_has = bits_best_valid_155;
-      7'h1c: done_slot_has = bits_best_valid_156;
-      7'h1d: done_slot_has = bits_best_valid_157;
-      7'h1e: done_slot_has = bits_best_valid_158;
-      7'h1f: done_slot_has = bits_best_valid_159;
-      7'h20: done_slot_has = bits_best_valid_160;
-      7'h21: done_slot_has = bits_best_valid_161;
-      7'h22: done_slot_has = bits_best_valid_162;
-      7'h23: done_slot_has = bits_best_valid_163;
-      7'h24: done_slot_has = bits_best_valid_164;
-      7'h25: done_slot_has = bits_best_valid_165;
-      7'h26: done_slot_has = bits_best_valid_166;
-      7'h27: done_slot_has = bits_best_valid_167;
-      7'h28: done_slot_has = bits_best_valid_168;
-      7'h29: done_slot_has = bits_best_valid_169;
-      7'h2a: done_slot_has = bits_best_valid_170;
-      7'h2b: done_slot_has = bits_best_valid_171;
-      7'h2c: done_slot_has = bits_best_valid_172;
-      7'h2d: done_slot_has = bits_best_valid_173;
-      7'h2e: done_slot_has = bits_best_valid_174;
-      7'h2f: done_slot_has = bits_best_valid_175;
-      7'h30: done_slot_has = bits_best_valid_176;
-      7'h31: done_slot_has = bits_best_valid_177;
-      7'h32: done_slot_has = bits_best_valid_178;
-      7'h33: done_slot_has = bits_best_valid_179;
-      7'h34: done_slot_has = bits_best_valid_180;
-      7'h35: done_slot_has = bits_best_valid_181;
-      7'h36: done_slot_has = bits_best_valid_182;
-      7'h37: done_slot_has = bits_best_valid_183;
-      7'h38: done_slot_has = bits_best_valid_184;
-      7'h39: done_slot_has = bits_best_valid_185;
-      7'h3a: done_slot_has = bits_best_valid_186;
-      7'h3b: done_slot_has = bits_best_valid_187;
-      7'h3c: done_slot_has = bits_best_valid_188;
-      7'h3d: done_slot_has = bits_best_valid_189;
-      7'h3e: done_slot_has = bits_best_valid_190;
-      7'h3f: done_slot_has = bits_best_valid_191;
-      7'h40: done_slot_has = bits_best_valid_192;
-      7'h41: done_slot_has = bits_best_valid_193;
-      7'h42: done_slot_has = bits_best_valid_194;
-      7'h43: done_slot_has = bits_best_valid_195;
-      7'h44: done_slot_has = bits_best_valid_196;
-      7'h45: done_slot_has = bits_best_valid_197;
-      7'h46: done_slot_has = bits_best_valid_198;
-      7'h47: done_slot_has = bits_best_valid_199;
-      7'h48: done_slot_has = bits_best_valid_200;
-      7'h49: done_slot_has = bits_best_valid_201;
-      7'h4a: done_slot_has = bits_best_valid_202;
-      7'h4b: done_slot_has = bits_best_valid_203;
-      7'h4c: done_slot_has = bits_best_valid_204;
-      7'h4d: done_slot_has = bits_best_valid_205;
-      7'h4e: done_slot_has = bits_best_valid_206;
-      7'h4f: done_slot_has = bits_best_valid_207;
-      7'h50: done_slot_has = bits_best_valid_208;
-      7'h51: done_slot_has = bits_best_valid_209;
-      7'h52: done_slot_has = bits_best_valid_210;
-      7'h53: done_slot_has = bits_best_valid_211;
-      7'h54: done_slot_has = bits_best_valid_212;
-      7'h55: done_slot_has = bits_best_valid_213;
-      7'h56: done_slot_has = bits_best_valid_214;
-      7'h57: done_slot_has = bits_best_valid_215;
-      7'h58: done_slot_has = bits_best_valid_216;
-      7'h59: done_slot_has = bits_best_valid_217;
-      7'h5a: done_slot_has = bits_best_valid_218;
-      7'h5b: done_slot_has = bits_best_valid_219;
-      7'h5c: done_slot_has = bits_best_valid_220;
-      7'h5d: done_slot_has = bits_best_valid_221;
-      7'h5e: done_slot_has = bits_best_valid_222;
-      7'h5f: done_slot_has = bits_best_valid_223;
-      7'h60: done_slot_has = bits_best_valid_224;
-      7'h61: done_slot_has = bits_best_valid_225;
-      7'h62: done_slot_has = bits_best_valid_226;
-      7'h63: done_slot_has = bits_best_valid_227;
-      7'h64: done_slot_has = bits_best_valid_228;
-      7'h65: done_slot_has = bits_best_valid_229;
-      7'h66: done_slot_has = bits_best_valid_230;
-      7'h67: done_slot_has = bits_best_valid_231;
-      7'h68: done_slot_has = bits_best_valid_232;
-      7'h69: done_slot_has = bits_best_valid_233;
-      7'h6a: done_slot_has = bits_best_valid_234;
-      7'h6b: done_slot_has = bits_best_valid_235;
-      7'h6c: done_slot_has = bits_best_valid_236;
-      7'h6d: done_slot_has = bits_best_valid_237;
-      7'h6e: done_slot_has = bits_best_valid_238;
-      7'h6f: done_slot_has = bits_best_valid_239;
-      7'h70: done_slot_has = bits_best_valid_240;
-      7'h71: done_slot_has = bits_best_valid_241;
-      7'h72: done_slot_has = bits_best_valid_242;
-      7'h73: done_slot_has = bits_best_valid_243;
-      7'h74: done_slot_has = bits_best_valid_244;
-      7'h75: done_slot_has = bits_best_valid_245;
-      7'h76: done_slot_has = bits_best_valid_246;
-      7'h77: done_slot_has = bits_best_valid_247;
-      7'h78: done_slot_has = bits_best_valid_248;
-      7'h79: done_slot_has = bits_best_valid_249;
-      7'h7a: done_slot_has = bits_best_valid_250;
-      7'h7b: done_slot_has = bits_best_valid_251;
-      7'h7c: done_slot_has = bits_best_valid_252;
-      7'h7d: done_slot_has = bits_best_valid_253;
-      7'h7e: done_slot_has = bits_best_valid_254;
-      7'h7f: done_slot_has = bits_best_valid_255;
-      default: done_slot_has = k_0;
+    case (bits_done_slot_7)
+      4'h0: done_has_g7_c = bits_best_valid_240;
+      4'h1: done_has_g7_c = bits_best_valid_241;
+      4'h2: done_has_g7_c = bits_best_valid_242;
+      4'h3: done_has_g7_c = bits_best_valid_243;
+      4'h4: done_has_g7_c = bits_best_valid_244;
+      4'h5: done_has_g7_c = bits_best_valid_245;
+      4'h6: done_has_g7_c = bits_best_valid_246;
+      4'h7: done_has_g7_c = bits_best_valid_247;
+      4'h8: done_has_g7_c = bits_best_valid_248;
+      4'h9: done_has_g7_c = bits_best_valid_249;
+      4'ha: done_has_g7_c = bits_best_valid_250;
+      4'hb: done_has_g7_c = bits_best_valid_251;
+      4'hc: done_has_g7_c = bits_best_valid_252;
+      4'hd: done_has_g7_c = bits_best_valid_253;
+      4'he: done_has_g7_c = bits_best_valid_254;
+      4'hf: done_has_g7_c = bits_best_valid_255;
+      default: done_has_g7_c = k_0;
+    endcase
+  end
+  assign bits_d0_slot = d0_slot[6:4];
+  always @* begin
+    case (bits_d0_slot)
+      3'h0: done_has_c = done_has_g0;
+      3'h1: done_has_c = done_has_g1;
+      3'h2: done_has_c = done_has_g2;
+      3'h3: done_has_c = done_has_g3;
+      3'h4: done_has_c = done_has_g4;
+      3'h5: done_has_c = done_has_g5;
+      3'h6: done_has_c = done_has_g6;
+      3'h7: done_has_c = done_has_g7;
+      default: done_has_c = k_0;
     endcase
   end
   assign m2_slot_eq_k_127 = m2_slot == k_127;
@@ -1759,7 +1925,15 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     m1 <= fin;
     m1_slot <= fin_slot;
     m1_sp <= fin_sp;
-    m1_slot_has <= fin_slot_has;
+    fin_has_g0 <= fin_has_g0_c;
+    fin_has_g1 <= fin_has_g1_c;
+    fin_has_g2 <= fin_has_g2_c;
+    fin_has_g3 <= fin_has_g3_c;
+    fin_has_g4 <= fin_has_g4_c;
+    fin_has_g5 <= fin_has_g5_c;
+    fin_has_g6 <= fin_has_g6_c;
+    fin_has_g7 <= fin_has_g7_c;
+    m1_slot_has <= fin_has_c;
     m1_leaf_empty <= acc_empty;
     m1_t_tri <= cat_5;
     m1_u_v <= cat_6;
@@ -1776,12 +1950,22 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     merge_hit_r <= m2_hit;
     merge_limit_r <= merged_limit;
     merge_sp_r <= m2_sp;
-    done_t_tri <= best_t_tri[done_slot];
-    done_u_v <= best_u_v[done_slot];
-    done_id <= ray_ids[done_slot];
-    d1 <= done_valid;
-    d1_slot <= done_slot;
-    d1_has <= done_slot_has;
+    d0 <= done_valid;
+    d0_slot <= done_slot;
+    done_t_tri <= best_t_tri[d0_slot];
+    done_u_v <= best_u_v[d0_slot];
+    done_id <= ray_ids[d0_slot];
+    d1 <= d0;
+    d1_slot <= d0_slot;
+    done_has_g0 <= done_has_g0_c;
+    done_has_g1 <= done_has_g1_c;
+    done_has_g2 <= done_has_g2_c;
+    done_has_g3 <= done_has_g3_c;
+    done_has_g4 <= done_has_g4_c;
+    done_has_g5 <= done_has_g5_c;
+    done_has_g6 <= done_has_g6_c;
+    done_has_g7 <= done_has_g7_c;
+    d1_has <= done_has_c;
     free_valid_r <= d1;
     free_slot_r <= d1_slot;
     if (rst) res_valid_r <= 1'h0;

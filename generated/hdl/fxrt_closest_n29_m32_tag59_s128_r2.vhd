@@ -530,6 +530,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_13 : unsigned(0 downto 0);
   signal bits_best_valid_14 : unsigned(0 downto 0);
   signal bits_best_valid_15 : unsigned(0 downto 0);
+  signal bits_in_slot : unsigned(3 downto 0);
+  signal fin_has_g0_c : unsigned(0 downto 0);
+  signal fin_has_g0 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_16 : unsigned(0 downto 0);
   signal bits_best_valid_17 : unsigned(0 downto 0);
   signal bits_best_valid_18 : unsigned(0 downto 0);
@@ -546,6 +549,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_29 : unsigned(0 downto 0);
   signal bits_best_valid_30 : unsigned(0 downto 0);
   signal bits_best_valid_31 : unsigned(0 downto 0);
+  signal bits_in_slot_1 : unsigned(3 downto 0);
+  signal fin_has_g1_c : unsigned(0 downto 0);
+  signal fin_has_g1 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_32 : unsigned(0 downto 0);
   signal bits_best_valid_33 : unsigned(0 downto 0);
   signal bits_best_valid_34 : unsigned(0 downto 0);
@@ -562,6 +568,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_45 : unsigned(0 downto 0);
   signal bits_best_valid_46 : unsigned(0 downto 0);
   signal bits_best_valid_47 : unsigned(0 downto 0);
+  signal bits_in_slot_2 : unsigned(3 downto 0);
+  signal fin_has_g2_c : unsigned(0 downto 0);
+  signal fin_has_g2 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_48 : unsigned(0 downto 0);
   signal bits_best_valid_49 : unsigned(0 downto 0);
   signal bits_best_valid_50 : unsigned(0 downto 0);
@@ -578,6 +587,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_61 : unsigned(0 downto 0);
   signal bits_best_valid_62 : unsigned(0 downto 0);
   signal bits_best_valid_63 : unsigned(0 downto 0);
+  signal bits_in_slot_3 : unsigned(3 downto 0);
+  signal fin_has_g3_c : unsigned(0 downto 0);
+  signal fin_has_g3 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_64 : unsigned(0 downto 0);
   signal bits_best_valid_65 : unsigned(0 downto 0);
   signal bits_best_valid_66 : unsigned(0 downto 0);
@@ -594,6 +606,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_77 : unsigned(0 downto 0);
   signal bits_best_valid_78 : unsigned(0 downto 0);
   signal bits_best_valid_79 : unsigned(0 downto 0);
+  signal bits_in_slot_4 : unsigned(3 downto 0);
+  signal fin_has_g4_c : unsigned(0 downto 0);
+  signal fin_has_g4 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_80 : unsigned(0 downto 0);
   signal bits_best_valid_81 : unsigned(0 downto 0);
   signal bits_best_valid_82 : unsigned(0 downto 0);
@@ -610,6 +625,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_93 : unsigned(0 downto 0);
   signal bits_best_valid_94 : unsigned(0 downto 0);
   signal bits_best_valid_95 : unsigned(0 downto 0);
+  signal bits_in_slot_5 : unsigned(3 downto 0);
+  signal fin_has_g5_c : unsigned(0 downto 0);
+  signal fin_has_g5 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_96 : unsigned(0 downto 0);
   signal bits_best_valid_97 : unsigned(0 downto 0);
   signal bits_best_valid_98 : unsigned(0 downto 0);
@@ -626,6 +644,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_109 : unsigned(0 downto 0);
   signal bits_best_valid_110 : unsigned(0 downto 0);
   signal bits_best_valid_111 : unsigned(0 downto 0);
+  signal bits_in_slot_6 : unsigned(3 downto 0);
+  signal fin_has_g6_c : unsigned(0 downto 0);
+  signal fin_has_g6 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_112 : unsigned(0 downto 0);
   signal bits_best_valid_113 : unsigned(0 downto 0);
   signal bits_best_valid_114 : unsigned(0 downto 0);
@@ -642,7 +663,11 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_125 : unsigned(0 downto 0);
   signal bits_best_valid_126 : unsigned(0 downto 0);
   signal bits_best_valid_127 : unsigned(0 downto 0);
-  signal fin_slot_has : unsigned(0 downto 0);
+  signal bits_in_slot_7 : unsigned(3 downto 0);
+  signal fin_has_g7_c : unsigned(0 downto 0);
+  signal fin_has_g7 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_fin_slot : unsigned(2 downto 0);
+  signal fin_has_c : unsigned(0 downto 0);
   signal m1_slot_has : unsigned(0 downto 0) := unsigned'("0");
   signal m1_leaf_empty : unsigned(0 downto 0) := unsigned'("0");
   signal cat_5 : unsigned(42 downto 0);
@@ -679,6 +704,8 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal merge_hit_r : unsigned(0 downto 0) := unsigned'("0");
   signal merge_limit_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal merge_sp_r : unsigned(5 downto 0) := unsigned'("000000");
+  signal d0 : unsigned(0 downto 0) := unsigned'("0");
+  signal d0_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal done_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
   signal done_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal done_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
@@ -700,6 +727,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_141 : unsigned(0 downto 0);
   signal bits_best_valid_142 : unsigned(0 downto 0);
   signal bits_best_valid_143 : unsigned(0 downto 0);
+  signal bits_done_slot : unsigned(3 downto 0);
+  signal done_has_g0_c : unsigned(0 downto 0);
+  signal done_has_g0 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_144 : unsigned(0 downto 0);
   signal bits_best_valid_145 : unsigned(0 downto 0);
   signal bits_best_valid_146 : unsigned(0 downto 0);
@@ -716,6 +746,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_157 : unsigned(0 downto 0);
   signal bits_best_valid_158 : unsigned(0 downto 0);
   signal bits_best_valid_159 : unsigned(0 downto 0);
+  signal bits_done_slot_1 : unsigned(3 downto 0);
+  signal done_has_g1_c : unsigned(0 downto 0);
+  signal done_has_g1 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_160 : unsigned(0 downto 0);
   signal bits_best_valid_161 : unsigned(0 downto 0);
   signal bits_best_valid_162 : unsigned(0 downto 0);
@@ -732,6 +765,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_173 : unsigned(0 downto 0);
   signal bits_best_valid_174 : unsigned(0 downto 0);
   signal bits_best_valid_175 : unsigned(0 downto 0);
+  signal bits_done_slot_2 : unsigned(3 downto 0);
+  signal done_has_g2_c : unsigned(0 downto 0);
+  signal done_has_g2 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_176 : unsigned(0 downto 0);
   signal bits_best_valid_177 : unsigned(0 downto 0);
   signal bits_best_valid_178 : unsigned(0 downto 0);
@@ -748,6 +784,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_189 : unsigned(0 downto 0);
   signal bits_best_valid_190 : unsigned(0 downto 0);
   signal bits_best_valid_191 : unsigned(0 downto 0);
+  signal bits_done_slot_3 : unsigned(3 downto 0);
+  signal done_has_g3_c : unsigned(0 downto 0);
+  signal done_has_g3 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_192 : unsigned(0 downto 0);
   signal bits_best_valid_193 : unsigned(0 downto 0);
   signal bits_best_valid_194 : unsigned(0 downto 0);
@@ -764,6 +803,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_205 : unsigned(0 downto 0);
   signal bits_best_valid_206 : unsigned(0 downto 0);
   signal bits_best_valid_207 : unsigned(0 downto 0);
+  signal bits_done_slot_4 : unsigned(3 downto 0);
+  signal done_has_g4_c : unsigned(0 downto 0);
+  signal done_has_g4 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_208 : unsigned(0 downto 0);
   signal bits_best_valid_209 : unsigned(0 downto 0);
   signal bits_best_valid_210 : unsigned(0 downto 0);
@@ -780,6 +822,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_221 : unsigned(0 downto 0);
   signal bits_best_valid_222 : unsigned(0 downto 0);
   signal bits_best_valid_223 : unsigned(0 downto 0);
+  signal bits_done_slot_5 : unsigned(3 downto 0);
+  signal done_has_g5_c : unsigned(0 downto 0);
+  signal done_has_g5 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_224 : unsigned(0 downto 0);
   signal bits_best_valid_225 : unsigned(0 downto 0);
   signal bits_best_valid_226 : unsigned(0 downto 0);
@@ -796,6 +841,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_237 : unsigned(0 downto 0);
   signal bits_best_valid_238 : unsigned(0 downto 0);
   signal bits_best_valid_239 : unsigned(0 downto 0);
+  signal bits_done_slot_6 : unsigned(3 downto 0);
+  signal done_has_g6_c : unsigned(0 downto 0);
+  signal done_has_g6 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_240 : unsigned(0 downto 0);
   signal bits_best_valid_241 : unsigned(0 downto 0);
   signal bits_best_valid_242 : unsigned(0 downto 0);
@@ -812,7 +860,11 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_best_valid_253 : unsigned(0 downto 0);
   signal bits_best_valid_254 : unsigned(0 downto 0);
   signal bits_best_valid_255 : unsigned(0 downto 0);
-  signal done_slot_has : unsigned(0 downto 0);
+  signal bits_done_slot_7 : unsigned(3 downto 0);
+  signal done_has_g7_c : unsigned(0 downto 0);
+  signal done_has_g7 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_d0_slot : unsigned(2 downto 0);
+  signal done_has_c : unsigned(0 downto 0);
   signal d1_has : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_1 : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   constant k_127 : unsigned(6 downto 0) := unsigned'("1111111");
@@ -1288,6 +1340,26 @@ begin
   bits_best_valid_13 <= unsigned(best_valid(13 downto 13));
   bits_best_valid_14 <= unsigned(best_valid(14 downto 14));
   bits_best_valid_15 <= unsigned(best_valid(15 downto 15));
+  bits_in_slot <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot select
+    fin_has_g0_c <=
+      bits_best_valid when "0000",
+      bits_best_valid_1 when "0001",
+      bits_best_valid_2 when "0010",
+      bits_best_valid_3 when "0011",
+      bits_best_valid_4 when "0100",
+      bits_best_valid_5 when "0101",
+      bits_best_valid_6 when "0110",
+      bits_best_valid_7 when "0111",
+      bits_best_valid_8 when "1000",
+      bits_best_valid_9 when "1001",
+      bits_best_valid_10 when "1010",
+      bits_best_valid_11 when "1011",
+      bits_best_valid_12 when "1100",
+      bits_best_valid_13 when "1101",
+      bits_best_valid_14 when "1110",
+      bits_best_valid_15 when "1111",
+      k_0 when others;
   bits_best_valid_16 <= unsigned(best_valid(16 downto 16));
   bits_best_valid_17 <= unsigned(best_valid(17 downto 17));
   bits_best_valid_18 <= unsigned(best_valid(18 downto 18));
@@ -1304,6 +1376,26 @@ begin
   bits_best_valid_29 <= unsigned(best_valid(29 downto 29));
   bits_best_valid_30 <= unsigned(best_valid(30 downto 30));
   bits_best_valid_31 <= unsigned(best_valid(31 downto 31));
+  bits_in_slot_1 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_1 select
+    fin_has_g1_c <=
+      bits_best_valid_16 when "0000",
+      bits_best_valid_17 when "0001",
+      bits_best_valid_18 when "0010",
+      bits_best_valid_19 when "0011",
+      bits_best_valid_20 when "0100",
+      bits_best_valid_21 when "0101",
+      bits_best_valid_22 when "0110",
+      bits_best_valid_23 when "0111",
+      bits_best_valid_24 when "1000",
+      bits_best_valid_25 when "1001",
+      bits_best_valid_26 when "1010",
+      bits_best_valid_27 when "1011",
+      bits_best_valid_28 when "1100",
+      bits_best_valid_29 when "1101",
+      bits_best_valid_30 when "1110",
+      bits_best_valid_31 when "1111",
+      k_0 when others;
   bits_best_valid_32 <= unsigned(best_valid(32 downto 32));
   bits_best_valid_33 <= unsigned(best_valid(33 downto 33));
   bits_best_valid_34 <= unsigned(best_valid(34 downto 34));
@@ -1320,6 +1412,26 @@ begin
   bits_best_valid_45 <= unsigned(best_valid(45 downto 45));
   bits_best_valid_46 <= unsigned(best_valid(46 downto 46));
   bits_best_valid_47 <= unsigned(best_valid(47 downto 47));
+  bits_in_slot_2 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_2 select
+    fin_has_g2_c <=
+      bits_best_valid_32 when "0000",
+      bits_best_valid_33 when "0001",
+      bits_best_valid_34 when "0010",
+      bits_best_valid_35 when "0011",
+      bits_best_valid_36 when "0100",
+      bits_best_valid_37 when "0101",
+      bits_best_valid_38 when "0110",
+      bits_best_valid_39 when "0111",
+      bits_best_valid_40 when "1000",
+      bits_best_valid_41 when "1001",
+      bits_best_valid_42 when "1010",
+      bits_best_valid_43 when "1011",
+      bits_best_valid_44 when "1100",
+      bits_best_valid_45 when "1101",
+      bits_best_valid_46 when "1110",
+      bits_best_valid_47 when "1111",
+      k_0 when others;
   bits_best_valid_48 <= unsigned(best_valid(48 downto 48));
   bits_best_valid_49 <= unsigned(best_valid(49 downto 49));
   bits_best_valid_50 <= unsigned(best_valid(50 downto 50));
@@ -1336,6 +1448,26 @@ begin
   bits_best_valid_61 <= unsigned(best_valid(61 downto 61));
   bits_best_valid_62 <= unsigned(best_valid(62 downto 62));
   bits_best_valid_63 <= unsigned(best_valid(63 downto 63));
+  bits_in_slot_3 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_3 select
+    fin_has_g3_c <=
+      bits_best_valid_48 when "0000",
+      bits_best_valid_49 when "0001",
+      bits_best_valid_50 when "0010",
+      bits_best_valid_51 when "0011",
+      bits_best_valid_52 when "0100",
+      bits_best_valid_53 when "0101",
+      bits_best_valid_54 when "0110",
+      bits_best_valid_55 when "0111",
+      bits_best_valid_56 when "1000",
+      bits_best_valid_57 when "1001",
+      bits_best_valid_58 when "1010",
+      bits_best_valid_59 when "1011",
+      bits_best_valid_60 when "1100",
+      bits_best_valid_61 when "1101",
+      bits_best_valid_62 when "1110",
+      bits_best_valid_63 when "1111",
+      k_0 when others;
   bits_best_valid_64 <= unsigned(best_valid(64 downto 64));
   bits_best_valid_65 <= unsigned(best_valid(65 downto 65));
   bits_best_valid_66 <= unsigned(best_valid(66 downto 66));
@@ -1352,6 +1484,26 @@ begin
   bits_best_valid_77 <= unsigned(best_valid(77 downto 77));
   bits_best_valid_78 <= unsigned(best_valid(78 downto 78));
   bits_best_valid_79 <= unsigned(best_valid(79 downto 79));
+  bits_in_slot_4 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_4 select
+    fin_has_g4_c <=
+      bits_best_valid_64 when "0000",
+      bits_best_valid_65 when "0001",
+      bits_best_valid_66 when "0010",
+      bits_best_valid_67 when "0011",
+      bits_best_valid_68 when "0100",
+      bits_best_valid_69 when "0101",
+      bits_best_valid_70 when "0110",
+      bits_best_valid_71 when "0111",
+      bits_best_valid_72 when "1000",
+      bits_best_valid_73 when "1001",
+      bits_best_valid_74 when "1010",
+      bits_best_valid_75 when "1011",
+      bits_best_valid_76 when "1100",
+      bits_best_valid_77 when "1101",
+      bits_best_valid_78 when "1110",
+      bits_best_valid_79 when "1111",
+      k_0 when others;
   bits_best_valid_80 <= unsigned(best_valid(80 downto 80));
   bits_best_valid_81 <= unsigned(best_valid(81 downto 81));
   bits_best_valid_82 <= unsigned(best_valid(82 downto 82));
@@ -1368,6 +1520,26 @@ begin
   bits_best_valid_93 <= unsigned(best_valid(93 downto 93));
   bits_best_valid_94 <= unsigned(best_valid(94 downto 94));
   bits_best_valid_95 <= unsigned(best_valid(95 downto 95));
+  bits_in_slot_5 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_5 select
+    fin_has_g5_c <=
+      bits_best_valid_80 when "0000",
+      bits_best_valid_81 when "0001",
+      bits_best_valid_82 when "0010",
+      bits_best_valid_83 when "0011",
+      bits_best_valid_84 when "0100",
+      bits_best_valid_85 when "0101",
+      bits_best_valid_86 when "0110",
+      bits_best_valid_87 when "0111",
+      bits_best_valid_88 when "1000",
+      bits_best_valid_89 when "1001",
+      bits_best_valid_90 when "1010",
+      bits_best_valid_91 when "1011",
+      bits_best_valid_92 when "1100",
+      bits_best_valid_93 when "1101",
+      bits_best_valid_94 when "1110",
+      bits_best_valid_95 when "1111",
+      k_0 when others;
   bits_best_valid_96 <= unsigned(best_valid(96 downto 96));
   bits_best_valid_97 <= unsigned(best_valid(97 downto 97));
   bits_best_valid_98 <= unsigned(best_valid(98 downto 98));
@@ -1384,6 +1556,26 @@ begin
   bits_best_valid_109 <= unsigned(best_valid(109 downto 109));
   bits_best_valid_110 <= unsigned(best_valid(110 downto 110));
   bits_best_valid_111 <= unsigned(best_valid(111 downto 111));
+  bits_in_slot_6 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_6 select
+    fin_has_g6_c <=
+      bits_best_valid_96 when "0000",
+      bits_best_valid_97 when "0001",
+      bits_best_valid_98 when "0010",
+      bits_best_valid_99 when "0011",
+      bits_best_valid_100 when "0100",
+      bits_best_valid_101 when "0101",
+      bits_best_valid_102 when "0110",
+      bits_best_valid_103 when "0111",
+      bits_best_valid_104 when "1000",
+      bits_best_valid_105 when "1001",
+      bits_best_valid_106 when "1010",
+      bits_best_valid_107 when "1011",
+      bits_best_valid_108 when "1100",
+      bits_best_valid_109 when "1101",
+      bits_best_valid_110 when "1110",
+      bits_best_valid_111 when "1111",
+      k_0 when others;
   bits_best_valid_112 <= unsigned(best_valid(112 downto 112));
   bits_best_valid_113 <= unsigned(best_valid(113 downto 113));
   bits_best_valid_114 <= unsigned(best_valid(114 downto 114));
@@ -1400,136 +1592,37 @@ begin
   bits_best_valid_125 <= unsigned(best_valid(125 downto 125));
   bits_best_valid_126 <= unsigned(best_valid(126 downto 126));
   bits_best_valid_127 <= unsigned(best_valid(127 downto 127));
-  with fin_slot select
-    fin_slot_has <=
-      bits_best_valid when "0000000",
-      bits_best_valid_1 when "0000001",
-      bits_best_valid_2 when "0000010",
-      bits_best_valid_3 when "0000011",
-      bits_best_valid_4 when "0000100",
-      bits_best_valid_5 when "0000101",
-      bits_best_valid_6 when "0000110",
-      bits_best_valid_7 when "0000111",
-      bits_best_valid_8 when "0001000",
-      bits_best_valid_9 when "0001001",
-      bits_best_valid_10 when "0001010",
-      bits_best_valid_11 when "0001011",
-      bits_best_valid_12 when "0001100",
-      bits_best_valid_13 when "0001101",
-      bits_best_valid_14 when "0001110",
-      bits_best_valid_15 when "0001111",
-      bits_best_valid_16 when "0010000",
-      bits_best_valid_17 when "0010001",
-      bits_best_valid_18 when "0010010",
-      bits_best_valid_19 when "0010011",
-      bits_best_valid_20 when "0010100",
-      bits_best_valid_21 when "0010101",
-      bits_best_valid_22 when "0010110",
-      bits_best_valid_23 when "0010111",
-      bits_best_valid_24 when "0011000",
-      bits_best_valid_25 when "0011001",
-      bits_best_valid_26 when "0011010",
-      bits_best_valid_27 when "0011011",
-      bits_best_valid_28 when "0011100",
-      bits_best_valid_29 when "0011101",
-      bits_best_valid_30 when "0011110",
-      bits_best_valid_31 when "0011111",
-      bits_best_valid_32 when "0100000",
-      bits_best_valid_33 when "0100001",
-      bits_best_valid_34 when "0100010",
-      bits_best_valid_35 when "0100011",
-      bits_best_valid_36 when "0100100",
-      bits_best_valid_37 when "0100101",
-      bits_best_valid_38 when "0100110",
-      bits_best_valid_39 when "0100111",
-      bits_best_valid_40 when "0101000",
-      bits_best_valid_41 when "0101001",
-      bits_best_valid_42 when "0101010",
-      bits_best_valid_43 when "0101011",
-      bits_best_valid_44 when "0101100",
-      bits_best_valid_45 when "0101101",
-      bits_best_valid_46 when "0101110",
-      bits_best_valid_47 when "0101111",
-      bits_best_valid_48 when "0110000",
-      bits_best_valid_49 when "0110001",
-      bits_best_valid_50 when "0110010",
-      bits_best_valid_51 when "0110011",
-      bits_best_valid_52 when "0110100",
-      bits_best_valid_53 when "0110101",
-      bits_best_valid_54 when "0110110",
-      bits_best_valid_55 when "0110111",
-      bits_best_valid_56 when "0111000",
-      bits_best_valid_57 when "0111001",
-      bits_best_valid_58 when "0111010",
-      bits_best_valid_59 when "0111011",
-      bits_best_valid_60 when "0111100",
-      bits_best_valid_61 when "0111101",
-      bits_best_valid_62 when "0111110",
-      bits_best_valid_63 when "0111111",
-      bits_best_valid_64 when "1000000",
-      bits_best_valid_65 when "1000001",
-      bits_best_valid_66 when "1000010",
-      bits_best_valid_67 when "1000011",
-      bits_best_valid_68 when "1000100",
-      bits_best_valid_69 when "1000101",
-      bits_best_valid_70 when "1000110",
-      bits_best_valid_71 when "1000111",
-      bits_best_valid_72 when "1001000",
-      bits_best_valid_73 when "1001001",
-      bits_best_valid_74 when "1001010",
-      bits_best_valid_75 when "1001011",
-      bits_best_valid_76 when "1001100",
-      bits_best_valid_77 when "1001101",
-      bits_best_valid_78 when "1001110",
-      bits_best_valid_79 when "1001111",
-      bits_best_valid_80 when "1010000",
-      bits_best_valid_81 when "1010001",
-      bits_best_valid_82 when "1010010",
-      bits_best_valid_83 when "1010011",
-      bits_best_valid_84 when "1010100",
-      bits_best_valid_85 when "1010101",
-      bits_best_valid_86 when "1010110",
-      bits_best_valid_87 when "1010111",
-      bits_best_valid_88 when "1011000",
-      bits_best_valid_89 when "1011001",
-      bits_best_valid_90 when "1011010",
-      bits_best_valid_91 when "1011011",
-      bits_best_valid_92 when "1011100",
-      bits_best_valid_93 when "1011101",
-      bits_best_valid_94 when "1011110",
-      bits_best_valid_95 when "1011111",
-      bits_best_valid_96 when "1100000",
-      bits_best_valid_97 when "1100001",
-      bits_best_valid_98 when "1100010",
-      bits_best_valid_99 when "1100011",
-      bits_best_valid_100 when "1100100",
-      bits_best_valid_101 when "1100101",
-      bits_best_valid_102 when "1100110",
-      bits_best_valid_103 when "1100111",
-      bits_best_valid_104 when "1101000",
-      bits_best_valid_105 when "1101001",
-      bits_best_valid_106 when "1101010",
-      bits_best_valid_107 when "1101011",
-      bits_best_valid_108 when "1101100",
-      bits_best_valid_109 when "1101101",
-      bits_best_valid_110 when "1101110",
-      bits_best_valid_111 when "1101111",
-      bits_best_valid_112 when "1110000",
-      bits_best_valid_113 when "1110001",
-      bits_best_valid_114 when "1110010",
-      bits_best_valid_115 when "1110011",
-      bits_best_valid_116 when "1110100",
-      bits_best_valid_117 when "1110101",
-      bits_best_valid_118 when "1110110",
-      bits_best_valid_119 when "1110111",
-      bits_best_valid_120 when "1111000",
-      bits_best_valid_121 when "1111001",
-      bits_best_valid_122 when "1111010",
-      bits_best_valid_123 when "1111011",
-      bits_best_valid_124 when "1111100",
-      bits_best_valid_125 when "1111101",
-      bits_best_valid_126 when "1111110",
-      bits_best_valid_127 when "1111111",
+  bits_in_slot_7 <= unsigned(in_slot(3 downto 0));
+  with bits_in_slot_7 select
+    fin_has_g7_c <=
+      bits_best_valid_112 when "0000",
+      bits_best_valid_113 when "0001",
+      bits_best_valid_114 when "0010",
+      bits_best_valid_115 when "0011",
+      bits_best_valid_116 when "0100",
+      bits_best_valid_117 when "0101",
+      bits_best_valid_118 when "0110",
+      bits_best_valid_119 when "0111",
+      bits_best_valid_120 when "1000",
+      bits_best_valid_121 when "1001",
+      bits_best_valid_122 when "1010",
+      bits_best_valid_123 when "1011",
+      bits_best_valid_124 when "1100",
+      bits_best_valid_125 when "1101",
+      bits_best_valid_126 when "1110",
+      bits_best_valid_127 when "1111",
+      k_0 when others;
+  bits_fin_slot <= unsigned(fin_slot(6 downto 4));
+  with bits_fin_slot select
+    fin_has_c <=
+      fin_has_g0 when "000",
+      fin_has_g1 when "001",
+      fin_has_g2 when "010",
+      fin_has_g3 when "011",
+      fin_has_g4 when "100",
+      fin_has_g5 when "101",
+      fin_has_g6 when "110",
+      fin_has_g7 when "111",
       k_0 when others;
   cat_5 <= unsigned(std_logic_vector'(std_logic_vector(acc_t) & std_logic_vector(acc_tri)));
   cat_6 <= unsigned(std_logic_vector'(std_logic_vector(acc_u) & std_logic_vector(acc_v)));
@@ -1566,6 +1659,26 @@ begin
   bits_best_valid_141 <= unsigned(best_valid(13 downto 13));
   bits_best_valid_142 <= unsigned(best_valid(14 downto 14));
   bits_best_valid_143 <= unsigned(best_valid(15 downto 15));
+  bits_done_slot <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot select
+    done_has_g0_c <=
+      bits_best_valid_128 when "0000",
+      bits_best_valid_129 when "0001",
+      bits_best_valid_130 when "0010",
+      bits_best_valid_131 when "0011",
+      bits_best_valid_132 when "0100",
+      bits_best_valid_133 when "0101",
+      bits_best_valid_134 when "0110",
+      bits_best_valid_135 when "0111",
+      bits_best_valid_136 when "1000",
+      bits_best_valid_137 when "1001",
+      bits_best_valid_138 when "1010",
+      bits_best_valid_139 when "1011",
+      bits_best_valid_140 when "1100",
+      bits_best_valid_141 when "1101",
+      bits_best_valid_142 when "1110",
+      bits_best_valid_143 when "1111",
+      k_0 when others;
   bits_best_valid_144 <= unsigned(best_valid(16 downto 16));
   bits_best_valid_145 <= unsigned(best_valid(17 downto 17));
   bits_best_valid_146 <= unsigned(best_valid(18 downto 18));
@@ -1582,6 +1695,26 @@ begin
   bits_best_valid_157 <= unsigned(best_valid(29 downto 29));
   bits_best_valid_158 <= unsigned(best_valid(30 downto 30));
   bits_best_valid_159 <= unsigned(best_valid(31 downto 31));
+  bits_done_slot_1 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_1 select
+    done_has_g1_c <=
+      bits_best_valid_144 when "0000",
+      bits_best_valid_145 when "0001",
+      bits_best_valid_146 when "0010",
+      bits_best_valid_147 when "0011",
+      bits_best_valid_148 when "0100",
+      bits_best_valid_149 when "0101",
+      bits_best_valid_150 when "0110",
+      bits_best_valid_151 when "0111",
+      bits_best_valid_152 when "1000",
+      bits_best_valid_153 when "1001",
+      bits_best_valid_154 when "1010",
+      bits_best_valid_155 when "1011",
+      bits_best_valid_156 when "1100",
+      bits_best_valid_157 when "1101",
+      bits_best_valid_158 when "1110",
+      bits_best_valid_159 when "1111",
+      k_0 when others;
   bits_best_valid_160 <= unsigned(best_valid(32 downto 32));
   bits_best_valid_161 <= unsigned(best_valid(33 downto 33));
   bits_best_valid_162 <= unsigned(best_valid(34 downto 34));
@@ -1598,6 +1731,26 @@ begin
   bits_best_valid_173 <= unsigned(best_valid(45 downto 45));
   bits_best_valid_174 <= unsigned(best_valid(46 downto 46));
   bits_best_valid_175 <= unsigned(best_valid(47 downto 47));
+  bits_done_slot_2 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_2 select
+    done_has_g2_c <=
+      bits_best_valid_160 when "0000",
+      bits_best_valid_161 when "0001",
+      bits_best_valid_162 when "0010",
+      bits_best_valid_163 when "0011",
+      bits_best_valid_164 when "0100",
+      bits_best_valid_165 when "0101",
+      bits_best_valid_166 when "0110",
+      bits_best_valid_167 when "0111",
+      bits_best_valid_168 when "1000",
+      bits_best_valid_169 when "1001",
+      bits_best_valid_170 when "1010",
+      bits_best_valid_171 when "1011",
+      bits_best_valid_172 when "1100",
+      bits_best_valid_173 when "1101",
+      bits_best_valid_174 when "1110",
+      bits_best_valid_175 when "1111",
+      k_0 when others;
   bits_best_valid_176 <= unsigned(best_valid(48 downto 48));
   bits_best_valid_177 <= unsigned(best_valid(49 downto 49));
   bits_best_valid_178 <= unsigned(best_valid(50 downto 50));
@@ -1614,6 +1767,26 @@ begin
   bits_best_valid_189 <= unsigned(best_valid(61 downto 61));
   bits_best_valid_190 <= unsigned(best_valid(62 downto 62));
   bits_best_valid_191 <= unsigned(best_valid(63 downto 63));
+  bits_done_slot_3 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_3 select
+    done_has_g3_c <=
+      bits_best_valid_176 when "0000",
+      bits_best_valid_177 when "0001",
+      bits_best_valid_178 when "0010",
+      bits_best_valid_179 when "0011",
+      bits_best_valid_180 when "0100",
+      bits_best_valid_181 when "0101",
+      bits_best_valid_182 when "0110",
+      bits_best_valid_183 when "0111",
+      bits_best_valid_184 when "1000",
+      bits_best_valid_185 when "1001",
+      bits_best_valid_186 when "1010",
+      bits_best_valid_187 when "1011",
+      bits_best_valid_188 when "1100",
+      bits_best_valid_189 when "1101",
+      bits_best_valid_190 when "1110",
+      bits_best_valid_191 when "1111",
+      k_0 when others;
   bits_best_valid_192 <= unsigned(best_valid(64 downto 64));
   bits_best_valid_193 <= unsigned(best_valid(65 downto 65));
   bits_best_valid_194 <= unsigned(best_valid(66 downto 66));
@@ -1630,6 +1803,26 @@ begin
   bits_best_valid_205 <= unsigned(best_valid(77 downto 77));
   bits_best_valid_206 <= unsigned(best_valid(78 downto 78));
   bits_best_valid_207 <= unsigned(best_valid(79 downto 79));
+  bits_done_slot_4 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_4 select
+    done_has_g4_c <=
+      bits_best_valid_192 when "0000",
+      bits_best_valid_193 when "0001",
+      bits_best_valid_194 when "0010",
+      bits_best_valid_195 when "0011",
+      bits_best_valid_196 when "0100",
+      bits_best_valid_197 when "0101",
+      bits_best_valid_198 when "0110",
+      bits_best_valid_199 when "0111",
+      bits_best_valid_200 when "1000",
+      bits_best_valid_201 when "1001",
+      bits_best_valid_202 when "1010",
+      bits_best_valid_203 when "1011",
+      bits_best_valid_204 when "1100",
+      bits_best_valid_205 when "1101",
+      bits_best_valid_206 when "1110",
+      bits_best_valid_207 when "1111",
+      k_0 when others;
   bits_best_valid_208 <= unsigned(best_valid(80 downto 80));
   bits_best_valid_209 <= unsigned(best_valid(81 downto 81));
   bits_best_valid_210 <= unsigned(best_valid(82 downto 82));
@@ -1646,6 +1839,26 @@ begin
   bits_best_valid_221 <= unsigned(best_valid(93 downto 93));
   bits_best_valid_222 <= unsigned(best_valid(94 downto 94));
   bits_best_valid_223 <= unsigned(best_valid(95 downto 95));
+  bits_done_slot_5 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_5 select
+    done_has_g5_c <=
+      bits_best_valid_208 when "0000",
+      bits_best_valid_209 when "0001",
+      bits_best_valid_210 when "0010",
+      bits_best_valid_211 when "0011",
+      bits_best_valid_212 when "0100",
+      bits_best_valid_213 when "0101",
+      bits_best_valid_214 when "0110",
+      bits_best_valid_215 when "0111",
+      bits_best_valid_216 when "1000",
+      bits_best_valid_217 when "1001",
+      bits_best_valid_218 when "1010",
+      bits_best_valid_219 when "1011",
+      bits_best_valid_220 when "1100",
+      bits_best_valid_221 when "1101",
+      bits_best_valid_222 when "1110",
+      bits_best_valid_223 when "1111",
+      k_0 when others;
   bits_best_valid_224 <= unsigned(best_valid(96 downto 96));
   bits_best_valid_225 <= unsigned(best_valid(97 downto 97));
   bits_best_valid_226 <= unsigned(best_valid(98 downto 98));
@@ -1662,6 +1875,26 @@ begin
   bits_best_valid_237 <= unsigned(best_valid(109 downto 109));
   bits_best_valid_238 <= unsigned(best_valid(110 downto 110));
   bits_best_valid_239 <= unsigned(best_valid(111 downto 111));
+  bits_done_slot_6 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_6 select
+    done_has_g6_c <=
+      bits_best_valid_224 when "0000",
+      bits_best_valid_225 when "0001",
+      bits_best_valid_226 when "0010",
+      bits_best_valid_227 when "0011",
+      bits_best_valid_228 when "0100",
+      bits_best_valid_229 when "0101",
+      bits_best_valid_230 when "0110",
+      bits_best_valid_231 when "0111",
+      bits_best_valid_232 when "1000",
+      bits_best_valid_233 when "1001",
+      bits_best_valid_234 when "1010",
+      bits_best_valid_235 when "1011",
+      bits_best_valid_236 when "1100",
+      bits_best_valid_237 when "1101",
+      bits_best_valid_238 when "1110",
+      bits_best_valid_239 when "1111",
+      k_0 when others;
   bits_best_valid_240 <= unsigned(best_valid(112 downto 112));
   bits_best_valid_241 <= unsigned(best_valid(113 downto 113));
   bits_best_valid_242 <= unsigned(best_valid(114 downto 114));
@@ -1678,136 +1911,37 @@ begin
   bits_best_valid_253 <= unsigned(best_valid(125 downto 125));
   bits_best_valid_254 <= unsigned(best_valid(126 downto 126));
   bits_best_valid_255 <= unsigned(best_valid(127 downto 127));
-  with done_slot select
-    done_slot_has <=
-      bits_best_valid_128 when "0000000",
-      bits_best_valid_129 when "0000001",
-      bits_best_valid_130 when "0000010",
-      bits_best_valid_131 when "0000011",
-      bits_best_valid_132 when "0000100",
-      bits_best_valid_133 when "0000101",
-      bits_best_valid_134 when "0000110",
-      bits_best_valid_135 when "0000111",
-      bits_best_valid_136 when "0001000",
-      bits_best_valid_137 when "0001001",
-      bits_best_valid_138 when "0001010",
-      bits_best_valid_139 when "0001011",
-      bits_best_valid_140 when "0001100",
-      bits_best_valid_141 when "0001101",
-      bits_best_valid_142 when "0001110",
-      bits_best_valid_143 when "0001111",
-      bits_best_valid_144 when "0010000",
-      bits_best_valid_145 when "0010001",
-      bits_best_valid_146 when "0010010",
-      bits_best_valid_147 when "0010011",
-      bits_best_valid_148 when "0010100",
-      bits_best_valid_149 when "0010101",
-      bits_best_valid_150 when "0010110",
-      bits_best_valid_151 when "0010111",
-      bits_best_valid_152 when "0011000",
-      bits_best_valid_153 when "0011001",
-      bits_best_valid_154 when "0011010",
-      bits_best_valid_155 when "0011011",
-      bits_best_valid_156 when "0011100",
-      bits_best_valid_157 when "0011101",
-      bits_best_valid_158 when "0011110",
-      bits_best_valid_159 when "0011111",
-      bits_best_valid_160 when "0100000",
-      bits_best_valid_161 when "0100001",
-      bits_best_valid_162 when "0100010",
-      bits_best_valid_163 when "0100011",
-      bits_best_valid_164 when "0100100",
-      bits_best_valid_165 when "0100101",
-      bits_best_valid_166 when "0100110",
-      bits_best_valid_167 when "0100111",
-      bits_best_valid_168 when "0101000",
-      bits_best_valid_169 when "0101001",
-      bits_best_valid_170 when "0101010",
-      bits_best_valid_171 when "0101011",
-      bits_best_valid_172 when "0101100",
-      bits_best_valid_173 when "0101101",
-      bits_best_valid_174 when "0101110",
-      bits_best_valid_175 when "0101111",
-      bits_best_valid_176 when "0110000",
-      bits_best_valid_177 when "0110001",
-      bits_best_valid_178 when "0110010",
-      bits_best_valid_179 when "0110011",
-      bits_best_valid_180 when "0110100",
-      bits_best_valid_181 when "0110101",
-      bits_best_valid_182 when "0110110",
-      bits_best_valid_183 when "0110111",
-      bits_best_valid_184 when "0111000",
-      bits_best_valid_185 when "0111001",
-      bits_best_valid_186 when "0111010",
-      bits_best_valid_187 when "0111011",
-      bits_best_valid_188 when "0111100",
-      bits_best_valid_189 when "0111101",
-      bits_best_valid_190 when "0111110",
-      bits_best_valid_191 when "0111111",
-      bits_best_valid_192 when "1000000",
-      bits_best_valid_193 when "1000001",
-      bits_best_valid_194 when "1000010",
-      bits_best_valid_195 when "1000011",
-      bits_best_valid_196 when "1000100",
-      bits_best_valid_197 when "1000101",
-      bits_best_valid_198 when "1000110",
-      bits_best_valid_199 when "1000111",
-      bits_best_valid_200 when "1001000",
-      bits_best_valid_201 when "1001001",
-      bits_best_valid_202 when "1001010",
-      bits_best_valid_203 when "1001011",
-      bits_best_valid_204 when "1001100",
-      bits_best_valid_205 when "1001101",
-      bits_best_valid_206 when "1001110",
-      bits_best_valid_207 when "1001111",
-      bits_best_valid_208 when "1010000",
-      bits_best_valid_209 when "1010001",
-      bits_best_valid_210 when "1010010",
-      bits_best_valid_211 when "1010011",
-      bits_best_valid_212 when "1010100",
-      bits_best_valid_213 when "1010101",
-      bits_best_valid_214 when "1010110",
-      bits_best_valid_215 when "1010111",
-      bits_best_valid_216 when "1011000",
-      bits_best_valid_217 when "1011001",
-      bits_best_valid_218 when "1011010",
-      bits_best_valid_219 when "1011011",
-      bits_best_valid_220 when "1011100",
-      bits_best_valid_221 when "1011101",
-      bits_best_valid_222 when "1011110",
-      bits_best_valid_223 when "1011111",
-      bits_best_valid_224 when "1100000",
-      bits_best_valid_225 when "1100001",
-      bits_best_valid_226 when "1100010",
-      bits_best_valid_227 when "1100011",
-      bits_best_valid_228 when "1100100",
-      bits_best_valid_229 when "1100101",
-      bits_best_valid_230 when "1100110",
-      bits_best_valid_231 when "1100111",
-      bits_best_valid_232 when "1101000",
-      bits_best_valid_233 when "1101001",
-      bits_best_valid_234 when "1101010",
-      bits_best_valid_235 when "1101011",
-      bits_best_valid_236 when "1101100",
-      bits_best_valid_237 when "1101101",
-      bits_best_valid_238 when "1101110",
-      bits_best_valid_239 when "1101111",
-      bits_best_valid_240 when "1110000",
-      bits_best_valid_241 when "1110001",
-      bits_best_valid_242 when "1110010",
-      bits_best_valid_243 when "1110011",
-      bits_best_valid_244 when "1110100",
-      bits_best_valid_245 when "1110101",
-      bits_best_valid_246 when "1110110",
-      bits_best_valid_247 when "1110111",
-      bits_best_valid_248 when "1111000",
-      bits_best_valid_249 when "1111001",
-      bits_best_valid_250 when "1111010",
-      bits_best_valid_251 when "1111011",
-      bits_best_valid_252 when "1111100",
-      bits_best_valid_253 when "1111101",
-      bits_best_valid_254 when "1111110",
-      bits_best_valid_255 when "1111111",
+  bits_done_slot_7 <= unsigned(done_slot(3 downto 0));
+  with bits_done_slot_7 select
+    done_has_g7_c <=
+      bits_best_valid_240 when "0000",
+      bits_best_valid_241 when "0001",
+      bits_best_valid_242 when "0010",
+      bits_best_valid_243 when "0011",
+      bits_best_valid_244 when "0100",
+      bits_best_valid_245 when "0101",
+      bits_best_valid_246 when "0110",
+      bits_best_valid_247 when "0111",
+      bits_best_valid_248 when "1000",
+      bits_best_valid_249 when "1001",
+      bits_best_valid_250 when "1010",
+      bits_best_valid_251 when "1011",
+      bits_best_valid_252 when "1100",
+      bits_best_valid_253 when "1101",
+      bits_best_valid_254 when "1110",
+      bits_best_valid_255 when "1111",
+      k_0 when others;
+  bits_d0_slot <= unsigned(d0_slot(6 downto 4));
+  with bits_d0_slot select
+    done_has_c <=
+      done_has_g0 when "000",
+      done_has_g1 when "001",
+      done_has_g2 when "010",
+      done_has_g3 when "011",
+      done_has_g4 when "100",
+      done_has_g5 when "101",
+      done_has_g6 when "110",
+      done_has_g7 when "111",
       k_0 when others;
   m2_slot_eq_k_127 <= "1" when m2_slot = k_127 else "0";
   m2_slot_eq_k_126 <= "1" when m2_slot = k_126 else "0";
@@ -2151,7 +2285,15 @@ begin
       m1 <= fin;
       m1_slot <= fin_slot;
       m1_sp <= fin_sp;
-      m1_slot_has <= fin_slot_has;
+      fin_has_g0 <= fin_has_g0_c;
+      fin_has_g1 <= fin_has_g1_c;
+      fin_has_g2 <= fin_has_g2_c;
+      fin_has_g3 <= fin_has_g3_c;
+      fin_has_g4 <= fin_has_g4_c;
+      fin_has_g5 <= fin_has_g5_c;
+      fin_has_g6 <= fin_has_g6_c;
+      fin_has_g7 <= fin_has_g7_c;
+      m1_slot_has <= fin_has_c;
       m1_leaf_empty <= acc_empty;
       m1_t_tri <= cat_5;
       m1_u_v <= cat_6;
@@ -2168,12 +2310,22 @@ begin
       merge_hit_r <= m2_hit;
       merge_limit_r <= merged_limit;
       merge_sp_r <= m2_sp;
-      done_t_tri <= best_t_tri(to_integer(done_slot));
-      done_u_v <= best_u_v(to_integer(done_slot));
-      done_id <= ray_ids(to_integer(done_slot));
-      d1 <= done_valid;
-      d1_slot <= done_slot;
-      d1_has <= done_slot_has;
+      d0 <= done_valid;
+      d0_slot <= done_slot;
+      done_t_tri <= best_t_tri(to_integer(d0_slot));
+      done_u_v <= best_u_v(to_integer(d0_slot));
+      done_id <= ray_ids(to_integer(d0_slot));
+      d1 <= d0;
+      d1_slot <= d0_slot;
+      done_has_g0 <= done_has_g0_c;
+      done_has_g1 <= done_has_g1_c;
+      done_has_g2 <= done_has_g2_c;
+      done_has_g3 <= done_has_g3_c;
+      done_has_g4 <= done_has_g4_c;
+      done_has_g5 <= done_has_g5_c;
+      done_has_g6 <= done_has_g6_c;
+      done_has_g7 <= done_has_g7_c;
+      d1_has <= done_has_c;
       free_valid_r <= d1;
       free_slot_r <= d1_slot;
       if rst = '1' then

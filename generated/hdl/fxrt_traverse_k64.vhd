@@ -1159,8 +1159,10 @@ architecture rtl of fxrt_traverse_k64 is
   signal unpark_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal unpark_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_unpark_q_push : unsigned(5 downto 0);
-  signal unpark_q_rd_plus_k_1 : unsigned(5 downto 0);
+  signal unpark_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal unpark_q_rd_next : unsigned(5 downto 0);
+  signal unpark_q_rd1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_unpark_pop : unsigned(5 downto 0);
   signal rs_unpark_pop : unsigned(6 downto 0);
   signal unpark_q_after_pop : unsigned(6 downto 0);
   signal rs_unpark_q_push : unsigned(6 downto 0);
@@ -1183,8 +1185,10 @@ architecture rtl of fxrt_traverse_k64 is
   signal new_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal new_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_new_q_push : unsigned(5 downto 0);
-  signal new_q_rd_plus_k_1 : unsigned(5 downto 0);
+  signal new_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal new_q_rd_next : unsigned(5 downto 0);
+  signal new_q_rd1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_new_pop : unsigned(5 downto 0);
   signal rs_new_pop : unsigned(6 downto 0);
   signal new_q_after_pop : unsigned(6 downto 0);
   signal rs_new_q_push : unsigned(6 downto 0);
@@ -1284,8 +1288,10 @@ architecture rtl of fxrt_traverse_k64 is
   signal done_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal done_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_done_q_push : unsigned(5 downto 0);
-  signal done_q_rd_plus_k_1 : unsigned(5 downto 0);
+  signal done_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal done_q_rd_next : unsigned(5 downto 0);
+  signal done_q_rd1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_done_pop_r : unsigned(5 downto 0);
   signal rs_done_pop_r : unsigned(6 downto 0);
   signal done_q_after_pop : unsigned(6 downto 0);
   signal rs_done_q_push : unsigned(6 downto 0);
@@ -1575,8 +1581,10 @@ architecture rtl of fxrt_traverse_k64 is
   signal leaf_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_leaf_q_push : unsigned(5 downto 0);
-  signal leaf_q_rd_plus_k_1 : unsigned(5 downto 0);
+  signal leaf_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal leaf_q_rd_next : unsigned(5 downto 0);
+  signal leaf_q_rd1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_leaf_pop_r : unsigned(5 downto 0);
   signal rs_leaf_pop_r : unsigned(6 downto 0);
   signal leaf_q_after_pop : unsigned(6 downto 0);
   signal rs_leaf_q_push : unsigned(6 downto 0);
@@ -2243,8 +2251,9 @@ begin
   cat_78 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot) & std_logic_vector(merge_sp)));
   unpark_q_wr_plus_k_1 <= unpark_q_wr + k_1;
   mux_unpark_q_push <= unpark_q_wr_plus_k_1 when unpark_q_push = "1" else unpark_q_wr;
-  unpark_q_rd_plus_k_1 <= unpark_q_rd + k_1;
-  unpark_q_rd_next <= unpark_q_rd_plus_k_1 when unpark_pop = "1" else unpark_q_rd;
+  unpark_q_rd_next <= unpark_q_rd1 when unpark_pop = "1" else unpark_q_rd;
+  unpark_q_rd1_plus_k_1 <= unpark_q_rd1 + k_1;
+  mux_unpark_pop <= unpark_q_rd1_plus_k_1 when unpark_pop = "1" else unpark_q_rd1;
   rs_unpark_pop <= resize(unpark_pop, 7);
   unpark_q_after_pop <= unpark_q_count - rs_unpark_pop;
   rs_unpark_q_push <= resize(unpark_q_push, 7);
@@ -2257,8 +2266,9 @@ begin
   cat_83 <= unsigned(std_logic_vector'(std_logic_vector(new_slot) & std_logic_vector(u_new_tmax) & std_logic_vector(new_miss)));
   new_q_wr_plus_k_1 <= new_q_wr + k_1;
   mux_new_q_push <= new_q_wr_plus_k_1 when new_q_push = "1" else new_q_wr;
-  new_q_rd_plus_k_1 <= new_q_rd + k_1;
-  new_q_rd_next <= new_q_rd_plus_k_1 when new_pop = "1" else new_q_rd;
+  new_q_rd_next <= new_q_rd1 when new_pop = "1" else new_q_rd;
+  new_q_rd1_plus_k_1 <= new_q_rd1 + k_1;
+  mux_new_pop <= new_q_rd1_plus_k_1 when new_pop = "1" else new_q_rd1;
   rs_new_pop <= resize(new_pop, 7);
   new_q_after_pop <= new_q_count - rs_new_pop;
   rs_new_q_push <= resize(new_q_push, 7);
@@ -2314,8 +2324,9 @@ begin
   b_from_stack <= b_from_stack_sr(2);
   done_q_wr_plus_k_1 <= done_q_wr + k_1;
   mux_done_q_push <= done_q_wr_plus_k_1 when done_q_push = "1" else done_q_wr;
-  done_q_rd_plus_k_1 <= done_q_rd + k_1;
-  done_q_rd_next <= done_q_rd_plus_k_1 when done_pop_r = "1" else done_q_rd;
+  done_q_rd_next <= done_q_rd1 when done_pop_r = "1" else done_q_rd;
+  done_q_rd1_plus_k_1 <= done_q_rd1 + k_1;
+  mux_done_pop_r <= done_q_rd1_plus_k_1 when done_pop_r = "1" else done_q_rd1;
   rs_done_pop_r <= resize(done_pop_r, 7);
   done_q_after_pop <= done_q_count - rs_done_pop_r;
   rs_done_q_push <= resize(done_q_push, 7);
@@ -2635,8 +2646,9 @@ begin
   cat_108 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
   leaf_q_wr_plus_k_1 <= leaf_q_wr + k_1;
   mux_leaf_q_push <= leaf_q_wr_plus_k_1 when leaf_q_push = "1" else leaf_q_wr;
-  leaf_q_rd_plus_k_1 <= leaf_q_rd + k_1;
-  leaf_q_rd_next <= leaf_q_rd_plus_k_1 when leaf_pop_r = "1" else leaf_q_rd;
+  leaf_q_rd_next <= leaf_q_rd1 when leaf_pop_r = "1" else leaf_q_rd;
+  leaf_q_rd1_plus_k_1 <= leaf_q_rd1 + k_1;
+  mux_leaf_pop_r <= leaf_q_rd1_plus_k_1 when leaf_pop_r = "1" else leaf_q_rd1;
   rs_leaf_pop_r <= resize(leaf_pop_r, 7);
   leaf_q_after_pop <= leaf_q_count - rs_leaf_pop_r;
   rs_leaf_q_push <= resize(leaf_q_push, 7);
@@ -2881,6 +2893,11 @@ begin
       else
         unpark_q_count <= unpark_q_count_next;
       end if;
+      if rst = '1' then
+        unpark_q_rd1 <= unsigned'("000001");
+      else
+        unpark_q_rd1 <= mux_unpark_pop;
+      end if;
       unpark_q_q <= unpark_q_mem(to_integer(unpark_q_rd_next));
       if rst = '1' then
         unpark_q_bypass <= unsigned'("0");
@@ -2911,6 +2928,11 @@ begin
         new_q_count <= unsigned'("0000000");
       else
         new_q_count <= new_q_count_next;
+      end if;
+      if rst = '1' then
+        new_q_rd1 <= unsigned'("000001");
+      else
+        new_q_rd1 <= mux_new_pop;
       end if;
       new_q_q <= new_q_mem(to_integer(new_q_rd_next));
       if rst = '1' then
@@ -2979,6 +3001,11 @@ begin
       else
         done_q_count <= done_q_count_next;
       end if;
+      if rst = '1' then
+        done_q_rd1 <= unsigned'("000001");
+      else
+        done_q_rd1 <= mux_done_pop_r;
+      end if;
       done_q_q <= done_q_mem(to_integer(done_q_rd_next));
       if rst = '1' then
         done_q_bypass <= unsigned'("0");
@@ -3038,6 +3065,11 @@ begin
         leaf_q_count <= unsigned'("0000000");
       else
         leaf_q_count <= leaf_q_count_next;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1 <= unsigned'("000001");
+      else
+        leaf_q_rd1 <= mux_leaf_pop_r;
       end if;
       leaf_q_q <= leaf_q_mem(to_integer(leaf_q_rd_next));
       if rst = '1' then

@@ -19,7 +19,7 @@
 
 use super::clock::ClockTarget;
 use super::lt_chain;
-use crate::rtl::build::Builder;
+use crate::rtl::build::{Builder, S};
 use crate::rtl::{Module, Ty};
 
 #[derive(Clone, Copy, Debug)]
@@ -49,7 +49,7 @@ pub fn input_latency(target: ClockTarget) -> u32 {
 /// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot` →
 /// `merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` (best t + 8, signed n + 3 bits),
 /// `merge_sp`; `free_valid`, `free_slot`; res_valid, res_id, res_hit, res_tri, res_t, res_u, res_v
-/// (t, u, v and tri read 0 for a miss), registered, two cycles after `done_valid`.
+/// (t, u, v and tri read 0 for a miss), registered, three cycles after `done_valid`.
 pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u32, target: ClockTarget) -> Module {
     let staged = input_latency(target) > 0;
     let suffix = if staged { "_r2" } else { "" };
@@ -131,7 +131,6 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     let id_mem = b.ram("ray_ids", id_bits, vec![0; k as usize]);
     b.ram_write(id_mem, id_we, id_slot, id_in);
     let best_valid = b.reg("best_valid", Ty::u(k), Some(0));
-    let slot_bit = |s| b.case(s, &(0..k).map(|i| (i as u128, best_valid.bit(i))).collect::<Vec<_>>(), zero);
 
     // The merge: fin (the cycle after a leaf's last triangle: the accumulator is final), M1
     // (the leaf's best and the slot's, read at fin's address one clock before), M2 (the
@@ -143,7 +142,10 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     let m1 = b.delay("m1", fin);
     let m1_slot = b.delay("m1_slot", fin_slot);
     let m1_sp = b.delay("m1_sp", fin_sp);
-    let m1_has = b.delay("m1_slot_has", slot_bit(fin_slot).name("fin_slot_has"));
+    // The slot's has-best bit over two clocks: from the leaf's slot while its last triangle is
+    // here, then at fin (a slot's bit cannot change in between: its previous leaf was merged
+    // before it was unparked, and it is done only after its last leaf).
+    let m1_has = b.delay("m1_slot_has", slot_bit_2(&b, "fin_has", best_valid, k, slot, fin_slot));
     let m1_empty = b.delay("m1_leaf_empty", acc_empty);
     let m1_tt = b.delay("m1_t_tri", b.cat(&[acc_t, acc_tri]));
     let m1_uv = b.delay("m1_u_v", b.cat(&[acc_u, acc_v]));
@@ -170,12 +172,16 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     b.output("merge_sp", b.delay("merge_sp_r", m2_sp));
 
     // A ray done: its best hit and id are read, then sent out; the slot is freed.
-    let d_tt = b.read("done_t_tri", tt_mem, done_slot);
-    let d_uv = b.read("done_u_v", uv_mem, done_slot);
-    let d_id = b.read("done_id", id_mem, done_slot);
-    let d1 = b.delay("d1", done_valid);
-    let d1_slot = b.delay("d1_slot", done_slot);
-    let d1_has = b.delay("d1_has", slot_bit(done_slot).name("done_slot_has"));
+    // d0 holds the done slot here, by the RAMs and the slots' bits (the top's register that
+    // feeds `done_slot` sits by its arbiter); the has-best bit is selected over d0 and d1.
+    let d0 = b.delay("d0", done_valid);
+    let d0_slot = b.delay("d0_slot", done_slot);
+    let d_tt = b.read("done_t_tri", tt_mem, d0_slot);
+    let d_uv = b.read("done_u_v", uv_mem, d0_slot);
+    let d_id = b.read("done_id", id_mem, d0_slot);
+    let d1 = b.delay("d1", d0);
+    let d1_slot = b.delay("d1_slot", d0_slot);
+    let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, done_slot, d0_slot));
     let none = b.konst(Ty::u(k), 0);
     let set = we.select(super::onehot(m2_slot, k), none).name("best_set");
     let clear = d1.select(super::onehot(d1_slot, k), none).name("best_clear");
@@ -196,4 +202,24 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     res("u", d_uv.slice(m_bits, m_bits), true);
     res("v", d_uv.slice(0, m_bits), true);
     b.finish()
+}
+
+/// Bit `slot` of the k-bit register `bits`, selected over two clocks: groups of 16 bits by the
+/// slot's low bits from `early` into registers, then the group by the high bits of `late`
+/// (`early` a clock later). A 128-to-1 select in one clock was the core's critical path, its
+/// slot register placed across the die from the bits. The bit must not change in between.
+fn slot_bit_2<'b>(b: &'b Builder, name: &str, bits: S<'b>, k: u32, early: S<'b>, late: S<'b>) -> S<'b> {
+    let zero = b.konst(Ty::BIT, 0);
+    let low = early.width().min(4);
+    let groups: Vec<S> = (0..k.div_ceil(16))
+        .map(|g| {
+            let cases: Vec<(u128, S)> = (0..16.min(k - 16 * g)).map(|i| (i as u128, bits.bit(16 * g + i))).collect();
+            b.delay(&format!("{name}_g{g}"), b.case(early.slice(0, low), &cases, zero).name(&format!("{name}_g{g}_c")))
+        })
+        .collect();
+    if groups.len() == 1 {
+        return groups[0];
+    }
+    let cases: Vec<(u128, S)> = groups.iter().enumerate().map(|(g, &x)| (g as u128, x)).collect();
+    b.case(late.slice(4, late.width() - 4), &cases, zero).name(&format!("{name}_c"))
 }
