@@ -307,12 +307,22 @@ module fxrt_core (
   wire [0:0] not_leaf_active;
   wire [0:0] leaf_can_take;
   reg [0:0] leaf_turn = 1'h0;
-  reg [0:0] u0_leaf_took = 1'h0;
-  wire [0:0] not_u0_leaf_took;
-  wire [0:0] u0_leaf_avail;
-  reg [0:0] u1_leaf_took = 1'h0;
-  wire [0:0] not_u1_leaf_took;
-  wire [0:0] u1_leaf_avail;
+  reg [0:0] u0_leaf_buf_valid = 1'h0;
+  wire [0:0] not_u0_leaf_buf_valid;
+  wire [0:0] u0_leaf_fill;
+  reg [5:0] u0_buf_leaf_slot = 6'h00;
+  reg [12:0] u0_buf_leaf_first = 13'h0000;
+  reg [2:0] u0_buf_leaf_count = 3'h0;
+  reg [30:0] u0_buf_leaf_tmin = 31'h00000000;
+  reg [5:0] u0_buf_leaf_sp = 6'h00;
+  reg [0:0] u1_leaf_buf_valid = 1'h0;
+  wire [0:0] not_u1_leaf_buf_valid;
+  wire [0:0] u1_leaf_fill;
+  reg [5:0] u1_buf_leaf_slot = 6'h00;
+  reg [12:0] u1_buf_leaf_first = 13'h0000;
+  reg [2:0] u1_buf_leaf_count = 3'h0;
+  reg [30:0] u1_buf_leaf_tmin = 31'h00000000;
+  reg [5:0] u1_buf_leaf_sp = 6'h00;
   reg [0:0] case_leaf_turn;
   reg [0:0] case_leaf_turn_1;
   reg [0:0] case_leaf_turn_2;
@@ -322,13 +332,19 @@ module fxrt_core (
   wire [0:0] leaf_take;
   wire [0:0] eq_26;
   wire [0:0] u0_leaf_take;
-  wire [0:0] eq_27;
+  wire [0:0] not_u0_leaf_take;
+  wire [0:0] and_27;
+  wire [0:0] u0_leaf_fill_or_and_27;
+  wire [0:0] eq_28;
   wire [0:0] u1_leaf_take;
-  reg [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_28;
-  wire [0:0] not_leaf_last_entry;
+  wire [0:0] not_u1_leaf_take;
   wire [0:0] and_29;
-  wire [0:0] leaf_take_or_and_29;
+  wire [0:0] u1_leaf_fill_or_and_29;
+  reg [5:0] case_mux_case_leaf_turn_2;
+  wire [6:0] cat_30;
+  wire [0:0] not_leaf_last_entry;
+  wire [0:0] and_31;
+  wire [0:0] leaf_take_or_and_31;
   wire [6:0] mux_leaf_take;
   reg [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
@@ -343,13 +359,13 @@ module fxrt_core (
   reg [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   reg [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_30;
+  wire [0:0] eq_32;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_31;
+  wire [58:0] cat_33;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -422,12 +438,12 @@ module fxrt_core (
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_35;
+  wire [6:0] cat_37;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_37;
+  wire [6:0] cat_39;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_38;
+  wire [0:0] or_40;
   reg [0:0] done_valid_r = 1'h0;
   reg [6:0] done_slot_r = 7'h00;
   wire [0:0] u_closest_merge_valid;
@@ -444,8 +460,8 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_39;
-  wire [5:0] mux_lt_39;
+  wire [0:0] lt_41;
+  wire [5:0] mux_lt_41;
   wire [2:0] rs_u_traverse_0_visit;
   wire [2:0] rs_u_traverse_1_visit;
   wire [2:0] visits_c;
@@ -571,8 +587,8 @@ module fxrt_core (
   assign merge_sp = u_closest_merge_sp;
   assign free_valid = u_closest_free_valid;
   assign free_slot = u_closest_free_slot;
-  assign u0_leaf_pop = u0_leaf_take;
-  assign u1_leaf_pop = u1_leaf_take;
+  assign u0_leaf_pop = u0_leaf_fill;
+  assign u1_leaf_pop = u1_leaf_fill;
   assign u0_done_pop = u0_done_avail;
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
@@ -615,14 +631,14 @@ module fxrt_core (
   assign leaf_last_entry = leaf_active & leaf_last;
   assign not_leaf_active = ~leaf_active;
   assign leaf_can_take = not_leaf_active | leaf_last_entry;
-  assign not_u0_leaf_took = ~u0_leaf_took;
-  assign u0_leaf_avail = u_traverse_0_leaf_valid & not_u0_leaf_took;
-  assign not_u1_leaf_took = ~u1_leaf_took;
-  assign u1_leaf_avail = u_traverse_1_leaf_valid & not_u1_leaf_took;
+  assign not_u0_leaf_buf_valid = ~u0_leaf_buf_valid;
+  assign u0_leaf_fill = u_traverse_0_leaf_valid & not_u0_leaf_buf_valid;
+  assign not_u1_leaf_buf_valid = ~u1_leaf_buf_valid;
+  assign u1_leaf_fill = u_traverse_1_leaf_valid & not_u1_leaf_buf_valid;
   always @* begin
     case (leaf_turn)
-      1'h0: case_leaf_turn = u0_leaf_avail;
-      1'h1: case_leaf_turn = u1_leaf_avail;
+      1'h0: case_leaf_turn = u0_leaf_buf_valid;
+      1'h1: case_leaf_turn = u1_leaf_buf_valid;
       default: case_leaf_turn = k_0;
     endcase
   end
@@ -635,8 +651,8 @@ module fxrt_core (
   end
   always @* begin
     case (leaf_turn)
-      1'h0: case_leaf_turn_2 = u1_leaf_avail;
-      1'h1: case_leaf_turn_2 = u0_leaf_avail;
+      1'h0: case_leaf_turn_2 = u1_leaf_buf_valid;
+      1'h1: case_leaf_turn_2 = u0_leaf_buf_valid;
       default: case_leaf_turn_2 = k_0;
     endcase
   end
@@ -652,65 +668,71 @@ module fxrt_core (
   assign leaf_take = leaf_can_take & or_25;
   assign eq_26 = mux_case_leaf_turn_2 == k_0;
   assign u0_leaf_take = leaf_take & eq_26;
-  assign eq_27 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_27;
+  assign not_u0_leaf_take = ~u0_leaf_take;
+  assign and_27 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_27 = u0_leaf_fill | and_27;
+  assign eq_28 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_28;
+  assign not_u1_leaf_take = ~u1_leaf_take;
+  assign and_29 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_29 = u1_leaf_fill | and_29;
   always @* begin
     case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
-      1'h1: case_mux_case_leaf_turn_2 = u_traverse_1_leaf_slot;
-      default: case_mux_case_leaf_turn_2 = u_traverse_0_leaf_slot;
+      1'h0: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
+      1'h1: case_mux_case_leaf_turn_2 = u1_buf_leaf_slot;
+      default: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
     endcase
   end
-  assign cat_28 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_30 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_29 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_29 = leaf_take | and_29;
-  assign mux_leaf_take = leaf_take ? cat_28 : leaf_slot;
+  assign and_31 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_31 = leaf_take | and_31;
+  assign mux_leaf_take = leaf_take ? cat_30 : leaf_slot;
   always @* begin
     case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
-      1'h1: case_mux_case_leaf_turn_2_1 = u_traverse_1_leaf_first;
-      default: case_mux_case_leaf_turn_2_1 = u_traverse_0_leaf_first;
+      1'h0: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
+      1'h1: case_mux_case_leaf_turn_2_1 = u1_buf_leaf_first;
+      default: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
     endcase
   end
   assign leaf_ptr_plus_k_1_2 = leaf_ptr + k_1_2;
   assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_2;
   always @* begin
     case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_2 = u_traverse_0_leaf_count;
-      1'h1: case_mux_case_leaf_turn_2_2 = u_traverse_1_leaf_count;
-      default: case_mux_case_leaf_turn_2_2 = u_traverse_0_leaf_count;
+      1'h0: case_mux_case_leaf_turn_2_2 = u0_buf_leaf_count;
+      1'h1: case_mux_case_leaf_turn_2_2 = u1_buf_leaf_count;
+      default: case_mux_case_leaf_turn_2_2 = u0_buf_leaf_count;
     endcase
   end
   assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
   assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_3;
   always @* begin
     case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_3 = u_traverse_0_leaf_tmin;
-      1'h1: case_mux_case_leaf_turn_2_3 = u_traverse_1_leaf_tmin;
-      default: case_mux_case_leaf_turn_2_3 = u_traverse_0_leaf_tmin;
+      1'h0: case_mux_case_leaf_turn_2_3 = u0_buf_leaf_tmin;
+      1'h1: case_mux_case_leaf_turn_2_3 = u1_buf_leaf_tmin;
+      default: case_mux_case_leaf_turn_2_3 = u0_buf_leaf_tmin;
     endcase
   end
   assign mux_leaf_take_3 = leaf_take ? case_mux_case_leaf_turn_2_3 : leaf_tmin;
   always @* begin
     case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_4 = u_traverse_0_leaf_sp;
-      1'h1: case_mux_case_leaf_turn_2_4 = u_traverse_1_leaf_sp;
-      default: case_mux_case_leaf_turn_2_4 = u_traverse_0_leaf_sp;
+      1'h0: case_mux_case_leaf_turn_2_4 = u0_buf_leaf_sp;
+      1'h1: case_mux_case_leaf_turn_2_4 = u1_buf_leaf_sp;
+      default: case_mux_case_leaf_turn_2_4 = u0_buf_leaf_sp;
     endcase
   end
   assign mux_leaf_take_4 = leaf_take ? case_mux_case_leaf_turn_2_4 : leaf_sp;
   always @* begin
     case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_5 = u_traverse_0_leaf_count;
-      1'h1: case_mux_case_leaf_turn_2_5 = u_traverse_1_leaf_count;
-      default: case_mux_case_leaf_turn_2_5 = u_traverse_0_leaf_count;
+      1'h0: case_mux_case_leaf_turn_2_5 = u0_buf_leaf_count;
+      1'h1: case_mux_case_leaf_turn_2_5 = u1_buf_leaf_count;
+      default: case_mux_case_leaf_turn_2_5 = u0_buf_leaf_count;
     endcase
   end
-  assign eq_30 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_32 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_30 : leaf_left_eq_k_2;
-  assign cat_31 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign mux_leaf_take_5 = leaf_take ? eq_32 : leaf_left_eq_k_2;
+  assign cat_33 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -750,14 +772,14 @@ module fxrt_core (
   assign u0_done_avail = u_traverse_0_done_valid & not_u0_done_took;
   assign not_u1_done_took = ~u1_done_took;
   assign u1_done_avail = u_traverse_1_done_valid & not_u1_done_took;
-  assign cat_35 = {k_0, u_traverse_0_done_slot};
+  assign cat_37 = {k_0, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_37 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_35 : cat_37;
-  assign or_38 = u0_done_avail | u1_done_avail;
-  assign lt_39 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_39 = lt_39 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign cat_39 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_37 : cat_39;
+  assign or_40 = u0_done_avail | u1_done_avail;
+  assign lt_41 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_41 = lt_41 ? u_traverse_1_depth : u_traverse_0_depth;
   assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
   assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
   assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -849,7 +871,7 @@ module fxrt_core (
       box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
     box_done_slot_sr[1] <= box_slot;
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_29;
+    else leaf_active <= leaf_take_or_and_31;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -859,11 +881,23 @@ module fxrt_core (
     leaf_last <= mux_leaf_take_5;
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
-    u0_leaf_took <= u0_leaf_pop;
-    u1_leaf_took <= u1_leaf_pop;
+    if (rst) u0_leaf_buf_valid <= 1'h0;
+    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
+    if (u0_leaf_fill) u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
+    if (u0_leaf_fill) u0_buf_leaf_first <= u_traverse_0_leaf_first;
+    if (u0_leaf_fill) u0_buf_leaf_count <= u_traverse_0_leaf_count;
+    if (u0_leaf_fill) u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
+    if (u0_leaf_fill) u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
+    if (rst) u1_leaf_buf_valid <= 1'h0;
+    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
+    if (u1_leaf_fill) u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
+    if (u1_leaf_fill) u1_buf_leaf_first <= u_traverse_1_leaf_first;
+    if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
+    if (u1_leaf_fill) u1_buf_leaf_tmin <= u_traverse_1_leaf_tmin;
+    if (u1_leaf_fill) u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
-    emit_tag_sr[1] <= cat_31;
+    emit_tag_sr[1] <= cat_33;
     for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
       emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
     emit_valid_sr[1] <= leaf_active;
@@ -883,7 +917,7 @@ module fxrt_core (
     pipe_w_sr[1] <= ray_w_q;
     u0_done_took <= u0_done_pop;
     u1_done_took <= u1_done_pop;
-    done_valid_r <= or_38;
+    done_valid_r <= or_40;
     done_slot_r <= mux_u0_done_avail;
   end
 
@@ -1083,7 +1117,7 @@ module fxrt_core (
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
   assign busy = pipe_valid;
-  assign stack_depth = mux_lt_39;
+  assign stack_depth = mux_lt_41;
   assign visits = visits_c;
   assign culls = culls_c;
   assign occupied = occupied_c;

@@ -708,12 +708,22 @@ architecture rtl of fxrt_core is
   signal not_leaf_active : unsigned(0 downto 0);
   signal leaf_can_take : unsigned(0 downto 0);
   signal leaf_turn : unsigned(0 downto 0) := unsigned'("0");
-  signal u0_leaf_took : unsigned(0 downto 0) := unsigned'("0");
-  signal not_u0_leaf_took : unsigned(0 downto 0);
-  signal u0_leaf_avail : unsigned(0 downto 0);
-  signal u1_leaf_took : unsigned(0 downto 0) := unsigned'("0");
-  signal not_u1_leaf_took : unsigned(0 downto 0);
-  signal u1_leaf_avail : unsigned(0 downto 0);
+  signal u0_leaf_buf_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal not_u0_leaf_buf_valid : unsigned(0 downto 0);
+  signal u0_leaf_fill : unsigned(0 downto 0);
+  signal u0_buf_leaf_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal u0_buf_leaf_first : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal u0_buf_leaf_count : unsigned(2 downto 0) := unsigned'("000");
+  signal u0_buf_leaf_tmin : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal u0_buf_leaf_sp : unsigned(5 downto 0) := unsigned'("000000");
+  signal u1_leaf_buf_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal not_u1_leaf_buf_valid : unsigned(0 downto 0);
+  signal u1_leaf_fill : unsigned(0 downto 0);
+  signal u1_buf_leaf_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal u1_buf_leaf_first : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal u1_buf_leaf_count : unsigned(2 downto 0) := unsigned'("000");
+  signal u1_buf_leaf_tmin : unsigned(30 downto 0) := unsigned'("0000000000000000000000000000000");
+  signal u1_buf_leaf_sp : unsigned(5 downto 0) := unsigned'("000000");
   signal case_leaf_turn : unsigned(0 downto 0);
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
@@ -723,13 +733,19 @@ architecture rtl of fxrt_core is
   signal leaf_take : unsigned(0 downto 0);
   signal eq_26 : unsigned(0 downto 0);
   signal u0_leaf_take : unsigned(0 downto 0);
-  signal eq_27 : unsigned(0 downto 0);
+  signal not_u0_leaf_take : unsigned(0 downto 0);
+  signal and_27 : unsigned(0 downto 0);
+  signal u0_leaf_fill_or_and_27 : unsigned(0 downto 0);
+  signal eq_28 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
-  signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_28 : unsigned(6 downto 0);
-  signal not_leaf_last_entry : unsigned(0 downto 0);
+  signal not_u1_leaf_take : unsigned(0 downto 0);
   signal and_29 : unsigned(0 downto 0);
-  signal leaf_take_or_and_29 : unsigned(0 downto 0);
+  signal u1_leaf_fill_or_and_29 : unsigned(0 downto 0);
+  signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
+  signal cat_30 : unsigned(6 downto 0);
+  signal not_leaf_last_entry : unsigned(0 downto 0);
+  signal and_31 : unsigned(0 downto 0);
+  signal leaf_take_or_and_31 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
   constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
@@ -744,13 +760,13 @@ architecture rtl of fxrt_core is
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_30 : unsigned(0 downto 0);
+  signal eq_32 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_31 : unsigned(58 downto 0);
+  signal cat_33 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -815,12 +831,12 @@ architecture rtl of fxrt_core is
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
-  signal cat_35 : unsigned(6 downto 0);
+  signal cat_37 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_37 : unsigned(6 downto 0);
+  signal cat_39 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
-  signal or_38 : unsigned(0 downto 0);
+  signal or_40 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal u_closest_merge_valid : unsigned(0 downto 0);
@@ -837,8 +853,8 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal lt_39 : unsigned(0 downto 0);
-  signal mux_lt_39 : unsigned(5 downto 0);
+  signal lt_41 : unsigned(0 downto 0);
+  signal mux_lt_41 : unsigned(5 downto 0);
   signal rs_u_traverse_0_visit : unsigned(2 downto 0);
   signal rs_u_traverse_1_visit : unsigned(2 downto 0);
   signal visits_c : unsigned(2 downto 0);
@@ -953,8 +969,8 @@ begin
   merge_sp <= u_closest_merge_sp;
   free_valid <= u_closest_free_valid;
   free_slot <= u_closest_free_slot;
-  u0_leaf_pop <= u0_leaf_take;
-  u1_leaf_pop <= u1_leaf_take;
+  u0_leaf_pop <= u0_leaf_fill;
+  u1_leaf_pop <= u1_leaf_fill;
   u0_done_pop <= u0_done_avail;
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
@@ -997,14 +1013,14 @@ begin
   leaf_last_entry <= leaf_active and leaf_last;
   not_leaf_active <= not leaf_active;
   leaf_can_take <= not_leaf_active or leaf_last_entry;
-  not_u0_leaf_took <= not u0_leaf_took;
-  u0_leaf_avail <= u_traverse_0_leaf_valid and not_u0_leaf_took;
-  not_u1_leaf_took <= not u1_leaf_took;
-  u1_leaf_avail <= u_traverse_1_leaf_valid and not_u1_leaf_took;
+  not_u0_leaf_buf_valid <= not u0_leaf_buf_valid;
+  u0_leaf_fill <= u_traverse_0_leaf_valid and not_u0_leaf_buf_valid;
+  not_u1_leaf_buf_valid <= not u1_leaf_buf_valid;
+  u1_leaf_fill <= u_traverse_1_leaf_valid and not_u1_leaf_buf_valid;
   with leaf_turn select
     case_leaf_turn <=
-      u0_leaf_avail when "0",
-      u1_leaf_avail when "1",
+      u0_leaf_buf_valid when "0",
+      u1_leaf_buf_valid when "1",
       k_0 when others;
   with leaf_turn select
     case_leaf_turn_1 <=
@@ -1013,8 +1029,8 @@ begin
       k_0 when others;
   with leaf_turn select
     case_leaf_turn_2 <=
-      u1_leaf_avail when "0",
-      u0_leaf_avail when "1",
+      u1_leaf_buf_valid when "0",
+      u0_leaf_buf_valid when "1",
       k_0 when others;
   with leaf_turn select
     case_leaf_turn_3 <=
@@ -1026,53 +1042,59 @@ begin
   leaf_take <= leaf_can_take and or_25;
   eq_26 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
   u0_leaf_take <= leaf_take and eq_26;
-  eq_27 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_27;
+  not_u0_leaf_take <= not u0_leaf_take;
+  and_27 <= u0_leaf_buf_valid and not_u0_leaf_take;
+  u0_leaf_fill_or_and_27 <= u0_leaf_fill or and_27;
+  eq_28 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_28;
+  not_u1_leaf_take <= not u1_leaf_take;
+  and_29 <= u1_leaf_buf_valid and not_u1_leaf_take;
+  u1_leaf_fill_or_and_29 <= u1_leaf_fill or and_29;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
-      u_traverse_0_leaf_slot when "0",
-      u_traverse_1_leaf_slot when "1",
-      u_traverse_0_leaf_slot when others;
-  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+      u0_buf_leaf_slot when "0",
+      u1_buf_leaf_slot when "1",
+      u0_buf_leaf_slot when others;
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_29 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_29 <= leaf_take or and_29;
-  mux_leaf_take <= cat_28 when leaf_take = "1" else leaf_slot;
+  and_31 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_31 <= leaf_take or and_31;
+  mux_leaf_take <= cat_30 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
-      u_traverse_0_leaf_first when "0",
-      u_traverse_1_leaf_first when "1",
-      u_traverse_0_leaf_first when others;
+      u0_buf_leaf_first when "0",
+      u1_buf_leaf_first when "1",
+      u0_buf_leaf_first when others;
   leaf_ptr_plus_k_1_2 <= leaf_ptr + k_1_2;
   mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_2;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_2 <=
-      u_traverse_0_leaf_count when "0",
-      u_traverse_1_leaf_count when "1",
-      u_traverse_0_leaf_count when others;
+      u0_buf_leaf_count when "0",
+      u1_buf_leaf_count when "1",
+      u0_buf_leaf_count when others;
   leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
   mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_3;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_3 <=
-      u_traverse_0_leaf_tmin when "0",
-      u_traverse_1_leaf_tmin when "1",
-      u_traverse_0_leaf_tmin when others;
+      u0_buf_leaf_tmin when "0",
+      u1_buf_leaf_tmin when "1",
+      u0_buf_leaf_tmin when others;
   mux_leaf_take_3 <= case_mux_case_leaf_turn_2_3 when leaf_take = "1" else leaf_tmin;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_4 <=
-      u_traverse_0_leaf_sp when "0",
-      u_traverse_1_leaf_sp when "1",
-      u_traverse_0_leaf_sp when others;
+      u0_buf_leaf_sp when "0",
+      u1_buf_leaf_sp when "1",
+      u0_buf_leaf_sp when others;
   mux_leaf_take_4 <= case_mux_case_leaf_turn_2_4 when leaf_take = "1" else leaf_sp;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_5 <=
-      u_traverse_0_leaf_count when "0",
-      u_traverse_1_leaf_count when "1",
-      u_traverse_0_leaf_count when others;
-  eq_30 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+      u0_buf_leaf_count when "0",
+      u1_buf_leaf_count when "1",
+      u0_buf_leaf_count when others;
+  eq_32 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_30 when leaf_take = "1" else leaf_left_eq_k_2;
-  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  mux_leaf_take_5 <= eq_32 when leaf_take = "1" else leaf_left_eq_k_2;
+  cat_33 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -1112,14 +1134,14 @@ begin
   u0_done_avail <= u_traverse_0_done_valid and not_u0_done_took;
   not_u1_done_took <= not u1_done_took;
   u1_done_avail <= u_traverse_1_done_valid and not_u1_done_took;
-  cat_35 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_35 when u0_done_avail = "1" else cat_37;
-  or_38 <= u0_done_avail or u1_done_avail;
-  lt_39 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
-  mux_lt_39 <= u_traverse_1_depth when lt_39 = "1" else u_traverse_0_depth;
+  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_37 when u0_done_avail = "1" else cat_39;
+  or_40 <= u0_done_avail or u1_done_avail;
+  lt_41 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
+  mux_lt_41 <= u_traverse_1_depth when lt_41 = "1" else u_traverse_0_depth;
   rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
   rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
   visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -1275,7 +1297,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_29;
+        leaf_active <= leaf_take_or_and_31;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -1289,10 +1311,48 @@ begin
       elsif leaf_take = "1" then
         leaf_turn <= mux_case_leaf_turn_2;
       end if;
-      u0_leaf_took <= u0_leaf_pop;
-      u1_leaf_took <= u1_leaf_pop;
+      if rst = '1' then
+        u0_leaf_buf_valid <= unsigned'("0");
+      else
+        u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
+      end if;
+      if u0_leaf_fill = "1" then
+        u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
+      end if;
+      if u0_leaf_fill = "1" then
+        u0_buf_leaf_first <= u_traverse_0_leaf_first;
+      end if;
+      if u0_leaf_fill = "1" then
+        u0_buf_leaf_count <= u_traverse_0_leaf_count;
+      end if;
+      if u0_leaf_fill = "1" then
+        u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
+      end if;
+      if u0_leaf_fill = "1" then
+        u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
+      end if;
+      if rst = '1' then
+        u1_leaf_buf_valid <= unsigned'("0");
+      else
+        u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
+      end if;
+      if u1_leaf_fill = "1" then
+        u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
+      end if;
+      if u1_leaf_fill = "1" then
+        u1_buf_leaf_first <= u_traverse_1_leaf_first;
+      end if;
+      if u1_leaf_fill = "1" then
+        u1_buf_leaf_count <= u_traverse_1_leaf_count;
+      end if;
+      if u1_leaf_fill = "1" then
+        u1_buf_leaf_tmin <= u_traverse_1_leaf_tmin;
+      end if;
+      if u1_leaf_fill = "1" then
+        u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
+      end if;
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_31;
+      emit_tag_sr(1) <= cat_33;
       emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
       emit_valid_sr(1) <= leaf_active;
       pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
@@ -1307,7 +1367,7 @@ begin
       pipe_w_sr(1) <= ray_w_q;
       u0_done_took <= u0_done_pop;
       u1_done_took <= u1_done_pop;
-      done_valid_r <= or_38;
+      done_valid_r <= or_40;
       done_slot_r <= mux_u0_done_avail;
     end if;
   end process regs;
@@ -1518,7 +1578,7 @@ begin
   res_u <= u_closest_res_u;
   res_v <= u_closest_res_v;
   busy <= pipe_valid;
-  stack_depth <= mux_lt_39;
+  stack_depth <= mux_lt_41;
   visits <= visits_c;
   culls <= culls_c;
   occupied <= occupied_c;

@@ -355,14 +355,31 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let last_entry = (cur_valid & cur_last).name("leaf_last_entry");
     let can_take = (!cur_valid | last_entry).name("leaf_can_take");
     let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
-    // Rotating priority: the unit after the last one served first.
-    // A unit's queue pops a clock after it is taken from (`traverse_core`): not taken from again
-    // in that clock.
-    let avail: Vec<S> = trav
+    // Each unit's next leaf waits in a register of the top's (`leaf_buf`), filled from the
+    // unit's queue while empty: the arbiter then chooses among registers beside it, and the
+    // queues (across the die) only feed a register each. A unit's queue pops a clock after it
+    // is taken from (`traverse_core`), and its buffer is full in that clock anyway.
+    let fields = ["leaf_slot", "leaf_first", "leaf_count", "leaf_tmin", "leaf_sp"];
+    let bufs: Vec<(S, S, Vec<S>)> = trav
         .iter()
         .enumerate()
-        .map(|(u, t)| (t.get("leaf_valid") & !b.delay(&format!("u{u}_leaf_took"), leaf_pop[u])).name(&format!("u{u}_leaf_avail")))
+        .map(|(u, t)| {
+            let full = b.reg(&format!("u{u}_leaf_buf_valid"), bit, Some(0));
+            let fill = (t.get("leaf_valid") & !full).name(&format!("u{u}_leaf_fill"));
+            b.drive(leaf_pop[u], fill);
+            let held: Vec<S> = fields
+                .iter()
+                .map(|f| {
+                    let r = b.reg(&format!("u{u}_buf_{f}"), t.get(f).ty(), None);
+                    b.next_when(r, fill, t.get(f));
+                    r
+                })
+                .collect();
+            (full, fill, held)
+        })
         .collect();
+    let avail: Vec<S> = bufs.iter().map(|(full, _, _)| *full).collect();
+    // Rotating priority: the unit after the last one served first.
     let mut pick: Option<(S, S)> = None; // (any, unit)
     for j in (0..units).rev() {
         // Candidate j places after leaf_turn: unit (leaf_turn + 1 + j) mod units.
@@ -376,9 +393,9 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     }
     let (any_leaf, pick_u) = pick.expect("one unit or more");
     let take = (can_take & any_leaf).name("leaf_take");
-    for u in 0..units {
+    for (u, &(full, fill, _)) in bufs.iter().enumerate() {
         let me = if units == 1 { take } else { (take & pick_u.eq(u as i128)).name(&format!("u{u}_leaf_take")) };
-        b.drive(leaf_pop[u as usize], me);
+        b.next(full, fill | (full & !me));
     }
     if units > 1 {
         b.next_when(leaf_turn, take, pick_u);
@@ -386,7 +403,8 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
         b.next(leaf_turn, leaf_turn);
     }
     let sel = |port: &str| {
-        let v: Vec<S> = trav.iter().map(|t| t.get(port)).collect();
+        let k = fields.iter().position(|f| *f == port).expect("a buffered leaf field");
+        let v: Vec<S> = bufs.iter().map(|(_, _, held)| held[k]).collect();
         if units == 1 { v[0] } else { b.case(pick_u, &(0..units).map(|u| (u as u128, v[u as usize])).collect::<Vec<_>>(), v[0]) }
     };
     let next_slot = if ub == 0 { sel("leaf_slot") } else { b.cat(&[pick_u, sel("leaf_slot")]) };
