@@ -30,77 +30,14 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   output wire [31:0] res_v
 );
 
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b0 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b0.hex", best_t_tri_b0);
+  (* ram_style = "distributed" *) reg [42:0] best_t_tri [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri.hex", best_t_tri);
 
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b1 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b1.hex", best_t_tri_b1);
+  (* ram_style = "distributed" *) reg [63:0] best_u_v [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v.hex", best_u_v);
 
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b2 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b2.hex", best_t_tri_b2);
-
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b3 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b3.hex", best_t_tri_b3);
-
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b4 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b4.hex", best_t_tri_b4);
-
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b5 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b5.hex", best_t_tri_b5);
-
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b6 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b6.hex", best_t_tri_b6);
-
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri_b7 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_t_tri_b7.hex", best_t_tri_b7);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b0 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b0.hex", best_u_v_b0);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b1 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b1.hex", best_u_v_b1);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b2 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b2.hex", best_u_v_b2);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b3 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b3.hex", best_u_v_b3);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b4 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b4.hex", best_u_v_b4);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b5 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b5.hex", best_u_v_b5);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b6 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b6.hex", best_u_v_b6);
-
-  (* ram_style = "distributed" *) reg [63:0] best_u_v_b7 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_best_u_v_b7.hex", best_u_v_b7);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b0 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b0.hex", ray_ids_b0);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b1 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b1.hex", ray_ids_b1);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b2 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b2.hex", ray_ids_b2);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b3 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b3.hex", ray_ids_b3);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b4 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b4.hex", ray_ids_b4);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b5 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b5.hex", ray_ids_b5);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b6 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b6.hex", ray_ids_b6);
-
-  (* ram_style = "distributed" *) reg [19:0] ray_ids_b7 [0:15];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids_b7.hex", ray_ids_b7);
+  (* ram_style = "distributed" *) reg [19:0] ray_ids [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids.hex", ray_ids);
 
   wire [12:0] tri_s;
   wire [30:0] tmin;
@@ -187,70 +124,11 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] k_1 = 1'h1;
   wire [0:0] mux_in_valid2_and_in_first;
   wire [0:0] mux_take;
-  wire [2:0] bits_id_slot;
-  wire [2:0] k_0_1 = 3'h0;
-  wire [0:0] bits_id_slot_eq_k_0_1;
-  wire [0:0] and_5;
-  wire [3:0] bits_id_slot_1;
-  wire [2:0] bits_id_slot_2;
-  wire [2:0] k_1_1 = 3'h1;
-  wire [0:0] bits_id_slot_2_eq_k_1_1;
-  wire [0:0] and_6;
-  wire [3:0] bits_id_slot_3;
-  wire [2:0] bits_id_slot_4;
-  wire [2:0] k_2 = 3'h2;
-  wire [0:0] bits_id_slot_4_eq_k_2;
-  wire [0:0] and_7;
-  wire [3:0] bits_id_slot_5;
-  wire [2:0] bits_id_slot_6;
-  wire [2:0] k_3 = 3'h3;
-  wire [0:0] bits_id_slot_6_eq_k_3;
-  wire [0:0] and_8;
-  wire [3:0] bits_id_slot_7;
-  wire [2:0] bits_id_slot_8;
-  wire [2:0] k_4 = 3'h4;
-  wire [0:0] bits_id_slot_8_eq_k_4;
-  wire [0:0] and_9;
-  wire [3:0] bits_id_slot_9;
-  wire [2:0] bits_id_slot_10;
-  wire [2:0] k_5 = 3'h5;
-  wire [0:0] bits_id_slot_10_eq_k_5;
-  wire [0:0] and_10;
-  wire [3:0] bits_id_slot_11;
-  wire [2:0] bits_id_slot_12;
-  wire [2:0] k_6 = 3'h6;
-  wire [0:0] bits_id_slot_12_eq_k_6;
-  wire [0:0] and_11;
-  wire [3:0] bits_id_slot_13;
-  wire [2:0] bits_id_slot_14;
-  wire [2:0] k_7 = 3'h7;
-  wire [0:0] bits_id_slot_14_eq_k_7;
-  wire [0:0] and_12;
-  wire [3:0] bits_id_slot_15;
   reg [127:0] best_valid = 128'h00000000000000000000000000000000;
   wire [0:0] leaf_last;
   reg [0:0] fin = 1'h0;
   reg [6:0] fin_slot = 7'h00;
   reg [5:0] fin_sp = 6'h00;
-  wire [3:0] bits_in_slot;
-  reg [42:0] slot_t_tri_q_b0 = 43'h00000000000;
-  wire [3:0] bits_in_slot_1;
-  reg [42:0] slot_t_tri_q_b1 = 43'h00000000000;
-  wire [3:0] bits_in_slot_2;
-  reg [42:0] slot_t_tri_q_b2 = 43'h00000000000;
-  wire [3:0] bits_in_slot_3;
-  reg [42:0] slot_t_tri_q_b3 = 43'h00000000000;
-  wire [3:0] bits_in_slot_4;
-  reg [42:0] slot_t_tri_q_b4 = 43'h00000000000;
-  wire [3:0] bits_in_slot_5;
-  reg [42:0] slot_t_tri_q_b5 = 43'h00000000000;
-  wire [3:0] bits_in_slot_6;
-  reg [42:0] slot_t_tri_q_b6 = 43'h00000000000;
-  wire [3:0] bits_in_slot_7;
-  reg [42:0] slot_t_tri_q_b7 = 43'h00000000000;
-  wire [2:0] bits_fin_slot;
-  wire [42:0] k_0_2 = 43'h00000000000;
-  reg [42:0] slot_t_tri_q_c;
   reg [42:0] slot_t_tri = 43'h00000000000;
   reg [0:0] m1 = 1'h0;
   reg [6:0] m1_slot = 7'h00;
@@ -271,7 +149,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_13;
   wire [0:0] bits_best_valid_14;
   wire [0:0] bits_best_valid_15;
-  wire [3:0] bits_in_slot_8;
+  wire [3:0] bits_in_slot;
   reg [0:0] fin_has_g0_c;
   reg [0:0] fin_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_16;
@@ -290,7 +168,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_29;
   wire [0:0] bits_best_valid_30;
   wire [0:0] bits_best_valid_31;
-  wire [3:0] bits_in_slot_9;
+  wire [3:0] bits_in_slot_1;
   reg [0:0] fin_has_g1_c;
   reg [0:0] fin_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_32;
@@ -309,7 +187,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_45;
   wire [0:0] bits_best_valid_46;
   wire [0:0] bits_best_valid_47;
-  wire [3:0] bits_in_slot_10;
+  wire [3:0] bits_in_slot_2;
   reg [0:0] fin_has_g2_c;
   reg [0:0] fin_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_48;
@@ -328,7 +206,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_61;
   wire [0:0] bits_best_valid_62;
   wire [0:0] bits_best_valid_63;
-  wire [3:0] bits_in_slot_11;
+  wire [3:0] bits_in_slot_3;
   reg [0:0] fin_has_g3_c;
   reg [0:0] fin_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_64;
@@ -347,7 +225,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_77;
   wire [0:0] bits_best_valid_78;
   wire [0:0] bits_best_valid_79;
-  wire [3:0] bits_in_slot_12;
+  wire [3:0] bits_in_slot_4;
   reg [0:0] fin_has_g4_c;
   reg [0:0] fin_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_80;
@@ -366,7 +244,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_93;
   wire [0:0] bits_best_valid_94;
   wire [0:0] bits_best_valid_95;
-  wire [3:0] bits_in_slot_13;
+  wire [3:0] bits_in_slot_5;
   reg [0:0] fin_has_g5_c;
   reg [0:0] fin_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_96;
@@ -385,7 +263,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_109;
   wire [0:0] bits_best_valid_110;
   wire [0:0] bits_best_valid_111;
-  wire [3:0] bits_in_slot_14;
+  wire [3:0] bits_in_slot_6;
   reg [0:0] fin_has_g6_c;
   reg [0:0] fin_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_112;
@@ -404,24 +282,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_125;
   wire [0:0] bits_best_valid_126;
   wire [0:0] bits_best_valid_127;
-  wire [3:0] bits_in_slot_15;
+  wire [3:0] bits_in_slot_7;
   reg [0:0] fin_has_g7_c;
   reg [0:0] fin_has_g7 = 1'h0;
-  wire [2:0] bits_fin_slot_1;
+  wire [2:0] bits_fin_slot;
   reg [0:0] fin_has_c;
   reg [0:0] m1_slot_has = 1'h0;
   reg [0:0] m1_leaf_empty = 1'h0;
-  wire [42:0] cat_13;
+  wire [42:0] cat_5;
   reg [42:0] m1_t_tri = 43'h00000000000;
-  wire [63:0] cat_14;
+  wire [63:0] cat_6;
   reg [63:0] m1_u_v = 64'h0000000000000000;
-  wire [44:0] cat_15;
+  wire [44:0] cat_7;
   wire [0:0] not_m1_slot_has;
-  wire [44:0] cat_16;
-  wire [45:0] rs_cat_15;
-  wire [45:0] rs_cat_16;
+  wire [44:0] cat_8;
+  wire [45:0] rs_cat_7;
+  wire [45:0] rs_cat_8;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 45 are read
-  wire [45:0] minus_17;
+  wire [45:0] rs_cat_7_minus_rs_cat_8;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] leaf_better;
   reg [0:0] m2 = 1'h0;
@@ -436,70 +314,6 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [29:0] bits_slot_t_tri;
   reg [29:0] m2_slot_t_1 = 30'h00000000;
   wire [0:0] best_we;
-  wire [2:0] bits_m2_slot;
-  wire [0:0] bits_m2_slot_eq_k_0_1;
-  wire [0:0] and_19;
-  wire [3:0] bits_m2_slot_1;
-  wire [2:0] bits_m2_slot_2;
-  wire [0:0] bits_m2_slot_2_eq_k_1_1;
-  wire [0:0] and_20;
-  wire [3:0] bits_m2_slot_3;
-  wire [2:0] bits_m2_slot_4;
-  wire [0:0] bits_m2_slot_4_eq_k_2;
-  wire [0:0] and_21;
-  wire [3:0] bits_m2_slot_5;
-  wire [2:0] bits_m2_slot_6;
-  wire [0:0] bits_m2_slot_6_eq_k_3;
-  wire [0:0] and_22;
-  wire [3:0] bits_m2_slot_7;
-  wire [2:0] bits_m2_slot_8;
-  wire [0:0] bits_m2_slot_8_eq_k_4;
-  wire [0:0] and_23;
-  wire [3:0] bits_m2_slot_9;
-  wire [2:0] bits_m2_slot_10;
-  wire [0:0] bits_m2_slot_10_eq_k_5;
-  wire [0:0] and_24;
-  wire [3:0] bits_m2_slot_11;
-  wire [2:0] bits_m2_slot_12;
-  wire [0:0] bits_m2_slot_12_eq_k_6;
-  wire [0:0] and_25;
-  wire [3:0] bits_m2_slot_13;
-  wire [2:0] bits_m2_slot_14;
-  wire [0:0] bits_m2_slot_14_eq_k_7;
-  wire [0:0] and_26;
-  wire [3:0] bits_m2_slot_15;
-  wire [2:0] bits_m2_slot_16;
-  wire [0:0] bits_m2_slot_16_eq_k_0_1;
-  wire [0:0] and_27;
-  wire [3:0] bits_m2_slot_17;
-  wire [2:0] bits_m2_slot_18;
-  wire [0:0] bits_m2_slot_18_eq_k_1_1;
-  wire [0:0] and_28;
-  wire [3:0] bits_m2_slot_19;
-  wire [2:0] bits_m2_slot_20;
-  wire [0:0] bits_m2_slot_20_eq_k_2;
-  wire [0:0] and_29;
-  wire [3:0] bits_m2_slot_21;
-  wire [2:0] bits_m2_slot_22;
-  wire [0:0] bits_m2_slot_22_eq_k_3;
-  wire [0:0] and_30;
-  wire [3:0] bits_m2_slot_23;
-  wire [2:0] bits_m2_slot_24;
-  wire [0:0] bits_m2_slot_24_eq_k_4;
-  wire [0:0] and_31;
-  wire [3:0] bits_m2_slot_25;
-  wire [2:0] bits_m2_slot_26;
-  wire [0:0] bits_m2_slot_26_eq_k_5;
-  wire [0:0] and_32;
-  wire [3:0] bits_m2_slot_27;
-  wire [2:0] bits_m2_slot_28;
-  wire [0:0] bits_m2_slot_28_eq_k_6;
-  wire [0:0] and_33;
-  wire [3:0] bits_m2_slot_29;
-  wire [2:0] bits_m2_slot_30;
-  wire [0:0] bits_m2_slot_30_eq_k_7;
-  wire [0:0] and_34;
-  wire [3:0] bits_m2_slot_31;
   wire [29:0] bits_m2_t_tri;
   wire [29:0] merged_t;
   wire [30:0] rs_merged_t;
@@ -513,64 +327,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   reg [5:0] merge_sp_r = 6'h00;
   reg [0:0] d0 = 1'h0;
   reg [6:0] d0_slot = 7'h00;
-  wire [3:0] bits_done_slot;
-  reg [42:0] done_t_tri_q_b0 = 43'h00000000000;
-  wire [3:0] bits_done_slot_1;
-  reg [42:0] done_t_tri_q_b1 = 43'h00000000000;
-  wire [3:0] bits_done_slot_2;
-  reg [42:0] done_t_tri_q_b2 = 43'h00000000000;
-  wire [3:0] bits_done_slot_3;
-  reg [42:0] done_t_tri_q_b3 = 43'h00000000000;
-  wire [3:0] bits_done_slot_4;
-  reg [42:0] done_t_tri_q_b4 = 43'h00000000000;
-  wire [3:0] bits_done_slot_5;
-  reg [42:0] done_t_tri_q_b5 = 43'h00000000000;
-  wire [3:0] bits_done_slot_6;
-  reg [42:0] done_t_tri_q_b6 = 43'h00000000000;
-  wire [3:0] bits_done_slot_7;
-  reg [42:0] done_t_tri_q_b7 = 43'h00000000000;
-  wire [2:0] bits_d0_slot;
-  reg [42:0] done_t_tri_q_c;
   reg [42:0] done_t_tri = 43'h00000000000;
-  wire [3:0] bits_done_slot_8;
-  reg [63:0] done_u_v_q_b0 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_9;
-  reg [63:0] done_u_v_q_b1 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_10;
-  reg [63:0] done_u_v_q_b2 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_11;
-  reg [63:0] done_u_v_q_b3 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_12;
-  reg [63:0] done_u_v_q_b4 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_13;
-  reg [63:0] done_u_v_q_b5 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_14;
-  reg [63:0] done_u_v_q_b6 = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_15;
-  reg [63:0] done_u_v_q_b7 = 64'h0000000000000000;
-  wire [2:0] bits_d0_slot_1;
-  wire [63:0] k_0_3 = 64'h0000000000000000;
-  reg [63:0] done_u_v_q_c;
   reg [63:0] done_u_v = 64'h0000000000000000;
-  wire [3:0] bits_done_slot_16;
-  reg [19:0] done_id_q_b0 = 20'h00000;
-  wire [3:0] bits_done_slot_17;
-  reg [19:0] done_id_q_b1 = 20'h00000;
-  wire [3:0] bits_done_slot_18;
-  reg [19:0] done_id_q_b2 = 20'h00000;
-  wire [3:0] bits_done_slot_19;
-  reg [19:0] done_id_q_b3 = 20'h00000;
-  wire [3:0] bits_done_slot_20;
-  reg [19:0] done_id_q_b4 = 20'h00000;
-  wire [3:0] bits_done_slot_21;
-  reg [19:0] done_id_q_b5 = 20'h00000;
-  wire [3:0] bits_done_slot_22;
-  reg [19:0] done_id_q_b6 = 20'h00000;
-  wire [3:0] bits_done_slot_23;
-  reg [19:0] done_id_q_b7 = 20'h00000;
-  wire [2:0] bits_d0_slot_2;
-  wire [19:0] k_0_4 = 20'h00000;
-  reg [19:0] done_id_q_c;
   reg [19:0] done_id = 20'h00000;
   reg [0:0] d1 = 1'h0;
   reg [6:0] d1_slot = 7'h00;
@@ -590,7 +348,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_141;
   wire [0:0] bits_best_valid_142;
   wire [0:0] bits_best_valid_143;
-  wire [3:0] bits_done_slot_24;
+  wire [3:0] bits_done_slot;
   reg [0:0] done_has_g0_c;
   reg [0:0] done_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_144;
@@ -609,7 +367,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_157;
   wire [0:0] bits_best_valid_158;
   wire [0:0] bits_best_valid_159;
-  wire [3:0] bits_done_slot_25;
+  wire [3:0] bits_done_slot_1;
   reg [0:0] done_has_g1_c;
   reg [0:0] done_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_160;
@@ -628,7 +386,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_173;
   wire [0:0] bits_best_valid_174;
   wire [0:0] bits_best_valid_175;
-  wire [3:0] bits_done_slot_26;
+  wire [3:0] bits_done_slot_2;
   reg [0:0] done_has_g2_c;
   reg [0:0] done_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_176;
@@ -647,7 +405,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_189;
   wire [0:0] bits_best_valid_190;
   wire [0:0] bits_best_valid_191;
-  wire [3:0] bits_done_slot_27;
+  wire [3:0] bits_done_slot_3;
   reg [0:0] done_has_g3_c;
   reg [0:0] done_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_192;
@@ -666,7 +424,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_205;
   wire [0:0] bits_best_valid_206;
   wire [0:0] bits_best_valid_207;
-  wire [3:0] bits_done_slot_28;
+  wire [3:0] bits_done_slot_4;
   reg [0:0] done_has_g4_c;
   reg [0:0] done_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_208;
@@ -685,7 +443,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_221;
   wire [0:0] bits_best_valid_222;
   wire [0:0] bits_best_valid_223;
-  wire [3:0] bits_done_slot_29;
+  wire [3:0] bits_done_slot_5;
   reg [0:0] done_has_g5_c;
   reg [0:0] done_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_224;
@@ -704,7 +462,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_237;
   wire [0:0] bits_best_valid_238;
   wire [0:0] bits_best_valid_239;
-  wire [3:0] bits_done_slot_30;
+  wire [3:0] bits_done_slot_6;
   reg [0:0] done_has_g6_c;
   reg [0:0] done_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_240;
@@ -723,13 +481,13 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_253;
   wire [0:0] bits_best_valid_254;
   wire [0:0] bits_best_valid_255;
-  wire [3:0] bits_done_slot_31;
+  wire [3:0] bits_done_slot_7;
   reg [0:0] done_has_g7_c;
   reg [0:0] done_has_g7 = 1'h0;
-  wire [2:0] bits_d0_slot_3;
+  wire [2:0] bits_d0_slot;
   reg [0:0] done_has_c;
   reg [0:0] d1_has = 1'h0;
-  wire [127:0] k_0_5 = 128'h00000000000000000000000000000000;
+  wire [127:0] k_0_1 = 128'h00000000000000000000000000000000;
   wire [6:0] k_127 = 7'h7f;
   wire [0:0] m2_slot_eq_k_127;
   wire [6:0] k_126 = 7'h7e;
@@ -970,23 +728,23 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] m2_slot_eq_k_9;
   wire [6:0] k_8_1 = 7'h08;
   wire [0:0] m2_slot_eq_k_8_1;
-  wire [6:0] k_7_1 = 7'h07;
-  wire [0:0] m2_slot_eq_k_7_1;
-  wire [6:0] k_6_1 = 7'h06;
-  wire [0:0] m2_slot_eq_k_6_1;
-  wire [6:0] k_5_1 = 7'h05;
-  wire [0:0] m2_slot_eq_k_5_1;
-  wire [6:0] k_4_1 = 7'h04;
-  wire [0:0] m2_slot_eq_k_4_1;
-  wire [6:0] k_3_1 = 7'h03;
-  wire [0:0] m2_slot_eq_k_3_1;
-  wire [6:0] k_2_1 = 7'h02;
-  wire [0:0] m2_slot_eq_k_2_1;
-  wire [6:0] k_1_2 = 7'h01;
-  wire [0:0] m2_slot_eq_k_1_2;
-  wire [6:0] k_0_6 = 7'h00;
-  wire [0:0] m2_slot_eq_k_0_6;
-  wire [127:0] cat_36;
+  wire [6:0] k_7 = 7'h07;
+  wire [0:0] m2_slot_eq_k_7;
+  wire [6:0] k_6 = 7'h06;
+  wire [0:0] m2_slot_eq_k_6;
+  wire [6:0] k_5 = 7'h05;
+  wire [0:0] m2_slot_eq_k_5;
+  wire [6:0] k_4 = 7'h04;
+  wire [0:0] m2_slot_eq_k_4;
+  wire [6:0] k_3 = 7'h03;
+  wire [0:0] m2_slot_eq_k_3;
+  wire [6:0] k_2 = 7'h02;
+  wire [0:0] m2_slot_eq_k_2;
+  wire [6:0] k_1_1 = 7'h01;
+  wire [0:0] m2_slot_eq_k_1_1;
+  wire [6:0] k_0_2 = 7'h00;
+  wire [0:0] m2_slot_eq_k_0_2;
+  wire [127:0] cat_11;
   wire [127:0] best_set;
   wire [0:0] d1_slot_eq_k_127;
   wire [0:0] d1_slot_eq_k_126;
@@ -1108,19 +866,19 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] d1_slot_eq_k_10;
   wire [0:0] d1_slot_eq_k_9;
   wire [0:0] d1_slot_eq_k_8_1;
-  wire [0:0] d1_slot_eq_k_7_1;
-  wire [0:0] d1_slot_eq_k_6_1;
-  wire [0:0] d1_slot_eq_k_5_1;
-  wire [0:0] d1_slot_eq_k_4_1;
-  wire [0:0] d1_slot_eq_k_3_1;
-  wire [0:0] d1_slot_eq_k_2_1;
-  wire [0:0] d1_slot_eq_k_1_2;
-  wire [0:0] d1_slot_eq_k_0_6;
-  wire [127:0] cat_37;
+  wire [0:0] d1_slot_eq_k_7;
+  wire [0:0] d1_slot_eq_k_6;
+  wire [0:0] d1_slot_eq_k_5;
+  wire [0:0] d1_slot_eq_k_4;
+  wire [0:0] d1_slot_eq_k_3;
+  wire [0:0] d1_slot_eq_k_2;
+  wire [0:0] d1_slot_eq_k_1_1;
+  wire [0:0] d1_slot_eq_k_0_2;
+  wire [127:0] cat_12;
   wire [127:0] best_clear;
   wire [127:0] not_best_clear;
-  wire [127:0] and_38;
-  wire [127:0] and_38_or_best_set;
+  wire [127:0] and_13;
+  wire [127:0] and_13_or_best_set;
   reg [0:0] free_valid_r = 1'h0;
   reg [6:0] free_slot_r = 7'h00;
   reg [0:0] res_valid_r = 1'h0;
@@ -1129,15 +887,15 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] res_hit_c;
   reg [0:0] res_hit_r = 1'h0;
   wire [12:0] bits_done_t_tri;
-  wire [12:0] k_0_7 = 13'h0000;
+  wire [12:0] k_0_3 = 13'h0000;
   wire [12:0] res_tri_c;
   reg [12:0] res_tri_r = 13'h0000;
   wire [29:0] bits_done_t_tri_1;
-  wire [29:0] k_0_8 = 30'h00000000;
+  wire [29:0] k_0_4 = 30'h00000000;
   wire [29:0] res_t_c;
   reg [29:0] res_t_r = 30'h00000000;
   wire [31:0] bits_done_u_v;
-  wire [31:0] k_0_9 = 32'h00000000;
+  wire [31:0] k_0_5 = 32'h00000000;
   wire [31:0] res_u_c;
   reg [31:0] res_u_r = 32'h00000000;
   wire [31:0] bits_done_u_v_1;
@@ -1185,61 +943,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign in_valid2_and_in_first = in_valid2 & in_first;
   assign mux_in_valid2_and_in_first = in_valid2_and_in_first ? k_1 : acc_empty;
   assign mux_take = take ? k_0 : mux_in_valid2_and_in_first;
-  assign bits_id_slot = id_slot[6:4];
-  assign bits_id_slot_eq_k_0_1 = bits_id_slot == k_0_1;
-  assign and_5 = id_we & bits_id_slot_eq_k_0_1;
-  assign bits_id_slot_1 = id_slot[3:0];
-  assign bits_id_slot_2 = id_slot[6:4];
-  assign bits_id_slot_2_eq_k_1_1 = bits_id_slot_2 == k_1_1;
-  assign and_6 = id_we & bits_id_slot_2_eq_k_1_1;
-  assign bits_id_slot_3 = id_slot[3:0];
-  assign bits_id_slot_4 = id_slot[6:4];
-  assign bits_id_slot_4_eq_k_2 = bits_id_slot_4 == k_2;
-  assign and_7 = id_we & bits_id_slot_4_eq_k_2;
-  assign bits_id_slot_5 = id_slot[3:0];
-  assign bits_id_slot_6 = id_slot[6:4];
-  assign bits_id_slot_6_eq_k_3 = bits_id_slot_6 == k_3;
-  assign and_8 = id_we & bits_id_slot_6_eq_k_3;
-  assign bits_id_slot_7 = id_slot[3:0];
-  assign bits_id_slot_8 = id_slot[6:4];
-  assign bits_id_slot_8_eq_k_4 = bits_id_slot_8 == k_4;
-  assign and_9 = id_we & bits_id_slot_8_eq_k_4;
-  assign bits_id_slot_9 = id_slot[3:0];
-  assign bits_id_slot_10 = id_slot[6:4];
-  assign bits_id_slot_10_eq_k_5 = bits_id_slot_10 == k_5;
-  assign and_10 = id_we & bits_id_slot_10_eq_k_5;
-  assign bits_id_slot_11 = id_slot[3:0];
-  assign bits_id_slot_12 = id_slot[6:4];
-  assign bits_id_slot_12_eq_k_6 = bits_id_slot_12 == k_6;
-  assign and_11 = id_we & bits_id_slot_12_eq_k_6;
-  assign bits_id_slot_13 = id_slot[3:0];
-  assign bits_id_slot_14 = id_slot[6:4];
-  assign bits_id_slot_14_eq_k_7 = bits_id_slot_14 == k_7;
-  assign and_12 = id_we & bits_id_slot_14_eq_k_7;
-  assign bits_id_slot_15 = id_slot[3:0];
   assign leaf_last = in_valid2 & in_last;
-  assign bits_in_slot = in_slot[3:0];
-  assign bits_in_slot_1 = in_slot[3:0];
-  assign bits_in_slot_2 = in_slot[3:0];
-  assign bits_in_slot_3 = in_slot[3:0];
-  assign bits_in_slot_4 = in_slot[3:0];
-  assign bits_in_slot_5 = in_slot[3:0];
-  assign bits_in_slot_6 = in_slot[3:0];
-  assign bits_in_slot_7 = in_slot[3:0];
-  assign bits_fin_slot = fin_slot[6:4];
-  always @* begin
-    case (bits_fin_slot)
-      3'h0: slot_t_tri_q_c = slot_t_tri_q_b0;
-      3'h1: slot_t_tri_q_c = slot_t_tri_q_b1;
-      3'h2: slot_t_tri_q_c = slot_t_tri_q_b2;
-      3'h3: slot_t_tri_q_c = slot_t_tri_q_b3;
-      3'h4: slot_t_tri_q_c = slot_t_tri_q_b4;
-      3'h5: slot_t_tri_q_c = slot_t_tri_q_b5;
-      3'h6: slot_t_tri_q_c = slot_t_tri_q_b6;
-      3'h7: slot_t_tri_q_c = slot_t_tri_q_b7;
-      default: slot_t_tri_q_c = k_0_2;
-    endcase
-  end
   assign bits_best_valid = best_valid[0];
   assign bits_best_valid_1 = best_valid[1];
   assign bits_best_valid_2 = best_valid[2];
@@ -1256,9 +960,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_13 = best_valid[13];
   assign bits_best_valid_14 = best_valid[14];
   assign bits_best_valid_15 = best_valid[15];
-  assign bits_in_slot_8 = in_slot[3:0];
+  assign bits_in_slot = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_8)
+    case (bits_in_slot)
       4'h0: fin_has_g0_c = bits_best_valid;
       4'h1: fin_has_g0_c = bits_best_valid_1;
       4'h2: fin_has_g0_c = bits_best_valid_2;
@@ -1294,9 +998,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_29 = best_valid[29];
   assign bits_best_valid_30 = best_valid[30];
   assign bits_best_valid_31 = best_valid[31];
-  assign bits_in_slot_9 = in_slot[3:0];
+  assign bits_in_slot_1 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_9)
+    case (bits_in_slot_1)
       4'h0: fin_has_g1_c = bits_best_valid_16;
       4'h1: fin_has_g1_c = bits_best_valid_17;
       4'h2: fin_has_g1_c = bits_best_valid_18;
@@ -1332,9 +1036,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_45 = best_valid[45];
   assign bits_best_valid_46 = best_valid[46];
   assign bits_best_valid_47 = best_valid[47];
-  assign bits_in_slot_10 = in_slot[3:0];
+  assign bits_in_slot_2 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_10)
+    case (bits_in_slot_2)
       4'h0: fin_has_g2_c = bits_best_valid_32;
       4'h1: fin_has_g2_c = bits_best_valid_33;
       4'h2: fin_has_g2_c = bits_best_valid_34;
@@ -1370,9 +1074,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_61 = best_valid[61];
   assign bits_best_valid_62 = best_valid[62];
   assign bits_best_valid_63 = best_valid[63];
-  assign bits_in_slot_11 = in_slot[3:0];
+  assign bits_in_slot_3 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_11)
+    case (bits_in_slot_3)
       4'h0: fin_has_g3_c = bits_best_valid_48;
       4'h1: fin_has_g3_c = bits_best_valid_49;
       4'h2: fin_has_g3_c = bits_best_valid_50;
@@ -1408,9 +1112,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_77 = best_valid[77];
   assign bits_best_valid_78 = best_valid[78];
   assign bits_best_valid_79 = best_valid[79];
-  assign bits_in_slot_12 = in_slot[3:0];
+  assign bits_in_slot_4 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_12)
+    case (bits_in_slot_4)
       4'h0: fin_has_g4_c = bits_best_valid_64;
       4'h1: fin_has_g4_c = bits_best_valid_65;
       4'h2: fin_has_g4_c = bits_best_valid_66;
@@ -1446,9 +1150,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_93 = best_valid[93];
   assign bits_best_valid_94 = best_valid[94];
   assign bits_best_valid_95 = best_valid[95];
-  assign bits_in_slot_13 = in_slot[3:0];
+  assign bits_in_slot_5 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_13)
+    case (bits_in_slot_5)
       4'h0: fin_has_g5_c = bits_best_valid_80;
       4'h1: fin_has_g5_c = bits_best_valid_81;
       4'h2: fin_has_g5_c = bits_best_valid_82;
@@ -1484,9 +1188,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_109 = best_valid[109];
   assign bits_best_valid_110 = best_valid[110];
   assign bits_best_valid_111 = best_valid[111];
-  assign bits_in_slot_14 = in_slot[3:0];
+  assign bits_in_slot_6 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_14)
+    case (bits_in_slot_6)
       4'h0: fin_has_g6_c = bits_best_valid_96;
       4'h1: fin_has_g6_c = bits_best_valid_97;
       4'h2: fin_has_g6_c = bits_best_valid_98;
@@ -1522,9 +1226,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_125 = best_valid[125];
   assign bits_best_valid_126 = best_valid[126];
   assign bits_best_valid_127 = best_valid[127];
-  assign bits_in_slot_15 = in_slot[3:0];
+  assign bits_in_slot_7 = in_slot[3:0];
   always @* begin
-    case (bits_in_slot_15)
+    case (bits_in_slot_7)
       4'h0: fin_has_g7_c = bits_best_valid_112;
       4'h1: fin_has_g7_c = bits_best_valid_113;
       4'h2: fin_has_g7_c = bits_best_valid_114;
@@ -1544,9 +1248,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
       default: fin_has_g7_c = k_0;
     endcase
   end
-  assign bits_fin_slot_1 = fin_slot[6:4];
+  assign bits_fin_slot = fin_slot[6:4];
   always @* begin
-    case (bits_fin_slot_1)
+    case (bits_fin_slot)
       3'h0: fin_has_c = fin_has_g0;
       3'h1: fin_has_c = fin_has_g1;
       3'h2: fin_has_c = fin_has_g2;
@@ -1558,155 +1262,25 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
       default: fin_has_c = k_0;
     endcase
   end
-  assign cat_13 = {acc_t, acc_tri};
-  assign cat_14 = {acc_u, acc_v};
-  assign cat_15 = {m1_leaf_empty, k_0, m1_t_tri};
+  assign cat_5 = {acc_t, acc_tri};
+  assign cat_6 = {acc_u, acc_v};
+  assign cat_7 = {m1_leaf_empty, k_0, m1_t_tri};
   assign not_m1_slot_has = ~m1_slot_has;
-  assign cat_16 = {k_0, not_m1_slot_has, slot_t_tri};
-  assign rs_cat_15 = {{1{1'b0}}, cat_15};
-  assign rs_cat_16 = {{1{1'b0}}, cat_16};
-  assign minus_17 = rs_cat_15 - rs_cat_16;
-  assign leaf_better = minus_17[45];
+  assign cat_8 = {k_0, not_m1_slot_has, slot_t_tri};
+  assign rs_cat_7 = {{1{1'b0}}, cat_7};
+  assign rs_cat_8 = {{1{1'b0}}, cat_8};
+  assign rs_cat_7_minus_rs_cat_8 = rs_cat_7 - rs_cat_8;
+  assign leaf_better = rs_cat_7_minus_rs_cat_8[45];
   assign not_m1_leaf_empty = ~m1_leaf_empty;
   assign m1_hit = m1_slot_has | not_m1_leaf_empty;
   assign bits_slot_t_tri = slot_t_tri[42:13];
   assign best_we = m2 & m2_better;
-  assign bits_m2_slot = m2_slot[6:4];
-  assign bits_m2_slot_eq_k_0_1 = bits_m2_slot == k_0_1;
-  assign and_19 = best_we & bits_m2_slot_eq_k_0_1;
-  assign bits_m2_slot_1 = m2_slot[3:0];
-  assign bits_m2_slot_2 = m2_slot[6:4];
-  assign bits_m2_slot_2_eq_k_1_1 = bits_m2_slot_2 == k_1_1;
-  assign and_20 = best_we & bits_m2_slot_2_eq_k_1_1;
-  assign bits_m2_slot_3 = m2_slot[3:0];
-  assign bits_m2_slot_4 = m2_slot[6:4];
-  assign bits_m2_slot_4_eq_k_2 = bits_m2_slot_4 == k_2;
-  assign and_21 = best_we & bits_m2_slot_4_eq_k_2;
-  assign bits_m2_slot_5 = m2_slot[3:0];
-  assign bits_m2_slot_6 = m2_slot[6:4];
-  assign bits_m2_slot_6_eq_k_3 = bits_m2_slot_6 == k_3;
-  assign and_22 = best_we & bits_m2_slot_6_eq_k_3;
-  assign bits_m2_slot_7 = m2_slot[3:0];
-  assign bits_m2_slot_8 = m2_slot[6:4];
-  assign bits_m2_slot_8_eq_k_4 = bits_m2_slot_8 == k_4;
-  assign and_23 = best_we & bits_m2_slot_8_eq_k_4;
-  assign bits_m2_slot_9 = m2_slot[3:0];
-  assign bits_m2_slot_10 = m2_slot[6:4];
-  assign bits_m2_slot_10_eq_k_5 = bits_m2_slot_10 == k_5;
-  assign and_24 = best_we & bits_m2_slot_10_eq_k_5;
-  assign bits_m2_slot_11 = m2_slot[3:0];
-  assign bits_m2_slot_12 = m2_slot[6:4];
-  assign bits_m2_slot_12_eq_k_6 = bits_m2_slot_12 == k_6;
-  assign and_25 = best_we & bits_m2_slot_12_eq_k_6;
-  assign bits_m2_slot_13 = m2_slot[3:0];
-  assign bits_m2_slot_14 = m2_slot[6:4];
-  assign bits_m2_slot_14_eq_k_7 = bits_m2_slot_14 == k_7;
-  assign and_26 = best_we & bits_m2_slot_14_eq_k_7;
-  assign bits_m2_slot_15 = m2_slot[3:0];
-  assign bits_m2_slot_16 = m2_slot[6:4];
-  assign bits_m2_slot_16_eq_k_0_1 = bits_m2_slot_16 == k_0_1;
-  assign and_27 = best_we & bits_m2_slot_16_eq_k_0_1;
-  assign bits_m2_slot_17 = m2_slot[3:0];
-  assign bits_m2_slot_18 = m2_slot[6:4];
-  assign bits_m2_slot_18_eq_k_1_1 = bits_m2_slot_18 == k_1_1;
-  assign and_28 = best_we & bits_m2_slot_18_eq_k_1_1;
-  assign bits_m2_slot_19 = m2_slot[3:0];
-  assign bits_m2_slot_20 = m2_slot[6:4];
-  assign bits_m2_slot_20_eq_k_2 = bits_m2_slot_20 == k_2;
-  assign and_29 = best_we & bits_m2_slot_20_eq_k_2;
-  assign bits_m2_slot_21 = m2_slot[3:0];
-  assign bits_m2_slot_22 = m2_slot[6:4];
-  assign bits_m2_slot_22_eq_k_3 = bits_m2_slot_22 == k_3;
-  assign and_30 = best_we & bits_m2_slot_22_eq_k_3;
-  assign bits_m2_slot_23 = m2_slot[3:0];
-  assign bits_m2_slot_24 = m2_slot[6:4];
-  assign bits_m2_slot_24_eq_k_4 = bits_m2_slot_24 == k_4;
-  assign and_31 = best_we & bits_m2_slot_24_eq_k_4;
-  assign bits_m2_slot_25 = m2_slot[3:0];
-  assign bits_m2_slot_26 = m2_slot[6:4];
-  assign bits_m2_slot_26_eq_k_5 = bits_m2_slot_26 == k_5;
-  assign and_32 = best_we & bits_m2_slot_26_eq_k_5;
-  assign bits_m2_slot_27 = m2_slot[3:0];
-  assign bits_m2_slot_28 = m2_slot[6:4];
-  assign bits_m2_slot_28_eq_k_6 = bits_m2_slot_28 == k_6;
-  assign and_33 = best_we & bits_m2_slot_28_eq_k_6;
-  assign bits_m2_slot_29 = m2_slot[3:0];
-  assign bits_m2_slot_30 = m2_slot[6:4];
-  assign bits_m2_slot_30_eq_k_7 = bits_m2_slot_30 == k_7;
-  assign and_34 = best_we & bits_m2_slot_30_eq_k_7;
-  assign bits_m2_slot_31 = m2_slot[3:0];
   assign bits_m2_t_tri = m2_t_tri[42:13];
   assign merged_t = m2_better ? bits_m2_t_tri : m2_slot_t_1;
   assign rs_merged_t = {{1{1'b0}}, merged_t};
   assign s_rs_merged_t = $signed(rs_merged_t);
   assign rs_s_rs_merged_t = $signed({{1{s_rs_merged_t[30]}}, s_rs_merged_t});
   assign merged_limit = rs_s_rs_merged_t + k_8;
-  assign bits_done_slot = done_slot[3:0];
-  assign bits_done_slot_1 = done_slot[3:0];
-  assign bits_done_slot_2 = done_slot[3:0];
-  assign bits_done_slot_3 = done_slot[3:0];
-  assign bits_done_slot_4 = done_slot[3:0];
-  assign bits_done_slot_5 = done_slot[3:0];
-  assign bits_done_slot_6 = done_slot[3:0];
-  assign bits_done_slot_7 = done_slot[3:0];
-  assign bits_d0_slot = d0_slot[6:4];
-  always @* begin
-    case (bits_d0_slot)
-      3'h0: done_t_tri_q_c = done_t_tri_q_b0;
-      3'h1: done_t_tri_q_c = done_t_tri_q_b1;
-      3'h2: done_t_tri_q_c = done_t_tri_q_b2;
-      3'h3: done_t_tri_q_c = done_t_tri_q_b3;
-      3'h4: done_t_tri_q_c = done_t_tri_q_b4;
-      3'h5: done_t_tri_q_c = done_t_tri_q_b5;
-      3'h6: done_t_tri_q_c = done_t_tri_q_b6;
-      3'h7: done_t_tri_q_c = done_t_tri_q_b7;
-      default: done_t_tri_q_c = k_0_2;
-    endcase
-  end
-  assign bits_done_slot_8 = done_slot[3:0];
-  assign bits_done_slot_9 = done_slot[3:0];
-  assign bits_done_slot_10 = done_slot[3:0];
-  assign bits_done_slot_11 = done_slot[3:0];
-  assign bits_done_slot_12 = done_slot[3:0];
-  assign bits_done_slot_13 = done_slot[3:0];
-  assign bits_done_slot_14 = done_slot[3:0];
-  assign bits_done_slot_15 = done_slot[3:0];
-  assign bits_d0_slot_1 = d0_slot[6:4];
-  always @* begin
-    case (bits_d0_slot_1)
-      3'h0: done_u_v_q_c = done_u_v_q_b0;
-      3'h1: done_u_v_q_c = done_u_v_q_b1;
-      3'h2: done_u_v_q_c = done_u_v_q_b2;
-      3'h3: done_u_v_q_c = done_u_v_q_b3;
-      3'h4: done_u_v_q_c = done_u_v_q_b4;
-      3'h5: done_u_v_q_c = done_u_v_q_b5;
-      3'h6: done_u_v_q_c = done_u_v_q_b6;
-      3'h7: done_u_v_q_c = done_u_v_q_b7;
-      default: done_u_v_q_c = k_0_3;
-    endcase
-  end
-  assign bits_done_slot_16 = done_slot[3:0];
-  assign bits_done_slot_17 = done_slot[3:0];
-  assign bits_done_slot_18 = done_slot[3:0];
-  assign bits_done_slot_19 = done_slot[3:0];
-  assign bits_done_slot_20 = done_slot[3:0];
-  assign bits_done_slot_21 = done_slot[3:0];
-  assign bits_done_slot_22 = done_slot[3:0];
-  assign bits_done_slot_23 = done_slot[3:0];
-  assign bits_d0_slot_2 = d0_slot[6:4];
-  always @* begin
-    case (bits_d0_slot_2)
-      3'h0: done_id_q_c = done_id_q_b0;
-      3'h1: done_id_q_c = done_id_q_b1;
-      3'h2: done_id_q_c = done_id_q_b2;
-      3'h3: done_id_q_c = done_id_q_b3;
-      3'h4: done_id_q_c = done_id_q_b4;
-      3'h5: done_id_q_c = done_id_q_b5;
-      3'h6: done_id_q_c = done_id_q_b6;
-      3'h7: done_id_q_c = done_id_q_b7;
-      default: done_id_q_c = k_0_4;
-    endcase
-  end
   assign bits_best_valid_128 = best_valid[0];
   assign bits_best_valid_129 = best_valid[1];
   assign bits_best_valid_130 = best_valid[2];
@@ -1723,9 +1297,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_141 = best_valid[13];
   assign bits_best_valid_142 = best_valid[14];
   assign bits_best_valid_143 = best_valid[15];
-  assign bits_done_slot_24 = done_slot[3:0];
+  assign bits_done_slot = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_24)
+    case (bits_done_slot)
       4'h0: done_has_g0_c = bits_best_valid_128;
       4'h1: done_has_g0_c = bits_best_valid_129;
       4'h2: done_has_g0_c = bits_best_valid_130;
@@ -1761,9 +1335,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_157 = best_valid[29];
   assign bits_best_valid_158 = best_valid[30];
   assign bits_best_valid_159 = best_valid[31];
-  assign bits_done_slot_25 = done_slot[3:0];
+  assign bits_done_slot_1 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_25)
+    case (bits_done_slot_1)
       4'h0: done_has_g1_c = bits_best_valid_144;
       4'h1: done_has_g1_c = bits_best_valid_145;
       4'h2: done_has_g1_c = bits_best_valid_146;
@@ -1799,9 +1373,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_173 = best_valid[45];
   assign bits_best_valid_174 = best_valid[46];
   assign bits_best_valid_175 = best_valid[47];
-  assign bits_done_slot_26 = done_slot[3:0];
+  assign bits_done_slot_2 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_26)
+    case (bits_done_slot_2)
       4'h0: done_has_g2_c = bits_best_valid_160;
       4'h1: done_has_g2_c = bits_best_valid_161;
       4'h2: done_has_g2_c = bits_best_valid_162;
@@ -1837,9 +1411,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_189 = best_valid[61];
   assign bits_best_valid_190 = best_valid[62];
   assign bits_best_valid_191 = best_valid[63];
-  assign bits_done_slot_27 = done_slot[3:0];
+  assign bits_done_slot_3 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_27)
+    case (bits_done_slot_3)
       4'h0: done_has_g3_c = bits_best_valid_176;
       4'h1: done_has_g3_c = bits_best_valid_177;
       4'h2: done_has_g3_c = bits_best_valid_178;
@@ -1875,9 +1449,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_205 = best_valid[77];
   assign bits_best_valid_206 = best_valid[78];
   assign bits_best_valid_207 = best_valid[79];
-  assign bits_done_slot_28 = done_slot[3:0];
+  assign bits_done_slot_4 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_28)
+    case (bits_done_slot_4)
       4'h0: done_has_g4_c = bits_best_valid_192;
       4'h1: done_has_g4_c = bits_best_valid_193;
       4'h2: done_has_g4_c = bits_best_valid_194;
@@ -1913,9 +1487,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_221 = best_valid[93];
   assign bits_best_valid_222 = best_valid[94];
   assign bits_best_valid_223 = best_valid[95];
-  assign bits_done_slot_29 = done_slot[3:0];
+  assign bits_done_slot_5 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_29)
+    case (bits_done_slot_5)
       4'h0: done_has_g5_c = bits_best_valid_208;
       4'h1: done_has_g5_c = bits_best_valid_209;
       4'h2: done_has_g5_c = bits_best_valid_210;
@@ -1951,9 +1525,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_237 = best_valid[109];
   assign bits_best_valid_238 = best_valid[110];
   assign bits_best_valid_239 = best_valid[111];
-  assign bits_done_slot_30 = done_slot[3:0];
+  assign bits_done_slot_6 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_30)
+    case (bits_done_slot_6)
       4'h0: done_has_g6_c = bits_best_valid_224;
       4'h1: done_has_g6_c = bits_best_valid_225;
       4'h2: done_has_g6_c = bits_best_valid_226;
@@ -1989,9 +1563,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_253 = best_valid[125];
   assign bits_best_valid_254 = best_valid[126];
   assign bits_best_valid_255 = best_valid[127];
-  assign bits_done_slot_31 = done_slot[3:0];
+  assign bits_done_slot_7 = done_slot[3:0];
   always @* begin
-    case (bits_done_slot_31)
+    case (bits_done_slot_7)
       4'h0: done_has_g7_c = bits_best_valid_240;
       4'h1: done_has_g7_c = bits_best_valid_241;
       4'h2: done_has_g7_c = bits_best_valid_242;
@@ -2011,9 +1585,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
       default: done_has_g7_c = k_0;
     endcase
   end
-  assign bits_d0_slot_3 = d0_slot[6:4];
+  assign bits_d0_slot = d0_slot[6:4];
   always @* begin
-    case (bits_d0_slot_3)
+    case (bits_d0_slot)
       3'h0: done_has_c = done_has_g0;
       3'h1: done_has_c = done_has_g1;
       3'h2: done_has_c = done_has_g2;
@@ -2145,16 +1719,16 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign m2_slot_eq_k_10 = m2_slot == k_10;
   assign m2_slot_eq_k_9 = m2_slot == k_9;
   assign m2_slot_eq_k_8_1 = m2_slot == k_8_1;
-  assign m2_slot_eq_k_7_1 = m2_slot == k_7_1;
-  assign m2_slot_eq_k_6_1 = m2_slot == k_6_1;
-  assign m2_slot_eq_k_5_1 = m2_slot == k_5_1;
-  assign m2_slot_eq_k_4_1 = m2_slot == k_4_1;
-  assign m2_slot_eq_k_3_1 = m2_slot == k_3_1;
-  assign m2_slot_eq_k_2_1 = m2_slot == k_2_1;
-  assign m2_slot_eq_k_1_2 = m2_slot == k_1_2;
-  assign m2_slot_eq_k_0_6 = m2_slot == k_0_6;
-  assign cat_36 = {m2_slot_eq_k_127, m2_slot_eq_k_126, m2_slot_eq_k_125, m2_slot_eq_k_124, m2_slot_eq_k_123, m2_slot_eq_k_122, m2_slot_eq_k_121, m2_slot_eq_k_120, m2_slot_eq_k_119, m2_slot_eq_k_118, m2_slot_eq_k_117, m2_slot_eq_k_116, m2_slot_eq_k_115, m2_slot_eq_k_114, m2_slot_eq_k_113, m2_slot_eq_k_112, m2_slot_eq_k_111, m2_slot_eq_k_110, m2_slot_eq_k_109, m2_slot_eq_k_108, m2_slot_eq_k_107, m2_slot_eq_k_106, m2_slot_eq_k_105, m2_slot_eq_k_104, m2_slot_eq_k_103, m2_slot_eq_k_102, m2_slot_eq_k_101, m2_slot_eq_k_100, m2_slot_eq_k_99, m2_slot_eq_k_98, m2_slot_eq_k_97, m2_slot_eq_k_96, m2_slot_eq_k_95, m2_slot_eq_k_94, m2_slot_eq_k_93, m2_slot_eq_k_92, m2_slot_eq_k_91, m2_slot_eq_k_90, m2_slot_eq_k_89, m2_slot_eq_k_88, m2_slot_eq_k_87, m2_slot_eq_k_86, m2_slot_eq_k_85, m2_slot_eq_k_84, m2_slot_eq_k_83, m2_slot_eq_k_82, m2_slot_eq_k_81, m2_slot_eq_k_80, m2_slot_eq_k_79, m2_slot_eq_k_78, m2_slot_eq_k_77, m2_slot_eq_k_76, m2_slot_eq_k_75, m2_slot_eq_k_74, m2_slot_eq_k_73, m2_slot_eq_k_72, m2_slot_eq_k_71, m2_slot_eq_k_70, m2_slot_eq_k_69, m2_slot_eq_k_68, m2_slot_eq_k_67, m2_slot_eq_k_66, m2_slot_eq_k_65, m2_slot_eq_k_64, m2_slot_eq_k_63, m2_slot_eq_k_62, m2_slot_eq_k_61, m2_slot_eq_k_60, m2_slot_eq_k_59, m2_slot_eq_k_58, m2_slot_eq_k_57, m2_slot_eq_k_56, m2_slot_eq_k_55, m2_slot_eq_k_54, m2_slot_eq_k_53, m2_slot_eq_k_52, m2_slot_eq_k_51, m2_slot_eq_k_50, m2_slot_eq_k_49, m2_slot_eq_k_48, m2_slot_eq_k_47, m2_slot_eq_k_46, m2_slot_eq_k_45, m2_slot_eq_k_44, m2_slot_eq_k_43, m2_slot_eq_k_42, m2_slot_eq_k_41, m2_slot_eq_k_40, m2_slot_eq_k_39, m2_slot_eq_k_38, m2_slot_eq_k_37, m2_slot_eq_k_36, m2_slot_eq_k_35, m2_slot_eq_k_34, m2_slot_eq_k_33, m2_slot_eq_k_32, m2_slot_eq_k_31, m2_slot_eq_k_30, m2_slot_eq_k_29, m2_slot_eq_k_28, m2_slot_eq_k_27, m2_slot_eq_k_26, m2_slot_eq_k_25, m2_slot_eq_k_24, m2_slot_eq_k_23, m2_slot_eq_k_22, m2_slot_eq_k_21, m2_slot_eq_k_20, m2_slot_eq_k_19, m2_slot_eq_k_18, m2_slot_eq_k_17, m2_slot_eq_k_16, m2_slot_eq_k_15, m2_slot_eq_k_14, m2_slot_eq_k_13, m2_slot_eq_k_12, m2_slot_eq_k_11, m2_slot_eq_k_10, m2_slot_eq_k_9, m2_slot_eq_k_8_1, m2_slot_eq_k_7_1, m2_slot_eq_k_6_1, m2_slot_eq_k_5_1, m2_slot_eq_k_4_1, m2_slot_eq_k_3_1, m2_slot_eq_k_2_1, m2_slot_eq_k_1_2, m2_slot_eq_k_0_6};
-  assign best_set = best_we ? cat_36 : k_0_5;
+  assign m2_slot_eq_k_7 = m2_slot == k_7;
+  assign m2_slot_eq_k_6 = m2_slot == k_6;
+  assign m2_slot_eq_k_5 = m2_slot == k_5;
+  assign m2_slot_eq_k_4 = m2_slot == k_4;
+  assign m2_slot_eq_k_3 = m2_slot == k_3;
+  assign m2_slot_eq_k_2 = m2_slot == k_2;
+  assign m2_slot_eq_k_1_1 = m2_slot == k_1_1;
+  assign m2_slot_eq_k_0_2 = m2_slot == k_0_2;
+  assign cat_11 = {m2_slot_eq_k_127, m2_slot_eq_k_126, m2_slot_eq_k_125, m2_slot_eq_k_124, m2_slot_eq_k_123, m2_slot_eq_k_122, m2_slot_eq_k_121, m2_slot_eq_k_120, m2_slot_eq_k_119, m2_slot_eq_k_118, m2_slot_eq_k_117, m2_slot_eq_k_116, m2_slot_eq_k_115, m2_slot_eq_k_114, m2_slot_eq_k_113, m2_slot_eq_k_112, m2_slot_eq_k_111, m2_slot_eq_k_110, m2_slot_eq_k_109, m2_slot_eq_k_108, m2_slot_eq_k_107, m2_slot_eq_k_106, m2_slot_eq_k_105, m2_slot_eq_k_104, m2_slot_eq_k_103, m2_slot_eq_k_102, m2_slot_eq_k_101, m2_slot_eq_k_100, m2_slot_eq_k_99, m2_slot_eq_k_98, m2_slot_eq_k_97, m2_slot_eq_k_96, m2_slot_eq_k_95, m2_slot_eq_k_94, m2_slot_eq_k_93, m2_slot_eq_k_92, m2_slot_eq_k_91, m2_slot_eq_k_90, m2_slot_eq_k_89, m2_slot_eq_k_88, m2_slot_eq_k_87, m2_slot_eq_k_86, m2_slot_eq_k_85, m2_slot_eq_k_84, m2_slot_eq_k_83, m2_slot_eq_k_82, m2_slot_eq_k_81, m2_slot_eq_k_80, m2_slot_eq_k_79, m2_slot_eq_k_78, m2_slot_eq_k_77, m2_slot_eq_k_76, m2_slot_eq_k_75, m2_slot_eq_k_74, m2_slot_eq_k_73, m2_slot_eq_k_72, m2_slot_eq_k_71, m2_slot_eq_k_70, m2_slot_eq_k_69, m2_slot_eq_k_68, m2_slot_eq_k_67, m2_slot_eq_k_66, m2_slot_eq_k_65, m2_slot_eq_k_64, m2_slot_eq_k_63, m2_slot_eq_k_62, m2_slot_eq_k_61, m2_slot_eq_k_60, m2_slot_eq_k_59, m2_slot_eq_k_58, m2_slot_eq_k_57, m2_slot_eq_k_56, m2_slot_eq_k_55, m2_slot_eq_k_54, m2_slot_eq_k_53, m2_slot_eq_k_52, m2_slot_eq_k_51, m2_slot_eq_k_50, m2_slot_eq_k_49, m2_slot_eq_k_48, m2_slot_eq_k_47, m2_slot_eq_k_46, m2_slot_eq_k_45, m2_slot_eq_k_44, m2_slot_eq_k_43, m2_slot_eq_k_42, m2_slot_eq_k_41, m2_slot_eq_k_40, m2_slot_eq_k_39, m2_slot_eq_k_38, m2_slot_eq_k_37, m2_slot_eq_k_36, m2_slot_eq_k_35, m2_slot_eq_k_34, m2_slot_eq_k_33, m2_slot_eq_k_32, m2_slot_eq_k_31, m2_slot_eq_k_30, m2_slot_eq_k_29, m2_slot_eq_k_28, m2_slot_eq_k_27, m2_slot_eq_k_26, m2_slot_eq_k_25, m2_slot_eq_k_24, m2_slot_eq_k_23, m2_slot_eq_k_22, m2_slot_eq_k_21, m2_slot_eq_k_20, m2_slot_eq_k_19, m2_slot_eq_k_18, m2_slot_eq_k_17, m2_slot_eq_k_16, m2_slot_eq_k_15, m2_slot_eq_k_14, m2_slot_eq_k_13, m2_slot_eq_k_12, m2_slot_eq_k_11, m2_slot_eq_k_10, m2_slot_eq_k_9, m2_slot_eq_k_8_1, m2_slot_eq_k_7, m2_slot_eq_k_6, m2_slot_eq_k_5, m2_slot_eq_k_4, m2_slot_eq_k_3, m2_slot_eq_k_2, m2_slot_eq_k_1_1, m2_slot_eq_k_0_2};
+  assign best_set = best_we ? cat_11 : k_0_1;
   assign d1_slot_eq_k_127 = d1_slot == k_127;
   assign d1_slot_eq_k_126 = d1_slot == k_126;
   assign d1_slot_eq_k_125 = d1_slot == k_125;
@@ -2275,55 +1849,34 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign d1_slot_eq_k_10 = d1_slot == k_10;
   assign d1_slot_eq_k_9 = d1_slot == k_9;
   assign d1_slot_eq_k_8_1 = d1_slot == k_8_1;
-  assign d1_slot_eq_k_7_1 = d1_slot == k_7_1;
-  assign d1_slot_eq_k_6_1 = d1_slot == k_6_1;
-  assign d1_slot_eq_k_5_1 = d1_slot == k_5_1;
-  assign d1_slot_eq_k_4_1 = d1_slot == k_4_1;
-  assign d1_slot_eq_k_3_1 = d1_slot == k_3_1;
-  assign d1_slot_eq_k_2_1 = d1_slot == k_2_1;
-  assign d1_slot_eq_k_1_2 = d1_slot == k_1_2;
-  assign d1_slot_eq_k_0_6 = d1_slot == k_0_6;
-  assign cat_37 = {d1_slot_eq_k_127, d1_slot_eq_k_126, d1_slot_eq_k_125, d1_slot_eq_k_124, d1_slot_eq_k_123, d1_slot_eq_k_122, d1_slot_eq_k_121, d1_slot_eq_k_120, d1_slot_eq_k_119, d1_slot_eq_k_118, d1_slot_eq_k_117, d1_slot_eq_k_116, d1_slot_eq_k_115, d1_slot_eq_k_114, d1_slot_eq_k_113, d1_slot_eq_k_112, d1_slot_eq_k_111, d1_slot_eq_k_110, d1_slot_eq_k_109, d1_slot_eq_k_108, d1_slot_eq_k_107, d1_slot_eq_k_106, d1_slot_eq_k_105, d1_slot_eq_k_104, d1_slot_eq_k_103, d1_slot_eq_k_102, d1_slot_eq_k_101, d1_slot_eq_k_100, d1_slot_eq_k_99, d1_slot_eq_k_98, d1_slot_eq_k_97, d1_slot_eq_k_96, d1_slot_eq_k_95, d1_slot_eq_k_94, d1_slot_eq_k_93, d1_slot_eq_k_92, d1_slot_eq_k_91, d1_slot_eq_k_90, d1_slot_eq_k_89, d1_slot_eq_k_88, d1_slot_eq_k_87, d1_slot_eq_k_86, d1_slot_eq_k_85, d1_slot_eq_k_84, d1_slot_eq_k_83, d1_slot_eq_k_82, d1_slot_eq_k_81, d1_slot_eq_k_80, d1_slot_eq_k_79, d1_slot_eq_k_78, d1_slot_eq_k_77, d1_slot_eq_k_76, d1_slot_eq_k_75, d1_slot_eq_k_74, d1_slot_eq_k_73, d1_slot_eq_k_72, d1_slot_eq_k_71, d1_slot_eq_k_70, d1_slot_eq_k_69, d1_slot_eq_k_68, d1_slot_eq_k_67, d1_slot_eq_k_66, d1_slot_eq_k_65, d1_slot_eq_k_64, d1_slot_eq_k_63, d1_slot_eq_k_62, d1_slot_eq_k_61, d1_slot_eq_k_60, d1_slot_eq_k_59, d1_slot_eq_k_58, d1_slot_eq_k_57, d1_slot_eq_k_56, d1_slot_eq_k_55, d1_slot_eq_k_54, d1_slot_eq_k_53, d1_slot_eq_k_52, d1_slot_eq_k_51, d1_slot_eq_k_50, d1_slot_eq_k_49, d1_slot_eq_k_48, d1_slot_eq_k_47, d1_slot_eq_k_46, d1_slot_eq_k_45, d1_slot_eq_k_44, d1_slot_eq_k_43, d1_slot_eq_k_42, d1_slot_eq_k_41, d1_slot_eq_k_40, d1_slot_eq_k_39, d1_slot_eq_k_38, d1_slot_eq_k_37, d1_slot_eq_k_36, d1_slot_eq_k_35, d1_slot_eq_k_34, d1_slot_eq_k_33, d1_slot_eq_k_32, d1_slot_eq_k_31, d1_slot_eq_k_30, d1_slot_eq_k_29, d1_slot_eq_k_28, d1_slot_eq_k_27, d1_slot_eq_k_26, d1_slot_eq_k_25, d1_slot_eq_k_24, d1_slot_eq_k_23, d1_slot_eq_k_22, d1_slot_eq_k_21, d1_slot_eq_k_20, d1_slot_eq_k_19, d1_slot_eq_k_18, d1_slot_eq_k_17, d1_slot_eq_k_16, d1_slot_eq_k_15, d1_slot_eq_k_14, d1_slot_eq_k_13, d1_slot_eq_k_12, d1_slot_eq_k_11, d1_slot_eq_k_10, d1_slot_eq_k_9, d1_slot_eq_k_8_1, d1_slot_eq_k_7_1, d1_slot_eq_k_6_1, d1_slot_eq_k_5_1, d1_slot_eq_k_4_1, d1_slot_eq_k_3_1, d1_slot_eq_k_2_1, d1_slot_eq_k_1_2, d1_slot_eq_k_0_6};
-  assign best_clear = d1 ? cat_37 : k_0_5;
+  assign d1_slot_eq_k_7 = d1_slot == k_7;
+  assign d1_slot_eq_k_6 = d1_slot == k_6;
+  assign d1_slot_eq_k_5 = d1_slot == k_5;
+  assign d1_slot_eq_k_4 = d1_slot == k_4;
+  assign d1_slot_eq_k_3 = d1_slot == k_3;
+  assign d1_slot_eq_k_2 = d1_slot == k_2;
+  assign d1_slot_eq_k_1_1 = d1_slot == k_1_1;
+  assign d1_slot_eq_k_0_2 = d1_slot == k_0_2;
+  assign cat_12 = {d1_slot_eq_k_127, d1_slot_eq_k_126, d1_slot_eq_k_125, d1_slot_eq_k_124, d1_slot_eq_k_123, d1_slot_eq_k_122, d1_slot_eq_k_121, d1_slot_eq_k_120, d1_slot_eq_k_119, d1_slot_eq_k_118, d1_slot_eq_k_117, d1_slot_eq_k_116, d1_slot_eq_k_115, d1_slot_eq_k_114, d1_slot_eq_k_113, d1_slot_eq_k_112, d1_slot_eq_k_111, d1_slot_eq_k_110, d1_slot_eq_k_109, d1_slot_eq_k_108, d1_slot_eq_k_107, d1_slot_eq_k_106, d1_slot_eq_k_105, d1_slot_eq_k_104, d1_slot_eq_k_103, d1_slot_eq_k_102, d1_slot_eq_k_101, d1_slot_eq_k_100, d1_slot_eq_k_99, d1_slot_eq_k_98, d1_slot_eq_k_97, d1_slot_eq_k_96, d1_slot_eq_k_95, d1_slot_eq_k_94, d1_slot_eq_k_93, d1_slot_eq_k_92, d1_slot_eq_k_91, d1_slot_eq_k_90, d1_slot_eq_k_89, d1_slot_eq_k_88, d1_slot_eq_k_87, d1_slot_eq_k_86, d1_slot_eq_k_85, d1_slot_eq_k_84, d1_slot_eq_k_83, d1_slot_eq_k_82, d1_slot_eq_k_81, d1_slot_eq_k_80, d1_slot_eq_k_79, d1_slot_eq_k_78, d1_slot_eq_k_77, d1_slot_eq_k_76, d1_slot_eq_k_75, d1_slot_eq_k_74, d1_slot_eq_k_73, d1_slot_eq_k_72, d1_slot_eq_k_71, d1_slot_eq_k_70, d1_slot_eq_k_69, d1_slot_eq_k_68, d1_slot_eq_k_67, d1_slot_eq_k_66, d1_slot_eq_k_65, d1_slot_eq_k_64, d1_slot_eq_k_63, d1_slot_eq_k_62, d1_slot_eq_k_61, d1_slot_eq_k_60, d1_slot_eq_k_59, d1_slot_eq_k_58, d1_slot_eq_k_57, d1_slot_eq_k_56, d1_slot_eq_k_55, d1_slot_eq_k_54, d1_slot_eq_k_53, d1_slot_eq_k_52, d1_slot_eq_k_51, d1_slot_eq_k_50, d1_slot_eq_k_49, d1_slot_eq_k_48, d1_slot_eq_k_47, d1_slot_eq_k_46, d1_slot_eq_k_45, d1_slot_eq_k_44, d1_slot_eq_k_43, d1_slot_eq_k_42, d1_slot_eq_k_41, d1_slot_eq_k_40, d1_slot_eq_k_39, d1_slot_eq_k_38, d1_slot_eq_k_37, d1_slot_eq_k_36, d1_slot_eq_k_35, d1_slot_eq_k_34, d1_slot_eq_k_33, d1_slot_eq_k_32, d1_slot_eq_k_31, d1_slot_eq_k_30, d1_slot_eq_k_29, d1_slot_eq_k_28, d1_slot_eq_k_27, d1_slot_eq_k_26, d1_slot_eq_k_25, d1_slot_eq_k_24, d1_slot_eq_k_23, d1_slot_eq_k_22, d1_slot_eq_k_21, d1_slot_eq_k_20, d1_slot_eq_k_19, d1_slot_eq_k_18, d1_slot_eq_k_17, d1_slot_eq_k_16, d1_slot_eq_k_15, d1_slot_eq_k_14, d1_slot_eq_k_13, d1_slot_eq_k_12, d1_slot_eq_k_11, d1_slot_eq_k_10, d1_slot_eq_k_9, d1_slot_eq_k_8_1, d1_slot_eq_k_7, d1_slot_eq_k_6, d1_slot_eq_k_5, d1_slot_eq_k_4, d1_slot_eq_k_3, d1_slot_eq_k_2, d1_slot_eq_k_1_1, d1_slot_eq_k_0_2};
+  assign best_clear = d1 ? cat_12 : k_0_1;
   assign not_best_clear = ~best_clear;
-  assign and_38 = best_valid & not_best_clear;
-  assign and_38_or_best_set = and_38 | best_set;
+  assign and_13 = best_valid & not_best_clear;
+  assign and_13_or_best_set = and_13 | best_set;
   assign res_id_c = done_id;
   assign res_hit_c = d1_has;
   assign bits_done_t_tri = done_t_tri[12:0];
-  assign res_tri_c = d1_has ? bits_done_t_tri : k_0_7;
+  assign res_tri_c = d1_has ? bits_done_t_tri : k_0_3;
   assign bits_done_t_tri_1 = done_t_tri[42:13];
-  assign res_t_c = d1_has ? bits_done_t_tri_1 : k_0_8;
+  assign res_t_c = d1_has ? bits_done_t_tri_1 : k_0_4;
   assign bits_done_u_v = done_u_v[63:32];
-  assign res_u_c = d1_has ? bits_done_u_v : k_0_9;
+  assign res_u_c = d1_has ? bits_done_u_v : k_0_5;
   assign bits_done_u_v_1 = done_u_v[31:0];
-  assign res_v_c = d1_has ? bits_done_u_v_1 : k_0_9;
+  assign res_v_c = d1_has ? bits_done_u_v_1 : k_0_5;
 
   always @(posedge clk) begin : regs
-    if (and_19) best_t_tri_b0[bits_m2_slot_1] <= m2_t_tri;
-    if (and_20) best_t_tri_b1[bits_m2_slot_3] <= m2_t_tri;
-    if (and_21) best_t_tri_b2[bits_m2_slot_5] <= m2_t_tri;
-    if (and_22) best_t_tri_b3[bits_m2_slot_7] <= m2_t_tri;
-    if (and_23) best_t_tri_b4[bits_m2_slot_9] <= m2_t_tri;
-    if (and_24) best_t_tri_b5[bits_m2_slot_11] <= m2_t_tri;
-    if (and_25) best_t_tri_b6[bits_m2_slot_13] <= m2_t_tri;
-    if (and_26) best_t_tri_b7[bits_m2_slot_15] <= m2_t_tri;
-    if (and_27) best_u_v_b0[bits_m2_slot_17] <= m2_u_v;
-    if (and_28) best_u_v_b1[bits_m2_slot_19] <= m2_u_v;
-    if (and_29) best_u_v_b2[bits_m2_slot_21] <= m2_u_v;
-    if (and_30) best_u_v_b3[bits_m2_slot_23] <= m2_u_v;
-    if (and_31) best_u_v_b4[bits_m2_slot_25] <= m2_u_v;
-    if (and_32) best_u_v_b5[bits_m2_slot_27] <= m2_u_v;
-    if (and_33) best_u_v_b6[bits_m2_slot_29] <= m2_u_v;
-    if (and_34) best_u_v_b7[bits_m2_slot_31] <= m2_u_v;
-    if (and_5) ray_ids_b0[bits_id_slot_1] <= id;
-    if (and_6) ray_ids_b1[bits_id_slot_3] <= id;
-    if (and_7) ray_ids_b2[bits_id_slot_5] <= id;
-    if (and_8) ray_ids_b3[bits_id_slot_7] <= id;
-    if (and_9) ray_ids_b4[bits_id_slot_9] <= id;
-    if (and_10) ray_ids_b5[bits_id_slot_11] <= id;
-    if (and_11) ray_ids_b6[bits_id_slot_13] <= id;
-    if (and_12) ray_ids_b7[bits_id_slot_15] <= id;
+    if (best_we) best_t_tri[m2_slot] <= m2_t_tri;
+    if (best_we) best_u_v[m2_slot] <= m2_u_v;
+    if (id_we) ray_ids[id_slot] <= id;
     in_tmin_less <= tmin_less;
     in_t_plus_8 <= t_plus_8;
     in_valid <= valid;
@@ -2364,19 +1917,11 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     if (take) acc_u <= in_u;
     if (take) acc_v <= in_v;
     if (rst) best_valid <= 128'h00000000000000000000000000000000;
-    else best_valid <= and_38_or_best_set;
+    else best_valid <= and_13_or_best_set;
     fin <= leaf_last;
     fin_slot <= in_slot;
     fin_sp <= in_sp;
-    slot_t_tri_q_b0 <= best_t_tri_b0[bits_in_slot];
-    slot_t_tri_q_b1 <= best_t_tri_b1[bits_in_slot_1];
-    slot_t_tri_q_b2 <= best_t_tri_b2[bits_in_slot_2];
-    slot_t_tri_q_b3 <= best_t_tri_b3[bits_in_slot_3];
-    slot_t_tri_q_b4 <= best_t_tri_b4[bits_in_slot_4];
-    slot_t_tri_q_b5 <= best_t_tri_b5[bits_in_slot_5];
-    slot_t_tri_q_b6 <= best_t_tri_b6[bits_in_slot_6];
-    slot_t_tri_q_b7 <= best_t_tri_b7[bits_in_slot_7];
-    slot_t_tri <= slot_t_tri_q_c;
+    slot_t_tri <= best_t_tri[fin_slot];
     m1 <= fin;
     m1_slot <= fin_slot;
     m1_sp <= fin_sp;
@@ -2390,8 +1935,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     fin_has_g7 <= fin_has_g7_c;
     m1_slot_has <= fin_has_c;
     m1_leaf_empty <= acc_empty;
-    m1_t_tri <= cat_13;
-    m1_u_v <= cat_14;
+    m1_t_tri <= cat_5;
+    m1_u_v <= cat_6;
     m2 <= m1;
     m2_better <= leaf_better;
     m2_hit <= m1_hit;
@@ -2407,33 +1952,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     merge_sp_r <= m2_sp;
     d0 <= done_valid;
     d0_slot <= done_slot;
-    done_t_tri_q_b0 <= best_t_tri_b0[bits_done_slot];
-    done_t_tri_q_b1 <= best_t_tri_b1[bits_done_slot_1];
-    done_t_tri_q_b2 <= best_t_tri_b2[bits_done_slot_2];
-    done_t_tri_q_b3 <= best_t_tri_b3[bits_done_slot_3];
-    done_t_tri_q_b4 <= best_t_tri_b4[bits_done_slot_4];
-    done_t_tri_q_b5 <= best_t_tri_b5[bits_done_slot_5];
-    done_t_tri_q_b6 <= best_t_tri_b6[bits_done_slot_6];
-    done_t_tri_q_b7 <= best_t_tri_b7[bits_done_slot_7];
-    done_t_tri <= done_t_tri_q_c;
-    done_u_v_q_b0 <= best_u_v_b0[bits_done_slot_8];
-    done_u_v_q_b1 <= best_u_v_b1[bits_done_slot_9];
-    done_u_v_q_b2 <= best_u_v_b2[bits_done_slot_10];
-    done_u_v_q_b3 <= best_u_v_b3[bits_done_slot_11];
-    done_u_v_q_b4 <= best_u_v_b4[bits_done_slot_12];
-    done_u_v_q_b5 <= best_u_v_b5[bits_done_slot_13];
-    done_u_v_q_b6 <= best_u_v_b6[bits_done_slot_14];
-    done_u_v_q_b7 <= best_u_v_b7[bits_done_slot_15];
-    done_u_v <= done_u_v_q_c;
-    done_id_q_b0 <= ray_ids_b0[bits_done_slot_16];
-    done_id_q_b1 <= ray_ids_b1[bits_done_slot_17];
-    done_id_q_b2 <= ray_ids_b2[bits_done_slot_18];
-    done_id_q_b3 <= ray_ids_b3[bits_done_slot_19];
-    done_id_q_b4 <= ray_ids_b4[bits_done_slot_20];
-    done_id_q_b5 <= ray_ids_b5[bits_done_slot_21];
-    done_id_q_b6 <= ray_ids_b6[bits_done_slot_22];
-    done_id_q_b7 <= ray_ids_b7[bits_done_slot_23];
-    done_id <= done_id_q_c;
+    done_t_tri <= best_t_tri[d0_slot];
+    done_u_v <= best_u_v[d0_slot];
+    done_id <= ray_ids[d0_slot];
     d1 <= d0;
     d1_slot <= d0_slot;
     done_has_g0 <= done_has_g0_c;

@@ -38,53 +38,11 @@ module fxrt_core (
   output wire [12:0] visit1_node
 );
 
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b0 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b0.hex", ray_o_b0);
+  (* ram_style = "distributed" *) reg [86:0] ray_o [0:127];
+  initial $readmemh("fxrt_core_ray_o.hex", ray_o);
 
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b1 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b1.hex", ray_o_b1);
-
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b2 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b2.hex", ray_o_b2);
-
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b3 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b3.hex", ray_o_b3);
-
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b4 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b4.hex", ray_o_b4);
-
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b5 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b5.hex", ray_o_b5);
-
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b6 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b6.hex", ray_o_b6);
-
-  (* ram_style = "distributed" *) reg [86:0] ray_o_b7 [0:15];
-  initial $readmemh("fxrt_core_ray_o_b7.hex", ray_o_b7);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b0 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b0.hex", ray_w_b0);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b1 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b1.hex", ray_w_b1);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b2 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b2.hex", ray_w_b2);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b3 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b3.hex", ray_w_b3);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b4 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b4.hex", ray_w_b4);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b5 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b5.hex", ray_w_b5);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b6 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b6.hex", ray_w_b6);
-
-  (* ram_style = "distributed" *) reg [95:0] ray_w_b7 [0:15];
-  initial $readmemh("fxrt_core_ray_w_b7.hex", ray_w_b7);
+  (* ram_style = "distributed" *) reg [95:0] ray_w [0:127];
+  initial $readmemh("fxrt_core_ray_w.hex", ray_w);
 
   wire [0:0] u0_has_free;
   wire [0:0] u1_has_free;
@@ -333,82 +291,10 @@ module fxrt_core (
   wire [72:0] u_node_rom_0_data;
   wire [72:0] u_node_rom_0_data_b;
   wire [86:0] cat_19;
-  wire [2:0] bits_accept_slot_3;
-  wire [2:0] k_0_4 = 3'h0;
-  wire [0:0] eq_20;
-  wire [0:0] accept_and_eq_20;
-  wire [3:0] bits_accept_slot_4;
-  wire [2:0] bits_accept_slot_5;
-  wire [2:0] k_1_2 = 3'h1;
-  wire [0:0] eq_21;
-  wire [0:0] accept_and_eq_21;
-  wire [3:0] bits_accept_slot_6;
-  wire [2:0] bits_accept_slot_7;
-  wire [2:0] k_2 = 3'h2;
-  wire [0:0] eq_22;
-  wire [0:0] accept_and_eq_22;
-  wire [3:0] bits_accept_slot_8;
-  wire [2:0] bits_accept_slot_9;
-  wire [2:0] k_3_1 = 3'h3;
-  wire [0:0] eq_23;
-  wire [0:0] accept_and_eq_23;
-  wire [3:0] bits_accept_slot_10;
-  wire [2:0] bits_accept_slot_11;
-  wire [2:0] k_4 = 3'h4;
-  wire [0:0] eq_24;
-  wire [0:0] accept_and_eq_24;
-  wire [3:0] bits_accept_slot_12;
-  wire [2:0] bits_accept_slot_13;
-  wire [2:0] k_5 = 3'h5;
-  wire [0:0] eq_25;
-  wire [0:0] accept_and_eq_25;
-  wire [3:0] bits_accept_slot_14;
-  wire [2:0] bits_accept_slot_15;
-  wire [2:0] k_6 = 3'h6;
-  wire [0:0] eq_26;
-  wire [0:0] accept_and_eq_26;
-  wire [3:0] bits_accept_slot_16;
-  wire [2:0] bits_accept_slot_17;
-  wire [2:0] k_7 = 3'h7;
-  wire [0:0] eq_27;
-  wire [0:0] accept_and_eq_27;
-  wire [3:0] bits_accept_slot_18;
   wire [31:0] u_acc_in_wz;
   wire [31:0] u_acc_in_wy;
   wire [31:0] u_acc_in_wx;
-  wire [95:0] cat_28;
-  wire [2:0] bits_accept_slot_19;
-  wire [0:0] eq_29;
-  wire [0:0] accept_and_eq_29;
-  wire [3:0] bits_accept_slot_20;
-  wire [2:0] bits_accept_slot_21;
-  wire [0:0] eq_30;
-  wire [0:0] accept_and_eq_30;
-  wire [3:0] bits_accept_slot_22;
-  wire [2:0] bits_accept_slot_23;
-  wire [0:0] eq_31;
-  wire [0:0] accept_and_eq_31;
-  wire [3:0] bits_accept_slot_24;
-  wire [2:0] bits_accept_slot_25;
-  wire [0:0] eq_32;
-  wire [0:0] accept_and_eq_32;
-  wire [3:0] bits_accept_slot_26;
-  wire [2:0] bits_accept_slot_27;
-  wire [0:0] eq_33;
-  wire [0:0] accept_and_eq_33;
-  wire [3:0] bits_accept_slot_28;
-  wire [2:0] bits_accept_slot_29;
-  wire [0:0] eq_34;
-  wire [0:0] accept_and_eq_34;
-  wire [3:0] bits_accept_slot_30;
-  wire [2:0] bits_accept_slot_31;
-  wire [0:0] eq_35;
-  wire [0:0] accept_and_eq_35;
-  wire [3:0] bits_accept_slot_32;
-  wire [2:0] bits_accept_slot_33;
-  wire [0:0] eq_36;
-  wire [0:0] accept_and_eq_36;
-  wire [3:0] bits_accept_slot_34;
+  wire [95:0] cat_20;
   reg [0:0] leaf_active = 1'h0;
   reg [6:0] leaf_slot = 7'h00;
   reg [12:0] leaf_ptr = 13'h0000;
@@ -441,43 +327,45 @@ module fxrt_core (
   reg [0:0] case_leaf_turn_1;
   reg [0:0] case_leaf_turn_2;
   reg [0:0] case_leaf_turn_3;
-  wire [0:0] or_41;
+  wire [0:0] or_25;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_42;
+  wire [0:0] eq_26;
   wire [0:0] u0_leaf_take;
   wire [0:0] not_u0_leaf_take;
-  wire [0:0] and_43;
-  wire [0:0] u0_leaf_fill_or_and_43;
-  wire [0:0] eq_44;
+  wire [0:0] and_27;
+  wire [0:0] u0_leaf_fill_or_and_27;
+  wire [0:0] eq_28;
   wire [0:0] u1_leaf_take;
   wire [0:0] not_u1_leaf_take;
-  wire [0:0] and_45;
-  wire [0:0] u1_leaf_fill_or_and_45;
+  wire [0:0] and_29;
+  wire [0:0] u1_leaf_fill_or_and_29;
   reg [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_46;
+  wire [6:0] cat_30;
   wire [0:0] not_leaf_last_entry;
-  wire [0:0] and_47;
-  wire [0:0] leaf_take_or_and_47;
+  wire [0:0] and_31;
+  wire [0:0] leaf_take_or_and_31;
   wire [6:0] mux_leaf_take;
   reg [12:0] case_mux_case_leaf_turn_2_1;
-  wire [12:0] k_1_3 = 13'h0001;
-  wire [12:0] leaf_ptr_plus_k_1_3;
+  wire [12:0] k_1_2 = 13'h0001;
+  wire [12:0] leaf_ptr_plus_k_1_2;
   wire [12:0] mux_leaf_take_1;
   reg [2:0] case_mux_case_leaf_turn_2_2;
-  wire [2:0] leaf_left_minus_k_1_2;
+  wire [2:0] k_1_3 = 3'h1;
+  wire [2:0] leaf_left_minus_k_1_3;
   wire [2:0] mux_leaf_take_2;
   reg [30:0] case_mux_case_leaf_turn_2_3;
   wire [30:0] mux_leaf_take_3;
   reg [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   reg [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_48;
+  wire [0:0] eq_32;
+  wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
   wire [12:0] u_leaf_rom_data;
-  wire [12:0] k_0_5 = 13'h0000;
-  wire [58:0] cat_49;
+  wire [12:0] k_0_4 = 13'h0000;
+  wire [58:0] cat_33;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -519,51 +407,12 @@ module fxrt_core (
   initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 59'h000000000000000;
   wire [58:0] pipe_tag;
   wire [6:0] bits_emit_tag_tri;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 6:4 are read
-  reg [6:0] emit_slot_d = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [3:0] bits_bits_emit_tag_tri;
-  reg [86:0] ray_o_q_b0 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_1;
-  reg [86:0] ray_o_q_b1 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_2;
-  reg [86:0] ray_o_q_b2 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_3;
-  reg [86:0] ray_o_q_b3 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_4;
-  reg [86:0] ray_o_q_b4 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_5;
-  reg [86:0] ray_o_q_b5 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_6;
-  reg [86:0] ray_o_q_b6 = 87'h0000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_7;
-  reg [86:0] ray_o_q_b7 = 87'h0000000000000000000000;
-  wire [2:0] bits_emit_slot_d;
-  wire [86:0] k_0_6 = 87'h0000000000000000000000;
-  reg [86:0] ray_o_q_c;
+  reg [86:0] ray_o_q = 87'h0000000000000000000000;
   (* mem2reg *) reg [86:0] pipe_o_sr [1:2];
   integer pipe_o_i;
   initial for (pipe_o_i = 1; pipe_o_i <= 2; pipe_o_i = pipe_o_i + 1) pipe_o_sr[pipe_o_i] = 87'h0000000000000000000000;
   wire [86:0] pipe_o;
-  wire [3:0] bits_bits_emit_tag_tri_8;
-  reg [95:0] ray_w_q_b0 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_9;
-  reg [95:0] ray_w_q_b1 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_10;
-  reg [95:0] ray_w_q_b2 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_11;
-  reg [95:0] ray_w_q_b3 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_12;
-  reg [95:0] ray_w_q_b4 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_13;
-  reg [95:0] ray_w_q_b5 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_14;
-  reg [95:0] ray_w_q_b6 = 96'h000000000000000000000000;
-  wire [3:0] bits_bits_emit_tag_tri_15;
-  reg [95:0] ray_w_q_b7 = 96'h000000000000000000000000;
-  wire [2:0] bits_emit_slot_d_1;
-  wire [95:0] k_0_7 = 96'h000000000000000000000000;
-  reg [95:0] ray_w_q_c;
+  reg [95:0] ray_w_q = 96'h000000000000000000000000;
   (* mem2reg *) reg [95:0] pipe_w_sr [1:2];
   integer pipe_w_i;
   initial for (pipe_w_i = 1; pipe_w_i <= 2; pipe_w_i = pipe_w_i + 1) pipe_w_sr[pipe_w_i] = 96'h000000000000000000000000;
@@ -589,12 +438,12 @@ module fxrt_core (
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_53;
+  wire [6:0] cat_37;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_55;
+  wire [6:0] cat_39;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_56;
+  wire [0:0] or_40;
   reg [0:0] done_valid_r = 1'h0;
   reg [6:0] done_slot_r = 7'h00;
   wire [0:0] u_closest_merge_valid;
@@ -611,8 +460,8 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_57;
-  wire [5:0] mux_lt_57;
+  wire [0:0] lt_41;
+  wire [5:0] mux_lt_41;
   wire [2:0] rs_u_traverse_0_visit;
   wire [2:0] rs_u_traverse_1_visit;
   wire [2:0] visits_c;
@@ -775,74 +624,10 @@ module fxrt_core (
   assign bits_merge_slot_3 = merge_slot[5:0];
   assign bits_free_slot_3 = free_slot[5:0];
   assign cat_19 = {acc_in_oz, acc_in_oy, acc_in_ox};
-  assign bits_accept_slot_3 = accept_slot_int[6:4];
-  assign eq_20 = bits_accept_slot_3 == k_0_4;
-  assign accept_and_eq_20 = accept_int & eq_20;
-  assign bits_accept_slot_4 = accept_slot_int[3:0];
-  assign bits_accept_slot_5 = accept_slot_int[6:4];
-  assign eq_21 = bits_accept_slot_5 == k_1_2;
-  assign accept_and_eq_21 = accept_int & eq_21;
-  assign bits_accept_slot_6 = accept_slot_int[3:0];
-  assign bits_accept_slot_7 = accept_slot_int[6:4];
-  assign eq_22 = bits_accept_slot_7 == k_2;
-  assign accept_and_eq_22 = accept_int & eq_22;
-  assign bits_accept_slot_8 = accept_slot_int[3:0];
-  assign bits_accept_slot_9 = accept_slot_int[6:4];
-  assign eq_23 = bits_accept_slot_9 == k_3_1;
-  assign accept_and_eq_23 = accept_int & eq_23;
-  assign bits_accept_slot_10 = accept_slot_int[3:0];
-  assign bits_accept_slot_11 = accept_slot_int[6:4];
-  assign eq_24 = bits_accept_slot_11 == k_4;
-  assign accept_and_eq_24 = accept_int & eq_24;
-  assign bits_accept_slot_12 = accept_slot_int[3:0];
-  assign bits_accept_slot_13 = accept_slot_int[6:4];
-  assign eq_25 = bits_accept_slot_13 == k_5;
-  assign accept_and_eq_25 = accept_int & eq_25;
-  assign bits_accept_slot_14 = accept_slot_int[3:0];
-  assign bits_accept_slot_15 = accept_slot_int[6:4];
-  assign eq_26 = bits_accept_slot_15 == k_6;
-  assign accept_and_eq_26 = accept_int & eq_26;
-  assign bits_accept_slot_16 = accept_slot_int[3:0];
-  assign bits_accept_slot_17 = accept_slot_int[6:4];
-  assign eq_27 = bits_accept_slot_17 == k_7;
-  assign accept_and_eq_27 = accept_int & eq_27;
-  assign bits_accept_slot_18 = accept_slot_int[3:0];
   assign u_acc_in_wz = $unsigned(acc_in_wz);
   assign u_acc_in_wy = $unsigned(acc_in_wy);
   assign u_acc_in_wx = $unsigned(acc_in_wx);
-  assign cat_28 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
-  assign bits_accept_slot_19 = accept_slot_int[6:4];
-  assign eq_29 = bits_accept_slot_19 == k_0_4;
-  assign accept_and_eq_29 = accept_int & eq_29;
-  assign bits_accept_slot_20 = accept_slot_int[3:0];
-  assign bits_accept_slot_21 = accept_slot_int[6:4];
-  assign eq_30 = bits_accept_slot_21 == k_1_2;
-  assign accept_and_eq_30 = accept_int & eq_30;
-  assign bits_accept_slot_22 = accept_slot_int[3:0];
-  assign bits_accept_slot_23 = accept_slot_int[6:4];
-  assign eq_31 = bits_accept_slot_23 == k_2;
-  assign accept_and_eq_31 = accept_int & eq_31;
-  assign bits_accept_slot_24 = accept_slot_int[3:0];
-  assign bits_accept_slot_25 = accept_slot_int[6:4];
-  assign eq_32 = bits_accept_slot_25 == k_3_1;
-  assign accept_and_eq_32 = accept_int & eq_32;
-  assign bits_accept_slot_26 = accept_slot_int[3:0];
-  assign bits_accept_slot_27 = accept_slot_int[6:4];
-  assign eq_33 = bits_accept_slot_27 == k_4;
-  assign accept_and_eq_33 = accept_int & eq_33;
-  assign bits_accept_slot_28 = accept_slot_int[3:0];
-  assign bits_accept_slot_29 = accept_slot_int[6:4];
-  assign eq_34 = bits_accept_slot_29 == k_5;
-  assign accept_and_eq_34 = accept_int & eq_34;
-  assign bits_accept_slot_30 = accept_slot_int[3:0];
-  assign bits_accept_slot_31 = accept_slot_int[6:4];
-  assign eq_35 = bits_accept_slot_31 == k_6;
-  assign accept_and_eq_35 = accept_int & eq_35;
-  assign bits_accept_slot_32 = accept_slot_int[3:0];
-  assign bits_accept_slot_33 = accept_slot_int[6:4];
-  assign eq_36 = bits_accept_slot_33 == k_7;
-  assign accept_and_eq_36 = accept_int & eq_36;
-  assign bits_accept_slot_34 = accept_slot_int[3:0];
+  assign cat_20 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
   assign leaf_last_entry = leaf_active & leaf_last;
   assign not_leaf_active = ~leaf_active;
   assign leaf_can_take = not_leaf_active | leaf_last_entry;
@@ -878,19 +663,19 @@ module fxrt_core (
       default: case_leaf_turn_3 = k_0;
     endcase
   end
-  assign or_41 = case_leaf_turn_2 | case_leaf_turn;
+  assign or_25 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_41;
-  assign eq_42 = mux_case_leaf_turn_2 == k_0;
-  assign u0_leaf_take = leaf_take & eq_42;
+  assign leaf_take = leaf_can_take & or_25;
+  assign eq_26 = mux_case_leaf_turn_2 == k_0;
+  assign u0_leaf_take = leaf_take & eq_26;
   assign not_u0_leaf_take = ~u0_leaf_take;
-  assign and_43 = u0_leaf_buf_valid & not_u0_leaf_take;
-  assign u0_leaf_fill_or_and_43 = u0_leaf_fill | and_43;
-  assign eq_44 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_44;
+  assign and_27 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_27 = u0_leaf_fill | and_27;
+  assign eq_28 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_28;
   assign not_u1_leaf_take = ~u1_leaf_take;
-  assign and_45 = u1_leaf_buf_valid & not_u1_leaf_take;
-  assign u1_leaf_fill_or_and_45 = u1_leaf_fill | and_45;
+  assign and_29 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_29 = u1_leaf_fill | and_29;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
@@ -898,11 +683,11 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
     endcase
   end
-  assign cat_46 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_30 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_47 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_47 = leaf_take | and_47;
-  assign mux_leaf_take = leaf_take ? cat_46 : leaf_slot;
+  assign and_31 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_31 = leaf_take | and_31;
+  assign mux_leaf_take = leaf_take ? cat_30 : leaf_slot;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
@@ -910,8 +695,8 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
     endcase
   end
-  assign leaf_ptr_plus_k_1_3 = leaf_ptr + k_1_3;
-  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_3;
+  assign leaf_ptr_plus_k_1_2 = leaf_ptr + k_1_2;
+  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_2;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_2 = u0_buf_leaf_count;
@@ -919,8 +704,8 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_2 = u0_buf_leaf_count;
     endcase
   end
-  assign leaf_left_minus_k_1_2 = leaf_left - k_1_2;
-  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_2;
+  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
+  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_3;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_3 = u0_buf_leaf_tmin;
@@ -944,10 +729,10 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_5 = u0_buf_leaf_count;
     endcase
   end
-  assign eq_48 = case_mux_case_leaf_turn_2_5 == k_1_2;
+  assign eq_32 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_48 : leaf_left_eq_k_2;
-  assign cat_49 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_5};
+  assign mux_leaf_take_5 = leaf_take ? eq_32 : leaf_left_eq_k_2;
+  assign cat_33 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -972,51 +757,7 @@ module fxrt_core (
   assign pipe_valid = pipe_valid_sr[3];
   assign pipe_tag = pipe_tag_sr[3];
   assign bits_emit_tag_tri = emit_tag_tri[56:50];
-  assign bits_bits_emit_tag_tri = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_1 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_2 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_3 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_4 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_5 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_6 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_7 = bits_emit_tag_tri[3:0];
-  assign bits_emit_slot_d = emit_slot_d[6:4];
-  always @* begin
-    case (bits_emit_slot_d)
-      3'h0: ray_o_q_c = ray_o_q_b0;
-      3'h1: ray_o_q_c = ray_o_q_b1;
-      3'h2: ray_o_q_c = ray_o_q_b2;
-      3'h3: ray_o_q_c = ray_o_q_b3;
-      3'h4: ray_o_q_c = ray_o_q_b4;
-      3'h5: ray_o_q_c = ray_o_q_b5;
-      3'h6: ray_o_q_c = ray_o_q_b6;
-      3'h7: ray_o_q_c = ray_o_q_b7;
-      default: ray_o_q_c = k_0_6;
-    endcase
-  end
   assign pipe_o = pipe_o_sr[2];
-  assign bits_bits_emit_tag_tri_8 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_9 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_10 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_11 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_12 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_13 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_14 = bits_emit_tag_tri[3:0];
-  assign bits_bits_emit_tag_tri_15 = bits_emit_tag_tri[3:0];
-  assign bits_emit_slot_d_1 = emit_slot_d[6:4];
-  always @* begin
-    case (bits_emit_slot_d_1)
-      3'h0: ray_w_q_c = ray_w_q_b0;
-      3'h1: ray_w_q_c = ray_w_q_b1;
-      3'h2: ray_w_q_c = ray_w_q_b2;
-      3'h3: ray_w_q_c = ray_w_q_b3;
-      3'h4: ray_w_q_c = ray_w_q_b4;
-      3'h5: ray_w_q_c = ray_w_q_b5;
-      3'h6: ray_w_q_c = ray_w_q_b6;
-      3'h7: ray_w_q_c = ray_w_q_b7;
-      default: ray_w_q_c = k_0_7;
-    endcase
-  end
   assign pipe_w = pipe_w_sr[2];
   assign bits_pipe_o = pipe_o[28:0];
   assign bits_pipe_o_1 = pipe_o[57:29];
@@ -1031,14 +772,14 @@ module fxrt_core (
   assign u0_done_avail = u_traverse_0_done_valid & not_u0_done_took;
   assign not_u1_done_took = ~u1_done_took;
   assign u1_done_avail = u_traverse_1_done_valid & not_u1_done_took;
-  assign cat_53 = {k_0, u_traverse_0_done_slot};
+  assign cat_37 = {k_0, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_55 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_53 : cat_55;
-  assign or_56 = u0_done_avail | u1_done_avail;
-  assign lt_57 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_57 = lt_57 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign cat_39 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_37 : cat_39;
+  assign or_40 = u0_done_avail | u1_done_avail;
+  assign lt_41 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_41 = lt_41 ? u_traverse_1_depth : u_traverse_0_depth;
   assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
   assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
   assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -1050,22 +791,8 @@ module fxrt_core (
   assign occupied_c = rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   always @(posedge clk) begin : regs
-    if (accept_and_eq_20) ray_o_b0[bits_accept_slot_4] <= cat_19;
-    if (accept_and_eq_21) ray_o_b1[bits_accept_slot_6] <= cat_19;
-    if (accept_and_eq_22) ray_o_b2[bits_accept_slot_8] <= cat_19;
-    if (accept_and_eq_23) ray_o_b3[bits_accept_slot_10] <= cat_19;
-    if (accept_and_eq_24) ray_o_b4[bits_accept_slot_12] <= cat_19;
-    if (accept_and_eq_25) ray_o_b5[bits_accept_slot_14] <= cat_19;
-    if (accept_and_eq_26) ray_o_b6[bits_accept_slot_16] <= cat_19;
-    if (accept_and_eq_27) ray_o_b7[bits_accept_slot_18] <= cat_19;
-    if (accept_and_eq_29) ray_w_b0[bits_accept_slot_20] <= cat_28;
-    if (accept_and_eq_30) ray_w_b1[bits_accept_slot_22] <= cat_28;
-    if (accept_and_eq_31) ray_w_b2[bits_accept_slot_24] <= cat_28;
-    if (accept_and_eq_32) ray_w_b3[bits_accept_slot_26] <= cat_28;
-    if (accept_and_eq_33) ray_w_b4[bits_accept_slot_28] <= cat_28;
-    if (accept_and_eq_34) ray_w_b5[bits_accept_slot_30] <= cat_28;
-    if (accept_and_eq_35) ray_w_b6[bits_accept_slot_32] <= cat_28;
-    if (accept_and_eq_36) ray_w_b7[bits_accept_slot_34] <= cat_28;
+    if (accept_int) ray_o[accept_slot_int] <= cat_19;
+    if (accept_int) ray_w[accept_slot_int] <= cat_20;
     if (rst) turn <= 1'h0;
     else turn <= mux_take_or_not_case_turn;
     if (rst) box_phase <= 2'h0;
@@ -1144,7 +871,7 @@ module fxrt_core (
       box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
     box_done_slot_sr[1] <= box_slot;
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_47;
+    else leaf_active <= leaf_take_or_and_31;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -1155,14 +882,14 @@ module fxrt_core (
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
     if (rst) u0_leaf_buf_valid <= 1'h0;
-    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_43;
+    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
     if (u0_leaf_fill) u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
     if (u0_leaf_fill) u0_buf_leaf_first <= u_traverse_0_leaf_first;
     if (u0_leaf_fill) u0_buf_leaf_count <= u_traverse_0_leaf_count;
     if (u0_leaf_fill) u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
     if (u0_leaf_fill) u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
     if (rst) u1_leaf_buf_valid <= 1'h0;
-    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_45;
+    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
     if (u1_leaf_fill) u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
     if (u1_leaf_fill) u1_buf_leaf_first <= u_traverse_1_leaf_first;
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
@@ -1170,7 +897,7 @@ module fxrt_core (
     if (u1_leaf_fill) u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
-    emit_tag_sr[1] <= cat_49;
+    emit_tag_sr[1] <= cat_33;
     for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
       emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
     emit_valid_sr[1] <= leaf_active;
@@ -1180,32 +907,17 @@ module fxrt_core (
     for (pipe_tag_i = 3; pipe_tag_i > 1; pipe_tag_i = pipe_tag_i - 1)
       pipe_tag_sr[pipe_tag_i] <= pipe_tag_sr[pipe_tag_i - 1];
     pipe_tag_sr[1] <= emit_tag_tri;
-    emit_slot_d <= bits_emit_tag_tri;
-    ray_o_q_b0 <= ray_o_b0[bits_bits_emit_tag_tri];
-    ray_o_q_b1 <= ray_o_b1[bits_bits_emit_tag_tri_1];
-    ray_o_q_b2 <= ray_o_b2[bits_bits_emit_tag_tri_2];
-    ray_o_q_b3 <= ray_o_b3[bits_bits_emit_tag_tri_3];
-    ray_o_q_b4 <= ray_o_b4[bits_bits_emit_tag_tri_4];
-    ray_o_q_b5 <= ray_o_b5[bits_bits_emit_tag_tri_5];
-    ray_o_q_b6 <= ray_o_b6[bits_bits_emit_tag_tri_6];
-    ray_o_q_b7 <= ray_o_b7[bits_bits_emit_tag_tri_7];
+    ray_o_q <= ray_o[bits_emit_tag_tri];
     for (pipe_o_i = 2; pipe_o_i > 1; pipe_o_i = pipe_o_i - 1)
       pipe_o_sr[pipe_o_i] <= pipe_o_sr[pipe_o_i - 1];
-    pipe_o_sr[1] <= ray_o_q_c;
-    ray_w_q_b0 <= ray_w_b0[bits_bits_emit_tag_tri_8];
-    ray_w_q_b1 <= ray_w_b1[bits_bits_emit_tag_tri_9];
-    ray_w_q_b2 <= ray_w_b2[bits_bits_emit_tag_tri_10];
-    ray_w_q_b3 <= ray_w_b3[bits_bits_emit_tag_tri_11];
-    ray_w_q_b4 <= ray_w_b4[bits_bits_emit_tag_tri_12];
-    ray_w_q_b5 <= ray_w_b5[bits_bits_emit_tag_tri_13];
-    ray_w_q_b6 <= ray_w_b6[bits_bits_emit_tag_tri_14];
-    ray_w_q_b7 <= ray_w_b7[bits_bits_emit_tag_tri_15];
+    pipe_o_sr[1] <= ray_o_q;
+    ray_w_q <= ray_w[bits_emit_tag_tri];
     for (pipe_w_i = 2; pipe_w_i > 1; pipe_w_i = pipe_w_i - 1)
       pipe_w_sr[pipe_w_i] <= pipe_w_sr[pipe_w_i - 1];
-    pipe_w_sr[1] <= ray_w_q_c;
+    pipe_w_sr[1] <= ray_w_q;
     u0_done_took <= u0_done_pop;
     u1_done_took <= u1_done_pop;
-    done_valid_r <= or_56;
+    done_valid_r <= or_40;
     done_slot_r <= mux_u0_done_avail;
   end
 
@@ -1405,7 +1117,7 @@ module fxrt_core (
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
   assign busy = pipe_valid;
-  assign stack_depth = mux_lt_57;
+  assign stack_depth = mux_lt_41;
   assign visits = visits_c;
   assign culls = culls_c;
   assign occupied = occupied_c;

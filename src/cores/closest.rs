@@ -19,8 +19,7 @@
 
 use super::clock::ClockTarget;
 use super::lt_chain;
-use super::lutram::{banked, select_bit2};
-use crate::rtl::build::Builder;
+use crate::rtl::build::{Builder, S};
 use crate::rtl::{Module, Ty};
 
 #[derive(Clone, Copy, Debug)]
@@ -127,12 +126,10 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
 
     // The slots' best hits: (t, tri) and (u, v) RAMs and a valid bit per slot.
     let k = slots;
-    // In banks read over two clocks (`lutram`): from the slot a clock early, then by the
-    // registered one.
-    let tt_mem = banked(&b, "best_t_tri", t.width() + tri.width(), k);
-    let uv_mem = banked(&b, "best_u_v", 2 * m_bits, k);
-    let id_mem = banked(&b, "ray_ids", id_bits, k);
-    id_mem.write(&b, id_we, id_slot, id_in);
+    let tt_mem = b.ram("best_t_tri", t.width() + tri.width(), vec![0; k as usize]);
+    let uv_mem = b.ram("best_u_v", 2 * m_bits, vec![0; k as usize]);
+    let id_mem = b.ram("ray_ids", id_bits, vec![0; k as usize]);
+    b.ram_write(id_mem, id_we, id_slot, id_in);
     let best_valid = b.reg("best_valid", Ty::u(k), Some(0));
 
     // The merge: fin (the cycle after a leaf's last triangle: the accumulator is final), M1
@@ -141,14 +138,14 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     let fin = b.delay("fin", (valid & last).name("leaf_last"));
     let fin_slot = b.delay("fin_slot", slot);
     let fin_sp = b.delay("fin_sp", sp);
-    let st_tt = b.delay("slot_t_tri", tt_mem.read2(&b, "slot_t_tri_q", slot, fin_slot));
+    let st_tt = b.read("slot_t_tri", tt_mem, fin_slot);
     let m1 = b.delay("m1", fin);
     let m1_slot = b.delay("m1_slot", fin_slot);
     let m1_sp = b.delay("m1_sp", fin_sp);
     // The slot's has-best bit over two clocks: from the leaf's slot while its last triangle is
     // here, then at fin (a slot's bit cannot change in between: its previous leaf was merged
     // before it was unparked, and it is done only after its last leaf).
-    let m1_has = b.delay("m1_slot_has", select_bit2(&b, "fin_has", best_valid, k, slot, fin_slot));
+    let m1_has = b.delay("m1_slot_has", slot_bit_2(&b, "fin_has", best_valid, k, slot, fin_slot));
     let m1_empty = b.delay("m1_leaf_empty", acc_empty);
     let m1_tt = b.delay("m1_t_tri", b.cat(&[acc_t, acc_tri]));
     let m1_uv = b.delay("m1_u_v", b.cat(&[acc_u, acc_v]));
@@ -164,8 +161,8 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     let m2_uv = b.delay("m2_u_v", m1_uv);
     let m2_slot_t = b.delay("m2_slot_t", st_tt.slice(tri.width(), t.width()));
     let we = (m2 & m2_better).name("best_we");
-    tt_mem.write(&b, we, m2_slot, m2_tt);
-    uv_mem.write(&b, we, m2_slot, m2_uv);
+    b.ram_write(tt_mem, we, m2_slot, m2_tt);
+    b.ram_write(uv_mem, we, m2_slot, m2_uv);
     let best_t = m2_better.select(m2_tt.slice(tri.width(), t.width()), m2_slot_t).name("merged_t");
     let limit = (best_t.xsigned().resize(dist) + 8).name("merged_limit");
     b.output("merge_valid", b.delay("merge_valid_r", m2));
@@ -179,12 +176,12 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     // feeds `done_slot` sits by its arbiter); the has-best bit is selected over d0 and d1.
     let d0 = b.delay("d0", done_valid);
     let d0_slot = b.delay("d0_slot", done_slot);
-    let d_tt = b.delay("done_t_tri", tt_mem.read2(&b, "done_t_tri_q", done_slot, d0_slot));
-    let d_uv = b.delay("done_u_v", uv_mem.read2(&b, "done_u_v_q", done_slot, d0_slot));
-    let d_id = b.delay("done_id", id_mem.read2(&b, "done_id_q", done_slot, d0_slot));
+    let d_tt = b.read("done_t_tri", tt_mem, d0_slot);
+    let d_uv = b.read("done_u_v", uv_mem, d0_slot);
+    let d_id = b.read("done_id", id_mem, d0_slot);
     let d1 = b.delay("d1", d0);
     let d1_slot = b.delay("d1_slot", d0_slot);
-    let d1_has = b.delay("d1_has", select_bit2(&b, "done_has", best_valid, k, done_slot, d0_slot));
+    let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, done_slot, d0_slot));
     let none = b.konst(Ty::u(k), 0);
     let set = we.select(super::onehot(m2_slot, k), none).name("best_set");
     let clear = d1.select(super::onehot(d1_slot, k), none).name("best_clear");
@@ -205,4 +202,24 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     res("u", d_uv.slice(m_bits, m_bits), true);
     res("v", d_uv.slice(0, m_bits), true);
     b.finish()
+}
+
+/// Bit `slot` of the k-bit register `bits`, selected over two clocks: groups of 16 bits by the
+/// slot's low bits from `early` into registers, then the group by the high bits of `late`
+/// (`early` a clock later). A 128-to-1 select in one clock was the core's critical path, its
+/// slot register placed across the die from the bits. The bit must not change in between.
+fn slot_bit_2<'b>(b: &'b Builder, name: &str, bits: S<'b>, k: u32, early: S<'b>, late: S<'b>) -> S<'b> {
+    let zero = b.konst(Ty::BIT, 0);
+    let low = early.width().min(4);
+    let groups: Vec<S> = (0..k.div_ceil(16))
+        .map(|g| {
+            let cases: Vec<(u128, S)> = (0..16.min(k - 16 * g)).map(|i| (i as u128, bits.bit(16 * g + i))).collect();
+            b.delay(&format!("{name}_g{g}"), b.case(early.slice(0, low), &cases, zero).name(&format!("{name}_g{g}_c")))
+        })
+        .collect();
+    if groups.len() == 1 {
+        return groups[0];
+    }
+    let cases: Vec<(u128, S)> = groups.iter().enumerate().map(|(g, &x)| (g as u128, x)).collect();
+    b.case(late.slice(4, late.width() - 4), &cases, zero).name(&format!("{name}_c"))
 }

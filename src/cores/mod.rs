@@ -8,7 +8,6 @@ pub mod cost;
 pub mod divider;
 pub mod fifo;
 pub mod intersect;
-pub mod lutram;
 pub mod mul;
 pub mod plane;
 pub mod raygen;

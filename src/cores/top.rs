@@ -25,7 +25,6 @@ use super::intersect::{IntersectParams, intersect_core};
 use super::plane::{PlaneIssue, plane_unit};
 use super::traverse::{TraverseParams, field, traverse_core, word_bits};
 use super::lt_chain;
-use super::lutram::banked;
 use crate::model::golden::GridRay;
 use crate::rtl::build::{Builder, S};
 use crate::rtl::width::MAX_WIDTH;
@@ -333,10 +332,10 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
 
     // The core's ray RAMs (origin and direction, for the pipeline), by global slot.
     let slots = p.total_slots() as usize;
-    let o_mem = banked(&b, "ray_o", 3 * n, slots as u32);
-    o_mem.write(&b, accept, gslot, b.cat(&[oz, oy, ox]));
-    let w_mem = banked(&b, "ray_w", 3 * p.isect.m, slots as u32);
-    w_mem.write(&b, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
+    let o_mem = b.ram("ray_o", 3 * n, vec![0; slots]);
+    b.ram_write(o_mem, accept, gslot, b.cat(&[oz, oy, ox]));
+    let w_mem = b.ram("ray_w", 3 * p.isect.m, vec![0; slots]);
+    b.ram_write(w_mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
 
     // The leaf stream: the leaf in flight (slot, next entry, entries left, tmin, sp), and the
     // next leaf taken, in turn, from a unit's queue when the last entry goes.
@@ -442,10 +441,8 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let tag_d = b.delay_line("pipe_tag", tag, trc);
     // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
     let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
-    // (In two clocks, from the banks of `lutram`: the triangle ROMs take two or more.)
-    let emit_slot_d = b.delay("emit_slot_d", emit_slot);
-    let o_word = b.delay_line("pipe_o", o_mem.read2(&b, "ray_o_q", emit_slot, emit_slot_d), trc - 1);
-    let w_word = b.delay_line("pipe_w", w_mem.read2(&b, "ray_w_q", emit_slot, emit_slot_d), trc - 1);
+    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", o_mem, emit_slot), trc - 1);
+    let w_word = b.delay_line("pipe_w", b.read("ray_w_q", w_mem, emit_slot), trc - 1);
     let m = p.isect.m;
     let mut pipe_in = vec![valid_d, tag_d];
     pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));

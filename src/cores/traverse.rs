@@ -38,7 +38,6 @@ use super::clock::ClockTarget;
 use super::fifo::fifo;
 use super::mul::MulStyle;
 use super::plane::{PlaneIssue, plane_unit};
-use super::lutram::{banked, select_bit2};
 use super::{lowest_set, lt_chain, onehot};
 use crate::rtl::build::{Builder, S};
 use crate::rtl::{Module, Ty};
@@ -176,12 +175,11 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let word = b.input("node_word", Ty::u(node_l.width));
 
     // The ray RAMs: written when the top accepts a ray, read in N for the plane units.
-    // (In banks read over two clocks, `lutram`, from the slot a stage early.)
-    let o_mem = banked(&b, "ray_o", 3 * n, k);
-    o_mem.write(&b, ray_we, ray_slot, b.cat(&[o_in[2], o_in[1], o_in[0]]));
+    let o_mem = b.ram("ray_o", 3 * n, vec![0; k as usize]);
+    b.ram_write(o_mem, ray_we, ray_slot, b.cat(&[o_in[2], o_in[1], o_in[0]]));
     let inv_mem = [0, 1, 2].map(|a| {
-        let mem = banked(&b, &format!("ray_inv{}", ["x", "y", "z"][a]), p.inv_width(), k);
-        mem.write(&b, ray_we, ray_slot, inv_in[a].unsigned());
+        let mem = b.ram(&format!("ray_inv{}", ["x", "y", "z"][a]), p.inv_width(), vec![0; k as usize]);
+        b.ram_write(mem, ray_we, ray_slot, inv_in[a].unsigned());
         mem
     });
 
@@ -296,14 +294,12 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // C: the node ROM read, and the cull test: lower_t(tmin) > best t ⟺ tmin − tmin/64 >
     // best t + 8 (`golden::lower_t`), only when the slot has a best hit.
     let nrc = p.node_rom_cycles;
-    // The slot's limit and has-best bit are read from B2's slot over two clocks (`lutram`): a
-    // slot's are written only while it is parked, out of the ring.
-    let limit_mem = banked(&b, "cull_limit", dist.width, k);
-    limit_mem.write(&b, (merge_valid & merge_hit).name("limit_we"), merge_slot, merge_limit.unsigned());
-    let limit = b.delay("limit_q", limit_mem.read2(&b, "limit_r", bt.slot, c.slot)).signed();
+    let limit_mem = b.ram("cull_limit", dist.width, vec![0; k as usize]);
+    b.ram_write(limit_mem, (merge_valid & merge_hit).name("limit_we"), merge_slot, merge_limit.unsigned());
+    let limit = b.read("limit_q", limit_mem, c.slot).signed();
     let has_best = b.reg("has_best", Ty::u(k), Some(0));
     let x = b.delay("cull_x", (c.tmin - (c.tmin >> 6)).name("tmin_less"));
-    let hb = b.delay("cull_has_best", select_bit2(&b, "slot_has_best", has_best, k, bt.slot, c.slot));
+    let hb = b.delay("cull_has_best", b.case(c.slot, &(0..k).map(|i| (i as u128, has_best.bit(i))).collect::<Vec<_>>(), b.konst(bit, 0)).name("slot_has_best"));
     let culled = b.delay("culled", (hb & lt_chain(limit, x)).name("culled_c"));
     let culled = b.delay_line("culled_n", culled, nrc - 2);
     let set_best = (merge_valid & merge_hit).select(onehot(merge_slot, k), b.konst(Ty::u(k), 0)).name("best_set");
@@ -311,10 +307,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     b.next(has_best, (has_best & !clear_best) | set_best);
 
     // N: the node word.
-    let n_slot_pre = b.delay_line("n_slot_pre", c.slot, nrc - 1);
     let nt = Token {
         valid: b.delay_line("n_valid", c.valid, nrc),
-        slot: b.delay("n_slot", n_slot_pre),
+        slot: b.delay_line("n_slot", c.slot, nrc),
         node: b.delay_line("n_node", c.node, nrc),
         tmin: b.delay_line("n_tmin", c.tmin, nrc),
         tmax: b.delay_line("n_tmax", c.tmax, nrc),
@@ -332,12 +327,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
 
     // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
     // the units' second stage in N + 1).
-    let o_word = b.delay("ray_o_q", o_mem.read2(&b, "ray_o_r", n_slot_pre, nt.slot));
+    let o_word = b.read("ray_o_q", o_mem, nt.slot);
     let o = [0, 1, 2].map(|a| o_word.slice(a * n, n));
-    let inv = [0, 1, 2].map(|a| {
-        let name = format!("ray_inv{}", ["x", "y", "z"][a]);
-        b.delay(&format!("{name}_q"), inv_mem[a].read2(&b, &format!("{name}_r"), n_slot_pre, nt.slot)).signed()
-    });
+    let inv = [0, 1, 2].map(|a| b.read(&format!("ray_inv{}_q", ["x", "y", "z"][a]), inv_mem[a], nt.slot).signed());
     let pu0 = plane_unit(&b, n, p.c, o, inv, PlaneIssue { valid: is_inner, last: is_inner.k(0), plane: w_clip0, axis: w_axis }, p.product);
     let pu1 = plane_unit(&b, n, p.c, o, inv, PlaneIssue { valid: is_inner, last: is_inner.k(1), plane: w_clip1, axis: w_axis }, p.product);
     let l = pu0.latency;
