@@ -6,7 +6,7 @@
 
 use super::eval::Row;
 use super::output::Results;
-use super::plots::{FONT, H, W, plot_err};
+use super::plots::{FONT, H, W, draw_legend, plot_err};
 use super::report::list;
 use crate::error::Result;
 use crate::io::write_atomic;
@@ -183,15 +183,7 @@ fn panel(
             .label(scene.clone())
             .legend(move |(x, y)| Circle::new((x + 9, y), 5, color.filled()));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font((FONT, 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(plot_err)?;
-    Ok(())
+    draw_legend(&mut chart)
 }
 
 /// A finding: the range of rays per clock over the configurations, and where it is highest.
