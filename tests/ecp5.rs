@@ -4,6 +4,7 @@
 
 use fxrt::cores::divider::{DividerShape, divider_core};
 use fxrt::flow::ecp5::{Tools, place_and_route};
+use std::fmt::Write as _;
 use std::io::Write;
 
 #[test]
@@ -144,5 +145,117 @@ fn the_divider_step_as_a_carry_chain_equals_the_generated_step() {
             String::from_utf8_lossy(&out.stdout),
             String::from_utf8_lossy(&out.stderr)
         );
+    }
+}
+
+/// A behavioural DP16KD for the test below, decoding INITVALs by the layout that
+/// `block_rom_contents_are_the_ones_yosys_infers` proves equal to yosys's: read ports only,
+/// with the output register when REGMODE is OUTREG (yosys's cells_sim.v has the block only as
+/// a black box).
+fn dp16kd_model() -> String {
+    let params: String = (0..64).map(|i| format!("  parameter [319:0] INITVAL_{i:02X} = 320'h0;\n")).collect();
+    let init: Vec<String> = (0..64).rev().map(|i| format!("INITVAL_{i:02X}")).collect();
+    let pins = |p: &str, n: u32| (0..n).rev().map(|i| format!("{p}{i}")).collect::<Vec<_>>().join(", ");
+    let mut v = format!(
+        "module DP16KD(input {dia}, {dib}, {ada}, {adb}, CLKA, CEA, OCEA, WEA, RSTA, CSA0, CSA1, CSA2, \
+         CLKB, CEB, OCEB, WEB, RSTB, CSB0, CSB1, CSB2, output {doa}, {dob});\n{params}",
+        dia = pins("DIA", 18),
+        dib = pins("DIB", 18),
+        ada = pins("ADA", 14),
+        adb = pins("ADB", 14),
+        doa = pins("DOA", 18),
+        dob = pins("DOB", 18),
+    );
+    v.push_str(
+        "  parameter DATA_WIDTH_A = 18; parameter DATA_WIDTH_B = 18; parameter REGMODE_A = \"NOREG\";\n  \
+         parameter REGMODE_B = \"NOREG\"; parameter RESETMODE = \"SYNC\"; parameter ASYNC_RESET_RELEASE = \"SYNC\";\n  \
+         parameter CSDECODE_A = \"0b000\"; parameter CSDECODE_B = \"0b000\"; parameter WRITEMODE_A = \"NORMAL\";\n  \
+         parameter WRITEMODE_B = \"NORMAL\"; parameter GSR = \"DISABLED\";\n",
+    );
+    let _ = writeln!(v, "  wire [20479:0] init = {{{}}};", init.join(", "));
+    v.push_str(
+        "  function [17:0] word(input [13:0] ad, input integer w);\n    integer i, k, row, col, shift;\n    begin\n      \
+         shift = w == 18 ? 4 : w == 9 ? 3 : w == 4 ? 2 : w == 2 ? 1 : 0;\n      word = 18'h0;\n      \
+         for (i = 0; i < w; i = i + 1) begin\n        k = (ad >> shift) * w + i;\n        \
+         if (w >= 9) begin row = k / 18; col = k % 18; end\n        \
+         else begin row = k / 16; col = k % 16 + (k % 16 >= 8 ? 1 : 0); end\n        \
+         word[i] = init[(row / 16) * 320 + (row % 16) * 20 + col];\n      end\n    end\n  endfunction\n",
+    );
+    for (p, clk) in [("A", "CLKA"), ("B", "CLKB")] {
+        let _ = writeln!(
+            v,
+            "  reg [17:0] r{p} = 0, q{p} = 0;\n  always @(posedge {clk}) begin r{p} <= word({{{ad}}}, DATA_WIDTH_{p}); q{p} <= r{p}; end\n  \
+             assign {{{do_}}} = REGMODE_{p} == \"OUTREG\" ? q{p} : r{p};",
+            ad = pins(&format!("AD{p}"), 14),
+            do_ = pins(&format!("DO{p}"), 18),
+        );
+    }
+    v.push_str("endmodule\n");
+    v
+}
+
+/// A block ROM split into banks (`flow::ecp5_bram::banks`: blocks of several depths, a LUT
+/// tail, a select and a multiplexer after the output registers) reads every word as the
+/// generated ROM does, on both ports, clock for clock: Icarus runs the two side by side
+/// over every address, with the DP16KD model above.
+#[test]
+fn banked_block_roms_read_what_the_generated_rom_reads() {
+    use fxrt::cores::brom::brom_module_ports;
+    use fxrt::flow::ecp5_bram::{banks, dp16kd_rom};
+    if std::process::Command::new("iverilog").arg("-V").output().is_err() {
+        let _ = writeln!(std::io::stderr().lock(), "skipped: iverilog is not installed");
+        return;
+    }
+    let mut rng = fxrt::rng::SplitMix64(7);
+    // 5,000 words: 4K×4 and 1K×18 blocks; 4,150: 4K×4 and a LUT tail; both ports, 3 clocks;
+    // one port, 2 clocks.
+    for (words, width, ports, cycles) in [(5000usize, 21u32, 2u32, 3u32), (4150, 13, 2, 3), (5000, 21, 1, 2)] {
+        let layout = banks(words, width).unwrap();
+        assert!(layout.len() > 1, "{words}: {layout:?}");
+        let data: Vec<u128> = (0..words).map(|_| (rng.next_u64() & ((1 << width) - 1)) as u128).collect();
+        let m = brom_module_ports("t", width, data, cycles, ports);
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ecp5_banks_{words}_{ports}_{cycles}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let files = fxrt::rtl::emit::design_files(&m, "v");
+        for (name, text) in &files {
+            std::fs::write(dir.join(name), text).unwrap();
+        }
+        let (name, text) = files.iter().find(|(n, _)| n.starts_with("fxrt_brom_t") && n.ends_with(".v")).unwrap();
+        let banked = dp16kd_rom(text, &m).unwrap();
+        let module = name.trim_end_matches(".v");
+        std::fs::write(dir.join("banked.v"), banked.replacen(&format!("module {module}"), "module banked", 1)).unwrap();
+        std::fs::write(dir.join("dp16kd.v"), dp16kd_model()).unwrap();
+        let abits = fxrt::scene::rom::rom_addr_bits(words);
+        let (b_ports, b_cmp) = if ports == 2 {
+            (", .addr_b(ab), .data_b(qb1)".to_string(), " || qb1 !== qb0".to_string())
+        } else {
+            (String::new(), String::new())
+        };
+        let b_ref = if ports == 2 { ", .addr_b(ab), .data_b(qb0)" } else { "" };
+        let tb = format!(
+            "module tb;\n  reg clk = 0; reg [{a1}:0] a = 0, ab = 0; wire [{w1}:0] q0, q1, qb0, qb1;\n  \
+             integer n, bad = 0;\n  {module} r(.clk(clk), .addr(a), .data(q0){b_ref});\n  \
+             banked d(.clk(clk), .addr(a), .data(q1){b_ports});\n  \
+             initial begin\n    for (n = 0; n < {total}; n = n + 1) begin\n      \
+             a = n % {words}; ab = (n * 7919) % {words}; #1 clk = 1; #1 clk = 0;\n      \
+             if (n > 4 && (q1 !== q0{b_cmp})) bad = bad + 1;\n    end\n    \
+             $display(\"MISMATCHES %0d\", bad);\n    $finish;\n  end\nendmodule\n",
+            a1 = abits - 1,
+            w1 = width - 1,
+            total = words + 8,
+        );
+        std::fs::write(dir.join("tb.v"), tb).unwrap();
+        let sources: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| f.ends_with(".v")).collect();
+        let out = std::process::Command::new("iverilog")
+            .args(["-g2005", "-o", "tb.vvp", "-s", "tb", "tb.v", "banked.v", "dp16kd.v"])
+            .args(&sources)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let run = std::process::Command::new("vvp").args(["-n", "tb.vvp"]).current_dir(&dir).output().unwrap();
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        assert!(stdout.contains("MISMATCHES 0"), "{words} words, {ports} ports, {cycles} clocks: {stdout}");
     }
 }

@@ -10,11 +10,14 @@
 //! `ecp5_dsp` puts multiplier pieces in MULT18X18Ds. The ports and the cycle behaviour are the
 //! generated module's, which every simulator checks.
 //!
-//! Each DP16KD holds the whole depth of the ROM at the widest data width that covers it
-//! (1K×18, 2K×9, 4K×4, 8K×2, 16K×1), so the ROM is a row of blocks side by side with no
-//! multiplexer after them: the teapot's 4,379 nodes of 73 bits are 37 blocks of 8K×2, its
-//! 6,320 triangles of 284 bits 142. ROMs deeper than 16K words, and ROMs of fewer than
-//! `MIN_WORDS` words (yosys makes those of LUTs), are left as yosys infers them.
+//! A ROM whose depth fills its configuration is a row of blocks side by side at the widest
+//! data width that covers the depth (1K×18, 2K×9, 4K×4, 8K×2, 16K×1), with no multiplexer
+//! after them. A ROM that a power of two overshoots is split by depth into banks (`banks`):
+//! the teapot's 6,320 triangles of 284 bits take 121 blocks as 4K×4 + 2K×9 + 1K×18 where
+//! 8K×2 took 142, its 4,450 nodes 24 where they took 37 (issue 12: the blocks saved hold the
+//! second node ROM of four traversal units). The banks' words meet in a one-hot multiplexer
+//! between the blocks' output registers and the fabric register. ROMs of fewer than
+//! `MIN_WORDS` words are left as yosys infers them (LUTs).
 //!
 //! The initial contents follow yosys's own DP16KD mapping (`share/lattice/brams_map_16kd.v`
 //! with `memory_libmap`): the block is 1,024 rows of 18 bits, INITVAL_00 … INITVAL_3F hold 16
@@ -64,79 +67,180 @@ pub fn initvals(words: &[u128], lsb: u32, w: u32) -> Vec<String> {
         .collect()
 }
 
-/// The block ROM module `m` (`cores::brom::brom_module`) as DP16KDs (and a fabric register
-/// after them when it reads in three clocks), or None when it stays as
-/// yosys infers it. `generated` is its printed Verilog; its port list is kept.
+/// Words of a ROM's last bank small enough to be LUTs rather than a block.
+pub const LUT_TAIL: usize = 128;
+
+/// One bank of a block ROM split by depth: its words [base, base + 2^abits), in DP16KDs of data
+/// width `w` side by side, or in LUTs when `w == 0` (a short tail).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bank {
+    pub base: usize,
+    pub abits: u32,
+    pub w: u32,
+}
+
+impl Bank {
+    pub fn blocks(&self, width: u32) -> usize {
+        if self.w == 0 { 0 } else { width.div_ceil(self.w) as usize }
+    }
+}
+
+/// How a ROM of `words` words of `width` bits is laid out in DP16KDs: one bank at the widest
+/// configuration holding the whole depth when that takes fewest blocks (no multiplexer after
+/// the blocks), else banks of decreasing depth — the deepest configuration not deeper than
+/// the words left, the last words in LUTs when at most `LUT_TAIL` remain — so a ROM's
+/// power-of-two padding no longer costs blocks: the teapot's 6,320 triangles of 124 bits are
+/// 4,096 words in 4K×4 (31 blocks), 2,048 in 2K×9 (14) and 176 in 1K×18 (7), 52 blocks, where
+/// 8K×2 took 62. Each bank's base is a multiple of its depth, so its select is a compare of the
+/// address's top bits. None when no layout holds it (deeper than 16K words in one bank and
+/// not split) — cannot happen for a split.
+pub fn banks(words: usize, width: u32) -> Option<Vec<Bank>> {
+    let depth = crate::scene::rom::rom_depth(words);
+    let whole = config(depth).map(|(w, d)| vec![Bank { base: 0, abits: d.trailing_zeros().min(depth.trailing_zeros()), w }]);
+    let mut split = Vec::new();
+    let mut base = 0;
+    while base < words {
+        let left = words - base;
+        if !split.is_empty() && left <= LUT_TAIL {
+            split.push(Bank { base, abits: crate::scene::rom::rom_addr_bits(left), w: 0 });
+            break;
+        }
+        let (w, d) = CONFIGS.iter().rev().copied().find(|&(_, d)| d <= left).unwrap_or(CONFIGS[0]);
+        split.push(Bank { base, abits: d.trailing_zeros(), w });
+        base += d;
+    }
+    let cost = |v: &Vec<Bank>| v.iter().map(|b| b.blocks(width)).sum::<usize>();
+    match whole {
+        Some(whole) if cost(&whole) <= cost(&split) => Some(whole),
+        _ => Some(split),
+    }
+}
+
+/// The block ROM module `m` (`cores::brom::brom_module`) as DP16KDs (banks of them, `banks`,
+/// with a one-hot multiplexer after the blocks' output registers), and a fabric register after
+/// them when it reads in three clocks, or None when it stays as yosys infers it. `generated`
+/// is its printed Verilog; its port list is kept.
 pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
     let rom = m.roms.first()?;
-    let depth = crate::scene::rom::rom_depth(rom.words.len());
     if rom.words.len() < MIN_WORDS {
         return None;
     }
-    let (w, cfg_depth) = config(depth)?;
+    let layout = banks(rom.words.len(), rom.width)?;
     let abits = crate::scene::rom::rom_addr_bits(rom.words.len());
-    let shift = (16384 / cfg_depth).trailing_zeros();
     let end = generated.find("\n);\n")? + 4;
     let mut v = String::from(&generated[..end]);
     v.push_str("\n  // DP16KD blocks with their output register (fxrt synth --family ecp5, flow::ecp5_bram).\n");
-    let blocks = rom.width.div_ceil(w);
-    // A two-port ROM (`brom_module_ports`) reads its second address on the block's port B.
-    let two = m.outputs.len() == 2;
-    let _ = writeln!(v, "  wire [{}:0] dout;", blocks * w - 1);
-    if two {
-        let _ = writeln!(v, "  wire [{}:0] dout_b;", blocks * w - 1);
-    }
-    let (wb, regb) = if two { (w, "OUTREG") } else { (18, "NOREG") };
+    // A two-port ROM (`brom_module_ports`) reads its second address on the blocks' port B.
+    let ports: &[(&str, &str, &str)] = &[("", "addr", "data"), ("_b", "addr_b", "data_b")][..m.outputs.len()];
+    let two = ports.len() == 2;
+    let one = layout.len() == 1;
     let zeros = |pin: &str, n| (0..n).map(|i| format!(".{pin}{i}(1'b0)")).collect::<Vec<_>>().join(", ");
-    let address = |pin: &str, addr: &str| -> String {
-        (0..14u32)
-            .map(|p| match p.checked_sub(shift) {
-                Some(i) if i < abits => format!(".{pin}{p}({addr}[{i}])"),
-                _ => format!(".{pin}{p}(1'b0)"),
-            })
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    for j in 0..blocks {
-        let _ = writeln!(v, "  DP16KD #(");
-        for (i, init) in initvals(&rom.words, j * w, w).iter().enumerate() {
-            let _ = writeln!(v, "    .INITVAL_{i:02X}(320'h{init}),");
-        }
-        let _ = writeln!(
-            v,
-            "    .DATA_WIDTH_A({w}), .DATA_WIDTH_B({wb}), .REGMODE_A(\"OUTREG\"), .REGMODE_B(\"{regb}\"),\n    \
-             .RESETMODE(\"SYNC\"), .ASYNC_RESET_RELEASE(\"SYNC\"), .CSDECODE_A(\"0b000\"), .CSDECODE_B(\"0b000\"),\n    \
-             .WRITEMODE_A(\"NORMAL\"), .WRITEMODE_B(\"NORMAL\"), .GSR(\"DISABLED\")\n  ) u_bram{j} ("
-        );
-        let _ = writeln!(v, "    {},", address("ADA", "addr"));
-        let _ = writeln!(v, "    {},", zeros("DIA", 18));
-        let _ = writeln!(v, "    {},", zeros("DIB", 18));
-        let dout: Vec<String> = (0..w).map(|i| format!(".DOA{i}(dout[{}])", j * w + i)).collect();
-        let _ = writeln!(v, "    {},", dout.join(", "));
-        v.push_str("    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(1'b0), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n");
-        if two {
-            let _ = writeln!(v, "    {},", address("ADB", "addr_b"));
-            let dout: Vec<String> = (0..w).map(|i| format!(".DOB{i}(dout_b[{}])", j * w + i)).collect();
-            let _ = writeln!(v, "    {},", dout.join(", "));
-            v.push_str("    .CLKB(clk), .CEB(1'b1), .OCEB(1'b1), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+    for (k, bank) in layout.iter().enumerate() {
+        let tag = if one { String::new() } else { k.to_string() };
+        let words_of_bank: Vec<u128> =
+            rom.words.iter().copied().skip(bank.base).take(1 << bank.abits).collect();
+        if bank.w == 0 {
+            // The tail in LUTs, read through two registers like a block with its output register.
+            let _ = writeln!(v, "  (* rom_style = \"logic\" *) reg [{}:0] tail{k} [0:{}];", rom.width - 1, (1usize << bank.abits) - 1);
+            v.push_str("  initial begin\n");
+            for a in 0..1usize << bank.abits {
+                let word = words_of_bank.get(a).copied().unwrap_or(0);
+                let _ = writeln!(v, "    tail{k}[{a}] = {}'h{word:x};", rom.width);
+            }
+            v.push_str("  end\n");
+            for (x, addr, _) in ports {
+                let _ = writeln!(
+                    v,
+                    "  reg [{w1}:0] dout{k}{x}_1 = {w}'h0, dout{k}{x} = {w}'h0;\n  \
+                     always @(posedge clk) begin dout{k}{x}_1 <= tail{k}[{addr}[{a1}:0]]; dout{k}{x} <= dout{k}{x}_1; end",
+                    w1 = rom.width - 1,
+                    w = rom.width,
+                    a1 = bank.abits - 1
+                );
+            }
         } else {
-            let _ = writeln!(v, "    {},", zeros("ADB", 14));
-            v.push_str("    .CLKB(1'b0), .CEB(1'b0), .OCEB(1'b0), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+            let (w, cfg_depth) = (bank.w, 1usize << bank.abits);
+            let cfg_depth = CONFIGS.iter().find(|c| c.0 == w).map_or(cfg_depth, |c| c.1);
+            let shift = (16384 / cfg_depth).trailing_zeros();
+            let blocks = bank.blocks(rom.width);
+            let bank_abits = bank.abits.min(abits);
+            let address = |pin: &str, addr: &str| -> String {
+                (0..14u32)
+                    .map(|p| match p.checked_sub(shift) {
+                        Some(i) if i < bank_abits => format!(".{pin}{p}({addr}[{i}])"),
+                        _ => format!(".{pin}{p}(1'b0)"),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            for (x, _, _) in ports {
+                let _ = writeln!(v, "  wire [{}:0] dout{tag}{x};", blocks as u32 * w - 1);
+            }
+            let (wb, regb) = if two { (w, "OUTREG") } else { (18, "NOREG") };
+            for j in 0..blocks as u32 {
+                let _ = writeln!(v, "  DP16KD #(");
+                for (i, init) in initvals(&words_of_bank, j * w, w).iter().enumerate() {
+                    let _ = writeln!(v, "    .INITVAL_{i:02X}(320'h{init}),");
+                }
+                let label = if one { format!("u_bram{j}") } else { format!("u_bank{k}_bram{j}") };
+                let _ = writeln!(
+                    v,
+                    "    .DATA_WIDTH_A({w}), .DATA_WIDTH_B({wb}), .REGMODE_A(\"OUTREG\"), .REGMODE_B(\"{regb}\"),\n    \
+                     .RESETMODE(\"SYNC\"), .ASYNC_RESET_RELEASE(\"SYNC\"), .CSDECODE_A(\"0b000\"), .CSDECODE_B(\"0b000\"),\n    \
+                     .WRITEMODE_A(\"NORMAL\"), .WRITEMODE_B(\"NORMAL\"), .GSR(\"DISABLED\")\n  ) {label} ("
+                );
+                let _ = writeln!(v, "    {},", address("ADA", "addr"));
+                let _ = writeln!(v, "    {},", zeros("DIA", 18));
+                let _ = writeln!(v, "    {},", zeros("DIB", 18));
+                let dout: Vec<String> = (0..w).map(|i| format!(".DOA{i}(dout{tag}[{}])", j * w + i)).collect();
+                let _ = writeln!(v, "    {},", dout.join(", "));
+                v.push_str("    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(1'b0), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n");
+                if two {
+                    let _ = writeln!(v, "    {},", address("ADB", "addr_b"));
+                    let dout: Vec<String> = (0..w).map(|i| format!(".DOB{i}(dout{tag}_b[{}])", j * w + i)).collect();
+                    let _ = writeln!(v, "    {},", dout.join(", "));
+                    v.push_str("    .CLKB(clk), .CEB(1'b1), .OCEB(1'b1), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+                } else {
+                    let _ = writeln!(v, "    {},", zeros("ADB", 14));
+                    v.push_str("    .CLKB(1'b0), .CEB(1'b0), .OCEB(1'b0), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+                }
+                v.push_str("  );\n");
+            }
         }
-        v.push_str("  );\n");
     }
-    for (x, out) in [("", "data"), ("_b", "data_b")][..m.outputs.len()].iter() {
+    for (x, addr, out) in ports {
+        let word = if one {
+            format!("dout{x}[{}:0]", rom.width - 1)
+        } else {
+            // Each bank's select: the address's top bits are its base's, registered twice to
+            // meet the words leaving the blocks' output registers.
+            let mut terms = Vec::new();
+            for (k, bank) in layout.iter().enumerate() {
+                let prefix = bank.base >> bank.abits;
+                let _ = writeln!(
+                    v,
+                    "  reg sel{k}{x}_1 = 1'b0, sel{k}{x} = 1'b0;\n  \
+                     always @(posedge clk) begin sel{k}{x}_1 <= {addr}[{}:{}] == {}'d{prefix}; sel{k}{x} <= sel{k}{x}_1; end",
+                    abits - 1,
+                    bank.abits,
+                    abits - bank.abits
+                );
+                terms.push(format!("({{{}{{sel{k}{x}}}}} & dout{k}{x}[{}:0])", rom.width, rom.width - 1));
+            }
+            let _ = writeln!(v, "  wire [{}:0] word{x} = {};", rom.width - 1, terms.join(" | "));
+            format!("word{x}")
+        };
         if crate::cores::brom::brom_cycles(m) == 3 {
             // The third clock: a fabric register after the block's output register.
             let _ = writeln!(
                 v,
-                "  reg [{0}:0] dout{x}_q = {1}'h0;\n  always @(posedge clk) dout{x}_q <= dout{x}[{0}:0];",
+                "  reg [{0}:0] dout{x}_q = {1}'h0;\n  always @(posedge clk) dout{x}_q <= {word};",
                 rom.width - 1,
                 rom.width
             );
             let _ = writeln!(v, "  assign {out} = dout{x}_q;");
         } else {
-            let _ = writeln!(v, "  assign {out} = dout{x}[{}:0];", rom.width - 1);
+            let _ = writeln!(v, "  assign {out} = {word};");
         }
     }
     v.push_str("endmodule\n");
@@ -212,6 +316,31 @@ mod tests {
         assert_eq!(config(8192), Some((2, 8192)));
         assert_eq!(config(8193), Some((1, 16384)));
         assert_eq!(config(16385), None);
+    }
+
+    /// Banks cover every word once, in decreasing depth, each base a multiple of its depth;
+    /// a split is taken only when it saves blocks (the teapot's triangle and node ROMs).
+    #[test]
+    fn banks_cover_the_words_and_save_blocks() {
+        let blocks = |v: &[Bank], w| v.iter().map(|b| b.blocks(w)).sum::<usize>();
+        assert_eq!(banks(6320, 124).unwrap().iter().map(|b| (b.base, b.w)).collect::<Vec<_>>(), [(0, 4), (4096, 9), (6144, 18)]);
+        assert_eq!(blocks(&banks(6320, 124).unwrap(), 124), 31 + 14 + 7);
+        assert_eq!(blocks(&banks(4450, 76).unwrap(), 76), 19 + 5, "not 38 of 8K×2");
+        assert_eq!(banks(6240, 76).unwrap().last(), Some(&Bank { base: 6144, abits: 7, w: 0 }), "96 words in LUTs");
+        assert_eq!(banks(8192, 76).unwrap(), [Bank { base: 0, abits: 13, w: 2 }], "a full depth stays one bank");
+        assert_eq!(banks(3000, 20).unwrap(), [Bank { base: 0, abits: 12, w: 4 }], "no saving, no split");
+        for words in [128, 1000, 1025, 3000, 4097, 5000, 6240, 6320, 12_345, 16_384, 40_000] {
+            let v = banks(words, 76).unwrap();
+            let mut next = 0;
+            for b in &v {
+                assert_eq!(b.base, next, "{words}: {v:?}");
+                assert_eq!(b.base % (1 << b.abits), 0, "{words}: {v:?}");
+                next += 1 << b.abits;
+            }
+            assert!(next >= words && (v.len() == 1 || next - (1 << v.last().unwrap().abits) < words), "{words}: {v:?}");
+            let whole = config(crate::scene::rom::rom_depth(words)).map(|(w, _)| 76usize.div_ceil(w as usize));
+            assert!(whole.is_none_or(|whole| blocks(&v, 76) <= whole), "{words}: {v:?}");
+        }
     }
 
     /// The substitute keeps the ports, uses one block per w bits, the output register, and
