@@ -50,16 +50,13 @@ module fxrt_core (
   wire [5:0] u1_free_slot;
   reg [0:0] turn = 1'h0;
   reg [1:0] box_phase = 2'h0;
-  reg [0:0] u0_has_free_r = 1'h1;
-  reg [0:0] u1_has_free_r = 1'h1;
   reg [5:0] u0_free_slot_r = 6'h00;
   reg [5:0] u1_free_slot_r = 6'h00;
-  wire [0:0] k_0 = 1'h0;
-  reg [0:0] case_turn;
-  reg [5:0] case_turn_1;
+  reg [0:0] turn_free = 1'h1;
+  reg [5:0] case_turn;
   reg [0:0] in_valid = 1'h0;
-  wire [1:0] k_0_1 = 2'h0;
-  wire [0:0] box_phase_eq_k_0_1;
+  wire [1:0] k_0 = 2'h0;
+  wire [0:0] box_phase_eq_k_0;
   wire [0:0] and_0;
   wire [0:0] take;
   wire [0:0] not_in_valid;
@@ -80,14 +77,16 @@ module fxrt_core (
   wire [6:0] take_slot;
   wire [0:0] k_1 = 1'h1;
   wire [0:0] turn_plus_1;
-  wire [0:0] not_case_turn;
-  wire [0:0] take_or_not_case_turn;
-  wire [0:0] mux_take_or_not_case_turn;
-  wire [0:0] box_phase_ne_k_0_1;
-  wire [0:0] or_3;
+  wire [0:0] not_turn_free;
+  wire [0:0] take_or_not_turn_free;
+  wire [0:0] turn_next;
+  wire [0:0] k_0_1 = 1'h0;
+  reg [0:0] case_turn_next;
+  wire [0:0] box_phase_ne_k_0;
+  wire [0:0] take_or_box_phase_ne_k_0;
   wire [1:0] k_1_1 = 2'h1;
   wire [1:0] box_phase_plus_k_1_1;
-  wire [1:0] mux_or_3;
+  wire [1:0] mux_take_or_box_phase_ne_k_0;
   wire [0:0] box_idle;
   reg [28:0] box_in_ox = 29'h00000000;
   reg [28:0] box_in_oy = 29'h00000000;
@@ -185,14 +184,14 @@ module fxrt_core (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_box_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_7;
+  wire signed [32:0] minus_6;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt1_c;
   reg [0:0] box_lt1 = 1'h0;
   wire signed [32:0] rs_plane_t_1;
   wire signed [32:0] rs_box_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_8;
+  wire signed [32:0] minus_7;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt2_c;
   reg [0:0] box_lt2 = 1'h0;
@@ -202,7 +201,7 @@ module fxrt_core (
   wire signed [31:0] box_tmax;
   wire [0:0] bits_box_d1;
   wire [0:0] bits_box_d2;
-  wire [0:0] or_9;
+  wire [0:0] or_8;
   wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire [0:0] box_last;
@@ -225,16 +224,16 @@ module fxrt_core (
   wire [72:0] u0_node_word;
   wire [72:0] u1_node_word;
   wire [0:0] bits_accept_slot_1;
-  wire [0:0] eq_11;
+  wire [0:0] eq_10;
   wire [0:0] u0_alloc;
   wire [0:0] bits_box_done_slot;
-  wire [0:0] eq_12;
+  wire [0:0] eq_11;
   wire [0:0] u0_new;
   wire [0:0] bits_merge_slot;
-  wire [0:0] bits_merge_slot_eq_k_0;
+  wire [0:0] bits_merge_slot_eq_k_0_1;
   wire [0:0] u0_merge;
   wire [0:0] bits_free_slot;
-  wire [0:0] bits_free_slot_eq_k_0;
+  wire [0:0] bits_free_slot_eq_k_0_1;
   wire [0:0] u0_free;
   wire [5:0] bits_box_done_slot_1;
   wire [5:0] bits_merge_slot_1;
@@ -257,10 +256,10 @@ module fxrt_core (
   wire [5:0] u_traverse_0_depth;
   wire [6:0] u_traverse_0_occupied;
   wire [0:0] bits_accept_slot_2;
-  wire [0:0] eq_15;
+  wire [0:0] eq_14;
   wire [0:0] u1_alloc;
   wire [0:0] bits_box_done_slot_2;
-  wire [0:0] eq_16;
+  wire [0:0] eq_15;
   wire [0:0] u1_new;
   wire [0:0] bits_merge_slot_2;
   wire [0:0] bits_merge_slot_2_eq_k_1;
@@ -290,11 +289,11 @@ module fxrt_core (
   wire [6:0] u_traverse_1_occupied;
   wire [72:0] u_node_rom_0_data;
   wire [72:0] u_node_rom_0_data_b;
-  wire [86:0] cat_19;
+  wire [86:0] cat_18;
   wire [31:0] u_acc_in_wz;
   wire [31:0] u_acc_in_wy;
   wire [31:0] u_acc_in_wx;
-  wire [95:0] cat_20;
+  wire [95:0] cat_19;
   reg [0:0] leaf_active = 1'h0;
   reg [6:0] leaf_slot = 7'h00;
   reg [12:0] leaf_ptr = 13'h0000;
@@ -327,24 +326,24 @@ module fxrt_core (
   reg [0:0] case_leaf_turn_1;
   reg [0:0] case_leaf_turn_2;
   reg [0:0] case_leaf_turn_3;
-  wire [0:0] or_25;
+  wire [0:0] or_24;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_26;
+  wire [0:0] eq_25;
   wire [0:0] u0_leaf_take;
   wire [0:0] not_u0_leaf_take;
-  wire [0:0] and_27;
-  wire [0:0] u0_leaf_fill_or_and_27;
-  wire [0:0] eq_28;
+  wire [0:0] and_26;
+  wire [0:0] u0_leaf_fill_or_and_26;
+  wire [0:0] eq_27;
   wire [0:0] u1_leaf_take;
   wire [0:0] not_u1_leaf_take;
-  wire [0:0] and_29;
-  wire [0:0] u1_leaf_fill_or_and_29;
+  wire [0:0] and_28;
+  wire [0:0] u1_leaf_fill_or_and_28;
   reg [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_30;
+  wire [6:0] cat_29;
   wire [0:0] not_leaf_last_entry;
-  wire [0:0] and_31;
-  wire [0:0] leaf_take_or_and_31;
+  wire [0:0] and_30;
+  wire [0:0] leaf_take_or_and_30;
   wire [6:0] mux_leaf_take;
   reg [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
@@ -359,13 +358,13 @@ module fxrt_core (
   reg [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   reg [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_32;
+  wire [0:0] eq_31;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_33;
+  wire [58:0] cat_32;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -438,12 +437,12 @@ module fxrt_core (
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_37;
+  wire [6:0] cat_36;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_39;
+  wire [6:0] cat_38;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_40;
+  wire [0:0] or_39;
   reg [0:0] done_valid_r = 1'h0;
   reg [6:0] done_slot_r = 7'h00;
   wire [0:0] u_closest_merge_valid;
@@ -460,8 +459,9 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_41;
-  wire [5:0] mux_lt_41;
+  wire [0:0] lt_40;
+  wire [5:0] mux_lt_40;
+  reg [5:0] obs_depth_l1_0 = 6'h00;
   wire [2:0] rs_u_traverse_0_visit;
   wire [2:0] rs_u_traverse_1_visit;
   wire [2:0] visits_c;
@@ -470,7 +470,8 @@ module fxrt_core (
   wire [2:0] culls_c;
   wire [7:0] rs_u_traverse_0_occupied;
   wire [7:0] rs_u_traverse_1_occupied;
-  wire [7:0] occupied_c;
+  wire [7:0] plus_43;
+  reg [7:0] obs_occupied_l1_0 = 8'h00;
 
   assign u0_has_free = u_traverse_0_has_free;
   assign u1_has_free = u_traverse_1_has_free;
@@ -478,36 +479,36 @@ module fxrt_core (
   assign u1_free_slot = u_traverse_1_free_slot_out;
   always @* begin
     case (turn)
-      1'h0: case_turn = u0_has_free_r;
-      1'h1: case_turn = u1_has_free_r;
-      default: case_turn = k_0;
+      1'h0: case_turn = u0_free_slot_r;
+      1'h1: case_turn = u1_free_slot_r;
+      default: case_turn = u0_free_slot_r;
     endcase
   end
-  always @* begin
-    case (turn)
-      1'h0: case_turn_1 = u0_free_slot_r;
-      1'h1: case_turn_1 = u1_free_slot_r;
-      default: case_turn_1 = u0_free_slot_r;
-    endcase
-  end
-  assign box_phase_eq_k_0_1 = box_phase == k_0_1;
-  assign and_0 = in_valid & box_phase_eq_k_0_1;
-  assign take = and_0 & case_turn;
+  assign box_phase_eq_k_0 = box_phase == k_0;
+  assign and_0 = in_valid & box_phase_eq_k_0;
+  assign take = and_0 & turn_free;
   assign not_in_valid = ~in_valid;
   assign port_ready = not_in_valid | take;
   assign not_take = ~take;
   assign in_valid_and_not_take = in_valid & not_take;
   assign or_1 = ray_valid | in_valid_and_not_take;
-  assign take_slot = {turn, case_turn_1};
+  assign take_slot = {turn, case_turn};
   assign turn_plus_1 = turn + k_1;
-  assign not_case_turn = ~case_turn;
-  assign take_or_not_case_turn = take | not_case_turn;
-  assign mux_take_or_not_case_turn = take_or_not_case_turn ? turn_plus_1 : turn;
-  assign box_phase_ne_k_0_1 = box_phase != k_0_1;
-  assign or_3 = take | box_phase_ne_k_0_1;
+  assign not_turn_free = ~turn_free;
+  assign take_or_not_turn_free = take | not_turn_free;
+  assign turn_next = take_or_not_turn_free ? turn_plus_1 : turn;
+  always @* begin
+    case (turn_next)
+      1'h0: case_turn_next = u0_has_free;
+      1'h1: case_turn_next = u1_has_free;
+      default: case_turn_next = k_0_1;
+    endcase
+  end
+  assign box_phase_ne_k_0 = box_phase != k_0;
+  assign take_or_box_phase_ne_k_0 = take | box_phase_ne_k_0;
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
-  assign mux_or_3 = or_3 ? box_phase_plus_k_1_1 : box_phase;
-  assign box_idle = box_phase == k_0_1;
+  assign mux_take_or_box_phase_ne_k_0 = take_or_box_phase_ne_k_0 ? box_phase_plus_k_1_1 : box_phase;
+  assign box_idle = box_phase == k_0;
   assign bits_accept_slot = accept_slot_int[5:0];
   assign box_axis = box_phase - k_1_1;
   always @* begin
@@ -518,7 +519,7 @@ module fxrt_core (
     endcase
   end
   assign box_neg = case_box_axis[47];
-  assign box_issue = box_phase != k_0_1;
+  assign box_issue = box_phase != k_0;
   assign box_issue_last = box_phase == k_3;
   always @* begin
     case (box_axis)
@@ -564,20 +565,20 @@ module fxrt_core (
   assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
-  assign minus_7 = rs_plane_t - rs_box_d1;
-  assign box_lt1_c = minus_7[32];
+  assign minus_6 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_6[32];
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
-  assign minus_8 = rs_plane_t_1 - rs_box_d2;
-  assign box_lt2_c = minus_8[32];
+  assign minus_7 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_7[32];
   assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
   assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
   assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
   assign bits_box_d1 = box_d1[31];
   assign bits_box_d2 = box_d2[31];
-  assign or_9 = bits_box_d1 | bits_box_d2;
+  assign or_8 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_9 | bits_box_d3;
+  assign box_miss = or_8 | bits_box_d3;
   assign box_last = plane_t_valid & plane_t_last;
   assign box_done_slot = box_done_slot_sr[11];
   assign merge_valid = u_closest_merge_valid;
@@ -594,26 +595,26 @@ module fxrt_core (
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
   assign bits_accept_slot_1 = accept_slot_int[6];
-  assign eq_11 = bits_accept_slot_1 == k_0;
-  assign u0_alloc = accept_int & eq_11;
+  assign eq_10 = bits_accept_slot_1 == k_0_1;
+  assign u0_alloc = accept_int & eq_10;
   assign bits_box_done_slot = box_done_slot[6];
-  assign eq_12 = bits_box_done_slot == k_0;
-  assign u0_new = box_done & eq_12;
+  assign eq_11 = bits_box_done_slot == k_0_1;
+  assign u0_new = box_done & eq_11;
   assign bits_merge_slot = merge_slot[6];
-  assign bits_merge_slot_eq_k_0 = bits_merge_slot == k_0;
-  assign u0_merge = merge_valid & bits_merge_slot_eq_k_0;
+  assign bits_merge_slot_eq_k_0_1 = bits_merge_slot == k_0_1;
+  assign u0_merge = merge_valid & bits_merge_slot_eq_k_0_1;
   assign bits_free_slot = free_slot[6];
-  assign bits_free_slot_eq_k_0 = bits_free_slot == k_0;
-  assign u0_free = free_valid & bits_free_slot_eq_k_0;
+  assign bits_free_slot_eq_k_0_1 = bits_free_slot == k_0_1;
+  assign u0_free = free_valid & bits_free_slot_eq_k_0_1;
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_merge_slot_1 = merge_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
   assign bits_accept_slot_2 = accept_slot_int[6];
-  assign eq_15 = bits_accept_slot_2 == k_1;
-  assign u1_alloc = accept_int & eq_15;
+  assign eq_14 = bits_accept_slot_2 == k_1;
+  assign u1_alloc = accept_int & eq_14;
   assign bits_box_done_slot_2 = box_done_slot[6];
-  assign eq_16 = bits_box_done_slot_2 == k_1;
-  assign u1_new = box_done & eq_16;
+  assign eq_15 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_15;
   assign bits_merge_slot_2 = merge_slot[6];
   assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
   assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
@@ -623,11 +624,11 @@ module fxrt_core (
   assign bits_box_done_slot_3 = box_done_slot[5:0];
   assign bits_merge_slot_3 = merge_slot[5:0];
   assign bits_free_slot_3 = free_slot[5:0];
-  assign cat_19 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign cat_18 = {acc_in_oz, acc_in_oy, acc_in_ox};
   assign u_acc_in_wz = $unsigned(acc_in_wz);
   assign u_acc_in_wy = $unsigned(acc_in_wy);
   assign u_acc_in_wx = $unsigned(acc_in_wx);
-  assign cat_20 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
+  assign cat_19 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
   assign leaf_last_entry = leaf_active & leaf_last;
   assign not_leaf_active = ~leaf_active;
   assign leaf_can_take = not_leaf_active | leaf_last_entry;
@@ -639,43 +640,43 @@ module fxrt_core (
     case (leaf_turn)
       1'h0: case_leaf_turn = u0_leaf_buf_valid;
       1'h1: case_leaf_turn = u1_leaf_buf_valid;
-      default: case_leaf_turn = k_0;
+      default: case_leaf_turn = k_0_1;
     endcase
   end
   always @* begin
     case (leaf_turn)
-      1'h0: case_leaf_turn_1 = k_0;
+      1'h0: case_leaf_turn_1 = k_0_1;
       1'h1: case_leaf_turn_1 = k_1;
-      default: case_leaf_turn_1 = k_0;
+      default: case_leaf_turn_1 = k_0_1;
     endcase
   end
   always @* begin
     case (leaf_turn)
       1'h0: case_leaf_turn_2 = u1_leaf_buf_valid;
       1'h1: case_leaf_turn_2 = u0_leaf_buf_valid;
-      default: case_leaf_turn_2 = k_0;
+      default: case_leaf_turn_2 = k_0_1;
     endcase
   end
   always @* begin
     case (leaf_turn)
       1'h0: case_leaf_turn_3 = k_1;
-      1'h1: case_leaf_turn_3 = k_0;
-      default: case_leaf_turn_3 = k_0;
+      1'h1: case_leaf_turn_3 = k_0_1;
+      default: case_leaf_turn_3 = k_0_1;
     endcase
   end
-  assign or_25 = case_leaf_turn_2 | case_leaf_turn;
+  assign or_24 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_25;
-  assign eq_26 = mux_case_leaf_turn_2 == k_0;
-  assign u0_leaf_take = leaf_take & eq_26;
+  assign leaf_take = leaf_can_take & or_24;
+  assign eq_25 = mux_case_leaf_turn_2 == k_0_1;
+  assign u0_leaf_take = leaf_take & eq_25;
   assign not_u0_leaf_take = ~u0_leaf_take;
-  assign and_27 = u0_leaf_buf_valid & not_u0_leaf_take;
-  assign u0_leaf_fill_or_and_27 = u0_leaf_fill | and_27;
-  assign eq_28 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_28;
+  assign and_26 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_26 = u0_leaf_fill | and_26;
+  assign eq_27 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_27;
   assign not_u1_leaf_take = ~u1_leaf_take;
-  assign and_29 = u1_leaf_buf_valid & not_u1_leaf_take;
-  assign u1_leaf_fill_or_and_29 = u1_leaf_fill | and_29;
+  assign and_28 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_28 = u1_leaf_fill | and_28;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
@@ -683,11 +684,11 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
     endcase
   end
-  assign cat_30 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_29 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_31 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_31 = leaf_take | and_31;
-  assign mux_leaf_take = leaf_take ? cat_30 : leaf_slot;
+  assign and_30 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_30 = leaf_take | and_30;
+  assign mux_leaf_take = leaf_take ? cat_29 : leaf_slot;
   always @* begin
     case (mux_case_leaf_turn_2)
       1'h0: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
@@ -729,10 +730,10 @@ module fxrt_core (
       default: case_mux_case_leaf_turn_2_5 = u0_buf_leaf_count;
     endcase
   end
-  assign eq_32 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_31 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_32 : leaf_left_eq_k_2;
-  assign cat_33 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign mux_leaf_take_5 = leaf_take ? eq_31 : leaf_left_eq_k_2;
+  assign cat_32 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -772,14 +773,14 @@ module fxrt_core (
   assign u0_done_avail = u_traverse_0_done_valid & not_u0_done_took;
   assign not_u1_done_took = ~u1_done_took;
   assign u1_done_avail = u_traverse_1_done_valid & not_u1_done_took;
-  assign cat_37 = {k_0, u_traverse_0_done_slot};
+  assign cat_36 = {k_0_1, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_39 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_37 : cat_39;
-  assign or_40 = u0_done_avail | u1_done_avail;
-  assign lt_41 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_41 = lt_41 ? u_traverse_1_depth : u_traverse_0_depth;
+  assign cat_38 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_36 : cat_38;
+  assign or_39 = u0_done_avail | u1_done_avail;
+  assign lt_40 = u_traverse_0_depth < u_traverse_1_depth;
+  assign mux_lt_40 = lt_40 ? u_traverse_1_depth : u_traverse_0_depth;
   assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
   assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
   assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -788,23 +789,21 @@ module fxrt_core (
   assign culls_c = rs_u_traverse_0_cull + rs_u_traverse_1_cull;
   assign rs_u_traverse_0_occupied = {{1{1'b0}}, u_traverse_0_occupied};
   assign rs_u_traverse_1_occupied = {{1{1'b0}}, u_traverse_1_occupied};
-  assign occupied_c = rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
+  assign plus_43 = rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   always @(posedge clk) begin : regs
-    if (accept_int) ray_o[accept_slot_int] <= cat_19;
-    if (accept_int) ray_w[accept_slot_int] <= cat_20;
+    if (accept_int) ray_o[accept_slot_int] <= cat_18;
+    if (accept_int) ray_w[accept_slot_int] <= cat_19;
     if (rst) turn <= 1'h0;
-    else turn <= mux_take_or_not_case_turn;
+    else turn <= turn_next;
     if (rst) box_phase <= 2'h0;
-    else box_phase <= mux_or_3;
-    if (rst) u0_has_free_r <= 1'h1;
-    else u0_has_free_r <= u0_has_free;
-    if (rst) u1_has_free_r <= 1'h1;
-    else u1_has_free_r <= u1_has_free;
+    else box_phase <= mux_take_or_box_phase_ne_k_0;
     if (rst) u0_free_slot_r <= 6'h00;
     else u0_free_slot_r <= u0_free_slot;
     if (rst) u1_free_slot_r <= 6'h00;
     else u1_free_slot_r <= u1_free_slot;
+    if (rst) turn_free <= 1'h1;
+    else turn_free <= case_turn_next;
     if (rst) in_valid <= 1'h0;
     else in_valid <= or_1;
     if (port_ready) in_ray_id <= ray_id;
@@ -871,7 +870,7 @@ module fxrt_core (
       box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
     box_done_slot_sr[1] <= box_slot;
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_31;
+    else leaf_active <= leaf_take_or_and_30;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -882,14 +881,14 @@ module fxrt_core (
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
     if (rst) u0_leaf_buf_valid <= 1'h0;
-    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
+    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_26;
     if (u0_leaf_fill) u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
     if (u0_leaf_fill) u0_buf_leaf_first <= u_traverse_0_leaf_first;
     if (u0_leaf_fill) u0_buf_leaf_count <= u_traverse_0_leaf_count;
     if (u0_leaf_fill) u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
     if (u0_leaf_fill) u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
     if (rst) u1_leaf_buf_valid <= 1'h0;
-    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
+    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_28;
     if (u1_leaf_fill) u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
     if (u1_leaf_fill) u1_buf_leaf_first <= u_traverse_1_leaf_first;
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
@@ -897,7 +896,7 @@ module fxrt_core (
     if (u1_leaf_fill) u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
-    emit_tag_sr[1] <= cat_33;
+    emit_tag_sr[1] <= cat_32;
     for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
       emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
     emit_valid_sr[1] <= leaf_active;
@@ -917,8 +916,10 @@ module fxrt_core (
     pipe_w_sr[1] <= ray_w_q;
     u0_done_took <= u0_done_pop;
     u1_done_took <= u1_done_pop;
-    done_valid_r <= or_40;
+    done_valid_r <= or_39;
     done_slot_r <= mux_u0_done_avail;
+    obs_depth_l1_0 <= mux_lt_40;
+    obs_occupied_l1_0 <= plus_43;
   end
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
@@ -1117,10 +1118,10 @@ module fxrt_core (
   assign res_u = u_closest_res_u;
   assign res_v = u_closest_res_v;
   assign busy = pipe_valid;
-  assign stack_depth = mux_lt_41;
+  assign stack_depth = obs_depth_l1_0;
   assign visits = visits_c;
   assign culls = culls_c;
-  assign occupied = occupied_c;
+  assign occupied = obs_occupied_l1_0;
   assign accept = accept_int;
   assign accept_id = acc_in_ray_id;
   assign accept_slot = accept_slot_int;

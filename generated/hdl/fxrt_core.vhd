@@ -466,16 +466,13 @@ architecture rtl of fxrt_core is
   signal u1_free_slot : unsigned(5 downto 0);
   signal turn : unsigned(0 downto 0) := unsigned'("0");
   signal box_phase : unsigned(1 downto 0) := unsigned'("00");
-  signal u0_has_free_r : unsigned(0 downto 0) := unsigned'("1");
-  signal u1_has_free_r : unsigned(0 downto 0) := unsigned'("1");
   signal u0_free_slot_r : unsigned(5 downto 0) := unsigned'("000000");
   signal u1_free_slot_r : unsigned(5 downto 0) := unsigned'("000000");
-  constant k_0 : unsigned(0 downto 0) := unsigned'("0");
-  signal case_turn : unsigned(0 downto 0);
-  signal case_turn_1 : unsigned(5 downto 0);
+  signal turn_free : unsigned(0 downto 0) := unsigned'("1");
+  signal case_turn : unsigned(5 downto 0);
   signal in_valid : unsigned(0 downto 0) := unsigned'("0");
-  constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
-  signal box_phase_eq_k_0_1 : unsigned(0 downto 0);
+  constant k_0 : unsigned(1 downto 0) := unsigned'("00");
+  signal box_phase_eq_k_0 : unsigned(0 downto 0);
   signal and_0 : unsigned(0 downto 0);
   signal take : unsigned(0 downto 0);
   signal not_in_valid : unsigned(0 downto 0);
@@ -496,14 +493,16 @@ architecture rtl of fxrt_core is
   signal take_slot : unsigned(6 downto 0);
   constant k_1 : unsigned(0 downto 0) := unsigned'("1");
   signal turn_plus_1 : unsigned(0 downto 0);
-  signal not_case_turn : unsigned(0 downto 0);
-  signal take_or_not_case_turn : unsigned(0 downto 0);
-  signal mux_take_or_not_case_turn : unsigned(0 downto 0);
-  signal box_phase_ne_k_0_1 : unsigned(0 downto 0);
-  signal or_3 : unsigned(0 downto 0);
+  signal not_turn_free : unsigned(0 downto 0);
+  signal take_or_not_turn_free : unsigned(0 downto 0);
+  signal turn_next : unsigned(0 downto 0);
+  constant k_0_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal case_turn_next : unsigned(0 downto 0);
+  signal box_phase_ne_k_0 : unsigned(0 downto 0);
+  signal take_or_box_phase_ne_k_0 : unsigned(0 downto 0);
   constant k_1_1 : unsigned(1 downto 0) := unsigned'("01");
   signal box_phase_plus_k_1_1 : unsigned(1 downto 0);
-  signal mux_or_3 : unsigned(1 downto 0);
+  signal mux_take_or_box_phase_ne_k_0 : unsigned(1 downto 0);
   signal box_idle : unsigned(0 downto 0);
   signal box_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal box_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -590,12 +589,12 @@ architecture rtl of fxrt_core is
   signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_plane_t : signed(32 downto 0);
   signal rs_box_d1 : signed(32 downto 0);
-  signal minus_7 : signed(32 downto 0);
+  signal minus_6 : signed(32 downto 0);
   signal box_lt1_c : unsigned(0 downto 0);
   signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
   signal rs_plane_t_1 : signed(32 downto 0);
   signal rs_box_d2 : signed(32 downto 0);
-  signal minus_8 : signed(32 downto 0);
+  signal minus_7 : signed(32 downto 0);
   signal box_lt2_c : unsigned(0 downto 0);
   signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
   signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
@@ -604,7 +603,7 @@ architecture rtl of fxrt_core is
   signal box_tmax : signed(31 downto 0);
   signal bits_box_d1 : unsigned(0 downto 0);
   signal bits_box_d2 : unsigned(0 downto 0);
-  signal or_9 : unsigned(0 downto 0);
+  signal or_8 : unsigned(0 downto 0);
   signal bits_box_d3 : unsigned(0 downto 0);
   signal box_miss : unsigned(0 downto 0);
   signal box_last : unsigned(0 downto 0);
@@ -626,16 +625,16 @@ architecture rtl of fxrt_core is
   signal u0_node_word : unsigned(72 downto 0);
   signal u1_node_word : unsigned(72 downto 0);
   signal bits_accept_slot_1 : unsigned(0 downto 0);
-  signal eq_11 : unsigned(0 downto 0);
+  signal eq_10 : unsigned(0 downto 0);
   signal u0_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot : unsigned(0 downto 0);
-  signal eq_12 : unsigned(0 downto 0);
+  signal eq_11 : unsigned(0 downto 0);
   signal u0_new : unsigned(0 downto 0);
   signal bits_merge_slot : unsigned(0 downto 0);
-  signal bits_merge_slot_eq_k_0 : unsigned(0 downto 0);
+  signal bits_merge_slot_eq_k_0_1 : unsigned(0 downto 0);
   signal u0_merge : unsigned(0 downto 0);
   signal bits_free_slot : unsigned(0 downto 0);
-  signal bits_free_slot_eq_k_0 : unsigned(0 downto 0);
+  signal bits_free_slot_eq_k_0_1 : unsigned(0 downto 0);
   signal u0_free : unsigned(0 downto 0);
   signal bits_box_done_slot_1 : unsigned(5 downto 0);
   signal bits_merge_slot_1 : unsigned(5 downto 0);
@@ -658,10 +657,10 @@ architecture rtl of fxrt_core is
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
   signal bits_accept_slot_2 : unsigned(0 downto 0);
-  signal eq_15 : unsigned(0 downto 0);
+  signal eq_14 : unsigned(0 downto 0);
   signal u1_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
-  signal eq_16 : unsigned(0 downto 0);
+  signal eq_15 : unsigned(0 downto 0);
   signal u1_new : unsigned(0 downto 0);
   signal bits_merge_slot_2 : unsigned(0 downto 0);
   signal bits_merge_slot_2_eq_k_1 : unsigned(0 downto 0);
@@ -691,11 +690,11 @@ architecture rtl of fxrt_core is
   signal u_traverse_1_occupied : unsigned(6 downto 0);
   signal u_node_rom_0_data : unsigned(72 downto 0);
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
-  signal cat_19 : unsigned(86 downto 0);
+  signal cat_18 : unsigned(86 downto 0);
   signal u_acc_in_wz : unsigned(31 downto 0);
   signal u_acc_in_wy : unsigned(31 downto 0);
   signal u_acc_in_wx : unsigned(31 downto 0);
-  signal cat_20 : unsigned(95 downto 0);
+  signal cat_19 : unsigned(95 downto 0);
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
@@ -728,24 +727,24 @@ architecture rtl of fxrt_core is
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
   signal case_leaf_turn_3 : unsigned(0 downto 0);
-  signal or_25 : unsigned(0 downto 0);
+  signal or_24 : unsigned(0 downto 0);
   signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
   signal leaf_take : unsigned(0 downto 0);
-  signal eq_26 : unsigned(0 downto 0);
+  signal eq_25 : unsigned(0 downto 0);
   signal u0_leaf_take : unsigned(0 downto 0);
   signal not_u0_leaf_take : unsigned(0 downto 0);
-  signal and_27 : unsigned(0 downto 0);
-  signal u0_leaf_fill_or_and_27 : unsigned(0 downto 0);
-  signal eq_28 : unsigned(0 downto 0);
+  signal and_26 : unsigned(0 downto 0);
+  signal u0_leaf_fill_or_and_26 : unsigned(0 downto 0);
+  signal eq_27 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
   signal not_u1_leaf_take : unsigned(0 downto 0);
-  signal and_29 : unsigned(0 downto 0);
-  signal u1_leaf_fill_or_and_29 : unsigned(0 downto 0);
+  signal and_28 : unsigned(0 downto 0);
+  signal u1_leaf_fill_or_and_28 : unsigned(0 downto 0);
   signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_30 : unsigned(6 downto 0);
+  signal cat_29 : unsigned(6 downto 0);
   signal not_leaf_last_entry : unsigned(0 downto 0);
-  signal and_31 : unsigned(0 downto 0);
-  signal leaf_take_or_and_31 : unsigned(0 downto 0);
+  signal and_30 : unsigned(0 downto 0);
+  signal leaf_take_or_and_30 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
   constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
@@ -760,13 +759,13 @@ architecture rtl of fxrt_core is
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_32 : unsigned(0 downto 0);
+  signal eq_31 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_33 : unsigned(58 downto 0);
+  signal cat_32 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -831,12 +830,12 @@ architecture rtl of fxrt_core is
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
-  signal cat_37 : unsigned(6 downto 0);
+  signal cat_36 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_39 : unsigned(6 downto 0);
+  signal cat_38 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
-  signal or_40 : unsigned(0 downto 0);
+  signal or_39 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal u_closest_merge_valid : unsigned(0 downto 0);
@@ -853,8 +852,9 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal lt_41 : unsigned(0 downto 0);
-  signal mux_lt_41 : unsigned(5 downto 0);
+  signal lt_40 : unsigned(0 downto 0);
+  signal mux_lt_40 : unsigned(5 downto 0);
+  signal obs_depth_l1_0 : unsigned(5 downto 0) := unsigned'("000000");
   signal rs_u_traverse_0_visit : unsigned(2 downto 0);
   signal rs_u_traverse_1_visit : unsigned(2 downto 0);
   signal visits_c : unsigned(2 downto 0);
@@ -863,7 +863,8 @@ architecture rtl of fxrt_core is
   signal culls_c : unsigned(2 downto 0);
   signal rs_u_traverse_0_occupied : unsigned(7 downto 0);
   signal rs_u_traverse_1_occupied : unsigned(7 downto 0);
-  signal occupied_c : unsigned(7 downto 0);
+  signal plus_43 : unsigned(7 downto 0);
+  signal obs_occupied_l1_0 : unsigned(7 downto 0) := unsigned'("00000000");
 begin
 
   u0_has_free <= u_traverse_0_has_free;
@@ -872,32 +873,32 @@ begin
   u1_free_slot <= u_traverse_1_free_slot_out;
   with turn select
     case_turn <=
-      u0_has_free_r when "0",
-      u1_has_free_r when "1",
-      k_0 when others;
-  with turn select
-    case_turn_1 <=
       u0_free_slot_r when "0",
       u1_free_slot_r when "1",
       u0_free_slot_r when others;
-  box_phase_eq_k_0_1 <= "1" when box_phase = k_0_1 else "0";
-  and_0 <= in_valid and box_phase_eq_k_0_1;
-  take <= and_0 and case_turn;
+  box_phase_eq_k_0 <= "1" when box_phase = k_0 else "0";
+  and_0 <= in_valid and box_phase_eq_k_0;
+  take <= and_0 and turn_free;
   not_in_valid <= not in_valid;
   port_ready <= not_in_valid or take;
   not_take <= not take;
   in_valid_and_not_take <= in_valid and not_take;
   or_1 <= ray_valid or in_valid_and_not_take;
-  take_slot <= unsigned(std_logic_vector'(std_logic_vector(turn) & std_logic_vector(case_turn_1)));
+  take_slot <= unsigned(std_logic_vector'(std_logic_vector(turn) & std_logic_vector(case_turn)));
   turn_plus_1 <= turn + k_1;
-  not_case_turn <= not case_turn;
-  take_or_not_case_turn <= take or not_case_turn;
-  mux_take_or_not_case_turn <= turn_plus_1 when take_or_not_case_turn = "1" else turn;
-  box_phase_ne_k_0_1 <= "1" when box_phase /= k_0_1 else "0";
-  or_3 <= take or box_phase_ne_k_0_1;
+  not_turn_free <= not turn_free;
+  take_or_not_turn_free <= take or not_turn_free;
+  turn_next <= turn_plus_1 when take_or_not_turn_free = "1" else turn;
+  with turn_next select
+    case_turn_next <=
+      u0_has_free when "0",
+      u1_has_free when "1",
+      k_0_1 when others;
+  box_phase_ne_k_0 <= "1" when box_phase /= k_0 else "0";
+  take_or_box_phase_ne_k_0 <= take or box_phase_ne_k_0;
   box_phase_plus_k_1_1 <= box_phase + k_1_1;
-  mux_or_3 <= box_phase_plus_k_1_1 when or_3 = "1" else box_phase;
-  box_idle <= "1" when box_phase = k_0_1 else "0";
+  mux_take_or_box_phase_ne_k_0 <= box_phase_plus_k_1_1 when take_or_box_phase_ne_k_0 = "1" else box_phase;
+  box_idle <= "1" when box_phase = k_0 else "0";
   bits_accept_slot <= unsigned(accept_slot_int(5 downto 0));
   box_axis <= box_phase - k_1_1;
   with box_axis select
@@ -906,7 +907,7 @@ begin
       box_in_invz when "10",
       box_in_invx when others;
   box_neg <= unsigned(case_box_axis(47 downto 47));
-  box_issue <= "1" when box_phase /= k_0_1 else "0";
+  box_issue <= "1" when box_phase /= k_0 else "0";
   box_issue_last <= "1" when box_phase = k_3 else "0";
   with box_axis select
     case_box_axis_1 <=
@@ -946,20 +947,20 @@ begin
   pu_first <= pu_clamp_valid and not_pu_clamp_last;
   rs_plane_t <= resize(plane_t, 33);
   rs_box_d1 <= resize(box_d1, 33);
-  minus_7 <= rs_plane_t - rs_box_d1;
-  box_lt1_c <= unsigned(minus_7(32 downto 32));
+  minus_6 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_6(32 downto 32));
   rs_plane_t_1 <= resize(plane_t, 33);
   rs_box_d2 <= resize(box_d2, 33);
-  minus_8 <= rs_plane_t_1 - rs_box_d2;
-  box_lt2_c <= unsigned(minus_8(32 downto 32));
+  minus_7 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_7(32 downto 32));
   box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
   mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
   box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
   bits_box_d1 <= unsigned(box_d1(31 downto 31));
   bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_9 <= bits_box_d1 or bits_box_d2;
+  or_8 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_9 or bits_box_d3;
+  box_miss <= or_8 or bits_box_d3;
   box_last <= plane_t_valid and plane_t_last;
   box_done_slot <= box_done_slot_sr(11);
   merge_valid <= u_closest_merge_valid;
@@ -976,26 +977,26 @@ begin
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
   bits_accept_slot_1 <= unsigned(accept_slot_int(6 downto 6));
-  eq_11 <= "1" when bits_accept_slot_1 = k_0 else "0";
-  u0_alloc <= accept_int and eq_11;
+  eq_10 <= "1" when bits_accept_slot_1 = k_0_1 else "0";
+  u0_alloc <= accept_int and eq_10;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
-  eq_12 <= "1" when bits_box_done_slot = k_0 else "0";
-  u0_new <= box_done and eq_12;
+  eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
+  u0_new <= box_done and eq_11;
   bits_merge_slot <= unsigned(merge_slot(6 downto 6));
-  bits_merge_slot_eq_k_0 <= "1" when bits_merge_slot = k_0 else "0";
-  u0_merge <= merge_valid and bits_merge_slot_eq_k_0;
+  bits_merge_slot_eq_k_0_1 <= "1" when bits_merge_slot = k_0_1 else "0";
+  u0_merge <= merge_valid and bits_merge_slot_eq_k_0_1;
   bits_free_slot <= unsigned(free_slot(6 downto 6));
-  bits_free_slot_eq_k_0 <= "1" when bits_free_slot = k_0 else "0";
-  u0_free <= free_valid and bits_free_slot_eq_k_0;
+  bits_free_slot_eq_k_0_1 <= "1" when bits_free_slot = k_0_1 else "0";
+  u0_free <= free_valid and bits_free_slot_eq_k_0_1;
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
   bits_accept_slot_2 <= unsigned(accept_slot_int(6 downto 6));
-  eq_15 <= "1" when bits_accept_slot_2 = k_1 else "0";
-  u1_alloc <= accept_int and eq_15;
+  eq_14 <= "1" when bits_accept_slot_2 = k_1 else "0";
+  u1_alloc <= accept_int and eq_14;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
-  eq_16 <= "1" when bits_box_done_slot_2 = k_1 else "0";
-  u1_new <= box_done and eq_16;
+  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_15;
   bits_merge_slot_2 <= unsigned(merge_slot(6 downto 6));
   bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
   u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
@@ -1005,11 +1006,11 @@ begin
   bits_box_done_slot_3 <= unsigned(box_done_slot(5 downto 0));
   bits_merge_slot_3 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
-  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
   u_acc_in_wz <= unsigned(acc_in_wz);
   u_acc_in_wy <= unsigned(acc_in_wy);
   u_acc_in_wx <= unsigned(acc_in_wx);
-  cat_20 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
   leaf_last_entry <= leaf_active and leaf_last;
   not_leaf_active <= not leaf_active;
   leaf_can_take <= not_leaf_active or leaf_last_entry;
@@ -1021,45 +1022,45 @@ begin
     case_leaf_turn <=
       u0_leaf_buf_valid when "0",
       u1_leaf_buf_valid when "1",
-      k_0 when others;
+      k_0_1 when others;
   with leaf_turn select
     case_leaf_turn_1 <=
-      k_0 when "0",
+      k_0_1 when "0",
       k_1 when "1",
-      k_0 when others;
+      k_0_1 when others;
   with leaf_turn select
     case_leaf_turn_2 <=
       u1_leaf_buf_valid when "0",
       u0_leaf_buf_valid when "1",
-      k_0 when others;
+      k_0_1 when others;
   with leaf_turn select
     case_leaf_turn_3 <=
       k_1 when "0",
-      k_0 when "1",
-      k_0 when others;
-  or_25 <= case_leaf_turn_2 or case_leaf_turn;
+      k_0_1 when "1",
+      k_0_1 when others;
+  or_24 <= case_leaf_turn_2 or case_leaf_turn;
   mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_25;
-  eq_26 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
-  u0_leaf_take <= leaf_take and eq_26;
+  leaf_take <= leaf_can_take and or_24;
+  eq_25 <= "1" when mux_case_leaf_turn_2 = k_0_1 else "0";
+  u0_leaf_take <= leaf_take and eq_25;
   not_u0_leaf_take <= not u0_leaf_take;
-  and_27 <= u0_leaf_buf_valid and not_u0_leaf_take;
-  u0_leaf_fill_or_and_27 <= u0_leaf_fill or and_27;
-  eq_28 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_28;
+  and_26 <= u0_leaf_buf_valid and not_u0_leaf_take;
+  u0_leaf_fill_or_and_26 <= u0_leaf_fill or and_26;
+  eq_27 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_27;
   not_u1_leaf_take <= not u1_leaf_take;
-  and_29 <= u1_leaf_buf_valid and not_u1_leaf_take;
-  u1_leaf_fill_or_and_29 <= u1_leaf_fill or and_29;
+  and_28 <= u1_leaf_buf_valid and not_u1_leaf_take;
+  u1_leaf_fill_or_and_28 <= u1_leaf_fill or and_28;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
       u0_buf_leaf_slot when "0",
       u1_buf_leaf_slot when "1",
       u0_buf_leaf_slot when others;
-  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_31 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_31 <= leaf_take or and_31;
-  mux_leaf_take <= cat_30 when leaf_take = "1" else leaf_slot;
+  and_30 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_30 <= leaf_take or and_30;
+  mux_leaf_take <= cat_29 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
       u0_buf_leaf_first when "0",
@@ -1091,10 +1092,10 @@ begin
       u0_buf_leaf_count when "0",
       u1_buf_leaf_count when "1",
       u0_buf_leaf_count when others;
-  eq_32 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  eq_31 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_32 when leaf_take = "1" else leaf_left_eq_k_2;
-  cat_33 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  mux_leaf_take_5 <= eq_31 when leaf_take = "1" else leaf_left_eq_k_2;
+  cat_32 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -1134,14 +1135,14 @@ begin
   u0_done_avail <= u_traverse_0_done_valid and not_u0_done_took;
   not_u1_done_took <= not u1_done_took;
   u1_done_avail <= u_traverse_1_done_valid and not_u1_done_took;
-  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_37 when u0_done_avail = "1" else cat_39;
-  or_40 <= u0_done_avail or u1_done_avail;
-  lt_41 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
-  mux_lt_41 <= u_traverse_1_depth when lt_41 = "1" else u_traverse_0_depth;
+  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_36 when u0_done_avail = "1" else cat_38;
+  or_39 <= u0_done_avail or u1_done_avail;
+  lt_40 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
+  mux_lt_40 <= u_traverse_1_depth when lt_40 = "1" else u_traverse_0_depth;
   rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
   rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
   visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
@@ -1150,36 +1151,26 @@ begin
   culls_c <= rs_u_traverse_0_cull + rs_u_traverse_1_cull;
   rs_u_traverse_0_occupied <= resize(u_traverse_0_occupied, 8);
   rs_u_traverse_1_occupied <= resize(u_traverse_1_occupied, 8);
-  occupied_c <= rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
+  plus_43 <= rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
       if accept_int = "1" then
-        ray_o(to_integer(accept_slot_int)) <= cat_19;
+        ray_o(to_integer(accept_slot_int)) <= cat_18;
       end if;
       if accept_int = "1" then
-        ray_w(to_integer(accept_slot_int)) <= cat_20;
+        ray_w(to_integer(accept_slot_int)) <= cat_19;
       end if;
       if rst = '1' then
         turn <= unsigned'("0");
       else
-        turn <= mux_take_or_not_case_turn;
+        turn <= turn_next;
       end if;
       if rst = '1' then
         box_phase <= unsigned'("00");
       else
-        box_phase <= mux_or_3;
-      end if;
-      if rst = '1' then
-        u0_has_free_r <= unsigned'("1");
-      else
-        u0_has_free_r <= u0_has_free;
-      end if;
-      if rst = '1' then
-        u1_has_free_r <= unsigned'("1");
-      else
-        u1_has_free_r <= u1_has_free;
+        box_phase <= mux_take_or_box_phase_ne_k_0;
       end if;
       if rst = '1' then
         u0_free_slot_r <= unsigned'("000000");
@@ -1190,6 +1181,11 @@ begin
         u1_free_slot_r <= unsigned'("000000");
       else
         u1_free_slot_r <= u1_free_slot;
+      end if;
+      if rst = '1' then
+        turn_free <= unsigned'("1");
+      else
+        turn_free <= case_turn_next;
       end if;
       if rst = '1' then
         in_valid <= unsigned'("0");
@@ -1297,7 +1293,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_31;
+        leaf_active <= leaf_take_or_and_30;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -1314,7 +1310,7 @@ begin
       if rst = '1' then
         u0_leaf_buf_valid <= unsigned'("0");
       else
-        u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
+        u0_leaf_buf_valid <= u0_leaf_fill_or_and_26;
       end if;
       if u0_leaf_fill = "1" then
         u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
@@ -1334,7 +1330,7 @@ begin
       if rst = '1' then
         u1_leaf_buf_valid <= unsigned'("0");
       else
-        u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
+        u1_leaf_buf_valid <= u1_leaf_fill_or_and_28;
       end if;
       if u1_leaf_fill = "1" then
         u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
@@ -1352,7 +1348,7 @@ begin
         u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
       end if;
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_33;
+      emit_tag_sr(1) <= cat_32;
       emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
       emit_valid_sr(1) <= leaf_active;
       pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
@@ -1367,8 +1363,10 @@ begin
       pipe_w_sr(1) <= ray_w_q;
       u0_done_took <= u0_done_pop;
       u1_done_took <= u1_done_pop;
-      done_valid_r <= or_40;
+      done_valid_r <= or_39;
       done_slot_r <= mux_u0_done_avail;
+      obs_depth_l1_0 <= mux_lt_40;
+      obs_occupied_l1_0 <= plus_43;
     end if;
   end process regs;
 
@@ -1578,10 +1576,10 @@ begin
   res_u <= u_closest_res_u;
   res_v <= u_closest_res_v;
   busy <= pipe_valid;
-  stack_depth <= mux_lt_41;
+  stack_depth <= obs_depth_l1_0;
   visits <= visits_c;
   culls <= culls_c;
-  occupied <= occupied_c;
+  occupied <= obs_occupied_l1_0;
   accept <= accept_int;
   accept_id <= acc_in_ray_id;
   accept_slot <= accept_slot_int;

@@ -211,9 +211,13 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
         b.next(r, x);
         r
     };
-    let has_free: Vec<S> = has_free_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_has_free_r"), x, 1)).collect();
     let free_idx: Vec<S> = free_idx_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_free_slot_r"), x, 0)).collect();
-    let turn_free = if units == 1 { has_free[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, has_free[u as usize])).collect::<Vec<_>>(), b.konst(bit, 0)) };
+    // Whether the unit whose turn it is has a free slot, as one register: chosen by the next
+    // turn among the units' outputs (what copies of them would hold next clock), it equals the
+    // choice by `turn` among such copies, so the take — which loads every port register, a net
+    // across the die — depends on three registers through one LUT (with four units the choice
+    // after the copies cost 9.6 ns: 103.8 MHz).
+    let turn_free = b.reg("turn_free", bit, Some(1));
     let turn_slot = if units == 1 { free_idx[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, free_idx[u as usize])).collect::<Vec<_>>(), free_idx[0]) };
     // The ray port's register: a ray waits in it for the box-exit unit and a slot. The port is
     // ready when the register is empty or its ray is taken this clock (no path from ray_valid
@@ -231,7 +235,10 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let take_slot = if ub == 0 { turn_slot } else { b.cat(&[turn.resize(ub), turn_slot]) }.name("take_slot");
     let next_turn = (turn + 1).name("turn_plus_1");
     let next_turn = if units.is_power_of_two() { next_turn } else { next_turn.eq(units as i128).select(turn.k(0), next_turn) };
-    b.next(turn, (take | !turn_free).select(next_turn, turn));
+    let turn_next = (take | !turn_free).select(next_turn, turn).name("turn_next");
+    b.next(turn, turn_next);
+    let pick = |u: u32| (u as u128, has_free_w[u as usize]);
+    b.next(turn_free, if units == 1 { has_free_w[0] } else { b.case(turn_next, &(0..units).map(pick).collect::<Vec<_>>(), b.konst(bit, 0)) });
     b.next(phase, (take | phase.ne(0)).select(phase + 1, phase));
     // The box-exit unit's operands load whenever it is idle: when a ray is taken they hold it.
     let idle = phase.eq(0).name("box_idle");
@@ -485,16 +492,29 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
         b.output(name, res.get(name));
     }
     // Observation ports for `fxrt sim`: a triangle entering the pipeline, the deepest stack in
-    // the units' N stages, node visits and culls this clock, slots holding a ray.
+    // the units' N stages, node visits and culls this clock, slots holding a ray. The deepest
+    // stack and the occupied slots come through a tree with a register after each level (a
+    // clock per level of log2 U: a frame's maximum and sums hardly notice), so these counters
+    // are never the core's slowest path (four units' chained maxima were: 102.5 MHz).
     b.output("busy", valid_d);
     let sum = |port: &str, w: u32| {
         trav.iter().map(|t| t.get(port).resize(w)).reduce(|a, c| a + c).expect("one unit or more")
     };
-    let depth = trav.iter().map(|t| t.get("depth")).reduce(|a, c| a.max(c)).expect("one unit or more");
-    b.output("stack_depth", depth);
+    fn tree<'b>(b: &'b Builder, name: &str, mut level: Vec<S<'b>>, join: impl Fn(S<'b>, S<'b>) -> S<'b>) -> S<'b> {
+        let mut depth = 0;
+        while level.len() > 1 {
+            depth += 1;
+            let next: Vec<S<'b>> = level.chunks(2).map(|p| if p.len() == 2 { join(p[0], p[1]) } else { p[0] }).collect();
+            level = next.into_iter().enumerate().map(|(i, x)| b.delay(&format!("{name}_l{depth}_{i}"), x)).collect();
+        }
+        level[0]
+    }
+    let depths = trav.iter().map(|t| t.get("depth")).collect();
+    b.output("stack_depth", tree(&b, "obs_depth", depths, |a, c| a.max(c)));
     b.output("visits", sum("visit", 3).name("visits_c"));
     b.output("culls", sum("cull", 3).name("culls_c"));
-    b.output("occupied", sum("occupied", gb + 1).name("occupied_c"));
+    let occupied = trav.iter().map(|t| t.get("occupied").resize(gb + 1)).collect();
+    b.output("occupied", tree(&b, "obs_occupied", occupied, |a, c| a + c));
     // The walk of every slot (for the visit-order check): the ray written into a slot, and each
     // unit's node visits.
     b.output("accept", accept);
