@@ -33,10 +33,16 @@ const DEFAULT: u32 = fxrt::cores::clock::DEFAULT_TARGET_MHZ;
 /// A frame through the core built for `target_mhz`, in the Rust simulator: its ids must equal
 /// `fxrt render`'s.
 fn rust_frame(name: &str, size: u32, target_mhz: u32) {
-    let s = scene(name);
+    let shape = (Params::default().leaf_size, fxrt::cores::top::DEFAULT_SLOTS, fxrt::cores::top::DEFAULT_UNITS);
+    rust_frame_shaped(name, size, target_mhz, shape);
+}
+
+/// The same for a core of `slots` × `units` on a tree of leaves up to `leaf_size`.
+fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, (leaf_size, slots, units): (u32, u32, u32)) {
+    let s = Scene::load(&SceneSource::Builtin(name.into()), &Params { leaf_size, ..Params::default() }).unwrap();
     let roms = SceneRoms::of(&s);
     let cam = Camera::default_for(&s, size, size);
-    let p = CoreParams::new(&roms, 16, 1, target_mhz);
+    let p = CoreParams::with_slots(&roms, 16, 1, target_mhz, slots, units);
     let rays = frame_rays(&s, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(mismatches(&s, &rays, &results), 0, "{name}");
@@ -68,6 +74,13 @@ fn rust_frame(name: &str, size: u32, target_mhz: u32) {
 #[test]
 fn rust_teapot_128() {
     rust_frame("teapot", 128, DEFAULT);
+}
+
+/// The throughput build of docs/TIMING.md (four units of 32 slots, leaves of up to three
+/// triangles: 10 Mrays/s on the LFE5U-85F).
+#[test]
+fn rust_teapot_128_four_units_leaf_3() {
+    rust_frame_shaped("teapot", 128, DEFAULT, (3, 32, 4));
 }
 
 #[test]
