@@ -384,6 +384,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         files.push((path.clone(), ids.iter().flat_map(|i| i.to_le_bytes()).collect()));
     }
     crate::io::write_all_atomic(&files)?;
+    let counted = c.sim.name() == "rust";
     let mut line = serde_json::json!({
         "scene": scene.name, "simulator": c.sim.name(), "size": format!("{w}x{h}"),
         "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
@@ -392,8 +393,10 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
         "rays_per_clock": (stats.rays_per_clock() * 1e5).round() / 1e5,
         "triangle_tests_per_ray": (stats.triangle_tests_per_ray() * 100.0).round() / 100.0,
-        "node_steps_per_ray": (stats.node_steps_per_ray() * 100.0).round() / 100.0,
-        "slot_occupancy": (stats.slot_occupancy() * 10000.0).round() / 10000.0,
+        // The HDL testbenches count neither node steps nor occupied slots (`CoreStats`): null
+        // there rather than a zero that reads as measured.
+        "node_steps_per_ray": counted.then(|| (stats.node_steps_per_ray() * 100.0).round() / 100.0),
+        "slot_occupancy": counted.then(|| (stats.slot_occupancy() * 10000.0).round() / 10000.0),
         "slots": p.slot_count(), "units": p.units,
         "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
         "shuffle_seed": c.shuffle_seed, "stall_percent": c.stalls.map_or(0, |s| s.0),
