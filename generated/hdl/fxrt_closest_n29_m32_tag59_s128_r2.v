@@ -313,7 +313,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   reg [63:0] m2_u_v = 64'h0000000000000000;
   wire [29:0] bits_slot_t_tri;
   reg [29:0] m2_slot_t_1 = 30'h00000000;
-  wire [0:0] best_we;
+  wire [0:0] m1_we;
+  reg [0:0] best_we = 1'h0;
   wire [29:0] bits_m2_t_tri;
   wire [29:0] merged_t;
   wire [30:0] rs_merged_t;
@@ -1276,7 +1277,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign not_m1_leaf_empty = ~m1_leaf_empty;
   assign m1_hit = m1_slot_has | not_m1_leaf_empty;
   assign bits_slot_t_tri = slot_t_tri[42:13];
-  assign best_we = m2 & m2_better;
+  assign m1_we = m1 & leaf_better;
   assign bits_m2_t_tri = m2_t_tri[42:13];
   assign merged_t = m2_better ? bits_m2_t_tri : m2_slot_t_1;
   assign rs_merged_t = {{1{1'b0}}, merged_t};
@@ -1947,6 +1948,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     m2_t_tri <= m1_t_tri;
     m2_u_v <= m1_u_v;
     m2_slot_t_1 <= bits_slot_t_tri;
+    best_we <= m1_we;
     merge_valid_r <= m2;
     merge_slot_r <= m2_slot;
     merge_hit_r <= m2_hit;

@@ -692,7 +692,8 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal m2_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal bits_slot_t_tri : unsigned(29 downto 0);
   signal m2_slot_t_1 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal best_we : unsigned(0 downto 0);
+  signal m1_we : unsigned(0 downto 0);
+  signal best_we : unsigned(0 downto 0) := unsigned'("0");
   signal bits_m2_t_tri : unsigned(29 downto 0);
   signal merged_t : unsigned(29 downto 0);
   signal rs_merged_t : unsigned(30 downto 0);
@@ -1638,7 +1639,7 @@ begin
   not_m1_leaf_empty <= not m1_leaf_empty;
   m1_hit <= m1_slot_has or not_m1_leaf_empty;
   bits_slot_t_tri <= unsigned(slot_t_tri(42 downto 13));
-  best_we <= m2 and m2_better;
+  m1_we <= m1 and leaf_better;
   bits_m2_t_tri <= unsigned(m2_t_tri(42 downto 13));
   merged_t <= bits_m2_t_tri when m2_better = "1" else m2_slot_t_1;
   rs_merged_t <= resize(merged_t, 31);
@@ -2307,6 +2308,7 @@ begin
       m2_t_tri <= m1_t_tri;
       m2_u_v <= m1_u_v;
       m2_slot_t_1 <= bits_slot_t_tri;
+      best_we <= m1_we;
       merge_valid_r <= m2;
       merge_slot_r <= m2_slot;
       merge_hit_r <= m2_hit;
