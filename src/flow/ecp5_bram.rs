@@ -92,11 +92,10 @@ impl Bank {
 /// power-of-two padding no longer costs blocks: the teapot's 6,320 triangles of 124 bits are
 /// 4,096 words in 4K×4 (31 blocks), 2,048 in 2K×9 (14) and 176 in 1K×18 (7), 52 blocks, where
 /// 8K×2 took 62. Each bank's base is a multiple of its depth, so its select is a compare of the
-/// address's top bits. None when no layout holds it (deeper than 16K words in one bank and
-/// not split) — cannot happen for a split.
-pub fn banks(words: usize, width: u32) -> Option<Vec<Bank>> {
+/// address's top bits.
+pub fn banks(words: usize, width: u32) -> Vec<Bank> {
     let depth = crate::scene::rom::rom_depth(words);
-    let whole = config(depth).map(|(w, d)| vec![Bank { base: 0, abits: d.trailing_zeros().min(depth.trailing_zeros()), w }]);
+    let whole = config(depth).map(|(w, _)| vec![Bank { base: 0, abits: depth.trailing_zeros(), w }]);
     let mut split = Vec::new();
     let mut base = 0;
     while base < words {
@@ -111,8 +110,8 @@ pub fn banks(words: usize, width: u32) -> Option<Vec<Bank>> {
     }
     let cost = |v: &Vec<Bank>| v.iter().map(|b| b.blocks(width)).sum::<usize>();
     match whole {
-        Some(whole) if cost(&whole) <= cost(&split) => Some(whole),
-        _ => Some(split),
+        Some(whole) if cost(&whole) <= cost(&split) => whole,
+        _ => split,
     }
 }
 
@@ -125,7 +124,7 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
     if rom.words.len() < MIN_WORDS {
         return None;
     }
-    let layout = banks(rom.words.len(), rom.width)?;
+    let layout = banks(rom.words.len(), rom.width);
     let abits = crate::scene::rom::rom_addr_bits(rom.words.len());
     let end = generated.find("\n);\n")? + 4;
     let mut v = String::from(&generated[..end]);
@@ -159,11 +158,11 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
                 );
             }
         } else {
-            let (w, cfg_depth) = (bank.w, 1usize << bank.abits);
-            let cfg_depth = CONFIGS.iter().find(|c| c.0 == w).map_or(cfg_depth, |c| c.1);
+            let w = bank.w;
+            let cfg_depth = CONFIGS.iter().find(|c| c.0 == w).expect("a DP16KD width").1;
             let shift = (16384 / cfg_depth).trailing_zeros();
             let blocks = bank.blocks(rom.width);
-            let bank_abits = bank.abits.min(abits);
+            let bank_abits = bank.abits;
             let address = |pin: &str, addr: &str| -> String {
                 (0..14u32)
                     .map(|p| match p.checked_sub(shift) {
@@ -323,14 +322,14 @@ mod tests {
     #[test]
     fn banks_cover_the_words_and_save_blocks() {
         let blocks = |v: &[Bank], w| v.iter().map(|b| b.blocks(w)).sum::<usize>();
-        assert_eq!(banks(6320, 124).unwrap().iter().map(|b| (b.base, b.w)).collect::<Vec<_>>(), [(0, 4), (4096, 9), (6144, 18)]);
-        assert_eq!(blocks(&banks(6320, 124).unwrap(), 124), 31 + 14 + 7);
-        assert_eq!(blocks(&banks(4450, 76).unwrap(), 76), 19 + 5, "not 38 of 8K×2");
-        assert_eq!(banks(6240, 76).unwrap().last(), Some(&Bank { base: 6144, abits: 7, w: 0 }), "96 words in LUTs");
-        assert_eq!(banks(8192, 76).unwrap(), [Bank { base: 0, abits: 13, w: 2 }], "a full depth stays one bank");
-        assert_eq!(banks(3000, 20).unwrap(), [Bank { base: 0, abits: 12, w: 4 }], "no saving, no split");
+        assert_eq!(banks(6320, 124).iter().map(|b| (b.base, b.w)).collect::<Vec<_>>(), [(0, 4), (4096, 9), (6144, 18)]);
+        assert_eq!(blocks(&banks(6320, 124), 124), 31 + 14 + 7);
+        assert_eq!(blocks(&banks(4450, 76), 76), 19 + 5, "not 38 of 8K×2");
+        assert_eq!(banks(6240, 76).last(), Some(&Bank { base: 6144, abits: 7, w: 0 }), "96 words in LUTs");
+        assert_eq!(banks(8192, 76), [Bank { base: 0, abits: 13, w: 2 }], "a full depth stays one bank");
+        assert_eq!(banks(3000, 20), [Bank { base: 0, abits: 12, w: 4 }], "no saving, no split");
         for words in [128, 1000, 1025, 3000, 4097, 5000, 6240, 6320, 12_345, 16_384, 40_000] {
-            let v = banks(words, 76).unwrap();
+            let v = banks(words, 76);
             let mut next = 0;
             for b in &v {
                 assert_eq!(b.base, next, "{words}: {v:?}");
