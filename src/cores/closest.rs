@@ -90,8 +90,9 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     // accumulator's compare starts from registers (a result arrives two cycles later;
     // nothing else changes).
     let reg = |name: &str, x, k: u32| if staged { b.delay_line(&format!("in_{name}"), x, k) } else { x };
+    let vreg = |name: &str, x, k: u32| if staged { b.valid_line(&format!("in_{name}"), x, k) } else { x };
     let (x, t8) = (reg("tmin_less", x, 1), reg("t_plus_8", t8, 1));
-    let (valid1, hit1) = (reg("valid", valid, 1), reg("hit", hit, 1));
+    let (valid1, hit1) = (vreg("valid", valid, 1), reg("hit", hit, 1));
     let accepted = (!lt_chain(t8, x)).name("accepted");
     // Held inverted, the accumulator's compare taking it as its top bit (below); staged, its
     // register resets to 1 (no candidate).
@@ -103,7 +104,7 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     } else {
         no_candidate
     };
-    let (valid, first, last) = (reg("valid2", valid, 2), reg("first", first, 2), reg("last", last, 2));
+    let (valid, first, last) = (vreg("valid2", valid, 2), reg("first", first, 2), reg("last", last, 2));
     let (tri, slot, sp) = (reg("tri", tri, 2), reg("slot", slot, 2), reg("sp", sp, 2));
     let (t, u, v) = (reg("t", t, 2), reg("u", u, 2), reg("v", v, 2));
 
@@ -135,11 +136,11 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     // The merge: fin (the cycle after a leaf's last triangle: the accumulator is final), M1
     // (the leaf's best and the slot's, read at fin's address one clock before), M2 (the
     // compare's result: write the slot's best, report the merge).
-    let fin = b.delay("fin", (valid & last).name("leaf_last"));
+    let fin = b.valid_delay("fin", (valid & last).name("leaf_last"));
     let fin_slot = b.delay("fin_slot", slot);
     let fin_sp = b.delay("fin_sp", sp);
     let st_tt = b.read("slot_t_tri", tt_mem, fin_slot);
-    let m1 = b.delay("m1", fin);
+    let m1 = b.valid_delay("m1", fin);
     let m1_slot = b.delay("m1_slot", fin_slot);
     let m1_sp = b.delay("m1_sp", fin_sp);
     // The slot's has-best bit over two clocks: from the leaf's slot while its last triangle is
@@ -152,7 +153,7 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     // The leaf's best replaces the slot's when (¬leaf hit, 0, leaf t, tri) < (0, ¬slot hit,
     // slot t, tri): one chain again.
     let better = lt_chain(b.cat(&[m1_empty, zero, m1_tt]), b.cat(&[zero, !m1_has, st_tt])).name("leaf_better");
-    let m2 = b.delay("m2", m1);
+    let m2 = b.valid_delay("m2", m1);
     let m2_better = b.delay("m2_better", better);
     let m2_hit = b.delay("m2_hit", (m1_has | !m1_empty).name("m1_hit"));
     let m2_slot = b.delay("m2_slot", m1_slot);
@@ -163,12 +164,12 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     // The write enable is one register of its own (not m2 ∧ m2_better after them): it fans
     // out to every LUT-RAM cell of both best RAMs, spread over the die, and the AND's LUT
     // placed between them cost three placement seeds of the four-unit core 10.8–14.2 ns.
-    let we = b.delay("best_we", (m1 & better).name("m1_we"));
+    let we = b.valid_delay("best_we", (m1 & better).name("m1_we"));
     b.ram_write(tt_mem, we, m2_slot, m2_tt);
     b.ram_write(uv_mem, we, m2_slot, m2_uv);
     let best_t = m2_better.select(m2_tt.slice(tri.width(), t.width()), m2_slot_t).name("merged_t");
     let limit = (best_t.xsigned().resize(dist) + 8).name("merged_limit");
-    b.output("merge_valid", b.delay("merge_valid_r", m2));
+    b.output("merge_valid", b.valid_delay("merge_valid_r", m2));
     b.output("merge_slot", b.delay("merge_slot_r", m2_slot));
     b.output("merge_hit", b.delay("merge_hit_r", m2_hit));
     b.output("merge_limit", b.delay("merge_limit_r", limit));
@@ -177,12 +178,12 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     // A ray done: its best hit and id are read, then sent out; the slot is freed.
     // d0 holds the done slot here, by the RAMs and the slots' bits (the top's register that
     // feeds `done_slot` sits by its arbiter); the has-best bit is selected over d0 and d1.
-    let d0 = b.delay("d0", done_valid);
+    let d0 = b.valid_delay("d0", done_valid);
     let d0_slot = b.delay("d0_slot", done_slot);
     let d_tt = b.read("done_t_tri", tt_mem, d0_slot);
     let d_uv = b.read("done_u_v", uv_mem, d0_slot);
     let d_id = b.read("done_id", id_mem, d0_slot);
-    let d1 = b.delay("d1", d0);
+    let d1 = b.valid_delay("d1", d0);
     let d1_slot = b.delay("d1_slot", d0_slot);
     let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, done_slot, d0_slot));
     let none = b.konst(Ty::u(k), 0);
@@ -192,7 +193,7 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     let set = we.select(b.delay("m2_onehot", super::onehot(m1_slot, k)), none).name("best_set");
     let clear = d1.select(b.delay("d1_onehot", super::onehot(d0_slot, k)), none).name("best_clear");
     b.next(best_valid, (best_valid & !clear) | set);
-    b.output("free_valid", b.delay("free_valid_r", d1));
+    b.output("free_valid", b.valid_delay("free_valid_r", d1));
     b.output("free_slot", b.delay("free_slot_r", d1_slot));
     let res = |name: &str, x, masked: bool| {
         let x = if masked { d1_has.select(x, x.k(0)) } else { x };

@@ -273,7 +273,7 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
     let x = pipe.stage(
         "inputs",
         "register the inputs",
-        Inputs { valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q },
+        Inputs { valid: pipe.valid(valid), tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q },
     );
     // Permute by r: (r, p, q) = (r, r+1 mod 3, r+2 mod 3).
     let sel_p = next_axis(x.r).name("perm_p");

@@ -76,18 +76,18 @@ pub fn plane_unit<'b>(
     product: MulStyle,
 ) -> PlaneResult<'b> {
     // 1. select
-    let valid = b.delay("pu_sel_valid", issue.valid);
+    let valid = b.valid_delay("pu_sel_valid", issue.valid);
     let last = b.delay("pu_sel_last", issue.last);
     let plane = b.delay("pu_sel_plane", issue.plane);
     let axis = b.delay("pu_sel_axis", issue.axis);
     // 2. delta: P − O never leaves ±(2^n − 1), so n + 1 signed bits hold it.
     let delta = b.delay("pu_delta", (plane.xsigned() - b.pick(axis, o).xsigned()).name("pu_diff"));
     let inv_a = b.delay("pu_inv", b.pick(axis, inv).name("pu_inv_axis"));
-    let (valid, last) = (b.delay("pu_delta_valid", valid), b.delay("pu_delta_last", last));
+    let (valid, last) = (b.valid_delay("pu_delta_valid", valid), b.delay("pu_delta_last", last));
     // 3. product
     let product_style = product;
     let (product, product_latency) = plane_product(b, delta, inv_a, product);
-    let valid = b.delay_line("pu_product_valid", valid, product_latency);
+    let valid = b.valid_line("pu_product_valid", valid, product_latency);
     let last = b.delay_line("pu_product_last", last, product_latency);
     // 4. clamp. The two range tests are bit reductions, not compares with constants: yosys
     // builds those as two carry chains of the shifted product's full width (62 bits by
@@ -114,7 +114,7 @@ pub fn plane_unit<'b>(
             b.delay("pu_above_r", above),
             b.delay("pu_below_r", below),
             b.delay("pu_low_r", low),
-            b.delay("pu_clamp_valid", valid),
+            b.valid_delay("pu_clamp_valid", valid),
             b.delay("pu_clamp_last", last),
         )
     } else {
@@ -137,7 +137,7 @@ pub fn plane_unit<'b>(
         t,
         t_last,
         t_first,
-        valid: b.delay("plane_t_valid", valid),
+        valid: b.valid_delay("plane_t_valid", valid),
         last: b.delay("plane_t_last", last),
         latency: 3 + product_latency + split as u32,
     }

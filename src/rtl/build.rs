@@ -148,6 +148,16 @@ impl Builder {
         self.s(self.m.borrow_mut().delay(name, x.sig))
     }
 
+    /// `x` one clock later in a register `rst` clears: a valid bit.
+    pub fn valid_delay(&self, name: &str, x: S<'_>) -> S<'_> {
+        self.valid_line(name, x, 1)
+    }
+
+    /// `x` `depth` clocks later in registers `rst` clears: a valid bit (`Module::valid_line`).
+    pub fn valid_line(&self, name: &str, x: S<'_>, depth: u32) -> S<'_> {
+        self.s(self.m.borrow_mut().valid_line(name, x.sig, depth))
+    }
+
     /// `x` `depth` clocks later (a shift register).
     pub fn delay_line(&self, name: &str, x: S<'_>, depth: u32) -> S<'_> {
         self.s(self.m.borrow_mut().delay_line(name, x.sig, depth))

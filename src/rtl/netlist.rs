@@ -337,6 +337,19 @@ impl Module {
         r
     }
 
+    /// `src` `depth` clocks later in registers that `rst` clears: a valid bit, so that a reset
+    /// leaves nothing in flight (a data shift register may keep its contents).
+    pub fn valid_line(&mut self, name: &str, src: Sig, depth: u32) -> Sig {
+        let mut prev = src;
+        for k in 0..depth {
+            let stage = if depth == 1 { name.to_string() } else { format!("{name}_{}", k + 1) };
+            let r = self.reg(&stage, src.ty, Some(0));
+            self.connect(r, prev, None);
+            prev = r;
+        }
+        prev
+    }
+
     /// `src` delayed by `depth` clock cycles (`src` itself for 0; a register for 1).
     pub fn delay_line(&mut self, name: &str, src: Sig, depth: u32) -> Sig {
         match depth {

@@ -61,6 +61,9 @@ pub struct Pipeline<'b> {
     stage: Cell<u32>,
     /// Every stage name seen, to check the policy's names against.
     names: RefCell<Vec<String>>,
+    /// Valid bits (`valid`) and their copies: their registers are cleared by `rst`, so a
+    /// reset leaves nothing in flight.
+    valids: RefCell<std::collections::BTreeSet<u32>>,
 }
 
 impl<'b> Pipeline<'b> {
@@ -75,7 +78,24 @@ impl<'b> Pipeline<'b> {
             delayed: RefCell::new(BTreeMap::new()),
             stage: Cell::new(0),
             names: RefCell::new(Vec::new()),
+            valids: RefCell::new(Default::default()),
         }
+    }
+
+    /// Marks `x` as a valid bit: every register that carries it down the pipeline is one that
+    /// `rst` clears.
+    pub fn valid(&self, x: S<'b>) -> S<'b> {
+        self.valids.borrow_mut().insert(x.sig.id.0);
+        x
+    }
+
+    fn is_valid(&self, x: S<'b>) -> bool {
+        self.valids.borrow().contains(&x.sig.id.0)
+    }
+
+    /// `x` `d` clocks later: a valid line for a valid bit, else a shift register.
+    fn delayed_copy(&self, name: &str, x: S<'b>, d: u32) -> S<'b> {
+        if self.is_valid(x) { self.valid(self.b.valid_line(name, x, d)) } else { self.b.delay_line(name, x, d) }
     }
 
     /// The stage a signal is produced in.
@@ -110,7 +130,7 @@ impl<'b> Pipeline<'b> {
             .next_back()
             .map_or((x, 0), |(k, s)| (*s, k.1));
         let name = format!("{}_d{d}", self.b.name_of(x.sig));
-        let s = self.b.delay_line(&name, base, d - from);
+        let s = self.delayed_copy(&name, base, d - from);
         self.delayed.borrow_mut().insert(key, s);
         s
     }
@@ -137,7 +157,7 @@ impl<'b> Pipeline<'b> {
         // The registers are the first signals of stage k (and printed in this block).
         self.bounds.borrow_mut().push(self.next_id());
         self.stage.set(k);
-        let registered = aligned.map_fields(&mut |field, s| self.b.delay(&format!("s{k}_{field}"), s));
+        let registered = aligned.map_fields(&mut |field, s| self.delayed_copy(&format!("s{k}_{field}"), s, 1));
         self.b.with(|m| {
             m.end_block();
             m.begin_block(&format!("s{}", k + 1), "", BlockKind::Stage);

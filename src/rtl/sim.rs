@@ -128,6 +128,26 @@ impl Sim {
         }
     }
 
+    /// Fills every register, every RAM read register and every written memory with seeded
+    /// random bits (ROMs keep their contents): an arbitrary state, as at power-up or in the
+    /// middle of any computation. A reset test scrambles, resets for one clock and expects
+    /// the design to work from there.
+    pub fn scramble(&mut self, seed: u64) {
+        let mut rng = crate::rng::SplitMix64(seed);
+        let mut random = |ty: Ty| ty.wrap(((rng.next_u64() as u128) << 64 | rng.next_u64() as u128) as i128);
+        let dsts: Vec<usize> = self.regs.iter().map(|r| r.dst).chain(self.rom_reads.iter().map(|r| r.dst)).collect();
+        for i in dsts {
+            self.vals[i] = random(self.tys[i]);
+        }
+        for &(mem, _, _, data) in &self.writes {
+            let ty = self.tys[data];
+            for w in self.roms[mem].iter_mut() {
+                *w = random(ty);
+            }
+        }
+        self.eval();
+    }
+
     /// One rising clock edge: evaluate, latch every register and ROM read, evaluate again so
     /// outputs show the new state.
     pub fn tick(&mut self) {
