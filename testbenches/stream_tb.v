@@ -5,6 +5,15 @@
 // {{ stalls }}: the source's stall pattern ($readmemb); on cycle c it holds ray_valid low if
 // bit c mod {{ stall_period }} is 1, even with rays left.
 {%- endif %}
+{%- if sink_period > 0 %}
+// {{ sink }}: the consumer's pattern ($readmemb); on cycle c it holds res_ready low if bit
+// c mod {{ sink_period }} is 1. A result is taken on a cycle with res_valid and res_ready high.
+{%- endif %}
+{%- if !resets.is_empty() %}
+// rst is high for one clock on cycles{% for r in resets %} {{ r }}{% endfor %}: nothing is transferred then,
+// and the frame starts again after it (results before it must be right, those after it
+// complete; {{ results }} holds the results after the last reset).
+{%- endif %}
 // {{ expected }}: word k is the golden model's result for ray id k, its top bit set if a ray has
 // id k. Results may come in any order: each is looked up by its {{ id }}; a result for an id
 // no ray has, a second result for an id, and an id without a result each fail. Every result is
@@ -19,6 +28,9 @@ module {{ tb }};
   reg rst = 1'b0;
 {%- endif %}
   reg ray_valid = 1'b0;
+{%- if has_res_ready %}
+  reg res_ready = 1'b1;
+{%- endif %}
 {%- for p in inputs %}
   reg {{ p.decl }} {{ p.name }} = {{ p.width }}'h0;
 {%- endfor %}
@@ -31,15 +43,19 @@ module {{ tb }};
 {%- if stall_period > 0 %}
   reg stall_bits [0:{{ stall_period - 1 }}];
 {%- endif %}
+{%- if sink_period > 0 %}
+  reg sink_bits [0:{{ sink_period - 1 }}];
+{%- endif %}
   reg [{{ ray_width - 1 }}:0] r;
   reg [{{ result_width }}:0] e;
   integer next, done, passed, failed, cycles, busy_cycles, max_sp, stall_cycles, out, k;
-  reg fire, ok, stall;
+  reg fire, take, in_reset, ok, stall;
 
   {{ module }} dut (
     .clk(clk){% if has_reset %},
     .rst(rst){% endif %},
-    .ray_valid(ray_valid){% for p in inputs %},
+    .ray_valid(ray_valid){% if has_res_ready %},
+    .res_ready(res_ready){% endif %}{% for p in inputs %},
     .{{ p.name }}({{ p.name }}){% endfor %}{% for p in outputs %},
     .{{ p.name }}({{ p.name }}){% endfor %}
   );
@@ -49,6 +65,9 @@ module {{ tb }};
     $readmemh("{{ expected }}", expected_words);
 {%- if stall_period > 0 %}
     $readmemb("{{ stalls }}", stall_bits);
+{%- endif %}
+{%- if sink_period > 0 %}
+    $readmemb("{{ sink }}", sink_bits);
 {%- endif %}
     for (k = 0; k < {{ ids }}; k = k + 1) seen[k] = 1'b0;
     out = $fopen("{{ results }}", "w");
@@ -69,19 +88,18 @@ module {{ tb }};
         stall = 1'b0;
         ray_valid = 1'b0;
       end
+{%- if sink_period > 0 %}
+      res_ready = !sink_bits[cycles % {{ sink_period }}];
+{%- endif %}
+      in_reset = {% for r in resets %}cycles == {{ r }} || {% endfor %}1'b0;
+{%- if has_reset %}
+      rst = in_reset;
+{%- endif %}
       #1;
-      fire = ray_valid && ray_ready;
-      clk = 1'b1;
-      #1 clk = 1'b0;
-      #1;
-      cycles = cycles + 1;
-      // Counted here, after the edge: Verilator 5.006 (--timing) lost the count when it was
-      // made before the first delay of the iteration.
-      if (stall) stall_cycles = stall_cycles + 1;
-      if (busy) busy_cycles = busy_cycles + 1;
-      if (stack_depth > max_sp) max_sp = stack_depth;
-      if (fire) next = next + 1;
-      if (res_valid) begin
+      fire = !in_reset && ray_valid && ray_ready;
+      take = !in_reset && res_valid{% if has_res_ready %} && res_ready{% endif %};
+      // The result taken in this clock, checked before the edge.
+      if (take) begin
         $fwrite(out, "{% for p in checked %}%b {% endfor %}\n"{% for p in checked %}, {{ p.name }}{% endfor %});
         ok = 1'b0;
         if ({{ id }} >= {{ ids }} || expected_words[{{ id }}][{{ result_width }}] !== 1'b1) begin
@@ -97,6 +115,24 @@ module {{ tb }};
         if (ok) passed = passed + 1;
         else failed = failed + 1;
         done = done + 1;
+      end
+      clk = 1'b1;
+      #1 clk = 1'b0;
+      #1;
+      cycles = cycles + 1;
+      // Counted here, after the edge: Verilator 5.006 (--timing) lost the count when it was
+      // made before the first delay of the iteration.
+      if (stall) stall_cycles = stall_cycles + 1;
+      if (busy) busy_cycles = busy_cycles + 1;
+      if (stack_depth > max_sp) max_sp = stack_depth;
+      if (fire) next = next + 1;
+      if (in_reset) begin
+        // The frame again: results so far were right or counted failed; now every ray needs
+        // one result again.
+        next = 0; done = 0; passed = 0;
+        for (k = 0; k < {{ ids }}; k = k + 1) seen[k] = 1'b0;
+        $fclose(out);
+        out = $fopen("{{ results }}", "w");
       end
       if (cycles >= {{ max_cycles }}) $fatal(1, "the core stopped producing results");
     end

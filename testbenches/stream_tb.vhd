@@ -6,6 +6,15 @@
 -- {{ stalls }}: the source's stall pattern, a bit per line; on cycle c it holds ray_valid low
 -- if bit c mod {{ stall_period }} is 1, even with rays left.
 {%- endif %}
+{%- if sink_period > 0 %}
+-- {{ sink }}: the consumer's pattern, a bit per line; on cycle c it holds res_ready low if bit
+-- c mod {{ sink_period }} is 1. A result is taken on a cycle with res_valid and res_ready high.
+{%- endif %}
+{%- if !resets.is_empty() %}
+-- rst is high for one clock on cycles{% for r in resets %} {{ r }}{% endfor %}: nothing is transferred then,
+-- and the frame starts again after it (results before it must be right, those after it
+-- complete; {{ results }} holds the results after the last reset).
+{%- endif %}
 -- {{ expected }}: line k is the golden model's result for ray id k, after a bit that is 1 if a
 -- ray has id k. Results may come in any order: each is looked up by its {{ id }}; a result for
 -- an id no ray has, a second result for an id, and an id without a result each fail. Every
@@ -26,6 +35,9 @@ architecture sim of {{ tb }} is
   signal rst : std_logic := '0';
 {%- endif %}
   signal ray_valid : unsigned(0 downto 0) := "0";
+{%- if has_res_ready %}
+  signal res_ready : unsigned(0 downto 0) := "1";
+{%- endif %}
 {%- for p in inputs %}
   signal {{ p.name }} : {{ p.vtype }} := (others => '0');
 {%- endfor %}
@@ -37,7 +49,8 @@ begin
     port map (
       clk => clk{% if has_reset %},
       rst => rst{% endif %},
-      ray_valid => ray_valid{% for p in inputs %},
+      ray_valid => ray_valid{% if has_res_ready %},
+      res_ready => res_ready{% endif %}{% for p in inputs %},
       {{ p.name }} => {{ p.name }}{% endfor %}{% for p in outputs %},
       {{ p.name }} => {{ p.name }}{% endfor %}
     );
@@ -47,11 +60,16 @@ begin
     type flag_array is array (0 to {{ ids - 1 }}) of boolean;
     file rays : text open read_mode is "{{ rays }}";
     file expected : text open read_mode is "{{ expected }}";
-    file results : text open write_mode is "{{ results }}";
+    file results : text;
 {%- if stall_period > 0 %}
     type stall_array is array (0 to {{ stall_period - 1 }}) of bit;
     file stall_file : text open read_mode is "{{ stalls }}";
     variable stall_bits : stall_array;
+{%- endif %}
+{%- if sink_period > 0 %}
+    type sink_array is array (0 to {{ sink_period - 1 }}) of bit;
+    file sink_file : text open read_mode is "{{ sink }}";
+    variable sink_bits : sink_array;
 {%- endif %}
     variable expected_words : word_array;
     variable seen : flag_array := (others => false);
@@ -64,9 +82,10 @@ begin
 {%- for p in checked %}
     variable e_{{ p.name }} : bit_vector({{ p.width - 1 }} downto 0);
 {%- endfor %}
-    variable have_ray, offer, fire, ok : boolean := false;
+    variable have_ray, offer, fire, take, in_reset, ok : boolean := false;
     variable done, passed, failed, cycles, busy_cycles, max_sp, stall_cycles, id : natural := 0;
   begin
+    file_open(results, "{{ results }}", write_mode);
     for k in 0 to {{ ids - 1 }} loop
       readline(expected, le);
       read(le, known);
@@ -81,6 +100,12 @@ begin
     for k in 0 to {{ stall_period - 1 }} loop
       readline(stall_file, l);
       read(l, stall_bits(k));
+    end loop;
+{%- endif %}
+{%- if sink_period > 0 %}
+    for k in 0 to {{ sink_period - 1 }} loop
+      readline(sink_file, l);
+      read(l, sink_bits(k));
     end loop;
 {%- endif %}
     if not endfile(rays) then
@@ -109,30 +134,26 @@ begin
       else
         ray_valid <= "0";
       end if;
-      wait for 1 ns;
-      fire := offer and ray_ready = "1";
-      clk <= '1';
-      wait for 1 ns;
-      clk <= '0';
-      wait for 1 ns;
-      cycles := cycles + 1;
-      if busy = "1" then
-        busy_cycles := busy_cycles + 1;
+{%- if sink_period > 0 %}
+      if sink_bits(cycles mod {{ sink_period }}) = '1' then
+        res_ready <= "0";
+      else
+        res_ready <= "1";
       end if;
-      if to_integer(stack_depth) > max_sp then
-        max_sp := to_integer(stack_depth);
+{%- endif %}
+      in_reset := {% for r in resets %}cycles = {{ r }} or {% endfor %}false;
+{%- if has_reset %}
+      if in_reset then
+        rst <= '1';
+      else
+        rst <= '0';
       end if;
-      if fire then
-        have_ray := false;
-        if not endfile(rays) then
-          readline(rays, l);
-{%- for p in inputs %}
-          read(l, v_{{ p.name }});
-{%- endfor %}
-          have_ray := true;
-        end if;
-      end if;
-      if res_valid = "1" then
+{%- endif %}
+      wait for 1 ns;
+      fire := not in_reset and offer and ray_ready = "1";
+      take := not in_reset and res_valid = "1"{% if has_res_ready %} and res_ready = "1"{% endif %};
+      -- The result taken in this clock, checked before the edge.
+      if take then
 {%- for p in checked %}
         write(lo, to_bitvector(std_logic_vector({{ p.name }})));
         write(lo, ' ');
@@ -173,6 +194,46 @@ begin
           failed := failed + 1;
         end if;
         done := done + 1;
+      end if;
+      clk <= '1';
+      wait for 1 ns;
+      clk <= '0';
+      wait for 1 ns;
+      cycles := cycles + 1;
+      if busy = "1" then
+        busy_cycles := busy_cycles + 1;
+      end if;
+      if to_integer(stack_depth) > max_sp then
+        max_sp := to_integer(stack_depth);
+      end if;
+      if fire then
+        have_ray := false;
+        if not endfile(rays) then
+          readline(rays, l);
+{%- for p in inputs %}
+          read(l, v_{{ p.name }});
+{%- endfor %}
+          have_ray := true;
+        end if;
+      end if;
+      if in_reset then
+        -- The frame again: results so far were right or counted failed; now every ray needs
+        -- one result again.
+        done := 0;
+        passed := 0;
+        seen := (others => false);
+        file_close(results);
+        file_open(results, "{{ results }}", write_mode);
+        file_close(rays);
+        file_open(rays, "{{ rays }}", read_mode);
+        have_ray := false;
+        if not endfile(rays) then
+          readline(rays, l);
+{%- for p in inputs %}
+          read(l, v_{{ p.name }});
+{%- endfor %}
+          have_ray := true;
+        end if;
       end if;
       assert cycles < {{ max_cycles }} report "the core stopped producing results" severity failure;
     end loop;

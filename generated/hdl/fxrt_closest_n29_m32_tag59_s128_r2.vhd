@@ -461,9 +461,8 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal and_2 : unsigned(0 downto 0);
   signal no_candidate_c : unsigned(0 downto 0);
   signal in_no_candidate : unsigned(0 downto 0) := unsigned'("1");
-  type in_valid2_sr_t is array (1 to 2) of unsigned(0 downto 0);
-  signal in_valid2_sr : in_valid2_sr_t := (others => (others => '0'));
-  signal in_valid2 : unsigned(0 downto 0);
+  signal in_valid2_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal in_valid2_2 : unsigned(0 downto 0) := unsigned'("0");
   type in_first_sr_t is array (1 to 2) of unsigned(0 downto 0);
   signal in_first_sr : in_first_sr_t := (others => (others => '0'));
   signal in_first : unsigned(0 downto 0);
@@ -501,9 +500,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal rs_cat_4 : unsigned(45 downto 0);
   signal rs_cat_3_minus_rs_cat_4 : unsigned(45 downto 0);
   signal take : unsigned(0 downto 0);
-  signal in_valid2_and_in_first : unsigned(0 downto 0);
+  signal in_valid2_2_and_in_first : unsigned(0 downto 0);
   constant k_1 : unsigned(0 downto 0) := unsigned'("1");
-  signal mux_in_valid2_and_in_first : unsigned(0 downto 0);
+  signal mux_in_valid2_2_and_in_first : unsigned(0 downto 0);
   signal mux_take : unsigned(0 downto 0);
   signal best_valid : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal leaf_last : unsigned(0 downto 0);
@@ -1307,7 +1306,6 @@ begin
   in_valid_and_in_hit <= in_valid and in_hit;
   and_2 <= in_valid_and_in_hit and accepted;
   no_candidate_c <= not and_2;
-  in_valid2 <= in_valid2_sr(2);
   in_first <= in_first_sr(2);
   in_last <= in_last_sr(2);
   in_tri <= in_tri_sr(2);
@@ -1323,10 +1321,10 @@ begin
   rs_cat_4 <= resize(cat_4, 46);
   rs_cat_3_minus_rs_cat_4 <= rs_cat_3 - rs_cat_4;
   take <= unsigned(rs_cat_3_minus_rs_cat_4(45 downto 45));
-  in_valid2_and_in_first <= in_valid2 and in_first;
-  mux_in_valid2_and_in_first <= k_1 when in_valid2_and_in_first = "1" else acc_empty;
-  mux_take <= k_0 when take = "1" else mux_in_valid2_and_in_first;
-  leaf_last <= in_valid2 and in_last;
+  in_valid2_2_and_in_first <= in_valid2_2 and in_first;
+  mux_in_valid2_2_and_in_first <= k_1 when in_valid2_2_and_in_first = "1" else acc_empty;
+  mux_take <= k_0 when take = "1" else mux_in_valid2_2_and_in_first;
+  leaf_last <= in_valid2_2 and in_last;
   bits_best_valid <= unsigned(best_valid(0 downto 0));
   bits_best_valid_1 <= unsigned(best_valid(1 downto 1));
   bits_best_valid_2 <= unsigned(best_valid(2 downto 2));
@@ -2234,15 +2232,27 @@ begin
       end if;
       in_tmin_less <= tmin_less;
       in_t_plus_8 <= t_plus_8;
-      in_valid <= valid;
+      if rst = '1' then
+        in_valid <= unsigned'("0");
+      else
+        in_valid <= valid;
+      end if;
       in_hit <= hit;
       if rst = '1' then
         in_no_candidate <= unsigned'("1");
       else
         in_no_candidate <= no_candidate_c;
       end if;
-      in_valid2_sr(2 to 2) <= in_valid2_sr(1 to 1);
-      in_valid2_sr(1) <= valid;
+      if rst = '1' then
+        in_valid2_1 <= unsigned'("0");
+      else
+        in_valid2_1 <= valid;
+      end if;
+      if rst = '1' then
+        in_valid2_2 <= unsigned'("0");
+      else
+        in_valid2_2 <= in_valid2_1;
+      end if;
       in_first_sr(2 to 2) <= in_first_sr(1 to 1);
       in_first_sr(1) <= first;
       in_last_sr(2 to 2) <= in_last_sr(1 to 1);
@@ -2281,11 +2291,19 @@ begin
       else
         best_valid <= and_13_or_best_set;
       end if;
-      fin <= leaf_last;
+      if rst = '1' then
+        fin <= unsigned'("0");
+      else
+        fin <= leaf_last;
+      end if;
       fin_slot <= in_slot;
       fin_sp <= in_sp;
       slot_t_tri <= best_t_tri(to_integer(fin_slot));
-      m1 <= fin;
+      if rst = '1' then
+        m1 <= unsigned'("0");
+      else
+        m1 <= fin;
+      end if;
       m1_slot <= fin_slot;
       m1_sp <= fin_sp;
       fin_has_g0 <= fin_has_g0_c;
@@ -2300,7 +2318,11 @@ begin
       m1_leaf_empty <= acc_empty;
       m1_t_tri <= cat_5;
       m1_u_v <= cat_6;
-      m2 <= m1;
+      if rst = '1' then
+        m2 <= unsigned'("0");
+      else
+        m2 <= m1;
+      end if;
       m2_better <= leaf_better;
       m2_hit <= m1_hit;
       m2_slot <= m1_slot;
@@ -2308,18 +2330,34 @@ begin
       m2_t_tri <= m1_t_tri;
       m2_u_v <= m1_u_v;
       m2_slot_t_1 <= bits_slot_t_tri;
-      best_we <= m1_we;
-      merge_valid_r <= m2;
+      if rst = '1' then
+        best_we <= unsigned'("0");
+      else
+        best_we <= m1_we;
+      end if;
+      if rst = '1' then
+        merge_valid_r <= unsigned'("0");
+      else
+        merge_valid_r <= m2;
+      end if;
       merge_slot_r <= m2_slot;
       merge_hit_r <= m2_hit;
       merge_limit_r <= merged_limit;
       merge_sp_r <= m2_sp;
-      d0 <= done_valid;
+      if rst = '1' then
+        d0 <= unsigned'("0");
+      else
+        d0 <= done_valid;
+      end if;
       d0_slot <= done_slot;
       done_t_tri <= best_t_tri(to_integer(d0_slot));
       done_u_v <= best_u_v(to_integer(d0_slot));
       done_id <= ray_ids(to_integer(d0_slot));
-      d1 <= d0;
+      if rst = '1' then
+        d1 <= unsigned'("0");
+      else
+        d1 <= d0;
+      end if;
       d1_slot <= d0_slot;
       done_has_g0 <= done_has_g0_c;
       done_has_g1 <= done_has_g1_c;
@@ -2332,7 +2370,11 @@ begin
       d1_has <= done_has_c;
       m2_onehot <= cat_11;
       d1_onehot <= cat_12;
-      free_valid_r <= d1;
+      if rst = '1' then
+        free_valid_r <= unsigned'("0");
+      else
+        free_valid_r <= d1;
+      end if;
       free_slot_r <= d1_slot;
       if rst = '1' then
         res_valid_r <= unsigned'("0");

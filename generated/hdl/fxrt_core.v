@@ -14,6 +14,7 @@ module fxrt_core (
   input wire signed [47:0] invx,
   input wire signed [47:0] invy,
   input wire signed [47:0] invz,
+  input wire [0:0] res_ready,
   output wire [0:0] ray_ready,
   output wire [0:0] res_valid,
   output wire [19:0] res_id,
@@ -21,21 +22,7 @@ module fxrt_core (
   output wire [12:0] res_tri,
   output wire [29:0] res_t,
   output wire [31:0] res_u,
-  output wire [31:0] res_v,
-  output wire [0:0] busy,
-  output wire [5:0] stack_depth,
-  output wire [2:0] visits,
-  output wire [2:0] culls,
-  output wire [7:0] occupied,
-  output wire [0:0] accept,
-  output wire [19:0] accept_id,
-  output wire [6:0] accept_slot,
-  output wire [0:0] visit0,
-  output wire [5:0] visit0_slot,
-  output wire [12:0] visit0_node,
-  output wire [0:0] visit1,
-  output wire [5:0] visit1_slot,
-  output wire [12:0] visit1_node
+  output wire [31:0] res_v
 );
 
   (* ram_style = "distributed" *) reg [86:0] ray_o [0:127];
@@ -43,6 +30,12 @@ module fxrt_core (
 
   (* ram_style = "distributed" *) reg [95:0] ray_w [0:127];
   initial $readmemh("fxrt_core_ray_w.hex", ray_w);
+
+  (* ram_style = "distributed" *) reg [63:0] res_q_mem0 [0:15];
+  initial $readmemh("fxrt_core_res_q_mem0.hex", res_q_mem0);
+
+  (* ram_style = "distributed" *) reg [63:0] res_q_mem1 [0:15];
+  initial $readmemh("fxrt_core_res_q_mem1.hex", res_q_mem1);
 
   wire [0:0] u0_has_free;
   wire [0:0] u1_has_free;
@@ -94,8 +87,8 @@ module fxrt_core (
   reg signed [47:0] box_in_invx = 48'sh000000000000;
   reg signed [47:0] box_in_invy = 48'sh000000000000;
   reg signed [47:0] box_in_invz = 48'sh000000000000;
-  reg [0:0] accept_int = 1'h0;
-  reg [6:0] accept_slot_int = 7'h00;
+  reg [0:0] accept = 1'h0;
+  reg [6:0] accept_slot = 7'h00;
   reg [19:0] acc_in_ray_id = 20'h00000;
   reg [28:0] acc_in_ox = 29'h00000000;
   reg [28:0] acc_in_oy = 29'h00000000;
@@ -141,10 +134,12 @@ module fxrt_core (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 77:16 are read
   wire signed [77:0] pu_product;
   /* verilator lint_on UNUSEDSIGNAL */
-  (* mem2reg *) reg [0:0] pu_product_valid_sr [1:6];
-  integer pu_product_valid_i;
-  initial for (pu_product_valid_i = 1; pu_product_valid_i <= 6; pu_product_valid_i = pu_product_valid_i + 1) pu_product_valid_sr[pu_product_valid_i] = 1'h0;
-  wire [0:0] pu_product_valid;
+  reg [0:0] pu_product_valid_1 = 1'h0;
+  reg [0:0] pu_product_valid_2 = 1'h0;
+  reg [0:0] pu_product_valid_3 = 1'h0;
+  reg [0:0] pu_product_valid_4 = 1'h0;
+  reg [0:0] pu_product_valid_5 = 1'h0;
+  reg [0:0] pu_product_valid_6 = 1'h0;
   (* mem2reg *) reg [0:0] pu_product_last_sr [1:6];
   integer pu_product_last_i;
   initial for (pu_product_last_i = 1; pu_product_last_i <= 6; pu_product_last_i = pu_product_last_i + 1) pu_product_last_sr[pu_product_last_i] = 1'h0;
@@ -249,12 +244,24 @@ module fxrt_core (
   wire [5:0] u_traverse_0_leaf_sp;
   wire [0:0] u_traverse_0_done_valid;
   wire [5:0] u_traverse_0_done_slot;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [0:0] u_traverse_0_visit;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [5:0] u_traverse_0_visit_slot;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [12:0] u_traverse_0_visit_node;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [0:0] u_traverse_0_cull;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [5:0] u_traverse_0_depth;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [6:0] u_traverse_0_occupied;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_accept_slot_2;
   wire [0:0] eq_14;
   wire [0:0] u1_alloc;
@@ -281,12 +288,24 @@ module fxrt_core (
   wire [5:0] u_traverse_1_leaf_sp;
   wire [0:0] u_traverse_1_done_valid;
   wire [5:0] u_traverse_1_done_slot;
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [0:0] u_traverse_1_visit;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [5:0] u_traverse_1_visit_slot;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [12:0] u_traverse_1_visit_node;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [0:0] u_traverse_1_cull;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [5:0] u_traverse_1_depth;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [6:0] u_traverse_1_occupied;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [72:0] u_node_rom_0_data;
   wire [72:0] u_node_rom_0_data_b;
   wire [86:0] cat_18;
@@ -373,10 +392,9 @@ module fxrt_core (
   /* verilator lint_on UNUSEDSIGNAL */
   wire [45:0] bits_emit_tag;
   wire [58:0] emit_tag_tri;
-  (* mem2reg *) reg [0:0] emit_valid_sr [1:3];
-  integer emit_valid_i;
-  initial for (emit_valid_i = 1; emit_valid_i <= 3; emit_valid_i = emit_valid_i + 1) emit_valid_sr[emit_valid_i] = 1'h0;
-  wire [0:0] emit_valid;
+  reg [0:0] emit_valid_1 = 1'h0;
+  reg [0:0] emit_valid_2 = 1'h0;
+  reg [0:0] emit_valid_3 = 1'h0;
   wire [12:0] tri_addr;
   wire [123:0] u_tri_rom_0_data;
   wire [1:0] tri_r;
@@ -397,10 +415,9 @@ module fxrt_core (
   wire signed [31:0] tri_e2p;
   wire [31:0] u_tri_rom_2_data;
   wire signed [31:0] tri_e2q;
-  (* mem2reg *) reg [0:0] pipe_valid_sr [1:3];
-  integer pipe_valid_i;
-  initial for (pipe_valid_i = 1; pipe_valid_i <= 3; pipe_valid_i = pipe_valid_i + 1) pipe_valid_sr[pipe_valid_i] = 1'h0;
-  wire [0:0] pipe_valid;
+  reg [0:0] pipe_valid_1 = 1'h0;
+  reg [0:0] pipe_valid_2 = 1'h0;
+  reg [0:0] pipe_valid_3 = 1'h0;
   (* mem2reg *) reg [58:0] pipe_tag_sr [1:3];
   integer pipe_tag_i;
   initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 59'h000000000000000;
@@ -431,11 +448,14 @@ module fxrt_core (
   wire [29:0] u_intersect_t_1;
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
+  reg [0:0] res_credit_ok = 1'h1;
   reg [0:0] u0_done_took = 1'h0;
   wire [0:0] not_u0_done_took;
+  wire [0:0] and_34;
   wire [0:0] u0_done_avail;
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
+  wire [0:0] and_35;
   wire [0:0] u1_done_avail;
   wire [6:0] cat_36;
   wire [0:0] not_u0_done_avail;
@@ -459,19 +479,52 @@ module fxrt_core (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
-  wire [0:0] lt_40;
-  wire [5:0] mux_lt_40;
-  reg [5:0] obs_depth_l1_0 = 6'h00;
-  wire [2:0] rs_u_traverse_0_visit;
-  wire [2:0] rs_u_traverse_1_visit;
-  wire [2:0] visits_c;
-  wire [2:0] rs_u_traverse_0_cull;
-  wire [2:0] rs_u_traverse_1_cull;
-  wire [2:0] culls_c;
-  wire [7:0] rs_u_traverse_0_occupied;
-  wire [7:0] rs_u_traverse_1_occupied;
-  wire [7:0] plus_43;
-  reg [7:0] obs_occupied_l1_0 = 8'h00;
+  wire [63:0] cat_40;
+  wire [63:0] cat_41;
+  wire [0:0] res_take;
+  reg [0:0] res_q_push = 1'h0;
+  reg [3:0] res_q_wr = 4'h0;
+  reg [3:0] res_q_rd = 4'h0;
+  reg [4:0] res_q_count = 5'h00;
+  wire [3:0] k_1_4 = 4'h1;
+  wire [3:0] res_q_wr_plus_k_1_4;
+  wire [3:0] mux_res_q_push;
+  reg [3:0] res_q_rd1 = 4'h1;
+  wire [3:0] res_q_rd_next;
+  wire [3:0] res_q_rd1_plus_k_1_4;
+  wire [3:0] mux_res_take;
+  wire [4:0] rs_res_take;
+  wire [4:0] res_q_after_pop;
+  wire [4:0] rs_res_q_push;
+  wire [4:0] res_q_count_next;
+  reg [0:0] res_q_bypass = 1'h0;
+  wire [4:0] k_0_5 = 5'h00;
+  wire [0:0] res_q_after_pop_eq_k_0_5;
+  wire [0:0] res_q_bypass_c;
+  reg [0:0] res_q_nonempty = 1'h0;
+  wire [0:0] ne_45;
+  reg [63:0] res_q_din0 = 64'h0000000000000000;
+  reg [63:0] res_q_q0 = 64'h0000000000000000;
+  reg [63:0] res_q_din_r0 = 64'h0000000000000000;
+  wire [63:0] res_q_head0;
+  reg [63:0] res_q_din1 = 64'h0000000000000000;
+  reg [63:0] res_q_q1 = 64'h0000000000000000;
+  reg [63:0] res_q_din_r1 = 64'h0000000000000000;
+  wire [63:0] res_q_head1;
+  wire [0:0] res_take_c;
+  reg [5:0] res_credits = 6'h10;
+  wire [5:0] rs_done_valid_r;
+  wire [5:0] minus_47;
+  wire [5:0] rs_res_take_1;
+  wire [5:0] res_credits_next;
+  wire [4:0] bits_res_credits_next;
+  wire [0:0] ne_49;
+  wire [29:0] res_t_q;
+  wire [12:0] res_tri_q;
+  wire [0:0] res_hit_q;
+  wire [19:0] res_id_q;
+  wire [31:0] res_v_q;
+  wire [31:0] res_u_q;
 
   assign u0_has_free = u_traverse_0_has_free;
   assign u1_has_free = u_traverse_1_has_free;
@@ -509,7 +562,7 @@ module fxrt_core (
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
   assign mux_take_or_box_phase_ne_k_0 = take_or_box_phase_ne_k_0 ? box_phase_plus_k_1_1 : box_phase;
   assign box_idle = box_phase == k_0;
-  assign bits_accept_slot = accept_slot_int[5:0];
+  assign bits_accept_slot = accept_slot[5:0];
   assign box_axis = box_phase - k_1_1;
   always @* begin
     case (box_axis)
@@ -549,7 +602,6 @@ module fxrt_core (
     endcase
   end
   assign pu_product = u_plane_product_p;
-  assign pu_product_valid = pu_product_valid_sr[6];
   assign pu_product_last = pu_product_last_sr[6];
   assign bits_pu_product = pu_product[77:16];
   assign pu_shifted = $signed(bits_pu_product);
@@ -594,9 +646,9 @@ module fxrt_core (
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
-  assign bits_accept_slot_1 = accept_slot_int[6];
+  assign bits_accept_slot_1 = accept_slot[6];
   assign eq_10 = bits_accept_slot_1 == k_0_1;
-  assign u0_alloc = accept_int & eq_10;
+  assign u0_alloc = accept & eq_10;
   assign bits_box_done_slot = box_done_slot[6];
   assign eq_11 = bits_box_done_slot == k_0_1;
   assign u0_new = box_done & eq_11;
@@ -609,9 +661,9 @@ module fxrt_core (
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_merge_slot_1 = merge_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
-  assign bits_accept_slot_2 = accept_slot_int[6];
+  assign bits_accept_slot_2 = accept_slot[6];
   assign eq_14 = bits_accept_slot_2 == k_1;
-  assign u1_alloc = accept_int & eq_14;
+  assign u1_alloc = accept & eq_14;
   assign bits_box_done_slot_2 = box_done_slot[6];
   assign eq_15 = bits_box_done_slot_2 == k_1;
   assign u1_new = box_done & eq_15;
@@ -737,7 +789,6 @@ module fxrt_core (
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
-  assign emit_valid = emit_valid_sr[3];
   assign tri_addr = u_leaf_rom_data;
   assign tri_r = u_tri_rom_0_data[1:0];
   assign tri_pp = u_tri_rom_0_data[30:2];
@@ -755,7 +806,6 @@ module fxrt_core (
   assign bits_u_tri_rom_1_data_3 = u_tri_rom_1_data[127:96];
   assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
   assign tri_e2q = $signed(u_tri_rom_2_data);
-  assign pipe_valid = pipe_valid_sr[3];
   assign pipe_tag = pipe_tag_sr[3];
   assign bits_emit_tag_tri = emit_tag_tri[56:50];
   assign pipe_o = pipe_o_sr[2];
@@ -770,30 +820,53 @@ module fxrt_core (
   assign bits_pipe_w_2 = pipe_w[95:64];
   assign s_bits_pipe_w_2 = $signed(bits_pipe_w_2);
   assign not_u0_done_took = ~u0_done_took;
-  assign u0_done_avail = u_traverse_0_done_valid & not_u0_done_took;
+  assign and_34 = u_traverse_0_done_valid & not_u0_done_took;
+  assign u0_done_avail = and_34 & res_credit_ok;
   assign not_u1_done_took = ~u1_done_took;
-  assign u1_done_avail = u_traverse_1_done_valid & not_u1_done_took;
+  assign and_35 = u_traverse_1_done_valid & not_u1_done_took;
+  assign u1_done_avail = and_35 & res_credit_ok;
   assign cat_36 = {k_0_1, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
   assign cat_38 = {k_1, u_traverse_1_done_slot};
   assign mux_u0_done_avail = u0_done_avail ? cat_36 : cat_38;
   assign or_39 = u0_done_avail | u1_done_avail;
-  assign lt_40 = u_traverse_0_depth < u_traverse_1_depth;
-  assign mux_lt_40 = lt_40 ? u_traverse_1_depth : u_traverse_0_depth;
-  assign rs_u_traverse_0_visit = {{2{1'b0}}, u_traverse_0_visit};
-  assign rs_u_traverse_1_visit = {{2{1'b0}}, u_traverse_1_visit};
-  assign visits_c = rs_u_traverse_0_visit + rs_u_traverse_1_visit;
-  assign rs_u_traverse_0_cull = {{2{1'b0}}, u_traverse_0_cull};
-  assign rs_u_traverse_1_cull = {{2{1'b0}}, u_traverse_1_cull};
-  assign culls_c = rs_u_traverse_0_cull + rs_u_traverse_1_cull;
-  assign rs_u_traverse_0_occupied = {{1{1'b0}}, u_traverse_0_occupied};
-  assign rs_u_traverse_1_occupied = {{1{1'b0}}, u_traverse_1_occupied};
-  assign plus_43 = rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
+  assign cat_40 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
+  assign cat_41 = {u_closest_res_u, u_closest_res_v};
+  assign res_take = res_take_c;
+  assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
+  assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
+  assign res_q_rd_next = res_take ? res_q_rd1 : res_q_rd;
+  assign res_q_rd1_plus_k_1_4 = res_q_rd1 + k_1_4;
+  assign mux_res_take = res_take ? res_q_rd1_plus_k_1_4 : res_q_rd1;
+  assign rs_res_take = {{4{1'b0}}, res_take};
+  assign res_q_after_pop = res_q_count - rs_res_take;
+  assign rs_res_q_push = {{4{1'b0}}, res_q_push};
+  assign res_q_count_next = res_q_after_pop + rs_res_q_push;
+  assign res_q_after_pop_eq_k_0_5 = res_q_after_pop == k_0_5;
+  assign res_q_bypass_c = res_q_push & res_q_after_pop_eq_k_0_5;
+  assign ne_45 = res_q_count_next != k_0_5;
+  assign res_q_head0 = res_q_bypass ? res_q_din_r0 : res_q_q0;
+  assign res_q_head1 = res_q_bypass ? res_q_din_r1 : res_q_q1;
+  assign res_take_c = res_q_nonempty & res_ready;
+  assign rs_done_valid_r = {{5{1'b0}}, done_valid_r};
+  assign minus_47 = res_credits - rs_done_valid_r;
+  assign rs_res_take_1 = {{5{1'b0}}, res_take};
+  assign res_credits_next = minus_47 + rs_res_take_1;
+  assign bits_res_credits_next = res_credits_next[5:1];
+  assign ne_49 = bits_res_credits_next != k_0_5;
+  assign res_t_q = res_q_head0[29:0];
+  assign res_tri_q = res_q_head0[42:30];
+  assign res_hit_q = res_q_head0[43];
+  assign res_id_q = res_q_head0[63:44];
+  assign res_v_q = res_q_head1[31:0];
+  assign res_u_q = res_q_head1[63:32];
 
   always @(posedge clk) begin : regs
-    if (accept_int) ray_o[accept_slot_int] <= cat_18;
-    if (accept_int) ray_w[accept_slot_int] <= cat_19;
+    if (accept) ray_o[accept_slot] <= cat_18;
+    if (accept) ray_w[accept_slot] <= cat_19;
+    if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
+    if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
     if (rst) turn <= 1'h0;
     else turn <= turn_next;
     if (rst) box_phase <= 2'h0;
@@ -822,8 +895,9 @@ module fxrt_core (
     if (box_idle) box_in_invx <= in_invx;
     if (box_idle) box_in_invy <= in_invy;
     if (box_idle) box_in_invz <= in_invz;
-    accept_int <= take;
-    accept_slot_int <= take_slot;
+    if (rst) accept <= 1'h0;
+    else accept <= take;
+    accept_slot <= take_slot;
     acc_in_ray_id <= in_ray_id;
     acc_in_ox <= in_ox;
     acc_in_oy <= in_oy;
@@ -835,29 +909,42 @@ module fxrt_core (
     acc_in_invy <= in_invy;
     acc_in_invz <= in_invz;
     if (take) box_slot <= take_slot;
-    pu_sel_valid <= box_issue;
+    if (rst) pu_sel_valid <= 1'h0;
+    else pu_sel_valid <= box_issue;
     pu_sel_last <= box_issue_last;
     pu_sel_plane <= box_plane;
     pu_sel_axis <= box_axis;
     pu_delta <= pu_diff;
     pu_inv <= pu_inv_axis;
-    pu_delta_valid <= pu_sel_valid;
+    if (rst) pu_delta_valid <= 1'h0;
+    else pu_delta_valid <= pu_sel_valid;
     pu_delta_last <= pu_sel_last;
-    for (pu_product_valid_i = 6; pu_product_valid_i > 1; pu_product_valid_i = pu_product_valid_i - 1)
-      pu_product_valid_sr[pu_product_valid_i] <= pu_product_valid_sr[pu_product_valid_i - 1];
-    pu_product_valid_sr[1] <= pu_delta_valid;
+    if (rst) pu_product_valid_1 <= 1'h0;
+    else pu_product_valid_1 <= pu_delta_valid;
+    if (rst) pu_product_valid_2 <= 1'h0;
+    else pu_product_valid_2 <= pu_product_valid_1;
+    if (rst) pu_product_valid_3 <= 1'h0;
+    else pu_product_valid_3 <= pu_product_valid_2;
+    if (rst) pu_product_valid_4 <= 1'h0;
+    else pu_product_valid_4 <= pu_product_valid_3;
+    if (rst) pu_product_valid_5 <= 1'h0;
+    else pu_product_valid_5 <= pu_product_valid_4;
+    if (rst) pu_product_valid_6 <= 1'h0;
+    else pu_product_valid_6 <= pu_product_valid_5;
     for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
       pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
     pu_product_last_sr[1] <= pu_delta_last;
     pu_above_r <= pu_above;
     pu_below_r <= pu_below;
     pu_low_r <= rs_pu_shifted;
-    pu_clamp_valid <= pu_product_valid;
+    if (rst) pu_clamp_valid <= 1'h0;
+    else pu_clamp_valid <= pu_product_valid_6;
     pu_clamp_last <= pu_product_last;
     plane_t <= pu_clamped;
     if (pu_clamp_last) plane_t_of_last <= pu_clamped;
     if (pu_first) plane_t_of_first <= pu_clamped;
-    plane_t_valid <= pu_clamp_valid;
+    if (rst) plane_t_valid <= 1'h0;
+    else plane_t_valid <= pu_clamp_valid;
     plane_t_last <= pu_clamp_last;
     box_d1 <= plane_t;
     box_d2 <= box_d1;
@@ -865,7 +952,8 @@ module fxrt_core (
     box_lt1 <= box_lt1_c;
     box_lt2 <= box_lt2_c;
     box_lt1_d <= box_lt1;
-    box_done <= box_last;
+    if (rst) box_done <= 1'h0;
+    else box_done <= box_last;
     for (box_done_slot_i = 11; box_done_slot_i > 1; box_done_slot_i = box_done_slot_i - 1)
       box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
     box_done_slot_sr[1] <= box_slot;
@@ -897,12 +985,18 @@ module fxrt_core (
     for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
       emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
     emit_tag_sr[1] <= cat_32;
-    for (emit_valid_i = 3; emit_valid_i > 1; emit_valid_i = emit_valid_i - 1)
-      emit_valid_sr[emit_valid_i] <= emit_valid_sr[emit_valid_i - 1];
-    emit_valid_sr[1] <= leaf_active;
-    for (pipe_valid_i = 3; pipe_valid_i > 1; pipe_valid_i = pipe_valid_i - 1)
-      pipe_valid_sr[pipe_valid_i] <= pipe_valid_sr[pipe_valid_i - 1];
-    pipe_valid_sr[1] <= emit_valid;
+    if (rst) emit_valid_1 <= 1'h0;
+    else emit_valid_1 <= leaf_active;
+    if (rst) emit_valid_2 <= 1'h0;
+    else emit_valid_2 <= emit_valid_1;
+    if (rst) emit_valid_3 <= 1'h0;
+    else emit_valid_3 <= emit_valid_2;
+    if (rst) pipe_valid_1 <= 1'h0;
+    else pipe_valid_1 <= emit_valid_3;
+    if (rst) pipe_valid_2 <= 1'h0;
+    else pipe_valid_2 <= pipe_valid_1;
+    if (rst) pipe_valid_3 <= 1'h0;
+    else pipe_valid_3 <= pipe_valid_2;
     for (pipe_tag_i = 3; pipe_tag_i > 1; pipe_tag_i = pipe_tag_i - 1)
       pipe_tag_sr[pipe_tag_i] <= pipe_tag_sr[pipe_tag_i - 1];
     pipe_tag_sr[1] <= emit_tag_tri;
@@ -914,12 +1008,37 @@ module fxrt_core (
     for (pipe_w_i = 2; pipe_w_i > 1; pipe_w_i = pipe_w_i - 1)
       pipe_w_sr[pipe_w_i] <= pipe_w_sr[pipe_w_i - 1];
     pipe_w_sr[1] <= ray_w_q;
-    u0_done_took <= u0_done_pop;
-    u1_done_took <= u1_done_pop;
-    done_valid_r <= or_39;
+    if (rst) res_credit_ok <= 1'h1;
+    else res_credit_ok <= ne_49;
+    if (rst) u0_done_took <= 1'h0;
+    else u0_done_took <= u0_done_pop;
+    if (rst) u1_done_took <= 1'h0;
+    else u1_done_took <= u1_done_pop;
+    if (rst) done_valid_r <= 1'h0;
+    else done_valid_r <= or_39;
     done_slot_r <= mux_u0_done_avail;
-    obs_depth_l1_0 <= mux_lt_40;
-    obs_occupied_l1_0 <= plus_43;
+    if (rst) res_q_push <= 1'h0;
+    else res_q_push <= u_closest_res_valid;
+    if (rst) res_q_wr <= 4'h0;
+    else res_q_wr <= mux_res_q_push;
+    if (rst) res_q_rd <= 4'h0;
+    else res_q_rd <= res_q_rd_next;
+    if (rst) res_q_count <= 5'h00;
+    else res_q_count <= res_q_count_next;
+    if (rst) res_q_rd1 <= 4'h1;
+    else res_q_rd1 <= mux_res_take;
+    if (rst) res_q_bypass <= 1'h0;
+    else res_q_bypass <= res_q_bypass_c;
+    if (rst) res_q_nonempty <= 1'h0;
+    else res_q_nonempty <= ne_45;
+    res_q_din0 <= cat_40;
+    res_q_q0 <= res_q_mem0[res_q_rd_next];
+    if (res_q_push) res_q_din_r0 <= res_q_din0;
+    res_q_din1 <= cat_41;
+    res_q_q1 <= res_q_mem1[res_q_rd_next];
+    if (res_q_push) res_q_din_r1 <= res_q_din1;
+    if (rst) res_credits <= 6'h10;
+    else res_credits <= res_credits_next;
   end
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
@@ -1053,7 +1172,8 @@ module fxrt_core (
 
   fxrt_intersect_n29_m32_t0_e18_tag59_c150 u_intersect (
     .clk(clk),
-    .valid(pipe_valid),
+    .rst(rst),
+    .valid(pipe_valid_3),
     .tag(pipe_tag),
     .ox(bits_pipe_o),
     .oy(bits_pipe_o_1),
@@ -1088,8 +1208,8 @@ module fxrt_core (
     .t(u_intersect_t_1),
     .u(u_intersect_u),
     .v(u_intersect_v),
-    .id_we(accept_int),
-    .id_slot(accept_slot_int),
+    .id_we(accept),
+    .id_slot(accept_slot),
     .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),
@@ -1110,26 +1230,12 @@ module fxrt_core (
   );
 
   assign ray_ready = port_ready;
-  assign res_valid = u_closest_res_valid;
-  assign res_id = u_closest_res_id;
-  assign res_hit = u_closest_res_hit;
-  assign res_tri = u_closest_res_tri;
-  assign res_t = u_closest_res_t;
-  assign res_u = u_closest_res_u;
-  assign res_v = u_closest_res_v;
-  assign busy = pipe_valid;
-  assign stack_depth = obs_depth_l1_0;
-  assign visits = visits_c;
-  assign culls = culls_c;
-  assign occupied = obs_occupied_l1_0;
-  assign accept = accept_int;
-  assign accept_id = acc_in_ray_id;
-  assign accept_slot = accept_slot_int;
-  assign visit0 = u_traverse_0_visit;
-  assign visit0_slot = u_traverse_0_visit_slot;
-  assign visit0_node = u_traverse_0_visit_node;
-  assign visit1 = u_traverse_1_visit;
-  assign visit1_slot = u_traverse_1_visit_slot;
-  assign visit1_node = u_traverse_1_visit_node;
+  assign res_valid = res_q_nonempty;
+  assign res_id = res_id_q;
+  assign res_hit = res_hit_q;
+  assign res_tri = res_tri_q;
+  assign res_t = res_t_q;
+  assign res_u = res_u_q;
+  assign res_v = res_v_q;
 endmodule
 `default_nettype wire

@@ -18,6 +18,7 @@ entity fxrt_core is
     invx : in signed(47 downto 0);
     invy : in signed(47 downto 0);
     invz : in signed(47 downto 0);
+    res_ready : in unsigned(0 downto 0);
     ray_ready : out unsigned(0 downto 0);
     res_valid : out unsigned(0 downto 0);
     res_id : out unsigned(19 downto 0);
@@ -25,21 +26,7 @@ entity fxrt_core is
     res_tri : out unsigned(12 downto 0);
     res_t : out unsigned(29 downto 0);
     res_u : out unsigned(31 downto 0);
-    res_v : out unsigned(31 downto 0);
-    busy : out unsigned(0 downto 0);
-    stack_depth : out unsigned(5 downto 0);
-    visits : out unsigned(2 downto 0);
-    culls : out unsigned(2 downto 0);
-    occupied : out unsigned(7 downto 0);
-    accept : out unsigned(0 downto 0);
-    accept_id : out unsigned(19 downto 0);
-    accept_slot : out unsigned(6 downto 0);
-    visit0 : out unsigned(0 downto 0);
-    visit0_slot : out unsigned(5 downto 0);
-    visit0_node : out unsigned(12 downto 0);
-    visit1 : out unsigned(0 downto 0);
-    visit1_slot : out unsigned(5 downto 0);
-    visit1_node : out unsigned(12 downto 0)
+    res_v : out unsigned(31 downto 0)
   );
 end entity fxrt_core;
 
@@ -138,6 +125,7 @@ architecture rtl of fxrt_core is
   component fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
     port (
       clk : in std_logic;
+      rst : in std_logic;
       valid : in unsigned(0 downto 0);
       tag : in unsigned(58 downto 0);
       ox : in unsigned(28 downto 0);
@@ -460,6 +448,46 @@ architecture rtl of fxrt_core is
     127 => "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
     others => (others => '0'));
 
+  type res_q_mem0_t is array (0 to 15) of unsigned(63 downto 0);
+  signal res_q_mem0 : res_q_mem0_t := (
+    0 => "0000000000000000000000000000000000000000000000000000000000000000",
+    1 => "0000000000000000000000000000000000000000000000000000000000000000",
+    2 => "0000000000000000000000000000000000000000000000000000000000000000",
+    3 => "0000000000000000000000000000000000000000000000000000000000000000",
+    4 => "0000000000000000000000000000000000000000000000000000000000000000",
+    5 => "0000000000000000000000000000000000000000000000000000000000000000",
+    6 => "0000000000000000000000000000000000000000000000000000000000000000",
+    7 => "0000000000000000000000000000000000000000000000000000000000000000",
+    8 => "0000000000000000000000000000000000000000000000000000000000000000",
+    9 => "0000000000000000000000000000000000000000000000000000000000000000",
+    10 => "0000000000000000000000000000000000000000000000000000000000000000",
+    11 => "0000000000000000000000000000000000000000000000000000000000000000",
+    12 => "0000000000000000000000000000000000000000000000000000000000000000",
+    13 => "0000000000000000000000000000000000000000000000000000000000000000",
+    14 => "0000000000000000000000000000000000000000000000000000000000000000",
+    15 => "0000000000000000000000000000000000000000000000000000000000000000",
+    others => (others => '0'));
+
+  type res_q_mem1_t is array (0 to 15) of unsigned(63 downto 0);
+  signal res_q_mem1 : res_q_mem1_t := (
+    0 => "0000000000000000000000000000000000000000000000000000000000000000",
+    1 => "0000000000000000000000000000000000000000000000000000000000000000",
+    2 => "0000000000000000000000000000000000000000000000000000000000000000",
+    3 => "0000000000000000000000000000000000000000000000000000000000000000",
+    4 => "0000000000000000000000000000000000000000000000000000000000000000",
+    5 => "0000000000000000000000000000000000000000000000000000000000000000",
+    6 => "0000000000000000000000000000000000000000000000000000000000000000",
+    7 => "0000000000000000000000000000000000000000000000000000000000000000",
+    8 => "0000000000000000000000000000000000000000000000000000000000000000",
+    9 => "0000000000000000000000000000000000000000000000000000000000000000",
+    10 => "0000000000000000000000000000000000000000000000000000000000000000",
+    11 => "0000000000000000000000000000000000000000000000000000000000000000",
+    12 => "0000000000000000000000000000000000000000000000000000000000000000",
+    13 => "0000000000000000000000000000000000000000000000000000000000000000",
+    14 => "0000000000000000000000000000000000000000000000000000000000000000",
+    15 => "0000000000000000000000000000000000000000000000000000000000000000",
+    others => (others => '0'));
+
   signal u0_has_free : unsigned(0 downto 0);
   signal u1_has_free : unsigned(0 downto 0);
   signal u0_free_slot : unsigned(5 downto 0);
@@ -510,8 +538,8 @@ architecture rtl of fxrt_core is
   signal box_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal accept_int : unsigned(0 downto 0) := unsigned'("0");
-  signal accept_slot_int : unsigned(6 downto 0) := unsigned'("0000000");
+  signal accept : unsigned(0 downto 0) := unsigned'("0");
+  signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal acc_in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal acc_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal acc_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -553,9 +581,12 @@ architecture rtl of fxrt_core is
   signal pu_delta_last : unsigned(0 downto 0) := unsigned'("0");
   signal u_plane_product_p : signed(77 downto 0);
   signal pu_product : signed(77 downto 0);
-  type pu_product_valid_sr_t is array (1 to 6) of unsigned(0 downto 0);
-  signal pu_product_valid_sr : pu_product_valid_sr_t := (others => (others => '0'));
-  signal pu_product_valid : unsigned(0 downto 0);
+  signal pu_product_valid_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_6 : unsigned(0 downto 0) := unsigned'("0");
   type pu_product_last_sr_t is array (1 to 6) of unsigned(0 downto 0);
   signal pu_product_last_sr : pu_product_last_sr_t := (others => (others => '0'));
   signal pu_product_last : unsigned(0 downto 0);
@@ -771,9 +802,9 @@ architecture rtl of fxrt_core is
   signal emit_tag : unsigned(58 downto 0);
   signal bits_emit_tag : unsigned(45 downto 0);
   signal emit_tag_tri : unsigned(58 downto 0);
-  type emit_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
-  signal emit_valid_sr : emit_valid_sr_t := (others => (others => '0'));
-  signal emit_valid : unsigned(0 downto 0);
+  signal emit_valid_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal emit_valid_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal emit_valid_3 : unsigned(0 downto 0) := unsigned'("0");
   signal tri_addr : unsigned(12 downto 0);
   signal u_tri_rom_0_data : unsigned(123 downto 0);
   signal tri_r : unsigned(1 downto 0);
@@ -794,9 +825,9 @@ architecture rtl of fxrt_core is
   signal tri_e2p : signed(31 downto 0);
   signal u_tri_rom_2_data : unsigned(31 downto 0);
   signal tri_e2q : signed(31 downto 0);
-  type pipe_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
-  signal pipe_valid_sr : pipe_valid_sr_t := (others => (others => '0'));
-  signal pipe_valid : unsigned(0 downto 0);
+  signal pipe_valid_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pipe_valid_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal pipe_valid_3 : unsigned(0 downto 0) := unsigned'("0");
   type pipe_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal pipe_tag_sr : pipe_tag_sr_t := (others => (others => '0'));
   signal pipe_tag : unsigned(58 downto 0);
@@ -824,11 +855,14 @@ architecture rtl of fxrt_core is
   signal u_intersect_t_1 : unsigned(29 downto 0);
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
+  signal res_credit_ok : unsigned(0 downto 0) := unsigned'("1");
   signal u0_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u0_done_took : unsigned(0 downto 0);
+  signal and_34 : unsigned(0 downto 0);
   signal u0_done_avail : unsigned(0 downto 0);
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
+  signal and_35 : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
   signal cat_36 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
@@ -852,19 +886,52 @@ architecture rtl of fxrt_core is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
-  signal lt_40 : unsigned(0 downto 0);
-  signal mux_lt_40 : unsigned(5 downto 0);
-  signal obs_depth_l1_0 : unsigned(5 downto 0) := unsigned'("000000");
-  signal rs_u_traverse_0_visit : unsigned(2 downto 0);
-  signal rs_u_traverse_1_visit : unsigned(2 downto 0);
-  signal visits_c : unsigned(2 downto 0);
-  signal rs_u_traverse_0_cull : unsigned(2 downto 0);
-  signal rs_u_traverse_1_cull : unsigned(2 downto 0);
-  signal culls_c : unsigned(2 downto 0);
-  signal rs_u_traverse_0_occupied : unsigned(7 downto 0);
-  signal rs_u_traverse_1_occupied : unsigned(7 downto 0);
-  signal plus_43 : unsigned(7 downto 0);
-  signal obs_occupied_l1_0 : unsigned(7 downto 0) := unsigned'("00000000");
+  signal cat_40 : unsigned(63 downto 0);
+  signal cat_41 : unsigned(63 downto 0);
+  signal res_take : unsigned(0 downto 0);
+  signal res_q_push : unsigned(0 downto 0) := unsigned'("0");
+  signal res_q_wr : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_count : unsigned(4 downto 0) := unsigned'("00000");
+  constant k_1_4 : unsigned(3 downto 0) := unsigned'("0001");
+  signal res_q_wr_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_q_push : unsigned(3 downto 0);
+  signal res_q_rd1 : unsigned(3 downto 0) := unsigned'("0001");
+  signal res_q_rd_next : unsigned(3 downto 0);
+  signal res_q_rd1_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take : unsigned(3 downto 0);
+  signal rs_res_take : unsigned(4 downto 0);
+  signal res_q_after_pop : unsigned(4 downto 0);
+  signal rs_res_q_push : unsigned(4 downto 0);
+  signal res_q_count_next : unsigned(4 downto 0);
+  signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
+  constant k_0_5 : unsigned(4 downto 0) := unsigned'("00000");
+  signal res_q_after_pop_eq_k_0_5 : unsigned(0 downto 0);
+  signal res_q_bypass_c : unsigned(0 downto 0);
+  signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
+  signal ne_45 : unsigned(0 downto 0);
+  signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_q_q0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_q_din_r0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_q_head0 : unsigned(63 downto 0);
+  signal res_q_din1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_q_q1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_q_din_r1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_q_head1 : unsigned(63 downto 0);
+  signal res_take_c : unsigned(0 downto 0);
+  signal res_credits : unsigned(5 downto 0) := unsigned'("010000");
+  signal rs_done_valid_r : unsigned(5 downto 0);
+  signal minus_47 : unsigned(5 downto 0);
+  signal rs_res_take_1 : unsigned(5 downto 0);
+  signal res_credits_next : unsigned(5 downto 0);
+  signal bits_res_credits_next : unsigned(4 downto 0);
+  signal ne_49 : unsigned(0 downto 0);
+  signal res_t_q : unsigned(29 downto 0);
+  signal res_tri_q : unsigned(12 downto 0);
+  signal res_hit_q : unsigned(0 downto 0);
+  signal res_id_q : unsigned(19 downto 0);
+  signal res_v_q : unsigned(31 downto 0);
+  signal res_u_q : unsigned(31 downto 0);
 begin
 
   u0_has_free <= u_traverse_0_has_free;
@@ -899,7 +966,7 @@ begin
   box_phase_plus_k_1_1 <= box_phase + k_1_1;
   mux_take_or_box_phase_ne_k_0 <= box_phase_plus_k_1_1 when take_or_box_phase_ne_k_0 = "1" else box_phase;
   box_idle <= "1" when box_phase = k_0 else "0";
-  bits_accept_slot <= unsigned(accept_slot_int(5 downto 0));
+  bits_accept_slot <= unsigned(accept_slot(5 downto 0));
   box_axis <= box_phase - k_1_1;
   with box_axis select
     case_box_axis <=
@@ -931,7 +998,6 @@ begin
       box_in_invz when "10",
       box_in_invx when others;
   pu_product <= u_plane_product_p;
-  pu_product_valid <= pu_product_valid_sr(6);
   pu_product_last <= pu_product_last_sr(6);
   bits_pu_product <= unsigned(pu_product(77 downto 16));
   pu_shifted <= signed(bits_pu_product);
@@ -976,9 +1042,9 @@ begin
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
-  bits_accept_slot_1 <= unsigned(accept_slot_int(6 downto 6));
+  bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
   eq_10 <= "1" when bits_accept_slot_1 = k_0_1 else "0";
-  u0_alloc <= accept_int and eq_10;
+  u0_alloc <= accept and eq_10;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
   eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
   u0_new <= box_done and eq_11;
@@ -991,9 +1057,9 @@ begin
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
-  bits_accept_slot_2 <= unsigned(accept_slot_int(6 downto 6));
+  bits_accept_slot_2 <= unsigned(accept_slot(6 downto 6));
   eq_14 <= "1" when bits_accept_slot_2 = k_1 else "0";
-  u1_alloc <= accept_int and eq_14;
+  u1_alloc <= accept and eq_14;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
   eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
   u1_new <= box_done and eq_15;
@@ -1099,7 +1165,6 @@ begin
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
-  emit_valid <= emit_valid_sr(3);
   tri_addr <= u_leaf_rom_data;
   tri_r <= unsigned(u_tri_rom_0_data(1 downto 0));
   tri_pp <= unsigned(u_tri_rom_0_data(30 downto 2));
@@ -1117,7 +1182,6 @@ begin
   bits_u_tri_rom_1_data_3 <= unsigned(u_tri_rom_1_data(127 downto 96));
   tri_e2p <= signed(bits_u_tri_rom_1_data_3);
   tri_e2q <= signed(u_tri_rom_2_data);
-  pipe_valid <= pipe_valid_sr(3);
   pipe_tag <= pipe_tag_sr(3);
   bits_emit_tag_tri <= unsigned(emit_tag_tri(56 downto 50));
   pipe_o <= pipe_o_sr(2);
@@ -1132,35 +1196,62 @@ begin
   bits_pipe_w_2 <= unsigned(pipe_w(95 downto 64));
   s_bits_pipe_w_2 <= signed(bits_pipe_w_2);
   not_u0_done_took <= not u0_done_took;
-  u0_done_avail <= u_traverse_0_done_valid and not_u0_done_took;
+  and_34 <= u_traverse_0_done_valid and not_u0_done_took;
+  u0_done_avail <= and_34 and res_credit_ok;
   not_u1_done_took <= not u1_done_took;
-  u1_done_avail <= u_traverse_1_done_valid and not_u1_done_took;
+  and_35 <= u_traverse_1_done_valid and not_u1_done_took;
+  u1_done_avail <= and_35 and res_credit_ok;
   cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
   cat_38 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
   mux_u0_done_avail <= cat_36 when u0_done_avail = "1" else cat_38;
   or_39 <= u0_done_avail or u1_done_avail;
-  lt_40 <= "1" when u_traverse_0_depth < u_traverse_1_depth else "0";
-  mux_lt_40 <= u_traverse_1_depth when lt_40 = "1" else u_traverse_0_depth;
-  rs_u_traverse_0_visit <= resize(u_traverse_0_visit, 3);
-  rs_u_traverse_1_visit <= resize(u_traverse_1_visit, 3);
-  visits_c <= rs_u_traverse_0_visit + rs_u_traverse_1_visit;
-  rs_u_traverse_0_cull <= resize(u_traverse_0_cull, 3);
-  rs_u_traverse_1_cull <= resize(u_traverse_1_cull, 3);
-  culls_c <= rs_u_traverse_0_cull + rs_u_traverse_1_cull;
-  rs_u_traverse_0_occupied <= resize(u_traverse_0_occupied, 8);
-  rs_u_traverse_1_occupied <= resize(u_traverse_1_occupied, 8);
-  plus_43 <= rs_u_traverse_0_occupied + rs_u_traverse_1_occupied;
+  cat_40 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
+  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
+  res_take <= res_take_c;
+  res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
+  mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
+  res_q_rd_next <= res_q_rd1 when res_take = "1" else res_q_rd;
+  res_q_rd1_plus_k_1_4 <= res_q_rd1 + k_1_4;
+  mux_res_take <= res_q_rd1_plus_k_1_4 when res_take = "1" else res_q_rd1;
+  rs_res_take <= resize(res_take, 5);
+  res_q_after_pop <= res_q_count - rs_res_take;
+  rs_res_q_push <= resize(res_q_push, 5);
+  res_q_count_next <= res_q_after_pop + rs_res_q_push;
+  res_q_after_pop_eq_k_0_5 <= "1" when res_q_after_pop = k_0_5 else "0";
+  res_q_bypass_c <= res_q_push and res_q_after_pop_eq_k_0_5;
+  ne_45 <= "1" when res_q_count_next /= k_0_5 else "0";
+  res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
+  res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
+  res_take_c <= res_q_nonempty and res_ready;
+  rs_done_valid_r <= resize(done_valid_r, 6);
+  minus_47 <= res_credits - rs_done_valid_r;
+  rs_res_take_1 <= resize(res_take, 6);
+  res_credits_next <= minus_47 + rs_res_take_1;
+  bits_res_credits_next <= unsigned(res_credits_next(5 downto 1));
+  ne_49 <= "1" when bits_res_credits_next /= k_0_5 else "0";
+  res_t_q <= unsigned(res_q_head0(29 downto 0));
+  res_tri_q <= unsigned(res_q_head0(42 downto 30));
+  res_hit_q <= unsigned(res_q_head0(43 downto 43));
+  res_id_q <= unsigned(res_q_head0(63 downto 44));
+  res_v_q <= unsigned(res_q_head1(31 downto 0));
+  res_u_q <= unsigned(res_q_head1(63 downto 32));
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if accept_int = "1" then
-        ray_o(to_integer(accept_slot_int)) <= cat_18;
+      if accept = "1" then
+        ray_o(to_integer(accept_slot)) <= cat_18;
       end if;
-      if accept_int = "1" then
-        ray_w(to_integer(accept_slot_int)) <= cat_19;
+      if accept = "1" then
+        ray_w(to_integer(accept_slot)) <= cat_19;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem1(to_integer(res_q_wr)) <= res_q_din1;
       end if;
       if rst = '1' then
         turn <= unsigned'("0");
@@ -1240,8 +1331,12 @@ begin
       if box_idle = "1" then
         box_in_invz <= in_invz;
       end if;
-      accept_int <= take;
-      accept_slot_int <= take_slot;
+      if rst = '1' then
+        accept <= unsigned'("0");
+      else
+        accept <= take;
+      end if;
+      accept_slot <= take_slot;
       acc_in_ray_id <= in_ray_id;
       acc_in_ox <= in_ox;
       acc_in_oy <= in_oy;
@@ -1255,22 +1350,62 @@ begin
       if take = "1" then
         box_slot <= take_slot;
       end if;
-      pu_sel_valid <= box_issue;
+      if rst = '1' then
+        pu_sel_valid <= unsigned'("0");
+      else
+        pu_sel_valid <= box_issue;
+      end if;
       pu_sel_last <= box_issue_last;
       pu_sel_plane <= box_plane;
       pu_sel_axis <= box_axis;
       pu_delta <= pu_diff;
       pu_inv <= pu_inv_axis;
-      pu_delta_valid <= pu_sel_valid;
+      if rst = '1' then
+        pu_delta_valid <= unsigned'("0");
+      else
+        pu_delta_valid <= pu_sel_valid;
+      end if;
       pu_delta_last <= pu_sel_last;
-      pu_product_valid_sr(2 to 6) <= pu_product_valid_sr(1 to 5);
-      pu_product_valid_sr(1) <= pu_delta_valid;
+      if rst = '1' then
+        pu_product_valid_1 <= unsigned'("0");
+      else
+        pu_product_valid_1 <= pu_delta_valid;
+      end if;
+      if rst = '1' then
+        pu_product_valid_2 <= unsigned'("0");
+      else
+        pu_product_valid_2 <= pu_product_valid_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_3 <= unsigned'("0");
+      else
+        pu_product_valid_3 <= pu_product_valid_2;
+      end if;
+      if rst = '1' then
+        pu_product_valid_4 <= unsigned'("0");
+      else
+        pu_product_valid_4 <= pu_product_valid_3;
+      end if;
+      if rst = '1' then
+        pu_product_valid_5 <= unsigned'("0");
+      else
+        pu_product_valid_5 <= pu_product_valid_4;
+      end if;
+      if rst = '1' then
+        pu_product_valid_6 <= unsigned'("0");
+      else
+        pu_product_valid_6 <= pu_product_valid_5;
+      end if;
       pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
       pu_product_last_sr(1) <= pu_delta_last;
       pu_above_r <= pu_above;
       pu_below_r <= pu_below;
       pu_low_r <= rs_pu_shifted;
-      pu_clamp_valid <= pu_product_valid;
+      if rst = '1' then
+        pu_clamp_valid <= unsigned'("0");
+      else
+        pu_clamp_valid <= pu_product_valid_6;
+      end if;
       pu_clamp_last <= pu_product_last;
       plane_t <= pu_clamped;
       if pu_clamp_last = "1" then
@@ -1279,7 +1414,11 @@ begin
       if pu_first = "1" then
         plane_t_of_first <= pu_clamped;
       end if;
-      plane_t_valid <= pu_clamp_valid;
+      if rst = '1' then
+        plane_t_valid <= unsigned'("0");
+      else
+        plane_t_valid <= pu_clamp_valid;
+      end if;
       plane_t_last <= pu_clamp_last;
       box_d1 <= plane_t;
       box_d2 <= box_d1;
@@ -1287,7 +1426,11 @@ begin
       box_lt1 <= box_lt1_c;
       box_lt2 <= box_lt2_c;
       box_lt1_d <= box_lt1;
-      box_done <= box_last;
+      if rst = '1' then
+        box_done <= unsigned'("0");
+      else
+        box_done <= box_last;
+      end if;
       box_done_slot_sr(2 to 11) <= box_done_slot_sr(1 to 10);
       box_done_slot_sr(1) <= box_slot;
       if rst = '1' then
@@ -1349,10 +1492,36 @@ begin
       end if;
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
       emit_tag_sr(1) <= cat_32;
-      emit_valid_sr(2 to 3) <= emit_valid_sr(1 to 2);
-      emit_valid_sr(1) <= leaf_active;
-      pipe_valid_sr(2 to 3) <= pipe_valid_sr(1 to 2);
-      pipe_valid_sr(1) <= emit_valid;
+      if rst = '1' then
+        emit_valid_1 <= unsigned'("0");
+      else
+        emit_valid_1 <= leaf_active;
+      end if;
+      if rst = '1' then
+        emit_valid_2 <= unsigned'("0");
+      else
+        emit_valid_2 <= emit_valid_1;
+      end if;
+      if rst = '1' then
+        emit_valid_3 <= unsigned'("0");
+      else
+        emit_valid_3 <= emit_valid_2;
+      end if;
+      if rst = '1' then
+        pipe_valid_1 <= unsigned'("0");
+      else
+        pipe_valid_1 <= emit_valid_3;
+      end if;
+      if rst = '1' then
+        pipe_valid_2 <= unsigned'("0");
+      else
+        pipe_valid_2 <= pipe_valid_1;
+      end if;
+      if rst = '1' then
+        pipe_valid_3 <= unsigned'("0");
+      else
+        pipe_valid_3 <= pipe_valid_2;
+      end if;
       pipe_tag_sr(2 to 3) <= pipe_tag_sr(1 to 2);
       pipe_tag_sr(1) <= emit_tag_tri;
       ray_o_q <= ray_o(to_integer(bits_emit_tag_tri));
@@ -1361,12 +1530,77 @@ begin
       ray_w_q <= ray_w(to_integer(bits_emit_tag_tri));
       pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
       pipe_w_sr(1) <= ray_w_q;
-      u0_done_took <= u0_done_pop;
-      u1_done_took <= u1_done_pop;
-      done_valid_r <= or_39;
+      if rst = '1' then
+        res_credit_ok <= unsigned'("1");
+      else
+        res_credit_ok <= ne_49;
+      end if;
+      if rst = '1' then
+        u0_done_took <= unsigned'("0");
+      else
+        u0_done_took <= u0_done_pop;
+      end if;
+      if rst = '1' then
+        u1_done_took <= unsigned'("0");
+      else
+        u1_done_took <= u1_done_pop;
+      end if;
+      if rst = '1' then
+        done_valid_r <= unsigned'("0");
+      else
+        done_valid_r <= or_39;
+      end if;
       done_slot_r <= mux_u0_done_avail;
-      obs_depth_l1_0 <= mux_lt_40;
-      obs_occupied_l1_0 <= plus_43;
+      if rst = '1' then
+        res_q_push <= unsigned'("0");
+      else
+        res_q_push <= u_closest_res_valid;
+      end if;
+      if rst = '1' then
+        res_q_wr <= unsigned'("0000");
+      else
+        res_q_wr <= mux_res_q_push;
+      end if;
+      if rst = '1' then
+        res_q_rd <= unsigned'("0000");
+      else
+        res_q_rd <= res_q_rd_next;
+      end if;
+      if rst = '1' then
+        res_q_count <= unsigned'("00000");
+      else
+        res_q_count <= res_q_count_next;
+      end if;
+      if rst = '1' then
+        res_q_rd1 <= unsigned'("0001");
+      else
+        res_q_rd1 <= mux_res_take;
+      end if;
+      if rst = '1' then
+        res_q_bypass <= unsigned'("0");
+      else
+        res_q_bypass <= res_q_bypass_c;
+      end if;
+      if rst = '1' then
+        res_q_nonempty <= unsigned'("0");
+      else
+        res_q_nonempty <= ne_45;
+      end if;
+      res_q_din0 <= cat_40;
+      res_q_q0 <= res_q_mem0(to_integer(res_q_rd_next));
+      if res_q_push = "1" then
+        res_q_din_r0 <= res_q_din0;
+      end if;
+      res_q_din1 <= cat_41;
+      res_q_q1 <= res_q_mem1(to_integer(res_q_rd_next));
+      if res_q_push = "1" then
+        res_q_din_r1 <= res_q_din1;
+      end if;
+      if rst = '1' then
+        res_credits <= unsigned'("010000");
+      else
+        res_credits <= res_credits_next;
+      end if;
     end if;
   end process regs;
 
@@ -1510,7 +1744,8 @@ begin
   u_intersect : fxrt_intersect_n29_m32_t0_e18_tag59_c150
     port map (
       clk => clk,
-      valid => pipe_valid,
+      rst => rst,
+      valid => pipe_valid_3,
       tag => pipe_tag,
       ox => bits_pipe_o,
       oy => bits_pipe_o_1,
@@ -1546,8 +1781,8 @@ begin
       t => u_intersect_t_1,
       u => u_intersect_u,
       v => u_intersect_v,
-      id_we => accept_int,
-      id_slot => accept_slot_int,
+      id_we => accept,
+      id_slot => accept_slot,
       id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,
@@ -1568,25 +1803,11 @@ begin
     );
 
   ray_ready <= port_ready;
-  res_valid <= u_closest_res_valid;
-  res_id <= u_closest_res_id;
-  res_hit <= u_closest_res_hit;
-  res_tri <= u_closest_res_tri;
-  res_t <= u_closest_res_t;
-  res_u <= u_closest_res_u;
-  res_v <= u_closest_res_v;
-  busy <= pipe_valid;
-  stack_depth <= obs_depth_l1_0;
-  visits <= visits_c;
-  culls <= culls_c;
-  occupied <= obs_occupied_l1_0;
-  accept <= accept_int;
-  accept_id <= acc_in_ray_id;
-  accept_slot <= accept_slot_int;
-  visit0 <= u_traverse_0_visit;
-  visit0_slot <= u_traverse_0_visit_slot;
-  visit0_node <= u_traverse_0_visit_node;
-  visit1 <= u_traverse_1_visit;
-  visit1_slot <= u_traverse_1_visit_slot;
-  visit1_node <= u_traverse_1_visit_node;
+  res_valid <= res_q_nonempty;
+  res_id <= res_id_q;
+  res_hit <= res_hit_q;
+  res_tri <= res_tri_q;
+  res_t <= res_t_q;
+  res_u <= res_u_q;
+  res_v <= res_v_q;
 end architecture rtl;

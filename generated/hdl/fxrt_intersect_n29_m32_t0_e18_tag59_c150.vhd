@@ -6,6 +6,7 @@ use ieee.numeric_std.all;
 entity fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   port (
     clk : in std_logic;
+    rst : in std_logic;
     valid : in unsigned(0 downto 0);
     tag : in unsigned(58 downto 0);
     ox : in unsigned(28 downto 0);
@@ -326,9 +327,60 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   type s53_v_d2_sr_t is array (1 to 2) of signed(64 downto 0);
   signal s53_v_d2_sr : s53_v_d2_sr_t := (others => (others => '0'));
   signal s53_v_d2 : signed(64 downto 0);
-  type s1_valid_d54_sr_t is array (1 to 54) of unsigned(0 downto 0);
-  signal s1_valid_d54_sr : s1_valid_d54_sr_t := (others => (others => '0'));
-  signal s1_valid_d54 : unsigned(0 downto 0);
+  signal s1_valid_d54_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_6 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_7 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_8 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_9 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_10 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_11 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_12 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_13 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_14 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_15 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_16 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_17 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_18 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_19 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_20 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_21 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_22 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_23 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_24 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_25 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_26 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_27 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_28 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_29 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_30 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_31 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_32 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_33 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_34 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_35 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_36 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_37 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_38 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_39 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_40 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_41 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_42 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_43 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_44 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_45 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_46 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_47 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_48 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_49 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_50 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_51 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_52 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_53 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d54_54 : unsigned(0 downto 0) := unsigned'("0");
   type s1_tag_d54_sr_t is array (1 to 54) of unsigned(58 downto 0);
   signal s1_tag_d54_sr : s1_tag_d54_sr_t := (others => (others => '0'));
   signal s1_tag_d54 : unsigned(58 downto 0);
@@ -358,7 +410,11 @@ begin
   s1_inputs_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s1_valid <= valid;
+      if rst = '1' then
+        s1_valid <= unsigned'("0");
+      else
+        s1_valid <= valid;
+      end if;
       s1_tag <= tag;
       s1_ox <= ox;
       s1_oy <= oy;
@@ -639,7 +695,6 @@ begin
   u_div_t_1_d15 <= u_div_t_1_d15_sr(15);
   s53_u_d2 <= s53_u_d2_sr(2);
   s53_v_d2 <= s53_v_d2_sr(2);
-  s1_valid_d54 <= s1_valid_d54_sr(54);
   s1_tag_d54 <= s1_tag_d54_sr(54);
   mux_s55_hit <= u_div_t_1_d15 when s55_hit = "1" else k_0_5;
   shr_s53_u_d2 <= shift_right(s53_u_d2, 18);
@@ -660,11 +715,283 @@ begin
       s53_u_d2_sr(1) <= s53_u;
       s53_v_d2_sr(2 to 2) <= s53_v_d2_sr(1 to 1);
       s53_v_d2_sr(1) <= s53_v;
-      s1_valid_d54_sr(2 to 54) <= s1_valid_d54_sr(1 to 53);
-      s1_valid_d54_sr(1) <= s1_valid;
+      if rst = '1' then
+        s1_valid_d54_1 <= unsigned'("0");
+      else
+        s1_valid_d54_1 <= s1_valid;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_2 <= unsigned'("0");
+      else
+        s1_valid_d54_2 <= s1_valid_d54_1;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_3 <= unsigned'("0");
+      else
+        s1_valid_d54_3 <= s1_valid_d54_2;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_4 <= unsigned'("0");
+      else
+        s1_valid_d54_4 <= s1_valid_d54_3;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_5 <= unsigned'("0");
+      else
+        s1_valid_d54_5 <= s1_valid_d54_4;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_6 <= unsigned'("0");
+      else
+        s1_valid_d54_6 <= s1_valid_d54_5;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_7 <= unsigned'("0");
+      else
+        s1_valid_d54_7 <= s1_valid_d54_6;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_8 <= unsigned'("0");
+      else
+        s1_valid_d54_8 <= s1_valid_d54_7;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_9 <= unsigned'("0");
+      else
+        s1_valid_d54_9 <= s1_valid_d54_8;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_10 <= unsigned'("0");
+      else
+        s1_valid_d54_10 <= s1_valid_d54_9;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_11 <= unsigned'("0");
+      else
+        s1_valid_d54_11 <= s1_valid_d54_10;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_12 <= unsigned'("0");
+      else
+        s1_valid_d54_12 <= s1_valid_d54_11;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_13 <= unsigned'("0");
+      else
+        s1_valid_d54_13 <= s1_valid_d54_12;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_14 <= unsigned'("0");
+      else
+        s1_valid_d54_14 <= s1_valid_d54_13;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_15 <= unsigned'("0");
+      else
+        s1_valid_d54_15 <= s1_valid_d54_14;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_16 <= unsigned'("0");
+      else
+        s1_valid_d54_16 <= s1_valid_d54_15;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_17 <= unsigned'("0");
+      else
+        s1_valid_d54_17 <= s1_valid_d54_16;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_18 <= unsigned'("0");
+      else
+        s1_valid_d54_18 <= s1_valid_d54_17;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_19 <= unsigned'("0");
+      else
+        s1_valid_d54_19 <= s1_valid_d54_18;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_20 <= unsigned'("0");
+      else
+        s1_valid_d54_20 <= s1_valid_d54_19;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_21 <= unsigned'("0");
+      else
+        s1_valid_d54_21 <= s1_valid_d54_20;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_22 <= unsigned'("0");
+      else
+        s1_valid_d54_22 <= s1_valid_d54_21;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_23 <= unsigned'("0");
+      else
+        s1_valid_d54_23 <= s1_valid_d54_22;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_24 <= unsigned'("0");
+      else
+        s1_valid_d54_24 <= s1_valid_d54_23;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_25 <= unsigned'("0");
+      else
+        s1_valid_d54_25 <= s1_valid_d54_24;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_26 <= unsigned'("0");
+      else
+        s1_valid_d54_26 <= s1_valid_d54_25;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_27 <= unsigned'("0");
+      else
+        s1_valid_d54_27 <= s1_valid_d54_26;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_28 <= unsigned'("0");
+      else
+        s1_valid_d54_28 <= s1_valid_d54_27;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_29 <= unsigned'("0");
+      else
+        s1_valid_d54_29 <= s1_valid_d54_28;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_30 <= unsigned'("0");
+      else
+        s1_valid_d54_30 <= s1_valid_d54_29;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_31 <= unsigned'("0");
+      else
+        s1_valid_d54_31 <= s1_valid_d54_30;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_32 <= unsigned'("0");
+      else
+        s1_valid_d54_32 <= s1_valid_d54_31;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_33 <= unsigned'("0");
+      else
+        s1_valid_d54_33 <= s1_valid_d54_32;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_34 <= unsigned'("0");
+      else
+        s1_valid_d54_34 <= s1_valid_d54_33;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_35 <= unsigned'("0");
+      else
+        s1_valid_d54_35 <= s1_valid_d54_34;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_36 <= unsigned'("0");
+      else
+        s1_valid_d54_36 <= s1_valid_d54_35;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_37 <= unsigned'("0");
+      else
+        s1_valid_d54_37 <= s1_valid_d54_36;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_38 <= unsigned'("0");
+      else
+        s1_valid_d54_38 <= s1_valid_d54_37;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_39 <= unsigned'("0");
+      else
+        s1_valid_d54_39 <= s1_valid_d54_38;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_40 <= unsigned'("0");
+      else
+        s1_valid_d54_40 <= s1_valid_d54_39;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_41 <= unsigned'("0");
+      else
+        s1_valid_d54_41 <= s1_valid_d54_40;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_42 <= unsigned'("0");
+      else
+        s1_valid_d54_42 <= s1_valid_d54_41;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_43 <= unsigned'("0");
+      else
+        s1_valid_d54_43 <= s1_valid_d54_42;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_44 <= unsigned'("0");
+      else
+        s1_valid_d54_44 <= s1_valid_d54_43;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_45 <= unsigned'("0");
+      else
+        s1_valid_d54_45 <= s1_valid_d54_44;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_46 <= unsigned'("0");
+      else
+        s1_valid_d54_46 <= s1_valid_d54_45;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_47 <= unsigned'("0");
+      else
+        s1_valid_d54_47 <= s1_valid_d54_46;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_48 <= unsigned'("0");
+      else
+        s1_valid_d54_48 <= s1_valid_d54_47;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_49 <= unsigned'("0");
+      else
+        s1_valid_d54_49 <= s1_valid_d54_48;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_50 <= unsigned'("0");
+      else
+        s1_valid_d54_50 <= s1_valid_d54_49;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_51 <= unsigned'("0");
+      else
+        s1_valid_d54_51 <= s1_valid_d54_50;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_52 <= unsigned'("0");
+      else
+        s1_valid_d54_52 <= s1_valid_d54_51;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_53 <= unsigned'("0");
+      else
+        s1_valid_d54_53 <= s1_valid_d54_52;
+      end if;
+      if rst = '1' then
+        s1_valid_d54_54 <= unsigned'("0");
+      else
+        s1_valid_d54_54 <= s1_valid_d54_53;
+      end if;
       s1_tag_d54_sr(2 to 54) <= s1_tag_d54_sr(1 to 53);
       s1_tag_d54_sr(1) <= s1_tag;
-      s56_valid_out <= s1_valid_d54;
+      if rst = '1' then
+        s56_valid_out <= unsigned'("0");
+      else
+        s56_valid_out <= s1_valid_d54_54;
+      end if;
       s56_tag_out <= s1_tag_d54;
       s56_hit <= s55_hit;
       s56_t <= mux_s55_hit;

@@ -543,7 +543,6 @@ module fxrt_traverse_k64 (
   wire [0:0] new_pop;
   wire [11:0] cat_78;
   reg [0:0] unpark_q_push = 1'h0;
-  reg [11:0] unpark_q_din = 12'h000;
   reg [5:0] unpark_q_wr = 6'h00;
   reg [5:0] unpark_q_rd = 6'h00;
   reg [6:0] unpark_q_count = 7'h00;
@@ -557,19 +556,19 @@ module fxrt_traverse_k64 (
   wire [6:0] unpark_q_after_pop;
   wire [6:0] rs_unpark_q_push;
   wire [6:0] unpark_q_count_next;
-  reg [11:0] unpark_q_q = 12'h000;
   reg [0:0] unpark_q_bypass = 1'h0;
   wire [6:0] k_0_3 = 7'h00;
   wire [0:0] eq_81;
   wire [0:0] unpark_q_bypass_c;
-  reg [11:0] unpark_q_din_r = 12'h000;
   reg [0:0] unpark_q_nonempty = 1'h0;
   wire [0:0] ne_82;
+  reg [11:0] unpark_q_din = 12'h000;
+  reg [11:0] unpark_q_q = 12'h000;
+  reg [11:0] unpark_q_din_r = 12'h000;
   wire [11:0] unpark_q_head;
   wire [31:0] u_new_tmax;
   wire [38:0] cat_83;
   reg [0:0] new_q_push = 1'h0;
-  reg [38:0] new_q_din = 39'h0000000000;
   reg [5:0] new_q_wr = 6'h00;
   reg [5:0] new_q_rd = 6'h00;
   reg [6:0] new_q_count = 7'h00;
@@ -583,13 +582,14 @@ module fxrt_traverse_k64 (
   wire [6:0] new_q_after_pop;
   wire [6:0] rs_new_q_push;
   wire [6:0] new_q_count_next;
-  reg [38:0] new_q_q = 39'h0000000000;
   reg [0:0] new_q_bypass = 1'h0;
   wire [0:0] new_q_after_pop_eq_k_0_3;
   wire [0:0] new_q_bypass_c;
-  reg [38:0] new_q_din_r = 39'h0000000000;
   reg [0:0] new_q_nonempty = 1'h0;
   wire [0:0] ne_87;
+  reg [38:0] new_q_din = 39'h0000000000;
+  reg [38:0] new_q_q = 39'h0000000000;
+  reg [38:0] new_q_din_r = 39'h0000000000;
   wire [38:0] new_q_head;
   wire [0:0] not_ring_g_valid;
   wire [0:0] take_unpark;
@@ -673,7 +673,6 @@ module fxrt_traverse_k64 (
   reg [5:0] b2_sp = 6'h00;
   reg [0:0] done_pop_r = 1'h0;
   reg [0:0] done_q_push = 1'h0;
-  reg [5:0] done_q_din = 6'h00;
   reg [5:0] done_q_wr = 6'h00;
   reg [5:0] done_q_rd = 6'h00;
   reg [6:0] done_q_count = 7'h00;
@@ -687,13 +686,14 @@ module fxrt_traverse_k64 (
   wire [6:0] done_q_after_pop;
   wire [6:0] rs_done_q_push;
   wire [6:0] done_q_count_next;
-  reg [5:0] done_q_q = 6'h00;
   reg [0:0] done_q_bypass = 1'h0;
   wire [0:0] eq_97;
   wire [0:0] done_q_bypass_c;
-  reg [5:0] done_q_din_r = 6'h00;
   reg [0:0] done_q_nonempty = 1'h0;
   wire [0:0] ne_98;
+  reg [5:0] done_q_din = 6'h00;
+  reg [5:0] done_q_q = 6'h00;
+  reg [5:0] done_q_din_r = 6'h00;
   wire [5:0] done_q_head;
   wire [31:0] bits_u_stack_data;
   wire signed [31:0] s_bits_u_stack_data;
@@ -929,10 +929,9 @@ module fxrt_traverse_k64 (
   wire [63:0] not_best_clear;
   wire [63:0] and_105;
   wire [63:0] and_105_or_best_set;
-  (* mem2reg *) reg [0:0] n_valid_sr [1:3];
-  integer n_valid_i;
-  initial for (n_valid_i = 1; n_valid_i <= 3; n_valid_i = n_valid_i + 1) n_valid_sr[n_valid_i] = 1'h0;
-  wire [0:0] n_valid;
+  reg [0:0] n_valid_1 = 1'h0;
+  reg [0:0] n_valid_2 = 1'h0;
+  reg [0:0] n_valid_3 = 1'h0;
   (* mem2reg *) reg [5:0] n_slot_sr [1:3];
   integer n_slot_i;
   initial for (n_slot_i = 1; n_slot_i <= 3; n_slot_i = n_slot_i + 1) n_slot_sr[n_slot_i] = 6'h00;
@@ -973,10 +972,9 @@ module fxrt_traverse_k64 (
   wire [31:0] u_n_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_n_tmin;
-  wire [58:0] cat_108;
+  wire [58:0] cat_109;
   reg [0:0] leaf_pop_r = 1'h0;
   reg [0:0] leaf_q_push = 1'h0;
-  reg [58:0] leaf_q_din = 59'h000000000000000;
   reg [5:0] leaf_q_wr = 6'h00;
   reg [5:0] leaf_q_rd = 6'h00;
   reg [6:0] leaf_q_count = 7'h00;
@@ -990,13 +988,14 @@ module fxrt_traverse_k64 (
   wire [6:0] leaf_q_after_pop;
   wire [6:0] rs_leaf_q_push;
   wire [6:0] leaf_q_count_next;
-  reg [58:0] leaf_q_q = 59'h000000000000000;
   reg [0:0] leaf_q_bypass = 1'h0;
-  wire [0:0] eq_111;
+  wire [0:0] eq_112;
   wire [0:0] leaf_q_bypass_c;
-  reg [58:0] leaf_q_din_r = 59'h000000000000000;
   reg [0:0] leaf_q_nonempty = 1'h0;
-  wire [0:0] ne_112;
+  wire [0:0] ne_113;
+  reg [58:0] leaf_q_din = 59'h000000000000000;
+  reg [58:0] leaf_q_q = 59'h000000000000000;
+  reg [58:0] leaf_q_din_r = 59'h000000000000000;
   wire [58:0] leaf_q_head;
   reg [86:0] ray_o_q = 87'h0000000000000000000000;
   wire [28:0] bits_ray_o_q;
@@ -1027,10 +1026,12 @@ module fxrt_traverse_k64 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 77:16 are read
   wire signed [77:0] pu_product;
   /* verilator lint_on UNUSEDSIGNAL */
-  (* mem2reg *) reg [0:0] pu_product_valid_sr [1:6];
-  integer pu_product_valid_i;
-  initial for (pu_product_valid_i = 1; pu_product_valid_i <= 6; pu_product_valid_i = pu_product_valid_i + 1) pu_product_valid_sr[pu_product_valid_i] = 1'h0;
-  wire [0:0] pu_product_valid;
+  reg [0:0] pu_product_valid_1 = 1'h0;
+  reg [0:0] pu_product_valid_2 = 1'h0;
+  reg [0:0] pu_product_valid_3 = 1'h0;
+  reg [0:0] pu_product_valid_4 = 1'h0;
+  reg [0:0] pu_product_valid_5 = 1'h0;
+  reg [0:0] pu_product_valid_6 = 1'h0;
   (* mem2reg *) reg [0:0] pu_product_last_sr [1:6];
   integer pu_product_last_i;
   initial for (pu_product_last_i = 1; pu_product_last_i <= 6; pu_product_last_i = pu_product_last_i + 1) pu_product_last_sr[pu_product_last_i] = 1'h0;
@@ -1088,10 +1089,12 @@ module fxrt_traverse_k64 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 77:16 are read
   wire signed [77:0] pu_product_1;
   /* verilator lint_on UNUSEDSIGNAL */
-  (* mem2reg *) reg [0:0] pu_product_valid_1_sr [1:6];
-  integer pu_product_valid_1_i;
-  initial for (pu_product_valid_1_i = 1; pu_product_valid_1_i <= 6; pu_product_valid_1_i = pu_product_valid_1_i + 1) pu_product_valid_1_sr[pu_product_valid_1_i] = 1'h0;
-  wire [0:0] pu_product_valid_1;
+  reg [0:0] pu_product_valid_1_1 = 1'h0;
+  reg [0:0] pu_product_valid_2_1 = 1'h0;
+  reg [0:0] pu_product_valid_3_1 = 1'h0;
+  reg [0:0] pu_product_valid_4_1 = 1'h0;
+  reg [0:0] pu_product_valid_5_1 = 1'h0;
+  reg [0:0] pu_product_valid_6_1 = 1'h0;
   (* mem2reg *) reg [0:0] pu_product_last_1_sr [1:6];
   integer pu_product_last_1_i;
   initial for (pu_product_last_1_i = 1; pu_product_last_1_i <= 6; pu_product_last_1_i = pu_product_last_1_i + 1) pu_product_last_1_sr[pu_product_last_1_i] = 1'h0;
@@ -1101,7 +1104,7 @@ module fxrt_traverse_k64 (
   wire [0:0] pu_below_1;
   wire [0:0] not_pu_below_1;
   wire [30:0] bits_pu_shifted_1;
-  wire [0:0] ne_117;
+  wire [0:0] ne_118;
   wire [0:0] pu_above_1;
   wire signed [31:0] rs_pu_shifted_1;
   reg [0:0] pu_above_r_1 = 1'h0;
@@ -1137,10 +1140,16 @@ module fxrt_traverse_k64 (
   wire [0:0] negative;
   wire [0:0] not_leaf_push;
   wire [0:0] n_stays;
-  (* mem2reg *) reg [0:0] f_valid_sr [1:10];
-  integer f_valid_i;
-  initial for (f_valid_i = 1; f_valid_i <= 10; f_valid_i = f_valid_i + 1) f_valid_sr[f_valid_i] = 1'h0;
-  wire [0:0] f_valid;
+  reg [0:0] f_valid_1 = 1'h0;
+  reg [0:0] f_valid_2 = 1'h0;
+  reg [0:0] f_valid_3 = 1'h0;
+  reg [0:0] f_valid_4 = 1'h0;
+  reg [0:0] f_valid_5 = 1'h0;
+  reg [0:0] f_valid_6 = 1'h0;
+  reg [0:0] f_valid_7 = 1'h0;
+  reg [0:0] f_valid_8 = 1'h0;
+  reg [0:0] f_valid_9 = 1'h0;
+  reg [0:0] f_valid_10 = 1'h0;
   (* mem2reg *) reg [0:0] f_inner_sr [1:10];
   integer f_inner_i;
   initial for (f_inner_i = 1; f_inner_i <= 10; f_inner_i = f_inner_i + 1) f_inner_sr[f_inner_i] = 1'h0;
@@ -1180,7 +1189,7 @@ module fxrt_traverse_k64 (
   wire signed [32:0] rs_tmin_n1;
   wire signed [32:0] rs_tmax_p1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_121;
+  wire signed [32:0] minus_122;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
@@ -1222,25 +1231,25 @@ module fxrt_traverse_k64 (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_122;
+  wire signed [32:0] minus_123;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below;
   wire signed [32:0] rs_d0_lo;
   wire signed [32:0] rs_plane_t_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_123;
+  wire signed [32:0] minus_124;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_above;
   wire signed [32:0] rs_plane_t_1_1;
   wire signed [32:0] rs_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_124;
+  wire signed [32:0] minus_125;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
   wire signed [32:0] rs_d1_lo;
   wire signed [32:0] rs_plane_t_1_2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_125;
+  wire signed [32:0] minus_126;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
@@ -1275,10 +1284,10 @@ module fxrt_traverse_k64 (
   wire [0:0] enter_far;
   wire [0:0] push;
   wire [4:0] rs_g_sp;
-  wire [10:0] cat_127;
+  wire [10:0] cat_128;
   wire [31:0] u_far_min;
   wire [31:0] u_g_tmax;
-  wire [76:0] cat_128;
+  wire [76:0] cat_129;
   wire [0:0] enter_near_or_enter_far;
   wire [0:0] not_enter_near_or_enter_far;
   wire [12:0] mux_enter_near;
@@ -1288,7 +1297,7 @@ module fxrt_traverse_k64 (
   wire [5:0] mux_push;
   wire [0:0] not_push;
   wire [0:0] g_sp_eq_k_0_1;
-  wire [0:0] and_129;
+  wire [0:0] and_130;
   wire [5:0] g_sp_minus_k_1;
   wire [5:0] mux_push_1;
   wire [0:0] not_just_alloc;
@@ -1761,8 +1770,8 @@ module fxrt_traverse_k64 (
   assign not_a_sp_zero = ~a_sp_zero;
   assign a_from_stack = a_pop & not_a_sp_zero;
   assign stack_we = push;
-  assign stack_waddr = cat_127;
-  assign stack_wdata = cat_128;
+  assign stack_waddr = cat_128;
+  assign stack_wdata = cat_129;
   assign rs_a_sp_m1 = a_sp_m1[4:0];
   assign stack_raddr = {a_slot, rs_a_sp_m1};
   assign not_a_done = ~a_done;
@@ -2073,7 +2082,6 @@ module fxrt_traverse_k64 (
   assign not_best_clear = ~best_clear;
   assign and_105 = has_best & not_best_clear;
   assign and_105_or_best_set = and_105 | best_set;
-  assign n_valid = n_valid_sr[3];
   assign n_slot = n_slot_sr[3];
   assign n_node = n_node_sr[3];
   assign n_tmin = n_tmin_sr[3];
@@ -2087,7 +2095,7 @@ module fxrt_traverse_k64 (
   assign nw_count = node_word[17:15];
   assign nw_is_leaf = nw_axis == k_3_1;
   assign not_culled_n = ~culled_n;
-  assign visit_c = n_valid & not_culled_n;
+  assign visit_c = n_valid_3 & not_culled_n;
   assign not_nw_is_leaf = ~nw_is_leaf;
   assign is_inner = visit_c & not_nw_is_leaf;
   assign visit_c_and_nw_is_leaf = visit_c & nw_is_leaf;
@@ -2095,7 +2103,7 @@ module fxrt_traverse_k64 (
   assign leaf_push = visit_c_and_nw_is_leaf & nw_count_ne_k_0_6;
   assign u_n_tmin = $unsigned(n_tmin);
   assign rs_u_n_tmin = u_n_tmin[30:0];
-  assign cat_108 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
+  assign cat_109 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
   assign leaf_q_wr_plus_k_1 = leaf_q_wr + k_1;
   assign mux_leaf_q_push = leaf_q_push ? leaf_q_wr_plus_k_1 : leaf_q_wr;
   assign leaf_q_rd_next = leaf_pop_r ? leaf_q_rd1 : leaf_q_rd;
@@ -2105,9 +2113,9 @@ module fxrt_traverse_k64 (
   assign leaf_q_after_pop = leaf_q_count - rs_leaf_pop_r;
   assign rs_leaf_q_push = {{6{1'b0}}, leaf_q_push};
   assign leaf_q_count_next = leaf_q_after_pop + rs_leaf_q_push;
-  assign eq_111 = leaf_q_after_pop == k_0_3;
-  assign leaf_q_bypass_c = leaf_q_push & eq_111;
-  assign ne_112 = leaf_q_count_next != k_0_3;
+  assign eq_112 = leaf_q_after_pop == k_0_3;
+  assign leaf_q_bypass_c = leaf_q_push & eq_112;
+  assign ne_113 = leaf_q_count_next != k_0_3;
   assign leaf_q_head = leaf_q_bypass ? leaf_q_din_r : leaf_q_q;
   assign bits_ray_o_q = ray_o_q[28:0];
   assign bits_ray_o_q_1 = ray_o_q[57:29];
@@ -2135,7 +2143,6 @@ module fxrt_traverse_k64 (
     endcase
   end
   assign pu_product = u_plane_product_p;
-  assign pu_product_valid = pu_product_valid_sr[6];
   assign pu_product_last = pu_product_last_sr[6];
   assign bits_pu_product = pu_product[77:16];
   assign pu_shifted = $signed(bits_pu_product);
@@ -2169,15 +2176,14 @@ module fxrt_traverse_k64 (
     endcase
   end
   assign pu_product_1 = u_plane_product_1_p;
-  assign pu_product_valid_1 = pu_product_valid_1_sr[6];
   assign pu_product_last_1 = pu_product_last_1_sr[6];
   assign bits_pu_product_1 = pu_product_1[77:16];
   assign pu_shifted_1 = $signed(bits_pu_product_1);
   assign pu_below_1 = pu_shifted_1[61];
   assign not_pu_below_1 = ~pu_below_1;
   assign bits_pu_shifted_1 = pu_shifted_1[60:30];
-  assign ne_117 = bits_pu_shifted_1 != k_0_7;
-  assign pu_above_1 = not_pu_below_1 & ne_117;
+  assign ne_118 = bits_pu_shifted_1 != k_0_7;
+  assign pu_above_1 = not_pu_below_1 & ne_118;
   assign rs_pu_shifted_1 = $signed(pu_shifted_1[31:0]);
   assign mux_pu_below_r_1 = pu_below_r_1 ? k_m1 : pu_low_r_1;
   assign pu_clamped_1 = pu_above_r_1 ? k_1073741824 : mux_pu_below_r_1;
@@ -2193,8 +2199,7 @@ module fxrt_traverse_k64 (
   assign negative_c = case_axis_n1[47];
   assign negative = negative_sr[9];
   assign not_leaf_push = ~leaf_push;
-  assign n_stays = n_valid & not_leaf_push;
-  assign f_valid = f_valid_sr[10];
+  assign n_stays = n_valid_3 & not_leaf_push;
   assign f_inner = f_inner_sr[10];
   assign f_slot = f_slot_sr[10];
   assign f_tmin = f_tmin_sr[10];
@@ -2213,8 +2218,8 @@ module fxrt_traverse_k64 (
   assign tmin_minus_1 = n_tmin - k_1_2;
   assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
-  assign minus_121 = rs_tmin_n1 - rs_tmax_p1;
-  assign tmin_le_tmax_c = minus_121[32];
+  assign minus_122 = rs_tmin_n1 - rs_tmax_p1;
+  assign tmin_le_tmax_c = minus_122[32];
   assign mux_negative_n2 = negative_n2 ? tmax_p1_n2 : tmax_n2;
   assign d0_hi_c = tmin_le_tmax ? mux_negative_n2 : k_m2147483648;
   assign d0_hi = d0_hi_sr[7];
@@ -2229,20 +2234,20 @@ module fxrt_traverse_k64 (
   assign d1_lo = d1_lo_sr[7];
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_122 = rs_plane_t - rs_d0_hi;
-  assign d0_below = minus_122[32];
+  assign minus_123 = rs_plane_t - rs_d0_hi;
+  assign d0_below = minus_123[32];
   assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign minus_123 = rs_d0_lo - rs_plane_t_1;
-  assign d0_above = minus_123[32];
+  assign minus_124 = rs_d0_lo - rs_plane_t_1;
+  assign d0_above = minus_124[32];
   assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
   assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_124 = rs_plane_t_1_1 - rs_d1_hi;
-  assign d1_below = minus_124[32];
+  assign minus_125 = rs_plane_t_1_1 - rs_d1_hi;
+  assign d1_below = minus_125[32];
   assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
   assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign minus_125 = rs_d1_lo - rs_plane_t_1_2;
-  assign d1_above = minus_125[32];
+  assign minus_126 = rs_d1_lo - rs_plane_t_1_2;
+  assign d1_above = minus_126[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
   assign go_near_c = negative ? d1_above : d0_above;
@@ -2260,10 +2265,10 @@ module fxrt_traverse_k64 (
   assign enter_far = g_inner_and_not_go_near & go_far;
   assign push = enter_near & go_far;
   assign rs_g_sp = g_sp[4:0];
-  assign cat_127 = {g_slot, rs_g_sp};
+  assign cat_128 = {g_slot, rs_g_sp};
   assign u_far_min = $unsigned(far_min);
   assign u_g_tmax = $unsigned(g_tmax);
-  assign cat_128 = {far, u_far_min, u_g_tmax};
+  assign cat_129 = {far, u_far_min, u_g_tmax};
   assign enter_near_or_enter_far = enter_near | enter_far;
   assign not_enter_near_or_enter_far = ~enter_near_or_enter_far;
   assign mux_enter_near = enter_near ? near : far;
@@ -2273,7 +2278,7 @@ module fxrt_traverse_k64 (
   assign mux_push = push ? g_sp_plus_k_1 : g_sp;
   assign not_push = ~push;
   assign g_sp_eq_k_0_1 = g_sp == k_0_1;
-  assign and_129 = not_push & g_sp_eq_k_0_1;
+  assign and_130 = not_push & g_sp_eq_k_0_1;
   assign g_sp_minus_k_1 = g_sp - k_1;
   assign mux_push_1 = push ? g_sp : g_sp_minus_k_1;
   assign not_just_alloc = ~just_alloc;
@@ -2283,7 +2288,7 @@ module fxrt_traverse_k64 (
   assign bits_leaf_q_head_2 = leaf_q_head[39:37];
   assign bits_leaf_q_head_3 = leaf_q_head[52:40];
   assign bits_leaf_q_head_4 = leaf_q_head[58:53];
-  assign cull_c = n_valid & culled_n;
+  assign cull_c = n_valid_3 & culled_n;
 
   always @(posedge clk) begin : regs
     if (ray_we) ray_o[ray_slot] <= cat_0;
@@ -2305,8 +2310,8 @@ module fxrt_traverse_k64 (
     else just_alloc <= alloc;
     if (rst) occupied_r <= 7'h00;
     else occupied_r <= minus_77;
-    unpark_q_push <= merge_valid;
-    unpark_q_din <= cat_78;
+    if (rst) unpark_q_push <= 1'h0;
+    else unpark_q_push <= merge_valid;
     if (rst) unpark_q_wr <= 6'h00;
     else unpark_q_wr <= mux_unpark_q_push;
     if (rst) unpark_q_rd <= 6'h00;
@@ -2315,14 +2320,15 @@ module fxrt_traverse_k64 (
     else unpark_q_count <= unpark_q_count_next;
     if (rst) unpark_q_rd1 <= 6'h01;
     else unpark_q_rd1 <= mux_unpark_pop;
-    unpark_q_q <= unpark_q_mem[unpark_q_rd_next];
     if (rst) unpark_q_bypass <= 1'h0;
     else unpark_q_bypass <= unpark_q_bypass_c;
-    if (unpark_q_push) unpark_q_din_r <= unpark_q_din;
     if (rst) unpark_q_nonempty <= 1'h0;
     else unpark_q_nonempty <= ne_82;
-    new_q_push <= new_valid;
-    new_q_din <= cat_83;
+    unpark_q_din <= cat_78;
+    unpark_q_q <= unpark_q_mem[unpark_q_rd_next];
+    if (unpark_q_push) unpark_q_din_r <= unpark_q_din;
+    if (rst) new_q_push <= 1'h0;
+    else new_q_push <= new_valid;
     if (rst) new_q_wr <= 6'h00;
     else new_q_wr <= mux_new_q_push;
     if (rst) new_q_rd <= 6'h00;
@@ -2331,13 +2337,15 @@ module fxrt_traverse_k64 (
     else new_q_count <= new_q_count_next;
     if (rst) new_q_rd1 <= 6'h01;
     else new_q_rd1 <= mux_new_pop;
-    new_q_q <= new_q_mem[new_q_rd_next];
     if (rst) new_q_bypass <= 1'h0;
     else new_q_bypass <= new_q_bypass_c;
-    if (new_q_push) new_q_din_r <= new_q_din;
     if (rst) new_q_nonempty <= 1'h0;
     else new_q_nonempty <= ne_87;
-    q_valid <= take_unpark_or_take_new;
+    new_q_din <= cat_83;
+    new_q_q <= new_q_mem[new_q_rd_next];
+    if (new_q_push) new_q_din_r <= new_q_din;
+    if (rst) q_valid <= 1'h0;
+    else q_valid <= take_unpark_or_take_new;
     q_new <= take_new;
     q_slot <= mux_take_unpark;
     q_sp <= bits_unpark_q_head_1;
@@ -2348,14 +2356,15 @@ module fxrt_traverse_k64 (
     if (rst) r_valid <= 1'h0;
     else r_valid <= g_valid;
     r_pop <= not_enter_near_or_enter_far;
-    r_sp_zero <= and_129;
+    r_sp_zero <= and_130;
     r_sp_m1 <= mux_push_1;
     r_slot <= g_slot;
     r_node <= mux_enter_near;
     r_tmin <= mux_enter_far;
     r_tmax <= mux_enter_near_1;
     r_sp <= mux_push;
-    b_valid <= a_live;
+    if (rst) b_valid <= 1'h0;
+    else b_valid <= a_live;
     b_slot <= a_slot;
     b_node <= mux_r_valid;
     b_tmin <= mux_r_valid_1;
@@ -2364,15 +2373,17 @@ module fxrt_traverse_k64 (
     for (b_from_stack_i = 2; b_from_stack_i > 1; b_from_stack_i = b_from_stack_i - 1)
       b_from_stack_sr[b_from_stack_i] <= b_from_stack_sr[b_from_stack_i - 1];
     b_from_stack_sr[1] <= a_from_stack;
-    b2_valid <= b_valid;
+    if (rst) b2_valid <= 1'h0;
+    else b2_valid <= b_valid;
     b2_slot <= b_slot;
     b2_node <= b_node;
     b2_tmin <= b_tmin;
     b2_tmax <= b_tmax;
     b2_sp <= b_sp;
-    done_pop_r <= done_pop;
-    done_q_push <= a_done;
-    done_q_din <= a_slot;
+    if (rst) done_pop_r <= 1'h0;
+    else done_pop_r <= done_pop;
+    if (rst) done_q_push <= 1'h0;
+    else done_q_push <= a_done;
     if (rst) done_q_wr <= 6'h00;
     else done_q_wr <= mux_done_q_push;
     if (rst) done_q_rd <= 6'h00;
@@ -2381,13 +2392,15 @@ module fxrt_traverse_k64 (
     else done_q_count <= done_q_count_next;
     if (rst) done_q_rd1 <= 6'h01;
     else done_q_rd1 <= mux_done_pop_r;
-    done_q_q <= done_q_mem[done_q_rd_next];
     if (rst) done_q_bypass <= 1'h0;
     else done_q_bypass <= done_q_bypass_c;
-    if (done_q_push) done_q_din_r <= done_q_din;
     if (rst) done_q_nonempty <= 1'h0;
     else done_q_nonempty <= ne_98;
-    c_valid <= b2_valid;
+    done_q_din <= a_slot;
+    done_q_q <= done_q_mem[done_q_rd_next];
+    if (done_q_push) done_q_din_r <= done_q_din;
+    if (rst) c_valid <= 1'h0;
+    else c_valid <= b2_valid;
     c_slot <= b2_slot;
     c_node <= mux_b_from_stack;
     c_tmin <= mux_b_from_stack_1;
@@ -2400,9 +2413,12 @@ module fxrt_traverse_k64 (
     cull_has_best <= slot_has_best;
     culled <= culled_c;
     culled_n <= culled;
-    for (n_valid_i = 3; n_valid_i > 1; n_valid_i = n_valid_i - 1)
-      n_valid_sr[n_valid_i] <= n_valid_sr[n_valid_i - 1];
-    n_valid_sr[1] <= c_valid;
+    if (rst) n_valid_1 <= 1'h0;
+    else n_valid_1 <= c_valid;
+    if (rst) n_valid_2 <= 1'h0;
+    else n_valid_2 <= n_valid_1;
+    if (rst) n_valid_3 <= 1'h0;
+    else n_valid_3 <= n_valid_2;
     for (n_slot_i = 3; n_slot_i > 1; n_slot_i = n_slot_i - 1)
       n_slot_sr[n_slot_i] <= n_slot_sr[n_slot_i - 1];
     n_slot_sr[1] <= c_slot;
@@ -2418,9 +2434,10 @@ module fxrt_traverse_k64 (
     for (n_sp_i = 3; n_sp_i > 1; n_sp_i = n_sp_i - 1)
       n_sp_sr[n_sp_i] <= n_sp_sr[n_sp_i - 1];
     n_sp_sr[1] <= c_sp;
-    leaf_pop_r <= leaf_pop;
-    leaf_q_push <= leaf_push;
-    leaf_q_din <= cat_108;
+    if (rst) leaf_pop_r <= 1'h0;
+    else leaf_pop_r <= leaf_pop;
+    if (rst) leaf_q_push <= 1'h0;
+    else leaf_q_push <= leaf_push;
     if (rst) leaf_q_wr <= 6'h00;
     else leaf_q_wr <= mux_leaf_q_push;
     if (rst) leaf_q_rd <= 6'h00;
@@ -2429,71 +2446,115 @@ module fxrt_traverse_k64 (
     else leaf_q_count <= leaf_q_count_next;
     if (rst) leaf_q_rd1 <= 6'h01;
     else leaf_q_rd1 <= mux_leaf_pop_r;
-    leaf_q_q <= leaf_q_mem[leaf_q_rd_next];
     if (rst) leaf_q_bypass <= 1'h0;
     else leaf_q_bypass <= leaf_q_bypass_c;
-    if (leaf_q_push) leaf_q_din_r <= leaf_q_din;
     if (rst) leaf_q_nonempty <= 1'h0;
-    else leaf_q_nonempty <= ne_112;
+    else leaf_q_nonempty <= ne_113;
+    leaf_q_din <= cat_109;
+    leaf_q_q <= leaf_q_mem[leaf_q_rd_next];
+    if (leaf_q_push) leaf_q_din_r <= leaf_q_din;
     ray_o_q <= ray_o[n_slot];
     ray_invx_q <= ray_invx[n_slot];
     ray_invy_q <= ray_invy[n_slot];
     ray_invz_q <= ray_invz[n_slot];
-    pu_sel_valid <= is_inner;
+    if (rst) pu_sel_valid <= 1'h0;
+    else pu_sel_valid <= is_inner;
     pu_sel_last <= k_0;
     pu_sel_plane <= nw_clip0;
     pu_sel_axis <= nw_axis;
     pu_delta <= pu_diff;
     pu_inv <= pu_inv_axis;
-    pu_delta_valid <= pu_sel_valid;
+    if (rst) pu_delta_valid <= 1'h0;
+    else pu_delta_valid <= pu_sel_valid;
     pu_delta_last <= pu_sel_last;
-    for (pu_product_valid_i = 6; pu_product_valid_i > 1; pu_product_valid_i = pu_product_valid_i - 1)
-      pu_product_valid_sr[pu_product_valid_i] <= pu_product_valid_sr[pu_product_valid_i - 1];
-    pu_product_valid_sr[1] <= pu_delta_valid;
+    if (rst) pu_product_valid_1 <= 1'h0;
+    else pu_product_valid_1 <= pu_delta_valid;
+    if (rst) pu_product_valid_2 <= 1'h0;
+    else pu_product_valid_2 <= pu_product_valid_1;
+    if (rst) pu_product_valid_3 <= 1'h0;
+    else pu_product_valid_3 <= pu_product_valid_2;
+    if (rst) pu_product_valid_4 <= 1'h0;
+    else pu_product_valid_4 <= pu_product_valid_3;
+    if (rst) pu_product_valid_5 <= 1'h0;
+    else pu_product_valid_5 <= pu_product_valid_4;
+    if (rst) pu_product_valid_6 <= 1'h0;
+    else pu_product_valid_6 <= pu_product_valid_5;
     for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
       pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
     pu_product_last_sr[1] <= pu_delta_last;
     pu_above_r <= pu_above;
     pu_below_r <= pu_below;
     pu_low_r <= rs_pu_shifted;
-    pu_clamp_valid <= pu_product_valid;
+    if (rst) pu_clamp_valid <= 1'h0;
+    else pu_clamp_valid <= pu_product_valid_6;
     pu_clamp_last <= pu_product_last;
     plane_t <= pu_clamped;
     if (pu_clamp_last) plane_t_of_last <= pu_clamped;
     if (pu_first) plane_t_of_first <= pu_clamped;
-    plane_t_valid <= pu_clamp_valid;
+    if (rst) plane_t_valid <= 1'h0;
+    else plane_t_valid <= pu_clamp_valid;
     plane_t_last <= pu_clamp_last;
-    pu_sel_valid_1 <= is_inner;
+    if (rst) pu_sel_valid_1 <= 1'h0;
+    else pu_sel_valid_1 <= is_inner;
     pu_sel_last_1 <= k_1_1;
     pu_sel_plane_1 <= nw_clip1;
     pu_sel_axis_1 <= nw_axis;
     pu_delta_1 <= pu_diff_1;
     pu_inv_1 <= pu_inv_axis_1;
-    pu_delta_valid_1 <= pu_sel_valid_1;
+    if (rst) pu_delta_valid_1 <= 1'h0;
+    else pu_delta_valid_1 <= pu_sel_valid_1;
     pu_delta_last_1 <= pu_sel_last_1;
-    for (pu_product_valid_1_i = 6; pu_product_valid_1_i > 1; pu_product_valid_1_i = pu_product_valid_1_i - 1)
-      pu_product_valid_1_sr[pu_product_valid_1_i] <= pu_product_valid_1_sr[pu_product_valid_1_i - 1];
-    pu_product_valid_1_sr[1] <= pu_delta_valid_1;
+    if (rst) pu_product_valid_1_1 <= 1'h0;
+    else pu_product_valid_1_1 <= pu_delta_valid_1;
+    if (rst) pu_product_valid_2_1 <= 1'h0;
+    else pu_product_valid_2_1 <= pu_product_valid_1_1;
+    if (rst) pu_product_valid_3_1 <= 1'h0;
+    else pu_product_valid_3_1 <= pu_product_valid_2_1;
+    if (rst) pu_product_valid_4_1 <= 1'h0;
+    else pu_product_valid_4_1 <= pu_product_valid_3_1;
+    if (rst) pu_product_valid_5_1 <= 1'h0;
+    else pu_product_valid_5_1 <= pu_product_valid_4_1;
+    if (rst) pu_product_valid_6_1 <= 1'h0;
+    else pu_product_valid_6_1 <= pu_product_valid_5_1;
     for (pu_product_last_1_i = 6; pu_product_last_1_i > 1; pu_product_last_1_i = pu_product_last_1_i - 1)
       pu_product_last_1_sr[pu_product_last_1_i] <= pu_product_last_1_sr[pu_product_last_1_i - 1];
     pu_product_last_1_sr[1] <= pu_delta_last_1;
     pu_above_r_1 <= pu_above_1;
     pu_below_r_1 <= pu_below_1;
     pu_low_r_1 <= rs_pu_shifted_1;
-    pu_clamp_valid_1 <= pu_product_valid_1;
+    if (rst) pu_clamp_valid_1 <= 1'h0;
+    else pu_clamp_valid_1 <= pu_product_valid_6_1;
     pu_clamp_last_1 <= pu_product_last_1;
     plane_t_1 <= pu_clamped_1;
     if (pu_clamp_last_1) plane_t_of_last_1 <= pu_clamped_1;
     if (pu_first_1) plane_t_of_first_1 <= pu_clamped_1;
-    plane_t_valid_1 <= pu_clamp_valid_1;
+    if (rst) plane_t_valid_1 <= 1'h0;
+    else plane_t_valid_1 <= pu_clamp_valid_1;
     plane_t_last_1 <= pu_clamp_last_1;
     axis_n1 <= nw_axis;
     for (negative_i = 9; negative_i > 1; negative_i = negative_i - 1)
       negative_sr[negative_i] <= negative_sr[negative_i - 1];
     negative_sr[1] <= negative_c;
-    for (f_valid_i = 10; f_valid_i > 1; f_valid_i = f_valid_i - 1)
-      f_valid_sr[f_valid_i] <= f_valid_sr[f_valid_i - 1];
-    f_valid_sr[1] <= n_stays;
+    if (rst) f_valid_1 <= 1'h0;
+    else f_valid_1 <= n_stays;
+    if (rst) f_valid_2 <= 1'h0;
+    else f_valid_2 <= f_valid_1;
+    if (rst) f_valid_3 <= 1'h0;
+    else f_valid_3 <= f_valid_2;
+    if (rst) f_valid_4 <= 1'h0;
+    else f_valid_4 <= f_valid_3;
+    if (rst) f_valid_5 <= 1'h0;
+    else f_valid_5 <= f_valid_4;
+    if (rst) f_valid_6 <= 1'h0;
+    else f_valid_6 <= f_valid_5;
+    if (rst) f_valid_7 <= 1'h0;
+    else f_valid_7 <= f_valid_6;
+    if (rst) f_valid_8 <= 1'h0;
+    else f_valid_8 <= f_valid_7;
+    if (rst) f_valid_9 <= 1'h0;
+    else f_valid_9 <= f_valid_8;
+    if (rst) f_valid_10 <= 1'h0;
+    else f_valid_10 <= f_valid_9;
     for (f_inner_i = 10; f_inner_i > 1; f_inner_i = f_inner_i - 1)
       f_inner_sr[f_inner_i] <= f_inner_sr[f_inner_i - 1];
     f_inner_sr[1] <= is_inner;
@@ -2545,7 +2606,8 @@ module fxrt_traverse_k64 (
     go_far <= go_far_c;
     near_end <= mux_negative;
     far_start <= mux_negative_1;
-    g_valid <= f_valid;
+    if (rst) g_valid <= 1'h0;
+    else g_valid <= f_valid_10;
     g_slot <= f_slot;
     g_child <= f_child;
     g_tmin <= f_tmin;

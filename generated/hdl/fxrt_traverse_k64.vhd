@@ -1153,7 +1153,6 @@ architecture rtl of fxrt_traverse_k64 is
   signal new_pop : unsigned(0 downto 0);
   signal cat_78 : unsigned(11 downto 0);
   signal unpark_q_push : unsigned(0 downto 0) := unsigned'("0");
-  signal unpark_q_din : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal unpark_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal unpark_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -1167,19 +1166,19 @@ architecture rtl of fxrt_traverse_k64 is
   signal unpark_q_after_pop : unsigned(6 downto 0);
   signal rs_unpark_q_push : unsigned(6 downto 0);
   signal unpark_q_count_next : unsigned(6 downto 0);
-  signal unpark_q_q : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_3 : unsigned(6 downto 0) := unsigned'("0000000");
   signal eq_81 : unsigned(0 downto 0);
   signal unpark_q_bypass_c : unsigned(0 downto 0);
-  signal unpark_q_din_r : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal ne_82 : unsigned(0 downto 0);
+  signal unpark_q_din : unsigned(11 downto 0) := unsigned'("000000000000");
+  signal unpark_q_q : unsigned(11 downto 0) := unsigned'("000000000000");
+  signal unpark_q_din_r : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_head : unsigned(11 downto 0);
   signal u_new_tmax : unsigned(31 downto 0);
   signal cat_83 : unsigned(38 downto 0);
   signal new_q_push : unsigned(0 downto 0) := unsigned'("0");
-  signal new_q_din : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal new_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal new_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal new_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -1193,13 +1192,14 @@ architecture rtl of fxrt_traverse_k64 is
   signal new_q_after_pop : unsigned(6 downto 0);
   signal rs_new_q_push : unsigned(6 downto 0);
   signal new_q_count_next : unsigned(6 downto 0);
-  signal new_q_q : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal new_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal new_q_after_pop_eq_k_0_3 : unsigned(0 downto 0);
   signal new_q_bypass_c : unsigned(0 downto 0);
-  signal new_q_din_r : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal new_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal ne_87 : unsigned(0 downto 0);
+  signal new_q_din : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
+  signal new_q_q : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
+  signal new_q_din_r : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal new_q_head : unsigned(38 downto 0);
   signal not_ring_g_valid : unsigned(0 downto 0);
   signal take_unpark : unsigned(0 downto 0);
@@ -1282,7 +1282,6 @@ architecture rtl of fxrt_traverse_k64 is
   signal b2_sp : unsigned(5 downto 0) := unsigned'("000000");
   signal done_pop_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_push : unsigned(0 downto 0) := unsigned'("0");
-  signal done_q_din : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -1296,13 +1295,14 @@ architecture rtl of fxrt_traverse_k64 is
   signal done_q_after_pop : unsigned(6 downto 0);
   signal rs_done_q_push : unsigned(6 downto 0);
   signal done_q_count_next : unsigned(6 downto 0);
-  signal done_q_q : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal eq_97 : unsigned(0 downto 0);
   signal done_q_bypass_c : unsigned(0 downto 0);
-  signal done_q_din_r : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal ne_98 : unsigned(0 downto 0);
+  signal done_q_din : unsigned(5 downto 0) := unsigned'("000000");
+  signal done_q_q : unsigned(5 downto 0) := unsigned'("000000");
+  signal done_q_din_r : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_head : unsigned(5 downto 0);
   signal bits_u_stack_data : unsigned(31 downto 0);
   signal s_bits_u_stack_data : signed(31 downto 0);
@@ -1536,9 +1536,9 @@ architecture rtl of fxrt_traverse_k64 is
   signal not_best_clear : unsigned(63 downto 0);
   signal and_105 : unsigned(63 downto 0);
   signal and_105_or_best_set : unsigned(63 downto 0);
-  type n_valid_sr_t is array (1 to 3) of unsigned(0 downto 0);
-  signal n_valid_sr : n_valid_sr_t := (others => (others => '0'));
-  signal n_valid : unsigned(0 downto 0);
+  signal n_valid_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal n_valid_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal n_valid_3 : unsigned(0 downto 0) := unsigned'("0");
   type n_slot_sr_t is array (1 to 3) of unsigned(5 downto 0);
   signal n_slot_sr : n_slot_sr_t := (others => (others => '0'));
   signal n_slot : unsigned(5 downto 0);
@@ -1572,10 +1572,9 @@ architecture rtl of fxrt_traverse_k64 is
   signal leaf_push : unsigned(0 downto 0);
   signal u_n_tmin : unsigned(31 downto 0);
   signal rs_u_n_tmin : unsigned(30 downto 0);
-  signal cat_108 : unsigned(58 downto 0);
+  signal cat_109 : unsigned(58 downto 0);
   signal leaf_pop_r : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_push : unsigned(0 downto 0) := unsigned'("0");
-  signal leaf_q_din : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -1589,13 +1588,14 @@ architecture rtl of fxrt_traverse_k64 is
   signal leaf_q_after_pop : unsigned(6 downto 0);
   signal rs_leaf_q_push : unsigned(6 downto 0);
   signal leaf_q_count_next : unsigned(6 downto 0);
-  signal leaf_q_q : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_bypass : unsigned(0 downto 0) := unsigned'("0");
-  signal eq_111 : unsigned(0 downto 0);
+  signal eq_112 : unsigned(0 downto 0);
   signal leaf_q_bypass_c : unsigned(0 downto 0);
-  signal leaf_q_din_r : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_112 : unsigned(0 downto 0);
+  signal ne_113 : unsigned(0 downto 0);
+  signal leaf_q_din : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal leaf_q_q : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal leaf_q_din_r : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_head : unsigned(58 downto 0);
   signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal bits_ray_o_q : unsigned(28 downto 0);
@@ -1624,9 +1624,12 @@ architecture rtl of fxrt_traverse_k64 is
   signal pu_delta_last : unsigned(0 downto 0) := unsigned'("0");
   signal u_plane_product_p : signed(77 downto 0);
   signal pu_product : signed(77 downto 0);
-  type pu_product_valid_sr_t is array (1 to 6) of unsigned(0 downto 0);
-  signal pu_product_valid_sr : pu_product_valid_sr_t := (others => (others => '0'));
-  signal pu_product_valid : unsigned(0 downto 0);
+  signal pu_product_valid_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_6 : unsigned(0 downto 0) := unsigned'("0");
   type pu_product_last_sr_t is array (1 to 6) of unsigned(0 downto 0);
   signal pu_product_last_sr : pu_product_last_sr_t := (others => (others => '0'));
   signal pu_product_last : unsigned(0 downto 0);
@@ -1673,9 +1676,12 @@ architecture rtl of fxrt_traverse_k64 is
   signal pu_delta_last_1 : unsigned(0 downto 0) := unsigned'("0");
   signal u_plane_product_1_p : signed(77 downto 0);
   signal pu_product_1 : signed(77 downto 0);
-  type pu_product_valid_1_sr_t is array (1 to 6) of unsigned(0 downto 0);
-  signal pu_product_valid_1_sr : pu_product_valid_1_sr_t := (others => (others => '0'));
-  signal pu_product_valid_1 : unsigned(0 downto 0);
+  signal pu_product_valid_1_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_2_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_3_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_4_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_5_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal pu_product_valid_6_1 : unsigned(0 downto 0) := unsigned'("0");
   type pu_product_last_1_sr_t is array (1 to 6) of unsigned(0 downto 0);
   signal pu_product_last_1_sr : pu_product_last_1_sr_t := (others => (others => '0'));
   signal pu_product_last_1 : unsigned(0 downto 0);
@@ -1684,7 +1690,7 @@ architecture rtl of fxrt_traverse_k64 is
   signal pu_below_1 : unsigned(0 downto 0);
   signal not_pu_below_1 : unsigned(0 downto 0);
   signal bits_pu_shifted_1 : unsigned(30 downto 0);
-  signal ne_117 : unsigned(0 downto 0);
+  signal ne_118 : unsigned(0 downto 0);
   signal pu_above_1 : unsigned(0 downto 0);
   signal rs_pu_shifted_1 : signed(31 downto 0);
   signal pu_above_r_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1709,9 +1715,16 @@ architecture rtl of fxrt_traverse_k64 is
   signal negative : unsigned(0 downto 0);
   signal not_leaf_push : unsigned(0 downto 0);
   signal n_stays : unsigned(0 downto 0);
-  type f_valid_sr_t is array (1 to 10) of unsigned(0 downto 0);
-  signal f_valid_sr : f_valid_sr_t := (others => (others => '0'));
-  signal f_valid : unsigned(0 downto 0);
+  signal f_valid_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_6 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_7 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_8 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_9 : unsigned(0 downto 0) := unsigned'("0");
+  signal f_valid_10 : unsigned(0 downto 0) := unsigned'("0");
   type f_inner_sr_t is array (1 to 10) of unsigned(0 downto 0);
   signal f_inner_sr : f_inner_sr_t := (others => (others => '0'));
   signal f_inner : unsigned(0 downto 0);
@@ -1742,7 +1755,7 @@ architecture rtl of fxrt_traverse_k64 is
   signal tmin_m1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_tmin_n1 : signed(32 downto 0);
   signal rs_tmax_p1 : signed(32 downto 0);
-  signal minus_121 : signed(32 downto 0);
+  signal minus_122 : signed(32 downto 0);
   signal tmin_le_tmax_c : unsigned(0 downto 0);
   signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
   signal negative_n2 : unsigned(0 downto 0) := unsigned'("0");
@@ -1778,19 +1791,19 @@ architecture rtl of fxrt_traverse_k64 is
   signal d1_lo : signed(31 downto 0);
   signal rs_plane_t : signed(32 downto 0);
   signal rs_d0_hi : signed(32 downto 0);
-  signal minus_122 : signed(32 downto 0);
+  signal minus_123 : signed(32 downto 0);
   signal d0_below : unsigned(0 downto 0);
   signal rs_d0_lo : signed(32 downto 0);
   signal rs_plane_t_1 : signed(32 downto 0);
-  signal minus_123 : signed(32 downto 0);
+  signal minus_124 : signed(32 downto 0);
   signal d0_above : unsigned(0 downto 0);
   signal rs_plane_t_1_1 : signed(32 downto 0);
   signal rs_d1_hi : signed(32 downto 0);
-  signal minus_124 : signed(32 downto 0);
+  signal minus_125 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
   signal rs_d1_lo : signed(32 downto 0);
   signal rs_plane_t_1_2 : signed(32 downto 0);
-  signal minus_125 : signed(32 downto 0);
+  signal minus_126 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
@@ -1824,10 +1837,10 @@ architecture rtl of fxrt_traverse_k64 is
   signal enter_far : unsigned(0 downto 0);
   signal push : unsigned(0 downto 0);
   signal rs_g_sp : unsigned(4 downto 0);
-  signal cat_127 : unsigned(10 downto 0);
+  signal cat_128 : unsigned(10 downto 0);
   signal u_far_min : unsigned(31 downto 0);
   signal u_g_tmax : unsigned(31 downto 0);
-  signal cat_128 : unsigned(76 downto 0);
+  signal cat_129 : unsigned(76 downto 0);
   signal enter_near_or_enter_far : unsigned(0 downto 0);
   signal not_enter_near_or_enter_far : unsigned(0 downto 0);
   signal mux_enter_near : unsigned(12 downto 0);
@@ -1837,7 +1850,7 @@ architecture rtl of fxrt_traverse_k64 is
   signal mux_push : unsigned(5 downto 0);
   signal not_push : unsigned(0 downto 0);
   signal g_sp_eq_k_0_1 : unsigned(0 downto 0);
-  signal and_129 : unsigned(0 downto 0);
+  signal and_130 : unsigned(0 downto 0);
   signal g_sp_minus_k_1 : unsigned(5 downto 0);
   signal mux_push_1 : unsigned(5 downto 0);
   signal not_just_alloc : unsigned(0 downto 0);
@@ -2311,8 +2324,8 @@ begin
   not_a_sp_zero <= not a_sp_zero;
   a_from_stack <= a_pop and not_a_sp_zero;
   stack_we <= push;
-  stack_waddr <= cat_127;
-  stack_wdata <= cat_128;
+  stack_waddr <= cat_128;
+  stack_wdata <= cat_129;
   rs_a_sp_m1 <= a_sp_m1(4 downto 0);
   stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(a_slot) & std_logic_vector(rs_a_sp_m1)));
   not_a_done <= not a_done;
@@ -2621,7 +2634,6 @@ begin
   not_best_clear <= not best_clear;
   and_105 <= has_best and not_best_clear;
   and_105_or_best_set <= and_105 or best_set;
-  n_valid <= n_valid_sr(3);
   n_slot <= n_slot_sr(3);
   n_node <= n_node_sr(3);
   n_tmin <= n_tmin_sr(3);
@@ -2635,7 +2647,7 @@ begin
   nw_count <= unsigned(node_word(17 downto 15));
   nw_is_leaf <= "1" when nw_axis = k_3_1 else "0";
   not_culled_n <= not culled_n;
-  visit_c <= n_valid and not_culled_n;
+  visit_c <= n_valid_3 and not_culled_n;
   not_nw_is_leaf <= not nw_is_leaf;
   is_inner <= visit_c and not_nw_is_leaf;
   visit_c_and_nw_is_leaf <= visit_c and nw_is_leaf;
@@ -2643,7 +2655,7 @@ begin
   leaf_push <= visit_c_and_nw_is_leaf and nw_count_ne_k_0_6;
   u_n_tmin <= unsigned(n_tmin);
   rs_u_n_tmin <= u_n_tmin(30 downto 0);
-  cat_108 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
+  cat_109 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
   leaf_q_wr_plus_k_1 <= leaf_q_wr + k_1;
   mux_leaf_q_push <= leaf_q_wr_plus_k_1 when leaf_q_push = "1" else leaf_q_wr;
   leaf_q_rd_next <= leaf_q_rd1 when leaf_pop_r = "1" else leaf_q_rd;
@@ -2653,9 +2665,9 @@ begin
   leaf_q_after_pop <= leaf_q_count - rs_leaf_pop_r;
   rs_leaf_q_push <= resize(leaf_q_push, 7);
   leaf_q_count_next <= leaf_q_after_pop + rs_leaf_q_push;
-  eq_111 <= "1" when leaf_q_after_pop = k_0_3 else "0";
-  leaf_q_bypass_c <= leaf_q_push and eq_111;
-  ne_112 <= "1" when leaf_q_count_next /= k_0_3 else "0";
+  eq_112 <= "1" when leaf_q_after_pop = k_0_3 else "0";
+  leaf_q_bypass_c <= leaf_q_push and eq_112;
+  ne_113 <= "1" when leaf_q_count_next /= k_0_3 else "0";
   leaf_q_head <= leaf_q_din_r when leaf_q_bypass = "1" else leaf_q_q;
   bits_ray_o_q <= unsigned(ray_o_q(28 downto 0));
   bits_ray_o_q_1 <= unsigned(ray_o_q(57 downto 29));
@@ -2679,7 +2691,6 @@ begin
       s_ray_invz_q when "10",
       s_ray_invx_q when others;
   pu_product <= u_plane_product_p;
-  pu_product_valid <= pu_product_valid_sr(6);
   pu_product_last <= pu_product_last_sr(6);
   bits_pu_product <= unsigned(pu_product(77 downto 16));
   pu_shifted <= signed(bits_pu_product);
@@ -2709,15 +2720,14 @@ begin
       s_ray_invz_q when "10",
       s_ray_invx_q when others;
   pu_product_1 <= u_plane_product_1_p;
-  pu_product_valid_1 <= pu_product_valid_1_sr(6);
   pu_product_last_1 <= pu_product_last_1_sr(6);
   bits_pu_product_1 <= unsigned(pu_product_1(77 downto 16));
   pu_shifted_1 <= signed(bits_pu_product_1);
   pu_below_1 <= unsigned(pu_shifted_1(61 downto 61));
   not_pu_below_1 <= not pu_below_1;
   bits_pu_shifted_1 <= unsigned(pu_shifted_1(60 downto 30));
-  ne_117 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
-  pu_above_1 <= not_pu_below_1 and ne_117;
+  ne_118 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
+  pu_above_1 <= not_pu_below_1 and ne_118;
   rs_pu_shifted_1 <= pu_shifted_1(31 downto 0);
   mux_pu_below_r_1 <= k_m1 when pu_below_r_1 = "1" else pu_low_r_1;
   pu_clamped_1 <= k_1073741824 when pu_above_r_1 = "1" else mux_pu_below_r_1;
@@ -2731,8 +2741,7 @@ begin
   negative_c <= unsigned(case_axis_n1(47 downto 47));
   negative <= negative_sr(9);
   not_leaf_push <= not leaf_push;
-  n_stays <= n_valid and not_leaf_push;
-  f_valid <= f_valid_sr(10);
+  n_stays <= n_valid_3 and not_leaf_push;
   f_inner <= f_inner_sr(10);
   f_slot <= f_slot_sr(10);
   f_tmin <= f_tmin_sr(10);
@@ -2749,8 +2758,8 @@ begin
   tmin_minus_1 <= n_tmin - k_1_2;
   rs_tmin_n1 <= resize(tmin_n1, 33);
   rs_tmax_p1 <= resize(tmax_p1, 33);
-  minus_121 <= rs_tmin_n1 - rs_tmax_p1;
-  tmin_le_tmax_c <= unsigned(minus_121(32 downto 32));
+  minus_122 <= rs_tmin_n1 - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(minus_122(32 downto 32));
   mux_negative_n2 <= tmax_p1_n2 when negative_n2 = "1" else tmax_n2;
   d0_hi_c <= mux_negative_n2 when tmin_le_tmax = "1" else k_m2147483648;
   d0_hi <= d0_hi_sr(7);
@@ -2765,20 +2774,20 @@ begin
   d1_lo <= d1_lo_sr(7);
   rs_plane_t <= resize(plane_t, 33);
   rs_d0_hi <= resize(d0_hi, 33);
-  minus_122 <= rs_plane_t - rs_d0_hi;
-  d0_below <= unsigned(minus_122(32 downto 32));
+  minus_123 <= rs_plane_t - rs_d0_hi;
+  d0_below <= unsigned(minus_123(32 downto 32));
   rs_d0_lo <= resize(d0_lo, 33);
   rs_plane_t_1 <= resize(plane_t, 33);
-  minus_123 <= rs_d0_lo - rs_plane_t_1;
-  d0_above <= unsigned(minus_123(32 downto 32));
+  minus_124 <= rs_d0_lo - rs_plane_t_1;
+  d0_above <= unsigned(minus_124(32 downto 32));
   rs_plane_t_1_1 <= resize(plane_t_1, 33);
   rs_d1_hi <= resize(d1_hi, 33);
-  minus_124 <= rs_plane_t_1_1 - rs_d1_hi;
-  d1_below <= unsigned(minus_124(32 downto 32));
+  minus_125 <= rs_plane_t_1_1 - rs_d1_hi;
+  d1_below <= unsigned(minus_125(32 downto 32));
   rs_d1_lo <= resize(d1_lo, 33);
   rs_plane_t_1_2 <= resize(plane_t_1, 33);
-  minus_125 <= rs_d1_lo - rs_plane_t_1_2;
-  d1_above <= unsigned(minus_125(32 downto 32));
+  minus_126 <= rs_d1_lo - rs_plane_t_1_2;
+  d1_above <= unsigned(minus_126(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
   go_near_c <= d1_above when negative = "1" else d0_above;
@@ -2796,10 +2805,10 @@ begin
   enter_far <= g_inner_and_not_go_near and go_far;
   push <= enter_near and go_far;
   rs_g_sp <= g_sp(4 downto 0);
-  cat_127 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
+  cat_128 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
   u_far_min <= unsigned(far_min);
   u_g_tmax <= unsigned(g_tmax);
-  cat_128 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
+  cat_129 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
   enter_near_or_enter_far <= enter_near or enter_far;
   not_enter_near_or_enter_far <= not enter_near_or_enter_far;
   mux_enter_near <= near when enter_near = "1" else far;
@@ -2809,7 +2818,7 @@ begin
   mux_push <= g_sp_plus_k_1 when push = "1" else g_sp;
   not_push <= not push;
   g_sp_eq_k_0_1 <= "1" when g_sp = k_0_1 else "0";
-  and_129 <= not_push and g_sp_eq_k_0_1;
+  and_130 <= not_push and g_sp_eq_k_0_1;
   g_sp_minus_k_1 <= g_sp - k_1;
   mux_push_1 <= g_sp when push = "1" else g_sp_minus_k_1;
   not_just_alloc <= not just_alloc;
@@ -2819,7 +2828,7 @@ begin
   bits_leaf_q_head_2 <= unsigned(leaf_q_head(39 downto 37));
   bits_leaf_q_head_3 <= unsigned(leaf_q_head(52 downto 40));
   bits_leaf_q_head_4 <= unsigned(leaf_q_head(58 downto 53));
-  cull_c <= n_valid and culled_n;
+  cull_c <= n_valid_3 and culled_n;
 
   regs : process (clk)
   begin
@@ -2876,8 +2885,11 @@ begin
       else
         occupied_r <= minus_77;
       end if;
-      unpark_q_push <= merge_valid;
-      unpark_q_din <= cat_78;
+      if rst = '1' then
+        unpark_q_push <= unsigned'("0");
+      else
+        unpark_q_push <= merge_valid;
+      end if;
       if rst = '1' then
         unpark_q_wr <= unsigned'("000000");
       else
@@ -2898,22 +2910,26 @@ begin
       else
         unpark_q_rd1 <= mux_unpark_pop;
       end if;
-      unpark_q_q <= unpark_q_mem(to_integer(unpark_q_rd_next));
       if rst = '1' then
         unpark_q_bypass <= unsigned'("0");
       else
         unpark_q_bypass <= unpark_q_bypass_c;
-      end if;
-      if unpark_q_push = "1" then
-        unpark_q_din_r <= unpark_q_din;
       end if;
       if rst = '1' then
         unpark_q_nonempty <= unsigned'("0");
       else
         unpark_q_nonempty <= ne_82;
       end if;
-      new_q_push <= new_valid;
-      new_q_din <= cat_83;
+      unpark_q_din <= cat_78;
+      unpark_q_q <= unpark_q_mem(to_integer(unpark_q_rd_next));
+      if unpark_q_push = "1" then
+        unpark_q_din_r <= unpark_q_din;
+      end if;
+      if rst = '1' then
+        new_q_push <= unsigned'("0");
+      else
+        new_q_push <= new_valid;
+      end if;
       if rst = '1' then
         new_q_wr <= unsigned'("000000");
       else
@@ -2934,21 +2950,26 @@ begin
       else
         new_q_rd1 <= mux_new_pop;
       end if;
-      new_q_q <= new_q_mem(to_integer(new_q_rd_next));
       if rst = '1' then
         new_q_bypass <= unsigned'("0");
       else
         new_q_bypass <= new_q_bypass_c;
-      end if;
-      if new_q_push = "1" then
-        new_q_din_r <= new_q_din;
       end if;
       if rst = '1' then
         new_q_nonempty <= unsigned'("0");
       else
         new_q_nonempty <= ne_87;
       end if;
-      q_valid <= take_unpark_or_take_new;
+      new_q_din <= cat_83;
+      new_q_q <= new_q_mem(to_integer(new_q_rd_next));
+      if new_q_push = "1" then
+        new_q_din_r <= new_q_din;
+      end if;
+      if rst = '1' then
+        q_valid <= unsigned'("0");
+      else
+        q_valid <= take_unpark_or_take_new;
+      end if;
       q_new <= take_new;
       q_slot <= mux_take_unpark;
       q_sp <= bits_unpark_q_head_1;
@@ -2962,14 +2983,18 @@ begin
         r_valid <= g_valid;
       end if;
       r_pop <= not_enter_near_or_enter_far;
-      r_sp_zero <= and_129;
+      r_sp_zero <= and_130;
       r_sp_m1 <= mux_push_1;
       r_slot <= g_slot;
       r_node <= mux_enter_near;
       r_tmin <= mux_enter_far;
       r_tmax <= mux_enter_near_1;
       r_sp <= mux_push;
-      b_valid <= a_live;
+      if rst = '1' then
+        b_valid <= unsigned'("0");
+      else
+        b_valid <= a_live;
+      end if;
       b_slot <= a_slot;
       b_node <= mux_r_valid;
       b_tmin <= mux_r_valid_1;
@@ -2977,15 +3002,26 @@ begin
       b_sp <= mux_a_from_stack;
       b_from_stack_sr(2 to 2) <= b_from_stack_sr(1 to 1);
       b_from_stack_sr(1) <= a_from_stack;
-      b2_valid <= b_valid;
+      if rst = '1' then
+        b2_valid <= unsigned'("0");
+      else
+        b2_valid <= b_valid;
+      end if;
       b2_slot <= b_slot;
       b2_node <= b_node;
       b2_tmin <= b_tmin;
       b2_tmax <= b_tmax;
       b2_sp <= b_sp;
-      done_pop_r <= done_pop;
-      done_q_push <= a_done;
-      done_q_din <= a_slot;
+      if rst = '1' then
+        done_pop_r <= unsigned'("0");
+      else
+        done_pop_r <= done_pop;
+      end if;
+      if rst = '1' then
+        done_q_push <= unsigned'("0");
+      else
+        done_q_push <= a_done;
+      end if;
       if rst = '1' then
         done_q_wr <= unsigned'("000000");
       else
@@ -3006,21 +3042,26 @@ begin
       else
         done_q_rd1 <= mux_done_pop_r;
       end if;
-      done_q_q <= done_q_mem(to_integer(done_q_rd_next));
       if rst = '1' then
         done_q_bypass <= unsigned'("0");
       else
         done_q_bypass <= done_q_bypass_c;
-      end if;
-      if done_q_push = "1" then
-        done_q_din_r <= done_q_din;
       end if;
       if rst = '1' then
         done_q_nonempty <= unsigned'("0");
       else
         done_q_nonempty <= ne_98;
       end if;
-      c_valid <= b2_valid;
+      done_q_din <= a_slot;
+      done_q_q <= done_q_mem(to_integer(done_q_rd_next));
+      if done_q_push = "1" then
+        done_q_din_r <= done_q_din;
+      end if;
+      if rst = '1' then
+        c_valid <= unsigned'("0");
+      else
+        c_valid <= b2_valid;
+      end if;
       c_slot <= b2_slot;
       c_node <= mux_b_from_stack;
       c_tmin <= mux_b_from_stack_1;
@@ -3036,8 +3077,21 @@ begin
       cull_has_best <= slot_has_best;
       culled <= culled_c;
       culled_n <= culled;
-      n_valid_sr(2 to 3) <= n_valid_sr(1 to 2);
-      n_valid_sr(1) <= c_valid;
+      if rst = '1' then
+        n_valid_1 <= unsigned'("0");
+      else
+        n_valid_1 <= c_valid;
+      end if;
+      if rst = '1' then
+        n_valid_2 <= unsigned'("0");
+      else
+        n_valid_2 <= n_valid_1;
+      end if;
+      if rst = '1' then
+        n_valid_3 <= unsigned'("0");
+      else
+        n_valid_3 <= n_valid_2;
+      end if;
       n_slot_sr(2 to 3) <= n_slot_sr(1 to 2);
       n_slot_sr(1) <= c_slot;
       n_node_sr(2 to 3) <= n_node_sr(1 to 2);
@@ -3048,9 +3102,16 @@ begin
       n_tmax_sr(1) <= c_tmax;
       n_sp_sr(2 to 3) <= n_sp_sr(1 to 2);
       n_sp_sr(1) <= c_sp;
-      leaf_pop_r <= leaf_pop;
-      leaf_q_push <= leaf_push;
-      leaf_q_din <= cat_108;
+      if rst = '1' then
+        leaf_pop_r <= unsigned'("0");
+      else
+        leaf_pop_r <= leaf_pop;
+      end if;
+      if rst = '1' then
+        leaf_q_push <= unsigned'("0");
+      else
+        leaf_q_push <= leaf_push;
+      end if;
       if rst = '1' then
         leaf_q_wr <= unsigned'("000000");
       else
@@ -3071,40 +3132,81 @@ begin
       else
         leaf_q_rd1 <= mux_leaf_pop_r;
       end if;
-      leaf_q_q <= leaf_q_mem(to_integer(leaf_q_rd_next));
       if rst = '1' then
         leaf_q_bypass <= unsigned'("0");
       else
         leaf_q_bypass <= leaf_q_bypass_c;
       end if;
-      if leaf_q_push = "1" then
-        leaf_q_din_r <= leaf_q_din;
-      end if;
       if rst = '1' then
         leaf_q_nonempty <= unsigned'("0");
       else
-        leaf_q_nonempty <= ne_112;
+        leaf_q_nonempty <= ne_113;
+      end if;
+      leaf_q_din <= cat_109;
+      leaf_q_q <= leaf_q_mem(to_integer(leaf_q_rd_next));
+      if leaf_q_push = "1" then
+        leaf_q_din_r <= leaf_q_din;
       end if;
       ray_o_q <= ray_o(to_integer(n_slot));
       ray_invx_q <= ray_invx(to_integer(n_slot));
       ray_invy_q <= ray_invy(to_integer(n_slot));
       ray_invz_q <= ray_invz(to_integer(n_slot));
-      pu_sel_valid <= is_inner;
+      if rst = '1' then
+        pu_sel_valid <= unsigned'("0");
+      else
+        pu_sel_valid <= is_inner;
+      end if;
       pu_sel_last <= k_0;
       pu_sel_plane <= nw_clip0;
       pu_sel_axis <= nw_axis;
       pu_delta <= pu_diff;
       pu_inv <= pu_inv_axis;
-      pu_delta_valid <= pu_sel_valid;
+      if rst = '1' then
+        pu_delta_valid <= unsigned'("0");
+      else
+        pu_delta_valid <= pu_sel_valid;
+      end if;
       pu_delta_last <= pu_sel_last;
-      pu_product_valid_sr(2 to 6) <= pu_product_valid_sr(1 to 5);
-      pu_product_valid_sr(1) <= pu_delta_valid;
+      if rst = '1' then
+        pu_product_valid_1 <= unsigned'("0");
+      else
+        pu_product_valid_1 <= pu_delta_valid;
+      end if;
+      if rst = '1' then
+        pu_product_valid_2 <= unsigned'("0");
+      else
+        pu_product_valid_2 <= pu_product_valid_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_3 <= unsigned'("0");
+      else
+        pu_product_valid_3 <= pu_product_valid_2;
+      end if;
+      if rst = '1' then
+        pu_product_valid_4 <= unsigned'("0");
+      else
+        pu_product_valid_4 <= pu_product_valid_3;
+      end if;
+      if rst = '1' then
+        pu_product_valid_5 <= unsigned'("0");
+      else
+        pu_product_valid_5 <= pu_product_valid_4;
+      end if;
+      if rst = '1' then
+        pu_product_valid_6 <= unsigned'("0");
+      else
+        pu_product_valid_6 <= pu_product_valid_5;
+      end if;
       pu_product_last_sr(2 to 6) <= pu_product_last_sr(1 to 5);
       pu_product_last_sr(1) <= pu_delta_last;
       pu_above_r <= pu_above;
       pu_below_r <= pu_below;
       pu_low_r <= rs_pu_shifted;
-      pu_clamp_valid <= pu_product_valid;
+      if rst = '1' then
+        pu_clamp_valid <= unsigned'("0");
+      else
+        pu_clamp_valid <= pu_product_valid_6;
+      end if;
       pu_clamp_last <= pu_product_last;
       plane_t <= pu_clamped;
       if pu_clamp_last = "1" then
@@ -3113,24 +3215,68 @@ begin
       if pu_first = "1" then
         plane_t_of_first <= pu_clamped;
       end if;
-      plane_t_valid <= pu_clamp_valid;
+      if rst = '1' then
+        plane_t_valid <= unsigned'("0");
+      else
+        plane_t_valid <= pu_clamp_valid;
+      end if;
       plane_t_last <= pu_clamp_last;
-      pu_sel_valid_1 <= is_inner;
+      if rst = '1' then
+        pu_sel_valid_1 <= unsigned'("0");
+      else
+        pu_sel_valid_1 <= is_inner;
+      end if;
       pu_sel_last_1 <= k_1_1;
       pu_sel_plane_1 <= nw_clip1;
       pu_sel_axis_1 <= nw_axis;
       pu_delta_1 <= pu_diff_1;
       pu_inv_1 <= pu_inv_axis_1;
-      pu_delta_valid_1 <= pu_sel_valid_1;
+      if rst = '1' then
+        pu_delta_valid_1 <= unsigned'("0");
+      else
+        pu_delta_valid_1 <= pu_sel_valid_1;
+      end if;
       pu_delta_last_1 <= pu_sel_last_1;
-      pu_product_valid_1_sr(2 to 6) <= pu_product_valid_1_sr(1 to 5);
-      pu_product_valid_1_sr(1) <= pu_delta_valid_1;
+      if rst = '1' then
+        pu_product_valid_1_1 <= unsigned'("0");
+      else
+        pu_product_valid_1_1 <= pu_delta_valid_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_2_1 <= unsigned'("0");
+      else
+        pu_product_valid_2_1 <= pu_product_valid_1_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_3_1 <= unsigned'("0");
+      else
+        pu_product_valid_3_1 <= pu_product_valid_2_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_4_1 <= unsigned'("0");
+      else
+        pu_product_valid_4_1 <= pu_product_valid_3_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_5_1 <= unsigned'("0");
+      else
+        pu_product_valid_5_1 <= pu_product_valid_4_1;
+      end if;
+      if rst = '1' then
+        pu_product_valid_6_1 <= unsigned'("0");
+      else
+        pu_product_valid_6_1 <= pu_product_valid_5_1;
+      end if;
       pu_product_last_1_sr(2 to 6) <= pu_product_last_1_sr(1 to 5);
       pu_product_last_1_sr(1) <= pu_delta_last_1;
       pu_above_r_1 <= pu_above_1;
       pu_below_r_1 <= pu_below_1;
       pu_low_r_1 <= rs_pu_shifted_1;
-      pu_clamp_valid_1 <= pu_product_valid_1;
+      if rst = '1' then
+        pu_clamp_valid_1 <= unsigned'("0");
+      else
+        pu_clamp_valid_1 <= pu_product_valid_6_1;
+      end if;
       pu_clamp_last_1 <= pu_product_last_1;
       plane_t_1 <= pu_clamped_1;
       if pu_clamp_last_1 = "1" then
@@ -3139,13 +3285,65 @@ begin
       if pu_first_1 = "1" then
         plane_t_of_first_1 <= pu_clamped_1;
       end if;
-      plane_t_valid_1 <= pu_clamp_valid_1;
+      if rst = '1' then
+        plane_t_valid_1 <= unsigned'("0");
+      else
+        plane_t_valid_1 <= pu_clamp_valid_1;
+      end if;
       plane_t_last_1 <= pu_clamp_last_1;
       axis_n1 <= nw_axis;
       negative_sr(2 to 9) <= negative_sr(1 to 8);
       negative_sr(1) <= negative_c;
-      f_valid_sr(2 to 10) <= f_valid_sr(1 to 9);
-      f_valid_sr(1) <= n_stays;
+      if rst = '1' then
+        f_valid_1 <= unsigned'("0");
+      else
+        f_valid_1 <= n_stays;
+      end if;
+      if rst = '1' then
+        f_valid_2 <= unsigned'("0");
+      else
+        f_valid_2 <= f_valid_1;
+      end if;
+      if rst = '1' then
+        f_valid_3 <= unsigned'("0");
+      else
+        f_valid_3 <= f_valid_2;
+      end if;
+      if rst = '1' then
+        f_valid_4 <= unsigned'("0");
+      else
+        f_valid_4 <= f_valid_3;
+      end if;
+      if rst = '1' then
+        f_valid_5 <= unsigned'("0");
+      else
+        f_valid_5 <= f_valid_4;
+      end if;
+      if rst = '1' then
+        f_valid_6 <= unsigned'("0");
+      else
+        f_valid_6 <= f_valid_5;
+      end if;
+      if rst = '1' then
+        f_valid_7 <= unsigned'("0");
+      else
+        f_valid_7 <= f_valid_6;
+      end if;
+      if rst = '1' then
+        f_valid_8 <= unsigned'("0");
+      else
+        f_valid_8 <= f_valid_7;
+      end if;
+      if rst = '1' then
+        f_valid_9 <= unsigned'("0");
+      else
+        f_valid_9 <= f_valid_8;
+      end if;
+      if rst = '1' then
+        f_valid_10 <= unsigned'("0");
+      else
+        f_valid_10 <= f_valid_9;
+      end if;
       f_inner_sr(2 to 10) <= f_inner_sr(1 to 9);
       f_inner_sr(1) <= is_inner;
       f_slot_sr(2 to 10) <= f_slot_sr(1 to 9);
@@ -3187,7 +3385,11 @@ begin
       go_far <= go_far_c;
       near_end <= mux_negative;
       far_start <= mux_negative_1;
-      g_valid <= f_valid;
+      if rst = '1' then
+        g_valid <= unsigned'("0");
+      else
+        g_valid <= f_valid_10;
+      end if;
       g_slot <= f_slot;
       g_child <= f_child;
       g_tmin <= f_tmin;

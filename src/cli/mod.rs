@@ -280,6 +280,10 @@ pub struct GenArgs {
     /// Also write an ISE project script (xtclsh) and a UCF for the XC5VLX110T-1FF1136.
     #[arg(long)]
     pub ise: bool,
+    /// Also give the core its observation ports (busy, stack_depth, visits, culls, occupied,
+    /// accept*, visit*: docs/CORE.md), which the simulations count with.
+    #[arg(long = "debug-ports")]
+    pub debug_ports: bool,
     /// The clock the cores are pipelined for, MHz (50..=400); also the ISE UCF's constraint.
     #[arg(long = "target-mhz", alias = "clock-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,

@@ -239,7 +239,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     let p = crate::cores::top::CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
-    let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, clock_mhz: c.target_mhz as f64 };
+    let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, debug_ports: c.debug_ports, clock_mhz: c.target_mhz as f64 };
     let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref())
         .into_iter()
         .map(|(n, t)| (c.out.join(n), t.into_bytes()))
@@ -293,7 +293,7 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     }
     let family = if c.family == Family::Xc7 { "xc7" } else { "xc5v" };
     let mut cores = Vec::new();
-    let mut set = vec![(crate::cores::top::core_module(&core, &roms), None)];
+    let mut set = vec![(crate::cores::top::core_module_with(&core, &roms, false), None)];
     set.extend(generate::cores(&p).into_iter().map(|(m, lat, _)| (m, lat)));
     for (m, latency) in set {
         let area = synth::synth_xilinx(&m, family, &c.build.join(&m.name))?;
@@ -357,7 +357,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let (results, stats) = match (c.sim, &c.build, &raygen) {
         (Simulation::Rust, _, Some(g)) => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
-            let m = crate::cores::top::core_with_raygen(&p, &roms, g);
+            let m = crate::cores::top::core_with_raygen(&p, &roms, g, true);
             let r = frame::collect_batched(&m, rays.len(), p.slot_count(), 0, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r

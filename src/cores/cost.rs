@@ -1,7 +1,7 @@
 //! Hardware cost without synthesis: latencies, ROM bits and a DSP48E count derived from the
 //! netlist's multipliers, for sweeps that cannot afford yosys on every configuration.
 
-use super::top::{CoreParams, core_module};
+use super::top::{CoreParams, core_module_with};
 use crate::rtl::BinOp;
 use crate::rtl::Module;
 use crate::rtl::netlist::Def;
@@ -60,7 +60,7 @@ pub struct CoreCost {
 pub fn core_cost(roms: &SceneRoms) -> crate::error::Result<CoreCost> {
     let p = CoreParams::new(roms, 20, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
     p.check()?;
-    let core = core_module(&p, roms);
+    let core = core_module_with(&p, roms, false);
     let rom_bits = roms.rom_bits();
     Ok(CoreCost {
         div_latency: p.isect.div_latency(),

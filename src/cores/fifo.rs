@@ -21,15 +21,20 @@ pub struct Fifo<'b> {
 
 /// A queue of `width`-bit entries, at least `depth` deep (a power of two).
 pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>, din: S<'b>, pop: S<'b>) -> Fifo<'b> {
-    let push = b.delay(&format!("{name}_push"), push);
-    let din = b.delay(&format!("{name}_din"), din);
+    assert_eq!(din.width(), width, "{name}: entry width");
+    let (heads, nonempty) = fifo_words(b, name, depth, push, &[din], pop);
+    Fifo { head: heads[0], nonempty }
+}
+
+/// A queue whose entries are several words (each a RAM of its own, all at the same
+/// pointers): for entries wider than a signal may be. The heads of the words, and `nonempty`.
+pub fn fifo_words<'b>(b: &'b Builder, name: &str, depth: u32, push: S<'b>, dins: &[S<'b>], pop: S<'b>) -> (Vec<S<'b>>, S<'b>) {
+    let push = b.valid_delay(&format!("{name}_push"), push);
     let depth = depth.next_power_of_two().max(2);
     let ab = depth.trailing_zeros();
-    let mem = b.ram(&format!("{name}_mem"), width, vec![0; depth as usize]);
     let wr = b.reg(&format!("{name}_wr"), Ty::u(ab), Some(0));
     let rd = b.reg(&format!("{name}_rd"), Ty::u(ab), Some(0));
     let count = b.reg(&format!("{name}_count"), Ty::u(ab + 1), Some(0));
-    b.ram_write(mem, push, wr, din);
     b.next(wr, push.select(wr + 1, wr));
     // rd + 1 is kept in a register of its own, so the RAM's read address is a select between
     // two registers rather than a carry chain: the address fans out to every LUT-RAM cell of a
@@ -41,14 +46,26 @@ pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>,
     let after_pop = (count - pop.resize(ab + 1)).name(&format!("{name}_after_pop"));
     let count_next = (after_pop + push.resize(ab + 1)).name(&format!("{name}_count_next"));
     b.next(count, count_next);
-    let q = b.read(&format!("{name}_q"), mem, rd_next);
     let bypass = b.reg(&format!("{name}_bypass"), Ty::BIT, Some(0));
     b.next(bypass, (push & after_pop.eq(0)).name(&format!("{name}_bypass_c")));
-    let din_r = b.reg(&format!("{name}_din_r"), din.ty(), None);
-    b.next_when(din_r, push, din);
     let nonempty = b.reg(&format!("{name}_nonempty"), Ty::BIT, Some(0));
     b.next(nonempty, count_next.ne(0));
-    Fifo { head: bypass.select(din_r, q).name(&format!("{name}_head")), nonempty }
+    let one = dins.len() == 1;
+    let heads = dins
+        .iter()
+        .enumerate()
+        .map(|(k, &din)| {
+            let word = |what: &str| if one { format!("{name}_{what}") } else { format!("{name}_{what}{k}") };
+            let din = b.delay(&word("din"), din);
+            let mem = b.ram(&word("mem"), din.width(), vec![0; depth as usize]);
+            b.ram_write(mem, push, wr, din);
+            let q = b.read(&word("q"), mem, rd_next);
+            let din_r = b.reg(&word("din_r"), din.ty(), None);
+            b.next_when(din_r, push, din);
+            bypass.select(din_r, q).name(&word("head"))
+        })
+        .collect();
+    (heads, nonempty)
 }
 
 #[cfg(test)]

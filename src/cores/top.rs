@@ -182,10 +182,20 @@ pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
     v
 }
 
+/// The core with its observation ports (`flow::frame::OBSERVED`, the visit ports): what the
+/// simulations count with.
 pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
+    core_module_with(p, scene, true)
+}
+
+/// The core; with `debug` its observation ports too (busy, stack_depth, visits, culls,
+/// occupied, accept, accept_id, accept_slot, visit{u}, visit{u}_slot, visit{u}_node), which
+/// integrators do not need (`fxrt gen --debug-ports`).
+pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Module {
     let b = Builder::new("fxrt_core");
     let ins: Vec<S> = core_inputs(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
     let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!("11 ray ports") };
+    let res_ready = b.input("res_ready", Ty::BIT);
     let (n, units, sb, gb) = (p.isect.n, p.units, p.trav.slot_bits(), p.tag.slot_bits);
     let ub = p.unit_bits();
     let bit = Ty::BIT;
@@ -257,7 +267,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     // top's copies show 3 clocks after the take; a clock after that they show the new lowest
     // free slot. (One clock more would still be safe, two would give a slot twice: the
     // visit-order test fails then.)
-    let accept = b.delay("accept", take);
+    let accept = b.valid_delay("accept", take);
     let gslot = b.delay("accept_slot", take_slot);
     let [ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] =
         [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(|s| b.delay(&format!("acc_{}", b.name_of(s.sig)), s));
@@ -284,7 +294,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let box_lt1_d = b.delay("box_lt1_d", box_lt1);
     let box_tmax = (box_lt1 & box_lt2).select(box_d1, box_lt1_d.select(box_d2, box_d3)).name("box_tmax");
     let box_miss = (box_d1.msb() | box_d2.msb() | box_d3.msb()).name("box_miss");
-    let box_done = b.delay("box_done", (pu.valid & pu.last).name("box_last"));
+    let box_done = b.valid_delay("box_done", (pu.valid & pu.last).name("box_last"));
     let box_done_slot = b.delay_line("box_done_slot", box_slot, pu.latency + 1);
 
     // The traversal units.
@@ -432,7 +442,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let tag = b.cat(&[last_entry, cur_first, cur_slot, cur_sp, cur_tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
     let tag = b.delay_line("emit_tag", tag, lrc);
     let tag = b.cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)]).name("emit_tag_tri");
-    let emit_valid = b.delay_line("emit_valid", cur_valid, lrc);
+    let emit_valid = b.valid_line("emit_valid", cur_valid, lrc);
     let (tri_l, tri_words) = &scene.tri;
     let addr = tri_num.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
     let mut tri_fields: Vec<S> = Vec::new();
@@ -444,7 +454,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
         tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
     }
     let trc = p.tri_rom_cycles;
-    let valid_d = b.delay_line("pipe_valid", emit_valid, trc);
+    let valid_d = b.valid_line("pipe_valid", emit_valid, trc);
     let tag_d = b.delay_line("pipe_tag", tag, trc);
     // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
     let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
@@ -457,11 +467,16 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     pipe_in.extend(tri_fields);
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
 
-    // Rays done: taken from the units' done queues, lowest unit first (a ray finishes once).
+    // Rays done: taken from the units' done queues, lowest unit first (a ray finishes once),
+    // while the result queue has room for one more (`res_credit_ok`, below).
+    let credit_ok = b.reg("res_credit_ok", bit, Some(1));
     let dv: Vec<S> = trav
         .iter()
         .enumerate()
-        .map(|(u, t)| (t.get("done_valid") & !b.delay(&format!("u{u}_done_took"), done_pop[u])).name(&format!("u{u}_done_avail")))
+        .map(|(u, t)| {
+            let took = b.valid_delay(&format!("u{u}_done_took"), done_pop[u]);
+            (t.get("done_valid") & !took & credit_ok).name(&format!("u{u}_done_avail"))
+        })
         .collect();
     let mut done_any = dv[0];
     let mut done_slot = if ub == 0 { trav[0].get("done_slot") } else { b.cat(&[b.konst(Ty::u(ub), 0), trav[0].get("done_slot")]) };
@@ -476,7 +491,7 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     let mut cin: Vec<S> = r.all().to_vec();
     // Registered before the closest-hit unit, whose per-slot selects it drives (the units'
     // queues sit across the die).
-    let (done_any, done_slot) = (b.delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
+    let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
     cin.extend([accept, gslot, ray_id, done_any, done_slot]);
     let res = b.instance("u_closest", &closest, &cin);
     b.drive(merge_valid, res.get("merge_valid"));
@@ -488,55 +503,102 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     b.drive(free_slot, res.get("free_slot"));
 
     b.output("ray_ready", port_ready);
-    for name in ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"] {
-        b.output(name, res.get(name));
-    }
-    // Observation ports for `fxrt sim`: a triangle entering the pipeline, the deepest stack in
-    // the units' N stages, node visits and culls this clock, slots holding a ray. The deepest
-    // stack and the occupied slots come through a tree with a register after each level (a
-    // clock per level of log2 U: a frame's maximum and sums hardly notice), so these counters
-    // are never the core's slowest path (four units' chained maxima were: 102.5 MHz).
-    b.output("busy", valid_d);
-    let sum = |port: &str, w: u32| {
-        trav.iter().map(|t| t.get(port).resize(w)).reduce(|a, c| a + c).expect("one unit or more")
-    };
-    fn tree<'b>(b: &'b Builder, name: &str, mut level: Vec<S<'b>>, join: impl Fn(S<'b>, S<'b>) -> S<'b>) -> S<'b> {
-        let mut depth = 0;
-        while level.len() > 1 {
-            depth += 1;
-            let next: Vec<S<'b>> = level.chunks(2).map(|p| if p.len() == 2 { join(p[0], p[1]) } else { p[0] }).collect();
-            level = next.into_iter().enumerate().map(|(i, x)| b.delay(&format!("{name}_l{depth}_{i}"), x)).collect();
+    result_queue(&b, &res, done_any, res_ready, credit_ok);
+    if debug {
+        // Observation ports for `fxrt sim`: a triangle entering the pipeline, the deepest stack in
+        // the units' N stages, node visits and culls this clock, slots holding a ray. The deepest
+        // stack and the occupied slots come through a tree with a register after each level (a
+        // clock per level of log2 U: a frame's maximum and sums hardly notice), so these counters
+        // are never the core's slowest path (four units' chained maxima were: 102.5 MHz).
+        b.output("busy", valid_d);
+        let sum = |port: &str, w: u32| {
+            trav.iter().map(|t| t.get(port).resize(w)).reduce(|a, c| a + c).expect("one unit or more")
+        };
+        fn tree<'b>(b: &'b Builder, name: &str, mut level: Vec<S<'b>>, join: impl Fn(S<'b>, S<'b>) -> S<'b>) -> S<'b> {
+            let mut depth = 0;
+            while level.len() > 1 {
+                depth += 1;
+                let next: Vec<S<'b>> = level.chunks(2).map(|p| if p.len() == 2 { join(p[0], p[1]) } else { p[0] }).collect();
+                level = next.into_iter().enumerate().map(|(i, x)| b.delay(&format!("{name}_l{depth}_{i}"), x)).collect();
+            }
+            level[0]
         }
-        level[0]
-    }
-    let depths = trav.iter().map(|t| t.get("depth")).collect();
-    b.output("stack_depth", tree(&b, "obs_depth", depths, |a, c| a.max(c)));
-    b.output("visits", sum("visit", 3).name("visits_c"));
-    b.output("culls", sum("cull", 3).name("culls_c"));
-    let occupied = trav.iter().map(|t| t.get("occupied").resize(gb + 1)).collect();
-    b.output("occupied", tree(&b, "obs_occupied", occupied, |a, c| a + c));
-    // The walk of every slot (for the visit-order check): the ray written into a slot, and each
-    // unit's node visits.
-    b.output("accept", accept);
-    b.output("accept_id", ray_id);
-    b.output("accept_slot", gslot);
-    for (u, t) in trav.iter().enumerate() {
-        b.output(&format!("visit{u}"), t.get("visit"));
-        b.output(&format!("visit{u}_slot"), t.get("visit_slot"));
-        b.output(&format!("visit{u}_node"), t.get("visit_node"));
+        let depths = trav.iter().map(|t| t.get("depth")).collect();
+        b.output("stack_depth", tree(&b, "obs_depth", depths, |a, c| a.max(c)));
+        b.output("visits", sum("visit", 3).name("visits_c"));
+        b.output("culls", sum("cull", 3).name("culls_c"));
+        let occupied = trav.iter().map(|t| t.get("occupied").resize(gb + 1)).collect();
+        b.output("occupied", tree(&b, "obs_occupied", occupied, |a, c| a + c));
+        // The walk of every slot (for the visit-order check): the ray written into a slot, and each
+        // unit's node visits.
+        b.output("accept", accept);
+        b.output("accept_id", ray_id);
+        b.output("accept_slot", gslot);
+        for (u, t) in trav.iter().enumerate() {
+            b.output(&format!("visit{u}"), t.get("visit"));
+            b.output(&format!("visit{u}_slot"), t.get("visit_slot"));
+            b.output(&format!("visit{u}_node"), t.get("visit_node"));
+        }
     }
     b.finish()
 }
 
+/// Results a consumer has not taken yet, at most: the result queue's depth. Chosen so that a
+/// consumer always ready never holds a ray back (a result holds its place for 7 clocks, from
+/// leaving its done queue to leaving the result queue, and at most one leaves per clock).
+pub const RESULT_QUEUE: u32 = 16;
+
+/// The result ports behind a queue with credits: a result is taken on a clock with `res_valid`
+/// and `res_ready` both 1 and is held until then. A finished ray leaves its done queue only
+/// while the result queue has a place it has not promised (`credit_ok`): when the consumer
+/// stops, rays finish into the done queues, their slots stay taken, and `ray_ready` falls when
+/// the units are full — nothing is lost and nothing waits on a combinational path from
+/// `res_ready`. `popped` is the closest-hit unit's `done_valid` (a ray leaving its queue, a
+/// clock after the pop).
+fn result_queue<'b>(b: &'b Builder, res: &crate::rtl::build::Ports<'b>, popped: S<'b>, res_ready: S<'b>, credit_ok: S<'b>) {
+    let bit = Ty::BIT;
+    let field = |name: &str| res.get(&format!("res_{name}"));
+    let words = [b.cat(&[field("id"), field("hit"), field("tri"), field("t")]), b.cat(&[field("u"), field("v")])];
+    let take = b.wire("res_take", bit);
+    let (heads, nonempty) = super::fifo::fifo_words(b, "res_q", RESULT_QUEUE, field("valid"), &words, take);
+    b.drive(take, (nonempty & res_ready).name("res_take_c"));
+    // Places not promised, counted with the pops a clock late (`popped`): the queue then holds
+    // at most RESULT_QUEUE − credits + popped results, so a pop needs credits − popped ≥ 1,
+    // which credits ≥ 2 a clock earlier (registered: `credit_ok`) guarantees.
+    let w = RESULT_QUEUE.next_power_of_two().trailing_zeros() + 2;
+    let credits = b.reg("res_credits", Ty::u(w), Some(RESULT_QUEUE as i128));
+    let credits_next = (credits - popped.resize(w) + take.resize(w)).name("res_credits_next");
+    b.next(credits, credits_next);
+    b.next(credit_ok, credits_next.slice(1, w - 1).ne(0));
+    b.output("res_valid", nonempty);
+    // Each word's fields, least significant first (`cat` takes the most significant first).
+    let mut out = std::collections::BTreeMap::new();
+    for (word, names) in [(0, ["t", "tri", "hit", "id"].as_slice()), (1, ["v", "u"].as_slice())] {
+        let mut lsb = 0;
+        for name in names {
+            let width = field(name).width();
+            out.insert(*name, heads[word].slice(lsb, width).name(&format!("res_{name}_q")));
+            lsb += width;
+        }
+    }
+    for name in ["id", "hit", "tri", "t", "u", "v"] {
+        b.output(&format!("res_{name}"), out[name]);
+    }
+}
+
 /// The core fed by the on-chip ray generator instead of the ray port (the thesis's demo):
-/// no inputs but the clock and reset; the same result and observation outputs.
-pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::raygen::RayGen) -> Module {
+/// no inputs but the clock and reset; the same result outputs (and observation outputs with
+/// `debug`), every result taken the clock it is shown.
+pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::raygen::RayGen, debug: bool) -> Module {
     let mut m = Module::new("fxrt_core_raygen");
     let generator = Rc::new(super::raygen::raygen_core(g, p.isect.n, p.isect.m, p.trav.c, p.trav.id_width));
     let ready = m.wire("ready", Ty::BIT);
     let rays = m.instance("u_raygen", &generator, &[ready]);
-    let core = Rc::new(core_module(p, scene));
-    let outs = m.instance("u_core", &core, &rays);
+    let core = Rc::new(core_module_with(p, scene, debug));
+    // Results are taken the clock they are shown.
+    let mut ins = rays;
+    ins.push(m.konst("res_ready", Ty::BIT, 1));
+    let outs = m.instance("u_core", &core, &ins);
     for (k, (name, _)) in core.outputs.iter().enumerate() {
         if name == "ray_ready" {
             m.drive(ready, outs[k]);

@@ -213,7 +213,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let take_new = (!ring_g_valid & !unpark.nonempty & newq.nonempty).name("take_new");
     b.drive(unpark_pop, take_unpark);
     b.drive(new_pop, take_new);
-    let q_valid = b.delay("q_valid", take_unpark | take_new);
+    let q_valid = b.valid_delay("q_valid", take_unpark | take_new);
     let q_new = b.delay("q_new", take_new);
     let q_slot = b.delay("q_slot", take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb)));
     // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
@@ -257,7 +257,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let raddr = b.cat(&[a_slot, a_sp_m1.resize(stack_bits)]).name("stack_raddr");
     let top = bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, (k as usize) << stack_bits, push_w, push_addr, push_data, raddr);
     let bt = Token {
-        valid: b.delay("b_valid", (a_valid & !a_done).name("a_live")),
+        valid: b.valid_delay("b_valid", (a_valid & !a_done).name("a_live")),
         slot: b.delay("b_slot", a_slot),
         node: b.delay("b_node", r_valid.select(r.node, r.node.k(0))),
         tmin: b.delay("b_tmin", r_valid.select(r.tmin, r.tmin.k(0))),
@@ -267,7 +267,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let b_from_stack = b.delay_line("b_from_stack", a_from_stack, 2);
     // B waits a clock for the stack word (the block's output register).
     let bt = Token {
-        valid: b.delay("b2_valid", bt.valid),
+        valid: b.valid_delay("b2_valid", bt.valid),
         slot: b.delay("b2_slot", bt.slot),
         node: b.delay("b2_node", bt.node),
         tmin: b.delay("b2_tmin", bt.tmin),
@@ -276,14 +276,14 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     };
     // The top's pops arrive a clock late (registered here: the top's arbiter sits across the
     // die), so it does not take from a queue again in the clock after it took.
-    let done = fifo(&b, "done_q", sb, k, a_done, a_slot, b.delay("done_pop_r", done_pop));
+    let done = fifo(&b, "done_q", sb, k, a_done, a_slot, b.valid_delay("done_pop_r", done_pop));
 
     // B: a popped entry (far node, far_min, tmax) from the stack word.
     let top_tmax = top.slice(0, dist.width).signed();
     let top_tmin = top.slice(dist.width, dist.width).signed();
     let top_node = top.slice(2 * dist.width, node_bits);
     let c = Token {
-        valid: b.delay("c_valid", bt.valid),
+        valid: b.valid_delay("c_valid", bt.valid),
         slot: b.delay("c_slot", bt.slot),
         node: b.delay("c_node", b_from_stack.select(top_node, bt.node)),
         tmin: b.delay("c_tmin", b_from_stack.select(top_tmin, bt.tmin)),
@@ -308,7 +308,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
 
     // N: the node word.
     let nt = Token {
-        valid: b.delay_line("n_valid", c.valid, nrc),
+        valid: b.valid_line("n_valid", c.valid, nrc),
         slot: b.delay_line("n_slot", c.slot, nrc),
         node: b.delay_line("n_node", c.node, nrc),
         tmin: b.delay_line("n_tmin", c.tmin, nrc),
@@ -323,7 +323,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let is_inner = (visit & !w_leaf).name("is_inner");
     let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
     let leaf_in = b.cat(&[nt.slot, w_first.resize(leaf_bits), w_count, nt.tmin.unsigned().resize(p.tmin_width()), nt.sp]);
-    let leafq = fifo(&b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.delay("leaf_pop_r", leaf_pop));
+    let leafq = fifo(&b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.valid_delay("leaf_pop_r", leaf_pop));
 
     // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
     // the units' second stage in N + 1).
@@ -340,7 +340,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // N → F: the token rides along; the limits are made on the way (as `inner_step`'s compares,
     // every one a strict less-than; when tmin > tmax no distance passes any limit).
     let ring = (nt.valid & !leaf_push).name("n_stays");
-    let f_valid = b.delay_line("f_valid", ring, l);
+    let f_valid = b.valid_line("f_valid", ring, l);
     let f_inner = b.delay_line("f_inner", is_inner, l);
     let f_slot = b.delay_line("f_slot", nt.slot, l);
     let f_tmin = b.delay_line("f_tmin", nt.tmin, l);
@@ -382,7 +382,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let near_end = b.delay("near_end", negative.select(d1, d0));
     let far_start = b.delay("far_start", negative.select(d0, d1));
     let g = Token {
-        valid: b.delay("g_valid", f_valid),
+        valid: b.valid_delay("g_valid", f_valid),
         slot: b.delay("g_slot", f_slot),
         node: b.delay("g_child", f_child),
         tmin: b.delay("g_tmin", f_tmin),
@@ -494,6 +494,8 @@ mod tests {
             };
             let ins: Vec<_> = core_inputs(&p).iter().map(|(n, _)| port(n)).collect();
             let (ready, res_valid, res_id) = (port("ray_ready"), port("res_valid"), port("res_id"));
+            // Every result is taken the clock it is shown.
+            sim.set(port("res_ready"), 1);
             let (accept, accept_id, slot_out) = (port("accept"), port("accept_id"), port("accept_slot"));
             let visit: Vec<_> = (0..units)
                 .map(|u| (port(&format!("visit{u}")), port(&format!("visit{u}_slot")), port(&format!("visit{u}_node"))))

@@ -114,7 +114,8 @@ pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &
             closest::closest_core(core.tag, core.total_slots(), core.trav.id_width, isect.n, isect.m, isect.target()),
             Some(1 + closest::input_latency(isect.target())),
         ),
-        _ => (top::core_module(core, roms), None),
+        // The core as integrators get it: no observation ports.
+        _ => (top::core_module_with(core, roms, false), None),
     }
 }
 

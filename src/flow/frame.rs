@@ -14,7 +14,6 @@ use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
 use crate::render::fast::FastGolden;
 use crate::rtl::batch::BatchSim;
-use crate::rtl::sim::Sim;
 use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
@@ -71,7 +70,7 @@ impl CoreStats {
 
     /// One cycle's observation ports: triangle in the pipeline, stack depth, visits, culls,
     /// occupied slots.
-    fn count(&mut self, row: &[i128]) {
+    pub(crate) fn count(&mut self, row: &[i128]) {
         self.busy_cycles += row[0] as u64;
         self.max_stack_depth = self.max_stack_depth.max(row[1] as u32);
         self.visits += row[2] as u64;
@@ -105,7 +104,7 @@ impl CoreStats {
 /// Observation ports of the core, in the order `CoreStats::count` reads them.
 pub const OBSERVED: [&str; 5] = ["busy", "stack_depth", "visits", "culls", "occupied"];
 
-fn port(m: &Module, name: &str) -> crate::rtl::Sig {
+pub(crate) fn port(m: &Module, name: &str) -> crate::rtl::Sig {
     let id = m.outputs.iter().find(|o| o.0 == name).map(|o| o.1);
     let id = id.or_else(|| m.inputs.iter().copied().find(|&i| m.sig(i).name == name));
     m.handle(id.unwrap_or_else(|| panic!("{}: no port {name}", m.name)))
@@ -163,6 +162,8 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay], stall
         let raw = m.rom_read(&format!("ray_{name}"), rom, addr);
         ins.push(if ty.signed { m.un(&format!("ray_{name}_s"), crate::rtl::UnOp::AsSigned, raw) } else { raw });
     }
+    // The consumer is always ready: every result is taken the clock it is shown.
+    ins.push(m.konst("res_ready", Ty::BIT, 1));
     let core = std::rc::Rc::new(core_module(p, scene));
     let outs = m.instance("u_core", &core, &ins);
     let pos = |name: &str| core.outputs.iter().position(|o| o.0 == name).expect("core port");
@@ -224,7 +225,8 @@ pub fn collect_batched(
                     return;
                 }
                 let row: Vec<i128> = order.iter().map(|&i| all[i]).collect();
-                cycles = c as u64 + 1 - skip;
+                // Taken in the clock after the one that showed it (as the testbenches count).
+                cycles = c as u64 + 2 - skip;
                 stats.count(&row[7..]);
                 stats.stall_cycles += stall_out.map_or(0, |i| all[i] as u64);
                 if row[0] == 1 {
@@ -243,9 +245,8 @@ pub fn collect_batched(
 }
 
 /// `simulate_rust` in the cycle simulator (`rtl::sim`), driving the core's ports directly as
-/// the HDL testbenches do: each cycle the next ray (in the order given) is on the ports, with
-/// `ray_valid` high unless `stalls` holds it back; results are returned in the order they came
-/// out. `progress` gets the number of results now and then.
+/// the HDL testbenches do (`disturb::simulate_cycle` with a consumer always ready and no
+/// reset): results in the order they came out.
 pub fn simulate_rust_cycle(
     p: &CoreParams,
     scene: &SceneRoms,
@@ -253,46 +254,8 @@ pub fn simulate_rust_cycle(
     stalls: &Stalls,
     progress: &dyn Fn(u64),
 ) -> (Vec<CoreResult>, CoreStats) {
-    let m = core_module(p, scene);
-    let mut sim = Sim::new(&m);
-    let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
-    let ready = port(&m, "ray_ready");
-    let observed = OBSERVED.map(|n| port(&m, n));
-    let res: Vec<_> =
-        ["res_valid", "res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"].iter().map(|n| port(&m, n)).collect();
-    let mut stats = CoreStats::new(rays.len() as u64, p.slot_count() as u64);
-    let mut results = Vec::with_capacity(rays.len());
-    let mut next = 0;
-    let idle = vec![0i128; ins.len()];
-    while results.len() < rays.len() {
-        let mut values = rays.get(next).map(|r| ray_inputs(r.pixel as u64, &r.ray));
-        let stalled = values.is_some() && stalls.at(stats.cycles);
-        if let (true, Some(v)) = (stalled, values.as_mut()) {
-            // The ray stays on the data ports; only ray_valid drops.
-            v[0] = 0;
-        }
-        for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&idle)) {
-            sim.set(*s, *v);
-        }
-        sim.eval();
-        let fire = values.is_some() && !stalled && sim.get(ready) == 1;
-        sim.tick();
-        stats.cycles += 1;
-        stats.stall_cycles += stalled as u64;
-        // Observed after the edge, as the testbenches do (Verilator's timing mode does not
-        // show these before it).
-        stats.count(&observed.map(|o| sim.get(o)));
-        next += fire as usize;
-        if sim.get(res[0]) == 1 {
-            let row: Vec<i128> = res[1..].iter().map(|s| sim.get(*s)).collect();
-            results.push(core_result(&row));
-            if results.len() % 256 == 0 {
-                progress(results.len() as u64);
-            }
-        }
-        assert!(stats.cycles < 1 << 40, "the core stopped producing results");
-    }
-    (results, stats)
+    let run = super::disturb::simulate_cycle(p, scene, rays, stalls, &super::disturb::Disturb::none(), progress);
+    (run.results, run.stats)
 }
 
 /// Rays and results that do not match, whatever order the results came in: each result is
@@ -353,7 +316,7 @@ pub fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
 pub const RESULT_PORTS: [&str; 6] = ["res_id", "res_hit", "res_tri", "res_t", "res_u", "res_v"];
 
 /// A result from the values of `RESULT_PORTS`.
-fn core_result(r: &[i128]) -> CoreResult {
+pub(crate) fn core_result(r: &[i128]) -> CoreResult {
     let hit = (r[1] == 1).then(|| Hit { tri: r[2] as u32, t: r[3] as i64, u: r[4] as i64, v: r[5] as i64 });
     (r[0] as u64, hit)
 }
@@ -377,6 +340,10 @@ pub struct FrameStream {
     /// has that id.
     pub expected: Vec<Option<Vec<i128>>>,
     pub stalls: Stalls,
+    /// The consumer's `res_ready` pattern and the reset clocks (`disturb::Disturb`; no
+    /// scrambling in an HDL simulator).
+    pub sink: Stalls,
+    pub resets: Vec<u64>,
     pub max_cycles: u64,
     /// The core's ray slots (for the occupancy figure).
     pub slots: u64,
@@ -402,7 +369,8 @@ pub fn frame_stream(p: &CoreParams, scene: &Scene, rays: &[PixelRay], stalls: &S
     // 32-bit integers hold (GHDL would wrap it, Verilator refuses it).
     let max_cycles =
         ((100_000 + 100 * stalls.per_period() as u64) * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
-    Ok(FrameStream { core, rays: inputs, expected, stalls: stalls.clone(), max_cycles, slots: p.slot_count() as u64 })
+    let (sink, resets) = (Stalls::none(), Vec::new());
+    Ok(FrameStream { core, rays: inputs, expected, stalls: stalls.clone(), sink, resets, max_cycles, slots: p.slot_count() as u64 })
 }
 
 /// Streams `rays` (in the order given, with `stalls`) through the core's HDL in `sim` with a
@@ -432,12 +400,15 @@ pub fn simulate_hdl(
 pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<CoreResult>, CoreStats)> {
     let m = &s.core;
     let stall_bits = (!s.stalls.is_none()).then(|| s.stalls.period());
+    let sink_bits = (!s.sink.is_none()).then(|| s.sink.period());
     let stream = Stream {
         rays: &s.rays,
         expected: &s.expected,
         checked: &RESULT_PORTS,
         id: "res_id",
         stalls: stall_bits.as_deref(),
+        sink: sink_bits.as_deref(),
+        resets: &s.resets,
         max_cycles: s.max_cycles,
     };
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
@@ -480,6 +451,7 @@ mod tests {
     use super::*;
     use crate::flow::feed::feed_order;
     use crate::params::Params;
+    use crate::rtl::sim::Sim;
     use crate::scene::SceneSource;
 
     fn cornell(n: u32, m: u32) -> Scene {

@@ -1,7 +1,7 @@
 //! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files.
 
 use crate::cores::intersect::{IntersectParams, intersect_core};
-use crate::cores::top::{CoreParams, core_module, core_with_raygen};
+use crate::cores::top::{CoreParams, core_module_with, core_with_raygen};
 use crate::model::raygen::RayGen;
 use crate::rtl::emit;
 use crate::rtl::netlist::Module;
@@ -53,6 +53,8 @@ pub struct GenOptions {
     pub verilog: bool,
     /// ISE project script and UCF for the XC5VLX110T.
     pub ise: bool,
+    /// The core's observation ports too (`core_module_with`).
+    pub debug_ports: bool,
     pub clock_mhz: f64,
 }
 
@@ -101,15 +103,15 @@ fn write_set(cores: &[(Module, Option<u32>, Value)], o: GenOptions, scene: &str)
 
 /// The pipeline cores alone (intersection pipeline and divider).
 pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, String)> {
-    write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, clock_mhz: p.target_mhz as f64 }, "")
+    write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, debug_ports: false, clock_mhz: p.target_mhz as f64 }, "")
 }
 
 /// The whole ray tracing core for a scene (fed by the on-chip ray generator when `raygen` is
 /// given), with manifests for it and for each of its cores.
 pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions, raygen: Option<&RayGen>) -> Vec<(String, String)> {
     let top = match raygen {
-        Some(g) => core_with_raygen(p, roms, g),
-        None => core_module(p, roms),
+        Some(g) => core_with_raygen(p, roms, g, o.debug_ports),
+        None => core_module_with(p, roms, o.debug_ports),
     };
     let core_params = json!({
         "scene": roms.name,

@@ -1,6 +1,7 @@
 //! Running the generated HDL: testbenches and the external simulators.
 
 pub mod check;
+pub mod disturb;
 pub mod ecp5;
 pub mod ecp5_bram;
 pub mod ecp5_carry;

@@ -84,6 +84,13 @@ struct StreamTb<'a> {
     ids: usize,
     /// Entries of the stall pattern; 0: the source never stalls (no stall file).
     stall_period: usize,
+    /// The core has a `res_ready` input; the consumer's pattern file, and its entries (0:
+    /// always ready, no file).
+    has_res_ready: bool,
+    sink: &'a str,
+    sink_period: usize,
+    /// Cycles with `rst` high for one clock.
+    resets: &'a [u64],
     max_cycles: u64,
 }
 
@@ -99,6 +106,13 @@ pub struct Stream<'a> {
     /// The source's stall pattern: it holds `ray_valid` low on cycle c if entry c mod len is
     /// true (`flow::feed::Stalls`); None: never.
     pub stalls: Option<&'a [bool]>,
+    /// The consumer's pattern: it holds `res_ready` low on cycle c if entry c mod len is true;
+    /// None: always ready.
+    pub sink: Option<&'a [bool]>,
+    /// Cycles with `rst` high for one clock (ascending): nothing is transferred in that clock,
+    /// and the testbench starts the frame again after it (results before it are checked for
+    /// being right, not for being complete; `results.txt` holds those after the last reset).
+    pub resets: &'a [u64],
     pub max_cycles: u64,
 }
 
@@ -111,7 +125,9 @@ pub struct Stream<'a> {
 /// for an unknown id, a second result for an id and an id without result each fail) and
 /// writes `results.txt`, one line of checked outputs per result, in arrival order.
 pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, String)> {
-    let in_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid").collect();
+    let in_ids: Vec<(String, SigId)> =
+        input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid" && n != "res_ready").collect();
+    let has_res_ready = input_ids(m).iter().any(|(n, _)| n == "res_ready");
     let checked_ids: Vec<(String, SigId)> =
         s.checked.iter().map(|c| m.outputs.iter().find(|o| o.0 == *c).expect("checked output").clone()).collect();
     let (inputs, ray_width) = ports(m, &in_ids, 0);
@@ -119,7 +135,7 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     let id = checked.iter().find(|p| p.name == s.id).expect("the id output is checked");
     assert!(!id.ty.signed, "the id output is unsigned");
     let (outputs, _) = ports(m, &m.outputs, 0);
-    let (rays, expected, results, stalls) = ("rays.txt", "expected.txt", "results.txt", "stalls.txt");
+    let (rays, expected, results, stalls, sink) = ("rays.txt", "expected.txt", "results.txt", "stalls.txt", "ready.txt");
     let vhdl = sim == Simulator::Ghdl;
     let mut files = crate::rtl::emit::design_files(m, ext(vhdl));
     let fields = |row: &[i128], ports: &[Port]| -> Vec<(u128, u32)> {
@@ -139,8 +155,13 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
         })
         .collect();
     files.push((expected.into(), expected_lines));
+    let bits_file = |bits: &[bool]| bits.iter().map(|&b| if b { "1\n" } else { "0\n" }).collect::<String>();
     if let Some(bits) = s.stalls {
-        files.push((stalls.into(), bits.iter().map(|&b| if b { "1\n" } else { "0\n" }).collect()));
+        files.push((stalls.into(), bits_file(bits)));
+    }
+    assert!(has_res_ready || (s.sink.is_none() && s.resets.is_empty()), "a consumer pattern or resets need res_ready and rst");
+    if let Some(bits) = s.sink {
+        files.push((sink.into(), bits_file(bits)));
     }
     let text = StreamTb {
         vhdl,
@@ -160,6 +181,10 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
         count: s.rays.len(),
         ids: s.expected.len(),
         stall_period: s.stalls.map_or(0, |b| b.len()),
+        has_res_ready,
+        sink,
+        sink_period: s.sink.map_or(0, |b| b.len()),
+        resets: s.resets,
         max_cycles: s.max_cycles,
     }
     .render();

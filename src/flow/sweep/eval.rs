@@ -5,7 +5,7 @@ use super::pnr::{PlacedModule, Pnr};
 use super::{CameraSpec, Config, CoreShape, SceneSpec, Set, SweepSpec, params_label};
 use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
-use crate::cores::top::{CoreParams, core_module};
+use crate::cores::top::{CoreParams, core_module_with};
 use crate::error::{Error, Result};
 use crate::flow::feed::Stalls;
 use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
@@ -316,7 +316,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         row.core = Some(run);
     }
     if let (Some(dir), Some(_)) = (&extras.synth_dir, &row.cost) {
-        let core = core_module(&core_params, &roms);
+        let core = core_module_with(&core_params, &roms, false);
         match synth_xc5v(&core, &dir.join(&row.key)) {
             Ok(a) => {
                 row.synth = Some(SynthArea {
@@ -343,7 +343,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
 /// the multipliers' pieces. The ROMs do not depend on them.
 fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32, shape: CoreShape) -> CoreCost {
     let p = CoreParams::with_slots(roms, 20, 1, target_mhz, shape.slots, shape.units);
-    let core = core_module(&p, roms);
+    let core = core_module_with(&p, roms, false);
     CoreCost {
         div_latency: p.isect.div_latency(),
         isect_latency: p.isect.latency(),
