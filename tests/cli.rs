@@ -177,7 +177,15 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join(format!("{name}.json"))).unwrap()).unwrap();
     assert_eq!((manifest["latency_cycles"].clone(), manifest["params"]["target_mhz"].clone()), (38.into(), 150.into()));
-    let ucf = std::fs::read_to_string(out.join("fxrt_core.ucf")).unwrap();
+    // The scene-dependent modules carry the scene's tag: fxrt_core_s<6 hex digits>.
+    let top = |dir: &std::path::Path| -> String {
+        let names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        let json = names.iter().find(|n| n.starts_with("fxrt_core_s") && n.ends_with(".json")).expect("the core's manifest");
+        json.trim_end_matches(".json").to_string()
+    };
+    let core_name = top(&out);
+    assert_eq!(core_name.len(), "fxrt_core_s".len() + 6, "{core_name}");
+    let ucf = std::fs::read_to_string(out.join(format!("{core_name}.ucf"))).unwrap();
     assert!(ucf.contains("PERIOD \"clk\" 6.667 ns"), "{ucf}");
     // At 75 MHz the products take one clock: the thesis-like pipeline, 13 cycles shorter.
     let slow = dir.path().join("slow");
@@ -186,19 +194,31 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let slow_manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(slow.join("fxrt_intersect_n16_m16_t0_e4_tag44_c75.json")).unwrap()).unwrap();
     assert_eq!(slow_manifest["latency_cycles"], 25);
-    assert!(std::fs::read_to_string(slow.join("fxrt_core.ucf")).unwrap().contains("13.333 ns"));
-    let core: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("fxrt_core.json")).unwrap()).unwrap();
+    assert!(std::fs::read_to_string(slow.join(format!("{core_name}.ucf"))).unwrap().contains("13.333 ns"));
+    let core: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join(format!("{core_name}.json"))).unwrap()).unwrap();
+    // What an integrator needs besides the ports: latency bounds, reset, results held,
+    // the clock, the hashes naming the scene and parameters.
+    assert!(core["latency_cycles"]["min"].as_u64().is_some_and(|l| l > 10), "{core}");
+    assert_eq!((core["interface"]["reset_cycles"].clone(), core["interface"]["result_queue_depth"].clone()), (1.into(), 16.into()));
+    assert_eq!(core["interface"]["rays_held_max"], 128 + 16 + 1);
+    assert_eq!(core["clock"]["target_mhz"], 150);
+    assert_eq!(core["hashes"]["scene_tag"].as_str().unwrap(), &core_name["fxrt_core_".len()..]);
+    assert_eq!(core["hashes"]["scene_sha256"].as_str().unwrap().len(), 64);
     // Results leave in the order rays finish, and the manifest says so.
     assert_eq!(core["params"]["results_in_order"], false, "{core}");
     assert_eq!((core["params"]["ray_slots_per_unit"].clone(), core["params"]["traversal_units"].clone()), (64.into(), 2.into()));
     let files = core["files"]["vhdl"].as_array().unwrap();
-    assert_eq!(files.last().unwrap(), "fxrt_core.vhd");
-    for f in files.iter().chain(core["files"]["verilog"].as_array().unwrap()) {
+    assert_eq!(files.last().unwrap(), &format!("{core_name}.vhd"));
+    let hex = core["files"]["verilog_memory_init"].as_array().unwrap();
+    assert!(!hex.is_empty());
+    let ise = core["files"]["ise"].as_array().unwrap();
+    for f in files.iter().chain(core["files"]["verilog"].as_array().unwrap()).chain(hex).chain(ise) {
         assert!(out.join(f.as_str().unwrap()).exists(), "{f}");
     }
-    let tcl = std::fs::read_to_string(out.join("fxrt_core.tcl")).unwrap();
+    let tcl = std::fs::read_to_string(out.join(format!("{core_name}.tcl"))).unwrap();
     assert!(tcl.contains("xc5vlx110t") && tcl.contains(&format!("xfile add \"{name}.vhd\"")), "{tcl}");
-    assert!(out.join("fxrt_core.ucf").exists());
+    assert!(out.join(format!("{core_name}.ucf")).exists());
     // A scene folder from `fxrt scene` gives the same core as the scene itself.
     let rom = dir.path().join("rom");
     let o = fxrt(&["scene", "--builtin", "random", "--n", "16", "--m", "16", "--out", rom.to_str().unwrap()]);
@@ -206,8 +226,10 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let again = dir.path().join("again");
     let o = fxrt(&["gen", "--scene", rom.to_str().unwrap(), "--ise", "--out", again.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    for f in ["fxrt_core.vhd", "fxrt_core.v", "fxrt_traverse_k64.vhd", "fxrt_core.json"] {
-        assert_eq!(std::fs::read(out.join(f)).unwrap(), std::fs::read(again.join(f)).unwrap(), "{f}");
+    assert_eq!(top(&again), core_name, "the same scene, the same tag");
+    let tag = &core_name["fxrt_core_".len()..];
+    for f in [format!("{core_name}.vhd"), format!("{core_name}.v"), format!("fxrt_traverse_k64_{tag}.vhd"), format!("{core_name}.json")] {
+        assert_eq!(std::fs::read(out.join(&f)).unwrap(), std::fs::read(again.join(&f)).unwrap(), "{f}");
     }
     // A scene too large for the block RAM allowed is refused, naming the option.
     let small = dir.path().join("small");

@@ -284,6 +284,10 @@ pub struct GenArgs {
     /// accept*, visit*: docs/CORE.md), which the simulations count with.
     #[arg(long = "debug-ports")]
     pub debug_ports: bool,
+    /// A report of `fxrt synth --family ecp5` for this scene and parameters: its measured clock
+    /// and resources go into the core's manifest.
+    #[arg(long, value_name = "FILE")]
+    pub measured: Option<PathBuf>,
     /// The clock the cores are pipelined for, MHz (50..=400); also the ISE UCF's constraint.
     #[arg(long = "target-mhz", alias = "clock-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,

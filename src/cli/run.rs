@@ -217,6 +217,27 @@ fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen> {
     RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
 }
 
+/// The whole core's entry of a `fxrt synth --family ecp5` report, checked to be for this scene
+/// and these parameters (`fxrt gen --measured`).
+fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, scene: &str) -> Result<serde_json::Value> {
+    let bad = |msg: String| Error::file(file, msg);
+    let text = std::fs::read_to_string(file).map_err(|e| bad(e.to_string()))?;
+    let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("not a synth report: {e}")))?;
+    let want = serde_json::json!({ "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "e": p.isect.e, "target_mhz": p.isect.target_mhz, "div_bits": p.isect.div_bits });
+    let params = &doc["params"];
+    for (k, v) in want.as_object().expect("an object") {
+        if &params[k] != v {
+            return Err(bad(format!("measured with {k} = {}, not this core's {v}", params[k])));
+        }
+    }
+    if doc["scene"] != scene {
+        return Err(bad(format!("measured on scene {}, not {scene}", doc["scene"])));
+    }
+    let modules = doc["modules"].as_array().cloned().unwrap_or_default();
+    let core = modules.into_iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
+    core.filter(|m| m["fmax_mhz"].is_number()).ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))
+}
+
 pub fn gen_core(c: &GenConfig) -> Result<()> {
     let (roms, raygen) = match &c.scene {
         GenScene::Folder(dir) => (SceneRoms::load(dir)?, None),
@@ -240,14 +261,15 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, debug_ports: c.debug_ports, clock_mhz: c.target_mhz as f64 };
-    let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref())
+    let measured = c.measured.as_deref().map(|f| measured_core(f, &p, &roms.name)).transpose()?;
+    let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref())
         .into_iter()
         .map(|(n, t)| (c.out.join(n), t.into_bytes()))
         .collect();
     crate::io::write_all_atomic(&files)?;
     println!(
         "{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",
-        if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" },
+        format!("{}_{}", if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" }, p.trav.scene_tag),
         roms.name,
         roms.tri_count(),
         p.isect.latency(),

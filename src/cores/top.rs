@@ -192,7 +192,8 @@ pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
 /// occupied, accept, accept_id, accept_slot, visit{u}, visit{u}_slot, visit{u}_node), which
 /// integrators do not need (`fxrt gen --debug-ports`).
 pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Module {
-    let b = Builder::new("fxrt_core");
+    let scene_tag = &p.trav.scene_tag;
+    let b = Builder::new(&format!("fxrt_core_{scene_tag}"));
     let ins: Vec<S> = core_inputs(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
     let [ray_valid, ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = ins[..] else { unreachable!("11 ray ports") };
     let res_ready = b.input("res_ready", Ty::BIT);
@@ -338,11 +339,11 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
         let (label, nrc) = (format!("u_node_rom_{pair}"), p.trav.node_rom_cycles);
         if u1 < units as usize {
             let (a, c) = (trav[u0].get("node_addr"), trav[u1].get("node_addr"));
-            let (wa, wc) = brom2(&b, &label, "node", node_l.width, image.clone(), a, c, nrc);
+            let (wa, wc) = brom2(&b, &label, &format!("node_{scene_tag}"), node_l.width, image.clone(), a, c, nrc);
             b.drive(node_words[u0], wa);
             b.drive(node_words[u1], wc);
         } else {
-            let w = brom(&b, &label, "node", node_l.width, image.clone(), trav[u0].get("node_addr"), nrc);
+            let w = brom(&b, &label, &format!("node_{scene_tag}"), node_l.width, image.clone(), trav[u0].get("node_addr"), nrc);
             b.drive(node_words[u0], w);
         }
     }
@@ -437,7 +438,7 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     // Emission: the leaf ROM at the entry, then the triangle ROMs at its word; the tag and the
     // ray (read from the ray RAMs at the slot) wait alongside.
     let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
-    let tri_num = brom(&b, "u_leaf_rom", "leaf", leaf_l.width, leaf_image, cur_ptr, tp.leaf_rom_cycles);
+    let tri_num = brom(&b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, leaf_image, cur_ptr, tp.leaf_rom_cycles);
     let lrc = tp.leaf_rom_cycles;
     let tag = b.cat(&[last_entry, cur_first, cur_slot, cur_sp, cur_tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
     let tag = b.delay_line("emit_tag", tag, lrc);
@@ -450,7 +451,7 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
         let lsb = group[0].lsb;
         let width: u32 = group.iter().map(|f| f.width).sum();
         let image = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
-        let word = brom(&b, &format!("u_tri_rom_{k}"), &format!("tri_{k}"), width, image, addr, p.tri_rom_cycles);
+        let word = brom(&b, &format!("u_tri_rom_{k}"), &format!("tri_{k}_{scene_tag}"), width, image, addr, p.tri_rom_cycles);
         tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
     }
     let trc = p.tri_rom_cycles;
@@ -590,7 +591,7 @@ fn result_queue<'b>(b: &'b Builder, res: &crate::rtl::build::Ports<'b>, popped: 
 /// no inputs but the clock and reset; the same result outputs (and observation outputs with
 /// `debug`), every result taken the clock it is shown.
 pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::raygen::RayGen, debug: bool) -> Module {
-    let mut m = Module::new("fxrt_core_raygen");
+    let mut m = Module::new(&format!("fxrt_core_raygen_{}", p.trav.scene_tag));
     let generator = Rc::new(super::raygen::raygen_core(g, p.isect.n, p.isect.m, p.trav.c, p.trav.id_width));
     let ready = m.wire("ready", Ty::BIT);
     let rays = m.instance("u_raygen", &generator, &[ready]);

@@ -63,6 +63,8 @@ pub struct TraverseParams {
     pub leaf_rom_cycles: u32,
     /// Ray slots of the unit: rays it holds at once, each with its own registers and stack.
     pub slots: u32,
+    /// The scene's tag (`SceneRoms::tag`), in the names of the modules built for the scene.
+    pub scene_tag: String,
 }
 
 impl TraverseParams {
@@ -80,6 +82,7 @@ impl TraverseParams {
             node_rom_cycles: read_cycles(scene.node.1.len()),
             leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
             slots,
+            scene_tag: scene.tag(),
         }
     }
     /// Reciprocal directions: m + C bits.
@@ -144,7 +147,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let ((node_l, node_words), (_, leaf_words)) = (&scene.node, &scene.leaf);
     let k = p.slots;
     assert!((1..=64).contains(&k), "1 to 64 slots per unit");
-    let b = Builder::new(&format!("fxrt_traverse_k{k}"));
+    let b = Builder::new(&format!("fxrt_traverse_k{k}_{}", p.scene_tag));
     let (n, dist, sb, spw) = (p.n, p.dist_ty(), p.slot_bits(), p.sp_width());
     let slot_ty = Ty::u(sb);
     let node_bits = rom_addr_bits(node_words.len());

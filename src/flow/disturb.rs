@@ -127,6 +127,48 @@ pub fn simulate_cycle(
     CycleRun { results, stats, before_reset }
 }
 
+/// The core's shortest latency: clocks from the clock a ray is taken (`ray_valid` and
+/// `ray_ready` high) to the first clock its result is shown (`res_valid`), for a ray that
+/// leaves the scene box at once — its origin just past the box on an axis with room, pointing
+/// away — so the box exit finds it missing and it finishes without a node step, in an idle
+/// core. Every other ray takes longer (it adds node steps, leaves, the pipeline, waits). None
+/// when the box fills the grid on every axis (no such ray exists).
+pub fn min_latency(p: &CoreParams, scene: &SceneRoms) -> Option<u64> {
+    let n = p.isect.n;
+    let axis = (0..3).find(|&a| scene.box_hi[a] + 1 < 1i64 << n)?;
+    let mut o = [0i64; 3];
+    o[axis] = scene.box_hi[axis] + 1;
+    // The direction is read by the pipeline only; a tiny positive one on every axis, with
+    // its reciprocals saturated as the golden model's are.
+    let lim = (1i128 << (p.trav.inv_width() - 1)) - 1;
+    let ray = crate::model::golden::GridRay { o, w: [1; 3], inv: [lim; 3] };
+    let m = core_module(p, scene);
+    let mut sim = Sim::new(&m);
+    let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
+    let (ready, res_valid) = (port(&m, "ray_ready"), port(&m, "res_valid"));
+    sim.set(port(&m, "res_ready"), 1);
+    let values = ray_inputs(0, &ray);
+    let mut taken = None;
+    for cycle in 0..10_000u64 {
+        if taken.is_none() {
+            for (s, v) in ins.iter().zip(&values) {
+                sim.set(*s, *v);
+            }
+        } else {
+            sim.set(ins[0], 0);
+        }
+        sim.eval();
+        if sim.get(res_valid) == 1 {
+            return taken.map(|t| cycle - t);
+        }
+        if taken.is_none() && sim.get(ready) == 1 {
+            taken = Some(cycle);
+        }
+        sim.tick();
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,6 +208,21 @@ mod tests {
         assert_eq!(mismatches(&scene, &rays, &free.results), 0);
         // Results can leave only on the 30 % of clocks the consumer is ready.
         assert!(run.stats.cycles * 3 / 10 >= rays.len() as u64 && run.stats.cycles > free.stats.cycles, "{} vs {}", run.stats.cycles, free.stats.cycles);
+    }
+
+    /// The shortest latency is a real one and a bound: the box-missing ray's result comes
+    /// after it, and no ray of a frame fed one at a time into the idle core is faster.
+    #[test]
+    fn the_shortest_latency_bounds_every_ray() {
+        let (_, roms, p, rays) = setup("cornell", 6, 6);
+        let min = min_latency(&p, &roms).expect("the Cornell box leaves room on an axis");
+        assert!(min > 10, "{min}");
+        for r in rays.iter().take(8) {
+            let run = simulate_cycle(&p, &roms, std::slice::from_ref(r), &Stalls::none(), &Disturb::none(), &|_| {});
+            // Taken on clock 0 (the port is ready and the ray offered at once); its result
+            // shown and taken on the last clock counted.
+            assert!(run.stats.cycles - 1 >= min, "ray {}: {} clocks, the minimum {min}", r.pixel, run.stats.cycles - 1);
+        }
     }
 
     /// Seeded reset clocks spread over the first pass of the frame.

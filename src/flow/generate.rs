@@ -20,6 +20,7 @@ pub fn manifest(m: &Module, latency: Option<u32>, params: Value) -> Value {
     ports.extend(m.inputs.iter().map(|&i| port(&m.sig(i).name, "in", m.sig(i).ty)));
     ports.extend(m.outputs.iter().map(|(n, i)| port(n, "out", m.sig(*i).ty)));
     let names = |ext: &str| m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect::<Vec<_>>();
+    let hex: Vec<String> = m.hierarchy().iter().flat_map(|x| emit::verilog::mem_files(x)).map(|f| f.0).collect();
     json!({
         "name": m.name,
         "generator": format!("fxrt {}", env!("CARGO_PKG_VERSION")),
@@ -27,7 +28,7 @@ pub fn manifest(m: &Module, latency: Option<u32>, params: Value) -> Value {
         "params": params,
         "ports": ports,
         "register_bits": m.register_bits(),
-        "files": { "vhdl": names("vhd"), "verilog": names("v") },
+        "files": { "vhdl": names("vhd"), "verilog": names("v"), "verilog_memory_init": hex },
     })
 }
 
@@ -57,6 +58,9 @@ pub struct GenOptions {
     pub debug_ports: bool,
     pub clock_mhz: f64,
 }
+
+/// What `fxrt synth --family ecp5` measured of the core (`--measured`): its module's entry.
+pub type Measured = Value;
 
 #[derive(Template)]
 #[template(path = "ise_project.tcl", escape = "none")]
@@ -108,7 +112,13 @@ pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, Str
 
 /// The whole ray tracing core for a scene (fed by the on-chip ray generator when `raygen` is
 /// given), with manifests for it and for each of its cores.
-pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions, raygen: Option<&RayGen>) -> Vec<(String, String)> {
+pub fn core_files(
+    p: &CoreParams,
+    roms: &SceneRoms,
+    o: GenOptions,
+    raygen: Option<&RayGen>,
+    measured: Option<&Measured>,
+) -> Vec<(String, String)> {
     let top = match raygen {
         Some(g) => core_with_raygen(p, roms, g, o.debug_ports),
         None => core_module_with(p, roms, o.debug_ports),
@@ -124,7 +134,57 @@ pub fn core_files(p: &CoreParams, roms: &SceneRoms, o: GenOptions, raygen: Optio
         "results_in_order": false,
         "result_order": "rays finish out of order; every result carries its ray id (res_id)",
     });
-    let mut set = vec![(top, None, core_params)];
+    let min_latency = crate::flow::disturb::min_latency(p, roms);
+    let mut set = vec![(top, None, core_params.clone())];
     set.extend(cores(&p.isect));
-    write_set(&set, o, &roms.name)
+    let mut out = write_set(&set, o, &roms.name);
+    // The core's manifest (written first) gets what an integrator needs beyond its ports.
+    let out_names: Vec<String> = out.iter().map(|f| f.0.clone()).collect();
+    let ise: Vec<String> = out.iter().map(|f| f.0.clone()).filter(|n| n.ends_with(".tcl") || n.ends_with(".ucf")).collect();
+    let file = &mut out.iter_mut().find(|f| f.0 == format!("{}.json", set[0].0.name)).expect("the core's manifest").1;
+    let mut doc: Value = serde_json::from_str(file).expect("the manifest just written");
+    let sha = |text: &str| {
+        use sha2::{Digest, Sha256};
+        format!("{:x}", Sha256::digest(text.as_bytes()))
+    };
+    let slots = p.slot_count() as u64;
+    let queue = crate::cores::top::RESULT_QUEUE as u64;
+    doc["latency_cycles"] = json!({
+        "min": min_latency,
+        "min_is": "clocks from the clock a ray is taken (ray_valid and ray_ready high) to the first clock its result is shown (res_valid), for a ray that leaves the scene box at once, in an idle core; every other ray takes longer",
+        "max": null,
+        "max_bound": format!("no constant bound: a ray's latency grows with its walk (node steps, leaves, triangle tests) and with the other rays sharing the core (at most {slots} in its slots), and stops while the consumer holds res_ready low; `fxrt sim` measures frames"),
+    });
+    doc["interface"] = json!({
+        "reset_cycles": 1,
+        "reset": "rst is synchronous and active high; one clock of it clears every valid bit (the ray port register, the traversal units' rings, queues and free slots, the leaf stream, the intersection pipeline, the closest-hit unit, the result queue): rays in flight and results not taken are dropped, nothing is transferred in that clock, and the core takes rays from the next clock on",
+        "ray_handshake": "a ray is taken on a clock with ray_valid and ray_ready high; ray_ready comes from registers through one LUT (no path from ray_valid)",
+        "ray_interval_min_cycles": 4,
+        "result_handshake": "a result is taken on a clock with res_valid and res_ready high and holds res_* until then; no path from res_ready to any output",
+        "result_queue_depth": queue,
+        "rays_held_max": slots + queue + 1,
+        "rays_held_max_is": "rays taken whose results are not yet taken: the port register, the ray slots, the result queue",
+        "results_in_order": false,
+        "result_order": "rays finish out of order; every result carries its ray id (res_id)",
+        "debug_ports": o.debug_ports,
+    });
+    let pick = |k: &str| measured.and_then(|m| m.get(k)).cloned().unwrap_or(Value::Null);
+    doc["clock"] = json!({
+        "target_mhz": p.isect.target_mhz,
+        "measured_fmax_mhz": pick("fmax_mhz"),
+        "measured_on": measured.map(|_| json!({ "device": pick("device"), "package": pick("package"), "speed_grade": pick("speed_grade"), "seed": pick("seed"), "yosys": pick("yosys"), "nextpnr": pick("nextpnr"), "module": pick("module") })),
+    });
+    doc["resources"] = measured.map_or(Value::Null, |_| json!({ "lut4": pick("lut4"), "ff": pick("ff"), "mult18": pick("mult18"), "dp16kd": pick("dp16kd") }));
+    doc["hashes"] = json!({
+        "scene_sha256": roms.hash(),
+        "scene_tag": p.trav.scene_tag,
+        "params_sha256": sha(&core_params.to_string()),
+    });
+    doc["files"]["ise"] = json!(ise);
+    // Memory images only where the Verilog that reads them was written.
+    let written = |n: &str| out_names.iter().any(|w| w == n);
+    let hex: Vec<Value> = doc["files"]["verilog_memory_init"].as_array().cloned().unwrap_or_default();
+    doc["files"]["verilog_memory_init"] = json!(hex.into_iter().filter(|h| h.as_str().is_some_and(written)).collect::<Vec<_>>());
+    *file = serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n";
+    out
 }

@@ -62,6 +62,29 @@ const FIELD_NAMES: [&str; 15] =
     ["r", "pp", "pq", "d", "np", "nq", "e1p", "e1q", "e2p", "e2q", "axis", "clip0", "clip1", "child", "first"];
 
 impl SceneRoms {
+    /// SHA-256 (hex) of what the hardware holds of the scene: its parameters, box, edge shift
+    /// and every ROM's layout and words. Two builds with the same hash have the same ROMs.
+    pub fn hash(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut h = Sha256::new();
+        h.update(format!("{:?} {:?} {}", self.params, self.box_hi, self.edge_shift).as_bytes());
+        for (layout, words) in [&self.tri, &self.node, &self.leaf] {
+            h.update(format!("{:?}", layout).as_bytes());
+            for w in words {
+                for x in &w.0 {
+                    h.update(x.to_le_bytes());
+                }
+            }
+        }
+        format!("{:x}", h.finalize())
+    }
+
+    /// The short scene tag in the names of the modules that depend on the scene: `s` and the
+    /// first six hex digits of `hash`, so two scenes' cores can share one project.
+    pub fn tag(&self) -> String {
+        format!("s{}", &self.hash()[..6])
+    }
+
     pub fn of(scene: &Scene) -> SceneRoms {
         let [tri, node, leaf] = rom::words(scene);
         SceneRoms {
