@@ -541,7 +541,9 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
             b.output(&format!("visit{u}_node"), t.get("visit_node"));
         }
     }
-    b.finish()
+    let mut m = b.finish();
+    m.std_ports = true;
+    m
 }
 
 /// Results a consumer has not taken yet, at most: the result queue's depth. Chosen so that a
@@ -592,6 +594,7 @@ fn result_queue<'b>(b: &'b Builder, res: &crate::rtl::build::Ports<'b>, popped: 
 /// `debug`), every result taken the clock it is shown.
 pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::raygen::RayGen, debug: bool) -> Module {
     let mut m = Module::new(&format!("fxrt_core_raygen_{}", p.trav.scene_tag));
+    m.std_ports = true;
     let generator = Rc::new(super::raygen::raygen_core(g, p.isect.n, p.isect.m, p.trav.c, p.trav.id_width));
     let ready = m.wire("ready", Ty::BIT);
     let rays = m.instance("u_raygen", &generator, &[ready]);

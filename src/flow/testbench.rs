@@ -166,7 +166,7 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     let text = StreamTb {
         vhdl,
         tb: &tb_name(m),
-        module: &m.name,
+        module: &tb_entity(m, vhdl),
         rays,
         expected,
         results,
@@ -190,6 +190,12 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     .render();
     files.push((format!("tb.{}", ext(vhdl)), text.expect("testbench template renders") + "\n"));
     files
+}
+
+/// The entity or module a testbench instantiates: in VHDL the numeric_std one
+/// (`emit::vhdl::entity`), whose ports the testbenches' signals have.
+fn tb_entity(m: &Module, vhdl: bool) -> String {
+    if vhdl { crate::rtl::emit::vhdl::entity(m) } else { m.name.clone() }
 }
 
 /// The file extension of a language.
@@ -325,7 +331,7 @@ fn render_vectors(m: &Module, t: &Transcript, vhdl: bool) -> Vec<(String, String
     let text = VectorTb {
         vhdl,
         tb: &tb_name(m),
-        module: &m.name,
+        module: &tb_entity(m, vhdl),
         vectors,
         has_reset,
         reset_bit: total_width - 1,

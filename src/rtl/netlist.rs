@@ -193,6 +193,10 @@ pub struct Module {
     pub current_block: Option<usize>,
     /// Every identifier given out so far (signals, ports, memories, instances).
     idents: std::collections::BTreeSet<String>,
+    /// A module integrators instantiate: its VHDL entity has std_logic / std_logic_vector
+    /// ports (a thin entity around `{name}_rtl`, which has the numeric_std ports the other
+    /// generated modules use; `emit::vhdl`). Verilog has no port types to change.
+    pub std_ports: bool,
 }
 
 /// Suffixes the printers derive identifiers with (a shift register's array, its type and loop
@@ -212,6 +216,7 @@ impl Module {
             current_block: None,
             // The module's own name is an identifier of its HDL too.
             idents: [name.to_string()].into_iter().collect(),
+            std_ports: false,
         }
     }
 
