@@ -8,4 +8,11 @@ cargo build --release --quiet
 bin="${CARGO_TARGET_DIR:-target}/release/fxrt"
 rm -rf "$out/scene" "$out/hdl"
 "$bin" scene --builtin teapot --out "$out/scene" >/dev/null
-"$bin" gen --scene "$out/scene" --out "$out/hdl" --ise >/dev/null
+# The core's measured clock and resources (docs/TIMING.md): a `fxrt synth --family ecp5` report
+# of exactly this netlist; `fxrt gen` refuses it once the netlist changed (place and route
+# again: scripts/measure-default.sh).
+measured=()
+if [ -f generated/measured/ecp5-core.json ]; then
+    measured=(--measured generated/measured/ecp5-core.json)
+fi
+"$bin" gen --scene "$out/scene" --out "$out/hdl" --ise "${measured[@]}" >/dev/null

@@ -370,3 +370,51 @@ fn one_word_memories_simulate_in_ghdl() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("\"all_pixels_match\":true"));
 }
+
+/// `fxrt gen --measured` puts a place-and-route report's clock and resources into the core's
+/// manifest only when the report measured this very netlist, scene and parameters; otherwise
+/// exit 2, one line naming the report, nothing written.
+#[test]
+fn gen_takes_measured_figures_only_for_the_same_netlist() {
+    use fxrt::cores::top::{CoreParams, core_module_with};
+    use fxrt::scene::images::SceneRoms;
+    use fxrt::scene::{Scene, SceneSource};
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &fxrt::params::Params::default()).unwrap();
+    let roms = SceneRoms::of(&scene);
+    // `fxrt gen`'s defaults: 20-bit ray ids, one quotient bit per divider stage, 150 MHz.
+    let p = CoreParams::new(&roms, 20, 1, 150);
+    let core = core_module_with(&p, &roms, false);
+    let report = |hash: &str| {
+        serde_json::json!({
+            "family": "ecp5", "scene": "cornell",
+            "params": { "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "e": p.isect.e, "target_mhz": 150, "div_bits": 1 },
+            "modules": [{ "module": core.name, "fmax_mhz": 123.45, "lut4": 11, "ff": 22, "mult18": 33, "dp16kd": 44,
+                          "device": "LFE5U-85F", "package": "CABGA381", "speed_grade": 6, "seed": 3,
+                          "yosys": "Yosys", "nextpnr": "nextpnr", "netlist_sha256": hash }]
+        })
+        .to_string()
+    };
+    let good = write(dir.path(), "good.json", report(&fxrt::flow::ecp5::netlist_hash(&core)).as_bytes());
+    let out = dir.path().join("out");
+    let o = fxrt(&["gen", "--builtin", "cornell", "--measured", &good, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join(format!("{}.json", core.name))).unwrap()).unwrap();
+    assert_eq!(manifest["clock"]["measured_fmax_mhz"], 123.45);
+    assert_eq!(manifest["clock"]["measured_on"]["seed"], 3);
+    assert_eq!((manifest["resources"]["lut4"].clone(), manifest["resources"]["dp16kd"].clone()), (11.into(), 44.into()));
+    // The same report for the core with its observation ports, or for another netlist.
+    let reject = |extra: &[&str], file: &str, name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec!["gen", "--builtin", "cornell", "--out", out.to_str().unwrap(), "--measured", file];
+        args.extend(extra);
+        assert_rejected(&args, Path::new(file).file_name().unwrap().to_str().unwrap(), &out);
+    };
+    reject(&["--debug-ports"], &good, "debug");
+    let stale = write(dir.path(), "stale.json", report("0123").as_bytes());
+    reject(&[], &stale, "stale");
+    let other = report(&fxrt::flow::ecp5::netlist_hash(&core)).replace("\"cornell\"", "\"teapot\"");
+    let other = write(dir.path(), "other.json", other.as_bytes());
+    reject(&[], &other, "other");
+}

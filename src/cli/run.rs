@@ -219,7 +219,7 @@ fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen> {
 
 /// The whole core's entry of a `fxrt synth --family ecp5` report, checked to be for this scene
 /// and these parameters (`fxrt gen --measured`).
-fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, scene: &str) -> Result<serde_json::Value> {
+fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, netlist: &crate::rtl::Module, scene: &str) -> Result<serde_json::Value> {
     let bad = |msg: String| Error::file(file, msg);
     let text = std::fs::read_to_string(file).map_err(|e| bad(e.to_string()))?;
     let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("not a synth report: {e}")))?;
@@ -235,7 +235,17 @@ fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, scene: &str) ->
     }
     let modules = doc["modules"].as_array().cloned().unwrap_or_default();
     let core = modules.into_iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
-    core.filter(|m| m["fmax_mhz"].is_number()).ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))
+    let core_entry = core.filter(|m| m["fmax_mhz"].is_number()).ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))?;
+    // Figures of another netlist (the generator changed since, or other options) are not this
+    // core's.
+    let hash = crate::flow::ecp5::netlist_hash(netlist);
+    if core_entry["netlist_sha256"] != hash.as_str() {
+        return Err(bad(format!(
+            "measured another netlist (sha256 {}, this core's {hash}): place and route it again with fxrt synth --family ecp5",
+            core_entry["netlist_sha256"]
+        )));
+    }
+    Ok(core_entry)
 }
 
 pub fn gen_core(c: &GenConfig) -> Result<()> {
@@ -261,7 +271,10 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, debug_ports: c.debug_ports, clock_mhz: c.target_mhz as f64 };
-    let measured = c.measured.as_deref().map(|f| measured_core(f, &p, &roms.name)).transpose()?;
+    let measured = match c.measured.as_deref() {
+        Some(f) => Some(measured_core(f, &p, &crate::cores::top::core_module_with(&p, &roms, c.debug_ports), &roms.name)?),
+        None => None,
+    };
     let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref())
         .into_iter()
         .map(|(n, t)| (c.out.join(n), t.into_bytes()))

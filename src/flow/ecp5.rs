@@ -153,6 +153,24 @@ pub struct Timing {
     pub yosys: String,
     pub nextpnr: String,
     pub seed: u64,
+    /// `netlist_hash` of the module placed: `fxrt gen --measured` takes the figures only for
+    /// the same netlist.
+    #[serde(default)]
+    pub netlist_sha256: String,
+}
+
+/// SHA-256 (hex) of a module's Verilog (every file of its hierarchy, names and contents, in
+/// compile order): the netlist a measurement belongs to.
+pub fn netlist_hash(m: &Module) -> String {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    for (name, text) in emit::design_files(m, "v") {
+        h.update(name.as_bytes());
+        h.update([0]);
+        h.update(text.as_bytes());
+        h.update([0]);
+    }
+    format!("{:x}", h.finalize())
 }
 
 /// The slowest register-to-register path: its start and end cells and the nets in between
@@ -295,7 +313,9 @@ pub fn place_and_route(
     let report: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))?;
     let (yosys, nextpnr) = tools.versions();
-    Ok(timing_from_report(&report, &m.name, target_mhz, latency, wrapper_ff, seed, yosys, nextpnr))
+    let mut t = timing_from_report(&report, &m.name, target_mhz, latency, wrapper_ff, seed, yosys, nextpnr);
+    t.netlist_sha256 = netlist_hash(m);
+    Ok(t)
 }
 
 fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<()> {
@@ -347,6 +367,7 @@ pub fn timing_from_report(
         yosys,
         nextpnr,
         seed,
+        netlist_sha256: String::new(),
     }
 }
 
