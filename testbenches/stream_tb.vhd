@@ -84,6 +84,18 @@ begin
 {%- endfor %}
     variable have_ray, offer, fire, take, in_reset, ok : boolean := false;
     variable done, passed, failed, cycles, busy_cycles, max_sp, stall_cycles, id : natural := 0;
+    -- The next ray of the file onto the v_ variables (have_ray: whether there was one).
+    procedure next_ray is
+    begin
+      have_ray := false;
+      if not endfile(rays) then
+        readline(rays, l);
+{%- for p in inputs %}
+        read(l, v_{{ p.name }});
+{%- endfor %}
+        have_ray := true;
+      end if;
+    end procedure next_ray;
   begin
     file_open(results, "{{ results }}", write_mode);
     for k in 0 to {{ ids - 1 }} loop
@@ -108,13 +120,7 @@ begin
       read(l, sink_bits(k));
     end loop;
 {%- endif %}
-    if not endfile(rays) then
-      readline(rays, l);
-{%- for p in inputs %}
-      read(l, v_{{ p.name }});
-{%- endfor %}
-      have_ray := true;
-    end if;
+    next_ray;
     while done < {{ count }} loop
 {%- if stall_period > 0 %}
       offer := have_ray and stall_bits(cycles mod {{ stall_period }}) = '0';
@@ -207,14 +213,7 @@ begin
         max_sp := to_integer(stack_depth);
       end if;
       if fire then
-        have_ray := false;
-        if not endfile(rays) then
-          readline(rays, l);
-{%- for p in inputs %}
-          read(l, v_{{ p.name }});
-{%- endfor %}
-          have_ray := true;
-        end if;
+        next_ray;
       end if;
       if in_reset then
         -- The frame again: results so far were right or counted failed; now every ray needs
@@ -226,14 +225,7 @@ begin
         file_open(results, "{{ results }}", write_mode);
         file_close(rays);
         file_open(rays, "{{ rays }}", read_mode);
-        have_ray := false;
-        if not endfile(rays) then
-          readline(rays, l);
-{%- for p in inputs %}
-          read(l, v_{{ p.name }});
-{%- endfor %}
-          have_ray := true;
-        end if;
+        next_ray;
       end if;
       assert cycles < {{ max_cycles }} report "the core stopped producing results" severity failure;
     end loop;
