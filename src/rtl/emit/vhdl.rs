@@ -122,7 +122,11 @@ fn port_clause(w: &mut CodeWriter, ports: &[Port]) {
     w.nest("port (", ");", |w| {
         for (k, p) in ports.iter().enumerate() {
             let dir = if p.input { "in" } else { "out" };
-            let ty = p.ty.map_or_else(|| "std_logic".to_string(), vtype);
+            let ty = match p.ty {
+                None => "std_logic".to_string(),
+                Some(t) if p.vector => format!("std_logic_vector({} downto 0)", t.width - 1),
+                Some(t) => vtype(t),
+            };
             let sep = if k + 1 < ports.len() { ";" } else { "" };
             w.line(format!("{} : {dir} {ty}{sep}", p.name));
         }
@@ -241,6 +245,15 @@ impl Printer for Vhdl {
     fn concat(&self, parts: &[Operand]) -> String {
         let p: Vec<String> = parts.iter().map(|p| format!("std_logic_vector({})", p.name)).collect();
         format!("unsigned(std_logic_vector'({}))", p.join(" & "))
+    }
+
+    fn bus_bits(&self, bus: &str, lsb: u32, width: u32, target: bool) -> String {
+        let bits = format!("{bus}({} downto {lsb})", lsb + width - 1);
+        if target { bits } else { format!("unsigned({bits})") }
+    }
+
+    fn to_bus(&self, a: Operand) -> String {
+        format!("std_logic_vector({})", a.name)
     }
 
     fn tap(&self, name: &str, depth: u32) -> String {
