@@ -3,6 +3,7 @@
 //! program on the host (`c_header`). Offsets and widths all come from the `Layout`.
 
 use crate::cores::axis::{Field, Layout};
+use crate::flow::frame::PixelRay;
 use crate::model::golden::{GridRay, Hit};
 use crate::rtl::Ty;
 
@@ -59,6 +60,16 @@ pub fn unpack_result(layout: &Layout, tdata: &[u8]) -> (u64, Option<Hit>) {
     let hit = get(tdata, layout.res_field("flags")) & 1 == 1;
     let f = |name: &str| get(tdata, layout.res_field(name));
     (id, hit.then(|| Hit { tri: f("tri") as u32, t: f("t") as i64, u: f("u") as i64, v: f("v") as i64 }))
+}
+
+/// The AXI4-Stream form of a frame: `rays.bin`, each ray's tdata in the order given, and
+/// `expected.bin`, the golden model's result tdata for each, in the same order.
+pub fn frame_files(layout: &Layout, scene: &crate::scene::Scene, rays: &[PixelRay]) -> Vec<(String, Vec<u8>)> {
+    let g = crate::render::fast::FastGolden::new(scene);
+    let tdata = rays.iter().map(|r| pack_ray(layout, r.pixel as u64, &r.ray)).collect::<Vec<_>>().concat();
+    let expected =
+        rays.iter().map(|r| pack_result(layout, r.pixel as u64, g.trace(&r.ray).0)).collect::<Vec<_>>().concat();
+    vec![("rays.bin".into(), tdata), ("expected.bin".into(), expected)]
 }
 
 /// The C header for module `module`'s layout (`{module}.h`): each field's offset, bytes, bits
