@@ -28,11 +28,11 @@ fn installed(tool: &str) -> bool {
 }
 
 /// Runs the testbench in `sim`: (passed, the output's last lines).
-fn run(python: &Path, sim: &str, dir: &Path) -> (bool, String) {
+fn run(python: &Path, sim: &str, dir: &Path, top: &str) -> (bool, String) {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("testbenches/cocotb/run.py");
     let out = Command::new(python)
         .arg(&script)
-        .args(["--sim", sim, "--top", "fxrt_core_axis", "--frame", "50", "--seed", "3", "--dir"])
+        .args(["--sim", sim, "--top", top, "--frame", "50", "--seed", "3", "--dir"])
         .arg(dir)
         .output()
         .expect("python runs");
@@ -69,9 +69,15 @@ fn the_cocotb_testbench_passes_in_ghdl_icarus_and_verilator() {
         .output()
         .unwrap();
     assert!(generated.status.success(), "{}", String::from_utf8_lossy(&generated.stderr));
+    // The wrapper's name carries the core's (with its scene tag): its manifest says it.
+    let top = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.unwrap().file_name().into_string().ok())
+        .find_map(|n| n.strip_suffix("_axis.json").map(|core| format!("{core}_axis")))
+        .expect("the wrapper's manifest");
     for &(sim, _) in &sims {
         let start = std::time::Instant::now();
-        let (passed, tail) = run(&python, sim, dir.path());
+        let (passed, tail) = run(&python, sim, dir.path(), &top);
         assert!(passed, "cocotb in {sim}:\n{tail}");
         common::say(&format!("cocotb {sim}: passed in {:.0} s", start.elapsed().as_secs_f64()));
     }
@@ -83,6 +89,6 @@ fn the_cocotb_testbench_passes_in_ghdl_icarus_and_verilator() {
     assert_eq!(bytes.len(), 196 * 32);
     bytes[98 * 32 + 10] ^= 1;
     std::fs::write(&expected, &bytes).unwrap();
-    let (passed, tail) = run(&python, sim, dir.path());
+    let (passed, tail) = run(&python, sim, dir.path(), &top);
     assert!(!passed, "a corrupted expected.bin passed in {sim}:\n{tail}");
 }

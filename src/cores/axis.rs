@@ -148,10 +148,12 @@ pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
         if f.signed { x.signed() } else { x }
     };
 
-    // Rays taken but whose results have not left: the barrier waits for 0, and no ray is taken
-    // when the count is at its top (so it cannot wrap, whatever the core holds; a core holds
-    // at most its slots' rays plus a few in registers, far below the top).
-    let count_bits = crate::scene::rom::rom_addr_bits(4 * p.total_slots() as usize) + 1;
+    // Rays taken whose results have not left. The core holds at most its port register's, its
+    // slots' and its result queue's, the wrapper two more in its register slice; the count
+    // has a bit more than that needs, and no ray is taken at its top, so it cannot wrap
+    // whatever the core does (and never holds a ray back from a core that keeps its bound).
+    let held = p.slot_count() + super::top::RESULT_QUEUE + 3;
+    let count_bits = crate::scene::rom::value_bits(held as usize) + 1;
     let in_flight = b.reg("in_flight", Ty::u(count_bits), Some(0));
     let room = in_flight.ne((1i128 << count_bits) - 1).name("room");
     // A frame's last ray was taken: no ray until its results have left.
@@ -224,6 +226,8 @@ pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
     b.with(|m| {
         m.bus("s_axis_ray_tdata", &ray_names.iter().map(String::as_str).collect::<Vec<_>>());
         m.bus("m_axis_res_tdata", &res_names.iter().map(String::as_str).collect::<Vec<_>>());
+        // What integrators instantiate: std_logic / std_logic_vector ports in VHDL.
+        m.std_ports = true;
     });
     b.finish()
 }
