@@ -35,4 +35,16 @@ if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
         fi
     fi
 fi
+# cocotb for the AXI4-Stream testbench (tests/cocotb.rs, testbenches/cocotb/) in the same .venv:
+# 1.8.1, the last release that runs Debian's Verilator 5.006 (1.9 wants 5.022); it drives
+# Debian's GHDL 2.0 and Icarus 11 too.
+if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
+    venv="$(dirname "$0")/../.venv"
+    if ! "$venv/bin/python" -c 'import cocotb, sys; sys.exit(cocotb.__version__ != "1.8.1")' >/dev/null 2>&1; then
+        if ! { { [ -x "$venv/bin/pip" ] || python3 -m venv "$venv"; } \
+            && "$venv/bin/pip" install -q --disable-pip-version-check cocotb==1.8.1; }; then
+            echo "install-deps: warning: could not install cocotb into .venv" >&2
+        fi
+    fi
+fi
 cargo fetch --quiet

@@ -202,6 +202,8 @@ pub struct GenConfig {
     pub bram_kbits: u64,
     pub div_bits: u32,
     pub threads: super::ThreadArgs,
+    /// The camera of the frame written for the AXI4-Stream wrapper (`--axis-frame`).
+    pub axis_frame: Option<CameraSpec>,
 }
 
 impl GenArgs {
@@ -210,6 +212,12 @@ impl GenArgs {
             Some(_) if self.raygen => {
                 return Err(Error::param("raygen", "needs the scene itself (an OBJ or --builtin), not --scene DIR"));
             }
+            Some(_) if self.axis_frame => {
+                return Err(Error::param(
+                    "axis-frame",
+                    "needs the scene itself (an OBJ or --builtin), not --scene DIR",
+                ));
+            }
             Some(dir) => GenScene::Folder(dir.clone()),
             None => GenScene::Scene {
                 source: self.scene.source(),
@@ -217,6 +225,12 @@ impl GenArgs {
                 raygen: self.raygen.then(|| self.camera.spec()),
             },
         };
+        if self.axis_frame && self.raygen {
+            return Err(Error::param(
+                "axis-frame",
+                "the core fed by its ray generator has no ray port: not with --raygen",
+            ));
+        }
         if !(1..=64).contains(&self.ray_id_width) {
             return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", self.ray_id_width)));
         }
@@ -234,6 +248,7 @@ impl GenArgs {
             bram_kbits: self.bram_kbits,
             div_bits: self.div_bits,
             threads: self.threads,
+            axis_frame: self.axis_frame.then(|| self.camera.spec()),
         })
     }
 }

@@ -306,6 +306,11 @@ pub struct GenArgs {
     /// camera given by --eye/--at/--up/--fov/--size (the eye must be inside the scene box).
     #[arg(long)]
     pub raygen: bool,
+    /// Also write the frame of --size (and the other camera options) for the AXI4-Stream
+    /// wrapper: rays.bin, each ray's tdata in pixel order, and expected.bin, the golden model's
+    /// result tdata for each, in the same order (docs/AXIS.md).
+    #[arg(long = "axis-frame")]
+    pub axis_frame: bool,
     #[command(flatten)]
     pub camera: CameraArgs,
     #[command(flatten)]

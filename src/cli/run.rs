@@ -249,12 +249,12 @@ fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, netlist: &crate
 }
 
 pub fn gen_core(c: &GenConfig) -> Result<()> {
-    let (roms, raygen) = match &c.scene {
-        GenScene::Folder(dir) => (SceneRoms::load(dir)?, None),
+    let (roms, raygen, scene) = match &c.scene {
+        GenScene::Folder(dir) => (SceneRoms::load(dir)?, None, None),
         GenScene::Scene { source, params, raygen } => {
             let scene = Scene::load(source, params)?;
             let raygen = raygen.as_ref().map(|cam| ray_generator(&scene, cam)).transpose()?;
-            (SceneRoms::of(&scene), raygen)
+            (SceneRoms::of(&scene), raygen, Some(scene))
         }
     };
     if let Some(g) = &raygen {
@@ -275,10 +275,23 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         Some(f) => Some(measured_core(f, &p, &crate::cores::top::core_module_with(&p, &roms, c.debug_ports), &roms.name)?),
         None => None,
     };
-    let files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref())
+    let mut files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref())
         .into_iter()
         .map(|(n, t)| (c.out.join(n), t.into_bytes()))
         .collect();
+    if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
+        let rays = frame::frame_rays(scene, &spec.camera(scene)?);
+        let pixels = spec.width as u64 * spec.height as u64;
+        if c.ray_id_width < 64 && pixels > 1u64 << c.ray_id_width {
+            return Err(Error::param(
+                "ray-id-width",
+                format!("{} bits cannot number the {pixels} pixels of --size", c.ray_id_width),
+            ));
+        }
+        let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
+        files
+            .extend(crate::flow::axis::frame_files(&layout, scene, &rays).into_iter().map(|(n, b)| (c.out.join(n), b)));
+    }
     crate::io::write_all_atomic(&files)?;
     println!(
         "{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",

@@ -1,6 +1,7 @@
 //! Hardware cores: each builds its netlist from the parameters; its golden twin lives in
 //! `model/`.
 
+pub mod axis;
 pub mod brom;
 pub mod clock;
 pub mod closest;

@@ -1,5 +1,7 @@
 //! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files.
 
+use super::axis;
+use crate::cores::axis::{Layout, axis_module};
 use crate::cores::intersect::{IntersectParams, intersect_core};
 use crate::cores::top::{CoreParams, core_module_with, core_with_raygen};
 use crate::model::raygen::RayGen;
@@ -17,8 +19,8 @@ pub fn manifest(m: &Module, latency: Option<u32>, params: Value) -> Value {
     if m.has_reset() {
         ports.push(json!({ "name": "rst", "direction": "in", "width": 1, "signed": false }));
     }
-    ports.extend(m.inputs.iter().map(|&i| port(&m.sig(i).name, "in", m.sig(i).ty)));
-    ports.extend(m.outputs.iter().map(|(n, i)| port(n, "out", m.sig(*i).ty)));
+    // As printed: a bus (`rtl::bus`, an AXI4-Stream tdata) in place of its parts.
+    ports.extend(m.printed_ports().iter().map(|p| port(p.name, if p.input { "in" } else { "out" }, p.ty)));
     let names = |ext: &str| m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect::<Vec<_>>();
     let hex: Vec<String> = m.hierarchy().iter().flat_map(|x| emit::verilog::mem_files(x)).map(|f| f.0).collect();
     json!({
@@ -119,9 +121,10 @@ pub fn core_files(
     raygen: Option<&RayGen>,
     measured: Option<&Measured>,
 ) -> Vec<(String, String)> {
+    let core = std::rc::Rc::new(core_module_with(p, roms, o.debug_ports));
     let top = match raygen {
         Some(g) => core_with_raygen(p, roms, g, o.debug_ports),
-        None => core_module_with(p, roms, o.debug_ports),
+        None => (*core).clone(),
     };
     let core_params = json!({
         "scene": roms.name,
@@ -136,6 +139,22 @@ pub fn core_files(
     });
     let min_latency = crate::flow::disturb::min_latency(p, roms);
     let mut set = vec![(top, None, core_params.clone())];
+    // The core behind AXI4-Stream ports, with the C header of its layout (not for the core
+    // fed by its own ray generator, which has no ray port).
+    let axis = raygen.is_none().then(|| {
+        let layout = Layout::of(&core);
+        let wrapper = axis_module(&core, p);
+        let header = (format!("{}.h", wrapper.name), axis::c_header(&wrapper.name, &layout));
+        let params = json!({
+            "core": core.name,
+            "layout": layout,
+            "c_header": header.0,
+            "tlast": "s_axis_ray_tlast ends a frame: no ray is taken until every result of the frame has left; \
+                      m_axis_res_tlast marks the frame's last result (docs/AXIS.md)",
+        });
+        set.push((wrapper, None, params));
+        header
+    });
     set.extend(cores(&p.isect));
     let mut out = write_set(&set, o, &roms.name);
     // The core's manifest (written first) gets what an integrator needs beyond its ports.
@@ -186,5 +205,6 @@ pub fn core_files(
     let hex: Vec<Value> = doc["files"]["verilog_memory_init"].as_array().cloned().unwrap_or_default();
     doc["files"]["verilog_memory_init"] = json!(hex.into_iter().filter(|h| h.as_str().is_some_and(written)).collect::<Vec<_>>());
     *file = serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n";
+    out.extend(axis);
     out
 }

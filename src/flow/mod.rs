@@ -1,5 +1,6 @@
 //! Running the generated HDL: testbenches and the external simulators.
 
+pub mod axis;
 pub mod check;
 pub mod disturb;
 pub mod ecp5;

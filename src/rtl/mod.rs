@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod build;
+pub mod bus;
 pub mod emit;
 pub mod flatten;
 pub mod fsm;

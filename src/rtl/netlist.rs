@@ -189,10 +189,12 @@ pub struct Module {
     pub roms: Vec<Rom>,
     pub instances: Vec<Instance>,
     pub blocks: Vec<Block>,
+    /// Ports printed as one wider port (`bus.rs`).
+    pub buses: Vec<super::bus::Bus>,
     /// The block new signals are put in (`begin_block` … `end_block`).
     pub current_block: Option<usize>,
-    /// Every identifier given out so far (signals, ports, memories, instances).
-    idents: std::collections::BTreeSet<String>,
+    /// Every identifier given out so far (signals, ports, memories, instances, buses).
+    pub(super) idents: std::collections::BTreeSet<String>,
     /// A module integrators instantiate: its VHDL entity has std_logic / std_logic_vector
     /// ports (a thin entity around `{name}_rtl`, which has the numeric_std ports the other
     /// generated modules use; `emit::vhdl`). Verilog has no port types to change.
@@ -213,6 +215,7 @@ impl Module {
             roms: Vec::new(),
             instances: Vec::new(),
             blocks: Vec::new(),
+            buses: Vec::new(),
             current_block: None,
             // The module's own name is an identifier of its HDL too.
             idents: [name.to_string()].into_iter().collect(),

@@ -188,6 +188,14 @@ impl Printer for Verilog {
         format!("{{{}}}", parts.iter().map(|p| p.name).collect::<Vec<_>>().join(", "))
     }
 
+    fn bus_bits(&self, bus: &str, lsb: u32, width: u32, _target: bool) -> String {
+        format!("{bus}[{}:{lsb}]", lsb + width - 1)
+    }
+
+    fn to_bus(&self, a: Operand) -> String {
+        a.name.to_string()
+    }
+
     fn tap(&self, name: &str, depth: u32) -> String {
         format!("{name}_sr[{depth}]")
     }

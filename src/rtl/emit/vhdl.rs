@@ -49,18 +49,18 @@ fn std_wrapper(m: &Module) -> String {
         w.line(lib);
     }
     w.blank();
-    let mut ports: Vec<(String, bool, Option<crate::rtl::Ty>)> = vec![("clk".into(), true, None)];
+    // (name, input, type, a bus: std_logic_vector in `{name}_rtl` too).
+    let mut ports: Vec<(String, bool, Option<crate::rtl::Ty>, bool)> = vec![("clk".into(), true, None, false)];
     if m.has_reset() {
-        ports.push(("rst".into(), true, None));
+        ports.push(("rst".into(), true, None, false));
     }
-    ports.extend(m.inputs.iter().map(|&i| (m.sig(i).name.clone(), true, Some(m.sig(i).ty))));
-    ports.extend(m.outputs.iter().map(|(n, i)| (n.clone(), false, Some(m.sig(*i).ty))));
+    ports.extend(m.printed_ports().iter().map(|p| (p.name.to_string(), p.input, Some(p.ty), p.bus.is_some())));
     let clause = |w: &mut CodeWriter, numeric: bool| {
         w.nest("port (", ");", |w| {
-            for (k, (name, input, ty)) in ports.iter().enumerate() {
+            for (k, (name, input, ty, bus)) in ports.iter().enumerate() {
                 let dir = if *input { "in" } else { "out" };
                 let t = match ty {
-                    Some(t) if numeric => vtype(*t),
+                    Some(t) if numeric && !bus => vtype(*t),
                     Some(t) => std_type(t.width),
                     None => "std_logic".into(),
                 };
@@ -73,16 +73,19 @@ fn std_wrapper(m: &Module) -> String {
     w.line(format!("architecture rtl of {} is", m.name));
     w.indented(|w| {
         w.nest(format!("component {} is", entity(m)), "end component;", |w| clause(w, true));
-        for (name, _, ty) in &ports {
-            if let Some(t) = ty {
-                w.line(format!("signal {name}_n : {};", vtype(*t)));
+        for (name, _, ty, bus) in &ports {
+            match ty {
+                Some(t) if *bus => w.line(format!("signal {name}_n : {};", std_type(t.width))),
+                Some(t) => w.line(format!("signal {name}_n : {};", vtype(*t))),
+                None => {}
             }
         }
     });
     w.line("begin");
     w.indented(|w| {
-        for (name, input, ty) in &ports {
+        for (name, input, ty, bus) in &ports {
             match ty {
+                Some(_) if *input && *bus => w.line(format!("{name}_n <= {name};")),
                 Some(t) if *input && t.width == 1 => w.line(format!("{name}_n(0) <= {name};")),
                 Some(t) if *input => w.line(format!("{name}_n <= {}({name});", kind(*t))),
                 _ => {}
@@ -90,14 +93,15 @@ fn std_wrapper(m: &Module) -> String {
         }
         w.nest(format!("u_rtl : {}", entity(m)), "", |w| {
             w.nest("port map (", ");", |w| {
-                for (k, (name, _, ty)) in ports.iter().enumerate() {
+                for (k, (name, _, ty, _)) in ports.iter().enumerate() {
                     let actual = if ty.is_some() { format!("{name}_n") } else { name.clone() };
                     w.line(format!("{name} => {actual}{}", if k + 1 < ports.len() { "," } else { "" }));
                 }
             });
         });
-        for (name, input, ty) in &ports {
+        for (name, input, ty, bus) in &ports {
             match ty {
+                Some(_) if !*input && *bus => w.line(format!("{name} <= {name}_n;")),
                 Some(t) if !*input && t.width == 1 => w.line(format!("{name} <= {name}_n(0);")),
                 Some(_) if !*input => w.line(format!("{name} <= std_logic_vector({name}_n);")),
                 _ => {}
@@ -122,7 +126,11 @@ fn port_clause(w: &mut CodeWriter, ports: &[Port]) {
     w.nest("port (", ");", |w| {
         for (k, p) in ports.iter().enumerate() {
             let dir = if p.input { "in" } else { "out" };
-            let ty = p.ty.map_or_else(|| "std_logic".to_string(), vtype);
+            let ty = match p.ty {
+                None => "std_logic".to_string(),
+                Some(t) if p.vector => format!("std_logic_vector({} downto 0)", t.width - 1),
+                Some(t) => vtype(t),
+            };
             let sep = if k + 1 < ports.len() { ";" } else { "" };
             w.line(format!("{} : {dir} {ty}{sep}", p.name));
         }
@@ -241,6 +249,15 @@ impl Printer for Vhdl {
     fn concat(&self, parts: &[Operand]) -> String {
         let p: Vec<String> = parts.iter().map(|p| format!("std_logic_vector({})", p.name)).collect();
         format!("unsigned(std_logic_vector'({}))", p.join(" & "))
+    }
+
+    fn bus_bits(&self, bus: &str, lsb: u32, width: u32, target: bool) -> String {
+        let bits = format!("{bus}({} downto {lsb})", lsb + width - 1);
+        if target { bits } else { format!("unsigned({bits})") }
+    }
+
+    fn to_bus(&self, a: Operand) -> String {
+        format!("std_logic_vector({})", a.name)
     }
 
     fn tap(&self, name: &str, depth: u32) -> String {

@@ -21,6 +21,8 @@ pub struct Port<'a> {
     pub name: &'a str,
     pub input: bool,
     pub ty: Option<Ty>,
+    /// A bus (`rtl::bus`): a plain vector of bits (`std_logic_vector`), not a number.
+    pub vector: bool,
     /// Why the port is not read, or read in part only, where that is so (for a lint waiver).
     pub unread: Option<String>,
 }
@@ -77,6 +79,11 @@ pub trait Printer {
     fn mux(&self, sel: &str, t: &str, f: &str) -> String;
     /// A concatenation, most significant part first (unsigned).
     fn concat(&self, parts: &[Operand]) -> String;
+    /// Bits [lsb, lsb + width) of bus port `bus`: an assignment target, or else an unsigned
+    /// expression.
+    fn bus_bits(&self, bus: &str, lsb: u32, width: u32, target: bool) -> String;
+    /// An unsigned value as the bits of a bus.
+    fn to_bus(&self, a: Operand) -> String;
     /// The last word of the shift register of signal `name`.
     fn tap(&self, name: &str, depth: u32) -> String;
     /// A case selection: `arms` are (choice, value).
@@ -109,6 +116,11 @@ pub fn print(m: &Module, p: &impl Printer) -> String {
     w.indented(|w| declarations(m, &cx, p, w));
     p.begin_body(&mut w);
     w.indented(|w| {
+        for (k, &id) in m.inputs.iter().enumerate() {
+            if let Some((bus, lsb)) = m.bus_part(true, k) {
+                p.assign(w, cx.name(id), &p.bus_bits(&bus.name, lsb, m.sig(id).ty.width, false));
+            }
+        }
         for group in cx.groups.iter().filter(|g| !g.is_empty(m)) {
             w.blank();
             cx.heading(w, group.block);
@@ -135,8 +147,14 @@ pub fn print(m: &Module, p: &impl Printer) -> String {
             p.instance(w, inst, &map);
         }
         w.blank();
-        for (port, id) in &m.outputs {
-            p.assign(w, port, cx.name(*id));
+        for (k, (port, id)) in m.outputs.iter().enumerate() {
+            match m.bus_part(false, k) {
+                Some((bus, lsb)) => {
+                    let bits = p.bus_bits(&bus.name, lsb, m.sig(*id).ty.width, true);
+                    p.assign(w, &bits, &p.to_bus(Operand { name: cx.name(*id), ty: m.sig(*id).ty }));
+                }
+                None => p.assign(w, port, cx.name(*id)),
+            }
         }
     });
     p.close(&mut w, m);
@@ -173,6 +191,8 @@ fn declarations(m: &Module, cx: &Context, p: &impl Printer, w: &mut CodeWriter) 
             let unread = cx.unread(id);
             let unread = unread.as_deref();
             match &sig.def {
+                // A part of a bus is a signal assigned from the bus port.
+                Def::Input if m.is_bus_input(id) => p.declare(w, sig, Decl::Net, unread),
                 Def::Input => {}
                 // A state constant is written as the state's name.
                 Def::Const(v) if cx.state_name(id, *v).is_some() => {}
@@ -392,27 +412,8 @@ impl<'m> Context<'m> {
 
     /// Why signal `id` is not read, or read in part only (None when all of it is read).
     fn unread(&self, id: SigId) -> Option<String> {
-        let ty = self.m.sig(id).ty;
         let read = self.read[id.0 as usize];
-        if read == ty.mask() {
-            return None;
-        }
-        if read == 0 {
-            return Some("not read".into());
-        }
-        let mut ranges = Vec::new();
-        let mut b = ty.width;
-        while b > 0 {
-            b -= 1;
-            if (read >> b) & 1 == 1 {
-                let hi = b;
-                while b > 0 && (read >> (b - 1)) & 1 == 1 {
-                    b -= 1;
-                }
-                ranges.push(if hi == b { format!("{b}") } else { format!("{hi}:{b}") });
-            }
-        }
-        Some(format!("only bits {} are read", ranges.join(", ")))
+        unread_text(&(0..self.m.sig(id).ty.width).map(|b| (read >> b) & 1 == 1).collect::<Vec<_>>())
     }
 
     /// The ports of `m` (this module or one it instantiates) with what of them is not read.
@@ -423,22 +424,64 @@ impl<'m> Context<'m> {
                 || m.roms.iter().any(|r| r.write.is_some())
                 || !m.instances.is_empty();
         let clk_unread = (own && !clocked).then(|| "no register here: the clock is not read".to_string());
-        let mut ports = vec![Port { name: "clk", input: true, ty: None, unread: clk_unread }];
+        let mut ports = vec![Port { name: "clk", input: true, ty: None, vector: false, unread: clk_unread }];
         if m.has_reset() {
-            ports.push(Port { name: "rst", input: true, ty: None, unread: None });
+            ports.push(Port { name: "rst", input: true, ty: None, vector: false, unread: None });
         }
-        for &i in &m.inputs {
-            let unread = if own { self.unread(i) } else { None };
-            ports.push(Port { name: &m.sig(i).name, input: true, ty: Some(m.sig(i).ty), unread });
+        assert!(own || m.buses.is_empty(), "{}: a module with buses is a top level, not instantiated", m.name);
+        for port in m.printed_ports() {
+            let unread = match (own && port.input, port.bus) {
+                (false, _) => None,
+                (true, None) => {
+                    self.unread(m.inputs[m.inputs.iter().position(|&i| m.sig(i).name == port.name).expect("an input")])
+                }
+                (true, Some(bus)) => {
+                    // The bits of the bus that its parts' readers read.
+                    let bits: Vec<bool> = bus
+                        .parts
+                        .iter()
+                        .flat_map(|&k| {
+                            let id = m.inputs[k];
+                            (0..m.sig(id).ty.width).map(move |b| (self.read[id.0 as usize] >> b) & 1 == 1)
+                        })
+                        .collect();
+                    unread_text(&bits)
+                }
+            };
+            ports.push(Port {
+                name: port.name,
+                input: port.input,
+                ty: Some(port.ty),
+                vector: port.bus.is_some(),
+                unread,
+            });
         }
-        ports.extend(m.outputs.iter().map(|(name, i)| Port {
-            name,
-            input: false,
-            ty: Some(m.sig(*i).ty),
-            unread: None,
-        }));
         ports
     }
+}
+
+/// Why a port or signal whose bits (least significant first) are read where `read` is true is
+/// not read, or read in part only (None when all of it is read).
+fn unread_text(read: &[bool]) -> Option<String> {
+    if read.iter().all(|&r| r) {
+        return None;
+    }
+    if !read.iter().any(|&r| r) {
+        return Some("not read".into());
+    }
+    let mut ranges = Vec::new();
+    let mut b = read.len();
+    while b > 0 {
+        b -= 1;
+        if read[b] {
+            let hi = b;
+            while b > 0 && read[b - 1] {
+                b -= 1;
+            }
+            ranges.push(if hi == b { format!("{b}") } else { format!("{hi}:{b}") });
+        }
+    }
+    Some(format!("only bits {} are read", ranges.join(", ")))
 }
 
 /// Every identifier the printers use in `m` before the walk names states and processes.
@@ -457,6 +500,7 @@ fn taken_names(m: &Module) -> BTreeSet<String> {
         taken.insert(format!("{}_t", r.name));
     }
     taken.extend(m.outputs.iter().map(|o| o.0.clone()));
+    taken.extend(m.buses.iter().map(|b| b.name.clone()));
     for i in &m.instances {
         taken.insert(i.name.clone());
         taken.insert(i.module.name.clone());
