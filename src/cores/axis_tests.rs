@@ -43,8 +43,11 @@ struct Outcome {
 /// Streams `rays` into the wrapper, a frame ending (`tlast`) every `frame` rays and at the end
 /// when given. The source offers its next ray on `valid_pct` % of the cycles it is not already
 /// offering one and then holds it until taken (AXI4-Stream); the sink is ready on `ready_pct`
-/// % of the cycles. Runs until every ray has a result and 300 cycles more.
-fn stream(s: &Setup, rays: &[PixelRay], frame: Option<usize>, valid_pct: u64, ready_pct: u64, seed: u64) -> Outcome {
+/// % of the cycles. Runs until every ray has a result and 300 cycles more. With `scramble`,
+/// every register and RAM starts random (`Sim::scramble`) and `rst` is high for the first
+/// clock.
+fn stream(s: &Setup, rays: &[PixelRay], frame: Option<usize>, pct: (u64, u64), seed: u64, scramble: bool) -> Outcome {
+    let (valid_pct, ready_pct) = pct;
     let m = &s.wrapper;
     let input = |name: &str| m.handle(*m.inputs.iter().find(|&&i| m.sig(i).name == name).expect(name));
     let output = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).expect(name).1);
@@ -55,6 +58,12 @@ fn stream(s: &Setup, rays: &[PixelRay], frame: Option<usize>, valid_pct: u64, re
     let (s_ready, m_valid, m_last) =
         (output("s_axis_ray_tready"), output("m_axis_res_tvalid"), output("m_axis_res_tlast"));
     let mut sim = Sim::new(m);
+    if scramble {
+        sim.scramble(seed);
+        sim.reset = true;
+        sim.tick();
+        sim.reset = false;
+    }
     let mut rng = SplitMix64(seed);
     let mut out = Outcome { results: Vec::new(), lasts: Vec::new(), cycles: 0, source_waits: 0, sink_stalls: 0 };
     let (mut next, mut offering) = (0usize, false);
@@ -136,7 +145,7 @@ fn frames_stream_through_with_random_valid_and_ready() {
     assert_eq!((s.layout.ray_bytes, s.layout.res_bytes), (64, 16));
     let rays = crate::flow::feed::feed_order(&frame_rays(&s.scene, &Camera::default_for(&s.scene, 16, 16)), Some(5));
     for (frame, seed) in [(None, 1), (Some(60), 2), (Some(1), 3)] {
-        let o = stream(&s, &rays, frame, 60, 50, seed);
+        let o = stream(&s, &rays, frame, (60, 50), seed, false);
         check(&s, &rays, frame, &o);
         assert!(o.source_waits > 0 && o.sink_stalls > 0, "both sides stalled: {} {}", o.source_waits, o.sink_stalls);
     }
@@ -150,15 +159,27 @@ fn the_barrier_drains_the_core_once_per_frame() {
     let s = setup("cornell", 23, 27);
     assert_eq!((s.layout.ray_bytes, s.layout.res_bytes), (64, 16));
     let rays = frame_rays(&s.scene, &Camera::default_for(&s.scene, 8, 8));
-    let free = stream(&s, &rays, None, 100, 100, 4);
-    let whole = stream(&s, &rays, Some(rays.len()), 100, 100, 4);
-    let each = stream(&s, &rays, Some(1), 100, 100, 4);
+    let free = stream(&s, &rays, None, (100, 100), 4, false);
+    let whole = stream(&s, &rays, Some(rays.len()), (100, 100), 4, false);
+    let each = stream(&s, &rays, Some(1), (100, 100), 4, false);
     for (frame, o) in [(None, &free), (Some(rays.len()), &whole), (Some(1), &each)] {
         check(&s, &rays, frame, o);
     }
     assert_eq!(whole.cycles, free.cycles);
     assert!(each.cycles > 3 * free.cycles, "{} vs {}", each.cycles, free.cycles);
     assert!(s.p.slot_count() > 1);
+}
+
+/// One clock of `rst` from any state (every register and RAM random) and the wrapper works:
+/// its count, frame flag and register slice start empty, as the core's valid bits do.
+#[test]
+fn one_clock_of_reset_from_any_state_starts_clean() {
+    let s = setup("cornell", 16, 16);
+    let rays = frame_rays(&s.scene, &Camera::default_for(&s.scene, 8, 8));
+    for seed in [1, 2, 3] {
+        let o = stream(&s, &rays, Some(20), (60, 50), seed, true);
+        check(&s, &rays, Some(20), &o);
+    }
 }
 
 /// The inputs each output depends on within one clock (through any logic of the core too).
