@@ -2,7 +2,9 @@
 //! `model/`.
 
 pub mod axis;
+pub mod board;
 pub mod brom;
+pub mod checksum;
 pub mod clock;
 pub mod closest;
 pub mod cost;

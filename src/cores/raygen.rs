@@ -27,11 +27,22 @@ crate::states! {
 /// Ports: `ready` in; `ray_valid`, `ray_id`, `ox oy oz`, `wx wy wz`, `invx invy invz` out (the
 /// core's ray inputs, in `top::core_inputs` order).
 pub fn raygen_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Module {
+    generator(g, n, m_bits, c, id_width, false)
+}
+
+/// The generator that starts the frame again (`fxrt_raygen_restart`, for the board tops): a
+/// second input `restart`, taken in `done`, returns it to the first pixel with ray id 0.
+pub fn raygen_restart_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Module {
+    generator(g, n, m_bits, c, id_width, true)
+}
+
+fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: bool) -> Module {
     use GenState::*;
-    let b = Builder::new("fxrt_raygen");
+    let b = Builder::new(if restarts { "fxrt_raygen_restart" } else { "fxrt_raygen" });
     let f = m_bits - 1;
     let qbits = f + c + 1;
     let ready = b.input("ready", Ty::BIT);
+    let restart = restarts.then(|| b.input("restart", Ty::BIT));
     let fsm = Fsm::new(&b, "state", "pinhole rays, pixel after pixel", Div);
 
     // Pixel counters and the direction, stepped when a ray is taken.
@@ -102,7 +113,21 @@ pub fn raygen_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Mo
             s.when(last, |s| s.goto(Done)).otherwise(|s| s.goto(Div));
         });
     });
-    fsm.state(Done, |s| s.set_k(count, 0));
+    fsm.state(Done, |s| {
+        s.set_k(count, 0);
+        if let Some(restart) = restart {
+            s.when(restart, |s| {
+                s.set_k(px, 0);
+                s.set_k(py, 0);
+                s.set_k(id, 0);
+                for k in 0..3 {
+                    s.set_k(row[k], g.d0[k] as i128);
+                    s.set_k(d[k], g.d0[k] as i128);
+                }
+                s.goto(Div);
+            });
+        }
+    });
     let in_full = fsm.is(Full);
     fsm.finish();
 
