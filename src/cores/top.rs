@@ -115,6 +115,18 @@ impl CoreParams {
         if !(1..=4).contains(&self.units) {
             return Err(crate::error::Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
         }
+        // The closest-hit unit keeps a bit per slot in one word.
+        if self.slot_count() > MAX_WIDTH {
+            return Err(crate::error::Error::param(
+                "slots",
+                format!(
+                    "{} units × {} slots = {} ray slots; the closest-hit unit holds at most {MAX_WIDTH}: fewer --slots or --units",
+                    self.units,
+                    self.trav.slots,
+                    self.slot_count()
+                ),
+            ));
+        }
         Ok(())
     }
 
