@@ -71,6 +71,9 @@ struct IseProject<'a> {
     scene: &'a str,
     language: &'a str,
     files: &'a [String],
+    /// Whether the project goes on to a bitstream: only for a board top, whose every port is
+    /// on a pin of the board.
+    bitstream: bool,
 }
 
 #[derive(Template)]
@@ -78,6 +81,13 @@ struct IseProject<'a> {
 struct BoardUcf<'a> {
     top: &'a str,
     period_ns: String,
+}
+
+/// The ISE project script for `top` (its UCF `top.ucf` beside it) from `files` in `language`,
+/// run to the bitstream when `bitstream` (a board top) or else to the placed design's
+/// timing and area reports.
+pub fn ise_project(top: &str, scene: &str, language: &str, files: &[String], bitstream: bool) -> String {
+    IseProject { top, scene, language, files, bitstream }.render().expect("ISE template renders") + "\n"
 }
 
 /// (file name, contents) of every module of `cores` in the chosen languages (each module
@@ -98,8 +108,7 @@ fn write_set(cores: &[(Module, Option<u32>, Value)], o: GenOptions, scene: &str)
     if let (true, Some((top, _, _))) = (o.ise, cores.first()) {
         let (language, ext) = if o.vhdl { ("VHDL", "vhd") } else { ("Verilog", "v") };
         let files: Vec<String> = top.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
-        let tcl = IseProject { top: &top.name, scene, language, files: &files }.render().expect("ISE template renders");
-        out.push((format!("{}.tcl", top.name), tcl + "\n"));
+        out.push((format!("{}.tcl", top.name), ise_project(&top.name, scene, language, &files, false)));
         let period_ns = format!("{:.3}", 1000.0 / o.clock_mhz);
         let ucf = BoardUcf { top: &top.name, period_ns }.render().expect("UCF template renders");
         out.push((format!("{}.ucf", top.name), ucf + "\n"));
