@@ -14,6 +14,7 @@ pub mod intersect;
 pub mod mul;
 pub mod plane;
 pub mod raygen;
+pub mod result_queue;
 pub mod top;
 pub mod traverse;
 
