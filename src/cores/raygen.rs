@@ -1,7 +1,8 @@
 //! The on-chip pinhole ray generator (the thesis's demo): pixel after pixel, the ray of
 //! `model::raygen::RayGen` — origin the eye's grid point, direction d0 + px·dx + py·dy — with
-//! its three reciprocals from three sequential dividers (one quotient bit per clock, F + C + 1
-//! clocks). While the traversal works on one ray, the next one is being divided.
+//! its three reciprocals from three sequential dividers (a clock to load the divisors, then one
+//! quotient bit per clock: F + C + 2 clocks, and one more to hand the ray over). While the
+//! traversal works on one ray, the next one is being divided.
 //!
 //! States: `div` (the reciprocals of the current pixel), `full` (`ray_valid` until the core
 //! takes the ray; then the next pixel), `done` (after the last pixel).
@@ -60,9 +61,12 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
     let w_out = d.map(|d| d.resize(m_bits));
 
     // Three restoring dividers: q = floor(2^(F+C) / |w|), |w| = 1 for w = 0; one quotient bit
-    // per clock, the numerator's only 1 (its top bit) shifted in first.
-    let count = b.reg("div_count", Ty::u(value_bits(qbits as usize)), Some(0));
-    let first_bit = count.eq(0).name("first_bit");
+    // per clock, the numerator's only 1 (its top bit) shifted in first. The divisor |w| comes
+    // from a register, loaded in the first clock of `div` (count 0), so a step is one
+    // compare-subtract between registers (negating w in the same clock was the slowest path of
+    // the ULX3S board top: 98.9 MHz).
+    let count = b.reg("div_count", Ty::u(value_bits(qbits as usize + 1)), Some(0));
+    let first_bit = count.eq(1).name("first_bit");
     let lim = (1i128 << (m_bits + c - 1)) - 1;
     let rem = axes.map(|a| b.reg(&format!("rem_{a}"), Ty::u(f + 2), Some(0)));
     let quot = axes.map(|a| b.reg(&format!("quot_{a}"), Ty::u(qbits), Some(0)));
@@ -72,7 +76,7 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
         let w = w_out[k];
         let neg = w.lt(0).name(&format!("neg_{}", axes[k]));
         let mag = neg.select(-w, w).unsigned().resize(f + 2);
-        let divisor = w.eq(0).select(mag.k(1), mag).name(&format!("b_{}", axes[k]));
+        let divisor = b.delay(&format!("b_{}", axes[k]), w.eq(0).select(mag.k(1), mag));
         let r3 = (first_bit.select(rem[k].k(0), rem[k]) << 1) + first_bit.resize(f + 2);
         let ge = divisor.le(r3);
         let r_next = ge.select(r3 - divisor, r3);
@@ -86,11 +90,13 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
 
     fsm.state(Div, |s| {
         s.set(count, count + 1);
-        for k in 0..3 {
-            s.set(rem[k], steps[k].0);
-            s.set(quot[k], steps[k].1);
-        }
-        s.when(count.eq(qbits as i128 - 1), |s| s.goto(Full));
+        s.when(count.ne(0), |s| {
+            for k in 0..3 {
+                s.set(rem[k], steps[k].0);
+                s.set(quot[k], steps[k].1);
+            }
+        });
+        s.when(count.eq(qbits as i128), |s| s.goto(Full));
     });
     fsm.state(Full, |s| {
         s.set_k(count, 0);
