@@ -418,3 +418,34 @@ fn gen_takes_measured_figures_only_for_the_same_netlist() {
     let other = write(dir.path(), "other.json", other.as_bytes());
     reject(&[], &other, "other");
 }
+
+/// `gen --board` refuses contradictory or impossible options in one line, writing nothing, and
+/// with --no-bitstream writes the design without the ECP5 tools.
+#[test]
+fn gen_board_rejects_bad_options_and_writes_the_design() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("board");
+    let o = out.to_str().unwrap();
+    let base = ["gen", "--builtin", "cornell", "--size", "4x3", "--out", o, "--board"];
+    let with = |extra: &[&'static str]| -> Vec<&str> { base.iter().copied().chain(extra.iter().copied()).collect() };
+    assert_rejected(&with(&["ulx3s", "--no-bitstream", "--board-mhz", "5"]), "--board-mhz", &out);
+    assert_rejected(&with(&["ml509", "--board-mhz", "nan"]), "--board-mhz", &out);
+    assert_rejected(&with(&["ulx3s", "--no-bitstream", "--raygen"]), "--raygen", &out);
+    assert_rejected(&with(&["ml509", "--ise"]), "--ise", &out);
+    assert_rejected(&with(&["ml509", "--eye", "278,273,-800"]), "--eye", &out);
+    assert_rejected(&with(&["ml509", "--led-shift", "41"]), "--led-shift", &out);
+    assert_rejected(&with(&["ml509", "--ray-id-width", "3"]), "--ray-id-width", &out);
+    // Four traversal units need more DSP48E than the XC5VLX110T has; 4 × 64 slots are more
+    // than the closest-hit unit holds (this was a panic).
+    assert_rejected(&with(&["ml509", "--units", "4", "--slots", "32"]), "--units", &out);
+    assert_rejected(&with(&["ml509", "--units", "4"]), "--slots", &out);
+    assert_rejected(&["gen", "--builtin", "cornell", "--units", "4", "--out", o], "--slots", &out);
+    // The default core's two traversal units need 70 DSP48E: the ML509 takes one.
+    assert_rejected(&with(&["ml509"]), "--units", &out);
+    let o2 = fxrt(&with(&["ml509", "--units", "1"]));
+    assert!(o2.status.success(), "{}", stderr(&o2));
+    let names: Vec<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    for ext in [".ucf", ".tcl", ".json"] {
+        assert!(names.iter().any(|n| n.starts_with("fxrt_ml509_") && n.ends_with(ext)), "{ext} in {names:?}");
+    }
+}

@@ -204,10 +204,41 @@ pub struct GenConfig {
     pub threads: super::ThreadArgs,
     /// The camera of the frame written for the AXI4-Stream wrapper (`--axis-frame`).
     pub axis_frame: Option<CameraSpec>,
+    /// `--board`: the board design instead of the core's files (its camera in `scene`).
+    pub board: Option<BoardConfig>,
+}
+
+/// What `fxrt gen --board` builds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoardConfig {
+    pub board: crate::flow::board::Board,
+    pub mhz: f64,
+    pub led_shift: Option<u32>,
+    pub bitstream: bool,
+    pub seed: u64,
 }
 
 impl GenArgs {
     pub fn config(&self) -> Result<GenConfig> {
+        if self.board.is_some() {
+            let clash = [
+                ("raygen", self.raygen),
+                ("axis-frame", self.axis_frame),
+                ("ise", self.ise),
+                ("debug-ports", self.debug_ports),
+                ("measured", self.measured.is_some()),
+                ("scene", self.scene_dir.is_some()),
+            ];
+            if let Some((name, _)) = clash.iter().find(|c| c.1) {
+                return Err(Error::param(name, "not with --board (a board design has its own ray generator, pins and project)"));
+            }
+            if !(self.board_mhz.is_finite() && (10.0..=400.0).contains(&self.board_mhz)) {
+                return Err(Error::param("board-mhz", format!("{} is out of range: must be 10..=400", self.board_mhz)));
+            }
+            if self.led_shift.is_some_and(|s| s > 40) {
+                return Err(Error::param("led-shift", "is out of range: must be 0..=40"));
+            }
+        }
         let scene = match &self.scene_dir {
             Some(_) if self.raygen => {
                 return Err(Error::param("raygen", "needs the scene itself (an OBJ or --builtin), not --scene DIR"));
@@ -222,7 +253,7 @@ impl GenArgs {
             None => GenScene::Scene {
                 source: self.scene.source(),
                 params: self.params.params()?,
-                raygen: self.raygen.then(|| self.camera.spec()),
+                raygen: (self.raygen || self.board.is_some()).then(|| self.camera.spec()),
             },
         };
         if self.axis_frame && self.raygen {
@@ -249,6 +280,13 @@ impl GenArgs {
             div_bits: self.div_bits,
             threads: self.threads,
             axis_frame: self.axis_frame.then(|| self.camera.spec()),
+            board: self.board.map(|board| BoardConfig {
+                board,
+                mhz: self.board_mhz,
+                led_shift: self.led_shift,
+                bitstream: board == crate::flow::board::Board::Ulx3s && !self.no_bitstream,
+                seed: self.pnr_seed,
+            }),
         })
     }
 }

@@ -2,6 +2,7 @@
 //! command's arguments validated into a configuration before anything runs or any file is
 //! written (`config`), and the commands run on those (`run`). `main.rs` only dispatches.
 
+pub mod board;
 pub mod config;
 pub mod run;
 
@@ -306,6 +307,26 @@ pub struct GenArgs {
     /// camera given by --eye/--at/--up/--fov/--size (the eye must be inside the scene box).
     #[arg(long)]
     pub raygen: bool,
+    /// Build a board top instead of the core's files (docs/BOARDS.md): the on-chip ray
+    /// generator → the core → a checksum of every result, checked against the golden model's
+    /// at each frame's end and shown on the LEDs, with the PLL, reset and pins. ulx3s also
+    /// places, routes and packs the bitstream (the ECP5 tools in .venv); ml509 writes the ISE
+    /// project that does. The camera: --eye/--at/... inside the scene box (default: at the
+    /// middle of the box's front, looking at its centre).
+    #[arg(long, value_enum)]
+    pub board: Option<crate::flow::board::Board>,
+    /// --board: the board clock, MHz; the PLL makes the fastest clock not above it.
+    #[arg(long = "board-mhz", default_value_t = 80.0)]
+    pub board_mhz: f64,
+    /// --board: the frame counter bit LED 2 shows (default: one the eye can follow).
+    #[arg(long = "led-shift")]
+    pub led_shift: Option<u32>,
+    /// --board ulx3s: the HDL and constraints only, no place and route.
+    #[arg(long = "no-bitstream")]
+    pub no_bitstream: bool,
+    /// --board ulx3s: nextpnr's placement seed.
+    #[arg(long = "pnr-seed", default_value_t = 1)]
+    pub pnr_seed: u64,
     /// Also write the frame of --size (and the other camera options) for the AXI4-Stream
     /// wrapper: rays.bin, each ray's tdata in pixel order, and expected.bin, the golden model's
     /// result tdata for each, in the same order (docs/AXIS.md).

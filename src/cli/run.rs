@@ -28,7 +28,13 @@ pub fn run(cmd: Command) -> Result<bool> {
         Command::Scene(a) => scene(&a.config()?).map(|()| true),
         Command::Compare(a) => compare(&a.config()?).map(|()| true),
         Command::Bench(a) => bench(&a.config()?),
-        Command::Gen(a) => gen_core(&a.config()?).map(|()| true),
+        Command::Gen(a) => {
+            let c = a.config()?;
+            match &c.board {
+                Some(b) => super::board::gen_board(&c, b),
+                None => gen_core(&c).map(|()| true),
+            }
+        }
         Command::Synth(a) => synth_cores(&a.config()?).map(|()| true),
         Command::Sweep(a) => sweep_cmd(a.config()?),
         Command::Sim(a) => sim(&a.config()?),
@@ -212,7 +218,7 @@ fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<Inter
 }
 
 /// The on-chip ray generator for a camera (inside the scene box).
-fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen> {
+pub(super) fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen> {
     let cam = camera.camera(scene)?;
     RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
 }

@@ -257,37 +257,8 @@ pub fn place_and_route(
     let out_bits: u32 = m.outputs.iter().map(|o| m.sig(o.1).ty.width).sum();
     let wrapper_ff: u64 =
         m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
-    let files = emit::design_files(&top, "v");
-    let hierarchy = top.hierarchy();
-    let block_of = |file: &str, prefix: &str| {
-        let name = file.strip_suffix(".v").filter(|n| n.starts_with(prefix))?;
-        hierarchy.iter().find(|m| m.name == name).copied()
-    };
-    let brom_of = |file: &str| block_of(file, crate::cores::brom::BROM_PREFIX);
-    let bram_of = |file: &str| block_of(file, crate::cores::brom::BRAM_PREFIX);
-    for (file, text) in &files {
-        // Split multipliers' pieces become DSP blocks with their registers inside, block ROMs
-        // DP16KDs with their output register, the divider's steps carry chains that add or
-        // subtract in their own LUTs.
-        let text = super::ecp5_dsp::dsp_regs_of(file)
-            .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
-            .or_else(|| super::ecp5_carry::addsub_width_of(file).and_then(|w| super::ecp5_carry::ccu2c_addsub(text, w)))
-            .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
-            .or_else(|| bram_of(file).and_then(|m| super::ecp5_bram::dp16kd_ram(text, m)))
-            .unwrap_or_else(|| text.clone());
-        std::fs::write(dir.join(file), text).map_err(io)?;
-    }
-    let sources: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| emit::is_source(f)).collect();
-    // Flattened and read back as RTLIL before synthesis: a MULT18X18D with parameters inside a
-    // sub-module otherwise makes yosys re-derive the flattened top from its Verilog, which
-    // then misses the sub-module it no longer holds.
-    let script = format!(
-        "read_verilog {}; hierarchy -top {top}; proc; flatten; write_rtlil flat.il; design -reset; \
-         read_rtlil flat.il; synth_ecp5 -top {top} -json design.json",
-        sources.join(" "),
-        top = top.name
-    );
-    run(&tools.yosys, &["-q", "-l", "yosys.log", "-p", &script], dir, "yosys.log")?;
+    let sources = write_sources(&top, dir)?;
+    synthesize(tools, dir, &sources, &top.name)?;
     let (freq, seed_s) = (format!("{target_mhz}"), seed.to_string());
     let args = [
         "--85k",
@@ -318,7 +289,47 @@ pub fn place_and_route(
     Ok(t)
 }
 
-fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<()> {
+/// Writes `top`'s Verilog into `dir` as the ECP5 flow reads it — split multipliers' pieces as
+/// DSP blocks with their registers inside, block ROMs and RAMs as DP16KDs with their output
+/// register, the divider's steps as carry chains that add or subtract in their own LUTs — and
+/// returns the names of the source files (memory images beside them).
+pub fn write_sources(top: &Module, dir: &Path) -> Result<Vec<String>> {
+    let io = |e: std::io::Error| Error::file(dir, e.to_string());
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let files = emit::design_files(top, "v");
+    let hierarchy = top.hierarchy();
+    let block_of = |file: &str, prefix: &str| {
+        let name = file.strip_suffix(".v").filter(|n| n.starts_with(prefix))?;
+        hierarchy.iter().find(|m| m.name == name).copied()
+    };
+    let brom_of = |file: &str| block_of(file, crate::cores::brom::BROM_PREFIX);
+    let bram_of = |file: &str| block_of(file, crate::cores::brom::BRAM_PREFIX);
+    for (file, text) in &files {
+        let text = super::ecp5_dsp::dsp_regs_of(file)
+            .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
+            .or_else(|| super::ecp5_carry::addsub_width_of(file).and_then(|w| super::ecp5_carry::ccu2c_addsub(text, w)))
+            .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
+            .or_else(|| bram_of(file).and_then(|m| super::ecp5_bram::dp16kd_ram(text, m)))
+            .unwrap_or_else(|| text.clone());
+        std::fs::write(dir.join(file), text).map_err(io)?;
+    }
+    Ok(files.into_iter().map(|f| f.0).filter(|f| emit::is_source(f)).collect())
+}
+
+/// Yosys `synth_ecp5` of `sources` (in `dir`) with top module `top`, to `dir/design.json`.
+pub fn synthesize(tools: &Tools, dir: &Path, sources: &[String], top: &str) -> Result<()> {
+    // Flattened and read back as RTLIL before synthesis: a MULT18X18D with parameters inside a
+    // sub-module otherwise makes yosys re-derive the flattened top from its Verilog, which
+    // then misses the sub-module it no longer holds.
+    let script = format!(
+        "read_verilog {}; hierarchy -top {top}; proc; flatten; write_rtlil flat.il; design -reset; \
+         read_rtlil flat.il; synth_ecp5 -top {top} -json design.json",
+        sources.join(" ")
+    );
+    run(&tools.yosys, &["-q", "-l", "yosys.log", "-p", &script], dir, "yosys.log")
+}
+
+pub(crate) fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<()> {
     let name = tool.file_name().map_or("tool".into(), |n| n.to_string_lossy().to_string());
     let out = Command::new(tool)
         .args(args)

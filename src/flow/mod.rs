@@ -1,6 +1,7 @@
 //! Running the generated HDL: testbenches and the external simulators.
 
 pub mod axis;
+pub mod board;
 pub mod check;
 pub mod disturb;
 pub mod ecp5;

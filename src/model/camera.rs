@@ -96,6 +96,15 @@ impl Camera {
         Camera::framing(scene, width, height)
     }
 
+    /// A camera inside the scene box, for the on-chip ray generator: at the middle of the
+    /// box's front (2 % of its depth in from the −z face), looking at its centre.
+    pub fn inside(scene: &Scene, width: u32, height: u32, fov_deg: f64) -> Camera {
+        let (lo, hi) = world_bounds(scene);
+        let at: [f64; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+        let eye = [at[0], at[1], lo[2] + 0.02 * (hi[2] - lo[2])];
+        Camera { eye, at, up: [0.0, 1.0, 0.0], fov_deg, width, height }
+    }
+
     /// A camera that frames the whole scene from the front (−z), right and above.
     pub fn framing(scene: &Scene, width: u32, height: u32) -> Camera {
         let (lo, hi) = world_bounds(scene);

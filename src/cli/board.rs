@@ -1,0 +1,79 @@
+//! `fxrt gen --board`: the board design's files, and for the ULX3S its bitstream.
+
+use super::config::{BoardConfig, GenConfig, GenScene};
+use crate::cores::top::CoreParams;
+use crate::error::{Error, Result};
+use crate::flow::board::{BoardDesign, pnr};
+use crate::flow::ecp5::Tools;
+use crate::model::camera::{Camera, CameraSpec};
+use crate::scene::Scene;
+use crate::scene::images::SceneRoms;
+use std::path::PathBuf;
+
+/// The board's camera: the options given, the eye inside the box unless --eye says where.
+fn board_camera(scene: &Scene, spec: &CameraSpec) -> Result<crate::model::raygen::RayGen> {
+    let spec = match spec.eye {
+        Some(_) => spec.clone(),
+        None => {
+            let inside = Camera::inside(scene, spec.width, spec.height, spec.fov);
+            CameraSpec { eye: Some(inside.eye), at: Some(spec.at.unwrap_or(inside.at)), ..spec.clone() }
+        }
+    };
+    super::run::ray_generator(scene, &spec)
+}
+
+/// Writes the board design; for the ULX3S (unless --no-bitstream) places, routes and packs it.
+/// False when the bitstream misses its clock.
+pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
+    let GenScene::Scene { source, params, raygen: Some(spec) } = &c.scene else {
+        return Err(Error::param("board", "needs the scene itself (an OBJ or --builtin) and a camera"));
+    };
+    let scene = Scene::load(source, params)?;
+    let g = board_camera(&scene, spec)?;
+    let pixels = g.width as u64 * g.height as u64;
+    if c.ray_id_width < 64 && pixels > 1u64 << c.ray_id_width {
+        return Err(Error::param("ray-id-width", format!("{} bits cannot number the {pixels} pixels of --size", c.ray_id_width)));
+    }
+    let roms = SceneRoms::of(&scene);
+    let t = c.threads;
+    let p = CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
+    p.check()?;
+    p.check_device(&roms, c.bram_kbits)?;
+    let tools = if b.bitstream { Some(Tools::require().map_err(|e| Error::param("board", format!("{} (or --no-bitstream)", e.message)))?) } else { None };
+    let d = BoardDesign::new(b.board, &p, &roms, &scene, &g, b.mhz, b.led_shift, None)?;
+    let mut files: Vec<(PathBuf, Vec<u8>)> =
+        d.files(c.vhdl, c.verilog).into_iter().map(|(n, t)| (c.out.join(n), t.into_bytes())).collect();
+    crate::io::write_all_atomic(&files)?;
+    println!(
+        "{} ({}, {} MHz from the {} MHz oscillator; frame {}x{}, golden checksum {:08x}) written to {}",
+        d.top,
+        d.board.title(),
+        d.clock.mhz,
+        d.board.osc_mhz(),
+        g.width,
+        g.height,
+        d.check.golden,
+        c.out.display()
+    );
+    let Some(tools) = tools else { return Ok(true) };
+    let dir = c.out.join("pnr");
+    eprintln!("placing and routing {} (minutes; logs in {})", d.top, dir.display());
+    let timing = pnr::bitstream(&tools, &d, b.seed, &dir)?;
+    let bit = std::fs::read(dir.join(&timing.bitstream)).map_err(|e| Error::file(&dir.join(&timing.bitstream), e.to_string()))?;
+    let report = serde_json::to_string_pretty(&timing).unwrap_or_default() + "\n";
+    files = vec![(c.out.join(&timing.bitstream), bit), (c.out.join(format!("{}_timing.json", d.top)), report.into_bytes())];
+    crate::io::write_all_atomic(&files)?;
+    println!(
+        "{}: {} MHz reached on the {} MHz board clock ({}), {} LUT4, {} FF, {} MULT18X18D, {} DP16KD; seed {}",
+        timing.bitstream,
+        timing.fmax_mhz,
+        timing.clock_mhz,
+        if timing.met { "met" } else { "NOT met" },
+        timing.lut4,
+        timing.ff,
+        timing.mult18,
+        timing.dp16kd,
+        timing.seed
+    );
+    Ok(timing.met)
+}
