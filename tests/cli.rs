@@ -440,6 +440,16 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     assert_rejected(&with(&["ml509", "--units", "4", "--slots", "32"]), "--units", &out);
     assert_rejected(&with(&["ml509", "--units", "4"]), "--slots", &out);
     assert_rejected(&["gen", "--builtin", "cornell", "--units", "4", "--out", o], "--slots", &out);
+    // Without the ECP5 tools the ULX3S bitstream cannot be made: refused before anything is
+    // written (--no-bitstream writes the HDL).
+    let o3 = Command::new(env!("CARGO_BIN_EXE_fxrt"))
+        .args(with(&["ulx3s"]))
+        .env("FXRT_ECP5_BIN", dir.path().join("no-tools"))
+        .output()
+        .unwrap();
+    assert_eq!(o3.status.code(), Some(2), "{}", stderr(&o3));
+    assert!(stderr(&o3).starts_with("fxrt: --board: ") && stderr(&o3).contains("--no-bitstream"), "{}", stderr(&o3));
+    assert!(!out.exists());
     // The default core's two traversal units need 70 DSP48E: the ML509 takes one.
     assert_rejected(&with(&["ml509"]), "--units", &out);
     let o2 = fxrt(&with(&["ml509", "--units", "1"]));
