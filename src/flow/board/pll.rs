@@ -71,8 +71,9 @@ impl V5Pll {
     pub const PFD: (f64, f64) = (19.0, 400.0);
     pub const VCO: (f64, f64) = (400.0, 900.0);
 
-    /// The settings whose output is the highest not above `target_mhz`, the lowest VCO
-    /// among equals (less power; DS202 allows any in range).
+    /// The settings whose output is the highest not above `target_mhz`; among equals the
+    /// smallest input divider (the fastest phase detector), then the VCO nearest the middle of
+    /// its range (away from both edges of DS202's range).
     pub fn for_clock(in_mhz: f64, target_mhz: f64) -> Option<V5Pll> {
         let mut best: Option<(f64, f64, V5Pll)> = None;
         for divclk_divide in 1..=52u32 {
@@ -93,8 +94,10 @@ impl V5Pll {
                     if out > target_mhz + 1e-9 {
                         continue;
                     }
-                    let key = (target_mhz - out, vco);
-                    if best.is_none_or(|b| key.0 < b.0 - 1e-9 || (key.0 < b.0 + 1e-9 && key.1 < b.1 - 1e-9)) {
+                    // Input dividers come in rising order: a later one never wins a tie.
+                    let key = (target_mhz - out, (vco - 0.5 * (Self::VCO.0 + Self::VCO.1)).abs());
+                    let same_d = best.is_some_and(|b| b.2.divclk_divide == divclk_divide);
+                    if best.is_none_or(|b| key.0 < b.0 - 1e-9 || (same_d && key.0 < b.0 + 1e-9 && key.1 < b.1 - 1e-9)) {
                         best = Some((key.0, key.1, V5Pll { divclk_divide, clkfbout_mult, clkout0_divide }));
                     }
                     break;
@@ -136,6 +139,7 @@ mod tests {
             let vco = 100.0 * p.clkfbout_mult as f64 / p.divclk_divide as f64;
             assert!((400.0..=900.0).contains(&vco), "{p:?}");
         }
-        assert_eq!(V5Pll::for_clock(100.0, 80.0).unwrap().out_mhz(100.0), 80.0);
+        // 80 MHz: 100 · 8 / 1 / 10, the VCO at 800 MHz (400 · 2 / 1 / 5 would sit on the edge).
+        assert_eq!(V5Pll::for_clock(100.0, 80.0), Some(V5Pll { divclk_divide: 1, clkfbout_mult: 8, clkout0_divide: 10 }));
     }
 }
