@@ -180,13 +180,13 @@ impl BenchArgs {
             BenchWhat::Sim => BenchConfig::Sim { vectors: self.vectors.max(1), ghdl_vectors: self.ghdl_vectors },
             BenchWhat::Agree => BenchConfig::Agree { netlists: self.netlists.max(1) },
             BenchWhat::Render => {
-                let ((width, height), repeat) = (self.size, self.repeat.max(1));
-                match threads(self.threads)? {
-                    _ if self.against_embree => {
-                        let all = std::thread::available_parallelism().map_or(1, |n| n.get());
-                        BenchConfig::AgainstEmbree { width, height, threads: self.threads.unwrap_or(all), repeat }
-                    }
-                    t => BenchConfig::Render { width, height, threads: t.unwrap_or(1), repeat },
+                let ((width, height), repeat, t) = (self.size, self.repeat.max(1), threads(self.threads)?);
+                if self.against_embree {
+                    // One thread, then all cores (or --threads).
+                    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+                    BenchConfig::AgainstEmbree { width, height, threads: t.unwrap_or(all), repeat }
+                } else {
+                    BenchConfig::Render { width, height, threads: t.unwrap_or(1), repeat }
                 }
             }
         })

@@ -115,7 +115,8 @@ fn bench_agree(netlists: u64) -> bool {
     failures.is_empty()
 }
 
-/// Runs a benchmark; false when `bench agree` found a difference.
+/// Runs a benchmark; false when `bench agree` found a difference, or `--against-embree` hit
+/// counts that disagree.
 pub fn bench(c: &BenchConfig) -> Result<bool> {
     match *c {
         BenchConfig::Agree { netlists } => return Ok(bench_agree(netlists)),
