@@ -14,6 +14,7 @@ Exit 3 with one line on stderr when embreex cannot be imported (fxrt says what t
 """
 
 import argparse
+import itertools
 import json
 import os
 import sys
@@ -29,9 +30,11 @@ except ImportError as e:
     print(f"embree_bench: embreex is not installed ({e})", file=sys.stderr)
     sys.exit(3)
 
-# Rows of pixels a thread takes at a time: small enough that threads share the frame's
-# costly middle evenly, large enough that each thread's rays stay coherent.
-ROWS_PER_BLOCK = 4
+# Rows of pixels a thread takes at a time, from a shared queue (as rayon's work stealing
+# does for fxrt, so a thread slowed by other work on the machine holds no one up): small enough
+# to share the frame's costly middle evenly, large enough that each `run` call's own overhead
+# (its argument checks and result arrays) stays near 1 %.
+ROWS_PER_BLOCK = 16
 
 
 def load(folder):
@@ -52,39 +55,41 @@ def scene_of(tris):
     return scene
 
 
-def split(org, dirs, threads, width):
-    """Each thread's rays: blocks of ROWS_PER_BLOCK rows dealt out in turn, copied contiguous
-    (embreex takes C-contiguous arrays), so the copying is not timed."""
+def blocks(org, dirs, width):
+    """The frame in blocks of ROWS_PER_BLOCK rows: contiguous slices, no copies."""
+    step = max(1, ROWS_PER_BLOCK * width)
+    return [(org[s : s + step], dirs[s : s + step]) for s in range(0, len(org), step)]
+
+
+def hits_of(ids):
+    return int((ids >= 0).sum())
+
+
+def trace(scene, org, dirs, parts, threads, pool):
+    """Closest hit of every ray; returns the number of hits. One thread: one `run` over all
+    rays. Several: each takes the next block until none is left (embreex's loop runs without
+    the GIL, so they trace at once)."""
     if threads == 1:
-        return [(org, dirs)]
-    block = max(1, ROWS_PER_BLOCK * width)
-    starts = range(0, len(org), block)
-    parts = []
-    for t in range(threads):
-        mine = [s for k, s in enumerate(starts) if k % threads == t]
-        idx = np.concatenate([np.arange(s, min(s + block, len(org))) for s in mine]) if mine else np.arange(0)
-        parts.append((np.ascontiguousarray(org[idx]), np.ascontiguousarray(dirs[idx])))
-    return parts
+        return hits_of(scene.run(org, dirs))
+    queue = itertools.count()  # next() is atomic under the GIL
 
+    def worker():
+        hits = 0
+        while (k := next(queue)) < len(parts):
+            hits += hits_of(scene.run(*parts[k]))
+        return hits
 
-def trace(scene, parts, pool):
-    """Closest hit of every ray; returns the number of hits. One part runs in this thread;
-    several run at once in the pool (embreex's loop runs without the GIL)."""
-    if len(parts) == 1:
-        ids = scene.run(parts[0][0], parts[0][1])
-        return int((ids >= 0).sum())
-    results = pool.map(lambda p: scene.run(p[0], p[1]), parts)
-    return sum(int((ids >= 0).sum()) for ids in results)
+    return sum(f.result() for f in [pool.submit(worker) for _ in range(threads)])
 
 
 def measure(scene, org, dirs, threads, repeat, width):
-    parts = split(org, dirs, threads, width)
+    parts = blocks(org, dirs, width)
     with ThreadPoolExecutor(max_workers=threads) as pool:
-        hits = trace(scene, parts, pool)  # warm-up: caches, pool threads
+        hits = trace(scene, org, dirs, parts, threads, pool)  # warm-up: caches, pool threads
         best = float("inf")
         for _ in range(repeat):
             start = time.perf_counter()
-            again = trace(scene, parts, pool)
+            again = trace(scene, org, dirs, parts, threads, pool)
             best = min(best, time.perf_counter() - start)
             if again != hits:
                 raise SystemExit(f"embree_bench: {again} hits, then {hits}")
@@ -96,7 +101,7 @@ def main():
     ap.add_argument("dir", help="folder with triangles.f32, origins.f64, directions.f64")
     ap.add_argument("--threads", default="1", help="thread counts, comma-separated (default 1)")
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per thread count; the best counts")
-    ap.add_argument("--width", type=int, default=1, help="image width: rays per row, for dealing out rows")
+    ap.add_argument("--width", type=int, default=1, help="image width: rays per row (the blocks are rows)")
     a = ap.parse_args()
     tris, org, dirs = load(a.dir)
     scene = scene_of(tris)
