@@ -47,4 +47,15 @@ if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
         fi
     fi
 fi
+# embreex (Embree 4 with float32 rays, manylinux wheels with numpy) for `fxrt bench
+# --against-embree` (scripts/embree_bench.py, tests/bench_embree.rs) in the same .venv. Pinned,
+# so the Embree the golden model is measured against stays the same. Not an HDL tool: installed
+# even with FXRT_SKIP_HDL_TOOLS=1; not fatal, the test says it was skipped without it.
+venv="$(dirname "$0")/../.venv"
+if ! "$venv/bin/python" -c 'import embreex, sys; sys.exit(embreex.__version__ != "4.4.0.post1")' >/dev/null 2>&1; then
+    if ! { { [ -x "$venv/bin/pip" ] || python3 -m venv "$venv"; } \
+        && "$venv/bin/pip" install -q --disable-pip-version-check embreex==4.4.0.post1; }; then
+        echo "install-deps: warning: could not install embreex into .venv" >&2
+    fi
+fi
 cargo fetch --quiet

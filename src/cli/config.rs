@@ -159,6 +159,9 @@ impl SceneArgs {
 pub enum BenchConfig {
     /// Golden-model render speed; the best of `repeat` (≥ 1) renders.
     Render { width: u32, height: u32, threads: usize, repeat: u32 },
+    /// The golden model against Embree on the same rays, with 1 and `threads` threads (the
+    /// same count once when `threads` is 1), best of `repeat` (≥ 1) each.
+    AgainstEmbree { width: u32, height: u32, threads: usize, repeat: u32 },
     /// Simulator speed on `vectors` (≥ 1) intersection vectors, GHDL on a prefix.
     Sim { vectors: usize, ghdl_vectors: usize },
     /// The agreement property on `netlists` (≥ 1) random netlists.
@@ -167,13 +170,24 @@ pub enum BenchConfig {
 
 impl BenchArgs {
     pub fn config(&self) -> Result<BenchConfig> {
+        if self.against_embree && self.what != BenchWhat::Render {
+            return Err(Error::param(
+                "against-embree",
+                "measures the golden model's render speed only, not `bench sim` or `bench agree`",
+            ));
+        }
         Ok(match self.what {
             BenchWhat::Sim => BenchConfig::Sim { vectors: self.vectors.max(1), ghdl_vectors: self.ghdl_vectors },
             BenchWhat::Agree => BenchConfig::Agree { netlists: self.netlists.max(1) },
             BenchWhat::Render => {
-                threads(Some(self.threads))?;
-                let (width, height) = self.size;
-                BenchConfig::Render { width, height, threads: self.threads, repeat: self.repeat.max(1) }
+                let ((width, height), repeat, t) = (self.size, self.repeat.max(1), threads(self.threads)?);
+                if self.against_embree {
+                    // One thread, then all cores (or --threads).
+                    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+                    BenchConfig::AgainstEmbree { width, height, threads: t.unwrap_or(all), repeat }
+                } else {
+                    BenchConfig::Render { width, height, threads: t.unwrap_or(1), repeat }
+                }
             }
         })
     }

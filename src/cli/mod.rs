@@ -2,6 +2,7 @@
 //! command's arguments validated into a configuration before anything runs or any file is
 //! written (`config`), and the commands run on those (`run`). `main.rs` only dispatches.
 
+pub mod bench_embree;
 pub mod board;
 pub mod config;
 pub mod run;
@@ -546,12 +547,18 @@ pub struct BenchArgs {
     /// Image size WxH.
     #[arg(long, value_parser = parse_size, default_value = "1024x1024")]
     pub size: (u32, u32),
-    /// Worker threads.
-    #[arg(long, default_value_t = 1)]
-    pub threads: usize,
+    /// Worker threads. Default: 1; with --against-embree, 1 and then all cores (this many
+    /// instead of all).
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// Repetitions; the best is reported.
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
+    /// Trace the same camera's rays in Embree (the Python package embreex in .venv) in the
+    /// same run, one thread and all threads, for two views (framing and distant): both
+    /// throughputs and their ratio (docs/PERFORMANCE.md).
+    #[arg(long = "against-embree")]
+    pub against_embree: bool,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {

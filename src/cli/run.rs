@@ -42,7 +42,7 @@ pub fn run(cmd: Command) -> Result<bool> {
     }
 }
 
-fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+pub(super) fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         b = b.num_threads(n);
@@ -115,10 +115,15 @@ fn bench_agree(netlists: u64) -> bool {
     failures.is_empty()
 }
 
-/// Runs a benchmark; false when `bench agree` found a difference.
+/// Runs a benchmark; false when `bench agree` found a difference, or `--against-embree` hit
+/// counts that disagree.
 pub fn bench(c: &BenchConfig) -> Result<bool> {
-    if let BenchConfig::Agree { netlists } = *c {
-        return Ok(bench_agree(netlists));
+    match *c {
+        BenchConfig::Agree { netlists } => return Ok(bench_agree(netlists)),
+        BenchConfig::AgainstEmbree { width, height, threads, repeat } => {
+            return super::bench_embree::against_embree(width, height, threads, repeat);
+        }
+        _ => {}
     }
     let params = Params::default();
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params)?;
@@ -169,7 +174,7 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
                 rays as f64 / best / 1e6
             );
         }
-        BenchConfig::Agree { .. } => unreachable!("answered above"),
+        BenchConfig::Agree { .. } | BenchConfig::AgainstEmbree { .. } => unreachable!("answered above"),
     }
     Ok(true)
 }

@@ -104,6 +104,15 @@ fn bench_counts_at_least_one() {
 }
 
 #[test]
+fn bench_against_embree_takes_one_and_the_given_threads_and_only_renders() {
+    let args = ["bench", "--against-embree", "--threads", "3", "--size", "8x4"];
+    let Command::Bench(a) = command(&args) else { panic!() };
+    assert_eq!(a.config(), Ok(BenchConfig::AgainstEmbree { width: 8, height: 4, threads: 3, repeat: 3 }));
+    assert_eq!(refused(&["bench", "--against-embree", "--threads", "0"]), "--threads");
+    assert_eq!(refused(&["bench", "sim", "--against-embree"]), "--against-embree");
+}
+
+#[test]
 fn gen_checks_its_ranges_and_the_scene_folder() {
     assert_eq!(refused(&["gen", "--out", "x", "--scene", "rom", "--raygen"]), "--raygen");
     for w in ["0", "65"] {

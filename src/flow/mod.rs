@@ -4,6 +4,7 @@ pub mod axis;
 pub mod board;
 pub mod check;
 pub mod disturb;
+pub mod embree;
 pub mod ecp5;
 pub mod ecp5_bram;
 pub mod ecp5_carry;
