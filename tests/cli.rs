@@ -459,3 +459,34 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
         assert!(names.iter().any(|n| n.starts_with("fxrt_ml509_") && n.ends_with(ext)), "{ext} in {names:?}");
     }
 }
+
+/// `$FXRT_GOLDEN_PATH` forces the golden model's code path; a name that is no path is refused
+/// (exit 2, one line naming the variable) before anything runs, and every path renders the
+/// same picture.
+#[test]
+fn a_forced_golden_path_renders_the_same_ids() {
+    let dir = tempfile::tempdir().unwrap();
+    let ids = |path: &str| -> Vec<u8> {
+        let out = dir.path().join(format!("{path}.bin"));
+        let o = Command::new(env!("CARGO_BIN_EXE_fxrt"))
+            .args(["render", "--builtin", "teapot", "--size", "48x40", "--ids", out.to_str().unwrap()])
+            .env("FXRT_GOLDEN_PATH", path)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{path}: {}", stderr(&o));
+        std::fs::read(&out).unwrap()
+    };
+    let auto = ids("auto");
+    for path in ["reference", "scalar", "avx512"] {
+        assert_eq!(ids(path), auto, "{path}");
+    }
+    let bad = dir.path().join("bad.bin");
+    let o = Command::new(env!("CARGO_BIN_EXE_fxrt"))
+        .args(["render", "--builtin", "teapot", "--size", "8x8", "--ids", bad.to_str().unwrap()])
+        .env("FXRT_GOLDEN_PATH", "avx2")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("$FXRT_GOLDEN_PATH") && stderr(&o).trim_end().lines().count() == 1, "{}", stderr(&o));
+    assert!(!bad.exists());
+}

@@ -30,9 +30,9 @@ fn golden_path(t: &GoldenTracer) -> &'static str {
     if t.fast.packets() {
         "AVX-512 packets of 16 rays (render::fast::packet)"
     } else if t.fast.has_narrow_path() {
-        "scalar i64 path, one ray at a time (no AVX-512F/DQ)"
+        "scalar i64 path, one ray at a time (no AVX-512F/DQ, or $FXRT_GOLDEN_PATH=scalar)"
     } else {
-        "the 128-bit specification path"
+        "the 128-bit reference path (the widths allow no other, or $FXRT_GOLDEN_PATH=reference)"
     }
 }
 

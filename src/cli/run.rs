@@ -23,6 +23,8 @@ use std::path::{Path, PathBuf};
 
 /// Runs `cmd`: Ok(true) when it succeeded, Ok(false) when it found a mismatch.
 pub fn run(cmd: Command) -> Result<bool> {
+    // A misspelt forced path is an input error, not a silent fallback (render::fast).
+    crate::render::fast::GoldenPath::from_env()?;
     match cmd {
         Command::Render(a) => render(&a.config()?).map(|()| true),
         Command::Scene(a) => scene(&a.config()?).map(|()| true),

@@ -22,6 +22,45 @@ use crate::scene::accel::AccelTri;
 use crate::scene::bih::Node;
 use std::mem::MaybeUninit;
 
+/// Which code traces: every path gives the reference's answer, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum GoldenPath {
+    /// The fastest the CPU, the scene and the widths allow (the default).
+    Auto,
+    /// `model::golden` itself: i128 arithmetic, the plain walk.
+    Reference,
+    /// The i64 path, a ray at a time, no vector instructions (what a CPU without AVX-512 runs).
+    Scalar,
+    /// AVX-512 packets of 16 rays (and the i64 path for rays that do not fit a packet).
+    Avx512,
+}
+
+impl GoldenPath {
+    pub const ALL: [GoldenPath; 4] = [GoldenPath::Auto, GoldenPath::Reference, GoldenPath::Scalar, GoldenPath::Avx512];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            GoldenPath::Auto => "auto",
+            GoldenPath::Reference => "reference",
+            GoldenPath::Scalar => "scalar",
+            GoldenPath::Avx512 => "avx512",
+        }
+    }
+
+    /// The path `$FXRT_GOLDEN_PATH` names (auto when unset); an error names the variable.
+    pub fn from_env() -> crate::error::Result<GoldenPath> {
+        match std::env::var("FXRT_GOLDEN_PATH") {
+            Err(_) => Ok(GoldenPath::Auto),
+            Ok(v) => GoldenPath::ALL.into_iter().find(|p| p.name() == v).ok_or_else(|| {
+                crate::error::Error::new(
+                    "$FXRT_GOLDEN_PATH",
+                    format!("'{v}' is not a path: use auto, reference, scalar or avx512"),
+                )
+            }),
+        }
+    }
+}
+
 /// The golden model of one scene with its fast layout (when the scene has one).
 #[derive(Debug)]
 pub struct FastGolden<'a> {
@@ -33,10 +72,37 @@ pub struct FastGolden<'a> {
 }
 
 impl<'a> FastGolden<'a> {
+    /// The fastest path (`GoldenPath::Auto`), or the one `$FXRT_GOLDEN_PATH` forces when it
+    /// names one this machine and scene can run (else the fastest: `path_available` tells).
     pub fn new(scene: &'a Scene) -> Self {
-        let layout = FastScene::new(scene);
-        let packets = layout.is_some() && packet::available(&scene.params);
+        Self::with_path(scene, GoldenPath::from_env().unwrap_or(GoldenPath::Auto))
+    }
+
+    /// Whether `path` can run on this CPU for `scene` (reference, and auto, always can).
+    pub fn path_available(scene: &Scene, path: GoldenPath) -> bool {
+        match path {
+            GoldenPath::Auto | GoldenPath::Reference => true,
+            GoldenPath::Scalar => FastScene::new(scene).is_some(),
+            GoldenPath::Avx512 => FastScene::new(scene).is_some() && packet::available(&scene.params),
+        }
+    }
+
+    /// The model tracing by `path`; a path that cannot run here falls back to the fastest
+    /// (check `path_available` first to know).
+    pub fn with_path(scene: &'a Scene, path: GoldenPath) -> Self {
+        let path = if Self::path_available(scene, path) { path } else { GoldenPath::Auto };
+        let layout = if path == GoldenPath::Reference { None } else { FastScene::new(scene) };
+        let packets = layout.is_some() && path != GoldenPath::Scalar && packet::available(&scene.params);
         FastGolden { scene, golden: Golden::new(scene), layout, packets }
+    }
+
+    /// The path that runs: reference, scalar or avx512.
+    pub fn path(&self) -> GoldenPath {
+        match (&self.layout, self.packets) {
+            (None, _) => GoldenPath::Reference,
+            (Some(_), false) => GoldenPath::Scalar,
+            (Some(_), true) => GoldenPath::Avx512,
+        }
     }
 
     /// `Golden::trace`'s answer, bit for bit; the statistics count only what was visited.
