@@ -30,10 +30,7 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     };
     let scene = Scene::load(source, params)?;
     let g = board_camera(&scene, spec)?;
-    let pixels = g.width as u64 * g.height as u64;
-    if c.ray_id_width < 64 && pixels > 1u64 << c.ray_id_width {
-        return Err(Error::param("ray-id-width", format!("{} bits cannot number the {pixels} pixels of --size", c.ray_id_width)));
-    }
+    super::run::ids_fit(c.ray_id_width, g.width, g.height)?;
     let roms = SceneRoms::of(&scene);
     let t = c.threads;
     let p = CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);

@@ -261,6 +261,15 @@ fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, netlist: &crate
     Ok(core_entry)
 }
 
+/// A frame of `width` × `height` rays numbered by pixel fits ray ids of `id_width` bits.
+pub(super) fn ids_fit(id_width: u32, width: u32, height: u32) -> Result<()> {
+    let pixels = width as u64 * height as u64;
+    if id_width < 64 && pixels > 1u64 << id_width {
+        return Err(Error::param("ray-id-width", format!("{id_width} bits cannot number the {pixels} pixels of --size")));
+    }
+    Ok(())
+}
+
 pub fn gen_core(c: &GenConfig) -> Result<()> {
     let (roms, raygen, scene) = match &c.scene {
         GenScene::Folder(dir) => (SceneRoms::load(dir)?, None, None),
@@ -271,13 +280,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         }
     };
     if let Some(g) = &raygen {
-        let pixels = g.width as u64 * g.height as u64;
-        if c.ray_id_width < 64 && pixels > 1u64 << c.ray_id_width {
-            return Err(Error::param(
-                "ray-id-width",
-                format!("{} bits cannot number the {pixels} pixels of --size", c.ray_id_width),
-            ));
-        }
+        ids_fit(c.ray_id_width, g.width, g.height)?;
     }
     let t = c.threads;
     let p = crate::cores::top::CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
@@ -294,13 +297,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         .collect();
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
-        let pixels = spec.width as u64 * spec.height as u64;
-        if c.ray_id_width < 64 && pixels > 1u64 << c.ray_id_width {
-            return Err(Error::param(
-                "ray-id-width",
-                format!("{} bits cannot number the {pixels} pixels of --size", c.ray_id_width),
-            ));
-        }
+        ids_fit(c.ray_id_width, spec.width, spec.height)?;
         let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
         files
             .extend(crate::flow::axis::frame_files(&layout, scene, &rays).into_iter().map(|(n, b)| (c.out.join(n), b)));

@@ -131,11 +131,11 @@ pub struct BoardDesign {
 
 /// The golden model's checksum of the frame `g` generates.
 pub fn golden_checksum(scene: &Scene, core: &Module, g: &RayGen) -> u32 {
-    let golden = crate::model::golden::Golden::new(scene);
     let fast = FastGolden::new(scene);
     let w = result_widths(core);
     let pixels = g.width as u64 * g.height as u64;
-    frame_checksum(&w, (0..pixels).map(|i| (i, fast.trace(&g.ray(&golden, (i % g.width as u64) as u32, (i / g.width as u64) as u32)).0)))
+    let ray = |i: u64| g.ray(&fast.golden, (i % g.width as u64) as u32, (i / g.width as u64) as u32);
+    frame_checksum(&w, (0..pixels).map(|i| (i, fast.trace(&ray(i)).0)))
 }
 
 impl BoardDesign {
@@ -201,6 +201,15 @@ impl BoardDesign {
         text.expect("board top template renders") + "\n"
     }
 
+    /// The pin and clock constraints: (`<top>.lpf` or `<top>.ucf`, text).
+    pub fn constraints(&self) -> (String, String) {
+        let t = self.template();
+        match self.board {
+            Board::Ulx3s => (format!("{}.lpf", self.top), Lpf(&t).render().expect("LPF renders") + "\n"),
+            Board::Ml509 => (format!("{}.ucf", self.top), Ucf(&t).render().expect("UCF renders") + "\n"),
+        }
+    }
+
     /// Every file: the logic's HDL and the top in the languages asked for, the constraints, the
     /// ISE project (ML509), the manifest.
     pub fn files(&self, vhdl: bool, verilog: bool) -> Vec<(String, String)> {
@@ -211,17 +220,14 @@ impl BoardDesign {
                 out.push((format!("{}.{ext}", self.top), self.top_hdl(ext)));
             }
         }
-        let t = self.template();
-        match self.board {
-            Board::Ulx3s => out.push((format!("{}.lpf", self.top), Lpf(&t).render().expect("LPF renders") + "\n")),
-            Board::Ml509 => {
-                out.push((format!("{}.ucf", self.top), Ucf(&t).render().expect("UCF renders") + "\n"));
-                let (language, ext) = if vhdl { ("VHDL", "vhd") } else { ("Verilog", "v") };
-                let mut files: Vec<String> = self.logic.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
-                files.push(format!("{}.{ext}", self.top));
-                let tcl = crate::flow::generate::ise_project(&self.top, &self.scene, language, &files, true);
-                out.push((format!("{}.tcl", self.top), tcl));
-            }
+        out.push(self.constraints());
+        // The ML509's bitstream comes from ISE: its project script.
+        if self.board == Board::Ml509 {
+            let (language, ext) = if vhdl { ("VHDL", "vhd") } else { ("Verilog", "v") };
+            let mut files: Vec<String> = self.logic.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
+            files.push(format!("{}.{ext}", self.top));
+            let tcl = crate::flow::generate::ise_project(&self.top, &self.scene, language, &files, true);
+            out.push((format!("{}.tcl", self.top), tcl));
         }
         let names: Vec<String> = out.iter().map(|f| f.0.clone()).collect();
         out.push((format!("{}.json", self.top), serde_json::to_string_pretty(&self.manifest(&names)).unwrap_or_default() + "\n"));
@@ -273,20 +279,22 @@ struct TopTemplate<'a> {
     leds: Vec<(usize, &'static str, &'static str)>,
 }
 
+/// A template over a borrowed set of fields (`$fields<'a>`): several templates share one.
 macro_rules! board_template {
-    ($name:ident, $path:literal) => {
-        #[derive(Template)]
+    ($name:ident, $fields:ident, $path:literal) => {
+        #[derive(askama::Template)]
         #[template(path = $path, escape = "none")]
-        struct $name<'a, 'b>(&'b TopTemplate<'a>);
+        struct $name<'a, 'b>(&'b $fields<'a>);
         impl<'a, 'b> std::ops::Deref for $name<'a, 'b> {
-            type Target = TopTemplate<'a>;
-            fn deref(&self) -> &TopTemplate<'a> {
+            type Target = $fields<'a>;
+            fn deref(&self) -> &$fields<'a> {
                 self.0
             }
         }
     };
 }
-board_template!(TopVerilog, "board_top.v");
-board_template!(TopVhdl, "board_top.vhd");
-board_template!(Lpf, "ulx3s.lpf");
-board_template!(Ucf, "ml509.ucf");
+pub(crate) use board_template;
+board_template!(TopVerilog, TopTemplate, "board_top.v");
+board_template!(TopVhdl, TopTemplate, "board_top.vhd");
+board_template!(Lpf, TopTemplate, "ulx3s.lpf");
+board_template!(Ucf, TopTemplate, "ml509.ucf");

@@ -51,8 +51,7 @@ pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Resul
     let top_file = format!("{}.v", d.top);
     std::fs::write(dir.join(&top_file), d.top_hdl("v")).map_err(io)?;
     sources.push(top_file);
-    let lpf = format!("{}.lpf", d.top);
-    let lpf_text = d.files(false, false).into_iter().find(|f| f.0 == lpf).map(|f| f.1).unwrap_or_default();
+    let (lpf, lpf_text) = d.constraints();
     std::fs::write(dir.join(&lpf), lpf_text).map_err(io)?;
     synthesize(tools, dir, &sources, &d.top)?;
     let seed_s = seed.to_string();

@@ -30,27 +30,8 @@ struct TbFields<'a> {
     max_cycles: u64,
 }
 
-#[derive(Template)]
-#[template(path = "board_tb.v", escape = "none")]
-struct TbVerilog<'a, 'b>(&'b TbFields<'a>);
-
-#[derive(Template)]
-#[template(path = "board_tb.vhd", escape = "none")]
-struct TbVhdl<'a, 'b>(&'b TbFields<'a>);
-
-impl<'a> std::ops::Deref for TbVerilog<'a, '_> {
-    type Target = TbFields<'a>;
-    fn deref(&self) -> &TbFields<'a> {
-        self.0
-    }
-}
-
-impl<'a> std::ops::Deref for TbVhdl<'a, '_> {
-    type Target = TbFields<'a>;
-    fn deref(&self) -> &TbFields<'a> {
-        self.0
-    }
-}
+super::board_template!(TbVerilog, TbFields, "board_tb.v");
+super::board_template!(TbVhdl, TbFields, "board_tb.vhd");
 
 /// The testbench for `d` (built with LED shift 0) in `ext` ("v" or "vhd"): the button
 /// pressed `press_at` clocks into the second frame, at most `max_cycles` clocks.
