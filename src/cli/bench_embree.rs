@@ -27,12 +27,12 @@ pub fn views(scene: &Scene, width: u32, height: u32) -> [(&'static str, Camera);
 
 /// Which of the golden model's code paths `render` takes on this CPU (`render::fast`).
 fn golden_path(t: &GoldenTracer) -> &'static str {
-    if t.fast.packets() {
-        "AVX-512 packets of 16 rays (render::fast::packet)"
-    } else if t.fast.has_narrow_path() {
-        "scalar i64 path, one ray at a time (no AVX-512F/DQ, or $FXRT_GOLDEN_PATH=scalar)"
-    } else {
-        "the 128-bit reference path (the widths allow no other, or $FXRT_GOLDEN_PATH=reference)"
+    use crate::render::fast::GoldenPath;
+    match t.fast.path() {
+        GoldenPath::Avx512 => "AVX-512 packets of 16 rays (render::fast::packet)",
+        GoldenPath::Avx2 => "AVX2 packets of 8 rays (render::fast::packet; no AVX-512F/DQ, or $FXRT_GOLDEN_PATH=avx2)",
+        GoldenPath::Scalar => "scalar i64 path, one ray at a time (no AVX2, or $FXRT_GOLDEN_PATH=scalar)",
+        _ => "the 128-bit reference path (the widths allow no other, or $FXRT_GOLDEN_PATH=reference)",
     }
 }
 

@@ -4,15 +4,15 @@
 //!   is skipped (exact because of `lower_t`, docs/ARITHMETIC.md);
 //! - an i64 path (`trace_narrow`) where the widths and the scene's values bound every value,
 //!   over a copy of the BIH laid out for speed;
-//! - AVX-512 where the CPU has it: eight rays quantised at once (`quantize8`) and primary rays
-//!   traced sixteen to a packet (`packet`).
+//! - primary rays traced sixteen to a packet (`packet`) with AVX-512 or AVX2, whichever the
+//!   CPU has (chosen at run time), and with AVX-512 eight rays quantised at once (`quantize8`).
 //!
 //! The golden model itself (`model::golden`) stays the plain reference.
 
 mod packet;
 mod quantize8;
 
-pub(crate) use packet::LANES;
+pub(crate) use packet::{Kernel, LANES};
 pub(crate) use quantize8::quantize_ray8;
 
 use crate::model::golden::{Golden, GridRay, Hit, TraversalStats, TriHit, lower_t};
@@ -29,20 +29,25 @@ pub enum GoldenPath {
     Auto,
     /// `model::golden` itself: i128 arithmetic, the plain walk.
     Reference,
-    /// The i64 path, a ray at a time, no vector instructions (what a CPU without AVX-512 runs).
+    /// The i64 path, a ray at a time, no vector instructions (what a CPU without AVX2 runs).
     Scalar,
-    /// AVX-512 packets of 16 rays (and the i64 path for rays that do not fit a packet).
+    /// AVX2 packets of 16 rays (and the i64 path for rays that do not fit a packet).
+    Avx2,
+    /// AVX-512 packets of 16 rays, eight rays quantised at once (and the i64 path for rays
+    /// that do not fit a packet).
     Avx512,
 }
 
 impl GoldenPath {
-    pub const ALL: [GoldenPath; 4] = [GoldenPath::Auto, GoldenPath::Reference, GoldenPath::Scalar, GoldenPath::Avx512];
+    pub const ALL: [GoldenPath; 5] =
+        [GoldenPath::Auto, GoldenPath::Reference, GoldenPath::Scalar, GoldenPath::Avx2, GoldenPath::Avx512];
 
     pub fn name(self) -> &'static str {
         match self {
             GoldenPath::Auto => "auto",
             GoldenPath::Reference => "reference",
             GoldenPath::Scalar => "scalar",
+            GoldenPath::Avx2 => "avx2",
             GoldenPath::Avx512 => "avx512",
         }
     }
@@ -54,7 +59,7 @@ impl GoldenPath {
             Ok(v) => GoldenPath::ALL.into_iter().find(|p| p.name() == v).ok_or_else(|| {
                 crate::error::Error::new(
                     "$FXRT_GOLDEN_PATH",
-                    format!("'{v}' is not a path: use auto, reference, scalar or avx512"),
+                    format!("'{v}' is not a path: use auto, reference, scalar, avx2 or avx512"),
                 )
             }),
         }
@@ -67,8 +72,9 @@ pub struct FastGolden<'a> {
     pub scene: &'a Scene,
     pub golden: Golden,
     layout: Option<FastScene>,
-    /// `trace_packet` may run: the layout exists and the CPU and widths suit `packet`.
-    packets: bool,
+    /// The instruction set `trace_packet` runs on, when the layout exists and the CPU and
+    /// widths suit one.
+    kernel: Option<Kernel>,
 }
 
 impl<'a> FastGolden<'a> {
@@ -83,7 +89,8 @@ impl<'a> FastGolden<'a> {
         match path {
             GoldenPath::Auto | GoldenPath::Reference => true,
             GoldenPath::Scalar => FastScene::new(scene).is_some(),
-            GoldenPath::Avx512 => FastScene::new(scene).is_some() && packet::available(&scene.params),
+            GoldenPath::Avx2 => FastScene::new(scene).is_some() && Kernel::Avx2.available(&scene.params),
+            GoldenPath::Avx512 => FastScene::new(scene).is_some() && Kernel::Avx512.available(&scene.params),
         }
     }
 
@@ -92,16 +99,23 @@ impl<'a> FastGolden<'a> {
     pub fn with_path(scene: &'a Scene, path: GoldenPath) -> Self {
         let path = if Self::path_available(scene, path) { path } else { GoldenPath::Auto };
         let layout = if path == GoldenPath::Reference { None } else { FastScene::new(scene) };
-        let packets = layout.is_some() && path != GoldenPath::Scalar && packet::available(&scene.params);
-        FastGolden { scene, golden: Golden::new(scene), layout, packets }
+        let kernel = match path {
+            _ if layout.is_none() => None,
+            GoldenPath::Auto => Kernel::best(&scene.params),
+            GoldenPath::Avx2 => Some(Kernel::Avx2),
+            GoldenPath::Avx512 => Some(Kernel::Avx512),
+            GoldenPath::Reference | GoldenPath::Scalar => None,
+        };
+        FastGolden { scene, golden: Golden::new(scene), layout, kernel }
     }
 
-    /// The path that runs: reference, scalar or avx512.
+    /// The path that runs: reference, scalar, avx2 or avx512.
     pub fn path(&self) -> GoldenPath {
-        match (&self.layout, self.packets) {
+        match (&self.layout, self.kernel) {
             (None, _) => GoldenPath::Reference,
-            (Some(_), false) => GoldenPath::Scalar,
-            (Some(_), true) => GoldenPath::Avx512,
+            (Some(_), None) => GoldenPath::Scalar,
+            (Some(_), Some(Kernel::Avx2)) => GoldenPath::Avx2,
+            (Some(_), Some(Kernel::Avx512)) => GoldenPath::Avx512,
         }
     }
 
@@ -118,9 +132,9 @@ impl<'a> FastGolden<'a> {
         self.layout.is_some()
     }
 
-    /// Whether `trace_packet` is available.
-    pub(crate) fn packets(&self) -> bool {
-        self.packets
+    /// The instruction set `trace_packet` runs on, if any.
+    pub(crate) fn kernel(&self) -> Option<Kernel> {
+        self.kernel
     }
 
     /// Whether `ray` takes the i64 path, as every ray of a packet must.
@@ -128,13 +142,12 @@ impl<'a> FastGolden<'a> {
         NarrowRay::fits(&self.golden, ray)
     }
 
-    /// `trace` of up to LANES rays at once (each must `fit`); only when `packets()` holds.
+    /// `trace` of up to LANES rays at once (each must `fit`); only when `kernel()` is some.
     pub(crate) fn trace_packet(&self, rays: &[GridRay]) -> [Option<Hit>; LANES] {
-        // `packet::trace` runs AVX-512 code: this check is what makes it sound.
-        assert!(self.packets, "packet tracing needs AVX-512 and the i64 layout");
-        match &self.layout {
-            Some(fs) => packet::trace(&self.golden, fs, rays),
-            None => unreachable!("packets implies a layout"),
+        // `Kernel::trace` runs AVX code: `with_path` chose the kernel only where it is available.
+        match (&self.layout, self.kernel) {
+            (Some(fs), Some(kernel)) => kernel.trace(&self.golden, fs, rays),
+            _ => panic!("packet tracing needs AVX2 or AVX-512 and the i64 layout"),
         }
     }
 }
