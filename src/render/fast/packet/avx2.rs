@@ -60,15 +60,15 @@ fn to_f64(a: __m256i) -> __m256d {
 }
 
 /// One register, floor(a / b) off by at most one for 0 ≤ a, b < 2^63 (as `div_floor`): the
-/// quotient is capped at 2^51 (b = 0 gives +inf or NaN, and `min_pd` returns the cap for NaN),
-/// truncated, and read back through the bits of q + 2^52.
+/// quotient y is within 1/4 of a/b, and q = y rounded to the nearest integer (read from the
+/// bits of y + 2^52) is floor(a/b) or one more, which the remainder corrects. Where y ≥ 2^52,
+/// +inf or NaN (b = 0) the bits give a q ≥ 2^32 or a negative one, outside every window.
 #[inline]
 #[target_feature(enable = "avx2")]
 fn div1(a: __m256i, b: __m256i) -> __m256i {
     let p52 = _mm256_set1_pd(2f64.powi(52));
-    let q = _mm256_min_pd(_mm256_div_pd(to_f64(a), to_f64(b)), _mm256_set1_pd(2f64.powi(51)));
-    let q = _mm256_round_pd::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(q);
-    _mm256_sub_epi64(_mm256_castpd_si256(_mm256_add_pd(q, p52)), _mm256_castpd_si256(p52))
+    let q = _mm256_add_pd(_mm256_div_pd(to_f64(a), to_f64(b)), p52);
+    _mm256_sub_epi64(_mm256_castpd_si256(q), _mm256_castpd_si256(p52))
 }
 
 // Lane-wise operations, register by register.
@@ -89,12 +89,14 @@ lanewise! {
     bit_and(a, b) = _mm256_and_si256;
     bit_or(a, b) = _mm256_or_si256;
     xor(a, b) = _mm256_xor_si256;
-    abs(a) = |a| { let m = negative1(a); _mm256_sub_epi64(_mm256_xor_si256(a, m), m) };
+    // |a| where b has a's sign: (a ^ m) − m with m = −1 for b < 0.
+    abs_by(a, b) = |a, b| { let m = negative1(b); _mm256_sub_epi64(_mm256_xor_si256(a, m), m) };
     mul32(a, b) = _mm256_mul_epi32;
     div_f64(a, b) = div1;
     mul_lo32(a, b) = |a, b| _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64::<32>(_mm256_mul_epu32(a, _mm256_srli_epi64::<32>(b))));
     sign(a) = negative1;
-    div64(a) = |a| sra1(a, _mm_set_epi64x(0, 6));
+    // floor(a / 64) for a ≥ 0.
+    div64(a) = _mm256_srli_epi64::<6>;
     // Comparisons: a mask per lane in the sign bit. a ≤ b is not a > b.
     lt(a, b) = |a, b| _mm256_cmpgt_epi64(b, a);
     le(a, b) = |a, b| _mm256_xor_si256(_mm256_cmpgt_epi64(a, b), _mm256_set1_epi64x(-1));
@@ -137,6 +139,15 @@ fn blend(m: Mask, a: W, b: W) -> W {
 fn sra(a: W, s: u32) -> W {
     let s = _mm_set_epi64x(0, s as i64);
     a.map(|x| sra1(x, s))
+}
+
+/// `sra` for |a| < 2^62, one instruction shorter: a + 2^62 is not negative, and
+/// floor((a + 2^62) / 2^s) − 2^(62−s) = floor(a / 2^s).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn sra_small(a: W, s: u32) -> W {
+    let (bias, back, s) = (_mm256_set1_epi64x(1 << 62), _mm256_set1_epi64x(1 << (62 - s)), _mm_set_epi64x(0, s as i64));
+    a.map(|x| _mm256_sub_epi64(_mm256_srl_epi64(_mm256_add_epi64(x, bias), s), back))
 }
 
 #[inline]

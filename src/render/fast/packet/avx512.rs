@@ -42,7 +42,7 @@ lanewise! {
     bit_and(a, b) = _mm512_and_si512;
     bit_or(a, b) = _mm512_or_si512;
     xor(a, b) = _mm512_xor_si512;
-    abs(a) = _mm512_abs_epi64;
+    abs_by(a, b) = |a, _| _mm512_abs_epi64(a);
     mul32(a, b) = _mm512_mul_epi32;
     // A lane with b = 0 converts ±inf or NaN to i64::MIN (negative).
     div_f64(a, b) = |a, b| _mm512_cvttpd_epi64(_mm512_div_pd(_mm512_cvtepi64_pd(a), _mm512_cvtepi64_pd(b)));
@@ -93,6 +93,12 @@ fn blend(m: Mask, a: W, b: W) -> W {
 #[target_feature(enable = "avx512f,avx512dq")]
 fn sra(a: W, s: u32) -> W {
     a.map(|x| _mm512_sra_epi64(x, _mm_set_epi64x(0, s as i64)))
+}
+
+#[inline]
+#[target_feature(enable = "avx512f,avx512dq")]
+fn sra_small(a: W, s: u32) -> W {
+    sra(a, s)
 }
 
 #[inline]

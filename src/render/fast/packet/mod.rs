@@ -70,9 +70,9 @@ impl Kernel {
 /// The walk of one packet, as a function `walk` with `$features` enabled, over the lane-wise
 /// operations in scope where it expands: W (a value per lane), Mask (a bit per lane), `to_w`,
 /// `to_a`, `splat`, `splat32` (a factor for `mul32`), add, sub, min, max, bit_and, bit_or,
-/// xor, abs, mul32 (signed low 32 × low 32 → 64), mul_lo32 (a·b mod 2^64 for 0 ≤ a < 2^32),
+/// xor, abs_by (|a| where b has a's sign), mul32 (signed low 32 × low 32 → 64), mul_lo32 (a·b mod 2^64 for 0 ≤ a < 2^32),
 /// div_f64 (floor(a/b) off by at most one for 0 ≤ a, b < 2^63; ≥ 2^32 − 1 or negative when
-/// b = 0 or a/b ≥ 2^32 − 1), sign (−1 or 0), div64 (floor(a/64)), sra, sll (by a run-time
+/// b = 0 or a/b ≥ 2^32 − 1), sign (−1 or 0), div64 (floor(a/64) for a ≥ 0), sra, sra_small (for |a| < 2^62), sll (by a run-time
 /// count), le, lt, ge, le_unsigned (→ Mask), negative (lanes < 0), blend (b in the mask's
 /// lanes), and the mask operations both, either, any, count, all_if, first.
 #[cfg(target_arch = "x86_64")]
@@ -113,7 +113,8 @@ macro_rules! packet_walk {
             });
             let plane_t = |k: usize, p: W| {
                 let d = sub(p, o[k]);
-                add(mul32(d, inv_hi[k]), sra(mul32(d, inv_lo[k]), g.c))
+                // |d·inv_lo| < 2^(n+C) ≤ 2^60.
+                add(mul32(d, inv_hi[k]), sra_small(mul32(d, inv_lo[k]), g.c))
             };
             let (zero, one, half) = (splat(0), splat(1), splat(1 << (g.f - 1)));
             let (t_sat, t_top, min_v, max_v) = (splat(g.t_sat), splat(g.t_sat - 1), splat(i64::MIN), splat(i64::MAX));
@@ -122,6 +123,7 @@ macro_rules! packet_walk {
             let exit = |k: usize| max(min(plane_t(k, blend(neg[k], splat(g.box_hi[k]), zero)), t_sat), splat(-1));
             let tmax0 = blend(first(rays.len()), splat(-1), min(min(exit(0), exit(1)), exit(2)));
             let uv_max = splat(1u64.checked_shl(g.e + g.f).unwrap_or(u64::MAX) as i64);
+            // For x ≥ 0: every tmin is (it starts at 0 and only grows).
             let lower_t = |x: W| sub(sub(x, div64(x)), splat(8));
             // The divider's precision drop, skipped when there is none (the default T = 0).
             let drop_t = |x: W| if g.t == 0 { x } else { sra(x, g.t) };
@@ -180,7 +182,8 @@ macro_rules! packet_walk {
                         }
                         // floor(a / b) as in `div_floor`. A lane with b = 0 or a / b ≥ 2^32 − 2
                         // gets a t far outside [lo, hi] and fails the window, as the divider must.
-                        let (a_, b_) = (abs(num), abs(den));
+                        // |num| and |den| in the lanes where their signs agree (garbage elsewhere).
+                        let (a_, b_) = (abs_by(num, den), abs_by(den, den));
                         let q = div_f64(a_, b_);
                         let r = sub(a_, mul_lo32(q, b_));
                         let t = add(add(q, sign(r)), blend(ge(r, b_), zero, one));
@@ -188,7 +191,8 @@ macro_rules! packet_walk {
                         if !any(ok) {
                             continue;
                         }
-                        let k = |o: W, p: i64, w: W| add(sub(o, splat(p)), sra(add(mul32(t, w), half), g.f));
+                        // |t·ω| < 2^(n+1+F) ≤ 2^61 where t is in the window (garbage elsewhere).
+                        let k = |o: W, p: i64, w: W| add(sub(o, splat(p)), sra_small(add(mul32(t, w), half), g.f));
                         let (kp, kq) = (k(op, tri.pp, wp), k(oq, tri.pq, wq));
                         let u = sub(mul32(splat32(tri.e1p), kq), mul32(splat32(tri.e1q), kp));
                         let v = sub(mul32(splat32(tri.e2q), kp), mul32(splat32(tri.e2p), kq));
