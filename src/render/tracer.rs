@@ -95,11 +95,24 @@ impl Tracer for GoldenTracer<'_> {
                 }
             });
         };
-        let (mut grid, mut pixel) = (Vec::with_capacity(rays.len()), Vec::with_capacity(rays.len()));
+        // Rays that reach the box gather into a packet, traced as soon as it is full (and the
+        // last, partial one at the end): a small buffer that stays in the cache.
+        let (mut grid, mut pixel) = (Vec::with_capacity(LANES), Vec::with_capacity(LANES));
+        let flush = |grid: &mut Vec<GridRay>, pixel: &mut Vec<(usize, f64)>, found: &mut dyn FnMut(usize, PrimaryHit)| {
+            for ((ray, &(i, t_offset)), hit) in grid.iter().zip(pixel.iter()).zip(self.fast.trace_packet(grid)) {
+                if let Some(h) = hit {
+                    found(i, self.primary_hit(&QuantizedRay { ray: *ray, t_offset }, h));
+                }
+            }
+            (grid.clear(), pixel.clear());
+        };
         let mut keep = |i: usize, q: QuantizedRay| {
             if self.fast.fits(&q.ray) {
                 grid.push(q.ray);
                 pixel.push((i, q.t_offset));
+                if grid.len() == LANES {
+                    flush(&mut grid, &mut pixel, found);
+                }
             } else if let Some(hit) = self.fast.trace(&q.ray).0 {
                 found(i, self.primary_hit(&q, hit));
             }
@@ -115,12 +128,8 @@ impl Tracer for GoldenTracer<'_> {
                 }
             }
         }
-        for (rays, pixels) in grid.chunks(LANES).zip(pixel.chunks(LANES)) {
-            for ((ray, &(i, t_offset)), hit) in rays.iter().zip(pixels).zip(self.fast.trace_packet(rays)) {
-                if let Some(h) = hit {
-                    found(i, self.primary_hit(&QuantizedRay { ray: *ray, t_offset }, h));
-                }
-            }
+        if !grid.is_empty() {
+            flush(&mut grid, &mut pixel, found);
         }
     }
 
