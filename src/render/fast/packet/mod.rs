@@ -128,14 +128,27 @@ macro_rules! packet_walk {
             // The divider's precision drop, skipped when there is none (the default T = 0).
             let drop_t = |x: W| if g.t == 0 { x } else { sra(x, g.t) };
             let (mut best_t, mut best_id, mut best_u, mut best_v) = (max_v, max_v, zero, zero);
+            // Per lane, a bound P ≥ prune_limit(best t) (the largest tmin with lower_t(tmin) ≤
+            // best t): a node with tmin > P cannot hold a better hit. With y = t + 8,
+            // prune_limit = y + floor(y/63), and floor(y/63) ≤ Σ_{k=1..4} floor(y/64^k) + 6 for
+            // y < 2^31 (t < 2^(n+1) ≤ 2^30): 1/63 = Σ 64^−k, the four floors lose < 4 and the
+            // tail from k = 5 is < 2·64/63. A looser bound only visits a node more, never
+            // changes a hit.
+            let mut prune = max_v;
+            let prune_bound = |t: W| {
+                let y = add(t, splat(8));
+                let (d1, d2) = (div64(y), div64(div64(y)));
+                let (d3, d4) = (div64(d2), div64(div64(d2)));
+                add(add(add(y, d1), add(d2, d3)), add(d4, splat(6)))
+            };
             // Lanes that take part in a node: non-empty interval, not pruned by their best.
-            let live = |iv: &Interval, best_t: W| both(le(iv.tmin, iv.tmax), le(lower_t(iv.tmin), best_t));
+            let live = |iv: &Interval, prune: W| le(iv.tmin, min(iv.tmax, prune));
 
             // One spare slot: every inner node writes its second child, pushed or not.
             let mut stack = [const { MaybeUninit::<(Interval, u32)>::uninit() }; 257];
             let mut sp = 0;
             let (mut node, mut iv) = (0u32, Interval { tmin: zero, tmax: tmax0 });
-            let mut act = live(&iv, best_t);
+            let mut act = live(&iv, prune);
             loop {
                 let nd = &fs.nodes[node as usize];
                 if any(act) && nd.kind < LEAF {
@@ -151,7 +164,7 @@ macro_rules! packet_walk {
                         tmin: max(iv.tmin, blend(neg[a], min(d1, t_sat), min_v)),
                         tmax: min(iv.tmax, blend(neg[a], max_v, d1)),
                     };
-                    let (lm, rm) = (live(&left, best_t), live(&right, best_t));
+                    let (lm, rm) = (live(&left, prune), live(&right, prune));
                     let right_first = 2 * count(both(neg[a], act)) > count(act);
                     let (left, right) = ((nd.link, left, lm), (nd.link + 1, right, rm));
                     let (first, second) = if right_first { (right, left) } else { (left, right) };
@@ -200,10 +213,14 @@ macro_rules! packet_walk {
                         // t ≤ best t here, so (t, id) < best ⟺ t < best t or id < best id.
                         let id = splat(ft.id as i64);
                         let better = both(both(ok, inside), either(lt(t, best_t), lt(id, best_id)));
+                        if !any(better) {
+                            continue;
+                        }
                         best_t = blend(better, best_t, t);
                         best_id = blend(better, best_id, id);
                         best_u = blend(better, best_u, u);
                         best_v = blend(better, best_v, v);
+                        prune = blend(better, prune, prune_bound(t));
                     }
                 }
                 if sp == 0 {
@@ -212,7 +229,7 @@ macro_rules! packet_walk {
                 sp -= 1;
                 // SAFETY: entries below the stack pointer were written by a push.
                 (iv, node) = unsafe { stack[sp].assume_init() };
-                act = live(&iv, best_t);
+                act = live(&iv, prune);
             }
             let (t, id, u, v) = (to_a(best_t), to_a(best_id), to_a(best_u), to_a(best_v));
             let shr = |x: i64| x.checked_shr(g.e).unwrap_or(0);
