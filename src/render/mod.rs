@@ -50,30 +50,32 @@ pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, pro
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_message("render");
-    // The frame's pixels, written in place row by row (allocated and touched before the clock
-    // starts: the frame buffer is the output, not part of tracing).
-    let mut pixels = vec![(-1, f64::INFINITY, -1.0f32, 1u8); w as usize * h as usize];
     let start = std::time::Instant::now();
     let pixel_rays = cam.pixel_rays();
-    pixels.par_chunks_mut(w as usize).enumerate().for_each(|(py, row)| {
-        let rays: Vec<_> = (0..w).map(|px| pixel_rays.ray(px, py as u32)).collect();
-        tracer.primary_row(&rays, &mut |px, hit| {
-            let (ray, n) = (&rays[px], normals[hit.id as usize]);
-            let (brightness, traced) = if shade {
-                let p: [f64; 3] = std::array::from_fn(|k| ray.o[k] + hit.dist * ray.d[k]);
-                let l = normalize(sub(light, p));
-                let lit = !tracer.shadowed(ray, &hit, light);
-                (0.12 + if lit { 0.88 * dot(n, l).abs() } else { 0.0 }, 2)
-            } else {
-                (0.12 + 0.88 * dot(n, ray.d).abs(), 1)
-            };
-            row[px] = (hit.id as i32, hit.dist, brightness as f32, traced);
-        });
-        bar.inc(1);
-    });
+    let rows: Vec<Vec<(i32, f64, f32, u8)>> = (0..h)
+        .into_par_iter()
+        .map(|py| {
+            let rays: Vec<_> = (0..w).map(|px| pixel_rays.ray(px, py)).collect();
+            let mut row = vec![(-1, f64::INFINITY, -1.0, 1); w as usize];
+            tracer.primary_row(&rays, &mut |px, hit| {
+                let (ray, n) = (&rays[px], normals[hit.id as usize]);
+                let (brightness, traced) = if shade {
+                    let p: [f64; 3] = std::array::from_fn(|k| ray.o[k] + hit.dist * ray.d[k]);
+                    let l = normalize(sub(light, p));
+                    let lit = !tracer.shadowed(ray, &hit, light);
+                    (0.12 + if lit { 0.88 * dot(n, l).abs() } else { 0.0 }, 2)
+                } else {
+                    (0.12 + 0.88 * dot(n, ray.d).abs(), 1)
+                };
+                row[px] = (hit.id as i32, hit.dist, brightness as f32, traced);
+            });
+            bar.inc(1);
+            row
+        })
+        .collect();
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    let px = pixels.into_iter();
+    let px = rows.into_iter().flatten();
     let mut f = Frame { width: w, height: h, ids: vec![], depth: vec![], shade: vec![], rays: 0, hits: 0, seconds };
     for (id, d, s, rays) in px {
         f.ids.push(id);
