@@ -5,6 +5,7 @@
 pub mod bench_embree;
 pub mod board;
 pub mod config;
+pub mod demo;
 pub mod run;
 
 use crate::params::{EdgeShift, TreeSplit};
@@ -24,11 +25,11 @@ pub struct Cli {
 }
 
 impl Cli {
-    /// The command given, or the main job on the embedded default: render the teapot to
-    /// teapot.png.
+    /// The command given, or the main job on the embedded default: `fxrt demo` (the core
+    /// generated for the teapot, a frame simulated and checked, both pictures, into fxrt-out/).
     pub fn command_or_default(self) -> Command {
         self.command.unwrap_or_else(|| {
-            let job = Cli::parse_from(["fxrt", "render", "--png", "teapot.png", "--shade", "--size", "512x512"]);
+            let job = Cli::parse_from(["fxrt", "demo"]);
             job.command.expect("the default job is a command")
         })
     }
@@ -42,6 +43,10 @@ pub fn error_line(e: &clap::Error) -> String {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// The whole product on the embedded teapot (what `fxrt` alone runs): the core generated
+    /// in VHDL and Verilog with its ROMs and manifest, a frame through it in the Rust
+    /// simulator checked pixel by pixel against the golden model, both pictures, a summary.
+    Demo(DemoArgs),
     /// Render a scene through a model (golden integer, f64, f32 or watertight).
     Render(RenderArgs),
     /// Quantise a scene, build its BIH and write the ROM images and scene.json.
@@ -61,6 +66,25 @@ pub enum Command {
     /// Image error and hardware cost over lists of n, m, T, C and E: each takes values
     /// `12,16`, ranges `20..29` (inclusive) or steps `0..24:8`; `sweep merge` joins shards.
     Sweep(SweepArgs),
+}
+
+/// `fxrt demo` (and `fxrt` with no arguments).
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Output folder: hdl/ (the core's files), golden.png, hardware.png.
+    #[arg(long, default_value = "fxrt-out")]
+    pub out: PathBuf,
+    /// The simulated frame, WxH (at most 256x256).
+    #[arg(long, value_parser = parse_size, default_value = "128x128")]
+    pub size: (u32, u32),
+}
+
+impl DemoArgs {
+    pub fn config(&self) -> crate::error::Result<demo::DemoConfig> {
+        let (width, height) = self.size;
+        demo::check_size(width, height)?;
+        Ok(demo::DemoConfig { out: self.out.clone(), width, height })
+    }
 }
 
 /// `fxrt sweep`: every parameter takes a list (`12,16,20`), a range (`20..29`, inclusive) or a

@@ -26,6 +26,7 @@ pub fn run(cmd: Command) -> Result<bool> {
     // A misspelt forced path is an input error, not a silent fallback (render::fast).
     crate::render::fast::GoldenPath::from_env()?;
     match cmd {
+        Command::Demo(a) => super::demo::demo(&a.config()?),
         Command::Render(a) => render(&a.config()?).map(|()| true),
         Command::Scene(a) => scene(&a.config()?).map(|()| true),
         Command::Compare(a) => compare(&a.config()?).map(|()| true),
@@ -233,9 +234,21 @@ pub(super) fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen
 /// The whole core's entry of a `fxrt synth --family ecp5` report, checked to be for this scene
 /// and these parameters (`fxrt gen --measured`).
 fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, netlist: &crate::rtl::Module, scene: &str) -> Result<serde_json::Value> {
+    let text = std::fs::read_to_string(file).map_err(|e| Error::file(file, e.to_string()))?;
+    measured_entry(file, &text, p, netlist, scene)
+}
+
+/// The placed and routed core of a `fxrt synth --family ecp5` report (`text`, read from
+/// `file`), when it measured exactly this netlist of this scene and parameters.
+pub(super) fn measured_entry(
+    file: &Path,
+    text: &str,
+    p: &crate::cores::top::CoreParams,
+    netlist: &crate::rtl::Module,
+    scene: &str,
+) -> Result<serde_json::Value> {
     let bad = |msg: String| Error::file(file, msg);
-    let text = std::fs::read_to_string(file).map_err(|e| bad(e.to_string()))?;
-    let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("not a synth report: {e}")))?;
+    let doc: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(format!("not a synth report: {e}")))?;
     let want = serde_json::json!({ "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "e": p.isect.e, "target_mhz": p.isect.target_mhz, "div_bits": p.isect.div_bits });
     let params = &doc["params"];
     for (k, v) in want.as_object().expect("an object") {

@@ -4,8 +4,6 @@ use super::config::*;
 use super::*;
 use crate::error::Result;
 use crate::flow::simulators::Simulator;
-use crate::params::Params;
-use crate::scene::SceneSource;
 use clap::Parser;
 
 #[test]
@@ -63,6 +61,7 @@ fn check(args: &[&str]) -> Result<()> {
         Command::Synth(a) => a.config().map(drop),
         Command::Sim(a) => a.config().map(drop),
         Command::Sweep(a) => a.config().map(drop),
+        Command::Demo(a) => a.config().map(drop),
     }
 }
 
@@ -85,14 +84,14 @@ fn threads_are_1_to_1024_or_all_cores() {
 }
 
 #[test]
-fn the_default_job_renders_the_shaded_teapot() {
-    let Command::Render(a) = command(&[]) else { panic!("not a render") };
+fn the_default_job_is_the_demo() {
+    let Command::Demo(a) = command(&[]) else { panic!("not the demo") };
     let c = a.config().unwrap();
-    assert_eq!(c.scene, SceneSource::Builtin("teapot".into()));
-    assert_eq!(c.files.png, Some(PathBuf::from("teapot.png")));
-    assert!(c.shade && c.files.ids.is_none());
-    assert_eq!((c.camera.width, c.camera.height), (512, 512));
-    assert_eq!(c.params, Params::default());
+    assert_eq!(c.out, PathBuf::from("fxrt-out"));
+    assert_eq!((c.width, c.height), (128, 128));
+    // Its frame stays small enough for the demo's minute.
+    let Command::Demo(a) = command(&["demo", "--size", "257x8"]) else { panic!() };
+    assert!(a.config().unwrap_err().to_string().starts_with("--size: 257x8"));
 }
 
 #[test]
@@ -390,7 +389,7 @@ fn every_command_with_parameters_takes_tree() {
         Command::Synth(a) => a.params.params().unwrap().tree,
         Command::Sim(a) => a.params.params().unwrap().tree,
         Command::Sweep(a) => a.spec().unwrap().defaults().tree,
-        Command::Bench(_) => panic!("bench takes no parameters"),
+        Command::Bench(_) | Command::Demo(_) => panic!("bench and demo take no parameters"),
     };
     for cmd in ["render", "scene", "compare", "gen", "test", "synth", "sim", "sweep"] {
         let out: &[&str] = if matches!(cmd, "sweep" | "scene" | "gen") { &["--out", "x"] } else { &[] };

@@ -1,0 +1,142 @@
+//! `fxrt` with no arguments (and `fxrt demo`): the whole product on the embedded teapot, in one
+//! folder and under a minute. The core is generated in both languages (with its ROM images and
+//! manifest), a frame runs through that same netlist in the Rust simulator, every pixel is
+//! checked against the golden model, and both pictures are written: the golden model's, shaded,
+//! and the one the hardware's hits make.
+
+use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_with};
+use crate::error::{Error, Result};
+use crate::flow::{feed, frame, generate};
+use crate::model::camera::Camera;
+use crate::model::ray::dot;
+use crate::params::Params;
+use crate::render::{self, Frame, tracer::GoldenTracer};
+use crate::scene::images::SceneRoms;
+use crate::scene::{Scene, SceneSource};
+use std::path::{Path, PathBuf};
+
+/// The ray id width of `fxrt gen`'s default, so the simulated core is the generated one.
+const RAY_ID_WIDTH: u32 = 20;
+/// The default build's place-and-route report (scripts/measure-default.sh): its clock is the
+/// demo core's when it measured this very netlist.
+const MEASURED: &str = include_str!("../../generated/measured/ecp5-core.json");
+/// The golden model's picture: larger than the simulated frame, it costs a fraction of a second.
+const PICTURE: u32 = 512;
+
+/// What `demo` is asked for.
+#[derive(Debug, Clone)]
+pub struct DemoConfig {
+    pub out: PathBuf,
+    /// The simulated frame.
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Runs the demo; Ok(false) when a pixel of the simulated core differs from the golden model.
+pub fn demo(c: &DemoConfig) -> Result<bool> {
+    let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default())?;
+    let roms = SceneRoms::of(&scene);
+    let target = crate::cores::clock::DEFAULT_TARGET_MHZ;
+    let p = CoreParams::with_slots(&roms, RAY_ID_WIDTH, 1, target, DEFAULT_SLOTS, DEFAULT_UNITS);
+    p.check()?;
+    super::run::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
+    let netlist = core_module_with(&p, &roms, false);
+    let measured = super::run::measured_entry(Path::new("generated/measured/ecp5-core.json"), MEASURED, &p, &netlist, &roms.name).ok();
+    let o = generate::GenOptions { vhdl: true, verilog: true, ise: false, debug_ports: false, clock_mhz: target as f64 };
+    let hdl = c.out.join("hdl");
+    let mut files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, None, measured.as_ref())
+        .into_iter()
+        .map(|(n, t)| (hdl.join(n), t.into_bytes()))
+        .collect();
+    let hdl_files = files.len();
+
+    // A frame through the core, in the Rust simulator, every pixel against the golden model.
+    let cam = Camera::default_for(&scene, c.width, c.height);
+    let rays = frame::frame_rays(&scene, &cam);
+    let bar = frame::progress_bar(rays.len() as u64, "rust");
+    let (results, stats) = frame::simulate_rust(&p, &roms, &rays, &feed::Stalls::none(), &|n| bar.set_position(n));
+    bar.finish_and_clear();
+    let mismatches = frame::mismatches(&scene, &rays, &results);
+    let ids = frame::ids_image(&scene, c.width, c.height, &results);
+
+    let golden = GoldenTracer::new(&scene);
+    let picture = render::render(&scene, &golden, &Camera::default_for(&scene, PICTURE, PICTURE), true, false);
+    let (golden_png, hardware_png) = (c.out.join("golden.png"), c.out.join("hardware.png"));
+    files.push((golden_png.clone(), picture.png_bytes()));
+    files.push((hardware_png.clone(), hardware_picture(&scene, &cam, ids).png_bytes()));
+    crate::io::write_all_atomic(&files)?;
+
+    let core = format!("fxrt_core_{}", p.trav.scene_tag);
+    let pixels = (c.width * c.height) as u64;
+    println!("fxrt: the embedded teapot ({} triangles) as a ray tracing core, checked in the Rust simulator", roms.tri_count());
+    println!(
+        "  wrote {}: {hdl_files} files, {core} in VHDL-93 and Verilog-2001 with its ROM images and manifest {core}.json",
+        hdl.display()
+    );
+    println!(
+        "  frame {}x{}: {} rays reached the scene box, {:.2} clock cycles per ray ({:.3} rays per clock, {} units × {} slots)",
+        c.width,
+        c.height,
+        stats.rays,
+        stats.cycles_per_ray(),
+        stats.rays_per_clock(),
+        p.units,
+        p.slot_count() / p.units.max(1)
+    );
+    if mismatches == 0 {
+        println!("  every pixel matched the golden model ({pixels} of {pixels})");
+    } else {
+        println!("  MISMATCH: {mismatches} of {pixels} pixels differ from the golden model");
+    }
+    match measured.as_ref().and_then(|m| m["fmax_mhz"].as_f64().map(|f| (f, m))) {
+        Some((fmax, m)) => println!(
+            "  clock: {fmax:.1} MHz placed and routed on the {} (nextpnr, seed {}): {:.1} Mrays/s",
+            m["device"].as_str().unwrap_or("ECP5"),
+            m["seed"],
+            fmax * stats.rays_per_clock()
+        ),
+        None => println!("  clock: not measured for this netlist (scripts/measure-default.sh places and routes it)"),
+    }
+    println!("  pictures: {} (golden model, shaded, {PICTURE}x{PICTURE}), {} (the core's hits)", golden_png.display(), hardware_png.display());
+    println!("next:");
+    for (cmd, what) in [
+        ("fxrt sim --builtin teapot --sim ghdl --size 24x24", "the same check in GHDL (or --sim verilator)"),
+        ("fxrt gen --builtin cornell --out cornell/", "a core for another scene (or: fxrt gen yours.obj --out yours/)"),
+        ("fxrt synth --family ecp5 --modules core --builtin teapot > core.json", "its clock and area, placed and routed"),
+        ("fxrt bench --against-embree", "the golden model against Embree on this CPU"),
+    ] {
+        println!("  {cmd:<68} # {what}");
+    }
+    Ok(mismatches == 0)
+}
+
+/// The core's hits as a picture: each hit pixel shaded by how squarely its ray meets the
+/// triangle the core returned (as `render` without shadows), misses dark.
+fn hardware_picture(scene: &Scene, cam: &Camera, ids: Vec<i32>) -> Frame {
+    let pixel_rays = cam.pixel_rays();
+    let shade = ids
+        .iter()
+        .enumerate()
+        .map(|(i, &id)| match scene.world.get(id as usize) {
+            Some(t) if id >= 0 => {
+                let n = crate::model::ray::normalize(crate::model::ray::cross(
+                    crate::model::ray::sub(t[1], t[0]),
+                    crate::model::ray::sub(t[2], t[0]),
+                ));
+                let d = pixel_rays.ray(i as u32 % cam.width, i as u32 / cam.width).d;
+                (0.12 + 0.88 * dot(n, d).abs()) as f32
+            }
+            _ => -1.0,
+        })
+        .collect();
+    let hits = ids.iter().filter(|&&i| i >= 0).count() as u64;
+    Frame { width: cam.width, height: cam.height, ids, depth: vec![], shade, rays: 0, hits, seconds: 0.0 }
+}
+
+/// `--size` of the demo frame: at most 256 × 256 (the Rust simulator's pace keeps the demo short).
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 || width > 256 || height > 256 {
+        return Err(Error::param("size", format!("{width}x{height}: the demo frame is 1x1 to 256x256")));
+    }
+    Ok(())
+}
