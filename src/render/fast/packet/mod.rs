@@ -67,14 +67,17 @@ impl Kernel {
     }
 }
 
-/// The walk of one packet, as a function `walk` with `$features` enabled, over the lane-wise
-/// operations in scope where it expands: W (a value per lane), Mask (a bit per lane), `to_w`,
-/// `to_a`, `splat`, `splat32` (a factor for `mul32`), add, sub, min, max, bit_and, bit_or,
-/// xor, abs_by (|a| where b has a's sign), mul32 (signed low 32 × low 32 → 64), mul_lo32 (a·b mod 2^64 for 0 ≤ a < 2^32),
-/// div_f64 (floor(a/b) off by at most one for 0 ≤ a, b < 2^63; ≥ 2^32 − 1 or negative when
-/// b = 0 or a/b ≥ 2^32 − 1), sign (−1 or 0), div64 (floor(a/64) for a ≥ 0), sra, sra_small (for |a| < 2^62), sll (by a run-time
-/// count), le, lt, ge, le_unsigned (→ Mask), negative (lanes < 0), blend (b in the mask's
-/// lanes), and the mask operations both, either, any, count, all_if, first.
+/// The walk of one packet, as a function `walk` with `$features` enabled (and `trace`, LANES
+/// rays as packets of PACKET), over the lane-wise operations in scope where it expands:
+/// - W (a value per lane), Mask (a bit per lane), `to_w`, `to_a`, `splat`, `splat32` (a
+///   factor for `mul32`);
+/// - add, sub, min, max, bit_and, bit_or, xor; abs_by (|a| where b has a's sign); mul32
+///   (signed low 32 × low 32 → 64); mul_lo32 (a·b mod 2^64 for 0 ≤ a < 2^32); div_f64
+///   (floor(a/b) off by at most one for 0 ≤ a, b < 2^63; ≥ 2^32 − 1 or negative when b = 0 or
+///   a/b ≥ 2^32 − 1); sign (−1 or 0); div64 (floor(a/64) for a ≥ 0); sra, sra_small (for
+///   |a| < 2^62), sll (by a run-time count);
+/// - le, lt, ge, le_unsigned, negative (→ Mask); blend (b in the mask's lanes); the mask
+///   operations both, either, any, count, all_if, first.
 #[cfg(target_arch = "x86_64")]
 macro_rules! packet_walk {
     ($features:literal) => {
