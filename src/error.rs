@@ -18,6 +18,11 @@ impl Error {
     pub fn file(path: &Path, message: impl Into<String>) -> Self {
         Error::new(path.display().to_string(), message)
     }
+    /// A problem on one line of a file: prints as `path:line: message`, the position
+    /// compilers and HDL tools give, which editors and terminals jump to.
+    pub fn file_line(path: &Path, line: usize, message: impl Into<String>) -> Self {
+        Error::new(format!("{}:{line}", path.display()), message)
+    }
     pub fn param(name: &str, message: impl Into<String>) -> Self {
         Error::new(format!("--{name}"), message)
     }
