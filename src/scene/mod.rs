@@ -5,6 +5,7 @@ pub mod bih;
 pub mod builtin;
 pub mod images;
 pub mod obj;
+mod obj_lines;
 pub mod report;
 pub mod rom;
 
