@@ -156,6 +156,27 @@ fn bad_input_is_exit_2_with_one_line_and_no_output() {
 }
 
 #[test]
+fn a_bad_obj_is_rejected_with_its_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let png = d.join("out.png");
+    let png_s = png.to_str().unwrap();
+    let head = "# a scan\n\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let cases = [
+        ("coord.obj", format!("{head}v 1 abc 0\nf 1 2 4\n"), 7, "'abc'"),
+        ("index.obj", format!("{head}f 1 2 3\nf 1 2 9\n"), 8, "'9'"),
+        ("nan.obj", format!("{head}v nan 0 0\nf 1 2 4\n"), 7, "non-finite"),
+    ];
+    for (name, text, line, token) in cases {
+        let p = write(d, name, text.as_bytes());
+        let at = format!("{p}:{line}: ");
+        assert_rejected(&["render", &p, "--png", png_s], &at, &png);
+        let err = stderr(&fxrt(&["render", &p, "--png", png_s]));
+        assert!(err.contains(token), "{err:?} should contain {token:?}");
+    }
+}
+
+#[test]
 fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("hdl");
