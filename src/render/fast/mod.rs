@@ -4,8 +4,8 @@
 //!   is skipped (exact because of `lower_t`, docs/ARITHMETIC.md);
 //! - an i64 path (`trace_narrow`) where the widths and the scene's values bound every value,
 //!   over a copy of the BIH laid out for speed;
-//! - primary rays traced sixteen to a packet (`packet`) with AVX-512 or AVX2, whichever the
-//!   CPU has (chosen at run time), and with AVX-512 eight rays quantised at once (`quantize8`).
+//! - primary rays traced in packets (`packet`: 16 lanes with AVX-512, 8 with AVX2, whichever
+//!   the CPU has, chosen at run time) after eight rays are quantised at once (`quantize8`).
 //!
 //! The golden model itself (`model::golden`) stays the plain reference.
 
@@ -31,7 +31,8 @@ pub enum GoldenPath {
     Reference,
     /// The i64 path, a ray at a time, no vector instructions (what a CPU without AVX2 runs).
     Scalar,
-    /// AVX2 packets of 16 rays (and the i64 path for rays that do not fit a packet).
+    /// AVX2 packets of 8 rays, eight rays quantised at once (and the i64 path for rays that
+    /// do not fit a packet).
     Avx2,
     /// AVX-512 packets of 16 rays, eight rays quantised at once (and the i64 path for rays
     /// that do not fit a packet).
