@@ -104,7 +104,8 @@ impl Tracer for GoldenTracer<'_> {
                     found(i, self.primary_hit(&QuantizedRay { ray: *ray, t_offset }, h));
                 }
             }
-            (grid.clear(), pixel.clear());
+            grid.clear();
+            pixel.clear();
         };
         let mut keep = |i: usize, q: QuantizedRay| {
             if self.fast.fits(&q.ray) {

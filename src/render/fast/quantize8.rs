@@ -147,9 +147,10 @@ mod avx2 {
             }
         }
         // Both halves computed before any ray is handed on, so that their divisions overlap.
+        type Half = ([__m256d; 3], [__m256d; 3]);
         // SAFETY: [f64; 4] and __m256d are both 32 bytes of plain f64.
-        let halves: [Quantized4; 2] =
-            std::array::from_fn(|h| quantize_ray4(scene, g, unsafe { std::mem::transmute((org[h], dir[h])) }));
+        let half = |h: usize| unsafe { std::mem::transmute::<([[f64; 4]; 3], [[f64; 4]; 3]), Half>((org[h], dir[h])) };
+        let halves: [Quantized4; 2] = std::array::from_fn(|h| quantize_ray4(scene, g, half(h)));
         for (h, q) in halves.iter().enumerate() {
             for l in (0..4).filter(|l| q.misses >> l & 1 == 0) {
                 let ray = GridRay { o: q.origin.map(|v| v[l]), w: q.w.map(|v| v[l]), inv: q.inv.map(|v| v[l] as i128) };
