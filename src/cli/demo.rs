@@ -8,7 +8,6 @@ use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_wi
 use crate::error::{Error, Result};
 use crate::flow::{feed, frame, generate};
 use crate::model::camera::Camera;
-use crate::model::ray::dot;
 use crate::params::Params;
 use crate::render::{self, Frame, tracer::GoldenTracer};
 use crate::scene::images::SceneRoms;
@@ -113,20 +112,13 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
 /// The core's hits as a picture: each hit pixel shaded by how squarely its ray meets the
 /// triangle the core returned (as `render` without shadows), misses dark.
 fn hardware_picture(scene: &Scene, cam: &Camera, ids: Vec<i32>) -> Frame {
-    let pixel_rays = cam.pixel_rays();
+    let (pixel_rays, normals) = (cam.pixel_rays(), render::world_normals(scene));
     let shade = ids
         .iter()
         .enumerate()
-        .map(|(i, &id)| match scene.world.get(id as usize) {
-            Some(t) if id >= 0 => {
-                let n = crate::model::ray::normalize(crate::model::ray::cross(
-                    crate::model::ray::sub(t[1], t[0]),
-                    crate::model::ray::sub(t[2], t[0]),
-                ));
-                let d = pixel_rays.ray(i as u32 % cam.width, i as u32 / cam.width).d;
-                (0.12 + 0.88 * dot(n, d).abs()) as f32
-            }
-            _ => -1.0,
+        .map(|(i, &id)| match usize::try_from(id).ok().and_then(|id| normals.get(id)) {
+            Some(&n) => render::headlight(n, pixel_rays.ray(i as u32 % cam.width, i as u32 / cam.width).d) as f32,
+            None => -1.0,
         })
         .collect();
     let hits = ids.iter().filter(|&&i| i >= 0).count() as u64;

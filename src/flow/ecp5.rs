@@ -39,7 +39,7 @@ impl Tools {
         let chosen = std::env::var_os("FXRT_ECP5_BIN").map(PathBuf::from);
         let dirs: Vec<PathBuf> = match &chosen {
             Some(d) => vec![d.clone()],
-            None => vec![PathBuf::from(".venv/bin"), Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin")],
+            None => super::venv_bins().to_vec(),
         };
         let find = |name: &str| -> Option<PathBuf> {
             // Absolute, as the tools run in the build folder.

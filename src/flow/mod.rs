@@ -17,3 +17,8 @@ pub mod sweep;
 pub mod synth;
 pub mod testbench;
 pub mod vectors;
+
+/// Where scripts/install-deps.sh puts the Python tools: `./.venv/bin`, then the source tree's.
+pub fn venv_bins() -> [std::path::PathBuf; 2] {
+    [std::path::PathBuf::from(".venv/bin"), std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin")]
+}

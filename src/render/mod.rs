@@ -35,11 +35,20 @@ pub fn light_position(cam: &Camera) -> [f64; 3] {
     std::array::from_fn(|k| cam.eye[k] + 0.15 * dist * (r[k] + u[k]))
 }
 
+/// Each input triangle's unit normal (world space), by triangle number.
+pub fn world_normals(scene: &Scene) -> Vec<[f64; 3]> {
+    scene.world.iter().map(|t| normalize(cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect()
+}
+
+/// The unshadowed brightness of a surface of normal `n` seen along `d` (a headlight).
+pub fn headlight(n: [f64; 3], d: [f64; 3]) -> f64 {
+    0.12 + 0.88 * dot(n, d).abs()
+}
+
 pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, progress: bool) -> Frame {
     let (w, h) = (cam.width, cam.height);
     let light = light_position(cam);
-    let normals: Vec<[f64; 3]> =
-        scene.world.iter().map(|t| normalize(cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect();
+    let normals = world_normals(scene);
     let bar = if progress && (w as u64) * (h as u64) >= 1 << 18 {
         indicatif::ProgressBar::new(h as u64)
     } else {
@@ -65,7 +74,7 @@ pub fn render(scene: &Scene, tracer: &dyn Tracer, cam: &Camera, shade: bool, pro
                     let lit = !tracer.shadowed(ray, &hit, light);
                     (0.12 + if lit { 0.88 * dot(n, l).abs() } else { 0.0 }, 2)
                 } else {
-                    (0.12 + 0.88 * dot(n, ray.d).abs(), 1)
+                    (headlight(n, ray.d), 1)
                 };
                 row[px] = (hit.id as i32, hit.dist, brightness as f32, traced);
             });

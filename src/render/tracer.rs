@@ -156,8 +156,7 @@ pub struct FloatTracer<F: Real> {
 
 impl<F: Real> FloatTracer<F> {
     pub fn new(scene: &Scene, test: FloatTest) -> Self {
-        let normals =
-            scene.world.iter().map(|t| normalize(crate::model::ray::cross(sub(t[1], t[0]), sub(t[2], t[0])))).collect();
+        let normals = super::world_normals(scene);
         FloatTracer { fs: FloatScene::new(scene, test), eps: 4.0 / scene.transform.scale, normals }
     }
 }

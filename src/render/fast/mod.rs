@@ -98,14 +98,18 @@ impl<'a> FastGolden<'a> {
     /// The model tracing by `path`; a path that cannot run here falls back to the fastest
     /// (check `path_available` first to know).
     pub fn with_path(scene: &'a Scene, path: GoldenPath) -> Self {
-        let path = if Self::path_available(scene, path) { path } else { GoldenPath::Auto };
+        // The layout is built once; a forced kernel this CPU or these widths cannot run falls
+        // back to the fastest (what `path_available` tells beforehand).
         let layout = if path == GoldenPath::Reference { None } else { FastScene::new(scene) };
-        let kernel = match path {
-            _ if layout.is_none() => None,
-            GoldenPath::Auto => Kernel::best(&scene.params),
+        let forced = match path {
             GoldenPath::Avx2 => Some(Kernel::Avx2),
             GoldenPath::Avx512 => Some(Kernel::Avx512),
+            _ => None,
+        };
+        let kernel = match path {
+            _ if layout.is_none() => None,
             GoldenPath::Reference | GoldenPath::Scalar => None,
+            _ => forced.filter(|k| k.available(&scene.params)).or_else(|| Kernel::best(&scene.params)),
         };
         FastGolden { scene, golden: Golden::new(scene), layout, kernel }
     }
