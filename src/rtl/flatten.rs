@@ -25,6 +25,10 @@ pub struct Flat {
     pub mems: Vec<FlatMem>,
     /// Slot of each signal of the top module, by `SigId`.
     pub top: Vec<usize>,
+    /// Every named signal of the hierarchy as `instance/…/signal` with its slot, for probing
+    /// internal state in a debugger or a reproducer (`Sim::probe`); top-level names have no
+    /// prefix.
+    pub names: Vec<(String, usize)>,
 }
 
 enum Global {
@@ -36,14 +40,17 @@ enum Global {
 
 struct Builder {
     signals: Vec<Global>,
+    /// Hierarchical name of each global signal that came from a module's signal list.
+    names: Vec<(String, usize)>,
     mems: Vec<(Vec<u128>, Option<(usize, usize, usize)>)>,
 }
 
 impl Builder {
     /// Adds `m`'s signals, then its instances' (recursively); `drivers` are the global
     /// signals driving `m`'s inputs (None for the top module). Returns `m`'s first number.
-    fn add(&mut self, m: &Module, drivers: Option<&[usize]>) -> usize {
+    fn add(&mut self, m: &Module, drivers: Option<&[usize]>, prefix: &str) -> usize {
         let base = self.signals.len();
+        self.names.extend(m.signals.iter().enumerate().map(|(k, s)| (format!("{prefix}{}", s.name), base + k)));
         let g = |id: SigId| SigId((base + id.0 as usize) as u32);
         self.signals.extend(m.signals.iter().map(|_| Global::Alias(usize::MAX)));
         let mem_base = self.mems.len();
@@ -56,7 +63,7 @@ impl Builder {
             .iter()
             .map(|inst| {
                 let d: Vec<usize> = inst.inputs.iter().map(|&i| g(i).0 as usize).collect();
-                self.add(&inst.module, Some(&d))
+                self.add(&inst.module, Some(&d), &format!("{prefix}{}/", inst.name))
             })
             .collect();
         for (k, s) in m.signals.iter().enumerate() {
@@ -108,8 +115,8 @@ pub fn flatten(m: &Module) -> Flat {
         m.instances.iter().for_each(|i| check_all(&i.module));
     }
     check_all(m);
-    let mut b = Builder { signals: Vec::new(), mems: Vec::new() };
-    b.add(m, None);
+    let mut b = Builder { signals: Vec::new(), names: Vec::new(), mems: Vec::new() };
+    b.add(m, None, "");
     // Slots for real signals, in global order; aliases share their root's slot.
     let mut slot = vec![usize::MAX; b.signals.len()];
     let mut count = 0;
@@ -138,7 +145,8 @@ pub fn flatten(m: &Module) -> Flat {
         .map(|(words, w)| FlatMem { words: words.clone(), write: w.map(|(we, a, d)| (slot[we], slot[a], slot[d])) })
         .collect();
     let comb_order = topological(&defs);
-    Flat { tys, defs, comb_order, mems, top: slot[..m.signals.len()].to_vec() }
+    let names = b.names.into_iter().map(|(name, i)| (name, slot[i])).collect();
+    Flat { tys, defs, comb_order, mems, top: slot[..m.signals.len()].to_vec(), names }
 }
 
 fn is_comb(d: &Def) -> bool {

@@ -43,6 +43,8 @@ pub struct Sim {
     writes: Vec<(usize, usize, usize, usize)>,
     /// Scratch for the two-phase register update, kept to avoid allocation per cycle.
     next: Vec<u128>,
+    /// Hierarchical signal names (`flatten::Flat::names`), sorted, for `probe`.
+    names: Vec<(String, usize)>,
     /// The `rst` input of the module.
     pub reset: bool,
     pub cycles: u64,
@@ -94,8 +96,10 @@ impl Sim {
         let writes =
             flat.mems.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, we, a, d))).collect();
         let next = vec![0; regs.len() + rom_reads.len()];
+        let mut names = flat.names;
+        names.sort();
         let mut sim =
-            Sim { vals, tys, top: flat.top, comb, regs, rom_reads, roms, writes, next, reset: false, cycles: 0 };
+            Sim { vals, tys, top: flat.top, comb, regs, rom_reads, roms, writes, next, names, reset: false, cycles: 0 };
         sim.eval();
         sim
     }
@@ -110,6 +114,14 @@ impl Sim {
     pub fn get(&self, s: Sig) -> i128 {
         let i = self.top[s.id.0 as usize];
         self.tys[i].value(self.vals[i])
+    }
+
+    /// The value of any signal of the hierarchy by its path, `instance/…/signal` (e.g.
+    /// `u_traverse_0/g_slot`), as it is now: for debugging and reproducers, not for ports.
+    pub fn probe(&self, path: &str) -> Option<i128> {
+        let k = self.names.binary_search_by(|(n, _)| n.as_str().cmp(path)).ok()?;
+        let i = self.names[k].1;
+        Some(self.tys[i].value(self.vals[i]))
     }
 
     /// Evaluates all combinational logic from the inputs and the current state.
