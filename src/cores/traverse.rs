@@ -258,7 +258,10 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let (push_w, push_addr, push_data) =
         (b.wire("stack_we", bit), b.wire("stack_waddr", stack_addr_ty), b.wire("stack_wdata", Ty::u(stack_w)));
     let raddr = b.cat(&[a_slot, a_sp_m1.resize(stack_bits)]).name("stack_raddr");
-    let top = bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, (k as usize) << stack_bits, push_w, push_addr, push_data, raddr);
+    // One stack of 2^stack_bits words per slot number the address can hold: a slot number has
+    // at least one bit, so one slot still takes two stacks' worth of address space.
+    let stack_words = (k.max(2) as usize) << stack_bits;
+    let top = bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, stack_words, push_w, push_addr, push_data, raddr);
     let bt = Token {
         valid: b.valid_delay("b_valid", (a_valid & !a_done).name("a_live")),
         slot: b.delay("b_slot", a_slot),
@@ -355,13 +358,12 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let tmax_p1 = b.delay("tmax_p1", (nt.tmax + 1).name("tmax_plus_1"));
     let tmin_m1 = b.delay("tmin_m1", (nt.tmin - 1).name("tmin_minus_1"));
     let tmin_le_tmax = b.delay("tmin_le_tmax", lt_chain(tmin1, tmax_p1).name("tmin_le_tmax_c"));
-    let neg2 = b.delay("negative_n2", neg1);
     let (tmin2, tmax2, tmax_p1_2, tmin_m1_2) =
         (b.delay("tmin_n2", tmin1), b.delay("tmax_n2", tmax1), b.delay("tmax_p1_n2", tmax_p1), b.delay("tmin_m1_n2", tmin_m1));
     let never_below = tmax2.k(-(1i128 << (n + 2)));
     let never_above = tmax2.k((1i128 << (n + 2)) - 1);
     let limit_reg = |name: &str, if_negative: S<'_>, if_positive: S<'_>, never: S<'_>| {
-        let x = tmin_le_tmax.select(neg2.select(if_negative, if_positive), never);
+        let x = tmin_le_tmax.select(neg1.select(if_negative, if_positive), never);
         b.delay_line(name, b.delay(&format!("{name}_n3"), x.name(&format!("{name}_c"))), l - 3)
     };
     let d0_hi = limit_reg("d0_hi", tmax_p1_2, tmax2, never_below);
@@ -449,7 +451,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
 #[cfg(test)]
 mod tests {
     use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
-    use crate::flow::frame::frame_rays;
+    use crate::flow::frame::{PixelRay, frame_rays};
     use crate::model::camera::Camera;
     use crate::model::golden::{Closest, Culled, Golden, Visitor};
     use crate::params::Params;
@@ -472,10 +474,65 @@ mod tests {
         }
     }
 
+    /// Streams `rays` through the whole core (every result taken the clock it is shown) and
+    /// checks that each ray's node visits, seen on the units' observation ports by slot, are
+    /// those of `Golden::trace_culled`, in its order.
+    fn assert_walks_are_the_culled_golden_walks(label: &str, scene: &Scene, rays: &[PixelRay], mhz: u32, slots: u32, units: u32) {
+        let g = Golden::new(scene);
+        let roms = SceneRoms::of(scene);
+        let p = CoreParams::with_slots(&roms, 16, 1, mhz, slots, units);
+        let m = core_module(&p, &roms);
+        let mut sim = Sim::new(&m);
+        let port = |name: &str| {
+            let id = m.outputs.iter().find(|o| o.0 == name).map(|o| o.1);
+            m.handle(id.or_else(|| m.inputs.iter().copied().find(|&i| m.sig(i).name == name)).unwrap())
+        };
+        let ins: Vec<_> = core_inputs(&p).iter().map(|(n, _)| port(n)).collect();
+        let (ready, res_valid, res_id) = (port("ray_ready"), port("res_valid"), port("res_id"));
+        sim.set(port("res_ready"), 1);
+        let (accept, accept_id, slot_out) = (port("accept"), port("accept_id"), port("accept_slot"));
+        let visit: Vec<_> = (0..units)
+            .map(|u| (port(&format!("visit{u}")), port(&format!("visit{u}_slot")), port(&format!("visit{u}_node"))))
+            .collect();
+        let mut walks: Vec<Vec<u32>> = vec![Vec::new(); rays.len()];
+        let mut in_slot = vec![usize::MAX; p.total_slots() as usize];
+        let (mut next, mut done) = (0, 0);
+        let sb = p.trav.slot_bits();
+        while done < rays.len() {
+            let values = rays.get(next).map(|r| ray_inputs(next as u64, &r.ray));
+            for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&vec![0; ins.len()])) {
+                sim.set(*s, *v);
+            }
+            sim.eval();
+            if values.is_some() && sim.get(ready) == 1 {
+                next += 1;
+            }
+            if sim.get(accept) == 1 {
+                in_slot[sim.get(slot_out) as usize] = sim.get(accept_id) as usize;
+            }
+            sim.tick();
+            for (u, &(v, s, node)) in visit.iter().enumerate() {
+                if sim.get(v) == 1 {
+                    let slot = ((u as i128) << sb | sim.get(s)) as usize;
+                    walks[in_slot[slot]].push(sim.get(node) as u32);
+                }
+            }
+            if sim.get(res_valid) == 1 {
+                assert!(sim.get(res_id) < next as i128);
+                done += 1;
+            }
+            assert!(sim.cycles < 2_000_000, "{label}: the core stopped");
+        }
+        for (k, r) in rays.iter().enumerate() {
+            let mut want = Visits(Culled(Closest::new(&g, scene, &r.ray)), Vec::new());
+            g.walk(scene, &r.ray, &mut want);
+            assert_eq!(walks[k], want.1, "{label} at {mhz} MHz, {slots}×{units} slots, ray {k} (pixel {})", r.pixel);
+        }
+    }
+
     /// Every ray of a small frame through the whole core, many at once: each ray's node visits
-    /// (seen on the units' observation ports, by slot) are those of `Golden::trace_culled`, in
-    /// its order — at three clock targets, with few slots (rays wait for slots, slots park
-    /// and are reused) and with several units.
+    /// are those of `Golden::trace_culled`, in its order — at three clock targets, with few
+    /// slots (rays wait for slots, slots park and are reused), one slot, and several units.
     #[test]
     fn every_ray_visits_what_the_culled_golden_walk_visits_in_its_order() {
         let cornell = Params { n: 20, m: 20, ..Params::default() };
@@ -484,60 +541,26 @@ mod tests {
             ("cornell", cornell, 75, 3, 1),
             ("cornell", cornell, 250, 5, 3),
             ("teapot", Params::default(), 200, 2, 4),
+            ("cornell", cornell, 150, 1, 2),
         ] {
             let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
-            let g = Golden::new(&scene);
-            let roms = SceneRoms::of(&scene);
-            let p = CoreParams::with_slots(&roms, 16, 1, mhz, slots, units);
-            let m = core_module(&p, &roms);
-            let mut sim = Sim::new(&m);
-            let port = |name: &str| {
-                let id = m.outputs.iter().find(|o| o.0 == name).map(|o| o.1);
-                m.handle(id.or_else(|| m.inputs.iter().copied().find(|&i| m.sig(i).name == name)).unwrap())
-            };
-            let ins: Vec<_> = core_inputs(&p).iter().map(|(n, _)| port(n)).collect();
-            let (ready, res_valid, res_id) = (port("ray_ready"), port("res_valid"), port("res_id"));
-            // Every result is taken the clock it is shown.
-            sim.set(port("res_ready"), 1);
-            let (accept, accept_id, slot_out) = (port("accept"), port("accept_id"), port("accept_slot"));
-            let visit: Vec<_> = (0..units)
-                .map(|u| (port(&format!("visit{u}")), port(&format!("visit{u}_slot")), port(&format!("visit{u}_node"))))
-                .collect();
             let rays = frame_rays(&scene, &Camera::default_for(&scene, 20, 20));
-            let mut walks: Vec<Vec<u32>> = vec![Vec::new(); rays.len()];
-            let mut in_slot = vec![usize::MAX; p.total_slots() as usize];
-            let (mut next, mut done) = (0, 0);
-            let sb = p.trav.slot_bits();
-            while done < rays.len() {
-                let values = rays.get(next).map(|r| ray_inputs(next as u64, &r.ray));
-                for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&vec![0; ins.len()])) {
-                    sim.set(*s, *v);
-                }
-                sim.eval();
-                if values.is_some() && sim.get(ready) == 1 {
-                    next += 1;
-                }
-                if sim.get(accept) == 1 {
-                    in_slot[sim.get(slot_out) as usize] = sim.get(accept_id) as usize;
-                }
-                sim.tick();
-                for (u, &(v, s, node)) in visit.iter().enumerate() {
-                    if sim.get(v) == 1 {
-                        let slot = ((u as i128) << sb | sim.get(s)) as usize;
-                        walks[in_slot[slot]].push(sim.get(node) as u32);
-                    }
-                }
-                if sim.get(res_valid) == 1 {
-                    assert!(sim.get(res_id) < next as i128);
-                    done += 1;
-                }
-                assert!(sim.cycles < 2_000_000, "{name}: the core stopped");
-            }
-            for (k, r) in rays.iter().enumerate() {
-                let mut want = Visits(Culled(Closest::new(&g, &scene, &r.ray)), Vec::new());
-                g.walk(&scene, &r.ray, &mut want);
-                assert_eq!(walks[k], want.1, "{name} at {mhz} MHz, {slots}×{units} slots, ray {k}");
-            }
+            assert_walks_are_the_culled_golden_walks(name, &scene, &rays, mhz, slots, units);
         }
+    }
+
+    /// Issue 27's small-width disagreement, reduced to two rays: the teapot at n = 4, m = 8,
+    /// pixels 0 and 1 of the default 8×8 view, one unit of two slots. Ray 1 enters node 50
+    /// at tmin = 8 with d0 = 8 (the near child's end equal to tmin, common on a 4-bit grid);
+    /// the near child was skipped when the sign of the ray's direction, which chooses the
+    /// decision limits (d0 ≥ tmin is d0 > tmin − 1), was taken from the token a clock ahead
+    /// of it in the ring instead of its own.
+    #[test]
+    fn each_token_decides_its_step_with_its_own_direction_sign() {
+        let params = Params { n: 4, m: 8, ..Params::default() };
+        let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 8, 8));
+        assert_eq!((rays[0].pixel, rays[1].pixel), (0, 1));
+        assert_walks_are_the_culled_golden_walks("teapot n4 m8", &scene, &rays[..2], 150, 2, 1);
     }
 }
