@@ -216,8 +216,10 @@ pub fn collect_batched(
     let mut finished: Option<u64> = None;
     let mut cycles = 0u64;
     while finished.is_none() {
+        // A few batches at a time: a small frame ends after a few thousand cycles, and every
+        // cycle advanced past its last result is simulated for nothing.
         sim.advance(
-            1 << 16,
+            1 << 10,
             |_, _| 0,
             |c, k, v| {
                 all[k] = v;
