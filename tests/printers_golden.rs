@@ -1,4 +1,4 @@
-//! Golden files: a small design with a pipeline stage, a state machine and a delay line, printed
+//! Golden files: a small design with a pipeline stage, a state machine and delay lines, printed
 //! in both languages and compared with `tests/golden/`. After an intended change to the
 //! printers, rewrite them with `UPDATE_GOLDEN=1 cargo test --test printers_golden` and review
 //! the diff.
@@ -34,9 +34,13 @@ fn demo() -> Module {
     let is_done = m.eq_k("is_done", state, 2);
     m.end_block();
     let go_late = m.delay_line("go_late", go, 3);
+    // A delay line deeper than 64: Verilator does not unroll a longer loop and refuses a
+    // delayed assignment to an array inside one (BLKLOOPINIT), so the printers write no loop.
+    let go_later = m.delay_line("go_later", go, 70);
     m.output("o_high", high);
     m.output("o_done", is_done);
     m.output("o_go_late", go_late);
+    m.output("o_go_later", go_later);
     m
 }
 

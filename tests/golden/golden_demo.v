@@ -7,7 +7,8 @@ module golden_demo (
   input wire [0:0] go,
   output wire [7:0] o_high,
   output wire [0:0] o_done,
-  output wire [0:0] o_go_late
+  output wire [0:0] o_go_late,
+  output wire [0:0] o_go_later
 );
 
   // states of ctl
@@ -23,6 +24,10 @@ module golden_demo (
   integer go_late_i;
   initial for (go_late_i = 1; go_late_i <= 3; go_late_i = go_late_i + 1) go_late_sr[go_late_i] = 1'h0;
   wire [0:0] go_late;
+  (* mem2reg *) reg [0:0] go_later_sr [1:70];
+  integer go_later_i;
+  initial for (go_later_i = 1; go_later_i <= 70; go_later_i = go_later_i + 1) go_later_sr[go_later_i] = 1'h0;
+  wire [0:0] go_later;
 
   // stage square: x squared, high byte
   wire signed [15:0] sq;
@@ -40,11 +45,82 @@ module golden_demo (
 
   // not in a stage or state machine
   assign go_late = go_late_sr[3];
+  assign go_later = go_later_sr[70];
 
   always @(posedge clk) begin : regs
-    for (go_late_i = 3; go_late_i > 1; go_late_i = go_late_i - 1)
-      go_late_sr[go_late_i] <= go_late_sr[go_late_i - 1];
+    go_late_sr[3] <= go_late_sr[2];
+    go_late_sr[2] <= go_late_sr[1];
     go_late_sr[1] <= go;
+    go_later_sr[70] <= go_later_sr[69];
+    go_later_sr[69] <= go_later_sr[68];
+    go_later_sr[68] <= go_later_sr[67];
+    go_later_sr[67] <= go_later_sr[66];
+    go_later_sr[66] <= go_later_sr[65];
+    go_later_sr[65] <= go_later_sr[64];
+    go_later_sr[64] <= go_later_sr[63];
+    go_later_sr[63] <= go_later_sr[62];
+    go_later_sr[62] <= go_later_sr[61];
+    go_later_sr[61] <= go_later_sr[60];
+    go_later_sr[60] <= go_later_sr[59];
+    go_later_sr[59] <= go_later_sr[58];
+    go_later_sr[58] <= go_later_sr[57];
+    go_later_sr[57] <= go_later_sr[56];
+    go_later_sr[56] <= go_later_sr[55];
+    go_later_sr[55] <= go_later_sr[54];
+    go_later_sr[54] <= go_later_sr[53];
+    go_later_sr[53] <= go_later_sr[52];
+    go_later_sr[52] <= go_later_sr[51];
+    go_later_sr[51] <= go_later_sr[50];
+    go_later_sr[50] <= go_later_sr[49];
+    go_later_sr[49] <= go_later_sr[48];
+    go_later_sr[48] <= go_later_sr[47];
+    go_later_sr[47] <= go_later_sr[46];
+    go_later_sr[46] <= go_later_sr[45];
+    go_later_sr[45] <= go_later_sr[44];
+    go_later_sr[44] <= go_later_sr[43];
+    go_later_sr[43] <= go_later_sr[42];
+    go_later_sr[42] <= go_later_sr[41];
+    go_later_sr[41] <= go_later_sr[40];
+    go_later_sr[40] <= go_later_sr[39];
+    go_later_sr[39] <= go_later_sr[38];
+    go_later_sr[38] <= go_later_sr[37];
+    go_later_sr[37] <= go_later_sr[36];
+    go_later_sr[36] <= go_later_sr[35];
+    go_later_sr[35] <= go_later_sr[34];
+    go_later_sr[34] <= go_later_sr[33];
+    go_later_sr[33] <= go_later_sr[32];
+    go_later_sr[32] <= go_later_sr[31];
+    go_later_sr[31] <= go_later_sr[30];
+    go_later_sr[30] <= go_later_sr[29];
+    go_later_sr[29] <= go_later_sr[28];
+    go_later_sr[28] <= go_later_sr[27];
+    go_later_sr[27] <= go_later_sr[26];
+    go_later_sr[26] <= go_later_sr[25];
+    go_later_sr[25] <= go_later_sr[24];
+    go_later_sr[24] <= go_later_sr[23];
+    go_later_sr[23] <= go_later_sr[22];
+    go_later_sr[22] <= go_later_sr[21];
+    go_later_sr[21] <= go_later_sr[20];
+    go_later_sr[20] <= go_later_sr[19];
+    go_later_sr[19] <= go_later_sr[18];
+    go_later_sr[18] <= go_later_sr[17];
+    go_later_sr[17] <= go_later_sr[16];
+    go_later_sr[16] <= go_later_sr[15];
+    go_later_sr[15] <= go_later_sr[14];
+    go_later_sr[14] <= go_later_sr[13];
+    go_later_sr[13] <= go_later_sr[12];
+    go_later_sr[12] <= go_later_sr[11];
+    go_later_sr[11] <= go_later_sr[10];
+    go_later_sr[10] <= go_later_sr[9];
+    go_later_sr[9] <= go_later_sr[8];
+    go_later_sr[8] <= go_later_sr[7];
+    go_later_sr[7] <= go_later_sr[6];
+    go_later_sr[6] <= go_later_sr[5];
+    go_later_sr[5] <= go_later_sr[4];
+    go_later_sr[4] <= go_later_sr[3];
+    go_later_sr[3] <= go_later_sr[2];
+    go_later_sr[2] <= go_later_sr[1];
+    go_later_sr[1] <= go;
   end
 
   // stage square: x squared, high byte
@@ -75,5 +151,6 @@ module golden_demo (
   assign o_high = high;
   assign o_done = is_done;
   assign o_go_late = go_late;
+  assign o_go_later = go_later;
 endmodule
 `default_nettype wire

@@ -11,7 +11,8 @@ entity golden_demo is
     go : in unsigned(0 downto 0);
     o_high : out unsigned(7 downto 0);
     o_done : out unsigned(0 downto 0);
-    o_go_late : out unsigned(0 downto 0)
+    o_go_late : out unsigned(0 downto 0);
+    o_go_later : out unsigned(0 downto 0)
   );
 end entity golden_demo;
 
@@ -27,6 +28,9 @@ architecture rtl of golden_demo is
   type go_late_sr_t is array (1 to 3) of unsigned(0 downto 0);
   signal go_late_sr : go_late_sr_t := (others => (others => '0'));
   signal go_late : unsigned(0 downto 0);
+  type go_later_sr_t is array (1 to 70) of unsigned(0 downto 0);
+  signal go_later_sr : go_later_sr_t := (others => (others => '0'));
+  signal go_later : unsigned(0 downto 0);
 
   -- stage square: x squared, high byte
   signal sq : signed(15 downto 0);
@@ -43,12 +47,15 @@ begin
 
   -- not in a stage or state machine
   go_late <= go_late_sr(3);
+  go_later <= go_later_sr(70);
 
   regs : process (clk)
   begin
     if rising_edge(clk) then
       go_late_sr(2 to 3) <= go_late_sr(1 to 2);
       go_late_sr(1) <= go;
+      go_later_sr(2 to 70) <= go_later_sr(1 to 69);
+      go_later_sr(1) <= go;
     end if;
   end process regs;
 
@@ -87,4 +94,5 @@ begin
   o_high <= high;
   o_done <= is_done;
   o_go_late <= go_late;
+  o_go_later <= go_later;
 end architecture rtl;

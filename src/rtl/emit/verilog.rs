@@ -245,8 +245,12 @@ impl Printer for Verilog {
     }
 
     fn shift(&self, w: &mut CodeWriter, name: &str, src: &str, depth: u32) {
-        w.line(format!("for ({name}_i = {depth}; {name}_i > 1; {name}_i = {name}_i - 1)"));
-        w.indented(|w| w.line(format!("{name}_sr[{name}_i] <= {name}_sr[{name}_i - 1];")));
+        // One statement per register, no loop: Verilator unrolls at most 64 iterations and
+        // refuses a delayed assignment to an array inside a loop it keeps (BLKLOOPINIT), which
+        // a pipeline at n = 40 reached (a 71-deep tag line).
+        for i in (2..=depth).rev() {
+            w.line(format!("{name}_sr[{i}] <= {name}_sr[{}];", i - 1));
+        }
         w.line(format!("{name}_sr[1] <= {src};"));
     }
 
