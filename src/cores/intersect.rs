@@ -46,8 +46,23 @@ impl IntersectParams {
         )
     }
     /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
-    /// parameter to change.
+    /// parameter to change; the standalone pipeline's `--tag-width` is 1..=64 (its test
+    /// vectors carry 64-bit tags).
     pub fn check(&self) -> crate::error::Result<()> {
+        self.check_widths()?;
+        if self.tag_width == 0 || self.tag_width > 64 {
+            return Err(crate::error::Error::param(
+                "tag-width",
+                format!("{} is out of range: must be 1..=64", self.tag_width),
+            ));
+        }
+        Ok(())
+    }
+
+    /// `check` for the pipeline inside the core, whose tag (triangle, leaf entry distance,
+    /// stack pointer, slot, two flags) the core makes itself: up to 88 bits at n = 40, which
+    /// only the signal width bounds.
+    pub fn check_widths(&self) -> crate::error::Result<()> {
         use crate::error::Error;
         let max = crate::rtl::width::MAX_WIDTH;
         let f = self.f();
@@ -68,9 +83,7 @@ impl IntersectParams {
             return Err(Error::param("div-bits", format!("{} is out of range: must be 1 or 2", self.div_bits)));
         }
         self.target().check()?;
-        if self.tag_width == 0 || self.tag_width > 64 {
-            return Err(Error::param("tag-width", format!("{} is out of range: must be 1..=64", self.tag_width)));
-        }
+        assert!((1..=max).contains(&self.tag_width), "a tag of {} bits", self.tag_width);
         Ok(())
     }
 

@@ -101,7 +101,7 @@ impl CoreParams {
 
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
     pub fn check(&self) -> crate::error::Result<()> {
-        self.isect.check()?;
+        self.isect.check_widths()?;
         let w = self.trav.n + 1 + self.trav.inv_width();
         if w > MAX_WIDTH {
             return Err(crate::error::Error::param(
@@ -117,12 +117,19 @@ impl CoreParams {
         if !(1..=4).contains(&self.units) {
             return Err(crate::error::Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
         }
-        // The closest-hit unit keeps a bit per slot in one word.
-        if self.slot_count() > MAX_WIDTH {
+        // The closest-hit unit keeps a bit per global slot number in one word; a unit's slot
+        // numbers take a power of two (3 units × 33 slots are numbered as 3 × 64).
+        if self.total_slots() > MAX_WIDTH {
+            let numbered = if self.total_slots() == self.slot_count() {
+                String::new()
+            } else {
+                format!(", numbered as {} × {}", self.units, 1u32 << self.trav.slot_bits())
+            };
             return Err(crate::error::Error::param(
                 "slots",
                 format!(
-                    "{} units × {} slots = {} ray slots; the closest-hit unit holds at most {MAX_WIDTH}: fewer --slots or --units",
+                    "{} units × {} slots = {} ray slots{numbered}; the closest-hit unit holds at most {MAX_WIDTH}: \
+                     fewer --slots or --units",
                     self.units,
                     self.trav.slots,
                     self.slot_count()
@@ -366,8 +373,21 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let slots = p.total_slots() as usize;
     let o_mem = b.ram("ray_o", 3 * n, vec![0; slots]);
     b.ram_write(o_mem, accept, gslot, b.cat(&[oz, oy, ox]));
-    let w_mem = b.ram("ray_w", 3 * p.isect.m, vec![0; slots]);
-    b.ram_write(w_mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
+    // The directions in one RAM word while three fit a signal (m ≤ 42), else a RAM per axis.
+    let w_rams: Vec<usize> = if 3 * p.isect.m <= MAX_WIDTH {
+        let mem = b.ram("ray_w", 3 * p.isect.m, vec![0; slots]);
+        b.ram_write(mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
+        vec![mem]
+    } else {
+        [("x", wx), ("y", wy), ("z", wz)]
+            .into_iter()
+            .map(|(axis, w)| {
+                let mem = b.ram(&format!("ray_w{axis}"), p.isect.m, vec![0; slots]);
+                b.ram_write(mem, accept, gslot, w.unsigned());
+                mem
+            })
+            .collect()
+    };
 
     // The leaf stream: the leaf in flight (slot, next entry, entries left, tmin, sp), and the
     // next leaf taken, in turn, from a unit's queue when the last entry goes.
@@ -474,11 +494,18 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
     let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
     let o_word = b.delay_line("pipe_o", b.read("ray_o_q", o_mem, emit_slot), trc - 1);
-    let w_word = b.delay_line("pipe_w", b.read("ray_w_q", w_mem, emit_slot), trc - 1);
+    let w_words: Vec<S> = w_rams
+        .iter()
+        .enumerate()
+        .map(|(k, &mem)| {
+            let suffix = if w_rams.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
+            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, emit_slot), trc - 1)
+        })
+        .collect();
     let m = p.isect.m;
     let mut pipe_in = vec![valid_d, tag_d];
     pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
-    pipe_in.extend((0..3).map(|a| w_word.slice(a * m, m).signed()));
+    pipe_in.extend((0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * m, m) } else { w_words[a as usize] }.signed()));
     pipe_in.extend(tri_fields);
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
 
