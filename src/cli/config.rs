@@ -166,6 +166,8 @@ pub enum BenchConfig {
     Sim { vectors: usize, ghdl_vectors: usize },
     /// The agreement property on `netlists` (≥ 1) random netlists.
     Agree { netlists: u64 },
+    /// The differential campaign of the core against the golden model.
+    Exact(crate::flow::exact::Campaign),
 }
 
 impl BenchArgs {
@@ -179,6 +181,7 @@ impl BenchArgs {
         Ok(match self.what {
             BenchWhat::Sim => BenchConfig::Sim { vectors: self.vectors.max(1), ghdl_vectors: self.ghdl_vectors },
             BenchWhat::Agree => BenchConfig::Agree { netlists: self.netlists.max(1) },
+            BenchWhat::Exact => BenchConfig::Exact(super::exact::campaign_config(self)?),
             BenchWhat::Render => {
                 let ((width, height), repeat, t) = (self.size, self.repeat.max(1), threads(self.threads)?);
                 if self.against_embree {

@@ -6,6 +6,7 @@ pub mod bench_embree;
 pub mod board;
 pub mod config;
 pub mod demo;
+pub mod exact;
 pub mod run;
 
 use crate::params::{EdgeShift, TreeSplit};
@@ -552,6 +553,10 @@ pub enum BenchWhat {
     /// The agreement property at length: `--netlists` random netlists, cycle simulator
     /// against batched simulator, every output of every cycle (exit 1 on a difference).
     Agree,
+    /// The differential campaign: random scenes, parameters, core shapes, cameras and feeds,
+    /// every ray through the core in the Rust simulator against the golden model, for
+    /// `--seconds`; the first disagreement is written as a reproducer (exit 1).
+    Exact,
 }
 
 #[derive(Args, Debug)]
@@ -583,6 +588,21 @@ pub struct BenchArgs {
     /// throughputs and their ratio (docs/PERFORMANCE.md).
     #[arg(long = "against-embree")]
     pub against_embree: bool,
+    /// `bench exact`: draw new cases for this many seconds.
+    #[arg(long, default_value_t = 60.0)]
+    pub seconds: f64,
+    /// `bench exact`: at most this many cases (and at most --seconds).
+    #[arg(long)]
+    pub cases: Option<u64>,
+    /// `bench exact`: the campaign's seed; case k is a function of it and k alone.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// `bench exact`: a folder whose .obj files are drawn from too (e.g. ../shared/scenes).
+    #[arg(long, value_name = "DIR")]
+    pub scenes: Option<PathBuf>,
+    /// `bench exact`: where the first disagreement's reproducer is written.
+    #[arg(long, default_value = "fxrt-exact")]
+    pub out: PathBuf,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {

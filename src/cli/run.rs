@@ -123,6 +123,7 @@ fn bench_agree(netlists: u64) -> bool {
 pub fn bench(c: &BenchConfig) -> Result<bool> {
     match *c {
         BenchConfig::Agree { netlists } => return Ok(bench_agree(netlists)),
+        BenchConfig::Exact(ref campaign) => return super::exact::bench_exact(campaign),
         BenchConfig::AgainstEmbree { width, height, threads, repeat } => {
             return super::bench_embree::against_embree(width, height, threads, repeat);
         }
@@ -177,7 +178,9 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
                 rays as f64 / best / 1e6
             );
         }
-        BenchConfig::Agree { .. } | BenchConfig::AgainstEmbree { .. } => unreachable!("answered above"),
+        BenchConfig::Agree { .. } | BenchConfig::AgainstEmbree { .. } | BenchConfig::Exact(_) => {
+            unreachable!("answered above")
+        }
     }
     Ok(true)
 }
@@ -456,6 +459,11 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     }
     crate::io::write_all_atomic(&files)?;
     let counted = c.sim.name() == "rust";
+    // The walk: the core's node steps (counted in the Rust simulator only) and triangle tests
+    // against the golden culled walk's — equal for every shape and feed order when the core
+    // visits what the model specifies.
+    let (golden_steps, golden_tests) = frame::golden_walk(&scene, &rays);
+    let walk_matches = stats.busy_cycles == golden_tests && (!counted || stats.visits + stats.culls == golden_steps);
     let mut line = serde_json::json!({
         "scene": scene.name, "simulator": c.sim.name(), "size": format!("{w}x{h}"),
         "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
@@ -467,6 +475,8 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         // The HDL testbenches count neither node steps nor occupied slots (`CoreStats`): null
         // there rather than a zero that reads as measured.
         "node_steps_per_ray": counted.then(|| (stats.node_steps_per_ray() * 100.0).round() / 100.0),
+        "golden_node_steps_per_ray": (golden_steps as f64 / stats.rays.max(1) as f64 * 100.0).round() / 100.0,
+        "walk_matches": walk_matches,
         "slot_occupancy": counted.then(|| (stats.slot_occupancy() * 10000.0).round() / 10000.0),
         "slots": p.slot_count(), "units": p.units,
         "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
@@ -481,7 +491,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         line[key] = serde_json::json!((mhz / stats.cycles_per_ray() * 1e4).round() / 1e4);
     }
     println!("{line}");
-    Ok(mismatches == 0)
+    Ok(mismatches == 0 && walk_matches)
 }
 
 /// Ok(false): the simulated core disagreed with the golden model somewhere (`--core-sim`).

@@ -285,6 +285,17 @@ pub fn mismatches(scene: &Scene, rays: &[PixelRay], results: &[CoreResult]) -> u
     bad + seen.iter().filter(|&&s| !s).count() as u64
 }
 
+/// The golden culled walk's totals over `rays` (`Golden::trace_culled`, the hardware's walk):
+/// node steps (visits and culled entries) and triangle tests — what the core's observation
+/// ports must count, whatever its shape and the order the rays came in.
+pub fn golden_walk(scene: &Scene, rays: &[PixelRay]) -> (u64, u64) {
+    let g = Golden::new(scene);
+    rays.iter().fold((0, 0), |(steps, tests), r| {
+        let st = g.trace_culled(scene, &r.ray).1;
+        (steps + (st.nodes + st.culled) as u64, tests + st.tri_tests as u64)
+    })
+}
+
 /// W·H input triangle numbers (−1 for a miss) from the core's results, placed by the ray id
 /// each result carries.
 pub fn ids_image(scene: &Scene, width: u32, height: u32, results: &[CoreResult]) -> Vec<i32> {

@@ -5,6 +5,7 @@ pub mod board;
 pub mod check;
 pub mod disturb;
 pub mod embree;
+pub mod exact;
 pub mod ecp5;
 pub mod ecp5_bram;
 pub mod ecp5_carry;

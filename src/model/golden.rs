@@ -8,7 +8,7 @@ use crate::scene::bih::{Node, Step, inner_step};
 
 /// A ray on the grid: origin (n-bit unsigned), direction (m-bit signed, F fraction bits),
 /// reciprocal direction (m+C-bit signed, F+C fraction bits).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct GridRay {
     pub o: [i64; 3],
     pub w: [i64; 3],
@@ -24,7 +24,7 @@ pub struct TriHit {
 }
 
 /// The closest hit of a ray: `tri` indexes the scene's triangle table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct Hit {
     pub tri: u32,
     pub t: i64,
