@@ -511,3 +511,34 @@ fn a_forced_golden_path_renders_the_same_ids() {
     assert!(stderr(&o).contains("$FXRT_GOLDEN_PATH") && stderr(&o).trim_end().lines().count() == 1, "{}", stderr(&o));
     assert!(!bad.exists());
 }
+
+/// Issue 27's small-width case: `fxrt sim --builtin teapot --n 4 --m 8 --size 8x8` exited 1 with
+/// 4 mismatches (the traversal's direction sign a clock late). Now every pixel matches, and the
+/// core's node steps are the golden culled walk's (`walk_matches`, which also decides the exit).
+#[test]
+fn sim_matches_at_small_widths_and_walks_as_the_golden_model() {
+    let o = fxrt(&["sim", "--builtin", "teapot", "--n", "4", "--m", "8", "--size", "8x8"]);
+    assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(line["mismatches"], 0);
+    assert_eq!(line["walk_matches"], true);
+    assert_eq!(line["node_steps_per_ray"], line["golden_node_steps_per_ray"]);
+}
+
+#[test]
+fn bench_exact_refuses_bad_options_naming_them() {
+    for (args, subject) in [
+        (vec!["--seconds", "0"], "--seconds"),
+        (vec!["--seconds", "nan"], "--seconds"),
+        (vec!["--cases", "0"], "--cases"),
+        (vec!["--scenes", "/nonexistent/scenes"], "/nonexistent/scenes"),
+    ] {
+        let mut all = vec!["bench", "exact"];
+        all.extend(&args);
+        let o = fxrt(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with(&format!("fxrt: {subject}")), "{err}");
+    }
+}

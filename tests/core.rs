@@ -12,8 +12,8 @@ mod common;
 use fxrt::cores::top::CoreParams;
 use fxrt::flow::feed::{Stalls, feed_order};
 use fxrt::flow::frame::{
-    CoreResult, PixelRay, binary_png, frame_rays, frame_stream, ids_image, mismatches, run_stream, simulate_hdl,
-    simulate_rust,
+    CoreResult, PixelRay, binary_png, frame_rays, frame_stream, golden_walk, ids_image, mismatches, run_stream,
+    simulate_hdl, simulate_rust,
 };
 use fxrt::flow::simulators::Simulator;
 use fxrt::flow::simulators::parse_summary;
@@ -69,6 +69,26 @@ fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, (leaf_size, slots, 
         stats.slot_occupancy(),
         stats.max_stack_depth
     ));
+}
+
+/// Issue 27's small widths (n = 4 and 8 with m = 8 or 16, other T and C: the traversal took
+/// the ray ahead's direction sign when a plane distance equalled tmin, common on a coarse
+/// grid) and the widths at the ends of the ranges (m = 50: three directions no longer fit one
+/// RAM word; n = 40: a pipeline tag of 70 bits), each an 8² teapot frame in the Rust
+/// simulator: every result and the walk as the golden model's.
+#[test]
+fn rust_teapot_small_and_extreme_widths() {
+    for (n, m, t, c) in [(4, 8, 0, 16), (4, 16, 0, 16), (8, 8, 3, 2), (8, 8, 0, 0), (4, 8, 6, 64), (20, 50, 0, 8), (40, 45, 0, 40)] {
+        let params = Params { n, m, t, c, ..Params::default() };
+        let s = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
+        let roms = SceneRoms::of(&s);
+        let p = CoreParams::with_slots(&roms, 8, 1, DEFAULT, 64, 2);
+        p.check().unwrap();
+        let rays = frame_rays(&s, &Camera::default_for(&s, 8, 8));
+        let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
+        assert_eq!(mismatches(&s, &rays, &results), 0, "n {n} m {m} t {t} c {c}");
+        assert_eq!((stats.visits + stats.culls, stats.busy_cycles), golden_walk(&s, &rays), "n {n} m {m} t {t} c {c}");
+    }
 }
 
 #[test]

@@ -620,6 +620,19 @@ mod tests {
     use crate::params::Params;
     use crate::scene::{Scene, SceneSource};
 
+    /// Three units number their slots as 3 × 2^⌈log2 K⌉: 33 slots each need 192 slot numbers,
+    /// more than the closest-hit unit's 128-bit word (this panicked while building).
+    #[test]
+    fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
+        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let err = CoreParams::with_slots(&roms, 16, 1, 150, 33, 3).check().unwrap_err();
+        assert_eq!(err.subject, "--slots");
+        assert!(err.message.contains("99 ray slots, numbered as 3 × 64"), "{err}");
+        CoreParams::with_slots(&roms, 16, 1, 150, 32, 3).check().unwrap();
+        CoreParams::with_slots(&roms, 16, 1, 150, 42, 2).check().unwrap();
+    }
+
     #[test]
     fn a_small_frame_matches_the_golden_model() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
