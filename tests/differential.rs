@@ -30,6 +30,7 @@ fn a_short_campaign_finds_no_disagreement() {
         max_cases: Some(24),
         files,
         out: out.path().to_path_buf(),
+        hdl: None,
     };
     let r = exact::campaign(&c, &|_, _| {}).unwrap();
     assert_eq!(r.cases, 24);
@@ -66,7 +67,7 @@ fn an_interior_at_default_parameters_matches_and_walks_as_specified() {
 fn a_reproducer_is_self_contained() {
     let out = tempfile::tempdir().unwrap();
     // The first case of seed 5 that runs (a random scene, drawn fresh).
-    let run = (0..20).map(|i| exact::run_case(5, i, &[])).find(|r| matches!(r.verdict, Verdict::Ran(_))).unwrap();
+    let run = (0..20).map(|i| exact::run_case(5, i, &[], None)).find(|r| matches!(r.verdict, Verdict::Ran(_))).unwrap();
     let Verdict::Ran(outcome) = &run.verdict else { unreachable!() };
     assert!(matches!(run.case.scene, draw::CaseScene::Random { .. }) || matches!(run.case.scene, draw::CaseScene::Builtin(_)));
     let dir = repro::write(out.path(), &run).unwrap();
@@ -85,4 +86,19 @@ fn a_reproducer_is_self_contained() {
     assert!((steps - outcome.core_walk.0 as f64).abs() < 0.01 * outcome.rays as f64);
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("case.json")).unwrap()).unwrap();
     assert_eq!(json["command"], command.trim_end());
+}
+
+/// A case also run in Verilator (`--hdl verilator`): the HDL gives the Rust simulator's results
+/// in the same order and in the same cycles, and its testbench checks each against the golden
+/// model. (Verilator first refused the n = 40 pipeline's 71-deep tag line this way.)
+#[test]
+fn a_case_runs_in_verilator_as_in_the_rust_simulator() {
+    if !fxrt::flow::simulators::Simulator::Verilator.available() {
+        common::say("skipped: verilator is not installed");
+        return;
+    }
+    let run = exact::run_case(3, 0, &[], Some(fxrt::flow::simulators::Simulator::Verilator));
+    let Verdict::Ran(o) = &run.verdict else { panic!("case 0 of seed 3 runs: {:?}", run.verdict) };
+    assert_eq!(o.hdl, Some(fxrt::flow::simulators::Simulator::Verilator));
+    assert!(o.agrees() && o.rays > 0, "{o:?}");
 }

@@ -5,6 +5,7 @@
 use super::BenchArgs;
 use crate::error::{Error, Result};
 use crate::flow::exact::{Campaign, campaign};
+use crate::flow::simulators::Simulator;
 
 /// The campaign `bench exact` runs; errors name the option.
 pub fn campaign_config(a: &BenchArgs) -> Result<Campaign> {
@@ -30,7 +31,30 @@ pub fn campaign_config(a: &BenchArgs) -> Result<Campaign> {
             files
         }
     };
-    Ok(Campaign { seed: a.seed, budget: std::time::Duration::from_secs_f64(a.seconds), max_cases: a.cases, files, out: a.out.clone() })
+    let hdl = match a.hdl {
+        None => None,
+        Some(super::FrameSim::Rust) => {
+            return Err(Error::param("hdl", "rust is the campaign's own simulator: give ghdl or verilator"));
+        }
+        Some(super::FrameSim::Ghdl) => Some(Simulator::Ghdl),
+        Some(super::FrameSim::Verilator) => Some(Simulator::Verilator),
+    };
+    if let Some(sim) = hdl {
+        if !sim.available() {
+            return Err(Error::param("hdl", format!("{} is not installed (scripts/install-deps.sh installs it)", sim.name())));
+        }
+        if a.hdl_every == 0 {
+            return Err(Error::param("hdl-every", "0 is out of range: must be at least 1"));
+        }
+    }
+    Ok(Campaign {
+        seed: a.seed,
+        budget: std::time::Duration::from_secs_f64(a.seconds),
+        max_cases: a.cases,
+        files,
+        out: a.out.clone(),
+        hdl: hdl.map(|s| (s, a.hdl_every)),
+    })
 }
 
 /// Runs the campaign; Ok(false) when the core (or the model with itself) disagreed.
@@ -53,7 +77,7 @@ pub fn bench_exact(c: &Campaign) -> Result<bool> {
         "cases": report.cases, "refused": report.refused, "refused_by": report.refused_by,
         "rays": report.rays, "cycles": report.cycles,
         "scenes": report.scenes, "parameter_sets": report.parameter_sets, "shapes": report.shapes,
-        "inside_cameras": report.inside_cameras,
+        "inside_cameras": report.inside_cameras, "hdl_cases": report.hdl_cases,
         "findings": report.findings, "disagreeing_rays": report.disagreeing_rays, "panics": report.panics,
         "first_disagreement": first,
     });

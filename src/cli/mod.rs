@@ -603,6 +603,14 @@ pub struct BenchArgs {
     /// `bench exact`: where the first disagreement's reproducer is written.
     #[arg(long, default_value = "fxrt-exact")]
     pub out: PathBuf,
+    /// `bench exact`: run cases in this HDL simulator too (ghdl or verilator), every
+    /// --hdl-every-th case: the same results in the same order and cycles as the Rust simulator.
+    #[arg(long, value_enum)]
+    pub hdl: Option<FrameSim>,
+    /// `bench exact`: with --hdl, cases 0, K, 2K, … run in the HDL simulator (each takes a
+    /// minute or more there).
+    #[arg(long = "hdl-every", value_name = "K", default_value_t = 10)]
+    pub hdl_every: u64,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {

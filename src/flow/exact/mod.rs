@@ -15,7 +15,8 @@ pub mod soups;
 
 use crate::cores::top::CoreParams;
 use crate::flow::feed::{Stalls, feed_order};
-use crate::flow::frame::{PixelRay, frame_rays, simulate_rust};
+use crate::flow::frame::{PixelRay, frame_rays, simulate_hdl, simulate_rust};
+use crate::flow::simulators::Simulator;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::render::fast::FastGolden;
 use crate::scene::images::SceneRoms;
@@ -38,7 +39,7 @@ pub struct RayDisagreement {
 }
 
 /// What one case found.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct CaseOutcome {
     pub rays: u64,
     pub cycles: u64,
@@ -51,11 +52,19 @@ pub struct CaseOutcome {
     /// culled walk's over the same rays: equal when the hardware walks as specified.
     pub core_walk: (u64, u64),
     pub golden_walk: (u64, u64),
+    /// The HDL simulator the frame also ran in (`Campaign::hdl`), and what differed there from
+    /// the Rust simulator's run — results, their order, cycles, triangle tests — or why it
+    /// failed; None when it was not run or agreed.
+    pub hdl: Option<Simulator>,
+    pub hdl_disagreement: Option<String>,
 }
 
 impl CaseOutcome {
     pub fn agrees(&self) -> bool {
-        self.disagreeing_rays == 0 && self.stray_results == 0 && self.core_walk == self.golden_walk
+        self.disagreeing_rays == 0
+            && self.stray_results == 0
+            && self.core_walk == self.golden_walk
+            && self.hdl_disagreement.is_none()
     }
 }
 
@@ -114,11 +123,31 @@ fn estimated_cycles(scene: &Scene, rays: &[PixelRay], shape: draw::Shape) -> u64
     steps * 25 / parallel + tests * 20 / parallel + tests
 }
 
-/// Runs a built case through the core in the Rust simulator and compares every ray.
-pub fn run(case: &Case, b: &Built) -> CaseOutcome {
+/// Runs a built case through the core in the Rust simulator and compares every ray; with
+/// `hdl`, the same frame in that simulator too, which must give the same results in the same
+/// order, in the same cycles (its testbench checks every result against the golden model).
+pub fn run(case: &Case, b: &Built, hdl: Option<Simulator>) -> CaseOutcome {
     let stalls = case.stalls.map_or_else(Stalls::none, |(percent, seed)| Stalls::random(percent, seed));
     let (results, stats) = simulate_rust(&b.core, &b.roms, &b.rays, &stalls, &|_| {});
-    compare(&b.scene, &b.rays, &results, (stats.visits + stats.culls, stats.busy_cycles), stats.cycles)
+    let mut out = compare(&b.scene, &b.rays, &results, (stats.visits + stats.culls, stats.busy_cycles), stats.cycles);
+    if let Some(sim) = hdl {
+        out.hdl = Some(sim);
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        out.hdl_disagreement = match simulate_hdl(sim, &b.core, &b.scene, &b.rays, &stalls, dir.path()) {
+            Err(e) => Some(e.to_string()),
+            Ok((r, _)) if r != results => Some(format!("{} results differ from the Rust simulator's", sim.name())),
+            Ok((_, st)) if (st.cycles, st.busy_cycles) != (stats.cycles, stats.busy_cycles) => Some(format!(
+                "{}: {} cycles and {} triangle tests, the Rust simulator {} and {}",
+                sim.name(),
+                st.cycles,
+                st.busy_cycles,
+                stats.cycles,
+                stats.busy_cycles
+            )),
+            Ok(_) => None,
+        };
+    }
+    out
 }
 
 /// Every ray's result against the golden model; the core's walk totals against the culled
@@ -150,6 +179,8 @@ pub fn compare(
         stray_results: stray,
         core_walk,
         golden_walk: (0, 0),
+        hdl: None,
+        hdl_disagreement: None,
     };
     for (k, r) in rays.iter().enumerate() {
         let (golden, st) = g.trace_culled(scene, &r.ray);
@@ -194,15 +225,16 @@ impl CaseRun {
     }
 }
 
-/// Draws, builds and runs case `index`, catching a panic as a finding.
-pub fn run_case(seed: u64, index: u64, files: &[PathBuf]) -> CaseRun {
+/// Draws, builds and runs case `index` (with `hdl`, in that simulator too), catching a panic
+/// as a finding.
+pub fn run_case(seed: u64, index: u64, files: &[PathBuf], hdl: Option<Simulator>) -> CaseRun {
     let mut case = draw::case(seed, index, files);
     let tris = match triangles(&case.scene) {
         Ok(t) => t,
         Err(e) => return CaseRun { case, tris: None, verdict: Verdict::Refused(e) },
     };
     let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        build(&mut case, tris.clone()).map(|b| run(&case, &b))
+        build(&mut case, tris.clone()).map(|b| run(&case, &b, hdl))
     }));
     let verdict = match attempt {
         Ok(Ok(outcome)) => Verdict::Ran(outcome),
@@ -231,6 +263,8 @@ pub struct Campaign {
     pub files: Vec<PathBuf>,
     /// Where the first disagreement's reproducer goes.
     pub out: PathBuf,
+    /// Every `hdl.1`-th case (0, k, 2k, …) also runs in HDL simulator `hdl.0`.
+    pub hdl: Option<(Simulator, u64)>,
 }
 
 /// What a campaign did.
@@ -248,6 +282,8 @@ pub struct Report {
     pub parameter_sets: usize,
     pub shapes: usize,
     pub inside_cameras: u64,
+    /// Cases that also ran in the HDL simulator.
+    pub hdl_cases: u64,
     /// Cases with a wrong result, walk or panic, and rays with a wrong result.
     pub findings: u64,
     pub disagreeing_rays: u64,
@@ -270,7 +306,8 @@ pub fn campaign(c: &Campaign, progress: &dyn Fn(u64, u64)) -> crate::error::Resu
     let mut first: Option<CaseRun> = None;
     while start.elapsed() < c.budget && c.max_cases.is_none_or(|m| next < m) && first.is_none() {
         let count = c.max_cases.map_or(batch, |m| batch.min(m - next));
-        let runs: Vec<CaseRun> = (next..next + count).into_par_iter().map(|i| run_case(c.seed, i, &c.files)).collect();
+        let runs: Vec<CaseRun> = (next..next + count).into_par_iter().map(|i| run_case(c.seed, i, &c.files, c.hdl.filter(|h| i % h.1 == 0).map(|h| h.0)))
+            .collect();
         next += count;
         for run in runs {
             report.cases += 1;
@@ -283,6 +320,7 @@ pub fn campaign(c: &Campaign, progress: &dyn Fn(u64, u64)) -> crate::error::Resu
                     report.rays += o.rays;
                     report.cycles += o.cycles;
                     report.inside_cameras += run.case.inside as u64;
+                    report.hdl_cases += o.hdl.is_some() as u64;
                     report.disagreeing_rays += o.disagreeing_rays;
                     scenes.insert(run.case.scene.label());
                     params.insert(format!("{:?}", run.case.params));

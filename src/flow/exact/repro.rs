@@ -26,8 +26,8 @@ pub fn obj_text(tris: &[crate::scene::Tri]) -> String {
     s
 }
 
-/// The `fxrt sim` arguments that run `case` on `obj`.
-pub fn sim_command(case: &Case, obj: &Path) -> String {
+/// The `fxrt sim` arguments that run `case` on `obj` (in `hdl`, when given).
+pub fn sim_command(case: &Case, obj: &Path, hdl: Option<crate::flow::simulators::Simulator>) -> String {
     let p = &case.params;
     let s = &case.shape;
     let v = |x: [f64; 3]| format!("{},{},{}", x[0], x[1], x[2]);
@@ -57,6 +57,9 @@ pub fn sim_command(case: &Case, obj: &Path) -> String {
         write!(cmd, " --eye {} --at {} --up {} --fov {} --size {size}", v(cam.eye), v(cam.at), v(cam.up), cam.fov_deg)
             .expect("a String");
     }
+    if let Some(sim) = hdl {
+        write!(cmd, " --sim {}", sim.name()).expect("a String");
+    }
     if let Some(seed) = case.shuffle_seed {
         write!(cmd, " --shuffle-seed {seed}").expect("a String");
     }
@@ -79,7 +82,12 @@ pub fn write(out: &Path, run: &CaseRun) -> Result<PathBuf> {
     if !tris.is_empty() && crate::scene::obj::load_obj(check.path())? != tris {
         return Err(Error::file(&obj_path, "the scene does not read back bit for bit as OBJ"));
     }
-    let command = sim_command(case, &obj_path);
+    // A frame that disagreed only in the HDL simulator is reproduced there.
+    let hdl = match &run.verdict {
+        Verdict::Ran(o) if o.hdl_disagreement.is_some() && o.disagreeing_rays == 0 && o.core_walk == o.golden_walk => o.hdl,
+        _ => None,
+    };
+    let command = sim_command(case, &obj_path, hdl);
     let mut json = serde_json::json!({
         "case": case.index,
         "scene": case.scene.label(),
@@ -99,6 +107,8 @@ pub fn write(out: &Path, run: &CaseRun) -> Result<PathBuf> {
             json["node_steps_and_triangle_tests"] =
                 serde_json::json!({ "core": o.core_walk, "golden_culled_walk": o.golden_walk });
             json["disagreements"] = serde_json::to_value(&o.disagreements).expect("serialisable");
+            json["hdl"] = o.hdl.map(|s| s.name()).into();
+            json["hdl_disagreement"] = o.hdl_disagreement.clone().into();
         }
         Verdict::Panicked(message) => json["panic"] = message.clone().into(),
         Verdict::Refused(e) => json["refused"] = e.to_string().into(),
