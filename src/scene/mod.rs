@@ -186,7 +186,7 @@ pub enum SceneSource {
 
 /// Upper bound on E so that edge quantisation (|Δx| · 2^(E+F), |Δx| < 2^n) fits the model.
 pub fn max_edge_shift(params: &Params) -> u32 {
-    120u32.min(126 - params.n - 1 - params.f())
+    params.max_edge_shift()
 }
 
 /// Seed 003's scene-adaptive edge shift: the largest E with every |e_ik| ≤ 2^−E, limited
