@@ -84,9 +84,24 @@ fn gen_refuses_scene_images_that_are_not_fxrts() {
             "scene.json: ",
             "the node ROM's count field is 4294967295 bits",
         ),
-        ("self", Box::new(|s: &Path| edit_word(s, "node", 0, &[("child", 0)])), "node.hex:2: ", "inner node 0: its children 0 and 1"),
-        ("beyond", Box::new(|s: &Path| edit_word(s, "node", 1, &[("first", 4)])), "node.hex:3: ", "run beyond the 5 of the leaf table"),
-        ("missing", Box::new(|s: &Path| edit_word(s, "leaf", 2, &[("tri", 7)])), "leaf.hex:4: ", "triangle 7 is not in the table of 5"),
+        (
+            "self",
+            Box::new(|s: &Path| edit_word(s, "node", 0, &[("child", 0)])),
+            "node.hex:2: ",
+            "inner node 0: its children 0 and 1",
+        ),
+        (
+            "beyond",
+            Box::new(|s: &Path| edit_word(s, "node", 1, &[("first", 4)])),
+            "node.hex:3: ",
+            "run beyond the 5 of the leaf table",
+        ),
+        (
+            "missing",
+            Box::new(|s: &Path| edit_word(s, "leaf", 2, &[("tri", 7)])),
+            "leaf.hex:4: ",
+            "triangle 7 is not in the table of 5",
+        ),
     ];
     for (name, edit, file, want) in cases {
         let scene = d.join(name);
@@ -129,12 +144,46 @@ fn an_edge_shift_above_the_limit_names_the_limit() {
     let dir = tempfile::tempdir().unwrap();
     let (png, rom, sw) = (dir.path().join("out.png"), dir.path().join("rom"), dir.path().join("sw"));
     let want = "is above 65, the largest E for --n 29 --m 32";
-    refused(&["scene", "--builtin", "thin", "--edge-shift", "120", "--out", rom.to_str().unwrap()], "--edge-shift: 120 ", want, &rom);
-    refused(&["render", "--builtin", "thin", "--edge-shift", "66", "--png", png.to_str().unwrap()], "--edge-shift: 66 ", want, &png);
+    refused(
+        &["scene", "--builtin", "thin", "--edge-shift", "120", "--out", rom.to_str().unwrap()],
+        "--edge-shift: 120 ",
+        want,
+        &rom,
+    );
+    refused(
+        &["render", "--builtin", "thin", "--edge-shift", "66", "--png", png.to_str().unwrap()],
+        "--edge-shift: 66 ",
+        want,
+        &png,
+    );
     let want = "is above 84, the largest E for --n 10 --m 32";
-    refused(&["render", "--builtin", "thin", "--n", "10", "--edge-shift", "85", "--png", png.to_str().unwrap()], "--edge-shift: 85 ", want, &png);
-    refused(&["sweep", "--builtin", "thin", "--edge-shift", "93", "--out", sw.to_str().unwrap()], "sweep: ", "--edge-shift: 93 is above 65", &sw);
+    refused(
+        &["render", "--builtin", "thin", "--n", "10", "--edge-shift", "85", "--png", png.to_str().unwrap()],
+        "--edge-shift: 85 ",
+        want,
+        &png,
+    );
+    refused(
+        &["sweep", "--builtin", "thin", "--edge-shift", "93", "--out", sw.to_str().unwrap()],
+        "sweep: ",
+        "--edge-shift: 93 is above 65",
+        &sw,
+    );
     // The largest E is accepted.
     let o = fxrt(&["scene", "--builtin", "thin", "--edge-shift", "65", "--out", rom.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// m = 43 … 63 passed every width check but panicked building the core (its ray RAM keeps the
+/// three m-bit directions in one word): refused before anything is written, naming --m.
+#[test]
+fn gen_refuses_directions_wider_than_the_ray_ram_word() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hdl");
+    let args =
+        ["gen", "--builtin", "thin", "--n", "40", "--m", "46", "--t", "44", "--c", "0", "--out", out.to_str().unwrap()];
+    refused(&args, "--m: ", "the ray RAM's direction word needs 3m = 138 bits; the RTL layer holds 128", &out);
+    let png = dir.path().join("hits.png");
+    let args = ["sim", "--builtin", "thin", "--size", "4x4", "--m", "43", "--png", png.to_str().unwrap()];
+    refused(&args, "--m: ", "3m = 129 bits", &png);
 }

@@ -102,14 +102,16 @@ impl CoreParams {
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
     pub fn check(&self) -> crate::error::Result<()> {
         self.isect.check()?;
-        let w = self.trav.n + 1 + self.trav.inv_width();
-        if w > MAX_WIDTH {
-            return Err(crate::error::Error::param(
-                "c",
-                format!(
-                    "the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"
-                ),
-            ));
+        // The ray RAM keeps a ray's three directions in one word (m = 43 … 63 passed the
+        // pipeline's limits and panicked building a 3m-bit word).
+        for (param, what, w) in [
+            ("c", "the traversal's plane distance needs n + m + C + 1", self.trav.n + 1 + self.trav.inv_width()),
+            ("m", "the ray RAM's direction word needs 3m", 3 * self.isect.m),
+        ] {
+            if w > MAX_WIDTH {
+                let msg = format!("{what} = {w} bits; the RTL layer holds {MAX_WIDTH}");
+                return Err(crate::error::Error::param(param, msg));
+            }
         }
         if !(1..=64).contains(&self.trav.slots) {
             return Err(crate::error::Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
