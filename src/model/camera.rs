@@ -164,15 +164,7 @@ impl PixelRays {
 
 /// The world-space bounding box of the scene's input triangles.
 pub fn world_bounds(scene: &Scene) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for v in scene.world.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-        }
-    }
-    (lo, hi)
+    crate::scene::world_box(&scene.world)
 }
 
 #[cfg(test)]

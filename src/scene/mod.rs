@@ -180,6 +180,19 @@ pub enum SceneSource {
 pub const MAX_COORDINATE: f64 = 1.6069380442589903e60;
 pub const MIN_EXTENT: f64 = 6.223015277861142e-61;
 
+/// The bounding box (lo, hi) of world-space triangles.
+pub fn world_box(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in tris.iter().flatten() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+    }
+    (lo, hi)
+}
+
 /// The scene's lower corner and extent (its bounding box's longest side), checked against the
 /// limits above; errors name the scene and the real cause.
 fn world_extent(name: &str, world: &[Tri]) -> Result<([f64; 3], f64)> {
@@ -197,14 +210,7 @@ fn world_extent(name: &str, world: &[Tri]) -> Result<([f64; 3], f64)> {
             ));
         }
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for v in world.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-        }
-    }
+    let (lo, hi) = world_box(world);
     let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     if extent == 0.0 {
         return Err(Error::new(name, "the scene has no extent: all vertices are at one point"));
