@@ -5,6 +5,7 @@ pub mod cli;
 pub mod cores;
 pub mod error;
 pub mod flow;
+pub mod fuzzing;
 pub mod io;
 pub mod model;
 pub mod params;

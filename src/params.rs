@@ -104,6 +104,14 @@ impl Params {
         self.m - 1
     }
 
+    /// The largest edge shift E for this n and m: edge quantisation shifts an edge
+    /// |Δx| < 2^n left by E + F, so n + 1 + E + F must fit the model's 126 bits (beyond, the
+    /// shift wraps and the stored edges are garbage). `auto` stays within it; a fixed
+    /// `--edge-shift` above it is refused by `validate`.
+    pub fn max_edge_shift(&self) -> u32 {
+        120u32.min(MODEL_BITS.saturating_sub(self.n + 1 + self.f()))
+    }
+
     /// Checks every range and every cross-parameter limit; the message names the parameter,
     /// the value and the limit.
     pub fn validate(&self) -> Result<()> {
@@ -148,6 +156,21 @@ impl Params {
         if self.t > self.m - 2 {
             return Err(Error::param("t", format!("{} must be at most m−2 = {}", self.t, self.m - 2)));
         }
+        if let EdgeShift::Fixed(e) = self.edge_shift {
+            let max = self.max_edge_shift();
+            if e > max {
+                return Err(Error::param(
+                    "edge-shift",
+                    format!(
+                        "{e} is above {max}, the largest E for --n {} --m {}: edge quantisation needs \
+                         n + 1 + E + F = {} bits; the limit is {MODEL_BITS}",
+                        self.n,
+                        self.m,
+                        self.n + 1 + e + self.f()
+                    ),
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -172,6 +195,31 @@ mod tests {
         assert!(p.validate().unwrap_err().to_string().starts_with("--t: 31"));
         let p = Params { n: 40, m: 64, ..Params::default() };
         assert!(p.validate().unwrap_err().to_string().starts_with("--m: 64"));
+    }
+
+    /// E beyond n + 1 + E + F ≤ 126 made edge quantisation's shift wrap (120 passed for n 29,
+    /// m 32, and `scene` reported no clamped triangle for garbage edges).
+    #[test]
+    fn edge_shift_above_the_width_limit_is_refused() {
+        let at = |n, m, e| Params { n, m, edge_shift: EdgeShift::Fixed(e), ..Params::default() };
+        assert_eq!(at(29, 32, 0).max_edge_shift(), 65);
+        at(29, 32, 65).validate().unwrap();
+        let e = at(29, 32, 66).validate().unwrap_err().to_string();
+        assert!(e.starts_with("--edge-shift: 66 is above 65, the largest E for --n 29 --m 32"), "{e}");
+        assert!(at(29, 32, 120).validate().is_err());
+        // The smallest widths allow the whole documented range but for its top.
+        assert_eq!(at(4, 8, 0).max_edge_shift(), 114);
+        at(4, 8, 114).validate().unwrap();
+        assert!(at(4, 8, 115).validate().is_err());
+        // Every valid set's largest E is valid.
+        for n in 4..=40 {
+            for m in 8..=64 {
+                let p = Params { n, m, t: 0, c: 0, ..Params::default() };
+                if p.validate().is_ok() {
+                    at(n, m, p.max_edge_shift()).validate().unwrap();
+                }
+            }
+        }
     }
 
     #[test]

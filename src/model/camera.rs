@@ -30,7 +30,18 @@ impl CameraSpec {
         }
         cam.up = self.up;
         cam.fov_deg = self.fov;
-        cam.validate().map_err(|(opt, msg)| crate::error::Error::param(opt, msg))?;
+        cam.validate().map_err(|(opt, msg)| match (opt, self.eye, self.at) {
+            // Only --eye was given, and it is the point the camera looks at by default.
+            ("at", Some(_), None) => crate::error::Error::param(
+                "eye",
+                "is the scene's centre, where the camera looks when --at is not given: give --at too",
+            ),
+            // Neither was given: the scene's own camera failed, which names the scene.
+            ("eye" | "at", None, None) => {
+                crate::error::Error::new(&scene.name, format!("the default camera cannot frame the scene: {msg}"))
+            }
+            _ => crate::error::Error::param(opt, msg),
+        })?;
         Ok(cam)
     }
 }
@@ -49,8 +60,10 @@ impl Camera {
     /// Checks that the camera defines a basis; the message names the offending option.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
         let f = sub(self.at, self.eye);
-        if self.eye.iter().chain(&self.at).chain(&self.up).any(|x| !x.is_finite()) {
-            return Err(("eye", "camera coordinates must be finite".into()));
+        for (opt, v) in [("eye", self.eye), ("at", self.at), ("up", self.up)] {
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err((opt, "camera coordinates must be finite".into()));
+            }
         }
         if f == [0.0; 3] {
             return Err(("at", "must differ from --eye".into()));
@@ -151,15 +164,7 @@ impl PixelRays {
 
 /// The world-space bounding box of the scene's input triangles.
 pub fn world_bounds(scene: &Scene) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for v in scene.world.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-        }
-    }
-    (lo, hi)
+    crate::scene::world_box(&scene.world)
 }
 
 #[cfg(test)]
@@ -177,6 +182,35 @@ mod tests {
         assert!(right[0] > 0.0);
         // tan(45°) · 2/3 off-centre at the edge pixel centre.
         assert!((top[1] / -top[2] - 2.0 / 3.0).abs() < 1e-12);
+    }
+
+    /// At the scene limits (`scene::MAX_COORDINATE`, `MIN_EXTENT`) the default camera frames
+    /// the scene: finite, eye apart from at (a 1e-310 extent used to fail as "--at").
+    #[test]
+    fn the_default_camera_frames_scenes_at_the_limits() {
+        use crate::scene::{MAX_COORDINATE, MIN_EXTENT};
+        let spec = CameraSpec { eye: None, at: None, up: [0.0, 1.0, 0.0], fov: 45.0, width: 4, height: 4 };
+        for (a, b) in [(-MAX_COORDINATE, MAX_COORDINATE), (0.0, MIN_EXTENT), (-MIN_EXTENT, 0.0)] {
+            let tris = vec![[[a, a, a], [b, a, a], [a, b, b]]];
+            let s = Scene::build("s", tris, &crate::params::Params::default()).unwrap();
+            let cam = spec.camera(&s).unwrap();
+            assert!(cam.eye != cam.at && cam.ray(0, 0).d.iter().all(|x| x.is_finite()), "{cam:?}");
+        }
+    }
+
+    /// Errors name the option the user gave, or the scene when the camera is its default.
+    #[test]
+    fn camera_errors_name_the_real_cause() {
+        let tris = vec![[[0., 0., 0.], [2., 0., 0.], [0., 2., 2.]]];
+        let s = Scene::build("s.obj", tris, &crate::params::Params::default()).unwrap();
+        let spec =
+            CameraSpec { eye: Some([1.0, 1.0, 1.0]), at: None, up: [0.0, 1.0, 0.0], fov: 45.0, width: 4, height: 4 };
+        let e = spec.camera(&s).unwrap_err().to_string();
+        assert!(e.starts_with("--eye: is the scene's centre"), "{e}");
+        let spec = CameraSpec { eye: None, up: [0.0, f64::INFINITY, 0.0], ..spec };
+        assert!(spec.camera(&s).unwrap_err().to_string().starts_with("--up: "));
+        let spec = CameraSpec { at: Some([f64::NAN, 0.0, 0.0]), up: [0.0, 1.0, 0.0], ..spec };
+        assert!(spec.camera(&s).unwrap_err().to_string().starts_with("--at: "));
     }
 
     #[test]

@@ -466,15 +466,7 @@ mod tests {
     }
 
     fn bbox(tris: &[Tri]) -> (V3, V3) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for v in tris.iter().flatten() {
-            for k in 0..3 {
-                lo[k] = lo[k].min(v[k]);
-                hi[k] = hi[k].max(v[k]);
-            }
-        }
-        (lo, hi)
+        super::super::world_box(tris)
     }
 
     fn assert_close(actual: V3, expected: V3, tol: f64, what: &str) {

@@ -3,9 +3,10 @@
 //! .hex files), so `fxrt gen --scene DIR` builds the core from exactly those ROM contents.
 
 use super::Scene;
+use super::image_check::{self, HexFile};
 use super::rom::{self, Field, Layout, Word};
 use crate::error::{Error, Result};
-use crate::params::{EdgeShift, Params, TreeSplit};
+use crate::params::Params;
 use serde::Deserialize;
 use std::path::Path;
 
@@ -32,26 +33,15 @@ struct JsonField {
 struct JsonRom {
     rom: String,
     width: u32,
+    depth: usize,
     fields: Vec<JsonField>,
 }
 
-#[derive(Deserialize)]
-struct JsonParams {
-    n: u32,
-    m: u32,
-    t: u32,
-    c: u32,
-    leaf_size: u32,
-    stack_depth: u32,
-    #[serde(default)]
-    tree: TreeSplit,
-    edge_shift: serde_json::Value,
-}
-
+/// What `load` reads of scene.json (`report::scene_json` writes more).
 #[derive(Deserialize)]
 struct JsonScene {
     scene: String,
-    params: JsonParams,
+    params: Params,
     edge_shift_used: u32,
     grid_box_hi: [i64; 3],
     roms: Vec<JsonRom>,
@@ -110,82 +100,36 @@ impl SceneRoms {
             .sum()
     }
 
-    /// Reads scene.json and tri.hex, node.hex, leaf.hex from `dir`.
+    /// Reads scene.json and tri.hex, node.hex, leaf.hex from `dir`, and checks that every
+    /// layout, word and value is one fxrt writes (`image_check`) before anything is built from
+    /// them. Errors name the file (and line) at fault.
     pub fn load(dir: &Path) -> Result<SceneRoms> {
         let json_path = dir.join("scene.json");
         let text = std::fs::read_to_string(&json_path).map_err(|e| Error::file(&json_path, e.to_string()))?;
         let j: JsonScene = serde_json::from_str(&text).map_err(|e| Error::file(&json_path, e.to_string()))?;
-        let edge_shift = match &j.params.edge_shift {
-            serde_json::Value::Number(v) => EdgeShift::Fixed(v.as_u64().unwrap_or(0) as u32),
-            _ => EdgeShift::Auto,
-        };
-        let p = &j.params;
-        let params = Params {
-            n: p.n,
-            m: p.m,
-            edge_shift,
-            t: p.t,
-            c: p.c,
-            leaf_size: p.leaf_size,
-            stack_depth: p.stack_depth,
-            tree: p.tree,
-        };
-        params.validate().map_err(|e| Error::file(&json_path, e.to_string()))?;
-        let mut images = Vec::new();
-        for name in ["tri", "node", "leaf"] {
+        let params = j.params;
+        image_check::header(&json_path, &j.scene, &params, j.edge_shift_used, &j.grid_box_hi)?;
+        let hex = [HexFile::read(dir, "tri")?, HexFile::read(dir, "node")?, HexFile::read(dir, "leaf")?];
+        let mut json_layouts = Vec::new();
+        for (&name, file) in ["tri", "node", "leaf"].iter().zip(&hex) {
             let l = j
                 .roms
                 .iter()
                 .find(|r| r.rom == name)
                 .ok_or_else(|| Error::file(&json_path, format!("no layout of the {name} ROM")))?;
-            let fields = l
-                .fields
-                .iter()
-                .map(|f| {
-                    let name = FIELD_NAMES
-                        .iter()
-                        .chain(&["count", "tri"])
-                        .find(|n| **n == f.name)
-                        .ok_or_else(|| Error::file(&json_path, format!("unknown ROM field '{}'", f.name)))?;
-                    Ok(Field { name, lsb: f.lsb, width: f.width, signed: f.signed })
-                })
-                .collect::<Result<Vec<_>>>()?;
-            let hex = dir.join(format!("{name}.hex"));
-            let text = std::fs::read_to_string(&hex).map_err(|e| Error::file(&hex, e.to_string()))?;
-            let digits = l.width.div_ceil(4) as usize;
-            let words = text
-                .lines()
-                .filter(|x| !x.starts_with("//") && !x.trim().is_empty())
-                .enumerate()
-                .map(|(i, x)| {
-                    let x = x.trim();
-                    Word::from_hex(x)
-                        .filter(|_| x.len() == digits)
-                        .ok_or_else(|| Error::file(&hex, format!("word {}: '{x}' is not {digits} hex digits", i + 1)))
-                })
-                .collect::<Result<Vec<Word>>>()?;
-            if words.is_empty() {
-                return Err(Error::file(&hex, "has no words"));
+            if l.depth != file.len() {
+                let msg = format!("has {} words; scene.json gives the {name} ROM {}", file.len(), l.depth);
+                return Err(Error::file(&file.path, msg));
             }
-            let rom_name = match name {
-                "tri" => "tri",
-                "node" => "node",
-                _ => "leaf",
-            };
-            images.push((Layout { rom: rom_name, width: l.width, depth: words.len(), fields }, words));
+            json_layouts.push(Layout { rom: name, width: l.width, depth: l.depth, fields: fields(&json_path, l)? });
         }
         // The hardware is wired from these layouts: they must be exactly the ones fxrt writes
-        // for these parameters and table sizes (a reordered or resized field is an error).
-        let count_bits = images[1].0.fields.iter().find(|f| f.name == "count").map_or(0, |f| f.width);
-        let expected = rom::layouts_for(
-            params.n,
-            params.m,
-            images[0].1.len(),
-            images[1].1.len(),
-            images[2].1.len(),
-            count_bits.max(1),
-        );
-        for ((got, _), want) in images.iter().zip(&expected) {
+        // for these parameters and table sizes (a reordered or resized field is an error). The
+        // count width comes from the file, so it is bounded before any width is summed.
+        let count_bits = json_layouts[1].fields.iter().find(|f| f.name == "count").map_or(1, |f| f.width);
+        image_check::count_width(&json_path, count_bits, hex[2].len())?;
+        let expected = rom::layouts_for(params.n, params.m, hex[0].len(), hex[1].len(), hex[2].len(), count_bits);
+        for (got, want) in json_layouts.iter().zip(&expected) {
             if got.width != want.width || got.fields != want.fields {
                 return Err(Error::file(
                     &json_path,
@@ -196,12 +140,36 @@ impl SceneRoms {
                 ));
             }
         }
-        if j.grid_box_hi.iter().any(|&h| h < 0 || h >= 1i64 << params.n) {
-            return Err(Error::file(&json_path, format!("grid_box_hi does not fit {} bits", params.n)));
-        }
-        let leaf = images.pop().expect("three images");
-        let node = images.pop().expect("three images");
-        let tri = images.pop().expect("three images");
-        Ok(SceneRoms { name: j.scene, params, edge_shift: j.edge_shift_used, box_hi: j.grid_box_hi, tri, node, leaf })
+        let [tri_l, node_l, leaf_l] = expected;
+        let tri_w = hex[0].words(&tri_l)?;
+        let node_w = hex[1].words(&node_l)?;
+        let leaf_w = hex[2].words(&leaf_l)?;
+        image_check::triangles(&hex[0], &tri_l, &tri_w, &params)?;
+        image_check::nodes(&hex[1], &node_l, &node_w, leaf_w.len(), params.stack_depth)?;
+        image_check::leaves(&hex[2], &leaf_l, &leaf_w, tri_w.len())?;
+        Ok(SceneRoms {
+            name: j.scene,
+            params,
+            edge_shift: j.edge_shift_used,
+            box_hi: j.grid_box_hi,
+            tri: (tri_l, tri_w),
+            node: (node_l, node_w),
+            leaf: (leaf_l, leaf_w),
+        })
     }
+}
+
+/// A ROM's fields as scene.json lists them, named by the layouts' own names.
+fn fields(json_path: &Path, l: &JsonRom) -> Result<Vec<Field>> {
+    l.fields
+        .iter()
+        .map(|f| {
+            let name = FIELD_NAMES
+                .iter()
+                .chain(&["count", "tri"])
+                .find(|n| **n == f.name)
+                .ok_or_else(|| Error::file(json_path, format!("unknown ROM field '{}'", f.name)))?;
+            Ok(Field { name, lsb: f.lsb, width: f.width, signed: f.signed })
+        })
+        .collect()
 }

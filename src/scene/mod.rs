@@ -3,6 +3,7 @@
 pub mod accel;
 pub mod bih;
 pub mod builtin;
+mod image_check;
 pub mod images;
 pub mod obj;
 mod obj_lines;
@@ -76,21 +77,7 @@ impl Scene {
         if world.is_empty() {
             return Err(Error::new(name, "no triangles"));
         }
-        if let Some(i) = world.iter().position(|t| t.iter().flatten().any(|x| !x.is_finite())) {
-            return Err(Error::new(name, format!("triangle {i} has a non-finite coordinate")));
-        }
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for v in world.iter().flatten() {
-            for k in 0..3 {
-                lo[k] = lo[k].min(v[k]);
-                hi[k] = hi[k].max(v[k]);
-            }
-        }
-        let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-        if !(extent > 0.0) || !extent.is_finite() {
-            return Err(Error::new(name, "the scene has no extent: all vertices are at one point"));
-        }
+        let (lo, extent) = world_extent(name, &world)?;
         // The scene spans [G, 2^n − 1 − G] on its longest axis: a ray clipped to the grid box
         // then starts at least G units before any surface, so the divider's t ≥ 1 cannot
         // reject a surface lying on the scene's bounding box (a Cornell box seen from outside).
@@ -184,9 +171,65 @@ pub enum SceneSource {
     Builtin(String),
 }
 
+/// The largest magnitude of a world coordinate, 2^200 (≈ 1.6e60), and the smallest extent of
+/// a scene, 2^−200 (≈ 6.2e−61). Within them every world length L of the scene lies in
+/// [2^−200, 2^202) and L^4 in the normal f64 range (2^−1022, 2^1023): squared lengths (the
+/// default camera's radius) and the squared cross products that normalise a triangle's normal
+/// stay finite and non-zero, and the grid scale (2^n − 9)/extent is finite. Beyond them the
+/// scene built "fine" and failed later under another name (--eye, --at) or wrote a null scale.
+pub const MAX_COORDINATE: f64 = 1.6069380442589903e60;
+pub const MIN_EXTENT: f64 = 6.223015277861142e-61;
+
+/// The bounding box (lo, hi) of world-space triangles.
+pub fn world_box(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in tris.iter().flatten() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(v[k]);
+            hi[k] = hi[k].max(v[k]);
+        }
+    }
+    (lo, hi)
+}
+
+/// The scene's lower corner and extent (its bounding box's longest side), checked against the
+/// limits above; errors name the scene and the real cause.
+fn world_extent(name: &str, world: &[Tri]) -> Result<([f64; 3], f64)> {
+    for (i, t) in world.iter().enumerate() {
+        if let Some(x) = t.iter().flatten().find(|x| !x.is_finite()) {
+            return Err(Error::new(name, format!("triangle {i} has a non-finite coordinate ({x})")));
+        }
+        if let Some(x) = t.iter().flatten().find(|x| x.abs() > MAX_COORDINATE) {
+            return Err(Error::new(
+                name,
+                format!(
+                    "coordinates too large: triangle {i} has {x:e}; the scene's coordinates must lie within \
+                     ±2^200 (±{MAX_COORDINATE:.2e}) so that its extent and the squares of its lengths stay finite"
+                ),
+            ));
+        }
+    }
+    let (lo, hi) = world_box(world);
+    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    if extent == 0.0 {
+        return Err(Error::new(name, "the scene has no extent: all vertices are at one point"));
+    }
+    if extent < MIN_EXTENT {
+        return Err(Error::new(
+            name,
+            format!(
+                "the scene's extent {extent:e} is too small to scale onto the grid: it must be at least 2^-200 \
+                 ({MIN_EXTENT:.2e}), so that the squares of its lengths do not vanish"
+            ),
+        ));
+    }
+    Ok((lo, extent))
+}
+
 /// Upper bound on E so that edge quantisation (|Δx| · 2^(E+F), |Δx| < 2^n) fits the model.
 pub fn max_edge_shift(params: &Params) -> u32 {
-    120u32.min(126 - params.n - 1 - params.f())
+    params.max_edge_shift()
 }
 
 /// Seed 003's scene-adaptive edge shift: the largest E with every |e_ik| ≤ 2^−E, limited
@@ -260,6 +303,33 @@ mod tests {
         assert!(Scene::build("x", flat, &p).unwrap_err().message.contains("degenerate"));
         let nan = vec![[[0., 0., f64::NAN], [1., 0., 0.], [0., 1., 0.]]];
         assert!(Scene::build("x", nan, &p).unwrap_err().message.contains("non-finite"));
+    }
+
+    /// Coordinates of ±1e300 built (and failed later as "--eye"), ±1.7e308 overflowed the
+    /// extent into "no extent", a denormal extent wrote a null scale: each now names its cause.
+    #[test]
+    fn extents_beyond_the_limits_name_their_cause() {
+        let p = Params::default();
+        let tri = |a: f64, b: f64| vec![[[a, 0., 0.], [b, 0., 0.], [0., b, 0.]]];
+        for (t, want) in [
+            (tri(-1e300, 1e300), "coordinates too large: triangle 0 has -1e300"),
+            (tri(-1.7e308, 1.7e308), "coordinates too large"),
+            (tri(0.0, 1e-310), "extent 1e-310 is too small to scale onto the grid"),
+            (tri(0.0, MIN_EXTENT / 2.0), "too small to scale"),
+        ] {
+            let e = Scene::build("s.obj", t, &p).unwrap_err().to_string();
+            assert!(e.starts_with("s.obj: ") && e.contains(want), "{e:?} should contain {want:?}");
+        }
+        assert_eq!((MAX_COORDINATE, MIN_EXTENT), (2f64.powi(200), 2f64.powi(-200)));
+        // At the limits the scene builds with a finite, positive scale.
+        for t in [tri(-MAX_COORDINATE, MAX_COORDINATE), tri(0.0, MIN_EXTENT)] {
+            let s = Scene::build("s", t, &p).unwrap();
+            assert!(
+                s.transform.scale.is_finite()
+                    && s.transform.scale > 0.0
+                    && s.transform.min.iter().all(|x| x.is_finite())
+            );
+        }
     }
 
     #[test]

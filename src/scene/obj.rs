@@ -15,7 +15,12 @@ use std::path::Path;
 /// costs exactly the one pass through tobj.
 pub fn load_obj(path: &Path) -> Result<Vec<Tri>> {
     let bytes = std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let text = match std::str::from_utf8(&bytes) {
+    parse_obj(path, &bytes)
+}
+
+/// `load_obj` of the file contents `bytes`; `path` names the file in errors.
+pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<Vec<Tri>> {
+    let text = match std::str::from_utf8(bytes) {
         Ok(text) => text,
         Err(e) => {
             let good = &bytes[..e.valid_up_to()];

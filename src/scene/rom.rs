@@ -126,11 +126,11 @@ pub fn layouts_for(n: u32, m: u32, tris: usize, nodes: usize, leaf_entries: usiz
 pub struct Word(pub Vec<u64>);
 
 impl Word {
-    fn zero(width: u32) -> Word {
+    pub(super) fn zero(width: u32) -> Word {
         Word(vec![0; width.div_ceil(64) as usize])
     }
     /// Stores `value` (two's complement for negatives) in bits [lsb, lsb + width).
-    fn set(&mut self, f: &Field, value: i128) {
+    pub(super) fn set(&mut self, f: &Field, value: i128) {
         let lim_ok = if f.signed {
             value >= -(1i128 << (f.width - 1)) && value < (1i128 << (f.width - 1))
         } else {

@@ -126,7 +126,11 @@ impl<'a> FastGolden<'a> {
 
     /// `Golden::trace`'s answer, bit for bit; the statistics count only what was visited.
     pub fn trace(&self, ray: &GridRay) -> (Option<Hit>, TraversalStats) {
-        if let (Some(fs), Some(nr)) = (&self.layout, NarrowRay::new(&self.golden, ray)) {
+        // The i64 ray only where the layout exists: its widths (`narrow_widths`) are what keep
+        // NarrowRay's shifts by C in range (C = 64 is a valid parameter).
+        if let Some(fs) = &self.layout
+            && let Some(nr) = NarrowRay::new(&self.golden, ray)
+        {
             return trace_narrow(&self.golden, fs, &nr);
         }
         self.golden.trace_culled(self.scene, ray)
@@ -392,9 +396,10 @@ impl NarrowRay {
             && ray.inv.iter().all(|&i| i.unsigned_abs() < 1 << (g.f + g.c))
     }
 
-    /// None when the ray does not fit.
+    /// None when the ray does not fit, or C is too wide for an i64 shift (the fast layout's
+    /// widths have C ≤ 62 − n).
     fn new(g: &Golden, ray: &GridRay) -> Option<NarrowRay> {
-        if !Self::fits(g, ray) {
+        if g.c > 62 || !Self::fits(g, ray) {
             return None;
         }
         let axes: [NarrowAxis; 3] = std::array::from_fn(|k| {
@@ -478,6 +483,28 @@ mod tests {
             let want = g.intersect(&tri, &ray);
             prop_assert_eq!(intersect_narrow(&g, &tri, &nr, 1, g.t_sat - 1, uv_max), want);
             prop_assert_eq!(intersect_narrow(&g, &tri, &nr, lo, hi, uv_max), want.filter(|h| (lo..=hi).contains(&h.t)));
+        }
+    }
+
+    /// C = 64 is valid (with small n and m) but no i64 shift: the fast path must fall back
+    /// to the model without evaluating its i64 ray (a debug build overflowed in `inv >> C`).
+    #[test]
+    fn the_widest_c_falls_back_to_the_model() {
+        for (n, m) in [(4, 8), (20, 40)] {
+            let params = Params { n, m, c: 64, ..Params::default() };
+            let tris = vec![[[0., 0., 0.], [1., 0., 0.], [0., 1., 1.]], [[0., 0., 1.], [1., 1., 0.], [1., 0., 1.]]];
+            let s = crate::scene::Scene::build("wide c", tris, &params).unwrap();
+            let fast = FastGolden::new(&s);
+            assert!(!fast.has_narrow_path());
+            let g = &fast.golden;
+            let hi = (1i64 << n) - 1;
+            for (o, d) in
+                [([hi / 3, hi / 4, 0], [0.1, 0.2, 1.0]), ([hi, hi, hi], [-0.5, -0.6, -0.7]), ([0; 3], [1.0, 0.0, 0.0])]
+            {
+                let ray = g.ray(o, quantize_direction(crate::model::ray::normalize(d), g.f));
+                assert!(NarrowRay::new(g, &ray).is_none());
+                assert_eq!(fast.trace(&ray).0, g.trace(&s, &ray).0);
+            }
         }
     }
 

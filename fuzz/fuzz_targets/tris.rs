@@ -1,0 +1,10 @@
+//! Fuzz target `tris`: the body is `fxrt::fuzzing::tris` (docs/FUZZING.md).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    // An error is a clean refusal (exit code 2 in the command line); only a panic, an abort,
+    // a hang or a runaway allocation is a finding.
+    let _ = fxrt::fuzzing::tris(data);
+});
