@@ -19,20 +19,6 @@ const EXECUTABLE_MODE: u32 = 0o755;
 /// Temporary names: hidden, and recognisably fxrt's if a killed process leaves one behind.
 const TEMP_PREFIX: &str = ".fxrt-";
 
-/// Writes one file atomically: a set of one.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let mut set = OutputSet::new();
-    set.add(path, bytes)?;
-    set.commit()
-}
-
-/// Writes several files as one set.
-pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
-    let mut set = OutputSet::new();
-    set.extend(files.iter().map(|(p, b)| (p, b)))?;
-    set.commit()
-}
-
 /// The files of one command, committed together or not at all (module documentation).
 #[must_use = "an output set writes nothing until it is committed"]
 #[derive(Debug, Default)]

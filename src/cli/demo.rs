@@ -7,6 +7,7 @@
 use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_with};
 use crate::error::{Error, Result};
 use crate::flow::{feed, frame, generate};
+use crate::io::OutputSet;
 use crate::model::camera::Camera;
 use crate::params::Params;
 use crate::render::{self, Frame, tracer::GoldenTracer};
@@ -43,10 +44,9 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let measured = super::run::measured_entry(Path::new("generated/measured/ecp5-core.json"), MEASURED, &p, &netlist, &roms.name).ok();
     let o = generate::GenOptions { vhdl: true, verilog: true, ise: false, debug_ports: false, clock_mhz: target as f64 };
     let hdl = c.out.join("hdl");
-    let mut files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, None, measured.as_ref())
-        .into_iter()
-        .map(|(n, t)| (hdl.join(n), t.into_bytes()))
-        .collect();
+    // Staged now, placed with the pictures only when every pixel has been simulated.
+    let mut files = OutputSet::new();
+    files.extend(generate::core_files(&p, &roms, o, None, measured.as_ref()).into_iter().map(|(n, t)| (hdl.join(n), t)))?;
     let hdl_files = files.len();
 
     // A frame through the core, in the Rust simulator, every pixel against the golden model.
@@ -61,9 +61,9 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let golden = GoldenTracer::new(&scene);
     let picture = render::render(&scene, &golden, &Camera::default_for(&scene, PICTURE, PICTURE), true, false);
     let (golden_png, hardware_png) = (c.out.join("golden.png"), c.out.join("hardware.png"));
-    files.push((golden_png.clone(), picture.png_bytes()));
-    files.push((hardware_png.clone(), hardware_picture(&scene, &cam, ids).png_bytes()));
-    crate::io::write_all_atomic(&files)?;
+    files.add(&golden_png, &picture.png_bytes())?;
+    files.add(&hardware_png, &hardware_picture(&scene, &cam, ids).png_bytes())?;
+    files.commit()?;
 
     let core = format!("fxrt_core_{}", p.trav.scene_tag);
     let pixels = (c.width * c.height) as u64;
