@@ -7,6 +7,7 @@ pub mod board;
 pub mod config;
 pub mod demo;
 pub mod run;
+pub mod sweep_config;
 
 use crate::params::{EdgeShift, TreeSplit};
 use crate::render::tracer::ModelKind;
