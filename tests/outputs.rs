@@ -140,6 +140,34 @@ fn demo_writes_no_hdl_when_its_picture_cannot_be_written() {
 }
 
 #[test]
+fn sim_refuses_an_output_it_cannot_write_before_simulating() {
+    let (dir, blocker) = with_blocker();
+    let d = dir.path();
+    let (build, png) = (d.join("build"), blocker.join("o.png"));
+    // GHDL would compile and run the core in the build folder first; nothing runs.
+    let args = ["sim", "--builtin", "cornell", "--size", "4x4", "--sim", "ghdl", "--build", s(&build), "--png", s(&png)];
+    assert_fails(&args, "F");
+    assert_eq!(tree(d), ["F"]);
+    let below = blocker.join("b");
+    let args = ["sim", "--builtin", "cornell", "--size", "4x4", "--sim", "ghdl", "--build", s(&below)];
+    assert_fails(&args, "F");
+}
+
+#[test]
+fn sweep_with_a_bad_out_prints_only_the_error() {
+    let (dir, blocker) = with_blocker();
+    let out = blocker.join("sw");
+    let err = assert_fails(&["sweep", "--builtin", "cornell", "--m", "16", "--size", "8x8", "--out", s(&out)], "F");
+    assert!(err.starts_with("fxrt: "), "{err}");
+    assert_fails(&["sweep", "--builtin", "cornell", "--m", "16", "--size", "8x8", "--out", s(&blocker)], "F");
+    let cache = blocker.join("cache");
+    let sw = dir.path().join("sw");
+    let args = ["sweep", "--builtin", "cornell", "--size", "8x8", "--out", s(&sw), "--cache", s(&cache)];
+    assert_fails(&args, "F");
+    assert_eq!(tree(dir.path()), ["F"]);
+}
+
+#[test]
 fn sweep_keeps_its_cache_but_writes_no_table_when_one_cannot_be_written() {
     let dir = scratch();
     let out = dir.path().join("sw");

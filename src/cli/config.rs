@@ -1,6 +1,8 @@
 //! Each command's arguments validated into what it runs on: ranges checked, defaults filled
-//! in, the command line's choices mapped to the library's types. Nothing here reads a file or
-//! writes one; what needs the scene (the camera's defaults, widths against the scene's E, the
+//! in, the command line's choices mapped to the library's types. Nothing here writes a file;
+//! output paths are only looked at, so one that can never be written (a folder, a path below a
+//! regular file, two options naming one file) is refused before anything runs. What needs the
+//! scene (the camera's defaults, widths against the scene's E, the
 //! core's memories) is checked in `cli::run` as soon as the scene is loaded, still before
 //! anything is written.
 
@@ -11,6 +13,7 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::flow::simulators::Simulator;
+use crate::io::check_folder;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::params::Params;
 use crate::render::tracer::ModelKind;
@@ -44,10 +47,14 @@ impl Simulation {
     }
 
     /// The build folder of an HDL run: `dir` if given, else `default_root`/SIMULATOR.
-    fn build_dir(self, dir: &Option<PathBuf>, default_root: &str) -> Option<PathBuf> {
+    fn build_dir(self, dir: &Option<PathBuf>, default_root: &str) -> Result<Option<PathBuf>> {
         match self {
-            Simulation::Rust => None,
-            Simulation::Hdl(s) => Some(dir.clone().unwrap_or_else(|| PathBuf::from(default_root).join(s.name()))),
+            Simulation::Rust => Ok(None),
+            Simulation::Hdl(s) => {
+                let dir = dir.clone().unwrap_or_else(|| PathBuf::from(default_root).join(s.name()));
+                check_folder(&dir)?;
+                Ok(Some(dir))
+            }
         }
     }
 }
@@ -81,6 +88,20 @@ pub fn threads(n: Option<usize>) -> Result<Option<usize>> {
     }
 }
 
+/// Output files of one command, (option, path) for those given: each can be written
+/// (`io::check_writable`) and no two name one file.
+pub fn check_outputs(files: &[(&str, &Option<PathBuf>)]) -> Result<()> {
+    let given: Vec<(&str, &PathBuf)> = files.iter().filter_map(|(o, p)| Some((*o, p.as_ref()?))).collect();
+    for (i, &(option, path)) in given.iter().enumerate() {
+        crate::io::check_writable(path)?;
+        let same = |p: &PathBuf| std::path::absolute(p).ok() == std::path::absolute(path).ok();
+        if let Some((other, _)) = given[..i].iter().find(|(_, p)| same(p)) {
+            return Err(Error::param(option, format!("{} is also the --{other} file", path.display())));
+        }
+    }
+    Ok(())
+}
+
 /// Output files of a frame; none is written before everything is computed.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct FrameFiles {
@@ -102,6 +123,7 @@ pub struct RenderConfig {
 
 impl RenderArgs {
     pub fn config(&self) -> Result<RenderConfig> {
+        check_outputs(&[("png", &self.png), ("ids", &self.ids), ("depth", &self.depth)])?;
         Ok(RenderConfig {
             params: self.params.params()?,
             threads: threads(self.threads)?,
@@ -145,6 +167,7 @@ pub struct SceneConfig {
 
 impl SceneArgs {
     pub fn config(&self) -> Result<SceneConfig> {
+        check_folder(&self.out)?;
         Ok(SceneConfig {
             params: self.params.params()?,
             scene: self.scene.source(),
@@ -280,6 +303,7 @@ impl GenArgs {
             return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", self.ray_id_width)));
         }
         crate::cores::clock::ClockTarget(self.target_mhz).check()?;
+        check_folder(&self.out)?;
         Ok(GenConfig {
             scene,
             out: self.out.clone(),
@@ -338,7 +362,7 @@ impl TestArgs {
             sim,
             vectors,
             seed: self.seed,
-            build: sim.build_dir(&self.build, "target/fxrt-test"),
+            build: sim.build_dir(&self.build, "target/fxrt-test")?,
         })
     }
 }
@@ -380,13 +404,9 @@ impl SynthArgs {
                 return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));
             }
         };
-        Ok(SynthConfig {
-            params: self.params.params()?,
-            scene: self.scene.source(),
-            hw: self.hw.clone(),
-            build: self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth")),
-            family,
-        })
+        let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
+        check_folder(&build)?;
+        Ok(SynthConfig { params: self.params.params()?, scene: self.scene.source(), hw: self.hw.clone(), build, family })
     }
 }
 
@@ -428,6 +448,7 @@ impl SimArgs {
     pub fn config(&self) -> Result<SimConfig> {
         let params = self.params.params()?;
         let sim = Simulation::from(self.sim);
+        check_outputs(&[("png", &self.png), ("ids", &self.ids)])?;
         if self.raygen && sim != Simulation::Rust {
             return Err(Error::param("raygen", "runs in the Rust simulator only (--sim rust)"));
         }
@@ -459,7 +480,7 @@ impl SimArgs {
             threads: self.threads,
             png: self.png.clone(),
             ids: self.ids.clone(),
-            build: sim.build_dir(&self.build, "target/fxrt-sim"),
+            build: sim.build_dir(&self.build, "target/fxrt-sim")?,
             clock: match (self.clock_mhz, &self.fmax_json) {
                 (Some(f), _) if !(f.is_finite() && f > 0.0) => {
                     return Err(Error::param("clock-mhz", format!("{f} is out of range: must be > 0")));

@@ -84,6 +84,7 @@ impl DemoArgs {
     pub fn config(&self) -> crate::error::Result<demo::DemoConfig> {
         let (width, height) = self.size;
         demo::check_size(width, height)?;
+        crate::io::check_folder(&self.out)?;
         Ok(demo::DemoConfig { out: self.out.clone(), width, height })
     }
 }

@@ -1,9 +1,10 @@
-//! `fxrt sweep`'s arguments validated: every list parsed and checked and the plan made before
-//! anything runs or is written (`cli::config`).
+//! `fxrt sweep`'s arguments validated: every list parsed and checked, the plan made, the
+//! output and cache folders looked at, before anything runs or is written (`cli::config`).
 
 use super::config::{ECP5_MODULES, threads};
 use super::{SweepAction, SweepArgs};
 use crate::error::{Error, Result};
+use crate::io::check_folder;
 use crate::flow::sweep::{Plan, Shard, SweepSpec};
 use crate::params::Params;
 use std::path::PathBuf;
@@ -36,6 +37,8 @@ pub struct SweepRun {
 impl SweepArgs {
     pub fn config(&self) -> Result<SweepConfig> {
         if let Some(SweepAction::Merge(m)) = &self.action {
+            check_folder(&m.out)?;
+            m.cache.as_deref().map(check_folder).transpose()?;
             return Ok(SweepConfig::Merge { dirs: m.dirs.clone(), out: m.out.clone(), cache: m.cache.clone() });
         }
         let spec = self.spec()?;
@@ -47,8 +50,12 @@ impl SweepArgs {
         if self.emit_slurm && self.shard.is_some() {
             return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
         }
+        // Refused here, before the sweep's first line (the cache folder is made as it starts).
+        let cache = self.cache.clone().unwrap_or_else(|| out.join("cache"));
+        check_folder(&out)?;
+        check_folder(&cache)?;
         Ok(SweepConfig::Run(Box::new(SweepRun {
-            cache: self.cache.clone().unwrap_or_else(|| out.join("cache")),
+            cache,
             spec,
             plan,
             out,
