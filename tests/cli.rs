@@ -259,6 +259,27 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     assert!(stderr(&o).contains("--bram-kbits") && !small.exists(), "{}", stderr(&o));
 }
 
+/// The core's tag width is derived from the scene and the core's shape: gen and sim name the
+/// parameters they have, not the pipeline's --tag-width.
+#[test]
+fn gen_and_sim_name_their_own_parameters_when_the_core_tag_is_too_wide() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hdl");
+    let out_s = out.to_str().unwrap();
+    // teapot: 6,320 triangles (13 bits) + tmin (n + 2 = 42) + stack pointer + slot: 70 bits.
+    let wide = ["--builtin", "teapot", "--n", "40", "--m", "40", "--c", "40"];
+    for args in [[&["gen", "--out", out_s][..], &wide].concat(), [&["sim", "--size", "4x4"][..], &wide].concat()] {
+        assert_rejected(&args, "--n: the core's pipeline tag needs 70 bits", &out);
+        let err = stderr(&fxrt(&args));
+        assert!(!err.contains("tag-width") && err.contains("--slots") && err.contains("--stack-depth"), "{err}");
+    }
+    // 3m = 135 bits of a ray's direction in the core's ray RAM: refused, not a panic.
+    let wide = ["--builtin", "cornell", "--n", "40", "--m", "45", "--c", "40"];
+    for args in [[&["gen", "--out", out_s][..], &wide].concat(), [&["sim", "--size", "4x4"][..], &wide].concat()] {
+        assert_rejected(&args, "--m: the core's ray RAM", &out);
+    }
+}
+
 #[test]
 fn test_command_reports_and_fails_on_nothing_to_run() {
     let o = fxrt(&["test", "--builtin", "cornell", "--vectors", "3000"]);

@@ -354,7 +354,6 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let t = c.hw.threads;
     let core = crate::cores::top::CoreParams::with_slots(&roms, 20, c.hw.div_bits, c.hw.target_mhz, t.slots, t.units);
     core.check()?;
-    core.check()?;
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
     }

@@ -99,12 +99,36 @@ impl CoreParams {
         self.units * self.trav.slots
     }
 
-    /// Rejects what the RTL layer cannot hold, naming the parameter to change.
+    /// Rejects what the RTL layer cannot hold, naming the parameter to change: one the
+    /// command has (the core's tag width is derived from the scene and the core's shape, so
+    /// it is checked here, before the pipeline's own check that names `--tag-width`).
     pub fn check(&self) -> crate::error::Result<()> {
+        use crate::error::Error;
+        let tag = self.tag.width();
+        if tag > 64 {
+            let (t, tv) = (&self.tag, &self.trav);
+            return Err(Error::param(
+                "n",
+                format!(
+                    "the core's pipeline tag needs {tag} bits, at most 64: triangle number {} + leaf distance {} (n + 2) \
+                     + stack pointer {} (--stack-depth {}) + slot {} (--slots {} × --units {}) + 2; \
+                     lower --n, --stack-depth, --slots or --units, or use a scene of fewer triangles",
+                    t.tri_bits, t.tmin_bits, t.sp_bits, tv.stack_depth, t.slot_bits, tv.slots, self.units
+                ),
+            ));
+        }
+        // The core's ray RAM keeps a ray's direction, three m-bit components, in one word.
+        let w = 3 * self.isect.m;
+        if w > MAX_WIDTH {
+            return Err(Error::param(
+                "m",
+                format!("the core's ray RAM holds a direction in 3m = {w} bits; the RTL layer holds {MAX_WIDTH}: --m at most {}", MAX_WIDTH / 3),
+            ));
+        }
         self.isect.check()?;
         let w = self.trav.n + 1 + self.trav.inv_width();
         if w > MAX_WIDTH {
-            return Err(crate::error::Error::param(
+            return Err(Error::param(
                 "c",
                 format!(
                     "the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"
@@ -112,10 +136,10 @@ impl CoreParams {
             ));
         }
         if !(1..=64).contains(&self.trav.slots) {
-            return Err(crate::error::Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
+            return Err(Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
         }
         if !(1..=4).contains(&self.units) {
-            return Err(crate::error::Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
+            return Err(Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
         }
         // The closest-hit unit keeps a bit per slot in one word.
         if self.slot_count() > MAX_WIDTH {
