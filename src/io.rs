@@ -162,7 +162,8 @@ fn keep_old(target: &Path) -> Result<TempPath> {
         r => r,
     };
     let kept = tempfile::Builder::new().prefix(TEMP_PREFIX).suffix(".old").make_in(parent(target), link);
-    let kept = kept.map_err(|e| Error::file(target, format!("cannot replace it (keeping the old file failed): {e}")))?;
+    let kept =
+        kept.map_err(|e| Error::file(target, format!("cannot replace it (keeping the old file failed): {e}")))?;
     Ok(kept.into_temp_path())
 }
 

@@ -42,6 +42,9 @@ fn assert_fails(args: &[&str], subject: &str) -> String {
     err
 }
 
+/// A small sweep: two configurations of 8x8 pixels.
+const SWEEP: [&str; 7] = ["sweep", "--builtin", "cornell", "--m", "16,20", "--size", "8x8"];
+
 /// A scratch folder whose name holds no `.tmp` (tempfile's default), so an error naming a
 /// temporary file stands out.
 fn scratch() -> tempfile::TempDir {
@@ -56,27 +59,38 @@ fn with_blocker() -> (tempfile::TempDir, PathBuf) {
     (dir, blocker)
 }
 
+/// Runs `args`, a command writing into `out`, with its file `blocked` (a path below `out`) an
+/// existing folder: it fails naming that file and leaves nothing in `out` but the folder.
+fn assert_blocked(args: &[&str], out: &Path, blocked: &str) {
+    std::fs::create_dir_all(out.join(blocked)).unwrap();
+    assert_fails(args, blocked);
+    let folders: Vec<String> =
+        Path::new(blocked).ancestors().filter(|a| !a.as_os_str().is_empty()).map(|a| a.display().to_string()).collect();
+    assert_eq!(tree(out), folders.into_iter().rev().collect::<Vec<_>>(), "{args:?} left files in {}", out.display());
+}
+
 #[test]
 fn render_writes_none_of_its_files_when_one_cannot_be_written() {
     let (dir, blocker) = with_blocker();
     let d = dir.path();
     let (png, ids, depth) = (d.join("o.png"), d.join("ids.bin"), blocker.join("d.bin"));
-    let args = ["render", "--builtin", "cornell", "--size", "16x16", "--png", s(&png), "--ids", s(&ids), "--depth", s(&depth)];
+    let render = ["render", "--builtin", "cornell", "--size", "16x16"];
+    let args = [&render[..], &["--png", s(&png), "--ids", s(&ids), "--depth", s(&depth)]].concat();
     assert_fails(&args, "F");
     assert_eq!(tree(d), ["F"]);
     // A target that is a folder is refused the same way.
     let folder = d.join("depth-folder");
     std::fs::create_dir(&folder).unwrap();
-    let args = ["render", "--builtin", "cornell", "--size", "16x16", "--png", s(&png), "--ids", s(&ids), "--depth", s(&folder)];
+    let args = [&render[..], &["--png", s(&png), "--ids", s(&ids), "--depth", s(&folder)]].concat();
     assert_fails(&args, "depth-folder");
     assert_eq!(tree(d), ["F", "depth-folder"]);
     // Files it would have replaced keep their old contents.
     std::fs::write(&png, b"old picture").unwrap();
-    let args = ["render", "--builtin", "cornell", "--size", "16x16", "--png", s(&png), "--depth", s(&depth)];
+    let args = [&render[..], &["--png", s(&png), "--depth", s(&depth)]].concat();
     assert_fails(&args, "F");
     assert_eq!(std::fs::read(&png).unwrap(), b"old picture");
     // Two options naming one file would have the second overwrite the first.
-    let args = ["render", "--builtin", "cornell", "--size", "16x16", "--ids", s(&ids), "--depth", s(&ids)];
+    let args = [&render[..], &["--ids", s(&ids), "--depth", s(&ids)]].concat();
     assert_fails(&args, "ids.bin");
     assert!(!ids.exists());
 }
@@ -95,9 +109,7 @@ fn sim_writes_no_picture_when_its_ids_cannot_be_written() {
 fn scene_writes_no_rom_image_when_scene_json_cannot_be_written() {
     let dir = scratch();
     let out = dir.path().join("s");
-    std::fs::create_dir_all(out.join("scene.json")).unwrap();
-    assert_fails(&["scene", "--builtin", "cornell", "--out", s(&out)], "scene.json");
-    assert_eq!(tree(&out), ["scene.json"]);
+    assert_blocked(&["scene", "--builtin", "cornell", "--out", s(&out)], &out, "scene.json");
     // An --out below a file: nothing at all, and the one line names it.
     let (dir, blocker) = with_blocker();
     assert_fails(&["scene", "--builtin", "cornell", "--out", s(&blocker.join("rom"))], "F");
@@ -110,10 +122,8 @@ fn gen_writes_no_core_file_when_one_of_the_set_cannot_be_written() {
     let out = dir.path().join("hdl");
     // expected.bin, the last file of `--axis-frame`, is a folder: the core's files, written
     // before it, must not stay.
-    std::fs::create_dir_all(out.join("expected.bin")).unwrap();
     let args = ["gen", "--builtin", "cornell", "--size", "4x4", "--axis-frame", "--ise", "--out", s(&out)];
-    assert_fails(&args, "expected.bin");
-    assert_eq!(tree(&out), ["expected.bin"]);
+    assert_blocked(&args, &out, "expected.bin");
 }
 
 #[test]
@@ -125,18 +135,14 @@ fn gen_board_writes_nothing_when_a_file_of_the_design_cannot_be_written() {
     let o = fxrt(&["gen", "--board", "ml509", "--units", "1", "--builtin", "cornell", "--out", s(&probe)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let ucf = tree(&probe).into_iter().find(|f| f.ends_with(".ucf")).expect("a UCF");
-    std::fs::create_dir_all(out.join(&ucf)).unwrap();
-    assert_fails(&["gen", "--board", "ml509", "--units", "1", "--builtin", "cornell", "--out", s(&out)], &ucf);
-    assert_eq!(tree(&out), [ucf]);
+    assert_blocked(&["gen", "--board", "ml509", "--units", "1", "--builtin", "cornell", "--out", s(&out)], &out, &ucf);
 }
 
 #[test]
 fn demo_writes_no_hdl_when_its_picture_cannot_be_written() {
     let dir = scratch();
     let out = dir.path().join("demo");
-    std::fs::create_dir_all(out.join("hardware.png")).unwrap();
-    assert_fails(&["demo", "--size", "4x4", "--out", s(&out)], "hardware.png");
-    assert_eq!(tree(&out), ["hardware.png"]);
+    assert_blocked(&["demo", "--size", "4x4", "--out", s(&out)], &out, "hardware.png");
 }
 
 #[test]
@@ -145,7 +151,8 @@ fn sim_refuses_an_output_it_cannot_write_before_simulating() {
     let d = dir.path();
     let (build, png) = (d.join("build"), blocker.join("o.png"));
     // GHDL would compile and run the core in the build folder first; nothing runs.
-    let args = ["sim", "--builtin", "cornell", "--size", "4x4", "--sim", "ghdl", "--build", s(&build), "--png", s(&png)];
+    let args =
+        ["sim", "--builtin", "cornell", "--size", "4x4", "--sim", "ghdl", "--build", s(&build), "--png", s(&png)];
     assert_fails(&args, "F");
     assert_eq!(tree(d), ["F"]);
     let below = blocker.join("b");
@@ -172,7 +179,7 @@ fn sweep_keeps_its_cache_but_writes_no_table_when_one_cannot_be_written() {
     let dir = scratch();
     let out = dir.path().join("sw");
     std::fs::create_dir_all(out.join("report.md")).unwrap();
-    let o = fxrt(&["sweep", "--builtin", "cornell", "--m", "16,20", "--size", "8x8", "--out", s(&out)]);
+    let o = fxrt(&[&SWEEP[..], &["--out", s(&out)]].concat());
     // The sweep ran (its first line says so); the error is the last line.
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -192,24 +199,19 @@ fn sweep_merge_writes_no_table_when_one_cannot_be_written() {
     for i in 1..=2 {
         let shard = d.join(format!("shard-{i}"));
         let sh = format!("{i}/2");
-        let args = ["sweep", "--builtin", "cornell", "--m", "16,20", "--size", "8x8", "--shard", &sh, "--cache", s(&cache), "--out", s(&shard)];
-        let o = fxrt(&args);
+        let o = fxrt(&[&SWEEP[..], &["--shard", &sh, "--cache", s(&cache), "--out", s(&shard)]].concat());
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let out = d.join("merged");
-    std::fs::create_dir_all(out.join("results.csv")).unwrap();
     let (one, two) = (d.join("shard-1"), d.join("shard-2"));
     let args = ["sweep", "merge", s(&one), s(&two), "--cache", s(&cache), "--out", s(&out)];
-    assert_fails(&args, "results.csv");
-    assert_eq!(tree(&out), ["results.csv"]);
+    assert_blocked(&args, &out, "results.csv");
 }
 
 #[test]
 fn sweep_emit_slurm_writes_no_script_when_one_cannot_be_written() {
     let dir = scratch();
     let out = dir.path().join("sw");
-    std::fs::create_dir_all(out.join("slurm/commands.txt")).unwrap();
     let args = ["sweep", "--builtin", "cornell", "--m", "16,20", "--emit-slurm", "--shards", "2", "--out", s(&out)];
-    assert_fails(&args, "commands.txt");
-    assert_eq!(tree(&out), ["slurm", "slurm/commands.txt"]);
+    assert_blocked(&args, &out, "slurm/commands.txt");
 }

@@ -406,7 +406,13 @@ impl SynthArgs {
         };
         let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
         check_folder(&build)?;
-        Ok(SynthConfig { params: self.params.params()?, scene: self.scene.source(), hw: self.hw.clone(), build, family })
+        Ok(SynthConfig {
+            params: self.params.params()?,
+            scene: self.scene.source(),
+            hw: self.hw.clone(),
+            build,
+            family,
+        })
     }
 }
 

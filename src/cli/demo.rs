@@ -46,7 +46,8 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let hdl = c.out.join("hdl");
     // Staged now, placed with the pictures only when every pixel has been simulated.
     let mut files = OutputSet::new();
-    files.extend(generate::core_files(&p, &roms, o, None, measured.as_ref()).into_iter().map(|(n, t)| (hdl.join(n), t)))?;
+    let core = generate::core_files(&p, &roms, o, None, measured.as_ref());
+    files.extend(core.into_iter().map(|(n, t)| (hdl.join(n), t)))?;
     let hdl_files = files.len();
 
     // A frame through the core, in the Rust simulator, every pixel against the golden model.

@@ -10,9 +10,9 @@ use super::config::{
 };
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
-use crate::io::OutputSet;
 use crate::flow::sweep::{run as sweep, slurm};
 use crate::flow::{check, feed, frame, generate, synth, vectors};
+use crate::io::OutputSet;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::model::golden::Golden;
 use crate::model::raygen::RayGen;
@@ -194,7 +194,8 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
     }
     files.add(&c.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).as_bytes())?;
     let json = scene::report::scene_json(&scene, &roms);
-    files.add(&c.out.join("scene.json"), (serde_json::to_string_pretty(&json).unwrap_or_default() + "\n").as_bytes())?;
+    let json = serde_json::to_string_pretty(&json).unwrap_or_default() + "\n";
+    files.add(&c.out.join("scene.json"), json.as_bytes())?;
     files.commit()?;
     if c.stats {
         print!("{}", scene::report::stats_text(&scene));
@@ -308,7 +309,8 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
         let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
-        files.extend(crate::flow::axis::frame_files(&layout, scene, &rays).into_iter().map(|(n, b)| (c.out.join(n), b)))?;
+        let stream = crate::flow::axis::frame_files(&layout, scene, &rays);
+        files.extend(stream.into_iter().map(|(n, b)| (c.out.join(n), b)))?;
     }
     files.commit()?;
     println!(

@@ -4,8 +4,8 @@
 use super::config::{ECP5_MODULES, threads};
 use super::{SweepAction, SweepArgs};
 use crate::error::{Error, Result};
-use crate::io::check_folder;
 use crate::flow::sweep::{Plan, Shard, SweepSpec};
+use crate::io::check_folder;
 use crate::params::Params;
 use std::path::PathBuf;
 

@@ -118,11 +118,13 @@ impl CoreParams {
             ));
         }
         // The core's ray RAM keeps a ray's direction, three m-bit components, in one word.
-        let w = 3 * self.isect.m;
+        let (w, most) = (3 * self.isect.m, MAX_WIDTH / 3);
         if w > MAX_WIDTH {
             return Err(Error::param(
                 "m",
-                format!("the core's ray RAM holds a direction in 3m = {w} bits; the RTL layer holds {MAX_WIDTH}: --m at most {}", MAX_WIDTH / 3),
+                format!(
+                    "the core's ray RAM holds a direction in 3m = {w} bits; the RTL layer holds {MAX_WIDTH}: --m at most {most}"
+                ),
             ));
         }
         self.isect.check()?;

@@ -59,7 +59,13 @@ pub fn testbench(d: &BoardDesign, ext: &str, press_at: u64, max_cycles: u64) -> 
 
 /// Writes the design in `ext` ("v" or "vhd"), the primitives' stand-ins and the testbench
 /// into `dir`; returns the source files in compile order (testbench last).
-pub fn write(dir: &Path, d: &BoardDesign, ext: &str, press_at: u64, max_cycles: u64) -> crate::error::Result<Vec<String>> {
+pub fn write(
+    dir: &Path,
+    d: &BoardDesign,
+    ext: &str,
+    press_at: u64,
+    max_cycles: u64,
+) -> crate::error::Result<Vec<String>> {
     let mut files = crate::io::OutputSet::new();
     let mut sources = Vec::new();
     let (prim, text) = primitives(d.board, ext);

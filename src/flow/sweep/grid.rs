@@ -34,7 +34,13 @@ pub fn series<'a>(results: &'a Results, plan: &Plan, scene: &str, axis: Axis) ->
 
 /// Stages grids/SCENE_PARAM.png for every scene and swept parameter that can change the image
 /// (not the core's shape); returns their paths.
-pub fn add_grids(files: &mut OutputSet, dir: &Path, cache: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
+pub fn add_grids(
+    files: &mut OutputSet,
+    dir: &Path,
+    cache: &Path,
+    results: &Results,
+    plan: &Plan,
+) -> Result<Vec<String>> {
     let mut written = Vec::new();
     for scene in super::run::scene_labels(&results.spec.scenes) {
         for axis in results.spec.swept_axes().into_iter().filter(|a| a.changes_image()) {

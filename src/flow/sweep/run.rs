@@ -1,9 +1,7 @@
 //! Running a sweep (or a shard of one) and merging shards.
 
 use super::eval::{Extras, Row, SceneCtx, evaluate};
-use super::output::{
-    Results, add_tables_and_images, copy_cached, has_cached, load_cached, read_results, store_cached,
-};
+use super::output::{Results, add_tables_and_images, copy_cached, has_cached, load_cached, read_results, store_cached};
 use super::pnr::Pnr;
 use super::{Plan, SceneSpec, Shard, SweepSpec};
 use crate::error::{Error, Result};
