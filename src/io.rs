@@ -9,6 +9,7 @@
 //! Every error names the target, never a temporary name.
 
 use crate::error::{Error, Result};
+use std::collections::HashSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use tempfile::TempPath;
@@ -24,6 +25,8 @@ const TEMP_PREFIX: &str = ".fxrt-";
 #[derive(Debug, Default)]
 pub struct OutputSet {
     staged: Vec<Staged>,
+    /// The staged targets with their folders resolved: two names of one file are one target.
+    targets: HashSet<PathBuf>,
     /// Folders this set created, parents first: removed again (when empty) unless it commits.
     created: Vec<PathBuf>,
 }
@@ -32,8 +35,6 @@ pub struct OutputSet {
 struct Staged {
     tmp: TempPath,
     target: PathBuf,
-    /// The target with its folder resolved: two names of one file are one target.
-    key: PathBuf,
 }
 
 /// A file renamed into place, with the hard link to the file it replaced (if any).
@@ -78,7 +79,7 @@ impl OutputSet {
         self.create_folders(path, dir)?;
         let cannot = |e: std::io::Error| Error::file(path, format!("cannot write: {e}"));
         let key = dir.canonicalize().map_err(cannot)?.join(name);
-        if self.staged.iter().any(|s| s.key == key) {
+        if !self.targets.insert(key) {
             return Err(Error::file(path, "is named twice among this command's outputs"));
         }
         // `make_in` with a plain `File`: tempfile's own writers would put the temporary name
@@ -97,7 +98,7 @@ impl OutputSet {
         #[cfg(not(unix))]
         let _ = mode;
         // Closed: a sweep stages thousands of files.
-        self.staged.push(Staged { tmp: tmp.into_temp_path(), target: path.to_path_buf(), key });
+        self.staged.push(Staged { tmp: tmp.into_temp_path(), target: path.to_path_buf() });
         Ok(())
     }
 
