@@ -295,6 +295,17 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
 
+/// One ray slot per traversal unit (it used to panic: the stack address has a slot bit).
+#[test]
+fn sim_with_one_slot_per_unit_matches_every_pixel() {
+    let o = fxrt(&["sim", "--builtin", "cornell", "--size", "8x8", "--slots", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((v["slots"].as_u64(), v["units"].as_u64()), (Some(2), Some(2)), "{v}");
+    assert_eq!((v["all_pixels_match"].as_bool(), v["mismatches"].as_u64()), (Some(true), Some(0)), "{v}");
+    assert!(v["rays"].as_u64().unwrap() > 0, "{v}");
+}
+
 /// Shuffled rays and a stalling source: every pixel still right, the options in the JSON line,
 /// the same ids as `render`; bad values refused with one line naming the option.
 #[test]

@@ -5,6 +5,7 @@ use crate::cores::top::CoreParams;
 use crate::error::{Error, Result};
 use crate::flow::board::{BoardDesign, pnr};
 use crate::flow::ecp5::Tools;
+use crate::io::OutputSet;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
@@ -38,10 +39,9 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     p.check_device(&roms, c.bram_kbits)?;
     let tools = if b.bitstream { Some(Tools::require().map_err(|e| Error::param("board", format!("{} (or --no-bitstream)", e.message)))?) } else { None };
     let d = BoardDesign::new(b.board, &p, &roms, &scene, &g, b.mhz, b.led_shift, None)?;
-    let mut files: Vec<(PathBuf, Vec<u8>)> =
-        d.files(c.vhdl, c.verilog).into_iter().map(|(n, t)| (c.out.join(n), t.into_bytes())).collect();
-    crate::io::write_all_atomic(&files)?;
-    println!(
+    let design: Vec<(PathBuf, String)> =
+        d.files(c.vhdl, c.verilog).into_iter().map(|(n, t)| (c.out.join(n), t)).collect();
+    let written = format!(
         "{} ({}, {} MHz from the {} MHz oscillator; frame {}x{}, golden checksum {:08x}) written to {}",
         d.top,
         d.board.title(),
@@ -52,14 +52,29 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
         d.check.golden,
         c.out.display()
     );
-    let Some(tools) = tools else { return Ok(true) };
+    let Some(tools) = tools else {
+        let mut files = OutputSet::new();
+        files.extend(design)?;
+        files.commit()?;
+        println!("{written}");
+        return Ok(true);
+    };
+    // The design's files are written with the bitstream or not at all, after minutes of place
+    // and route (held in memory meanwhile, so an interrupted run leaves none; a path that
+    // cannot take them is refused first). The tools' folder keeps their logs either way: a
+    // failure names them.
+    design.iter().try_for_each(|(p, _)| crate::io::check_writable(p))?;
     let dir = c.out.join("pnr");
     eprintln!("placing and routing {} (minutes; logs in {})", d.top, dir.display());
     let timing = pnr::bitstream(&tools, &d, b.seed, &dir)?;
     let bit = std::fs::read(dir.join(&timing.bitstream)).map_err(|e| Error::file(&dir.join(&timing.bitstream), e.to_string()))?;
     let report = serde_json::to_string_pretty(&timing).unwrap_or_default() + "\n";
-    files = vec![(c.out.join(&timing.bitstream), bit), (c.out.join(format!("{}_timing.json", d.top)), report.into_bytes())];
-    crate::io::write_all_atomic(&files)?;
+    let mut files = OutputSet::new();
+    files.extend(design)?;
+    files.add(&c.out.join(&timing.bitstream), &bit)?;
+    files.add(&c.out.join(format!("{}_timing.json", d.top)), report.as_bytes())?;
+    files.commit()?;
+    println!("{written}");
     println!(
         "{}: {} MHz reached on the {} MHz board clock ({}), {} LUT4, {} FF, {} MULT18X18D, {} DP16KD; seed {}",
         timing.bitstream,

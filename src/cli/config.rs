@@ -1,16 +1,19 @@
 //! Each command's arguments validated into what it runs on: ranges checked, defaults filled
-//! in, the command line's choices mapped to the library's types. Nothing here reads a file or
-//! writes one; what needs the scene (the camera's defaults, widths against the scene's E, the
+//! in, the command line's choices mapped to the library's types. Nothing here writes a file;
+//! output paths are only looked at, so one that can never be written (a folder, a path below a
+//! regular file, two options naming one file) is refused before anything runs. What needs the
+//! scene (the camera's defaults, widths against the scene's E, the
 //! core's memories) is checked in `cli::run` as soon as the scene is loaded, still before
 //! anything is written.
 
+pub use super::sweep_config::{SweepConfig, SweepRun};
 use super::{
     BenchArgs, BenchWhat, CameraArgs, CompareArgs, FrameSim, GenArgs, HwArgs, Lang, ParamArgs, RenderArgs, SceneArgs,
-    SceneChoice, SimArgs, SimChoice, SweepAction, SweepArgs, SynthArgs, TestArgs,
+    SceneChoice, SimArgs, SimChoice, SynthArgs, TestArgs,
 };
 use crate::error::{Error, Result};
 use crate::flow::simulators::Simulator;
-use crate::flow::sweep::{Plan, Shard, SweepSpec};
+use crate::io::check_folder;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::params::Params;
 use crate::render::tracer::ModelKind;
@@ -44,10 +47,14 @@ impl Simulation {
     }
 
     /// The build folder of an HDL run: `dir` if given, else `default_root`/SIMULATOR.
-    fn build_dir(self, dir: &Option<PathBuf>, default_root: &str) -> Option<PathBuf> {
+    fn build_dir(self, dir: &Option<PathBuf>, default_root: &str) -> Result<Option<PathBuf>> {
         match self {
-            Simulation::Rust => None,
-            Simulation::Hdl(s) => Some(dir.clone().unwrap_or_else(|| PathBuf::from(default_root).join(s.name()))),
+            Simulation::Rust => Ok(None),
+            Simulation::Hdl(s) => {
+                let dir = dir.clone().unwrap_or_else(|| PathBuf::from(default_root).join(s.name()));
+                check_folder(&dir)?;
+                Ok(Some(dir))
+            }
         }
     }
 }
@@ -81,6 +88,20 @@ pub fn threads(n: Option<usize>) -> Result<Option<usize>> {
     }
 }
 
+/// Output files of one command, (option, path) for those given: each can be written
+/// (`io::check_writable`) and no two name one file.
+pub fn check_outputs(files: &[(&str, &Option<PathBuf>)]) -> Result<()> {
+    let given: Vec<(&str, &PathBuf)> = files.iter().filter_map(|(o, p)| Some((*o, p.as_ref()?))).collect();
+    for (i, &(option, path)) in given.iter().enumerate() {
+        crate::io::check_writable(path)?;
+        let same = |p: &PathBuf| std::path::absolute(p).ok() == std::path::absolute(path).ok();
+        if let Some((other, _)) = given[..i].iter().find(|(_, p)| same(p)) {
+            return Err(Error::param(option, format!("{} is also the --{other} file", path.display())));
+        }
+    }
+    Ok(())
+}
+
 /// Output files of a frame; none is written before everything is computed.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct FrameFiles {
@@ -102,6 +123,7 @@ pub struct RenderConfig {
 
 impl RenderArgs {
     pub fn config(&self) -> Result<RenderConfig> {
+        check_outputs(&[("png", &self.png), ("ids", &self.ids), ("depth", &self.depth)])?;
         Ok(RenderConfig {
             params: self.params.params()?,
             threads: threads(self.threads)?,
@@ -145,6 +167,7 @@ pub struct SceneConfig {
 
 impl SceneArgs {
     pub fn config(&self) -> Result<SceneConfig> {
+        check_folder(&self.out)?;
         Ok(SceneConfig {
             params: self.params.params()?,
             scene: self.scene.source(),
@@ -283,6 +306,7 @@ impl GenArgs {
             return Err(Error::param("ray-id-width", format!("{} is out of range: must be 1..=64", self.ray_id_width)));
         }
         crate::cores::clock::ClockTarget(self.target_mhz).check()?;
+        check_folder(&self.out)?;
         Ok(GenConfig {
             scene,
             out: self.out.clone(),
@@ -341,7 +365,7 @@ impl TestArgs {
             sim,
             vectors,
             seed: self.seed,
-            build: sim.build_dir(&self.build, "target/fxrt-test"),
+            build: sim.build_dir(&self.build, "target/fxrt-test")?,
         })
     }
 }
@@ -383,11 +407,13 @@ impl SynthArgs {
                 return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));
             }
         };
+        let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
+        check_folder(&build)?;
         Ok(SynthConfig {
             params: self.params.params()?,
             scene: self.scene.source(),
             hw: self.hw.clone(),
-            build: self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth")),
+            build,
             family,
         })
     }
@@ -431,6 +457,7 @@ impl SimArgs {
     pub fn config(&self) -> Result<SimConfig> {
         let params = self.params.params()?;
         let sim = Simulation::from(self.sim);
+        check_outputs(&[("png", &self.png), ("ids", &self.ids)])?;
         if self.raygen && sim != Simulation::Rust {
             return Err(Error::param("raygen", "runs in the Rust simulator only (--sim rust)"));
         }
@@ -462,7 +489,7 @@ impl SimArgs {
             threads: self.threads,
             png: self.png.clone(),
             ids: self.ids.clone(),
-            build: sim.build_dir(&self.build, "target/fxrt-sim"),
+            build: sim.build_dir(&self.build, "target/fxrt-sim")?,
             clock: match (self.clock_mhz, &self.fmax_json) {
                 (Some(f), _) if !(f.is_finite() && f > 0.0) => {
                     return Err(Error::param("clock-mhz", format!("{f} is out of range: must be > 0")));
@@ -474,118 +501,6 @@ impl SimArgs {
             shuffle_seed: self.shuffle_seed,
             stalls: (self.stall_percent > 0).then(|| (self.stall_percent, self.stall_seed.unwrap_or(1))),
         })
-    }
-}
-
-/// `fxrt sweep`: join shards, or run (a shard of) a sweep, or write its Slurm scripts.
-#[derive(Debug)]
-pub enum SweepConfig {
-    Merge {
-        dirs: Vec<PathBuf>,
-        out: PathBuf,
-        cache: Option<PathBuf>,
-    },
-    /// Boxed: a plan is large beside a merge.
-    Run(Box<SweepRun>),
-}
-
-#[derive(Debug)]
-pub struct SweepRun {
-    pub spec: SweepSpec,
-    pub plan: Plan,
-    pub out: PathBuf,
-    /// Default: OUT/cache.
-    pub cache: PathBuf,
-    pub threads: Option<usize>,
-    pub shard: Option<Shard>,
-    /// `--emit-slurm`: the shard count and the threads (CPUs) of each shard, default 4.
-    pub slurm: Option<(u32, u32)>,
-}
-
-impl SweepArgs {
-    pub fn config(&self) -> Result<SweepConfig> {
-        if let Some(SweepAction::Merge(m)) = &self.action {
-            return Ok(SweepConfig::Merge { dirs: m.dirs.clone(), out: m.out.clone(), cache: m.cache.clone() });
-        }
-        let spec = self.spec()?;
-        let plan = spec.plan()?;
-        // clap requires --out without a subcommand; checked again so a hand-made SweepArgs
-        // gets an error rather than a panic.
-        let out = self.out.clone().ok_or_else(|| Error::param("out", "is required"))?;
-        let threads = threads(self.threads)?;
-        if self.emit_slurm && self.shard.is_some() {
-            return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
-        }
-        Ok(SweepConfig::Run(Box::new(SweepRun {
-            cache: self.cache.clone().unwrap_or_else(|| out.join("cache")),
-            spec,
-            plan,
-            out,
-            threads,
-            shard: self.shard,
-            slurm: self.emit_slurm.then(|| (self.shards, self.threads.unwrap_or(4) as u32)),
-        })))
-    }
-
-    /// The sweep the arguments describe; every list is checked here, before anything runs.
-    pub fn spec(&self) -> Result<SweepSpec> {
-        use crate::flow::sweep::{SceneSpec, axis};
-        // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
-        // sweep as a run from here.
-        let mut scenes = Vec::new();
-        for p in &self.scenes {
-            scenes.push(SceneSpec::Obj(std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()))?));
-        }
-        scenes.extend(self.builtin.iter().map(|b| SceneSpec::Builtin(b.trim().to_string())));
-        if scenes.is_empty() {
-            scenes.push(SceneSpec::Builtin("teapot".into()));
-        }
-        if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
-            return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
-        }
-        let single = Params { stack_depth: self.stack_depth, tree: self.tree, ..Params::default() };
-        single.validate()?;
-        crate::cores::clock::ClockTarget(self.target_mhz).check()?;
-        Ok(SweepSpec {
-            scenes,
-            camera: self.camera.spec(),
-            n: axis::parse_u32_list("n", &self.n)?,
-            m: axis::parse_u32_list("m", &self.m)?,
-            t: axis::parse_u32_list("t", &self.t)?,
-            c: axis::parse_u32_list("c", &self.c)?,
-            edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
-            leaf_size: axis::parse_u32_list("leaf-size", &self.leaf_size)?,
-            stack_depth: self.stack_depth,
-            tree: self.tree,
-            one_at_a_time: self.one_at_a_time,
-            synth: self.synth,
-            core_sim: self.core_sim,
-            target_mhz: self.target_mhz,
-            slots: axis::parse_u32_list("slots", &self.slots)?,
-            units: axis::parse_u32_list("units", &self.units)?,
-            ecp5: self.ecp5()?,
-        })
-    }
-
-    /// `--family` and the options of ecp5 alone: the modules in `ECP5_MODULES` order, each
-    /// once.
-    fn ecp5(&self) -> Result<Option<crate::flow::sweep::Ecp5Choice>> {
-        let family = self.family.as_deref().unwrap_or("xc5v");
-        match family {
-            "ecp5" if !self.synth => Err(Error::param("family", "ecp5 places and routes with --synth: add --synth")),
-            "ecp5" => {
-                let given = self.modules.clone().unwrap_or_else(|| vec!["core".into()]);
-                crate::flow::ecp5::check_modules(&given)?;
-                let modules = ECP5_MODULES.iter().filter(|m| given.iter().any(|g| g == *m)).map(|m| m.to_string());
-                Ok(Some(crate::flow::sweep::Ecp5Choice { modules: modules.collect(), seed: self.seed.unwrap_or(1) }))
-            }
-            "xc5v" if self.seed.is_some() => Err(Error::param("seed", "is nextpnr's: only with --family ecp5")),
-            "xc5v" if self.modules.is_some() => {
-                Err(Error::param("modules", "are placed and routed only with --family ecp5"))
-            }
-            "xc5v" => Ok(None),
-            other => Err(Error::param("family", format!("'{other}' is not a sweep family: use xc5v or ecp5"))),
-        }
     }
 }
 

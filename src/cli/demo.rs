@@ -7,6 +7,7 @@
 use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_with};
 use crate::error::{Error, Result};
 use crate::flow::{feed, frame, generate};
+use crate::io::OutputSet;
 use crate::model::camera::Camera;
 use crate::params::Params;
 use crate::render::{self, Frame, tracer::GoldenTracer};
@@ -43,11 +44,10 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let measured = super::run::measured_entry(Path::new("generated/measured/ecp5-core.json"), MEASURED, &p, &netlist, &roms.name).ok();
     let o = generate::GenOptions { vhdl: true, verilog: true, ise: false, debug_ports: false, clock_mhz: target as f64 };
     let hdl = c.out.join("hdl");
-    let mut files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, None, measured.as_ref())
-        .into_iter()
-        .map(|(n, t)| (hdl.join(n), t.into_bytes()))
-        .collect();
-    let hdl_files = files.len();
+    // Kept in memory while the frame is simulated (an interrupted demo leaves nothing), then
+    // written with the pictures as one set.
+    let core_files = generate::core_files(&p, &roms, o, None, measured.as_ref());
+    let hdl_files = core_files.len();
 
     // A frame through the core, in the Rust simulator, every pixel against the golden model.
     let cam = Camera::default_for(&scene, c.width, c.height);
@@ -61,9 +61,11 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let golden = GoldenTracer::new(&scene);
     let picture = render::render(&scene, &golden, &Camera::default_for(&scene, PICTURE, PICTURE), true, false);
     let (golden_png, hardware_png) = (c.out.join("golden.png"), c.out.join("hardware.png"));
-    files.push((golden_png.clone(), picture.png_bytes()));
-    files.push((hardware_png.clone(), hardware_picture(&scene, &cam, ids).png_bytes()));
-    crate::io::write_all_atomic(&files)?;
+    let mut files = OutputSet::new();
+    files.extend(core_files.into_iter().map(|(n, t)| (hdl.join(n), t)))?;
+    files.add(&golden_png, &picture.png_bytes())?;
+    files.add(&hardware_png, &hardware_picture(&scene, &cam, ids).png_bytes())?;
+    files.commit()?;
 
     let core = format!("fxrt_core_{}", p.trav.scene_tag);
     let pixels = (c.width * c.height) as u64;

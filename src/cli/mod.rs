@@ -8,6 +8,7 @@ pub mod config;
 pub mod demo;
 pub mod exact;
 pub mod run;
+pub mod sweep_config;
 
 use crate::params::{EdgeShift, TreeSplit};
 use crate::render::tracer::ModelKind;
@@ -84,6 +85,7 @@ impl DemoArgs {
     pub fn config(&self) -> crate::error::Result<demo::DemoConfig> {
         let (width, height) = self.size;
         demo::check_size(width, height)?;
+        crate::io::check_folder(&self.out)?;
         Ok(demo::DemoConfig { out: self.out.clone(), width, height })
     }
 }

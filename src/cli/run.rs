@@ -12,6 +12,7 @@ use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};
 use crate::flow::{check, feed, frame, generate, synth, vectors};
+use crate::io::OutputSet;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::model::golden::Golden;
 use crate::model::raygen::RayGen;
@@ -19,7 +20,7 @@ use crate::params::Params;
 use crate::render::{self, tracer};
 use crate::scene::images::SceneRoms;
 use crate::scene::{self, Scene, SceneSource, rom};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Runs `cmd`: Ok(true) when it succeeded, Ok(false) when it found a mismatch.
 pub fn run(cmd: Command) -> Result<bool> {
@@ -59,18 +60,17 @@ pub fn render(c: &RenderConfig) -> Result<()> {
     let cam = c.camera.camera(&scene)?;
     let tracer = tracer::make_tracer(&scene, c.model);
     let frame = pool.install(|| render::render(&scene, tracer.as_ref(), &cam, c.shade, true));
-    // Everything is computed before the first file is written.
-    let mut files = Vec::new();
+    let mut files = OutputSet::new();
     if let Some(p) = &c.files.png {
-        files.push((p.clone(), frame.png_bytes()));
+        files.add(p, &frame.png_bytes())?;
     }
     if let Some(p) = &c.files.ids {
-        files.push((p.clone(), frame.ids_bytes()));
+        files.add(p, &frame.ids_bytes())?;
     }
     if let Some(p) = &c.files.depth {
-        files.push((p.clone(), frame.depth_bytes()));
+        files.add(p, &frame.depth_bytes())?;
     }
-    crate::io::write_all_atomic(&files)?;
+    files.commit()?;
     println!(
         "rays: {}, hits: {}, seconds: {:.3}, Mrays/s: {:.2}",
         frame.rays,
@@ -188,20 +188,18 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
 pub fn scene(c: &SceneConfig) -> Result<()> {
     let scene = Scene::load(&c.scene, &c.params)?;
     let roms = rom::words(&scene);
-    let mut files = Vec::new();
+    let mut files = OutputSet::new();
     for (layout, words) in &roms {
         let text = rom::readmemh(layout, words);
-        files.push((c.out.join(format!("{}.hex", layout.rom)), text.clone().into_bytes()));
-        files.push((c.out.join(format!("{}.mem", layout.rom)), text.into_bytes()));
-        files.push((c.out.join(format!("{}.coe", layout.rom)), rom::coe(layout, words).into_bytes()));
+        files.add(&c.out.join(format!("{}.hex", layout.rom)), text.as_bytes())?;
+        files.add(&c.out.join(format!("{}.mem", layout.rom)), text.as_bytes())?;
+        files.add(&c.out.join(format!("{}.coe", layout.rom)), rom::coe(layout, words).as_bytes())?;
     }
-    files.push((c.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).into_bytes()));
+    files.add(&c.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).as_bytes())?;
     let json = scene::report::scene_json(&scene, &roms);
-    files.push((
-        c.out.join("scene.json"),
-        (serde_json::to_string_pretty(&json).unwrap_or_default() + "\n").into_bytes(),
-    ));
-    crate::io::write_all_atomic(&files)?;
+    let json = serde_json::to_string_pretty(&json).unwrap_or_default() + "\n";
+    files.add(&c.out.join("scene.json"), json.as_bytes())?;
+    files.commit()?;
     if c.stats {
         print!("{}", scene::report::stats_text(&scene));
     }
@@ -307,21 +305,21 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         Some(f) => Some(measured_core(f, &p, &crate::cores::top::core_module_with(&p, &roms, c.debug_ports), &roms.name)?),
         None => None,
     };
-    let mut files: Vec<(PathBuf, Vec<u8>)> = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref())
-        .into_iter()
-        .map(|(n, t)| (c.out.join(n), t.into_bytes()))
-        .collect();
+    let mut files = OutputSet::new();
+    let core = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref());
+    files.extend(core.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
         let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
-        files
-            .extend(crate::flow::axis::frame_files(&layout, scene, &rays).into_iter().map(|(n, b)| (c.out.join(n), b)));
+        let stream = crate::flow::axis::frame_files(&layout, scene, &rays);
+        files.extend(stream.into_iter().map(|(n, b)| (c.out.join(n), b)))?;
     }
-    crate::io::write_all_atomic(&files)?;
+    files.commit()?;
     println!(
-        "{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",
-        format!("{}_{}", if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" }, p.trav.scene_tag),
+        "{}_{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",
+        if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" },
+        p.trav.scene_tag,
         roms.name,
         roms.tri_count(),
         p.isect.latency(),
@@ -360,7 +358,6 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let roms = SceneRoms::of(&scene);
     let t = c.hw.threads;
     let core = crate::cores::top::CoreParams::with_slots(&roms, 20, c.hw.div_bits, c.hw.target_mhz, t.slots, t.units);
-    core.check()?;
     core.check()?;
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
@@ -450,14 +447,14 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let in_order = results.len() == rays.len() && results.iter().zip(&rays).all(|(r, ray)| r.0 == ray.pixel as u64);
     let in_pixel_order = results.windows(2).all(|w| w[0].0 < w[1].0);
     let ids = frame::ids_image(&scene, w, h, &results);
-    let mut files = Vec::new();
+    let mut files = OutputSet::new();
     if let Some(path) = &c.png {
-        files.push((path.clone(), frame::binary_png(w, h, &ids)));
+        files.add(path, &frame::binary_png(w, h, &ids))?;
     }
     if let Some(path) = &c.ids {
-        files.push((path.clone(), ids.iter().flat_map(|i| i.to_le_bytes()).collect()));
+        files.add(path, &ids.iter().flat_map(|i| i.to_le_bytes()).collect::<Vec<u8>>())?;
     }
-    crate::io::write_all_atomic(&files)?;
+    files.commit()?;
     let counted = c.sim.name() == "rust";
     // The walk: the core's node steps (counted in the Rust simulator only) and triangle tests
     // against the golden culled walk's — equal for every shape and feed order when the core

@@ -101,10 +101,11 @@ impl CoreParams {
 
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
     pub fn check(&self) -> crate::error::Result<()> {
+        use crate::error::Error;
         self.isect.check_widths()?;
         let w = self.trav.n + 1 + self.trav.inv_width();
         if w > MAX_WIDTH {
-            return Err(crate::error::Error::param(
+            return Err(Error::param(
                 "c",
                 format!(
                     "the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"
@@ -112,10 +113,10 @@ impl CoreParams {
             ));
         }
         if !(1..=64).contains(&self.trav.slots) {
-            return Err(crate::error::Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
+            return Err(Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
         }
         if !(1..=4).contains(&self.units) {
-            return Err(crate::error::Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
+            return Err(Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
         }
         // The closest-hit unit keeps a bit per global slot number in one word; a unit's slot
         // numbers take a power of two (3 units × 33 slots are numbered as 3 × 64).

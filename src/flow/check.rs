@@ -173,10 +173,8 @@ pub fn bench_sims(p: &IntersectParams, vectors: &[Vector], ghdl_vectors: usize, 
 /// for `sim` into `dir`, and runs the testbench there.
 fn simulate_hdl(sim: Simulator, module: &Module, latency: u32, vectors: &[Vector], dir: &Path) -> Result<RunResult> {
     let transcript = record(module, stimuli(module, latency, vectors));
-    let io = |e: std::io::Error| Error::file(dir, e.to_string());
-    std::fs::create_dir_all(dir).map_err(io)?;
-    for (file, text) in bench_files(module, &transcript, sim) {
-        std::fs::write(dir.join(file), text).map_err(io)?;
-    }
+    let mut files = crate::io::OutputSet::new();
+    files.extend(bench_files(module, &transcript, sim).into_iter().map(|(file, text)| (dir.join(file), text)))?;
+    files.commit()?;
     sim.run_timed(dir, module).map_err(|e| Error::new(sim.name(), e))
 }

@@ -251,7 +251,6 @@ pub fn place_and_route(
     dir: &Path,
 ) -> Result<Timing> {
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
-    std::fs::create_dir_all(dir).map_err(io)?;
     let top = wrapper(&Rc::new(m.clone()));
     let pins = (PIN_REGS.0 + PIN_REGS.1) as u64;
     let out_bits: u32 = m.outputs.iter().map(|o| m.sig(o.1).ty.width).sum();
@@ -294,8 +293,7 @@ pub fn place_and_route(
 /// register, the divider's steps as carry chains that add or subtract in their own LUTs — and
 /// returns the names of the source files (memory images beside them).
 pub fn write_sources(top: &Module, dir: &Path) -> Result<Vec<String>> {
-    let io = |e: std::io::Error| Error::file(dir, e.to_string());
-    std::fs::create_dir_all(dir).map_err(io)?;
+    let mut set = crate::io::OutputSet::new();
     let files = emit::design_files(top, "v");
     let hierarchy = top.hierarchy();
     let block_of = |file: &str, prefix: &str| {
@@ -311,8 +309,9 @@ pub fn write_sources(top: &Module, dir: &Path) -> Result<Vec<String>> {
             .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
             .or_else(|| bram_of(file).and_then(|m| super::ecp5_bram::dp16kd_ram(text, m)))
             .unwrap_or_else(|| text.clone());
-        std::fs::write(dir.join(file), text).map_err(io)?;
+        set.add(&dir.join(file), text.as_bytes())?;
     }
+    set.commit()?;
     Ok(files.into_iter().map(|f| f.0).filter(|f| emit::is_source(f)).collect())
 }
 

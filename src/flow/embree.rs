@@ -113,13 +113,12 @@ pub fn measure(
 ) -> Result<EmbreeReport> {
     let (origins, dirs) = ray_bytes(cam);
     let script = dir.join("embree_bench.py");
-    let files = [
-        (script.clone(), SCRIPT.as_bytes().to_vec()),
-        (dir.join("triangles.f32"), triangle_bytes(scene)),
-        (dir.join("origins.f64"), origins),
-        (dir.join("directions.f64"), dirs),
-    ];
-    crate::io::write_all_atomic(&files)?;
+    let mut files = crate::io::OutputSet::new();
+    files.add(&script, SCRIPT.as_bytes())?;
+    files.add(&dir.join("triangles.f32"), &triangle_bytes(scene))?;
+    files.add(&dir.join("origins.f64"), &origins)?;
+    files.add(&dir.join("directions.f64"), &dirs)?;
+    files.commit()?;
     let counts: Vec<String> = threads.iter().map(|t| t.to_string()).collect();
     let out = Command::new(python)
         .arg(&script)

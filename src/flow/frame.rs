@@ -425,10 +425,9 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
         max_cycles: s.max_cycles,
     };
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
-    std::fs::create_dir_all(dir).map_err(io)?;
-    for (file, text) in stream_files(m, &stream, sim) {
-        std::fs::write(dir.join(file), text).map_err(io)?;
-    }
+    let mut files = crate::io::OutputSet::new();
+    files.extend(stream_files(m, &stream, sim).into_iter().map(|(file, text)| (dir.join(file), text)))?;
+    files.commit()?;
     let (_, out) = sim.run_bench(dir, m, Bench::Stream).map_err(|e| Error::new(sim.name(), e))?;
     let text = std::fs::read_to_string(dir.join("results.txt")).map_err(io)?;
     let rows = parse_results(m, &RESULT_PORTS, &text).map_err(|e| Error::file(&dir.join("results.txt"), e))?;

@@ -59,11 +59,10 @@ pub fn synth_xc5v(m: &Module, dir: &Path) -> Result<Area> {
 /// Synthesises `m` with `synth_xilinx -family FAMILY` (xc5v or xc7) in `dir`.
 pub fn synth_xilinx(m: &Module, family: &str, dir: &Path) -> Result<Area> {
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
-    std::fs::create_dir_all(dir).map_err(io)?;
     let files = emit::design_files(m, "v");
-    for (file, text) in &files {
-        std::fs::write(dir.join(file), text).map_err(io)?;
-    }
+    let mut set = crate::io::OutputSet::new();
+    set.extend(files.iter().map(|(file, text)| (dir.join(file), text)))?;
+    set.commit()?;
     let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).filter(|f| emit::is_source(f)).collect();
     // -flatten: one area figure for the whole hierarchy.
     let script = format!(

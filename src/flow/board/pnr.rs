@@ -49,10 +49,12 @@ pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Resul
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let mut sources = write_sources(&d.logic, dir)?;
     let top_file = format!("{}.v", d.top);
-    std::fs::write(dir.join(&top_file), d.top_hdl("v")).map_err(io)?;
-    sources.push(top_file);
     let (lpf, lpf_text) = d.constraints();
-    std::fs::write(dir.join(&lpf), lpf_text).map_err(io)?;
+    let mut files = crate::io::OutputSet::new();
+    files.add(&dir.join(&top_file), d.top_hdl("v").as_bytes())?;
+    files.add(&dir.join(&lpf), lpf_text.as_bytes())?;
+    files.commit()?;
+    sources.push(top_file);
     synthesize(tools, dir, &sources, &d.top)?;
     let seed_s = seed.to_string();
     let args = [

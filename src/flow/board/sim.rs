@@ -59,20 +59,27 @@ pub fn testbench(d: &BoardDesign, ext: &str, press_at: u64, max_cycles: u64) -> 
 
 /// Writes the design in `ext` ("v" or "vhd"), the primitives' stand-ins and the testbench
 /// into `dir`; returns the source files in compile order (testbench last).
-pub fn write(dir: &Path, d: &BoardDesign, ext: &str, press_at: u64, max_cycles: u64) -> std::io::Result<Vec<String>> {
-    std::fs::create_dir_all(dir)?;
+pub fn write(
+    dir: &Path,
+    d: &BoardDesign,
+    ext: &str,
+    press_at: u64,
+    max_cycles: u64,
+) -> crate::error::Result<Vec<String>> {
+    let mut files = crate::io::OutputSet::new();
     let mut sources = Vec::new();
     let (prim, text) = primitives(d.board, ext);
-    std::fs::write(dir.join(prim), text)?;
+    files.add(&dir.join(prim), text.as_bytes())?;
     sources.push(prim.to_string());
     for (name, text) in d.files(ext == "vhd", ext == "v") {
-        std::fs::write(dir.join(&name), &text)?;
+        files.add(&dir.join(&name), text.as_bytes())?;
         if name.ends_with(&format!(".{ext}")) {
             sources.push(name);
         }
     }
     let tb = format!("board_tb.{ext}");
-    std::fs::write(dir.join(&tb), testbench(d, ext, press_at, max_cycles))?;
+    files.add(&dir.join(&tb), testbench(d, ext, press_at, max_cycles).as_bytes())?;
+    files.commit()?;
     sources.push(tb);
     Ok(sources)
 }

@@ -114,10 +114,10 @@ pub fn write(out: &Path, run: &CaseRun) -> Result<PathBuf> {
         Verdict::Refused(e) => json["refused"] = e.to_string().into(),
     }
     let text = serde_json::to_string_pretty(&json).expect("serialisable") + "\n";
-    crate::io::write_all_atomic(&[
-        (obj_path.clone(), obj.into_bytes()),
-        (dir.join("case.json"), text.into_bytes()),
-        (dir.join("command.txt"), format!("{command}\n").into_bytes()),
-    ])?;
+    let mut out = crate::io::OutputSet::new();
+    out.add(&obj_path, obj.as_bytes())?;
+    out.add(&dir.join("case.json"), text.as_bytes())?;
+    out.add(&dir.join("command.txt"), format!("{command}\n").as_bytes())?;
+    out.commit()?;
     Ok(dir)
 }

@@ -6,7 +6,7 @@ use super::output::{Results, cached_images};
 use super::plots::{FONT, register_font};
 use super::{Axis, Plan};
 use crate::error::{Error, Result};
-use crate::io::write_atomic;
+use crate::io::OutputSet;
 use crate::render::encode_png;
 use plotters::prelude::*;
 use std::path::Path;
@@ -32,9 +32,15 @@ pub fn series<'a>(results: &'a Results, plan: &Plan, scene: &str, axis: Axis) ->
     rows
 }
 
-/// Writes grids/SCENE_PARAM.png for every scene and swept parameter that can change the image
+/// Stages grids/SCENE_PARAM.png for every scene and swept parameter that can change the image
 /// (not the core's shape); returns their paths.
-pub fn write_grids(dir: &Path, cache: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
+pub fn add_grids(
+    files: &mut OutputSet,
+    dir: &Path,
+    cache: &Path,
+    results: &Results,
+    plan: &Plan,
+) -> Result<Vec<String>> {
     let mut written = Vec::new();
     for scene in super::run::scene_labels(&results.spec.scenes) {
         for axis in results.spec.swept_axes().into_iter().filter(|a| a.changes_image()) {
@@ -44,7 +50,7 @@ pub fn write_grids(dir: &Path, cache: &Path, results: &Results, plan: &Plan) -> 
             }
             let png = grid_png(cache, &scene, axis, &rows)?;
             let rel = format!("grids/{scene}_{}.png", axis.name());
-            write_atomic(&dir.join(&rel), &png)?;
+            files.add(&dir.join(&rel), &png)?;
             written.push(rel);
         }
     }

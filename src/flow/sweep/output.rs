@@ -12,7 +12,7 @@
 use super::eval::{Evaluated, Row};
 use super::{Skipped, SweepSpec};
 use crate::error::{Error, Result};
-use crate::io::write_atomic;
+use crate::io::OutputSet;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -53,25 +53,29 @@ pub fn load_cached(dir: &Path, key: &str, index: usize, scene: &str) -> Option<R
     Some(row)
 }
 
-/// Stores a finished configuration; the row last, so a row in the cache has its images.
+/// Stores a finished configuration: its row and images placed together, so a row in the cache
+/// has its images (the row last: a shard sharing the cache takes an entry by its row).
 pub fn store_cached(dir: &Path, e: &Evaluated) -> Result<()> {
     let [json, png, errors] = cache_files(dir, &e.row.key);
+    let mut files = OutputSet::new();
     if !e.render_png.is_empty() {
-        write_atomic(&png, &e.render_png)?;
-        write_atomic(&errors, &e.errors_png)?;
+        files.add(&png, &e.render_png)?;
+        files.add(&errors, &e.errors_png)?;
     }
-    write_atomic(&json, &serde_json::to_vec_pretty(&e.row).expect("rows serialise"))
+    files.add(&json, &serde_json::to_vec_pretty(&e.row).expect("rows serialise"))?;
+    files.commit()
 }
 
-/// Copies a cache entry from one cache folder to another (merging shards).
+/// Copies a cache entry from one cache folder to another (merging shards), whole.
 pub fn copy_cached(from: &Path, to: &Path, key: &str) -> Result<()> {
+    let mut files = OutputSet::new();
     for (src, dst) in cache_files(from, key).iter().zip(cache_files(to, key)) {
         if src.is_file() {
             let bytes = std::fs::read(src).map_err(|e| Error::file(src, format!("cannot read: {e}")))?;
-            write_atomic(&dst, &bytes)?;
+            files.add(&dst, &bytes)?;
         }
     }
-    Ok(())
+    files.commit()
 }
 
 /// The render and error images of a row, from the cache.
@@ -258,16 +262,16 @@ pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
     w.into_inner().expect("csv into memory")
 }
 
-/// Writes results.json, results.csv and the images of every row (from the cache).
-pub fn write_tables_and_images(dir: &Path, cache: &Path, results: &Results) -> Result<()> {
+/// Stages results.json, results.csv and the images of every row (from the cache) into `files`.
+pub fn add_tables_and_images(files: &mut OutputSet, dir: &Path, cache: &Path, results: &Results) -> Result<()> {
     for r in results.rows.iter().filter(|r| r.quality.is_some()) {
         let (png, errors) = cached_images(cache, &r.key)?;
         let (p, e) = r.image_paths();
-        write_atomic(&dir.join(p), &png)?;
-        write_atomic(&dir.join(e), &errors)?;
+        files.add(&dir.join(p), &png)?;
+        files.add(&dir.join(e), &errors)?;
     }
-    write_atomic(&dir.join("results.csv"), &csv_bytes(&results.spec, &results.rows))?;
+    files.add(&dir.join("results.csv"), &csv_bytes(&results.spec, &results.rows))?;
     let mut json = serde_json::to_vec_pretty(results).expect("results serialise");
     json.push(b'\n');
-    write_atomic(&dir.join("results.json"), &json)
+    files.add(&dir.join("results.json"), &json)
 }

@@ -9,7 +9,7 @@ use super::output::Results;
 use super::summary::{pareto_front, set_summaries};
 use super::{Axis, Plan, set_label};
 use crate::error::{Error, Result};
-use crate::io::write_atomic;
+use crate::io::OutputSet;
 use crate::render::encode_png;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
@@ -53,30 +53,30 @@ pub(super) fn plot_err(e: impl std::fmt::Display) -> Error {
 /// Where the Fmax plots of `--family ecp5` go: plots/fmax_PARAM.png.
 pub const FMAX_PLOTS: &str = "plots/fmax_";
 
-/// Writes plots/error_PARAM.png per swept parameter that can change the image, with
+/// Stages plots/error_PARAM.png per swept parameter that can change the image, with
 /// `--family ecp5` plots/fmax_PARAM.png per swept parameter, plots/pareto_dsp48e.png, and with
 /// `--core-sim` plots/throughput_AREA.png per area measure.
-pub fn write_plots(dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
+pub fn add_plots(files: &mut OutputSet, dir: &Path, results: &Results, plan: &Plan) -> Result<Vec<String>> {
     register_font();
     let mut written = Vec::new();
     for axis in results.spec.swept_axes().into_iter().filter(|a| a.changes_image()) {
         let rel = format!("plots/error_{}.png", axis.name());
-        write_atomic(&dir.join(&rel), &error_plot(results, plan, axis)?)?;
+        files.add(&dir.join(&rel), &error_plot(results, plan, axis)?)?;
         written.push(rel);
     }
     if let Some(e) = &results.spec.ecp5 {
         for axis in results.spec.swept_axes() {
             let rel = format!("{FMAX_PLOTS}{}.png", axis.name());
-            write_atomic(&dir.join(&rel), &fmax_plot(results, plan, axis, &e.modules)?)?;
+            files.add(&dir.join(&rel), &fmax_plot(results, plan, axis, &e.modules)?)?;
             written.push(rel);
         }
     }
     if !set_summaries(results).is_empty() {
         let rel = "plots/pareto_dsp48e.png".to_string();
-        write_atomic(&dir.join(&rel), &pareto_plot(results)?)?;
+        files.add(&dir.join(&rel), &pareto_plot(results)?)?;
         written.push(rel);
     }
-    written.extend(super::throughput::write_plots(dir, results)?);
+    written.extend(super::throughput::add_plots(files, dir, results)?);
     Ok(written)
 }
 

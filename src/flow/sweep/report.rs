@@ -8,7 +8,7 @@ use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summarie
 use super::throughput::THROUGHPUT_PLOTS;
 use super::{Axis, Plan, Set};
 use crate::error::{Error, Result};
-use crate::io::write_atomic;
+use crate::io::OutputSet;
 use askama::Template;
 use std::path::Path;
 
@@ -198,8 +198,15 @@ fn lists(results: &Results, plan: &Plan) -> Vec<(&'static str, String)> {
     v
 }
 
-/// Writes report.md.
-pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String], plots: &[String]) -> Result<()> {
+/// Stages report.md.
+pub fn add_report(
+    files: &mut OutputSet,
+    dir: &Path,
+    results: &Results,
+    plan: &Plan,
+    grids: &[String],
+    plots: &[String],
+) -> Result<()> {
     let spec = &results.spec;
     let sets = set_summaries(results);
     let pareto = pareto_front(&sets)
@@ -253,5 +260,5 @@ pub fn write_report(dir: &Path, results: &Results, plan: &Plan, grids: &[String]
         area_source: super::throughput::source_text(results),
     };
     let text = report.render().map_err(|e| Error::new("sweep report", e.to_string()))?;
-    write_atomic(&dir.join("report.md"), text.as_bytes())
+    files.add(&dir.join("report.md"), text.as_bytes())
 }

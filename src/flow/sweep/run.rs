@@ -1,9 +1,7 @@
 //! Running a sweep (or a shard of one) and merging shards.
 
 use super::eval::{Extras, Row, SceneCtx, evaluate};
-use super::output::{
-    Results, copy_cached, has_cached, load_cached, read_results, store_cached, write_tables_and_images,
-};
+use super::output::{Results, add_tables_and_images, copy_cached, has_cached, load_cached, read_results, store_cached};
 use super::pnr::Pnr;
 use super::{Plan, SceneSpec, Shard, SweepSpec};
 use crate::error::{Error, Result};
@@ -134,12 +132,15 @@ pub fn run(
     Ok(summary)
 }
 
-/// Every output of a sweep folder, from its results and cache alone.
+/// Every output of a sweep folder, from its results and cache alone, placed together (the
+/// cache, filled as configurations finish, is not part of the set).
 fn write_all(out: &Path, cache: &Path, results: &Results, plan: &Plan) -> Result<()> {
-    write_tables_and_images(out, cache, results)?;
-    let grids = super::grid::write_grids(out, cache, results, plan)?;
-    let plots = super::plots::write_plots(out, results, plan)?;
-    super::report::write_report(out, results, plan, &grids, &plots)
+    let mut files = crate::io::OutputSet::new();
+    add_tables_and_images(&mut files, out, cache, results)?;
+    let grids = super::grid::add_grids(&mut files, out, cache, results, plan)?;
+    let plots = super::plots::add_plots(&mut files, out, results, plan)?;
+    super::report::add_report(&mut files, out, results, plan, &grids, &plots)?;
+    files.commit()
 }
 
 /// Joins shard folders into `out`: the same spec everywhere, every configuration exactly once.

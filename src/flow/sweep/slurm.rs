@@ -4,7 +4,7 @@
 use super::report::list;
 use super::{SceneSpec, SweepSpec};
 use crate::error::{Error, Result};
-use crate::io::write_atomic;
+use crate::io::OutputSet;
 use askama::Template;
 use std::path::Path;
 
@@ -32,17 +32,16 @@ pub fn emit(spec: &SweepSpec, configs: usize, out: &Path, cache: &Path, shards: 
     let abs = |p: &Path| std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()));
     let exe = std::env::current_exe().map_err(|e| Error::new("fxrt", format!("cannot find its own path: {e}")))?;
     let files = slurm_files(&exe, spec, &abs(out)?, &abs(cache)?, shards, cpus)?;
+    let mut set = OutputSet::new();
     for (name, text, executable) in &files {
         let path = out.join("slurm").join(name);
-        write_atomic(&path, text.as_bytes())?;
-        #[cfg(unix)]
         if *executable {
-            use std::os::unix::fs::PermissionsExt;
-            // Best effort: the scripts also run with `sh submit.sh`.
-            let _ = std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755));
+            set.add_executable(&path, text.as_bytes())?;
+        } else {
+            set.add(&path, text.as_bytes())?;
         }
     }
-    Ok(())
+    set.commit()
 }
 
 /// Quotes a word for a POSIX shell when it needs it.

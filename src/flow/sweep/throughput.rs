@@ -9,7 +9,7 @@ use super::output::Results;
 use super::plots::{FONT, H, W, draw_legend, plot_err};
 use super::report::list;
 use crate::error::Result;
-use crate::io::write_atomic;
+use crate::io::OutputSet;
 use crate::render::encode_png;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -98,9 +98,9 @@ fn series(results: &Results, x: fn(&Row) -> Option<f64>, y: &dyn Fn(&Row) -> Opt
         .collect()
 }
 
-/// Writes plots/throughput_AREA.png per area measure when rows carry the simulated core's
+/// Stages plots/throughput_AREA.png per area measure when rows carry the simulated core's
 /// figures; returns their paths.
-pub fn write_plots(dir: &Path, results: &Results) -> Result<Vec<String>> {
+pub fn add_plots(files: &mut OutputSet, dir: &Path, results: &Results) -> Result<Vec<String>> {
     let mut written = Vec::new();
     if !results.spec.core_sim {
         return Ok(written);
@@ -115,7 +115,7 @@ pub fn write_plots(dir: &Path, results: &Results) -> Result<Vec<String>> {
         let bottom = series(results, m.of, &mrays);
         let bottom = (!bottom.iter().all(|s| s.1.is_empty())).then_some(bottom);
         let rel = format!("{THROUGHPUT_PLOTS}{}.png", m.file);
-        write_atomic(&dir.join(&rel), &plot(results, &m, &top, bottom.as_deref())?)?;
+        files.add(&dir.join(&rel), &plot(results, &m, &top, bottom.as_deref())?)?;
         written.push(rel);
     }
     Ok(written)

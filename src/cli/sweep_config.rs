@@ -1,0 +1,128 @@
+//! `fxrt sweep`'s arguments validated: every list parsed and checked, the plan made, the
+//! output and cache folders looked at, before anything runs or is written (`cli::config`).
+
+use super::config::{ECP5_MODULES, threads};
+use super::{SweepAction, SweepArgs};
+use crate::error::{Error, Result};
+use crate::flow::sweep::{Plan, Shard, SweepSpec};
+use crate::io::check_folder;
+use crate::params::Params;
+use std::path::PathBuf;
+
+/// `fxrt sweep`: join shards, or run (a shard of) a sweep, or write its Slurm scripts.
+#[derive(Debug)]
+pub enum SweepConfig {
+    Merge {
+        dirs: Vec<PathBuf>,
+        out: PathBuf,
+        cache: Option<PathBuf>,
+    },
+    /// Boxed: a plan is large beside a merge.
+    Run(Box<SweepRun>),
+}
+
+#[derive(Debug)]
+pub struct SweepRun {
+    pub spec: SweepSpec,
+    pub plan: Plan,
+    pub out: PathBuf,
+    /// Default: OUT/cache.
+    pub cache: PathBuf,
+    pub threads: Option<usize>,
+    pub shard: Option<Shard>,
+    /// `--emit-slurm`: the shard count and the threads (CPUs) of each shard, default 4.
+    pub slurm: Option<(u32, u32)>,
+}
+
+impl SweepArgs {
+    pub fn config(&self) -> Result<SweepConfig> {
+        if let Some(SweepAction::Merge(m)) = &self.action {
+            check_folder(&m.out)?;
+            m.cache.as_deref().map(check_folder).transpose()?;
+            return Ok(SweepConfig::Merge { dirs: m.dirs.clone(), out: m.out.clone(), cache: m.cache.clone() });
+        }
+        let spec = self.spec()?;
+        let plan = spec.plan()?;
+        // clap requires --out without a subcommand; checked again so a hand-made SweepArgs
+        // gets an error rather than a panic.
+        let out = self.out.clone().ok_or_else(|| Error::param("out", "is required"))?;
+        let threads = threads(self.threads)?;
+        if self.emit_slurm && self.shard.is_some() {
+            return Err(Error::param("emit-slurm", "writes the scripts for every shard: leave out --shard"));
+        }
+        // Refused here, before the sweep's first line (the cache folder is made as it starts).
+        let cache = self.cache.clone().unwrap_or_else(|| out.join("cache"));
+        check_folder(&out)?;
+        check_folder(&cache)?;
+        Ok(SweepConfig::Run(Box::new(SweepRun {
+            cache,
+            spec,
+            plan,
+            out,
+            threads,
+            shard: self.shard,
+            slurm: self.emit_slurm.then(|| (self.shards, self.threads.unwrap_or(4) as u32)),
+        })))
+    }
+
+    /// The sweep the arguments describe; every list is checked here, before anything runs.
+    pub fn spec(&self) -> Result<SweepSpec> {
+        use crate::flow::sweep::{SceneSpec, axis};
+        // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
+        // sweep as a run from here.
+        let mut scenes = Vec::new();
+        for p in &self.scenes {
+            scenes.push(SceneSpec::Obj(std::path::absolute(p).map_err(|e| Error::file(p, e.to_string()))?));
+        }
+        scenes.extend(self.builtin.iter().map(|b| SceneSpec::Builtin(b.trim().to_string())));
+        if scenes.is_empty() {
+            scenes.push(SceneSpec::Builtin("teapot".into()));
+        }
+        if !(self.camera.fov > 0.0 && self.camera.fov < 180.0) {
+            return Err(Error::param("fov", format!("{} is out of range: must be in (0, 180)", self.camera.fov)));
+        }
+        let single = Params { stack_depth: self.stack_depth, tree: self.tree, ..Params::default() };
+        single.validate()?;
+        crate::cores::clock::ClockTarget(self.target_mhz).check()?;
+        Ok(SweepSpec {
+            scenes,
+            camera: self.camera.spec(),
+            n: axis::parse_u32_list("n", &self.n)?,
+            m: axis::parse_u32_list("m", &self.m)?,
+            t: axis::parse_u32_list("t", &self.t)?,
+            c: axis::parse_u32_list("c", &self.c)?,
+            edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
+            leaf_size: axis::parse_u32_list("leaf-size", &self.leaf_size)?,
+            stack_depth: self.stack_depth,
+            tree: self.tree,
+            one_at_a_time: self.one_at_a_time,
+            synth: self.synth,
+            core_sim: self.core_sim,
+            target_mhz: self.target_mhz,
+            slots: axis::parse_u32_list("slots", &self.slots)?,
+            units: axis::parse_u32_list("units", &self.units)?,
+            ecp5: self.ecp5()?,
+        })
+    }
+
+    /// `--family` and the options of ecp5 alone: the modules in `ECP5_MODULES` order, each
+    /// once.
+    fn ecp5(&self) -> Result<Option<crate::flow::sweep::Ecp5Choice>> {
+        let family = self.family.as_deref().unwrap_or("xc5v");
+        match family {
+            "ecp5" if !self.synth => Err(Error::param("family", "ecp5 places and routes with --synth: add --synth")),
+            "ecp5" => {
+                let given = self.modules.clone().unwrap_or_else(|| vec!["core".into()]);
+                crate::flow::ecp5::check_modules(&given)?;
+                let modules = ECP5_MODULES.iter().filter(|m| given.iter().any(|g| g == *m)).map(|m| m.to_string());
+                Ok(Some(crate::flow::sweep::Ecp5Choice { modules: modules.collect(), seed: self.seed.unwrap_or(1) }))
+            }
+            "xc5v" if self.seed.is_some() => Err(Error::param("seed", "is nextpnr's: only with --family ecp5")),
+            "xc5v" if self.modules.is_some() => {
+                Err(Error::param("modules", "are placed and routed only with --family ecp5"))
+            }
+            "xc5v" => Ok(None),
+            other => Err(Error::param("family", format!("'{other}' is not a sweep family: use xc5v or ecp5"))),
+        }
+    }
+}
