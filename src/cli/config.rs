@@ -6,7 +6,6 @@
 //! core's memories) is checked in `cli::run` as soon as the scene is loaded, still before
 //! anything is written.
 
-pub use super::sweep_config::{SweepConfig, SweepRun};
 use super::{
     BenchArgs, BenchWhat, CameraArgs, CompareArgs, FrameSim, GenArgs, HwArgs, Lang, ParamArgs, RenderArgs, SceneArgs,
     SceneChoice, SimArgs, SimChoice, SynthArgs, TestArgs,

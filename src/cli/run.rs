@@ -6,8 +6,9 @@ use super::Command;
 use super::HwArgs;
 use super::config::{
     BenchConfig, CompareConfig, Family, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation,
-    SweepConfig, SweepRun, SynthConfig, TestConfig,
+    SynthConfig, TestConfig,
 };
+use super::sweep_config::{SweepConfig, SweepRun};
 use crate::cores::intersect::IntersectParams;
 use crate::error::{Error, Result};
 use crate::flow::sweep::{run as sweep, slurm};

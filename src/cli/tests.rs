@@ -1,6 +1,7 @@
 //! The command line's parsers and each command's validation (`config`).
 
 use super::config::*;
+use super::sweep_config::SweepConfig;
 use super::*;
 use crate::error::Result;
 use crate::flow::simulators::Simulator;
