@@ -1888,29 +1888,21 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     else in_valid2_1 <= valid;
     if (rst) in_valid2_2 <= 1'h0;
     else in_valid2_2 <= in_valid2_1;
-    for (in_first_i = 2; in_first_i > 1; in_first_i = in_first_i - 1)
-      in_first_sr[in_first_i] <= in_first_sr[in_first_i - 1];
+    in_first_sr[2] <= in_first_sr[1];
     in_first_sr[1] <= first;
-    for (in_last_i = 2; in_last_i > 1; in_last_i = in_last_i - 1)
-      in_last_sr[in_last_i] <= in_last_sr[in_last_i - 1];
+    in_last_sr[2] <= in_last_sr[1];
     in_last_sr[1] <= last;
-    for (in_tri_i = 2; in_tri_i > 1; in_tri_i = in_tri_i - 1)
-      in_tri_sr[in_tri_i] <= in_tri_sr[in_tri_i - 1];
+    in_tri_sr[2] <= in_tri_sr[1];
     in_tri_sr[1] <= tri_s;
-    for (in_slot_i = 2; in_slot_i > 1; in_slot_i = in_slot_i - 1)
-      in_slot_sr[in_slot_i] <= in_slot_sr[in_slot_i - 1];
+    in_slot_sr[2] <= in_slot_sr[1];
     in_slot_sr[1] <= slot;
-    for (in_sp_i = 2; in_sp_i > 1; in_sp_i = in_sp_i - 1)
-      in_sp_sr[in_sp_i] <= in_sp_sr[in_sp_i - 1];
+    in_sp_sr[2] <= in_sp_sr[1];
     in_sp_sr[1] <= sp;
-    for (in_t_i = 2; in_t_i > 1; in_t_i = in_t_i - 1)
-      in_t_sr[in_t_i] <= in_t_sr[in_t_i - 1];
+    in_t_sr[2] <= in_t_sr[1];
     in_t_sr[1] <= t;
-    for (in_u_i = 2; in_u_i > 1; in_u_i = in_u_i - 1)
-      in_u_sr[in_u_i] <= in_u_sr[in_u_i - 1];
+    in_u_sr[2] <= in_u_sr[1];
     in_u_sr[1] <= u;
-    for (in_v_i = 2; in_v_i > 1; in_v_i = in_v_i - 1)
-      in_v_sr[in_v_i] <= in_v_sr[in_v_i - 1];
+    in_v_sr[2] <= in_v_sr[1];
     in_v_sr[1] <= v;
     if (rst) acc_empty <= 1'h1;
     else acc_empty <= mux_take;

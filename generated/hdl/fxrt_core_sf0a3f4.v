@@ -931,8 +931,11 @@ module fxrt_core_sf0a3f4 (
     else pu_product_valid_5 <= pu_product_valid_4;
     if (rst) pu_product_valid_6 <= 1'h0;
     else pu_product_valid_6 <= pu_product_valid_5;
-    for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
-      pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
+    pu_product_last_sr[6] <= pu_product_last_sr[5];
+    pu_product_last_sr[5] <= pu_product_last_sr[4];
+    pu_product_last_sr[4] <= pu_product_last_sr[3];
+    pu_product_last_sr[3] <= pu_product_last_sr[2];
+    pu_product_last_sr[2] <= pu_product_last_sr[1];
     pu_product_last_sr[1] <= pu_delta_last;
     pu_above_r <= pu_above;
     pu_below_r <= pu_below;
@@ -954,8 +957,16 @@ module fxrt_core_sf0a3f4 (
     box_lt1_d <= box_lt1;
     if (rst) box_done <= 1'h0;
     else box_done <= box_last;
-    for (box_done_slot_i = 11; box_done_slot_i > 1; box_done_slot_i = box_done_slot_i - 1)
-      box_done_slot_sr[box_done_slot_i] <= box_done_slot_sr[box_done_slot_i - 1];
+    box_done_slot_sr[11] <= box_done_slot_sr[10];
+    box_done_slot_sr[10] <= box_done_slot_sr[9];
+    box_done_slot_sr[9] <= box_done_slot_sr[8];
+    box_done_slot_sr[8] <= box_done_slot_sr[7];
+    box_done_slot_sr[7] <= box_done_slot_sr[6];
+    box_done_slot_sr[6] <= box_done_slot_sr[5];
+    box_done_slot_sr[5] <= box_done_slot_sr[4];
+    box_done_slot_sr[4] <= box_done_slot_sr[3];
+    box_done_slot_sr[3] <= box_done_slot_sr[2];
+    box_done_slot_sr[2] <= box_done_slot_sr[1];
     box_done_slot_sr[1] <= box_slot;
     if (rst) leaf_active <= 1'h0;
     else leaf_active <= leaf_take_or_and_30;
@@ -982,8 +993,8 @@ module fxrt_core_sf0a3f4 (
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
     if (u1_leaf_fill) u1_buf_leaf_tmin <= u_traverse_1_leaf_tmin;
     if (u1_leaf_fill) u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
-    for (emit_tag_i = 3; emit_tag_i > 1; emit_tag_i = emit_tag_i - 1)
-      emit_tag_sr[emit_tag_i] <= emit_tag_sr[emit_tag_i - 1];
+    emit_tag_sr[3] <= emit_tag_sr[2];
+    emit_tag_sr[2] <= emit_tag_sr[1];
     emit_tag_sr[1] <= cat_32;
     if (rst) emit_valid_1 <= 1'h0;
     else emit_valid_1 <= leaf_active;
@@ -997,16 +1008,14 @@ module fxrt_core_sf0a3f4 (
     else pipe_valid_2 <= pipe_valid_1;
     if (rst) pipe_valid_3 <= 1'h0;
     else pipe_valid_3 <= pipe_valid_2;
-    for (pipe_tag_i = 3; pipe_tag_i > 1; pipe_tag_i = pipe_tag_i - 1)
-      pipe_tag_sr[pipe_tag_i] <= pipe_tag_sr[pipe_tag_i - 1];
+    pipe_tag_sr[3] <= pipe_tag_sr[2];
+    pipe_tag_sr[2] <= pipe_tag_sr[1];
     pipe_tag_sr[1] <= emit_tag_tri;
     ray_o_q <= ray_o[bits_emit_tag_tri];
-    for (pipe_o_i = 2; pipe_o_i > 1; pipe_o_i = pipe_o_i - 1)
-      pipe_o_sr[pipe_o_i] <= pipe_o_sr[pipe_o_i - 1];
+    pipe_o_sr[2] <= pipe_o_sr[1];
     pipe_o_sr[1] <= ray_o_q;
     ray_w_q <= ray_w[bits_emit_tag_tri];
-    for (pipe_w_i = 2; pipe_w_i > 1; pipe_w_i = pipe_w_i - 1)
-      pipe_w_sr[pipe_w_i] <= pipe_w_sr[pipe_w_i - 1];
+    pipe_w_sr[2] <= pipe_w_sr[1];
     pipe_w_sr[1] <= ray_w_q;
     if (rst) res_credit_ok <= 1'h1;
     else res_credit_ok <= ne_49;

@@ -1193,35 +1193,34 @@ module fxrt_traverse_k64_sf0a3f4 (
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
-  reg [0:0] negative_n2 = 1'h0;
   reg signed [31:0] tmin_n2 = 32'sh00000000;
   reg signed [31:0] tmax_n2 = 32'sh00000000;
   reg signed [31:0] tmax_p1_n2 = 32'sh00000000;
   reg signed [31:0] tmin_m1_n2 = 32'sh00000000;
   wire signed [31:0] k_m2147483648 = 32'sh80000000;
   wire signed [31:0] k_2147483647 = 32'sh7fffffff;
-  wire signed [31:0] mux_negative_n2;
+  wire signed [31:0] mux_negative_n1;
   wire signed [31:0] d0_hi_c;
   reg signed [31:0] d0_hi_n3 = 32'sh00000000;
   (* mem2reg *) reg signed [31:0] d0_hi_sr [1:7];
   integer d0_hi_i;
   initial for (d0_hi_i = 1; d0_hi_i <= 7; d0_hi_i = d0_hi_i + 1) d0_hi_sr[d0_hi_i] = 32'sh00000000;
   wire signed [31:0] d0_hi;
-  wire signed [31:0] mux_negative_n2_1;
+  wire signed [31:0] mux_negative_n1_1;
   wire signed [31:0] d0_lo_c;
   reg signed [31:0] d0_lo_n3 = 32'sh00000000;
   (* mem2reg *) reg signed [31:0] d0_lo_sr [1:7];
   integer d0_lo_i;
   initial for (d0_lo_i = 1; d0_lo_i <= 7; d0_lo_i = d0_lo_i + 1) d0_lo_sr[d0_lo_i] = 32'sh00000000;
   wire signed [31:0] d0_lo;
-  wire signed [31:0] mux_negative_n2_2;
+  wire signed [31:0] mux_negative_n1_2;
   wire signed [31:0] d1_hi_c;
   reg signed [31:0] d1_hi_n3 = 32'sh00000000;
   (* mem2reg *) reg signed [31:0] d1_hi_sr [1:7];
   integer d1_hi_i;
   initial for (d1_hi_i = 1; d1_hi_i <= 7; d1_hi_i = d1_hi_i + 1) d1_hi_sr[d1_hi_i] = 32'sh00000000;
   wire signed [31:0] d1_hi;
-  wire signed [31:0] mux_negative_n2_3;
+  wire signed [31:0] mux_negative_n1_3;
   wire signed [31:0] d1_lo_c;
   reg signed [31:0] d1_lo_n3 = 32'sh00000000;
   (* mem2reg *) reg signed [31:0] d1_lo_sr [1:7];
@@ -2220,17 +2219,17 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
   assign minus_122 = rs_tmin_n1 - rs_tmax_p1;
   assign tmin_le_tmax_c = minus_122[32];
-  assign mux_negative_n2 = negative_n2 ? tmax_p1_n2 : tmax_n2;
-  assign d0_hi_c = tmin_le_tmax ? mux_negative_n2 : k_m2147483648;
+  assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
+  assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
   assign d0_hi = d0_hi_sr[7];
-  assign mux_negative_n2_1 = negative_n2 ? tmin_n2 : tmin_m1_n2;
-  assign d0_lo_c = tmin_le_tmax ? mux_negative_n2_1 : k_2147483647;
+  assign mux_negative_n1_1 = negative_n1 ? tmin_n2 : tmin_m1_n2;
+  assign d0_lo_c = tmin_le_tmax ? mux_negative_n1_1 : k_2147483647;
   assign d0_lo = d0_lo_sr[7];
-  assign mux_negative_n2_2 = negative_n2 ? tmax_n2 : tmax_p1_n2;
-  assign d1_hi_c = tmin_le_tmax ? mux_negative_n2_2 : k_m2147483648;
+  assign mux_negative_n1_2 = negative_n1 ? tmax_n2 : tmax_p1_n2;
+  assign d1_hi_c = tmin_le_tmax ? mux_negative_n1_2 : k_m2147483648;
   assign d1_hi = d1_hi_sr[7];
-  assign mux_negative_n2_3 = negative_n2 ? tmin_m1_n2 : tmin_n2;
-  assign d1_lo_c = tmin_le_tmax ? mux_negative_n2_3 : k_2147483647;
+  assign mux_negative_n1_3 = negative_n1 ? tmin_m1_n2 : tmin_n2;
+  assign d1_lo_c = tmin_le_tmax ? mux_negative_n1_3 : k_2147483647;
   assign d1_lo = d1_lo_sr[7];
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
@@ -2370,8 +2369,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     b_tmin <= mux_r_valid_1;
     b_tmax <= mux_r_valid_2;
     b_sp <= mux_a_from_stack;
-    for (b_from_stack_i = 2; b_from_stack_i > 1; b_from_stack_i = b_from_stack_i - 1)
-      b_from_stack_sr[b_from_stack_i] <= b_from_stack_sr[b_from_stack_i - 1];
+    b_from_stack_sr[2] <= b_from_stack_sr[1];
     b_from_stack_sr[1] <= a_from_stack;
     if (rst) b2_valid <= 1'h0;
     else b2_valid <= b_valid;
@@ -2419,20 +2417,20 @@ module fxrt_traverse_k64_sf0a3f4 (
     else n_valid_2 <= n_valid_1;
     if (rst) n_valid_3 <= 1'h0;
     else n_valid_3 <= n_valid_2;
-    for (n_slot_i = 3; n_slot_i > 1; n_slot_i = n_slot_i - 1)
-      n_slot_sr[n_slot_i] <= n_slot_sr[n_slot_i - 1];
+    n_slot_sr[3] <= n_slot_sr[2];
+    n_slot_sr[2] <= n_slot_sr[1];
     n_slot_sr[1] <= c_slot;
-    for (n_node_i = 3; n_node_i > 1; n_node_i = n_node_i - 1)
-      n_node_sr[n_node_i] <= n_node_sr[n_node_i - 1];
+    n_node_sr[3] <= n_node_sr[2];
+    n_node_sr[2] <= n_node_sr[1];
     n_node_sr[1] <= c_node;
-    for (n_tmin_i = 3; n_tmin_i > 1; n_tmin_i = n_tmin_i - 1)
-      n_tmin_sr[n_tmin_i] <= n_tmin_sr[n_tmin_i - 1];
+    n_tmin_sr[3] <= n_tmin_sr[2];
+    n_tmin_sr[2] <= n_tmin_sr[1];
     n_tmin_sr[1] <= c_tmin;
-    for (n_tmax_i = 3; n_tmax_i > 1; n_tmax_i = n_tmax_i - 1)
-      n_tmax_sr[n_tmax_i] <= n_tmax_sr[n_tmax_i - 1];
+    n_tmax_sr[3] <= n_tmax_sr[2];
+    n_tmax_sr[2] <= n_tmax_sr[1];
     n_tmax_sr[1] <= c_tmax;
-    for (n_sp_i = 3; n_sp_i > 1; n_sp_i = n_sp_i - 1)
-      n_sp_sr[n_sp_i] <= n_sp_sr[n_sp_i - 1];
+    n_sp_sr[3] <= n_sp_sr[2];
+    n_sp_sr[2] <= n_sp_sr[1];
     n_sp_sr[1] <= c_sp;
     if (rst) leaf_pop_r <= 1'h0;
     else leaf_pop_r <= leaf_pop;
@@ -2479,8 +2477,11 @@ module fxrt_traverse_k64_sf0a3f4 (
     else pu_product_valid_5 <= pu_product_valid_4;
     if (rst) pu_product_valid_6 <= 1'h0;
     else pu_product_valid_6 <= pu_product_valid_5;
-    for (pu_product_last_i = 6; pu_product_last_i > 1; pu_product_last_i = pu_product_last_i - 1)
-      pu_product_last_sr[pu_product_last_i] <= pu_product_last_sr[pu_product_last_i - 1];
+    pu_product_last_sr[6] <= pu_product_last_sr[5];
+    pu_product_last_sr[5] <= pu_product_last_sr[4];
+    pu_product_last_sr[4] <= pu_product_last_sr[3];
+    pu_product_last_sr[3] <= pu_product_last_sr[2];
+    pu_product_last_sr[2] <= pu_product_last_sr[1];
     pu_product_last_sr[1] <= pu_delta_last;
     pu_above_r <= pu_above;
     pu_below_r <= pu_below;
@@ -2516,8 +2517,11 @@ module fxrt_traverse_k64_sf0a3f4 (
     else pu_product_valid_5_1 <= pu_product_valid_4_1;
     if (rst) pu_product_valid_6_1 <= 1'h0;
     else pu_product_valid_6_1 <= pu_product_valid_5_1;
-    for (pu_product_last_1_i = 6; pu_product_last_1_i > 1; pu_product_last_1_i = pu_product_last_1_i - 1)
-      pu_product_last_1_sr[pu_product_last_1_i] <= pu_product_last_1_sr[pu_product_last_1_i - 1];
+    pu_product_last_1_sr[6] <= pu_product_last_1_sr[5];
+    pu_product_last_1_sr[5] <= pu_product_last_1_sr[4];
+    pu_product_last_1_sr[4] <= pu_product_last_1_sr[3];
+    pu_product_last_1_sr[3] <= pu_product_last_1_sr[2];
+    pu_product_last_1_sr[2] <= pu_product_last_1_sr[1];
     pu_product_last_1_sr[1] <= pu_delta_last_1;
     pu_above_r_1 <= pu_above_1;
     pu_below_r_1 <= pu_below_1;
@@ -2532,8 +2536,14 @@ module fxrt_traverse_k64_sf0a3f4 (
     else plane_t_valid_1 <= pu_clamp_valid_1;
     plane_t_last_1 <= pu_clamp_last_1;
     axis_n1 <= nw_axis;
-    for (negative_i = 9; negative_i > 1; negative_i = negative_i - 1)
-      negative_sr[negative_i] <= negative_sr[negative_i - 1];
+    negative_sr[9] <= negative_sr[8];
+    negative_sr[8] <= negative_sr[7];
+    negative_sr[7] <= negative_sr[6];
+    negative_sr[6] <= negative_sr[5];
+    negative_sr[5] <= negative_sr[4];
+    negative_sr[4] <= negative_sr[3];
+    negative_sr[3] <= negative_sr[2];
+    negative_sr[2] <= negative_sr[1];
     negative_sr[1] <= negative_c;
     if (rst) f_valid_1 <= 1'h0;
     else f_valid_1 <= n_stays;
@@ -2555,23 +2565,65 @@ module fxrt_traverse_k64_sf0a3f4 (
     else f_valid_9 <= f_valid_8;
     if (rst) f_valid_10 <= 1'h0;
     else f_valid_10 <= f_valid_9;
-    for (f_inner_i = 10; f_inner_i > 1; f_inner_i = f_inner_i - 1)
-      f_inner_sr[f_inner_i] <= f_inner_sr[f_inner_i - 1];
+    f_inner_sr[10] <= f_inner_sr[9];
+    f_inner_sr[9] <= f_inner_sr[8];
+    f_inner_sr[8] <= f_inner_sr[7];
+    f_inner_sr[7] <= f_inner_sr[6];
+    f_inner_sr[6] <= f_inner_sr[5];
+    f_inner_sr[5] <= f_inner_sr[4];
+    f_inner_sr[4] <= f_inner_sr[3];
+    f_inner_sr[3] <= f_inner_sr[2];
+    f_inner_sr[2] <= f_inner_sr[1];
     f_inner_sr[1] <= is_inner;
-    for (f_slot_i = 10; f_slot_i > 1; f_slot_i = f_slot_i - 1)
-      f_slot_sr[f_slot_i] <= f_slot_sr[f_slot_i - 1];
+    f_slot_sr[10] <= f_slot_sr[9];
+    f_slot_sr[9] <= f_slot_sr[8];
+    f_slot_sr[8] <= f_slot_sr[7];
+    f_slot_sr[7] <= f_slot_sr[6];
+    f_slot_sr[6] <= f_slot_sr[5];
+    f_slot_sr[5] <= f_slot_sr[4];
+    f_slot_sr[4] <= f_slot_sr[3];
+    f_slot_sr[3] <= f_slot_sr[2];
+    f_slot_sr[2] <= f_slot_sr[1];
     f_slot_sr[1] <= n_slot;
-    for (f_tmin_i = 10; f_tmin_i > 1; f_tmin_i = f_tmin_i - 1)
-      f_tmin_sr[f_tmin_i] <= f_tmin_sr[f_tmin_i - 1];
+    f_tmin_sr[10] <= f_tmin_sr[9];
+    f_tmin_sr[9] <= f_tmin_sr[8];
+    f_tmin_sr[8] <= f_tmin_sr[7];
+    f_tmin_sr[7] <= f_tmin_sr[6];
+    f_tmin_sr[6] <= f_tmin_sr[5];
+    f_tmin_sr[5] <= f_tmin_sr[4];
+    f_tmin_sr[4] <= f_tmin_sr[3];
+    f_tmin_sr[3] <= f_tmin_sr[2];
+    f_tmin_sr[2] <= f_tmin_sr[1];
     f_tmin_sr[1] <= n_tmin;
-    for (f_tmax_i = 10; f_tmax_i > 1; f_tmax_i = f_tmax_i - 1)
-      f_tmax_sr[f_tmax_i] <= f_tmax_sr[f_tmax_i - 1];
+    f_tmax_sr[10] <= f_tmax_sr[9];
+    f_tmax_sr[9] <= f_tmax_sr[8];
+    f_tmax_sr[8] <= f_tmax_sr[7];
+    f_tmax_sr[7] <= f_tmax_sr[6];
+    f_tmax_sr[6] <= f_tmax_sr[5];
+    f_tmax_sr[5] <= f_tmax_sr[4];
+    f_tmax_sr[4] <= f_tmax_sr[3];
+    f_tmax_sr[3] <= f_tmax_sr[2];
+    f_tmax_sr[2] <= f_tmax_sr[1];
     f_tmax_sr[1] <= n_tmax;
-    for (f_sp_i = 10; f_sp_i > 1; f_sp_i = f_sp_i - 1)
-      f_sp_sr[f_sp_i] <= f_sp_sr[f_sp_i - 1];
+    f_sp_sr[10] <= f_sp_sr[9];
+    f_sp_sr[9] <= f_sp_sr[8];
+    f_sp_sr[8] <= f_sp_sr[7];
+    f_sp_sr[7] <= f_sp_sr[6];
+    f_sp_sr[6] <= f_sp_sr[5];
+    f_sp_sr[5] <= f_sp_sr[4];
+    f_sp_sr[4] <= f_sp_sr[3];
+    f_sp_sr[3] <= f_sp_sr[2];
+    f_sp_sr[2] <= f_sp_sr[1];
     f_sp_sr[1] <= n_sp;
-    for (f_child_i = 10; f_child_i > 1; f_child_i = f_child_i - 1)
-      f_child_sr[f_child_i] <= f_child_sr[f_child_i - 1];
+    f_child_sr[10] <= f_child_sr[9];
+    f_child_sr[9] <= f_child_sr[8];
+    f_child_sr[8] <= f_child_sr[7];
+    f_child_sr[7] <= f_child_sr[6];
+    f_child_sr[6] <= f_child_sr[5];
+    f_child_sr[5] <= f_child_sr[4];
+    f_child_sr[4] <= f_child_sr[3];
+    f_child_sr[3] <= f_child_sr[2];
+    f_child_sr[2] <= f_child_sr[1];
     f_child_sr[1] <= nw_child;
     negative_n1 <= bits_case_axis_n1_1;
     tmin_n1 <= n_tmin;
@@ -2579,26 +2631,41 @@ module fxrt_traverse_k64_sf0a3f4 (
     tmax_p1 <= tmax_plus_1;
     tmin_m1 <= tmin_minus_1;
     tmin_le_tmax <= tmin_le_tmax_c;
-    negative_n2 <= negative_n1;
     tmin_n2 <= tmin_n1;
     tmax_n2 <= tmax_n1;
     tmax_p1_n2 <= tmax_p1;
     tmin_m1_n2 <= tmin_m1;
     d0_hi_n3 <= d0_hi_c;
-    for (d0_hi_i = 7; d0_hi_i > 1; d0_hi_i = d0_hi_i - 1)
-      d0_hi_sr[d0_hi_i] <= d0_hi_sr[d0_hi_i - 1];
+    d0_hi_sr[7] <= d0_hi_sr[6];
+    d0_hi_sr[6] <= d0_hi_sr[5];
+    d0_hi_sr[5] <= d0_hi_sr[4];
+    d0_hi_sr[4] <= d0_hi_sr[3];
+    d0_hi_sr[3] <= d0_hi_sr[2];
+    d0_hi_sr[2] <= d0_hi_sr[1];
     d0_hi_sr[1] <= d0_hi_n3;
     d0_lo_n3 <= d0_lo_c;
-    for (d0_lo_i = 7; d0_lo_i > 1; d0_lo_i = d0_lo_i - 1)
-      d0_lo_sr[d0_lo_i] <= d0_lo_sr[d0_lo_i - 1];
+    d0_lo_sr[7] <= d0_lo_sr[6];
+    d0_lo_sr[6] <= d0_lo_sr[5];
+    d0_lo_sr[5] <= d0_lo_sr[4];
+    d0_lo_sr[4] <= d0_lo_sr[3];
+    d0_lo_sr[3] <= d0_lo_sr[2];
+    d0_lo_sr[2] <= d0_lo_sr[1];
     d0_lo_sr[1] <= d0_lo_n3;
     d1_hi_n3 <= d1_hi_c;
-    for (d1_hi_i = 7; d1_hi_i > 1; d1_hi_i = d1_hi_i - 1)
-      d1_hi_sr[d1_hi_i] <= d1_hi_sr[d1_hi_i - 1];
+    d1_hi_sr[7] <= d1_hi_sr[6];
+    d1_hi_sr[6] <= d1_hi_sr[5];
+    d1_hi_sr[5] <= d1_hi_sr[4];
+    d1_hi_sr[4] <= d1_hi_sr[3];
+    d1_hi_sr[3] <= d1_hi_sr[2];
+    d1_hi_sr[2] <= d1_hi_sr[1];
     d1_hi_sr[1] <= d1_hi_n3;
     d1_lo_n3 <= d1_lo_c;
-    for (d1_lo_i = 7; d1_lo_i > 1; d1_lo_i = d1_lo_i - 1)
-      d1_lo_sr[d1_lo_i] <= d1_lo_sr[d1_lo_i - 1];
+    d1_lo_sr[7] <= d1_lo_sr[6];
+    d1_lo_sr[6] <= d1_lo_sr[5];
+    d1_lo_sr[5] <= d1_lo_sr[4];
+    d1_lo_sr[4] <= d1_lo_sr[3];
+    d1_lo_sr[3] <= d1_lo_sr[2];
+    d1_lo_sr[2] <= d1_lo_sr[1];
     d1_lo_sr[1] <= d1_lo_n3;
     near_lt_tmax <= near_lt_tmax_c;
     far_gt_tmin <= far_gt_tmin_c;
