@@ -264,9 +264,15 @@ pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
 
 /// Stages results.json, results.csv and the images of every row (from the cache) into `files`.
 pub fn add_tables_and_images(files: &mut OutputSet, dir: &Path, cache: &Path, results: &Results) -> Result<()> {
+    // Rows that differ only in the core's shape share their images (the picture is the
+    // model's): each is staged once.
+    let mut staged = std::collections::BTreeSet::new();
     for r in results.rows.iter().filter(|r| r.quality.is_some()) {
-        let (png, errors) = cached_images(cache, &r.key)?;
         let (p, e) = r.image_paths();
+        if !staged.insert(p.clone()) {
+            continue;
+        }
+        let (png, errors) = cached_images(cache, &r.key)?;
         files.add(&dir.join(p), &png)?;
         files.add(&dir.join(e), &errors)?;
     }
