@@ -318,7 +318,7 @@ pub struct GenArgs {
     #[arg(long, value_name = "FILE")]
     pub measured: Option<PathBuf>,
     /// The clock the cores are pipelined for, MHz (50..=400); also the ISE UCF's constraint.
-    #[arg(long = "target-mhz", alias = "clock-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
+    #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,
     #[command(flatten)]
     pub threads: ThreadArgs,

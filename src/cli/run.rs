@@ -247,7 +247,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
         let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
-        let stream = crate::flow::axis::frame_files(&layout, scene, &rays);
+        let stream = crate::flow::axis_host::frame_files(&layout, scene, &rays);
         files.extend(stream.into_iter().map(|(n, b)| (c.out.join(n), b)))?;
     }
     files.commit()?;

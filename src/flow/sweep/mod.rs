@@ -8,7 +8,7 @@
 //! the configurations with index ≡ I−1 (mod N); `merge` joins shards. The outputs are a
 //! function of (spec, rows) alone, so a merged sweep is byte-identical to an unsharded one.
 
-pub mod axis;
+pub mod values;
 pub mod compat;
 pub mod draw;
 pub mod eval;
