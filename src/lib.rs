@@ -1,6 +1,7 @@
 //! fxrt: a generator of fixed-point ray tracing hardware (after Hanika 2007), and the models
 //! that prove it correct. The modules follow the data path: scene → model → render.
 
+pub mod bits;
 pub mod cli;
 pub mod cores;
 pub mod error;

@@ -4,7 +4,6 @@
 //! (the integer type the model computes in), so the model never has to check for overflow.
 
 use crate::error::{Error, Result};
-pub use crate::scene::bih::Split as TreeSplit;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -37,6 +36,52 @@ impl fmt::Display for EdgeShift {
         }
     }
 }
+
+/// How the BIH builder chooses an inner node's split plane (`--tree`; `scene::bih`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TreeSplit {
+    /// The thesis's: halve the split box on its longest axis (DECISIONS.md 11).
+    Middle,
+    /// Binned surface-area heuristic over the traversal's clipped boxes (DECISIONS.md 72): the
+    /// default, by measurement.
+    #[default]
+    Sah,
+}
+
+impl TreeSplit {
+    pub const ALL: [TreeSplit; 2] = [TreeSplit::Middle, TreeSplit::Sah];
+
+    pub fn is_middle(&self) -> bool {
+        *self == TreeSplit::Middle
+    }
+
+    /// A JSON file without the field: written before the option existed, so middle-split.
+    pub fn absent() -> TreeSplit {
+        TreeSplit::Middle
+    }
+}
+
+impl FromStr for TreeSplit {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "middle" => Ok(TreeSplit::Middle),
+            "sah" => Ok(TreeSplit::Sah),
+            _ => Err(format!("'{s}' is not a split: use middle or sah")),
+        }
+    }
+}
+
+impl fmt::Display for TreeSplit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            TreeSplit::Middle => "middle",
+            TreeSplit::Sah => "sah",
+        })
+    }
+}
+
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Params {

@@ -5,7 +5,7 @@ mod common;
 
 use fxrt::cores::axis::{Field, Layout};
 use fxrt::cores::top::{CoreParams, core_module};
-use fxrt::flow::axis::{c_header, pack_ray, pack_result, unpack_result};
+use fxrt::flow::axis_host::{c_header, pack_ray, pack_result, unpack_result};
 use fxrt::flow::frame::frame_rays;
 use fxrt::model::camera::Camera;
 use fxrt::model::golden::{GridRay, Hit};

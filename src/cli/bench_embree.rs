@@ -4,7 +4,7 @@
 //! (`flow::embree`); its hit count must be the golden model's within 1 % of the pixels, or the
 //! two did not trace the same rays (exit 1).
 
-use super::run::thread_pool;
+use super::config::thread_pool;
 use crate::error::Result;
 use crate::flow::embree::{self, EmbreeReport};
 use crate::model::camera::Camera;

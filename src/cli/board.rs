@@ -20,7 +20,7 @@ fn board_camera(scene: &Scene, spec: &CameraSpec) -> Result<crate::model::raygen
             CameraSpec { eye: Some(inside.eye), at: Some(spec.at.unwrap_or(inside.at)), ..spec.clone() }
         }
     };
-    super::run::ray_generator(scene, &spec)
+    crate::model::raygen::RayGen::for_camera(scene, &spec)
 }
 
 /// Writes the board design; for the ULX3S (unless --no-bitstream) places, routes and packs it.
@@ -31,7 +31,7 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     };
     let scene = Scene::load(source, params)?;
     let g = board_camera(&scene, spec)?;
-    super::run::ids_fit(c.ray_id_width, g.width, g.height)?;
+    super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
     let roms = SceneRoms::of(&scene);
     let t = c.threads;
     let p = CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);

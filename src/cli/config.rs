@@ -87,6 +87,24 @@ pub fn threads(n: Option<usize>) -> Result<Option<usize>> {
     }
 }
 
+/// The worker pool for `threads` (None: all cores).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        b = b.num_threads(n);
+    }
+    b.build().map_err(|e| Error::param("threads", e.to_string()))
+}
+
+/// A frame of `width` × `height` rays numbered by pixel fits ray ids of `id_width` bits.
+pub fn ids_fit(id_width: u32, width: u32, height: u32) -> Result<()> {
+    let pixels = width as u64 * height as u64;
+    if id_width < 64 && pixels > 1u64 << id_width {
+        return Err(Error::param("ray-id-width", format!("{id_width} bits cannot number the {pixels} pixels of --size")));
+    }
+    Ok(())
+}
+
 /// Output files of one command, (option, path) for those given: each can be written
 /// (`io::check_writable`) and no two name one file.
 pub fn check_outputs(files: &[(&str, &Option<PathBuf>)]) -> Result<()> {

@@ -39,9 +39,9 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let target = crate::cores::clock::DEFAULT_TARGET_MHZ;
     let p = CoreParams::with_slots(&roms, RAY_ID_WIDTH, 1, target, DEFAULT_SLOTS, DEFAULT_UNITS);
     p.check()?;
-    super::run::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
+    super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     let netlist = core_module_with(&p, &roms, false);
-    let measured = super::run::measured_entry(Path::new("generated/measured/ecp5-core.json"), MEASURED, &p, &netlist, &roms.name).ok();
+    let measured = crate::flow::ecp5::measured_entry(Path::new("generated/measured/ecp5-core.json"), MEASURED, &p, &netlist, &roms.name).ok();
     let o = generate::GenOptions { vhdl: true, verilog: true, ise: false, debug_ports: false, clock_mhz: target as f64 };
     let hdl = c.out.join("hdl");
     // Kept in memory while the frame is simulated (an interrupted demo leaves nothing), then

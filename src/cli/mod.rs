@@ -318,7 +318,7 @@ pub struct GenArgs {
     #[arg(long, value_name = "FILE")]
     pub measured: Option<PathBuf>,
     /// The clock the cores are pipelined for, MHz (50..=400); also the ISE UCF's constraint.
-    #[arg(long = "target-mhz", alias = "clock-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
+    #[arg(long = "target-mhz", default_value_t = crate::cores::clock::DEFAULT_TARGET_MHZ)]
     pub target_mhz: u32,
     #[command(flatten)]
     pub threads: ThreadArgs,
@@ -357,7 +357,8 @@ pub struct GenArgs {
     pub pnr_seed: u64,
     /// Also write the frame of --size (and the other camera options) for the AXI4-Stream
     /// wrapper: rays.bin, each ray's tdata in pixel order, and expected.bin, the golden model's
-    /// result tdata for each, in the same order (docs/AXIS.md).
+    /// result tdata for each, in the same order (docs/AXIS.md). Only the rays that reach the
+    /// scene's box are in it: their ids, the pixel numbers, have gaps.
     #[arg(long = "axis-frame")]
     pub axis_frame: bool,
     #[command(flatten)]

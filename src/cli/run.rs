@@ -6,15 +6,15 @@ use super::Command;
 use super::HwArgs;
 use super::config::{
     BenchConfig, CompareConfig, Family, GenConfig, GenScene, RenderConfig, SceneConfig, SimConfig, Simulation,
-    SynthConfig, TestConfig,
+    SynthConfig, TestConfig, ids_fit, thread_pool,
 };
 use super::sweep_config::{SweepConfig, SweepRun};
 use crate::cores::intersect::IntersectParams;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::flow::sweep::{run as sweep, slurm};
 use crate::flow::{check, feed, frame, generate, synth, vectors};
 use crate::io::OutputSet;
-use crate::model::camera::{Camera, CameraSpec};
+use crate::model::camera::Camera;
 use crate::model::golden::Golden;
 use crate::model::raygen::RayGen;
 use crate::params::Params;
@@ -45,14 +45,6 @@ pub fn run(cmd: Command) -> Result<bool> {
         Command::Sim(a) => sim(&a.config()?),
         Command::Test(a) => test(&a.config()?),
     }
-}
-
-pub(super) fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    let mut b = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        b = b.num_threads(n);
-    }
-    b.build().map_err(|e| Error::param("threads", e.to_string()))
 }
 
 pub fn render(c: &RenderConfig) -> Result<()> {
@@ -227,70 +219,12 @@ fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<Inter
     Ok(p)
 }
 
-/// The on-chip ray generator for a camera (inside the scene box).
-pub(super) fn ray_generator(scene: &Scene, camera: &CameraSpec) -> Result<RayGen> {
-    let cam = camera.camera(scene)?;
-    RayGen::new(scene, &cam).map_err(|(opt, msg)| Error::param(opt, msg))
-}
-
-/// The whole core's entry of a `fxrt synth --family ecp5` report, checked to be for this scene
-/// and these parameters (`fxrt gen --measured`).
-fn measured_core(file: &Path, p: &crate::cores::top::CoreParams, netlist: &crate::rtl::Module, scene: &str) -> Result<serde_json::Value> {
-    let text = std::fs::read_to_string(file).map_err(|e| Error::file(file, e.to_string()))?;
-    measured_entry(file, &text, p, netlist, scene)
-}
-
-/// The placed and routed core of a `fxrt synth --family ecp5` report (`text`, read from
-/// `file`), when it measured exactly this netlist of this scene and parameters.
-pub(super) fn measured_entry(
-    file: &Path,
-    text: &str,
-    p: &crate::cores::top::CoreParams,
-    netlist: &crate::rtl::Module,
-    scene: &str,
-) -> Result<serde_json::Value> {
-    let bad = |msg: String| Error::file(file, msg);
-    let doc: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(format!("not a synth report: {e}")))?;
-    let want = serde_json::json!({ "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "e": p.isect.e, "target_mhz": p.isect.target_mhz, "div_bits": p.isect.div_bits });
-    let params = &doc["params"];
-    for (k, v) in want.as_object().expect("an object") {
-        if &params[k] != v {
-            return Err(bad(format!("measured with {k} = {}, not this core's {v}", params[k])));
-        }
-    }
-    if doc["scene"] != scene {
-        return Err(bad(format!("measured on scene {}, not {scene}", doc["scene"])));
-    }
-    let modules = doc["modules"].as_array().cloned().unwrap_or_default();
-    let core = modules.into_iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
-    let core_entry = core.filter(|m| m["fmax_mhz"].is_number()).ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))?;
-    // Figures of another netlist (the generator changed since, or other options) are not this
-    // core's.
-    let hash = crate::flow::ecp5::netlist_hash(netlist);
-    if core_entry["netlist_sha256"] != hash.as_str() {
-        return Err(bad(format!(
-            "measured another netlist (sha256 {}, this core's {hash}): place and route it again with fxrt synth --family ecp5",
-            core_entry["netlist_sha256"]
-        )));
-    }
-    Ok(core_entry)
-}
-
-/// A frame of `width` × `height` rays numbered by pixel fits ray ids of `id_width` bits.
-pub(super) fn ids_fit(id_width: u32, width: u32, height: u32) -> Result<()> {
-    let pixels = width as u64 * height as u64;
-    if id_width < 64 && pixels > 1u64 << id_width {
-        return Err(Error::param("ray-id-width", format!("{id_width} bits cannot number the {pixels} pixels of --size")));
-    }
-    Ok(())
-}
-
 pub fn gen_core(c: &GenConfig) -> Result<()> {
     let (roms, raygen, scene) = match &c.scene {
         GenScene::Folder(dir) => (SceneRoms::load(dir)?, None, None),
         GenScene::Scene { source, params, raygen } => {
             let scene = Scene::load(source, params)?;
-            let raygen = raygen.as_ref().map(|cam| ray_generator(&scene, cam)).transpose()?;
+            let raygen = raygen.as_ref().map(|cam| RayGen::for_camera(&scene, cam)).transpose()?;
             (SceneRoms::of(&scene), raygen, Some(scene))
         }
     };
@@ -303,7 +237,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, debug_ports: c.debug_ports, clock_mhz: c.target_mhz as f64 };
     let measured = match c.measured.as_deref() {
-        Some(f) => Some(measured_core(f, &p, &crate::cores::top::core_module_with(&p, &roms, c.debug_ports), &roms.name)?),
+        Some(f) => Some(crate::flow::ecp5::measured_core(f, &p, &crate::cores::top::core_module_with(&p, &roms, c.debug_ports), &roms.name)?),
         None => None,
     };
     let mut files = OutputSet::new();
@@ -313,7 +247,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
         let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
-        let stream = crate::flow::axis::frame_files(&layout, scene, &rays);
+        let stream = crate::flow::axis_host::frame_files(&layout, scene, &rays);
         files.extend(stream.into_iter().map(|(n, b)| (c.out.join(n), b)))?;
     }
     files.commit()?;
@@ -414,7 +348,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let t = c.threads;
     let p = crate::cores::top::CoreParams::with_slots(&roms, id_width, c.div_bits, c.target_mhz, t.slots, t.units);
     p.check()?;
-    let raygen = if c.raygen { Some(ray_generator(&scene, &c.camera)?) } else { None };
+    let raygen = if c.raygen { Some(RayGen::for_camera(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {
         Some(g) => {
             let golden = Golden::new(&scene);

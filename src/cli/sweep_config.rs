@@ -67,7 +67,7 @@ impl SweepArgs {
 
     /// The sweep the arguments describe; every list is checked here, before anything runs.
     pub fn spec(&self) -> Result<SweepSpec> {
-        use crate::flow::sweep::{SceneSpec, axis};
+        use crate::flow::sweep::{SceneSpec, values};
         // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
         // sweep as a run from here.
         let mut scenes = Vec::new();
@@ -87,20 +87,20 @@ impl SweepArgs {
         Ok(SweepSpec {
             scenes,
             camera: self.camera.spec(),
-            n: axis::parse_u32_list("n", &self.n)?,
-            m: axis::parse_u32_list("m", &self.m)?,
-            t: axis::parse_u32_list("t", &self.t)?,
-            c: axis::parse_u32_list("c", &self.c)?,
-            edge_shift: axis::parse_edge_shift_list(&self.edge_shift)?,
-            leaf_size: axis::parse_u32_list("leaf-size", &self.leaf_size)?,
+            n: values::parse_u32_list("n", &self.n)?,
+            m: values::parse_u32_list("m", &self.m)?,
+            t: values::parse_u32_list("t", &self.t)?,
+            c: values::parse_u32_list("c", &self.c)?,
+            edge_shift: values::parse_edge_shift_list(&self.edge_shift)?,
+            leaf_size: values::parse_u32_list("leaf-size", &self.leaf_size)?,
             stack_depth: self.stack_depth,
             tree: self.tree,
             one_at_a_time: self.one_at_a_time,
             synth: self.synth,
             core_sim: self.core_sim,
             target_mhz: self.target_mhz,
-            slots: axis::parse_u32_list("slots", &self.slots)?,
-            units: axis::parse_u32_list("units", &self.units)?,
+            slots: values::parse_u32_list("slots", &self.slots)?,
+            units: values::parse_u32_list("units", &self.units)?,
             ecp5: self.ecp5()?,
         })
     }

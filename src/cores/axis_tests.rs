@@ -4,7 +4,7 @@
 //! an input to an output.
 
 use super::*;
-use crate::flow::axis::{pack_ray, unpack_result};
+use crate::flow::axis_host::{pack_ray, unpack_result};
 use crate::flow::frame::{PixelRay, frame_rays, mismatches};
 use crate::model::camera::Camera;
 use crate::model::golden::Hit;

@@ -616,7 +616,8 @@ pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::ray
 mod tests {
     use super::*;
     use crate::flow::feed::Stalls;
-    use crate::flow::frame::{frame_rays, mismatches, simulate_rust, simulate_rust_cycle};
+    use crate::flow::disturb::simulate_rust_cycle;
+    use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
     use crate::model::camera::Camera;
     use crate::params::Params;
     use crate::scene::{Scene, SceneSource};

@@ -169,6 +169,20 @@ pub fn min_latency(p: &CoreParams, scene: &SceneRoms) -> Option<u64> {
     None
 }
 
+/// `simulate_rust` in the cycle simulator (`rtl::sim`), driving the core's ports directly as
+/// the HDL testbenches do (`simulate_cycle` with a consumer always ready and no
+/// reset): results in the order they came out.
+pub fn simulate_rust_cycle(
+    p: &CoreParams,
+    scene: &SceneRoms,
+    rays: &[PixelRay],
+    stalls: &Stalls,
+    progress: &dyn Fn(u64),
+) -> (Vec<CoreResult>, CoreStats) {
+    let run = simulate_cycle(p, scene, rays, stalls, &Disturb::none(), progress);
+    (run.results, run.stats)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -425,6 +425,49 @@ fn critical_path(r: &serde_json::Value) -> CriticalPath {
     }
 }
 
+/// The whole core's entry of a `fxrt synth --family ecp5` report, checked to be for this scene
+/// and these parameters (`fxrt gen --measured`).
+pub fn measured_core(file: &Path, p: &CoreParams, netlist: &Module, scene: &str) -> Result<serde_json::Value> {
+    let text = std::fs::read_to_string(file).map_err(|e| Error::file(file, e.to_string()))?;
+    measured_entry(file, &text, p, netlist, scene)
+}
+
+/// The placed and routed core of a `fxrt synth --family ecp5` report (`text`, read from
+/// `file`), when it measured exactly this netlist of this scene and parameters.
+pub fn measured_entry(
+    file: &Path,
+    text: &str,
+    p: &CoreParams,
+    netlist: &Module,
+    scene: &str,
+) -> Result<serde_json::Value> {
+    let bad = |msg: String| Error::file(file, msg);
+    let doc: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(format!("not a synth report: {e}")))?;
+    let want = serde_json::json!({ "n": p.isect.n, "m": p.isect.m, "t": p.isect.t, "e": p.isect.e, "target_mhz": p.isect.target_mhz, "div_bits": p.isect.div_bits });
+    let params = &doc["params"];
+    for (k, v) in want.as_object().expect("an object") {
+        if &params[k] != v {
+            return Err(bad(format!("measured with {k} = {}, not this core's {v}", params[k])));
+        }
+    }
+    if doc["scene"] != scene {
+        return Err(bad(format!("measured on scene {}, not {scene}", doc["scene"])));
+    }
+    let modules = doc["modules"].as_array().cloned().unwrap_or_default();
+    let core = modules.into_iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
+    let core_entry = core.filter(|m| m["fmax_mhz"].is_number()).ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))?;
+    // Figures of another netlist (the generator changed since, or other options) are not this
+    // core's.
+    let hash = netlist_hash(netlist);
+    if core_entry["netlist_sha256"] != hash.as_str() {
+        return Err(bad(format!(
+            "measured another netlist (sha256 {}, this core's {hash}): place and route it again with fxrt synth --family ecp5",
+            core_entry["netlist_sha256"]
+        )));
+    }
+    Ok(core_entry)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

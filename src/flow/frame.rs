@@ -179,7 +179,7 @@ pub fn frame_harness(p: &CoreParams, scene: &SceneRoms, rays: &[PixelRay], stall
 
 /// Streams `rays` through the core in the batched Rust simulator (`rtl::batch`) in the order
 /// given, with the ray source in the netlist (`frame_harness`) holding back on the cycles of
-/// `stalls`. The same results, in the same order, and counts as `simulate_rust_cycle` and the
+/// `stalls`. The same results, in the same order, and counts as `disturb::simulate_rust_cycle` and the
 /// HDL testbenches, several times faster. `progress` gets the number of results now and then.
 pub fn simulate_rust(
     p: &CoreParams,
@@ -244,20 +244,6 @@ pub fn collect_batched(
     }
     stats.cycles = finished.unwrap_or(cycles);
     (results, stats)
-}
-
-/// `simulate_rust` in the cycle simulator (`rtl::sim`), driving the core's ports directly as
-/// the HDL testbenches do (`disturb::simulate_cycle` with a consumer always ready and no
-/// reset): results in the order they came out.
-pub fn simulate_rust_cycle(
-    p: &CoreParams,
-    scene: &SceneRoms,
-    rays: &[PixelRay],
-    stalls: &Stalls,
-    progress: &dyn Fn(u64),
-) -> (Vec<CoreResult>, CoreStats) {
-    let run = super::disturb::simulate_cycle(p, scene, rays, stalls, &super::disturb::Disturb::none(), progress);
-    (run.results, run.stats)
 }
 
 /// Rays and results that do not match, whatever order the results came in: each result is
@@ -465,6 +451,7 @@ mod tests {
     use crate::params::Params;
     use crate::rtl::sim::Sim;
     use crate::scene::SceneSource;
+    use crate::flow::disturb::simulate_rust_cycle;
 
     fn cornell(n: u32, m: u32) -> Scene {
         Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n, m, ..Params::default() }).unwrap()

@@ -1,6 +1,6 @@
 //! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files.
 
-use super::axis;
+use super::axis_host;
 use crate::cores::axis::{Layout, axis_module};
 use crate::cores::intersect::{IntersectParams, intersect_core};
 use crate::cores::top::{CoreParams, core_module_with, core_with_raygen};
@@ -153,7 +153,7 @@ pub fn core_files(
     let axis = raygen.is_none().then(|| {
         let layout = Layout::of(&core);
         let wrapper = axis_module(&core, p);
-        let header = (format!("{}.h", wrapper.name), axis::c_header(&wrapper.name, &layout));
+        let header = (format!("{}.h", wrapper.name), axis_host::c_header(&wrapper.name, &layout));
         let params = json!({
             "core": core.name,
             "layout": layout,

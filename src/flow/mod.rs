@@ -1,6 +1,6 @@
 //! Running the generated HDL: testbenches and the external simulators.
 
-pub mod axis;
+pub mod axis_host;
 pub mod board;
 pub mod check;
 pub mod disturb;

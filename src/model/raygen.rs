@@ -21,6 +21,13 @@ pub struct RayGen {
 }
 
 impl RayGen {
+    /// The generator for a camera given on the command line (inside the scene box); the error
+    /// names the camera option at fault.
+    pub fn for_camera(scene: &Scene, camera: &super::camera::CameraSpec) -> crate::error::Result<RayGen> {
+        let cam = camera.camera(scene)?;
+        RayGen::new(scene, &cam).map_err(|(opt, msg)| crate::error::Error::param(opt, msg))
+    }
+
     /// The generator for `cam` in `scene`'s grid; the error names the camera option at fault.
     pub fn new(scene: &Scene, cam: &Camera) -> Result<RayGen, (&'static str, String)> {
         let hi = scene.grid_box.hi;

@@ -8,16 +8,10 @@
 //! A module with buses is a top level: the printers do not instantiate one (its component
 //! would have the bus, its instance the parts).
 
+pub use super::netlist::Bus;
 use super::netlist::{Module, SigId};
 use super::width::Ty;
 
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Bus {
-    pub name: String,
-    pub input: bool,
-    /// Indices into the module's `inputs` (an input bus) or `outputs`, least significant first.
-    pub parts: Vec<usize>,
-}
 
 /// A port as the printers show it (the clock and reset aside).
 pub struct PrintedPort<'a> {

@@ -37,7 +37,7 @@ pub trait States: Copy + Eq + std::fmt::Debug + 'static {
     }
     /// Bits of the state register.
     fn width() -> u32 {
-        crate::scene::rom::value_bits(Self::ALL.len().saturating_sub(1))
+        crate::bits::value_bits(Self::ALL.len().saturating_sub(1))
     }
     fn names() -> Vec<&'static str> {
         Self::ALL.iter().map(|s| s.name()).collect()

@@ -179,6 +179,17 @@ pub struct Instance {
     pub inputs: Vec<SigId>,
 }
 
+/// Ports printed as one port wider than a signal may be (their parts least significant
+/// first): what `bus.rs` builds and the printers show.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Bus {
+    pub name: String,
+    pub input: bool,
+    /// Indices into the module's `inputs` (an input bus) or `outputs`, least significant first.
+    pub parts: Vec<usize>,
+}
+
+
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Module {
     pub name: String,
@@ -190,7 +201,7 @@ pub struct Module {
     pub instances: Vec<Instance>,
     pub blocks: Vec<Block>,
     /// Ports printed as one wider port (`bus.rs`).
-    pub buses: Vec<super::bus::Bus>,
+    pub buses: Vec<Bus>,
     /// The block new signals are put in (`begin_block` … `end_block`).
     pub current_block: Option<usize>,
     /// Every identifier given out so far (signals, ports, memories, instances, buses).
@@ -380,13 +391,13 @@ impl Module {
     }
 
     pub fn ram_write(&mut self, mem: usize, we: Sig, addr: Sig, data: Sig) {
-        let bits = crate::scene::rom::rom_addr_bits(self.roms[mem].words.len());
+        let bits = crate::bits::rom_addr_bits(self.roms[mem].words.len());
         assert_eq!(we.ty, Ty::BIT, "{}: write enable must be 1 bit", self.name);
         assert_eq!(addr.ty, Ty::u(bits), "{}: RAM {} takes a {bits}-bit address", self.name, self.roms[mem].name);
         assert_eq!(data.ty, Ty::u(self.roms[mem].width), "{}: RAM {} data type", self.name, self.roms[mem].name);
         assert!(self.roms[mem].write.is_none(), "{}: RAM {} has one write port", self.name, self.roms[mem].name);
         // Padded to the power of two the printers use, so every address is a real word.
-        let depth = crate::scene::rom::rom_depth(self.roms[mem].words.len());
+        let depth = crate::bits::rom_depth(self.roms[mem].words.len());
         self.roms[mem].words.resize(depth, 0);
         self.roms[mem].write = Some((we.id, addr.id, data.id));
     }
@@ -394,7 +405,7 @@ impl Module {
     pub fn rom_read(&mut self, name: &str, rom: usize, addr: Sig) -> Sig {
         let w = self.roms[rom].width;
         // The printers pad the ROM to a power of two; the address covers exactly that.
-        let bits = crate::scene::rom::rom_addr_bits(self.roms[rom].words.len());
+        let bits = crate::bits::rom_addr_bits(self.roms[rom].words.len());
         assert_eq!(
             addr.ty,
             Ty::u(bits),

@@ -179,7 +179,7 @@ fn random_named(name: &str, seed: u64, shape: Shape, nested: bool) -> Module {
         let words = (0..3 + g.r.below(6)).map(|_| g.r.next_u64() as u128 & t.mask()).collect();
         let k = g.m.rom("table", t.width, words);
         let a = g.pick();
-        let a = g.to_ty(a, Ty::u(crate::scene::rom::rom_addr_bits(g.m.roms[k].words.len())));
+        let a = g.to_ty(a, Ty::u(crate::bits::rom_addr_bits(g.m.roms[k].words.len())));
         let q = g.m.rom_read("rom_q", k, a);
         g.pool.push(q);
     }
@@ -187,7 +187,7 @@ fn random_named(name: &str, seed: u64, shape: Shape, nested: bool) -> Module {
         let t = g.ty();
         let words = (0..2 + g.r.below(5)).map(|_| g.r.next_u64() as u128 & t.mask()).collect();
         let k = g.m.ram("mem", t.width, words);
-        let bits = crate::scene::rom::rom_addr_bits(g.m.roms[k].words.len());
+        let bits = crate::bits::rom_addr_bits(g.m.roms[k].words.len());
         let a = g.pick();
         let a = g.to_ty(a, Ty::u(bits));
         let q = g.m.rom_read("ram_q", k, a);

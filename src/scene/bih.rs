@@ -5,54 +5,10 @@
 //! (docs/ARITHMETIC.md §5, DECISIONS.md 11 and 72). The depth is bounded by the hardware
 //! stack (seed 001 §3.4).
 
-use serde::{Deserialize, Serialize};
-use std::fmt;
-use std::str::FromStr;
+use serde::Serialize;
 
-/// How the builder chooses an inner node's split plane (`--tree`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Split {
-    /// The thesis's: halve the split box on its longest axis (DECISIONS.md 11).
-    Middle,
-    /// Binned surface-area heuristic over the traversal's clipped boxes (DECISIONS.md 72): the
-    /// default, by measurement.
-    #[default]
-    Sah,
-}
-
-impl Split {
-    pub const ALL: [Split; 2] = [Split::Middle, Split::Sah];
-
-    pub fn is_middle(&self) -> bool {
-        *self == Split::Middle
-    }
-
-    /// A JSON file without the field: written before the option existed, so middle-split.
-    pub fn absent() -> Split {
-        Split::Middle
-    }
-}
-
-impl FromStr for Split {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "middle" => Ok(Split::Middle),
-            "sah" => Ok(Split::Sah),
-            _ => Err(format!("'{s}' is not a split: use middle or sah")),
-        }
-    }
-}
-
-impl fmt::Display for Split {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Split::Middle => "middle",
-            Split::Sah => "sah",
-        })
-    }
-}
+/// How the builder chooses an inner node's split plane: the `--tree` parameter.
+use crate::params::TreeSplit as Split;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Node {

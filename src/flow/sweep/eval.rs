@@ -331,7 +331,13 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         }
     }
     if let (Some(pnr), Some(_)) = (&extras.pnr, &row.cost) {
-        pnr.place(&mut row, &core_params, &roms);
+        let (placed, error) = pnr.place(&row.key, &core_params, &roms);
+        row.ecp5 = placed;
+        match (error, &row.core, super::pnr::clock(&row.ecp5)) {
+            (Some(e), _, _) => row.error = Some(e),
+            (None, Some(run), Some(mhz)) => row.mrays_per_s_at_fmax = Some((mhz / run.cycles_per_ray * 1e4).round() / 1e4),
+            _ => {}
+        }
     }
     let render_png = frame.png_bytes();
     let errors_png = errors_png(&frame, reference);

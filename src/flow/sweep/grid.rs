@@ -3,7 +3,7 @@
 
 use super::eval::Row;
 use super::output::{Results, cached_images};
-use super::plots::{FONT, register_font};
+use super::draw::{FONT, register_font};
 use super::{Axis, Plan};
 use crate::error::{Error, Result};
 use crate::io::OutputSet;
@@ -42,7 +42,7 @@ pub fn add_grids(
     plan: &Plan,
 ) -> Result<Vec<String>> {
     let mut written = Vec::new();
-    for scene in super::run::scene_labels(&results.spec.scenes) {
+    for scene in super::scene_labels(&results.spec.scenes) {
         for axis in results.spec.swept_axes().into_iter().filter(|a| a.changes_image()) {
             let rows = series(results, plan, &scene, axis);
             if rows.len() < 2 {

@@ -8,8 +8,9 @@
 //! the configurations with index ≡ I−1 (mod N); `merge` joins shards. The outputs are a
 //! function of (spec, rows) alone, so a merged sweep is byte-identical to an unsharded one.
 
-pub mod axis;
+pub mod values;
 pub mod compat;
+pub mod draw;
 pub mod eval;
 pub mod grid;
 pub mod output;
@@ -451,6 +452,32 @@ pub fn params_label(p: &Params) -> String {
     }
     s
 }
+
+/// Labels for the scenes: built-in names and OBJ file stems, numbered where two coincide
+/// (and numbered further while a number collides with another scene's name).
+pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
+    let base: Vec<String> = scenes
+        .iter()
+        .map(|s| match s {
+            SceneSpec::Builtin(b) => b.clone(),
+            SceneSpec::Obj(p) => p.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or("scene".into()),
+        })
+        .map(|l| l.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect())
+        .collect();
+    let mut out: Vec<String> = Vec::new();
+    for (i, l) in base.iter().enumerate() {
+        let shared = base.iter().filter(|x| *x == l).count() > 1;
+        let mut k = 1 + base[..i].iter().filter(|x| *x == l).count();
+        let mut label = if shared { format!("{l}-{k}") } else { l.clone() };
+        while out.contains(&label) || (shared && base.contains(&label)) {
+            k += 1;
+            label = format!("{l}-{k}");
+        }
+        out.push(label);
+    }
+    out
+}
+
 
 /// `params_label` with the core's shape when it is not the default: `…_c16_k8_u1`.
 pub fn set_label(s: &Set) -> String {

@@ -257,7 +257,7 @@ pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
             k.map(|k| k.slot_occupancy.to_string()).unwrap_or_default(),
         ];
         let fields = with_optional(spec, csv_record(r), shape, core);
-        w.write_record(with_extra(fields, super::pnr::csv_cells(spec, r))).expect("csv into memory");
+        w.write_record(with_extra(fields, super::pnr::csv_cells(spec, &r.ecp5, r.mrays_per_s_at_fmax))).expect("csv into memory");
     }
     w.into_inner().expect("csv into memory")
 }
@@ -280,4 +280,9 @@ pub fn add_tables_and_images(files: &mut OutputSet, dir: &Path, cache: &Path, re
     let mut json = serde_json::to_vec_pretty(results).expect("results serialise");
     json.push(b'\n');
     files.add(&dir.join("results.json"), &json)
+}
+
+/// Values as a comma-separated list, for the report's and the scripts' text.
+pub(super) fn list<T: ToString>(v: &[T]) -> String {
+    v.iter().map(T::to_string).collect::<Vec<_>>().join(", ")
 }

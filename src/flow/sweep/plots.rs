@@ -3,52 +3,21 @@
 //! parameter; with `--core-sim`, throughput against area (`throughput.rs`). Text uses DejaVu
 //! Sans compiled in, so no system font is needed.
 
+use super::draw::{FONT, H, W, draw_legend, plot_err, register_font};
 use super::eval::Row;
 use super::grid::series;
 use super::output::Results;
 use super::summary::{pareto_front, set_summaries};
 use super::{Axis, Plan, set_label};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::io::OutputSet;
 use crate::render::encode_png;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The font family name plots and grids draw with.
-pub const FONT: &str = "fxrt-sans";
-
-pub fn register_font() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        // The font is compiled in and known to be valid.
-        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular())
-            .unwrap_or_else(|_| panic!("the embedded DejaVu Sans is a valid font"));
-    });
-}
-
-pub(super) const W: u32 = 900;
-pub(super) const H: u32 = 560;
 /// Where a count of 0 is drawn on the logarithmic axes.
 const ZERO: f64 = 0.5;
-
-/// The sweep plots' legend: upper left, on a light box.
-pub(super) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
-    chart: &mut ChartContext<'a, DB, CT>,
-) -> Result<()> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font((FONT, 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(plot_err)
-}
-
-pub(super) fn plot_err(e: impl std::fmt::Display) -> Error {
-    Error::new("sweep plot", e.to_string())
-}
 
 /// Where the Fmax plots of `--family ecp5` go: plots/fmax_PARAM.png.
 pub const FMAX_PLOTS: &str = "plots/fmax_";
@@ -91,7 +60,7 @@ fn points(results: &Results, plan: &Plan, scene: &str, axis: Axis, y: &dyn Fn(&R
 }
 
 fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
-    let labels = super::run::scene_labels(&results.spec.scenes);
+    let labels = super::scene_labels(&results.spec.scenes);
     let wrong = |r: &Row| Some((r.quality.as_ref()?.wrong_pixels as f64).max(ZERO));
     let lines: Vec<Line> =
         labels.iter().map(|scene| (scene.clone(), points(results, plan, scene, axis, &wrong))).collect();
@@ -103,7 +72,7 @@ fn error_plot(results: &Results, plan: &Plan, axis: Axis) -> Result<Vec<u8>> {
 /// plots/fmax_PARAM.png: each placed module's Fmax along `axis`, per scene, and the target.
 fn fmax_plot(results: &Results, plan: &Plan, axis: Axis, modules: &[String]) -> Result<Vec<u8>> {
     let mut lines: Vec<Line> = Vec::new();
-    for scene in super::run::scene_labels(&results.spec.scenes) {
+    for scene in super::scene_labels(&results.spec.scenes) {
         for kind in modules {
             let fmax = |r: &Row| r.ecp5.iter().find(|p| &p.kind == kind).map(|p| p.timing.fmax_mhz);
             lines.push((format!("{scene} · {kind}"), points(results, plan, &scene, axis, &fmax)));

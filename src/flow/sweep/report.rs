@@ -1,13 +1,14 @@
 //! report.md (the findings, the Pareto front, the plots and grids, every row), and the Slurm /
 //! GNU parallel scripts of `--emit-slurm`. Both are askama templates in `hdl/`.
 
-use super::eval::OTHER_SURFACE_REL;
-use super::output::Results;
+use super::eval::{OTHER_SURFACE_REL, Row};
+use super::output::{Results, list};
 use super::plots::FMAX_PLOTS;
 use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summaries};
 use super::throughput::THROUGHPUT_PLOTS;
 use super::{Axis, Plan, Set};
 use crate::error::{Error, Result};
+use crate::flow::ecp5::{CriticalPath, DEVICE, PACKAGE, SPEED, Timing};
 use crate::io::OutputSet;
 use askama::Template;
 use std::path::Path;
@@ -42,9 +43,6 @@ struct Report {
     area_source: String,
 }
 
-pub(super) fn list<T: ToString>(v: &[T]) -> String {
-    v.iter().map(T::to_string).collect::<Vec<_>>().join(", ")
-}
 
 fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
     let mut out = Vec::new();
@@ -95,7 +93,7 @@ fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
         ));
     }
     out.extend(super::throughput::finding(results));
-    out.extend(super::pnr::findings(results));
+    out.extend(pnr_findings(results));
     let failed = results.rows.iter().filter(|r| r.error.is_some()).count();
     if failed > 0 {
         out.push(format!("{failed} configurations could not be evaluated completely; see the note column."));
@@ -224,7 +222,7 @@ pub fn add_report(
             ]
         })
         .collect();
-    let labels = super::run::scene_labels(&spec.scenes);
+    let labels = super::scene_labels(&spec.scenes);
     let report = Report {
         title: labels.join(", "),
         version: results.fxrt.clone(),
@@ -253,12 +251,102 @@ pub fn add_report(
         head: table_head(results),
         rows: results.rows.iter().map(|r| row_cells(results, r)).collect(),
         skipped: plan.skipped.iter().map(|s| format!("{}: {}", spec.params_text(&s.params), s.reason)).collect(),
-        ecp5_setup: super::pnr::setup_text(results),
-        ecp5_rows: super::pnr::report_rows(results),
+        ecp5_setup: pnr_setup_text(results),
+        ecp5_rows: pnr_report_rows(results),
         fmax_plots: plots.iter().filter(|p| p.starts_with(FMAX_PLOTS)).cloned().collect(),
         throughput_plots: plots.iter().filter(|p| p.starts_with(THROUGHPUT_PLOTS)).cloned().collect(),
         area_source: super::throughput::source_text(results),
     };
     let text = report.render().map_err(|e| Error::new("sweep report", e.to_string()))?;
     files.add(&dir.join("report.md"), text.as_bytes())
+}
+
+/// The P&R setup, for the report: device, target, seed and the tools' versions.
+fn pnr_setup_text(results: &Results) -> String {
+    let Some(e) = &results.spec.ecp5 else { return String::new() };
+    let first = results.rows.iter().flat_map(|r| r.ecp5.first()).next();
+    let tools = first.map(|p| format!("; {}; {}", p.timing.yosys, p.timing.nextpnr)).unwrap_or_default();
+    format!(
+        "{DEVICE} ({PACKAGE}, speed grade {SPEED}), clock target {} MHz, {} ray slots × {} traversal units, \
+         placement seed {}, modules {}{tools}",
+        results.spec.target_mhz,
+        list(&results.spec.slots),
+        list(&results.spec.units),
+        e.seed,
+        e.modules.join(", ")
+    )
+}
+/// A line per placed module of every row: scene, parameters, module, Fmax, resources,
+/// latency, critical path, and the row's Mrays/s at Fmax on the line of the module it is
+/// clocked by.
+fn pnr_report_rows(results: &Results) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    for r in &results.rows {
+        let clock = super::pnr::clock(&r.ecp5);
+        let mut marked = false;
+        for p in &r.ecp5 {
+            let t = &p.timing;
+            let by_this = !marked && Some(t.fmax_mhz) == clock;
+            marked |= by_this;
+            let path = &t.critical_path;
+            out.push(vec![
+                r.scene.clone(),
+                results.spec.set_text(&r.set()),
+                p.kind.clone(),
+                format!("{:.1}", t.fmax_mhz),
+                t.lut4.to_string(),
+                format!("{} ({})", t.ff, t.wrapper_ff),
+                t.mult18.to_string(),
+                t.dp16kd.to_string(),
+                t.latency_cycles.map(|l| l.to_string()).unwrap_or_else(|| "–".into()),
+                path_text(path),
+                r.mrays_per_s_at_fmax.filter(|_| by_this).map(|x| format!("{x:.3}")).unwrap_or_default(),
+            ]);
+        }
+    }
+    out
+}
+/// A critical path for the report: start → end and its delay, marked when both ends are the
+/// wrapper's (pins, XOR tree): the module itself is then at least this fast.
+fn path_text(p: &CriticalPath) -> String {
+    let ours = |cell: &str| cell.starts_with("u_dut");
+    let wrapper = if !ours(&p.start) && !ours(&p.end) { " (the wrapper's)" } else { "" };
+    format!("`{}` → `{}`, {:.2} ns{wrapper}", p.start, p.end, p.delay_ns).replace('|', "/")
+}
+/// Findings: per module, the range of Fmax over the sweep and where its slowest
+/// configuration's critical path runs; the range of Mrays/s at Fmax.
+fn pnr_findings(results: &Results) -> Vec<String> {
+    let Some(e) = &results.spec.ecp5 else { return Vec::new() };
+    let mut out = Vec::new();
+    for kind in &e.modules {
+        let placed: Vec<(&Row, &Timing)> = results
+            .rows
+            .iter()
+            .filter_map(|r| r.ecp5.iter().find(|p| &p.kind == kind).map(|p| (r, &p.timing)))
+            .collect();
+        let by_fmax = |a: &&(&Row, &Timing), b: &&(&Row, &Timing)| a.1.fmax_mhz.total_cmp(&b.1.fmax_mhz);
+        let (Some(lo), Some(hi)) = (placed.iter().min_by(by_fmax), placed.iter().max_by(by_fmax)) else { continue };
+        out.push(format!(
+            "ECP5 {kind}: Fmax {:.1} to {:.1} MHz over {} configurations at a {} MHz target; the slowest ({} {}): {}.",
+            lo.1.fmax_mhz,
+            hi.1.fmax_mhz,
+            placed.len(),
+            results.spec.target_mhz,
+            lo.0.scene,
+            super::set_label(&lo.0.set()),
+            path_text(&lo.1.critical_path)
+        ));
+    }
+    let rates: Vec<f64> = results.rows.iter().filter_map(|r| r.mrays_per_s_at_fmax).collect();
+    if let (Some(lo), Some(hi)) = (rates.iter().copied().reduce(f64::min), rates.iter().copied().reduce(f64::max)) {
+        let clock = if e.modules.iter().any(|m| m == "core") {
+            "the whole core's Fmax"
+        } else {
+            "the slowest placed module's Fmax, an upper bound: place `core` for the core's own"
+        };
+        out.push(format!(
+            "At Fmax, with one ray in flight: {lo:.3} to {hi:.3} Mrays/s ({clock} ÷ cycles per ray of the simulated core)."
+        ));
+    }
+    out
 }

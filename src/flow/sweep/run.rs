@@ -3,37 +3,13 @@
 use super::eval::{Extras, Row, SceneCtx, evaluate};
 use super::output::{Results, add_tables_and_images, copy_cached, has_cached, load_cached, read_results, store_cached};
 use super::pnr::Pnr;
-use super::{Plan, SceneSpec, Shard, SweepSpec};
+use super::{Plan, Shard, SweepSpec, scene_labels};
 use crate::error::{Error, Result};
 use crate::flow::ecp5::Tools;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Labels for the scenes: built-in names and OBJ file stems, numbered where two coincide
-/// (and numbered further while a number collides with another scene's name).
-pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
-    let base: Vec<String> = scenes
-        .iter()
-        .map(|s| match s {
-            SceneSpec::Builtin(b) => b.clone(),
-            SceneSpec::Obj(p) => p.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or("scene".into()),
-        })
-        .map(|l| l.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect())
-        .collect();
-    let mut out: Vec<String> = Vec::new();
-    for (i, l) in base.iter().enumerate() {
-        let shared = base.iter().filter(|x| *x == l).count() > 1;
-        let mut k = 1 + base[..i].iter().filter(|x| *x == l).count();
-        let mut label = if shared { format!("{l}-{k}") } else { l.clone() };
-        while out.contains(&label) || (shared && base.contains(&label)) {
-            k += 1;
-            label = format!("{l}-{k}");
-        }
-        out.push(label);
-    }
-    out
-}
 
 /// What a run did, for the summary line.
 #[derive(Debug, Default, PartialEq, Eq)]

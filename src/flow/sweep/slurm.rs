@@ -1,7 +1,7 @@
 //! `sweep --emit-slurm`: the sweep's shards as a Slurm job array with a merge job after it,
 //! and the same as a GNU parallel command list, written into OUT/slurm.
 
-use super::report::list;
+use super::output::list;
 use super::{SceneSpec, SweepSpec};
 use crate::error::{Error, Result};
 use crate::io::OutputSet;

@@ -1,5 +1,5 @@
 use super::eval::quality;
-use super::run::scene_labels;
+use super::scene_labels;
 use super::slurm::shell_quote;
 use super::*;
 use crate::render::Frame;
@@ -293,7 +293,7 @@ fn ecp5_columns_follow_the_modules() {
         mrays_per_s_at_fmax: None,
         error: None,
     };
-    assert_eq!(super::pnr::clock(&row), Some(113.3), "the whole core's Fmax, not the slowest module's");
+    assert_eq!(super::pnr::clock(&row.ecp5), Some(113.3), "the whole core's Fmax, not the slowest module's");
     let bytes = output::csv_bytes(&s, std::slice::from_ref(&row));
     let mut r = csv::Reader::from_reader(bytes.as_slice());
     let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();

@@ -6,8 +6,8 @@
 
 use super::eval::Row;
 use super::output::Results;
-use super::plots::{FONT, H, W, draw_legend, plot_err};
-use super::report::list;
+use super::draw::{FONT, H, W, draw_legend, plot_err};
+use super::output::list;
 use crate::error::Result;
 use crate::io::OutputSet;
 use crate::render::encode_png;
@@ -84,7 +84,7 @@ fn label(results: &Results, r: &Row) -> String {
 type Series = (String, Vec<(f64, f64, String)>);
 
 fn series(results: &Results, x: fn(&Row) -> Option<f64>, y: &dyn Fn(&Row) -> Option<f64>) -> Vec<Series> {
-    super::run::scene_labels(&results.spec.scenes)
+    super::scene_labels(&results.spec.scenes)
         .into_iter()
         .map(|scene| {
             let pts = results

@@ -12,7 +12,7 @@ pub use walk::{Printer, print};
 pub use writer::CodeWriter;
 
 use crate::rtl::width::BinOp;
-use crate::scene::rom::rom_depth;
+use crate::bits::rom_depth;
 
 /// The operator as Verilog (and C) spell it.
 pub fn symbol(op: BinOp) -> &'static str {
