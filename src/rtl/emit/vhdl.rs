@@ -166,14 +166,20 @@ impl Printer for Vhdl {
         w.nest(format!("component {} is", entity(sub)), "end component;", |w| port_clause(w, ports));
     }
 
-    /// A RAM is a signal (written in a clocked process), a ROM a constant.
+    /// A RAM is a signal (written in a clocked process), a ROM a constant. Only non-zero words
+    /// are listed: `others` gives the rest, so a RAM that starts empty is one line.
     fn memory(&self, w: &mut CodeWriter, _m: &Module, r: &Rom) {
         let depth = super::rom_depth(r.words.len());
         w.line(format!("type {}_t is array (0 to {}) of unsigned({} downto 0);", r.name, depth - 1, r.width - 1));
         let kind = if r.write.is_some() { "signal" } else { "constant" };
+        let listed: Vec<(usize, u128)> = r.words.iter().copied().enumerate().filter(|&(_, word)| word != 0).collect();
+        if listed.is_empty() {
+            w.line(format!("{kind} {} : {}_t := (others => (others => '0'));", r.name, r.name));
+            return;
+        }
         w.nest(format!("{kind} {} : {}_t := (", r.name, r.name), "", |w| {
-            for (i, word) in r.words.iter().enumerate() {
-                w.line(format!("{i} => \"{}\",", bit_string(*word, r.width)));
+            for (i, word) in listed {
+                w.line(format!("{i} => \"{}\",", bit_string(word, r.width)));
             }
             w.line("others => (others => '0'));");
         });
