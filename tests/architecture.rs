@@ -148,16 +148,16 @@ fn expand(body: &str) -> Vec<String> {
 /// A path as written (`crate::a::b`, `super::super::c`, `self::d`) made absolute.
 fn absolute(module: &[String], path: &str) -> Option<Vec<String>> {
     let mut parts: Vec<&str> = path.split("::").filter(|p| !p.is_empty()).collect();
-    let mut base: Vec<String> = match parts.first()? {
-        &"crate" => {
+    let mut base: Vec<String> = match *parts.first()? {
+        "crate" => {
             parts.remove(0);
             Vec::new()
         }
-        &"self" => {
+        "self" => {
             parts.remove(0);
             module.to_vec()
         }
-        &"super" => module.to_vec(),
+        "super" => module.to_vec(),
         _ => return None,
     };
     while parts.first() == Some(&"super") {

@@ -167,7 +167,7 @@ mod tests {
             // After edge k + 1, data is the word at the address of edge k + 2 − cycles.
             let c = cycles as usize;
             for k in c - 1..seq.len() {
-                assert_eq!(got[k], 100 + seq[k + 1 - c] as i128, "{cycles} clocks, edge {}", k + 1);
+                assert_eq!(got[k], 100 + seq[k + 1 - c], "{cycles} clocks, edge {}", k + 1);
             }
         }
     }
@@ -192,7 +192,7 @@ mod tests {
             let c = cycles as usize;
             for k in c - 1..seq.len() {
                 let (x, y) = seq[k + 1 - c];
-                assert_eq!(got[k], (50 + x as i128, 50 + y as i128), "{cycles} clocks, edge {}", k + 1);
+                assert_eq!(got[k], (50 + x, 50 + y), "{cycles} clocks, edge {}", k + 1);
             }
         }
     }

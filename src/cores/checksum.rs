@@ -72,9 +72,9 @@ mod tests {
         for cycle in 0..200 {
             let r = |bits: u32, rng: &mut crate::rng::SplitMix64| (rng.next_u64() & ((1u64 << bits) - 1)) as i64;
             let signed = |bits: u32, rng: &mut crate::rng::SplitMix64| r(bits, rng) - (1i64 << (bits - 1));
-            let valid = rng.next_u64() % 3 != 0;
+            let valid = !rng.next_u64().is_multiple_of(3);
             let id = r(w.id, &mut rng) as u64;
-            let hit = (rng.next_u64() % 4 != 0).then(|| Hit {
+            let hit = (!rng.next_u64().is_multiple_of(4)).then(|| Hit {
                 tri: r(w.tri, &mut rng) as u32,
                 t: signed(w.t, &mut rng),
                 u: signed(w.u, &mut rng),

@@ -65,7 +65,7 @@ fn random_pipeline(seed: u64) -> Module {
                 d = m.delay(&format!("{name}_d{i}"), d);
             }
             next.push(d);
-            if r.next_u64() % 3 == 0 {
+            if r.next_u64().is_multiple_of(3) {
                 m.output(&format!("o{stage}_{j}"), d);
             }
         }
