@@ -82,7 +82,6 @@ impl fmt::Display for TreeSplit {
     }
 }
 
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Params {
     /// Bits of the vertex grid: the scene's longest side maps to 2^n − 1.

@@ -347,18 +347,15 @@ fn the_check_finds_a_loop_and_an_upward_import() {
     write("lib.rs", "pub mod rtl;\npub mod scene;\n");
     write("rtl/mod.rs", "pub mod a;\npub mod b;\n#[cfg(test)]\n#[path = \"t.rs\"]\nmod t;\n#[cfg(test)]\nmod u;\n");
     // Comments and test code may name a higher layer.
-    write("rtl/a.rs", "use super::b::{X, self};\n// use crate::scene::rom;\n#[cfg(test)]\nmod tests { use crate::scene::rom; }\n");
+    write(
+        "rtl/a.rs",
+        "use super::b::{X, self};\n// use crate::scene::rom;\n#[cfg(test)]\nmod tests { use crate::scene::rom; }\n",
+    );
     write("rtl/b.rs", "pub fn f() { super::a::g(); crate::scene::rom::h(); }\n");
     write("rtl/t.rs", "use crate::scene::rom;\n");
     write("rtl/u.rs", "use crate::scene::rom;\n");
     write("scene/mod.rs", "pub mod rom;\n");
     write("scene/rom.rs", "pub fn h() {}\n");
     let (bad, _) = violations(src);
-    assert_eq!(
-        bad,
-        [
-            "loop: rtl/a.rs ↔ rtl/b.rs",
-            "upward: rtl/b.rs imports scene/rom.rs (rtl is below scene)",
-        ],
-    );
+    assert_eq!(bad, ["loop: rtl/a.rs ↔ rtl/b.rs", "upward: rtl/b.rs imports scene/rom.rs (rtl is below scene)",],);
 }

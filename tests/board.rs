@@ -142,7 +142,9 @@ fn every_top_port_has_a_site() {
         };
         let constraints = &files.iter().find(|f| f.0.ends_with(ext)).unwrap().1;
         let mut sites: Vec<(String, String)> = Vec::new();
-        for line in constraints.lines().filter(|l| l.starts_with(key) && (l.contains(" SITE ") || l.contains(" LOC = "))) {
+        for line in
+            constraints.lines().filter(|l| l.starts_with(key) && (l.contains(" SITE ") || l.contains(" LOC = ")))
+        {
             let name = line[key.len()..].split('"').next().unwrap().replace('<', "[").replace('>', "]");
             let site = line.split('"').nth(3).unwrap().to_string();
             sites.push((name, site));
@@ -157,8 +159,13 @@ fn every_top_port_has_a_site() {
         assert_eq!(unique.len(), sites.len(), "{}: a site twice", board.name());
         let site = |p: &str| sites.iter().find(|s| s.0 == p).map(|s| s.1.as_str());
         match board {
-            Board::Ulx3s => assert_eq!((site("clk_25mhz"), site("led[0]"), site("btn_fire1")), (Some("G2"), Some("B2"), Some("R1"))),
-            Board::Ml509 => assert_eq!((site("user_clk"), site("led[0]"), site("cpu_reset_b")), (Some("AH15"), Some("H18"), Some("E9"))),
+            Board::Ulx3s => {
+                assert_eq!((site("clk_25mhz"), site("led[0]"), site("btn_fire1")), (Some("G2"), Some("B2"), Some("R1")))
+            }
+            Board::Ml509 => assert_eq!(
+                (site("user_clk"), site("led[0]"), site("cpu_reset_b")),
+                (Some("AH15"), Some("H18"), Some("E9"))
+            ),
         }
     }
 }
@@ -181,7 +188,11 @@ fn the_ulx3s_bitstream_meets_its_clock() {
     let (stdout, stderr) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     eprintln!("{stdout}{stderr}");
     assert!(o.status.success(), "{stdout}{stderr}");
-    let report = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).find(|p| p.to_string_lossy().ends_with("_timing.json")).unwrap();
+    let report = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.to_string_lossy().ends_with("_timing.json"))
+        .unwrap();
     let t: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(t["met"], true, "{t}");
     assert_eq!(t["clock_mhz"], 80.0, "{t}");

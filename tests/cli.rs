@@ -200,8 +200,10 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     assert_eq!((manifest["latency_cycles"].clone(), manifest["params"]["target_mhz"].clone()), (38.into(), 150.into()));
     // The scene-dependent modules carry the scene's tag: fxrt_core_s<6 hex digits>.
     let top = |dir: &std::path::Path| -> String {
-        let names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
-        let json = names.iter().find(|n| n.starts_with("fxrt_core_s") && n.ends_with(".json")).expect("the core's manifest");
+        let names: Vec<String> =
+            std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        let json =
+            names.iter().find(|n| n.starts_with("fxrt_core_s") && n.ends_with(".json")).expect("the core's manifest");
         json.trim_end_matches(".json").to_string()
     };
     let core_name = top(&out);
@@ -210,10 +212,24 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     assert!(ucf.contains("PERIOD \"clk\" 6.667 ns"), "{ucf}");
     // At 75 MHz the products take one clock: the thesis-like pipeline, 13 cycles shorter.
     let slow = dir.path().join("slow");
-    let o = fxrt(&["gen", "--builtin", "random", "--n", "16", "--m", "16", "--ise", "--target-mhz", "75", "--out", slow.to_str().unwrap()]);
+    let o = fxrt(&[
+        "gen",
+        "--builtin",
+        "random",
+        "--n",
+        "16",
+        "--m",
+        "16",
+        "--ise",
+        "--target-mhz",
+        "75",
+        "--out",
+        slow.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let slow_manifest: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(slow.join("fxrt_intersect_n16_m16_t0_e4_tag44_c75.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(slow.join("fxrt_intersect_n16_m16_t0_e4_tag44_c75.json")).unwrap())
+            .unwrap();
     assert_eq!(slow_manifest["latency_cycles"], 25);
     assert!(std::fs::read_to_string(slow.join(format!("{core_name}.ucf"))).unwrap().contains("13.333 ns"));
     let core: serde_json::Value =
@@ -221,14 +237,20 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     // What an integrator needs besides the ports: latency bounds, reset, results held,
     // the clock, the hashes naming the scene and parameters.
     assert!(core["latency_cycles"]["min"].as_u64().is_some_and(|l| l > 10), "{core}");
-    assert_eq!((core["interface"]["reset_cycles"].clone(), core["interface"]["result_queue_depth"].clone()), (1.into(), 16.into()));
+    assert_eq!(
+        (core["interface"]["reset_cycles"].clone(), core["interface"]["result_queue_depth"].clone()),
+        (1.into(), 16.into())
+    );
     assert_eq!(core["interface"]["rays_held_max"], 128 + 16 + 1);
     assert_eq!(core["clock"]["target_mhz"], 150);
     assert_eq!(core["hashes"]["scene_tag"].as_str().unwrap(), &core_name["fxrt_core_".len()..]);
     assert_eq!(core["hashes"]["scene_sha256"].as_str().unwrap().len(), 64);
     // Results leave in the order rays finish, and the manifest says so.
     assert_eq!(core["params"]["results_in_order"], false, "{core}");
-    assert_eq!((core["params"]["ray_slots_per_unit"].clone(), core["params"]["traversal_units"].clone()), (64.into(), 2.into()));
+    assert_eq!(
+        (core["params"]["ray_slots_per_unit"].clone(), core["params"]["traversal_units"].clone()),
+        (64.into(), 2.into())
+    );
     let files = core["files"]["vhdl"].as_array().unwrap();
     assert_eq!(files.last().unwrap(), &format!("{core_name}.vhd"));
     let hex = core["files"]["verilog_memory_init"].as_array().unwrap();
@@ -249,7 +271,12 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(top(&again), core_name, "the same scene, the same tag");
     let tag = &core_name["fxrt_core_".len()..];
-    for f in [format!("{core_name}.vhd"), format!("{core_name}.v"), format!("fxrt_traverse_k64_{tag}.vhd"), format!("{core_name}.json")] {
+    for f in [
+        format!("{core_name}.vhd"),
+        format!("{core_name}.v"),
+        format!("fxrt_traverse_k64_{tag}.vhd"),
+        format!("{core_name}.json"),
+    ] {
         assert_eq!(std::fs::read(out.join(&f)).unwrap(), std::fs::read(again.join(&f)).unwrap(), "{f}");
     }
     // A scene too large for the block RAM allowed is refused, naming the option.
@@ -435,7 +462,10 @@ fn gen_takes_measured_figures_only_for_the_same_netlist() {
         serde_json::from_slice(&std::fs::read(out.join(format!("{}.json", core.name))).unwrap()).unwrap();
     assert_eq!(manifest["clock"]["measured_fmax_mhz"], 123.45);
     assert_eq!(manifest["clock"]["measured_on"]["seed"], 3);
-    assert_eq!((manifest["resources"]["lut4"].clone(), manifest["resources"]["dp16kd"].clone()), (11.into(), 44.into()));
+    assert_eq!(
+        (manifest["resources"]["lut4"].clone(), manifest["resources"]["dp16kd"].clone()),
+        (11.into(), 44.into())
+    );
     // The same report for the core with its observation ports, or for another netlist.
     let reject = |extra: &[&str], file: &str, name: &str| {
         let out = dir.path().join(name);
@@ -486,7 +516,8 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     assert_rejected(&with(&["ml509"]), "--units", &out);
     let o2 = fxrt(&with(&["ml509", "--units", "1"]));
     assert!(o2.status.success(), "{}", stderr(&o2));
-    let names: Vec<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     for ext in [".ucf", ".tcl", ".json"] {
         assert!(names.iter().any(|n| n.starts_with("fxrt_ml509_") && n.ends_with(ext)), "{ext} in {names:?}");
     }

@@ -78,7 +78,9 @@ fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, (leaf_size, slots, 
 /// simulator: every result and the walk as the golden model's.
 #[test]
 fn rust_teapot_small_and_extreme_widths() {
-    for (n, m, t, c) in [(4, 8, 0, 16), (4, 16, 0, 16), (8, 8, 3, 2), (8, 8, 0, 0), (4, 8, 6, 64), (20, 50, 0, 8), (40, 45, 0, 40)] {
+    for (n, m, t, c) in
+        [(4, 8, 0, 16), (4, 16, 0, 16), (8, 8, 3, 2), (8, 8, 0, 0), (4, 8, 6, 64), (20, 50, 0, 8), (40, 45, 0, 40)]
+    {
         let params = Params { n, m, t, c, ..Params::default() };
         let s = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
         let roms = SceneRoms::of(&s);

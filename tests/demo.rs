@@ -42,7 +42,8 @@ fn fxrt_alone_generates_the_core_simulates_a_frame_and_checks_every_pixel() {
     // The manifest lists the core's files in compile order; every one is there.
     let hdl = folder.join("hdl");
     // The summary names the core's manifest (an AXI4-Stream wrapper's manifest sits beside it).
-    let manifest = out.split_whitespace().find(|w| w.starts_with("fxrt_core_") && w.ends_with(".json")).expect("a manifest");
+    let manifest =
+        out.split_whitespace().find(|w| w.starts_with("fxrt_core_") && w.ends_with(".json")).expect("a manifest");
     let manifest = hdl.join(manifest);
     let m: serde_json::Value = serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
     let name = m["name"].as_str().unwrap().to_string();

@@ -69,7 +69,10 @@ fn a_reproducer_is_self_contained() {
     // The first case of seed 5 that runs (a random scene, drawn fresh).
     let run = (0..20).map(|i| exact::run_case(5, i, &[], None)).find(|r| matches!(r.verdict, Verdict::Ran(_))).unwrap();
     let Verdict::Ran(outcome) = &run.verdict else { unreachable!() };
-    assert!(matches!(run.case.scene, draw::CaseScene::Random { .. }) || matches!(run.case.scene, draw::CaseScene::Builtin(_)));
+    assert!(
+        matches!(run.case.scene, draw::CaseScene::Random { .. })
+            || matches!(run.case.scene, draw::CaseScene::Builtin(_))
+    );
     let dir = repro::write(out.path(), &run).unwrap();
     let back = fxrt::scene::obj::load_obj(&dir.join("scene.obj")).unwrap();
     assert_eq!(Some(back), run.tris);
@@ -84,7 +87,8 @@ fn a_reproducer_is_self_contained() {
     assert_eq!(line["walk_matches"], true);
     let steps = line["node_steps_per_ray"].as_f64().unwrap() * outcome.rays as f64;
     assert!((steps - outcome.core_walk.0 as f64).abs() < 0.01 * outcome.rays as f64);
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("case.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("case.json")).unwrap()).unwrap();
     assert_eq!(json["command"], command.trim_end());
 }
 

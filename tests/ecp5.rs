@@ -214,7 +214,8 @@ fn banked_block_roms_read_what_the_generated_rom_reads() {
         assert!(layout.len() > 1, "{words}: {layout:?}");
         let data: Vec<u128> = (0..words).map(|_| (rng.next_u64() & ((1 << width) - 1)) as u128).collect();
         let m = brom_module_ports("t", width, data, cycles, ports);
-        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ecp5_banks_{words}_{ports}_{cycles}"));
+        let dir =
+            std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ecp5_banks_{words}_{ports}_{cycles}"));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let files = fxrt::rtl::emit::design_files(&m, "v");

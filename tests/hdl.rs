@@ -17,7 +17,15 @@ fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::flow::vect
 
 fn setup_bits(params: Params, div_bits: u32, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
-    let p = IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width: 20, div_bits, target_mhz: fxrt::cores::clock::DEFAULT_TARGET_MHZ };
+    let p = IntersectParams {
+        n: params.n,
+        m: params.m,
+        t: params.t,
+        e: scene.edge_shift,
+        tag_width: 20,
+        div_bits,
+        target_mhz: fxrt::cores::clock::DEFAULT_TARGET_MHZ,
+    };
     p.check().unwrap();
     let v = generate(&scene, count, 7);
     let hits = v.iter().filter(|x| x.expected.is_some()).count();
@@ -43,8 +51,16 @@ fn hdl_bits(sim: Simulator, params: Params, div_bits: u32, count: usize) {
 const SMALL: Params = Params { n: 16, m: 16, ..DEFAULTS };
 const ODD: Params = Params { n: 23, m: 27, t: 5, ..DEFAULTS };
 const WIDE: Params = Params { n: 32, m: 40, ..DEFAULTS };
-const DEFAULTS: Params =
-    Params { n: 29, m: 32, edge_shift: fxrt::params::EdgeShift::Auto, t: 0, c: 16, leaf_size: 4, stack_depth: 32, tree: fxrt::params::TreeSplit::Middle };
+const DEFAULTS: Params = Params {
+    n: 29,
+    m: 32,
+    edge_shift: fxrt::params::EdgeShift::Auto,
+    t: 0,
+    c: 16,
+    leaf_size: 4,
+    stack_depth: 32,
+    tree: fxrt::params::TreeSplit::Middle,
+};
 
 #[test]
 fn rust_simulator_matches_golden_on_a_million_vectors_at_defaults() {

@@ -121,7 +121,10 @@ fn two_tiny_cores_are_placed_and_routed_in_a_sweep() {
         assert_eq!(r["core_mismatches"], "0");
     }
     let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
-    assert_eq!((&json["spec"]["target_mhz"], &json["spec"]["slots"], &json["spec"]["units"]), (&100.into(), &4.into(), &1.into()));
+    assert_eq!(
+        (&json["spec"]["target_mhz"], &json["spec"]["slots"], &json["spec"]["units"]),
+        (&100.into(), &4.into(), &1.into())
+    );
     assert_eq!(json["spec"]["ecp5"], serde_json::json!({ "modules": ["closest", "core"], "seed": 3 }));
     let placed = &json["rows"][0]["ecp5"][1];
     assert_eq!(
@@ -135,7 +138,10 @@ fn two_tiny_cores_are_placed_and_routed_in_a_sweep() {
     assert!(info.width > 200 && info.height > 100);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("## ECP5 place and route") && report.contains("(plots/fmax_n.png)"), "{report}");
-    assert!(report.contains("clock target 100 MHz, 4 ray slots × 1 traversal units, placement seed 3") && report.contains("ECP5 core: Fmax"));
+    assert!(
+        report.contains("clock target 100 MHz, 4 ray slots × 1 traversal units, placement seed 3")
+            && report.contains("ECP5 core: Fmax")
+    );
     assert_eq!(report.matches("| thin | n=").count(), 4, "a line per module and configuration");
     // A rerun takes both rows from the cache and writes the same files.
     let before = (std::fs::read(out.join("results.csv")).unwrap(), report);

@@ -37,7 +37,11 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     let p = CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
-    let tools = if b.bitstream { Some(Tools::require().map_err(|e| Error::param("board", format!("{} (or --no-bitstream)", e.message)))?) } else { None };
+    let tools = if b.bitstream {
+        Some(Tools::require().map_err(|e| Error::param("board", format!("{} (or --no-bitstream)", e.message)))?)
+    } else {
+        None
+    };
     let d = BoardDesign::new(b.board, &p, &roms, &scene, &g, b.mhz, b.led_shift, None)?;
     let design: Vec<(PathBuf, String)> =
         d.files(c.vhdl, c.verilog).into_iter().map(|(n, t)| (c.out.join(n), t)).collect();
@@ -67,7 +71,8 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     let dir = c.out.join("pnr");
     eprintln!("placing and routing {} (minutes; logs in {})", d.top, dir.display());
     let timing = pnr::bitstream(&tools, &d, b.seed, &dir)?;
-    let bit = std::fs::read(dir.join(&timing.bitstream)).map_err(|e| Error::file(&dir.join(&timing.bitstream), e.to_string()))?;
+    let bit = std::fs::read(dir.join(&timing.bitstream))
+        .map_err(|e| Error::file(&dir.join(&timing.bitstream), e.to_string()))?;
     let report = serde_json::to_string_pretty(&timing).unwrap_or_default() + "\n";
     let mut files = OutputSet::new();
     files.extend(design)?;

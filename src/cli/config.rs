@@ -100,7 +100,10 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 pub fn ids_fit(id_width: u32, width: u32, height: u32) -> Result<()> {
     let pixels = width as u64 * height as u64;
     if id_width < 64 && pixels > 1u64 << id_width {
-        return Err(Error::param("ray-id-width", format!("{id_width} bits cannot number the {pixels} pixels of --size")));
+        return Err(Error::param(
+            "ray-id-width",
+            format!("{id_width} bits cannot number the {pixels} pixels of --size"),
+        ));
     }
     Ok(())
 }
@@ -287,7 +290,10 @@ impl GenArgs {
                 ("scene", self.scene_dir.is_some()),
             ];
             if let Some((name, _)) = clash.iter().find(|c| c.1) {
-                return Err(Error::param(name, "not with --board (a board design has its own ray generator, pins and project)"));
+                return Err(Error::param(
+                    name,
+                    "not with --board (a board design has its own ray generator, pins and project)",
+                ));
             }
             if !(self.board_mhz.is_finite() && (10.0..=400.0).contains(&self.board_mhz)) {
                 return Err(Error::param("board-mhz", format!("{} is out of range: must be 10..=400", self.board_mhz)));

@@ -41,8 +41,16 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     p.check()?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     let netlist = core_module_with(&p, &roms, false);
-    let measured = crate::flow::ecp5::measured_entry(Path::new("generated/measured/ecp5-core.json"), MEASURED, &p, &netlist, &roms.name).ok();
-    let o = generate::GenOptions { vhdl: true, verilog: true, ise: false, debug_ports: false, clock_mhz: target as f64 };
+    let measured = crate::flow::ecp5::measured_entry(
+        Path::new("generated/measured/ecp5-core.json"),
+        MEASURED,
+        &p,
+        &netlist,
+        &roms.name,
+    )
+    .ok();
+    let o =
+        generate::GenOptions { vhdl: true, verilog: true, ise: false, debug_ports: false, clock_mhz: target as f64 };
     let hdl = c.out.join("hdl");
     // Kept in memory while the frame is simulated (an interrupted demo leaves nothing), then
     // written with the pictures as one set.
@@ -69,7 +77,10 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
 
     let core = format!("fxrt_core_{}", p.trav.scene_tag);
     let pixels = (c.width * c.height) as u64;
-    println!("fxrt: the embedded teapot ({} triangles) as a ray tracing core, checked in the Rust simulator", roms.tri_count());
+    println!(
+        "fxrt: the embedded teapot ({} triangles) as a ray tracing core, checked in the Rust simulator",
+        roms.tri_count()
+    );
     println!(
         "  wrote {}: {hdl_files} files, {core} in VHDL-93 and Verilog-2001 with its ROM images and manifest {core}.json",
         hdl.display()
@@ -98,12 +109,19 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
         ),
         None => println!("  clock: not measured for this netlist (scripts/measure-default.sh places and routes it)"),
     }
-    println!("  pictures: {} (golden model, shaded, {PICTURE}x{PICTURE}), {} (the core's hits)", golden_png.display(), hardware_png.display());
+    println!(
+        "  pictures: {} (golden model, shaded, {PICTURE}x{PICTURE}), {} (the core's hits)",
+        golden_png.display(),
+        hardware_png.display()
+    );
     println!("next:");
     for (cmd, what) in [
         ("fxrt sim --builtin teapot --sim ghdl --size 24x24", "the same check in GHDL (or --sim verilator)"),
         ("fxrt gen --builtin cornell --out cornell/", "a core for another scene (or: fxrt gen yours.obj --out yours/)"),
-        ("fxrt synth --family ecp5 --modules core --builtin teapot > core.json", "its clock and area, placed and routed"),
+        (
+            "fxrt synth --family ecp5 --modules core --builtin teapot > core.json",
+            "its clock and area, placed and routed",
+        ),
         ("fxrt bench --against-embree", "the golden model against Embree on this CPU"),
     ] {
         println!("  {cmd:<68} # {what}");

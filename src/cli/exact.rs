@@ -18,7 +18,8 @@ pub fn campaign_config(a: &BenchArgs) -> Result<Campaign> {
     let files = match &a.scenes {
         None => Vec::new(),
         Some(dir) => {
-            let entries = std::fs::read_dir(dir).map_err(|e| Error::file(dir, format!("cannot read the folder: {e}")))?;
+            let entries =
+                std::fs::read_dir(dir).map_err(|e| Error::file(dir, format!("cannot read the folder: {e}")))?;
             let mut files: Vec<_> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj")))
@@ -41,7 +42,10 @@ pub fn campaign_config(a: &BenchArgs) -> Result<Campaign> {
     };
     if let Some(sim) = hdl {
         if !sim.available() {
-            return Err(Error::param("hdl", format!("{} is not installed (scripts/install-deps.sh installs it)", sim.name())));
+            return Err(Error::param(
+                "hdl",
+                format!("{} is not installed (scripts/install-deps.sh installs it)", sim.name()),
+            ));
         }
         if a.hdl_every == 0 {
             return Err(Error::param("hdl-every", "0 is out of range: must be at least 1"));
@@ -84,7 +88,11 @@ pub fn bench_exact(c: &Campaign) -> Result<bool> {
     println!("{line}");
     if let Some((_, dir)) = &report.first {
         let command = std::fs::read_to_string(dir.join("command.txt")).unwrap_or_default();
-        eprintln!("fxrt: a finding (a disagreement or a panic), written to {}; reproduce with:\n{}", dir.display(), command.trim_end());
+        eprintln!(
+            "fxrt: a finding (a disagreement or a panic), written to {}; reproduce with:\n{}",
+            dir.display(),
+            command.trim_end()
+        );
     }
     Ok(report.first.is_none())
 }

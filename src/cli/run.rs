@@ -232,12 +232,24 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         ids_fit(c.ray_id_width, g.width, g.height)?;
     }
     let t = c.threads;
-    let p = crate::cores::top::CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
+    let p =
+        crate::cores::top::CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
-    let o = generate::GenOptions { vhdl: c.vhdl, verilog: c.verilog, ise: c.ise, debug_ports: c.debug_ports, clock_mhz: c.target_mhz as f64 };
+    let o = generate::GenOptions {
+        vhdl: c.vhdl,
+        verilog: c.verilog,
+        ise: c.ise,
+        debug_ports: c.debug_ports,
+        clock_mhz: c.target_mhz as f64,
+    };
     let measured = match c.measured.as_deref() {
-        Some(f) => Some(crate::flow::ecp5::measured_core(f, &p, &crate::cores::top::core_module_with(&p, &roms, c.debug_ports), &roms.name)?),
+        Some(f) => Some(crate::flow::ecp5::measured_core(
+            f,
+            &p,
+            &crate::cores::top::core_module_with(&p, &roms, c.debug_ports),
+            &roms.name,
+        )?),
         None => None,
     };
     let mut files = OutputSet::new();

@@ -66,7 +66,8 @@ pub fn board_logic(p: &CoreParams, scene: &SceneRoms, g: &RayGen, check: BoardCh
     let res = b.instance("u_core", &core, &ins);
     b.drive(ready, res.get("ray_ready"));
 
-    let words = pack(&b, &widths, res.get("res_hit"), ["res_id", "res_tri", "res_t", "res_u", "res_v"].map(|n| res.get(n)));
+    let words =
+        pack(&b, &widths, res.get("res_hit"), ["res_id", "res_tri", "res_t", "res_u", "res_v"].map(|n| res.get(n)));
     let (mixed, mix) = mix_pipeline(&b, res.get("res_valid"), &words);
 
     let pixels = g.width as u64 * g.height as u64;

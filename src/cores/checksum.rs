@@ -57,7 +57,13 @@ mod tests {
         let b = Builder::new("mix_dut");
         let valid = b.input("valid", Ty::BIT);
         let hit = b.input("hit", Ty::BIT);
-        let ins = [b.input("id", Ty::u(w.id)), b.input("tri", Ty::u(w.tri)), b.input("t", Ty::s(w.t)), b.input("u", Ty::s(w.u)), b.input("v", Ty::s(w.v))];
+        let ins = [
+            b.input("id", Ty::u(w.id)),
+            b.input("tri", Ty::u(w.tri)),
+            b.input("t", Ty::s(w.t)),
+            b.input("u", Ty::s(w.u)),
+            b.input("v", Ty::s(w.v)),
+        ];
         let words = pack(&b, &w, hit, ins);
         let (mv, m) = mix_pipeline(&b, valid, &words);
         b.output("mv", mv);
@@ -82,7 +88,11 @@ mod tests {
             });
             // A miss's other fields are noise the mix must ignore.
             let h = hit.unwrap_or(Hit { tri: 5, t: -3, u: 7, v: 1 });
-            for (k, x) in [valid as i128, hit.is_some() as i128, id as i128, h.tri as i128, h.t as i128, h.u as i128, h.v as i128].into_iter().enumerate() {
+            for (k, x) in
+                [valid as i128, hit.is_some() as i128, id as i128, h.tri as i128, h.t as i128, h.u as i128, h.v as i128]
+                    .into_iter()
+                    .enumerate()
+            {
                 sim.set(port(k), x);
             }
             sim.eval();

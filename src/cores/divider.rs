@@ -155,7 +155,8 @@ fn divider_body<'b>(b: &'b Builder, n: u32, shape: DividerShape, wn: u32, wd: u3
         // The zero tests as ORs of bytes registered here and combined in the next stage: a
         // 63-bit test in one clock was the slowest path at 250 MHz (5.1 ns).
         // lo's bytes on their own: lo = 0 is also the negation's carry.
-        let (lo_nz, hi_nz, den_nz, sign_err) = (lo_x.nonzero_bytes(), hi_x.nonzero_bytes(), den.nonzero_bytes(), n_neg ^ d_neg);
+        let (lo_nz, hi_nz, den_nz, sign_err) =
+            (lo_x.nonzero_bytes(), hi_x.nonzero_bytes(), den.nonzero_bytes(), n_neg ^ d_neg);
         let h = pipe.stage(
             "negations",
             "signs, zero tests by bytes, both operands negated",
@@ -179,8 +180,10 @@ fn divider_body<'b>(b: &'b Builder, n: u32, shape: DividerShape, wn: u32, wd: u3
     let lo = ops.a.resize(qbits.min(wn)).resize(qbits).name("lo");
     let cw = hi.width().max(wd) + 1;
     let test = Rc::new(addsub_core(cw));
-    let overflow =
-        b.instance("u_overflow", &test, &[hi.resize(cw), ops.b.resize(cw), b.konst(Ty::BIT, 1)]).get("ge").name("overflow");
+    let overflow = b
+        .instance("u_overflow", &test, &[hi.resize(cw), ops.b.resize(cw), b.konst(Ty::BIT, 1)])
+        .get("ge")
+        .name("overflow");
     let err = |pipe: &Pipeline<'b>| pipe.now(ops.err) | pipe.now(overflow);
     let one = b.konst(Ty::BIT, 1);
     let mut part = Partial { ge: one, r: hi.resize(wd), q: b.konst(Ty::u(qbits), 0), zero: one };

@@ -28,7 +28,14 @@ pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>,
 
 /// A queue whose entries are several words (each a RAM of its own, all at the same
 /// pointers): for entries wider than a signal may be. The heads of the words, and `nonempty`.
-pub fn fifo_words<'b>(b: &'b Builder, name: &str, depth: u32, push: S<'b>, dins: &[S<'b>], pop: S<'b>) -> (Vec<S<'b>>, S<'b>) {
+pub fn fifo_words<'b>(
+    b: &'b Builder,
+    name: &str,
+    depth: u32,
+    push: S<'b>,
+    dins: &[S<'b>],
+    pop: S<'b>,
+) -> (Vec<S<'b>>, S<'b>) {
     let push = b.valid_delay(&format!("{name}_push"), push);
     let depth = depth.next_power_of_two().max(2);
     let ab = depth.trailing_zeros();

@@ -482,7 +482,8 @@ mod tests {
             let (ui, vi, o) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]), m.handle(m.outputs[0].1));
             let p = 1i128 << k;
             let top = 1i128 << (w - 2);
-            let mut values = vec![0, 1, 2, p / 2, p / 2 + 1, p - 1, p, p + 1, 2 * p - 1, 2 * p, 2 * p + 1, p + (p >> 1), top - 1];
+            let mut values =
+                vec![0, 1, 2, p / 2, p / 2 + 1, p - 1, p, p + 1, 2 * p - 1, 2 * p, 2 * p + 1, p + (p >> 1), top - 1];
             values.extend((0..40).map(|i: i128| (i * 0x9E37_79B9_7F4A_7C15) % top));
             values.retain(|&x| (0..top).contains(&x));
             for &a in &values {

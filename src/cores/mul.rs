@@ -191,7 +191,9 @@ fn split_product<'b>(b: &'b Builder, x: S<'b>, y: S<'b>, style: MulStyle) -> S<'
         let next: Vec<Term> = terms
             .chunks(2)
             .enumerate()
-            .map(|(i, c)| if c.len() == 2 { add_terms(c[0], c[1], width + 1, &format!("sum{level}_{i}")) } else { c[0] })
+            .map(
+                |(i, c)| if c.len() == 2 { add_terms(c[0], c[1], width + 1, &format!("sum{level}_{i}")) } else { c[0] },
+            )
             .collect();
         level += 1;
         let last = next.len() == 1;
@@ -235,7 +237,6 @@ mod tests {
     use super::*;
     use crate::rtl::sim::Sim;
     use proptest::prelude::*;
-
 
     /// Every style gives the exact product at its stated latency, back to back, for signed and
     /// unsigned operands from 1 to 63 bits.

@@ -16,7 +16,13 @@ pub const RESULT_QUEUE: u32 = 16;
 /// the units are full — nothing is lost and nothing waits on a combinational path from
 /// `res_ready`. `popped` is the closest-hit unit's `done_valid` (a ray leaving its queue, a
 /// clock after the pop).
-pub fn result_queue<'b>(b: &'b Builder, res: &crate::rtl::build::Ports<'b>, popped: S<'b>, res_ready: S<'b>, credit_ok: S<'b>) {
+pub fn result_queue<'b>(
+    b: &'b Builder,
+    res: &crate::rtl::build::Ports<'b>,
+    popped: S<'b>,
+    res_ready: S<'b>,
+    credit_ok: S<'b>,
+) {
     let bit = Ty::BIT;
     let field = |name: &str| res.get(&format!("res_{name}"));
     let words = [b.cat(&[field("id"), field("hit"), field("tri"), field("t")]), b.cat(&[field("u"), field("v")])];

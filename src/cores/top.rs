@@ -22,9 +22,9 @@
 use super::brom::{brom, brom2};
 use super::closest::{TagLayout, closest_core};
 use super::intersect::{IntersectParams, intersect_core};
+use super::lt_chain;
 use super::plane::{PlaneIssue, plane_unit};
 use super::traverse::{TraverseParams, field, traverse_core, word_bits};
-use super::lt_chain;
 use crate::model::golden::GridRay;
 use crate::rtl::build::{Builder, S};
 use crate::rtl::width::MAX_WIDTH;
@@ -244,14 +244,19 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
         b.next(r, x);
         r
     };
-    let free_idx: Vec<S> = free_idx_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_free_slot_r"), x, 0)).collect();
+    let free_idx: Vec<S> =
+        free_idx_w.iter().enumerate().map(|(u, &x)| copy(format!("u{u}_free_slot_r"), x, 0)).collect();
     // Whether the unit whose turn it is has a free slot, as one register: chosen by the next
     // turn among the units' outputs (what copies of them would hold next clock), it equals the
     // choice by `turn` among such copies, so the take — which loads every port register, a net
     // across the die — depends on three registers through one LUT (with four units the choice
     // after the copies cost 9.6 ns: 103.8 MHz).
     let turn_free = b.reg("turn_free", bit, Some(1));
-    let turn_slot = if units == 1 { free_idx[0] } else { b.case(turn, &(0..units).map(|u| (u as u128, free_idx[u as usize])).collect::<Vec<_>>(), free_idx[0]) };
+    let turn_slot = if units == 1 {
+        free_idx[0]
+    } else {
+        b.case(turn, &(0..units).map(|u| (u as u128, free_idx[u as usize])).collect::<Vec<_>>(), free_idx[0])
+    };
     // The ray port's register: a ray waits in it for the box-exit unit and a slot. The port is
     // ready when the register is empty or its ray is taken this clock (no path from ray_valid
     // to ray_ready); the register loads whenever the port is ready.
@@ -267,11 +272,19 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz] = [ray_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(hold);
     let take_slot = if ub == 0 { turn_slot } else { b.cat(&[turn.resize(ub), turn_slot]) }.name("take_slot");
     let next_turn = (turn + 1).name("turn_plus_1");
-    let next_turn = if units.is_power_of_two() { next_turn } else { next_turn.eq(units as i128).select(turn.k(0), next_turn) };
+    let next_turn =
+        if units.is_power_of_two() { next_turn } else { next_turn.eq(units as i128).select(turn.k(0), next_turn) };
     let turn_next = (take | !turn_free).select(next_turn, turn).name("turn_next");
     b.next(turn, turn_next);
     let pick = |u: u32| (u as u128, has_free_w[u as usize]);
-    b.next(turn_free, if units == 1 { has_free_w[0] } else { b.case(turn_next, &(0..units).map(pick).collect::<Vec<_>>(), b.konst(bit, 0)) });
+    b.next(
+        turn_free,
+        if units == 1 {
+            has_free_w[0]
+        } else {
+            b.case(turn_next, &(0..units).map(pick).collect::<Vec<_>>(), b.konst(bit, 0))
+        },
+    );
     b.next(phase, (take | phase.ne(0)).select(phase + 1, phase));
     // The box-exit unit's operands load whenever it is idle: when a ray is taken they hold it.
     let idle = phase.eq(0).name("box_idle");
@@ -332,7 +345,8 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let leaf_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_leaf_pop"), bit)).collect();
     let done_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_done_pop"), bit)).collect();
     let unit = Rc::new(traverse_core(&p.trav, scene));
-    let node_words: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_node_word"), Ty::u(scene.node.0.width))).collect();
+    let node_words: Vec<S> =
+        (0..units).map(|u| b.wire(&format!("u{u}_node_word"), Ty::u(scene.node.0.width))).collect();
     let trav: Vec<_> = (0..units)
         .map(|u| {
             let mine = is_unit(gslot, u, sb, ub);
@@ -341,10 +355,28 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
             let mv = (merge_valid & is_unit(merge_slot, u, sb, ub)).name(&format!("u{u}_merge"));
             let fv = (free_valid & is_unit(free_slot, u, sb, ub)).name(&format!("u{u}_free"));
             let ins = [
-                we, turn_slot, ox, oy, oz, ix, iy, iz,
-                new_valid, box_done_slot.slice(0, sb), box_tmax, box_miss,
-                mv, merge_slot.slice(0, sb), merge_hit, merge_limit, merge_sp,
-                fv, free_slot.slice(0, sb), we, leaf_pop[u as usize], done_pop[u as usize],
+                we,
+                turn_slot,
+                ox,
+                oy,
+                oz,
+                ix,
+                iy,
+                iz,
+                new_valid,
+                box_done_slot.slice(0, sb),
+                box_tmax,
+                box_miss,
+                mv,
+                merge_slot.slice(0, sb),
+                merge_hit,
+                merge_limit,
+                merge_sp,
+                fv,
+                free_slot.slice(0, sb),
+                we,
+                leaf_pop[u as usize],
+                done_pop[u as usize],
                 node_words[u as usize],
             ];
             let t = b.instance(&format!("u_traverse_{u}"), &unit, &ins);
@@ -365,7 +397,15 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
             b.drive(node_words[u0], wa);
             b.drive(node_words[u1], wc);
         } else {
-            let w = brom(&b, &label, &format!("node_{scene_tag}"), node_l.width, image.clone(), trav[u0].get("node_addr"), nrc);
+            let w = brom(
+                &b,
+                &label,
+                &format!("node_{scene_tag}"),
+                node_l.width,
+                image.clone(),
+                trav[u0].get("node_addr"),
+                nrc,
+            );
             b.drive(node_words[u0], w);
         }
     }
@@ -437,8 +477,24 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     for j in (0..units).rev() {
         // Candidate j places after leaf_turn: unit (leaf_turn + 1 + j) mod units.
         let cand = |u: u32| (u + 1 + j) % units;
-        let sel_any = if units == 1 { avail[0] } else { b.case(leaf_turn, &(0..units).map(|t| (t as u128, avail[cand(t) as usize])).collect::<Vec<_>>(), b.konst(bit, 0)) };
-        let sel_u = if units == 1 { b.konst(Ty::u(1), 0) } else { b.case(leaf_turn, &(0..units).map(|t| (t as u128, b.konst(Ty::u(ub), cand(t) as i128))).collect::<Vec<_>>(), b.konst(Ty::u(ub), 0)) };
+        let sel_any = if units == 1 {
+            avail[0]
+        } else {
+            b.case(
+                leaf_turn,
+                &(0..units).map(|t| (t as u128, avail[cand(t) as usize])).collect::<Vec<_>>(),
+                b.konst(bit, 0),
+            )
+        };
+        let sel_u = if units == 1 {
+            b.konst(Ty::u(1), 0)
+        } else {
+            b.case(
+                leaf_turn,
+                &(0..units).map(|t| (t as u128, b.konst(Ty::u(ub), cand(t) as i128))).collect::<Vec<_>>(),
+                b.konst(Ty::u(ub), 0),
+            )
+        };
         pick = Some(match pick {
             None => (sel_any, sel_u),
             Some((any, u)) => (sel_any | any, sel_any.select(sel_u, u)),
@@ -458,7 +514,11 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let sel = |port: &str| {
         let k = fields.iter().position(|f| *f == port).expect("a buffered leaf field");
         let v: Vec<S> = bufs.iter().map(|(_, _, held)| held[k]).collect();
-        if units == 1 { v[0] } else { b.case(pick_u, &(0..units).map(|u| (u as u128, v[u as usize])).collect::<Vec<_>>(), v[0]) }
+        if units == 1 {
+            v[0]
+        } else {
+            b.case(pick_u, &(0..units).map(|u| (u as u128, v[u as usize])).collect::<Vec<_>>(), v[0])
+        }
     };
     let next_slot = if ub == 0 { sel("leaf_slot") } else { b.cat(&[pick_u, sel("leaf_slot")]) };
     b.next(cur_valid, take | (cur_valid & !last_entry));
@@ -473,11 +533,13 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     // Emission: the leaf ROM at the entry, then the triangle ROMs at its word; the tag and the
     // ray (read from the ray RAMs at the slot) wait alongside.
     let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
-    let tri_num = brom(&b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, leaf_image, cur_ptr, tp.leaf_rom_cycles);
+    let tri_num =
+        brom(&b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, leaf_image, cur_ptr, tp.leaf_rom_cycles);
     let lrc = tp.leaf_rom_cycles;
     let tag = b.cat(&[last_entry, cur_first, cur_slot, cur_sp, cur_tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
     let tag = b.delay_line("emit_tag", tag, lrc);
-    let tag = b.cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)]).name("emit_tag_tri");
+    let tag =
+        b.cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)]).name("emit_tag_tri");
     let emit_valid = b.valid_line("emit_valid", cur_valid, lrc);
     let (tri_l, tri_words) = &scene.tri;
     let addr = tri_num.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
@@ -486,7 +548,8 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
         let lsb = group[0].lsb;
         let width: u32 = group.iter().map(|f| f.width).sum();
         let image = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
-        let word = brom(&b, &format!("u_tri_rom_{k}"), &format!("tri_{k}_{scene_tag}"), width, image, addr, p.tri_rom_cycles);
+        let word =
+            brom(&b, &format!("u_tri_rom_{k}"), &format!("tri_{k}_{scene_tag}"), width, image, addr, p.tri_rom_cycles);
         tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
     }
     let trc = p.tri_rom_cycles;
@@ -506,7 +569,9 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let m = p.isect.m;
     let mut pipe_in = vec![valid_d, tag_d];
     pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
-    pipe_in.extend((0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * m, m) } else { w_words[a as usize] }.signed()));
+    pipe_in.extend(
+        (0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * m, m) } else { w_words[a as usize] }.signed()),
+    );
     pipe_in.extend(tri_fields);
     let r = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
 
@@ -522,7 +587,8 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
         })
         .collect();
     let mut done_any = dv[0];
-    let mut done_slot = if ub == 0 { trav[0].get("done_slot") } else { b.cat(&[b.konst(Ty::u(ub), 0), trav[0].get("done_slot")]) };
+    let mut done_slot =
+        if ub == 0 { trav[0].get("done_slot") } else { b.cat(&[b.konst(Ty::u(ub), 0), trav[0].get("done_slot")]) };
     b.drive(done_pop[0], dv[0]);
     for u in 1..units as usize {
         let mine = (dv[u] & !done_any).name(&format!("u{u}_done_take"));
@@ -561,8 +627,10 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
             let mut depth = 0;
             while level.len() > 1 {
                 depth += 1;
-                let next: Vec<S<'b>> = level.chunks(2).map(|p| if p.len() == 2 { join(p[0], p[1]) } else { p[0] }).collect();
-                level = next.into_iter().enumerate().map(|(i, x)| b.delay(&format!("{name}_l{depth}_{i}"), x)).collect();
+                let next: Vec<S<'b>> =
+                    level.chunks(2).map(|p| if p.len() == 2 { join(p[0], p[1]) } else { p[0] }).collect();
+                level =
+                    next.into_iter().enumerate().map(|(i, x)| b.delay(&format!("{name}_l{depth}_{i}"), x)).collect();
             }
             level[0]
         }
@@ -615,8 +683,8 @@ pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::ray
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::feed::Stalls;
     use crate::flow::disturb::simulate_rust_cycle;
+    use crate::flow::feed::Stalls;
     use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
     use crate::model::camera::Camera;
     use crate::params::Params;

@@ -120,7 +120,6 @@ pub fn field<'b>(name: &str, word: S<'b>, f: &Field, word_lsb: u32) -> S<'b> {
     if f.signed { raw.signed().name(name) } else { raw.name(name) }
 }
 
-
 /// A token's fields in the ring.
 #[derive(Clone, Copy)]
 struct Token<'b> {
@@ -210,7 +209,15 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let unpark_pop = b.wire("unpark_pop", bit);
     let new_pop = b.wire("new_pop", bit);
     let unpark = fifo(&b, "unpark_q", sb + spw, k, merge_valid, b.cat(&[merge_slot, merge_sp]), unpark_pop);
-    let newq = fifo(&b, "new_q", sb + dist.width + 1, k, new_valid, b.cat(&[new_slot, new_tmax.unsigned(), new_miss]), new_pop);
+    let newq = fifo(
+        &b,
+        "new_q",
+        sb + dist.width + 1,
+        k,
+        new_valid,
+        b.cat(&[new_slot, new_tmax.unsigned(), new_miss]),
+        new_pop,
+    );
     // E: a queued ray enters when the token now in G will not return (R empty in A).
     let take_unpark = (!ring_g_valid & unpark.nonempty).name("take_unpark");
     let take_new = (!ring_g_valid & !unpark.nonempty & newq.nonempty).name("take_new");
@@ -261,7 +268,8 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // One stack of 2^stack_bits words per slot number the address can hold: a slot number has
     // at least one bit, so one slot still takes two stacks' worth of address space.
     let stack_words = (k.max(2) as usize) << stack_bits;
-    let top = bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, stack_words, push_w, push_addr, push_data, raddr);
+    let top =
+        bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, stack_words, push_w, push_addr, push_data, raddr);
     let bt = Token {
         valid: b.valid_delay("b_valid", (a_valid & !a_done).name("a_live")),
         slot: b.delay("b_slot", a_slot),
@@ -305,7 +313,11 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let limit = b.read("limit_q", limit_mem, c.slot).signed();
     let has_best = b.reg("has_best", Ty::u(k), Some(0));
     let x = b.delay("cull_x", (c.tmin - (c.tmin >> 6)).name("tmin_less"));
-    let hb = b.delay("cull_has_best", b.case(c.slot, &(0..k).map(|i| (i as u128, has_best.bit(i))).collect::<Vec<_>>(), b.konst(bit, 0)).name("slot_has_best"));
+    let hb = b.delay(
+        "cull_has_best",
+        b.case(c.slot, &(0..k).map(|i| (i as u128, has_best.bit(i))).collect::<Vec<_>>(), b.konst(bit, 0))
+            .name("slot_has_best"),
+    );
     let culled = b.delay("culled", (hb & lt_chain(limit, x)).name("culled_c"));
     let culled = b.delay_line("culled_n", culled, nrc - 2);
     let set_best = (merge_valid & merge_hit).select(onehot(merge_slot, k), b.konst(Ty::u(k), 0)).name("best_set");
@@ -328,7 +340,8 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let visit = (nt.valid & !culled).name("visit_c");
     let is_inner = (visit & !w_leaf).name("is_inner");
     let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
-    let leaf_in = b.cat(&[nt.slot, w_first.resize(leaf_bits), w_count, nt.tmin.unsigned().resize(p.tmin_width()), nt.sp]);
+    let leaf_in =
+        b.cat(&[nt.slot, w_first.resize(leaf_bits), w_count, nt.tmin.unsigned().resize(p.tmin_width()), nt.sp]);
     let leafq = fifo(&b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.valid_delay("leaf_pop_r", leaf_pop));
 
     // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
@@ -336,8 +349,24 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let o_word = b.read("ray_o_q", o_mem, nt.slot);
     let o = [0, 1, 2].map(|a| o_word.slice(a * n, n));
     let inv = [0, 1, 2].map(|a| b.read(&format!("ray_inv{}_q", ["x", "y", "z"][a]), inv_mem[a], nt.slot).signed());
-    let pu0 = plane_unit(&b, n, p.c, o, inv, PlaneIssue { valid: is_inner, last: is_inner.k(0), plane: w_clip0, axis: w_axis }, p.product);
-    let pu1 = plane_unit(&b, n, p.c, o, inv, PlaneIssue { valid: is_inner, last: is_inner.k(1), plane: w_clip1, axis: w_axis }, p.product);
+    let pu0 = plane_unit(
+        &b,
+        n,
+        p.c,
+        o,
+        inv,
+        PlaneIssue { valid: is_inner, last: is_inner.k(0), plane: w_clip0, axis: w_axis },
+        p.product,
+    );
+    let pu1 = plane_unit(
+        &b,
+        n,
+        p.c,
+        o,
+        inv,
+        PlaneIssue { valid: is_inner, last: is_inner.k(1), plane: w_clip1, axis: w_axis },
+        p.product,
+    );
     let l = pu0.latency;
     assert!(l >= 4, "the decision limits need 3 cycles after N");
     let axis1 = b.delay("axis_n1", w_axis);
@@ -358,8 +387,12 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let tmax_p1 = b.delay("tmax_p1", (nt.tmax + 1).name("tmax_plus_1"));
     let tmin_m1 = b.delay("tmin_m1", (nt.tmin - 1).name("tmin_minus_1"));
     let tmin_le_tmax = b.delay("tmin_le_tmax", lt_chain(tmin1, tmax_p1).name("tmin_le_tmax_c"));
-    let (tmin2, tmax2, tmax_p1_2, tmin_m1_2) =
-        (b.delay("tmin_n2", tmin1), b.delay("tmax_n2", tmax1), b.delay("tmax_p1_n2", tmax_p1), b.delay("tmin_m1_n2", tmin_m1));
+    let (tmin2, tmax2, tmax_p1_2, tmin_m1_2) = (
+        b.delay("tmin_n2", tmin1),
+        b.delay("tmax_n2", tmax1),
+        b.delay("tmax_p1_n2", tmax_p1),
+        b.delay("tmin_m1_n2", tmin_m1),
+    );
     let never_below = tmax2.k(-(1i128 << (n + 2)));
     let never_above = tmax2.k((1i128 << (n + 2)) - 1);
     let limit_reg = |name: &str, if_negative: S<'_>, if_positive: S<'_>, never: S<'_>| {
@@ -404,7 +437,8 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let far = g_neg.select(g.node, child_b).resize(node_bits).name("far");
     let near_max = near_lt_tmax.select(near_end, g.tmax).name("near_max");
     let far_min = far_gt_tmin.select(far_start, g.tmin).name("far_min");
-    let (enter_near, enter_far) = ((g_inner & go_near).name("enter_near"), (g_inner & !go_near & go_far).name("enter_far"));
+    let (enter_near, enter_far) =
+        ((g_inner & go_near).name("enter_near"), (g_inner & !go_near & go_far).name("enter_far"));
     let push = (enter_near & go_far).name("push");
     b.drive(push_w, push);
     b.drive(push_addr, b.cat(&[g.slot, g.sp.resize(stack_bits)]));
@@ -477,7 +511,14 @@ mod tests {
     /// Streams `rays` through the whole core (every result taken the clock it is shown) and
     /// checks that each ray's node visits, seen on the units' observation ports by slot, are
     /// those of `Golden::trace_culled`, in its order.
-    fn assert_walks_are_the_culled_golden_walks(label: &str, scene: &Scene, rays: &[PixelRay], mhz: u32, slots: u32, units: u32) {
+    fn assert_walks_are_the_culled_golden_walks(
+        label: &str,
+        scene: &Scene,
+        rays: &[PixelRay],
+        mhz: u32,
+        slots: u32,
+        units: u32,
+    ) {
         let g = Golden::new(scene);
         let roms = SceneRoms::of(scene);
         let p = CoreParams::with_slots(&roms, 16, 1, mhz, slots, units);

@@ -206,7 +206,9 @@ mod tests {
     /// flight, never corrupts what already left).
     fn all_right(scene: &Scene, rays: &[PixelRay], results: &[CoreResult]) -> bool {
         let g = FastGolden::new(scene);
-        results.iter().all(|(id, hit)| rays.iter().find(|r| r.pixel as u64 == *id).is_some_and(|r| g.trace(&r.ray).0 == *hit))
+        results
+            .iter()
+            .all(|(id, hit)| rays.iter().find(|r| r.pixel as u64 == *id).is_some_and(|r| g.trace(&r.ray).0 == *hit))
     }
 
     /// A consumer ready on 30 % of the clocks, a source stalling on 20 %: every ray gets
@@ -221,7 +223,12 @@ mod tests {
         let free = simulate_cycle(&p, &roms, &rays, &Stalls::random(20, 4), &Disturb::none(), &|_| {});
         assert_eq!(mismatches(&scene, &rays, &free.results), 0);
         // Results can leave only on the 30 % of clocks the consumer is ready.
-        assert!(run.stats.cycles * 3 / 10 >= rays.len() as u64 && run.stats.cycles > free.stats.cycles, "{} vs {}", run.stats.cycles, free.stats.cycles);
+        assert!(
+            run.stats.cycles * 3 / 10 >= rays.len() as u64 && run.stats.cycles > free.stats.cycles,
+            "{} vs {}",
+            run.stats.cycles,
+            free.stats.cycles
+        );
     }
 
     /// The shortest latency is a real one and a bound: the box-missing ray's result comes

@@ -405,7 +405,8 @@ fn critical_path(r: &serde_json::Value) -> CriticalPath {
     let delay = |p: &serde_json::Value| -> f64 {
         p["path"].as_array().map_or(0.0, |s| s.iter().filter_map(|x| x["delay"].as_f64()).sum())
     };
-    let clocked = |p: &&serde_json::Value| ["from", "to"].iter().all(|e| p[*e].as_str().is_some_and(|c| c != "<async>"));
+    let clocked =
+        |p: &&serde_json::Value| ["from", "to"].iter().all(|e| p[*e].as_str().is_some_and(|c| c != "<async>"));
     let Some(worst) = paths.iter().filter(clocked).max_by(|a, b| delay(a).total_cmp(&delay(b))) else {
         return CriticalPath::default();
     };
@@ -455,7 +456,9 @@ pub fn measured_entry(
     }
     let modules = doc["modules"].as_array().cloned().unwrap_or_default();
     let core = modules.into_iter().find(|m| m["module"].as_str().is_some_and(|n| n.starts_with("fxrt_core")));
-    let core_entry = core.filter(|m| m["fmax_mhz"].is_number()).ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))?;
+    let core_entry = core
+        .filter(|m| m["fmax_mhz"].is_number())
+        .ok_or_else(|| bad("no placed and routed fxrt_core module in it".into()))?;
     // Figures of another netlist (the generator changed since, or other options) are not this
     // core's.
     let hash = netlist_hash(netlist);

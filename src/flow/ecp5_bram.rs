@@ -136,11 +136,15 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
     let zeros = |pin: &str, n| (0..n).map(|i| format!(".{pin}{i}(1'b0)")).collect::<Vec<_>>().join(", ");
     for (k, bank) in layout.iter().enumerate() {
         let tag = if one { String::new() } else { k.to_string() };
-        let words_of_bank: Vec<u128> =
-            rom.words.iter().copied().skip(bank.base).take(1 << bank.abits).collect();
+        let words_of_bank: Vec<u128> = rom.words.iter().copied().skip(bank.base).take(1 << bank.abits).collect();
         if bank.w == 0 {
             // The tail in LUTs, read through two registers like a block with its output register.
-            let _ = writeln!(v, "  (* rom_style = \"logic\" *) reg [{}:0] tail{k} [0:{}];", rom.width - 1, (1usize << bank.abits) - 1);
+            let _ = writeln!(
+                v,
+                "  (* rom_style = \"logic\" *) reg [{}:0] tail{k} [0:{}];",
+                rom.width - 1,
+                (1usize << bank.abits) - 1
+            );
             v.push_str("  initial begin\n");
             for a in 0..1usize << bank.abits {
                 let word = words_of_bank.get(a).copied().unwrap_or(0);
@@ -286,15 +290,21 @@ pub fn dp16kd_ram(generated: &str, m: &Module) -> Option<String> {
              .WRITEMODE_A(\"NORMAL\"), .WRITEMODE_B(\"NORMAL\"), .GSR(\"DISABLED\")\n  ) u_bram{j} ("
         );
         let _ = writeln!(v, "    {},", address("ADA", "waddr", true));
-        let din: Vec<String> = (0..18).map(|i| if i < w { format!(".DIA{i}(din[{}])", j * w + i) } else { format!(".DIA{i}(1'b0)") }).collect();
+        let din: Vec<String> = (0..18)
+            .map(|i| if i < w { format!(".DIA{i}(din[{}])", j * w + i) } else { format!(".DIA{i}(1'b0)") })
+            .collect();
         let _ = writeln!(v, "    {},", din.join(", "));
-        v.push_str("    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(we), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n");
+        v.push_str(
+            "    .CLKA(clk), .CEA(1'b1), .OCEA(1'b1), .WEA(we), .RSTA(1'b0), .CSA0(1'b0), .CSA1(1'b0), .CSA2(1'b0),\n",
+        );
         let _ = writeln!(v, "    {},", address("ADB", "raddr", false));
         let zeros: Vec<String> = (0..18).map(|i| format!(".DIB{i}(1'b0)")).collect();
         let _ = writeln!(v, "    {},", zeros.join(", "));
         let dout: Vec<String> = (0..w).map(|i| format!(".DOB{i}(dout[{}])", j * w + i)).collect();
         let _ = writeln!(v, "    {},", dout.join(", "));
-        v.push_str("    .CLKB(clk), .CEB(1'b1), .OCEB(1'b1), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n");
+        v.push_str(
+            "    .CLKB(clk), .CEB(1'b1), .OCEB(1'b1), .WEB(1'b0), .RSTB(1'b0), .CSB0(1'b0), .CSB1(1'b0), .CSB2(1'b0)\n",
+        );
         v.push_str("  );\n");
     }
     let _ = writeln!(v, "  assign data = dout[{}:0];", ram.width - 1);

@@ -33,7 +33,9 @@ pub fn addsub_width_of(file: &str) -> Option<u32> {
 pub fn ccu2c_addsub(generated: &str, w: u32) -> Option<String> {
     let end = generated.find("\n);\n")? + 4;
     let mut v = String::from(&generated[..end]);
-    v.push_str("\n  // The step as one ECP5 carry chain, the add-or-subtract in each cell's LUT (fxrt synth --family ecp5).\n");
+    v.push_str(
+        "\n  // The step as one ECP5 carry chain, the add-or-subtract in each cell's LUT (fxrt synth --family ecp5).\n",
+    );
     // Chain bit 0 brings in the carry; bit i + 1 is sum bit i.
     let bits = w + 1;
     let cells = bits.div_ceil(2);

@@ -39,13 +39,17 @@ pub fn mult18x18d(generated: &str, regs: u32) -> Option<String> {
         p = clk(regs >= 3),
         o = clk(regs >= 2),
     );
-    let bus = |name: &str, port: char, n: u32| (0..n).map(|i| format!(".{port}{i}({name}[{i}])")).collect::<Vec<_>>().join(", ");
+    let bus = |name: &str, port: char, n: u32| {
+        (0..n).map(|i| format!(".{port}{i}({name}[{i}])")).collect::<Vec<_>>().join(", ")
+    };
     let _ = writeln!(v, "    {},", bus("a", 'A', 18));
     let _ = writeln!(v, "    {},", bus("b", 'B', 18));
     let zeros: Vec<String> = (0..18).map(|i| format!(".C{i}(1'b0)")).collect();
     let _ = writeln!(v, "    {},", zeros.join(", "));
     v.push_str("    .SIGNEDA(1'b1), .SIGNEDB(1'b1), .SOURCEA(1'b0), .SOURCEB(1'b0),\n");
-    v.push_str("    .CLK0(clk), .CLK1(1'b0), .CLK2(1'b0), .CLK3(1'b0), .CE0(1'b1), .CE1(1'b0), .CE2(1'b0), .CE3(1'b0),\n");
+    v.push_str(
+        "    .CLK0(clk), .CLK1(1'b0), .CLK2(1'b0), .CLK3(1'b0), .CE0(1'b1), .CE1(1'b0), .CE2(1'b0), .CE3(1'b0),\n",
+    );
     v.push_str("    .RST0(1'b0), .RST1(1'b0), .RST2(1'b0), .RST3(1'b0),\n");
     // The fourth level lands the product in the fabric, where the adder tree is.
     let out = if regs >= 4 { "p_dsp" } else { "p" };
@@ -75,7 +79,9 @@ mod tests {
             let header = &text[..text.find("\n);\n").unwrap()];
             assert!(v.starts_with(header), "{v}");
             assert_eq!(v.contains("always"), regs == 4, "a fabric register only after a 4-level block: {v}");
-            for (param, on) in [("REG_INPUTA_CLK", regs >= 1), ("REG_PIPELINE_CLK", regs >= 3), ("REG_OUTPUT_CLK", regs >= 2)] {
+            for (param, on) in
+                [("REG_INPUTA_CLK", regs >= 1), ("REG_PIPELINE_CLK", regs >= 3), ("REG_OUTPUT_CLK", regs >= 2)]
+            {
                 let want = format!(".{param}({})", if on { "\"CLK0\"" } else { "\"NONE\"" });
                 assert!(v.contains(&want), "{regs}: {want} in {v}");
             }

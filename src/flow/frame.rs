@@ -369,7 +369,16 @@ pub fn frame_stream(p: &CoreParams, scene: &Scene, rays: &[PixelRay], stalls: &S
     let max_cycles =
         ((100_000 + 100 * stalls.per_period() as u64) * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
     let (sink, resets) = (Stalls::none(), Vec::new());
-    Ok(FrameStream { core, rays: inputs, expected, stalls: stalls.clone(), sink, resets, max_cycles, slots: p.slot_count() as u64 })
+    Ok(FrameStream {
+        core,
+        rays: inputs,
+        expected,
+        stalls: stalls.clone(),
+        sink,
+        resets,
+        max_cycles,
+        slots: p.slot_count() as u64,
+    })
 }
 
 /// Streams `rays` (in the order given, with `stalls`) through the core's HDL in `sim` with a
@@ -447,11 +456,11 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::flow::disturb::simulate_rust_cycle;
     use crate::flow::feed::feed_order;
     use crate::params::Params;
     use crate::rtl::sim::Sim;
     use crate::scene::SceneSource;
-    use crate::flow::disturb::simulate_rust_cycle;
 
     fn cornell(n: u32, m: u32) -> Scene {
         Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n, m, ..Params::default() }).unwrap()
@@ -552,7 +561,13 @@ mod tests {
         let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &fed, &stalls, &|_| {});
         assert_eq!(cycle_results, results);
         assert_eq!(
-            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.stall_cycles, cycle_stats.visits, cycle_stats.culls),
+            (
+                cycle_stats.cycles,
+                cycle_stats.busy_cycles,
+                cycle_stats.stall_cycles,
+                cycle_stats.visits,
+                cycle_stats.culls
+            ),
             (stats.cycles, stats.busy_cycles, stats.stall_cycles, stats.visits, stats.culls)
         );
         assert_eq!(mismatches(&scene, &rays, &results), 0);

@@ -118,7 +118,11 @@ fn write_set(cores: &[(Module, Option<u32>, Value)], o: GenOptions, scene: &str)
 
 /// The pipeline cores alone (intersection pipeline and divider).
 pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, String)> {
-    write_set(&cores(p), GenOptions { vhdl, verilog, ise: false, debug_ports: false, clock_mhz: p.target_mhz as f64 }, "")
+    write_set(
+        &cores(p),
+        GenOptions { vhdl, verilog, ise: false, debug_ports: false, clock_mhz: p.target_mhz as f64 },
+        "",
+    )
 }
 
 /// The whole ray tracing core for a scene (fed by the on-chip ray generator when `raygen` is
@@ -168,7 +172,8 @@ pub fn core_files(
     let mut out = write_set(&set, o, &roms.name);
     // The core's manifest (written first) gets what an integrator needs beyond its ports.
     let out_names: Vec<String> = out.iter().map(|f| f.0.clone()).collect();
-    let ise: Vec<String> = out.iter().map(|f| f.0.clone()).filter(|n| n.ends_with(".tcl") || n.ends_with(".ucf")).collect();
+    let ise: Vec<String> =
+        out.iter().map(|f| f.0.clone()).filter(|n| n.ends_with(".tcl") || n.ends_with(".ucf")).collect();
     let file = &mut out.iter_mut().find(|f| f.0 == format!("{}.json", set[0].0.name)).expect("the core's manifest").1;
     let mut doc: Value = serde_json::from_str(file).expect("the manifest just written");
     let sha = |text: &str| {
@@ -202,7 +207,10 @@ pub fn core_files(
         "measured_fmax_mhz": pick("fmax_mhz"),
         "measured_on": measured.map(|_| json!({ "device": pick("device"), "package": pick("package"), "speed_grade": pick("speed_grade"), "seed": pick("seed"), "yosys": pick("yosys"), "nextpnr": pick("nextpnr"), "module": pick("module") })),
     });
-    doc["resources"] = measured.map_or(Value::Null, |_| json!({ "lut4": pick("lut4"), "ff": pick("ff"), "mult18": pick("mult18"), "dp16kd": pick("dp16kd") }));
+    doc["resources"] = measured.map_or(
+        Value::Null,
+        |_| json!({ "lut4": pick("lut4"), "ff": pick("ff"), "mult18": pick("mult18"), "dp16kd": pick("dp16kd") }),
+    );
     doc["hashes"] = json!({
         "scene_sha256": roms.hash(),
         "scene_tag": p.trav.scene_tag,
@@ -212,7 +220,8 @@ pub fn core_files(
     // Memory images only where the Verilog that reads them was written.
     let written = |n: &str| out_names.iter().any(|w| w == n);
     let hex: Vec<Value> = doc["files"]["verilog_memory_init"].as_array().cloned().unwrap_or_default();
-    doc["files"]["verilog_memory_init"] = json!(hex.into_iter().filter(|h| h.as_str().is_some_and(written)).collect::<Vec<_>>());
+    doc["files"]["verilog_memory_init"] =
+        json!(hex.into_iter().filter(|h| h.as_str().is_some_and(written)).collect::<Vec<_>>());
     *file = serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n";
     out.extend(axis);
     out

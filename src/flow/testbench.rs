@@ -135,7 +135,8 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     let id = checked.iter().find(|p| p.name == s.id).expect("the id output is checked");
     assert!(!id.ty.signed, "the id output is unsigned");
     let (outputs, _) = ports(m, &m.outputs, 0);
-    let (rays, expected, results, stalls, sink) = ("rays.txt", "expected.txt", "results.txt", "stalls.txt", "ready.txt");
+    let (rays, expected, results, stalls, sink) =
+        ("rays.txt", "expected.txt", "results.txt", "stalls.txt", "ready.txt");
     let vhdl = sim == Simulator::Ghdl;
     let mut files = crate::rtl::emit::design_files(m, ext(vhdl));
     let fields = |row: &[i128], ports: &[Port]| -> Vec<(u128, u32)> {
@@ -159,7 +160,10 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
     if let Some(bits) = s.stalls {
         files.push((stalls.into(), bits_file(bits)));
     }
-    assert!(has_res_ready || (s.sink.is_none() && s.resets.is_empty()), "a consumer pattern or resets need res_ready and rst");
+    assert!(
+        has_res_ready || (s.sink.is_none() && s.resets.is_empty()),
+        "a consumer pattern or resets need res_ready and rst"
+    );
     if let Some(bits) = s.sink {
         files.push((sink.into(), bits_file(bits)));
     }

@@ -297,9 +297,11 @@ impl Visitor for Closest<'_> {
     #[inline]
     fn triangle(&mut self, i: u32, leaf_tmin: i64) {
         if let Some(h) = self.g.intersect(&self.scene.tris[i as usize], self.ray)
-            && h.t >= lower_t(leaf_tmin) && self.best.is_none_or(|b| (h.t, i) < (b.t, b.tri)) {
-                self.best = Some(Hit { tri: i, t: h.t, u: h.u, v: h.v });
-            }
+            && h.t >= lower_t(leaf_tmin)
+            && self.best.is_none_or(|b| (h.t, i) < (b.t, b.tri))
+        {
+            self.best = Some(Hit { tri: i, t: h.t, u: h.u, v: h.v });
+        }
     }
 }
 

@@ -98,9 +98,10 @@ impl<F: Real> FloatScene<F> {
             // t_max is inclusive for the tie-break, so test against a slightly larger bound.
             if let Some(t) =
                 self.test_tri(id, o, d, if best.is_some() { t_max + t_max.abs() * F::from_f64(1e-12) } else { t_max })
-                && best.is_none_or(|b| t < b.1 || (t == b.1 && id < b.0)) {
-                    *best = Some((id, t));
-                }
+                && best.is_none_or(|b| t < b.1 || (t == b.1 && id < b.0))
+            {
+                *best = Some((id, t));
+            }
         };
         for &id in &self.extra {
             consider(id, &mut best);

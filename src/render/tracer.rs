@@ -98,15 +98,16 @@ impl Tracer for GoldenTracer<'_> {
         // Rays that reach the box gather into a packet, traced as soon as it is full (and the
         // last, partial one at the end): a small buffer that stays in the cache.
         let (mut grid, mut pixel) = (Vec::with_capacity(LANES), Vec::with_capacity(LANES));
-        let flush = |grid: &mut Vec<GridRay>, pixel: &mut Vec<(usize, f64)>, found: &mut dyn FnMut(usize, PrimaryHit)| {
-            for ((ray, &(i, t_offset)), hit) in grid.iter().zip(pixel.iter()).zip(self.fast.trace_packet(grid)) {
-                if let Some(h) = hit {
-                    found(i, self.primary_hit(&QuantizedRay { ray: *ray, t_offset }, h));
+        let flush =
+            |grid: &mut Vec<GridRay>, pixel: &mut Vec<(usize, f64)>, found: &mut dyn FnMut(usize, PrimaryHit)| {
+                for ((ray, &(i, t_offset)), hit) in grid.iter().zip(pixel.iter()).zip(self.fast.trace_packet(grid)) {
+                    if let Some(h) = hit {
+                        found(i, self.primary_hit(&QuantizedRay { ray: *ray, t_offset }, h));
+                    }
                 }
-            }
-            grid.clear();
-            pixel.clear();
-        };
+                grid.clear();
+                pixel.clear();
+            };
         let mut keep = |i: usize, q: QuantizedRay| {
             if self.fast.fits(&q.ray) {
                 grid.push(q.ray);
@@ -257,7 +258,9 @@ mod tests {
         };
         use crate::render::fast::GoldenPath;
         let mut skipped = std::collections::BTreeSet::new();
-        for (params, path) in sets.into_iter().flat_map(|p| [GoldenPath::Scalar, GoldenPath::Avx2, GoldenPath::Avx512].map(|g| (p, g))) {
+        for (params, path) in
+            sets.into_iter().flat_map(|p| [GoldenPath::Scalar, GoldenPath::Avx2, GoldenPath::Avx512].map(|g| (p, g)))
+        {
             for name in BUILTIN_NAMES {
                 let scene = Scene::load(&SceneSource::Builtin(name.to_string()), &params).unwrap();
                 if !FastGolden::path_available(&scene, path) {
@@ -297,7 +300,10 @@ mod tests {
         for s in skipped {
             // Past the test harness's capture: a skipped path is worth seeing in every run.
             use std::io::Write;
-            let _ = writeln!(std::io::stderr().lock(), "skipped: the golden model's {s}: not on this CPU or not for these widths");
+            let _ = writeln!(
+                std::io::stderr().lock(),
+                "skipped: the golden model's {s}: not on this CPU or not for these widths"
+            );
         }
     }
 }

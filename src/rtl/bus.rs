@@ -12,7 +12,6 @@ pub use super::netlist::Bus;
 use super::netlist::{Module, SigId};
 use super::width::Ty;
 
-
 /// A port as the printers show it (the clock and reset aside).
 pub struct PrintedPort<'a> {
     pub name: &'a str,

@@ -189,7 +189,6 @@ pub struct Bus {
     pub parts: Vec<usize>,
 }
 
-
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Module {
     pub name: String,

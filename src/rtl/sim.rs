@@ -181,9 +181,10 @@ impl Sim {
         // Writes after the reads: a read of the written address sees the old word.
         for &(mem, we, addr, data) in &self.writes {
             if v[we] & 1 == 1
-                && let Some(w) = usize::try_from(v[addr]).ok().and_then(|a| self.roms[mem].get_mut(a)) {
-                    *w = v[data];
-                }
+                && let Some(w) = usize::try_from(v[addr]).ok().and_then(|a| self.roms[mem].get_mut(a))
+            {
+                *w = v[data];
+            }
         }
         for (k, r) in self.regs.iter().enumerate() {
             self.vals[r.dst] = self.next[k];

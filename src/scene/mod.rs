@@ -240,9 +240,10 @@ pub fn auto_edge_shift(grid: &[[GridVertex; 3]], params: &Params) -> u32 {
     let (mut a, mut b) = (0i128, 1i128);
     for g in grid {
         if let Some((x, y)) = accel::max_edge_ratio(g)
-            && x * b > a * y {
-                (a, b) = (x, y);
-            }
+            && x * b > a * y
+        {
+            (a, b) = (x, y);
+        }
     }
     let cap = max_edge_shift(params);
     if a == 0 {

@@ -32,12 +32,24 @@ pub enum Board {
 /// banks 3 at 2.5 V and 21 at 1.8 V) from the board's UCF as copied in VLSI-EDA/PoC and
 /// hdl4fpga (docs/BOARDS.md).
 const ULX3S_LEDS: [(&str, &str); 8] = [
-    ("B2", "LVCMOS33"), ("C2", "LVCMOS33"), ("C1", "LVCMOS33"), ("D2", "LVCMOS33"),
-    ("D1", "LVCMOS33"), ("E2", "LVCMOS33"), ("E1", "LVCMOS33"), ("H3", "LVCMOS33"),
+    ("B2", "LVCMOS33"),
+    ("C2", "LVCMOS33"),
+    ("C1", "LVCMOS33"),
+    ("D2", "LVCMOS33"),
+    ("D1", "LVCMOS33"),
+    ("E2", "LVCMOS33"),
+    ("E1", "LVCMOS33"),
+    ("H3", "LVCMOS33"),
 ];
 const ML509_LEDS: [(&str, &str); 8] = [
-    ("H18", "LVCMOS25"), ("L18", "LVCMOS25"), ("G15", "LVCMOS25"), ("AD26", "LVCMOS18"),
-    ("G16", "LVCMOS25"), ("AD25", "LVCMOS18"), ("AD24", "LVCMOS18"), ("AE24", "LVCMOS18"),
+    ("H18", "LVCMOS25"),
+    ("L18", "LVCMOS25"),
+    ("G15", "LVCMOS25"),
+    ("AD26", "LVCMOS18"),
+    ("G16", "LVCMOS25"),
+    ("AD25", "LVCMOS18"),
+    ("AD24", "LVCMOS18"),
+    ("AE24", "LVCMOS18"),
 ];
 
 impl Board {
@@ -86,15 +98,32 @@ pub struct BoardClock {
 impl BoardClock {
     pub fn for_board(board: Board, target_mhz: f64) -> Result<BoardClock> {
         let osc = board.osc_mhz();
-        let none = || Error::param("board-mhz", format!("{target_mhz} MHz: the {} PLL cannot make it from {osc} MHz", board.name()));
+        let none = || {
+            Error::param(
+                "board-mhz",
+                format!("{target_mhz} MHz: the {} PLL cannot make it from {osc} MHz", board.name()),
+            )
+        };
         Ok(match board {
             Board::Ulx3s => {
                 let p = Ecp5Pll::for_clock(osc, target_mhz).ok_or_else(none)?;
-                BoardClock { mhz: p.out_mhz(osc), mult: p.clkfb_div, div_in: p.clki_div, div_out: p.clkop_div, cphase: p.cphase() }
+                BoardClock {
+                    mhz: p.out_mhz(osc),
+                    mult: p.clkfb_div,
+                    div_in: p.clki_div,
+                    div_out: p.clkop_div,
+                    cphase: p.cphase(),
+                }
             }
             Board::Ml509 => {
                 let p = V5Pll::for_clock(osc, target_mhz).ok_or_else(none)?;
-                BoardClock { mhz: p.out_mhz(osc), mult: p.clkfbout_mult, div_in: p.divclk_divide, div_out: p.clkout0_divide, cphase: 0 }
+                BoardClock {
+                    mhz: p.out_mhz(osc),
+                    mult: p.clkfbout_mult,
+                    div_in: p.divclk_divide,
+                    div_out: p.clkout0_divide,
+                    cphase: 0,
+                }
             }
         })
     }
@@ -230,7 +259,10 @@ impl BoardDesign {
             out.push((format!("{}.tcl", self.top), tcl));
         }
         let names: Vec<String> = out.iter().map(|f| f.0.clone()).collect();
-        out.push((format!("{}.json", self.top), serde_json::to_string_pretty(&self.manifest(&names)).unwrap_or_default() + "\n"));
+        out.push((
+            format!("{}.json", self.top),
+            serde_json::to_string_pretty(&self.manifest(&names)).unwrap_or_default() + "\n",
+        ));
         out
     }
 

@@ -140,6 +140,9 @@ mod tests {
             assert!((400.0..=900.0).contains(&vco), "{p:?}");
         }
         // 80 MHz: 100 · 8 / 1 / 10, the VCO at 800 MHz (400 · 2 / 1 / 5 would sit on the edge).
-        assert_eq!(V5Pll::for_clock(100.0, 80.0), Some(V5Pll { divclk_divide: 1, clkfbout_mult: 8, clkout0_divide: 10 }));
+        assert_eq!(
+            V5Pll::for_clock(100.0, 80.0),
+            Some(V5Pll { divclk_divide: 1, clkfbout_mult: 8, clkout0_divide: 10 })
+        );
     }
 }

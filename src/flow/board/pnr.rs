@@ -44,7 +44,10 @@ fn ecppack(tools: &Tools) -> PathBuf {
 /// bitstream `<top>.bit` there.
 pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Result<BoardTiming> {
     if d.board != Board::Ulx3s {
-        return Err(Error::param("board", format!("{}: the bitstream comes from ISE (the .tcl project)", d.board.name())));
+        return Err(Error::param(
+            "board",
+            format!("{}: the bitstream comes from ISE (the .tcl project)", d.board.name()),
+        ));
     }
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let mut sources = write_sources(&d.logic, dir)?;
@@ -58,8 +61,25 @@ pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Resul
     synthesize(tools, dir, &sources, &d.top)?;
     let seed_s = seed.to_string();
     let args = [
-        "--85k", "--package", PACKAGE, "--speed", "6", "--json", "design.json", "--lpf", &lpf, "--textcfg",
-        "design.config", "--seed", &seed_s, "--report", "report.json", "--timing-allow-fail", "--log", "nextpnr.log", "-q",
+        "--85k",
+        "--package",
+        PACKAGE,
+        "--speed",
+        "6",
+        "--json",
+        "design.json",
+        "--lpf",
+        &lpf,
+        "--textcfg",
+        "design.config",
+        "--seed",
+        &seed_s,
+        "--report",
+        "report.json",
+        "--timing-allow-fail",
+        "--log",
+        "nextpnr.log",
+        "-q",
     ];
     run(&tools.nextpnr, &args, dir, "nextpnr.log")?;
     let bit = format!("{}.bit", d.top);
@@ -72,13 +92,22 @@ pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Resul
 }
 
 /// The figures of nextpnr's `--report` for `d`.
-pub fn timing_of(r: &serde_json::Value, d: &BoardDesign, seed: u64, yosys: String, nextpnr: String, bitstream: String) -> BoardTiming {
+pub fn timing_of(
+    r: &serde_json::Value,
+    d: &BoardDesign,
+    seed: u64,
+    yosys: String,
+    nextpnr: String,
+    bitstream: String,
+) -> BoardTiming {
     let used = |cell: &str| r["utilization"][cell]["used"].as_u64().unwrap_or(0);
     let domains: Vec<(String, f64, f64)> = r["fmax"]
         .as_object()
         .map(|o| {
             o.iter()
-                .map(|(net, v)| (net.clone(), v["achieved"].as_f64().unwrap_or(0.0), v["constraint"].as_f64().unwrap_or(0.0)))
+                .map(|(net, v)| {
+                    (net.clone(), v["achieved"].as_f64().unwrap_or(0.0), v["constraint"].as_f64().unwrap_or(0.0))
+                })
                 .collect()
         })
         .unwrap_or_default();

@@ -87,7 +87,8 @@ pub fn write(
 /// GHDL on the VHDL files `write` wrote: (PASS reported, the whole output).
 pub fn ghdl(dir: &Path, sources: &[String]) -> Result<(bool, String), String> {
     let step = |args: &[&str], extra: &[String]| -> Result<String, String> {
-        let o = Command::new("ghdl").args(args).args(extra).current_dir(dir).output().map_err(|e| format!("ghdl: {e}"))?;
+        let o =
+            Command::new("ghdl").args(args).args(extra).current_dir(dir).output().map_err(|e| format!("ghdl: {e}"))?;
         let text = String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
         if o.status.success() { Ok(text) } else { Err(format!("ghdl {}: {text}", args[0])) }
     };
@@ -108,7 +109,8 @@ pub fn icarus(dir: &Path, sources: &[String]) -> Result<(bool, String), String> 
     if !compile.status.success() {
         return Err(format!("iverilog: {}", String::from_utf8_lossy(&compile.stderr)));
     }
-    let run = Command::new("vvp").args(["-n", "board_tb.vvp"]).current_dir(dir).output().map_err(|e| format!("vvp: {e}"))?;
+    let run =
+        Command::new("vvp").args(["-n", "board_tb.vvp"]).current_dir(dir).output().map_err(|e| format!("vvp: {e}"))?;
     let text = String::from_utf8_lossy(&run.stdout).to_string();
     Ok((text.lines().any(|l| l.trim() == "PASS"), text))
 }

@@ -14,14 +14,19 @@ pub enum CaseScene {
     /// An OBJ file (the campaign's `--scenes` folder).
     File(std::path::PathBuf),
     /// `soups::scene(kind, seed)`.
-    Random { kind: &'static str, seed: u64 },
+    Random {
+        kind: &'static str,
+        seed: u64,
+    },
 }
 
 impl CaseScene {
     pub fn label(&self) -> String {
         match self {
             CaseScene::Builtin(name) => name.clone(),
-            CaseScene::File(path) => path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into()),
+            CaseScene::File(path) => {
+                path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into())
+            }
             CaseScene::Random { kind, seed } => format!("{kind}#{seed:016x}"),
         }
     }

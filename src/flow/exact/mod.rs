@@ -191,7 +191,14 @@ pub fn compare(
         if got[k] != Some(golden) || golden_full != golden || golden_fast != golden {
             out.disagreeing_rays += 1;
             if out.disagreements.len() < 16 {
-                out.disagreements.push(RayDisagreement { pixel: r.pixel, ray: r.ray, core: got[k], golden, golden_full, golden_fast });
+                out.disagreements.push(RayDisagreement {
+                    pixel: r.pixel,
+                    ray: r.ray,
+                    core: got[k],
+                    golden,
+                    golden_full,
+                    golden_fast,
+                });
             }
         }
     }
@@ -306,7 +313,9 @@ pub fn campaign(c: &Campaign, progress: &dyn Fn(u64, u64)) -> crate::error::Resu
     let mut first: Option<CaseRun> = None;
     while start.elapsed() < c.budget && c.max_cases.is_none_or(|m| next < m) && first.is_none() {
         let count = c.max_cases.map_or(batch, |m| batch.min(m - next));
-        let runs: Vec<CaseRun> = (next..next + count).into_par_iter().map(|i| run_case(c.seed, i, &c.files, c.hdl.filter(|h| i % h.1 == 0).map(|h| h.0)))
+        let runs: Vec<CaseRun> = (next..next + count)
+            .into_par_iter()
+            .map(|i| run_case(c.seed, i, &c.files, c.hdl.filter(|h| i % h.1 == 0).map(|h| h.0)))
             .collect();
         next += count;
         for run in runs {

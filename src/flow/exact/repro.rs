@@ -84,7 +84,9 @@ pub fn write(out: &Path, run: &CaseRun) -> Result<PathBuf> {
     }
     // A frame that disagreed only in the HDL simulator is reproduced there.
     let hdl = match &run.verdict {
-        Verdict::Ran(o) if o.hdl_disagreement.is_some() && o.disagreeing_rays == 0 && o.core_walk == o.golden_walk => o.hdl,
+        Verdict::Ran(o) if o.hdl_disagreement.is_some() && o.disagreeing_rays == 0 && o.core_walk == o.golden_walk => {
+            o.hdl
+        }
         _ => None,
     };
     let command = sim_command(case, &obj_path, hdl);

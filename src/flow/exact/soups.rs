@@ -98,7 +98,8 @@ fn layers(rng: &mut SplitMix64) -> Vec<Tri> {
         for i in 0..=cells {
             for j in 0..=cells {
                 let inner = i > 0 && j > 0 && i < cells && j < cells;
-                let (dx, dy) = if inner { (rng.range(-jitter, jitter), rng.range(-jitter, jitter)) } else { (0.0, 0.0) };
+                let (dx, dy) =
+                    if inner { (rng.range(-jitter, jitter), rng.range(-jitter, jitter)) } else { (0.0, 0.0) };
                 grid[i * (cells + 1) + j] = [i as f64 + dx, j as f64 + dy];
             }
         }

@@ -335,7 +335,9 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         row.ecp5 = placed;
         match (error, &row.core, super::pnr::clock(&row.ecp5)) {
             (Some(e), _, _) => row.error = Some(e),
-            (None, Some(run), Some(mhz)) => row.mrays_per_s_at_fmax = Some((mhz / run.cycles_per_ray * 1e4).round() / 1e4),
+            (None, Some(run), Some(mhz)) => {
+                row.mrays_per_s_at_fmax = Some((mhz / run.cycles_per_ray * 1e4).round() / 1e4)
+            }
             _ => {}
         }
     }

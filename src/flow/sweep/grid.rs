@@ -1,9 +1,9 @@
 //! Image grids like seed 001 figures 2.7 (m), 2.8 (T) and 2.9 (C): one scene, one parameter
 //! varied, the others at the base set; renders on top, error maps below.
 
+use super::draw::{FONT, register_font};
 use super::eval::Row;
 use super::output::{Results, cached_images};
-use super::draw::{FONT, register_font};
 use super::{Axis, Plan};
 use crate::error::{Error, Result};
 use crate::io::OutputSet;

@@ -8,7 +8,6 @@
 //! the configurations with index ≡ I−1 (mod N); `merge` joins shards. The outputs are a
 //! function of (spec, rows) alone, so a merged sweep is byte-identical to an unsharded one.
 
-pub mod values;
 pub mod compat;
 pub mod draw;
 pub mod eval;
@@ -21,6 +20,7 @@ pub mod run;
 pub mod slurm;
 pub mod summary;
 pub mod throughput;
+pub mod values;
 
 use crate::cores::top::{DEFAULT_SLOTS, DEFAULT_UNITS};
 use crate::error::{Error, Result};
@@ -477,7 +477,6 @@ pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
     }
     out
 }
-
 
 /// `params_label` with the core's shape when it is not the default: `…_c16_k8_u1`.
 pub fn set_label(s: &Set) -> String {

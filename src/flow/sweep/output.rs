@@ -257,7 +257,8 @@ pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
             k.map(|k| k.slot_occupancy.to_string()).unwrap_or_default(),
         ];
         let fields = with_optional(spec, csv_record(r), shape, core);
-        w.write_record(with_extra(fields, super::pnr::csv_cells(spec, &r.ecp5, r.mrays_per_s_at_fmax))).expect("csv into memory");
+        w.write_record(with_extra(fields, super::pnr::csv_cells(spec, &r.ecp5, r.mrays_per_s_at_fmax)))
+            .expect("csv into memory");
     }
     w.into_inner().expect("csv into memory")
 }

@@ -98,7 +98,3 @@ pub fn csv_cells(spec: &SweepSpec, placed: &[PlacedModule], mrays_per_s_at_fmax:
     }
     v
 }
-
-
-
-

@@ -43,7 +43,6 @@ struct Report {
     area_source: String,
 }
 
-
 fn findings(results: &Results, sets: &[SetSummary]) -> Vec<String> {
     let mut out = Vec::new();
     let spec = &results.spec;

@@ -10,7 +10,6 @@ use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-
 /// What a run did, for the summary line.
 #[derive(Debug, Default, PartialEq, Eq)]
 pub struct RunSummary {

@@ -4,9 +4,9 @@
 //! (`core` among the modules; then a second panel shows Mrays/s at Fmax), else yosys's
 //! Virtex-5 DSP48E and LUTs with `--synth`, else the estimated DSP48E and register bits.
 
+use super::draw::{FONT, H, W, draw_legend, plot_err};
 use super::eval::Row;
 use super::output::Results;
-use super::draw::{FONT, H, W, draw_legend, plot_err};
 use super::output::list;
 use crate::error::Result;
 use crate::io::OutputSet;

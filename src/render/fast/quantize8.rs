@@ -185,7 +185,8 @@ mod avx2 {
             t1 = _mm256_min_pd(t1, _mm256_max_pd(a, b));
         }
         let magic = splat(1.5 * 2f64.powi(52));
-        let to_i64 = |x: __m256d| _mm256_sub_epi64(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic));
+        let to_i64 =
+            |x: __m256d| _mm256_sub_epi64(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic));
         // round_i64: trunc(x) + (frac ≥ 1/2) − (frac ≤ −1/2); NaN becomes −2^50 (max_pd gives
         // its second operand), which clamps to what round_i64's 0 clamps to.
         let round = |x: __m256d| {
@@ -217,8 +218,14 @@ mod avx2 {
             let neg = _mm256_cmpgt_epi64(zero, w);
             let a = _mm256_sub_epi64(_mm256_xor_si256(w, neg), neg);
             let a_f = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_add_epi64(a, _mm256_castpd_si256(magic))), magic);
-            let q = to_i64(_mm256_round_pd::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(_mm256_div_pd(splat(s as f64), a_f)));
-            let qa = _mm256_add_epi64(_mm256_mul_epu32(a, q), _mm256_slli_epi64::<32>(_mm256_mul_epu32(a, _mm256_srli_epi64::<32>(q))));
+            let q = to_i64(_mm256_round_pd::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(_mm256_div_pd(
+                splat(s as f64),
+                a_f,
+            )));
+            let qa = _mm256_add_epi64(
+                _mm256_mul_epu32(a, q),
+                _mm256_slli_epi64::<32>(_mm256_mul_epu32(a, _mm256_srli_epi64::<32>(q))),
+            );
             let r = _mm256_sub_epi64(_mm256_set1_epi64x(s), qa);
             // q − 1 when r < 0, q + 1 when r ≥ |ω| (the masks are −1 where true).
             let up = _mm256_xor_si256(_mm256_cmpgt_epi64(a, r), _mm256_set1_epi64x(-1));

@@ -11,8 +11,8 @@ pub mod writer;
 pub use walk::{Printer, print};
 pub use writer::CodeWriter;
 
-use crate::rtl::width::BinOp;
 use crate::bits::rom_depth;
+use crate::rtl::width::BinOp;
 
 /// The operator as Verilog (and C) spell it.
 pub fn symbol(op: BinOp) -> &'static str {

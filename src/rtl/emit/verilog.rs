@@ -107,7 +107,8 @@ impl Printer for Verilog {
         // asked for in LUTs: yosys otherwise spends a block on each of them (8 DP16KDs the
         // teapot's core did not have to spare); Xilinx tools read the same attribute.
         let depth = rom_depth(r.words.len());
-        let style = if r.write.is_some() && depth <= DISTRIBUTED_WORDS { "(* ram_style = \"distributed\" *) " } else { "" };
+        let style =
+            if r.write.is_some() && depth <= DISTRIBUTED_WORDS { "(* ram_style = \"distributed\" *) " } else { "" };
         w.line(format!("{style}reg [{}:0] {} [0:{}];", r.width - 1, r.name, depth - 1));
         w.line(format!("initial $readmemh(\"{}\", {});", mem_file(m, &r.name), r.name));
     }
