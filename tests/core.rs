@@ -234,7 +234,8 @@ fn hdl_frames_shuffled_and_stalled() {
             _ => Ok(()),
         }
     };
-    let failures = each_simulator(&[Simulator::Iverilog, Simulator::Ghdl, Simulator::Verilator], check);
+    let failures =
+        each_simulator(&[Simulator::Iverilog, Simulator::IverilogSv, Simulator::Ghdl, Simulator::Verilator], check);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
@@ -264,7 +265,8 @@ fn hdl_frames_with_a_slow_consumer_and_resets() {
             _ => Ok(()),
         }
     };
-    let failures = each_simulator(&[Simulator::Iverilog, Simulator::Ghdl, Simulator::Verilator], check);
+    let failures =
+        each_simulator(&[Simulator::Iverilog, Simulator::IverilogSv, Simulator::Ghdl, Simulator::Verilator], check);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

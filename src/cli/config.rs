@@ -27,7 +27,7 @@ pub enum Simulation {
 }
 
 impl Simulation {
-    /// As the JSON of `fxrt sim` names it: rust, ghdl, iverilog, verilator.
+    /// As the JSON of `fxrt sim` names it: rust, ghdl, iverilog, iverilog-sv, verilator.
     pub fn name(self) -> &'static str {
         match self {
             Simulation::Rust => "rust",
@@ -41,6 +41,7 @@ impl Simulation {
             Simulation::Rust => "Rust",
             Simulation::Hdl(Simulator::Ghdl) => "Ghdl",
             Simulation::Hdl(Simulator::Iverilog) => "Iverilog",
+            Simulation::Hdl(Simulator::IverilogSv) => "Iverilog (SystemVerilog rules)",
             Simulation::Hdl(Simulator::Verilator) => "Verilator",
         }
     }
@@ -64,6 +65,7 @@ impl From<SimChoice> for Simulation {
             SimChoice::Rust => Simulation::Rust,
             SimChoice::Ghdl => Simulation::Hdl(Simulator::Ghdl),
             SimChoice::Iverilog => Simulation::Hdl(Simulator::Iverilog),
+            SimChoice::IverilogSv => Simulation::Hdl(Simulator::IverilogSv),
             SimChoice::Verilator => Simulation::Hdl(Simulator::Verilator),
         }
     }
@@ -374,7 +376,7 @@ impl TestArgs {
         // The slow simulators get fewer vectors by default.
         let vectors = self.vectors.unwrap_or(match self.sim {
             SimChoice::Rust | SimChoice::Verilator => 100_000,
-            SimChoice::Iverilog => 20_000,
+            SimChoice::Iverilog | SimChoice::IverilogSv => 20_000,
             SimChoice::Ghdl => 2_000,
         });
         if vectors == 0 {

@@ -428,7 +428,11 @@ pub struct TestArgs {
 pub enum SimChoice {
     Rust,
     Ghdl,
+    /// Icarus under Verilog-2005 rules.
     Iverilog,
+    /// Icarus under SystemVerilog rules (-g2012, as cocotb runs it).
+    #[value(name = "iverilog-sv")]
+    IverilogSv,
     Verilator,
 }
 

@@ -296,6 +296,7 @@ fn each_simulator_choice_maps_once() {
     for (choice, frame, sim) in [
         (SimChoice::Ghdl, Some(FrameSim::Ghdl), Simulator::Ghdl),
         (SimChoice::Iverilog, None, Simulator::Iverilog),
+        (SimChoice::IverilogSv, None, Simulator::IverilogSv),
         (SimChoice::Verilator, Some(FrameSim::Verilator), Simulator::Verilator),
     ] {
         assert_eq!(Simulation::from(choice), Simulation::Hdl(sim));

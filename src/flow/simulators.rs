@@ -8,7 +8,12 @@ use std::process::Command;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Simulator {
     Ghdl,
+    /// Icarus under Verilog-2005 rules (`-g2005`).
     Iverilog,
+    /// Icarus under SystemVerilog rules (`-g2012`, what cocotb's runner asks for): variable
+    /// initialisers run before any process, so logic that waits for a time-0 event shows X.
+    #[value(name = "iverilog-sv")]
+    IverilogSv,
     Verilator,
 }
 
@@ -19,6 +24,7 @@ impl Simulator {
         match self {
             Simulator::Ghdl => "ghdl",
             Simulator::Iverilog => "iverilog",
+            Simulator::IverilogSv => "iverilog-sv",
             Simulator::Verilator => "verilator",
         }
     }
@@ -27,13 +33,18 @@ impl Simulator {
     fn program(self) -> &'static str {
         match self {
             Simulator::Ghdl => "ghdl",
-            Simulator::Iverilog => "iverilog",
+            Simulator::Iverilog | Simulator::IverilogSv => "iverilog",
             Simulator::Verilator => "verilator",
         }
     }
 
+    /// Whether this simulator runs the Verilog testbenches written for Icarus.
+    pub fn is_icarus(self) -> bool {
+        matches!(self, Simulator::Iverilog | Simulator::IverilogSv)
+    }
+
     pub fn available(self) -> bool {
-        let flag = if self == Simulator::Iverilog { "-V" } else { "--version" };
+        let flag = if self.is_icarus() { "-V" } else { "--version" };
         Command::new(self.program()).arg(flag).output().is_ok_and(|o| o.status.success())
     }
 
@@ -67,8 +78,9 @@ impl Simulator {
                     words(&["ghdl", "-r", "--std=93c", "--workdir=.", &tb]),
                 ]
             }
-            Simulator::Iverilog => {
-                let mut compile = words(&["iverilog", "-g2005", "-o", "tb.vvp", "-s", &tb]);
+            Simulator::Iverilog | Simulator::IverilogSv => {
+                let rules = if self == Simulator::Iverilog { "-g2005" } else { "-g2012" };
+                let mut compile = words(&["iverilog", rules, "-o", "tb.vvp", "-s", &tb]);
                 compile.extend(design);
                 compile.push("tb.v".into());
                 vec![compile, words(&["vvp", "-n", "tb.vvp"])]

@@ -305,7 +305,7 @@ pub fn bench_files(m: &Module, t: &Transcript, sim: Simulator) -> Vec<(String, S
     let mut files = crate::rtl::emit::design_files(m, ext(sim == Simulator::Ghdl));
     files.extend(match sim {
         Simulator::Ghdl => render_vectors(m, t, true),
-        Simulator::Iverilog => render_vectors(m, t, false),
+        Simulator::Iverilog | Simulator::IverilogSv => render_vectors(m, t, false),
         Simulator::Verilator => render_harness(m, t),
     });
     files

@@ -35,10 +35,9 @@ def main():
         runner.build(vhdl_sources=[folder / f for f in files["vhdl"]], hdl_toplevel=a.top, build_args=std, build_dir=build)
         test_dir, test_args = build, std  # the work library is in the build folder
     else:
-        # Icarus as Verilog-2005 (cocotb asks for 2012 first; the last -g counts), as fxrt's own
-        # Icarus runs: in 2012 mode a variable's initialiser runs before the `always @*` blocks
-        # wait, so a `case` whose inputs never change from their power-up values stays X.
-        icarus = ["-g2005", "-s", a.top]
+        # Icarus as cocotb runs it (SystemVerilog rules, -g2012): the generated Verilog has no
+        # logic that waits for a time-0 event, so it settles under these rules as under 2005's.
+        icarus = ["-s", a.top]
         args = icarus if a.sim == "icarus" else ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3"]
         runner.build(verilog_sources=[folder / f for f in files["verilog"]], hdl_toplevel=a.top, build_args=args, build_dir=build)
         test_dir, test_args = folder, []  # $readmemh finds the memory images here

@@ -1,5 +1,5 @@
 //! Verilog-2001 printer (Icarus `-g2005`, Verilator `-Wall`): one module per netlist, a
-//! continuous assignment per combinational signal, an `always @*` block per `case`, and an
+//! continuous assignment per combinational signal (a `case` too, as a chain of `?:`), and an
 //! `always @(posedge clk)` block per pipeline stage or state machine (and one for the
 //! registers in no block). Operands are extended explicitly wherever Verilog's
 //! context-determined widths would otherwise decide (products), so the width lint stays quiet;
@@ -135,9 +135,8 @@ impl Printer for Verilog {
                 w.line(format!("initial for ({n}_i = 1; {n}_i <= {depth}; {n}_i = {n}_i + 1) {n}_sr[{n}_i] = {zero};"));
                 w.line(format!("wire {t} {n};"));
             }
-            // A case is a combinational `always` block, so its target is a `reg`.
-            Decl::Selected => w.line(format!("reg {t} {n};")),
-            Decl::Net => w.line(format!("wire {t} {n};")),
+            // A case is a continuous assignment too (see `case`), so its target is a `wire`.
+            Decl::Net | Decl::Selected => w.line(format!("wire {t} {n};")),
         });
     }
 
@@ -201,12 +200,16 @@ impl Printer for Verilog {
         format!("{name}_sr[{depth}]")
     }
 
+    /// A chain of conditional operators in one continuous assignment, not an `always @*`
+    /// block: under SystemVerilog rules (Icarus `-g2012`, as cocotb runs it) an `always @*`
+    /// whose inputs are registers with initial values never runs at time 0 and leaves its
+    /// target X until an input changes; a continuous assignment is evaluated at time 0 under
+    /// both rule sets.
     fn case(&self, w: &mut CodeWriter, target: &str, sel: &str, arms: &[(String, &str)], default: &str) {
-        w.nest("always @* begin", "end", |w| {
-            w.nest(format!("case ({sel})"), "endcase", |w| {
-                arms.iter().for_each(|(choice, v)| w.line(format!("{choice}: {target} = {v};")));
-                w.line(format!("default: {target} = {default};"));
-            });
+        w.line(format!("assign {target} ="));
+        w.indented(|w| {
+            arms.iter().for_each(|(choice, v)| w.line(format!("({sel} == {choice}) ? {v} :")));
+            w.line(format!("{default};"));
         });
     }
 
