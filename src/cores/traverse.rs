@@ -131,6 +131,23 @@ struct Token<'b> {
     sp: S<'b>,
 }
 
+impl<'b> Token<'b> {
+    /// The token `depth` clocks later, in the stage's registers `{stage}_valid`,
+    /// `{stage}_slot`, … (the valid bit cleared by `rst`); each field passes through
+    /// `through(field, value)` on the way in, in field order.
+    fn delayed(self, b: &'b Builder, stage: &str, depth: u32, through: impl Fn(&str, S<'b>) -> S<'b>) -> Token<'b> {
+        let line = |field: &str, x: S<'b>| b.delay_line(&format!("{stage}_{field}"), through(field, x), depth);
+        Token {
+            valid: b.valid_line(&format!("{stage}_valid"), through("valid", self.valid), depth),
+            slot: line("slot", self.slot),
+            node: line("node", self.node),
+            tmin: line("tmin", self.tmin),
+            tmax: line("tmax", self.tmax),
+            sp: line("sp", self.sp),
+        }
+    }
+}
+
 /// The unit. Inputs: the ray RAM write (`ray_we`, `ray_slot`, ox, oy, oz, invx, invy, invz),
 /// a new ray's box exit (`new_valid`, `new_slot`, `new_tmax`, `new_miss`), a leaf merged
 /// (`merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` = best t + 8, `merge_sp`), a slot
@@ -185,6 +202,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         mem
     });
 
+    b.stage("slots", "the free-slot bits, the lowest free slot for the top, the slots holding a ray");
     // Free slots: a bit per slot, the lowest free one registered (one clock stale, so a slot
     // just taken is masked for a clock by `just_alloc`).
     let all = (1i128 << k) - 1;
@@ -204,6 +222,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let occupied = b.reg("occupied_r", Ty::u(sb + 1), Some(0));
     b.next(occupied, occupied + alloc.resize(sb + 1) - free_valid.resize(sb + 1));
 
+    b.stage("queues", "E: rays back from a leaf and new rays wait; one enters when no token returns");
     // The queues into the ring: rays back from a leaf (slot, sp) and new rays (slot, tmax, miss).
     let ring_g_valid = b.wire("ring_g_valid", bit);
     let unpark_pop = b.wire("unpark_pop", bit);
@@ -234,6 +253,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let q_tmax = b.delay("q_tmax", newq.head.slice(1, dist.width).signed());
     let q_miss = b.delay("q_miss", newq.head.bit(0));
 
+    b.stage("ring_r", "R: the token back from G, loaded in G");
     // R: the token back from G (a wire here, a register below), with sp = 0 and sp − 1 made in G.
     let r_valid = b.reg("r_valid", bit, Some(0));
     let r_pop = b.reg("r_pop", bit, None);
@@ -248,6 +268,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
         sp: b.reg("r_sp", Ty::u(spw), None),
     };
 
+    b.stage("ring_a", "A: the returning token or a queued ray; a pop reads the stack; done rays leave");
     // A.
     let a_valid = (r_valid | q_valid).name("a_valid");
     let a_slot = r_valid.select(r.slot, q_slot).name("a_slot");
@@ -270,6 +291,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let stack_words = (k.max(2) as usize) << stack_bits;
     let top =
         bram(&b, "u_stack", &format!("stack_w{stack_w}"), stack_w, stack_words, push_w, push_addr, push_data, raddr);
+    b.stage("ring_b", "B, B2: the token waits two clocks for the stack word");
     let bt = Token {
         valid: b.valid_delay("b_valid", (a_valid & !a_done).name("a_live")),
         slot: b.delay("b_slot", a_slot),
@@ -280,30 +302,23 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     };
     let b_from_stack = b.delay_line("b_from_stack", a_from_stack, 2);
     // B waits a clock for the stack word (the block's output register).
-    let bt = Token {
-        valid: b.valid_delay("b2_valid", bt.valid),
-        slot: b.delay("b2_slot", bt.slot),
-        node: b.delay("b2_node", bt.node),
-        tmin: b.delay("b2_tmin", bt.tmin),
-        tmax: b.delay("b2_tmax", bt.tmax),
-        sp: b.delay("b2_sp", bt.sp),
-    };
+    let bt = bt.delayed(&b, "b2", 1, |_, x| x);
+    b.stage("done", "the done queue: slots whose ray left the ring in A, for the top");
     // The top's pops arrive a clock late (registered here: the top's arbiter sits across the
     // die), so it does not take from a queue again in the clock after it took.
     let done = fifo(&b, "done_q", sb, k, a_done, a_slot, b.valid_delay("done_pop_r", done_pop));
 
+    b.stage("ring_c", "C: a popped entry from the stack word; the node ROM addressed; the cull test");
     // B: a popped entry (far node, far_min, tmax) from the stack word.
     let top_tmax = top.slice(0, dist.width).signed();
     let top_tmin = top.slice(dist.width, dist.width).signed();
     let top_node = top.slice(2 * dist.width, node_bits);
-    let c = Token {
-        valid: b.valid_delay("c_valid", bt.valid),
-        slot: b.delay("c_slot", bt.slot),
-        node: b.delay("c_node", b_from_stack.select(top_node, bt.node)),
-        tmin: b.delay("c_tmin", b_from_stack.select(top_tmin, bt.tmin)),
-        tmax: b.delay("c_tmax", b_from_stack.select(top_tmax, bt.tmax)),
-        sp: b.delay("c_sp", bt.sp),
-    };
+    let c = bt.delayed(&b, "c", 1, |field, x| match field {
+        "node" => b_from_stack.select(top_node, x),
+        "tmin" => b_from_stack.select(top_tmin, x),
+        "tmax" => b_from_stack.select(top_tmax, x),
+        _ => x,
+    });
 
     // C: the node ROM read, and the cull test: lower_t(tmin) > best t ⟺ tmin − tmin/64 >
     // best t + 8 (`golden::lower_t`), only when the slot has a best hit.
@@ -324,15 +339,9 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let clear_best = (a_new & a_valid).select(onehot(a_slot, k), b.konst(Ty::u(k), 0)).name("best_clear");
     b.next(has_best, (has_best & !clear_best) | set_best);
 
+    b.stage("ring_n", "N: the node word; a leaf queued, an inner node to the plane units");
     // N: the node word.
-    let nt = Token {
-        valid: b.valid_line("n_valid", c.valid, nrc),
-        slot: b.delay_line("n_slot", c.slot, nrc),
-        node: b.delay_line("n_node", c.node, nrc),
-        tmin: b.delay_line("n_tmin", c.tmin, nrc),
-        tmax: b.delay_line("n_tmax", c.tmax, nrc),
-        sp: b.delay_line("n_sp", c.sp, nrc),
-    };
+    let nt = c.delayed(&b, "n", nrc, |_, x| x);
     let nf = |name: &str| field(&format!("nw_{name}"), word, node_l.field(name), 0);
     let (w_axis, w_clip0, w_clip1, w_child, w_first, w_count) =
         (nf("axis"), nf("clip0"), nf("clip1"), nf("child"), nf("first"), nf("count"));
@@ -372,6 +381,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let axis1 = b.delay("axis_n1", w_axis);
     let negative = b.delay_line("negative", b.pick(axis1, inv).msb().name("negative_c"), l - 1);
 
+    b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
     // N → F: the token rides along; the limits are made on the way (as `inner_step`'s compares,
     // every one a strict less-than; when tmin > tmax no distance passes any limit).
     let ring = (nt.valid & !leaf_push).name("n_stays");
@@ -430,6 +440,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     let g_inner = b.delay("g_inner", f_inner);
     let g_neg = b.delay("g_negative", negative);
 
+    b.stage("ring_g", "G: the decision: push the far child and enter the near one, enter one, or pop");
     // G: the step.
     b.drive(ring_g_valid, g.valid);
     let child_b = g.node + 1;
@@ -453,6 +464,7 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     b.next(r_sp_zero, !push & g.sp.eq(0));
     b.next(r_sp_m1, push.select(g.sp, g.sp - 1));
 
+    b.end_stage();
     b.output("node_addr", c.node);
     b.output("has_free", (free_any_r & !just_alloc).name("has_free_c"));
     b.output("free_slot_out", free_idx_r);

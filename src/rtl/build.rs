@@ -7,7 +7,7 @@
 //! (`tmin_lt_tmax`), or a numbered one when that would be long; `name()` gives the name a
 //! person wants. Two constant operands fold into a constant by `Def::eval`.
 
-use super::netlist::{Def, Module, Sig};
+use super::netlist::{BlockKind, Def, Module, Sig};
 use super::width::{BinOp, Ty, UnOp, bin_ty, un_ty};
 use std::cell::{Cell, RefCell};
 use std::ops;
@@ -138,6 +138,25 @@ impl Builder {
         self.m.borrow_mut().connect(reg.sig, next.sig, None);
     }
 
+    /// Opens the named stage of a hand-built core (a ring stage, a port, an arbiter), closing
+    /// the one before: the signals made until the next `stage` or `end_stage` belong to it, and
+    /// the printers lay them out together under a comment `stage {name}: {doc}`, with one
+    /// clocked process for its registers, as a `Pipeline`'s stages are. It changes how the HDL
+    /// reads, never the circuit.
+    pub fn stage(&self, name: &str, doc: &str) {
+        self.end_stage();
+        self.m.borrow_mut().begin_block(name, doc, BlockKind::Stage);
+    }
+
+    /// Closes the stage `stage` opened (the signals made next belong to none).
+    pub fn end_stage(&self) {
+        let mut m = self.m.borrow_mut();
+        if let Some(open) = m.current_block {
+            assert!(matches!(m.blocks[open].kind, BlockKind::Stage), "{}: a stage inside a state machine", m.name);
+            m.end_block();
+        }
+    }
+
     /// `reg` loads `next` in the clocks where `enable` is 1.
     pub fn next_when(&self, reg: S<'_>, enable: S<'_>, next: S<'_>) {
         self.m.borrow_mut().connect(reg.sig, next.sig, Some(enable.sig));
@@ -213,6 +232,21 @@ impl Builder {
             names: sub.outputs.iter().map(|o| o.0.clone()).collect(),
             sigs: outs.into_iter().map(|s| self.s(s)).collect(),
         }
+    }
+
+    /// Instantiates `sub` with its inputs bound by port name (each exactly once, in any
+    /// order); its outputs by port name.
+    pub fn instance_named<'b>(&'b self, label: &str, sub: &Rc<Module>, bind: &[(&str, S<'b>)]) -> Ports<'b> {
+        let ports: Vec<&str> = sub.inputs.iter().map(|&i| sub.sig(i).name.as_str()).collect();
+        for (k, (port, _)) in bind.iter().enumerate() {
+            assert!(ports.contains(port), "{label}: {} has no input port {port}", sub.name);
+            assert!(!bind[..k].iter().any(|(p, _)| p == port), "{label}: input port {port} bound twice");
+        }
+        let inputs: Vec<S<'b>> = ports
+            .iter()
+            .map(|port| bind.iter().find(|(p, _)| p == port).unwrap_or_else(|| panic!("{label}: {port} unbound")).1)
+            .collect();
+        self.instance(label, sub, &inputs)
     }
 
     fn bin<'b>(&'b self, op: BinOp, a: S<'b>, b: S<'b>, sym: &str) -> S<'b> {

@@ -152,7 +152,8 @@ pub struct Block {
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum BlockKind {
-    /// A pipeline stage: its registers load together every clock.
+    /// A pipeline stage (its registers load together every clock), or a named stage of a
+    /// hand-built core (`Builder::stage`).
     Stage,
     /// A state machine: `state` is its state register; state k (k = its encoding) is named
     /// `states[k]`.

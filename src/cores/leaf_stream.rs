@@ -1,0 +1,233 @@
+//! The core's leaf stream (`top.rs` builds the rest around it): whole leaves taken in turn
+//! from the traversal units' leaf queues, one triangle per clock from the leaf and triangle
+//! ROMs into the intersection pipeline, with the ray read from the core's ray RAMs by slot.
+
+use super::brom::brom;
+use super::intersect::intersect_core;
+use super::ray_port::RayPort;
+use super::top::{CoreParams, tri_rom_groups};
+use super::traverse::{field, word_bits};
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, Ports, S};
+use crate::rtl::width::MAX_WIDTH;
+use crate::scene::images::SceneRoms;
+use crate::scene::rom::rom_addr_bits;
+use std::rc::Rc;
+
+/// The core's ray RAMs (origin and direction, for the pipeline), by global slot, written at
+/// the accept: the origin RAM and the direction RAMs.
+pub struct RayRams {
+    pub o: usize,
+    /// One RAM of three directions while they fit a signal (m ≤ 42), else one per axis.
+    pub w: Vec<usize>,
+}
+
+pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>) -> RayRams {
+    let (slots, n, (accept, gslot)) = (p.total_slots() as usize, p.isect.n, (port.accept, port.slot));
+    let [ox, oy, oz] = port.o;
+    let [wx, wy, wz] = port.w;
+    let o = b.ram("ray_o", 3 * n, vec![0; slots]);
+    b.ram_write(o, accept, gslot, b.cat(&[oz, oy, ox]));
+    let w = if 3 * p.isect.m <= MAX_WIDTH {
+        let mem = b.ram("ray_w", 3 * p.isect.m, vec![0; slots]);
+        b.ram_write(mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
+        vec![mem]
+    } else {
+        [("x", wx), ("y", wy), ("z", wz)]
+            .into_iter()
+            .map(|(axis, w)| {
+                let mem = b.ram(&format!("ray_w{axis}"), p.isect.m, vec![0; slots]);
+                b.ram_write(mem, accept, gslot, w.unsigned());
+                mem
+            })
+            .collect()
+    };
+    RayRams { o, w }
+}
+
+/// The leaf in flight: the registers the emission reads.
+pub struct Leaf<'b> {
+    pub valid: S<'b>,
+    pub slot: S<'b>,
+    pub ptr: S<'b>,
+    pub tmin: S<'b>,
+    pub sp: S<'b>,
+    /// The entry now sent is the leaf's first, its last.
+    pub first: S<'b>,
+    pub last_entry: S<'b>,
+}
+
+/// The leaf in flight (slot, next entry, entries left, tmin, sp), and the next leaf taken, in
+/// turn, from a unit's queue when the last entry goes. `trav` are the units' ports, `leaf_pop`
+/// the wires of their queues' pops.
+pub fn leaf_stream<'b>(
+    b: &'b Builder,
+    p: &CoreParams,
+    scene: &SceneRoms,
+    trav: &[Ports<'b>],
+    leaf_pop: &[S<'b>],
+) -> Leaf<'b> {
+    let (tp, units, ub, gb, bit) = (&p.trav, p.units, p.unit_bits(), p.tag.slot_bits, Ty::BIT);
+    b.stage("leaf_stream", "the leaf in flight, and the next leaf from the units' queues in turn");
+    let leaf_bits = rom_addr_bits(scene.leaf.1.len());
+    let count_w = scene.node.0.field("count").width;
+    let cur_valid = b.reg("leaf_active", bit, Some(0));
+    let cur_slot = b.reg("leaf_slot", Ty::u(gb), None);
+    let cur_ptr = b.reg("leaf_ptr", Ty::u(leaf_bits), None);
+    let cur_left = b.reg("leaf_left", Ty::u(count_w), None);
+    let cur_tmin = b.reg("leaf_tmin", Ty::u(tp.tmin_width()), None);
+    let cur_sp = b.reg("leaf_sp", Ty::u(tp.sp_width()), None);
+    let cur_first = b.reg("leaf_first_entry", bit, None);
+    // Whether the entry now sent is the leaf's last: a register of its own (left = 1 next).
+    let cur_last = b.reg("leaf_last", bit, None);
+    let last_entry = (cur_valid & cur_last).name("leaf_last_entry");
+    let can_take = (!cur_valid | last_entry).name("leaf_can_take");
+    let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
+    // Each unit's next leaf waits in a register of the top's (`leaf_buf`), filled from the
+    // unit's queue while empty: the arbiter then chooses among registers beside it, and the
+    // queues (across the die) only feed a register each. A unit's queue pops a clock after it
+    // is taken from (`traverse_core`), and its buffer is full in that clock anyway.
+    let fields = ["leaf_slot", "leaf_first", "leaf_count", "leaf_tmin", "leaf_sp"];
+    let bufs: Vec<(S, S, Vec<S>)> = trav
+        .iter()
+        .enumerate()
+        .map(|(u, t)| {
+            let full = b.reg(&format!("u{u}_leaf_buf_valid"), bit, Some(0));
+            let fill = (t.get("leaf_valid") & !full).name(&format!("u{u}_leaf_fill"));
+            b.drive(leaf_pop[u], fill);
+            let held: Vec<S> = fields
+                .iter()
+                .map(|f| {
+                    let r = b.reg(&format!("u{u}_buf_{f}"), t.get(f).ty(), None);
+                    b.next_when(r, fill, t.get(f));
+                    r
+                })
+                .collect();
+            (full, fill, held)
+        })
+        .collect();
+    let avail: Vec<S> = bufs.iter().map(|(full, _, _)| *full).collect();
+    let (any_leaf, pick_u) = rotating_pick(b, &avail, leaf_turn, ub);
+    let take = (can_take & any_leaf).name("leaf_take");
+    for (u, &(full, fill, _)) in bufs.iter().enumerate() {
+        let me = if units == 1 { take } else { (take & pick_u.eq(u as i128)).name(&format!("u{u}_leaf_take")) };
+        b.next(full, fill | (full & !me));
+    }
+    if units > 1 {
+        b.next_when(leaf_turn, take, pick_u);
+    } else {
+        b.next(leaf_turn, leaf_turn);
+    }
+    let sel = |port: &str| {
+        let k = fields.iter().position(|f| *f == port).expect("a buffered leaf field");
+        let v: Vec<S> = bufs.iter().map(|(_, _, held)| held[k]).collect();
+        if units == 1 {
+            v[0]
+        } else {
+            b.case(pick_u, &(0..units).map(|u| (u as u128, v[u as usize])).collect::<Vec<_>>(), v[0])
+        }
+    };
+    let next_slot = if ub == 0 { sel("leaf_slot") } else { b.cat(&[pick_u, sel("leaf_slot")]) };
+    b.next(cur_valid, take | (cur_valid & !last_entry));
+    b.next(cur_slot, take.select(next_slot, cur_slot));
+    b.next(cur_ptr, take.select(sel("leaf_first"), cur_ptr + 1));
+    b.next(cur_left, take.select(sel("leaf_count"), cur_left - 1));
+    b.next(cur_tmin, take.select(sel("leaf_tmin"), cur_tmin));
+    b.next(cur_sp, take.select(sel("leaf_sp"), cur_sp));
+    b.next(cur_first, take);
+    b.next(cur_last, take.select(sel("leaf_count").eq(1), cur_left.eq(2)));
+    Leaf { valid: cur_valid, slot: cur_slot, ptr: cur_ptr, tmin: cur_tmin, sp: cur_sp, first: cur_first, last_entry }
+}
+
+/// Rotating priority among the units' buffered leaves (`avail`): the unit after the last one
+/// served (`turn`) first. Returns whether any waits and the unit chosen.
+fn rotating_pick<'b>(b: &'b Builder, avail: &[S<'b>], turn: S<'b>, ub: u32) -> (S<'b>, S<'b>) {
+    let (units, bit) = (avail.len() as u32, Ty::BIT);
+    let mut pick: Option<(S, S)> = None; // (any, unit)
+    for j in (0..units).rev() {
+        // Candidate j places after the turn: unit (turn + 1 + j) mod units.
+        let cand = |u: u32| (u + 1 + j) % units;
+        let sel_any = if units == 1 {
+            avail[0]
+        } else {
+            b.case(turn, &(0..units).map(|t| (t as u128, avail[cand(t) as usize])).collect::<Vec<_>>(), b.konst(bit, 0))
+        };
+        let sel_u = if units == 1 {
+            b.konst(Ty::u(1), 0)
+        } else {
+            b.case(
+                turn,
+                &(0..units).map(|t| (t as u128, b.konst(Ty::u(ub), cand(t) as i128))).collect::<Vec<_>>(),
+                b.konst(Ty::u(ub), 0),
+            )
+        };
+        pick = Some(match pick {
+            None => (sel_any, sel_u),
+            Some((any, u)) => (sel_any | any, sel_any.select(sel_u, u)),
+        });
+    }
+    pick.expect("one unit or more")
+}
+
+/// The pipeline's input: the intersection pipeline's outputs and its valid input (`busy`).
+pub struct Emission<'b> {
+    pub pipe: Ports<'b>,
+    pub valid: S<'b>,
+}
+
+/// Emission: the leaf ROM at the entry, then the triangle ROMs at its word; the tag and the
+/// ray (read from the ray RAMs at the slot) wait alongside, into the intersection pipeline.
+pub fn emission<'b>(
+    b: &'b Builder,
+    p: &CoreParams,
+    scene: &SceneRoms,
+    leaf: &Leaf<'b>,
+    rams: &RayRams,
+) -> Emission<'b> {
+    let (tp, n, m, gb, scene_tag) = (&p.trav, p.isect.n, p.isect.m, p.tag.slot_bits, &p.trav.scene_tag);
+    b.stage("emission", "the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline");
+    let (leaf_l, leaf_words) = &scene.leaf;
+    let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
+    let tri_num =
+        brom(b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, leaf_image, leaf.ptr, tp.leaf_rom_cycles);
+    let lrc = tp.leaf_rom_cycles;
+    let tag = b.cat(&[leaf.last_entry, leaf.first, leaf.slot, leaf.sp, leaf.tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
+    let tag = b.delay_line("emit_tag", tag, lrc);
+    let tag =
+        b.cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)]).name("emit_tag_tri");
+    let emit_valid = b.valid_line("emit_valid", leaf.valid, lrc);
+    let (tri_l, tri_words) = &scene.tri;
+    let addr = tri_num.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
+    let mut tri_fields: Vec<S> = Vec::new();
+    for (k, group) in tri_rom_groups(&tri_l.fields).iter().enumerate() {
+        let lsb = group[0].lsb;
+        let width: u32 = group.iter().map(|f| f.width).sum();
+        let image = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
+        let word =
+            brom(b, &format!("u_tri_rom_{k}"), &format!("tri_{k}_{scene_tag}"), width, image, addr, p.tri_rom_cycles);
+        tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
+    }
+    let trc = p.tri_rom_cycles;
+    let valid_d = b.valid_line("pipe_valid", emit_valid, trc);
+    let tag_d = b.delay_line("pipe_tag", tag, trc);
+    // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
+    let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
+    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", rams.o, emit_slot), trc - 1);
+    let w_words: Vec<S> = rams
+        .w
+        .iter()
+        .enumerate()
+        .map(|(k, &mem)| {
+            let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
+            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, emit_slot), trc - 1)
+        })
+        .collect();
+    let mut pipe_in = vec![valid_d, tag_d];
+    pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
+    pipe_in.extend(
+        (0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * m, m) } else { w_words[a as usize] }.signed()),
+    );
+    pipe_in.extend(tri_fields);
+    let pipe = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
+    Emission { pipe, valid: valid_d }
+}
