@@ -50,6 +50,7 @@ module {{ tb }};
   reg [{{ result_width }}:0] e;
   integer next, done, passed, failed, cycles, busy_cycles, max_sp, stall_cycles, out, k;
   reg fire, take, in_reset, ok, stall;
+  reg x_seen = 1'b0;
 
   {{ module }} dut (
     .clk(clk){% if has_reset %},
@@ -96,6 +97,13 @@ module {{ tb }};
       rst = in_reset;
 {%- endif %}
       #1;
+      // Every output of the core is 0 or 1 in every clock: an X or Z (logic that never
+      // settled, as a `case` did under SystemVerilog rules before issue 28) fails the run.
+      if (!x_seen && ^{ {%- for p in outputs %}{% if !loop.first %}, {% endif %}{{ p.name }}{% endfor -%} } === 1'bx) begin
+        $display("cycle %0d: an output of the core is X or Z", cycles);
+        x_seen = 1'b1;
+        failed = failed + 1;
+      end
       fire = !in_reset && ray_valid && ray_ready;
       take = !in_reset && res_valid{% if has_res_ready %} && res_ready{% endif %};
       // The result taken in this clock, checked before the edge.
