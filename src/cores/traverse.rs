@@ -260,7 +260,10 @@ struct RingN<'b> {
     is_inner: S<'b>,
     leaf_push: S<'b>,
     leafq: Fifo<'b>,
-    axis: S<'b>,
+    /// The node's axis a clock after N, and whether the ray's direction is negative on it
+    /// (as seen in F).
+    axis1: S<'b>,
+    negative: S<'b>,
     child: S<'b>,
     inv: [S<'b>; 3],
     plane_t: [S<'b>; 2],
@@ -516,6 +519,9 @@ impl<'b> Unit<'b> {
         let pu1 = plane_unit(b, n, p.c, o, inv, issue(1, w_clip1), p.product);
         let plane_latency = pu0.latency;
         assert!(plane_latency >= 4, "the decision limits need 3 cycles after N");
+        // The axis's direction sign, for the roles of the two distances in F and G.
+        let axis1 = b.delay("axis_n1", w_axis);
+        let negative = b.delay_line("negative", b.pick(axis1, inv).msb().name("negative_c"), plane_latency - 1);
         RingN {
             token,
             culled,
@@ -523,7 +529,8 @@ impl<'b> Unit<'b> {
             is_inner,
             leaf_push,
             leafq,
-            axis: w_axis,
+            axis1,
+            negative,
             child: w_child,
             inv,
             plane_t: [pu0.t, pu1.t],
@@ -535,10 +542,8 @@ impl<'b> Unit<'b> {
     /// compares, every one a strict less-than; when tmin > tmax no distance passes any limit).
     /// F: both distances arrive and are compared by their roles, registered for G.
     fn ring_f(&self, nn: &RingN<'b>) -> RingF<'b> {
-        let (b, n, l, nt) = (self.b, self.p.n, nn.plane_latency, nn.token);
+        let (b, n, l, nt, axis1, negative) = (self.b, self.p.n, nn.plane_latency, nn.token, nn.axis1, nn.negative);
         b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
-        let axis1 = b.delay("axis_n1", nn.axis);
-        let negative = b.delay_line("negative", b.pick(axis1, nn.inv).msb().name("negative_c"), l - 1);
         let ring = (nt.valid & !nn.leaf_push).name("n_stays");
         let f_valid = b.valid_line("f_valid", ring, l);
         let f_inner = b.delay_line("f_inner", nn.is_inner, l);
