@@ -20,7 +20,13 @@ const LAYERS: &[&[&str]] = &[
     &["model"],
     &["render"],
     &["cores"],
-    &["flow"],
+    // Simulating the cores against the models, and synthesising them for FPGAs: peers, neither
+    // needs the other.
+    &["verify", "fpga"],
+    // The files `fxrt gen` writes (a manifest gives the latency `verify` measures).
+    &["generate"],
+    // The board tops (generated files, placed and routed) and the sweeps (simulated and placed).
+    &["board", "sweep"],
     &["fuzzing"],
     &["cli"],
 ];

@@ -12,9 +12,9 @@
 use super::feed::Stalls;
 use super::frame::{CoreResult, CoreStats, OBSERVED, RESULT_PORTS, core_result, port};
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
-use crate::flow::frame::PixelRay;
 use crate::rtl::sim::Sim;
 use crate::scene::images::SceneRoms;
+use crate::verify::frame::PixelRay;
 
 /// What happens to the core besides the frame's rays.
 #[derive(Clone, Debug, Default)]
@@ -186,13 +186,13 @@ pub fn simulate_rust_cycle(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::feed::feed_order;
-    use crate::flow::frame::{frame_rays, mismatches};
     use crate::model::camera::Camera;
     use crate::params::Params;
     use crate::render::fast::FastGolden;
     use crate::rng::SplitMix64;
     use crate::scene::{Scene, SceneSource};
+    use crate::verify::feed::feed_order;
+    use crate::verify::frame::{frame_rays, mismatches};
 
     fn setup(name: &str, w: u32, h: u32) -> (Scene, SceneRoms, CoreParams, Vec<PixelRay>) {
         let scene = Scene::load(&SceneSource::Builtin(name.into()), &Params::default()).unwrap();

@@ -1,10 +1,10 @@
 //! The ULX3S bitstream: yosys `synth_ecp5` of the board top and its logic (the ECP5 sources of
-//! `flow::ecp5`), nextpnr-ecp5 with the board's LPF — its 25 MHz `FREQUENCY` constraint,
+//! `fpga::ecp5`), nextpnr-ecp5 with the board's LPF — its 25 MHz `FREQUENCY` constraint,
 //! carried through the PLL to the board clock — and ecppack.
 
 use super::{Board, BoardDesign};
 use crate::error::{Error, Result};
-use crate::flow::ecp5::{PACKAGE, Tools, run, synthesize, write_sources};
+use crate::fpga::ecp5::{PACKAGE, Tools, run, synthesize, write_sources};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

@@ -9,6 +9,10 @@
 //! bit and a reduction tree after the outputs' own registers, so the paths it adds are short
 //! (a register to an input register, an XOR tree into one flip-flop).
 
+pub mod bram;
+pub mod carry;
+pub mod dsp;
+
 use crate::cores::intersect::IntersectParams;
 use crate::cores::top::CoreParams;
 use crate::error::{Error, Result};
@@ -39,7 +43,7 @@ impl Tools {
         let chosen = std::env::var_os("FXRT_ECP5_BIN").map(PathBuf::from);
         let dirs: Vec<PathBuf> = match &chosen {
             Some(d) => vec![d.clone()],
-            None => super::venv_bins().to_vec(),
+            None => crate::io::venv_bins().to_vec(),
         };
         let find = |name: &str| -> Option<PathBuf> {
             // Absolute, as the tools run in the build folder.
@@ -303,11 +307,11 @@ pub fn write_sources(top: &Module, dir: &Path) -> Result<Vec<String>> {
     let brom_of = |file: &str| block_of(file, crate::cores::brom::BROM_PREFIX);
     let bram_of = |file: &str| block_of(file, crate::cores::brom::BRAM_PREFIX);
     for (file, text) in &files {
-        let text = super::ecp5_dsp::dsp_regs_of(file)
-            .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
-            .or_else(|| super::ecp5_carry::addsub_width_of(file).and_then(|w| super::ecp5_carry::ccu2c_addsub(text, w)))
-            .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
-            .or_else(|| bram_of(file).and_then(|m| super::ecp5_bram::dp16kd_ram(text, m)))
+        let text = dsp::dsp_regs_of(file)
+            .and_then(|regs| dsp::mult18x18d(text, regs))
+            .or_else(|| carry::addsub_width_of(file).and_then(|w| carry::ccu2c_addsub(text, w)))
+            .or_else(|| brom_of(file).and_then(|m| bram::dp16kd_rom(text, m)))
+            .or_else(|| bram_of(file).and_then(|m| bram::dp16kd_ram(text, m)))
             .unwrap_or_else(|| text.clone());
         set.add(&dir.join(file), text.as_bytes())?;
     }

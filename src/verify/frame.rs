@@ -1,14 +1,11 @@
 //! Whole frames through the generated core (`fxrt sim`): every pixel's ray that reaches the
 //! scene box is streamed into the core — in pixel order, or shuffled and with random input
-//! stalls (`flow::feed`) — and each result is matched by its ray id (the pixel number) to its
+//! stalls (`verify::feed`) — and each result is matched by its ray id (the pixel number) to its
 //! ray and compared with the golden model's (`render::fast`), pixel by pixel. Nothing assumes
 //! that results leave the core in the order the rays entered it.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::error::{Error, Result};
-use crate::flow::feed::Stalls;
-use crate::flow::simulators::{Bench, Simulator};
-use crate::flow::testbench::{Stream, parse_results, stream_files};
 use crate::model::camera::Camera;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
@@ -17,6 +14,9 @@ use crate::rtl::batch::BatchSim;
 use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
+use crate::verify::feed::Stalls;
+use crate::verify::simulators::{Bench, Simulator};
+use crate::verify::testbench::{Stream, parse_results, stream_files};
 use serde::Serialize;
 use std::path::Path;
 
@@ -456,11 +456,11 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::disturb::simulate_rust_cycle;
-    use crate::flow::feed::feed_order;
     use crate::params::Params;
     use crate::rtl::sim::Sim;
     use crate::scene::SceneSource;
+    use crate::verify::disturb::simulate_rust_cycle;
+    use crate::verify::feed::feed_order;
 
     fn cornell(n: u32, m: u32) -> Scene {
         Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n, m, ..Params::default() }).unwrap()
