@@ -254,7 +254,6 @@ pub fn place_and_route(
     seed: u64,
     dir: &Path,
 ) -> Result<Timing> {
-    let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let top = wrapper(&Rc::new(m.clone()));
     let pins = (PIN_REGS.0 + PIN_REGS.1) as u64;
     let out_bits: u32 = m.outputs.iter().map(|o| m.sig(o.1).ty.width).sum();
@@ -262,30 +261,8 @@ pub fn place_and_route(
         m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
     let sources = write_sources(&top, dir)?;
     synthesize(tools, dir, &sources, &top.name)?;
-    let (freq, seed_s) = (format!("{target_mhz}"), seed.to_string());
-    let args = [
-        "--85k",
-        "--package",
-        PACKAGE,
-        "--speed",
-        "6",
-        "--json",
-        "design.json",
-        "--freq",
-        &freq,
-        "--seed",
-        &seed_s,
-        "--report",
-        "report.json",
-        "--timing-allow-fail",
-        "--log",
-        "nextpnr.log",
-        "-q",
-    ];
-    run(&tools.nextpnr, &args, dir, "nextpnr.log")?;
-    let text = std::fs::read_to_string(dir.join("report.json")).map_err(io)?;
-    let report: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))?;
+    nextpnr(tools, dir, &["--freq", &format!("{target_mhz}")], seed)?;
+    let report = read_report(dir)?;
     let (yosys, nextpnr) = tools.versions();
     let mut t = timing_from_report(&report, &m.name, target_mhz, latency, wrapper_ff, seed, yosys, nextpnr);
     t.netlist_sha256 = netlist_hash(m);
@@ -343,6 +320,23 @@ pub(crate) fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<(
         return Err(Error::new(&name, format!("failed, see {}", dir.join(log).display())));
     }
     Ok(())
+}
+
+/// Runs nextpnr-ecp5 in `dir` on the synthesised `design.json` for the LFE5U-85F (`PACKAGE`,
+/// speed grade 6) with `constraint` (a clock `--freq`, or the board's `--lpf` and what else
+/// the board wants) and placement seed `seed`, writing `report.json` and `nextpnr.log`.
+pub fn nextpnr(tools: &Tools, dir: &Path, constraint: &[&str], seed: u64) -> Result<()> {
+    let seed = seed.to_string();
+    let mut args = vec!["--85k", "--package", PACKAGE, "--speed", "6", "--json", "design.json"];
+    args.extend_from_slice(constraint);
+    args.extend(["--seed", &seed, "--report", "report.json", "--timing-allow-fail", "--log", "nextpnr.log", "-q"]);
+    run(&tools.nextpnr, &args, dir, "nextpnr.log")
+}
+
+/// The `report.json` nextpnr wrote in `dir`.
+pub fn read_report(dir: &Path) -> Result<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("report.json")).map_err(|e| Error::file(dir, e.to_string()))?;
+    serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))
 }
 
 /// Reads nextpnr's `--report` JSON.
