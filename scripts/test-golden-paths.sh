@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 for path in reference scalar avx2 avx512; do
     echo "== FXRT_GOLDEN_PATH=$path" >&2
-    FXRT_GOLDEN_PATH=$path cargo test --release --quiet --lib -- render:: model:: flow::frame
+    FXRT_GOLDEN_PATH=$path cargo test --release --quiet --lib -- render:: model:: verify::frame
     FXRT_GOLDEN_PATH=$path cargo test --release --quiet --test precision --test exact
 done
 echo "every golden-model test passed with each path forced" >&2

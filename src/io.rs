@@ -7,6 +7,8 @@
 //! was taken before the rename), a new one is removed.
 //!
 //! Every error names the target, never a temporary name.
+//!
+//! Also where the project's Python tools are (`venv_bins`), for the flows that run them.
 
 use crate::error::{Error, Result};
 use std::collections::HashSet;
@@ -220,6 +222,11 @@ pub fn check_folder(dir: &Path) -> Result<()> {
         Some(f) => Err(Error::file(dir, format!("cannot create the folder: {} is a file, not a folder", f.display()))),
         None => Ok(()),
     }
+}
+
+/// Where scripts/install-deps.sh puts the Python tools: `./.venv/bin`, then the source tree's.
+pub fn venv_bins() -> [PathBuf; 2] {
+    [PathBuf::from(".venv/bin"), Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin")]
 }
 
 #[cfg(test)]

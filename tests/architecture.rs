@@ -3,8 +3,10 @@
 //! that need each other are one concept: make them one file, or move what both need below
 //! them) and no edge from a lower layer to a higher one. The layers are written once, here.
 //!
-//! Test code is exempt: a `#[cfg(test)]` module (inline, or a file it declares) may drive a
-//! layer through a higher one's harness, as a whole-frame test of a core does.
+//! Test code obeys the layers too: a test that drives a layer through a higher one's harness
+//! (a whole-frame test of a core) lives in the higher layer (`verify::core_tests`). A
+//! `#[cfg(test)]` module's paths are read from inside it (`super::` in an inline `mod tests`
+//! is the file's own module; a test file declared with `#[path]` is its declarer's child).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -20,7 +22,13 @@ const LAYERS: &[&[&str]] = &[
     &["model"],
     &["render"],
     &["cores"],
-    &["flow"],
+    // Simulating the cores against the models, and synthesising them for FPGAs: peers, neither
+    // needs the other.
+    &["verify", "fpga"],
+    // The files `fxrt gen` writes (a manifest gives the latency `verify` measures).
+    &["generate"],
+    // The board tops (generated files, placed and routed) and the sweeps (simulated and placed).
+    &["board", "sweep"],
     &["fuzzing"],
     &["cli"],
 ];
@@ -28,7 +36,7 @@ const LAYERS: &[&[&str]] = &[
 /// A source file: its module path (`cores::top`) and what it imports.
 struct File {
     module: Vec<String>,
-    /// Module paths named in non-test code, as written (relative ones resolved).
+    /// Module paths named, test code included (relative ones resolved).
     paths: Vec<Vec<String>>,
 }
 
@@ -66,9 +74,16 @@ fn strip_comments(text: &str) -> String {
     text.lines().map(|l| l.find("//").map_or(l, |i| &l[..i])).collect::<Vec<_>>().join("\n")
 }
 
-/// Splits off test code: returns the non-test text and the files its `#[cfg(test)]` module
-/// declarations name (by `#[path]` or by module name), which are test code too.
-fn split_tests(src: &Path, file: &Path, module: &[String], text: &str) -> (String, Vec<PathBuf>) {
+/// Splits off test code: returns the text before an inline `#[cfg(test)] mod` (which the
+/// shared convention puts last), that module's name and text, and the files its `#[cfg(test)]`
+/// module declarations name (by `#[path]` or by module name) with their module paths.
+#[allow(clippy::type_complexity)]
+fn split_tests(
+    src: &Path,
+    file: &Path,
+    module: &[String],
+    text: &str,
+) -> (String, Option<(String, String)>, Vec<(PathBuf, Vec<String>)>) {
     let mut test_files = Vec::new();
     let mut keep = String::new();
     let mut rest = text;
@@ -89,27 +104,27 @@ fn split_tests(src: &Path, file: &Path, module: &[String], text: &str) -> (Strin
         if let Some(decl) = item.strip_prefix("mod ") {
             let name: String = decl.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
             let rest_of_decl = decl[name.len()..].trim_start();
-            if rest_of_decl.starts_with('{') {
+            if let Some(body) = rest_of_decl.strip_prefix('{') {
                 // An inline test module: the shared convention puts it last.
-                return (keep, test_files);
+                return (keep, Some((name, body.to_string())), test_files);
             }
+            let mut m = module.to_vec();
+            m.push(name);
             let dir = file.parent().unwrap();
             let child = match path_attr {
                 Some(p) => dir.join(p),
                 None => {
-                    let mut m = module.to_vec();
-                    m.push(name);
                     let base = src.join(m.join("/"));
                     let flat = base.with_extension("rs");
                     if flat.exists() { flat } else { base.join("mod.rs") }
                 }
             };
-            test_files.push(child);
+            test_files.push((child, m));
         }
         rest = after;
     }
     keep.push_str(rest);
-    (keep, test_files)
+    (keep, None, test_files)
 }
 
 /// `a::{b, c::{d, e}}` → `a::b`, `a::c::d`, `a::c::e` (`self` inside braces is the head).
@@ -205,22 +220,29 @@ fn named_paths(module: &[String], text: &str) -> Vec<Vec<String>> {
     out
 }
 
-/// The crate's files and their imports; test code left out.
+/// The crate's files and their imports, test code included.
 fn read_crate(src: &Path) -> BTreeMap<PathBuf, File> {
     let mut paths = Vec::new();
     rust_files(src, &mut paths);
+    let texts: Vec<String> = paths.iter().map(|p| strip_comments(&std::fs::read_to_string(p).unwrap())).collect();
+    // A test file's module is its declarer's child (a `#[path]` may name any file).
+    let mut declared = BTreeMap::new();
+    for (p, text) in paths.iter().zip(&texts) {
+        declared.extend(split_tests(src, p, &module_of(src, p), text).2);
+    }
     let mut files = BTreeMap::new();
-    let mut test_files = BTreeSet::new();
-    for p in &paths {
-        let module = module_of(src, p);
-        let text = strip_comments(&std::fs::read_to_string(p).unwrap());
-        let (code, tests) = split_tests(src, p, &module, &text);
-        test_files.extend(tests);
-        let named = named_paths(&module, &code);
+    for (p, text) in paths.iter().zip(&texts) {
+        let module = declared.get(p).cloned().unwrap_or_else(|| module_of(src, p));
+        let (code, inline, _) = split_tests(src, p, &module, text);
+        let mut named = named_paths(&module, &code);
+        if let Some((name, body)) = inline {
+            let inner: Vec<String> = module.iter().cloned().chain([name]).collect();
+            named.extend(named_paths(&inner, &body));
+        }
         files.insert(p.clone(), File { module, paths: named });
     }
-    // The binary dispatches through `fxrt::`; test files are exempt.
-    files.retain(|p, _| !test_files.contains(p) && p != &src.join("main.rs"));
+    // The binary dispatches through `fxrt::`.
+    files.remove(&src.join("main.rs"));
     files
 }
 
@@ -334,7 +356,7 @@ fn no_file_imports_in_a_loop_or_from_a_higher_layer() {
     assert!(bad.is_empty(), "{} violations:\n{}", bad.len(), bad.join("\n"));
 }
 
-/// The reader itself on a small crate with one loop and one upward import.
+/// The reader itself on a small crate with one loop and upward imports, in code and tests.
 #[test]
 fn the_check_finds_a_loop_and_an_upward_import() {
     let dir = tempfile::tempdir().unwrap();
@@ -345,17 +367,29 @@ fn the_check_finds_a_loop_and_an_upward_import() {
         std::fs::write(path, text).unwrap();
     };
     write("lib.rs", "pub mod rtl;\npub mod scene;\n");
-    write("rtl/mod.rs", "pub mod a;\npub mod b;\n#[cfg(test)]\n#[path = \"t.rs\"]\nmod t;\n#[cfg(test)]\nmod u;\n");
-    // Comments and test code may name a higher layer.
+    write(
+        "rtl/mod.rs",
+        "pub mod a;\npub mod b;\npub use self::a::X;\n#[cfg(test)]\n#[path = \"t.rs\"]\nmod t;\n#[cfg(test)]\nmod u;\n",
+    );
+    // Comments may name a higher layer; test code may not. `super::` in an inline test module
+    // is the file's module (read as `rtl`, it would make a loop with rtl/mod.rs).
     write(
         "rtl/a.rs",
-        "use super::b::{X, self};\n// use crate::scene::rom;\n#[cfg(test)]\nmod tests { use crate::scene::rom; }\n",
+        "use super::b::{X, self};\n// use crate::scene::rom;\n#[cfg(test)]\nmod tests { use super::*; use crate::scene::rom; }\n",
     );
     write("rtl/b.rs", "pub fn f() { super::a::g(); crate::scene::rom::h(); }\n");
     write("rtl/t.rs", "use crate::scene::rom;\n");
-    write("rtl/u.rs", "use crate::scene::rom;\n");
+    write("rtl/u.rs", "use super::b::f;\n");
     write("scene/mod.rs", "pub mod rom;\n");
     write("scene/rom.rs", "pub fn h() {}\n");
     let (bad, _) = violations(src);
-    assert_eq!(bad, ["loop: rtl/a.rs ↔ rtl/b.rs", "upward: rtl/b.rs imports scene/rom.rs (rtl is below scene)",],);
+    assert_eq!(
+        bad,
+        [
+            "loop: rtl/a.rs ↔ rtl/b.rs",
+            "upward: rtl/a.rs imports scene/rom.rs (rtl is below scene)",
+            "upward: rtl/b.rs imports scene/rom.rs (rtl is below scene)",
+            "upward: rtl/t.rs imports scene/rom.rs (rtl is below scene)",
+        ],
+    );
 }

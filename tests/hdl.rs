@@ -5,17 +5,17 @@
 mod common;
 
 use fxrt::cores::intersect::IntersectParams;
-use fxrt::flow::check::{run_hdl, run_rust};
-use fxrt::flow::simulators::Simulator;
-use fxrt::flow::vectors::generate;
 use fxrt::params::Params;
 use fxrt::scene::{Scene, SceneSource};
+use fxrt::verify::check::{run_hdl, run_rust};
+use fxrt::verify::simulators::Simulator;
+use fxrt::verify::vectors::generate;
 
-fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
+fn setup(params: Params, count: usize) -> (IntersectParams, Vec<fxrt::verify::vectors::Vector>) {
     setup_bits(params, 1, count)
 }
 
-fn setup_bits(params: Params, div_bits: u32, count: usize) -> (IntersectParams, Vec<fxrt::flow::vectors::Vector>) {
+fn setup_bits(params: Params, div_bits: u32, count: usize) -> (IntersectParams, Vec<fxrt::verify::vectors::Vector>) {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
     let p = IntersectParams {
         n: params.n,
@@ -71,7 +71,7 @@ fn rust_simulator_matches_golden_on_a_million_vectors_at_defaults() {
 
 #[test]
 fn cycle_and_batch_engines_both_match_golden() {
-    use fxrt::flow::check::{Engine, run_rust_with};
+    use fxrt::verify::check::{Engine, run_rust_with};
     let (p, v) = setup(ODD, 20_000);
     for engine in [Engine::Cycle, Engine::Batch] {
         let (o, _) = run_rust_with(engine, &p, &v);
@@ -124,7 +124,7 @@ fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
     let (p, _) = setup(SMALL, 100);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("hdl_tools");
     std::fs::create_dir_all(&dir).unwrap();
-    for (name, text) in fxrt::flow::generate::files(&p, true, true) {
+    for (name, text) in fxrt::generate::files(&p, true, true) {
         std::fs::write(dir.join(name), text).unwrap();
     }
     let run = |prog: &str, args: &[&str]| -> Option<std::process::Output> {
@@ -163,7 +163,7 @@ fn generated_hdl_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
         assert!(o.status.success() && !err.contains("%Warning"), "verilator lint: {err}");
     }
     if run("yosys", &["-V"]).is_some() {
-        let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
+        let area = fxrt::fpga::xilinx::synth_xc5v(&module, &dir.join("synth")).unwrap();
         // Four products ahead of the divider, two after it, four for u and v: all on DSP48E.
         assert!(area.dsp48e >= 10, "{area:?}");
         // The sweeps' DSP48E estimate is what yosys does.
@@ -189,7 +189,7 @@ fn whole_core_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
     let module = core_module(&p, &roms);
     let dir = lint_and_ghdl_synth(&module, "whole_core_tools");
     if std::process::Command::new("yosys").arg("-V").output().is_ok() {
-        let area = fxrt::flow::synth::synth_xc5v(&module, &dir.join("synth")).unwrap();
+        let area = fxrt::fpga::xilinx::synth_xc5v(&module, &dir.join("synth")).unwrap();
         // A small scene's ROMs fit distributed RAM; the teapot's map to block RAM (docs/CORE.md).
         assert!(area.dsp48e >= 10 && area.bram18 + area.lutram_cells > 0, "{area:?}");
         assert_eq!(area.dsp48e, fxrt::cores::cost::dsp48e_estimate(&module) as u64);

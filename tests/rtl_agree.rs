@@ -3,11 +3,11 @@
 //! simulator and the batched simulator, and a sample of them in GHDL, Icarus and Verilator,
 //! must agree bit for bit on every output of every cycle.
 
-use fxrt::flow::simulators::Simulator;
-use fxrt::flow::testbench::{Stimulus, bench_files, record};
 use fxrt::rtl::random::{Shape, agree, random_inputs, random_module, sim_vs_batch};
 use fxrt::rtl::sim::Sim;
 use fxrt::rtl::{Module, Ty};
+use fxrt::verify::simulators::Simulator;
+use fxrt::verify::testbench::{Stimulus, bench_files, record};
 use std::io::Write;
 
 /// The divergence found in issue 10: a register `r: s(2)` with next value

@@ -3,11 +3,11 @@
 //! GHDL, Icarus and Verilator against the Rust transcript; both languages also pass Verilator's
 //! lint, `ghdl --synth` and yosys. Each tool that is not installed is reported as skipped.
 
-use fxrt::flow::simulators::Simulator;
-use fxrt::flow::testbench::{Stimulus, bench_files, record};
 use fxrt::rtl::emit::{design_files, verilog, vhdl};
 use fxrt::rtl::netlist::BlockKind;
 use fxrt::rtl::{BinOp, Module, Ty, UnOp};
+use fxrt::verify::simulators::Simulator;
+use fxrt::verify::testbench::{Stimulus, bench_files, record};
 use std::io::Write;
 
 fn all_ops() -> Module {

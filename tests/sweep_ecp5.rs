@@ -5,7 +5,7 @@
 
 mod common;
 use common::sweep_rows as rows;
-use fxrt::flow::ecp5::Tools;
+use fxrt::fpga::ecp5::Tools;
 use std::io::Write;
 use std::path::Path;
 use std::process::{Command, Output};

@@ -1,14 +1,14 @@
 //! `fxrt bench --against-embree`: the golden model and Embree trace the same camera's rays in
 //! one run, one thread and all threads, for two views of the built-in teapot; a table of both
 //! throughputs and their ratio (docs/PERFORMANCE.md). Embree runs in a subprocess
-//! (`flow::embree`); its hit count must be the golden model's within 1 % of the pixels, or the
+//! (`render::embree`); its hit count must be the golden model's within 1 % of the pixels, or the
 //! two did not trace the same rays (exit 1).
 
 use super::config::thread_pool;
 use crate::error::Result;
-use crate::flow::embree::{self, EmbreeReport};
 use crate::model::camera::Camera;
 use crate::params::Params;
+use crate::render::embree::{self, EmbreeReport};
 use crate::render::{self, tracer::GoldenTracer};
 use crate::scene::{Scene, SceneSource};
 

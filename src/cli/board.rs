@@ -1,10 +1,10 @@
 //! `fxrt gen --board`: the board design's files, and for the ULX3S its bitstream.
 
 use super::config::{BoardConfig, GenConfig, GenScene};
+use crate::board::{BoardDesign, pnr};
 use crate::cores::top::CoreParams;
 use crate::error::{Error, Result};
-use crate::flow::board::{BoardDesign, pnr};
-use crate::flow::ecp5::Tools;
+use crate::fpga::ecp5::Tools;
 use crate::io::OutputSet;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::scene::Scene;

@@ -11,12 +11,12 @@ use super::{
     SceneChoice, SimArgs, SimChoice, SynthArgs, TestArgs,
 };
 use crate::error::{Error, Result};
-use crate::flow::simulators::Simulator;
 use crate::io::check_folder;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::params::Params;
 use crate::render::tracer::ModelKind;
 use crate::scene::SceneSource;
+use crate::verify::simulators::Simulator;
 use std::path::PathBuf;
 
 /// Where a design runs: the Rust simulator or an HDL simulator.
@@ -212,7 +212,7 @@ pub enum BenchConfig {
     /// The agreement property on `netlists` (≥ 1) random netlists.
     Agree { netlists: u64 },
     /// The differential campaign of the core against the golden model.
-    Exact(crate::flow::exact::Campaign),
+    Exact(crate::verify::exact::Campaign),
 }
 
 impl BenchArgs {
@@ -273,7 +273,7 @@ pub struct GenConfig {
 /// What `fxrt gen --board` builds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BoardConfig {
-    pub board: crate::flow::board::Board,
+    pub board: crate::board::Board,
     pub mhz: f64,
     pub led_shift: Option<u32>,
     pub bitstream: bool,
@@ -350,7 +350,7 @@ impl GenArgs {
                 board,
                 mhz: self.board_mhz,
                 led_shift: self.led_shift,
-                bitstream: board == crate::flow::board::Board::Ulx3s && !self.no_bitstream,
+                bitstream: board == crate::board::Board::Ulx3s && !self.no_bitstream,
                 seed: self.pnr_seed,
             }),
         })
@@ -416,7 +416,7 @@ pub enum Family {
 }
 
 /// The modules `synth --family ecp5` (and `sweep --synth --family ecp5`) can place and route.
-pub use crate::flow::ecp5::MODULES as ECP5_MODULES;
+pub use crate::fpga::ecp5::MODULES as ECP5_MODULES;
 
 impl SynthArgs {
     pub fn config(&self) -> Result<SynthConfig> {
@@ -425,7 +425,7 @@ impl SynthArgs {
             "xc7" => Family::Xc7,
             "ecp5" => {
                 crate::cores::clock::ClockTarget(self.hw.target_mhz).check()?;
-                crate::flow::ecp5::check_modules(&self.modules)?;
+                crate::fpga::ecp5::check_modules(&self.modules)?;
                 Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seed: self.seed, modules: self.modules.clone() }
             }
             other => {
@@ -475,7 +475,7 @@ pub fn fmax_of(path: &std::path::Path) -> Result<f64> {
     let modules =
         v["modules"].as_array().ok_or_else(|| Error::file(path, "no \"modules\": not a synth --family ecp5 JSON"))?;
     let placed = modules.iter().map(|m| (m["module"].as_str().unwrap_or(""), m["fmax_mhz"].as_f64().unwrap_or(0.0)));
-    crate::flow::ecp5::core_clock(placed).ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
+    crate::fpga::ecp5::core_clock(placed).ok_or_else(|| Error::file(path, "no module with an fmax_mhz"))
 }
 
 impl SimArgs {
@@ -486,7 +486,7 @@ impl SimArgs {
         if self.raygen && sim != Simulation::Rust {
             return Err(Error::param("raygen", "runs in the Rust simulator only (--sim rust)"));
         }
-        let max = crate::flow::feed::Stalls::MAX_PERCENT;
+        let max = crate::verify::feed::Stalls::MAX_PERCENT;
         if self.stall_percent > max {
             return Err(Error::param(
                 "stall-percent",

@@ -6,13 +6,14 @@
 
 use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_with};
 use crate::error::{Error, Result};
-use crate::flow::{feed, frame, generate};
+use crate::generate;
 use crate::io::OutputSet;
 use crate::model::camera::Camera;
 use crate::params::Params;
 use crate::render::{self, Frame, tracer::GoldenTracer};
 use crate::scene::images::SceneRoms;
 use crate::scene::{Scene, SceneSource};
+use crate::verify::{feed, frame};
 use std::path::{Path, PathBuf};
 
 /// The ray id width of `fxrt gen`'s default, so the simulated core is the generated one.
@@ -41,7 +42,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     p.check()?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     let netlist = core_module_with(&p, &roms, false);
-    let measured = crate::flow::ecp5::measured_entry(
+    let measured = crate::fpga::ecp5::measured_entry(
         Path::new("generated/measured/ecp5-core.json"),
         MEASURED,
         &p,

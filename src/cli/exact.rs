@@ -1,11 +1,11 @@
-//! `fxrt bench exact`: the differential campaign (`flow::exact`) from the command line — its
+//! `fxrt bench exact`: the differential campaign (`verify::exact`) from the command line — its
 //! options checked, a progress bar, the figures as one JSON line, and the first disagreement's
 //! reproducer command.
 
 use super::BenchArgs;
 use crate::error::{Error, Result};
-use crate::flow::exact::{Campaign, campaign};
-use crate::flow::simulators::Simulator;
+use crate::verify::exact::{Campaign, campaign};
+use crate::verify::simulators::Simulator;
 
 /// The campaign `bench exact` runs; errors name the option.
 pub fn campaign_config(a: &BenchArgs) -> Result<Campaign> {

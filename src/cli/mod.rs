@@ -173,8 +173,8 @@ pub struct SweepArgs {
     #[arg(long)]
     pub cache: Option<PathBuf>,
     /// Compute only shard I of N: the configurations whose index mod N is I − 1.
-    #[arg(long, value_parser = crate::flow::sweep::Shard::parse)]
-    pub shard: Option<crate::flow::sweep::Shard>,
+    #[arg(long, value_parser = crate::sweep::Shard::parse)]
+    pub shard: Option<crate::sweep::Shard>,
     /// Write a Slurm job-array script, a merge job and a GNU parallel command list into
     /// OUT/slurm instead of running.
     #[arg(long = "emit-slurm")]
@@ -342,7 +342,7 @@ pub struct GenArgs {
     /// project that does. The camera: --eye/--at/... inside the scene box (default: at the
     /// middle of the box's front, looking at its centre).
     #[arg(long, value_enum)]
-    pub board: Option<crate::flow::board::Board>,
+    pub board: Option<crate::board::Board>,
     /// --board: the board clock, MHz; the PLL makes the fastest clock not above it.
     #[arg(long = "board-mhz", default_value_t = 80.0)]
     pub board_mhz: f64,
@@ -637,7 +637,7 @@ fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {
 
 /// A stall percentage: 0..=`Stalls::MAX_PERCENT`.
 fn parse_percent(s: &str) -> std::result::Result<u32, String> {
-    let max = crate::flow::feed::Stalls::MAX_PERCENT;
+    let max = crate::verify::feed::Stalls::MAX_PERCENT;
     let p: u32 = s.trim().parse().map_err(|_| format!("'{s}' is not an integer 0..={max}"))?;
     if p > max {
         return Err(format!("{p} is out of range: must be 0..={max} (at 100 no ray is ever offered)"));

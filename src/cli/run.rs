@@ -11,8 +11,8 @@ use super::config::{
 use super::sweep_config::{SweepConfig, SweepRun};
 use crate::cores::intersect::IntersectParams;
 use crate::error::Result;
-use crate::flow::sweep::{run as sweep, slurm};
-use crate::flow::{check, feed, frame, generate, synth, vectors};
+use crate::fpga::xilinx;
+use crate::generate;
 use crate::io::OutputSet;
 use crate::model::camera::Camera;
 use crate::model::golden::Golden;
@@ -21,6 +21,8 @@ use crate::params::Params;
 use crate::render::{self, tracer};
 use crate::scene::images::SceneRoms;
 use crate::scene::{self, Scene, SceneSource, rom};
+use crate::sweep::{run as sweep, slurm};
+use crate::verify::{check, feed, frame, vectors};
 use std::path::Path;
 
 /// Runs `cmd`: Ok(true) when it succeeded, Ok(false) when it found a mismatch.
@@ -244,7 +246,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         clock_mhz: c.target_mhz as f64,
     };
     let measured = match c.measured.as_deref() {
-        Some(f) => Some(crate::flow::ecp5::measured_core(
+        Some(f) => Some(crate::fpga::ecp5::measured_core(
             f,
             &p,
             &crate::cores::top::core_module_with(&p, &roms, c.debug_ports),
@@ -259,7 +261,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
         let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
-        let stream = crate::flow::axis_host::frame_files(&layout, scene, &rays);
+        let stream = crate::generate::axis_host::frame_files(&layout, scene, &rays);
         files.extend(stream.into_iter().map(|(n, b)| (c.out.join(n), b)))?;
     }
     files.commit()?;
@@ -314,7 +316,7 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let mut set = vec![(crate::cores::top::core_module_with(&core, &roms, false), None)];
     set.extend(generate::cores(&p).into_iter().map(|(m, lat, _)| (m, lat)));
     for (m, latency) in set {
-        let area = synth::synth_xilinx(&m, family, &c.build.join(&m.name))?;
+        let area = xilinx::synth_xilinx(&m, family, &c.build.join(&m.name))?;
         cores.push(serde_json::json!({ "latency_cycles": latency, "area": area }));
     }
     let thesis = serde_json::json!({ "note": "whole design of seed 001 table 3.2 (BIH + intersection + ray generator), XST", "luts": 5278, "registers": 3274, "dsp48e": 52, "bram18": 22 });
@@ -337,12 +339,12 @@ fn synth_ecp5(
     modules: &[String],
     scene: &str,
 ) -> Result<()> {
-    let tools = crate::flow::ecp5::Tools::require()?;
+    let tools = crate::fpga::ecp5::Tools::require()?;
     let mut timings = Vec::new();
     for name in modules {
-        let (m, latency) = crate::flow::ecp5::module_of(name, p, core, roms);
+        let (m, latency) = crate::fpga::ecp5::module_of(name, p, core, roms);
         eprintln!("ecp5: placing and routing {} (minutes for the larger modules)", m.name);
-        let t = crate::flow::ecp5::place_and_route(&tools, &m, latency, target_mhz, seed, &c.build.join(&m.name))?;
+        let t = crate::fpga::ecp5::place_and_route(&tools, &m, latency, target_mhz, seed, &c.build.join(&m.name))?;
         eprintln!("ecp5: {}: {:.1} MHz", m.name, t.fmax_mhz);
         timings.push(t);
     }
@@ -466,7 +468,7 @@ fn sweep_cmd(c: SweepConfig) -> Result<bool> {
     }
     // Refused before the first line of output (sweep::run checks again for other callers).
     if spec.ecp5.is_some() {
-        crate::flow::ecp5::Tools::require()?;
+        crate::fpga::ecp5::Tools::require()?;
     }
     eprintln!(
         "sweep: {} configurations ({} parameter sets × {} scenes){}{}",

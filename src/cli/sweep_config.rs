@@ -4,9 +4,9 @@
 use super::config::{ECP5_MODULES, threads};
 use super::{SweepAction, SweepArgs};
 use crate::error::{Error, Result};
-use crate::flow::sweep::{Plan, Shard, SweepSpec};
 use crate::io::check_folder;
 use crate::params::Params;
+use crate::sweep::{Plan, Shard, SweepSpec};
 use std::path::PathBuf;
 
 /// `fxrt sweep`: join shards, or run (a shard of) a sweep, or write its Slurm scripts.
@@ -67,7 +67,7 @@ impl SweepArgs {
 
     /// The sweep the arguments describe; every list is checked here, before anything runs.
     pub fn spec(&self) -> Result<SweepSpec> {
-        use crate::flow::sweep::{SceneSpec, values};
+        use crate::sweep::{SceneSpec, values};
         // OBJ paths are made absolute, so a shard started elsewhere (Slurm) describes the same
         // sweep as a run from here.
         let mut scenes = Vec::new();
@@ -107,15 +107,15 @@ impl SweepArgs {
 
     /// `--family` and the options of ecp5 alone: the modules in `ECP5_MODULES` order, each
     /// once.
-    fn ecp5(&self) -> Result<Option<crate::flow::sweep::Ecp5Choice>> {
+    fn ecp5(&self) -> Result<Option<crate::sweep::Ecp5Choice>> {
         let family = self.family.as_deref().unwrap_or("xc5v");
         match family {
             "ecp5" if !self.synth => Err(Error::param("family", "ecp5 places and routes with --synth: add --synth")),
             "ecp5" => {
                 let given = self.modules.clone().unwrap_or_else(|| vec!["core".into()]);
-                crate::flow::ecp5::check_modules(&given)?;
+                crate::fpga::ecp5::check_modules(&given)?;
                 let modules = ECP5_MODULES.iter().filter(|m| given.iter().any(|g| g == *m)).map(|m| m.to_string());
-                Ok(Some(crate::flow::sweep::Ecp5Choice { modules: modules.collect(), seed: self.seed.unwrap_or(1) }))
+                Ok(Some(crate::sweep::Ecp5Choice { modules: modules.collect(), seed: self.seed.unwrap_or(1) }))
             }
             "xc5v" if self.seed.is_some() => Err(Error::param("seed", "is nextpnr's: only with --family ecp5")),
             "xc5v" if self.modules.is_some() => {

@@ -4,7 +4,7 @@ use super::config::*;
 use super::sweep_config::SweepConfig;
 use super::*;
 use crate::error::Result;
-use crate::flow::simulators::Simulator;
+use crate::verify::simulators::Simulator;
 use clap::Parser;
 
 #[test]
@@ -247,7 +247,7 @@ fn the_emitted_sweep_command_describes_the_same_sweep() {
         "--out",
         "x",
     ]);
-    let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    let mut argv = crate::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
     assert_eq!(argv[..2], ["/opt/fxrt", "sweep"]);
     argv.extend(["--out".into(), "y".into()]);
     let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
@@ -281,7 +281,7 @@ fn sweep_leaf_size_slots_and_units_take_lists() {
         assert_eq!(e.subject, args[0], "{args:?}");
     }
     // What --emit-slurm writes for each shard describes the same sweep.
-    let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    let mut argv = crate::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
     let line = argv.join(" ");
     assert!(line.contains("--leaf-size 4,2") && line.contains("--slots 2,8,16 --units 1,2"), "{line}");
     argv.extend(["--out".into(), "x".into()]);
@@ -350,14 +350,11 @@ fn sweep_ecp5_options_are_checked() {
     assert!(!s.xc5v_synth());
     assert!(spec(&["sweep", "--out", "x", "--synth", "--family", "xc5v"]).xc5v_synth());
     let s = spec(&["sweep", "--out", "x", "--synth", "--family", "ecp5"]);
-    assert_eq!(s.ecp5, Some(crate::flow::sweep::Ecp5Choice { modules: vec!["core".into()], seed: 1 }));
+    assert_eq!(s.ecp5, Some(crate::sweep::Ecp5Choice { modules: vec!["core".into()], seed: 1 }));
     assert!(!s.xc5v_synth(), "no Virtex-5 area in an ecp5 sweep");
     let args = ["sweep", "--out", "x", "--synth", "--family", "ecp5", "--modules", "core,divider,core", "--seed", "7"];
     let s = spec(&[&args[..], &["--target-mhz", "100"]].concat());
-    assert_eq!(
-        s.ecp5,
-        Some(crate::flow::sweep::Ecp5Choice { modules: vec!["divider".into(), "core".into()], seed: 7 })
-    );
+    assert_eq!(s.ecp5, Some(crate::sweep::Ecp5Choice { modules: vec!["divider".into(), "core".into()], seed: 7 }));
     assert_eq!(s.target_mhz, 100);
     for (args, subject) in [
         (&["--family", "ecp5"][..], "--family"),
@@ -372,7 +369,7 @@ fn sweep_ecp5_options_are_checked() {
         assert_eq!(refused(&[&["sweep", "--out", "x"][..], args].concat()), subject, "{args:?}");
     }
     // What --emit-slurm writes for each shard describes the same ecp5 sweep.
-    let mut argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
+    let mut argv = crate::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &s);
     argv.extend(["--out".into(), "y".into()]);
     let argv: Vec<&str> = argv.iter().skip(1).map(|a| a.as_str()).collect();
     assert_eq!(spec(&argv), s);
@@ -406,9 +403,9 @@ fn every_command_with_parameters_takes_tree() {
     }
     // A sweep's shards are started with the same tree; the default adds nothing to the line.
     let Command::Sweep(a) = command(&["sweep", "--tree", "middle", "--out", "x"]) else { panic!("not a sweep") };
-    let argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
+    let argv = crate::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
     assert!(argv.windows(2).any(|w| w == ["--tree", "middle"]), "{argv:?}");
     let Command::Sweep(a) = command(&["sweep", "--out", "x"]) else { panic!("not a sweep") };
-    let argv = crate::flow::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
+    let argv = crate::sweep::slurm::sweep_command(std::path::Path::new("/opt/fxrt"), &a.spec().unwrap());
     assert!(!argv.iter().any(|w| w == "--tree"), "{argv:?}");
 }

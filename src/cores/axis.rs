@@ -33,7 +33,7 @@ pub struct Field {
 
 /// Where every field sits in the ray and result `tdata`, and their widths in bytes (the
 /// smallest power of two that holds the fields: AXI DMA engines and interconnects take only
-/// those). The one place offsets are computed: the wrapper, the host packer (`flow::axis`),
+/// those). The one place offsets are computed: the wrapper, the host packer (`generate::axis_host`),
 /// the C header and the manifest all read them here.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct Layout {
@@ -231,7 +231,3 @@ pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
     });
     b.finish()
 }
-
-#[cfg(test)]
-#[path = "axis_tests.rs"]
-mod tests;

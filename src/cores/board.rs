@@ -1,7 +1,7 @@
 //! What a board top runs (docs/BOARDS.md): the on-chip ray generator feeding the core, frame
 //! after frame, every result mixed into the frame's checksum (`cores::checksum`), and the
 //! checksum compared with the golden model's at the end of each frame. The board's own top
-//! (`flow::board`) adds the clock from a PLL, the reset synchroniser and the pins.
+//! (`board`) adds the clock from a PLL, the reset synchroniser and the pins.
 //!
 //! A frame ends when its W·H-th result has been summed; the generator, which has given its
 //! last ray by then, starts the next frame a clock later, so the frames' results never mix.

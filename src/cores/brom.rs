@@ -9,7 +9,7 @@
 //! infers `REGMODE = OUTREG` (yosys issue 5814: the output register is only available by
 //! instantiating the primitive), so `fxrt synth --family ecp5` replaces the body of each
 //! module named `fxrt_brom_…` by DP16KD primitives with their output register
-//! (`flow::ecp5_bram`), the way it places the multiplier pieces in MULT18X18Ds. The generated
+//! (`fpga::ecp5::bram`), the way it places the multiplier pieces in MULT18X18Ds. The generated
 //! HDL stays portable, and every simulator runs it as written here.
 //!
 //! A third clock is a fabric register after the block's output register: a design of many

@@ -12,7 +12,7 @@
 //! shifted restoring remainder minus b, whose sign is the restoring comparison
 //! (docs/ARITHMETIC.md). A step is then one carry chain whose add-or-subtract is chosen by
 //! the *registered* last quotient bit — `fxrt_addsub_w{W}`, which `fxrt synth --family ecp5`
-//! maps to a CCU2C chain with the choice inside each cell's LUT (`flow::ecp5_carry`), so a
+//! maps to a CCU2C chain with the choice inside each cell's LUT (`fpga::ecp5::carry`), so a
 //! quotient stage is a bare carry chain between registers (a restoring stage is a chain and a
 //! select by its own carry-out, routed to every bit: 195 MHz at best on the ECP5, docs/TIMING.md).
 //! Latency n + 2 (the thesis's divider: n + 3): one stage for the magnitudes and signs, then
@@ -42,7 +42,7 @@ pub enum StageForm {
     SeparateEnds,
 }
 
-/// The file name prefix of the add-or-subtract step modules (`flow::ecp5_carry`).
+/// The file name prefix of the add-or-subtract step modules (`fpga::ecp5::carry`).
 pub const ADDSUB_PREFIX: &str = "fxrt_addsub_w";
 
 /// The divider's shape: quotient bits per pipeline stage and how a bit is built.
@@ -110,7 +110,7 @@ pub fn divider_core(n: u32, shape: DividerShape, num_width: u32, den_width: u32)
 /// sub → diff (the low w − 1 bits of a + b when !sub, a − b when sub, modulo 2^w) and ge (its
 /// top bit inverted: the result is not negative). Written as a + (b ^ sub…sub) + sub: one
 /// carry chain whose operand inversion a LUT in front of the chain makes (yosys) or each
-/// chain cell's own LUT (`flow::ecp5_carry`).
+/// chain cell's own LUT (`fpga::ecp5::carry`).
 pub fn addsub_core(w: u32) -> Module {
     assert!(w >= 2, "a step of at least two bits");
     let b = Builder::new(&format!("{ADDSUB_PREFIX}{w}"));

@@ -204,7 +204,7 @@ pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
     v
 }
 
-/// The core with its observation ports (`flow::frame::OBSERVED`, the visit ports): what the
+/// The core with its observation ports (`verify::frame::OBSERVED`, the visit ports): what the
 /// simulations count with.
 pub fn core_module(p: &CoreParams, scene: &SceneRoms) -> Module {
     core_module_with(p, scene, true)
@@ -447,48 +447,4 @@ pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::ray
         }
     }
     m
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::flow::disturb::simulate_rust_cycle;
-    use crate::flow::feed::Stalls;
-    use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
-    use crate::model::camera::Camera;
-    use crate::params::Params;
-    use crate::scene::{Scene, SceneSource};
-
-    /// Three units number their slots as 3 × 2^⌈log2 K⌉: 33 slots each need 192 slot numbers,
-    /// more than the closest-hit unit's 128-bit word (this panicked while building).
-    #[test]
-    fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
-        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
-        let roms = SceneRoms::of(&scene);
-        let err = CoreParams::with_slots(&roms, 16, 1, 150, 33, 3).check().unwrap_err();
-        assert_eq!(err.subject, "--slots");
-        assert!(err.message.contains("99 ray slots, numbered as 3 × 64"), "{err}");
-        CoreParams::with_slots(&roms, 16, 1, 150, 32, 3).check().unwrap();
-        CoreParams::with_slots(&roms, 16, 1, 150, 42, 2).check().unwrap();
-    }
-
-    #[test]
-    fn a_small_frame_matches_the_golden_model() {
-        let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
-        let roms = SceneRoms::of(&scene);
-        let p = CoreParams::new(&roms, 16, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
-        let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
-        let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
-        assert_eq!(mismatches(&scene, &rays, &results), 0);
-        assert!(results.iter().filter(|r| r.1.is_some()).count() > 20);
-        assert!(stats.busy_cycles > 0 && stats.max_stack_depth > 0, "{stats:?}");
-        // The batched engine (ray source in the netlist) and the cycle engine (ports driven
-        // like a testbench) agree on every result and every count.
-        let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &rays, &Stalls::none(), &|_| {});
-        assert_eq!(cycle_results, results);
-        assert_eq!(
-            (cycle_stats.cycles, cycle_stats.busy_cycles, cycle_stats.max_stack_depth, cycle_stats.visits),
-            (stats.cycles, stats.busy_cycles, stats.max_stack_depth, stats.visits)
-        );
-    }
 }

@@ -1,6 +1,9 @@
-//! `fxrt render`: one primary ray per pixel through any of the models, in parallel.
+//! `fxrt render`: one primary ray per pixel through any of the models, in parallel; and
+//! Embree's side of `fxrt bench --against-embree` (`embree`), the CPU tracer the golden
+//! model's speed is measured against.
 
 pub mod compare;
+pub mod embree;
 pub mod fast;
 pub mod tracer;
 

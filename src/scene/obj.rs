@@ -275,4 +275,22 @@ mod tests {
         // tobj 4 has no line continuation: the backslash is a fourth value of its own line.
         fails_at(&format!("{HEAD}v 1 2 3 \\\n4\nf 1 2 3\n"), 8, &["weight", "'\\'"]);
     }
+
+    // `obj_lines` finds no fault where tobj finds none (its own tests are of the faults).
+    const GOOD: &str = "# fine\nv 0 0 0 1\nv 1 0 0\nvt 0 0\nvn 0 0 1\nv 0 1 0\nusemtl red\n\
+                        f 1/1/1 2/1/1 3//1\ng two\nf -1 -2 -3 1\nl 1 2\nf 7\n";
+
+    #[test]
+    fn a_good_file_has_no_fault_of_any_kind() {
+        assert!(tobj_load(GOOD.as_bytes()).is_ok());
+        assert!(obj_lines::locate(GOOD, None).is_none());
+        assert!(obj_lines::locate_non_finite(GOOD).is_none());
+    }
+
+    #[test]
+    fn index_zero_of_a_texture_coordinate_means_none_to_tobj() {
+        let text = "v 0 0 0\nvt 0 0\nf 1/0 1/-2 1/1\n";
+        assert!(tobj_load(text.as_bytes()).is_ok());
+        assert!(obj_lines::locate(text, None).is_none());
+    }
 }

@@ -438,16 +438,6 @@ fn face_fault(
 mod tests {
     use super::*;
 
-    const GOOD: &str = "# fine\nv 0 0 0 1\nv 1 0 0\nvt 0 0\nvn 0 0 1\nv 0 1 0\nusemtl red\n\
-                        f 1/1/1 2/1/1 3//1\ng two\nf -1 -2 -3 1\nl 1 2\nf 7\n";
-
-    #[test]
-    fn a_good_file_has_no_fault_of_any_kind() {
-        assert!(super::super::obj::tobj_load(GOOD.as_bytes()).is_ok());
-        assert!(locate(GOOD, None).is_none());
-        assert!(locate_non_finite(GOOD).is_none());
-    }
-
     #[test]
     fn any_fault_comes_in_tobjs_order() {
         // An index fault is met when its object ends: a bad line before that comes first.
@@ -466,12 +456,5 @@ mod tests {
         for fault in [Fault::Position, Fault::Normal, Fault::VertexIndex, Fault::ColourIndex] {
             assert!(locate("v 0 0 0\nf 1 1 1\n", Some(fault)).is_none(), "{fault:?}");
         }
-    }
-
-    #[test]
-    fn index_zero_of_a_texture_coordinate_means_none_to_tobj() {
-        let text = "v 0 0 0\nvt 0 0\nf 1/0 1/-2 1/1\n";
-        assert!(super::super::obj::tobj_load(text.as_bytes()).is_ok());
-        assert!(locate(text, None).is_none());
     }
 }

@@ -1,18 +1,22 @@
 //! The AXI4-Stream wrapper in the cycle simulator: whole frames with a source and a sink that
 //! stall at random (seeded), every result against the golden model, the frame barrier and
 //! `tlast`, the AXI rule that a result offered stays offered, and no combinational path from
-//! an input to an output.
+//! an input to an output. (Here beside the host side, `axis_host`, which packs its rays and
+//! unpacks its results.)
 
-use super::*;
-use crate::flow::axis_host::{pack_ray, unpack_result};
-use crate::flow::frame::{PixelRay, frame_rays, mismatches};
+use crate::cores::axis::{Layout, axis_module, part_names};
+use crate::cores::top::{CoreParams, core_module};
+use crate::generate::axis_host::{pack_ray, unpack_result};
 use crate::model::camera::Camera;
 use crate::model::golden::Hit;
 use crate::params::Params;
 use crate::rng::SplitMix64;
 use crate::rtl::sim::Sim;
+use crate::rtl::{Module, Ty};
 use crate::scene::images::SceneRoms;
 use crate::scene::{Scene, SceneSource};
+use crate::verify::frame::{PixelRay, frame_rays, mismatches};
+use std::rc::Rc;
 
 struct Setup {
     scene: Scene,
@@ -25,7 +29,7 @@ fn setup(name: &str, n: u32, m: u32) -> Setup {
     let scene = Scene::load(&SceneSource::Builtin(name.into()), &Params { n, m, ..Params::default() }).unwrap();
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::new(&roms, 16, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
-    let core = Rc::new(super::super::top::core_module(&p, &roms));
+    let core = Rc::new(core_module(&p, &roms));
     let wrapper = axis_module(&core, &p);
     Setup { scene, p, wrapper, layout: Layout::of(&core) }
 }
@@ -143,7 +147,7 @@ fn check(s: &Setup, rays: &[PixelRay], frame: Option<usize>, o: &Outcome) {
 fn frames_stream_through_with_random_valid_and_ready() {
     let s = setup("cornell", 29, 32);
     assert_eq!((s.layout.ray_bytes, s.layout.res_bytes), (64, 16));
-    let rays = crate::flow::feed::feed_order(&frame_rays(&s.scene, &Camera::default_for(&s.scene, 16, 16)), Some(5));
+    let rays = crate::verify::feed::feed_order(&frame_rays(&s.scene, &Camera::default_for(&s.scene, 16, 16)), Some(5));
     for (frame, seed) in [(None, 1), (Some(60), 2), (Some(1), 3)] {
         let o = stream(&s, &rays, frame, (60, 50), seed, false);
         check(&s, &rays, frame, &o);

@@ -27,7 +27,7 @@ struct Measure {
     of: fn(&Row) -> Option<f64>,
 }
 
-fn placed_core(r: &Row) -> Option<&crate::flow::ecp5::Timing> {
+fn placed_core(r: &Row) -> Option<&crate::fpga::ecp5::Timing> {
     r.ecp5.iter().find(|p| p.kind == "core").map(|p| &p.timing)
 }
 

@@ -1,10 +1,10 @@
 //! The ULX3S bitstream: yosys `synth_ecp5` of the board top and its logic (the ECP5 sources of
-//! `flow::ecp5`), nextpnr-ecp5 with the board's LPF — its 25 MHz `FREQUENCY` constraint,
+//! `fpga::ecp5`), nextpnr-ecp5 with the board's LPF — its 25 MHz `FREQUENCY` constraint,
 //! carried through the PLL to the board clock — and ecppack.
 
 use super::{Board, BoardDesign};
 use crate::error::{Error, Result};
-use crate::flow::ecp5::{PACKAGE, Tools, run, synthesize, write_sources};
+use crate::fpga::ecp5::{Tools, nextpnr, read_report, run, synthesize, write_sources};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -49,7 +49,6 @@ pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Resul
             format!("{}: the bitstream comes from ISE (the .tcl project)", d.board.name()),
         ));
     }
-    let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let mut sources = write_sources(&d.logic, dir)?;
     let top_file = format!("{}.v", d.top);
     let (lpf, lpf_text) = d.constraints();
@@ -59,34 +58,10 @@ pub fn bitstream(tools: &Tools, d: &BoardDesign, seed: u64, dir: &Path) -> Resul
     files.commit()?;
     sources.push(top_file);
     synthesize(tools, dir, &sources, &d.top)?;
-    let seed_s = seed.to_string();
-    let args = [
-        "--85k",
-        "--package",
-        PACKAGE,
-        "--speed",
-        "6",
-        "--json",
-        "design.json",
-        "--lpf",
-        &lpf,
-        "--textcfg",
-        "design.config",
-        "--seed",
-        &seed_s,
-        "--report",
-        "report.json",
-        "--timing-allow-fail",
-        "--log",
-        "nextpnr.log",
-        "-q",
-    ];
-    run(&tools.nextpnr, &args, dir, "nextpnr.log")?;
+    nextpnr(tools, dir, &["--lpf", &lpf, "--textcfg", "design.config"], seed)?;
     let bit = format!("{}.bit", d.top);
     run(&ecppack(tools), &["--compress", "design.config", &bit], dir, "nextpnr.log")?;
-    let text = std::fs::read_to_string(dir.join("report.json")).map_err(io)?;
-    let report: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))?;
+    let report = read_report(dir)?;
     let (yosys, nextpnr) = tools.versions();
     Ok(timing_of(&report, d, seed, yosys, nextpnr, bit))
 }

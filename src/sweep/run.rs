@@ -5,7 +5,7 @@ use super::output::{Results, add_tables_and_images, copy_cached, has_cached, loa
 use super::pnr::Pnr;
 use super::{Plan, Shard, SweepSpec, scene_labels};
 use crate::error::{Error, Result};
-use crate::flow::ecp5::Tools;
+use crate::fpga::ecp5::Tools;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -9,6 +9,10 @@
 //! bit and a reduction tree after the outputs' own registers, so the paths it adds are short
 //! (a register to an input register, an XOR tree into one flip-flop).
 
+pub mod bram;
+pub mod carry;
+pub mod dsp;
+
 use crate::cores::intersect::IntersectParams;
 use crate::cores::top::CoreParams;
 use crate::error::{Error, Result};
@@ -39,7 +43,7 @@ impl Tools {
         let chosen = std::env::var_os("FXRT_ECP5_BIN").map(PathBuf::from);
         let dirs: Vec<PathBuf> = match &chosen {
             Some(d) => vec![d.clone()],
-            None => super::venv_bins().to_vec(),
+            None => crate::io::venv_bins().to_vec(),
         };
         let find = |name: &str| -> Option<PathBuf> {
             // Absolute, as the tools run in the build folder.
@@ -250,7 +254,6 @@ pub fn place_and_route(
     seed: u64,
     dir: &Path,
 ) -> Result<Timing> {
-    let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let top = wrapper(&Rc::new(m.clone()));
     let pins = (PIN_REGS.0 + PIN_REGS.1) as u64;
     let out_bits: u32 = m.outputs.iter().map(|o| m.sig(o.1).ty.width).sum();
@@ -258,30 +261,8 @@ pub fn place_and_route(
         m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
     let sources = write_sources(&top, dir)?;
     synthesize(tools, dir, &sources, &top.name)?;
-    let (freq, seed_s) = (format!("{target_mhz}"), seed.to_string());
-    let args = [
-        "--85k",
-        "--package",
-        PACKAGE,
-        "--speed",
-        "6",
-        "--json",
-        "design.json",
-        "--freq",
-        &freq,
-        "--seed",
-        &seed_s,
-        "--report",
-        "report.json",
-        "--timing-allow-fail",
-        "--log",
-        "nextpnr.log",
-        "-q",
-    ];
-    run(&tools.nextpnr, &args, dir, "nextpnr.log")?;
-    let text = std::fs::read_to_string(dir.join("report.json")).map_err(io)?;
-    let report: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))?;
+    nextpnr(tools, dir, &["--freq", &format!("{target_mhz}")], seed)?;
+    let report = read_report(dir)?;
     let (yosys, nextpnr) = tools.versions();
     let mut t = timing_from_report(&report, &m.name, target_mhz, latency, wrapper_ff, seed, yosys, nextpnr);
     t.netlist_sha256 = netlist_hash(m);
@@ -303,11 +284,11 @@ pub fn write_sources(top: &Module, dir: &Path) -> Result<Vec<String>> {
     let brom_of = |file: &str| block_of(file, crate::cores::brom::BROM_PREFIX);
     let bram_of = |file: &str| block_of(file, crate::cores::brom::BRAM_PREFIX);
     for (file, text) in &files {
-        let text = super::ecp5_dsp::dsp_regs_of(file)
-            .and_then(|regs| super::ecp5_dsp::mult18x18d(text, regs))
-            .or_else(|| super::ecp5_carry::addsub_width_of(file).and_then(|w| super::ecp5_carry::ccu2c_addsub(text, w)))
-            .or_else(|| brom_of(file).and_then(|m| super::ecp5_bram::dp16kd_rom(text, m)))
-            .or_else(|| bram_of(file).and_then(|m| super::ecp5_bram::dp16kd_ram(text, m)))
+        let text = dsp::dsp_regs_of(file)
+            .and_then(|regs| dsp::mult18x18d(text, regs))
+            .or_else(|| carry::addsub_width_of(file).and_then(|w| carry::ccu2c_addsub(text, w)))
+            .or_else(|| brom_of(file).and_then(|m| bram::dp16kd_rom(text, m)))
+            .or_else(|| bram_of(file).and_then(|m| bram::dp16kd_ram(text, m)))
             .unwrap_or_else(|| text.clone());
         set.add(&dir.join(file), text.as_bytes())?;
     }
@@ -339,6 +320,23 @@ pub(crate) fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<(
         return Err(Error::new(&name, format!("failed, see {}", dir.join(log).display())));
     }
     Ok(())
+}
+
+/// Runs nextpnr-ecp5 in `dir` on the synthesised `design.json` for the LFE5U-85F (`PACKAGE`,
+/// speed grade 6) with `constraint` (a clock `--freq`, or the board's `--lpf` and what else
+/// the board wants) and placement seed `seed`, writing `report.json` and `nextpnr.log`.
+pub fn nextpnr(tools: &Tools, dir: &Path, constraint: &[&str], seed: u64) -> Result<()> {
+    let seed = seed.to_string();
+    let mut args = vec!["--85k", "--package", PACKAGE, "--speed", "6", "--json", "design.json"];
+    args.extend_from_slice(constraint);
+    args.extend(["--seed", &seed, "--report", "report.json", "--timing-allow-fail", "--log", "nextpnr.log", "-q"]);
+    run(&tools.nextpnr, &args, dir, "nextpnr.log")
+}
+
+/// The `report.json` nextpnr wrote in `dir`.
+pub fn read_report(dir: &Path) -> Result<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("report.json")).map_err(|e| Error::file(dir, e.to_string()))?;
+    serde_json::from_str(&text).map_err(|e| Error::file(&dir.join("report.json"), e.to_string()))
 }
 
 /// Reads nextpnr's `--report` JSON.

@@ -244,7 +244,7 @@ fn cache_keys_tell_families_seeds_targets_and_core_shapes_apart() {
 fn ecp5_columns_follow_the_modules() {
     use super::eval::Row;
     use super::pnr::{FIELDS, PlacedModule};
-    use crate::flow::ecp5::{CriticalPath, Timing};
+    use crate::fpga::ecp5::{CriticalPath, Timing};
     let timing = |module: &str, fmax: f64, latency: Option<u32>| Timing {
         module: module.into(),
         device: "LFE5U-85F".into(),

@@ -12,10 +12,10 @@ use std::process::Command;
 /// "vhd"): (file name, text).
 pub fn primitives(board: Board, ext: &str) -> (&'static str, &'static str) {
     match (board, ext) {
-        (Board::Ulx3s, "v") => ("ecp5_primitives.v", include_str!("../../../testbenches/primitives/ecp5.v")),
-        (Board::Ulx3s, _) => ("ecp5_primitives.vhd", include_str!("../../../testbenches/primitives/ecp5.vhd")),
-        (Board::Ml509, "v") => ("virtex5_primitives.v", include_str!("../../../testbenches/primitives/virtex5.v")),
-        (Board::Ml509, _) => ("virtex5_primitives.vhd", include_str!("../../../testbenches/primitives/virtex5.vhd")),
+        (Board::Ulx3s, "v") => ("ecp5_primitives.v", include_str!("../../testbenches/primitives/ecp5.v")),
+        (Board::Ulx3s, _) => ("ecp5_primitives.vhd", include_str!("../../testbenches/primitives/ecp5.vhd")),
+        (Board::Ml509, "v") => ("virtex5_primitives.v", include_str!("../../testbenches/primitives/virtex5.v")),
+        (Board::Ml509, _) => ("virtex5_primitives.vhd", include_str!("../../testbenches/primitives/virtex5.vhd")),
     }
 }
 

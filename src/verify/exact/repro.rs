@@ -27,7 +27,7 @@ pub fn obj_text(tris: &[crate::scene::Tri]) -> String {
 }
 
 /// The `fxrt sim` arguments that run `case` on `obj` (in `hdl`, when given).
-pub fn sim_command(case: &Case, obj: &Path, hdl: Option<crate::flow::simulators::Simulator>) -> String {
+pub fn sim_command(case: &Case, obj: &Path, hdl: Option<crate::verify::simulators::Simulator>) -> String {
     let p = &case.params;
     let s = &case.shape;
     let v = |x: [f64; 3]| format!("{},{},{}", x[0], x[1], x[2]);

@@ -8,7 +8,7 @@ use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summarie
 use super::throughput::THROUGHPUT_PLOTS;
 use super::{Axis, Plan, Set};
 use crate::error::{Error, Result};
-use crate::flow::ecp5::{CriticalPath, DEVICE, PACKAGE, SPEED, Timing};
+use crate::fpga::ecp5::{CriticalPath, DEVICE, PACKAGE, SPEED, Timing};
 use crate::io::OutputSet;
 use askama::Template;
 use std::path::Path;

@@ -1,6 +1,11 @@
-//! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files.
+//! `fxrt gen`: the cores' HDL, their JSON manifests, and the ISE project files; and the host
+//! side of the AXI4-Stream wrapper (`axis_host`: ray and result packing, the C header, a
+//! frame's stream files).
 
-use super::axis_host;
+pub mod axis_host;
+#[cfg(test)]
+mod axis_tests;
+
 use crate::cores::axis::{Layout, axis_module};
 use crate::cores::intersect::{IntersectParams, intersect_core};
 use crate::cores::top::{CoreParams, core_module_with, core_with_raygen};
@@ -150,7 +155,7 @@ pub fn core_files(
         "results_in_order": false,
         "result_order": "rays finish out of order; every result carries its ray id (res_id)",
     });
-    let min_latency = crate::flow::disturb::min_latency(p, roms);
+    let min_latency = crate::verify::disturb::min_latency(p, roms);
     let mut set = vec![(top, None, core_params.clone())];
     // The core behind AXI4-Stream ports, with the C header of its layout (not for the core
     // fed by its own ray generator, which has no ray port).

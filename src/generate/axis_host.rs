@@ -3,9 +3,9 @@
 //! program on the host (`c_header`). Offsets and widths all come from the `Layout`.
 
 use crate::cores::axis::{Field, Layout};
-use crate::flow::frame::PixelRay;
 use crate::model::golden::{GridRay, Hit};
 use crate::rtl::Ty;
+use crate::verify::frame::PixelRay;
 
 fn ty(f: &Field) -> Ty {
     if f.signed { Ty::s(f.bits) } else { Ty::u(f.bits) }

@@ -255,7 +255,7 @@ impl BoardDesign {
             let (language, ext) = if vhdl { ("VHDL", "vhd") } else { ("Verilog", "v") };
             let mut files: Vec<String> = self.logic.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
             files.push(format!("{}.{ext}", self.top));
-            let tcl = crate::flow::generate::ise_project(&self.top, &self.scene, language, &files, true);
+            let tcl = crate::generate::ise_project(&self.top, &self.scene, language, &files, true);
             out.push((format!("{}.tcl", self.top), tcl));
         }
         let names: Vec<String> = out.iter().map(|f| f.0.clone()).collect();

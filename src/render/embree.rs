@@ -76,7 +76,9 @@ pub fn ray_bytes(cam: &Camera) -> (Vec<u8>, Vec<u8>) {
 pub fn python() -> Option<PathBuf> {
     let candidates = match std::env::var_os("FXRT_PYTHON") {
         Some(p) => vec![PathBuf::from(p)],
-        None => super::venv_bins().into_iter().map(|d| d.join("python")).chain([PathBuf::from("python3")]).collect(),
+        None => {
+            crate::io::venv_bins().into_iter().map(|d| d.join("python")).chain([PathBuf::from("python3")]).collect()
+        }
     };
     let imports =
         |p: &PathBuf| Command::new(p).args(["-c", "import embreex, numpy"]).output().is_ok_and(|o| o.status.success());

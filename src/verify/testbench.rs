@@ -104,7 +104,7 @@ pub struct Stream<'a> {
     pub checked: &'a [&'a str],
     pub id: &'a str,
     /// The source's stall pattern: it holds `ray_valid` low on cycle c if entry c mod len is
-    /// true (`flow::feed::Stalls`); None: never.
+    /// true (`verify::feed::Stalls`); None: never.
     pub stalls: Option<&'a [bool]>,
     /// The consumer's pattern: it holds `res_ready` low on cycle c if entry c mod len is true;
     /// None: always ready.

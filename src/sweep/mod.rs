@@ -106,7 +106,7 @@ impl SweepSpec {
 /// What `sweep --synth --family ecp5` places and routes, and with which placement seed.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Ecp5Choice {
-    /// Names of `flow::ecp5::MODULES`, in that order.
+    /// Names of `fpga::ecp5::MODULES`, in that order.
     pub modules: Vec<String>,
     pub seed: u64,
 }

@@ -1,11 +1,11 @@
 //! `sweep --synth --family ecp5`: each configuration's modules placed and routed on the
-//! LFE5U-85F by the ECP5 flow (`flow::ecp5`, the same as `fxrt synth --family ecp5`) at the
+//! LFE5U-85F by the ECP5 flow (`fpga::ecp5`, the same as `fxrt synth --family ecp5`) at the
 //! sweep's clock target and seed, and the columns results.csv gains (report.md's tables of
 //! them are in `report.rs`).
 
 use super::{Ecp5Choice, SweepSpec};
 use crate::cores::top::CoreParams;
-use crate::flow::ecp5::{Timing, Tools, core_clock, module_of, place_and_route};
+use crate::fpga::ecp5::{Timing, Tools, core_clock, module_of, place_and_route};
 use crate::scene::images::SceneRoms;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -13,7 +13,7 @@ use std::path::PathBuf;
 /// One module of a configuration, placed and routed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PlacedModule {
-    /// Which of `flow::ecp5::MODULES`.
+    /// Which of `fpga::ecp5::MODULES`.
     pub kind: String,
     #[serde(flatten)]
     pub timing: Timing,

@@ -7,15 +7,15 @@ use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
 use crate::cores::top::{CoreParams, core_module_with};
 use crate::error::{Error, Result};
-use crate::flow::feed::Stalls;
-use crate::flow::frame::{frame_rays, mismatches, simulate_rust};
-use crate::flow::synth::synth_xc5v;
+use crate::fpga::xilinx::synth_xc5v;
 use crate::model::camera::Camera;
 use crate::params::Params;
 use crate::render::tracer::{ModelKind, make_tracer};
 use crate::render::{Frame, encode_png, render};
 use crate::scene::images::SceneRoms;
 use crate::scene::{Scene, Tri, TriangleCounts, builtin, obj};
+use crate::verify::feed::Stalls;
+use crate::verify::frame::{frame_rays, mismatches, simulate_rust};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::sync::OnceLock;
@@ -208,7 +208,7 @@ pub struct Row {
     pub cost: Option<CoreCost>,
     pub synth: Option<SynthArea>,
     pub core: Option<CoreRun>,
-    /// `--family ecp5`: each module placed and routed, in `flow::ecp5::MODULES` order.
+    /// `--family ecp5`: each module placed and routed, in `fpga::ecp5::MODULES` order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub ecp5: Vec<PlacedModule>,
     /// With `--core-sim` and `--family ecp5`: the placed core's Fmax (or the slowest placed

@@ -14,13 +14,13 @@ pub mod repro;
 pub mod soups;
 
 use crate::cores::top::CoreParams;
-use crate::flow::feed::{Stalls, feed_order};
-use crate::flow::frame::{PixelRay, frame_rays, simulate_hdl, simulate_rust};
-use crate::flow::simulators::Simulator;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::render::fast::FastGolden;
 use crate::scene::images::SceneRoms;
 use crate::scene::{Scene, Tri};
+use crate::verify::feed::{Stalls, feed_order};
+use crate::verify::frame::{PixelRay, frame_rays, simulate_hdl, simulate_rust};
+use crate::verify::simulators::Simulator;
 use draw::{Case, CaseScene};
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -118,7 +118,7 @@ const MAX_CYCLES: u64 = 30_000;
 /// slots (the ring is some 25 clocks long), a slot waits some 80 clocks per leaf, and the
 /// pipeline takes a triangle per clock.
 fn estimated_cycles(scene: &Scene, rays: &[PixelRay], shape: draw::Shape) -> u64 {
-    let (steps, tests) = crate::flow::frame::golden_walk(scene, rays);
+    let (steps, tests) = crate::verify::frame::golden_walk(scene, rays);
     let parallel = (shape.slots * shape.units).min(25) as u64;
     steps * 25 / parallel + tests * 20 / parallel + tests
 }
@@ -155,7 +155,7 @@ pub fn run(case: &Case, b: &Built, hdl: Option<Simulator>) -> CaseOutcome {
 pub fn compare(
     scene: &Scene,
     rays: &[PixelRay],
-    results: &[crate::flow::frame::CoreResult],
+    results: &[crate::verify::frame::CoreResult],
     core_walk: (u64, u64),
     cycles: u64,
 ) -> CaseOutcome {

@@ -1,14 +1,11 @@
 //! Whole frames through the generated core (`fxrt sim`): every pixel's ray that reaches the
 //! scene box is streamed into the core — in pixel order, or shuffled and with random input
-//! stalls (`flow::feed`) — and each result is matched by its ray id (the pixel number) to its
+//! stalls (`verify::feed`) — and each result is matched by its ray id (the pixel number) to its
 //! ray and compared with the golden model's (`render::fast`), pixel by pixel. Nothing assumes
 //! that results leave the core in the order the rays entered it.
 
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::error::{Error, Result};
-use crate::flow::feed::Stalls;
-use crate::flow::simulators::{Bench, Simulator};
-use crate::flow::testbench::{Stream, parse_results, stream_files};
 use crate::model::camera::Camera;
 use crate::model::golden::{Golden, GridRay, Hit};
 use crate::model::ray::quantize_ray;
@@ -17,6 +14,9 @@ use crate::rtl::batch::BatchSim;
 use crate::rtl::{Module, Ty};
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
+use crate::verify::feed::Stalls;
+use crate::verify::simulators::{Bench, Simulator};
+use crate::verify::testbench::{Stream, parse_results, stream_files};
 use serde::Serialize;
 use std::path::Path;
 
@@ -456,11 +456,10 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::disturb::simulate_rust_cycle;
-    use crate::flow::feed::feed_order;
     use crate::params::Params;
     use crate::rtl::sim::Sim;
     use crate::scene::SceneSource;
+    use crate::verify::feed::feed_order;
 
     fn cornell(n: u32, m: u32) -> Scene {
         Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n, m, ..Params::default() }).unwrap()
@@ -544,42 +543,5 @@ mod tests {
         renamed[a].0 = 12 * 10 + 5;
         assert_eq!(mismatches(&scene, &rays, &renamed), 2, "an unknown id instead of a's");
         assert_eq!(mismatches(&scene, &rays, &[]), rays.len() as u64);
-    }
-
-    /// Shuffled rays and a stalling source, in both engines: the same results in the same
-    /// (arrival) order, the same counts; every result right; the rays really went in shuffled
-    /// and the stalls really cost cycles.
-    #[test]
-    fn shuffled_stalled_frames_run_alike_in_both_engines() {
-        let scene = cornell(29, 32);
-        let roms = SceneRoms::of(&scene);
-        let p = CoreParams::new(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ);
-        let rays = frame_rays(&scene, &Camera::default_for(&scene, 10, 8));
-        let fed = feed_order(&rays, Some(11));
-        let stalls = Stalls::random(40, 5);
-        let (results, stats) = simulate_rust(&p, &roms, &fed, &stalls, &|_| {});
-        let (cycle_results, cycle_stats) = simulate_rust_cycle(&p, &roms, &fed, &stalls, &|_| {});
-        assert_eq!(cycle_results, results);
-        assert_eq!(
-            (
-                cycle_stats.cycles,
-                cycle_stats.busy_cycles,
-                cycle_stats.stall_cycles,
-                cycle_stats.visits,
-                cycle_stats.culls
-            ),
-            (stats.cycles, stats.busy_cycles, stats.stall_cycles, stats.visits, stats.culls)
-        );
-        assert_eq!(mismatches(&scene, &rays, &results), 0);
-        let arrival: Vec<u64> = results.iter().map(|r| r.0).collect();
-        let mut sorted = arrival.clone();
-        sorted.sort();
-        assert_ne!(arrival, sorted, "the rays were fed shuffled");
-        let (_, plain) = simulate_rust(&p, &roms, &fed, &Stalls::none(), &|_| {});
-        assert_eq!(plain.stall_cycles, 0);
-        // About 40 % of the cycles in which rays remained, which are at least 4 per ray (the
-        // core takes one ray per 4 clocks at most): over 30 % of those.
-        assert!(stats.stall_cycles * 10 >= 3 * 4 * stats.rays, "{stats:?}");
-        assert!(stats.cycles > plain.cycles, "stalls cost cycles: {} vs {}", stats.cycles, plain.cycles);
     }
 }
