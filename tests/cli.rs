@@ -251,6 +251,14 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
         (core["params"]["ray_slots_per_unit"].clone(), core["params"]["traversal_units"].clone()),
         (64.into(), 2.into())
     );
+    // The AXI4-Stream wrapper's manifest, the file an integrator of the wrapper reads, says
+    // the same interface facts (its latency one clock more: its output register).
+    let axis: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join(format!("{core_name}_axis.json"))).unwrap()).unwrap();
+    assert_eq!(axis["latency_cycles"]["min"].as_u64(), core["latency_cycles"]["min"].as_u64().map(|l| l + 1), "{axis}");
+    assert_eq!(axis["interface"]["reset_cycles"], 1);
+    assert_eq!(axis["interface"]["rays_held_max"], 128 + 16 + 3);
+    assert_eq!(axis["clock"], core["clock"]);
     let files = core["files"]["vhdl"].as_array().unwrap();
     assert_eq!(files.last().unwrap(), &format!("{core_name}.vhd"));
     let hex = core["files"]["verilog_memory_init"].as_array().unwrap();

@@ -185,7 +185,10 @@ fn whole_core_passes_ghdl_synth_verilator_lint_and_yosys_xc5v() {
     let mut cam = fxrt::model::camera::Camera::default_for(&scene, 32, 24);
     cam.eye = [278.0, 273.0, 60.0];
     let generator = fxrt::model::raygen::RayGen::new(&scene, &cam).unwrap();
-    lint_and_ghdl_synth(&core_with_raygen(&p, &roms, &generator, true), "whole_core_raygen_tools");
+    lint_and_ghdl_synth(
+        &core_with_raygen(&p, &std::rc::Rc::new(fxrt::cores::top::core_module(&p, &roms)), &generator),
+        "whole_core_raygen_tools",
+    );
     let module = core_module(&p, &roms);
     let dir = lint_and_ghdl_synth(&module, "whole_core_tools");
     if std::process::Command::new("yosys").arg("-V").output().is_ok() {

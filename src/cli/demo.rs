@@ -41,7 +41,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let p = CoreParams::with_slots(&roms, RAY_ID_WIDTH, 1, target, DEFAULT_SLOTS, DEFAULT_UNITS);
     p.check()?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
-    let netlist = core_module_with(&p, &roms, false);
+    let netlist = std::rc::Rc::new(core_module_with(&p, &roms, false));
     let measured = crate::fpga::ecp5::measured_entry(
         Path::new("generated/measured/ecp5-core.json"),
         MEASURED,
@@ -55,7 +55,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let hdl = c.out.join("hdl");
     // Kept in memory while the frame is simulated (an interrupted demo leaves nothing), then
     // written with the pictures as one set.
-    let core_files = generate::core_files(&p, &roms, o, None, measured.as_ref());
+    let core_files = generate::core_files(&p, &roms, &netlist, o, None, measured.as_ref());
     let hdl_files = core_files.len();
 
     // A frame through the core, in the Rust simulator, every pixel against the golden model.

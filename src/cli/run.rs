@@ -245,22 +245,20 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         debug_ports: c.debug_ports,
         clock_mhz: c.target_mhz as f64,
     };
+    // The core, built once: its measured report is checked against it, and its files, its
+    // manifest's latency and the AXI frame's layout are made from it.
+    let core = std::rc::Rc::new(crate::cores::top::core_module_with(&p, &roms, c.debug_ports));
     let measured = match c.measured.as_deref() {
-        Some(f) => Some(crate::fpga::ecp5::measured_core(
-            f,
-            &p,
-            &crate::cores::top::core_module_with(&p, &roms, c.debug_ports),
-            &roms.name,
-        )?),
+        Some(f) => Some(crate::fpga::ecp5::measured_core(f, &p, &core, &roms.name)?),
         None => None,
     };
     let mut files = OutputSet::new();
-    let core = generate::core_files(&p, &roms, o, raygen.as_ref(), measured.as_ref());
-    files.extend(core.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
+    let written = generate::core_files(&p, &roms, &core, o, raygen.as_ref(), measured.as_ref());
+    files.extend(written.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
-        let layout = crate::cores::axis::Layout::of(&crate::cores::top::core_module(&p, &roms));
+        let layout = crate::cores::axis::Layout::of(&core);
         let stream = crate::generate::axis_host::frame_files(&layout, scene, &rays);
         files.extend(stream.into_iter().map(|(n, b)| (c.out.join(n), b)))?;
     }
@@ -377,7 +375,11 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let (results, stats) = match (c.sim, &c.build, &raygen) {
         (Simulation::Rust, _, Some(g)) => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
-            let m = crate::cores::top::core_with_raygen(&p, &roms, g, true);
+            let m = crate::cores::top::core_with_raygen(
+                &p,
+                &std::rc::Rc::new(crate::cores::top::core_module(&p, &roms)),
+                g,
+            );
             let r = frame::collect_batched(&m, rays.len(), p.slot_count(), 0, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r

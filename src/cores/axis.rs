@@ -131,6 +131,10 @@ pub fn part_names(bus: &str, bytes: u32) -> Vec<String> {
 
 /// The core `core` (built by `top::core_module` for `p`) behind AXI4-Stream ports: module
 /// `{core}_axis`.
+/// Clocks the wrapper adds to the core's latency: a result leaves the core into the output
+/// register, which drives `m_axis_res_*`; a ray goes into the core's port the clock it is taken.
+pub const AXIS_ADDED_LATENCY: u64 = 1;
+
 pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
     let layout = Layout::of(core);
     let b = Builder::new(&format!("{}_axis", core.name));

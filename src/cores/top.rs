@@ -426,19 +426,18 @@ fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports
 }
 
 /// The core fed by the on-chip ray generator instead of the ray port (the thesis's demo):
-/// no inputs but the clock and reset; the same result outputs (and observation outputs with
-/// `debug`), every result taken the clock it is shown.
-pub fn core_with_raygen(p: &CoreParams, scene: &SceneRoms, g: &crate::model::raygen::RayGen, debug: bool) -> Module {
+/// no inputs but the clock and reset; the same result outputs as `core` (`core_module_with`,
+/// observation outputs included when it has them), every result taken the clock it is shown.
+pub fn core_with_raygen(p: &CoreParams, core: &Rc<Module>, g: &crate::model::raygen::RayGen) -> Module {
     let mut m = Module::new(&format!("fxrt_core_raygen_{}", p.trav.scene_tag));
     m.std_ports = true;
     let generator = Rc::new(super::raygen::raygen_core(g, p.isect.n, p.isect.m, p.trav.c, p.trav.id_width));
     let ready = m.wire("ready", Ty::BIT);
     let rays = m.instance("u_raygen", &generator, &[ready]);
-    let core = Rc::new(core_module_with(p, scene, debug));
     // Results are taken the clock they are shown.
     let mut ins = rays;
     ins.push(m.konst("res_ready", Ty::BIT, 1));
-    let outs = m.instance("u_core", &core, &ins);
+    let outs = m.instance("u_core", core, &ins);
     for (k, (name, _)) in core.outputs.iter().enumerate() {
         if name == "ray_ready" {
             m.drive(ready, outs[k]);

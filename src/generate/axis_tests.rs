@@ -245,3 +245,39 @@ fn tdata_is_one_port_in_both_languages() {
     assert!(verilog.contains("assign m_axis_res_tdata[127:64] = res_tdata_1;"));
     assert!(s.wrapper.name.ends_with("_axis") && s.wrapper.name.starts_with(&s.wrapper.instances[0].module.name));
 }
+
+/// The wrapper's shortest latency is the core's plus `AXIS_ADDED_LATENCY` (its output
+/// register), the figure its manifest gives: the box-missing ray offered to an idle wrapper
+/// whose sink is always ready, counted from the clock it is taken to the clock its result is
+/// offered.
+#[test]
+fn the_wrapper_adds_its_output_register_to_the_shortest_latency() {
+    use crate::cores::axis::AXIS_ADDED_LATENCY;
+    use crate::verify::disturb::{min_latency, min_latency_ray};
+    let s = setup("cornell", 16, 16);
+    let roms = SceneRoms::of(&s.scene);
+    let core_min = min_latency(&core_module(&s.p, &roms), &s.p, &roms).expect("room on an axis");
+    let m = &s.wrapper;
+    let input = |name: &str| m.handle(*m.inputs.iter().find(|&&i| m.sig(i).name == name).expect(name));
+    let output = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).expect(name).1);
+    let mut sim = Sim::new(m);
+    let bytes = pack_ray(&s.layout, 0, &min_latency_ray(&s.p, &roms).unwrap());
+    for (k, name) in part_names("s_axis_ray_tdata", s.layout.ray_bytes).iter().enumerate() {
+        sim.set(input(name), u64::from_le_bytes(bytes[8 * k..8 * k + 8].try_into().unwrap()) as i128);
+    }
+    sim.set(input("m_axis_res_tready"), 1);
+    let mut taken = None;
+    let latency = (0..10_000u64).find_map(|cycle| {
+        sim.set(input("s_axis_ray_tvalid"), taken.is_none() as i128);
+        sim.eval();
+        if sim.get(output("m_axis_res_tvalid")) == 1 {
+            return Some(cycle - taken.expect("a result after the ray"));
+        }
+        if taken.is_none() && sim.get(output("s_axis_ray_tready")) == 1 {
+            taken = Some(cycle);
+        }
+        sim.tick();
+        None
+    });
+    assert_eq!(latency, Some(core_min + AXIS_ADDED_LATENCY), "the core's shortest latency is {core_min}");
+}

@@ -8,13 +8,14 @@ mod axis_tests;
 
 use crate::cores::axis::{Layout, axis_module};
 use crate::cores::intersect::{IntersectParams, intersect_core};
-use crate::cores::top::{CoreParams, core_module_with, core_with_raygen};
+use crate::cores::top::{CoreParams, core_with_raygen};
 use crate::model::raygen::RayGen;
 use crate::rtl::emit;
 use crate::rtl::netlist::Module;
 use crate::scene::images::SceneRoms;
 use askama::Template;
 use serde_json::{Value, json};
+use std::rc::Rc;
 
 /// The JSON manifest written beside a core's HDL. `latency` is None for the whole core, whose
 /// results come after a number of cycles that depends on the ray.
@@ -130,19 +131,20 @@ pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, Str
     )
 }
 
-/// The whole ray tracing core for a scene (fed by the on-chip ray generator when `raygen` is
-/// given), with manifests for it and for each of its cores.
+/// The whole ray tracing core `core` (`core_module_with(p, roms, o.debug_ports)`, built once
+/// by the caller) for a scene (fed by the on-chip ray generator when `raygen` is given), with
+/// manifests for it and for each of its cores.
 pub fn core_files(
     p: &CoreParams,
     roms: &SceneRoms,
+    core: &Rc<Module>,
     o: GenOptions,
     raygen: Option<&RayGen>,
     measured: Option<&Measured>,
 ) -> Vec<(String, String)> {
-    let core = std::rc::Rc::new(core_module_with(p, roms, o.debug_ports));
     let top = match raygen {
-        Some(g) => core_with_raygen(p, roms, g, o.debug_ports),
-        None => (*core).clone(),
+        Some(g) => core_with_raygen(p, core, g),
+        None => (**core).clone(),
     };
     let core_params = json!({
         "scene": roms.name,
@@ -155,7 +157,7 @@ pub fn core_files(
         "results_in_order": false,
         "result_order": "rays finish out of order; every result carries its ray id (res_id)",
     });
-    let min_latency = crate::verify::disturb::min_latency(p, roms);
+    let min_latency = crate::verify::disturb::min_latency(core, p, roms);
     let mut set = vec![(top, None, core_params.clone())];
     // The core behind AXI4-Stream ports, with the C header of its layout (not for the core
     // fed by its own ray generator, which has no ray port).
@@ -228,6 +230,43 @@ pub fn core_files(
     doc["files"]["verilog_memory_init"] =
         json!(hex.into_iter().filter(|h| h.as_str().is_some_and(written)).collect::<Vec<_>>());
     *file = serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n";
+    if let Some(header) = &axis {
+        let name = format!("{}.json", header.0.trim_end_matches(".h"));
+        if let Some(f) = out.iter_mut().find(|f| f.0 == name) {
+            f.1 = axis_manifest(&f.1, &doc, min_latency, slots + queue + 3);
+        }
+    }
     out.extend(axis);
     out
+}
+
+/// The AXI4-Stream wrapper's manifest `text` with what an integrator needs beyond its ports,
+/// from the core's manifest `core` (its clock, measured resources, reset) and the core's
+/// shortest latency: the wrapper adds `AXIS_ADDED_LATENCY` clocks, and holds `held` rays at
+/// most (the core's, and two in its result register slice).
+fn axis_manifest(text: &str, core: &Value, min_latency: Option<u64>, held: u64) -> String {
+    let mut doc: Value = serde_json::from_str(text).expect("the manifest just written");
+    let added = crate::cores::axis::AXIS_ADDED_LATENCY;
+    doc["latency_cycles"] = json!({
+        "min": min_latency.map(|m| m + added),
+        "min_is": format!("clocks from the clock a ray is taken (s_axis_ray_tvalid and s_axis_ray_tready high) to the first clock its result is offered (m_axis_res_tvalid), for a ray that leaves the scene box at once, in an idle core: the core's minimum plus {added} (the wrapper's output register); every other ray takes longer"),
+        "max": null,
+        "max_bound": "no constant bound: a ray's latency grows with its walk and with the other rays sharing the core, and stops while m_axis_res_tready is low and while a frame's results drain (tlast); `fxrt sim` measures frames",
+    });
+    doc["interface"] = json!({
+        "clock": "clk: every port is sampled and driven at its rising edge (one clock domain)",
+        "reset_cycles": 1,
+        "reset": "rst is synchronous and active high; one clock of it clears the core (see the core's manifest) and the wrapper's frame flag, ray count and result register slice: rays in flight and results not taken are dropped, nothing is transferred in that clock, and the wrapper takes rays from the next clock on",
+        "ray_handshake": "AXI4-Stream: a ray is taken on a clock with s_axis_ray_tvalid and s_axis_ray_tready high; tready comes from registers (the core's ray port, the frame flag and count), with no path from tvalid or tdata",
+        "result_handshake": "AXI4-Stream: a result is taken on a clock with m_axis_res_tvalid and m_axis_res_tready high; tvalid and tdata are registers and hold until taken; tlast is out_valid AND the frame flag AND (count = 1), all registers; m_axis_res_tready reaches only register enables",
+        "rays_held_max": held,
+        "results_in_order": false,
+        "result_order": "rays finish out of order; every result carries its ray id (the id field of tdata)",
+    });
+    doc["clock"] = core["clock"].clone();
+    doc["resources"] = match &core["resources"] {
+        Value::Null => Value::Null,
+        r => json!({ "core": r, "wrapper": "not placed on its own: its registers are register_bits less the core's" }),
+    };
+    serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n"
 }

@@ -172,8 +172,13 @@ fn the_core_with_its_generator_renders_the_golden_frame() {
     let rays: Vec<PixelRay> = (0..cam.width * cam.height)
         .map(|i| PixelRay { pixel: i, ray: rg.ray(&g, i % cam.width, i / cam.width) })
         .collect();
-    let (results, stats) =
-        collect_batched(&core_with_raygen(&p, &roms, &rg, true), rays.len(), p.slot_count(), 0, &|_| {});
+    let (results, stats) = collect_batched(
+        &core_with_raygen(&p, &std::rc::Rc::new(core_module(&p, &roms)), &rg),
+        rays.len(),
+        p.slot_count(),
+        0,
+        &|_| {},
+    );
     assert_eq!(mismatches(&scene, &rays, &results), 0);
     assert!(results.iter().all(|r| r.1.is_some()), "every ray from inside the box hits a wall");
     assert!(stats.busy_cycles > 0);

@@ -12,6 +12,7 @@
 use super::feed::Stalls;
 use super::frame::{CoreResult, CoreStats, OBSERVED, RESULT_PORTS, core_result, port};
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
+use crate::rtl::Module;
 use crate::rtl::sim::Sim;
 use crate::scene::images::SceneRoms;
 use crate::verify::frame::PixelRay;
@@ -127,13 +128,10 @@ pub fn simulate_cycle(
     CycleRun { results, stats, before_reset }
 }
 
-/// The core's shortest latency: clocks from the clock a ray is taken (`ray_valid` and
-/// `ray_ready` high) to the first clock its result is shown (`res_valid`), for a ray that
-/// leaves the scene box at once — its origin just past the box on an axis with room, pointing
-/// away — so the box exit finds it missing and it finishes without a node step, in an idle
-/// core. Every other ray takes longer (it adds node steps, leaves, the pipeline, waits). None
-/// when the box fills the grid on every axis (no such ray exists).
-pub fn min_latency(p: &CoreParams, scene: &SceneRoms) -> Option<u64> {
+/// The ray of the core's shortest latency: its origin just past the scene box on an axis with
+/// room, pointing away, so the box exit finds it missing and it finishes without a node step.
+/// None when the box fills the grid on every axis (no such ray exists).
+pub fn min_latency_ray(p: &CoreParams, scene: &SceneRoms) -> Option<crate::model::golden::GridRay> {
     let n = p.isect.n;
     let axis = (0..3).find(|&a| scene.box_hi[a] + 1 < 1i64 << n)?;
     let mut o = [0i64; 3];
@@ -141,12 +139,19 @@ pub fn min_latency(p: &CoreParams, scene: &SceneRoms) -> Option<u64> {
     // The direction is read by the pipeline only; a tiny positive one on every axis, with
     // its reciprocals saturated as the golden model's are.
     let lim = (1i128 << (p.trav.inv_width() - 1)) - 1;
-    let ray = crate::model::golden::GridRay { o, w: [1; 3], inv: [lim; 3] };
-    let m = core_module(p, scene);
-    let mut sim = Sim::new(&m);
-    let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
-    let (ready, res_valid) = (port(&m, "ray_ready"), port(&m, "res_valid"));
-    sim.set(port(&m, "res_ready"), 1);
+    Some(crate::model::golden::GridRay { o, w: [1; 3], inv: [lim; 3] })
+}
+
+/// The core's shortest latency: clocks from the clock a ray is taken (`ray_valid` and
+/// `ray_ready` high) to the first clock its result is shown (`res_valid`), for
+/// `min_latency_ray` in an idle core `m` (the core of `p`, with or without observation ports).
+/// Every other ray takes longer (it adds node steps, leaves, the pipeline, waits).
+pub fn min_latency(m: &Module, p: &CoreParams, scene: &SceneRoms) -> Option<u64> {
+    let ray = min_latency_ray(p, scene)?;
+    let mut sim = Sim::new(m);
+    let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(m, name)).collect();
+    let (ready, res_valid) = (port(m, "ray_ready"), port(m, "res_valid"));
+    sim.set(port(m, "res_ready"), 1);
     let values = ray_inputs(0, &ray);
     let mut taken = None;
     for cycle in 0..10_000u64 {
@@ -236,7 +241,7 @@ mod tests {
     #[test]
     fn the_shortest_latency_bounds_every_ray() {
         let (_, roms, p, rays) = setup("cornell", 6, 6);
-        let min = min_latency(&p, &roms).expect("the Cornell box leaves room on an axis");
+        let min = min_latency(&core_module(&p, &roms), &p, &roms).expect("the Cornell box leaves room on an axis");
         assert!(min > 10, "{min}");
         for r in rays.iter().take(8) {
             let run = simulate_cycle(&p, &roms, std::slice::from_ref(r), &Stalls::none(), &Disturb::none(), &|_| {});
