@@ -45,7 +45,10 @@ fn main() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
         let roms = SceneRoms::of(&scene);
         let p = match (slots, units) {
-            (Some(s), Some(u)) => CoreParams::with_slots(&roms, 20, 1, 150, s, u),
+            (Some(s), Some(u)) => CoreParams::shaped(
+                &roms,
+                &fxrt::cores::top::CoreSpec { id_width: 20, div_bits: 1, target_mhz: 150, slots: s, units: u },
+            ),
             _ => CoreParams::new(&roms, 20, 1, 150),
         };
         let m = core_module_with(&p, &roms, debug);

@@ -6,7 +6,6 @@
 //! build, or the fast paths disagreeing with the golden model), which is what the fuzzer is to
 //! report.
 
-use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::top::{CoreParams, core_module};
 use crate::error::Result;
 use crate::model::golden::{Golden, GridRay};
@@ -166,7 +165,7 @@ pub fn rom(dir: &Path, data: &[u8]) -> Result<()> {
         }
     }
     let roms = SceneRoms::load(dir)?;
-    let p = CoreParams::with_slots(&roms, 20, 1, DEFAULT_TARGET_MHZ, 1, 1);
+    let p = CoreParams::shaped(&roms, &crate::cores::top::CoreSpec { slots: 1, units: 1, ..Default::default() });
     p.check()?;
     // The netlist's structure depends on the image only through its parameters, edge shift
     // and layouts (the words are constants in it); building and printing a core costs some

@@ -22,7 +22,16 @@ fn cornell(w: u32, h: u32) -> (Scene, SceneRoms, RayGen, CoreParams) {
     let cam = Camera::inside(&scene, w, h, 45.0);
     let g = RayGen::new(&scene, &cam).unwrap();
     let roms = SceneRoms::of(&scene);
-    let p = CoreParams::with_slots(&roms, 12, 1, fxrt::cores::clock::DEFAULT_TARGET_MHZ, 8, 1);
+    let p = CoreParams::shaped(
+        &roms,
+        &fxrt::cores::top::CoreSpec {
+            id_width: 12,
+            div_bits: 1,
+            target_mhz: fxrt::cores::clock::DEFAULT_TARGET_MHZ,
+            slots: 8,
+            units: 1,
+        },
+    );
     (scene, roms, g, p)
 }
 

@@ -42,7 +42,8 @@ fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, (leaf_size, slots, 
     let s = Scene::load(&SceneSource::Builtin(name.into()), &Params { leaf_size, ..Params::default() }).unwrap();
     let roms = SceneRoms::of(&s);
     let cam = Camera::default_for(&s, size, size);
-    let p = CoreParams::with_slots(&roms, 16, 1, target_mhz, slots, units);
+    let p =
+        CoreParams::shaped(&roms, &fxrt::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz, slots, units });
     let rays = frame_rays(&s, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(mismatches(&s, &rays, &results), 0, "{name}");
@@ -84,7 +85,10 @@ fn rust_teapot_small_and_extreme_widths() {
         let params = Params { n, m, t, c, ..Params::default() };
         let s = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
         let roms = SceneRoms::of(&s);
-        let p = CoreParams::with_slots(&roms, 8, 1, DEFAULT, 64, 2);
+        let p = CoreParams::shaped(
+            &roms,
+            &fxrt::cores::top::CoreSpec { id_width: 8, div_bits: 1, target_mhz: DEFAULT, slots: 64, units: 2 },
+        );
         p.check().unwrap();
         let rays = frame_rays(&s, &Camera::default_for(&s, 8, 8));
         let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});

@@ -53,7 +53,10 @@ fn an_interior_at_default_parameters_matches_and_walks_as_specified() {
     let eye = [lo[0] + 0.3 * (hi[0] - lo[0]), at[1], lo[2] + 0.2 * (hi[2] - lo[2])];
     let cam = Camera { eye, at, up: [0.0, 1.0, 0.0], fov_deg: 70.0, width: 24, height: 24 };
     let roms = SceneRoms::of(&scene);
-    let p = CoreParams::with_slots(&roms, 10, 1, 150, 64, 2);
+    let p = CoreParams::shaped(
+        &roms,
+        &fxrt::cores::top::CoreSpec { id_width: 10, div_bits: 1, target_mhz: 150, slots: 64, units: 2 },
+    );
     let rays = frame_rays(&scene, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(mismatches(&scene, &rays, &results), 0);

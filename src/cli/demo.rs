@@ -4,7 +4,7 @@
 //! checked against the golden model, and both pictures are written: the golden model's, shaded,
 //! and the one the hardware's hits make.
 
-use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_with};
+use crate::cores::top::{CoreParams, core_module_with};
 use crate::error::{Error, Result};
 use crate::generate;
 use crate::io::OutputSet;
@@ -38,7 +38,10 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default())?;
     let roms = SceneRoms::of(&scene);
     let target = crate::cores::clock::DEFAULT_TARGET_MHZ;
-    let p = CoreParams::with_slots(&roms, RAY_ID_WIDTH, 1, target, DEFAULT_SLOTS, DEFAULT_UNITS);
+    let p = CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() },
+    );
     p.check()?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     let netlist = std::rc::Rc::new(core_module_with(&p, &roms, false));

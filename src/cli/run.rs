@@ -234,8 +234,16 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         ids_fit(c.ray_id_width, g.width, g.height)?;
     }
     let t = c.threads;
-    let p =
-        crate::cores::top::CoreParams::with_slots(&roms, c.ray_id_width, c.div_bits, c.target_mhz, t.slots, t.units);
+    let p = crate::cores::top::CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec {
+            id_width: c.ray_id_width,
+            div_bits: c.div_bits,
+            target_mhz: c.target_mhz,
+            slots: t.slots,
+            units: t.units,
+        },
+    );
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions {
@@ -304,7 +312,16 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let p = intersect_params(&c.params, &scene, &c.hw)?;
     let roms = SceneRoms::of(&scene);
     let t = c.hw.threads;
-    let core = crate::cores::top::CoreParams::with_slots(&roms, 20, c.hw.div_bits, c.hw.target_mhz, t.slots, t.units);
+    let core = crate::cores::top::CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec {
+            id_width: crate::cores::top::DEFAULT_RAY_ID_WIDTH,
+            div_bits: c.hw.div_bits,
+            target_mhz: c.hw.target_mhz,
+            slots: t.slots,
+            units: t.units,
+        },
+    );
     core.check()?;
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
@@ -358,7 +375,16 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let id_width = rom::addr_bits((w * h) as usize);
     let roms = SceneRoms::of(&scene);
     let t = c.threads;
-    let p = crate::cores::top::CoreParams::with_slots(&roms, id_width, c.div_bits, c.target_mhz, t.slots, t.units);
+    let p = crate::cores::top::CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec {
+            id_width,
+            div_bits: c.div_bits,
+            target_mhz: c.target_mhz,
+            slots: t.slots,
+            units: t.units,
+        },
+    );
     p.check()?;
     let raygen = if c.raygen { Some(RayGen::for_camera(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {

@@ -118,7 +118,16 @@ mod tests {
         let g = Golden::new(&scene);
         let rg = RayGen::new(&scene, &cam).unwrap();
         let roms = SceneRoms::of(&scene);
-        let p = CoreParams::with_slots(&roms, 8, 1, crate::cores::clock::DEFAULT_TARGET_MHZ, 4, 1);
+        let p = CoreParams::shaped(
+            &roms,
+            &crate::cores::top::CoreSpec {
+                id_width: 8,
+                div_bits: 1,
+                target_mhz: crate::cores::clock::DEFAULT_TARGET_MHZ,
+                slots: 4,
+                units: 1,
+            },
+        );
         let core = core_module_with(&p, &roms, false);
         let w = result_widths(&core);
         let golden = frame_checksum(

@@ -52,19 +52,43 @@ pub struct CoreParams {
     pub tri_rom_cycles: u32,
 }
 
+/// What shapes a core besides its scene: the width of its ray ids, the divider's quotient
+/// bits per stage, the clock it is pipelined for, and its ray slots per traversal unit and
+/// units. `Default` is `fxrt gen`'s defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CoreSpec {
+    pub id_width: u32,
+    pub div_bits: u32,
+    pub target_mhz: u32,
+    pub slots: u32,
+    pub units: u32,
+}
+
+/// The ray id width by default (`--ray-id-width`): a 1024 × 1024 frame's pixel numbers.
+pub const DEFAULT_RAY_ID_WIDTH: u32 = 20;
+
+impl Default for CoreSpec {
+    fn default() -> CoreSpec {
+        CoreSpec {
+            id_width: DEFAULT_RAY_ID_WIDTH,
+            div_bits: 1,
+            target_mhz: super::clock::DEFAULT_TARGET_MHZ,
+            slots: DEFAULT_SLOTS,
+            units: DEFAULT_UNITS,
+        }
+    }
+}
+
 impl CoreParams {
+    /// The default shape but for the ray id width, the divider and the clock target.
     pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32, target_mhz: u32) -> CoreParams {
-        Self::with_slots(scene, id_width, div_bits, target_mhz, DEFAULT_SLOTS, DEFAULT_UNITS)
+        Self::shaped(scene, &CoreSpec { id_width, div_bits, target_mhz, ..CoreSpec::default() })
     }
 
-    pub fn with_slots(
-        scene: &SceneRoms,
-        id_width: u32,
-        div_bits: u32,
-        target_mhz: u32,
-        slots: u32,
-        units: u32,
-    ) -> CoreParams {
+    /// The core of `shape` for `scene` (not checked: `check` says what the RTL layer cannot
+    /// hold).
+    pub fn shaped(scene: &SceneRoms, shape: &CoreSpec) -> CoreParams {
+        let CoreSpec { id_width, div_bits, target_mhz, slots, units } = *shape;
         let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
         let tag = TagLayout {

@@ -296,7 +296,10 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
     let (slots, units) = (cfg.shape.slots, cfg.shape.units);
-    let core_params = CoreParams::with_slots(&roms, id_width, 1, extras.target_mhz, slots, units);
+    let core_params = CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width, div_bits: 1, target_mhz: extras.target_mhz, slots, units },
+    );
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         let rays = frame_rays(&scene, &ctx.camera);
         let (results, stats) = simulate_rust(&core_params, &roms, &rays, &Stalls::none(), &|_| {});
@@ -350,7 +353,10 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
 /// shape change: the divider's and the intersection pipeline's latencies, the registers and
 /// the multipliers' pieces. The ROMs do not depend on them.
 fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32, shape: CoreShape) -> CoreCost {
-    let p = CoreParams::with_slots(roms, 20, 1, target_mhz, shape.slots, shape.units);
+    let p = CoreParams::shaped(
+        roms,
+        &crate::cores::top::CoreSpec { target_mhz, slots: shape.slots, units: shape.units, ..Default::default() },
+    );
     let core = core_module_with(&p, roms, false);
     CoreCost {
         div_latency: p.isect.div_latency(),

@@ -23,11 +23,26 @@ use crate::verify::frame::{PixelRay, collect_batched, frame_rays, mismatches, si
 fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
     let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
     let roms = SceneRoms::of(&scene);
-    let err = CoreParams::with_slots(&roms, 16, 1, 150, 33, 3).check().unwrap_err();
+    let err = CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 33, units: 3 },
+    )
+    .check()
+    .unwrap_err();
     assert_eq!(err.subject, "--slots");
     assert!(err.message.contains("99 ray slots, numbered as 3 × 64"), "{err}");
-    CoreParams::with_slots(&roms, 16, 1, 150, 32, 3).check().unwrap();
-    CoreParams::with_slots(&roms, 16, 1, 150, 42, 2).check().unwrap();
+    CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 32, units: 3 },
+    )
+    .check()
+    .unwrap();
+    CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 42, units: 2 },
+    )
+    .check()
+    .unwrap();
 }
 
 #[test]
@@ -78,7 +93,10 @@ fn assert_walks_are_the_culled_golden_walks(
 ) {
     let g = Golden::new(scene);
     let roms = SceneRoms::of(scene);
-    let p = CoreParams::with_slots(&roms, 16, 1, mhz, slots, units);
+    let p = CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: mhz, slots, units },
+    );
     let m = core_module(&p, &roms);
     let mut sim = Sim::new(&m);
     let port = |name: &str| {

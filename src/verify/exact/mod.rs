@@ -105,7 +105,16 @@ pub fn build(case: &mut Case, tris: Vec<Tri>) -> crate::error::Result<Built> {
     let roms = SceneRoms::of(&scene);
     let id_width = crate::scene::rom::addr_bits((cam.width * cam.height) as usize);
     let s = case.shape;
-    let core = CoreParams::with_slots(&roms, id_width, s.div_bits, s.target_mhz, s.slots, s.units);
+    let core = CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec {
+            id_width,
+            div_bits: s.div_bits,
+            target_mhz: s.target_mhz,
+            slots: s.slots,
+            units: s.units,
+        },
+    );
     core.check()?;
     let rays = feed_order(&rays, case.shuffle_seed);
     Ok(Built { scene, roms, core, rays })
