@@ -148,7 +148,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_14;
   wire [0:0] bits_best_valid_15;
   wire [3:0] bits_in_slot;
-  reg [0:0] fin_has_g0_c;
+  wire [0:0] fin_has_g0_c;
   reg [0:0] fin_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_16;
   wire [0:0] bits_best_valid_17;
@@ -167,7 +167,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_30;
   wire [0:0] bits_best_valid_31;
   wire [3:0] bits_in_slot_1;
-  reg [0:0] fin_has_g1_c;
+  wire [0:0] fin_has_g1_c;
   reg [0:0] fin_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_32;
   wire [0:0] bits_best_valid_33;
@@ -186,7 +186,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_46;
   wire [0:0] bits_best_valid_47;
   wire [3:0] bits_in_slot_2;
-  reg [0:0] fin_has_g2_c;
+  wire [0:0] fin_has_g2_c;
   reg [0:0] fin_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_48;
   wire [0:0] bits_best_valid_49;
@@ -205,7 +205,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_62;
   wire [0:0] bits_best_valid_63;
   wire [3:0] bits_in_slot_3;
-  reg [0:0] fin_has_g3_c;
+  wire [0:0] fin_has_g3_c;
   reg [0:0] fin_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_64;
   wire [0:0] bits_best_valid_65;
@@ -224,7 +224,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_78;
   wire [0:0] bits_best_valid_79;
   wire [3:0] bits_in_slot_4;
-  reg [0:0] fin_has_g4_c;
+  wire [0:0] fin_has_g4_c;
   reg [0:0] fin_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_80;
   wire [0:0] bits_best_valid_81;
@@ -243,7 +243,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_94;
   wire [0:0] bits_best_valid_95;
   wire [3:0] bits_in_slot_5;
-  reg [0:0] fin_has_g5_c;
+  wire [0:0] fin_has_g5_c;
   reg [0:0] fin_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_96;
   wire [0:0] bits_best_valid_97;
@@ -262,7 +262,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_110;
   wire [0:0] bits_best_valid_111;
   wire [3:0] bits_in_slot_6;
-  reg [0:0] fin_has_g6_c;
+  wire [0:0] fin_has_g6_c;
   reg [0:0] fin_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_112;
   wire [0:0] bits_best_valid_113;
@@ -281,10 +281,10 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_126;
   wire [0:0] bits_best_valid_127;
   wire [3:0] bits_in_slot_7;
-  reg [0:0] fin_has_g7_c;
+  wire [0:0] fin_has_g7_c;
   reg [0:0] fin_has_g7 = 1'h0;
   wire [2:0] bits_fin_slot;
-  reg [0:0] fin_has_c;
+  wire [0:0] fin_has_c;
   reg [0:0] m1_slot_has = 1'h0;
   reg [0:0] m1_leaf_empty = 1'h0;
   wire [42:0] cat_5;
@@ -348,7 +348,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_142;
   wire [0:0] bits_best_valid_143;
   wire [3:0] bits_done_slot;
-  reg [0:0] done_has_g0_c;
+  wire [0:0] done_has_g0_c;
   reg [0:0] done_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_144;
   wire [0:0] bits_best_valid_145;
@@ -367,7 +367,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_158;
   wire [0:0] bits_best_valid_159;
   wire [3:0] bits_done_slot_1;
-  reg [0:0] done_has_g1_c;
+  wire [0:0] done_has_g1_c;
   reg [0:0] done_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_160;
   wire [0:0] bits_best_valid_161;
@@ -386,7 +386,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_174;
   wire [0:0] bits_best_valid_175;
   wire [3:0] bits_done_slot_2;
-  reg [0:0] done_has_g2_c;
+  wire [0:0] done_has_g2_c;
   reg [0:0] done_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_176;
   wire [0:0] bits_best_valid_177;
@@ -405,7 +405,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_190;
   wire [0:0] bits_best_valid_191;
   wire [3:0] bits_done_slot_3;
-  reg [0:0] done_has_g3_c;
+  wire [0:0] done_has_g3_c;
   reg [0:0] done_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_192;
   wire [0:0] bits_best_valid_193;
@@ -424,7 +424,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_206;
   wire [0:0] bits_best_valid_207;
   wire [3:0] bits_done_slot_4;
-  reg [0:0] done_has_g4_c;
+  wire [0:0] done_has_g4_c;
   reg [0:0] done_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_208;
   wire [0:0] bits_best_valid_209;
@@ -443,7 +443,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_222;
   wire [0:0] bits_best_valid_223;
   wire [3:0] bits_done_slot_5;
-  reg [0:0] done_has_g5_c;
+  wire [0:0] done_has_g5_c;
   reg [0:0] done_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_224;
   wire [0:0] bits_best_valid_225;
@@ -462,7 +462,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_238;
   wire [0:0] bits_best_valid_239;
   wire [3:0] bits_done_slot_6;
-  reg [0:0] done_has_g6_c;
+  wire [0:0] done_has_g6_c;
   reg [0:0] done_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_240;
   wire [0:0] bits_best_valid_241;
@@ -481,10 +481,10 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] bits_best_valid_254;
   wire [0:0] bits_best_valid_255;
   wire [3:0] bits_done_slot_7;
-  reg [0:0] done_has_g7_c;
+  wire [0:0] done_has_g7_c;
   reg [0:0] done_has_g7 = 1'h0;
   wire [2:0] bits_d0_slot;
-  reg [0:0] done_has_c;
+  wire [0:0] done_has_c;
   reg [0:0] d1_has = 1'h0;
   wire [127:0] k_0_1 = 128'h00000000000000000000000000000000;
   wire [6:0] k_127 = 7'h7f;
@@ -961,27 +961,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_14 = best_valid[14];
   assign bits_best_valid_15 = best_valid[15];
   assign bits_in_slot = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot)
-      4'h0: fin_has_g0_c = bits_best_valid;
-      4'h1: fin_has_g0_c = bits_best_valid_1;
-      4'h2: fin_has_g0_c = bits_best_valid_2;
-      4'h3: fin_has_g0_c = bits_best_valid_3;
-      4'h4: fin_has_g0_c = bits_best_valid_4;
-      4'h5: fin_has_g0_c = bits_best_valid_5;
-      4'h6: fin_has_g0_c = bits_best_valid_6;
-      4'h7: fin_has_g0_c = bits_best_valid_7;
-      4'h8: fin_has_g0_c = bits_best_valid_8;
-      4'h9: fin_has_g0_c = bits_best_valid_9;
-      4'ha: fin_has_g0_c = bits_best_valid_10;
-      4'hb: fin_has_g0_c = bits_best_valid_11;
-      4'hc: fin_has_g0_c = bits_best_valid_12;
-      4'hd: fin_has_g0_c = bits_best_valid_13;
-      4'he: fin_has_g0_c = bits_best_valid_14;
-      4'hf: fin_has_g0_c = bits_best_valid_15;
-      default: fin_has_g0_c = k_0;
-    endcase
-  end
+  assign fin_has_g0_c =
+    (bits_in_slot == 4'h0) ? bits_best_valid :
+    (bits_in_slot == 4'h1) ? bits_best_valid_1 :
+    (bits_in_slot == 4'h2) ? bits_best_valid_2 :
+    (bits_in_slot == 4'h3) ? bits_best_valid_3 :
+    (bits_in_slot == 4'h4) ? bits_best_valid_4 :
+    (bits_in_slot == 4'h5) ? bits_best_valid_5 :
+    (bits_in_slot == 4'h6) ? bits_best_valid_6 :
+    (bits_in_slot == 4'h7) ? bits_best_valid_7 :
+    (bits_in_slot == 4'h8) ? bits_best_valid_8 :
+    (bits_in_slot == 4'h9) ? bits_best_valid_9 :
+    (bits_in_slot == 4'ha) ? bits_best_valid_10 :
+    (bits_in_slot == 4'hb) ? bits_best_valid_11 :
+    (bits_in_slot == 4'hc) ? bits_best_valid_12 :
+    (bits_in_slot == 4'hd) ? bits_best_valid_13 :
+    (bits_in_slot == 4'he) ? bits_best_valid_14 :
+    (bits_in_slot == 4'hf) ? bits_best_valid_15 :
+    k_0;
   assign bits_best_valid_16 = best_valid[16];
   assign bits_best_valid_17 = best_valid[17];
   assign bits_best_valid_18 = best_valid[18];
@@ -999,27 +996,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_30 = best_valid[30];
   assign bits_best_valid_31 = best_valid[31];
   assign bits_in_slot_1 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_1)
-      4'h0: fin_has_g1_c = bits_best_valid_16;
-      4'h1: fin_has_g1_c = bits_best_valid_17;
-      4'h2: fin_has_g1_c = bits_best_valid_18;
-      4'h3: fin_has_g1_c = bits_best_valid_19;
-      4'h4: fin_has_g1_c = bits_best_valid_20;
-      4'h5: fin_has_g1_c = bits_best_valid_21;
-      4'h6: fin_has_g1_c = bits_best_valid_22;
-      4'h7: fin_has_g1_c = bits_best_valid_23;
-      4'h8: fin_has_g1_c = bits_best_valid_24;
-      4'h9: fin_has_g1_c = bits_best_valid_25;
-      4'ha: fin_has_g1_c = bits_best_valid_26;
-      4'hb: fin_has_g1_c = bits_best_valid_27;
-      4'hc: fin_has_g1_c = bits_best_valid_28;
-      4'hd: fin_has_g1_c = bits_best_valid_29;
-      4'he: fin_has_g1_c = bits_best_valid_30;
-      4'hf: fin_has_g1_c = bits_best_valid_31;
-      default: fin_has_g1_c = k_0;
-    endcase
-  end
+  assign fin_has_g1_c =
+    (bits_in_slot_1 == 4'h0) ? bits_best_valid_16 :
+    (bits_in_slot_1 == 4'h1) ? bits_best_valid_17 :
+    (bits_in_slot_1 == 4'h2) ? bits_best_valid_18 :
+    (bits_in_slot_1 == 4'h3) ? bits_best_valid_19 :
+    (bits_in_slot_1 == 4'h4) ? bits_best_valid_20 :
+    (bits_in_slot_1 == 4'h5) ? bits_best_valid_21 :
+    (bits_in_slot_1 == 4'h6) ? bits_best_valid_22 :
+    (bits_in_slot_1 == 4'h7) ? bits_best_valid_23 :
+    (bits_in_slot_1 == 4'h8) ? bits_best_valid_24 :
+    (bits_in_slot_1 == 4'h9) ? bits_best_valid_25 :
+    (bits_in_slot_1 == 4'ha) ? bits_best_valid_26 :
+    (bits_in_slot_1 == 4'hb) ? bits_best_valid_27 :
+    (bits_in_slot_1 == 4'hc) ? bits_best_valid_28 :
+    (bits_in_slot_1 == 4'hd) ? bits_best_valid_29 :
+    (bits_in_slot_1 == 4'he) ? bits_best_valid_30 :
+    (bits_in_slot_1 == 4'hf) ? bits_best_valid_31 :
+    k_0;
   assign bits_best_valid_32 = best_valid[32];
   assign bits_best_valid_33 = best_valid[33];
   assign bits_best_valid_34 = best_valid[34];
@@ -1037,27 +1031,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_46 = best_valid[46];
   assign bits_best_valid_47 = best_valid[47];
   assign bits_in_slot_2 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_2)
-      4'h0: fin_has_g2_c = bits_best_valid_32;
-      4'h1: fin_has_g2_c = bits_best_valid_33;
-      4'h2: fin_has_g2_c = bits_best_valid_34;
-      4'h3: fin_has_g2_c = bits_best_valid_35;
-      4'h4: fin_has_g2_c = bits_best_valid_36;
-      4'h5: fin_has_g2_c = bits_best_valid_37;
-      4'h6: fin_has_g2_c = bits_best_valid_38;
-      4'h7: fin_has_g2_c = bits_best_valid_39;
-      4'h8: fin_has_g2_c = bits_best_valid_40;
-      4'h9: fin_has_g2_c = bits_best_valid_41;
-      4'ha: fin_has_g2_c = bits_best_valid_42;
-      4'hb: fin_has_g2_c = bits_best_valid_43;
-      4'hc: fin_has_g2_c = bits_best_valid_44;
-      4'hd: fin_has_g2_c = bits_best_valid_45;
-      4'he: fin_has_g2_c = bits_best_valid_46;
-      4'hf: fin_has_g2_c = bits_best_valid_47;
-      default: fin_has_g2_c = k_0;
-    endcase
-  end
+  assign fin_has_g2_c =
+    (bits_in_slot_2 == 4'h0) ? bits_best_valid_32 :
+    (bits_in_slot_2 == 4'h1) ? bits_best_valid_33 :
+    (bits_in_slot_2 == 4'h2) ? bits_best_valid_34 :
+    (bits_in_slot_2 == 4'h3) ? bits_best_valid_35 :
+    (bits_in_slot_2 == 4'h4) ? bits_best_valid_36 :
+    (bits_in_slot_2 == 4'h5) ? bits_best_valid_37 :
+    (bits_in_slot_2 == 4'h6) ? bits_best_valid_38 :
+    (bits_in_slot_2 == 4'h7) ? bits_best_valid_39 :
+    (bits_in_slot_2 == 4'h8) ? bits_best_valid_40 :
+    (bits_in_slot_2 == 4'h9) ? bits_best_valid_41 :
+    (bits_in_slot_2 == 4'ha) ? bits_best_valid_42 :
+    (bits_in_slot_2 == 4'hb) ? bits_best_valid_43 :
+    (bits_in_slot_2 == 4'hc) ? bits_best_valid_44 :
+    (bits_in_slot_2 == 4'hd) ? bits_best_valid_45 :
+    (bits_in_slot_2 == 4'he) ? bits_best_valid_46 :
+    (bits_in_slot_2 == 4'hf) ? bits_best_valid_47 :
+    k_0;
   assign bits_best_valid_48 = best_valid[48];
   assign bits_best_valid_49 = best_valid[49];
   assign bits_best_valid_50 = best_valid[50];
@@ -1075,27 +1066,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_62 = best_valid[62];
   assign bits_best_valid_63 = best_valid[63];
   assign bits_in_slot_3 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_3)
-      4'h0: fin_has_g3_c = bits_best_valid_48;
-      4'h1: fin_has_g3_c = bits_best_valid_49;
-      4'h2: fin_has_g3_c = bits_best_valid_50;
-      4'h3: fin_has_g3_c = bits_best_valid_51;
-      4'h4: fin_has_g3_c = bits_best_valid_52;
-      4'h5: fin_has_g3_c = bits_best_valid_53;
-      4'h6: fin_has_g3_c = bits_best_valid_54;
-      4'h7: fin_has_g3_c = bits_best_valid_55;
-      4'h8: fin_has_g3_c = bits_best_valid_56;
-      4'h9: fin_has_g3_c = bits_best_valid_57;
-      4'ha: fin_has_g3_c = bits_best_valid_58;
-      4'hb: fin_has_g3_c = bits_best_valid_59;
-      4'hc: fin_has_g3_c = bits_best_valid_60;
-      4'hd: fin_has_g3_c = bits_best_valid_61;
-      4'he: fin_has_g3_c = bits_best_valid_62;
-      4'hf: fin_has_g3_c = bits_best_valid_63;
-      default: fin_has_g3_c = k_0;
-    endcase
-  end
+  assign fin_has_g3_c =
+    (bits_in_slot_3 == 4'h0) ? bits_best_valid_48 :
+    (bits_in_slot_3 == 4'h1) ? bits_best_valid_49 :
+    (bits_in_slot_3 == 4'h2) ? bits_best_valid_50 :
+    (bits_in_slot_3 == 4'h3) ? bits_best_valid_51 :
+    (bits_in_slot_3 == 4'h4) ? bits_best_valid_52 :
+    (bits_in_slot_3 == 4'h5) ? bits_best_valid_53 :
+    (bits_in_slot_3 == 4'h6) ? bits_best_valid_54 :
+    (bits_in_slot_3 == 4'h7) ? bits_best_valid_55 :
+    (bits_in_slot_3 == 4'h8) ? bits_best_valid_56 :
+    (bits_in_slot_3 == 4'h9) ? bits_best_valid_57 :
+    (bits_in_slot_3 == 4'ha) ? bits_best_valid_58 :
+    (bits_in_slot_3 == 4'hb) ? bits_best_valid_59 :
+    (bits_in_slot_3 == 4'hc) ? bits_best_valid_60 :
+    (bits_in_slot_3 == 4'hd) ? bits_best_valid_61 :
+    (bits_in_slot_3 == 4'he) ? bits_best_valid_62 :
+    (bits_in_slot_3 == 4'hf) ? bits_best_valid_63 :
+    k_0;
   assign bits_best_valid_64 = best_valid[64];
   assign bits_best_valid_65 = best_valid[65];
   assign bits_best_valid_66 = best_valid[66];
@@ -1113,27 +1101,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_78 = best_valid[78];
   assign bits_best_valid_79 = best_valid[79];
   assign bits_in_slot_4 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_4)
-      4'h0: fin_has_g4_c = bits_best_valid_64;
-      4'h1: fin_has_g4_c = bits_best_valid_65;
-      4'h2: fin_has_g4_c = bits_best_valid_66;
-      4'h3: fin_has_g4_c = bits_best_valid_67;
-      4'h4: fin_has_g4_c = bits_best_valid_68;
-      4'h5: fin_has_g4_c = bits_best_valid_69;
-      4'h6: fin_has_g4_c = bits_best_valid_70;
-      4'h7: fin_has_g4_c = bits_best_valid_71;
-      4'h8: fin_has_g4_c = bits_best_valid_72;
-      4'h9: fin_has_g4_c = bits_best_valid_73;
-      4'ha: fin_has_g4_c = bits_best_valid_74;
-      4'hb: fin_has_g4_c = bits_best_valid_75;
-      4'hc: fin_has_g4_c = bits_best_valid_76;
-      4'hd: fin_has_g4_c = bits_best_valid_77;
-      4'he: fin_has_g4_c = bits_best_valid_78;
-      4'hf: fin_has_g4_c = bits_best_valid_79;
-      default: fin_has_g4_c = k_0;
-    endcase
-  end
+  assign fin_has_g4_c =
+    (bits_in_slot_4 == 4'h0) ? bits_best_valid_64 :
+    (bits_in_slot_4 == 4'h1) ? bits_best_valid_65 :
+    (bits_in_slot_4 == 4'h2) ? bits_best_valid_66 :
+    (bits_in_slot_4 == 4'h3) ? bits_best_valid_67 :
+    (bits_in_slot_4 == 4'h4) ? bits_best_valid_68 :
+    (bits_in_slot_4 == 4'h5) ? bits_best_valid_69 :
+    (bits_in_slot_4 == 4'h6) ? bits_best_valid_70 :
+    (bits_in_slot_4 == 4'h7) ? bits_best_valid_71 :
+    (bits_in_slot_4 == 4'h8) ? bits_best_valid_72 :
+    (bits_in_slot_4 == 4'h9) ? bits_best_valid_73 :
+    (bits_in_slot_4 == 4'ha) ? bits_best_valid_74 :
+    (bits_in_slot_4 == 4'hb) ? bits_best_valid_75 :
+    (bits_in_slot_4 == 4'hc) ? bits_best_valid_76 :
+    (bits_in_slot_4 == 4'hd) ? bits_best_valid_77 :
+    (bits_in_slot_4 == 4'he) ? bits_best_valid_78 :
+    (bits_in_slot_4 == 4'hf) ? bits_best_valid_79 :
+    k_0;
   assign bits_best_valid_80 = best_valid[80];
   assign bits_best_valid_81 = best_valid[81];
   assign bits_best_valid_82 = best_valid[82];
@@ -1151,27 +1136,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_94 = best_valid[94];
   assign bits_best_valid_95 = best_valid[95];
   assign bits_in_slot_5 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_5)
-      4'h0: fin_has_g5_c = bits_best_valid_80;
-      4'h1: fin_has_g5_c = bits_best_valid_81;
-      4'h2: fin_has_g5_c = bits_best_valid_82;
-      4'h3: fin_has_g5_c = bits_best_valid_83;
-      4'h4: fin_has_g5_c = bits_best_valid_84;
-      4'h5: fin_has_g5_c = bits_best_valid_85;
-      4'h6: fin_has_g5_c = bits_best_valid_86;
-      4'h7: fin_has_g5_c = bits_best_valid_87;
-      4'h8: fin_has_g5_c = bits_best_valid_88;
-      4'h9: fin_has_g5_c = bits_best_valid_89;
-      4'ha: fin_has_g5_c = bits_best_valid_90;
-      4'hb: fin_has_g5_c = bits_best_valid_91;
-      4'hc: fin_has_g5_c = bits_best_valid_92;
-      4'hd: fin_has_g5_c = bits_best_valid_93;
-      4'he: fin_has_g5_c = bits_best_valid_94;
-      4'hf: fin_has_g5_c = bits_best_valid_95;
-      default: fin_has_g5_c = k_0;
-    endcase
-  end
+  assign fin_has_g5_c =
+    (bits_in_slot_5 == 4'h0) ? bits_best_valid_80 :
+    (bits_in_slot_5 == 4'h1) ? bits_best_valid_81 :
+    (bits_in_slot_5 == 4'h2) ? bits_best_valid_82 :
+    (bits_in_slot_5 == 4'h3) ? bits_best_valid_83 :
+    (bits_in_slot_5 == 4'h4) ? bits_best_valid_84 :
+    (bits_in_slot_5 == 4'h5) ? bits_best_valid_85 :
+    (bits_in_slot_5 == 4'h6) ? bits_best_valid_86 :
+    (bits_in_slot_5 == 4'h7) ? bits_best_valid_87 :
+    (bits_in_slot_5 == 4'h8) ? bits_best_valid_88 :
+    (bits_in_slot_5 == 4'h9) ? bits_best_valid_89 :
+    (bits_in_slot_5 == 4'ha) ? bits_best_valid_90 :
+    (bits_in_slot_5 == 4'hb) ? bits_best_valid_91 :
+    (bits_in_slot_5 == 4'hc) ? bits_best_valid_92 :
+    (bits_in_slot_5 == 4'hd) ? bits_best_valid_93 :
+    (bits_in_slot_5 == 4'he) ? bits_best_valid_94 :
+    (bits_in_slot_5 == 4'hf) ? bits_best_valid_95 :
+    k_0;
   assign bits_best_valid_96 = best_valid[96];
   assign bits_best_valid_97 = best_valid[97];
   assign bits_best_valid_98 = best_valid[98];
@@ -1189,27 +1171,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_110 = best_valid[110];
   assign bits_best_valid_111 = best_valid[111];
   assign bits_in_slot_6 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_6)
-      4'h0: fin_has_g6_c = bits_best_valid_96;
-      4'h1: fin_has_g6_c = bits_best_valid_97;
-      4'h2: fin_has_g6_c = bits_best_valid_98;
-      4'h3: fin_has_g6_c = bits_best_valid_99;
-      4'h4: fin_has_g6_c = bits_best_valid_100;
-      4'h5: fin_has_g6_c = bits_best_valid_101;
-      4'h6: fin_has_g6_c = bits_best_valid_102;
-      4'h7: fin_has_g6_c = bits_best_valid_103;
-      4'h8: fin_has_g6_c = bits_best_valid_104;
-      4'h9: fin_has_g6_c = bits_best_valid_105;
-      4'ha: fin_has_g6_c = bits_best_valid_106;
-      4'hb: fin_has_g6_c = bits_best_valid_107;
-      4'hc: fin_has_g6_c = bits_best_valid_108;
-      4'hd: fin_has_g6_c = bits_best_valid_109;
-      4'he: fin_has_g6_c = bits_best_valid_110;
-      4'hf: fin_has_g6_c = bits_best_valid_111;
-      default: fin_has_g6_c = k_0;
-    endcase
-  end
+  assign fin_has_g6_c =
+    (bits_in_slot_6 == 4'h0) ? bits_best_valid_96 :
+    (bits_in_slot_6 == 4'h1) ? bits_best_valid_97 :
+    (bits_in_slot_6 == 4'h2) ? bits_best_valid_98 :
+    (bits_in_slot_6 == 4'h3) ? bits_best_valid_99 :
+    (bits_in_slot_6 == 4'h4) ? bits_best_valid_100 :
+    (bits_in_slot_6 == 4'h5) ? bits_best_valid_101 :
+    (bits_in_slot_6 == 4'h6) ? bits_best_valid_102 :
+    (bits_in_slot_6 == 4'h7) ? bits_best_valid_103 :
+    (bits_in_slot_6 == 4'h8) ? bits_best_valid_104 :
+    (bits_in_slot_6 == 4'h9) ? bits_best_valid_105 :
+    (bits_in_slot_6 == 4'ha) ? bits_best_valid_106 :
+    (bits_in_slot_6 == 4'hb) ? bits_best_valid_107 :
+    (bits_in_slot_6 == 4'hc) ? bits_best_valid_108 :
+    (bits_in_slot_6 == 4'hd) ? bits_best_valid_109 :
+    (bits_in_slot_6 == 4'he) ? bits_best_valid_110 :
+    (bits_in_slot_6 == 4'hf) ? bits_best_valid_111 :
+    k_0;
   assign bits_best_valid_112 = best_valid[112];
   assign bits_best_valid_113 = best_valid[113];
   assign bits_best_valid_114 = best_valid[114];
@@ -1227,41 +1206,35 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_126 = best_valid[126];
   assign bits_best_valid_127 = best_valid[127];
   assign bits_in_slot_7 = in_slot[3:0];
-  always @* begin
-    case (bits_in_slot_7)
-      4'h0: fin_has_g7_c = bits_best_valid_112;
-      4'h1: fin_has_g7_c = bits_best_valid_113;
-      4'h2: fin_has_g7_c = bits_best_valid_114;
-      4'h3: fin_has_g7_c = bits_best_valid_115;
-      4'h4: fin_has_g7_c = bits_best_valid_116;
-      4'h5: fin_has_g7_c = bits_best_valid_117;
-      4'h6: fin_has_g7_c = bits_best_valid_118;
-      4'h7: fin_has_g7_c = bits_best_valid_119;
-      4'h8: fin_has_g7_c = bits_best_valid_120;
-      4'h9: fin_has_g7_c = bits_best_valid_121;
-      4'ha: fin_has_g7_c = bits_best_valid_122;
-      4'hb: fin_has_g7_c = bits_best_valid_123;
-      4'hc: fin_has_g7_c = bits_best_valid_124;
-      4'hd: fin_has_g7_c = bits_best_valid_125;
-      4'he: fin_has_g7_c = bits_best_valid_126;
-      4'hf: fin_has_g7_c = bits_best_valid_127;
-      default: fin_has_g7_c = k_0;
-    endcase
-  end
+  assign fin_has_g7_c =
+    (bits_in_slot_7 == 4'h0) ? bits_best_valid_112 :
+    (bits_in_slot_7 == 4'h1) ? bits_best_valid_113 :
+    (bits_in_slot_7 == 4'h2) ? bits_best_valid_114 :
+    (bits_in_slot_7 == 4'h3) ? bits_best_valid_115 :
+    (bits_in_slot_7 == 4'h4) ? bits_best_valid_116 :
+    (bits_in_slot_7 == 4'h5) ? bits_best_valid_117 :
+    (bits_in_slot_7 == 4'h6) ? bits_best_valid_118 :
+    (bits_in_slot_7 == 4'h7) ? bits_best_valid_119 :
+    (bits_in_slot_7 == 4'h8) ? bits_best_valid_120 :
+    (bits_in_slot_7 == 4'h9) ? bits_best_valid_121 :
+    (bits_in_slot_7 == 4'ha) ? bits_best_valid_122 :
+    (bits_in_slot_7 == 4'hb) ? bits_best_valid_123 :
+    (bits_in_slot_7 == 4'hc) ? bits_best_valid_124 :
+    (bits_in_slot_7 == 4'hd) ? bits_best_valid_125 :
+    (bits_in_slot_7 == 4'he) ? bits_best_valid_126 :
+    (bits_in_slot_7 == 4'hf) ? bits_best_valid_127 :
+    k_0;
   assign bits_fin_slot = fin_slot[6:4];
-  always @* begin
-    case (bits_fin_slot)
-      3'h0: fin_has_c = fin_has_g0;
-      3'h1: fin_has_c = fin_has_g1;
-      3'h2: fin_has_c = fin_has_g2;
-      3'h3: fin_has_c = fin_has_g3;
-      3'h4: fin_has_c = fin_has_g4;
-      3'h5: fin_has_c = fin_has_g5;
-      3'h6: fin_has_c = fin_has_g6;
-      3'h7: fin_has_c = fin_has_g7;
-      default: fin_has_c = k_0;
-    endcase
-  end
+  assign fin_has_c =
+    (bits_fin_slot == 3'h0) ? fin_has_g0 :
+    (bits_fin_slot == 3'h1) ? fin_has_g1 :
+    (bits_fin_slot == 3'h2) ? fin_has_g2 :
+    (bits_fin_slot == 3'h3) ? fin_has_g3 :
+    (bits_fin_slot == 3'h4) ? fin_has_g4 :
+    (bits_fin_slot == 3'h5) ? fin_has_g5 :
+    (bits_fin_slot == 3'h6) ? fin_has_g6 :
+    (bits_fin_slot == 3'h7) ? fin_has_g7 :
+    k_0;
   assign cat_5 = {acc_t, acc_tri};
   assign cat_6 = {acc_u, acc_v};
   assign cat_7 = {m1_leaf_empty, k_0, m1_t_tri};
@@ -1298,27 +1271,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_142 = best_valid[14];
   assign bits_best_valid_143 = best_valid[15];
   assign bits_done_slot = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot)
-      4'h0: done_has_g0_c = bits_best_valid_128;
-      4'h1: done_has_g0_c = bits_best_valid_129;
-      4'h2: done_has_g0_c = bits_best_valid_130;
-      4'h3: done_has_g0_c = bits_best_valid_131;
-      4'h4: done_has_g0_c = bits_best_valid_132;
-      4'h5: done_has_g0_c = bits_best_valid_133;
-      4'h6: done_has_g0_c = bits_best_valid_134;
-      4'h7: done_has_g0_c = bits_best_valid_135;
-      4'h8: done_has_g0_c = bits_best_valid_136;
-      4'h9: done_has_g0_c = bits_best_valid_137;
-      4'ha: done_has_g0_c = bits_best_valid_138;
-      4'hb: done_has_g0_c = bits_best_valid_139;
-      4'hc: done_has_g0_c = bits_best_valid_140;
-      4'hd: done_has_g0_c = bits_best_valid_141;
-      4'he: done_has_g0_c = bits_best_valid_142;
-      4'hf: done_has_g0_c = bits_best_valid_143;
-      default: done_has_g0_c = k_0;
-    endcase
-  end
+  assign done_has_g0_c =
+    (bits_done_slot == 4'h0) ? bits_best_valid_128 :
+    (bits_done_slot == 4'h1) ? bits_best_valid_129 :
+    (bits_done_slot == 4'h2) ? bits_best_valid_130 :
+    (bits_done_slot == 4'h3) ? bits_best_valid_131 :
+    (bits_done_slot == 4'h4) ? bits_best_valid_132 :
+    (bits_done_slot == 4'h5) ? bits_best_valid_133 :
+    (bits_done_slot == 4'h6) ? bits_best_valid_134 :
+    (bits_done_slot == 4'h7) ? bits_best_valid_135 :
+    (bits_done_slot == 4'h8) ? bits_best_valid_136 :
+    (bits_done_slot == 4'h9) ? bits_best_valid_137 :
+    (bits_done_slot == 4'ha) ? bits_best_valid_138 :
+    (bits_done_slot == 4'hb) ? bits_best_valid_139 :
+    (bits_done_slot == 4'hc) ? bits_best_valid_140 :
+    (bits_done_slot == 4'hd) ? bits_best_valid_141 :
+    (bits_done_slot == 4'he) ? bits_best_valid_142 :
+    (bits_done_slot == 4'hf) ? bits_best_valid_143 :
+    k_0;
   assign bits_best_valid_144 = best_valid[16];
   assign bits_best_valid_145 = best_valid[17];
   assign bits_best_valid_146 = best_valid[18];
@@ -1336,27 +1306,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_158 = best_valid[30];
   assign bits_best_valid_159 = best_valid[31];
   assign bits_done_slot_1 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_1)
-      4'h0: done_has_g1_c = bits_best_valid_144;
-      4'h1: done_has_g1_c = bits_best_valid_145;
-      4'h2: done_has_g1_c = bits_best_valid_146;
-      4'h3: done_has_g1_c = bits_best_valid_147;
-      4'h4: done_has_g1_c = bits_best_valid_148;
-      4'h5: done_has_g1_c = bits_best_valid_149;
-      4'h6: done_has_g1_c = bits_best_valid_150;
-      4'h7: done_has_g1_c = bits_best_valid_151;
-      4'h8: done_has_g1_c = bits_best_valid_152;
-      4'h9: done_has_g1_c = bits_best_valid_153;
-      4'ha: done_has_g1_c = bits_best_valid_154;
-      4'hb: done_has_g1_c = bits_best_valid_155;
-      4'hc: done_has_g1_c = bits_best_valid_156;
-      4'hd: done_has_g1_c = bits_best_valid_157;
-      4'he: done_has_g1_c = bits_best_valid_158;
-      4'hf: done_has_g1_c = bits_best_valid_159;
-      default: done_has_g1_c = k_0;
-    endcase
-  end
+  assign done_has_g1_c =
+    (bits_done_slot_1 == 4'h0) ? bits_best_valid_144 :
+    (bits_done_slot_1 == 4'h1) ? bits_best_valid_145 :
+    (bits_done_slot_1 == 4'h2) ? bits_best_valid_146 :
+    (bits_done_slot_1 == 4'h3) ? bits_best_valid_147 :
+    (bits_done_slot_1 == 4'h4) ? bits_best_valid_148 :
+    (bits_done_slot_1 == 4'h5) ? bits_best_valid_149 :
+    (bits_done_slot_1 == 4'h6) ? bits_best_valid_150 :
+    (bits_done_slot_1 == 4'h7) ? bits_best_valid_151 :
+    (bits_done_slot_1 == 4'h8) ? bits_best_valid_152 :
+    (bits_done_slot_1 == 4'h9) ? bits_best_valid_153 :
+    (bits_done_slot_1 == 4'ha) ? bits_best_valid_154 :
+    (bits_done_slot_1 == 4'hb) ? bits_best_valid_155 :
+    (bits_done_slot_1 == 4'hc) ? bits_best_valid_156 :
+    (bits_done_slot_1 == 4'hd) ? bits_best_valid_157 :
+    (bits_done_slot_1 == 4'he) ? bits_best_valid_158 :
+    (bits_done_slot_1 == 4'hf) ? bits_best_valid_159 :
+    k_0;
   assign bits_best_valid_160 = best_valid[32];
   assign bits_best_valid_161 = best_valid[33];
   assign bits_best_valid_162 = best_valid[34];
@@ -1374,27 +1341,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_174 = best_valid[46];
   assign bits_best_valid_175 = best_valid[47];
   assign bits_done_slot_2 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_2)
-      4'h0: done_has_g2_c = bits_best_valid_160;
-      4'h1: done_has_g2_c = bits_best_valid_161;
-      4'h2: done_has_g2_c = bits_best_valid_162;
-      4'h3: done_has_g2_c = bits_best_valid_163;
-      4'h4: done_has_g2_c = bits_best_valid_164;
-      4'h5: done_has_g2_c = bits_best_valid_165;
-      4'h6: done_has_g2_c = bits_best_valid_166;
-      4'h7: done_has_g2_c = bits_best_valid_167;
-      4'h8: done_has_g2_c = bits_best_valid_168;
-      4'h9: done_has_g2_c = bits_best_valid_169;
-      4'ha: done_has_g2_c = bits_best_valid_170;
-      4'hb: done_has_g2_c = bits_best_valid_171;
-      4'hc: done_has_g2_c = bits_best_valid_172;
-      4'hd: done_has_g2_c = bits_best_valid_173;
-      4'he: done_has_g2_c = bits_best_valid_174;
-      4'hf: done_has_g2_c = bits_best_valid_175;
-      default: done_has_g2_c = k_0;
-    endcase
-  end
+  assign done_has_g2_c =
+    (bits_done_slot_2 == 4'h0) ? bits_best_valid_160 :
+    (bits_done_slot_2 == 4'h1) ? bits_best_valid_161 :
+    (bits_done_slot_2 == 4'h2) ? bits_best_valid_162 :
+    (bits_done_slot_2 == 4'h3) ? bits_best_valid_163 :
+    (bits_done_slot_2 == 4'h4) ? bits_best_valid_164 :
+    (bits_done_slot_2 == 4'h5) ? bits_best_valid_165 :
+    (bits_done_slot_2 == 4'h6) ? bits_best_valid_166 :
+    (bits_done_slot_2 == 4'h7) ? bits_best_valid_167 :
+    (bits_done_slot_2 == 4'h8) ? bits_best_valid_168 :
+    (bits_done_slot_2 == 4'h9) ? bits_best_valid_169 :
+    (bits_done_slot_2 == 4'ha) ? bits_best_valid_170 :
+    (bits_done_slot_2 == 4'hb) ? bits_best_valid_171 :
+    (bits_done_slot_2 == 4'hc) ? bits_best_valid_172 :
+    (bits_done_slot_2 == 4'hd) ? bits_best_valid_173 :
+    (bits_done_slot_2 == 4'he) ? bits_best_valid_174 :
+    (bits_done_slot_2 == 4'hf) ? bits_best_valid_175 :
+    k_0;
   assign bits_best_valid_176 = best_valid[48];
   assign bits_best_valid_177 = best_valid[49];
   assign bits_best_valid_178 = best_valid[50];
@@ -1412,27 +1376,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_190 = best_valid[62];
   assign bits_best_valid_191 = best_valid[63];
   assign bits_done_slot_3 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_3)
-      4'h0: done_has_g3_c = bits_best_valid_176;
-      4'h1: done_has_g3_c = bits_best_valid_177;
-      4'h2: done_has_g3_c = bits_best_valid_178;
-      4'h3: done_has_g3_c = bits_best_valid_179;
-      4'h4: done_has_g3_c = bits_best_valid_180;
-      4'h5: done_has_g3_c = bits_best_valid_181;
-      4'h6: done_has_g3_c = bits_best_valid_182;
-      4'h7: done_has_g3_c = bits_best_valid_183;
-      4'h8: done_has_g3_c = bits_best_valid_184;
-      4'h9: done_has_g3_c = bits_best_valid_185;
-      4'ha: done_has_g3_c = bits_best_valid_186;
-      4'hb: done_has_g3_c = bits_best_valid_187;
-      4'hc: done_has_g3_c = bits_best_valid_188;
-      4'hd: done_has_g3_c = bits_best_valid_189;
-      4'he: done_has_g3_c = bits_best_valid_190;
-      4'hf: done_has_g3_c = bits_best_valid_191;
-      default: done_has_g3_c = k_0;
-    endcase
-  end
+  assign done_has_g3_c =
+    (bits_done_slot_3 == 4'h0) ? bits_best_valid_176 :
+    (bits_done_slot_3 == 4'h1) ? bits_best_valid_177 :
+    (bits_done_slot_3 == 4'h2) ? bits_best_valid_178 :
+    (bits_done_slot_3 == 4'h3) ? bits_best_valid_179 :
+    (bits_done_slot_3 == 4'h4) ? bits_best_valid_180 :
+    (bits_done_slot_3 == 4'h5) ? bits_best_valid_181 :
+    (bits_done_slot_3 == 4'h6) ? bits_best_valid_182 :
+    (bits_done_slot_3 == 4'h7) ? bits_best_valid_183 :
+    (bits_done_slot_3 == 4'h8) ? bits_best_valid_184 :
+    (bits_done_slot_3 == 4'h9) ? bits_best_valid_185 :
+    (bits_done_slot_3 == 4'ha) ? bits_best_valid_186 :
+    (bits_done_slot_3 == 4'hb) ? bits_best_valid_187 :
+    (bits_done_slot_3 == 4'hc) ? bits_best_valid_188 :
+    (bits_done_slot_3 == 4'hd) ? bits_best_valid_189 :
+    (bits_done_slot_3 == 4'he) ? bits_best_valid_190 :
+    (bits_done_slot_3 == 4'hf) ? bits_best_valid_191 :
+    k_0;
   assign bits_best_valid_192 = best_valid[64];
   assign bits_best_valid_193 = best_valid[65];
   assign bits_best_valid_194 = best_valid[66];
@@ -1450,27 +1411,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_206 = best_valid[78];
   assign bits_best_valid_207 = best_valid[79];
   assign bits_done_slot_4 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_4)
-      4'h0: done_has_g4_c = bits_best_valid_192;
-      4'h1: done_has_g4_c = bits_best_valid_193;
-      4'h2: done_has_g4_c = bits_best_valid_194;
-      4'h3: done_has_g4_c = bits_best_valid_195;
-      4'h4: done_has_g4_c = bits_best_valid_196;
-      4'h5: done_has_g4_c = bits_best_valid_197;
-      4'h6: done_has_g4_c = bits_best_valid_198;
-      4'h7: done_has_g4_c = bits_best_valid_199;
-      4'h8: done_has_g4_c = bits_best_valid_200;
-      4'h9: done_has_g4_c = bits_best_valid_201;
-      4'ha: done_has_g4_c = bits_best_valid_202;
-      4'hb: done_has_g4_c = bits_best_valid_203;
-      4'hc: done_has_g4_c = bits_best_valid_204;
-      4'hd: done_has_g4_c = bits_best_valid_205;
-      4'he: done_has_g4_c = bits_best_valid_206;
-      4'hf: done_has_g4_c = bits_best_valid_207;
-      default: done_has_g4_c = k_0;
-    endcase
-  end
+  assign done_has_g4_c =
+    (bits_done_slot_4 == 4'h0) ? bits_best_valid_192 :
+    (bits_done_slot_4 == 4'h1) ? bits_best_valid_193 :
+    (bits_done_slot_4 == 4'h2) ? bits_best_valid_194 :
+    (bits_done_slot_4 == 4'h3) ? bits_best_valid_195 :
+    (bits_done_slot_4 == 4'h4) ? bits_best_valid_196 :
+    (bits_done_slot_4 == 4'h5) ? bits_best_valid_197 :
+    (bits_done_slot_4 == 4'h6) ? bits_best_valid_198 :
+    (bits_done_slot_4 == 4'h7) ? bits_best_valid_199 :
+    (bits_done_slot_4 == 4'h8) ? bits_best_valid_200 :
+    (bits_done_slot_4 == 4'h9) ? bits_best_valid_201 :
+    (bits_done_slot_4 == 4'ha) ? bits_best_valid_202 :
+    (bits_done_slot_4 == 4'hb) ? bits_best_valid_203 :
+    (bits_done_slot_4 == 4'hc) ? bits_best_valid_204 :
+    (bits_done_slot_4 == 4'hd) ? bits_best_valid_205 :
+    (bits_done_slot_4 == 4'he) ? bits_best_valid_206 :
+    (bits_done_slot_4 == 4'hf) ? bits_best_valid_207 :
+    k_0;
   assign bits_best_valid_208 = best_valid[80];
   assign bits_best_valid_209 = best_valid[81];
   assign bits_best_valid_210 = best_valid[82];
@@ -1488,27 +1446,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_222 = best_valid[94];
   assign bits_best_valid_223 = best_valid[95];
   assign bits_done_slot_5 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_5)
-      4'h0: done_has_g5_c = bits_best_valid_208;
-      4'h1: done_has_g5_c = bits_best_valid_209;
-      4'h2: done_has_g5_c = bits_best_valid_210;
-      4'h3: done_has_g5_c = bits_best_valid_211;
-      4'h4: done_has_g5_c = bits_best_valid_212;
-      4'h5: done_has_g5_c = bits_best_valid_213;
-      4'h6: done_has_g5_c = bits_best_valid_214;
-      4'h7: done_has_g5_c = bits_best_valid_215;
-      4'h8: done_has_g5_c = bits_best_valid_216;
-      4'h9: done_has_g5_c = bits_best_valid_217;
-      4'ha: done_has_g5_c = bits_best_valid_218;
-      4'hb: done_has_g5_c = bits_best_valid_219;
-      4'hc: done_has_g5_c = bits_best_valid_220;
-      4'hd: done_has_g5_c = bits_best_valid_221;
-      4'he: done_has_g5_c = bits_best_valid_222;
-      4'hf: done_has_g5_c = bits_best_valid_223;
-      default: done_has_g5_c = k_0;
-    endcase
-  end
+  assign done_has_g5_c =
+    (bits_done_slot_5 == 4'h0) ? bits_best_valid_208 :
+    (bits_done_slot_5 == 4'h1) ? bits_best_valid_209 :
+    (bits_done_slot_5 == 4'h2) ? bits_best_valid_210 :
+    (bits_done_slot_5 == 4'h3) ? bits_best_valid_211 :
+    (bits_done_slot_5 == 4'h4) ? bits_best_valid_212 :
+    (bits_done_slot_5 == 4'h5) ? bits_best_valid_213 :
+    (bits_done_slot_5 == 4'h6) ? bits_best_valid_214 :
+    (bits_done_slot_5 == 4'h7) ? bits_best_valid_215 :
+    (bits_done_slot_5 == 4'h8) ? bits_best_valid_216 :
+    (bits_done_slot_5 == 4'h9) ? bits_best_valid_217 :
+    (bits_done_slot_5 == 4'ha) ? bits_best_valid_218 :
+    (bits_done_slot_5 == 4'hb) ? bits_best_valid_219 :
+    (bits_done_slot_5 == 4'hc) ? bits_best_valid_220 :
+    (bits_done_slot_5 == 4'hd) ? bits_best_valid_221 :
+    (bits_done_slot_5 == 4'he) ? bits_best_valid_222 :
+    (bits_done_slot_5 == 4'hf) ? bits_best_valid_223 :
+    k_0;
   assign bits_best_valid_224 = best_valid[96];
   assign bits_best_valid_225 = best_valid[97];
   assign bits_best_valid_226 = best_valid[98];
@@ -1526,27 +1481,24 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_238 = best_valid[110];
   assign bits_best_valid_239 = best_valid[111];
   assign bits_done_slot_6 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_6)
-      4'h0: done_has_g6_c = bits_best_valid_224;
-      4'h1: done_has_g6_c = bits_best_valid_225;
-      4'h2: done_has_g6_c = bits_best_valid_226;
-      4'h3: done_has_g6_c = bits_best_valid_227;
-      4'h4: done_has_g6_c = bits_best_valid_228;
-      4'h5: done_has_g6_c = bits_best_valid_229;
-      4'h6: done_has_g6_c = bits_best_valid_230;
-      4'h7: done_has_g6_c = bits_best_valid_231;
-      4'h8: done_has_g6_c = bits_best_valid_232;
-      4'h9: done_has_g6_c = bits_best_valid_233;
-      4'ha: done_has_g6_c = bits_best_valid_234;
-      4'hb: done_has_g6_c = bits_best_valid_235;
-      4'hc: done_has_g6_c = bits_best_valid_236;
-      4'hd: done_has_g6_c = bits_best_valid_237;
-      4'he: done_has_g6_c = bits_best_valid_238;
-      4'hf: done_has_g6_c = bits_best_valid_239;
-      default: done_has_g6_c = k_0;
-    endcase
-  end
+  assign done_has_g6_c =
+    (bits_done_slot_6 == 4'h0) ? bits_best_valid_224 :
+    (bits_done_slot_6 == 4'h1) ? bits_best_valid_225 :
+    (bits_done_slot_6 == 4'h2) ? bits_best_valid_226 :
+    (bits_done_slot_6 == 4'h3) ? bits_best_valid_227 :
+    (bits_done_slot_6 == 4'h4) ? bits_best_valid_228 :
+    (bits_done_slot_6 == 4'h5) ? bits_best_valid_229 :
+    (bits_done_slot_6 == 4'h6) ? bits_best_valid_230 :
+    (bits_done_slot_6 == 4'h7) ? bits_best_valid_231 :
+    (bits_done_slot_6 == 4'h8) ? bits_best_valid_232 :
+    (bits_done_slot_6 == 4'h9) ? bits_best_valid_233 :
+    (bits_done_slot_6 == 4'ha) ? bits_best_valid_234 :
+    (bits_done_slot_6 == 4'hb) ? bits_best_valid_235 :
+    (bits_done_slot_6 == 4'hc) ? bits_best_valid_236 :
+    (bits_done_slot_6 == 4'hd) ? bits_best_valid_237 :
+    (bits_done_slot_6 == 4'he) ? bits_best_valid_238 :
+    (bits_done_slot_6 == 4'hf) ? bits_best_valid_239 :
+    k_0;
   assign bits_best_valid_240 = best_valid[112];
   assign bits_best_valid_241 = best_valid[113];
   assign bits_best_valid_242 = best_valid[114];
@@ -1564,41 +1516,35 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign bits_best_valid_254 = best_valid[126];
   assign bits_best_valid_255 = best_valid[127];
   assign bits_done_slot_7 = done_slot[3:0];
-  always @* begin
-    case (bits_done_slot_7)
-      4'h0: done_has_g7_c = bits_best_valid_240;
-      4'h1: done_has_g7_c = bits_best_valid_241;
-      4'h2: done_has_g7_c = bits_best_valid_242;
-      4'h3: done_has_g7_c = bits_best_valid_243;
-      4'h4: done_has_g7_c = bits_best_valid_244;
-      4'h5: done_has_g7_c = bits_best_valid_245;
-      4'h6: done_has_g7_c = bits_best_valid_246;
-      4'h7: done_has_g7_c = bits_best_valid_247;
-      4'h8: done_has_g7_c = bits_best_valid_248;
-      4'h9: done_has_g7_c = bits_best_valid_249;
-      4'ha: done_has_g7_c = bits_best_valid_250;
-      4'hb: done_has_g7_c = bits_best_valid_251;
-      4'hc: done_has_g7_c = bits_best_valid_252;
-      4'hd: done_has_g7_c = bits_best_valid_253;
-      4'he: done_has_g7_c = bits_best_valid_254;
-      4'hf: done_has_g7_c = bits_best_valid_255;
-      default: done_has_g7_c = k_0;
-    endcase
-  end
+  assign done_has_g7_c =
+    (bits_done_slot_7 == 4'h0) ? bits_best_valid_240 :
+    (bits_done_slot_7 == 4'h1) ? bits_best_valid_241 :
+    (bits_done_slot_7 == 4'h2) ? bits_best_valid_242 :
+    (bits_done_slot_7 == 4'h3) ? bits_best_valid_243 :
+    (bits_done_slot_7 == 4'h4) ? bits_best_valid_244 :
+    (bits_done_slot_7 == 4'h5) ? bits_best_valid_245 :
+    (bits_done_slot_7 == 4'h6) ? bits_best_valid_246 :
+    (bits_done_slot_7 == 4'h7) ? bits_best_valid_247 :
+    (bits_done_slot_7 == 4'h8) ? bits_best_valid_248 :
+    (bits_done_slot_7 == 4'h9) ? bits_best_valid_249 :
+    (bits_done_slot_7 == 4'ha) ? bits_best_valid_250 :
+    (bits_done_slot_7 == 4'hb) ? bits_best_valid_251 :
+    (bits_done_slot_7 == 4'hc) ? bits_best_valid_252 :
+    (bits_done_slot_7 == 4'hd) ? bits_best_valid_253 :
+    (bits_done_slot_7 == 4'he) ? bits_best_valid_254 :
+    (bits_done_slot_7 == 4'hf) ? bits_best_valid_255 :
+    k_0;
   assign bits_d0_slot = d0_slot[6:4];
-  always @* begin
-    case (bits_d0_slot)
-      3'h0: done_has_c = done_has_g0;
-      3'h1: done_has_c = done_has_g1;
-      3'h2: done_has_c = done_has_g2;
-      3'h3: done_has_c = done_has_g3;
-      3'h4: done_has_c = done_has_g4;
-      3'h5: done_has_c = done_has_g5;
-      3'h6: done_has_c = done_has_g6;
-      3'h7: done_has_c = done_has_g7;
-      default: done_has_c = k_0;
-    endcase
-  end
+  assign done_has_c =
+    (bits_d0_slot == 3'h0) ? done_has_g0 :
+    (bits_d0_slot == 3'h1) ? done_has_g1 :
+    (bits_d0_slot == 3'h2) ? done_has_g2 :
+    (bits_d0_slot == 3'h3) ? done_has_g3 :
+    (bits_d0_slot == 3'h4) ? done_has_g4 :
+    (bits_d0_slot == 3'h5) ? done_has_g5 :
+    (bits_d0_slot == 3'h6) ? done_has_g6 :
+    (bits_d0_slot == 3'h7) ? done_has_g7 :
+    k_0;
   assign m1_slot_eq_k_127 = m1_slot == k_127;
   assign m1_slot_eq_k_126 = m1_slot == k_126;
   assign m1_slot_eq_k_125 = m1_slot == k_125;

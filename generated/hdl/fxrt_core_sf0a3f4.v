@@ -37,6 +37,9 @@ module fxrt_core_sf0a3f4 (
   (* ram_style = "distributed" *) reg [63:0] res_q_mem1 [0:15];
   initial $readmemh("fxrt_core_sf0a3f4_res_q_mem1.hex", res_q_mem1);
 
+  // not in a stage or state machine
+
+  // stage ray_port: the ray port's register, the unit whose turn it is, the take (a ray per 4 clocks)
   wire [0:0] u0_has_free;
   wire [0:0] u1_has_free;
   wire [5:0] u0_free_slot;
@@ -46,7 +49,7 @@ module fxrt_core_sf0a3f4 (
   reg [5:0] u0_free_slot_r = 6'h00;
   reg [5:0] u1_free_slot_r = 6'h00;
   reg [0:0] turn_free = 1'h1;
-  reg [5:0] case_turn;
+  wire [5:0] case_turn;
   reg [0:0] in_valid = 1'h0;
   wire [1:0] k_0 = 2'h0;
   wire [0:0] box_phase_eq_k_0;
@@ -74,7 +77,7 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] take_or_not_turn_free;
   wire [0:0] turn_next;
   wire [0:0] k_0_1 = 1'h0;
-  reg [0:0] case_turn_next;
+  wire [0:0] case_turn_next;
   wire [0:0] box_phase_ne_k_0;
   wire [0:0] take_or_box_phase_ne_k_0;
   wire [1:0] k_1_1 = 2'h1;
@@ -100,20 +103,22 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] acc_in_invy = 48'sh000000000000;
   reg signed [47:0] acc_in_invz = 48'sh000000000000;
   wire [5:0] bits_accept_slot;
+
+  // stage box_exit: the scene-box exit distance: three plane distances, the smallest
   reg [6:0] box_slot = 7'h00;
   wire [1:0] box_axis;
   wire [28:0] box_hi_0 = 29'h1fffffff;
   wire [28:0] box_hi_1 = 29'h0faab179;
   wire [28:0] box_hi_2 = 29'h13e4f19b;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
-  reg signed [47:0] case_box_axis;
+  wire signed [47:0] case_box_axis;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_neg;
   wire [0:0] box_issue;
   wire [1:0] k_3 = 2'h3;
   wire [0:0] box_issue_last;
   wire [28:0] k_0_2 = 29'h00000000;
-  reg [28:0] case_box_axis_1;
+  wire [28:0] case_box_axis_1;
   wire [28:0] box_plane;
   reg [0:0] pu_sel_valid = 1'h0;
   reg [0:0] pu_sel_last = 1'h0;
@@ -121,12 +126,12 @@ module fxrt_core_sf0a3f4 (
   reg [1:0] pu_sel_axis = 2'h0;
   wire [29:0] rs_pu_sel_plane;
   wire signed [29:0] s_rs_pu_sel_plane;
-  reg [28:0] case_pu_sel_axis;
+  wire [28:0] case_pu_sel_axis;
   wire [29:0] rs_case_pu_sel_axis;
   wire signed [29:0] s_rs_case_pu_sel_axis;
   wire signed [29:0] pu_diff;
   reg signed [29:0] pu_delta = 30'sh00000000;
-  reg signed [47:0] pu_inv_axis;
+  wire signed [47:0] pu_inv_axis;
   reg signed [47:0] pu_inv = 48'sh000000000000;
   reg [0:0] pu_delta_valid = 1'h0;
   reg [0:0] pu_delta_last = 1'h0;
@@ -205,6 +210,8 @@ module fxrt_core_sf0a3f4 (
   integer box_done_slot_i;
   initial for (box_done_slot_i = 1; box_done_slot_i <= 11; box_done_slot_i = box_done_slot_i + 1) box_done_slot_sr[box_done_slot_i] = 7'h00;
   wire [6:0] box_done_slot;
+
+  // stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
   wire [0:0] merge_valid;
   wire [6:0] merge_slot;
   wire [0:0] merge_hit;
@@ -308,11 +315,15 @@ module fxrt_core_sf0a3f4 (
   /* verilator lint_on UNUSEDSIGNAL */
   wire [72:0] u_node_rom_0_data;
   wire [72:0] u_node_rom_0_data_b;
+
+  // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
   wire [86:0] cat_18;
   wire [31:0] u_acc_in_wz;
   wire [31:0] u_acc_in_wy;
   wire [31:0] u_acc_in_wx;
   wire [95:0] cat_19;
+
+  // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   reg [0:0] leaf_active = 1'h0;
   reg [6:0] leaf_slot = 7'h00;
   reg [12:0] leaf_ptr = 13'h0000;
@@ -341,10 +352,10 @@ module fxrt_core_sf0a3f4 (
   reg [2:0] u1_buf_leaf_count = 3'h0;
   reg [30:0] u1_buf_leaf_tmin = 31'h00000000;
   reg [5:0] u1_buf_leaf_sp = 6'h00;
-  reg [0:0] case_leaf_turn;
-  reg [0:0] case_leaf_turn_1;
-  reg [0:0] case_leaf_turn_2;
-  reg [0:0] case_leaf_turn_3;
+  wire [0:0] case_leaf_turn;
+  wire [0:0] case_leaf_turn_1;
+  wire [0:0] case_leaf_turn_2;
+  wire [0:0] case_leaf_turn_3;
   wire [0:0] or_24;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
@@ -358,29 +369,31 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] not_u1_leaf_take;
   wire [0:0] and_28;
   wire [0:0] u1_leaf_fill_or_and_28;
-  reg [5:0] case_mux_case_leaf_turn_2;
+  wire [5:0] case_mux_case_leaf_turn_2;
   wire [6:0] cat_29;
   wire [0:0] not_leaf_last_entry;
   wire [0:0] and_30;
   wire [0:0] leaf_take_or_and_30;
   wire [6:0] mux_leaf_take;
-  reg [12:0] case_mux_case_leaf_turn_2_1;
+  wire [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
   wire [12:0] leaf_ptr_plus_k_1_2;
   wire [12:0] mux_leaf_take_1;
-  reg [2:0] case_mux_case_leaf_turn_2_2;
+  wire [2:0] case_mux_case_leaf_turn_2_2;
   wire [2:0] k_1_3 = 3'h1;
   wire [2:0] leaf_left_minus_k_1_3;
   wire [2:0] mux_leaf_take_2;
-  reg [30:0] case_mux_case_leaf_turn_2_3;
+  wire [30:0] case_mux_case_leaf_turn_2_3;
   wire [30:0] mux_leaf_take_3;
-  reg [5:0] case_mux_case_leaf_turn_2_4;
+  wire [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
-  reg [2:0] case_mux_case_leaf_turn_2_5;
+  wire [2:0] case_mux_case_leaf_turn_2_5;
   wire [0:0] eq_31;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
+
+  // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
   wire [58:0] cat_32;
@@ -448,6 +461,8 @@ module fxrt_core_sf0a3f4 (
   wire [29:0] u_intersect_t_1;
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
+
+  // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   reg [0:0] res_credit_ok = 1'h1;
   reg [0:0] u0_done_took = 1'h0;
   wire [0:0] not_u0_done_took;
@@ -479,6 +494,8 @@ module fxrt_core_sf0a3f4 (
   wire [29:0] u_closest_res_t;
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
+
+  // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
   wire [63:0] cat_40;
   wire [63:0] cat_41;
   wire [0:0] res_take;
@@ -526,17 +543,24 @@ module fxrt_core_sf0a3f4 (
   wire [31:0] res_v_q;
   wire [31:0] res_u_q;
 
+  // not in a stage or state machine
+
+  always @(posedge clk) begin : regs
+    if (accept) ray_o[accept_slot] <= cat_18;
+    if (accept) ray_w[accept_slot] <= cat_19;
+    if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
+    if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
+  end
+
+  // stage ray_port: the ray port's register, the unit whose turn it is, the take (a ray per 4 clocks)
   assign u0_has_free = u_traverse_0_has_free;
   assign u1_has_free = u_traverse_1_has_free;
   assign u0_free_slot = u_traverse_0_free_slot_out;
   assign u1_free_slot = u_traverse_1_free_slot_out;
-  always @* begin
-    case (turn)
-      1'h0: case_turn = u0_free_slot_r;
-      1'h1: case_turn = u1_free_slot_r;
-      default: case_turn = u0_free_slot_r;
-    endcase
-  end
+  assign case_turn =
+    (turn == 1'h0) ? u0_free_slot_r :
+    (turn == 1'h1) ? u1_free_slot_r :
+    u0_free_slot_r;
   assign box_phase_eq_k_0 = box_phase == k_0;
   assign and_0 = in_valid & box_phase_eq_k_0;
   assign take = and_0 & turn_free;
@@ -550,323 +574,18 @@ module fxrt_core_sf0a3f4 (
   assign not_turn_free = ~turn_free;
   assign take_or_not_turn_free = take | not_turn_free;
   assign turn_next = take_or_not_turn_free ? turn_plus_1 : turn;
-  always @* begin
-    case (turn_next)
-      1'h0: case_turn_next = u0_has_free;
-      1'h1: case_turn_next = u1_has_free;
-      default: case_turn_next = k_0_1;
-    endcase
-  end
+  assign case_turn_next =
+    (turn_next == 1'h0) ? u0_has_free :
+    (turn_next == 1'h1) ? u1_has_free :
+    k_0_1;
   assign box_phase_ne_k_0 = box_phase != k_0;
   assign take_or_box_phase_ne_k_0 = take | box_phase_ne_k_0;
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
   assign mux_take_or_box_phase_ne_k_0 = take_or_box_phase_ne_k_0 ? box_phase_plus_k_1_1 : box_phase;
   assign box_idle = box_phase == k_0;
   assign bits_accept_slot = accept_slot[5:0];
-  assign box_axis = box_phase - k_1_1;
-  always @* begin
-    case (box_axis)
-      2'h1: case_box_axis = box_in_invy;
-      2'h2: case_box_axis = box_in_invz;
-      default: case_box_axis = box_in_invx;
-    endcase
-  end
-  assign box_neg = case_box_axis[47];
-  assign box_issue = box_phase != k_0;
-  assign box_issue_last = box_phase == k_3;
-  always @* begin
-    case (box_axis)
-      2'h1: case_box_axis_1 = box_hi_1;
-      2'h2: case_box_axis_1 = box_hi_2;
-      default: case_box_axis_1 = box_hi_0;
-    endcase
-  end
-  assign box_plane = box_neg ? k_0_2 : case_box_axis_1;
-  assign rs_pu_sel_plane = {{1{1'b0}}, pu_sel_plane};
-  assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
-  always @* begin
-    case (pu_sel_axis)
-      2'h1: case_pu_sel_axis = box_in_oy;
-      2'h2: case_pu_sel_axis = box_in_oz;
-      default: case_pu_sel_axis = box_in_ox;
-    endcase
-  end
-  assign rs_case_pu_sel_axis = {{1{1'b0}}, case_pu_sel_axis};
-  assign s_rs_case_pu_sel_axis = $signed(rs_case_pu_sel_axis);
-  assign pu_diff = s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
-  always @* begin
-    case (pu_sel_axis)
-      2'h1: pu_inv_axis = box_in_invy;
-      2'h2: pu_inv_axis = box_in_invz;
-      default: pu_inv_axis = box_in_invx;
-    endcase
-  end
-  assign pu_product = u_plane_product_p;
-  assign pu_product_last = pu_product_last_sr[6];
-  assign bits_pu_product = pu_product[77:16];
-  assign pu_shifted = $signed(bits_pu_product);
-  assign pu_below = pu_shifted[61];
-  assign not_pu_below = ~pu_below;
-  assign bits_pu_shifted = pu_shifted[60:30];
-  assign bits_pu_shifted_ne_k_0_3 = bits_pu_shifted != k_0_3;
-  assign pu_above = not_pu_below & bits_pu_shifted_ne_k_0_3;
-  assign rs_pu_shifted = $signed(pu_shifted[31:0]);
-  assign mux_pu_below_r = pu_below_r ? k_m1 : pu_low_r;
-  assign pu_clamped = pu_above_r ? k_1073741824 : mux_pu_below_r;
-  assign not_pu_clamp_last = ~pu_clamp_last;
-  assign pu_first = pu_clamp_valid & not_pu_clamp_last;
-  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
-  assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
-  assign minus_6 = rs_plane_t - rs_box_d1;
-  assign box_lt1_c = minus_6[32];
-  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
-  assign minus_7 = rs_plane_t_1 - rs_box_d2;
-  assign box_lt2_c = minus_7[32];
-  assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
-  assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
-  assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
-  assign bits_box_d1 = box_d1[31];
-  assign bits_box_d2 = box_d2[31];
-  assign or_8 = bits_box_d1 | bits_box_d2;
-  assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_8 | bits_box_d3;
-  assign box_last = plane_t_valid & plane_t_last;
-  assign box_done_slot = box_done_slot_sr[11];
-  assign merge_valid = u_closest_merge_valid;
-  assign merge_slot = u_closest_merge_slot;
-  assign merge_hit = u_closest_merge_hit;
-  assign merge_limit = u_closest_merge_limit;
-  assign merge_sp = u_closest_merge_sp;
-  assign free_valid = u_closest_free_valid;
-  assign free_slot = u_closest_free_slot;
-  assign u0_leaf_pop = u0_leaf_fill;
-  assign u1_leaf_pop = u1_leaf_fill;
-  assign u0_done_pop = u0_done_avail;
-  assign u1_done_pop = u1_done_take;
-  assign u0_node_word = u_node_rom_0_data;
-  assign u1_node_word = u_node_rom_0_data_b;
-  assign bits_accept_slot_1 = accept_slot[6];
-  assign eq_10 = bits_accept_slot_1 == k_0_1;
-  assign u0_alloc = accept & eq_10;
-  assign bits_box_done_slot = box_done_slot[6];
-  assign eq_11 = bits_box_done_slot == k_0_1;
-  assign u0_new = box_done & eq_11;
-  assign bits_merge_slot = merge_slot[6];
-  assign bits_merge_slot_eq_k_0_1 = bits_merge_slot == k_0_1;
-  assign u0_merge = merge_valid & bits_merge_slot_eq_k_0_1;
-  assign bits_free_slot = free_slot[6];
-  assign bits_free_slot_eq_k_0_1 = bits_free_slot == k_0_1;
-  assign u0_free = free_valid & bits_free_slot_eq_k_0_1;
-  assign bits_box_done_slot_1 = box_done_slot[5:0];
-  assign bits_merge_slot_1 = merge_slot[5:0];
-  assign bits_free_slot_1 = free_slot[5:0];
-  assign bits_accept_slot_2 = accept_slot[6];
-  assign eq_14 = bits_accept_slot_2 == k_1;
-  assign u1_alloc = accept & eq_14;
-  assign bits_box_done_slot_2 = box_done_slot[6];
-  assign eq_15 = bits_box_done_slot_2 == k_1;
-  assign u1_new = box_done & eq_15;
-  assign bits_merge_slot_2 = merge_slot[6];
-  assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
-  assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
-  assign bits_free_slot_2 = free_slot[6];
-  assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
-  assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
-  assign bits_box_done_slot_3 = box_done_slot[5:0];
-  assign bits_merge_slot_3 = merge_slot[5:0];
-  assign bits_free_slot_3 = free_slot[5:0];
-  assign cat_18 = {acc_in_oz, acc_in_oy, acc_in_ox};
-  assign u_acc_in_wz = $unsigned(acc_in_wz);
-  assign u_acc_in_wy = $unsigned(acc_in_wy);
-  assign u_acc_in_wx = $unsigned(acc_in_wx);
-  assign cat_19 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
-  assign leaf_last_entry = leaf_active & leaf_last;
-  assign not_leaf_active = ~leaf_active;
-  assign leaf_can_take = not_leaf_active | leaf_last_entry;
-  assign not_u0_leaf_buf_valid = ~u0_leaf_buf_valid;
-  assign u0_leaf_fill = u_traverse_0_leaf_valid & not_u0_leaf_buf_valid;
-  assign not_u1_leaf_buf_valid = ~u1_leaf_buf_valid;
-  assign u1_leaf_fill = u_traverse_1_leaf_valid & not_u1_leaf_buf_valid;
-  always @* begin
-    case (leaf_turn)
-      1'h0: case_leaf_turn = u0_leaf_buf_valid;
-      1'h1: case_leaf_turn = u1_leaf_buf_valid;
-      default: case_leaf_turn = k_0_1;
-    endcase
-  end
-  always @* begin
-    case (leaf_turn)
-      1'h0: case_leaf_turn_1 = k_0_1;
-      1'h1: case_leaf_turn_1 = k_1;
-      default: case_leaf_turn_1 = k_0_1;
-    endcase
-  end
-  always @* begin
-    case (leaf_turn)
-      1'h0: case_leaf_turn_2 = u1_leaf_buf_valid;
-      1'h1: case_leaf_turn_2 = u0_leaf_buf_valid;
-      default: case_leaf_turn_2 = k_0_1;
-    endcase
-  end
-  always @* begin
-    case (leaf_turn)
-      1'h0: case_leaf_turn_3 = k_1;
-      1'h1: case_leaf_turn_3 = k_0_1;
-      default: case_leaf_turn_3 = k_0_1;
-    endcase
-  end
-  assign or_24 = case_leaf_turn_2 | case_leaf_turn;
-  assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_24;
-  assign eq_25 = mux_case_leaf_turn_2 == k_0_1;
-  assign u0_leaf_take = leaf_take & eq_25;
-  assign not_u0_leaf_take = ~u0_leaf_take;
-  assign and_26 = u0_leaf_buf_valid & not_u0_leaf_take;
-  assign u0_leaf_fill_or_and_26 = u0_leaf_fill | and_26;
-  assign eq_27 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_27;
-  assign not_u1_leaf_take = ~u1_leaf_take;
-  assign and_28 = u1_leaf_buf_valid & not_u1_leaf_take;
-  assign u1_leaf_fill_or_and_28 = u1_leaf_fill | and_28;
-  always @* begin
-    case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
-      1'h1: case_mux_case_leaf_turn_2 = u1_buf_leaf_slot;
-      default: case_mux_case_leaf_turn_2 = u0_buf_leaf_slot;
-    endcase
-  end
-  assign cat_29 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
-  assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_30 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_30 = leaf_take | and_30;
-  assign mux_leaf_take = leaf_take ? cat_29 : leaf_slot;
-  always @* begin
-    case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
-      1'h1: case_mux_case_leaf_turn_2_1 = u1_buf_leaf_first;
-      default: case_mux_case_leaf_turn_2_1 = u0_buf_leaf_first;
-    endcase
-  end
-  assign leaf_ptr_plus_k_1_2 = leaf_ptr + k_1_2;
-  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_2;
-  always @* begin
-    case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_2 = u0_buf_leaf_count;
-      1'h1: case_mux_case_leaf_turn_2_2 = u1_buf_leaf_count;
-      default: case_mux_case_leaf_turn_2_2 = u0_buf_leaf_count;
-    endcase
-  end
-  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
-  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_3;
-  always @* begin
-    case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_3 = u0_buf_leaf_tmin;
-      1'h1: case_mux_case_leaf_turn_2_3 = u1_buf_leaf_tmin;
-      default: case_mux_case_leaf_turn_2_3 = u0_buf_leaf_tmin;
-    endcase
-  end
-  assign mux_leaf_take_3 = leaf_take ? case_mux_case_leaf_turn_2_3 : leaf_tmin;
-  always @* begin
-    case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_4 = u0_buf_leaf_sp;
-      1'h1: case_mux_case_leaf_turn_2_4 = u1_buf_leaf_sp;
-      default: case_mux_case_leaf_turn_2_4 = u0_buf_leaf_sp;
-    endcase
-  end
-  assign mux_leaf_take_4 = leaf_take ? case_mux_case_leaf_turn_2_4 : leaf_sp;
-  always @* begin
-    case (mux_case_leaf_turn_2)
-      1'h0: case_mux_case_leaf_turn_2_5 = u0_buf_leaf_count;
-      1'h1: case_mux_case_leaf_turn_2_5 = u1_buf_leaf_count;
-      default: case_mux_case_leaf_turn_2_5 = u0_buf_leaf_count;
-    endcase
-  end
-  assign eq_31 = case_mux_case_leaf_turn_2_5 == k_1_3;
-  assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_31 : leaf_left_eq_k_2;
-  assign cat_32 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
-  assign emit_tag = emit_tag_sr[3];
-  assign bits_emit_tag = emit_tag[58:13];
-  assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
-  assign tri_addr = u_leaf_rom_data;
-  assign tri_r = u_tri_rom_0_data[1:0];
-  assign tri_pp = u_tri_rom_0_data[30:2];
-  assign tri_pq = u_tri_rom_0_data[59:31];
-  assign bits_u_tri_rom_0_data = u_tri_rom_0_data[91:60];
-  assign tri_d = $signed(bits_u_tri_rom_0_data);
-  assign bits_u_tri_rom_0_data_1 = u_tri_rom_0_data[123:92];
-  assign tri_np = $signed(bits_u_tri_rom_0_data_1);
-  assign bits_u_tri_rom_1_data = u_tri_rom_1_data[31:0];
-  assign tri_nq = $signed(bits_u_tri_rom_1_data);
-  assign bits_u_tri_rom_1_data_1 = u_tri_rom_1_data[63:32];
-  assign tri_e1p = $signed(bits_u_tri_rom_1_data_1);
-  assign bits_u_tri_rom_1_data_2 = u_tri_rom_1_data[95:64];
-  assign tri_e1q = $signed(bits_u_tri_rom_1_data_2);
-  assign bits_u_tri_rom_1_data_3 = u_tri_rom_1_data[127:96];
-  assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
-  assign tri_e2q = $signed(u_tri_rom_2_data);
-  assign pipe_tag = pipe_tag_sr[3];
-  assign bits_emit_tag_tri = emit_tag_tri[56:50];
-  assign pipe_o = pipe_o_sr[2];
-  assign pipe_w = pipe_w_sr[2];
-  assign bits_pipe_o = pipe_o[28:0];
-  assign bits_pipe_o_1 = pipe_o[57:29];
-  assign bits_pipe_o_2 = pipe_o[86:58];
-  assign bits_pipe_w = pipe_w[31:0];
-  assign s_bits_pipe_w = $signed(bits_pipe_w);
-  assign bits_pipe_w_1 = pipe_w[63:32];
-  assign s_bits_pipe_w_1 = $signed(bits_pipe_w_1);
-  assign bits_pipe_w_2 = pipe_w[95:64];
-  assign s_bits_pipe_w_2 = $signed(bits_pipe_w_2);
-  assign not_u0_done_took = ~u0_done_took;
-  assign and_34 = u_traverse_0_done_valid & not_u0_done_took;
-  assign u0_done_avail = and_34 & res_credit_ok;
-  assign not_u1_done_took = ~u1_done_took;
-  assign and_35 = u_traverse_1_done_valid & not_u1_done_took;
-  assign u1_done_avail = and_35 & res_credit_ok;
-  assign cat_36 = {k_0_1, u_traverse_0_done_slot};
-  assign not_u0_done_avail = ~u0_done_avail;
-  assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_38 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_36 : cat_38;
-  assign or_39 = u0_done_avail | u1_done_avail;
-  assign cat_40 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
-  assign cat_41 = {u_closest_res_u, u_closest_res_v};
-  assign res_take = res_take_c;
-  assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
-  assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
-  assign res_q_rd_next = res_take ? res_q_rd1 : res_q_rd;
-  assign res_q_rd1_plus_k_1_4 = res_q_rd1 + k_1_4;
-  assign mux_res_take = res_take ? res_q_rd1_plus_k_1_4 : res_q_rd1;
-  assign rs_res_take = {{4{1'b0}}, res_take};
-  assign res_q_after_pop = res_q_count - rs_res_take;
-  assign rs_res_q_push = {{4{1'b0}}, res_q_push};
-  assign res_q_count_next = res_q_after_pop + rs_res_q_push;
-  assign res_q_after_pop_eq_k_0_5 = res_q_after_pop == k_0_5;
-  assign res_q_bypass_c = res_q_push & res_q_after_pop_eq_k_0_5;
-  assign ne_45 = res_q_count_next != k_0_5;
-  assign res_q_head0 = res_q_bypass ? res_q_din_r0 : res_q_q0;
-  assign res_q_head1 = res_q_bypass ? res_q_din_r1 : res_q_q1;
-  assign res_take_c = res_q_nonempty & res_ready;
-  assign rs_done_valid_r = {{5{1'b0}}, done_valid_r};
-  assign minus_47 = res_credits - rs_done_valid_r;
-  assign rs_res_take_1 = {{5{1'b0}}, res_take};
-  assign res_credits_next = minus_47 + rs_res_take_1;
-  assign bits_res_credits_next = res_credits_next[5:1];
-  assign ne_49 = bits_res_credits_next != k_0_5;
-  assign res_t_q = res_q_head0[29:0];
-  assign res_tri_q = res_q_head0[42:30];
-  assign res_hit_q = res_q_head0[43];
-  assign res_id_q = res_q_head0[63:44];
-  assign res_v_q = res_q_head1[31:0];
-  assign res_u_q = res_q_head1[63:32];
 
-  always @(posedge clk) begin : regs
-    if (accept) ray_o[accept_slot] <= cat_18;
-    if (accept) ray_w[accept_slot] <= cat_19;
-    if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
-    if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
+  always @(posedge clk) begin : ray_port_regs
     if (rst) turn <= 1'h0;
     else turn <= turn_next;
     if (rst) box_phase <= 2'h0;
@@ -908,6 +627,69 @@ module fxrt_core_sf0a3f4 (
     acc_in_invx <= in_invx;
     acc_in_invy <= in_invy;
     acc_in_invz <= in_invz;
+  end
+
+  // stage box_exit: the scene-box exit distance: three plane distances, the smallest
+  assign box_axis = box_phase - k_1_1;
+  assign case_box_axis =
+    (box_axis == 2'h1) ? box_in_invy :
+    (box_axis == 2'h2) ? box_in_invz :
+    box_in_invx;
+  assign box_neg = case_box_axis[47];
+  assign box_issue = box_phase != k_0;
+  assign box_issue_last = box_phase == k_3;
+  assign case_box_axis_1 =
+    (box_axis == 2'h1) ? box_hi_1 :
+    (box_axis == 2'h2) ? box_hi_2 :
+    box_hi_0;
+  assign box_plane = box_neg ? k_0_2 : case_box_axis_1;
+  assign rs_pu_sel_plane = {{1{1'b0}}, pu_sel_plane};
+  assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
+  assign case_pu_sel_axis =
+    (pu_sel_axis == 2'h1) ? box_in_oy :
+    (pu_sel_axis == 2'h2) ? box_in_oz :
+    box_in_ox;
+  assign rs_case_pu_sel_axis = {{1{1'b0}}, case_pu_sel_axis};
+  assign s_rs_case_pu_sel_axis = $signed(rs_case_pu_sel_axis);
+  assign pu_diff = s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
+  assign pu_inv_axis =
+    (pu_sel_axis == 2'h1) ? box_in_invy :
+    (pu_sel_axis == 2'h2) ? box_in_invz :
+    box_in_invx;
+  assign pu_product = u_plane_product_p;
+  assign pu_product_last = pu_product_last_sr[6];
+  assign bits_pu_product = pu_product[77:16];
+  assign pu_shifted = $signed(bits_pu_product);
+  assign pu_below = pu_shifted[61];
+  assign not_pu_below = ~pu_below;
+  assign bits_pu_shifted = pu_shifted[60:30];
+  assign bits_pu_shifted_ne_k_0_3 = bits_pu_shifted != k_0_3;
+  assign pu_above = not_pu_below & bits_pu_shifted_ne_k_0_3;
+  assign rs_pu_shifted = $signed(pu_shifted[31:0]);
+  assign mux_pu_below_r = pu_below_r ? k_m1 : pu_low_r;
+  assign pu_clamped = pu_above_r ? k_1073741824 : mux_pu_below_r;
+  assign not_pu_clamp_last = ~pu_clamp_last;
+  assign pu_first = pu_clamp_valid & not_pu_clamp_last;
+  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
+  assign minus_6 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_6[32];
+  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
+  assign minus_7 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_7[32];
+  assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
+  assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
+  assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
+  assign bits_box_d1 = box_d1[31];
+  assign bits_box_d2 = box_d2[31];
+  assign or_8 = bits_box_d1 | bits_box_d2;
+  assign bits_box_d3 = box_d3[31];
+  assign box_miss = or_8 | bits_box_d3;
+  assign box_last = plane_t_valid & plane_t_last;
+  assign box_done_slot = box_done_slot_sr[11];
+
+  always @(posedge clk) begin : box_exit_regs
     if (take) box_slot <= take_slot;
     if (rst) pu_sel_valid <= 1'h0;
     else pu_sel_valid <= box_issue;
@@ -968,6 +750,137 @@ module fxrt_core_sf0a3f4 (
     box_done_slot_sr[3] <= box_done_slot_sr[2];
     box_done_slot_sr[2] <= box_done_slot_sr[1];
     box_done_slot_sr[1] <= box_slot;
+  end
+
+  // stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
+  assign merge_valid = u_closest_merge_valid;
+  assign merge_slot = u_closest_merge_slot;
+  assign merge_hit = u_closest_merge_hit;
+  assign merge_limit = u_closest_merge_limit;
+  assign merge_sp = u_closest_merge_sp;
+  assign free_valid = u_closest_free_valid;
+  assign free_slot = u_closest_free_slot;
+  assign u0_leaf_pop = u0_leaf_fill;
+  assign u1_leaf_pop = u1_leaf_fill;
+  assign u0_done_pop = u0_done_avail;
+  assign u1_done_pop = u1_done_take;
+  assign u0_node_word = u_node_rom_0_data;
+  assign u1_node_word = u_node_rom_0_data_b;
+  assign bits_accept_slot_1 = accept_slot[6];
+  assign eq_10 = bits_accept_slot_1 == k_0_1;
+  assign u0_alloc = accept & eq_10;
+  assign bits_box_done_slot = box_done_slot[6];
+  assign eq_11 = bits_box_done_slot == k_0_1;
+  assign u0_new = box_done & eq_11;
+  assign bits_merge_slot = merge_slot[6];
+  assign bits_merge_slot_eq_k_0_1 = bits_merge_slot == k_0_1;
+  assign u0_merge = merge_valid & bits_merge_slot_eq_k_0_1;
+  assign bits_free_slot = free_slot[6];
+  assign bits_free_slot_eq_k_0_1 = bits_free_slot == k_0_1;
+  assign u0_free = free_valid & bits_free_slot_eq_k_0_1;
+  assign bits_box_done_slot_1 = box_done_slot[5:0];
+  assign bits_merge_slot_1 = merge_slot[5:0];
+  assign bits_free_slot_1 = free_slot[5:0];
+  assign bits_accept_slot_2 = accept_slot[6];
+  assign eq_14 = bits_accept_slot_2 == k_1;
+  assign u1_alloc = accept & eq_14;
+  assign bits_box_done_slot_2 = box_done_slot[6];
+  assign eq_15 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_15;
+  assign bits_merge_slot_2 = merge_slot[6];
+  assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
+  assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
+  assign bits_free_slot_2 = free_slot[6];
+  assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
+  assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
+  assign bits_box_done_slot_3 = box_done_slot[5:0];
+  assign bits_merge_slot_3 = merge_slot[5:0];
+  assign bits_free_slot_3 = free_slot[5:0];
+
+  // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
+  assign cat_18 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign u_acc_in_wz = $unsigned(acc_in_wz);
+  assign u_acc_in_wy = $unsigned(acc_in_wy);
+  assign u_acc_in_wx = $unsigned(acc_in_wx);
+  assign cat_19 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
+
+  // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
+  assign leaf_last_entry = leaf_active & leaf_last;
+  assign not_leaf_active = ~leaf_active;
+  assign leaf_can_take = not_leaf_active | leaf_last_entry;
+  assign not_u0_leaf_buf_valid = ~u0_leaf_buf_valid;
+  assign u0_leaf_fill = u_traverse_0_leaf_valid & not_u0_leaf_buf_valid;
+  assign not_u1_leaf_buf_valid = ~u1_leaf_buf_valid;
+  assign u1_leaf_fill = u_traverse_1_leaf_valid & not_u1_leaf_buf_valid;
+  assign case_leaf_turn =
+    (leaf_turn == 1'h0) ? u0_leaf_buf_valid :
+    (leaf_turn == 1'h1) ? u1_leaf_buf_valid :
+    k_0_1;
+  assign case_leaf_turn_1 =
+    (leaf_turn == 1'h0) ? k_0_1 :
+    (leaf_turn == 1'h1) ? k_1 :
+    k_0_1;
+  assign case_leaf_turn_2 =
+    (leaf_turn == 1'h0) ? u1_leaf_buf_valid :
+    (leaf_turn == 1'h1) ? u0_leaf_buf_valid :
+    k_0_1;
+  assign case_leaf_turn_3 =
+    (leaf_turn == 1'h0) ? k_1 :
+    (leaf_turn == 1'h1) ? k_0_1 :
+    k_0_1;
+  assign or_24 = case_leaf_turn_2 | case_leaf_turn;
+  assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
+  assign leaf_take = leaf_can_take & or_24;
+  assign eq_25 = mux_case_leaf_turn_2 == k_0_1;
+  assign u0_leaf_take = leaf_take & eq_25;
+  assign not_u0_leaf_take = ~u0_leaf_take;
+  assign and_26 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_26 = u0_leaf_fill | and_26;
+  assign eq_27 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_27;
+  assign not_u1_leaf_take = ~u1_leaf_take;
+  assign and_28 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_28 = u1_leaf_fill | and_28;
+  assign case_mux_case_leaf_turn_2 =
+    (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_slot :
+    (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_slot :
+    u0_buf_leaf_slot;
+  assign cat_29 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign not_leaf_last_entry = ~leaf_last_entry;
+  assign and_30 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_30 = leaf_take | and_30;
+  assign mux_leaf_take = leaf_take ? cat_29 : leaf_slot;
+  assign case_mux_case_leaf_turn_2_1 =
+    (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_first :
+    (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_first :
+    u0_buf_leaf_first;
+  assign leaf_ptr_plus_k_1_2 = leaf_ptr + k_1_2;
+  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_2;
+  assign case_mux_case_leaf_turn_2_2 =
+    (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_count :
+    (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_count :
+    u0_buf_leaf_count;
+  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
+  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_3;
+  assign case_mux_case_leaf_turn_2_3 =
+    (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_tmin :
+    (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_tmin :
+    u0_buf_leaf_tmin;
+  assign mux_leaf_take_3 = leaf_take ? case_mux_case_leaf_turn_2_3 : leaf_tmin;
+  assign case_mux_case_leaf_turn_2_4 =
+    (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_sp :
+    (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_sp :
+    u0_buf_leaf_sp;
+  assign mux_leaf_take_4 = leaf_take ? case_mux_case_leaf_turn_2_4 : leaf_sp;
+  assign case_mux_case_leaf_turn_2_5 =
+    (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_count :
+    (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_count :
+    u0_buf_leaf_count;
+  assign eq_31 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign leaf_left_eq_k_2 = leaf_left == k_2;
+  assign mux_leaf_take_5 = leaf_take ? eq_31 : leaf_left_eq_k_2;
+
+  always @(posedge clk) begin : leaf_stream_regs
     if (rst) leaf_active <= 1'h0;
     else leaf_active <= leaf_take_or_and_30;
     leaf_slot <= mux_leaf_take;
@@ -993,6 +906,45 @@ module fxrt_core_sf0a3f4 (
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
     if (u1_leaf_fill) u1_buf_leaf_tmin <= u_traverse_1_leaf_tmin;
     if (u1_leaf_fill) u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
+  end
+
+  // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
+  assign cat_32 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign emit_tag = emit_tag_sr[3];
+  assign bits_emit_tag = emit_tag[58:13];
+  assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
+  assign tri_addr = u_leaf_rom_data;
+  assign tri_r = u_tri_rom_0_data[1:0];
+  assign tri_pp = u_tri_rom_0_data[30:2];
+  assign tri_pq = u_tri_rom_0_data[59:31];
+  assign bits_u_tri_rom_0_data = u_tri_rom_0_data[91:60];
+  assign tri_d = $signed(bits_u_tri_rom_0_data);
+  assign bits_u_tri_rom_0_data_1 = u_tri_rom_0_data[123:92];
+  assign tri_np = $signed(bits_u_tri_rom_0_data_1);
+  assign bits_u_tri_rom_1_data = u_tri_rom_1_data[31:0];
+  assign tri_nq = $signed(bits_u_tri_rom_1_data);
+  assign bits_u_tri_rom_1_data_1 = u_tri_rom_1_data[63:32];
+  assign tri_e1p = $signed(bits_u_tri_rom_1_data_1);
+  assign bits_u_tri_rom_1_data_2 = u_tri_rom_1_data[95:64];
+  assign tri_e1q = $signed(bits_u_tri_rom_1_data_2);
+  assign bits_u_tri_rom_1_data_3 = u_tri_rom_1_data[127:96];
+  assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
+  assign tri_e2q = $signed(u_tri_rom_2_data);
+  assign pipe_tag = pipe_tag_sr[3];
+  assign bits_emit_tag_tri = emit_tag_tri[56:50];
+  assign pipe_o = pipe_o_sr[2];
+  assign pipe_w = pipe_w_sr[2];
+  assign bits_pipe_o = pipe_o[28:0];
+  assign bits_pipe_o_1 = pipe_o[57:29];
+  assign bits_pipe_o_2 = pipe_o[86:58];
+  assign bits_pipe_w = pipe_w[31:0];
+  assign s_bits_pipe_w = $signed(bits_pipe_w);
+  assign bits_pipe_w_1 = pipe_w[63:32];
+  assign s_bits_pipe_w_1 = $signed(bits_pipe_w_1);
+  assign bits_pipe_w_2 = pipe_w[95:64];
+  assign s_bits_pipe_w_2 = $signed(bits_pipe_w_2);
+
+  always @(posedge clk) begin : emission_regs
     emit_tag_sr[3] <= emit_tag_sr[2];
     emit_tag_sr[2] <= emit_tag_sr[1];
     emit_tag_sr[1] <= cat_32;
@@ -1017,6 +969,23 @@ module fxrt_core_sf0a3f4 (
     ray_w_q <= ray_w[bits_emit_tag_tri];
     pipe_w_sr[2] <= pipe_w_sr[1];
     pipe_w_sr[1] <= ray_w_q;
+  end
+
+  // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
+  assign not_u0_done_took = ~u0_done_took;
+  assign and_34 = u_traverse_0_done_valid & not_u0_done_took;
+  assign u0_done_avail = and_34 & res_credit_ok;
+  assign not_u1_done_took = ~u1_done_took;
+  assign and_35 = u_traverse_1_done_valid & not_u1_done_took;
+  assign u1_done_avail = and_35 & res_credit_ok;
+  assign cat_36 = {k_0_1, u_traverse_0_done_slot};
+  assign not_u0_done_avail = ~u0_done_avail;
+  assign u1_done_take = u1_done_avail & not_u0_done_avail;
+  assign cat_38 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_36 : cat_38;
+  assign or_39 = u0_done_avail | u1_done_avail;
+
+  always @(posedge clk) begin : done_regs
     if (rst) res_credit_ok <= 1'h1;
     else res_credit_ok <= ne_49;
     if (rst) u0_done_took <= 1'h0;
@@ -1026,6 +995,41 @@ module fxrt_core_sf0a3f4 (
     if (rst) done_valid_r <= 1'h0;
     else done_valid_r <= or_39;
     done_slot_r <= mux_u0_done_avail;
+  end
+
+  // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
+  assign cat_40 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
+  assign cat_41 = {u_closest_res_u, u_closest_res_v};
+  assign res_take = res_take_c;
+  assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
+  assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
+  assign res_q_rd_next = res_take ? res_q_rd1 : res_q_rd;
+  assign res_q_rd1_plus_k_1_4 = res_q_rd1 + k_1_4;
+  assign mux_res_take = res_take ? res_q_rd1_plus_k_1_4 : res_q_rd1;
+  assign rs_res_take = {{4{1'b0}}, res_take};
+  assign res_q_after_pop = res_q_count - rs_res_take;
+  assign rs_res_q_push = {{4{1'b0}}, res_q_push};
+  assign res_q_count_next = res_q_after_pop + rs_res_q_push;
+  assign res_q_after_pop_eq_k_0_5 = res_q_after_pop == k_0_5;
+  assign res_q_bypass_c = res_q_push & res_q_after_pop_eq_k_0_5;
+  assign ne_45 = res_q_count_next != k_0_5;
+  assign res_q_head0 = res_q_bypass ? res_q_din_r0 : res_q_q0;
+  assign res_q_head1 = res_q_bypass ? res_q_din_r1 : res_q_q1;
+  assign res_take_c = res_q_nonempty & res_ready;
+  assign rs_done_valid_r = {{5{1'b0}}, done_valid_r};
+  assign minus_47 = res_credits - rs_done_valid_r;
+  assign rs_res_take_1 = {{5{1'b0}}, res_take};
+  assign res_credits_next = minus_47 + rs_res_take_1;
+  assign bits_res_credits_next = res_credits_next[5:1];
+  assign ne_49 = bits_res_credits_next != k_0_5;
+  assign res_t_q = res_q_head0[29:0];
+  assign res_tri_q = res_q_head0[42:30];
+  assign res_hit_q = res_q_head0[43];
+  assign res_id_q = res_q_head0[63:44];
+  assign res_v_q = res_q_head1[31:0];
+  assign res_u_q = res_q_head1[63:32];
+
+  always @(posedge clk) begin : result_queue_regs
     if (rst) res_q_push <= 1'h0;
     else res_q_push <= u_closest_res_valid;
     if (rst) res_q_wr <= 4'h0;

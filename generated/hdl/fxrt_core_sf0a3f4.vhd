@@ -196,6 +196,9 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   type res_q_mem1_t is array (0 to 15) of unsigned(63 downto 0);
   signal res_q_mem1 : res_q_mem1_t := (others => (others => '0'));
 
+  -- not in a stage or state machine
+
+  -- stage ray_port: the ray port's register, the unit whose turn it is, the take (a ray per 4 clocks)
   signal u0_has_free : unsigned(0 downto 0);
   signal u1_has_free : unsigned(0 downto 0);
   signal u0_free_slot : unsigned(5 downto 0);
@@ -259,6 +262,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal acc_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal bits_accept_slot : unsigned(5 downto 0);
+
+  -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal box_axis : unsigned(1 downto 0);
   constant box_hi_0 : unsigned(28 downto 0) := unsigned'("11111111111111111111111111111");
@@ -350,6 +355,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   type box_done_slot_sr_t is array (1 to 11) of unsigned(6 downto 0);
   signal box_done_slot_sr : box_done_slot_sr_t := (others => (others => '0'));
   signal box_done_slot : unsigned(6 downto 0);
+
+  -- stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
   signal merge_valid : unsigned(0 downto 0);
   signal merge_slot : unsigned(6 downto 0);
   signal merge_hit : unsigned(0 downto 0);
@@ -429,11 +436,15 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_traverse_1_occupied : unsigned(6 downto 0);
   signal u_node_rom_0_data : unsigned(72 downto 0);
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
+
+  -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
   signal cat_18 : unsigned(86 downto 0);
   signal u_acc_in_wz : unsigned(31 downto 0);
   signal u_acc_in_wy : unsigned(31 downto 0);
   signal u_acc_in_wx : unsigned(31 downto 0);
   signal cat_19 : unsigned(95 downto 0);
+
+  -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_ptr : unsigned(12 downto 0) := unsigned'("0000000000000");
@@ -502,6 +513,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
+
+  -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal cat_32 : unsigned(58 downto 0);
@@ -563,6 +576,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_intersect_t_1 : unsigned(29 downto 0);
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
+
+  -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   signal res_credit_ok : unsigned(0 downto 0) := unsigned'("1");
   signal u0_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u0_done_took : unsigned(0 downto 0);
@@ -594,6 +609,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_closest_res_t : unsigned(29 downto 0);
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
+
+  -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
   signal cat_40 : unsigned(63 downto 0);
   signal cat_41 : unsigned(63 downto 0);
   signal res_take : unsigned(0 downto 0);
@@ -642,6 +659,27 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_u_q : unsigned(31 downto 0);
 begin
 
+  -- not in a stage or state machine
+
+  regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if accept = "1" then
+        ray_o(to_integer(accept_slot)) <= cat_18;
+      end if;
+      if accept = "1" then
+        ray_w(to_integer(accept_slot)) <= cat_19;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem1(to_integer(res_q_wr)) <= res_q_din1;
+      end if;
+    end if;
+  end process regs;
+
+  -- stage ray_port: the ray port's register, the unit whose turn it is, the take (a ray per 4 clocks)
   u0_has_free <= u_traverse_0_has_free;
   u1_has_free <= u_traverse_1_has_free;
   u0_free_slot <= u_traverse_0_free_slot_out;
@@ -675,292 +713,10 @@ begin
   mux_take_or_box_phase_ne_k_0 <= box_phase_plus_k_1_1 when take_or_box_phase_ne_k_0 = "1" else box_phase;
   box_idle <= "1" when box_phase = k_0 else "0";
   bits_accept_slot <= unsigned(accept_slot(5 downto 0));
-  box_axis <= box_phase - k_1_1;
-  with box_axis select
-    case_box_axis <=
-      box_in_invy when "01",
-      box_in_invz when "10",
-      box_in_invx when others;
-  box_neg <= unsigned(case_box_axis(47 downto 47));
-  box_issue <= "1" when box_phase /= k_0 else "0";
-  box_issue_last <= "1" when box_phase = k_3 else "0";
-  with box_axis select
-    case_box_axis_1 <=
-      box_hi_1 when "01",
-      box_hi_2 when "10",
-      box_hi_0 when others;
-  box_plane <= k_0_2 when box_neg = "1" else case_box_axis_1;
-  rs_pu_sel_plane <= resize(pu_sel_plane, 30);
-  s_rs_pu_sel_plane <= signed(rs_pu_sel_plane);
-  with pu_sel_axis select
-    case_pu_sel_axis <=
-      box_in_oy when "01",
-      box_in_oz when "10",
-      box_in_ox when others;
-  rs_case_pu_sel_axis <= resize(case_pu_sel_axis, 30);
-  s_rs_case_pu_sel_axis <= signed(rs_case_pu_sel_axis);
-  pu_diff <= s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
-  with pu_sel_axis select
-    pu_inv_axis <=
-      box_in_invy when "01",
-      box_in_invz when "10",
-      box_in_invx when others;
-  pu_product <= u_plane_product_p;
-  pu_product_last <= pu_product_last_sr(6);
-  bits_pu_product <= unsigned(pu_product(77 downto 16));
-  pu_shifted <= signed(bits_pu_product);
-  pu_below <= unsigned(pu_shifted(61 downto 61));
-  not_pu_below <= not pu_below;
-  bits_pu_shifted <= unsigned(pu_shifted(60 downto 30));
-  bits_pu_shifted_ne_k_0_3 <= "1" when bits_pu_shifted /= k_0_3 else "0";
-  pu_above <= not_pu_below and bits_pu_shifted_ne_k_0_3;
-  rs_pu_shifted <= pu_shifted(31 downto 0);
-  mux_pu_below_r <= k_m1 when pu_below_r = "1" else pu_low_r;
-  pu_clamped <= k_1073741824 when pu_above_r = "1" else mux_pu_below_r;
-  not_pu_clamp_last <= not pu_clamp_last;
-  pu_first <= pu_clamp_valid and not_pu_clamp_last;
-  rs_plane_t <= resize(plane_t, 33);
-  rs_box_d1 <= resize(box_d1, 33);
-  minus_6 <= rs_plane_t - rs_box_d1;
-  box_lt1_c <= unsigned(minus_6(32 downto 32));
-  rs_plane_t_1 <= resize(plane_t, 33);
-  rs_box_d2 <= resize(box_d2, 33);
-  minus_7 <= rs_plane_t_1 - rs_box_d2;
-  box_lt2_c <= unsigned(minus_7(32 downto 32));
-  box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
-  mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
-  box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
-  bits_box_d1 <= unsigned(box_d1(31 downto 31));
-  bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_8 <= bits_box_d1 or bits_box_d2;
-  bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_8 or bits_box_d3;
-  box_last <= plane_t_valid and plane_t_last;
-  box_done_slot <= box_done_slot_sr(11);
-  merge_valid <= u_closest_merge_valid;
-  merge_slot <= u_closest_merge_slot;
-  merge_hit <= u_closest_merge_hit;
-  merge_limit <= u_closest_merge_limit;
-  merge_sp <= u_closest_merge_sp;
-  free_valid <= u_closest_free_valid;
-  free_slot <= u_closest_free_slot;
-  u0_leaf_pop <= u0_leaf_fill;
-  u1_leaf_pop <= u1_leaf_fill;
-  u0_done_pop <= u0_done_avail;
-  u1_done_pop <= u1_done_take;
-  u0_node_word <= u_node_rom_0_data;
-  u1_node_word <= u_node_rom_0_data_b;
-  bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
-  eq_10 <= "1" when bits_accept_slot_1 = k_0_1 else "0";
-  u0_alloc <= accept and eq_10;
-  bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
-  eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
-  u0_new <= box_done and eq_11;
-  bits_merge_slot <= unsigned(merge_slot(6 downto 6));
-  bits_merge_slot_eq_k_0_1 <= "1" when bits_merge_slot = k_0_1 else "0";
-  u0_merge <= merge_valid and bits_merge_slot_eq_k_0_1;
-  bits_free_slot <= unsigned(free_slot(6 downto 6));
-  bits_free_slot_eq_k_0_1 <= "1" when bits_free_slot = k_0_1 else "0";
-  u0_free <= free_valid and bits_free_slot_eq_k_0_1;
-  bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
-  bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
-  bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
-  bits_accept_slot_2 <= unsigned(accept_slot(6 downto 6));
-  eq_14 <= "1" when bits_accept_slot_2 = k_1 else "0";
-  u1_alloc <= accept and eq_14;
-  bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
-  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
-  u1_new <= box_done and eq_15;
-  bits_merge_slot_2 <= unsigned(merge_slot(6 downto 6));
-  bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
-  u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
-  bits_free_slot_2 <= unsigned(free_slot(6 downto 6));
-  bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
-  u1_free <= free_valid and bits_free_slot_2_eq_k_1;
-  bits_box_done_slot_3 <= unsigned(box_done_slot(5 downto 0));
-  bits_merge_slot_3 <= unsigned(merge_slot(5 downto 0));
-  bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
-  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
-  u_acc_in_wz <= unsigned(acc_in_wz);
-  u_acc_in_wy <= unsigned(acc_in_wy);
-  u_acc_in_wx <= unsigned(acc_in_wx);
-  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
-  leaf_last_entry <= leaf_active and leaf_last;
-  not_leaf_active <= not leaf_active;
-  leaf_can_take <= not_leaf_active or leaf_last_entry;
-  not_u0_leaf_buf_valid <= not u0_leaf_buf_valid;
-  u0_leaf_fill <= u_traverse_0_leaf_valid and not_u0_leaf_buf_valid;
-  not_u1_leaf_buf_valid <= not u1_leaf_buf_valid;
-  u1_leaf_fill <= u_traverse_1_leaf_valid and not_u1_leaf_buf_valid;
-  with leaf_turn select
-    case_leaf_turn <=
-      u0_leaf_buf_valid when "0",
-      u1_leaf_buf_valid when "1",
-      k_0_1 when others;
-  with leaf_turn select
-    case_leaf_turn_1 <=
-      k_0_1 when "0",
-      k_1 when "1",
-      k_0_1 when others;
-  with leaf_turn select
-    case_leaf_turn_2 <=
-      u1_leaf_buf_valid when "0",
-      u0_leaf_buf_valid when "1",
-      k_0_1 when others;
-  with leaf_turn select
-    case_leaf_turn_3 <=
-      k_1 when "0",
-      k_0_1 when "1",
-      k_0_1 when others;
-  or_24 <= case_leaf_turn_2 or case_leaf_turn;
-  mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_24;
-  eq_25 <= "1" when mux_case_leaf_turn_2 = k_0_1 else "0";
-  u0_leaf_take <= leaf_take and eq_25;
-  not_u0_leaf_take <= not u0_leaf_take;
-  and_26 <= u0_leaf_buf_valid and not_u0_leaf_take;
-  u0_leaf_fill_or_and_26 <= u0_leaf_fill or and_26;
-  eq_27 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_27;
-  not_u1_leaf_take <= not u1_leaf_take;
-  and_28 <= u1_leaf_buf_valid and not_u1_leaf_take;
-  u1_leaf_fill_or_and_28 <= u1_leaf_fill or and_28;
-  with mux_case_leaf_turn_2 select
-    case_mux_case_leaf_turn_2 <=
-      u0_buf_leaf_slot when "0",
-      u1_buf_leaf_slot when "1",
-      u0_buf_leaf_slot when others;
-  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
-  not_leaf_last_entry <= not leaf_last_entry;
-  and_30 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_30 <= leaf_take or and_30;
-  mux_leaf_take <= cat_29 when leaf_take = "1" else leaf_slot;
-  with mux_case_leaf_turn_2 select
-    case_mux_case_leaf_turn_2_1 <=
-      u0_buf_leaf_first when "0",
-      u1_buf_leaf_first when "1",
-      u0_buf_leaf_first when others;
-  leaf_ptr_plus_k_1_2 <= leaf_ptr + k_1_2;
-  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_2;
-  with mux_case_leaf_turn_2 select
-    case_mux_case_leaf_turn_2_2 <=
-      u0_buf_leaf_count when "0",
-      u1_buf_leaf_count when "1",
-      u0_buf_leaf_count when others;
-  leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
-  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_3;
-  with mux_case_leaf_turn_2 select
-    case_mux_case_leaf_turn_2_3 <=
-      u0_buf_leaf_tmin when "0",
-      u1_buf_leaf_tmin when "1",
-      u0_buf_leaf_tmin when others;
-  mux_leaf_take_3 <= case_mux_case_leaf_turn_2_3 when leaf_take = "1" else leaf_tmin;
-  with mux_case_leaf_turn_2 select
-    case_mux_case_leaf_turn_2_4 <=
-      u0_buf_leaf_sp when "0",
-      u1_buf_leaf_sp when "1",
-      u0_buf_leaf_sp when others;
-  mux_leaf_take_4 <= case_mux_case_leaf_turn_2_4 when leaf_take = "1" else leaf_sp;
-  with mux_case_leaf_turn_2 select
-    case_mux_case_leaf_turn_2_5 <=
-      u0_buf_leaf_count when "0",
-      u1_buf_leaf_count when "1",
-      u0_buf_leaf_count when others;
-  eq_31 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
-  leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_31 when leaf_take = "1" else leaf_left_eq_k_2;
-  cat_32 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
-  emit_tag <= emit_tag_sr(3);
-  bits_emit_tag <= unsigned(emit_tag(58 downto 13));
-  emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
-  tri_addr <= u_leaf_rom_data;
-  tri_r <= unsigned(u_tri_rom_0_data(1 downto 0));
-  tri_pp <= unsigned(u_tri_rom_0_data(30 downto 2));
-  tri_pq <= unsigned(u_tri_rom_0_data(59 downto 31));
-  bits_u_tri_rom_0_data <= unsigned(u_tri_rom_0_data(91 downto 60));
-  tri_d <= signed(bits_u_tri_rom_0_data);
-  bits_u_tri_rom_0_data_1 <= unsigned(u_tri_rom_0_data(123 downto 92));
-  tri_np <= signed(bits_u_tri_rom_0_data_1);
-  bits_u_tri_rom_1_data <= unsigned(u_tri_rom_1_data(31 downto 0));
-  tri_nq <= signed(bits_u_tri_rom_1_data);
-  bits_u_tri_rom_1_data_1 <= unsigned(u_tri_rom_1_data(63 downto 32));
-  tri_e1p <= signed(bits_u_tri_rom_1_data_1);
-  bits_u_tri_rom_1_data_2 <= unsigned(u_tri_rom_1_data(95 downto 64));
-  tri_e1q <= signed(bits_u_tri_rom_1_data_2);
-  bits_u_tri_rom_1_data_3 <= unsigned(u_tri_rom_1_data(127 downto 96));
-  tri_e2p <= signed(bits_u_tri_rom_1_data_3);
-  tri_e2q <= signed(u_tri_rom_2_data);
-  pipe_tag <= pipe_tag_sr(3);
-  bits_emit_tag_tri <= unsigned(emit_tag_tri(56 downto 50));
-  pipe_o <= pipe_o_sr(2);
-  pipe_w <= pipe_w_sr(2);
-  bits_pipe_o <= unsigned(pipe_o(28 downto 0));
-  bits_pipe_o_1 <= unsigned(pipe_o(57 downto 29));
-  bits_pipe_o_2 <= unsigned(pipe_o(86 downto 58));
-  bits_pipe_w <= unsigned(pipe_w(31 downto 0));
-  s_bits_pipe_w <= signed(bits_pipe_w);
-  bits_pipe_w_1 <= unsigned(pipe_w(63 downto 32));
-  s_bits_pipe_w_1 <= signed(bits_pipe_w_1);
-  bits_pipe_w_2 <= unsigned(pipe_w(95 downto 64));
-  s_bits_pipe_w_2 <= signed(bits_pipe_w_2);
-  not_u0_done_took <= not u0_done_took;
-  and_34 <= u_traverse_0_done_valid and not_u0_done_took;
-  u0_done_avail <= and_34 and res_credit_ok;
-  not_u1_done_took <= not u1_done_took;
-  and_35 <= u_traverse_1_done_valid and not_u1_done_took;
-  u1_done_avail <= and_35 and res_credit_ok;
-  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
-  not_u0_done_avail <= not u0_done_avail;
-  u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_36 when u0_done_avail = "1" else cat_38;
-  or_39 <= u0_done_avail or u1_done_avail;
-  cat_40 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
-  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
-  res_take <= res_take_c;
-  res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
-  mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
-  res_q_rd_next <= res_q_rd1 when res_take = "1" else res_q_rd;
-  res_q_rd1_plus_k_1_4 <= res_q_rd1 + k_1_4;
-  mux_res_take <= res_q_rd1_plus_k_1_4 when res_take = "1" else res_q_rd1;
-  rs_res_take <= resize(res_take, 5);
-  res_q_after_pop <= res_q_count - rs_res_take;
-  rs_res_q_push <= resize(res_q_push, 5);
-  res_q_count_next <= res_q_after_pop + rs_res_q_push;
-  res_q_after_pop_eq_k_0_5 <= "1" when res_q_after_pop = k_0_5 else "0";
-  res_q_bypass_c <= res_q_push and res_q_after_pop_eq_k_0_5;
-  ne_45 <= "1" when res_q_count_next /= k_0_5 else "0";
-  res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
-  res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
-  res_take_c <= res_q_nonempty and res_ready;
-  rs_done_valid_r <= resize(done_valid_r, 6);
-  minus_47 <= res_credits - rs_done_valid_r;
-  rs_res_take_1 <= resize(res_take, 6);
-  res_credits_next <= minus_47 + rs_res_take_1;
-  bits_res_credits_next <= unsigned(res_credits_next(5 downto 1));
-  ne_49 <= "1" when bits_res_credits_next /= k_0_5 else "0";
-  res_t_q <= unsigned(res_q_head0(29 downto 0));
-  res_tri_q <= unsigned(res_q_head0(42 downto 30));
-  res_hit_q <= unsigned(res_q_head0(43 downto 43));
-  res_id_q <= unsigned(res_q_head0(63 downto 44));
-  res_v_q <= unsigned(res_q_head1(31 downto 0));
-  res_u_q <= unsigned(res_q_head1(63 downto 32));
 
-  regs : process (clk)
+  ray_port_regs : process (clk)
   begin
     if rising_edge(clk) then
-      if accept = "1" then
-        ray_o(to_integer(accept_slot)) <= cat_18;
-      end if;
-      if accept = "1" then
-        ray_w(to_integer(accept_slot)) <= cat_19;
-      end if;
-      if res_q_push = "1" then
-        res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
-      end if;
-      if res_q_push = "1" then
-        res_q_mem1(to_integer(res_q_wr)) <= res_q_din1;
-      end if;
       if rst = '1' then
         turn <= unsigned'("0");
       else
@@ -1055,6 +811,76 @@ begin
       acc_in_invx <= in_invx;
       acc_in_invy <= in_invy;
       acc_in_invz <= in_invz;
+    end if;
+  end process ray_port_regs;
+
+  -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
+  box_axis <= box_phase - k_1_1;
+  with box_axis select
+    case_box_axis <=
+      box_in_invy when "01",
+      box_in_invz when "10",
+      box_in_invx when others;
+  box_neg <= unsigned(case_box_axis(47 downto 47));
+  box_issue <= "1" when box_phase /= k_0 else "0";
+  box_issue_last <= "1" when box_phase = k_3 else "0";
+  with box_axis select
+    case_box_axis_1 <=
+      box_hi_1 when "01",
+      box_hi_2 when "10",
+      box_hi_0 when others;
+  box_plane <= k_0_2 when box_neg = "1" else case_box_axis_1;
+  rs_pu_sel_plane <= resize(pu_sel_plane, 30);
+  s_rs_pu_sel_plane <= signed(rs_pu_sel_plane);
+  with pu_sel_axis select
+    case_pu_sel_axis <=
+      box_in_oy when "01",
+      box_in_oz when "10",
+      box_in_ox when others;
+  rs_case_pu_sel_axis <= resize(case_pu_sel_axis, 30);
+  s_rs_case_pu_sel_axis <= signed(rs_case_pu_sel_axis);
+  pu_diff <= s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
+  with pu_sel_axis select
+    pu_inv_axis <=
+      box_in_invy when "01",
+      box_in_invz when "10",
+      box_in_invx when others;
+  pu_product <= u_plane_product_p;
+  pu_product_last <= pu_product_last_sr(6);
+  bits_pu_product <= unsigned(pu_product(77 downto 16));
+  pu_shifted <= signed(bits_pu_product);
+  pu_below <= unsigned(pu_shifted(61 downto 61));
+  not_pu_below <= not pu_below;
+  bits_pu_shifted <= unsigned(pu_shifted(60 downto 30));
+  bits_pu_shifted_ne_k_0_3 <= "1" when bits_pu_shifted /= k_0_3 else "0";
+  pu_above <= not_pu_below and bits_pu_shifted_ne_k_0_3;
+  rs_pu_shifted <= pu_shifted(31 downto 0);
+  mux_pu_below_r <= k_m1 when pu_below_r = "1" else pu_low_r;
+  pu_clamped <= k_1073741824 when pu_above_r = "1" else mux_pu_below_r;
+  not_pu_clamp_last <= not pu_clamp_last;
+  pu_first <= pu_clamp_valid and not_pu_clamp_last;
+  rs_plane_t <= resize(plane_t, 33);
+  rs_box_d1 <= resize(box_d1, 33);
+  minus_6 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_6(32 downto 32));
+  rs_plane_t_1 <= resize(plane_t, 33);
+  rs_box_d2 <= resize(box_d2, 33);
+  minus_7 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_7(32 downto 32));
+  box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
+  mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
+  box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
+  bits_box_d1 <= unsigned(box_d1(31 downto 31));
+  bits_box_d2 <= unsigned(box_d2(31 downto 31));
+  or_8 <= bits_box_d1 or bits_box_d2;
+  bits_box_d3 <= unsigned(box_d3(31 downto 31));
+  box_miss <= or_8 or bits_box_d3;
+  box_last <= plane_t_valid and plane_t_last;
+  box_done_slot <= box_done_slot_sr(11);
+
+  box_exit_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       if take = "1" then
         box_slot <= take_slot;
       end if;
@@ -1141,6 +967,150 @@ begin
       end if;
       box_done_slot_sr(2 to 11) <= box_done_slot_sr(1 to 10);
       box_done_slot_sr(1) <= box_slot;
+    end if;
+  end process box_exit_regs;
+
+  -- stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
+  merge_valid <= u_closest_merge_valid;
+  merge_slot <= u_closest_merge_slot;
+  merge_hit <= u_closest_merge_hit;
+  merge_limit <= u_closest_merge_limit;
+  merge_sp <= u_closest_merge_sp;
+  free_valid <= u_closest_free_valid;
+  free_slot <= u_closest_free_slot;
+  u0_leaf_pop <= u0_leaf_fill;
+  u1_leaf_pop <= u1_leaf_fill;
+  u0_done_pop <= u0_done_avail;
+  u1_done_pop <= u1_done_take;
+  u0_node_word <= u_node_rom_0_data;
+  u1_node_word <= u_node_rom_0_data_b;
+  bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
+  eq_10 <= "1" when bits_accept_slot_1 = k_0_1 else "0";
+  u0_alloc <= accept and eq_10;
+  bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
+  eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
+  u0_new <= box_done and eq_11;
+  bits_merge_slot <= unsigned(merge_slot(6 downto 6));
+  bits_merge_slot_eq_k_0_1 <= "1" when bits_merge_slot = k_0_1 else "0";
+  u0_merge <= merge_valid and bits_merge_slot_eq_k_0_1;
+  bits_free_slot <= unsigned(free_slot(6 downto 6));
+  bits_free_slot_eq_k_0_1 <= "1" when bits_free_slot = k_0_1 else "0";
+  u0_free <= free_valid and bits_free_slot_eq_k_0_1;
+  bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
+  bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
+  bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
+  bits_accept_slot_2 <= unsigned(accept_slot(6 downto 6));
+  eq_14 <= "1" when bits_accept_slot_2 = k_1 else "0";
+  u1_alloc <= accept and eq_14;
+  bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
+  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_15;
+  bits_merge_slot_2 <= unsigned(merge_slot(6 downto 6));
+  bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
+  u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
+  bits_free_slot_2 <= unsigned(free_slot(6 downto 6));
+  bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
+  u1_free <= free_valid and bits_free_slot_2_eq_k_1;
+  bits_box_done_slot_3 <= unsigned(box_done_slot(5 downto 0));
+  bits_merge_slot_3 <= unsigned(merge_slot(5 downto 0));
+  bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
+
+  -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
+  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  u_acc_in_wz <= unsigned(acc_in_wz);
+  u_acc_in_wy <= unsigned(acc_in_wy);
+  u_acc_in_wx <= unsigned(acc_in_wx);
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
+
+  -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
+  leaf_last_entry <= leaf_active and leaf_last;
+  not_leaf_active <= not leaf_active;
+  leaf_can_take <= not_leaf_active or leaf_last_entry;
+  not_u0_leaf_buf_valid <= not u0_leaf_buf_valid;
+  u0_leaf_fill <= u_traverse_0_leaf_valid and not_u0_leaf_buf_valid;
+  not_u1_leaf_buf_valid <= not u1_leaf_buf_valid;
+  u1_leaf_fill <= u_traverse_1_leaf_valid and not_u1_leaf_buf_valid;
+  with leaf_turn select
+    case_leaf_turn <=
+      u0_leaf_buf_valid when "0",
+      u1_leaf_buf_valid when "1",
+      k_0_1 when others;
+  with leaf_turn select
+    case_leaf_turn_1 <=
+      k_0_1 when "0",
+      k_1 when "1",
+      k_0_1 when others;
+  with leaf_turn select
+    case_leaf_turn_2 <=
+      u1_leaf_buf_valid when "0",
+      u0_leaf_buf_valid when "1",
+      k_0_1 when others;
+  with leaf_turn select
+    case_leaf_turn_3 <=
+      k_1 when "0",
+      k_0_1 when "1",
+      k_0_1 when others;
+  or_24 <= case_leaf_turn_2 or case_leaf_turn;
+  mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
+  leaf_take <= leaf_can_take and or_24;
+  eq_25 <= "1" when mux_case_leaf_turn_2 = k_0_1 else "0";
+  u0_leaf_take <= leaf_take and eq_25;
+  not_u0_leaf_take <= not u0_leaf_take;
+  and_26 <= u0_leaf_buf_valid and not_u0_leaf_take;
+  u0_leaf_fill_or_and_26 <= u0_leaf_fill or and_26;
+  eq_27 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_27;
+  not_u1_leaf_take <= not u1_leaf_take;
+  and_28 <= u1_leaf_buf_valid and not_u1_leaf_take;
+  u1_leaf_fill_or_and_28 <= u1_leaf_fill or and_28;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2 <=
+      u0_buf_leaf_slot when "0",
+      u1_buf_leaf_slot when "1",
+      u0_buf_leaf_slot when others;
+  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  not_leaf_last_entry <= not leaf_last_entry;
+  and_30 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_30 <= leaf_take or and_30;
+  mux_leaf_take <= cat_29 when leaf_take = "1" else leaf_slot;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_1 <=
+      u0_buf_leaf_first when "0",
+      u1_buf_leaf_first when "1",
+      u0_buf_leaf_first when others;
+  leaf_ptr_plus_k_1_2 <= leaf_ptr + k_1_2;
+  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_2;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_2 <=
+      u0_buf_leaf_count when "0",
+      u1_buf_leaf_count when "1",
+      u0_buf_leaf_count when others;
+  leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
+  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_3;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_3 <=
+      u0_buf_leaf_tmin when "0",
+      u1_buf_leaf_tmin when "1",
+      u0_buf_leaf_tmin when others;
+  mux_leaf_take_3 <= case_mux_case_leaf_turn_2_3 when leaf_take = "1" else leaf_tmin;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_4 <=
+      u0_buf_leaf_sp when "0",
+      u1_buf_leaf_sp when "1",
+      u0_buf_leaf_sp when others;
+  mux_leaf_take_4 <= case_mux_case_leaf_turn_2_4 when leaf_take = "1" else leaf_sp;
+  with mux_case_leaf_turn_2 select
+    case_mux_case_leaf_turn_2_5 <=
+      u0_buf_leaf_count when "0",
+      u1_buf_leaf_count when "1",
+      u0_buf_leaf_count when others;
+  eq_31 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
+  mux_leaf_take_5 <= eq_31 when leaf_take = "1" else leaf_left_eq_k_2;
+
+  leaf_stream_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
@@ -1198,6 +1168,48 @@ begin
       if u1_leaf_fill = "1" then
         u1_buf_leaf_sp <= u_traverse_1_leaf_sp;
       end if;
+    end if;
+  end process leaf_stream_regs;
+
+  -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
+  cat_32 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  emit_tag <= emit_tag_sr(3);
+  bits_emit_tag <= unsigned(emit_tag(58 downto 13));
+  emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
+  tri_addr <= u_leaf_rom_data;
+  tri_r <= unsigned(u_tri_rom_0_data(1 downto 0));
+  tri_pp <= unsigned(u_tri_rom_0_data(30 downto 2));
+  tri_pq <= unsigned(u_tri_rom_0_data(59 downto 31));
+  bits_u_tri_rom_0_data <= unsigned(u_tri_rom_0_data(91 downto 60));
+  tri_d <= signed(bits_u_tri_rom_0_data);
+  bits_u_tri_rom_0_data_1 <= unsigned(u_tri_rom_0_data(123 downto 92));
+  tri_np <= signed(bits_u_tri_rom_0_data_1);
+  bits_u_tri_rom_1_data <= unsigned(u_tri_rom_1_data(31 downto 0));
+  tri_nq <= signed(bits_u_tri_rom_1_data);
+  bits_u_tri_rom_1_data_1 <= unsigned(u_tri_rom_1_data(63 downto 32));
+  tri_e1p <= signed(bits_u_tri_rom_1_data_1);
+  bits_u_tri_rom_1_data_2 <= unsigned(u_tri_rom_1_data(95 downto 64));
+  tri_e1q <= signed(bits_u_tri_rom_1_data_2);
+  bits_u_tri_rom_1_data_3 <= unsigned(u_tri_rom_1_data(127 downto 96));
+  tri_e2p <= signed(bits_u_tri_rom_1_data_3);
+  tri_e2q <= signed(u_tri_rom_2_data);
+  pipe_tag <= pipe_tag_sr(3);
+  bits_emit_tag_tri <= unsigned(emit_tag_tri(56 downto 50));
+  pipe_o <= pipe_o_sr(2);
+  pipe_w <= pipe_w_sr(2);
+  bits_pipe_o <= unsigned(pipe_o(28 downto 0));
+  bits_pipe_o_1 <= unsigned(pipe_o(57 downto 29));
+  bits_pipe_o_2 <= unsigned(pipe_o(86 downto 58));
+  bits_pipe_w <= unsigned(pipe_w(31 downto 0));
+  s_bits_pipe_w <= signed(bits_pipe_w);
+  bits_pipe_w_1 <= unsigned(pipe_w(63 downto 32));
+  s_bits_pipe_w_1 <= signed(bits_pipe_w_1);
+  bits_pipe_w_2 <= unsigned(pipe_w(95 downto 64));
+  s_bits_pipe_w_2 <= signed(bits_pipe_w_2);
+
+  emission_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
       emit_tag_sr(1) <= cat_32;
       if rst = '1' then
@@ -1238,6 +1250,26 @@ begin
       ray_w_q <= ray_w(to_integer(bits_emit_tag_tri));
       pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
       pipe_w_sr(1) <= ray_w_q;
+    end if;
+  end process emission_regs;
+
+  -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
+  not_u0_done_took <= not u0_done_took;
+  and_34 <= u_traverse_0_done_valid and not_u0_done_took;
+  u0_done_avail <= and_34 and res_credit_ok;
+  not_u1_done_took <= not u1_done_took;
+  and_35 <= u_traverse_1_done_valid and not_u1_done_took;
+  u1_done_avail <= and_35 and res_credit_ok;
+  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
+  not_u0_done_avail <= not u0_done_avail;
+  u1_done_take <= u1_done_avail and not_u0_done_avail;
+  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_36 when u0_done_avail = "1" else cat_38;
+  or_39 <= u0_done_avail or u1_done_avail;
+
+  done_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       if rst = '1' then
         res_credit_ok <= unsigned'("1");
       else
@@ -1259,6 +1291,44 @@ begin
         done_valid_r <= or_39;
       end if;
       done_slot_r <= mux_u0_done_avail;
+    end if;
+  end process done_regs;
+
+  -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
+  cat_40 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
+  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
+  res_take <= res_take_c;
+  res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
+  mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
+  res_q_rd_next <= res_q_rd1 when res_take = "1" else res_q_rd;
+  res_q_rd1_plus_k_1_4 <= res_q_rd1 + k_1_4;
+  mux_res_take <= res_q_rd1_plus_k_1_4 when res_take = "1" else res_q_rd1;
+  rs_res_take <= resize(res_take, 5);
+  res_q_after_pop <= res_q_count - rs_res_take;
+  rs_res_q_push <= resize(res_q_push, 5);
+  res_q_count_next <= res_q_after_pop + rs_res_q_push;
+  res_q_after_pop_eq_k_0_5 <= "1" when res_q_after_pop = k_0_5 else "0";
+  res_q_bypass_c <= res_q_push and res_q_after_pop_eq_k_0_5;
+  ne_45 <= "1" when res_q_count_next /= k_0_5 else "0";
+  res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
+  res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
+  res_take_c <= res_q_nonempty and res_ready;
+  rs_done_valid_r <= resize(done_valid_r, 6);
+  minus_47 <= res_credits - rs_done_valid_r;
+  rs_res_take_1 <= resize(res_take, 6);
+  res_credits_next <= minus_47 + rs_res_take_1;
+  bits_res_credits_next <= unsigned(res_credits_next(5 downto 1));
+  ne_49 <= "1" when bits_res_credits_next /= k_0_5 else "0";
+  res_t_q <= unsigned(res_q_head0(29 downto 0));
+  res_tri_q <= unsigned(res_q_head0(42 downto 30));
+  res_hit_q <= unsigned(res_q_head0(43 downto 43));
+  res_id_q <= unsigned(res_q_head0(63 downto 44));
+  res_v_q <= unsigned(res_q_head1(31 downto 0));
+  res_u_q <= unsigned(res_q_head1(63 downto 32));
+
+  result_queue_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       if rst = '1' then
         res_q_push <= unsigned'("0");
       else
@@ -1310,7 +1380,7 @@ begin
         res_credits <= res_credits_next;
       end if;
     end if;
-  end process regs;
+  end process result_queue_regs;
 
   u_plane_product : fxrt_mul_s30xs48_d3l1
     port map (

@@ -61,12 +61,12 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire [0:0] perm_p_eq_k_2;
   wire [1:0] perm_p_plus_k_1;
   wire [1:0] perm_q;
-  reg [28:0] o_r;
-  reg [28:0] o_p;
-  reg [28:0] o_q;
-  reg signed [31:0] w_r;
-  reg signed [31:0] w_p;
-  reg signed [31:0] w_q;
+  wire [28:0] o_r;
+  wire [28:0] o_p;
+  wire [28:0] o_q;
+  wire signed [31:0] w_r;
+  wire signed [31:0] w_p;
+  wire signed [31:0] w_q;
   wire [29:0] rs_o_p;
   wire signed [29:0] s_rs_o_p;
   wire [29:0] rs_o_q;
@@ -409,48 +409,30 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   assign perm_p_eq_k_2 = perm_p == k_2;
   assign perm_p_plus_k_1 = perm_p + k_1;
   assign perm_q = perm_p_eq_k_2 ? k_0 : perm_p_plus_k_1;
-  always @* begin
-    case (s1_r)
-      2'h1: o_r = s1_oy;
-      2'h2: o_r = s1_oz;
-      default: o_r = s1_ox;
-    endcase
-  end
-  always @* begin
-    case (perm_p)
-      2'h1: o_p = s1_oy;
-      2'h2: o_p = s1_oz;
-      default: o_p = s1_ox;
-    endcase
-  end
-  always @* begin
-    case (perm_q)
-      2'h1: o_q = s1_oy;
-      2'h2: o_q = s1_oz;
-      default: o_q = s1_ox;
-    endcase
-  end
-  always @* begin
-    case (s1_r)
-      2'h1: w_r = s1_wy;
-      2'h2: w_r = s1_wz;
-      default: w_r = s1_wx;
-    endcase
-  end
-  always @* begin
-    case (perm_p)
-      2'h1: w_p = s1_wy;
-      2'h2: w_p = s1_wz;
-      default: w_p = s1_wx;
-    endcase
-  end
-  always @* begin
-    case (perm_q)
-      2'h1: w_q = s1_wy;
-      2'h2: w_q = s1_wz;
-      default: w_q = s1_wx;
-    endcase
-  end
+  assign o_r =
+    (s1_r == 2'h1) ? s1_oy :
+    (s1_r == 2'h2) ? s1_oz :
+    s1_ox;
+  assign o_p =
+    (perm_p == 2'h1) ? s1_oy :
+    (perm_p == 2'h2) ? s1_oz :
+    s1_ox;
+  assign o_q =
+    (perm_q == 2'h1) ? s1_oy :
+    (perm_q == 2'h2) ? s1_oz :
+    s1_ox;
+  assign w_r =
+    (s1_r == 2'h1) ? s1_wy :
+    (s1_r == 2'h2) ? s1_wz :
+    s1_wx;
+  assign w_p =
+    (perm_p == 2'h1) ? s1_wy :
+    (perm_p == 2'h2) ? s1_wz :
+    s1_wx;
+  assign w_q =
+    (perm_q == 2'h1) ? s1_wy :
+    (perm_q == 2'h2) ? s1_wz :
+    s1_wx;
   assign rs_o_p = {{1{1'b0}}, o_p};
   assign s_rs_o_p = $signed(rs_o_p);
   assign rs_o_q = {{1{1'b0}}, o_q};

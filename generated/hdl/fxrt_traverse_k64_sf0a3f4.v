@@ -72,10 +72,21 @@ module fxrt_traverse_k64_sf0a3f4 (
   (* ram_style = "distributed" *) reg [58:0] leaf_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem.hex", leaf_q_mem);
 
+  // not in a stage or state machine
   wire [86:0] cat_0;
   wire [47:0] u_invx;
   wire [47:0] u_invy;
   wire [47:0] u_invz;
+  wire [0:0] not_just_alloc;
+  wire [0:0] has_free_c;
+  wire [5:0] bits_leaf_q_head;
+  wire [30:0] bits_leaf_q_head_1;
+  wire [2:0] bits_leaf_q_head_2;
+  wire [12:0] bits_leaf_q_head_3;
+  wire [5:0] bits_leaf_q_head_4;
+  wire [0:0] cull_c;
+
+  // stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
   reg [63:0] free_bits = 64'hffffffffffffffff;
   wire [0:0] bits_free_bits;
   wire [0:0] bits_free_bits_1;
@@ -538,6 +549,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] occupied_r_plus_rs_alloc;
   wire [6:0] rs_free_valid;
   wire [6:0] minus_77;
+
+  // stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   wire [0:0] ring_g_valid;
   wire [0:0] unpark_pop;
   wire [0:0] new_pop;
@@ -615,6 +628,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg signed [31:0] q_tmax = 32'sh00000000;
   wire [0:0] bits_new_q_head_2;
   reg [0:0] q_miss = 1'h0;
+
+  // stage ring_r: R: the token back from G, loaded in G
   reg [0:0] r_valid = 1'h0;
   reg [0:0] r_pop = 1'h0;
   reg [0:0] r_sp_zero = 1'h0;
@@ -624,6 +639,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg signed [31:0] r_tmin = 32'sh00000000;
   reg signed [31:0] r_tmax = 32'sh00000000;
   reg [5:0] r_sp = 6'h00;
+
+  // stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   wire [0:0] a_valid;
   wire [5:0] a_slot;
   wire [0:0] not_r_valid;
@@ -647,6 +664,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [4:0] rs_a_sp_m1;
   wire [10:0] stack_raddr;
   wire [76:0] u_stack_data;
+
+  // stage ring_b: B, B2: the token waits two clocks for the stack word
   wire [0:0] not_a_done;
   wire [0:0] a_live;
   reg [0:0] b_valid = 1'h0;
@@ -671,6 +690,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg signed [31:0] b2_tmin = 32'sh00000000;
   reg signed [31:0] b2_tmax = 32'sh00000000;
   reg [5:0] b2_sp = 6'h00;
+
+  // stage done: the done queue: slots whose ray left the ring in A, for the top
   reg [0:0] done_pop_r = 1'h0;
   reg [0:0] done_q_push = 1'h0;
   reg [5:0] done_q_wr = 6'h00;
@@ -695,6 +716,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [5:0] done_q_q = 6'h00;
   reg [5:0] done_q_din_r = 6'h00;
   wire [5:0] done_q_head;
+
+  // stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   wire [31:0] bits_u_stack_data;
   wire signed [31:0] s_bits_u_stack_data;
   wire [31:0] bits_u_stack_data_1;
@@ -781,7 +804,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] bits_has_best_61;
   wire [0:0] bits_has_best_62;
   wire [0:0] bits_has_best_63;
-  reg [0:0] slot_has_best;
+  wire [0:0] slot_has_best;
   reg [0:0] cull_has_best = 1'h0;
   wire signed [32:0] rs_s_limit_q;
   wire signed [32:0] rs_cull_x;
@@ -929,6 +952,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [63:0] not_best_clear;
   wire [63:0] and_105;
   wire [63:0] and_105_or_best_set;
+
+  // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   reg [0:0] n_valid_1 = 1'h0;
   reg [0:0] n_valid_2 = 1'h0;
   reg [0:0] n_valid_3 = 1'h0;
@@ -1013,12 +1038,12 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [1:0] pu_sel_axis = 2'h0;
   wire [29:0] rs_pu_sel_plane;
   wire signed [29:0] s_rs_pu_sel_plane;
-  reg [28:0] case_pu_sel_axis;
+  wire [28:0] case_pu_sel_axis;
   wire [29:0] rs_case_pu_sel_axis;
   wire signed [29:0] s_rs_case_pu_sel_axis;
   wire signed [29:0] pu_diff;
   reg signed [29:0] pu_delta = 30'sh00000000;
-  reg signed [47:0] pu_inv_axis;
+  wire signed [47:0] pu_inv_axis;
   reg signed [47:0] pu_inv = 48'sh000000000000;
   reg [0:0] pu_delta_valid = 1'h0;
   reg [0:0] pu_delta_last = 1'h0;
@@ -1076,12 +1101,12 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [1:0] pu_sel_axis_1 = 2'h0;
   wire [29:0] rs_pu_sel_plane_1;
   wire signed [29:0] s_rs_pu_sel_plane_1;
-  reg [28:0] case_pu_sel_axis_1;
+  wire [28:0] case_pu_sel_axis_1;
   wire [29:0] rs_case_pu_sel_axis_1;
   wire signed [29:0] s_rs_case_pu_sel_axis_1;
   wire signed [29:0] pu_diff_1;
   reg signed [29:0] pu_delta_1 = 30'sh00000000;
-  reg signed [47:0] pu_inv_axis_1;
+  wire signed [47:0] pu_inv_axis_1;
   reg signed [47:0] pu_inv_1 = 48'sh000000000000;
   reg [0:0] pu_delta_valid_1 = 1'h0;
   reg [0:0] pu_delta_last_1 = 1'h0;
@@ -1131,13 +1156,15 @@ module fxrt_traverse_k64_sf0a3f4 (
   /* verilator lint_on UNUSEDSIGNAL */
   reg [1:0] axis_n1 = 2'h0;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
-  reg signed [47:0] case_axis_n1;
+  wire signed [47:0] case_axis_n1;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] negative_c;
   (* mem2reg *) reg [0:0] negative_sr [1:9];
   integer negative_i;
   initial for (negative_i = 1; negative_i <= 9; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
   wire [0:0] negative;
+
+  // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   wire [0:0] not_leaf_push;
   wire [0:0] n_stays;
   reg [0:0] f_valid_1 = 1'h0;
@@ -1175,7 +1202,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   initial for (f_child_i = 1; f_child_i <= 10; f_child_i = f_child_i + 1) f_child_sr[f_child_i] = 13'h0000;
   wire [12:0] f_child;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
-  reg signed [47:0] case_axis_n1_1;
+  wire signed [47:0] case_axis_n1_1;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_case_axis_n1_1;
   reg [0:0] negative_n1 = 1'h0;
@@ -1271,6 +1298,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [5:0] g_sp = 6'h00;
   reg [0:0] g_inner = 1'h0;
   reg [0:0] g_negative = 1'h0;
+
+  // stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
   wire [12:0] k_1_3 = 13'h0001;
   wire [12:0] g_child_plus_k_1_3;
   wire [12:0] near;
@@ -1299,19 +1328,34 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] and_130;
   wire [5:0] g_sp_minus_k_1;
   wire [5:0] mux_push_1;
-  wire [0:0] not_just_alloc;
-  wire [0:0] has_free_c;
-  wire [5:0] bits_leaf_q_head;
-  wire [30:0] bits_leaf_q_head_1;
-  wire [2:0] bits_leaf_q_head_2;
-  wire [12:0] bits_leaf_q_head_3;
-  wire [5:0] bits_leaf_q_head_4;
-  wire [0:0] cull_c;
 
+  // not in a stage or state machine
   assign cat_0 = {oz, oy, ox};
   assign u_invx = $unsigned(invx);
   assign u_invy = $unsigned(invy);
   assign u_invz = $unsigned(invz);
+  assign not_just_alloc = ~just_alloc;
+  assign has_free_c = free_any_r & not_just_alloc;
+  assign bits_leaf_q_head = leaf_q_head[5:0];
+  assign bits_leaf_q_head_1 = leaf_q_head[36:6];
+  assign bits_leaf_q_head_2 = leaf_q_head[39:37];
+  assign bits_leaf_q_head_3 = leaf_q_head[52:40];
+  assign bits_leaf_q_head_4 = leaf_q_head[58:53];
+  assign cull_c = n_valid_3 & culled_n;
+
+  always @(posedge clk) begin : regs
+    if (ray_we) ray_o[ray_slot] <= cat_0;
+    if (ray_we) ray_invx[ray_slot] <= u_invx;
+    if (ray_we) ray_invy[ray_slot] <= u_invy;
+    if (ray_we) ray_invz[ray_slot] <= u_invz;
+    if (unpark_q_push) unpark_q_mem[unpark_q_wr] <= unpark_q_din;
+    if (new_q_push) new_q_mem[new_q_wr] <= new_q_din;
+    if (done_q_push) done_q_mem[done_q_wr] <= done_q_din;
+    if (limit_we) cull_limit[merge_slot] <= u_merge_limit;
+    if (leaf_q_push) leaf_q_mem[leaf_q_wr] <= leaf_q_din;
+  end
+
+  // stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
   assign bits_free_bits = free_bits[0];
   assign bits_free_bits_1 = free_bits[1];
   assign bits_free_bits_2 = free_bits[2];
@@ -1703,6 +1747,21 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign occupied_r_plus_rs_alloc = occupied_r + rs_alloc;
   assign rs_free_valid = {{6{1'b0}}, free_valid};
   assign minus_77 = occupied_r_plus_rs_alloc - rs_free_valid;
+
+  always @(posedge clk) begin : slots_regs
+    if (rst) free_bits <= 64'hffffffffffffffff;
+    else free_bits <= and_76_or_freed_mask;
+    if (rst) free_any_r <= 1'h1;
+    else free_any_r <= free_any_c;
+    if (rst) free_idx_r <= 6'h00;
+    else free_idx_r <= free_idx_c;
+    if (rst) just_alloc <= 1'h0;
+    else just_alloc <= alloc;
+    if (rst) occupied_r <= 7'h00;
+    else occupied_r <= minus_77;
+  end
+
+  // stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   assign ring_g_valid = g_valid;
   assign unpark_pop = take_unpark;
   assign new_pop = take_new;
@@ -1751,6 +1810,69 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_new_q_head_1 = new_q_head[32:1];
   assign s_bits_new_q_head_1 = $signed(bits_new_q_head_1);
   assign bits_new_q_head_2 = new_q_head[0];
+
+  always @(posedge clk) begin : queues_regs
+    if (rst) unpark_q_push <= 1'h0;
+    else unpark_q_push <= merge_valid;
+    if (rst) unpark_q_wr <= 6'h00;
+    else unpark_q_wr <= mux_unpark_q_push;
+    if (rst) unpark_q_rd <= 6'h00;
+    else unpark_q_rd <= unpark_q_rd_next;
+    if (rst) unpark_q_count <= 7'h00;
+    else unpark_q_count <= unpark_q_count_next;
+    if (rst) unpark_q_rd1 <= 6'h01;
+    else unpark_q_rd1 <= mux_unpark_pop;
+    if (rst) unpark_q_bypass <= 1'h0;
+    else unpark_q_bypass <= unpark_q_bypass_c;
+    if (rst) unpark_q_nonempty <= 1'h0;
+    else unpark_q_nonempty <= ne_82;
+    unpark_q_din <= cat_78;
+    unpark_q_q <= unpark_q_mem[unpark_q_rd_next];
+    if (unpark_q_push) unpark_q_din_r <= unpark_q_din;
+    if (rst) new_q_push <= 1'h0;
+    else new_q_push <= new_valid;
+    if (rst) new_q_wr <= 6'h00;
+    else new_q_wr <= mux_new_q_push;
+    if (rst) new_q_rd <= 6'h00;
+    else new_q_rd <= new_q_rd_next;
+    if (rst) new_q_count <= 7'h00;
+    else new_q_count <= new_q_count_next;
+    if (rst) new_q_rd1 <= 6'h01;
+    else new_q_rd1 <= mux_new_pop;
+    if (rst) new_q_bypass <= 1'h0;
+    else new_q_bypass <= new_q_bypass_c;
+    if (rst) new_q_nonempty <= 1'h0;
+    else new_q_nonempty <= ne_87;
+    new_q_din <= cat_83;
+    new_q_q <= new_q_mem[new_q_rd_next];
+    if (new_q_push) new_q_din_r <= new_q_din;
+    if (rst) q_valid <= 1'h0;
+    else q_valid <= take_unpark_or_take_new;
+    q_new <= take_new;
+    q_slot <= mux_take_unpark;
+    q_sp <= bits_unpark_q_head_1;
+    q_sp_zero <= eq_91;
+    q_sp_m1 <= minus_92;
+    q_tmax <= s_bits_new_q_head_1;
+    q_miss <= bits_new_q_head_2;
+  end
+
+  // stage ring_r: R: the token back from G, loaded in G
+
+  always @(posedge clk) begin : ring_r_regs
+    if (rst) r_valid <= 1'h0;
+    else r_valid <= g_valid;
+    r_pop <= not_enter_near_or_enter_far;
+    r_sp_zero <= and_130;
+    r_sp_m1 <= mux_push_1;
+    r_slot <= g_slot;
+    r_node <= mux_enter_near;
+    r_tmin <= mux_enter_far;
+    r_tmax <= mux_enter_near_1;
+    r_sp <= mux_push;
+  end
+
+  // stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   assign a_valid = r_valid | q_valid;
   assign a_slot = r_valid ? r_slot : q_slot;
   assign not_r_valid = ~r_valid;
@@ -1773,6 +1895,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign stack_wdata = cat_129;
   assign rs_a_sp_m1 = a_sp_m1[4:0];
   assign stack_raddr = {a_slot, rs_a_sp_m1};
+
+  // stage ring_b: B, B2: the token waits two clocks for the stack word
   assign not_a_done = ~a_done;
   assign a_live = a_valid & not_a_done;
   assign mux_r_valid = r_valid ? r_node : k_0_4;
@@ -1780,6 +1904,27 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign mux_r_valid_2 = r_valid ? r_tmax : q_tmax;
   assign mux_a_from_stack = a_from_stack ? a_sp_m1 : a_sp;
   assign b_from_stack = b_from_stack_sr[2];
+
+  always @(posedge clk) begin : ring_b_regs
+    if (rst) b_valid <= 1'h0;
+    else b_valid <= a_live;
+    b_slot <= a_slot;
+    b_node <= mux_r_valid;
+    b_tmin <= mux_r_valid_1;
+    b_tmax <= mux_r_valid_2;
+    b_sp <= mux_a_from_stack;
+    b_from_stack_sr[2] <= b_from_stack_sr[1];
+    b_from_stack_sr[1] <= a_from_stack;
+    if (rst) b2_valid <= 1'h0;
+    else b2_valid <= b_valid;
+    b2_slot <= b_slot;
+    b2_node <= b_node;
+    b2_tmin <= b_tmin;
+    b2_tmax <= b_tmax;
+    b2_sp <= b_sp;
+  end
+
+  // stage done: the done queue: slots whose ray left the ring in A, for the top
   assign done_q_wr_plus_k_1 = done_q_wr + k_1;
   assign mux_done_q_push = done_q_push ? done_q_wr_plus_k_1 : done_q_wr;
   assign done_q_rd_next = done_pop_r ? done_q_rd1 : done_q_rd;
@@ -1793,6 +1938,30 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign done_q_bypass_c = done_q_push & eq_97;
   assign ne_98 = done_q_count_next != k_0_3;
   assign done_q_head = done_q_bypass ? done_q_din_r : done_q_q;
+
+  always @(posedge clk) begin : done_regs
+    if (rst) done_pop_r <= 1'h0;
+    else done_pop_r <= done_pop;
+    if (rst) done_q_push <= 1'h0;
+    else done_q_push <= a_done;
+    if (rst) done_q_wr <= 6'h00;
+    else done_q_wr <= mux_done_q_push;
+    if (rst) done_q_rd <= 6'h00;
+    else done_q_rd <= done_q_rd_next;
+    if (rst) done_q_count <= 7'h00;
+    else done_q_count <= done_q_count_next;
+    if (rst) done_q_rd1 <= 6'h01;
+    else done_q_rd1 <= mux_done_pop_r;
+    if (rst) done_q_bypass <= 1'h0;
+    else done_q_bypass <= done_q_bypass_c;
+    if (rst) done_q_nonempty <= 1'h0;
+    else done_q_nonempty <= ne_98;
+    done_q_din <= a_slot;
+    done_q_q <= done_q_mem[done_q_rd_next];
+    if (done_q_push) done_q_din_r <= done_q_din;
+  end
+
+  // stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   assign bits_u_stack_data = u_stack_data[31:0];
   assign s_bits_u_stack_data = $signed(bits_u_stack_data);
   assign bits_u_stack_data_1 = u_stack_data[63:32];
@@ -1870,75 +2039,72 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_has_best_61 = has_best[61];
   assign bits_has_best_62 = has_best[62];
   assign bits_has_best_63 = has_best[63];
-  always @* begin
-    case (c_slot)
-      6'h00: slot_has_best = bits_has_best;
-      6'h01: slot_has_best = bits_has_best_1;
-      6'h02: slot_has_best = bits_has_best_2;
-      6'h03: slot_has_best = bits_has_best_3;
-      6'h04: slot_has_best = bits_has_best_4;
-      6'h05: slot_has_best = bits_has_best_5;
-      6'h06: slot_has_best = bits_has_best_6;
-      6'h07: slot_has_best = bits_has_best_7;
-      6'h08: slot_has_best = bits_has_best_8;
-      6'h09: slot_has_best = bits_has_best_9;
-      6'h0a: slot_has_best = bits_has_best_10;
-      6'h0b: slot_has_best = bits_has_best_11;
-      6'h0c: slot_has_best = bits_has_best_12;
-      6'h0d: slot_has_best = bits_has_best_13;
-      6'h0e: slot_has_best = bits_has_best_14;
-      6'h0f: slot_has_best = bits_has_best_15;
-      6'h10: slot_has_best = bits_has_best_16;
-      6'h11: slot_has_best = bits_has_best_17;
-      6'h12: slot_has_best = bits_has_best_18;
-      6'h13: slot_has_best = bits_has_best_19;
-      6'h14: slot_has_best = bits_has_best_20;
-      6'h15: slot_has_best = bits_has_best_21;
-      6'h16: slot_has_best = bits_has_best_22;
-      6'h17: slot_has_best = bits_has_best_23;
-      6'h18: slot_has_best = bits_has_best_24;
-      6'h19: slot_has_best = bits_has_best_25;
-      6'h1a: slot_has_best = bits_has_best_26;
-      6'h1b: slot_has_best = bits_has_best_27;
-      6'h1c: slot_has_best = bits_has_best_28;
-      6'h1d: slot_has_best = bits_has_best_29;
-      6'h1e: slot_has_best = bits_has_best_30;
-      6'h1f: slot_has_best = bits_has_best_31;
-      6'h20: slot_has_best = bits_has_best_32;
-      6'h21: slot_has_best = bits_has_best_33;
-      6'h22: slot_has_best = bits_has_best_34;
-      6'h23: slot_has_best = bits_has_best_35;
-      6'h24: slot_has_best = bits_has_best_36;
-      6'h25: slot_has_best = bits_has_best_37;
-      6'h26: slot_has_best = bits_has_best_38;
-      6'h27: slot_has_best = bits_has_best_39;
-      6'h28: slot_has_best = bits_has_best_40;
-      6'h29: slot_has_best = bits_has_best_41;
-      6'h2a: slot_has_best = bits_has_best_42;
-      6'h2b: slot_has_best = bits_has_best_43;
-      6'h2c: slot_has_best = bits_has_best_44;
-      6'h2d: slot_has_best = bits_has_best_45;
-      6'h2e: slot_has_best = bits_has_best_46;
-      6'h2f: slot_has_best = bits_has_best_47;
-      6'h30: slot_has_best = bits_has_best_48;
-      6'h31: slot_has_best = bits_has_best_49;
-      6'h32: slot_has_best = bits_has_best_50;
-      6'h33: slot_has_best = bits_has_best_51;
-      6'h34: slot_has_best = bits_has_best_52;
-      6'h35: slot_has_best = bits_has_best_53;
-      6'h36: slot_has_best = bits_has_best_54;
-      6'h37: slot_has_best = bits_has_best_55;
-      6'h38: slot_has_best = bits_has_best_56;
-      6'h39: slot_has_best = bits_has_best_57;
-      6'h3a: slot_has_best = bits_has_best_58;
-      6'h3b: slot_has_best = bits_has_best_59;
-      6'h3c: slot_has_best = bits_has_best_60;
-      6'h3d: slot_has_best = bits_has_best_61;
-      6'h3e: slot_has_best = bits_has_best_62;
-      6'h3f: slot_has_best = bits_has_best_63;
-      default: slot_has_best = k_0;
-    endcase
-  end
+  assign slot_has_best =
+    (c_slot == 6'h00) ? bits_has_best :
+    (c_slot == 6'h01) ? bits_has_best_1 :
+    (c_slot == 6'h02) ? bits_has_best_2 :
+    (c_slot == 6'h03) ? bits_has_best_3 :
+    (c_slot == 6'h04) ? bits_has_best_4 :
+    (c_slot == 6'h05) ? bits_has_best_5 :
+    (c_slot == 6'h06) ? bits_has_best_6 :
+    (c_slot == 6'h07) ? bits_has_best_7 :
+    (c_slot == 6'h08) ? bits_has_best_8 :
+    (c_slot == 6'h09) ? bits_has_best_9 :
+    (c_slot == 6'h0a) ? bits_has_best_10 :
+    (c_slot == 6'h0b) ? bits_has_best_11 :
+    (c_slot == 6'h0c) ? bits_has_best_12 :
+    (c_slot == 6'h0d) ? bits_has_best_13 :
+    (c_slot == 6'h0e) ? bits_has_best_14 :
+    (c_slot == 6'h0f) ? bits_has_best_15 :
+    (c_slot == 6'h10) ? bits_has_best_16 :
+    (c_slot == 6'h11) ? bits_has_best_17 :
+    (c_slot == 6'h12) ? bits_has_best_18 :
+    (c_slot == 6'h13) ? bits_has_best_19 :
+    (c_slot == 6'h14) ? bits_has_best_20 :
+    (c_slot == 6'h15) ? bits_has_best_21 :
+    (c_slot == 6'h16) ? bits_has_best_22 :
+    (c_slot == 6'h17) ? bits_has_best_23 :
+    (c_slot == 6'h18) ? bits_has_best_24 :
+    (c_slot == 6'h19) ? bits_has_best_25 :
+    (c_slot == 6'h1a) ? bits_has_best_26 :
+    (c_slot == 6'h1b) ? bits_has_best_27 :
+    (c_slot == 6'h1c) ? bits_has_best_28 :
+    (c_slot == 6'h1d) ? bits_has_best_29 :
+    (c_slot == 6'h1e) ? bits_has_best_30 :
+    (c_slot == 6'h1f) ? bits_has_best_31 :
+    (c_slot == 6'h20) ? bits_has_best_32 :
+    (c_slot == 6'h21) ? bits_has_best_33 :
+    (c_slot == 6'h22) ? bits_has_best_34 :
+    (c_slot == 6'h23) ? bits_has_best_35 :
+    (c_slot == 6'h24) ? bits_has_best_36 :
+    (c_slot == 6'h25) ? bits_has_best_37 :
+    (c_slot == 6'h26) ? bits_has_best_38 :
+    (c_slot == 6'h27) ? bits_has_best_39 :
+    (c_slot == 6'h28) ? bits_has_best_40 :
+    (c_slot == 6'h29) ? bits_has_best_41 :
+    (c_slot == 6'h2a) ? bits_has_best_42 :
+    (c_slot == 6'h2b) ? bits_has_best_43 :
+    (c_slot == 6'h2c) ? bits_has_best_44 :
+    (c_slot == 6'h2d) ? bits_has_best_45 :
+    (c_slot == 6'h2e) ? bits_has_best_46 :
+    (c_slot == 6'h2f) ? bits_has_best_47 :
+    (c_slot == 6'h30) ? bits_has_best_48 :
+    (c_slot == 6'h31) ? bits_has_best_49 :
+    (c_slot == 6'h32) ? bits_has_best_50 :
+    (c_slot == 6'h33) ? bits_has_best_51 :
+    (c_slot == 6'h34) ? bits_has_best_52 :
+    (c_slot == 6'h35) ? bits_has_best_53 :
+    (c_slot == 6'h36) ? bits_has_best_54 :
+    (c_slot == 6'h37) ? bits_has_best_55 :
+    (c_slot == 6'h38) ? bits_has_best_56 :
+    (c_slot == 6'h39) ? bits_has_best_57 :
+    (c_slot == 6'h3a) ? bits_has_best_58 :
+    (c_slot == 6'h3b) ? bits_has_best_59 :
+    (c_slot == 6'h3c) ? bits_has_best_60 :
+    (c_slot == 6'h3d) ? bits_has_best_61 :
+    (c_slot == 6'h3e) ? bits_has_best_62 :
+    (c_slot == 6'h3f) ? bits_has_best_63 :
+    k_0;
   assign rs_s_limit_q = $signed({{1{s_limit_q[31]}}, s_limit_q});
   assign rs_cull_x = $signed({{1{cull_x[31]}}, cull_x});
   assign minus_100 = rs_s_limit_q - rs_cull_x;
@@ -2081,6 +2247,25 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign not_best_clear = ~best_clear;
   assign and_105 = has_best & not_best_clear;
   assign and_105_or_best_set = and_105 | best_set;
+
+  always @(posedge clk) begin : ring_c_regs
+    if (rst) c_valid <= 1'h0;
+    else c_valid <= b2_valid;
+    c_slot <= b2_slot;
+    c_node <= mux_b_from_stack;
+    c_tmin <= mux_b_from_stack_1;
+    c_tmax <= mux_b_from_stack_2;
+    c_sp <= b2_sp;
+    limit_q <= cull_limit[c_slot];
+    if (rst) has_best <= 64'h0000000000000000;
+    else has_best <= and_105_or_best_set;
+    cull_x <= tmin_less;
+    cull_has_best <= slot_has_best;
+    culled <= culled_c;
+    culled_n <= culled;
+  end
+
+  // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   assign n_slot = n_slot_sr[3];
   assign n_node = n_node_sr[3];
   assign n_tmin = n_tmin_sr[3];
@@ -2124,23 +2309,17 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign s_ray_invz_q = $signed(ray_invz_q);
   assign rs_pu_sel_plane = {{1{1'b0}}, pu_sel_plane};
   assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
-  always @* begin
-    case (pu_sel_axis)
-      2'h1: case_pu_sel_axis = bits_ray_o_q_1;
-      2'h2: case_pu_sel_axis = bits_ray_o_q_2;
-      default: case_pu_sel_axis = bits_ray_o_q;
-    endcase
-  end
+  assign case_pu_sel_axis =
+    (pu_sel_axis == 2'h1) ? bits_ray_o_q_1 :
+    (pu_sel_axis == 2'h2) ? bits_ray_o_q_2 :
+    bits_ray_o_q;
   assign rs_case_pu_sel_axis = {{1{1'b0}}, case_pu_sel_axis};
   assign s_rs_case_pu_sel_axis = $signed(rs_case_pu_sel_axis);
   assign pu_diff = s_rs_pu_sel_plane - s_rs_case_pu_sel_axis;
-  always @* begin
-    case (pu_sel_axis)
-      2'h1: pu_inv_axis = s_ray_invy_q;
-      2'h2: pu_inv_axis = s_ray_invz_q;
-      default: pu_inv_axis = s_ray_invx_q;
-    endcase
-  end
+  assign pu_inv_axis =
+    (pu_sel_axis == 2'h1) ? s_ray_invy_q :
+    (pu_sel_axis == 2'h2) ? s_ray_invz_q :
+    s_ray_invx_q;
   assign pu_product = u_plane_product_p;
   assign pu_product_last = pu_product_last_sr[6];
   assign bits_pu_product = pu_product[77:16];
@@ -2157,23 +2336,17 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign rs_pu_sel_plane_1 = {{1{1'b0}}, pu_sel_plane_1};
   assign s_rs_pu_sel_plane_1 = $signed(rs_pu_sel_plane_1);
-  always @* begin
-    case (pu_sel_axis_1)
-      2'h1: case_pu_sel_axis_1 = bits_ray_o_q_1;
-      2'h2: case_pu_sel_axis_1 = bits_ray_o_q_2;
-      default: case_pu_sel_axis_1 = bits_ray_o_q;
-    endcase
-  end
+  assign case_pu_sel_axis_1 =
+    (pu_sel_axis_1 == 2'h1) ? bits_ray_o_q_1 :
+    (pu_sel_axis_1 == 2'h2) ? bits_ray_o_q_2 :
+    bits_ray_o_q;
   assign rs_case_pu_sel_axis_1 = {{1{1'b0}}, case_pu_sel_axis_1};
   assign s_rs_case_pu_sel_axis_1 = $signed(rs_case_pu_sel_axis_1);
   assign pu_diff_1 = s_rs_pu_sel_plane_1 - s_rs_case_pu_sel_axis_1;
-  always @* begin
-    case (pu_sel_axis_1)
-      2'h1: pu_inv_axis_1 = s_ray_invy_q;
-      2'h2: pu_inv_axis_1 = s_ray_invz_q;
-      default: pu_inv_axis_1 = s_ray_invx_q;
-    endcase
-  end
+  assign pu_inv_axis_1 =
+    (pu_sel_axis_1 == 2'h1) ? s_ray_invy_q :
+    (pu_sel_axis_1 == 2'h2) ? s_ray_invz_q :
+    s_ray_invx_q;
   assign pu_product_1 = u_plane_product_1_p;
   assign pu_product_last_1 = pu_product_last_1_sr[6];
   assign bits_pu_product_1 = pu_product_1[77:16];
@@ -2188,229 +2361,14 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign pu_clamped_1 = pu_above_r_1 ? k_1073741824 : mux_pu_below_r_1;
   assign not_pu_clamp_last_1 = ~pu_clamp_last_1;
   assign pu_first_1 = pu_clamp_valid_1 & not_pu_clamp_last_1;
-  always @* begin
-    case (axis_n1)
-      2'h1: case_axis_n1 = s_ray_invy_q;
-      2'h2: case_axis_n1 = s_ray_invz_q;
-      default: case_axis_n1 = s_ray_invx_q;
-    endcase
-  end
+  assign case_axis_n1 =
+    (axis_n1 == 2'h1) ? s_ray_invy_q :
+    (axis_n1 == 2'h2) ? s_ray_invz_q :
+    s_ray_invx_q;
   assign negative_c = case_axis_n1[47];
   assign negative = negative_sr[9];
-  assign not_leaf_push = ~leaf_push;
-  assign n_stays = n_valid_3 & not_leaf_push;
-  assign f_inner = f_inner_sr[10];
-  assign f_slot = f_slot_sr[10];
-  assign f_tmin = f_tmin_sr[10];
-  assign f_tmax = f_tmax_sr[10];
-  assign f_sp = f_sp_sr[10];
-  assign f_child = f_child_sr[10];
-  always @* begin
-    case (axis_n1)
-      2'h1: case_axis_n1_1 = s_ray_invy_q;
-      2'h2: case_axis_n1_1 = s_ray_invz_q;
-      default: case_axis_n1_1 = s_ray_invx_q;
-    endcase
-  end
-  assign bits_case_axis_n1_1 = case_axis_n1_1[47];
-  assign tmax_plus_1 = n_tmax + k_1_2;
-  assign tmin_minus_1 = n_tmin - k_1_2;
-  assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
-  assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
-  assign minus_122 = rs_tmin_n1 - rs_tmax_p1;
-  assign tmin_le_tmax_c = minus_122[32];
-  assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
-  assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
-  assign d0_hi = d0_hi_sr[7];
-  assign mux_negative_n1_1 = negative_n1 ? tmin_n2 : tmin_m1_n2;
-  assign d0_lo_c = tmin_le_tmax ? mux_negative_n1_1 : k_2147483647;
-  assign d0_lo = d0_lo_sr[7];
-  assign mux_negative_n1_2 = negative_n1 ? tmax_n2 : tmax_p1_n2;
-  assign d1_hi_c = tmin_le_tmax ? mux_negative_n1_2 : k_m2147483648;
-  assign d1_hi = d1_hi_sr[7];
-  assign mux_negative_n1_3 = negative_n1 ? tmin_m1_n2 : tmin_n2;
-  assign d1_lo_c = tmin_le_tmax ? mux_negative_n1_3 : k_2147483647;
-  assign d1_lo = d1_lo_sr[7];
-  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
-  assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_123 = rs_plane_t - rs_d0_hi;
-  assign d0_below = minus_123[32];
-  assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
-  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign minus_124 = rs_d0_lo - rs_plane_t_1;
-  assign d0_above = minus_124[32];
-  assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_125 = rs_plane_t_1_1 - rs_d1_hi;
-  assign d1_below = minus_125[32];
-  assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
-  assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign minus_126 = rs_d1_lo - rs_plane_t_1_2;
-  assign d1_above = minus_126[32];
-  assign near_lt_tmax_c = negative ? d1_below : d0_below;
-  assign far_gt_tmin_c = negative ? d0_above : d1_above;
-  assign go_near_c = negative ? d1_above : d0_above;
-  assign go_far_c = negative ? d0_below : d1_below;
-  assign mux_negative = negative ? plane_t_1 : plane_t;
-  assign mux_negative_1 = negative ? plane_t : plane_t_1;
-  assign g_child_plus_k_1_3 = g_child + k_1_3;
-  assign near = g_negative ? g_child_plus_k_1_3 : g_child;
-  assign far = g_negative ? g_child : g_child_plus_k_1_3;
-  assign near_max = near_lt_tmax ? near_end : g_tmax;
-  assign far_min = far_gt_tmin ? far_start : g_tmin;
-  assign enter_near = g_inner & go_near;
-  assign not_go_near = ~go_near;
-  assign g_inner_and_not_go_near = g_inner & not_go_near;
-  assign enter_far = g_inner_and_not_go_near & go_far;
-  assign push = enter_near & go_far;
-  assign rs_g_sp = g_sp[4:0];
-  assign cat_128 = {g_slot, rs_g_sp};
-  assign u_far_min = $unsigned(far_min);
-  assign u_g_tmax = $unsigned(g_tmax);
-  assign cat_129 = {far, u_far_min, u_g_tmax};
-  assign enter_near_or_enter_far = enter_near | enter_far;
-  assign not_enter_near_or_enter_far = ~enter_near_or_enter_far;
-  assign mux_enter_near = enter_near ? near : far;
-  assign mux_enter_far = enter_far ? far_min : g_tmin;
-  assign mux_enter_near_1 = enter_near ? near_max : g_tmax;
-  assign g_sp_plus_k_1 = g_sp + k_1;
-  assign mux_push = push ? g_sp_plus_k_1 : g_sp;
-  assign not_push = ~push;
-  assign g_sp_eq_k_0_1 = g_sp == k_0_1;
-  assign and_130 = not_push & g_sp_eq_k_0_1;
-  assign g_sp_minus_k_1 = g_sp - k_1;
-  assign mux_push_1 = push ? g_sp : g_sp_minus_k_1;
-  assign not_just_alloc = ~just_alloc;
-  assign has_free_c = free_any_r & not_just_alloc;
-  assign bits_leaf_q_head = leaf_q_head[5:0];
-  assign bits_leaf_q_head_1 = leaf_q_head[36:6];
-  assign bits_leaf_q_head_2 = leaf_q_head[39:37];
-  assign bits_leaf_q_head_3 = leaf_q_head[52:40];
-  assign bits_leaf_q_head_4 = leaf_q_head[58:53];
-  assign cull_c = n_valid_3 & culled_n;
 
-  always @(posedge clk) begin : regs
-    if (ray_we) ray_o[ray_slot] <= cat_0;
-    if (ray_we) ray_invx[ray_slot] <= u_invx;
-    if (ray_we) ray_invy[ray_slot] <= u_invy;
-    if (ray_we) ray_invz[ray_slot] <= u_invz;
-    if (unpark_q_push) unpark_q_mem[unpark_q_wr] <= unpark_q_din;
-    if (new_q_push) new_q_mem[new_q_wr] <= new_q_din;
-    if (done_q_push) done_q_mem[done_q_wr] <= done_q_din;
-    if (limit_we) cull_limit[merge_slot] <= u_merge_limit;
-    if (leaf_q_push) leaf_q_mem[leaf_q_wr] <= leaf_q_din;
-    if (rst) free_bits <= 64'hffffffffffffffff;
-    else free_bits <= and_76_or_freed_mask;
-    if (rst) free_any_r <= 1'h1;
-    else free_any_r <= free_any_c;
-    if (rst) free_idx_r <= 6'h00;
-    else free_idx_r <= free_idx_c;
-    if (rst) just_alloc <= 1'h0;
-    else just_alloc <= alloc;
-    if (rst) occupied_r <= 7'h00;
-    else occupied_r <= minus_77;
-    if (rst) unpark_q_push <= 1'h0;
-    else unpark_q_push <= merge_valid;
-    if (rst) unpark_q_wr <= 6'h00;
-    else unpark_q_wr <= mux_unpark_q_push;
-    if (rst) unpark_q_rd <= 6'h00;
-    else unpark_q_rd <= unpark_q_rd_next;
-    if (rst) unpark_q_count <= 7'h00;
-    else unpark_q_count <= unpark_q_count_next;
-    if (rst) unpark_q_rd1 <= 6'h01;
-    else unpark_q_rd1 <= mux_unpark_pop;
-    if (rst) unpark_q_bypass <= 1'h0;
-    else unpark_q_bypass <= unpark_q_bypass_c;
-    if (rst) unpark_q_nonempty <= 1'h0;
-    else unpark_q_nonempty <= ne_82;
-    unpark_q_din <= cat_78;
-    unpark_q_q <= unpark_q_mem[unpark_q_rd_next];
-    if (unpark_q_push) unpark_q_din_r <= unpark_q_din;
-    if (rst) new_q_push <= 1'h0;
-    else new_q_push <= new_valid;
-    if (rst) new_q_wr <= 6'h00;
-    else new_q_wr <= mux_new_q_push;
-    if (rst) new_q_rd <= 6'h00;
-    else new_q_rd <= new_q_rd_next;
-    if (rst) new_q_count <= 7'h00;
-    else new_q_count <= new_q_count_next;
-    if (rst) new_q_rd1 <= 6'h01;
-    else new_q_rd1 <= mux_new_pop;
-    if (rst) new_q_bypass <= 1'h0;
-    else new_q_bypass <= new_q_bypass_c;
-    if (rst) new_q_nonempty <= 1'h0;
-    else new_q_nonempty <= ne_87;
-    new_q_din <= cat_83;
-    new_q_q <= new_q_mem[new_q_rd_next];
-    if (new_q_push) new_q_din_r <= new_q_din;
-    if (rst) q_valid <= 1'h0;
-    else q_valid <= take_unpark_or_take_new;
-    q_new <= take_new;
-    q_slot <= mux_take_unpark;
-    q_sp <= bits_unpark_q_head_1;
-    q_sp_zero <= eq_91;
-    q_sp_m1 <= minus_92;
-    q_tmax <= s_bits_new_q_head_1;
-    q_miss <= bits_new_q_head_2;
-    if (rst) r_valid <= 1'h0;
-    else r_valid <= g_valid;
-    r_pop <= not_enter_near_or_enter_far;
-    r_sp_zero <= and_130;
-    r_sp_m1 <= mux_push_1;
-    r_slot <= g_slot;
-    r_node <= mux_enter_near;
-    r_tmin <= mux_enter_far;
-    r_tmax <= mux_enter_near_1;
-    r_sp <= mux_push;
-    if (rst) b_valid <= 1'h0;
-    else b_valid <= a_live;
-    b_slot <= a_slot;
-    b_node <= mux_r_valid;
-    b_tmin <= mux_r_valid_1;
-    b_tmax <= mux_r_valid_2;
-    b_sp <= mux_a_from_stack;
-    b_from_stack_sr[2] <= b_from_stack_sr[1];
-    b_from_stack_sr[1] <= a_from_stack;
-    if (rst) b2_valid <= 1'h0;
-    else b2_valid <= b_valid;
-    b2_slot <= b_slot;
-    b2_node <= b_node;
-    b2_tmin <= b_tmin;
-    b2_tmax <= b_tmax;
-    b2_sp <= b_sp;
-    if (rst) done_pop_r <= 1'h0;
-    else done_pop_r <= done_pop;
-    if (rst) done_q_push <= 1'h0;
-    else done_q_push <= a_done;
-    if (rst) done_q_wr <= 6'h00;
-    else done_q_wr <= mux_done_q_push;
-    if (rst) done_q_rd <= 6'h00;
-    else done_q_rd <= done_q_rd_next;
-    if (rst) done_q_count <= 7'h00;
-    else done_q_count <= done_q_count_next;
-    if (rst) done_q_rd1 <= 6'h01;
-    else done_q_rd1 <= mux_done_pop_r;
-    if (rst) done_q_bypass <= 1'h0;
-    else done_q_bypass <= done_q_bypass_c;
-    if (rst) done_q_nonempty <= 1'h0;
-    else done_q_nonempty <= ne_98;
-    done_q_din <= a_slot;
-    done_q_q <= done_q_mem[done_q_rd_next];
-    if (done_q_push) done_q_din_r <= done_q_din;
-    if (rst) c_valid <= 1'h0;
-    else c_valid <= b2_valid;
-    c_slot <= b2_slot;
-    c_node <= mux_b_from_stack;
-    c_tmin <= mux_b_from_stack_1;
-    c_tmax <= mux_b_from_stack_2;
-    c_sp <= b2_sp;
-    limit_q <= cull_limit[c_slot];
-    if (rst) has_best <= 64'h0000000000000000;
-    else has_best <= and_105_or_best_set;
-    cull_x <= tmin_less;
-    cull_has_best <= slot_has_best;
-    culled <= culled_c;
-    culled_n <= culled;
+  always @(posedge clk) begin : ring_n_regs
     if (rst) n_valid_1 <= 1'h0;
     else n_valid_1 <= c_valid;
     if (rst) n_valid_2 <= 1'h0;
@@ -2545,6 +2503,64 @@ module fxrt_traverse_k64_sf0a3f4 (
     negative_sr[3] <= negative_sr[2];
     negative_sr[2] <= negative_sr[1];
     negative_sr[1] <= negative_c;
+  end
+
+  // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
+  assign not_leaf_push = ~leaf_push;
+  assign n_stays = n_valid_3 & not_leaf_push;
+  assign f_inner = f_inner_sr[10];
+  assign f_slot = f_slot_sr[10];
+  assign f_tmin = f_tmin_sr[10];
+  assign f_tmax = f_tmax_sr[10];
+  assign f_sp = f_sp_sr[10];
+  assign f_child = f_child_sr[10];
+  assign case_axis_n1_1 =
+    (axis_n1 == 2'h1) ? s_ray_invy_q :
+    (axis_n1 == 2'h2) ? s_ray_invz_q :
+    s_ray_invx_q;
+  assign bits_case_axis_n1_1 = case_axis_n1_1[47];
+  assign tmax_plus_1 = n_tmax + k_1_2;
+  assign tmin_minus_1 = n_tmin - k_1_2;
+  assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
+  assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
+  assign minus_122 = rs_tmin_n1 - rs_tmax_p1;
+  assign tmin_le_tmax_c = minus_122[32];
+  assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
+  assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
+  assign d0_hi = d0_hi_sr[7];
+  assign mux_negative_n1_1 = negative_n1 ? tmin_n2 : tmin_m1_n2;
+  assign d0_lo_c = tmin_le_tmax ? mux_negative_n1_1 : k_2147483647;
+  assign d0_lo = d0_lo_sr[7];
+  assign mux_negative_n1_2 = negative_n1 ? tmax_n2 : tmax_p1_n2;
+  assign d1_hi_c = tmin_le_tmax ? mux_negative_n1_2 : k_m2147483648;
+  assign d1_hi = d1_hi_sr[7];
+  assign mux_negative_n1_3 = negative_n1 ? tmin_m1_n2 : tmin_n2;
+  assign d1_lo_c = tmin_le_tmax ? mux_negative_n1_3 : k_2147483647;
+  assign d1_lo = d1_lo_sr[7];
+  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
+  assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
+  assign minus_123 = rs_plane_t - rs_d0_hi;
+  assign d0_below = minus_123[32];
+  assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
+  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
+  assign minus_124 = rs_d0_lo - rs_plane_t_1;
+  assign d0_above = minus_124[32];
+  assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
+  assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
+  assign minus_125 = rs_plane_t_1_1 - rs_d1_hi;
+  assign d1_below = minus_125[32];
+  assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
+  assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
+  assign minus_126 = rs_d1_lo - rs_plane_t_1_2;
+  assign d1_above = minus_126[32];
+  assign near_lt_tmax_c = negative ? d1_below : d0_below;
+  assign far_gt_tmin_c = negative ? d0_above : d1_above;
+  assign go_near_c = negative ? d1_above : d0_above;
+  assign go_far_c = negative ? d0_below : d1_below;
+  assign mux_negative = negative ? plane_t_1 : plane_t;
+  assign mux_negative_1 = negative ? plane_t : plane_t_1;
+
+  always @(posedge clk) begin : ring_f_regs
     if (rst) f_valid_1 <= 1'h0;
     else f_valid_1 <= n_stays;
     if (rst) f_valid_2 <= 1'h0;
@@ -2683,6 +2699,35 @@ module fxrt_traverse_k64_sf0a3f4 (
     g_inner <= f_inner;
     g_negative <= negative;
   end
+
+  // stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
+  assign g_child_plus_k_1_3 = g_child + k_1_3;
+  assign near = g_negative ? g_child_plus_k_1_3 : g_child;
+  assign far = g_negative ? g_child : g_child_plus_k_1_3;
+  assign near_max = near_lt_tmax ? near_end : g_tmax;
+  assign far_min = far_gt_tmin ? far_start : g_tmin;
+  assign enter_near = g_inner & go_near;
+  assign not_go_near = ~go_near;
+  assign g_inner_and_not_go_near = g_inner & not_go_near;
+  assign enter_far = g_inner_and_not_go_near & go_far;
+  assign push = enter_near & go_far;
+  assign rs_g_sp = g_sp[4:0];
+  assign cat_128 = {g_slot, rs_g_sp};
+  assign u_far_min = $unsigned(far_min);
+  assign u_g_tmax = $unsigned(g_tmax);
+  assign cat_129 = {far, u_far_min, u_g_tmax};
+  assign enter_near_or_enter_far = enter_near | enter_far;
+  assign not_enter_near_or_enter_far = ~enter_near_or_enter_far;
+  assign mux_enter_near = enter_near ? near : far;
+  assign mux_enter_far = enter_far ? far_min : g_tmin;
+  assign mux_enter_near_1 = enter_near ? near_max : g_tmax;
+  assign g_sp_plus_k_1 = g_sp + k_1;
+  assign mux_push = push ? g_sp_plus_k_1 : g_sp;
+  assign not_push = ~push;
+  assign g_sp_eq_k_0_1 = g_sp == k_0_1;
+  assign and_130 = not_push & g_sp_eq_k_0_1;
+  assign g_sp_minus_k_1 = g_sp - k_1;
+  assign mux_push_1 = push ? g_sp : g_sp_minus_k_1;
 
   fxrt_bram_stack_w77 u_stack (
     .clk(clk),

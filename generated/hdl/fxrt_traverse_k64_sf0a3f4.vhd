@@ -97,10 +97,21 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type leaf_q_mem_t is array (0 to 63) of unsigned(58 downto 0);
   signal leaf_q_mem : leaf_q_mem_t := (others => (others => '0'));
 
+  -- not in a stage or state machine
   signal cat_0 : unsigned(86 downto 0);
   signal u_invx : unsigned(47 downto 0);
   signal u_invy : unsigned(47 downto 0);
   signal u_invz : unsigned(47 downto 0);
+  signal not_just_alloc : unsigned(0 downto 0);
+  signal has_free_c : unsigned(0 downto 0);
+  signal bits_leaf_q_head : unsigned(5 downto 0);
+  signal bits_leaf_q_head_1 : unsigned(30 downto 0);
+  signal bits_leaf_q_head_2 : unsigned(2 downto 0);
+  signal bits_leaf_q_head_3 : unsigned(12 downto 0);
+  signal bits_leaf_q_head_4 : unsigned(5 downto 0);
+  signal cull_c : unsigned(0 downto 0);
+
+  -- stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
   signal free_bits : unsigned(63 downto 0) := unsigned'("1111111111111111111111111111111111111111111111111111111111111111");
   signal bits_free_bits : unsigned(0 downto 0);
   signal bits_free_bits_1 : unsigned(0 downto 0);
@@ -563,6 +574,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal occupied_r_plus_rs_alloc : unsigned(6 downto 0);
   signal rs_free_valid : unsigned(6 downto 0);
   signal minus_77 : unsigned(6 downto 0);
+
+  -- stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   signal ring_g_valid : unsigned(0 downto 0);
   signal unpark_pop : unsigned(0 downto 0);
   signal new_pop : unsigned(0 downto 0);
@@ -640,6 +653,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal q_tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal bits_new_q_head_2 : unsigned(0 downto 0);
   signal q_miss : unsigned(0 downto 0) := unsigned'("0");
+
+  -- stage ring_r: R: the token back from G, loaded in G
   signal r_valid : unsigned(0 downto 0) := unsigned'("0");
   signal r_pop : unsigned(0 downto 0) := unsigned'("0");
   signal r_sp_zero : unsigned(0 downto 0) := unsigned'("0");
@@ -649,6 +664,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal r_tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal r_tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal r_sp : unsigned(5 downto 0) := unsigned'("000000");
+
+  -- stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   signal a_valid : unsigned(0 downto 0);
   signal a_slot : unsigned(5 downto 0);
   signal not_r_valid : unsigned(0 downto 0);
@@ -672,6 +689,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal rs_a_sp_m1 : unsigned(4 downto 0);
   signal stack_raddr : unsigned(10 downto 0);
   signal u_stack_data : unsigned(76 downto 0);
+
+  -- stage ring_b: B, B2: the token waits two clocks for the stack word
   signal not_a_done : unsigned(0 downto 0);
   signal a_live : unsigned(0 downto 0);
   signal b_valid : unsigned(0 downto 0) := unsigned'("0");
@@ -695,6 +714,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal b2_tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal b2_tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal b2_sp : unsigned(5 downto 0) := unsigned'("000000");
+
+  -- stage done: the done queue: slots whose ray left the ring in A, for the top
   signal done_pop_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_wr : unsigned(5 downto 0) := unsigned'("000000");
@@ -719,6 +740,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal done_q_q : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_din_r : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_head : unsigned(5 downto 0);
+
+  -- stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   signal bits_u_stack_data : unsigned(31 downto 0);
   signal s_bits_u_stack_data : signed(31 downto 0);
   signal bits_u_stack_data_1 : unsigned(31 downto 0);
@@ -951,6 +974,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal not_best_clear : unsigned(63 downto 0);
   signal and_105 : unsigned(63 downto 0);
   signal and_105_or_best_set : unsigned(63 downto 0);
+
+  -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   signal n_valid_1 : unsigned(0 downto 0) := unsigned'("0");
   signal n_valid_2 : unsigned(0 downto 0) := unsigned'("0");
   signal n_valid_3 : unsigned(0 downto 0) := unsigned'("0");
@@ -1128,6 +1153,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type negative_sr_t is array (1 to 9) of unsigned(0 downto 0);
   signal negative_sr : negative_sr_t := (others => (others => '0'));
   signal negative : unsigned(0 downto 0);
+
+  -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   signal not_leaf_push : unsigned(0 downto 0);
   signal n_stays : unsigned(0 downto 0);
   signal f_valid_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1239,6 +1266,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal g_sp : unsigned(5 downto 0) := unsigned'("000000");
   signal g_inner : unsigned(0 downto 0) := unsigned'("0");
   signal g_negative : unsigned(0 downto 0) := unsigned'("0");
+
+  -- stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
   constant k_1_3 : unsigned(12 downto 0) := unsigned'("0000000000001");
   signal g_child_plus_k_1_3 : unsigned(12 downto 0);
   signal near : unsigned(12 downto 0);
@@ -1267,20 +1296,56 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal and_130 : unsigned(0 downto 0);
   signal g_sp_minus_k_1 : unsigned(5 downto 0);
   signal mux_push_1 : unsigned(5 downto 0);
-  signal not_just_alloc : unsigned(0 downto 0);
-  signal has_free_c : unsigned(0 downto 0);
-  signal bits_leaf_q_head : unsigned(5 downto 0);
-  signal bits_leaf_q_head_1 : unsigned(30 downto 0);
-  signal bits_leaf_q_head_2 : unsigned(2 downto 0);
-  signal bits_leaf_q_head_3 : unsigned(12 downto 0);
-  signal bits_leaf_q_head_4 : unsigned(5 downto 0);
-  signal cull_c : unsigned(0 downto 0);
 begin
 
+  -- not in a stage or state machine
   cat_0 <= unsigned(std_logic_vector'(std_logic_vector(oz) & std_logic_vector(oy) & std_logic_vector(ox)));
   u_invx <= unsigned(invx);
   u_invy <= unsigned(invy);
   u_invz <= unsigned(invz);
+  not_just_alloc <= not just_alloc;
+  has_free_c <= free_any_r and not_just_alloc;
+  bits_leaf_q_head <= unsigned(leaf_q_head(5 downto 0));
+  bits_leaf_q_head_1 <= unsigned(leaf_q_head(36 downto 6));
+  bits_leaf_q_head_2 <= unsigned(leaf_q_head(39 downto 37));
+  bits_leaf_q_head_3 <= unsigned(leaf_q_head(52 downto 40));
+  bits_leaf_q_head_4 <= unsigned(leaf_q_head(58 downto 53));
+  cull_c <= n_valid_3 and culled_n;
+
+  regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if ray_we = "1" then
+        ray_o(to_integer(ray_slot)) <= cat_0;
+      end if;
+      if ray_we = "1" then
+        ray_invx(to_integer(ray_slot)) <= u_invx;
+      end if;
+      if ray_we = "1" then
+        ray_invy(to_integer(ray_slot)) <= u_invy;
+      end if;
+      if ray_we = "1" then
+        ray_invz(to_integer(ray_slot)) <= u_invz;
+      end if;
+      if unpark_q_push = "1" then
+        unpark_q_mem(to_integer(unpark_q_wr)) <= unpark_q_din;
+      end if;
+      if new_q_push = "1" then
+        new_q_mem(to_integer(new_q_wr)) <= new_q_din;
+      end if;
+      if done_q_push = "1" then
+        done_q_mem(to_integer(done_q_wr)) <= done_q_din;
+      end if;
+      if limit_we = "1" then
+        cull_limit(to_integer(merge_slot)) <= u_merge_limit;
+      end if;
+      if leaf_q_push = "1" then
+        leaf_q_mem(to_integer(leaf_q_wr)) <= leaf_q_din;
+      end if;
+    end if;
+  end process regs;
+
+  -- stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
   bits_free_bits <= unsigned(free_bits(0 downto 0));
   bits_free_bits_1 <= unsigned(free_bits(1 downto 1));
   bits_free_bits_2 <= unsigned(free_bits(2 downto 2));
@@ -1672,6 +1737,39 @@ begin
   occupied_r_plus_rs_alloc <= occupied_r + rs_alloc;
   rs_free_valid <= resize(free_valid, 7);
   minus_77 <= occupied_r_plus_rs_alloc - rs_free_valid;
+
+  slots_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        free_bits <= unsigned'("1111111111111111111111111111111111111111111111111111111111111111");
+      else
+        free_bits <= and_76_or_freed_mask;
+      end if;
+      if rst = '1' then
+        free_any_r <= unsigned'("1");
+      else
+        free_any_r <= free_any_c;
+      end if;
+      if rst = '1' then
+        free_idx_r <= unsigned'("000000");
+      else
+        free_idx_r <= free_idx_c;
+      end if;
+      if rst = '1' then
+        just_alloc <= unsigned'("0");
+      else
+        just_alloc <= alloc;
+      end if;
+      if rst = '1' then
+        occupied_r <= unsigned'("0000000");
+      else
+        occupied_r <= minus_77;
+      end if;
+    end if;
+  end process slots_regs;
+
+  -- stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   ring_g_valid <= g_valid;
   unpark_pop <= take_unpark;
   new_pop <= take_new;
@@ -1720,6 +1818,127 @@ begin
   bits_new_q_head_1 <= unsigned(new_q_head(32 downto 1));
   s_bits_new_q_head_1 <= signed(bits_new_q_head_1);
   bits_new_q_head_2 <= unsigned(new_q_head(0 downto 0));
+
+  queues_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        unpark_q_push <= unsigned'("0");
+      else
+        unpark_q_push <= merge_valid;
+      end if;
+      if rst = '1' then
+        unpark_q_wr <= unsigned'("000000");
+      else
+        unpark_q_wr <= mux_unpark_q_push;
+      end if;
+      if rst = '1' then
+        unpark_q_rd <= unsigned'("000000");
+      else
+        unpark_q_rd <= unpark_q_rd_next;
+      end if;
+      if rst = '1' then
+        unpark_q_count <= unsigned'("0000000");
+      else
+        unpark_q_count <= unpark_q_count_next;
+      end if;
+      if rst = '1' then
+        unpark_q_rd1 <= unsigned'("000001");
+      else
+        unpark_q_rd1 <= mux_unpark_pop;
+      end if;
+      if rst = '1' then
+        unpark_q_bypass <= unsigned'("0");
+      else
+        unpark_q_bypass <= unpark_q_bypass_c;
+      end if;
+      if rst = '1' then
+        unpark_q_nonempty <= unsigned'("0");
+      else
+        unpark_q_nonempty <= ne_82;
+      end if;
+      unpark_q_din <= cat_78;
+      unpark_q_q <= unpark_q_mem(to_integer(unpark_q_rd_next));
+      if unpark_q_push = "1" then
+        unpark_q_din_r <= unpark_q_din;
+      end if;
+      if rst = '1' then
+        new_q_push <= unsigned'("0");
+      else
+        new_q_push <= new_valid;
+      end if;
+      if rst = '1' then
+        new_q_wr <= unsigned'("000000");
+      else
+        new_q_wr <= mux_new_q_push;
+      end if;
+      if rst = '1' then
+        new_q_rd <= unsigned'("000000");
+      else
+        new_q_rd <= new_q_rd_next;
+      end if;
+      if rst = '1' then
+        new_q_count <= unsigned'("0000000");
+      else
+        new_q_count <= new_q_count_next;
+      end if;
+      if rst = '1' then
+        new_q_rd1 <= unsigned'("000001");
+      else
+        new_q_rd1 <= mux_new_pop;
+      end if;
+      if rst = '1' then
+        new_q_bypass <= unsigned'("0");
+      else
+        new_q_bypass <= new_q_bypass_c;
+      end if;
+      if rst = '1' then
+        new_q_nonempty <= unsigned'("0");
+      else
+        new_q_nonempty <= ne_87;
+      end if;
+      new_q_din <= cat_83;
+      new_q_q <= new_q_mem(to_integer(new_q_rd_next));
+      if new_q_push = "1" then
+        new_q_din_r <= new_q_din;
+      end if;
+      if rst = '1' then
+        q_valid <= unsigned'("0");
+      else
+        q_valid <= take_unpark_or_take_new;
+      end if;
+      q_new <= take_new;
+      q_slot <= mux_take_unpark;
+      q_sp <= bits_unpark_q_head_1;
+      q_sp_zero <= eq_91;
+      q_sp_m1 <= minus_92;
+      q_tmax <= s_bits_new_q_head_1;
+      q_miss <= bits_new_q_head_2;
+    end if;
+  end process queues_regs;
+
+  -- stage ring_r: R: the token back from G, loaded in G
+
+  ring_r_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        r_valid <= unsigned'("0");
+      else
+        r_valid <= g_valid;
+      end if;
+      r_pop <= not_enter_near_or_enter_far;
+      r_sp_zero <= and_130;
+      r_sp_m1 <= mux_push_1;
+      r_slot <= g_slot;
+      r_node <= mux_enter_near;
+      r_tmin <= mux_enter_far;
+      r_tmax <= mux_enter_near_1;
+      r_sp <= mux_push;
+    end if;
+  end process ring_r_regs;
+
+  -- stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   a_valid <= r_valid or q_valid;
   a_slot <= r_slot when r_valid = "1" else q_slot;
   not_r_valid <= not r_valid;
@@ -1742,6 +1961,8 @@ begin
   stack_wdata <= cat_129;
   rs_a_sp_m1 <= a_sp_m1(4 downto 0);
   stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(a_slot) & std_logic_vector(rs_a_sp_m1)));
+
+  -- stage ring_b: B, B2: the token waits two clocks for the stack word
   not_a_done <= not a_done;
   a_live <= a_valid and not_a_done;
   mux_r_valid <= r_node when r_valid = "1" else k_0_4;
@@ -1749,6 +1970,36 @@ begin
   mux_r_valid_2 <= r_tmax when r_valid = "1" else q_tmax;
   mux_a_from_stack <= a_sp_m1 when a_from_stack = "1" else a_sp;
   b_from_stack <= b_from_stack_sr(2);
+
+  ring_b_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        b_valid <= unsigned'("0");
+      else
+        b_valid <= a_live;
+      end if;
+      b_slot <= a_slot;
+      b_node <= mux_r_valid;
+      b_tmin <= mux_r_valid_1;
+      b_tmax <= mux_r_valid_2;
+      b_sp <= mux_a_from_stack;
+      b_from_stack_sr(2 to 2) <= b_from_stack_sr(1 to 1);
+      b_from_stack_sr(1) <= a_from_stack;
+      if rst = '1' then
+        b2_valid <= unsigned'("0");
+      else
+        b2_valid <= b_valid;
+      end if;
+      b2_slot <= b_slot;
+      b2_node <= b_node;
+      b2_tmin <= b_tmin;
+      b2_tmax <= b_tmax;
+      b2_sp <= b_sp;
+    end if;
+  end process ring_b_regs;
+
+  -- stage done: the done queue: slots whose ray left the ring in A, for the top
   done_q_wr_plus_k_1 <= done_q_wr + k_1;
   mux_done_q_push <= done_q_wr_plus_k_1 when done_q_push = "1" else done_q_wr;
   done_q_rd_next <= done_q_rd1 when done_pop_r = "1" else done_q_rd;
@@ -1762,6 +2013,59 @@ begin
   done_q_bypass_c <= done_q_push and eq_97;
   ne_98 <= "1" when done_q_count_next /= k_0_3 else "0";
   done_q_head <= done_q_din_r when done_q_bypass = "1" else done_q_q;
+
+  done_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        done_pop_r <= unsigned'("0");
+      else
+        done_pop_r <= done_pop;
+      end if;
+      if rst = '1' then
+        done_q_push <= unsigned'("0");
+      else
+        done_q_push <= a_done;
+      end if;
+      if rst = '1' then
+        done_q_wr <= unsigned'("000000");
+      else
+        done_q_wr <= mux_done_q_push;
+      end if;
+      if rst = '1' then
+        done_q_rd <= unsigned'("000000");
+      else
+        done_q_rd <= done_q_rd_next;
+      end if;
+      if rst = '1' then
+        done_q_count <= unsigned'("0000000");
+      else
+        done_q_count <= done_q_count_next;
+      end if;
+      if rst = '1' then
+        done_q_rd1 <= unsigned'("000001");
+      else
+        done_q_rd1 <= mux_done_pop_r;
+      end if;
+      if rst = '1' then
+        done_q_bypass <= unsigned'("0");
+      else
+        done_q_bypass <= done_q_bypass_c;
+      end if;
+      if rst = '1' then
+        done_q_nonempty <= unsigned'("0");
+      else
+        done_q_nonempty <= ne_98;
+      end if;
+      done_q_din <= a_slot;
+      done_q_q <= done_q_mem(to_integer(done_q_rd_next));
+      if done_q_push = "1" then
+        done_q_din_r <= done_q_din;
+      end if;
+    end if;
+  end process done_regs;
+
+  -- stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   bits_u_stack_data <= unsigned(u_stack_data(31 downto 0));
   s_bits_u_stack_data <= signed(bits_u_stack_data);
   bits_u_stack_data_1 <= unsigned(u_stack_data(63 downto 32));
@@ -2048,6 +2352,34 @@ begin
   not_best_clear <= not best_clear;
   and_105 <= has_best and not_best_clear;
   and_105_or_best_set <= and_105 or best_set;
+
+  ring_c_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        c_valid <= unsigned'("0");
+      else
+        c_valid <= b2_valid;
+      end if;
+      c_slot <= b2_slot;
+      c_node <= mux_b_from_stack;
+      c_tmin <= mux_b_from_stack_1;
+      c_tmax <= mux_b_from_stack_2;
+      c_sp <= b2_sp;
+      limit_q <= cull_limit(to_integer(c_slot));
+      if rst = '1' then
+        has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+      else
+        has_best <= and_105_or_best_set;
+      end if;
+      cull_x <= tmin_less;
+      cull_has_best <= slot_has_best;
+      culled <= culled_c;
+      culled_n <= culled;
+    end if;
+  end process ring_c_regs;
+
+  -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   n_slot <= n_slot_sr(3);
   n_node <= n_node_sr(3);
   n_tmin <= n_tmin_sr(3);
@@ -2154,343 +2486,10 @@ begin
       s_ray_invx_q when others;
   negative_c <= unsigned(case_axis_n1(47 downto 47));
   negative <= negative_sr(9);
-  not_leaf_push <= not leaf_push;
-  n_stays <= n_valid_3 and not_leaf_push;
-  f_inner <= f_inner_sr(10);
-  f_slot <= f_slot_sr(10);
-  f_tmin <= f_tmin_sr(10);
-  f_tmax <= f_tmax_sr(10);
-  f_sp <= f_sp_sr(10);
-  f_child <= f_child_sr(10);
-  with axis_n1 select
-    case_axis_n1_1 <=
-      s_ray_invy_q when "01",
-      s_ray_invz_q when "10",
-      s_ray_invx_q when others;
-  bits_case_axis_n1_1 <= unsigned(case_axis_n1_1(47 downto 47));
-  tmax_plus_1 <= n_tmax + k_1_2;
-  tmin_minus_1 <= n_tmin - k_1_2;
-  rs_tmin_n1 <= resize(tmin_n1, 33);
-  rs_tmax_p1 <= resize(tmax_p1, 33);
-  minus_122 <= rs_tmin_n1 - rs_tmax_p1;
-  tmin_le_tmax_c <= unsigned(minus_122(32 downto 32));
-  mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
-  d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
-  d0_hi <= d0_hi_sr(7);
-  mux_negative_n1_1 <= tmin_n2 when negative_n1 = "1" else tmin_m1_n2;
-  d0_lo_c <= mux_negative_n1_1 when tmin_le_tmax = "1" else k_2147483647;
-  d0_lo <= d0_lo_sr(7);
-  mux_negative_n1_2 <= tmax_n2 when negative_n1 = "1" else tmax_p1_n2;
-  d1_hi_c <= mux_negative_n1_2 when tmin_le_tmax = "1" else k_m2147483648;
-  d1_hi <= d1_hi_sr(7);
-  mux_negative_n1_3 <= tmin_m1_n2 when negative_n1 = "1" else tmin_n2;
-  d1_lo_c <= mux_negative_n1_3 when tmin_le_tmax = "1" else k_2147483647;
-  d1_lo <= d1_lo_sr(7);
-  rs_plane_t <= resize(plane_t, 33);
-  rs_d0_hi <= resize(d0_hi, 33);
-  minus_123 <= rs_plane_t - rs_d0_hi;
-  d0_below <= unsigned(minus_123(32 downto 32));
-  rs_d0_lo <= resize(d0_lo, 33);
-  rs_plane_t_1 <= resize(plane_t, 33);
-  minus_124 <= rs_d0_lo - rs_plane_t_1;
-  d0_above <= unsigned(minus_124(32 downto 32));
-  rs_plane_t_1_1 <= resize(plane_t_1, 33);
-  rs_d1_hi <= resize(d1_hi, 33);
-  minus_125 <= rs_plane_t_1_1 - rs_d1_hi;
-  d1_below <= unsigned(minus_125(32 downto 32));
-  rs_d1_lo <= resize(d1_lo, 33);
-  rs_plane_t_1_2 <= resize(plane_t_1, 33);
-  minus_126 <= rs_d1_lo - rs_plane_t_1_2;
-  d1_above <= unsigned(minus_126(32 downto 32));
-  near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
-  far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
-  go_near_c <= d1_above when negative = "1" else d0_above;
-  go_far_c <= d0_below when negative = "1" else d1_below;
-  mux_negative <= plane_t_1 when negative = "1" else plane_t;
-  mux_negative_1 <= plane_t when negative = "1" else plane_t_1;
-  g_child_plus_k_1_3 <= g_child + k_1_3;
-  near <= g_child_plus_k_1_3 when g_negative = "1" else g_child;
-  far <= g_child when g_negative = "1" else g_child_plus_k_1_3;
-  near_max <= near_end when near_lt_tmax = "1" else g_tmax;
-  far_min <= far_start when far_gt_tmin = "1" else g_tmin;
-  enter_near <= g_inner and go_near;
-  not_go_near <= not go_near;
-  g_inner_and_not_go_near <= g_inner and not_go_near;
-  enter_far <= g_inner_and_not_go_near and go_far;
-  push <= enter_near and go_far;
-  rs_g_sp <= g_sp(4 downto 0);
-  cat_128 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
-  u_far_min <= unsigned(far_min);
-  u_g_tmax <= unsigned(g_tmax);
-  cat_129 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
-  enter_near_or_enter_far <= enter_near or enter_far;
-  not_enter_near_or_enter_far <= not enter_near_or_enter_far;
-  mux_enter_near <= near when enter_near = "1" else far;
-  mux_enter_far <= far_min when enter_far = "1" else g_tmin;
-  mux_enter_near_1 <= near_max when enter_near = "1" else g_tmax;
-  g_sp_plus_k_1 <= g_sp + k_1;
-  mux_push <= g_sp_plus_k_1 when push = "1" else g_sp;
-  not_push <= not push;
-  g_sp_eq_k_0_1 <= "1" when g_sp = k_0_1 else "0";
-  and_130 <= not_push and g_sp_eq_k_0_1;
-  g_sp_minus_k_1 <= g_sp - k_1;
-  mux_push_1 <= g_sp when push = "1" else g_sp_minus_k_1;
-  not_just_alloc <= not just_alloc;
-  has_free_c <= free_any_r and not_just_alloc;
-  bits_leaf_q_head <= unsigned(leaf_q_head(5 downto 0));
-  bits_leaf_q_head_1 <= unsigned(leaf_q_head(36 downto 6));
-  bits_leaf_q_head_2 <= unsigned(leaf_q_head(39 downto 37));
-  bits_leaf_q_head_3 <= unsigned(leaf_q_head(52 downto 40));
-  bits_leaf_q_head_4 <= unsigned(leaf_q_head(58 downto 53));
-  cull_c <= n_valid_3 and culled_n;
 
-  regs : process (clk)
+  ring_n_regs : process (clk)
   begin
     if rising_edge(clk) then
-      if ray_we = "1" then
-        ray_o(to_integer(ray_slot)) <= cat_0;
-      end if;
-      if ray_we = "1" then
-        ray_invx(to_integer(ray_slot)) <= u_invx;
-      end if;
-      if ray_we = "1" then
-        ray_invy(to_integer(ray_slot)) <= u_invy;
-      end if;
-      if ray_we = "1" then
-        ray_invz(to_integer(ray_slot)) <= u_invz;
-      end if;
-      if unpark_q_push = "1" then
-        unpark_q_mem(to_integer(unpark_q_wr)) <= unpark_q_din;
-      end if;
-      if new_q_push = "1" then
-        new_q_mem(to_integer(new_q_wr)) <= new_q_din;
-      end if;
-      if done_q_push = "1" then
-        done_q_mem(to_integer(done_q_wr)) <= done_q_din;
-      end if;
-      if limit_we = "1" then
-        cull_limit(to_integer(merge_slot)) <= u_merge_limit;
-      end if;
-      if leaf_q_push = "1" then
-        leaf_q_mem(to_integer(leaf_q_wr)) <= leaf_q_din;
-      end if;
-      if rst = '1' then
-        free_bits <= unsigned'("1111111111111111111111111111111111111111111111111111111111111111");
-      else
-        free_bits <= and_76_or_freed_mask;
-      end if;
-      if rst = '1' then
-        free_any_r <= unsigned'("1");
-      else
-        free_any_r <= free_any_c;
-      end if;
-      if rst = '1' then
-        free_idx_r <= unsigned'("000000");
-      else
-        free_idx_r <= free_idx_c;
-      end if;
-      if rst = '1' then
-        just_alloc <= unsigned'("0");
-      else
-        just_alloc <= alloc;
-      end if;
-      if rst = '1' then
-        occupied_r <= unsigned'("0000000");
-      else
-        occupied_r <= minus_77;
-      end if;
-      if rst = '1' then
-        unpark_q_push <= unsigned'("0");
-      else
-        unpark_q_push <= merge_valid;
-      end if;
-      if rst = '1' then
-        unpark_q_wr <= unsigned'("000000");
-      else
-        unpark_q_wr <= mux_unpark_q_push;
-      end if;
-      if rst = '1' then
-        unpark_q_rd <= unsigned'("000000");
-      else
-        unpark_q_rd <= unpark_q_rd_next;
-      end if;
-      if rst = '1' then
-        unpark_q_count <= unsigned'("0000000");
-      else
-        unpark_q_count <= unpark_q_count_next;
-      end if;
-      if rst = '1' then
-        unpark_q_rd1 <= unsigned'("000001");
-      else
-        unpark_q_rd1 <= mux_unpark_pop;
-      end if;
-      if rst = '1' then
-        unpark_q_bypass <= unsigned'("0");
-      else
-        unpark_q_bypass <= unpark_q_bypass_c;
-      end if;
-      if rst = '1' then
-        unpark_q_nonempty <= unsigned'("0");
-      else
-        unpark_q_nonempty <= ne_82;
-      end if;
-      unpark_q_din <= cat_78;
-      unpark_q_q <= unpark_q_mem(to_integer(unpark_q_rd_next));
-      if unpark_q_push = "1" then
-        unpark_q_din_r <= unpark_q_din;
-      end if;
-      if rst = '1' then
-        new_q_push <= unsigned'("0");
-      else
-        new_q_push <= new_valid;
-      end if;
-      if rst = '1' then
-        new_q_wr <= unsigned'("000000");
-      else
-        new_q_wr <= mux_new_q_push;
-      end if;
-      if rst = '1' then
-        new_q_rd <= unsigned'("000000");
-      else
-        new_q_rd <= new_q_rd_next;
-      end if;
-      if rst = '1' then
-        new_q_count <= unsigned'("0000000");
-      else
-        new_q_count <= new_q_count_next;
-      end if;
-      if rst = '1' then
-        new_q_rd1 <= unsigned'("000001");
-      else
-        new_q_rd1 <= mux_new_pop;
-      end if;
-      if rst = '1' then
-        new_q_bypass <= unsigned'("0");
-      else
-        new_q_bypass <= new_q_bypass_c;
-      end if;
-      if rst = '1' then
-        new_q_nonempty <= unsigned'("0");
-      else
-        new_q_nonempty <= ne_87;
-      end if;
-      new_q_din <= cat_83;
-      new_q_q <= new_q_mem(to_integer(new_q_rd_next));
-      if new_q_push = "1" then
-        new_q_din_r <= new_q_din;
-      end if;
-      if rst = '1' then
-        q_valid <= unsigned'("0");
-      else
-        q_valid <= take_unpark_or_take_new;
-      end if;
-      q_new <= take_new;
-      q_slot <= mux_take_unpark;
-      q_sp <= bits_unpark_q_head_1;
-      q_sp_zero <= eq_91;
-      q_sp_m1 <= minus_92;
-      q_tmax <= s_bits_new_q_head_1;
-      q_miss <= bits_new_q_head_2;
-      if rst = '1' then
-        r_valid <= unsigned'("0");
-      else
-        r_valid <= g_valid;
-      end if;
-      r_pop <= not_enter_near_or_enter_far;
-      r_sp_zero <= and_130;
-      r_sp_m1 <= mux_push_1;
-      r_slot <= g_slot;
-      r_node <= mux_enter_near;
-      r_tmin <= mux_enter_far;
-      r_tmax <= mux_enter_near_1;
-      r_sp <= mux_push;
-      if rst = '1' then
-        b_valid <= unsigned'("0");
-      else
-        b_valid <= a_live;
-      end if;
-      b_slot <= a_slot;
-      b_node <= mux_r_valid;
-      b_tmin <= mux_r_valid_1;
-      b_tmax <= mux_r_valid_2;
-      b_sp <= mux_a_from_stack;
-      b_from_stack_sr(2 to 2) <= b_from_stack_sr(1 to 1);
-      b_from_stack_sr(1) <= a_from_stack;
-      if rst = '1' then
-        b2_valid <= unsigned'("0");
-      else
-        b2_valid <= b_valid;
-      end if;
-      b2_slot <= b_slot;
-      b2_node <= b_node;
-      b2_tmin <= b_tmin;
-      b2_tmax <= b_tmax;
-      b2_sp <= b_sp;
-      if rst = '1' then
-        done_pop_r <= unsigned'("0");
-      else
-        done_pop_r <= done_pop;
-      end if;
-      if rst = '1' then
-        done_q_push <= unsigned'("0");
-      else
-        done_q_push <= a_done;
-      end if;
-      if rst = '1' then
-        done_q_wr <= unsigned'("000000");
-      else
-        done_q_wr <= mux_done_q_push;
-      end if;
-      if rst = '1' then
-        done_q_rd <= unsigned'("000000");
-      else
-        done_q_rd <= done_q_rd_next;
-      end if;
-      if rst = '1' then
-        done_q_count <= unsigned'("0000000");
-      else
-        done_q_count <= done_q_count_next;
-      end if;
-      if rst = '1' then
-        done_q_rd1 <= unsigned'("000001");
-      else
-        done_q_rd1 <= mux_done_pop_r;
-      end if;
-      if rst = '1' then
-        done_q_bypass <= unsigned'("0");
-      else
-        done_q_bypass <= done_q_bypass_c;
-      end if;
-      if rst = '1' then
-        done_q_nonempty <= unsigned'("0");
-      else
-        done_q_nonempty <= ne_98;
-      end if;
-      done_q_din <= a_slot;
-      done_q_q <= done_q_mem(to_integer(done_q_rd_next));
-      if done_q_push = "1" then
-        done_q_din_r <= done_q_din;
-      end if;
-      if rst = '1' then
-        c_valid <= unsigned'("0");
-      else
-        c_valid <= b2_valid;
-      end if;
-      c_slot <= b2_slot;
-      c_node <= mux_b_from_stack;
-      c_tmin <= mux_b_from_stack_1;
-      c_tmax <= mux_b_from_stack_2;
-      c_sp <= b2_sp;
-      limit_q <= cull_limit(to_integer(c_slot));
-      if rst = '1' then
-        has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-      else
-        has_best <= and_105_or_best_set;
-      end if;
-      cull_x <= tmin_less;
-      cull_has_best <= slot_has_best;
-      culled <= culled_c;
-      culled_n <= culled;
       if rst = '1' then
         n_valid_1 <= unsigned'("0");
       else
@@ -2708,6 +2707,68 @@ begin
       axis_n1 <= nw_axis;
       negative_sr(2 to 9) <= negative_sr(1 to 8);
       negative_sr(1) <= negative_c;
+    end if;
+  end process ring_n_regs;
+
+  -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
+  not_leaf_push <= not leaf_push;
+  n_stays <= n_valid_3 and not_leaf_push;
+  f_inner <= f_inner_sr(10);
+  f_slot <= f_slot_sr(10);
+  f_tmin <= f_tmin_sr(10);
+  f_tmax <= f_tmax_sr(10);
+  f_sp <= f_sp_sr(10);
+  f_child <= f_child_sr(10);
+  with axis_n1 select
+    case_axis_n1_1 <=
+      s_ray_invy_q when "01",
+      s_ray_invz_q when "10",
+      s_ray_invx_q when others;
+  bits_case_axis_n1_1 <= unsigned(case_axis_n1_1(47 downto 47));
+  tmax_plus_1 <= n_tmax + k_1_2;
+  tmin_minus_1 <= n_tmin - k_1_2;
+  rs_tmin_n1 <= resize(tmin_n1, 33);
+  rs_tmax_p1 <= resize(tmax_p1, 33);
+  minus_122 <= rs_tmin_n1 - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(minus_122(32 downto 32));
+  mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
+  d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
+  d0_hi <= d0_hi_sr(7);
+  mux_negative_n1_1 <= tmin_n2 when negative_n1 = "1" else tmin_m1_n2;
+  d0_lo_c <= mux_negative_n1_1 when tmin_le_tmax = "1" else k_2147483647;
+  d0_lo <= d0_lo_sr(7);
+  mux_negative_n1_2 <= tmax_n2 when negative_n1 = "1" else tmax_p1_n2;
+  d1_hi_c <= mux_negative_n1_2 when tmin_le_tmax = "1" else k_m2147483648;
+  d1_hi <= d1_hi_sr(7);
+  mux_negative_n1_3 <= tmin_m1_n2 when negative_n1 = "1" else tmin_n2;
+  d1_lo_c <= mux_negative_n1_3 when tmin_le_tmax = "1" else k_2147483647;
+  d1_lo <= d1_lo_sr(7);
+  rs_plane_t <= resize(plane_t, 33);
+  rs_d0_hi <= resize(d0_hi, 33);
+  minus_123 <= rs_plane_t - rs_d0_hi;
+  d0_below <= unsigned(minus_123(32 downto 32));
+  rs_d0_lo <= resize(d0_lo, 33);
+  rs_plane_t_1 <= resize(plane_t, 33);
+  minus_124 <= rs_d0_lo - rs_plane_t_1;
+  d0_above <= unsigned(minus_124(32 downto 32));
+  rs_plane_t_1_1 <= resize(plane_t_1, 33);
+  rs_d1_hi <= resize(d1_hi, 33);
+  minus_125 <= rs_plane_t_1_1 - rs_d1_hi;
+  d1_below <= unsigned(minus_125(32 downto 32));
+  rs_d1_lo <= resize(d1_lo, 33);
+  rs_plane_t_1_2 <= resize(plane_t_1, 33);
+  minus_126 <= rs_d1_lo - rs_plane_t_1_2;
+  d1_above <= unsigned(minus_126(32 downto 32));
+  near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
+  far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
+  go_near_c <= d1_above when negative = "1" else d0_above;
+  go_far_c <= d0_below when negative = "1" else d1_below;
+  mux_negative <= plane_t_1 when negative = "1" else plane_t;
+  mux_negative_1 <= plane_t when negative = "1" else plane_t_1;
+
+  ring_f_regs : process (clk)
+  begin
+    if rising_edge(clk) then
       if rst = '1' then
         f_valid_1 <= unsigned'("0");
       else
@@ -2811,7 +2872,36 @@ begin
       g_inner <= f_inner;
       g_negative <= negative;
     end if;
-  end process regs;
+  end process ring_f_regs;
+
+  -- stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
+  g_child_plus_k_1_3 <= g_child + k_1_3;
+  near <= g_child_plus_k_1_3 when g_negative = "1" else g_child;
+  far <= g_child when g_negative = "1" else g_child_plus_k_1_3;
+  near_max <= near_end when near_lt_tmax = "1" else g_tmax;
+  far_min <= far_start when far_gt_tmin = "1" else g_tmin;
+  enter_near <= g_inner and go_near;
+  not_go_near <= not go_near;
+  g_inner_and_not_go_near <= g_inner and not_go_near;
+  enter_far <= g_inner_and_not_go_near and go_far;
+  push <= enter_near and go_far;
+  rs_g_sp <= g_sp(4 downto 0);
+  cat_128 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
+  u_far_min <= unsigned(far_min);
+  u_g_tmax <= unsigned(g_tmax);
+  cat_129 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
+  enter_near_or_enter_far <= enter_near or enter_far;
+  not_enter_near_or_enter_far <= not enter_near_or_enter_far;
+  mux_enter_near <= near when enter_near = "1" else far;
+  mux_enter_far <= far_min when enter_far = "1" else g_tmin;
+  mux_enter_near_1 <= near_max when enter_near = "1" else g_tmax;
+  g_sp_plus_k_1 <= g_sp + k_1;
+  mux_push <= g_sp_plus_k_1 when push = "1" else g_sp;
+  not_push <= not push;
+  g_sp_eq_k_0_1 <= "1" when g_sp = k_0_1 else "0";
+  and_130 <= not_push and g_sp_eq_k_0_1;
+  g_sp_minus_k_1 <= g_sp - k_1;
+  mux_push_1 <= g_sp when push = "1" else g_sp_minus_k_1;
 
   u_stack : fxrt_bram_stack_w77
     port map (
