@@ -40,7 +40,7 @@ module golden_demo (
   reg [1:0] state = st_idle;
   wire [1:0] from_idle;
   wire [1:0] from_busy;
-  reg [1:0] state_next;
+  wire [1:0] state_next;
   wire [0:0] is_done;
 
   // not in a stage or state machine
@@ -134,13 +134,10 @@ module golden_demo (
   // state machine ctl: waits for go
   assign from_idle = go ? st_busy : st_idle;
   assign from_busy = go ? st_busy : st_done;
-  always @* begin
-    case (state)
-      st_idle: state_next = from_idle;
-      st_busy: state_next = from_busy;
-      default: state_next = st_idle;
-    endcase
-  end
+  assign state_next =
+    (state == st_idle) ? from_idle :
+    (state == st_busy) ? from_busy :
+    st_idle;
   assign is_done = state == st_done;
 
   always @(posedge clk) begin : ctl_regs
