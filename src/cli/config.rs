@@ -41,7 +41,7 @@ impl Simulation {
             Simulation::Rust => "Rust",
             Simulation::Hdl(Simulator::Ghdl) => "Ghdl",
             Simulation::Hdl(Simulator::Iverilog) => "Iverilog",
-            Simulation::Hdl(Simulator::IverilogSv) => "Iverilog (SystemVerilog rules)",
+            Simulation::Hdl(Simulator::IverilogSv) => "IverilogSv",
             Simulation::Hdl(Simulator::Verilator) => "Verilator",
         }
     }

@@ -3,9 +3,9 @@
 //! ROMs into the intersection pipeline, with the ray read from the core's ray RAMs by slot.
 
 use super::brom::brom;
+use super::core_params::{CoreParams, tri_rom_groups};
 use super::intersect::intersect_core;
 use super::ray_port::RayPort;
-use super::top::{CoreParams, tri_rom_groups};
 use super::traverse::{field, word_bits};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, Ports, S};

@@ -7,6 +7,7 @@ pub mod brom;
 pub mod checksum;
 pub mod clock;
 pub mod closest;
+pub mod core_params;
 pub mod cost;
 pub mod divider;
 pub mod fifo;
@@ -19,6 +20,7 @@ pub mod raygen;
 pub mod result_queue;
 pub mod top;
 pub mod traverse;
+mod traverse_stages;
 
 use crate::rtl::build::S;
 

@@ -6,9 +6,9 @@
 //! has a free slot. A clock after the take the ray is written into that slot (`accept`); its
 //! box exit follows through the unit's new-ray queue when the plane unit has it.
 
+use super::core_params::CoreParams;
 use super::lt_chain;
 use super::plane::{PlaneIssue, plane_unit};
-use super::top::CoreParams;
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 

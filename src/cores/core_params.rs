@@ -1,0 +1,205 @@
+//! What shapes a whole core (`top.rs`): its build options (`CoreSpec`), the parameters every
+//! part of it derives from them (`CoreParams`), with the checks that name the parameter to
+//! change, and its ray port's inputs.
+
+use super::closest::TagLayout;
+use super::intersect::IntersectParams;
+use super::traverse::TraverseParams;
+use crate::model::golden::GridRay;
+use crate::rtl::Ty;
+use crate::rtl::width::MAX_WIDTH;
+use crate::scene::images::SceneRoms;
+use crate::scene::rom::Field;
+use crate::scene::rom::rom_addr_bits;
+
+/// Ray slots per traversal unit and traversal units, by default (chosen by measurement:
+/// docs/CORE.md).
+pub const DEFAULT_SLOTS: u32 = 64;
+pub const DEFAULT_UNITS: u32 = 2;
+
+#[derive(Clone, Debug)]
+pub struct CoreParams {
+    pub isect: IntersectParams,
+    pub trav: TraverseParams,
+    pub tag: TagLayout,
+    /// Traversal units feeding the one intersection pipeline.
+    pub units: u32,
+    /// Clocks of a triangle ROM read (`brom::read_cycles`).
+    pub tri_rom_cycles: u32,
+}
+
+/// What shapes a core besides its scene: the width of its ray ids, the divider's quotient
+/// bits per stage, the clock it is pipelined for, and its ray slots per traversal unit and
+/// units. `Default` is `fxrt gen`'s defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CoreSpec {
+    pub id_width: u32,
+    pub div_bits: u32,
+    pub target_mhz: u32,
+    pub slots: u32,
+    pub units: u32,
+}
+
+/// The ray id width by default (`--ray-id-width`): a 1024 × 1024 frame's pixel numbers.
+pub const DEFAULT_RAY_ID_WIDTH: u32 = 20;
+
+impl Default for CoreSpec {
+    fn default() -> CoreSpec {
+        CoreSpec {
+            id_width: DEFAULT_RAY_ID_WIDTH,
+            div_bits: 1,
+            target_mhz: super::clock::DEFAULT_TARGET_MHZ,
+            slots: DEFAULT_SLOTS,
+            units: DEFAULT_UNITS,
+        }
+    }
+}
+
+impl CoreParams {
+    /// The default shape but for the ray id width, the divider and the clock target.
+    pub fn new(scene: &SceneRoms, id_width: u32, div_bits: u32, target_mhz: u32) -> CoreParams {
+        Self::shaped(scene, &CoreSpec { id_width, div_bits, target_mhz, ..CoreSpec::default() })
+    }
+
+    /// The core of `shape` for `scene` (not checked: `check` says what the RTL layer cannot
+    /// hold).
+    pub fn shaped(scene: &SceneRoms, shape: &CoreSpec) -> CoreParams {
+        let CoreSpec { id_width, div_bits, target_mhz, slots, units } = *shape;
+        let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
+        let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
+        let tag = TagLayout {
+            tri_bits: trav.tri_bits,
+            tmin_bits: trav.tmin_width(),
+            sp_bits: trav.sp_width(),
+            slot_bits: trav.slot_bits() + unit_bits,
+        };
+        let p = &scene.params;
+        let isect = IntersectParams {
+            n: p.n,
+            m: p.m,
+            t: p.t,
+            e: scene.edge_shift,
+            tag_width: tag.width(),
+            div_bits,
+            target_mhz,
+        };
+        CoreParams { isect, trav, tag, units, tri_rom_cycles: super::brom::read_cycles(scene.tri.1.len()) }
+    }
+
+    /// Bits of a unit number within a global slot number (0 for one unit).
+    pub fn unit_bits(&self) -> u32 {
+        self.tag.slot_bits - self.trav.slot_bits()
+    }
+    /// Global slot numbers of the core (unit bits above slot bits: a power of two per unit).
+    pub fn total_slots(&self) -> u32 {
+        self.units << self.trav.slot_bits()
+    }
+    /// Ray slots of the core: the rays it holds at once.
+    pub fn slot_count(&self) -> u32 {
+        self.units * self.trav.slots
+    }
+
+    /// Rejects what the RTL layer cannot hold, naming the parameter to change.
+    pub fn check(&self) -> crate::error::Result<()> {
+        use crate::error::Error;
+        self.isect.check_widths()?;
+        let w = self.trav.n + 1 + self.trav.inv_width();
+        if w > MAX_WIDTH {
+            return Err(Error::param(
+                "c",
+                format!(
+                    "the traversal's plane distance needs n + m + C + 1 = {w} bits; the RTL layer holds {MAX_WIDTH}"
+                ),
+            ));
+        }
+        if !(1..=64).contains(&self.trav.slots) {
+            return Err(Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
+        }
+        if !(1..=4).contains(&self.units) {
+            return Err(Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
+        }
+        // The closest-hit unit keeps a bit per global slot number in one word; a unit's slot
+        // numbers take a power of two (3 units × 33 slots are numbered as 3 × 64).
+        if self.total_slots() > MAX_WIDTH {
+            let numbered = if self.total_slots() == self.slot_count() {
+                String::new()
+            } else {
+                format!(", numbered as {} × {}", self.units, 1u32 << self.trav.slot_bits())
+            };
+            return Err(crate::error::Error::param(
+                "slots",
+                format!(
+                    "{} units × {} slots = {} ray slots{numbered}; the closest-hit unit holds at most {MAX_WIDTH}: \
+                     fewer --slots or --units",
+                    self.units,
+                    self.trav.slots,
+                    self.slot_count()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM (each ROM rounded up
+    /// to a power-of-two depth, as the printers emit it).
+    pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
+        let stack_word = self.trav.n as u64 * 2 + 6 + 32;
+        let stack = stack_word
+            * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64
+            * self.total_slots() as u64;
+        let total = scene.rom_bits() + stack;
+        if total > bram_kbits * 1024 {
+            return Err(crate::error::Error::param(
+                "bram-kbits",
+                format!(
+                    "scene {} needs {} Kb of ROM and stacks, more than the {bram_kbits} Kb of block RAM allowed \
+                     (the XC5VLX110T has 5328): use a smaller scene, a smaller --n/--m, fewer --slots/--units, \
+                     or raise --bram-kbits for a larger device",
+                    scene.name,
+                    total.div_ceil(1024)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Cycles from a leaf entry leaving its queue to its result in the closest-hit unit's
+    /// accumulator: leaf ROM, triangle ROMs, the pipeline, the unit's input stage.
+    pub fn stream_latency(&self) -> u32 {
+        1 + self.trav.leaf_rom_cycles
+            + self.tri_rom_cycles
+            + self.isect.latency()
+            + super::closest::input_latency(self.isect.target())
+    }
+}
+
+/// Consecutive triangle fields grouped into words of at most 128 bits.
+pub fn tri_rom_groups(fields: &[Field]) -> Vec<Vec<Field>> {
+    let mut groups: Vec<Vec<Field>> = Vec::new();
+    for f in fields {
+        match groups.last_mut() {
+            Some(g) if g.iter().map(|x| x.width).sum::<u32>() + f.width <= MAX_WIDTH => g.push(f.clone()),
+            _ => groups.push(vec![f.clone()]),
+        }
+    }
+    groups
+}
+
+/// Input ports of the core in order, with types.
+pub fn core_inputs(p: &CoreParams) -> Vec<(&'static str, Ty)> {
+    let (n, m, iw) = (p.isect.n, p.isect.m, p.trav.inv_width());
+    let mut v = vec![("ray_valid", Ty::BIT), ("ray_id", Ty::u(p.trav.id_width))];
+    v.extend([("ox", Ty::u(n)), ("oy", Ty::u(n)), ("oz", Ty::u(n))]);
+    v.extend([("wx", Ty::s(m)), ("wy", Ty::s(m)), ("wz", Ty::s(m))]);
+    v.extend([("invx", Ty::s(iw)), ("invy", Ty::s(iw)), ("invz", Ty::s(iw))]);
+    v
+}
+
+/// The input values of one ray (valid = 1), in `core_inputs` order.
+pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
+    let mut v = vec![1, id as i128];
+    v.extend(ray.o.iter().map(|&x| x as i128));
+    v.extend(ray.w.iter().map(|&x| x as i128));
+    v.extend(ray.inv.iter().copied());
+    v
+}

@@ -1,0 +1,610 @@
+//! The traversal unit's parts (`traverse.rs` says what the unit does and wires them): its
+//! parameters, the ring token, and each stage of the ring the token goes round, built by a
+//! method of `Unit`, in the order the stages are printed.
+
+use super::brom::bram;
+use super::brom::read_cycles;
+use super::clock::ClockTarget;
+use super::fifo::{Fifo, fifo};
+use super::mul::MulStyle;
+use super::plane::{PlaneIssue, plane_unit};
+use super::{lowest_set, lt_chain, onehot};
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, S};
+use crate::scene::images::SceneRoms;
+use crate::scene::rom::{self, Field, Word, rom_addr_bits};
+
+/// The widths of one traversal unit.
+#[derive(Clone, Debug)]
+pub struct TraverseParams {
+    pub n: u32,
+    pub m: u32,
+    pub c: u32,
+    pub id_width: u32,
+    pub stack_depth: u32,
+    pub box_hi: [i64; 3],
+    pub tri_bits: u32,
+    /// How the plane-distance product is built (`plane::plane_product`): the clock target's.
+    pub product: MulStyle,
+    /// Clocks of a node ROM read and of a leaf ROM read (`brom::read_cycles`: 3 for block RAM,
+    /// whose fabric register the placer puts between the blocks spread over the die and the
+    /// logic; 2 for LUTs). The emitted triangle stream is `leaf_rom_cycles` behind `leaf`.
+    pub node_rom_cycles: u32,
+    pub leaf_rom_cycles: u32,
+    /// Ray slots of the unit: rays it holds at once, each with its own registers and stack.
+    pub slots: u32,
+    /// The scene's tag (`SceneRoms::tag`), in the names of the modules built for the scene.
+    pub scene_tag: String,
+}
+
+impl TraverseParams {
+    pub fn new(scene: &SceneRoms, id_width: u32, target: ClockTarget, slots: u32) -> TraverseParams {
+        let p = &scene.params;
+        TraverseParams {
+            n: p.n,
+            m: p.m,
+            c: p.c,
+            id_width,
+            stack_depth: p.stack_depth,
+            box_hi: scene.box_hi,
+            tri_bits: rom::addr_bits(scene.tri_count()),
+            product: target.mul_style(),
+            node_rom_cycles: read_cycles(scene.node.1.len()),
+            leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
+            slots,
+            scene_tag: scene.tag(),
+        }
+    }
+    /// Reciprocal directions: m + C bits.
+    pub fn inv_width(&self) -> u32 {
+        self.m + self.c
+    }
+    /// Distances: −1 … 2^(n+1), signed n + 3 bits.
+    pub fn dist_ty(&self) -> Ty {
+        Ty::s(self.n + 3)
+    }
+    /// Leaf entry distances are never negative: unsigned n + 2 bits.
+    pub fn tmin_width(&self) -> u32 {
+        self.n + 2
+    }
+    /// Bits of a slot number within the unit.
+    pub fn slot_bits(&self) -> u32 {
+        rom::rom_addr_bits(self.slots as usize)
+    }
+    pub fn sp_width(&self) -> u32 {
+        rom::value_bits(self.stack_depth as usize)
+    }
+}
+
+/// Bits [lsb, lsb + width) of a ROM word (width ≤ 128).
+pub fn word_bits(w: &Word, lsb: u32, width: u32) -> u128 {
+    (0..width).fold(0u128, |acc, b| {
+        let bit = lsb + b;
+        acc | ((((w.0[(bit / 64) as usize] >> (bit % 64)) & 1) as u128) << b)
+    })
+}
+
+/// A field of a ROM read: its bits as a signal of the field's type.
+pub fn field<'b>(name: &str, word: S<'b>, f: &Field, word_lsb: u32) -> S<'b> {
+    let raw = word.slice(f.lsb - word_lsb, f.width);
+    if f.signed { raw.signed().name(name) } else { raw.name(name) }
+}
+
+/// A token's fields in the ring.
+#[derive(Clone, Copy)]
+pub(super) struct Token<'b> {
+    pub(super) valid: S<'b>,
+    pub(super) slot: S<'b>,
+    pub(super) node: S<'b>,
+    pub(super) tmin: S<'b>,
+    pub(super) tmax: S<'b>,
+    pub(super) sp: S<'b>,
+}
+
+impl<'b> Token<'b> {
+    /// The token `depth` clocks later, in the stage's registers `{stage}_valid`,
+    /// `{stage}_slot`, … (the valid bit cleared by `rst`); each field passes through
+    /// `through(field, value)` on the way in, in field order.
+    pub(super) fn delayed(
+        self,
+        b: &'b Builder,
+        stage: &str,
+        depth: u32,
+        through: impl Fn(&str, S<'b>) -> S<'b>,
+    ) -> Token<'b> {
+        let line = |field: &str, x: S<'b>| b.delay_line(&format!("{stage}_{field}"), through(field, x), depth);
+        Token {
+            valid: b.valid_line(&format!("{stage}_valid"), through("valid", self.valid), depth),
+            slot: line("slot", self.slot),
+            node: line("node", self.node),
+            tmin: line("tmin", self.tmin),
+            tmax: line("tmax", self.tmax),
+            sp: line("sp", self.sp),
+        }
+    }
+}
+
+/// The unit's input ports.
+pub(super) struct Inputs<'b> {
+    pub(super) new_valid: S<'b>,
+    pub(super) new_slot: S<'b>,
+    pub(super) new_tmax: S<'b>,
+    pub(super) new_miss: S<'b>,
+    pub(super) merge_valid: S<'b>,
+    pub(super) merge_slot: S<'b>,
+    pub(super) merge_hit: S<'b>,
+    pub(super) merge_limit: S<'b>,
+    pub(super) merge_sp: S<'b>,
+    pub(super) free_valid: S<'b>,
+    pub(super) free_slot: S<'b>,
+    pub(super) alloc: S<'b>,
+    pub(super) ray_slot: S<'b>,
+    pub(super) leaf_pop: S<'b>,
+    pub(super) done_pop: S<'b>,
+    pub(super) node_word: S<'b>,
+}
+
+/// What every stage of the unit reads: the builder, the widths, the inputs and the ray RAMs.
+pub(super) struct Unit<'b> {
+    pub(super) b: &'b Builder,
+    pub(super) p: &'b TraverseParams,
+    pub(super) scene: &'b SceneRoms,
+    pub(super) inp: Inputs<'b>,
+    /// The ray RAMs (origin; reciprocal direction per axis): written when the top accepts a
+    /// ray, read in N for the plane units.
+    pub(super) o_mem: usize,
+    pub(super) inv_mem: [usize; 3],
+    pub(super) sb: u32,
+    pub(super) spw: u32,
+    pub(super) node_bits: u32,
+    pub(super) dist: Ty,
+}
+
+/// The token entering A: R's or a queued ray's, and the stack read it starts.
+pub(super) struct RingA<'b> {
+    pub(super) valid: S<'b>,
+    pub(super) slot: S<'b>,
+    pub(super) new: S<'b>,
+    pub(super) sp: S<'b>,
+    pub(super) sp_m1: S<'b>,
+    pub(super) done: S<'b>,
+    pub(super) from_stack: S<'b>,
+    /// The stack word (two clocks after A) and its write port (driven in G).
+    pub(super) stack_top: S<'b>,
+    pub(super) push: [S<'b>; 3],
+}
+
+/// The queues' head, registered for A.
+pub(super) struct Queued<'b> {
+    pub(super) ring_g_valid: S<'b>,
+    pub(super) valid: S<'b>,
+    pub(super) new: S<'b>,
+    pub(super) slot: S<'b>,
+    pub(super) sp: S<'b>,
+    pub(super) sp_zero: S<'b>,
+    pub(super) sp_m1: S<'b>,
+    pub(super) tmax: S<'b>,
+    pub(super) miss: S<'b>,
+}
+
+/// R: the token back from G, with its pop flag and sp = 0, sp − 1 made in G.
+pub(super) struct Returning<'b> {
+    pub(super) token: Token<'b>,
+    pub(super) pop: S<'b>,
+    pub(super) sp_zero: S<'b>,
+    pub(super) sp_m1: S<'b>,
+}
+
+/// N: the token with its node word.
+pub(super) struct RingN<'b> {
+    pub(super) token: Token<'b>,
+    pub(super) culled: S<'b>,
+    pub(super) visit: S<'b>,
+    pub(super) is_inner: S<'b>,
+    pub(super) leaf_push: S<'b>,
+    pub(super) leafq: Fifo<'b>,
+    /// The node's axis a clock after N, and whether the ray's direction is negative on it
+    /// (as seen in F).
+    pub(super) axis1: S<'b>,
+    pub(super) negative: S<'b>,
+    pub(super) child: S<'b>,
+    pub(super) inv: [S<'b>; 3],
+    pub(super) plane_t: [S<'b>; 2],
+    pub(super) plane_latency: u32,
+}
+
+/// G's operands: the token, and F's compares by role.
+pub(super) struct RingF<'b> {
+    pub(super) g: Token<'b>,
+    pub(super) inner: S<'b>,
+    pub(super) negative: S<'b>,
+    pub(super) near_lt_tmax: S<'b>,
+    pub(super) far_gt_tmin: S<'b>,
+    pub(super) go_near: S<'b>,
+    pub(super) go_far: S<'b>,
+    pub(super) near_end: S<'b>,
+    pub(super) far_start: S<'b>,
+}
+
+/// The unit's free-slot state, for the outputs.
+pub(super) struct Slots<'b> {
+    pub(super) free_any: S<'b>,
+    pub(super) free_idx: S<'b>,
+    pub(super) just_alloc: S<'b>,
+    pub(super) occupied: S<'b>,
+}
+
+impl<'b> Unit<'b> {
+    /// The input ports, and the ray RAMs' write port.
+    pub(super) fn new(b: &'b Builder, p: &'b TraverseParams, scene: &'b SceneRoms) -> Unit<'b> {
+        let (k, n, dist, sb, spw, bit) = (p.slots, p.n, p.dist_ty(), p.slot_bits(), p.sp_width(), Ty::BIT);
+        let slot_ty = Ty::u(sb);
+        let ray_we = b.input("ray_we", bit);
+        let ray_slot = b.input("ray_slot", slot_ty);
+        let o_in = ["ox", "oy", "oz"].map(|s| b.input(s, Ty::u(n)));
+        let inv_in = ["invx", "invy", "invz"].map(|s| b.input(s, Ty::s(p.inv_width())));
+        let inp = Inputs {
+            new_valid: b.input("new_valid", bit),
+            new_slot: b.input("new_slot", slot_ty),
+            new_tmax: b.input("new_tmax", dist),
+            new_miss: b.input("new_miss", bit),
+            merge_valid: b.input("merge_valid", bit),
+            merge_slot: b.input("merge_slot", slot_ty),
+            merge_hit: b.input("merge_hit", bit),
+            merge_limit: b.input("merge_limit", dist),
+            merge_sp: b.input("merge_sp", Ty::u(spw)),
+            free_valid: b.input("free_valid", bit),
+            free_slot: b.input("free_slot", slot_ty),
+            alloc: b.input("alloc", bit),
+            ray_slot,
+            leaf_pop: b.input("leaf_pop", bit),
+            done_pop: b.input("done_pop", bit),
+            // The node ROM is the core's (two units share one through a block RAM's two
+            // ports): the unit sends the address in C and gets the word `node_rom_cycles`
+            // later, in N.
+            node_word: b.input("node_word", Ty::u(scene.node.0.width)),
+        };
+        let o_mem = b.ram("ray_o", 3 * n, vec![0; k as usize]);
+        b.ram_write(o_mem, ray_we, ray_slot, b.cat(&[o_in[2], o_in[1], o_in[0]]));
+        let inv_mem = [0, 1, 2].map(|a| {
+            let mem = b.ram(&format!("ray_inv{}", ["x", "y", "z"][a]), p.inv_width(), vec![0; k as usize]);
+            b.ram_write(mem, ray_we, ray_slot, inv_in[a].unsigned());
+            mem
+        });
+        let node_bits = rom_addr_bits(scene.node.1.len());
+        Unit { b, p, scene, inp, o_mem, inv_mem, sb, spw, node_bits, dist }
+    }
+
+    pub(super) fn slots(&self) -> Slots<'b> {
+        let (b, k, sb, inp) = (self.b, self.p.slots, self.sb, &self.inp);
+        b.stage("slots", "the free-slot bits, the lowest free slot for the top, the slots holding a ray");
+        // Free slots: a bit per slot, the lowest free one registered (one clock stale, so a slot
+        // just taken is masked for a clock by `just_alloc`).
+        let all = (1i128 << k) - 1;
+        let free_bits = b.reg("free_bits", Ty::u(k), Some(all));
+        let (any_free, lowest) = lowest_set(&(0..k).map(|i| free_bits.bit(i)).collect::<Vec<_>>(), sb);
+        // Reset to what they hold after a clock of reset (all free, slot 0), so a core that idles
+        // for a while after reset behaves as one that does not.
+        let free_any = b.reg("free_any_r", Ty::BIT, Some(1));
+        b.next(free_any, any_free.name("free_any_c"));
+        let free_idx = b.reg("free_idx_r", Ty::u(sb), Some(0));
+        b.next(free_idx, lowest.name("free_idx_c"));
+        let just_alloc = b.reg("just_alloc", Ty::BIT, Some(0));
+        b.next(just_alloc, inp.alloc);
+        let taken = inp.alloc.select(onehot(inp.ray_slot, k), b.konst(Ty::u(k), 0)).name("taken_mask");
+        let freed = inp.free_valid.select(onehot(inp.free_slot, k), b.konst(Ty::u(k), 0)).name("freed_mask");
+        b.next(free_bits, (free_bits & !taken) | freed);
+        let occupied = b.reg("occupied_r", Ty::u(sb + 1), Some(0));
+        b.next(occupied, occupied + inp.alloc.resize(sb + 1) - inp.free_valid.resize(sb + 1));
+        Slots { free_any, free_idx, just_alloc, occupied }
+    }
+
+    /// The queues into the ring: rays back from a leaf (slot, sp) and new rays (slot, tmax,
+    /// miss).
+    pub(super) fn queues(&self) -> Queued<'b> {
+        let (b, k, sb, spw, dist, inp) = (self.b, self.p.slots, self.sb, self.spw, self.dist, &self.inp);
+        b.stage("queues", "E: rays back from a leaf and new rays wait; one enters when no token returns");
+        let ring_g_valid = b.wire("ring_g_valid", Ty::BIT);
+        let unpark_pop = b.wire("unpark_pop", Ty::BIT);
+        let new_pop = b.wire("new_pop", Ty::BIT);
+        let unpark_in = b.cat(&[inp.merge_slot, inp.merge_sp]);
+        let unpark = fifo(b, "unpark_q", sb + spw, k, inp.merge_valid, unpark_in, unpark_pop);
+        let new_in = b.cat(&[inp.new_slot, inp.new_tmax.unsigned(), inp.new_miss]);
+        let newq = fifo(b, "new_q", sb + dist.width + 1, k, inp.new_valid, new_in, new_pop);
+        // E: a queued ray enters when the token now in G will not return (R empty in A).
+        let take_unpark = (!ring_g_valid & unpark.nonempty).name("take_unpark");
+        let take_new = (!ring_g_valid & !unpark.nonempty & newq.nonempty).name("take_new");
+        b.drive(unpark_pop, take_unpark);
+        b.drive(new_pop, take_new);
+        let valid = b.valid_delay("q_valid", take_unpark | take_new);
+        let new = b.delay("q_new", take_new);
+        let slot =
+            b.delay("q_slot", take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb)));
+        // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
+        let head_sp = unpark.head.slice(0, spw);
+        let sp = b.delay("q_sp", head_sp);
+        let sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
+        let sp_m1 = b.delay("q_sp_m1", head_sp - 1);
+        let tmax = b.delay("q_tmax", newq.head.slice(1, dist.width).signed());
+        let miss = b.delay("q_miss", newq.head.bit(0));
+        Queued { ring_g_valid, valid, new, slot, sp, sp_zero, sp_m1, tmax, miss }
+    }
+
+    pub(super) fn returning(&self) -> Returning<'b> {
+        let (b, spw, dist) = (self.b, self.spw, self.dist);
+        b.stage("ring_r", "R: the token back from G, loaded in G");
+        let valid = b.reg("r_valid", Ty::BIT, Some(0));
+        let pop = b.reg("r_pop", Ty::BIT, None);
+        let sp_zero = b.reg("r_sp_zero", Ty::BIT, None);
+        let sp_m1 = b.reg("r_sp_m1", Ty::u(spw), None);
+        let token = Token {
+            valid,
+            slot: b.reg("r_slot", Ty::u(self.sb), None),
+            node: b.reg("r_node", Ty::u(self.node_bits), None),
+            tmin: b.reg("r_tmin", dist, None),
+            tmax: b.reg("r_tmax", dist, None),
+            sp: b.reg("r_sp", Ty::u(spw), None),
+        };
+        Returning { token, pop, sp_zero, sp_m1 }
+    }
+
+    /// A: the returning token, else a queued ray; a pop of an empty stack or a ray that misses
+    /// the scene box is done; a pop reads the slot's stack at sp − 1.
+    pub(super) fn ring_a(&self, r: &Returning<'b>, q: &Queued<'b>) -> RingA<'b> {
+        let (b, k, sb, dist) = (self.b, self.p.slots, self.sb, self.dist);
+        b.stage("ring_a", "A: the returning token or a queued ray; a pop reads the stack; done rays leave");
+        let rv = r.token.valid;
+        let valid = (rv | q.valid).name("a_valid");
+        let slot = rv.select(r.token.slot, q.slot).name("a_slot");
+        let new = (!rv & q.new).name("a_new");
+        let pop = rv.select(r.pop, !q.new).name("a_pop");
+        let sp = rv.select(r.token.sp, q.new.select(q.sp.k(0), q.sp)).name("a_sp");
+        let sp_zero = rv.select(r.sp_zero, q.new | q.sp_zero).name("a_sp_zero");
+        let sp_m1 = rv.select(r.sp_m1, q.sp_m1).name("a_sp_m1");
+        let done = (valid & ((pop & sp_zero) | (new & q.miss))).name("a_done");
+        let from_stack = (pop & !sp_zero).name("a_from_stack");
+        let stack_bits = rom_addr_bits(self.p.stack_depth as usize);
+        // The stack: a block RAM read in two clocks (`brom::bram`), written in G.
+        let stack_w = self.node_bits + 2 * dist.width;
+        let push = [
+            b.wire("stack_we", Ty::BIT),
+            b.wire("stack_waddr", Ty::u(sb + stack_bits)),
+            b.wire("stack_wdata", Ty::u(stack_w)),
+        ];
+        let raddr = b.cat(&[slot, sp_m1.resize(stack_bits)]).name("stack_raddr");
+        // One stack of 2^stack_bits words per slot number the address can hold: a slot number has
+        // at least one bit, so one slot still takes two stacks' worth of address space.
+        let words = (k.max(2) as usize) << stack_bits;
+        let stack_top =
+            bram(b, "u_stack", &format!("stack_w{stack_w}"), stack_w, words, push[0], push[1], push[2], raddr);
+        RingA { valid, slot, new, sp, sp_m1, done, from_stack, stack_top, push }
+    }
+
+    /// B, B2: the token waits two clocks for the stack word (the block's output register).
+    pub(super) fn ring_b(&self, a: &RingA<'b>, r: &Returning<'b>, q: &Queued<'b>) -> (Token<'b>, S<'b>) {
+        let (b, rt) = (self.b, r.token);
+        b.stage("ring_b", "B, B2: the token waits two clocks for the stack word");
+        let bt = Token {
+            valid: b.valid_delay("b_valid", (a.valid & !a.done).name("a_live")),
+            slot: b.delay("b_slot", a.slot),
+            node: b.delay("b_node", rt.valid.select(rt.node, rt.node.k(0))),
+            tmin: b.delay("b_tmin", rt.valid.select(rt.tmin, rt.tmin.k(0))),
+            tmax: b.delay("b_tmax", rt.valid.select(rt.tmax, q.tmax)),
+            sp: b.delay("b_sp", a.from_stack.select(a.sp_m1, a.sp)),
+        };
+        let from_stack = b.delay_line("b_from_stack", a.from_stack, 2);
+        (bt.delayed(b, "b2", 1, |_, x| x), from_stack)
+    }
+
+    /// C: a popped entry (far node, far_min, tmax) from the stack word; the node ROM is
+    /// addressed; the cull test: lower_t(tmin) > best t ⟺ tmin − tmin/64 > best t + 8
+    /// (`golden::lower_t`), only when the slot has a best hit. Returns C's token and the cull
+    /// decision as seen in N.
+    pub(super) fn ring_c(&self, bt: Token<'b>, from_stack: S<'b>, top: S<'b>, a: &RingA<'b>) -> (Token<'b>, S<'b>) {
+        let (b, k, dist, inp) = (self.b, self.p.slots, self.dist, &self.inp);
+        b.stage("ring_c", "C: a popped entry from the stack word; the node ROM addressed; the cull test");
+        let top_tmax = top.slice(0, dist.width).signed();
+        let top_tmin = top.slice(dist.width, dist.width).signed();
+        let top_node = top.slice(2 * dist.width, self.node_bits);
+        let c = bt.delayed(b, "c", 1, |field, x| match field {
+            "node" => from_stack.select(top_node, x),
+            "tmin" => from_stack.select(top_tmin, x),
+            "tmax" => from_stack.select(top_tmax, x),
+            _ => x,
+        });
+        let limit_mem = b.ram("cull_limit", dist.width, vec![0; k as usize]);
+        let limit_we = (inp.merge_valid & inp.merge_hit).name("limit_we");
+        b.ram_write(limit_mem, limit_we, inp.merge_slot, inp.merge_limit.unsigned());
+        let limit = b.read("limit_q", limit_mem, c.slot).signed();
+        let has_best = b.reg("has_best", Ty::u(k), Some(0));
+        let x = b.delay("cull_x", (c.tmin - (c.tmin >> 6)).name("tmin_less"));
+        let arms: Vec<(u128, S)> = (0..k).map(|i| (i as u128, has_best.bit(i))).collect();
+        let hb = b.delay("cull_has_best", b.case(c.slot, &arms, b.konst(Ty::BIT, 0)).name("slot_has_best"));
+        let culled = b.delay("culled", (hb & lt_chain(limit, x)).name("culled_c"));
+        let culled = b.delay_line("culled_n", culled, self.p.node_rom_cycles - 2);
+        let onehot_or_0 = |v: S<'b>, slot: S<'b>| v.select(onehot(slot, k), b.konst(Ty::u(k), 0));
+        let set_best = onehot_or_0(inp.merge_valid & inp.merge_hit, inp.merge_slot).name("best_set");
+        let clear_best = onehot_or_0(a.new & a.valid, a.slot).name("best_clear");
+        b.next(has_best, (has_best & !clear_best) | set_best);
+        (c, culled)
+    }
+
+    /// N: the node word. A culled entry or an empty leaf goes on as a pop; a leaf with entries
+    /// is queued for the leaf stream and leaves the ring; an inner node issues both plane
+    /// distances, one to each of two plane units, with the slot's ray from the ray RAMs.
+    pub(super) fn ring_n(&self, c: Token<'b>, culled: S<'b>) -> RingN<'b> {
+        let (b, p, n, k, word) = (self.b, self.p, self.p.n, self.p.slots, self.inp.node_word);
+        b.stage("ring_n", "N: the node word; a leaf queued, an inner node to the plane units");
+        let token = c.delayed(b, "n", p.node_rom_cycles, |_, x| x);
+        let node_l = &self.scene.node.0;
+        let nf = |name: &str| field(&format!("nw_{name}"), word, node_l.field(name), 0);
+        let (w_axis, w_clip0, w_clip1, w_child, w_first, w_count) =
+            (nf("axis"), nf("clip0"), nf("clip1"), nf("child"), nf("first"), nf("count"));
+        let w_leaf = w_axis.eq(3).name("nw_is_leaf");
+        let visit = (token.valid & !culled).name("visit_c");
+        let is_inner = (visit & !w_leaf).name("is_inner");
+        let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
+        let leaf_bits = rom_addr_bits(self.scene.leaf.1.len());
+        let t = token;
+        let leaf_in =
+            b.cat(&[t.slot, w_first.resize(leaf_bits), w_count, t.tmin.unsigned().resize(p.tmin_width()), t.sp]);
+        let leafq =
+            fifo(b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.valid_delay("leaf_pop_r", self.inp.leaf_pop));
+        // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
+        // the units' second stage in N + 1).
+        let o_word = b.read("ray_o_q", self.o_mem, t.slot);
+        let o = [0, 1, 2].map(|a| o_word.slice(a * n, n));
+        let inv =
+            [0, 1, 2].map(|a| b.read(&format!("ray_inv{}_q", ["x", "y", "z"][a]), self.inv_mem[a], t.slot).signed());
+        let issue =
+            |last: i128, plane: S<'b>| PlaneIssue { valid: is_inner, last: is_inner.k(last), plane, axis: w_axis };
+        let pu0 = plane_unit(b, n, p.c, o, inv, issue(0, w_clip0), p.product);
+        let pu1 = plane_unit(b, n, p.c, o, inv, issue(1, w_clip1), p.product);
+        let plane_latency = pu0.latency;
+        assert!(plane_latency >= 4, "the decision limits need 3 cycles after N");
+        // The axis's direction sign, for the roles of the two distances in F and G.
+        let axis1 = b.delay("axis_n1", w_axis);
+        let negative = b.delay_line("negative", b.pick(axis1, inv).msb().name("negative_c"), plane_latency - 1);
+        RingN {
+            token,
+            culled,
+            visit,
+            is_inner,
+            leaf_push,
+            leafq,
+            axis1,
+            negative,
+            child: w_child,
+            inv,
+            plane_t: [pu0.t, pu1.t],
+            plane_latency,
+        }
+    }
+
+    /// N → F: the token rides along; the limits are made on the way (as `inner_step`'s
+    /// compares, every one a strict less-than; when tmin > tmax no distance passes any limit).
+    /// F: both distances arrive and are compared by their roles, registered for G.
+    pub(super) fn ring_f(&self, nn: &RingN<'b>) -> RingF<'b> {
+        let (b, n, l, nt, axis1, negative) = (self.b, self.p.n, nn.plane_latency, nn.token, nn.axis1, nn.negative);
+        b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
+        let ring = (nt.valid & !nn.leaf_push).name("n_stays");
+        let f_valid = b.valid_line("f_valid", ring, l);
+        let f_inner = b.delay_line("f_inner", nn.is_inner, l);
+        let f_slot = b.delay_line("f_slot", nt.slot, l);
+        let f_tmin = b.delay_line("f_tmin", nt.tmin, l);
+        let f_tmax = b.delay_line("f_tmax", nt.tmax, l);
+        let f_sp = b.delay_line("f_sp", nt.sp, l);
+        let f_child = b.delay_line("f_child", nn.child, l);
+        let neg1 = b.delay("negative_n1", b.pick(axis1, nn.inv).msb());
+        let (tmin1, tmax1) = (b.delay("tmin_n1", nt.tmin), b.delay("tmax_n1", nt.tmax));
+        let tmax_p1 = b.delay("tmax_p1", (nt.tmax + 1).name("tmax_plus_1"));
+        let tmin_m1 = b.delay("tmin_m1", (nt.tmin - 1).name("tmin_minus_1"));
+        let tmin_le_tmax = b.delay("tmin_le_tmax", lt_chain(tmin1, tmax_p1).name("tmin_le_tmax_c"));
+        let (tmin2, tmax2, tmax_p1_2, tmin_m1_2) = (
+            b.delay("tmin_n2", tmin1),
+            b.delay("tmax_n2", tmax1),
+            b.delay("tmax_p1_n2", tmax_p1),
+            b.delay("tmin_m1_n2", tmin_m1),
+        );
+        let never_below = tmax2.k(-(1i128 << (n + 2)));
+        let never_above = tmax2.k((1i128 << (n + 2)) - 1);
+        let limit_reg = |name: &str, if_negative: S<'b>, if_positive: S<'b>, never: S<'b>| {
+            let x = tmin_le_tmax.select(neg1.select(if_negative, if_positive), never);
+            b.delay_line(name, b.delay(&format!("{name}_n3"), x.name(&format!("{name}_c"))), l - 3)
+        };
+        let d0_hi = limit_reg("d0_hi", tmax_p1_2, tmax2, never_below);
+        let d0_lo = limit_reg("d0_lo", tmin2, tmin_m1_2, never_above);
+        let d1_hi = limit_reg("d1_hi", tmax2, tmax_p1_2, never_below);
+        let d1_lo = limit_reg("d1_lo", tmin_m1_2, tmin2, never_above);
+
+        // F: the compares, registered by role for G.
+        let [d0, d1] = nn.plane_t;
+        let d0_below = lt_chain(d0, d0_hi).name("d0_below");
+        let d0_above = lt_chain(d0_lo, d0).name("d0_above");
+        let d1_below = lt_chain(d1, d1_hi).name("d1_below");
+        let d1_above = lt_chain(d1_lo, d1).name("d1_above");
+        let reg = |name: &str, if_negative: S<'b>, if_positive: S<'b>| {
+            b.delay(name, negative.select(if_negative, if_positive).name(&format!("{name}_c")))
+        };
+        let near_lt_tmax = reg("near_lt_tmax", d1_below, d0_below);
+        let far_gt_tmin = reg("far_gt_tmin", d0_above, d1_above);
+        let go_near = reg("go_near", d1_above, d0_above);
+        let go_far = reg("go_far", d0_below, d1_below);
+        let near_end = b.delay("near_end", negative.select(d1, d0));
+        let far_start = b.delay("far_start", negative.select(d0, d1));
+        let g = Token {
+            valid: b.valid_delay("g_valid", f_valid),
+            slot: b.delay("g_slot", f_slot),
+            node: b.delay("g_child", f_child),
+            tmin: b.delay("g_tmin", f_tmin),
+            tmax: b.delay("g_tmax", f_tmax),
+            sp: b.delay("g_sp", f_sp),
+        };
+        let inner = b.delay("g_inner", f_inner);
+        let negative = b.delay("g_negative", negative);
+        RingF { g, inner, negative, near_lt_tmax, far_gt_tmin, go_near, go_far, near_end, far_start }
+    }
+
+    /// G: the decision: push the far child (stack[slot][sp]) and enter the near one, enter one
+    /// child, or pop. The token goes into R and is back at A in the next cycle.
+    pub(super) fn ring_g(&self, f: &RingF<'b>, r: &Returning<'b>, push: &[S<'b>; 3], ring_g_valid: S<'b>) {
+        let (b, g, node_bits) = (self.b, f.g, self.node_bits);
+        b.stage("ring_g", "G: the decision: push the far child and enter the near one, enter one, or pop");
+        b.drive(ring_g_valid, g.valid);
+        let child_b = g.node + 1;
+        let near = f.negative.select(child_b, g.node).resize(node_bits).name("near");
+        let far = f.negative.select(g.node, child_b).resize(node_bits).name("far");
+        let near_max = f.near_lt_tmax.select(f.near_end, g.tmax).name("near_max");
+        let far_min = f.far_gt_tmin.select(f.far_start, g.tmin).name("far_min");
+        let (enter_near, enter_far) =
+            ((f.inner & f.go_near).name("enter_near"), (f.inner & !f.go_near & f.go_far).name("enter_far"));
+        let push_now = (enter_near & f.go_far).name("push");
+        let stack_bits = rom_addr_bits(self.p.stack_depth as usize);
+        b.drive(push[0], push_now);
+        b.drive(push[1], b.cat(&[g.slot, g.sp.resize(stack_bits)]));
+        b.drive(push[2], b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()]));
+        let rt = r.token;
+        b.next(rt.valid, g.valid);
+        b.next(r.pop, !(enter_near | enter_far));
+        b.next(rt.slot, g.slot);
+        b.next(rt.node, enter_near.select(near, far));
+        b.next(rt.tmin, enter_far.select(far_min, g.tmin));
+        b.next(rt.tmax, enter_near.select(near_max, g.tmax));
+        b.next(rt.sp, push_now.select(g.sp + 1, g.sp));
+        b.next(r.sp_zero, !push_now & g.sp.eq(0));
+        b.next(r.sp_m1, push_now.select(g.sp, g.sp - 1));
+    }
+
+    /// The output ports (see `traverse_core`).
+    pub(super) fn outputs(&self, slots: &Slots<'b>, node_addr: S<'b>, nn: &RingN<'b>, done: &Fifo<'b>) {
+        let (b, p, nt) = (self.b, self.p, nn.token);
+        b.output("node_addr", node_addr);
+        b.output("has_free", (slots.free_any & !slots.just_alloc).name("has_free_c"));
+        b.output("free_slot_out", slots.free_idx);
+        let lh = nn.leafq.head;
+        let mut at = 0;
+        let mut take = |w: u32| {
+            let s = lh.slice(at, w);
+            at += w;
+            s
+        };
+        let count_w = self.scene.node.0.field("count").width;
+        let leaf_bits = rom_addr_bits(self.scene.leaf.1.len());
+        let (l_sp, l_tmin, l_count, l_first, l_slot) =
+            (take(self.spw), take(p.tmin_width()), take(count_w), take(leaf_bits), take(self.sb));
+        b.output("leaf_valid", nn.leafq.nonempty);
+        b.output("leaf_slot", l_slot);
+        b.output("leaf_first", l_first);
+        b.output("leaf_count", l_count);
+        b.output("leaf_tmin", l_tmin);
+        b.output("leaf_sp", l_sp);
+        b.output("done_valid", done.nonempty);
+        b.output("done_slot", done.head);
+        b.output("visit", nn.visit);
+        b.output("visit_slot", nt.slot);
+        b.output("visit_node", nt.node);
+        b.output("cull", (nt.valid & nn.culled).name("cull_c"));
+        b.output("depth", nt.sp);
+        b.output("occupied", slots.occupied);
+    }
+}
