@@ -16,6 +16,8 @@ use crate::scene::{Scene, SceneSource};
 use crate::verify::{feed, frame};
 use std::path::{Path, PathBuf};
 
+use super::args_hw::DemoArgs;
+
 /// The ray id width of `fxrt gen`'s default, so the simulated core is the generated one.
 const RAY_ID_WIDTH: u32 = 20;
 /// The default build's place-and-route report (scripts/measure-default.sh): its clock is the
@@ -31,6 +33,15 @@ pub struct DemoConfig {
     /// The simulated frame.
     pub width: u32,
     pub height: u32,
+}
+
+impl DemoArgs {
+    pub fn config(&self) -> crate::error::Result<DemoConfig> {
+        let (width, height) = self.size;
+        check_size(width, height)?;
+        crate::io::check_folder(&self.out)?;
+        Ok(DemoConfig { out: self.out.clone(), width, height })
+    }
 }
 
 /// Runs the demo; Ok(false) when a pixel of the simulated core differs from the golden model.

@@ -1,11 +1,14 @@
 //! The command line's parsers and each command's validation (`config`).
 
+use super::args::{parse_percent, parse_size, parse_vec3};
 use super::config::*;
 use super::sweep_config::SweepConfig;
 use super::*;
 use crate::error::Result;
+use crate::params::EdgeShift;
 use crate::verify::simulators::Simulator;
 use clap::Parser;
+use std::path::PathBuf;
 
 #[test]
 fn parsers() {
@@ -303,7 +306,9 @@ fn each_simulator_choice_maps_once() {
         assert_eq!(frame.map(Simulation::from), frame.map(|_| Simulation::Hdl(sim)));
         // The names printed before the mapping moved here: `{:?}` and its lower case.
         assert_eq!(Simulation::from(choice).title(), format!("{choice:?}"));
-        assert_eq!(Simulation::from(choice).name(), format!("{choice:?}").to_lowercase());
+        // The JSON names the simulator as the option does (`--sim iverilog-sv`).
+        let value = clap::ValueEnum::to_possible_value(&choice).expect("a value");
+        assert_eq!(Simulation::from(choice).name(), value.get_name());
     }
 }
 
