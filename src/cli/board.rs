@@ -33,17 +33,7 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     let g = board_camera(&scene, spec)?;
     super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
     let roms = SceneRoms::of(&scene);
-    let t = c.threads;
-    let p = CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec {
-            id_width: c.ray_id_width,
-            div_bits: c.div_bits,
-            target_mhz: c.target_mhz,
-            slots: t.slots,
-            units: t.units,
-        },
-    );
+    let p = CoreParams::shaped(&roms, &c.core_spec());
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let tools = if b.bitstream {

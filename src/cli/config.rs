@@ -270,6 +270,19 @@ pub struct GenConfig {
     pub board: Option<BoardConfig>,
 }
 
+impl GenConfig {
+    /// The core these options describe.
+    pub fn core_spec(&self) -> crate::cores::top::CoreSpec {
+        crate::cores::top::CoreSpec {
+            id_width: self.ray_id_width,
+            div_bits: self.div_bits,
+            target_mhz: self.target_mhz,
+            slots: self.threads.slots,
+            units: self.threads.units,
+        }
+    }
+}
+
 /// What `fxrt gen --board` builds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BoardConfig {

@@ -233,17 +233,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     if let Some(g) = &raygen {
         ids_fit(c.ray_id_width, g.width, g.height)?;
     }
-    let t = c.threads;
-    let p = crate::cores::top::CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec {
-            id_width: c.ray_id_width,
-            div_bits: c.div_bits,
-            target_mhz: c.target_mhz,
-            slots: t.slots,
-            units: t.units,
-        },
-    );
+    let p = crate::cores::top::CoreParams::shaped(&roms, &c.core_spec());
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions {
