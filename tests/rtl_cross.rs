@@ -218,7 +218,7 @@ fn printers_are_deterministic_and_lint_clean() {
     for text in [
         "always @(posedge clk) begin : ctl_regs",
         "// state machine ctl: a small controller",
-        "st_run: state_next = from_run;",
+        "(state == st_run) ? from_run :",
     ] {
         assert!(v.contains(text), "{text}\n{v}");
     }
