@@ -135,6 +135,12 @@ pub fn part_names(bus: &str, bytes: u32) -> Vec<String> {
 /// register, which drives `m_axis_res_*`; a ray goes into the core's port the clock it is taken.
 pub const AXIS_ADDED_LATENCY: u64 = 1;
 
+/// Rays taken whose results have not left the wrapper, at most: the core's and two in its
+/// result register slice.
+pub fn axis_rays_held(p: &CoreParams) -> u32 {
+    p.rays_held() + 2
+}
+
 pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
     let layout = Layout::of(core);
     let b = Builder::new(&format!("{}_axis", core.name));
@@ -156,7 +162,7 @@ pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
     // slots' and its result queue's, the wrapper two more in its register slice; the count
     // has a bit more than that needs, and no ray is taken at its top, so it cannot wrap
     // whatever the core does (and never holds a ray back from a core that keeps its bound).
-    let held = p.slot_count() + super::top::RESULT_QUEUE + 3;
+    let held = axis_rays_held(p);
     let count_bits = crate::scene::rom::value_bits(held as usize) + 1;
     let in_flight = b.reg("in_flight", Ty::u(count_bits), Some(0));
     let room = in_flight.ne((1i128 << count_bits) - 1).name("room");

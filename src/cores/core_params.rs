@@ -94,6 +94,11 @@ impl CoreParams {
     pub fn total_slots(&self) -> u32 {
         self.units << self.trav.slot_bits()
     }
+    /// Rays taken whose results are not yet taken, at most: the ray port's register, the
+    /// slots and the result queue.
+    pub fn rays_held(&self) -> u32 {
+        self.slot_count() + super::result_queue::RESULT_QUEUE + 1
+    }
     /// Ray slots of the core: the rays it holds at once.
     pub fn slot_count(&self) -> u32 {
         self.units * self.trav.slots

@@ -157,6 +157,9 @@ pub(super) struct Unit<'b> {
     pub(super) sb: u32,
     pub(super) spw: u32,
     pub(super) node_bits: u32,
+    /// Address bits of a slot's stack and of the leaf table.
+    pub(super) stack_bits: u32,
+    pub(super) leaf_bits: u32,
     pub(super) dist: Ty,
 }
 
@@ -272,7 +275,8 @@ impl<'b> Unit<'b> {
             mem
         });
         let node_bits = rom_addr_bits(scene.node.1.len());
-        Unit { b, p, scene, inp, o_mem, inv_mem, sb, spw, node_bits, dist }
+        let (stack_bits, leaf_bits) = (rom_addr_bits(p.stack_depth as usize), rom_addr_bits(scene.leaf.1.len()));
+        Unit { b, p, scene, inp, o_mem, inv_mem, sb, spw, node_bits, stack_bits, leaf_bits, dist }
     }
 
     pub(super) fn slots(&self) -> Slots<'b> {
@@ -363,7 +367,7 @@ impl<'b> Unit<'b> {
         let sp_m1 = rv.select(r.sp_m1, q.sp_m1).name("a_sp_m1");
         let done = (valid & ((pop & sp_zero) | (new & q.miss))).name("a_done");
         let from_stack = (pop & !sp_zero).name("a_from_stack");
-        let stack_bits = rom_addr_bits(self.p.stack_depth as usize);
+        let stack_bits = self.stack_bits;
         // The stack: a block RAM read in two clocks (`brom::bram`), written in G.
         let stack_w = self.node_bits + 2 * dist.width;
         let push = [
@@ -444,7 +448,7 @@ impl<'b> Unit<'b> {
         let visit = (token.valid & !culled).name("visit_c");
         let is_inner = (visit & !w_leaf).name("is_inner");
         let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
-        let leaf_bits = rom_addr_bits(self.scene.leaf.1.len());
+        let leaf_bits = self.leaf_bits;
         let t = token;
         let leaf_in =
             b.cat(&[t.slot, w_first.resize(leaf_bits), w_count, t.tmin.unsigned().resize(p.tmin_width()), t.sp]);
@@ -559,7 +563,7 @@ impl<'b> Unit<'b> {
         let (enter_near, enter_far) =
             ((f.inner & f.go_near).name("enter_near"), (f.inner & !f.go_near & f.go_far).name("enter_far"));
         let push_now = (enter_near & f.go_far).name("push");
-        let stack_bits = rom_addr_bits(self.p.stack_depth as usize);
+        let stack_bits = self.stack_bits;
         b.drive(push[0], push_now);
         b.drive(push[1], b.cat(&[g.slot, g.sp.resize(stack_bits)]));
         b.drive(push[2], b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()]));
@@ -589,7 +593,7 @@ impl<'b> Unit<'b> {
             s
         };
         let count_w = self.scene.node.0.field("count").width;
-        let leaf_bits = rom_addr_bits(self.scene.leaf.1.len());
+        let leaf_bits = self.leaf_bits;
         let (l_sp, l_tmin, l_count, l_first, l_slot) =
             (take(self.spw), take(p.tmin_width()), take(count_w), take(leaf_bits), take(self.sb));
         b.output("leaf_valid", nn.leafq.nonempty);

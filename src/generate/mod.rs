@@ -202,7 +202,7 @@ pub fn core_files(
         "ray_interval_min_cycles": 4,
         "result_handshake": "a result is taken on a clock with res_valid and res_ready high and holds res_* until then; no path from res_ready to any output",
         "result_queue_depth": queue,
-        "rays_held_max": slots + queue + 1,
+        "rays_held_max": p.rays_held(),
         "rays_held_max_is": "rays taken whose results are not yet taken: the port register, the ray slots, the result queue",
         "results_in_order": false,
         "result_order": "rays finish out of order; every result carries its ray id (res_id)",
@@ -233,7 +233,7 @@ pub fn core_files(
     if let Some(header) = &axis {
         let name = format!("{}.json", header.0.trim_end_matches(".h"));
         if let Some(f) = out.iter_mut().find(|f| f.0 == name) {
-            f.1 = axis_manifest(&f.1, &doc, min_latency, slots + queue + 3);
+            f.1 = axis_manifest(&f.1, &doc, min_latency, crate::cores::axis::axis_rays_held(p));
         }
     }
     out.extend(axis);
@@ -244,7 +244,7 @@ pub fn core_files(
 /// from the core's manifest `core` (its clock, measured resources, reset) and the core's
 /// shortest latency: the wrapper adds `AXIS_ADDED_LATENCY` clocks, and holds `held` rays at
 /// most (the core's, and two in its result register slice).
-fn axis_manifest(text: &str, core: &Value, min_latency: Option<u64>, held: u64) -> String {
+fn axis_manifest(text: &str, core: &Value, min_latency: Option<u64>, held: u32) -> String {
     let mut doc: Value = serde_json::from_str(text).expect("the manifest just written");
     let added = crate::cores::axis::AXIS_ADDED_LATENCY;
     doc["latency_cycles"] = json!({
