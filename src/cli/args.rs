@@ -131,7 +131,28 @@ pub struct SceneArgs {
     #[arg(long)]
     pub stats: bool,
     #[command(flatten)]
+    pub memory: MemoryArgs,
+    #[command(flatten)]
     pub params: ParamArgs,
+}
+
+/// The shape of the scene image for external memory (docs/MEMORY.md).
+#[derive(Args, Debug, Clone)]
+pub struct MemoryArgs {
+    /// Data width of the memory's AXI4 read port, bits: 32, 64 or 128.
+    #[arg(long, default_value_t = crate::scene::memory::DEFAULT_MEM_BITS)]
+    pub mem_bits: u32,
+    /// Cache line in bytes, one AXI4 burst: a power of two, two beats to 4096.
+    #[arg(long, default_value_t = crate::scene::memory::DEFAULT_LINE_BYTES)]
+    pub cache_line: u32,
+}
+
+impl MemoryArgs {
+    pub fn shape(&self) -> crate::error::Result<crate::scene::memory::MemoryShape> {
+        let shape = crate::scene::memory::MemoryShape { mem_bits: self.mem_bits, line_bytes: self.cache_line };
+        shape.validate().map_err(|(p, m)| crate::error::Error::param(p, m))?;
+        Ok(shape)
+    }
 }
 
 #[derive(Args, Debug)]

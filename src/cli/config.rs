@@ -185,6 +185,7 @@ pub struct SceneConfig {
     pub scene: SceneSource,
     pub out: PathBuf,
     pub stats: bool,
+    pub memory: crate::scene::memory::MemoryShape,
 }
 
 impl SceneArgs {
@@ -195,6 +196,7 @@ impl SceneArgs {
             scene: self.scene.source(),
             out: self.out.clone(),
             stats: self.stats,
+            memory: self.memory.shape()?,
         })
     }
 }

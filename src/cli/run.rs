@@ -191,7 +191,11 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
         files.add(&c.out.join(format!("{}.coe", layout.rom)), rom::coe(layout, words).as_bytes())?;
     }
     files.add(&c.out.join("fxrt_scene_pkg.vhd"), rom::vhdl_package(&scene, &roms).as_bytes())?;
-    let json = scene::report::scene_json(&scene, &roms);
+    let image = scene::memory::SceneImage::build(&SceneRoms::of(&scene), c.memory)?;
+    files.add(&c.out.join("scene.bin"), &image.bytes)?;
+    files.add(&c.out.join("fxrt_scene.h"), scene::memory_c::c_header(&scene.name, &image.layout).as_bytes())?;
+    let mut json = scene::report::scene_json(&scene, &roms);
+    json["memory"] = serde_json::to_value(&image.layout).unwrap_or_default();
     let json = serde_json::to_string_pretty(&json).unwrap_or_default() + "\n";
     files.add(&c.out.join("scene.json"), json.as_bytes())?;
     files.commit()?;
@@ -199,7 +203,7 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
         print!("{}", scene::report::stats_text(&scene));
     }
     println!(
-        "{}: {} triangles ({} degenerate, {} clamped), E = {}, {} BIH nodes, depth {}, written to {}",
+        "{}: {} triangles ({} degenerate, {} clamped), E = {}, {} BIH nodes, depth {}, memory image {} bytes ({}-bit port, {}-byte lines), written to {}",
         scene.name,
         scene.counts.stored,
         scene.counts.degenerate,
@@ -207,6 +211,9 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
         scene.edge_shift,
         scene.bih_stats.nodes,
         scene.bih_stats.depth,
+        image.layout.total_bytes,
+        c.memory.mem_bits,
+        c.memory.line_bytes,
         c.out.display()
     );
     Ok(())

@@ -5,6 +5,8 @@ pub mod bih;
 pub mod builtin;
 mod image_check;
 pub mod images;
+pub mod memory;
+pub mod memory_c;
 pub mod obj;
 mod obj_lines;
 pub mod report;

@@ -25,7 +25,7 @@ pub struct Layout {
 }
 
 impl Layout {
-    fn build(rom: &'static str, depth: usize, spec: &[(&'static str, u32, bool)]) -> Layout {
+    pub(super) fn build(rom: &'static str, depth: usize, spec: &[(&'static str, u32, bool)]) -> Layout {
         let mut lsb = 0;
         let fields = spec
             .iter()
