@@ -65,7 +65,12 @@ impl Cache {
             return true;
         }
         self.misses += 1;
-        let victim = ways.iter_mut().min_by_key(|w| w.1).unwrap();
+        let victim = if std::env::var("RANDOM_VICTIM").is_ok_and(|v| v == "1") {
+            // A round-robin counter over the misses: no per-set state.
+            &mut ways[(self.misses as usize) % self.ways]
+        } else {
+            ways.iter_mut().min_by_key(|w| w.1).unwrap()
+        };
         *victim = (line, self.clock);
         false
     }

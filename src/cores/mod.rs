@@ -1,9 +1,11 @@
 //! Hardware cores: each builds its netlist from the parameters; its golden twin lives in
 //! `model/`.
 
+pub mod axi_read;
 pub mod axis;
 pub mod board;
 pub mod brom;
+pub mod cache;
 pub mod checksum;
 pub mod clock;
 pub mod closest;

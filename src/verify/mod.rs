@@ -9,6 +9,8 @@ pub mod disturb;
 pub mod exact;
 pub mod feed;
 pub mod frame;
+pub mod memory;
+pub mod memory_tests;
 pub mod simulators;
 pub mod testbench;
 pub mod vectors;

@@ -1,0 +1,297 @@
+//! The read master and two caches against the memory model, in the Rust simulator: random
+//! lookups (hits, misses, misses to lines on their way, evictions in tiny caches), each answered
+//! three clocks later; a hit must carry the image's record, a miss must be released by a fill
+//! and hit when asked again; no line is asked for twice while on its way; a broken memory is
+//! flagged. `harness` and `drive` also give the transcript tests/memory.rs replays in the HDL
+//! simulators. Checks shown failing on their defects: a merge turned off (a line asked for
+//! twice), a waiter given the wrong fill number (never released), a lost beat (flagged).
+
+use super::memory::{MasterOut, MemoryModel, MemoryTiming, xorshift32};
+use super::testbench::Stimulus;
+use crate::cores::axi_read::{AxiIn, AxiReadParams, LineRequest, axi_read};
+use crate::cores::cache::{CacheParams, Lookup, cache};
+use crate::rtl::Ty;
+use crate::rtl::build::Builder;
+use crate::rtl::netlist::Module;
+use crate::rtl::sim::Sim;
+use std::collections::HashMap;
+
+pub const LINE: u64 = 128;
+const ADDR_BITS: u32 = 20;
+
+/// The two caches of the harness: node-like (76-bit records in 16 bytes, 8 a line) and
+/// triangle-like (297-bit records in 40 bytes, 3 a line), each tiny (4 sets × 2 ways) over a
+/// region of `lines` lines, so lines are evicted all the time.
+pub fn shapes() -> [(CacheParams, u64, u32); 2] {
+    let node = CacheParams {
+        record_bits: 76,
+        record_beats: 2,
+        records_per_line: 8,
+        line_beats: 16,
+        data_bits: 64,
+        sets: 4,
+        ways: 2,
+        line_bits: 6,
+        inflight: 4,
+    };
+    let tri = CacheParams { record_bits: 297, record_beats: 5, records_per_line: 3, line_bits: 5, ..node };
+    // (shape, region offset in bytes, record bytes)
+    [(node, LINE, 16), (tri, LINE + 64 * LINE, 40)]
+}
+
+pub fn harness(outstanding: u32) -> Module {
+    let b = Builder::new("mem_harness");
+    let base = b.input("base", Ty::u(ADDR_BITS));
+    let shapes = shapes();
+    let looks: Vec<Lookup> = shapes
+        .iter()
+        .enumerate()
+        .map(|(c, (p, _, _))| Lookup {
+            valid: b.input(&format!("look{c}_valid"), Ty::BIT),
+            line: b.input(&format!("look{c}_line"), Ty::u(p.line_bits)),
+            rec: b.input(&format!("look{c}_rec"), Ty::u(p.rec_bits())),
+        })
+        .collect();
+    let bus = AxiIn {
+        arready: b.input("arready", Ty::BIT),
+        rvalid: b.input("rvalid", Ty::BIT),
+        rdata: b.input("rdata", Ty::u(64)),
+        rlast: b.input("rlast", Ty::BIT),
+        rresp: b.input("rresp", Ty::u(2)),
+    };
+    let ap = AxiReadParams { addr_bits: ADDR_BITS, data_bits: 64, line_beats: 16, outstanding, queue: 4 };
+    // The caches' requests feed the master, whose fills feed the caches: wires close the loop.
+    let req: Vec<_> = (0..2).map(|c| (b.wire(&format!("req{c}_valid"), Ty::BIT), b.wire(&format!("req{c}_offset"), Ty::u(ADDR_BITS)))).collect();
+    let requests: Vec<LineRequest> = req.iter().map(|&(valid, offset)| LineRequest { valid, offset }).collect();
+    let (out, fills) = axi_read(&b, &ap, base, &requests, &bus);
+    for (c, (p, region, _)) in shapes.iter().enumerate() {
+        let k = cache(&b, &format!("c{c}"), p, &looks[c], &fills[c]);
+        b.drive(req[c].0, k.request.0);
+        let offset = (k.request.1.resize(ADDR_BITS) << LINE.trailing_zeros()) + *region as i128;
+        b.drive(req[c].1, offset);
+        b.output(&format!("ans{c}_valid"), k.answer.valid);
+        b.output(&format!("ans{c}_hit"), k.answer.hit);
+        b.output(&format!("ans{c}_wait"), k.answer.wait);
+        for (j, d) in k.answer.data.iter().enumerate() {
+            b.output(&format!("ans{c}_data{j}"), *d);
+        }
+        b.output(&format!("done{c}"), k.done);
+    }
+    b.output("arvalid", out.arvalid);
+    b.output("araddr", out.araddr);
+    b.output("arlen", out.arlen);
+    b.output("error", out.error);
+    b.finish()
+}
+
+/// A test image: every byte a function of its address.
+pub fn image() -> Vec<u8> {
+    (0..(LINE * 100) as u32).map(|k| (k.wrapping_mul(2654435761) >> 13) as u8).collect()
+}
+
+/// The record `rec` of `line` in cache `c`'s region, as parts of at most 128 bits.
+fn record(img: &[u8], c: usize, line: u64, rec: u64) -> Vec<u128> {
+    let (p, region, rbytes) = shapes()[c];
+    let at = (region + line * LINE + rec * rbytes as u64) as usize;
+    p.parts()
+        .iter()
+        .scan(0u32, |lsb, &w| {
+            let mut v = 0u128;
+            for bit in 0..w {
+                let a = *lsb + bit;
+                v |= (((img[at + (a / 8) as usize] >> (a % 8)) & 1) as u128) << bit;
+            }
+            *lsb += w;
+            Some(v)
+        })
+        .collect()
+}
+
+/// What a drive found.
+#[derive(Default)]
+pub struct Drive {
+    pub hits: u64,
+    pub misses: u64,
+    /// Bursts the master asked for.
+    pub bursts: u64,
+    pub stimuli: Vec<Stimulus>,
+    pub error: bool,
+}
+
+/// Runs `clocks` clocks of random lookups; `drop_beat` makes the memory lose that beat
+/// (counted from 0) of its answer, a broken memory. Panics on a wrong record, a wrong
+/// latency, a line asked for twice while on its way, or a waiter never released.
+pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat: Option<u64>) -> Drive {
+    let img = image();
+    let base = 0x4000u64;
+    let mut mem = MemoryModel::new(img.clone(), base, 64, timing);
+    let mut sim = Sim::new(m);
+    let input = |name: &str| m.handle(*m.inputs.iter().find(|&&i| m.sig(i).name == name).unwrap());
+    let output = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+    let names: Vec<String> = m.inputs.iter().map(|&i| m.sig(i).name.clone()).collect();
+    let mut d = Drive::default();
+    let mut x = seed | 1;
+    // Per cache: tasks (line, rec, state) — state None: ready to ask; Some(k): waiting for k.
+    let mut tasks: Vec<Vec<(u64, u64, Option<u16>, u64)>> = vec![Vec::new(), Vec::new()];
+    let mut in_pipe: Vec<Vec<(u64, usize)>> = vec![Vec::new(), Vec::new()];
+    let mut on_way: HashMap<u64, u64> = HashMap::new(); // line address → clock asked
+    let mut ar_order = std::collections::VecDeque::new();
+    // Misses as answered — (cache, fill number, line, fills done then) — and each cache's
+    // bursts in the order asked: fill k of cache c is its k-th burst.
+    let mut claims = Vec::new();
+    let mut asked: [Vec<u64>; 2] = [Vec::new(), Vec::new()];
+    let mut beats_seen = 0u64;
+    for clock in 0..clocks {
+        let mut inputs: HashMap<&str, i128> = HashMap::new();
+        for c in 0..2 {
+            let (p, _, _) = shapes()[c];
+            let done = sim.get(output(&format!("done{c}"))) as u16;
+            // Answers due now.
+            if let Some(&(at, t)) = in_pipe[c].first()
+                && at + 3 == clock
+            {
+                in_pipe[c].remove(0);
+                assert_eq!(sim.get(output(&format!("ans{c}_valid"))), 1, "cache {c}: answer at clock {clock}");
+                let (line, rec, _, _) = tasks[c][t];
+                if sim.get(output(&format!("ans{c}_hit"))) == 1 {
+                    let got: Vec<u128> = (0..p.parts().len())
+                        .map(|j| sim.get(output(&format!("ans{c}_data{j}"))) as u128 & Ty::u(p.parts()[j]).mask())
+                        .collect();
+                    if drop_beat.is_none() {
+                        assert_eq!(got, record(&img, c, line, rec), "cache {c}: line {line} record {rec} at clock {clock}");
+                    }
+                    d.hits += 1;
+                    tasks[c].swap_remove(t);
+                    for e in in_pipe[c].iter_mut() {
+                        if e.1 == tasks[c].len() {
+                            e.1 = t;
+                        }
+                    }
+                } else {
+                    let k = sim.get(output(&format!("ans{c}_wait"))) as u16;
+                    d.misses += 1;
+                    claims.push((c, k, line, done));
+                    tasks[c][t].2 = Some(k);
+                    tasks[c][t].3 = clock;
+                }
+            } else {
+                assert_eq!(sim.get(output(&format!("ans{c}_valid"))), 0, "cache {c}: no answer due at clock {clock}");
+            }
+            // The last 3,000 clocks only finish what was asked: every waiter must be released.
+            while tasks[c].len() < 6 && clock + 3_000 < clocks {
+                x = xorshift32(x);
+                tasks[c].push(((x >> 4) as u64 % (1 << p.line_bits), (x >> 20) as u64 % p.records_per_line as u64, None, clock));
+            }
+            // One lookup: the first task that is ready or released and not in the pipeline.
+            x = xorshift32(x);
+            let pick = (0..tasks[c].len()).find(|&t| {
+                !in_pipe[c].iter().any(|e| e.1 == t)
+                    && match tasks[c][t].2 {
+                        None => true,
+                        Some(k) => (done.wrapping_sub(k) as i16) >= 0,
+                    }
+            });
+            for (t, task) in tasks[c].iter().enumerate() {
+                if let Some(k) = task.2 {
+                    assert!(clock - task.3 < 20_000, "cache {c}: task {t} waits for fill {k} since {} (done {done})", task.3);
+                }
+            }
+            let (valid, line, rec) = match pick {
+                Some(t) if x & 3 != 0 && clock > 0 => {
+                    in_pipe[c].push((clock, t));
+                    (1, tasks[c][t].0, tasks[c][t].1)
+                }
+                _ => (0, 0, 0),
+            };
+            inputs.insert(["look0_valid", "look1_valid"][c], valid);
+            inputs.insert(["look0_line", "look1_line"][c], line as i128);
+            inputs.insert(["look0_rec", "look1_rec"][c], rec as i128);
+        }
+        let mo = MasterOut {
+            arvalid: sim.get(output("arvalid")) == 1,
+            araddr: sim.get(output("araddr")) as u64,
+            arlen: sim.get(output("arlen")) as u32,
+            rready: true,
+        };
+        let mut r = mem.out().clone();
+        if r.rvalid && drop_beat == Some(beats_seen) {
+            r.rvalid = false;
+        }
+        if mem.out().rvalid && mem.out().rlast {
+            let done = ar_order.pop_front().expect("a burst in flight");
+            on_way.remove(&done);
+        }
+        if mo.arvalid && mem.out().arready {
+            assert_eq!(mo.arlen, 15);
+            assert!(!on_way.contains_key(&mo.araddr), "line {:#x} asked for again while on its way (clock {clock})", mo.araddr);
+            on_way.insert(mo.araddr, clock);
+            ar_order.push_back(mo.araddr);
+            let c = (mo.araddr - base >= shapes()[1].1) as usize;
+            asked[c].push((mo.araddr - base - shapes()[c].1) / LINE);
+            d.bursts += 1;
+        }
+        if mem.out().rvalid {
+            beats_seen += 1;
+        }
+        inputs.insert("base", base as i128);
+        inputs.insert("arready", mem.out().arready as i128);
+        inputs.insert("rvalid", r.rvalid as i128);
+        inputs.insert("rdata", r.rdata as i128);
+        inputs.insert("rlast", r.rlast as i128);
+        inputs.insert("rresp", 0);
+        let st = Stimulus { reset: clock == 0, inputs: names.iter().map(|n| inputs[n.as_str()]).collect() };
+        for (name, v) in names.iter().zip(&st.inputs) {
+            sim.set(input(name), *v);
+        }
+        sim.reset = st.reset;
+        d.stimuli.push(st);
+        mem.clock(&mo);
+        sim.tick();
+    }
+    d.error = sim.get(output("error")) == 1;
+    if drop_beat.is_none() {
+        // A miss waits for its own line's fill (merged or new), or — every place in flight
+        // taken — for the next fill, after which it asks again (`done` is read at the answer,
+        // a clock or two after the cache chose).
+        for &(c, k, line, done) in &claims {
+            let fill_line = asked[c].get(k as usize - 1).copied();
+            assert!(
+                fill_line == Some(line) || (k <= done.wrapping_add(1) && k + 2 > done),
+                "cache {c}: a miss on line {line} told to wait for fill {k} (line {fill_line:?}), {done} done"
+            );
+        }
+        for (c, t) in tasks.iter().enumerate() {
+            assert!(t.is_empty(), "cache {c}: {} lookups never answered with a hit (a wake-up lost)", t.len());
+        }
+    }
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lookups_hit_the_image_after_their_fills() {
+        let m = harness(8);
+        for (timing, seed) in [
+            (MemoryTiming { latency: 40, ..MemoryTiming::default() }, 3),
+            (MemoryTiming { latency: 1, outstanding: 2, ..MemoryTiming::default() }, 5),
+            (MemoryTiming { latency: 200, extra_delay: 60, pause_in_256: 100, seed: 9, ..MemoryTiming::default() }, 7),
+        ] {
+            let d = drive(&m, timing, 30_000, seed, None);
+            assert!(!d.error, "{timing:?}: the master flagged a protocol error");
+            // More misses than bursts: misses to lines on their way were merged.
+            let (h, m, b) = (d.hits, d.misses, d.bursts);
+            assert!(h > 1_000 && m > 200 && m > b + 100, "{timing:?}: {h} hits, {m} misses, {b} bursts");
+        }
+    }
+
+    /// A memory that loses a beat: the master's count and RLAST disagree from there on.
+    #[test]
+    fn a_lost_beat_is_flagged() {
+        let m = harness(8);
+        assert!(!drive(&m, MemoryTiming::default(), 6_000, 3, None).error);
+        assert!(drive(&m, MemoryTiming::default(), 6_000, 3, Some(37)).error);
+    }
+}
