@@ -100,14 +100,21 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let parts = p.parts();
     let seq = Ty::u(SEQ_BITS);
     let depth_words = (p.sets << rb) as usize;
-    let tags: Vec<usize> = (0..p.ways).map(|w| b.ram(&nm(&format!("tag{w}")), tb.max(1), vec![0; p.sets as usize])).collect();
+    let tags: Vec<usize> =
+        (0..p.ways).map(|w| b.ram(&nm(&format!("tag{w}")), tb.max(1), vec![0; p.sets as usize])).collect();
     // Valid bits are registers, not RAM: the one-clock reset empties the cache (a new scene
     // may be in memory after it), and a scrambled power-up state holds no false hit.
     let valid: Vec<Vec<S<'b>>> = (0..p.ways)
         .map(|w| (0..p.sets).map(|k| b.reg(&nm(&format!("v{w}_{k}")), Ty::BIT, Some(0))).collect())
         .collect();
     let datas: Vec<Vec<usize>> = (0..p.ways)
-        .map(|w| parts.iter().enumerate().map(|(j, &pw)| b.ram(&nm(&format!("data{w}_{j}")), pw, vec![0; depth_words])).collect())
+        .map(|w| {
+            parts
+                .iter()
+                .enumerate()
+                .map(|(j, &pw)| b.ram(&nm(&format!("data{w}_{j}")), pw, vec![0; depth_words]))
+                .collect()
+        })
         .collect();
 
     b.stage(&nm("fill"), "beats gathered into records and written; the victim's tag cleared at the first beat, the new one written at the last");
@@ -135,7 +142,8 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let first = (fill.valid & fill.beat.eq(0)).name(&nm("fill_first"));
     let last = (fill.valid & fill.last).name(&nm("fill_last"));
     // Record assembly: the beats before a record's last, oldest at 0.
-    let held: Vec<S<'b>> = (0..p.record_beats - 1).map(|k| b.reg(&nm(&format!("beat{k}")), fill.data.ty(), None)).collect();
+    let held: Vec<S<'b>> =
+        (0..p.record_beats - 1).map(|k| b.reg(&nm(&format!("beat{k}")), fill.data.ty(), None)).collect();
     for k in 0..held.len() {
         let src = if k + 1 < held.len() { held[k + 1] } else { fill.data };
         b.next_when(held[k], fill.valid, src);
@@ -187,7 +195,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let free_at = b.delay_line(&nm("free_at"), nf, 2);
     b.end_stage();
 
-    b.stage(&nm("look"), "the lookup registered, tags and records read, compared; a miss merged or given a new fill number");
+    b.stage(
+        &nm("look"),
+        "the lookup registered, tags and records read, compared; a miss merged or given a new fill number",
+    );
     let l0_valid = b.valid_delay(&nm("l0_valid"), look.valid);
     let l0_line = b.delay(&nm("l0_line"), look.line);
     let l0_rec = b.delay(&nm("l0_rec"), look.rec.resize(rb));
@@ -211,13 +222,19 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let data_q: Vec<Vec<S<'b>>> = datas
         .iter()
         .enumerate()
-        .map(|(w, rams)| rams.iter().enumerate().map(|(j, &r)| b.read(&nm(&format!("data_q{w}_{j}")), r, raddr)).collect())
+        .map(|(w, rams)| {
+            rams.iter().enumerate().map(|(j, &r)| b.read(&nm(&format!("data_q{w}_{j}")), r, raddr)).collect()
+        })
         .collect();
     let l1_valid = b.valid_delay(&nm("l1_valid"), l0_valid);
     let l1_line = b.delay(&nm("l1_line"), l0_line);
     let want = if tb == 0 { b.konst(Ty::u(1), 0) } else { l1_line.slice(sb, tb) };
-    let hits: Vec<S<'b>> =
-        tag_q.iter().zip(&valid_q).enumerate().map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}")))).collect();
+    let hits: Vec<S<'b>> = tag_q
+        .iter()
+        .zip(&valid_q)
+        .enumerate()
+        .map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}"))))
+        .collect();
     let hit = hits.iter().skip(1).fold(hits[0], |a, &h| a | h).name(&nm("hit"));
     let data: Vec<S<'b>> = (0..parts.len())
         .map(|j| (1..p.ways as usize).fold(data_q[0][j], |acc, w| hits[w].select(data_q[w][j], acc)))
@@ -233,7 +250,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         found = found | m;
     }
     let new_seq = (req + 1).name(&nm("new_seq"));
-    let slot_free = !slots.iter().enumerate().fold(b.konst(Ty::BIT, 0), |acc, (j, s)| acc | (new_seq.slice(0, db).eq(j as i128) & s.2));
+    let slot_free = !slots
+        .iter()
+        .enumerate()
+        .fold(b.konst(Ty::BIT, 0), |acc, (j, s)| acc | (new_seq.slice(0, db).eq(j as i128) & s.2));
     let miss = (l1_valid & !hit).name(&nm("miss"));
     let alloc = (miss & !found & slot_free).name(&nm("alloc"));
     let victim = b.reg(&nm("victim"), Ty::u(wb), Some(0));
@@ -255,5 +275,9 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let req_valid = b.valid_delay(&nm("req_valid"), alloc);
     let req_line = b.delay(&nm("req_line"), l1_line);
     b.end_stage();
-    Cache { answer: Answer { valid: a_valid, hit: a_hit, data: a_data, wait: a_wait }, request: (req_valid, req_line), done }
+    Cache {
+        answer: Answer { valid: a_valid, hit: a_hit, data: a_data, wait: a_wait },
+        request: (req_valid, req_line),
+        done,
+    }
 }

@@ -27,7 +27,13 @@ pub struct MemoryTiming {
 
 impl Default for MemoryTiming {
     fn default() -> Self {
-        MemoryTiming { latency: DEFAULT_LATENCY, outstanding: DEFAULT_OUTSTANDING, extra_delay: 0, pause_in_256: 0, seed: 1 }
+        MemoryTiming {
+            latency: DEFAULT_LATENCY,
+            outstanding: DEFAULT_OUTSTANDING,
+            extra_delay: 0,
+            pause_in_256: 0,
+            seed: 1,
+        }
     }
 }
 
@@ -158,8 +164,10 @@ impl MemoryModel {
             Some(b) if pending || (b.first_clock <= self.clock && !pause) => {
                 let at = (b.addr + (self.taken * self.beat_bytes) as u64) as usize;
                 assert!(at + self.beat_bytes as usize <= self.image.len(), "read beyond the scene image: {at:#x}");
-                self.out.rdata =
-                    self.image[at..at + self.beat_bytes as usize].iter().rev().fold(0u128, |v, &x| (v << 8) | x as u128);
+                self.out.rdata = self.image[at..at + self.beat_bytes as usize]
+                    .iter()
+                    .rev()
+                    .fold(0u128, |v, &x| (v << 8) | x as u128);
                 self.out.rvalid = true;
                 self.out.rlast = self.taken + 1 == b.beats;
             }
@@ -232,10 +240,12 @@ mod tests {
     fn xorshift_is_marsaglias() {
         // The sequence from 1: the HDL testbench models are checked against these.
         let mut x = 1;
-        let seq: Vec<u32> = (0..3).map(|_| {
-            x = xorshift32(x);
-            x
-        }).collect();
+        let seq: Vec<u32> = (0..3)
+            .map(|_| {
+                x = xorshift32(x);
+                x
+            })
+            .collect();
         assert_eq!(seq, [270369, 67634689, 2647435461]);
     }
 }

@@ -61,7 +61,9 @@ pub fn harness(outstanding: u32) -> Module {
     };
     let ap = AxiReadParams { addr_bits: ADDR_BITS, data_bits: 64, line_beats: 16, outstanding, queue: 4 };
     // The caches' requests feed the master, whose fills feed the caches: wires close the loop.
-    let req: Vec<_> = (0..2).map(|c| (b.wire(&format!("req{c}_valid"), Ty::BIT), b.wire(&format!("req{c}_offset"), Ty::u(ADDR_BITS)))).collect();
+    let req: Vec<_> = (0..2)
+        .map(|c| (b.wire(&format!("req{c}_valid"), Ty::BIT), b.wire(&format!("req{c}_offset"), Ty::u(ADDR_BITS))))
+        .collect();
     let requests: Vec<LineRequest> = req.iter().map(|&(valid, offset)| LineRequest { valid, offset }).collect();
     let (out, fills) = axi_read(&b, &ap, base, &requests, &bus);
     for (c, (p, region, _)) in shapes.iter().enumerate() {
@@ -107,6 +109,10 @@ fn record(img: &[u8], c: usize, line: u64, rec: u64) -> Vec<u128> {
         .collect()
 }
 
+/// A lookup the driver makes until it hits: line, record, the fill it waits for (None: ready
+/// to ask), the clock it began waiting.
+type Task = (u64, u64, Option<u16>, u64);
+
 /// What a drive found.
 #[derive(Default)]
 pub struct Drive {
@@ -131,8 +137,8 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
     let names: Vec<String> = m.inputs.iter().map(|&i| m.sig(i).name.clone()).collect();
     let mut d = Drive::default();
     let mut x = seed | 1;
-    // Per cache: tasks (line, rec, state) — state None: ready to ask; Some(k): waiting for k.
-    let mut tasks: Vec<Vec<(u64, u64, Option<u16>, u64)>> = vec![Vec::new(), Vec::new()];
+    // Per cache: lookups to make, each (line, record, the fill it waits for, since when).
+    let mut tasks: Vec<Vec<Task>> = vec![Vec::new(), Vec::new()];
     let mut in_pipe: Vec<Vec<(u64, usize)>> = vec![Vec::new(), Vec::new()];
     let mut on_way: HashMap<u64, u64> = HashMap::new(); // line address → clock asked
     let mut ar_order = std::collections::VecDeque::new();
@@ -158,7 +164,11 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
                         .map(|j| sim.get(output(&format!("ans{c}_data{j}"))) as u128 & Ty::u(p.parts()[j]).mask())
                         .collect();
                     if drop_beat.is_none() {
-                        assert_eq!(got, record(&img, c, line, rec), "cache {c}: line {line} record {rec} at clock {clock}");
+                        assert_eq!(
+                            got,
+                            record(&img, c, line, rec),
+                            "cache {c}: line {line} record {rec} at clock {clock}"
+                        );
                     }
                     d.hits += 1;
                     tasks[c].swap_remove(t);
@@ -180,7 +190,12 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
             // The last 3,000 clocks only finish what was asked: every waiter must be released.
             while tasks[c].len() < 6 && clock + 3_000 < clocks {
                 x = xorshift32(x);
-                tasks[c].push(((x >> 4) as u64 % (1 << p.line_bits), (x >> 20) as u64 % p.records_per_line as u64, None, clock));
+                tasks[c].push((
+                    (x >> 4) as u64 % (1 << p.line_bits),
+                    (x >> 20) as u64 % p.records_per_line as u64,
+                    None,
+                    clock,
+                ));
             }
             // One lookup: the first task that is ready or released and not in the pipeline.
             x = xorshift32(x);
@@ -193,7 +208,11 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
             });
             for (t, task) in tasks[c].iter().enumerate() {
                 if let Some(k) = task.2 {
-                    assert!(clock - task.3 < 20_000, "cache {c}: task {t} waits for fill {k} since {} (done {done})", task.3);
+                    assert!(
+                        clock - task.3 < 20_000,
+                        "cache {c}: task {t} waits for fill {k} since {} (done {done})",
+                        task.3
+                    );
                 }
             }
             let (valid, line, rec) = match pick {
@@ -223,7 +242,11 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
         }
         if mo.arvalid && mem.out().arready {
             assert_eq!(mo.arlen, 15);
-            assert!(!on_way.contains_key(&mo.araddr), "line {:#x} asked for again while on its way (clock {clock})", mo.araddr);
+            assert!(
+                !on_way.contains_key(&mo.araddr),
+                "line {:#x} asked for again while on its way (clock {clock})",
+                mo.araddr
+            );
             on_way.insert(mo.araddr, clock);
             ar_order.push_back(mo.araddr);
             let c = (mo.araddr - base >= shapes()[1].1) as usize;
