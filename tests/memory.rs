@@ -36,3 +36,78 @@ fn caches_and_master_agree_in_every_simulator() {
     }
     eprintln!("{ran} HDL simulators ran");
 }
+
+/// The memory model as the testbenches have it (`verify::memory_hdl`) against the Rust one: a
+/// random master (addresses, burst lengths, RREADY low at times, resets) drives both; every
+/// output of the HDL model equals the Rust model's on every clock, in every simulator.
+#[test]
+fn the_memory_model_is_the_same_in_every_simulator() {
+    use fxrt::rtl::Ty;
+    use fxrt::rtl::build::Builder;
+    use fxrt::verify::memory::{MasterOut, MemoryModel, xorshift32};
+    use fxrt::verify::memory_hdl::{MODEL, model_files};
+    use fxrt::verify::testbench::{Stimulus, Transcript};
+    for (data_bits, timing) in [
+        (64, MemoryTiming { latency: 5, outstanding: 3, extra_delay: 7, pause_in_256: 80, seed: 12345 }),
+        (128, MemoryTiming { latency: 1, outstanding: 1, extra_delay: 0, pause_in_256: 0, seed: 1 }),
+        (32, MemoryTiming { latency: 40, outstanding: 16, extra_delay: 0, pause_in_256: 200, seed: 7 }),
+    ] {
+        let addr_bits = 16;
+        let base = 0x1000u64;
+        let image: Vec<u8> = (0..4096u32).map(|k| (k.wrapping_mul(2654435761) >> 11) as u8).collect();
+        // A module with the model's ports, for the testbench generator; its design file is
+        // replaced by the model's.
+        let b = Builder::new(MODEL);
+        let ins = [("arvalid", 1), ("araddr", addr_bits), ("arlen", 8), ("rready", 1)]
+            .map(|(name, w)| b.input(name, Ty::u(w)));
+        let keep = b.reg("keep", Ty::BIT, Some(0));
+        b.next(keep, ins[0]);
+        for (name, w) in [("arready", 1), ("rvalid", 1), ("rdata", data_bits), ("rlast", 1)] {
+            b.output(name, keep.resize(w));
+        }
+        let m = b.finish();
+        let mut mem = MemoryModel::new(image.clone(), base, data_bits, timing);
+        let (mut stimuli, mut outputs) = (Vec::new(), Vec::new());
+        let mut x = 99u32;
+        let beat = (data_bits / 8) as u64;
+        for clock in 0..3_000u32 {
+            x = xorshift32(x);
+            let reset = clock == 0 || x % 997 == 0;
+            let arlen = (x >> 4) % 16;
+            let line = ((x >> 12) as u64 % (4096 / beat / 16)) * beat * 16;
+            let mo = MasterOut { arvalid: x & 3 != 0, araddr: base + line, arlen, rready: (x >> 8) & 3 != 0 };
+            if reset {
+                mem.reset();
+            } else {
+                mem.clock(&mo);
+            }
+            let o = mem.out();
+            stimuli.push(Stimulus {
+                reset,
+                inputs: vec![mo.arvalid as i128, mo.araddr as i128, mo.arlen as i128, mo.rready as i128],
+            });
+            let mask = Ty::u(data_bits).mask();
+            outputs.push(vec![o.arready as u128, o.rvalid as u128, o.rdata & mask, o.rlast as u128]);
+        }
+        let t = Transcript { stimuli, outputs };
+        for sim in Simulator::ALL.into_iter().chain([Simulator::IverilogSv]) {
+            if !sim.available() {
+                let _ = writeln!(std::io::stderr().lock(), "skipped: {} is not installed", sim.name());
+                continue;
+            }
+            let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+                .join(format!("memory_model_{}_{data_bits}", sim.name()));
+            let _ = std::fs::remove_dir_all(&dir);
+            std::fs::create_dir_all(&dir).unwrap();
+            for (file, text) in bench_files(&m, &t, sim) {
+                std::fs::write(dir.join(file), text).unwrap();
+            }
+            for (file, text) in model_files(&timing, data_bits, addr_bits, base, &image, sim == Simulator::Ghdl) {
+                std::fs::write(dir.join(file), text).unwrap();
+            }
+            let (passed, failed) = sim.run(&dir, &m).unwrap_or_else(|e| panic!("{e}"));
+            eprintln!("{} at {data_bits} bits: {passed} passed, {failed} failed", sim.name());
+            assert_eq!((passed, failed), (3_000, 0), "{} at {data_bits} bits, {timing:?}", sim.name());
+        }
+    }
+}

@@ -129,6 +129,16 @@ impl MemoryModel {
         }
     }
 
+    /// A clock of the one-clock reset (AXI's ARESETn): bursts in flight are forgotten; the
+    /// xorshift and the clock count do not step.
+    pub fn reset(&mut self) {
+        self.bursts.clear();
+        self.taken = 0;
+        self.out.arready = true;
+        self.out.rvalid = false;
+        self.out.rlast = false;
+    }
+
     /// The memory's outputs in this clock.
     pub fn out(&self) -> &MemoryOut {
         &self.out

@@ -10,6 +10,7 @@ pub mod exact;
 pub mod feed;
 pub mod frame;
 pub mod memory;
+pub mod memory_hdl;
 pub mod memory_tests;
 pub mod simulators;
 pub mod testbench;
