@@ -4,16 +4,17 @@
 //! output equal on every clock. Each simulator not installed is reported as skipped.
 
 use fxrt::verify::memory::MemoryTiming;
-use fxrt::verify::memory_tests::{drive, harness};
+use fxrt::verify::memory_tests::{Shape, drive, harness};
 use fxrt::verify::simulators::Simulator;
 use fxrt::verify::testbench::{bench_files, record};
 use std::io::Write;
 
 #[test]
 fn caches_and_master_agree_in_every_simulator() {
-    let m = harness(4);
+    let shape = Shape { data_bits: 64, ways: 2, outstanding: 4 };
+    let m = harness(shape);
     let timing = MemoryTiming { latency: 12, outstanding: 3, extra_delay: 9, pause_in_256: 60, seed: 77 };
-    let d = drive(&m, timing, 5_000, 11, None);
+    let d = drive(&m, shape, timing, 5_000, 11, None);
     assert!(d.hits > 100 && d.bursts > 50, "{} hits, {} bursts", d.hits, d.bursts);
     let clocks = d.stimuli.len() as u64;
     let t = record(&m, d.stimuli);
@@ -72,7 +73,7 @@ fn the_memory_model_is_the_same_in_every_simulator() {
         let beat = (data_bits / 8) as u64;
         for clock in 0..3_000u32 {
             x = xorshift32(x);
-            let reset = clock == 0 || x % 997 == 0;
+            let reset = clock == 0 || x.is_multiple_of(997);
             let arlen = (x >> 4) % 16;
             let line = ((x >> 12) as u64 % (4096 / beat / 16)) * beat * 16;
             let mo = MasterOut { arvalid: x & 3 != 0, araddr: base + line, arlen, rready: (x >> 8) & 3 != 0 };

@@ -19,30 +19,48 @@ use std::collections::HashMap;
 pub const LINE: u64 = 128;
 const ADDR_BITS: u32 = 20;
 
-/// The two caches of the harness: node-like (76-bit records in 16 bytes, 8 a line) and
-/// triangle-like (297-bit records in 40 bytes, 3 a line), each tiny (4 sets × 2 ways) over a
-/// region of `lines` lines, so lines are evicted all the time.
-pub fn shapes() -> [(CacheParams, u64, u32); 2] {
-    let node = CacheParams {
-        record_bits: 76,
-        record_beats: 2,
-        records_per_line: 8,
-        line_beats: 16,
-        data_bits: 64,
-        sets: 4,
-        ways: 2,
-        line_bits: 6,
-        inflight: 4,
-    };
-    let tri = CacheParams { record_bits: 297, record_beats: 5, records_per_line: 3, line_bits: 5, ..node };
-    // (shape, region offset in bytes, record bytes)
-    [(node, LINE, 16), (tri, LINE + 64 * LINE, 40)]
+/// The harness's shape: the read port's data width, the caches' ways, bursts in flight.
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    pub data_bits: u32,
+    pub ways: u32,
+    pub outstanding: u32,
 }
 
-pub fn harness(outstanding: u32) -> Module {
+impl Shape {
+    /// The two caches: node-like (76-bit records in 16 bytes) and triangle-like (297-bit
+    /// records in whole beats: 40 bytes at 32 and 64 bits, 48 at 128), each tiny (8 lines in
+    /// sets × ways) over a region of 64 or 32 lines, so lines are evicted all the time. With
+    /// (region offset, record bytes).
+    pub fn caches(&self) -> [(CacheParams, u64, u32); 2] {
+        let beat = self.data_bits / 8;
+        let node = CacheParams {
+            record_bits: 76,
+            record_beats: 16 / beat,
+            records_per_line: 8,
+            line_beats: LINE as u32 / beat,
+            data_bits: self.data_bits,
+            sets: 8 / self.ways,
+            ways: self.ways,
+            line_bits: 6,
+            inflight: 4,
+        };
+        let tri_bytes = 297u32.div_ceil(self.data_bits) * beat;
+        let tri = CacheParams {
+            record_bits: 297,
+            record_beats: tri_bytes / beat,
+            records_per_line: LINE as u32 / tri_bytes,
+            line_bits: 5,
+            ..node
+        };
+        [(node, LINE, 16), (tri, LINE + 64 * LINE, tri_bytes)]
+    }
+}
+
+pub fn harness(shape: Shape) -> Module {
     let b = Builder::new("mem_harness");
     let base = b.input("base", Ty::u(ADDR_BITS));
-    let shapes = shapes();
+    let shapes = shape.caches();
     let looks: Vec<Lookup> = shapes
         .iter()
         .enumerate()
@@ -55,11 +73,17 @@ pub fn harness(outstanding: u32) -> Module {
     let bus = AxiIn {
         arready: b.input("arready", Ty::BIT),
         rvalid: b.input("rvalid", Ty::BIT),
-        rdata: b.input("rdata", Ty::u(64)),
+        rdata: b.input("rdata", Ty::u(shape.data_bits)),
         rlast: b.input("rlast", Ty::BIT),
         rresp: b.input("rresp", Ty::u(2)),
     };
-    let ap = AxiReadParams { addr_bits: ADDR_BITS, data_bits: 64, line_beats: 16, outstanding, queue: 4 };
+    let ap = AxiReadParams {
+        addr_bits: ADDR_BITS,
+        data_bits: shape.data_bits,
+        line_beats: LINE as u32 * 8 / shape.data_bits,
+        outstanding: shape.outstanding,
+        queue: 4,
+    };
     // The caches' requests feed the master, whose fills feed the caches: wires close the loop.
     let req: Vec<_> = (0..2)
         .map(|c| (b.wire(&format!("req{c}_valid"), Ty::BIT), b.wire(&format!("req{c}_offset"), Ty::u(ADDR_BITS))))
@@ -92,8 +116,8 @@ pub fn image() -> Vec<u8> {
 }
 
 /// The record `rec` of `line` in cache `c`'s region, as parts of at most 128 bits.
-fn record(img: &[u8], c: usize, line: u64, rec: u64) -> Vec<u128> {
-    let (p, region, rbytes) = shapes()[c];
+fn record(img: &[u8], shape: Shape, c: usize, line: u64, rec: u64) -> Vec<u128> {
+    let (p, region, rbytes) = shape.caches()[c];
     let at = (region + line * LINE + rec * rbytes as u64) as usize;
     p.parts()
         .iter()
@@ -127,10 +151,10 @@ pub struct Drive {
 /// Runs `clocks` clocks of random lookups; `drop_beat` makes the memory lose that beat
 /// (counted from 0) of its answer, a broken memory. Panics on a wrong record, a wrong
 /// latency, a line asked for twice while on its way, or a waiter never released.
-pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat: Option<u64>) -> Drive {
+pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat: Option<u64>) -> Drive {
     let img = image();
     let base = 0x4000u64;
-    let mut mem = MemoryModel::new(img.clone(), base, 64, timing);
+    let mut mem = MemoryModel::new(img.clone(), base, shape.data_bits, timing);
     let mut sim = Sim::new(m);
     let input = |name: &str| m.handle(*m.inputs.iter().find(|&&i| m.sig(i).name == name).unwrap());
     let output = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
@@ -150,7 +174,7 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
     for clock in 0..clocks {
         let mut inputs: HashMap<&str, i128> = HashMap::new();
         for c in 0..2 {
-            let (p, _, _) = shapes()[c];
+            let (p, _, _) = shape.caches()[c];
             let done = sim.get(output(&format!("done{c}"))) as u16;
             // Answers due now.
             if let Some(&(at, t)) = in_pipe[c].first()
@@ -166,7 +190,7 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
                     if drop_beat.is_none() {
                         assert_eq!(
                             got,
-                            record(&img, c, line, rec),
+                            record(&img, shape, c, line, rec),
                             "cache {c}: line {line} record {rec} at clock {clock}"
                         );
                     }
@@ -241,7 +265,7 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
             on_way.remove(&done);
         }
         if mo.arvalid && mem.out().arready {
-            assert_eq!(mo.arlen, 15);
+            assert_eq!(mo.arlen as u64, LINE * 8 / shape.data_bits as u64 - 1);
             assert!(
                 !on_way.contains_key(&mo.araddr),
                 "line {:#x} asked for again while on its way (clock {clock})",
@@ -249,8 +273,9 @@ pub fn drive(m: &Module, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat
             );
             on_way.insert(mo.araddr, clock);
             ar_order.push_back(mo.araddr);
-            let c = (mo.araddr - base >= shapes()[1].1) as usize;
-            asked[c].push((mo.araddr - base - shapes()[c].1) / LINE);
+            let regions = shape.caches().map(|k| k.1);
+            let c = (mo.araddr - base >= regions[1]) as usize;
+            asked[c].push((mo.araddr - base - regions[c]) / LINE);
             d.bursts += 1;
         }
         if mem.out().rvalid {
@@ -296,13 +321,14 @@ mod tests {
 
     #[test]
     fn lookups_hit_the_image_after_their_fills() {
-        let m = harness(8);
+        let two = Shape { data_bits: 64, ways: 2, outstanding: 8 };
+        let m = harness(two);
         for (timing, seed) in [
             (MemoryTiming { latency: 40, ..MemoryTiming::default() }, 3),
             (MemoryTiming { latency: 1, outstanding: 2, ..MemoryTiming::default() }, 5),
             (MemoryTiming { latency: 200, extra_delay: 60, pause_in_256: 100, seed: 9, ..MemoryTiming::default() }, 7),
         ] {
-            let d = drive(&m, timing, 30_000, seed, None);
+            let d = drive(&m, two, timing, 30_000, seed, None);
             assert!(!d.error, "{timing:?}: the master flagged a protocol error");
             // More misses than bursts: misses to lines on their way were merged.
             let (h, m, b) = (d.hits, d.misses, d.bursts);
@@ -313,8 +339,31 @@ mod tests {
     /// A memory that loses a beat: the master's count and RLAST disagree from there on.
     #[test]
     fn a_lost_beat_is_flagged() {
-        let m = harness(8);
-        assert!(!drive(&m, MemoryTiming::default(), 6_000, 3, None).error);
-        assert!(drive(&m, MemoryTiming::default(), 6_000, 3, Some(37)).error);
+        let two = Shape { data_bits: 64, ways: 2, outstanding: 8 };
+        let m = harness(two);
+        assert!(!drive(&m, two, MemoryTiming::default(), 6_000, 3, None).error);
+        assert!(drive(&m, two, MemoryTiming::default(), 6_000, 3, Some(37)).error);
+    }
+
+    /// Other data widths (records of 1 to 10 beats, lines of 2 or 3 triangle records) and 1 or
+    /// 4 ways, one outstanding burst or many.
+    #[test]
+    fn every_width_and_associativity() {
+        for shape in [
+            Shape { data_bits: 128, ways: 1, outstanding: 1 },
+            Shape { data_bits: 32, ways: 4, outstanding: 16 },
+            Shape { data_bits: 128, ways: 4, outstanding: 4 },
+        ] {
+            let m = harness(shape);
+            let d = drive(
+                &m,
+                shape,
+                MemoryTiming { latency: 30, pause_in_256: 50, ..MemoryTiming::default() },
+                20_000,
+                5,
+                None,
+            );
+            assert!(!d.error && d.hits > 500 && d.misses > 100, "{shape:?}: {} hits, {} misses", d.hits, d.misses);
+        }
     }
 }
