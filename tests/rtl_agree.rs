@@ -7,7 +7,7 @@ use fxrt::rtl::random::{Shape, agree, random_inputs, random_module, sim_vs_batch
 use fxrt::rtl::sim::Sim;
 use fxrt::rtl::{Module, Ty};
 use fxrt::verify::simulators::Simulator;
-use fxrt::verify::testbench::{Stimulus, bench_files, record};
+use fxrt::verify::testbench::{Stimulus, record, replay};
 use std::io::Write;
 
 /// The divergence found in issue 10: a register `r: s(2)` with next value
@@ -62,12 +62,8 @@ fn hdl_simulators_agree_on_sampled_random_netlists() {
                 .collect();
             let t = record(&m, stimuli);
             let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("agree_{}_{seed}", sim.name()));
-            let _ = std::fs::remove_dir_all(&dir);
-            std::fs::create_dir_all(&dir).unwrap();
-            for (file, text) in bench_files(&m, &t, sim) {
-                std::fs::write(dir.join(file), text).unwrap();
-            }
-            let (passed, failed) = sim.run(&dir, &m).unwrap_or_else(|e| panic!("{} seed {seed}: {e}", sim.name()));
+            let (passed, failed) =
+                replay(&m, &t, sim, &dir, &[]).unwrap_or_else(|e| panic!("{} seed {seed}: {e}", sim.name()));
             assert_eq!((passed, failed), (120, 0), "{} seed {seed}: see {}", sim.name(), dir.display());
             ran += 1;
         }

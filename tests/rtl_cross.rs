@@ -7,7 +7,7 @@ use fxrt::rtl::emit::{design_files, verilog, vhdl};
 use fxrt::rtl::netlist::BlockKind;
 use fxrt::rtl::{BinOp, Module, Ty, UnOp};
 use fxrt::verify::simulators::Simulator;
-use fxrt::verify::testbench::{Stimulus, bench_files, record};
+use fxrt::verify::testbench::{Stimulus, record, replay};
 use std::io::Write;
 
 fn all_ops() -> Module {
@@ -183,12 +183,7 @@ fn rust_ghdl_iverilog_and_verilator_agree_on_every_operator() {
         }
         // Kept under target/ so a failure can be inspected (and rerun by hand).
         let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("rtl_cross_{}", sim.name()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        for (file, text) in bench_files(&m, &t, sim) {
-            std::fs::write(dir.join(file), text).unwrap();
-        }
-        let (passed, failed) = sim.run(&dir, &m).unwrap_or_else(|e| panic!("{e}"));
+        let (passed, failed) = replay(&m, &t, sim, &dir, &[]).unwrap_or_else(|e| panic!("{e}"));
         eprintln!("{}: {passed} passed, {failed} failed", sim.name());
         assert_eq!((passed, failed), (400, 0), "{}", sim.name());
         ran += 1;

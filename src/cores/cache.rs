@@ -1,6 +1,6 @@
 //! A read-only cache of scene records in front of the AXI read master (docs/MEMORY.md "The
-//! caches"): set-associative, lines of whole records, one lookup a clock, answered three clocks
-//! later like a block ROM — a hit with the record, or a miss with the **fill number to wait
+//! caches"): set-associative, lines of whole records, one lookup a clock, answered `LATENCY` (4)
+//! clocks later — a hit with the record, or a miss with the **fill number to wait
 //! for**. Misses never block: the asker parks what missed and asks again once `done` has
 //! reached that number. Fills are numbered in the order the cache asked for them, and the
 //! memory answers in order, so "line k arrived" is one counter compare; a miss to a line
@@ -19,6 +19,10 @@ use super::axi_read::Fill;
 use crate::bits::addr_bits;
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
+
+/// Clocks from a lookup to its answer: the input register, the RAM read, a fabric register
+/// after it (while the in-flight table is searched), the compare and decision.
+pub const LATENCY: u32 = 4;
 
 /// Bits of a fill number (wrapping; compared as serial numbers, so a waiter may wait up to
 /// 2^15 fills).
@@ -68,7 +72,7 @@ pub struct Lookup<'b> {
     pub rec: S<'b>,
 }
 
-/// The answer, three clocks after the lookup.
+/// The answer, `LATENCY` clocks after the lookup.
 pub struct Answer<'b> {
     pub valid: S<'b>,
     pub hit: S<'b>,
@@ -133,11 +137,24 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         .collect();
     let next_fill = (done + 1).name(&nm("next_fill"));
     let nf = next_fill.slice(0, db);
+    // The line and way of fill done + 1, in registers (the beats of one fill may follow the
+    // last beat of the one before on the next clock; a select over the table from `done` would
+    // sit between the counter and every RAM's write port). Loaded from the table's next entry
+    // when a fill ends, or from the decision when it asks for exactly that fill.
+    let f_line = b.reg(&nm("fill_line"), Ty::u(p.line_bits), None);
+    let f_way = b.reg(&nm("fill_way"), Ty::u(wb), None);
+    let after = (done + 2).name(&nm("after_next")).slice(0, db);
     let pick = |f: &dyn Fn(&(S<'b>, S<'b>, S<'b>)) -> S<'b>, ty: Ty| {
-        slots.iter().enumerate().fold(b.konst(ty, 0), |acc, (j, s)| nf.eq(j as i128).select(f(s), acc))
+        slots.iter().enumerate().fold(b.konst(ty, 0), |acc, (j, s)| after.eq(j as i128).select(f(s), acc))
     };
-    let f_line = pick(&|s| s.0, Ty::u(p.line_bits)).name(&nm("fill_line"));
-    let f_way = pick(&|s| s.1, Ty::u(wb)).name(&nm("fill_way"));
+    let table_line = pick(&|s| s.0, Ty::u(p.line_bits)).name(&nm("table_line"));
+    let table_way = pick(&|s| s.1, Ty::u(wb)).name(&nm("table_way"));
+    // Driven by the decision below: it asks for fill `asked_seq` of line `asked_line` into way
+    // `asked_way` this clock.
+    let asked = b.wire(&nm("asked"), Ty::BIT);
+    let asked_seq = b.wire(&nm("asked_seq"), seq);
+    let asked_line = b.wire(&nm("asked_line"), Ty::u(p.line_bits));
+    let asked_way = b.wire(&nm("asked_way"), Ty::u(wb));
     let f_set = f_line.slice(0, sb).name(&nm("fill_set"));
     let first = (fill.valid & fill.beat.eq(0)).name(&nm("fill_first"));
     let last = (fill.valid & fill.last).name(&nm("fill_last"));
@@ -190,6 +207,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         }
     }
     b.next_when(done, last, next_fill);
+    let target = last.select((done + 2).name(&nm("after_next_seq")), next_fill);
+    let from_decision = (asked & asked_seq.eq(target)).name(&nm("fill_from_decision"));
+    b.next_when(f_line, last | from_decision, from_decision.select(asked_line, table_line));
+    b.next_when(f_way, last | from_decision, from_decision.select(asked_way, table_way));
     // A line leaves the table two clocks after its tag is written.
     let free = b.valid_line(&nm("free"), last, 2);
     let free_at = b.delay_line(&nm("free_at"), nf, 2);
@@ -226,20 +247,18 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
             rams.iter().enumerate().map(|(j, &r)| b.read(&nm(&format!("data_q{w}_{j}")), r, raddr)).collect()
         })
         .collect();
+    // A fabric register after the RAMs (the block RAM's output sits far from the logic), and
+    // the in-flight table searched for the line meanwhile.
     let l1_valid = b.valid_delay(&nm("l1_valid"), l0_valid);
     let l1_line = b.delay(&nm("l1_line"), l0_line);
-    let want = if tb == 0 { b.konst(Ty::u(1), 0) } else { l1_line.slice(sb, tb) };
-    let hits: Vec<S<'b>> = tag_q
+    let tag_r: Vec<S<'b>> = tag_q.iter().enumerate().map(|(w, &t)| b.delay(&nm(&format!("tag_r{w}")), t)).collect();
+    let valid_r: Vec<S<'b>> =
+        valid_q.iter().enumerate().map(|(w, &v)| b.delay(&nm(&format!("valid_r{w}")), v)).collect();
+    let data_r: Vec<Vec<S<'b>>> = data_q
         .iter()
-        .zip(&valid_q)
         .enumerate()
-        .map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}"))))
+        .map(|(w, ds)| ds.iter().enumerate().map(|(j, &d)| b.delay(&nm(&format!("data_r{w}_{j}")), d)).collect())
         .collect();
-    let hit = hits.iter().skip(1).fold(hits[0], |a, &h| a | h).name(&nm("hit"));
-    let data: Vec<S<'b>> = (0..parts.len())
-        .map(|j| (1..p.ways as usize).fold(data_q[0][j], |acc, w| hits[w].select(data_q[w][j], acc)))
-        .collect();
-    // Merge: the line's fill number if it is in flight.
     let mut found = b.konst(Ty::BIT, 0);
     let mut found_seq = b.konst(seq, 0);
     for (j, s) in slots.iter().enumerate() {
@@ -249,31 +268,61 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         found_seq = m.select(req - back, found_seq);
         found = found | m;
     }
+    let l2_valid = b.valid_delay(&nm("l2_valid"), l1_valid);
+    let l2_line = b.delay(&nm("l2_line"), l1_line);
+    let found2 = b.delay(&nm("found_r"), found);
+    let found_seq2 = b.delay(&nm("found_seq_r"), found_seq);
+    // The compare and the decision. The table was searched a clock ago: a fill asked for by
+    // the lookup just before this one is not in that search, so it is compared here.
+    let want = if tb == 0 { b.konst(Ty::u(1), 0) } else { l2_line.slice(sb, tb) };
+    let hits: Vec<S<'b>> = tag_r
+        .iter()
+        .zip(&valid_r)
+        .enumerate()
+        .map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}"))))
+        .collect();
+    let hit = hits.iter().skip(1).fold(hits[0], |a, &h| a | h).name(&nm("hit"));
+    let data: Vec<S<'b>> = (0..parts.len())
+        .map(|j| (1..p.ways as usize).fold(data_r[0][j], |acc, w| hits[w].select(data_r[w][j], acc)))
+        .collect();
+    let prev_alloc = b.reg(&nm("prev_alloc"), Ty::BIT, Some(0));
+    let prev_line = b.reg(&nm("prev_line"), Ty::u(p.line_bits), None);
+    let prev_seq = b.reg(&nm("prev_seq"), seq, None);
+    let same_as_prev = (prev_alloc & prev_line.eq(l2_line)).name(&nm("same_as_prev"));
+    let found = (found2 | same_as_prev).name(&nm("found"));
+    let found_seq = same_as_prev.select(prev_seq, found_seq2).name(&nm("found_seq"));
     let new_seq = (req + 1).name(&nm("new_seq"));
     let slot_free = !slots
         .iter()
         .enumerate()
         .fold(b.konst(Ty::BIT, 0), |acc, (j, s)| acc | (new_seq.slice(0, db).eq(j as i128) & s.2));
-    let miss = (l1_valid & !hit).name(&nm("miss"));
+    let miss = (l2_valid & !hit).name(&nm("miss"));
     let alloc = (miss & !found & slot_free).name(&nm("alloc"));
+    b.next(prev_alloc, alloc);
+    b.next(prev_line, l2_line);
+    b.next(prev_seq, new_seq);
     let victim = b.reg(&nm("victim"), Ty::u(wb), Some(0));
     b.next_when(victim, alloc, if p.ways == 1 { victim } else { victim + 1 });
+    b.drive(asked, alloc);
+    b.drive(asked_seq, new_seq);
+    b.drive(asked_line, l2_line);
+    b.drive(asked_way, victim);
     b.next_when(req, alloc, new_seq);
     for (j, s) in slots.iter().enumerate() {
         let mine = (alloc & new_seq.slice(0, db).eq(j as i128)).name(&nm(&format!("alloc{j}")));
-        b.next_when(s.0, mine, l1_line);
+        b.next_when(s.0, mine, l2_line);
         b.next_when(s.1, mine, victim);
         let freed = free & free_at.eq(j as i128);
         b.next(s.2, mine.select(b.konst(Ty::BIT, 1), freed.select(b.konst(Ty::BIT, 0), s.2)));
     }
     // A miss that can neither merge nor take a place waits for the next fill and asks again.
     let wait = found.select(found_seq, alloc.select(new_seq, next_fill)).name(&nm("wait_c"));
-    let a_valid = b.valid_delay(&nm("a_valid"), l1_valid);
+    let a_valid = b.valid_delay(&nm("a_valid"), l2_valid);
     let a_hit = b.delay(&nm("a_hit"), hit);
     let a_data: Vec<S<'b>> = data.iter().enumerate().map(|(j, &d)| b.delay(&nm(&format!("a_data{j}")), d)).collect();
     let a_wait = b.delay(&nm("a_wait"), wait);
     let req_valid = b.valid_delay(&nm("req_valid"), alloc);
-    let req_line = b.delay(&nm("req_line"), l1_line);
+    let req_line = b.delay(&nm("req_line"), l2_line);
     b.end_stage();
     Cache {
         answer: Answer { valid: a_valid, hit: a_hit, data: a_data, wait: a_wait },

@@ -1,6 +1,6 @@
 //! The read master and two caches against the memory model, in the Rust simulator: random
 //! lookups (hits, misses, misses to lines on their way, evictions in tiny caches), each answered
-//! three clocks later; a hit must carry the image's record, a miss must be released by a fill
+//! `cache::LATENCY` clocks later; a hit must carry the image's record, a miss must be released by a fill
 //! and hit when asked again; no line is asked for twice while on its way; a broken memory is
 //! flagged. `harness` and `drive` also give the transcript tests/memory.rs replays in the HDL
 //! simulators. Checks shown failing on their defects: a merge turned off (a line asked for
@@ -9,7 +9,7 @@
 use super::memory::{MasterOut, MemoryModel, MemoryTiming, xorshift32};
 use super::testbench::Stimulus;
 use crate::cores::axi_read::{AxiIn, AxiReadParams, LineRequest, axi_read};
-use crate::cores::cache::{CacheParams, Lookup, cache};
+use crate::cores::cache::{CacheParams, LATENCY, Lookup, cache};
 use crate::rtl::Ty;
 use crate::rtl::build::Builder;
 use crate::rtl::netlist::Module;
@@ -58,13 +58,28 @@ impl Shape {
 }
 
 pub fn harness(shape: Shape) -> Module {
-    let b = Builder::new("mem_harness");
-    let base = b.input("base", Ty::u(ADDR_BITS));
-    let shapes = shape.caches();
-    let looks: Vec<Lookup> = shapes
+    let ap = AxiReadParams {
+        addr_bits: ADDR_BITS,
+        data_bits: shape.data_bits,
+        line_beats: LINE as u32 * 8 / shape.data_bits,
+        outstanding: shape.outstanding,
+        queue: 4,
+    };
+    let caches: Vec<(CacheParams, u64)> = shape.caches().iter().map(|&(p, region, _)| (p, region)).collect();
+    mem_side("mem_harness", &ap, &caches)
+}
+
+/// The read master and caches (each with the byte offset of its region of the image) as one
+/// module with the bus, the base address and every cache's lookup as inputs, and every answer,
+/// `done` counter and the master's outputs as outputs: `look{c}_valid/_line/_rec`,
+/// `ans{c}_valid/_hit/_wait/_data{j}`, `done{c}`, `arvalid`, `araddr`, `arlen`, `error`.
+pub fn mem_side(name: &str, ap: &AxiReadParams, caches: &[(CacheParams, u64)]) -> Module {
+    let b = Builder::new(name);
+    let base = b.input("base", Ty::u(ap.addr_bits));
+    let looks: Vec<Lookup> = caches
         .iter()
         .enumerate()
-        .map(|(c, (p, _, _))| Lookup {
+        .map(|(c, (p, _))| Lookup {
             valid: b.input(&format!("look{c}_valid"), Ty::BIT),
             line: b.input(&format!("look{c}_line"), Ty::u(p.line_bits)),
             rec: b.input(&format!("look{c}_rec"), Ty::u(p.rec_bits())),
@@ -73,27 +88,21 @@ pub fn harness(shape: Shape) -> Module {
     let bus = AxiIn {
         arready: b.input("arready", Ty::BIT),
         rvalid: b.input("rvalid", Ty::BIT),
-        rdata: b.input("rdata", Ty::u(shape.data_bits)),
+        rdata: b.input("rdata", Ty::u(ap.data_bits)),
         rlast: b.input("rlast", Ty::BIT),
         rresp: b.input("rresp", Ty::u(2)),
     };
-    let ap = AxiReadParams {
-        addr_bits: ADDR_BITS,
-        data_bits: shape.data_bits,
-        line_beats: LINE as u32 * 8 / shape.data_bits,
-        outstanding: shape.outstanding,
-        queue: 4,
-    };
     // The caches' requests feed the master, whose fills feed the caches: wires close the loop.
-    let req: Vec<_> = (0..2)
-        .map(|c| (b.wire(&format!("req{c}_valid"), Ty::BIT), b.wire(&format!("req{c}_offset"), Ty::u(ADDR_BITS))))
+    let req: Vec<_> = (0..caches.len())
+        .map(|c| (b.wire(&format!("req{c}_valid"), Ty::BIT), b.wire(&format!("req{c}_offset"), Ty::u(ap.addr_bits))))
         .collect();
     let requests: Vec<LineRequest> = req.iter().map(|&(valid, offset)| LineRequest { valid, offset }).collect();
-    let (out, fills) = axi_read(&b, &ap, base, &requests, &bus);
-    for (c, (p, region, _)) in shapes.iter().enumerate() {
+    let (out, fills) = axi_read(&b, ap, base, &requests, &bus);
+    let line_bytes = ap.line_beats * ap.data_bits / 8;
+    for (c, (p, region)) in caches.iter().enumerate() {
         let k = cache(&b, &format!("c{c}"), p, &looks[c], &fills[c]);
         b.drive(req[c].0, k.request.0);
-        let offset = (k.request.1.resize(ADDR_BITS) << LINE.trailing_zeros()) + *region as i128;
+        let offset = (k.request.1.resize(ap.addr_bits) << line_bytes.trailing_zeros()) + *region as i128;
         b.drive(req[c].1, offset);
         b.output(&format!("ans{c}_valid"), k.answer.valid);
         b.output(&format!("ans{c}_hit"), k.answer.hit);
@@ -178,7 +187,7 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
             let done = sim.get(output(&format!("done{c}"))) as u16;
             // Answers due now.
             if let Some(&(at, t)) = in_pipe[c].first()
-                && at + 3 == clock
+                && at + LATENCY as u64 == clock
             {
                 in_pipe[c].remove(0);
                 assert_eq!(sim.get(output(&format!("ans{c}_valid"))), 1, "cache {c}: answer at clock {clock}");

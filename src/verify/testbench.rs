@@ -299,6 +299,26 @@ fn ports(m: &Module, ids: &[(String, SigId)], mut lsb: u32) -> (Vec<Port>, u32) 
     (v, lsb)
 }
 
+/// Replays `t` in simulator `sim` in a fresh folder `dir` (kept for inspection): the design,
+/// its vector testbench and the `extra` files (a model the testbench needs, or a design file
+/// that replaces the printed one). The testbench's (passed, failed) clocks.
+pub fn replay(
+    m: &Module,
+    t: &Transcript,
+    sim: Simulator,
+    dir: &std::path::Path,
+    extra: &[(String, String)],
+) -> Result<(u64, u64), String> {
+    let _ = std::fs::remove_dir_all(dir);
+    let write =
+        |file: &str, text: &str| std::fs::write(dir.join(file), text).map_err(|e| format!("{}: {e}", dir.display()));
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    for (file, text) in bench_files(m, t, sim).iter().chain(extra) {
+        write(file, text)?;
+    }
+    sim.run(dir, m)
+}
+
 /// Everything one simulator needs in its directory: the design in its language (one file per
 /// module), its testbench and its vectors, as (file name, contents).
 pub fn bench_files(m: &Module, t: &Transcript, sim: Simulator) -> Vec<(String, String)> {
