@@ -261,11 +261,12 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         .collect();
     let mut found = b.konst(Ty::BIT, 0);
     let mut found_seq = b.konst(seq, 0);
+    // Each place keeps its fill number (a register, not req minus the distance: that was a
+    // subtractor per place on the path to the decision).
+    let seqs: Vec<S<'b>> = (0..p.inflight).map(|j| b.reg(&nm(&format!("fl{j}_seq")), seq, None)).collect();
     for (j, s) in slots.iter().enumerate() {
         let m = (s.2 & s.0.eq(l1_line)).name(&nm(&format!("match{j}")));
-        // Slot j holds fill number ≡ j (mod inflight) among the last `inflight` asked for.
-        let back = (req.slice(0, db) - j as i128).slice(0, db).resize(SEQ_BITS);
-        found_seq = m.select(req - back, found_seq);
+        found_seq = m.select(seqs[j], found_seq);
         found = found | m;
     }
     let l2_valid = b.valid_delay(&nm("l2_valid"), l1_valid);
@@ -312,6 +313,7 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         let mine = (alloc & new_seq.slice(0, db).eq(j as i128)).name(&nm(&format!("alloc{j}")));
         b.next_when(s.0, mine, l2_line);
         b.next_when(s.1, mine, victim);
+        b.next_when(seqs[j], mine, new_seq);
         let freed = free & free_at.eq(j as i128);
         b.next(s.2, mine.select(b.konst(Ty::BIT, 1), freed.select(b.konst(Ty::BIT, 0), s.2)));
     }
