@@ -70,6 +70,7 @@ fn scene_output_is_complete_and_byte_identical_across_runs() {
         std::fs::read_dir(a.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     names.sort();
     let want = [
+        "fxrt_scene.h",
         "fxrt_scene_pkg.vhd",
         "leaf.coe",
         "leaf.hex",
@@ -77,6 +78,7 @@ fn scene_output_is_complete_and_byte_identical_across_runs() {
         "node.coe",
         "node.hex",
         "node.mem",
+        "scene.bin",
         "scene.json",
         "tri.coe",
         "tri.hex",
