@@ -174,12 +174,12 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let beats: Vec<S<'b>> = held.iter().copied().chain([fill.data]).collect();
     let record = |lsb: u32, w: u32| -> S<'b> {
         // Bits [lsb, lsb + w) of the record made of `beats`.
-        let db = p.data_bits;
+        let beat_bits = p.data_bits;
         let mut pieces = Vec::new();
         let mut at = lsb;
         while at < lsb + w {
-            let (k, off) = (at / db, at % db);
-            let take = (db - off).min(lsb + w - at);
+            let (k, off) = (at / beat_bits, at % beat_bits);
+            let take = (beat_bits - off).min(lsb + w - at);
             pieces.push(beats[k as usize].slice(off, take));
             at += take;
         }

@@ -155,20 +155,21 @@ impl MemoryLayout {
         ((k / per) << self.slot_bits) | (k % per)
     }
 
+    /// A pointer's (line, slot).
+    pub fn split(&self, pointer: u64) -> (u64, u64) {
+        (pointer >> self.slot_bits, pointer & ((1 << self.slot_bits) - 1))
+    }
+
     /// The pointer of the record after the one `pointer` names (the hardware's increment: the
     /// slot counts up to `tris_per_line`, then the line moves on).
     pub fn next(&self, pointer: u64) -> u64 {
-        let slot = pointer & ((1 << self.slot_bits) - 1);
-        if slot + 1 == self.tris_per_line as u64 {
-            ((pointer >> self.slot_bits) + 1) << self.slot_bits
-        } else {
-            pointer + 1
-        }
+        let (line, slot) = self.split(pointer);
+        if slot + 1 == self.tris_per_line as u64 { (line + 1) << self.slot_bits } else { pointer + 1 }
     }
 
     /// Byte address (from the image's base) of the record a pointer names.
     pub fn tri_address(&self, pointer: u64) -> u64 {
-        let (line, slot) = (pointer >> self.slot_bits, pointer & ((1 << self.slot_bits) - 1));
+        let (line, slot) = self.split(pointer);
         self.tri_offset + line * self.shape.line_bytes as u64 + slot * self.tri_bytes as u64
     }
 
@@ -275,7 +276,7 @@ impl SceneImage {
                 w.set(node_l.field("axis"), axis);
                 if axis == 3 {
                     let p = rec.get(l.node.field("first")) as u64;
-                    let (line, slot) = (p >> l.slot_bits, p & ((1 << l.slot_bits) - 1));
+                    let (line, slot) = l.split(p);
                     w.set(node_l.field("first"), (line * l.tris_per_line as u64 + slot) as i128);
                     w.set(node_l.field("count"), rec.get(l.node.field("count")));
                 } else {
