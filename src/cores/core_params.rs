@@ -4,6 +4,7 @@
 
 use super::closest::TagLayout;
 use super::intersect::IntersectParams;
+use super::memory_params::{ExternalMemory, MemorySpec};
 use super::traverse::TraverseParams;
 use crate::model::golden::GridRay;
 use crate::rtl::Ty;
@@ -26,6 +27,8 @@ pub struct CoreParams {
     pub units: u32,
     /// Clocks of a triangle ROM read (`brom::read_cycles`).
     pub tri_rom_cycles: u32,
+    /// With the scene in external memory (`external`): its image, caches and read port.
+    pub mem: Option<ExternalMemory>,
 }
 
 /// What shapes a core besides its scene: the width of its ray ids, the divider's quotient
@@ -83,7 +86,22 @@ impl CoreParams {
             div_bits,
             target_mhz,
         };
-        CoreParams { isect, trav, tag, units, tri_rom_cycles: super::brom::read_cycles(scene.tri.1.len()) }
+        let tri_rom_cycles = super::brom::read_cycles(scene.tri.1.len());
+        CoreParams { isect, trav, tag, units, tri_rom_cycles, mem: None }
+    }
+
+    /// The core of `shape` for `scene` in external memory (`--memory external`): no scene ROMs;
+    /// the nodes through a cache per unit, the triangles through the triangle cache and the
+    /// staging RAM (2 clocks to the pipeline).
+    pub fn external(scene: &SceneRoms, shape: &CoreSpec, spec: MemorySpec) -> crate::error::Result<CoreParams> {
+        let mut p = Self::shaped(scene, shape);
+        let m = ExternalMemory::new(scene, spec)?;
+        p.trav = p.trav.with_node_cache(&m.layout);
+        p.trav.scene_tag = format!("{}_ext", p.trav.scene_tag);
+        p.trav.leaf_rom_cycles = 0;
+        p.tri_rom_cycles = 2;
+        p.mem = Some(m);
+        Ok(p)
     }
 
     /// Bits of a unit number within a global slot number (0 for one unit).

@@ -67,7 +67,7 @@ pub fn leaf_stream<'b>(
     trav: &[Ports<'b>],
     leaf_pop: &[S<'b>],
 ) -> Leaf<'b> {
-    let (tp, units, ub, gb, bit) = (&p.trav, p.units, p.unit_bits(), p.tag.slot_bits, Ty::BIT);
+    let (tp, gb, bit) = (&p.trav, p.tag.slot_bits, Ty::BIT);
     b.stage("leaf_stream", "the leaf in flight, and the next leaf from the units' queues in turn");
     let leaf_bits = rom_addr_bits(scene.leaf.1.len());
     let count_w = scene.node.0.field("count").width;
@@ -82,12 +82,67 @@ pub fn leaf_stream<'b>(
     let cur_last = b.reg("leaf_last", bit, None);
     let last_entry = (cur_valid & cur_last).name("leaf_last_entry");
     let can_take = (!cur_valid | last_entry).name("leaf_can_take");
+    let picked = leaf_buffers(b, p, trav, leaf_pop, can_take);
+    let (take, sel) = (picked.take, |f: &str| picked.field(f));
+    let next_slot = picked.slot();
+    b.next(cur_valid, take | (cur_valid & !last_entry));
+    b.next(cur_slot, take.select(next_slot, cur_slot));
+    b.next(cur_ptr, take.select(sel("leaf_first"), cur_ptr + 1));
+    b.next(cur_left, take.select(sel("leaf_count"), cur_left - 1));
+    b.next(cur_tmin, take.select(sel("leaf_tmin"), cur_tmin));
+    b.next(cur_sp, take.select(sel("leaf_sp"), cur_sp));
+    b.next(cur_first, take);
+    b.next(cur_last, take.select(sel("leaf_count").eq(1), cur_left.eq(2)));
+    Leaf { valid: cur_valid, slot: cur_slot, ptr: cur_ptr, tmin: cur_tmin, sp: cur_sp, first: cur_first, last_entry }
+}
+
+/// The units' next leaves, each in a register of the top's, and the one taken when `can_take`.
+pub struct Picked<'b> {
+    b: &'b Builder,
+    /// A leaf is taken this clock.
+    pub take: S<'b>,
+    /// The unit whose leaf is taken (with more than one), and each unit's buffered fields.
+    pick_u: Option<S<'b>>,
+    held: Vec<Vec<S<'b>>>,
+}
+
+const LEAF_FIELDS: [&str; 5] = ["leaf_slot", "leaf_first", "leaf_count", "leaf_tmin", "leaf_sp"];
+
+impl<'b> Picked<'b> {
+    /// A field of the leaf taken (`leaf_first`, `leaf_count`, `leaf_tmin`, `leaf_sp`; a select
+    /// built at each call).
+    pub fn field(&self, name: &str) -> S<'b> {
+        let k = LEAF_FIELDS.iter().position(|f| *f == name).expect("a buffered leaf field");
+        let v: Vec<S> = self.held.iter().map(|held| held[k]).collect();
+        match self.pick_u {
+            None => v[0],
+            Some(u) => self.b.case(u, &v.iter().enumerate().map(|(k, x)| (k as u128, *x)).collect::<Vec<_>>(), v[0]),
+        }
+    }
+
+    /// Its global slot: the unit number above the unit's slot.
+    pub fn slot(&self) -> S<'b> {
+        match self.pick_u {
+            None => self.field("leaf_slot"),
+            Some(u) => self.b.cat(&[u, self.field("leaf_slot")]),
+        }
+    }
+}
+
+/// Each unit's next leaf waits in a register of the top's (`leaf_buf`), filled from the unit's
+/// queue while empty: the arbiter then chooses among registers beside it, and the queues (across
+/// the die) only feed a register each. A unit's queue pops a clock after it is taken from
+/// (`traverse_core`), and its buffer is full in that clock anyway. Taken in turn when `can_take`.
+pub fn leaf_buffers<'b>(
+    b: &'b Builder,
+    p: &CoreParams,
+    trav: &[Ports<'b>],
+    leaf_pop: &[S<'b>],
+    can_take: S<'b>,
+) -> Picked<'b> {
+    let (units, ub, bit) = (p.units, p.unit_bits(), Ty::BIT);
     let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
-    // Each unit's next leaf waits in a register of the top's (`leaf_buf`), filled from the
-    // unit's queue while empty: the arbiter then chooses among registers beside it, and the
-    // queues (across the die) only feed a register each. A unit's queue pops a clock after it
-    // is taken from (`traverse_core`), and its buffer is full in that clock anyway.
-    let fields = ["leaf_slot", "leaf_first", "leaf_count", "leaf_tmin", "leaf_sp"];
+    let fields = LEAF_FIELDS;
     let bufs: Vec<(S, S, Vec<S>)> = trav
         .iter()
         .enumerate()
@@ -118,25 +173,8 @@ pub fn leaf_stream<'b>(
     } else {
         b.next(leaf_turn, leaf_turn);
     }
-    let sel = |port: &str| {
-        let k = fields.iter().position(|f| *f == port).expect("a buffered leaf field");
-        let v: Vec<S> = bufs.iter().map(|(_, _, held)| held[k]).collect();
-        if units == 1 {
-            v[0]
-        } else {
-            b.case(pick_u, &(0..units).map(|u| (u as u128, v[u as usize])).collect::<Vec<_>>(), v[0])
-        }
-    };
-    let next_slot = if ub == 0 { sel("leaf_slot") } else { b.cat(&[pick_u, sel("leaf_slot")]) };
-    b.next(cur_valid, take | (cur_valid & !last_entry));
-    b.next(cur_slot, take.select(next_slot, cur_slot));
-    b.next(cur_ptr, take.select(sel("leaf_first"), cur_ptr + 1));
-    b.next(cur_left, take.select(sel("leaf_count"), cur_left - 1));
-    b.next(cur_tmin, take.select(sel("leaf_tmin"), cur_tmin));
-    b.next(cur_sp, take.select(sel("leaf_sp"), cur_sp));
-    b.next(cur_first, take);
-    b.next(cur_last, take.select(sel("leaf_count").eq(1), cur_left.eq(2)));
-    Leaf { valid: cur_valid, slot: cur_slot, ptr: cur_ptr, tmin: cur_tmin, sp: cur_sp, first: cur_first, last_entry }
+    let held = bufs.into_iter().map(|(_, _, held)| held).collect();
+    Picked { b, take, pick_u: (units > 1).then_some(pick_u), held }
 }
 
 /// Rotating priority among the units' buffered leaves (`avail`): the unit after the last one

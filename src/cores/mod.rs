@@ -15,14 +15,18 @@ pub mod divider;
 pub mod fifo;
 pub mod intersect;
 pub mod leaf_stream;
+pub mod memory_params;
 pub mod mul;
 pub mod plane;
 pub mod ray_port;
 pub mod raygen;
 pub mod result_queue;
 pub mod top;
+pub mod top_memory;
 pub mod traverse;
+mod traverse_retry;
 mod traverse_stages;
+pub mod tri_fetch;
 
 use crate::rtl::build::S;
 

@@ -23,6 +23,7 @@ use super::brom::{brom, brom2};
 use super::closest::closest_core;
 use super::leaf_stream::{Emission, emission, leaf_stream, ray_rams};
 use super::ray_port::{BoxExit, RayPort, box_exit, is_unit, ray_port};
+use super::top_memory::{MemoryObserved, NodeIn, memory_inputs, memory_side};
 use super::traverse::{traverse_core, word_bits};
 use crate::rtl::build::{Builder, Ports, S};
 use crate::rtl::{Module, Ty};
@@ -48,19 +49,32 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let b = Builder::new(&format!("fxrt_core_{}", p.trav.scene_tag));
     let ins: Vec<S> = core_inputs(p).iter().map(|(name, ty)| b.input(name, *ty)).collect();
     let res_ready = b.input("res_ready", Ty::BIT);
+    let mem_in: Option<Vec<S>> =
+        p.mem.as_ref().map(|m| memory_inputs(m).iter().map(|(name, ty)| b.input(name, *ty)).collect());
     let port = ray_port(&b, p, &ins);
     let exit = box_exit(&b, p, &port);
     let units = traversal_units(&b, p, scene, &port, &exit);
     b.stage("ray_rams", "the accepted ray into the core's ray RAMs, by global slot");
     let rams = ray_rams(&b, p, &port);
-    let leaf = leaf_stream(&b, p, scene, &units.trav, &units.leaf_pop);
-    let emitted = emission(&b, p, scene, &leaf, &rams);
+    let (emitted, mem_observed) = match (&p.mem, &mem_in) {
+        (Some(m), Some(inputs)) => {
+            let (e, o) = memory_side(&b, p, m, inputs, &units.trav, &units.node_in, &units.leaf_pop, &rams);
+            (e, Some(o))
+        }
+        _ => {
+            let leaf = leaf_stream(&b, p, scene, &units.trav, &units.leaf_pop);
+            (emission(&b, p, scene, &leaf, &rams), None)
+        }
+    };
     let (done_valid, res, credit_ok) = results(&b, p, &port, &units, &emitted);
     b.output("ray_ready", port.ready);
     b.stage("result_queue", "the results, queued for the consumer (`result_queue.rs`)");
     super::result_queue::result_queue(&b, &res, done_valid, res_ready, credit_ok);
     if debug {
         observe(&b, p, &port, &units.trav, emitted.valid);
+        if let Some(o) = mem_observed {
+            observe_memory(&b, &o);
+        }
     }
     b.end_stage();
     let mut m = b.finish();
@@ -78,6 +92,8 @@ struct Units<'b> {
     free: [S<'b>; 2],
     leaf_pop: Vec<S<'b>>,
     done_pop: Vec<S<'b>>,
+    /// With external memory: what each unit's node cache drives into it.
+    node_in: Vec<NodeIn<'b>>,
 }
 
 fn traversal_units<'b>(
@@ -100,9 +116,20 @@ fn traversal_units<'b>(
     let free = [wire("free_valid", bit), wire("free_slot", Ty::u(gb))];
     let leaf_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_leaf_pop"), bit)).collect();
     let done_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_done_pop"), bit)).collect();
-    let unit = Rc::new(traverse_core(&p.trav, scene));
+    let unit = Rc::new(traverse_core(&p.trav));
     let node_words: Vec<S> =
-        (0..units).map(|u| b.wire(&format!("u{u}_node_word"), Ty::u(scene.node.0.width))).collect();
+        (0..units).map(|u| b.wire(&format!("u{u}_node_word"), Ty::u(p.trav.node_layout.width))).collect();
+    // With external memory, the node cache's answer besides the word (hit, wait, done).
+    let node_in: Vec<NodeIn> = match &p.mem {
+        Some(_) => (0..units)
+            .map(|u| {
+                let w = |name: &str, ty: Ty| b.wire(&format!("u{u}_node_{name}"), ty);
+                let seq = Ty::u(super::cache::SEQ_BITS);
+                [node_words[u as usize], w("hit", bit), w("wait", seq), w("done", seq)]
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     let [merge_valid, merge_slot, merge_hit, merge_limit, merge_sp] = merge;
     let [free_valid, free_slot] = free;
     let trav: Vec<_> = (0..units)
@@ -113,42 +140,44 @@ fn traversal_units<'b>(
             let fv = (free_valid & is_unit(free_slot, u, sb, ub)).name(&format!("u{u}_free"));
             let [ox, oy, oz] = port.o;
             let [ix, iy, iz] = port.inv;
-            let t = b.instance_named(
-                &format!("u_traverse_{u}"),
-                &unit,
-                &[
-                    ("ray_we", we),
-                    ("ray_slot", port.unit_slot),
-                    ("ox", ox),
-                    ("oy", oy),
-                    ("oz", oz),
-                    ("invx", ix),
-                    ("invy", iy),
-                    ("invz", iz),
-                    ("new_valid", new_valid),
-                    ("new_slot", exit.slot.slice(0, sb)),
-                    ("new_tmax", exit.tmax),
-                    ("new_miss", exit.miss),
-                    ("merge_valid", mv),
-                    ("merge_slot", merge_slot.slice(0, sb)),
-                    ("merge_hit", merge_hit),
-                    ("merge_limit", merge_limit),
-                    ("merge_sp", merge_sp),
-                    ("free_valid", fv),
-                    ("free_slot", free_slot.slice(0, sb)),
-                    ("alloc", we),
-                    ("leaf_pop", leaf_pop[u as usize]),
-                    ("done_pop", done_pop[u as usize]),
-                    ("node_word", node_words[u as usize]),
-                ],
-            );
+            let mut ins = vec![
+                ("ray_we", we),
+                ("ray_slot", port.unit_slot),
+                ("ox", ox),
+                ("oy", oy),
+                ("oz", oz),
+                ("invx", ix),
+                ("invy", iy),
+                ("invz", iz),
+                ("new_valid", new_valid),
+                ("new_slot", exit.slot.slice(0, sb)),
+                ("new_tmax", exit.tmax),
+                ("new_miss", exit.miss),
+                ("merge_valid", mv),
+                ("merge_slot", merge_slot.slice(0, sb)),
+                ("merge_hit", merge_hit),
+                ("merge_limit", merge_limit),
+                ("merge_sp", merge_sp),
+                ("free_valid", fv),
+                ("free_slot", free_slot.slice(0, sb)),
+                ("alloc", we),
+                ("leaf_pop", leaf_pop[u as usize]),
+                ("done_pop", done_pop[u as usize]),
+                ("node_word", node_words[u as usize]),
+            ];
+            if let Some([_, hit, wait, done]) = node_in.get(u as usize) {
+                ins.extend([("node_hit", *hit), ("node_wait", *wait), ("node_done", *done)]);
+            }
+            let t = b.instance_named(&format!("u_traverse_{u}"), &unit, &ins);
             b.drive(port.unit_has_free[u as usize], t.get("has_free"));
             b.drive(port.unit_free_slot[u as usize], t.get("free_slot_out"));
             t
         })
         .collect();
-    node_roms(b, p, scene, &trav, &node_words);
-    Units { trav, merge, free, leaf_pop, done_pop }
+    if p.mem.is_none() {
+        node_roms(b, p, scene, &trav, &node_words);
+    }
+    Units { trav, merge, free, leaf_pop, done_pop, node_in }
 }
 
 /// The node ROM: one per two units, on a block RAM's two ports.
@@ -253,6 +282,18 @@ fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports
         b.output(&format!("visit{u}_slot"), t.get("visit_slot"));
         b.output(&format!("visit{u}_node"), t.get("visit_node"));
     }
+}
+
+/// With external memory, observation ports for `fxrt sim`: node lookups answered and hits,
+/// triangle lookups answered and hits, a beat in, and a clock the pipeline took no triangle while
+/// a leaf waited for memory.
+fn observe_memory<'b>(b: &'b Builder, o: &MemoryObserved<'b>) {
+    b.output("node_looks", o.node_looks);
+    b.output("node_hits", o.node_hits);
+    b.output("tri_looks", o.tri.looks);
+    b.output("tri_hits", o.tri.hits);
+    b.output("mem_beat", o.beat);
+    b.output("mem_stall", o.tri.stall);
 }
 
 /// The core fed by the on-chip ray generator instead of the ray port (the thesis's demo):

@@ -37,7 +37,6 @@ use super::fifo::fifo;
 use super::traverse_stages::Unit;
 use crate::rtl::Module;
 use crate::rtl::build::Builder;
-use crate::scene::images::SceneRoms;
 
 pub use super::traverse_stages::{TraverseParams, field, word_bits};
 
@@ -52,10 +51,10 @@ pub use super::traverse_stages::{TraverseParams, field, word_bits};
 /// `leaf_count`, `leaf_tmin`, `leaf_sp`), the done queue's head (`done_valid`, `done_slot`), and
 /// observations: `visit` (a node visited in N, `visit_slot`, `visit_node`), `cull`, `depth`
 /// (the stack depth in N), `occupied` (slots holding a ray).
-pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
+pub fn traverse_core(p: &TraverseParams) -> Module {
     assert!((1..=64).contains(&p.slots), "1 to 64 slots per unit");
     let b = Builder::new(&format!("fxrt_traverse_k{}_{}", p.slots, p.scene_tag));
-    let u = Unit::new(&b, p, scene);
+    let u = Unit::new(&b, p);
     let slots = u.slots();
     let q = u.queues();
     let r = u.returning();
@@ -65,11 +64,18 @@ pub fn traverse_core(p: &TraverseParams, scene: &SceneRoms) -> Module {
     // The top's pops arrive a clock late (registered here: the top's arbiter sits across the
     // die), so it does not take from a queue again in the clock after it took.
     let done = fifo(&b, "done_q", u.sb, p.slots, a.done, a.slot, b.valid_delay("done_pop_r", u.inp.done_pop));
-    let (c, culled) = u.ring_c(bt, b_from_stack, a.stack_top, &a);
-    let n = u.ring_n(c, culled);
+    let (c, culled, lookup) = u.ring_c(bt, b_from_stack, a.stack_top, &a);
+    let n = u.ring_n(c, culled, &q);
     let f = u.ring_f(&n);
     u.ring_g(&f, &r, &a.push, q.ring_g_valid);
     b.end_stage();
-    u.outputs(&slots, c.node, &n, &done);
+    match lookup {
+        // With a node cache: the lookup a clock after C.
+        Some([valid, node]) => {
+            b.output("node_look", valid);
+            u.outputs(&slots, node, &n, &done);
+        }
+        None => u.outputs(&slots, c.node, &n, &done),
+    }
     b.finish()
 }

@@ -8,11 +8,12 @@ use super::clock::ClockTarget;
 use super::fifo::{Fifo, fifo};
 use super::mul::MulStyle;
 use super::plane::{PlaneIssue, plane_unit};
+use super::traverse_retry::RetryQueue;
 use super::{lowest_set, lt_chain, onehot};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 use crate::scene::images::SceneRoms;
-use crate::scene::rom::{self, Field, Word, rom_addr_bits};
+use crate::scene::rom::{self, Field, Layout, Word, rom_addr_bits};
 
 /// The widths of one traversal unit.
 #[derive(Clone, Debug)]
@@ -35,6 +36,15 @@ pub struct TraverseParams {
     pub slots: u32,
     /// The scene's tag (`SceneRoms::tag`), in the names of the modules built for the scene.
     pub scene_tag: String,
+    /// The node word the unit reads (the node ROM's, or the scene image's node record), the
+    /// bits of a node's number and of a leaf's `first`, and the root's number.
+    pub node_layout: Layout,
+    pub node_bits: u32,
+    pub leaf_bits: u32,
+    pub root: u64,
+    /// Whether the nodes come through a cache (`with_node_cache`): a lookup in C + 1 answered in
+    /// N, a miss parked in the retry queue.
+    pub node_cache: bool,
 }
 
 impl TraverseParams {
@@ -53,7 +63,25 @@ impl TraverseParams {
             leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
             slots,
             scene_tag: scene.tag(),
+            node_layout: scene.node.0.clone(),
+            node_bits: rom_addr_bits(scene.node.1.len()),
+            leaf_bits: rom_addr_bits(scene.leaf.1.len()),
+            root: 0,
+            node_cache: false,
         }
+    }
+
+    /// The unit of an external-memory core: node records of the scene image (`layout`), read
+    /// through a node cache: the lookup one clock after C (once the cull test is known, so a
+    /// culled entry fetches nothing), its answer `cache::LATENCY` clocks later in N.
+    pub fn with_node_cache(mut self, layout: &crate::scene::memory::MemoryLayout) -> TraverseParams {
+        self.node_layout = layout.node.clone();
+        self.node_bits = crate::bits::addr_bits(layout.node_records as usize);
+        self.leaf_bits = layout.node.field("first").width;
+        self.root = crate::scene::memory::ROOT_RECORD;
+        self.node_rom_cycles = 1 + super::cache::LATENCY;
+        self.node_cache = true;
+        self
     }
     /// Reciprocal directions: m + C bits.
     pub fn inv_width(&self) -> u32 {
@@ -142,13 +170,23 @@ pub(super) struct Inputs<'b> {
     pub(super) leaf_pop: S<'b>,
     pub(super) done_pop: S<'b>,
     pub(super) node_word: S<'b>,
+    /// With a node cache: its answer in N besides the word (hit; when a miss, the fill to wait
+    /// for) and its `done` counter.
+    pub(super) cache: Option<NodeAnswer<'b>>,
+}
+
+/// The node cache's answer and fill counter (`cache::Answer`, `cache::Cache::done`).
+#[derive(Clone, Copy)]
+pub(super) struct NodeAnswer<'b> {
+    pub(super) hit: S<'b>,
+    pub(super) wait: S<'b>,
+    pub(super) done: S<'b>,
 }
 
 /// What every stage of the unit reads: the builder, the widths, the inputs and the ray RAMs.
 pub(super) struct Unit<'b> {
     pub(super) b: &'b Builder,
     pub(super) p: &'b TraverseParams,
-    pub(super) scene: &'b SceneRoms,
     pub(super) inp: Inputs<'b>,
     /// The ray RAMs (origin; reciprocal direction per axis): written when the top accepts a
     /// ray, read in N for the plane units.
@@ -188,6 +226,20 @@ pub(super) struct Queued<'b> {
     pub(super) sp_m1: S<'b>,
     pub(super) tmax: S<'b>,
     pub(super) miss: S<'b>,
+    /// With a node cache: the queued token is a node step that missed, back from the retry
+    /// queue with its node and tmin (tmax and sp come in `tmax`, `sp`).
+    pub(super) retry: Option<Retried<'b>>,
+}
+
+/// A node step back from the retry queue (registered for A), and the queue's push port
+/// (driven in N: `Unit::retry_push`).
+#[derive(Clone, Copy)]
+pub(super) struct Retried<'b> {
+    pub(super) valid: S<'b>,
+    pub(super) node: S<'b>,
+    pub(super) tmin: S<'b>,
+    pub(super) push: S<'b>,
+    pub(super) entry: S<'b>,
 }
 
 /// R: the token back from G, with its pop flag and sp = 0, sp − 1 made in G.
@@ -204,7 +256,8 @@ pub(super) struct RingN<'b> {
     pub(super) culled: S<'b>,
     pub(super) visit: S<'b>,
     pub(super) is_inner: S<'b>,
-    pub(super) leaf_push: S<'b>,
+    /// The token leaves the ring: a leaf queued, or (with a node cache) a miss.
+    pub(super) leaves: S<'b>,
     pub(super) leafq: Fifo<'b>,
     /// The node's axis a clock after N, and whether the ray's direction is negative on it
     /// (as seen in F).
@@ -239,7 +292,7 @@ pub(super) struct Slots<'b> {
 
 impl<'b> Unit<'b> {
     /// The input ports, and the ray RAMs' write port.
-    pub(super) fn new(b: &'b Builder, p: &'b TraverseParams, scene: &'b SceneRoms) -> Unit<'b> {
+    pub(super) fn new(b: &'b Builder, p: &'b TraverseParams) -> Unit<'b> {
         let (k, n, dist, sb, spw, bit) = (p.slots, p.n, p.dist_ty(), p.slot_bits(), p.sp_width(), Ty::BIT);
         let slot_ty = Ty::u(sb);
         let ray_we = b.input("ray_we", bit);
@@ -265,7 +318,12 @@ impl<'b> Unit<'b> {
             // The node ROM is the core's (two units share one through a block RAM's two
             // ports): the unit sends the address in C and gets the word `node_rom_cycles`
             // later, in N.
-            node_word: b.input("node_word", Ty::u(scene.node.0.width)),
+            node_word: b.input("node_word", Ty::u(p.node_layout.width)),
+            cache: p.node_cache.then(|| NodeAnswer {
+                hit: b.input("node_hit", bit),
+                wait: b.input("node_wait", Ty::u(super::cache::SEQ_BITS)),
+                done: b.input("node_done", Ty::u(super::cache::SEQ_BITS)),
+            }),
         };
         let o_mem = b.ram("ray_o", 3 * n, vec![0; k as usize]);
         b.ram_write(o_mem, ray_we, ray_slot, b.cat(&[o_in[2], o_in[1], o_in[0]]));
@@ -274,9 +332,9 @@ impl<'b> Unit<'b> {
             b.ram_write(mem, ray_we, ray_slot, inv_in[a].unsigned());
             mem
         });
-        let node_bits = rom_addr_bits(scene.node.1.len());
-        let (stack_bits, leaf_bits) = (rom_addr_bits(p.stack_depth as usize), rom_addr_bits(scene.leaf.1.len()));
-        Unit { b, p, scene, inp, o_mem, inv_mem, sb, spw, node_bits, stack_bits, leaf_bits, dist }
+        let (node_bits, leaf_bits) = (p.node_bits, p.leaf_bits);
+        let stack_bits = rom_addr_bits(p.stack_depth as usize);
+        Unit { b, p, inp, o_mem, inv_mem, sb, spw, node_bits, stack_bits, leaf_bits, dist }
     }
 
     pub(super) fn slots(&self) -> Slots<'b> {
@@ -315,23 +373,50 @@ impl<'b> Unit<'b> {
         let unpark = fifo(b, "unpark_q", sb + spw, k, inp.merge_valid, unpark_in, unpark_pop);
         let new_in = b.cat(&[inp.new_slot, inp.new_tmax.unsigned(), inp.new_miss]);
         let newq = fifo(b, "new_q", sb + dist.width + 1, k, inp.new_valid, new_in, new_pop);
-        // E: a queued ray enters when the token now in G will not return (R empty in A).
-        let take_unpark = (!ring_g_valid & unpark.nonempty).name("take_unpark");
-        let take_new = (!ring_g_valid & !unpark.nonempty & newq.nonempty).name("take_new");
+        // E: a queued ray enters when the token now in G will not return (R empty in A); a node
+        // step back from the retry queue first (its ray is walking), once its line is in.
+        let retry = inp.cache.map(|c| self.retry_queue(c));
+        let free = || match retry {
+            Some(r) => !ring_g_valid & !r.ready,
+            None => !ring_g_valid,
+        };
+        let take_unpark = (free() & unpark.nonempty).name("take_unpark");
+        let take_new = (free() & !unpark.nonempty & newq.nonempty).name("take_new");
         b.drive(unpark_pop, take_unpark);
         b.drive(new_pop, take_new);
-        let valid = b.valid_delay("q_valid", take_unpark | take_new);
+        let retried = retry.map(|r| {
+            let take = (!ring_g_valid & r.ready).name("take_retry");
+            b.drive(r.pop, take);
+            (take, r)
+        });
+        let taken = match retried {
+            Some((take, _)) => take | take_unpark | take_new,
+            None => take_unpark | take_new,
+        };
+        let valid = b.valid_delay("q_valid", taken);
         let new = b.delay("q_new", take_new);
-        let slot =
-            b.delay("q_slot", take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb)));
+        // A retried step's fields, else `queued`.
+        let or_retried = |field: fn(&RetryQueue<'b>) -> S<'b>, queued: S<'b>| match &retried {
+            Some((take, r)) => take.select(field(r), queued),
+            None => queued,
+        };
+        let queued_slot = take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb));
+        let slot = b.delay("q_slot", or_retried(|r| r.slot, queued_slot));
         // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
-        let head_sp = unpark.head.slice(0, spw);
+        let head_sp = or_retried(|r| r.sp, unpark.head.slice(0, spw));
         let sp = b.delay("q_sp", head_sp);
         let sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
         let sp_m1 = b.delay("q_sp_m1", head_sp - 1);
-        let tmax = b.delay("q_tmax", newq.head.slice(1, dist.width).signed());
+        let tmax = b.delay("q_tmax", or_retried(|r| r.tmax, newq.head.slice(1, dist.width).signed()));
         let miss = b.delay("q_miss", newq.head.bit(0));
-        Queued { ring_g_valid, valid, new, slot, sp, sp_zero, sp_m1, tmax, miss }
+        let retry = retried.map(|(take, r)| Retried {
+            valid: b.delay("q_retry", take),
+            node: b.delay("q_node", r.node),
+            tmin: b.delay("q_tmin", r.tmin),
+            push: r.push,
+            entry: r.entry,
+        });
+        Queued { ring_g_valid, valid, new, slot, sp, sp_zero, sp_m1, tmax, miss, retry }
     }
 
     pub(super) fn returning(&self) -> Returning<'b> {
@@ -361,7 +446,11 @@ impl<'b> Unit<'b> {
         let valid = (rv | q.valid).name("a_valid");
         let slot = rv.select(r.token.slot, q.slot).name("a_slot");
         let new = (!rv & q.new).name("a_new");
-        let pop = rv.select(r.pop, !q.new).name("a_pop");
+        let not_popped = match q.retry {
+            Some(t) => !(q.new | t.valid),
+            None => !q.new,
+        };
+        let pop = rv.select(r.pop, not_popped).name("a_pop");
         let sp = rv.select(r.token.sp, q.new.select(q.sp.k(0), q.sp)).name("a_sp");
         let sp_zero = rv.select(r.sp_zero, q.new | q.sp_zero).name("a_sp_zero");
         let sp_m1 = rv.select(r.sp_m1, q.sp_m1).name("a_sp_m1");
@@ -384,6 +473,15 @@ impl<'b> Unit<'b> {
         RingA { valid, slot, new, sp, sp_m1, done, from_stack, stack_top, push }
     }
 
+    /// A queued token's field: the retried step's (`field`) or `otherwise` (a new or unparked
+    /// ray's).
+    fn queued(&self, q: &Queued<'b>, field: impl Fn(&Retried<'b>) -> S<'b>, otherwise: S<'b>) -> S<'b> {
+        match &q.retry {
+            Some(t) => t.valid.select(field(t), otherwise),
+            None => otherwise,
+        }
+    }
+
     /// B, B2: the token waits two clocks for the stack word (the block's output register).
     pub(super) fn ring_b(&self, a: &RingA<'b>, r: &Returning<'b>, q: &Queued<'b>) -> (Token<'b>, S<'b>) {
         let (b, rt) = (self.b, r.token);
@@ -391,8 +489,9 @@ impl<'b> Unit<'b> {
         let bt = Token {
             valid: b.valid_delay("b_valid", (a.valid & !a.done).name("a_live")),
             slot: b.delay("b_slot", a.slot),
-            node: b.delay("b_node", rt.valid.select(rt.node, rt.node.k(0))),
-            tmin: b.delay("b_tmin", rt.valid.select(rt.tmin, rt.tmin.k(0))),
+            node: b
+                .delay("b_node", rt.valid.select(rt.node, self.queued(q, |t| t.node, rt.node.k(self.p.root as i128)))),
+            tmin: b.delay("b_tmin", rt.valid.select(rt.tmin, self.queued(q, |t| t.tmin, rt.tmin.k(0)))),
             tmax: b.delay("b_tmax", rt.valid.select(rt.tmax, q.tmax)),
             sp: b.delay("b_sp", a.from_stack.select(a.sp_m1, a.sp)),
         };
@@ -403,8 +502,14 @@ impl<'b> Unit<'b> {
     /// C: a popped entry (far node, far_min, tmax) from the stack word; the node ROM is
     /// addressed; the cull test: lower_t(tmin) > best t ⟺ tmin − tmin/64 > best t + 8
     /// (`golden::lower_t`), only when the slot has a best hit. Returns C's token and the cull
-    /// decision as seen in N.
-    pub(super) fn ring_c(&self, bt: Token<'b>, from_stack: S<'b>, top: S<'b>, a: &RingA<'b>) -> (Token<'b>, S<'b>) {
+    /// decision as seen in N, and with a node cache the lookup (valid, node) a clock after C.
+    pub(super) fn ring_c(
+        &self,
+        bt: Token<'b>,
+        from_stack: S<'b>,
+        top: S<'b>,
+        a: &RingA<'b>,
+    ) -> (Token<'b>, S<'b>, Option<[S<'b>; 2]>) {
         let (b, k, dist, inp) = (self.b, self.p.slots, self.dist, &self.inp);
         b.stage("ring_c", "C: a popped entry from the stack word; the node ROM addressed; the cull test");
         let top_tmax = top.slice(0, dist.width).signed();
@@ -424,30 +529,46 @@ impl<'b> Unit<'b> {
         let x = b.delay("cull_x", (c.tmin - (c.tmin >> 6)).name("tmin_less"));
         let arms: Vec<(u128, S)> = (0..k).map(|i| (i as u128, has_best.bit(i))).collect();
         let hb = b.delay("cull_has_best", b.case(c.slot, &arms, b.konst(Ty::BIT, 0)).name("slot_has_best"));
-        let culled = b.delay("culled", (hb & lt_chain(limit, x)).name("culled_c"));
+        let culled_c = (hb & lt_chain(limit, x)).name("culled_c");
+        // With a node cache, the lookup a clock after C, once the cull test is known: a culled
+        // entry fetches nothing.
+        let lookup = self.p.node_cache.then(|| {
+            let valid = (b.valid_delay("look_valid", c.valid) & !culled_c).name("node_look_c");
+            [valid, b.delay("look_node", c.node)]
+        });
+        let culled = b.delay("culled", culled_c);
         let culled = b.delay_line("culled_n", culled, self.p.node_rom_cycles - 2);
         let onehot_or_0 = |v: S<'b>, slot: S<'b>| v.select(onehot(slot, k), b.konst(Ty::u(k), 0));
         let set_best = onehot_or_0(inp.merge_valid & inp.merge_hit, inp.merge_slot).name("best_set");
         let clear_best = onehot_or_0(a.new & a.valid, a.slot).name("best_clear");
         b.next(has_best, (has_best & !clear_best) | set_best);
-        (c, culled)
+        (c, culled, lookup)
     }
 
     /// N: the node word. A culled entry or an empty leaf goes on as a pop; a leaf with entries
     /// is queued for the leaf stream and leaves the ring; an inner node issues both plane
     /// distances, one to each of two plane units, with the slot's ray from the ray RAMs.
-    pub(super) fn ring_n(&self, c: Token<'b>, culled: S<'b>) -> RingN<'b> {
+    pub(super) fn ring_n(&self, c: Token<'b>, culled: S<'b>, q: &Queued<'b>) -> RingN<'b> {
         let (b, p, n, k, word) = (self.b, self.p, self.p.n, self.p.slots, self.inp.node_word);
         b.stage("ring_n", "N: the node word; a leaf queued, an inner node to the plane units");
         let token = c.delayed(b, "n", p.node_rom_cycles, |_, x| x);
-        let node_l = &self.scene.node.0;
+        let node_l = &p.node_layout;
         let nf = |name: &str| field(&format!("nw_{name}"), word, node_l.field(name), 0);
         let (w_axis, w_clip0, w_clip1, w_child, w_first, w_count) =
             (nf("axis"), nf("clip0"), nf("clip1"), nf("child"), nf("first"), nf("count"));
         let w_leaf = w_axis.eq(3).name("nw_is_leaf");
-        let visit = (token.valid & !culled).name("visit_c");
+        // With a node cache only a hit is a visit; a miss leaves the ring for the retry queue.
+        let visit = match (self.inp.cache, q.retry) {
+            (Some(cache), Some(_)) => token.valid & !culled & cache.hit,
+            _ => token.valid & !culled,
+        }
+        .name("visit_c");
         let is_inner = (visit & !w_leaf).name("is_inner");
         let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
+        let leaves = match (self.inp.cache, q.retry) {
+            (Some(cache), Some(r)) => leaf_push | self.retry_push(token, culled, cache, r.push, r.entry),
+            _ => leaf_push,
+        };
         let leaf_bits = self.leaf_bits;
         let t = token;
         let leaf_in =
@@ -474,7 +595,7 @@ impl<'b> Unit<'b> {
             culled,
             visit,
             is_inner,
-            leaf_push,
+            leaves,
             leafq,
             axis1,
             negative,
@@ -491,7 +612,7 @@ impl<'b> Unit<'b> {
     pub(super) fn ring_f(&self, nn: &RingN<'b>) -> RingF<'b> {
         let (b, n, l, nt, axis1, negative) = (self.b, self.p.n, nn.plane_latency, nn.token, nn.axis1, nn.negative);
         b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
-        let ring = (nt.valid & !nn.leaf_push).name("n_stays");
+        let ring = (nt.valid & !nn.leaves).name("n_stays");
         let f_valid = b.valid_line("f_valid", ring, l);
         let f_inner = b.delay_line("f_inner", nn.is_inner, l);
         let f_slot = b.delay_line("f_slot", nt.slot, l);
@@ -592,7 +713,7 @@ impl<'b> Unit<'b> {
             at += w;
             s
         };
-        let count_w = self.scene.node.0.field("count").width;
+        let count_w = p.node_layout.field("count").width;
         let leaf_bits = self.leaf_bits;
         let (l_sp, l_tmin, l_count, l_first, l_slot) =
             (take(self.spw), take(p.tmin_width()), take(count_w), take(leaf_bits), take(self.sb));

@@ -9,6 +9,7 @@ pub mod disturb;
 pub mod exact;
 pub mod feed;
 pub mod frame;
+pub mod frame_memory;
 pub mod memory;
 pub mod memory_hdl;
 pub mod memory_tests;

@@ -113,7 +113,7 @@ pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &
     match name {
         "divider" => (isect.divider(), Some(isect.div_latency())),
         "intersect" => (intersect::intersect_core(isect), Some(isect.latency())),
-        "traverse" => (traverse::traverse_core(&core.trav, roms), None),
+        "traverse" => (traverse::traverse_core(&core.trav), None),
         "closest" => (
             closest::closest_core(core.tag, core.total_slots(), core.trav.id_width, isect.n, isect.m, isect.target()),
             Some(1 + closest::input_latency(isect.target())),

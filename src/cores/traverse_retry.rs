@@ -1,0 +1,78 @@
+//! The traversal unit's node cache side (an external-memory core, docs/MEMORY.md "The
+//! traversal with a node cache"): the lookup one clock after C, and the **retry queue** of node
+//! steps that missed. A miss in N takes the token out of the ring with everything it needs to
+//! step again — slot, node, tmin, tmax, sp — and the number of the fill that brings its line;
+//! the queue's head goes back into the ring at A (before rays back from a leaf and new rays)
+//! once the cache's `done` counter has reached that number. The walk is unchanged: a step that
+//! missed is neither a visit nor a cull, and when it comes back its cull test sees the same best
+//! hit (the slot's best changes only when a leaf it sent is merged, and the slot sends nothing
+//! while it waits here). The queue holds one entry per slot at most, so it never overflows.
+//!
+//! The retry queue is in order: a head waiting for a later fill holds back an entry whose fill
+//! came earlier. That costs a few clocks, never a deadlock: fills come whatever the ring does.
+
+use super::cache::{SEQ_BITS, released};
+use super::fifo::fifo;
+use super::traverse_stages::{NodeAnswer, Token, Unit};
+use crate::rtl::Ty;
+use crate::rtl::build::S;
+
+/// The retry queue: its head (when `ready`: its fill is in) and its ports.
+#[derive(Clone, Copy)]
+pub(super) struct RetryQueue<'b> {
+    pub(super) ready: S<'b>,
+    /// Driven by the queues' arbiter: the head goes into the ring.
+    pub(super) pop: S<'b>,
+    pub(super) slot: S<'b>,
+    pub(super) node: S<'b>,
+    pub(super) tmin: S<'b>,
+    pub(super) tmax: S<'b>,
+    pub(super) sp: S<'b>,
+    /// Driven in N (`retry_push`): a node step that missed, and its entry.
+    pub(super) push: S<'b>,
+    pub(super) entry: S<'b>,
+}
+
+impl<'b> Unit<'b> {
+    /// Entry bits, most significant first: slot, node, tmin, tmax, sp, the fill to wait for.
+    fn retry_widths(&self) -> [u32; 6] {
+        let d = self.dist.width;
+        [self.sb, self.node_bits, d, d, self.spw, SEQ_BITS]
+    }
+
+    pub(super) fn retry_queue(&self, cache: NodeAnswer<'b>) -> RetryQueue<'b> {
+        let b = self.b;
+        let widths = self.retry_widths();
+        let width = widths.iter().sum();
+        let push = b.wire("retry_push", Ty::BIT);
+        let entry = b.wire("retry_entry", Ty::u(width));
+        let pop = b.wire("retry_pop", Ty::BIT);
+        let q = fifo(b, "retry_q", width, self.p.slots, push, entry, pop);
+        let mut at = width;
+        let mut field = |k: usize| {
+            at -= widths[k];
+            q.head.slice(at, widths[k])
+        };
+        let (slot, node, tmin, tmax, sp, wait) = (field(0), field(1), field(2), field(3), field(4), field(5));
+        // `done` is the cache's register and the head a RAM's: one 16-bit subtract between them.
+        let ready = (q.nonempty & released(cache.done, wait)).name("retry_ready");
+        RetryQueue { ready, pop, slot, node, tmin: tmin.signed(), tmax: tmax.signed(), sp, push, entry }
+    }
+
+    /// N with a node cache: a step that is not culled and misses leaves the ring for the retry
+    /// queue (`retry`: its push port). Returns the miss.
+    pub(super) fn retry_push(
+        &self,
+        t: Token<'b>,
+        culled: S<'b>,
+        cache: NodeAnswer<'b>,
+        push: S<'b>,
+        entry: S<'b>,
+    ) -> S<'b> {
+        let b = self.b;
+        let miss = (t.valid & !culled & !cache.hit).name("node_miss");
+        b.drive(push, miss);
+        b.drive(entry, b.cat(&[t.slot, t.node, t.tmin.unsigned(), t.tmax.unsigned(), t.sp, cache.wait]));
+        miss
+    }
+}

@@ -1,0 +1,220 @@
+//! The leaf stream of an external-memory core (docs/MEMORY.md "Triangles"): a leaf's triangle
+//! records are fetched through the triangle cache into a **staging RAM** (2^stage_bits records
+//! per global slot: a slot has one leaf in flight at most) before the leaf goes to the
+//! intersection pipeline, so the pipeline never waits on memory in the middle of a leaf.
+//!
+//! - **Fetch**: whole leaves, a record a clock, from the units' leaf buffers in turn
+//!   (`leaf_buffers`) or — first — a leaf back from the retry queue once its lines are in. Each
+//!   record is looked up in the triangle cache; `cache::LATENCY` clocks later a hit is written to
+//!   the staging RAM, a miss marks the leaf and keeps the latest fill it must wait for. At the
+//!   leaf's last answer it goes to the ready queue if every record hit, else to the retry queue
+//!   with that fill number, and is fetched whole again once the fill is done.
+//! - **Emission**: leaves from the ready queue, a triangle a clock from the staging RAM (two
+//!   clocks: the block's read and output register) with the slot's ray, into the pipeline.
+//!
+//! What it costs: the staging RAM (slots × 2^stage_bits records) and one extra lookup per
+//! record of a leaf that missed.
+
+use super::axi_read::Fill;
+use super::brom::bram;
+use super::cache::{Cache, LATENCY, Lookup, SEQ_BITS, cache, released};
+use super::core_params::CoreParams;
+use super::fifo::fifo;
+use super::intersect::intersect_core;
+use super::leaf_stream::{Emission, RayRams, leaf_buffers};
+use super::memory_params::ExternalMemory;
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, Ports, S};
+use crate::scene::rom::Field;
+use std::rc::Rc;
+
+/// What the fetch shows the observation ports: triangle lookups and hits answered this clock,
+/// and a clock the pipeline took no triangle while a leaf waited for memory.
+pub struct FetchObserved<'b> {
+    pub looks: S<'b>,
+    pub hits: S<'b>,
+    pub stall: S<'b>,
+}
+
+/// Splits `entry` (fields most significant first, of `widths`).
+fn unpack<'b>(entry: S<'b>, widths: &[u32]) -> Vec<S<'b>> {
+    let mut at = entry.width();
+    widths
+        .iter()
+        .map(|&w| {
+            at -= w;
+            entry.slice(at, w)
+        })
+        .collect()
+}
+
+/// Bits [f.lsb, f.lsb + f.width) of a record held as parts of 128 bits (least significant
+/// first), with the field's sign.
+fn record_field<'b>(b: &'b Builder, parts: &[S<'b>], f: &Field) -> S<'b> {
+    let mut pieces = Vec::new();
+    let mut at = f.lsb;
+    while at < f.lsb + f.width {
+        let (k, off) = (at / 128, at % 128);
+        let take = (parts[k as usize].width() - off).min(f.lsb + f.width - at);
+        pieces.push(parts[k as usize].slice(off, take));
+        at += take;
+    }
+    pieces.reverse();
+    let raw = if pieces.len() == 1 { pieces[0] } else { b.cat(&pieces) };
+    let raw = raw.name(&format!("tri_{}", f.name));
+    if f.signed { raw.signed() } else { raw }
+}
+
+/// The fetch, the triangle cache, the staging RAM and the emission into the pipeline. `fill`
+/// is the read master's beats for the triangle cache; the cache's line requests go out on
+/// `request` (valid, line number).
+#[allow(clippy::too_many_arguments)]
+pub fn tri_fetch<'b>(
+    b: &'b Builder,
+    p: &CoreParams,
+    m: &ExternalMemory,
+    trav: &[Ports<'b>],
+    leaf_pop: &[S<'b>],
+    fill: &Fill<'b>,
+    request: (S<'b>, S<'b>),
+    rams: &RayRams,
+) -> (Emission<'b>, FetchObserved<'b>) {
+    let (tp, gb, bit, l) = (&p.trav, p.tag.slot_bits, Ty::BIT, &m.layout);
+    let (pb, cw, ib, tw, spw) =
+        (tp.leaf_bits, tp.node_layout.field("count").width, m.stage_bits, tp.tmin_width(), tp.sp_width());
+    b.stage("tri_fetch", "leaves' triangle records through the triangle cache into the staging RAM");
+    let w_valid = b.reg("fetch_active", bit, Some(0));
+    let reg = |name: &str, w: u32| b.reg(name, Ty::u(w), None);
+    let (w_slot, w_ptr, w_idx, w_left) =
+        (reg("fetch_slot", gb), reg("fetch_ptr", pb), reg("fetch_idx", ib), reg("fetch_left", cw));
+    let (w_head, w_count, w_tmin, w_sp) =
+        (reg("fetch_head", pb), reg("fetch_count", cw), reg("fetch_tmin", tw), reg("fetch_sp", spw));
+    let w_last = b.reg("fetch_last", bit, None);
+    let last_entry = (w_valid & w_last).name("fetch_last_entry");
+    let can_take = (!w_valid | last_entry).name("fetch_can_take");
+
+    // The retry queue: (slot, first, count, tmin, sp, fill to wait for), pushed at a leaf's
+    // last answer.
+    let retry_widths = [gb, pb, cw, tw, spw, SEQ_BITS];
+    let retry_w: u32 = retry_widths.iter().sum();
+    let (retry_push, retry_entry) = (b.wire("tri_retry_push", bit), b.wire("tri_retry_entry", Ty::u(retry_w)));
+    let retry_pop = b.wire("tri_retry_pop", bit);
+    let slots = p.total_slots();
+    let retry = fifo(b, "tri_retry_q", retry_w, slots, retry_push, retry_entry, retry_pop);
+    let r = unpack(retry.head, &retry_widths);
+    let tri_done = b.wire("tri_done", Ty::u(SEQ_BITS));
+    let retry_ready = (retry.nonempty & released(tri_done, r[5])).name("tri_retry_ready");
+    let take_retry = (can_take & retry_ready).name("fetch_take_retry");
+    b.drive(retry_pop, take_retry);
+    let picked = leaf_buffers(b, p, trav, leaf_pop, (can_take & !retry_ready).name("fetch_can_take_leaf"));
+    let take = (take_retry | picked.take).name("fetch_take");
+    let src = |k: usize, leaf_field: &str| take_retry.select(r[k], picked.field(leaf_field));
+    let (first, count) = (src(1, "leaf_first"), src(2, "leaf_count"));
+    b.next(w_valid, take | (w_valid & !last_entry));
+    b.next(w_slot, take.select(take_retry.select(r[0], picked.slot()), w_slot));
+    // The next record: the next slot of the line, or slot 0 of the next line.
+    let sb = l.slot_bits;
+    let next_ptr = if sb == 0 {
+        w_ptr + 1
+    } else {
+        let line_end = w_ptr.slice(0, sb).eq((l.tris_per_line - 1) as i128);
+        line_end.select(((w_ptr >> sb) + 1) << sb, w_ptr + 1).name("fetch_next_ptr")
+    };
+    b.next(w_ptr, take.select(first, next_ptr));
+    b.next(w_idx, take.select(w_idx.k(0), w_idx + 1));
+    b.next(w_left, take.select(count, w_left - 1));
+    b.next(w_last, take.select(count.eq(1), w_left.eq(2)));
+    b.next_when(w_head, take, first);
+    b.next_when(w_count, take, count);
+    b.next_when(w_tmin, take, src(3, "leaf_tmin"));
+    b.next_when(w_sp, take, src(4, "leaf_sp"));
+
+    let rec = if sb == 0 { b.konst(Ty::u(m.tri.rec_bits()), 0) } else { w_ptr.slice(0, sb).resize(m.tri.rec_bits()) };
+    let look = Lookup { valid: w_valid, line: (w_ptr >> sb).resize(m.tri.line_bits), rec };
+    let Cache { answer, request: (req_valid, req_line), done } = cache(b, "tc", &m.tri, &look, fill);
+    b.drive(request.0, req_valid);
+    b.drive(request.1, req_line);
+    b.drive(tri_done, done);
+
+    b.stage("tri_answer", "the answers: hits into the staging RAM; a leaf with a miss to the retry queue");
+    let tag = b.cat(&[w_slot, w_idx, w_head, w_count, w_tmin, w_sp, w_last]);
+    let a = unpack(b.delay_line("fetch_tag", tag, LATENCY), &[gb, ib, pb, cw, tw, spw, 1]);
+    let (a_slot, a_idx, a_last) = (a[0], a[1], a[6]);
+    let av = answer.valid;
+    let acc_miss = b.reg("fetch_missed", bit, Some(0));
+    let acc_wait = b.reg("fetch_wait", Ty::u(SEQ_BITS), None);
+    let earlier = (a_idx.ne(0) & acc_miss).name("fetch_missed_before");
+    let missed = (earlier | !answer.hit).name("fetch_missed_c");
+    // The later of the fills to wait for (fills are numbered in order, compared as serial numbers).
+    let later = (earlier & released(acc_wait, answer.wait)).name("fetch_wait_keep");
+    let wait = (answer.hit | later).select(acc_wait, answer.wait).name("fetch_wait_c");
+    b.next_when(acc_miss, av, missed);
+    b.next_when(acc_wait, av, wait);
+    let leaf_done = (av & a_last).name("fetch_leaf_done");
+    b.drive(retry_push, leaf_done & missed);
+    b.drive(retry_entry, b.cat(&[a_slot, a[2], a[3], a[4], a[5], wait]));
+    let ready_widths = [gb, cw, tw, spw];
+    let ready_push = (leaf_done & !missed).name("fetch_ready");
+    let ready_pop = b.wire("ready_pop", bit);
+    let ready =
+        fifo(b, "ready_q", ready_widths.iter().sum(), slots, ready_push, b.cat(&[a_slot, a[3], a[4], a[5]]), ready_pop);
+    let stage_words = (slots as usize) << ib;
+    let waddr = b.cat(&[a_slot, a_idx]).name("stage_waddr");
+    let we = (av & answer.hit).name("stage_we");
+
+    b.stage("tri_emit", "leaves from the ready queue, a triangle a clock from the staging RAM into the pipeline");
+    let e_valid = b.reg("emit_active", bit, Some(0));
+    let (e_slot, e_idx, e_left) = (reg("emit_slot", gb), reg("emit_idx", ib), reg("emit_left", cw));
+    let (e_tmin, e_sp) = (reg("emit_tmin", tw), reg("emit_sp", spw));
+    let (e_first, e_last) = (b.reg("emit_first", bit, None), b.reg("emit_last", bit, None));
+    let e_last_entry = (e_valid & e_last).name("emit_last_entry");
+    let e_take = ((!e_valid | e_last_entry) & ready.nonempty).name("emit_take");
+    b.drive(ready_pop, e_take);
+    let h = unpack(ready.head, &ready_widths);
+    b.next(e_valid, e_take | (e_valid & !e_last_entry));
+    b.next(e_slot, e_take.select(h[0], e_slot));
+    b.next(e_idx, e_take.select(e_idx.k(0), e_idx + 1));
+    b.next(e_left, e_take.select(h[1], e_left - 1));
+    b.next(e_last, e_take.select(h[1].eq(1), e_left.eq(2)));
+    b.next(e_first, e_take);
+    b.next_when(e_tmin, e_take, h[2]);
+    b.next_when(e_sp, e_take, h[3]);
+    let raddr = b.cat(&[e_slot, e_idx]).name("stage_raddr");
+    let parts: Vec<S> = m
+        .tri
+        .parts()
+        .iter()
+        .enumerate()
+        .zip(&answer.data)
+        .map(|((j, &w), &data)| {
+            bram(b, &format!("u_stage_{j}"), &format!("stage_{j}_w{w}"), w, stage_words, we, waddr, data, raddr)
+        })
+        .collect();
+    // Two clocks: the staging RAM's read and output register; the slot's ray alongside.
+    let lat = 2;
+    let valid_d = b.valid_line("pipe_valid", e_valid, lat);
+    let tag = b.delay_line("pipe_tag_leaf", b.cat(&[e_last_entry, e_first, e_slot, e_sp, e_tmin]), lat);
+    let id = record_field(b, &parts, l.tri.field("id"));
+    let tag = b.cat(&[tag, id.resize(tp.tri_bits)]).name("pipe_tag");
+    let o_word = b.delay("pipe_o", b.read("ray_o_q", rams.o, e_slot));
+    let w_words: Vec<S> = rams
+        .w
+        .iter()
+        .enumerate()
+        .map(|(k, &mem)| {
+            let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
+            b.delay(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, e_slot))
+        })
+        .collect();
+    let (n, mw) = (p.isect.n, p.isect.m);
+    let mut pipe_in = vec![valid_d, tag];
+    pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
+    pipe_in.extend(
+        (0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * mw, mw) } else { w_words[a as usize] }.signed()),
+    );
+    pipe_in.extend(l.tri.fields.iter().filter(|f| f.name != "id").map(|f| record_field(b, &parts, f)));
+    let pipe = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
+    let stall = b.delay("mem_stall", (!valid_d & retry.nonempty).name("mem_stall_c"));
+    let observed = FetchObserved { looks: av, hits: (av & answer.hit).name("tri_hit"), stall };
+    (Emission { pipe, valid: valid_d }, observed)
+}

@@ -1,0 +1,174 @@
+//! Whole frames through an external-memory core (`--memory external`) in the cycle simulator,
+//! its AXI4 read port answered by the memory model (`verify::memory`) from the scene image:
+//! the same rays and checks as `verify::frame`, and what the memory side did (`MemoryStats`).
+
+use super::frame::{CoreResult, CoreStats, OBSERVED, RESULT_PORTS, core_result, port};
+use super::memory::{MasterOut, MemoryModel, MemoryTiming};
+use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
+use crate::cores::top_memory::memory_inputs;
+use crate::rtl::sim::Sim;
+use crate::scene::images::SceneRoms;
+use crate::scene::memory::SceneImage;
+use crate::verify::frame::PixelRay;
+use serde::Serialize;
+
+/// The byte address the simulations put the scene image at (`mem_base`): not 0, so a core that
+/// forgot the base reads the wrong bytes.
+pub const SIM_BASE: u64 = 0x10_0000;
+
+/// Observation ports of an external-memory core, in `MemoryStats::count` order.
+pub const MEMORY_OBSERVED: [&str; 6] = ["node_looks", "node_hits", "tri_looks", "tri_hits", "mem_beat", "mem_stall"];
+
+/// What the memory side did over a frame.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct MemoryStats {
+    pub latency: u32,
+    pub mem_bits: u32,
+    /// Bursts (cache lines) read and beats carried.
+    pub reads: u64,
+    pub beats: u64,
+    pub node_lookups: u64,
+    pub node_hits: u64,
+    pub tri_lookups: u64,
+    pub tri_hits: u64,
+    /// Clocks in which a beat came in (the R channel busy).
+    pub beat_clocks: u64,
+    /// Clocks in which no triangle entered the pipeline while a leaf waited for memory.
+    pub stall_clocks: u64,
+    /// Derived figures (`finish`): per ray, rates and fractions.
+    pub mem_bytes_per_ray: f64,
+    pub mem_reads_per_ray: f64,
+    pub node_cache_hit_rate: f64,
+    pub tri_cache_hit_rate: f64,
+    pub mem_busy: f64,
+    pub memory_stall_fraction: f64,
+}
+
+impl MemoryStats {
+    fn count(&mut self, row: &[i128; 6]) {
+        self.node_lookups += row[0] as u64;
+        self.node_hits += row[1] as u64;
+        self.tri_lookups += row[2] as u64;
+        self.tri_hits += row[3] as u64;
+        self.beat_clocks += row[4] as u64;
+        self.stall_clocks += row[5] as u64;
+    }
+
+    fn finish(&mut self, rays: u64, cycles: u64) {
+        let (rays, cycles) = (rays.max(1) as f64, cycles.max(1) as f64);
+        self.mem_bytes_per_ray = (self.beats * self.mem_bits as u64 / 8) as f64 / rays;
+        self.mem_reads_per_ray = self.reads as f64 / rays;
+        self.node_cache_hit_rate = self.node_hits as f64 / self.node_lookups.max(1) as f64;
+        self.tri_cache_hit_rate = self.tri_hits as f64 / self.tri_lookups.max(1) as f64;
+        self.mem_busy = self.beat_clocks as f64 / cycles;
+        self.memory_stall_fraction = self.stall_clocks as f64 / cycles;
+    }
+}
+
+/// Streams `rays` (in the order given, every result taken when shown) through the core of `p`
+/// (which must have external memory) in the cycle simulator, the memory model of `timing`
+/// answering from `image` at `SIM_BASE`. Returns the results in the order they came out, the
+/// core's counts and the memory side's. Panics (a test failure) if the core stops producing
+/// results or flags a memory error.
+pub fn simulate_external(
+    p: &CoreParams,
+    roms: &SceneRoms,
+    image: &SceneImage,
+    rays: &[PixelRay],
+    timing: MemoryTiming,
+    progress: &dyn Fn(u64),
+) -> (Vec<CoreResult>, CoreStats, MemoryStats) {
+    let mem = p.mem.as_ref().expect("an external-memory core");
+    let m = core_module(p, roms);
+    let mut sim = Sim::new(&m);
+    let ins: Vec<_> = core_inputs(p).iter().map(|(name, _)| port(&m, name)).collect();
+    let mem_ins: Vec<_> = memory_inputs(mem).iter().map(|(name, _)| port(&m, name)).collect();
+    let (ready, res_ready, res_valid) = (port(&m, "ray_ready"), port(&m, "res_ready"), port(&m, "res_valid"));
+    let [arvalid, araddr, arlen, error] =
+        ["m_axi_arvalid", "m_axi_araddr", "m_axi_arlen", "mem_error"].map(|n| port(&m, n));
+    let observed = OBSERVED.map(|n| port(&m, n));
+    let mem_observed = MEMORY_OBSERVED.map(|n| port(&m, n));
+    let res: Vec<_> = RESULT_PORTS.iter().map(|n| port(&m, n)).collect();
+    let mut model = MemoryModel::new(image.bytes.clone(), SIM_BASE, mem.spec.shape.mem_bits, timing);
+    let mut stats = CoreStats { rays: rays.len() as u64, slots: p.slot_count() as u64, ..Default::default() };
+    let mut ms = MemoryStats { latency: timing.latency, mem_bits: mem.spec.shape.mem_bits, ..Default::default() };
+    let mut results = Vec::with_capacity(rays.len());
+    let idle = vec![0i128; ins.len()];
+    let mut next = 0;
+    let limit = 400_000 + 20_000 * rays.len() as u64 + 200 * timing.latency as u64 * rays.len() as u64;
+    sim.set(res_ready, 1);
+    sim.set(mem_ins[0], SIM_BASE as i128);
+    while results.len() < rays.len() {
+        let values = rays.get(next).map(|r| ray_inputs(r.pixel as u64, &r.ray));
+        for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&idle)) {
+            sim.set(*s, *v);
+        }
+        let bus = model.out();
+        let bus_in = [bus.arready as i128, bus.rvalid as i128, bus.rdata as i128, bus.rlast as i128, 0];
+        for (s, v) in mem_ins[1..].iter().zip(bus_in) {
+            sim.set(*s, v);
+        }
+        sim.eval();
+        let fire = values.is_some() && sim.get(ready) == 1;
+        let shown = (sim.get(res_valid) == 1).then(|| res.iter().map(|s| sim.get(*s)).collect::<Vec<i128>>());
+        let master = MasterOut {
+            arvalid: sim.get(arvalid) == 1,
+            araddr: sim.get(araddr) as u64,
+            arlen: sim.get(arlen) as u32,
+            rready: true,
+        };
+        sim.tick();
+        model.clock(&master);
+        stats.cycles += 1;
+        stats.count(&observed.map(|o| sim.get(o)));
+        ms.count(&mem_observed.map(|o| sim.get(o)));
+        next += fire as usize;
+        if let Some(row) = shown {
+            results.push(core_result(&row));
+            if results.len() % 256 == 0 {
+                progress(results.len() as u64);
+            }
+        }
+        assert!(sim.get(error) == 0, "cycle {}: the read master flagged a memory error", stats.cycles);
+        assert!(stats.cycles < limit, "the core stopped producing results ({} of {})", results.len(), rays.len());
+    }
+    (ms.reads, ms.beats) = (model.bursts_taken, model.beats);
+    ms.finish(stats.rays, stats.cycles);
+    (results, stats, ms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cores::memory_params::MemorySpec;
+    use crate::cores::top::CoreSpec;
+    use crate::model::camera::Camera;
+    use crate::params::Params;
+    use crate::scene::memory::MemoryShape;
+    use crate::scene::{Scene, SceneSource};
+    use crate::verify::frame::{frame_rays, golden_walk, mismatches};
+
+    /// Every ray's result is the golden model's, and the walk is `trace_culled`'s step for
+    /// step, whatever the memory's latency and pauses.
+    #[test]
+    fn external_memory_frames_are_exact() {
+        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 10, 10));
+        let spec = MemorySpec { node_cache_kb: 1, tri_cache_kb: 1, ..MemorySpec::default() };
+        let shape = CoreSpec { slots: 16, ..CoreSpec::default() };
+        let p = CoreParams::external(&roms, &shape, spec).unwrap();
+        let image = SceneImage::build(&roms, MemoryShape::default()).unwrap();
+        let (steps, tests) = golden_walk(&scene, &rays);
+        for timing in [
+            MemoryTiming::default(),
+            MemoryTiming { latency: 200, extra_delay: 30, pause_in_256: 60, seed: 7, ..MemoryTiming::default() },
+        ] {
+            let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, timing, &|_| ());
+            assert_eq!(mismatches(&scene, &rays, &results), 0, "{timing:?}");
+            assert_eq!((stats.visits + stats.culls, stats.busy_cycles), (steps, tests), "{timing:?}");
+            assert!(ms.node_hits < ms.node_lookups && ms.tri_hits < ms.tri_lookups, "{ms:?}");
+            eprintln!("{timing:?}: {} cycles, {:?}", stats.cycles, ms);
+        }
+    }
+}
