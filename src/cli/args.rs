@@ -155,6 +155,86 @@ impl MemoryArgs {
     }
 }
 
+/// Where the core keeps its scene (`--memory`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MemoryPlace {
+    /// In on-chip ROMs.
+    Onchip,
+    /// In external memory behind an AXI4 read port and on-chip caches.
+    External,
+    /// On chip when the ROMs fit --bram-kbits, else external.
+    Auto,
+}
+
+/// The order rays are fed in (`--ray-order`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum RayOrder {
+    Pixels,
+    /// 8 × 8-pixel tiles (the caches' friend).
+    Tiles,
+}
+
+/// An external-memory core's options and its memory model's (docs/MEMORY.md).
+#[derive(Args, Debug, Clone)]
+pub struct ExternalArgs {
+    /// Where the scene lives: onchip, external or auto (on chip when it fits --bram-kbits).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub memory: MemoryPlace,
+    #[command(flatten)]
+    pub shape: MemoryArgs,
+    /// Each traversal unit's node cache, KB.
+    #[arg(long = "node-cache-kb", default_value_t = crate::cores::memory_params::DEFAULT_NODE_CACHE_KB)]
+    pub node_cache_kb: u32,
+    /// The triangle cache, KB.
+    #[arg(long = "tri-cache-kb", default_value_t = crate::cores::memory_params::DEFAULT_TRI_CACHE_KB)]
+    pub tri_cache_kb: u32,
+    /// Ways of each cache: 1, 2 or 4.
+    #[arg(long = "cache-ways", default_value_t = crate::cores::memory_params::DEFAULT_WAYS)]
+    pub cache_ways: u32,
+    /// The memory model: clocks from an address to its first beat.
+    #[arg(long = "mem-latency", default_value_t = crate::verify::memory::DEFAULT_LATENCY)]
+    pub mem_latency: u32,
+    /// The memory model: bursts taken and not finished, at most.
+    #[arg(long = "mem-outstanding", default_value_t = crate::verify::memory::DEFAULT_OUTSTANDING)]
+    pub mem_outstanding: u32,
+    /// The memory model: a burst's first beat up to this many clocks later still (random).
+    #[arg(long = "mem-jitter", default_value_t = 0)]
+    pub mem_jitter: u32,
+    /// The memory model: chance in 256 that a clock carries no beat (R pauses).
+    #[arg(long = "mem-pauses", default_value_t = 0)]
+    pub mem_pauses: u32,
+    /// The memory model's random seed (jitter and pauses).
+    #[arg(long = "mem-seed", default_value_t = 1)]
+    pub mem_seed: u32,
+    /// Feed rays in pixel order or in 8 × 8 tiles (not with --shuffle-seed).
+    #[arg(long = "ray-order", value_enum, default_value = "pixels")]
+    pub ray_order: RayOrder,
+}
+
+impl ExternalArgs {
+    /// The external-memory core's options and the memory model's timing, checked.
+    pub fn spec(
+        &self,
+    ) -> crate::error::Result<(crate::cores::memory_params::MemorySpec, crate::verify::memory::MemoryTiming)> {
+        let spec = crate::cores::memory_params::MemorySpec {
+            shape: self.shape.shape()?,
+            node_cache_kb: self.node_cache_kb,
+            tri_cache_kb: self.tri_cache_kb,
+            ways: self.cache_ways,
+            ..Default::default()
+        };
+        let timing = crate::verify::memory::MemoryTiming {
+            latency: self.mem_latency,
+            outstanding: self.mem_outstanding,
+            extra_delay: self.mem_jitter,
+            pause_in_256: self.mem_pauses,
+            seed: self.mem_seed,
+        };
+        timing.validate().map_err(|(p, m)| crate::error::Error::param(p, m))?;
+        Ok((spec, timing))
+    }
+}
+
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     #[command(flatten)]

@@ -182,6 +182,11 @@ pub struct SimArgs {
     #[arg(long = "stall-seed", value_name = "SEED", allow_hyphen_values = true)]
     pub stall_seed: Option<u64>,
     #[command(flatten)]
+    pub external: super::args::ExternalArgs,
+    /// Block RAM the scene's ROMs may take, Kb (--memory auto: external when they do not fit).
+    #[arg(long = "bram-kbits", default_value_t = 5328)]
+    pub bram_kbits: u64,
+    #[command(flatten)]
     pub params: ParamArgs,
 }
 

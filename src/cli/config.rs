@@ -480,6 +480,13 @@ pub struct SimConfig {
     pub shuffle_seed: Option<u64>,
     /// The source's stalls: (percent of cycles 1..=99, seed); None: it never stalls.
     pub stalls: Option<(u32, u64)>,
+    /// Where the scene lives (`auto` decided by `bram_kbits`), the external core's options and
+    /// its memory model, and the ray order.
+    pub memory: super::args::MemoryPlace,
+    pub bram_kbits: u64,
+    pub mem_spec: crate::cores::memory_params::MemorySpec,
+    pub mem_timing: crate::verify::memory::MemoryTiming,
+    pub tiles: bool,
 }
 
 /// The clock of a `fxrt synth --family ecp5` JSON: the whole core's Fmax, else the slowest
@@ -511,9 +518,17 @@ impl SimArgs {
         if self.stall_seed.is_some() && self.stall_percent == 0 {
             return Err(Error::param("stall-seed", "seeds the stalls of --stall-percent: add --stall-percent"));
         }
+        let (mem_spec, mem_timing) = self.external.spec()?;
+        let tiles = self.external.ray_order == super::args::RayOrder::Tiles;
+        if tiles && self.shuffle_seed.is_some() {
+            return Err(Error::param("ray-order", "tiles is an order of its own: not with --shuffle-seed"));
+        }
         // The ray generator feeds the core itself, in pixel order, whenever it is ready.
-        for (given, name) in [(self.shuffle_seed.is_some(), "shuffle-seed"), (self.stall_percent > 0, "stall-percent")]
-        {
+        for (given, name) in [
+            (self.shuffle_seed.is_some(), "shuffle-seed"),
+            (self.stall_percent > 0, "stall-percent"),
+            (tiles, "ray-order"),
+        ] {
             if given && self.raygen {
                 return Err(Error::param(name, "feeds host rays: not with --raygen (the generator feeds the core)"));
             }
@@ -540,6 +555,11 @@ impl SimArgs {
             },
             shuffle_seed: self.shuffle_seed,
             stalls: (self.stall_percent > 0).then(|| (self.stall_percent, self.stall_seed.unwrap_or(1))),
+            memory: self.external.memory,
+            bram_kbits: self.bram_kbits,
+            mem_spec,
+            mem_timing,
+            tiles: self.external.ray_order == super::args::RayOrder::Tiles,
         })
     }
 }

@@ -372,26 +372,27 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let id_width = rom::addr_bits((w * h) as usize);
     let roms = SceneRoms::of(&scene);
     let t = c.threads;
-    let p = crate::cores::top::CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec {
-            id_width,
-            div_bits: c.div_bits,
-            target_mhz: c.target_mhz,
-            slots: t.slots,
-            units: t.units,
-        },
-    );
+    let spec = crate::cores::top::CoreSpec {
+        id_width,
+        div_bits: c.div_bits,
+        target_mhz: c.target_mhz,
+        slots: t.slots,
+        units: t.units,
+    };
+    let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
+    let p = external_core(c, &roms, &spec, p)?;
     let raygen = if c.raygen { Some(RayGen::for_camera(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {
         Some(g) => {
             let golden = Golden::new(&scene);
             (0..w * h).map(|i| frame::PixelRay { pixel: i, ray: g.ray(&golden, i % w, i / w) }).collect()
         }
+        None if c.tiles => feed::tile_order(&frame::frame_rays(&scene, &cam), w, 8),
         // Shuffled (or not) here, once: every simulator feeds the rays in this order.
         None => feed::feed_order(&frame::frame_rays(&scene, &cam), c.shuffle_seed),
     };
+    let mut memory_stats = None;
     let stalls = c.stalls.map_or_else(feed::Stalls::none, |(percent, seed)| feed::Stalls::random(percent, seed));
     let start = std::time::Instant::now();
     // `SimArgs::config` allows the ray generator in the Rust simulator only.
@@ -406,6 +407,17 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             let r = frame::collect_batched(&m, rays.len(), p.slot_count(), 0, &|n| bar.set_position(n));
             bar.finish_and_clear();
             r
+        }
+        (Simulation::Rust, _, None) if p.mem.is_some() => {
+            let image = scene::memory::SceneImage::build(&roms, c.mem_spec.shape)?;
+            let bar = frame::progress_bar(rays.len() as u64, "rust");
+            let (results, stats, ms) =
+                crate::verify::frame_memory::simulate_external(&p, &roms, &image, &rays, c.mem_timing, &|n| {
+                    bar.set_position(n)
+                });
+            bar.finish_and_clear();
+            memory_stats = Some(ms);
+            (results, stats)
         }
         (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, &stalls, dir)?,
         _ => {
@@ -454,7 +466,14 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "shuffle_seed": c.shuffle_seed, "stall_percent": c.stalls.map_or(0, |s| s.0),
         "stall_seed": c.stalls.map(|s| s.1), "stall_cycles": stats.stall_cycles,
         "results_in_feed_order": in_order, "results_in_pixel_order": in_pixel_order,
+        "memory": if p.mem.is_some() { "external" } else { "onchip" },
+        "ray_order": if c.tiles { "tiles" } else { "pixels" },
     });
+    if let (Some(ms), Some(obj)) = (memory_stats, line.as_object_mut()) {
+        if let serde_json::Value::Object(fields) = serde_json::to_value(&ms).unwrap_or_default() {
+            obj.extend(fields);
+        }
+    }
     // Hardware speed: one ray per `cycles_per_ray` clocks (one ray in flight).
     if let Some((mhz, measured)) = c.clock {
         let key = if measured { "mrays_per_s_at_fmax" } else { "mrays_per_s_at_clock" };
@@ -463,6 +482,34 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     }
     println!("{line}");
     Ok(mismatches == 0 && walk_matches)
+}
+
+/// The core `fxrt sim` runs: `p` (on chip) unless `--memory external`, or `auto` and its ROMs do
+/// not fit `--bram-kbits`; an external-memory core runs in the Rust simulator with host rays.
+fn external_core(
+    c: &SimConfig,
+    roms: &SceneRoms,
+    shape: &crate::cores::top::CoreSpec,
+    p: crate::cores::top::CoreParams,
+) -> Result<crate::cores::top::CoreParams> {
+    use super::args::MemoryPlace;
+    let external = match c.memory {
+        MemoryPlace::Onchip => false,
+        MemoryPlace::External => true,
+        MemoryPlace::Auto => p.check_device(roms, c.bram_kbits).is_err(),
+    };
+    if !external {
+        return Ok(p);
+    }
+    if c.sim != Simulation::Rust || c.raygen {
+        return Err(crate::error::Error::param(
+            "memory",
+            "an external-memory core runs in the Rust simulator with host rays (--sim rust, no --raygen)",
+        ));
+    }
+    let p = crate::cores::top::CoreParams::external(roms, shape, c.mem_spec)?;
+    p.check_device(roms, c.bram_kbits)?;
+    Ok(p)
 }
 
 /// Ok(false): the simulated core disagreed with the golden model somewhere (`--core-sim`).

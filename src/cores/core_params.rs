@@ -170,6 +170,9 @@ impl CoreParams {
         let stack = stack_word
             * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64
             * self.total_slots() as u64;
+        if let Some(m) = &self.mem {
+            return m.check_device(self.units, self.total_slots(), stack, bram_kbits);
+        }
         let total = scene.rom_bits() + stack;
         if total > bram_kbits * 1024 {
             return Err(crate::error::Error::param(

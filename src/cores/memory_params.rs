@@ -72,6 +72,15 @@ impl ExternalMemory {
                 ),
             ));
         }
+        if layout.node.width > crate::rtl::width::MAX_WIDTH {
+            return Err(Error::param(
+                "n",
+                format!(
+                    "a node record of {} bits is wider than the RTL layer's signals: a smaller n",
+                    layout.node.width
+                ),
+            ));
+        }
         let (line, beat) = (spec.shape.line_bytes, spec.shape.beat_bytes());
         let cache = |flag: &'static str, kb: u32, rec_bytes: u32, records_per_line: u32, lines: u64, bits: u32| {
             let line_count = (kb as u64 * 1024) / line as u64;
@@ -127,6 +136,32 @@ impl ExternalMemory {
         let largest = roms.node.1.iter().filter(|w| w.get(roms.node.0.field("axis")) == 3).map(|w| w.get(count));
         let largest = largest.max().unwrap_or(1).max(1) as usize;
         Ok(ExternalMemory { spec, layout, node, tri, axi, stage_bits: addr_bits(largest) })
+    }
+
+    /// Bits of block RAM the memory side takes: `units` node caches, the triangle cache and the
+    /// staging RAM (`slots` global slots).
+    pub fn bram_bits(&self, units: u32, slots: u32) -> u64 {
+        let staging = ((slots as u64) << self.stage_bits) * self.tri.record_bits as u64;
+        units as u64 * self.node.bits() + self.tri.bits() + staging
+    }
+
+    /// Rejects caches, staging RAM and `stack_bits` of stacks that do not fit `bram_kbits`.
+    pub fn check_device(&self, units: u32, slots: u32, stack_bits: u64, bram_kbits: u64) -> Result<()> {
+        let total = self.bram_bits(units, slots) + stack_bits;
+        if total > bram_kbits * 1024 {
+            return Err(Error::param(
+                "bram-kbits",
+                format!(
+                    "the caches ({units} × {} KB of nodes, {} KB of triangles), the staging RAM and the stacks need {} Kb, \
+                     more than the {bram_kbits} Kb of block RAM allowed: smaller --node-cache-kb/--tri-cache-kb, \
+                     fewer --slots/--units, or a larger --bram-kbits",
+                    self.spec.node_cache_kb,
+                    self.spec.tri_cache_kb,
+                    total.div_ceil(1024)
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Byte offsets of the node and triangle regions in the image (each cache's lines are

@@ -23,6 +23,20 @@ pub fn feed_order<T: Clone>(rays: &[T], seed: Option<u64>) -> Vec<T> {
     v
 }
 
+/// The rays of a `width`-pixel-wide frame (`PixelRay`s in any order) in tiles of `tile` ×
+/// `tile` pixels, tile rows top to bottom, tiles left to right, pixel order within a tile: rays
+/// that follow each other walk nearby nodes and triangles (what the caches of an
+/// external-memory core live on, docs/MEMORY.md).
+pub fn tile_order(rays: &[super::frame::PixelRay], width: u32, tile: u32) -> Vec<super::frame::PixelRay> {
+    let mut v = rays.to_vec();
+    let tile = tile.max(1);
+    v.sort_by_key(|r| {
+        let (x, y) = (r.pixel % width, r.pixel / width);
+        (y / tile, x / tile, y % tile, x % tile)
+    });
+    v
+}
+
 /// The source's stall pattern: on cycle c (counted from the first cycle the source may offer
 /// a ray, the testbenches' cycle 0) it offers nothing — `ray_valid` low, even with rays left
 /// and a ray on the data ports — iff `pattern[c mod PERIOD]`. The source may so drop
