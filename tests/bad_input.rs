@@ -173,3 +173,35 @@ fn an_edge_shift_above_the_limit_names_the_limit() {
     let o = fxrt(&["scene", "--builtin", "thin", "--edge-shift", "65", "--out", rom.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// An external-memory core's options out of range, contradictory, or caches that do not fit
+/// the block RAM: exit 2 naming the option, no picture written.
+#[test]
+fn external_memory_options_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("x.png");
+    let p = png.to_str().unwrap();
+    let sim = |extra: &[&'static str]| -> Vec<String> {
+        let mut v: Vec<String> = ["sim", "--builtin", "cornell", "--size", "8x8", "--memory", "external", "--png", p]
+            .map(String::from)
+            .to_vec();
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    for (extra, subject, want) in [
+        (&["--node-cache-kb", "3"][..], "node-cache-kb", "power of two"),
+        (&["--tri-cache-kb", "0"][..], "tri-cache-kb", "power of two"),
+        (&["--cache-ways", "3"][..], "cache-ways", "1, 2, 4"),
+        (&["--mem-latency", "0"][..], "mem-latency", "from 1"),
+        (&["--mem-pauses", "256"][..], "mem-pauses", "at most 255"),
+        (&["--cache-line", "96"][..], "cache-line", "power of two"),
+        (&["--mem-bits", "48"][..], "mem-bits", "32, 64, 128"),
+        (&["--tri-cache-kb", "1024", "--bram-kbits", "4000"][..], "bram-kbits", "caches"),
+        (&["--sim", "ghdl"][..], "memory", "Rust simulator"),
+        (&["--ray-order", "tiles", "--shuffle-seed", "3"][..], "ray-order", "shuffle"),
+    ] {
+        let args = sim(extra);
+        let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        refused(&args, &format!("--{subject}"), want, &png);
+    }
+}

@@ -594,3 +594,38 @@ fn bench_exact_refuses_bad_options_naming_them() {
         assert!(err.starts_with(&format!("fxrt: {subject}")), "{err}");
     }
 }
+
+/// `fxrt sim --memory external`: the scene read through the AXI4 port and the caches from the
+/// memory model, slow and pausing, every pixel right, the walk the golden one, and the memory
+/// figures in the JSON; `auto` keeps a scene that fits on chip there; tiles are one more order.
+#[test]
+fn sim_runs_external_memory_cores() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ext_ids, chip_ids) = (dir.path().join("ext.ids"), dir.path().join("chip.ids"));
+    let base = ["sim", "--builtin", "cornell", "--size", "16x12", "--slots", "16", "--ids"];
+    let o = fxrt(
+        &[
+            &base[..],
+            &[ext_ids.to_str().unwrap(), "--memory", "external", "--node-cache-kb", "1", "--tri-cache-kb", "1"],
+            &["--mem-latency", "200", "--mem-jitter", "25", "--mem-pauses", "70", "--mem-seed", "9"],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((line["memory"].as_str(), line["all_pixels_match"].as_bool()), (Some("external"), Some(true)), "{line}");
+    assert_eq!(line["walk_matches"], true, "{line}");
+    for key in ["node_cache_hit_rate", "tri_cache_hit_rate", "mem_busy", "memory_stall_fraction"] {
+        let v = line[key].as_f64().unwrap();
+        assert!(v > 0.0 && v < 1.0, "{key} = {v}: {line}");
+    }
+    // Every burst is a 128-byte line of 16 beats.
+    let (reads, bytes) = (line["mem_reads_per_ray"].as_f64().unwrap(), line["mem_bytes_per_ray"].as_f64().unwrap());
+    assert!((bytes - 128.0 * reads).abs() < 1e-6 && bytes > 0.0, "{line}");
+    let o = fxrt(&[&base[..], &[chip_ids.to_str().unwrap(), "--memory", "auto", "--ray-order", "tiles"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((line["memory"].as_str(), line["ray_order"].as_str()), (Some("onchip"), Some("tiles")), "{line}");
+    assert_eq!(line["all_pixels_match"], true, "{line}");
+    assert_eq!(std::fs::read(&ext_ids).unwrap(), std::fs::read(&chip_ids).unwrap());
+}
