@@ -37,6 +37,20 @@ module {{ tb }};
 {%- for p in outputs %}
   wire {{ p.decl }} {{ p.name }};
 {%- endfor %}
+{%- if !mem_inputs.is_empty() %}
+  // The scene in external memory: the memory model ({{ mem_model }}.v, the same beats on the
+  // same clocks as fxrt's Rust one) behind the core's AXI4 read port, the image at {{ mem_base }}.
+{%- for p in mem_inputs %}
+  wire {{ p.decl }} {{ p.name }};
+{%- endfor %}
+  assign mem_base = {{ mem_base }};
+  assign m_axi_rresp = 2'b00;
+  {{ mem_model }} mem (
+    .clk(clk), .rst(rst), .arvalid(m_axi_arvalid), .araddr(m_axi_araddr), .arlen(m_axi_arlen),
+    .rready(m_axi_rready), .arready(m_axi_arready), .rvalid(m_axi_rvalid), .rdata(m_axi_rdata),
+    .rlast(m_axi_rlast)
+  );
+{%- endif %}
   reg [{{ ray_width - 1 }}:0] ray_words [0:{{ count - 1 }}];
   reg [{{ result_width }}:0] expected_words [0:{{ ids - 1 }}];
   reg seen [0:{{ ids - 1 }}];
@@ -57,6 +71,7 @@ module {{ tb }};
     .rst(rst){% endif %},
     .ray_valid(ray_valid){% if has_res_ready %},
     .res_ready(res_ready){% endif %}{% for p in inputs %},
+    .{{ p.name }}({{ p.name }}){% endfor %}{% for p in mem_inputs %},
     .{{ p.name }}({{ p.name }}){% endfor %}{% for p in outputs %},
     .{{ p.name }}({{ p.name }}){% endfor %}
   );

@@ -44,13 +44,30 @@ architecture sim of {{ tb }} is
 {%- for p in outputs %}
   signal {{ p.name }} : {{ p.vtype }};
 {%- endfor %}
+{%- for p in mem_inputs %}
+  signal {{ p.name }} : {{ p.vtype }};
+{%- endfor %}
 begin
+{%- if !mem_inputs.is_empty() %}
+  -- The scene in external memory: the memory model ({{ mem_model }}.vhd, the same beats on
+  -- the same clocks as fxrt's Rust one) behind the core's AXI4 read port, the image at byte
+  -- address {{ mem_base }}.
+  mem_base <= "{{ mem_base_bits }}";
+  m_axi_rresp <= "00";
+  mem : entity work.{{ mem_model }}
+    port map (
+      clk => clk, rst => rst, arvalid => m_axi_arvalid, araddr => m_axi_araddr, arlen => m_axi_arlen,
+      rready => m_axi_rready, arready => m_axi_arready, rvalid => m_axi_rvalid, rdata => m_axi_rdata,
+      rlast => m_axi_rlast
+    );
+{%- endif %}
   dut : entity work.{{ module }}
     port map (
       clk => clk{% if has_reset %},
       rst => rst{% endif %},
       ray_valid => ray_valid{% if has_res_ready %},
       res_ready => res_ready{% endif %}{% for p in inputs %},
+      {{ p.name }} => {{ p.name }}{% endfor %}{% for p in mem_inputs %},
       {{ p.name }} => {{ p.name }}{% endfor %}{% for p in outputs %},
       {{ p.name }} => {{ p.name }}{% endfor %}
     );

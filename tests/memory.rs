@@ -101,3 +101,43 @@ fn the_memory_model_is_the_same_in_every_simulator() {
         }
     }
 }
+
+/// An external-memory core (the Cornell box, tiny caches, the memory slow and pausing) in every
+/// HDL simulator with the testbench's memory model: every result right (the testbench checks
+/// each against the golden model) and the result stream the Rust simulator's, in order and on
+/// the same clock count.
+#[test]
+fn external_memory_cores_run_alike_in_every_simulator() {
+    use fxrt::cores::memory_params::MemorySpec;
+    use fxrt::cores::top::{CoreParams, CoreSpec};
+    use fxrt::model::camera::Camera;
+    use fxrt::params::Params;
+    use fxrt::scene::images::SceneRoms;
+    use fxrt::scene::memory::SceneImage;
+    use fxrt::scene::{Scene, SceneSource};
+    use fxrt::verify::feed::Stalls;
+    use fxrt::verify::frame::{frame_rays, frame_stream, mismatches, run_stream};
+    use fxrt::verify::frame_memory::simulate_external;
+    let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() }).unwrap();
+    let roms = SceneRoms::of(&scene);
+    let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 5));
+    let spec = MemorySpec { node_cache_kb: 1, tri_cache_kb: 1, ..MemorySpec::default() };
+    let p = CoreParams::external(&roms, &CoreSpec { id_width: 8, slots: 8, ..CoreSpec::default() }, spec).unwrap();
+    let timing = MemoryTiming { latency: 60, extra_delay: 20, pause_in_256: 70, seed: 5, ..MemoryTiming::default() };
+    let image = SceneImage::build(&roms, spec.shape).unwrap();
+    let (want, stats, _) = simulate_external(&p, &roms, &image, &rays, timing, &|_| ());
+    assert_eq!(mismatches(&scene, &rays, &want), 0);
+    let mut stream = frame_stream(&p, &scene, &rays, &Stalls::none()).unwrap();
+    stream.memory = Some((timing, image.bytes.clone()));
+    for sim in Simulator::ALL.into_iter().chain([Simulator::IverilogSv]) {
+        if !sim.available() {
+            let _ = writeln!(std::io::stderr().lock(), "skipped: {} is not installed", sim.name());
+            continue;
+        }
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("memory_core_{}", sim.name()));
+        let (got, hdl) = run_stream(sim, &stream, &dir).unwrap_or_else(|e| panic!("{}: {e}", sim.name()));
+        eprintln!("{}: {} cycles (Rust {})", sim.name(), hdl.cycles, stats.cycles);
+        assert_eq!(got, want, "{}: the result stream", sim.name());
+        assert_eq!((hdl.cycles, hdl.busy_cycles), (stats.cycles, stats.busy_cycles), "{}", sim.name());
+    }
+}

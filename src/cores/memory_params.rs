@@ -104,7 +104,8 @@ impl ExternalMemory {
                 data_bits: spec.shape.mem_bits,
                 sets: sets as u32,
                 ways: spec.ways,
-                line_bits: addr_bits(lines as usize),
+                // At least the set bits: a scene smaller than the cache still indexes every set.
+                line_bits: addr_bits(lines as usize).max(sets.trailing_zeros()),
                 inflight: INFLIGHT,
             })
         };

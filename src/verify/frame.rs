@@ -346,6 +346,9 @@ pub struct FrameStream {
     pub max_cycles: u64,
     /// The core's ray slots (for the occupancy figure).
     pub slots: u64,
+    /// With an external-memory core: the memory model's timing and the scene image it serves
+    /// (at `frame_memory::SIM_BASE`).
+    pub memory: Option<(crate::verify::memory::MemoryTiming, Vec<u8>)>,
 }
 
 /// The stream testbench's data for `rays` (in feed order) through the core.
@@ -369,6 +372,13 @@ pub fn frame_stream(p: &CoreParams, scene: &Scene, rays: &[PixelRay], stalls: &S
     let max_cycles =
         ((100_000 + 100 * stalls.per_period() as u64) * rays.len() as u64 + 10_000).min(i32::MAX as u64 - 1);
     let (sink, resets) = (Stalls::none(), Vec::new());
+    let memory = match &p.mem {
+        Some(m) => Some((
+            crate::verify::memory::MemoryTiming::default(),
+            crate::scene::memory::SceneImage::build(&roms, m.spec.shape)?.bytes,
+        )),
+        None => None,
+    };
     Ok(FrameStream {
         core,
         rays: inputs,
@@ -378,6 +388,7 @@ pub fn frame_stream(p: &CoreParams, scene: &Scene, rays: &[PixelRay], stalls: &S
         resets,
         max_cycles,
         slots: p.slot_count() as u64,
+        memory,
     })
 }
 
@@ -418,12 +429,22 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
         sink: sink_bits.as_deref(),
         resets: &s.resets,
         max_cycles: s.max_cycles,
+        mem_base: s.memory.as_ref().map(|_| crate::verify::frame_memory::SIM_BASE),
     };
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let mut files = crate::io::OutputSet::new();
     files.extend(stream_files(m, &stream, sim).into_iter().map(|(file, text)| (dir.join(file), text)))?;
+    let mut extra = Vec::new();
+    if let Some((timing, image)) = &s.memory {
+        let addr_bits = m.inputs.iter().find(|&&i| m.sig(i).name == "mem_base").map_or(32, |&i| m.sig(i).ty.width);
+        let data_bits = m.inputs.iter().find(|&&i| m.sig(i).name == "m_axi_rdata").map_or(64, |&i| m.sig(i).ty.width);
+        let base = crate::verify::frame_memory::SIM_BASE;
+        let model = crate::verify::memory_hdl::model_files(timing, data_bits, addr_bits, base, image, sim == Simulator::Ghdl);
+        files.extend(model.into_iter().map(|(file, text)| (dir.join(file), text)))?;
+        extra.push(crate::verify::memory_hdl::MODEL);
+    }
     files.commit()?;
-    let (_, out) = sim.run_bench(dir, m, Bench::Stream).map_err(|e| Error::new(sim.name(), e))?;
+    let (_, out) = sim.run_bench_with(dir, m, Bench::Stream, &extra).map_err(|e| Error::new(sim.name(), e))?;
     let text = std::fs::read_to_string(dir.join("results.txt")).map_err(io)?;
     let rows = parse_results(m, &RESULT_PORTS, &text).map_err(|e| Error::file(&dir.join("results.txt"), e))?;
     let results = rows.iter().map(|r| core_result(r)).collect();

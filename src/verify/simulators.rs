@@ -63,8 +63,21 @@ impl Simulator {
     /// Runs the testbench of kind `bench` (its files already in `dir`); also returns the
     /// simulator's whole output, for the lines a stream testbench prints.
     pub fn run_bench(self, dir: &Path, m: &Module, bench: Bench) -> Result<(RunResult, String), String> {
+        self.run_bench_with(dir, m, bench, &[])
+    }
+
+    /// `run_bench` with more design units compiled before the testbench (`extra`: module names
+    /// whose files are in `dir`, e.g. the memory model).
+    pub fn run_bench_with(
+        self,
+        dir: &Path,
+        m: &Module,
+        bench: Bench,
+        extra: &[&str],
+    ) -> Result<(RunResult, String), String> {
         let ext = if self == Simulator::Ghdl { "vhd" } else { "v" };
-        let design: Vec<String> = m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
+        let mut design: Vec<String> = m.hierarchy().iter().map(|x| format!("{}.{ext}", x.name)).collect();
+        design.extend(extra.iter().map(|x| format!("{x}.{ext}")));
         let tb = tb_name(m);
         let words = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<String>>();
         let steps: Vec<Vec<String>> = match self {

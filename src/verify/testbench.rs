@@ -92,6 +92,18 @@ struct StreamTb<'a> {
     /// Cycles with `rst` high for one clock.
     resets: &'a [u64],
     max_cycles: u64,
+    /// An external-memory core's memory inputs (driven by the memory model `mem_model`), and
+    /// the image's base address as a Verilog literal and as VHDL bits.
+    mem_inputs: &'a [Port],
+    mem_model: &'a str,
+    mem_base: String,
+    mem_base_bits: String,
+}
+
+/// Whether an input is one of an external-memory core's memory inputs (the testbench's memory
+/// model drives them).
+fn is_memory_input(name: &str) -> bool {
+    name == "mem_base" || name.starts_with("m_axi_")
 }
 
 /// A stream testbench's data: the inputs of each ray (every input port but `ray_valid`, in
@@ -114,6 +126,9 @@ pub struct Stream<'a> {
     /// being right, not for being complete; `results.txt` holds those after the last reset).
     pub resets: &'a [u64],
     pub max_cycles: u64,
+    /// With an external-memory core: the image's base address (`mem_base`; the memory model's
+    /// files are the caller's, `verify::memory_hdl::model_files`).
+    pub mem_base: Option<u64>,
 }
 
 /// The stream testbench for GHDL (VHDL) or Icarus/Verilator (Verilog), with its data files
@@ -125,8 +140,15 @@ pub struct Stream<'a> {
 /// for an unknown id, a second result for an id and an id without result each fail) and
 /// writes `results.txt`, one line of checked outputs per result, in arrival order.
 pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, String)> {
-    let in_ids: Vec<(String, SigId)> =
-        input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid" && n != "res_ready").collect();
+    let in_ids: Vec<(String, SigId)> = input_ids(m)
+        .into_iter()
+        .filter(|(n, _)| n != "ray_valid" && n != "res_ready" && !is_memory_input(n))
+        .collect();
+    let mem_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| is_memory_input(n)).collect();
+    let (mem_inputs, _) = ports(m, &mem_ids, 0);
+    assert_eq!(mem_inputs.is_empty(), s.mem_base.is_none(), "a memory model for an external-memory core alone");
+    let base = s.mem_base.unwrap_or(0);
+    let base_width = mem_inputs.iter().find(|p| p.name == "mem_base").map_or(1, |p| p.width);
     let has_res_ready = input_ids(m).iter().any(|(n, _)| n == "res_ready");
     let checked_ids: Vec<(String, SigId)> =
         s.checked.iter().map(|c| m.outputs.iter().find(|o| o.0 == *c).expect("checked output").clone()).collect();
@@ -190,6 +212,10 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
         sink_period: s.sink.map_or(0, |b| b.len()),
         resets: s.resets,
         max_cycles: s.max_cycles,
+        mem_inputs: &mem_inputs,
+        mem_model: super::memory_hdl::MODEL,
+        mem_base: format!("{base_width}'h{base:x}"),
+        mem_base_bits: (0..base_width).rev().map(|k| if (base >> k.min(63)) & 1 == 1 && k < 64 { '1' } else { '0' }).collect(),
     }
     .render();
     files.push((format!("tb.{}", ext(vhdl)), text.expect("testbench template renders") + "\n"));
