@@ -197,7 +197,7 @@ fn external_memory_options_are_checked() {
         (&["--cache-line", "96"][..], "cache-line", "power of two"),
         (&["--mem-bits", "48"][..], "mem-bits", "32, 64, 128"),
         (&["--tri-cache-kb", "1024", "--bram-kbits", "4000"][..], "bram-kbits", "caches"),
-        (&["--sim", "ghdl"][..], "memory", "Rust simulator"),
+        (&["--raygen", "--eye", "0,1,0", "--at", "1,1,0"][..], "memory", "host rays"),
         (&["--ray-order", "tiles", "--shuffle-seed", "3"][..], "ray-order", "shuffle"),
     ] {
         let args = sim(extra);

@@ -419,6 +419,17 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             memory_stats = Some(ms);
             (results, stats)
         }
+        (Simulation::Hdl(sim), Some(dir), None) if p.mem.is_some() => {
+            if !sim.available() {
+                return Err(crate::error::Error::new(sim.name(), "is not installed (scripts/install-deps.sh installs it)"));
+            }
+            // The testbench's memory model, with this run's timing.
+            let mut stream = frame::frame_stream(&p, &scene, &rays, &stalls)?;
+            if let Some((timing, _)) = stream.memory.as_mut() {
+                *timing = c.mem_timing;
+            }
+            frame::run_stream(sim, &stream, dir)?
+        }
         (Simulation::Hdl(sim), Some(dir), None) => frame::simulate_hdl(sim, &p, &scene, &rays, &stalls, dir)?,
         _ => {
             let bar = frame::progress_bar(rays.len() as u64, "rust");
@@ -485,7 +496,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
 }
 
 /// The core `fxrt sim` runs: `p` (on chip) unless `--memory external`, or `auto` and its ROMs do
-/// not fit `--bram-kbits`; an external-memory core runs in the Rust simulator with host rays.
+/// not fit `--bram-kbits`; an external-memory core runs with host rays.
 fn external_core(
     c: &SimConfig,
     roms: &SceneRoms,
@@ -501,11 +512,8 @@ fn external_core(
     if !external {
         return Ok(p);
     }
-    if c.sim != Simulation::Rust || c.raygen {
-        return Err(crate::error::Error::param(
-            "memory",
-            "an external-memory core runs in the Rust simulator with host rays (--sim rust, no --raygen)",
-        ));
+    if c.raygen {
+        return Err(crate::error::Error::param("memory", "an external-memory core runs with host rays (no --raygen)"));
     }
     let p = crate::cores::top::CoreParams::external(roms, shape, c.mem_spec)?;
     p.check_device(roms, c.bram_kbits)?;
