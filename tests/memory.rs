@@ -118,7 +118,8 @@ fn external_memory_cores_run_alike_in_every_simulator() {
     use fxrt::verify::feed::Stalls;
     use fxrt::verify::frame::{frame_rays, frame_stream, mismatches, run_stream};
     use fxrt::verify::frame_memory::simulate_external;
-    let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() }).unwrap();
+    let scene =
+        Scene::load(&SceneSource::Builtin("cornell".into()), &Params { n: 16, m: 16, ..Params::default() }).unwrap();
     let roms = SceneRoms::of(&scene);
     let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 5));
     let spec = MemorySpec { node_cache_kb: 1, tri_cache_kb: 1, ..MemorySpec::default() };

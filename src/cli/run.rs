@@ -388,7 +388,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             let golden = Golden::new(&scene);
             (0..w * h).map(|i| frame::PixelRay { pixel: i, ray: g.ray(&golden, i % w, i / w) }).collect()
         }
-        None if c.tiles => feed::tile_order(&frame::frame_rays(&scene, &cam), w, 8),
+        None if c.tiles => feed::tile_order(&frame::frame_rays(&scene, &cam), |r| r.pixel, w, 8),
         // Shuffled (or not) here, once: every simulator feeds the rays in this order.
         None => feed::feed_order(&frame::frame_rays(&scene, &cam), c.shuffle_seed),
     };
@@ -421,7 +421,10 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         }
         (Simulation::Hdl(sim), Some(dir), None) if p.mem.is_some() => {
             if !sim.available() {
-                return Err(crate::error::Error::new(sim.name(), "is not installed (scripts/install-deps.sh installs it)"));
+                return Err(crate::error::Error::new(
+                    sim.name(),
+                    "is not installed (scripts/install-deps.sh installs it)",
+                ));
             }
             // The testbench's memory model, with this run's timing.
             let mut stream = frame::frame_stream(&p, &scene, &rays, &stalls)?;

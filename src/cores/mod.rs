@@ -24,6 +24,7 @@ pub mod result_queue;
 pub mod top;
 pub mod top_memory;
 pub mod traverse;
+mod traverse_decide;
 mod traverse_retry;
 mod traverse_stages;
 pub mod tri_fetch;

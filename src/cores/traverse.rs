@@ -33,10 +33,11 @@
 //! distance comes in through the new-ray queue (`new_*`). A slot is freed by the top when the
 //! ray's result has left the core (`free_*`), so a slot's best hit is never read after reuse.
 
-use super::fifo::fifo;
-use super::traverse_stages::Unit;
+use super::fifo::{Fifo, fifo};
+use super::traverse_stages::{RingN, Slots, Unit};
 use crate::rtl::Module;
 use crate::rtl::build::Builder;
+use crate::rtl::build::S;
 
 pub use super::traverse_stages::{TraverseParams, field, word_bits};
 
@@ -78,4 +79,39 @@ pub fn traverse_core(p: &TraverseParams) -> Module {
         None => u.outputs(&slots, c.node, &n, &done),
     }
     b.finish()
+}
+
+impl<'b> Unit<'b> {
+    /// The output ports (see `traverse_core`).
+    pub(super) fn outputs(&self, slots: &Slots<'b>, node_addr: S<'b>, nn: &RingN<'b>, done: &Fifo<'b>) {
+        let (b, p, nt) = (self.b, self.p, nn.token);
+        b.output("node_addr", node_addr);
+        b.output("has_free", (slots.free_any & !slots.just_alloc).name("has_free_c"));
+        b.output("free_slot_out", slots.free_idx);
+        let lh = nn.leafq.head;
+        let mut at = 0;
+        let mut take = |w: u32| {
+            let s = lh.slice(at, w);
+            at += w;
+            s
+        };
+        let count_w = p.node_layout.field("count").width;
+        let leaf_bits = self.leaf_bits;
+        let (l_sp, l_tmin, l_count, l_first, l_slot) =
+            (take(self.spw), take(p.tmin_width()), take(count_w), take(leaf_bits), take(self.sb));
+        b.output("leaf_valid", nn.leafq.nonempty);
+        b.output("leaf_slot", l_slot);
+        b.output("leaf_first", l_first);
+        b.output("leaf_count", l_count);
+        b.output("leaf_tmin", l_tmin);
+        b.output("leaf_sp", l_sp);
+        b.output("done_valid", done.nonempty);
+        b.output("done_slot", done.head);
+        b.output("visit", nn.visit);
+        b.output("visit_slot", nt.slot);
+        b.output("visit_node", nt.node);
+        b.output("cull", (nt.valid & nn.culled).name("cull_c"));
+        b.output("depth", nt.sp);
+        b.output("occupied", slots.occupied);
+    }
 }

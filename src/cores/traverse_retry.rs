@@ -13,25 +13,9 @@
 
 use super::cache::{SEQ_BITS, released};
 use super::fifo::fifo;
-use super::traverse_stages::{NodeAnswer, Token, Unit};
+use super::traverse_stages::{NodeAnswer, RetryQueue, Token, Unit};
 use crate::rtl::Ty;
 use crate::rtl::build::S;
-
-/// The retry queue: its head (when `ready`: its fill is in) and its ports.
-#[derive(Clone, Copy)]
-pub(super) struct RetryQueue<'b> {
-    pub(super) ready: S<'b>,
-    /// Driven by the queues' arbiter: the head goes into the ring.
-    pub(super) pop: S<'b>,
-    pub(super) slot: S<'b>,
-    pub(super) node: S<'b>,
-    pub(super) tmin: S<'b>,
-    pub(super) tmax: S<'b>,
-    pub(super) sp: S<'b>,
-    /// Driven in N (`retry_push`): a node step that missed, and its entry.
-    pub(super) push: S<'b>,
-    pub(super) entry: S<'b>,
-}
 
 impl<'b> Unit<'b> {
     /// Entry bits, most significant first: slot, node, tmin, tmax, sp, the fill to wait for.

@@ -23,15 +23,15 @@ pub fn feed_order<T: Clone>(rays: &[T], seed: Option<u64>) -> Vec<T> {
     v
 }
 
-/// The rays of a `width`-pixel-wide frame (`PixelRay`s in any order) in tiles of `tile` ×
+/// The rays of a `width`-pixel-wide frame (in any order; `pixel` gives a ray's pixel number) in tiles of `tile` ×
 /// `tile` pixels, tile rows top to bottom, tiles left to right, pixel order within a tile: rays
 /// that follow each other walk nearby nodes and triangles (what the caches of an
 /// external-memory core live on, docs/MEMORY.md).
-pub fn tile_order(rays: &[super::frame::PixelRay], width: u32, tile: u32) -> Vec<super::frame::PixelRay> {
+pub fn tile_order<T: Clone>(rays: &[T], pixel: impl Fn(&T) -> u32, width: u32, tile: u32) -> Vec<T> {
     let mut v = rays.to_vec();
     let tile = tile.max(1);
     v.sort_by_key(|r| {
-        let (x, y) = (r.pixel % width, r.pixel / width);
+        let (x, y) = (pixel(r) % width, pixel(r) / width);
         (y / tile, x / tile, y % tile, x % tile)
     });
     v

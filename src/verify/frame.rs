@@ -429,7 +429,7 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
         sink: sink_bits.as_deref(),
         resets: &s.resets,
         max_cycles: s.max_cycles,
-        mem_base: s.memory.as_ref().map(|_| crate::verify::frame_memory::SIM_BASE),
+        mem_base: s.memory.as_ref().map(|_| crate::verify::memory::SIM_BASE),
     };
     let io = |e: std::io::Error| Error::file(dir, e.to_string());
     let mut files = crate::io::OutputSet::new();
@@ -438,8 +438,9 @@ pub fn run_stream(sim: Simulator, s: &FrameStream, dir: &Path) -> Result<(Vec<Co
     if let Some((timing, image)) = &s.memory {
         let addr_bits = m.inputs.iter().find(|&&i| m.sig(i).name == "mem_base").map_or(32, |&i| m.sig(i).ty.width);
         let data_bits = m.inputs.iter().find(|&&i| m.sig(i).name == "m_axi_rdata").map_or(64, |&i| m.sig(i).ty.width);
-        let base = crate::verify::frame_memory::SIM_BASE;
-        let model = crate::verify::memory_hdl::model_files(timing, data_bits, addr_bits, base, image, sim == Simulator::Ghdl);
+        let base = crate::verify::memory::SIM_BASE;
+        let model =
+            crate::verify::memory_hdl::model_files(timing, data_bits, addr_bits, base, image, sim == Simulator::Ghdl);
         files.extend(model.into_iter().map(|(file, text)| (dir.join(file), text)))?;
         extra.push(crate::verify::memory_hdl::MODEL);
     }

@@ -3,7 +3,7 @@
 //! the same rays and checks as `verify::frame`, and what the memory side did (`MemoryStats`).
 
 use super::frame::{CoreResult, CoreStats, OBSERVED, RESULT_PORTS, core_result, port};
-use super::memory::{MasterOut, MemoryModel, MemoryTiming};
+use super::memory::{MasterOut, MemoryModel, MemoryTiming, SIM_BASE};
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
 use crate::cores::top_memory::memory_inputs;
 use crate::rtl::sim::Sim;
@@ -11,10 +11,6 @@ use crate::scene::images::SceneRoms;
 use crate::scene::memory::SceneImage;
 use crate::verify::frame::PixelRay;
 use serde::Serialize;
-
-/// The byte address the simulations put the scene image at (`mem_base`): not 0, so a core that
-/// forgot the base reads the wrong bytes.
-pub const SIM_BASE: u64 = 0x10_0000;
 
 /// Observation ports of an external-memory core, in `MemoryStats::count` order.
 pub const MEMORY_OBSERVED: [&str; 6] = ["node_looks", "node_hits", "tri_looks", "tri_hits", "mem_beat", "mem_stall"];

@@ -38,6 +38,10 @@ impl Default for MemoryTiming {
 }
 
 pub const DEFAULT_LATENCY: u32 = 40;
+
+/// The byte address the simulations put the scene image at (`mem_base`): not 0, so a core that
+/// forgot the base reads the wrong bytes.
+pub const SIM_BASE: u64 = 0x10_0000;
 pub const DEFAULT_OUTSTANDING: u32 = 16;
 /// The longest latency `--mem-latency` takes.
 pub const MAX_LATENCY: u32 = 1000;

@@ -140,10 +140,8 @@ pub struct Stream<'a> {
 /// for an unknown id, a second result for an id and an id without result each fail) and
 /// writes `results.txt`, one line of checked outputs per result, in arrival order.
 pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, String)> {
-    let in_ids: Vec<(String, SigId)> = input_ids(m)
-        .into_iter()
-        .filter(|(n, _)| n != "ray_valid" && n != "res_ready" && !is_memory_input(n))
-        .collect();
+    let in_ids: Vec<(String, SigId)> =
+        input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid" && n != "res_ready" && !is_memory_input(n)).collect();
     let mem_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| is_memory_input(n)).collect();
     let (mem_inputs, _) = ports(m, &mem_ids, 0);
     assert_eq!(mem_inputs.is_empty(), s.mem_base.is_none(), "a memory model for an external-memory core alone");
@@ -215,7 +213,10 @@ pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, Stri
         mem_inputs: &mem_inputs,
         mem_model: super::memory_hdl::MODEL,
         mem_base: format!("{base_width}'h{base:x}"),
-        mem_base_bits: (0..base_width).rev().map(|k| if (base >> k.min(63)) & 1 == 1 && k < 64 { '1' } else { '0' }).collect(),
+        mem_base_bits: (0..base_width)
+            .rev()
+            .map(|k| if (base >> k.min(63)) & 1 == 1 && k < 64 { '1' } else { '0' })
+            .collect(),
     }
     .render();
     files.push((format!("tb.{}", ext(vhdl)), text.expect("testbench template renders") + "\n"));

@@ -1,0 +1,103 @@
+//! The traversal unit's last stages (`traverse.rs` says what the unit does): from N to F the
+//! token rides along while the limits of `bih::inner_step`'s decision are made; in F the two
+//! plane distances are compared by their roles; in G the decision pushes, enters or pops.
+
+use super::lt_chain;
+use super::traverse_stages::{Returning, RingF, RingN, Token, Unit};
+use crate::rtl::build::S;
+
+impl<'b> Unit<'b> {
+    /// N → F: the token rides along; the limits are made on the way (as `inner_step`'s
+    /// compares, every one a strict less-than; when tmin > tmax no distance passes any limit).
+    /// F: both distances arrive and are compared by their roles, registered for G.
+    pub(super) fn ring_f(&self, nn: &RingN<'b>) -> RingF<'b> {
+        let (b, n, l, nt, axis1, negative) = (self.b, self.p.n, nn.plane_latency, nn.token, nn.axis1, nn.negative);
+        b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
+        let ring = (nt.valid & !nn.leaves).name("n_stays");
+        let f_valid = b.valid_line("f_valid", ring, l);
+        let f_inner = b.delay_line("f_inner", nn.is_inner, l);
+        let f_slot = b.delay_line("f_slot", nt.slot, l);
+        let f_tmin = b.delay_line("f_tmin", nt.tmin, l);
+        let f_tmax = b.delay_line("f_tmax", nt.tmax, l);
+        let f_sp = b.delay_line("f_sp", nt.sp, l);
+        let f_child = b.delay_line("f_child", nn.child, l);
+        let neg1 = b.delay("negative_n1", b.pick(axis1, nn.inv).msb());
+        let (tmin1, tmax1) = (b.delay("tmin_n1", nt.tmin), b.delay("tmax_n1", nt.tmax));
+        let tmax_p1 = b.delay("tmax_p1", (nt.tmax + 1).name("tmax_plus_1"));
+        let tmin_m1 = b.delay("tmin_m1", (nt.tmin - 1).name("tmin_minus_1"));
+        let tmin_le_tmax = b.delay("tmin_le_tmax", lt_chain(tmin1, tmax_p1).name("tmin_le_tmax_c"));
+        let (tmin2, tmax2, tmax_p1_2, tmin_m1_2) = (
+            b.delay("tmin_n2", tmin1),
+            b.delay("tmax_n2", tmax1),
+            b.delay("tmax_p1_n2", tmax_p1),
+            b.delay("tmin_m1_n2", tmin_m1),
+        );
+        let never_below = tmax2.k(-(1i128 << (n + 2)));
+        let never_above = tmax2.k((1i128 << (n + 2)) - 1);
+        let limit_reg = |name: &str, if_negative: S<'b>, if_positive: S<'b>, never: S<'b>| {
+            let x = tmin_le_tmax.select(neg1.select(if_negative, if_positive), never);
+            b.delay_line(name, b.delay(&format!("{name}_n3"), x.name(&format!("{name}_c"))), l - 3)
+        };
+        let d0_hi = limit_reg("d0_hi", tmax_p1_2, tmax2, never_below);
+        let d0_lo = limit_reg("d0_lo", tmin2, tmin_m1_2, never_above);
+        let d1_hi = limit_reg("d1_hi", tmax2, tmax_p1_2, never_below);
+        let d1_lo = limit_reg("d1_lo", tmin_m1_2, tmin2, never_above);
+
+        // F: the compares, registered by role for G.
+        let [d0, d1] = nn.plane_t;
+        let d0_below = lt_chain(d0, d0_hi).name("d0_below");
+        let d0_above = lt_chain(d0_lo, d0).name("d0_above");
+        let d1_below = lt_chain(d1, d1_hi).name("d1_below");
+        let d1_above = lt_chain(d1_lo, d1).name("d1_above");
+        let reg = |name: &str, if_negative: S<'b>, if_positive: S<'b>| {
+            b.delay(name, negative.select(if_negative, if_positive).name(&format!("{name}_c")))
+        };
+        let near_lt_tmax = reg("near_lt_tmax", d1_below, d0_below);
+        let far_gt_tmin = reg("far_gt_tmin", d0_above, d1_above);
+        let go_near = reg("go_near", d1_above, d0_above);
+        let go_far = reg("go_far", d0_below, d1_below);
+        let near_end = b.delay("near_end", negative.select(d1, d0));
+        let far_start = b.delay("far_start", negative.select(d0, d1));
+        let g = Token {
+            valid: b.valid_delay("g_valid", f_valid),
+            slot: b.delay("g_slot", f_slot),
+            node: b.delay("g_child", f_child),
+            tmin: b.delay("g_tmin", f_tmin),
+            tmax: b.delay("g_tmax", f_tmax),
+            sp: b.delay("g_sp", f_sp),
+        };
+        let inner = b.delay("g_inner", f_inner);
+        let negative = b.delay("g_negative", negative);
+        RingF { g, inner, negative, near_lt_tmax, far_gt_tmin, go_near, go_far, near_end, far_start }
+    }
+
+    /// G: the decision: push the far child (stack[slot][sp]) and enter the near one, enter one
+    /// child, or pop. The token goes into R and is back at A in the next cycle.
+    pub(super) fn ring_g(&self, f: &RingF<'b>, r: &Returning<'b>, push: &[S<'b>; 3], ring_g_valid: S<'b>) {
+        let (b, g, node_bits) = (self.b, f.g, self.node_bits);
+        b.stage("ring_g", "G: the decision: push the far child and enter the near one, enter one, or pop");
+        b.drive(ring_g_valid, g.valid);
+        let child_b = g.node + 1;
+        let near = f.negative.select(child_b, g.node).resize(node_bits).name("near");
+        let far = f.negative.select(g.node, child_b).resize(node_bits).name("far");
+        let near_max = f.near_lt_tmax.select(f.near_end, g.tmax).name("near_max");
+        let far_min = f.far_gt_tmin.select(f.far_start, g.tmin).name("far_min");
+        let (enter_near, enter_far) =
+            ((f.inner & f.go_near).name("enter_near"), (f.inner & !f.go_near & f.go_far).name("enter_far"));
+        let push_now = (enter_near & f.go_far).name("push");
+        let stack_bits = self.stack_bits;
+        b.drive(push[0], push_now);
+        b.drive(push[1], b.cat(&[g.slot, g.sp.resize(stack_bits)]));
+        b.drive(push[2], b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()]));
+        let rt = r.token;
+        b.next(rt.valid, g.valid);
+        b.next(r.pop, !(enter_near | enter_far));
+        b.next(rt.slot, g.slot);
+        b.next(rt.node, enter_near.select(near, far));
+        b.next(rt.tmin, enter_far.select(far_min, g.tmin));
+        b.next(rt.tmax, enter_near.select(near_max, g.tmax));
+        b.next(rt.sp, push_now.select(g.sp + 1, g.sp));
+        b.next(r.sp_zero, !push_now & g.sp.eq(0));
+        b.next(r.sp_m1, push_now.select(g.sp, g.sp - 1));
+    }
+}
