@@ -222,7 +222,7 @@ pub fn emission<'b>(
     leaf: &Leaf<'b>,
     rams: &RayRams,
 ) -> Emission<'b> {
-    let (tp, n, m, gb, scene_tag) = (&p.trav, p.isect.n, p.isect.m, p.tag.slot_bits, &p.trav.scene_tag);
+    let (tp, gb, scene_tag) = (&p.trav, p.tag.slot_bits, &p.trav.scene_tag);
     b.stage("emission", "the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline");
     let (leaf_l, leaf_words) = &scene.leaf;
     let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
@@ -250,22 +250,38 @@ pub fn emission<'b>(
     let tag_d = b.delay_line("pipe_tag", tag, trc);
     // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
     let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
-    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", rams.o, emit_slot), trc - 1);
+    into_pipeline(b, p, rams, emit_slot, trc, [valid_d, tag_d], tri_fields)
+}
+
+/// The intersection pipeline fed a triangle (`valid_tag`: its valid bit and tag, `tri_fields`:
+/// its fields) and the ray of global slot `slot`, read from the core's ray RAMs `clocks` clocks
+/// before the triangle enters (the RAM read and `clocks` − 1 registers).
+pub fn into_pipeline<'b>(
+    b: &'b Builder,
+    p: &CoreParams,
+    rams: &RayRams,
+    slot: S<'b>,
+    clocks: u32,
+    valid_tag: [S<'b>; 2],
+    tri_fields: Vec<S<'b>>,
+) -> Emission<'b> {
+    let (n, m) = (p.isect.n, p.isect.m);
+    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", rams.o, slot), clocks - 1);
     let w_words: Vec<S> = rams
         .w
         .iter()
         .enumerate()
         .map(|(k, &mem)| {
             let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
-            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, emit_slot), trc - 1)
+            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, slot), clocks - 1)
         })
         .collect();
-    let mut pipe_in = vec![valid_d, tag_d];
+    let mut pipe_in = valid_tag.to_vec();
     pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
     pipe_in.extend(
         (0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * m, m) } else { w_words[a as usize] }.signed()),
     );
     pipe_in.extend(tri_fields);
     let pipe = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
-    Emission { pipe, valid: valid_d }
+    Emission { pipe, valid: valid_tag[0] }
 }

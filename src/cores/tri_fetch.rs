@@ -20,13 +20,11 @@ use super::brom::bram;
 use super::cache::{Cache, LATENCY, Lookup, SEQ_BITS, cache, released};
 use super::core_params::CoreParams;
 use super::fifo::fifo;
-use super::intersect::intersect_core;
-use super::leaf_stream::{Emission, RayRams, leaf_buffers};
+use super::leaf_stream::{Emission, RayRams, into_pipeline, leaf_buffers};
 use super::memory_params::ExternalMemory;
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, Ports, S};
 use crate::scene::rom::Field;
-use std::rc::Rc;
 
 /// What the fetch shows the observation ports: triangle lookups and hits answered this clock,
 /// and a clock the pipeline took no triangle while a leaf waited for memory.
@@ -196,25 +194,9 @@ pub fn tri_fetch<'b>(
     let tag = b.delay_line("pipe_tag_leaf", b.cat(&[e_last_entry, e_first, e_slot, e_sp, e_tmin]), lat);
     let id = record_field(b, &parts, l.tri.field("id"));
     let tag = b.cat(&[tag, id.resize(tp.tri_bits)]).name("pipe_tag");
-    let o_word = b.delay("pipe_o", b.read("ray_o_q", rams.o, e_slot));
-    let w_words: Vec<S> = rams
-        .w
-        .iter()
-        .enumerate()
-        .map(|(k, &mem)| {
-            let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
-            b.delay(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, e_slot))
-        })
-        .collect();
-    let (n, mw) = (p.isect.n, p.isect.m);
-    let mut pipe_in = vec![valid_d, tag];
-    pipe_in.extend((0..3).map(|a| o_word.slice(a * n, n)));
-    pipe_in.extend(
-        (0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * mw, mw) } else { w_words[a as usize] }.signed()),
-    );
-    pipe_in.extend(l.tri.fields.iter().filter(|f| f.name != "id").map(|f| record_field(b, &parts, f)));
-    let pipe = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
+    let fields = l.tri.fields.iter().filter(|f| f.name != "id").map(|f| record_field(b, &parts, f)).collect();
+    let emitted = into_pipeline(b, p, rams, e_slot, lat, [valid_d, tag], fields);
     let stall = b.delay("mem_stall", (!valid_d & retry.nonempty).name("mem_stall_c"));
     let observed = FetchObserved { looks: av, hits: (av & answer.hit).name("tri_hit"), stall };
-    (Emission { pipe, valid: valid_d }, observed)
+    (emitted, observed)
 }
