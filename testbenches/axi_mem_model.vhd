@@ -36,29 +36,31 @@ begin
   serve : process (clk)
     type image_t is array (0 to {{ depth - 1 }}) of unsigned({{ data_bits - 1 }} downto 0);
     type naturals is array (0 to {{ outstanding - 1 }}) of natural;
-    -- Loads the image once, when the process is elaborated.
-    impure function load return image_t is
-      file f : text open read_mode is "{{ image_bits }}";
-      variable l : line;
-      variable beat : bit_vector({{ data_bits - 1 }} downto 0);
-      variable im : image_t := (others => (others => '0'));
-      variable k : natural := 0;
-    begin
-      while not endfile(f) and k <= {{ depth - 1 }} loop
-        readline(f, l);
-        read(l, beat);
-        im(k) := unsigned(to_stdlogicvector(beat));
-        k := k + 1;
-      end loop;
-      return im;
-    end function;
-    variable image : image_t := load;
+    -- The image, read from the file in the process's first run (at time 0, before any edge):
+    -- loaded in place, not returned by a function, whose result would sit on the simulator's
+    -- stack (a 2.9-MB scene is 23 MB of std_logic).
+    file image_file : text open read_mode is "{{ image_bits }}";
+    variable image : image_t;
+    variable loaded : boolean := false;
+    variable l : line;
+    variable beat : bit_vector({{ data_bits - 1 }} downto 0);
     -- The bursts taken and not finished, oldest at q_head: first beat's index, beats, first clock.
     variable q_beat, q_beats, q_first : naturals := (others => 0);
     variable q_head, q_count, taken, tail, last, first, extra, clock_no : natural := 0;
     variable x : unsigned(31 downto 0) := to_unsigned({{ seed }}, 32);
     variable pending, pause : boolean;
   begin
+    if not loaded then
+      for k in 0 to {{ depth - 1 }} loop
+        image(k) := (others => '0');
+        if not endfile(image_file) then
+          readline(image_file, l);
+          read(l, beat);
+          image(k) := unsigned(to_stdlogicvector(beat));
+        end if;
+      end loop;
+      loaded := true;
+    end if;
     if rising_edge(clk) then
       if rst = '1' then
         -- AXI's ARESETn: bursts in flight are forgotten (the core forgets them too).
