@@ -629,3 +629,56 @@ fn sim_runs_external_memory_cores() {
     assert_eq!(line["all_pixels_match"], true, "{line}");
     assert_eq!(std::fs::read(&ext_ids).unwrap(), std::fs::read(&chip_ids).unwrap());
 }
+
+/// `fxrt gen --memory external`: the core with its AXI4 read port instead of scene ROMs, the
+/// image and its C header beside it (the same bytes as `fxrt scene` writes), the port's rules in
+/// the manifest, byte-identical across runs; `auto` goes external for a scene too large for
+/// `--bram-kbits`.
+#[test]
+fn gen_writes_external_memory_cores() {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, b, sc, auto] = ["a", "b", "scene", "auto"].map(|d| dir.path().join(d));
+    for out in [&a, &b] {
+        let o = fxrt(&["gen", "--builtin", "cornell", "--memory", "external", "--out", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let o = fxrt(&["scene", "--builtin", "cornell", "--out", sc.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(a.join("scene.bin")).unwrap(), std::fs::read(sc.join("scene.bin")).unwrap());
+    let names = |d: &std::path::Path| {
+        let mut v: Vec<String> =
+            std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        v.sort();
+        v
+    };
+    assert_eq!(names(&a), names(&b));
+    for f in names(&a) {
+        assert_eq!(std::fs::read(a.join(&f)).unwrap(), std::fs::read(b.join(&f)).unwrap(), "{f}");
+    }
+    assert!(!names(&a).iter().any(|f| f.contains("brom_node") || f.contains("_axis")), "{:?}", names(&a));
+    let json =
+        names(&a).into_iter().find(|f| f.starts_with("fxrt_core_") && f.ends_with("_ext.json")).expect("a manifest");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(a.join(json)).unwrap()).unwrap();
+    assert_eq!(doc["memory"]["axi4_read"]["arlen"], 15);
+    assert!(doc["memory"]["axi4_read"]["id"].as_str().unwrap().contains("in order"));
+    let verilog = names(&a).into_iter().find(|f| f.starts_with("fxrt_core_") && f.ends_with("_ext.v")).unwrap();
+    let text = std::fs::read_to_string(a.join(verilog)).unwrap();
+    for port in ["m_axi_araddr", "m_axi_arlen", "m_axi_rdata", "mem_base", "mem_error"] {
+        assert!(text.contains(port), "{port}");
+    }
+    // Too large for 2,000 Kb on chip: external, whose caches fit.
+    let o = fxrt(&["gen", "--builtin", "teapot", "--bram-kbits", "2000", "--out", auto.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("external memory") && auto.join("scene.bin").exists());
+    let o = fxrt(&[
+        "gen",
+        "--builtin",
+        "cornell",
+        "--memory",
+        "external",
+        "--raygen",
+        "--out",
+        dir.path().join("r").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

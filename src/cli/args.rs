@@ -174,9 +174,9 @@ pub enum RayOrder {
     Tiles,
 }
 
-/// An external-memory core's options and its memory model's (docs/MEMORY.md).
+/// Where a core keeps its scene and, external, its caches (docs/MEMORY.md).
 #[derive(Args, Debug, Clone)]
-pub struct ExternalArgs {
+pub struct CoreMemoryArgs {
     /// Where the scene lives: onchip, external or auto (on chip when it fits --bram-kbits).
     #[arg(long, value_enum, default_value = "auto")]
     pub memory: MemoryPlace,
@@ -191,6 +191,25 @@ pub struct ExternalArgs {
     /// Ways of each cache: 1, 2 or 4.
     #[arg(long = "cache-ways", default_value_t = crate::cores::memory_params::DEFAULT_WAYS)]
     pub cache_ways: u32,
+}
+
+impl CoreMemoryArgs {
+    pub fn spec(&self) -> crate::error::Result<crate::cores::memory_params::MemorySpec> {
+        Ok(crate::cores::memory_params::MemorySpec {
+            shape: self.shape.shape()?,
+            node_cache_kb: self.node_cache_kb,
+            tri_cache_kb: self.tri_cache_kb,
+            ways: self.cache_ways,
+            ..Default::default()
+        })
+    }
+}
+
+/// An external-memory core's options and its memory model's (docs/MEMORY.md).
+#[derive(Args, Debug, Clone)]
+pub struct ExternalArgs {
+    #[command(flatten)]
+    pub core: CoreMemoryArgs,
     /// The memory model: clocks from an address to its first beat.
     #[arg(long = "mem-latency", default_value_t = crate::verify::memory::DEFAULT_LATENCY)]
     pub mem_latency: u32,
@@ -216,13 +235,7 @@ impl ExternalArgs {
     pub fn spec(
         &self,
     ) -> crate::error::Result<(crate::cores::memory_params::MemorySpec, crate::verify::memory::MemoryTiming)> {
-        let spec = crate::cores::memory_params::MemorySpec {
-            shape: self.shape.shape()?,
-            node_cache_kb: self.node_cache_kb,
-            tri_cache_kb: self.tri_cache_kb,
-            ways: self.cache_ways,
-            ..Default::default()
-        };
+        let spec = self.core.spec()?;
         let timing = crate::verify::memory::MemoryTiming {
             latency: self.mem_latency,
             outstanding: self.mem_outstanding,

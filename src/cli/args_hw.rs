@@ -253,6 +253,8 @@ pub struct GenArgs {
     /// Block RAM the ROMs may use, kilobits (default: the XC5VLX110T's 148 × 36 Kb).
     #[arg(long = "bram-kbits", default_value_t = 5328)]
     pub bram_kbits: u64,
+    #[command(flatten)]
+    pub memory: super::args::CoreMemoryArgs,
     /// Quotient bits per divider stage: 1 or 2.
     #[arg(long = "div-bits", default_value_t = 1)]
     pub div_bits: u32,

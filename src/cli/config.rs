@@ -270,6 +270,9 @@ pub struct GenConfig {
     pub axis_frame: Option<CameraSpec>,
     /// `--board`: the board design instead of the core's files (its camera in `scene`).
     pub board: Option<BoardConfig>,
+    /// Where the scene lives (`auto` decided by `bram_kbits`) and the external core's options.
+    pub memory: super::args::MemoryPlace,
+    pub mem_spec: crate::cores::memory_params::MemorySpec,
 }
 
 impl GenConfig {
@@ -347,7 +350,19 @@ impl GenArgs {
         }
         crate::cores::clock::ClockTarget(self.target_mhz).check()?;
         check_folder(&self.out)?;
+        let mem_spec = self.memory.spec()?;
+        if self.memory.memory == super::args::MemoryPlace::External {
+            for (name, given) in
+                [("raygen", self.raygen), ("axis-frame", self.axis_frame), ("board", self.board.is_some())]
+            {
+                if given {
+                    return Err(Error::param(name, "not with --memory external yet (docs/MEMORY.md)"));
+                }
+            }
+        }
         Ok(GenConfig {
+            memory: self.memory.memory,
+            mem_spec,
             scene,
             out: self.out.clone(),
             vhdl: self.lang.contains(&Lang::Vhdl),
@@ -555,7 +570,7 @@ impl SimArgs {
             },
             shuffle_seed: self.shuffle_seed,
             stalls: (self.stall_percent > 0).then(|| (self.stall_percent, self.stall_seed.unwrap_or(1))),
-            memory: self.external.memory,
+            memory: self.external.core.memory,
             bram_kbits: self.bram_kbits,
             mem_spec,
             mem_timing,

@@ -242,6 +242,13 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     }
     let p = crate::cores::top::CoreParams::shaped(&roms, &c.core_spec());
     p.check()?;
+    let p = place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &c.core_spec(), p)?;
+    if p.mem.is_some() && raygen.is_some() {
+        return Err(crate::error::Error::param(
+            "raygen",
+            "not with the scene in external memory yet (--memory onchip)",
+        ));
+    }
     p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions {
         vhdl: c.vhdl,
@@ -260,6 +267,12 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     let mut files = OutputSet::new();
     let written = generate::core_files(&p, &roms, &core, o, raygen.as_ref(), measured.as_ref());
     files.extend(written.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
+    if let Some(m) = &p.mem {
+        // The image to put in memory at mem_base, and its C header.
+        let image = scene::memory::SceneImage::build(&roms, m.spec.shape)?;
+        files.add(&c.out.join("scene.bin"), &image.bytes)?;
+        files.add(&c.out.join("fxrt_scene.h"), scene::memory_c::c_header(&roms.name, &image.layout).as_bytes())?;
+    }
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
@@ -269,11 +282,12 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     }
     files.commit()?;
     println!(
-        "{}_{} for {} ({} triangles; intersection pipeline {} cycles) written to {}",
+        "{}_{} for {} ({} triangles{}; intersection pipeline {} cycles) written to {}",
         if raygen.is_some() { "fxrt_core_raygen" } else { "fxrt_core" },
         p.trav.scene_tag,
         roms.name,
         roms.tri_count(),
+        if p.mem.is_some() { ", scene in external memory: scene.bin" } else { ", scene on chip" },
         p.isect.latency(),
         c.out.display()
     );
@@ -506,21 +520,31 @@ fn external_core(
     shape: &crate::cores::top::CoreSpec,
     p: crate::cores::top::CoreParams,
 ) -> Result<crate::cores::top::CoreParams> {
-    use super::args::MemoryPlace;
-    let external = match c.memory {
-        MemoryPlace::Onchip => false,
-        MemoryPlace::External => true,
-        MemoryPlace::Auto => p.check_device(roms, c.bram_kbits).is_err(),
-    };
-    if !external {
-        return Ok(p);
-    }
-    if c.raygen {
+    let p = place_scene(c.memory, c.mem_spec, c.bram_kbits, roms, shape, p)?;
+    if p.mem.is_some() && c.raygen {
         return Err(crate::error::Error::param("memory", "an external-memory core runs with host rays (no --raygen)"));
     }
-    let p = crate::cores::top::CoreParams::external(roms, shape, c.mem_spec)?;
     p.check_device(roms, c.bram_kbits)?;
     Ok(p)
+}
+
+/// The on-chip core `p`, or with `--memory external` (or `auto` when `p`'s ROMs and stacks do
+/// not fit `bram_kbits`) the same shape with its scene in external memory.
+fn place_scene(
+    place: super::args::MemoryPlace,
+    spec: crate::cores::memory_params::MemorySpec,
+    bram_kbits: u64,
+    roms: &SceneRoms,
+    shape: &crate::cores::top::CoreSpec,
+    p: crate::cores::top::CoreParams,
+) -> Result<crate::cores::top::CoreParams> {
+    use super::args::MemoryPlace;
+    let external = match place {
+        MemoryPlace::Onchip => false,
+        MemoryPlace::External => true,
+        MemoryPlace::Auto => p.check_device(roms, bram_kbits).is_err(),
+    };
+    if external { crate::cores::top::CoreParams::external(roms, shape, spec) } else { Ok(p) }
 }
 
 /// Ok(false): the simulated core disagreed with the golden model somewhere (`--core-sim`).

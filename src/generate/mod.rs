@@ -160,8 +160,9 @@ pub fn core_files(
     let min_latency = crate::verify::disturb::min_latency(core, p, roms);
     let mut set = vec![(top, None, core_params.clone())];
     // The core behind AXI4-Stream ports, with the C header of its layout (not for the core
-    // fed by its own ray generator, which has no ray port).
-    let axis = raygen.is_none().then(|| {
+    // fed by its own ray generator, which has no ray port, nor yet for one with its scene in
+    // external memory, whose read port the wrapper does not pass through).
+    let axis = (raygen.is_none() && p.mem.is_none()).then(|| {
         let layout = Layout::of(&core);
         let wrapper = axis_module(&core, p);
         let header = (format!("{}.h", wrapper.name), axis_host::c_header(&wrapper.name, &layout));
@@ -224,6 +225,9 @@ pub fn core_files(
         "params_sha256": sha(&core_params.to_string()),
     });
     doc["files"]["ise"] = json!(ise);
+    if let Some(m) = &p.mem {
+        doc["memory"] = memory_manifest(m);
+    }
     // Memory images only where the Verilog that reads them was written.
     let written = |n: &str| out_names.iter().any(|w| w == n);
     let hex: Vec<Value> = doc["files"]["verilog_memory_init"].as_array().cloned().unwrap_or_default();
@@ -238,6 +242,32 @@ pub fn core_files(
     }
     out.extend(axis);
     out
+}
+
+/// What an integrator needs to know of an external-memory core's read port and scene image.
+fn memory_manifest(m: &crate::cores::memory_params::ExternalMemory) -> Value {
+    json!({
+        "where": "external: the scene image scene.bin (written beside the core) at byte address mem_base",
+        "image": m.layout,
+        "image_file": "scene.bin",
+        "c_header": "fxrt_scene.h",
+        "axi4_read": {
+            "channels": "AR and R only (m_axi_ar*, m_axi_r*); RREADY is always 1",
+            "data_bits": m.axi.data_bits,
+            "address_bits": m.axi.addr_bits,
+            "arlen": m.axi.line_beats - 1,
+            "arsize": m.axi.arsize(),
+            "arburst": "INCR (1)",
+            "burst": "one cache line, line-aligned (never crosses 4 KB)",
+            "id": "no ARID/RID: every read uses one ID, so the memory returns bursts in order",
+            "outstanding_max": m.axi.outstanding,
+            "errors": "mem_error (sticky until rst): a beat not asked for, RLAST where the burst's count does not end (or missing where it does), RRESP other than OKAY",
+            "reset": "rst must also reset the memory side (ARESETn): bursts in flight are forgotten",
+        },
+        "node_cache_per_unit": { "kb": m.spec.node_cache_kb, "sets": m.node.sets, "ways": m.node.ways, "line_bytes": m.spec.shape.line_bytes },
+        "tri_cache": { "kb": m.spec.tri_cache_kb, "sets": m.tri.sets, "ways": m.tri.ways, "line_bytes": m.spec.shape.line_bytes },
+        "staging_records_per_slot": 1u32 << m.stage_bits,
+    })
 }
 
 /// The AXI4-Stream wrapper's manifest `text` with what an integrator needs beyond its ports,
