@@ -497,10 +497,9 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "memory": if p.mem.is_some() { "external" } else { "onchip" },
         "ray_order": if c.tiles { "tiles" } else { "pixels" },
     });
-    if let (Some(ms), Some(obj)) = (memory_stats, line.as_object_mut()) {
-        if let serde_json::Value::Object(fields) = serde_json::to_value(&ms).unwrap_or_default() {
-            obj.extend(fields);
-        }
+    let memory_fields = memory_stats.map(|ms| serde_json::to_value(&ms).unwrap_or_default());
+    if let (Some(serde_json::Value::Object(fields)), Some(obj)) = (memory_fields, line.as_object_mut()) {
+        obj.extend(fields);
     }
     // Hardware speed: one ray per `cycles_per_ray` clocks (one ray in flight).
     if let Some((mhz, measured)) = c.clock {
