@@ -90,6 +90,21 @@ pub struct Cache<'b> {
     pub done: S<'b>,
 }
 
+/// Bits [lsb, lsb + width) of a value held as `words` of `word_bits` each (least significant
+/// first; the last may be narrower): a record across beats, or across a record's parts.
+pub fn bits_across<'b>(b: &'b Builder, words: &[S<'b>], word_bits: u32, lsb: u32, width: u32) -> S<'b> {
+    let mut pieces = Vec::new();
+    let mut at = lsb;
+    while at < lsb + width {
+        let (k, off) = (at / word_bits, at % word_bits);
+        let take = (words[k as usize].width() - off).min(lsb + width - at);
+        pieces.push(words[k as usize].slice(off, take));
+        at += take;
+    }
+    pieces.reverse();
+    if pieces.len() == 1 { pieces[0] } else { b.cat(&pieces) }
+}
+
 /// Whether a waiter for fill `wait` may look again: `done` has reached it (serial-number
 /// compare: done − wait, wrapped, is below half the range).
 pub fn released<'b>(done: S<'b>, wait: S<'b>) -> S<'b> {
@@ -172,20 +187,7 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     b.next_when(in_rec, fill.valid, (rec_end | fill.last).select(in_rec.k(0), in_rec + 1));
     b.next_when(rec_no, fill.valid, fill.last.select(rec_no.k(0), rec_end.select(rec_no + 1, rec_no)));
     let beats: Vec<S<'b>> = held.iter().copied().chain([fill.data]).collect();
-    let record = |lsb: u32, w: u32| -> S<'b> {
-        // Bits [lsb, lsb + w) of the record made of `beats`.
-        let beat_bits = p.data_bits;
-        let mut pieces = Vec::new();
-        let mut at = lsb;
-        while at < lsb + w {
-            let (k, off) = (at / beat_bits, at % beat_bits);
-            let take = (beat_bits - off).min(lsb + w - at);
-            pieces.push(beats[k as usize].slice(off, take));
-            at += take;
-        }
-        pieces.reverse();
-        if pieces.len() == 1 { pieces[0] } else { b.cat(&pieces) }
-    };
+    let record = |lsb: u32, w: u32| bits_across(b, &beats, p.data_bits, lsb, w);
     let waddr = b.cat(&[f_set, rec_no.resize(rb)]).name(&nm("fill_addr"));
     for (w, rams) in datas.iter().enumerate() {
         let we = (write_rec & f_way.eq(w as i128)).name(&nm(&format!("write{w}")));

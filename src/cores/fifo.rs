@@ -26,6 +26,18 @@ pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>,
     Fifo { head: heads[0], nonempty }
 }
 
+/// Splits a queue entry packed with `b.cat` (fields most significant first, of `widths`).
+pub fn unpack<'b>(entry: S<'b>, widths: &[u32]) -> Vec<S<'b>> {
+    let mut at = entry.width();
+    widths
+        .iter()
+        .map(|&w| {
+            at -= w;
+            entry.slice(at, w)
+        })
+        .collect()
+}
+
 /// A queue whose entries are several words (each a RAM of its own, all at the same
 /// pointers): for entries wider than a signal may be. The heads of the words, and `nonempty`.
 pub fn fifo_words<'b>(

@@ -12,7 +12,7 @@
 //! came earlier. That costs a few clocks, never a deadlock: fills come whatever the ring does.
 
 use super::cache::{SEQ_BITS, released};
-use super::fifo::fifo;
+use super::fifo::{fifo, unpack};
 use super::traverse_stages::{NodeAnswer, RetryQueue, Token, Unit};
 use crate::rtl::Ty;
 use crate::rtl::build::S;
@@ -32,12 +32,7 @@ impl<'b> Unit<'b> {
         let entry = b.wire("retry_entry", Ty::u(width));
         let pop = b.wire("retry_pop", Ty::BIT);
         let q = fifo(b, "retry_q", width, self.p.slots, push, entry, pop);
-        let mut at = width;
-        let mut field = |k: usize| {
-            at -= widths[k];
-            q.head.slice(at, widths[k])
-        };
-        let (slot, node, tmin, tmax, sp, wait) = (field(0), field(1), field(2), field(3), field(4), field(5));
+        let [slot, node, tmin, tmax, sp, wait] = unpack(q.head, &widths)[..] else { unreachable!("six fields") };
         // `done` is the cache's register and the head a RAM's: one 16-bit subtract between them.
         let ready = (q.nonempty & released(cache.done, wait)).name("retry_ready");
         RetryQueue { ready, pop, slot, node, tmin: tmin.signed(), tmax: tmax.signed(), sp, push, entry }

@@ -17,9 +17,9 @@
 
 use super::axi_read::Fill;
 use super::brom::bram;
-use super::cache::{Cache, LATENCY, Lookup, SEQ_BITS, cache, released};
+use super::cache::{Cache, LATENCY, Lookup, SEQ_BITS, bits_across, cache, released};
 use super::core_params::CoreParams;
-use super::fifo::fifo;
+use super::fifo::{fifo, unpack};
 use super::leaf_stream::{Emission, RayRams, into_pipeline, leaf_buffers};
 use super::memory_params::ExternalMemory;
 use crate::rtl::Ty;
@@ -34,32 +34,10 @@ pub struct FetchObserved<'b> {
     pub stall: S<'b>,
 }
 
-/// Splits `entry` (fields most significant first, of `widths`).
-fn unpack<'b>(entry: S<'b>, widths: &[u32]) -> Vec<S<'b>> {
-    let mut at = entry.width();
-    widths
-        .iter()
-        .map(|&w| {
-            at -= w;
-            entry.slice(at, w)
-        })
-        .collect()
-}
-
 /// Bits [f.lsb, f.lsb + f.width) of a record held as parts of 128 bits (least significant
 /// first), with the field's sign.
 fn record_field<'b>(b: &'b Builder, parts: &[S<'b>], f: &Field) -> S<'b> {
-    let mut pieces = Vec::new();
-    let mut at = f.lsb;
-    while at < f.lsb + f.width {
-        let (k, off) = (at / 128, at % 128);
-        let take = (parts[k as usize].width() - off).min(f.lsb + f.width - at);
-        pieces.push(parts[k as usize].slice(off, take));
-        at += take;
-    }
-    pieces.reverse();
-    let raw = if pieces.len() == 1 { pieces[0] } else { b.cat(&pieces) };
-    let raw = raw.name(&format!("tri_{}", f.name));
+    let raw = bits_across(b, parts, 128, f.lsb, f.width).name(&format!("tri_{}", f.name));
     if f.signed { raw.signed() } else { raw }
 }
 
