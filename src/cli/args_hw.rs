@@ -211,6 +211,12 @@ pub struct SynthArgs {
     #[arg(long)]
     pub build: Option<PathBuf>,
     #[command(flatten)]
+    pub memory: super::args::CoreMemoryArgs,
+    /// Block RAM the scene's ROMs (or the caches) may take, Kb. Default: the family's device
+    /// (ecp5: the LFE5U-85F's 208 DP16KD, 3744; xc5v and xc7: the XC5VLX110T's 5328).
+    #[arg(long = "bram-kbits")]
+    pub bram_kbits: Option<u64>,
+    #[command(flatten)]
     pub hw: HwArgs,
     #[command(flatten)]
     pub params: ParamArgs,

@@ -353,7 +353,7 @@ impl GenArgs {
         let mem_spec = self.memory.spec()?;
         if self.memory.memory == super::args::MemoryPlace::External {
             for (name, given) in
-                [("raygen", self.raygen), ("axis-frame", self.axis_frame), ("board", self.board.is_some())]
+                [("raygen", self.raygen), ("board", self.board.is_some())]
             {
                 if given {
                     return Err(Error::param(name, "not with --memory external yet (docs/MEMORY.md)"));
@@ -432,7 +432,16 @@ pub struct SynthConfig {
     pub hw: HwArgs,
     pub build: PathBuf,
     pub family: Family,
+    /// Where the scene lives (`auto` decided by `bram_kbits`) and the external core's caches.
+    pub memory: super::args::MemoryPlace,
+    pub mem_spec: crate::cores::memory_params::MemorySpec,
+    pub bram_kbits: u64,
 }
+
+/// Block RAM of the LFE5U-85F, Kb: 208 DP16KD of 18 Kb.
+pub const ECP5_85F_BRAM_KBITS: u64 = 208 * 18;
+/// Block RAM of the XC5VLX110T, Kb (the thesis's device).
+pub const XC5VLX110T_BRAM_KBITS: u64 = 5328;
 
 /// Where `fxrt synth` maps the cores.
 #[derive(Clone, Debug, PartialEq)]
@@ -464,12 +473,16 @@ impl SynthArgs {
         };
         let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
         check_folder(&build)?;
+        let device_kbits = if matches!(family, Family::Ecp5 { .. }) { ECP5_85F_BRAM_KBITS } else { XC5VLX110T_BRAM_KBITS };
         Ok(SynthConfig {
             params: self.params.params()?,
             scene: self.scene.source(),
             hw: self.hw.clone(),
             build,
             family,
+            memory: self.memory.memory,
+            mem_spec: self.memory.spec()?,
+            bram_kbits: self.bram_kbits.unwrap_or(device_kbits),
         })
     }
 }

@@ -323,17 +323,22 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let p = intersect_params(&c.params, &scene, &c.hw)?;
     let roms = SceneRoms::of(&scene);
     let t = c.hw.threads;
-    let core = crate::cores::top::CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec {
-            id_width: crate::cores::top::DEFAULT_RAY_ID_WIDTH,
-            div_bits: c.hw.div_bits,
-            target_mhz: c.hw.target_mhz,
-            slots: t.slots,
-            units: t.units,
-        },
-    );
+    let shape = crate::cores::top::CoreSpec {
+        id_width: crate::cores::top::DEFAULT_RAY_ID_WIDTH,
+        div_bits: c.hw.div_bits,
+        target_mhz: c.hw.target_mhz,
+        slots: t.slots,
+        units: t.units,
+    };
+    let core = crate::cores::top::CoreParams::shaped(&roms, &shape);
     core.check()?;
+    let core = place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core)?;
+    core.check_device(&roms, c.bram_kbits)?;
+    eprintln!(
+        "synth: scene {} {}",
+        scene.name,
+        if core.mem.is_some() { "in external memory (AXI4 read port, caches on chip)" } else { "in on-chip ROMs" }
+    );
     if let Family::Ecp5 { target_mhz, seed, modules } = &c.family {
         return synth_ecp5(c, &p, &core, &roms, *target_mhz, *seed, modules, &scene.name);
     }
