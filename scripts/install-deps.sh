@@ -46,6 +46,13 @@ if [ "${FXRT_SKIP_HDL_TOOLS:-0}" != "1" ]; then
             echo "install-deps: warning: could not install cocotb into .venv" >&2
         fi
     fi
+    # cocotbext-axi's AxiRamRead: a third-party AXI4 memory behind the external-memory core's
+    # read port (tests/cocotb.rs). Pinned with cocotb, so pip keeps cocotb at 1.8.1.
+    if ! "$venv/bin/python" -c 'import cocotbext.axi, sys; sys.exit(cocotbext.axi.__version__ != "0.1.28")' >/dev/null 2>&1; then
+        if ! "$venv/bin/pip" install -q --disable-pip-version-check cocotb==1.8.1 cocotbext-axi==0.1.28; then
+            echo "install-deps: warning: could not install cocotbext-axi into .venv" >&2
+        fi
+    fi
 fi
 # embreex (Embree 4 with float32 rays, manylinux wheels with numpy) for `fxrt bench
 # --against-embree` (scripts/embree_bench.py, tests/bench_embree.rs) in the same .venv. Pinned,

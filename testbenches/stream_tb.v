@@ -45,6 +45,7 @@ module {{ tb }};
 {%- endfor %}
   assign mem_base = {{ mem_base }};
   assign m_axi_rresp = 2'b00;
+  assign m_axi_rid = 1'b0;
   {{ mem_model }} mem (
     .clk(clk), .rst(rst), .arvalid(m_axi_arvalid), .araddr(m_axi_araddr), .arlen(m_axi_arlen),
     .rready(m_axi_rready), .arready(m_axi_arready), .rvalid(m_axi_rvalid), .rdata(m_axi_rdata),

@@ -54,6 +54,7 @@ begin
   -- address {{ mem_base }}.
   mem_base <= "{{ mem_base_bits }}";
   m_axi_rresp <= "00";
+  m_axi_rid <= "0";
   mem : entity work.{{ mem_model }}
     port map (
       clk => clk, rst => rst, arvalid => m_axi_arvalid, araddr => m_axi_araddr, arlen => m_axi_arlen,

@@ -186,6 +186,8 @@ pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
         ins.push(match port {
             "ray_valid" => offer,
             "res_ready" => res_ready,
+            // An external-memory core's read port and base address, passed through.
+            _ if super::top_memory::is_memory_port(port) => b.input(port, core.sig(i).ty),
             _ => match RAY_FIELDS.iter().find(|f| f.1 == port) {
                 Some(&(name, _)) => field(layout.ray_field(name)),
                 None => panic!("{}: the AXI4-Stream wrapper does not know input {port}", core.name),
@@ -232,6 +234,9 @@ pub fn axis_module(core: &Rc<Module>, p: &CoreParams) -> Module {
         b.output(name, bits);
     }
     b.output("m_axis_res_tlast", (out_valid & last_out).name("res_tlast"));
+    for (port, _) in core.outputs.iter().filter(|o| super::top_memory::is_memory_port(&o.0)) {
+        b.output(port, c.get(port));
+    }
     let ray_names = part_names("s_axis_ray_tdata", layout.ray_bytes);
     b.with(|m| {
         m.bus("s_axis_ray_tdata", &ray_names.iter().map(String::as_str).collect::<Vec<_>>());

@@ -4,8 +4,9 @@
 //! node caches (0 … U − 1), then the triangle cache (U).
 //!
 //! Ports (docs/MEMORY.md "The read port"): inputs `mem_base` and `m_axi_arready`,
-//! `m_axi_rvalid`, `m_axi_rdata`, `m_axi_rlast`, `m_axi_rresp`; outputs `m_axi_araddr`,
-//! `m_axi_arlen`, `m_axi_arsize`, `m_axi_arburst`, `m_axi_arvalid`, `m_axi_rready`, `mem_error`.
+//! `m_axi_rvalid`, `m_axi_rdata`, `m_axi_rlast`, `m_axi_rresp`, `m_axi_rid`; outputs
+//! `m_axi_araddr`, `m_axi_arlen`, `m_axi_arsize`, `m_axi_arburst`, `m_axi_arid`,
+//! `m_axi_arvalid`, `m_axi_rready`, `mem_error`.
 
 use super::axi_read::{AxiIn, LineRequest, axi_read};
 use super::cache::{Lookup, cache};
@@ -25,7 +26,16 @@ pub fn memory_inputs(m: &ExternalMemory) -> Vec<(&'static str, Ty)> {
         ("m_axi_rdata", Ty::u(m.axi.data_bits)),
         ("m_axi_rlast", Ty::BIT),
         ("m_axi_rresp", Ty::u(2)),
+        // One read ID (0), so bursts come back in order; RID is there for memories and
+        // interconnects that have it (LiteDRAM's AXI port, cocotbext-axi), and not used.
+        ("m_axi_rid", Ty::u(1)),
     ]
+}
+
+/// A port of the core's memory side (`memory_inputs` and the read master's outputs): what a
+/// wrapper passes through unchanged.
+pub fn is_memory_port(name: &str) -> bool {
+    name == "mem_base" || name == "mem_error" || name.starts_with("m_axi_")
 }
 
 /// What each traversal unit's node cache drives into it: the record, hit, the fill to wait for,
@@ -99,6 +109,7 @@ pub fn memory_side<'b>(
     b.output("m_axi_arlen", out.arlen);
     b.output("m_axi_arsize", b.konst(Ty::u(3), m.axi.arsize() as i128));
     b.output("m_axi_arburst", b.konst(Ty::u(2), 1));
+    b.output("m_axi_arid", b.konst(Ty::u(1), 0));
     b.output("m_axi_arvalid", out.arvalid);
     b.output("m_axi_rready", b.konst(Ty::BIT, 1));
     b.output("mem_error", out.error);

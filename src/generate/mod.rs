@@ -160,9 +160,9 @@ pub fn core_files(
     let min_latency = crate::verify::disturb::min_latency(core, p, roms);
     let mut set = vec![(top, None, core_params.clone())];
     // The core behind AXI4-Stream ports, with the C header of its layout (not for the core
-    // fed by its own ray generator, which has no ray port, nor yet for one with its scene in
-    // external memory, whose read port the wrapper does not pass through).
-    let axis = (raygen.is_none() && p.mem.is_none()).then(|| {
+    // fed by its own ray generator, which has no ray port); an external-memory core's read
+    // port and `mem_base` pass through the wrapper unchanged.
+    let axis = raygen.is_none().then(|| {
         let layout = Layout::of(&core);
         let wrapper = axis_module(&core, p);
         let header = (format!("{}.h", wrapper.name), axis_host::c_header(&wrapper.name, &layout));
@@ -259,7 +259,7 @@ fn memory_manifest(m: &crate::cores::memory_params::ExternalMemory) -> Value {
             "arsize": m.axi.arsize(),
             "arburst": "INCR (1)",
             "burst": "one cache line, line-aligned (never crosses 4 KB)",
-            "id": "no ARID/RID: every read uses one ID, so the memory returns bursts in order",
+            "id": "m_axi_arid is 0 on every read (one ID), so the memory returns bursts in order; m_axi_rid (1 bit) is not used",
             "outstanding_max": m.axi.outstanding,
             "errors": "mem_error (sticky until rst): a beat not asked for, RLAST where the burst's count does not end (or missing where it does), RRESP other than OKAY",
             "reset": "rst must also reset the memory side (ARESETn): bursts in flight are forgotten",
@@ -294,6 +294,10 @@ fn axis_manifest(text: &str, core: &Value, min_latency: Option<u64>, held: u32) 
         "result_order": "rays finish out of order; every result carries its ray id (the id field of tdata)",
     });
     doc["clock"] = core["clock"].clone();
+    if !core["memory"].is_null() {
+        // The core's read port and mem_base are the wrapper's, unchanged.
+        doc["memory"] = core["memory"].clone();
+    }
     doc["resources"] = match &core["resources"] {
         Value::Null => Value::Null,
         r => json!({ "core": r, "wrapper": "not placed on its own: its registers are register_bits less the core's" }),
