@@ -152,19 +152,30 @@ fn strips(rng: &mut SplitMix64) -> Vec<Tri> {
 /// Small random triangles in the unit cube, a tenth of them sliver-thin.
 fn soup(rng: &mut SplitMix64) -> Vec<Tri> {
     let count = 1 + rng.below(800);
-    (0..count)
-        .map(|_| {
-            let a: [f64; 3] = std::array::from_fn(|_| rng.next_f64());
-            let size = 10f64.powf(rng.range(-3.0, -0.5));
-            let b: [f64; 3] = std::array::from_fn(|k| a[k] + rng.range(-size, size));
-            let c: [f64; 3] = if rng.below(10) == 0 {
-                std::array::from_fn(|k| a[k] + (b[k] - a[k]) * 0.5 + rng.range(-1e-6, 1e-6))
-            } else {
-                std::array::from_fn(|k| a[k] + rng.range(-size, size))
-            };
-            [a, b, c]
-        })
-        .collect()
+    (0..count).map(|_| soup_triangle(rng, (-3.0, -0.5))).collect()
+}
+
+/// `count` small triangles at random places in the unit cube (sides up to 10^-2, one in ten
+/// nearly a line): a large soup for the external-memory figures (`examples/memory_acceptance`),
+/// deterministic in `seed`.
+pub fn small_soup(seed: u64, count: usize) -> Vec<Tri> {
+    let mut rng = SplitMix64(seed);
+    (0..count).map(|_| soup_triangle(&mut rng, (-3.0, -2.0))).collect()
+}
+
+/// A triangle at a random corner in the unit cube, its other corners within 10^e of it for e
+/// drawn from `exponents`; one in ten nearly degenerate (its third corner a hair off the
+/// middle of the first two).
+fn soup_triangle(rng: &mut SplitMix64, exponents: (f64, f64)) -> Tri {
+    let a: [f64; 3] = std::array::from_fn(|_| rng.next_f64());
+    let size = 10f64.powf(rng.range(exponents.0, exponents.1));
+    let b: [f64; 3] = std::array::from_fn(|k| a[k] + rng.range(-size, size));
+    let c: [f64; 3] = if rng.below(10) == 0 {
+        std::array::from_fn(|k| a[k] + (b[k] - a[k]) * 0.5 + rng.range(-1e-6, 1e-6))
+    } else {
+        std::array::from_fn(|k| a[k] + rng.range(-size, size))
+    };
+    [a, b, c]
 }
 
 /// Twice the area's square (nonzero for a proper triangle).
