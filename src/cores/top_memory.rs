@@ -82,7 +82,9 @@ pub fn memory_side<'b>(
     let mut looks = Vec::new();
     let mut hits = Vec::new();
     for (u, t) in trav.iter().enumerate() {
+        // A tree with fewer nodes than a line holds has node numbers narrower than `shift`.
         let record = t.get("node_addr");
+        let record = record.resize(record.ty().width.max(shift + 1));
         let rec = if shift == 0 {
             b.konst(Ty::u(m.node.rec_bits()), 0)
         } else {
