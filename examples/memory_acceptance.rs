@@ -98,7 +98,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let p = CoreParams::external(&roms, &shape, spec)?;
         let image = SceneImage::build(&roms, spec.shape)?;
         let bar = progress_bar(rays.len() as u64, c.name);
-        let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, c.timing, &|n| bar.set_position(n));
+        let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, c.timing, &fxrt::verify::feed::Stalls::none(), &|n| {
+            bar.set_position(n)
+        });
         bar.finish_and_clear();
         let wrong = mismatches(&scene, &rays, &results);
         let t = c.timing;

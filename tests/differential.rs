@@ -39,6 +39,8 @@ fn a_short_campaign_finds_no_disagreement() {
     // The run compared something: most cases ran, with cameras inside the scene box too.
     assert!(r.cases - r.refused >= 18 && r.rays > 1000 && r.inside_cameras >= 4, "{r:?}");
     assert!(r.scenes >= 12 && r.shapes >= 18 && r.parameter_sets >= 18, "{r:?}");
+    // Some cases ran with the scene in external memory (a third are drawn so; some refused).
+    assert!(r.external_cases >= 3, "{r:?}");
 }
 
 /// Issue 27's interior disagreement at the default parameters, on a random room with boxes
@@ -71,12 +73,32 @@ fn a_reproducer_is_self_contained() {
     let out = tempfile::tempdir().unwrap();
     // The first case of seed 5 that runs (a random scene, drawn fresh).
     let run = (0..20).map(|i| exact::run_case(5, i, &[], None)).find(|r| matches!(r.verdict, Verdict::Ran(_))).unwrap();
-    let Verdict::Ran(outcome) = &run.verdict else { unreachable!() };
     assert!(
         matches!(run.case.scene, draw::CaseScene::Random { .. })
             || matches!(run.case.scene, draw::CaseScene::Builtin(_))
     );
-    let dir = repro::write(out.path(), &run).unwrap();
+    reproduces(&run, out.path());
+}
+
+/// The same for a case with its scene in external memory: the command carries the caches and
+/// the memory model's timing, and `fxrt sim` runs the frame in the same clocks.
+#[test]
+fn a_reproducer_of_an_external_memory_case_runs_the_same_frame() {
+    let out = tempfile::tempdir().unwrap();
+    let run = (0..60)
+        .filter(|&i| draw::case(5, i, &[]).memory.is_some())
+        .map(|i| exact::run_case(5, i, &[], None))
+        .find(|r| matches!(r.verdict, Verdict::Ran(_)))
+        .expect("an external-memory case of seed 5 that runs");
+    let command = reproduces(&run, out.path());
+    assert!(command.contains("--memory external") && command.contains("--mem-latency"), "{command}");
+}
+
+/// Writes `run` out under `out`, checks the scene reads back and the command gives the same
+/// frame; returns the command.
+fn reproduces(run: &exact::CaseRun, out: &std::path::Path) -> String {
+    let Verdict::Ran(outcome) = &run.verdict else { unreachable!() };
+    let dir = repro::write(out, run).unwrap();
     let back = fxrt::scene::obj::load_obj(&dir.join("scene.obj")).unwrap();
     assert_eq!(Some(back), run.tris);
     let command = std::fs::read_to_string(dir.join("command.txt")).unwrap();
@@ -93,6 +115,7 @@ fn a_reproducer_is_self_contained() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("case.json")).unwrap()).unwrap();
     assert_eq!(json["command"], command.trim_end());
+    command
 }
 
 /// A case also run in Verilator (`--hdl verilator`): the HDL gives the Rust simulator's results

@@ -431,7 +431,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
             let image = scene::memory::SceneImage::build(&roms, c.mem_spec.shape)?;
             let bar = frame::progress_bar(rays.len() as u64, "rust");
             let (results, stats, ms) =
-                crate::verify::frame_memory::simulate_external(&p, &roms, &image, &rays, c.mem_timing, &|n| {
+                crate::verify::frame_memory::simulate_external(&p, &roms, &image, &rays, c.mem_timing, &stalls, &|n| {
                     bar.set_position(n)
                 });
             bar.finish_and_clear();

@@ -2,6 +2,7 @@
 //! its AXI4 read port answered by the memory model (`verify::memory`) from the scene image:
 //! the same rays and checks as `verify::frame`, and what the memory side did (`MemoryStats`).
 
+use super::feed::Stalls;
 use super::frame::{CoreResult, CoreStats, OBSERVED, RESULT_PORTS, core_result, port};
 use super::memory::{MasterOut, MemoryModel, MemoryTiming, SIM_BASE};
 use crate::cores::top::{CoreParams, core_inputs, core_module, ray_inputs};
@@ -61,9 +62,10 @@ impl MemoryStats {
     }
 }
 
-/// Streams `rays` (in the order given, every result taken when shown) through the core of `p`
-/// (which must have external memory) in the cycle simulator, the memory model of `timing`
-/// answering from `image` at `SIM_BASE`. Returns the results in the order they came out, the
+/// Streams `rays` (in the order given, the source holding back on the cycles of `stalls` as the
+/// testbenches' does, every result taken when shown) through the core of `p` (which must have
+/// external memory) in the cycle simulator, the memory model of `timing` answering from
+/// `image` at `SIM_BASE`. Returns the results in the order they came out, the
 /// core's counts and the memory side's. Panics (a test failure) if the core stops producing
 /// results or flags a memory error.
 pub fn simulate_external(
@@ -72,6 +74,7 @@ pub fn simulate_external(
     image: &SceneImage,
     rays: &[PixelRay],
     timing: MemoryTiming,
+    stalls: &Stalls,
     progress: &dyn Fn(u64),
 ) -> (Vec<CoreResult>, CoreStats, MemoryStats) {
     let mem = p.mem.as_ref().expect("an external-memory core");
@@ -95,7 +98,8 @@ pub fn simulate_external(
     sim.set(res_ready, 1);
     sim.set(mem_ins[0], SIM_BASE as i128);
     while results.len() < rays.len() {
-        let values = rays.get(next).map(|r| ray_inputs(r.pixel as u64, &r.ray));
+        let offered = rays.get(next).filter(|_| !stalls.at(stats.cycles));
+        let values = offered.map(|r| ray_inputs(r.pixel as u64, &r.ray));
         for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&idle)) {
             sim.set(*s, *v);
         }
@@ -160,7 +164,7 @@ mod tests {
             MemoryTiming::default(),
             MemoryTiming { latency: 200, extra_delay: 30, pause_in_256: 60, seed: 7, ..MemoryTiming::default() },
         ] {
-            let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, timing, &|_| ());
+            let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ());
             assert_eq!(mismatches(&scene, &rays, &results), 0, "{timing:?}");
             assert_eq!((stats.visits + stats.culls, stats.busy_cycles), (steps, tests), "{timing:?}");
             assert!(ms.node_hits < ms.node_lookups && ms.tri_hits < ms.tri_lookups, "{ms:?}");

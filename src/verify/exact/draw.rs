@@ -2,7 +2,10 @@
 //! whole valid range, a core shape, a camera outside or inside the scene box, and a feed
 //! (shuffled, stalling). Every draw is a function of the case seed alone.
 
+use crate::cores::memory_params::MemorySpec;
 use crate::model::camera::Camera;
+use crate::scene::memory::MemoryShape;
+use crate::verify::memory::MemoryTiming;
 use crate::params::{EdgeShift, Params, TreeSplit};
 use crate::rng::SplitMix64;
 use crate::scene::{Scene, max_edge_shift};
@@ -56,6 +59,8 @@ pub struct Case {
     pub shuffle_seed: Option<u64>,
     /// (percent, seed) of the source's stalls.
     pub stalls: Option<(u32, u64)>,
+    /// The scene in external memory behind caches, and the memory model's timing; None: on chip.
+    pub memory: Option<(MemorySpec, MemoryTiming)>,
 }
 
 /// Built-in scenes the campaign draws (teapot-fine's core takes a minute to simulate: it is
@@ -81,7 +86,32 @@ pub fn case(seed: u64, index: u64, files: &[std::path::PathBuf]) -> Case {
     let camera_seed = rng.next_u64();
     let shuffle_seed = (rng.below(2) == 0).then(|| rng.below(1000));
     let stalls = (rng.below(3) == 0).then(|| (1 + rng.below(60) as u32, rng.below(1000)));
-    Case { index, scene, params, shape, camera: None, inside, camera_seed, shuffle_seed, stalls }
+    // Drawn last, so the cases of a seed keep every draw they had before external memory.
+    let memory = (rng.below(3) == 0).then(|| memory(&mut rng));
+    Case { index, scene, params, shape, camera: None, inside, camera_seed, shuffle_seed, stalls, memory }
+}
+
+/// An external-memory core and a memory: small caches (a case's scene is small, and misses,
+/// evictions and merged misses are what is hunted), any port width, line, associativity, and
+/// a memory from fast to slow, steady to jittery and pausing. Shapes the caches cannot take
+/// (a record wider than a line) are refused by `CoreParams::external` and counted.
+fn memory(rng: &mut SplitMix64) -> (MemorySpec, MemoryTiming) {
+    let pick = |rng: &mut SplitMix64, from: &[u32]| from[rng.below(from.len() as u64) as usize];
+    let spec = MemorySpec {
+        shape: MemoryShape { mem_bits: pick(rng, &[32, 64, 128]), line_bytes: pick(rng, &[32, 64, 128, 256]) },
+        node_cache_kb: pick(rng, &[1, 1, 2, 4, 32]),
+        tri_cache_kb: pick(rng, &[1, 1, 2, 4, 64]),
+        ways: pick(rng, &[1, 2, 4]),
+        ..MemorySpec::default()
+    };
+    let timing = MemoryTiming {
+        latency: 1 + rng.below(200) as u32,
+        outstanding: pick(rng, &[1, 2, 4, 16]),
+        extra_delay: pick(rng, &[0, 0, 5, 30]),
+        pause_in_256: pick(rng, &[0, 0, 30, 100]),
+        seed: 1 + rng.below(1000) as u32,
+    };
+    (spec, timing)
 }
 
 /// A parameter set from the whole valid range: n and m first (every n from 4 to 40 as likely),

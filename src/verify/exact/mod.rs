@@ -19,7 +19,9 @@ use crate::render::fast::FastGolden;
 use crate::scene::images::SceneRoms;
 use crate::scene::{Scene, Tri};
 use crate::verify::feed::{Stalls, feed_order};
-use crate::verify::frame::{PixelRay, frame_rays, simulate_hdl, simulate_rust};
+use crate::scene::memory::SceneImage;
+use crate::verify::frame::{PixelRay, frame_rays, frame_stream, run_stream, simulate_hdl, simulate_rust};
+use crate::verify::frame_memory::simulate_external;
 use crate::verify::simulators::Simulator;
 use draw::{Case, CaseScene};
 use serde::Serialize;
@@ -75,6 +77,8 @@ pub struct Built {
     pub roms: SceneRoms,
     pub core: CoreParams,
     pub rays: Vec<PixelRay>,
+    /// The scene's image in memory, for a core with its scene there.
+    pub image: Option<SceneImage>,
 }
 
 /// The triangles of a case's scene.
@@ -97,7 +101,9 @@ pub fn build(case: &mut Case, tris: Vec<Tri>) -> crate::error::Result<Built> {
     // A frame whose walks would take the core more than `MAX_CYCLES` (a one-slot core on a
     // deep scene) is made smaller, so every case takes seconds, not minutes.
     let mut rays = frame_rays(&scene, &cam);
-    while cam.width * cam.height > 4 && estimated_cycles(&scene, &rays, case.shape) > MAX_CYCLES {
+    // An external-memory core waits on its memory and simulates at a third of the speed.
+    let budget = if case.memory.is_some() { MAX_CYCLES / 4 } else { MAX_CYCLES };
+    while cam.width * cam.height > 4 && estimated_cycles(&scene, &rays, case.shape) > budget {
         (cam.width, cam.height) = ((cam.width * 7 / 10).max(2), (cam.height * 7 / 10).max(2));
         rays = frame_rays(&scene, &cam);
     }
@@ -105,19 +111,21 @@ pub fn build(case: &mut Case, tris: Vec<Tri>) -> crate::error::Result<Built> {
     let roms = SceneRoms::of(&scene);
     let id_width = crate::scene::rom::addr_bits((cam.width * cam.height) as usize);
     let s = case.shape;
-    let core = CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec {
-            id_width,
-            div_bits: s.div_bits,
-            target_mhz: s.target_mhz,
-            slots: s.slots,
-            units: s.units,
-        },
-    );
+    let spec = crate::cores::top::CoreSpec {
+        id_width,
+        div_bits: s.div_bits,
+        target_mhz: s.target_mhz,
+        slots: s.slots,
+        units: s.units,
+    };
+    let core = CoreParams::shaped(&roms, &spec);
     core.check()?;
+    let (core, image) = match case.memory {
+        Some((mem, _)) => (CoreParams::external(&roms, &spec, mem)?, Some(SceneImage::build(&roms, mem.shape)?)),
+        None => (core, None),
+    };
     let rays = feed_order(&rays, case.shuffle_seed);
-    Ok(Built { scene, roms, core, rays })
+    Ok(Built { scene, roms, core, rays, image })
 }
 
 /// About what a case may cost: the Rust simulator runs the core at some 6,000 cycles a second.
@@ -137,12 +145,29 @@ fn estimated_cycles(scene: &Scene, rays: &[PixelRay], shape: draw::Shape) -> u64
 /// order, in the same cycles (its testbench checks every result against the golden model).
 pub fn run(case: &Case, b: &Built, hdl: Option<Simulator>) -> CaseOutcome {
     let stalls = case.stalls.map_or_else(Stalls::none, |(percent, seed)| Stalls::random(percent, seed));
-    let (results, stats) = simulate_rust(&b.core, &b.roms, &b.rays, &stalls, &|_| {});
+    let external = b.image.as_ref().zip(case.memory.map(|m| m.1));
+    let (results, stats) = match external {
+        Some((image, timing)) => {
+            let (results, stats, _) = simulate_external(&b.core, &b.roms, image, &b.rays, timing, &stalls, &|_| {});
+            (results, stats)
+        }
+        None => simulate_rust(&b.core, &b.roms, &b.rays, &stalls, &|_| {}),
+    };
     let mut out = compare(&b.scene, &b.rays, &results, (stats.visits + stats.culls, stats.busy_cycles), stats.cycles);
     if let Some(sim) = hdl {
         out.hdl = Some(sim);
         let dir = tempfile::tempdir().expect("a temporary folder");
-        out.hdl_disagreement = match simulate_hdl(sim, &b.core, &b.scene, &b.rays, &stalls, dir.path()) {
+        let ran = match external {
+            // The testbench's memory model with the case's timing (frame_stream gives it the image).
+            Some((_, timing)) => frame_stream(&b.core, &b.scene, &b.rays, &stalls).and_then(|mut stream| {
+                if let Some((t, _)) = stream.memory.as_mut() {
+                    *t = timing;
+                }
+                run_stream(sim, &stream, dir.path())
+            }),
+            None => simulate_hdl(sim, &b.core, &b.scene, &b.rays, &stalls, dir.path()),
+        };
+        out.hdl_disagreement = match ran {
             Err(e) => Some(e.to_string()),
             Ok((r, _)) if r != results => Some(format!("{} results differ from the Rust simulator's", sim.name())),
             Ok((_, st)) if (st.cycles, st.busy_cycles) != (stats.cycles, stats.busy_cycles) => Some(format!(
@@ -298,6 +323,8 @@ pub struct Report {
     pub parameter_sets: usize,
     pub shapes: usize,
     pub inside_cameras: u64,
+    /// Cases that ran with the scene in external memory (tiny caches, a random memory).
+    pub external_cases: u64,
     /// Cases that also ran in the HDL simulator.
     pub hdl_cases: u64,
     /// Cases with a wrong result, walk or panic, and rays with a wrong result.
@@ -338,6 +365,7 @@ pub fn campaign(c: &Campaign, progress: &dyn Fn(u64, u64)) -> crate::error::Resu
                     report.rays += o.rays;
                     report.cycles += o.cycles;
                     report.inside_cameras += run.case.inside as u64;
+                    report.external_cases += run.case.memory.is_some() as u64;
                     report.hdl_cases += o.hdl.is_some() as u64;
                     report.disagreeing_rays += o.disagreeing_rays;
                     scenes.insert(run.case.scene.label());

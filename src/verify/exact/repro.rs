@@ -66,6 +66,24 @@ pub fn sim_command(case: &Case, obj: &Path, hdl: Option<crate::verify::simulator
     if let Some((percent, seed)) = case.stalls {
         write!(cmd, " --stall-percent {percent} --stall-seed {seed}").expect("a String");
     }
+    if let Some((m, t)) = case.memory {
+        write!(
+            cmd,
+            " --memory external --mem-bits {} --cache-line {} --node-cache-kb {} --tri-cache-kb {} --cache-ways {} \
+             --mem-latency {} --mem-outstanding {} --mem-jitter {} --mem-pauses {} --mem-seed {}",
+            m.shape.mem_bits,
+            m.shape.line_bytes,
+            m.node_cache_kb,
+            m.tri_cache_kb,
+            m.ways,
+            t.latency,
+            t.outstanding,
+            t.extra_delay,
+            t.pause_in_256,
+            t.seed
+        )
+        .expect("a String");
+    }
     cmd
 }
 
@@ -99,6 +117,10 @@ pub fn write(out: &Path, run: &CaseRun) -> Result<PathBuf> {
         "camera": case.camera.map(|c| serde_json::json!({
             "eye": c.eye, "at": c.at, "up": c.up, "fov": c.fov_deg, "size": [c.width, c.height], "inside": case.inside })),
         "shuffle_seed": case.shuffle_seed, "stalls": case.stalls,
+        "memory": case.memory.map(|(m, t)| serde_json::json!({
+            "mem_bits": m.shape.mem_bits, "line_bytes": m.shape.line_bytes, "node_cache_kb": m.node_cache_kb,
+            "tri_cache_kb": m.tri_cache_kb, "ways": m.ways, "latency": t.latency, "outstanding": t.outstanding,
+            "jitter": t.extra_delay, "pauses_in_256": t.pause_in_256, "seed": t.seed })),
         "command": command,
     });
     match &run.verdict {
