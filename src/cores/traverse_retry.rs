@@ -33,8 +33,14 @@ impl<'b> Unit<'b> {
         let pop = b.wire("retry_pop", Ty::BIT);
         let q = fifo(b, "retry_q", width, self.p.slots, push, entry, pop);
         let [slot, node, tmin, tmax, sp, wait] = unpack(q.head, &widths)[..] else { unreachable!("six fields") };
-        // `done` is the cache's register and the head a RAM's: one 16-bit subtract between them.
-        let ready = (q.nonempty & released(cache.done, wait)).name("retry_ready");
+        // Registered, so A's choice (a retry before rays back from a leaf and new rays) starts at
+        // a register: the 16-bit subtract behind the head's bypass select, then A's pops and the
+        // unpark queue's count, were the external core's critical path (16.6 ns, 60 MHz on the
+        // LFE5U-85F). A head released in clock c is ready in c + 1: `released` stays true once
+        // true, and the head changes only by a pop, after which the next head waits a clock.
+        let released_now = (q.nonempty & released(cache.done, wait) & !pop).name("retry_released");
+        let ready = b.reg("retry_ready", Ty::BIT, Some(0));
+        b.next(ready, released_now);
         RetryQueue { ready, pop, slot, node, tmin: tmin.signed(), tmax: tmax.signed(), sp, push, entry }
     }
 
