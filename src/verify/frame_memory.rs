@@ -171,4 +171,22 @@ mod tests {
             eprintln!("{timing:?}: {} cycles, {:?}", stats.cycles, ms);
         }
     }
+
+    /// A tree with fewer nodes than a node line holds (the five-triangle `thin`, 8-byte node
+    /// records at a 32-bit port: 16 to a line, node numbers of 3 bits): the core builds and
+    /// every ray is right. The campaign's first external finding was a panic building it.
+    #[test]
+    fn a_tree_smaller_than_a_node_line_works() {
+        let params = Params { n: 24, m: 51, leaf_size: 1, ..Params::default() };
+        let scene = Scene::load(&SceneSource::Builtin("thin".into()), &params).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 4, 4));
+        let spec = MemorySpec { shape: MemoryShape { mem_bits: 32, line_bytes: 128 }, ..MemorySpec::default() };
+        let p = CoreParams::external(&roms, &CoreSpec::default(), spec).unwrap();
+        assert!(p.mem.as_ref().unwrap().node_line_shift() > p.trav.node_bits, "the case it guards");
+        let image = SceneImage::build(&roms, spec.shape).unwrap();
+        let (results, _, _) =
+            simulate_external(&p, &roms, &image, &rays, MemoryTiming::default(), &Stalls::none(), &|_| ());
+        assert_eq!(mismatches(&scene, &rays, &results), 0);
+    }
 }
