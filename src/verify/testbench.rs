@@ -3,6 +3,7 @@
 //! Verilog testbench that apply the same inputs to the generated HDL and compare. Each kind of
 //! testbench is one struct for both languages: its template includes the language's file.
 
+use crate::cores::top_memory::is_memory_port;
 use super::simulators::{Simulator, tb_name};
 use crate::rtl::netlist::{Module, SigId};
 use crate::rtl::sim::Sim;
@@ -100,11 +101,6 @@ struct StreamTb<'a> {
     mem_base_bits: String,
 }
 
-/// Whether an input is one of an external-memory core's memory inputs (the testbench's memory
-/// model drives them).
-fn is_memory_input(name: &str) -> bool {
-    name == "mem_base" || name.starts_with("m_axi_")
-}
 
 /// A stream testbench's data: the inputs of each ray (every input port but `ray_valid`, in
 /// port order) in the order the source offers them, and, indexed by id, the expected values of
@@ -141,8 +137,8 @@ pub struct Stream<'a> {
 /// writes `results.txt`, one line of checked outputs per result, in arrival order.
 pub fn stream_files(m: &Module, s: &Stream, sim: Simulator) -> Vec<(String, String)> {
     let in_ids: Vec<(String, SigId)> =
-        input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid" && n != "res_ready" && !is_memory_input(n)).collect();
-    let mem_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| is_memory_input(n)).collect();
+        input_ids(m).into_iter().filter(|(n, _)| n != "ray_valid" && n != "res_ready" && !is_memory_port(n)).collect();
+    let mem_ids: Vec<(String, SigId)> = input_ids(m).into_iter().filter(|(n, _)| is_memory_port(n)).collect();
     let (mem_inputs, _) = ports(m, &mem_ids, 0);
     assert_eq!(mem_inputs.is_empty(), s.mem_base.is_none(), "a memory model for an external-memory core alone");
     let base = s.mem_base.unwrap_or(0);
