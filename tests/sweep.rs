@@ -326,3 +326,71 @@ fn core_shapes_are_swept_and_throughput_is_plotted_against_area() {
     assert!(text(&o.stdout).starts_with("0 computed, 4 from the cache"), "{}", text(&o.stdout));
     assert!(tree(&out) == before);
 }
+
+/// `--memory external --core-sim`: the memory's latency and the node cache's size as axes, a
+/// row per point with the memory side's figures, every ray against the golden model, and rays
+/// per clock and bytes per ray plotted against each and linked in the report.
+#[test]
+fn external_memory_sweeps_plot_throughput_and_bytes_per_ray_against_latency_and_cache_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("memory");
+    let args = ["sweep", "--builtin", "teapot", "--size", "8x8", "--memory", "external", "--mem-latency", "1,100"];
+    let args = [&args[..], &["--node-cache-kb", "2,16", "--tri-cache-kb", "4", "--core-sim", "--out"]].concat();
+    let o = fxrt(&[&args[..], &[out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let rows = rows(&out);
+    let points: Vec<(&str, &str, &str)> = rows
+        .iter()
+        .map(|r| (r["mem_latency"].as_str(), r["node_cache_kb"].as_str(), r["tri_cache_kb"].as_str()))
+        .collect();
+    assert_eq!(points, [("1", "2", "4"), ("1", "16", "4"), ("100", "2", "4"), ("100", "16", "4")]);
+    let num = |r: &BTreeMap<String, String>, k: &str| -> f64 {
+        r[k].parse().unwrap_or_else(|_| panic!("{k} = '{}' is not a number", r[k]))
+    };
+    for r in &rows {
+        assert_eq!(r["core_mismatches"], "0", "{r:?}");
+        assert!(num(r, "mem_bytes_per_ray") > 0.0 && num(r, "mem_reads_per_ray") > 0.0, "{r:?}");
+        for k in ["node_cache_hit_rate", "tri_cache_hit_rate", "mem_busy", "memory_stall_fraction"] {
+            assert!((0.0..=1.0).contains(&num(r, k)), "{k}: {r:?}");
+        }
+    }
+    // A larger node cache hits more and takes more block RAM; a longer latency costs clocks.
+    for (small, large) in [(0, 1), (2, 3)] {
+        assert!(num(&rows[large], "node_cache_hit_rate") > num(&rows[small], "node_cache_hit_rate"));
+        assert!(num(&rows[large], "cache_bram_bits") > num(&rows[small], "cache_bram_bits"));
+    }
+    for (near, far) in [(0, 2), (1, 3)] {
+        assert!(num(&rows[far], "rays_per_clock") < num(&rows[near], "rays_per_clock"), "{rows:?}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## External memory") && report.contains("| L (memory latency, clocks) | 1, 100 |"));
+    for what in ["rays_per_clock", "bytes_per_ray"] {
+        for axis in ["mem-latency", "node-cache-kb"] {
+            let file = format!("plots/memory_{what}_{axis}.png");
+            assert!(report.contains(&format!("({file})")), "{file} not in the report");
+            let bytes = std::fs::read(out.join(&file)).unwrap();
+            let info = png::Decoder::new(std::io::Cursor::new(bytes)).read_info().unwrap().info().clone();
+            assert!(info.width >= 800 && info.height >= 400, "{file}: {}×{}", info.width, info.height);
+        }
+    }
+    // The memory's lists belong to external sweeps, and are checked before anything runs.
+    for (extra, expect) in [
+        (vec!["--mem-latency", "40"], "--mem-latency: is an axis of external-memory sweeps: add --memory external"),
+        (
+            vec!["--memory", "external", "--mem-latency", "0,40"],
+            "--mem-latency: 0 (in '0') is out of range: must be 1..=1000",
+        ),
+        (
+            vec!["--memory", "external", "--node-cache-kb", "3"],
+            "--node-cache-kb: 3 KB: a cache must hold a power of two",
+        ),
+        (vec!["--memory", "auto"], "--memory: a sweep names onchip or external"),
+    ] {
+        let bad = dir.path().join("bad");
+        let o = fxrt(&[&["sweep", "--size", "8x8", "--out", bad.to_str().unwrap()][..], &extra[..]].concat());
+        let err = text(&o.stderr);
+        assert_eq!((o.status.code(), err.lines().count()), (Some(2), 1), "{extra:?}: {err}");
+        assert!(err.contains(expect), "{extra:?}: {err}");
+        assert!(!bad.exists());
+    }
+}

@@ -112,6 +112,34 @@ pub struct SweepArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    #[command(flatten)]
+    pub memory: SweepMemoryArgs,
+}
+
+/// `fxrt sweep --memory external`: the memory's latency and the caches' sizes as lists.
+#[derive(Args, Debug)]
+pub struct SweepMemoryArgs {
+    /// Where every core keeps its scene: onchip, or external (behind an AXI4 read port and
+    /// on-chip caches; the lists below become axes).
+    #[arg(long, value_enum, default_value = "onchip")]
+    pub memory: super::args::MemoryPlace,
+    /// --memory external: the memory model's latency, clocks (1..=1000; list).
+    #[arg(long = "mem-latency")]
+    pub mem_latency: Option<String>,
+    /// --memory external: each traversal unit's node cache, KB (list).
+    #[arg(long = "node-cache-kb")]
+    pub node_cache_kb: Option<String>,
+    /// --memory external: the triangle cache, KB (list).
+    #[arg(long = "tri-cache-kb")]
+    pub tri_cache_kb: Option<String>,
+    #[command(flatten)]
+    pub shape: super::args::MemoryArgs,
+    /// --memory external: ways of each cache: 1, 2 or 4.
+    #[arg(long = "cache-ways", default_value_t = crate::cores::memory_params::DEFAULT_WAYS)]
+    pub cache_ways: u32,
+    /// --memory external: feed rays in pixel order or in 8 × 8 tiles.
+    #[arg(long = "ray-order", value_enum, default_value = "pixels")]
+    pub ray_order: super::args::RayOrder,
 }
 
 #[derive(Subcommand, Debug)]

@@ -102,6 +102,7 @@ impl SweepArgs {
             slots: values::parse_u32_list("slots", &self.slots)?,
             units: values::parse_u32_list("units", &self.units)?,
             ecp5: self.ecp5()?,
+            memory: self.memory.sweep()?,
         })
     }
 
@@ -124,5 +125,59 @@ impl SweepArgs {
             "xc5v" => Ok(None),
             other => Err(Error::param("family", format!("'{other}' is not a sweep family: use xc5v or ecp5"))),
         }
+    }
+}
+
+impl super::args_hw::SweepMemoryArgs {
+    /// `--memory external`'s fixed options and lists, each value checked; None on chip (where
+    /// the lists are refused, naming the option).
+    fn sweep(&self) -> Result<Option<crate::sweep::memory::MemorySweep>> {
+        use super::args::{MemoryPlace, RayOrder};
+        use crate::sweep::values::parse_u32_list;
+        let lists = [
+            ("mem-latency", &self.mem_latency),
+            ("node-cache-kb", &self.node_cache_kb),
+            ("tri-cache-kb", &self.tri_cache_kb),
+        ];
+        match self.memory {
+            MemoryPlace::Auto => {
+                return Err(Error::param(
+                    "memory",
+                    "a sweep names onchip or external (auto is per scene in sim and gen)",
+                ));
+            }
+            MemoryPlace::Onchip => {
+                if let Some((name, _)) = lists.iter().find(|(_, v)| v.is_some()) {
+                    return Err(Error::param(name, "is an axis of external-memory sweeps: add --memory external"));
+                }
+                return Ok(None);
+            }
+            MemoryPlace::External => {}
+        }
+        let shape = self.shape.shape()?;
+        if ![1, 2, 4].contains(&self.cache_ways) {
+            return Err(Error::param("cache-ways", format!("{} is not one of 1, 2, 4", self.cache_ways)));
+        }
+        let d = crate::sweep::memory::MemoryPoint::default();
+        let list = |name: &str, v: &Option<String>, default: u32| match v {
+            Some(text) => parse_u32_list(name, text),
+            None => Ok(vec![default]),
+        };
+        let node_cache_kb = list("node-cache-kb", &self.node_cache_kb, d.node_cache_kb)?;
+        let tri_cache_kb = list("tri-cache-kb", &self.tri_cache_kb, d.tri_cache_kb)?;
+        for (flag, kbs) in [("node-cache-kb", &node_cache_kb), ("tri-cache-kb", &tri_cache_kb)] {
+            for &kb in kbs {
+                crate::cores::memory_params::check_cache_kb(flag, kb, shape.line_bytes, self.cache_ways)?;
+            }
+        }
+        Ok(Some(crate::sweep::memory::MemorySweep {
+            mem_bits: shape.mem_bits,
+            cache_line: shape.line_bytes,
+            ways: self.cache_ways,
+            tiles: self.ray_order == RayOrder::Tiles,
+            latency: list("mem-latency", &self.mem_latency, d.latency)?,
+            node_cache_kb,
+            tri_cache_kb,
+        }))
     }
 }

@@ -21,6 +21,23 @@ pub const INFLIGHT: u32 = 8;
 /// Bursts the read master keeps in flight at most.
 pub const OUTSTANDING: u32 = 16;
 
+/// The sets of a `kb`-KB cache of `ways`-way sets of `line`-byte lines: refused (naming
+/// `flag`) unless a power of two of at least two, and the size 1 to 4096 KB.
+pub fn check_cache_kb(flag: &'static str, kb: u32, line: u32, ways: u32) -> Result<u64> {
+    let sets = (kb as u64 * 1024) / line as u64 / ways as u64;
+    if kb == 0 || kb > 4096 || !sets.is_power_of_two() || sets < 2 {
+        return Err(Error::param(
+            flag,
+            format!(
+                "{kb} KB: a cache must hold a power of two of at least two sets of {ways} {line}-byte lines (e.g. {} \
+                 KB)",
+                (2 * ways * line).div_ceil(1024).next_power_of_two()
+            ),
+        ));
+    }
+    Ok(sets)
+}
+
 /// The options of an external-memory core.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MemorySpec {
@@ -83,19 +100,7 @@ impl ExternalMemory {
         }
         let (line, beat) = (spec.shape.line_bytes, spec.shape.beat_bytes());
         let cache = |flag: &'static str, kb: u32, rec_bytes: u32, records_per_line: u32, lines: u64, bits: u32| {
-            let line_count = (kb as u64 * 1024) / line as u64;
-            let sets = line_count / spec.ways as u64;
-            if kb == 0 || kb > 4096 || !sets.is_power_of_two() || sets < 2 {
-                return Err(Error::param(
-                    flag,
-                    format!(
-                        "{kb} KB: a cache must hold a power of two of at least two sets of {} {line}-byte lines \
-                         (e.g. {} KB)",
-                        spec.ways,
-                        (2 * spec.ways * line).div_ceil(1024).next_power_of_two()
-                    ),
-                ));
-            }
+            let sets = check_cache_kb(flag, kb, line, spec.ways)?;
             Ok(CacheParams {
                 record_bits: bits,
                 record_beats: rec_bytes / beat,

@@ -1,11 +1,12 @@
 //! One configuration: the golden model's frame against the f64 reference, the triangle counts,
 //! and the hardware cost (estimated, or from yosys with `--synth`).
 
+use super::memory::{self, MemoryPoint, MemoryRun, MemorySweep};
 use super::pnr::{PlacedModule, Pnr};
 use super::{CameraSpec, Config, CoreShape, SceneSpec, Set, SweepSpec, params_label};
 use crate::cores::clock::DEFAULT_TARGET_MHZ;
 use crate::cores::cost::{CoreCost, core_cost, dsp48e_estimate};
-use crate::cores::top::{CoreParams, core_module_with};
+use crate::cores::top::{CoreParams, DEFAULT_SLOTS, DEFAULT_UNITS, core_module_with};
 use crate::error::{Error, Result};
 use crate::fpga::xilinx::synth_xc5v;
 use crate::model::camera::Camera;
@@ -13,9 +14,11 @@ use crate::params::Params;
 use crate::render::tracer::{ModelKind, make_tracer};
 use crate::render::{Frame, encode_png, render};
 use crate::scene::images::SceneRoms;
+use crate::scene::memory::SceneImage;
 use crate::scene::{Scene, Tri, TriangleCounts, builtin, obj};
-use crate::verify::feed::Stalls;
+use crate::verify::feed::{Stalls, tile_order};
 use crate::verify::frame::{frame_rays, mismatches, simulate_rust};
+use crate::verify::frame_memory::simulate_external;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::sync::OnceLock;
@@ -127,9 +130,12 @@ impl SceneCtx {
         if spec.target_mhz != DEFAULT_TARGET_MHZ {
             text["target_mhz"] = spec.target_mhz.into();
         }
-        if !shape.is_default() {
+        if (shape.slots, shape.units) != (DEFAULT_SLOTS, DEFAULT_UNITS) {
             text["slots"] = shape.slots.into();
             text["units"] = shape.units.into();
+        }
+        if let Some(m) = &spec.memory {
+            text["memory"] = serde_json::json!({ "sweep": m, "point": shape.memory });
         }
         if let (true, Some(e)) = (synth, &spec.ecp5) {
             text["family"] = "ecp5".into();
@@ -208,6 +214,9 @@ pub struct Row {
     pub cost: Option<CoreCost>,
     pub synth: Option<SynthArea>,
     pub core: Option<CoreRun>,
+    /// `--memory external --core-sim`: what the memory side did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory: Option<MemoryRun>,
     /// `--family ecp5`: each module placed and routed, in `fpga::ecp5::MODULES` order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub ecp5: Vec<PlacedModule>,
@@ -253,6 +262,8 @@ pub struct Extras {
     pub target_mhz: u32,
     /// Place and route on the ECP5 (`--family ecp5`), in DIR/KEY/MODULE.
     pub pnr: Option<Pnr>,
+    /// `--memory external`: the cores read their scene from external memory.
+    pub memory: Option<MemorySweep>,
 }
 
 pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> Evaluated {
@@ -267,6 +278,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         cost: None,
         synth: None,
         core: None,
+        memory: None,
         ecp5: Vec::new(),
         mrays_per_s_at_fmax: None,
         error: None,
@@ -296,27 +308,24 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
     let (slots, units) = (cfg.shape.slots, cfg.shape.units);
-    let core_params = CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec { id_width, div_bits: 1, target_mhz: extras.target_mhz, slots, units },
-    );
+    let core_spec = crate::cores::top::CoreSpec { id_width, div_bits: 1, target_mhz: extras.target_mhz, slots, units };
+    let core_params = match &extras.memory {
+        None => CoreParams::shaped(&roms, &core_spec),
+        Some(m) => match CoreParams::external(&roms, &core_spec, m.spec(cfg.shape.memory)) {
+            Ok(p) => p,
+            Err(e) => {
+                row.error = Some(e.to_string());
+                return Evaluated { render_png: frame.png_bytes(), errors_png: errors_png(&frame, reference), row };
+            }
+        },
+    };
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
-        let rays = frame_rays(&scene, &ctx.camera);
-        let (results, stats) = simulate_rust(&core_params, &roms, &rays, &Stalls::none(), &|_| {});
-        let run = CoreRun {
-            cycles_per_ray: stats.cycles_per_ray(),
-            rays_per_clock: stats.rays_per_clock(),
-            fill: stats.fill(),
-            triangle_tests_per_ray: stats.triangle_tests_per_ray(),
-            node_steps_per_ray: stats.node_steps_per_ray(),
-            slot_occupancy: stats.slot_occupancy(),
-            max_stack_depth: stats.max_stack_depth as u64,
-            mismatches: mismatches(&scene, &rays, &results),
-        };
+        let (run, memory) = simulate_core(&scene, &ctx.camera, &core_params, &roms, cfg.shape.memory, &extras.memory);
         if run.mismatches > 0 {
             row.error = Some(format!("the core disagrees with the golden model on {} rays", run.mismatches));
         }
         row.core = Some(run);
+        row.memory = memory;
     }
     if let (Some(dir), Some(_)) = (&extras.synth_dir, &row.cost) {
         let core = core_module_with(&core_params, &roms, false);
@@ -347,6 +356,44 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     let render_png = frame.png_bytes();
     let errors_png = errors_png(&frame, reference);
     Evaluated { row, render_png, errors_png }
+}
+
+/// The frame through the core of `p` in the Rust simulator: the core's figures and, for an
+/// external-memory core (`memory`), the memory side's at `point`'s latency.
+fn simulate_core(
+    scene: &Scene,
+    camera: &Camera,
+    p: &CoreParams,
+    roms: &SceneRoms,
+    point: MemoryPoint,
+    memory: &Option<MemorySweep>,
+) -> (CoreRun, Option<MemoryRun>) {
+    let rays = frame_rays(scene, camera);
+    let (results, stats, ms) = match (memory, &p.mem) {
+        (Some(m), Some(ext)) => {
+            let rays = if m.tiles { tile_order(&rays, |r| r.pixel, camera.width, 8) } else { rays.clone() };
+            // The image of a scene the core was just built for fits its own layout.
+            let image = SceneImage::build(roms, ext.spec.shape).expect("the scene image of a built core");
+            let (results, stats, ms) =
+                simulate_external(p, roms, &image, &rays, memory::timing(point), &Stalls::none(), &|_| {});
+            (results, stats, Some(MemoryRun::of(&ms, ext.bram_bits(p.units, p.total_slots()))))
+        }
+        _ => {
+            let (results, stats) = simulate_rust(p, roms, &rays, &Stalls::none(), &|_| {});
+            (results, stats, None)
+        }
+    };
+    let run = CoreRun {
+        cycles_per_ray: stats.cycles_per_ray(),
+        rays_per_clock: stats.rays_per_clock(),
+        fill: stats.fill(),
+        triangle_tests_per_ray: stats.triangle_tests_per_ray(),
+        node_steps_per_ray: stats.node_steps_per_ray(),
+        slot_occupancy: stats.slot_occupancy(),
+        max_stack_depth: stats.max_stack_depth as u64,
+        mismatches: mismatches(scene, &rays, &results),
+    };
+    (run, ms)
 }
 
 /// `cost` (`core_cost`'s, for the default core) with what the clock target and the core's

@@ -12,6 +12,7 @@ pub mod compat;
 pub mod draw;
 pub mod eval;
 pub mod grid;
+pub mod memory;
 pub mod output;
 pub mod plots;
 pub mod pnr;
@@ -28,6 +29,7 @@ pub use crate::model::camera::CameraSpec;
 use crate::params::{EdgeShift, Params, TreeSplit};
 use crate::scene::SceneSource;
 use compat::{default_slots, default_units, is_default_slots, is_default_units, one_or_many};
+use memory::{MemoryPoint, MemorySweep};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -86,6 +88,10 @@ pub struct SweepSpec {
     /// `--synth --family ecp5`: place and route on the LFE5U-85F instead of Virtex-5 area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ecp5: Option<Ecp5Choice>,
+    /// `--memory external`: the cores read their scene from external memory; the memory's
+    /// latency and the caches' sizes are axes (absent for on-chip sweeps, as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory: Option<MemorySweep>,
 }
 
 fn default_target_mhz() -> u32 {
@@ -124,11 +130,27 @@ pub enum Axis {
     LeafSize,
     Slots,
     Units,
+    MemLatency,
+    NodeCacheKb,
+    TriCacheKb,
 }
 
 impl Axis {
-    pub const ALL: [Axis; 8] =
-        [Axis::N, Axis::M, Axis::EdgeShift, Axis::T, Axis::C, Axis::LeafSize, Axis::Slots, Axis::Units];
+    pub const ALL: [Axis; 11] = [
+        Axis::N,
+        Axis::M,
+        Axis::EdgeShift,
+        Axis::T,
+        Axis::C,
+        Axis::LeafSize,
+        Axis::Slots,
+        Axis::Units,
+        Axis::MemLatency,
+        Axis::NodeCacheKb,
+        Axis::TriCacheKb,
+    ];
+    /// The axes of an external-memory sweep (`--memory external`).
+    pub const MEMORY: [Axis; 3] = [Axis::MemLatency, Axis::NodeCacheKb, Axis::TriCacheKb];
     /// The axes sweeps had before the leaf size and the core's shape became lists: always
     /// named in titles and labels; the others only when swept.
     pub const ARITHMETIC: [Axis; 5] = [Axis::N, Axis::M, Axis::EdgeShift, Axis::T, Axis::C];
@@ -143,6 +165,9 @@ impl Axis {
             Axis::LeafSize => "leaf-size",
             Axis::Slots => "slots",
             Axis::Units => "units",
+            Axis::MemLatency => "mem-latency",
+            Axis::NodeCacheKb => "node-cache-kb",
+            Axis::TriCacheKb => "tri-cache-kb",
         }
     }
     /// The symbol the thesis uses (docs/CORE.md's K and U for the core's shape).
@@ -156,6 +181,9 @@ impl Axis {
             Axis::LeafSize => "leaf",
             Axis::Slots => "K",
             Axis::Units => "U",
+            Axis::MemLatency => "L",
+            Axis::NodeCacheKb => "node KB",
+            Axis::TriCacheKb => "tri KB",
         }
     }
     /// This parameter of `s`, as text (`auto` for the adaptive edge shift).
@@ -170,28 +198,35 @@ impl Axis {
             Axis::LeafSize => p.leaf_size.to_string(),
             Axis::Slots => s.shape.slots.to_string(),
             Axis::Units => s.shape.units.to_string(),
+            Axis::MemLatency => s.shape.memory.latency.to_string(),
+            Axis::NodeCacheKb => s.shape.memory.node_cache_kb.to_string(),
+            Axis::TriCacheKb => s.shape.memory.tri_cache_kb.to_string(),
         }
     }
-    /// Whether the golden model's image can depend on this parameter (the core's shape
-    /// changes how fast the core computes it, not what).
+    /// Whether the golden model's image can depend on this parameter (the core's shape and
+    /// its memory change how fast the core computes it, not what).
     pub fn changes_image(self) -> bool {
-        !matches!(self, Axis::Slots | Axis::Units)
+        !matches!(self, Axis::Slots | Axis::Units) && !Axis::MEMORY.contains(&self)
     }
 }
 
 /// More configurations than any sweep should hold in one plan (a shard still plans them all).
 pub const MAX_CONFIGURATIONS: usize = 1_000_000;
 
-/// The core's shape: ray slots per traversal unit (K) and traversal units (U), docs/CORE.md.
+/// The core's shape: ray slots per traversal unit (K) and traversal units (U), docs/CORE.md;
+/// with `--memory external` also its caches' sizes and the memory's latency (docs/MEMORY.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct CoreShape {
     pub slots: u32,
     pub units: u32,
+    /// Absent from rows at the defaults (every on-chip sweep), as before it was swept.
+    #[serde(default, skip_serializing_if = "MemoryPoint::is_default")]
+    pub memory: MemoryPoint,
 }
 
 impl Default for CoreShape {
     fn default() -> Self {
-        CoreShape { slots: DEFAULT_SLOTS, units: DEFAULT_UNITS }
+        CoreShape { slots: DEFAULT_SLOTS, units: DEFAULT_UNITS, memory: MemoryPoint::default() }
     }
 }
 
@@ -260,6 +295,20 @@ impl SweepSpec {
             Axis::LeafSize => text(&self.leaf_size),
             Axis::Slots => text(&self.slots),
             Axis::Units => text(&self.units),
+            Axis::MemLatency | Axis::NodeCacheKb | Axis::TriCacheKb => text(&self.memory_values(axis)),
+        }
+    }
+
+    /// The values of a memory axis: its list with `--memory external`, else its default.
+    fn memory_values(&self, axis: Axis) -> Vec<u32> {
+        let d = MemoryPoint::default();
+        match (&self.memory, axis) {
+            (Some(m), Axis::MemLatency) => m.latency.clone(),
+            (Some(m), Axis::NodeCacheKb) => m.node_cache_kb.clone(),
+            (Some(m), _) => m.tri_cache_kb.clone(),
+            (None, Axis::MemLatency) => vec![d.latency],
+            (None, Axis::NodeCacheKb) => vec![d.node_cache_kb],
+            (None, _) => vec![d.tri_cache_kb],
         }
     }
 
@@ -280,6 +329,9 @@ impl SweepSpec {
             Axis::LeafSize => p.leaf_size = self.leaf_size[i],
             Axis::Slots => s.shape.slots = self.slots[i],
             Axis::Units => s.shape.units = self.units[i],
+            Axis::MemLatency => s.shape.memory.latency = self.memory_values(axis)[i],
+            Axis::NodeCacheKb => s.shape.memory.node_cache_kb = self.memory_values(axis)[i],
+            Axis::TriCacheKb => s.shape.memory.tri_cache_kb = self.memory_values(axis)[i],
         }
         s
     }
@@ -478,11 +530,16 @@ pub fn scene_labels(scenes: &[SceneSpec]) -> Vec<String> {
     out
 }
 
-/// `params_label` with the core's shape when it is not the default: `…_c16_k8_u1`.
+/// `params_label` with the core's shape when it is not the default: `…_c16_k8_u1`, and the
+/// memory point when not the default: `…_lat100_nc32_tc64`.
 pub fn set_label(s: &Set) -> String {
     let mut label = params_label(&s.params);
-    if !s.shape.is_default() {
+    let m = s.shape.memory;
+    if (s.shape.slots, s.shape.units) != (DEFAULT_SLOTS, DEFAULT_UNITS) {
         label += &format!("_k{}_u{}", s.shape.slots, s.shape.units);
+    }
+    if !m.is_default() {
+        label += &format!("_lat{}_nc{}_tc{}", m.latency, m.node_cache_kb, m.tri_cache_kb);
     }
     label
 }

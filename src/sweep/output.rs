@@ -235,11 +235,13 @@ fn with_extra(mut fields: Vec<String>, extra: Vec<String>) -> Vec<String> {
 }
 
 /// The header of results.csv: `CSV_COLUMNS`, with `SHAPE_COLUMNS` and `CORE_COLUMNS` where the
-/// sweep has them and `pnr::csv_columns` before the last three.
+/// sweep has them and `memory::csv_columns` and `pnr::csv_columns` before the last three.
 pub fn csv_columns(spec: &SweepSpec) -> Vec<String> {
     let header = CSV_COLUMNS.iter().map(|c| c.to_string()).collect();
     let fields = with_optional(spec, header, SHAPE_COLUMNS.map(String::from), CORE_COLUMNS.map(String::from));
-    with_extra(fields, super::pnr::csv_columns(spec))
+    let mut extra = super::memory::csv_columns(spec);
+    extra.extend(super::pnr::csv_columns(spec));
+    with_extra(fields, extra)
 }
 
 /// results.csv: a line per row under `csv_columns`.
@@ -257,8 +259,9 @@ pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
             k.map(|k| k.slot_occupancy.to_string()).unwrap_or_default(),
         ];
         let fields = with_optional(spec, csv_record(r), shape, core);
-        w.write_record(with_extra(fields, super::pnr::csv_cells(spec, &r.ecp5, r.mrays_per_s_at_fmax)))
-            .expect("csv into memory");
+        let mut extra = super::memory::csv_cells(spec, r.shape.memory, r.memory.as_ref());
+        extra.extend(super::pnr::csv_cells(spec, &r.ecp5, r.mrays_per_s_at_fmax));
+        w.write_record(with_extra(fields, extra)).expect("csv into memory");
     }
     w.into_inner().expect("csv into memory")
 }

@@ -22,6 +22,9 @@ const ZERO: f64 = 0.5;
 /// Where the Fmax plots of `--family ecp5` go: plots/fmax_PARAM.png.
 pub const FMAX_PLOTS: &str = "plots/fmax_";
 
+/// Where the plots of `--memory external --core-sim` go: plots/memory_WHAT_PARAM.png.
+pub const MEMORY_PLOTS: &str = "plots/memory_";
+
 /// Stages plots/error_PARAM.png per swept parameter that can change the image, with
 /// `--family ecp5` plots/fmax_PARAM.png per swept parameter, plots/pareto_dsp48e.png, and with
 /// `--core-sim` plots/throughput_AREA.png per area measure.
@@ -46,7 +49,48 @@ pub fn add_plots(files: &mut OutputSet, dir: &Path, results: &Results, plan: &Pl
         written.push(rel);
     }
     written.extend(super::throughput::add_plots(files, dir, results)?);
+    if results.spec.memory.is_some() && results.spec.core_sim {
+        for axis in results.spec.swept_axes() {
+            for (what, file) in
+                [(MemoryFigure::RaysPerClock, "rays_per_clock"), (MemoryFigure::BytesPerRay, "bytes_per_ray")]
+            {
+                let rel = format!("{MEMORY_PLOTS}{file}_{}.png", axis.name());
+                files.add(&dir.join(&rel), &memory_plot(results, plan, axis, what)?)?;
+                written.push(rel);
+            }
+        }
+    }
     Ok(written)
+}
+
+/// What a memory plot draws along an axis.
+#[derive(Clone, Copy)]
+enum MemoryFigure {
+    RaysPerClock,
+    BytesPerRay,
+}
+
+/// plots/memory_WHAT_PARAM.png: rays per clock or bytes read from memory per ray along `axis`
+/// (the others at the base set), a line per scene.
+fn memory_plot(results: &Results, plan: &Plan, axis: Axis, what: MemoryFigure) -> Result<Vec<u8>> {
+    let y: &dyn Fn(&Row) -> Option<f64> = match what {
+        MemoryFigure::RaysPerClock => &|r| Some(r.core.as_ref()?.rays_per_clock),
+        MemoryFigure::BytesPerRay => &|r| Some(r.memory.as_ref()?.mem_bytes_per_ray),
+    };
+    let (title, y_desc) = match what {
+        MemoryFigure::RaysPerClock => ("Rays per clock, scene in external memory,", "rays per clock (Rust simulator)"),
+        MemoryFigure::BytesPerRay => ("Bytes read from memory per ray", "bytes per ray (R beats × port width)"),
+    };
+    let lines: Vec<Line> = super::scene_labels(&results.spec.scenes)
+        .into_iter()
+        .map(|scene| {
+            let pts = points(results, plan, &scene, axis, y);
+            (scene, pts)
+        })
+        .collect();
+    let top = lines.iter().flat_map(|l| l.1.iter().map(|p| p.1)).fold(f64::MIN_POSITIVE, f64::max) * 1.2;
+    let chart = AxisChart::new(results, plan, axis, title, y_desc);
+    axis_chart(&AxisChart { lines, ..chart }, 0f64..top)
 }
 
 /// The points of one scene along `axis`: (position in the axis's list, y) for each row where

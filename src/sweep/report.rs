@@ -3,7 +3,7 @@
 
 use super::eval::{OTHER_SURFACE_REL, Row};
 use super::output::{Results, list};
-use super::plots::FMAX_PLOTS;
+use super::plots::{FMAX_PLOTS, MEMORY_PLOTS};
 use super::summary::{SetSummary, cheapest_same_image, pareto_front, set_summaries};
 use super::throughput::THROUGHPUT_PLOTS;
 use super::{Axis, Plan, Set};
@@ -40,6 +40,7 @@ struct Report {
     ecp5_rows: Vec<Vec<String>>,
     fmax_plots: Vec<String>,
     throughput_plots: Vec<String>,
+    memory_plots: Vec<String>,
     area_source: String,
 }
 
@@ -111,6 +112,7 @@ fn extra_axes(results: &Results) -> Vec<Axis> {
     if !spec.default_core_shape() {
         v.extend([Axis::Slots, Axis::Units]);
     }
+    v.extend(Axis::MEMORY.into_iter().filter(|&a| spec.values(a).len() > 1));
     v
 }
 
@@ -136,6 +138,9 @@ fn table_head(results: &Results) -> Vec<String> {
     );
     if results.spec.core_sim {
         head.push("rays/clock".into());
+    }
+    if results.spec.core_sim && results.spec.memory.is_some() {
+        head.extend(["bytes/ray", "node hits", "tri hits"].map(String::from));
     }
     head.push("note".into());
     head
@@ -169,6 +174,12 @@ fn row_cells(results: &Results, r: &super::eval::Row) -> Vec<String> {
     if results.spec.core_sim {
         v.push(r.core.as_ref().map(|k| format!("{:.4}", k.rays_per_clock)).unwrap_or_default());
     }
+    if results.spec.core_sim && results.spec.memory.is_some() {
+        let m = r.memory.as_ref();
+        v.push(m.map(|m| format!("{:.1}", m.mem_bytes_per_ray)).unwrap_or_default());
+        v.push(m.map(|m| format!("{:.3}", m.node_cache_hit_rate)).unwrap_or_default());
+        v.push(m.map(|m| format!("{:.3}", m.tri_cache_hit_rate)).unwrap_or_default());
+    }
     v.push(r.error.clone().unwrap_or_default().replace('|', "/"));
     v
 }
@@ -190,6 +201,19 @@ fn lists(results: &Results, plan: &Plan) -> Vec<(&'static str, String)> {
     if !spec.default_core_shape() {
         v.push(("K (ray slots per unit)", list(&spec.slots)));
         v.push(("U (traversal units)", list(&spec.units)));
+    }
+    if let Some(m) = &spec.memory {
+        let order = if m.tiles { "8 × 8 tiles" } else { "pixel order" };
+        v.push((
+            "memory",
+            format!(
+                "external: {}-bit AXI4 read port, {}-byte lines, {}-way caches, rays in {order}",
+                m.mem_bits, m.cache_line, m.ways
+            ),
+        ));
+        v.push(("L (memory latency, clocks)", list(&m.latency)));
+        v.push(("node cache KB (each unit's)", list(&m.node_cache_kb)));
+        v.push(("triangle cache KB", list(&m.tri_cache_kb)));
     }
     v.push(("base set", spec.set_text(&plan.base)));
     v
@@ -243,7 +267,7 @@ pub fn add_report(
         pareto,
         plots: plots
             .iter()
-            .filter(|p| !p.starts_with(FMAX_PLOTS) && !p.starts_with(THROUGHPUT_PLOTS))
+            .filter(|p| ![FMAX_PLOTS, THROUGHPUT_PLOTS, MEMORY_PLOTS].iter().any(|k| p.starts_with(k)))
             .cloned()
             .collect(),
         grids: grids.to_vec(),
@@ -254,6 +278,7 @@ pub fn add_report(
         ecp5_rows: pnr_report_rows(results),
         fmax_plots: plots.iter().filter(|p| p.starts_with(FMAX_PLOTS)).cloned().collect(),
         throughput_plots: plots.iter().filter(|p| p.starts_with(THROUGHPUT_PLOTS)).cloned().collect(),
+        memory_plots: plots.iter().filter(|p| p.starts_with(MEMORY_PLOTS)).cloned().collect(),
         area_source: super::throughput::source_text(results),
     };
     let text = report.render().map_err(|e| Error::new("sweep report", e.to_string()))?;

@@ -63,6 +63,7 @@ pub fn run(
         core_sim: spec.core_sim,
         target_mhz: spec.target_mhz,
         pnr,
+        memory: spec.memory.clone(),
     };
     let results: Vec<Result<(Row, bool)>> = mine
         .par_iter()

@@ -23,6 +23,7 @@ fn spec() -> SweepSpec {
         slots: vec![crate::cores::top::DEFAULT_SLOTS],
         units: vec![crate::cores::top::DEFAULT_UNITS],
         ecp5: None,
+        memory: None,
     }
 }
 
@@ -286,6 +287,7 @@ fn ecp5_columns_follow_the_modules() {
             max_stack_depth: 4,
             mismatches: 0,
         }),
+        memory: None,
         ecp5: vec![
             PlacedModule { kind: "divider".into(), timing: timing("fxrt_div", 172.1, Some(31)) },
             PlacedModule { kind: "core".into(), timing: timing("fxrt_core", 113.3, None) },
@@ -340,7 +342,7 @@ fn leaf_size_slots_and_units_are_axes() {
     assert!(plan.sets[..6].iter().all(|x| x.params == Params { m: 12, leaf_size: 2, ..Params::default() }));
     assert_eq!(plan.sets[6].params.leaf_size, 4);
     let c = &plan.configs[3];
-    assert_eq!((c.index, c.scene, c.shape), (3, 1, CoreShape { slots: 8, units: 2 }));
+    assert_eq!((c.index, c.scene, c.shape), (3, 1, CoreShape { slots: 8, units: 2, ..CoreShape::default() }));
     // The base: each at its default where listed (leaf 4, K 64, U 2).
     assert_eq!(plan.base.shape, CoreShape::default());
     assert_eq!(plan.base.params.leaf_size, 4);
@@ -353,16 +355,16 @@ fn leaf_size_slots_and_units_are_axes() {
     let expected = vec![
         base,
         Set { params: Params { leaf_size: 2, ..base.params }, ..base },
-        Set { shape: CoreShape { slots: 8, units: 2 }, ..base },
-        Set { shape: CoreShape { slots: 64, units: 1 }, ..base },
-        Set { shape: CoreShape { slots: 64, units: 4 }, ..base },
+        Set { shape: CoreShape { slots: 8, units: 2, ..CoreShape::default() }, ..base },
+        Set { shape: CoreShape { slots: 64, units: 1, ..CoreShape::default() }, ..base },
+        Set { shape: CoreShape { slots: 64, units: 4, ..CoreShape::default() }, ..base },
     ];
     assert_eq!(plan.sets, expected);
     assert_eq!(set_label(&expected[2]), "n29_m32_eauto_t0_c16_k8_u2");
     // Lists without the default: the base takes the first value.
     let s = SweepSpec { slots: vec![16, 8], units: vec![4], leaf_size: vec![8, 1], ..spec() };
     let base = s.plan().unwrap().base;
-    assert_eq!((base.shape, base.params.leaf_size), (CoreShape { slots: 16, units: 4 }, 8));
+    assert_eq!((base.shape, base.params.leaf_size), (CoreShape { slots: 16, units: 4, ..CoreShape::default() }, 8));
     let s = SweepSpec { slots: vec![], ..spec() };
     assert_eq!(s.plan().unwrap_err().to_string(), "--slots: the list is empty");
 }
@@ -392,4 +394,50 @@ fn specs_written_before_the_lists_read_back_the_same() {
     assert!(text.contains(r#""leaf_size":[2,8]"#) && text.contains(r#""slots":[8,64],"units":[1,2]"#), "{text}");
     assert_eq!(serde_json::from_str::<SweepSpec>(&text).unwrap(), lists);
     assert!(serde_json::from_str::<SweepSpec>(&old.replace(r#""leaf_size":2"#, r#""leaf_size":"2""#)).is_err());
+}
+
+/// `--memory external`: the latency and the two caches' sizes are axes of the core's shape
+/// (varied last), named where swept, in the key and the label; on-chip sweeps keep their keys.
+#[test]
+fn memory_latency_and_cache_sizes_are_axes_of_external_sweeps() {
+    use super::memory::{MemoryPoint, MemorySweep};
+    let memory = MemorySweep {
+        mem_bits: 64,
+        cache_line: 128,
+        ways: 2,
+        tiles: false,
+        latency: vec![1, 40, 200],
+        node_cache_kb: vec![32],
+        tri_cache_kb: vec![16, 64],
+    };
+    let s = SweepSpec { m: vec![32], t: vec![0], edge_shift: vec![EdgeShift::Auto], memory: Some(memory), ..spec() };
+    let plan = s.plan().unwrap();
+    assert_eq!(plan.sets.len(), 3 * 2);
+    assert_eq!(s.swept_axes(), vec![Axis::MemLatency, Axis::TriCacheKb]);
+    let points: Vec<(u32, u32)> =
+        plan.sets.iter().map(|x| (x.shape.memory.latency, x.shape.memory.tri_cache_kb)).collect();
+    assert_eq!(points, [(1, 16), (1, 64), (40, 16), (40, 64), (200, 16), (200, 64)]);
+    // The base: the defaults, 40 clocks and 32 + 64 KB.
+    assert_eq!(plan.base.shape.memory, MemoryPoint::default());
+    assert_eq!(s.set_text(&plan.base), "n=29 m=32 E=auto T=0 C=16 L=40 tri KB=64");
+    assert!(Axis::MEMORY.iter().all(|a| !a.changes_image()));
+    assert_eq!(set_label(&plan.sets[0]), "n29_m32_eauto_t0_c16_lat1_nc32_tc16");
+    assert_eq!(set_label(&plan.base), "n29_m32_eauto_t0_c16");
+    // Every point has its own key; the same point on chip keeps the key it always had.
+    let ctx = super::eval::SceneCtx::load(
+        &SceneSpec::Builtin("thin".into()),
+        "thin".into(),
+        &spec().camera,
+        &Params::default(),
+        &[4],
+    )
+    .unwrap();
+    let p = Params::default();
+    let keys: std::collections::BTreeSet<String> = plan.sets.iter().map(|x| ctx.key(&p, x.shape, &s)).collect();
+    assert_eq!(keys.len(), plan.sets.len());
+    assert!(!keys.contains(&ctx.key(&p, CoreShape::default(), &spec())));
+    // Written and read back; an on-chip spec writes no memory at all.
+    let text = serde_json::to_string(&s).unwrap();
+    assert_eq!(serde_json::from_str::<SweepSpec>(&text).unwrap(), s);
+    assert!(!serde_json::to_string(&spec()).unwrap().contains("memory"));
 }

@@ -7,8 +7,15 @@ use crate::error::{Error, Result};
 use crate::params::{EdgeShift, RANGES};
 
 /// The core's shape (`CoreParams::check`'s limits): ray slots per traversal unit, traversal
-/// units.
-pub const CORE_RANGES: &[(&str, u32, u32)] = &[("slots", 1, 64), ("units", 1, 4)];
+/// units; and with `--memory external` the memory model's latency and the caches' sizes
+/// (`MemoryTiming::validate`'s and `check_cache_kb`'s limits).
+pub const CORE_RANGES: &[(&str, u32, u32)] = &[
+    ("slots", 1, 64),
+    ("units", 1, 4),
+    ("mem-latency", 1, crate::verify::memory::MAX_LATENCY),
+    ("node-cache-kb", 1, 4096),
+    ("tri-cache-kb", 1, 4096),
+];
 
 /// Parses a list of unsigned values and ranges for parameter `name` (as in `params::RANGES`
 /// or `CORE_RANGES`), keeping the order given and dropping repeats.
