@@ -77,7 +77,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let chosen: Vec<Case> =
         cases().into_iter().filter(|c| wanted == "all" || wanted.split(',').any(|w| w == c.name)).collect();
     if chosen.is_empty() {
-        return Err(format!("--cases {wanted}: none of {}", cases().iter().map(|c| c.name).collect::<Vec<_>>().join(", ")).into());
+        return Err(format!(
+            "--cases {wanted}: none of {}",
+            cases().iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
+        )
+        .into());
     }
     println!(
         "External memory, {}-bit port, {}-byte lines, {} × {} KB node caches and a {} KB triangle cache, {} ways.\n",
@@ -88,7 +92,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         spec.tri_cache_kb,
         spec.ways
     );
-    println!("| case | scene (triangles) | frame | order | memory | rays | wrong | clocks | rays per clock | bytes per ray | reads per ray | node hit | triangle hit | R busy | stall |");
+    println!(
+        "| case | scene (triangles) | frame | order | memory | rays | wrong | clocks | rays per clock | bytes per ray | reads per ray | node hit | triangle hit | R busy | stall |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for c in &chosen {
         let scene = scene_of(c.scene)?;
@@ -96,13 +102,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let cam = Camera::default_for(&scene, c.size, c.size);
         let rays = frame_rays(&scene, &cam);
         let rays = if c.tiles { tile_order(&rays, |r| r.pixel, c.size, 8) } else { rays };
-        let shape = CoreSpec { id_width: fxrt::scene::rom::addr_bits((c.size * c.size) as usize), ..CoreSpec::default() };
+        let shape =
+            CoreSpec { id_width: fxrt::scene::rom::addr_bits((c.size * c.size) as usize), ..CoreSpec::default() };
         let p = CoreParams::external(&roms, &shape, spec)?;
         let image = SceneImage::build(&roms, spec.shape)?;
         let bar = progress_bar(rays.len() as u64, c.name);
-        let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, c.timing, &fxrt::verify::feed::Stalls::none(), &|n| {
-            bar.set_position(n)
-        });
+        let (results, stats, ms) =
+            simulate_external(&p, &roms, &image, &rays, c.timing, &fxrt::verify::feed::Stalls::none(), &|n| {
+                bar.set_position(n)
+            });
         bar.finish_and_clear();
         let wrong = mismatches(&scene, &rays, &results);
         let t = c.timing;

@@ -352,9 +352,7 @@ impl GenArgs {
         check_folder(&self.out)?;
         let mem_spec = self.memory.spec()?;
         if self.memory.memory == super::args::MemoryPlace::External {
-            for (name, given) in
-                [("raygen", self.raygen), ("board", self.board.is_some())]
-            {
+            for (name, given) in [("raygen", self.raygen), ("board", self.board.is_some())] {
                 if given {
                     return Err(Error::param(name, "not with --memory external yet (docs/MEMORY.md)"));
                 }
@@ -473,7 +471,8 @@ impl SynthArgs {
         };
         let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
         check_folder(&build)?;
-        let device_kbits = if matches!(family, Family::Ecp5 { .. }) { ECP5_85F_BRAM_KBITS } else { XC5VLX110T_BRAM_KBITS };
+        let device_kbits =
+            if matches!(family, Family::Ecp5 { .. }) { ECP5_85F_BRAM_KBITS } else { XC5VLX110T_BRAM_KBITS };
         Ok(SynthConfig {
             params: self.params.params()?,
             scene: self.scene.source(),

@@ -3,8 +3,8 @@
 //! Verilog testbench that apply the same inputs to the generated HDL and compare. Each kind of
 //! testbench is one struct for both languages: its template includes the language's file.
 
-use crate::cores::top_memory::is_memory_port;
 use super::simulators::{Simulator, tb_name};
+use crate::cores::top_memory::is_memory_port;
 use crate::rtl::netlist::{Module, SigId};
 use crate::rtl::sim::Sim;
 use crate::rtl::width::Ty;
@@ -100,7 +100,6 @@ struct StreamTb<'a> {
     mem_base: String,
     mem_base_bits: String,
 }
-
 
 /// A stream testbench's data: the inputs of each ray (every input port but `ray_valid`, in
 /// port order) in the order the source offers them, and, indexed by id, the expected values of

@@ -4,11 +4,11 @@
 
 use crate::cores::memory_params::MemorySpec;
 use crate::model::camera::Camera;
-use crate::scene::memory::MemoryShape;
-use crate::verify::memory::MemoryTiming;
 use crate::params::{EdgeShift, Params, TreeSplit};
 use crate::rng::SplitMix64;
+use crate::scene::memory::MemoryShape;
 use crate::scene::{Scene, max_edge_shift};
+use crate::verify::memory::MemoryTiming;
 
 /// Where a case's triangles come from.
 #[derive(Clone, Debug, PartialEq, Eq)]
