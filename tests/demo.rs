@@ -71,3 +71,32 @@ fn fxrt_alone_generates_the_core_simulates_a_frame_and_checks_every_pixel() {
         assert!(o.status.success() && !err.contains("%Warning"), "verilator lint: {err}");
     }
 }
+
+/// `fxrt demo --memory external`: the teapot's core with its scene behind the AXI4 read port,
+/// the frame run against the memory model, every pixel checked, and the scene image written
+/// beside the core at the size its manifest states.
+#[test]
+fn the_demo_runs_the_external_memory_core_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["demo", "--memory", "external", "--size", "16x16", "--out", "ext"];
+    let o = Command::new(env!("CARGO_BIN_EXE_fxrt")).args(args).current_dir(dir.path()).output().expect("fxrt runs");
+    let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{out}{err}");
+    assert!(out.contains("every pixel matched the golden model (256 of 256)"), "{out}");
+    assert!(out.contains("external memory (L = 40 clocks, 64-bit port") && out.contains("bytes per ray"), "{out}");
+    let hdl = dir.path().join("ext/hdl");
+    let manifest =
+        out.split_whitespace().find(|w| w.starts_with("fxrt_core_") && w.ends_with(".json")).expect("a manifest");
+    assert!(manifest.contains("_ext"), "{manifest}");
+    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(hdl.join(manifest)).unwrap()).unwrap();
+    let image = std::fs::read(hdl.join("scene.bin")).unwrap();
+    assert_eq!(Some(image.len() as u64), m["memory"]["image"]["total_bytes"].as_u64(), "{}", m["memory"]);
+    assert!(hdl.join("fxrt_scene.h").is_file());
+    // The teapot fits on chip: auto keeps it there.
+    let o = Command::new(env!("CARGO_BIN_EXE_fxrt"))
+        .args(["demo", "--size", "8x8", "--out", "auto"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success() && !dir.path().join("auto/hdl/scene.bin").exists());
+}

@@ -15,6 +15,11 @@ pub struct DemoArgs {
     /// The simulated frame, WxH (at most 256x256).
     #[arg(long, value_parser = parse_size, default_value = "128x128")]
     pub size: (u32, u32),
+    /// Where the core keeps the teapot: onchip, external (behind an AXI4 read port and on-chip
+    /// caches at their defaults; the frame then runs against the memory model at L = 40) or
+    /// auto (on chip when it fits the LFE5U-85F's block RAM, as the teapot does).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub memory: super::args::MemoryPlace,
 }
 
 /// `fxrt sweep`: every parameter takes a list (`12,16,20`), a range (`20..29`, inclusive) or a

@@ -4,6 +4,7 @@
 //! checked against the golden model, and both pictures are written: the golden model's, shaded,
 //! and the one the hardware's hits make.
 
+use crate::cores::memory_params::MemorySpec;
 use crate::cores::top::{CoreParams, core_module_with};
 use crate::error::{Error, Result};
 use crate::generate;
@@ -12,7 +13,10 @@ use crate::model::camera::Camera;
 use crate::params::Params;
 use crate::render::{self, Frame, tracer::GoldenTracer};
 use crate::scene::images::SceneRoms;
+use crate::scene::memory::SceneImage;
 use crate::scene::{Scene, SceneSource};
+use crate::verify::frame_memory::simulate_external;
+use crate::verify::memory::MemoryTiming;
 use crate::verify::{feed, frame};
 use std::path::{Path, PathBuf};
 
@@ -33,6 +37,7 @@ pub struct DemoConfig {
     /// The simulated frame.
     pub width: u32,
     pub height: u32,
+    pub memory: super::args::MemoryPlace,
 }
 
 impl DemoArgs {
@@ -40,7 +45,7 @@ impl DemoArgs {
         let (width, height) = self.size;
         check_size(width, height)?;
         crate::io::check_folder(&self.out)?;
-        Ok(DemoConfig { out: self.out.clone(), width, height })
+        Ok(DemoConfig { out: self.out.clone(), width, height, memory: self.memory })
     }
 }
 
@@ -49,11 +54,12 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default())?;
     let roms = SceneRoms::of(&scene);
     let target = crate::cores::clock::DEFAULT_TARGET_MHZ;
-    let p = CoreParams::shaped(
-        &roms,
-        &crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() },
-    );
+    let shape = crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() };
+    let p = CoreParams::shaped(&roms, &shape);
     p.check()?;
+    let bram_kbits = super::config::ECP5_85F_BRAM_KBITS;
+    let p = super::run::place_scene(c.memory, MemorySpec::default(), bram_kbits, &roms, &shape, p)?;
+    p.check_device(&roms, bram_kbits)?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     let netlist = std::rc::Rc::new(core_module_with(&p, &roms, false));
     let measured = crate::fpga::ecp5::measured_entry(
@@ -76,7 +82,19 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let cam = Camera::default_for(&scene, c.width, c.height);
     let rays = frame::frame_rays(&scene, &cam);
     let bar = frame::progress_bar(rays.len() as u64, "rust");
-    let (results, stats) = frame::simulate_rust(&p, &roms, &rays, &feed::Stalls::none(), &|n| bar.set_position(n));
+    let stalls = feed::Stalls::none();
+    let (results, stats, memory) = match &p.mem {
+        Some(m) => {
+            let image = SceneImage::build(&roms, m.spec.shape)?;
+            let timing = MemoryTiming::default();
+            let (r, s, ms) = simulate_external(&p, &roms, &image, &rays, timing, &stalls, &|n| bar.set_position(n));
+            (r, s, Some(ms))
+        }
+        None => {
+            let (r, s) = frame::simulate_rust(&p, &roms, &rays, &stalls, &|n| bar.set_position(n));
+            (r, s, None)
+        }
+    };
     bar.finish_and_clear();
     let mismatches = frame::mismatches(&scene, &rays, &results);
     let ids = frame::ids_image(&scene, c.width, c.height, &results);
@@ -86,6 +104,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let (golden_png, hardware_png) = (c.out.join("golden.png"), c.out.join("hardware.png"));
     let mut files = OutputSet::new();
     files.extend(core_files.into_iter().map(|(n, t)| (hdl.join(n), t)))?;
+    super::run::add_scene_image(&mut files, &hdl, &p, &roms)?;
     files.add(&golden_png, &picture.png_bytes())?;
     files.add(&hardware_png, &hardware_picture(&scene, &cam, ids).png_bytes())?;
     files.commit()?;
@@ -96,9 +115,14 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
         "fxrt: the embedded teapot ({} triangles) as a ray tracing core, checked in the Rust simulator",
         roms.tri_count()
     );
+    let scene_files = match &p.mem {
+        Some(_) => "the scene image scene.bin for its external memory, fxrt_scene.h",
+        None => "its ROM images",
+    };
     println!(
-        "  wrote {}: {hdl_files} files, {core} in VHDL-93 and Verilog-2001 with its ROM images and manifest {core}.json",
-        hdl.display()
+        "  wrote {}: {} files, {core} in VHDL-93 and Verilog-2001 with {scene_files} and manifest {core}.json",
+        hdl.display(),
+        hdl_files + if p.mem.is_some() { 2 } else { 0 },
     );
     println!(
         "  frame {}x{}: {} rays reached the scene box, {:.2} clock cycles per ray ({:.3} rays per clock, {} units × {} slots)",
@@ -110,6 +134,19 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
         p.units,
         p.slot_count() / p.units.max(1)
     );
+    if let (Some(ms), Some(m)) = (&memory, &p.mem) {
+        println!(
+            "  external memory (L = {} clocks, {}-bit port, {} KB node caches, {} KB triangle cache): {:.1} bytes per \
+             ray, node cache hits {:.1} %, triangle cache hits {:.1} %",
+            ms.latency,
+            ms.mem_bits,
+            m.spec.node_cache_kb,
+            m.spec.tri_cache_kb,
+            ms.mem_bytes_per_ray,
+            100.0 * ms.node_cache_hit_rate,
+            100.0 * ms.tri_cache_hit_rate
+        );
+    }
     if mismatches == 0 {
         println!("  every pixel matched the golden model ({pixels} of {pixels})");
     } else {

@@ -267,12 +267,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     let mut files = OutputSet::new();
     let written = generate::core_files(&p, &roms, &core, o, raygen.as_ref(), measured.as_ref());
     files.extend(written.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
-    if let Some(m) = &p.mem {
-        // The image to put in memory at mem_base, and its C header.
-        let image = scene::memory::SceneImage::build(&roms, m.spec.shape)?;
-        files.add(&c.out.join("scene.bin"), &image.bytes)?;
-        files.add(&c.out.join("fxrt_scene.h"), scene::memory_c::c_header(&roms.name, &image.layout).as_bytes())?;
-    }
+    add_scene_image(&mut files, &c.out, &p, &roms)?;
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
@@ -532,9 +527,25 @@ fn external_core(
     Ok(p)
 }
 
+/// For an external-memory core `p`: the image to put in memory at mem_base (`OUT/scene.bin`) and
+/// its C header (`OUT/fxrt_scene.h`); nothing for an on-chip core.
+pub(super) fn add_scene_image(
+    files: &mut OutputSet,
+    out: &std::path::Path,
+    p: &crate::cores::top::CoreParams,
+    roms: &SceneRoms,
+) -> Result<()> {
+    if let Some(m) = &p.mem {
+        let image = scene::memory::SceneImage::build(roms, m.spec.shape)?;
+        files.add(&out.join("scene.bin"), &image.bytes)?;
+        files.add(&out.join("fxrt_scene.h"), scene::memory_c::c_header(&roms.name, &image.layout).as_bytes())?;
+    }
+    Ok(())
+}
+
 /// The on-chip core `p`, or with `--memory external` (or `auto` when `p`'s ROMs and stacks do
 /// not fit `bram_kbits`) the same shape with its scene in external memory.
-fn place_scene(
+pub(super) fn place_scene(
     place: super::args::MemoryPlace,
     spec: crate::cores::memory_params::MemorySpec,
     bram_kbits: u64,
