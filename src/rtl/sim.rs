@@ -48,6 +48,10 @@ pub struct Sim {
     /// The `rst` input of the module.
     pub reset: bool,
     pub cycles: u64,
+    /// An input changed since the last `eval`: `tick` must evaluate before it latches. Saves
+    /// one of a cycle's evaluations where the caller evaluates to read outputs before `tick`
+    /// (evaluation is idempotent: topological order, no state of its own).
+    stale: bool,
 }
 
 impl Sim {
@@ -99,7 +103,21 @@ impl Sim {
         let mut names = flat.names;
         names.sort();
         let mut sim =
-            Sim { vals, tys, top: flat.top, comb, regs, rom_reads, roms, writes, next, names, reset: false, cycles: 0 };
+            Sim {
+            vals,
+            tys,
+            top: flat.top,
+            comb,
+            regs,
+            rom_reads,
+            roms,
+            writes,
+            next,
+            names,
+            reset: false,
+            cycles: 0,
+            stale: true,
+        };
         sim.eval();
         sim
     }
@@ -109,6 +127,7 @@ impl Sim {
         let ty = self.tys[i];
         debug_assert!(ty.fits(value) || ty.fits(value - (1i128 << ty.width.min(126))), "value {value} for {ty:?}");
         self.vals[i] = ty.wrap(value);
+        self.stale = true;
     }
 
     pub fn get(&self, s: Sig) -> i128 {
@@ -126,6 +145,7 @@ impl Sim {
 
     /// Evaluates all combinational logic from the inputs and the current state.
     pub fn eval(&mut self) {
+        self.stale = false;
         let v = &mut self.vals;
         for op in &self.comb {
             match *op {
@@ -160,10 +180,12 @@ impl Sim {
         self.eval();
     }
 
-    /// One rising clock edge: evaluate, latch every register and ROM read, evaluate again so
-    /// outputs show the new state.
+    /// One rising clock edge: evaluate (unless nothing changed since the last evaluation),
+    /// latch every register and ROM read, evaluate again so outputs show the new state.
     pub fn tick(&mut self) {
-        self.eval();
+        if self.stale {
+            self.eval();
+        }
         let v = &self.vals;
         for (k, r) in self.regs.iter().enumerate() {
             self.next[k] = match (self.reset, r.reset) {
