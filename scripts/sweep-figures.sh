@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces the sweeps behind docs/SWEEPS.md and copies its figures into docs/sweeps/.
-# Usage: scripts/sweep-figures.sh [WORK_DIR]   (about a minute on 2 cores; needs a release build)
+# Usage: scripts/sweep-figures.sh [WORK_DIR]   (a few minutes on 2 cores; needs a release build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 work="${1:-target/sweep-figures}"
@@ -23,9 +23,18 @@ shared=()
 # The same at n = 16, where E = 10 clamps most edges, for the plot.
 "$fxrt" sweep "${shared[@]}" --builtin teapot,cornell,jackstraws,thin,random --size 128x128 \
     --n 16 --edge-shift auto,6,8,10,12 --out "$work/edge16"
+# The scene in external memory: rays per clock and bytes per ray against the memory's latency
+# and the node cache's size (the teapot in 8 x 8 tiles).
+"$fxrt" sweep --builtin teapot --size 64x64 --memory external --mem-latency 1,40,100,200 \
+    --node-cache-kb 4,8,32 --ray-order tiles --core-sim --out "$work/memory"
 mkdir -p docs/sweeps
 cp "$work/figures/grids/teapot_m.png" "$work/figures/grids/teapot_t.png" "$work/figures/grids/teapot_c.png" docs/sweeps/
 cp "$work/oblique/grids/cornell_c.png" docs/sweeps/cornell_oblique_c.png
 cp "$work/edge16/plots/error_edge-shift.png" docs/sweeps/error_edge-shift_n16.png
 cp "$work/cross/plots/pareto_dsp48e.png" docs/sweeps/pareto_dsp48e.png
+for what in rays_per_clock bytes_per_ray; do
+    for axis in mem-latency node-cache-kb; do
+        cp "$work/memory/plots/memory_${what}_${axis}.png" "docs/sweeps/teapot64_tiles_${what}_${axis}.png"
+    done
+done
 echo "figures in docs/sweeps; reports in $work/*/report.md"
