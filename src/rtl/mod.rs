@@ -12,6 +12,7 @@ pub mod netlist;
 pub mod pipeline;
 pub mod random;
 pub mod sim;
+mod sim_ops;
 pub mod width;
 
 pub use netlist::{Module, Sig};

@@ -3,16 +3,8 @@
 
 use super::flatten::flatten;
 use super::netlist::{Def, Module, Sig, SigId};
-use super::width::{BinOp, Ty, UnOp, case_arm, eval_bin, eval_concat, eval_mux, eval_un};
-
-#[derive(Clone, Debug)]
-enum Op {
-    Bin { op: BinOp, dst: usize, a: usize, b: usize, ta: Ty, tb: Ty, tr: Ty },
-    Un { op: UnOp, dst: usize, a: usize, ta: Ty, tr: Ty },
-    Mux { dst: usize, sel: usize, t: usize, f: usize },
-    Case { dst: usize, sel: usize, arms: Vec<(u128, usize)>, default: usize },
-    Concat { dst: usize, parts: Vec<(usize, u32)> },
-}
+use super::sim_ops::{Op, run};
+use super::width::Ty;
 
 #[derive(Clone, Debug)]
 struct RegUpdate {
@@ -79,10 +71,8 @@ impl Sim {
             .comb_order
             .iter()
             .map(|&i| match &flat.defs[i] {
-                Def::Bin(op, a, b) => {
-                    Op::Bin { op: *op, dst: i, a: ix(*a), b: ix(*b), ta: tys[ix(*a)], tb: tys[ix(*b)], tr: tys[i] }
-                }
-                Def::Un(op, a) => Op::Un { op: *op, dst: i, a: ix(*a), ta: tys[ix(*a)], tr: tys[i] },
+                Def::Bin(op, a, b) => Op::bin(*op, i, (ix(*a), tys[ix(*a)]), (ix(*b), tys[ix(*b)]), tys[i]),
+                Def::Un(op, a) => Op::un(*op, i, (ix(*a), tys[ix(*a)]), tys[i]),
                 Def::Mux { sel, t, f } => Op::Mux { dst: i, sel: ix(*sel), t: ix(*t), f: ix(*f) },
                 Def::Case { sel, arms, default } => Op::Case {
                     dst: i,
@@ -146,18 +136,7 @@ impl Sim {
     /// Evaluates all combinational logic from the inputs and the current state.
     pub fn eval(&mut self) {
         self.stale = false;
-        let v = &mut self.vals;
-        for op in &self.comb {
-            match *op {
-                Op::Bin { op, dst, a, b, ta, tb, tr } => v[dst] = eval_bin(op, ta, v[a], tb, v[b], tr),
-                Op::Un { op, dst, a, ta, tr } => v[dst] = eval_un(op, ta, v[a], tr),
-                Op::Mux { dst, sel, t, f } => v[dst] = eval_mux(v[sel], v[t], v[f]),
-                Op::Case { dst, sel, ref arms, default } => {
-                    v[dst] = v[case_arm(v[sel], arms.iter().map(|a| a.0)).map_or(default, |k| arms[k].1)];
-                }
-                Op::Concat { dst, ref parts } => v[dst] = eval_concat(parts.iter().map(|&(p, w)| (w, v[p]))),
-            }
-        }
+        run(&self.comb, &mut self.vals);
     }
 
     /// Fills every register, every RAM read register and every written memory with seeded
