@@ -62,11 +62,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!(
             "| {latency} | {rpc:.4} | {:.2} | {:.1} | {:.4} | {:.4} | {:.2} | {:.3} |",
             rpc / chip.rays_per_clock(),
-            ms.mem_bytes_per_ray,
-            ms.node_cache_hit_rate,
-            ms.tri_cache_hit_rate,
-            ms.mem_busy,
-            ms.memory_stall_fraction
+            ms.figures.mem_bytes_per_ray,
+            ms.figures.node_cache_hit_rate,
+            ms.figures.tri_cache_hit_rate,
+            ms.figures.mem_busy,
+            ms.figures.memory_stall_fraction
         );
         points.push((latency as f64, rpc));
     }

@@ -127,12 +127,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rays.len(),
             stats.cycles,
             stats.rays_per_clock(),
-            ms.mem_bytes_per_ray,
-            ms.mem_reads_per_ray,
-            ms.node_cache_hit_rate,
-            ms.tri_cache_hit_rate,
-            ms.mem_busy,
-            ms.memory_stall_fraction
+            ms.figures.mem_bytes_per_ray,
+            ms.figures.mem_reads_per_ray,
+            ms.figures.node_cache_hit_rate,
+            ms.figures.tri_cache_hit_rate,
+            ms.figures.mem_busy,
+            ms.figures.memory_stall_fraction
         );
         if wrong > 0 {
             return Err(format!("{}: {wrong} rays differ from the golden model", c.name).into());

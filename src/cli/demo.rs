@@ -142,9 +142,9 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
             ms.mem_bits,
             m.spec.node_cache_kb,
             m.spec.tri_cache_kb,
-            ms.mem_bytes_per_ray,
-            100.0 * ms.node_cache_hit_rate,
-            100.0 * ms.tri_cache_hit_rate
+            ms.figures.mem_bytes_per_ray,
+            100.0 * ms.figures.node_cache_hit_rate,
+            100.0 * ms.figures.tri_cache_hit_rate
         );
     }
     if mismatches == 0 {

@@ -92,8 +92,7 @@ impl Sim {
         let next = vec![0; regs.len() + rom_reads.len()];
         let mut names = flat.names;
         names.sort();
-        let mut sim =
-            Sim {
+        let mut sim = Sim {
             vals,
             tys,
             top: flat.top,

@@ -20,33 +20,144 @@ fn val(bits: u128, shift: u32) -> i128 {
 
 #[derive(Clone, Debug)]
 pub(super) enum Op {
-    And { dst: usize, a: usize, b: usize },
-    Or { dst: usize, a: usize, b: usize },
-    Xor { dst: usize, a: usize, b: usize },
-    Eq { dst: usize, a: usize, b: usize },
-    Ne { dst: usize, a: usize, b: usize },
+    And {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
+    Or {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
+    Xor {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
+    Eq {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
+    Ne {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
     /// Unsigned comparisons on the bit patterns.
-    LtBits { dst: usize, a: usize, b: usize },
-    LeBits { dst: usize, a: usize, b: usize },
+    LtBits {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
+    LeBits {
+        dst: usize,
+        a: usize,
+        b: usize,
+    },
     /// Comparisons of the values (a signed left operand).
-    Lt { dst: usize, a: usize, b: usize, sa: u32, sb: u32 },
-    Le { dst: usize, a: usize, b: usize, sa: u32, sb: u32 },
-    Add { dst: usize, a: usize, b: usize, sa: u32, sb: u32, mask: u128 },
-    Sub { dst: usize, a: usize, b: usize, sa: u32, sb: u32, mask: u128 },
-    Mul { dst: usize, a: usize, b: usize, sa: u32, sb: u32, mask: u128 },
+    Lt {
+        dst: usize,
+        a: usize,
+        b: usize,
+        sa: u32,
+        sb: u32,
+    },
+    Le {
+        dst: usize,
+        a: usize,
+        b: usize,
+        sa: u32,
+        sb: u32,
+    },
+    Add {
+        dst: usize,
+        a: usize,
+        b: usize,
+        sa: u32,
+        sb: u32,
+        mask: u128,
+    },
+    Sub {
+        dst: usize,
+        a: usize,
+        b: usize,
+        sa: u32,
+        sb: u32,
+        mask: u128,
+    },
+    Mul {
+        dst: usize,
+        a: usize,
+        b: usize,
+        sa: u32,
+        sb: u32,
+        mask: u128,
+    },
     /// `!a` within `mask` (the operand's).
-    Not { dst: usize, a: usize, mask: u128 },
-    Neg { dst: usize, a: usize, sa: u32, mask: u128 },
-    Shl { dst: usize, a: usize, k: u32, mask: u128 },
-    ShrBits { dst: usize, a: usize, k: u32 },
-    Shr { dst: usize, a: usize, sa: u32, k: u32, mask: u128 },
-    Slice { dst: usize, a: usize, lsb: u32, mask: u128 },
+    Not {
+        dst: usize,
+        a: usize,
+        mask: u128,
+    },
+    Neg {
+        dst: usize,
+        a: usize,
+        sa: u32,
+        mask: u128,
+    },
+    Shl {
+        dst: usize,
+        a: usize,
+        k: u32,
+        mask: u128,
+    },
+    ShrBits {
+        dst: usize,
+        a: usize,
+        k: u32,
+    },
+    Shr {
+        dst: usize,
+        a: usize,
+        sa: u32,
+        k: u32,
+        mask: u128,
+    },
+    Slice {
+        dst: usize,
+        a: usize,
+        lsb: u32,
+        mask: u128,
+    },
     /// A value re-wrapped in the result's width (`Resize`).
-    Resize { dst: usize, a: usize, sa: u32, mask: u128 },
-    Copy { dst: usize, a: usize },
-    Mux { dst: usize, sel: usize, t: usize, f: usize },
-    Case { dst: usize, sel: usize, arms: Vec<(u128, usize)>, default: usize },
-    Concat { dst: usize, parts: Vec<(usize, u32)> },
+    Resize {
+        dst: usize,
+        a: usize,
+        sa: u32,
+        mask: u128,
+    },
+    Copy {
+        dst: usize,
+        a: usize,
+    },
+    Mux {
+        dst: usize,
+        sel: usize,
+        t: usize,
+        f: usize,
+    },
+    Case {
+        dst: usize,
+        sel: usize,
+        arms: Vec<(u128, usize)>,
+        default: usize,
+    },
+    Concat {
+        dst: usize,
+        parts: Vec<(usize, u32)>,
+    },
 }
 
 impl Op {

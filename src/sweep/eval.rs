@@ -376,7 +376,11 @@ fn simulate_core(
             let image = SceneImage::build(roms, ext.spec.shape).expect("the scene image of a built core");
             let (results, stats, ms) =
                 simulate_external(p, roms, &image, &rays, memory::timing(point), &Stalls::none(), &|_| {});
-            (results, stats, Some(MemoryRun::of(&ms, ext.bram_bits(p.units, p.total_slots()))))
+            (
+                results,
+                stats,
+                Some(MemoryRun { figures: ms.figures, cache_bram_bits: ext.bram_bits(p.units, p.total_slots()) }),
+            )
         }
         _ => {
             let (results, stats) = simulate_rust(p, roms, &rays, &Stalls::none(), &|_| {});

@@ -6,7 +6,7 @@
 use super::SweepSpec;
 use crate::cores::memory_params::{DEFAULT_NODE_CACHE_KB, DEFAULT_TRI_CACHE_KB, MemorySpec};
 use crate::scene::memory::MemoryShape;
-use crate::verify::frame_memory::MemoryStats;
+use crate::verify::frame_memory::MemoryFigures;
 use crate::verify::memory::{DEFAULT_LATENCY, MemoryTiming};
 use serde::{Deserialize, Serialize};
 
@@ -70,34 +70,14 @@ impl MemoryPoint {
     }
 }
 
-/// What the memory side did over a configuration's frame (`fxrt sim`'s JSON figures).
+/// What the memory side did over a configuration's frame (`fxrt sim`'s JSON figures) and the
+/// block RAM bits of the node caches, the triangle cache and its staging RAM
+/// (`ExternalMemory::bram_bits`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MemoryRun {
-    pub mem_bytes_per_ray: f64,
-    pub mem_reads_per_ray: f64,
-    pub node_cache_hit_rate: f64,
-    pub tri_cache_hit_rate: f64,
-    /// Fraction of clocks the R channel carried a beat.
-    pub mem_busy: f64,
-    /// Fraction of clocks no triangle entered the pipeline while a leaf waited for memory.
-    pub memory_stall_fraction: f64,
-    /// Block RAM bits of the node caches, the triangle cache and its staging RAM
-    /// (`ExternalMemory::bram_bits`).
+    #[serde(flatten)]
+    pub figures: MemoryFigures,
     pub cache_bram_bits: u64,
-}
-
-impl MemoryRun {
-    pub fn of(s: &MemoryStats, cache_bram_bits: u64) -> MemoryRun {
-        MemoryRun {
-            mem_bytes_per_ray: s.mem_bytes_per_ray,
-            mem_reads_per_ray: s.mem_reads_per_ray,
-            node_cache_hit_rate: s.node_cache_hit_rate,
-            tri_cache_hit_rate: s.tri_cache_hit_rate,
-            mem_busy: s.mem_busy,
-            memory_stall_fraction: s.memory_stall_fraction,
-            cache_bram_bits,
-        }
-    }
 }
 
 /// Columns of an external-memory sweep (before the ECP5 columns): the point, then with
@@ -129,16 +109,16 @@ pub fn csv_cells(spec: &SweepSpec, point: MemoryPoint, run: Option<&MemoryRun>) 
     }
     let mut cells = vec![point.latency.to_string(), point.node_cache_kb.to_string(), point.tri_cache_kb.to_string()];
     if spec.core_sim {
-        let f = |v: fn(&MemoryRun) -> String| run.map(v).unwrap_or_default();
+        let f = |v: fn(&MemoryFigures) -> f64| run.map(|r| v(&r.figures).to_string()).unwrap_or_default();
         cells.extend([
-            f(|r| r.mem_bytes_per_ray.to_string()),
-            f(|r| r.mem_reads_per_ray.to_string()),
-            f(|r| r.node_cache_hit_rate.to_string()),
-            f(|r| r.tri_cache_hit_rate.to_string()),
-            f(|r| r.mem_busy.to_string()),
-            f(|r| r.memory_stall_fraction.to_string()),
-            f(|r| r.cache_bram_bits.to_string()),
+            f(|r| r.mem_bytes_per_ray),
+            f(|r| r.mem_reads_per_ray),
+            f(|r| r.node_cache_hit_rate),
+            f(|r| r.tri_cache_hit_rate),
+            f(|r| r.mem_busy),
+            f(|r| r.memory_stall_fraction),
         ]);
+        cells.push(run.map(|r| r.cache_bram_bits.to_string()).unwrap_or_default());
     }
     cells
 }

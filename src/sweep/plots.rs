@@ -75,7 +75,7 @@ enum MemoryFigure {
 fn memory_plot(results: &Results, plan: &Plan, axis: Axis, what: MemoryFigure) -> Result<Vec<u8>> {
     let y: &dyn Fn(&Row) -> Option<f64> = match what {
         MemoryFigure::RaysPerClock => &|r| Some(r.core.as_ref()?.rays_per_clock),
-        MemoryFigure::BytesPerRay => &|r| Some(r.memory.as_ref()?.mem_bytes_per_ray),
+        MemoryFigure::BytesPerRay => &|r| Some(r.memory.as_ref()?.figures.mem_bytes_per_ray),
     };
     let (title, y_desc) = match what {
         MemoryFigure::RaysPerClock => ("Rays per clock, scene in external memory,", "rays per clock (Rust simulator)"),

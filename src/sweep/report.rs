@@ -176,9 +176,9 @@ fn row_cells(results: &Results, r: &super::eval::Row) -> Vec<String> {
     }
     if results.spec.core_sim && results.spec.memory.is_some() {
         let m = r.memory.as_ref();
-        v.push(m.map(|m| format!("{:.1}", m.mem_bytes_per_ray)).unwrap_or_default());
-        v.push(m.map(|m| format!("{:.3}", m.node_cache_hit_rate)).unwrap_or_default());
-        v.push(m.map(|m| format!("{:.3}", m.tri_cache_hit_rate)).unwrap_or_default());
+        v.push(m.map(|m| format!("{:.1}", m.figures.mem_bytes_per_ray)).unwrap_or_default());
+        v.push(m.map(|m| format!("{:.3}", m.figures.node_cache_hit_rate)).unwrap_or_default());
+        v.push(m.map(|m| format!("{:.3}", m.figures.tri_cache_hit_rate)).unwrap_or_default());
     }
     v.push(r.error.clone().unwrap_or_default().replace('|', "/"));
     v

@@ -179,16 +179,15 @@ fn slurm_shards_are_checked_and_the_scripts_written() {
 /// Rows of one sweep are reused only by a sweep that would compute the same: the family, the
 /// ECP5 modules and seed, and the clock target are in the key; a sweep without them keeps the
 /// key it always had, and its results.json does not mention them.
+/// The `thin` scene loaded for `spec()`'s camera at the defaults (for its keys).
+fn thin_ctx() -> eval::SceneCtx {
+    let thin = SceneSpec::Builtin("thin".into());
+    eval::SceneCtx::load(&thin, "thin".into(), &spec().camera, &Params::default(), &[4]).unwrap()
+}
+
 #[test]
 fn cache_keys_tell_families_seeds_targets_and_core_shapes_apart() {
-    let ctx = eval::SceneCtx::load(
-        &SceneSpec::Builtin("thin".into()),
-        "thin".into(),
-        &spec().camera,
-        &Params::default(),
-        &[4],
-    )
-    .unwrap();
+    let ctx = thin_ctx();
     let p = Params::default();
     let d = CoreShape::default();
     let xc5v = SweepSpec { synth: true, ..spec() };
@@ -424,14 +423,7 @@ fn memory_latency_and_cache_sizes_are_axes_of_external_sweeps() {
     assert_eq!(set_label(&plan.sets[0]), "n29_m32_eauto_t0_c16_lat1_nc32_tc16");
     assert_eq!(set_label(&plan.base), "n29_m32_eauto_t0_c16");
     // Every point has its own key; the same point on chip keeps the key it always had.
-    let ctx = super::eval::SceneCtx::load(
-        &SceneSpec::Builtin("thin".into()),
-        "thin".into(),
-        &spec().camera,
-        &Params::default(),
-        &[4],
-    )
-    .unwrap();
+    let ctx = thin_ctx();
     let p = Params::default();
     let keys: std::collections::BTreeSet<String> = plan.sets.iter().map(|x| ctx.key(&p, x.shape, &s)).collect();
     assert_eq!(keys.len(), plan.sets.len());

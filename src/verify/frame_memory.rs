@@ -11,7 +11,7 @@ use crate::rtl::sim::Sim;
 use crate::scene::images::SceneRoms;
 use crate::scene::memory::SceneImage;
 use crate::verify::frame::PixelRay;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Observation ports of an external-memory core, in `MemoryStats::count` order.
 pub const MEMORY_OBSERVED: [&str; 6] = ["node_looks", "node_hits", "tri_looks", "tri_hits", "mem_beat", "mem_stall"];
@@ -33,11 +33,20 @@ pub struct MemoryStats {
     /// Clocks in which no triangle entered the pipeline while a leaf waited for memory.
     pub stall_clocks: u64,
     /// Derived figures (`finish`): per ray, rates and fractions.
+    #[serde(flatten)]
+    pub figures: MemoryFigures,
+}
+
+/// What the memory side did, per ray and per clock: `fxrt sim`'s JSON and a sweep's row.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MemoryFigures {
     pub mem_bytes_per_ray: f64,
     pub mem_reads_per_ray: f64,
     pub node_cache_hit_rate: f64,
     pub tri_cache_hit_rate: f64,
+    /// Fraction of clocks the R channel carried a beat.
     pub mem_busy: f64,
+    /// Fraction of clocks no triangle entered the pipeline while a leaf waited for memory.
     pub memory_stall_fraction: f64,
 }
 
@@ -53,12 +62,14 @@ impl MemoryStats {
 
     fn finish(&mut self, rays: u64, cycles: u64) {
         let (rays, cycles) = (rays.max(1) as f64, cycles.max(1) as f64);
-        self.mem_bytes_per_ray = (self.beats * self.mem_bits as u64 / 8) as f64 / rays;
-        self.mem_reads_per_ray = self.reads as f64 / rays;
-        self.node_cache_hit_rate = self.node_hits as f64 / self.node_lookups.max(1) as f64;
-        self.tri_cache_hit_rate = self.tri_hits as f64 / self.tri_lookups.max(1) as f64;
-        self.mem_busy = self.beat_clocks as f64 / cycles;
-        self.memory_stall_fraction = self.stall_clocks as f64 / cycles;
+        self.figures = MemoryFigures {
+            mem_bytes_per_ray: (self.beats * self.mem_bits as u64 / 8) as f64 / rays,
+            mem_reads_per_ray: self.reads as f64 / rays,
+            node_cache_hit_rate: self.node_hits as f64 / self.node_lookups.max(1) as f64,
+            tri_cache_hit_rate: self.tri_hits as f64 / self.tri_lookups.max(1) as f64,
+            mem_busy: self.beat_clocks as f64 / cycles,
+            memory_stall_fraction: self.stall_clocks as f64 / cycles,
+        };
     }
 }
 
