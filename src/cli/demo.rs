@@ -58,7 +58,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let p = CoreParams::shaped(&roms, &shape);
     p.check()?;
     let bram_kbits = super::config::ECP5_85F_BRAM_KBITS;
-    let p = super::run::place_scene(c.memory, MemorySpec::default(), bram_kbits, &roms, &shape, p)?;
+    let p = super::placement::place_scene(c.memory, MemorySpec::default(), bram_kbits, &roms, &shape, p)?;
     p.check_device(&roms, bram_kbits)?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     let netlist = std::rc::Rc::new(core_module_with(&p, &roms, false));
@@ -104,7 +104,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let (golden_png, hardware_png) = (c.out.join("golden.png"), c.out.join("hardware.png"));
     let mut files = OutputSet::new();
     files.extend(core_files.into_iter().map(|(n, t)| (hdl.join(n), t)))?;
-    super::run::add_scene_image(&mut files, &hdl, &p, &roms)?;
+    super::placement::add_scene_image(&mut files, &hdl, &p, &roms)?;
     files.add(&golden_png, &picture.png_bytes())?;
     files.add(&hardware_png, &hardware_picture(&scene, &cam, ids).png_bytes())?;
     files.commit()?;

@@ -10,6 +10,7 @@ pub mod board;
 pub mod config;
 pub mod demo;
 pub mod exact;
+pub mod placement;
 pub mod run;
 pub mod sweep_config;
 

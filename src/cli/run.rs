@@ -242,7 +242,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     }
     let p = crate::cores::top::CoreParams::shaped(&roms, &c.core_spec());
     p.check()?;
-    let p = place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &c.core_spec(), p)?;
+    let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &c.core_spec(), p)?;
     if p.mem.is_some() && raygen.is_some() {
         return Err(crate::error::Error::param(
             "raygen",
@@ -267,7 +267,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     let mut files = OutputSet::new();
     let written = generate::core_files(&p, &roms, &core, o, raygen.as_ref(), measured.as_ref());
     files.extend(written.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
-    add_scene_image(&mut files, &c.out, &p, &roms)?;
+    super::placement::add_scene_image(&mut files, &c.out, &p, &roms)?;
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {
         let rays = frame::frame_rays(scene, &spec.camera(scene)?);
         ids_fit(c.ray_id_width, spec.width, spec.height)?;
@@ -327,7 +327,7 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     };
     let core = crate::cores::top::CoreParams::shaped(&roms, &shape);
     core.check()?;
-    let core = place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core)?;
+    let core = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core)?;
     core.check_device(&roms, c.bram_kbits)?;
     eprintln!(
         "synth: scene {} {}",
@@ -519,47 +519,12 @@ fn external_core(
     shape: &crate::cores::top::CoreSpec,
     p: crate::cores::top::CoreParams,
 ) -> Result<crate::cores::top::CoreParams> {
-    let p = place_scene(c.memory, c.mem_spec, c.bram_kbits, roms, shape, p)?;
+    let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, roms, shape, p)?;
     if p.mem.is_some() && c.raygen {
         return Err(crate::error::Error::param("memory", "an external-memory core runs with host rays (no --raygen)"));
     }
     p.check_device(roms, c.bram_kbits)?;
     Ok(p)
-}
-
-/// For an external-memory core `p`: the image to put in memory at mem_base (`OUT/scene.bin`) and
-/// its C header (`OUT/fxrt_scene.h`); nothing for an on-chip core.
-pub(super) fn add_scene_image(
-    files: &mut OutputSet,
-    out: &std::path::Path,
-    p: &crate::cores::top::CoreParams,
-    roms: &SceneRoms,
-) -> Result<()> {
-    if let Some(m) = &p.mem {
-        let image = scene::memory::SceneImage::build(roms, m.spec.shape)?;
-        files.add(&out.join("scene.bin"), &image.bytes)?;
-        files.add(&out.join("fxrt_scene.h"), scene::memory_c::c_header(&roms.name, &image.layout).as_bytes())?;
-    }
-    Ok(())
-}
-
-/// The on-chip core `p`, or with `--memory external` (or `auto` when `p`'s ROMs and stacks do
-/// not fit `bram_kbits`) the same shape with its scene in external memory.
-pub(super) fn place_scene(
-    place: super::args::MemoryPlace,
-    spec: crate::cores::memory_params::MemorySpec,
-    bram_kbits: u64,
-    roms: &SceneRoms,
-    shape: &crate::cores::top::CoreSpec,
-    p: crate::cores::top::CoreParams,
-) -> Result<crate::cores::top::CoreParams> {
-    use super::args::MemoryPlace;
-    let external = match place {
-        MemoryPlace::Onchip => false,
-        MemoryPlace::External => true,
-        MemoryPlace::Auto => p.check_device(roms, bram_kbits).is_err(),
-    };
-    if external { crate::cores::top::CoreParams::external(roms, shape, spec) } else { Ok(p) }
 }
 
 /// Ok(false): the simulated core disagreed with the golden model somewhere (`--core-sim`).

@@ -1,0 +1,42 @@
+//! Where a core keeps its scene (`--memory`), and the files an external-memory core needs
+//! beside it: shared by `gen`, `sim`, `synth` (`run.rs`) and `demo`.
+
+use super::args::MemoryPlace;
+use crate::error::Result;
+use crate::io::OutputSet;
+use crate::scene;
+use crate::scene::images::SceneRoms;
+
+/// For an external-memory core `p`: the image to put in memory at mem_base (`OUT/scene.bin`) and
+/// its C header (`OUT/fxrt_scene.h`); nothing for an on-chip core.
+pub fn add_scene_image(
+    files: &mut OutputSet,
+    out: &std::path::Path,
+    p: &crate::cores::top::CoreParams,
+    roms: &SceneRoms,
+) -> Result<()> {
+    if let Some(m) = &p.mem {
+        let image = scene::memory::SceneImage::build(roms, m.spec.shape)?;
+        files.add(&out.join("scene.bin"), &image.bytes)?;
+        files.add(&out.join("fxrt_scene.h"), scene::memory_c::c_header(&roms.name, &image.layout).as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The on-chip core `p`, or with `--memory external` (or `auto` when `p`'s ROMs and stacks do
+/// not fit `bram_kbits`) the same shape with its scene in external memory.
+pub fn place_scene(
+    place: MemoryPlace,
+    spec: crate::cores::memory_params::MemorySpec,
+    bram_kbits: u64,
+    roms: &SceneRoms,
+    shape: &crate::cores::top::CoreSpec,
+    p: crate::cores::top::CoreParams,
+) -> Result<crate::cores::top::CoreParams> {
+    let external = match place {
+        MemoryPlace::Onchip => false,
+        MemoryPlace::External => true,
+        MemoryPlace::Auto => p.check_device(roms, bram_kbits).is_err(),
+    };
+    if external { crate::cores::top::CoreParams::external(roms, shape, spec) } else { Ok(p) }
+}
