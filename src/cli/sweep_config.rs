@@ -155,9 +155,7 @@ impl super::args_hw::SweepMemoryArgs {
             MemoryPlace::External => {}
         }
         let shape = self.shape.shape()?;
-        if ![1, 2, 4].contains(&self.cache_ways) {
-            return Err(Error::param("cache-ways", format!("{} is not one of 1, 2, 4", self.cache_ways)));
-        }
+        crate::cores::memory_params::check_ways(self.cache_ways)?;
         let d = crate::sweep::memory::MemoryPoint::default();
         let list = |name: &str, v: &Option<String>, default: u32| match v {
             Some(text) => parse_u32_list(name, text),

@@ -21,6 +21,14 @@ pub const INFLIGHT: u32 = 8;
 /// Bursts the read master keeps in flight at most.
 pub const OUTSTANDING: u32 = 16;
 
+/// `--cache-ways`: 1, 2 or 4.
+pub fn check_ways(ways: u32) -> Result<()> {
+    if ![1, 2, 4].contains(&ways) {
+        return Err(Error::param("cache-ways", format!("{ways} is not one of 1, 2, 4")));
+    }
+    Ok(())
+}
+
 /// The sets of a `kb`-KB cache of `ways`-way sets of `line`-byte lines: refused (naming
 /// `flag`) unless a power of two of at least two, and the size 1 to 4096 KB.
 pub fn check_cache_kb(flag: &'static str, kb: u32, line: u32, ways: u32) -> Result<u64> {
@@ -77,9 +85,7 @@ pub struct ExternalMemory {
 impl ExternalMemory {
     pub fn new(roms: &SceneRoms, spec: MemorySpec) -> Result<ExternalMemory> {
         let layout = MemoryLayout::for_roms(roms, spec.shape)?;
-        if ![1, 2, 4].contains(&spec.ways) {
-            return Err(Error::param("cache-ways", format!("{} is not one of 1, 2, 4", spec.ways)));
-        }
+        check_ways(spec.ways)?;
         if !(12..=64).contains(&spec.addr_bits) || layout.total_bytes > 1u64 << spec.addr_bits.min(63) {
             return Err(Error::param(
                 "mem-addr-bits",
