@@ -35,7 +35,9 @@ pub struct LineRequest<'b> {
     pub offset: S<'b>,
 }
 
-/// The beats of a line, as one asker sees them (one clock after they crossed the bus).
+/// The beats of a line, as one asker sees them (two clocks after they crossed the bus: the
+/// bus register, then the asker's own, so the burst bookkeeping is not on the path into the
+/// caches' fill logic).
 #[derive(Clone, Copy)]
 pub struct Fill<'b> {
     pub valid: S<'b>,
@@ -148,12 +150,17 @@ pub fn axi_read<'b>(
     let error = b.reg("axi_error", Ty::BIT, Some(0));
     b.next(error, error | bad);
     b.end_stage();
+    let (data, fill_beat, fill_last) =
+        (b.delay("axi_fill_data", rdata), b.delay("axi_fill_beat", beat), b.delay("axi_fill_last", last_beat));
     let fills = (0..n)
         .map(|k| Fill {
-            valid: (rvalid & who_nonempty & who.eq(k as i128)).name(&format!("axi_fill{k}")),
-            data: rdata,
-            beat,
-            last: last_beat,
+            valid: b.valid_delay(
+                &format!("axi_fill{k}"),
+                (rvalid & who_nonempty & who.eq(k as i128)).name(&format!("axi_fill{k}_c")),
+            ),
+            data,
+            beat: fill_beat,
+            last: fill_last,
         })
         .collect();
     let arlen = b.konst(Ty::u(8), (p.line_beats - 1) as i128);

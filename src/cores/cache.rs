@@ -1,5 +1,5 @@
 //! A read-only cache of scene records in front of the AXI read master (docs/MEMORY.md "The
-//! caches"): set-associative, lines of whole records, one lookup a clock, answered `LATENCY` (4)
+//! caches"): set-associative, lines of whole records, one lookup a clock, answered `LATENCY` (5)
 //! clocks later — a hit with the record, or a miss with the **fill number to wait
 //! for**. Misses never block: the asker parks what missed and asks again once `done` has
 //! reached that number. Fills are numbered in the order the cache asked for them, and the
@@ -21,8 +21,8 @@ use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 
 /// Clocks from a lookup to its answer: the input register, the RAM read, a fabric register
-/// after it (while the in-flight table is searched), the compare and decision.
-pub const LATENCY: u32 = 4;
+/// after it, the compare (while the in-flight table is searched), the decision.
+pub const LATENCY: u32 = 5;
 
 /// Bits of a fill number (wrapping; compared as serial numbers, so a waiter may wait up to
 /// 2^15 fills).
@@ -138,7 +138,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
 
     b.stage(&nm("fill"), "beats gathered into records and written; the victim's tag cleared at the first beat, the new one written at the last");
     let done = b.reg(&nm("done"), seq, Some(0));
-    let req = b.reg(&nm("req"), seq, Some(0));
+    // The number the next fill asked for gets (the last asked for + 1), and how many are asked
+    // for and not done: registers, so the decision needs no adder and no compare of numbers.
+    let new_seq = b.reg(&nm("new_seq"), seq, Some(1));
+    let pending = b.reg(&nm("pending"), Ty::u(addr_bits(p.inflight as usize + 1) + 1), Some(0));
     let db = addr_bits(p.inflight as usize);
     // The in-flight table, by fill number mod `inflight`: line, way, live.
     let slots: Vec<(S<'b>, S<'b>, S<'b>)> = (0..p.inflight)
@@ -158,7 +161,8 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // when a fill ends, or from the decision when it asks for exactly that fill.
     let f_line = b.reg(&nm("fill_line"), Ty::u(p.line_bits), None);
     let f_way = b.reg(&nm("fill_way"), Ty::u(wb), None);
-    let after = (done + 2).name(&nm("after_next")).slice(0, db);
+    // (done + 2) mod inflight: the table's entry for the fill after the next, kept in a register.
+    let after = b.reg(&nm("after_next"), Ty::u(db), Some(2 % (1i128 << db)));
     let pick = |f: &dyn Fn(&(S<'b>, S<'b>, S<'b>)) -> S<'b>, ty: Ty| {
         slots.iter().enumerate().fold(b.konst(ty, 0), |acc, (j, s)| after.eq(j as i128).select(f(s), acc))
     };
@@ -167,7 +171,6 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // Driven by the decision below: it asks for fill `asked_seq` of line `asked_line` into way
     // `asked_way` this clock.
     let asked = b.wire(&nm("asked"), Ty::BIT);
-    let asked_seq = b.wire(&nm("asked_seq"), seq);
     let asked_line = b.wire(&nm("asked_line"), Ty::u(p.line_bits));
     let asked_way = b.wire(&nm("asked_way"), Ty::u(wb));
     let f_set = f_line.slice(0, sb).name(&nm("fill_set"));
@@ -209,8 +212,12 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         }
     }
     b.next_when(done, last, next_fill);
-    let target = last.select((done + 2).name(&nm("after_next_seq")), next_fill);
-    let from_decision = (asked & asked_seq.eq(target)).name(&nm("fill_from_decision"));
+    b.next_when(after, last, after + 1);
+    // The fill asked for this clock is the next to arrive: nothing else was pending, or only
+    // the one whose last beat is this clock.
+    let next_is_asked = last.select(pending.eq(1), pending.eq(0));
+    let from_decision = (asked & next_is_asked).name(&nm("fill_from_decision"));
+    b.next(pending, pending + asked.resize(pending.width()) - last.resize(pending.width()));
     b.next_when(f_line, last | from_decision, from_decision.select(asked_line, table_line));
     b.next_when(f_way, last | from_decision, from_decision.select(asked_way, table_way));
     // A line leaves the table two clocks after its tag is written.
@@ -261,59 +268,63 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         .enumerate()
         .map(|(w, ds)| ds.iter().enumerate().map(|(j, &d)| b.delay(&nm(&format!("data_r{w}_{j}")), d)).collect())
         .collect();
+    // The compare, while the in-flight table is searched for the line; both registered.
+    let l2_valid = b.valid_delay(&nm("l2_valid"), l1_valid);
+    let l2_line = b.delay(&nm("l2_line"), l1_line);
+    let want = if tb == 0 { b.konst(Ty::u(1), 0) } else { l2_line.slice(sb, tb) };
+    let hit_c: Vec<S<'b>> = tag_r
+        .iter()
+        .zip(&valid_r)
+        .enumerate()
+        .map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}_c"))))
+        .collect();
+    let hits: Vec<S<'b>> = hit_c.iter().enumerate().map(|(w, &h)| b.delay(&nm(&format!("hit{w}")), h)).collect();
+    let data: Vec<S<'b>> = (0..parts.len())
+        .map(|j| {
+            let d = (1..p.ways as usize).fold(data_r[0][j], |acc, w| hit_c[w].select(data_r[w][j], acc));
+            b.delay(&nm(&format!("data_s{j}")), d)
+        })
+        .collect();
     let mut found = b.konst(Ty::BIT, 0);
     let mut found_seq = b.konst(seq, 0);
     // Each place keeps its fill number (a register, not req minus the distance: that was a
     // subtractor per place on the path to the decision).
     let seqs: Vec<S<'b>> = (0..p.inflight).map(|j| b.reg(&nm(&format!("fl{j}_seq")), seq, None)).collect();
     for (j, s) in slots.iter().enumerate() {
-        let m = (s.2 & s.0.eq(l1_line)).name(&nm(&format!("match{j}")));
+        let m = (s.2 & s.0.eq(l2_line)).name(&nm(&format!("match{j}")));
         found_seq = m.select(seqs[j], found_seq);
         found = found | m;
     }
-    let l2_valid = b.valid_delay(&nm("l2_valid"), l1_valid);
-    let l2_line = b.delay(&nm("l2_line"), l1_line);
+    let l3_valid = b.valid_delay(&nm("l3_valid"), l2_valid);
+    let l3_line = b.delay(&nm("l3_line"), l2_line);
     let found2 = b.delay(&nm("found_r"), found);
     let found_seq2 = b.delay(&nm("found_seq_r"), found_seq);
-    // The compare and the decision. The table was searched a clock ago: a fill asked for by
-    // the lookup just before this one is not in that search, so it is compared here.
-    let want = if tb == 0 { b.konst(Ty::u(1), 0) } else { l2_line.slice(sb, tb) };
-    let hits: Vec<S<'b>> = tag_r
-        .iter()
-        .zip(&valid_r)
-        .enumerate()
-        .map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}"))))
-        .collect();
+    // The decision. The table was searched a clock ago: a fill asked for by the lookup just
+    // before this one is not in that search, so its line was compared with this one's then.
+    let same_line = b.delay(&nm("same_line"), l2_line.eq(l3_line).name(&nm("same_line_c")));
     let hit = hits.iter().skip(1).fold(hits[0], |a, &h| a | h).name(&nm("hit"));
-    let data: Vec<S<'b>> = (0..parts.len())
-        .map(|j| (1..p.ways as usize).fold(data_r[0][j], |acc, w| hits[w].select(data_r[w][j], acc)))
-        .collect();
     let prev_alloc = b.reg(&nm("prev_alloc"), Ty::BIT, Some(0));
-    let prev_line = b.reg(&nm("prev_line"), Ty::u(p.line_bits), None);
     let prev_seq = b.reg(&nm("prev_seq"), seq, None);
-    let same_as_prev = (prev_alloc & prev_line.eq(l2_line)).name(&nm("same_as_prev"));
+    let same_as_prev = (prev_alloc & same_line).name(&nm("same_as_prev"));
     let found = (found2 | same_as_prev).name(&nm("found"));
     let found_seq = same_as_prev.select(prev_seq, found_seq2).name(&nm("found_seq"));
-    let new_seq = (req + 1).name(&nm("new_seq"));
     let slot_free = !slots
         .iter()
         .enumerate()
         .fold(b.konst(Ty::BIT, 0), |acc, (j, s)| acc | (new_seq.slice(0, db).eq(j as i128) & s.2));
-    let miss = (l2_valid & !hit).name(&nm("miss"));
+    let miss = (l3_valid & !hit).name(&nm("miss"));
     let alloc = (miss & !found & slot_free).name(&nm("alloc"));
     b.next(prev_alloc, alloc);
-    b.next(prev_line, l2_line);
     b.next(prev_seq, new_seq);
     let victim = b.reg(&nm("victim"), Ty::u(wb), Some(0));
     b.next_when(victim, alloc, if p.ways == 1 { victim } else { victim + 1 });
     b.drive(asked, alloc);
-    b.drive(asked_seq, new_seq);
-    b.drive(asked_line, l2_line);
+    b.drive(asked_line, l3_line);
     b.drive(asked_way, victim);
-    b.next_when(req, alloc, new_seq);
+    b.next_when(new_seq, alloc, new_seq + 1);
     for (j, s) in slots.iter().enumerate() {
         let mine = (alloc & new_seq.slice(0, db).eq(j as i128)).name(&nm(&format!("alloc{j}")));
-        b.next_when(s.0, mine, l2_line);
+        b.next_when(s.0, mine, l3_line);
         b.next_when(s.1, mine, victim);
         b.next_when(seqs[j], mine, new_seq);
         let freed = free & free_at.eq(j as i128);
@@ -321,12 +332,12 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     }
     // A miss that can neither merge nor take a place waits for the next fill and asks again.
     let wait = found.select(found_seq, alloc.select(new_seq, next_fill)).name(&nm("wait_c"));
-    let a_valid = b.valid_delay(&nm("a_valid"), l2_valid);
+    let a_valid = b.valid_delay(&nm("a_valid"), l3_valid);
     let a_hit = b.delay(&nm("a_hit"), hit);
     let a_data: Vec<S<'b>> = data.iter().enumerate().map(|(j, &d)| b.delay(&nm(&format!("a_data{j}")), d)).collect();
     let a_wait = b.delay(&nm("a_wait"), wait);
     let req_valid = b.valid_delay(&nm("req_valid"), alloc);
-    let req_line = b.delay(&nm("req_line"), l2_line);
+    let req_line = b.delay(&nm("req_line"), l3_line);
     b.end_stage();
     Cache {
         answer: Answer { valid: a_valid, hit: a_hit, data: a_data, wait: a_wait },

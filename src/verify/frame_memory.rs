@@ -73,6 +73,35 @@ impl MemoryStats {
     }
 }
 
+/// When a run through an external-memory core has stopped making progress. A slow memory
+/// may make a frame take millions of clocks (thousands of triangle tests a ray, each a miss
+/// through a tiny cache), so the bound is not on the frame's clocks but (a) on the clocks
+/// without a result, a node step or a triangle test — a core that fetches the same lines for
+/// ever (a livelock) steps nothing — and (b) on the node steps and tests themselves: a ray
+/// visits each node (or culls it) and tests each leaf entry at most once (doubled for margin).
+struct RunLimits {
+    quiet: u64,
+    walk: u64,
+    /// Node steps and tests seen at the last progress.
+    walked_before: u64,
+}
+
+impl RunLimits {
+    fn new(p: &CoreParams, roms: &SceneRoms, rays: u64, timing: &MemoryTiming) -> RunLimits {
+        let mem = p.mem.as_ref().expect("an external-memory core");
+        let shape = mem.spec.shape;
+        let beats = (shape.line_bytes * 8 / shape.mem_bits) as u64;
+        // Clocks one line takes at the worst: latency, extra delay, its beats through the pauses.
+        let pause = timing.pause_in_256.min(255) as u64;
+        let per_line = (timing.latency + timing.extra_delay) as u64 + (beats * 256).div_ceil(256 - pause) + 1;
+        // A step may wait behind every fill the askers have in flight and a leaf's retries:
+        // 2,000 lines is far beyond either.
+        let quiet = 50_000 + 2_000 * per_line;
+        let walk = 2 * rays * (roms.node.1.len() + roms.leaf.1.len()) as u64 + 1;
+        RunLimits { quiet, walk, walked_before: 0 }
+    }
+}
+
 /// Streams `rays` (in the order given, the source holding back on the cycles of `stalls` as the
 /// testbenches' does, every result taken when shown) through the core of `p` (which must have
 /// external memory) in the cycle simulator, the memory model of `timing` answering from
@@ -105,7 +134,8 @@ pub fn simulate_external(
     let mut results = Vec::with_capacity(rays.len());
     let idle = vec![0i128; ins.len()];
     let mut next = 0;
-    let limit = 400_000 + 20_000 * rays.len() as u64 + 200 * timing.latency as u64 * rays.len() as u64;
+    let mut limits = RunLimits::new(p, roms, rays.len() as u64, &timing);
+    let mut last_progress = 0;
     sim.set(res_ready, 1);
     sim.set(mem_ins[0], SIM_BASE as i128);
     while results.len() < rays.len() {
@@ -134,14 +164,24 @@ pub fn simulate_external(
         stats.count(&observed.map(|o| sim.get(o)));
         ms.count(&mem_observed.map(|o| sim.get(o)));
         next += fire as usize;
-        if let Some(row) = shown {
-            results.push(core_result(&row));
+        if let Some(row) = &shown {
+            results.push(core_result(row));
             if results.len() % 256 == 0 {
                 progress(results.len() as u64);
             }
         }
         assert!(sim.get(error) == 0, "cycle {}: the read master flagged a memory error", stats.cycles);
-        assert!(stats.cycles < limit, "the core stopped producing results ({} of {})", results.len(), rays.len());
+        let walked = stats.visits + stats.culls + stats.busy_cycles;
+        if shown.is_some() || walked > limits.walked_before {
+            (last_progress, limits.walked_before) = (stats.cycles, walked);
+        }
+        assert!(
+            stats.cycles - last_progress < limits.quiet && walked <= limits.walk,
+            "the core stopped producing results ({} of {}; {walked} node steps and tests, the last {} clocks ago)",
+            results.len(),
+            rays.len(),
+            stats.cycles - last_progress
+        );
     }
     (ms.reads, ms.beats) = (model.bursts_taken, model.beats);
     ms.finish(stats.rays, stats.cycles);

@@ -4,7 +4,9 @@
 //! and hit when asked again; no line is asked for twice while on its way; a broken memory is
 //! flagged. `harness` and `drive` also give the transcript tests/memory.rs replays in the HDL
 //! simulators. Checks shown failing on their defects: a merge turned off (a line asked for
-//! twice), a waiter given the wrong fill number (never released), a lost beat (flagged).
+//! twice), a waiter given the wrong fill number (never released), a lost beat (flagged), a
+//! fill asked for the clock the only one pending ends written to the wrong line (a wrong
+//! record: the phases of two lookups outstanding make that clock happen).
 
 use super::memory::{MasterOut, MemoryModel, MemoryTiming, xorshift32};
 use super::testbench::Stimulus;
@@ -221,7 +223,10 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
                 assert_eq!(sim.get(output(&format!("ans{c}_valid"))), 0, "cache {c}: no answer due at clock {clock}");
             }
             // The last 3,000 clocks only finish what was asked: every waiter must be released.
-            while tasks[c].len() < 6 && clock + 3_000 < clocks {
+            // Phases of 6 lookups outstanding (the table full) and of 2 (fills one at a time,
+            // a new one asked for as the last ends).
+            let outstanding = if (clock / 1_500) % 2 == 0 { 6 } else { 2 };
+            while tasks[c].len() < outstanding && clock + 3_000 < clocks {
                 x = xorshift32(x);
                 tasks[c].push((
                     (x >> 4) as u64 % (1 << p.line_bits),
@@ -341,7 +346,7 @@ mod tests {
             assert!(!d.error, "{timing:?}: the master flagged a protocol error");
             // More misses than bursts: misses to lines on their way were merged.
             let (h, m, b) = (d.hits, d.misses, d.bursts);
-            assert!(h > 1_000 && m > 200 && m > b + 100, "{timing:?}: {h} hits, {m} misses, {b} bursts");
+            assert!(h > 500 && m > 200 && m > b + 100, "{timing:?}: {h} hits, {m} misses, {b} bursts");
         }
     }
 
