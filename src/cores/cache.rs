@@ -126,6 +126,16 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let valid: Vec<Vec<S<'b>>> = (0..p.ways)
         .map(|w| (0..p.sets).map(|k| b.reg(&nm(&format!("v{w}_{k}")), Ty::BIT, Some(0))).collect())
         .collect();
+    // A line is fresh from its fill until its first hit; no fill may replace a fresh line (nor
+    // be asked for into a set with a fill on its way). So every line that arrives is hit once
+    // before it can leave: two slots whose lines share a set cannot evict each other's lines
+    // for ever (seen: a one-way triangle cache in the campaign, fills back to back).
+    let fresh: Vec<Vec<S<'b>>> = (0..p.ways)
+        .map(|w| (0..p.sets).map(|k| b.reg(&nm(&format!("f{w}_{k}")), Ty::BIT, Some(0))).collect())
+        .collect();
+    // Driven by the decision: the way hit (one-hot) and the set, to clear the fresh bit.
+    let hit_way: Vec<S<'b>> = (0..p.ways).map(|w| b.wire(&nm(&format!("hit_way{w}")), Ty::BIT)).collect();
+    let hit_set = b.wire(&nm("hit_set"), Ty::u(sb));
     let datas: Vec<Vec<usize>> = (0..p.ways)
         .map(|w| {
             parts
@@ -210,6 +220,11 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         for (k, &v) in valid[w].iter().enumerate() {
             b.next_when(v, (clear | set) & set_hot[k], set);
         }
+        let hit_here = hit_way[w];
+        for (k, &f) in fresh[w].iter().enumerate() {
+            let filled = (clear | set) & set_hot[k];
+            b.next_when(f, filled | (hit_here & hit_set.eq(k as i128)), filled & set);
+        }
     }
     b.next_when(done, last, next_fill);
     b.next_when(after, last, after + 1);
@@ -237,18 +252,20 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let tag_q: Vec<S<'b>> = tags.iter().enumerate().map(|(w, &t)| b.read(&nm(&format!("tag_q{w}")), t, set)).collect();
     // The valid bits at the set, through a tree of 2:1 selects by the set's bits, registered
     // beside the RAM reads.
-    let valid_q: Vec<S<'b>> = valid
-        .iter()
-        .enumerate()
-        .map(|(w, bits)| {
-            let mut level = bits.clone();
-            for bit in 0..sb {
-                let sel = set.bit(bit);
-                level = level.chunks(2).map(|pair| sel.select(pair[1], pair[0])).collect();
-            }
-            b.delay(&nm(&format!("valid_q{w}")), level[0])
-        })
-        .collect();
+    let at_set = |bits: &Vec<S<'b>>| {
+        let mut level = bits.clone();
+        for bit in 0..sb {
+            let sel = set.bit(bit);
+            level = level.chunks(2).map(|pair| sel.select(pair[1], pair[0])).collect();
+        }
+        level[0]
+    };
+    let valid_q: Vec<S<'b>> =
+        valid.iter().enumerate().map(|(w, bits)| b.delay(&nm(&format!("valid_q{w}")), at_set(bits))).collect();
+    // The fresh bits too: read with the tags, so a fill whose last beat comes later is still
+    // in the table when it is searched (it leaves two clocks after).
+    let fresh_l3: Vec<S<'b>> =
+        fresh.iter().enumerate().map(|(w, bits)| b.delay_line(&nm(&format!("fresh_q{w}")), at_set(bits), 3)).collect();
     let data_q: Vec<Vec<S<'b>>> = datas
         .iter()
         .enumerate()
@@ -287,6 +304,7 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         .collect();
     let mut found = b.konst(Ty::BIT, 0);
     let mut found_seq = b.konst(seq, 0);
+    let mut busy = b.konst(Ty::BIT, 0);
     // Each place keeps its fill number (a register, not req minus the distance: that was a
     // subtractor per place on the path to the decision).
     let seqs: Vec<S<'b>> = (0..p.inflight).map(|j| b.reg(&nm(&format!("fl{j}_seq")), seq, None)).collect();
@@ -294,6 +312,7 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         let m = (s.2 & s.0.eq(l2_line)).name(&nm(&format!("match{j}")));
         found_seq = m.select(seqs[j], found_seq);
         found = found | m;
+        busy = busy | (s.2 & s.0.slice(0, sb).eq(l2_line.slice(0, sb)));
     }
     let l3_valid = b.valid_delay(&nm("l3_valid"), l2_valid);
     let l3_line = b.delay(&nm("l3_line"), l2_line);
@@ -302,6 +321,8 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // The decision. The table was searched a clock ago: a fill asked for by the lookup just
     // before this one is not in that search, so its line was compared with this one's then.
     let same_line = b.delay(&nm("same_line"), l2_line.eq(l3_line).name(&nm("same_line_c")));
+    let same_set = b.delay(&nm("same_set"), l2_line.slice(0, sb).eq(l3_line.slice(0, sb)).name(&nm("same_set_c")));
+    let busy2 = b.delay(&nm("busy_r"), busy.name(&nm("busy_c")));
     let hit = hits.iter().skip(1).fold(hits[0], |a, &h| a | h).name(&nm("hit"));
     let prev_alloc = b.reg(&nm("prev_alloc"), Ty::BIT, Some(0));
     let prev_seq = b.reg(&nm("prev_seq"), seq, None);
@@ -313,10 +334,18 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         .enumerate()
         .fold(b.konst(Ty::BIT, 0), |acc, (j, s)| acc | (new_seq.slice(0, db).eq(j as i128) & s.2));
     let miss = (l3_valid & !hit).name(&nm("miss"));
-    let alloc = (miss & !found & slot_free).name(&nm("alloc"));
+    let victim = b.reg(&nm("victim"), Ty::u(wb), Some(0));
+    let victim_fresh = (1..p.ways as usize)
+        .fold(fresh_l3[0], |acc, w| victim.eq(w as i128).select(fresh_l3[w], acc))
+        .name(&nm("victim_fresh"));
+    let blocked = (busy2 | (prev_alloc & same_set) | victim_fresh).name(&nm("blocked"));
+    let alloc = (miss & !found & slot_free & !blocked).name(&nm("alloc"));
     b.next(prev_alloc, alloc);
     b.next(prev_seq, new_seq);
-    let victim = b.reg(&nm("victim"), Ty::u(wb), Some(0));
+    for (w, &h) in hits.iter().enumerate() {
+        b.drive(hit_way[w], l3_valid & h);
+    }
+    b.drive(hit_set, l3_line.slice(0, sb));
     b.next_when(victim, alloc, if p.ways == 1 { victim } else { victim + 1 });
     b.drive(asked, alloc);
     b.drive(asked_line, l3_line);
@@ -330,8 +359,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         let freed = free & free_at.eq(j as i128);
         b.next(s.2, mine.select(b.konst(Ty::BIT, 1), freed.select(b.konst(Ty::BIT, 0), s.2)));
     }
-    // A miss that can neither merge nor take a place waits for the next fill and asks again.
-    let wait = found.select(found_seq, alloc.select(new_seq, next_fill)).name(&nm("wait_c"));
+    // A miss that can neither merge nor take a place waits for the next fill and asks again
+    // (at once when no fill is on its way: it waits for a fresh line's first hit).
+    let retry_at = pending.eq(0).select(done, next_fill);
+    let wait = found.select(found_seq, alloc.select(new_seq, retry_at)).name(&nm("wait_c"));
     let a_valid = b.valid_delay(&nm("a_valid"), l3_valid);
     let a_hit = b.delay(&nm("a_hit"), hit);
     let a_data: Vec<S<'b>> = data.iter().enumerate().map(|(j, &d)| b.delay(&nm(&format!("a_data{j}")), d)).collect();

@@ -66,6 +66,9 @@ pub fn tri_fetch<'b>(
     let (w_head, w_count, w_tmin, w_sp) =
         (reg("fetch_head", pb), reg("fetch_count", cw), reg("fetch_tmin", tw), reg("fetch_sp", spw));
     let w_last = b.reg("fetch_last", bit, None);
+    // Whether this pass over the leaf is a retry: then records staged by an earlier pass are
+    // not looked up again.
+    let w_retry = b.reg("fetch_retry", bit, None);
     let last_entry = (w_valid & w_last).name("fetch_last_entry");
     let can_take = (!w_valid | last_entry).name("fetch_can_take");
 
@@ -104,9 +107,25 @@ pub fn tri_fetch<'b>(
     b.next_when(w_count, take, count);
     b.next_when(w_tmin, take, src(3, "leaf_tmin"));
     b.next_when(w_sp, take, src(4, "leaf_sp"));
+    b.next_when(w_retry, take, take_retry);
+
+    // Which records of a slot's leaf are in the staging RAM: written at every answer of every
+    // pass (so a leaf's first pass overwrites what an earlier leaf left), read a clock before
+    // the lookup. A record staged stays staged until its leaf is emitted, so every line that
+    // arrives and is hit once moves its leaf forward for good: a leaf whose lines evict each
+    // other (or are evicted by other slots' fills) still finishes.
+    let stage_words = (slots as usize) << ib;
+    let staged = b.ram("tri_staged", 1, vec![0; stage_words]);
+    let staged_q = b.read("tri_staged_q", staged, b.cat(&[w_slot, w_idx]));
+    let f_valid = b.valid_delay("fetch1_valid", w_valid);
+    let skip = (f_valid & b.delay("fetch1_retry", w_retry) & staged_q).name("fetch1_staged");
 
     let rec = if sb == 0 { b.konst(Ty::u(m.tri.rec_bits()), 0) } else { w_ptr.slice(0, sb).resize(m.tri.rec_bits()) };
-    let look = Lookup { valid: w_valid, line: (w_ptr >> sb).resize(m.tri.line_bits), rec };
+    let look = Lookup {
+        valid: (f_valid & !skip).name("tri_look_valid"),
+        line: b.delay("fetch1_line", (w_ptr >> sb).resize(m.tri.line_bits)),
+        rec: b.delay("fetch1_rec", rec),
+    };
     let Cache { answer, request: (req_valid, req_line), done } = cache(b, "tc", &m.tri, &look, fill);
     b.drive(request.0, req_valid);
     b.drive(request.1, req_line);
@@ -114,16 +133,20 @@ pub fn tri_fetch<'b>(
 
     b.stage("tri_answer", "the answers: hits into the staging RAM; a leaf with a miss to the retry queue");
     let tag = b.cat(&[w_slot, w_idx, w_head, w_count, w_tmin, w_sp, w_last]);
-    let a = unpack(b.delay_line("fetch_tag", tag, LATENCY), &[gb, ib, pb, cw, tw, spw, 1]);
+    let a = unpack(b.delay_line("fetch_tag", tag, LATENCY + 1), &[gb, ib, pb, cw, tw, spw, 1]);
     let (a_slot, a_idx, a_last) = (a[0], a[1], a[6]);
-    let av = answer.valid;
+    // Every record of a pass is answered: by the cache, or as staged before.
+    let av = b.valid_line("fetch_answered", w_valid, LATENCY + 1);
+    let a_skip = b.delay_line("fetch_skip", skip, LATENCY);
+    let looked_hit = (answer.valid & answer.hit).name("tri_hit");
+    let good = (a_skip | looked_hit).name("fetch_good");
     let acc_miss = b.reg("fetch_missed", bit, Some(0));
     let acc_wait = b.reg("fetch_wait", Ty::u(SEQ_BITS), None);
     let earlier = (a_idx.ne(0) & acc_miss).name("fetch_missed_before");
-    let missed = (earlier | !answer.hit).name("fetch_missed_c");
+    let missed = (earlier | !good).name("fetch_missed_c");
     // The later of the fills to wait for (fills are numbered in order, compared as serial numbers).
     let later = (earlier & released(acc_wait, answer.wait)).name("fetch_wait_keep");
-    let wait = (answer.hit | later).select(acc_wait, answer.wait).name("fetch_wait_c");
+    let wait = (good | later).select(acc_wait, answer.wait).name("fetch_wait_c");
     b.next_when(acc_miss, av, missed);
     b.next_when(acc_wait, av, wait);
     let leaf_done = (av & a_last).name("fetch_leaf_done");
@@ -134,9 +157,9 @@ pub fn tri_fetch<'b>(
     let ready_pop = b.wire("ready_pop", bit);
     let ready =
         fifo(b, "ready_q", ready_widths.iter().sum(), slots, ready_push, b.cat(&[a_slot, a[3], a[4], a[5]]), ready_pop);
-    let stage_words = (slots as usize) << ib;
     let waddr = b.cat(&[a_slot, a_idx]).name("stage_waddr");
-    let we = (av & answer.hit).name("stage_we");
+    let we = looked_hit;
+    b.ram_write(staged, av, waddr, good);
 
     b.stage("tri_emit", "leaves from the ready queue, a triangle a clock from the staging RAM into the pipeline");
     let e_valid = b.reg("emit_active", bit, Some(0));
@@ -175,6 +198,6 @@ pub fn tri_fetch<'b>(
     let fields = l.tri.fields.iter().filter(|f| f.name != "id").map(|f| record_field(b, &parts, f)).collect();
     let emitted = into_pipeline(b, p, rams, e_slot, lat, [valid_d, tag], fields);
     let stall = b.delay("mem_stall", (!valid_d & retry.nonempty).name("mem_stall_c"));
-    let observed = FetchObserved { looks: av, hits: (av & answer.hit).name("tri_hit"), stall };
+    let observed = FetchObserved { looks: answer.valid, hits: looked_hit, stall };
     (emitted, observed)
 }
