@@ -5,15 +5,16 @@
 //!
 //! - **Fetch**: whole leaves, a record a clock, from the units' leaf buffers in turn
 //!   (`leaf_buffers`) or — first — a leaf back from the retry queue once its lines are in. Each
-//!   record is looked up in the triangle cache; `cache::LATENCY` clocks later a hit is written to
-//!   the staging RAM, a miss marks the leaf and keeps the latest fill it must wait for. At the
-//!   leaf's last answer it goes to the ready queue if every record hit, else to the retry queue
-//!   with that fill number, and is fetched whole again once the fill is done.
+//!   record not staged by an earlier pass is looked up in the triangle cache a clock later;
+//!   `cache::LATENCY` clocks after that a hit is written to the staging RAM, a miss marks the
+//!   leaf and keeps the latest fill it must wait for. At the leaf's last answer it goes to the
+//!   ready queue if every record is staged, else to the retry queue with that fill number, and
+//!   its missing records are fetched again once the fill is done (DECISIONS 109).
 //! - **Emission**: leaves from the ready queue, a triangle a clock from the staging RAM (two
 //!   clocks: the block's read and output register) with the slot's ray, into the pipeline.
 //!
-//! What it costs: the staging RAM (slots × 2^stage_bits records) and one extra lookup per
-//! record of a leaf that missed.
+//! What it costs: the staging RAM (slots × 2^stage_bits records), a bit per record of it (what
+//! is staged), and a clock per record of a leaf that missed on each retry.
 
 use super::axi_read::Fill;
 use super::brom::bram;
