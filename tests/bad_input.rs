@@ -199,8 +199,6 @@ fn external_memory_options_are_checked() {
         (&["--tri-cache-kb", "1024", "--bram-kbits", "4000"][..], "bram-kbits", "caches"),
         (&["--raygen", "--eye", "0,1,0", "--at", "1,1,0"][..], "memory", "host rays"),
         (&["--ray-order", "tiles", "--shuffle-seed", "3"][..], "ray-order", "shuffle"),
-        // One leaf of all 32 triangles: 12 lines, and a 1 KB cache has 4 sets.
-        (&["--leaf-size", "64", "--tri-cache-kb", "1"][..], "tri-cache-kb", "evict its own lines"),
     ] {
         let args = sim(extra);
         let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();

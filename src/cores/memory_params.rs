@@ -147,24 +147,9 @@ impl ExternalMemory {
         let count = roms.node.0.field("count");
         let largest = roms.node.1.iter().filter(|w| w.get(roms.node.0.field("axis")) == 3).map(|w| w.get(count));
         let largest = largest.max().unwrap_or(1).max(1) as usize;
-        // A leaf is staged whole or fetched again whole (`tri_fetch`): its lines must fit the
-        // triangle cache without evicting one another, or it misses on every fetch for ever
-        // (the differential campaign found a depth-limited jackstraws tree doing so). Its
-        // records are consecutive, so they take distinct sets when they span at most `sets`
-        // lines, from any slot of the first line.
-        let per_line = layout.tris_per_line as u64;
-        let span = (per_line - 1 + largest as u64 - 1) / per_line + 1;
-        if span > tri.sets as u64 {
-            return Err(Error::param(
-                "tri-cache-kb",
-                format!(
-                    "{} KB: the largest leaf ({largest} triangles) spans up to {span} lines, more than the \
-                     triangle cache's {} sets, so it would evict its own lines and never be staged whole: a larger \
-                     --tri-cache-kb, a smaller --leaf-size or a deeper --stack-depth",
-                    spec.tri_cache_kb, tri.sets
-                ),
-            ));
-        }
+        // A leaf may span more lines than the triangle cache has sets: a pass over it keeps
+        // what it staged and looks up only the rest, and a line stays until its first hit
+        // (DECISIONS 109), so its lines evicting one another cannot stall it for ever.
         Ok(ExternalMemory { spec, layout, node, tri, axi, stage_bits: addr_bits(largest) })
     }
 

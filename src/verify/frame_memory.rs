@@ -223,6 +223,36 @@ mod tests {
         }
     }
 
+    /// A leaf spanning more lines than the triangle cache has sets (the Cornell box in one
+    /// 32-triangle leaf, a 1 KB cache of four 2-way sets or eight 1-way ones) evicts its own
+    /// lines while it is fetched, yet finishes: what a pass staged stays staged (DECISIONS 109).
+    /// Such scenes were refused before (DECISIONS 103); with every pass fetching the whole
+    /// leaf again, this one hangs.
+    #[test]
+    fn a_leaf_larger_than_the_triangle_cache_finishes() {
+        let params = Params { leaf_size: 64, ..Params::default() };
+        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &params).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 6));
+        let (steps, tests) = golden_walk(&scene, &rays);
+        for ways in [1, 2] {
+            let spec = MemorySpec { node_cache_kb: 1, tri_cache_kb: 1, ways, ..MemorySpec::default() };
+            let p = CoreParams::external(&roms, &CoreSpec { slots: 8, ..CoreSpec::default() }, spec).unwrap();
+            let mem = p.mem.as_ref().unwrap();
+            let (layout, words) = &roms.node;
+            let leaves = words.iter().filter(|w| w.get(layout.field("axis")) == 3);
+            let largest = leaves.map(|w| w.get(layout.field("count"))).max().unwrap() as usize;
+            let lines = largest.div_ceil(mem.layout.tris_per_line as usize);
+            assert!(lines > mem.tri.sets as usize, "the case it guards: {lines} lines, {} sets", mem.tri.sets);
+            let image = SceneImage::build(&roms, spec.shape).unwrap();
+            let timing =
+                MemoryTiming { latency: 60, extra_delay: 20, pause_in_256: 50, seed: 3, ..MemoryTiming::default() };
+            let (results, stats, _) = simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ());
+            assert_eq!(mismatches(&scene, &rays, &results), 0, "{ways} ways");
+            assert_eq!((stats.visits + stats.culls, stats.busy_cycles), (steps, tests), "{ways} ways");
+        }
+    }
+
     /// A tree with fewer nodes than a node line holds (the five-triangle `thin`, 8-byte node
     /// records at a 32-bit port: 16 to a line, node numbers of 3 bits): the core builds and
     /// every ray is right. The campaign's first external finding was a panic building it.
