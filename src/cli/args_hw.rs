@@ -233,9 +233,11 @@ pub struct SynthArgs {
     /// .venv: Fmax, critical path, resources).
     #[arg(long, default_value = "xc5v")]
     pub family: String,
-    /// ecp5: nextpnr's placement seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    /// ecp5: nextpnr's placement seeds — one (`3`), a range (`1..5`) or a list (`1,4,9`): the
+    /// netlist is synthesised once and placed at each seed (as many at once as the machine has
+    /// cores); the report gives the median seed's figures and the spread.
+    #[arg(long = "seeds", visible_alias = "seed", default_value = "1")]
+    pub seeds: String,
     /// ecp5: which modules to place and route (each takes minutes; the whole core is the
     /// longest): any of divider, intersect, traverse, closest, core.
     #[arg(long, value_delimiter = ',', default_value = "divider,intersect,traverse,closest,core")]

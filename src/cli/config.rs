@@ -448,8 +448,8 @@ pub enum Family {
     Xc5v,
     /// 7-series (Artix-7) area from Debian's yosys, a second reference.
     Xc7,
-    /// LFE5U-85F place and route: the clock constraint, nextpnr's seed and the modules.
-    Ecp5 { target_mhz: f64, seed: u64, modules: Vec<String> },
+    /// LFE5U-85F place and route: the clock constraint, nextpnr's seeds and the modules.
+    Ecp5 { target_mhz: f64, seeds: Vec<u64>, modules: Vec<String> },
 }
 
 /// The modules `synth --family ecp5` (and `sweep --synth --family ecp5`) can place and route.
@@ -463,7 +463,8 @@ impl SynthArgs {
             "ecp5" => {
                 crate::cores::clock::ClockTarget(self.hw.target_mhz).check()?;
                 crate::fpga::ecp5::check_modules(&self.modules)?;
-                Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seed: self.seed, modules: self.modules.clone() }
+                let seeds = crate::fpga::ecp5::seeds::parse_seeds(&self.seeds)?;
+                Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seeds, modules: self.modules.clone() }
             }
             other => {
                 return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));

@@ -319,7 +319,15 @@ fn synth_ecp5_options_are_checked() {
         panic!()
     };
     let c = a.config().unwrap();
-    assert_eq!(c.family, Family::Ecp5 { target_mhz: 150.0, seed: 1, modules: vec!["divider".into(), "core".into()] });
+    assert_eq!(
+        c.family,
+        Family::Ecp5 { target_mhz: 150.0, seeds: vec![1], modules: vec!["divider".into(), "core".into()] }
+    );
+    let Command::Synth(a) = command(&["synth", "--family", "ecp5", "--seeds", "2..4"]) else { panic!() };
+    assert!(matches!(a.config().unwrap().family, Family::Ecp5 { seeds, .. } if seeds == [2, 3, 4]));
+    let Command::Synth(a) = command(&["synth", "--family", "ecp5", "--seed", "7"]) else { panic!() };
+    assert!(matches!(a.config().unwrap().family, Family::Ecp5 { seeds, .. } if seeds == [7]));
+    assert_eq!(refused(&["synth", "--family", "ecp5", "--seeds", "3..1"]), "--seeds");
     assert_eq!(refused(&["synth", "--family", "ecp5", "--modules", "divider,alu"]), "--modules");
     assert_eq!(refused(&["synth", "--family", "ecp5", "--target-mhz", "0"]), "--target-mhz");
     assert_eq!(refused(&["synth", "--family", "xc4"]), "--family");

@@ -12,6 +12,7 @@
 pub mod bram;
 pub mod carry;
 pub mod dsp;
+pub mod seeds;
 
 use crate::cores::intersect::IntersectParams;
 use crate::cores::top::CoreParams;
@@ -136,7 +137,7 @@ pub fn core_clock<'a>(modules: impl IntoIterator<Item = (&'a str, f64)>) -> Opti
 }
 
 /// The measured timing and resources of one module.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     pub module: String,
     pub device: String,
@@ -254,19 +255,7 @@ pub fn place_and_route(
     seed: u64,
     dir: &Path,
 ) -> Result<Timing> {
-    let top = wrapper(&Rc::new(m.clone()));
-    let pins = (PIN_REGS.0 + PIN_REGS.1) as u64;
-    let out_bits: u32 = m.outputs.iter().map(|o| m.sig(o.1).ty.width).sum();
-    let wrapper_ff: u64 =
-        m.inputs.iter().map(|&i| m.sig(i).ty.width as u64).sum::<u64>() + 1 + pins + xor_tree(out_bits).1 as u64;
-    let sources = write_sources(&top, dir)?;
-    synthesize(tools, dir, &sources, &top.name)?;
-    nextpnr(tools, dir, &["--freq", &format!("{target_mhz}")], seed)?;
-    let report = read_report(dir)?;
-    let (yosys, nextpnr) = tools.versions();
-    let mut t = timing_from_report(&report, &m.name, target_mhz, latency, wrapper_ff, seed, yosys, nextpnr);
-    t.netlist_sha256 = netlist_hash(m);
-    Ok(t)
+    Ok(seeds::place_and_route_seeds(tools, m, latency, target_mhz, &[seed], 1, dir, &|_| ())?.median)
 }
 
 /// Writes `top`'s Verilog into `dir` as the ECP5 flow reads it — split multipliers' pieces as
