@@ -130,8 +130,8 @@ impl BoardClock {
 }
 
 /// The frame counter bit to show on LED 2: the lowest whose LED changes no faster than about
-/// four times a second, for a frame of `pixels` rays at `clock_mhz`, the generator giving a
-/// ray every `ray_cycles` clocks (it, not the core, bounds the frame rate: docs/BOARDS.md).
+/// four times a second, for a frame of `pixels` rays at `clock_mhz`, a ray at most every
+/// `ray_cycles` clocks (the generator's bound; the core is slower, so the LED is too).
 pub fn led_shift(pixels: u64, ray_cycles: u32, clock_mhz: f64) -> u32 {
     let frame_s = pixels as f64 * ray_cycles as f64 / (clock_mhz * 1e6);
     let mut shift = 0;
@@ -141,10 +141,10 @@ pub fn led_shift(pixels: u64, ray_cycles: u32, clock_mhz: f64) -> u32 {
     shift
 }
 
-/// Clocks the ray generator takes per ray: the clock that loads its divisors, its F + C + 1
-/// quotient bits and the clock a ray is offered in.
-pub fn generator_cycles(p: &CoreParams) -> u32 {
-    1 + (p.isect.m - 1 + p.trav.c + 1) + 1
+/// Clocks per ray the ray generator gives at most (its divider sets take turns: a ray every
+/// `CLOCKS_PER_RAY` clocks or faster, whatever m and C).
+pub fn generator_cycles(_p: &CoreParams) -> u32 {
+    crate::cores::raygen::CLOCKS_PER_RAY
 }
 
 /// A board design: the logic module, its top's name and everything the files say.

@@ -1,28 +1,31 @@
 //! The on-chip pinhole ray generator (the thesis's demo): pixel after pixel, the ray of
 //! `model::raygen::RayGen` — origin the eye's grid point, direction d0 + px·dx + py·dy — with
-//! its three reciprocals from three sequential dividers (a clock to load the divisors, then one
-//! quotient bit per clock: F + C + 2 clocks, and one more to hand the ray over). While the
-//! traversal works on one ray, the next one is being divided.
+//! its three reciprocals from restoring dividers (one quotient bit per clock, F + C + 1 of
+//! them). One divider set takes F + C + 2 clocks a ray, the core one ray every ~4–10 clocks, so
+//! there are `dividers(..)` sets, dealt pixels in turn and emptied in the same turn: rays leave
+//! in pixel order, one a clock when the sets are ahead of the core.
 //!
-//! States: `div` (the reciprocals of the current pixel), `full` (`ray_valid` until the core
-//! takes the ray; then the next pixel), `done` (after the last pixel).
+//! A pixel walker loads the next pixel's direction into the set whose turn it is once that
+//! set is empty; the set divides; the set at the output turn hands its ray to the port's two
+//! registers once the first is empty and the turn moves on. The core's `ready` only empties
+//! the port, so no path runs from the core into the sets (the first version, without the
+//! registers, missed the ULX3S board's 80 MHz). After the last pixel the walker stops (`restart`, when every set is
+//! empty, starts the frame again).
 
 use crate::model::raygen::RayGen;
-use crate::rtl::build::Builder;
-use crate::rtl::fsm::Fsm;
+use crate::rtl::build::{Builder, S};
 use crate::rtl::{Module, Ty};
 use crate::scene::rom::value_bits;
 
-crate::states! {
-    /// The generator's states, in encoding order.
-    pub enum GenState {
-        /// The reciprocals of the current pixel's direction.
-        Div = "div",
-        /// `ray_valid` until the core takes the ray.
-        Full = "full",
-        /// After the last pixel.
-        Done = "done",
-    }
+/// A ray every this many clocks at least, from `dividers` sets: ahead of the core with up to
+/// four intersection pipelines (about a ray every 2.5 clocks at 0.4 rays per clock would need
+/// more; the teapot's core takes one every ~10).
+pub const CLOCKS_PER_RAY: u32 = 4;
+
+/// Divider sets for quotients of `qbits` bits: each takes qbits + 2 clocks a ray (a load, the
+/// bits, the hand-over), so this many give a ray every `CLOCKS_PER_RAY` clocks.
+pub fn dividers(qbits: u32) -> u32 {
+    (qbits + 2).div_ceil(CLOCKS_PER_RAY)
 }
 
 /// Ports: `ready` in; `ray_valid`, `ray_id`, `ox oy oz`, `wx wy wz`, `invx invy invz` out (the
@@ -32,123 +35,166 @@ pub fn raygen_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Mo
 }
 
 /// The generator that starts the frame again (`fxrt_raygen_restart`, for the board tops): a
-/// second input `restart`, taken in `done`, returns it to the first pixel with ray id 0.
+/// second input `restart`, taken once every ray of the frame has left, returns it to the first
+/// pixel with ray id 0.
 pub fn raygen_restart_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Module {
     generator(g, n, m_bits, c, id_width, true)
 }
 
 fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: bool) -> Module {
-    use GenState::*;
     let b = Builder::new(if restarts { "fxrt_raygen_restart" } else { "fxrt_raygen" });
     let f = m_bits - 1;
     let qbits = f + c + 1;
+    let sets = dividers(qbits);
+    let turn_ty = Ty::u(value_bits(sets as usize));
     let ready = b.input("ready", Ty::BIT);
     let restart = restarts.then(|| b.input("restart", Ty::BIT));
-    let fsm = Fsm::new(&b, "state", "pinhole rays, pixel after pixel", Div);
+    let axes = ["x", "y", "z"];
 
-    // Pixel counters and the direction, stepped when a ray is taken.
+    // The pixel walker: the next pixel to load, its direction (m + 2 bits, so no step in or
+    // just past the frame wraps), and whether the frame's pixels are all loaded.
+    b.stage("walk", "the next pixel to load into a divider set");
     let px = b.reg("px", Ty::u(value_bits(g.width as usize)), Some(0));
     let py = b.reg("py", Ty::u(value_bits(g.height as usize)), Some(0));
-    let id = b.reg("pixel", Ty::u(id_width), Some(0));
+    let walked = b.reg("walked", Ty::BIT, Some(0));
     let last_x = px.eq(g.width as i128 - 1).name("last_x");
     let last = (last_x & py.eq(g.height as i128 - 1)).name("last_pixel");
-    // Directions in m + 2 bits, so no step in or just past the frame wraps.
     let dw = Ty::s(m_bits + 2);
-    let axes = ["x", "y", "z"];
     let row = [0, 1, 2].map(|k| b.reg(&format!("row_{}", axes[k]), dw, Some(g.d0[k] as i128)));
     let d = [0, 1, 2].map(|k| b.reg(&format!("d_{}", axes[k]), dw, Some(g.d0[k] as i128)));
     let row_next = [0, 1, 2].map(|k| row[k] + g.dy[k] as i128);
-    let w_out = d.map(|d| d.resize(m_bits));
+    let load_turn = b.reg("load_turn", turn_ty, Some(0));
+    let out_turn = b.reg("out_turn", turn_ty, Some(0));
+    let out_id = b.reg("ray_id_next", Ty::u(id_width), Some(0));
 
-    // Three restoring dividers: q = floor(2^(F+C) / |w|), |w| = 1 for w = 0; one quotient bit
-    // per clock, the numerator's only 1 (its top bit) shifted in first. The divisor |w| comes
-    // from a register, loaded in the first clock of `div` (count 0), so a step is one
-    // compare-subtract between registers (negating w in the same clock was the slowest path of
-    // the ULX3S board top: 98.9 MHz).
-    let count = b.reg("div_count", Ty::u(value_bits(qbits as usize + 1)), Some(0));
-    let first_bit = count.eq(1).name("first_bit");
+    // Each set: its direction, |w| (1 for w = 0), remainder and quotient, and whether it is
+    // dividing (`run`, with the bit count) or holds a finished ray (`held`).
+    b.stage("divide", "restoring dividers: q = floor(2^(F+C) / |w|), a bit a clock");
     let lim = (1i128 << (m_bits + c - 1)) - 1;
-    let rem = axes.map(|a| b.reg(&format!("rem_{a}"), Ty::u(f + 2), Some(0)));
-    let quot = axes.map(|a| b.reg(&format!("quot_{a}"), Ty::u(qbits), Some(0)));
-    let mut steps = Vec::new();
-    let mut inv_out = Vec::new();
+    let mut load = Vec::new();
+    let mut busy = Vec::new();
+    let mut held = Vec::new();
+    let mut outs = Vec::new();
+    let take = b.wire("take", Ty::BIT);
+    for s in 0..sets {
+        let is_load = load_turn.eq(s as i128);
+        let run = b.reg(&format!("run{s}"), Ty::BIT, Some(0));
+        let hold = b.reg(&format!("held{s}"), Ty::BIT, Some(0));
+        let idle = (!run & !hold).name(&format!("idle{s}"));
+        let loads = (is_load & idle & !walked).name(&format!("load{s}"));
+        let count = b.reg(&format!("count{s}"), Ty::u(value_bits(qbits as usize + 1)), Some(0));
+        let first = count.eq(1).name(&format!("first{s}"));
+        let ends = (run & count.eq(qbits as i128)).name(&format!("ends{s}"));
+        let taken = (take & out_turn.eq(s as i128)).name(&format!("taken{s}"));
+        b.next(run, loads.select(run.k(1), ends.select(run.k(0), run)));
+        b.next(hold, ends.select(hold.k(1), taken.select(hold.k(0), hold)));
+        b.next(count, loads.select(count.k(1), run.select(count + 1, count)));
+        let mut set_out = Vec::new();
+        for (k, axis) in axes.iter().enumerate() {
+            let w_new = d[k].resize(m_bits);
+            let w = b.reg(&format!("w{s}_{axis}"), Ty::s(m_bits), Some(0));
+            b.next_when(w, loads, w_new);
+            let neg = w_new.lt(0);
+            let mag = neg.select(-w_new, w_new).unsigned().resize(f + 2);
+            let divisor = b.reg(&format!("b{s}_{axis}"), Ty::u(f + 2), Some(0));
+            b.next_when(divisor, loads, w_new.eq(0).select(mag.k(1), mag));
+            let rem = b.reg(&format!("rem{s}_{axis}"), Ty::u(f + 2), Some(0));
+            let quot = b.reg(&format!("quot{s}_{axis}"), Ty::u(qbits), Some(0));
+            // The numerator's only 1 (its top bit) enters with the first quotient bit.
+            let r3 = (first.select(rem.k(0), rem) << 1) + first.resize(f + 2);
+            let ge = divisor.le(r3);
+            b.next_when(rem, run, ge.select(r3 - divisor, r3));
+            b.next_when(quot, run, (first.select(quot.k(0), quot) << 1) + ge.resize(qbits));
+            set_out.push((w, quot));
+        }
+        load.push(loads);
+        busy.push(!idle);
+        held.push(hold);
+        outs.push(set_out);
+    }
+    let loaded = load.iter().copied().reduce(|a, x| a | x).expect("a set").name("loaded");
+    let any_busy = busy.iter().copied().reduce(|a, x| a | x).expect("a set").name("any_busy");
+
+    // The walker steps when its pixel is loaded.
+    b.stage("step", "the walker steps past a loaded pixel");
+    let wrap = |t| next_turn(t, sets);
+    // The port's two registers (below) hold rays until the core takes them: a frame ends when
+    // they are empty too.
+    let pick_valid = b.reg("pick_valid", Ty::BIT, Some(0));
+    let port_valid = b.reg("port_valid", Ty::BIT, Some(0));
+    let restarting = match restart {
+        Some(r) => (r & walked & !any_busy & !pick_valid & !port_valid).name("restarting"),
+        None => b.konst(Ty::BIT, 0),
+    };
+    b.next(load_turn, restarting.select(load_turn.k(0), loaded.select(wrap(load_turn), load_turn)));
+    b.next(out_turn, restarting.select(out_turn.k(0), take.select(wrap(out_turn), out_turn)));
+    b.next(out_id, restarting.select(out_id.k(0), take.select(out_id + 1, out_id)));
+    b.next(walked, restarting.select(walked.k(0), (loaded & last).select(walked.k(1), walked)));
+    b.next(px, restarting.select(px.k(0), loaded.select(last_x.select(px.k(0), px + 1), px)));
+    b.next(py, restarting.select(py.k(0), (loaded & last_x).select(py + 1, py)));
     for k in 0..3 {
-        let w = w_out[k];
-        let neg = w.lt(0).name(&format!("neg_{}", axes[k]));
-        let mag = neg.select(-w, w).unsigned().resize(f + 2);
-        let divisor = b.delay(&format!("b_{}", axes[k]), w.eq(0).select(mag.k(1), mag));
-        let r3 = (first_bit.select(rem[k].k(0), rem[k]) << 1) + first_bit.resize(f + 2);
-        let ge = divisor.le(r3);
-        let r_next = ge.select(r3 - divisor, r3);
-        let q_next = (first_bit.select(quot[k].k(0), quot[k]) << 1) + ge.resize(qbits);
-        steps.push((r_next, q_next));
-        // Saturate to the m + C-bit range, then the sign.
-        let q = quot[k];
-        let q_s = q.gt(lim).select(q.k(lim), q).resize(m_bits + c).signed();
-        inv_out.push(neg.select(-q_s, q_s).name(&format!("inv_{}", axes[k])));
+        let d0 = d[k].k(g.d0[k] as i128);
+        b.next(row[k], restarting.select(d0, (loaded & last_x).select(row_next[k], row[k])));
+        let stepped = last_x.select(row_next[k], d[k] + g.dx[k] as i128);
+        b.next(d[k], restarting.select(d0, loaded.select(stepped, d[k])));
     }
 
-    fsm.state(Div, |s| {
-        s.set(count, count + 1);
-        s.when(count.ne(0), |s| {
-            for k in 0..3 {
-                s.set(rem[k], steps[k].0);
-                s.set(quot[k], steps[k].1);
-            }
-        });
-        s.when(count.eq(qbits as i128), |s| s.goto(Full));
-    });
-    fsm.state(Full, |s| {
-        s.set_k(count, 0);
-        s.when(ready, |s| {
-            s.set(id, id + 1);
-            s.when(last_x, |s| {
-                s.set_k(px, 0);
-                s.set(py, py + 1);
-                for k in 0..3 {
-                    s.set(row[k], row_next[k]);
-                    s.set(d[k], row_next[k]);
-                }
-            })
-            .otherwise(|s| {
-                s.set(px, px + 1);
-                for k in 0..3 {
-                    s.set(d[k], d[k] + g.dx[k] as i128);
-                }
-            });
-            s.when(last, |s| s.goto(Done)).otherwise(|s| s.goto(Div));
-        });
-    });
-    fsm.state(Done, |s| {
-        s.set_k(count, 0);
-        if let Some(restart) = restart {
-            s.when(restart, |s| {
-                s.set_k(px, 0);
-                s.set_k(py, 0);
-                s.set_k(id, 0);
-                for k in 0..3 {
-                    s.set_k(row[k], g.d0[k] as i128);
-                    s.set_k(d[k], g.d0[k] as i128);
-                }
-                s.goto(Div);
-            });
-        }
-    });
-    let in_full = fsm.is(Full);
-    fsm.finish();
-
-    b.output("ray_valid", in_full);
-    b.output("ray_id", id);
+    // The ray port, two registers deep: the set at the output turn hands its ray to `pick`
+    // while that is empty (the 13-way select ends there), `pick` moves to the port while the
+    // port is empty (saturation and sign end there), and the core's `ready` only empties the
+    // port — no path runs from the core into the sets, and none through both the select and
+    // the carry chains (a ray every 2 clocks at most, twice what `CLOCKS_PER_RAY` needs).
+    b.stage("port", "the finished ray of the set at the output turn, in two registers");
+    let pick = |v| pick_set(&b, out_turn, v);
+    let handing = (pick(held.clone()) & !pick_valid).name("hand_over");
+    let moving = (pick_valid & !port_valid).name("to_port");
+    b.drive(take, handing);
+    b.next(pick_valid, handing.select(pick_valid.k(1), moving.select(pick_valid.k(0), pick_valid)));
+    b.next(port_valid, moving.select(port_valid.k(1), port_valid & !ready));
+    let pick_id = b.reg("pick_id", Ty::u(id_width), Some(0));
+    b.next_when(pick_id, handing, out_id);
+    let port_id = b.reg("port_id", Ty::u(id_width), Some(0));
+    b.next_when(port_id, moving, pick_id);
+    let mut port_w = Vec::new();
+    let mut port_inv = Vec::new();
+    for (k, axis) in axes.iter().enumerate() {
+        let w_pick = b.reg(&format!("pick_w{axis}"), Ty::s(m_bits), Some(0));
+        b.next_when(w_pick, handing, pick(outs.iter().map(|o| o[k].0).collect()));
+        let q = b.reg(&format!("pick_q{axis}"), Ty::u(qbits), Some(0));
+        b.next_when(q, handing, pick(outs.iter().map(|o| o[k].1).collect()));
+        let w = b.reg(&format!("port_w{axis}"), Ty::s(m_bits), Some(0));
+        b.next_when(w, moving, w_pick);
+        // Saturate to the m + C-bit range, then the sign.
+        let q_s = q.gt(lim).select(q.k(lim), q).resize(m_bits + c).signed();
+        let inv = b.reg(&format!("port_inv{axis}"), Ty::s(m_bits + c), Some(0));
+        b.next_when(inv, moving, w_pick.lt(0).select(-q_s, q_s));
+        port_w.push(w);
+        port_inv.push(inv);
+    }
+    b.end_stage();
+    b.output("ray_valid", port_valid);
+    b.output("ray_id", port_id);
     for (k, name) in ["ox", "oy", "oz"].iter().enumerate() {
         b.output(name, b.konst_named(&format!("eye_{name}"), Ty::u(n), g.eye[k] as i128));
     }
-    for (name, w) in ["wx", "wy", "wz"].iter().zip(w_out) {
-        b.output(name, w);
+    for (name, w) in ["wx", "wy", "wz"].iter().zip(&port_w) {
+        b.output(name, *w);
     }
-    for (name, inv) in ["invx", "invy", "invz"].iter().zip(inv_out) {
-        b.output(name, inv);
+    for (name, inv) in ["invx", "invy", "invz"].iter().zip(&port_inv) {
+        b.output(name, *inv);
     }
     b.finish()
+}
+
+/// The turn after `t` among `sets`.
+fn next_turn(t: S<'_>, sets: u32) -> S<'_> {
+    t.eq(sets as i128 - 1).select(t.k(0), t + 1)
+}
+
+/// `v[turn]`: one value of each divider set.
+fn pick_set<'b>(b: &'b Builder, turn: S<'b>, v: Vec<S<'b>>) -> S<'b> {
+    let arms: Vec<(u128, S)> = v.iter().enumerate().skip(1).map(|(i, &x)| (i as u128, x)).collect();
+    b.case(turn, &arms, v[0])
 }
 
 /// A camera inside the Cornell box, looking at the back wall (the generator's tests, here and
@@ -201,6 +247,43 @@ mod tests {
             sim.tick();
         }
         assert_eq!(seen, cam.width * cam.height);
+    }
+
+    /// A consumer that always takes: after the first ray (a load, F + C + 1 bits, the port) the
+    /// divider sets hand over a ray every `CLOCKS_PER_RAY` clocks or faster, in pixel order;
+    /// the restarting generator starts the frame again once every ray has left.
+    #[test]
+    fn keeps_up_a_ray_every_few_clocks_and_restarts() {
+        let (scene, cam) = inside_cornell();
+        let g = Golden::new(&scene);
+        let rg = RayGen::new(&scene, &cam).unwrap();
+        let p = &scene.params;
+        let m = raygen_restart_core(&rg, p.n, p.m, p.c, 8);
+        let mut sim = Sim::new(&m);
+        let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+        let (ready, restart) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
+        let pixels = cam.width * cam.height;
+        let mut taken = Vec::new();
+        for cycle in 0..4_000u32 {
+            sim.set(ready, 1);
+            sim.set(restart, (cycle == 1_000) as i128);
+            sim.eval();
+            if sim.get(out("ray_valid")) == 1 {
+                let seen = taken.len() as u32 % pixels;
+                let want = rg.ray(&g, seen % cam.width, seen / cam.width);
+                assert_eq!(sim.get(out("ray_id")), seen as i128);
+                assert_eq!(sim.get(out("invz")), want.inv[2], "ray {seen}");
+                assert_eq!(sim.get(out("wy")), want.w[1] as i128, "ray {seen}");
+                taken.push(cycle);
+            }
+            sim.tick();
+        }
+        assert_eq!(taken.len() as u32, 2 * pixels, "two frames, the second after the restart");
+        let qbits = p.m + p.c;
+        assert!(taken[0] <= qbits + 4, "the first ray at {}", taken[0]);
+        let span = taken[pixels as usize - 1] - taken[0];
+        assert!(span <= (pixels - 1) * CLOCKS_PER_RAY, "{pixels} rays in {span} clocks");
+        assert!(taken[pixels as usize] > 1_000, "the second frame waits for the restart");
     }
 
     #[test]
