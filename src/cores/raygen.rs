@@ -3,14 +3,14 @@
 //! its three reciprocals from restoring dividers (one quotient bit per clock, F + C + 1 of
 //! them). One divider set takes F + C + 2 clocks a ray, the core one ray every ~4–10 clocks, so
 //! there are `dividers(..)` sets, dealt pixels in turn and emptied in the same turn: rays leave
-//! in pixel order, one a clock when the sets are ahead of the core.
+//! in pixel order, one every 2 clocks when the sets are ahead of the core.
 //!
 //! A pixel walker loads the next pixel's direction into the set whose turn it is once that
 //! set is empty; the set divides; the set at the output turn hands its ray to the port's two
 //! registers once the first is empty and the turn moves on. The core's `ready` only empties
 //! the port, so no path runs from the core into the sets (the first version, without the
-//! registers, missed the ULX3S board's 80 MHz). After the last pixel the walker stops (`restart`, when every set is
-//! empty, starts the frame again).
+//! registers, missed the ULX3S board's 80 MHz). After the last pixel the walker stops
+//! (`restart`, when every set and both registers are empty, starts the frame again).
 
 use crate::model::raygen::RayGen;
 use crate::rtl::build::{Builder, S};
