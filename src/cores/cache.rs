@@ -119,23 +119,12 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let parts = p.parts();
     let seq = Ty::u(SEQ_BITS);
     let depth_words = (p.sets << rb) as usize;
+    // A tag word is the line's upper bits with a valid bit on top. The valid bits live in the
+    // tag RAMs, not in flip-flops (512-set arrays of them, each with its own set decode, were
+    // what kept the teapot-fine core from routing): after the one-clock reset a sweep clears
+    // one set a clock, and until it ends no lookup hits and no fill is asked for.
     let tags: Vec<usize> =
-        (0..p.ways).map(|w| b.ram(&nm(&format!("tag{w}")), tb.max(1), vec![0; p.sets as usize])).collect();
-    // Valid bits are registers, not RAM: the one-clock reset empties the cache (a new scene
-    // may be in memory after it), and a scrambled power-up state holds no false hit.
-    let valid: Vec<Vec<S<'b>>> = (0..p.ways)
-        .map(|w| (0..p.sets).map(|k| b.reg(&nm(&format!("v{w}_{k}")), Ty::BIT, Some(0))).collect())
-        .collect();
-    // A line is fresh from its fill until its first hit; no fill may replace a fresh line (nor
-    // be asked for into a set with a fill on its way). So every line that arrives is hit once
-    // before it can leave: two slots whose lines share a set cannot evict each other's lines
-    // for ever (seen: a one-way triangle cache in the campaign, fills back to back).
-    let fresh: Vec<Vec<S<'b>>> = (0..p.ways)
-        .map(|w| (0..p.sets).map(|k| b.reg(&nm(&format!("f{w}_{k}")), Ty::BIT, Some(0))).collect())
-        .collect();
-    // Driven by the decision: the way hit (one-hot) and the set, to clear the fresh bit.
-    let hit_way: Vec<S<'b>> = (0..p.ways).map(|w| b.wire(&nm(&format!("hit_way{w}")), Ty::BIT)).collect();
-    let hit_set = b.wire(&nm("hit_set"), Ty::u(sb));
+        (0..p.ways).map(|w| b.ram(&nm(&format!("tag{w}")), tb + 1, vec![0; p.sets as usize])).collect();
     let datas: Vec<Vec<usize>> = (0..p.ways)
         .map(|w| {
             parts
@@ -164,7 +153,6 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         })
         .collect();
     let next_fill = (done + 1).name(&nm("next_fill"));
-    let nf = next_fill.slice(0, db);
     // The line and way of fill done + 1, in registers (the beats of one fill may follow the
     // last beat of the one before on the next clock; a select over the table from `done` would
     // sit between the counter and every RAM's write port). Loaded from the table's next entry
@@ -211,20 +199,18 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
             lsb += parts[j];
         }
     }
-    let tag_word = if tb == 0 { b.konst(Ty::u(1), 0) } else { f_line.slice(sb, tb) };
-    let set_hot: Vec<S<'b>> = (0..p.sets).map(|k| f_set.eq(k as i128)).collect();
+    let sweep = b.reg(&nm("sweep"), Ty::u(sb + 1), Some(0));
+    let sweeping = (!sweep.msb()).name(&nm("sweeping"));
+    b.next_when(sweep, sweeping, sweep + 1);
+    let valid_bit = last & !sweeping;
+    let tag_word = if tb == 0 { valid_bit } else { b.cat(&[valid_bit, f_line.slice(sb, tb)]) };
+    let tag_addr = sweeping.select(sweep.slice(0, sb), f_set).name(&nm("tag_addr"));
+    let tag_data = sweeping.select(b.konst(Ty::u(tb + 1), 0), tag_word).name(&nm("tag_data"));
     for (w, &ram) in tags.iter().enumerate() {
         let way = f_way.eq(w as i128).name(&nm(&format!("fill_way{w}")));
-        b.ram_write(ram, last & way, f_set, tag_word);
-        let (clear, set) = ((first & way).name(&nm(&format!("clear{w}"))), (last & way).name(&nm(&format!("set{w}"))));
-        for (k, &v) in valid[w].iter().enumerate() {
-            b.next_when(v, (clear | set) & set_hot[k], set);
-        }
-        let hit_here = hit_way[w];
-        for (k, &f) in fresh[w].iter().enumerate() {
-            let filled = (clear | set) & set_hot[k];
-            b.next_when(f, filled | (hit_here & hit_set.eq(k as i128)), filled & set);
-        }
+        // The first beat writes the tag invalid (the victim's records are overwritten from
+        // now on), the last writes it valid.
+        b.ram_write(ram, sweeping | ((first | last) & way), tag_addr, tag_data);
     }
     b.next_when(done, last, next_fill);
     b.next_when(after, last, after + 1);
@@ -235,9 +221,6 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     b.next(pending, pending + asked.resize(pending.width()) - last.resize(pending.width()));
     b.next_when(f_line, last | from_decision, from_decision.select(asked_line, table_line));
     b.next_when(f_way, last | from_decision, from_decision.select(asked_way, table_way));
-    // A line leaves the table two clocks after its tag is written.
-    let free = b.valid_line(&nm("free"), last, 2);
-    let free_at = b.delay_line(&nm("free_at"), nf, 2);
     b.end_stage();
 
     b.stage(
@@ -250,22 +233,8 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let set = l0_line.slice(0, sb);
     let raddr = b.cat(&[set, l0_rec]);
     let tag_q: Vec<S<'b>> = tags.iter().enumerate().map(|(w, &t)| b.read(&nm(&format!("tag_q{w}")), t, set)).collect();
-    // The valid bits at the set, through a tree of 2:1 selects by the set's bits, registered
-    // beside the RAM reads.
-    let at_set = |bits: &Vec<S<'b>>| {
-        let mut level = bits.clone();
-        for bit in 0..sb {
-            let sel = set.bit(bit);
-            level = level.chunks(2).map(|pair| sel.select(pair[1], pair[0])).collect();
-        }
-        level[0]
-    };
-    let valid_q: Vec<S<'b>> =
-        valid.iter().enumerate().map(|(w, bits)| b.delay(&nm(&format!("valid_q{w}")), at_set(bits))).collect();
-    // The fresh bits too: read with the tags, so a fill whose last beat comes later is still
-    // in the table when it is searched (it leaves two clocks after).
-    let fresh_l3: Vec<S<'b>> =
-        fresh.iter().enumerate().map(|(w, bits)| b.delay_line(&nm(&format!("fresh_q{w}")), at_set(bits), 3)).collect();
+    // A lookup may hit only if its tags were read after the sweep (2 clocks on: with `tag_r`).
+    let swept_r = b.valid_line(&nm("swept_r"), !sweeping, 2);
     let data_q: Vec<Vec<S<'b>>> = datas
         .iter()
         .enumerate()
@@ -278,8 +247,6 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let l1_valid = b.valid_delay(&nm("l1_valid"), l0_valid);
     let l1_line = b.delay(&nm("l1_line"), l0_line);
     let tag_r: Vec<S<'b>> = tag_q.iter().enumerate().map(|(w, &t)| b.delay(&nm(&format!("tag_r{w}")), t)).collect();
-    let valid_r: Vec<S<'b>> =
-        valid_q.iter().enumerate().map(|(w, &v)| b.delay(&nm(&format!("valid_r{w}")), v)).collect();
     let data_r: Vec<Vec<S<'b>>> = data_q
         .iter()
         .enumerate()
@@ -288,12 +255,13 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // The compare, while the in-flight table is searched for the line; both registered.
     let l2_valid = b.valid_delay(&nm("l2_valid"), l1_valid);
     let l2_line = b.delay(&nm("l2_line"), l1_line);
-    let want = if tb == 0 { b.konst(Ty::u(1), 0) } else { l2_line.slice(sb, tb) };
+    // The tag word wanted: valid, and the line's upper bits.
+    let one = b.konst(Ty::BIT, 1);
+    let want = if tb == 0 { one } else { b.cat(&[one, l2_line.slice(sb, tb)]) };
     let hit_c: Vec<S<'b>> = tag_r
         .iter()
-        .zip(&valid_r)
         .enumerate()
-        .map(|(w, (&t, &v))| (v & t.eq(want)).name(&nm(&format!("hit{w}_c"))))
+        .map(|(w, &t)| (swept_r & t.eq(want)).name(&nm(&format!("hit{w}_c"))))
         .collect();
     let hits: Vec<S<'b>> = hit_c.iter().enumerate().map(|(w, &h)| b.delay(&nm(&format!("hit{w}")), h)).collect();
     let data: Vec<S<'b>> = (0..parts.len())
@@ -308,8 +276,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // Each place keeps its fill number (a register, not req minus the distance: that was a
     // subtractor per place on the path to the decision).
     let seqs: Vec<S<'b>> = (0..p.inflight).map(|j| b.reg(&nm(&format!("fl{j}_seq")), seq, None)).collect();
+    let mut matched = Vec::new();
     for (j, s) in slots.iter().enumerate() {
         let m = (s.2 & s.0.eq(l2_line)).name(&nm(&format!("match{j}")));
+        matched.push(b.delay(&nm(&format!("match_r{j}")), m));
         found_seq = m.select(seqs[j], found_seq);
         found = found | m;
         busy = busy | (s.2 & s.0.slice(0, sb).eq(l2_line.slice(0, sb)));
@@ -335,17 +305,11 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         .fold(b.konst(Ty::BIT, 0), |acc, (j, s)| acc | (new_seq.slice(0, db).eq(j as i128) & s.2));
     let miss = (l3_valid & !hit).name(&nm("miss"));
     let victim = b.reg(&nm("victim"), Ty::u(wb), Some(0));
-    let victim_fresh = (1..p.ways as usize)
-        .fold(fresh_l3[0], |acc, w| victim.eq(w as i128).select(fresh_l3[w], acc))
-        .name(&nm("victim_fresh"));
-    let blocked = (busy2 | (prev_alloc & same_set) | victim_fresh).name(&nm("blocked"));
+    // While the tags are swept nothing is asked for (its tag write would be lost).
+    let blocked = (busy2 | (prev_alloc & same_set) | sweeping).name(&nm("blocked"));
     let alloc = (miss & !found & slot_free & !blocked).name(&nm("alloc"));
     b.next(prev_alloc, alloc);
     b.next(prev_seq, new_seq);
-    for (w, &h) in hits.iter().enumerate() {
-        b.drive(hit_way[w], l3_valid & h);
-    }
-    b.drive(hit_set, l3_line.slice(0, sb));
     b.next_when(victim, alloc, if p.ways == 1 { victim } else { victim + 1 });
     b.drive(asked, alloc);
     b.drive(asked_line, l3_line);
@@ -356,7 +320,8 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         b.next_when(s.0, mine, l3_line);
         b.next_when(s.1, mine, victim);
         b.next_when(seqs[j], mine, new_seq);
-        let freed = free & free_at.eq(j as i128);
+        // A line leaves the table at its first hit (found in the table a clock before).
+        let freed = l3_valid & hit & matched[j];
         b.next(s.2, mine.select(b.konst(Ty::BIT, 1), freed.select(b.konst(Ty::BIT, 0), s.2)));
     }
     // A miss that can neither merge nor take a place waits for the next fill and asks again
