@@ -1,10 +1,10 @@
 //! The AXI read master and two caches in every HDL simulator: the transcript of a Rust-simulator
-//! run against the memory model (`verify::memory_tests::drive`, with random R pauses and extra
-//! delays) replayed in GHDL, Icarus (Verilog-2005 and SystemVerilog rules) and Verilator, every
+//! run against the memory model (`verify::memory_tests::drive_across_a_reset`, with random R
+//! pauses and extra delays, a reset and a new image halfway) replayed in GHDL, Icarus (Verilog-2005 and SystemVerilog rules) and Verilator, every
 //! output equal on every clock. Each simulator not installed is reported as skipped.
 
 use fxrt::verify::memory::MemoryTiming;
-use fxrt::verify::memory_tests::{Shape, drive, harness};
+use fxrt::verify::memory_tests::{Shape, drive_across_a_reset, harness};
 use fxrt::verify::simulators::Simulator;
 use fxrt::verify::testbench::{record, replay};
 use std::io::Write;
@@ -14,7 +14,7 @@ fn caches_and_master_agree_in_every_simulator() {
     let shape = Shape { data_bits: 64, ways: 2, outstanding: 4 };
     let m = harness(shape);
     let timing = MemoryTiming { latency: 12, outstanding: 3, extra_delay: 9, pause_in_256: 60, seed: 77 };
-    let d = drive(&m, shape, timing, 5_000, 11, None);
+    let d = drive_across_a_reset(&m, shape, timing, 4_000, 11);
     assert!(d.hits > 100 && d.bursts > 50, "{} hits, {} bursts", d.hits, d.bursts);
     let clocks = d.stimuli.len() as u64;
     let t = record(&m, d.stimuli);

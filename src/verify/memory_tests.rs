@@ -123,7 +123,12 @@ pub fn mem_side(name: &str, ap: &AxiReadParams, caches: &[(CacheParams, u64)]) -
 
 /// A test image: every byte a function of its address.
 pub fn image() -> Vec<u8> {
-    (0..(LINE * 100) as u32).map(|k| (k.wrapping_mul(2654435761) >> 13) as u8).collect()
+    image_salted(0)
+}
+
+/// Another test image for each `salt` (a new scene after a reset).
+fn image_salted(salt: u32) -> Vec<u8> {
+    (0..(LINE * 100) as u32).map(|k| ((k ^ salt).wrapping_mul(2654435761) >> 13) as u8).collect()
 }
 
 /// The record `rec` of `line` in cache `c`'s region, as parts of at most 128 bits.
@@ -163,10 +168,47 @@ pub struct Drive {
 /// (counted from 0) of its answer, a broken memory. Panics on a wrong record, a wrong
 /// latency, a line asked for twice while on its way, or a waiter never released.
 pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: u32, drop_beat: Option<u64>) -> Drive {
-    let img = image();
-    let base = 0x4000u64;
-    let mut mem = MemoryModel::new(img.clone(), base, shape.data_bits, timing);
+    drive_on(&mut Sim::new(m), m, shape, &image(), timing, clocks, seed, drop_beat, None)
+}
+
+/// `drive` for `clocks`, then a reset and `clocks` more with another image in memory: every hit
+/// after the reset must carry the new image's record (the reset empties the caches). The
+/// stimuli of both runs, one after the other.
+pub fn drive_across_a_reset(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: u32) -> Drive {
     let mut sim = Sim::new(m);
+    let mut d = drive_on(&mut sim, m, shape, &image(), timing, clocks, seed, None, None);
+    let e = drive_on(&mut sim, m, shape, &image_salted(0x5a5a), timing, clocks, seed, None, None);
+    d.hits += e.hits;
+    d.misses += e.misses;
+    d.bursts += e.bursts;
+    d.stimuli.extend(e.stimuli);
+    d.error |= e.error;
+    d
+}
+
+/// A clock count after which a waiter for its own line's fill looks again in a duel (`drive_on`).
+const SLOW: u64 = 300;
+
+/// `drive` on a simulation that may have run before (its first clock is a reset), with the
+/// image `img` in memory. A `duel` of two lines (in one set) replaces the random lookups: each
+/// cache is asked for record 0 of both lines, again after every hit, and a task whose miss
+/// asked for its own line looks again only `SLOW` clocks after the miss while the other looks
+/// as soon as released — the schedule under which each fill's first beat evicts the other
+/// line before its waiter comes back, unless the cache keeps a line until its first hit.
+#[allow(clippy::too_many_arguments)]
+fn drive_on(
+    sim: &mut Sim,
+    m: &Module,
+    shape: Shape,
+    img: &[u8],
+    timing: MemoryTiming,
+    clocks: u64,
+    seed: u32,
+    drop_beat: Option<u64>,
+    duel: Option<[u64; 2]>,
+) -> Drive {
+    let base = 0x4000u64;
+    let mut mem = MemoryModel::new(img.to_vec(), base, shape.data_bits, timing);
     let input = |name: &str| m.handle(*m.inputs.iter().find(|&&i| m.sig(i).name == name).unwrap());
     let output = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
     let names: Vec<String> = m.inputs.iter().map(|&i| m.sig(i).name.clone()).collect();
@@ -201,7 +243,7 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
                     if drop_beat.is_none() {
                         assert_eq!(
                             got,
-                            record(&img, shape, c, line, rec),
+                            record(img, shape, c, line, rec),
                             "cache {c}: line {line} record {rec} at clock {clock}"
                         );
                     }
@@ -226,7 +268,14 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
             // Phases of 6 lookups outstanding (the table full) and of 2 (fills one at a time,
             // a new one asked for as the last ends).
             let outstanding = if (clock / 1_500) % 2 == 0 { 6 } else { 2 };
-            while tasks[c].len() < outstanding && clock + 3_000 < clocks {
+            while let Some(lines) = duel
+                && tasks[c].len() < 2
+                && clock + 3_000 < clocks
+            {
+                let line = lines[(tasks[c].first().is_some_and(|t| t.0 == lines[0])) as usize];
+                tasks[c].push((line, 0, None, clock));
+            }
+            while duel.is_none() && tasks[c].len() < outstanding && clock + 3_000 < clocks {
                 x = xorshift32(x);
                 tasks[c].push((
                     (x >> 4) as u64 % (1 << p.line_bits),
@@ -241,7 +290,11 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
                 !in_pipe[c].iter().any(|e| e.1 == t)
                     && match tasks[c][t].2 {
                         None => true,
-                        Some(k) => (done.wrapping_sub(k) as i16) >= 0,
+                        Some(k) => {
+                            let own = asked[c].get((k as usize).wrapping_sub(1)) == Some(&tasks[c][t].0);
+                            (done.wrapping_sub(k) as i16) >= 0
+                                && (duel.is_none() || !own || clock >= tasks[c][t].3 + SLOW)
+                        }
                     }
             });
             for (t, task) in tasks[c].iter().enumerate() {
@@ -254,7 +307,7 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
                 }
             }
             let (valid, line, rec) = match pick {
-                Some(t) if x & 3 != 0 && clock > 0 => {
+                Some(t) if (x & 3 != 0 || duel.is_some()) && clock > 0 => {
                     in_pipe[c].push((clock, t));
                     (1, tasks[c][t].0, tasks[c][t].1)
                 }
@@ -332,6 +385,33 @@ pub fn drive(m: &Module, shape: Shape, timing: MemoryTiming, clocks: u64, seed: 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The one-clock reset empties the caches (a new scene may be in memory after it): after
+    /// a drive that leaves them full of one image, a reset and a drive over another image hit
+    /// only the new image's records. With the tag RAMs' valid bits not swept after the reset,
+    /// the first lookups hit the old lines (a wrong record).
+    #[test]
+    fn a_reset_empties_the_caches() {
+        for shape in [Shape { data_bits: 64, ways: 2, outstanding: 8 }, Shape { data_bits: 128, ways: 1, outstanding: 2 }] {
+            let m = harness(shape);
+            let timing = MemoryTiming { latency: 20, ..MemoryTiming::default() };
+            let d = drive_across_a_reset(&m, shape, timing, 10_000, 3);
+            assert!(!d.error && d.hits > 600, "{shape:?}: {} hits", d.hits);
+        }
+    }
+
+    /// Forward progress (DECISIONS 109, 113): two waiters whose lines share a set of a one-way
+    /// cache, scheduled so that each comes back only after the other's fill has begun, still
+    /// hit. With a line free to leave as soon as it arrives, neither ever hits (the waits pass
+    /// 20,000 clocks).
+    #[test]
+    fn two_lines_in_one_set_do_not_evict_each_other_for_ever() {
+        let shape = Shape { data_bits: 64, ways: 1, outstanding: 4 };
+        let m = harness(shape);
+        let timing = MemoryTiming { latency: 20, ..MemoryTiming::default() };
+        let d = drive_on(&mut Sim::new(&m), &m, shape, &image(), timing, 30_000, 3, None, Some([3, 11]));
+        assert!(d.hits > 100, "{} hits, {} misses", d.hits, d.misses);
+    }
 
     #[test]
     fn lookups_hit_the_image_after_their_fills() {
