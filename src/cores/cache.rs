@@ -111,6 +111,26 @@ pub fn released<'b>(done: S<'b>, wait: S<'b>) -> S<'b> {
     !(done - wait).msb()
 }
 
+/// Whether the head of a retry queue (`nonempty`, waiting for fill `wait`) may go, in a
+/// register: the 16-bit subtract behind the queue's head then ends at a flip-flop instead of
+/// reaching the pop, the queue's read pointer and its LUT-RAM (the external core's slowest
+/// paths: the node retry queue's at 60 MHz, then the triangle one's at 69.6). A head released
+/// in clock c is ready in c + 1: `released` stays true once true, and the head changes only by
+/// a `pop`, after which the next head waits a clock.
+pub fn ready_when_released<'b>(
+    b: &'b Builder,
+    name: &str,
+    nonempty: S<'b>,
+    done: S<'b>,
+    wait: S<'b>,
+    pop: S<'b>,
+) -> S<'b> {
+    let now = (nonempty & released(done, wait) & !pop).name(&format!("{name}_released"));
+    let ready = b.reg(&format!("{name}_ready"), Ty::BIT, Some(0));
+    b.next(ready, now);
+    ready
+}
+
 pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>, fill: &Fill<'b>) -> Cache<'b> {
     assert!(p.sets.is_power_of_two() && p.sets >= 2 && [1, 2, 4].contains(&p.ways) && p.inflight.is_power_of_two());
     let nm = |s: &str| format!("{name}_{s}");
@@ -258,11 +278,8 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // The tag word wanted: valid, and the line's upper bits.
     let one = b.konst(Ty::BIT, 1);
     let want = if tb == 0 { one } else { b.cat(&[one, l2_line.slice(sb, tb)]) };
-    let hit_c: Vec<S<'b>> = tag_r
-        .iter()
-        .enumerate()
-        .map(|(w, &t)| (swept_r & t.eq(want)).name(&nm(&format!("hit{w}_c"))))
-        .collect();
+    let hit_c: Vec<S<'b>> =
+        tag_r.iter().enumerate().map(|(w, &t)| (swept_r & t.eq(want)).name(&nm(&format!("hit{w}_c")))).collect();
     let hits: Vec<S<'b>> = hit_c.iter().enumerate().map(|(w, &h)| b.delay(&nm(&format!("hit{w}")), h)).collect();
     let data: Vec<S<'b>> = (0..parts.len())
         .map(|j| {

@@ -11,7 +11,7 @@
 //! The retry queue is in order: a head waiting for a later fill holds back an entry whose fill
 //! came earlier. That costs a few clocks, never a deadlock: fills come whatever the ring does.
 
-use super::cache::{SEQ_BITS, released};
+use super::cache::{SEQ_BITS, ready_when_released};
 use super::fifo::{fifo, unpack};
 use super::traverse_stages::{NodeAnswer, RetryQueue, Token, Unit};
 use crate::rtl::Ty;
@@ -34,13 +34,8 @@ impl<'b> Unit<'b> {
         let q = fifo(b, "retry_q", width, self.p.slots, push, entry, pop);
         let [slot, node, tmin, tmax, sp, wait] = unpack(q.head, &widths)[..] else { unreachable!("six fields") };
         // Registered, so A's choice (a retry before rays back from a leaf and new rays) starts at
-        // a register: the 16-bit subtract behind the head's bypass select, then A's pops and the
-        // unpark queue's count, were the external core's critical path (16.6 ns, 60 MHz on the
-        // LFE5U-85F). A head released in clock c is ready in c + 1: `released` stays true once
-        // true, and the head changes only by a pop, after which the next head waits a clock.
-        let released_now = (q.nonempty & released(cache.done, wait) & !pop).name("retry_released");
-        let ready = b.reg("retry_ready", Ty::BIT, Some(0));
-        b.next(ready, released_now);
+        // a register (the subtract, A's pops and the unpark queue's count were 16.6 ns).
+        let ready = ready_when_released(b, "retry", q.nonempty, cache.done, wait, pop);
         RetryQueue { ready, pop, slot, node, tmin: tmin.signed(), tmax: tmax.signed(), sp, push, entry }
     }
 

@@ -18,7 +18,7 @@
 
 use super::axi_read::Fill;
 use super::brom::bram;
-use super::cache::{Cache, LATENCY, Lookup, SEQ_BITS, bits_across, cache, released};
+use super::cache::{Cache, LATENCY, Lookup, SEQ_BITS, bits_across, cache, ready_when_released, released};
 use super::core_params::CoreParams;
 use super::fifo::{fifo, unpack};
 use super::leaf_stream::{Emission, RayRams, into_pipeline, leaf_buffers};
@@ -83,7 +83,7 @@ pub fn tri_fetch<'b>(
     let retry = fifo(b, "tri_retry_q", retry_w, slots, retry_push, retry_entry, retry_pop);
     let r = unpack(retry.head, &retry_widths);
     let tri_done = b.wire("tri_done", Ty::u(SEQ_BITS));
-    let retry_ready = (retry.nonempty & released(tri_done, r[5])).name("tri_retry_ready");
+    let retry_ready = ready_when_released(b, "tri_retry", retry.nonempty, tri_done, r[5], retry_pop);
     let take_retry = (can_take & retry_ready).name("fetch_take_retry");
     b.drive(retry_pop, take_retry);
     let picked = leaf_buffers(b, p, trav, leaf_pop, (can_take & !retry_ready).name("fetch_can_take_leaf"));

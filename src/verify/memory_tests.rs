@@ -392,7 +392,9 @@ mod tests {
     /// the first lookups hit the old lines (a wrong record).
     #[test]
     fn a_reset_empties_the_caches() {
-        for shape in [Shape { data_bits: 64, ways: 2, outstanding: 8 }, Shape { data_bits: 128, ways: 1, outstanding: 2 }] {
+        for shape in
+            [Shape { data_bits: 64, ways: 2, outstanding: 8 }, Shape { data_bits: 128, ways: 1, outstanding: 2 }]
+        {
             let m = harness(shape);
             let timing = MemoryTiming { latency: 20, ..MemoryTiming::default() };
             let d = drive_across_a_reset(&m, shape, timing, 10_000, 3);
