@@ -7,12 +7,14 @@
 //! already on its way gets that line's number (misses to one line are merged); a miss when
 //! every in-flight place is taken waits for the next fill and asks again.
 //!
-//! Fills: a line's first beat clears the victim's valid bit, every record is written the clock
-//! its last beat comes, the last beat writes the new tag and sets the bit. A lookup reads valid
-//! bit, tag and record in one clock (read-first RAMs), so it sees either the old line whole or
-//! a miss. Valid bits are registers: the one-clock reset empties the cache. A line leaves the
-//! in-flight table two clocks after its tag is written, so a lookup that read the tag just
-//! before still finds it on its way. The victim way is a round-robin counter (no per-set state;
+//! Fills: a line's first beat writes the victim's tag word (valid bit and tag, in the tag RAM)
+//! invalid, every record is written the clock its last beat comes, the last beat writes the new
+//! tag word valid. A lookup reads tag word and record in one clock (read-first RAMs), so it sees
+//! either the old line whole or a miss. The one-clock reset starts a sweep that writes one
+//! set's tag words invalid a clock; until it ends nothing hits and nothing is asked for. A line
+//! stays in the in-flight table until its first hit, and no fill is asked for into a set with a
+//! line in the table, so every line that arrives is hit once before it can leave (DECISIONS
+//! 109, 113). The victim way is a round-robin counter (no per-set state;
 //! examples/memory_study.rs: 8 % more bytes than LRU at 64 KB).
 
 use super::axi_read::Fill;
@@ -342,7 +344,7 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         b.next(s.2, mine.select(b.konst(Ty::BIT, 1), freed.select(b.konst(Ty::BIT, 0), s.2)));
     }
     // A miss that can neither merge nor take a place waits for the next fill and asks again
-    // (at once when no fill is on its way: it waits for a fresh line's first hit).
+    // (at once when no fill is on its way: it waits for a line in the table to be hit).
     let retry_at = pending.eq(0).select(done, next_fill);
     let wait = found.select(found_seq, alloc.select(new_seq, retry_at)).name(&nm("wait_c"));
     let a_valid = b.valid_delay(&nm("a_valid"), l3_valid);

@@ -404,8 +404,8 @@ mod tests {
 
     /// Forward progress (DECISIONS 109, 113): two waiters whose lines share a set of a one-way
     /// cache, scheduled so that each comes back only after the other's fill has begun, still
-    /// hit. With a line free to leave as soon as it arrives, neither ever hits (the waits pass
-    /// 20,000 clocks).
+    /// hit. With a line free to leave as soon as it arrives, neither ever hits (both lookups are
+    /// left unanswered by a hit at the end).
     #[test]
     fn two_lines_in_one_set_do_not_evict_each_other_for_ever() {
         let shape = Shape { data_bits: 64, ways: 1, outstanding: 4 };
