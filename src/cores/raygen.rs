@@ -100,11 +100,16 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
             b.next_when(divisor, loads, w_new.eq(0).select(mag.k(1), mag));
             let rem = b.reg(&format!("rem{s}_{axis}"), Ty::u(f + 2), Some(0));
             let quot = b.reg(&format!("quot{s}_{axis}"), Ty::u(qbits), Some(0));
-            // The numerator's only 1 (its top bit) enters with the first quotient bit.
-            let r3 = (first.select(rem.k(0), rem) << 1) + first.resize(f + 2);
-            let ge = divisor.le(r3);
-            b.next_when(rem, run, ge.select(r3 - divisor, r3));
-            b.next_when(quot, run, (first.select(quot.k(0), quot) << 1) + ge.resize(qbits));
+            // Area (13 sets × 3 axes of these): the remainder is cleared at the load, so the
+            // shift is a wiring; the numerator's only 1 (its top bit) enters with the first
+            // quotient bit; one subtractor, its borrow the compare; the quotient needs no
+            // clearing (its qbits shifts push the last ray's bits out).
+            let r3 = b.cat(&[rem.slice(0, f + 1), first]);
+            let diff = (r3.resize(f + 3) - divisor.resize(f + 3)).name(&format!("diff{s}_{axis}"));
+            let fits = !diff.msb();
+            b.next(rem, loads.select(rem.k(0), run.select(fits.select(diff.resize(f + 2), r3), rem)));
+            let shifted = if qbits > 1 { b.cat(&[quot.slice(0, qbits - 1), fits]) } else { fits };
+            b.next_when(quot, run, shifted);
             set_out.push((w, quot));
         }
         load.push(loads);
