@@ -73,7 +73,7 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
     let lim = (1i128 << (m_bits + c - 1)) - 1;
     let mut load = Vec::new();
     let mut busy = Vec::new();
-    let mut held = Vec::new();
+    let mut held_next = Vec::new();
     let mut outs = Vec::new();
     let take = b.wire("take", Ty::BIT);
     for s in 0..sets {
@@ -87,7 +87,9 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
         let ends = (run & count.eq(qbits as i128)).name(&format!("ends{s}"));
         let taken = (take & out_turn.eq(s as i128)).name(&format!("taken{s}"));
         b.next(run, loads.select(run.k(1), ends.select(run.k(0), run)));
-        b.next(hold, ends.select(hold.k(1), taken.select(hold.k(0), hold)));
+        let hold_next = ends.select(hold.k(1), taken.select(hold.k(0), hold)).name(&format!("held_next{s}"));
+        b.next(hold, hold_next);
+        held_next.push(hold_next);
         b.next(count, loads.select(count.k(1), run.select(count + 1, count)));
         let mut set_out = Vec::new();
         for (k, axis) in axes.iter().enumerate() {
@@ -114,7 +116,6 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
         }
         load.push(loads);
         busy.push(!idle);
-        held.push(hold);
         outs.push(set_out);
     }
     let loaded = load.iter().copied().reduce(|a, x| a | x).expect("a set").name("loaded");
@@ -151,7 +152,14 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
     // the carry chains (a ray every 2 clocks at most, twice what `CLOCKS_PER_RAY` needs).
     b.stage("port", "the finished ray of the set at the output turn, in two registers");
     let pick = |v| pick_set(&b, out_turn, v);
-    let handing = (pick(held.clone()) & !pick_valid).name("hand_over");
+    // Whether the set at the output turn holds a ray, in a register (its 13-way select by the
+    // turn, then the enables of every `pick` register, was the board's slowest path: 78 MHz):
+    // next clock's turn is this one or the one after, so both selects are made and `take` picks.
+    let turn_held = b.reg("turn_held", Ty::BIT, Some(0));
+    let held_here = pick(held_next.clone());
+    let held_after = pick_set(&b, wrap(out_turn), held_next.clone());
+    b.next(turn_held, restarting.select(turn_held.k(0), take.select(held_after, held_here)));
+    let handing = (turn_held & !pick_valid).name("hand_over");
     let moving = (pick_valid & !port_valid).name("to_port");
     b.drive(take, handing);
     b.next(pick_valid, handing.select(pick_valid.k(1), moving.select(pick_valid.k(0), pick_valid)));
