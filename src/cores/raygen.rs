@@ -35,8 +35,8 @@ pub fn raygen_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Mo
 }
 
 /// The generator that starts the frame again (`fxrt_raygen_restart`, for the board tops): a
-/// second input `restart`, taken once every ray of the frame has left, returns it to the first
-/// pixel with ray id 0.
+/// second input `restart`, taken once every ray of the frame has left (from the clock after the
+/// port empties; a pulse earlier is ignored), returns it to the first pixel with ray id 0.
 pub fn raygen_restart_core(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32) -> Module {
     generator(g, n, m_bits, c, id_width, true)
 }
@@ -128,8 +128,19 @@ fn generator(g: &RayGen, n: u32, m_bits: u32, c: u32, id_width: u32, restarts: b
     // they are empty too.
     let pick_valid = b.reg("pick_valid", Ty::BIT, Some(0));
     let port_valid = b.reg("port_valid", Ty::BIT, Some(0));
+    // Whether the frame has ended, in a register (`restart` through the whole of it into the
+    // stepping registers' resets was the board's slowest path after the divider cut: 78.7
+    // MHz). Once true it stays true until a restart, so a clock's delay only delays the
+    // restart; the register drops with the restart, so a held `restart` does not repeat it
+    // before the walk is under way.
     let restarting = match restart {
-        Some(r) => (r & walked & !any_busy & !pick_valid & !port_valid).name("restarting"),
+        Some(r) => {
+            let quiet = b.reg("frame_done", Ty::BIT, Some(0));
+            let restarting = (r & quiet).name("restarting");
+            let done_now = walked & !any_busy & !pick_valid & !port_valid;
+            b.next(quiet, done_now & !restarting);
+            restarting
+        }
         None => b.konst(Ty::BIT, 0),
     };
     b.next(load_turn, restarting.select(load_turn.k(0), loaded.select(wrap(load_turn), load_turn)));
