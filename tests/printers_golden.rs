@@ -1,4 +1,5 @@
-//! Golden files: a small design with a pipeline stage, a state machine and delay lines, printed
+//! Golden files: a small design with a pipeline stage, a state machine, register copies and
+//! delay lines, printed
 //! in both languages and compared with `tests/golden/`. After an intended change to the
 //! printers, rewrite them with `UPDATE_GOLDEN=1 cargo test --test printers_golden` and review
 //! the diff.
@@ -33,6 +34,8 @@ fn demo() -> Module {
     m.connect(state, next, None);
     let is_done = m.eq_k("is_done", state, 2);
     m.end_block();
+    // Two copies of the square's register, which synthesis must not merge back into it.
+    let copies = m.copies(sq_r, 2);
     let go_late = m.delay_line("go_late", go, 3);
     // A delay line deeper than 64: Verilator does not unroll a longer loop and refuses a
     // delayed assignment to an array inside one (BLKLOOPINIT), so the printers write no loop.
@@ -41,6 +44,8 @@ fn demo() -> Module {
     m.output("o_done", is_done);
     m.output("o_go_late", go_late);
     m.output("o_go_later", go_later);
+    let both = m.concat("both_copies", &copies);
+    m.output("o_sq_copies", both);
     m
 }
 

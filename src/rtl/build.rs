@@ -157,6 +157,15 @@ impl Builder {
         }
     }
 
+    /// `k` copies of register `reg` (its input already given): registers `{reg}_c1`, … that
+    /// load what it loads, with its reset, so they always hold its value. Each drives part of
+    /// a fan-out too wide for one net (a LUT-RAM's read address across a hundred RAM slices);
+    /// the printers tell synthesis not to merge them (`BlockKind::Copies`).
+    pub fn copies(&self, reg: S<'_>, k: usize) -> Vec<S<'_>> {
+        let copies = self.m.borrow_mut().copies(reg.sig, k);
+        copies.into_iter().map(|s| self.s(s)).collect()
+    }
+
     /// `reg` loads `next` in the clocks where `enable` is 1.
     pub fn next_when(&self, reg: S<'_>, enable: S<'_>, next: S<'_>) {
         self.m.borrow_mut().connect(reg.sig, next.sig, Some(enable.sig));

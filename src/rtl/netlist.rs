@@ -158,6 +158,10 @@ pub enum BlockKind {
     /// A state machine: `state` is its state register; state k (k = its encoding) is named
     /// `states[k]`.
     Fsm { state: SigId, states: Vec<String> },
+    /// A register and copies of it, loading what it loads (`Builder::copies`): each drives part of a
+    /// fan-out too wide for one net. Printed in a process the synthesizer is told to keep
+    /// (Yosys `keep`, XST `equivalent_register_removal = "no"`), or it would merge them back.
+    Copies,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -239,6 +243,12 @@ impl Module {
         assert!(self.current_block.is_none(), "{}: block {name} opened inside another", self.name);
         self.blocks.push(Block { name: names::legal(name), doc: doc.to_string(), kind });
         self.current_block = Some(self.blocks.len() - 1);
+        self.blocks.len() - 1
+    }
+
+    /// A block that new signals are not put in (`set_block` puts them there). Returns its index.
+    pub fn add_block(&mut self, name: &str, doc: &str, kind: BlockKind) -> usize {
+        self.blocks.push(Block { name: names::legal(name), doc: doc.to_string(), kind });
         self.blocks.len() - 1
     }
 
@@ -347,6 +357,30 @@ impl Module {
             }
             _ => panic!("{}: register {reg_name} is driven twice (or is no register)", self.name),
         }
+    }
+
+    /// `k` copies of register `reg`, whose input is given (`Builder::copies`), in a block of
+    /// their own (`BlockKind::Copies`) with `reg` itself: yosys would merge a register left
+    /// outside into a kept copy.
+    pub fn copies(&mut self, reg: Sig, k: usize) -> Vec<Sig> {
+        let sig = self.sig(reg.id).clone();
+        let in_fsm = sig.block.is_some_and(|b| matches!(self.blocks[b].kind, BlockKind::Fsm { .. }));
+        assert!(!in_fsm, "{}: {} is a state machine's register", self.name, sig.name);
+        let Def::Reg { next: Some(next), enable, reset } = sig.def else {
+            panic!("{}: {} is no register with its input given", self.name, sig.name)
+        };
+        let doc = format!("{} and {k} copies, to split its fan-out", sig.name);
+        let block = self.add_block(&format!("{}_copies", sig.name), &doc, BlockKind::Copies);
+        self.set_block(reg.id, block);
+        let (next, enable) = (self.handle(next), enable.map(|e| self.handle(e)));
+        (1..=k)
+            .map(|i| {
+                let r = self.reg(&format!("{}_c{i}", sig.name), sig.ty, reset.map(|v| sig.ty.value(v)));
+                self.connect(r, next, enable);
+                self.set_block(r.id, block);
+                r
+            })
+            .collect()
     }
 
     /// A register that loads `next` every cycle (a pipeline stage).

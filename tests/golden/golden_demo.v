@@ -8,7 +8,8 @@ module golden_demo (
   output wire [7:0] o_high,
   output wire [0:0] o_done,
   output wire [0:0] o_go_late,
-  output wire [0:0] o_go_later
+  output wire [0:0] o_go_later,
+  output wire [31:0] o_sq_copies
 );
 
   // states of ctl
@@ -28,12 +29,10 @@ module golden_demo (
   integer go_later_i;
   initial for (go_later_i = 1; go_later_i <= 70; go_later_i = go_later_i + 1) go_later_sr[go_later_i] = 1'h0;
   wire [0:0] go_later;
+  wire [31:0] both_copies;
 
   // stage square: x squared, high byte
   wire signed [15:0] sq;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 15:8 are read
-  reg signed [15:0] sq_r = 16'sh0000;
-  /* verilator lint_on UNUSEDSIGNAL */
   wire [7:0] high;
 
   // state machine ctl: waits for go
@@ -43,9 +42,17 @@ module golden_demo (
   wire [1:0] state_next;
   wire [0:0] is_done;
 
+  // register copies sq_r_copies: sq_r and 2 copies, to split its fan-out
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 15:8 are read
+  reg signed [15:0] sq_r = 16'sh0000;
+  /* verilator lint_on UNUSEDSIGNAL */
+  reg signed [15:0] sq_r_c1 = 16'sh0000;
+  reg signed [15:0] sq_r_c2 = 16'sh0000;
+
   // not in a stage or state machine
   assign go_late = go_late_sr[3];
   assign go_later = go_later_sr[70];
+  assign both_copies = {sq_r_c1, sq_r_c2};
 
   always @(posedge clk) begin : regs
     go_late_sr[3] <= go_late_sr[2];
@@ -127,10 +134,6 @@ module golden_demo (
   assign sq = $signed({{8{x[7]}}, x}) * $signed({{8{x[7]}}, x});
   assign high = sq_r[15:8];
 
-  always @(posedge clk) begin : square_regs
-    sq_r <= sq;
-  end
-
   // state machine ctl: waits for go
   assign from_idle = go ? st_busy : st_idle;
   assign from_busy = go ? st_busy : st_done;
@@ -145,9 +148,18 @@ module golden_demo (
     else state <= state_next;
   end
 
+  // register copies sq_r_copies: sq_r and 2 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : sq_r_copies_regs
+    sq_r <= sq;
+    sq_r_c1 <= sq;
+    sq_r_c2 <= sq;
+  end
+
   assign o_high = high;
   assign o_done = is_done;
   assign o_go_late = go_late;
   assign o_go_later = go_later;
+  assign o_sq_copies = both_copies;
 endmodule
 `default_nettype wire

@@ -12,7 +12,8 @@ entity golden_demo is
     o_high : out unsigned(7 downto 0);
     o_done : out unsigned(0 downto 0);
     o_go_late : out unsigned(0 downto 0);
-    o_go_later : out unsigned(0 downto 0)
+    o_go_later : out unsigned(0 downto 0);
+    o_sq_copies : out unsigned(31 downto 0)
   );
 end entity golden_demo;
 
@@ -24,6 +25,9 @@ architecture rtl of golden_demo is
   constant st_done : unsigned(1 downto 0) := "10";
   constant st_spare : unsigned(1 downto 0) := "11";
 
+  attribute keep : boolean;
+  attribute equivalent_register_removal : string;
+
   -- not in a stage or state machine
   type go_late_sr_t is array (1 to 3) of unsigned(0 downto 0);
   signal go_late_sr : go_late_sr_t := (others => (others => '0'));
@@ -31,10 +35,10 @@ architecture rtl of golden_demo is
   type go_later_sr_t is array (1 to 70) of unsigned(0 downto 0);
   signal go_later_sr : go_later_sr_t := (others => (others => '0'));
   signal go_later : unsigned(0 downto 0);
+  signal both_copies : unsigned(31 downto 0);
 
   -- stage square: x squared, high byte
   signal sq : signed(15 downto 0);
-  signal sq_r : signed(15 downto 0) := signed'("0000000000000000");
   signal high : unsigned(7 downto 0);
 
   -- state machine ctl: waits for go
@@ -43,11 +47,23 @@ architecture rtl of golden_demo is
   signal from_busy : unsigned(1 downto 0);
   signal state_next : unsigned(1 downto 0);
   signal is_done : unsigned(0 downto 0);
+
+  -- register copies sq_r_copies: sq_r and 2 copies, to split its fan-out
+  signal sq_r : signed(15 downto 0) := signed'("0000000000000000");
+  attribute keep of sq_r : signal is true;
+  attribute equivalent_register_removal of sq_r : signal is "no";
+  signal sq_r_c1 : signed(15 downto 0) := signed'("0000000000000000");
+  attribute keep of sq_r_c1 : signal is true;
+  attribute equivalent_register_removal of sq_r_c1 : signal is "no";
+  signal sq_r_c2 : signed(15 downto 0) := signed'("0000000000000000");
+  attribute keep of sq_r_c2 : signal is true;
+  attribute equivalent_register_removal of sq_r_c2 : signal is "no";
 begin
 
   -- not in a stage or state machine
   go_late <= go_late_sr(3);
   go_later <= go_later_sr(70);
+  both_copies <= unsigned(std_logic_vector'(std_logic_vector(sq_r_c1) & std_logic_vector(sq_r_c2)));
 
   regs : process (clk)
   begin
@@ -62,13 +78,6 @@ begin
   -- stage square: x squared, high byte
   sq <= x * x;
   high <= unsigned(sq_r(15 downto 8));
-
-  square_regs : process (clk)
-  begin
-    if rising_edge(clk) then
-      sq_r <= sq;
-    end if;
-  end process square_regs;
 
   -- state machine ctl: waits for go
   from_idle <= st_busy when go = "1" else st_idle;
@@ -91,8 +100,20 @@ begin
     end if;
   end process ctl_regs;
 
+  -- register copies sq_r_copies: sq_r and 2 copies, to split its fan-out
+
+  sq_r_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      sq_r <= sq;
+      sq_r_c1 <= sq;
+      sq_r_c2 <= sq;
+    end if;
+  end process sq_r_copies_regs;
+
   o_high <= high;
   o_done <= is_done;
   o_go_late <= go_late;
   o_go_later <= go_later;
+  o_sq_copies <= both_copies;
 end architecture rtl;

@@ -126,7 +126,7 @@ impl Printer for Verilog {
         let (n, t) = (&sig.name, decl(sig.ty));
         waived(w, "UNUSEDSIGNAL", unread, |w| match d {
             Decl::Constant(v) => w.line(format!("wire {t} {n} = {v};")),
-            Decl::Register(v) => w.line(format!("reg {t} {n} = {v};")),
+            Decl::Register(v) | Decl::KeptRegister(v) => w.line(format!("reg {t} {n} = {v};")),
             Decl::Shift { depth } => {
                 // Registers, not a memory: yosys would say so with a warning otherwise.
                 w.line(format!("(* mem2reg *) reg {t} {n}_sr [1:{depth}];"));
@@ -222,8 +222,13 @@ impl Printer for Verilog {
         });
     }
 
-    fn begin_clocked(&self, w: &mut CodeWriter, label: &str) {
-        w.open(format!("always @(posedge clk) begin : {label}"));
+    fn keep_attributes(&self, _w: &mut CodeWriter) {}
+
+    /// Yosys puts a process's attributes on the flip-flops it makes of it (`keep` on the
+    /// register itself would keep only the net); `opt_merge` leaves kept cells apart.
+    fn begin_clocked(&self, w: &mut CodeWriter, label: &str, keep: bool) {
+        let keep = if keep { "(* keep *) " } else { "" };
+        w.open(format!("{keep}always @(posedge clk) begin : {label}"));
     }
 
     fn load(&self, w: &mut CodeWriter, target: &str, next: &str, enable: Option<&str>, reset: Option<&str>) {

@@ -196,6 +196,11 @@ impl Printer for Vhdl {
         match decl {
             Decl::Constant(v) => w.line(format!("constant {n} : {t} := {v};")),
             Decl::Register(v) => w.line(format!("signal {n} : {t} := {v};")),
+            Decl::KeptRegister(v) => {
+                w.line(format!("signal {n} : {t} := {v};"));
+                w.line(format!("attribute keep of {n} : signal is true;"));
+                w.line(format!("attribute equivalent_register_removal of {n} : signal is \"no\";"));
+            }
             Decl::Shift { depth } => {
                 w.line(format!("type {n}_sr_t is array (1 to {depth}) of {t};"));
                 w.line(format!("signal {n}_sr : {n}_sr_t := (others => (others => '0'));"));
@@ -290,7 +295,14 @@ impl Printer for Vhdl {
         });
     }
 
-    fn begin_clocked(&self, w: &mut CodeWriter, label: &str) {
+    /// `keep` (Yosys, GHDL, Vivado) and XST's own switch against merging equal registers.
+    fn keep_attributes(&self, w: &mut CodeWriter) {
+        w.blank();
+        w.line("attribute keep : boolean;");
+        w.line("attribute equivalent_register_removal : string;");
+    }
+
+    fn begin_clocked(&self, w: &mut CodeWriter, label: &str, _keep: bool) {
         w.line(format!("{label} : process (clk)"));
         w.line("begin");
         w.open("");

@@ -40,6 +40,8 @@ pub enum Decl<'a> {
     Constant(&'a str),
     /// Clocked storage (a register, a memory read) and its power-up value.
     Register(&'a str),
+    /// A register of a `Copies` block: as `Register`, and synthesis must not merge it.
+    KeptRegister(&'a str),
     /// A shift register of `depth` words powering up at zero; the signal is its last word.
     Shift { depth: u32 },
     /// Driven by a continuous assignment.
@@ -90,8 +92,11 @@ pub trait Printer {
     fn case(&self, w: &mut CodeWriter, target: &str, sel: &str, arms: &[(String, &str)], default: &str);
     /// An instance with its port map (formal, actual).
     fn instance(&self, w: &mut CodeWriter, inst: &Instance, map: &[(&str, &str)]);
-    /// The start of a clocked process named `label`.
-    fn begin_clocked(&self, w: &mut CodeWriter, label: &str);
+    /// The attribute declarations `KeptRegister` declarations use (once, before them).
+    fn keep_attributes(&self, w: &mut CodeWriter);
+    /// The start of a clocked process named `label`; `keep`: its registers are copies that
+    /// synthesis must not merge.
+    fn begin_clocked(&self, w: &mut CodeWriter, label: &str, keep: bool);
     /// A register load: the synchronous reset value first, then the enable.
     fn load(&self, w: &mut CodeWriter, target: &str, next: &str, enable: Option<&str>, reset: Option<&str>);
     /// A synchronous memory read.
@@ -182,9 +187,13 @@ fn declarations(m: &Module, cx: &Context, p: &impl Printer, w: &mut CodeWriter) 
         let all_used = (0..names.len()).all(|v| cx.used_states.contains(&(*b, v as u128)));
         p.states(w, m.sig(*state).ty, &states, all_used);
     }
+    if m.blocks.iter().any(|b| b.kind == BlockKind::Copies) {
+        p.keep_attributes(w);
+    }
     for group in cx.groups.iter().filter(|g| !g.is_empty(m)) {
         w.blank();
         cx.heading(w, group.block);
+        let kept = cx.is_copies(group);
         for &id in &group.signals {
             let sig = m.sig(id);
             let power_up = |v: u128| cx.value(p, id, v);
@@ -198,7 +207,10 @@ fn declarations(m: &Module, cx: &Context, p: &impl Printer, w: &mut CodeWriter) 
                 Def::Const(v) if cx.state_name(id, *v).is_some() => {}
                 Def::Const(v) => p.declare(w, sig, Decl::Constant(&power_up(*v)), unread),
                 // Registers power up at their reset value (0 without one), as in the simulator.
-                Def::Reg { reset, .. } => p.declare(w, sig, Decl::Register(&power_up(reset.unwrap_or(0))), unread),
+                Def::Reg { reset, .. } => {
+                    let v = power_up(reset.unwrap_or(0));
+                    p.declare(w, sig, if kept { Decl::KeptRegister(&v) } else { Decl::Register(&v) }, unread)
+                }
                 Def::RomRead { .. } => p.declare(w, sig, Decl::Register(&p.literal(sig.ty, 0)), unread),
                 Def::DelayLine { depth, .. } => p.declare(w, sig, Decl::Shift { depth: *depth }, unread),
                 Def::Case { .. } => p.declare(w, sig, Decl::Selected, unread),
@@ -246,7 +258,7 @@ fn clocked(m: &Module, cx: &Context, p: &impl Printer, w: &mut CodeWriter, group
         return;
     }
     w.blank();
-    p.begin_clocked(w, &group.label);
+    p.begin_clocked(w, &group.label, cx.is_copies(group));
     for r in writes {
         let (we, addr, data) = r.write.expect("filtered");
         p.write(w, &r.name, cx.name(we), cx.name(addr), cx.name(data));
@@ -362,8 +374,14 @@ impl<'m> Context<'m> {
         let kind = match block.kind {
             BlockKind::Stage => "stage",
             BlockKind::Fsm { .. } => "state machine",
+            BlockKind::Copies => "register copies",
         };
         w.comment(format!("{kind} {}: {}", block.name, block.doc));
+    }
+
+    /// Whether `group` is a block of register copies.
+    fn is_copies(&self, group: &Group) -> bool {
+        group.block.is_some_and(|b| self.m.blocks[b].kind == BlockKind::Copies)
     }
 
     /// The name of state `v` when signal `id` holds a state of a machine that names it.
