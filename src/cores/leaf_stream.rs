@@ -23,7 +23,7 @@ pub struct RayRams {
 }
 
 pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>) -> RayRams {
-    let (slots, n, (accept, gslot)) = (p.total_slots() as usize, p.isect.n, (port.accept, port.slot));
+    let (slots, n, (accept, gslot)) = (p.total_slots() as usize, p.isect.n, (port.accept, port.ram_slot));
     let [ox, oy, oz] = port.o;
     let [wx, wy, wz] = port.w;
     let o = b.ram("ray_o", 3 * n, vec![0; slots]);
@@ -250,30 +250,33 @@ pub fn emission<'b>(
     let tag_d = b.delay_line("pipe_tag", tag, trc);
     // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
     let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
-    into_pipeline(b, p, rams, emit_slot, trc, [valid_d, tag_d], tri_fields)
+    into_pipeline(b, p, rams, &[emit_slot], trc, [valid_d, tag_d], tri_fields)
 }
 
 /// The intersection pipeline fed a triangle (`valid_tag`: its valid bit and tag, `tri_fields`:
 /// its fields) and the ray of global slot `slot`, read from the core's ray RAMs `clocks` clocks
-/// before the triangle enters (the RAM read and `clocks` − 1 registers).
+/// before the triangle enters (the RAM read and `clocks` − 1 registers). `slot` holds the slot
+/// once; several equal registers may share out the RAMs' read addresses (RAM k reads with
+/// `slot[k % slot.len()]`, the origins' RAM first).
 pub fn into_pipeline<'b>(
     b: &'b Builder,
     p: &CoreParams,
     rams: &RayRams,
-    slot: S<'b>,
+    slot: &[S<'b>],
     clocks: u32,
     valid_tag: [S<'b>; 2],
     tri_fields: Vec<S<'b>>,
 ) -> Emission<'b> {
     let (n, m) = (p.isect.n, p.isect.m);
-    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", rams.o, slot), clocks - 1);
+    let addr = |k: usize| slot[k % slot.len()];
+    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", rams.o, addr(0)), clocks - 1);
     let w_words: Vec<S> = rams
         .w
         .iter()
         .enumerate()
         .map(|(k, &mem)| {
             let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
-            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, slot), clocks - 1)
+            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, addr(k + 1)), clocks - 1)
         })
         .collect();
     let mut pipe_in = valid_tag.to_vec();

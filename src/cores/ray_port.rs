@@ -28,11 +28,17 @@ pub struct RayPort<'b> {
     pub phase: S<'b>,
     pub box_o: [S<'b>; 3],
     pub box_inv: [S<'b>; 3],
-    /// A clock after the take: the ray written into its slot (`slot` global, `unit_slot` within
-    /// its unit), its id, origin, direction and reciprocal direction.
+    /// A clock after the take: the ray written into its slot (`slot` global), its id, origin,
+    /// direction and reciprocal direction. The slot is also in registers of their own for the
+    /// write addresses of the RAMs it reaches (a LUT-RAM slice per 4 bits and 16 slots each,
+    /// 888 sinks a bit from one register on the teapot-fine core): `ram_slot` the leaf
+    /// stream's ray RAMs, `closest_slot` the closest-hit unit's, `unit_slot[u]` unit u's
+    /// (within the unit).
     pub accept: S<'b>,
     pub slot: S<'b>,
-    pub unit_slot: S<'b>,
+    pub ram_slot: S<'b>,
+    pub closest_slot: S<'b>,
+    pub unit_slot: Vec<S<'b>>,
     pub id: S<'b>,
     pub o: [S<'b>; 3],
     pub w: [S<'b>; 3],
@@ -126,6 +132,7 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
     // visit-order test fails then.)
     let accept = b.valid_delay("accept", take);
     let gslot = b.delay("accept_slot", take_slot);
+    let copies = b.copies(gslot, 2 + units as usize);
     let [id, ox, oy, oz, wx, wy, wz, ix, iy, iz] =
         [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(|s| b.delay(&format!("acc_{}", b.name_of(s.sig)), s));
     RayPort {
@@ -137,7 +144,9 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
         box_inv,
         accept,
         slot: gslot,
-        unit_slot: gslot.slice(0, sb),
+        ram_slot: copies[0],
+        closest_slot: copies[1],
+        unit_slot: copies[2..].iter().map(|c| c.slice(0, sb)).collect(),
         id,
         o: [ox, oy, oz],
         w: [wx, wy, wz],

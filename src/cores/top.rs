@@ -142,7 +142,7 @@ fn traversal_units<'b>(
             let [ix, iy, iz] = port.inv;
             let mut ins = vec![
                 ("ray_we", we),
-                ("ray_slot", port.unit_slot),
+                ("ray_slot", port.unit_slot[u as usize]),
                 ("ox", ox),
                 ("oy", oy),
                 ("oz", oz),
@@ -238,7 +238,7 @@ fn results<'b>(
     // Registered before the closest-hit unit, whose per-slot selects it drives (the units'
     // queues sit across the die).
     let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
-    cin.extend([port.accept, port.slot, port.id, done_any, done_slot]);
+    cin.extend([port.accept, port.closest_slot, port.id, done_any, done_slot]);
     let res = b.instance("u_closest", &closest, &cin);
     let names = ["merge_valid", "merge_slot", "merge_hit", "merge_limit", "merge_sp", "free_valid", "free_slot"];
     for (wire, name) in units.merge.iter().chain(&units.free).zip(names) {

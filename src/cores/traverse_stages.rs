@@ -591,11 +591,18 @@ impl<'b> Unit<'b> {
         let leafq =
             fifo(b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.valid_delay("leaf_pop_r", self.inp.leaf_pop));
         // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
-        // the units' second stage in N + 1).
-        let o_word = b.read("ray_o_q", self.o_mem, t.slot);
+        // the units' second stage in N + 1). The read address in a register per RAM: one
+        // register reaching all four RAMs' LUT-RAM slices and bank selects had 694 sinks a bit
+        // (K = 64, teapot-fine).
+        let early = b.delay_line("n_ray_slot_early", c.slot, p.node_rom_cycles - 1);
+        let addr = b.delay("n_ray_slot", early);
+        let mut addrs = vec![addr];
+        addrs.extend(b.copies(addr, 3));
+        let o_word = b.read("ray_o_q", self.o_mem, addrs[0]);
         let o = [0, 1, 2].map(|a| o_word.slice(a * n, n));
-        let inv =
-            [0, 1, 2].map(|a| b.read(&format!("ray_inv{}_q", ["x", "y", "z"][a]), self.inv_mem[a], t.slot).signed());
+        let inv = [0, 1, 2].map(|a| {
+            b.read(&format!("ray_inv{}_q", ["x", "y", "z"][a]), self.inv_mem[a], addrs[a as usize + 1]).signed()
+        });
         let issue =
             |last: i128, plane: S<'b>| PlaneIssue { valid: is_inner, last: is_inner.k(last), plane, axis: w_axis };
         let pu0 = plane_unit(b, n, p.c, o, inv, issue(0, w_clip0), p.product);

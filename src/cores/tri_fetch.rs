@@ -197,7 +197,10 @@ pub fn tri_fetch<'b>(
     let id = record_field(b, &parts, l.tri.field("id"));
     let tag = b.cat(&[tag, id.resize(tp.tri_bits)]).name("pipe_tag");
     let fields = l.tri.fields.iter().filter(|f| f.name != "id").map(|f| record_field(b, &parts, f)).collect();
-    let emitted = into_pipeline(b, p, rams, e_slot, lat, [valid_d, tag], fields);
+    // The slot addresses the ray RAMs, ~180 LUT-RAM slices and their bank selects: a copy per
+    // RAM splits that fan-out (935 sinks a bit on the teapot-fine core).
+    let slot_copies = b.copies(e_slot, 1 + rams.w.len());
+    let emitted = into_pipeline(b, p, rams, &slot_copies, lat, [valid_d, tag], fields);
     let stall = b.delay("mem_stall", (!valid_d & retry.nonempty).name("mem_stall_c"));
     let observed = FetchObserved { looks: answer.valid, hits: looked_hit, stall };
     (emitted, observed)
