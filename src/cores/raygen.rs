@@ -310,6 +310,37 @@ mod tests {
         assert!(taken[pixels as usize] > 1_000, "the second frame waits for the restart");
     }
 
+    /// `restart` held high from the start: frame after frame, each in pixel order from ray id
+    /// 0 with every pixel once (a restart that repeated while the walk starts again would give
+    /// pixel 0 twice), and a consumer that takes one clock in three.
+    #[test]
+    fn a_held_restart_gives_whole_frames_one_after_another() {
+        let (scene, cam) = inside_cornell();
+        let g = Golden::new(&scene);
+        let rg = RayGen::new(&scene, &cam).unwrap();
+        let p = &scene.params;
+        let m = raygen_restart_core(&rg, p.n, p.m, p.c, 8);
+        let mut sim = Sim::new(&m);
+        let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+        let (ready, restart) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
+        let pixels = cam.width * cam.height;
+        let mut seen = 0u32;
+        for cycle in 0..3_000u32 {
+            sim.set(ready, (cycle % 3 == 0) as i128);
+            sim.set(restart, 1);
+            sim.eval();
+            if sim.get(out("ray_valid")) == 1 && cycle % 3 == 0 {
+                let k = seen % pixels;
+                let want = rg.ray(&g, k % cam.width, k / cam.width);
+                assert_eq!(sim.get(out("ray_id")), k as i128, "ray {seen}");
+                assert_eq!(sim.get(out("wx")), want.w[0] as i128, "ray {seen}");
+                seen += 1;
+            }
+            sim.tick();
+        }
+        assert!(seen >= 3 * pixels, "{seen} rays: three frames at least");
+    }
+
     #[test]
     fn a_camera_outside_the_box_is_refused() {
         let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
