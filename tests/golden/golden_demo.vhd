@@ -25,7 +25,7 @@ architecture rtl of golden_demo is
   constant st_done : unsigned(1 downto 0) := "10";
   constant st_spare : unsigned(1 downto 0) := "11";
 
-  attribute keep : boolean;
+  attribute keep : string;
   attribute equivalent_register_removal : string;
 
   -- not in a stage or state machine
@@ -50,13 +50,13 @@ architecture rtl of golden_demo is
 
   -- register copies sq_r_copies: sq_r and 2 copies, to split its fan-out
   signal sq_r : signed(15 downto 0) := signed'("0000000000000000");
-  attribute keep of sq_r : signal is true;
+  attribute keep of sq_r : signal is "true";
   attribute equivalent_register_removal of sq_r : signal is "no";
   signal sq_r_c1 : signed(15 downto 0) := signed'("0000000000000000");
-  attribute keep of sq_r_c1 : signal is true;
+  attribute keep of sq_r_c1 : signal is "true";
   attribute equivalent_register_removal of sq_r_c1 : signal is "no";
   signal sq_r_c2 : signed(15 downto 0) := signed'("0000000000000000");
-  attribute keep of sq_r_c2 : signal is true;
+  attribute keep of sq_r_c2 : signal is "true";
   attribute equivalent_register_removal of sq_r_c2 : signal is "no";
 begin
 

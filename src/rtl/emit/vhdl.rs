@@ -198,7 +198,7 @@ impl Printer for Vhdl {
             Decl::Register(v) => w.line(format!("signal {n} : {t} := {v};")),
             Decl::KeptRegister(v) => {
                 w.line(format!("signal {n} : {t} := {v};"));
-                w.line(format!("attribute keep of {n} : signal is true;"));
+                w.line(format!("attribute keep of {n} : signal is \"true\";"));
                 w.line(format!("attribute equivalent_register_removal of {n} : signal is \"no\";"));
             }
             Decl::Shift { depth } => {
@@ -295,10 +295,11 @@ impl Printer for Vhdl {
         });
     }
 
-    /// `keep` (Yosys, GHDL, Vivado) and XST's own switch against merging equal registers.
+    /// `keep` as a string (the Xilinx tools' type; GHDL and Yosys take it too) and XST's own
+    /// switch against merging equal registers.
     fn keep_attributes(&self, w: &mut CodeWriter) {
         w.blank();
-        w.line("attribute keep : boolean;");
+        w.line("attribute keep : string;");
         w.line("attribute equivalent_register_removal : string;");
     }
 
