@@ -91,7 +91,6 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] box_in_invy = 48'sh000000000000;
   reg signed [47:0] box_in_invz = 48'sh000000000000;
   reg [0:0] accept = 1'h0;
-  reg [6:0] accept_slot = 7'h00;
   reg [19:0] acc_in_ray_id = 20'h00000;
   reg [28:0] acc_in_ox = 29'h00000000;
   reg [28:0] acc_in_oy = 29'h00000000;
@@ -102,7 +101,21 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] acc_in_invx = 48'sh000000000000;
   reg signed [47:0] acc_in_invy = 48'sh000000000000;
   reg signed [47:0] acc_in_invz = 48'sh000000000000;
-  wire [5:0] bits_accept_slot;
+  wire [5:0] bits_accept_slot_c3;
+  wire [5:0] bits_accept_slot_c4;
+
+  // register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 6 are read
+  reg [6:0] accept_slot = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  reg [6:0] accept_slot_c1 = 7'h00;
+  reg [6:0] accept_slot_c2 = 7'h00;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c3 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c4 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
   reg [6:0] box_slot = 7'h00;
@@ -225,7 +238,7 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] u1_done_pop;
   wire [72:0] u0_node_word;
   wire [72:0] u1_node_word;
-  wire [0:0] bits_accept_slot_1;
+  wire [0:0] bits_accept_slot;
   wire [0:0] eq_10;
   wire [0:0] u0_alloc;
   wire [0:0] bits_box_done_slot;
@@ -269,7 +282,7 @@ module fxrt_core_sf0a3f4 (
   /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [6:0] u_traverse_0_occupied;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_accept_slot_2;
+  wire [0:0] bits_accept_slot_1;
   wire [0:0] eq_14;
   wire [0:0] u1_alloc;
   wire [0:0] bits_box_done_slot_2;
@@ -546,8 +559,8 @@ module fxrt_core_sf0a3f4 (
   // not in a stage or state machine
 
   always @(posedge clk) begin : regs
-    if (accept) ray_o[accept_slot] <= cat_18;
-    if (accept) ray_w[accept_slot] <= cat_19;
+    if (accept) ray_o[accept_slot_c1] <= cat_18;
+    if (accept) ray_w[accept_slot_c1] <= cat_19;
     if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
     if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
   end
@@ -583,7 +596,8 @@ module fxrt_core_sf0a3f4 (
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
   assign mux_take_or_box_phase_ne_k_0 = take_or_box_phase_ne_k_0 ? box_phase_plus_k_1_1 : box_phase;
   assign box_idle = box_phase == k_0;
-  assign bits_accept_slot = accept_slot[5:0];
+  assign bits_accept_slot_c3 = accept_slot_c3[5:0];
+  assign bits_accept_slot_c4 = accept_slot_c4[5:0];
 
   always @(posedge clk) begin : ray_port_regs
     if (rst) turn <= 1'h0;
@@ -616,7 +630,6 @@ module fxrt_core_sf0a3f4 (
     if (box_idle) box_in_invz <= in_invz;
     if (rst) accept <= 1'h0;
     else accept <= take;
-    accept_slot <= take_slot;
     acc_in_ray_id <= in_ray_id;
     acc_in_ox <= in_ox;
     acc_in_oy <= in_oy;
@@ -627,6 +640,16 @@ module fxrt_core_sf0a3f4 (
     acc_in_invx <= in_invx;
     acc_in_invy <= in_invy;
     acc_in_invz <= in_invz;
+  end
+
+  // register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : accept_slot_copies_regs
+    accept_slot <= take_slot;
+    accept_slot_c1 <= take_slot;
+    accept_slot_c2 <= take_slot;
+    accept_slot_c3 <= take_slot;
+    accept_slot_c4 <= take_slot;
   end
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
@@ -766,8 +789,8 @@ module fxrt_core_sf0a3f4 (
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
-  assign bits_accept_slot_1 = accept_slot[6];
-  assign eq_10 = bits_accept_slot_1 == k_0_1;
+  assign bits_accept_slot = accept_slot[6];
+  assign eq_10 = bits_accept_slot == k_0_1;
   assign u0_alloc = accept & eq_10;
   assign bits_box_done_slot = box_done_slot[6];
   assign eq_11 = bits_box_done_slot == k_0_1;
@@ -781,8 +804,8 @@ module fxrt_core_sf0a3f4 (
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_merge_slot_1 = merge_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
-  assign bits_accept_slot_2 = accept_slot[6];
-  assign eq_14 = bits_accept_slot_2 == k_1;
+  assign bits_accept_slot_1 = accept_slot[6];
+  assign eq_14 = bits_accept_slot_1 == k_1;
   assign u1_alloc = accept & eq_14;
   assign bits_box_done_slot_2 = box_done_slot[6];
   assign eq_15 = bits_box_done_slot_2 == k_1;
@@ -1065,7 +1088,7 @@ module fxrt_core_sf0a3f4 (
     .clk(clk),
     .rst(rst),
     .ray_we(u0_alloc),
-    .ray_slot(bits_accept_slot),
+    .ray_slot(bits_accept_slot_c3),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1110,7 +1133,7 @@ module fxrt_core_sf0a3f4 (
     .clk(clk),
     .rst(rst),
     .ray_we(u1_alloc),
-    .ray_slot(bits_accept_slot),
+    .ray_slot(bits_accept_slot_c4),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1222,7 +1245,7 @@ module fxrt_core_sf0a3f4 (
     .u(u_intersect_u),
     .v(u_intersect_v),
     .id_we(accept),
-    .id_slot(accept_slot),
+    .id_slot(accept_slot_c2),
     .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),

@@ -196,6 +196,9 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   type res_q_mem1_t is array (0 to 15) of unsigned(63 downto 0);
   signal res_q_mem1 : res_q_mem1_t := (others => (others => '0'));
 
+  attribute keep : string;
+  attribute equivalent_register_removal : string;
+
   -- not in a stage or state machine
 
   -- stage ray_port: the ray port's register, the unit whose turn it is, the take (a ray per 4 clocks)
@@ -250,7 +253,6 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal accept : unsigned(0 downto 0) := unsigned'("0");
-  signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal acc_in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal acc_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal acc_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -261,7 +263,25 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal acc_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal bits_accept_slot : unsigned(5 downto 0);
+  signal bits_accept_slot_c3 : unsigned(5 downto 0);
+  signal bits_accept_slot_c4 : unsigned(5 downto 0);
+
+  -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+  signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot : signal is "true";
+  attribute equivalent_register_removal of accept_slot : signal is "no";
+  signal accept_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c1 : signal is "true";
+  attribute equivalent_register_removal of accept_slot_c1 : signal is "no";
+  signal accept_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c2 : signal is "true";
+  attribute equivalent_register_removal of accept_slot_c2 : signal is "no";
+  signal accept_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c3 : signal is "true";
+  attribute equivalent_register_removal of accept_slot_c3 : signal is "no";
+  signal accept_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c4 : signal is "true";
+  attribute equivalent_register_removal of accept_slot_c4 : signal is "no";
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -370,7 +390,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u1_done_pop : unsigned(0 downto 0);
   signal u0_node_word : unsigned(72 downto 0);
   signal u1_node_word : unsigned(72 downto 0);
-  signal bits_accept_slot_1 : unsigned(0 downto 0);
+  signal bits_accept_slot : unsigned(0 downto 0);
   signal eq_10 : unsigned(0 downto 0);
   signal u0_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot : unsigned(0 downto 0);
@@ -402,7 +422,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_traverse_0_cull : unsigned(0 downto 0);
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
-  signal bits_accept_slot_2 : unsigned(0 downto 0);
+  signal bits_accept_slot_1 : unsigned(0 downto 0);
   signal eq_14 : unsigned(0 downto 0);
   signal u1_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
@@ -665,10 +685,10 @@ begin
   begin
     if rising_edge(clk) then
       if accept = "1" then
-        ray_o(to_integer(accept_slot)) <= cat_18;
+        ray_o(to_integer(accept_slot_c1)) <= cat_18;
       end if;
       if accept = "1" then
-        ray_w(to_integer(accept_slot)) <= cat_19;
+        ray_w(to_integer(accept_slot_c1)) <= cat_19;
       end if;
       if res_q_push = "1" then
         res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
@@ -712,7 +732,8 @@ begin
   box_phase_plus_k_1_1 <= box_phase + k_1_1;
   mux_take_or_box_phase_ne_k_0 <= box_phase_plus_k_1_1 when take_or_box_phase_ne_k_0 = "1" else box_phase;
   box_idle <= "1" when box_phase = k_0 else "0";
-  bits_accept_slot <= unsigned(accept_slot(5 downto 0));
+  bits_accept_slot_c3 <= unsigned(accept_slot_c3(5 downto 0));
+  bits_accept_slot_c4 <= unsigned(accept_slot_c4(5 downto 0));
 
   ray_port_regs : process (clk)
   begin
@@ -800,7 +821,6 @@ begin
       else
         accept <= take;
       end if;
-      accept_slot <= take_slot;
       acc_in_ray_id <= in_ray_id;
       acc_in_ox <= in_ox;
       acc_in_oy <= in_oy;
@@ -813,6 +833,19 @@ begin
       acc_in_invz <= in_invz;
     end if;
   end process ray_port_regs;
+
+  -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+
+  accept_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      accept_slot <= take_slot;
+      accept_slot_c1 <= take_slot;
+      accept_slot_c2 <= take_slot;
+      accept_slot_c3 <= take_slot;
+      accept_slot_c4 <= take_slot;
+    end if;
+  end process accept_slot_copies_regs;
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   box_axis <= box_phase - k_1_1;
@@ -984,8 +1017,8 @@ begin
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
-  bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
-  eq_10 <= "1" when bits_accept_slot_1 = k_0_1 else "0";
+  bits_accept_slot <= unsigned(accept_slot(6 downto 6));
+  eq_10 <= "1" when bits_accept_slot = k_0_1 else "0";
   u0_alloc <= accept and eq_10;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
   eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
@@ -999,8 +1032,8 @@ begin
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
-  bits_accept_slot_2 <= unsigned(accept_slot(6 downto 6));
-  eq_14 <= "1" when bits_accept_slot_2 = k_1 else "0";
+  bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
+  eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
   u1_alloc <= accept and eq_14;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
   eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
@@ -1395,7 +1428,7 @@ begin
       clk => clk,
       rst => rst,
       ray_we => u0_alloc,
-      ray_slot => bits_accept_slot,
+      ray_slot => bits_accept_slot_c3,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -1441,7 +1474,7 @@ begin
       clk => clk,
       rst => rst,
       ray_we => u1_alloc,
-      ray_slot => bits_accept_slot,
+      ray_slot => bits_accept_slot_c4,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -1560,7 +1593,7 @@ begin
       u => u_intersect_u,
       v => u_intersect_v,
       id_we => accept,
-      id_slot => accept_slot,
+      id_slot => accept_slot_c2,
       id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,

@@ -1022,6 +1022,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [58:0] leaf_q_q = 59'h000000000000000;
   reg [58:0] leaf_q_din_r = 59'h000000000000000;
   wire [58:0] leaf_q_head;
+  (* mem2reg *) reg [5:0] n_ray_slot_early_sr [1:2];
+  integer n_ray_slot_early_i;
+  initial for (n_ray_slot_early_i = 1; n_ray_slot_early_i <= 2; n_ray_slot_early_i = n_ray_slot_early_i + 1) n_ray_slot_early_sr[n_ray_slot_early_i] = 6'h00;
+  wire [5:0] n_ray_slot_early;
   reg [86:0] ray_o_q = 87'h0000000000000000000000;
   wire [28:0] bits_ray_o_q;
   wire [28:0] bits_ray_o_q_1;
@@ -1163,6 +1167,12 @@ module fxrt_traverse_k64_sf0a3f4 (
   integer negative_i;
   initial for (negative_i = 1; negative_i <= 9; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
   wire [0:0] negative;
+
+  // register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+  reg [5:0] n_ray_slot = 6'h00;
+  reg [5:0] n_ray_slot_c1 = 6'h00;
+  reg [5:0] n_ray_slot_c2 = 6'h00;
+  reg [5:0] n_ray_slot_c3 = 6'h00;
 
   // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   wire [0:0] not_leaf_push;
@@ -2301,6 +2311,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_q_bypass_c = leaf_q_push & eq_112;
   assign ne_113 = leaf_q_count_next != k_0_3;
   assign leaf_q_head = leaf_q_bypass ? leaf_q_din_r : leaf_q_q;
+  assign n_ray_slot_early = n_ray_slot_early_sr[2];
   assign bits_ray_o_q = ray_o_q[28:0];
   assign bits_ray_o_q_1 = ray_o_q[57:29];
   assign bits_ray_o_q_2 = ray_o_q[86:58];
@@ -2409,10 +2420,12 @@ module fxrt_traverse_k64_sf0a3f4 (
     leaf_q_din <= cat_109;
     leaf_q_q <= leaf_q_mem[leaf_q_rd_next];
     if (leaf_q_push) leaf_q_din_r <= leaf_q_din;
-    ray_o_q <= ray_o[n_slot];
-    ray_invx_q <= ray_invx[n_slot];
-    ray_invy_q <= ray_invy[n_slot];
-    ray_invz_q <= ray_invz[n_slot];
+    n_ray_slot_early_sr[2] <= n_ray_slot_early_sr[1];
+    n_ray_slot_early_sr[1] <= c_slot;
+    ray_o_q <= ray_o[n_ray_slot];
+    ray_invx_q <= ray_invx[n_ray_slot_c1];
+    ray_invy_q <= ray_invy[n_ray_slot_c2];
+    ray_invz_q <= ray_invz[n_ray_slot_c3];
     if (rst) pu_sel_valid <= 1'h0;
     else pu_sel_valid <= is_inner;
     pu_sel_last <= k_0;
@@ -2503,6 +2516,15 @@ module fxrt_traverse_k64_sf0a3f4 (
     negative_sr[3] <= negative_sr[2];
     negative_sr[2] <= negative_sr[1];
     negative_sr[1] <= negative_c;
+  end
+
+  // register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : n_ray_slot_copies_regs
+    n_ray_slot <= n_ray_slot_early;
+    n_ray_slot_c1 <= n_ray_slot_early;
+    n_ray_slot_c2 <= n_ray_slot_early;
+    n_ray_slot_c3 <= n_ray_slot_early;
   end
 
   // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares

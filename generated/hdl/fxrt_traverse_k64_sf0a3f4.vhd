@@ -97,6 +97,9 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type leaf_q_mem_t is array (0 to 63) of unsigned(58 downto 0);
   signal leaf_q_mem : leaf_q_mem_t := (others => (others => '0'));
 
+  attribute keep : string;
+  attribute equivalent_register_removal : string;
+
   -- not in a stage or state machine
   signal cat_0 : unsigned(86 downto 0);
   signal u_invx : unsigned(47 downto 0);
@@ -1037,6 +1040,9 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_q_q : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_din_r : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_head : unsigned(58 downto 0);
+  type n_ray_slot_early_sr_t is array (1 to 2) of unsigned(5 downto 0);
+  signal n_ray_slot_early_sr : n_ray_slot_early_sr_t := (others => (others => '0'));
+  signal n_ray_slot_early : unsigned(5 downto 0);
   signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal bits_ray_o_q : unsigned(28 downto 0);
   signal bits_ray_o_q_1 : unsigned(28 downto 0);
@@ -1153,6 +1159,20 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type negative_sr_t is array (1 to 9) of unsigned(0 downto 0);
   signal negative_sr : negative_sr_t := (others => (others => '0'));
   signal negative : unsigned(0 downto 0);
+
+  -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+  signal n_ray_slot : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot : signal is "true";
+  attribute equivalent_register_removal of n_ray_slot : signal is "no";
+  signal n_ray_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c1 : signal is "true";
+  attribute equivalent_register_removal of n_ray_slot_c1 : signal is "no";
+  signal n_ray_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c2 : signal is "true";
+  attribute equivalent_register_removal of n_ray_slot_c2 : signal is "no";
+  signal n_ray_slot_c3 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c3 : signal is "true";
+  attribute equivalent_register_removal of n_ray_slot_c3 : signal is "no";
 
   -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   signal not_leaf_push : unsigned(0 downto 0);
@@ -2415,6 +2435,7 @@ begin
   leaf_q_bypass_c <= leaf_q_push and eq_112;
   ne_113 <= "1" when leaf_q_count_next /= k_0_3 else "0";
   leaf_q_head <= leaf_q_din_r when leaf_q_bypass = "1" else leaf_q_q;
+  n_ray_slot_early <= n_ray_slot_early_sr(2);
   bits_ray_o_q <= unsigned(ray_o_q(28 downto 0));
   bits_ray_o_q_1 <= unsigned(ray_o_q(57 downto 29));
   bits_ray_o_q_2 <= unsigned(ray_o_q(86 downto 58));
@@ -2560,10 +2581,12 @@ begin
       if leaf_q_push = "1" then
         leaf_q_din_r <= leaf_q_din;
       end if;
-      ray_o_q <= ray_o(to_integer(n_slot));
-      ray_invx_q <= ray_invx(to_integer(n_slot));
-      ray_invy_q <= ray_invy(to_integer(n_slot));
-      ray_invz_q <= ray_invz(to_integer(n_slot));
+      n_ray_slot_early_sr(2 to 2) <= n_ray_slot_early_sr(1 to 1);
+      n_ray_slot_early_sr(1) <= c_slot;
+      ray_o_q <= ray_o(to_integer(n_ray_slot));
+      ray_invx_q <= ray_invx(to_integer(n_ray_slot_c1));
+      ray_invy_q <= ray_invy(to_integer(n_ray_slot_c2));
+      ray_invz_q <= ray_invz(to_integer(n_ray_slot_c3));
       if rst = '1' then
         pu_sel_valid <= unsigned'("0");
       else
@@ -2709,6 +2732,18 @@ begin
       negative_sr(1) <= negative_c;
     end if;
   end process ring_n_regs;
+
+  -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+
+  n_ray_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      n_ray_slot <= n_ray_slot_early;
+      n_ray_slot_c1 <= n_ray_slot_early;
+      n_ray_slot_c2 <= n_ray_slot_early;
+      n_ray_slot_c3 <= n_ray_slot_early;
+    end if;
+  end process n_ray_slot_copies_regs;
 
   -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   not_leaf_push <= not leaf_push;
