@@ -197,7 +197,6 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_mem1 : res_q_mem1_t := (others => (others => '0'));
 
   attribute keep : string;
-  attribute equivalent_register_removal : string;
 
   -- not in a stage or state machine
 
@@ -269,19 +268,14 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
   signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot : signal is "true";
-  attribute equivalent_register_removal of accept_slot : signal is "no";
   signal accept_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c1 : signal is "true";
-  attribute equivalent_register_removal of accept_slot_c1 : signal is "no";
   signal accept_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c2 : signal is "true";
-  attribute equivalent_register_removal of accept_slot_c2 : signal is "no";
   signal accept_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c3 : signal is "true";
-  attribute equivalent_register_removal of accept_slot_c3 : signal is "no";
   signal accept_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c4 : signal is "true";
-  attribute equivalent_register_removal of accept_slot_c4 : signal is "no";
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");

@@ -98,7 +98,6 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_q_mem : leaf_q_mem_t := (others => (others => '0'));
 
   attribute keep : string;
-  attribute equivalent_register_removal : string;
 
   -- not in a stage or state machine
   signal cat_0 : unsigned(86 downto 0);
@@ -1163,16 +1162,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
   signal n_ray_slot : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of n_ray_slot : signal is "true";
-  attribute equivalent_register_removal of n_ray_slot : signal is "no";
   signal n_ray_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of n_ray_slot_c1 : signal is "true";
-  attribute equivalent_register_removal of n_ray_slot_c1 : signal is "no";
   signal n_ray_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of n_ray_slot_c2 : signal is "true";
-  attribute equivalent_register_removal of n_ray_slot_c2 : signal is "no";
   signal n_ray_slot_c3 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of n_ray_slot_c3 : signal is "true";
-  attribute equivalent_register_removal of n_ray_slot_c3 : signal is "no";
 
   -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   signal not_leaf_push : unsigned(0 downto 0);

@@ -3,7 +3,7 @@
 /// Names no emitted identifier may take: VHDL-93 and Verilog-2001 keywords, the names of
 /// the library functions and types the VHDL printer calls (a signal named `resize` hides
 /// numeric_std's `resize`), the ports the printers add themselves (`clk`, `rst`) and the
-/// attributes the VHDL printer declares (`keep`, `equivalent_register_removal`).
+/// attribute the VHDL printer declares (`keep`).
 const RESERVED: &str = "
 abs access after alias all always and architecture array assert assign attribute begin block body
 buf buffer bufif0 bufif1 bus case casex casez clk cmos component configuration constant deassign
@@ -28,7 +28,7 @@ logic bit byte int shortint longint string unique priority local const static vo
 union typedef class extends package import export interface modport program property sequence
 assert assume cover bind chandle final foreach inside new null ref return this var virtual
 wildcard with alias always_comb always_ff always_latch break continue do iff
-keep equivalent_register_removal";
+keep";
 
 pub fn is_reserved(s: &str) -> bool {
     RESERVED.split_whitespace().any(|w| w == s)

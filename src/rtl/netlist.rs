@@ -160,7 +160,7 @@ pub enum BlockKind {
     Fsm { state: SigId, states: Vec<String> },
     /// A register and copies of it, loading what it loads (`Builder::copies`): each drives part of a
     /// fan-out too wide for one net. Printed in a process the synthesizer is told to keep
-    /// (Yosys `keep`, XST `equivalent_register_removal = "no"`), or it would merge them back.
+    /// (`keep`), or it would merge them back.
     Copies,
 }
 

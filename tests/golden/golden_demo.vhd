@@ -26,7 +26,6 @@ architecture rtl of golden_demo is
   constant st_spare : unsigned(1 downto 0) := "11";
 
   attribute keep : string;
-  attribute equivalent_register_removal : string;
 
   -- not in a stage or state machine
   type go_late_sr_t is array (1 to 3) of unsigned(0 downto 0);
@@ -51,13 +50,10 @@ architecture rtl of golden_demo is
   -- register copies sq_r_copies: sq_r and 2 copies, to split its fan-out
   signal sq_r : signed(15 downto 0) := signed'("0000000000000000");
   attribute keep of sq_r : signal is "true";
-  attribute equivalent_register_removal of sq_r : signal is "no";
   signal sq_r_c1 : signed(15 downto 0) := signed'("0000000000000000");
   attribute keep of sq_r_c1 : signal is "true";
-  attribute equivalent_register_removal of sq_r_c1 : signal is "no";
   signal sq_r_c2 : signed(15 downto 0) := signed'("0000000000000000");
   attribute keep of sq_r_c2 : signal is "true";
-  attribute equivalent_register_removal of sq_r_c2 : signal is "no";
 begin
 
   -- not in a stage or state machine

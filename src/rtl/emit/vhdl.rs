@@ -199,7 +199,6 @@ impl Printer for Vhdl {
             Decl::KeptRegister(v) => {
                 w.line(format!("signal {n} : {t} := {v};"));
                 w.line(format!("attribute keep of {n} : signal is \"true\";"));
-                w.line(format!("attribute equivalent_register_removal of {n} : signal is \"no\";"));
             }
             Decl::Shift { depth } => {
                 w.line(format!("type {n}_sr_t is array (1 to {depth}) of {t};"));
@@ -295,12 +294,12 @@ impl Printer for Vhdl {
         });
     }
 
-    /// `keep` as a string (the Xilinx tools' type; GHDL and Yosys take it too) and XST's own
-    /// switch against merging equal registers.
+    /// `keep` as a string, as the Xilinx tools declare it (GHDL and Yosys take it too). Not
+    /// XST's `equivalent_register_removal`: GHDL warns on an attribute it does not know, and
+    /// the copies change the timing only (ISE users may turn that XST option off).
     fn keep_attributes(&self, w: &mut CodeWriter) {
         w.blank();
         w.line("attribute keep : string;");
-        w.line("attribute equivalent_register_removal : string;");
     }
 
     fn begin_clocked(&self, w: &mut CodeWriter, label: &str, _keep: bool) {
