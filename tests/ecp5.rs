@@ -45,6 +45,13 @@ fn a_small_divider_places_and_routes_above_the_floor() {
     assert_ne!(placed.seeds[0].fmax_mhz, placed.seeds[1].fmax_mhz, "{:?}", placed.seeds);
     assert_eq!(t.fmax_mhz, placed.fmax_min_mhz, "of two seeds the median is the lower");
     assert!(placed.fmax_max_mhz > t.fmax_mhz);
+    // The slowest paths read from the SDF: the first is nextpnr's own critical path (its
+    // delay to the picosecond, its end), the rest no slower, each endpoint group once.
+    let worst = &t.slow_paths[0];
+    assert!((worst.delay_ns - t.critical_path.delay_ns).abs() < 0.0015, "{worst:?} against {:?}", t.critical_path);
+    assert_eq!(worst.end, t.critical_path.end, "{worst:?} against {:?}", t.critical_path);
+    assert!(t.slow_paths.windows(2).all(|w| w[0].delay_ns >= w[1].delay_ns), "{:?}", t.slow_paths);
+    assert!(t.slow_paths.len() > 1);
 }
 
 /// A 32 × 32 product split into four 18 × 18 DSP pieces with their own input, pipeline and

@@ -263,6 +263,7 @@ fn ecp5_columns_follow_the_modules() {
         nextpnr: "nextpnr".into(),
         seed: 1,
         netlist_sha256: String::new(),
+        slow_paths: Vec::new(),
     };
     let modules = vec!["divider".to_string(), "intersect".into(), "core".into()];
     let s = SweepSpec { synth: true, core_sim: true, ecp5: Some(Ecp5Choice { modules, seed: 1 }), ..spec() };

@@ -13,6 +13,7 @@ pub mod bram;
 pub mod carry;
 pub mod dsp;
 pub mod seeds;
+pub mod sta;
 
 use crate::cores::intersect::IntersectParams;
 use crate::cores::top::CoreParams;
@@ -162,6 +163,10 @@ pub struct Timing {
     /// the same netlist.
     #[serde(default)]
     pub netlist_sha256: String,
+    /// The slowest endpoint groups of the routed design, from nextpnr's SDF (`sta`): where a
+    /// clock is lost besides the one critical path nextpnr names. Empty when not analysed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub slow_paths: Vec<sta::SlowPath>,
 }
 
 /// SHA-256 (hex) of a module's Verilog (every file of its hierarchy, names and contents, in
@@ -313,12 +318,14 @@ pub(crate) fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<(
 
 /// Runs nextpnr-ecp5 in `dir` on the synthesised `design.json` for the LFE5U-85F (`PACKAGE`,
 /// speed grade 6) with `constraint` (a clock `--freq`, or the board's `--lpf` and what else
-/// the board wants) and placement seed `seed`, writing `report.json` and `nextpnr.log`.
+/// the board wants) and placement seed `seed`, writing `report.json`, `timing.sdf` (every
+/// routed delay, for `sta`) and `nextpnr.log`.
 pub fn nextpnr(tools: &Tools, dir: &Path, constraint: &[&str], seed: u64) -> Result<()> {
     let seed = seed.to_string();
     let mut args = vec!["--85k", "--package", PACKAGE, "--speed", "6", "--json", "design.json"];
     args.extend_from_slice(constraint);
-    args.extend(["--seed", &seed, "--report", "report.json", "--timing-allow-fail", "--log", "nextpnr.log", "-q"]);
+    args.extend(["--seed", &seed, "--report", "report.json", "--sdf", "timing.sdf", "--timing-allow-fail"]);
+    args.extend(["--log", "nextpnr.log", "-q"]);
     run(&tools.nextpnr, &args, dir, "nextpnr.log")
 }
 
@@ -365,7 +372,19 @@ pub fn timing_from_report(
         nextpnr,
         seed,
         netlist_sha256: String::new(),
+        slow_paths: Vec::new(),
     }
+}
+
+/// How many endpoint groups `slow_paths_of` lists.
+pub const SLOW_PATHS: usize = 12;
+
+/// The slowest endpoint groups of the design nextpnr routed in `dir` (its `timing.sdf`), with
+/// the endpoints slower than the `target_mhz` period counted.
+pub fn slow_paths_of(dir: &Path, target_mhz: f64) -> Result<Vec<sta::SlowPath>> {
+    let path = dir.join("timing.sdf");
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::file(&path, e.to_string()))?;
+    sta::slowest_paths(&text, SLOW_PATHS, 1000.0 / target_mhz).map_err(|e| Error::file(&path, e))
 }
 
 /// The netlist's own name in a name yosys and nextpnr derived from it: the part before the

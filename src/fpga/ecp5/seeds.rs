@@ -3,7 +3,10 @@
 //! is the median of several seeds, never the best (nextpnr's placement spreads one netlist
 //! over tens of MHz: docs/TIMING.md).
 
-use super::{PIN_REGS, Timing, Tools, nextpnr, read_report, synthesize, timing_from_report, wrapper, write_sources};
+use super::{
+    PIN_REGS, Timing, Tools, nextpnr, read_report, slow_paths_of, synthesize, timing_from_report, wrapper,
+    write_sources,
+};
 use crate::error::{Error, Result};
 use crate::rtl::Module;
 use serde::{Deserialize, Serialize};
@@ -135,6 +138,7 @@ pub fn place_and_route_seeds(
             nextpnr_version.clone(),
         );
         t.netlist_sha256 = netlist_sha256.clone();
+        t.slow_paths = slow_paths_of(&seed_dir, target_mhz)?;
         done(&t);
         Ok(t)
     };
