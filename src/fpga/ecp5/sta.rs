@@ -18,6 +18,9 @@ pub struct SlowPath {
     /// The cells between start and end, in order (netlist names: yosys names a LUT after the
     /// signal it makes).
     pub through: Vec<String>,
+    /// The cells the path passes through between start and end (LUTs, carry cells, RAM and
+    /// multiplier stages): `through` names them once per netlist name.
+    pub cells: usize,
     /// How many endpoint pins of this group are slower than `floor_ns` (`slowest_paths`).
     pub endpoints_over: usize,
 }
@@ -297,14 +300,20 @@ pub fn slowest_paths(sdf: &str, count: usize, floor_ns: f64) -> Result<Vec<SlowP
             start: String::new(),
             end: String::new(),
             through: Vec::new(),
+            cells: 0,
             endpoints_over: 0,
         });
         entry.endpoints_over += usize::from(delay_ns > floor_ns);
         if delay_ns > entry.delay_ns {
             let mut cells: Vec<String> = Vec::new();
+            let mut raw: Vec<&str> = Vec::new();
             let mut at = p;
             while let Some(prev) = pred[at as usize] {
-                let cell = netlist_name(instance(&g.names[prev as usize]));
+                let inst = instance(&g.names[prev as usize]);
+                if raw.last() != Some(&inst) {
+                    raw.push(inst);
+                }
+                let cell = netlist_name(inst);
                 if cells.last() != Some(&cell) {
                     cells.push(cell);
                 }
@@ -314,7 +323,8 @@ pub fn slowest_paths(sdf: &str, count: usize, floor_ns: f64) -> Result<Vec<SlowP
             let start = cells.first().cloned().unwrap_or_default();
             let end = group(name);
             let through = cells.into_iter().skip(1).filter(|c| *c != end).collect();
-            *entry = SlowPath { delay_ns, start, end, through, endpoints_over: entry.endpoints_over };
+            let cells = raw.len().saturating_sub(1);
+            *entry = SlowPath { delay_ns, start, end, through, cells, endpoints_over: entry.endpoints_over };
         }
     }
     let mut paths: Vec<SlowPath> = groups.into_values().collect();
@@ -353,6 +363,7 @@ mod tests {
         assert_eq!(p.delay_ns, 1.06);
         assert_eq!((p.start.as_str(), p.end.as_str()), ("a_ff", "b_ff_3"));
         assert_eq!(p.through, vec!["lut[1]".to_string()]);
+        assert_eq!(p.cells, 1);
         assert_eq!(p.endpoints_over, 1);
         assert_eq!(group("u.x_TRELLIS_FF_Q_12/DI"), "u.x");
     }
