@@ -273,11 +273,12 @@ mod tests {
         assert_eq!(seen, cam.width * cam.height);
     }
 
-    /// A consumer that always takes: after the first ray (a load, F + C + 1 bits, the port) the
-    /// divider sets hand over a ray every `CLOCKS_PER_RAY` clocks or faster, in pixel order;
-    /// the restarting generator starts the frame again once every ray has left.
-    #[test]
-    fn keeps_up_a_ray_every_few_clocks_and_restarts() {
+    /// Drives the inside-Cornell restarting generator for `cycles` clocks, `ready` and
+    /// `restart` given by the clock, and checks each ray taken (valid while ready) against the
+    /// golden ray of the pixel it should be: the frames one after another, in pixel order, each
+    /// pixel once (its id, `invz`, `wx` and `wy`). Returns the clocks the rays were taken at,
+    /// and the pixels in a frame.
+    fn restarting_frames(cycles: u32, ready: impl Fn(u32) -> bool, restart: impl Fn(u32) -> bool) -> (Vec<u32>, u32) {
         let (scene, cam) = inside_cornell();
         let g = Golden::new(&scene);
         let rg = RayGen::new(&scene, &cam).unwrap();
@@ -285,26 +286,37 @@ mod tests {
         let m = raygen_restart_core(&rg, p.n, p.m, p.c, 8);
         let mut sim = Sim::new(&m);
         let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
-        let (ready, restart) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
+        let (ready_in, restart_in) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
         let pixels = cam.width * cam.height;
         let mut taken = Vec::new();
-        for cycle in 0..4_000u32 {
-            sim.set(ready, 1);
-            sim.set(restart, (cycle == 1_000) as i128);
+        for cycle in 0..cycles {
+            sim.set(ready_in, ready(cycle) as i128);
+            sim.set(restart_in, restart(cycle) as i128);
             sim.eval();
-            if sim.get(out("ray_valid")) == 1 {
-                let seen = taken.len() as u32 % pixels;
-                let want = rg.ray(&g, seen % cam.width, seen / cam.width);
-                assert_eq!(sim.get(out("ray_id")), seen as i128);
-                assert_eq!(sim.get(out("invz")), want.inv[2], "ray {seen}");
-                assert_eq!(sim.get(out("wy")), want.w[1] as i128, "ray {seen}");
+            if sim.get(out("ray_valid")) == 1 && ready(cycle) {
+                let k = taken.len() as u32 % pixels;
+                let want = rg.ray(&g, k % cam.width, k / cam.width);
+                let ray = taken.len();
+                assert_eq!(sim.get(out("ray_id")), k as i128, "ray {ray}");
+                assert_eq!(sim.get(out("invz")), want.inv[2], "ray {ray}");
+                assert_eq!(sim.get(out("wx")), want.w[0] as i128, "ray {ray}");
+                assert_eq!(sim.get(out("wy")), want.w[1] as i128, "ray {ray}");
                 taken.push(cycle);
             }
             sim.tick();
         }
+        (taken, pixels)
+    }
+
+    /// A consumer that always takes: after the first ray (a load, F + C + 1 bits, the port) the
+    /// divider sets hand over a ray every `CLOCKS_PER_RAY` clocks or faster, in pixel order;
+    /// the restarting generator starts the frame again once every ray has left.
+    #[test]
+    fn keeps_up_a_ray_every_few_clocks_and_restarts() {
+        let (taken, pixels) = restarting_frames(4_000, |_| true, |cycle| cycle == 1_000);
         assert_eq!(taken.len() as u32, 2 * pixels, "two frames, the second after the restart");
-        let qbits = p.m + p.c;
-        assert!(taken[0] <= qbits + 4, "the first ray at {}", taken[0]);
+        let p = &inside_cornell().0.params;
+        assert!(taken[0] <= p.m + p.c + 4, "the first ray at {}", taken[0]);
         let span = taken[pixels as usize - 1] - taken[0];
         assert!(span <= (pixels - 1) * CLOCKS_PER_RAY, "{pixels} rays in {span} clocks");
         assert!(taken[pixels as usize] > 1_000, "the second frame waits for the restart");
@@ -315,30 +327,8 @@ mod tests {
     /// pixel 0 twice), and a consumer that takes one clock in three.
     #[test]
     fn a_held_restart_gives_whole_frames_one_after_another() {
-        let (scene, cam) = inside_cornell();
-        let g = Golden::new(&scene);
-        let rg = RayGen::new(&scene, &cam).unwrap();
-        let p = &scene.params;
-        let m = raygen_restart_core(&rg, p.n, p.m, p.c, 8);
-        let mut sim = Sim::new(&m);
-        let out = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
-        let (ready, restart) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]));
-        let pixels = cam.width * cam.height;
-        let mut seen = 0u32;
-        for cycle in 0..3_000u32 {
-            sim.set(ready, (cycle % 3 == 0) as i128);
-            sim.set(restart, 1);
-            sim.eval();
-            if sim.get(out("ray_valid")) == 1 && cycle % 3 == 0 {
-                let k = seen % pixels;
-                let want = rg.ray(&g, k % cam.width, k / cam.width);
-                assert_eq!(sim.get(out("ray_id")), k as i128, "ray {seen}");
-                assert_eq!(sim.get(out("wx")), want.w[0] as i128, "ray {seen}");
-                seen += 1;
-            }
-            sim.tick();
-        }
-        assert!(seen >= 3 * pixels, "{seen} rays: three frames at least");
+        let (taken, pixels) = restarting_frames(3_000, |cycle| cycle % 3 == 0, |_| true);
+        assert!(taken.len() as u32 >= 3 * pixels, "{} rays: three frames at least", taken.len());
     }
 
     #[test]

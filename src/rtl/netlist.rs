@@ -241,9 +241,9 @@ impl Module {
     /// Opens a block: signals created until `end_block` belong to it. Returns its index.
     pub fn begin_block(&mut self, name: &str, doc: &str, kind: BlockKind) -> usize {
         assert!(self.current_block.is_none(), "{}: block {name} opened inside another", self.name);
-        self.blocks.push(Block { name: names::legal(name), doc: doc.to_string(), kind });
-        self.current_block = Some(self.blocks.len() - 1);
-        self.blocks.len() - 1
+        let block = self.add_block(name, doc, kind);
+        self.current_block = Some(block);
+        block
     }
 
     /// A block that new signals are not put in (`set_block` puts them there). Returns its index.
