@@ -6,10 +6,12 @@
 //! A push is registered before it reaches the queue (the producers are logic far away on the
 //! die, and the count's carry chain is the queue's own), so an entry pushed in cycle c is on
 //! `head` from cycle c + 2. `head` is the oldest entry whenever `nonempty` is 1; `pop` (only
-//! when nonempty) takes it, and the next one is on `head` in the next cycle. The RAM is read synchronously (read-first) at the
-//! next read pointer, so `head` is a RAM output register; an entry pushed into a queue that is
-//! empty (after this cycle's pop) is read in the same cycle it is written, which a read-first RAM
-//! answers with the old word, so it comes from a copy of the pushed word instead (`bypass`).
+//! when nonempty) takes it, and the next one is on `head` in the next cycle. The RAM is read
+//! synchronously (read-first) at both the read pointer and the one after it, and the registered
+//! pop picks between the two words, so `head` is a RAM output register and a select; an entry
+//! pushed into a queue that is empty (after this cycle's pop) is read in the same cycle it is
+//! written, which a read-first RAM answers with the old word, so it comes from a copy of the
+//! pushed word instead (`bypass`).
 
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
@@ -22,7 +24,7 @@ pub struct Fifo<'b> {
 /// A queue of `width`-bit entries, at least `depth` deep (a power of two).
 pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>, din: S<'b>, pop: S<'b>) -> Fifo<'b> {
     assert_eq!(din.width(), width, "{name}: entry width");
-    let (heads, nonempty) = fifo_words(b, name, depth, push, &[din], pop);
+    let (heads, nonempty) = queue(b, name, depth, push, &[din], pop, true);
     Fifo { head: heads[0], nonempty }
 }
 
@@ -48,6 +50,21 @@ pub fn fifo_words<'b>(
     dins: &[S<'b>],
     pop: S<'b>,
 ) -> (Vec<S<'b>>, S<'b>) {
+    queue(b, name, depth, push, dins, pop, false)
+}
+
+/// The queue; with `two_reads` the RAM has two read ports and the pop picks after it (the
+/// control queues, in LUT RAM), else one read port at the next read pointer (the result
+/// queue's wide words: a second port would double its RAM).
+fn queue<'b>(
+    b: &'b Builder,
+    name: &str,
+    depth: u32,
+    push: S<'b>,
+    dins: &[S<'b>],
+    pop: S<'b>,
+    two_reads: bool,
+) -> (Vec<S<'b>>, S<'b>) {
     let push = b.valid_delay(&format!("{name}_push"), push);
     let depth = depth.next_power_of_two().max(2);
     let ab = depth.trailing_zeros();
@@ -65,10 +82,15 @@ pub fn fifo_words<'b>(
     let after_pop = (count - pop.resize(ab + 1)).name(&format!("{name}_after_pop"));
     let count_next = (after_pop + push.resize(ab + 1)).name(&format!("{name}_count_next"));
     b.next(count, count_next);
+    // `bypass` and `nonempty` from compares of the count register, the pop one gate before
+    // the flip-flop (through the subtractor and adder it was among the slowest paths).
+    let (empty, one_left) = (count.eq(0), count.eq(1).name(&format!("{name}_one_left")));
+    let drained = (empty | (one_left & pop)).name(&format!("{name}_drained"));
     let bypass = b.reg(&format!("{name}_bypass"), Ty::BIT, Some(0));
-    b.next(bypass, (push & after_pop.eq(0)).name(&format!("{name}_bypass_c")));
+    b.next(bypass, (push & drained).name(&format!("{name}_bypass_c")));
+    let popped = two_reads.then(|| b.valid_delay(&format!("{name}_popped"), pop));
     let nonempty = b.reg(&format!("{name}_nonempty"), Ty::BIT, Some(0));
-    b.next(nonempty, count_next.ne(0));
+    b.next(nonempty, (push | count.gt(1) | (one_left & !pop)).name(&format!("{name}_nonempty_c")));
     let one = dins.len() == 1;
     let heads = dins
         .iter()
@@ -78,7 +100,16 @@ pub fn fifo_words<'b>(
             let din = b.delay(&word("din"), din);
             let mem = b.ram(&word("mem"), din.width(), vec![0; depth as usize]);
             b.ram_write(mem, push, wr, din);
-            let q = b.read(&word("q"), mem, rd_next);
+            // Both words the head may be next are read (two read ports, from registers); the
+            // pop only picks one after the RAM. A read at `rd_next` put the pop's logic, the
+            // address's fan-out and the LUT-RAM read on one path: the slowest of the queues.
+            let q = if let Some(popped) = popped {
+                let q_stay = b.read(&word("q_stay"), mem, rd);
+                let q_next = b.read(&word("q_next"), mem, rd1);
+                popped.select(q_next, q_stay)
+            } else {
+                b.read(&word("q"), mem, rd_next)
+            };
             let din_r = b.reg(&word("din_r"), din.ty(), None);
             b.next_when(din_r, push, din);
             bypass.select(din_r, q).name(&word("head"))
@@ -97,14 +128,14 @@ mod tests {
     /// including pushes into an empty queue while popping its last entry.
     #[test]
     fn behaves_like_a_queue() {
-        for depth in [2u32, 4, 16] {
+        for (depth, two_reads) in [(2u32, true), (4, true), (16, true), (4, false), (16, false)] {
             let b = Builder::new("t");
             let push = b.input("push", Ty::BIT);
             let din = b.input("din", Ty::u(8));
             let pop = b.input("pop", Ty::BIT);
-            let f = fifo(&b, "q", 8, depth, push, din, pop);
-            b.output("head", f.head);
-            b.output("nonempty", f.nonempty);
+            let (heads, nonempty) = queue(&b, "q", depth, push, &[din], pop, two_reads);
+            b.output("head", heads[0]);
+            b.output("nonempty", nonempty);
             let m = b.finish();
             let mut sim = Sim::new(&m);
             let h = |i: usize| m.handle(m.inputs[i]);
