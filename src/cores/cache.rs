@@ -147,15 +147,6 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     // one set a clock, and until it ends no lookup hits and no fill is asked for.
     let tags: Vec<usize> =
         (0..p.ways).map(|w| b.ram(&nm(&format!("tag{w}")), tb + 1, vec![0; p.sets as usize])).collect();
-    let datas: Vec<Vec<usize>> = (0..p.ways)
-        .map(|w| {
-            parts
-                .iter()
-                .enumerate()
-                .map(|(j, &pw)| b.ram(&nm(&format!("data{w}_{j}")), pw, vec![0; depth_words]))
-                .collect()
-        })
-        .collect();
 
     b.stage(&nm("fill"), "beats gathered into records and written; the victim's tag cleared at the first beat, the new one written at the last");
     let done = b.reg(&nm("done"), seq, Some(0));
@@ -212,15 +203,23 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let beats: Vec<S<'b>> = held.iter().copied().chain([fill.data]).collect();
     let record = |lsb: u32, w: u32| bits_across(b, &beats, p.data_bits, lsb, w);
     let waddr = b.cat(&[f_set, rec_no.resize(rb)]).name(&nm("fill_addr"));
-    for (w, rams) in datas.iter().enumerate() {
-        let we = (write_rec & f_way.eq(w as i128)).name(&nm(&format!("write{w}")));
-        let mut lsb = 0;
-        for (j, &ram) in rams.iter().enumerate() {
-            let data = record(lsb, parts[j]).name(&nm(&format!("rec{w}_{j}")));
-            b.ram_write(ram, we, waddr, data);
-            lsb += parts[j];
-        }
-    }
+    // The record RAMs' write ports, by way and part: (enable, data); the RAMs are made with
+    // their read ports below.
+    let writes: Vec<Vec<(S<'b>, S<'b>)>> = (0..p.ways)
+        .map(|w| {
+            let we = (write_rec & f_way.eq(w as i128)).name(&nm(&format!("write{w}")));
+            let mut lsb = 0;
+            parts
+                .iter()
+                .enumerate()
+                .map(|(j, &pw)| {
+                    let data = record(lsb, pw).name(&nm(&format!("rec{w}_{j}")));
+                    lsb += pw;
+                    (we, data)
+                })
+                .collect()
+        })
+        .collect();
     let sweep = b.reg(&nm("sweep"), Ty::u(sb + 1), Some(0));
     let sweeping = (!sweep.msb()).name(&nm("sweeping"));
     b.next_when(sweep, sweeping, sweep + 1);
@@ -257,23 +256,25 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     let tag_q: Vec<S<'b>> = tags.iter().enumerate().map(|(w, &t)| b.read(&nm(&format!("tag_q{w}")), t, set)).collect();
     // A lookup may hit only if its tags were read after the sweep (2 clocks on: with `tag_r`).
     let swept_r = b.valid_line(&nm("swept_r"), !sweeping, 2);
-    let data_q: Vec<Vec<S<'b>>> = datas
+    // The records two clocks after `raddr`: the RAM's read register and a second register
+    // after it (the block RAM's output sits far from the logic).
+    let data_r: Vec<Vec<S<'b>>> = writes
         .iter()
         .enumerate()
-        .map(|(w, rams)| {
-            rams.iter().enumerate().map(|(j, &r)| b.read(&nm(&format!("data_q{w}_{j}")), r, raddr)).collect()
+        .map(|(w, parts_w)| {
+            parts_w
+                .iter()
+                .enumerate()
+                .map(|(j, &(we, data))| {
+                    record_ram(b, &nm(&format!("data{w}_{j}")), p, depth_words, we, waddr, data, raddr)
+                })
+                .collect()
         })
         .collect();
-    // A fabric register after the RAMs (the block RAM's output sits far from the logic), and
-    // the in-flight table searched for the line meanwhile.
+    // The in-flight table is searched for the line meanwhile.
     let l1_valid = b.valid_delay(&nm("l1_valid"), l0_valid);
     let l1_line = b.delay(&nm("l1_line"), l0_line);
     let tag_r: Vec<S<'b>> = tag_q.iter().enumerate().map(|(w, &t)| b.delay(&nm(&format!("tag_r{w}")), t)).collect();
-    let data_r: Vec<Vec<S<'b>>> = data_q
-        .iter()
-        .enumerate()
-        .map(|(w, ds)| ds.iter().enumerate().map(|(j, &d)| b.delay(&nm(&format!("data_r{w}_{j}")), d)).collect())
-        .collect();
     // The compare, while the in-flight table is searched for the line; both registered.
     let l2_valid = b.valid_delay(&nm("l2_valid"), l1_valid);
     let l2_line = b.delay(&nm("l2_line"), l1_line);
@@ -359,4 +360,35 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         request: (req_valid, req_line),
         done,
     }
+}
+
+/// A record RAM of the cache: the word at `raddr` two clocks later. When a record takes two
+/// beats or more it is a block RAM module (`brom::bram`, whose second register the ECP5 flow
+/// makes the DP16KD's own output register: a DP16KD without it gives its data 5.8 ns after the
+/// clock, and the cache's record registers were the slowest paths of the teapot-fine core).
+/// A DP16KD's read of the word its other port writes in the same clock is not defined, and
+/// then no lookup uses it: the line's tag was written invalid at its first beat, which writes
+/// no record. A record of one beat is written at the first beat, while a lookup may still read
+/// the victim's tag valid, so it stays a RAM that yosys maps with the read-first behaviour the
+/// simulators give.
+#[allow(clippy::too_many_arguments)]
+fn record_ram<'b>(
+    b: &'b Builder,
+    name: &str,
+    p: &CacheParams,
+    words: usize,
+    we: S<'b>,
+    waddr: S<'b>,
+    wdata: S<'b>,
+    raddr: S<'b>,
+) -> S<'b> {
+    let width = wdata.width();
+    if p.record_beats >= 2 {
+        let shape = format!("cache_w{width}_d{words}");
+        return super::brom::bram(b, &format!("u_{name}"), &shape, width, words, we, waddr, wdata, raddr);
+    }
+    let ram = b.ram(name, width, vec![0; words]);
+    b.ram_write(ram, we, waddr, wdata);
+    let q = b.read(&format!("{name}_q"), ram, raddr);
+    b.delay(&format!("{name}_r"), q)
 }
