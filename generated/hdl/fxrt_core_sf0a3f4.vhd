@@ -643,12 +643,20 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_after_pop : unsigned(4 downto 0);
   signal rs_res_q_push : unsigned(4 downto 0);
   signal res_q_count_next : unsigned(4 downto 0);
-  signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_5 : unsigned(4 downto 0) := unsigned'("00000");
-  signal res_q_after_pop_eq_k_0_5 : unsigned(0 downto 0);
+  signal res_q_count_eq_k_0_5 : unsigned(0 downto 0);
+  constant k_1_5 : unsigned(4 downto 0) := unsigned'("00001");
+  signal res_q_one_left : unsigned(0 downto 0);
+  signal and_44 : unsigned(0 downto 0);
+  signal res_q_drained : unsigned(0 downto 0);
+  signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_bypass_c : unsigned(0 downto 0);
   signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_45 : unsigned(0 downto 0);
+  signal k_1_5_lt_res_q_count : unsigned(0 downto 0);
+  signal or_47 : unsigned(0 downto 0);
+  signal not_res_take : unsigned(0 downto 0);
+  signal and_48 : unsigned(0 downto 0);
+  signal res_q_nonempty_c : unsigned(0 downto 0);
   signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_q0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_din_r0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
@@ -660,11 +668,11 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_take_c : unsigned(0 downto 0);
   signal res_credits : unsigned(5 downto 0) := unsigned'("010000");
   signal rs_done_valid_r : unsigned(5 downto 0);
-  signal minus_47 : unsigned(5 downto 0);
+  signal minus_50 : unsigned(5 downto 0);
   signal rs_res_take_1 : unsigned(5 downto 0);
   signal res_credits_next : unsigned(5 downto 0);
   signal bits_res_credits_next : unsigned(4 downto 0);
-  signal ne_49 : unsigned(0 downto 0);
+  signal ne_52 : unsigned(0 downto 0);
   signal res_t_q : unsigned(29 downto 0);
   signal res_tri_q : unsigned(12 downto 0);
   signal res_hit_q : unsigned(0 downto 0);
@@ -1300,7 +1308,7 @@ begin
       if rst = '1' then
         res_credit_ok <= unsigned'("1");
       else
-        res_credit_ok <= ne_49;
+        res_credit_ok <= ne_52;
       end if;
       if rst = '1' then
         u0_done_took <= unsigned'("0");
@@ -1334,18 +1342,25 @@ begin
   res_q_after_pop <= res_q_count - rs_res_take;
   rs_res_q_push <= resize(res_q_push, 5);
   res_q_count_next <= res_q_after_pop + rs_res_q_push;
-  res_q_after_pop_eq_k_0_5 <= "1" when res_q_after_pop = k_0_5 else "0";
-  res_q_bypass_c <= res_q_push and res_q_after_pop_eq_k_0_5;
-  ne_45 <= "1" when res_q_count_next /= k_0_5 else "0";
+  res_q_count_eq_k_0_5 <= "1" when res_q_count = k_0_5 else "0";
+  res_q_one_left <= "1" when res_q_count = k_1_5 else "0";
+  and_44 <= res_q_one_left and res_take;
+  res_q_drained <= res_q_count_eq_k_0_5 or and_44;
+  res_q_bypass_c <= res_q_push and res_q_drained;
+  k_1_5_lt_res_q_count <= "1" when k_1_5 < res_q_count else "0";
+  or_47 <= res_q_push or k_1_5_lt_res_q_count;
+  not_res_take <= not res_take;
+  and_48 <= res_q_one_left and not_res_take;
+  res_q_nonempty_c <= or_47 or and_48;
   res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
   res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
   res_take_c <= res_q_nonempty and res_ready;
   rs_done_valid_r <= resize(done_valid_r, 6);
-  minus_47 <= res_credits - rs_done_valid_r;
+  minus_50 <= res_credits - rs_done_valid_r;
   rs_res_take_1 <= resize(res_take, 6);
-  res_credits_next <= minus_47 + rs_res_take_1;
+  res_credits_next <= minus_50 + rs_res_take_1;
   bits_res_credits_next <= unsigned(res_credits_next(5 downto 1));
-  ne_49 <= "1" when bits_res_credits_next /= k_0_5 else "0";
+  ne_52 <= "1" when bits_res_credits_next /= k_0_5 else "0";
   res_t_q <= unsigned(res_q_head0(29 downto 0));
   res_tri_q <= unsigned(res_q_head0(42 downto 30));
   res_hit_q <= unsigned(res_q_head0(43 downto 43));
@@ -1389,7 +1404,7 @@ begin
       if rst = '1' then
         res_q_nonempty <= unsigned'("0");
       else
-        res_q_nonempty <= ne_45;
+        res_q_nonempty <= res_q_nonempty_c;
       end if;
       res_q_din0 <= cat_40;
       res_q_q0 <= res_q_mem0(to_integer(res_q_rd_next));

@@ -569,18 +569,29 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] unpark_q_after_pop;
   wire [6:0] rs_unpark_q_push;
   wire [6:0] unpark_q_count_next;
-  reg [0:0] unpark_q_bypass = 1'h0;
   wire [6:0] k_0_3 = 7'h00;
-  wire [0:0] eq_81;
+  wire [0:0] unpark_q_count_eq_k_0_3;
+  wire [6:0] k_1_1 = 7'h01;
+  wire [0:0] unpark_q_one_left;
+  wire [0:0] and_81;
+  wire [0:0] unpark_q_drained;
+  reg [0:0] unpark_q_bypass = 1'h0;
   wire [0:0] unpark_q_bypass_c;
+  reg [0:0] unpark_q_popped = 1'h0;
   reg [0:0] unpark_q_nonempty = 1'h0;
-  wire [0:0] ne_82;
+  wire [0:0] k_1_1_lt_unpark_q_count;
+  wire [0:0] or_84;
+  wire [0:0] not_unpark_pop;
+  wire [0:0] and_85;
+  wire [0:0] unpark_q_nonempty_c;
   reg [11:0] unpark_q_din = 12'h000;
-  reg [11:0] unpark_q_q = 12'h000;
+  reg [11:0] unpark_q_q_stay = 12'h000;
+  reg [11:0] unpark_q_q_next = 12'h000;
+  wire [11:0] mux_unpark_q_popped;
   reg [11:0] unpark_q_din_r = 12'h000;
   wire [11:0] unpark_q_head;
   wire [31:0] u_new_tmax;
-  wire [38:0] cat_83;
+  wire [38:0] cat_86;
   reg [0:0] new_q_push = 1'h0;
   reg [5:0] new_q_wr = 6'h00;
   reg [5:0] new_q_rd = 6'h00;
@@ -595,20 +606,30 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] new_q_after_pop;
   wire [6:0] rs_new_q_push;
   wire [6:0] new_q_count_next;
+  wire [0:0] new_q_count_eq_k_0_3;
+  wire [0:0] new_q_one_left;
+  wire [0:0] and_89;
+  wire [0:0] new_q_drained;
   reg [0:0] new_q_bypass = 1'h0;
-  wire [0:0] new_q_after_pop_eq_k_0_3;
   wire [0:0] new_q_bypass_c;
+  reg [0:0] new_q_popped = 1'h0;
   reg [0:0] new_q_nonempty = 1'h0;
-  wire [0:0] ne_87;
+  wire [0:0] k_1_1_lt_new_q_count;
+  wire [0:0] or_92;
+  wire [0:0] not_new_pop;
+  wire [0:0] and_93;
+  wire [0:0] new_q_nonempty_c;
   reg [38:0] new_q_din = 39'h0000000000;
-  reg [38:0] new_q_q = 39'h0000000000;
+  reg [38:0] new_q_q_stay = 39'h0000000000;
+  reg [38:0] new_q_q_next = 39'h0000000000;
+  wire [38:0] mux_new_q_popped;
   reg [38:0] new_q_din_r = 39'h0000000000;
   wire [38:0] new_q_head;
   wire [0:0] not_ring_g_valid;
   wire [0:0] take_unpark;
   wire [0:0] not_ring_g_valid_1;
   wire [0:0] not_unpark_q_nonempty;
-  wire [0:0] and_89;
+  wire [0:0] and_95;
   wire [0:0] take_new;
   wire [0:0] take_unpark_or_take_new;
   reg [0:0] q_valid = 1'h0;
@@ -619,9 +640,9 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [5:0] q_slot = 6'h00;
   wire [5:0] bits_unpark_q_head_1;
   reg [5:0] q_sp = 6'h00;
-  wire [0:0] eq_91;
+  wire [0:0] eq_97;
   reg [0:0] q_sp_zero = 1'h0;
-  wire [5:0] minus_92;
+  wire [5:0] minus_98;
   reg [5:0] q_sp_m1 = 6'h00;
   wire [31:0] bits_new_q_head_1;
   wire signed [31:0] s_bits_new_q_head_1;
@@ -654,7 +675,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] a_sp_m1;
   wire [0:0] a_pop_and_a_sp_zero;
   wire [0:0] a_new_and_q_miss;
-  wire [0:0] or_93;
+  wire [0:0] or_99;
   wire [0:0] a_done;
   wire [0:0] not_a_sp_zero;
   wire [0:0] a_from_stack;
@@ -707,13 +728,23 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] done_q_after_pop;
   wire [6:0] rs_done_q_push;
   wire [6:0] done_q_count_next;
+  wire [0:0] done_q_count_eq_k_0_3;
+  wire [0:0] done_q_one_left;
+  wire [0:0] and_103;
+  wire [0:0] done_q_drained;
   reg [0:0] done_q_bypass = 1'h0;
-  wire [0:0] eq_97;
   wire [0:0] done_q_bypass_c;
+  reg [0:0] done_q_popped = 1'h0;
   reg [0:0] done_q_nonempty = 1'h0;
-  wire [0:0] ne_98;
+  wire [0:0] k_1_1_lt_done_q_count;
+  wire [0:0] or_106;
+  wire [0:0] not_done_pop_r;
+  wire [0:0] and_107;
+  wire [0:0] done_q_nonempty_c;
   reg [5:0] done_q_din = 6'h00;
-  reg [5:0] done_q_q = 6'h00;
+  reg [5:0] done_q_q_stay = 6'h00;
+  reg [5:0] done_q_q_next = 6'h00;
+  wire [5:0] mux_done_q_popped;
   reg [5:0] done_q_din_r = 6'h00;
   wire [5:0] done_q_head;
 
@@ -809,13 +840,13 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_s_limit_q;
   wire signed [32:0] rs_cull_x;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_100;
+  wire signed [32:0] minus_109;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_minus_100;
+  wire [0:0] bits_minus_109;
   wire [0:0] culled_c;
   reg [0:0] culled = 1'h0;
   reg [0:0] culled_n = 1'h0;
-  wire [0:0] and_102;
+  wire [0:0] and_111;
   wire [0:0] merge_slot_eq_k_63;
   wire [0:0] merge_slot_eq_k_62;
   wire [0:0] merge_slot_eq_k_61;
@@ -880,7 +911,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] merge_slot_eq_k_2;
   wire [0:0] merge_slot_eq_k_1;
   wire [0:0] merge_slot_eq_k_0_1;
-  wire [63:0] cat_103;
+  wire [63:0] cat_112;
   wire [63:0] best_set;
   wire [0:0] a_new_and_a_valid;
   wire [0:0] a_slot_eq_k_63;
@@ -947,11 +978,11 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] a_slot_eq_k_2;
   wire [0:0] a_slot_eq_k_1;
   wire [0:0] a_slot_eq_k_0_1;
-  wire [63:0] cat_104;
+  wire [63:0] cat_113;
   wire [63:0] best_clear;
   wire [63:0] not_best_clear;
-  wire [63:0] and_105;
-  wire [63:0] and_105_or_best_set;
+  wire [63:0] and_114;
+  wire [63:0] and_114_or_best_set;
 
   // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   reg [0:0] n_valid_1 = 1'h0;
@@ -997,7 +1028,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [31:0] u_n_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_n_tmin;
-  wire [58:0] cat_109;
+  wire [58:0] cat_118;
   reg [0:0] leaf_pop_r = 1'h0;
   reg [0:0] leaf_q_push = 1'h0;
   reg [5:0] leaf_q_wr = 6'h00;
@@ -1013,13 +1044,23 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] leaf_q_after_pop;
   wire [6:0] rs_leaf_q_push;
   wire [6:0] leaf_q_count_next;
+  wire [0:0] leaf_q_count_eq_k_0_3;
+  wire [0:0] leaf_q_one_left;
+  wire [0:0] and_121;
+  wire [0:0] leaf_q_drained;
   reg [0:0] leaf_q_bypass = 1'h0;
-  wire [0:0] eq_112;
   wire [0:0] leaf_q_bypass_c;
+  reg [0:0] leaf_q_popped = 1'h0;
   reg [0:0] leaf_q_nonempty = 1'h0;
-  wire [0:0] ne_113;
+  wire [0:0] k_1_1_lt_leaf_q_count;
+  wire [0:0] or_124;
+  wire [0:0] not_leaf_pop_r;
+  wire [0:0] and_125;
+  wire [0:0] leaf_q_nonempty_c;
   reg [58:0] leaf_q_din = 59'h000000000000000;
-  reg [58:0] leaf_q_q = 59'h000000000000000;
+  reg [58:0] leaf_q_q_stay = 59'h000000000000000;
+  reg [58:0] leaf_q_q_next = 59'h000000000000000;
+  wire [58:0] mux_leaf_q_popped;
   reg [58:0] leaf_q_din_r = 59'h000000000000000;
   wire [58:0] leaf_q_head;
   (* mem2reg *) reg [5:0] n_ray_slot_early_sr [1:2];
@@ -1098,7 +1139,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   /* verilator lint_off UNUSEDSIGNAL */  // not read
   reg [0:0] plane_t_last = 1'h0;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] k_1_1 = 1'h1;
+  wire [0:0] k_1_2 = 1'h1;
   reg [0:0] pu_sel_valid_1 = 1'h0;
   reg [0:0] pu_sel_last_1 = 1'h0;
   reg [28:0] pu_sel_plane_1 = 29'h00000000;
@@ -1133,7 +1174,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] pu_below_1;
   wire [0:0] not_pu_below_1;
   wire [30:0] bits_pu_shifted_1;
-  wire [0:0] ne_118;
+  wire [0:0] ne_130;
   wire [0:0] pu_above_1;
   wire signed [31:0] rs_pu_shifted_1;
   reg [0:0] pu_above_r_1 = 1'h0;
@@ -1218,7 +1259,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [0:0] negative_n1 = 1'h0;
   reg signed [31:0] tmin_n1 = 32'sh00000000;
   reg signed [31:0] tmax_n1 = 32'sh00000000;
-  wire signed [31:0] k_1_2 = 32'sh00000001;
+  wire signed [31:0] k_1_3 = 32'sh00000001;
   wire signed [31:0] tmax_plus_1;
   reg signed [31:0] tmax_p1 = 32'sh00000000;
   wire signed [31:0] tmin_minus_1;
@@ -1226,7 +1267,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_tmin_n1;
   wire signed [32:0] rs_tmax_p1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_122;
+  wire signed [32:0] minus_134;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
@@ -1267,25 +1308,25 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_123;
+  wire signed [32:0] minus_135;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below;
   wire signed [32:0] rs_d0_lo;
   wire signed [32:0] rs_plane_t_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_124;
+  wire signed [32:0] minus_136;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_above;
   wire signed [32:0] rs_plane_t_1_1;
   wire signed [32:0] rs_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_125;
+  wire signed [32:0] minus_137;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
   wire signed [32:0] rs_d1_lo;
   wire signed [32:0] rs_plane_t_1_2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_126;
+  wire signed [32:0] minus_138;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
@@ -1310,8 +1351,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [0:0] g_negative = 1'h0;
 
   // stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  wire [12:0] k_1_3 = 13'h0001;
-  wire [12:0] g_child_plus_k_1_3;
+  wire [12:0] k_1_4 = 13'h0001;
+  wire [12:0] g_child_plus_k_1_4;
   wire [12:0] near;
   wire [12:0] far;
   wire signed [31:0] near_max;
@@ -1322,10 +1363,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] enter_far;
   wire [0:0] push;
   wire [4:0] rs_g_sp;
-  wire [10:0] cat_128;
+  wire [10:0] cat_140;
   wire [31:0] u_far_min;
   wire [31:0] u_g_tmax;
-  wire [76:0] cat_129;
+  wire [76:0] cat_141;
   wire [0:0] enter_near_or_enter_far;
   wire [0:0] not_enter_near_or_enter_far;
   wire [12:0] mux_enter_near;
@@ -1335,7 +1376,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] mux_push;
   wire [0:0] not_push;
   wire [0:0] g_sp_eq_k_0_1;
-  wire [0:0] and_130;
+  wire [0:0] and_142;
   wire [5:0] g_sp_minus_k_1;
   wire [5:0] mux_push_1;
 
@@ -1785,12 +1826,20 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign unpark_q_after_pop = unpark_q_count - rs_unpark_pop;
   assign rs_unpark_q_push = {{6{1'b0}}, unpark_q_push};
   assign unpark_q_count_next = unpark_q_after_pop + rs_unpark_q_push;
-  assign eq_81 = unpark_q_after_pop == k_0_3;
-  assign unpark_q_bypass_c = unpark_q_push & eq_81;
-  assign ne_82 = unpark_q_count_next != k_0_3;
-  assign unpark_q_head = unpark_q_bypass ? unpark_q_din_r : unpark_q_q;
+  assign unpark_q_count_eq_k_0_3 = unpark_q_count == k_0_3;
+  assign unpark_q_one_left = unpark_q_count == k_1_1;
+  assign and_81 = unpark_q_one_left & unpark_pop;
+  assign unpark_q_drained = unpark_q_count_eq_k_0_3 | and_81;
+  assign unpark_q_bypass_c = unpark_q_push & unpark_q_drained;
+  assign k_1_1_lt_unpark_q_count = k_1_1 < unpark_q_count;
+  assign or_84 = unpark_q_push | k_1_1_lt_unpark_q_count;
+  assign not_unpark_pop = ~unpark_pop;
+  assign and_85 = unpark_q_one_left & not_unpark_pop;
+  assign unpark_q_nonempty_c = or_84 | and_85;
+  assign mux_unpark_q_popped = unpark_q_popped ? unpark_q_q_next : unpark_q_q_stay;
+  assign unpark_q_head = unpark_q_bypass ? unpark_q_din_r : mux_unpark_q_popped;
   assign u_new_tmax = $unsigned(new_tmax);
-  assign cat_83 = {new_slot, u_new_tmax, new_miss};
+  assign cat_86 = {new_slot, u_new_tmax, new_miss};
   assign new_q_wr_plus_k_1 = new_q_wr + k_1;
   assign mux_new_q_push = new_q_push ? new_q_wr_plus_k_1 : new_q_wr;
   assign new_q_rd_next = new_pop ? new_q_rd1 : new_q_rd;
@@ -1800,23 +1849,31 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign new_q_after_pop = new_q_count - rs_new_pop;
   assign rs_new_q_push = {{6{1'b0}}, new_q_push};
   assign new_q_count_next = new_q_after_pop + rs_new_q_push;
-  assign new_q_after_pop_eq_k_0_3 = new_q_after_pop == k_0_3;
-  assign new_q_bypass_c = new_q_push & new_q_after_pop_eq_k_0_3;
-  assign ne_87 = new_q_count_next != k_0_3;
-  assign new_q_head = new_q_bypass ? new_q_din_r : new_q_q;
+  assign new_q_count_eq_k_0_3 = new_q_count == k_0_3;
+  assign new_q_one_left = new_q_count == k_1_1;
+  assign and_89 = new_q_one_left & new_pop;
+  assign new_q_drained = new_q_count_eq_k_0_3 | and_89;
+  assign new_q_bypass_c = new_q_push & new_q_drained;
+  assign k_1_1_lt_new_q_count = k_1_1 < new_q_count;
+  assign or_92 = new_q_push | k_1_1_lt_new_q_count;
+  assign not_new_pop = ~new_pop;
+  assign and_93 = new_q_one_left & not_new_pop;
+  assign new_q_nonempty_c = or_92 | and_93;
+  assign mux_new_q_popped = new_q_popped ? new_q_q_next : new_q_q_stay;
+  assign new_q_head = new_q_bypass ? new_q_din_r : mux_new_q_popped;
   assign not_ring_g_valid = ~ring_g_valid;
   assign take_unpark = not_ring_g_valid & unpark_q_nonempty;
   assign not_ring_g_valid_1 = ~ring_g_valid;
   assign not_unpark_q_nonempty = ~unpark_q_nonempty;
-  assign and_89 = not_ring_g_valid_1 & not_unpark_q_nonempty;
-  assign take_new = and_89 & new_q_nonempty;
+  assign and_95 = not_ring_g_valid_1 & not_unpark_q_nonempty;
+  assign take_new = and_95 & new_q_nonempty;
   assign take_unpark_or_take_new = take_unpark | take_new;
   assign bits_unpark_q_head = unpark_q_head[11:6];
   assign bits_new_q_head = new_q_head[38:33];
   assign mux_take_unpark = take_unpark ? bits_unpark_q_head : bits_new_q_head;
   assign bits_unpark_q_head_1 = unpark_q_head[5:0];
-  assign eq_91 = bits_unpark_q_head_1 == k_0_1;
-  assign minus_92 = bits_unpark_q_head_1 - k_1;
+  assign eq_97 = bits_unpark_q_head_1 == k_0_1;
+  assign minus_98 = bits_unpark_q_head_1 - k_1;
   assign bits_new_q_head_1 = new_q_head[32:1];
   assign s_bits_new_q_head_1 = $signed(bits_new_q_head_1);
   assign bits_new_q_head_2 = new_q_head[0];
@@ -1834,10 +1891,13 @@ module fxrt_traverse_k64_sf0a3f4 (
     else unpark_q_rd1 <= mux_unpark_pop;
     if (rst) unpark_q_bypass <= 1'h0;
     else unpark_q_bypass <= unpark_q_bypass_c;
+    if (rst) unpark_q_popped <= 1'h0;
+    else unpark_q_popped <= unpark_pop;
     if (rst) unpark_q_nonempty <= 1'h0;
-    else unpark_q_nonempty <= ne_82;
+    else unpark_q_nonempty <= unpark_q_nonempty_c;
     unpark_q_din <= cat_78;
-    unpark_q_q <= unpark_q_mem[unpark_q_rd_next];
+    unpark_q_q_stay <= unpark_q_mem[unpark_q_rd];
+    unpark_q_q_next <= unpark_q_mem[unpark_q_rd1];
     if (unpark_q_push) unpark_q_din_r <= unpark_q_din;
     if (rst) new_q_push <= 1'h0;
     else new_q_push <= new_valid;
@@ -1851,18 +1911,21 @@ module fxrt_traverse_k64_sf0a3f4 (
     else new_q_rd1 <= mux_new_pop;
     if (rst) new_q_bypass <= 1'h0;
     else new_q_bypass <= new_q_bypass_c;
+    if (rst) new_q_popped <= 1'h0;
+    else new_q_popped <= new_pop;
     if (rst) new_q_nonempty <= 1'h0;
-    else new_q_nonempty <= ne_87;
-    new_q_din <= cat_83;
-    new_q_q <= new_q_mem[new_q_rd_next];
+    else new_q_nonempty <= new_q_nonempty_c;
+    new_q_din <= cat_86;
+    new_q_q_stay <= new_q_mem[new_q_rd];
+    new_q_q_next <= new_q_mem[new_q_rd1];
     if (new_q_push) new_q_din_r <= new_q_din;
     if (rst) q_valid <= 1'h0;
     else q_valid <= take_unpark_or_take_new;
     q_new <= take_new;
     q_slot <= mux_take_unpark;
     q_sp <= bits_unpark_q_head_1;
-    q_sp_zero <= eq_91;
-    q_sp_m1 <= minus_92;
+    q_sp_zero <= eq_97;
+    q_sp_m1 <= minus_98;
     q_tmax <= s_bits_new_q_head_1;
     q_miss <= bits_new_q_head_2;
   end
@@ -1873,7 +1936,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (rst) r_valid <= 1'h0;
     else r_valid <= g_valid;
     r_pop <= not_enter_near_or_enter_far;
-    r_sp_zero <= and_130;
+    r_sp_zero <= and_142;
     r_sp_m1 <= mux_push_1;
     r_slot <= g_slot;
     r_node <= mux_enter_near;
@@ -1896,13 +1959,13 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign a_sp_m1 = r_valid ? r_sp_m1 : q_sp_m1;
   assign a_pop_and_a_sp_zero = a_pop & a_sp_zero;
   assign a_new_and_q_miss = a_new & q_miss;
-  assign or_93 = a_pop_and_a_sp_zero | a_new_and_q_miss;
-  assign a_done = a_valid & or_93;
+  assign or_99 = a_pop_and_a_sp_zero | a_new_and_q_miss;
+  assign a_done = a_valid & or_99;
   assign not_a_sp_zero = ~a_sp_zero;
   assign a_from_stack = a_pop & not_a_sp_zero;
   assign stack_we = push;
-  assign stack_waddr = cat_128;
-  assign stack_wdata = cat_129;
+  assign stack_waddr = cat_140;
+  assign stack_wdata = cat_141;
   assign rs_a_sp_m1 = a_sp_m1[4:0];
   assign stack_raddr = {a_slot, rs_a_sp_m1};
 
@@ -1944,10 +2007,18 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign done_q_after_pop = done_q_count - rs_done_pop_r;
   assign rs_done_q_push = {{6{1'b0}}, done_q_push};
   assign done_q_count_next = done_q_after_pop + rs_done_q_push;
-  assign eq_97 = done_q_after_pop == k_0_3;
-  assign done_q_bypass_c = done_q_push & eq_97;
-  assign ne_98 = done_q_count_next != k_0_3;
-  assign done_q_head = done_q_bypass ? done_q_din_r : done_q_q;
+  assign done_q_count_eq_k_0_3 = done_q_count == k_0_3;
+  assign done_q_one_left = done_q_count == k_1_1;
+  assign and_103 = done_q_one_left & done_pop_r;
+  assign done_q_drained = done_q_count_eq_k_0_3 | and_103;
+  assign done_q_bypass_c = done_q_push & done_q_drained;
+  assign k_1_1_lt_done_q_count = k_1_1 < done_q_count;
+  assign or_106 = done_q_push | k_1_1_lt_done_q_count;
+  assign not_done_pop_r = ~done_pop_r;
+  assign and_107 = done_q_one_left & not_done_pop_r;
+  assign done_q_nonempty_c = or_106 | and_107;
+  assign mux_done_q_popped = done_q_popped ? done_q_q_next : done_q_q_stay;
+  assign done_q_head = done_q_bypass ? done_q_din_r : mux_done_q_popped;
 
   always @(posedge clk) begin : done_regs
     if (rst) done_pop_r <= 1'h0;
@@ -1964,10 +2035,13 @@ module fxrt_traverse_k64_sf0a3f4 (
     else done_q_rd1 <= mux_done_pop_r;
     if (rst) done_q_bypass <= 1'h0;
     else done_q_bypass <= done_q_bypass_c;
+    if (rst) done_q_popped <= 1'h0;
+    else done_q_popped <= done_pop_r;
     if (rst) done_q_nonempty <= 1'h0;
-    else done_q_nonempty <= ne_98;
+    else done_q_nonempty <= done_q_nonempty_c;
     done_q_din <= a_slot;
-    done_q_q <= done_q_mem[done_q_rd_next];
+    done_q_q_stay <= done_q_mem[done_q_rd];
+    done_q_q_next <= done_q_mem[done_q_rd1];
     if (done_q_push) done_q_din_r <= done_q_din;
   end
 
@@ -2117,10 +2191,10 @@ module fxrt_traverse_k64_sf0a3f4 (
     k_0;
   assign rs_s_limit_q = $signed({{1{s_limit_q[31]}}, s_limit_q});
   assign rs_cull_x = $signed({{1{cull_x[31]}}, cull_x});
-  assign minus_100 = rs_s_limit_q - rs_cull_x;
-  assign bits_minus_100 = minus_100[32];
-  assign culled_c = cull_has_best & bits_minus_100;
-  assign and_102 = merge_valid & merge_hit;
+  assign minus_109 = rs_s_limit_q - rs_cull_x;
+  assign bits_minus_109 = minus_109[32];
+  assign culled_c = cull_has_best & bits_minus_109;
+  assign and_111 = merge_valid & merge_hit;
   assign merge_slot_eq_k_63 = merge_slot == k_63;
   assign merge_slot_eq_k_62 = merge_slot == k_62;
   assign merge_slot_eq_k_61 = merge_slot == k_61;
@@ -2185,8 +2259,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign merge_slot_eq_k_2 = merge_slot == k_2;
   assign merge_slot_eq_k_1 = merge_slot == k_1;
   assign merge_slot_eq_k_0_1 = merge_slot == k_0_1;
-  assign cat_103 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
-  assign best_set = and_102 ? cat_103 : k_0_2;
+  assign cat_112 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
+  assign best_set = and_111 ? cat_112 : k_0_2;
   assign a_new_and_a_valid = a_new & a_valid;
   assign a_slot_eq_k_63 = a_slot == k_63;
   assign a_slot_eq_k_62 = a_slot == k_62;
@@ -2252,11 +2326,11 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign a_slot_eq_k_2 = a_slot == k_2;
   assign a_slot_eq_k_1 = a_slot == k_1;
   assign a_slot_eq_k_0_1 = a_slot == k_0_1;
-  assign cat_104 = {a_slot_eq_k_63, a_slot_eq_k_62, a_slot_eq_k_61, a_slot_eq_k_60, a_slot_eq_k_59, a_slot_eq_k_58, a_slot_eq_k_57, a_slot_eq_k_56, a_slot_eq_k_55, a_slot_eq_k_54, a_slot_eq_k_53, a_slot_eq_k_52, a_slot_eq_k_51, a_slot_eq_k_50, a_slot_eq_k_49, a_slot_eq_k_48, a_slot_eq_k_47, a_slot_eq_k_46, a_slot_eq_k_45, a_slot_eq_k_44, a_slot_eq_k_43, a_slot_eq_k_42, a_slot_eq_k_41, a_slot_eq_k_40, a_slot_eq_k_39, a_slot_eq_k_38, a_slot_eq_k_37, a_slot_eq_k_36, a_slot_eq_k_35, a_slot_eq_k_34, a_slot_eq_k_33, a_slot_eq_k_32, a_slot_eq_k_31, a_slot_eq_k_30, a_slot_eq_k_29, a_slot_eq_k_28, a_slot_eq_k_27, a_slot_eq_k_26, a_slot_eq_k_25, a_slot_eq_k_24, a_slot_eq_k_23, a_slot_eq_k_22, a_slot_eq_k_21, a_slot_eq_k_20, a_slot_eq_k_19, a_slot_eq_k_18, a_slot_eq_k_17, a_slot_eq_k_16, a_slot_eq_k_15, a_slot_eq_k_14, a_slot_eq_k_13, a_slot_eq_k_12, a_slot_eq_k_11, a_slot_eq_k_10, a_slot_eq_k_9, a_slot_eq_k_8, a_slot_eq_k_7, a_slot_eq_k_6, a_slot_eq_k_5, a_slot_eq_k_4, a_slot_eq_k_3, a_slot_eq_k_2, a_slot_eq_k_1, a_slot_eq_k_0_1};
-  assign best_clear = a_new_and_a_valid ? cat_104 : k_0_2;
+  assign cat_113 = {a_slot_eq_k_63, a_slot_eq_k_62, a_slot_eq_k_61, a_slot_eq_k_60, a_slot_eq_k_59, a_slot_eq_k_58, a_slot_eq_k_57, a_slot_eq_k_56, a_slot_eq_k_55, a_slot_eq_k_54, a_slot_eq_k_53, a_slot_eq_k_52, a_slot_eq_k_51, a_slot_eq_k_50, a_slot_eq_k_49, a_slot_eq_k_48, a_slot_eq_k_47, a_slot_eq_k_46, a_slot_eq_k_45, a_slot_eq_k_44, a_slot_eq_k_43, a_slot_eq_k_42, a_slot_eq_k_41, a_slot_eq_k_40, a_slot_eq_k_39, a_slot_eq_k_38, a_slot_eq_k_37, a_slot_eq_k_36, a_slot_eq_k_35, a_slot_eq_k_34, a_slot_eq_k_33, a_slot_eq_k_32, a_slot_eq_k_31, a_slot_eq_k_30, a_slot_eq_k_29, a_slot_eq_k_28, a_slot_eq_k_27, a_slot_eq_k_26, a_slot_eq_k_25, a_slot_eq_k_24, a_slot_eq_k_23, a_slot_eq_k_22, a_slot_eq_k_21, a_slot_eq_k_20, a_slot_eq_k_19, a_slot_eq_k_18, a_slot_eq_k_17, a_slot_eq_k_16, a_slot_eq_k_15, a_slot_eq_k_14, a_slot_eq_k_13, a_slot_eq_k_12, a_slot_eq_k_11, a_slot_eq_k_10, a_slot_eq_k_9, a_slot_eq_k_8, a_slot_eq_k_7, a_slot_eq_k_6, a_slot_eq_k_5, a_slot_eq_k_4, a_slot_eq_k_3, a_slot_eq_k_2, a_slot_eq_k_1, a_slot_eq_k_0_1};
+  assign best_clear = a_new_and_a_valid ? cat_113 : k_0_2;
   assign not_best_clear = ~best_clear;
-  assign and_105 = has_best & not_best_clear;
-  assign and_105_or_best_set = and_105 | best_set;
+  assign and_114 = has_best & not_best_clear;
+  assign and_114_or_best_set = and_114 | best_set;
 
   always @(posedge clk) begin : ring_c_regs
     if (rst) c_valid <= 1'h0;
@@ -2268,7 +2342,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     c_sp <= b2_sp;
     limit_q <= cull_limit[c_slot];
     if (rst) has_best <= 64'h0000000000000000;
-    else has_best <= and_105_or_best_set;
+    else has_best <= and_114_or_best_set;
     cull_x <= tmin_less;
     cull_has_best <= slot_has_best;
     culled <= culled_c;
@@ -2297,7 +2371,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_push = visit_c_and_nw_is_leaf & nw_count_ne_k_0_6;
   assign u_n_tmin = $unsigned(n_tmin);
   assign rs_u_n_tmin = u_n_tmin[30:0];
-  assign cat_109 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
+  assign cat_118 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
   assign leaf_q_wr_plus_k_1 = leaf_q_wr + k_1;
   assign mux_leaf_q_push = leaf_q_push ? leaf_q_wr_plus_k_1 : leaf_q_wr;
   assign leaf_q_rd_next = leaf_pop_r ? leaf_q_rd1 : leaf_q_rd;
@@ -2307,10 +2381,18 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_q_after_pop = leaf_q_count - rs_leaf_pop_r;
   assign rs_leaf_q_push = {{6{1'b0}}, leaf_q_push};
   assign leaf_q_count_next = leaf_q_after_pop + rs_leaf_q_push;
-  assign eq_112 = leaf_q_after_pop == k_0_3;
-  assign leaf_q_bypass_c = leaf_q_push & eq_112;
-  assign ne_113 = leaf_q_count_next != k_0_3;
-  assign leaf_q_head = leaf_q_bypass ? leaf_q_din_r : leaf_q_q;
+  assign leaf_q_count_eq_k_0_3 = leaf_q_count == k_0_3;
+  assign leaf_q_one_left = leaf_q_count == k_1_1;
+  assign and_121 = leaf_q_one_left & leaf_pop_r;
+  assign leaf_q_drained = leaf_q_count_eq_k_0_3 | and_121;
+  assign leaf_q_bypass_c = leaf_q_push & leaf_q_drained;
+  assign k_1_1_lt_leaf_q_count = k_1_1 < leaf_q_count;
+  assign or_124 = leaf_q_push | k_1_1_lt_leaf_q_count;
+  assign not_leaf_pop_r = ~leaf_pop_r;
+  assign and_125 = leaf_q_one_left & not_leaf_pop_r;
+  assign leaf_q_nonempty_c = or_124 | and_125;
+  assign mux_leaf_q_popped = leaf_q_popped ? leaf_q_q_next : leaf_q_q_stay;
+  assign leaf_q_head = leaf_q_bypass ? leaf_q_din_r : mux_leaf_q_popped;
   assign n_ray_slot_early = n_ray_slot_early_sr[2];
   assign bits_ray_o_q = ray_o_q[28:0];
   assign bits_ray_o_q_1 = ray_o_q[57:29];
@@ -2365,8 +2447,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign pu_below_1 = pu_shifted_1[61];
   assign not_pu_below_1 = ~pu_below_1;
   assign bits_pu_shifted_1 = pu_shifted_1[60:30];
-  assign ne_118 = bits_pu_shifted_1 != k_0_7;
-  assign pu_above_1 = not_pu_below_1 & ne_118;
+  assign ne_130 = bits_pu_shifted_1 != k_0_7;
+  assign pu_above_1 = not_pu_below_1 & ne_130;
   assign rs_pu_shifted_1 = $signed(pu_shifted_1[31:0]);
   assign mux_pu_below_r_1 = pu_below_r_1 ? k_m1 : pu_low_r_1;
   assign pu_clamped_1 = pu_above_r_1 ? k_1073741824 : mux_pu_below_r_1;
@@ -2415,10 +2497,13 @@ module fxrt_traverse_k64_sf0a3f4 (
     else leaf_q_rd1 <= mux_leaf_pop_r;
     if (rst) leaf_q_bypass <= 1'h0;
     else leaf_q_bypass <= leaf_q_bypass_c;
+    if (rst) leaf_q_popped <= 1'h0;
+    else leaf_q_popped <= leaf_pop_r;
     if (rst) leaf_q_nonempty <= 1'h0;
-    else leaf_q_nonempty <= ne_113;
-    leaf_q_din <= cat_109;
-    leaf_q_q <= leaf_q_mem[leaf_q_rd_next];
+    else leaf_q_nonempty <= leaf_q_nonempty_c;
+    leaf_q_din <= cat_118;
+    leaf_q_q_stay <= leaf_q_mem[leaf_q_rd];
+    leaf_q_q_next <= leaf_q_mem[leaf_q_rd1];
     if (leaf_q_push) leaf_q_din_r <= leaf_q_din;
     n_ray_slot_early_sr[2] <= n_ray_slot_early_sr[1];
     n_ray_slot_early_sr[1] <= c_slot;
@@ -2468,7 +2553,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     plane_t_last <= pu_clamp_last;
     if (rst) pu_sel_valid_1 <= 1'h0;
     else pu_sel_valid_1 <= is_inner;
-    pu_sel_last_1 <= k_1_1;
+    pu_sel_last_1 <= k_1_2;
     pu_sel_plane_1 <= nw_clip1;
     pu_sel_axis_1 <= nw_axis;
     pu_delta_1 <= pu_diff_1;
@@ -2541,12 +2626,12 @@ module fxrt_traverse_k64_sf0a3f4 (
     (axis_n1 == 2'h2) ? s_ray_invz_q :
     s_ray_invx_q;
   assign bits_case_axis_n1_1 = case_axis_n1_1[47];
-  assign tmax_plus_1 = n_tmax + k_1_2;
-  assign tmin_minus_1 = n_tmin - k_1_2;
+  assign tmax_plus_1 = n_tmax + k_1_3;
+  assign tmin_minus_1 = n_tmin - k_1_3;
   assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
-  assign minus_122 = rs_tmin_n1 - rs_tmax_p1;
-  assign tmin_le_tmax_c = minus_122[32];
+  assign minus_134 = rs_tmin_n1 - rs_tmax_p1;
+  assign tmin_le_tmax_c = minus_134[32];
   assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
   assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
   assign d0_hi = d0_hi_sr[7];
@@ -2561,20 +2646,20 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign d1_lo = d1_lo_sr[7];
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_123 = rs_plane_t - rs_d0_hi;
-  assign d0_below = minus_123[32];
+  assign minus_135 = rs_plane_t - rs_d0_hi;
+  assign d0_below = minus_135[32];
   assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign minus_124 = rs_d0_lo - rs_plane_t_1;
-  assign d0_above = minus_124[32];
+  assign minus_136 = rs_d0_lo - rs_plane_t_1;
+  assign d0_above = minus_136[32];
   assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
   assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_125 = rs_plane_t_1_1 - rs_d1_hi;
-  assign d1_below = minus_125[32];
+  assign minus_137 = rs_plane_t_1_1 - rs_d1_hi;
+  assign d1_below = minus_137[32];
   assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
   assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign minus_126 = rs_d1_lo - rs_plane_t_1_2;
-  assign d1_above = minus_126[32];
+  assign minus_138 = rs_d1_lo - rs_plane_t_1_2;
+  assign d1_above = minus_138[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
   assign go_near_c = negative ? d1_above : d0_above;
@@ -2723,9 +2808,9 @@ module fxrt_traverse_k64_sf0a3f4 (
   end
 
   // stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  assign g_child_plus_k_1_3 = g_child + k_1_3;
-  assign near = g_negative ? g_child_plus_k_1_3 : g_child;
-  assign far = g_negative ? g_child : g_child_plus_k_1_3;
+  assign g_child_plus_k_1_4 = g_child + k_1_4;
+  assign near = g_negative ? g_child_plus_k_1_4 : g_child;
+  assign far = g_negative ? g_child : g_child_plus_k_1_4;
   assign near_max = near_lt_tmax ? near_end : g_tmax;
   assign far_min = far_gt_tmin ? far_start : g_tmin;
   assign enter_near = g_inner & go_near;
@@ -2734,10 +2819,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign enter_far = g_inner_and_not_go_near & go_far;
   assign push = enter_near & go_far;
   assign rs_g_sp = g_sp[4:0];
-  assign cat_128 = {g_slot, rs_g_sp};
+  assign cat_140 = {g_slot, rs_g_sp};
   assign u_far_min = $unsigned(far_min);
   assign u_g_tmax = $unsigned(g_tmax);
-  assign cat_129 = {far, u_far_min, u_g_tmax};
+  assign cat_141 = {far, u_far_min, u_g_tmax};
   assign enter_near_or_enter_far = enter_near | enter_far;
   assign not_enter_near_or_enter_far = ~enter_near_or_enter_far;
   assign mux_enter_near = enter_near ? near : far;
@@ -2747,7 +2832,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign mux_push = push ? g_sp_plus_k_1 : g_sp;
   assign not_push = ~push;
   assign g_sp_eq_k_0_1 = g_sp == k_0_1;
-  assign and_130 = not_push & g_sp_eq_k_0_1;
+  assign and_142 = not_push & g_sp_eq_k_0_1;
   assign g_sp_minus_k_1 = g_sp - k_1;
   assign mux_push_1 = push ? g_sp : g_sp_minus_k_1;
 

@@ -596,18 +596,29 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal unpark_q_after_pop : unsigned(6 downto 0);
   signal rs_unpark_q_push : unsigned(6 downto 0);
   signal unpark_q_count_next : unsigned(6 downto 0);
-  signal unpark_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   constant k_0_3 : unsigned(6 downto 0) := unsigned'("0000000");
-  signal eq_81 : unsigned(0 downto 0);
+  signal unpark_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  constant k_1_1 : unsigned(6 downto 0) := unsigned'("0000001");
+  signal unpark_q_one_left : unsigned(0 downto 0);
+  signal and_81 : unsigned(0 downto 0);
+  signal unpark_q_drained : unsigned(0 downto 0);
+  signal unpark_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal unpark_q_bypass_c : unsigned(0 downto 0);
+  signal unpark_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal unpark_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_82 : unsigned(0 downto 0);
+  signal k_1_1_lt_unpark_q_count : unsigned(0 downto 0);
+  signal or_84 : unsigned(0 downto 0);
+  signal not_unpark_pop : unsigned(0 downto 0);
+  signal and_85 : unsigned(0 downto 0);
+  signal unpark_q_nonempty_c : unsigned(0 downto 0);
   signal unpark_q_din : unsigned(11 downto 0) := unsigned'("000000000000");
-  signal unpark_q_q : unsigned(11 downto 0) := unsigned'("000000000000");
+  signal unpark_q_q_stay : unsigned(11 downto 0) := unsigned'("000000000000");
+  signal unpark_q_q_next : unsigned(11 downto 0) := unsigned'("000000000000");
+  signal mux_unpark_q_popped : unsigned(11 downto 0);
   signal unpark_q_din_r : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_head : unsigned(11 downto 0);
   signal u_new_tmax : unsigned(31 downto 0);
-  signal cat_83 : unsigned(38 downto 0);
+  signal cat_86 : unsigned(38 downto 0);
   signal new_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal new_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal new_q_rd : unsigned(5 downto 0) := unsigned'("000000");
@@ -622,20 +633,30 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal new_q_after_pop : unsigned(6 downto 0);
   signal rs_new_q_push : unsigned(6 downto 0);
   signal new_q_count_next : unsigned(6 downto 0);
+  signal new_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  signal new_q_one_left : unsigned(0 downto 0);
+  signal and_89 : unsigned(0 downto 0);
+  signal new_q_drained : unsigned(0 downto 0);
   signal new_q_bypass : unsigned(0 downto 0) := unsigned'("0");
-  signal new_q_after_pop_eq_k_0_3 : unsigned(0 downto 0);
   signal new_q_bypass_c : unsigned(0 downto 0);
+  signal new_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal new_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_87 : unsigned(0 downto 0);
+  signal k_1_1_lt_new_q_count : unsigned(0 downto 0);
+  signal or_92 : unsigned(0 downto 0);
+  signal not_new_pop : unsigned(0 downto 0);
+  signal and_93 : unsigned(0 downto 0);
+  signal new_q_nonempty_c : unsigned(0 downto 0);
   signal new_q_din : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
-  signal new_q_q : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
+  signal new_q_q_stay : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
+  signal new_q_q_next : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
+  signal mux_new_q_popped : unsigned(38 downto 0);
   signal new_q_din_r : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal new_q_head : unsigned(38 downto 0);
   signal not_ring_g_valid : unsigned(0 downto 0);
   signal take_unpark : unsigned(0 downto 0);
   signal not_ring_g_valid_1 : unsigned(0 downto 0);
   signal not_unpark_q_nonempty : unsigned(0 downto 0);
-  signal and_89 : unsigned(0 downto 0);
+  signal and_95 : unsigned(0 downto 0);
   signal take_new : unsigned(0 downto 0);
   signal take_unpark_or_take_new : unsigned(0 downto 0);
   signal q_valid : unsigned(0 downto 0) := unsigned'("0");
@@ -646,9 +667,9 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal q_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal bits_unpark_q_head_1 : unsigned(5 downto 0);
   signal q_sp : unsigned(5 downto 0) := unsigned'("000000");
-  signal eq_91 : unsigned(0 downto 0);
+  signal eq_97 : unsigned(0 downto 0);
   signal q_sp_zero : unsigned(0 downto 0) := unsigned'("0");
-  signal minus_92 : unsigned(5 downto 0);
+  signal minus_98 : unsigned(5 downto 0);
   signal q_sp_m1 : unsigned(5 downto 0) := unsigned'("000000");
   signal bits_new_q_head_1 : unsigned(31 downto 0);
   signal s_bits_new_q_head_1 : signed(31 downto 0);
@@ -681,7 +702,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal a_sp_m1 : unsigned(5 downto 0);
   signal a_pop_and_a_sp_zero : unsigned(0 downto 0);
   signal a_new_and_q_miss : unsigned(0 downto 0);
-  signal or_93 : unsigned(0 downto 0);
+  signal or_99 : unsigned(0 downto 0);
   signal a_done : unsigned(0 downto 0);
   signal not_a_sp_zero : unsigned(0 downto 0);
   signal a_from_stack : unsigned(0 downto 0);
@@ -733,13 +754,23 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal done_q_after_pop : unsigned(6 downto 0);
   signal rs_done_q_push : unsigned(6 downto 0);
   signal done_q_count_next : unsigned(6 downto 0);
+  signal done_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  signal done_q_one_left : unsigned(0 downto 0);
+  signal and_103 : unsigned(0 downto 0);
+  signal done_q_drained : unsigned(0 downto 0);
   signal done_q_bypass : unsigned(0 downto 0) := unsigned'("0");
-  signal eq_97 : unsigned(0 downto 0);
   signal done_q_bypass_c : unsigned(0 downto 0);
+  signal done_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_98 : unsigned(0 downto 0);
+  signal k_1_1_lt_done_q_count : unsigned(0 downto 0);
+  signal or_106 : unsigned(0 downto 0);
+  signal not_done_pop_r : unsigned(0 downto 0);
+  signal and_107 : unsigned(0 downto 0);
+  signal done_q_nonempty_c : unsigned(0 downto 0);
   signal done_q_din : unsigned(5 downto 0) := unsigned'("000000");
-  signal done_q_q : unsigned(5 downto 0) := unsigned'("000000");
+  signal done_q_q_stay : unsigned(5 downto 0) := unsigned'("000000");
+  signal done_q_q_next : unsigned(5 downto 0) := unsigned'("000000");
+  signal mux_done_q_popped : unsigned(5 downto 0);
   signal done_q_din_r : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_head : unsigned(5 downto 0);
 
@@ -834,12 +865,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal cull_has_best : unsigned(0 downto 0) := unsigned'("0");
   signal rs_s_limit_q : signed(32 downto 0);
   signal rs_cull_x : signed(32 downto 0);
-  signal minus_100 : signed(32 downto 0);
-  signal bits_minus_100 : unsigned(0 downto 0);
+  signal minus_109 : signed(32 downto 0);
+  signal bits_minus_109 : unsigned(0 downto 0);
   signal culled_c : unsigned(0 downto 0);
   signal culled : unsigned(0 downto 0) := unsigned'("0");
   signal culled_n : unsigned(0 downto 0) := unsigned'("0");
-  signal and_102 : unsigned(0 downto 0);
+  signal and_111 : unsigned(0 downto 0);
   signal merge_slot_eq_k_63 : unsigned(0 downto 0);
   signal merge_slot_eq_k_62 : unsigned(0 downto 0);
   signal merge_slot_eq_k_61 : unsigned(0 downto 0);
@@ -904,7 +935,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal merge_slot_eq_k_2 : unsigned(0 downto 0);
   signal merge_slot_eq_k_1 : unsigned(0 downto 0);
   signal merge_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_103 : unsigned(63 downto 0);
+  signal cat_112 : unsigned(63 downto 0);
   signal best_set : unsigned(63 downto 0);
   signal a_new_and_a_valid : unsigned(0 downto 0);
   signal a_slot_eq_k_63 : unsigned(0 downto 0);
@@ -971,11 +1002,11 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal a_slot_eq_k_2 : unsigned(0 downto 0);
   signal a_slot_eq_k_1 : unsigned(0 downto 0);
   signal a_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_104 : unsigned(63 downto 0);
+  signal cat_113 : unsigned(63 downto 0);
   signal best_clear : unsigned(63 downto 0);
   signal not_best_clear : unsigned(63 downto 0);
-  signal and_105 : unsigned(63 downto 0);
-  signal and_105_or_best_set : unsigned(63 downto 0);
+  signal and_114 : unsigned(63 downto 0);
+  signal and_114_or_best_set : unsigned(63 downto 0);
 
   -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   signal n_valid_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1014,7 +1045,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_push : unsigned(0 downto 0);
   signal u_n_tmin : unsigned(31 downto 0);
   signal rs_u_n_tmin : unsigned(30 downto 0);
-  signal cat_109 : unsigned(58 downto 0);
+  signal cat_118 : unsigned(58 downto 0);
   signal leaf_pop_r : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_wr : unsigned(5 downto 0) := unsigned'("000000");
@@ -1030,13 +1061,23 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_q_after_pop : unsigned(6 downto 0);
   signal rs_leaf_q_push : unsigned(6 downto 0);
   signal leaf_q_count_next : unsigned(6 downto 0);
+  signal leaf_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  signal leaf_q_one_left : unsigned(0 downto 0);
+  signal and_121 : unsigned(0 downto 0);
+  signal leaf_q_drained : unsigned(0 downto 0);
   signal leaf_q_bypass : unsigned(0 downto 0) := unsigned'("0");
-  signal eq_112 : unsigned(0 downto 0);
   signal leaf_q_bypass_c : unsigned(0 downto 0);
+  signal leaf_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_113 : unsigned(0 downto 0);
+  signal k_1_1_lt_leaf_q_count : unsigned(0 downto 0);
+  signal or_124 : unsigned(0 downto 0);
+  signal not_leaf_pop_r : unsigned(0 downto 0);
+  signal and_125 : unsigned(0 downto 0);
+  signal leaf_q_nonempty_c : unsigned(0 downto 0);
   signal leaf_q_din : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
-  signal leaf_q_q : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal leaf_q_q_stay : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal leaf_q_q_next : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal mux_leaf_q_popped : unsigned(58 downto 0);
   signal leaf_q_din_r : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_head : unsigned(58 downto 0);
   type n_ray_slot_early_sr_t is array (1 to 2) of unsigned(5 downto 0);
@@ -1103,7 +1144,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal pu_first : unsigned(0 downto 0);
   signal plane_t_valid : unsigned(0 downto 0) := unsigned'("0");
   signal plane_t_last : unsigned(0 downto 0) := unsigned'("0");
-  constant k_1_1 : unsigned(0 downto 0) := unsigned'("1");
+  constant k_1_2 : unsigned(0 downto 0) := unsigned'("1");
   signal pu_sel_valid_1 : unsigned(0 downto 0) := unsigned'("0");
   signal pu_sel_last_1 : unsigned(0 downto 0) := unsigned'("0");
   signal pu_sel_plane_1 : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -1135,7 +1176,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal pu_below_1 : unsigned(0 downto 0);
   signal not_pu_below_1 : unsigned(0 downto 0);
   signal bits_pu_shifted_1 : unsigned(30 downto 0);
-  signal ne_118 : unsigned(0 downto 0);
+  signal ne_130 : unsigned(0 downto 0);
   signal pu_above_1 : unsigned(0 downto 0);
   signal rs_pu_shifted_1 : signed(31 downto 0);
   signal pu_above_r_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1205,14 +1246,14 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal negative_n1 : unsigned(0 downto 0) := unsigned'("0");
   signal tmin_n1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmax_n1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  constant k_1_2 : signed(31 downto 0) := signed'("00000000000000000000000000000001");
+  constant k_1_3 : signed(31 downto 0) := signed'("00000000000000000000000000000001");
   signal tmax_plus_1 : signed(31 downto 0);
   signal tmax_p1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmin_minus_1 : signed(31 downto 0);
   signal tmin_m1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_tmin_n1 : signed(32 downto 0);
   signal rs_tmax_p1 : signed(32 downto 0);
-  signal minus_122 : signed(32 downto 0);
+  signal minus_134 : signed(32 downto 0);
   signal tmin_le_tmax_c : unsigned(0 downto 0);
   signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
   signal tmin_n2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -1247,19 +1288,19 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal d1_lo : signed(31 downto 0);
   signal rs_plane_t : signed(32 downto 0);
   signal rs_d0_hi : signed(32 downto 0);
-  signal minus_123 : signed(32 downto 0);
+  signal minus_135 : signed(32 downto 0);
   signal d0_below : unsigned(0 downto 0);
   signal rs_d0_lo : signed(32 downto 0);
   signal rs_plane_t_1 : signed(32 downto 0);
-  signal minus_124 : signed(32 downto 0);
+  signal minus_136 : signed(32 downto 0);
   signal d0_above : unsigned(0 downto 0);
   signal rs_plane_t_1_1 : signed(32 downto 0);
   signal rs_d1_hi : signed(32 downto 0);
-  signal minus_125 : signed(32 downto 0);
+  signal minus_137 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
   signal rs_d1_lo : signed(32 downto 0);
   signal rs_plane_t_1_2 : signed(32 downto 0);
-  signal minus_126 : signed(32 downto 0);
+  signal minus_138 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
@@ -1283,8 +1324,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal g_negative : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  constant k_1_3 : unsigned(12 downto 0) := unsigned'("0000000000001");
-  signal g_child_plus_k_1_3 : unsigned(12 downto 0);
+  constant k_1_4 : unsigned(12 downto 0) := unsigned'("0000000000001");
+  signal g_child_plus_k_1_4 : unsigned(12 downto 0);
   signal near : unsigned(12 downto 0);
   signal far : unsigned(12 downto 0);
   signal near_max : signed(31 downto 0);
@@ -1295,10 +1336,10 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal enter_far : unsigned(0 downto 0);
   signal push : unsigned(0 downto 0);
   signal rs_g_sp : unsigned(4 downto 0);
-  signal cat_128 : unsigned(10 downto 0);
+  signal cat_140 : unsigned(10 downto 0);
   signal u_far_min : unsigned(31 downto 0);
   signal u_g_tmax : unsigned(31 downto 0);
-  signal cat_129 : unsigned(76 downto 0);
+  signal cat_141 : unsigned(76 downto 0);
   signal enter_near_or_enter_far : unsigned(0 downto 0);
   signal not_enter_near_or_enter_far : unsigned(0 downto 0);
   signal mux_enter_near : unsigned(12 downto 0);
@@ -1308,7 +1349,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal mux_push : unsigned(5 downto 0);
   signal not_push : unsigned(0 downto 0);
   signal g_sp_eq_k_0_1 : unsigned(0 downto 0);
-  signal and_130 : unsigned(0 downto 0);
+  signal and_142 : unsigned(0 downto 0);
   signal g_sp_minus_k_1 : unsigned(5 downto 0);
   signal mux_push_1 : unsigned(5 downto 0);
 begin
@@ -1798,12 +1839,20 @@ begin
   unpark_q_after_pop <= unpark_q_count - rs_unpark_pop;
   rs_unpark_q_push <= resize(unpark_q_push, 7);
   unpark_q_count_next <= unpark_q_after_pop + rs_unpark_q_push;
-  eq_81 <= "1" when unpark_q_after_pop = k_0_3 else "0";
-  unpark_q_bypass_c <= unpark_q_push and eq_81;
-  ne_82 <= "1" when unpark_q_count_next /= k_0_3 else "0";
-  unpark_q_head <= unpark_q_din_r when unpark_q_bypass = "1" else unpark_q_q;
+  unpark_q_count_eq_k_0_3 <= "1" when unpark_q_count = k_0_3 else "0";
+  unpark_q_one_left <= "1" when unpark_q_count = k_1_1 else "0";
+  and_81 <= unpark_q_one_left and unpark_pop;
+  unpark_q_drained <= unpark_q_count_eq_k_0_3 or and_81;
+  unpark_q_bypass_c <= unpark_q_push and unpark_q_drained;
+  k_1_1_lt_unpark_q_count <= "1" when k_1_1 < unpark_q_count else "0";
+  or_84 <= unpark_q_push or k_1_1_lt_unpark_q_count;
+  not_unpark_pop <= not unpark_pop;
+  and_85 <= unpark_q_one_left and not_unpark_pop;
+  unpark_q_nonempty_c <= or_84 or and_85;
+  mux_unpark_q_popped <= unpark_q_q_next when unpark_q_popped = "1" else unpark_q_q_stay;
+  unpark_q_head <= unpark_q_din_r when unpark_q_bypass = "1" else mux_unpark_q_popped;
   u_new_tmax <= unsigned(new_tmax);
-  cat_83 <= unsigned(std_logic_vector'(std_logic_vector(new_slot) & std_logic_vector(u_new_tmax) & std_logic_vector(new_miss)));
+  cat_86 <= unsigned(std_logic_vector'(std_logic_vector(new_slot) & std_logic_vector(u_new_tmax) & std_logic_vector(new_miss)));
   new_q_wr_plus_k_1 <= new_q_wr + k_1;
   mux_new_q_push <= new_q_wr_plus_k_1 when new_q_push = "1" else new_q_wr;
   new_q_rd_next <= new_q_rd1 when new_pop = "1" else new_q_rd;
@@ -1813,23 +1862,31 @@ begin
   new_q_after_pop <= new_q_count - rs_new_pop;
   rs_new_q_push <= resize(new_q_push, 7);
   new_q_count_next <= new_q_after_pop + rs_new_q_push;
-  new_q_after_pop_eq_k_0_3 <= "1" when new_q_after_pop = k_0_3 else "0";
-  new_q_bypass_c <= new_q_push and new_q_after_pop_eq_k_0_3;
-  ne_87 <= "1" when new_q_count_next /= k_0_3 else "0";
-  new_q_head <= new_q_din_r when new_q_bypass = "1" else new_q_q;
+  new_q_count_eq_k_0_3 <= "1" when new_q_count = k_0_3 else "0";
+  new_q_one_left <= "1" when new_q_count = k_1_1 else "0";
+  and_89 <= new_q_one_left and new_pop;
+  new_q_drained <= new_q_count_eq_k_0_3 or and_89;
+  new_q_bypass_c <= new_q_push and new_q_drained;
+  k_1_1_lt_new_q_count <= "1" when k_1_1 < new_q_count else "0";
+  or_92 <= new_q_push or k_1_1_lt_new_q_count;
+  not_new_pop <= not new_pop;
+  and_93 <= new_q_one_left and not_new_pop;
+  new_q_nonempty_c <= or_92 or and_93;
+  mux_new_q_popped <= new_q_q_next when new_q_popped = "1" else new_q_q_stay;
+  new_q_head <= new_q_din_r when new_q_bypass = "1" else mux_new_q_popped;
   not_ring_g_valid <= not ring_g_valid;
   take_unpark <= not_ring_g_valid and unpark_q_nonempty;
   not_ring_g_valid_1 <= not ring_g_valid;
   not_unpark_q_nonempty <= not unpark_q_nonempty;
-  and_89 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
-  take_new <= and_89 and new_q_nonempty;
+  and_95 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
+  take_new <= and_95 and new_q_nonempty;
   take_unpark_or_take_new <= take_unpark or take_new;
   bits_unpark_q_head <= unsigned(unpark_q_head(11 downto 6));
   bits_new_q_head <= unsigned(new_q_head(38 downto 33));
   mux_take_unpark <= bits_unpark_q_head when take_unpark = "1" else bits_new_q_head;
   bits_unpark_q_head_1 <= unsigned(unpark_q_head(5 downto 0));
-  eq_91 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
-  minus_92 <= bits_unpark_q_head_1 - k_1;
+  eq_97 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
+  minus_98 <= bits_unpark_q_head_1 - k_1;
   bits_new_q_head_1 <= unsigned(new_q_head(32 downto 1));
   s_bits_new_q_head_1 <= signed(bits_new_q_head_1);
   bits_new_q_head_2 <= unsigned(new_q_head(0 downto 0));
@@ -1868,12 +1925,18 @@ begin
         unpark_q_bypass <= unpark_q_bypass_c;
       end if;
       if rst = '1' then
+        unpark_q_popped <= unsigned'("0");
+      else
+        unpark_q_popped <= unpark_pop;
+      end if;
+      if rst = '1' then
         unpark_q_nonempty <= unsigned'("0");
       else
-        unpark_q_nonempty <= ne_82;
+        unpark_q_nonempty <= unpark_q_nonempty_c;
       end if;
       unpark_q_din <= cat_78;
-      unpark_q_q <= unpark_q_mem(to_integer(unpark_q_rd_next));
+      unpark_q_q_stay <= unpark_q_mem(to_integer(unpark_q_rd));
+      unpark_q_q_next <= unpark_q_mem(to_integer(unpark_q_rd1));
       if unpark_q_push = "1" then
         unpark_q_din_r <= unpark_q_din;
       end if;
@@ -1908,12 +1971,18 @@ begin
         new_q_bypass <= new_q_bypass_c;
       end if;
       if rst = '1' then
+        new_q_popped <= unsigned'("0");
+      else
+        new_q_popped <= new_pop;
+      end if;
+      if rst = '1' then
         new_q_nonempty <= unsigned'("0");
       else
-        new_q_nonempty <= ne_87;
+        new_q_nonempty <= new_q_nonempty_c;
       end if;
-      new_q_din <= cat_83;
-      new_q_q <= new_q_mem(to_integer(new_q_rd_next));
+      new_q_din <= cat_86;
+      new_q_q_stay <= new_q_mem(to_integer(new_q_rd));
+      new_q_q_next <= new_q_mem(to_integer(new_q_rd1));
       if new_q_push = "1" then
         new_q_din_r <= new_q_din;
       end if;
@@ -1925,8 +1994,8 @@ begin
       q_new <= take_new;
       q_slot <= mux_take_unpark;
       q_sp <= bits_unpark_q_head_1;
-      q_sp_zero <= eq_91;
-      q_sp_m1 <= minus_92;
+      q_sp_zero <= eq_97;
+      q_sp_m1 <= minus_98;
       q_tmax <= s_bits_new_q_head_1;
       q_miss <= bits_new_q_head_2;
     end if;
@@ -1943,7 +2012,7 @@ begin
         r_valid <= g_valid;
       end if;
       r_pop <= not_enter_near_or_enter_far;
-      r_sp_zero <= and_130;
+      r_sp_zero <= and_142;
       r_sp_m1 <= mux_push_1;
       r_slot <= g_slot;
       r_node <= mux_enter_near;
@@ -1967,13 +2036,13 @@ begin
   a_sp_m1 <= r_sp_m1 when r_valid = "1" else q_sp_m1;
   a_pop_and_a_sp_zero <= a_pop and a_sp_zero;
   a_new_and_q_miss <= a_new and q_miss;
-  or_93 <= a_pop_and_a_sp_zero or a_new_and_q_miss;
-  a_done <= a_valid and or_93;
+  or_99 <= a_pop_and_a_sp_zero or a_new_and_q_miss;
+  a_done <= a_valid and or_99;
   not_a_sp_zero <= not a_sp_zero;
   a_from_stack <= a_pop and not_a_sp_zero;
   stack_we <= push;
-  stack_waddr <= cat_128;
-  stack_wdata <= cat_129;
+  stack_waddr <= cat_140;
+  stack_wdata <= cat_141;
   rs_a_sp_m1 <= a_sp_m1(4 downto 0);
   stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(a_slot) & std_logic_vector(rs_a_sp_m1)));
 
@@ -2024,10 +2093,18 @@ begin
   done_q_after_pop <= done_q_count - rs_done_pop_r;
   rs_done_q_push <= resize(done_q_push, 7);
   done_q_count_next <= done_q_after_pop + rs_done_q_push;
-  eq_97 <= "1" when done_q_after_pop = k_0_3 else "0";
-  done_q_bypass_c <= done_q_push and eq_97;
-  ne_98 <= "1" when done_q_count_next /= k_0_3 else "0";
-  done_q_head <= done_q_din_r when done_q_bypass = "1" else done_q_q;
+  done_q_count_eq_k_0_3 <= "1" when done_q_count = k_0_3 else "0";
+  done_q_one_left <= "1" when done_q_count = k_1_1 else "0";
+  and_103 <= done_q_one_left and done_pop_r;
+  done_q_drained <= done_q_count_eq_k_0_3 or and_103;
+  done_q_bypass_c <= done_q_push and done_q_drained;
+  k_1_1_lt_done_q_count <= "1" when k_1_1 < done_q_count else "0";
+  or_106 <= done_q_push or k_1_1_lt_done_q_count;
+  not_done_pop_r <= not done_pop_r;
+  and_107 <= done_q_one_left and not_done_pop_r;
+  done_q_nonempty_c <= or_106 or and_107;
+  mux_done_q_popped <= done_q_q_next when done_q_popped = "1" else done_q_q_stay;
+  done_q_head <= done_q_din_r when done_q_bypass = "1" else mux_done_q_popped;
 
   done_regs : process (clk)
   begin
@@ -2068,12 +2145,18 @@ begin
         done_q_bypass <= done_q_bypass_c;
       end if;
       if rst = '1' then
+        done_q_popped <= unsigned'("0");
+      else
+        done_q_popped <= done_pop_r;
+      end if;
+      if rst = '1' then
         done_q_nonempty <= unsigned'("0");
       else
-        done_q_nonempty <= ne_98;
+        done_q_nonempty <= done_q_nonempty_c;
       end if;
       done_q_din <= a_slot;
-      done_q_q <= done_q_mem(to_integer(done_q_rd_next));
+      done_q_q_stay <= done_q_mem(to_integer(done_q_rd));
+      done_q_q_next <= done_q_mem(to_integer(done_q_rd1));
       if done_q_push = "1" then
         done_q_din_r <= done_q_din;
       end if;
@@ -2227,10 +2310,10 @@ begin
       k_0 when others;
   rs_s_limit_q <= resize(s_limit_q, 33);
   rs_cull_x <= resize(cull_x, 33);
-  minus_100 <= rs_s_limit_q - rs_cull_x;
-  bits_minus_100 <= unsigned(minus_100(32 downto 32));
-  culled_c <= cull_has_best and bits_minus_100;
-  and_102 <= merge_valid and merge_hit;
+  minus_109 <= rs_s_limit_q - rs_cull_x;
+  bits_minus_109 <= unsigned(minus_109(32 downto 32));
+  culled_c <= cull_has_best and bits_minus_109;
+  and_111 <= merge_valid and merge_hit;
   merge_slot_eq_k_63 <= "1" when merge_slot = k_63 else "0";
   merge_slot_eq_k_62 <= "1" when merge_slot = k_62 else "0";
   merge_slot_eq_k_61 <= "1" when merge_slot = k_61 else "0";
@@ -2295,8 +2378,8 @@ begin
   merge_slot_eq_k_2 <= "1" when merge_slot = k_2 else "0";
   merge_slot_eq_k_1 <= "1" when merge_slot = k_1 else "0";
   merge_slot_eq_k_0_1 <= "1" when merge_slot = k_0_1 else "0";
-  cat_103 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
-  best_set <= cat_103 when and_102 = "1" else k_0_2;
+  cat_112 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
+  best_set <= cat_112 when and_111 = "1" else k_0_2;
   a_new_and_a_valid <= a_new and a_valid;
   a_slot_eq_k_63 <= "1" when a_slot = k_63 else "0";
   a_slot_eq_k_62 <= "1" when a_slot = k_62 else "0";
@@ -2362,11 +2445,11 @@ begin
   a_slot_eq_k_2 <= "1" when a_slot = k_2 else "0";
   a_slot_eq_k_1 <= "1" when a_slot = k_1 else "0";
   a_slot_eq_k_0_1 <= "1" when a_slot = k_0_1 else "0";
-  cat_104 <= unsigned(std_logic_vector'(std_logic_vector(a_slot_eq_k_63) & std_logic_vector(a_slot_eq_k_62) & std_logic_vector(a_slot_eq_k_61) & std_logic_vector(a_slot_eq_k_60) & std_logic_vector(a_slot_eq_k_59) & std_logic_vector(a_slot_eq_k_58) & std_logic_vector(a_slot_eq_k_57) & std_logic_vector(a_slot_eq_k_56) & std_logic_vector(a_slot_eq_k_55) & std_logic_vector(a_slot_eq_k_54) & std_logic_vector(a_slot_eq_k_53) & std_logic_vector(a_slot_eq_k_52) & std_logic_vector(a_slot_eq_k_51) & std_logic_vector(a_slot_eq_k_50) & std_logic_vector(a_slot_eq_k_49) & std_logic_vector(a_slot_eq_k_48) & std_logic_vector(a_slot_eq_k_47) & std_logic_vector(a_slot_eq_k_46) & std_logic_vector(a_slot_eq_k_45) & std_logic_vector(a_slot_eq_k_44) & std_logic_vector(a_slot_eq_k_43) & std_logic_vector(a_slot_eq_k_42) & std_logic_vector(a_slot_eq_k_41) & std_logic_vector(a_slot_eq_k_40) & std_logic_vector(a_slot_eq_k_39) & std_logic_vector(a_slot_eq_k_38) & std_logic_vector(a_slot_eq_k_37) & std_logic_vector(a_slot_eq_k_36) & std_logic_vector(a_slot_eq_k_35) & std_logic_vector(a_slot_eq_k_34) & std_logic_vector(a_slot_eq_k_33) & std_logic_vector(a_slot_eq_k_32) & std_logic_vector(a_slot_eq_k_31) & std_logic_vector(a_slot_eq_k_30) & std_logic_vector(a_slot_eq_k_29) & std_logic_vector(a_slot_eq_k_28) & std_logic_vector(a_slot_eq_k_27) & std_logic_vector(a_slot_eq_k_26) & std_logic_vector(a_slot_eq_k_25) & std_logic_vector(a_slot_eq_k_24) & std_logic_vector(a_slot_eq_k_23) & std_logic_vector(a_slot_eq_k_22) & std_logic_vector(a_slot_eq_k_21) & std_logic_vector(a_slot_eq_k_20) & std_logic_vector(a_slot_eq_k_19) & std_logic_vector(a_slot_eq_k_18) & std_logic_vector(a_slot_eq_k_17) & std_logic_vector(a_slot_eq_k_16) & std_logic_vector(a_slot_eq_k_15) & std_logic_vector(a_slot_eq_k_14) & std_logic_vector(a_slot_eq_k_13) & std_logic_vector(a_slot_eq_k_12) & std_logic_vector(a_slot_eq_k_11) & std_logic_vector(a_slot_eq_k_10) & std_logic_vector(a_slot_eq_k_9) & std_logic_vector(a_slot_eq_k_8) & std_logic_vector(a_slot_eq_k_7) & std_logic_vector(a_slot_eq_k_6) & std_logic_vector(a_slot_eq_k_5) & std_logic_vector(a_slot_eq_k_4) & std_logic_vector(a_slot_eq_k_3) & std_logic_vector(a_slot_eq_k_2) & std_logic_vector(a_slot_eq_k_1) & std_logic_vector(a_slot_eq_k_0_1)));
-  best_clear <= cat_104 when a_new_and_a_valid = "1" else k_0_2;
+  cat_113 <= unsigned(std_logic_vector'(std_logic_vector(a_slot_eq_k_63) & std_logic_vector(a_slot_eq_k_62) & std_logic_vector(a_slot_eq_k_61) & std_logic_vector(a_slot_eq_k_60) & std_logic_vector(a_slot_eq_k_59) & std_logic_vector(a_slot_eq_k_58) & std_logic_vector(a_slot_eq_k_57) & std_logic_vector(a_slot_eq_k_56) & std_logic_vector(a_slot_eq_k_55) & std_logic_vector(a_slot_eq_k_54) & std_logic_vector(a_slot_eq_k_53) & std_logic_vector(a_slot_eq_k_52) & std_logic_vector(a_slot_eq_k_51) & std_logic_vector(a_slot_eq_k_50) & std_logic_vector(a_slot_eq_k_49) & std_logic_vector(a_slot_eq_k_48) & std_logic_vector(a_slot_eq_k_47) & std_logic_vector(a_slot_eq_k_46) & std_logic_vector(a_slot_eq_k_45) & std_logic_vector(a_slot_eq_k_44) & std_logic_vector(a_slot_eq_k_43) & std_logic_vector(a_slot_eq_k_42) & std_logic_vector(a_slot_eq_k_41) & std_logic_vector(a_slot_eq_k_40) & std_logic_vector(a_slot_eq_k_39) & std_logic_vector(a_slot_eq_k_38) & std_logic_vector(a_slot_eq_k_37) & std_logic_vector(a_slot_eq_k_36) & std_logic_vector(a_slot_eq_k_35) & std_logic_vector(a_slot_eq_k_34) & std_logic_vector(a_slot_eq_k_33) & std_logic_vector(a_slot_eq_k_32) & std_logic_vector(a_slot_eq_k_31) & std_logic_vector(a_slot_eq_k_30) & std_logic_vector(a_slot_eq_k_29) & std_logic_vector(a_slot_eq_k_28) & std_logic_vector(a_slot_eq_k_27) & std_logic_vector(a_slot_eq_k_26) & std_logic_vector(a_slot_eq_k_25) & std_logic_vector(a_slot_eq_k_24) & std_logic_vector(a_slot_eq_k_23) & std_logic_vector(a_slot_eq_k_22) & std_logic_vector(a_slot_eq_k_21) & std_logic_vector(a_slot_eq_k_20) & std_logic_vector(a_slot_eq_k_19) & std_logic_vector(a_slot_eq_k_18) & std_logic_vector(a_slot_eq_k_17) & std_logic_vector(a_slot_eq_k_16) & std_logic_vector(a_slot_eq_k_15) & std_logic_vector(a_slot_eq_k_14) & std_logic_vector(a_slot_eq_k_13) & std_logic_vector(a_slot_eq_k_12) & std_logic_vector(a_slot_eq_k_11) & std_logic_vector(a_slot_eq_k_10) & std_logic_vector(a_slot_eq_k_9) & std_logic_vector(a_slot_eq_k_8) & std_logic_vector(a_slot_eq_k_7) & std_logic_vector(a_slot_eq_k_6) & std_logic_vector(a_slot_eq_k_5) & std_logic_vector(a_slot_eq_k_4) & std_logic_vector(a_slot_eq_k_3) & std_logic_vector(a_slot_eq_k_2) & std_logic_vector(a_slot_eq_k_1) & std_logic_vector(a_slot_eq_k_0_1)));
+  best_clear <= cat_113 when a_new_and_a_valid = "1" else k_0_2;
   not_best_clear <= not best_clear;
-  and_105 <= has_best and not_best_clear;
-  and_105_or_best_set <= and_105 or best_set;
+  and_114 <= has_best and not_best_clear;
+  and_114_or_best_set <= and_114 or best_set;
 
   ring_c_regs : process (clk)
   begin
@@ -2385,7 +2468,7 @@ begin
       if rst = '1' then
         has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
       else
-        has_best <= and_105_or_best_set;
+        has_best <= and_114_or_best_set;
       end if;
       cull_x <= tmin_less;
       cull_has_best <= slot_has_best;
@@ -2416,7 +2499,7 @@ begin
   leaf_push <= visit_c_and_nw_is_leaf and nw_count_ne_k_0_6;
   u_n_tmin <= unsigned(n_tmin);
   rs_u_n_tmin <= u_n_tmin(30 downto 0);
-  cat_109 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
+  cat_118 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
   leaf_q_wr_plus_k_1 <= leaf_q_wr + k_1;
   mux_leaf_q_push <= leaf_q_wr_plus_k_1 when leaf_q_push = "1" else leaf_q_wr;
   leaf_q_rd_next <= leaf_q_rd1 when leaf_pop_r = "1" else leaf_q_rd;
@@ -2426,10 +2509,18 @@ begin
   leaf_q_after_pop <= leaf_q_count - rs_leaf_pop_r;
   rs_leaf_q_push <= resize(leaf_q_push, 7);
   leaf_q_count_next <= leaf_q_after_pop + rs_leaf_q_push;
-  eq_112 <= "1" when leaf_q_after_pop = k_0_3 else "0";
-  leaf_q_bypass_c <= leaf_q_push and eq_112;
-  ne_113 <= "1" when leaf_q_count_next /= k_0_3 else "0";
-  leaf_q_head <= leaf_q_din_r when leaf_q_bypass = "1" else leaf_q_q;
+  leaf_q_count_eq_k_0_3 <= "1" when leaf_q_count = k_0_3 else "0";
+  leaf_q_one_left <= "1" when leaf_q_count = k_1_1 else "0";
+  and_121 <= leaf_q_one_left and leaf_pop_r;
+  leaf_q_drained <= leaf_q_count_eq_k_0_3 or and_121;
+  leaf_q_bypass_c <= leaf_q_push and leaf_q_drained;
+  k_1_1_lt_leaf_q_count <= "1" when k_1_1 < leaf_q_count else "0";
+  or_124 <= leaf_q_push or k_1_1_lt_leaf_q_count;
+  not_leaf_pop_r <= not leaf_pop_r;
+  and_125 <= leaf_q_one_left and not_leaf_pop_r;
+  leaf_q_nonempty_c <= or_124 or and_125;
+  mux_leaf_q_popped <= leaf_q_q_next when leaf_q_popped = "1" else leaf_q_q_stay;
+  leaf_q_head <= leaf_q_din_r when leaf_q_bypass = "1" else mux_leaf_q_popped;
   n_ray_slot_early <= n_ray_slot_early_sr(2);
   bits_ray_o_q <= unsigned(ray_o_q(28 downto 0));
   bits_ray_o_q_1 <= unsigned(ray_o_q(57 downto 29));
@@ -2488,8 +2579,8 @@ begin
   pu_below_1 <= unsigned(pu_shifted_1(61 downto 61));
   not_pu_below_1 <= not pu_below_1;
   bits_pu_shifted_1 <= unsigned(pu_shifted_1(60 downto 30));
-  ne_118 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
-  pu_above_1 <= not_pu_below_1 and ne_118;
+  ne_130 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
+  pu_above_1 <= not_pu_below_1 and ne_130;
   rs_pu_shifted_1 <= pu_shifted_1(31 downto 0);
   mux_pu_below_r_1 <= k_m1 when pu_below_r_1 = "1" else pu_low_r_1;
   pu_clamped_1 <= k_1073741824 when pu_above_r_1 = "1" else mux_pu_below_r_1;
@@ -2567,12 +2658,18 @@ begin
         leaf_q_bypass <= leaf_q_bypass_c;
       end if;
       if rst = '1' then
+        leaf_q_popped <= unsigned'("0");
+      else
+        leaf_q_popped <= leaf_pop_r;
+      end if;
+      if rst = '1' then
         leaf_q_nonempty <= unsigned'("0");
       else
-        leaf_q_nonempty <= ne_113;
+        leaf_q_nonempty <= leaf_q_nonempty_c;
       end if;
-      leaf_q_din <= cat_109;
-      leaf_q_q <= leaf_q_mem(to_integer(leaf_q_rd_next));
+      leaf_q_din <= cat_118;
+      leaf_q_q_stay <= leaf_q_mem(to_integer(leaf_q_rd));
+      leaf_q_q_next <= leaf_q_mem(to_integer(leaf_q_rd1));
       if leaf_q_push = "1" then
         leaf_q_din_r <= leaf_q_din;
       end if;
@@ -2657,7 +2754,7 @@ begin
       else
         pu_sel_valid_1 <= is_inner;
       end if;
-      pu_sel_last_1 <= k_1_1;
+      pu_sel_last_1 <= k_1_2;
       pu_sel_plane_1 <= nw_clip1;
       pu_sel_axis_1 <= nw_axis;
       pu_delta_1 <= pu_diff_1;
@@ -2755,12 +2852,12 @@ begin
       s_ray_invz_q when "10",
       s_ray_invx_q when others;
   bits_case_axis_n1_1 <= unsigned(case_axis_n1_1(47 downto 47));
-  tmax_plus_1 <= n_tmax + k_1_2;
-  tmin_minus_1 <= n_tmin - k_1_2;
+  tmax_plus_1 <= n_tmax + k_1_3;
+  tmin_minus_1 <= n_tmin - k_1_3;
   rs_tmin_n1 <= resize(tmin_n1, 33);
   rs_tmax_p1 <= resize(tmax_p1, 33);
-  minus_122 <= rs_tmin_n1 - rs_tmax_p1;
-  tmin_le_tmax_c <= unsigned(minus_122(32 downto 32));
+  minus_134 <= rs_tmin_n1 - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(minus_134(32 downto 32));
   mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
   d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
   d0_hi <= d0_hi_sr(7);
@@ -2775,20 +2872,20 @@ begin
   d1_lo <= d1_lo_sr(7);
   rs_plane_t <= resize(plane_t, 33);
   rs_d0_hi <= resize(d0_hi, 33);
-  minus_123 <= rs_plane_t - rs_d0_hi;
-  d0_below <= unsigned(minus_123(32 downto 32));
+  minus_135 <= rs_plane_t - rs_d0_hi;
+  d0_below <= unsigned(minus_135(32 downto 32));
   rs_d0_lo <= resize(d0_lo, 33);
   rs_plane_t_1 <= resize(plane_t, 33);
-  minus_124 <= rs_d0_lo - rs_plane_t_1;
-  d0_above <= unsigned(minus_124(32 downto 32));
+  minus_136 <= rs_d0_lo - rs_plane_t_1;
+  d0_above <= unsigned(minus_136(32 downto 32));
   rs_plane_t_1_1 <= resize(plane_t_1, 33);
   rs_d1_hi <= resize(d1_hi, 33);
-  minus_125 <= rs_plane_t_1_1 - rs_d1_hi;
-  d1_below <= unsigned(minus_125(32 downto 32));
+  minus_137 <= rs_plane_t_1_1 - rs_d1_hi;
+  d1_below <= unsigned(minus_137(32 downto 32));
   rs_d1_lo <= resize(d1_lo, 33);
   rs_plane_t_1_2 <= resize(plane_t_1, 33);
-  minus_126 <= rs_d1_lo - rs_plane_t_1_2;
-  d1_above <= unsigned(minus_126(32 downto 32));
+  minus_138 <= rs_d1_lo - rs_plane_t_1_2;
+  d1_above <= unsigned(minus_138(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
   go_near_c <= d1_above when negative = "1" else d0_above;
@@ -2905,9 +3002,9 @@ begin
   end process ring_f_regs;
 
   -- stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  g_child_plus_k_1_3 <= g_child + k_1_3;
-  near <= g_child_plus_k_1_3 when g_negative = "1" else g_child;
-  far <= g_child when g_negative = "1" else g_child_plus_k_1_3;
+  g_child_plus_k_1_4 <= g_child + k_1_4;
+  near <= g_child_plus_k_1_4 when g_negative = "1" else g_child;
+  far <= g_child when g_negative = "1" else g_child_plus_k_1_4;
   near_max <= near_end when near_lt_tmax = "1" else g_tmax;
   far_min <= far_start when far_gt_tmin = "1" else g_tmin;
   enter_near <= g_inner and go_near;
@@ -2916,10 +3013,10 @@ begin
   enter_far <= g_inner_and_not_go_near and go_far;
   push <= enter_near and go_far;
   rs_g_sp <= g_sp(4 downto 0);
-  cat_128 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
+  cat_140 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
   u_far_min <= unsigned(far_min);
   u_g_tmax <= unsigned(g_tmax);
-  cat_129 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
+  cat_141 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
   enter_near_or_enter_far <= enter_near or enter_far;
   not_enter_near_or_enter_far <= not enter_near_or_enter_far;
   mux_enter_near <= near when enter_near = "1" else far;
@@ -2929,7 +3026,7 @@ begin
   mux_push <= g_sp_plus_k_1 when push = "1" else g_sp;
   not_push <= not push;
   g_sp_eq_k_0_1 <= "1" when g_sp = k_0_1 else "0";
-  and_130 <= not_push and g_sp_eq_k_0_1;
+  and_142 <= not_push and g_sp_eq_k_0_1;
   g_sp_minus_k_1 <= g_sp - k_1;
   mux_push_1 <= g_sp when push = "1" else g_sp_minus_k_1;
 
