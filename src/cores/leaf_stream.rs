@@ -222,7 +222,7 @@ pub fn emission<'b>(
     leaf: &Leaf<'b>,
     rams: &RayRams,
 ) -> Emission<'b> {
-    let (tp, gb, scene_tag) = (&p.trav, p.tag.slot_bits, &p.trav.scene_tag);
+    let (tp, scene_tag) = (&p.trav, &p.trav.scene_tag);
     b.stage("emission", "the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline");
     let (leaf_l, leaf_words) = &scene.leaf;
     let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
@@ -248,9 +248,12 @@ pub fn emission<'b>(
     let trc = p.tri_rom_cycles;
     let valid_d = b.valid_line("pipe_valid", emit_valid, trc);
     let tag_d = b.delay_line("pipe_tag", tag, trc);
-    // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks).
-    let emit_slot = tag.slice(tp.tri_bits + tp.tmin_width() + tp.sp_width(), gb);
-    into_pipeline(b, p, rams, &[emit_slot], trc, [valid_d, tag_d], tri_fields)
+    // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks), its
+    // address from a register per ray RAM (the tag's slot bits fanned out to all of them).
+    let emit_slot =
+        b.delay("emit_slot", if lrc > 1 { b.delay_line("emit_slot_sr", leaf.slot, lrc - 1) } else { leaf.slot });
+    let emit_slots = b.copies(emit_slot, 1 + rams.w.len());
+    into_pipeline(b, p, rams, &emit_slots, trc, [valid_d, tag_d], tri_fields)
 }
 
 /// The intersection pipeline fed a triangle (`valid_tag`: its valid bit and tag, `tri_fields`:
