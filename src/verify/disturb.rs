@@ -236,6 +236,20 @@ mod tests {
         );
     }
 
+    /// A consumer away for 3,000 clocks of every 4,096: the result queue fills to its depth
+    /// and the done queues back up behind it, and still every ray gets exactly one right
+    /// result (a credit promised beyond the queue's depth would overwrite a waiting result).
+    #[test]
+    fn a_consumer_away_for_long_loses_nothing() {
+        let (scene, roms, _, rays) = setup("teapot", 14, 14);
+        // More slots than the queue is deep (with 16 they could never overfill it).
+        let p = CoreParams::new(&roms, 64, 2, crate::cores::clock::DEFAULT_TARGET_MHZ);
+        let d = Disturb { sink: Stalls::block(3_000), ..Disturb::none() };
+        let run = simulate_cycle(&p, &roms, &rays, &Stalls::none(), &d, &|_| {});
+        assert_eq!(mismatches(&scene, &rays, &run.results), 0);
+        assert_eq!(run.results.len(), rays.len());
+    }
+
     /// The shortest latency is a real one and a bound: the box-missing ray's result comes
     /// after it, and no ray of a frame fed one at a time into the idle core is faster.
     #[test]

@@ -81,6 +81,13 @@ impl Stalls {
         Stalls { pattern }
     }
 
+    /// Stalls on the first `cycles` cycles of each period, in one block (a consumer away for a
+    /// while: queues behind it fill up). At most `PERIOD` − 1.
+    pub fn block(cycles: usize) -> Stalls {
+        assert!(cycles < Self::PERIOD, "a stall block of {cycles} cycles");
+        Stalls { pattern: (0..Self::PERIOD).map(|c| c < cycles).collect() }
+    }
+
     /// Whether the source holds back on cycle `cycle`.
     pub fn at(&self, cycle: u64) -> bool {
         !self.pattern.is_empty() && self.pattern[(cycle % Self::PERIOD as u64) as usize]
