@@ -41,6 +41,9 @@ pub struct LineRequest<'b> {
 #[derive(Clone, Copy)]
 pub struct Fill<'b> {
     pub valid: S<'b>,
+    /// What `valid` will be next clock (the bus side's logic before the asker's register): a
+    /// cache computes its record RAMs' write enables from it a clock early, into registers.
+    pub valid_next: S<'b>,
     pub data: S<'b>,
     /// The beat's number in its line.
     pub beat: S<'b>,
@@ -153,14 +156,15 @@ pub fn axi_read<'b>(
     let (data, fill_beat, fill_last) =
         (b.delay("axi_fill_data", rdata), b.delay("axi_fill_beat", beat), b.delay("axi_fill_last", last_beat));
     let fills = (0..n)
-        .map(|k| Fill {
-            valid: b.valid_delay(
-                &format!("axi_fill{k}"),
-                (rvalid & who_nonempty & who.eq(k as i128)).name(&format!("axi_fill{k}_c")),
-            ),
-            data,
-            beat: fill_beat,
-            last: fill_last,
+        .map(|k| {
+            let valid_next = (rvalid & who_nonempty & who.eq(k as i128)).name(&format!("axi_fill{k}_c"));
+            Fill {
+                valid: b.valid_delay(&format!("axi_fill{k}"), valid_next),
+                valid_next,
+                data,
+                beat: fill_beat,
+                last: fill_last,
+            }
         })
         .collect();
     let arlen = b.konst(Ty::u(8), (p.line_beats - 1) as i128);
