@@ -12,6 +12,8 @@ use super::width::Ty;
 pub struct FlatMem {
     pub words: Vec<u128>,
     pub write: Option<(usize, usize, usize)>,
+    /// `Rom::collision_undefined`.
+    pub collision_undefined: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -42,7 +44,7 @@ struct Builder {
     signals: Vec<Global>,
     /// Hierarchical name of each global signal that came from a module's signal list.
     names: Vec<(String, usize)>,
-    mems: Vec<(Vec<u128>, Option<(usize, usize, usize)>)>,
+    mems: Vec<FlatMem>,
 }
 
 impl Builder {
@@ -56,7 +58,7 @@ impl Builder {
         let mem_base = self.mems.len();
         for r in &m.roms {
             let write = r.write.map(|(we, a, d)| (g(we).0 as usize, g(a).0 as usize, g(d).0 as usize));
-            self.mems.push((r.words.clone(), write));
+            self.mems.push(FlatMem { words: r.words.clone(), write, collision_undefined: r.collision_undefined });
         }
         let sub_bases: Vec<usize> = m
             .instances
@@ -141,8 +143,8 @@ pub fn flatten(m: &Module) -> Flat {
     }
     let mems = b
         .mems
-        .iter()
-        .map(|(words, w)| FlatMem { words: words.clone(), write: w.map(|(we, a, d)| (slot[we], slot[a], slot[d])) })
+        .into_iter()
+        .map(|mem| FlatMem { write: mem.write.map(|(we, a, d)| (slot[we], slot[a], slot[d])), ..mem })
         .collect();
     let comb_order = topological(&defs);
     let names = b.names.into_iter().map(|(name, i)| (name, slot[i])).collect();
