@@ -39,6 +39,7 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   (* ram_style = "distributed" *) reg [19:0] ray_ids [0:127];
   initial $readmemh("fxrt_closest_n29_m32_tag59_s128_r2_ray_ids.hex", ray_ids);
 
+  // not in a stage or state machine
   wire [12:0] tri_s;
   wire [30:0] tmin;
   wire [5:0] sp;
@@ -119,9 +120,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] take;
   wire [0:0] in_valid2_2_and_in_first;
-  wire [0:0] k_1 = 1'h1;
-  wire [0:0] mux_in_valid2_2_and_in_first;
-  wire [0:0] mux_take;
+  wire [0:0] or_5;
+  wire [0:0] mux_in_no_candidate;
   reg [127:0] best_valid = 128'h00000000000000000000000000000000;
   wire [0:0] leaf_last;
   reg [0:0] fin = 1'h0;
@@ -287,17 +287,17 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] fin_has_c;
   reg [0:0] m1_slot_has = 1'h0;
   reg [0:0] m1_leaf_empty = 1'h0;
-  wire [42:0] cat_5;
+  wire [42:0] cat_6;
   reg [42:0] m1_t_tri = 43'h00000000000;
-  wire [63:0] cat_6;
+  wire [63:0] cat_7;
   reg [63:0] m1_u_v = 64'h0000000000000000;
-  wire [44:0] cat_7;
-  wire [0:0] not_m1_slot_has;
   wire [44:0] cat_8;
-  wire [45:0] rs_cat_7;
+  wire [0:0] not_m1_slot_has;
+  wire [44:0] cat_9;
   wire [45:0] rs_cat_8;
+  wire [45:0] rs_cat_9;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 45 are read
-  wire [45:0] rs_cat_7_minus_rs_cat_8;
+  wire [45:0] rs_cat_8_minus_rs_cat_9;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] leaf_better;
   reg [0:0] m2 = 1'h0;
@@ -305,7 +305,6 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] not_m1_leaf_empty;
   wire [0:0] m1_hit;
   reg [0:0] m2_hit = 1'h0;
-  reg [6:0] m2_slot = 7'h00;
   reg [5:0] m2_sp = 6'h00;
   reg [42:0] m2_t_tri = 43'h00000000000;
   reg [63:0] m2_u_v = 64'h0000000000000000;
@@ -325,7 +324,6 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   reg signed [31:0] merge_limit_r = 32'sh00000000;
   reg [5:0] merge_sp_r = 6'h00;
   reg [0:0] d0 = 1'h0;
-  reg [6:0] d0_slot = 7'h00;
   reg [42:0] done_t_tri = 43'h00000000000;
   reg [63:0] done_u_v = 64'h0000000000000000;
   reg [19:0] done_id = 20'h00000;
@@ -739,11 +737,11 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] m1_slot_eq_k_3;
   wire [6:0] k_2 = 7'h02;
   wire [0:0] m1_slot_eq_k_2;
-  wire [6:0] k_1_1 = 7'h01;
-  wire [0:0] m1_slot_eq_k_1_1;
+  wire [6:0] k_1 = 7'h01;
+  wire [0:0] m1_slot_eq_k_1;
   wire [6:0] k_0_2 = 7'h00;
   wire [0:0] m1_slot_eq_k_0_2;
-  wire [127:0] cat_11;
+  wire [127:0] cat_12;
   reg [127:0] m2_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_set;
   wire [0:0] d0_slot_eq_k_127;
@@ -872,14 +870,14 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [0:0] d0_slot_eq_k_4;
   wire [0:0] d0_slot_eq_k_3;
   wire [0:0] d0_slot_eq_k_2;
-  wire [0:0] d0_slot_eq_k_1_1;
+  wire [0:0] d0_slot_eq_k_1;
   wire [0:0] d0_slot_eq_k_0_2;
-  wire [127:0] cat_12;
+  wire [127:0] cat_13;
   reg [127:0] d1_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_clear;
   wire [127:0] not_best_clear;
-  wire [127:0] and_13;
-  wire [127:0] and_13_or_best_set;
+  wire [127:0] and_14;
+  wire [127:0] and_14_or_best_set;
   reg [0:0] free_valid_r = 1'h0;
   reg [6:0] free_slot_r = 7'h00;
   reg [0:0] res_valid_r = 1'h0;
@@ -903,6 +901,18 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   wire [31:0] res_v_c;
   reg [31:0] res_v_r = 32'h00000000;
 
+  // register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
+  reg [6:0] m2_slot = 7'h00;
+  reg [6:0] m2_slot_c1 = 7'h00;
+  reg [6:0] m2_slot_c2 = 7'h00;
+
+  // register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+  reg [6:0] d0_slot = 7'h00;
+  reg [6:0] d0_slot_c1 = 7'h00;
+  reg [6:0] d0_slot_c2 = 7'h00;
+  reg [6:0] d0_slot_c3 = 7'h00;
+
+  // not in a stage or state machine
   assign tri_s = tag[12:0];
   assign tmin = tag[43:13];
   assign sp = tag[49:44];
@@ -941,8 +951,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign rs_cat_3_minus_rs_cat_4 = rs_cat_3 - rs_cat_4;
   assign take = rs_cat_3_minus_rs_cat_4[45];
   assign in_valid2_2_and_in_first = in_valid2_2 & in_first;
-  assign mux_in_valid2_2_and_in_first = in_valid2_2_and_in_first ? k_1 : acc_empty;
-  assign mux_take = take ? k_0 : mux_in_valid2_2_and_in_first;
+  assign or_5 = in_valid2_2_and_in_first | acc_empty;
+  assign mux_in_no_candidate = in_no_candidate ? or_5 : k_0;
   assign leaf_last = in_valid2_2 & in_last;
   assign bits_best_valid = best_valid[0];
   assign bits_best_valid_1 = best_valid[1];
@@ -1235,15 +1245,15 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     (bits_fin_slot == 3'h6) ? fin_has_g6 :
     (bits_fin_slot == 3'h7) ? fin_has_g7 :
     k_0;
-  assign cat_5 = {acc_t, acc_tri};
-  assign cat_6 = {acc_u, acc_v};
-  assign cat_7 = {m1_leaf_empty, k_0, m1_t_tri};
+  assign cat_6 = {acc_t, acc_tri};
+  assign cat_7 = {acc_u, acc_v};
+  assign cat_8 = {m1_leaf_empty, k_0, m1_t_tri};
   assign not_m1_slot_has = ~m1_slot_has;
-  assign cat_8 = {k_0, not_m1_slot_has, slot_t_tri};
-  assign rs_cat_7 = {{1{1'b0}}, cat_7};
+  assign cat_9 = {k_0, not_m1_slot_has, slot_t_tri};
   assign rs_cat_8 = {{1{1'b0}}, cat_8};
-  assign rs_cat_7_minus_rs_cat_8 = rs_cat_7 - rs_cat_8;
-  assign leaf_better = rs_cat_7_minus_rs_cat_8[45];
+  assign rs_cat_9 = {{1{1'b0}}, cat_9};
+  assign rs_cat_8_minus_rs_cat_9 = rs_cat_8 - rs_cat_9;
+  assign leaf_better = rs_cat_8_minus_rs_cat_9[45];
   assign not_m1_leaf_empty = ~m1_leaf_empty;
   assign m1_hit = m1_slot_has | not_m1_leaf_empty;
   assign bits_slot_t_tri = slot_t_tri[42:13];
@@ -1671,9 +1681,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign m1_slot_eq_k_4 = m1_slot == k_4;
   assign m1_slot_eq_k_3 = m1_slot == k_3;
   assign m1_slot_eq_k_2 = m1_slot == k_2;
-  assign m1_slot_eq_k_1_1 = m1_slot == k_1_1;
+  assign m1_slot_eq_k_1 = m1_slot == k_1;
   assign m1_slot_eq_k_0_2 = m1_slot == k_0_2;
-  assign cat_11 = {m1_slot_eq_k_127, m1_slot_eq_k_126, m1_slot_eq_k_125, m1_slot_eq_k_124, m1_slot_eq_k_123, m1_slot_eq_k_122, m1_slot_eq_k_121, m1_slot_eq_k_120, m1_slot_eq_k_119, m1_slot_eq_k_118, m1_slot_eq_k_117, m1_slot_eq_k_116, m1_slot_eq_k_115, m1_slot_eq_k_114, m1_slot_eq_k_113, m1_slot_eq_k_112, m1_slot_eq_k_111, m1_slot_eq_k_110, m1_slot_eq_k_109, m1_slot_eq_k_108, m1_slot_eq_k_107, m1_slot_eq_k_106, m1_slot_eq_k_105, m1_slot_eq_k_104, m1_slot_eq_k_103, m1_slot_eq_k_102, m1_slot_eq_k_101, m1_slot_eq_k_100, m1_slot_eq_k_99, m1_slot_eq_k_98, m1_slot_eq_k_97, m1_slot_eq_k_96, m1_slot_eq_k_95, m1_slot_eq_k_94, m1_slot_eq_k_93, m1_slot_eq_k_92, m1_slot_eq_k_91, m1_slot_eq_k_90, m1_slot_eq_k_89, m1_slot_eq_k_88, m1_slot_eq_k_87, m1_slot_eq_k_86, m1_slot_eq_k_85, m1_slot_eq_k_84, m1_slot_eq_k_83, m1_slot_eq_k_82, m1_slot_eq_k_81, m1_slot_eq_k_80, m1_slot_eq_k_79, m1_slot_eq_k_78, m1_slot_eq_k_77, m1_slot_eq_k_76, m1_slot_eq_k_75, m1_slot_eq_k_74, m1_slot_eq_k_73, m1_slot_eq_k_72, m1_slot_eq_k_71, m1_slot_eq_k_70, m1_slot_eq_k_69, m1_slot_eq_k_68, m1_slot_eq_k_67, m1_slot_eq_k_66, m1_slot_eq_k_65, m1_slot_eq_k_64, m1_slot_eq_k_63, m1_slot_eq_k_62, m1_slot_eq_k_61, m1_slot_eq_k_60, m1_slot_eq_k_59, m1_slot_eq_k_58, m1_slot_eq_k_57, m1_slot_eq_k_56, m1_slot_eq_k_55, m1_slot_eq_k_54, m1_slot_eq_k_53, m1_slot_eq_k_52, m1_slot_eq_k_51, m1_slot_eq_k_50, m1_slot_eq_k_49, m1_slot_eq_k_48, m1_slot_eq_k_47, m1_slot_eq_k_46, m1_slot_eq_k_45, m1_slot_eq_k_44, m1_slot_eq_k_43, m1_slot_eq_k_42, m1_slot_eq_k_41, m1_slot_eq_k_40, m1_slot_eq_k_39, m1_slot_eq_k_38, m1_slot_eq_k_37, m1_slot_eq_k_36, m1_slot_eq_k_35, m1_slot_eq_k_34, m1_slot_eq_k_33, m1_slot_eq_k_32, m1_slot_eq_k_31, m1_slot_eq_k_30, m1_slot_eq_k_29, m1_slot_eq_k_28, m1_slot_eq_k_27, m1_slot_eq_k_26, m1_slot_eq_k_25, m1_slot_eq_k_24, m1_slot_eq_k_23, m1_slot_eq_k_22, m1_slot_eq_k_21, m1_slot_eq_k_20, m1_slot_eq_k_19, m1_slot_eq_k_18, m1_slot_eq_k_17, m1_slot_eq_k_16, m1_slot_eq_k_15, m1_slot_eq_k_14, m1_slot_eq_k_13, m1_slot_eq_k_12, m1_slot_eq_k_11, m1_slot_eq_k_10, m1_slot_eq_k_9, m1_slot_eq_k_8_1, m1_slot_eq_k_7, m1_slot_eq_k_6, m1_slot_eq_k_5, m1_slot_eq_k_4, m1_slot_eq_k_3, m1_slot_eq_k_2, m1_slot_eq_k_1_1, m1_slot_eq_k_0_2};
+  assign cat_12 = {m1_slot_eq_k_127, m1_slot_eq_k_126, m1_slot_eq_k_125, m1_slot_eq_k_124, m1_slot_eq_k_123, m1_slot_eq_k_122, m1_slot_eq_k_121, m1_slot_eq_k_120, m1_slot_eq_k_119, m1_slot_eq_k_118, m1_slot_eq_k_117, m1_slot_eq_k_116, m1_slot_eq_k_115, m1_slot_eq_k_114, m1_slot_eq_k_113, m1_slot_eq_k_112, m1_slot_eq_k_111, m1_slot_eq_k_110, m1_slot_eq_k_109, m1_slot_eq_k_108, m1_slot_eq_k_107, m1_slot_eq_k_106, m1_slot_eq_k_105, m1_slot_eq_k_104, m1_slot_eq_k_103, m1_slot_eq_k_102, m1_slot_eq_k_101, m1_slot_eq_k_100, m1_slot_eq_k_99, m1_slot_eq_k_98, m1_slot_eq_k_97, m1_slot_eq_k_96, m1_slot_eq_k_95, m1_slot_eq_k_94, m1_slot_eq_k_93, m1_slot_eq_k_92, m1_slot_eq_k_91, m1_slot_eq_k_90, m1_slot_eq_k_89, m1_slot_eq_k_88, m1_slot_eq_k_87, m1_slot_eq_k_86, m1_slot_eq_k_85, m1_slot_eq_k_84, m1_slot_eq_k_83, m1_slot_eq_k_82, m1_slot_eq_k_81, m1_slot_eq_k_80, m1_slot_eq_k_79, m1_slot_eq_k_78, m1_slot_eq_k_77, m1_slot_eq_k_76, m1_slot_eq_k_75, m1_slot_eq_k_74, m1_slot_eq_k_73, m1_slot_eq_k_72, m1_slot_eq_k_71, m1_slot_eq_k_70, m1_slot_eq_k_69, m1_slot_eq_k_68, m1_slot_eq_k_67, m1_slot_eq_k_66, m1_slot_eq_k_65, m1_slot_eq_k_64, m1_slot_eq_k_63, m1_slot_eq_k_62, m1_slot_eq_k_61, m1_slot_eq_k_60, m1_slot_eq_k_59, m1_slot_eq_k_58, m1_slot_eq_k_57, m1_slot_eq_k_56, m1_slot_eq_k_55, m1_slot_eq_k_54, m1_slot_eq_k_53, m1_slot_eq_k_52, m1_slot_eq_k_51, m1_slot_eq_k_50, m1_slot_eq_k_49, m1_slot_eq_k_48, m1_slot_eq_k_47, m1_slot_eq_k_46, m1_slot_eq_k_45, m1_slot_eq_k_44, m1_slot_eq_k_43, m1_slot_eq_k_42, m1_slot_eq_k_41, m1_slot_eq_k_40, m1_slot_eq_k_39, m1_slot_eq_k_38, m1_slot_eq_k_37, m1_slot_eq_k_36, m1_slot_eq_k_35, m1_slot_eq_k_34, m1_slot_eq_k_33, m1_slot_eq_k_32, m1_slot_eq_k_31, m1_slot_eq_k_30, m1_slot_eq_k_29, m1_slot_eq_k_28, m1_slot_eq_k_27, m1_slot_eq_k_26, m1_slot_eq_k_25, m1_slot_eq_k_24, m1_slot_eq_k_23, m1_slot_eq_k_22, m1_slot_eq_k_21, m1_slot_eq_k_20, m1_slot_eq_k_19, m1_slot_eq_k_18, m1_slot_eq_k_17, m1_slot_eq_k_16, m1_slot_eq_k_15, m1_slot_eq_k_14, m1_slot_eq_k_13, m1_slot_eq_k_12, m1_slot_eq_k_11, m1_slot_eq_k_10, m1_slot_eq_k_9, m1_slot_eq_k_8_1, m1_slot_eq_k_7, m1_slot_eq_k_6, m1_slot_eq_k_5, m1_slot_eq_k_4, m1_slot_eq_k_3, m1_slot_eq_k_2, m1_slot_eq_k_1, m1_slot_eq_k_0_2};
   assign best_set = best_we ? m2_onehot : k_0_1;
   assign d0_slot_eq_k_127 = d0_slot == k_127;
   assign d0_slot_eq_k_126 = d0_slot == k_126;
@@ -1801,13 +1811,13 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign d0_slot_eq_k_4 = d0_slot == k_4;
   assign d0_slot_eq_k_3 = d0_slot == k_3;
   assign d0_slot_eq_k_2 = d0_slot == k_2;
-  assign d0_slot_eq_k_1_1 = d0_slot == k_1_1;
+  assign d0_slot_eq_k_1 = d0_slot == k_1;
   assign d0_slot_eq_k_0_2 = d0_slot == k_0_2;
-  assign cat_12 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
+  assign cat_13 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1, d0_slot_eq_k_0_2};
   assign best_clear = d1 ? d1_onehot : k_0_1;
   assign not_best_clear = ~best_clear;
-  assign and_13 = best_valid & not_best_clear;
-  assign and_13_or_best_set = and_13 | best_set;
+  assign and_14 = best_valid & not_best_clear;
+  assign and_14_or_best_set = and_14 | best_set;
   assign res_id_c = done_id;
   assign res_hit_c = d1_has;
   assign bits_done_t_tri = done_t_tri[12:0];
@@ -1820,8 +1830,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
   assign res_v_c = d1_has ? bits_done_u_v_1 : k_0_5;
 
   always @(posedge clk) begin : regs
-    if (best_we) best_t_tri[m2_slot] <= m2_t_tri;
-    if (best_we) best_u_v[m2_slot] <= m2_u_v;
+    if (best_we) best_t_tri[m2_slot_c1] <= m2_t_tri;
+    if (best_we) best_u_v[m2_slot_c2] <= m2_u_v;
     if (id_we) ray_ids[id_slot] <= id;
     in_tmin_less <= tmin_less;
     in_t_plus_8 <= t_plus_8;
@@ -1851,13 +1861,13 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     in_v_sr[2] <= in_v_sr[1];
     in_v_sr[1] <= v;
     if (rst) acc_empty <= 1'h1;
-    else acc_empty <= mux_take;
+    else acc_empty <= mux_in_no_candidate;
     if (take) acc_t <= in_t;
     if (take) acc_tri <= in_tri;
     if (take) acc_u <= in_u;
     if (take) acc_v <= in_v;
     if (rst) best_valid <= 128'h00000000000000000000000000000000;
-    else best_valid <= and_13_or_best_set;
+    else best_valid <= and_14_or_best_set;
     if (rst) fin <= 1'h0;
     else fin <= leaf_last;
     fin_slot <= in_slot;
@@ -1877,13 +1887,12 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     fin_has_g7 <= fin_has_g7_c;
     m1_slot_has <= fin_has_c;
     m1_leaf_empty <= acc_empty;
-    m1_t_tri <= cat_5;
-    m1_u_v <= cat_6;
+    m1_t_tri <= cat_6;
+    m1_u_v <= cat_7;
     if (rst) m2 <= 1'h0;
     else m2 <= m1;
     m2_better <= leaf_better;
     m2_hit <= m1_hit;
-    m2_slot <= m1_slot;
     m2_sp <= m1_sp;
     m2_t_tri <= m1_t_tri;
     m2_u_v <= m1_u_v;
@@ -1898,10 +1907,9 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     merge_sp_r <= m2_sp;
     if (rst) d0 <= 1'h0;
     else d0 <= done_valid;
-    d0_slot <= done_slot;
-    done_t_tri <= best_t_tri[d0_slot];
-    done_u_v <= best_u_v[d0_slot];
-    done_id <= ray_ids[d0_slot];
+    done_t_tri <= best_t_tri[d0_slot_c1];
+    done_u_v <= best_u_v[d0_slot_c2];
+    done_id <= ray_ids[d0_slot_c3];
     if (rst) d1 <= 1'h0;
     else d1 <= d0;
     d1_slot <= d0_slot;
@@ -1914,8 +1922,8 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     done_has_g6 <= done_has_g6_c;
     done_has_g7 <= done_has_g7_c;
     d1_has <= done_has_c;
-    m2_onehot <= cat_11;
-    d1_onehot <= cat_12;
+    m2_onehot <= cat_12;
+    d1_onehot <= cat_13;
     if (rst) free_valid_r <= 1'h0;
     else free_valid_r <= d1;
     free_slot_r <= d1_slot;
@@ -1927,6 +1935,23 @@ module fxrt_closest_n29_m32_tag59_s128_r2 (
     res_t_r <= res_t_c;
     res_u_r <= res_u_c;
     res_v_r <= res_v_c;
+  end
+
+  // register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : m2_slot_copies_regs
+    m2_slot <= m1_slot;
+    m2_slot_c1 <= m1_slot;
+    m2_slot_c2 <= m1_slot;
+  end
+
+  // register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : d0_slot_copies_regs
+    d0_slot <= done_slot;
+    d0_slot_c1 <= done_slot;
+    d0_slot_c2 <= done_slot;
+    d0_slot_c3 <= done_slot;
   end
 
   assign merge_valid = merge_valid_r;

@@ -46,6 +46,9 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   type ray_ids_t is array (0 to 127) of unsigned(19 downto 0);
   signal ray_ids : ray_ids_t := (others => (others => '0'));
 
+  attribute keep : string;
+
+  -- not in a stage or state machine
   signal tri_s : unsigned(12 downto 0);
   signal tmin : unsigned(30 downto 0);
   signal sp : unsigned(5 downto 0);
@@ -114,9 +117,8 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal rs_cat_3_minus_rs_cat_4 : unsigned(45 downto 0);
   signal take : unsigned(0 downto 0);
   signal in_valid2_2_and_in_first : unsigned(0 downto 0);
-  constant k_1 : unsigned(0 downto 0) := unsigned'("1");
-  signal mux_in_valid2_2_and_in_first : unsigned(0 downto 0);
-  signal mux_take : unsigned(0 downto 0);
+  signal or_5 : unsigned(0 downto 0);
+  signal mux_in_no_candidate : unsigned(0 downto 0);
   signal best_valid : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal leaf_last : unsigned(0 downto 0);
   signal fin : unsigned(0 downto 0) := unsigned'("0");
@@ -282,23 +284,22 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal fin_has_c : unsigned(0 downto 0);
   signal m1_slot_has : unsigned(0 downto 0) := unsigned'("0");
   signal m1_leaf_empty : unsigned(0 downto 0) := unsigned'("0");
-  signal cat_5 : unsigned(42 downto 0);
+  signal cat_6 : unsigned(42 downto 0);
   signal m1_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
-  signal cat_6 : unsigned(63 downto 0);
+  signal cat_7 : unsigned(63 downto 0);
   signal m1_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-  signal cat_7 : unsigned(44 downto 0);
-  signal not_m1_slot_has : unsigned(0 downto 0);
   signal cat_8 : unsigned(44 downto 0);
-  signal rs_cat_7 : unsigned(45 downto 0);
+  signal not_m1_slot_has : unsigned(0 downto 0);
+  signal cat_9 : unsigned(44 downto 0);
   signal rs_cat_8 : unsigned(45 downto 0);
-  signal rs_cat_7_minus_rs_cat_8 : unsigned(45 downto 0);
+  signal rs_cat_9 : unsigned(45 downto 0);
+  signal rs_cat_8_minus_rs_cat_9 : unsigned(45 downto 0);
   signal leaf_better : unsigned(0 downto 0);
   signal m2 : unsigned(0 downto 0) := unsigned'("0");
   signal m2_better : unsigned(0 downto 0) := unsigned'("0");
   signal not_m1_leaf_empty : unsigned(0 downto 0);
   signal m1_hit : unsigned(0 downto 0);
   signal m2_hit : unsigned(0 downto 0) := unsigned'("0");
-  signal m2_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal m2_sp : unsigned(5 downto 0) := unsigned'("000000");
   signal m2_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
   signal m2_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
@@ -318,7 +319,6 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal merge_limit_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal merge_sp_r : unsigned(5 downto 0) := unsigned'("000000");
   signal d0 : unsigned(0 downto 0) := unsigned'("0");
-  signal d0_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal done_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
   signal done_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal done_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
@@ -732,11 +732,11 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal m1_slot_eq_k_3 : unsigned(0 downto 0);
   constant k_2 : unsigned(6 downto 0) := unsigned'("0000010");
   signal m1_slot_eq_k_2 : unsigned(0 downto 0);
-  constant k_1_1 : unsigned(6 downto 0) := unsigned'("0000001");
-  signal m1_slot_eq_k_1_1 : unsigned(0 downto 0);
+  constant k_1 : unsigned(6 downto 0) := unsigned'("0000001");
+  signal m1_slot_eq_k_1 : unsigned(0 downto 0);
   constant k_0_2 : unsigned(6 downto 0) := unsigned'("0000000");
   signal m1_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_11 : unsigned(127 downto 0);
+  signal cat_12 : unsigned(127 downto 0);
   signal m2_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_set : unsigned(127 downto 0);
   signal d0_slot_eq_k_127 : unsigned(0 downto 0);
@@ -865,14 +865,14 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal d0_slot_eq_k_4 : unsigned(0 downto 0);
   signal d0_slot_eq_k_3 : unsigned(0 downto 0);
   signal d0_slot_eq_k_2 : unsigned(0 downto 0);
-  signal d0_slot_eq_k_1_1 : unsigned(0 downto 0);
+  signal d0_slot_eq_k_1 : unsigned(0 downto 0);
   signal d0_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_12 : unsigned(127 downto 0);
+  signal cat_13 : unsigned(127 downto 0);
   signal d1_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_clear : unsigned(127 downto 0);
   signal not_best_clear : unsigned(127 downto 0);
-  signal and_13 : unsigned(127 downto 0);
-  signal and_13_or_best_set : unsigned(127 downto 0);
+  signal and_14 : unsigned(127 downto 0);
+  signal and_14_or_best_set : unsigned(127 downto 0);
   signal free_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal free_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal res_valid_r : unsigned(0 downto 0) := unsigned'("0");
@@ -895,8 +895,27 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_r2 is
   signal bits_done_u_v_1 : unsigned(31 downto 0);
   signal res_v_c : unsigned(31 downto 0);
   signal res_v_r : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+
+  -- register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
+  signal m2_slot : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m2_slot : signal is "true";
+  signal m2_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m2_slot_c1 : signal is "true";
+  signal m2_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m2_slot_c2 : signal is "true";
+
+  -- register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+  signal d0_slot : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot : signal is "true";
+  signal d0_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c1 : signal is "true";
+  signal d0_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c2 : signal is "true";
+  signal d0_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c3 : signal is "true";
 begin
 
+  -- not in a stage or state machine
   tri_s <= unsigned(tag(12 downto 0));
   tmin <= unsigned(tag(43 downto 13));
   sp <= unsigned(tag(49 downto 44));
@@ -935,8 +954,8 @@ begin
   rs_cat_3_minus_rs_cat_4 <= rs_cat_3 - rs_cat_4;
   take <= unsigned(rs_cat_3_minus_rs_cat_4(45 downto 45));
   in_valid2_2_and_in_first <= in_valid2_2 and in_first;
-  mux_in_valid2_2_and_in_first <= k_1 when in_valid2_2_and_in_first = "1" else acc_empty;
-  mux_take <= k_0 when take = "1" else mux_in_valid2_2_and_in_first;
+  or_5 <= in_valid2_2_and_in_first or acc_empty;
+  mux_in_no_candidate <= or_5 when in_no_candidate = "1" else k_0;
   leaf_last <= in_valid2_2 and in_last;
   bits_best_valid <= unsigned(best_valid(0 downto 0));
   bits_best_valid_1 <= unsigned(best_valid(1 downto 1));
@@ -1238,15 +1257,15 @@ begin
       fin_has_g6 when "110",
       fin_has_g7 when "111",
       k_0 when others;
-  cat_5 <= unsigned(std_logic_vector'(std_logic_vector(acc_t) & std_logic_vector(acc_tri)));
-  cat_6 <= unsigned(std_logic_vector'(std_logic_vector(acc_u) & std_logic_vector(acc_v)));
-  cat_7 <= unsigned(std_logic_vector'(std_logic_vector(m1_leaf_empty) & std_logic_vector(k_0) & std_logic_vector(m1_t_tri)));
+  cat_6 <= unsigned(std_logic_vector'(std_logic_vector(acc_t) & std_logic_vector(acc_tri)));
+  cat_7 <= unsigned(std_logic_vector'(std_logic_vector(acc_u) & std_logic_vector(acc_v)));
+  cat_8 <= unsigned(std_logic_vector'(std_logic_vector(m1_leaf_empty) & std_logic_vector(k_0) & std_logic_vector(m1_t_tri)));
   not_m1_slot_has <= not m1_slot_has;
-  cat_8 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(not_m1_slot_has) & std_logic_vector(slot_t_tri)));
-  rs_cat_7 <= resize(cat_7, 46);
+  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(not_m1_slot_has) & std_logic_vector(slot_t_tri)));
   rs_cat_8 <= resize(cat_8, 46);
-  rs_cat_7_minus_rs_cat_8 <= rs_cat_7 - rs_cat_8;
-  leaf_better <= unsigned(rs_cat_7_minus_rs_cat_8(45 downto 45));
+  rs_cat_9 <= resize(cat_9, 46);
+  rs_cat_8_minus_rs_cat_9 <= rs_cat_8 - rs_cat_9;
+  leaf_better <= unsigned(rs_cat_8_minus_rs_cat_9(45 downto 45));
   not_m1_leaf_empty <= not m1_leaf_empty;
   m1_hit <= m1_slot_has or not_m1_leaf_empty;
   bits_slot_t_tri <= unsigned(slot_t_tri(42 downto 13));
@@ -1683,9 +1702,9 @@ begin
   m1_slot_eq_k_4 <= "1" when m1_slot = k_4 else "0";
   m1_slot_eq_k_3 <= "1" when m1_slot = k_3 else "0";
   m1_slot_eq_k_2 <= "1" when m1_slot = k_2 else "0";
-  m1_slot_eq_k_1_1 <= "1" when m1_slot = k_1_1 else "0";
+  m1_slot_eq_k_1 <= "1" when m1_slot = k_1 else "0";
   m1_slot_eq_k_0_2 <= "1" when m1_slot = k_0_2 else "0";
-  cat_11 <= unsigned(std_logic_vector'(std_logic_vector(m1_slot_eq_k_127) & std_logic_vector(m1_slot_eq_k_126) & std_logic_vector(m1_slot_eq_k_125) & std_logic_vector(m1_slot_eq_k_124) & std_logic_vector(m1_slot_eq_k_123) & std_logic_vector(m1_slot_eq_k_122) & std_logic_vector(m1_slot_eq_k_121) & std_logic_vector(m1_slot_eq_k_120) & std_logic_vector(m1_slot_eq_k_119) & std_logic_vector(m1_slot_eq_k_118) & std_logic_vector(m1_slot_eq_k_117) & std_logic_vector(m1_slot_eq_k_116) & std_logic_vector(m1_slot_eq_k_115) & std_logic_vector(m1_slot_eq_k_114) & std_logic_vector(m1_slot_eq_k_113) & std_logic_vector(m1_slot_eq_k_112) & std_logic_vector(m1_slot_eq_k_111) & std_logic_vector(m1_slot_eq_k_110) & std_logic_vector(m1_slot_eq_k_109) & std_logic_vector(m1_slot_eq_k_108) & std_logic_vector(m1_slot_eq_k_107) & std_logic_vector(m1_slot_eq_k_106) & std_logic_vector(m1_slot_eq_k_105) & std_logic_vector(m1_slot_eq_k_104) & std_logic_vector(m1_slot_eq_k_103) & std_logic_vector(m1_slot_eq_k_102) & std_logic_vector(m1_slot_eq_k_101) & std_logic_vector(m1_slot_eq_k_100) & std_logic_vector(m1_slot_eq_k_99) & std_logic_vector(m1_slot_eq_k_98) & std_logic_vector(m1_slot_eq_k_97) & std_logic_vector(m1_slot_eq_k_96) & std_logic_vector(m1_slot_eq_k_95) & std_logic_vector(m1_slot_eq_k_94) & std_logic_vector(m1_slot_eq_k_93) & std_logic_vector(m1_slot_eq_k_92) & std_logic_vector(m1_slot_eq_k_91) & std_logic_vector(m1_slot_eq_k_90) & std_logic_vector(m1_slot_eq_k_89) & std_logic_vector(m1_slot_eq_k_88) & std_logic_vector(m1_slot_eq_k_87) & std_logic_vector(m1_slot_eq_k_86) & std_logic_vector(m1_slot_eq_k_85) & std_logic_vector(m1_slot_eq_k_84) & std_logic_vector(m1_slot_eq_k_83) & std_logic_vector(m1_slot_eq_k_82) & std_logic_vector(m1_slot_eq_k_81) & std_logic_vector(m1_slot_eq_k_80) & std_logic_vector(m1_slot_eq_k_79) & std_logic_vector(m1_slot_eq_k_78) & std_logic_vector(m1_slot_eq_k_77) & std_logic_vector(m1_slot_eq_k_76) & std_logic_vector(m1_slot_eq_k_75) & std_logic_vector(m1_slot_eq_k_74) & std_logic_vector(m1_slot_eq_k_73) & std_logic_vector(m1_slot_eq_k_72) & std_logic_vector(m1_slot_eq_k_71) & std_logic_vector(m1_slot_eq_k_70) & std_logic_vector(m1_slot_eq_k_69) & std_logic_vector(m1_slot_eq_k_68) & std_logic_vector(m1_slot_eq_k_67) & std_logic_vector(m1_slot_eq_k_66) & std_logic_vector(m1_slot_eq_k_65) & std_logic_vector(m1_slot_eq_k_64) & std_logic_vector(m1_slot_eq_k_63) & std_logic_vector(m1_slot_eq_k_62) & std_logic_vector(m1_slot_eq_k_61) & std_logic_vector(m1_slot_eq_k_60) & std_logic_vector(m1_slot_eq_k_59) & std_logic_vector(m1_slot_eq_k_58) & std_logic_vector(m1_slot_eq_k_57) & std_logic_vector(m1_slot_eq_k_56) & std_logic_vector(m1_slot_eq_k_55) & std_logic_vector(m1_slot_eq_k_54) & std_logic_vector(m1_slot_eq_k_53) & std_logic_vector(m1_slot_eq_k_52) & std_logic_vector(m1_slot_eq_k_51) & std_logic_vector(m1_slot_eq_k_50) & std_logic_vector(m1_slot_eq_k_49) & std_logic_vector(m1_slot_eq_k_48) & std_logic_vector(m1_slot_eq_k_47) & std_logic_vector(m1_slot_eq_k_46) & std_logic_vector(m1_slot_eq_k_45) & std_logic_vector(m1_slot_eq_k_44) & std_logic_vector(m1_slot_eq_k_43) & std_logic_vector(m1_slot_eq_k_42) & std_logic_vector(m1_slot_eq_k_41) & std_logic_vector(m1_slot_eq_k_40) & std_logic_vector(m1_slot_eq_k_39) & std_logic_vector(m1_slot_eq_k_38) & std_logic_vector(m1_slot_eq_k_37) & std_logic_vector(m1_slot_eq_k_36) & std_logic_vector(m1_slot_eq_k_35) & std_logic_vector(m1_slot_eq_k_34) & std_logic_vector(m1_slot_eq_k_33) & std_logic_vector(m1_slot_eq_k_32) & std_logic_vector(m1_slot_eq_k_31) & std_logic_vector(m1_slot_eq_k_30) & std_logic_vector(m1_slot_eq_k_29) & std_logic_vector(m1_slot_eq_k_28) & std_logic_vector(m1_slot_eq_k_27) & std_logic_vector(m1_slot_eq_k_26) & std_logic_vector(m1_slot_eq_k_25) & std_logic_vector(m1_slot_eq_k_24) & std_logic_vector(m1_slot_eq_k_23) & std_logic_vector(m1_slot_eq_k_22) & std_logic_vector(m1_slot_eq_k_21) & std_logic_vector(m1_slot_eq_k_20) & std_logic_vector(m1_slot_eq_k_19) & std_logic_vector(m1_slot_eq_k_18) & std_logic_vector(m1_slot_eq_k_17) & std_logic_vector(m1_slot_eq_k_16) & std_logic_vector(m1_slot_eq_k_15) & std_logic_vector(m1_slot_eq_k_14) & std_logic_vector(m1_slot_eq_k_13) & std_logic_vector(m1_slot_eq_k_12) & std_logic_vector(m1_slot_eq_k_11) & std_logic_vector(m1_slot_eq_k_10) & std_logic_vector(m1_slot_eq_k_9) & std_logic_vector(m1_slot_eq_k_8_1) & std_logic_vector(m1_slot_eq_k_7) & std_logic_vector(m1_slot_eq_k_6) & std_logic_vector(m1_slot_eq_k_5) & std_logic_vector(m1_slot_eq_k_4) & std_logic_vector(m1_slot_eq_k_3) & std_logic_vector(m1_slot_eq_k_2) & std_logic_vector(m1_slot_eq_k_1_1) & std_logic_vector(m1_slot_eq_k_0_2)));
+  cat_12 <= unsigned(std_logic_vector'(std_logic_vector(m1_slot_eq_k_127) & std_logic_vector(m1_slot_eq_k_126) & std_logic_vector(m1_slot_eq_k_125) & std_logic_vector(m1_slot_eq_k_124) & std_logic_vector(m1_slot_eq_k_123) & std_logic_vector(m1_slot_eq_k_122) & std_logic_vector(m1_slot_eq_k_121) & std_logic_vector(m1_slot_eq_k_120) & std_logic_vector(m1_slot_eq_k_119) & std_logic_vector(m1_slot_eq_k_118) & std_logic_vector(m1_slot_eq_k_117) & std_logic_vector(m1_slot_eq_k_116) & std_logic_vector(m1_slot_eq_k_115) & std_logic_vector(m1_slot_eq_k_114) & std_logic_vector(m1_slot_eq_k_113) & std_logic_vector(m1_slot_eq_k_112) & std_logic_vector(m1_slot_eq_k_111) & std_logic_vector(m1_slot_eq_k_110) & std_logic_vector(m1_slot_eq_k_109) & std_logic_vector(m1_slot_eq_k_108) & std_logic_vector(m1_slot_eq_k_107) & std_logic_vector(m1_slot_eq_k_106) & std_logic_vector(m1_slot_eq_k_105) & std_logic_vector(m1_slot_eq_k_104) & std_logic_vector(m1_slot_eq_k_103) & std_logic_vector(m1_slot_eq_k_102) & std_logic_vector(m1_slot_eq_k_101) & std_logic_vector(m1_slot_eq_k_100) & std_logic_vector(m1_slot_eq_k_99) & std_logic_vector(m1_slot_eq_k_98) & std_logic_vector(m1_slot_eq_k_97) & std_logic_vector(m1_slot_eq_k_96) & std_logic_vector(m1_slot_eq_k_95) & std_logic_vector(m1_slot_eq_k_94) & std_logic_vector(m1_slot_eq_k_93) & std_logic_vector(m1_slot_eq_k_92) & std_logic_vector(m1_slot_eq_k_91) & std_logic_vector(m1_slot_eq_k_90) & std_logic_vector(m1_slot_eq_k_89) & std_logic_vector(m1_slot_eq_k_88) & std_logic_vector(m1_slot_eq_k_87) & std_logic_vector(m1_slot_eq_k_86) & std_logic_vector(m1_slot_eq_k_85) & std_logic_vector(m1_slot_eq_k_84) & std_logic_vector(m1_slot_eq_k_83) & std_logic_vector(m1_slot_eq_k_82) & std_logic_vector(m1_slot_eq_k_81) & std_logic_vector(m1_slot_eq_k_80) & std_logic_vector(m1_slot_eq_k_79) & std_logic_vector(m1_slot_eq_k_78) & std_logic_vector(m1_slot_eq_k_77) & std_logic_vector(m1_slot_eq_k_76) & std_logic_vector(m1_slot_eq_k_75) & std_logic_vector(m1_slot_eq_k_74) & std_logic_vector(m1_slot_eq_k_73) & std_logic_vector(m1_slot_eq_k_72) & std_logic_vector(m1_slot_eq_k_71) & std_logic_vector(m1_slot_eq_k_70) & std_logic_vector(m1_slot_eq_k_69) & std_logic_vector(m1_slot_eq_k_68) & std_logic_vector(m1_slot_eq_k_67) & std_logic_vector(m1_slot_eq_k_66) & std_logic_vector(m1_slot_eq_k_65) & std_logic_vector(m1_slot_eq_k_64) & std_logic_vector(m1_slot_eq_k_63) & std_logic_vector(m1_slot_eq_k_62) & std_logic_vector(m1_slot_eq_k_61) & std_logic_vector(m1_slot_eq_k_60) & std_logic_vector(m1_slot_eq_k_59) & std_logic_vector(m1_slot_eq_k_58) & std_logic_vector(m1_slot_eq_k_57) & std_logic_vector(m1_slot_eq_k_56) & std_logic_vector(m1_slot_eq_k_55) & std_logic_vector(m1_slot_eq_k_54) & std_logic_vector(m1_slot_eq_k_53) & std_logic_vector(m1_slot_eq_k_52) & std_logic_vector(m1_slot_eq_k_51) & std_logic_vector(m1_slot_eq_k_50) & std_logic_vector(m1_slot_eq_k_49) & std_logic_vector(m1_slot_eq_k_48) & std_logic_vector(m1_slot_eq_k_47) & std_logic_vector(m1_slot_eq_k_46) & std_logic_vector(m1_slot_eq_k_45) & std_logic_vector(m1_slot_eq_k_44) & std_logic_vector(m1_slot_eq_k_43) & std_logic_vector(m1_slot_eq_k_42) & std_logic_vector(m1_slot_eq_k_41) & std_logic_vector(m1_slot_eq_k_40) & std_logic_vector(m1_slot_eq_k_39) & std_logic_vector(m1_slot_eq_k_38) & std_logic_vector(m1_slot_eq_k_37) & std_logic_vector(m1_slot_eq_k_36) & std_logic_vector(m1_slot_eq_k_35) & std_logic_vector(m1_slot_eq_k_34) & std_logic_vector(m1_slot_eq_k_33) & std_logic_vector(m1_slot_eq_k_32) & std_logic_vector(m1_slot_eq_k_31) & std_logic_vector(m1_slot_eq_k_30) & std_logic_vector(m1_slot_eq_k_29) & std_logic_vector(m1_slot_eq_k_28) & std_logic_vector(m1_slot_eq_k_27) & std_logic_vector(m1_slot_eq_k_26) & std_logic_vector(m1_slot_eq_k_25) & std_logic_vector(m1_slot_eq_k_24) & std_logic_vector(m1_slot_eq_k_23) & std_logic_vector(m1_slot_eq_k_22) & std_logic_vector(m1_slot_eq_k_21) & std_logic_vector(m1_slot_eq_k_20) & std_logic_vector(m1_slot_eq_k_19) & std_logic_vector(m1_slot_eq_k_18) & std_logic_vector(m1_slot_eq_k_17) & std_logic_vector(m1_slot_eq_k_16) & std_logic_vector(m1_slot_eq_k_15) & std_logic_vector(m1_slot_eq_k_14) & std_logic_vector(m1_slot_eq_k_13) & std_logic_vector(m1_slot_eq_k_12) & std_logic_vector(m1_slot_eq_k_11) & std_logic_vector(m1_slot_eq_k_10) & std_logic_vector(m1_slot_eq_k_9) & std_logic_vector(m1_slot_eq_k_8_1) & std_logic_vector(m1_slot_eq_k_7) & std_logic_vector(m1_slot_eq_k_6) & std_logic_vector(m1_slot_eq_k_5) & std_logic_vector(m1_slot_eq_k_4) & std_logic_vector(m1_slot_eq_k_3) & std_logic_vector(m1_slot_eq_k_2) & std_logic_vector(m1_slot_eq_k_1) & std_logic_vector(m1_slot_eq_k_0_2)));
   best_set <= m2_onehot when best_we = "1" else k_0_1;
   d0_slot_eq_k_127 <= "1" when d0_slot = k_127 else "0";
   d0_slot_eq_k_126 <= "1" when d0_slot = k_126 else "0";
@@ -1813,13 +1832,13 @@ begin
   d0_slot_eq_k_4 <= "1" when d0_slot = k_4 else "0";
   d0_slot_eq_k_3 <= "1" when d0_slot = k_3 else "0";
   d0_slot_eq_k_2 <= "1" when d0_slot = k_2 else "0";
-  d0_slot_eq_k_1_1 <= "1" when d0_slot = k_1_1 else "0";
+  d0_slot_eq_k_1 <= "1" when d0_slot = k_1 else "0";
   d0_slot_eq_k_0_2 <= "1" when d0_slot = k_0_2 else "0";
-  cat_12 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
+  cat_13 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1) & std_logic_vector(d0_slot_eq_k_0_2)));
   best_clear <= d1_onehot when d1 = "1" else k_0_1;
   not_best_clear <= not best_clear;
-  and_13 <= best_valid and not_best_clear;
-  and_13_or_best_set <= and_13 or best_set;
+  and_14 <= best_valid and not_best_clear;
+  and_14_or_best_set <= and_14 or best_set;
   res_id_c <= done_id;
   res_hit_c <= d1_has;
   bits_done_t_tri <= unsigned(done_t_tri(12 downto 0));
@@ -1835,10 +1854,10 @@ begin
   begin
     if rising_edge(clk) then
       if best_we = "1" then
-        best_t_tri(to_integer(m2_slot)) <= m2_t_tri;
+        best_t_tri(to_integer(m2_slot_c1)) <= m2_t_tri;
       end if;
       if best_we = "1" then
-        best_u_v(to_integer(m2_slot)) <= m2_u_v;
+        best_u_v(to_integer(m2_slot_c2)) <= m2_u_v;
       end if;
       if id_we = "1" then
         ray_ids(to_integer(id_slot)) <= id;
@@ -1885,7 +1904,7 @@ begin
       if rst = '1' then
         acc_empty <= unsigned'("1");
       else
-        acc_empty <= mux_take;
+        acc_empty <= mux_in_no_candidate;
       end if;
       if take = "1" then
         acc_t <= in_t;
@@ -1902,7 +1921,7 @@ begin
       if rst = '1' then
         best_valid <= unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
       else
-        best_valid <= and_13_or_best_set;
+        best_valid <= and_14_or_best_set;
       end if;
       if rst = '1' then
         fin <= unsigned'("0");
@@ -1929,8 +1948,8 @@ begin
       fin_has_g7 <= fin_has_g7_c;
       m1_slot_has <= fin_has_c;
       m1_leaf_empty <= acc_empty;
-      m1_t_tri <= cat_5;
-      m1_u_v <= cat_6;
+      m1_t_tri <= cat_6;
+      m1_u_v <= cat_7;
       if rst = '1' then
         m2 <= unsigned'("0");
       else
@@ -1938,7 +1957,6 @@ begin
       end if;
       m2_better <= leaf_better;
       m2_hit <= m1_hit;
-      m2_slot <= m1_slot;
       m2_sp <= m1_sp;
       m2_t_tri <= m1_t_tri;
       m2_u_v <= m1_u_v;
@@ -1962,10 +1980,9 @@ begin
       else
         d0 <= done_valid;
       end if;
-      d0_slot <= done_slot;
-      done_t_tri <= best_t_tri(to_integer(d0_slot));
-      done_u_v <= best_u_v(to_integer(d0_slot));
-      done_id <= ray_ids(to_integer(d0_slot));
+      done_t_tri <= best_t_tri(to_integer(d0_slot_c1));
+      done_u_v <= best_u_v(to_integer(d0_slot_c2));
+      done_id <= ray_ids(to_integer(d0_slot_c3));
       if rst = '1' then
         d1 <= unsigned'("0");
       else
@@ -1981,8 +1998,8 @@ begin
       done_has_g6 <= done_has_g6_c;
       done_has_g7 <= done_has_g7_c;
       d1_has <= done_has_c;
-      m2_onehot <= cat_11;
-      d1_onehot <= cat_12;
+      m2_onehot <= cat_12;
+      d1_onehot <= cat_13;
       if rst = '1' then
         free_valid_r <= unsigned'("0");
       else
@@ -2002,6 +2019,29 @@ begin
       res_v_r <= res_v_c;
     end if;
   end process regs;
+
+  -- register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
+
+  m2_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      m2_slot <= m1_slot;
+      m2_slot_c1 <= m1_slot;
+      m2_slot_c2 <= m1_slot;
+    end if;
+  end process m2_slot_copies_regs;
+
+  -- register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+
+  d0_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      d0_slot <= done_slot;
+      d0_slot_c1 <= done_slot;
+      d0_slot_c2 <= done_slot;
+      d0_slot_c3 <= done_slot;
+    end if;
+  end process d0_slot_copies_regs;
 
   merge_valid <= merge_valid_r;
   merge_slot <= merge_slot_r;

@@ -448,7 +448,10 @@ module fxrt_core_sf0a3f4 (
   integer pipe_tag_i;
   initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 59'h000000000000000;
   wire [58:0] pipe_tag;
-  wire [6:0] bits_emit_tag_tri;
+  (* mem2reg *) reg [6:0] emit_slot_sr_sr [1:2];
+  integer emit_slot_sr_i;
+  initial for (emit_slot_sr_i = 1; emit_slot_sr_i <= 2; emit_slot_sr_i = emit_slot_sr_i + 1) emit_slot_sr_sr[emit_slot_sr_i] = 7'h00;
+  wire [6:0] emit_slot_sr;
   reg [86:0] ray_o_q = 87'h0000000000000000000000;
   (* mem2reg *) reg [86:0] pipe_o_sr [1:2];
   integer pipe_o_i;
@@ -474,6 +477,13 @@ module fxrt_core_sf0a3f4 (
   wire [29:0] u_intersect_t_1;
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
+
+  // register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  reg [6:0] emit_slot_1 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  reg [6:0] emit_slot_1_c1 = 7'h00;
+  reg [6:0] emit_slot_1_c2 = 7'h00;
 
   // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   reg [0:0] res_credit_ok = 1'h1;
@@ -555,8 +565,15 @@ module fxrt_core_sf0a3f4 (
   wire [5:0] minus_50;
   wire [5:0] rs_res_take_1;
   wire [5:0] res_credits_next;
-  wire [4:0] bits_res_credits_next;
-  wire [0:0] ne_52;
+  wire [5:0] k_1_6 = 6'h01;
+  wire [0:0] res_credits_ge1;
+  wire [5:0] k_2_1 = 6'h02;
+  wire [0:0] res_credits_ge2;
+  wire [5:0] k_3_1 = 6'h03;
+  wire [0:0] res_credits_ge3;
+  wire [0:0] mux_done_valid_r;
+  wire [0:0] mux_done_valid_r_1;
+  wire [0:0] res_credit_ok_c;
   wire [29:0] res_t_q;
   wire [12:0] res_tri_q;
   wire [0:0] res_hit_q;
@@ -962,7 +979,7 @@ module fxrt_core_sf0a3f4 (
   assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
   assign tri_e2q = $signed(u_tri_rom_2_data);
   assign pipe_tag = pipe_tag_sr[3];
-  assign bits_emit_tag_tri = emit_tag_tri[56:50];
+  assign emit_slot_sr = emit_slot_sr_sr[2];
   assign pipe_o = pipe_o_sr[2];
   assign pipe_w = pipe_w_sr[2];
   assign bits_pipe_o = pipe_o[28:0];
@@ -994,12 +1011,22 @@ module fxrt_core_sf0a3f4 (
     pipe_tag_sr[3] <= pipe_tag_sr[2];
     pipe_tag_sr[2] <= pipe_tag_sr[1];
     pipe_tag_sr[1] <= emit_tag_tri;
-    ray_o_q <= ray_o[bits_emit_tag_tri];
+    emit_slot_sr_sr[2] <= emit_slot_sr_sr[1];
+    emit_slot_sr_sr[1] <= leaf_slot;
+    ray_o_q <= ray_o[emit_slot_1_c1];
     pipe_o_sr[2] <= pipe_o_sr[1];
     pipe_o_sr[1] <= ray_o_q;
-    ray_w_q <= ray_w[bits_emit_tag_tri];
+    ray_w_q <= ray_w[emit_slot_1_c2];
     pipe_w_sr[2] <= pipe_w_sr[1];
     pipe_w_sr[1] <= ray_w_q;
+  end
+
+  // register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : emit_slot_1_copies_regs
+    emit_slot_1 <= emit_slot_sr;
+    emit_slot_1_c1 <= emit_slot_sr;
+    emit_slot_1_c2 <= emit_slot_sr;
   end
 
   // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
@@ -1018,7 +1045,7 @@ module fxrt_core_sf0a3f4 (
 
   always @(posedge clk) begin : done_regs
     if (rst) res_credit_ok <= 1'h1;
-    else res_credit_ok <= ne_52;
+    else res_credit_ok <= res_credit_ok_c;
     if (rst) u0_done_took <= 1'h0;
     else u0_done_took <= u0_done_pop;
     if (rst) u1_done_took <= 1'h0;
@@ -1058,8 +1085,12 @@ module fxrt_core_sf0a3f4 (
   assign minus_50 = res_credits - rs_done_valid_r;
   assign rs_res_take_1 = {{5{1'b0}}, res_take};
   assign res_credits_next = minus_50 + rs_res_take_1;
-  assign bits_res_credits_next = res_credits_next[5:1];
-  assign ne_52 = bits_res_credits_next != k_0_5;
+  assign res_credits_ge1 = k_1_6 <= res_credits;
+  assign res_credits_ge2 = k_2_1 <= res_credits;
+  assign res_credits_ge3 = k_3_1 <= res_credits;
+  assign mux_done_valid_r = done_valid_r ? res_credits_ge2 : res_credits_ge1;
+  assign mux_done_valid_r_1 = done_valid_r ? res_credits_ge3 : res_credits_ge2;
+  assign res_credit_ok_c = res_take ? mux_done_valid_r : mux_done_valid_r_1;
   assign res_t_q = res_q_head0[29:0];
   assign res_tri_q = res_q_head0[42:30];
   assign res_hit_q = res_q_head0[43];

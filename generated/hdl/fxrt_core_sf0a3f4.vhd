@@ -566,7 +566,9 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   type pipe_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal pipe_tag_sr : pipe_tag_sr_t := (others => (others => '0'));
   signal pipe_tag : unsigned(58 downto 0);
-  signal bits_emit_tag_tri : unsigned(6 downto 0);
+  type emit_slot_sr_sr_t is array (1 to 2) of unsigned(6 downto 0);
+  signal emit_slot_sr_sr : emit_slot_sr_sr_t := (others => (others => '0'));
+  signal emit_slot_sr : unsigned(6 downto 0);
   signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   type pipe_o_sr_t is array (1 to 2) of unsigned(86 downto 0);
   signal pipe_o_sr : pipe_o_sr_t := (others => (others => '0'));
@@ -590,6 +592,14 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_intersect_t_1 : unsigned(29 downto 0);
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
+
+  -- register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+  signal emit_slot_1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1 : signal is "true";
+  signal emit_slot_1_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c1 : signal is "true";
+  signal emit_slot_1_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c2 : signal is "true";
 
   -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   signal res_credit_ok : unsigned(0 downto 0) := unsigned'("1");
@@ -671,8 +681,15 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal minus_50 : unsigned(5 downto 0);
   signal rs_res_take_1 : unsigned(5 downto 0);
   signal res_credits_next : unsigned(5 downto 0);
-  signal bits_res_credits_next : unsigned(4 downto 0);
-  signal ne_52 : unsigned(0 downto 0);
+  constant k_1_6 : unsigned(5 downto 0) := unsigned'("000001");
+  signal res_credits_ge1 : unsigned(0 downto 0);
+  constant k_2_1 : unsigned(5 downto 0) := unsigned'("000010");
+  signal res_credits_ge2 : unsigned(0 downto 0);
+  constant k_3_1 : unsigned(5 downto 0) := unsigned'("000011");
+  signal res_credits_ge3 : unsigned(0 downto 0);
+  signal mux_done_valid_r : unsigned(0 downto 0);
+  signal mux_done_valid_r_1 : unsigned(0 downto 0);
+  signal res_credit_ok_c : unsigned(0 downto 0);
   signal res_t_q : unsigned(29 downto 0);
   signal res_tri_q : unsigned(12 downto 0);
   signal res_hit_q : unsigned(0 downto 0);
@@ -1229,7 +1246,7 @@ begin
   tri_e2p <= signed(bits_u_tri_rom_1_data_3);
   tri_e2q <= signed(u_tri_rom_2_data);
   pipe_tag <= pipe_tag_sr(3);
-  bits_emit_tag_tri <= unsigned(emit_tag_tri(56 downto 50));
+  emit_slot_sr <= emit_slot_sr_sr(2);
   pipe_o <= pipe_o_sr(2);
   pipe_w <= pipe_w_sr(2);
   bits_pipe_o <= unsigned(pipe_o(28 downto 0));
@@ -1279,14 +1296,27 @@ begin
       end if;
       pipe_tag_sr(2 to 3) <= pipe_tag_sr(1 to 2);
       pipe_tag_sr(1) <= emit_tag_tri;
-      ray_o_q <= ray_o(to_integer(bits_emit_tag_tri));
+      emit_slot_sr_sr(2 to 2) <= emit_slot_sr_sr(1 to 1);
+      emit_slot_sr_sr(1) <= leaf_slot;
+      ray_o_q <= ray_o(to_integer(emit_slot_1_c1));
       pipe_o_sr(2 to 2) <= pipe_o_sr(1 to 1);
       pipe_o_sr(1) <= ray_o_q;
-      ray_w_q <= ray_w(to_integer(bits_emit_tag_tri));
+      ray_w_q <= ray_w(to_integer(emit_slot_1_c2));
       pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
       pipe_w_sr(1) <= ray_w_q;
     end if;
   end process emission_regs;
+
+  -- register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+
+  emit_slot_1_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      emit_slot_1 <= emit_slot_sr;
+      emit_slot_1_c1 <= emit_slot_sr;
+      emit_slot_1_c2 <= emit_slot_sr;
+    end if;
+  end process emit_slot_1_copies_regs;
 
   -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   not_u0_done_took <= not u0_done_took;
@@ -1308,7 +1338,7 @@ begin
       if rst = '1' then
         res_credit_ok <= unsigned'("1");
       else
-        res_credit_ok <= ne_52;
+        res_credit_ok <= res_credit_ok_c;
       end if;
       if rst = '1' then
         u0_done_took <= unsigned'("0");
@@ -1359,8 +1389,12 @@ begin
   minus_50 <= res_credits - rs_done_valid_r;
   rs_res_take_1 <= resize(res_take, 6);
   res_credits_next <= minus_50 + rs_res_take_1;
-  bits_res_credits_next <= unsigned(res_credits_next(5 downto 1));
-  ne_52 <= "1" when bits_res_credits_next /= k_0_5 else "0";
+  res_credits_ge1 <= "1" when k_1_6 <= res_credits else "0";
+  res_credits_ge2 <= "1" when k_2_1 <= res_credits else "0";
+  res_credits_ge3 <= "1" when k_3_1 <= res_credits else "0";
+  mux_done_valid_r <= res_credits_ge2 when done_valid_r = "1" else res_credits_ge1;
+  mux_done_valid_r_1 <= res_credits_ge3 when done_valid_r = "1" else res_credits_ge2;
+  res_credit_ok_c <= mux_done_valid_r when res_take = "1" else mux_done_valid_r_1;
   res_t_q <= unsigned(res_q_head0(29 downto 0));
   res_tri_q <= unsigned(res_q_head0(42 downto 30));
   res_hit_q <= unsigned(res_q_head0(43 downto 43));
