@@ -539,32 +539,4 @@ mod tests {
         let k = b.konst(Ty::s(8), 100) + 100;
         assert!(matches!(b.with(|m| m.sig(k.sig.id).def.clone()), Def::Const(v) if Ty::s(8).value(v) == -56));
     }
-
-    /// A read of the word being written gives the old word, or its complement where the RAM
-    /// says such a read is undefined; a read of another word is not touched.
-    #[test]
-    fn a_read_of_the_word_being_written_is_wrong_where_undefined() {
-        for undefined in [false, true] {
-            let b = Builder::new("t");
-            let (we, waddr, raddr) = (b.input("we", Ty::BIT), b.input("waddr", Ty::u(2)), b.input("raddr", Ty::u(2)));
-            let mem = b.ram("mem", 8, vec![5; 4]);
-            b.ram_write(mem, we, waddr, b.konst(Ty::u(8), 9));
-            if undefined {
-                b.collision_undefined(mem);
-            }
-            b.output("q", b.read("q", mem, raddr));
-            let m = b.finish();
-            let mut sim = Sim::new(&m);
-            let (we, waddr, raddr) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]), m.handle(m.inputs[2]));
-            let q = m.handle(m.outputs[0].1);
-            let poison = if undefined { !5i128 & 0xff } else { 5 };
-            for (w, wa, ra, want) in [(1, 1, 2, 5), (1, 2, 2, poison), (0, 3, 3, 5), (1, 3, 2, 9), (1, 0, 0, poison)] {
-                sim.set(we, w);
-                sim.set(waddr, wa);
-                sim.set(raddr, ra);
-                sim.tick();
-                assert_eq!(sim.get(q), want, "undefined {undefined}: writing {wa} (enable {w}), reading {ra}");
-            }
-        }
-    }
 }
