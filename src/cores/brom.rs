@@ -104,9 +104,6 @@ pub fn bram_module(name: &str, width: u32, words: usize) -> Module {
     let raddr = b.input("raddr", Ty::u(bits));
     let mem = b.ram("mem", width, vec![0; words]);
     b.ram_write(mem, we, waddr, wdata);
-    // Built of DP16KDs (`fpga::ecp5::bram`), whose read of the word the other port writes is
-    // not defined: the simulator gives a wrong word there, so no check passes that uses one.
-    b.collision_undefined(mem);
     let word = b.read("word", mem, raddr);
     b.output("data", b.delay("data_r", word));
     b.finish()

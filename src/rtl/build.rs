@@ -228,12 +228,6 @@ impl Builder {
         self.m.borrow_mut().ram_write(mem, we.sig, addr.sig, data.sig);
     }
 
-    /// Marks RAM `mem`'s read of the word being written in the same clock undefined: the
-    /// simulator gives a wrong word there (`Rom::collision_undefined`).
-    pub fn collision_undefined(&self, mem: usize) {
-        self.m.borrow_mut().collision_undefined(mem);
-    }
-
     /// The word of memory `mem` at `addr`, one clock later.
     pub fn read(&self, name: &str, mem: usize, addr: S<'_>) -> S<'_> {
         self.s(self.m.borrow_mut().rom_read(name, mem, addr.sig))

@@ -12,8 +12,6 @@ use super::width::Ty;
 pub struct FlatMem {
     pub words: Vec<u128>,
     pub write: Option<(usize, usize, usize)>,
-    /// `Rom::collision_undefined`.
-    pub collision_undefined: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -44,7 +42,7 @@ struct Builder {
     signals: Vec<Global>,
     /// Hierarchical name of each global signal that came from a module's signal list.
     names: Vec<(String, usize)>,
-    mems: Vec<FlatMem>,
+    mems: Vec<(Vec<u128>, Option<(usize, usize, usize)>)>,
 }
 
 impl Builder {
@@ -58,7 +56,7 @@ impl Builder {
         let mem_base = self.mems.len();
         for r in &m.roms {
             let write = r.write.map(|(we, a, d)| (g(we).0 as usize, g(a).0 as usize, g(d).0 as usize));
-            self.mems.push(FlatMem { words: r.words.clone(), write, collision_undefined: r.collision_undefined });
+            self.mems.push((r.words.clone(), write));
         }
         let sub_bases: Vec<usize> = m
             .instances
@@ -143,8 +141,8 @@ pub fn flatten(m: &Module) -> Flat {
     }
     let mems = b
         .mems
-        .into_iter()
-        .map(|mem| FlatMem { write: mem.write.map(|(we, a, d)| (slot[we], slot[a], slot[d])), ..mem })
+        .iter()
+        .map(|(words, w)| FlatMem { words: words.clone(), write: w.map(|(we, a, d)| (slot[we], slot[a], slot[d])) })
         .collect();
     let comb_order = topological(&defs);
     let names = b.names.into_iter().map(|(name, i)| (name, slot[i])).collect();

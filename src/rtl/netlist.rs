@@ -173,11 +173,6 @@ pub struct Rom {
     /// A RAM's synchronous write port: (write enable, address, data). Reads see the old word
     /// in the cycle of a write to the same address (read-first, as block RAM does).
     pub write: Option<(SigId, SigId, SigId)>,
-    /// A read of the word the write port writes in the same clock is not defined (a RAM the
-    /// ECP5 flow builds of DP16KDs by hand, which do not define it across their ports): the
-    /// simulator reads such a word as the complement of the old word, so a design that uses
-    /// it fails its checks (`Sim::tick`). Printed like any RAM (read-first).
-    pub collision_undefined: bool,
 }
 
 /// An instance of another module: `inputs[i]` drives the sub-module's i-th input port; its
@@ -420,7 +415,7 @@ impl Module {
     pub fn rom(&mut self, name: &str, width: u32, words: Vec<u128>) -> usize {
         let name = self.unique_name(name);
         assert!(!words.is_empty());
-        self.roms.push(Rom { name, width, words, write: None, collision_undefined: false });
+        self.roms.push(Rom { name, width, words, write: None });
         self.roms.len() - 1
     }
 
@@ -439,12 +434,6 @@ impl Module {
         let depth = crate::bits::rom_depth(self.roms[mem].words.len());
         self.roms[mem].words.resize(depth, 0);
         self.roms[mem].write = Some((we.id, addr.id, data.id));
-    }
-
-    /// Marks RAM `mem`'s read of the word being written in the same clock undefined
-    /// (`Rom::collision_undefined`).
-    pub fn collision_undefined(&mut self, mem: usize) {
-        self.roms[mem].collision_undefined = true;
     }
 
     pub fn rom_read(&mut self, name: &str, rom: usize, addr: Sig) -> Sig {

@@ -37,10 +37,6 @@ pub struct Sim {
     next: Vec<u128>,
     /// Hierarchical signal names (`flatten::Flat::names`), sorted, for `probe`.
     names: Vec<(String, usize)>,
-    /// The reads of RAMs whose read of the word being written is undefined
-    /// (`Rom::collision_undefined`): (index in `rom_reads`, the write port's enable and
-    /// address slots, the word's mask).
-    undefined_reads: Vec<(usize, usize, usize, u128)>,
     /// The `rst` input of the module.
     pub reset: bool,
     pub cycles: u64,
@@ -93,15 +89,6 @@ impl Sim {
         let roms = flat.mems.iter().map(|r| r.words.clone()).collect();
         let writes =
             flat.mems.iter().enumerate().filter_map(|(k, r)| r.write.map(|(we, a, d)| (k, we, a, d))).collect();
-        let undefined_reads = rom_reads
-            .iter()
-            .enumerate()
-            .filter_map(|(k, r)| {
-                let mem = &flat.mems[r.rom];
-                let (we, addr, _) = mem.write.filter(|_| mem.collision_undefined)?;
-                Some((k, we, addr, tys[r.dst].mask()))
-            })
-            .collect();
         let next = vec![0; regs.len() + rom_reads.len()];
         let mut names = flat.names;
         names.sort();
@@ -116,7 +103,6 @@ impl Sim {
             writes,
             next,
             names,
-            undefined_reads,
             reset: false,
             cycles: 0,
             stale: true,
@@ -192,12 +178,6 @@ impl Sim {
             // Out-of-range addresses read 0, like an unloaded 2-state block RAM word.
             self.next[nr + k] = usize::try_from(v[r.addr]).ok().and_then(|a| words.get(a)).copied().unwrap_or(0);
         }
-        // A read of the word being written where that is undefined: the old word's complement.
-        for &(k, we, addr, mask) in &self.undefined_reads {
-            if v[we] & 1 == 1 && v[addr] == v[self.rom_reads[k].addr] {
-                self.next[nr + k] = !self.next[nr + k] & mask;
-            }
-        }
         // Writes after the reads: a read of the written address sees the old word.
         for &(mem, we, addr, data) in &self.writes {
             if v[we] & 1 == 1
@@ -214,39 +194,5 @@ impl Sim {
         }
         self.cycles += 1;
         self.eval();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::rtl::build::Builder;
-
-    /// A read of the word being written gives the old word, or its complement where the RAM
-    /// says such a read is undefined; a read of another word is not touched.
-    #[test]
-    fn a_read_of_the_word_being_written_is_wrong_where_undefined() {
-        for undefined in [false, true] {
-            let b = Builder::new("t");
-            let (we, waddr, raddr) = (b.input("we", Ty::BIT), b.input("waddr", Ty::u(2)), b.input("raddr", Ty::u(2)));
-            let mem = b.ram("mem", 8, vec![5; 4]);
-            b.ram_write(mem, we, waddr, b.konst(Ty::u(8), 9));
-            if undefined {
-                b.collision_undefined(mem);
-            }
-            b.output("q", b.read("q", mem, raddr));
-            let m = b.finish();
-            let mut sim = Sim::new(&m);
-            let (we, waddr, raddr) = (m.handle(m.inputs[0]), m.handle(m.inputs[1]), m.handle(m.inputs[2]));
-            let q = m.handle(m.outputs[0].1);
-            let poison = if undefined { !5i128 & 0xff } else { 5 };
-            for (w, wa, ra, want) in [(1, 1, 2, 5), (1, 2, 2, poison), (0, 3, 3, 5), (1, 3, 2, 9), (1, 0, 0, poison)] {
-                sim.set(we, w);
-                sim.set(waddr, wa);
-                sim.set(raddr, ra);
-                sim.tick();
-                assert_eq!(sim.get(q), want, "undefined {undefined}: writing {wa} (enable {w}), reading {ra}");
-            }
-        }
     }
 }
