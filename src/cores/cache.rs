@@ -366,15 +366,6 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     }
 }
 
-/// A record RAM of the cache: the word at `raddr` two clocks later. When a record takes two
-/// beats or more it is a block RAM module (`brom::bram`, whose second register the ECP5 flow
-/// makes the DP16KD's own output register: a DP16KD without it gives its data 5.8 ns after the
-/// clock, and the cache's record registers were the slowest paths of the teapot-fine core).
-/// A DP16KD's read of the word its other port writes in the same clock is not defined, and
-/// then no lookup uses it: the line's tag was written invalid at its first beat, which writes
-/// no record. A record of one beat is written at the first beat, while a lookup may still read
-/// the victim's tag valid, so it stays a RAM that yosys maps with the read-first behaviour the
-/// simulators give.
 /// A record RAM's write enable for way `way` as a register of its own, computed a clock early
 /// from the fill's next valid and the record counters' next values, when a record takes two
 /// beats or more (`None`: one beat). The enable of a block RAM module fans out to its DP16KDs,
@@ -401,6 +392,15 @@ fn early_write_enable<'b>(
     })
 }
 
+/// A record RAM of the cache: the word at `raddr` two clocks later. When a record takes two
+/// beats or more it is a block RAM module (`brom::bram`, whose second register the ECP5 flow
+/// makes the DP16KD's own output register: a DP16KD without it gives its data 5.8 ns after the
+/// clock, and the cache's record registers were the slowest paths of the teapot-fine core).
+/// A DP16KD's read of the word its other port writes in the same clock is not defined, and
+/// then no lookup uses it: the line's tag was written invalid at its first beat, which writes
+/// no record. A record of one beat is written at the first beat, while a lookup may still read
+/// the victim's tag valid, so it stays a RAM that yosys maps with the read-first behaviour the
+/// simulators give.
 #[allow(clippy::too_many_arguments)]
 fn record_ram<'b>(
     b: &'b Builder,
