@@ -47,13 +47,23 @@ pub fn input_latency(target: ClockTarget) -> u32 {
 
 /// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) from the pipeline; `id_we`, `id_slot`,
 /// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot` →
-/// `merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` (best t + 8, signed n + 3 bits),
-/// `merge_sp`; `free_valid`, `free_slot`; res_valid, res_id, res_hit, res_tri, res_t, res_u, res_v
+/// per traversal unit u `merge_valid{u}`, `merge_slot{u}` (the slot within the unit: the global
+/// slot's low bits below the `unit_bits` unit number), `merge_hit{u}`, and for all of them
+/// `merge_limit` (best t + 8, signed n + 3 bits), `merge_sp`; `free_valid`, `free_slot`; res_valid, res_id, res_hit, res_tri, res_t, res_u, res_v
 /// (t, u, v and tri read 0 for a miss), registered, three cycles after `done_valid`.
-pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u32, target: ClockTarget) -> Module {
+#[allow(clippy::too_many_arguments)]
+pub fn closest_core(
+    tag: TagLayout,
+    slots: u32,
+    [units, unit_bits]: [u32; 2],
+    id_bits: u32,
+    n: u32,
+    m_bits: u32,
+    target: ClockTarget,
+) -> Module {
     let staged = input_latency(target) > 0;
     let suffix = if staged { "_r2" } else { "" };
-    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}_s{slots}{suffix}", tag.width()));
+    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}_s{slots}_u{units}{suffix}", tag.width()));
     let valid = b.input("valid", Ty::BIT);
     let tag_in = b.input("tag", Ty::u(tag.width()));
     let hit = b.input("hit", Ty::BIT);
@@ -175,9 +185,25 @@ pub fn closest_core(tag: TagLayout, slots: u32, id_bits: u32, n: u32, m_bits: u3
     b.ram_write(uv_mem, we, m2_slots[1], m2_uv);
     let best_t = m2_better.select(m2_tt.slice(tri.width(), t.width()), m2_slot_t).name("merged_t");
     let limit = (best_t.xsigned().resize(dist) + 8).name("merged_limit");
-    b.output("merge_valid", b.valid_delay("merge_valid_r", m2));
-    b.output("merge_slot", b.delay("merge_slot_r", m2_slot));
-    b.output("merge_hit", b.delay("merge_hit_r", m2_hit));
+    // The merge reaches each traversal unit through registers of its own (valid, slot in the
+    // unit, hit): one shared set drove both units' cull-limit LUT-RAM write enables through
+    // the unit decode and an AND, across the die (12.1 ns at a seed of the external core).
+    let sb = tag.slot_bits - unit_bits;
+    let slot_r = b.delay("merge_slot_r", m2_slot.slice(0, sb));
+    let hit_r = b.delay("merge_hit_r", m2_hit);
+    let (slot_copies, hit_copies) = (b.copies(slot_r, units as usize - 1), b.copies(hit_r, units as usize - 1));
+    for u in 0..units {
+        let mine = if unit_bits == 0 {
+            m2
+        } else {
+            (m2 & m2_slot.slice(sb, unit_bits).eq(u as i128)).name(&format!("m2_unit{u}"))
+        };
+        let k = u as usize;
+        let (slot_u, hit_u) = if k == 0 { (slot_r, hit_r) } else { (slot_copies[k - 1], hit_copies[k - 1]) };
+        b.output(&format!("merge_valid{u}"), b.valid_delay(&format!("merge_valid{u}_r"), mine));
+        b.output(&format!("merge_slot{u}"), slot_u);
+        b.output(&format!("merge_hit{u}"), hit_u);
+    }
     b.output("merge_limit", b.delay("merge_limit_r", limit));
     b.output("merge_sp", b.delay("merge_sp_r", m2_sp));
 

@@ -86,8 +86,10 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
 /// closest-hit unit and the leaf stream drive.
 struct Units<'b> {
     trav: Vec<Ports<'b>>,
-    /// A leaf merged (closest-hit unit → its unit): valid, global slot, hit, limit, sp.
-    merge: [S<'b>; 5],
+    /// A leaf merged (closest-hit unit → its unit): per unit valid, slot in the unit, hit.
+    merge_unit: Vec<[S<'b>; 3]>,
+    /// … and for all units the limit and sp.
+    merge: [S<'b>; 2],
     /// A slot freed (its result left the core): valid, global slot.
     free: [S<'b>; 2],
     leaf_pop: Vec<S<'b>>,
@@ -106,13 +108,13 @@ fn traversal_units<'b>(
     let (units, sb, ub, gb, bit) = (p.units, p.trav.slot_bits(), p.unit_bits(), p.tag.slot_bits, Ty::BIT);
     b.stage("units", "the traversal units (K ray slots each) and their node ROMs, one per two units");
     let wire = |name: &str, ty: Ty| b.wire(name, ty);
-    let merge = [
-        wire("merge_valid", bit),
-        wire("merge_slot", Ty::u(gb)),
-        wire("merge_hit", bit),
-        wire("merge_limit", p.trav.dist_ty()),
-        wire("merge_sp", Ty::u(p.trav.sp_width())),
-    ];
+    let merge_unit: Vec<[S; 3]> = (0..units)
+        .map(|u| {
+            let w = |name: &str, ty: Ty| wire(&format!("u{u}_merge_{name}"), ty);
+            [w("valid", bit), w("slot", Ty::u(sb)), w("hit", bit)]
+        })
+        .collect();
+    let merge = [wire("merge_limit", p.trav.dist_ty()), wire("merge_sp", Ty::u(p.trav.sp_width()))];
     let free = [wire("free_valid", bit), wire("free_slot", Ty::u(gb))];
     let leaf_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_leaf_pop"), bit)).collect();
     let done_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_done_pop"), bit)).collect();
@@ -130,13 +132,13 @@ fn traversal_units<'b>(
             .collect(),
         None => Vec::new(),
     };
-    let [merge_valid, merge_slot, merge_hit, merge_limit, merge_sp] = merge;
+    let [merge_limit, merge_sp] = merge;
     let [free_valid, free_slot] = free;
     let trav: Vec<_> = (0..units)
         .map(|u| {
             let we = (port.accept & is_unit(port.slot, u, sb, ub)).name(&format!("u{u}_alloc"));
             let new_valid = (exit.done & is_unit(exit.slot, u, sb, ub)).name(&format!("u{u}_new"));
-            let mv = (merge_valid & is_unit(merge_slot, u, sb, ub)).name(&format!("u{u}_merge"));
+            let [mv, merge_slot, merge_hit] = merge_unit[u as usize];
             let fv = (free_valid & is_unit(free_slot, u, sb, ub)).name(&format!("u{u}_free"));
             let [ox, oy, oz] = port.o;
             let [ix, iy, iz] = port.inv;
@@ -154,7 +156,7 @@ fn traversal_units<'b>(
                 ("new_tmax", exit.tmax),
                 ("new_miss", exit.miss),
                 ("merge_valid", mv),
-                ("merge_slot", merge_slot.slice(0, sb)),
+                ("merge_slot", merge_slot),
                 ("merge_hit", merge_hit),
                 ("merge_limit", merge_limit),
                 ("merge_sp", merge_sp),
@@ -177,7 +179,7 @@ fn traversal_units<'b>(
     if p.mem.is_none() {
         node_roms(b, p, scene, &trav, &node_words);
     }
-    Units { trav, merge, free, leaf_pop, done_pop, node_in }
+    Units { trav, merge_unit, merge, free, leaf_pop, done_pop, node_in }
 }
 
 /// The node ROM: one per two units, on a block RAM's two ports.
@@ -232,15 +234,27 @@ fn results<'b>(
         done_slot = done_any.select(done_slot, b.cat(&[b.konst(Ty::u(ub), u as i128), trav[u].get("done_slot")]));
         done_any = done_any | dv[u];
     }
-    let closest =
-        Rc::new(closest_core(p.tag, p.total_slots(), p.trav.id_width, p.isect.n, p.isect.m, p.isect.target()));
+    let closest = Rc::new(closest_core(
+        p.tag,
+        p.total_slots(),
+        [p.units, p.unit_bits()],
+        p.trav.id_width,
+        p.isect.n,
+        p.isect.m,
+        p.isect.target(),
+    ));
     let mut cin: Vec<S> = emitted.pipe.all().to_vec();
     // Registered before the closest-hit unit, whose per-slot selects it drives (the units'
     // queues sit across the die).
     let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
     cin.extend([port.accept, port.closest_slot, port.id, done_any, done_slot]);
     let res = b.instance("u_closest", &closest, &cin);
-    let names = ["merge_valid", "merge_slot", "merge_hit", "merge_limit", "merge_sp", "free_valid", "free_slot"];
+    for (u, wires) in units.merge_unit.iter().enumerate() {
+        for (wire, name) in wires.iter().zip(["valid", "slot", "hit"]) {
+            b.drive(*wire, res.get(&format!("merge_{name}{u}")));
+        }
+    }
+    let names = ["merge_limit", "merge_sp", "free_valid", "free_slot"];
     for (wire, name) in units.merge.iter().chain(&units.free).zip(names) {
         b.drive(*wire, res.get(name));
     }

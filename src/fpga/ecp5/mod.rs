@@ -117,7 +117,15 @@ pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &
         "intersect" => (intersect::intersect_core(isect), Some(isect.latency())),
         "traverse" => (traverse::traverse_core(&core.trav), None),
         "closest" => (
-            closest::closest_core(core.tag, core.total_slots(), core.trav.id_width, isect.n, isect.m, isect.target()),
+            closest::closest_core(
+                core.tag,
+                core.total_slots(),
+                [core.units, core.unit_bits()],
+                core.trav.id_width,
+                isect.n,
+                isect.m,
+                isect.target(),
+            ),
             Some(1 + closest::input_latency(isect.target())),
         ),
         // The core as integrators get it: no observation ports.
