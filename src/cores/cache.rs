@@ -72,6 +72,10 @@ pub struct Lookup<'b> {
     pub valid: S<'b>,
     pub line: S<'b>,
     pub rec: S<'b>,
+    /// A register that withdraws the lookup a clock after `valid` (the node's cull test, known
+    /// a clock late): the lookup goes no further than the cache's first register, which then
+    /// never sees the cull test's carry chain (10.5 ns into it at a seed of the external core).
+    pub cancel: Option<S<'b>>,
 }
 
 /// The answer, `LATENCY` clocks after the lookup.
@@ -276,7 +280,11 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
         })
         .collect();
     // The in-flight table is searched for the line meanwhile.
-    let l1_valid = b.valid_delay(&nm("l1_valid"), l0_valid);
+    let l0_kept = match look.cancel {
+        Some(cancel) => (l0_valid & !cancel).name(&nm("l0_kept")),
+        None => l0_valid,
+    };
+    let l1_valid = b.valid_delay(&nm("l1_valid"), l0_kept);
     let l1_line = b.delay(&nm("l1_line"), l0_line);
     let tag_r: Vec<S<'b>> = tag_q.iter().enumerate().map(|(w, &t)| b.delay(&nm(&format!("tag_r{w}")), t)).collect();
     // The compare, while the in-flight table is searched for the line; both registered.

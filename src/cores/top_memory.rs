@@ -90,7 +90,8 @@ pub fn memory_side<'b>(
         } else {
             record.slice(0, shift).resize(m.node.rec_bits())
         };
-        let look = Lookup { valid: t.get("node_look"), line: (record >> shift).resize(m.node.line_bits), rec };
+        let line = (record >> shift).resize(m.node.line_bits);
+        let look = Lookup { valid: t.get("node_look"), line, rec, cancel: Some(t.get("node_look_culled")) };
         let c = cache(b, &format!("nc{u}"), &m.node, &look, &fills[u]);
         let [word, hit, wait, done] = node_in[u];
         b.drive(word, c.answer.data[0]);

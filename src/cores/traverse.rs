@@ -65,7 +65,7 @@ pub fn traverse_core(p: &TraverseParams) -> Module {
     // The top's pops arrive a clock late (registered here: the top's arbiter sits across the
     // die), so it does not take from a queue again in the clock after it took.
     let done = fifo(&b, "done_q", u.sb, p.slots, a.done, a.slot, b.valid_delay("done_pop_r", u.inp.done_pop));
-    let (c, culled, lookup) = u.ring_c(bt, b_from_stack, a.stack_top, &a);
+    let (c, [culled_first, culled], lookup) = u.ring_c(bt, b_from_stack, a.stack_top, &a);
     let n = u.ring_n(c, culled, &q);
     let f = u.ring_f(&n);
     u.ring_g(&f, &r, &a.push, q.ring_g_valid);
@@ -74,6 +74,7 @@ pub fn traverse_core(p: &TraverseParams) -> Module {
         // With a node cache: the lookup a clock after C.
         Some([valid, node]) => {
             b.output("node_look", valid);
+            b.output("node_look_culled", culled_first);
             u.outputs(&slots, node, &n, &done);
         }
         None => u.outputs(&slots, c.node, &n, &done),

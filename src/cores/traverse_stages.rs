@@ -516,15 +516,16 @@ impl<'b> Unit<'b> {
 
     /// C: a popped entry (far node, far_min, tmax) from the stack word; the node ROM is
     /// addressed; the cull test: lower_t(tmin) > best t ⟺ tmin − tmin/64 > best t + 8
-    /// (`golden::lower_t`), only when the slot has a best hit. Returns C's token and the cull
-    /// decision as seen in N, and with a node cache the lookup (valid, node) a clock after C.
+    /// (`golden::lower_t`), only when the slot has a best hit. Returns C's token, the cull
+    /// decision registered (two clocks after C) and as seen in N, and with a node cache the
+    /// lookup (valid, node) a clock after C.
     pub(super) fn ring_c(
         &self,
         bt: Token<'b>,
         from_stack: S<'b>,
         top: S<'b>,
         a: &RingA<'b>,
-    ) -> (Token<'b>, S<'b>, Option<[S<'b>; 2]>) {
+    ) -> (Token<'b>, [S<'b>; 2], Option<[S<'b>; 2]>) {
         let (b, k, dist, inp) = (self.b, self.p.slots, self.dist, &self.inp);
         b.stage("ring_c", "C: a popped entry from the stack word; the node ROM addressed; the cull test");
         let top_tmax = top.slice(0, dist.width).signed();
@@ -545,19 +546,17 @@ impl<'b> Unit<'b> {
         let arms: Vec<(u128, S)> = (0..k).map(|i| (i as u128, has_best.bit(i))).collect();
         let hb = b.delay("cull_has_best", b.case(c.slot, &arms, b.konst(Ty::BIT, 0)).name("slot_has_best"));
         let culled_c = (hb & lt_chain(limit, x)).name("culled_c");
-        // With a node cache, the lookup a clock after C, once the cull test is known: a culled
-        // entry fetches nothing.
-        let lookup = self.p.node_cache.then(|| {
-            let valid = (b.valid_delay("look_valid", c.valid) & !culled_c).name("node_look_c");
-            [valid, b.delay("look_node", c.node)]
-        });
-        let culled = b.delay("culled", culled_c);
-        let culled = b.delay_line("culled_n", culled, self.p.node_rom_cycles - 2);
+        // With a node cache, the lookup a clock after C; the cull test, known then, withdraws
+        // it a clock later (`culled`, the cache's `Lookup::cancel`): a culled entry fetches
+        // nothing.
+        let lookup = self.p.node_cache.then(|| [b.valid_delay("look_valid", c.valid), b.delay("look_node", c.node)]);
+        let culled_first = b.delay("culled", culled_c);
+        let culled = b.delay_line("culled_n", culled_first, self.p.node_rom_cycles - 2);
         let onehot_or_0 = |v: S<'b>, slot: S<'b>| v.select(onehot(slot, k), b.konst(Ty::u(k), 0));
         let set_best = onehot_or_0(inp.merge_valid & inp.merge_hit, inp.merge_slot).name("best_set");
         let clear_best = onehot_or_0(a.new & a.valid, a.slot).name("best_clear");
         b.next(has_best, (has_best & !clear_best) | set_best);
-        (c, culled, lookup)
+        (c, [culled_first, culled], lookup)
     }
 
     /// N: the node word. A culled entry or an empty leaf goes on as a pop; a leaf with entries

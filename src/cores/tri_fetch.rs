@@ -126,6 +126,7 @@ pub fn tri_fetch<'b>(
         valid: (f_valid & !skip).name("tri_look_valid"),
         line: b.delay("fetch1_line", (w_ptr >> sb).resize(m.tri.line_bits)),
         rec: b.delay("fetch1_rec", rec),
+        cancel: None,
     };
     let Cache { answer, request: (req_valid, req_line), done } = cache(b, "tc", &m.tri, &look, fill);
     b.drive(request.0, req_valid);

@@ -85,6 +85,7 @@ pub fn mem_side(name: &str, ap: &AxiReadParams, caches: &[(CacheParams, u64)]) -
             valid: b.input(&format!("look{c}_valid"), Ty::BIT),
             line: b.input(&format!("look{c}_line"), Ty::u(p.line_bits)),
             rec: b.input(&format!("look{c}_rec"), Ty::u(p.rec_bits())),
+            cancel: None,
         })
         .collect();
     let bus = AxiIn {
