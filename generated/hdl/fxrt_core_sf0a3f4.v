@@ -225,9 +225,12 @@ module fxrt_core_sf0a3f4 (
   wire [6:0] box_done_slot;
 
   // stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
-  wire [0:0] merge_valid;
-  wire [6:0] merge_slot;
-  wire [0:0] merge_hit;
+  wire [0:0] u0_merge_valid;
+  wire [5:0] u0_merge_slot;
+  wire [0:0] u0_merge_hit;
+  wire [0:0] u1_merge_valid;
+  wire [5:0] u1_merge_slot;
+  wire [0:0] u1_merge_hit;
   wire signed [31:0] merge_limit;
   wire [5:0] merge_sp;
   wire [0:0] free_valid;
@@ -244,14 +247,10 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] bits_box_done_slot;
   wire [0:0] eq_11;
   wire [0:0] u0_new;
-  wire [0:0] bits_merge_slot;
-  wire [0:0] bits_merge_slot_eq_k_0_1;
-  wire [0:0] u0_merge;
   wire [0:0] bits_free_slot;
   wire [0:0] bits_free_slot_eq_k_0_1;
   wire [0:0] u0_free;
   wire [5:0] bits_box_done_slot_1;
-  wire [5:0] bits_merge_slot_1;
   wire [5:0] bits_free_slot_1;
   wire [12:0] u_traverse_0_node_addr;
   wire [0:0] u_traverse_0_has_free;
@@ -283,19 +282,15 @@ module fxrt_core_sf0a3f4 (
   wire [6:0] u_traverse_0_occupied;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_accept_slot_1;
-  wire [0:0] eq_14;
+  wire [0:0] eq_13;
   wire [0:0] u1_alloc;
   wire [0:0] bits_box_done_slot_2;
-  wire [0:0] eq_15;
+  wire [0:0] eq_14;
   wire [0:0] u1_new;
-  wire [0:0] bits_merge_slot_2;
-  wire [0:0] bits_merge_slot_2_eq_k_1;
-  wire [0:0] u1_merge;
   wire [0:0] bits_free_slot_2;
   wire [0:0] bits_free_slot_2_eq_k_1;
   wire [0:0] u1_free;
   wire [5:0] bits_box_done_slot_3;
-  wire [5:0] bits_merge_slot_3;
   wire [5:0] bits_free_slot_3;
   wire [12:0] u_traverse_1_node_addr;
   wire [0:0] u_traverse_1_has_free;
@@ -330,11 +325,11 @@ module fxrt_core_sf0a3f4 (
   wire [72:0] u_node_rom_0_data_b;
 
   // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  wire [86:0] cat_18;
+  wire [86:0] cat_16;
   wire [31:0] u_acc_in_wz;
   wire [31:0] u_acc_in_wy;
   wire [31:0] u_acc_in_wx;
-  wire [95:0] cat_19;
+  wire [95:0] cat_17;
 
   // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   reg [0:0] leaf_active = 1'h0;
@@ -369,24 +364,24 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] case_leaf_turn_1;
   wire [0:0] case_leaf_turn_2;
   wire [0:0] case_leaf_turn_3;
-  wire [0:0] or_24;
+  wire [0:0] or_22;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_25;
+  wire [0:0] eq_23;
   wire [0:0] u0_leaf_take;
   wire [0:0] not_u0_leaf_take;
-  wire [0:0] and_26;
-  wire [0:0] u0_leaf_fill_or_and_26;
-  wire [0:0] eq_27;
+  wire [0:0] and_24;
+  wire [0:0] u0_leaf_fill_or_and_24;
+  wire [0:0] eq_25;
   wire [0:0] u1_leaf_take;
   wire [0:0] not_u1_leaf_take;
-  wire [0:0] and_28;
-  wire [0:0] u1_leaf_fill_or_and_28;
+  wire [0:0] and_26;
+  wire [0:0] u1_leaf_fill_or_and_26;
   wire [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_29;
+  wire [6:0] cat_27;
   wire [0:0] not_leaf_last_entry;
-  wire [0:0] and_30;
-  wire [0:0] leaf_take_or_and_30;
+  wire [0:0] and_28;
+  wire [0:0] leaf_take_or_and_28;
   wire [6:0] mux_leaf_take;
   wire [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
@@ -401,7 +396,7 @@ module fxrt_core_sf0a3f4 (
   wire [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   wire [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_31;
+  wire [0:0] eq_29;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
@@ -409,7 +404,7 @@ module fxrt_core_sf0a3f4 (
   // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_32;
+  wire [58:0] cat_30;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -489,23 +484,26 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] res_credit_ok = 1'h1;
   reg [0:0] u0_done_took = 1'h0;
   wire [0:0] not_u0_done_took;
-  wire [0:0] and_34;
+  wire [0:0] and_32;
   wire [0:0] u0_done_avail;
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
-  wire [0:0] and_35;
+  wire [0:0] and_33;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_36;
+  wire [6:0] cat_34;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_38;
+  wire [6:0] cat_36;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_39;
+  wire [0:0] or_37;
   reg [0:0] done_valid_r = 1'h0;
   reg [6:0] done_slot_r = 7'h00;
-  wire [0:0] u_closest_merge_valid;
-  wire [6:0] u_closest_merge_slot;
-  wire [0:0] u_closest_merge_hit;
+  wire [0:0] u_closest_merge_valid0;
+  wire [5:0] u_closest_merge_slot0;
+  wire [0:0] u_closest_merge_hit0;
+  wire [0:0] u_closest_merge_valid1;
+  wire [5:0] u_closest_merge_slot1;
+  wire [0:0] u_closest_merge_hit1;
   wire signed [31:0] u_closest_merge_limit;
   wire [5:0] u_closest_merge_sp;
   wire [0:0] u_closest_free_valid;
@@ -519,8 +517,8 @@ module fxrt_core_sf0a3f4 (
   wire [31:0] u_closest_res_v;
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  wire [63:0] cat_40;
-  wire [63:0] cat_41;
+  wire [63:0] cat_38;
+  wire [63:0] cat_39;
   wire [0:0] res_take;
   reg [0:0] res_q_push = 1'h0;
   reg [3:0] res_q_wr = 4'h0;
@@ -541,15 +539,15 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_q_count_eq_k_0_5;
   wire [4:0] k_1_5 = 5'h01;
   wire [0:0] res_q_one_left;
-  wire [0:0] and_44;
+  wire [0:0] and_42;
   wire [0:0] res_q_drained;
   reg [0:0] res_q_bypass = 1'h0;
   wire [0:0] res_q_bypass_c;
   reg [0:0] res_q_nonempty = 1'h0;
   wire [0:0] k_1_5_lt_res_q_count;
-  wire [0:0] or_47;
+  wire [0:0] or_45;
   wire [0:0] not_res_take;
-  wire [0:0] and_48;
+  wire [0:0] and_46;
   wire [0:0] res_q_nonempty_c;
   reg [63:0] res_q_din0 = 64'h0000000000000000;
   reg [63:0] res_q_q0 = 64'h0000000000000000;
@@ -562,7 +560,7 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_take_c;
   reg [5:0] res_credits = 6'h10;
   wire [5:0] rs_done_valid_r;
-  wire [5:0] minus_50;
+  wire [5:0] minus_48;
   wire [5:0] rs_res_take_1;
   wire [5:0] res_credits_next;
   wire [5:0] k_1_6 = 6'h01;
@@ -584,8 +582,8 @@ module fxrt_core_sf0a3f4 (
   // not in a stage or state machine
 
   always @(posedge clk) begin : regs
-    if (accept) ray_o[accept_slot_c1] <= cat_18;
-    if (accept) ray_w[accept_slot_c1] <= cat_19;
+    if (accept) ray_o[accept_slot_c1] <= cat_16;
+    if (accept) ray_w[accept_slot_c1] <= cat_17;
     if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
     if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
   end
@@ -801,9 +799,12 @@ module fxrt_core_sf0a3f4 (
   end
 
   // stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
-  assign merge_valid = u_closest_merge_valid;
-  assign merge_slot = u_closest_merge_slot;
-  assign merge_hit = u_closest_merge_hit;
+  assign u0_merge_valid = u_closest_merge_valid0;
+  assign u0_merge_slot = u_closest_merge_slot0;
+  assign u0_merge_hit = u_closest_merge_hit0;
+  assign u1_merge_valid = u_closest_merge_valid1;
+  assign u1_merge_slot = u_closest_merge_slot1;
+  assign u1_merge_hit = u_closest_merge_hit1;
   assign merge_limit = u_closest_merge_limit;
   assign merge_sp = u_closest_merge_sp;
   assign free_valid = u_closest_free_valid;
@@ -820,37 +821,29 @@ module fxrt_core_sf0a3f4 (
   assign bits_box_done_slot = box_done_slot[6];
   assign eq_11 = bits_box_done_slot == k_0_1;
   assign u0_new = box_done & eq_11;
-  assign bits_merge_slot = merge_slot[6];
-  assign bits_merge_slot_eq_k_0_1 = bits_merge_slot == k_0_1;
-  assign u0_merge = merge_valid & bits_merge_slot_eq_k_0_1;
   assign bits_free_slot = free_slot[6];
   assign bits_free_slot_eq_k_0_1 = bits_free_slot == k_0_1;
   assign u0_free = free_valid & bits_free_slot_eq_k_0_1;
   assign bits_box_done_slot_1 = box_done_slot[5:0];
-  assign bits_merge_slot_1 = merge_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
   assign bits_accept_slot_1 = accept_slot[6];
-  assign eq_14 = bits_accept_slot_1 == k_1;
-  assign u1_alloc = accept & eq_14;
+  assign eq_13 = bits_accept_slot_1 == k_1;
+  assign u1_alloc = accept & eq_13;
   assign bits_box_done_slot_2 = box_done_slot[6];
-  assign eq_15 = bits_box_done_slot_2 == k_1;
-  assign u1_new = box_done & eq_15;
-  assign bits_merge_slot_2 = merge_slot[6];
-  assign bits_merge_slot_2_eq_k_1 = bits_merge_slot_2 == k_1;
-  assign u1_merge = merge_valid & bits_merge_slot_2_eq_k_1;
+  assign eq_14 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_14;
   assign bits_free_slot_2 = free_slot[6];
   assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
   assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
   assign bits_box_done_slot_3 = box_done_slot[5:0];
-  assign bits_merge_slot_3 = merge_slot[5:0];
   assign bits_free_slot_3 = free_slot[5:0];
 
   // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  assign cat_18 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign cat_16 = {acc_in_oz, acc_in_oy, acc_in_ox};
   assign u_acc_in_wz = $unsigned(acc_in_wz);
   assign u_acc_in_wy = $unsigned(acc_in_wy);
   assign u_acc_in_wx = $unsigned(acc_in_wx);
-  assign cat_19 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
+  assign cat_17 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
 
   // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   assign leaf_last_entry = leaf_active & leaf_last;
@@ -876,28 +869,28 @@ module fxrt_core_sf0a3f4 (
     (leaf_turn == 1'h0) ? k_1 :
     (leaf_turn == 1'h1) ? k_0_1 :
     k_0_1;
-  assign or_24 = case_leaf_turn_2 | case_leaf_turn;
+  assign or_22 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_24;
-  assign eq_25 = mux_case_leaf_turn_2 == k_0_1;
-  assign u0_leaf_take = leaf_take & eq_25;
+  assign leaf_take = leaf_can_take & or_22;
+  assign eq_23 = mux_case_leaf_turn_2 == k_0_1;
+  assign u0_leaf_take = leaf_take & eq_23;
   assign not_u0_leaf_take = ~u0_leaf_take;
-  assign and_26 = u0_leaf_buf_valid & not_u0_leaf_take;
-  assign u0_leaf_fill_or_and_26 = u0_leaf_fill | and_26;
-  assign eq_27 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_27;
+  assign and_24 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_24 = u0_leaf_fill | and_24;
+  assign eq_25 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_25;
   assign not_u1_leaf_take = ~u1_leaf_take;
-  assign and_28 = u1_leaf_buf_valid & not_u1_leaf_take;
-  assign u1_leaf_fill_or_and_28 = u1_leaf_fill | and_28;
+  assign and_26 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_26 = u1_leaf_fill | and_26;
   assign case_mux_case_leaf_turn_2 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_slot :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_slot :
     u0_buf_leaf_slot;
-  assign cat_29 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_27 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_30 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_30 = leaf_take | and_30;
-  assign mux_leaf_take = leaf_take ? cat_29 : leaf_slot;
+  assign and_28 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_28 = leaf_take | and_28;
+  assign mux_leaf_take = leaf_take ? cat_27 : leaf_slot;
   assign case_mux_case_leaf_turn_2_1 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_first :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_first :
@@ -924,13 +917,13 @@ module fxrt_core_sf0a3f4 (
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_count :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_count :
     u0_buf_leaf_count;
-  assign eq_31 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_29 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_31 : leaf_left_eq_k_2;
+  assign mux_leaf_take_5 = leaf_take ? eq_29 : leaf_left_eq_k_2;
 
   always @(posedge clk) begin : leaf_stream_regs
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_30;
+    else leaf_active <= leaf_take_or_and_28;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -941,14 +934,14 @@ module fxrt_core_sf0a3f4 (
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
     if (rst) u0_leaf_buf_valid <= 1'h0;
-    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_26;
+    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_24;
     if (u0_leaf_fill) u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
     if (u0_leaf_fill) u0_buf_leaf_first <= u_traverse_0_leaf_first;
     if (u0_leaf_fill) u0_buf_leaf_count <= u_traverse_0_leaf_count;
     if (u0_leaf_fill) u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
     if (u0_leaf_fill) u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
     if (rst) u1_leaf_buf_valid <= 1'h0;
-    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_28;
+    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_26;
     if (u1_leaf_fill) u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
     if (u1_leaf_fill) u1_buf_leaf_first <= u_traverse_1_leaf_first;
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
@@ -957,7 +950,7 @@ module fxrt_core_sf0a3f4 (
   end
 
   // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
-  assign cat_32 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign cat_30 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -995,7 +988,7 @@ module fxrt_core_sf0a3f4 (
   always @(posedge clk) begin : emission_regs
     emit_tag_sr[3] <= emit_tag_sr[2];
     emit_tag_sr[2] <= emit_tag_sr[1];
-    emit_tag_sr[1] <= cat_32;
+    emit_tag_sr[1] <= cat_30;
     if (rst) emit_valid_1 <= 1'h0;
     else emit_valid_1 <= leaf_active;
     if (rst) emit_valid_2 <= 1'h0;
@@ -1031,17 +1024,17 @@ module fxrt_core_sf0a3f4 (
 
   // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   assign not_u0_done_took = ~u0_done_took;
-  assign and_34 = u_traverse_0_done_valid & not_u0_done_took;
-  assign u0_done_avail = and_34 & res_credit_ok;
+  assign and_32 = u_traverse_0_done_valid & not_u0_done_took;
+  assign u0_done_avail = and_32 & res_credit_ok;
   assign not_u1_done_took = ~u1_done_took;
-  assign and_35 = u_traverse_1_done_valid & not_u1_done_took;
-  assign u1_done_avail = and_35 & res_credit_ok;
-  assign cat_36 = {k_0_1, u_traverse_0_done_slot};
+  assign and_33 = u_traverse_1_done_valid & not_u1_done_took;
+  assign u1_done_avail = and_33 & res_credit_ok;
+  assign cat_34 = {k_0_1, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_38 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_36 : cat_38;
-  assign or_39 = u0_done_avail | u1_done_avail;
+  assign cat_36 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_34 : cat_36;
+  assign or_37 = u0_done_avail | u1_done_avail;
 
   always @(posedge clk) begin : done_regs
     if (rst) res_credit_ok <= 1'h1;
@@ -1051,13 +1044,13 @@ module fxrt_core_sf0a3f4 (
     if (rst) u1_done_took <= 1'h0;
     else u1_done_took <= u1_done_pop;
     if (rst) done_valid_r <= 1'h0;
-    else done_valid_r <= or_39;
+    else done_valid_r <= or_37;
     done_slot_r <= mux_u0_done_avail;
   end
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  assign cat_40 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
-  assign cat_41 = {u_closest_res_u, u_closest_res_v};
+  assign cat_38 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
+  assign cat_39 = {u_closest_res_u, u_closest_res_v};
   assign res_take = res_take_c;
   assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
   assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
@@ -1070,21 +1063,21 @@ module fxrt_core_sf0a3f4 (
   assign res_q_count_next = res_q_after_pop + rs_res_q_push;
   assign res_q_count_eq_k_0_5 = res_q_count == k_0_5;
   assign res_q_one_left = res_q_count == k_1_5;
-  assign and_44 = res_q_one_left & res_take;
-  assign res_q_drained = res_q_count_eq_k_0_5 | and_44;
+  assign and_42 = res_q_one_left & res_take;
+  assign res_q_drained = res_q_count_eq_k_0_5 | and_42;
   assign res_q_bypass_c = res_q_push & res_q_drained;
   assign k_1_5_lt_res_q_count = k_1_5 < res_q_count;
-  assign or_47 = res_q_push | k_1_5_lt_res_q_count;
+  assign or_45 = res_q_push | k_1_5_lt_res_q_count;
   assign not_res_take = ~res_take;
-  assign and_48 = res_q_one_left & not_res_take;
-  assign res_q_nonempty_c = or_47 | and_48;
+  assign and_46 = res_q_one_left & not_res_take;
+  assign res_q_nonempty_c = or_45 | and_46;
   assign res_q_head0 = res_q_bypass ? res_q_din_r0 : res_q_q0;
   assign res_q_head1 = res_q_bypass ? res_q_din_r1 : res_q_q1;
   assign res_take_c = res_q_nonempty & res_ready;
   assign rs_done_valid_r = {{5{1'b0}}, done_valid_r};
-  assign minus_50 = res_credits - rs_done_valid_r;
+  assign minus_48 = res_credits - rs_done_valid_r;
   assign rs_res_take_1 = {{5{1'b0}}, res_take};
-  assign res_credits_next = minus_50 + rs_res_take_1;
+  assign res_credits_next = minus_48 + rs_res_take_1;
   assign res_credits_ge1 = k_1_6 <= res_credits;
   assign res_credits_ge2 = k_2_1 <= res_credits;
   assign res_credits_ge3 = k_3_1 <= res_credits;
@@ -1113,10 +1106,10 @@ module fxrt_core_sf0a3f4 (
     else res_q_bypass <= res_q_bypass_c;
     if (rst) res_q_nonempty <= 1'h0;
     else res_q_nonempty <= res_q_nonempty_c;
-    res_q_din0 <= cat_40;
+    res_q_din0 <= cat_38;
     res_q_q0 <= res_q_mem0[res_q_rd_next];
     if (res_q_push) res_q_din_r0 <= res_q_din0;
-    res_q_din1 <= cat_41;
+    res_q_din1 <= cat_39;
     res_q_q1 <= res_q_mem1[res_q_rd_next];
     if (res_q_push) res_q_din_r1 <= res_q_din1;
     if (rst) res_credits <= 6'h10;
@@ -1145,9 +1138,9 @@ module fxrt_core_sf0a3f4 (
     .new_slot(bits_box_done_slot_1),
     .new_tmax(box_tmax),
     .new_miss(box_miss),
-    .merge_valid(u0_merge),
-    .merge_slot(bits_merge_slot_1),
-    .merge_hit(merge_hit),
+    .merge_valid(u0_merge_valid),
+    .merge_slot(u0_merge_slot),
+    .merge_hit(u0_merge_hit),
     .merge_limit(merge_limit),
     .merge_sp(merge_sp),
     .free_valid(u0_free),
@@ -1190,9 +1183,9 @@ module fxrt_core_sf0a3f4 (
     .new_slot(bits_box_done_slot_3),
     .new_tmax(box_tmax),
     .new_miss(box_miss),
-    .merge_valid(u1_merge),
-    .merge_slot(bits_merge_slot_3),
-    .merge_hit(merge_hit),
+    .merge_valid(u1_merge_valid),
+    .merge_slot(u1_merge_slot),
+    .merge_hit(u1_merge_hit),
     .merge_limit(merge_limit),
     .merge_sp(merge_sp),
     .free_valid(u1_free),
@@ -1281,7 +1274,7 @@ module fxrt_core_sf0a3f4 (
     .v(u_intersect_v)
   );
 
-  fxrt_closest_n29_m32_tag59_s128_r2 u_closest (
+  fxrt_closest_n29_m32_tag59_s128_u2_r2 u_closest (
     .clk(clk),
     .rst(rst),
     .valid(u_intersect_valid_out),
@@ -1295,9 +1288,12 @@ module fxrt_core_sf0a3f4 (
     .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),
-    .merge_valid(u_closest_merge_valid),
-    .merge_slot(u_closest_merge_slot),
-    .merge_hit(u_closest_merge_hit),
+    .merge_valid0(u_closest_merge_valid0),
+    .merge_slot0(u_closest_merge_slot0),
+    .merge_hit0(u_closest_merge_hit0),
+    .merge_valid1(u_closest_merge_valid1),
+    .merge_slot1(u_closest_merge_slot1),
+    .merge_hit1(u_closest_merge_hit1),
     .merge_limit(u_closest_merge_limit),
     .merge_sp(u_closest_merge_sp),
     .free_valid(u_closest_free_valid),

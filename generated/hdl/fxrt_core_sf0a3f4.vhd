@@ -152,7 +152,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
       v : out unsigned(31 downto 0)
     );
   end component;
-  component fxrt_closest_n29_m32_tag59_s128_r2 is
+  component fxrt_closest_n29_m32_tag59_s128_u2_r2 is
     port (
       clk : in std_logic;
       rst : in std_logic;
@@ -167,9 +167,12 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
       id : in unsigned(19 downto 0);
       done_valid : in unsigned(0 downto 0);
       done_slot : in unsigned(6 downto 0);
-      merge_valid : out unsigned(0 downto 0);
-      merge_slot : out unsigned(6 downto 0);
-      merge_hit : out unsigned(0 downto 0);
+      merge_valid0 : out unsigned(0 downto 0);
+      merge_slot0 : out unsigned(5 downto 0);
+      merge_hit0 : out unsigned(0 downto 0);
+      merge_valid1 : out unsigned(0 downto 0);
+      merge_slot1 : out unsigned(5 downto 0);
+      merge_hit1 : out unsigned(0 downto 0);
       merge_limit : out signed(31 downto 0);
       merge_sp : out unsigned(5 downto 0);
       free_valid : out unsigned(0 downto 0);
@@ -371,9 +374,12 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_done_slot : unsigned(6 downto 0);
 
   -- stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
-  signal merge_valid : unsigned(0 downto 0);
-  signal merge_slot : unsigned(6 downto 0);
-  signal merge_hit : unsigned(0 downto 0);
+  signal u0_merge_valid : unsigned(0 downto 0);
+  signal u0_merge_slot : unsigned(5 downto 0);
+  signal u0_merge_hit : unsigned(0 downto 0);
+  signal u1_merge_valid : unsigned(0 downto 0);
+  signal u1_merge_slot : unsigned(5 downto 0);
+  signal u1_merge_hit : unsigned(0 downto 0);
   signal merge_limit : signed(31 downto 0);
   signal merge_sp : unsigned(5 downto 0);
   signal free_valid : unsigned(0 downto 0);
@@ -390,14 +396,10 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal bits_box_done_slot : unsigned(0 downto 0);
   signal eq_11 : unsigned(0 downto 0);
   signal u0_new : unsigned(0 downto 0);
-  signal bits_merge_slot : unsigned(0 downto 0);
-  signal bits_merge_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal u0_merge : unsigned(0 downto 0);
   signal bits_free_slot : unsigned(0 downto 0);
   signal bits_free_slot_eq_k_0_1 : unsigned(0 downto 0);
   signal u0_free : unsigned(0 downto 0);
   signal bits_box_done_slot_1 : unsigned(5 downto 0);
-  signal bits_merge_slot_1 : unsigned(5 downto 0);
   signal bits_free_slot_1 : unsigned(5 downto 0);
   signal u_traverse_0_node_addr : unsigned(12 downto 0);
   signal u_traverse_0_has_free : unsigned(0 downto 0);
@@ -417,19 +419,15 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
   signal bits_accept_slot_1 : unsigned(0 downto 0);
-  signal eq_14 : unsigned(0 downto 0);
+  signal eq_13 : unsigned(0 downto 0);
   signal u1_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
-  signal eq_15 : unsigned(0 downto 0);
+  signal eq_14 : unsigned(0 downto 0);
   signal u1_new : unsigned(0 downto 0);
-  signal bits_merge_slot_2 : unsigned(0 downto 0);
-  signal bits_merge_slot_2_eq_k_1 : unsigned(0 downto 0);
-  signal u1_merge : unsigned(0 downto 0);
   signal bits_free_slot_2 : unsigned(0 downto 0);
   signal bits_free_slot_2_eq_k_1 : unsigned(0 downto 0);
   signal u1_free : unsigned(0 downto 0);
   signal bits_box_done_slot_3 : unsigned(5 downto 0);
-  signal bits_merge_slot_3 : unsigned(5 downto 0);
   signal bits_free_slot_3 : unsigned(5 downto 0);
   signal u_traverse_1_node_addr : unsigned(12 downto 0);
   signal u_traverse_1_has_free : unsigned(0 downto 0);
@@ -452,11 +450,11 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
 
   -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  signal cat_18 : unsigned(86 downto 0);
+  signal cat_16 : unsigned(86 downto 0);
   signal u_acc_in_wz : unsigned(31 downto 0);
   signal u_acc_in_wy : unsigned(31 downto 0);
   signal u_acc_in_wx : unsigned(31 downto 0);
-  signal cat_19 : unsigned(95 downto 0);
+  signal cat_17 : unsigned(95 downto 0);
 
   -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
@@ -491,24 +489,24 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
   signal case_leaf_turn_3 : unsigned(0 downto 0);
-  signal or_24 : unsigned(0 downto 0);
+  signal or_22 : unsigned(0 downto 0);
   signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
   signal leaf_take : unsigned(0 downto 0);
-  signal eq_25 : unsigned(0 downto 0);
+  signal eq_23 : unsigned(0 downto 0);
   signal u0_leaf_take : unsigned(0 downto 0);
   signal not_u0_leaf_take : unsigned(0 downto 0);
-  signal and_26 : unsigned(0 downto 0);
-  signal u0_leaf_fill_or_and_26 : unsigned(0 downto 0);
-  signal eq_27 : unsigned(0 downto 0);
+  signal and_24 : unsigned(0 downto 0);
+  signal u0_leaf_fill_or_and_24 : unsigned(0 downto 0);
+  signal eq_25 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
   signal not_u1_leaf_take : unsigned(0 downto 0);
-  signal and_28 : unsigned(0 downto 0);
-  signal u1_leaf_fill_or_and_28 : unsigned(0 downto 0);
+  signal and_26 : unsigned(0 downto 0);
+  signal u1_leaf_fill_or_and_26 : unsigned(0 downto 0);
   signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_29 : unsigned(6 downto 0);
+  signal cat_27 : unsigned(6 downto 0);
   signal not_leaf_last_entry : unsigned(0 downto 0);
-  signal and_30 : unsigned(0 downto 0);
-  signal leaf_take_or_and_30 : unsigned(0 downto 0);
+  signal and_28 : unsigned(0 downto 0);
+  signal leaf_take_or_and_28 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
   constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
@@ -523,7 +521,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_31 : unsigned(0 downto 0);
+  signal eq_29 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
@@ -531,7 +529,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_32 : unsigned(58 downto 0);
+  signal cat_30 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -605,23 +603,26 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_credit_ok : unsigned(0 downto 0) := unsigned'("1");
   signal u0_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u0_done_took : unsigned(0 downto 0);
-  signal and_34 : unsigned(0 downto 0);
+  signal and_32 : unsigned(0 downto 0);
   signal u0_done_avail : unsigned(0 downto 0);
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
-  signal and_35 : unsigned(0 downto 0);
+  signal and_33 : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
-  signal cat_36 : unsigned(6 downto 0);
+  signal cat_34 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_38 : unsigned(6 downto 0);
+  signal cat_36 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
-  signal or_39 : unsigned(0 downto 0);
+  signal or_37 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
-  signal u_closest_merge_valid : unsigned(0 downto 0);
-  signal u_closest_merge_slot : unsigned(6 downto 0);
-  signal u_closest_merge_hit : unsigned(0 downto 0);
+  signal u_closest_merge_valid0 : unsigned(0 downto 0);
+  signal u_closest_merge_slot0 : unsigned(5 downto 0);
+  signal u_closest_merge_hit0 : unsigned(0 downto 0);
+  signal u_closest_merge_valid1 : unsigned(0 downto 0);
+  signal u_closest_merge_slot1 : unsigned(5 downto 0);
+  signal u_closest_merge_hit1 : unsigned(0 downto 0);
   signal u_closest_merge_limit : signed(31 downto 0);
   signal u_closest_merge_sp : unsigned(5 downto 0);
   signal u_closest_free_valid : unsigned(0 downto 0);
@@ -635,8 +636,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_closest_res_v : unsigned(31 downto 0);
 
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  signal cat_40 : unsigned(63 downto 0);
-  signal cat_41 : unsigned(63 downto 0);
+  signal cat_38 : unsigned(63 downto 0);
+  signal cat_39 : unsigned(63 downto 0);
   signal res_take : unsigned(0 downto 0);
   signal res_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_wr : unsigned(3 downto 0) := unsigned'("0000");
@@ -657,15 +658,15 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_count_eq_k_0_5 : unsigned(0 downto 0);
   constant k_1_5 : unsigned(4 downto 0) := unsigned'("00001");
   signal res_q_one_left : unsigned(0 downto 0);
-  signal and_44 : unsigned(0 downto 0);
+  signal and_42 : unsigned(0 downto 0);
   signal res_q_drained : unsigned(0 downto 0);
   signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_bypass_c : unsigned(0 downto 0);
   signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_5_lt_res_q_count : unsigned(0 downto 0);
-  signal or_47 : unsigned(0 downto 0);
+  signal or_45 : unsigned(0 downto 0);
   signal not_res_take : unsigned(0 downto 0);
-  signal and_48 : unsigned(0 downto 0);
+  signal and_46 : unsigned(0 downto 0);
   signal res_q_nonempty_c : unsigned(0 downto 0);
   signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_q0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
@@ -678,7 +679,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_take_c : unsigned(0 downto 0);
   signal res_credits : unsigned(5 downto 0) := unsigned'("010000");
   signal rs_done_valid_r : unsigned(5 downto 0);
-  signal minus_50 : unsigned(5 downto 0);
+  signal minus_48 : unsigned(5 downto 0);
   signal rs_res_take_1 : unsigned(5 downto 0);
   signal res_credits_next : unsigned(5 downto 0);
   constant k_1_6 : unsigned(5 downto 0) := unsigned'("000001");
@@ -704,10 +705,10 @@ begin
   begin
     if rising_edge(clk) then
       if accept = "1" then
-        ray_o(to_integer(accept_slot_c1)) <= cat_18;
+        ray_o(to_integer(accept_slot_c1)) <= cat_16;
       end if;
       if accept = "1" then
-        ray_w(to_integer(accept_slot_c1)) <= cat_19;
+        ray_w(to_integer(accept_slot_c1)) <= cat_17;
       end if;
       if res_q_push = "1" then
         res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
@@ -1023,9 +1024,12 @@ begin
   end process box_exit_regs;
 
   -- stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
-  merge_valid <= u_closest_merge_valid;
-  merge_slot <= u_closest_merge_slot;
-  merge_hit <= u_closest_merge_hit;
+  u0_merge_valid <= u_closest_merge_valid0;
+  u0_merge_slot <= u_closest_merge_slot0;
+  u0_merge_hit <= u_closest_merge_hit0;
+  u1_merge_valid <= u_closest_merge_valid1;
+  u1_merge_slot <= u_closest_merge_slot1;
+  u1_merge_hit <= u_closest_merge_hit1;
   merge_limit <= u_closest_merge_limit;
   merge_sp <= u_closest_merge_sp;
   free_valid <= u_closest_free_valid;
@@ -1042,37 +1046,29 @@ begin
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
   eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
   u0_new <= box_done and eq_11;
-  bits_merge_slot <= unsigned(merge_slot(6 downto 6));
-  bits_merge_slot_eq_k_0_1 <= "1" when bits_merge_slot = k_0_1 else "0";
-  u0_merge <= merge_valid and bits_merge_slot_eq_k_0_1;
   bits_free_slot <= unsigned(free_slot(6 downto 6));
   bits_free_slot_eq_k_0_1 <= "1" when bits_free_slot = k_0_1 else "0";
   u0_free <= free_valid and bits_free_slot_eq_k_0_1;
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
-  bits_merge_slot_1 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
   bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
-  eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
-  u1_alloc <= accept and eq_14;
+  eq_13 <= "1" when bits_accept_slot_1 = k_1 else "0";
+  u1_alloc <= accept and eq_13;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
-  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
-  u1_new <= box_done and eq_15;
-  bits_merge_slot_2 <= unsigned(merge_slot(6 downto 6));
-  bits_merge_slot_2_eq_k_1 <= "1" when bits_merge_slot_2 = k_1 else "0";
-  u1_merge <= merge_valid and bits_merge_slot_2_eq_k_1;
+  eq_14 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_14;
   bits_free_slot_2 <= unsigned(free_slot(6 downto 6));
   bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
   u1_free <= free_valid and bits_free_slot_2_eq_k_1;
   bits_box_done_slot_3 <= unsigned(box_done_slot(5 downto 0));
-  bits_merge_slot_3 <= unsigned(merge_slot(5 downto 0));
   bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
 
   -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  cat_16 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
   u_acc_in_wz <= unsigned(acc_in_wz);
   u_acc_in_wy <= unsigned(acc_in_wy);
   u_acc_in_wx <= unsigned(acc_in_wx);
-  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
+  cat_17 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
 
   -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   leaf_last_entry <= leaf_active and leaf_last;
@@ -1102,29 +1098,29 @@ begin
       k_1 when "0",
       k_0_1 when "1",
       k_0_1 when others;
-  or_24 <= case_leaf_turn_2 or case_leaf_turn;
+  or_22 <= case_leaf_turn_2 or case_leaf_turn;
   mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_24;
-  eq_25 <= "1" when mux_case_leaf_turn_2 = k_0_1 else "0";
-  u0_leaf_take <= leaf_take and eq_25;
+  leaf_take <= leaf_can_take and or_22;
+  eq_23 <= "1" when mux_case_leaf_turn_2 = k_0_1 else "0";
+  u0_leaf_take <= leaf_take and eq_23;
   not_u0_leaf_take <= not u0_leaf_take;
-  and_26 <= u0_leaf_buf_valid and not_u0_leaf_take;
-  u0_leaf_fill_or_and_26 <= u0_leaf_fill or and_26;
-  eq_27 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_27;
+  and_24 <= u0_leaf_buf_valid and not_u0_leaf_take;
+  u0_leaf_fill_or_and_24 <= u0_leaf_fill or and_24;
+  eq_25 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_25;
   not_u1_leaf_take <= not u1_leaf_take;
-  and_28 <= u1_leaf_buf_valid and not_u1_leaf_take;
-  u1_leaf_fill_or_and_28 <= u1_leaf_fill or and_28;
+  and_26 <= u1_leaf_buf_valid and not_u1_leaf_take;
+  u1_leaf_fill_or_and_26 <= u1_leaf_fill or and_26;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
       u0_buf_leaf_slot when "0",
       u1_buf_leaf_slot when "1",
       u0_buf_leaf_slot when others;
-  cat_29 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_30 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_30 <= leaf_take or and_30;
-  mux_leaf_take <= cat_29 when leaf_take = "1" else leaf_slot;
+  and_28 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_28 <= leaf_take or and_28;
+  mux_leaf_take <= cat_27 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
       u0_buf_leaf_first when "0",
@@ -1156,9 +1152,9 @@ begin
       u0_buf_leaf_count when "0",
       u1_buf_leaf_count when "1",
       u0_buf_leaf_count when others;
-  eq_31 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  eq_29 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_31 when leaf_take = "1" else leaf_left_eq_k_2;
+  mux_leaf_take_5 <= eq_29 when leaf_take = "1" else leaf_left_eq_k_2;
 
   leaf_stream_regs : process (clk)
   begin
@@ -1166,7 +1162,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_30;
+        leaf_active <= leaf_take_or_and_28;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -1183,7 +1179,7 @@ begin
       if rst = '1' then
         u0_leaf_buf_valid <= unsigned'("0");
       else
-        u0_leaf_buf_valid <= u0_leaf_fill_or_and_26;
+        u0_leaf_buf_valid <= u0_leaf_fill_or_and_24;
       end if;
       if u0_leaf_fill = "1" then
         u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
@@ -1203,7 +1199,7 @@ begin
       if rst = '1' then
         u1_leaf_buf_valid <= unsigned'("0");
       else
-        u1_leaf_buf_valid <= u1_leaf_fill_or_and_28;
+        u1_leaf_buf_valid <= u1_leaf_fill_or_and_26;
       end if;
       if u1_leaf_fill = "1" then
         u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
@@ -1224,7 +1220,7 @@ begin
   end process leaf_stream_regs;
 
   -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
-  cat_32 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -1263,7 +1259,7 @@ begin
   begin
     if rising_edge(clk) then
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_32;
+      emit_tag_sr(1) <= cat_30;
       if rst = '1' then
         emit_valid_1 <= unsigned'("0");
       else
@@ -1320,17 +1316,17 @@ begin
 
   -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   not_u0_done_took <= not u0_done_took;
-  and_34 <= u_traverse_0_done_valid and not_u0_done_took;
-  u0_done_avail <= and_34 and res_credit_ok;
+  and_32 <= u_traverse_0_done_valid and not_u0_done_took;
+  u0_done_avail <= and_32 and res_credit_ok;
   not_u1_done_took <= not u1_done_took;
-  and_35 <= u_traverse_1_done_valid and not_u1_done_took;
-  u1_done_avail <= and_35 and res_credit_ok;
-  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
+  and_33 <= u_traverse_1_done_valid and not_u1_done_took;
+  u1_done_avail <= and_33 and res_credit_ok;
+  cat_34 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_36 when u0_done_avail = "1" else cat_38;
-  or_39 <= u0_done_avail or u1_done_avail;
+  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_34 when u0_done_avail = "1" else cat_36;
+  or_37 <= u0_done_avail or u1_done_avail;
 
   done_regs : process (clk)
   begin
@@ -1353,15 +1349,15 @@ begin
       if rst = '1' then
         done_valid_r <= unsigned'("0");
       else
-        done_valid_r <= or_39;
+        done_valid_r <= or_37;
       end if;
       done_slot_r <= mux_u0_done_avail;
     end if;
   end process done_regs;
 
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  cat_40 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
-  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
+  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
+  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
   res_take <= res_take_c;
   res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
   mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
@@ -1374,21 +1370,21 @@ begin
   res_q_count_next <= res_q_after_pop + rs_res_q_push;
   res_q_count_eq_k_0_5 <= "1" when res_q_count = k_0_5 else "0";
   res_q_one_left <= "1" when res_q_count = k_1_5 else "0";
-  and_44 <= res_q_one_left and res_take;
-  res_q_drained <= res_q_count_eq_k_0_5 or and_44;
+  and_42 <= res_q_one_left and res_take;
+  res_q_drained <= res_q_count_eq_k_0_5 or and_42;
   res_q_bypass_c <= res_q_push and res_q_drained;
   k_1_5_lt_res_q_count <= "1" when k_1_5 < res_q_count else "0";
-  or_47 <= res_q_push or k_1_5_lt_res_q_count;
+  or_45 <= res_q_push or k_1_5_lt_res_q_count;
   not_res_take <= not res_take;
-  and_48 <= res_q_one_left and not_res_take;
-  res_q_nonempty_c <= or_47 or and_48;
+  and_46 <= res_q_one_left and not_res_take;
+  res_q_nonempty_c <= or_45 or and_46;
   res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
   res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
   res_take_c <= res_q_nonempty and res_ready;
   rs_done_valid_r <= resize(done_valid_r, 6);
-  minus_50 <= res_credits - rs_done_valid_r;
+  minus_48 <= res_credits - rs_done_valid_r;
   rs_res_take_1 <= resize(res_take, 6);
-  res_credits_next <= minus_50 + rs_res_take_1;
+  res_credits_next <= minus_48 + rs_res_take_1;
   res_credits_ge1 <= "1" when k_1_6 <= res_credits else "0";
   res_credits_ge2 <= "1" when k_2_1 <= res_credits else "0";
   res_credits_ge3 <= "1" when k_3_1 <= res_credits else "0";
@@ -1440,12 +1436,12 @@ begin
       else
         res_q_nonempty <= res_q_nonempty_c;
       end if;
-      res_q_din0 <= cat_40;
+      res_q_din0 <= cat_38;
       res_q_q0 <= res_q_mem0(to_integer(res_q_rd_next));
       if res_q_push = "1" then
         res_q_din_r0 <= res_q_din0;
       end if;
-      res_q_din1 <= cat_41;
+      res_q_din1 <= cat_39;
       res_q_q1 <= res_q_mem1(to_integer(res_q_rd_next));
       if res_q_push = "1" then
         res_q_din_r1 <= res_q_din1;
@@ -1482,9 +1478,9 @@ begin
       new_slot => bits_box_done_slot_1,
       new_tmax => box_tmax,
       new_miss => box_miss,
-      merge_valid => u0_merge,
-      merge_slot => bits_merge_slot_1,
-      merge_hit => merge_hit,
+      merge_valid => u0_merge_valid,
+      merge_slot => u0_merge_slot,
+      merge_hit => u0_merge_hit,
       merge_limit => merge_limit,
       merge_sp => merge_sp,
       free_valid => u0_free,
@@ -1528,9 +1524,9 @@ begin
       new_slot => bits_box_done_slot_3,
       new_tmax => box_tmax,
       new_miss => box_miss,
-      merge_valid => u1_merge,
-      merge_slot => bits_merge_slot_3,
-      merge_hit => merge_hit,
+      merge_valid => u1_merge_valid,
+      merge_slot => u1_merge_slot,
+      merge_hit => u1_merge_hit,
       merge_limit => merge_limit,
       merge_sp => merge_sp,
       free_valid => u1_free,
@@ -1625,7 +1621,7 @@ begin
       v => u_intersect_v
     );
 
-  u_closest : fxrt_closest_n29_m32_tag59_s128_r2
+  u_closest : fxrt_closest_n29_m32_tag59_s128_u2_r2
     port map (
       clk => clk,
       rst => rst,
@@ -1640,9 +1636,12 @@ begin
       id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,
-      merge_valid => u_closest_merge_valid,
-      merge_slot => u_closest_merge_slot,
-      merge_hit => u_closest_merge_hit,
+      merge_valid0 => u_closest_merge_valid0,
+      merge_slot0 => u_closest_merge_slot0,
+      merge_hit0 => u_closest_merge_hit0,
+      merge_valid1 => u_closest_merge_valid1,
+      merge_slot1 => u_closest_merge_slot1,
+      merge_hit1 => u_closest_merge_hit1,
       merge_limit => u_closest_merge_limit,
       merge_sp => u_closest_merge_sp,
       free_valid => u_closest_free_valid,

@@ -755,7 +755,6 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [31:0] s_bits_u_stack_data_1;
   wire [12:0] bits_u_stack_data_2;
   reg [0:0] c_valid = 1'h0;
-  reg [5:0] c_slot = 6'h00;
   wire [12:0] mux_b_from_stack;
   reg [12:0] c_node = 13'h0000;
   wire signed [31:0] mux_b_from_stack_1;
@@ -983,6 +982,11 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [63:0] not_best_clear;
   wire [63:0] and_114;
   wire [63:0] and_114_or_best_set;
+
+  // register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
+  reg [5:0] c_slot = 6'h00;
+  reg [5:0] c_slot_c1 = 6'h00;
+  reg [5:0] c_slot_c2 = 6'h00;
 
   // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   reg [0:0] n_valid_1 = 1'h0;
@@ -2124,70 +2128,70 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_has_best_62 = has_best[62];
   assign bits_has_best_63 = has_best[63];
   assign slot_has_best =
-    (c_slot == 6'h00) ? bits_has_best :
-    (c_slot == 6'h01) ? bits_has_best_1 :
-    (c_slot == 6'h02) ? bits_has_best_2 :
-    (c_slot == 6'h03) ? bits_has_best_3 :
-    (c_slot == 6'h04) ? bits_has_best_4 :
-    (c_slot == 6'h05) ? bits_has_best_5 :
-    (c_slot == 6'h06) ? bits_has_best_6 :
-    (c_slot == 6'h07) ? bits_has_best_7 :
-    (c_slot == 6'h08) ? bits_has_best_8 :
-    (c_slot == 6'h09) ? bits_has_best_9 :
-    (c_slot == 6'h0a) ? bits_has_best_10 :
-    (c_slot == 6'h0b) ? bits_has_best_11 :
-    (c_slot == 6'h0c) ? bits_has_best_12 :
-    (c_slot == 6'h0d) ? bits_has_best_13 :
-    (c_slot == 6'h0e) ? bits_has_best_14 :
-    (c_slot == 6'h0f) ? bits_has_best_15 :
-    (c_slot == 6'h10) ? bits_has_best_16 :
-    (c_slot == 6'h11) ? bits_has_best_17 :
-    (c_slot == 6'h12) ? bits_has_best_18 :
-    (c_slot == 6'h13) ? bits_has_best_19 :
-    (c_slot == 6'h14) ? bits_has_best_20 :
-    (c_slot == 6'h15) ? bits_has_best_21 :
-    (c_slot == 6'h16) ? bits_has_best_22 :
-    (c_slot == 6'h17) ? bits_has_best_23 :
-    (c_slot == 6'h18) ? bits_has_best_24 :
-    (c_slot == 6'h19) ? bits_has_best_25 :
-    (c_slot == 6'h1a) ? bits_has_best_26 :
-    (c_slot == 6'h1b) ? bits_has_best_27 :
-    (c_slot == 6'h1c) ? bits_has_best_28 :
-    (c_slot == 6'h1d) ? bits_has_best_29 :
-    (c_slot == 6'h1e) ? bits_has_best_30 :
-    (c_slot == 6'h1f) ? bits_has_best_31 :
-    (c_slot == 6'h20) ? bits_has_best_32 :
-    (c_slot == 6'h21) ? bits_has_best_33 :
-    (c_slot == 6'h22) ? bits_has_best_34 :
-    (c_slot == 6'h23) ? bits_has_best_35 :
-    (c_slot == 6'h24) ? bits_has_best_36 :
-    (c_slot == 6'h25) ? bits_has_best_37 :
-    (c_slot == 6'h26) ? bits_has_best_38 :
-    (c_slot == 6'h27) ? bits_has_best_39 :
-    (c_slot == 6'h28) ? bits_has_best_40 :
-    (c_slot == 6'h29) ? bits_has_best_41 :
-    (c_slot == 6'h2a) ? bits_has_best_42 :
-    (c_slot == 6'h2b) ? bits_has_best_43 :
-    (c_slot == 6'h2c) ? bits_has_best_44 :
-    (c_slot == 6'h2d) ? bits_has_best_45 :
-    (c_slot == 6'h2e) ? bits_has_best_46 :
-    (c_slot == 6'h2f) ? bits_has_best_47 :
-    (c_slot == 6'h30) ? bits_has_best_48 :
-    (c_slot == 6'h31) ? bits_has_best_49 :
-    (c_slot == 6'h32) ? bits_has_best_50 :
-    (c_slot == 6'h33) ? bits_has_best_51 :
-    (c_slot == 6'h34) ? bits_has_best_52 :
-    (c_slot == 6'h35) ? bits_has_best_53 :
-    (c_slot == 6'h36) ? bits_has_best_54 :
-    (c_slot == 6'h37) ? bits_has_best_55 :
-    (c_slot == 6'h38) ? bits_has_best_56 :
-    (c_slot == 6'h39) ? bits_has_best_57 :
-    (c_slot == 6'h3a) ? bits_has_best_58 :
-    (c_slot == 6'h3b) ? bits_has_best_59 :
-    (c_slot == 6'h3c) ? bits_has_best_60 :
-    (c_slot == 6'h3d) ? bits_has_best_61 :
-    (c_slot == 6'h3e) ? bits_has_best_62 :
-    (c_slot == 6'h3f) ? bits_has_best_63 :
+    (c_slot_c2 == 6'h00) ? bits_has_best :
+    (c_slot_c2 == 6'h01) ? bits_has_best_1 :
+    (c_slot_c2 == 6'h02) ? bits_has_best_2 :
+    (c_slot_c2 == 6'h03) ? bits_has_best_3 :
+    (c_slot_c2 == 6'h04) ? bits_has_best_4 :
+    (c_slot_c2 == 6'h05) ? bits_has_best_5 :
+    (c_slot_c2 == 6'h06) ? bits_has_best_6 :
+    (c_slot_c2 == 6'h07) ? bits_has_best_7 :
+    (c_slot_c2 == 6'h08) ? bits_has_best_8 :
+    (c_slot_c2 == 6'h09) ? bits_has_best_9 :
+    (c_slot_c2 == 6'h0a) ? bits_has_best_10 :
+    (c_slot_c2 == 6'h0b) ? bits_has_best_11 :
+    (c_slot_c2 == 6'h0c) ? bits_has_best_12 :
+    (c_slot_c2 == 6'h0d) ? bits_has_best_13 :
+    (c_slot_c2 == 6'h0e) ? bits_has_best_14 :
+    (c_slot_c2 == 6'h0f) ? bits_has_best_15 :
+    (c_slot_c2 == 6'h10) ? bits_has_best_16 :
+    (c_slot_c2 == 6'h11) ? bits_has_best_17 :
+    (c_slot_c2 == 6'h12) ? bits_has_best_18 :
+    (c_slot_c2 == 6'h13) ? bits_has_best_19 :
+    (c_slot_c2 == 6'h14) ? bits_has_best_20 :
+    (c_slot_c2 == 6'h15) ? bits_has_best_21 :
+    (c_slot_c2 == 6'h16) ? bits_has_best_22 :
+    (c_slot_c2 == 6'h17) ? bits_has_best_23 :
+    (c_slot_c2 == 6'h18) ? bits_has_best_24 :
+    (c_slot_c2 == 6'h19) ? bits_has_best_25 :
+    (c_slot_c2 == 6'h1a) ? bits_has_best_26 :
+    (c_slot_c2 == 6'h1b) ? bits_has_best_27 :
+    (c_slot_c2 == 6'h1c) ? bits_has_best_28 :
+    (c_slot_c2 == 6'h1d) ? bits_has_best_29 :
+    (c_slot_c2 == 6'h1e) ? bits_has_best_30 :
+    (c_slot_c2 == 6'h1f) ? bits_has_best_31 :
+    (c_slot_c2 == 6'h20) ? bits_has_best_32 :
+    (c_slot_c2 == 6'h21) ? bits_has_best_33 :
+    (c_slot_c2 == 6'h22) ? bits_has_best_34 :
+    (c_slot_c2 == 6'h23) ? bits_has_best_35 :
+    (c_slot_c2 == 6'h24) ? bits_has_best_36 :
+    (c_slot_c2 == 6'h25) ? bits_has_best_37 :
+    (c_slot_c2 == 6'h26) ? bits_has_best_38 :
+    (c_slot_c2 == 6'h27) ? bits_has_best_39 :
+    (c_slot_c2 == 6'h28) ? bits_has_best_40 :
+    (c_slot_c2 == 6'h29) ? bits_has_best_41 :
+    (c_slot_c2 == 6'h2a) ? bits_has_best_42 :
+    (c_slot_c2 == 6'h2b) ? bits_has_best_43 :
+    (c_slot_c2 == 6'h2c) ? bits_has_best_44 :
+    (c_slot_c2 == 6'h2d) ? bits_has_best_45 :
+    (c_slot_c2 == 6'h2e) ? bits_has_best_46 :
+    (c_slot_c2 == 6'h2f) ? bits_has_best_47 :
+    (c_slot_c2 == 6'h30) ? bits_has_best_48 :
+    (c_slot_c2 == 6'h31) ? bits_has_best_49 :
+    (c_slot_c2 == 6'h32) ? bits_has_best_50 :
+    (c_slot_c2 == 6'h33) ? bits_has_best_51 :
+    (c_slot_c2 == 6'h34) ? bits_has_best_52 :
+    (c_slot_c2 == 6'h35) ? bits_has_best_53 :
+    (c_slot_c2 == 6'h36) ? bits_has_best_54 :
+    (c_slot_c2 == 6'h37) ? bits_has_best_55 :
+    (c_slot_c2 == 6'h38) ? bits_has_best_56 :
+    (c_slot_c2 == 6'h39) ? bits_has_best_57 :
+    (c_slot_c2 == 6'h3a) ? bits_has_best_58 :
+    (c_slot_c2 == 6'h3b) ? bits_has_best_59 :
+    (c_slot_c2 == 6'h3c) ? bits_has_best_60 :
+    (c_slot_c2 == 6'h3d) ? bits_has_best_61 :
+    (c_slot_c2 == 6'h3e) ? bits_has_best_62 :
+    (c_slot_c2 == 6'h3f) ? bits_has_best_63 :
     k_0;
   assign rs_s_limit_q = $signed({{1{s_limit_q[31]}}, s_limit_q});
   assign rs_cull_x = $signed({{1{cull_x[31]}}, cull_x});
@@ -2335,18 +2339,25 @@ module fxrt_traverse_k64_sf0a3f4 (
   always @(posedge clk) begin : ring_c_regs
     if (rst) c_valid <= 1'h0;
     else c_valid <= b2_valid;
-    c_slot <= b2_slot;
     c_node <= mux_b_from_stack;
     c_tmin <= mux_b_from_stack_1;
     c_tmax <= mux_b_from_stack_2;
     c_sp <= b2_sp;
-    limit_q <= cull_limit[c_slot];
+    limit_q <= cull_limit[c_slot_c1];
     if (rst) has_best <= 64'h0000000000000000;
     else has_best <= and_114_or_best_set;
     cull_x <= tmin_less;
     cull_has_best <= slot_has_best;
     culled <= culled_c;
     culled_n <= culled;
+  end
+
+  // register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : c_slot_copies_regs
+    c_slot <= b2_slot;
+    c_slot_c1 <= b2_slot;
+    c_slot_c2 <= b2_slot;
   end
 
   // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units

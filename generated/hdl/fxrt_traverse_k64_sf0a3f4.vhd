@@ -781,7 +781,6 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal s_bits_u_stack_data_1 : signed(31 downto 0);
   signal bits_u_stack_data_2 : unsigned(12 downto 0);
   signal c_valid : unsigned(0 downto 0) := unsigned'("0");
-  signal c_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal mux_b_from_stack : unsigned(12 downto 0);
   signal c_node : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal mux_b_from_stack_1 : signed(31 downto 0);
@@ -1007,6 +1006,14 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal not_best_clear : unsigned(63 downto 0);
   signal and_114 : unsigned(63 downto 0);
   signal and_114_or_best_set : unsigned(63 downto 0);
+
+  -- register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
+  signal c_slot : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of c_slot : signal is "true";
+  signal c_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of c_slot_c1 : signal is "true";
+  signal c_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of c_slot_c2 : signal is "true";
 
   -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   signal n_valid_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -2241,7 +2248,7 @@ begin
   bits_has_best_61 <= unsigned(has_best(61 downto 61));
   bits_has_best_62 <= unsigned(has_best(62 downto 62));
   bits_has_best_63 <= unsigned(has_best(63 downto 63));
-  with c_slot select
+  with c_slot_c2 select
     slot_has_best <=
       bits_has_best when "000000",
       bits_has_best_1 when "000001",
@@ -2459,12 +2466,11 @@ begin
       else
         c_valid <= b2_valid;
       end if;
-      c_slot <= b2_slot;
       c_node <= mux_b_from_stack;
       c_tmin <= mux_b_from_stack_1;
       c_tmax <= mux_b_from_stack_2;
       c_sp <= b2_sp;
-      limit_q <= cull_limit(to_integer(c_slot));
+      limit_q <= cull_limit(to_integer(c_slot_c1));
       if rst = '1' then
         has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
       else
@@ -2476,6 +2482,17 @@ begin
       culled_n <= culled;
     end if;
   end process ring_c_regs;
+
+  -- register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
+
+  c_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      c_slot <= b2_slot;
+      c_slot_c1 <= b2_slot;
+      c_slot_c2 <= b2_slot;
+    end if;
+  end process c_slot_copies_regs;
 
   -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   n_slot <= n_slot_sr(3);
