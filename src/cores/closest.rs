@@ -191,18 +191,18 @@ pub fn closest_core(
     let sb = tag.slot_bits - unit_bits;
     let slot_r = b.delay("merge_slot_r", m2_slot.slice(0, sb));
     let hit_r = b.delay("merge_hit_r", m2_hit);
-    let (slot_copies, hit_copies) = (b.copies(slot_r, units as usize - 1), b.copies(hit_r, units as usize - 1));
+    // The register and its copies, one per unit.
+    let per_unit = |r| -> Vec<S> { std::iter::once(r).chain(b.copies(r, units as usize - 1)).collect() };
+    let (slots_u, hits_u) = (per_unit(slot_r), per_unit(hit_r));
     for u in 0..units {
         let mine = if unit_bits == 0 {
             m2
         } else {
             (m2 & m2_slot.slice(sb, unit_bits).eq(u as i128)).name(&format!("m2_unit{u}"))
         };
-        let k = u as usize;
-        let (slot_u, hit_u) = if k == 0 { (slot_r, hit_r) } else { (slot_copies[k - 1], hit_copies[k - 1]) };
         b.output(&format!("merge_valid{u}"), b.valid_delay(&format!("merge_valid{u}_r"), mine));
-        b.output(&format!("merge_slot{u}"), slot_u);
-        b.output(&format!("merge_hit{u}"), hit_u);
+        b.output(&format!("merge_slot{u}"), slots_u[u as usize]);
+        b.output(&format!("merge_hit{u}"), hits_u[u as usize]);
     }
     b.output("merge_limit", b.delay("merge_limit_r", limit));
     b.output("merge_sp", b.delay("merge_sp_r", m2_sp));
