@@ -99,7 +99,7 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
     // Four registers of it, each loading a part of the port.
     let empties: Vec<S<'b>> = [port_empty].into_iter().chain(b.copies(port_empty, 3)).collect();
     let mut holds = 0usize;
-    let mut hold = |s: S<'b>| {
+    let hold = |s: S<'b>| {
         let r = b.reg(&format!("in_{}", b.name_of(s.sig)), s.ty(), None);
         b.next_when(r, empties[holds * empties.len() / 10], s);
         holds += 1;
