@@ -312,7 +312,10 @@ pub fn cache<'b>(b: &'b Builder, name: &str, p: &CacheParams, look: &Lookup<'b>,
     for (j, s) in slots.iter().enumerate() {
         let m = (s.2 & s.0.eq(l2_line)).name(&nm(&format!("match{j}")));
         matched.push(b.delay(&nm(&format!("match_r{j}")), m));
-        found_seq = m.select(seqs[j], found_seq);
+        // An OR of the matches' numbers rather than a chain of selects (8 in series were
+        // 10.25 ns at seed 2 of the external core): a line is in the table at most once (a
+        // miss takes a place only when no place holds its line: `found`, `same_as_prev`).
+        found_seq = found_seq | m.select(seqs[j], seqs[j].k(0));
         found = found | m;
         busy = busy | (s.2 & s.0.slice(0, sb).eq(l2_line.slice(0, sb)));
     }
