@@ -463,4 +463,74 @@ mod tests {
             assert!(!d.error && d.hits > 500 && d.misses > 100, "{shape:?}: {} hits, {} misses", d.hits, d.misses);
         }
     }
+    /// A block RAM's read of the word its other port writes in the same clock is not defined
+    /// (DP16KD), so a lookup whose tag read meets a fill's tag write in its set is a miss
+    /// (`cache`'s `tag_clash`). In a one-way cache, line A hit, then line B of the same set
+    /// missed and its fill began: a lookup of A hits exactly when its tag is read before the
+    /// clock of B's first beat. With the clash not taken as a miss, the read in that clock
+    /// is a hit on the victim (the simulators' RAMs read the old word).
+    #[test]
+    fn a_tag_read_in_the_clock_of_its_sets_fill_is_a_miss() {
+        let shape = Shape { data_bits: 64, ways: 1, outstanding: 4 };
+        let m = harness(shape);
+        let input = |name: &str| m.handle(*m.inputs.iter().find(|&&i| m.sig(i).name == name).unwrap());
+        let output = |name: &str| m.handle(m.outputs.iter().find(|o| o.0 == name).unwrap().1);
+        let (line_a, line_b, base) = (1, 9, 0x4000u64);
+        let mut seen = [false, false];
+        for k in 1..40u64 {
+            let mut sim = Sim::new(&m);
+            let timing = MemoryTiming { latency: 20, ..MemoryTiming::default() };
+            let mut mem = MemoryModel::new(image(), base, shape.data_bits, timing);
+            // Lookups of cache 0 by clock: A (miss, filled), A (hit), B (miss), A again.
+            let (at_b, at_a) = (150, 150 + k);
+            let looks = [(20, line_a), (120, line_a), (at_b, line_b), (at_a, line_a)];
+            let (mut first_beat, mut hits) = (None, Vec::new());
+            for clock in 0..300u64 {
+                if let Some(l) = looks.iter().find(|l| l.0 + LATENCY as u64 == clock) {
+                    assert_eq!(sim.get(output("ans0_valid")), 1);
+                    hits.push((l.0, sim.get(output("ans0_hit")) == 1));
+                }
+                let mo = MasterOut {
+                    arvalid: sim.get(output("arvalid")) == 1,
+                    araddr: sim.get(output("araddr")) as u64,
+                    arlen: sim.get(output("arlen")) as u32,
+                    rready: true,
+                };
+                let look = looks.iter().find(|l| l.0 == clock);
+                let r = mem.out().clone();
+                for (name, v) in [
+                    ("look0_valid", look.is_some() as i128),
+                    ("look0_line", look.map_or(0, |l| l.1) as i128),
+                    ("look0_rec", 0),
+                    ("look1_valid", 0),
+                    ("look1_line", 0),
+                    ("look1_rec", 0),
+                    ("base", base as i128),
+                    ("arready", r.arready as i128),
+                    ("rvalid", r.rvalid as i128),
+                    ("rdata", r.rdata as i128),
+                    ("rlast", r.rlast as i128),
+                    ("rresp", 0),
+                ] {
+                    sim.set(input(name), v);
+                }
+                sim.reset = clock == 0;
+                sim.eval();
+                if clock > at_b && first_beat.is_none() && sim.probe("c0_fill_first") == Some(1) {
+                    first_beat = Some(clock);
+                }
+                mem.clock(&mo);
+                sim.tick();
+            }
+            let first_beat = first_beat.expect("B's fill arrived");
+            // Answers come LATENCY clocks after their lookup; the last lookup may be pending.
+            assert_eq!(&hits[..3], &[(20, false), (120, true), (at_b, false)], "k {k}");
+            // A's tag is read at the clock after its lookup (the lookup's input register).
+            let read = at_a + 1;
+            let hit = hits.iter().find(|h| h.0 == at_a).expect("A answered").1;
+            assert_eq!(hit, read < first_beat, "k {k}: A's tag read at {read}, B's first beat at {first_beat}");
+            seen[usize::from(read == first_beat)] = true;
+        }
+        assert!(seen[1], "no lookup's tag read met the first beat");
+    }
 }
