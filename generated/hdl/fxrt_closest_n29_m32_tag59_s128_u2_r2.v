@@ -288,24 +288,26 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg [0:0] fin_has_g7 = 1'h0;
   wire [2:0] bits_fin_slot;
   wire [0:0] fin_has_c;
-  reg [0:0] m1_slot_has = 1'h0;
   reg [0:0] m1_leaf_empty = 1'h0;
   wire [42:0] cat_6;
   reg [42:0] m1_t_tri = 43'h00000000000;
   wire [63:0] cat_7;
   reg [63:0] m1_u_v = 64'h0000000000000000;
-  wire [44:0] cat_8;
-  wire [0:0] not_m1_slot_has;
-  wire [44:0] cat_9;
-  wire [45:0] rs_cat_8;
-  wire [45:0] rs_cat_9;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 45 are read
-  wire [45:0] rs_cat_8_minus_rs_cat_9;
+  wire [43:0] cat_8;
+  wire [43:0] cat_9;
+  wire [44:0] rs_cat_8;
+  wire [44:0] rs_cat_9;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 44 are read
+  wire [44:0] rs_cat_8_minus_rs_cat_9;
   /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] leaf_tt_less;
+  wire [0:0] not_m1_slot_has_c1;
+  wire [0:0] not_m1_leaf_empty;
+  wire [0:0] and_10;
   wire [0:0] leaf_better;
   reg [0:0] m2 = 1'h0;
   reg [0:0] m2_better = 1'h0;
-  wire [0:0] not_m1_leaf_empty;
+  wire [0:0] not_m1_leaf_empty_1;
   wire [0:0] m1_hit;
   reg [0:0] m2_hit = 1'h0;
   reg [5:0] m2_sp = 6'h00;
@@ -751,7 +753,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] m1_slot_eq_k_1_1;
   wire [6:0] k_0_2 = 7'h00;
   wire [0:0] m1_slot_eq_k_0_2;
-  wire [127:0] cat_14;
+  wire [127:0] cat_15;
   reg [127:0] m2_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_set;
   wire [0:0] d0_slot_eq_k_127;
@@ -882,12 +884,12 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] d0_slot_eq_k_2;
   wire [0:0] d0_slot_eq_k_1_1;
   wire [0:0] d0_slot_eq_k_0_2;
-  wire [127:0] cat_15;
+  wire [127:0] cat_16;
   reg [127:0] d1_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_clear;
   wire [127:0] not_best_clear;
-  wire [127:0] and_16;
-  wire [127:0] and_16_or_best_set;
+  wire [127:0] and_17;
+  wire [127:0] and_17_or_best_set;
   reg [0:0] free_valid_r = 1'h0;
   reg [6:0] free_slot_r = 7'h00;
   reg [0:0] res_valid_r = 1'h0;
@@ -910,6 +912,10 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [31:0] bits_done_u_v_1;
   wire [31:0] res_v_c;
   reg [31:0] res_v_r = 32'h00000000;
+
+  // register copies m1_slot_has_copies: m1_slot_has and 1 copies, to split its fan-out
+  reg [0:0] m1_slot_has = 1'h0;
+  reg [0:0] m1_slot_has_c1 = 1'h0;
 
   // register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
   reg [6:0] m2_slot = 7'h00;
@@ -1265,15 +1271,18 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     k_0;
   assign cat_6 = {acc_t, acc_tri};
   assign cat_7 = {acc_u, acc_v};
-  assign cat_8 = {m1_leaf_empty, k_0, m1_t_tri};
-  assign not_m1_slot_has = ~m1_slot_has;
-  assign cat_9 = {k_0, not_m1_slot_has, slot_t_tri};
+  assign cat_8 = {m1_leaf_empty, m1_t_tri};
+  assign cat_9 = {k_0, slot_t_tri};
   assign rs_cat_8 = {{1{1'b0}}, cat_8};
   assign rs_cat_9 = {{1{1'b0}}, cat_9};
   assign rs_cat_8_minus_rs_cat_9 = rs_cat_8 - rs_cat_9;
-  assign leaf_better = rs_cat_8_minus_rs_cat_9[45];
+  assign leaf_tt_less = rs_cat_8_minus_rs_cat_9[44];
+  assign not_m1_slot_has_c1 = ~m1_slot_has_c1;
   assign not_m1_leaf_empty = ~m1_leaf_empty;
-  assign m1_hit = m1_slot_has | not_m1_leaf_empty;
+  assign and_10 = not_m1_slot_has_c1 & not_m1_leaf_empty;
+  assign leaf_better = leaf_tt_less | and_10;
+  assign not_m1_leaf_empty_1 = ~m1_leaf_empty;
+  assign m1_hit = m1_slot_has | not_m1_leaf_empty_1;
   assign bits_slot_t_tri = slot_t_tri[42:13];
   assign m1_we = m1 & leaf_better;
   assign bits_m2_t_tri = m2_t_tri[42:13];
@@ -1708,7 +1717,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign m1_slot_eq_k_2 = m1_slot == k_2;
   assign m1_slot_eq_k_1_1 = m1_slot == k_1_1;
   assign m1_slot_eq_k_0_2 = m1_slot == k_0_2;
-  assign cat_14 = {m1_slot_eq_k_127, m1_slot_eq_k_126, m1_slot_eq_k_125, m1_slot_eq_k_124, m1_slot_eq_k_123, m1_slot_eq_k_122, m1_slot_eq_k_121, m1_slot_eq_k_120, m1_slot_eq_k_119, m1_slot_eq_k_118, m1_slot_eq_k_117, m1_slot_eq_k_116, m1_slot_eq_k_115, m1_slot_eq_k_114, m1_slot_eq_k_113, m1_slot_eq_k_112, m1_slot_eq_k_111, m1_slot_eq_k_110, m1_slot_eq_k_109, m1_slot_eq_k_108, m1_slot_eq_k_107, m1_slot_eq_k_106, m1_slot_eq_k_105, m1_slot_eq_k_104, m1_slot_eq_k_103, m1_slot_eq_k_102, m1_slot_eq_k_101, m1_slot_eq_k_100, m1_slot_eq_k_99, m1_slot_eq_k_98, m1_slot_eq_k_97, m1_slot_eq_k_96, m1_slot_eq_k_95, m1_slot_eq_k_94, m1_slot_eq_k_93, m1_slot_eq_k_92, m1_slot_eq_k_91, m1_slot_eq_k_90, m1_slot_eq_k_89, m1_slot_eq_k_88, m1_slot_eq_k_87, m1_slot_eq_k_86, m1_slot_eq_k_85, m1_slot_eq_k_84, m1_slot_eq_k_83, m1_slot_eq_k_82, m1_slot_eq_k_81, m1_slot_eq_k_80, m1_slot_eq_k_79, m1_slot_eq_k_78, m1_slot_eq_k_77, m1_slot_eq_k_76, m1_slot_eq_k_75, m1_slot_eq_k_74, m1_slot_eq_k_73, m1_slot_eq_k_72, m1_slot_eq_k_71, m1_slot_eq_k_70, m1_slot_eq_k_69, m1_slot_eq_k_68, m1_slot_eq_k_67, m1_slot_eq_k_66, m1_slot_eq_k_65, m1_slot_eq_k_64, m1_slot_eq_k_63, m1_slot_eq_k_62, m1_slot_eq_k_61, m1_slot_eq_k_60, m1_slot_eq_k_59, m1_slot_eq_k_58, m1_slot_eq_k_57, m1_slot_eq_k_56, m1_slot_eq_k_55, m1_slot_eq_k_54, m1_slot_eq_k_53, m1_slot_eq_k_52, m1_slot_eq_k_51, m1_slot_eq_k_50, m1_slot_eq_k_49, m1_slot_eq_k_48, m1_slot_eq_k_47, m1_slot_eq_k_46, m1_slot_eq_k_45, m1_slot_eq_k_44, m1_slot_eq_k_43, m1_slot_eq_k_42, m1_slot_eq_k_41, m1_slot_eq_k_40, m1_slot_eq_k_39, m1_slot_eq_k_38, m1_slot_eq_k_37, m1_slot_eq_k_36, m1_slot_eq_k_35, m1_slot_eq_k_34, m1_slot_eq_k_33, m1_slot_eq_k_32, m1_slot_eq_k_31, m1_slot_eq_k_30, m1_slot_eq_k_29, m1_slot_eq_k_28, m1_slot_eq_k_27, m1_slot_eq_k_26, m1_slot_eq_k_25, m1_slot_eq_k_24, m1_slot_eq_k_23, m1_slot_eq_k_22, m1_slot_eq_k_21, m1_slot_eq_k_20, m1_slot_eq_k_19, m1_slot_eq_k_18, m1_slot_eq_k_17, m1_slot_eq_k_16, m1_slot_eq_k_15, m1_slot_eq_k_14, m1_slot_eq_k_13, m1_slot_eq_k_12, m1_slot_eq_k_11, m1_slot_eq_k_10, m1_slot_eq_k_9, m1_slot_eq_k_8_1, m1_slot_eq_k_7, m1_slot_eq_k_6, m1_slot_eq_k_5, m1_slot_eq_k_4, m1_slot_eq_k_3, m1_slot_eq_k_2, m1_slot_eq_k_1_1, m1_slot_eq_k_0_2};
+  assign cat_15 = {m1_slot_eq_k_127, m1_slot_eq_k_126, m1_slot_eq_k_125, m1_slot_eq_k_124, m1_slot_eq_k_123, m1_slot_eq_k_122, m1_slot_eq_k_121, m1_slot_eq_k_120, m1_slot_eq_k_119, m1_slot_eq_k_118, m1_slot_eq_k_117, m1_slot_eq_k_116, m1_slot_eq_k_115, m1_slot_eq_k_114, m1_slot_eq_k_113, m1_slot_eq_k_112, m1_slot_eq_k_111, m1_slot_eq_k_110, m1_slot_eq_k_109, m1_slot_eq_k_108, m1_slot_eq_k_107, m1_slot_eq_k_106, m1_slot_eq_k_105, m1_slot_eq_k_104, m1_slot_eq_k_103, m1_slot_eq_k_102, m1_slot_eq_k_101, m1_slot_eq_k_100, m1_slot_eq_k_99, m1_slot_eq_k_98, m1_slot_eq_k_97, m1_slot_eq_k_96, m1_slot_eq_k_95, m1_slot_eq_k_94, m1_slot_eq_k_93, m1_slot_eq_k_92, m1_slot_eq_k_91, m1_slot_eq_k_90, m1_slot_eq_k_89, m1_slot_eq_k_88, m1_slot_eq_k_87, m1_slot_eq_k_86, m1_slot_eq_k_85, m1_slot_eq_k_84, m1_slot_eq_k_83, m1_slot_eq_k_82, m1_slot_eq_k_81, m1_slot_eq_k_80, m1_slot_eq_k_79, m1_slot_eq_k_78, m1_slot_eq_k_77, m1_slot_eq_k_76, m1_slot_eq_k_75, m1_slot_eq_k_74, m1_slot_eq_k_73, m1_slot_eq_k_72, m1_slot_eq_k_71, m1_slot_eq_k_70, m1_slot_eq_k_69, m1_slot_eq_k_68, m1_slot_eq_k_67, m1_slot_eq_k_66, m1_slot_eq_k_65, m1_slot_eq_k_64, m1_slot_eq_k_63, m1_slot_eq_k_62, m1_slot_eq_k_61, m1_slot_eq_k_60, m1_slot_eq_k_59, m1_slot_eq_k_58, m1_slot_eq_k_57, m1_slot_eq_k_56, m1_slot_eq_k_55, m1_slot_eq_k_54, m1_slot_eq_k_53, m1_slot_eq_k_52, m1_slot_eq_k_51, m1_slot_eq_k_50, m1_slot_eq_k_49, m1_slot_eq_k_48, m1_slot_eq_k_47, m1_slot_eq_k_46, m1_slot_eq_k_45, m1_slot_eq_k_44, m1_slot_eq_k_43, m1_slot_eq_k_42, m1_slot_eq_k_41, m1_slot_eq_k_40, m1_slot_eq_k_39, m1_slot_eq_k_38, m1_slot_eq_k_37, m1_slot_eq_k_36, m1_slot_eq_k_35, m1_slot_eq_k_34, m1_slot_eq_k_33, m1_slot_eq_k_32, m1_slot_eq_k_31, m1_slot_eq_k_30, m1_slot_eq_k_29, m1_slot_eq_k_28, m1_slot_eq_k_27, m1_slot_eq_k_26, m1_slot_eq_k_25, m1_slot_eq_k_24, m1_slot_eq_k_23, m1_slot_eq_k_22, m1_slot_eq_k_21, m1_slot_eq_k_20, m1_slot_eq_k_19, m1_slot_eq_k_18, m1_slot_eq_k_17, m1_slot_eq_k_16, m1_slot_eq_k_15, m1_slot_eq_k_14, m1_slot_eq_k_13, m1_slot_eq_k_12, m1_slot_eq_k_11, m1_slot_eq_k_10, m1_slot_eq_k_9, m1_slot_eq_k_8_1, m1_slot_eq_k_7, m1_slot_eq_k_6, m1_slot_eq_k_5, m1_slot_eq_k_4, m1_slot_eq_k_3, m1_slot_eq_k_2, m1_slot_eq_k_1_1, m1_slot_eq_k_0_2};
   assign best_set = best_we ? m2_onehot : k_0_1;
   assign d0_slot_eq_k_127 = d0_slot == k_127;
   assign d0_slot_eq_k_126 = d0_slot == k_126;
@@ -1838,11 +1847,11 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign d0_slot_eq_k_2 = d0_slot == k_2;
   assign d0_slot_eq_k_1_1 = d0_slot == k_1_1;
   assign d0_slot_eq_k_0_2 = d0_slot == k_0_2;
-  assign cat_15 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
+  assign cat_16 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
   assign best_clear = d1 ? d1_onehot : k_0_1;
   assign not_best_clear = ~best_clear;
-  assign and_16 = best_valid & not_best_clear;
-  assign and_16_or_best_set = and_16 | best_set;
+  assign and_17 = best_valid & not_best_clear;
+  assign and_17_or_best_set = and_17 | best_set;
   assign res_id_c = done_id;
   assign res_hit_c = d1_has;
   assign bits_done_t_tri = done_t_tri[12:0];
@@ -1892,7 +1901,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     if (take) acc_u <= in_u;
     if (take) acc_v <= in_v;
     if (rst) best_valid <= 128'h00000000000000000000000000000000;
-    else best_valid <= and_16_or_best_set;
+    else best_valid <= and_17_or_best_set;
     if (rst) fin <= 1'h0;
     else fin <= leaf_last;
     fin_slot <= in_slot;
@@ -1910,7 +1919,6 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     fin_has_g5 <= fin_has_g5_c;
     fin_has_g6 <= fin_has_g6_c;
     fin_has_g7 <= fin_has_g7_c;
-    m1_slot_has <= fin_has_c;
     m1_leaf_empty <= acc_empty;
     m1_t_tri <= cat_6;
     m1_u_v <= cat_7;
@@ -1947,8 +1955,8 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     done_has_g6 <= done_has_g6_c;
     done_has_g7 <= done_has_g7_c;
     d1_has <= done_has_c;
-    m2_onehot <= cat_14;
-    d1_onehot <= cat_15;
+    m2_onehot <= cat_15;
+    d1_onehot <= cat_16;
     if (rst) free_valid_r <= 1'h0;
     else free_valid_r <= d1;
     free_slot_r <= d1_slot;
@@ -1960,6 +1968,13 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     res_t_r <= res_t_c;
     res_u_r <= res_u_c;
     res_v_r <= res_v_c;
+  end
+
+  // register copies m1_slot_has_copies: m1_slot_has and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : m1_slot_has_copies_regs
+    m1_slot_has <= fin_has_c;
+    m1_slot_has_c1 <= fin_has_c;
   end
 
   // register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out

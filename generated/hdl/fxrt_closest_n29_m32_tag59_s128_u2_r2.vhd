@@ -285,22 +285,24 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal fin_has_g7 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_fin_slot : unsigned(2 downto 0);
   signal fin_has_c : unsigned(0 downto 0);
-  signal m1_slot_has : unsigned(0 downto 0) := unsigned'("0");
   signal m1_leaf_empty : unsigned(0 downto 0) := unsigned'("0");
   signal cat_6 : unsigned(42 downto 0);
   signal m1_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
   signal cat_7 : unsigned(63 downto 0);
   signal m1_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-  signal cat_8 : unsigned(44 downto 0);
-  signal not_m1_slot_has : unsigned(0 downto 0);
-  signal cat_9 : unsigned(44 downto 0);
-  signal rs_cat_8 : unsigned(45 downto 0);
-  signal rs_cat_9 : unsigned(45 downto 0);
-  signal rs_cat_8_minus_rs_cat_9 : unsigned(45 downto 0);
+  signal cat_8 : unsigned(43 downto 0);
+  signal cat_9 : unsigned(43 downto 0);
+  signal rs_cat_8 : unsigned(44 downto 0);
+  signal rs_cat_9 : unsigned(44 downto 0);
+  signal rs_cat_8_minus_rs_cat_9 : unsigned(44 downto 0);
+  signal leaf_tt_less : unsigned(0 downto 0);
+  signal not_m1_slot_has_c1 : unsigned(0 downto 0);
+  signal not_m1_leaf_empty : unsigned(0 downto 0);
+  signal and_10 : unsigned(0 downto 0);
   signal leaf_better : unsigned(0 downto 0);
   signal m2 : unsigned(0 downto 0) := unsigned'("0");
   signal m2_better : unsigned(0 downto 0) := unsigned'("0");
-  signal not_m1_leaf_empty : unsigned(0 downto 0);
+  signal not_m1_leaf_empty_1 : unsigned(0 downto 0);
   signal m1_hit : unsigned(0 downto 0);
   signal m2_hit : unsigned(0 downto 0) := unsigned'("0");
   signal m2_sp : unsigned(5 downto 0) := unsigned'("000000");
@@ -746,7 +748,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal m1_slot_eq_k_1_1 : unsigned(0 downto 0);
   constant k_0_2 : unsigned(6 downto 0) := unsigned'("0000000");
   signal m1_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_14 : unsigned(127 downto 0);
+  signal cat_15 : unsigned(127 downto 0);
   signal m2_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_set : unsigned(127 downto 0);
   signal d0_slot_eq_k_127 : unsigned(0 downto 0);
@@ -877,12 +879,12 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal d0_slot_eq_k_2 : unsigned(0 downto 0);
   signal d0_slot_eq_k_1_1 : unsigned(0 downto 0);
   signal d0_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_15 : unsigned(127 downto 0);
+  signal cat_16 : unsigned(127 downto 0);
   signal d1_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_clear : unsigned(127 downto 0);
   signal not_best_clear : unsigned(127 downto 0);
-  signal and_16 : unsigned(127 downto 0);
-  signal and_16_or_best_set : unsigned(127 downto 0);
+  signal and_17 : unsigned(127 downto 0);
+  signal and_17_or_best_set : unsigned(127 downto 0);
   signal free_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal free_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal res_valid_r : unsigned(0 downto 0) := unsigned'("0");
@@ -905,6 +907,12 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_done_u_v_1 : unsigned(31 downto 0);
   signal res_v_c : unsigned(31 downto 0);
   signal res_v_r : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+
+  -- register copies m1_slot_has_copies: m1_slot_has and 1 copies, to split its fan-out
+  signal m1_slot_has : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of m1_slot_has : signal is "true";
+  signal m1_slot_has_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of m1_slot_has_c1 : signal is "true";
 
   -- register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
   signal m2_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -1281,15 +1289,18 @@ begin
       k_0 when others;
   cat_6 <= unsigned(std_logic_vector'(std_logic_vector(acc_t) & std_logic_vector(acc_tri)));
   cat_7 <= unsigned(std_logic_vector'(std_logic_vector(acc_u) & std_logic_vector(acc_v)));
-  cat_8 <= unsigned(std_logic_vector'(std_logic_vector(m1_leaf_empty) & std_logic_vector(k_0) & std_logic_vector(m1_t_tri)));
-  not_m1_slot_has <= not m1_slot_has;
-  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(not_m1_slot_has) & std_logic_vector(slot_t_tri)));
-  rs_cat_8 <= resize(cat_8, 46);
-  rs_cat_9 <= resize(cat_9, 46);
+  cat_8 <= unsigned(std_logic_vector'(std_logic_vector(m1_leaf_empty) & std_logic_vector(m1_t_tri)));
+  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(slot_t_tri)));
+  rs_cat_8 <= resize(cat_8, 45);
+  rs_cat_9 <= resize(cat_9, 45);
   rs_cat_8_minus_rs_cat_9 <= rs_cat_8 - rs_cat_9;
-  leaf_better <= unsigned(rs_cat_8_minus_rs_cat_9(45 downto 45));
+  leaf_tt_less <= unsigned(rs_cat_8_minus_rs_cat_9(44 downto 44));
+  not_m1_slot_has_c1 <= not m1_slot_has_c1;
   not_m1_leaf_empty <= not m1_leaf_empty;
-  m1_hit <= m1_slot_has or not_m1_leaf_empty;
+  and_10 <= not_m1_slot_has_c1 and not_m1_leaf_empty;
+  leaf_better <= leaf_tt_less or and_10;
+  not_m1_leaf_empty_1 <= not m1_leaf_empty;
+  m1_hit <= m1_slot_has or not_m1_leaf_empty_1;
   bits_slot_t_tri <= unsigned(slot_t_tri(42 downto 13));
   m1_we <= m1 and leaf_better;
   bits_m2_t_tri <= unsigned(m2_t_tri(42 downto 13));
@@ -1733,7 +1744,7 @@ begin
   m1_slot_eq_k_2 <= "1" when m1_slot = k_2 else "0";
   m1_slot_eq_k_1_1 <= "1" when m1_slot = k_1_1 else "0";
   m1_slot_eq_k_0_2 <= "1" when m1_slot = k_0_2 else "0";
-  cat_14 <= unsigned(std_logic_vector'(std_logic_vector(m1_slot_eq_k_127) & std_logic_vector(m1_slot_eq_k_126) & std_logic_vector(m1_slot_eq_k_125) & std_logic_vector(m1_slot_eq_k_124) & std_logic_vector(m1_slot_eq_k_123) & std_logic_vector(m1_slot_eq_k_122) & std_logic_vector(m1_slot_eq_k_121) & std_logic_vector(m1_slot_eq_k_120) & std_logic_vector(m1_slot_eq_k_119) & std_logic_vector(m1_slot_eq_k_118) & std_logic_vector(m1_slot_eq_k_117) & std_logic_vector(m1_slot_eq_k_116) & std_logic_vector(m1_slot_eq_k_115) & std_logic_vector(m1_slot_eq_k_114) & std_logic_vector(m1_slot_eq_k_113) & std_logic_vector(m1_slot_eq_k_112) & std_logic_vector(m1_slot_eq_k_111) & std_logic_vector(m1_slot_eq_k_110) & std_logic_vector(m1_slot_eq_k_109) & std_logic_vector(m1_slot_eq_k_108) & std_logic_vector(m1_slot_eq_k_107) & std_logic_vector(m1_slot_eq_k_106) & std_logic_vector(m1_slot_eq_k_105) & std_logic_vector(m1_slot_eq_k_104) & std_logic_vector(m1_slot_eq_k_103) & std_logic_vector(m1_slot_eq_k_102) & std_logic_vector(m1_slot_eq_k_101) & std_logic_vector(m1_slot_eq_k_100) & std_logic_vector(m1_slot_eq_k_99) & std_logic_vector(m1_slot_eq_k_98) & std_logic_vector(m1_slot_eq_k_97) & std_logic_vector(m1_slot_eq_k_96) & std_logic_vector(m1_slot_eq_k_95) & std_logic_vector(m1_slot_eq_k_94) & std_logic_vector(m1_slot_eq_k_93) & std_logic_vector(m1_slot_eq_k_92) & std_logic_vector(m1_slot_eq_k_91) & std_logic_vector(m1_slot_eq_k_90) & std_logic_vector(m1_slot_eq_k_89) & std_logic_vector(m1_slot_eq_k_88) & std_logic_vector(m1_slot_eq_k_87) & std_logic_vector(m1_slot_eq_k_86) & std_logic_vector(m1_slot_eq_k_85) & std_logic_vector(m1_slot_eq_k_84) & std_logic_vector(m1_slot_eq_k_83) & std_logic_vector(m1_slot_eq_k_82) & std_logic_vector(m1_slot_eq_k_81) & std_logic_vector(m1_slot_eq_k_80) & std_logic_vector(m1_slot_eq_k_79) & std_logic_vector(m1_slot_eq_k_78) & std_logic_vector(m1_slot_eq_k_77) & std_logic_vector(m1_slot_eq_k_76) & std_logic_vector(m1_slot_eq_k_75) & std_logic_vector(m1_slot_eq_k_74) & std_logic_vector(m1_slot_eq_k_73) & std_logic_vector(m1_slot_eq_k_72) & std_logic_vector(m1_slot_eq_k_71) & std_logic_vector(m1_slot_eq_k_70) & std_logic_vector(m1_slot_eq_k_69) & std_logic_vector(m1_slot_eq_k_68) & std_logic_vector(m1_slot_eq_k_67) & std_logic_vector(m1_slot_eq_k_66) & std_logic_vector(m1_slot_eq_k_65) & std_logic_vector(m1_slot_eq_k_64) & std_logic_vector(m1_slot_eq_k_63) & std_logic_vector(m1_slot_eq_k_62) & std_logic_vector(m1_slot_eq_k_61) & std_logic_vector(m1_slot_eq_k_60) & std_logic_vector(m1_slot_eq_k_59) & std_logic_vector(m1_slot_eq_k_58) & std_logic_vector(m1_slot_eq_k_57) & std_logic_vector(m1_slot_eq_k_56) & std_logic_vector(m1_slot_eq_k_55) & std_logic_vector(m1_slot_eq_k_54) & std_logic_vector(m1_slot_eq_k_53) & std_logic_vector(m1_slot_eq_k_52) & std_logic_vector(m1_slot_eq_k_51) & std_logic_vector(m1_slot_eq_k_50) & std_logic_vector(m1_slot_eq_k_49) & std_logic_vector(m1_slot_eq_k_48) & std_logic_vector(m1_slot_eq_k_47) & std_logic_vector(m1_slot_eq_k_46) & std_logic_vector(m1_slot_eq_k_45) & std_logic_vector(m1_slot_eq_k_44) & std_logic_vector(m1_slot_eq_k_43) & std_logic_vector(m1_slot_eq_k_42) & std_logic_vector(m1_slot_eq_k_41) & std_logic_vector(m1_slot_eq_k_40) & std_logic_vector(m1_slot_eq_k_39) & std_logic_vector(m1_slot_eq_k_38) & std_logic_vector(m1_slot_eq_k_37) & std_logic_vector(m1_slot_eq_k_36) & std_logic_vector(m1_slot_eq_k_35) & std_logic_vector(m1_slot_eq_k_34) & std_logic_vector(m1_slot_eq_k_33) & std_logic_vector(m1_slot_eq_k_32) & std_logic_vector(m1_slot_eq_k_31) & std_logic_vector(m1_slot_eq_k_30) & std_logic_vector(m1_slot_eq_k_29) & std_logic_vector(m1_slot_eq_k_28) & std_logic_vector(m1_slot_eq_k_27) & std_logic_vector(m1_slot_eq_k_26) & std_logic_vector(m1_slot_eq_k_25) & std_logic_vector(m1_slot_eq_k_24) & std_logic_vector(m1_slot_eq_k_23) & std_logic_vector(m1_slot_eq_k_22) & std_logic_vector(m1_slot_eq_k_21) & std_logic_vector(m1_slot_eq_k_20) & std_logic_vector(m1_slot_eq_k_19) & std_logic_vector(m1_slot_eq_k_18) & std_logic_vector(m1_slot_eq_k_17) & std_logic_vector(m1_slot_eq_k_16) & std_logic_vector(m1_slot_eq_k_15) & std_logic_vector(m1_slot_eq_k_14) & std_logic_vector(m1_slot_eq_k_13) & std_logic_vector(m1_slot_eq_k_12) & std_logic_vector(m1_slot_eq_k_11) & std_logic_vector(m1_slot_eq_k_10) & std_logic_vector(m1_slot_eq_k_9) & std_logic_vector(m1_slot_eq_k_8_1) & std_logic_vector(m1_slot_eq_k_7) & std_logic_vector(m1_slot_eq_k_6) & std_logic_vector(m1_slot_eq_k_5) & std_logic_vector(m1_slot_eq_k_4) & std_logic_vector(m1_slot_eq_k_3) & std_logic_vector(m1_slot_eq_k_2) & std_logic_vector(m1_slot_eq_k_1_1) & std_logic_vector(m1_slot_eq_k_0_2)));
+  cat_15 <= unsigned(std_logic_vector'(std_logic_vector(m1_slot_eq_k_127) & std_logic_vector(m1_slot_eq_k_126) & std_logic_vector(m1_slot_eq_k_125) & std_logic_vector(m1_slot_eq_k_124) & std_logic_vector(m1_slot_eq_k_123) & std_logic_vector(m1_slot_eq_k_122) & std_logic_vector(m1_slot_eq_k_121) & std_logic_vector(m1_slot_eq_k_120) & std_logic_vector(m1_slot_eq_k_119) & std_logic_vector(m1_slot_eq_k_118) & std_logic_vector(m1_slot_eq_k_117) & std_logic_vector(m1_slot_eq_k_116) & std_logic_vector(m1_slot_eq_k_115) & std_logic_vector(m1_slot_eq_k_114) & std_logic_vector(m1_slot_eq_k_113) & std_logic_vector(m1_slot_eq_k_112) & std_logic_vector(m1_slot_eq_k_111) & std_logic_vector(m1_slot_eq_k_110) & std_logic_vector(m1_slot_eq_k_109) & std_logic_vector(m1_slot_eq_k_108) & std_logic_vector(m1_slot_eq_k_107) & std_logic_vector(m1_slot_eq_k_106) & std_logic_vector(m1_slot_eq_k_105) & std_logic_vector(m1_slot_eq_k_104) & std_logic_vector(m1_slot_eq_k_103) & std_logic_vector(m1_slot_eq_k_102) & std_logic_vector(m1_slot_eq_k_101) & std_logic_vector(m1_slot_eq_k_100) & std_logic_vector(m1_slot_eq_k_99) & std_logic_vector(m1_slot_eq_k_98) & std_logic_vector(m1_slot_eq_k_97) & std_logic_vector(m1_slot_eq_k_96) & std_logic_vector(m1_slot_eq_k_95) & std_logic_vector(m1_slot_eq_k_94) & std_logic_vector(m1_slot_eq_k_93) & std_logic_vector(m1_slot_eq_k_92) & std_logic_vector(m1_slot_eq_k_91) & std_logic_vector(m1_slot_eq_k_90) & std_logic_vector(m1_slot_eq_k_89) & std_logic_vector(m1_slot_eq_k_88) & std_logic_vector(m1_slot_eq_k_87) & std_logic_vector(m1_slot_eq_k_86) & std_logic_vector(m1_slot_eq_k_85) & std_logic_vector(m1_slot_eq_k_84) & std_logic_vector(m1_slot_eq_k_83) & std_logic_vector(m1_slot_eq_k_82) & std_logic_vector(m1_slot_eq_k_81) & std_logic_vector(m1_slot_eq_k_80) & std_logic_vector(m1_slot_eq_k_79) & std_logic_vector(m1_slot_eq_k_78) & std_logic_vector(m1_slot_eq_k_77) & std_logic_vector(m1_slot_eq_k_76) & std_logic_vector(m1_slot_eq_k_75) & std_logic_vector(m1_slot_eq_k_74) & std_logic_vector(m1_slot_eq_k_73) & std_logic_vector(m1_slot_eq_k_72) & std_logic_vector(m1_slot_eq_k_71) & std_logic_vector(m1_slot_eq_k_70) & std_logic_vector(m1_slot_eq_k_69) & std_logic_vector(m1_slot_eq_k_68) & std_logic_vector(m1_slot_eq_k_67) & std_logic_vector(m1_slot_eq_k_66) & std_logic_vector(m1_slot_eq_k_65) & std_logic_vector(m1_slot_eq_k_64) & std_logic_vector(m1_slot_eq_k_63) & std_logic_vector(m1_slot_eq_k_62) & std_logic_vector(m1_slot_eq_k_61) & std_logic_vector(m1_slot_eq_k_60) & std_logic_vector(m1_slot_eq_k_59) & std_logic_vector(m1_slot_eq_k_58) & std_logic_vector(m1_slot_eq_k_57) & std_logic_vector(m1_slot_eq_k_56) & std_logic_vector(m1_slot_eq_k_55) & std_logic_vector(m1_slot_eq_k_54) & std_logic_vector(m1_slot_eq_k_53) & std_logic_vector(m1_slot_eq_k_52) & std_logic_vector(m1_slot_eq_k_51) & std_logic_vector(m1_slot_eq_k_50) & std_logic_vector(m1_slot_eq_k_49) & std_logic_vector(m1_slot_eq_k_48) & std_logic_vector(m1_slot_eq_k_47) & std_logic_vector(m1_slot_eq_k_46) & std_logic_vector(m1_slot_eq_k_45) & std_logic_vector(m1_slot_eq_k_44) & std_logic_vector(m1_slot_eq_k_43) & std_logic_vector(m1_slot_eq_k_42) & std_logic_vector(m1_slot_eq_k_41) & std_logic_vector(m1_slot_eq_k_40) & std_logic_vector(m1_slot_eq_k_39) & std_logic_vector(m1_slot_eq_k_38) & std_logic_vector(m1_slot_eq_k_37) & std_logic_vector(m1_slot_eq_k_36) & std_logic_vector(m1_slot_eq_k_35) & std_logic_vector(m1_slot_eq_k_34) & std_logic_vector(m1_slot_eq_k_33) & std_logic_vector(m1_slot_eq_k_32) & std_logic_vector(m1_slot_eq_k_31) & std_logic_vector(m1_slot_eq_k_30) & std_logic_vector(m1_slot_eq_k_29) & std_logic_vector(m1_slot_eq_k_28) & std_logic_vector(m1_slot_eq_k_27) & std_logic_vector(m1_slot_eq_k_26) & std_logic_vector(m1_slot_eq_k_25) & std_logic_vector(m1_slot_eq_k_24) & std_logic_vector(m1_slot_eq_k_23) & std_logic_vector(m1_slot_eq_k_22) & std_logic_vector(m1_slot_eq_k_21) & std_logic_vector(m1_slot_eq_k_20) & std_logic_vector(m1_slot_eq_k_19) & std_logic_vector(m1_slot_eq_k_18) & std_logic_vector(m1_slot_eq_k_17) & std_logic_vector(m1_slot_eq_k_16) & std_logic_vector(m1_slot_eq_k_15) & std_logic_vector(m1_slot_eq_k_14) & std_logic_vector(m1_slot_eq_k_13) & std_logic_vector(m1_slot_eq_k_12) & std_logic_vector(m1_slot_eq_k_11) & std_logic_vector(m1_slot_eq_k_10) & std_logic_vector(m1_slot_eq_k_9) & std_logic_vector(m1_slot_eq_k_8_1) & std_logic_vector(m1_slot_eq_k_7) & std_logic_vector(m1_slot_eq_k_6) & std_logic_vector(m1_slot_eq_k_5) & std_logic_vector(m1_slot_eq_k_4) & std_logic_vector(m1_slot_eq_k_3) & std_logic_vector(m1_slot_eq_k_2) & std_logic_vector(m1_slot_eq_k_1_1) & std_logic_vector(m1_slot_eq_k_0_2)));
   best_set <= m2_onehot when best_we = "1" else k_0_1;
   d0_slot_eq_k_127 <= "1" when d0_slot = k_127 else "0";
   d0_slot_eq_k_126 <= "1" when d0_slot = k_126 else "0";
@@ -1863,11 +1874,11 @@ begin
   d0_slot_eq_k_2 <= "1" when d0_slot = k_2 else "0";
   d0_slot_eq_k_1_1 <= "1" when d0_slot = k_1_1 else "0";
   d0_slot_eq_k_0_2 <= "1" when d0_slot = k_0_2 else "0";
-  cat_15 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
+  cat_16 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
   best_clear <= d1_onehot when d1 = "1" else k_0_1;
   not_best_clear <= not best_clear;
-  and_16 <= best_valid and not_best_clear;
-  and_16_or_best_set <= and_16 or best_set;
+  and_17 <= best_valid and not_best_clear;
+  and_17_or_best_set <= and_17 or best_set;
   res_id_c <= done_id;
   res_hit_c <= d1_has;
   bits_done_t_tri <= unsigned(done_t_tri(12 downto 0));
@@ -1950,7 +1961,7 @@ begin
       if rst = '1' then
         best_valid <= unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
       else
-        best_valid <= and_16_or_best_set;
+        best_valid <= and_17_or_best_set;
       end if;
       if rst = '1' then
         fin <= unsigned'("0");
@@ -1975,7 +1986,6 @@ begin
       fin_has_g5 <= fin_has_g5_c;
       fin_has_g6 <= fin_has_g6_c;
       fin_has_g7 <= fin_has_g7_c;
-      m1_slot_has <= fin_has_c;
       m1_leaf_empty <= acc_empty;
       m1_t_tri <= cat_6;
       m1_u_v <= cat_7;
@@ -2030,8 +2040,8 @@ begin
       done_has_g6 <= done_has_g6_c;
       done_has_g7 <= done_has_g7_c;
       d1_has <= done_has_c;
-      m2_onehot <= cat_14;
-      d1_onehot <= cat_15;
+      m2_onehot <= cat_15;
+      d1_onehot <= cat_16;
       if rst = '1' then
         free_valid_r <= unsigned'("0");
       else
@@ -2051,6 +2061,16 @@ begin
       res_v_r <= res_v_c;
     end if;
   end process regs;
+
+  -- register copies m1_slot_has_copies: m1_slot_has and 1 copies, to split its fan-out
+
+  m1_slot_has_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      m1_slot_has <= fin_has_c;
+      m1_slot_has_c1 <= fin_has_c;
+    end if;
+  end process m1_slot_has_copies_regs;
 
   -- register copies m2_slot_copies: m2_slot and 2 copies, to split its fan-out
 

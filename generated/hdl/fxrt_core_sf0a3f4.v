@@ -55,11 +55,11 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] box_phase_eq_k_0;
   wire [0:0] and_0;
   wire [0:0] take;
-  wire [0:0] not_in_valid;
-  wire [0:0] port_ready;
+  wire [0:0] port_empty_and_ray_valid;
   wire [0:0] not_take;
   wire [0:0] in_valid_and_not_take;
   wire [0:0] or_1;
+  wire [0:0] not_or_1;
   reg [19:0] in_ray_id = 20'h00000;
   reg [28:0] in_ox = 29'h00000000;
   reg [28:0] in_oy = 29'h00000000;
@@ -103,6 +103,12 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] acc_in_invz = 48'sh000000000000;
   wire [5:0] bits_accept_slot_c3;
   wire [5:0] bits_accept_slot_c4;
+
+  // register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
+  reg [0:0] port_empty = 1'h1;
+  reg [0:0] port_empty_c1 = 1'h1;
+  reg [0:0] port_empty_c2 = 1'h1;
+  reg [0:0] port_empty_c3 = 1'h1;
 
   // register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 6 are read
@@ -600,11 +606,11 @@ module fxrt_core_sf0a3f4 (
   assign box_phase_eq_k_0 = box_phase == k_0;
   assign and_0 = in_valid & box_phase_eq_k_0;
   assign take = and_0 & turn_free;
-  assign not_in_valid = ~in_valid;
-  assign port_ready = not_in_valid | take;
+  assign port_empty_and_ray_valid = port_empty & ray_valid;
   assign not_take = ~take;
   assign in_valid_and_not_take = in_valid & not_take;
-  assign or_1 = ray_valid | in_valid_and_not_take;
+  assign or_1 = port_empty_and_ray_valid | in_valid_and_not_take;
+  assign not_or_1 = ~or_1;
   assign take_slot = {turn, case_turn};
   assign turn_plus_1 = turn + k_1;
   assign not_turn_free = ~turn_free;
@@ -635,16 +641,16 @@ module fxrt_core_sf0a3f4 (
     else turn_free <= case_turn_next;
     if (rst) in_valid <= 1'h0;
     else in_valid <= or_1;
-    if (port_ready) in_ray_id <= ray_id;
-    if (port_ready) in_ox <= ox;
-    if (port_ready) in_oy <= oy;
-    if (port_ready) in_oz <= oz;
-    if (port_ready) in_wx <= wx;
-    if (port_ready) in_wy <= wy;
-    if (port_ready) in_wz <= wz;
-    if (port_ready) in_invx <= invx;
-    if (port_ready) in_invy <= invy;
-    if (port_ready) in_invz <= invz;
+    if (port_empty) in_ray_id <= ray_id;
+    if (port_empty) in_ox <= ox;
+    if (port_empty) in_oy <= oy;
+    if (port_empty_c1) in_oz <= oz;
+    if (port_empty_c1) in_wx <= wx;
+    if (port_empty_c2) in_wy <= wy;
+    if (port_empty_c2) in_wz <= wz;
+    if (port_empty_c2) in_invx <= invx;
+    if (port_empty_c3) in_invy <= invy;
+    if (port_empty_c3) in_invz <= invz;
     if (box_idle) box_in_ox <= in_ox;
     if (box_idle) box_in_oy <= in_oy;
     if (box_idle) box_in_oz <= in_oz;
@@ -663,6 +669,19 @@ module fxrt_core_sf0a3f4 (
     acc_in_invx <= in_invx;
     acc_in_invy <= in_invy;
     acc_in_invz <= in_invz;
+  end
+
+  // register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : port_empty_copies_regs
+    if (rst) port_empty <= 1'h1;
+    else port_empty <= not_or_1;
+    if (rst) port_empty_c1 <= 1'h1;
+    else port_empty_c1 <= not_or_1;
+    if (rst) port_empty_c2 <= 1'h1;
+    else port_empty_c2 <= not_or_1;
+    if (rst) port_empty_c3 <= 1'h1;
+    else port_empty_c3 <= not_or_1;
   end
 
   // register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
@@ -1307,7 +1326,7 @@ module fxrt_core_sf0a3f4 (
     .res_v(u_closest_res_v)
   );
 
-  assign ray_ready = port_ready;
+  assign ray_ready = port_empty;
   assign res_valid = res_q_nonempty;
   assign res_id = res_id_q;
   assign res_hit = res_hit_q;

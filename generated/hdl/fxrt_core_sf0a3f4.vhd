@@ -219,11 +219,11 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_phase_eq_k_0 : unsigned(0 downto 0);
   signal and_0 : unsigned(0 downto 0);
   signal take : unsigned(0 downto 0);
-  signal not_in_valid : unsigned(0 downto 0);
-  signal port_ready : unsigned(0 downto 0);
+  signal port_empty_and_ray_valid : unsigned(0 downto 0);
   signal not_take : unsigned(0 downto 0);
   signal in_valid_and_not_take : unsigned(0 downto 0);
   signal or_1 : unsigned(0 downto 0);
+  signal not_or_1 : unsigned(0 downto 0);
   signal in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -267,6 +267,16 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal bits_accept_slot_c3 : unsigned(5 downto 0);
   signal bits_accept_slot_c4 : unsigned(5 downto 0);
+
+  -- register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
+  signal port_empty : unsigned(0 downto 0) := unsigned'("1");
+  attribute keep of port_empty : signal is "true";
+  signal port_empty_c1 : unsigned(0 downto 0) := unsigned'("1");
+  attribute keep of port_empty_c1 : signal is "true";
+  signal port_empty_c2 : unsigned(0 downto 0) := unsigned'("1");
+  attribute keep of port_empty_c2 : signal is "true";
+  signal port_empty_c3 : unsigned(0 downto 0) := unsigned'("1");
+  attribute keep of port_empty_c3 : signal is "true";
 
   -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
   signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -732,11 +742,11 @@ begin
   box_phase_eq_k_0 <= "1" when box_phase = k_0 else "0";
   and_0 <= in_valid and box_phase_eq_k_0;
   take <= and_0 and turn_free;
-  not_in_valid <= not in_valid;
-  port_ready <= not_in_valid or take;
+  port_empty_and_ray_valid <= port_empty and ray_valid;
   not_take <= not take;
   in_valid_and_not_take <= in_valid and not_take;
-  or_1 <= ray_valid or in_valid_and_not_take;
+  or_1 <= port_empty_and_ray_valid or in_valid_and_not_take;
+  not_or_1 <= not or_1;
   take_slot <= unsigned(std_logic_vector'(std_logic_vector(turn) & std_logic_vector(case_turn)));
   turn_plus_1 <= turn + k_1;
   not_turn_free <= not turn_free;
@@ -788,34 +798,34 @@ begin
       else
         in_valid <= or_1;
       end if;
-      if port_ready = "1" then
+      if port_empty = "1" then
         in_ray_id <= ray_id;
       end if;
-      if port_ready = "1" then
+      if port_empty = "1" then
         in_ox <= ox;
       end if;
-      if port_ready = "1" then
+      if port_empty = "1" then
         in_oy <= oy;
       end if;
-      if port_ready = "1" then
+      if port_empty_c1 = "1" then
         in_oz <= oz;
       end if;
-      if port_ready = "1" then
+      if port_empty_c1 = "1" then
         in_wx <= wx;
       end if;
-      if port_ready = "1" then
+      if port_empty_c2 = "1" then
         in_wy <= wy;
       end if;
-      if port_ready = "1" then
+      if port_empty_c2 = "1" then
         in_wz <= wz;
       end if;
-      if port_ready = "1" then
+      if port_empty_c2 = "1" then
         in_invx <= invx;
       end if;
-      if port_ready = "1" then
+      if port_empty_c3 = "1" then
         in_invy <= invy;
       end if;
-      if port_ready = "1" then
+      if port_empty_c3 = "1" then
         in_invz <= invz;
       end if;
       if box_idle = "1" then
@@ -853,6 +863,34 @@ begin
       acc_in_invz <= in_invz;
     end if;
   end process ray_port_regs;
+
+  -- register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
+
+  port_empty_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        port_empty <= unsigned'("1");
+      else
+        port_empty <= not_or_1;
+      end if;
+      if rst = '1' then
+        port_empty_c1 <= unsigned'("1");
+      else
+        port_empty_c1 <= not_or_1;
+      end if;
+      if rst = '1' then
+        port_empty_c2 <= unsigned'("1");
+      else
+        port_empty_c2 <= not_or_1;
+      end if;
+      if rst = '1' then
+        port_empty_c3 <= unsigned'("1");
+      else
+        port_empty_c3 <= not_or_1;
+      end if;
+    end if;
+  end process port_empty_copies_regs;
 
   -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
 
@@ -1655,7 +1693,7 @@ begin
       res_v => u_closest_res_v
     );
 
-  ray_ready <= port_ready;
+  ray_ready <= port_empty;
   res_valid <= res_q_nonempty;
   res_id <= res_id_q;
   res_hit <= res_hit_q;

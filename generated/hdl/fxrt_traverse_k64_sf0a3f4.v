@@ -978,7 +978,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] a_slot_eq_k_1;
   wire [0:0] a_slot_eq_k_0_1;
   wire [63:0] cat_113;
-  wire [63:0] best_clear;
+  wire [63:0] best_clear_c;
+  reg [63:0] best_clear = 64'h0000000000000000;
   wire [63:0] not_best_clear;
   wire [63:0] and_114;
   wire [63:0] and_114_or_best_set;
@@ -2331,7 +2332,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign a_slot_eq_k_1 = a_slot == k_1;
   assign a_slot_eq_k_0_1 = a_slot == k_0_1;
   assign cat_113 = {a_slot_eq_k_63, a_slot_eq_k_62, a_slot_eq_k_61, a_slot_eq_k_60, a_slot_eq_k_59, a_slot_eq_k_58, a_slot_eq_k_57, a_slot_eq_k_56, a_slot_eq_k_55, a_slot_eq_k_54, a_slot_eq_k_53, a_slot_eq_k_52, a_slot_eq_k_51, a_slot_eq_k_50, a_slot_eq_k_49, a_slot_eq_k_48, a_slot_eq_k_47, a_slot_eq_k_46, a_slot_eq_k_45, a_slot_eq_k_44, a_slot_eq_k_43, a_slot_eq_k_42, a_slot_eq_k_41, a_slot_eq_k_40, a_slot_eq_k_39, a_slot_eq_k_38, a_slot_eq_k_37, a_slot_eq_k_36, a_slot_eq_k_35, a_slot_eq_k_34, a_slot_eq_k_33, a_slot_eq_k_32, a_slot_eq_k_31, a_slot_eq_k_30, a_slot_eq_k_29, a_slot_eq_k_28, a_slot_eq_k_27, a_slot_eq_k_26, a_slot_eq_k_25, a_slot_eq_k_24, a_slot_eq_k_23, a_slot_eq_k_22, a_slot_eq_k_21, a_slot_eq_k_20, a_slot_eq_k_19, a_slot_eq_k_18, a_slot_eq_k_17, a_slot_eq_k_16, a_slot_eq_k_15, a_slot_eq_k_14, a_slot_eq_k_13, a_slot_eq_k_12, a_slot_eq_k_11, a_slot_eq_k_10, a_slot_eq_k_9, a_slot_eq_k_8, a_slot_eq_k_7, a_slot_eq_k_6, a_slot_eq_k_5, a_slot_eq_k_4, a_slot_eq_k_3, a_slot_eq_k_2, a_slot_eq_k_1, a_slot_eq_k_0_1};
-  assign best_clear = a_new_and_a_valid ? cat_113 : k_0_2;
+  assign best_clear_c = a_new_and_a_valid ? cat_113 : k_0_2;
   assign not_best_clear = ~best_clear;
   assign and_114 = has_best & not_best_clear;
   assign and_114_or_best_set = and_114 | best_set;
@@ -2350,6 +2351,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     cull_has_best <= slot_has_best;
     culled <= culled_c;
     culled_n <= culled;
+    best_clear <= best_clear_c;
   end
 
   // register copies c_slot_copies: c_slot and 2 copies, to split its fan-out

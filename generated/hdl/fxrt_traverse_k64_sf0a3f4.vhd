@@ -1002,7 +1002,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal a_slot_eq_k_1 : unsigned(0 downto 0);
   signal a_slot_eq_k_0_1 : unsigned(0 downto 0);
   signal cat_113 : unsigned(63 downto 0);
-  signal best_clear : unsigned(63 downto 0);
+  signal best_clear_c : unsigned(63 downto 0);
+  signal best_clear : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal not_best_clear : unsigned(63 downto 0);
   signal and_114 : unsigned(63 downto 0);
   signal and_114_or_best_set : unsigned(63 downto 0);
@@ -2453,7 +2454,7 @@ begin
   a_slot_eq_k_1 <= "1" when a_slot = k_1 else "0";
   a_slot_eq_k_0_1 <= "1" when a_slot = k_0_1 else "0";
   cat_113 <= unsigned(std_logic_vector'(std_logic_vector(a_slot_eq_k_63) & std_logic_vector(a_slot_eq_k_62) & std_logic_vector(a_slot_eq_k_61) & std_logic_vector(a_slot_eq_k_60) & std_logic_vector(a_slot_eq_k_59) & std_logic_vector(a_slot_eq_k_58) & std_logic_vector(a_slot_eq_k_57) & std_logic_vector(a_slot_eq_k_56) & std_logic_vector(a_slot_eq_k_55) & std_logic_vector(a_slot_eq_k_54) & std_logic_vector(a_slot_eq_k_53) & std_logic_vector(a_slot_eq_k_52) & std_logic_vector(a_slot_eq_k_51) & std_logic_vector(a_slot_eq_k_50) & std_logic_vector(a_slot_eq_k_49) & std_logic_vector(a_slot_eq_k_48) & std_logic_vector(a_slot_eq_k_47) & std_logic_vector(a_slot_eq_k_46) & std_logic_vector(a_slot_eq_k_45) & std_logic_vector(a_slot_eq_k_44) & std_logic_vector(a_slot_eq_k_43) & std_logic_vector(a_slot_eq_k_42) & std_logic_vector(a_slot_eq_k_41) & std_logic_vector(a_slot_eq_k_40) & std_logic_vector(a_slot_eq_k_39) & std_logic_vector(a_slot_eq_k_38) & std_logic_vector(a_slot_eq_k_37) & std_logic_vector(a_slot_eq_k_36) & std_logic_vector(a_slot_eq_k_35) & std_logic_vector(a_slot_eq_k_34) & std_logic_vector(a_slot_eq_k_33) & std_logic_vector(a_slot_eq_k_32) & std_logic_vector(a_slot_eq_k_31) & std_logic_vector(a_slot_eq_k_30) & std_logic_vector(a_slot_eq_k_29) & std_logic_vector(a_slot_eq_k_28) & std_logic_vector(a_slot_eq_k_27) & std_logic_vector(a_slot_eq_k_26) & std_logic_vector(a_slot_eq_k_25) & std_logic_vector(a_slot_eq_k_24) & std_logic_vector(a_slot_eq_k_23) & std_logic_vector(a_slot_eq_k_22) & std_logic_vector(a_slot_eq_k_21) & std_logic_vector(a_slot_eq_k_20) & std_logic_vector(a_slot_eq_k_19) & std_logic_vector(a_slot_eq_k_18) & std_logic_vector(a_slot_eq_k_17) & std_logic_vector(a_slot_eq_k_16) & std_logic_vector(a_slot_eq_k_15) & std_logic_vector(a_slot_eq_k_14) & std_logic_vector(a_slot_eq_k_13) & std_logic_vector(a_slot_eq_k_12) & std_logic_vector(a_slot_eq_k_11) & std_logic_vector(a_slot_eq_k_10) & std_logic_vector(a_slot_eq_k_9) & std_logic_vector(a_slot_eq_k_8) & std_logic_vector(a_slot_eq_k_7) & std_logic_vector(a_slot_eq_k_6) & std_logic_vector(a_slot_eq_k_5) & std_logic_vector(a_slot_eq_k_4) & std_logic_vector(a_slot_eq_k_3) & std_logic_vector(a_slot_eq_k_2) & std_logic_vector(a_slot_eq_k_1) & std_logic_vector(a_slot_eq_k_0_1)));
-  best_clear <= cat_113 when a_new_and_a_valid = "1" else k_0_2;
+  best_clear_c <= cat_113 when a_new_and_a_valid = "1" else k_0_2;
   not_best_clear <= not best_clear;
   and_114 <= has_best and not_best_clear;
   and_114_or_best_set <= and_114 or best_set;
@@ -2480,6 +2481,7 @@ begin
       cull_has_best <= slot_has_best;
       culled <= culled_c;
       culled_n <= culled;
+      best_clear <= best_clear_c;
     end if;
   end process ring_c_regs;
 
