@@ -47,7 +47,14 @@ fn main() {
         let p = match (slots, units) {
             (Some(s), Some(u)) => CoreParams::shaped(
                 &roms,
-                &fxrt::cores::top::CoreSpec { id_width: 20, div_bits: 1, target_mhz: 150, slots: s, units: u },
+                &fxrt::cores::top::CoreSpec {
+                    id_width: 20,
+                    div_bits: 1,
+                    target_mhz: 150,
+                    slots: s,
+                    units: u,
+                    pipelines: 1,
+                },
             ),
             _ => CoreParams::new(&roms, 20, 1, 150),
         };

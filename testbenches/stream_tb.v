@@ -147,7 +147,7 @@ module {{ tb }};
       // Counted here, after the edge: Verilator 5.006 (--timing) lost the count when it was
       // made before the first delay of the iteration.
       if (stall) stall_cycles = stall_cycles + 1;
-      if (busy) busy_cycles = busy_cycles + 1;
+      busy_cycles = busy_cycles + busy; // triangles that entered a pipeline
       if (stack_depth > max_sp) max_sp = stack_depth;
       if (fire) next = next + 1;
       if (in_reset) begin

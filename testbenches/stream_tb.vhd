@@ -224,9 +224,8 @@ begin
       clk <= '0';
       wait for 1 ns;
       cycles := cycles + 1;
-      if busy = "1" then
-        busy_cycles := busy_cycles + 1;
-      end if;
+      -- One triangle per pipeline that took one (`busy` has a bit per pipeline's count).
+      busy_cycles := busy_cycles + to_integer(busy);
       if to_integer(stack_depth) > max_sp then
         max_sp := to_integer(stack_depth);
       end if;

@@ -30,6 +30,7 @@ fn cornell(w: u32, h: u32) -> (Scene, SceneRoms, RayGen, CoreParams) {
             target_mhz: fxrt::cores::clock::DEFAULT_TARGET_MHZ,
             slots: 8,
             units: 1,
+            pipelines: 1,
         },
     );
     (scene, roms, g, p)

@@ -332,6 +332,17 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
 
+/// Two pipelines, one unit each: every pixel matches, and the JSON says the shape.
+#[test]
+fn sim_with_two_pipelines_matches_every_pixel() {
+    let o = fxrt(&["sim", "--builtin", "cornell", "--size", "8x8", "--slots", "4", "--pipelines", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((v["units"].as_u64(), v["pipelines"].as_u64()), (Some(2), Some(2)), "{v}");
+    assert_eq!((v["all_pixels_match"].as_bool(), v["walk_matches"].as_bool()), (Some(true), Some(true)), "{v}");
+    assert!(v["rays"].as_u64().unwrap() > 0 && v["pipeline_fill"].as_f64().unwrap() <= 1.0, "{v}");
+}
+
 /// One ray slot per traversal unit (it used to panic: the stack address has a slot bit).
 #[test]
 fn sim_with_one_slot_per_unit_matches_every_pixel() {
@@ -512,6 +523,16 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     assert_rejected(&with(&["ml509", "--units", "4", "--slots", "32"]), "--units", &out);
     assert_rejected(&with(&["ml509", "--units", "4"]), "--slots", &out);
     assert_rejected(&["gen", "--builtin", "cornell", "--units", "4", "--out", o], "--slots", &out);
+    // Pipelines serve units of their own: 3 of 2 units, or 2 of 1, cannot; nor one beside
+    // external memory (yet).
+    assert_rejected(&["gen", "--builtin", "cornell", "--pipelines", "3", "--out", o], "--pipelines", &out);
+    assert_rejected(
+        &["gen", "--builtin", "cornell", "--units", "1", "--pipelines", "2", "--out", o],
+        "--pipelines",
+        &out,
+    );
+    let external = ["gen", "--builtin", "cornell", "--memory", "external", "--pipelines", "2", "--out", o];
+    assert_rejected(&external, "--pipelines", &out);
     // Without the ECP5 tools the ULX3S bitstream cannot be made: refused before anything is
     // written (--no-bitstream writes the HDL).
     let o3 = Command::new(env!("CARGO_BIN_EXE_fxrt"))

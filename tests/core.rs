@@ -33,17 +33,21 @@ const DEFAULT: u32 = fxrt::cores::clock::DEFAULT_TARGET_MHZ;
 /// A frame through the core built for `target_mhz`, in the Rust simulator: its ids must equal
 /// `fxrt render`'s.
 fn rust_frame(name: &str, size: u32, target_mhz: u32) {
-    let shape = (Params::default().leaf_size, fxrt::cores::top::DEFAULT_SLOTS, fxrt::cores::top::DEFAULT_UNITS);
+    let shape = (Params::default().leaf_size, fxrt::cores::top::DEFAULT_SLOTS, fxrt::cores::top::DEFAULT_UNITS, 1);
     rust_frame_shaped(name, size, target_mhz, shape);
 }
 
-/// The same for a core of `slots` × `units` on a tree of leaves up to `leaf_size`.
-fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, (leaf_size, slots, units): (u32, u32, u32)) {
+/// The same for a core of `slots` × `units` and `pipelines` on a tree of leaves up to
+/// `leaf_size`.
+fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, shape: (u32, u32, u32, u32)) {
+    let (leaf_size, slots, units, pipelines) = shape;
     let s = Scene::load(&SceneSource::Builtin(name.into()), &Params { leaf_size, ..Params::default() }).unwrap();
     let roms = SceneRoms::of(&s);
     let cam = Camera::default_for(&s, size, size);
-    let p =
-        CoreParams::shaped(&roms, &fxrt::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz, slots, units });
+    let p = CoreParams::shaped(
+        &roms,
+        &fxrt::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz, slots, units, pipelines },
+    );
     let rays = frame_rays(&s, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
     assert_eq!(mismatches(&s, &rays, &results), 0, "{name}");
@@ -60,7 +64,8 @@ fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, (leaf_size, slots, 
     assert_eq!((stats.visits, stats.culls, stats.busy_cycles), (visits, culls, tests), "{name}");
     common::say(&format!(
         "{name} {size}² at {target_mhz} MHz: {} rays, {:.2} cycles/ray ({:.4} rays/clock), fill {:.3}, \
-         {:.2} node steps and {:.2} triangle tests per ray, slots {:.3} occupied, stack {}",
+         {:.2} node steps and {:.2} triangle tests per ray, slots {:.3} occupied, stack {} ({units} × {slots}, \
+         {pipelines} pipelines, leaves ≤ {leaf_size})",
         stats.rays,
         stats.cycles_per_ray(),
         stats.rays_per_clock(),
@@ -87,7 +92,14 @@ fn rust_teapot_small_and_extreme_widths() {
         let roms = SceneRoms::of(&s);
         let p = CoreParams::shaped(
             &roms,
-            &fxrt::cores::top::CoreSpec { id_width: 8, div_bits: 1, target_mhz: DEFAULT, slots: 64, units: 2 },
+            &fxrt::cores::top::CoreSpec {
+                id_width: 8,
+                div_bits: 1,
+                target_mhz: DEFAULT,
+                slots: 64,
+                units: 2,
+                pipelines: 1,
+            },
         );
         p.check().unwrap();
         let rays = frame_rays(&s, &Camera::default_for(&s, 8, 8));
@@ -106,7 +118,14 @@ fn rust_teapot_128() {
 /// triangles: 10 Mrays/s on the LFE5U-85F).
 #[test]
 fn rust_teapot_128_four_units_leaf_3() {
-    rust_frame_shaped("teapot", 128, DEFAULT, (3, 32, 4));
+    rust_frame_shaped("teapot", 128, DEFAULT, (3, 32, 4, 1));
+}
+
+/// Two intersection pipelines, each fed by two of four units of 32 slots (issue 30's shape
+/// for the LFE5U-85F): every pixel, visit, cull and triangle test the golden model's.
+#[test]
+fn rust_teapot_128_four_units_two_pipelines() {
+    rust_frame_shaped("teapot", 128, DEFAULT, (4, 32, 4, 2));
 }
 
 #[test]
@@ -218,16 +237,44 @@ fn tiny_shuffled() -> (fxrt::scene::Scene, CoreParams, Vec<PixelRay>, Vec<PixelR
 
 /// The HDL stream testbenches with shuffled rays and a stalling source: they pass, their
 /// results come in the same order as the Rust simulator's and their counts — stall cycles
-/// too — are the same, so every simulator saw the same stream, cycle for cycle.
+/// too — are the same, so every simulator saw the same stream, cycle for cycle. Then a core
+/// of four units and two intersection pipelines, in three of the simulators.
 #[test]
 fn hdl_frames_shuffled_and_stalled() {
     let (s, p, pixel_order, rays, stalls) = tiny_shuffled();
-    let (rust, rust_stats) = simulate_rust(&p, &SceneRoms::of(&s), &rays, &stalls, &|_| {});
+    let all = [Simulator::Iverilog, Simulator::IverilogSv, Simulator::Ghdl, Simulator::Verilator];
+    let mut failures = shuffled_and_stalled_in(&all, "", &s, &p, (&pixel_order, &rays), &stalls);
+    let shape = fxrt::cores::top::CoreSpec {
+        id_width: 8,
+        target_mhz: 75,
+        slots: 4,
+        units: 4,
+        pipelines: 2,
+        ..Default::default()
+    };
+    let two = CoreParams::shaped(&SceneRoms::of(&s), &shape);
+    let some = [Simulator::IverilogSv, Simulator::Ghdl, Simulator::Verilator];
+    failures.extend(shuffled_and_stalled_in(&some, "two_pipelines_", &s, &two, (&pixel_order, &rays), &stalls));
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The frame `rays` (`pixel_order` the same rays in pixel order) through core `p` in each of
+/// `sims` (`label` names their folders) against the Rust simulator: the failures.
+fn shuffled_and_stalled_in(
+    sims: &[Simulator],
+    label: &str,
+    s: &Scene,
+    p: &CoreParams,
+    (pixel_order, rays): (&[PixelRay], &[PixelRay]),
+    stalls: &Stalls,
+) -> Vec<String> {
+    let (rust, rust_stats) = simulate_rust(p, &SceneRoms::of(s), rays, stalls, &|_| {});
     assert!(out_of_pixel_order(&rust) && rust_stats.stall_cycles > 0);
+    assert_eq!(mismatches(s, pixel_order, &rust), 0, "{label}");
     let check = |sim: Simulator| -> Result<(), String> {
-        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("shuffled_{}", sim.name()));
-        let (results, stats) = simulate_hdl(sim, &p, &s, &rays, &stalls, &dir).map_err(|e| e.to_string())?;
-        let bad = mismatches(&s, &pixel_order, &results);
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("shuffled_{label}{}", sim.name()));
+        let (results, stats) = simulate_hdl(sim, p, s, rays, stalls, &dir).map_err(|e| e.to_string())?;
+        let bad = mismatches(s, pixel_order, &results);
         let counts = |c: &fxrt::verify::frame::CoreStats| (c.cycles, c.busy_cycles, c.max_stack_depth, c.stall_cycles);
         match () {
             _ if bad != 0 => Err(format!("{bad} mismatches")),
@@ -238,9 +285,7 @@ fn hdl_frames_shuffled_and_stalled() {
             _ => Ok(()),
         }
     };
-    let failures =
-        each_simulator(&[Simulator::Iverilog, Simulator::IverilogSv, Simulator::Ghdl, Simulator::Verilator], check);
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    each_simulator(sims, check)
 }
 
 /// The HDL stream testbenches with a consumer ready on 40 % of the clocks and three one-clock

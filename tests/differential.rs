@@ -57,7 +57,7 @@ fn an_interior_at_default_parameters_matches_and_walks_as_specified() {
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(
         &roms,
-        &fxrt::cores::top::CoreSpec { id_width: 10, div_bits: 1, target_mhz: 150, slots: 64, units: 2 },
+        &fxrt::cores::top::CoreSpec { id_width: 10, div_bits: 1, target_mhz: 150, slots: 64, units: 2, pipelines: 1 },
     );
     let rays = frame_rays(&scene, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});

@@ -193,7 +193,10 @@ impl BoardDesign {
         if let Some(have) = board.dsp48e().filter(|&have| dsp > have) {
             return Err(Error::param(
                 "units",
-                format!("the core needs {dsp} DSP48E, the {}'s XC5VLX110T has {have}: use fewer --units", board.name()),
+                format!(
+                    "the core needs {dsp} DSP48E, the {}'s XC5VLX110T has {have}: use fewer --units or --pipelines",
+                    board.name()
+                ),
             ));
         }
         let top = format!("fxrt_{}{}", board.name(), logic.name.trim_start_matches("fxrt_board"));

@@ -284,6 +284,7 @@ impl GenConfig {
             target_mhz: self.target_mhz,
             slots: self.threads.slots,
             units: self.threads.units,
+            pipelines: self.threads.pipelines,
         }
     }
 }

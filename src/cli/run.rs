@@ -135,6 +135,7 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
                 threads: super::ThreadArgs {
                     slots: crate::cores::top::DEFAULT_SLOTS,
                     units: crate::cores::top::DEFAULT_UNITS,
+                    pipelines: 1,
                 },
             };
             let p = intersect_params(&params, &scene, &hw)?;
@@ -324,6 +325,7 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
         target_mhz: c.hw.target_mhz,
         slots: t.slots,
         units: t.units,
+        pipelines: t.pipelines,
     };
     let core = crate::cores::top::CoreParams::shaped(&roms, &shape);
     core.check()?;
@@ -414,6 +416,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         target_mhz: c.target_mhz,
         slots: t.slots,
         units: t.units,
+        pipelines: t.pipelines,
     };
     let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
@@ -501,7 +504,8 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "scene": scene.name, "simulator": c.sim.name(), "size": format!("{w}x{h}"),
         "pixels": w * h, "rays": stats.rays, "cycles": stats.cycles,
         "cycles_per_ray": (stats.cycles_per_ray() * 100.0).round() / 100.0,
-        "pipeline_fill": (stats.fill() * 10000.0).round() / 10000.0,
+        // Per pipeline: the triangles that entered them over cycles × pipelines.
+        "pipeline_fill": (stats.fill() / p.pipelines as f64 * 10000.0).round() / 10000.0,
         "max_stack_depth": stats.max_stack_depth, "mismatches": mismatches,
         "rays_per_clock": (stats.rays_per_clock() * 1e5).round() / 1e5,
         "triangle_tests_per_ray": (stats.triangle_tests_per_ray() * 100.0).round() / 100.0,
@@ -511,7 +515,7 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         "golden_node_steps_per_ray": (golden_steps as f64 / stats.rays.max(1) as f64 * 100.0).round() / 100.0,
         "walk_matches": walk_matches,
         "slot_occupancy": counted.then(|| (stats.slot_occupancy() * 10000.0).round() / 10000.0),
-        "slots": p.slot_count(), "units": p.units,
+        "slots": p.slot_count(), "units": p.units, "pipelines": p.pipelines,
         "all_pixels_match": mismatches == 0, "seconds": (seconds * 1000.0).round() / 1000.0,
         "shuffle_seed": c.shuffle_seed, "stall_percent": c.stalls.map_or(0, |s| s.0),
         "stall_seed": c.stalls.map(|s| s.1), "stall_cycles": stats.stall_cycles,

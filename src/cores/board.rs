@@ -126,6 +126,7 @@ mod tests {
                 target_mhz: crate::cores::clock::DEFAULT_TARGET_MHZ,
                 slots: 4,
                 units: 1,
+                pipelines: 1,
             },
         );
         let core = core_module_with(&p, &roms, false);

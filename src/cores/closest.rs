@@ -45,6 +45,10 @@ pub fn input_latency(target: ClockTarget) -> u32 {
     2 * target.splits(STAGED_FROM_MHZ) as u32
 }
 
+/// The unit of one lane (intersection pipeline) of the core: `slots` slot numbers, `units`
+/// traversal units, `unit_bits` their numbers' bits, and `lane_bits` bits of the lane number
+/// above them in the tag's global slot (0 with one pipeline), which the unit drops: its RAMs
+/// and ports take the slot number within the lane.
 /// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) from the pipeline; `id_we`, `id_slot`,
 /// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot` →
 /// per traversal unit u `merge_valid{u}`, `merge_slot{u}` (the slot within the unit: the global
@@ -55,7 +59,7 @@ pub fn input_latency(target: ClockTarget) -> u32 {
 pub fn closest_core(
     tag: TagLayout,
     slots: u32,
-    [units, unit_bits]: [u32; 2],
+    [units, unit_bits, lane_bits]: [u32; 3],
     id_bits: u32,
     n: u32,
     m_bits: u32,
@@ -63,14 +67,15 @@ pub fn closest_core(
 ) -> Module {
     let staged = input_latency(target) > 0;
     let suffix = if staged { "_r2" } else { "" };
-    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}_s{slots}_u{units}{suffix}", tag.width()));
+    let lanes = if lane_bits > 0 { format!("_l{}", 1 << lane_bits) } else { String::new() };
+    let b = Builder::new(&format!("fxrt_closest_n{n}_m{m_bits}_tag{}_s{slots}_u{units}{lanes}{suffix}", tag.width()));
     let valid = b.input("valid", Ty::BIT);
     let tag_in = b.input("tag", Ty::u(tag.width()));
     let hit = b.input("hit", Ty::BIT);
     let t = b.input("t", Ty::u(n + 1));
     let u = b.input("u", Ty::u(m_bits));
     let v = b.input("v", Ty::u(m_bits));
-    let slot_ty = Ty::u(tag.slot_bits);
+    let slot_ty = Ty::u(tag.slot_bits - lane_bits);
     let id_we = b.input("id_we", Ty::BIT);
     let id_slot = b.input("id_slot", slot_ty);
     let id_in = b.input("id", Ty::u(id_bits));
@@ -85,7 +90,7 @@ pub fn closest_core(
     let tri = take(tag.tri_bits).name("tri");
     let tmin = take(tag.tmin_bits).name("tmin");
     let sp = take(tag.sp_bits).name("sp");
-    let slot = take(tag.slot_bits).name("slot");
+    let slot = take(tag.slot_bits).slice(0, tag.slot_bits - lane_bits).name("slot");
     let first = take(1).name("first");
     let last = take(1).name("last");
 
@@ -194,7 +199,7 @@ pub fn closest_core(
     // The merge reaches each traversal unit through registers of its own (valid, slot in the
     // unit, hit): one shared set drove both units' cull-limit LUT-RAM write enables through
     // the unit decode and an AND, across the die (12.1 ns at a seed of the external core).
-    let sb = tag.slot_bits - unit_bits;
+    let sb = tag.slot_bits - lane_bits - unit_bits;
     let slot_r = b.delay("merge_slot_r", m2_slot.slice(0, sb));
     let hit_r = b.delay("merge_hit_r", m2_hit);
     // The register and its copies, one per unit.

@@ -23,8 +23,10 @@ pub struct CoreParams {
     pub isect: IntersectParams,
     pub trav: TraverseParams,
     pub tag: TagLayout,
-    /// Traversal units feeding the one intersection pipeline.
+    /// Traversal units.
     pub units: u32,
+    /// Intersection pipelines (lanes): lane l serves units l·U/P … (l + 1)·U/P − 1.
+    pub pipelines: u32,
     /// Clocks of a triangle ROM read (`brom::read_cycles`).
     pub tri_rom_cycles: u32,
     /// With the scene in external memory (`external`): its image, caches and read port.
@@ -32,8 +34,8 @@ pub struct CoreParams {
 }
 
 /// What shapes a core besides its scene: the width of its ray ids, the divider's quotient
-/// bits per stage, the clock it is pipelined for, and its ray slots per traversal unit and
-/// units. `Default` is `fxrt gen`'s defaults.
+/// bits per stage, the clock it is pipelined for, its ray slots per traversal unit, units and
+/// intersection pipelines. `Default` is `fxrt gen`'s defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CoreSpec {
     pub id_width: u32,
@@ -41,6 +43,7 @@ pub struct CoreSpec {
     pub target_mhz: u32,
     pub slots: u32,
     pub units: u32,
+    pub pipelines: u32,
 }
 
 /// The ray id width by default (`--ray-id-width`): a 1024 × 1024 frame's pixel numbers.
@@ -54,6 +57,7 @@ impl Default for CoreSpec {
             target_mhz: super::clock::DEFAULT_TARGET_MHZ,
             slots: DEFAULT_SLOTS,
             units: DEFAULT_UNITS,
+            pipelines: 1,
         }
     }
 }
@@ -67,7 +71,7 @@ impl CoreParams {
     /// The core of `shape` for `scene` (not checked: `check` says what the RTL layer cannot
     /// hold).
     pub fn shaped(scene: &SceneRoms, shape: &CoreSpec) -> CoreParams {
-        let CoreSpec { id_width, div_bits, target_mhz, slots, units } = *shape;
+        let CoreSpec { id_width, div_bits, target_mhz, slots, units, pipelines } = *shape;
         let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
         let tag = TagLayout {
@@ -87,7 +91,7 @@ impl CoreParams {
             target_mhz,
         };
         let tri_rom_cycles = super::brom::read_cycles(scene.tri.1.len());
-        CoreParams { isect, trav, tag, units, tri_rom_cycles, mem: None }
+        CoreParams { isect, trav, tag, units, pipelines, tri_rom_cycles, mem: None }
     }
 
     /// The core of `shape` for `scene` in external memory (`--memory external`): no scene ROMs;
@@ -101,7 +105,39 @@ impl CoreParams {
         p.trav.leaf_rom_cycles = 0;
         p.tri_rom_cycles = 2;
         p.mem = Some(m);
+        p.check_pipelines()?;
         Ok(p)
+    }
+
+    /// A name of lane `lane`'s: `l{lane}_{name}` with more than one pipeline, else `name`.
+    pub fn lane_name(&self, lane: u32, name: &str) -> String {
+        if self.pipelines > 1 { format!("l{lane}_{name}") } else { name.to_string() }
+    }
+    /// Bits of a lane (intersection pipeline) number: the top bits of a global slot number.
+    pub fn lane_bits(&self) -> u32 {
+        self.pipelines.trailing_zeros()
+    }
+    /// Traversal units per lane.
+    pub fn lane_units(&self) -> u32 {
+        self.units / self.pipelines
+    }
+    /// Bits of a global slot number within its lane (the lane's slot numbers).
+    pub fn lane_slot_bits(&self) -> u32 {
+        self.tag.slot_bits - self.lane_bits()
+    }
+
+    /// The closest-hit unit of one lane: its slots, units and their numbers' bits.
+    pub fn closest_module(&self) -> crate::rtl::Module {
+        let lb = self.lane_bits();
+        super::closest::closest_core(
+            self.tag,
+            self.total_slots() >> lb,
+            [self.lane_units(), self.unit_bits() - lb, lb],
+            self.trav.id_width,
+            self.isect.n,
+            self.isect.m,
+            self.isect.target(),
+        )
     }
 
     /// Bits of a unit number within a global slot number (0 for one unit).
@@ -120,6 +156,30 @@ impl CoreParams {
     /// Ray slots of the core: the rays it holds at once.
     pub fn slot_count(&self) -> u32 {
         self.units * self.trav.slots
+    }
+
+    /// Rejects pipelines that cannot each serve units of their own, or a second pipeline beside
+    /// external memory.
+    fn check_pipelines(&self) -> crate::error::Result<()> {
+        use crate::error::Error;
+        let pl = self.pipelines;
+        if ![1, 2, 4].contains(&pl) || !self.units.is_multiple_of(pl) {
+            return Err(Error::param(
+                "pipelines",
+                format!(
+                    "{pl} is out of range: must be 1, 2 or 4 and divide --units ({}): each pipeline serves \
+                     units of its own",
+                    self.units
+                ),
+            ));
+        }
+        if pl > 1 && self.mem.is_some() {
+            return Err(Error::param(
+                "pipelines",
+                format!("{pl}: with the scene in external memory the core has one intersection pipeline (yet)"),
+            ));
+        }
+        Ok(())
     }
 
     /// Rejects what the RTL layer cannot hold, naming the parameter to change.
@@ -141,9 +201,10 @@ impl CoreParams {
         if !(1..=4).contains(&self.units) {
             return Err(Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
         }
-        // The closest-hit unit keeps a bit per global slot number in one word; a unit's slot
-        // numbers take a power of two (3 units × 33 slots are numbered as 3 × 64).
-        if self.total_slots() > MAX_WIDTH {
+        self.check_pipelines()?;
+        // A lane's closest-hit unit keeps a bit per slot number of its lane in one word; a
+        // unit's slot numbers take a power of two (3 units × 33 slots are numbered as 3 × 64).
+        if self.total_slots() >> self.lane_bits() > MAX_WIDTH {
             let numbered = if self.total_slots() == self.slot_count() {
                 String::new()
             } else {
@@ -152,11 +213,12 @@ impl CoreParams {
             return Err(crate::error::Error::param(
                 "slots",
                 format!(
-                    "{} units × {} slots = {} ray slots{numbered}; the closest-hit unit holds at most {MAX_WIDTH}: \
-                     fewer --slots or --units",
+                    "{} units × {} slots = {} ray slots{numbered}; the closest-hit unit of each of the {} \
+                     pipelines holds at most {MAX_WIDTH}: fewer --slots or --units, or more --pipelines",
                     self.units,
                     self.trav.slots,
-                    self.slot_count()
+                    self.slot_count(),
+                    self.pipelines
                 ),
             ));
         }

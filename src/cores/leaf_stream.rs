@@ -2,7 +2,7 @@
 //! from the traversal units' leaf queues, one triangle per clock from the leaf and triangle
 //! ROMs into the intersection pipeline, with the ray read from the core's ray RAMs by slot.
 
-use super::brom::brom;
+use super::brom::{brom, brom2};
 use super::core_params::{CoreParams, tri_rom_groups};
 use super::intersect::intersect_core;
 use super::ray_port::RayPort;
@@ -14,29 +14,38 @@ use crate::scene::images::SceneRoms;
 use crate::scene::rom::rom_addr_bits;
 use std::rc::Rc;
 
-/// The core's ray RAMs (origin and direction, for the pipeline), by global slot, written at
-/// the accept: the origin RAM and the direction RAMs.
+/// A lane's ray RAMs (origin and direction, for its pipeline), by slot within the lane,
+/// written at the accept of a ray into one of the lane's slots: the origin RAM and the
+/// direction RAMs.
 pub struct RayRams {
     pub o: usize,
     /// One RAM of three directions while they fit a signal (m ≤ 42), else one per axis.
     pub w: Vec<usize>,
 }
 
-pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>) -> RayRams {
-    let (slots, n, (accept, gslot)) = (p.total_slots() as usize, p.isect.n, (port.accept, port.ram_slot));
+pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> RayRams {
+    let (slots, n, lsb) = ((p.total_slots() >> p.lane_bits()) as usize, p.isect.n, p.lane_slot_bits());
+    let (accept, gslot) = match p.lane_bits() {
+        0 => (port.accept, port.ram_slot),
+        lb => {
+            let mine = port.ram_slot.slice(lsb, lb).eq(lane as i128);
+            ((port.accept & mine).name(&p.lane_name(lane, "ray_we")), port.ram_slot.slice(0, lsb))
+        }
+    };
+    let name = |x: &str| p.lane_name(lane, x);
     let [ox, oy, oz] = port.o;
     let [wx, wy, wz] = port.w;
-    let o = b.ram("ray_o", 3 * n, vec![0; slots]);
+    let o = b.ram(&name("ray_o"), 3 * n, vec![0; slots]);
     b.ram_write(o, accept, gslot, b.cat(&[oz, oy, ox]));
     let w = if 3 * p.isect.m <= MAX_WIDTH {
-        let mem = b.ram("ray_w", 3 * p.isect.m, vec![0; slots]);
+        let mem = b.ram(&name("ray_w"), 3 * p.isect.m, vec![0; slots]);
         b.ram_write(mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
         vec![mem]
     } else {
         [("x", wx), ("y", wy), ("z", wz)]
             .into_iter()
             .map(|(axis, w)| {
-                let mem = b.ram(&format!("ray_w{axis}"), p.isect.m, vec![0; slots]);
+                let mem = b.ram(&name(&format!("ray_w{axis}")), p.isect.m, vec![0; slots]);
                 b.ram_write(mem, accept, gslot, w.unsigned());
                 mem
             })
@@ -57,32 +66,34 @@ pub struct Leaf<'b> {
     pub last_entry: S<'b>,
 }
 
-/// The leaf in flight (slot, next entry, entries left, tmin, sp), and the next leaf taken, in
-/// turn, from a unit's queue when the last entry goes. `trav` are the units' ports, `leaf_pop`
-/// the wires of their queues' pops.
+/// Lane `lane`'s leaf in flight (slot within the lane, next entry, entries left, tmin, sp),
+/// and the next leaf taken, in turn, from a unit's queue when the last entry goes. `trav` are
+/// the lane's units' ports, `leaf_pop` the wires of their queues' pops.
 pub fn leaf_stream<'b>(
     b: &'b Builder,
     p: &CoreParams,
+    lane: u32,
     scene: &SceneRoms,
     trav: &[Ports<'b>],
     leaf_pop: &[S<'b>],
 ) -> Leaf<'b> {
-    let (tp, gb, bit) = (&p.trav, p.tag.slot_bits, Ty::BIT);
-    b.stage("leaf_stream", "the leaf in flight, and the next leaf from the units' queues in turn");
+    let (tp, gb, bit) = (&p.trav, p.lane_slot_bits(), Ty::BIT);
+    b.stage(&p.lane_name(lane, "leaf_stream"), "the leaf in flight, and the next leaf from the units' queues in turn");
+    let nm = |x: &str| p.lane_name(lane, x);
     let leaf_bits = rom_addr_bits(scene.leaf.1.len());
     let count_w = scene.node.0.field("count").width;
-    let cur_valid = b.reg("leaf_active", bit, Some(0));
-    let cur_slot = b.reg("leaf_slot", Ty::u(gb), None);
-    let cur_ptr = b.reg("leaf_ptr", Ty::u(leaf_bits), None);
-    let cur_left = b.reg("leaf_left", Ty::u(count_w), None);
-    let cur_tmin = b.reg("leaf_tmin", Ty::u(tp.tmin_width()), None);
-    let cur_sp = b.reg("leaf_sp", Ty::u(tp.sp_width()), None);
-    let cur_first = b.reg("leaf_first_entry", bit, None);
+    let cur_valid = b.reg(&nm("leaf_active"), bit, Some(0));
+    let cur_slot = b.reg(&nm("leaf_slot"), Ty::u(gb), None);
+    let cur_ptr = b.reg(&nm("leaf_ptr"), Ty::u(leaf_bits), None);
+    let cur_left = b.reg(&nm("leaf_left"), Ty::u(count_w), None);
+    let cur_tmin = b.reg(&nm("leaf_tmin"), Ty::u(tp.tmin_width()), None);
+    let cur_sp = b.reg(&nm("leaf_sp"), Ty::u(tp.sp_width()), None);
+    let cur_first = b.reg(&nm("leaf_first_entry"), bit, None);
     // Whether the entry now sent is the leaf's last: a register of its own (left = 1 next).
-    let cur_last = b.reg("leaf_last", bit, None);
-    let last_entry = (cur_valid & cur_last).name("leaf_last_entry");
-    let can_take = (!cur_valid | last_entry).name("leaf_can_take");
-    let picked = leaf_buffers(b, p, trav, leaf_pop, can_take);
+    let cur_last = b.reg(&nm("leaf_last"), bit, None);
+    let last_entry = (cur_valid & cur_last).name(&nm("leaf_last_entry"));
+    let can_take = (!cur_valid | last_entry).name(&nm("leaf_can_take"));
+    let picked = leaf_buffers(b, p, lane, trav, leaf_pop, can_take);
     let (take, sel) = (picked.take, |f: &str| picked.field(f));
     let next_slot = picked.slot();
     b.next(cur_valid, take | (cur_valid & !last_entry));
@@ -132,24 +143,29 @@ impl<'b> Picked<'b> {
 /// Each unit's next leaf waits in a register of the top's (`leaf_buf`), filled from the unit's
 /// queue while empty: the arbiter then chooses among registers beside it, and the queues (across
 /// the die) only feed a register each. A unit's queue pops a clock after it is taken from
-/// (`traverse_core`), and its buffer is full in that clock anyway. Taken in turn when `can_take`.
+/// (`traverse_core`), and its buffer is full in that clock anyway. Taken in turn when `can_take`;
+/// `trav` are the units of one lane (the slot taken is a slot within the lane).
 pub fn leaf_buffers<'b>(
     b: &'b Builder,
     p: &CoreParams,
+    lane: u32,
     trav: &[Ports<'b>],
     leaf_pop: &[S<'b>],
     can_take: S<'b>,
 ) -> Picked<'b> {
-    let (units, ub, bit) = (p.units, p.unit_bits(), Ty::BIT);
-    let leaf_turn = b.reg("leaf_turn", Ty::u(ub.max(1)), Some(0));
+    let (units, bit) = (trav.len() as u32, Ty::BIT);
+    let ub = p.unit_bits() - p.lane_bits();
+    let leaf_turn = b.reg(&p.lane_name(lane, "leaf_turn"), Ty::u(ub.max(1)), Some(0));
+    let first_unit = (lane * p.lane_units()) as usize;
     let fields = LEAF_FIELDS;
     let bufs: Vec<(S, S, Vec<S>)> = trav
         .iter()
         .enumerate()
-        .map(|(u, t)| {
+        .map(|(k, t)| {
+            let u = first_unit + k;
             let full = b.reg(&format!("u{u}_leaf_buf_valid"), bit, Some(0));
             let fill = (t.get("leaf_valid") & !full).name(&format!("u{u}_leaf_fill"));
-            b.drive(leaf_pop[u], fill);
+            b.drive(leaf_pop[k], fill);
             let held: Vec<S> = fields
                 .iter()
                 .map(|f| {
@@ -163,9 +179,10 @@ pub fn leaf_buffers<'b>(
         .collect();
     let avail: Vec<S> = bufs.iter().map(|(full, _, _)| *full).collect();
     let (any_leaf, pick_u) = rotating_pick(b, &avail, leaf_turn, ub);
-    let take = (can_take & any_leaf).name("leaf_take");
-    for (u, &(full, fill, _)) in bufs.iter().enumerate() {
-        let me = if units == 1 { take } else { (take & pick_u.eq(u as i128)).name(&format!("u{u}_leaf_take")) };
+    let take = (can_take & any_leaf).name(&p.lane_name(lane, "leaf_take"));
+    for (k, &(full, fill, _)) in bufs.iter().enumerate() {
+        let u = first_unit + k;
+        let me = if units == 1 { take } else { (take & pick_u.eq(k as i128)).name(&format!("u{u}_leaf_take")) };
         b.next(full, fill | (full & !me));
     }
     if units > 1 {
@@ -213,58 +230,105 @@ pub struct Emission<'b> {
     pub valid: S<'b>,
 }
 
-/// Emission: the leaf ROM at the entry, then the triangle ROMs at its word; the tag and the
-/// ray (read from the ray RAMs at the slot) wait alongside, into the intersection pipeline.
+/// Emission, per lane: the leaf ROM at the entry, then the triangle ROMs at its word; the tag
+/// and the ray (read from the lane's ray RAMs at the slot) wait alongside, into the lane's
+/// intersection pipeline. Two lanes share each ROM, on its two ports.
 pub fn emission<'b>(
     b: &'b Builder,
     p: &CoreParams,
     scene: &SceneRoms,
-    leaf: &Leaf<'b>,
-    rams: &RayRams,
-) -> Emission<'b> {
+    leaves: &[Leaf<'b>],
+    rams: &[RayRams],
+) -> Vec<Emission<'b>> {
     let (tp, scene_tag) = (&p.trav, &p.trav.scene_tag);
     b.stage("emission", "the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline");
     let (leaf_l, leaf_words) = &scene.leaf;
-    let leaf_image = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
-    let tri_num =
-        brom(b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, leaf_image, leaf.ptr, tp.leaf_rom_cycles);
+    let leaf_image: Vec<u128> = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
     let lrc = tp.leaf_rom_cycles;
-    let tag = b.cat(&[leaf.last_entry, leaf.first, leaf.slot, leaf.sp, leaf.tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
-    let tag = b.delay_line("emit_tag", tag, lrc);
-    let tag =
-        b.cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)]).name("emit_tag_tri");
-    let emit_valid = b.valid_line("emit_valid", leaf.valid, lrc);
+    let ptrs: Vec<S> = leaves.iter().map(|l| l.ptr).collect();
+    let tri_nums = rom_reads(b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, &leaf_image, &ptrs, lrc);
     let (tri_l, tri_words) = &scene.tri;
-    let addr = tri_num.resize(rom_addr_bits(tri_words.len())).name("tri_addr");
-    let mut tri_fields: Vec<S> = Vec::new();
+    let lanes: Vec<(S, S, S)> = leaves
+        .iter()
+        .zip(&tri_nums)
+        .enumerate()
+        .map(|(lane, (leaf, &tri_num))| {
+            let nm = |x: &str| p.lane_name(lane as u32, x);
+            let slot = match p.lane_bits() {
+                0 => leaf.slot,
+                lb => b.cat(&[b.konst(Ty::u(lb), lane as i128), leaf.slot]),
+            };
+            let tag = b.cat(&[leaf.last_entry, leaf.first, slot, leaf.sp, leaf.tmin, b.konst(Ty::u(tp.tri_bits), 0)]);
+            let tag = b.delay_line(&nm("emit_tag"), tag, lrc);
+            let tag = b
+                .cat(&[tag.slice(tp.tri_bits, tag.width() - tp.tri_bits), tri_num.resize(tp.tri_bits)])
+                .name(&nm("emit_tag_tri"));
+            let emit_valid = b.valid_line(&nm("emit_valid"), leaf.valid, lrc);
+            (tag, emit_valid, tri_num.resize(rom_addr_bits(tri_words.len())).name(&nm("tri_addr")))
+        })
+        .collect();
+    let addrs: Vec<S> = lanes.iter().map(|l| l.2).collect();
+    let mut tri_fields: Vec<Vec<S>> = vec![Vec::new(); leaves.len()];
     for (k, group) in tri_rom_groups(&tri_l.fields).iter().enumerate() {
         let lsb = group[0].lsb;
         let width: u32 = group.iter().map(|f| f.width).sum();
-        let image = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
-        let word =
-            brom(b, &format!("u_tri_rom_{k}"), &format!("tri_{k}_{scene_tag}"), width, image, addr, p.tri_rom_cycles);
-        tri_fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
+        let image: Vec<u128> = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
+        let name = format!("tri_{k}_{scene_tag}");
+        let words = rom_reads(b, &format!("u_tri_rom_{k}"), &name, width, &image, &addrs, p.tri_rom_cycles);
+        for (fields, word) in tri_fields.iter_mut().zip(words) {
+            fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
+        }
     }
     let trc = p.tri_rom_cycles;
-    let valid_d = b.valid_line("pipe_valid", emit_valid, trc);
-    let tag_d = b.delay_line("pipe_tag", tag, trc);
-    // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks), its
-    // address from a register per ray RAM (the tag's slot bits fanned out to all of them).
-    let emit_slot =
-        b.delay("emit_slot", if lrc > 1 { b.delay_line("emit_slot_sr", leaf.slot, lrc - 1) } else { leaf.slot });
-    let emit_slots = b.copies(emit_slot, 1 + rams.w.len());
-    into_pipeline(b, p, rams, &emit_slots, trc, [valid_d, tag_d], tri_fields)
+    let out = lanes.into_iter().zip(tri_fields).zip(leaves.iter().zip(rams)).enumerate();
+    out.map(|(lane, (((tag, emit_valid, _), tri_fields), (leaf, rams)))| {
+        let nm = |x: &str| p.lane_name(lane as u32, x);
+        let valid_d = b.valid_line(&nm("pipe_valid"), emit_valid, trc);
+        let tag_d = b.delay_line(&nm("pipe_tag"), tag, trc);
+        // The slot's ray, read as the triangle ROMs are (its RAM read is one of the clocks), its
+        // address from a register per ray RAM (the tag's slot bits fanned out to all of them).
+        let slot = if lrc > 1 { b.delay_line(&nm("emit_slot_sr"), leaf.slot, lrc - 1) } else { leaf.slot };
+        let emit_slot = b.delay(&nm("emit_slot"), slot);
+        let emit_slots = b.copies(emit_slot, 1 + rams.w.len());
+        into_pipeline(b, p, (lane as u32, rams), &emit_slots, trc, [valid_d, tag_d], tri_fields)
+    })
+    .collect()
 }
 
-/// The intersection pipeline fed a triangle (`valid_tag`: its valid bit and tag, `tri_fields`:
-/// its fields) and the ray of global slot `slot`, read from the core's ray RAMs `clocks` clocks
-/// before the triangle enters (the RAM read and `clocks` − 1 registers). `slot` holds the slot
+/// A ROM read at each of `addrs` (`cycles` clocks later): one block ROM's two ports per two
+/// addresses, a block ROM of one port for an odd one left.
+fn rom_reads<'b>(
+    b: &'b Builder,
+    label: &str,
+    name: &str,
+    width: u32,
+    image: &[u128],
+    addrs: &[S<'b>],
+    cycles: u32,
+) -> Vec<S<'b>> {
+    let label = |pair: usize| if pair == 0 { label.to_string() } else { format!("{label}_{pair}") };
+    let mut words = Vec::new();
+    for (pair, two) in addrs.chunks(2).enumerate() {
+        match *two {
+            [a, c] => {
+                let (wa, wc) = brom2(b, &label(pair), name, width, image.to_vec(), a, c, cycles);
+                words.extend([wa, wc]);
+            }
+            _ => words.push(brom(b, &label(pair), name, width, image.to_vec(), two[0], cycles)),
+        }
+    }
+    words
+}
+
+/// Lane `lane`'s intersection pipeline fed a triangle (`valid_tag`: its valid bit and tag,
+/// `tri_fields`: its fields) and the ray of slot `slot` (within the lane), read from the lane's
+/// ray RAMs `rams` `clocks` clocks before the triangle enters (the RAM read and `clocks` − 1 registers). `slot` holds the slot
 /// once; several equal registers may share out the RAMs' read addresses (RAM k reads with
 /// `slot[k % slot.len()]`, the origins' RAM first).
 pub fn into_pipeline<'b>(
     b: &'b Builder,
     p: &CoreParams,
-    rams: &RayRams,
+    (lane, rams): (u32, &RayRams),
     slot: &[S<'b>],
     clocks: u32,
     valid_tag: [S<'b>; 2],
@@ -272,14 +336,16 @@ pub fn into_pipeline<'b>(
 ) -> Emission<'b> {
     let (n, m) = (p.isect.n, p.isect.m);
     let addr = |k: usize| slot[k % slot.len()];
-    let o_word = b.delay_line("pipe_o", b.read("ray_o_q", rams.o, addr(0)), clocks - 1);
+    let nm = |x: &str| p.lane_name(lane, x);
+    let o_word = b.delay_line(&nm("pipe_o"), b.read(&nm("ray_o_q"), rams.o, addr(0)), clocks - 1);
     let w_words: Vec<S> = rams
         .w
         .iter()
         .enumerate()
         .map(|(k, &mem)| {
             let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
-            b.delay_line(&format!("pipe_w{suffix}"), b.read(&format!("ray_w{suffix}_q"), mem, addr(k + 1)), clocks - 1)
+            let q = b.read(&nm(&format!("ray_w{suffix}_q")), mem, addr(k + 1));
+            b.delay_line(&nm(&format!("pipe_w{suffix}")), q, clocks - 1)
         })
         .collect();
     let mut pipe_in = valid_tag.to_vec();
@@ -288,6 +354,6 @@ pub fn into_pipeline<'b>(
         (0..3).map(|a| if w_words.len() == 1 { w_words[0].slice(a * m, m) } else { w_words[a as usize] }.signed()),
     );
     pipe_in.extend(tri_fields);
-    let pipe = b.instance("u_intersect", &Rc::new(intersect_core(&p.isect)), &pipe_in);
+    let pipe = b.instance(&p.lane_name(lane, "u_intersect"), &Rc::new(intersect_core(&p.isect)), &pipe_in);
     Emission { pipe, valid: valid_tag[0] }
 }

@@ -14,17 +14,16 @@ pub const RESULT_QUEUE: u32 = 16;
 /// while the result queue has a place it has not promised (`credit_ok`): when the consumer
 /// stops, rays finish into the done queues, their slots stay taken, and `ray_ready` falls when
 /// the units are full — nothing is lost and nothing waits on a combinational path from
-/// `res_ready`. `popped` is the closest-hit unit's `done_valid` (a ray leaving its queue, a
-/// clock after the pop).
+/// `res_ready`. `field(name)` is the closest-hit units' `res_{name}`; `popped` is their
+/// `done_valid` (a ray leaving its queue, a clock after the pop).
 pub fn result_queue<'b>(
     b: &'b Builder,
-    res: &crate::rtl::build::Ports<'b>,
+    field: &dyn Fn(&str) -> S<'b>,
     popped: S<'b>,
     res_ready: S<'b>,
     credit_ok: S<'b>,
 ) {
     let bit = Ty::BIT;
-    let field = |name: &str| res.get(&format!("res_{name}"));
     let words = [b.cat(&[field("id"), field("hit"), field("tri"), field("t")]), b.cat(&[field("u"), field("v")])];
     let take = b.wire("res_take", bit);
     let (heads, nonempty) = super::fifo::fifo_words(b, "res_q", RESULT_QUEUE, field("valid"), &words, take);

@@ -20,7 +20,6 @@
 //! ROMs of whole fields, ≤ 128 bits each, all read at the same address.
 
 use super::brom::{brom, brom2};
-use super::closest::closest_core;
 use super::leaf_stream::{Emission, emission, leaf_stream, ray_rams};
 use super::ray_port::{BoxExit, RayPort, box_exit, is_unit, ray_port};
 use super::top_memory::{MemoryObserved, NodeIn, memory_inputs, memory_side};
@@ -55,23 +54,30 @@ pub fn core_module_with(p: &CoreParams, scene: &SceneRoms, debug: bool) -> Modul
     let exit = box_exit(&b, p, &port);
     let units = traversal_units(&b, p, scene, &port, &exit);
     b.stage("ray_rams", "the accepted ray into the core's ray RAMs, by global slot");
-    let rams = ray_rams(&b, p, &port);
+    let rams: Vec<_> = (0..p.pipelines).map(|lane| ray_rams(&b, p, &port, lane)).collect();
     let (emitted, mem_observed) = match (&p.mem, &mem_in) {
         (Some(m), Some(inputs)) => {
-            let (e, o) = memory_side(&b, p, m, inputs, &units.trav, &units.node_in, &units.leaf_pop, &rams);
-            (e, Some(o))
+            let (e, o) = memory_side(&b, p, m, inputs, &units.trav, &units.node_in, &units.leaf_pop, &rams[0]);
+            (vec![e], Some(o))
         }
         _ => {
-            let leaf = leaf_stream(&b, p, scene, &units.trav, &units.leaf_pop);
-            (emission(&b, p, scene, &leaf, &rams), None)
+            let lu = p.lane_units() as usize;
+            let leaves: Vec<_> = (0..p.pipelines as usize)
+                .map(|l| {
+                    let (trav, pops) = (&units.trav[l * lu..(l + 1) * lu], &units.leaf_pop[l * lu..(l + 1) * lu]);
+                    leaf_stream(&b, p, l as u32, scene, trav, pops)
+                })
+                .collect();
+            (emission(&b, p, scene, &leaves, &rams), None)
         }
     };
-    let (done_valid, res, credit_ok) = results(&b, p, &port, &units, &emitted);
+    let (done_valid, lanes, credit_ok) = results(&b, p, &port, &units, &emitted);
     b.output("ray_ready", port.ready);
     b.stage("result_queue", "the results, queued for the consumer (`result_queue.rs`)");
-    super::result_queue::result_queue(&b, &res, done_valid, res_ready, credit_ok);
+    let field = |name: &str| result_field(&lanes, name);
+    super::result_queue::result_queue(&b, &field, done_valid, res_ready, credit_ok);
     if debug {
-        observe(&b, p, &port, &units.trav, emitted.valid);
+        observe(&b, p, &port, &units.trav, &emitted);
         if let Some(o) = mem_observed {
             observe_memory(&b, &o);
         }
@@ -88,10 +94,10 @@ struct Units<'b> {
     trav: Vec<Ports<'b>>,
     /// A leaf merged (closest-hit unit → its unit): per unit valid, slot in the unit, hit.
     merge_unit: Vec<[S<'b>; 3]>,
-    /// … and for all units the limit and sp.
-    merge: [S<'b>; 2],
-    /// A slot freed (its result left the core): valid, global slot.
-    free: [S<'b>; 2],
+    /// … and per lane, for its units, the limit and sp.
+    merge: Vec<[S<'b>; 2]>,
+    /// Per lane, a slot freed (its result left the core): valid, slot within the lane.
+    free: Vec<[S<'b>; 2]>,
     leaf_pop: Vec<S<'b>>,
     done_pop: Vec<S<'b>>,
     /// With external memory: what each unit's node cache drives into it.
@@ -114,8 +120,13 @@ fn traversal_units<'b>(
             [w("valid", bit), w("slot", Ty::u(sb)), w("hit", bit)]
         })
         .collect();
-    let merge = [wire("merge_limit", p.trav.dist_ty()), wire("merge_sp", Ty::u(p.trav.sp_width()))];
-    let free = [wire("free_valid", bit), wire("free_slot", Ty::u(gb))];
+    let (lanes, lu, lb) = (p.pipelines, p.lane_units(), p.lane_bits());
+    let lane_wire = |l: u32, name: &str, ty: Ty| wire(&p.lane_name(l, name), ty);
+    let merge: Vec<[S; 2]> = (0..lanes)
+        .map(|l| [lane_wire(l, "merge_limit", p.trav.dist_ty()), lane_wire(l, "merge_sp", Ty::u(p.trav.sp_width()))])
+        .collect();
+    let free: Vec<[S; 2]> =
+        (0..lanes).map(|l| [lane_wire(l, "free_valid", bit), lane_wire(l, "free_slot", Ty::u(gb - lb))]).collect();
     let leaf_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_leaf_pop"), bit)).collect();
     let done_pop: Vec<S> = (0..units).map(|u| b.wire(&format!("u{u}_done_pop"), bit)).collect();
     let unit = Rc::new(traverse_core(&p.trav));
@@ -132,14 +143,14 @@ fn traversal_units<'b>(
             .collect(),
         None => Vec::new(),
     };
-    let [merge_limit, merge_sp] = merge;
-    let [free_valid, free_slot] = free;
     let trav: Vec<_> = (0..units)
         .map(|u| {
+            let [merge_limit, merge_sp] = merge[(u / lu) as usize];
+            let [free_valid, free_slot] = free[(u / lu) as usize];
             let we = (port.accept & is_unit(port.slot, u, sb, ub)).name(&format!("u{u}_alloc"));
             let new_valid = (exit.done & is_unit(exit.slot, u, sb, ub)).name(&format!("u{u}_new"));
             let [mv, merge_slot, merge_hit] = merge_unit[u as usize];
-            let fv = (free_valid & is_unit(free_slot, u, sb, ub)).name(&format!("u{u}_free"));
+            let fv = (free_valid & is_unit(free_slot, u % lu, sb, ub - lb)).name(&format!("u{u}_free"));
             let [ox, oy, oz] = port.o;
             let [ix, iy, iz] = port.inv;
             let mut ins = vec![
@@ -203,16 +214,17 @@ fn node_roms<'b>(b: &'b Builder, p: &CoreParams, scene: &SceneRoms, trav: &[Port
 }
 
 /// Rays done, taken from the units' done queues, lowest unit first (a ray finishes once),
-/// while the result queue has room for one more (`res_credit_ok`), and the closest-hit unit
-/// that keeps each slot's best hit and unparks slots after their leaves. Returns a ray done
-/// (registered), the closest-hit unit's ports and the credit register (`result_queue` drives it).
+/// while the result queue has room for one more (`res_credit_ok`), and the closest-hit units
+/// (one per lane) that keep each slot's best hit and unpark slots after their leaves. Returns
+/// a ray done (registered), the closest-hit units' ports and the credit register
+/// (`result_queue` drives it).
 fn results<'b>(
     b: &'b Builder,
     p: &CoreParams,
     port: &RayPort<'b>,
     units: &Units<'b>,
-    emitted: &Emission<'b>,
-) -> (S<'b>, Ports<'b>, S<'b>) {
+    emitted: &[Emission<'b>],
+) -> (S<'b>, Vec<Ports<'b>>, S<'b>) {
     let (trav, done_pop, ub) = (&units.trav, &units.done_pop, p.unit_bits());
     b.stage("done", "rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit");
     let credit_ok = b.reg("res_credit_ok", Ty::BIT, Some(1));
@@ -234,31 +246,54 @@ fn results<'b>(
         done_slot = done_any.select(done_slot, b.cat(&[b.konst(Ty::u(ub), u as i128), trav[u].get("done_slot")]));
         done_any = done_any | dv[u];
     }
-    let closest = Rc::new(closest_core(
-        p.tag,
-        p.total_slots(),
-        [p.units, p.unit_bits()],
-        p.trav.id_width,
-        p.isect.n,
-        p.isect.m,
-        p.isect.target(),
-    ));
-    let mut cin: Vec<S> = emitted.pipe.all().to_vec();
+    let closest = Rc::new(p.closest_module());
     // Registered before the closest-hit unit, whose per-slot selects it drives (the units'
     // queues sit across the die).
     let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
-    cin.extend([port.accept, port.closest_slot, port.id, done_any, done_slot]);
-    let res = b.instance("u_closest", &closest, &cin);
+    let (lb, lsb, lu) = (p.lane_bits(), p.lane_slot_bits(), p.lane_units() as usize);
+    let outs: Vec<Ports> = emitted
+        .iter()
+        .enumerate()
+        .map(|(lane, e)| {
+            let mut cin: Vec<S> = e.pipe.all().to_vec();
+            if lb == 0 {
+                cin.extend([port.accept, port.closest_slot, port.id, done_any, done_slot]);
+            } else {
+                // The lane's own slots: the global slot's top bits are the lane.
+                let nm = |x: &str| p.lane_name(lane as u32, x);
+                let mine = |slot: S<'b>| slot.slice(lsb, lb).eq(lane as i128);
+                let id_we = (port.accept & mine(port.closest_slot)).name(&nm("id_we"));
+                let done = (done_any & mine(done_slot)).name(&nm("done_valid"));
+                cin.extend([id_we, port.closest_slot.slice(0, lsb), port.id, done, done_slot.slice(0, lsb)]);
+            }
+            b.instance(&p.lane_name(lane as u32, "u_closest"), &closest, &cin)
+        })
+        .collect();
     for (u, wires) in units.merge_unit.iter().enumerate() {
         for (wire, name) in wires.iter().zip(["valid", "slot", "hit"]) {
-            b.drive(*wire, res.get(&format!("merge_{name}{u}")));
+            b.drive(*wire, outs[u / lu].get(&format!("merge_{name}{}", u % lu)));
         }
     }
     let names = ["merge_limit", "merge_sp", "free_valid", "free_slot"];
-    for (wire, name) in units.merge.iter().chain(&units.free).zip(names) {
-        b.drive(*wire, res.get(name));
+    for (lane, res) in outs.iter().enumerate() {
+        for (wire, name) in units.merge[lane].iter().chain(&units.free[lane]).zip(names) {
+            b.drive(*wire, res.get(name));
+        }
     }
-    (done_any, res, credit_ok)
+    (done_any, outs, credit_ok)
+}
+
+/// Result field `res_{name}` of the closest-hit units: a lane's shows a result three clocks
+/// after its done input, and rays finish one a clock, so at most one lane shows one in a clock
+/// (`valid` is their OR, a field the showing lane's).
+fn result_field<'b>(lanes: &[Ports<'b>], name: &str) -> S<'b> {
+    let get = |r: &Ports<'b>, f: &str| r.get(&format!("res_{f}"));
+    let (first, rest) = lanes.split_first().expect("a lane");
+    let mut x = get(first, name);
+    for r in rest {
+        x = if name == "valid" { x | get(r, name) } else { get(r, "valid").select(get(r, name), x) };
+    }
+    if rest.is_empty() { x } else { x.name(&format!("res_{name}_lanes")) }
 }
 
 /// Observation ports for `fxrt sim`: a triangle entering the pipeline, the deepest stack in
@@ -266,8 +301,16 @@ fn results<'b>(
 /// stack and the occupied slots come through a tree with a register after each level (a
 /// clock per level of log2 U: a frame's maximum and sums hardly notice), so these counters
 /// are never the core's slowest path (four units' chained maxima were: 102.5 MHz).
-fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports<'b>], busy: S<'b>) {
+fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports<'b>], emitted: &[Emission<'b>]) {
     b.stage("observe", "observation ports for fxrt sim: pipeline busy, stack depth, visits, culls, slots, walks");
+    // Triangles entering the pipelines this clock (one bit with one pipeline).
+    let busy = match emitted {
+        [one] => one.valid,
+        _ => {
+            let w = 32 - (emitted.len() as u32).leading_zeros();
+            emitted.iter().map(|e| e.valid.resize(w)).reduce(|a, c| a + c).expect("a lane").name("busy_c")
+        }
+    };
     b.output("busy", busy);
     let sum = |port: &str, w: u32| trav.iter().map(|t| t.get(port).resize(w)).reduce(|a, c| a + c).expect("a unit");
     fn tree<'b>(b: &'b Builder, name: &str, mut level: Vec<S<'b>>, join: impl Fn(S<'b>, S<'b>) -> S<'b>) -> S<'b> {

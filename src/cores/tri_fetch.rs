@@ -86,7 +86,7 @@ pub fn tri_fetch<'b>(
     let retry_ready = ready_when_released(b, "tri_retry", retry.nonempty, tri_done, r[5], retry_pop);
     let take_retry = (can_take & retry_ready).name("fetch_take_retry");
     b.drive(retry_pop, take_retry);
-    let picked = leaf_buffers(b, p, trav, leaf_pop, (can_take & !retry_ready).name("fetch_can_take_leaf"));
+    let picked = leaf_buffers(b, p, 0, trav, leaf_pop, (can_take & !retry_ready).name("fetch_can_take_leaf"));
     let take = (take_retry | picked.take).name("fetch_take");
     let src = |k: usize, leaf_field: &str| take_retry.select(r[k], picked.field(leaf_field));
     let (first, count) = (src(1, "leaf_first"), src(2, "leaf_count"));
@@ -210,7 +210,7 @@ pub fn tri_fetch<'b>(
     // The slot addresses the ray RAMs, ~180 LUT-RAM slices and their bank selects: a copy per
     // RAM splits that fan-out (935 sinks a bit on the teapot-fine core).
     let slot_copies = b.copies(e_slot, 1 + rams.w.len());
-    let emitted = into_pipeline(b, p, rams, &slot_copies, lat, [valid_d, tag], fields);
+    let emitted = into_pipeline(b, p, (0, rams), &slot_copies, lat, [valid_d, tag], fields);
     let stall = b.delay("mem_stall", (!valid_d & retry.nonempty).name("mem_stall_c"));
     let observed = FetchObserved { looks: answer.valid, hits: looked_hit, stall };
     (emitted, observed)

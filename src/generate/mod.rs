@@ -153,7 +153,7 @@ pub fn core_files(
         "stack_depth": p.trav.stack_depth, "ray_id_width": p.trav.id_width, "div_bits": p.isect.div_bits, "target_mhz": p.isect.target_mhz,
         "intersection_latency_cycles": p.isect.latency(),
         "leaf_entry_to_result_cycles": p.stream_latency() + 1,
-        "ray_slots_per_unit": p.trav.slots, "traversal_units": p.units,
+        "ray_slots_per_unit": p.trav.slots, "traversal_units": p.units, "intersection_pipelines": p.pipelines,
         "results_in_order": false,
         "result_order": "rays finish out of order; every result carries its ray id (res_id)",
     });

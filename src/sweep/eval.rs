@@ -308,7 +308,14 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
     let (slots, units) = (cfg.shape.slots, cfg.shape.units);
-    let core_spec = crate::cores::top::CoreSpec { id_width, div_bits: 1, target_mhz: extras.target_mhz, slots, units };
+    let core_spec = crate::cores::top::CoreSpec {
+        id_width,
+        div_bits: 1,
+        target_mhz: extras.target_mhz,
+        slots,
+        units,
+        ..Default::default()
+    };
     let core_params = match &extras.memory {
         None => CoreParams::shaped(&roms, &core_spec),
         Some(m) => match CoreParams::external(&roms, &core_spec, m.spec(cfg.shape.memory)) {

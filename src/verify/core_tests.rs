@@ -25,7 +25,7 @@ fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
     let roms = SceneRoms::of(&scene);
     let err = CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 33, units: 3 },
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 33, units: 3, pipelines: 1 },
     )
     .check()
     .unwrap_err();
@@ -33,16 +33,39 @@ fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
     assert!(err.message.contains("99 ray slots, numbered as 3 × 64"), "{err}");
     CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 32, units: 3 },
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 32, units: 3, pipelines: 1 },
     )
     .check()
     .unwrap();
     CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 42, units: 2 },
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 42, units: 2, pipelines: 1 },
     )
     .check()
     .unwrap();
+}
+
+/// Pipelines come in 1, 2 or 4, each serving units of its own (so dividing the units), and
+/// only with the scene on chip; a lane's closest-hit unit numbers its own slots, so two
+/// pipelines hold four units of 64 (256 slot numbers).
+#[test]
+fn pipelines_that_cannot_share_the_units_are_refused_naming_pipelines() {
+    let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
+    let roms = SceneRoms::of(&scene);
+    let shape = |units, pipelines| crate::cores::top::CoreSpec { slots: 64, units, pipelines, ..Default::default() };
+    for (units, pipelines) in [(2, 3), (3, 2), (1, 2), (2, 4), (4, 0)] {
+        let err = CoreParams::shaped(&roms, &shape(units, pipelines)).check().unwrap_err();
+        assert_eq!(err.subject, "--pipelines", "{units} units, {pipelines} pipelines");
+    }
+    let err = CoreParams::shaped(&roms, &shape(4, 1)).check().unwrap_err();
+    assert!(err.message.contains("more --pipelines"), "{err}");
+    for (units, pipelines) in [(4, 2), (4, 4), (2, 2)] {
+        CoreParams::shaped(&roms, &shape(units, pipelines)).check().unwrap();
+    }
+    let spec = crate::cores::memory_params::MemorySpec::default();
+    let mut external = CoreParams::external(&roms, &shape(2, 1), spec).unwrap();
+    external.pipelines = 2;
+    assert_eq!(external.check().unwrap_err().subject, "--pipelines");
 }
 
 #[test]
@@ -89,13 +112,13 @@ fn assert_walks_are_the_culled_golden_walks(
     rays: &[PixelRay],
     mhz: u32,
     slots: u32,
-    units: u32,
+    [units, pipelines]: [u32; 2],
 ) {
     let g = Golden::new(scene);
     let roms = SceneRoms::of(scene);
     let p = CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: mhz, slots, units },
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: mhz, slots, units, pipelines },
     );
     let m = core_module(&p, &roms);
     let mut sim = Sim::new(&m);
@@ -153,11 +176,15 @@ fn assert_walks_are_the_culled_golden_walks(
 fn every_ray_visits_what_the_culled_golden_walk_visits_in_its_order() {
     let cornell = Params { n: 20, m: 20, ..Params::default() };
     for (name, params, mhz, slots, units) in [
-        ("teapot", Params::default(), 150, 32, 2),
-        ("cornell", cornell, 75, 3, 1),
-        ("cornell", cornell, 250, 5, 3),
-        ("teapot", Params::default(), 200, 2, 4),
-        ("cornell", cornell, 150, 1, 2),
+        ("teapot", Params::default(), 150, 32, [2, 1]),
+        ("cornell", cornell, 75, 3, [1, 1]),
+        ("cornell", cornell, 250, 5, [3, 1]),
+        ("teapot", Params::default(), 200, 2, [4, 1]),
+        ("cornell", cornell, 150, 1, [2, 1]),
+        // Several intersection pipelines: each lane's leaves in its own stream.
+        ("teapot", Params::default(), 150, 16, [2, 2]),
+        ("cornell", cornell, 100, 3, [4, 4]),
+        ("teapot", Params::default(), 250, 5, [4, 2]),
     ] {
         let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 20, 20));
@@ -177,7 +204,7 @@ fn each_token_decides_its_step_with_its_own_direction_sign() {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
     let rays = frame_rays(&scene, &Camera::default_for(&scene, 8, 8));
     assert_eq!((rays[0].pixel, rays[1].pixel), (0, 1));
-    assert_walks_are_the_culled_golden_walks("teapot n4 m8", &scene, &rays[..2], 150, 2, 1);
+    assert_walks_are_the_culled_golden_walks("teapot n4 m8", &scene, &rays[..2], 150, 2, [1, 1]);
 }
 
 #[test]

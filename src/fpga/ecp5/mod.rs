@@ -116,18 +116,7 @@ pub fn module_of(name: &str, isect: &IntersectParams, core: &CoreParams, roms: &
         "divider" => (isect.divider(), Some(isect.div_latency())),
         "intersect" => (intersect::intersect_core(isect), Some(isect.latency())),
         "traverse" => (traverse::traverse_core(&core.trav), None),
-        "closest" => (
-            closest::closest_core(
-                core.tag,
-                core.total_slots(),
-                [core.units, core.unit_bits()],
-                core.trav.id_width,
-                isect.n,
-                isect.m,
-                isect.target(),
-            ),
-            Some(1 + closest::input_latency(isect.target())),
-        ),
+        "closest" => (core.closest_module(), Some(1 + closest::input_latency(isect.target()))),
         // The core as integrators get it: no observation ports.
         _ => (top::core_module_with(core, roms, false), None),
     }

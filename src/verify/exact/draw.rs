@@ -40,6 +40,8 @@ impl CaseScene {
 pub struct Shape {
     pub slots: u32,
     pub units: u32,
+    /// Intersection pipelines: 1, 2 or 4, dividing `units`.
+    pub pipelines: u32,
     pub target_mhz: u32,
     pub div_bits: u32,
 }
@@ -81,13 +83,19 @@ pub fn case(seed: u64, index: u64, files: &[std::path::PathBuf]) -> Case {
         CaseScene::Builtin(BUILTINS[rng.below(BUILTINS.len() as u64) as usize].into())
     };
     let params = params(&mut rng);
-    let shape = shape(&mut rng);
+    let mut shape = shape(&mut rng);
     let inside = rng.below(2) == 0;
     let camera_seed = rng.next_u64();
     let shuffle_seed = (rng.below(2) == 0).then(|| rng.below(1000));
     let stalls = (rng.below(3) == 0).then(|| (1 + rng.below(60) as u32, rng.below(1000)));
     // Drawn last, so the cases of a seed keep every draw they had before external memory.
     let memory = (rng.below(3) == 0).then(|| memory(&mut rng));
+    // Then the pipelines (one with the scene in external memory): each that divides the units
+    // as likely.
+    if memory.is_none() {
+        let fits: Vec<u32> = [1, 2, 4].into_iter().filter(|p| shape.units % p == 0).collect();
+        shape.pipelines = fits[rng.below(fits.len() as u64) as usize];
+    }
     Case { index, scene, params, shape, camera: None, inside, camera_seed, shuffle_seed, stalls, memory }
 }
 
@@ -148,7 +156,7 @@ fn shape(rng: &mut SplitMix64) -> Shape {
         _ => 1 + rng.below(most as u64) as u32,
     };
     let target_mhz = [50, 75, 100, 125, 126, 150, 175, 200, 250, 300, 400][rng.below(11) as usize];
-    Shape { slots, units, target_mhz, div_bits: 1 + rng.below(2) as u32 }
+    Shape { slots, units, pipelines: 1, target_mhz, div_bits: 1 + rng.below(2) as u32 }
 }
 
 /// The case's camera for its built scene: inside the scene's world box (a random eye and view

@@ -117,6 +117,7 @@ pub fn build(case: &mut Case, tris: Vec<Tri>) -> crate::error::Result<Built> {
         target_mhz: s.target_mhz,
         slots: s.slots,
         units: s.units,
+        pipelines: s.pipelines,
     };
     let core = CoreParams::shaped(&roms, &spec);
     core.check()?;
