@@ -9,6 +9,7 @@
 //! bit and a reduction tree after the outputs' own registers, so the paths it adds are short
 //! (a register to an input register, an XOR tree into one flip-flop).
 
+pub mod blocks;
 pub mod bram;
 pub mod carry;
 pub mod dsp;
