@@ -80,7 +80,7 @@ impl Board {
     pub fn dsp48e(self) -> Option<u32> {
         match self {
             Board::Ulx3s => None,
-            Board::Ml509 => Some(64),
+            Board::Ml509 => Some(crate::fpga::device::Device::Xc5vlx110t.capacity().multipliers),
         }
     }
 }

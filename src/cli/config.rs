@@ -11,6 +11,7 @@ use super::{
     SceneChoice, SimArgs, SimChoice, SynthArgs, TestArgs,
 };
 use crate::error::{Error, Result};
+use crate::fpga::device::Device;
 use crate::io::check_folder;
 use crate::model::camera::{Camera, CameraSpec};
 use crate::params::Params;
@@ -438,9 +439,9 @@ pub struct SynthConfig {
 }
 
 /// Block RAM of the LFE5U-85F, Kb: 208 DP16KD of 18 Kb.
-pub const ECP5_85F_BRAM_KBITS: u64 = 208 * 18;
+pub const ECP5_85F_BRAM_KBITS: u64 = Device::Lfe5u85f.bram_kbits();
 /// Block RAM of the XC5VLX110T, Kb (the thesis's device).
-pub const XC5VLX110T_BRAM_KBITS: u64 = 5328;
+pub const XC5VLX110T_BRAM_KBITS: u64 = Device::Xc5vlx110t.bram_kbits();
 
 /// Where `fxrt synth` maps the cores.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,5 +2,6 @@
 //! clock frequency, with the cores' block RAMs, carry chains and multipliers as ECP5
 //! primitives) and the Xilinx area estimates (`xilinx`, yosys `synth_xilinx`).
 
+pub mod device;
 pub mod ecp5;
 pub mod xilinx;
