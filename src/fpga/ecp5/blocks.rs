@@ -14,7 +14,7 @@ use super::bram::{MIN_WORDS, banks, config};
 use super::dsp::DSP_MODULE_PREFIX;
 use crate::cores::brom::{BRAM_PREFIX, BROM_PREFIX};
 use crate::rtl::emit::verilog::DISTRIBUTED_WORDS;
-use crate::rtl::netlist::{Module, Rom};
+use crate::rtl::netlist::{Def, Module, Rom};
 use crate::scene::rom::rom_depth;
 
 /// Hard blocks and LUT-RAM bits of a module and everything it instantiates.
@@ -24,6 +24,10 @@ pub struct Blocks {
     pub mult18: usize,
     /// Bits of the RAMs and ROMs kept in LUTs (each at its power-of-two depth).
     pub lut_ram_bits: u64,
+    /// Register bits left in the fabric: every register, shift register and read register
+    /// but those inside the hard blocks (a DSP piece's, a block memory's read and output
+    /// registers). Synthesis removes what is constant or unread from these.
+    pub fabric_register_bits: u64,
 }
 
 impl std::ops::AddAssign for Blocks {
@@ -31,6 +35,7 @@ impl std::ops::AddAssign for Blocks {
         self.dp16kd += o.dp16kd;
         self.mult18 += o.mult18;
         self.lut_ram_bits += o.lut_ram_bits;
+        self.fabric_register_bits += o.fabric_register_bits;
     }
 }
 
@@ -53,12 +58,32 @@ fn inferred(r: &Rom) -> Blocks {
     }
 }
 
+/// Register bits of the module itself: registers, shift registers and, with `reads`, the read
+/// registers of its memories.
+fn register_bits(m: &Module, reads: bool) -> u64 {
+    m.signals
+        .iter()
+        .map(|s| match s.def {
+            Def::Reg { .. } => s.ty.width as u64,
+            Def::DelayLine { depth, .. } => s.ty.width as u64 * depth as u64,
+            Def::RomRead { .. } if reads => s.ty.width as u64,
+            _ => 0,
+        })
+        .sum()
+}
+
 /// The module's own memories and multiplier pieces, without its instances.
 fn own(m: &Module) -> Blocks {
     if m.name.starts_with(DSP_MODULE_PREFIX) {
         return Blocks { mult18: 1, ..Blocks::default() };
     }
-    let mut out = Blocks::default();
+    let block_module = m.roms.len() == 1
+        && m.roms[0].words.len() >= MIN_WORDS
+        && (m.name.starts_with(BROM_PREFIX)
+            || (m.name.starts_with(BRAM_PREFIX) && side_by_side(m.roms[0].words.len(), m.roms[0].width).is_some()));
+    // A block memory module's read register and first register after it are the block's.
+    let inside = if block_module { m.roms[0].width as u64 } else { 0 };
+    let mut out = Blocks { fabric_register_bits: register_bits(m, !block_module) - inside, ..Blocks::default() };
     for r in &m.roms {
         let big = r.words.len() >= MIN_WORDS;
         out += if m.name.starts_with(BROM_PREFIX) && big {
