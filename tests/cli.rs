@@ -483,6 +483,11 @@ fn gen_takes_measured_figures_only_for_the_same_netlist() {
         serde_json::from_slice(&std::fs::read(out.join(format!("{}.json", core.name))).unwrap()).unwrap();
     assert_eq!(manifest["clock"]["measured_fmax_mhz"], 123.45);
     assert_eq!(manifest["clock"]["measured_on"]["seed"], 3);
+    // Beside the measured figures, what the netlist predicts (`fpga::ecp5::blocks`).
+    let predicted = fxrt::fpga::ecp5::blocks::blocks(&core);
+    let on_ecp5 = &manifest["predicted"]["LFE5U-85F"];
+    assert_eq!((on_ecp5["mult18"].as_u64(), on_ecp5["dp16kd"].as_u64()), (Some(70), Some(predicted.dp16kd as u64)));
+    assert_eq!(manifest["predicted"]["XC5VLX110T"]["dsp48e"], 70);
     assert_eq!(
         (manifest["resources"]["lut4"].clone(), manifest["resources"]["dp16kd"].clone()),
         (11.into(), 44.into())

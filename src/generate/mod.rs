@@ -131,6 +131,27 @@ pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, Str
     )
 }
 
+/// What the core needs of each device `--device` knows, counted from its netlist before any
+/// synthesis: on the ECP5 the flow's own mapping (`fpga::ecp5::blocks`: MULT18X18D and DP16KD,
+/// equal to what nextpnr placed for every core measured), on the Xilinx parts yosys's slicing
+/// of each product into 25 × 18 DSP48s (`cores::cost`).
+fn predicted(core: &Module) -> Value {
+    use crate::fpga::device::Device;
+    let b = crate::fpga::ecp5::blocks::blocks(core);
+    let dsp = crate::cores::cost::dsp48e_estimate(core);
+    let of = |d: Device| d.capacity();
+    json!({
+        "how": "counted from the netlist by the flows' mapping rules, before synthesis (docs/CORE.md)",
+        Device::Lfe5u85f.name(): {
+            "mult18": b.mult18, "mult18_of": of(Device::Lfe5u85f).multipliers,
+            "dp16kd": b.dp16kd, "dp16kd_of": of(Device::Lfe5u85f).block_rams,
+            "lut_ram_bits": b.lut_ram_bits, "fabric_register_bits": b.fabric_register_bits,
+        },
+        Device::Xc5vlx110t.name(): { "dsp48e": dsp, "dsp48e_of": of(Device::Xc5vlx110t).multipliers },
+        Device::Xc7a100t.name(): { "dsp48e1": dsp, "dsp48e1_of": of(Device::Xc7a100t).multipliers },
+    })
+}
+
 /// The whole ray tracing core `core` (`core_module_with(p, roms, o.debug_ports)`, built once
 /// by the caller) for a scene (fed by the on-chip ray generator when `raygen` is given), with
 /// manifests for it and for each of its cores.
@@ -219,6 +240,7 @@ pub fn core_files(
         Value::Null,
         |_| json!({ "lut4": pick("lut4"), "ff": pick("ff"), "mult18": pick("mult18"), "dp16kd": pick("dp16kd") }),
     );
+    doc["predicted"] = predicted(core);
     doc["hashes"] = json!({
         "scene_sha256": roms.hash(),
         "scene_tag": p.trav.scene_tag,

@@ -130,17 +130,19 @@ mod tests {
 
     /// The counts nextpnr placed (docs/TIMING.md, docs/MEMORY.md, docs/BOARDS.md): the default
     /// core on the teapot, 170 DP16KD and 70 MULT18X18D; the throughput build (4 × 32 slots,
-    /// leaves ≤ 3) 204 and 94; the Cornell box's core of one unit × 8 slots 4 and 58.
+    /// leaves ≤ 3) 204 and 94; the Cornell box's core of one unit × 8 slots 4 and 58; four
+    /// units × 32 slots with two intersection pipelines (their ROMs on two ports) 196 and 134.
     #[test]
     fn on_chip_cores_count_what_nextpnr_placed() {
         let leaf3 = Params { leaf_size: 3, ..Params::default() };
-        for (scene, params, slots, units, dp16kd, mult18) in [
-            ("teapot", Params::default(), 64, 2, 170, 70),
-            ("teapot", leaf3, 32, 4, 204, 94),
-            ("cornell", Params::default(), 8, 1, 4, 58),
+        for (scene, params, [slots, units, pipelines], dp16kd, mult18) in [
+            ("teapot", Params::default(), [64, 2, 1], 170, 70),
+            ("teapot", leaf3, [32, 4, 1], 204, 94),
+            ("cornell", Params::default(), [8, 1, 1], 4, 58),
+            ("teapot", Params::default(), [32, 4, 2], 196, 134),
         ] {
             let r = roms(scene, &params);
-            let p = CoreParams::shaped(&r, &CoreSpec { slots, units, ..CoreSpec::default() });
+            let p = CoreParams::shaped(&r, &CoreSpec { slots, units, pipelines, ..CoreSpec::default() });
             let got = blocks(&core_module_with(&p, &r, false));
             assert_eq!((got.dp16kd, got.mult18), (dp16kd, mult18), "{scene} {units} × {slots}: {got:?}");
         }
