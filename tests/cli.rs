@@ -332,6 +332,28 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
 
+/// `--device` fits the shape: the ML509's top without `--units` (the XC5VLX110T's 64 DSP48E
+/// take one unit, said on stderr); with `--units` too it is refused, as is a folder of ROM
+/// images (the fit runs the scene).
+#[test]
+fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ml509");
+    let o = out.to_str().unwrap();
+    let board = ["gen", "--builtin", "cornell", "--size", "4x3", "--out", o, "--board", "ml509"];
+    let ok = fxrt(&[&board[..], &["--device", "xc5vlx110t"]].concat());
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    assert!(stderr(&ok).contains("chosen 1 units × 64 slots, 1 pipelines"), "{}", stderr(&ok));
+    let other = dir.path().join("other");
+    let sim = ["sim", "--builtin", "cornell", "--size", "4x4", "--device", "lfe5u-85f", "--units", "2"];
+    assert_rejected(&sim, "--device", &other);
+    let rom = dir.path().join("rom");
+    assert!(fxrt(&["scene", "--builtin", "cornell", "--out", rom.to_str().unwrap()]).status.success());
+    let from_roms =
+        ["gen", "--scene", rom.to_str().unwrap(), "--device", "lfe5u-85f", "--out", other.to_str().unwrap()];
+    assert_rejected(&from_roms, "--device", &other);
+}
+
 /// Two pipelines, one unit each: every pixel matches, and the JSON says the shape.
 #[test]
 fn sim_with_two_pipelines_matches_every_pixel() {

@@ -6,7 +6,8 @@ use crate::render::tracer::ModelKind;
 use clap::Args;
 use std::path::PathBuf;
 
-/// The core's ray slots and traversal units (docs/CORE.md): how many rays it holds at once.
+/// The core's ray slots, traversal units and intersection pipelines (docs/CORE.md), or the
+/// device to fit them to.
 #[derive(Args, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ThreadArgs {
     /// Ray slots per traversal unit: the rays each unit holds at once (1..=64).
@@ -18,6 +19,10 @@ pub struct ThreadArgs {
     /// Intersection pipelines (1, 2 or 4, dividing --units): each serves --units / P units.
     #[arg(long, default_value_t = 1)]
     pub pipelines: u32,
+    /// Fit the slots, units and pipelines to this device: of the shapes whose multipliers and
+    /// block RAM it holds, the one with the most rays per clock on a short frame of the scene.
+    #[arg(long, value_enum, conflicts_with_all = ["slots", "units", "pipelines"])]
+    pub device: Option<crate::fpga::device::Device>,
 }
 
 /// Choices of the hardware that do not change the arithmetic.

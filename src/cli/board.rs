@@ -33,7 +33,7 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     let g = board_camera(&scene, spec)?;
     super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
     let roms = SceneRoms::of(&scene);
-    let p = CoreParams::shaped(&roms, &c.core_spec());
+    let p = CoreParams::shaped(&roms, &super::device::shape(&c.threads, Some(&scene), c.core_spec())?);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let tools = if b.bitstream {

@@ -9,6 +9,7 @@ pub mod bench_embree;
 pub mod board;
 pub mod config;
 pub mod demo;
+pub mod device;
 pub mod exact;
 pub mod placement;
 pub mod run;

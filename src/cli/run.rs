@@ -136,6 +136,7 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
                     slots: crate::cores::top::DEFAULT_SLOTS,
                     units: crate::cores::top::DEFAULT_UNITS,
                     pipelines: 1,
+                    device: None,
                 },
             };
             let p = intersect_params(&params, &scene, &hw)?;
@@ -241,9 +242,10 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     if let Some(g) = &raygen {
         ids_fit(c.ray_id_width, g.width, g.height)?;
     }
-    let p = crate::cores::top::CoreParams::shaped(&roms, &c.core_spec());
+    let spec = super::device::shape(&c.threads, scene.as_ref(), c.core_spec())?;
+    let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
-    let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &c.core_spec(), p)?;
+    let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &spec, p)?;
     if p.mem.is_some() && raygen.is_some() {
         return Err(crate::error::Error::param(
             "raygen",
@@ -318,15 +320,13 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let scene = Scene::load(&c.scene, &c.params)?;
     let p = intersect_params(&c.params, &scene, &c.hw)?;
     let roms = SceneRoms::of(&scene);
-    let t = c.hw.threads;
-    let shape = crate::cores::top::CoreSpec {
+    let base = crate::cores::top::CoreSpec {
         id_width: crate::cores::top::DEFAULT_RAY_ID_WIDTH,
         div_bits: c.hw.div_bits,
         target_mhz: c.hw.target_mhz,
-        slots: t.slots,
-        units: t.units,
-        pipelines: t.pipelines,
+        ..Default::default()
     };
+    let shape = super::device::shape(&c.hw.threads, Some(&scene), base)?;
     let core = crate::cores::top::CoreParams::shaped(&roms, &shape);
     core.check()?;
     let core = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core)?;
@@ -409,15 +409,9 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let (w, h) = (cam.width, cam.height);
     let id_width = rom::addr_bits((w * h) as usize);
     let roms = SceneRoms::of(&scene);
-    let t = c.threads;
-    let spec = crate::cores::top::CoreSpec {
-        id_width,
-        div_bits: c.div_bits,
-        target_mhz: c.target_mhz,
-        slots: t.slots,
-        units: t.units,
-        pipelines: t.pipelines,
-    };
+    let base =
+        crate::cores::top::CoreSpec { id_width, div_bits: c.div_bits, target_mhz: c.target_mhz, ..Default::default() };
+    let spec = super::device::shape(&c.threads, Some(&scene), base)?;
     let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
     let p = external_core(c, &roms, &spec, p)?;

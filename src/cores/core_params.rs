@@ -225,13 +225,29 @@ impl CoreParams {
         Ok(())
     }
 
+    /// Bits of the units' stacks, as `check_device` counts them.
+    pub fn stack_bits(&self) -> u64 {
+        let stack_word = self.trav.n as u64 * 2 + 6 + 32;
+        stack_word * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64 * self.total_slots() as u64
+    }
+
+    /// Bits of block RAM the core on chip takes: every copy of a scene ROM (the node ROM one
+    /// per two units, the leaf and triangle ROMs one per two pipelines) at its power-of-two
+    /// depth, and the stacks.
+    pub fn bram_bits(&self, scene: &SceneRoms) -> u64 {
+        let bits = |(l, w): &(crate::scene::rom::Layout, Vec<crate::scene::rom::Word>)| {
+            l.width as u64 * crate::scene::rom::rom_depth(w.len()) as u64
+        };
+        let per_pair = |x: u32| x.div_ceil(2) as u64;
+        bits(&scene.node) * per_pair(self.units)
+            + (bits(&scene.tri) + bits(&scene.leaf)) * per_pair(self.pipelines)
+            + self.stack_bits()
+    }
+
     /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM (each ROM rounded up
     /// to a power-of-two depth, as the printers emit it).
     pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
-        let stack_word = self.trav.n as u64 * 2 + 6 + 32;
-        let stack = stack_word
-            * crate::scene::rom::rom_depth(self.trav.stack_depth as usize) as u64
-            * self.total_slots() as u64;
+        let stack = self.stack_bits();
         if let Some(m) = &self.mem {
             return m.check_device(self.units, self.total_slots(), stack, bram_kbits);
         }

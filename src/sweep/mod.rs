@@ -11,6 +11,7 @@
 pub mod compat;
 pub mod draw;
 pub mod eval;
+pub mod fit;
 pub mod grid;
 pub mod memory;
 pub mod output;
