@@ -117,6 +117,10 @@ impl CoreParams {
     pub fn lane_bits(&self) -> u32 {
         self.pipelines.trailing_zeros()
     }
+    /// Whether global slot number `slot` is one of lane `lane`'s (its top bits are the lane).
+    pub fn in_lane<'b>(&self, slot: crate::rtl::build::S<'b>, lane: u32) -> crate::rtl::build::S<'b> {
+        slot.slice(self.lane_slot_bits(), self.lane_bits()).eq(lane as i128)
+    }
     /// Traversal units per lane.
     pub fn lane_units(&self) -> u32 {
         self.units / self.pipelines
@@ -213,12 +217,12 @@ impl CoreParams {
             return Err(crate::error::Error::param(
                 "slots",
                 format!(
-                    "{} units × {} slots = {} ray slots{numbered}; the closest-hit unit of each of the {} \
-                     pipelines holds at most {MAX_WIDTH}: fewer --slots or --units, or more --pipelines",
+                    "{} units × {} slots = {} ray slots{numbered}; a closest-hit unit (one per pipeline) numbers \
+                     at most {MAX_WIDTH}: fewer --slots or --units{}",
                     self.units,
                     self.trav.slots,
                     self.slot_count(),
-                    self.pipelines
+                    if self.units.is_multiple_of(2 * self.pipelines) { ", or more --pipelines" } else { "" }
                 ),
             ));
         }

@@ -27,8 +27,8 @@ pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> R
     let (slots, n, lsb) = ((p.total_slots() >> p.lane_bits()) as usize, p.isect.n, p.lane_slot_bits());
     let (accept, gslot) = match p.lane_bits() {
         0 => (port.accept, port.ram_slot),
-        lb => {
-            let mine = port.ram_slot.slice(lsb, lb).eq(lane as i128);
+        _ => {
+            let mine = p.in_lane(port.ram_slot, lane);
             ((port.accept & mine).name(&p.lane_name(lane, "ray_we")), port.ram_slot.slice(0, lsb))
         }
     };

@@ -24,7 +24,10 @@ pub fn result_queue<'b>(
     credit_ok: S<'b>,
 ) {
     let bit = Ty::BIT;
-    let words = [b.cat(&[field("id"), field("hit"), field("tri"), field("t")]), b.cat(&[field("u"), field("v")])];
+    // Each field taken once (with several pipelines `field` builds the lanes' select).
+    let fields: std::collections::BTreeMap<&str, S> =
+        ["id", "hit", "tri", "t", "u", "v"].into_iter().map(|name| (name, field(name))).collect();
+    let words = [b.cat(&[fields["id"], fields["hit"], fields["tri"], fields["t"]]), b.cat(&[fields["u"], fields["v"]])];
     let take = b.wire("res_take", bit);
     let (heads, nonempty) = super::fifo::fifo_words(b, "res_q", RESULT_QUEUE, field("valid"), &words, take);
     b.drive(take, (nonempty & res_ready).name("res_take_c"));
@@ -42,7 +45,7 @@ pub fn result_queue<'b>(
     for (word, names) in [(0, ["t", "tri", "hit", "id"].as_slice()), (1, ["v", "u"].as_slice())] {
         let mut lsb = 0;
         for name in names {
-            let width = field(name).width();
+            let width = fields[name].width();
             out.insert(*name, heads[word].slice(lsb, width).name(&format!("res_{name}_q")));
             lsb += width;
         }

@@ -261,7 +261,7 @@ fn results<'b>(
             } else {
                 // The lane's own slots: the global slot's top bits are the lane.
                 let nm = |x: &str| p.lane_name(lane as u32, x);
-                let mine = |slot: S<'b>| slot.slice(lsb, lb).eq(lane as i128);
+                let mine = |slot: S<'b>| p.in_lane(slot, lane as u32);
                 let id_we = (port.accept & mine(port.closest_slot)).name(&nm("id_we"));
                 let done = (done_any & mine(done_slot)).name(&nm("done_valid"));
                 cin.extend([id_we, port.closest_slot.slice(0, lsb), port.id, done, done_slot.slice(0, lsb)]);
