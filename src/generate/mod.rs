@@ -141,7 +141,7 @@ fn predicted(core: &Module) -> Value {
     let dsp = crate::cores::cost::dsp48e_estimate(core);
     let of = |d: Device| d.capacity();
     json!({
-        "how": "counted from the netlist by the flows' mapping rules, before synthesis (docs/CORE.md)",
+        "how": "counted from the netlist by the flows' mapping rules, before synthesis (docs/HDL.md)",
         Device::Lfe5u85f.name(): {
             "mult18": b.mult18, "mult18_of": of(Device::Lfe5u85f).multipliers,
             "dp16kd": b.dp16kd, "dp16kd_of": of(Device::Lfe5u85f).block_rams,

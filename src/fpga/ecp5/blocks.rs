@@ -81,8 +81,9 @@ fn own(m: &Module) -> Blocks {
         && m.roms[0].words.len() >= MIN_WORDS
         && (m.name.starts_with(BROM_PREFIX)
             || (m.name.starts_with(BRAM_PREFIX) && side_by_side(m.roms[0].words.len(), m.roms[0].width).is_some()));
-    // A block memory module's read register and first register after it are the block's.
-    let inside = if block_module { m.roms[0].width as u64 } else { 0 };
+    // A block memory module's read register and first register after it are the block's (one
+    // per read port: each output).
+    let inside = if block_module { m.roms[0].width as u64 * m.outputs.len() as u64 } else { 0 };
     let mut out = Blocks { fabric_register_bits: register_bits(m, !block_module) - inside, ..Blocks::default() };
     for r in &m.roms {
         let big = r.words.len() >= MIN_WORDS;
