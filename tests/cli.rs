@@ -352,6 +352,12 @@ fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
     let from_roms =
         ["gen", "--scene", rom.to_str().unwrap(), "--device", "lfe5u-85f", "--out", other.to_str().unwrap()];
     assert_rejected(&from_roms, "--device", &other);
+    let o = other.to_str().unwrap();
+    let external = ["gen", "--builtin", "cornell", "--memory", "external", "--device", "lfe5u-85f", "--out", o];
+    assert_rejected(&external, "--device", &other);
+    // A width no shape can hold is said as itself, not as a device too small.
+    let wide = ["gen", "--builtin", "cornell", "--m", "64", "--c", "40", "--device", "lfe5u-85f", "--out", o];
+    assert_rejected(&wide, "--c", &other);
 }
 
 /// Two pipelines, one unit each: every pixel matches, and the JSON says the shape.

@@ -33,7 +33,9 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     let g = board_camera(&scene, spec)?;
     super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
     let roms = SceneRoms::of(&scene);
-    let p = CoreParams::shaped(&roms, &super::device::shape(&c.threads, Some(&scene), c.core_spec())?);
+    let external = c.memory == super::args::MemoryPlace::External;
+    let (spec, fit) = super::device::shape(&c.threads, Some(&scene), c.core_spec(), external)?;
+    let p = CoreParams::shaped(&roms, &spec);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;
     let tools = if b.bitstream {
@@ -41,6 +43,7 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     } else {
         None
     };
+    super::device::say(fit.as_ref());
     let d = BoardDesign::new(b.board, &p, &roms, &scene, &g, b.mhz, b.led_shift, None)?;
     let design: Vec<(PathBuf, String)> =
         d.files(c.vhdl, c.verilog).into_iter().map(|(n, t)| (c.out.join(n), t)).collect();

@@ -4,39 +4,33 @@ use super::args::ThreadArgs;
 use crate::cores::top::CoreSpec;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::sweep::fit::Fit;
 
 /// `base` (ray ids, divider, clock target) with the slots, units and pipelines given, or with
-/// `--device` those of the fit, which is said on stderr a shape a line.
-pub fn shape(t: &ThreadArgs, scene: Option<&Scene>, base: CoreSpec) -> Result<CoreSpec> {
+/// `--device` those of the fit (returned too: `say` tells it once the command has done its
+/// work, so a later refusal stays one line). The fit counts cores with the scene on chip, so
+/// not with `external` memory.
+pub fn shape(t: &ThreadArgs, scene: Option<&Scene>, base: CoreSpec, external: bool) -> Result<(CoreSpec, Option<Fit>)> {
     let given = CoreSpec { slots: t.slots, units: t.units, pipelines: t.pipelines, ..base };
     let Some(device) = t.device else {
-        return Ok(given);
+        return Ok((given, None));
     };
     let Some(scene) = scene else {
         return Err(Error::param("device", "needs the scene itself (an OBJ or --builtin), not a folder of ROM images"));
     };
+    if external {
+        return Err(Error::param("device", "fits cores with the scene on chip: not with --memory external (yet)"));
+    }
     let bar = indicatif::ProgressBar::new_spinner();
     bar.set_message(format!("fitting the core to the {}: shapes run", device.name()));
     let fit = crate::sweep::fit::fit(device, scene, &base, &|| bar.inc(1))?;
     bar.finish_and_clear();
-    let unit = if fit.device == "LFE5U-85F" { "" } else { " Kb" };
-    for c in fit.candidates.iter().filter(|c| c.rays_per_clock.is_some()) {
-        eprintln!(
-            "device {}: {} units × {} slots, {} pipelines: {} of {} multipliers, {}{unit} of {}{unit} block RAM, \
-             {:.4} rays per clock ({})",
-            fit.device,
-            c.units,
-            c.slots,
-            c.pipelines,
-            c.multipliers,
-            fit.multipliers_of,
-            c.block_ram,
-            fit.block_ram_of,
-            c.rays_per_clock.unwrap_or(0.0),
-            fit.frame
-        );
+    Ok((fit.spec(&base), Some(fit)))
+}
+
+/// The fit's shapes and choice on stderr, a line each.
+pub fn say(fit: Option<&Fit>) {
+    for line in fit.map(Fit::lines).unwrap_or_default() {
+        eprintln!("{line}");
     }
-    let c = &fit.chosen;
-    eprintln!("device {}: chosen {} units × {} slots, {} pipelines", fit.device, c.units, c.slots, c.pipelines);
-    Ok(fit.spec(&base))
 }

@@ -242,7 +242,12 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     if let Some(g) = &raygen {
         ids_fit(c.ray_id_width, g.width, g.height)?;
     }
-    let spec = super::device::shape(&c.threads, scene.as_ref(), c.core_spec())?;
+    let (spec, fit) = super::device::shape(
+        &c.threads,
+        scene.as_ref(),
+        c.core_spec(),
+        c.memory == super::args::MemoryPlace::External,
+    )?;
     let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
     let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &spec, p)?;
@@ -289,6 +294,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         p.isect.latency(),
         c.out.display()
     );
+    super::device::say(fit.as_ref());
     Ok(())
 }
 
@@ -326,11 +332,13 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
         target_mhz: c.hw.target_mhz,
         ..Default::default()
     };
-    let shape = super::device::shape(&c.hw.threads, Some(&scene), base)?;
+    let (shape, fit) =
+        super::device::shape(&c.hw.threads, Some(&scene), base, c.memory == super::args::MemoryPlace::External)?;
     let core = crate::cores::top::CoreParams::shaped(&roms, &shape);
     core.check()?;
     let core = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core)?;
     core.check_device(&roms, c.bram_kbits)?;
+    super::device::say(fit.as_ref());
     eprintln!(
         "synth: scene {} {}",
         scene.name,
@@ -411,10 +419,12 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
     let roms = SceneRoms::of(&scene);
     let base =
         crate::cores::top::CoreSpec { id_width, div_bits: c.div_bits, target_mhz: c.target_mhz, ..Default::default() };
-    let spec = super::device::shape(&c.threads, Some(&scene), base)?;
+    let (spec, fit) =
+        super::device::shape(&c.threads, Some(&scene), base, c.memory == super::args::MemoryPlace::External)?;
     let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
     let p = external_core(c, &roms, &spec, p)?;
+    super::device::say(fit.as_ref());
     let raygen = if c.raygen { Some(RayGen::for_camera(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {
         Some(g) => {
@@ -526,6 +536,9 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         let key = if measured { "mrays_per_s_at_fmax" } else { "mrays_per_s_at_clock" };
         line["clock_mhz"] = serde_json::json!(mhz);
         line[key] = serde_json::json!((mhz / stats.cycles_per_ray() * 1e4).round() / 1e4);
+    }
+    if let Some(f) = &fit {
+        line["device_fit"] = serde_json::to_value(f).unwrap_or_default();
     }
     println!("{line}");
     Ok(mismatches == 0 && walk_matches)

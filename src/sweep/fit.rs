@@ -19,8 +19,8 @@ use crate::verify::frame::{frame_rays, simulate_rust};
 use rayon::prelude::*;
 use serde::Serialize;
 
-/// Slots per unit tried, most first.
-const SLOTS: [u32; 4] = [64, 48, 32, 16];
+/// Slots per unit tried, most first (48 is numbered, and built, as 64: not tried).
+const SLOTS: [u32; 3] = [64, 32, 16];
 /// The short frame each fitting shape runs (a side, pixels): long enough that 256 slots are
 /// full most of the frame.
 pub const FRAME: u32 = 48;
@@ -42,7 +42,7 @@ pub struct Candidate {
 /// The fit: every shape counted, the one chosen.
 #[derive(Clone, Debug, Serialize)]
 pub struct Fit {
-    pub device: &'static str,
+    pub device: Device,
     pub multipliers_of: u32,
     pub block_ram_of: u64,
     pub frame: String,
@@ -50,9 +50,50 @@ pub struct Fit {
     pub chosen: Candidate,
 }
 
+impl Candidate {
+    /// `base` (ray ids, divider, clock target) in this shape.
+    pub fn spec(&self, base: &CoreSpec) -> CoreSpec {
+        CoreSpec { units: self.units, slots: self.slots, pipelines: self.pipelines, ..*base }
+    }
+}
+
 impl Fit {
     pub fn spec(&self, base: &CoreSpec) -> CoreSpec {
-        CoreSpec { units: self.chosen.units, slots: self.chosen.slots, pipelines: self.chosen.pipelines, ..*base }
+        self.chosen.spec(base)
+    }
+
+    /// What the fit found, a line per shape run and the choice.
+    pub fn lines(&self) -> Vec<String> {
+        let unit = if self.device == Device::Lfe5u85f { "" } else { " Kb" };
+        let mut lines: Vec<String> = self
+            .candidates
+            .iter()
+            .filter_map(|c| {
+                let r = c.rays_per_clock?;
+                Some(format!(
+                    "device {}: {} units × {} slots, {} pipelines: {} of {} multipliers, {}{unit} of {}{unit} block \
+                     RAM, {r:.4} rays per clock ({})",
+                    self.device.name(),
+                    c.units,
+                    c.slots,
+                    c.pipelines,
+                    c.multipliers,
+                    self.multipliers_of,
+                    c.block_ram,
+                    self.block_ram_of,
+                    self.frame
+                ))
+            })
+            .collect();
+        let c = &self.chosen;
+        lines.push(format!(
+            "device {}: chosen {} units × {} slots, {} pipelines",
+            self.device.name(),
+            c.units,
+            c.slots,
+            c.pipelines
+        ));
+        lines
     }
 }
 
@@ -80,17 +121,20 @@ pub fn fit(device: Device, scene: &Scene, base: &CoreSpec, progress: &(dyn Fn() 
         Device::Lfe5u85f => cap.block_rams as u64,
         _ => device.bram_kbits(),
     };
+    // What no shape changes (widths, the clock) is said as itself, before any shape is tried.
+    CoreParams::shaped(&roms, &CoreSpec { units: 1, slots: 1, pipelines: 1, ..*base }).check()?;
     let mut candidates = Vec::new();
     for units in 1..=4u32 {
         for pipelines in [1, 2, 4].into_iter().filter(|p| units.is_multiple_of(*p)) {
             for slots in SLOTS {
-                let spec = CoreSpec { units, slots, pipelines, ..*base };
-                let p = CoreParams::shaped(&roms, &spec);
+                let mut c = Candidate { units, slots, pipelines, multipliers: 0, block_ram: 0, rays_per_clock: None };
+                let p = CoreParams::shaped(&roms, &c.spec(base));
+                // Shapes the closest-hit units cannot number (more than 128 slots a lane).
                 if p.check().is_err() {
                     continue;
                 }
-                let (multipliers, block_ram) = needs(device, &roms, &p);
-                candidates.push(Candidate { units, slots, pipelines, multipliers, block_ram, rays_per_clock: None });
+                (c.multipliers, c.block_ram) = needs(device, &roms, &p);
+                candidates.push(c);
             }
         }
     }
@@ -108,9 +152,8 @@ pub fn fit(device: Device, scene: &Scene, base: &CoreSpec, progress: &(dyn Fn() 
     let measured: Vec<(usize, f64)> = run
         .par_iter()
         .map(|&k| {
-            let c = &candidates[k];
-            let spec = CoreSpec { units: c.units, slots: c.slots, pipelines: c.pipelines, ..*base };
-            let (_, stats) = simulate_rust(&CoreParams::shaped(&roms, &spec), &roms, &rays, &Stalls::none(), &|_| {});
+            let p = CoreParams::shaped(&roms, &candidates[k].spec(base));
+            let (_, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
             progress();
             (k, stats.rays_per_clock())
         })
@@ -130,17 +173,17 @@ pub fn fit(device: Device, scene: &Scene, base: &CoreSpec, progress: &(dyn Fn() 
         return Err(Error::param(
             "device",
             format!(
-                "{}: no core shape for scene {} fits its {} multipliers and {} block RAM{}",
+                "{}: no core shape for scene {} fits its {} multipliers and {} {}",
                 device.name(),
                 scene.name,
                 cap.multipliers,
                 block_ram_of,
-                if device == Device::Lfe5u85f { "s" } else { " Kb" }
+                if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" }
             ),
         ));
     };
     Ok(Fit {
-        device: device.name(),
+        device,
         multipliers_of: cap.multipliers,
         block_ram_of,
         frame: format!("{FRAME}x{FRAME}, the scene's default view, Rust simulator"),
