@@ -143,6 +143,30 @@ pub fn brom2<'b>(
     (p.get("data"), p.get("data_b"))
 }
 
+/// A ROM read at each of `addrs` (`cycles` clocks later): one block ROM's two ports per two
+/// addresses, a block ROM of one port for an odd one left; `label(k)` names the k-th ROM.
+pub fn rom_reads<'b>(
+    b: &'b Builder,
+    label: &dyn Fn(usize) -> String,
+    name: &str,
+    width: u32,
+    image: &[u128],
+    addrs: &[S<'b>],
+    cycles: u32,
+) -> Vec<S<'b>> {
+    let mut words = Vec::new();
+    for (k, two) in addrs.chunks(2).enumerate() {
+        match *two {
+            [a, c] => {
+                let (wa, wc) = brom2(b, &label(k), name, width, image.to_vec(), a, c, cycles);
+                words.extend([wa, wc]);
+            }
+            _ => words.push(brom(b, &label(k), name, width, image.to_vec(), two[0], cycles)),
+        }
+    }
+    words
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,7 +2,7 @@
 //! from the traversal units' leaf queues, one triangle per clock from the leaf and triangle
 //! ROMs into the intersection pipeline, with the ray read from the core's ray RAMs by slot.
 
-use super::brom::{brom, brom2};
+use super::brom::rom_reads;
 use super::core_params::{CoreParams, tri_rom_groups};
 use super::intersect::intersect_core;
 use super::ray_port::RayPort;
@@ -246,7 +246,10 @@ pub fn emission<'b>(
     let leaf_image: Vec<u128> = leaf_words.iter().map(|w| word_bits(w, 0, leaf_l.width)).collect();
     let lrc = tp.leaf_rom_cycles;
     let ptrs: Vec<S> = leaves.iter().map(|l| l.ptr).collect();
-    let tri_nums = rom_reads(b, "u_leaf_rom", &format!("leaf_{scene_tag}"), leaf_l.width, &leaf_image, &ptrs, lrc);
+    // Labels as with one pipeline for the first ROM, `_1` after the second copy's.
+    let label = |base: String| move |pair: usize| if pair == 0 { base.clone() } else { format!("{base}_{pair}") };
+    let tri_nums =
+        rom_reads(b, &label("u_leaf_rom".into()), &format!("leaf_{scene_tag}"), leaf_l.width, &leaf_image, &ptrs, lrc);
     let (tri_l, tri_words) = &scene.tri;
     let lanes: Vec<(S, S, S)> = leaves
         .iter()
@@ -274,7 +277,7 @@ pub fn emission<'b>(
         let width: u32 = group.iter().map(|f| f.width).sum();
         let image: Vec<u128> = tri_words.iter().map(|w| word_bits(w, lsb, width)).collect();
         let name = format!("tri_{k}_{scene_tag}");
-        let words = rom_reads(b, &format!("u_tri_rom_{k}"), &name, width, &image, &addrs, p.tri_rom_cycles);
+        let words = rom_reads(b, &label(format!("u_tri_rom_{k}")), &name, width, &image, &addrs, p.tri_rom_cycles);
         for (fields, word) in tri_fields.iter_mut().zip(words) {
             fields.extend(group.iter().map(|f| field(&format!("tri_{}", f.name), word, f, lsb)));
         }
@@ -293,31 +296,6 @@ pub fn emission<'b>(
         into_pipeline(b, p, (lane as u32, rams), &emit_slots, trc, [valid_d, tag_d], tri_fields)
     })
     .collect()
-}
-
-/// A ROM read at each of `addrs` (`cycles` clocks later): one block ROM's two ports per two
-/// addresses, a block ROM of one port for an odd one left.
-fn rom_reads<'b>(
-    b: &'b Builder,
-    label: &str,
-    name: &str,
-    width: u32,
-    image: &[u128],
-    addrs: &[S<'b>],
-    cycles: u32,
-) -> Vec<S<'b>> {
-    let label = |pair: usize| if pair == 0 { label.to_string() } else { format!("{label}_{pair}") };
-    let mut words = Vec::new();
-    for (pair, two) in addrs.chunks(2).enumerate() {
-        match *two {
-            [a, c] => {
-                let (wa, wc) = brom2(b, &label(pair), name, width, image.to_vec(), a, c, cycles);
-                words.extend([wa, wc]);
-            }
-            _ => words.push(brom(b, &label(pair), name, width, image.to_vec(), two[0], cycles)),
-        }
-    }
-    words
 }
 
 /// Lane `lane`'s intersection pipeline fed a triangle (`valid_tag`: its valid bit and tag,

@@ -19,7 +19,7 @@
 //! The triangle table is wider than a signal may be (5 + 3n + 6m bits), so it is split into
 //! ROMs of whole fields, ≤ 128 bits each, all read at the same address.
 
-use super::brom::{brom, brom2};
+use super::brom::rom_reads;
 use super::leaf_stream::{Emission, emission, leaf_stream, ray_rams};
 use super::ray_port::{BoxExit, RayPort, box_exit, is_unit, ray_port};
 use super::top_memory::{MemoryObserved, NodeIn, memory_inputs, memory_side};
@@ -197,19 +197,12 @@ fn traversal_units<'b>(
 fn node_roms<'b>(b: &'b Builder, p: &CoreParams, scene: &SceneRoms, trav: &[Ports<'b>], node_words: &[S<'b>]) {
     let (node_l, node_image) = (&scene.node.0, &scene.node.1);
     let image: Vec<u128> = node_image.iter().map(|w| word_bits(w, 0, node_l.width)).collect();
+    let addrs: Vec<S> = trav.iter().map(|t| t.get("node_addr")).collect();
+    let label = |pair: usize| format!("u_node_rom_{pair}");
     let rom_name = format!("node_{}", p.trav.scene_tag);
-    for pair in 0..p.units.div_ceil(2) {
-        let (u0, u1) = (2 * pair as usize, 2 * pair as usize + 1);
-        let (label, nrc) = (format!("u_node_rom_{pair}"), p.trav.node_rom_cycles);
-        if u1 < p.units as usize {
-            let (a, c) = (trav[u0].get("node_addr"), trav[u1].get("node_addr"));
-            let (wa, wc) = brom2(b, &label, &rom_name, node_l.width, image.clone(), a, c, nrc);
-            b.drive(node_words[u0], wa);
-            b.drive(node_words[u1], wc);
-        } else {
-            let w = brom(b, &label, &rom_name, node_l.width, image.clone(), trav[u0].get("node_addr"), nrc);
-            b.drive(node_words[u0], w);
-        }
+    let words = rom_reads(b, &label, &rom_name, node_l.width, &image, &addrs, p.trav.node_rom_cycles);
+    for (wire, word) in node_words.iter().zip(words) {
+        b.drive(*wire, word);
     }
 }
 
