@@ -135,9 +135,18 @@ pub fn closest_core(
     let zero = b.konst(Ty::BIT, 0);
     let empty = (first | acc_empty).name("acc_empty_now");
     let take = lt_chain(b.cat(&[no_candidate, zero, t, tri]), b.cat(&[zero, empty, acc_t, acc_tri])).name("take");
-    for (r, x) in [(acc_t, t), (acc_tri, tri), (acc_u, u), (acc_v, v)] {
-        b.next_when(r, take, x);
-    }
+    b.next_when(acc_t, take, t);
+    b.next_when(acc_tri, take, tri);
+    // (u, v) follow a clock later, from the registered decision and a registered copy of the
+    // candidate's: `take` loading all 107 accumulator bits was the default core's fifth
+    // slowest path at seed 1 (7.72 ns, 84 endpoints over 6.67 ns), and a second carry chain
+    // for them was slower still at another seed (9.56 ns). The merge reads the (u, v) the
+    // accumulator is about to hold (`acc_u_v_now`), the same word.
+    let take_r = b.delay("take_r", take);
+    let (u_r, v_r) = (b.delay("cand_u", u), b.delay("cand_v", v));
+    b.next_when(acc_u, take_r, u_r);
+    b.next_when(acc_v, take_r, v_r);
+    let acc_uv_now = take_r.select(b.cat(&[u_r, v_r]), b.cat(&[acc_u, acc_v])).name("acc_u_v_now");
     // Empty after this clock unless a candidate came (a candidate into an empty accumulator is
     // taken; one into a full accumulator leaves it full): the same as clearing on `take`,
     // without the compare's carry chain on the path (10.6 ns at a seed of the external core).
@@ -154,7 +163,7 @@ pub fn closest_core(
 
     // The merge: fin (the cycle after a leaf's last triangle: the accumulator is final), M1
     // (the leaf's best and the slot's, read at fin's address one clock before), M2 (the
-    // compare's result: write the slot's best, report the merge).
+    // compare's result: report the merge), M3 (write the slot's best).
     let fin = b.valid_delay("fin", (valid & last).name("leaf_last"));
     let fin_slot = b.delay("fin_slot", slot);
     let fin_sp = b.delay("fin_sp", sp);
@@ -168,34 +177,41 @@ pub fn closest_core(
     let m1_has = b.delay("m1_slot_has", slot_bit_2(&b, "fin_has", best_valid, k, slot, fin_slot));
     let m1_empty = b.delay("m1_leaf_empty", acc_empty);
     let m1_tt = b.delay("m1_t_tri", b.cat(&[acc_t, acc_tri]));
-    let m1_uv = b.delay("m1_u_v", b.cat(&[acc_u, acc_v]));
+    let m1_uv = b.delay("m1_u_v", acc_uv_now);
     // The leaf's best replaces the slot's when (¬leaf hit, 0, leaf t, tri) < (0, ¬slot hit,
     // slot t, tri): the chain compares (¬leaf hit, leaf t, tri) < (0, slot t, tri), and a
-    // leaf hit into a slot without one is better whatever the chain says. The slot's has-best
-    // bit enters after the chain, from a copy of its own (its one register, between the
-    // select's group registers and the compare, was the default core's slowest path at seed
-    // 1: 7.55 ns into `best_we`).
-    let m1_has_we = b.copies(m1_has, 1)[0];
+    // leaf hit into a slot without one is better whatever the chain says. Both parts are
+    // registered apart (M2) and ORed there, and the best RAMs are written a clock later (M3):
+    // the chain, the OR and the AND into the write enable in one clock were the default core's
+    // slowest path at seed 1 (8.27 ns, 38 cells). The merge is reported from M2 as before; the
+    // slot's best is read again only after its ray has been unparked, many clocks later.
     let tt_less = lt_chain(b.cat(&[m1_empty, m1_tt]), b.cat(&[zero, st_tt])).name("leaf_tt_less");
-    let better = (tt_less | (!m1_has_we & !m1_empty)).name("leaf_better");
     let m2 = b.valid_delay("m2", m1);
-    let m2_better = b.delay("m2_better", better);
+    let m2_less = b.delay("m2_tt_less", tt_less);
+    let m2_first_hit = b.delay("m2_first_hit", (!m1_has & !m1_empty).name("m1_first_hit"));
+    let m2_better = (m2_less | m2_first_hit).name("leaf_better");
     let m2_hit = b.delay("m2_hit", (m1_has | !m1_empty).name("m1_hit"));
     let m2_slot = b.delay("m2_slot", m1_slot);
     let m2_sp = b.delay("m2_sp", m1_sp);
     let m2_tt = b.delay("m2_t_tri", m1_tt);
     let m2_uv = b.delay("m2_u_v", m1_uv);
-    let m2_slot_t = b.delay("m2_slot_t", st_tt.slice(tri.width(), t.width()));
-    // The write enable is one register of its own (not m2 ∧ m2_better after them): it fans
-    // out to every LUT-RAM cell of both best RAMs, spread over the die, and the AND's LUT
-    // placed between them cost three placement seeds of the four-unit core 10.8–14.2 ns.
-    let we = b.valid_delay("best_we", (m1 & better).name("m1_we"));
+    // Both cull limits (best t + 8) are made in M1 and the better picked in M2, so the OR is
+    // followed by a select rather than an adder.
+    let (tt_t, t_bits) = (tri.width(), t.width());
+    let leaf_limit = m1_tt.slice(tt_t, t_bits).xsigned().resize(dist) + 8;
+    let slot_limit = st_tt.slice(tt_t, t_bits).xsigned().resize(dist) + 8;
+    let m2_leaf_limit = b.delay("m2_leaf_limit", leaf_limit.name("leaf_limit"));
+    let m2_slot_limit = b.delay("m2_slot_limit", slot_limit.name("slot_limit"));
+    // The write enable is one register of its own (not m3 ∧ better after them): it fans out
+    // to every LUT-RAM cell of both best RAMs, spread over the die, and the AND's LUT placed
+    // between them cost three placement seeds of the four-unit core 10.8–14.2 ns.
+    let we = b.valid_delay("best_we", (m2 & m2_better).name("m2_we"));
     // The write address fans out to every LUT-RAM cell of both best RAMs: a register each.
-    let m2_slots = b.copies(m2_slot, 2);
-    b.ram_write(tt_mem, we, m2_slots[0], m2_tt);
-    b.ram_write(uv_mem, we, m2_slots[1], m2_uv);
-    let best_t = m2_better.select(m2_tt.slice(tri.width(), t.width()), m2_slot_t).name("merged_t");
-    let limit = (best_t.xsigned().resize(dist) + 8).name("merged_limit");
+    let m3_slot = b.delay("m3_slot", m2_slot);
+    let m3_slots = b.copies(m3_slot, 2);
+    b.ram_write(tt_mem, we, m3_slots[0], b.delay("m3_t_tri", m2_tt));
+    b.ram_write(uv_mem, we, m3_slots[1], b.delay("m3_u_v", m2_uv));
+    let limit = m2_better.select(m2_leaf_limit, m2_slot_limit).name("merged_limit");
     // The merge reaches each traversal unit through registers of its own (valid, slot in the
     // unit, hit): one shared set drove both units' cull-limit LUT-RAM write enables through
     // the unit decode and an AND, across the die (12.1 ns at a seed of the external core).
@@ -235,7 +251,7 @@ pub fn closest_core(
     // The slots' one-hot words are decoded a stage early into registers: the set and the clear
     // then reach the k has-best bits through one LUT (with four units the set's decode after
     // `m2_better` was the slowest path of a placement seed: 90.7 MHz).
-    let set = we.select(b.delay("m2_onehot", super::onehot(m1_slot, k)), none).name("best_set");
+    let set = we.select(b.delay("m3_onehot", super::onehot(m2_slot, k)), none).name("best_set");
     let clear = d1.select(b.delay("d1_onehot", super::onehot(d0_slot, k)), none).name("best_clear");
     b.next(best_valid, (best_valid & !clear) | set);
     b.output("free_valid", b.valid_delay("free_valid_r", d1));

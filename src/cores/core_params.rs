@@ -6,6 +6,7 @@ use super::closest::TagLayout;
 use super::intersect::IntersectParams;
 use super::memory_params::{ExternalMemory, MemorySpec};
 use super::traverse::TraverseParams;
+use super::wide_ram::group_widths;
 use crate::model::golden::GridRay;
 use crate::rtl::Ty;
 use crate::rtl::width::MAX_WIDTH;
@@ -120,6 +121,13 @@ impl CoreParams {
     /// Whether global slot number `slot` is one of lane `lane`'s (its top bits are the lane).
     pub fn in_lane<'b>(&self, slot: crate::rtl::build::S<'b>, lane: u32) -> crate::rtl::build::S<'b> {
         slot.slice(self.lane_slot_bits(), self.lane_bits()).eq(lane as i128)
+    }
+    /// LUT-RAM groups of a lane's ray RAMs (`wide_ram`), the origins' and the directions':
+    /// each is written from a write enable and an address register of its own.
+    pub fn ray_ram_groups(&self) -> usize {
+        let (n, m) = (self.isect.n, self.isect.m);
+        let w = if 3 * m <= MAX_WIDTH { group_widths(3 * m).len() } else { 3 * group_widths(m).len() };
+        group_widths(3 * n).len() + w
     }
     /// Traversal units per lane.
     pub fn lane_units(&self) -> u32 {
@@ -248,19 +256,20 @@ impl CoreParams {
             + self.stack_bits()
     }
 
-    /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM (each ROM rounded up
-    /// to a power-of-two depth, as the printers emit it).
+    /// Rejects a scene whose ROMs do not fit `bram_kbits` of block RAM: every copy the units
+    /// and pipelines read, each rounded up to a power-of-two depth as the printers emit it
+    /// (`bram_bits`, as `--device` counts them).
     pub fn check_device(&self, scene: &SceneRoms, bram_kbits: u64) -> crate::error::Result<()> {
         let stack = self.stack_bits();
         if let Some(m) = &self.mem {
             return m.check_device(self.units, self.total_slots(), stack, bram_kbits);
         }
-        let total = scene.rom_bits() + stack;
+        let total = self.bram_bits(scene);
         if total > bram_kbits * 1024 {
             return Err(crate::error::Error::param(
                 "bram-kbits",
                 format!(
-                    "scene {} needs {} Kb of ROM and stacks, more than the {bram_kbits} Kb of block RAM allowed \
+                    "scene {} needs {} Kb of ROM copies and stacks, more than the {bram_kbits} Kb of block RAM allowed \
                      (the XC5VLX110T has 5328): use a smaller scene, a smaller --n/--m, fewer --slots/--units, \
                      or raise --bram-kbits for a larger device",
                     scene.name,
@@ -310,4 +319,30 @@ pub fn ray_inputs(id: u64, ray: &GridRay) -> Vec<i128> {
     v.extend(ray.w.iter().map(|&x| x as i128));
     v.extend(ray.inv.iter().copied());
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+    use crate::scene::{Scene, SceneSource};
+
+    /// The block RAM check counts every ROM copy, as `--device` does: four units read two node
+    /// ROMs, so an allowance that two units fit in refuses four, naming `--bram-kbits`; four
+    /// pipelines copy the leaf and triangle ROMs too.
+    #[test]
+    fn the_block_ram_check_counts_every_rom_copy() {
+        let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let shape = |units, pipelines| CoreParams::shaped(&roms, &CoreSpec { units, pipelines, ..CoreSpec::default() });
+        let (two, four, four_p4) = (shape(2, 1), shape(4, 1), shape(4, 4));
+        let node_bits = four.bram_bits(&roms) - two.bram_bits(&roms) - (four.stack_bits() - two.stack_bits());
+        assert!(node_bits > 0 && four_p4.bram_bits(&roms) > four.bram_bits(&roms));
+        let allowed = two.bram_bits(&roms).div_ceil(1024);
+        two.check_device(&roms, allowed).unwrap();
+        let e = four.check_device(&roms, allowed).unwrap_err().to_string();
+        assert!(e.contains("bram-kbits"), "{e}");
+        four.check_device(&roms, four.bram_bits(&roms).div_ceil(1024)).unwrap();
+        assert!(four_p4.check_device(&roms, four.bram_bits(&roms).div_ceil(1024)).is_err());
+    }
 }

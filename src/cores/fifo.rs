@@ -13,6 +13,7 @@
 //! written, which a read-first RAM answers with the old word, so it comes from a copy of the
 //! pushed word instead (`bypass`).
 
+use super::wide_ram::{WideRam, address_registers};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 
@@ -98,16 +99,21 @@ fn queue<'b>(
         .map(|(k, &din)| {
             let word = |what: &str| if one { format!("{name}_{what}") } else { format!("{name}_{what}{k}") };
             let din = b.delay(&word("din"), din);
-            let mem = b.ram(&word("mem"), din.width(), vec![0; depth as usize]);
-            b.ram_write(mem, push, wr, din);
             // Both words the head may be next are read (two read ports, from registers); the
             // pop only picks one after the RAM. A read at `rd_next` put the pop's logic, the
             // address's fan-out and the LUT-RAM read on one path: the slowest of the queues.
+            // The RAM is cut into groups of columns, each read at copies of the pointers of its
+            // own (`wide_ram`).
             let q = if let Some(popped) = popped {
-                let q_stay = b.read(&word("q_stay"), mem, rd);
-                let q_next = b.read(&word("q_next"), mem, rd1);
+                let ram = WideRam::new(b, &word("mem"), din.width(), depth as usize);
+                ram.write(b, &[push], &[wr], din);
+                let (rds, rd1s) = (address_registers(b, rd, ram.groups()), address_registers(b, rd1, ram.groups()));
+                let q_stay = ram.read(b, &word("q_stay"), &rds);
+                let q_next = ram.read(b, &word("q_next"), &rd1s);
                 popped.select(q_next, q_stay)
             } else {
+                let mem = b.ram(&word("mem"), din.width(), vec![0; depth as usize]);
+                b.ram_write(mem, push, wr, din);
                 b.read(&word("q"), mem, rd_next)
             };
             let din_r = b.reg(&word("din_r"), din.ty(), None);
@@ -131,7 +137,7 @@ mod tests {
         for (depth, two_reads) in [(2u32, true), (4, true), (16, true), (4, false), (16, false)] {
             let b = Builder::new("t");
             let push = b.input("push", Ty::BIT);
-            let din = b.input("din", Ty::u(8));
+            let din = b.input("din", Ty::u(40));
             let pop = b.input("pop", Ty::BIT);
             let (heads, nonempty) = queue(&b, "q", depth, push, &[din], pop, two_reads);
             b.output("head", heads[0]);
@@ -150,7 +156,7 @@ mod tests {
                 x ^= x << 5;
                 assert_eq!(sim.get(out("nonempty")) == 1, !model.is_empty(), "depth {depth} cycle {cycle}");
                 if let Some(&v) = model.front() {
-                    assert_eq!(sim.get(out("head")), v as i128, "depth {depth} cycle {cycle}");
+                    assert_eq!(sim.get(out("head")), v, "depth {depth} cycle {cycle}");
                 }
                 let do_pop = !model.is_empty() && x & 3 != 0;
                 let do_push = model.len() + in_flight.len() - (do_pop as usize) < depth as usize && x & 12 != 0;
@@ -159,11 +165,13 @@ mod tests {
                 }
                 // A push reaches the queue a clock later.
                 model.extend(in_flight.drain(..));
+                // Entries of 40 bits, so the RAM is three groups of columns (`wide_ram`).
+                let entry = (pushed as i128 * 0x9e37_79b9_7f) & ((1 << 40) - 1);
                 if do_push {
-                    in_flight.push(pushed & 255);
+                    in_flight.push(entry);
                 }
                 sim.set(h(0), do_push as i128);
-                sim.set(h(1), (pushed & 255) as i128);
+                sim.set(h(1), entry);
                 sim.set(h(2), do_pop as i128);
                 pushed += do_push as u32;
                 sim.tick();

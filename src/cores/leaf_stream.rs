@@ -7,6 +7,7 @@ use super::core_params::{CoreParams, tri_rom_groups};
 use super::intersect::intersect_core;
 use super::ray_port::RayPort;
 use super::traverse::{field, word_bits};
+use super::wide_ram::{WideRam, address_registers};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, Ports, S};
 use crate::rtl::width::MAX_WIDTH;
@@ -18,35 +19,62 @@ use std::rc::Rc;
 /// written at the accept of a ray into one of the lane's slots: the origin RAM and the
 /// direction RAMs.
 pub struct RayRams {
-    pub o: usize,
+    pub o: WideRam,
     /// One RAM of three directions while they fit a signal (m ≤ 42), else one per axis.
-    pub w: Vec<usize>,
+    pub w: Vec<WideRam>,
+}
+
+impl RayRams {
+    /// How many read-address registers the emission's reads take: one per group of columns
+    /// (`wide_ram`), 12 on the default core.
+    pub fn read_groups(&self) -> usize {
+        self.o.groups() + self.w.iter().map(WideRam::groups).sum::<usize>()
+    }
 }
 
 pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> RayRams {
     let (slots, n, lsb) = ((p.total_slots() >> p.lane_bits()) as usize, p.isect.n, p.lane_slot_bits());
-    let (accept, gslot) = match p.lane_bits() {
-        0 => (port.accept, port.ram_slot),
-        _ => {
-            let mine = p.in_lane(port.ram_slot, lane);
-            ((port.accept & mine).name(&p.lane_name(lane, "ray_we")), port.ram_slot.slice(0, lsb))
-        }
+    // This lane's write enables and addresses, a register pair per group of columns.
+    let groups = p.ray_ram_groups();
+    let (wes, gslots) =
+        (&port.ram_we[lane as usize * groups..][..groups], &port.ram_slots[lane as usize * groups..][..groups]);
+    let (accept, gslot): (Vec<S>, Vec<S>) = match p.lane_bits() {
+        0 => (wes.to_vec(), gslots.to_vec()),
+        _ => wes
+            .iter()
+            .zip(gslots)
+            .enumerate()
+            .map(|(g, (&we, &slot))| {
+                let mine = p.in_lane(slot, lane);
+                ((we & mine).name(&p.lane_name(lane, &format!("ray_we{g}"))), slot.slice(0, lsb))
+            })
+            .unzip(),
+    };
+    // Group k of the origins' RAM, then the directions' RAMs' groups in turn.
+    let mut next = 0;
+    let mut take = |count: usize| -> (Vec<S>, Vec<S>) {
+        let run = (accept[next..next + count].to_vec(), gslot[next..next + count].to_vec());
+        next += count;
+        run
     };
     let name = |x: &str| p.lane_name(lane, x);
     let [ox, oy, oz] = port.o;
     let [wx, wy, wz] = port.w;
-    let o = b.ram(&name("ray_o"), 3 * n, vec![0; slots]);
-    b.ram_write(o, accept, gslot, b.cat(&[oz, oy, ox]));
+    let o = WideRam::new(b, &name("ray_o"), 3 * n, slots);
+    let (we, at) = take(o.groups());
+    o.write(b, &we, &at, b.cat(&[oz, oy, ox]));
     let w = if 3 * p.isect.m <= MAX_WIDTH {
-        let mem = b.ram(&name("ray_w"), 3 * p.isect.m, vec![0; slots]);
-        b.ram_write(mem, accept, gslot, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
+        let mem = WideRam::new(b, &name("ray_w"), 3 * p.isect.m, slots);
+        let (we, at) = take(mem.groups());
+        mem.write(b, &we, &at, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
         vec![mem]
     } else {
         [("x", wx), ("y", wy), ("z", wz)]
             .into_iter()
             .map(|(axis, w)| {
-                let mem = b.ram(&name(&format!("ray_w{axis}")), p.isect.m, vec![0; slots]);
-                b.ram_write(mem, accept, gslot, w.unsigned());
+                let mem = WideRam::new(b, &name(&format!("ray_w{axis}")), p.isect.m, slots);
+                let (we, at) = take(mem.groups());
+                mem.write(b, &we, &at, w.unsigned());
                 mem
             })
             .collect()
@@ -292,7 +320,7 @@ pub fn emission<'b>(
         // address from a register per ray RAM (the tag's slot bits fanned out to all of them).
         let slot = if lrc > 1 { b.delay_line(&nm("emit_slot_sr"), leaf.slot, lrc - 1) } else { leaf.slot };
         let emit_slot = b.delay(&nm("emit_slot"), slot);
-        let emit_slots = b.copies(emit_slot, 1 + rams.w.len());
+        let emit_slots = address_registers(b, emit_slot, rams.read_groups());
         into_pipeline(b, p, (lane as u32, rams), &emit_slots, trc, [valid_d, tag_d], tri_fields)
     })
     .collect()
@@ -313,16 +341,24 @@ pub fn into_pipeline<'b>(
     tri_fields: Vec<S<'b>>,
 ) -> Emission<'b> {
     let (n, m) = (p.isect.n, p.isect.m);
-    let addr = |k: usize| slot[k % slot.len()];
+    // The address registers, a run of them for each RAM's groups in turn (wrapping around
+    // when there are fewer).
+    let mut next = 0;
+    let mut addrs = |groups: usize| -> Vec<S<'b>> {
+        let run = (next..next + groups).map(|k| slot[k % slot.len()]).collect();
+        next += groups;
+        run
+    };
     let nm = |x: &str| p.lane_name(lane, x);
-    let o_word = b.delay_line(&nm("pipe_o"), b.read(&nm("ray_o_q"), rams.o, addr(0)), clocks - 1);
+    let o_word = rams.o.read(b, &nm("ray_o_q"), &addrs(rams.o.groups()));
+    let o_word = b.delay_line(&nm("pipe_o"), o_word, clocks - 1);
     let w_words: Vec<S> = rams
         .w
         .iter()
         .enumerate()
-        .map(|(k, &mem)| {
+        .map(|(k, mem)| {
             let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
-            let q = b.read(&nm(&format!("ray_w{suffix}_q")), mem, addr(k + 1));
+            let q = mem.read(b, &nm(&format!("ray_w{suffix}_q")), &addrs(mem.groups()));
             b.delay_line(&nm(&format!("pipe_w{suffix}")), q, clocks - 1)
         })
         .collect();

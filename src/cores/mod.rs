@@ -28,6 +28,7 @@ mod traverse_decide;
 mod traverse_retry;
 mod traverse_stages;
 pub mod tri_fetch;
+pub mod wide_ram;
 
 use crate::rtl::build::S;
 

@@ -31,12 +31,14 @@ pub struct RayPort<'b> {
     /// A clock after the take: the ray written into its slot (`slot` global), its id, origin,
     /// direction and reciprocal direction. The slot is also in registers of their own for the
     /// write addresses of the RAMs it reaches (a LUT-RAM slice per 4 bits and 16 slots each,
-    /// 888 sinks a bit from one register on the teapot-fine core): `ram_slot` the leaf
-    /// stream's ray RAMs, `closest_slot` the closest-hit unit's, `unit_slot[u]` unit u's
-    /// (within the unit).
+    /// 888 sinks a bit from one register on the teapot-fine core): `ram_slots` the leaf
+    /// streams' ray RAMs (lane by lane, a register per group of columns, `wide_ram`, with
+    /// `ram_we` the write enables alike), `closest_slot` the closest-hit unit's,
+    /// `unit_slot[u]` unit u's (within the unit).
     pub accept: S<'b>,
     pub slot: S<'b>,
-    pub ram_slot: S<'b>,
+    pub ram_we: Vec<S<'b>>,
+    pub ram_slots: Vec<S<'b>>,
     pub closest_slot: S<'b>,
     pub unit_slot: Vec<S<'b>>,
     pub id: S<'b>,
@@ -92,7 +94,12 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
     // clocks after the take.
     let in_valid = b.reg("in_valid", bit, Some(0));
     let port_empty = b.reg("port_empty", bit, Some(1));
-    let take = (in_valid & phase.eq(0) & turn_free).name("take");
+    // Whether the box-exit unit is idle (phase 0), as registers of its own: one for the take,
+    // one for the box-exit operands' ~180 load enables. The phase register drove both, so it
+    // sat among the operands, and the take's path from it to `port_empty` was the default
+    // core's third slowest at seed 1 (8.01 ns, 4 cells).
+    let idle = b.reg("box_idle", bit, Some(1));
+    let take = (in_valid & idle & turn_free).name("take");
     let in_valid_next = (port_empty & ray_valid) | (in_valid & !take);
     b.next(in_valid, in_valid_next);
     b.next(port_empty, !in_valid_next);
@@ -121,12 +128,14 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
             b.case(turn_next, &(0..units).map(pick).collect::<Vec<_>>(), b.konst(bit, 0))
         },
     );
-    b.next(phase, (take | phase.ne(0)).select(phase + 1, phase));
+    let phase_next = (take | phase.ne(0)).select(phase + 1, phase).name("box_phase_next");
+    b.next(phase, phase_next);
+    b.next(idle, phase_next.eq(0).name("box_idle_next"));
+    let idle_load = b.copies(idle, 1)[0];
     // The box-exit unit's operands load whenever it is idle: when a ray is taken they hold it.
-    let idle = phase.eq(0).name("box_idle");
     let box_reg = |s: S<'b>| {
         let r = b.reg(&format!("box_{}", b.name_of(s.sig)), s.ty(), None);
-        b.next_when(r, idle, s);
+        b.next_when(r, idle_load, s);
         r
     };
     let box_o = [ox, oy, oz].map(box_reg);
@@ -141,7 +150,11 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
     // visit-order test fails then.)
     let accept = b.valid_delay("accept", take);
     let gslot = b.delay("accept_slot", take_slot);
-    let copies = b.copies(gslot, 2 + units as usize);
+    // One write enable fanned out to all the ray RAMs' cells was a slowest path at seed 2
+    // (`accept` → `ray_w`, 7.82 ns, eight such).
+    let ram_groups = p.ray_ram_groups() * p.pipelines as usize;
+    let ram_we = super::wide_ram::address_registers(b, accept, ram_groups);
+    let copies = b.copies(gslot, ram_groups + 1 + units as usize);
     let [id, ox, oy, oz, wx, wy, wz, ix, iy, iz] =
         [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(|s| b.delay(&format!("acc_{}", b.name_of(s.sig)), s));
     RayPort {
@@ -153,9 +166,10 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
         box_inv,
         accept,
         slot: gslot,
-        ram_slot: copies[0],
-        closest_slot: copies[1],
-        unit_slot: copies[2..].iter().map(|c| c.slice(0, sb)).collect(),
+        ram_we,
+        ram_slots: copies[..ram_groups].to_vec(),
+        closest_slot: copies[ram_groups],
+        unit_slot: copies[ram_groups + 1..].iter().map(|c| c.slice(0, sb)).collect(),
         id,
         o: [ox, oy, oz],
         w: [wx, wy, wz],

@@ -65,10 +65,10 @@ pub fn traverse_core(p: &TraverseParams) -> Module {
     // The top's pops arrive a clock late (registered here: the top's arbiter sits across the
     // die), so it does not take from a queue again in the clock after it took.
     let done = fifo(&b, "done_q", u.sb, p.slots, a.done, a.slot, b.valid_delay("done_pop_r", u.inp.done_pop));
-    let (c, [culled_first, culled], lookup) = u.ring_c(bt, b_from_stack, a.stack_top, &a);
+    let (c, [culled_first, culled], lookup) = u.ring_c(bt, b_from_stack, a.stack_top, &q);
     let n = u.ring_n(c, culled, &q);
     let f = u.ring_f(&n);
-    u.ring_g(&f, &r, &a.push, q.ring_g_valid);
+    u.ring_g(&f, &r, &a, &q);
     b.end_stage();
     match lookup {
         // With a node cache: the lookup a clock after C.

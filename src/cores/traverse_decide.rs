@@ -3,7 +3,7 @@
 //! plane distances are compared by their roles; in G the decision pushes, enters or pops.
 
 use super::lt_chain;
-use super::traverse_stages::{Returning, RingF, RingN, Token, Unit};
+use super::traverse_stages::{Queued, Returning, RingA, RingF, RingN, Token, Unit};
 use crate::rtl::build::S;
 
 impl<'b> Unit<'b> {
@@ -73,10 +73,10 @@ impl<'b> Unit<'b> {
 
     /// G: the decision: push the far child (stack[slot][sp]) and enter the near one, enter one
     /// child, or pop. The token goes into R and is back at A in the next cycle.
-    pub(super) fn ring_g(&self, f: &RingF<'b>, r: &Returning<'b>, push: &[S<'b>; 3], ring_g_valid: S<'b>) {
-        let (b, g, node_bits) = (self.b, f.g, self.node_bits);
+    pub(super) fn ring_g(&self, f: &RingF<'b>, r: &Returning<'b>, a: &RingA<'b>, q: &Queued<'b>) {
+        let (b, g, node_bits, push) = (self.b, f.g, self.node_bits, &a.push);
         b.stage("ring_g", "G: the decision: push the far child and enter the near one, enter one, or pop");
-        b.drive(ring_g_valid, g.valid);
+        b.drive(q.ring_g_valid, g.valid);
         let child_b = g.node + 1;
         let near = f.negative.select(child_b, g.node).resize(node_bits).name("near");
         let far = f.negative.select(g.node, child_b).resize(node_bits).name("far");
@@ -86,18 +86,30 @@ impl<'b> Unit<'b> {
             ((f.inner & f.go_near).name("enter_near"), (f.inner & !f.go_near & f.go_far).name("enter_far"));
         let push_now = (enter_near & f.go_far).name("push");
         let stack_bits = self.stack_bits;
-        b.drive(push[0], push_now);
-        b.drive(push[1], b.cat(&[g.slot, g.sp.resize(stack_bits)]));
-        b.drive(push[2], b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()]));
+        // The push is written a clock later, from registers (the far child's select and
+        // increment into the block RAM's data pins was the slowest path at seed 3 of the
+        // default core: `g_child`, 7.72 ns). Safe: the entry is read only by its slot's pop, a
+        // ring pass later at the earliest (the token pushing enters its near child in A).
+        b.drive(push[0], b.valid_delay("stack_we_r", push_now));
+        b.drive(push[1], b.delay("stack_waddr_r", b.cat(&[g.slot, g.sp.resize(stack_bits)])));
+        b.drive(push[2], b.delay("stack_wdata_r", b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()])));
         let rt = r.token;
         b.next(rt.valid, g.valid);
-        b.next(r.pop, !(enter_near | enter_far));
+        let pop = (!(enter_near | enter_far)).name("g_pop");
+        b.next(r.pop, pop);
         b.next(rt.slot, g.slot);
         b.next(rt.node, enter_near.select(near, far));
         b.next(rt.tmin, enter_far.select(far_min, g.tmin));
         b.next(rt.tmax, enter_near.select(near_max, g.tmax));
         b.next(rt.sp, push_now.select(g.sp + 1, g.sp));
-        b.next(r.sp_zero, !push_now & g.sp.eq(0));
-        b.next(r.sp_m1, push_now.select(g.sp, g.sp - 1));
+        let sp_zero = g.sp.eq(0).name("g_sp_zero");
+        b.next(r.sp_zero, !push_now & sp_zero);
+        let sp_m1 = push_now.select(g.sp, g.sp - 1).name("g_sp_m1");
+        b.next(r.sp_m1, sp_m1);
+        b.next(r.done, (pop & sp_zero).name("g_done"));
+        // The stack read address of the token in A next clock: the returning one's, else the
+        // queued one's (E takes one exactly when G's token does not return).
+        let returning = b.cat(&[g.slot, sp_m1.resize(stack_bits)]);
+        b.next(a.raddr, g.valid.select(returning, q.raddr_next).name("stack_raddr_next"));
     }
 }

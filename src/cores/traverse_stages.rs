@@ -220,13 +220,14 @@ pub(super) struct Unit<'b> {
 pub(super) struct RingA<'b> {
     pub(super) valid: S<'b>,
     pub(super) slot: S<'b>,
-    pub(super) new: S<'b>,
     pub(super) sp: S<'b>,
     pub(super) sp_m1: S<'b>,
     pub(super) done: S<'b>,
     pub(super) from_stack: S<'b>,
-    /// The stack word (two clocks after A) and its write port (driven in G).
+    /// The stack word (two clocks after A), its read address register (loaded in G) and its
+    /// write port (driven in G).
     pub(super) stack_top: S<'b>,
+    pub(super) raddr: S<'b>,
     pub(super) push: [S<'b>; 3],
 }
 
@@ -240,7 +241,11 @@ pub(super) struct Queued<'b> {
     pub(super) sp_zero: S<'b>,
     pub(super) sp_m1: S<'b>,
     pub(super) tmax: S<'b>,
-    pub(super) miss: S<'b>,
+    /// The token taken will be done in A (a new ray that misses the box, an unparked ray with
+    /// an empty stack): a register.
+    pub(super) done: S<'b>,
+    /// The taken token's stack read address, before A's register (`RingA::raddr`).
+    pub(super) raddr_next: S<'b>,
     /// With a node cache: the queued token is a node step that missed, back from the retry
     /// queue with its node and tmin (tmax and sp come in `tmax`, `sp`).
     pub(super) retry: Option<Retried<'b>>,
@@ -263,6 +268,8 @@ pub(super) struct Returning<'b> {
     pub(super) pop: S<'b>,
     pub(super) sp_zero: S<'b>,
     pub(super) sp_m1: S<'b>,
+    /// A pop of an empty stack: the token is done in A.
+    pub(super) done: S<'b>,
 }
 
 /// N: the token with its node word.
@@ -416,14 +423,22 @@ impl<'b> Unit<'b> {
             None => queued,
         };
         let queued_slot = take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb));
-        let slot = b.delay("q_slot", or_retried(|r| r.slot, queued_slot));
+        let slot_next = or_retried(|r| r.slot, queued_slot);
+        let slot = b.delay("q_slot", slot_next);
         // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
         let head_sp = or_retried(|r| r.sp, unpark.head.slice(0, spw));
         let sp = b.delay("q_sp", head_sp);
         let sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
-        let sp_m1 = b.delay("q_sp_m1", head_sp - 1);
+        let sp_m1_next = head_sp - 1;
+        let sp_m1 = b.delay("q_sp_m1", sp_m1_next);
+        let raddr_next = b.cat(&[slot_next, sp_m1_next.resize(self.stack_bits)]).name("q_stack_raddr");
+        // Whether the token taken is done in A, decided here: from `q_new`, `q_miss` and the
+        // stack pointer's bits in A, the done and live bits were the slowest paths of a
+        // traversal unit at seed 2 of the default core (8.29 ns into `b_valid`).
+        let unpark_empty = unpark.head.slice(0, spw).eq(0);
+        let done_c = ((take_new & newq.head.bit(0)) | (take_unpark & unpark_empty)).name("q_done_c");
+        let done = b.delay("q_done", done_c);
         let tmax = b.delay("q_tmax", or_retried(|r| r.tmax, newq.head.slice(1, dist.width).signed()));
-        let miss = b.delay("q_miss", newq.head.bit(0));
         let retry = retried.map(|(take, r)| Retried {
             valid: b.delay("q_retry", take),
             node: b.delay("q_node", r.node),
@@ -431,7 +446,7 @@ impl<'b> Unit<'b> {
             push: r.push,
             entry: r.entry,
         });
-        Queued { ring_g_valid, valid, new, slot, sp, sp_zero, sp_m1, tmax, miss, retry }
+        Queued { ring_g_valid, valid, new, slot, sp, sp_zero, sp_m1, tmax, done, raddr_next, retry }
     }
 
     pub(super) fn returning(&self) -> Returning<'b> {
@@ -441,6 +456,7 @@ impl<'b> Unit<'b> {
         let pop = b.reg("r_pop", Ty::BIT, None);
         let sp_zero = b.reg("r_sp_zero", Ty::BIT, None);
         let sp_m1 = b.reg("r_sp_m1", Ty::u(spw), None);
+        let done = b.reg("r_done", Ty::BIT, None);
         let token = Token {
             valid,
             slot: b.reg("r_slot", Ty::u(self.sb), None),
@@ -449,7 +465,7 @@ impl<'b> Unit<'b> {
             tmax: b.reg("r_tmax", dist, None),
             sp: b.reg("r_sp", Ty::u(spw), None),
         };
-        Returning { token, pop, sp_zero, sp_m1 }
+        Returning { token, pop, sp_zero, sp_m1, done }
     }
 
     /// A: the returning token, else a queued ray; a pop of an empty stack or a ray that misses
@@ -460,7 +476,6 @@ impl<'b> Unit<'b> {
         let rv = r.token.valid;
         let valid = (rv | q.valid).name("a_valid");
         let slot = rv.select(r.token.slot, q.slot).name("a_slot");
-        let new = (!rv & q.new).name("a_new");
         let not_popped = match q.retry {
             Some(t) => !(q.new | t.valid),
             None => !q.new,
@@ -469,7 +484,9 @@ impl<'b> Unit<'b> {
         let sp = rv.select(r.token.sp, q.new.select(q.sp.k(0), q.sp)).name("a_sp");
         let sp_zero = rv.select(r.sp_zero, q.new | q.sp_zero).name("a_sp_zero");
         let sp_m1 = rv.select(r.sp_m1, q.sp_m1).name("a_sp_m1");
-        let done = (valid & ((pop & sp_zero) | (new & q.miss))).name("a_done");
+        // Done: a pop of an empty stack or a new ray that misses the box (both decided a clock
+        // before, in G and E).
+        let done = ((rv & r.done) | (!rv & q.valid & q.done)).name("a_done");
         let from_stack = (pop & !sp_zero).name("a_from_stack");
         let stack_bits = self.stack_bits;
         // The stack: a block RAM read in two clocks (`brom::bram`), written in G.
@@ -479,13 +496,16 @@ impl<'b> Unit<'b> {
             b.wire("stack_waddr", Ty::u(sb + stack_bits)),
             b.wire("stack_wdata", Ty::u(stack_w)),
         ];
-        let raddr = b.cat(&[slot, sp_m1.resize(stack_bits)]).name("stack_raddr");
+        // The read address (slot, sp − 1) of A's token, loaded a clock before by G or E
+        // (`ring_g`): selected in A, the returning token's valid bit fanned out to the address
+        // pins was a slowest path of a traversal unit at seed 2 (7.57 ns).
+        let raddr = b.reg("stack_raddr", Ty::u(sb + stack_bits), None);
         // One stack of 2^stack_bits words per slot number the address can hold: a slot number has
         // at least one bit, so one slot still takes two stacks' worth of address space.
         let words = (k.max(2) as usize) << stack_bits;
         let stack_top =
             bram(b, "u_stack", &format!("stack_w{stack_w}"), stack_w, words, push[0], push[1], push[2], raddr);
-        RingA { valid, slot, new, sp, sp_m1, done, from_stack, stack_top, push }
+        RingA { valid, slot, sp, sp_m1, done, from_stack, stack_top, raddr, push }
     }
 
     /// A queued token's field: the retried step's (`field`) or `otherwise` (a new or unparked
@@ -524,7 +544,7 @@ impl<'b> Unit<'b> {
         bt: Token<'b>,
         from_stack: S<'b>,
         top: S<'b>,
-        a: &RingA<'b>,
+        q: &Queued<'b>,
     ) -> (Token<'b>, [S<'b>; 2], Option<[S<'b>; 2]>) {
         let (b, k, dist, inp) = (self.b, self.p.slots, self.dist, &self.inp);
         b.stage("ring_c", "C: a popped entry from the stack word; the node ROM addressed; the cull test");
@@ -560,8 +580,11 @@ impl<'b> Unit<'b> {
         // A new ray's bit is cleared a clock after A, from a register (the decode of A's slot
         // behind A's selects, into the k bits, was 7.5 ns at seed 1 of the default core): it
         // is read first at C, two clocks after A, and no merge for a slot comes while its
-        // new ray is in A (the slot's previous ray was done after its last merge).
-        let clear_best = b.delay("best_clear", onehot_or_0(a.new & a.valid, a.slot).name("best_clear_c"));
+        // new ray is in A (the slot's previous ray was done after its last merge). A new ray
+        // in A is always the queued token (E takes one only when no token returns), so the
+        // decode is of the queue's registers, not of A's select by `r_valid` (8.59 ns into
+        // `best_clear` at seed 2).
+        let clear_best = b.delay("best_clear", onehot_or_0(q.new, q.slot).name("best_clear_c"));
         b.next(has_best, (has_best & !clear_best) | set_best);
         (c, [culled_first, culled], lookup)
     }

@@ -23,6 +23,7 @@ use super::core_params::CoreParams;
 use super::fifo::{fifo, unpack};
 use super::leaf_stream::{Emission, RayRams, into_pipeline, leaf_buffers};
 use super::memory_params::ExternalMemory;
+use super::wide_ram::address_registers;
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, Ports, S};
 use crate::scene::rom::Field;
@@ -208,8 +209,8 @@ pub fn tri_fetch<'b>(
     let tag = b.cat(&[tag, id.resize(tp.tri_bits)]).name("pipe_tag");
     let fields = l.tri.fields.iter().filter(|f| f.name != "id").map(|f| record_field(b, &parts, f)).collect();
     // The slot addresses the ray RAMs, ~180 LUT-RAM slices and their bank selects: a copy per
-    // RAM splits that fan-out (935 sinks a bit on the teapot-fine core).
-    let slot_copies = b.copies(e_slot, 1 + rams.w.len());
+    // group of columns splits that fan-out (935 sinks a bit on the teapot-fine core).
+    let slot_copies = address_registers(b, e_slot, rams.read_groups());
     let emitted = into_pipeline(b, p, (0, rams), &slot_copies, lat, [valid_d, tag], fields);
     let stall = b.delay("mem_stall", (!valid_d & retry.nonempty).name("mem_stall_c"));
     let observed = FetchObserved { looks: answer.valid, hits: looked_hit, stall };
