@@ -344,6 +344,22 @@ fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
     let ok = fxrt(&[&board[..], &["--device", "xc5vlx110t"]].concat());
     assert!(ok.status.success(), "{}", stderr(&ok));
     assert!(stderr(&ok).contains("chosen 1 units × 64 slots, 1 pipelines"), "{}", stderr(&ok));
+    // The core's manifest states the fit: the device, the shapes counted, the one chosen.
+    let plain = dir.path().join("plain");
+    let g = fxrt(&["gen", "--builtin", "cornell", "--device", "xc5vlx110t", "--out", plain.to_str().unwrap()]);
+    assert!(g.status.success(), "{}", stderr(&g));
+    let is_manifest =
+        |name: &str| name.starts_with("fxrt_core_") && name.ends_with(".json") && !name.ends_with("_axis.json");
+    let manifest = std::fs::read_dir(&plain)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|f| is_manifest(f.file_name().unwrap().to_str().unwrap()))
+        .expect("the core's manifest");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest).unwrap()).unwrap();
+    let fit = &doc["device_fit"];
+    assert_eq!((fit["device"].as_str(), fit["chosen"]["units"].as_u64()), (Some("xc5vlx110t"), Some(1)), "{fit}");
+    assert_eq!(doc["params"]["traversal_units"], 1, "{doc}");
+    assert!(fit["candidates"].as_array().is_some_and(|c| c.len() > 3), "{fit}");
     let other = dir.path().join("other");
     let sim = ["sim", "--builtin", "cornell", "--size", "4x4", "--device", "lfe5u-85f", "--units", "2"];
     assert_rejected(&sim, "--device", &other);

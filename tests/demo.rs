@@ -57,6 +57,18 @@ fn fxrt_alone_generates_the_core_simulates_a_frame_and_checks_every_pixel() {
     }
     assert_eq!(vhdl.last(), Some(&format!("{name}.vhd")));
     assert!(m["clock"]["measured_fmax_mhz"].as_f64().is_some_and(|f| f > 50.0), "{}", m["clock"]);
+    // The clock is the median of three placement seeds or more (issue 30), never one seed
+    // alone: the line says the seeds and the spread, the manifest every seed's clock.
+    assert!(out.contains("(nextpnr, median of seeds "), "{out}");
+    let clock = &m["clock"];
+    let seeds: Vec<f64> =
+        clock["measured_seeds"].as_array().unwrap().iter().map(|s| s["fmax_mhz"].as_f64().unwrap()).collect();
+    let median = clock["measured_fmax_mhz"].as_f64().unwrap();
+    assert!(seeds.len() >= 3 && seeds.contains(&median), "{clock}");
+    let (below, above) = (seeds.iter().filter(|&&f| f < median).count(), seeds.iter().filter(|&&f| f > median).count());
+    assert!(below <= seeds.len() / 2 && above <= seeds.len() / 2, "not the median: {clock}");
+    let lo = seeds.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert_eq!(clock["measured_fmax_min_mhz"].as_f64(), Some(lo), "{clock}");
 
     // GHDL analyses every VHDL file in the manifest's order; Verilator's lint is silent.
     let mut args = vec!["-a".to_string(), "--std=93c".into()];

@@ -273,7 +273,8 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
         None => None,
     };
     let mut files = OutputSet::new();
-    let written = generate::core_files(&p, &roms, &core, o, raygen.as_ref(), measured.as_ref());
+    let fit_json = fit.as_ref().map(|f| serde_json::to_value(f).expect("a fit serialises"));
+    let written = generate::core_files(&p, &roms, &core, o, raygen.as_ref(), measured.as_ref(), fit_json.as_ref());
     files.extend(written.into_iter().map(|(n, t)| (c.out.join(n), t)))?;
     super::placement::add_scene_image(&mut files, &c.out, &p, &roms)?;
     if let (Some(spec), Some(scene)) = (&c.axis_frame, &scene) {

@@ -70,6 +70,17 @@ pub struct GenOptions {
 /// What `fxrt synth --family ecp5` measured of the core (`--measured`): its module's entry.
 pub type Measured = Value;
 
+/// Each placement seed of a measured report with its clock, in the order run: `[{seed,
+/// fmax_mhz}]` (a one-seed report: that seed).
+fn seed_figures(m: &Measured) -> Value {
+    match m.get("seeds").and_then(Value::as_array) {
+        Some(seeds) => {
+            Value::Array(seeds.iter().map(|s| json!({ "seed": s["seed"], "fmax_mhz": s["fmax_mhz"] })).collect())
+        }
+        None => json!([{ "seed": m["seed"], "fmax_mhz": m["fmax_mhz"] }]),
+    }
+}
+
 #[derive(Template)]
 #[template(path = "ise_project.tcl", escape = "none")]
 struct IseProject<'a> {
@@ -162,6 +173,7 @@ pub fn core_files(
     o: GenOptions,
     raygen: Option<&RayGen>,
     measured: Option<&Measured>,
+    device_fit: Option<&Value>,
 ) -> Vec<(String, String)> {
     let top = match raygen {
         Some(g) => core_with_raygen(p, core, g),
@@ -235,12 +247,20 @@ pub fn core_files(
         "target_mhz": p.isect.target_mhz,
         "measured_fmax_mhz": pick("fmax_mhz"),
         "measured_on": measured.map(|_| json!({ "device": pick("device"), "package": pick("package"), "speed_grade": pick("speed_grade"), "seed": pick("seed"), "yosys": pick("yosys"), "nextpnr": pick("nextpnr"), "module": pick("module") })),
+        "measured_fmax_is": measured.map(|_| "the median over the placement seeds run (the lower middle one for an even count), never the best"),
+        "measured_seeds": measured.map(|m| seed_figures(m)),
+        "measured_fmax_min_mhz": pick("fmax_min_mhz"),
+        "measured_fmax_max_mhz": pick("fmax_max_mhz"),
     });
     doc["resources"] = measured.map_or(
         Value::Null,
         |_| json!({ "lut4": pick("lut4"), "ff": pick("ff"), "mult18": pick("mult18"), "dp16kd": pick("dp16kd") }),
     );
     doc["predicted"] = predicted(core);
+    // With `--device`: the shapes counted and run, and the one chosen (`sweep::fit`).
+    if let Some(fit) = device_fit {
+        doc["device_fit"] = fit.clone();
+    }
     doc["hashes"] = json!({
         "scene_sha256": roms.hash(),
         "scene_tag": p.trav.scene_tag,
