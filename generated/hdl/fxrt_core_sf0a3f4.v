@@ -25,11 +25,41 @@ module fxrt_core_sf0a3f4 (
   output wire [31:0] res_v
 );
 
-  (* ram_style = "distributed" *) reg [86:0] ray_o [0:127];
-  initial $readmemh("fxrt_core_sf0a3f4_ray_o.hex", ray_o);
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g0 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_o_g0.hex", ray_o_g0);
 
-  (* ram_style = "distributed" *) reg [95:0] ray_w [0:127];
-  initial $readmemh("fxrt_core_sf0a3f4_ray_w.hex", ray_w);
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g1 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_o_g1.hex", ray_o_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g2 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_o_g2.hex", ray_o_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g3 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_o_g3.hex", ray_o_g3);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g4 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_o_g4.hex", ray_o_g4);
+
+  (* ram_style = "distributed" *) reg [6:0] ray_o_g5 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_o_g5.hex", ray_o_g5);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_w_g0 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_w_g0.hex", ray_w_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_w_g1 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_w_g1.hex", ray_w_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_w_g2 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_w_g2.hex", ray_w_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_w_g3 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_w_g3.hex", ray_w_g3);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_w_g4 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_w_g4.hex", ray_w_g4);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_w_g5 [0:127];
+  initial $readmemh("fxrt_core_sf0a3f4_ray_w_g5.hex", ray_w_g5);
 
   (* ram_style = "distributed" *) reg [63:0] res_q_mem0 [0:15];
   initial $readmemh("fxrt_core_sf0a3f4_res_q_mem0.hex", res_q_mem0);
@@ -51,9 +81,7 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] turn_free = 1'h1;
   wire [5:0] case_turn;
   reg [0:0] in_valid = 1'h0;
-  wire [1:0] k_0 = 2'h0;
-  wire [0:0] box_phase_eq_k_0;
-  wire [0:0] and_0;
+  wire [0:0] in_valid_and_box_idle;
   wire [0:0] take;
   wire [0:0] port_empty_and_ray_valid;
   wire [0:0] not_take;
@@ -76,21 +104,21 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] not_turn_free;
   wire [0:0] take_or_not_turn_free;
   wire [0:0] turn_next;
-  wire [0:0] k_0_1 = 1'h0;
+  wire [0:0] k_0 = 1'h0;
   wire [0:0] case_turn_next;
-  wire [0:0] box_phase_ne_k_0;
-  wire [0:0] take_or_box_phase_ne_k_0;
+  wire [1:0] k_0_1 = 2'h0;
+  wire [0:0] box_phase_ne_k_0_1;
+  wire [0:0] or_3;
   wire [1:0] k_1_1 = 2'h1;
   wire [1:0] box_phase_plus_k_1_1;
-  wire [1:0] mux_take_or_box_phase_ne_k_0;
-  wire [0:0] box_idle;
+  wire [1:0] box_phase_next;
+  wire [0:0] box_idle_next;
   reg [28:0] box_in_ox = 29'h00000000;
   reg [28:0] box_in_oy = 29'h00000000;
   reg [28:0] box_in_oz = 29'h00000000;
   reg signed [47:0] box_in_invx = 48'sh000000000000;
   reg signed [47:0] box_in_invy = 48'sh000000000000;
   reg signed [47:0] box_in_invz = 48'sh000000000000;
-  reg [0:0] accept = 1'h0;
   reg [19:0] acc_in_ray_id = 20'h00000;
   reg [28:0] acc_in_ox = 29'h00000000;
   reg [28:0] acc_in_oy = 29'h00000000;
@@ -101,8 +129,8 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] acc_in_invx = 48'sh000000000000;
   reg signed [47:0] acc_in_invy = 48'sh000000000000;
   reg signed [47:0] acc_in_invz = 48'sh000000000000;
-  wire [5:0] bits_accept_slot_c3;
-  wire [5:0] bits_accept_slot_c4;
+  wire [5:0] bits_accept_slot_c14;
+  wire [5:0] bits_accept_slot_c15;
 
   // register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
   reg [0:0] port_empty = 1'h1;
@@ -110,17 +138,46 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] port_empty_c2 = 1'h1;
   reg [0:0] port_empty_c3 = 1'h1;
 
-  // register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+  // register copies box_idle_copies: box_idle and 1 copies, to split its fan-out
+  reg [0:0] box_idle = 1'h1;
+  reg [0:0] box_idle_c1 = 1'h1;
+
+  // register copies accept_copies: accept and 11 copies, to split its fan-out
+  reg [0:0] accept = 1'h0;
+  reg [0:0] accept_c1 = 1'h0;
+  reg [0:0] accept_c2 = 1'h0;
+  reg [0:0] accept_c3 = 1'h0;
+  reg [0:0] accept_c4 = 1'h0;
+  reg [0:0] accept_c5 = 1'h0;
+  reg [0:0] accept_c6 = 1'h0;
+  reg [0:0] accept_c7 = 1'h0;
+  reg [0:0] accept_c8 = 1'h0;
+  reg [0:0] accept_c9 = 1'h0;
+  reg [0:0] accept_c10 = 1'h0;
+  reg [0:0] accept_c11 = 1'h0;
+
+  // register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 6 are read
   reg [6:0] accept_slot = 7'h00;
   /* verilator lint_on UNUSEDSIGNAL */
   reg [6:0] accept_slot_c1 = 7'h00;
   reg [6:0] accept_slot_c2 = 7'h00;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
   reg [6:0] accept_slot_c3 = 7'h00;
+  reg [6:0] accept_slot_c4 = 7'h00;
+  reg [6:0] accept_slot_c5 = 7'h00;
+  reg [6:0] accept_slot_c6 = 7'h00;
+  reg [6:0] accept_slot_c7 = 7'h00;
+  reg [6:0] accept_slot_c8 = 7'h00;
+  reg [6:0] accept_slot_c9 = 7'h00;
+  reg [6:0] accept_slot_c10 = 7'h00;
+  reg [6:0] accept_slot_c11 = 7'h00;
+  reg [6:0] accept_slot_c12 = 7'h00;
+  reg [6:0] accept_slot_c13 = 7'h00;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c14 = 7'h00;
   /* verilator lint_on UNUSEDSIGNAL */
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c4 = 7'h00;
+  reg [6:0] accept_slot_c15 = 7'h00;
   /* verilator lint_on UNUSEDSIGNAL */
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
@@ -203,14 +260,14 @@ module fxrt_core_sf0a3f4 (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_box_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_6;
+  wire signed [32:0] minus_7;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt1_c;
   reg [0:0] box_lt1 = 1'h0;
   wire signed [32:0] rs_plane_t_1;
   wire signed [32:0] rs_box_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_7;
+  wire signed [32:0] minus_8;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt2_c;
   reg [0:0] box_lt2 = 1'h0;
@@ -220,7 +277,7 @@ module fxrt_core_sf0a3f4 (
   wire signed [31:0] box_tmax;
   wire [0:0] bits_box_d1;
   wire [0:0] bits_box_d2;
-  wire [0:0] or_8;
+  wire [0:0] or_9;
   wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire [0:0] box_last;
@@ -248,13 +305,13 @@ module fxrt_core_sf0a3f4 (
   wire [72:0] u0_node_word;
   wire [72:0] u1_node_word;
   wire [0:0] bits_accept_slot;
-  wire [0:0] eq_10;
+  wire [0:0] bits_accept_slot_eq_k_0;
   wire [0:0] u0_alloc;
   wire [0:0] bits_box_done_slot;
-  wire [0:0] eq_11;
+  wire [0:0] eq_12;
   wire [0:0] u0_new;
   wire [0:0] bits_free_slot;
-  wire [0:0] bits_free_slot_eq_k_0_1;
+  wire [0:0] bits_free_slot_eq_k_0;
   wire [0:0] u0_free;
   wire [5:0] bits_box_done_slot_1;
   wire [5:0] bits_free_slot_1;
@@ -288,10 +345,10 @@ module fxrt_core_sf0a3f4 (
   wire [6:0] u_traverse_0_occupied;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_accept_slot_1;
-  wire [0:0] eq_13;
+  wire [0:0] eq_14;
   wire [0:0] u1_alloc;
   wire [0:0] bits_box_done_slot_2;
-  wire [0:0] eq_14;
+  wire [0:0] eq_15;
   wire [0:0] u1_new;
   wire [0:0] bits_free_slot_2;
   wire [0:0] bits_free_slot_2_eq_k_1;
@@ -331,11 +388,23 @@ module fxrt_core_sf0a3f4 (
   wire [72:0] u_node_rom_0_data_b;
 
   // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  wire [86:0] cat_16;
+  wire [86:0] cat_17;
+  wire [15:0] bits_cat_17;
+  wire [15:0] bits_cat_17_1;
+  wire [15:0] bits_cat_17_2;
+  wire [15:0] bits_cat_17_3;
+  wire [15:0] bits_cat_17_4;
+  wire [6:0] bits_cat_17_5;
   wire [31:0] u_acc_in_wz;
   wire [31:0] u_acc_in_wy;
   wire [31:0] u_acc_in_wx;
-  wire [95:0] cat_17;
+  wire [95:0] cat_18;
+  wire [15:0] bits_cat_18;
+  wire [15:0] bits_cat_18_1;
+  wire [15:0] bits_cat_18_2;
+  wire [15:0] bits_cat_18_3;
+  wire [15:0] bits_cat_18_4;
+  wire [15:0] bits_cat_18_5;
 
   // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   reg [0:0] leaf_active = 1'h0;
@@ -370,24 +439,24 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] case_leaf_turn_1;
   wire [0:0] case_leaf_turn_2;
   wire [0:0] case_leaf_turn_3;
-  wire [0:0] or_22;
+  wire [0:0] or_23;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_23;
+  wire [0:0] eq_24;
   wire [0:0] u0_leaf_take;
   wire [0:0] not_u0_leaf_take;
-  wire [0:0] and_24;
-  wire [0:0] u0_leaf_fill_or_and_24;
-  wire [0:0] eq_25;
+  wire [0:0] and_25;
+  wire [0:0] u0_leaf_fill_or_and_25;
+  wire [0:0] eq_26;
   wire [0:0] u1_leaf_take;
   wire [0:0] not_u1_leaf_take;
-  wire [0:0] and_26;
-  wire [0:0] u1_leaf_fill_or_and_26;
+  wire [0:0] and_27;
+  wire [0:0] u1_leaf_fill_or_and_27;
   wire [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_27;
+  wire [6:0] cat_28;
   wire [0:0] not_leaf_last_entry;
-  wire [0:0] and_28;
-  wire [0:0] leaf_take_or_and_28;
+  wire [0:0] and_29;
+  wire [0:0] leaf_take_or_and_29;
   wire [6:0] mux_leaf_take;
   wire [12:0] case_mux_case_leaf_turn_2_1;
   wire [12:0] k_1_2 = 13'h0001;
@@ -402,7 +471,7 @@ module fxrt_core_sf0a3f4 (
   wire [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   wire [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_29;
+  wire [0:0] eq_30;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
@@ -410,7 +479,7 @@ module fxrt_core_sf0a3f4 (
   // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_30;
+  wire [58:0] cat_31;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -453,12 +522,24 @@ module fxrt_core_sf0a3f4 (
   integer emit_slot_sr_i;
   initial for (emit_slot_sr_i = 1; emit_slot_sr_i <= 2; emit_slot_sr_i = emit_slot_sr_i + 1) emit_slot_sr_sr[emit_slot_sr_i] = 7'h00;
   wire [6:0] emit_slot_sr;
-  reg [86:0] ray_o_q = 87'h0000000000000000000000;
+  reg [6:0] ray_o_q_g5 = 7'h00;
+  reg [15:0] ray_o_q_g4 = 16'h0000;
+  reg [15:0] ray_o_q_g3 = 16'h0000;
+  reg [15:0] ray_o_q_g2 = 16'h0000;
+  reg [15:0] ray_o_q_g1 = 16'h0000;
+  reg [15:0] ray_o_q_g0 = 16'h0000;
+  wire [86:0] ray_o_q;
   (* mem2reg *) reg [86:0] pipe_o_sr [1:2];
   integer pipe_o_i;
   initial for (pipe_o_i = 1; pipe_o_i <= 2; pipe_o_i = pipe_o_i + 1) pipe_o_sr[pipe_o_i] = 87'h0000000000000000000000;
   wire [86:0] pipe_o;
-  reg [95:0] ray_w_q = 96'h000000000000000000000000;
+  reg [15:0] ray_w_q_g5 = 16'h0000;
+  reg [15:0] ray_w_q_g4 = 16'h0000;
+  reg [15:0] ray_w_q_g3 = 16'h0000;
+  reg [15:0] ray_w_q_g2 = 16'h0000;
+  reg [15:0] ray_w_q_g1 = 16'h0000;
+  reg [15:0] ray_w_q_g0 = 16'h0000;
+  wire [95:0] ray_w_q;
   (* mem2reg *) reg [95:0] pipe_w_sr [1:2];
   integer pipe_w_i;
   initial for (pipe_w_i = 1; pipe_w_i <= 2; pipe_w_i = pipe_w_i + 1) pipe_w_sr[pipe_w_i] = 96'h000000000000000000000000;
@@ -479,29 +560,36 @@ module fxrt_core_sf0a3f4 (
   wire [31:0] u_intersect_u;
   wire [31:0] u_intersect_v;
 
-  // register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  // register copies emit_slot_1_copies: emit_slot_1 and 11 copies, to split its fan-out
   reg [6:0] emit_slot_1 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
   reg [6:0] emit_slot_1_c1 = 7'h00;
   reg [6:0] emit_slot_1_c2 = 7'h00;
+  reg [6:0] emit_slot_1_c3 = 7'h00;
+  reg [6:0] emit_slot_1_c4 = 7'h00;
+  reg [6:0] emit_slot_1_c5 = 7'h00;
+  reg [6:0] emit_slot_1_c6 = 7'h00;
+  reg [6:0] emit_slot_1_c7 = 7'h00;
+  reg [6:0] emit_slot_1_c8 = 7'h00;
+  reg [6:0] emit_slot_1_c9 = 7'h00;
+  reg [6:0] emit_slot_1_c10 = 7'h00;
+  reg [6:0] emit_slot_1_c11 = 7'h00;
 
   // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   reg [0:0] res_credit_ok = 1'h1;
   reg [0:0] u0_done_took = 1'h0;
   wire [0:0] not_u0_done_took;
-  wire [0:0] and_32;
+  wire [0:0] and_35;
   wire [0:0] u0_done_avail;
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
-  wire [0:0] and_33;
+  wire [0:0] and_36;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_34;
+  wire [6:0] cat_37;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_36;
+  wire [6:0] cat_39;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_37;
+  wire [0:0] or_40;
   reg [0:0] done_valid_r = 1'h0;
   reg [6:0] done_slot_r = 7'h00;
   wire [0:0] u_closest_merge_valid0;
@@ -523,8 +611,8 @@ module fxrt_core_sf0a3f4 (
   wire [31:0] u_closest_res_v;
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  wire [63:0] cat_38;
-  wire [63:0] cat_39;
+  wire [63:0] cat_41;
+  wire [63:0] cat_42;
   wire [0:0] res_take;
   reg [0:0] res_q_push = 1'h0;
   reg [3:0] res_q_wr = 4'h0;
@@ -545,15 +633,15 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_q_count_eq_k_0_5;
   wire [4:0] k_1_5 = 5'h01;
   wire [0:0] res_q_one_left;
-  wire [0:0] and_42;
+  wire [0:0] and_45;
   wire [0:0] res_q_drained;
   reg [0:0] res_q_bypass = 1'h0;
   wire [0:0] res_q_bypass_c;
   reg [0:0] res_q_nonempty = 1'h0;
   wire [0:0] k_1_5_lt_res_q_count;
-  wire [0:0] or_45;
+  wire [0:0] or_48;
   wire [0:0] not_res_take;
-  wire [0:0] and_46;
+  wire [0:0] and_49;
   wire [0:0] res_q_nonempty_c;
   reg [63:0] res_q_din0 = 64'h0000000000000000;
   reg [63:0] res_q_q0 = 64'h0000000000000000;
@@ -566,7 +654,7 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_take_c;
   reg [5:0] res_credits = 6'h10;
   wire [5:0] rs_done_valid_r;
-  wire [5:0] minus_48;
+  wire [5:0] minus_51;
   wire [5:0] rs_res_take_1;
   wire [5:0] res_credits_next;
   wire [5:0] k_1_6 = 6'h01;
@@ -588,8 +676,18 @@ module fxrt_core_sf0a3f4 (
   // not in a stage or state machine
 
   always @(posedge clk) begin : regs
-    if (accept) ray_o[accept_slot_c1] <= cat_16;
-    if (accept) ray_w[accept_slot_c1] <= cat_17;
+    if (accept) ray_o_g0[accept_slot_c1] <= bits_cat_17;
+    if (accept_c1) ray_o_g1[accept_slot_c2] <= bits_cat_17_1;
+    if (accept_c2) ray_o_g2[accept_slot_c3] <= bits_cat_17_2;
+    if (accept_c3) ray_o_g3[accept_slot_c4] <= bits_cat_17_3;
+    if (accept_c4) ray_o_g4[accept_slot_c5] <= bits_cat_17_4;
+    if (accept_c5) ray_o_g5[accept_slot_c6] <= bits_cat_17_5;
+    if (accept_c6) ray_w_g0[accept_slot_c7] <= bits_cat_18;
+    if (accept_c7) ray_w_g1[accept_slot_c8] <= bits_cat_18_1;
+    if (accept_c8) ray_w_g2[accept_slot_c9] <= bits_cat_18_2;
+    if (accept_c9) ray_w_g3[accept_slot_c10] <= bits_cat_18_3;
+    if (accept_c10) ray_w_g4[accept_slot_c11] <= bits_cat_18_4;
+    if (accept_c11) ray_w_g5[accept_slot_c12] <= bits_cat_18_5;
     if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
     if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
   end
@@ -603,9 +701,8 @@ module fxrt_core_sf0a3f4 (
     (turn == 1'h0) ? u0_free_slot_r :
     (turn == 1'h1) ? u1_free_slot_r :
     u0_free_slot_r;
-  assign box_phase_eq_k_0 = box_phase == k_0;
-  assign and_0 = in_valid & box_phase_eq_k_0;
-  assign take = and_0 & turn_free;
+  assign in_valid_and_box_idle = in_valid & box_idle;
+  assign take = in_valid_and_box_idle & turn_free;
   assign port_empty_and_ray_valid = port_empty & ray_valid;
   assign not_take = ~take;
   assign in_valid_and_not_take = in_valid & not_take;
@@ -619,20 +716,20 @@ module fxrt_core_sf0a3f4 (
   assign case_turn_next =
     (turn_next == 1'h0) ? u0_has_free :
     (turn_next == 1'h1) ? u1_has_free :
-    k_0_1;
-  assign box_phase_ne_k_0 = box_phase != k_0;
-  assign take_or_box_phase_ne_k_0 = take | box_phase_ne_k_0;
+    k_0;
+  assign box_phase_ne_k_0_1 = box_phase != k_0_1;
+  assign or_3 = take | box_phase_ne_k_0_1;
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
-  assign mux_take_or_box_phase_ne_k_0 = take_or_box_phase_ne_k_0 ? box_phase_plus_k_1_1 : box_phase;
-  assign box_idle = box_phase == k_0;
-  assign bits_accept_slot_c3 = accept_slot_c3[5:0];
-  assign bits_accept_slot_c4 = accept_slot_c4[5:0];
+  assign box_phase_next = or_3 ? box_phase_plus_k_1_1 : box_phase;
+  assign box_idle_next = box_phase_next == k_0_1;
+  assign bits_accept_slot_c14 = accept_slot_c14[5:0];
+  assign bits_accept_slot_c15 = accept_slot_c15[5:0];
 
   always @(posedge clk) begin : ray_port_regs
     if (rst) turn <= 1'h0;
     else turn <= turn_next;
     if (rst) box_phase <= 2'h0;
-    else box_phase <= mux_take_or_box_phase_ne_k_0;
+    else box_phase <= box_phase_next;
     if (rst) u0_free_slot_r <= 6'h00;
     else u0_free_slot_r <= u0_free_slot;
     if (rst) u1_free_slot_r <= 6'h00;
@@ -651,14 +748,12 @@ module fxrt_core_sf0a3f4 (
     if (port_empty_c2) in_invx <= invx;
     if (port_empty_c3) in_invy <= invy;
     if (port_empty_c3) in_invz <= invz;
-    if (box_idle) box_in_ox <= in_ox;
-    if (box_idle) box_in_oy <= in_oy;
-    if (box_idle) box_in_oz <= in_oz;
-    if (box_idle) box_in_invx <= in_invx;
-    if (box_idle) box_in_invy <= in_invy;
-    if (box_idle) box_in_invz <= in_invz;
-    if (rst) accept <= 1'h0;
-    else accept <= take;
+    if (box_idle_c1) box_in_ox <= in_ox;
+    if (box_idle_c1) box_in_oy <= in_oy;
+    if (box_idle_c1) box_in_oz <= in_oz;
+    if (box_idle_c1) box_in_invx <= in_invx;
+    if (box_idle_c1) box_in_invy <= in_invy;
+    if (box_idle_c1) box_in_invz <= in_invz;
     acc_in_ray_id <= in_ray_id;
     acc_in_ox <= in_ox;
     acc_in_oy <= in_oy;
@@ -684,7 +779,45 @@ module fxrt_core_sf0a3f4 (
     else port_empty_c3 <= not_or_1;
   end
 
-  // register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+  // register copies box_idle_copies: box_idle and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : box_idle_copies_regs
+    if (rst) box_idle <= 1'h1;
+    else box_idle <= box_idle_next;
+    if (rst) box_idle_c1 <= 1'h1;
+    else box_idle_c1 <= box_idle_next;
+  end
+
+  // register copies accept_copies: accept and 11 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : accept_copies_regs
+    if (rst) accept <= 1'h0;
+    else accept <= take;
+    if (rst) accept_c1 <= 1'h0;
+    else accept_c1 <= take;
+    if (rst) accept_c2 <= 1'h0;
+    else accept_c2 <= take;
+    if (rst) accept_c3 <= 1'h0;
+    else accept_c3 <= take;
+    if (rst) accept_c4 <= 1'h0;
+    else accept_c4 <= take;
+    if (rst) accept_c5 <= 1'h0;
+    else accept_c5 <= take;
+    if (rst) accept_c6 <= 1'h0;
+    else accept_c6 <= take;
+    if (rst) accept_c7 <= 1'h0;
+    else accept_c7 <= take;
+    if (rst) accept_c8 <= 1'h0;
+    else accept_c8 <= take;
+    if (rst) accept_c9 <= 1'h0;
+    else accept_c9 <= take;
+    if (rst) accept_c10 <= 1'h0;
+    else accept_c10 <= take;
+    if (rst) accept_c11 <= 1'h0;
+    else accept_c11 <= take;
+  end
+
+  // register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : accept_slot_copies_regs
     accept_slot <= take_slot;
@@ -692,6 +825,17 @@ module fxrt_core_sf0a3f4 (
     accept_slot_c2 <= take_slot;
     accept_slot_c3 <= take_slot;
     accept_slot_c4 <= take_slot;
+    accept_slot_c5 <= take_slot;
+    accept_slot_c6 <= take_slot;
+    accept_slot_c7 <= take_slot;
+    accept_slot_c8 <= take_slot;
+    accept_slot_c9 <= take_slot;
+    accept_slot_c10 <= take_slot;
+    accept_slot_c11 <= take_slot;
+    accept_slot_c12 <= take_slot;
+    accept_slot_c13 <= take_slot;
+    accept_slot_c14 <= take_slot;
+    accept_slot_c15 <= take_slot;
   end
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
@@ -701,7 +845,7 @@ module fxrt_core_sf0a3f4 (
     (box_axis == 2'h2) ? box_in_invz :
     box_in_invx;
   assign box_neg = case_box_axis[47];
-  assign box_issue = box_phase != k_0;
+  assign box_issue = box_phase != k_0_1;
   assign box_issue_last = box_phase == k_3;
   assign case_box_axis_1 =
     (box_axis == 2'h1) ? box_hi_1 :
@@ -737,20 +881,20 @@ module fxrt_core_sf0a3f4 (
   assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
-  assign minus_6 = rs_plane_t - rs_box_d1;
-  assign box_lt1_c = minus_6[32];
+  assign minus_7 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_7[32];
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
-  assign minus_7 = rs_plane_t_1 - rs_box_d2;
-  assign box_lt2_c = minus_7[32];
+  assign minus_8 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_8[32];
   assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
   assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
   assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
   assign bits_box_d1 = box_d1[31];
   assign bits_box_d2 = box_d2[31];
-  assign or_8 = bits_box_d1 | bits_box_d2;
+  assign or_9 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_8 | bits_box_d3;
+  assign box_miss = or_9 | bits_box_d3;
   assign box_last = plane_t_valid & plane_t_last;
   assign box_done_slot = box_done_slot_sr[11];
 
@@ -835,22 +979,22 @@ module fxrt_core_sf0a3f4 (
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
   assign bits_accept_slot = accept_slot[6];
-  assign eq_10 = bits_accept_slot == k_0_1;
-  assign u0_alloc = accept & eq_10;
+  assign bits_accept_slot_eq_k_0 = bits_accept_slot == k_0;
+  assign u0_alloc = accept & bits_accept_slot_eq_k_0;
   assign bits_box_done_slot = box_done_slot[6];
-  assign eq_11 = bits_box_done_slot == k_0_1;
-  assign u0_new = box_done & eq_11;
+  assign eq_12 = bits_box_done_slot == k_0;
+  assign u0_new = box_done & eq_12;
   assign bits_free_slot = free_slot[6];
-  assign bits_free_slot_eq_k_0_1 = bits_free_slot == k_0_1;
-  assign u0_free = free_valid & bits_free_slot_eq_k_0_1;
+  assign bits_free_slot_eq_k_0 = bits_free_slot == k_0;
+  assign u0_free = free_valid & bits_free_slot_eq_k_0;
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
   assign bits_accept_slot_1 = accept_slot[6];
-  assign eq_13 = bits_accept_slot_1 == k_1;
-  assign u1_alloc = accept & eq_13;
+  assign eq_14 = bits_accept_slot_1 == k_1;
+  assign u1_alloc = accept & eq_14;
   assign bits_box_done_slot_2 = box_done_slot[6];
-  assign eq_14 = bits_box_done_slot_2 == k_1;
-  assign u1_new = box_done & eq_14;
+  assign eq_15 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_15;
   assign bits_free_slot_2 = free_slot[6];
   assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
   assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
@@ -858,11 +1002,23 @@ module fxrt_core_sf0a3f4 (
   assign bits_free_slot_3 = free_slot[5:0];
 
   // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  assign cat_16 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign cat_17 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign bits_cat_17 = cat_17[15:0];
+  assign bits_cat_17_1 = cat_17[31:16];
+  assign bits_cat_17_2 = cat_17[47:32];
+  assign bits_cat_17_3 = cat_17[63:48];
+  assign bits_cat_17_4 = cat_17[79:64];
+  assign bits_cat_17_5 = cat_17[86:80];
   assign u_acc_in_wz = $unsigned(acc_in_wz);
   assign u_acc_in_wy = $unsigned(acc_in_wy);
   assign u_acc_in_wx = $unsigned(acc_in_wx);
-  assign cat_17 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
+  assign cat_18 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
+  assign bits_cat_18 = cat_18[15:0];
+  assign bits_cat_18_1 = cat_18[31:16];
+  assign bits_cat_18_2 = cat_18[47:32];
+  assign bits_cat_18_3 = cat_18[63:48];
+  assign bits_cat_18_4 = cat_18[79:64];
+  assign bits_cat_18_5 = cat_18[95:80];
 
   // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   assign leaf_last_entry = leaf_active & leaf_last;
@@ -875,41 +1031,41 @@ module fxrt_core_sf0a3f4 (
   assign case_leaf_turn =
     (leaf_turn == 1'h0) ? u0_leaf_buf_valid :
     (leaf_turn == 1'h1) ? u1_leaf_buf_valid :
-    k_0_1;
+    k_0;
   assign case_leaf_turn_1 =
-    (leaf_turn == 1'h0) ? k_0_1 :
+    (leaf_turn == 1'h0) ? k_0 :
     (leaf_turn == 1'h1) ? k_1 :
-    k_0_1;
+    k_0;
   assign case_leaf_turn_2 =
     (leaf_turn == 1'h0) ? u1_leaf_buf_valid :
     (leaf_turn == 1'h1) ? u0_leaf_buf_valid :
-    k_0_1;
+    k_0;
   assign case_leaf_turn_3 =
     (leaf_turn == 1'h0) ? k_1 :
-    (leaf_turn == 1'h1) ? k_0_1 :
-    k_0_1;
-  assign or_22 = case_leaf_turn_2 | case_leaf_turn;
+    (leaf_turn == 1'h1) ? k_0 :
+    k_0;
+  assign or_23 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_22;
-  assign eq_23 = mux_case_leaf_turn_2 == k_0_1;
-  assign u0_leaf_take = leaf_take & eq_23;
+  assign leaf_take = leaf_can_take & or_23;
+  assign eq_24 = mux_case_leaf_turn_2 == k_0;
+  assign u0_leaf_take = leaf_take & eq_24;
   assign not_u0_leaf_take = ~u0_leaf_take;
-  assign and_24 = u0_leaf_buf_valid & not_u0_leaf_take;
-  assign u0_leaf_fill_or_and_24 = u0_leaf_fill | and_24;
-  assign eq_25 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_25;
+  assign and_25 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_25 = u0_leaf_fill | and_25;
+  assign eq_26 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_26;
   assign not_u1_leaf_take = ~u1_leaf_take;
-  assign and_26 = u1_leaf_buf_valid & not_u1_leaf_take;
-  assign u1_leaf_fill_or_and_26 = u1_leaf_fill | and_26;
+  assign and_27 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_27 = u1_leaf_fill | and_27;
   assign case_mux_case_leaf_turn_2 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_slot :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_slot :
     u0_buf_leaf_slot;
-  assign cat_27 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_28 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_28 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_28 = leaf_take | and_28;
-  assign mux_leaf_take = leaf_take ? cat_27 : leaf_slot;
+  assign and_29 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_29 = leaf_take | and_29;
+  assign mux_leaf_take = leaf_take ? cat_28 : leaf_slot;
   assign case_mux_case_leaf_turn_2_1 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_first :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_first :
@@ -936,13 +1092,13 @@ module fxrt_core_sf0a3f4 (
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_count :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_count :
     u0_buf_leaf_count;
-  assign eq_29 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_30 = case_mux_case_leaf_turn_2_5 == k_1_3;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_29 : leaf_left_eq_k_2;
+  assign mux_leaf_take_5 = leaf_take ? eq_30 : leaf_left_eq_k_2;
 
   always @(posedge clk) begin : leaf_stream_regs
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_28;
+    else leaf_active <= leaf_take_or_and_29;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -953,14 +1109,14 @@ module fxrt_core_sf0a3f4 (
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
     if (rst) u0_leaf_buf_valid <= 1'h0;
-    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_24;
+    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_25;
     if (u0_leaf_fill) u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
     if (u0_leaf_fill) u0_buf_leaf_first <= u_traverse_0_leaf_first;
     if (u0_leaf_fill) u0_buf_leaf_count <= u_traverse_0_leaf_count;
     if (u0_leaf_fill) u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
     if (u0_leaf_fill) u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
     if (rst) u1_leaf_buf_valid <= 1'h0;
-    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_26;
+    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_27;
     if (u1_leaf_fill) u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
     if (u1_leaf_fill) u1_buf_leaf_first <= u_traverse_1_leaf_first;
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
@@ -969,7 +1125,7 @@ module fxrt_core_sf0a3f4 (
   end
 
   // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
-  assign cat_30 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign cat_31 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -992,7 +1148,9 @@ module fxrt_core_sf0a3f4 (
   assign tri_e2q = $signed(u_tri_rom_2_data);
   assign pipe_tag = pipe_tag_sr[3];
   assign emit_slot_sr = emit_slot_sr_sr[2];
+  assign ray_o_q = {ray_o_q_g5, ray_o_q_g4, ray_o_q_g3, ray_o_q_g2, ray_o_q_g1, ray_o_q_g0};
   assign pipe_o = pipe_o_sr[2];
+  assign ray_w_q = {ray_w_q_g5, ray_w_q_g4, ray_w_q_g3, ray_w_q_g2, ray_w_q_g1, ray_w_q_g0};
   assign pipe_w = pipe_w_sr[2];
   assign bits_pipe_o = pipe_o[28:0];
   assign bits_pipe_o_1 = pipe_o[57:29];
@@ -1007,7 +1165,7 @@ module fxrt_core_sf0a3f4 (
   always @(posedge clk) begin : emission_regs
     emit_tag_sr[3] <= emit_tag_sr[2];
     emit_tag_sr[2] <= emit_tag_sr[1];
-    emit_tag_sr[1] <= cat_30;
+    emit_tag_sr[1] <= cat_31;
     if (rst) emit_valid_1 <= 1'h0;
     else emit_valid_1 <= leaf_active;
     if (rst) emit_valid_2 <= 1'h0;
@@ -1025,35 +1183,54 @@ module fxrt_core_sf0a3f4 (
     pipe_tag_sr[1] <= emit_tag_tri;
     emit_slot_sr_sr[2] <= emit_slot_sr_sr[1];
     emit_slot_sr_sr[1] <= leaf_slot;
-    ray_o_q <= ray_o[emit_slot_1_c1];
+    ray_o_q_g5 <= ray_o_g5[emit_slot_1_c5];
+    ray_o_q_g4 <= ray_o_g4[emit_slot_1_c4];
+    ray_o_q_g3 <= ray_o_g3[emit_slot_1_c3];
+    ray_o_q_g2 <= ray_o_g2[emit_slot_1_c2];
+    ray_o_q_g1 <= ray_o_g1[emit_slot_1_c1];
+    ray_o_q_g0 <= ray_o_g0[emit_slot_1];
     pipe_o_sr[2] <= pipe_o_sr[1];
     pipe_o_sr[1] <= ray_o_q;
-    ray_w_q <= ray_w[emit_slot_1_c2];
+    ray_w_q_g5 <= ray_w_g5[emit_slot_1_c11];
+    ray_w_q_g4 <= ray_w_g4[emit_slot_1_c10];
+    ray_w_q_g3 <= ray_w_g3[emit_slot_1_c9];
+    ray_w_q_g2 <= ray_w_g2[emit_slot_1_c8];
+    ray_w_q_g1 <= ray_w_g1[emit_slot_1_c7];
+    ray_w_q_g0 <= ray_w_g0[emit_slot_1_c6];
     pipe_w_sr[2] <= pipe_w_sr[1];
     pipe_w_sr[1] <= ray_w_q;
   end
 
-  // register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+  // register copies emit_slot_1_copies: emit_slot_1 and 11 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : emit_slot_1_copies_regs
     emit_slot_1 <= emit_slot_sr;
     emit_slot_1_c1 <= emit_slot_sr;
     emit_slot_1_c2 <= emit_slot_sr;
+    emit_slot_1_c3 <= emit_slot_sr;
+    emit_slot_1_c4 <= emit_slot_sr;
+    emit_slot_1_c5 <= emit_slot_sr;
+    emit_slot_1_c6 <= emit_slot_sr;
+    emit_slot_1_c7 <= emit_slot_sr;
+    emit_slot_1_c8 <= emit_slot_sr;
+    emit_slot_1_c9 <= emit_slot_sr;
+    emit_slot_1_c10 <= emit_slot_sr;
+    emit_slot_1_c11 <= emit_slot_sr;
   end
 
   // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   assign not_u0_done_took = ~u0_done_took;
-  assign and_32 = u_traverse_0_done_valid & not_u0_done_took;
-  assign u0_done_avail = and_32 & res_credit_ok;
+  assign and_35 = u_traverse_0_done_valid & not_u0_done_took;
+  assign u0_done_avail = and_35 & res_credit_ok;
   assign not_u1_done_took = ~u1_done_took;
-  assign and_33 = u_traverse_1_done_valid & not_u1_done_took;
-  assign u1_done_avail = and_33 & res_credit_ok;
-  assign cat_34 = {k_0_1, u_traverse_0_done_slot};
+  assign and_36 = u_traverse_1_done_valid & not_u1_done_took;
+  assign u1_done_avail = and_36 & res_credit_ok;
+  assign cat_37 = {k_0, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_36 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_34 : cat_36;
-  assign or_37 = u0_done_avail | u1_done_avail;
+  assign cat_39 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_37 : cat_39;
+  assign or_40 = u0_done_avail | u1_done_avail;
 
   always @(posedge clk) begin : done_regs
     if (rst) res_credit_ok <= 1'h1;
@@ -1063,13 +1240,13 @@ module fxrt_core_sf0a3f4 (
     if (rst) u1_done_took <= 1'h0;
     else u1_done_took <= u1_done_pop;
     if (rst) done_valid_r <= 1'h0;
-    else done_valid_r <= or_37;
+    else done_valid_r <= or_40;
     done_slot_r <= mux_u0_done_avail;
   end
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  assign cat_38 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
-  assign cat_39 = {u_closest_res_u, u_closest_res_v};
+  assign cat_41 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
+  assign cat_42 = {u_closest_res_u, u_closest_res_v};
   assign res_take = res_take_c;
   assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
   assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
@@ -1082,21 +1259,21 @@ module fxrt_core_sf0a3f4 (
   assign res_q_count_next = res_q_after_pop + rs_res_q_push;
   assign res_q_count_eq_k_0_5 = res_q_count == k_0_5;
   assign res_q_one_left = res_q_count == k_1_5;
-  assign and_42 = res_q_one_left & res_take;
-  assign res_q_drained = res_q_count_eq_k_0_5 | and_42;
+  assign and_45 = res_q_one_left & res_take;
+  assign res_q_drained = res_q_count_eq_k_0_5 | and_45;
   assign res_q_bypass_c = res_q_push & res_q_drained;
   assign k_1_5_lt_res_q_count = k_1_5 < res_q_count;
-  assign or_45 = res_q_push | k_1_5_lt_res_q_count;
+  assign or_48 = res_q_push | k_1_5_lt_res_q_count;
   assign not_res_take = ~res_take;
-  assign and_46 = res_q_one_left & not_res_take;
-  assign res_q_nonempty_c = or_45 | and_46;
+  assign and_49 = res_q_one_left & not_res_take;
+  assign res_q_nonempty_c = or_48 | and_49;
   assign res_q_head0 = res_q_bypass ? res_q_din_r0 : res_q_q0;
   assign res_q_head1 = res_q_bypass ? res_q_din_r1 : res_q_q1;
   assign res_take_c = res_q_nonempty & res_ready;
   assign rs_done_valid_r = {{5{1'b0}}, done_valid_r};
-  assign minus_48 = res_credits - rs_done_valid_r;
+  assign minus_51 = res_credits - rs_done_valid_r;
   assign rs_res_take_1 = {{5{1'b0}}, res_take};
-  assign res_credits_next = minus_48 + rs_res_take_1;
+  assign res_credits_next = minus_51 + rs_res_take_1;
   assign res_credits_ge1 = k_1_6 <= res_credits;
   assign res_credits_ge2 = k_2_1 <= res_credits;
   assign res_credits_ge3 = k_3_1 <= res_credits;
@@ -1125,10 +1302,10 @@ module fxrt_core_sf0a3f4 (
     else res_q_bypass <= res_q_bypass_c;
     if (rst) res_q_nonempty <= 1'h0;
     else res_q_nonempty <= res_q_nonempty_c;
-    res_q_din0 <= cat_38;
+    res_q_din0 <= cat_41;
     res_q_q0 <= res_q_mem0[res_q_rd_next];
     if (res_q_push) res_q_din_r0 <= res_q_din0;
-    res_q_din1 <= cat_39;
+    res_q_din1 <= cat_42;
     res_q_q1 <= res_q_mem1[res_q_rd_next];
     if (res_q_push) res_q_din_r1 <= res_q_din1;
     if (rst) res_credits <= 6'h10;
@@ -1146,7 +1323,7 @@ module fxrt_core_sf0a3f4 (
     .clk(clk),
     .rst(rst),
     .ray_we(u0_alloc),
-    .ray_slot(bits_accept_slot_c3),
+    .ray_slot(bits_accept_slot_c14),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1191,7 +1368,7 @@ module fxrt_core_sf0a3f4 (
     .clk(clk),
     .rst(rst),
     .ray_we(u1_alloc),
-    .ray_slot(bits_accept_slot_c4),
+    .ray_slot(bits_accept_slot_c15),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1303,7 +1480,7 @@ module fxrt_core_sf0a3f4 (
     .u(u_intersect_u),
     .v(u_intersect_v),
     .id_we(accept),
-    .id_slot(accept_slot_c2),
+    .id_slot(accept_slot_c13),
     .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),

@@ -187,11 +187,41 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
     );
   end component;
 
-  type ray_o_t is array (0 to 127) of unsigned(86 downto 0);
-  signal ray_o : ray_o_t := (others => (others => '0'));
+  type ray_o_g0_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_o_g0 : ray_o_g0_t := (others => (others => '0'));
 
-  type ray_w_t is array (0 to 127) of unsigned(95 downto 0);
-  signal ray_w : ray_w_t := (others => (others => '0'));
+  type ray_o_g1_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_o_g1 : ray_o_g1_t := (others => (others => '0'));
+
+  type ray_o_g2_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_o_g2 : ray_o_g2_t := (others => (others => '0'));
+
+  type ray_o_g3_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_o_g3 : ray_o_g3_t := (others => (others => '0'));
+
+  type ray_o_g4_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_o_g4 : ray_o_g4_t := (others => (others => '0'));
+
+  type ray_o_g5_t is array (0 to 127) of unsigned(6 downto 0);
+  signal ray_o_g5 : ray_o_g5_t := (others => (others => '0'));
+
+  type ray_w_g0_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_w_g0 : ray_w_g0_t := (others => (others => '0'));
+
+  type ray_w_g1_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_w_g1 : ray_w_g1_t := (others => (others => '0'));
+
+  type ray_w_g2_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_w_g2 : ray_w_g2_t := (others => (others => '0'));
+
+  type ray_w_g3_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_w_g3 : ray_w_g3_t := (others => (others => '0'));
+
+  type ray_w_g4_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_w_g4 : ray_w_g4_t := (others => (others => '0'));
+
+  type ray_w_g5_t is array (0 to 127) of unsigned(15 downto 0);
+  signal ray_w_g5 : ray_w_g5_t := (others => (others => '0'));
 
   type res_q_mem0_t is array (0 to 15) of unsigned(63 downto 0);
   signal res_q_mem0 : res_q_mem0_t := (others => (others => '0'));
@@ -215,9 +245,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal turn_free : unsigned(0 downto 0) := unsigned'("1");
   signal case_turn : unsigned(5 downto 0);
   signal in_valid : unsigned(0 downto 0) := unsigned'("0");
-  constant k_0 : unsigned(1 downto 0) := unsigned'("00");
-  signal box_phase_eq_k_0 : unsigned(0 downto 0);
-  signal and_0 : unsigned(0 downto 0);
+  signal in_valid_and_box_idle : unsigned(0 downto 0);
   signal take : unsigned(0 downto 0);
   signal port_empty_and_ray_valid : unsigned(0 downto 0);
   signal not_take : unsigned(0 downto 0);
@@ -240,21 +268,21 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal not_turn_free : unsigned(0 downto 0);
   signal take_or_not_turn_free : unsigned(0 downto 0);
   signal turn_next : unsigned(0 downto 0);
-  constant k_0_1 : unsigned(0 downto 0) := unsigned'("0");
+  constant k_0 : unsigned(0 downto 0) := unsigned'("0");
   signal case_turn_next : unsigned(0 downto 0);
-  signal box_phase_ne_k_0 : unsigned(0 downto 0);
-  signal take_or_box_phase_ne_k_0 : unsigned(0 downto 0);
+  constant k_0_1 : unsigned(1 downto 0) := unsigned'("00");
+  signal box_phase_ne_k_0_1 : unsigned(0 downto 0);
+  signal or_3 : unsigned(0 downto 0);
   constant k_1_1 : unsigned(1 downto 0) := unsigned'("01");
   signal box_phase_plus_k_1_1 : unsigned(1 downto 0);
-  signal mux_take_or_box_phase_ne_k_0 : unsigned(1 downto 0);
-  signal box_idle : unsigned(0 downto 0);
+  signal box_phase_next : unsigned(1 downto 0);
+  signal box_idle_next : unsigned(0 downto 0);
   signal box_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal box_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal box_in_oz : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal box_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal accept : unsigned(0 downto 0) := unsigned'("0");
   signal acc_in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal acc_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal acc_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -265,8 +293,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal acc_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal bits_accept_slot_c3 : unsigned(5 downto 0);
-  signal bits_accept_slot_c4 : unsigned(5 downto 0);
+  signal bits_accept_slot_c14 : unsigned(5 downto 0);
+  signal bits_accept_slot_c15 : unsigned(5 downto 0);
 
   -- register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
   signal port_empty : unsigned(0 downto 0) := unsigned'("1");
@@ -278,7 +306,39 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal port_empty_c3 : unsigned(0 downto 0) := unsigned'("1");
   attribute keep of port_empty_c3 : signal is "true";
 
-  -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+  -- register copies box_idle_copies: box_idle and 1 copies, to split its fan-out
+  signal box_idle : unsigned(0 downto 0) := unsigned'("1");
+  attribute keep of box_idle : signal is "true";
+  signal box_idle_c1 : unsigned(0 downto 0) := unsigned'("1");
+  attribute keep of box_idle_c1 : signal is "true";
+
+  -- register copies accept_copies: accept and 11 copies, to split its fan-out
+  signal accept : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept : signal is "true";
+  signal accept_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c1 : signal is "true";
+  signal accept_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c2 : signal is "true";
+  signal accept_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c3 : signal is "true";
+  signal accept_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c4 : signal is "true";
+  signal accept_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c5 : signal is "true";
+  signal accept_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c6 : signal is "true";
+  signal accept_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c7 : signal is "true";
+  signal accept_c8 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c8 : signal is "true";
+  signal accept_c9 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c9 : signal is "true";
+  signal accept_c10 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c10 : signal is "true";
+  signal accept_c11 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_c11 : signal is "true";
+
+  -- register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
   signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot : signal is "true";
   signal accept_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
@@ -289,6 +349,28 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   attribute keep of accept_slot_c3 : signal is "true";
   signal accept_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c4 : signal is "true";
+  signal accept_slot_c5 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c5 : signal is "true";
+  signal accept_slot_c6 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c6 : signal is "true";
+  signal accept_slot_c7 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c7 : signal is "true";
+  signal accept_slot_c8 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c8 : signal is "true";
+  signal accept_slot_c9 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c9 : signal is "true";
+  signal accept_slot_c10 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c10 : signal is "true";
+  signal accept_slot_c11 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c11 : signal is "true";
+  signal accept_slot_c12 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c12 : signal is "true";
+  signal accept_slot_c13 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c13 : signal is "true";
+  signal accept_slot_c14 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c14 : signal is "true";
+  signal accept_slot_c15 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c15 : signal is "true";
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -360,12 +442,12 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_plane_t : signed(32 downto 0);
   signal rs_box_d1 : signed(32 downto 0);
-  signal minus_6 : signed(32 downto 0);
+  signal minus_7 : signed(32 downto 0);
   signal box_lt1_c : unsigned(0 downto 0);
   signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
   signal rs_plane_t_1 : signed(32 downto 0);
   signal rs_box_d2 : signed(32 downto 0);
-  signal minus_7 : signed(32 downto 0);
+  signal minus_8 : signed(32 downto 0);
   signal box_lt2_c : unsigned(0 downto 0);
   signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
   signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
@@ -374,7 +456,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_tmax : signed(31 downto 0);
   signal bits_box_d1 : unsigned(0 downto 0);
   signal bits_box_d2 : unsigned(0 downto 0);
-  signal or_8 : unsigned(0 downto 0);
+  signal or_9 : unsigned(0 downto 0);
   signal bits_box_d3 : unsigned(0 downto 0);
   signal box_miss : unsigned(0 downto 0);
   signal box_last : unsigned(0 downto 0);
@@ -401,13 +483,13 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u0_node_word : unsigned(72 downto 0);
   signal u1_node_word : unsigned(72 downto 0);
   signal bits_accept_slot : unsigned(0 downto 0);
-  signal eq_10 : unsigned(0 downto 0);
+  signal bits_accept_slot_eq_k_0 : unsigned(0 downto 0);
   signal u0_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot : unsigned(0 downto 0);
-  signal eq_11 : unsigned(0 downto 0);
+  signal eq_12 : unsigned(0 downto 0);
   signal u0_new : unsigned(0 downto 0);
   signal bits_free_slot : unsigned(0 downto 0);
-  signal bits_free_slot_eq_k_0_1 : unsigned(0 downto 0);
+  signal bits_free_slot_eq_k_0 : unsigned(0 downto 0);
   signal u0_free : unsigned(0 downto 0);
   signal bits_box_done_slot_1 : unsigned(5 downto 0);
   signal bits_free_slot_1 : unsigned(5 downto 0);
@@ -429,10 +511,10 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
   signal bits_accept_slot_1 : unsigned(0 downto 0);
-  signal eq_13 : unsigned(0 downto 0);
+  signal eq_14 : unsigned(0 downto 0);
   signal u1_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
-  signal eq_14 : unsigned(0 downto 0);
+  signal eq_15 : unsigned(0 downto 0);
   signal u1_new : unsigned(0 downto 0);
   signal bits_free_slot_2 : unsigned(0 downto 0);
   signal bits_free_slot_2_eq_k_1 : unsigned(0 downto 0);
@@ -460,11 +542,23 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
 
   -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  signal cat_16 : unsigned(86 downto 0);
+  signal cat_17 : unsigned(86 downto 0);
+  signal bits_cat_17 : unsigned(15 downto 0);
+  signal bits_cat_17_1 : unsigned(15 downto 0);
+  signal bits_cat_17_2 : unsigned(15 downto 0);
+  signal bits_cat_17_3 : unsigned(15 downto 0);
+  signal bits_cat_17_4 : unsigned(15 downto 0);
+  signal bits_cat_17_5 : unsigned(6 downto 0);
   signal u_acc_in_wz : unsigned(31 downto 0);
   signal u_acc_in_wy : unsigned(31 downto 0);
   signal u_acc_in_wx : unsigned(31 downto 0);
-  signal cat_17 : unsigned(95 downto 0);
+  signal cat_18 : unsigned(95 downto 0);
+  signal bits_cat_18 : unsigned(15 downto 0);
+  signal bits_cat_18_1 : unsigned(15 downto 0);
+  signal bits_cat_18_2 : unsigned(15 downto 0);
+  signal bits_cat_18_3 : unsigned(15 downto 0);
+  signal bits_cat_18_4 : unsigned(15 downto 0);
+  signal bits_cat_18_5 : unsigned(15 downto 0);
 
   -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
@@ -499,24 +593,24 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
   signal case_leaf_turn_3 : unsigned(0 downto 0);
-  signal or_22 : unsigned(0 downto 0);
+  signal or_23 : unsigned(0 downto 0);
   signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
   signal leaf_take : unsigned(0 downto 0);
-  signal eq_23 : unsigned(0 downto 0);
+  signal eq_24 : unsigned(0 downto 0);
   signal u0_leaf_take : unsigned(0 downto 0);
   signal not_u0_leaf_take : unsigned(0 downto 0);
-  signal and_24 : unsigned(0 downto 0);
-  signal u0_leaf_fill_or_and_24 : unsigned(0 downto 0);
-  signal eq_25 : unsigned(0 downto 0);
+  signal and_25 : unsigned(0 downto 0);
+  signal u0_leaf_fill_or_and_25 : unsigned(0 downto 0);
+  signal eq_26 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
   signal not_u1_leaf_take : unsigned(0 downto 0);
-  signal and_26 : unsigned(0 downto 0);
-  signal u1_leaf_fill_or_and_26 : unsigned(0 downto 0);
+  signal and_27 : unsigned(0 downto 0);
+  signal u1_leaf_fill_or_and_27 : unsigned(0 downto 0);
   signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_27 : unsigned(6 downto 0);
+  signal cat_28 : unsigned(6 downto 0);
   signal not_leaf_last_entry : unsigned(0 downto 0);
-  signal and_28 : unsigned(0 downto 0);
-  signal leaf_take_or_and_28 : unsigned(0 downto 0);
+  signal and_29 : unsigned(0 downto 0);
+  signal leaf_take_or_and_29 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
   constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
@@ -531,7 +625,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_29 : unsigned(0 downto 0);
+  signal eq_30 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
@@ -539,7 +633,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_30 : unsigned(58 downto 0);
+  signal cat_31 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -577,11 +671,23 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   type emit_slot_sr_sr_t is array (1 to 2) of unsigned(6 downto 0);
   signal emit_slot_sr_sr : emit_slot_sr_sr_t := (others => (others => '0'));
   signal emit_slot_sr : unsigned(6 downto 0);
-  signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal ray_o_q_g5 : unsigned(6 downto 0) := unsigned'("0000000");
+  signal ray_o_q_g4 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q : unsigned(86 downto 0);
   type pipe_o_sr_t is array (1 to 2) of unsigned(86 downto 0);
   signal pipe_o_sr : pipe_o_sr_t := (others => (others => '0'));
   signal pipe_o : unsigned(86 downto 0);
-  signal ray_w_q : unsigned(95 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal ray_w_q_g5 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_w_q_g4 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_w_q_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_w_q_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_w_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_w_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_w_q : unsigned(95 downto 0);
   type pipe_w_sr_t is array (1 to 2) of unsigned(95 downto 0);
   signal pipe_w_sr : pipe_w_sr_t := (others => (others => '0'));
   signal pipe_w : unsigned(95 downto 0);
@@ -601,30 +707,48 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_intersect_u : unsigned(31 downto 0);
   signal u_intersect_v : unsigned(31 downto 0);
 
-  -- register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+  -- register copies emit_slot_1_copies: emit_slot_1 and 11 copies, to split its fan-out
   signal emit_slot_1 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of emit_slot_1 : signal is "true";
   signal emit_slot_1_c1 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of emit_slot_1_c1 : signal is "true";
   signal emit_slot_1_c2 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of emit_slot_1_c2 : signal is "true";
+  signal emit_slot_1_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c3 : signal is "true";
+  signal emit_slot_1_c4 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c4 : signal is "true";
+  signal emit_slot_1_c5 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c5 : signal is "true";
+  signal emit_slot_1_c6 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c6 : signal is "true";
+  signal emit_slot_1_c7 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c7 : signal is "true";
+  signal emit_slot_1_c8 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c8 : signal is "true";
+  signal emit_slot_1_c9 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c9 : signal is "true";
+  signal emit_slot_1_c10 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c10 : signal is "true";
+  signal emit_slot_1_c11 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of emit_slot_1_c11 : signal is "true";
 
   -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   signal res_credit_ok : unsigned(0 downto 0) := unsigned'("1");
   signal u0_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u0_done_took : unsigned(0 downto 0);
-  signal and_32 : unsigned(0 downto 0);
+  signal and_35 : unsigned(0 downto 0);
   signal u0_done_avail : unsigned(0 downto 0);
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
-  signal and_33 : unsigned(0 downto 0);
+  signal and_36 : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
-  signal cat_34 : unsigned(6 downto 0);
+  signal cat_37 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_36 : unsigned(6 downto 0);
+  signal cat_39 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
-  signal or_37 : unsigned(0 downto 0);
+  signal or_40 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal u_closest_merge_valid0 : unsigned(0 downto 0);
@@ -646,8 +770,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_closest_res_v : unsigned(31 downto 0);
 
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  signal cat_38 : unsigned(63 downto 0);
-  signal cat_39 : unsigned(63 downto 0);
+  signal cat_41 : unsigned(63 downto 0);
+  signal cat_42 : unsigned(63 downto 0);
   signal res_take : unsigned(0 downto 0);
   signal res_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_wr : unsigned(3 downto 0) := unsigned'("0000");
@@ -668,15 +792,15 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_count_eq_k_0_5 : unsigned(0 downto 0);
   constant k_1_5 : unsigned(4 downto 0) := unsigned'("00001");
   signal res_q_one_left : unsigned(0 downto 0);
-  signal and_42 : unsigned(0 downto 0);
+  signal and_45 : unsigned(0 downto 0);
   signal res_q_drained : unsigned(0 downto 0);
   signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_bypass_c : unsigned(0 downto 0);
   signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_5_lt_res_q_count : unsigned(0 downto 0);
-  signal or_45 : unsigned(0 downto 0);
+  signal or_48 : unsigned(0 downto 0);
   signal not_res_take : unsigned(0 downto 0);
-  signal and_46 : unsigned(0 downto 0);
+  signal and_49 : unsigned(0 downto 0);
   signal res_q_nonempty_c : unsigned(0 downto 0);
   signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_q0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
@@ -689,7 +813,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_take_c : unsigned(0 downto 0);
   signal res_credits : unsigned(5 downto 0) := unsigned'("010000");
   signal rs_done_valid_r : unsigned(5 downto 0);
-  signal minus_48 : unsigned(5 downto 0);
+  signal minus_51 : unsigned(5 downto 0);
   signal rs_res_take_1 : unsigned(5 downto 0);
   signal res_credits_next : unsigned(5 downto 0);
   constant k_1_6 : unsigned(5 downto 0) := unsigned'("000001");
@@ -715,10 +839,40 @@ begin
   begin
     if rising_edge(clk) then
       if accept = "1" then
-        ray_o(to_integer(accept_slot_c1)) <= cat_16;
+        ray_o_g0(to_integer(accept_slot_c1)) <= bits_cat_17;
       end if;
-      if accept = "1" then
-        ray_w(to_integer(accept_slot_c1)) <= cat_17;
+      if accept_c1 = "1" then
+        ray_o_g1(to_integer(accept_slot_c2)) <= bits_cat_17_1;
+      end if;
+      if accept_c2 = "1" then
+        ray_o_g2(to_integer(accept_slot_c3)) <= bits_cat_17_2;
+      end if;
+      if accept_c3 = "1" then
+        ray_o_g3(to_integer(accept_slot_c4)) <= bits_cat_17_3;
+      end if;
+      if accept_c4 = "1" then
+        ray_o_g4(to_integer(accept_slot_c5)) <= bits_cat_17_4;
+      end if;
+      if accept_c5 = "1" then
+        ray_o_g5(to_integer(accept_slot_c6)) <= bits_cat_17_5;
+      end if;
+      if accept_c6 = "1" then
+        ray_w_g0(to_integer(accept_slot_c7)) <= bits_cat_18;
+      end if;
+      if accept_c7 = "1" then
+        ray_w_g1(to_integer(accept_slot_c8)) <= bits_cat_18_1;
+      end if;
+      if accept_c8 = "1" then
+        ray_w_g2(to_integer(accept_slot_c9)) <= bits_cat_18_2;
+      end if;
+      if accept_c9 = "1" then
+        ray_w_g3(to_integer(accept_slot_c10)) <= bits_cat_18_3;
+      end if;
+      if accept_c10 = "1" then
+        ray_w_g4(to_integer(accept_slot_c11)) <= bits_cat_18_4;
+      end if;
+      if accept_c11 = "1" then
+        ray_w_g5(to_integer(accept_slot_c12)) <= bits_cat_18_5;
       end if;
       if res_q_push = "1" then
         res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
@@ -739,9 +893,8 @@ begin
       u0_free_slot_r when "0",
       u1_free_slot_r when "1",
       u0_free_slot_r when others;
-  box_phase_eq_k_0 <= "1" when box_phase = k_0 else "0";
-  and_0 <= in_valid and box_phase_eq_k_0;
-  take <= and_0 and turn_free;
+  in_valid_and_box_idle <= in_valid and box_idle;
+  take <= in_valid_and_box_idle and turn_free;
   port_empty_and_ray_valid <= port_empty and ray_valid;
   not_take <= not take;
   in_valid_and_not_take <= in_valid and not_take;
@@ -756,14 +909,14 @@ begin
     case_turn_next <=
       u0_has_free when "0",
       u1_has_free when "1",
-      k_0_1 when others;
-  box_phase_ne_k_0 <= "1" when box_phase /= k_0 else "0";
-  take_or_box_phase_ne_k_0 <= take or box_phase_ne_k_0;
+      k_0 when others;
+  box_phase_ne_k_0_1 <= "1" when box_phase /= k_0_1 else "0";
+  or_3 <= take or box_phase_ne_k_0_1;
   box_phase_plus_k_1_1 <= box_phase + k_1_1;
-  mux_take_or_box_phase_ne_k_0 <= box_phase_plus_k_1_1 when take_or_box_phase_ne_k_0 = "1" else box_phase;
-  box_idle <= "1" when box_phase = k_0 else "0";
-  bits_accept_slot_c3 <= unsigned(accept_slot_c3(5 downto 0));
-  bits_accept_slot_c4 <= unsigned(accept_slot_c4(5 downto 0));
+  box_phase_next <= box_phase_plus_k_1_1 when or_3 = "1" else box_phase;
+  box_idle_next <= "1" when box_phase_next = k_0_1 else "0";
+  bits_accept_slot_c14 <= unsigned(accept_slot_c14(5 downto 0));
+  bits_accept_slot_c15 <= unsigned(accept_slot_c15(5 downto 0));
 
   ray_port_regs : process (clk)
   begin
@@ -776,7 +929,7 @@ begin
       if rst = '1' then
         box_phase <= unsigned'("00");
       else
-        box_phase <= mux_take_or_box_phase_ne_k_0;
+        box_phase <= box_phase_next;
       end if;
       if rst = '1' then
         u0_free_slot_r <= unsigned'("000000");
@@ -828,28 +981,23 @@ begin
       if port_empty_c3 = "1" then
         in_invz <= invz;
       end if;
-      if box_idle = "1" then
+      if box_idle_c1 = "1" then
         box_in_ox <= in_ox;
       end if;
-      if box_idle = "1" then
+      if box_idle_c1 = "1" then
         box_in_oy <= in_oy;
       end if;
-      if box_idle = "1" then
+      if box_idle_c1 = "1" then
         box_in_oz <= in_oz;
       end if;
-      if box_idle = "1" then
+      if box_idle_c1 = "1" then
         box_in_invx <= in_invx;
       end if;
-      if box_idle = "1" then
+      if box_idle_c1 = "1" then
         box_in_invy <= in_invy;
       end if;
-      if box_idle = "1" then
+      if box_idle_c1 = "1" then
         box_in_invz <= in_invz;
-      end if;
-      if rst = '1' then
-        accept <= unsigned'("0");
-      else
-        accept <= take;
       end if;
       acc_in_ray_id <= in_ray_id;
       acc_in_ox <= in_ox;
@@ -892,7 +1040,93 @@ begin
     end if;
   end process port_empty_copies_regs;
 
-  -- register copies accept_slot_copies: accept_slot and 4 copies, to split its fan-out
+  -- register copies box_idle_copies: box_idle and 1 copies, to split its fan-out
+
+  box_idle_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        box_idle <= unsigned'("1");
+      else
+        box_idle <= box_idle_next;
+      end if;
+      if rst = '1' then
+        box_idle_c1 <= unsigned'("1");
+      else
+        box_idle_c1 <= box_idle_next;
+      end if;
+    end if;
+  end process box_idle_copies_regs;
+
+  -- register copies accept_copies: accept and 11 copies, to split its fan-out
+
+  accept_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        accept <= unsigned'("0");
+      else
+        accept <= take;
+      end if;
+      if rst = '1' then
+        accept_c1 <= unsigned'("0");
+      else
+        accept_c1 <= take;
+      end if;
+      if rst = '1' then
+        accept_c2 <= unsigned'("0");
+      else
+        accept_c2 <= take;
+      end if;
+      if rst = '1' then
+        accept_c3 <= unsigned'("0");
+      else
+        accept_c3 <= take;
+      end if;
+      if rst = '1' then
+        accept_c4 <= unsigned'("0");
+      else
+        accept_c4 <= take;
+      end if;
+      if rst = '1' then
+        accept_c5 <= unsigned'("0");
+      else
+        accept_c5 <= take;
+      end if;
+      if rst = '1' then
+        accept_c6 <= unsigned'("0");
+      else
+        accept_c6 <= take;
+      end if;
+      if rst = '1' then
+        accept_c7 <= unsigned'("0");
+      else
+        accept_c7 <= take;
+      end if;
+      if rst = '1' then
+        accept_c8 <= unsigned'("0");
+      else
+        accept_c8 <= take;
+      end if;
+      if rst = '1' then
+        accept_c9 <= unsigned'("0");
+      else
+        accept_c9 <= take;
+      end if;
+      if rst = '1' then
+        accept_c10 <= unsigned'("0");
+      else
+        accept_c10 <= take;
+      end if;
+      if rst = '1' then
+        accept_c11 <= unsigned'("0");
+      else
+        accept_c11 <= take;
+      end if;
+    end if;
+  end process accept_copies_regs;
+
+  -- register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
 
   accept_slot_copies_regs : process (clk)
   begin
@@ -902,6 +1136,17 @@ begin
       accept_slot_c2 <= take_slot;
       accept_slot_c3 <= take_slot;
       accept_slot_c4 <= take_slot;
+      accept_slot_c5 <= take_slot;
+      accept_slot_c6 <= take_slot;
+      accept_slot_c7 <= take_slot;
+      accept_slot_c8 <= take_slot;
+      accept_slot_c9 <= take_slot;
+      accept_slot_c10 <= take_slot;
+      accept_slot_c11 <= take_slot;
+      accept_slot_c12 <= take_slot;
+      accept_slot_c13 <= take_slot;
+      accept_slot_c14 <= take_slot;
+      accept_slot_c15 <= take_slot;
     end if;
   end process accept_slot_copies_regs;
 
@@ -913,7 +1158,7 @@ begin
       box_in_invz when "10",
       box_in_invx when others;
   box_neg <= unsigned(case_box_axis(47 downto 47));
-  box_issue <= "1" when box_phase /= k_0 else "0";
+  box_issue <= "1" when box_phase /= k_0_1 else "0";
   box_issue_last <= "1" when box_phase = k_3 else "0";
   with box_axis select
     case_box_axis_1 <=
@@ -952,20 +1197,20 @@ begin
   pu_first <= pu_clamp_valid and not_pu_clamp_last;
   rs_plane_t <= resize(plane_t, 33);
   rs_box_d1 <= resize(box_d1, 33);
-  minus_6 <= rs_plane_t - rs_box_d1;
-  box_lt1_c <= unsigned(minus_6(32 downto 32));
+  minus_7 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_7(32 downto 32));
   rs_plane_t_1 <= resize(plane_t, 33);
   rs_box_d2 <= resize(box_d2, 33);
-  minus_7 <= rs_plane_t_1 - rs_box_d2;
-  box_lt2_c <= unsigned(minus_7(32 downto 32));
+  minus_8 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_8(32 downto 32));
   box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
   mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
   box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
   bits_box_d1 <= unsigned(box_d1(31 downto 31));
   bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_8 <= bits_box_d1 or bits_box_d2;
+  or_9 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_8 or bits_box_d3;
+  box_miss <= or_9 or bits_box_d3;
   box_last <= plane_t_valid and plane_t_last;
   box_done_slot <= box_done_slot_sr(11);
 
@@ -1079,22 +1324,22 @@ begin
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
   bits_accept_slot <= unsigned(accept_slot(6 downto 6));
-  eq_10 <= "1" when bits_accept_slot = k_0_1 else "0";
-  u0_alloc <= accept and eq_10;
+  bits_accept_slot_eq_k_0 <= "1" when bits_accept_slot = k_0 else "0";
+  u0_alloc <= accept and bits_accept_slot_eq_k_0;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
-  eq_11 <= "1" when bits_box_done_slot = k_0_1 else "0";
-  u0_new <= box_done and eq_11;
+  eq_12 <= "1" when bits_box_done_slot = k_0 else "0";
+  u0_new <= box_done and eq_12;
   bits_free_slot <= unsigned(free_slot(6 downto 6));
-  bits_free_slot_eq_k_0_1 <= "1" when bits_free_slot = k_0_1 else "0";
-  u0_free <= free_valid and bits_free_slot_eq_k_0_1;
+  bits_free_slot_eq_k_0 <= "1" when bits_free_slot = k_0 else "0";
+  u0_free <= free_valid and bits_free_slot_eq_k_0;
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
   bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
-  eq_13 <= "1" when bits_accept_slot_1 = k_1 else "0";
-  u1_alloc <= accept and eq_13;
+  eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
+  u1_alloc <= accept and eq_14;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
-  eq_14 <= "1" when bits_box_done_slot_2 = k_1 else "0";
-  u1_new <= box_done and eq_14;
+  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_15;
   bits_free_slot_2 <= unsigned(free_slot(6 downto 6));
   bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
   u1_free <= free_valid and bits_free_slot_2_eq_k_1;
@@ -1102,11 +1347,23 @@ begin
   bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
 
   -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  cat_16 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  cat_17 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  bits_cat_17 <= unsigned(cat_17(15 downto 0));
+  bits_cat_17_1 <= unsigned(cat_17(31 downto 16));
+  bits_cat_17_2 <= unsigned(cat_17(47 downto 32));
+  bits_cat_17_3 <= unsigned(cat_17(63 downto 48));
+  bits_cat_17_4 <= unsigned(cat_17(79 downto 64));
+  bits_cat_17_5 <= unsigned(cat_17(86 downto 80));
   u_acc_in_wz <= unsigned(acc_in_wz);
   u_acc_in_wy <= unsigned(acc_in_wy);
   u_acc_in_wx <= unsigned(acc_in_wx);
-  cat_17 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
+  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
+  bits_cat_18 <= unsigned(cat_18(15 downto 0));
+  bits_cat_18_1 <= unsigned(cat_18(31 downto 16));
+  bits_cat_18_2 <= unsigned(cat_18(47 downto 32));
+  bits_cat_18_3 <= unsigned(cat_18(63 downto 48));
+  bits_cat_18_4 <= unsigned(cat_18(79 downto 64));
+  bits_cat_18_5 <= unsigned(cat_18(95 downto 80));
 
   -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   leaf_last_entry <= leaf_active and leaf_last;
@@ -1120,45 +1377,45 @@ begin
     case_leaf_turn <=
       u0_leaf_buf_valid when "0",
       u1_leaf_buf_valid when "1",
-      k_0_1 when others;
+      k_0 when others;
   with leaf_turn select
     case_leaf_turn_1 <=
-      k_0_1 when "0",
+      k_0 when "0",
       k_1 when "1",
-      k_0_1 when others;
+      k_0 when others;
   with leaf_turn select
     case_leaf_turn_2 <=
       u1_leaf_buf_valid when "0",
       u0_leaf_buf_valid when "1",
-      k_0_1 when others;
+      k_0 when others;
   with leaf_turn select
     case_leaf_turn_3 <=
       k_1 when "0",
-      k_0_1 when "1",
-      k_0_1 when others;
-  or_22 <= case_leaf_turn_2 or case_leaf_turn;
+      k_0 when "1",
+      k_0 when others;
+  or_23 <= case_leaf_turn_2 or case_leaf_turn;
   mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_22;
-  eq_23 <= "1" when mux_case_leaf_turn_2 = k_0_1 else "0";
-  u0_leaf_take <= leaf_take and eq_23;
+  leaf_take <= leaf_can_take and or_23;
+  eq_24 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
+  u0_leaf_take <= leaf_take and eq_24;
   not_u0_leaf_take <= not u0_leaf_take;
-  and_24 <= u0_leaf_buf_valid and not_u0_leaf_take;
-  u0_leaf_fill_or_and_24 <= u0_leaf_fill or and_24;
-  eq_25 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_25;
+  and_25 <= u0_leaf_buf_valid and not_u0_leaf_take;
+  u0_leaf_fill_or_and_25 <= u0_leaf_fill or and_25;
+  eq_26 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_26;
   not_u1_leaf_take <= not u1_leaf_take;
-  and_26 <= u1_leaf_buf_valid and not_u1_leaf_take;
-  u1_leaf_fill_or_and_26 <= u1_leaf_fill or and_26;
+  and_27 <= u1_leaf_buf_valid and not_u1_leaf_take;
+  u1_leaf_fill_or_and_27 <= u1_leaf_fill or and_27;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
       u0_buf_leaf_slot when "0",
       u1_buf_leaf_slot when "1",
       u0_buf_leaf_slot when others;
-  cat_27 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_28 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_28 <= leaf_take or and_28;
-  mux_leaf_take <= cat_27 when leaf_take = "1" else leaf_slot;
+  and_29 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_29 <= leaf_take or and_29;
+  mux_leaf_take <= cat_28 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
       u0_buf_leaf_first when "0",
@@ -1190,9 +1447,9 @@ begin
       u0_buf_leaf_count when "0",
       u1_buf_leaf_count when "1",
       u0_buf_leaf_count when others;
-  eq_29 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  eq_30 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_29 when leaf_take = "1" else leaf_left_eq_k_2;
+  mux_leaf_take_5 <= eq_30 when leaf_take = "1" else leaf_left_eq_k_2;
 
   leaf_stream_regs : process (clk)
   begin
@@ -1200,7 +1457,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_28;
+        leaf_active <= leaf_take_or_and_29;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -1217,7 +1474,7 @@ begin
       if rst = '1' then
         u0_leaf_buf_valid <= unsigned'("0");
       else
-        u0_leaf_buf_valid <= u0_leaf_fill_or_and_24;
+        u0_leaf_buf_valid <= u0_leaf_fill_or_and_25;
       end if;
       if u0_leaf_fill = "1" then
         u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
@@ -1237,7 +1494,7 @@ begin
       if rst = '1' then
         u1_leaf_buf_valid <= unsigned'("0");
       else
-        u1_leaf_buf_valid <= u1_leaf_fill_or_and_26;
+        u1_leaf_buf_valid <= u1_leaf_fill_or_and_27;
       end if;
       if u1_leaf_fill = "1" then
         u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
@@ -1258,7 +1515,7 @@ begin
   end process leaf_stream_regs;
 
   -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
-  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -1281,7 +1538,9 @@ begin
   tri_e2q <= signed(u_tri_rom_2_data);
   pipe_tag <= pipe_tag_sr(3);
   emit_slot_sr <= emit_slot_sr_sr(2);
+  ray_o_q <= unsigned(std_logic_vector'(std_logic_vector(ray_o_q_g5) & std_logic_vector(ray_o_q_g4) & std_logic_vector(ray_o_q_g3) & std_logic_vector(ray_o_q_g2) & std_logic_vector(ray_o_q_g1) & std_logic_vector(ray_o_q_g0)));
   pipe_o <= pipe_o_sr(2);
+  ray_w_q <= unsigned(std_logic_vector'(std_logic_vector(ray_w_q_g5) & std_logic_vector(ray_w_q_g4) & std_logic_vector(ray_w_q_g3) & std_logic_vector(ray_w_q_g2) & std_logic_vector(ray_w_q_g1) & std_logic_vector(ray_w_q_g0)));
   pipe_w <= pipe_w_sr(2);
   bits_pipe_o <= unsigned(pipe_o(28 downto 0));
   bits_pipe_o_1 <= unsigned(pipe_o(57 downto 29));
@@ -1297,7 +1556,7 @@ begin
   begin
     if rising_edge(clk) then
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_30;
+      emit_tag_sr(1) <= cat_31;
       if rst = '1' then
         emit_valid_1 <= unsigned'("0");
       else
@@ -1332,16 +1591,26 @@ begin
       pipe_tag_sr(1) <= emit_tag_tri;
       emit_slot_sr_sr(2 to 2) <= emit_slot_sr_sr(1 to 1);
       emit_slot_sr_sr(1) <= leaf_slot;
-      ray_o_q <= ray_o(to_integer(emit_slot_1_c1));
+      ray_o_q_g5 <= ray_o_g5(to_integer(emit_slot_1_c5));
+      ray_o_q_g4 <= ray_o_g4(to_integer(emit_slot_1_c4));
+      ray_o_q_g3 <= ray_o_g3(to_integer(emit_slot_1_c3));
+      ray_o_q_g2 <= ray_o_g2(to_integer(emit_slot_1_c2));
+      ray_o_q_g1 <= ray_o_g1(to_integer(emit_slot_1_c1));
+      ray_o_q_g0 <= ray_o_g0(to_integer(emit_slot_1));
       pipe_o_sr(2 to 2) <= pipe_o_sr(1 to 1);
       pipe_o_sr(1) <= ray_o_q;
-      ray_w_q <= ray_w(to_integer(emit_slot_1_c2));
+      ray_w_q_g5 <= ray_w_g5(to_integer(emit_slot_1_c11));
+      ray_w_q_g4 <= ray_w_g4(to_integer(emit_slot_1_c10));
+      ray_w_q_g3 <= ray_w_g3(to_integer(emit_slot_1_c9));
+      ray_w_q_g2 <= ray_w_g2(to_integer(emit_slot_1_c8));
+      ray_w_q_g1 <= ray_w_g1(to_integer(emit_slot_1_c7));
+      ray_w_q_g0 <= ray_w_g0(to_integer(emit_slot_1_c6));
       pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
       pipe_w_sr(1) <= ray_w_q;
     end if;
   end process emission_regs;
 
-  -- register copies emit_slot_1_copies: emit_slot_1 and 2 copies, to split its fan-out
+  -- register copies emit_slot_1_copies: emit_slot_1 and 11 copies, to split its fan-out
 
   emit_slot_1_copies_regs : process (clk)
   begin
@@ -1349,22 +1618,31 @@ begin
       emit_slot_1 <= emit_slot_sr;
       emit_slot_1_c1 <= emit_slot_sr;
       emit_slot_1_c2 <= emit_slot_sr;
+      emit_slot_1_c3 <= emit_slot_sr;
+      emit_slot_1_c4 <= emit_slot_sr;
+      emit_slot_1_c5 <= emit_slot_sr;
+      emit_slot_1_c6 <= emit_slot_sr;
+      emit_slot_1_c7 <= emit_slot_sr;
+      emit_slot_1_c8 <= emit_slot_sr;
+      emit_slot_1_c9 <= emit_slot_sr;
+      emit_slot_1_c10 <= emit_slot_sr;
+      emit_slot_1_c11 <= emit_slot_sr;
     end if;
   end process emit_slot_1_copies_regs;
 
   -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   not_u0_done_took <= not u0_done_took;
-  and_32 <= u_traverse_0_done_valid and not_u0_done_took;
-  u0_done_avail <= and_32 and res_credit_ok;
+  and_35 <= u_traverse_0_done_valid and not_u0_done_took;
+  u0_done_avail <= and_35 and res_credit_ok;
   not_u1_done_took <= not u1_done_took;
-  and_33 <= u_traverse_1_done_valid and not_u1_done_took;
-  u1_done_avail <= and_33 and res_credit_ok;
-  cat_34 <= unsigned(std_logic_vector'(std_logic_vector(k_0_1) & std_logic_vector(u_traverse_0_done_slot)));
+  and_36 <= u_traverse_1_done_valid and not_u1_done_took;
+  u1_done_avail <= and_36 and res_credit_ok;
+  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_34 when u0_done_avail = "1" else cat_36;
-  or_37 <= u0_done_avail or u1_done_avail;
+  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_37 when u0_done_avail = "1" else cat_39;
+  or_40 <= u0_done_avail or u1_done_avail;
 
   done_regs : process (clk)
   begin
@@ -1387,15 +1665,15 @@ begin
       if rst = '1' then
         done_valid_r <= unsigned'("0");
       else
-        done_valid_r <= or_37;
+        done_valid_r <= or_40;
       end if;
       done_slot_r <= mux_u0_done_avail;
     end if;
   end process done_regs;
 
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
-  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
+  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
+  cat_42 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
   res_take <= res_take_c;
   res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
   mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
@@ -1408,21 +1686,21 @@ begin
   res_q_count_next <= res_q_after_pop + rs_res_q_push;
   res_q_count_eq_k_0_5 <= "1" when res_q_count = k_0_5 else "0";
   res_q_one_left <= "1" when res_q_count = k_1_5 else "0";
-  and_42 <= res_q_one_left and res_take;
-  res_q_drained <= res_q_count_eq_k_0_5 or and_42;
+  and_45 <= res_q_one_left and res_take;
+  res_q_drained <= res_q_count_eq_k_0_5 or and_45;
   res_q_bypass_c <= res_q_push and res_q_drained;
   k_1_5_lt_res_q_count <= "1" when k_1_5 < res_q_count else "0";
-  or_45 <= res_q_push or k_1_5_lt_res_q_count;
+  or_48 <= res_q_push or k_1_5_lt_res_q_count;
   not_res_take <= not res_take;
-  and_46 <= res_q_one_left and not_res_take;
-  res_q_nonempty_c <= or_45 or and_46;
+  and_49 <= res_q_one_left and not_res_take;
+  res_q_nonempty_c <= or_48 or and_49;
   res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
   res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
   res_take_c <= res_q_nonempty and res_ready;
   rs_done_valid_r <= resize(done_valid_r, 6);
-  minus_48 <= res_credits - rs_done_valid_r;
+  minus_51 <= res_credits - rs_done_valid_r;
   rs_res_take_1 <= resize(res_take, 6);
-  res_credits_next <= minus_48 + rs_res_take_1;
+  res_credits_next <= minus_51 + rs_res_take_1;
   res_credits_ge1 <= "1" when k_1_6 <= res_credits else "0";
   res_credits_ge2 <= "1" when k_2_1 <= res_credits else "0";
   res_credits_ge3 <= "1" when k_3_1 <= res_credits else "0";
@@ -1474,12 +1752,12 @@ begin
       else
         res_q_nonempty <= res_q_nonempty_c;
       end if;
-      res_q_din0 <= cat_38;
+      res_q_din0 <= cat_41;
       res_q_q0 <= res_q_mem0(to_integer(res_q_rd_next));
       if res_q_push = "1" then
         res_q_din_r0 <= res_q_din0;
       end if;
-      res_q_din1 <= cat_39;
+      res_q_din1 <= cat_42;
       res_q_q1 <= res_q_mem1(to_integer(res_q_rd_next));
       if res_q_push = "1" then
         res_q_din_r1 <= res_q_din1;
@@ -1505,7 +1783,7 @@ begin
       clk => clk,
       rst => rst,
       ray_we => u0_alloc,
-      ray_slot => bits_accept_slot_c3,
+      ray_slot => bits_accept_slot_c14,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -1551,7 +1829,7 @@ begin
       clk => clk,
       rst => rst,
       ray_we => u1_alloc,
-      ray_slot => bits_accept_slot_c4,
+      ray_slot => bits_accept_slot_c15,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -1670,7 +1948,7 @@ begin
       u => u_intersect_u,
       v => u_intersect_v,
       id_we => accept,
-      id_slot => accept_slot_c2,
+      id_slot => accept_slot_c13,
       id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,

@@ -60,8 +60,14 @@ module fxrt_traverse_k64_sf0a3f4 (
   (* ram_style = "distributed" *) reg [11:0] unpark_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_unpark_q_mem.hex", unpark_q_mem);
 
-  (* ram_style = "distributed" *) reg [38:0] new_q_mem [0:63];
-  initial $readmemh("fxrt_traverse_k64_sf0a3f4_new_q_mem.hex", new_q_mem);
+  (* ram_style = "distributed" *) reg [15:0] new_q_mem_g0 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_new_q_mem_g0.hex", new_q_mem_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] new_q_mem_g1 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_new_q_mem_g1.hex", new_q_mem_g1);
+
+  (* ram_style = "distributed" *) reg [6:0] new_q_mem_g2 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_new_q_mem_g2.hex", new_q_mem_g2);
 
   (* ram_style = "distributed" *) reg [5:0] done_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_done_q_mem.hex", done_q_mem);
@@ -69,8 +75,17 @@ module fxrt_traverse_k64_sf0a3f4 (
   (* ram_style = "distributed" *) reg [31:0] cull_limit [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_cull_limit.hex", cull_limit);
 
-  (* ram_style = "distributed" *) reg [58:0] leaf_q_mem [0:63];
-  initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem.hex", leaf_q_mem);
+  (* ram_style = "distributed" *) reg [15:0] leaf_q_mem_g0 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem_g0.hex", leaf_q_mem_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] leaf_q_mem_g1 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem_g1.hex", leaf_q_mem_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] leaf_q_mem_g2 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem_g2.hex", leaf_q_mem_g2);
+
+  (* ram_style = "distributed" *) reg [10:0] leaf_q_mem_g3 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem_g3.hex", leaf_q_mem_g3);
 
   // not in a stage or state machine
   wire [86:0] cat_0;
@@ -594,11 +609,9 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [38:0] cat_86;
   reg [0:0] new_q_push = 1'h0;
   reg [5:0] new_q_wr = 6'h00;
-  reg [5:0] new_q_rd = 6'h00;
   reg [6:0] new_q_count = 7'h00;
   wire [5:0] new_q_wr_plus_k_1;
   wire [5:0] mux_new_q_push;
-  reg [5:0] new_q_rd1 = 6'h01;
   wire [5:0] new_q_rd_next;
   wire [5:0] new_q_rd1_plus_k_1;
   wire [5:0] mux_new_pop;
@@ -620,8 +633,17 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] and_93;
   wire [0:0] new_q_nonempty_c;
   reg [38:0] new_q_din = 39'h0000000000;
-  reg [38:0] new_q_q_stay = 39'h0000000000;
-  reg [38:0] new_q_q_next = 39'h0000000000;
+  wire [15:0] bits_new_q_din;
+  wire [15:0] bits_new_q_din_1;
+  wire [6:0] bits_new_q_din_2;
+  reg [6:0] new_q_q_stay_g2 = 7'h00;
+  reg [15:0] new_q_q_stay_g1 = 16'h0000;
+  reg [15:0] new_q_q_stay_g0 = 16'h0000;
+  wire [38:0] new_q_q_stay;
+  reg [6:0] new_q_q_next_g2 = 7'h00;
+  reg [15:0] new_q_q_next_g1 = 16'h0000;
+  reg [15:0] new_q_q_next_g0 = 16'h0000;
+  wire [38:0] new_q_q_next;
   wire [38:0] mux_new_q_popped;
   reg [38:0] new_q_din_r = 39'h0000000000;
   wire [38:0] new_q_head;
@@ -629,7 +651,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] take_unpark;
   wire [0:0] not_ring_g_valid_1;
   wire [0:0] not_unpark_q_nonempty;
-  wire [0:0] and_95;
+  wire [0:0] and_97;
   wire [0:0] take_new;
   wire [0:0] take_unpark_or_take_new;
   reg [0:0] q_valid = 1'h0;
@@ -640,21 +662,39 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [5:0] q_slot = 6'h00;
   wire [5:0] bits_unpark_q_head_1;
   reg [5:0] q_sp = 6'h00;
-  wire [0:0] eq_97;
+  wire [0:0] eq_99;
   reg [0:0] q_sp_zero = 1'h0;
-  wire [5:0] minus_98;
+  wire [5:0] minus_100;
   reg [5:0] q_sp_m1 = 6'h00;
-  wire [31:0] bits_new_q_head_1;
-  wire signed [31:0] s_bits_new_q_head_1;
+  wire [4:0] rs_minus_100;
+  wire [10:0] q_stack_raddr;
+  wire [5:0] bits_unpark_q_head_2;
+  wire [0:0] eq_102;
+  wire [0:0] bits_new_q_head_1;
+  wire [0:0] and_103;
+  wire [0:0] take_unpark_and_eq_102;
+  wire [0:0] q_done_c;
+  reg [0:0] q_done = 1'h0;
+  wire [31:0] bits_new_q_head_2;
+  wire signed [31:0] s_bits_new_q_head_2;
   reg signed [31:0] q_tmax = 32'sh00000000;
-  wire [0:0] bits_new_q_head_2;
-  reg [0:0] q_miss = 1'h0;
+
+  // register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
+  reg [5:0] new_q_rd = 6'h00;
+  reg [5:0] new_q_rd_c1 = 6'h00;
+  reg [5:0] new_q_rd_c2 = 6'h00;
+
+  // register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
+  reg [5:0] new_q_rd1 = 6'h01;
+  reg [5:0] new_q_rd1_c1 = 6'h01;
+  reg [5:0] new_q_rd1_c2 = 6'h01;
 
   // stage ring_r: R: the token back from G, loaded in G
   reg [0:0] r_valid = 1'h0;
   reg [0:0] r_pop = 1'h0;
   reg [0:0] r_sp_zero = 1'h0;
   reg [5:0] r_sp_m1 = 6'h00;
+  reg [0:0] r_done = 1'h0;
   reg [5:0] r_slot = 6'h00;
   reg [12:0] r_node = 13'h0000;
   reg signed [31:0] r_tmin = 32'sh00000000;
@@ -664,8 +704,6 @@ module fxrt_traverse_k64_sf0a3f4 (
   // stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   wire [0:0] a_valid;
   wire [5:0] a_slot;
-  wire [0:0] not_r_valid;
-  wire [0:0] a_new;
   wire [0:0] not_q_new;
   wire [0:0] a_pop;
   wire [5:0] mux_q_new;
@@ -673,17 +711,17 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] q_new_or_q_sp_zero;
   wire [0:0] a_sp_zero;
   wire [5:0] a_sp_m1;
-  wire [0:0] a_pop_and_a_sp_zero;
-  wire [0:0] a_new_and_q_miss;
-  wire [0:0] or_99;
+  wire [0:0] r_valid_and_r_done;
+  wire [0:0] not_r_valid;
+  wire [0:0] not_r_valid_and_q_valid;
+  wire [0:0] and_105;
   wire [0:0] a_done;
   wire [0:0] not_a_sp_zero;
   wire [0:0] a_from_stack;
   wire [0:0] stack_we;
   wire [10:0] stack_waddr;
   wire [76:0] stack_wdata;
-  wire [4:0] rs_a_sp_m1;
-  wire [10:0] stack_raddr;
+  reg [10:0] stack_raddr = 11'h000;
   wire [76:0] u_stack_data;
 
   // stage ring_b: B, B2: the token waits two clocks for the stack word
@@ -730,16 +768,16 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] done_q_count_next;
   wire [0:0] done_q_count_eq_k_0_3;
   wire [0:0] done_q_one_left;
-  wire [0:0] and_103;
+  wire [0:0] and_109;
   wire [0:0] done_q_drained;
   reg [0:0] done_q_bypass = 1'h0;
   wire [0:0] done_q_bypass_c;
   reg [0:0] done_q_popped = 1'h0;
   reg [0:0] done_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_done_q_count;
-  wire [0:0] or_106;
+  wire [0:0] or_112;
   wire [0:0] not_done_pop_r;
-  wire [0:0] and_107;
+  wire [0:0] and_113;
   wire [0:0] done_q_nonempty_c;
   reg [5:0] done_q_din = 6'h00;
   reg [5:0] done_q_q_stay = 6'h00;
@@ -839,13 +877,13 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_s_limit_q;
   wire signed [32:0] rs_cull_x;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_109;
+  wire signed [32:0] minus_115;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_minus_109;
+  wire [0:0] bits_minus_115;
   wire [0:0] culled_c;
   reg [0:0] culled = 1'h0;
   reg [0:0] culled_n = 1'h0;
-  wire [0:0] and_111;
+  wire [0:0] and_117;
   wire [0:0] merge_slot_eq_k_63;
   wire [0:0] merge_slot_eq_k_62;
   wire [0:0] merge_slot_eq_k_61;
@@ -910,79 +948,78 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] merge_slot_eq_k_2;
   wire [0:0] merge_slot_eq_k_1;
   wire [0:0] merge_slot_eq_k_0_1;
-  wire [63:0] cat_112;
+  wire [63:0] cat_118;
   wire [63:0] best_set;
-  wire [0:0] a_new_and_a_valid;
-  wire [0:0] a_slot_eq_k_63;
-  wire [0:0] a_slot_eq_k_62;
-  wire [0:0] a_slot_eq_k_61;
-  wire [0:0] a_slot_eq_k_60;
-  wire [0:0] a_slot_eq_k_59;
-  wire [0:0] a_slot_eq_k_58;
-  wire [0:0] a_slot_eq_k_57;
-  wire [0:0] a_slot_eq_k_56;
-  wire [0:0] a_slot_eq_k_55;
-  wire [0:0] a_slot_eq_k_54;
-  wire [0:0] a_slot_eq_k_53;
-  wire [0:0] a_slot_eq_k_52;
-  wire [0:0] a_slot_eq_k_51;
-  wire [0:0] a_slot_eq_k_50;
-  wire [0:0] a_slot_eq_k_49;
-  wire [0:0] a_slot_eq_k_48;
-  wire [0:0] a_slot_eq_k_47;
-  wire [0:0] a_slot_eq_k_46;
-  wire [0:0] a_slot_eq_k_45;
-  wire [0:0] a_slot_eq_k_44;
-  wire [0:0] a_slot_eq_k_43;
-  wire [0:0] a_slot_eq_k_42;
-  wire [0:0] a_slot_eq_k_41;
-  wire [0:0] a_slot_eq_k_40;
-  wire [0:0] a_slot_eq_k_39;
-  wire [0:0] a_slot_eq_k_38;
-  wire [0:0] a_slot_eq_k_37;
-  wire [0:0] a_slot_eq_k_36;
-  wire [0:0] a_slot_eq_k_35;
-  wire [0:0] a_slot_eq_k_34;
-  wire [0:0] a_slot_eq_k_33;
-  wire [0:0] a_slot_eq_k_32;
-  wire [0:0] a_slot_eq_k_31;
-  wire [0:0] a_slot_eq_k_30;
-  wire [0:0] a_slot_eq_k_29;
-  wire [0:0] a_slot_eq_k_28;
-  wire [0:0] a_slot_eq_k_27;
-  wire [0:0] a_slot_eq_k_26;
-  wire [0:0] a_slot_eq_k_25;
-  wire [0:0] a_slot_eq_k_24;
-  wire [0:0] a_slot_eq_k_23;
-  wire [0:0] a_slot_eq_k_22;
-  wire [0:0] a_slot_eq_k_21;
-  wire [0:0] a_slot_eq_k_20;
-  wire [0:0] a_slot_eq_k_19;
-  wire [0:0] a_slot_eq_k_18;
-  wire [0:0] a_slot_eq_k_17;
-  wire [0:0] a_slot_eq_k_16;
-  wire [0:0] a_slot_eq_k_15;
-  wire [0:0] a_slot_eq_k_14;
-  wire [0:0] a_slot_eq_k_13;
-  wire [0:0] a_slot_eq_k_12;
-  wire [0:0] a_slot_eq_k_11;
-  wire [0:0] a_slot_eq_k_10;
-  wire [0:0] a_slot_eq_k_9;
-  wire [0:0] a_slot_eq_k_8;
-  wire [0:0] a_slot_eq_k_7;
-  wire [0:0] a_slot_eq_k_6;
-  wire [0:0] a_slot_eq_k_5;
-  wire [0:0] a_slot_eq_k_4;
-  wire [0:0] a_slot_eq_k_3;
-  wire [0:0] a_slot_eq_k_2;
-  wire [0:0] a_slot_eq_k_1;
-  wire [0:0] a_slot_eq_k_0_1;
-  wire [63:0] cat_113;
+  wire [0:0] q_slot_eq_k_63;
+  wire [0:0] q_slot_eq_k_62;
+  wire [0:0] q_slot_eq_k_61;
+  wire [0:0] q_slot_eq_k_60;
+  wire [0:0] q_slot_eq_k_59;
+  wire [0:0] q_slot_eq_k_58;
+  wire [0:0] q_slot_eq_k_57;
+  wire [0:0] q_slot_eq_k_56;
+  wire [0:0] q_slot_eq_k_55;
+  wire [0:0] q_slot_eq_k_54;
+  wire [0:0] q_slot_eq_k_53;
+  wire [0:0] q_slot_eq_k_52;
+  wire [0:0] q_slot_eq_k_51;
+  wire [0:0] q_slot_eq_k_50;
+  wire [0:0] q_slot_eq_k_49;
+  wire [0:0] q_slot_eq_k_48;
+  wire [0:0] q_slot_eq_k_47;
+  wire [0:0] q_slot_eq_k_46;
+  wire [0:0] q_slot_eq_k_45;
+  wire [0:0] q_slot_eq_k_44;
+  wire [0:0] q_slot_eq_k_43;
+  wire [0:0] q_slot_eq_k_42;
+  wire [0:0] q_slot_eq_k_41;
+  wire [0:0] q_slot_eq_k_40;
+  wire [0:0] q_slot_eq_k_39;
+  wire [0:0] q_slot_eq_k_38;
+  wire [0:0] q_slot_eq_k_37;
+  wire [0:0] q_slot_eq_k_36;
+  wire [0:0] q_slot_eq_k_35;
+  wire [0:0] q_slot_eq_k_34;
+  wire [0:0] q_slot_eq_k_33;
+  wire [0:0] q_slot_eq_k_32;
+  wire [0:0] q_slot_eq_k_31;
+  wire [0:0] q_slot_eq_k_30;
+  wire [0:0] q_slot_eq_k_29;
+  wire [0:0] q_slot_eq_k_28;
+  wire [0:0] q_slot_eq_k_27;
+  wire [0:0] q_slot_eq_k_26;
+  wire [0:0] q_slot_eq_k_25;
+  wire [0:0] q_slot_eq_k_24;
+  wire [0:0] q_slot_eq_k_23;
+  wire [0:0] q_slot_eq_k_22;
+  wire [0:0] q_slot_eq_k_21;
+  wire [0:0] q_slot_eq_k_20;
+  wire [0:0] q_slot_eq_k_19;
+  wire [0:0] q_slot_eq_k_18;
+  wire [0:0] q_slot_eq_k_17;
+  wire [0:0] q_slot_eq_k_16;
+  wire [0:0] q_slot_eq_k_15;
+  wire [0:0] q_slot_eq_k_14;
+  wire [0:0] q_slot_eq_k_13;
+  wire [0:0] q_slot_eq_k_12;
+  wire [0:0] q_slot_eq_k_11;
+  wire [0:0] q_slot_eq_k_10;
+  wire [0:0] q_slot_eq_k_9;
+  wire [0:0] q_slot_eq_k_8;
+  wire [0:0] q_slot_eq_k_7;
+  wire [0:0] q_slot_eq_k_6;
+  wire [0:0] q_slot_eq_k_5;
+  wire [0:0] q_slot_eq_k_4;
+  wire [0:0] q_slot_eq_k_3;
+  wire [0:0] q_slot_eq_k_2;
+  wire [0:0] q_slot_eq_k_1;
+  wire [0:0] q_slot_eq_k_0_1;
+  wire [63:0] cat_119;
   wire [63:0] best_clear_c;
   reg [63:0] best_clear = 64'h0000000000000000;
   wire [63:0] not_best_clear;
-  wire [63:0] and_114;
-  wire [63:0] and_114_or_best_set;
+  wire [63:0] and_120;
+  wire [63:0] and_120_or_best_set;
 
   // register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
   reg [5:0] c_slot = 6'h00;
@@ -1033,15 +1070,13 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [31:0] u_n_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_n_tmin;
-  wire [58:0] cat_118;
+  wire [58:0] cat_124;
   reg [0:0] leaf_pop_r = 1'h0;
   reg [0:0] leaf_q_push = 1'h0;
   reg [5:0] leaf_q_wr = 6'h00;
-  reg [5:0] leaf_q_rd = 6'h00;
   reg [6:0] leaf_q_count = 7'h00;
   wire [5:0] leaf_q_wr_plus_k_1;
   wire [5:0] mux_leaf_q_push;
-  reg [5:0] leaf_q_rd1 = 6'h01;
   wire [5:0] leaf_q_rd_next;
   wire [5:0] leaf_q_rd1_plus_k_1;
   wire [5:0] mux_leaf_pop_r;
@@ -1051,20 +1086,32 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] leaf_q_count_next;
   wire [0:0] leaf_q_count_eq_k_0_3;
   wire [0:0] leaf_q_one_left;
-  wire [0:0] and_121;
+  wire [0:0] and_127;
   wire [0:0] leaf_q_drained;
   reg [0:0] leaf_q_bypass = 1'h0;
   wire [0:0] leaf_q_bypass_c;
   reg [0:0] leaf_q_popped = 1'h0;
   reg [0:0] leaf_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_leaf_q_count;
-  wire [0:0] or_124;
+  wire [0:0] or_130;
   wire [0:0] not_leaf_pop_r;
-  wire [0:0] and_125;
+  wire [0:0] and_131;
   wire [0:0] leaf_q_nonempty_c;
   reg [58:0] leaf_q_din = 59'h000000000000000;
-  reg [58:0] leaf_q_q_stay = 59'h000000000000000;
-  reg [58:0] leaf_q_q_next = 59'h000000000000000;
+  wire [15:0] bits_leaf_q_din;
+  wire [15:0] bits_leaf_q_din_1;
+  wire [15:0] bits_leaf_q_din_2;
+  wire [10:0] bits_leaf_q_din_3;
+  reg [10:0] leaf_q_q_stay_g3 = 11'h000;
+  reg [15:0] leaf_q_q_stay_g2 = 16'h0000;
+  reg [15:0] leaf_q_q_stay_g1 = 16'h0000;
+  reg [15:0] leaf_q_q_stay_g0 = 16'h0000;
+  wire [58:0] leaf_q_q_stay;
+  reg [10:0] leaf_q_q_next_g3 = 11'h000;
+  reg [15:0] leaf_q_q_next_g2 = 16'h0000;
+  reg [15:0] leaf_q_q_next_g1 = 16'h0000;
+  reg [15:0] leaf_q_q_next_g0 = 16'h0000;
+  wire [58:0] leaf_q_q_next;
   wire [58:0] mux_leaf_q_popped;
   reg [58:0] leaf_q_din_r = 59'h000000000000000;
   wire [58:0] leaf_q_head;
@@ -1179,7 +1226,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] pu_below_1;
   wire [0:0] not_pu_below_1;
   wire [30:0] bits_pu_shifted_1;
-  wire [0:0] ne_130;
+  wire [0:0] ne_138;
   wire [0:0] pu_above_1;
   wire signed [31:0] rs_pu_shifted_1;
   reg [0:0] pu_above_r_1 = 1'h0;
@@ -1213,6 +1260,18 @@ module fxrt_traverse_k64_sf0a3f4 (
   integer negative_i;
   initial for (negative_i = 1; negative_i <= 9; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
   wire [0:0] negative;
+
+  // register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
+  reg [5:0] leaf_q_rd = 6'h00;
+  reg [5:0] leaf_q_rd_c1 = 6'h00;
+  reg [5:0] leaf_q_rd_c2 = 6'h00;
+  reg [5:0] leaf_q_rd_c3 = 6'h00;
+
+  // register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
+  reg [5:0] leaf_q_rd1 = 6'h01;
+  reg [5:0] leaf_q_rd1_c1 = 6'h01;
+  reg [5:0] leaf_q_rd1_c2 = 6'h01;
+  reg [5:0] leaf_q_rd1_c3 = 6'h01;
 
   // register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
   reg [5:0] n_ray_slot = 6'h00;
@@ -1272,7 +1331,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_tmin_n1;
   wire signed [32:0] rs_tmax_p1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_134;
+  wire signed [32:0] minus_142;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
@@ -1313,25 +1372,25 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_135;
+  wire signed [32:0] minus_143;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below;
   wire signed [32:0] rs_d0_lo;
   wire signed [32:0] rs_plane_t_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_136;
+  wire signed [32:0] minus_144;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_above;
   wire signed [32:0] rs_plane_t_1_1;
   wire signed [32:0] rs_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_137;
+  wire signed [32:0] minus_145;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
   wire signed [32:0] rs_d1_lo;
   wire signed [32:0] rs_plane_t_1_2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_138;
+  wire signed [32:0] minus_146;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
@@ -1367,23 +1426,30 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] g_inner_and_not_go_near;
   wire [0:0] enter_far;
   wire [0:0] push;
+  reg [0:0] stack_we_r = 1'h0;
   wire [4:0] rs_g_sp;
-  wire [10:0] cat_140;
+  wire [10:0] cat_148;
+  reg [10:0] stack_waddr_r = 11'h000;
   wire [31:0] u_far_min;
   wire [31:0] u_g_tmax;
-  wire [76:0] cat_141;
+  wire [76:0] cat_149;
+  reg [76:0] stack_wdata_r = 77'h00000000000000000000;
   wire [0:0] enter_near_or_enter_far;
-  wire [0:0] not_enter_near_or_enter_far;
+  wire [0:0] g_pop;
   wire [12:0] mux_enter_near;
   wire signed [31:0] mux_enter_far;
   wire signed [31:0] mux_enter_near_1;
   wire [5:0] g_sp_plus_k_1;
   wire [5:0] mux_push;
+  wire [0:0] g_sp_zero;
   wire [0:0] not_push;
-  wire [0:0] g_sp_eq_k_0_1;
-  wire [0:0] and_142;
+  wire [0:0] not_push_and_g_sp_zero;
   wire [5:0] g_sp_minus_k_1;
-  wire [5:0] mux_push_1;
+  wire [5:0] g_sp_m1;
+  wire [0:0] g_done;
+  wire [4:0] rs_g_sp_m1;
+  wire [10:0] cat_150;
+  wire [10:0] stack_raddr_next;
 
   // not in a stage or state machine
   assign cat_0 = {oz, oy, ox};
@@ -1405,10 +1471,15 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (ray_we) ray_invy[ray_slot] <= u_invy;
     if (ray_we) ray_invz[ray_slot] <= u_invz;
     if (unpark_q_push) unpark_q_mem[unpark_q_wr] <= unpark_q_din;
-    if (new_q_push) new_q_mem[new_q_wr] <= new_q_din;
+    if (new_q_push) new_q_mem_g0[new_q_wr] <= bits_new_q_din;
+    if (new_q_push) new_q_mem_g1[new_q_wr] <= bits_new_q_din_1;
+    if (new_q_push) new_q_mem_g2[new_q_wr] <= bits_new_q_din_2;
     if (done_q_push) done_q_mem[done_q_wr] <= done_q_din;
     if (limit_we) cull_limit[merge_slot] <= u_merge_limit;
-    if (leaf_q_push) leaf_q_mem[leaf_q_wr] <= leaf_q_din;
+    if (leaf_q_push) leaf_q_mem_g0[leaf_q_wr] <= bits_leaf_q_din;
+    if (leaf_q_push) leaf_q_mem_g1[leaf_q_wr] <= bits_leaf_q_din_1;
+    if (leaf_q_push) leaf_q_mem_g2[leaf_q_wr] <= bits_leaf_q_din_2;
+    if (leaf_q_push) leaf_q_mem_g3[leaf_q_wr] <= bits_leaf_q_din_3;
   end
 
   // stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
@@ -1864,24 +1935,36 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign not_new_pop = ~new_pop;
   assign and_93 = new_q_one_left & not_new_pop;
   assign new_q_nonempty_c = or_92 | and_93;
+  assign bits_new_q_din = new_q_din[15:0];
+  assign bits_new_q_din_1 = new_q_din[31:16];
+  assign bits_new_q_din_2 = new_q_din[38:32];
+  assign new_q_q_stay = {new_q_q_stay_g2, new_q_q_stay_g1, new_q_q_stay_g0};
+  assign new_q_q_next = {new_q_q_next_g2, new_q_q_next_g1, new_q_q_next_g0};
   assign mux_new_q_popped = new_q_popped ? new_q_q_next : new_q_q_stay;
   assign new_q_head = new_q_bypass ? new_q_din_r : mux_new_q_popped;
   assign not_ring_g_valid = ~ring_g_valid;
   assign take_unpark = not_ring_g_valid & unpark_q_nonempty;
   assign not_ring_g_valid_1 = ~ring_g_valid;
   assign not_unpark_q_nonempty = ~unpark_q_nonempty;
-  assign and_95 = not_ring_g_valid_1 & not_unpark_q_nonempty;
-  assign take_new = and_95 & new_q_nonempty;
+  assign and_97 = not_ring_g_valid_1 & not_unpark_q_nonempty;
+  assign take_new = and_97 & new_q_nonempty;
   assign take_unpark_or_take_new = take_unpark | take_new;
   assign bits_unpark_q_head = unpark_q_head[11:6];
   assign bits_new_q_head = new_q_head[38:33];
   assign mux_take_unpark = take_unpark ? bits_unpark_q_head : bits_new_q_head;
   assign bits_unpark_q_head_1 = unpark_q_head[5:0];
-  assign eq_97 = bits_unpark_q_head_1 == k_0_1;
-  assign minus_98 = bits_unpark_q_head_1 - k_1;
-  assign bits_new_q_head_1 = new_q_head[32:1];
-  assign s_bits_new_q_head_1 = $signed(bits_new_q_head_1);
-  assign bits_new_q_head_2 = new_q_head[0];
+  assign eq_99 = bits_unpark_q_head_1 == k_0_1;
+  assign minus_100 = bits_unpark_q_head_1 - k_1;
+  assign rs_minus_100 = minus_100[4:0];
+  assign q_stack_raddr = {mux_take_unpark, rs_minus_100};
+  assign bits_unpark_q_head_2 = unpark_q_head[5:0];
+  assign eq_102 = bits_unpark_q_head_2 == k_0_1;
+  assign bits_new_q_head_1 = new_q_head[0];
+  assign and_103 = take_new & bits_new_q_head_1;
+  assign take_unpark_and_eq_102 = take_unpark & eq_102;
+  assign q_done_c = and_103 | take_unpark_and_eq_102;
+  assign bits_new_q_head_2 = new_q_head[32:1];
+  assign s_bits_new_q_head_2 = $signed(bits_new_q_head_2);
 
   always @(posedge clk) begin : queues_regs
     if (rst) unpark_q_push <= 1'h0;
@@ -1908,12 +1991,8 @@ module fxrt_traverse_k64_sf0a3f4 (
     else new_q_push <= new_valid;
     if (rst) new_q_wr <= 6'h00;
     else new_q_wr <= mux_new_q_push;
-    if (rst) new_q_rd <= 6'h00;
-    else new_q_rd <= new_q_rd_next;
     if (rst) new_q_count <= 7'h00;
     else new_q_count <= new_q_count_next;
-    if (rst) new_q_rd1 <= 6'h01;
-    else new_q_rd1 <= mux_new_pop;
     if (rst) new_q_bypass <= 1'h0;
     else new_q_bypass <= new_q_bypass_c;
     if (rst) new_q_popped <= 1'h0;
@@ -1921,18 +2000,44 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (rst) new_q_nonempty <= 1'h0;
     else new_q_nonempty <= new_q_nonempty_c;
     new_q_din <= cat_86;
-    new_q_q_stay <= new_q_mem[new_q_rd];
-    new_q_q_next <= new_q_mem[new_q_rd1];
+    new_q_q_stay_g2 <= new_q_mem_g2[new_q_rd_c2];
+    new_q_q_stay_g1 <= new_q_mem_g1[new_q_rd_c1];
+    new_q_q_stay_g0 <= new_q_mem_g0[new_q_rd];
+    new_q_q_next_g2 <= new_q_mem_g2[new_q_rd1_c2];
+    new_q_q_next_g1 <= new_q_mem_g1[new_q_rd1_c1];
+    new_q_q_next_g0 <= new_q_mem_g0[new_q_rd1];
     if (new_q_push) new_q_din_r <= new_q_din;
     if (rst) q_valid <= 1'h0;
     else q_valid <= take_unpark_or_take_new;
     q_new <= take_new;
     q_slot <= mux_take_unpark;
     q_sp <= bits_unpark_q_head_1;
-    q_sp_zero <= eq_97;
-    q_sp_m1 <= minus_98;
-    q_tmax <= s_bits_new_q_head_1;
-    q_miss <= bits_new_q_head_2;
+    q_sp_zero <= eq_99;
+    q_sp_m1 <= minus_100;
+    q_done <= q_done_c;
+    q_tmax <= s_bits_new_q_head_2;
+  end
+
+  // register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : new_q_rd_copies_regs
+    if (rst) new_q_rd <= 6'h00;
+    else new_q_rd <= new_q_rd_next;
+    if (rst) new_q_rd_c1 <= 6'h00;
+    else new_q_rd_c1 <= new_q_rd_next;
+    if (rst) new_q_rd_c2 <= 6'h00;
+    else new_q_rd_c2 <= new_q_rd_next;
+  end
+
+  // register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : new_q_rd1_copies_regs
+    if (rst) new_q_rd1 <= 6'h01;
+    else new_q_rd1 <= mux_new_pop;
+    if (rst) new_q_rd1_c1 <= 6'h01;
+    else new_q_rd1_c1 <= mux_new_pop;
+    if (rst) new_q_rd1_c2 <= 6'h01;
+    else new_q_rd1_c2 <= mux_new_pop;
   end
 
   // stage ring_r: R: the token back from G, loaded in G
@@ -1940,9 +2045,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   always @(posedge clk) begin : ring_r_regs
     if (rst) r_valid <= 1'h0;
     else r_valid <= g_valid;
-    r_pop <= not_enter_near_or_enter_far;
-    r_sp_zero <= and_142;
-    r_sp_m1 <= mux_push_1;
+    r_pop <= g_pop;
+    r_sp_zero <= not_push_and_g_sp_zero;
+    r_sp_m1 <= g_sp_m1;
+    r_done <= g_done;
     r_slot <= g_slot;
     r_node <= mux_enter_near;
     r_tmin <= mux_enter_far;
@@ -1953,8 +2059,6 @@ module fxrt_traverse_k64_sf0a3f4 (
   // stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   assign a_valid = r_valid | q_valid;
   assign a_slot = r_valid ? r_slot : q_slot;
-  assign not_r_valid = ~r_valid;
-  assign a_new = not_r_valid & q_new;
   assign not_q_new = ~q_new;
   assign a_pop = r_valid ? r_pop : not_q_new;
   assign mux_q_new = q_new ? k_0_1 : q_sp;
@@ -1962,17 +2066,20 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign q_new_or_q_sp_zero = q_new | q_sp_zero;
   assign a_sp_zero = r_valid ? r_sp_zero : q_new_or_q_sp_zero;
   assign a_sp_m1 = r_valid ? r_sp_m1 : q_sp_m1;
-  assign a_pop_and_a_sp_zero = a_pop & a_sp_zero;
-  assign a_new_and_q_miss = a_new & q_miss;
-  assign or_99 = a_pop_and_a_sp_zero | a_new_and_q_miss;
-  assign a_done = a_valid & or_99;
+  assign r_valid_and_r_done = r_valid & r_done;
+  assign not_r_valid = ~r_valid;
+  assign not_r_valid_and_q_valid = not_r_valid & q_valid;
+  assign and_105 = not_r_valid_and_q_valid & q_done;
+  assign a_done = r_valid_and_r_done | and_105;
   assign not_a_sp_zero = ~a_sp_zero;
   assign a_from_stack = a_pop & not_a_sp_zero;
-  assign stack_we = push;
-  assign stack_waddr = cat_140;
-  assign stack_wdata = cat_141;
-  assign rs_a_sp_m1 = a_sp_m1[4:0];
-  assign stack_raddr = {a_slot, rs_a_sp_m1};
+  assign stack_we = stack_we_r;
+  assign stack_waddr = stack_waddr_r;
+  assign stack_wdata = stack_wdata_r;
+
+  always @(posedge clk) begin : ring_a_regs
+    stack_raddr <= stack_raddr_next;
+  end
 
   // stage ring_b: B, B2: the token waits two clocks for the stack word
   assign not_a_done = ~a_done;
@@ -2014,14 +2121,14 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign done_q_count_next = done_q_after_pop + rs_done_q_push;
   assign done_q_count_eq_k_0_3 = done_q_count == k_0_3;
   assign done_q_one_left = done_q_count == k_1_1;
-  assign and_103 = done_q_one_left & done_pop_r;
-  assign done_q_drained = done_q_count_eq_k_0_3 | and_103;
+  assign and_109 = done_q_one_left & done_pop_r;
+  assign done_q_drained = done_q_count_eq_k_0_3 | and_109;
   assign done_q_bypass_c = done_q_push & done_q_drained;
   assign k_1_1_lt_done_q_count = k_1_1 < done_q_count;
-  assign or_106 = done_q_push | k_1_1_lt_done_q_count;
+  assign or_112 = done_q_push | k_1_1_lt_done_q_count;
   assign not_done_pop_r = ~done_pop_r;
-  assign and_107 = done_q_one_left & not_done_pop_r;
-  assign done_q_nonempty_c = or_106 | and_107;
+  assign and_113 = done_q_one_left & not_done_pop_r;
+  assign done_q_nonempty_c = or_112 | and_113;
   assign mux_done_q_popped = done_q_popped ? done_q_q_next : done_q_q_stay;
   assign done_q_head = done_q_bypass ? done_q_din_r : mux_done_q_popped;
 
@@ -2196,10 +2303,10 @@ module fxrt_traverse_k64_sf0a3f4 (
     k_0;
   assign rs_s_limit_q = $signed({{1{s_limit_q[31]}}, s_limit_q});
   assign rs_cull_x = $signed({{1{cull_x[31]}}, cull_x});
-  assign minus_109 = rs_s_limit_q - rs_cull_x;
-  assign bits_minus_109 = minus_109[32];
-  assign culled_c = cull_has_best & bits_minus_109;
-  assign and_111 = merge_valid & merge_hit;
+  assign minus_115 = rs_s_limit_q - rs_cull_x;
+  assign bits_minus_115 = minus_115[32];
+  assign culled_c = cull_has_best & bits_minus_115;
+  assign and_117 = merge_valid & merge_hit;
   assign merge_slot_eq_k_63 = merge_slot == k_63;
   assign merge_slot_eq_k_62 = merge_slot == k_62;
   assign merge_slot_eq_k_61 = merge_slot == k_61;
@@ -2264,78 +2371,77 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign merge_slot_eq_k_2 = merge_slot == k_2;
   assign merge_slot_eq_k_1 = merge_slot == k_1;
   assign merge_slot_eq_k_0_1 = merge_slot == k_0_1;
-  assign cat_112 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
-  assign best_set = and_111 ? cat_112 : k_0_2;
-  assign a_new_and_a_valid = a_new & a_valid;
-  assign a_slot_eq_k_63 = a_slot == k_63;
-  assign a_slot_eq_k_62 = a_slot == k_62;
-  assign a_slot_eq_k_61 = a_slot == k_61;
-  assign a_slot_eq_k_60 = a_slot == k_60;
-  assign a_slot_eq_k_59 = a_slot == k_59;
-  assign a_slot_eq_k_58 = a_slot == k_58;
-  assign a_slot_eq_k_57 = a_slot == k_57;
-  assign a_slot_eq_k_56 = a_slot == k_56;
-  assign a_slot_eq_k_55 = a_slot == k_55;
-  assign a_slot_eq_k_54 = a_slot == k_54;
-  assign a_slot_eq_k_53 = a_slot == k_53;
-  assign a_slot_eq_k_52 = a_slot == k_52;
-  assign a_slot_eq_k_51 = a_slot == k_51;
-  assign a_slot_eq_k_50 = a_slot == k_50;
-  assign a_slot_eq_k_49 = a_slot == k_49;
-  assign a_slot_eq_k_48 = a_slot == k_48;
-  assign a_slot_eq_k_47 = a_slot == k_47;
-  assign a_slot_eq_k_46 = a_slot == k_46;
-  assign a_slot_eq_k_45 = a_slot == k_45;
-  assign a_slot_eq_k_44 = a_slot == k_44;
-  assign a_slot_eq_k_43 = a_slot == k_43;
-  assign a_slot_eq_k_42 = a_slot == k_42;
-  assign a_slot_eq_k_41 = a_slot == k_41;
-  assign a_slot_eq_k_40 = a_slot == k_40;
-  assign a_slot_eq_k_39 = a_slot == k_39;
-  assign a_slot_eq_k_38 = a_slot == k_38;
-  assign a_slot_eq_k_37 = a_slot == k_37;
-  assign a_slot_eq_k_36 = a_slot == k_36;
-  assign a_slot_eq_k_35 = a_slot == k_35;
-  assign a_slot_eq_k_34 = a_slot == k_34;
-  assign a_slot_eq_k_33 = a_slot == k_33;
-  assign a_slot_eq_k_32 = a_slot == k_32;
-  assign a_slot_eq_k_31 = a_slot == k_31;
-  assign a_slot_eq_k_30 = a_slot == k_30;
-  assign a_slot_eq_k_29 = a_slot == k_29;
-  assign a_slot_eq_k_28 = a_slot == k_28;
-  assign a_slot_eq_k_27 = a_slot == k_27;
-  assign a_slot_eq_k_26 = a_slot == k_26;
-  assign a_slot_eq_k_25 = a_slot == k_25;
-  assign a_slot_eq_k_24 = a_slot == k_24;
-  assign a_slot_eq_k_23 = a_slot == k_23;
-  assign a_slot_eq_k_22 = a_slot == k_22;
-  assign a_slot_eq_k_21 = a_slot == k_21;
-  assign a_slot_eq_k_20 = a_slot == k_20;
-  assign a_slot_eq_k_19 = a_slot == k_19;
-  assign a_slot_eq_k_18 = a_slot == k_18;
-  assign a_slot_eq_k_17 = a_slot == k_17;
-  assign a_slot_eq_k_16 = a_slot == k_16;
-  assign a_slot_eq_k_15 = a_slot == k_15;
-  assign a_slot_eq_k_14 = a_slot == k_14;
-  assign a_slot_eq_k_13 = a_slot == k_13;
-  assign a_slot_eq_k_12 = a_slot == k_12;
-  assign a_slot_eq_k_11 = a_slot == k_11;
-  assign a_slot_eq_k_10 = a_slot == k_10;
-  assign a_slot_eq_k_9 = a_slot == k_9;
-  assign a_slot_eq_k_8 = a_slot == k_8;
-  assign a_slot_eq_k_7 = a_slot == k_7;
-  assign a_slot_eq_k_6 = a_slot == k_6;
-  assign a_slot_eq_k_5 = a_slot == k_5;
-  assign a_slot_eq_k_4 = a_slot == k_4;
-  assign a_slot_eq_k_3 = a_slot == k_3;
-  assign a_slot_eq_k_2 = a_slot == k_2;
-  assign a_slot_eq_k_1 = a_slot == k_1;
-  assign a_slot_eq_k_0_1 = a_slot == k_0_1;
-  assign cat_113 = {a_slot_eq_k_63, a_slot_eq_k_62, a_slot_eq_k_61, a_slot_eq_k_60, a_slot_eq_k_59, a_slot_eq_k_58, a_slot_eq_k_57, a_slot_eq_k_56, a_slot_eq_k_55, a_slot_eq_k_54, a_slot_eq_k_53, a_slot_eq_k_52, a_slot_eq_k_51, a_slot_eq_k_50, a_slot_eq_k_49, a_slot_eq_k_48, a_slot_eq_k_47, a_slot_eq_k_46, a_slot_eq_k_45, a_slot_eq_k_44, a_slot_eq_k_43, a_slot_eq_k_42, a_slot_eq_k_41, a_slot_eq_k_40, a_slot_eq_k_39, a_slot_eq_k_38, a_slot_eq_k_37, a_slot_eq_k_36, a_slot_eq_k_35, a_slot_eq_k_34, a_slot_eq_k_33, a_slot_eq_k_32, a_slot_eq_k_31, a_slot_eq_k_30, a_slot_eq_k_29, a_slot_eq_k_28, a_slot_eq_k_27, a_slot_eq_k_26, a_slot_eq_k_25, a_slot_eq_k_24, a_slot_eq_k_23, a_slot_eq_k_22, a_slot_eq_k_21, a_slot_eq_k_20, a_slot_eq_k_19, a_slot_eq_k_18, a_slot_eq_k_17, a_slot_eq_k_16, a_slot_eq_k_15, a_slot_eq_k_14, a_slot_eq_k_13, a_slot_eq_k_12, a_slot_eq_k_11, a_slot_eq_k_10, a_slot_eq_k_9, a_slot_eq_k_8, a_slot_eq_k_7, a_slot_eq_k_6, a_slot_eq_k_5, a_slot_eq_k_4, a_slot_eq_k_3, a_slot_eq_k_2, a_slot_eq_k_1, a_slot_eq_k_0_1};
-  assign best_clear_c = a_new_and_a_valid ? cat_113 : k_0_2;
+  assign cat_118 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
+  assign best_set = and_117 ? cat_118 : k_0_2;
+  assign q_slot_eq_k_63 = q_slot == k_63;
+  assign q_slot_eq_k_62 = q_slot == k_62;
+  assign q_slot_eq_k_61 = q_slot == k_61;
+  assign q_slot_eq_k_60 = q_slot == k_60;
+  assign q_slot_eq_k_59 = q_slot == k_59;
+  assign q_slot_eq_k_58 = q_slot == k_58;
+  assign q_slot_eq_k_57 = q_slot == k_57;
+  assign q_slot_eq_k_56 = q_slot == k_56;
+  assign q_slot_eq_k_55 = q_slot == k_55;
+  assign q_slot_eq_k_54 = q_slot == k_54;
+  assign q_slot_eq_k_53 = q_slot == k_53;
+  assign q_slot_eq_k_52 = q_slot == k_52;
+  assign q_slot_eq_k_51 = q_slot == k_51;
+  assign q_slot_eq_k_50 = q_slot == k_50;
+  assign q_slot_eq_k_49 = q_slot == k_49;
+  assign q_slot_eq_k_48 = q_slot == k_48;
+  assign q_slot_eq_k_47 = q_slot == k_47;
+  assign q_slot_eq_k_46 = q_slot == k_46;
+  assign q_slot_eq_k_45 = q_slot == k_45;
+  assign q_slot_eq_k_44 = q_slot == k_44;
+  assign q_slot_eq_k_43 = q_slot == k_43;
+  assign q_slot_eq_k_42 = q_slot == k_42;
+  assign q_slot_eq_k_41 = q_slot == k_41;
+  assign q_slot_eq_k_40 = q_slot == k_40;
+  assign q_slot_eq_k_39 = q_slot == k_39;
+  assign q_slot_eq_k_38 = q_slot == k_38;
+  assign q_slot_eq_k_37 = q_slot == k_37;
+  assign q_slot_eq_k_36 = q_slot == k_36;
+  assign q_slot_eq_k_35 = q_slot == k_35;
+  assign q_slot_eq_k_34 = q_slot == k_34;
+  assign q_slot_eq_k_33 = q_slot == k_33;
+  assign q_slot_eq_k_32 = q_slot == k_32;
+  assign q_slot_eq_k_31 = q_slot == k_31;
+  assign q_slot_eq_k_30 = q_slot == k_30;
+  assign q_slot_eq_k_29 = q_slot == k_29;
+  assign q_slot_eq_k_28 = q_slot == k_28;
+  assign q_slot_eq_k_27 = q_slot == k_27;
+  assign q_slot_eq_k_26 = q_slot == k_26;
+  assign q_slot_eq_k_25 = q_slot == k_25;
+  assign q_slot_eq_k_24 = q_slot == k_24;
+  assign q_slot_eq_k_23 = q_slot == k_23;
+  assign q_slot_eq_k_22 = q_slot == k_22;
+  assign q_slot_eq_k_21 = q_slot == k_21;
+  assign q_slot_eq_k_20 = q_slot == k_20;
+  assign q_slot_eq_k_19 = q_slot == k_19;
+  assign q_slot_eq_k_18 = q_slot == k_18;
+  assign q_slot_eq_k_17 = q_slot == k_17;
+  assign q_slot_eq_k_16 = q_slot == k_16;
+  assign q_slot_eq_k_15 = q_slot == k_15;
+  assign q_slot_eq_k_14 = q_slot == k_14;
+  assign q_slot_eq_k_13 = q_slot == k_13;
+  assign q_slot_eq_k_12 = q_slot == k_12;
+  assign q_slot_eq_k_11 = q_slot == k_11;
+  assign q_slot_eq_k_10 = q_slot == k_10;
+  assign q_slot_eq_k_9 = q_slot == k_9;
+  assign q_slot_eq_k_8 = q_slot == k_8;
+  assign q_slot_eq_k_7 = q_slot == k_7;
+  assign q_slot_eq_k_6 = q_slot == k_6;
+  assign q_slot_eq_k_5 = q_slot == k_5;
+  assign q_slot_eq_k_4 = q_slot == k_4;
+  assign q_slot_eq_k_3 = q_slot == k_3;
+  assign q_slot_eq_k_2 = q_slot == k_2;
+  assign q_slot_eq_k_1 = q_slot == k_1;
+  assign q_slot_eq_k_0_1 = q_slot == k_0_1;
+  assign cat_119 = {q_slot_eq_k_63, q_slot_eq_k_62, q_slot_eq_k_61, q_slot_eq_k_60, q_slot_eq_k_59, q_slot_eq_k_58, q_slot_eq_k_57, q_slot_eq_k_56, q_slot_eq_k_55, q_slot_eq_k_54, q_slot_eq_k_53, q_slot_eq_k_52, q_slot_eq_k_51, q_slot_eq_k_50, q_slot_eq_k_49, q_slot_eq_k_48, q_slot_eq_k_47, q_slot_eq_k_46, q_slot_eq_k_45, q_slot_eq_k_44, q_slot_eq_k_43, q_slot_eq_k_42, q_slot_eq_k_41, q_slot_eq_k_40, q_slot_eq_k_39, q_slot_eq_k_38, q_slot_eq_k_37, q_slot_eq_k_36, q_slot_eq_k_35, q_slot_eq_k_34, q_slot_eq_k_33, q_slot_eq_k_32, q_slot_eq_k_31, q_slot_eq_k_30, q_slot_eq_k_29, q_slot_eq_k_28, q_slot_eq_k_27, q_slot_eq_k_26, q_slot_eq_k_25, q_slot_eq_k_24, q_slot_eq_k_23, q_slot_eq_k_22, q_slot_eq_k_21, q_slot_eq_k_20, q_slot_eq_k_19, q_slot_eq_k_18, q_slot_eq_k_17, q_slot_eq_k_16, q_slot_eq_k_15, q_slot_eq_k_14, q_slot_eq_k_13, q_slot_eq_k_12, q_slot_eq_k_11, q_slot_eq_k_10, q_slot_eq_k_9, q_slot_eq_k_8, q_slot_eq_k_7, q_slot_eq_k_6, q_slot_eq_k_5, q_slot_eq_k_4, q_slot_eq_k_3, q_slot_eq_k_2, q_slot_eq_k_1, q_slot_eq_k_0_1};
+  assign best_clear_c = q_new ? cat_119 : k_0_2;
   assign not_best_clear = ~best_clear;
-  assign and_114 = has_best & not_best_clear;
-  assign and_114_or_best_set = and_114 | best_set;
+  assign and_120 = has_best & not_best_clear;
+  assign and_120_or_best_set = and_120 | best_set;
 
   always @(posedge clk) begin : ring_c_regs
     if (rst) c_valid <= 1'h0;
@@ -2346,7 +2452,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     c_sp <= b2_sp;
     limit_q <= cull_limit[c_slot_c1];
     if (rst) has_best <= 64'h0000000000000000;
-    else has_best <= and_114_or_best_set;
+    else has_best <= and_120_or_best_set;
     cull_x <= tmin_less;
     cull_has_best <= slot_has_best;
     culled <= culled_c;
@@ -2384,7 +2490,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_push = visit_c_and_nw_is_leaf & nw_count_ne_k_0_6;
   assign u_n_tmin = $unsigned(n_tmin);
   assign rs_u_n_tmin = u_n_tmin[30:0];
-  assign cat_118 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
+  assign cat_124 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
   assign leaf_q_wr_plus_k_1 = leaf_q_wr + k_1;
   assign mux_leaf_q_push = leaf_q_push ? leaf_q_wr_plus_k_1 : leaf_q_wr;
   assign leaf_q_rd_next = leaf_pop_r ? leaf_q_rd1 : leaf_q_rd;
@@ -2396,14 +2502,20 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_q_count_next = leaf_q_after_pop + rs_leaf_q_push;
   assign leaf_q_count_eq_k_0_3 = leaf_q_count == k_0_3;
   assign leaf_q_one_left = leaf_q_count == k_1_1;
-  assign and_121 = leaf_q_one_left & leaf_pop_r;
-  assign leaf_q_drained = leaf_q_count_eq_k_0_3 | and_121;
+  assign and_127 = leaf_q_one_left & leaf_pop_r;
+  assign leaf_q_drained = leaf_q_count_eq_k_0_3 | and_127;
   assign leaf_q_bypass_c = leaf_q_push & leaf_q_drained;
   assign k_1_1_lt_leaf_q_count = k_1_1 < leaf_q_count;
-  assign or_124 = leaf_q_push | k_1_1_lt_leaf_q_count;
+  assign or_130 = leaf_q_push | k_1_1_lt_leaf_q_count;
   assign not_leaf_pop_r = ~leaf_pop_r;
-  assign and_125 = leaf_q_one_left & not_leaf_pop_r;
-  assign leaf_q_nonempty_c = or_124 | and_125;
+  assign and_131 = leaf_q_one_left & not_leaf_pop_r;
+  assign leaf_q_nonempty_c = or_130 | and_131;
+  assign bits_leaf_q_din = leaf_q_din[15:0];
+  assign bits_leaf_q_din_1 = leaf_q_din[31:16];
+  assign bits_leaf_q_din_2 = leaf_q_din[47:32];
+  assign bits_leaf_q_din_3 = leaf_q_din[58:48];
+  assign leaf_q_q_stay = {leaf_q_q_stay_g3, leaf_q_q_stay_g2, leaf_q_q_stay_g1, leaf_q_q_stay_g0};
+  assign leaf_q_q_next = {leaf_q_q_next_g3, leaf_q_q_next_g2, leaf_q_q_next_g1, leaf_q_q_next_g0};
   assign mux_leaf_q_popped = leaf_q_popped ? leaf_q_q_next : leaf_q_q_stay;
   assign leaf_q_head = leaf_q_bypass ? leaf_q_din_r : mux_leaf_q_popped;
   assign n_ray_slot_early = n_ray_slot_early_sr[2];
@@ -2460,8 +2572,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign pu_below_1 = pu_shifted_1[61];
   assign not_pu_below_1 = ~pu_below_1;
   assign bits_pu_shifted_1 = pu_shifted_1[60:30];
-  assign ne_130 = bits_pu_shifted_1 != k_0_7;
-  assign pu_above_1 = not_pu_below_1 & ne_130;
+  assign ne_138 = bits_pu_shifted_1 != k_0_7;
+  assign pu_above_1 = not_pu_below_1 & ne_138;
   assign rs_pu_shifted_1 = $signed(pu_shifted_1[31:0]);
   assign mux_pu_below_r_1 = pu_below_r_1 ? k_m1 : pu_low_r_1;
   assign pu_clamped_1 = pu_above_r_1 ? k_1073741824 : mux_pu_below_r_1;
@@ -2502,21 +2614,23 @@ module fxrt_traverse_k64_sf0a3f4 (
     else leaf_q_push <= leaf_push;
     if (rst) leaf_q_wr <= 6'h00;
     else leaf_q_wr <= mux_leaf_q_push;
-    if (rst) leaf_q_rd <= 6'h00;
-    else leaf_q_rd <= leaf_q_rd_next;
     if (rst) leaf_q_count <= 7'h00;
     else leaf_q_count <= leaf_q_count_next;
-    if (rst) leaf_q_rd1 <= 6'h01;
-    else leaf_q_rd1 <= mux_leaf_pop_r;
     if (rst) leaf_q_bypass <= 1'h0;
     else leaf_q_bypass <= leaf_q_bypass_c;
     if (rst) leaf_q_popped <= 1'h0;
     else leaf_q_popped <= leaf_pop_r;
     if (rst) leaf_q_nonempty <= 1'h0;
     else leaf_q_nonempty <= leaf_q_nonempty_c;
-    leaf_q_din <= cat_118;
-    leaf_q_q_stay <= leaf_q_mem[leaf_q_rd];
-    leaf_q_q_next <= leaf_q_mem[leaf_q_rd1];
+    leaf_q_din <= cat_124;
+    leaf_q_q_stay_g3 <= leaf_q_mem_g3[leaf_q_rd_c3];
+    leaf_q_q_stay_g2 <= leaf_q_mem_g2[leaf_q_rd_c2];
+    leaf_q_q_stay_g1 <= leaf_q_mem_g1[leaf_q_rd_c1];
+    leaf_q_q_stay_g0 <= leaf_q_mem_g0[leaf_q_rd];
+    leaf_q_q_next_g3 <= leaf_q_mem_g3[leaf_q_rd1_c3];
+    leaf_q_q_next_g2 <= leaf_q_mem_g2[leaf_q_rd1_c2];
+    leaf_q_q_next_g1 <= leaf_q_mem_g1[leaf_q_rd1_c1];
+    leaf_q_q_next_g0 <= leaf_q_mem_g0[leaf_q_rd1];
     if (leaf_q_push) leaf_q_din_r <= leaf_q_din;
     n_ray_slot_early_sr[2] <= n_ray_slot_early_sr[1];
     n_ray_slot_early_sr[1] <= c_slot;
@@ -2616,6 +2730,32 @@ module fxrt_traverse_k64_sf0a3f4 (
     negative_sr[1] <= negative_c;
   end
 
+  // register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : leaf_q_rd_copies_regs
+    if (rst) leaf_q_rd <= 6'h00;
+    else leaf_q_rd <= leaf_q_rd_next;
+    if (rst) leaf_q_rd_c1 <= 6'h00;
+    else leaf_q_rd_c1 <= leaf_q_rd_next;
+    if (rst) leaf_q_rd_c2 <= 6'h00;
+    else leaf_q_rd_c2 <= leaf_q_rd_next;
+    if (rst) leaf_q_rd_c3 <= 6'h00;
+    else leaf_q_rd_c3 <= leaf_q_rd_next;
+  end
+
+  // register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : leaf_q_rd1_copies_regs
+    if (rst) leaf_q_rd1 <= 6'h01;
+    else leaf_q_rd1 <= mux_leaf_pop_r;
+    if (rst) leaf_q_rd1_c1 <= 6'h01;
+    else leaf_q_rd1_c1 <= mux_leaf_pop_r;
+    if (rst) leaf_q_rd1_c2 <= 6'h01;
+    else leaf_q_rd1_c2 <= mux_leaf_pop_r;
+    if (rst) leaf_q_rd1_c3 <= 6'h01;
+    else leaf_q_rd1_c3 <= mux_leaf_pop_r;
+  end
+
   // register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : n_ray_slot_copies_regs
@@ -2643,8 +2783,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign tmin_minus_1 = n_tmin - k_1_3;
   assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
-  assign minus_134 = rs_tmin_n1 - rs_tmax_p1;
-  assign tmin_le_tmax_c = minus_134[32];
+  assign minus_142 = rs_tmin_n1 - rs_tmax_p1;
+  assign tmin_le_tmax_c = minus_142[32];
   assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
   assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
   assign d0_hi = d0_hi_sr[7];
@@ -2659,20 +2799,20 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign d1_lo = d1_lo_sr[7];
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_135 = rs_plane_t - rs_d0_hi;
-  assign d0_below = minus_135[32];
+  assign minus_143 = rs_plane_t - rs_d0_hi;
+  assign d0_below = minus_143[32];
   assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign minus_136 = rs_d0_lo - rs_plane_t_1;
-  assign d0_above = minus_136[32];
+  assign minus_144 = rs_d0_lo - rs_plane_t_1;
+  assign d0_above = minus_144[32];
   assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
   assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_137 = rs_plane_t_1_1 - rs_d1_hi;
-  assign d1_below = minus_137[32];
+  assign minus_145 = rs_plane_t_1_1 - rs_d1_hi;
+  assign d1_below = minus_145[32];
   assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
   assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign minus_138 = rs_d1_lo - rs_plane_t_1_2;
-  assign d1_above = minus_138[32];
+  assign minus_146 = rs_d1_lo - rs_plane_t_1_2;
+  assign d1_above = minus_146[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
   assign go_near_c = negative ? d1_above : d0_above;
@@ -2832,22 +2972,33 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign enter_far = g_inner_and_not_go_near & go_far;
   assign push = enter_near & go_far;
   assign rs_g_sp = g_sp[4:0];
-  assign cat_140 = {g_slot, rs_g_sp};
+  assign cat_148 = {g_slot, rs_g_sp};
   assign u_far_min = $unsigned(far_min);
   assign u_g_tmax = $unsigned(g_tmax);
-  assign cat_141 = {far, u_far_min, u_g_tmax};
+  assign cat_149 = {far, u_far_min, u_g_tmax};
   assign enter_near_or_enter_far = enter_near | enter_far;
-  assign not_enter_near_or_enter_far = ~enter_near_or_enter_far;
+  assign g_pop = ~enter_near_or_enter_far;
   assign mux_enter_near = enter_near ? near : far;
   assign mux_enter_far = enter_far ? far_min : g_tmin;
   assign mux_enter_near_1 = enter_near ? near_max : g_tmax;
   assign g_sp_plus_k_1 = g_sp + k_1;
   assign mux_push = push ? g_sp_plus_k_1 : g_sp;
+  assign g_sp_zero = g_sp == k_0_1;
   assign not_push = ~push;
-  assign g_sp_eq_k_0_1 = g_sp == k_0_1;
-  assign and_142 = not_push & g_sp_eq_k_0_1;
+  assign not_push_and_g_sp_zero = not_push & g_sp_zero;
   assign g_sp_minus_k_1 = g_sp - k_1;
-  assign mux_push_1 = push ? g_sp : g_sp_minus_k_1;
+  assign g_sp_m1 = push ? g_sp : g_sp_minus_k_1;
+  assign g_done = g_pop & g_sp_zero;
+  assign rs_g_sp_m1 = g_sp_m1[4:0];
+  assign cat_150 = {g_slot, rs_g_sp_m1};
+  assign stack_raddr_next = g_valid ? cat_150 : q_stack_raddr;
+
+  always @(posedge clk) begin : ring_g_regs
+    if (rst) stack_we_r <= 1'h0;
+    else stack_we_r <= push;
+    stack_waddr_r <= cat_148;
+    stack_wdata_r <= cat_149;
+  end
 
   fxrt_bram_stack_w77 u_stack (
     .clk(clk),

@@ -85,8 +85,14 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type unpark_q_mem_t is array (0 to 63) of unsigned(11 downto 0);
   signal unpark_q_mem : unpark_q_mem_t := (others => (others => '0'));
 
-  type new_q_mem_t is array (0 to 63) of unsigned(38 downto 0);
-  signal new_q_mem : new_q_mem_t := (others => (others => '0'));
+  type new_q_mem_g0_t is array (0 to 63) of unsigned(15 downto 0);
+  signal new_q_mem_g0 : new_q_mem_g0_t := (others => (others => '0'));
+
+  type new_q_mem_g1_t is array (0 to 63) of unsigned(15 downto 0);
+  signal new_q_mem_g1 : new_q_mem_g1_t := (others => (others => '0'));
+
+  type new_q_mem_g2_t is array (0 to 63) of unsigned(6 downto 0);
+  signal new_q_mem_g2 : new_q_mem_g2_t := (others => (others => '0'));
 
   type done_q_mem_t is array (0 to 63) of unsigned(5 downto 0);
   signal done_q_mem : done_q_mem_t := (others => (others => '0'));
@@ -94,8 +100,17 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type cull_limit_t is array (0 to 63) of unsigned(31 downto 0);
   signal cull_limit : cull_limit_t := (others => (others => '0'));
 
-  type leaf_q_mem_t is array (0 to 63) of unsigned(58 downto 0);
-  signal leaf_q_mem : leaf_q_mem_t := (others => (others => '0'));
+  type leaf_q_mem_g0_t is array (0 to 63) of unsigned(15 downto 0);
+  signal leaf_q_mem_g0 : leaf_q_mem_g0_t := (others => (others => '0'));
+
+  type leaf_q_mem_g1_t is array (0 to 63) of unsigned(15 downto 0);
+  signal leaf_q_mem_g1 : leaf_q_mem_g1_t := (others => (others => '0'));
+
+  type leaf_q_mem_g2_t is array (0 to 63) of unsigned(15 downto 0);
+  signal leaf_q_mem_g2 : leaf_q_mem_g2_t := (others => (others => '0'));
+
+  type leaf_q_mem_g3_t is array (0 to 63) of unsigned(10 downto 0);
+  signal leaf_q_mem_g3 : leaf_q_mem_g3_t := (others => (others => '0'));
 
   attribute keep : string;
 
@@ -621,11 +636,9 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal cat_86 : unsigned(38 downto 0);
   signal new_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal new_q_wr : unsigned(5 downto 0) := unsigned'("000000");
-  signal new_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal new_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal new_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_new_q_push : unsigned(5 downto 0);
-  signal new_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal new_q_rd_next : unsigned(5 downto 0);
   signal new_q_rd1_plus_k_1 : unsigned(5 downto 0);
   signal mux_new_pop : unsigned(5 downto 0);
@@ -647,8 +660,17 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal and_93 : unsigned(0 downto 0);
   signal new_q_nonempty_c : unsigned(0 downto 0);
   signal new_q_din : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
-  signal new_q_q_stay : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
-  signal new_q_q_next : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
+  signal bits_new_q_din : unsigned(15 downto 0);
+  signal bits_new_q_din_1 : unsigned(15 downto 0);
+  signal bits_new_q_din_2 : unsigned(6 downto 0);
+  signal new_q_q_stay_g2 : unsigned(6 downto 0) := unsigned'("0000000");
+  signal new_q_q_stay_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal new_q_q_stay_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal new_q_q_stay : unsigned(38 downto 0);
+  signal new_q_q_next_g2 : unsigned(6 downto 0) := unsigned'("0000000");
+  signal new_q_q_next_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal new_q_q_next_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal new_q_q_next : unsigned(38 downto 0);
   signal mux_new_q_popped : unsigned(38 downto 0);
   signal new_q_din_r : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal new_q_head : unsigned(38 downto 0);
@@ -656,7 +678,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal take_unpark : unsigned(0 downto 0);
   signal not_ring_g_valid_1 : unsigned(0 downto 0);
   signal not_unpark_q_nonempty : unsigned(0 downto 0);
-  signal and_95 : unsigned(0 downto 0);
+  signal and_97 : unsigned(0 downto 0);
   signal take_new : unsigned(0 downto 0);
   signal take_unpark_or_take_new : unsigned(0 downto 0);
   signal q_valid : unsigned(0 downto 0) := unsigned'("0");
@@ -667,21 +689,45 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal q_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal bits_unpark_q_head_1 : unsigned(5 downto 0);
   signal q_sp : unsigned(5 downto 0) := unsigned'("000000");
-  signal eq_97 : unsigned(0 downto 0);
+  signal eq_99 : unsigned(0 downto 0);
   signal q_sp_zero : unsigned(0 downto 0) := unsigned'("0");
-  signal minus_98 : unsigned(5 downto 0);
+  signal minus_100 : unsigned(5 downto 0);
   signal q_sp_m1 : unsigned(5 downto 0) := unsigned'("000000");
-  signal bits_new_q_head_1 : unsigned(31 downto 0);
-  signal s_bits_new_q_head_1 : signed(31 downto 0);
+  signal rs_minus_100 : unsigned(4 downto 0);
+  signal q_stack_raddr : unsigned(10 downto 0);
+  signal bits_unpark_q_head_2 : unsigned(5 downto 0);
+  signal eq_102 : unsigned(0 downto 0);
+  signal bits_new_q_head_1 : unsigned(0 downto 0);
+  signal and_103 : unsigned(0 downto 0);
+  signal take_unpark_and_eq_102 : unsigned(0 downto 0);
+  signal q_done_c : unsigned(0 downto 0);
+  signal q_done : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_new_q_head_2 : unsigned(31 downto 0);
+  signal s_bits_new_q_head_2 : signed(31 downto 0);
   signal q_tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal bits_new_q_head_2 : unsigned(0 downto 0);
-  signal q_miss : unsigned(0 downto 0) := unsigned'("0");
+
+  -- register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
+  signal new_q_rd : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of new_q_rd : signal is "true";
+  signal new_q_rd_c1 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of new_q_rd_c1 : signal is "true";
+  signal new_q_rd_c2 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of new_q_rd_c2 : signal is "true";
+
+  -- register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
+  signal new_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of new_q_rd1 : signal is "true";
+  signal new_q_rd1_c1 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of new_q_rd1_c1 : signal is "true";
+  signal new_q_rd1_c2 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of new_q_rd1_c2 : signal is "true";
 
   -- stage ring_r: R: the token back from G, loaded in G
   signal r_valid : unsigned(0 downto 0) := unsigned'("0");
   signal r_pop : unsigned(0 downto 0) := unsigned'("0");
   signal r_sp_zero : unsigned(0 downto 0) := unsigned'("0");
   signal r_sp_m1 : unsigned(5 downto 0) := unsigned'("000000");
+  signal r_done : unsigned(0 downto 0) := unsigned'("0");
   signal r_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal r_node : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal r_tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -691,8 +737,6 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   -- stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   signal a_valid : unsigned(0 downto 0);
   signal a_slot : unsigned(5 downto 0);
-  signal not_r_valid : unsigned(0 downto 0);
-  signal a_new : unsigned(0 downto 0);
   signal not_q_new : unsigned(0 downto 0);
   signal a_pop : unsigned(0 downto 0);
   signal mux_q_new : unsigned(5 downto 0);
@@ -700,17 +744,17 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal q_new_or_q_sp_zero : unsigned(0 downto 0);
   signal a_sp_zero : unsigned(0 downto 0);
   signal a_sp_m1 : unsigned(5 downto 0);
-  signal a_pop_and_a_sp_zero : unsigned(0 downto 0);
-  signal a_new_and_q_miss : unsigned(0 downto 0);
-  signal or_99 : unsigned(0 downto 0);
+  signal r_valid_and_r_done : unsigned(0 downto 0);
+  signal not_r_valid : unsigned(0 downto 0);
+  signal not_r_valid_and_q_valid : unsigned(0 downto 0);
+  signal and_105 : unsigned(0 downto 0);
   signal a_done : unsigned(0 downto 0);
   signal not_a_sp_zero : unsigned(0 downto 0);
   signal a_from_stack : unsigned(0 downto 0);
   signal stack_we : unsigned(0 downto 0);
   signal stack_waddr : unsigned(10 downto 0);
   signal stack_wdata : unsigned(76 downto 0);
-  signal rs_a_sp_m1 : unsigned(4 downto 0);
-  signal stack_raddr : unsigned(10 downto 0);
+  signal stack_raddr : unsigned(10 downto 0) := unsigned'("00000000000");
   signal u_stack_data : unsigned(76 downto 0);
 
   -- stage ring_b: B, B2: the token waits two clocks for the stack word
@@ -756,16 +800,16 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal done_q_count_next : unsigned(6 downto 0);
   signal done_q_count_eq_k_0_3 : unsigned(0 downto 0);
   signal done_q_one_left : unsigned(0 downto 0);
-  signal and_103 : unsigned(0 downto 0);
+  signal and_109 : unsigned(0 downto 0);
   signal done_q_drained : unsigned(0 downto 0);
   signal done_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_bypass_c : unsigned(0 downto 0);
   signal done_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_done_q_count : unsigned(0 downto 0);
-  signal or_106 : unsigned(0 downto 0);
+  signal or_112 : unsigned(0 downto 0);
   signal not_done_pop_r : unsigned(0 downto 0);
-  signal and_107 : unsigned(0 downto 0);
+  signal and_113 : unsigned(0 downto 0);
   signal done_q_nonempty_c : unsigned(0 downto 0);
   signal done_q_din : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_q_stay : unsigned(5 downto 0) := unsigned'("000000");
@@ -864,12 +908,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal cull_has_best : unsigned(0 downto 0) := unsigned'("0");
   signal rs_s_limit_q : signed(32 downto 0);
   signal rs_cull_x : signed(32 downto 0);
-  signal minus_109 : signed(32 downto 0);
-  signal bits_minus_109 : unsigned(0 downto 0);
+  signal minus_115 : signed(32 downto 0);
+  signal bits_minus_115 : unsigned(0 downto 0);
   signal culled_c : unsigned(0 downto 0);
   signal culled : unsigned(0 downto 0) := unsigned'("0");
   signal culled_n : unsigned(0 downto 0) := unsigned'("0");
-  signal and_111 : unsigned(0 downto 0);
+  signal and_117 : unsigned(0 downto 0);
   signal merge_slot_eq_k_63 : unsigned(0 downto 0);
   signal merge_slot_eq_k_62 : unsigned(0 downto 0);
   signal merge_slot_eq_k_61 : unsigned(0 downto 0);
@@ -934,79 +978,78 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal merge_slot_eq_k_2 : unsigned(0 downto 0);
   signal merge_slot_eq_k_1 : unsigned(0 downto 0);
   signal merge_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_112 : unsigned(63 downto 0);
+  signal cat_118 : unsigned(63 downto 0);
   signal best_set : unsigned(63 downto 0);
-  signal a_new_and_a_valid : unsigned(0 downto 0);
-  signal a_slot_eq_k_63 : unsigned(0 downto 0);
-  signal a_slot_eq_k_62 : unsigned(0 downto 0);
-  signal a_slot_eq_k_61 : unsigned(0 downto 0);
-  signal a_slot_eq_k_60 : unsigned(0 downto 0);
-  signal a_slot_eq_k_59 : unsigned(0 downto 0);
-  signal a_slot_eq_k_58 : unsigned(0 downto 0);
-  signal a_slot_eq_k_57 : unsigned(0 downto 0);
-  signal a_slot_eq_k_56 : unsigned(0 downto 0);
-  signal a_slot_eq_k_55 : unsigned(0 downto 0);
-  signal a_slot_eq_k_54 : unsigned(0 downto 0);
-  signal a_slot_eq_k_53 : unsigned(0 downto 0);
-  signal a_slot_eq_k_52 : unsigned(0 downto 0);
-  signal a_slot_eq_k_51 : unsigned(0 downto 0);
-  signal a_slot_eq_k_50 : unsigned(0 downto 0);
-  signal a_slot_eq_k_49 : unsigned(0 downto 0);
-  signal a_slot_eq_k_48 : unsigned(0 downto 0);
-  signal a_slot_eq_k_47 : unsigned(0 downto 0);
-  signal a_slot_eq_k_46 : unsigned(0 downto 0);
-  signal a_slot_eq_k_45 : unsigned(0 downto 0);
-  signal a_slot_eq_k_44 : unsigned(0 downto 0);
-  signal a_slot_eq_k_43 : unsigned(0 downto 0);
-  signal a_slot_eq_k_42 : unsigned(0 downto 0);
-  signal a_slot_eq_k_41 : unsigned(0 downto 0);
-  signal a_slot_eq_k_40 : unsigned(0 downto 0);
-  signal a_slot_eq_k_39 : unsigned(0 downto 0);
-  signal a_slot_eq_k_38 : unsigned(0 downto 0);
-  signal a_slot_eq_k_37 : unsigned(0 downto 0);
-  signal a_slot_eq_k_36 : unsigned(0 downto 0);
-  signal a_slot_eq_k_35 : unsigned(0 downto 0);
-  signal a_slot_eq_k_34 : unsigned(0 downto 0);
-  signal a_slot_eq_k_33 : unsigned(0 downto 0);
-  signal a_slot_eq_k_32 : unsigned(0 downto 0);
-  signal a_slot_eq_k_31 : unsigned(0 downto 0);
-  signal a_slot_eq_k_30 : unsigned(0 downto 0);
-  signal a_slot_eq_k_29 : unsigned(0 downto 0);
-  signal a_slot_eq_k_28 : unsigned(0 downto 0);
-  signal a_slot_eq_k_27 : unsigned(0 downto 0);
-  signal a_slot_eq_k_26 : unsigned(0 downto 0);
-  signal a_slot_eq_k_25 : unsigned(0 downto 0);
-  signal a_slot_eq_k_24 : unsigned(0 downto 0);
-  signal a_slot_eq_k_23 : unsigned(0 downto 0);
-  signal a_slot_eq_k_22 : unsigned(0 downto 0);
-  signal a_slot_eq_k_21 : unsigned(0 downto 0);
-  signal a_slot_eq_k_20 : unsigned(0 downto 0);
-  signal a_slot_eq_k_19 : unsigned(0 downto 0);
-  signal a_slot_eq_k_18 : unsigned(0 downto 0);
-  signal a_slot_eq_k_17 : unsigned(0 downto 0);
-  signal a_slot_eq_k_16 : unsigned(0 downto 0);
-  signal a_slot_eq_k_15 : unsigned(0 downto 0);
-  signal a_slot_eq_k_14 : unsigned(0 downto 0);
-  signal a_slot_eq_k_13 : unsigned(0 downto 0);
-  signal a_slot_eq_k_12 : unsigned(0 downto 0);
-  signal a_slot_eq_k_11 : unsigned(0 downto 0);
-  signal a_slot_eq_k_10 : unsigned(0 downto 0);
-  signal a_slot_eq_k_9 : unsigned(0 downto 0);
-  signal a_slot_eq_k_8 : unsigned(0 downto 0);
-  signal a_slot_eq_k_7 : unsigned(0 downto 0);
-  signal a_slot_eq_k_6 : unsigned(0 downto 0);
-  signal a_slot_eq_k_5 : unsigned(0 downto 0);
-  signal a_slot_eq_k_4 : unsigned(0 downto 0);
-  signal a_slot_eq_k_3 : unsigned(0 downto 0);
-  signal a_slot_eq_k_2 : unsigned(0 downto 0);
-  signal a_slot_eq_k_1 : unsigned(0 downto 0);
-  signal a_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_113 : unsigned(63 downto 0);
+  signal q_slot_eq_k_63 : unsigned(0 downto 0);
+  signal q_slot_eq_k_62 : unsigned(0 downto 0);
+  signal q_slot_eq_k_61 : unsigned(0 downto 0);
+  signal q_slot_eq_k_60 : unsigned(0 downto 0);
+  signal q_slot_eq_k_59 : unsigned(0 downto 0);
+  signal q_slot_eq_k_58 : unsigned(0 downto 0);
+  signal q_slot_eq_k_57 : unsigned(0 downto 0);
+  signal q_slot_eq_k_56 : unsigned(0 downto 0);
+  signal q_slot_eq_k_55 : unsigned(0 downto 0);
+  signal q_slot_eq_k_54 : unsigned(0 downto 0);
+  signal q_slot_eq_k_53 : unsigned(0 downto 0);
+  signal q_slot_eq_k_52 : unsigned(0 downto 0);
+  signal q_slot_eq_k_51 : unsigned(0 downto 0);
+  signal q_slot_eq_k_50 : unsigned(0 downto 0);
+  signal q_slot_eq_k_49 : unsigned(0 downto 0);
+  signal q_slot_eq_k_48 : unsigned(0 downto 0);
+  signal q_slot_eq_k_47 : unsigned(0 downto 0);
+  signal q_slot_eq_k_46 : unsigned(0 downto 0);
+  signal q_slot_eq_k_45 : unsigned(0 downto 0);
+  signal q_slot_eq_k_44 : unsigned(0 downto 0);
+  signal q_slot_eq_k_43 : unsigned(0 downto 0);
+  signal q_slot_eq_k_42 : unsigned(0 downto 0);
+  signal q_slot_eq_k_41 : unsigned(0 downto 0);
+  signal q_slot_eq_k_40 : unsigned(0 downto 0);
+  signal q_slot_eq_k_39 : unsigned(0 downto 0);
+  signal q_slot_eq_k_38 : unsigned(0 downto 0);
+  signal q_slot_eq_k_37 : unsigned(0 downto 0);
+  signal q_slot_eq_k_36 : unsigned(0 downto 0);
+  signal q_slot_eq_k_35 : unsigned(0 downto 0);
+  signal q_slot_eq_k_34 : unsigned(0 downto 0);
+  signal q_slot_eq_k_33 : unsigned(0 downto 0);
+  signal q_slot_eq_k_32 : unsigned(0 downto 0);
+  signal q_slot_eq_k_31 : unsigned(0 downto 0);
+  signal q_slot_eq_k_30 : unsigned(0 downto 0);
+  signal q_slot_eq_k_29 : unsigned(0 downto 0);
+  signal q_slot_eq_k_28 : unsigned(0 downto 0);
+  signal q_slot_eq_k_27 : unsigned(0 downto 0);
+  signal q_slot_eq_k_26 : unsigned(0 downto 0);
+  signal q_slot_eq_k_25 : unsigned(0 downto 0);
+  signal q_slot_eq_k_24 : unsigned(0 downto 0);
+  signal q_slot_eq_k_23 : unsigned(0 downto 0);
+  signal q_slot_eq_k_22 : unsigned(0 downto 0);
+  signal q_slot_eq_k_21 : unsigned(0 downto 0);
+  signal q_slot_eq_k_20 : unsigned(0 downto 0);
+  signal q_slot_eq_k_19 : unsigned(0 downto 0);
+  signal q_slot_eq_k_18 : unsigned(0 downto 0);
+  signal q_slot_eq_k_17 : unsigned(0 downto 0);
+  signal q_slot_eq_k_16 : unsigned(0 downto 0);
+  signal q_slot_eq_k_15 : unsigned(0 downto 0);
+  signal q_slot_eq_k_14 : unsigned(0 downto 0);
+  signal q_slot_eq_k_13 : unsigned(0 downto 0);
+  signal q_slot_eq_k_12 : unsigned(0 downto 0);
+  signal q_slot_eq_k_11 : unsigned(0 downto 0);
+  signal q_slot_eq_k_10 : unsigned(0 downto 0);
+  signal q_slot_eq_k_9 : unsigned(0 downto 0);
+  signal q_slot_eq_k_8 : unsigned(0 downto 0);
+  signal q_slot_eq_k_7 : unsigned(0 downto 0);
+  signal q_slot_eq_k_6 : unsigned(0 downto 0);
+  signal q_slot_eq_k_5 : unsigned(0 downto 0);
+  signal q_slot_eq_k_4 : unsigned(0 downto 0);
+  signal q_slot_eq_k_3 : unsigned(0 downto 0);
+  signal q_slot_eq_k_2 : unsigned(0 downto 0);
+  signal q_slot_eq_k_1 : unsigned(0 downto 0);
+  signal q_slot_eq_k_0_1 : unsigned(0 downto 0);
+  signal cat_119 : unsigned(63 downto 0);
   signal best_clear_c : unsigned(63 downto 0);
   signal best_clear : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal not_best_clear : unsigned(63 downto 0);
-  signal and_114 : unsigned(63 downto 0);
-  signal and_114_or_best_set : unsigned(63 downto 0);
+  signal and_120 : unsigned(63 downto 0);
+  signal and_120_or_best_set : unsigned(63 downto 0);
 
   -- register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
   signal c_slot : unsigned(5 downto 0) := unsigned'("000000");
@@ -1053,15 +1096,13 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_push : unsigned(0 downto 0);
   signal u_n_tmin : unsigned(31 downto 0);
   signal rs_u_n_tmin : unsigned(30 downto 0);
-  signal cat_118 : unsigned(58 downto 0);
+  signal cat_124 : unsigned(58 downto 0);
   signal leaf_pop_r : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_wr : unsigned(5 downto 0) := unsigned'("000000");
-  signal leaf_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_leaf_q_push : unsigned(5 downto 0);
-  signal leaf_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal leaf_q_rd_next : unsigned(5 downto 0);
   signal leaf_q_rd1_plus_k_1 : unsigned(5 downto 0);
   signal mux_leaf_pop_r : unsigned(5 downto 0);
@@ -1071,20 +1112,32 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_q_count_next : unsigned(6 downto 0);
   signal leaf_q_count_eq_k_0_3 : unsigned(0 downto 0);
   signal leaf_q_one_left : unsigned(0 downto 0);
-  signal and_121 : unsigned(0 downto 0);
+  signal and_127 : unsigned(0 downto 0);
   signal leaf_q_drained : unsigned(0 downto 0);
   signal leaf_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_bypass_c : unsigned(0 downto 0);
   signal leaf_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_leaf_q_count : unsigned(0 downto 0);
-  signal or_124 : unsigned(0 downto 0);
+  signal or_130 : unsigned(0 downto 0);
   signal not_leaf_pop_r : unsigned(0 downto 0);
-  signal and_125 : unsigned(0 downto 0);
+  signal and_131 : unsigned(0 downto 0);
   signal leaf_q_nonempty_c : unsigned(0 downto 0);
   signal leaf_q_din : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
-  signal leaf_q_q_stay : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
-  signal leaf_q_q_next : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal bits_leaf_q_din : unsigned(15 downto 0);
+  signal bits_leaf_q_din_1 : unsigned(15 downto 0);
+  signal bits_leaf_q_din_2 : unsigned(15 downto 0);
+  signal bits_leaf_q_din_3 : unsigned(10 downto 0);
+  signal leaf_q_q_stay_g3 : unsigned(10 downto 0) := unsigned'("00000000000");
+  signal leaf_q_q_stay_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal leaf_q_q_stay_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal leaf_q_q_stay_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal leaf_q_q_stay : unsigned(58 downto 0);
+  signal leaf_q_q_next_g3 : unsigned(10 downto 0) := unsigned'("00000000000");
+  signal leaf_q_q_next_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal leaf_q_q_next_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal leaf_q_q_next_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal leaf_q_q_next : unsigned(58 downto 0);
   signal mux_leaf_q_popped : unsigned(58 downto 0);
   signal leaf_q_din_r : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_q_head : unsigned(58 downto 0);
@@ -1184,7 +1237,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal pu_below_1 : unsigned(0 downto 0);
   signal not_pu_below_1 : unsigned(0 downto 0);
   signal bits_pu_shifted_1 : unsigned(30 downto 0);
-  signal ne_130 : unsigned(0 downto 0);
+  signal ne_138 : unsigned(0 downto 0);
   signal pu_above_1 : unsigned(0 downto 0);
   signal rs_pu_shifted_1 : signed(31 downto 0);
   signal pu_above_r_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1207,6 +1260,26 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type negative_sr_t is array (1 to 9) of unsigned(0 downto 0);
   signal negative_sr : negative_sr_t := (others => (others => '0'));
   signal negative : unsigned(0 downto 0);
+
+  -- register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
+  signal leaf_q_rd : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of leaf_q_rd : signal is "true";
+  signal leaf_q_rd_c1 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of leaf_q_rd_c1 : signal is "true";
+  signal leaf_q_rd_c2 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of leaf_q_rd_c2 : signal is "true";
+  signal leaf_q_rd_c3 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of leaf_q_rd_c3 : signal is "true";
+
+  -- register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
+  signal leaf_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of leaf_q_rd1 : signal is "true";
+  signal leaf_q_rd1_c1 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of leaf_q_rd1_c1 : signal is "true";
+  signal leaf_q_rd1_c2 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of leaf_q_rd1_c2 : signal is "true";
+  signal leaf_q_rd1_c3 : unsigned(5 downto 0) := unsigned'("000001");
+  attribute keep of leaf_q_rd1_c3 : signal is "true";
 
   -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
   signal n_ray_slot : unsigned(5 downto 0) := unsigned'("000000");
@@ -1261,7 +1334,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal tmin_m1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_tmin_n1 : signed(32 downto 0);
   signal rs_tmax_p1 : signed(32 downto 0);
-  signal minus_134 : signed(32 downto 0);
+  signal minus_142 : signed(32 downto 0);
   signal tmin_le_tmax_c : unsigned(0 downto 0);
   signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
   signal tmin_n2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -1296,19 +1369,19 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal d1_lo : signed(31 downto 0);
   signal rs_plane_t : signed(32 downto 0);
   signal rs_d0_hi : signed(32 downto 0);
-  signal minus_135 : signed(32 downto 0);
+  signal minus_143 : signed(32 downto 0);
   signal d0_below : unsigned(0 downto 0);
   signal rs_d0_lo : signed(32 downto 0);
   signal rs_plane_t_1 : signed(32 downto 0);
-  signal minus_136 : signed(32 downto 0);
+  signal minus_144 : signed(32 downto 0);
   signal d0_above : unsigned(0 downto 0);
   signal rs_plane_t_1_1 : signed(32 downto 0);
   signal rs_d1_hi : signed(32 downto 0);
-  signal minus_137 : signed(32 downto 0);
+  signal minus_145 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
   signal rs_d1_lo : signed(32 downto 0);
   signal rs_plane_t_1_2 : signed(32 downto 0);
-  signal minus_138 : signed(32 downto 0);
+  signal minus_146 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
@@ -1343,23 +1416,30 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal g_inner_and_not_go_near : unsigned(0 downto 0);
   signal enter_far : unsigned(0 downto 0);
   signal push : unsigned(0 downto 0);
+  signal stack_we_r : unsigned(0 downto 0) := unsigned'("0");
   signal rs_g_sp : unsigned(4 downto 0);
-  signal cat_140 : unsigned(10 downto 0);
+  signal cat_148 : unsigned(10 downto 0);
+  signal stack_waddr_r : unsigned(10 downto 0) := unsigned'("00000000000");
   signal u_far_min : unsigned(31 downto 0);
   signal u_g_tmax : unsigned(31 downto 0);
-  signal cat_141 : unsigned(76 downto 0);
+  signal cat_149 : unsigned(76 downto 0);
+  signal stack_wdata_r : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal enter_near_or_enter_far : unsigned(0 downto 0);
-  signal not_enter_near_or_enter_far : unsigned(0 downto 0);
+  signal g_pop : unsigned(0 downto 0);
   signal mux_enter_near : unsigned(12 downto 0);
   signal mux_enter_far : signed(31 downto 0);
   signal mux_enter_near_1 : signed(31 downto 0);
   signal g_sp_plus_k_1 : unsigned(5 downto 0);
   signal mux_push : unsigned(5 downto 0);
+  signal g_sp_zero : unsigned(0 downto 0);
   signal not_push : unsigned(0 downto 0);
-  signal g_sp_eq_k_0_1 : unsigned(0 downto 0);
-  signal and_142 : unsigned(0 downto 0);
+  signal not_push_and_g_sp_zero : unsigned(0 downto 0);
   signal g_sp_minus_k_1 : unsigned(5 downto 0);
-  signal mux_push_1 : unsigned(5 downto 0);
+  signal g_sp_m1 : unsigned(5 downto 0);
+  signal g_done : unsigned(0 downto 0);
+  signal rs_g_sp_m1 : unsigned(4 downto 0);
+  signal cat_150 : unsigned(10 downto 0);
+  signal stack_raddr_next : unsigned(10 downto 0);
 begin
 
   -- not in a stage or state machine
@@ -1395,7 +1475,13 @@ begin
         unpark_q_mem(to_integer(unpark_q_wr)) <= unpark_q_din;
       end if;
       if new_q_push = "1" then
-        new_q_mem(to_integer(new_q_wr)) <= new_q_din;
+        new_q_mem_g0(to_integer(new_q_wr)) <= bits_new_q_din;
+      end if;
+      if new_q_push = "1" then
+        new_q_mem_g1(to_integer(new_q_wr)) <= bits_new_q_din_1;
+      end if;
+      if new_q_push = "1" then
+        new_q_mem_g2(to_integer(new_q_wr)) <= bits_new_q_din_2;
       end if;
       if done_q_push = "1" then
         done_q_mem(to_integer(done_q_wr)) <= done_q_din;
@@ -1404,7 +1490,16 @@ begin
         cull_limit(to_integer(merge_slot)) <= u_merge_limit;
       end if;
       if leaf_q_push = "1" then
-        leaf_q_mem(to_integer(leaf_q_wr)) <= leaf_q_din;
+        leaf_q_mem_g0(to_integer(leaf_q_wr)) <= bits_leaf_q_din;
+      end if;
+      if leaf_q_push = "1" then
+        leaf_q_mem_g1(to_integer(leaf_q_wr)) <= bits_leaf_q_din_1;
+      end if;
+      if leaf_q_push = "1" then
+        leaf_q_mem_g2(to_integer(leaf_q_wr)) <= bits_leaf_q_din_2;
+      end if;
+      if leaf_q_push = "1" then
+        leaf_q_mem_g3(to_integer(leaf_q_wr)) <= bits_leaf_q_din_3;
       end if;
     end if;
   end process regs;
@@ -1880,24 +1975,36 @@ begin
   not_new_pop <= not new_pop;
   and_93 <= new_q_one_left and not_new_pop;
   new_q_nonempty_c <= or_92 or and_93;
+  bits_new_q_din <= unsigned(new_q_din(15 downto 0));
+  bits_new_q_din_1 <= unsigned(new_q_din(31 downto 16));
+  bits_new_q_din_2 <= unsigned(new_q_din(38 downto 32));
+  new_q_q_stay <= unsigned(std_logic_vector'(std_logic_vector(new_q_q_stay_g2) & std_logic_vector(new_q_q_stay_g1) & std_logic_vector(new_q_q_stay_g0)));
+  new_q_q_next <= unsigned(std_logic_vector'(std_logic_vector(new_q_q_next_g2) & std_logic_vector(new_q_q_next_g1) & std_logic_vector(new_q_q_next_g0)));
   mux_new_q_popped <= new_q_q_next when new_q_popped = "1" else new_q_q_stay;
   new_q_head <= new_q_din_r when new_q_bypass = "1" else mux_new_q_popped;
   not_ring_g_valid <= not ring_g_valid;
   take_unpark <= not_ring_g_valid and unpark_q_nonempty;
   not_ring_g_valid_1 <= not ring_g_valid;
   not_unpark_q_nonempty <= not unpark_q_nonempty;
-  and_95 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
-  take_new <= and_95 and new_q_nonempty;
+  and_97 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
+  take_new <= and_97 and new_q_nonempty;
   take_unpark_or_take_new <= take_unpark or take_new;
   bits_unpark_q_head <= unsigned(unpark_q_head(11 downto 6));
   bits_new_q_head <= unsigned(new_q_head(38 downto 33));
   mux_take_unpark <= bits_unpark_q_head when take_unpark = "1" else bits_new_q_head;
   bits_unpark_q_head_1 <= unsigned(unpark_q_head(5 downto 0));
-  eq_97 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
-  minus_98 <= bits_unpark_q_head_1 - k_1;
-  bits_new_q_head_1 <= unsigned(new_q_head(32 downto 1));
-  s_bits_new_q_head_1 <= signed(bits_new_q_head_1);
-  bits_new_q_head_2 <= unsigned(new_q_head(0 downto 0));
+  eq_99 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
+  minus_100 <= bits_unpark_q_head_1 - k_1;
+  rs_minus_100 <= minus_100(4 downto 0);
+  q_stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(mux_take_unpark) & std_logic_vector(rs_minus_100)));
+  bits_unpark_q_head_2 <= unsigned(unpark_q_head(5 downto 0));
+  eq_102 <= "1" when bits_unpark_q_head_2 = k_0_1 else "0";
+  bits_new_q_head_1 <= unsigned(new_q_head(0 downto 0));
+  and_103 <= take_new and bits_new_q_head_1;
+  take_unpark_and_eq_102 <= take_unpark and eq_102;
+  q_done_c <= and_103 or take_unpark_and_eq_102;
+  bits_new_q_head_2 <= unsigned(new_q_head(32 downto 1));
+  s_bits_new_q_head_2 <= signed(bits_new_q_head_2);
 
   queues_regs : process (clk)
   begin
@@ -1959,19 +2066,9 @@ begin
         new_q_wr <= mux_new_q_push;
       end if;
       if rst = '1' then
-        new_q_rd <= unsigned'("000000");
-      else
-        new_q_rd <= new_q_rd_next;
-      end if;
-      if rst = '1' then
         new_q_count <= unsigned'("0000000");
       else
         new_q_count <= new_q_count_next;
-      end if;
-      if rst = '1' then
-        new_q_rd1 <= unsigned'("000001");
-      else
-        new_q_rd1 <= mux_new_pop;
       end if;
       if rst = '1' then
         new_q_bypass <= unsigned'("0");
@@ -1989,8 +2086,12 @@ begin
         new_q_nonempty <= new_q_nonempty_c;
       end if;
       new_q_din <= cat_86;
-      new_q_q_stay <= new_q_mem(to_integer(new_q_rd));
-      new_q_q_next <= new_q_mem(to_integer(new_q_rd1));
+      new_q_q_stay_g2 <= new_q_mem_g2(to_integer(new_q_rd_c2));
+      new_q_q_stay_g1 <= new_q_mem_g1(to_integer(new_q_rd_c1));
+      new_q_q_stay_g0 <= new_q_mem_g0(to_integer(new_q_rd));
+      new_q_q_next_g2 <= new_q_mem_g2(to_integer(new_q_rd1_c2));
+      new_q_q_next_g1 <= new_q_mem_g1(to_integer(new_q_rd1_c1));
+      new_q_q_next_g0 <= new_q_mem_g0(to_integer(new_q_rd1));
       if new_q_push = "1" then
         new_q_din_r <= new_q_din;
       end if;
@@ -2002,12 +2103,58 @@ begin
       q_new <= take_new;
       q_slot <= mux_take_unpark;
       q_sp <= bits_unpark_q_head_1;
-      q_sp_zero <= eq_97;
-      q_sp_m1 <= minus_98;
-      q_tmax <= s_bits_new_q_head_1;
-      q_miss <= bits_new_q_head_2;
+      q_sp_zero <= eq_99;
+      q_sp_m1 <= minus_100;
+      q_done <= q_done_c;
+      q_tmax <= s_bits_new_q_head_2;
     end if;
   end process queues_regs;
+
+  -- register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
+
+  new_q_rd_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        new_q_rd <= unsigned'("000000");
+      else
+        new_q_rd <= new_q_rd_next;
+      end if;
+      if rst = '1' then
+        new_q_rd_c1 <= unsigned'("000000");
+      else
+        new_q_rd_c1 <= new_q_rd_next;
+      end if;
+      if rst = '1' then
+        new_q_rd_c2 <= unsigned'("000000");
+      else
+        new_q_rd_c2 <= new_q_rd_next;
+      end if;
+    end if;
+  end process new_q_rd_copies_regs;
+
+  -- register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
+
+  new_q_rd1_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        new_q_rd1 <= unsigned'("000001");
+      else
+        new_q_rd1 <= mux_new_pop;
+      end if;
+      if rst = '1' then
+        new_q_rd1_c1 <= unsigned'("000001");
+      else
+        new_q_rd1_c1 <= mux_new_pop;
+      end if;
+      if rst = '1' then
+        new_q_rd1_c2 <= unsigned'("000001");
+      else
+        new_q_rd1_c2 <= mux_new_pop;
+      end if;
+    end if;
+  end process new_q_rd1_copies_regs;
 
   -- stage ring_r: R: the token back from G, loaded in G
 
@@ -2019,9 +2166,10 @@ begin
       else
         r_valid <= g_valid;
       end if;
-      r_pop <= not_enter_near_or_enter_far;
-      r_sp_zero <= and_142;
-      r_sp_m1 <= mux_push_1;
+      r_pop <= g_pop;
+      r_sp_zero <= not_push_and_g_sp_zero;
+      r_sp_m1 <= g_sp_m1;
+      r_done <= g_done;
       r_slot <= g_slot;
       r_node <= mux_enter_near;
       r_tmin <= mux_enter_far;
@@ -2033,8 +2181,6 @@ begin
   -- stage ring_a: A: the returning token or a queued ray; a pop reads the stack; done rays leave
   a_valid <= r_valid or q_valid;
   a_slot <= r_slot when r_valid = "1" else q_slot;
-  not_r_valid <= not r_valid;
-  a_new <= not_r_valid and q_new;
   not_q_new <= not q_new;
   a_pop <= r_pop when r_valid = "1" else not_q_new;
   mux_q_new <= k_0_1 when q_new = "1" else q_sp;
@@ -2042,17 +2188,23 @@ begin
   q_new_or_q_sp_zero <= q_new or q_sp_zero;
   a_sp_zero <= r_sp_zero when r_valid = "1" else q_new_or_q_sp_zero;
   a_sp_m1 <= r_sp_m1 when r_valid = "1" else q_sp_m1;
-  a_pop_and_a_sp_zero <= a_pop and a_sp_zero;
-  a_new_and_q_miss <= a_new and q_miss;
-  or_99 <= a_pop_and_a_sp_zero or a_new_and_q_miss;
-  a_done <= a_valid and or_99;
+  r_valid_and_r_done <= r_valid and r_done;
+  not_r_valid <= not r_valid;
+  not_r_valid_and_q_valid <= not_r_valid and q_valid;
+  and_105 <= not_r_valid_and_q_valid and q_done;
+  a_done <= r_valid_and_r_done or and_105;
   not_a_sp_zero <= not a_sp_zero;
   a_from_stack <= a_pop and not_a_sp_zero;
-  stack_we <= push;
-  stack_waddr <= cat_140;
-  stack_wdata <= cat_141;
-  rs_a_sp_m1 <= a_sp_m1(4 downto 0);
-  stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(a_slot) & std_logic_vector(rs_a_sp_m1)));
+  stack_we <= stack_we_r;
+  stack_waddr <= stack_waddr_r;
+  stack_wdata <= stack_wdata_r;
+
+  ring_a_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      stack_raddr <= stack_raddr_next;
+    end if;
+  end process ring_a_regs;
 
   -- stage ring_b: B, B2: the token waits two clocks for the stack word
   not_a_done <= not a_done;
@@ -2103,14 +2255,14 @@ begin
   done_q_count_next <= done_q_after_pop + rs_done_q_push;
   done_q_count_eq_k_0_3 <= "1" when done_q_count = k_0_3 else "0";
   done_q_one_left <= "1" when done_q_count = k_1_1 else "0";
-  and_103 <= done_q_one_left and done_pop_r;
-  done_q_drained <= done_q_count_eq_k_0_3 or and_103;
+  and_109 <= done_q_one_left and done_pop_r;
+  done_q_drained <= done_q_count_eq_k_0_3 or and_109;
   done_q_bypass_c <= done_q_push and done_q_drained;
   k_1_1_lt_done_q_count <= "1" when k_1_1 < done_q_count else "0";
-  or_106 <= done_q_push or k_1_1_lt_done_q_count;
+  or_112 <= done_q_push or k_1_1_lt_done_q_count;
   not_done_pop_r <= not done_pop_r;
-  and_107 <= done_q_one_left and not_done_pop_r;
-  done_q_nonempty_c <= or_106 or and_107;
+  and_113 <= done_q_one_left and not_done_pop_r;
+  done_q_nonempty_c <= or_112 or and_113;
   mux_done_q_popped <= done_q_q_next when done_q_popped = "1" else done_q_q_stay;
   done_q_head <= done_q_din_r when done_q_bypass = "1" else mux_done_q_popped;
 
@@ -2318,10 +2470,10 @@ begin
       k_0 when others;
   rs_s_limit_q <= resize(s_limit_q, 33);
   rs_cull_x <= resize(cull_x, 33);
-  minus_109 <= rs_s_limit_q - rs_cull_x;
-  bits_minus_109 <= unsigned(minus_109(32 downto 32));
-  culled_c <= cull_has_best and bits_minus_109;
-  and_111 <= merge_valid and merge_hit;
+  minus_115 <= rs_s_limit_q - rs_cull_x;
+  bits_minus_115 <= unsigned(minus_115(32 downto 32));
+  culled_c <= cull_has_best and bits_minus_115;
+  and_117 <= merge_valid and merge_hit;
   merge_slot_eq_k_63 <= "1" when merge_slot = k_63 else "0";
   merge_slot_eq_k_62 <= "1" when merge_slot = k_62 else "0";
   merge_slot_eq_k_61 <= "1" when merge_slot = k_61 else "0";
@@ -2386,78 +2538,77 @@ begin
   merge_slot_eq_k_2 <= "1" when merge_slot = k_2 else "0";
   merge_slot_eq_k_1 <= "1" when merge_slot = k_1 else "0";
   merge_slot_eq_k_0_1 <= "1" when merge_slot = k_0_1 else "0";
-  cat_112 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
-  best_set <= cat_112 when and_111 = "1" else k_0_2;
-  a_new_and_a_valid <= a_new and a_valid;
-  a_slot_eq_k_63 <= "1" when a_slot = k_63 else "0";
-  a_slot_eq_k_62 <= "1" when a_slot = k_62 else "0";
-  a_slot_eq_k_61 <= "1" when a_slot = k_61 else "0";
-  a_slot_eq_k_60 <= "1" when a_slot = k_60 else "0";
-  a_slot_eq_k_59 <= "1" when a_slot = k_59 else "0";
-  a_slot_eq_k_58 <= "1" when a_slot = k_58 else "0";
-  a_slot_eq_k_57 <= "1" when a_slot = k_57 else "0";
-  a_slot_eq_k_56 <= "1" when a_slot = k_56 else "0";
-  a_slot_eq_k_55 <= "1" when a_slot = k_55 else "0";
-  a_slot_eq_k_54 <= "1" when a_slot = k_54 else "0";
-  a_slot_eq_k_53 <= "1" when a_slot = k_53 else "0";
-  a_slot_eq_k_52 <= "1" when a_slot = k_52 else "0";
-  a_slot_eq_k_51 <= "1" when a_slot = k_51 else "0";
-  a_slot_eq_k_50 <= "1" when a_slot = k_50 else "0";
-  a_slot_eq_k_49 <= "1" when a_slot = k_49 else "0";
-  a_slot_eq_k_48 <= "1" when a_slot = k_48 else "0";
-  a_slot_eq_k_47 <= "1" when a_slot = k_47 else "0";
-  a_slot_eq_k_46 <= "1" when a_slot = k_46 else "0";
-  a_slot_eq_k_45 <= "1" when a_slot = k_45 else "0";
-  a_slot_eq_k_44 <= "1" when a_slot = k_44 else "0";
-  a_slot_eq_k_43 <= "1" when a_slot = k_43 else "0";
-  a_slot_eq_k_42 <= "1" when a_slot = k_42 else "0";
-  a_slot_eq_k_41 <= "1" when a_slot = k_41 else "0";
-  a_slot_eq_k_40 <= "1" when a_slot = k_40 else "0";
-  a_slot_eq_k_39 <= "1" when a_slot = k_39 else "0";
-  a_slot_eq_k_38 <= "1" when a_slot = k_38 else "0";
-  a_slot_eq_k_37 <= "1" when a_slot = k_37 else "0";
-  a_slot_eq_k_36 <= "1" when a_slot = k_36 else "0";
-  a_slot_eq_k_35 <= "1" when a_slot = k_35 else "0";
-  a_slot_eq_k_34 <= "1" when a_slot = k_34 else "0";
-  a_slot_eq_k_33 <= "1" when a_slot = k_33 else "0";
-  a_slot_eq_k_32 <= "1" when a_slot = k_32 else "0";
-  a_slot_eq_k_31 <= "1" when a_slot = k_31 else "0";
-  a_slot_eq_k_30 <= "1" when a_slot = k_30 else "0";
-  a_slot_eq_k_29 <= "1" when a_slot = k_29 else "0";
-  a_slot_eq_k_28 <= "1" when a_slot = k_28 else "0";
-  a_slot_eq_k_27 <= "1" when a_slot = k_27 else "0";
-  a_slot_eq_k_26 <= "1" when a_slot = k_26 else "0";
-  a_slot_eq_k_25 <= "1" when a_slot = k_25 else "0";
-  a_slot_eq_k_24 <= "1" when a_slot = k_24 else "0";
-  a_slot_eq_k_23 <= "1" when a_slot = k_23 else "0";
-  a_slot_eq_k_22 <= "1" when a_slot = k_22 else "0";
-  a_slot_eq_k_21 <= "1" when a_slot = k_21 else "0";
-  a_slot_eq_k_20 <= "1" when a_slot = k_20 else "0";
-  a_slot_eq_k_19 <= "1" when a_slot = k_19 else "0";
-  a_slot_eq_k_18 <= "1" when a_slot = k_18 else "0";
-  a_slot_eq_k_17 <= "1" when a_slot = k_17 else "0";
-  a_slot_eq_k_16 <= "1" when a_slot = k_16 else "0";
-  a_slot_eq_k_15 <= "1" when a_slot = k_15 else "0";
-  a_slot_eq_k_14 <= "1" when a_slot = k_14 else "0";
-  a_slot_eq_k_13 <= "1" when a_slot = k_13 else "0";
-  a_slot_eq_k_12 <= "1" when a_slot = k_12 else "0";
-  a_slot_eq_k_11 <= "1" when a_slot = k_11 else "0";
-  a_slot_eq_k_10 <= "1" when a_slot = k_10 else "0";
-  a_slot_eq_k_9 <= "1" when a_slot = k_9 else "0";
-  a_slot_eq_k_8 <= "1" when a_slot = k_8 else "0";
-  a_slot_eq_k_7 <= "1" when a_slot = k_7 else "0";
-  a_slot_eq_k_6 <= "1" when a_slot = k_6 else "0";
-  a_slot_eq_k_5 <= "1" when a_slot = k_5 else "0";
-  a_slot_eq_k_4 <= "1" when a_slot = k_4 else "0";
-  a_slot_eq_k_3 <= "1" when a_slot = k_3 else "0";
-  a_slot_eq_k_2 <= "1" when a_slot = k_2 else "0";
-  a_slot_eq_k_1 <= "1" when a_slot = k_1 else "0";
-  a_slot_eq_k_0_1 <= "1" when a_slot = k_0_1 else "0";
-  cat_113 <= unsigned(std_logic_vector'(std_logic_vector(a_slot_eq_k_63) & std_logic_vector(a_slot_eq_k_62) & std_logic_vector(a_slot_eq_k_61) & std_logic_vector(a_slot_eq_k_60) & std_logic_vector(a_slot_eq_k_59) & std_logic_vector(a_slot_eq_k_58) & std_logic_vector(a_slot_eq_k_57) & std_logic_vector(a_slot_eq_k_56) & std_logic_vector(a_slot_eq_k_55) & std_logic_vector(a_slot_eq_k_54) & std_logic_vector(a_slot_eq_k_53) & std_logic_vector(a_slot_eq_k_52) & std_logic_vector(a_slot_eq_k_51) & std_logic_vector(a_slot_eq_k_50) & std_logic_vector(a_slot_eq_k_49) & std_logic_vector(a_slot_eq_k_48) & std_logic_vector(a_slot_eq_k_47) & std_logic_vector(a_slot_eq_k_46) & std_logic_vector(a_slot_eq_k_45) & std_logic_vector(a_slot_eq_k_44) & std_logic_vector(a_slot_eq_k_43) & std_logic_vector(a_slot_eq_k_42) & std_logic_vector(a_slot_eq_k_41) & std_logic_vector(a_slot_eq_k_40) & std_logic_vector(a_slot_eq_k_39) & std_logic_vector(a_slot_eq_k_38) & std_logic_vector(a_slot_eq_k_37) & std_logic_vector(a_slot_eq_k_36) & std_logic_vector(a_slot_eq_k_35) & std_logic_vector(a_slot_eq_k_34) & std_logic_vector(a_slot_eq_k_33) & std_logic_vector(a_slot_eq_k_32) & std_logic_vector(a_slot_eq_k_31) & std_logic_vector(a_slot_eq_k_30) & std_logic_vector(a_slot_eq_k_29) & std_logic_vector(a_slot_eq_k_28) & std_logic_vector(a_slot_eq_k_27) & std_logic_vector(a_slot_eq_k_26) & std_logic_vector(a_slot_eq_k_25) & std_logic_vector(a_slot_eq_k_24) & std_logic_vector(a_slot_eq_k_23) & std_logic_vector(a_slot_eq_k_22) & std_logic_vector(a_slot_eq_k_21) & std_logic_vector(a_slot_eq_k_20) & std_logic_vector(a_slot_eq_k_19) & std_logic_vector(a_slot_eq_k_18) & std_logic_vector(a_slot_eq_k_17) & std_logic_vector(a_slot_eq_k_16) & std_logic_vector(a_slot_eq_k_15) & std_logic_vector(a_slot_eq_k_14) & std_logic_vector(a_slot_eq_k_13) & std_logic_vector(a_slot_eq_k_12) & std_logic_vector(a_slot_eq_k_11) & std_logic_vector(a_slot_eq_k_10) & std_logic_vector(a_slot_eq_k_9) & std_logic_vector(a_slot_eq_k_8) & std_logic_vector(a_slot_eq_k_7) & std_logic_vector(a_slot_eq_k_6) & std_logic_vector(a_slot_eq_k_5) & std_logic_vector(a_slot_eq_k_4) & std_logic_vector(a_slot_eq_k_3) & std_logic_vector(a_slot_eq_k_2) & std_logic_vector(a_slot_eq_k_1) & std_logic_vector(a_slot_eq_k_0_1)));
-  best_clear_c <= cat_113 when a_new_and_a_valid = "1" else k_0_2;
+  cat_118 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
+  best_set <= cat_118 when and_117 = "1" else k_0_2;
+  q_slot_eq_k_63 <= "1" when q_slot = k_63 else "0";
+  q_slot_eq_k_62 <= "1" when q_slot = k_62 else "0";
+  q_slot_eq_k_61 <= "1" when q_slot = k_61 else "0";
+  q_slot_eq_k_60 <= "1" when q_slot = k_60 else "0";
+  q_slot_eq_k_59 <= "1" when q_slot = k_59 else "0";
+  q_slot_eq_k_58 <= "1" when q_slot = k_58 else "0";
+  q_slot_eq_k_57 <= "1" when q_slot = k_57 else "0";
+  q_slot_eq_k_56 <= "1" when q_slot = k_56 else "0";
+  q_slot_eq_k_55 <= "1" when q_slot = k_55 else "0";
+  q_slot_eq_k_54 <= "1" when q_slot = k_54 else "0";
+  q_slot_eq_k_53 <= "1" when q_slot = k_53 else "0";
+  q_slot_eq_k_52 <= "1" when q_slot = k_52 else "0";
+  q_slot_eq_k_51 <= "1" when q_slot = k_51 else "0";
+  q_slot_eq_k_50 <= "1" when q_slot = k_50 else "0";
+  q_slot_eq_k_49 <= "1" when q_slot = k_49 else "0";
+  q_slot_eq_k_48 <= "1" when q_slot = k_48 else "0";
+  q_slot_eq_k_47 <= "1" when q_slot = k_47 else "0";
+  q_slot_eq_k_46 <= "1" when q_slot = k_46 else "0";
+  q_slot_eq_k_45 <= "1" when q_slot = k_45 else "0";
+  q_slot_eq_k_44 <= "1" when q_slot = k_44 else "0";
+  q_slot_eq_k_43 <= "1" when q_slot = k_43 else "0";
+  q_slot_eq_k_42 <= "1" when q_slot = k_42 else "0";
+  q_slot_eq_k_41 <= "1" when q_slot = k_41 else "0";
+  q_slot_eq_k_40 <= "1" when q_slot = k_40 else "0";
+  q_slot_eq_k_39 <= "1" when q_slot = k_39 else "0";
+  q_slot_eq_k_38 <= "1" when q_slot = k_38 else "0";
+  q_slot_eq_k_37 <= "1" when q_slot = k_37 else "0";
+  q_slot_eq_k_36 <= "1" when q_slot = k_36 else "0";
+  q_slot_eq_k_35 <= "1" when q_slot = k_35 else "0";
+  q_slot_eq_k_34 <= "1" when q_slot = k_34 else "0";
+  q_slot_eq_k_33 <= "1" when q_slot = k_33 else "0";
+  q_slot_eq_k_32 <= "1" when q_slot = k_32 else "0";
+  q_slot_eq_k_31 <= "1" when q_slot = k_31 else "0";
+  q_slot_eq_k_30 <= "1" when q_slot = k_30 else "0";
+  q_slot_eq_k_29 <= "1" when q_slot = k_29 else "0";
+  q_slot_eq_k_28 <= "1" when q_slot = k_28 else "0";
+  q_slot_eq_k_27 <= "1" when q_slot = k_27 else "0";
+  q_slot_eq_k_26 <= "1" when q_slot = k_26 else "0";
+  q_slot_eq_k_25 <= "1" when q_slot = k_25 else "0";
+  q_slot_eq_k_24 <= "1" when q_slot = k_24 else "0";
+  q_slot_eq_k_23 <= "1" when q_slot = k_23 else "0";
+  q_slot_eq_k_22 <= "1" when q_slot = k_22 else "0";
+  q_slot_eq_k_21 <= "1" when q_slot = k_21 else "0";
+  q_slot_eq_k_20 <= "1" when q_slot = k_20 else "0";
+  q_slot_eq_k_19 <= "1" when q_slot = k_19 else "0";
+  q_slot_eq_k_18 <= "1" when q_slot = k_18 else "0";
+  q_slot_eq_k_17 <= "1" when q_slot = k_17 else "0";
+  q_slot_eq_k_16 <= "1" when q_slot = k_16 else "0";
+  q_slot_eq_k_15 <= "1" when q_slot = k_15 else "0";
+  q_slot_eq_k_14 <= "1" when q_slot = k_14 else "0";
+  q_slot_eq_k_13 <= "1" when q_slot = k_13 else "0";
+  q_slot_eq_k_12 <= "1" when q_slot = k_12 else "0";
+  q_slot_eq_k_11 <= "1" when q_slot = k_11 else "0";
+  q_slot_eq_k_10 <= "1" when q_slot = k_10 else "0";
+  q_slot_eq_k_9 <= "1" when q_slot = k_9 else "0";
+  q_slot_eq_k_8 <= "1" when q_slot = k_8 else "0";
+  q_slot_eq_k_7 <= "1" when q_slot = k_7 else "0";
+  q_slot_eq_k_6 <= "1" when q_slot = k_6 else "0";
+  q_slot_eq_k_5 <= "1" when q_slot = k_5 else "0";
+  q_slot_eq_k_4 <= "1" when q_slot = k_4 else "0";
+  q_slot_eq_k_3 <= "1" when q_slot = k_3 else "0";
+  q_slot_eq_k_2 <= "1" when q_slot = k_2 else "0";
+  q_slot_eq_k_1 <= "1" when q_slot = k_1 else "0";
+  q_slot_eq_k_0_1 <= "1" when q_slot = k_0_1 else "0";
+  cat_119 <= unsigned(std_logic_vector'(std_logic_vector(q_slot_eq_k_63) & std_logic_vector(q_slot_eq_k_62) & std_logic_vector(q_slot_eq_k_61) & std_logic_vector(q_slot_eq_k_60) & std_logic_vector(q_slot_eq_k_59) & std_logic_vector(q_slot_eq_k_58) & std_logic_vector(q_slot_eq_k_57) & std_logic_vector(q_slot_eq_k_56) & std_logic_vector(q_slot_eq_k_55) & std_logic_vector(q_slot_eq_k_54) & std_logic_vector(q_slot_eq_k_53) & std_logic_vector(q_slot_eq_k_52) & std_logic_vector(q_slot_eq_k_51) & std_logic_vector(q_slot_eq_k_50) & std_logic_vector(q_slot_eq_k_49) & std_logic_vector(q_slot_eq_k_48) & std_logic_vector(q_slot_eq_k_47) & std_logic_vector(q_slot_eq_k_46) & std_logic_vector(q_slot_eq_k_45) & std_logic_vector(q_slot_eq_k_44) & std_logic_vector(q_slot_eq_k_43) & std_logic_vector(q_slot_eq_k_42) & std_logic_vector(q_slot_eq_k_41) & std_logic_vector(q_slot_eq_k_40) & std_logic_vector(q_slot_eq_k_39) & std_logic_vector(q_slot_eq_k_38) & std_logic_vector(q_slot_eq_k_37) & std_logic_vector(q_slot_eq_k_36) & std_logic_vector(q_slot_eq_k_35) & std_logic_vector(q_slot_eq_k_34) & std_logic_vector(q_slot_eq_k_33) & std_logic_vector(q_slot_eq_k_32) & std_logic_vector(q_slot_eq_k_31) & std_logic_vector(q_slot_eq_k_30) & std_logic_vector(q_slot_eq_k_29) & std_logic_vector(q_slot_eq_k_28) & std_logic_vector(q_slot_eq_k_27) & std_logic_vector(q_slot_eq_k_26) & std_logic_vector(q_slot_eq_k_25) & std_logic_vector(q_slot_eq_k_24) & std_logic_vector(q_slot_eq_k_23) & std_logic_vector(q_slot_eq_k_22) & std_logic_vector(q_slot_eq_k_21) & std_logic_vector(q_slot_eq_k_20) & std_logic_vector(q_slot_eq_k_19) & std_logic_vector(q_slot_eq_k_18) & std_logic_vector(q_slot_eq_k_17) & std_logic_vector(q_slot_eq_k_16) & std_logic_vector(q_slot_eq_k_15) & std_logic_vector(q_slot_eq_k_14) & std_logic_vector(q_slot_eq_k_13) & std_logic_vector(q_slot_eq_k_12) & std_logic_vector(q_slot_eq_k_11) & std_logic_vector(q_slot_eq_k_10) & std_logic_vector(q_slot_eq_k_9) & std_logic_vector(q_slot_eq_k_8) & std_logic_vector(q_slot_eq_k_7) & std_logic_vector(q_slot_eq_k_6) & std_logic_vector(q_slot_eq_k_5) & std_logic_vector(q_slot_eq_k_4) & std_logic_vector(q_slot_eq_k_3) & std_logic_vector(q_slot_eq_k_2) & std_logic_vector(q_slot_eq_k_1) & std_logic_vector(q_slot_eq_k_0_1)));
+  best_clear_c <= cat_119 when q_new = "1" else k_0_2;
   not_best_clear <= not best_clear;
-  and_114 <= has_best and not_best_clear;
-  and_114_or_best_set <= and_114 or best_set;
+  and_120 <= has_best and not_best_clear;
+  and_120_or_best_set <= and_120 or best_set;
 
   ring_c_regs : process (clk)
   begin
@@ -2475,7 +2626,7 @@ begin
       if rst = '1' then
         has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
       else
-        has_best <= and_114_or_best_set;
+        has_best <= and_120_or_best_set;
       end if;
       cull_x <= tmin_less;
       cull_has_best <= slot_has_best;
@@ -2518,7 +2669,7 @@ begin
   leaf_push <= visit_c_and_nw_is_leaf and nw_count_ne_k_0_6;
   u_n_tmin <= unsigned(n_tmin);
   rs_u_n_tmin <= u_n_tmin(30 downto 0);
-  cat_118 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
+  cat_124 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
   leaf_q_wr_plus_k_1 <= leaf_q_wr + k_1;
   mux_leaf_q_push <= leaf_q_wr_plus_k_1 when leaf_q_push = "1" else leaf_q_wr;
   leaf_q_rd_next <= leaf_q_rd1 when leaf_pop_r = "1" else leaf_q_rd;
@@ -2530,14 +2681,20 @@ begin
   leaf_q_count_next <= leaf_q_after_pop + rs_leaf_q_push;
   leaf_q_count_eq_k_0_3 <= "1" when leaf_q_count = k_0_3 else "0";
   leaf_q_one_left <= "1" when leaf_q_count = k_1_1 else "0";
-  and_121 <= leaf_q_one_left and leaf_pop_r;
-  leaf_q_drained <= leaf_q_count_eq_k_0_3 or and_121;
+  and_127 <= leaf_q_one_left and leaf_pop_r;
+  leaf_q_drained <= leaf_q_count_eq_k_0_3 or and_127;
   leaf_q_bypass_c <= leaf_q_push and leaf_q_drained;
   k_1_1_lt_leaf_q_count <= "1" when k_1_1 < leaf_q_count else "0";
-  or_124 <= leaf_q_push or k_1_1_lt_leaf_q_count;
+  or_130 <= leaf_q_push or k_1_1_lt_leaf_q_count;
   not_leaf_pop_r <= not leaf_pop_r;
-  and_125 <= leaf_q_one_left and not_leaf_pop_r;
-  leaf_q_nonempty_c <= or_124 or and_125;
+  and_131 <= leaf_q_one_left and not_leaf_pop_r;
+  leaf_q_nonempty_c <= or_130 or and_131;
+  bits_leaf_q_din <= unsigned(leaf_q_din(15 downto 0));
+  bits_leaf_q_din_1 <= unsigned(leaf_q_din(31 downto 16));
+  bits_leaf_q_din_2 <= unsigned(leaf_q_din(47 downto 32));
+  bits_leaf_q_din_3 <= unsigned(leaf_q_din(58 downto 48));
+  leaf_q_q_stay <= unsigned(std_logic_vector'(std_logic_vector(leaf_q_q_stay_g3) & std_logic_vector(leaf_q_q_stay_g2) & std_logic_vector(leaf_q_q_stay_g1) & std_logic_vector(leaf_q_q_stay_g0)));
+  leaf_q_q_next <= unsigned(std_logic_vector'(std_logic_vector(leaf_q_q_next_g3) & std_logic_vector(leaf_q_q_next_g2) & std_logic_vector(leaf_q_q_next_g1) & std_logic_vector(leaf_q_q_next_g0)));
   mux_leaf_q_popped <= leaf_q_q_next when leaf_q_popped = "1" else leaf_q_q_stay;
   leaf_q_head <= leaf_q_din_r when leaf_q_bypass = "1" else mux_leaf_q_popped;
   n_ray_slot_early <= n_ray_slot_early_sr(2);
@@ -2598,8 +2755,8 @@ begin
   pu_below_1 <= unsigned(pu_shifted_1(61 downto 61));
   not_pu_below_1 <= not pu_below_1;
   bits_pu_shifted_1 <= unsigned(pu_shifted_1(60 downto 30));
-  ne_130 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
-  pu_above_1 <= not_pu_below_1 and ne_130;
+  ne_138 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
+  pu_above_1 <= not_pu_below_1 and ne_138;
   rs_pu_shifted_1 <= pu_shifted_1(31 downto 0);
   mux_pu_below_r_1 <= k_m1 when pu_below_r_1 = "1" else pu_low_r_1;
   pu_clamped_1 <= k_1073741824 when pu_above_r_1 = "1" else mux_pu_below_r_1;
@@ -2657,19 +2814,9 @@ begin
         leaf_q_wr <= mux_leaf_q_push;
       end if;
       if rst = '1' then
-        leaf_q_rd <= unsigned'("000000");
-      else
-        leaf_q_rd <= leaf_q_rd_next;
-      end if;
-      if rst = '1' then
         leaf_q_count <= unsigned'("0000000");
       else
         leaf_q_count <= leaf_q_count_next;
-      end if;
-      if rst = '1' then
-        leaf_q_rd1 <= unsigned'("000001");
-      else
-        leaf_q_rd1 <= mux_leaf_pop_r;
       end if;
       if rst = '1' then
         leaf_q_bypass <= unsigned'("0");
@@ -2686,9 +2833,15 @@ begin
       else
         leaf_q_nonempty <= leaf_q_nonempty_c;
       end if;
-      leaf_q_din <= cat_118;
-      leaf_q_q_stay <= leaf_q_mem(to_integer(leaf_q_rd));
-      leaf_q_q_next <= leaf_q_mem(to_integer(leaf_q_rd1));
+      leaf_q_din <= cat_124;
+      leaf_q_q_stay_g3 <= leaf_q_mem_g3(to_integer(leaf_q_rd_c3));
+      leaf_q_q_stay_g2 <= leaf_q_mem_g2(to_integer(leaf_q_rd_c2));
+      leaf_q_q_stay_g1 <= leaf_q_mem_g1(to_integer(leaf_q_rd_c1));
+      leaf_q_q_stay_g0 <= leaf_q_mem_g0(to_integer(leaf_q_rd));
+      leaf_q_q_next_g3 <= leaf_q_mem_g3(to_integer(leaf_q_rd1_c3));
+      leaf_q_q_next_g2 <= leaf_q_mem_g2(to_integer(leaf_q_rd1_c2));
+      leaf_q_q_next_g1 <= leaf_q_mem_g1(to_integer(leaf_q_rd1_c1));
+      leaf_q_q_next_g0 <= leaf_q_mem_g0(to_integer(leaf_q_rd1));
       if leaf_q_push = "1" then
         leaf_q_din_r <= leaf_q_din;
       end if;
@@ -2844,6 +2997,62 @@ begin
     end if;
   end process ring_n_regs;
 
+  -- register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
+
+  leaf_q_rd_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        leaf_q_rd <= unsigned'("000000");
+      else
+        leaf_q_rd <= leaf_q_rd_next;
+      end if;
+      if rst = '1' then
+        leaf_q_rd_c1 <= unsigned'("000000");
+      else
+        leaf_q_rd_c1 <= leaf_q_rd_next;
+      end if;
+      if rst = '1' then
+        leaf_q_rd_c2 <= unsigned'("000000");
+      else
+        leaf_q_rd_c2 <= leaf_q_rd_next;
+      end if;
+      if rst = '1' then
+        leaf_q_rd_c3 <= unsigned'("000000");
+      else
+        leaf_q_rd_c3 <= leaf_q_rd_next;
+      end if;
+    end if;
+  end process leaf_q_rd_copies_regs;
+
+  -- register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
+
+  leaf_q_rd1_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        leaf_q_rd1 <= unsigned'("000001");
+      else
+        leaf_q_rd1 <= mux_leaf_pop_r;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1_c1 <= unsigned'("000001");
+      else
+        leaf_q_rd1_c1 <= mux_leaf_pop_r;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1_c2 <= unsigned'("000001");
+      else
+        leaf_q_rd1_c2 <= mux_leaf_pop_r;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1_c3 <= unsigned'("000001");
+      else
+        leaf_q_rd1_c3 <= mux_leaf_pop_r;
+      end if;
+    end if;
+  end process leaf_q_rd1_copies_regs;
+
   -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
 
   n_ray_slot_copies_regs : process (clk)
@@ -2875,8 +3084,8 @@ begin
   tmin_minus_1 <= n_tmin - k_1_3;
   rs_tmin_n1 <= resize(tmin_n1, 33);
   rs_tmax_p1 <= resize(tmax_p1, 33);
-  minus_134 <= rs_tmin_n1 - rs_tmax_p1;
-  tmin_le_tmax_c <= unsigned(minus_134(32 downto 32));
+  minus_142 <= rs_tmin_n1 - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(minus_142(32 downto 32));
   mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
   d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
   d0_hi <= d0_hi_sr(7);
@@ -2891,20 +3100,20 @@ begin
   d1_lo <= d1_lo_sr(7);
   rs_plane_t <= resize(plane_t, 33);
   rs_d0_hi <= resize(d0_hi, 33);
-  minus_135 <= rs_plane_t - rs_d0_hi;
-  d0_below <= unsigned(minus_135(32 downto 32));
+  minus_143 <= rs_plane_t - rs_d0_hi;
+  d0_below <= unsigned(minus_143(32 downto 32));
   rs_d0_lo <= resize(d0_lo, 33);
   rs_plane_t_1 <= resize(plane_t, 33);
-  minus_136 <= rs_d0_lo - rs_plane_t_1;
-  d0_above <= unsigned(minus_136(32 downto 32));
+  minus_144 <= rs_d0_lo - rs_plane_t_1;
+  d0_above <= unsigned(minus_144(32 downto 32));
   rs_plane_t_1_1 <= resize(plane_t_1, 33);
   rs_d1_hi <= resize(d1_hi, 33);
-  minus_137 <= rs_plane_t_1_1 - rs_d1_hi;
-  d1_below <= unsigned(minus_137(32 downto 32));
+  minus_145 <= rs_plane_t_1_1 - rs_d1_hi;
+  d1_below <= unsigned(minus_145(32 downto 32));
   rs_d1_lo <= resize(d1_lo, 33);
   rs_plane_t_1_2 <= resize(plane_t_1, 33);
-  minus_138 <= rs_d1_lo - rs_plane_t_1_2;
-  d1_above <= unsigned(minus_138(32 downto 32));
+  minus_146 <= rs_d1_lo - rs_plane_t_1_2;
+  d1_above <= unsigned(minus_146(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
   go_near_c <= d1_above when negative = "1" else d0_above;
@@ -3032,22 +3241,39 @@ begin
   enter_far <= g_inner_and_not_go_near and go_far;
   push <= enter_near and go_far;
   rs_g_sp <= g_sp(4 downto 0);
-  cat_140 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
+  cat_148 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
   u_far_min <= unsigned(far_min);
   u_g_tmax <= unsigned(g_tmax);
-  cat_141 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
+  cat_149 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
   enter_near_or_enter_far <= enter_near or enter_far;
-  not_enter_near_or_enter_far <= not enter_near_or_enter_far;
+  g_pop <= not enter_near_or_enter_far;
   mux_enter_near <= near when enter_near = "1" else far;
   mux_enter_far <= far_min when enter_far = "1" else g_tmin;
   mux_enter_near_1 <= near_max when enter_near = "1" else g_tmax;
   g_sp_plus_k_1 <= g_sp + k_1;
   mux_push <= g_sp_plus_k_1 when push = "1" else g_sp;
+  g_sp_zero <= "1" when g_sp = k_0_1 else "0";
   not_push <= not push;
-  g_sp_eq_k_0_1 <= "1" when g_sp = k_0_1 else "0";
-  and_142 <= not_push and g_sp_eq_k_0_1;
+  not_push_and_g_sp_zero <= not_push and g_sp_zero;
   g_sp_minus_k_1 <= g_sp - k_1;
-  mux_push_1 <= g_sp when push = "1" else g_sp_minus_k_1;
+  g_sp_m1 <= g_sp when push = "1" else g_sp_minus_k_1;
+  g_done <= g_pop and g_sp_zero;
+  rs_g_sp_m1 <= g_sp_m1(4 downto 0);
+  cat_150 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp_m1)));
+  stack_raddr_next <= cat_150 when g_valid = "1" else q_stack_raddr;
+
+  ring_g_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        stack_we_r <= unsigned'("0");
+      else
+        stack_we_r <= push;
+      end if;
+      stack_waddr_r <= cat_148;
+      stack_wdata_r <= cat_149;
+    end if;
+  end process ring_g_regs;
 
   u_stack : fxrt_bram_stack_w77
     port map (
