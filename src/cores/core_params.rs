@@ -122,12 +122,16 @@ impl CoreParams {
     pub fn in_lane<'b>(&self, slot: crate::rtl::build::S<'b>, lane: u32) -> crate::rtl::build::S<'b> {
         slot.slice(self.lane_slot_bits(), self.lane_bits()).eq(lane as i128)
     }
-    /// LUT-RAM groups of a lane's ray RAMs (`wide_ram`), the origins' and the directions':
-    /// each is written from a write enable and an address register of its own.
-    pub fn ray_ram_groups(&self) -> usize {
+    /// The widths of a lane's ray RAMs: the origins' (3n), then the directions' — one RAM of
+    /// all three while they fit a signal (3m ≤ 128), else one per axis.
+    pub fn ray_ram_widths(&self) -> Vec<u32> {
         let (n, m) = (self.isect.n, self.isect.m);
-        let w = if 3 * m <= MAX_WIDTH { group_widths(3 * m).len() } else { 3 * group_widths(m).len() };
-        group_widths(3 * n).len() + w
+        if 3 * m <= MAX_WIDTH { vec![3 * n, 3 * m] } else { vec![3 * n, m, m, m] }
+    }
+    /// LUT-RAM groups of a lane's ray RAMs (`wide_ram`), in `ray_ram_widths` order: each is
+    /// written from a write enable and an address register of its own.
+    pub fn ray_ram_groups(&self) -> usize {
+        self.ray_ram_widths().iter().map(|&w| group_widths(w).len()).sum()
     }
     /// Traversal units per lane.
     pub fn lane_units(&self) -> u32 {

@@ -7,10 +7,9 @@ use super::core_params::{CoreParams, tri_rom_groups};
 use super::intersect::intersect_core;
 use super::ray_port::RayPort;
 use super::traverse::{field, word_bits};
-use super::wide_ram::{WideRam, address_registers};
+use super::wide_ram::{WideRam, address_registers, group_widths, runs};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, Ports, S};
-use crate::rtl::width::MAX_WIDTH;
 use crate::scene::images::SceneRoms;
 use crate::scene::rom::rom_addr_bits;
 use std::rc::Rc;
@@ -28,12 +27,17 @@ impl RayRams {
     /// How many read-address registers the emission's reads take: one per group of columns
     /// (`wide_ram`), 12 on the default core.
     pub fn read_groups(&self) -> usize {
-        self.o.groups() + self.w.iter().map(WideRam::groups).sum::<usize>()
+        self.group_counts().iter().sum()
+    }
+
+    /// Each RAM's groups, the origins' RAM first (`CoreParams::ray_ram_widths` order).
+    fn group_counts(&self) -> Vec<usize> {
+        std::iter::once(&self.o).chain(&self.w).map(WideRam::groups).collect()
     }
 }
 
 pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> RayRams {
-    let (slots, n, lsb) = ((p.total_slots() >> p.lane_bits()) as usize, p.isect.n, p.lane_slot_bits());
+    let (slots, lsb) = ((p.total_slots() >> p.lane_bits()) as usize, p.lane_slot_bits());
     // This lane's write enables and addresses, a register pair per group of columns.
     let groups = p.ray_ram_groups();
     let (wes, gslots) =
@@ -50,36 +54,28 @@ pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> R
             })
             .unzip(),
     };
-    // Group k of the origins' RAM, then the directions' RAMs' groups in turn.
-    let mut next = 0;
-    let mut take = |count: usize| -> (Vec<S>, Vec<S>) {
-        let run = (accept[next..next + count].to_vec(), gslot[next..next + count].to_vec());
-        next += count;
-        run
-    };
     let name = |x: &str| p.lane_name(lane, x);
     let [ox, oy, oz] = port.o;
     let [wx, wy, wz] = port.w;
-    let o = WideRam::new(b, &name("ray_o"), 3 * n, slots);
-    let (we, at) = take(o.groups());
-    o.write(b, &we, &at, b.cat(&[oz, oy, ox]));
-    let w = if 3 * p.isect.m <= MAX_WIDTH {
-        let mem = WideRam::new(b, &name("ray_w"), 3 * p.isect.m, slots);
-        let (we, at) = take(mem.groups());
-        mem.write(b, &we, &at, b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]));
-        vec![mem]
-    } else {
-        [("x", wx), ("y", wy), ("z", wz)]
-            .into_iter()
-            .map(|(axis, w)| {
-                let mem = WideRam::new(b, &name(&format!("ray_w{axis}")), p.isect.m, slots);
-                let (we, at) = take(mem.groups());
-                mem.write(b, &we, &at, w.unsigned());
-                mem
-            })
-            .collect()
+    // The RAMs as `ray_ram_widths` lays them out, each made and then written its word in turn.
+    let widths = p.ray_ram_widths();
+    let counts: Vec<usize> = widths.iter().map(|&w| group_widths(w).len()).collect();
+    let (wes, ats) = (runs(&accept, &counts), runs(&gslot, &counts));
+    let names: &[&str] = if widths.len() == 2 { &["ray_o", "ray_w"] } else { &["ray_o", "ray_wx", "ray_wy", "ray_wz"] };
+    let word = |k: usize| match (k, widths.len()) {
+        (0, _) => b.cat(&[oz, oy, ox]),
+        (_, 2) => b.cat(&[wz.unsigned(), wy.unsigned(), wx.unsigned()]),
+        _ => [wx, wy, wz][k - 1].unsigned(),
     };
-    RayRams { o, w }
+    let mut rams: Vec<WideRam> = (0..widths.len())
+        .map(|k| {
+            let ram = WideRam::new(b, &name(names[k]), widths[k], slots);
+            ram.write(b, &wes[k], &ats[k], word(k));
+            ram
+        })
+        .collect();
+    let o = rams.remove(0);
+    RayRams { o, w: rams }
 }
 
 /// The leaf in flight: the registers the emission reads.
@@ -341,16 +337,10 @@ pub fn into_pipeline<'b>(
     tri_fields: Vec<S<'b>>,
 ) -> Emission<'b> {
     let (n, m) = (p.isect.n, p.isect.m);
-    // The address registers, a run of them for each RAM's groups in turn (wrapping around
-    // when there are fewer).
-    let mut next = 0;
-    let mut addrs = |groups: usize| -> Vec<S<'b>> {
-        let run = (next..next + groups).map(|k| slot[k % slot.len()]).collect();
-        next += groups;
-        run
-    };
+    // The address registers, a run of them for each RAM's groups in turn.
+    let addrs = runs(slot, &rams.group_counts());
     let nm = |x: &str| p.lane_name(lane, x);
-    let o_word = rams.o.read(b, &nm("ray_o_q"), &addrs(rams.o.groups()));
+    let o_word = rams.o.read(b, &nm("ray_o_q"), &addrs[0]);
     let o_word = b.delay_line(&nm("pipe_o"), o_word, clocks - 1);
     let w_words: Vec<S> = rams
         .w
@@ -358,7 +348,7 @@ pub fn into_pipeline<'b>(
         .enumerate()
         .map(|(k, mem)| {
             let suffix = if rams.w.len() == 1 { String::new() } else { ["x", "y", "z"][k].to_string() };
-            let q = mem.read(b, &nm(&format!("ray_w{suffix}_q")), &addrs(mem.groups()));
+            let q = mem.read(b, &nm(&format!("ray_w{suffix}_q")), &addrs[k + 1]);
             b.delay_line(&nm(&format!("pipe_w{suffix}")), q, clocks - 1)
         })
         .collect();

@@ -97,6 +97,20 @@ pub fn address_registers<'b>(b: &'b Builder, reg: S<'b>, count: usize) -> Vec<S<
     regs
 }
 
+/// `items` dealt out in turn as runs of `counts` items, wrapping around when there are fewer:
+/// a RAM's groups' registers from a list of copies for several RAMs.
+pub fn runs<T: Copy>(items: &[T], counts: &[usize]) -> Vec<Vec<T>> {
+    let mut next = 0;
+    counts
+        .iter()
+        .map(|&count| {
+            let run = (next..next + count).map(|k| items[k % items.len()]).collect();
+            next += count;
+            run
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
