@@ -205,3 +205,23 @@ fn external_memory_options_are_checked() {
         refused(&args, &format!("--{subject}"), want, &png);
     }
 }
+
+/// `fxrt test` runs one intersection pipeline: a core shape (a device to fit, slots, units,
+/// pipelines) would be ignored, so it is refused, naming the option; the build folder is not
+/// made.
+#[test]
+fn test_refuses_a_core_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let build = dir.path().join("build");
+    let b = build.to_str().unwrap();
+    for (extra, subject) in [
+        (&["--device", "lfe5u-85f"][..], "device"),
+        (&["--pipelines", "2", "--units", "2"][..], "pipelines"),
+        (&["--slots", "8"][..], "slots"),
+        (&["--units", "4"][..], "units"),
+    ] {
+        let mut args = vec!["test", "--builtin", "cornell", "--vectors", "10", "--build", b];
+        args.extend_from_slice(extra);
+        refused(&args, &format!("--{subject}"), "intersection pipeline alone", &build);
+    }
+}

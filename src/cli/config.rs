@@ -412,6 +412,7 @@ impl TestArgs {
         if vectors == 0 {
             return Err(Error::param("vectors", "0: nothing would run"));
         }
+        refuse_core_shape(&self.hw.threads)?;
         let sim = Simulation::from(self.sim);
         Ok(TestConfig {
             params,
@@ -422,6 +423,25 @@ impl TestArgs {
             seed: self.seed,
             build: sim.build_dir(&self.build, "target/fxrt-test")?,
         })
+    }
+}
+
+/// `fxrt test` runs one intersection pipeline on vectors: the core's shape (slots, units,
+/// pipelines, a device to fit) does not reach it, so a shape other than the default is refused
+/// rather than ignored.
+fn refuse_core_shape(t: &super::args::ThreadArgs) -> Result<()> {
+    let what = "fxrt test checks the intersection pipeline alone; the core's shape is for fxrt sim, gen and synth";
+    if let Some(d) = t.device {
+        return Err(Error::param("device", format!("{}: {what}", d.name())));
+    }
+    let defaults = [
+        ("slots", t.slots, crate::cores::top::DEFAULT_SLOTS),
+        ("units", t.units, crate::cores::top::DEFAULT_UNITS),
+        ("pipelines", t.pipelines, 1),
+    ];
+    match defaults.into_iter().find(|&(_, given, default)| given != default) {
+        Some((name, given, _)) => Err(Error::param(name, format!("{given}: {what}"))),
+        None => Ok(()),
     }
 }
 
