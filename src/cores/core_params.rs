@@ -28,7 +28,7 @@ pub struct CoreParams {
     pub units: u32,
     /// Intersection pipelines (lanes): lane l serves units l·U/P … (l + 1)·U/P − 1.
     pub pipelines: u32,
-    /// Clocks of a triangle ROM read (`brom::read_cycles`).
+    /// Clocks of a triangle ROM read (`brom::tri_read_cycles`).
     pub tri_rom_cycles: u32,
     /// With the scene in external memory (`external`): its image, caches and read port.
     pub mem: Option<ExternalMemory>,
@@ -91,7 +91,7 @@ impl CoreParams {
             div_bits,
             target_mhz,
         };
-        let tri_rom_cycles = super::brom::read_cycles(scene.tri.1.len());
+        let tri_rom_cycles = super::brom::tri_read_cycles(scene.tri.1.len());
         CoreParams { isect, trav, tag, units, pipelines, tri_rom_cycles, mem: None }
     }
 

@@ -211,37 +211,58 @@ pub fn dp16kd_rom(generated: &str, m: &Module) -> Option<String> {
             }
         }
     }
+    let cycles = crate::cores::brom::brom_cycles(m);
+    // A fabric register of the word's width named `name`, loading `from`; its name.
+    let word_reg = |v: &mut String, name: &str, from: &str| {
+        let _ = writeln!(
+            v,
+            "  reg [{}:0] {name} = {}'h0;\n  always @(posedge clk) {name} <= {from};",
+            rom.width - 1,
+            rom.width
+        );
+        name.to_string()
+    };
+    // With four clocks, each bank's word is registered in the fabric before the multiplexer
+    // (the placer puts the register by its blocks), and again after it.
+    let bank_regs = cycles == 4;
     for (x, addr, out) in ports {
         let word = if one {
             format!("dout{x}[{}:0]", rom.width - 1)
         } else {
-            // Each bank's select: the address's top bits are its base's, registered twice to
-            // meet the words leaving the blocks' output registers.
+            // Each bank's select: the address's top bits are its base's, registered to meet the
+            // words leaving the blocks' output registers (and the banks' fabric registers).
             let mut terms = Vec::new();
             for (k, bank) in layout.iter().enumerate() {
                 let prefix = bank.base >> bank.abits;
+                let (last, extra) = if bank_regs {
+                    (format!("sel{k}{x}_2"), format!(" sel{k}{x}_2 <= sel{k}{x}_1;"))
+                } else {
+                    (format!("sel{k}{x}_1"), String::new())
+                };
+                let regs = if bank_regs { format!("sel{k}{x}_1 = 1'b0, sel{k}{x}_2") } else { format!("sel{k}{x}_1") };
                 let _ = writeln!(
                     v,
-                    "  reg sel{k}{x}_1 = 1'b0, sel{k}{x} = 1'b0;\n  \
-                     always @(posedge clk) begin sel{k}{x}_1 <= {addr}[{}:{}] == {}'d{prefix}; sel{k}{x} <= sel{k}{x}_1; end",
+                    "  reg {regs} = 1'b0, sel{k}{x} = 1'b0;\n  \
+                     always @(posedge clk) begin sel{k}{x}_1 <= {addr}[{}:{}] == {}'d{prefix};{extra} sel{k}{x} <= {last}; end",
                     abits - 1,
                     bank.abits,
                     abits - bank.abits
                 );
-                terms.push(format!("({{{}{{sel{k}{x}}}}} & dout{k}{x}[{}:0])", rom.width, rom.width - 1));
+                let dout = if bank_regs {
+                    word_reg(&mut v, &format!("dout{k}{x}_p"), &format!("dout{k}{x}[{}:0]", rom.width - 1))
+                } else {
+                    format!("dout{k}{x}[{}:0]", rom.width - 1)
+                };
+                terms.push(format!("({{{}{{sel{k}{x}}}}} & {dout})", rom.width));
             }
             let _ = writeln!(v, "  wire [{}:0] word{x} = {};", rom.width - 1, terms.join(" | "));
             format!("word{x}")
         };
-        if crate::cores::brom::brom_cycles(m) == 3 {
-            // The third clock: a fabric register after the block's output register.
-            let _ = writeln!(
-                v,
-                "  reg [{0}:0] dout{x}_q = {1}'h0;\n  always @(posedge clk) dout{x}_q <= {word};",
-                rom.width - 1,
-                rom.width
-            );
-            let _ = writeln!(v, "  assign {out} = dout{x}_q;");
+        let word = if bank_regs && one { word_reg(&mut v, &format!("dout{x}_p"), &word) } else { word };
+        if cycles >= 3 {
+            // The last clock: a fabric register after the block's output register.
+            let q = word_reg(&mut v, &format!("dout{x}_q"), &word);
+            let _ = writeln!(v, "  assign {out} = {q};");
         } else {
             let _ = writeln!(v, "  assign {out} = {word};");
         }
