@@ -139,7 +139,7 @@ pub fn axi_read<'b>(
     let last_beat = beat.eq((p.line_beats - 1) as i128).name("axi_last_beat");
     let done = b.wire("axi_burst_done", Ty::BIT);
     let who_pop = b.wire("axi_who_pop", Ty::BIT);
-    let (who, who_nonempty) = fifo_words(b, "axi_who", p.outstanding, go, &[pick], who_pop);
+    let (who, who_nonempty) = fifo_words(b, "axi_who", p.outstanding, go, &[pick], who_pop, false);
     b.drive(done, rvalid & who_nonempty & last_beat);
     b.drive(who_pop, done);
     let who = who[0];

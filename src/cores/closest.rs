@@ -18,7 +18,8 @@
 //! stack pointer, its slot, then the leaf's first and last flags.
 
 use super::clock::ClockTarget;
-use super::lt_chain;
+use super::wide_ram::WideRam;
+use super::{lt_chain, slot_bit_2};
 use crate::rtl::build::{Builder, S};
 use crate::rtl::{Module, Ty};
 
@@ -155,8 +156,11 @@ pub fn closest_core(
 
     // The slots' best hits: (t, tri) and (u, v) RAMs and a valid bit per slot.
     let k = slots;
-    let tt_mem = b.ram("best_t_tri", t.width() + tri.width(), vec![0; k as usize]);
-    let uv_mem = b.ram("best_u_v", 2 * m_bits, vec![0; k as usize]);
+    // In groups of LUT-RAM columns, each read and written at an address register of its own
+    // (`wide_ram`): one register per RAM reaching all its cells made the done read a slowest
+    // path at seed 2 (`d0_slot_c1` → `done_t_tri`, 7.39 ns).
+    let tt_mem = WideRam::new(&b, "best_t_tri", t.width() + tri.width(), k as usize);
+    let uv_mem = WideRam::new(&b, "best_u_v", 2 * m_bits, k as usize);
     let id_mem = b.ram("ray_ids", id_bits, vec![0; k as usize]);
     b.ram_write(id_mem, id_we, id_slot, id_in);
     let best_valid = b.reg("best_valid", Ty::u(k), Some(0));
@@ -167,7 +171,7 @@ pub fn closest_core(
     let fin = b.valid_delay("fin", (valid & last).name("leaf_last"));
     let fin_slot = b.delay("fin_slot", slot);
     let fin_sp = b.delay("fin_sp", sp);
-    let st_tt = b.read("slot_t_tri", tt_mem, fin_slot);
+    let st_tt = tt_mem.read(&b, "slot_t_tri", &b.copies(fin_slot, tt_mem.groups()));
     let m1 = b.valid_delay("m1", fin);
     let m1_slot = b.delay("m1_slot", fin_slot);
     let m1_sp = b.delay("m1_sp", fin_sp);
@@ -208,9 +212,10 @@ pub fn closest_core(
     let we = b.valid_delay("best_we", (m2 & m2_better).name("m2_we"));
     // The write address fans out to every LUT-RAM cell of both best RAMs: a register each.
     let m3_slot = b.delay("m3_slot", m2_slot);
-    let m3_slots = b.copies(m3_slot, 2);
-    b.ram_write(tt_mem, we, m3_slots[0], b.delay("m3_t_tri", m2_tt));
-    b.ram_write(uv_mem, we, m3_slots[1], b.delay("m3_u_v", m2_uv));
+    let m3_slots = b.copies(m3_slot, tt_mem.groups() + uv_mem.groups());
+    let (tt_slots, uv_slots) = m3_slots.split_at(tt_mem.groups());
+    tt_mem.write(&b, &[we], tt_slots, b.delay("m3_t_tri", m2_tt));
+    uv_mem.write(&b, &[we], uv_slots, b.delay("m3_u_v", m2_uv));
     let limit = m2_better.select(m2_leaf_limit, m2_slot_limit).name("merged_limit");
     // The merge reaches each traversal unit through registers of its own (valid, slot in the
     // unit, hit): one shared set drove both units' cull-limit LUT-RAM write enables through
@@ -240,10 +245,12 @@ pub fn closest_core(
     let d0 = b.valid_delay("d0", done_valid);
     let d0_slot = b.delay("d0_slot", done_slot);
     // A register per RAM it addresses (426 sinks a bit as one; DECISIONS 114).
-    let d0_slots = b.copies(d0_slot, 3);
-    let d_tt = b.read("done_t_tri", tt_mem, d0_slots[0]);
-    let d_uv = b.read("done_u_v", uv_mem, d0_slots[1]);
-    let d_id = b.read("done_id", id_mem, d0_slots[2]);
+    let d0_slots = b.copies(d0_slot, tt_mem.groups() + uv_mem.groups() + 1);
+    let (tt_slots, rest) = d0_slots.split_at(tt_mem.groups());
+    let (uv_slots, id_slot) = rest.split_at(uv_mem.groups());
+    let d_tt = tt_mem.read(&b, "done_t_tri", tt_slots);
+    let d_uv = uv_mem.read(&b, "done_u_v", uv_slots);
+    let d_id = b.read("done_id", id_mem, id_slot[0]);
     let d1 = b.valid_delay("d1", d0);
     let d1_slot = b.delay("d1_slot", d0_slot);
     let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, done_slot, d0_slot));
@@ -270,24 +277,4 @@ pub fn closest_core(
     res("u", d_uv.slice(m_bits, m_bits), true);
     res("v", d_uv.slice(0, m_bits), true);
     b.finish()
-}
-
-/// Bit `slot` of the k-bit register `bits`, selected over two clocks: groups of 16 bits by the
-/// slot's low bits from `early` into registers, then the group by the high bits of `late`
-/// (`early` a clock later). A 128-to-1 select in one clock was the core's critical path, its
-/// slot register placed across the die from the bits. The bit must not change in between.
-fn slot_bit_2<'b>(b: &'b Builder, name: &str, bits: S<'b>, k: u32, early: S<'b>, late: S<'b>) -> S<'b> {
-    let zero = b.konst(Ty::BIT, 0);
-    let low = early.width().min(4);
-    let groups: Vec<S> = (0..k.div_ceil(16))
-        .map(|g| {
-            let cases: Vec<(u128, S)> = (0..16.min(k - 16 * g)).map(|i| (i as u128, bits.bit(16 * g + i))).collect();
-            b.delay(&format!("{name}_g{g}"), b.case(early.slice(0, low), &cases, zero).name(&format!("{name}_g{g}_c")))
-        })
-        .collect();
-    if groups.len() == 1 {
-        return groups[0];
-    }
-    let cases: Vec<(u128, S)> = groups.iter().enumerate().map(|(g, &x)| (g as u128, x)).collect();
-    b.case(late.slice(4, late.width() - 4), &cases, zero).name(&format!("{name}_c"))
 }

@@ -13,7 +13,7 @@
 //! written, which a read-first RAM answers with the old word, so it comes from a copy of the
 //! pushed word instead (`bypass`).
 
-use super::wide_ram::{WideRam, address_registers};
+use super::wide_ram::WideRam;
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 
@@ -42,7 +42,8 @@ pub fn unpack<'b>(entry: S<'b>, widths: &[u32]) -> Vec<S<'b>> {
 }
 
 /// A queue whose entries are several words (each a RAM of its own, all at the same
-/// pointers): for entries wider than a signal may be. The heads of the words, and `nonempty`.
+/// pointers): for entries wider than a signal may be. The heads of the words, and `nonempty`;
+/// `two_reads` as `queue`'s.
 pub fn fifo_words<'b>(
     b: &'b Builder,
     name: &str,
@@ -50,13 +51,15 @@ pub fn fifo_words<'b>(
     push: S<'b>,
     dins: &[S<'b>],
     pop: S<'b>,
+    two_reads: bool,
 ) -> (Vec<S<'b>>, S<'b>) {
-    queue(b, name, depth, push, dins, pop, false)
+    queue(b, name, depth, push, dins, pop, two_reads)
 }
 
 /// The queue; with `two_reads` the RAM has two read ports and the pop picks after it (the
-/// control queues, in LUT RAM), else one read port at the next read pointer (the result
-/// queue's wide words: a second port would double its RAM).
+/// control queues and the result queue, in LUT RAM: the pop comes late, from a consumer), else
+/// one read port at the next read pointer (half the RAM, the pop before the read: the AXI
+/// read port's bookkeeping).
 fn queue<'b>(
     b: &'b Builder,
     name: &str,
@@ -67,6 +70,10 @@ fn queue<'b>(
     two_reads: bool,
 ) -> (Vec<S<'b>>, S<'b>) {
     let push = b.valid_delay(&format!("{name}_push"), push);
+    // The count's and flags' own copy: the push register also drives every LUT-RAM cell's
+    // write enable, and through that net it was a slowest path into the count at seed 2 (a
+    // leaf queue's, 7.45 ns).
+    let push_ctl = b.copies(push, 1)[0];
     let depth = depth.next_power_of_two().max(2);
     let ab = depth.trailing_zeros();
     let wr = b.reg(&format!("{name}_wr"), Ty::u(ab), Some(0));
@@ -80,18 +87,22 @@ fn queue<'b>(
     let rd_next = pop.select(rd1, rd).name(&format!("{name}_rd_next"));
     b.next(rd, rd_next);
     b.next(rd1, pop.select(rd1 + 1, rd1));
-    let after_pop = (count - pop.resize(ab + 1)).name(&format!("{name}_after_pop"));
-    let count_next = (after_pop + push.resize(ab + 1)).name(&format!("{name}_count_next"));
-    b.next(count, count_next);
+    // The count after the push either way, each one adder from registers, and the pop (a
+    // clock's late arrival, from the consumer's logic) picking one: with the pop through the
+    // adder a queue's `nonempty` → its count was a slowest path at seed 2 (7.20 ns, 8 cells).
+    let cw = ab + 1;
+    let if_popped = (count - (!push_ctl).resize(cw)).name(&format!("{name}_count_if_pop"));
+    let if_kept = (count + push_ctl.resize(cw)).name(&format!("{name}_count_if_kept"));
+    b.next(count, pop.select(if_popped, if_kept).name(&format!("{name}_count_next")));
     // `bypass` and `nonempty` from compares of the count register, the pop one gate before
     // the flip-flop (through the subtractor and adder it was among the slowest paths).
     let (empty, one_left) = (count.eq(0), count.eq(1).name(&format!("{name}_one_left")));
     let drained = (empty | (one_left & pop)).name(&format!("{name}_drained"));
     let bypass = b.reg(&format!("{name}_bypass"), Ty::BIT, Some(0));
-    b.next(bypass, (push & drained).name(&format!("{name}_bypass_c")));
+    b.next(bypass, (push_ctl & drained).name(&format!("{name}_bypass_c")));
     let popped = two_reads.then(|| b.valid_delay(&format!("{name}_popped"), pop));
     let nonempty = b.reg(&format!("{name}_nonempty"), Ty::BIT, Some(0));
-    b.next(nonempty, (push | count.gt(1) | (one_left & !pop)).name(&format!("{name}_nonempty_c")));
+    b.next(nonempty, (push_ctl | count.gt(1) | (one_left & !pop)).name(&format!("{name}_nonempty_c")));
     let one = dins.len() == 1;
     let heads = dins
         .iter()
@@ -107,7 +118,7 @@ fn queue<'b>(
             let q = if let Some(popped) = popped {
                 let ram = WideRam::new(b, &word("mem"), din.width(), depth as usize);
                 ram.write(b, &[push], &[wr], din);
-                let (rds, rd1s) = (address_registers(b, rd, ram.groups()), address_registers(b, rd1, ram.groups()));
+                let (rds, rd1s) = pointer_copies(b, &word("rd"), [rd, rd1], pop, ram.groups());
                 let q_stay = ram.read(b, &word("q_stay"), &rds);
                 let q_next = ram.read(b, &word("q_next"), &rd1s);
                 popped.select(q_next, q_stay)
@@ -122,6 +133,30 @@ fn queue<'b>(
         })
         .collect();
     (heads, nonempty)
+}
+
+/// The read pointers `rd`, `rd + 1` and `count − 1` more pairs that hold the same values, each
+/// pair counting by itself with `pop` (a group of the RAM's columns is read at each pair). Not
+/// copies of the registers (`Builder::copies`): those load the original's next value, a net
+/// from the original's adder to every group across the die, which was a slowest path at seeds
+/// 1 and 2 (a leaf queue's `rd1` back to its copies, 7.71 ns).
+fn pointer_copies<'b>(
+    b: &'b Builder,
+    name: &str,
+    [rd, rd1]: [S<'b>; 2],
+    pop: S<'b>,
+    count: usize,
+) -> (Vec<S<'b>>, Vec<S<'b>>) {
+    let (mut rds, mut rd1s) = (vec![rd], vec![rd1]);
+    for g in 1..count {
+        let r = b.reg(&format!("{name}_p{g}"), rd.ty(), Some(0));
+        let r1 = b.reg(&format!("{name}1_p{g}"), rd.ty(), Some(1));
+        b.next(r, pop.select(r1, r));
+        b.next(r1, pop.select(r1 + 1, r1));
+        rds.push(r);
+        rd1s.push(r1);
+    }
+    (rds, rd1s)
 }
 
 #[cfg(test)]

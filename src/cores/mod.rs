@@ -13,6 +13,7 @@ pub mod core_params;
 pub mod cost;
 pub mod divider;
 pub mod fifo;
+pub mod free_list;
 pub mod intersect;
 pub mod leaf_stream;
 pub mod memory_params;
@@ -30,7 +31,8 @@ mod traverse_stages;
 pub mod tri_fetch;
 pub mod wide_ram;
 
-use crate::rtl::build::S;
+use crate::rtl::Ty;
+use crate::rtl::build::{Builder, S};
 
 /// a < b (same type) as the sign of their difference one bit wider, which cannot overflow: one
 /// carry chain whose last sum bit is the result, so a register or a LUT can take it straight
@@ -48,28 +50,23 @@ pub fn onehot<'b>(x: S<'b>, k: u32) -> S<'b> {
     x.b.cat(&bits)
 }
 
-/// Whether any of `bits` is set, and the index of the lowest set one (`idx_bits` wide): a tree
-/// of log2(len) mux levels, not a priority chain.
-pub fn lowest_set<'b>(bits: &[S<'b>], idx_bits: u32) -> (S<'b>, S<'b>) {
-    let b = bits[0].b;
-    let zero = b.konst(crate::rtl::Ty::BIT, 0);
-    let mut level: Vec<(S<'b>, Option<S<'b>>)> = bits.iter().map(|&x| (x, None)).collect();
-    let len = bits.len().next_power_of_two().max(2);
-    level.resize(len, (zero, None));
-    while level.len() > 1 {
-        level = level
-            .chunks(2)
-            .map(|pair| {
-                let ((lo_any, lo_idx), (hi_any, hi_idx)) = (pair[0], pair[1]);
-                // The index below this level: the low half's when it has a set bit.
-                let idx = match (lo_idx, hi_idx) {
-                    (Some(l), Some(h)) => b.cat(&[!lo_any, lo_any.select(l, h)]),
-                    _ => !lo_any,
-                };
-                (lo_any | hi_any, Some(idx))
-            })
-            .collect();
+/// Bit `slot` of the k-bit register `bits`, selected over two clocks: groups of 16 bits by the
+/// slot's low bits from `early` into registers, then the group by the high bits of `late`
+/// (`early` a clock later). A 128-to-1 select in one clock was the core's critical path, its
+/// slot register placed across the die from the bits. The bit must not change in between (or
+/// `bits` is the register's next value, read a clock before the register would be).
+pub fn slot_bit_2<'b>(b: &'b Builder, name: &str, bits: S<'b>, k: u32, early: S<'b>, late: S<'b>) -> S<'b> {
+    let zero = b.konst(Ty::BIT, 0);
+    let low = early.width().min(4);
+    let groups: Vec<S> = (0..k.div_ceil(16))
+        .map(|g| {
+            let cases: Vec<(u128, S)> = (0..16.min(k - 16 * g)).map(|i| (i as u128, bits.bit(16 * g + i))).collect();
+            b.delay(&format!("{name}_g{g}"), b.case(early.slice(0, low), &cases, zero).name(&format!("{name}_g{g}_c")))
+        })
+        .collect();
+    if groups.len() == 1 {
+        return groups[0];
     }
-    let (any, idx) = level[0];
-    (any, idx.expect("two bits or more").resize(idx_bits))
+    let cases: Vec<(u128, S)> = groups.iter().enumerate().map(|(g, &x)| (g as u128, x)).collect();
+    b.case(late.slice(4, late.width() - 4), &cases, zero).name(&format!("{name}_c"))
 }

@@ -34,13 +34,16 @@ pub struct RayPort<'b> {
     /// 888 sinks a bit from one register on the teapot-fine core): `ram_slots` the leaf
     /// streams' ray RAMs (lane by lane, a register per group of columns, `wide_ram`, with
     /// `ram_we` the write enables alike), `closest_slot` the closest-hit unit's,
-    /// `unit_slot[u]` unit u's (within the unit).
+    /// `unit_slot[u]` unit u's (within the unit: one per group of its ray RAMs' columns), and
+    /// `unit_we[u]` unit u's write enables alike, then its `alloc`: registers of the take for
+    /// that unit.
     pub accept: S<'b>,
     pub slot: S<'b>,
     pub ram_we: Vec<S<'b>>,
     pub ram_slots: Vec<S<'b>>,
     pub closest_slot: S<'b>,
-    pub unit_slot: Vec<S<'b>>,
+    pub unit_slot: Vec<Vec<S<'b>>>,
+    pub unit_we: Vec<Vec<S<'b>>>,
     pub id: S<'b>,
     pub o: [S<'b>; 3],
     pub w: [S<'b>; 3],
@@ -154,7 +157,17 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
     // (`accept` → `ray_w`, 7.82 ns, eight such).
     let ram_groups = p.ray_ram_groups() * p.pipelines as usize;
     let ram_we = super::wide_ram::address_registers(b, accept, ram_groups);
-    let copies = b.copies(gslot, ram_groups + 1 + units as usize);
+    let unit_groups = p.trav.ray_ram_groups();
+    let copies = b.copies(gslot, ram_groups + 1 + units as usize * unit_groups);
+    // A unit's write enables are the take for that unit, registered: `accept` and a select of
+    // the slot's unit bits after it reached every cell of the unit's ray RAMs and its free list.
+    let unit_we = (0..units)
+        .map(|u| {
+            let mine = (take & is_unit(take_slot, u, sb, ub)).name(&format!("u{u}_take"));
+            let accept = b.valid_delay(&format!("u{u}_accept"), mine);
+            super::wide_ram::address_registers(b, accept, unit_groups + 1)
+        })
+        .collect();
     let [id, ox, oy, oz, wx, wy, wz, ix, iy, iz] =
         [in_id, ox, oy, oz, wx, wy, wz, ix, iy, iz].map(|s| b.delay(&format!("acc_{}", b.name_of(s.sig)), s));
     RayPort {
@@ -169,7 +182,11 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
         ram_we,
         ram_slots: copies[..ram_groups].to_vec(),
         closest_slot: copies[ram_groups],
-        unit_slot: copies[ram_groups + 1..].iter().map(|c| c.slice(0, sb)).collect(),
+        unit_slot: copies[ram_groups + 1..]
+            .chunks(unit_groups)
+            .map(|c| c.iter().map(|c| c.slice(0, sb)).collect())
+            .collect(),
+        unit_we,
         id,
         o: [ox, oy, oz],
         w: [wx, wy, wz],

@@ -29,15 +29,22 @@ pub fn result_queue<'b>(
         ["id", "hit", "tri", "t", "u", "v"].into_iter().map(|name| (name, field(name))).collect();
     let words = [b.cat(&[fields["id"], fields["hit"], fields["tri"], fields["t"]]), b.cat(&[fields["u"], fields["v"]])];
     let take = b.wire("res_take", bit);
-    let (heads, nonempty) = super::fifo::fifo_words(b, "res_q", RESULT_QUEUE, field("valid"), &words, take);
+    // Two read ports: the take (from `res_ready`) picks between the words after the RAM reads,
+    // not before them (through the read pointer into the RAM it was a slowest path at seed 3,
+    // 7.01 ns, 48 endpoints); the second port costs 33 LUT-RAM cells.
+    let (heads, nonempty) = super::fifo::fifo_words(b, "res_q", RESULT_QUEUE, field("valid"), &words, take, true);
     b.drive(take, (nonempty & res_ready).name("res_take_c"));
     // Places not promised, counted with the pops a clock late (`popped`): the queue then holds
     // at most RESULT_QUEUE − credits + popped results, so a pop needs credits − popped ≥ 1,
     // which credits ≥ 2 a clock earlier (registered: `credit_ok`) guarantees.
     let w = RESULT_QUEUE.next_power_of_two().trailing_zeros() + 2;
     let credits = b.reg("res_credits", Ty::u(w), Some(RESULT_QUEUE as i128));
-    let credits_next = (credits - popped.resize(w) + take.resize(w)).name("res_credits_next");
-    b.next(credits, credits_next);
+    // The next count either way, each one adder from registers, picked by the take (from
+    // `res_ready`, a clock's last arrival): through the adder it was a slowest path at seed 1
+    // (7.09 ns).
+    let if_taken = (credits + (!popped).resize(w)).name("res_credits_if_take");
+    let if_not = (credits - popped.resize(w)).name("res_credits_if_not");
+    b.next(credits, take.select(if_taken, if_not).name("res_credits_next"));
     b.next(credit_ok, at_least_two_next(credits, popped, take));
     b.output("res_valid", nonempty);
     // Each word's fields, least significant first (`cat` takes the most significant first).

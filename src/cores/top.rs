@@ -147,15 +147,20 @@ fn traversal_units<'b>(
         .map(|u| {
             let [merge_limit, merge_sp] = merge[(u / lu) as usize];
             let [free_valid, free_slot] = free[(u / lu) as usize];
-            let we = (port.accept & is_unit(port.slot, u, sb, ub)).name(&format!("u{u}_alloc"));
             let new_valid = (exit.done & is_unit(exit.slot, u, sb, ub)).name(&format!("u{u}_new"));
             let [mv, merge_slot, merge_hit] = merge_unit[u as usize];
             let fv = (free_valid & is_unit(free_slot, u % lu, sb, ub - lb)).name(&format!("u{u}_free"));
             let [ox, oy, oz] = port.o;
             let [ix, iy, iz] = port.inv;
-            let mut ins = vec![
-                ("ray_we", we),
-                ("ray_slot", port.unit_slot[u as usize]),
+            let (wes, slots) = (&port.unit_we[u as usize], &port.unit_slot[u as usize]);
+            let names: Vec<[String; 2]> =
+                (0..slots.len()).map(|g| [format!("ray_we_g{g}"), format!("ray_slot_g{g}")]).collect();
+            let mut ins: Vec<(&str, S)> = names
+                .iter()
+                .zip(wes.iter().zip(slots))
+                .flat_map(|([we_name, slot_name], (&we, &slot))| [(we_name.as_str(), we), (slot_name.as_str(), slot)])
+                .collect();
+            ins.extend([
                 ("ox", ox),
                 ("oy", oy),
                 ("oz", oz),
@@ -173,11 +178,11 @@ fn traversal_units<'b>(
                 ("merge_sp", merge_sp),
                 ("free_valid", fv),
                 ("free_slot", free_slot.slice(0, sb)),
-                ("alloc", we),
+                ("alloc", wes[slots.len()]),
                 ("leaf_pop", leaf_pop[u as usize]),
                 ("done_pop", done_pop[u as usize]),
                 ("node_word", node_words[u as usize]),
-            ];
+            ]);
             if let Some([_, hit, wait, done]) = node_in.get(u as usize) {
                 ins.extend([("node_hit", *hit), ("node_wait", *wait), ("node_done", *done)]);
             }

@@ -28,26 +28,29 @@
 //! Ring length P = N + L + 2 clocks (18 at the default 150 MHz with block ROMs): a slot steps
 //! once per P clocks, so K ≥ P slots keep the ring full when no slot is parked.
 //!
-//! Slots: a free-slot bit vector; the top takes the lowest free slot (`alloc`) and writes the
+//! Slots: a free list (`free_list.rs`: slots unused since reset in order, then slots given back
+//! in the order they came back); the top takes the slot offered (`alloc`) and writes the
 //! ray's origin and reciprocal direction into the ray RAMs, and later the ray's scene-box exit
 //! distance comes in through the new-ray queue (`new_*`). A slot is freed by the top when the
 //! ray's result has left the core (`free_*`), so a slot's best hit is never read after reuse.
 
 use super::fifo::{Fifo, fifo};
-use super::traverse_stages::{RingN, Slots, Unit};
+use super::free_list::FreeList;
+use super::traverse_stages::{RingN, Unit};
 use crate::rtl::Module;
 use crate::rtl::build::Builder;
 use crate::rtl::build::S;
 
 pub use super::traverse_stages::{TraverseParams, field, word_bits};
 
-/// The unit. Inputs: the ray RAM write (`ray_we`, `ray_slot`, ox, oy, oz, invx, invy, invz),
+/// The unit. Inputs: the ray RAM write (`ray_we_gI`, `ray_slot_gI` for each group I of the
+/// RAMs' LUT-RAM columns, `TraverseParams::ray_ram_groups`; ox, oy, oz, invx, invy, invz),
 /// a new ray's box exit (`new_valid`, `new_slot`, `new_tmax`, `new_miss`), a leaf merged
 /// (`merge_valid`, `merge_slot`, `merge_hit`, `merge_limit` = best t + 8, `merge_sp`), a slot
 /// freed (`free_valid`, `free_slot`), `alloc` (the top takes `free_slot_out`), `leaf_pop` and
 /// `done_pop` (the heads of the leaf and done queues are taken; the pop takes effect a clock
 /// later, so the head is not taken again in the next clock), `node_word` (the node ROM's
-/// word at `node_addr`, `node_rom_cycles` after it). Outputs: `node_addr`, the lowest free slot
+/// word at `node_addr`, `node_rom_cycles` after it). Outputs: `node_addr`, the slot offered
 /// (`has_free`, `free_slot_out`), the leaf queue's head (`leaf_valid`, `leaf_slot`, `leaf_first`,
 /// `leaf_count`, `leaf_tmin`, `leaf_sp`), the done queue's head (`done_valid`, `done_slot`), and
 /// observations: `visit` (a node visited in N, `visit_slot`, `visit_node`), `cull`, `depth`
@@ -84,7 +87,7 @@ pub fn traverse_core(p: &TraverseParams) -> Module {
 
 impl<'b> Unit<'b> {
     /// The output ports (see `traverse_core`).
-    pub(super) fn outputs(&self, slots: &Slots<'b>, node_addr: S<'b>, nn: &RingN<'b>, done: &Fifo<'b>) {
+    pub(super) fn outputs(&self, slots: &FreeList<'b>, node_addr: S<'b>, nn: &RingN<'b>, done: &Fifo<'b>) {
         let (b, p, nt) = (self.b, self.p, nn.token);
         b.output("node_addr", node_addr);
         b.output("has_free", (slots.free_any & !slots.just_alloc).name("has_free_c"));

@@ -6,9 +6,11 @@ use super::brom::bram;
 use super::brom::read_cycles;
 use super::clock::ClockTarget;
 use super::fifo::{Fifo, fifo};
+use super::free_list::{FreeList, free_list};
 use super::mul::MulStyle;
 use super::plane::{PlaneIssue, plane_unit};
-use super::{lowest_set, lt_chain, onehot};
+use super::wide_ram::{WideRam, group_widths};
+use super::{lt_chain, onehot, slot_bit_2};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 use crate::scene::images::SceneRoms;
@@ -85,6 +87,16 @@ impl TraverseParams {
     /// Reciprocal directions: m + C bits.
     pub fn inv_width(&self) -> u32 {
         self.m + self.c
+    }
+    /// The widths of the unit's ray RAMs: the origins' (3n), then each axis's reciprocal
+    /// direction.
+    pub fn ray_ram_widths(&self) -> [u32; 4] {
+        [3 * self.n, self.inv_width(), self.inv_width(), self.inv_width()]
+    }
+    /// LUT-RAM groups of the unit's ray RAMs (`wide_ram`): each written from a write enable
+    /// and a slot register of its own (the ports `ray_we_gI`, `ray_slot_gI`).
+    pub fn ray_ram_groups(&self) -> usize {
+        self.ray_ram_widths().iter().map(|&w| super::wide_ram::group_widths(w).len()).sum()
     }
     /// Distances: −1 … 2^(n+1), signed n + 3 bits.
     pub fn dist_ty(&self) -> Ty {
@@ -181,7 +193,6 @@ pub(super) struct Inputs<'b> {
     pub(super) free_valid: S<'b>,
     pub(super) free_slot: S<'b>,
     pub(super) alloc: S<'b>,
-    pub(super) ray_slot: S<'b>,
     pub(super) leaf_pop: S<'b>,
     pub(super) done_pop: S<'b>,
     pub(super) node_word: S<'b>,
@@ -205,8 +216,8 @@ pub(super) struct Unit<'b> {
     pub(super) inp: Inputs<'b>,
     /// The ray RAMs (origin; reciprocal direction per axis): written when the top accepts a
     /// ray, read in N for the plane units.
-    pub(super) o_mem: usize,
-    pub(super) inv_mem: [usize; 3],
+    pub(super) o_mem: WideRam,
+    pub(super) inv_mem: [WideRam; 3],
     pub(super) sb: u32,
     pub(super) spw: u32,
     pub(super) node_bits: u32,
@@ -304,21 +315,18 @@ pub(super) struct RingF<'b> {
     pub(super) far_start: S<'b>,
 }
 
-/// The unit's free-slot state, for the outputs.
-pub(super) struct Slots<'b> {
-    pub(super) free_any: S<'b>,
-    pub(super) free_idx: S<'b>,
-    pub(super) just_alloc: S<'b>,
-    pub(super) occupied: S<'b>,
-}
-
 impl<'b> Unit<'b> {
     /// The input ports, and the ray RAMs' write port.
     pub(super) fn new(b: &'b Builder, p: &'b TraverseParams) -> Unit<'b> {
         let (k, n, dist, sb, spw, bit) = (p.slots, p.n, p.dist_ty(), p.slot_bits(), p.sp_width(), Ty::BIT);
         let slot_ty = Ty::u(sb);
-        let ray_we = b.input("ray_we", bit);
-        let ray_slot = b.input("ray_slot", slot_ty);
+        // The ray RAMs' writes: a write enable and a slot per group of LUT-RAM columns, each
+        // from a register of the top's own (`ray_port`): one `accept` through a unit select to
+        // every cell was a slowest path at seed 2 (7.19 ns).
+        let groups = p.ray_ram_widths().map(|w| group_widths(w).len());
+        let (ray_we, ray_slot): (Vec<S>, Vec<S>) = (0..p.ray_ram_groups())
+            .map(|g| (b.input(&format!("ray_we_g{g}"), bit), b.input(&format!("ray_slot_g{g}"), slot_ty)))
+            .unzip();
         let o_in = ["ox", "oy", "oz"].map(|s| b.input(s, Ty::u(n)));
         let inv_in = ["invx", "invy", "invz"].map(|s| b.input(s, Ty::s(p.inv_width())));
         let inp = Inputs {
@@ -334,7 +342,6 @@ impl<'b> Unit<'b> {
             free_valid: b.input("free_valid", bit),
             free_slot: b.input("free_slot", slot_ty),
             alloc: b.input("alloc", bit),
-            ray_slot,
             leaf_pop: b.input("leaf_pop", bit),
             done_pop: b.input("done_pop", bit),
             // The node ROM is the core's (two units share one through a block RAM's two
@@ -347,40 +354,24 @@ impl<'b> Unit<'b> {
                 done: b.input("node_done", Ty::u(super::cache::SEQ_BITS)),
             }),
         };
-        let o_mem = b.ram("ray_o", 3 * n, vec![0; k as usize]);
-        b.ram_write(o_mem, ray_we, ray_slot, b.cat(&[o_in[2], o_in[1], o_in[0]]));
-        let inv_mem = [0, 1, 2].map(|a| {
-            let mem = b.ram(&format!("ray_inv{}", ["x", "y", "z"][a]), p.inv_width(), vec![0; k as usize]);
-            b.ram_write(mem, ray_we, ray_slot, inv_in[a].unsigned());
-            mem
-        });
+        let [o_mem, ix_mem, iy_mem, iz_mem] = ["ray_o", "ray_invx", "ray_invy", "ray_invz"]
+            .map(|name| WideRam::new(b, name, if name == "ray_o" { 3 * n } else { p.inv_width() }, k as usize));
+        let data =
+            [b.cat(&[o_in[2], o_in[1], o_in[0]]), inv_in[0].unsigned(), inv_in[1].unsigned(), inv_in[2].unsigned()];
+        let [wes, slots] = [&ray_we, &ray_slot].map(|v| super::wide_ram::runs(v, &groups));
+        for (r, ram) in [&o_mem, &ix_mem, &iy_mem, &iz_mem].into_iter().enumerate() {
+            ram.write(b, &wes[r], &slots[r], data[r]);
+        }
+        let inv_mem = [ix_mem, iy_mem, iz_mem];
         let (node_bits, leaf_bits) = (p.node_bits, p.leaf_bits);
         let stack_bits = rom_addr_bits(p.stack_depth as usize);
         Unit { b, p, inp, o_mem, inv_mem, sb, spw, node_bits, stack_bits, leaf_bits, dist }
     }
 
-    pub(super) fn slots(&self) -> Slots<'b> {
-        let (b, k, sb, inp) = (self.b, self.p.slots, self.sb, &self.inp);
-        b.stage("slots", "the free-slot bits, the lowest free slot for the top, the slots holding a ray");
-        // Free slots: a bit per slot, the lowest free one registered (one clock stale, so a slot
-        // just taken is masked for a clock by `just_alloc`).
-        let all = (1i128 << k) - 1;
-        let free_bits = b.reg("free_bits", Ty::u(k), Some(all));
-        let (any_free, lowest) = lowest_set(&(0..k).map(|i| free_bits.bit(i)).collect::<Vec<_>>(), sb);
-        // Reset to what they hold after a clock of reset (all free, slot 0), so a core that idles
-        // for a while after reset behaves as one that does not.
-        let free_any = b.reg("free_any_r", Ty::BIT, Some(1));
-        b.next(free_any, any_free.name("free_any_c"));
-        let free_idx = b.reg("free_idx_r", Ty::u(sb), Some(0));
-        b.next(free_idx, lowest.name("free_idx_c"));
-        let just_alloc = b.reg("just_alloc", Ty::BIT, Some(0));
-        b.next(just_alloc, inp.alloc);
-        let taken = inp.alloc.select(onehot(inp.ray_slot, k), b.konst(Ty::u(k), 0)).name("taken_mask");
-        let freed = inp.free_valid.select(onehot(inp.free_slot, k), b.konst(Ty::u(k), 0)).name("freed_mask");
-        b.next(free_bits, (free_bits & !taken) | freed);
-        let occupied = b.reg("occupied_r", Ty::u(sb + 1), Some(0));
-        b.next(occupied, occupied + inp.alloc.resize(sb + 1) - inp.free_valid.resize(sb + 1));
-        Slots { free_any, free_idx, just_alloc, occupied }
+    pub(super) fn slots(&self) -> FreeList<'b> {
+        let (b, inp) = (self.b, &self.inp);
+        b.stage("slots", "the free list: the next free slot for the top, the slots holding a ray");
+        free_list(b, self.p.slots, self.sb, inp.alloc, inp.free_valid, inp.free_slot)
     }
 
     /// The queues into the ring: rays back from a leaf (slot, sp) and new rays (slot, tmax,
@@ -551,6 +542,7 @@ impl<'b> Unit<'b> {
         let top_tmax = top.slice(0, dist.width).signed();
         let top_tmin = top.slice(dist.width, dist.width).signed();
         let top_node = top.slice(2 * dist.width, self.node_bits);
+        let b_slot = bt.slot;
         let c = bt.delayed(b, "c", 1, |field, x| match field {
             "node" => from_stack.select(top_node, x),
             "tmin" => from_stack.select(top_tmin, x),
@@ -566,8 +558,18 @@ impl<'b> Unit<'b> {
         let limit = b.read("limit_q", limit_mem, c_slots[0]).signed();
         let has_best = b.reg("has_best", Ty::u(k), Some(0));
         let x = b.delay("cull_x", (c.tmin - (c.tmin >> 6)).name("tmin_less"));
-        let arms: Vec<(u128, S)> = (0..k).map(|i| (i as u128, has_best.bit(i))).collect();
-        let hb = b.delay("cull_has_best", b.case(c_slots[1], &arms, b.konst(Ty::BIT, 0)).name("slot_has_best"));
+        let has_best_kept = b.wire("has_best_kept", Ty::u(k));
+        // The slot's bit over two clocks (`slot_bit_2`): groups of 16 by B's slot, then the group
+        // by C's slot; the 64-to-1 select from C's slot register in one clock was a slowest path
+        // at seeds 2 and 3 (7.72, 7.39 ns). The bit as it is in C is the bits after B's clear
+        // (`has_best_kept`, registers of the unit's own) or a merge's set in B's clock for the
+        // slot: compared with B's slot and registered beside the groups (the set's decode from
+        // the merge ports, across the die, before the groups was 8.07 ns at a seed).
+        let early = b.copies(b_slot, 1)[0];
+        let set_in_b = (inp.merge_valid & inp.merge_hit & inp.merge_slot.eq(early)).name("b_slot_merged_c");
+        let set_in_b = b.delay("b_slot_merged", set_in_b);
+        let grouped = slot_bit_2(b, "slot_has_best", has_best_kept, k, early, c_slots[1]);
+        let hb = b.delay("cull_has_best", (grouped | set_in_b).name("slot_has_best_now"));
         let culled_c = (hb & lt_chain(limit, x)).name("culled_c");
         // With a node cache, the lookup a clock after C; the cull test, known then, withdraws
         // it a clock later (`culled`, the cache's `Lookup::cancel`): a culled entry fetches
@@ -584,8 +586,22 @@ impl<'b> Unit<'b> {
         // in A is always the queued token (E takes one only when no token returns), so the
         // decode is of the queue's registers, not of A's select by `r_valid` (8.59 ns into
         // `best_clear` at seed 2).
-        let clear_best = b.delay("best_clear", onehot_or_0(q.new, q.slot).name("best_clear_c"));
-        b.next(has_best, (has_best & !clear_best) | set_best);
+        // In groups of 16 bits, each decoded from copies of `q_new` and `q_slot` of its own: one
+        // `q_new` reaching all k decodes was the slowest path at seeds 1 and 2 (7.91 ns, a route).
+        let groups = k.div_ceil(16);
+        let (news, slots) = (b.copies(q.new, groups as usize), b.copies(q.slot, groups as usize));
+        let clear_groups: Vec<S<'b>> = (0..groups)
+            .rev()
+            .map(|g| {
+                let (new, slot) = (news[g as usize], slots[g as usize]);
+                let bits = 16.min(k - 16 * g);
+                let dec: Vec<S<'b>> = (16 * g..16 * g + bits).rev().map(|i| new & slot.eq(i as i128)).collect();
+                b.cat(&dec)
+            })
+            .collect();
+        let clear_best = b.delay("best_clear", b.cat(&clear_groups).name("best_clear_c"));
+        b.drive(has_best_kept, (has_best & !clear_best).name("has_best_kept_c"));
+        b.next(has_best, has_best_kept | set_best);
         (c, [culled_first, culled], lookup)
     }
 
@@ -625,13 +641,15 @@ impl<'b> Unit<'b> {
         // (K = 64, teapot-fine).
         let early = b.delay_line("n_ray_slot_early", c.slot, p.node_rom_cycles - 1);
         let addr = b.delay("n_ray_slot", early);
-        let mut addrs = vec![addr];
-        addrs.extend(b.copies(addr, 3));
-        let o_word = b.read("ray_o_q", self.o_mem, addrs[0]);
+        // A register per group of the RAMs' columns (`wide_ram`): one per RAM was a slowest
+        // path into the origins' groups at seed 2 (7.08 ns).
+        let addrs = super::wide_ram::address_registers(b, addr, p.ray_ram_groups());
+        let counts = p.ray_ram_widths().map(|w| group_widths(w).len());
+        let reads = super::wide_ram::runs(&addrs, &counts);
+        let o_word = self.o_mem.read(b, "ray_o_q", &reads[0]);
         let o = [0, 1, 2].map(|a| o_word.slice(a * n, n));
-        let inv = [0, 1, 2].map(|a| {
-            b.read(&format!("ray_inv{}_q", ["x", "y", "z"][a]), self.inv_mem[a], addrs[a as usize + 1]).signed()
-        });
+        let inv = [0, 1, 2]
+            .map(|a| self.inv_mem[a].read(b, &format!("ray_inv{}_q", ["x", "y", "z"][a]), &reads[a + 1]).signed());
         let issue =
             |last: i128, plane: S<'b>| PlaneIssue { valid: is_inner, last: is_inner.k(last), plane, axis: w_axis };
         let pu0 = plane_unit(b, n, p.c, o, inv, issue(0, w_clip0), p.product);
