@@ -41,7 +41,7 @@ use crate::rtl::Module;
 use crate::rtl::build::Builder;
 use crate::rtl::build::S;
 
-pub use super::traverse_stages::{TraverseParams, field, word_bits};
+pub use super::traverse_params::{TraverseParams, field, word_bits};
 
 /// The unit. Inputs: the ray RAM write (`ray_we_gI`, `ray_slot_gI` for each group I of the
 /// RAMs' LUT-RAM columns, `TraverseParams::ray_ram_groups`; ox, oy, oz, invx, invy, invz),

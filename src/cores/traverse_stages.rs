@@ -1,133 +1,17 @@
-//! The traversal unit's parts (`traverse.rs` says what the unit does and wires them): its
-//! parameters, the ring token, and each stage of the ring the token goes round, built by a
+//! The traversal unit's parts (`traverse.rs` says what the unit does and wires them): the ring
+//! token, and each stage of the ring the token goes round, built by a
 //! method of `Unit`, in the order the stages are printed.
 
 use super::brom::bram;
-use super::brom::read_cycles;
-use super::clock::ClockTarget;
 use super::fifo::{Fifo, fifo};
 use super::free_list::{FreeList, free_list};
-use super::mul::MulStyle;
 use super::plane::{PlaneIssue, plane_unit};
+use super::traverse_params::{TraverseParams, field};
 use super::wide_ram::{WideRam, group_widths};
 use super::{lt_chain, onehot, slot_bit_2};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
-use crate::scene::images::SceneRoms;
-use crate::scene::rom::{self, Field, Layout, Word, rom_addr_bits};
-
-/// The widths of one traversal unit.
-#[derive(Clone, Debug)]
-pub struct TraverseParams {
-    pub n: u32,
-    pub m: u32,
-    pub c: u32,
-    pub id_width: u32,
-    pub stack_depth: u32,
-    pub box_hi: [i64; 3],
-    pub tri_bits: u32,
-    /// How the plane-distance product is built (`plane::plane_product`): the clock target's.
-    pub product: MulStyle,
-    /// Clocks of a node ROM read and of a leaf ROM read (`brom::read_cycles`: 3 for block RAM,
-    /// whose fabric register the placer puts between the blocks spread over the die and the
-    /// logic; 2 for LUTs). The emitted triangle stream is `leaf_rom_cycles` behind `leaf`.
-    pub node_rom_cycles: u32,
-    pub leaf_rom_cycles: u32,
-    /// Ray slots of the unit: rays it holds at once, each with its own registers and stack.
-    pub slots: u32,
-    /// The scene's tag (`SceneRoms::tag`), in the names of the modules built for the scene.
-    pub scene_tag: String,
-    /// The node word the unit reads (the node ROM's, or the scene image's node record), the
-    /// bits of a node's number and of a leaf's `first`, and the root's number.
-    pub node_layout: Layout,
-    pub node_bits: u32,
-    pub leaf_bits: u32,
-    pub root: u64,
-    /// Whether the nodes come through a cache (`with_node_cache`): a lookup in C + 1 answered in
-    /// N, a miss parked in the retry queue.
-    pub node_cache: bool,
-}
-
-impl TraverseParams {
-    pub fn new(scene: &SceneRoms, id_width: u32, target: ClockTarget, slots: u32) -> TraverseParams {
-        let p = &scene.params;
-        TraverseParams {
-            n: p.n,
-            m: p.m,
-            c: p.c,
-            id_width,
-            stack_depth: p.stack_depth,
-            box_hi: scene.box_hi,
-            tri_bits: rom::addr_bits(scene.tri_count()),
-            product: target.mul_style(),
-            node_rom_cycles: read_cycles(scene.node.1.len()),
-            leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
-            slots,
-            scene_tag: scene.tag(),
-            node_layout: scene.node.0.clone(),
-            node_bits: rom_addr_bits(scene.node.1.len()),
-            leaf_bits: rom_addr_bits(scene.leaf.1.len()),
-            root: 0,
-            node_cache: false,
-        }
-    }
-
-    /// The unit of an external-memory core: node records of the scene image (`layout`), read
-    /// through a node cache: the lookup one clock after C (once the cull test is known, so a
-    /// culled entry fetches nothing), its answer `cache::LATENCY` clocks later in N.
-    pub fn with_node_cache(mut self, layout: &crate::scene::memory::MemoryLayout) -> TraverseParams {
-        self.node_layout = layout.node.clone();
-        self.node_bits = crate::bits::addr_bits(layout.node_records as usize);
-        self.leaf_bits = layout.node.field("first").width;
-        self.root = crate::scene::memory::ROOT_RECORD;
-        self.node_rom_cycles = 1 + super::cache::LATENCY;
-        self.node_cache = true;
-        self
-    }
-    /// Reciprocal directions: m + C bits.
-    pub fn inv_width(&self) -> u32 {
-        self.m + self.c
-    }
-    /// The widths of the unit's ray RAMs: the origins' (3n), then each axis's reciprocal
-    /// direction.
-    pub fn ray_ram_widths(&self) -> [u32; 4] {
-        [3 * self.n, self.inv_width(), self.inv_width(), self.inv_width()]
-    }
-    /// LUT-RAM groups of the unit's ray RAMs (`wide_ram`): each written from a write enable
-    /// and a slot register of its own (the ports `ray_we_gI`, `ray_slot_gI`).
-    pub fn ray_ram_groups(&self) -> usize {
-        self.ray_ram_widths().iter().map(|&w| super::wide_ram::group_widths(w).len()).sum()
-    }
-    /// Distances: −1 … 2^(n+1), signed n + 3 bits.
-    pub fn dist_ty(&self) -> Ty {
-        Ty::s(self.n + 3)
-    }
-    /// Leaf entry distances are never negative: unsigned n + 2 bits.
-    pub fn tmin_width(&self) -> u32 {
-        self.n + 2
-    }
-    /// Bits of a slot number within the unit.
-    pub fn slot_bits(&self) -> u32 {
-        rom::rom_addr_bits(self.slots as usize)
-    }
-    pub fn sp_width(&self) -> u32 {
-        rom::value_bits(self.stack_depth as usize)
-    }
-}
-
-/// Bits [lsb, lsb + width) of a ROM word (width ≤ 128).
-pub fn word_bits(w: &Word, lsb: u32, width: u32) -> u128 {
-    (0..width).fold(0u128, |acc, b| {
-        let bit = lsb + b;
-        acc | ((((w.0[(bit / 64) as usize] >> (bit % 64)) & 1) as u128) << b)
-    })
-}
-
-/// A field of a ROM read: its bits as a signal of the field's type.
-pub fn field<'b>(name: &str, word: S<'b>, f: &Field, word_lsb: u32) -> S<'b> {
-    let raw = word.slice(f.lsb - word_lsb, f.width);
-    if f.signed { raw.signed().name(name) } else { raw.name(name) }
-}
+use crate::scene::rom::rom_addr_bits;
 
 /// A token's fields in the ring.
 #[derive(Clone, Copy)]
