@@ -12,13 +12,15 @@ module fxrt_brom_tri_2_sf0a3f4 (
   reg [31:0] word = 32'h00000000;
   reg [31:0] data_r = 32'h00000000;
   reg [31:0] data_rr = 32'h00000000;
+  reg [31:0] data_rrr = 32'h00000000;
 
   always @(posedge clk) begin : regs
     word <= mem[addr];
     data_r <= word;
     data_rr <= data_r;
+    data_rrr <= data_rr;
   end
 
-  assign data = data_rr;
+  assign data = data_rrr;
 endmodule
 `default_nettype wire

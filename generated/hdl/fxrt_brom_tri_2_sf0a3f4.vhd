@@ -5695,6 +5695,7 @@ architecture rtl of fxrt_brom_tri_2_sf0a3f4 is
   signal word : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal data_r : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
   signal data_rr : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal data_rrr : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 begin
 
   regs : process (clk)
@@ -5703,8 +5704,9 @@ begin
       word <= mem(to_integer(addr));
       data_r <= word;
       data_rr <= data_r;
+      data_rrr <= data_rr;
     end if;
   end process regs;
 
-  data <= data_rr;
+  data <= data_rrr;
 end architecture rtl;

@@ -33,11 +33,26 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   output wire [31:0] res_v
 );
 
-  (* ram_style = "distributed" *) reg [42:0] best_t_tri [0:127];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_t_tri.hex", best_t_tri);
+  (* ram_style = "distributed" *) reg [15:0] best_t_tri_g0 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_t_tri_g0.hex", best_t_tri_g0);
 
-  (* ram_style = "distributed" *) reg [63:0] best_u_v [0:127];
-  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_u_v.hex", best_u_v);
+  (* ram_style = "distributed" *) reg [15:0] best_t_tri_g1 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_t_tri_g1.hex", best_t_tri_g1);
+
+  (* ram_style = "distributed" *) reg [10:0] best_t_tri_g2 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_t_tri_g2.hex", best_t_tri_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] best_u_v_g0 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_u_v_g0.hex", best_u_v_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] best_u_v_g1 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_u_v_g1.hex", best_u_v_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] best_u_v_g2 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_u_v_g2.hex", best_u_v_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] best_u_v_g3 [0:127];
+  initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_best_u_v_g3.hex", best_u_v_g3);
 
   (* ram_style = "distributed" *) reg [19:0] ray_ids [0:127];
   initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_ray_ids.hex", ray_ids);
@@ -134,9 +149,11 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg [127:0] best_valid = 128'h00000000000000000000000000000000;
   wire [0:0] leaf_last;
   reg [0:0] fin = 1'h0;
-  reg [6:0] fin_slot = 7'h00;
   reg [5:0] fin_sp = 6'h00;
-  reg [42:0] slot_t_tri = 43'h00000000000;
+  reg [10:0] slot_t_tri_g2 = 11'h000;
+  reg [15:0] slot_t_tri_g1 = 16'h0000;
+  reg [15:0] slot_t_tri_g0 = 16'h0000;
+  wire [42:0] slot_t_tri;
   reg [0:0] m1 = 1'h0;
   reg [6:0] m1_slot = 7'h00;
   reg [5:0] m1_sp = 6'h00;
@@ -296,15 +313,15 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] fin_has_c;
   reg [0:0] m1_slot_has = 1'h0;
   reg [0:0] m1_leaf_empty = 1'h0;
-  wire [42:0] cat_8;
+  wire [42:0] cat_9;
   reg [42:0] m1_t_tri = 43'h00000000000;
   reg [63:0] m1_u_v = 64'h0000000000000000;
-  wire [43:0] cat_9;
   wire [43:0] cat_10;
-  wire [44:0] rs_cat_9;
+  wire [43:0] cat_11;
   wire [44:0] rs_cat_10;
+  wire [44:0] rs_cat_11;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 44 are read
-  wire [44:0] rs_cat_9_minus_rs_cat_10;
+  wire [44:0] minus_12;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] leaf_tt_less;
   reg [0:0] m2 = 1'h0;
@@ -336,7 +353,14 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] m2_we;
   reg [0:0] best_we = 1'h0;
   reg [42:0] m3_t_tri = 43'h00000000000;
+  wire [15:0] bits_m3_t_tri;
+  wire [15:0] bits_m3_t_tri_1;
+  wire [10:0] bits_m3_t_tri_2;
   reg [63:0] m3_u_v = 64'h0000000000000000;
+  wire [15:0] bits_m3_u_v;
+  wire [15:0] bits_m3_u_v_1;
+  wire [15:0] bits_m3_u_v_2;
+  wire [15:0] bits_m3_u_v_3;
   wire signed [31:0] merged_limit;
   wire [5:0] bits_m2_slot;
   wire [0:0] bits_m2_slot_1;
@@ -351,8 +375,15 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg signed [31:0] merge_limit_r = 32'sh00000000;
   reg [5:0] merge_sp_r = 6'h00;
   reg [0:0] d0 = 1'h0;
-  reg [42:0] done_t_tri = 43'h00000000000;
-  reg [63:0] done_u_v = 64'h0000000000000000;
+  reg [10:0] done_t_tri_g2 = 11'h000;
+  reg [15:0] done_t_tri_g1 = 16'h0000;
+  reg [15:0] done_t_tri_g0 = 16'h0000;
+  wire [42:0] done_t_tri;
+  reg [15:0] done_u_v_g3 = 16'h0000;
+  reg [15:0] done_u_v_g2 = 16'h0000;
+  reg [15:0] done_u_v_g1 = 16'h0000;
+  reg [15:0] done_u_v_g0 = 16'h0000;
+  wire [63:0] done_u_v;
   reg [19:0] done_id = 20'h00000;
   reg [0:0] d1 = 1'h0;
   reg [6:0] d1_slot = 7'h00;
@@ -768,7 +799,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] m2_slot_eq_k_1_1;
   wire [6:0] k_0_2 = 7'h00;
   wire [0:0] m2_slot_eq_k_0_2;
-  wire [127:0] cat_18;
+  wire [127:0] cat_22;
   reg [127:0] m3_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_set;
   wire [0:0] d0_slot_eq_k_127;
@@ -899,12 +930,12 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] d0_slot_eq_k_2;
   wire [0:0] d0_slot_eq_k_1_1;
   wire [0:0] d0_slot_eq_k_0_2;
-  wire [127:0] cat_19;
+  wire [127:0] cat_23;
   reg [127:0] d1_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_clear;
   wire [127:0] not_best_clear;
-  wire [127:0] and_20;
-  wire [127:0] and_20_or_best_set;
+  wire [127:0] and_24;
+  wire [127:0] and_24_or_best_set;
   reg [0:0] free_valid_r = 1'h0;
   reg [6:0] free_slot_r = 7'h00;
   reg [0:0] res_valid_r = 1'h0;
@@ -928,12 +959,23 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [31:0] res_v_c;
   reg [31:0] res_v_r = 32'h00000000;
 
-  // register copies m3_slot_copies: m3_slot and 2 copies, to split its fan-out
+  // register copies fin_slot_copies: fin_slot and 3 copies, to split its fan-out
+  reg [6:0] fin_slot = 7'h00;
+  reg [6:0] fin_slot_c1 = 7'h00;
+  reg [6:0] fin_slot_c2 = 7'h00;
+  reg [6:0] fin_slot_c3 = 7'h00;
+
+  // register copies m3_slot_copies: m3_slot and 7 copies, to split its fan-out
   /* verilator lint_off UNUSEDSIGNAL */  // not read
   reg [6:0] m3_slot = 7'h00;
   /* verilator lint_on UNUSEDSIGNAL */
   reg [6:0] m3_slot_c1 = 7'h00;
   reg [6:0] m3_slot_c2 = 7'h00;
+  reg [6:0] m3_slot_c3 = 7'h00;
+  reg [6:0] m3_slot_c4 = 7'h00;
+  reg [6:0] m3_slot_c5 = 7'h00;
+  reg [6:0] m3_slot_c6 = 7'h00;
+  reg [6:0] m3_slot_c7 = 7'h00;
 
   // register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out
   reg [5:0] merge_slot_r = 6'h00;
@@ -943,11 +985,16 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg [0:0] merge_hit_r = 1'h0;
   reg [0:0] merge_hit_r_c1 = 1'h0;
 
-  // register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+  // register copies d0_slot_copies: d0_slot and 8 copies, to split its fan-out
   reg [6:0] d0_slot = 7'h00;
   reg [6:0] d0_slot_c1 = 7'h00;
   reg [6:0] d0_slot_c2 = 7'h00;
   reg [6:0] d0_slot_c3 = 7'h00;
+  reg [6:0] d0_slot_c4 = 7'h00;
+  reg [6:0] d0_slot_c5 = 7'h00;
+  reg [6:0] d0_slot_c6 = 7'h00;
+  reg [6:0] d0_slot_c7 = 7'h00;
+  reg [6:0] d0_slot_c8 = 7'h00;
 
   // not in a stage or state machine
   assign tri_s = tag[12:0];
@@ -994,6 +1041,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign or_7 = in_valid2_2_and_in_first | acc_empty;
   assign mux_in_no_candidate = in_no_candidate ? or_7 : k_0;
   assign leaf_last = in_valid2_2 & in_last;
+  assign slot_t_tri = {slot_t_tri_g2, slot_t_tri_g1, slot_t_tri_g0};
   assign bits_best_valid = best_valid[0];
   assign bits_best_valid_1 = best_valid[1];
   assign bits_best_valid_2 = best_valid[2];
@@ -1285,13 +1333,13 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     (bits_fin_slot == 3'h6) ? fin_has_g6 :
     (bits_fin_slot == 3'h7) ? fin_has_g7 :
     k_0;
-  assign cat_8 = {acc_t, acc_tri};
-  assign cat_9 = {m1_leaf_empty, m1_t_tri};
-  assign cat_10 = {k_0, slot_t_tri};
-  assign rs_cat_9 = {{1{1'b0}}, cat_9};
+  assign cat_9 = {acc_t, acc_tri};
+  assign cat_10 = {m1_leaf_empty, m1_t_tri};
+  assign cat_11 = {k_0, slot_t_tri};
   assign rs_cat_10 = {{1{1'b0}}, cat_10};
-  assign rs_cat_9_minus_rs_cat_10 = rs_cat_9 - rs_cat_10;
-  assign leaf_tt_less = rs_cat_9_minus_rs_cat_10[44];
+  assign rs_cat_11 = {{1{1'b0}}, cat_11};
+  assign minus_12 = rs_cat_10 - rs_cat_11;
+  assign leaf_tt_less = minus_12[44];
   assign not_m1_slot_has = ~m1_slot_has;
   assign not_m1_leaf_empty = ~m1_leaf_empty;
   assign m1_first_hit = not_m1_slot_has & not_m1_leaf_empty;
@@ -1309,6 +1357,13 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign rs_s_rs_bits_slot_t_tri = $signed({{1{s_rs_bits_slot_t_tri[30]}}, s_rs_bits_slot_t_tri});
   assign slot_limit = rs_s_rs_bits_slot_t_tri + k_8;
   assign m2_we = m2 & leaf_better;
+  assign bits_m3_t_tri = m3_t_tri[15:0];
+  assign bits_m3_t_tri_1 = m3_t_tri[31:16];
+  assign bits_m3_t_tri_2 = m3_t_tri[42:32];
+  assign bits_m3_u_v = m3_u_v[15:0];
+  assign bits_m3_u_v_1 = m3_u_v[31:16];
+  assign bits_m3_u_v_2 = m3_u_v[47:32];
+  assign bits_m3_u_v_3 = m3_u_v[63:48];
   assign merged_limit = leaf_better ? m2_leaf_limit : m2_slot_limit;
   assign bits_m2_slot = m2_slot[5:0];
   assign bits_m2_slot_1 = m2_slot[6];
@@ -1317,6 +1372,8 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_m2_slot_2 = m2_slot[6];
   assign bits_m2_slot_2_eq_k_1 = bits_m2_slot_2 == k_1;
   assign m2_unit1 = m2 & bits_m2_slot_2_eq_k_1;
+  assign done_t_tri = {done_t_tri_g2, done_t_tri_g1, done_t_tri_g0};
+  assign done_u_v = {done_u_v_g3, done_u_v_g2, done_u_v_g1, done_u_v_g0};
   assign bits_best_valid_128 = best_valid[0];
   assign bits_best_valid_129 = best_valid[1];
   assign bits_best_valid_130 = best_valid[2];
@@ -1736,7 +1793,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign m2_slot_eq_k_2 = m2_slot == k_2;
   assign m2_slot_eq_k_1_1 = m2_slot == k_1_1;
   assign m2_slot_eq_k_0_2 = m2_slot == k_0_2;
-  assign cat_18 = {m2_slot_eq_k_127, m2_slot_eq_k_126, m2_slot_eq_k_125, m2_slot_eq_k_124, m2_slot_eq_k_123, m2_slot_eq_k_122, m2_slot_eq_k_121, m2_slot_eq_k_120, m2_slot_eq_k_119, m2_slot_eq_k_118, m2_slot_eq_k_117, m2_slot_eq_k_116, m2_slot_eq_k_115, m2_slot_eq_k_114, m2_slot_eq_k_113, m2_slot_eq_k_112, m2_slot_eq_k_111, m2_slot_eq_k_110, m2_slot_eq_k_109, m2_slot_eq_k_108, m2_slot_eq_k_107, m2_slot_eq_k_106, m2_slot_eq_k_105, m2_slot_eq_k_104, m2_slot_eq_k_103, m2_slot_eq_k_102, m2_slot_eq_k_101, m2_slot_eq_k_100, m2_slot_eq_k_99, m2_slot_eq_k_98, m2_slot_eq_k_97, m2_slot_eq_k_96, m2_slot_eq_k_95, m2_slot_eq_k_94, m2_slot_eq_k_93, m2_slot_eq_k_92, m2_slot_eq_k_91, m2_slot_eq_k_90, m2_slot_eq_k_89, m2_slot_eq_k_88, m2_slot_eq_k_87, m2_slot_eq_k_86, m2_slot_eq_k_85, m2_slot_eq_k_84, m2_slot_eq_k_83, m2_slot_eq_k_82, m2_slot_eq_k_81, m2_slot_eq_k_80, m2_slot_eq_k_79, m2_slot_eq_k_78, m2_slot_eq_k_77, m2_slot_eq_k_76, m2_slot_eq_k_75, m2_slot_eq_k_74, m2_slot_eq_k_73, m2_slot_eq_k_72, m2_slot_eq_k_71, m2_slot_eq_k_70, m2_slot_eq_k_69, m2_slot_eq_k_68, m2_slot_eq_k_67, m2_slot_eq_k_66, m2_slot_eq_k_65, m2_slot_eq_k_64, m2_slot_eq_k_63, m2_slot_eq_k_62, m2_slot_eq_k_61, m2_slot_eq_k_60, m2_slot_eq_k_59, m2_slot_eq_k_58, m2_slot_eq_k_57, m2_slot_eq_k_56, m2_slot_eq_k_55, m2_slot_eq_k_54, m2_slot_eq_k_53, m2_slot_eq_k_52, m2_slot_eq_k_51, m2_slot_eq_k_50, m2_slot_eq_k_49, m2_slot_eq_k_48, m2_slot_eq_k_47, m2_slot_eq_k_46, m2_slot_eq_k_45, m2_slot_eq_k_44, m2_slot_eq_k_43, m2_slot_eq_k_42, m2_slot_eq_k_41, m2_slot_eq_k_40, m2_slot_eq_k_39, m2_slot_eq_k_38, m2_slot_eq_k_37, m2_slot_eq_k_36, m2_slot_eq_k_35, m2_slot_eq_k_34, m2_slot_eq_k_33, m2_slot_eq_k_32, m2_slot_eq_k_31, m2_slot_eq_k_30, m2_slot_eq_k_29, m2_slot_eq_k_28, m2_slot_eq_k_27, m2_slot_eq_k_26, m2_slot_eq_k_25, m2_slot_eq_k_24, m2_slot_eq_k_23, m2_slot_eq_k_22, m2_slot_eq_k_21, m2_slot_eq_k_20, m2_slot_eq_k_19, m2_slot_eq_k_18, m2_slot_eq_k_17, m2_slot_eq_k_16, m2_slot_eq_k_15, m2_slot_eq_k_14, m2_slot_eq_k_13, m2_slot_eq_k_12, m2_slot_eq_k_11, m2_slot_eq_k_10, m2_slot_eq_k_9, m2_slot_eq_k_8_1, m2_slot_eq_k_7, m2_slot_eq_k_6, m2_slot_eq_k_5, m2_slot_eq_k_4, m2_slot_eq_k_3, m2_slot_eq_k_2, m2_slot_eq_k_1_1, m2_slot_eq_k_0_2};
+  assign cat_22 = {m2_slot_eq_k_127, m2_slot_eq_k_126, m2_slot_eq_k_125, m2_slot_eq_k_124, m2_slot_eq_k_123, m2_slot_eq_k_122, m2_slot_eq_k_121, m2_slot_eq_k_120, m2_slot_eq_k_119, m2_slot_eq_k_118, m2_slot_eq_k_117, m2_slot_eq_k_116, m2_slot_eq_k_115, m2_slot_eq_k_114, m2_slot_eq_k_113, m2_slot_eq_k_112, m2_slot_eq_k_111, m2_slot_eq_k_110, m2_slot_eq_k_109, m2_slot_eq_k_108, m2_slot_eq_k_107, m2_slot_eq_k_106, m2_slot_eq_k_105, m2_slot_eq_k_104, m2_slot_eq_k_103, m2_slot_eq_k_102, m2_slot_eq_k_101, m2_slot_eq_k_100, m2_slot_eq_k_99, m2_slot_eq_k_98, m2_slot_eq_k_97, m2_slot_eq_k_96, m2_slot_eq_k_95, m2_slot_eq_k_94, m2_slot_eq_k_93, m2_slot_eq_k_92, m2_slot_eq_k_91, m2_slot_eq_k_90, m2_slot_eq_k_89, m2_slot_eq_k_88, m2_slot_eq_k_87, m2_slot_eq_k_86, m2_slot_eq_k_85, m2_slot_eq_k_84, m2_slot_eq_k_83, m2_slot_eq_k_82, m2_slot_eq_k_81, m2_slot_eq_k_80, m2_slot_eq_k_79, m2_slot_eq_k_78, m2_slot_eq_k_77, m2_slot_eq_k_76, m2_slot_eq_k_75, m2_slot_eq_k_74, m2_slot_eq_k_73, m2_slot_eq_k_72, m2_slot_eq_k_71, m2_slot_eq_k_70, m2_slot_eq_k_69, m2_slot_eq_k_68, m2_slot_eq_k_67, m2_slot_eq_k_66, m2_slot_eq_k_65, m2_slot_eq_k_64, m2_slot_eq_k_63, m2_slot_eq_k_62, m2_slot_eq_k_61, m2_slot_eq_k_60, m2_slot_eq_k_59, m2_slot_eq_k_58, m2_slot_eq_k_57, m2_slot_eq_k_56, m2_slot_eq_k_55, m2_slot_eq_k_54, m2_slot_eq_k_53, m2_slot_eq_k_52, m2_slot_eq_k_51, m2_slot_eq_k_50, m2_slot_eq_k_49, m2_slot_eq_k_48, m2_slot_eq_k_47, m2_slot_eq_k_46, m2_slot_eq_k_45, m2_slot_eq_k_44, m2_slot_eq_k_43, m2_slot_eq_k_42, m2_slot_eq_k_41, m2_slot_eq_k_40, m2_slot_eq_k_39, m2_slot_eq_k_38, m2_slot_eq_k_37, m2_slot_eq_k_36, m2_slot_eq_k_35, m2_slot_eq_k_34, m2_slot_eq_k_33, m2_slot_eq_k_32, m2_slot_eq_k_31, m2_slot_eq_k_30, m2_slot_eq_k_29, m2_slot_eq_k_28, m2_slot_eq_k_27, m2_slot_eq_k_26, m2_slot_eq_k_25, m2_slot_eq_k_24, m2_slot_eq_k_23, m2_slot_eq_k_22, m2_slot_eq_k_21, m2_slot_eq_k_20, m2_slot_eq_k_19, m2_slot_eq_k_18, m2_slot_eq_k_17, m2_slot_eq_k_16, m2_slot_eq_k_15, m2_slot_eq_k_14, m2_slot_eq_k_13, m2_slot_eq_k_12, m2_slot_eq_k_11, m2_slot_eq_k_10, m2_slot_eq_k_9, m2_slot_eq_k_8_1, m2_slot_eq_k_7, m2_slot_eq_k_6, m2_slot_eq_k_5, m2_slot_eq_k_4, m2_slot_eq_k_3, m2_slot_eq_k_2, m2_slot_eq_k_1_1, m2_slot_eq_k_0_2};
   assign best_set = best_we ? m3_onehot : k_0_1;
   assign d0_slot_eq_k_127 = d0_slot == k_127;
   assign d0_slot_eq_k_126 = d0_slot == k_126;
@@ -1866,11 +1923,11 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign d0_slot_eq_k_2 = d0_slot == k_2;
   assign d0_slot_eq_k_1_1 = d0_slot == k_1_1;
   assign d0_slot_eq_k_0_2 = d0_slot == k_0_2;
-  assign cat_19 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
+  assign cat_23 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
   assign best_clear = d1 ? d1_onehot : k_0_1;
   assign not_best_clear = ~best_clear;
-  assign and_20 = best_valid & not_best_clear;
-  assign and_20_or_best_set = and_20 | best_set;
+  assign and_24 = best_valid & not_best_clear;
+  assign and_24_or_best_set = and_24 | best_set;
   assign res_id_c = done_id;
   assign res_hit_c = d1_has;
   assign bits_done_t_tri = done_t_tri[12:0];
@@ -1883,8 +1940,13 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign res_v_c = d1_has ? bits_done_u_v_1 : k_0_5;
 
   always @(posedge clk) begin : regs
-    if (best_we) best_t_tri[m3_slot_c1] <= m3_t_tri;
-    if (best_we) best_u_v[m3_slot_c2] <= m3_u_v;
+    if (best_we) best_t_tri_g0[m3_slot_c1] <= bits_m3_t_tri;
+    if (best_we) best_t_tri_g1[m3_slot_c2] <= bits_m3_t_tri_1;
+    if (best_we) best_t_tri_g2[m3_slot_c3] <= bits_m3_t_tri_2;
+    if (best_we) best_u_v_g0[m3_slot_c4] <= bits_m3_u_v;
+    if (best_we) best_u_v_g1[m3_slot_c5] <= bits_m3_u_v_1;
+    if (best_we) best_u_v_g2[m3_slot_c6] <= bits_m3_u_v_2;
+    if (best_we) best_u_v_g3[m3_slot_c7] <= bits_m3_u_v_3;
     if (id_we) ray_ids[id_slot] <= id;
     in_tmin_less <= tmin_less;
     in_t_plus_8 <= t_plus_8;
@@ -1923,12 +1985,13 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     cand_u <= in_u;
     cand_v <= in_v;
     if (rst) best_valid <= 128'h00000000000000000000000000000000;
-    else best_valid <= and_20_or_best_set;
+    else best_valid <= and_24_or_best_set;
     if (rst) fin <= 1'h0;
     else fin <= leaf_last;
-    fin_slot <= in_slot;
     fin_sp <= in_sp;
-    slot_t_tri <= best_t_tri[fin_slot];
+    slot_t_tri_g2 <= best_t_tri_g2[fin_slot_c3];
+    slot_t_tri_g1 <= best_t_tri_g1[fin_slot_c2];
+    slot_t_tri_g0 <= best_t_tri_g0[fin_slot_c1];
     if (rst) m1 <= 1'h0;
     else m1 <= fin;
     m1_slot <= fin_slot;
@@ -1943,7 +2006,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     fin_has_g7 <= fin_has_g7_c;
     m1_slot_has <= fin_has_c;
     m1_leaf_empty <= acc_empty;
-    m1_t_tri <= cat_8;
+    m1_t_tri <= cat_9;
     m1_u_v <= acc_u_v_now;
     if (rst) m2 <= 1'h0;
     else m2 <= m1;
@@ -1968,9 +2031,14 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     merge_sp_r <= m2_sp;
     if (rst) d0 <= 1'h0;
     else d0 <= done_valid;
-    done_t_tri <= best_t_tri[d0_slot_c1];
-    done_u_v <= best_u_v[d0_slot_c2];
-    done_id <= ray_ids[d0_slot_c3];
+    done_t_tri_g2 <= best_t_tri_g2[d0_slot_c3];
+    done_t_tri_g1 <= best_t_tri_g1[d0_slot_c2];
+    done_t_tri_g0 <= best_t_tri_g0[d0_slot_c1];
+    done_u_v_g3 <= best_u_v_g3[d0_slot_c7];
+    done_u_v_g2 <= best_u_v_g2[d0_slot_c6];
+    done_u_v_g1 <= best_u_v_g1[d0_slot_c5];
+    done_u_v_g0 <= best_u_v_g0[d0_slot_c4];
+    done_id <= ray_ids[d0_slot_c8];
     if (rst) d1 <= 1'h0;
     else d1 <= d0;
     d1_slot <= d0_slot;
@@ -1983,8 +2051,8 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     done_has_g6 <= done_has_g6_c;
     done_has_g7 <= done_has_g7_c;
     d1_has <= done_has_c;
-    m3_onehot <= cat_18;
-    d1_onehot <= cat_19;
+    m3_onehot <= cat_22;
+    d1_onehot <= cat_23;
     if (rst) free_valid_r <= 1'h0;
     else free_valid_r <= d1;
     free_slot_r <= d1_slot;
@@ -1998,12 +2066,26 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     res_v_r <= res_v_c;
   end
 
-  // register copies m3_slot_copies: m3_slot and 2 copies, to split its fan-out
+  // register copies fin_slot_copies: fin_slot and 3 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : fin_slot_copies_regs
+    fin_slot <= in_slot;
+    fin_slot_c1 <= in_slot;
+    fin_slot_c2 <= in_slot;
+    fin_slot_c3 <= in_slot;
+  end
+
+  // register copies m3_slot_copies: m3_slot and 7 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : m3_slot_copies_regs
     m3_slot <= m2_slot;
     m3_slot_c1 <= m2_slot;
     m3_slot_c2 <= m2_slot;
+    m3_slot_c3 <= m2_slot;
+    m3_slot_c4 <= m2_slot;
+    m3_slot_c5 <= m2_slot;
+    m3_slot_c6 <= m2_slot;
+    m3_slot_c7 <= m2_slot;
   end
 
   // register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out
@@ -2020,13 +2102,18 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     merge_hit_r_c1 <= m2_hit;
   end
 
-  // register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+  // register copies d0_slot_copies: d0_slot and 8 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : d0_slot_copies_regs
     d0_slot <= done_slot;
     d0_slot_c1 <= done_slot;
     d0_slot_c2 <= done_slot;
     d0_slot_c3 <= done_slot;
+    d0_slot_c4 <= done_slot;
+    d0_slot_c5 <= done_slot;
+    d0_slot_c6 <= done_slot;
+    d0_slot_c7 <= done_slot;
+    d0_slot_c8 <= done_slot;
   end
 
   assign merge_valid0 = merge_valid0_r;

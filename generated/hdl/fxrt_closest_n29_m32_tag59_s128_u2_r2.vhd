@@ -40,11 +40,26 @@ end entity fxrt_closest_n29_m32_tag59_s128_u2_r2;
 
 architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
 
-  type best_t_tri_t is array (0 to 127) of unsigned(42 downto 0);
-  signal best_t_tri : best_t_tri_t := (others => (others => '0'));
+  type best_t_tri_g0_t is array (0 to 127) of unsigned(15 downto 0);
+  signal best_t_tri_g0 : best_t_tri_g0_t := (others => (others => '0'));
 
-  type best_u_v_t is array (0 to 127) of unsigned(63 downto 0);
-  signal best_u_v : best_u_v_t := (others => (others => '0'));
+  type best_t_tri_g1_t is array (0 to 127) of unsigned(15 downto 0);
+  signal best_t_tri_g1 : best_t_tri_g1_t := (others => (others => '0'));
+
+  type best_t_tri_g2_t is array (0 to 127) of unsigned(10 downto 0);
+  signal best_t_tri_g2 : best_t_tri_g2_t := (others => (others => '0'));
+
+  type best_u_v_g0_t is array (0 to 127) of unsigned(15 downto 0);
+  signal best_u_v_g0 : best_u_v_g0_t := (others => (others => '0'));
+
+  type best_u_v_g1_t is array (0 to 127) of unsigned(15 downto 0);
+  signal best_u_v_g1 : best_u_v_g1_t := (others => (others => '0'));
+
+  type best_u_v_g2_t is array (0 to 127) of unsigned(15 downto 0);
+  signal best_u_v_g2 : best_u_v_g2_t := (others => (others => '0'));
+
+  type best_u_v_g3_t is array (0 to 127) of unsigned(15 downto 0);
+  signal best_u_v_g3 : best_u_v_g3_t := (others => (others => '0'));
 
   type ray_ids_t is array (0 to 127) of unsigned(19 downto 0);
   signal ray_ids : ray_ids_t := (others => (others => '0'));
@@ -131,9 +146,11 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal best_valid : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal leaf_last : unsigned(0 downto 0);
   signal fin : unsigned(0 downto 0) := unsigned'("0");
-  signal fin_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal fin_sp : unsigned(5 downto 0) := unsigned'("000000");
-  signal slot_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
+  signal slot_t_tri_g2 : unsigned(10 downto 0) := unsigned'("00000000000");
+  signal slot_t_tri_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal slot_t_tri_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal slot_t_tri : unsigned(42 downto 0);
   signal m1 : unsigned(0 downto 0) := unsigned'("0");
   signal m1_slot : unsigned(6 downto 0) := unsigned'("0000000");
   signal m1_sp : unsigned(5 downto 0) := unsigned'("000000");
@@ -293,14 +310,14 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal fin_has_c : unsigned(0 downto 0);
   signal m1_slot_has : unsigned(0 downto 0) := unsigned'("0");
   signal m1_leaf_empty : unsigned(0 downto 0) := unsigned'("0");
-  signal cat_8 : unsigned(42 downto 0);
+  signal cat_9 : unsigned(42 downto 0);
   signal m1_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
   signal m1_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-  signal cat_9 : unsigned(43 downto 0);
   signal cat_10 : unsigned(43 downto 0);
-  signal rs_cat_9 : unsigned(44 downto 0);
+  signal cat_11 : unsigned(43 downto 0);
   signal rs_cat_10 : unsigned(44 downto 0);
-  signal rs_cat_9_minus_rs_cat_10 : unsigned(44 downto 0);
+  signal rs_cat_11 : unsigned(44 downto 0);
+  signal minus_12 : unsigned(44 downto 0);
   signal leaf_tt_less : unsigned(0 downto 0);
   signal m2 : unsigned(0 downto 0) := unsigned'("0");
   signal m2_tt_less : unsigned(0 downto 0) := unsigned'("0");
@@ -331,7 +348,14 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal m2_we : unsigned(0 downto 0);
   signal best_we : unsigned(0 downto 0) := unsigned'("0");
   signal m3_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
+  signal bits_m3_t_tri : unsigned(15 downto 0);
+  signal bits_m3_t_tri_1 : unsigned(15 downto 0);
+  signal bits_m3_t_tri_2 : unsigned(10 downto 0);
   signal m3_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal bits_m3_u_v : unsigned(15 downto 0);
+  signal bits_m3_u_v_1 : unsigned(15 downto 0);
+  signal bits_m3_u_v_2 : unsigned(15 downto 0);
+  signal bits_m3_u_v_3 : unsigned(15 downto 0);
   signal merged_limit : signed(31 downto 0);
   signal bits_m2_slot : unsigned(5 downto 0);
   signal bits_m2_slot_1 : unsigned(0 downto 0);
@@ -346,8 +370,15 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal merge_limit_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal merge_sp_r : unsigned(5 downto 0) := unsigned'("000000");
   signal d0 : unsigned(0 downto 0) := unsigned'("0");
-  signal done_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
-  signal done_u_v : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal done_t_tri_g2 : unsigned(10 downto 0) := unsigned'("00000000000");
+  signal done_t_tri_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal done_t_tri_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal done_t_tri : unsigned(42 downto 0);
+  signal done_u_v_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal done_u_v_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal done_u_v_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal done_u_v_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal done_u_v : unsigned(63 downto 0);
   signal done_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal d1 : unsigned(0 downto 0) := unsigned'("0");
   signal d1_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -763,7 +794,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal m2_slot_eq_k_1_1 : unsigned(0 downto 0);
   constant k_0_2 : unsigned(6 downto 0) := unsigned'("0000000");
   signal m2_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_18 : unsigned(127 downto 0);
+  signal cat_22 : unsigned(127 downto 0);
   signal m3_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_set : unsigned(127 downto 0);
   signal d0_slot_eq_k_127 : unsigned(0 downto 0);
@@ -894,12 +925,12 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal d0_slot_eq_k_2 : unsigned(0 downto 0);
   signal d0_slot_eq_k_1_1 : unsigned(0 downto 0);
   signal d0_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_19 : unsigned(127 downto 0);
+  signal cat_23 : unsigned(127 downto 0);
   signal d1_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_clear : unsigned(127 downto 0);
   signal not_best_clear : unsigned(127 downto 0);
-  signal and_20 : unsigned(127 downto 0);
-  signal and_20_or_best_set : unsigned(127 downto 0);
+  signal and_24 : unsigned(127 downto 0);
+  signal and_24_or_best_set : unsigned(127 downto 0);
   signal free_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal free_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal res_valid_r : unsigned(0 downto 0) := unsigned'("0");
@@ -923,13 +954,33 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal res_v_c : unsigned(31 downto 0);
   signal res_v_r : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 
-  -- register copies m3_slot_copies: m3_slot and 2 copies, to split its fan-out
+  -- register copies fin_slot_copies: fin_slot and 3 copies, to split its fan-out
+  signal fin_slot : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of fin_slot : signal is "true";
+  signal fin_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of fin_slot_c1 : signal is "true";
+  signal fin_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of fin_slot_c2 : signal is "true";
+  signal fin_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of fin_slot_c3 : signal is "true";
+
+  -- register copies m3_slot_copies: m3_slot and 7 copies, to split its fan-out
   signal m3_slot : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of m3_slot : signal is "true";
   signal m3_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of m3_slot_c1 : signal is "true";
   signal m3_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of m3_slot_c2 : signal is "true";
+  signal m3_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m3_slot_c3 : signal is "true";
+  signal m3_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m3_slot_c4 : signal is "true";
+  signal m3_slot_c5 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m3_slot_c5 : signal is "true";
+  signal m3_slot_c6 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m3_slot_c6 : signal is "true";
+  signal m3_slot_c7 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of m3_slot_c7 : signal is "true";
 
   -- register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out
   signal merge_slot_r : unsigned(5 downto 0) := unsigned'("000000");
@@ -943,7 +994,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal merge_hit_r_c1 : unsigned(0 downto 0) := unsigned'("0");
   attribute keep of merge_hit_r_c1 : signal is "true";
 
-  -- register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+  -- register copies d0_slot_copies: d0_slot and 8 copies, to split its fan-out
   signal d0_slot : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of d0_slot : signal is "true";
   signal d0_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
@@ -952,6 +1003,16 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   attribute keep of d0_slot_c2 : signal is "true";
   signal d0_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of d0_slot_c3 : signal is "true";
+  signal d0_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c4 : signal is "true";
+  signal d0_slot_c5 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c5 : signal is "true";
+  signal d0_slot_c6 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c6 : signal is "true";
+  signal d0_slot_c7 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c7 : signal is "true";
+  signal d0_slot_c8 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of d0_slot_c8 : signal is "true";
 begin
 
   -- not in a stage or state machine
@@ -999,6 +1060,7 @@ begin
   or_7 <= in_valid2_2_and_in_first or acc_empty;
   mux_in_no_candidate <= or_7 when in_no_candidate = "1" else k_0;
   leaf_last <= in_valid2_2 and in_last;
+  slot_t_tri <= unsigned(std_logic_vector'(std_logic_vector(slot_t_tri_g2) & std_logic_vector(slot_t_tri_g1) & std_logic_vector(slot_t_tri_g0)));
   bits_best_valid <= unsigned(best_valid(0 downto 0));
   bits_best_valid_1 <= unsigned(best_valid(1 downto 1));
   bits_best_valid_2 <= unsigned(best_valid(2 downto 2));
@@ -1299,13 +1361,13 @@ begin
       fin_has_g6 when "110",
       fin_has_g7 when "111",
       k_0 when others;
-  cat_8 <= unsigned(std_logic_vector'(std_logic_vector(acc_t) & std_logic_vector(acc_tri)));
-  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(m1_leaf_empty) & std_logic_vector(m1_t_tri)));
-  cat_10 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(slot_t_tri)));
-  rs_cat_9 <= resize(cat_9, 45);
+  cat_9 <= unsigned(std_logic_vector'(std_logic_vector(acc_t) & std_logic_vector(acc_tri)));
+  cat_10 <= unsigned(std_logic_vector'(std_logic_vector(m1_leaf_empty) & std_logic_vector(m1_t_tri)));
+  cat_11 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(slot_t_tri)));
   rs_cat_10 <= resize(cat_10, 45);
-  rs_cat_9_minus_rs_cat_10 <= rs_cat_9 - rs_cat_10;
-  leaf_tt_less <= unsigned(rs_cat_9_minus_rs_cat_10(44 downto 44));
+  rs_cat_11 <= resize(cat_11, 45);
+  minus_12 <= rs_cat_10 - rs_cat_11;
+  leaf_tt_less <= unsigned(minus_12(44 downto 44));
   not_m1_slot_has <= not m1_slot_has;
   not_m1_leaf_empty <= not m1_leaf_empty;
   m1_first_hit <= not_m1_slot_has and not_m1_leaf_empty;
@@ -1323,6 +1385,13 @@ begin
   rs_s_rs_bits_slot_t_tri <= resize(s_rs_bits_slot_t_tri, 32);
   slot_limit <= rs_s_rs_bits_slot_t_tri + k_8;
   m2_we <= m2 and leaf_better;
+  bits_m3_t_tri <= unsigned(m3_t_tri(15 downto 0));
+  bits_m3_t_tri_1 <= unsigned(m3_t_tri(31 downto 16));
+  bits_m3_t_tri_2 <= unsigned(m3_t_tri(42 downto 32));
+  bits_m3_u_v <= unsigned(m3_u_v(15 downto 0));
+  bits_m3_u_v_1 <= unsigned(m3_u_v(31 downto 16));
+  bits_m3_u_v_2 <= unsigned(m3_u_v(47 downto 32));
+  bits_m3_u_v_3 <= unsigned(m3_u_v(63 downto 48));
   merged_limit <= m2_leaf_limit when leaf_better = "1" else m2_slot_limit;
   bits_m2_slot <= unsigned(m2_slot(5 downto 0));
   bits_m2_slot_1 <= unsigned(m2_slot(6 downto 6));
@@ -1331,6 +1400,8 @@ begin
   bits_m2_slot_2 <= unsigned(m2_slot(6 downto 6));
   bits_m2_slot_2_eq_k_1 <= "1" when bits_m2_slot_2 = k_1 else "0";
   m2_unit1 <= m2 and bits_m2_slot_2_eq_k_1;
+  done_t_tri <= unsigned(std_logic_vector'(std_logic_vector(done_t_tri_g2) & std_logic_vector(done_t_tri_g1) & std_logic_vector(done_t_tri_g0)));
+  done_u_v <= unsigned(std_logic_vector'(std_logic_vector(done_u_v_g3) & std_logic_vector(done_u_v_g2) & std_logic_vector(done_u_v_g1) & std_logic_vector(done_u_v_g0)));
   bits_best_valid_128 <= unsigned(best_valid(0 downto 0));
   bits_best_valid_129 <= unsigned(best_valid(1 downto 1));
   bits_best_valid_130 <= unsigned(best_valid(2 downto 2));
@@ -1759,7 +1830,7 @@ begin
   m2_slot_eq_k_2 <= "1" when m2_slot = k_2 else "0";
   m2_slot_eq_k_1_1 <= "1" when m2_slot = k_1_1 else "0";
   m2_slot_eq_k_0_2 <= "1" when m2_slot = k_0_2 else "0";
-  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(m2_slot_eq_k_127) & std_logic_vector(m2_slot_eq_k_126) & std_logic_vector(m2_slot_eq_k_125) & std_logic_vector(m2_slot_eq_k_124) & std_logic_vector(m2_slot_eq_k_123) & std_logic_vector(m2_slot_eq_k_122) & std_logic_vector(m2_slot_eq_k_121) & std_logic_vector(m2_slot_eq_k_120) & std_logic_vector(m2_slot_eq_k_119) & std_logic_vector(m2_slot_eq_k_118) & std_logic_vector(m2_slot_eq_k_117) & std_logic_vector(m2_slot_eq_k_116) & std_logic_vector(m2_slot_eq_k_115) & std_logic_vector(m2_slot_eq_k_114) & std_logic_vector(m2_slot_eq_k_113) & std_logic_vector(m2_slot_eq_k_112) & std_logic_vector(m2_slot_eq_k_111) & std_logic_vector(m2_slot_eq_k_110) & std_logic_vector(m2_slot_eq_k_109) & std_logic_vector(m2_slot_eq_k_108) & std_logic_vector(m2_slot_eq_k_107) & std_logic_vector(m2_slot_eq_k_106) & std_logic_vector(m2_slot_eq_k_105) & std_logic_vector(m2_slot_eq_k_104) & std_logic_vector(m2_slot_eq_k_103) & std_logic_vector(m2_slot_eq_k_102) & std_logic_vector(m2_slot_eq_k_101) & std_logic_vector(m2_slot_eq_k_100) & std_logic_vector(m2_slot_eq_k_99) & std_logic_vector(m2_slot_eq_k_98) & std_logic_vector(m2_slot_eq_k_97) & std_logic_vector(m2_slot_eq_k_96) & std_logic_vector(m2_slot_eq_k_95) & std_logic_vector(m2_slot_eq_k_94) & std_logic_vector(m2_slot_eq_k_93) & std_logic_vector(m2_slot_eq_k_92) & std_logic_vector(m2_slot_eq_k_91) & std_logic_vector(m2_slot_eq_k_90) & std_logic_vector(m2_slot_eq_k_89) & std_logic_vector(m2_slot_eq_k_88) & std_logic_vector(m2_slot_eq_k_87) & std_logic_vector(m2_slot_eq_k_86) & std_logic_vector(m2_slot_eq_k_85) & std_logic_vector(m2_slot_eq_k_84) & std_logic_vector(m2_slot_eq_k_83) & std_logic_vector(m2_slot_eq_k_82) & std_logic_vector(m2_slot_eq_k_81) & std_logic_vector(m2_slot_eq_k_80) & std_logic_vector(m2_slot_eq_k_79) & std_logic_vector(m2_slot_eq_k_78) & std_logic_vector(m2_slot_eq_k_77) & std_logic_vector(m2_slot_eq_k_76) & std_logic_vector(m2_slot_eq_k_75) & std_logic_vector(m2_slot_eq_k_74) & std_logic_vector(m2_slot_eq_k_73) & std_logic_vector(m2_slot_eq_k_72) & std_logic_vector(m2_slot_eq_k_71) & std_logic_vector(m2_slot_eq_k_70) & std_logic_vector(m2_slot_eq_k_69) & std_logic_vector(m2_slot_eq_k_68) & std_logic_vector(m2_slot_eq_k_67) & std_logic_vector(m2_slot_eq_k_66) & std_logic_vector(m2_slot_eq_k_65) & std_logic_vector(m2_slot_eq_k_64) & std_logic_vector(m2_slot_eq_k_63) & std_logic_vector(m2_slot_eq_k_62) & std_logic_vector(m2_slot_eq_k_61) & std_logic_vector(m2_slot_eq_k_60) & std_logic_vector(m2_slot_eq_k_59) & std_logic_vector(m2_slot_eq_k_58) & std_logic_vector(m2_slot_eq_k_57) & std_logic_vector(m2_slot_eq_k_56) & std_logic_vector(m2_slot_eq_k_55) & std_logic_vector(m2_slot_eq_k_54) & std_logic_vector(m2_slot_eq_k_53) & std_logic_vector(m2_slot_eq_k_52) & std_logic_vector(m2_slot_eq_k_51) & std_logic_vector(m2_slot_eq_k_50) & std_logic_vector(m2_slot_eq_k_49) & std_logic_vector(m2_slot_eq_k_48) & std_logic_vector(m2_slot_eq_k_47) & std_logic_vector(m2_slot_eq_k_46) & std_logic_vector(m2_slot_eq_k_45) & std_logic_vector(m2_slot_eq_k_44) & std_logic_vector(m2_slot_eq_k_43) & std_logic_vector(m2_slot_eq_k_42) & std_logic_vector(m2_slot_eq_k_41) & std_logic_vector(m2_slot_eq_k_40) & std_logic_vector(m2_slot_eq_k_39) & std_logic_vector(m2_slot_eq_k_38) & std_logic_vector(m2_slot_eq_k_37) & std_logic_vector(m2_slot_eq_k_36) & std_logic_vector(m2_slot_eq_k_35) & std_logic_vector(m2_slot_eq_k_34) & std_logic_vector(m2_slot_eq_k_33) & std_logic_vector(m2_slot_eq_k_32) & std_logic_vector(m2_slot_eq_k_31) & std_logic_vector(m2_slot_eq_k_30) & std_logic_vector(m2_slot_eq_k_29) & std_logic_vector(m2_slot_eq_k_28) & std_logic_vector(m2_slot_eq_k_27) & std_logic_vector(m2_slot_eq_k_26) & std_logic_vector(m2_slot_eq_k_25) & std_logic_vector(m2_slot_eq_k_24) & std_logic_vector(m2_slot_eq_k_23) & std_logic_vector(m2_slot_eq_k_22) & std_logic_vector(m2_slot_eq_k_21) & std_logic_vector(m2_slot_eq_k_20) & std_logic_vector(m2_slot_eq_k_19) & std_logic_vector(m2_slot_eq_k_18) & std_logic_vector(m2_slot_eq_k_17) & std_logic_vector(m2_slot_eq_k_16) & std_logic_vector(m2_slot_eq_k_15) & std_logic_vector(m2_slot_eq_k_14) & std_logic_vector(m2_slot_eq_k_13) & std_logic_vector(m2_slot_eq_k_12) & std_logic_vector(m2_slot_eq_k_11) & std_logic_vector(m2_slot_eq_k_10) & std_logic_vector(m2_slot_eq_k_9) & std_logic_vector(m2_slot_eq_k_8_1) & std_logic_vector(m2_slot_eq_k_7) & std_logic_vector(m2_slot_eq_k_6) & std_logic_vector(m2_slot_eq_k_5) & std_logic_vector(m2_slot_eq_k_4) & std_logic_vector(m2_slot_eq_k_3) & std_logic_vector(m2_slot_eq_k_2) & std_logic_vector(m2_slot_eq_k_1_1) & std_logic_vector(m2_slot_eq_k_0_2)));
+  cat_22 <= unsigned(std_logic_vector'(std_logic_vector(m2_slot_eq_k_127) & std_logic_vector(m2_slot_eq_k_126) & std_logic_vector(m2_slot_eq_k_125) & std_logic_vector(m2_slot_eq_k_124) & std_logic_vector(m2_slot_eq_k_123) & std_logic_vector(m2_slot_eq_k_122) & std_logic_vector(m2_slot_eq_k_121) & std_logic_vector(m2_slot_eq_k_120) & std_logic_vector(m2_slot_eq_k_119) & std_logic_vector(m2_slot_eq_k_118) & std_logic_vector(m2_slot_eq_k_117) & std_logic_vector(m2_slot_eq_k_116) & std_logic_vector(m2_slot_eq_k_115) & std_logic_vector(m2_slot_eq_k_114) & std_logic_vector(m2_slot_eq_k_113) & std_logic_vector(m2_slot_eq_k_112) & std_logic_vector(m2_slot_eq_k_111) & std_logic_vector(m2_slot_eq_k_110) & std_logic_vector(m2_slot_eq_k_109) & std_logic_vector(m2_slot_eq_k_108) & std_logic_vector(m2_slot_eq_k_107) & std_logic_vector(m2_slot_eq_k_106) & std_logic_vector(m2_slot_eq_k_105) & std_logic_vector(m2_slot_eq_k_104) & std_logic_vector(m2_slot_eq_k_103) & std_logic_vector(m2_slot_eq_k_102) & std_logic_vector(m2_slot_eq_k_101) & std_logic_vector(m2_slot_eq_k_100) & std_logic_vector(m2_slot_eq_k_99) & std_logic_vector(m2_slot_eq_k_98) & std_logic_vector(m2_slot_eq_k_97) & std_logic_vector(m2_slot_eq_k_96) & std_logic_vector(m2_slot_eq_k_95) & std_logic_vector(m2_slot_eq_k_94) & std_logic_vector(m2_slot_eq_k_93) & std_logic_vector(m2_slot_eq_k_92) & std_logic_vector(m2_slot_eq_k_91) & std_logic_vector(m2_slot_eq_k_90) & std_logic_vector(m2_slot_eq_k_89) & std_logic_vector(m2_slot_eq_k_88) & std_logic_vector(m2_slot_eq_k_87) & std_logic_vector(m2_slot_eq_k_86) & std_logic_vector(m2_slot_eq_k_85) & std_logic_vector(m2_slot_eq_k_84) & std_logic_vector(m2_slot_eq_k_83) & std_logic_vector(m2_slot_eq_k_82) & std_logic_vector(m2_slot_eq_k_81) & std_logic_vector(m2_slot_eq_k_80) & std_logic_vector(m2_slot_eq_k_79) & std_logic_vector(m2_slot_eq_k_78) & std_logic_vector(m2_slot_eq_k_77) & std_logic_vector(m2_slot_eq_k_76) & std_logic_vector(m2_slot_eq_k_75) & std_logic_vector(m2_slot_eq_k_74) & std_logic_vector(m2_slot_eq_k_73) & std_logic_vector(m2_slot_eq_k_72) & std_logic_vector(m2_slot_eq_k_71) & std_logic_vector(m2_slot_eq_k_70) & std_logic_vector(m2_slot_eq_k_69) & std_logic_vector(m2_slot_eq_k_68) & std_logic_vector(m2_slot_eq_k_67) & std_logic_vector(m2_slot_eq_k_66) & std_logic_vector(m2_slot_eq_k_65) & std_logic_vector(m2_slot_eq_k_64) & std_logic_vector(m2_slot_eq_k_63) & std_logic_vector(m2_slot_eq_k_62) & std_logic_vector(m2_slot_eq_k_61) & std_logic_vector(m2_slot_eq_k_60) & std_logic_vector(m2_slot_eq_k_59) & std_logic_vector(m2_slot_eq_k_58) & std_logic_vector(m2_slot_eq_k_57) & std_logic_vector(m2_slot_eq_k_56) & std_logic_vector(m2_slot_eq_k_55) & std_logic_vector(m2_slot_eq_k_54) & std_logic_vector(m2_slot_eq_k_53) & std_logic_vector(m2_slot_eq_k_52) & std_logic_vector(m2_slot_eq_k_51) & std_logic_vector(m2_slot_eq_k_50) & std_logic_vector(m2_slot_eq_k_49) & std_logic_vector(m2_slot_eq_k_48) & std_logic_vector(m2_slot_eq_k_47) & std_logic_vector(m2_slot_eq_k_46) & std_logic_vector(m2_slot_eq_k_45) & std_logic_vector(m2_slot_eq_k_44) & std_logic_vector(m2_slot_eq_k_43) & std_logic_vector(m2_slot_eq_k_42) & std_logic_vector(m2_slot_eq_k_41) & std_logic_vector(m2_slot_eq_k_40) & std_logic_vector(m2_slot_eq_k_39) & std_logic_vector(m2_slot_eq_k_38) & std_logic_vector(m2_slot_eq_k_37) & std_logic_vector(m2_slot_eq_k_36) & std_logic_vector(m2_slot_eq_k_35) & std_logic_vector(m2_slot_eq_k_34) & std_logic_vector(m2_slot_eq_k_33) & std_logic_vector(m2_slot_eq_k_32) & std_logic_vector(m2_slot_eq_k_31) & std_logic_vector(m2_slot_eq_k_30) & std_logic_vector(m2_slot_eq_k_29) & std_logic_vector(m2_slot_eq_k_28) & std_logic_vector(m2_slot_eq_k_27) & std_logic_vector(m2_slot_eq_k_26) & std_logic_vector(m2_slot_eq_k_25) & std_logic_vector(m2_slot_eq_k_24) & std_logic_vector(m2_slot_eq_k_23) & std_logic_vector(m2_slot_eq_k_22) & std_logic_vector(m2_slot_eq_k_21) & std_logic_vector(m2_slot_eq_k_20) & std_logic_vector(m2_slot_eq_k_19) & std_logic_vector(m2_slot_eq_k_18) & std_logic_vector(m2_slot_eq_k_17) & std_logic_vector(m2_slot_eq_k_16) & std_logic_vector(m2_slot_eq_k_15) & std_logic_vector(m2_slot_eq_k_14) & std_logic_vector(m2_slot_eq_k_13) & std_logic_vector(m2_slot_eq_k_12) & std_logic_vector(m2_slot_eq_k_11) & std_logic_vector(m2_slot_eq_k_10) & std_logic_vector(m2_slot_eq_k_9) & std_logic_vector(m2_slot_eq_k_8_1) & std_logic_vector(m2_slot_eq_k_7) & std_logic_vector(m2_slot_eq_k_6) & std_logic_vector(m2_slot_eq_k_5) & std_logic_vector(m2_slot_eq_k_4) & std_logic_vector(m2_slot_eq_k_3) & std_logic_vector(m2_slot_eq_k_2) & std_logic_vector(m2_slot_eq_k_1_1) & std_logic_vector(m2_slot_eq_k_0_2)));
   best_set <= m3_onehot when best_we = "1" else k_0_1;
   d0_slot_eq_k_127 <= "1" when d0_slot = k_127 else "0";
   d0_slot_eq_k_126 <= "1" when d0_slot = k_126 else "0";
@@ -1889,11 +1960,11 @@ begin
   d0_slot_eq_k_2 <= "1" when d0_slot = k_2 else "0";
   d0_slot_eq_k_1_1 <= "1" when d0_slot = k_1_1 else "0";
   d0_slot_eq_k_0_2 <= "1" when d0_slot = k_0_2 else "0";
-  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
+  cat_23 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
   best_clear <= d1_onehot when d1 = "1" else k_0_1;
   not_best_clear <= not best_clear;
-  and_20 <= best_valid and not_best_clear;
-  and_20_or_best_set <= and_20 or best_set;
+  and_24 <= best_valid and not_best_clear;
+  and_24_or_best_set <= and_24 or best_set;
   res_id_c <= done_id;
   res_hit_c <= d1_has;
   bits_done_t_tri <= unsigned(done_t_tri(12 downto 0));
@@ -1909,10 +1980,25 @@ begin
   begin
     if rising_edge(clk) then
       if best_we = "1" then
-        best_t_tri(to_integer(m3_slot_c1)) <= m3_t_tri;
+        best_t_tri_g0(to_integer(m3_slot_c1)) <= bits_m3_t_tri;
       end if;
       if best_we = "1" then
-        best_u_v(to_integer(m3_slot_c2)) <= m3_u_v;
+        best_t_tri_g1(to_integer(m3_slot_c2)) <= bits_m3_t_tri_1;
+      end if;
+      if best_we = "1" then
+        best_t_tri_g2(to_integer(m3_slot_c3)) <= bits_m3_t_tri_2;
+      end if;
+      if best_we = "1" then
+        best_u_v_g0(to_integer(m3_slot_c4)) <= bits_m3_u_v;
+      end if;
+      if best_we = "1" then
+        best_u_v_g1(to_integer(m3_slot_c5)) <= bits_m3_u_v_1;
+      end if;
+      if best_we = "1" then
+        best_u_v_g2(to_integer(m3_slot_c6)) <= bits_m3_u_v_2;
+      end if;
+      if best_we = "1" then
+        best_u_v_g3(to_integer(m3_slot_c7)) <= bits_m3_u_v_3;
       end if;
       if id_we = "1" then
         ray_ids(to_integer(id_slot)) <= id;
@@ -1979,16 +2065,17 @@ begin
       if rst = '1' then
         best_valid <= unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
       else
-        best_valid <= and_20_or_best_set;
+        best_valid <= and_24_or_best_set;
       end if;
       if rst = '1' then
         fin <= unsigned'("0");
       else
         fin <= leaf_last;
       end if;
-      fin_slot <= in_slot;
       fin_sp <= in_sp;
-      slot_t_tri <= best_t_tri(to_integer(fin_slot));
+      slot_t_tri_g2 <= best_t_tri_g2(to_integer(fin_slot_c3));
+      slot_t_tri_g1 <= best_t_tri_g1(to_integer(fin_slot_c2));
+      slot_t_tri_g0 <= best_t_tri_g0(to_integer(fin_slot_c1));
       if rst = '1' then
         m1 <= unsigned'("0");
       else
@@ -2006,7 +2093,7 @@ begin
       fin_has_g7 <= fin_has_g7_c;
       m1_slot_has <= fin_has_c;
       m1_leaf_empty <= acc_empty;
-      m1_t_tri <= cat_8;
+      m1_t_tri <= cat_9;
       m1_u_v <= acc_u_v_now;
       if rst = '1' then
         m2 <= unsigned'("0");
@@ -2046,9 +2133,14 @@ begin
       else
         d0 <= done_valid;
       end if;
-      done_t_tri <= best_t_tri(to_integer(d0_slot_c1));
-      done_u_v <= best_u_v(to_integer(d0_slot_c2));
-      done_id <= ray_ids(to_integer(d0_slot_c3));
+      done_t_tri_g2 <= best_t_tri_g2(to_integer(d0_slot_c3));
+      done_t_tri_g1 <= best_t_tri_g1(to_integer(d0_slot_c2));
+      done_t_tri_g0 <= best_t_tri_g0(to_integer(d0_slot_c1));
+      done_u_v_g3 <= best_u_v_g3(to_integer(d0_slot_c7));
+      done_u_v_g2 <= best_u_v_g2(to_integer(d0_slot_c6));
+      done_u_v_g1 <= best_u_v_g1(to_integer(d0_slot_c5));
+      done_u_v_g0 <= best_u_v_g0(to_integer(d0_slot_c4));
+      done_id <= ray_ids(to_integer(d0_slot_c8));
       if rst = '1' then
         d1 <= unsigned'("0");
       else
@@ -2064,8 +2156,8 @@ begin
       done_has_g6 <= done_has_g6_c;
       done_has_g7 <= done_has_g7_c;
       d1_has <= done_has_c;
-      m3_onehot <= cat_18;
-      d1_onehot <= cat_19;
+      m3_onehot <= cat_22;
+      d1_onehot <= cat_23;
       if rst = '1' then
         free_valid_r <= unsigned'("0");
       else
@@ -2086,7 +2178,19 @@ begin
     end if;
   end process regs;
 
-  -- register copies m3_slot_copies: m3_slot and 2 copies, to split its fan-out
+  -- register copies fin_slot_copies: fin_slot and 3 copies, to split its fan-out
+
+  fin_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      fin_slot <= in_slot;
+      fin_slot_c1 <= in_slot;
+      fin_slot_c2 <= in_slot;
+      fin_slot_c3 <= in_slot;
+    end if;
+  end process fin_slot_copies_regs;
+
+  -- register copies m3_slot_copies: m3_slot and 7 copies, to split its fan-out
 
   m3_slot_copies_regs : process (clk)
   begin
@@ -2094,6 +2198,11 @@ begin
       m3_slot <= m2_slot;
       m3_slot_c1 <= m2_slot;
       m3_slot_c2 <= m2_slot;
+      m3_slot_c3 <= m2_slot;
+      m3_slot_c4 <= m2_slot;
+      m3_slot_c5 <= m2_slot;
+      m3_slot_c6 <= m2_slot;
+      m3_slot_c7 <= m2_slot;
     end if;
   end process m3_slot_copies_regs;
 
@@ -2117,7 +2226,7 @@ begin
     end if;
   end process merge_hit_r_copies_regs;
 
-  -- register copies d0_slot_copies: d0_slot and 3 copies, to split its fan-out
+  -- register copies d0_slot_copies: d0_slot and 8 copies, to split its fan-out
 
   d0_slot_copies_regs : process (clk)
   begin
@@ -2126,6 +2235,11 @@ begin
       d0_slot_c1 <= done_slot;
       d0_slot_c2 <= done_slot;
       d0_slot_c3 <= done_slot;
+      d0_slot_c4 <= done_slot;
+      d0_slot_c5 <= done_slot;
+      d0_slot_c6 <= done_slot;
+      d0_slot_c7 <= done_slot;
+      d0_slot_c8 <= done_slot;
     end if;
   end process d0_slot_copies_regs;
 

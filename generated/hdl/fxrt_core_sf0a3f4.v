@@ -61,11 +61,29 @@ module fxrt_core_sf0a3f4 (
   (* ram_style = "distributed" *) reg [15:0] ray_w_g5 [0:127];
   initial $readmemh("fxrt_core_sf0a3f4_ray_w_g5.hex", ray_w_g5);
 
-  (* ram_style = "distributed" *) reg [63:0] res_q_mem0 [0:15];
-  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem0.hex", res_q_mem0);
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem0_g0 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem0_g0.hex", res_q_mem0_g0);
 
-  (* ram_style = "distributed" *) reg [63:0] res_q_mem1 [0:15];
-  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem1.hex", res_q_mem1);
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem0_g1 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem0_g1.hex", res_q_mem0_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem0_g2 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem0_g2.hex", res_q_mem0_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem0_g3 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem0_g3.hex", res_q_mem0_g3);
+
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem1_g0 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem1_g0.hex", res_q_mem1_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem1_g1 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem1_g1.hex", res_q_mem1_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem1_g2 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem1_g2.hex", res_q_mem1_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] res_q_mem1_g3 [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_res_q_mem1_g3.hex", res_q_mem1_g3);
 
   // not in a stage or state machine
 
@@ -119,6 +137,12 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] box_in_invx = 48'sh000000000000;
   reg signed [47:0] box_in_invy = 48'sh000000000000;
   reg signed [47:0] box_in_invz = 48'sh000000000000;
+  wire [0:0] bits_take_slot;
+  wire [0:0] bits_take_slot_eq_k_0;
+  wire [0:0] u0_take;
+  wire [0:0] bits_take_slot_1;
+  wire [0:0] bits_take_slot_1_eq_k_1;
+  wire [0:0] u1_take;
   reg [19:0] acc_in_ray_id = 20'h00000;
   reg [28:0] acc_in_ox = 29'h00000000;
   reg [28:0] acc_in_oy = 29'h00000000;
@@ -131,6 +155,34 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] acc_in_invz = 48'sh000000000000;
   wire [5:0] bits_accept_slot_c14;
   wire [5:0] bits_accept_slot_c15;
+  wire [5:0] bits_accept_slot_c16;
+  wire [5:0] bits_accept_slot_c17;
+  wire [5:0] bits_accept_slot_c18;
+  wire [5:0] bits_accept_slot_c19;
+  wire [5:0] bits_accept_slot_c20;
+  wire [5:0] bits_accept_slot_c21;
+  wire [5:0] bits_accept_slot_c22;
+  wire [5:0] bits_accept_slot_c23;
+  wire [5:0] bits_accept_slot_c24;
+  wire [5:0] bits_accept_slot_c25;
+  wire [5:0] bits_accept_slot_c26;
+  wire [5:0] bits_accept_slot_c27;
+  wire [5:0] bits_accept_slot_c28;
+  wire [5:0] bits_accept_slot_c29;
+  wire [5:0] bits_accept_slot_c30;
+  wire [5:0] bits_accept_slot_c31;
+  wire [5:0] bits_accept_slot_c32;
+  wire [5:0] bits_accept_slot_c33;
+  wire [5:0] bits_accept_slot_c34;
+  wire [5:0] bits_accept_slot_c35;
+  wire [5:0] bits_accept_slot_c36;
+  wire [5:0] bits_accept_slot_c37;
+  wire [5:0] bits_accept_slot_c38;
+  wire [5:0] bits_accept_slot_c39;
+  wire [5:0] bits_accept_slot_c40;
+  wire [5:0] bits_accept_slot_c41;
+  wire [5:0] bits_accept_slot_c42;
+  wire [5:0] bits_accept_slot_c43;
 
   // register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
   reg [0:0] port_empty = 1'h1;
@@ -156,8 +208,8 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] accept_c10 = 1'h0;
   reg [0:0] accept_c11 = 1'h0;
 
-  // register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 6 are read
+  // register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
+  /* verilator lint_off UNUSEDSIGNAL */  // not read
   reg [6:0] accept_slot = 7'h00;
   /* verilator lint_on UNUSEDSIGNAL */
   reg [6:0] accept_slot_c1 = 7'h00;
@@ -179,6 +231,126 @@ module fxrt_core_sf0a3f4 (
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
   reg [6:0] accept_slot_c15 = 7'h00;
   /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c16 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c17 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c18 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c19 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c20 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c21 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c22 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c23 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c24 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c25 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c26 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c27 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c28 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c29 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c30 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c31 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c32 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c33 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c34 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c35 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c36 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c37 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c38 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c39 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c40 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c41 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c42 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_slot_c43 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  // register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
+  reg [0:0] u0_accept = 1'h0;
+  reg [0:0] u0_accept_c1 = 1'h0;
+  reg [0:0] u0_accept_c2 = 1'h0;
+  reg [0:0] u0_accept_c3 = 1'h0;
+  reg [0:0] u0_accept_c4 = 1'h0;
+  reg [0:0] u0_accept_c5 = 1'h0;
+  reg [0:0] u0_accept_c6 = 1'h0;
+  reg [0:0] u0_accept_c7 = 1'h0;
+  reg [0:0] u0_accept_c8 = 1'h0;
+  reg [0:0] u0_accept_c9 = 1'h0;
+  reg [0:0] u0_accept_c10 = 1'h0;
+  reg [0:0] u0_accept_c11 = 1'h0;
+  reg [0:0] u0_accept_c12 = 1'h0;
+  reg [0:0] u0_accept_c13 = 1'h0;
+  reg [0:0] u0_accept_c14 = 1'h0;
+  reg [0:0] u0_accept_c15 = 1'h0;
+
+  // register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
+  reg [0:0] u1_accept = 1'h0;
+  reg [0:0] u1_accept_c1 = 1'h0;
+  reg [0:0] u1_accept_c2 = 1'h0;
+  reg [0:0] u1_accept_c3 = 1'h0;
+  reg [0:0] u1_accept_c4 = 1'h0;
+  reg [0:0] u1_accept_c5 = 1'h0;
+  reg [0:0] u1_accept_c6 = 1'h0;
+  reg [0:0] u1_accept_c7 = 1'h0;
+  reg [0:0] u1_accept_c8 = 1'h0;
+  reg [0:0] u1_accept_c9 = 1'h0;
+  reg [0:0] u1_accept_c10 = 1'h0;
+  reg [0:0] u1_accept_c11 = 1'h0;
+  reg [0:0] u1_accept_c12 = 1'h0;
+  reg [0:0] u1_accept_c13 = 1'h0;
+  reg [0:0] u1_accept_c14 = 1'h0;
+  reg [0:0] u1_accept_c15 = 1'h0;
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
   reg [6:0] box_slot = 7'h00;
@@ -260,14 +432,14 @@ module fxrt_core_sf0a3f4 (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_box_d1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_7;
+  wire signed [32:0] minus_9;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt1_c;
   reg [0:0] box_lt1 = 1'h0;
   wire signed [32:0] rs_plane_t_1;
   wire signed [32:0] rs_box_d2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_8;
+  wire signed [32:0] minus_10;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] box_lt2_c;
   reg [0:0] box_lt2 = 1'h0;
@@ -277,7 +449,7 @@ module fxrt_core_sf0a3f4 (
   wire signed [31:0] box_tmax;
   wire [0:0] bits_box_d1;
   wire [0:0] bits_box_d2;
-  wire [0:0] or_9;
+  wire [0:0] or_11;
   wire [0:0] bits_box_d3;
   wire [0:0] box_miss;
   wire [0:0] box_last;
@@ -304,11 +476,8 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] u1_done_pop;
   wire [72:0] u0_node_word;
   wire [72:0] u1_node_word;
-  wire [0:0] bits_accept_slot;
-  wire [0:0] bits_accept_slot_eq_k_0;
-  wire [0:0] u0_alloc;
   wire [0:0] bits_box_done_slot;
-  wire [0:0] eq_12;
+  wire [0:0] eq_13;
   wire [0:0] u0_new;
   wire [0:0] bits_free_slot;
   wire [0:0] bits_free_slot_eq_k_0;
@@ -344,9 +513,6 @@ module fxrt_core_sf0a3f4 (
   /* verilator lint_off UNUSEDSIGNAL */  // not read
   wire [6:0] u_traverse_0_occupied;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_accept_slot_1;
-  wire [0:0] eq_14;
-  wire [0:0] u1_alloc;
   wire [0:0] bits_box_done_slot_2;
   wire [0:0] eq_15;
   wire [0:0] u1_new;
@@ -514,9 +680,10 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] pipe_valid_1 = 1'h0;
   reg [0:0] pipe_valid_2 = 1'h0;
   reg [0:0] pipe_valid_3 = 1'h0;
-  (* mem2reg *) reg [58:0] pipe_tag_sr [1:3];
+  reg [0:0] pipe_valid_4 = 1'h0;
+  (* mem2reg *) reg [58:0] pipe_tag_sr [1:4];
   integer pipe_tag_i;
-  initial for (pipe_tag_i = 1; pipe_tag_i <= 3; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 59'h000000000000000;
+  initial for (pipe_tag_i = 1; pipe_tag_i <= 4; pipe_tag_i = pipe_tag_i + 1) pipe_tag_sr[pipe_tag_i] = 59'h000000000000000;
   wire [58:0] pipe_tag;
   (* mem2reg *) reg [6:0] emit_slot_sr_sr [1:2];
   integer emit_slot_sr_i;
@@ -529,9 +696,9 @@ module fxrt_core_sf0a3f4 (
   reg [15:0] ray_o_q_g1 = 16'h0000;
   reg [15:0] ray_o_q_g0 = 16'h0000;
   wire [86:0] ray_o_q;
-  (* mem2reg *) reg [86:0] pipe_o_sr [1:2];
+  (* mem2reg *) reg [86:0] pipe_o_sr [1:3];
   integer pipe_o_i;
-  initial for (pipe_o_i = 1; pipe_o_i <= 2; pipe_o_i = pipe_o_i + 1) pipe_o_sr[pipe_o_i] = 87'h0000000000000000000000;
+  initial for (pipe_o_i = 1; pipe_o_i <= 3; pipe_o_i = pipe_o_i + 1) pipe_o_sr[pipe_o_i] = 87'h0000000000000000000000;
   wire [86:0] pipe_o;
   reg [15:0] ray_w_q_g5 = 16'h0000;
   reg [15:0] ray_w_q_g4 = 16'h0000;
@@ -540,9 +707,9 @@ module fxrt_core_sf0a3f4 (
   reg [15:0] ray_w_q_g1 = 16'h0000;
   reg [15:0] ray_w_q_g0 = 16'h0000;
   wire [95:0] ray_w_q;
-  (* mem2reg *) reg [95:0] pipe_w_sr [1:2];
+  (* mem2reg *) reg [95:0] pipe_w_sr [1:3];
   integer pipe_w_i;
-  initial for (pipe_w_i = 1; pipe_w_i <= 2; pipe_w_i = pipe_w_i + 1) pipe_w_sr[pipe_w_i] = 96'h000000000000000000000000;
+  initial for (pipe_w_i = 1; pipe_w_i <= 3; pipe_w_i = pipe_w_i + 1) pipe_w_sr[pipe_w_i] = 96'h000000000000000000000000;
   wire [95:0] pipe_w;
   wire [28:0] bits_pipe_o;
   wire [28:0] bits_pipe_o_1;
@@ -614,7 +781,6 @@ module fxrt_core_sf0a3f4 (
   wire [63:0] cat_41;
   wire [63:0] cat_42;
   wire [0:0] res_take;
-  reg [0:0] res_q_push = 1'h0;
   reg [3:0] res_q_wr = 4'h0;
   reg [3:0] res_q_rd = 4'h0;
   reg [4:0] res_q_count = 5'h00;
@@ -625,9 +791,11 @@ module fxrt_core_sf0a3f4 (
   wire [3:0] res_q_rd_next;
   wire [3:0] res_q_rd1_plus_k_1_4;
   wire [3:0] mux_res_take;
-  wire [4:0] rs_res_take;
-  wire [4:0] res_q_after_pop;
-  wire [4:0] rs_res_q_push;
+  wire [0:0] not_res_q_push_c1;
+  wire [4:0] rs_not_res_q_push_c1;
+  wire [4:0] res_q_count_if_pop;
+  wire [4:0] rs_res_q_push_c1;
+  wire [4:0] res_q_count_if_kept;
   wire [4:0] res_q_count_next;
   wire [4:0] k_0_5 = 5'h00;
   wire [0:0] res_q_count_eq_k_0_5;
@@ -637,6 +805,7 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_q_drained;
   reg [0:0] res_q_bypass = 1'h0;
   wire [0:0] res_q_bypass_c;
+  reg [0:0] res_q_popped = 1'h0;
   reg [0:0] res_q_nonempty = 1'h0;
   wire [0:0] k_1_5_lt_res_q_count;
   wire [0:0] or_48;
@@ -644,18 +813,78 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] and_49;
   wire [0:0] res_q_nonempty_c;
   reg [63:0] res_q_din0 = 64'h0000000000000000;
-  reg [63:0] res_q_q0 = 64'h0000000000000000;
+  wire [15:0] bits_res_q_din0;
+  wire [15:0] bits_res_q_din0_1;
+  wire [15:0] bits_res_q_din0_2;
+  wire [15:0] bits_res_q_din0_3;
+  reg [3:0] res_q_rd0_p1 = 4'h0;
+  reg [3:0] res_q_rd01_p1 = 4'h1;
+  wire [3:0] mux_res_take_1;
+  wire [3:0] res_q_rd01_p1_plus_k_1_4;
+  wire [3:0] mux_res_take_2;
+  reg [3:0] res_q_rd0_p2 = 4'h0;
+  reg [3:0] res_q_rd01_p2 = 4'h1;
+  wire [3:0] mux_res_take_3;
+  wire [3:0] res_q_rd01_p2_plus_k_1_4;
+  wire [3:0] mux_res_take_4;
+  reg [3:0] res_q_rd0_p3 = 4'h0;
+  reg [3:0] res_q_rd01_p3 = 4'h1;
+  wire [3:0] mux_res_take_5;
+  wire [3:0] res_q_rd01_p3_plus_k_1_4;
+  wire [3:0] mux_res_take_6;
+  reg [15:0] res_q_q_stay0_g3 = 16'h0000;
+  reg [15:0] res_q_q_stay0_g2 = 16'h0000;
+  reg [15:0] res_q_q_stay0_g1 = 16'h0000;
+  reg [15:0] res_q_q_stay0_g0 = 16'h0000;
+  wire [63:0] res_q_q_stay0;
+  reg [15:0] res_q_q_next0_g3 = 16'h0000;
+  reg [15:0] res_q_q_next0_g2 = 16'h0000;
+  reg [15:0] res_q_q_next0_g1 = 16'h0000;
+  reg [15:0] res_q_q_next0_g0 = 16'h0000;
+  wire [63:0] res_q_q_next0;
+  wire [63:0] mux_res_q_popped;
   reg [63:0] res_q_din_r0 = 64'h0000000000000000;
   wire [63:0] res_q_head0;
   reg [63:0] res_q_din1 = 64'h0000000000000000;
-  reg [63:0] res_q_q1 = 64'h0000000000000000;
+  wire [15:0] bits_res_q_din1;
+  wire [15:0] bits_res_q_din1_1;
+  wire [15:0] bits_res_q_din1_2;
+  wire [15:0] bits_res_q_din1_3;
+  reg [3:0] res_q_rd1_p1 = 4'h0;
+  reg [3:0] res_q_rd11_p1 = 4'h1;
+  wire [3:0] mux_res_take_7;
+  wire [3:0] res_q_rd11_p1_plus_k_1_4;
+  wire [3:0] mux_res_take_8;
+  reg [3:0] res_q_rd1_p2 = 4'h0;
+  reg [3:0] res_q_rd11_p2 = 4'h1;
+  wire [3:0] mux_res_take_9;
+  wire [3:0] res_q_rd11_p2_plus_k_1_4;
+  wire [3:0] mux_res_take_10;
+  reg [3:0] res_q_rd1_p3 = 4'h0;
+  reg [3:0] res_q_rd11_p3 = 4'h1;
+  wire [3:0] mux_res_take_11;
+  wire [3:0] res_q_rd11_p3_plus_k_1_4;
+  wire [3:0] mux_res_take_12;
+  reg [15:0] res_q_q_stay1_g3 = 16'h0000;
+  reg [15:0] res_q_q_stay1_g2 = 16'h0000;
+  reg [15:0] res_q_q_stay1_g1 = 16'h0000;
+  reg [15:0] res_q_q_stay1_g0 = 16'h0000;
+  wire [63:0] res_q_q_stay1;
+  reg [15:0] res_q_q_next1_g3 = 16'h0000;
+  reg [15:0] res_q_q_next1_g2 = 16'h0000;
+  reg [15:0] res_q_q_next1_g1 = 16'h0000;
+  reg [15:0] res_q_q_next1_g0 = 16'h0000;
+  wire [63:0] res_q_q_next1;
+  wire [63:0] mux_res_q_popped_1;
   reg [63:0] res_q_din_r1 = 64'h0000000000000000;
   wire [63:0] res_q_head1;
   wire [0:0] res_take_c;
   reg [5:0] res_credits = 6'h10;
+  wire [0:0] not_done_valid_r;
+  wire [5:0] rs_not_done_valid_r;
+  wire [5:0] res_credits_if_take;
   wire [5:0] rs_done_valid_r;
-  wire [5:0] minus_51;
-  wire [5:0] rs_res_take_1;
+  wire [5:0] res_credits_if_not;
   wire [5:0] res_credits_next;
   wire [5:0] k_1_6 = 6'h01;
   wire [0:0] res_credits_ge1;
@@ -673,6 +902,10 @@ module fxrt_core_sf0a3f4 (
   wire [31:0] res_v_q;
   wire [31:0] res_u_q;
 
+  // register copies res_q_push_copies: res_q_push and 1 copies, to split its fan-out
+  reg [0:0] res_q_push = 1'h0;
+  reg [0:0] res_q_push_c1 = 1'h0;
+
   // not in a stage or state machine
 
   always @(posedge clk) begin : regs
@@ -688,8 +921,14 @@ module fxrt_core_sf0a3f4 (
     if (accept_c9) ray_w_g3[accept_slot_c10] <= bits_cat_18_3;
     if (accept_c10) ray_w_g4[accept_slot_c11] <= bits_cat_18_4;
     if (accept_c11) ray_w_g5[accept_slot_c12] <= bits_cat_18_5;
-    if (res_q_push) res_q_mem0[res_q_wr] <= res_q_din0;
-    if (res_q_push) res_q_mem1[res_q_wr] <= res_q_din1;
+    if (res_q_push) res_q_mem0_g0[res_q_wr] <= bits_res_q_din0;
+    if (res_q_push) res_q_mem0_g1[res_q_wr] <= bits_res_q_din0_1;
+    if (res_q_push) res_q_mem0_g2[res_q_wr] <= bits_res_q_din0_2;
+    if (res_q_push) res_q_mem0_g3[res_q_wr] <= bits_res_q_din0_3;
+    if (res_q_push) res_q_mem1_g0[res_q_wr] <= bits_res_q_din1;
+    if (res_q_push) res_q_mem1_g1[res_q_wr] <= bits_res_q_din1_1;
+    if (res_q_push) res_q_mem1_g2[res_q_wr] <= bits_res_q_din1_2;
+    if (res_q_push) res_q_mem1_g3[res_q_wr] <= bits_res_q_din1_3;
   end
 
   // stage ray_port: the ray port's register, the unit whose turn it is, the take (a ray per 4 clocks)
@@ -722,8 +961,42 @@ module fxrt_core_sf0a3f4 (
   assign box_phase_plus_k_1_1 = box_phase + k_1_1;
   assign box_phase_next = or_3 ? box_phase_plus_k_1_1 : box_phase;
   assign box_idle_next = box_phase_next == k_0_1;
+  assign bits_take_slot = take_slot[6];
+  assign bits_take_slot_eq_k_0 = bits_take_slot == k_0;
+  assign u0_take = take & bits_take_slot_eq_k_0;
+  assign bits_take_slot_1 = take_slot[6];
+  assign bits_take_slot_1_eq_k_1 = bits_take_slot_1 == k_1;
+  assign u1_take = take & bits_take_slot_1_eq_k_1;
   assign bits_accept_slot_c14 = accept_slot_c14[5:0];
   assign bits_accept_slot_c15 = accept_slot_c15[5:0];
+  assign bits_accept_slot_c16 = accept_slot_c16[5:0];
+  assign bits_accept_slot_c17 = accept_slot_c17[5:0];
+  assign bits_accept_slot_c18 = accept_slot_c18[5:0];
+  assign bits_accept_slot_c19 = accept_slot_c19[5:0];
+  assign bits_accept_slot_c20 = accept_slot_c20[5:0];
+  assign bits_accept_slot_c21 = accept_slot_c21[5:0];
+  assign bits_accept_slot_c22 = accept_slot_c22[5:0];
+  assign bits_accept_slot_c23 = accept_slot_c23[5:0];
+  assign bits_accept_slot_c24 = accept_slot_c24[5:0];
+  assign bits_accept_slot_c25 = accept_slot_c25[5:0];
+  assign bits_accept_slot_c26 = accept_slot_c26[5:0];
+  assign bits_accept_slot_c27 = accept_slot_c27[5:0];
+  assign bits_accept_slot_c28 = accept_slot_c28[5:0];
+  assign bits_accept_slot_c29 = accept_slot_c29[5:0];
+  assign bits_accept_slot_c30 = accept_slot_c30[5:0];
+  assign bits_accept_slot_c31 = accept_slot_c31[5:0];
+  assign bits_accept_slot_c32 = accept_slot_c32[5:0];
+  assign bits_accept_slot_c33 = accept_slot_c33[5:0];
+  assign bits_accept_slot_c34 = accept_slot_c34[5:0];
+  assign bits_accept_slot_c35 = accept_slot_c35[5:0];
+  assign bits_accept_slot_c36 = accept_slot_c36[5:0];
+  assign bits_accept_slot_c37 = accept_slot_c37[5:0];
+  assign bits_accept_slot_c38 = accept_slot_c38[5:0];
+  assign bits_accept_slot_c39 = accept_slot_c39[5:0];
+  assign bits_accept_slot_c40 = accept_slot_c40[5:0];
+  assign bits_accept_slot_c41 = accept_slot_c41[5:0];
+  assign bits_accept_slot_c42 = accept_slot_c42[5:0];
+  assign bits_accept_slot_c43 = accept_slot_c43[5:0];
 
   always @(posedge clk) begin : ray_port_regs
     if (rst) turn <= 1'h0;
@@ -817,7 +1090,7 @@ module fxrt_core_sf0a3f4 (
     else accept_c11 <= take;
   end
 
-  // register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
+  // register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : accept_slot_copies_regs
     accept_slot <= take_slot;
@@ -836,6 +1109,108 @@ module fxrt_core_sf0a3f4 (
     accept_slot_c13 <= take_slot;
     accept_slot_c14 <= take_slot;
     accept_slot_c15 <= take_slot;
+    accept_slot_c16 <= take_slot;
+    accept_slot_c17 <= take_slot;
+    accept_slot_c18 <= take_slot;
+    accept_slot_c19 <= take_slot;
+    accept_slot_c20 <= take_slot;
+    accept_slot_c21 <= take_slot;
+    accept_slot_c22 <= take_slot;
+    accept_slot_c23 <= take_slot;
+    accept_slot_c24 <= take_slot;
+    accept_slot_c25 <= take_slot;
+    accept_slot_c26 <= take_slot;
+    accept_slot_c27 <= take_slot;
+    accept_slot_c28 <= take_slot;
+    accept_slot_c29 <= take_slot;
+    accept_slot_c30 <= take_slot;
+    accept_slot_c31 <= take_slot;
+    accept_slot_c32 <= take_slot;
+    accept_slot_c33 <= take_slot;
+    accept_slot_c34 <= take_slot;
+    accept_slot_c35 <= take_slot;
+    accept_slot_c36 <= take_slot;
+    accept_slot_c37 <= take_slot;
+    accept_slot_c38 <= take_slot;
+    accept_slot_c39 <= take_slot;
+    accept_slot_c40 <= take_slot;
+    accept_slot_c41 <= take_slot;
+    accept_slot_c42 <= take_slot;
+    accept_slot_c43 <= take_slot;
+  end
+
+  // register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : u0_accept_copies_regs
+    if (rst) u0_accept <= 1'h0;
+    else u0_accept <= u0_take;
+    if (rst) u0_accept_c1 <= 1'h0;
+    else u0_accept_c1 <= u0_take;
+    if (rst) u0_accept_c2 <= 1'h0;
+    else u0_accept_c2 <= u0_take;
+    if (rst) u0_accept_c3 <= 1'h0;
+    else u0_accept_c3 <= u0_take;
+    if (rst) u0_accept_c4 <= 1'h0;
+    else u0_accept_c4 <= u0_take;
+    if (rst) u0_accept_c5 <= 1'h0;
+    else u0_accept_c5 <= u0_take;
+    if (rst) u0_accept_c6 <= 1'h0;
+    else u0_accept_c6 <= u0_take;
+    if (rst) u0_accept_c7 <= 1'h0;
+    else u0_accept_c7 <= u0_take;
+    if (rst) u0_accept_c8 <= 1'h0;
+    else u0_accept_c8 <= u0_take;
+    if (rst) u0_accept_c9 <= 1'h0;
+    else u0_accept_c9 <= u0_take;
+    if (rst) u0_accept_c10 <= 1'h0;
+    else u0_accept_c10 <= u0_take;
+    if (rst) u0_accept_c11 <= 1'h0;
+    else u0_accept_c11 <= u0_take;
+    if (rst) u0_accept_c12 <= 1'h0;
+    else u0_accept_c12 <= u0_take;
+    if (rst) u0_accept_c13 <= 1'h0;
+    else u0_accept_c13 <= u0_take;
+    if (rst) u0_accept_c14 <= 1'h0;
+    else u0_accept_c14 <= u0_take;
+    if (rst) u0_accept_c15 <= 1'h0;
+    else u0_accept_c15 <= u0_take;
+  end
+
+  // register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : u1_accept_copies_regs
+    if (rst) u1_accept <= 1'h0;
+    else u1_accept <= u1_take;
+    if (rst) u1_accept_c1 <= 1'h0;
+    else u1_accept_c1 <= u1_take;
+    if (rst) u1_accept_c2 <= 1'h0;
+    else u1_accept_c2 <= u1_take;
+    if (rst) u1_accept_c3 <= 1'h0;
+    else u1_accept_c3 <= u1_take;
+    if (rst) u1_accept_c4 <= 1'h0;
+    else u1_accept_c4 <= u1_take;
+    if (rst) u1_accept_c5 <= 1'h0;
+    else u1_accept_c5 <= u1_take;
+    if (rst) u1_accept_c6 <= 1'h0;
+    else u1_accept_c6 <= u1_take;
+    if (rst) u1_accept_c7 <= 1'h0;
+    else u1_accept_c7 <= u1_take;
+    if (rst) u1_accept_c8 <= 1'h0;
+    else u1_accept_c8 <= u1_take;
+    if (rst) u1_accept_c9 <= 1'h0;
+    else u1_accept_c9 <= u1_take;
+    if (rst) u1_accept_c10 <= 1'h0;
+    else u1_accept_c10 <= u1_take;
+    if (rst) u1_accept_c11 <= 1'h0;
+    else u1_accept_c11 <= u1_take;
+    if (rst) u1_accept_c12 <= 1'h0;
+    else u1_accept_c12 <= u1_take;
+    if (rst) u1_accept_c13 <= 1'h0;
+    else u1_accept_c13 <= u1_take;
+    if (rst) u1_accept_c14 <= 1'h0;
+    else u1_accept_c14 <= u1_take;
+    if (rst) u1_accept_c15 <= 1'h0;
+    else u1_accept_c15 <= u1_take;
   end
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
@@ -881,20 +1256,20 @@ module fxrt_core_sf0a3f4 (
   assign pu_first = pu_clamp_valid & not_pu_clamp_last;
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d1 = $signed({{1{box_d1[31]}}, box_d1});
-  assign minus_7 = rs_plane_t - rs_box_d1;
-  assign box_lt1_c = minus_7[32];
+  assign minus_9 = rs_plane_t - rs_box_d1;
+  assign box_lt1_c = minus_9[32];
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_box_d2 = $signed({{1{box_d2[31]}}, box_d2});
-  assign minus_8 = rs_plane_t_1 - rs_box_d2;
-  assign box_lt2_c = minus_8[32];
+  assign minus_10 = rs_plane_t_1 - rs_box_d2;
+  assign box_lt2_c = minus_10[32];
   assign box_lt1_and_box_lt2 = box_lt1 & box_lt2;
   assign mux_box_lt1_d = box_lt1_d ? box_d2 : box_d3;
   assign box_tmax = box_lt1_and_box_lt2 ? box_d1 : mux_box_lt1_d;
   assign bits_box_d1 = box_d1[31];
   assign bits_box_d2 = box_d2[31];
-  assign or_9 = bits_box_d1 | bits_box_d2;
+  assign or_11 = bits_box_d1 | bits_box_d2;
   assign bits_box_d3 = box_d3[31];
-  assign box_miss = or_9 | bits_box_d3;
+  assign box_miss = or_11 | bits_box_d3;
   assign box_last = plane_t_valid & plane_t_last;
   assign box_done_slot = box_done_slot_sr[11];
 
@@ -978,20 +1353,14 @@ module fxrt_core_sf0a3f4 (
   assign u1_done_pop = u1_done_take;
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
-  assign bits_accept_slot = accept_slot[6];
-  assign bits_accept_slot_eq_k_0 = bits_accept_slot == k_0;
-  assign u0_alloc = accept & bits_accept_slot_eq_k_0;
   assign bits_box_done_slot = box_done_slot[6];
-  assign eq_12 = bits_box_done_slot == k_0;
-  assign u0_new = box_done & eq_12;
+  assign eq_13 = bits_box_done_slot == k_0;
+  assign u0_new = box_done & eq_13;
   assign bits_free_slot = free_slot[6];
   assign bits_free_slot_eq_k_0 = bits_free_slot == k_0;
   assign u0_free = free_valid & bits_free_slot_eq_k_0;
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
-  assign bits_accept_slot_1 = accept_slot[6];
-  assign eq_14 = bits_accept_slot_1 == k_1;
-  assign u1_alloc = accept & eq_14;
   assign bits_box_done_slot_2 = box_done_slot[6];
   assign eq_15 = bits_box_done_slot_2 == k_1;
   assign u1_new = box_done & eq_15;
@@ -1146,12 +1515,12 @@ module fxrt_core_sf0a3f4 (
   assign bits_u_tri_rom_1_data_3 = u_tri_rom_1_data[127:96];
   assign tri_e2p = $signed(bits_u_tri_rom_1_data_3);
   assign tri_e2q = $signed(u_tri_rom_2_data);
-  assign pipe_tag = pipe_tag_sr[3];
+  assign pipe_tag = pipe_tag_sr[4];
   assign emit_slot_sr = emit_slot_sr_sr[2];
   assign ray_o_q = {ray_o_q_g5, ray_o_q_g4, ray_o_q_g3, ray_o_q_g2, ray_o_q_g1, ray_o_q_g0};
-  assign pipe_o = pipe_o_sr[2];
+  assign pipe_o = pipe_o_sr[3];
   assign ray_w_q = {ray_w_q_g5, ray_w_q_g4, ray_w_q_g3, ray_w_q_g2, ray_w_q_g1, ray_w_q_g0};
-  assign pipe_w = pipe_w_sr[2];
+  assign pipe_w = pipe_w_sr[3];
   assign bits_pipe_o = pipe_o[28:0];
   assign bits_pipe_o_1 = pipe_o[57:29];
   assign bits_pipe_o_2 = pipe_o[86:58];
@@ -1178,6 +1547,9 @@ module fxrt_core_sf0a3f4 (
     else pipe_valid_2 <= pipe_valid_1;
     if (rst) pipe_valid_3 <= 1'h0;
     else pipe_valid_3 <= pipe_valid_2;
+    if (rst) pipe_valid_4 <= 1'h0;
+    else pipe_valid_4 <= pipe_valid_3;
+    pipe_tag_sr[4] <= pipe_tag_sr[3];
     pipe_tag_sr[3] <= pipe_tag_sr[2];
     pipe_tag_sr[2] <= pipe_tag_sr[1];
     pipe_tag_sr[1] <= emit_tag_tri;
@@ -1189,6 +1561,7 @@ module fxrt_core_sf0a3f4 (
     ray_o_q_g2 <= ray_o_g2[emit_slot_1_c2];
     ray_o_q_g1 <= ray_o_g1[emit_slot_1_c1];
     ray_o_q_g0 <= ray_o_g0[emit_slot_1];
+    pipe_o_sr[3] <= pipe_o_sr[2];
     pipe_o_sr[2] <= pipe_o_sr[1];
     pipe_o_sr[1] <= ray_o_q;
     ray_w_q_g5 <= ray_w_g5[emit_slot_1_c11];
@@ -1197,6 +1570,7 @@ module fxrt_core_sf0a3f4 (
     ray_w_q_g2 <= ray_w_g2[emit_slot_1_c8];
     ray_w_q_g1 <= ray_w_g1[emit_slot_1_c7];
     ray_w_q_g0 <= ray_w_g0[emit_slot_1_c6];
+    pipe_w_sr[3] <= pipe_w_sr[2];
     pipe_w_sr[2] <= pipe_w_sr[1];
     pipe_w_sr[1] <= ray_w_q;
   end
@@ -1253,27 +1627,63 @@ module fxrt_core_sf0a3f4 (
   assign res_q_rd_next = res_take ? res_q_rd1 : res_q_rd;
   assign res_q_rd1_plus_k_1_4 = res_q_rd1 + k_1_4;
   assign mux_res_take = res_take ? res_q_rd1_plus_k_1_4 : res_q_rd1;
-  assign rs_res_take = {{4{1'b0}}, res_take};
-  assign res_q_after_pop = res_q_count - rs_res_take;
-  assign rs_res_q_push = {{4{1'b0}}, res_q_push};
-  assign res_q_count_next = res_q_after_pop + rs_res_q_push;
+  assign not_res_q_push_c1 = ~res_q_push_c1;
+  assign rs_not_res_q_push_c1 = {{4{1'b0}}, not_res_q_push_c1};
+  assign res_q_count_if_pop = res_q_count - rs_not_res_q_push_c1;
+  assign rs_res_q_push_c1 = {{4{1'b0}}, res_q_push_c1};
+  assign res_q_count_if_kept = res_q_count + rs_res_q_push_c1;
+  assign res_q_count_next = res_take ? res_q_count_if_pop : res_q_count_if_kept;
   assign res_q_count_eq_k_0_5 = res_q_count == k_0_5;
   assign res_q_one_left = res_q_count == k_1_5;
   assign and_45 = res_q_one_left & res_take;
   assign res_q_drained = res_q_count_eq_k_0_5 | and_45;
-  assign res_q_bypass_c = res_q_push & res_q_drained;
+  assign res_q_bypass_c = res_q_push_c1 & res_q_drained;
   assign k_1_5_lt_res_q_count = k_1_5 < res_q_count;
-  assign or_48 = res_q_push | k_1_5_lt_res_q_count;
+  assign or_48 = res_q_push_c1 | k_1_5_lt_res_q_count;
   assign not_res_take = ~res_take;
   assign and_49 = res_q_one_left & not_res_take;
   assign res_q_nonempty_c = or_48 | and_49;
-  assign res_q_head0 = res_q_bypass ? res_q_din_r0 : res_q_q0;
-  assign res_q_head1 = res_q_bypass ? res_q_din_r1 : res_q_q1;
+  assign bits_res_q_din0 = res_q_din0[15:0];
+  assign bits_res_q_din0_1 = res_q_din0[31:16];
+  assign bits_res_q_din0_2 = res_q_din0[47:32];
+  assign bits_res_q_din0_3 = res_q_din0[63:48];
+  assign mux_res_take_1 = res_take ? res_q_rd01_p1 : res_q_rd0_p1;
+  assign res_q_rd01_p1_plus_k_1_4 = res_q_rd01_p1 + k_1_4;
+  assign mux_res_take_2 = res_take ? res_q_rd01_p1_plus_k_1_4 : res_q_rd01_p1;
+  assign mux_res_take_3 = res_take ? res_q_rd01_p2 : res_q_rd0_p2;
+  assign res_q_rd01_p2_plus_k_1_4 = res_q_rd01_p2 + k_1_4;
+  assign mux_res_take_4 = res_take ? res_q_rd01_p2_plus_k_1_4 : res_q_rd01_p2;
+  assign mux_res_take_5 = res_take ? res_q_rd01_p3 : res_q_rd0_p3;
+  assign res_q_rd01_p3_plus_k_1_4 = res_q_rd01_p3 + k_1_4;
+  assign mux_res_take_6 = res_take ? res_q_rd01_p3_plus_k_1_4 : res_q_rd01_p3;
+  assign res_q_q_stay0 = {res_q_q_stay0_g3, res_q_q_stay0_g2, res_q_q_stay0_g1, res_q_q_stay0_g0};
+  assign res_q_q_next0 = {res_q_q_next0_g3, res_q_q_next0_g2, res_q_q_next0_g1, res_q_q_next0_g0};
+  assign mux_res_q_popped = res_q_popped ? res_q_q_next0 : res_q_q_stay0;
+  assign res_q_head0 = res_q_bypass ? res_q_din_r0 : mux_res_q_popped;
+  assign bits_res_q_din1 = res_q_din1[15:0];
+  assign bits_res_q_din1_1 = res_q_din1[31:16];
+  assign bits_res_q_din1_2 = res_q_din1[47:32];
+  assign bits_res_q_din1_3 = res_q_din1[63:48];
+  assign mux_res_take_7 = res_take ? res_q_rd11_p1 : res_q_rd1_p1;
+  assign res_q_rd11_p1_plus_k_1_4 = res_q_rd11_p1 + k_1_4;
+  assign mux_res_take_8 = res_take ? res_q_rd11_p1_plus_k_1_4 : res_q_rd11_p1;
+  assign mux_res_take_9 = res_take ? res_q_rd11_p2 : res_q_rd1_p2;
+  assign res_q_rd11_p2_plus_k_1_4 = res_q_rd11_p2 + k_1_4;
+  assign mux_res_take_10 = res_take ? res_q_rd11_p2_plus_k_1_4 : res_q_rd11_p2;
+  assign mux_res_take_11 = res_take ? res_q_rd11_p3 : res_q_rd1_p3;
+  assign res_q_rd11_p3_plus_k_1_4 = res_q_rd11_p3 + k_1_4;
+  assign mux_res_take_12 = res_take ? res_q_rd11_p3_plus_k_1_4 : res_q_rd11_p3;
+  assign res_q_q_stay1 = {res_q_q_stay1_g3, res_q_q_stay1_g2, res_q_q_stay1_g1, res_q_q_stay1_g0};
+  assign res_q_q_next1 = {res_q_q_next1_g3, res_q_q_next1_g2, res_q_q_next1_g1, res_q_q_next1_g0};
+  assign mux_res_q_popped_1 = res_q_popped ? res_q_q_next1 : res_q_q_stay1;
+  assign res_q_head1 = res_q_bypass ? res_q_din_r1 : mux_res_q_popped_1;
   assign res_take_c = res_q_nonempty & res_ready;
+  assign not_done_valid_r = ~done_valid_r;
+  assign rs_not_done_valid_r = {{5{1'b0}}, not_done_valid_r};
+  assign res_credits_if_take = res_credits + rs_not_done_valid_r;
   assign rs_done_valid_r = {{5{1'b0}}, done_valid_r};
-  assign minus_51 = res_credits - rs_done_valid_r;
-  assign rs_res_take_1 = {{5{1'b0}}, res_take};
-  assign res_credits_next = minus_51 + rs_res_take_1;
+  assign res_credits_if_not = res_credits - rs_done_valid_r;
+  assign res_credits_next = res_take ? res_credits_if_take : res_credits_if_not;
   assign res_credits_ge1 = k_1_6 <= res_credits;
   assign res_credits_ge2 = k_2_1 <= res_credits;
   assign res_credits_ge3 = k_3_1 <= res_credits;
@@ -1288,8 +1698,6 @@ module fxrt_core_sf0a3f4 (
   assign res_u_q = res_q_head1[63:32];
 
   always @(posedge clk) begin : result_queue_regs
-    if (rst) res_q_push <= 1'h0;
-    else res_q_push <= u_closest_res_valid;
     if (rst) res_q_wr <= 4'h0;
     else res_q_wr <= mux_res_q_push;
     if (rst) res_q_rd <= 4'h0;
@@ -1300,16 +1708,65 @@ module fxrt_core_sf0a3f4 (
     else res_q_rd1 <= mux_res_take;
     if (rst) res_q_bypass <= 1'h0;
     else res_q_bypass <= res_q_bypass_c;
+    if (rst) res_q_popped <= 1'h0;
+    else res_q_popped <= res_take;
     if (rst) res_q_nonempty <= 1'h0;
     else res_q_nonempty <= res_q_nonempty_c;
     res_q_din0 <= cat_41;
-    res_q_q0 <= res_q_mem0[res_q_rd_next];
+    if (rst) res_q_rd0_p1 <= 4'h0;
+    else res_q_rd0_p1 <= mux_res_take_1;
+    if (rst) res_q_rd01_p1 <= 4'h1;
+    else res_q_rd01_p1 <= mux_res_take_2;
+    if (rst) res_q_rd0_p2 <= 4'h0;
+    else res_q_rd0_p2 <= mux_res_take_3;
+    if (rst) res_q_rd01_p2 <= 4'h1;
+    else res_q_rd01_p2 <= mux_res_take_4;
+    if (rst) res_q_rd0_p3 <= 4'h0;
+    else res_q_rd0_p3 <= mux_res_take_5;
+    if (rst) res_q_rd01_p3 <= 4'h1;
+    else res_q_rd01_p3 <= mux_res_take_6;
+    res_q_q_stay0_g3 <= res_q_mem0_g3[res_q_rd0_p3];
+    res_q_q_stay0_g2 <= res_q_mem0_g2[res_q_rd0_p2];
+    res_q_q_stay0_g1 <= res_q_mem0_g1[res_q_rd0_p1];
+    res_q_q_stay0_g0 <= res_q_mem0_g0[res_q_rd];
+    res_q_q_next0_g3 <= res_q_mem0_g3[res_q_rd01_p3];
+    res_q_q_next0_g2 <= res_q_mem0_g2[res_q_rd01_p2];
+    res_q_q_next0_g1 <= res_q_mem0_g1[res_q_rd01_p1];
+    res_q_q_next0_g0 <= res_q_mem0_g0[res_q_rd1];
     if (res_q_push) res_q_din_r0 <= res_q_din0;
     res_q_din1 <= cat_42;
-    res_q_q1 <= res_q_mem1[res_q_rd_next];
+    if (rst) res_q_rd1_p1 <= 4'h0;
+    else res_q_rd1_p1 <= mux_res_take_7;
+    if (rst) res_q_rd11_p1 <= 4'h1;
+    else res_q_rd11_p1 <= mux_res_take_8;
+    if (rst) res_q_rd1_p2 <= 4'h0;
+    else res_q_rd1_p2 <= mux_res_take_9;
+    if (rst) res_q_rd11_p2 <= 4'h1;
+    else res_q_rd11_p2 <= mux_res_take_10;
+    if (rst) res_q_rd1_p3 <= 4'h0;
+    else res_q_rd1_p3 <= mux_res_take_11;
+    if (rst) res_q_rd11_p3 <= 4'h1;
+    else res_q_rd11_p3 <= mux_res_take_12;
+    res_q_q_stay1_g3 <= res_q_mem1_g3[res_q_rd1_p3];
+    res_q_q_stay1_g2 <= res_q_mem1_g2[res_q_rd1_p2];
+    res_q_q_stay1_g1 <= res_q_mem1_g1[res_q_rd1_p1];
+    res_q_q_stay1_g0 <= res_q_mem1_g0[res_q_rd];
+    res_q_q_next1_g3 <= res_q_mem1_g3[res_q_rd11_p3];
+    res_q_q_next1_g2 <= res_q_mem1_g2[res_q_rd11_p2];
+    res_q_q_next1_g1 <= res_q_mem1_g1[res_q_rd11_p1];
+    res_q_q_next1_g0 <= res_q_mem1_g0[res_q_rd1];
     if (res_q_push) res_q_din_r1 <= res_q_din1;
     if (rst) res_credits <= 6'h10;
     else res_credits <= res_credits_next;
+  end
+
+  // register copies res_q_push_copies: res_q_push and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : res_q_push_copies_regs
+    if (rst) res_q_push <= 1'h0;
+    else res_q_push <= u_closest_res_valid;
+    if (rst) res_q_push_c1 <= 1'h0;
+    else res_q_push_c1 <= u_closest_res_valid;
   end
 
   fxrt_mul_s30xs48_d3l1 u_plane_product (
@@ -1322,8 +1779,36 @@ module fxrt_core_sf0a3f4 (
   fxrt_traverse_k64_sf0a3f4 u_traverse_0 (
     .clk(clk),
     .rst(rst),
-    .ray_we(u0_alloc),
-    .ray_slot(bits_accept_slot_c14),
+    .ray_we_g0(u0_accept),
+    .ray_slot_g0(bits_accept_slot_c14),
+    .ray_we_g1(u0_accept_c1),
+    .ray_slot_g1(bits_accept_slot_c15),
+    .ray_we_g2(u0_accept_c2),
+    .ray_slot_g2(bits_accept_slot_c16),
+    .ray_we_g3(u0_accept_c3),
+    .ray_slot_g3(bits_accept_slot_c17),
+    .ray_we_g4(u0_accept_c4),
+    .ray_slot_g4(bits_accept_slot_c18),
+    .ray_we_g5(u0_accept_c5),
+    .ray_slot_g5(bits_accept_slot_c19),
+    .ray_we_g6(u0_accept_c6),
+    .ray_slot_g6(bits_accept_slot_c20),
+    .ray_we_g7(u0_accept_c7),
+    .ray_slot_g7(bits_accept_slot_c21),
+    .ray_we_g8(u0_accept_c8),
+    .ray_slot_g8(bits_accept_slot_c22),
+    .ray_we_g9(u0_accept_c9),
+    .ray_slot_g9(bits_accept_slot_c23),
+    .ray_we_g10(u0_accept_c10),
+    .ray_slot_g10(bits_accept_slot_c24),
+    .ray_we_g11(u0_accept_c11),
+    .ray_slot_g11(bits_accept_slot_c25),
+    .ray_we_g12(u0_accept_c12),
+    .ray_slot_g12(bits_accept_slot_c26),
+    .ray_we_g13(u0_accept_c13),
+    .ray_slot_g13(bits_accept_slot_c27),
+    .ray_we_g14(u0_accept_c14),
+    .ray_slot_g14(bits_accept_slot_c28),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1341,7 +1826,7 @@ module fxrt_core_sf0a3f4 (
     .merge_sp(merge_sp),
     .free_valid(u0_free),
     .free_slot(bits_free_slot_1),
-    .alloc(u0_alloc),
+    .alloc(u0_accept_c15),
     .leaf_pop(u0_leaf_pop),
     .done_pop(u0_done_pop),
     .node_word(u0_node_word),
@@ -1367,8 +1852,36 @@ module fxrt_core_sf0a3f4 (
   fxrt_traverse_k64_sf0a3f4 u_traverse_1 (
     .clk(clk),
     .rst(rst),
-    .ray_we(u1_alloc),
-    .ray_slot(bits_accept_slot_c15),
+    .ray_we_g0(u1_accept),
+    .ray_slot_g0(bits_accept_slot_c29),
+    .ray_we_g1(u1_accept_c1),
+    .ray_slot_g1(bits_accept_slot_c30),
+    .ray_we_g2(u1_accept_c2),
+    .ray_slot_g2(bits_accept_slot_c31),
+    .ray_we_g3(u1_accept_c3),
+    .ray_slot_g3(bits_accept_slot_c32),
+    .ray_we_g4(u1_accept_c4),
+    .ray_slot_g4(bits_accept_slot_c33),
+    .ray_we_g5(u1_accept_c5),
+    .ray_slot_g5(bits_accept_slot_c34),
+    .ray_we_g6(u1_accept_c6),
+    .ray_slot_g6(bits_accept_slot_c35),
+    .ray_we_g7(u1_accept_c7),
+    .ray_slot_g7(bits_accept_slot_c36),
+    .ray_we_g8(u1_accept_c8),
+    .ray_slot_g8(bits_accept_slot_c37),
+    .ray_we_g9(u1_accept_c9),
+    .ray_slot_g9(bits_accept_slot_c38),
+    .ray_we_g10(u1_accept_c10),
+    .ray_slot_g10(bits_accept_slot_c39),
+    .ray_we_g11(u1_accept_c11),
+    .ray_slot_g11(bits_accept_slot_c40),
+    .ray_we_g12(u1_accept_c12),
+    .ray_slot_g12(bits_accept_slot_c41),
+    .ray_we_g13(u1_accept_c13),
+    .ray_slot_g13(bits_accept_slot_c42),
+    .ray_we_g14(u1_accept_c14),
+    .ray_slot_g14(bits_accept_slot_c43),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1386,7 +1899,7 @@ module fxrt_core_sf0a3f4 (
     .merge_sp(merge_sp),
     .free_valid(u1_free),
     .free_slot(bits_free_slot_3),
-    .alloc(u1_alloc),
+    .alloc(u1_accept_c15),
     .leaf_pop(u1_leaf_pop),
     .done_pop(u1_done_pop),
     .node_word(u1_node_word),
@@ -1444,7 +1957,7 @@ module fxrt_core_sf0a3f4 (
   fxrt_intersect_n29_m32_t0_e18_tag59_c150 u_intersect (
     .clk(clk),
     .rst(rst),
-    .valid(pipe_valid_3),
+    .valid(pipe_valid_4),
     .tag(pipe_tag),
     .ox(bits_pipe_o),
     .oy(bits_pipe_o_1),

@@ -43,8 +43,36 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
     port (
       clk : in std_logic;
       rst : in std_logic;
-      ray_we : in unsigned(0 downto 0);
-      ray_slot : in unsigned(5 downto 0);
+      ray_we_g0 : in unsigned(0 downto 0);
+      ray_slot_g0 : in unsigned(5 downto 0);
+      ray_we_g1 : in unsigned(0 downto 0);
+      ray_slot_g1 : in unsigned(5 downto 0);
+      ray_we_g2 : in unsigned(0 downto 0);
+      ray_slot_g2 : in unsigned(5 downto 0);
+      ray_we_g3 : in unsigned(0 downto 0);
+      ray_slot_g3 : in unsigned(5 downto 0);
+      ray_we_g4 : in unsigned(0 downto 0);
+      ray_slot_g4 : in unsigned(5 downto 0);
+      ray_we_g5 : in unsigned(0 downto 0);
+      ray_slot_g5 : in unsigned(5 downto 0);
+      ray_we_g6 : in unsigned(0 downto 0);
+      ray_slot_g6 : in unsigned(5 downto 0);
+      ray_we_g7 : in unsigned(0 downto 0);
+      ray_slot_g7 : in unsigned(5 downto 0);
+      ray_we_g8 : in unsigned(0 downto 0);
+      ray_slot_g8 : in unsigned(5 downto 0);
+      ray_we_g9 : in unsigned(0 downto 0);
+      ray_slot_g9 : in unsigned(5 downto 0);
+      ray_we_g10 : in unsigned(0 downto 0);
+      ray_slot_g10 : in unsigned(5 downto 0);
+      ray_we_g11 : in unsigned(0 downto 0);
+      ray_slot_g11 : in unsigned(5 downto 0);
+      ray_we_g12 : in unsigned(0 downto 0);
+      ray_slot_g12 : in unsigned(5 downto 0);
+      ray_we_g13 : in unsigned(0 downto 0);
+      ray_slot_g13 : in unsigned(5 downto 0);
+      ray_we_g14 : in unsigned(0 downto 0);
+      ray_slot_g14 : in unsigned(5 downto 0);
       ox : in unsigned(28 downto 0);
       oy : in unsigned(28 downto 0);
       oz : in unsigned(28 downto 0);
@@ -223,11 +251,29 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   type ray_w_g5_t is array (0 to 127) of unsigned(15 downto 0);
   signal ray_w_g5 : ray_w_g5_t := (others => (others => '0'));
 
-  type res_q_mem0_t is array (0 to 15) of unsigned(63 downto 0);
-  signal res_q_mem0 : res_q_mem0_t := (others => (others => '0'));
+  type res_q_mem0_g0_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem0_g0 : res_q_mem0_g0_t := (others => (others => '0'));
 
-  type res_q_mem1_t is array (0 to 15) of unsigned(63 downto 0);
-  signal res_q_mem1 : res_q_mem1_t := (others => (others => '0'));
+  type res_q_mem0_g1_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem0_g1 : res_q_mem0_g1_t := (others => (others => '0'));
+
+  type res_q_mem0_g2_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem0_g2 : res_q_mem0_g2_t := (others => (others => '0'));
+
+  type res_q_mem0_g3_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem0_g3 : res_q_mem0_g3_t := (others => (others => '0'));
+
+  type res_q_mem1_g0_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem1_g0 : res_q_mem1_g0_t := (others => (others => '0'));
+
+  type res_q_mem1_g1_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem1_g1 : res_q_mem1_g1_t := (others => (others => '0'));
+
+  type res_q_mem1_g2_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem1_g2 : res_q_mem1_g2_t := (others => (others => '0'));
+
+  type res_q_mem1_g3_t is array (0 to 15) of unsigned(15 downto 0);
+  signal res_q_mem1_g3 : res_q_mem1_g3_t := (others => (others => '0'));
 
   attribute keep : string;
 
@@ -283,6 +329,12 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal bits_take_slot : unsigned(0 downto 0);
+  signal bits_take_slot_eq_k_0 : unsigned(0 downto 0);
+  signal u0_take : unsigned(0 downto 0);
+  signal bits_take_slot_1 : unsigned(0 downto 0);
+  signal bits_take_slot_1_eq_k_1 : unsigned(0 downto 0);
+  signal u1_take : unsigned(0 downto 0);
   signal acc_in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal acc_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal acc_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -295,6 +347,34 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal bits_accept_slot_c14 : unsigned(5 downto 0);
   signal bits_accept_slot_c15 : unsigned(5 downto 0);
+  signal bits_accept_slot_c16 : unsigned(5 downto 0);
+  signal bits_accept_slot_c17 : unsigned(5 downto 0);
+  signal bits_accept_slot_c18 : unsigned(5 downto 0);
+  signal bits_accept_slot_c19 : unsigned(5 downto 0);
+  signal bits_accept_slot_c20 : unsigned(5 downto 0);
+  signal bits_accept_slot_c21 : unsigned(5 downto 0);
+  signal bits_accept_slot_c22 : unsigned(5 downto 0);
+  signal bits_accept_slot_c23 : unsigned(5 downto 0);
+  signal bits_accept_slot_c24 : unsigned(5 downto 0);
+  signal bits_accept_slot_c25 : unsigned(5 downto 0);
+  signal bits_accept_slot_c26 : unsigned(5 downto 0);
+  signal bits_accept_slot_c27 : unsigned(5 downto 0);
+  signal bits_accept_slot_c28 : unsigned(5 downto 0);
+  signal bits_accept_slot_c29 : unsigned(5 downto 0);
+  signal bits_accept_slot_c30 : unsigned(5 downto 0);
+  signal bits_accept_slot_c31 : unsigned(5 downto 0);
+  signal bits_accept_slot_c32 : unsigned(5 downto 0);
+  signal bits_accept_slot_c33 : unsigned(5 downto 0);
+  signal bits_accept_slot_c34 : unsigned(5 downto 0);
+  signal bits_accept_slot_c35 : unsigned(5 downto 0);
+  signal bits_accept_slot_c36 : unsigned(5 downto 0);
+  signal bits_accept_slot_c37 : unsigned(5 downto 0);
+  signal bits_accept_slot_c38 : unsigned(5 downto 0);
+  signal bits_accept_slot_c39 : unsigned(5 downto 0);
+  signal bits_accept_slot_c40 : unsigned(5 downto 0);
+  signal bits_accept_slot_c41 : unsigned(5 downto 0);
+  signal bits_accept_slot_c42 : unsigned(5 downto 0);
+  signal bits_accept_slot_c43 : unsigned(5 downto 0);
 
   -- register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
   signal port_empty : unsigned(0 downto 0) := unsigned'("1");
@@ -338,7 +418,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal accept_c11 : unsigned(0 downto 0) := unsigned'("0");
   attribute keep of accept_c11 : signal is "true";
 
-  -- register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
+  -- register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
   signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot : signal is "true";
   signal accept_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
@@ -371,6 +451,130 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   attribute keep of accept_slot_c14 : signal is "true";
   signal accept_slot_c15 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c15 : signal is "true";
+  signal accept_slot_c16 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c16 : signal is "true";
+  signal accept_slot_c17 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c17 : signal is "true";
+  signal accept_slot_c18 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c18 : signal is "true";
+  signal accept_slot_c19 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c19 : signal is "true";
+  signal accept_slot_c20 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c20 : signal is "true";
+  signal accept_slot_c21 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c21 : signal is "true";
+  signal accept_slot_c22 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c22 : signal is "true";
+  signal accept_slot_c23 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c23 : signal is "true";
+  signal accept_slot_c24 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c24 : signal is "true";
+  signal accept_slot_c25 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c25 : signal is "true";
+  signal accept_slot_c26 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c26 : signal is "true";
+  signal accept_slot_c27 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c27 : signal is "true";
+  signal accept_slot_c28 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c28 : signal is "true";
+  signal accept_slot_c29 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c29 : signal is "true";
+  signal accept_slot_c30 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c30 : signal is "true";
+  signal accept_slot_c31 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c31 : signal is "true";
+  signal accept_slot_c32 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c32 : signal is "true";
+  signal accept_slot_c33 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c33 : signal is "true";
+  signal accept_slot_c34 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c34 : signal is "true";
+  signal accept_slot_c35 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c35 : signal is "true";
+  signal accept_slot_c36 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c36 : signal is "true";
+  signal accept_slot_c37 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c37 : signal is "true";
+  signal accept_slot_c38 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c38 : signal is "true";
+  signal accept_slot_c39 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c39 : signal is "true";
+  signal accept_slot_c40 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c40 : signal is "true";
+  signal accept_slot_c41 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c41 : signal is "true";
+  signal accept_slot_c42 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c42 : signal is "true";
+  signal accept_slot_c43 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_slot_c43 : signal is "true";
+
+  -- register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
+  signal u0_accept : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept : signal is "true";
+  signal u0_accept_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c1 : signal is "true";
+  signal u0_accept_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c2 : signal is "true";
+  signal u0_accept_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c3 : signal is "true";
+  signal u0_accept_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c4 : signal is "true";
+  signal u0_accept_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c5 : signal is "true";
+  signal u0_accept_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c6 : signal is "true";
+  signal u0_accept_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c7 : signal is "true";
+  signal u0_accept_c8 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c8 : signal is "true";
+  signal u0_accept_c9 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c9 : signal is "true";
+  signal u0_accept_c10 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c10 : signal is "true";
+  signal u0_accept_c11 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c11 : signal is "true";
+  signal u0_accept_c12 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c12 : signal is "true";
+  signal u0_accept_c13 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c13 : signal is "true";
+  signal u0_accept_c14 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c14 : signal is "true";
+  signal u0_accept_c15 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_c15 : signal is "true";
+
+  -- register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
+  signal u1_accept : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept : signal is "true";
+  signal u1_accept_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c1 : signal is "true";
+  signal u1_accept_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c2 : signal is "true";
+  signal u1_accept_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c3 : signal is "true";
+  signal u1_accept_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c4 : signal is "true";
+  signal u1_accept_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c5 : signal is "true";
+  signal u1_accept_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c6 : signal is "true";
+  signal u1_accept_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c7 : signal is "true";
+  signal u1_accept_c8 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c8 : signal is "true";
+  signal u1_accept_c9 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c9 : signal is "true";
+  signal u1_accept_c10 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c10 : signal is "true";
+  signal u1_accept_c11 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c11 : signal is "true";
+  signal u1_accept_c12 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c12 : signal is "true";
+  signal u1_accept_c13 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c13 : signal is "true";
+  signal u1_accept_c14 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c14 : signal is "true";
+  signal u1_accept_c15 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_c15 : signal is "true";
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -442,12 +646,12 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_d3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_plane_t : signed(32 downto 0);
   signal rs_box_d1 : signed(32 downto 0);
-  signal minus_7 : signed(32 downto 0);
+  signal minus_9 : signed(32 downto 0);
   signal box_lt1_c : unsigned(0 downto 0);
   signal box_lt1 : unsigned(0 downto 0) := unsigned'("0");
   signal rs_plane_t_1 : signed(32 downto 0);
   signal rs_box_d2 : signed(32 downto 0);
-  signal minus_8 : signed(32 downto 0);
+  signal minus_10 : signed(32 downto 0);
   signal box_lt2_c : unsigned(0 downto 0);
   signal box_lt2 : unsigned(0 downto 0) := unsigned'("0");
   signal box_lt1_d : unsigned(0 downto 0) := unsigned'("0");
@@ -456,7 +660,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_tmax : signed(31 downto 0);
   signal bits_box_d1 : unsigned(0 downto 0);
   signal bits_box_d2 : unsigned(0 downto 0);
-  signal or_9 : unsigned(0 downto 0);
+  signal or_11 : unsigned(0 downto 0);
   signal bits_box_d3 : unsigned(0 downto 0);
   signal box_miss : unsigned(0 downto 0);
   signal box_last : unsigned(0 downto 0);
@@ -482,11 +686,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u1_done_pop : unsigned(0 downto 0);
   signal u0_node_word : unsigned(72 downto 0);
   signal u1_node_word : unsigned(72 downto 0);
-  signal bits_accept_slot : unsigned(0 downto 0);
-  signal bits_accept_slot_eq_k_0 : unsigned(0 downto 0);
-  signal u0_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot : unsigned(0 downto 0);
-  signal eq_12 : unsigned(0 downto 0);
+  signal eq_13 : unsigned(0 downto 0);
   signal u0_new : unsigned(0 downto 0);
   signal bits_free_slot : unsigned(0 downto 0);
   signal bits_free_slot_eq_k_0 : unsigned(0 downto 0);
@@ -510,9 +711,6 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_traverse_0_cull : unsigned(0 downto 0);
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
-  signal bits_accept_slot_1 : unsigned(0 downto 0);
-  signal eq_14 : unsigned(0 downto 0);
-  signal u1_alloc : unsigned(0 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
   signal eq_15 : unsigned(0 downto 0);
   signal u1_new : unsigned(0 downto 0);
@@ -665,7 +863,8 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal pipe_valid_1 : unsigned(0 downto 0) := unsigned'("0");
   signal pipe_valid_2 : unsigned(0 downto 0) := unsigned'("0");
   signal pipe_valid_3 : unsigned(0 downto 0) := unsigned'("0");
-  type pipe_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
+  signal pipe_valid_4 : unsigned(0 downto 0) := unsigned'("0");
+  type pipe_tag_sr_t is array (1 to 4) of unsigned(58 downto 0);
   signal pipe_tag_sr : pipe_tag_sr_t := (others => (others => '0'));
   signal pipe_tag : unsigned(58 downto 0);
   type emit_slot_sr_sr_t is array (1 to 2) of unsigned(6 downto 0);
@@ -678,7 +877,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal ray_o_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal ray_o_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal ray_o_q : unsigned(86 downto 0);
-  type pipe_o_sr_t is array (1 to 2) of unsigned(86 downto 0);
+  type pipe_o_sr_t is array (1 to 3) of unsigned(86 downto 0);
   signal pipe_o_sr : pipe_o_sr_t := (others => (others => '0'));
   signal pipe_o : unsigned(86 downto 0);
   signal ray_w_q_g5 : unsigned(15 downto 0) := unsigned'("0000000000000000");
@@ -688,7 +887,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal ray_w_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal ray_w_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal ray_w_q : unsigned(95 downto 0);
-  type pipe_w_sr_t is array (1 to 2) of unsigned(95 downto 0);
+  type pipe_w_sr_t is array (1 to 3) of unsigned(95 downto 0);
   signal pipe_w_sr : pipe_w_sr_t := (others => (others => '0'));
   signal pipe_w : unsigned(95 downto 0);
   signal bits_pipe_o : unsigned(28 downto 0);
@@ -773,7 +972,6 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal cat_41 : unsigned(63 downto 0);
   signal cat_42 : unsigned(63 downto 0);
   signal res_take : unsigned(0 downto 0);
-  signal res_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_wr : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_count : unsigned(4 downto 0) := unsigned'("00000");
@@ -784,9 +982,11 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_rd_next : unsigned(3 downto 0);
   signal res_q_rd1_plus_k_1_4 : unsigned(3 downto 0);
   signal mux_res_take : unsigned(3 downto 0);
-  signal rs_res_take : unsigned(4 downto 0);
-  signal res_q_after_pop : unsigned(4 downto 0);
-  signal rs_res_q_push : unsigned(4 downto 0);
+  signal not_res_q_push_c1 : unsigned(0 downto 0);
+  signal rs_not_res_q_push_c1 : unsigned(4 downto 0);
+  signal res_q_count_if_pop : unsigned(4 downto 0);
+  signal rs_res_q_push_c1 : unsigned(4 downto 0);
+  signal res_q_count_if_kept : unsigned(4 downto 0);
   signal res_q_count_next : unsigned(4 downto 0);
   constant k_0_5 : unsigned(4 downto 0) := unsigned'("00000");
   signal res_q_count_eq_k_0_5 : unsigned(0 downto 0);
@@ -796,6 +996,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_drained : unsigned(0 downto 0);
   signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_bypass_c : unsigned(0 downto 0);
+  signal res_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_5_lt_res_q_count : unsigned(0 downto 0);
   signal or_48 : unsigned(0 downto 0);
@@ -803,18 +1004,78 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal and_49 : unsigned(0 downto 0);
   signal res_q_nonempty_c : unsigned(0 downto 0);
   signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-  signal res_q_q0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal bits_res_q_din0 : unsigned(15 downto 0);
+  signal bits_res_q_din0_1 : unsigned(15 downto 0);
+  signal bits_res_q_din0_2 : unsigned(15 downto 0);
+  signal bits_res_q_din0_3 : unsigned(15 downto 0);
+  signal res_q_rd0_p1 : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd01_p1 : unsigned(3 downto 0) := unsigned'("0001");
+  signal mux_res_take_1 : unsigned(3 downto 0);
+  signal res_q_rd01_p1_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take_2 : unsigned(3 downto 0);
+  signal res_q_rd0_p2 : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd01_p2 : unsigned(3 downto 0) := unsigned'("0001");
+  signal mux_res_take_3 : unsigned(3 downto 0);
+  signal res_q_rd01_p2_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take_4 : unsigned(3 downto 0);
+  signal res_q_rd0_p3 : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd01_p3 : unsigned(3 downto 0) := unsigned'("0001");
+  signal mux_res_take_5 : unsigned(3 downto 0);
+  signal res_q_rd01_p3_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take_6 : unsigned(3 downto 0);
+  signal res_q_q_stay0_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay0_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay0_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay0_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay0 : unsigned(63 downto 0);
+  signal res_q_q_next0_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next0_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next0_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next0_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next0 : unsigned(63 downto 0);
+  signal mux_res_q_popped : unsigned(63 downto 0);
   signal res_q_din_r0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_head0 : unsigned(63 downto 0);
   signal res_q_din1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-  signal res_q_q1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal bits_res_q_din1 : unsigned(15 downto 0);
+  signal bits_res_q_din1_1 : unsigned(15 downto 0);
+  signal bits_res_q_din1_2 : unsigned(15 downto 0);
+  signal bits_res_q_din1_3 : unsigned(15 downto 0);
+  signal res_q_rd1_p1 : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd11_p1 : unsigned(3 downto 0) := unsigned'("0001");
+  signal mux_res_take_7 : unsigned(3 downto 0);
+  signal res_q_rd11_p1_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take_8 : unsigned(3 downto 0);
+  signal res_q_rd1_p2 : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd11_p2 : unsigned(3 downto 0) := unsigned'("0001");
+  signal mux_res_take_9 : unsigned(3 downto 0);
+  signal res_q_rd11_p2_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take_10 : unsigned(3 downto 0);
+  signal res_q_rd1_p3 : unsigned(3 downto 0) := unsigned'("0000");
+  signal res_q_rd11_p3 : unsigned(3 downto 0) := unsigned'("0001");
+  signal mux_res_take_11 : unsigned(3 downto 0);
+  signal res_q_rd11_p3_plus_k_1_4 : unsigned(3 downto 0);
+  signal mux_res_take_12 : unsigned(3 downto 0);
+  signal res_q_q_stay1_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay1_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay1_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay1_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_stay1 : unsigned(63 downto 0);
+  signal res_q_q_next1_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next1_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next1_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next1_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal res_q_q_next1 : unsigned(63 downto 0);
+  signal mux_res_q_popped_1 : unsigned(63 downto 0);
   signal res_q_din_r1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_head1 : unsigned(63 downto 0);
   signal res_take_c : unsigned(0 downto 0);
   signal res_credits : unsigned(5 downto 0) := unsigned'("010000");
+  signal not_done_valid_r : unsigned(0 downto 0);
+  signal rs_not_done_valid_r : unsigned(5 downto 0);
+  signal res_credits_if_take : unsigned(5 downto 0);
   signal rs_done_valid_r : unsigned(5 downto 0);
-  signal minus_51 : unsigned(5 downto 0);
-  signal rs_res_take_1 : unsigned(5 downto 0);
+  signal res_credits_if_not : unsigned(5 downto 0);
   signal res_credits_next : unsigned(5 downto 0);
   constant k_1_6 : unsigned(5 downto 0) := unsigned'("000001");
   signal res_credits_ge1 : unsigned(0 downto 0);
@@ -831,6 +1092,12 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_id_q : unsigned(19 downto 0);
   signal res_v_q : unsigned(31 downto 0);
   signal res_u_q : unsigned(31 downto 0);
+
+  -- register copies res_q_push_copies: res_q_push and 1 copies, to split its fan-out
+  signal res_q_push : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of res_q_push : signal is "true";
+  signal res_q_push_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of res_q_push_c1 : signal is "true";
 begin
 
   -- not in a stage or state machine
@@ -875,10 +1142,28 @@ begin
         ray_w_g5(to_integer(accept_slot_c12)) <= bits_cat_18_5;
       end if;
       if res_q_push = "1" then
-        res_q_mem0(to_integer(res_q_wr)) <= res_q_din0;
+        res_q_mem0_g0(to_integer(res_q_wr)) <= bits_res_q_din0;
       end if;
       if res_q_push = "1" then
-        res_q_mem1(to_integer(res_q_wr)) <= res_q_din1;
+        res_q_mem0_g1(to_integer(res_q_wr)) <= bits_res_q_din0_1;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem0_g2(to_integer(res_q_wr)) <= bits_res_q_din0_2;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem0_g3(to_integer(res_q_wr)) <= bits_res_q_din0_3;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem1_g0(to_integer(res_q_wr)) <= bits_res_q_din1;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem1_g1(to_integer(res_q_wr)) <= bits_res_q_din1_1;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem1_g2(to_integer(res_q_wr)) <= bits_res_q_din1_2;
+      end if;
+      if res_q_push = "1" then
+        res_q_mem1_g3(to_integer(res_q_wr)) <= bits_res_q_din1_3;
       end if;
     end if;
   end process regs;
@@ -915,8 +1200,42 @@ begin
   box_phase_plus_k_1_1 <= box_phase + k_1_1;
   box_phase_next <= box_phase_plus_k_1_1 when or_3 = "1" else box_phase;
   box_idle_next <= "1" when box_phase_next = k_0_1 else "0";
+  bits_take_slot <= unsigned(take_slot(6 downto 6));
+  bits_take_slot_eq_k_0 <= "1" when bits_take_slot = k_0 else "0";
+  u0_take <= take and bits_take_slot_eq_k_0;
+  bits_take_slot_1 <= unsigned(take_slot(6 downto 6));
+  bits_take_slot_1_eq_k_1 <= "1" when bits_take_slot_1 = k_1 else "0";
+  u1_take <= take and bits_take_slot_1_eq_k_1;
   bits_accept_slot_c14 <= unsigned(accept_slot_c14(5 downto 0));
   bits_accept_slot_c15 <= unsigned(accept_slot_c15(5 downto 0));
+  bits_accept_slot_c16 <= unsigned(accept_slot_c16(5 downto 0));
+  bits_accept_slot_c17 <= unsigned(accept_slot_c17(5 downto 0));
+  bits_accept_slot_c18 <= unsigned(accept_slot_c18(5 downto 0));
+  bits_accept_slot_c19 <= unsigned(accept_slot_c19(5 downto 0));
+  bits_accept_slot_c20 <= unsigned(accept_slot_c20(5 downto 0));
+  bits_accept_slot_c21 <= unsigned(accept_slot_c21(5 downto 0));
+  bits_accept_slot_c22 <= unsigned(accept_slot_c22(5 downto 0));
+  bits_accept_slot_c23 <= unsigned(accept_slot_c23(5 downto 0));
+  bits_accept_slot_c24 <= unsigned(accept_slot_c24(5 downto 0));
+  bits_accept_slot_c25 <= unsigned(accept_slot_c25(5 downto 0));
+  bits_accept_slot_c26 <= unsigned(accept_slot_c26(5 downto 0));
+  bits_accept_slot_c27 <= unsigned(accept_slot_c27(5 downto 0));
+  bits_accept_slot_c28 <= unsigned(accept_slot_c28(5 downto 0));
+  bits_accept_slot_c29 <= unsigned(accept_slot_c29(5 downto 0));
+  bits_accept_slot_c30 <= unsigned(accept_slot_c30(5 downto 0));
+  bits_accept_slot_c31 <= unsigned(accept_slot_c31(5 downto 0));
+  bits_accept_slot_c32 <= unsigned(accept_slot_c32(5 downto 0));
+  bits_accept_slot_c33 <= unsigned(accept_slot_c33(5 downto 0));
+  bits_accept_slot_c34 <= unsigned(accept_slot_c34(5 downto 0));
+  bits_accept_slot_c35 <= unsigned(accept_slot_c35(5 downto 0));
+  bits_accept_slot_c36 <= unsigned(accept_slot_c36(5 downto 0));
+  bits_accept_slot_c37 <= unsigned(accept_slot_c37(5 downto 0));
+  bits_accept_slot_c38 <= unsigned(accept_slot_c38(5 downto 0));
+  bits_accept_slot_c39 <= unsigned(accept_slot_c39(5 downto 0));
+  bits_accept_slot_c40 <= unsigned(accept_slot_c40(5 downto 0));
+  bits_accept_slot_c41 <= unsigned(accept_slot_c41(5 downto 0));
+  bits_accept_slot_c42 <= unsigned(accept_slot_c42(5 downto 0));
+  bits_accept_slot_c43 <= unsigned(accept_slot_c43(5 downto 0));
 
   ray_port_regs : process (clk)
   begin
@@ -1126,7 +1445,7 @@ begin
     end if;
   end process accept_copies_regs;
 
-  -- register copies accept_slot_copies: accept_slot and 15 copies, to split its fan-out
+  -- register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
 
   accept_slot_copies_regs : process (clk)
   begin
@@ -1147,8 +1466,212 @@ begin
       accept_slot_c13 <= take_slot;
       accept_slot_c14 <= take_slot;
       accept_slot_c15 <= take_slot;
+      accept_slot_c16 <= take_slot;
+      accept_slot_c17 <= take_slot;
+      accept_slot_c18 <= take_slot;
+      accept_slot_c19 <= take_slot;
+      accept_slot_c20 <= take_slot;
+      accept_slot_c21 <= take_slot;
+      accept_slot_c22 <= take_slot;
+      accept_slot_c23 <= take_slot;
+      accept_slot_c24 <= take_slot;
+      accept_slot_c25 <= take_slot;
+      accept_slot_c26 <= take_slot;
+      accept_slot_c27 <= take_slot;
+      accept_slot_c28 <= take_slot;
+      accept_slot_c29 <= take_slot;
+      accept_slot_c30 <= take_slot;
+      accept_slot_c31 <= take_slot;
+      accept_slot_c32 <= take_slot;
+      accept_slot_c33 <= take_slot;
+      accept_slot_c34 <= take_slot;
+      accept_slot_c35 <= take_slot;
+      accept_slot_c36 <= take_slot;
+      accept_slot_c37 <= take_slot;
+      accept_slot_c38 <= take_slot;
+      accept_slot_c39 <= take_slot;
+      accept_slot_c40 <= take_slot;
+      accept_slot_c41 <= take_slot;
+      accept_slot_c42 <= take_slot;
+      accept_slot_c43 <= take_slot;
     end if;
   end process accept_slot_copies_regs;
+
+  -- register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
+
+  u0_accept_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        u0_accept <= unsigned'("0");
+      else
+        u0_accept <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c1 <= unsigned'("0");
+      else
+        u0_accept_c1 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c2 <= unsigned'("0");
+      else
+        u0_accept_c2 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c3 <= unsigned'("0");
+      else
+        u0_accept_c3 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c4 <= unsigned'("0");
+      else
+        u0_accept_c4 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c5 <= unsigned'("0");
+      else
+        u0_accept_c5 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c6 <= unsigned'("0");
+      else
+        u0_accept_c6 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c7 <= unsigned'("0");
+      else
+        u0_accept_c7 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c8 <= unsigned'("0");
+      else
+        u0_accept_c8 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c9 <= unsigned'("0");
+      else
+        u0_accept_c9 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c10 <= unsigned'("0");
+      else
+        u0_accept_c10 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c11 <= unsigned'("0");
+      else
+        u0_accept_c11 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c12 <= unsigned'("0");
+      else
+        u0_accept_c12 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c13 <= unsigned'("0");
+      else
+        u0_accept_c13 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c14 <= unsigned'("0");
+      else
+        u0_accept_c14 <= u0_take;
+      end if;
+      if rst = '1' then
+        u0_accept_c15 <= unsigned'("0");
+      else
+        u0_accept_c15 <= u0_take;
+      end if;
+    end if;
+  end process u0_accept_copies_regs;
+
+  -- register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
+
+  u1_accept_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        u1_accept <= unsigned'("0");
+      else
+        u1_accept <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c1 <= unsigned'("0");
+      else
+        u1_accept_c1 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c2 <= unsigned'("0");
+      else
+        u1_accept_c2 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c3 <= unsigned'("0");
+      else
+        u1_accept_c3 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c4 <= unsigned'("0");
+      else
+        u1_accept_c4 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c5 <= unsigned'("0");
+      else
+        u1_accept_c5 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c6 <= unsigned'("0");
+      else
+        u1_accept_c6 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c7 <= unsigned'("0");
+      else
+        u1_accept_c7 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c8 <= unsigned'("0");
+      else
+        u1_accept_c8 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c9 <= unsigned'("0");
+      else
+        u1_accept_c9 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c10 <= unsigned'("0");
+      else
+        u1_accept_c10 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c11 <= unsigned'("0");
+      else
+        u1_accept_c11 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c12 <= unsigned'("0");
+      else
+        u1_accept_c12 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c13 <= unsigned'("0");
+      else
+        u1_accept_c13 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c14 <= unsigned'("0");
+      else
+        u1_accept_c14 <= u1_take;
+      end if;
+      if rst = '1' then
+        u1_accept_c15 <= unsigned'("0");
+      else
+        u1_accept_c15 <= u1_take;
+      end if;
+    end if;
+  end process u1_accept_copies_regs;
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   box_axis <= box_phase - k_1_1;
@@ -1197,20 +1720,20 @@ begin
   pu_first <= pu_clamp_valid and not_pu_clamp_last;
   rs_plane_t <= resize(plane_t, 33);
   rs_box_d1 <= resize(box_d1, 33);
-  minus_7 <= rs_plane_t - rs_box_d1;
-  box_lt1_c <= unsigned(minus_7(32 downto 32));
+  minus_9 <= rs_plane_t - rs_box_d1;
+  box_lt1_c <= unsigned(minus_9(32 downto 32));
   rs_plane_t_1 <= resize(plane_t, 33);
   rs_box_d2 <= resize(box_d2, 33);
-  minus_8 <= rs_plane_t_1 - rs_box_d2;
-  box_lt2_c <= unsigned(minus_8(32 downto 32));
+  minus_10 <= rs_plane_t_1 - rs_box_d2;
+  box_lt2_c <= unsigned(minus_10(32 downto 32));
   box_lt1_and_box_lt2 <= box_lt1 and box_lt2;
   mux_box_lt1_d <= box_d2 when box_lt1_d = "1" else box_d3;
   box_tmax <= box_d1 when box_lt1_and_box_lt2 = "1" else mux_box_lt1_d;
   bits_box_d1 <= unsigned(box_d1(31 downto 31));
   bits_box_d2 <= unsigned(box_d2(31 downto 31));
-  or_9 <= bits_box_d1 or bits_box_d2;
+  or_11 <= bits_box_d1 or bits_box_d2;
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
-  box_miss <= or_9 or bits_box_d3;
+  box_miss <= or_11 or bits_box_d3;
   box_last <= plane_t_valid and plane_t_last;
   box_done_slot <= box_done_slot_sr(11);
 
@@ -1323,20 +1846,14 @@ begin
   u1_done_pop <= u1_done_take;
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
-  bits_accept_slot <= unsigned(accept_slot(6 downto 6));
-  bits_accept_slot_eq_k_0 <= "1" when bits_accept_slot = k_0 else "0";
-  u0_alloc <= accept and bits_accept_slot_eq_k_0;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
-  eq_12 <= "1" when bits_box_done_slot = k_0 else "0";
-  u0_new <= box_done and eq_12;
+  eq_13 <= "1" when bits_box_done_slot = k_0 else "0";
+  u0_new <= box_done and eq_13;
   bits_free_slot <= unsigned(free_slot(6 downto 6));
   bits_free_slot_eq_k_0 <= "1" when bits_free_slot = k_0 else "0";
   u0_free <= free_valid and bits_free_slot_eq_k_0;
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
-  bits_accept_slot_1 <= unsigned(accept_slot(6 downto 6));
-  eq_14 <= "1" when bits_accept_slot_1 = k_1 else "0";
-  u1_alloc <= accept and eq_14;
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
   eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
   u1_new <= box_done and eq_15;
@@ -1536,12 +2053,12 @@ begin
   bits_u_tri_rom_1_data_3 <= unsigned(u_tri_rom_1_data(127 downto 96));
   tri_e2p <= signed(bits_u_tri_rom_1_data_3);
   tri_e2q <= signed(u_tri_rom_2_data);
-  pipe_tag <= pipe_tag_sr(3);
+  pipe_tag <= pipe_tag_sr(4);
   emit_slot_sr <= emit_slot_sr_sr(2);
   ray_o_q <= unsigned(std_logic_vector'(std_logic_vector(ray_o_q_g5) & std_logic_vector(ray_o_q_g4) & std_logic_vector(ray_o_q_g3) & std_logic_vector(ray_o_q_g2) & std_logic_vector(ray_o_q_g1) & std_logic_vector(ray_o_q_g0)));
-  pipe_o <= pipe_o_sr(2);
+  pipe_o <= pipe_o_sr(3);
   ray_w_q <= unsigned(std_logic_vector'(std_logic_vector(ray_w_q_g5) & std_logic_vector(ray_w_q_g4) & std_logic_vector(ray_w_q_g3) & std_logic_vector(ray_w_q_g2) & std_logic_vector(ray_w_q_g1) & std_logic_vector(ray_w_q_g0)));
-  pipe_w <= pipe_w_sr(2);
+  pipe_w <= pipe_w_sr(3);
   bits_pipe_o <= unsigned(pipe_o(28 downto 0));
   bits_pipe_o_1 <= unsigned(pipe_o(57 downto 29));
   bits_pipe_o_2 <= unsigned(pipe_o(86 downto 58));
@@ -1587,7 +2104,12 @@ begin
       else
         pipe_valid_3 <= pipe_valid_2;
       end if;
-      pipe_tag_sr(2 to 3) <= pipe_tag_sr(1 to 2);
+      if rst = '1' then
+        pipe_valid_4 <= unsigned'("0");
+      else
+        pipe_valid_4 <= pipe_valid_3;
+      end if;
+      pipe_tag_sr(2 to 4) <= pipe_tag_sr(1 to 3);
       pipe_tag_sr(1) <= emit_tag_tri;
       emit_slot_sr_sr(2 to 2) <= emit_slot_sr_sr(1 to 1);
       emit_slot_sr_sr(1) <= leaf_slot;
@@ -1597,7 +2119,7 @@ begin
       ray_o_q_g2 <= ray_o_g2(to_integer(emit_slot_1_c2));
       ray_o_q_g1 <= ray_o_g1(to_integer(emit_slot_1_c1));
       ray_o_q_g0 <= ray_o_g0(to_integer(emit_slot_1));
-      pipe_o_sr(2 to 2) <= pipe_o_sr(1 to 1);
+      pipe_o_sr(2 to 3) <= pipe_o_sr(1 to 2);
       pipe_o_sr(1) <= ray_o_q;
       ray_w_q_g5 <= ray_w_g5(to_integer(emit_slot_1_c11));
       ray_w_q_g4 <= ray_w_g4(to_integer(emit_slot_1_c10));
@@ -1605,7 +2127,7 @@ begin
       ray_w_q_g2 <= ray_w_g2(to_integer(emit_slot_1_c8));
       ray_w_q_g1 <= ray_w_g1(to_integer(emit_slot_1_c7));
       ray_w_q_g0 <= ray_w_g0(to_integer(emit_slot_1_c6));
-      pipe_w_sr(2 to 2) <= pipe_w_sr(1 to 1);
+      pipe_w_sr(2 to 3) <= pipe_w_sr(1 to 2);
       pipe_w_sr(1) <= ray_w_q;
     end if;
   end process emission_regs;
@@ -1680,27 +2202,63 @@ begin
   res_q_rd_next <= res_q_rd1 when res_take = "1" else res_q_rd;
   res_q_rd1_plus_k_1_4 <= res_q_rd1 + k_1_4;
   mux_res_take <= res_q_rd1_plus_k_1_4 when res_take = "1" else res_q_rd1;
-  rs_res_take <= resize(res_take, 5);
-  res_q_after_pop <= res_q_count - rs_res_take;
-  rs_res_q_push <= resize(res_q_push, 5);
-  res_q_count_next <= res_q_after_pop + rs_res_q_push;
+  not_res_q_push_c1 <= not res_q_push_c1;
+  rs_not_res_q_push_c1 <= resize(not_res_q_push_c1, 5);
+  res_q_count_if_pop <= res_q_count - rs_not_res_q_push_c1;
+  rs_res_q_push_c1 <= resize(res_q_push_c1, 5);
+  res_q_count_if_kept <= res_q_count + rs_res_q_push_c1;
+  res_q_count_next <= res_q_count_if_pop when res_take = "1" else res_q_count_if_kept;
   res_q_count_eq_k_0_5 <= "1" when res_q_count = k_0_5 else "0";
   res_q_one_left <= "1" when res_q_count = k_1_5 else "0";
   and_45 <= res_q_one_left and res_take;
   res_q_drained <= res_q_count_eq_k_0_5 or and_45;
-  res_q_bypass_c <= res_q_push and res_q_drained;
+  res_q_bypass_c <= res_q_push_c1 and res_q_drained;
   k_1_5_lt_res_q_count <= "1" when k_1_5 < res_q_count else "0";
-  or_48 <= res_q_push or k_1_5_lt_res_q_count;
+  or_48 <= res_q_push_c1 or k_1_5_lt_res_q_count;
   not_res_take <= not res_take;
   and_49 <= res_q_one_left and not_res_take;
   res_q_nonempty_c <= or_48 or and_49;
-  res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else res_q_q0;
-  res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else res_q_q1;
+  bits_res_q_din0 <= unsigned(res_q_din0(15 downto 0));
+  bits_res_q_din0_1 <= unsigned(res_q_din0(31 downto 16));
+  bits_res_q_din0_2 <= unsigned(res_q_din0(47 downto 32));
+  bits_res_q_din0_3 <= unsigned(res_q_din0(63 downto 48));
+  mux_res_take_1 <= res_q_rd01_p1 when res_take = "1" else res_q_rd0_p1;
+  res_q_rd01_p1_plus_k_1_4 <= res_q_rd01_p1 + k_1_4;
+  mux_res_take_2 <= res_q_rd01_p1_plus_k_1_4 when res_take = "1" else res_q_rd01_p1;
+  mux_res_take_3 <= res_q_rd01_p2 when res_take = "1" else res_q_rd0_p2;
+  res_q_rd01_p2_plus_k_1_4 <= res_q_rd01_p2 + k_1_4;
+  mux_res_take_4 <= res_q_rd01_p2_plus_k_1_4 when res_take = "1" else res_q_rd01_p2;
+  mux_res_take_5 <= res_q_rd01_p3 when res_take = "1" else res_q_rd0_p3;
+  res_q_rd01_p3_plus_k_1_4 <= res_q_rd01_p3 + k_1_4;
+  mux_res_take_6 <= res_q_rd01_p3_plus_k_1_4 when res_take = "1" else res_q_rd01_p3;
+  res_q_q_stay0 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_stay0_g3) & std_logic_vector(res_q_q_stay0_g2) & std_logic_vector(res_q_q_stay0_g1) & std_logic_vector(res_q_q_stay0_g0)));
+  res_q_q_next0 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_next0_g3) & std_logic_vector(res_q_q_next0_g2) & std_logic_vector(res_q_q_next0_g1) & std_logic_vector(res_q_q_next0_g0)));
+  mux_res_q_popped <= res_q_q_next0 when res_q_popped = "1" else res_q_q_stay0;
+  res_q_head0 <= res_q_din_r0 when res_q_bypass = "1" else mux_res_q_popped;
+  bits_res_q_din1 <= unsigned(res_q_din1(15 downto 0));
+  bits_res_q_din1_1 <= unsigned(res_q_din1(31 downto 16));
+  bits_res_q_din1_2 <= unsigned(res_q_din1(47 downto 32));
+  bits_res_q_din1_3 <= unsigned(res_q_din1(63 downto 48));
+  mux_res_take_7 <= res_q_rd11_p1 when res_take = "1" else res_q_rd1_p1;
+  res_q_rd11_p1_plus_k_1_4 <= res_q_rd11_p1 + k_1_4;
+  mux_res_take_8 <= res_q_rd11_p1_plus_k_1_4 when res_take = "1" else res_q_rd11_p1;
+  mux_res_take_9 <= res_q_rd11_p2 when res_take = "1" else res_q_rd1_p2;
+  res_q_rd11_p2_plus_k_1_4 <= res_q_rd11_p2 + k_1_4;
+  mux_res_take_10 <= res_q_rd11_p2_plus_k_1_4 when res_take = "1" else res_q_rd11_p2;
+  mux_res_take_11 <= res_q_rd11_p3 when res_take = "1" else res_q_rd1_p3;
+  res_q_rd11_p3_plus_k_1_4 <= res_q_rd11_p3 + k_1_4;
+  mux_res_take_12 <= res_q_rd11_p3_plus_k_1_4 when res_take = "1" else res_q_rd11_p3;
+  res_q_q_stay1 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_stay1_g3) & std_logic_vector(res_q_q_stay1_g2) & std_logic_vector(res_q_q_stay1_g1) & std_logic_vector(res_q_q_stay1_g0)));
+  res_q_q_next1 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_next1_g3) & std_logic_vector(res_q_q_next1_g2) & std_logic_vector(res_q_q_next1_g1) & std_logic_vector(res_q_q_next1_g0)));
+  mux_res_q_popped_1 <= res_q_q_next1 when res_q_popped = "1" else res_q_q_stay1;
+  res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else mux_res_q_popped_1;
   res_take_c <= res_q_nonempty and res_ready;
+  not_done_valid_r <= not done_valid_r;
+  rs_not_done_valid_r <= resize(not_done_valid_r, 6);
+  res_credits_if_take <= res_credits + rs_not_done_valid_r;
   rs_done_valid_r <= resize(done_valid_r, 6);
-  minus_51 <= res_credits - rs_done_valid_r;
-  rs_res_take_1 <= resize(res_take, 6);
-  res_credits_next <= minus_51 + rs_res_take_1;
+  res_credits_if_not <= res_credits - rs_done_valid_r;
+  res_credits_next <= res_credits_if_take when res_take = "1" else res_credits_if_not;
   res_credits_ge1 <= "1" when k_1_6 <= res_credits else "0";
   res_credits_ge2 <= "1" when k_2_1 <= res_credits else "0";
   res_credits_ge3 <= "1" when k_3_1 <= res_credits else "0";
@@ -1717,11 +2275,6 @@ begin
   result_queue_regs : process (clk)
   begin
     if rising_edge(clk) then
-      if rst = '1' then
-        res_q_push <= unsigned'("0");
-      else
-        res_q_push <= u_closest_res_valid;
-      end if;
       if rst = '1' then
         res_q_wr <= unsigned'("0000");
       else
@@ -1748,17 +2301,96 @@ begin
         res_q_bypass <= res_q_bypass_c;
       end if;
       if rst = '1' then
+        res_q_popped <= unsigned'("0");
+      else
+        res_q_popped <= res_take;
+      end if;
+      if rst = '1' then
         res_q_nonempty <= unsigned'("0");
       else
         res_q_nonempty <= res_q_nonempty_c;
       end if;
       res_q_din0 <= cat_41;
-      res_q_q0 <= res_q_mem0(to_integer(res_q_rd_next));
+      if rst = '1' then
+        res_q_rd0_p1 <= unsigned'("0000");
+      else
+        res_q_rd0_p1 <= mux_res_take_1;
+      end if;
+      if rst = '1' then
+        res_q_rd01_p1 <= unsigned'("0001");
+      else
+        res_q_rd01_p1 <= mux_res_take_2;
+      end if;
+      if rst = '1' then
+        res_q_rd0_p2 <= unsigned'("0000");
+      else
+        res_q_rd0_p2 <= mux_res_take_3;
+      end if;
+      if rst = '1' then
+        res_q_rd01_p2 <= unsigned'("0001");
+      else
+        res_q_rd01_p2 <= mux_res_take_4;
+      end if;
+      if rst = '1' then
+        res_q_rd0_p3 <= unsigned'("0000");
+      else
+        res_q_rd0_p3 <= mux_res_take_5;
+      end if;
+      if rst = '1' then
+        res_q_rd01_p3 <= unsigned'("0001");
+      else
+        res_q_rd01_p3 <= mux_res_take_6;
+      end if;
+      res_q_q_stay0_g3 <= res_q_mem0_g3(to_integer(res_q_rd0_p3));
+      res_q_q_stay0_g2 <= res_q_mem0_g2(to_integer(res_q_rd0_p2));
+      res_q_q_stay0_g1 <= res_q_mem0_g1(to_integer(res_q_rd0_p1));
+      res_q_q_stay0_g0 <= res_q_mem0_g0(to_integer(res_q_rd));
+      res_q_q_next0_g3 <= res_q_mem0_g3(to_integer(res_q_rd01_p3));
+      res_q_q_next0_g2 <= res_q_mem0_g2(to_integer(res_q_rd01_p2));
+      res_q_q_next0_g1 <= res_q_mem0_g1(to_integer(res_q_rd01_p1));
+      res_q_q_next0_g0 <= res_q_mem0_g0(to_integer(res_q_rd1));
       if res_q_push = "1" then
         res_q_din_r0 <= res_q_din0;
       end if;
       res_q_din1 <= cat_42;
-      res_q_q1 <= res_q_mem1(to_integer(res_q_rd_next));
+      if rst = '1' then
+        res_q_rd1_p1 <= unsigned'("0000");
+      else
+        res_q_rd1_p1 <= mux_res_take_7;
+      end if;
+      if rst = '1' then
+        res_q_rd11_p1 <= unsigned'("0001");
+      else
+        res_q_rd11_p1 <= mux_res_take_8;
+      end if;
+      if rst = '1' then
+        res_q_rd1_p2 <= unsigned'("0000");
+      else
+        res_q_rd1_p2 <= mux_res_take_9;
+      end if;
+      if rst = '1' then
+        res_q_rd11_p2 <= unsigned'("0001");
+      else
+        res_q_rd11_p2 <= mux_res_take_10;
+      end if;
+      if rst = '1' then
+        res_q_rd1_p3 <= unsigned'("0000");
+      else
+        res_q_rd1_p3 <= mux_res_take_11;
+      end if;
+      if rst = '1' then
+        res_q_rd11_p3 <= unsigned'("0001");
+      else
+        res_q_rd11_p3 <= mux_res_take_12;
+      end if;
+      res_q_q_stay1_g3 <= res_q_mem1_g3(to_integer(res_q_rd1_p3));
+      res_q_q_stay1_g2 <= res_q_mem1_g2(to_integer(res_q_rd1_p2));
+      res_q_q_stay1_g1 <= res_q_mem1_g1(to_integer(res_q_rd1_p1));
+      res_q_q_stay1_g0 <= res_q_mem1_g0(to_integer(res_q_rd));
+      res_q_q_next1_g3 <= res_q_mem1_g3(to_integer(res_q_rd11_p3));
+      res_q_q_next1_g2 <= res_q_mem1_g2(to_integer(res_q_rd11_p2));
+      res_q_q_next1_g1 <= res_q_mem1_g1(to_integer(res_q_rd11_p1));
+      res_q_q_next1_g0 <= res_q_mem1_g0(to_integer(res_q_rd1));
       if res_q_push = "1" then
         res_q_din_r1 <= res_q_din1;
       end if;
@@ -1769,6 +2401,24 @@ begin
       end if;
     end if;
   end process result_queue_regs;
+
+  -- register copies res_q_push_copies: res_q_push and 1 copies, to split its fan-out
+
+  res_q_push_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        res_q_push <= unsigned'("0");
+      else
+        res_q_push <= u_closest_res_valid;
+      end if;
+      if rst = '1' then
+        res_q_push_c1 <= unsigned'("0");
+      else
+        res_q_push_c1 <= u_closest_res_valid;
+      end if;
+    end if;
+  end process res_q_push_copies_regs;
 
   u_plane_product : fxrt_mul_s30xs48_d3l1
     port map (
@@ -1782,8 +2432,36 @@ begin
     port map (
       clk => clk,
       rst => rst,
-      ray_we => u0_alloc,
-      ray_slot => bits_accept_slot_c14,
+      ray_we_g0 => u0_accept,
+      ray_slot_g0 => bits_accept_slot_c14,
+      ray_we_g1 => u0_accept_c1,
+      ray_slot_g1 => bits_accept_slot_c15,
+      ray_we_g2 => u0_accept_c2,
+      ray_slot_g2 => bits_accept_slot_c16,
+      ray_we_g3 => u0_accept_c3,
+      ray_slot_g3 => bits_accept_slot_c17,
+      ray_we_g4 => u0_accept_c4,
+      ray_slot_g4 => bits_accept_slot_c18,
+      ray_we_g5 => u0_accept_c5,
+      ray_slot_g5 => bits_accept_slot_c19,
+      ray_we_g6 => u0_accept_c6,
+      ray_slot_g6 => bits_accept_slot_c20,
+      ray_we_g7 => u0_accept_c7,
+      ray_slot_g7 => bits_accept_slot_c21,
+      ray_we_g8 => u0_accept_c8,
+      ray_slot_g8 => bits_accept_slot_c22,
+      ray_we_g9 => u0_accept_c9,
+      ray_slot_g9 => bits_accept_slot_c23,
+      ray_we_g10 => u0_accept_c10,
+      ray_slot_g10 => bits_accept_slot_c24,
+      ray_we_g11 => u0_accept_c11,
+      ray_slot_g11 => bits_accept_slot_c25,
+      ray_we_g12 => u0_accept_c12,
+      ray_slot_g12 => bits_accept_slot_c26,
+      ray_we_g13 => u0_accept_c13,
+      ray_slot_g13 => bits_accept_slot_c27,
+      ray_we_g14 => u0_accept_c14,
+      ray_slot_g14 => bits_accept_slot_c28,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -1801,7 +2479,7 @@ begin
       merge_sp => merge_sp,
       free_valid => u0_free,
       free_slot => bits_free_slot_1,
-      alloc => u0_alloc,
+      alloc => u0_accept_c15,
       leaf_pop => u0_leaf_pop,
       done_pop => u0_done_pop,
       node_word => u0_node_word,
@@ -1828,8 +2506,36 @@ begin
     port map (
       clk => clk,
       rst => rst,
-      ray_we => u1_alloc,
-      ray_slot => bits_accept_slot_c15,
+      ray_we_g0 => u1_accept,
+      ray_slot_g0 => bits_accept_slot_c29,
+      ray_we_g1 => u1_accept_c1,
+      ray_slot_g1 => bits_accept_slot_c30,
+      ray_we_g2 => u1_accept_c2,
+      ray_slot_g2 => bits_accept_slot_c31,
+      ray_we_g3 => u1_accept_c3,
+      ray_slot_g3 => bits_accept_slot_c32,
+      ray_we_g4 => u1_accept_c4,
+      ray_slot_g4 => bits_accept_slot_c33,
+      ray_we_g5 => u1_accept_c5,
+      ray_slot_g5 => bits_accept_slot_c34,
+      ray_we_g6 => u1_accept_c6,
+      ray_slot_g6 => bits_accept_slot_c35,
+      ray_we_g7 => u1_accept_c7,
+      ray_slot_g7 => bits_accept_slot_c36,
+      ray_we_g8 => u1_accept_c8,
+      ray_slot_g8 => bits_accept_slot_c37,
+      ray_we_g9 => u1_accept_c9,
+      ray_slot_g9 => bits_accept_slot_c38,
+      ray_we_g10 => u1_accept_c10,
+      ray_slot_g10 => bits_accept_slot_c39,
+      ray_we_g11 => u1_accept_c11,
+      ray_slot_g11 => bits_accept_slot_c40,
+      ray_we_g12 => u1_accept_c12,
+      ray_slot_g12 => bits_accept_slot_c41,
+      ray_we_g13 => u1_accept_c13,
+      ray_slot_g13 => bits_accept_slot_c42,
+      ray_we_g14 => u1_accept_c14,
+      ray_slot_g14 => bits_accept_slot_c43,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -1847,7 +2553,7 @@ begin
       merge_sp => merge_sp,
       free_valid => u1_free,
       free_slot => bits_free_slot_3,
-      alloc => u1_alloc,
+      alloc => u1_accept_c15,
       leaf_pop => u1_leaf_pop,
       done_pop => u1_done_pop,
       node_word => u1_node_word,
@@ -1911,7 +2617,7 @@ begin
     port map (
       clk => clk,
       rst => rst,
-      valid => pipe_valid_3,
+      valid => pipe_valid_4,
       tag => pipe_tag,
       ox => bits_pipe_o,
       oy => bits_pipe_o_1,

@@ -51,7 +51,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   reg signed [31:0] s1_e2p = 32'sh00000000;
   reg signed [31:0] s1_e2q = 32'sh00000000;
 
-  // stage s7_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  // stage s2_permute: the ray permuted by r, so the products' operands come from registers
   wire [1:0] k_2 = 2'h2;
   wire [0:0] s1_r_eq_k_2;
   wire [1:0] k_0 = 2'h0;
@@ -67,21 +67,34 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire signed [31:0] w_r;
   wire signed [31:0] w_p;
   wire signed [31:0] w_q;
-  wire [29:0] rs_o_p;
-  wire signed [29:0] s_rs_o_p;
-  wire [29:0] rs_o_q;
-  wire signed [29:0] s_rs_o_q;
-  wire signed [32:0] rs_s1_d;
-  wire [29:0] rs_o_r;
-  wire signed [29:0] s_rs_o_r;
-  wire signed [32:0] rs_s_rs_o_r;
+  reg [28:0] s2_o_r = 29'h00000000;
+  reg [28:0] s2_o_p = 29'h00000000;
+  reg [28:0] s2_o_q = 29'h00000000;
+  reg signed [31:0] s2_w_r = 32'sh00000000;
+  reg signed [31:0] s2_w_p = 32'sh00000000;
+  reg signed [31:0] s2_w_q = 32'sh00000000;
+
+  // stage s8_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  wire [29:0] rs_s2_o_p;
+  wire signed [29:0] s_rs_s2_o_p;
+  wire [29:0] rs_s2_o_q;
+  wire signed [29:0] s_rs_s2_o_q;
+  reg signed [31:0] s1_d_d1 = 32'sh00000000;
+  wire signed [32:0] rs_s1_d_d1;
+  wire [29:0] rs_s2_o_r;
+  wire signed [29:0] s_rs_s2_o_r;
+  wire signed [32:0] rs_s_rs_s2_o_r;
   wire signed [32:0] dmo;
-  wire [29:0] rs_s1_pp;
-  wire signed [29:0] s_rs_s1_pp;
+  reg [28:0] s1_pp_d1 = 29'h00000000;
+  wire [29:0] rs_s1_pp_d1;
+  wire signed [29:0] s_rs_s1_pp_d1;
   wire signed [29:0] kp0;
-  wire [29:0] rs_s1_pq;
-  wire signed [29:0] s_rs_s1_pq;
+  reg [28:0] s1_pq_d1 = 29'h00000000;
+  wire [29:0] rs_s1_pq_d1;
+  wire signed [29:0] s_rs_s1_pq_d1;
   wire signed [29:0] kq0;
+  reg signed [31:0] s1_np_d1 = 32'sh00000000;
+  reg signed [31:0] s1_nq_d1 = 32'sh00000000;
   wire signed [61:0] u_plane_products_p0;
   wire signed [61:0] u_plane_products_p1;
   wire signed [63:0] u_plane_products_p2;
@@ -90,10 +103,10 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   integer dmo_d5_i;
   initial for (dmo_d5_i = 1; dmo_d5_i <= 5; dmo_d5_i = dmo_d5_i + 1) dmo_d5_sr[dmo_d5_i] = 33'sh000000000;
   wire signed [32:0] dmo_d5;
-  (* mem2reg *) reg signed [31:0] w_r_d5_sr [1:5];
-  integer w_r_d5_i;
-  initial for (w_r_d5_i = 1; w_r_d5_i <= 5; w_r_d5_i = w_r_d5_i + 1) w_r_d5_sr[w_r_d5_i] = 32'sh00000000;
-  wire signed [31:0] w_r_d5;
+  (* mem2reg *) reg signed [31:0] s2_w_r_d5_sr [1:5];
+  integer s2_w_r_d5_i;
+  initial for (s2_w_r_d5_i = 1; s2_w_r_d5_i <= 5; s2_w_r_d5_i = s2_w_r_d5_i + 1) s2_w_r_d5_sr[s2_w_r_d5_i] = 32'sh00000000;
+  wire signed [31:0] s2_w_r_d5;
   (* mem2reg *) reg signed [29:0] kp0_d5_sr [1:5];
   integer kp0_d5_i;
   initial for (kp0_d5_i = 1; kp0_d5_i <= 5; kp0_d5_i = kp0_d5_i + 1) kp0_d5_sr[kp0_d5_i] = 30'sh00000000;
@@ -109,43 +122,43 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire signed [64:0] rs_u_plane_products_p2;
   wire signed [64:0] rs_u_plane_products_p3;
   wire signed [64:0] wsum;
-  reg signed [62:0] s7_num1 = 63'sh0000000000000000;
-  reg signed [61:0] s7_onq = 62'sh0000000000000000;
-  reg signed [64:0] s7_wsum = 65'sh00000000000000000;
-  reg signed [31:0] s7_w_r = 32'sh00000000;
+  reg signed [62:0] s8_num1 = 63'sh0000000000000000;
+  reg signed [61:0] s8_onq = 62'sh0000000000000000;
+  reg signed [64:0] s8_wsum = 65'sh00000000000000000;
+  reg signed [31:0] s8_w_r = 32'sh00000000;
 
-  // stage s8_quotient_in: the ω sum rounded
-  wire signed [62:0] rs_s7_onq;
+  // stage s9_quotient_in: the ω sum rounded
+  wire signed [62:0] rs_s8_onq;
   wire signed [62:0] num;
   wire signed [64:0] k_1073741824 = 65'sh00000000040000000;
   wire signed [64:0] plus_5;
   wire signed [64:0] shr_plus_5;
-  reg signed [62:0] s8_num = 63'sh0000000000000000;
+  reg signed [62:0] s9_num = 63'sh0000000000000000;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 33:0 are read
-  reg signed [64:0] s8_wr = 65'sh00000000000000000;
+  reg signed [64:0] s9_wr = 65'sh00000000000000000;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  // stage s9_quotient: numerator and rounded denominator, T bits dropped
-  reg signed [31:0] s7_w_r_d1 = 32'sh00000000;
-  wire signed [33:0] rs_s7_w_r_d1;
-  wire signed [33:0] rs_s8_wr;
+  // stage s10_quotient: numerator and rounded denominator, T bits dropped
+  reg signed [31:0] s8_w_r_d1 = 32'sh00000000;
+  wire signed [33:0] rs_s8_w_r_d1;
+  wire signed [33:0] rs_s9_wr;
   wire signed [33:0] den;
-  reg signed [62:0] s9_num = 63'sh0000000000000000;
-  reg signed [33:0] s9_den = 34'sh000000000;
+  reg signed [62:0] s10_num = 63'sh0000000000000000;
+  reg signed [33:0] s10_den = 34'sh000000000;
 
-  // stage s46_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
+  // stage s47_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   wire [29:0] u_div_t_1;
   wire [0:0] u_div_ok;
   wire [30:0] rs_u_div_t_1;
   wire signed [30:0] s_rs_u_div_t_1;
-  (* mem2reg *) reg signed [31:0] w_p_d39_sr [1:39];
-  integer w_p_d39_i;
-  initial for (w_p_d39_i = 1; w_p_d39_i <= 39; w_p_d39_i = w_p_d39_i + 1) w_p_d39_sr[w_p_d39_i] = 32'sh00000000;
-  wire signed [31:0] w_p_d39;
-  (* mem2reg *) reg signed [31:0] w_q_d39_sr [1:39];
-  integer w_q_d39_i;
-  initial for (w_q_d39_i = 1; w_q_d39_i <= 39; w_q_d39_i = w_q_d39_i + 1) w_q_d39_sr[w_q_d39_i] = 32'sh00000000;
-  wire signed [31:0] w_q_d39;
+  (* mem2reg *) reg signed [31:0] s2_w_p_d39_sr [1:39];
+  integer s2_w_p_d39_i;
+  initial for (s2_w_p_d39_i = 1; s2_w_p_d39_i <= 39; s2_w_p_d39_i = s2_w_p_d39_i + 1) s2_w_p_d39_sr[s2_w_p_d39_i] = 32'sh00000000;
+  wire signed [31:0] s2_w_p_d39;
+  (* mem2reg *) reg signed [31:0] s2_w_q_d39_sr [1:39];
+  integer s2_w_q_d39_i;
+  initial for (s2_w_q_d39_i = 1; s2_w_q_d39_i <= 39; s2_w_q_d39_i = s2_w_q_d39_i + 1) s2_w_q_d39_sr[s2_w_q_d39_i] = 32'sh00000000;
+  wire signed [31:0] s2_w_q_d39;
   wire signed [62:0] u_moved_products_p0;
   wire signed [62:0] u_moved_products_p1;
   wire signed [62:0] k_1073741824_1 = 63'sh0000000040000000;
@@ -154,47 +167,47 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire signed [62:0] plus_8;
   wire signed [62:0] shr_plus_8;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  reg signed [62:0] s46_tp = 63'sh0000000000000000;
+  reg signed [62:0] s47_tp = 63'sh0000000000000000;
   /* verilator lint_on UNUSEDSIGNAL */
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  reg signed [62:0] s46_tq = 63'sh0000000000000000;
+  reg signed [62:0] s47_tq = 63'sh0000000000000000;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  // stage s47_point: kp, kq: the hit point relative to the first vertex
+  // stage s48_point: kp, kq: the hit point relative to the first vertex
   (* mem2reg *) reg signed [29:0] kp0_d5_d40_sr [1:40];
   integer kp0_d5_d40_i;
   initial for (kp0_d5_d40_i = 1; kp0_d5_d40_i <= 40; kp0_d5_d40_i = kp0_d5_d40_i + 1) kp0_d5_d40_sr[kp0_d5_d40_i] = 30'sh00000000;
   wire signed [29:0] kp0_d5_d40;
   wire signed [31:0] rs_kp0_d5_d40;
-  wire signed [31:0] rs_s46_tp;
+  wire signed [31:0] rs_s47_tp;
   wire signed [31:0] kp;
   (* mem2reg *) reg signed [29:0] kq0_d5_d40_sr [1:40];
   integer kq0_d5_d40_i;
   initial for (kq0_d5_d40_i = 1; kq0_d5_d40_i <= 40; kq0_d5_d40_i = kq0_d5_d40_i + 1) kq0_d5_d40_sr[kq0_d5_d40_i] = 30'sh00000000;
   wire signed [29:0] kq0_d5_d40;
   wire signed [31:0] rs_kq0_d5_d40;
-  wire signed [31:0] rs_s46_tq;
+  wire signed [31:0] rs_s47_tq;
   wire signed [31:0] kq;
-  reg signed [31:0] s47_kp = 32'sh00000000;
-  reg signed [31:0] s47_kq = 32'sh00000000;
+  reg signed [31:0] s48_kp = 32'sh00000000;
+  reg signed [31:0] s48_kq = 32'sh00000000;
 
-  // stage s53_uv: the barycentric coordinates u, v
-  (* mem2reg *) reg signed [31:0] s1_e1p_d46_sr [1:46];
-  integer s1_e1p_d46_i;
-  initial for (s1_e1p_d46_i = 1; s1_e1p_d46_i <= 46; s1_e1p_d46_i = s1_e1p_d46_i + 1) s1_e1p_d46_sr[s1_e1p_d46_i] = 32'sh00000000;
-  wire signed [31:0] s1_e1p_d46;
-  (* mem2reg *) reg signed [31:0] s1_e1q_d46_sr [1:46];
-  integer s1_e1q_d46_i;
-  initial for (s1_e1q_d46_i = 1; s1_e1q_d46_i <= 46; s1_e1q_d46_i = s1_e1q_d46_i + 1) s1_e1q_d46_sr[s1_e1q_d46_i] = 32'sh00000000;
-  wire signed [31:0] s1_e1q_d46;
-  (* mem2reg *) reg signed [31:0] s1_e2q_d46_sr [1:46];
-  integer s1_e2q_d46_i;
-  initial for (s1_e2q_d46_i = 1; s1_e2q_d46_i <= 46; s1_e2q_d46_i = s1_e2q_d46_i + 1) s1_e2q_d46_sr[s1_e2q_d46_i] = 32'sh00000000;
-  wire signed [31:0] s1_e2q_d46;
-  (* mem2reg *) reg signed [31:0] s1_e2p_d46_sr [1:46];
-  integer s1_e2p_d46_i;
-  initial for (s1_e2p_d46_i = 1; s1_e2p_d46_i <= 46; s1_e2p_d46_i = s1_e2p_d46_i + 1) s1_e2p_d46_sr[s1_e2p_d46_i] = 32'sh00000000;
-  wire signed [31:0] s1_e2p_d46;
+  // stage s54_uv: the barycentric coordinates u, v
+  (* mem2reg *) reg signed [31:0] s1_e1p_d47_sr [1:47];
+  integer s1_e1p_d47_i;
+  initial for (s1_e1p_d47_i = 1; s1_e1p_d47_i <= 47; s1_e1p_d47_i = s1_e1p_d47_i + 1) s1_e1p_d47_sr[s1_e1p_d47_i] = 32'sh00000000;
+  wire signed [31:0] s1_e1p_d47;
+  (* mem2reg *) reg signed [31:0] s1_e1q_d47_sr [1:47];
+  integer s1_e1q_d47_i;
+  initial for (s1_e1q_d47_i = 1; s1_e1q_d47_i <= 47; s1_e1q_d47_i = s1_e1q_d47_i + 1) s1_e1q_d47_sr[s1_e1q_d47_i] = 32'sh00000000;
+  wire signed [31:0] s1_e1q_d47;
+  (* mem2reg *) reg signed [31:0] s1_e2q_d47_sr [1:47];
+  integer s1_e2q_d47_i;
+  initial for (s1_e2q_d47_i = 1; s1_e2q_d47_i <= 47; s1_e2q_d47_i = s1_e2q_d47_i + 1) s1_e2q_d47_sr[s1_e2q_d47_i] = 32'sh00000000;
+  wire signed [31:0] s1_e2q_d47;
+  (* mem2reg *) reg signed [31:0] s1_e2p_d47_sr [1:47];
+  integer s1_e2p_d47_i;
+  initial for (s1_e2p_d47_i = 1; s1_e2p_d47_i <= 47; s1_e2p_d47_i = s1_e2p_d47_i + 1) s1_e2p_d47_sr[s1_e2p_d47_i] = 32'sh00000000;
+  wire signed [31:0] s1_e2p_d47;
   wire signed [63:0] u_bary_products_p0;
   wire signed [63:0] u_bary_products_p1;
   wire signed [63:0] u_bary_products_p2;
@@ -205,176 +218,177 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire signed [64:0] rs_u_bary_products_p2;
   wire signed [64:0] rs_u_bary_products_p3;
   wire signed [64:0] v_int;
-  reg signed [64:0] s53_u = 65'sh00000000000000000;
-  reg signed [64:0] s53_v = 65'sh00000000000000000;
+  reg signed [64:0] s54_u = 65'sh00000000000000000;
+  reg signed [64:0] s54_v = 65'sh00000000000000000;
 
-  // stage s54_test: u + v as two short sums; the signs
+  // stage s55_test: u + v as two short sums; the signs
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 64:49 are read
-  wire [64:0] u_s53_u;
+  wire [64:0] u_s54_u;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [15:0] bits_u_s53_u;
-  wire [16:0] rs_bits_u_s53_u;
+  wire [15:0] bits_u_s54_u;
+  wire [16:0] rs_bits_u_s54_u;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 64:49 are read
-  wire [64:0] u_s53_v;
+  wire [64:0] u_s54_v;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [15:0] bits_u_s53_v;
-  wire [16:0] rs_bits_u_s53_v;
+  wire [15:0] bits_u_s54_v;
+  wire [16:0] rs_bits_u_s54_v;
   wire [16:0] uv_sum_high;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 48:0 are read
-  wire [64:0] u_s53_u_1;
+  wire [64:0] u_s54_u_1;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [48:0] bits_u_s53_u_1;
-  wire [49:0] rs_bits_u_s53_u_1;
+  wire [48:0] bits_u_s54_u_1;
+  wire [49:0] rs_bits_u_s54_u_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 48:0 are read
-  wire [64:0] u_s53_v_1;
+  wire [64:0] u_s54_v_1;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [48:0] bits_u_s53_v_1;
-  wire [49:0] rs_bits_u_s53_v_1;
+  wire [48:0] bits_u_s54_v_1;
+  wire [49:0] rs_bits_u_s54_v_1;
   wire [49:0] uv_sum_low;
   wire signed [64:0] k_0_1 = 65'sh00000000000000000;
-  wire [0:0] s53_u_lt_k_0_1;
-  wire [0:0] s53_v_lt_k_0_1;
+  wire [0:0] s54_u_lt_k_0_1;
+  wire [0:0] s54_v_lt_k_0_1;
   wire [0:0] negative;
-  reg [16:0] s54_hs = 17'h00000;
-  reg [49:0] s54_ls = 50'h0000000000000;
-  reg [0:0] s54_neg = 1'h0;
+  reg [16:0] s55_hs = 17'h00000;
+  reg [49:0] s55_ls = 50'h0000000000000;
+  reg [0:0] s55_neg = 1'h0;
 
-  // stage s55_hit: the hit bit
-  wire [15:0] bits_s54_hs;
-  wire [7:0] bits_bits_s54_hs;
+  // stage s56_hit: the hit bit
+  wire [15:0] bits_s55_hs;
+  wire [7:0] bits_bits_s55_hs;
   wire [7:0] k_0_2 = 8'h00;
   wire [0:0] ne_16;
-  wire [7:0] bits_bits_s54_hs_1;
+  wire [7:0] bits_bits_s55_hs_1;
   wire [0:0] ne_17;
   wire [1:0] high;
-  wire [0:0] bits_s54_hs_1;
-  wire [0:0] bits_s54_ls;
-  wire [48:0] bits_s54_ls_1;
-  wire [0:0] bits_bits_s54_ls_1;
+  wire [0:0] bits_s55_hs_1;
+  wire [0:0] bits_s55_ls;
+  wire [48:0] bits_s55_ls_1;
+  wire [0:0] bits_bits_s55_ls_1;
   wire [0:0] k_0_3 = 1'h0;
   wire [0:0] ne_19;
-  wire [7:0] bits_bits_s54_ls_1_1;
+  wire [7:0] bits_bits_s55_ls_1_1;
   wire [0:0] ne_20;
-  wire [7:0] bits_bits_s54_ls_1_2;
+  wire [7:0] bits_bits_s55_ls_1_2;
   wire [0:0] ne_21;
-  wire [7:0] bits_bits_s54_ls_1_3;
+  wire [7:0] bits_bits_s55_ls_1_3;
   wire [0:0] ne_22;
-  wire [7:0] bits_bits_s54_ls_1_4;
+  wire [7:0] bits_bits_s55_ls_1_4;
   wire [0:0] ne_23;
-  wire [7:0] bits_bits_s54_ls_1_5;
+  wire [7:0] bits_bits_s55_ls_1_5;
   wire [0:0] ne_24;
-  wire [7:0] bits_bits_s54_ls_1_6;
+  wire [7:0] bits_bits_s55_ls_1_6;
   wire [0:0] ne_25;
   wire [6:0] low;
   wire [6:0] k_0_4 = 7'h00;
   wire [0:0] low_ne_k_0_4;
   wire [0:0] high_ne_k_0;
   wire [0:0] or_27;
-  wire [0:0] bits_s54_hs_1_and_or_27;
+  wire [0:0] bits_s55_hs_1_and_or_27;
   wire [0:0] or_28;
   wire [0:0] and_29;
   wire [0:0] over;
-  wire [0:0] s54_neg_or_over;
-  wire [0:0] not_s54_neg_or_over;
+  wire [0:0] s55_neg_or_over;
+  wire [0:0] not_s55_neg_or_over;
   (* mem2reg *) reg [0:0] u_div_ok_d14_sr [1:14];
   integer u_div_ok_d14_i;
   initial for (u_div_ok_d14_i = 1; u_div_ok_d14_i <= 14; u_div_ok_d14_i = u_div_ok_d14_i + 1) u_div_ok_d14_sr[u_div_ok_d14_i] = 1'h0;
   wire [0:0] u_div_ok_d14;
   wire [0:0] hit_c;
-  reg [0:0] s55_hit = 1'h0;
+  reg [0:0] s56_hit = 1'h0;
 
-  // stage s56_result: the barycentric test; t, u, v zeroed on a miss
+  // stage s57_result: the barycentric test; t, u, v zeroed on a miss
   (* mem2reg *) reg [29:0] u_div_t_1_d15_sr [1:15];
   integer u_div_t_1_d15_i;
   initial for (u_div_t_1_d15_i = 1; u_div_t_1_d15_i <= 15; u_div_t_1_d15_i = u_div_t_1_d15_i + 1) u_div_t_1_d15_sr[u_div_t_1_d15_i] = 30'h00000000;
   wire [29:0] u_div_t_1_d15;
-  (* mem2reg *) reg signed [64:0] s53_u_d2_sr [1:2];
-  integer s53_u_d2_i;
-  initial for (s53_u_d2_i = 1; s53_u_d2_i <= 2; s53_u_d2_i = s53_u_d2_i + 1) s53_u_d2_sr[s53_u_d2_i] = 65'sh00000000000000000;
-  wire signed [64:0] s53_u_d2;
-  (* mem2reg *) reg signed [64:0] s53_v_d2_sr [1:2];
-  integer s53_v_d2_i;
-  initial for (s53_v_d2_i = 1; s53_v_d2_i <= 2; s53_v_d2_i = s53_v_d2_i + 1) s53_v_d2_sr[s53_v_d2_i] = 65'sh00000000000000000;
-  wire signed [64:0] s53_v_d2;
-  reg [0:0] s1_valid_d54_1 = 1'h0;
-  reg [0:0] s1_valid_d54_2 = 1'h0;
-  reg [0:0] s1_valid_d54_3 = 1'h0;
-  reg [0:0] s1_valid_d54_4 = 1'h0;
-  reg [0:0] s1_valid_d54_5 = 1'h0;
-  reg [0:0] s1_valid_d54_6 = 1'h0;
-  reg [0:0] s1_valid_d54_7 = 1'h0;
-  reg [0:0] s1_valid_d54_8 = 1'h0;
-  reg [0:0] s1_valid_d54_9 = 1'h0;
-  reg [0:0] s1_valid_d54_10 = 1'h0;
-  reg [0:0] s1_valid_d54_11 = 1'h0;
-  reg [0:0] s1_valid_d54_12 = 1'h0;
-  reg [0:0] s1_valid_d54_13 = 1'h0;
-  reg [0:0] s1_valid_d54_14 = 1'h0;
-  reg [0:0] s1_valid_d54_15 = 1'h0;
-  reg [0:0] s1_valid_d54_16 = 1'h0;
-  reg [0:0] s1_valid_d54_17 = 1'h0;
-  reg [0:0] s1_valid_d54_18 = 1'h0;
-  reg [0:0] s1_valid_d54_19 = 1'h0;
-  reg [0:0] s1_valid_d54_20 = 1'h0;
-  reg [0:0] s1_valid_d54_21 = 1'h0;
-  reg [0:0] s1_valid_d54_22 = 1'h0;
-  reg [0:0] s1_valid_d54_23 = 1'h0;
-  reg [0:0] s1_valid_d54_24 = 1'h0;
-  reg [0:0] s1_valid_d54_25 = 1'h0;
-  reg [0:0] s1_valid_d54_26 = 1'h0;
-  reg [0:0] s1_valid_d54_27 = 1'h0;
-  reg [0:0] s1_valid_d54_28 = 1'h0;
-  reg [0:0] s1_valid_d54_29 = 1'h0;
-  reg [0:0] s1_valid_d54_30 = 1'h0;
-  reg [0:0] s1_valid_d54_31 = 1'h0;
-  reg [0:0] s1_valid_d54_32 = 1'h0;
-  reg [0:0] s1_valid_d54_33 = 1'h0;
-  reg [0:0] s1_valid_d54_34 = 1'h0;
-  reg [0:0] s1_valid_d54_35 = 1'h0;
-  reg [0:0] s1_valid_d54_36 = 1'h0;
-  reg [0:0] s1_valid_d54_37 = 1'h0;
-  reg [0:0] s1_valid_d54_38 = 1'h0;
-  reg [0:0] s1_valid_d54_39 = 1'h0;
-  reg [0:0] s1_valid_d54_40 = 1'h0;
-  reg [0:0] s1_valid_d54_41 = 1'h0;
-  reg [0:0] s1_valid_d54_42 = 1'h0;
-  reg [0:0] s1_valid_d54_43 = 1'h0;
-  reg [0:0] s1_valid_d54_44 = 1'h0;
-  reg [0:0] s1_valid_d54_45 = 1'h0;
-  reg [0:0] s1_valid_d54_46 = 1'h0;
-  reg [0:0] s1_valid_d54_47 = 1'h0;
-  reg [0:0] s1_valid_d54_48 = 1'h0;
-  reg [0:0] s1_valid_d54_49 = 1'h0;
-  reg [0:0] s1_valid_d54_50 = 1'h0;
-  reg [0:0] s1_valid_d54_51 = 1'h0;
-  reg [0:0] s1_valid_d54_52 = 1'h0;
-  reg [0:0] s1_valid_d54_53 = 1'h0;
-  reg [0:0] s1_valid_d54_54 = 1'h0;
-  (* mem2reg *) reg [58:0] s1_tag_d54_sr [1:54];
-  integer s1_tag_d54_i;
-  initial for (s1_tag_d54_i = 1; s1_tag_d54_i <= 54; s1_tag_d54_i = s1_tag_d54_i + 1) s1_tag_d54_sr[s1_tag_d54_i] = 59'h000000000000000;
-  wire [58:0] s1_tag_d54;
+  (* mem2reg *) reg signed [64:0] s54_u_d2_sr [1:2];
+  integer s54_u_d2_i;
+  initial for (s54_u_d2_i = 1; s54_u_d2_i <= 2; s54_u_d2_i = s54_u_d2_i + 1) s54_u_d2_sr[s54_u_d2_i] = 65'sh00000000000000000;
+  wire signed [64:0] s54_u_d2;
+  (* mem2reg *) reg signed [64:0] s54_v_d2_sr [1:2];
+  integer s54_v_d2_i;
+  initial for (s54_v_d2_i = 1; s54_v_d2_i <= 2; s54_v_d2_i = s54_v_d2_i + 1) s54_v_d2_sr[s54_v_d2_i] = 65'sh00000000000000000;
+  wire signed [64:0] s54_v_d2;
+  reg [0:0] s1_valid_d55_1 = 1'h0;
+  reg [0:0] s1_valid_d55_2 = 1'h0;
+  reg [0:0] s1_valid_d55_3 = 1'h0;
+  reg [0:0] s1_valid_d55_4 = 1'h0;
+  reg [0:0] s1_valid_d55_5 = 1'h0;
+  reg [0:0] s1_valid_d55_6 = 1'h0;
+  reg [0:0] s1_valid_d55_7 = 1'h0;
+  reg [0:0] s1_valid_d55_8 = 1'h0;
+  reg [0:0] s1_valid_d55_9 = 1'h0;
+  reg [0:0] s1_valid_d55_10 = 1'h0;
+  reg [0:0] s1_valid_d55_11 = 1'h0;
+  reg [0:0] s1_valid_d55_12 = 1'h0;
+  reg [0:0] s1_valid_d55_13 = 1'h0;
+  reg [0:0] s1_valid_d55_14 = 1'h0;
+  reg [0:0] s1_valid_d55_15 = 1'h0;
+  reg [0:0] s1_valid_d55_16 = 1'h0;
+  reg [0:0] s1_valid_d55_17 = 1'h0;
+  reg [0:0] s1_valid_d55_18 = 1'h0;
+  reg [0:0] s1_valid_d55_19 = 1'h0;
+  reg [0:0] s1_valid_d55_20 = 1'h0;
+  reg [0:0] s1_valid_d55_21 = 1'h0;
+  reg [0:0] s1_valid_d55_22 = 1'h0;
+  reg [0:0] s1_valid_d55_23 = 1'h0;
+  reg [0:0] s1_valid_d55_24 = 1'h0;
+  reg [0:0] s1_valid_d55_25 = 1'h0;
+  reg [0:0] s1_valid_d55_26 = 1'h0;
+  reg [0:0] s1_valid_d55_27 = 1'h0;
+  reg [0:0] s1_valid_d55_28 = 1'h0;
+  reg [0:0] s1_valid_d55_29 = 1'h0;
+  reg [0:0] s1_valid_d55_30 = 1'h0;
+  reg [0:0] s1_valid_d55_31 = 1'h0;
+  reg [0:0] s1_valid_d55_32 = 1'h0;
+  reg [0:0] s1_valid_d55_33 = 1'h0;
+  reg [0:0] s1_valid_d55_34 = 1'h0;
+  reg [0:0] s1_valid_d55_35 = 1'h0;
+  reg [0:0] s1_valid_d55_36 = 1'h0;
+  reg [0:0] s1_valid_d55_37 = 1'h0;
+  reg [0:0] s1_valid_d55_38 = 1'h0;
+  reg [0:0] s1_valid_d55_39 = 1'h0;
+  reg [0:0] s1_valid_d55_40 = 1'h0;
+  reg [0:0] s1_valid_d55_41 = 1'h0;
+  reg [0:0] s1_valid_d55_42 = 1'h0;
+  reg [0:0] s1_valid_d55_43 = 1'h0;
+  reg [0:0] s1_valid_d55_44 = 1'h0;
+  reg [0:0] s1_valid_d55_45 = 1'h0;
+  reg [0:0] s1_valid_d55_46 = 1'h0;
+  reg [0:0] s1_valid_d55_47 = 1'h0;
+  reg [0:0] s1_valid_d55_48 = 1'h0;
+  reg [0:0] s1_valid_d55_49 = 1'h0;
+  reg [0:0] s1_valid_d55_50 = 1'h0;
+  reg [0:0] s1_valid_d55_51 = 1'h0;
+  reg [0:0] s1_valid_d55_52 = 1'h0;
+  reg [0:0] s1_valid_d55_53 = 1'h0;
+  reg [0:0] s1_valid_d55_54 = 1'h0;
+  reg [0:0] s1_valid_d55_55 = 1'h0;
+  (* mem2reg *) reg [58:0] s1_tag_d55_sr [1:55];
+  integer s1_tag_d55_i;
+  initial for (s1_tag_d55_i = 1; s1_tag_d55_i <= 55; s1_tag_d55_i = s1_tag_d55_i + 1) s1_tag_d55_sr[s1_tag_d55_i] = 59'h000000000000000;
+  wire [58:0] s1_tag_d55;
   wire [29:0] k_0_5 = 30'h00000000;
-  wire [29:0] mux_s55_hit;
+  wire [29:0] mux_s56_hit;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [64:0] shr_s53_u_d2;
+  wire signed [64:0] shr_s54_u_d2;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [31:0] rs_shr_s53_u_d2;
-  wire [31:0] u_rs_shr_s53_u_d2;
+  wire signed [31:0] rs_shr_s54_u_d2;
+  wire [31:0] u_rs_shr_s54_u_d2;
   wire [31:0] k_0_6 = 32'h00000000;
-  wire [31:0] mux_s55_hit_1;
+  wire [31:0] mux_s56_hit_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
-  wire signed [64:0] shr_s53_v_d2;
+  wire signed [64:0] shr_s54_v_d2;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [31:0] rs_shr_s53_v_d2;
-  wire [31:0] u_rs_shr_s53_v_d2;
-  wire [31:0] mux_s55_hit_2;
-  reg [0:0] s56_valid_out = 1'h0;
-  reg [58:0] s56_tag_out = 59'h000000000000000;
-  reg [0:0] s56_hit = 1'h0;
-  reg [29:0] s56_t = 30'h00000000;
-  reg [31:0] s56_u = 32'h00000000;
-  reg [31:0] s56_v = 32'h00000000;
+  wire signed [31:0] rs_shr_s54_v_d2;
+  wire [31:0] u_rs_shr_s54_v_d2;
+  wire [31:0] mux_s56_hit_2;
+  reg [0:0] s57_valid_out = 1'h0;
+  reg [58:0] s57_tag_out = 59'h000000000000000;
+  reg [0:0] s57_hit = 1'h0;
+  reg [29:0] s57_t = 30'h00000000;
+  reg [31:0] s57_u = 32'h00000000;
+  reg [31:0] s57_v = 32'h00000000;
 
   // not in a stage or state machine
 
@@ -402,7 +416,7 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     s1_e2q <= e2q;
   end
 
-  // stage s7_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  // stage s2_permute: the ray permuted by r, so the products' operands come from registers
   assign s1_r_eq_k_2 = s1_r == k_2;
   assign s1_r_plus_k_1 = s1_r + k_1;
   assign perm_p = s1_r_eq_k_2 ? k_0 : s1_r_plus_k_1;
@@ -433,23 +447,34 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     (perm_q == 2'h1) ? s1_wy :
     (perm_q == 2'h2) ? s1_wz :
     s1_wx;
-  assign rs_o_p = {{1{1'b0}}, o_p};
-  assign s_rs_o_p = $signed(rs_o_p);
-  assign rs_o_q = {{1{1'b0}}, o_q};
-  assign s_rs_o_q = $signed(rs_o_q);
-  assign rs_s1_d = $signed({{1{s1_d[31]}}, s1_d});
-  assign rs_o_r = {{1{1'b0}}, o_r};
-  assign s_rs_o_r = $signed(rs_o_r);
-  assign rs_s_rs_o_r = $signed({{3{s_rs_o_r[29]}}, s_rs_o_r});
-  assign dmo = rs_s1_d - rs_s_rs_o_r;
-  assign rs_s1_pp = {{1{1'b0}}, s1_pp};
-  assign s_rs_s1_pp = $signed(rs_s1_pp);
-  assign kp0 = s_rs_o_p - s_rs_s1_pp;
-  assign rs_s1_pq = {{1{1'b0}}, s1_pq};
-  assign s_rs_s1_pq = $signed(rs_s1_pq);
-  assign kq0 = s_rs_o_q - s_rs_s1_pq;
+
+  always @(posedge clk) begin : s2_permute_regs
+    s2_o_r <= o_r;
+    s2_o_p <= o_p;
+    s2_o_q <= o_q;
+    s2_w_r <= w_r;
+    s2_w_p <= w_p;
+    s2_w_q <= w_q;
+  end
+
+  // stage s8_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  assign rs_s2_o_p = {{1{1'b0}}, s2_o_p};
+  assign s_rs_s2_o_p = $signed(rs_s2_o_p);
+  assign rs_s2_o_q = {{1{1'b0}}, s2_o_q};
+  assign s_rs_s2_o_q = $signed(rs_s2_o_q);
+  assign rs_s1_d_d1 = $signed({{1{s1_d_d1[31]}}, s1_d_d1});
+  assign rs_s2_o_r = {{1{1'b0}}, s2_o_r};
+  assign s_rs_s2_o_r = $signed(rs_s2_o_r);
+  assign rs_s_rs_s2_o_r = $signed({{3{s_rs_s2_o_r[29]}}, s_rs_s2_o_r});
+  assign dmo = rs_s1_d_d1 - rs_s_rs_s2_o_r;
+  assign rs_s1_pp_d1 = {{1{1'b0}}, s1_pp_d1};
+  assign s_rs_s1_pp_d1 = $signed(rs_s1_pp_d1);
+  assign kp0 = s_rs_s2_o_p - s_rs_s1_pp_d1;
+  assign rs_s1_pq_d1 = {{1{1'b0}}, s1_pq_d1};
+  assign s_rs_s1_pq_d1 = $signed(rs_s1_pq_d1);
+  assign kq0 = s_rs_s2_o_q - s_rs_s1_pq_d1;
   assign dmo_d5 = dmo_d5_sr[5];
-  assign w_r_d5 = w_r_d5_sr[5];
+  assign s2_w_r_d5 = s2_w_r_d5_sr[5];
   assign kp0_d5 = kp0_d5_sr[5];
   assign kq0_d5 = kq0_d5_sr[5];
   assign rs_dmo_d5 = $signed({{30{dmo_d5[32]}}, dmo_d5});
@@ -460,17 +485,22 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   assign rs_u_plane_products_p3 = $signed({{1{u_plane_products_p3[63]}}, u_plane_products_p3});
   assign wsum = rs_u_plane_products_p2 + rs_u_plane_products_p3;
 
-  always @(posedge clk) begin : s7_numerator_regs
+  always @(posedge clk) begin : s8_numerator_regs
+    s1_d_d1 <= s1_d;
+    s1_pp_d1 <= s1_pp;
+    s1_pq_d1 <= s1_pq;
+    s1_np_d1 <= s1_np;
+    s1_nq_d1 <= s1_nq;
     dmo_d5_sr[5] <= dmo_d5_sr[4];
     dmo_d5_sr[4] <= dmo_d5_sr[3];
     dmo_d5_sr[3] <= dmo_d5_sr[2];
     dmo_d5_sr[2] <= dmo_d5_sr[1];
     dmo_d5_sr[1] <= dmo;
-    w_r_d5_sr[5] <= w_r_d5_sr[4];
-    w_r_d5_sr[4] <= w_r_d5_sr[3];
-    w_r_d5_sr[3] <= w_r_d5_sr[2];
-    w_r_d5_sr[2] <= w_r_d5_sr[1];
-    w_r_d5_sr[1] <= w_r;
+    s2_w_r_d5_sr[5] <= s2_w_r_d5_sr[4];
+    s2_w_r_d5_sr[4] <= s2_w_r_d5_sr[3];
+    s2_w_r_d5_sr[3] <= s2_w_r_d5_sr[2];
+    s2_w_r_d5_sr[2] <= s2_w_r_d5_sr[1];
+    s2_w_r_d5_sr[1] <= s2_w_r;
     kp0_d5_sr[5] <= kp0_d5_sr[4];
     kp0_d5_sr[4] <= kp0_d5_sr[3];
     kp0_d5_sr[3] <= kp0_d5_sr[2];
@@ -481,138 +511,138 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     kq0_d5_sr[3] <= kq0_d5_sr[2];
     kq0_d5_sr[2] <= kq0_d5_sr[1];
     kq0_d5_sr[1] <= kq0;
-    s7_num1 <= num1;
-    s7_onq <= u_plane_products_p1;
-    s7_wsum <= wsum;
-    s7_w_r <= w_r_d5;
+    s8_num1 <= num1;
+    s8_onq <= u_plane_products_p1;
+    s8_wsum <= wsum;
+    s8_w_r <= s2_w_r_d5;
   end
 
-  // stage s8_quotient_in: the ω sum rounded
-  assign rs_s7_onq = $signed({{1{s7_onq[61]}}, s7_onq});
-  assign num = s7_num1 - rs_s7_onq;
-  assign plus_5 = s7_wsum + k_1073741824;
+  // stage s9_quotient_in: the ω sum rounded
+  assign rs_s8_onq = $signed({{1{s8_onq[61]}}, s8_onq});
+  assign num = s8_num1 - rs_s8_onq;
+  assign plus_5 = s8_wsum + k_1073741824;
   assign shr_plus_5 = plus_5 >>> 31;
 
-  always @(posedge clk) begin : s8_quotient_in_regs
-    s8_num <= num;
-    s8_wr <= shr_plus_5;
+  always @(posedge clk) begin : s9_quotient_in_regs
+    s9_num <= num;
+    s9_wr <= shr_plus_5;
   end
 
-  // stage s9_quotient: numerator and rounded denominator, T bits dropped
-  assign rs_s7_w_r_d1 = $signed({{2{s7_w_r_d1[31]}}, s7_w_r_d1});
-  assign rs_s8_wr = $signed(s8_wr[33:0]);
-  assign den = rs_s7_w_r_d1 + rs_s8_wr;
+  // stage s10_quotient: numerator and rounded denominator, T bits dropped
+  assign rs_s8_w_r_d1 = $signed({{2{s8_w_r_d1[31]}}, s8_w_r_d1});
+  assign rs_s9_wr = $signed(s9_wr[33:0]);
+  assign den = rs_s8_w_r_d1 + rs_s9_wr;
 
-  always @(posedge clk) begin : s9_quotient_regs
-    s7_w_r_d1 <= s7_w_r;
-    s9_num <= s8_num;
-    s9_den <= den;
+  always @(posedge clk) begin : s10_quotient_regs
+    s8_w_r_d1 <= s8_w_r;
+    s10_num <= s9_num;
+    s10_den <= den;
   end
 
-  // stage s46_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
+  // stage s47_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   assign rs_u_div_t_1 = {{1{1'b0}}, u_div_t_1};
   assign s_rs_u_div_t_1 = $signed(rs_u_div_t_1);
-  assign w_p_d39 = w_p_d39_sr[39];
-  assign w_q_d39 = w_q_d39_sr[39];
+  assign s2_w_p_d39 = s2_w_p_d39_sr[39];
+  assign s2_w_q_d39 = s2_w_q_d39_sr[39];
   assign plus_7 = u_moved_products_p0 + k_1073741824_1;
   assign shr_plus_7 = plus_7 >>> 31;
   assign plus_8 = u_moved_products_p1 + k_1073741824_1;
   assign shr_plus_8 = plus_8 >>> 31;
 
-  always @(posedge clk) begin : s46_rounded_regs
-    w_p_d39_sr[39] <= w_p_d39_sr[38];
-    w_p_d39_sr[38] <= w_p_d39_sr[37];
-    w_p_d39_sr[37] <= w_p_d39_sr[36];
-    w_p_d39_sr[36] <= w_p_d39_sr[35];
-    w_p_d39_sr[35] <= w_p_d39_sr[34];
-    w_p_d39_sr[34] <= w_p_d39_sr[33];
-    w_p_d39_sr[33] <= w_p_d39_sr[32];
-    w_p_d39_sr[32] <= w_p_d39_sr[31];
-    w_p_d39_sr[31] <= w_p_d39_sr[30];
-    w_p_d39_sr[30] <= w_p_d39_sr[29];
-    w_p_d39_sr[29] <= w_p_d39_sr[28];
-    w_p_d39_sr[28] <= w_p_d39_sr[27];
-    w_p_d39_sr[27] <= w_p_d39_sr[26];
-    w_p_d39_sr[26] <= w_p_d39_sr[25];
-    w_p_d39_sr[25] <= w_p_d39_sr[24];
-    w_p_d39_sr[24] <= w_p_d39_sr[23];
-    w_p_d39_sr[23] <= w_p_d39_sr[22];
-    w_p_d39_sr[22] <= w_p_d39_sr[21];
-    w_p_d39_sr[21] <= w_p_d39_sr[20];
-    w_p_d39_sr[20] <= w_p_d39_sr[19];
-    w_p_d39_sr[19] <= w_p_d39_sr[18];
-    w_p_d39_sr[18] <= w_p_d39_sr[17];
-    w_p_d39_sr[17] <= w_p_d39_sr[16];
-    w_p_d39_sr[16] <= w_p_d39_sr[15];
-    w_p_d39_sr[15] <= w_p_d39_sr[14];
-    w_p_d39_sr[14] <= w_p_d39_sr[13];
-    w_p_d39_sr[13] <= w_p_d39_sr[12];
-    w_p_d39_sr[12] <= w_p_d39_sr[11];
-    w_p_d39_sr[11] <= w_p_d39_sr[10];
-    w_p_d39_sr[10] <= w_p_d39_sr[9];
-    w_p_d39_sr[9] <= w_p_d39_sr[8];
-    w_p_d39_sr[8] <= w_p_d39_sr[7];
-    w_p_d39_sr[7] <= w_p_d39_sr[6];
-    w_p_d39_sr[6] <= w_p_d39_sr[5];
-    w_p_d39_sr[5] <= w_p_d39_sr[4];
-    w_p_d39_sr[4] <= w_p_d39_sr[3];
-    w_p_d39_sr[3] <= w_p_d39_sr[2];
-    w_p_d39_sr[2] <= w_p_d39_sr[1];
-    w_p_d39_sr[1] <= w_p;
-    w_q_d39_sr[39] <= w_q_d39_sr[38];
-    w_q_d39_sr[38] <= w_q_d39_sr[37];
-    w_q_d39_sr[37] <= w_q_d39_sr[36];
-    w_q_d39_sr[36] <= w_q_d39_sr[35];
-    w_q_d39_sr[35] <= w_q_d39_sr[34];
-    w_q_d39_sr[34] <= w_q_d39_sr[33];
-    w_q_d39_sr[33] <= w_q_d39_sr[32];
-    w_q_d39_sr[32] <= w_q_d39_sr[31];
-    w_q_d39_sr[31] <= w_q_d39_sr[30];
-    w_q_d39_sr[30] <= w_q_d39_sr[29];
-    w_q_d39_sr[29] <= w_q_d39_sr[28];
-    w_q_d39_sr[28] <= w_q_d39_sr[27];
-    w_q_d39_sr[27] <= w_q_d39_sr[26];
-    w_q_d39_sr[26] <= w_q_d39_sr[25];
-    w_q_d39_sr[25] <= w_q_d39_sr[24];
-    w_q_d39_sr[24] <= w_q_d39_sr[23];
-    w_q_d39_sr[23] <= w_q_d39_sr[22];
-    w_q_d39_sr[22] <= w_q_d39_sr[21];
-    w_q_d39_sr[21] <= w_q_d39_sr[20];
-    w_q_d39_sr[20] <= w_q_d39_sr[19];
-    w_q_d39_sr[19] <= w_q_d39_sr[18];
-    w_q_d39_sr[18] <= w_q_d39_sr[17];
-    w_q_d39_sr[17] <= w_q_d39_sr[16];
-    w_q_d39_sr[16] <= w_q_d39_sr[15];
-    w_q_d39_sr[15] <= w_q_d39_sr[14];
-    w_q_d39_sr[14] <= w_q_d39_sr[13];
-    w_q_d39_sr[13] <= w_q_d39_sr[12];
-    w_q_d39_sr[12] <= w_q_d39_sr[11];
-    w_q_d39_sr[11] <= w_q_d39_sr[10];
-    w_q_d39_sr[10] <= w_q_d39_sr[9];
-    w_q_d39_sr[9] <= w_q_d39_sr[8];
-    w_q_d39_sr[8] <= w_q_d39_sr[7];
-    w_q_d39_sr[7] <= w_q_d39_sr[6];
-    w_q_d39_sr[6] <= w_q_d39_sr[5];
-    w_q_d39_sr[5] <= w_q_d39_sr[4];
-    w_q_d39_sr[4] <= w_q_d39_sr[3];
-    w_q_d39_sr[3] <= w_q_d39_sr[2];
-    w_q_d39_sr[2] <= w_q_d39_sr[1];
-    w_q_d39_sr[1] <= w_q;
-    s46_tp <= shr_plus_7;
-    s46_tq <= shr_plus_8;
+  always @(posedge clk) begin : s47_rounded_regs
+    s2_w_p_d39_sr[39] <= s2_w_p_d39_sr[38];
+    s2_w_p_d39_sr[38] <= s2_w_p_d39_sr[37];
+    s2_w_p_d39_sr[37] <= s2_w_p_d39_sr[36];
+    s2_w_p_d39_sr[36] <= s2_w_p_d39_sr[35];
+    s2_w_p_d39_sr[35] <= s2_w_p_d39_sr[34];
+    s2_w_p_d39_sr[34] <= s2_w_p_d39_sr[33];
+    s2_w_p_d39_sr[33] <= s2_w_p_d39_sr[32];
+    s2_w_p_d39_sr[32] <= s2_w_p_d39_sr[31];
+    s2_w_p_d39_sr[31] <= s2_w_p_d39_sr[30];
+    s2_w_p_d39_sr[30] <= s2_w_p_d39_sr[29];
+    s2_w_p_d39_sr[29] <= s2_w_p_d39_sr[28];
+    s2_w_p_d39_sr[28] <= s2_w_p_d39_sr[27];
+    s2_w_p_d39_sr[27] <= s2_w_p_d39_sr[26];
+    s2_w_p_d39_sr[26] <= s2_w_p_d39_sr[25];
+    s2_w_p_d39_sr[25] <= s2_w_p_d39_sr[24];
+    s2_w_p_d39_sr[24] <= s2_w_p_d39_sr[23];
+    s2_w_p_d39_sr[23] <= s2_w_p_d39_sr[22];
+    s2_w_p_d39_sr[22] <= s2_w_p_d39_sr[21];
+    s2_w_p_d39_sr[21] <= s2_w_p_d39_sr[20];
+    s2_w_p_d39_sr[20] <= s2_w_p_d39_sr[19];
+    s2_w_p_d39_sr[19] <= s2_w_p_d39_sr[18];
+    s2_w_p_d39_sr[18] <= s2_w_p_d39_sr[17];
+    s2_w_p_d39_sr[17] <= s2_w_p_d39_sr[16];
+    s2_w_p_d39_sr[16] <= s2_w_p_d39_sr[15];
+    s2_w_p_d39_sr[15] <= s2_w_p_d39_sr[14];
+    s2_w_p_d39_sr[14] <= s2_w_p_d39_sr[13];
+    s2_w_p_d39_sr[13] <= s2_w_p_d39_sr[12];
+    s2_w_p_d39_sr[12] <= s2_w_p_d39_sr[11];
+    s2_w_p_d39_sr[11] <= s2_w_p_d39_sr[10];
+    s2_w_p_d39_sr[10] <= s2_w_p_d39_sr[9];
+    s2_w_p_d39_sr[9] <= s2_w_p_d39_sr[8];
+    s2_w_p_d39_sr[8] <= s2_w_p_d39_sr[7];
+    s2_w_p_d39_sr[7] <= s2_w_p_d39_sr[6];
+    s2_w_p_d39_sr[6] <= s2_w_p_d39_sr[5];
+    s2_w_p_d39_sr[5] <= s2_w_p_d39_sr[4];
+    s2_w_p_d39_sr[4] <= s2_w_p_d39_sr[3];
+    s2_w_p_d39_sr[3] <= s2_w_p_d39_sr[2];
+    s2_w_p_d39_sr[2] <= s2_w_p_d39_sr[1];
+    s2_w_p_d39_sr[1] <= s2_w_p;
+    s2_w_q_d39_sr[39] <= s2_w_q_d39_sr[38];
+    s2_w_q_d39_sr[38] <= s2_w_q_d39_sr[37];
+    s2_w_q_d39_sr[37] <= s2_w_q_d39_sr[36];
+    s2_w_q_d39_sr[36] <= s2_w_q_d39_sr[35];
+    s2_w_q_d39_sr[35] <= s2_w_q_d39_sr[34];
+    s2_w_q_d39_sr[34] <= s2_w_q_d39_sr[33];
+    s2_w_q_d39_sr[33] <= s2_w_q_d39_sr[32];
+    s2_w_q_d39_sr[32] <= s2_w_q_d39_sr[31];
+    s2_w_q_d39_sr[31] <= s2_w_q_d39_sr[30];
+    s2_w_q_d39_sr[30] <= s2_w_q_d39_sr[29];
+    s2_w_q_d39_sr[29] <= s2_w_q_d39_sr[28];
+    s2_w_q_d39_sr[28] <= s2_w_q_d39_sr[27];
+    s2_w_q_d39_sr[27] <= s2_w_q_d39_sr[26];
+    s2_w_q_d39_sr[26] <= s2_w_q_d39_sr[25];
+    s2_w_q_d39_sr[25] <= s2_w_q_d39_sr[24];
+    s2_w_q_d39_sr[24] <= s2_w_q_d39_sr[23];
+    s2_w_q_d39_sr[23] <= s2_w_q_d39_sr[22];
+    s2_w_q_d39_sr[22] <= s2_w_q_d39_sr[21];
+    s2_w_q_d39_sr[21] <= s2_w_q_d39_sr[20];
+    s2_w_q_d39_sr[20] <= s2_w_q_d39_sr[19];
+    s2_w_q_d39_sr[19] <= s2_w_q_d39_sr[18];
+    s2_w_q_d39_sr[18] <= s2_w_q_d39_sr[17];
+    s2_w_q_d39_sr[17] <= s2_w_q_d39_sr[16];
+    s2_w_q_d39_sr[16] <= s2_w_q_d39_sr[15];
+    s2_w_q_d39_sr[15] <= s2_w_q_d39_sr[14];
+    s2_w_q_d39_sr[14] <= s2_w_q_d39_sr[13];
+    s2_w_q_d39_sr[13] <= s2_w_q_d39_sr[12];
+    s2_w_q_d39_sr[12] <= s2_w_q_d39_sr[11];
+    s2_w_q_d39_sr[11] <= s2_w_q_d39_sr[10];
+    s2_w_q_d39_sr[10] <= s2_w_q_d39_sr[9];
+    s2_w_q_d39_sr[9] <= s2_w_q_d39_sr[8];
+    s2_w_q_d39_sr[8] <= s2_w_q_d39_sr[7];
+    s2_w_q_d39_sr[7] <= s2_w_q_d39_sr[6];
+    s2_w_q_d39_sr[6] <= s2_w_q_d39_sr[5];
+    s2_w_q_d39_sr[5] <= s2_w_q_d39_sr[4];
+    s2_w_q_d39_sr[4] <= s2_w_q_d39_sr[3];
+    s2_w_q_d39_sr[3] <= s2_w_q_d39_sr[2];
+    s2_w_q_d39_sr[2] <= s2_w_q_d39_sr[1];
+    s2_w_q_d39_sr[1] <= s2_w_q;
+    s47_tp <= shr_plus_7;
+    s47_tq <= shr_plus_8;
   end
 
-  // stage s47_point: kp, kq: the hit point relative to the first vertex
+  // stage s48_point: kp, kq: the hit point relative to the first vertex
   assign kp0_d5_d40 = kp0_d5_d40_sr[40];
   assign rs_kp0_d5_d40 = $signed({{2{kp0_d5_d40[29]}}, kp0_d5_d40});
-  assign rs_s46_tp = $signed(s46_tp[31:0]);
-  assign kp = rs_kp0_d5_d40 + rs_s46_tp;
+  assign rs_s47_tp = $signed(s47_tp[31:0]);
+  assign kp = rs_kp0_d5_d40 + rs_s47_tp;
   assign kq0_d5_d40 = kq0_d5_d40_sr[40];
   assign rs_kq0_d5_d40 = $signed({{2{kq0_d5_d40[29]}}, kq0_d5_d40});
-  assign rs_s46_tq = $signed(s46_tq[31:0]);
-  assign kq = rs_kq0_d5_d40 + rs_s46_tq;
+  assign rs_s47_tq = $signed(s47_tq[31:0]);
+  assign kq = rs_kq0_d5_d40 + rs_s47_tq;
 
-  always @(posedge clk) begin : s47_point_regs
+  always @(posedge clk) begin : s48_point_regs
     kp0_d5_d40_sr[40] <= kp0_d5_d40_sr[39];
     kp0_d5_d40_sr[39] <= kp0_d5_d40_sr[38];
     kp0_d5_d40_sr[38] <= kp0_d5_d40_sr[37];
@@ -693,15 +723,15 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     kq0_d5_d40_sr[3] <= kq0_d5_d40_sr[2];
     kq0_d5_d40_sr[2] <= kq0_d5_d40_sr[1];
     kq0_d5_d40_sr[1] <= kq0_d5;
-    s47_kp <= kp;
-    s47_kq <= kq;
+    s48_kp <= kp;
+    s48_kq <= kq;
   end
 
-  // stage s53_uv: the barycentric coordinates u, v
-  assign s1_e1p_d46 = s1_e1p_d46_sr[46];
-  assign s1_e1q_d46 = s1_e1q_d46_sr[46];
-  assign s1_e2q_d46 = s1_e2q_d46_sr[46];
-  assign s1_e2p_d46 = s1_e2p_d46_sr[46];
+  // stage s54_uv: the barycentric coordinates u, v
+  assign s1_e1p_d47 = s1_e1p_d47_sr[47];
+  assign s1_e1q_d47 = s1_e1q_d47_sr[47];
+  assign s1_e2q_d47 = s1_e2q_d47_sr[47];
+  assign s1_e2p_d47 = s1_e2p_d47_sr[47];
   assign rs_u_bary_products_p0 = $signed({{1{u_bary_products_p0[63]}}, u_bary_products_p0});
   assign rs_u_bary_products_p1 = $signed({{1{u_bary_products_p1[63]}}, u_bary_products_p1});
   assign u_int = rs_u_bary_products_p0 - rs_u_bary_products_p1;
@@ -709,258 +739,262 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   assign rs_u_bary_products_p3 = $signed({{1{u_bary_products_p3[63]}}, u_bary_products_p3});
   assign v_int = rs_u_bary_products_p2 - rs_u_bary_products_p3;
 
-  always @(posedge clk) begin : s53_uv_regs
-    s1_e1p_d46_sr[46] <= s1_e1p_d46_sr[45];
-    s1_e1p_d46_sr[45] <= s1_e1p_d46_sr[44];
-    s1_e1p_d46_sr[44] <= s1_e1p_d46_sr[43];
-    s1_e1p_d46_sr[43] <= s1_e1p_d46_sr[42];
-    s1_e1p_d46_sr[42] <= s1_e1p_d46_sr[41];
-    s1_e1p_d46_sr[41] <= s1_e1p_d46_sr[40];
-    s1_e1p_d46_sr[40] <= s1_e1p_d46_sr[39];
-    s1_e1p_d46_sr[39] <= s1_e1p_d46_sr[38];
-    s1_e1p_d46_sr[38] <= s1_e1p_d46_sr[37];
-    s1_e1p_d46_sr[37] <= s1_e1p_d46_sr[36];
-    s1_e1p_d46_sr[36] <= s1_e1p_d46_sr[35];
-    s1_e1p_d46_sr[35] <= s1_e1p_d46_sr[34];
-    s1_e1p_d46_sr[34] <= s1_e1p_d46_sr[33];
-    s1_e1p_d46_sr[33] <= s1_e1p_d46_sr[32];
-    s1_e1p_d46_sr[32] <= s1_e1p_d46_sr[31];
-    s1_e1p_d46_sr[31] <= s1_e1p_d46_sr[30];
-    s1_e1p_d46_sr[30] <= s1_e1p_d46_sr[29];
-    s1_e1p_d46_sr[29] <= s1_e1p_d46_sr[28];
-    s1_e1p_d46_sr[28] <= s1_e1p_d46_sr[27];
-    s1_e1p_d46_sr[27] <= s1_e1p_d46_sr[26];
-    s1_e1p_d46_sr[26] <= s1_e1p_d46_sr[25];
-    s1_e1p_d46_sr[25] <= s1_e1p_d46_sr[24];
-    s1_e1p_d46_sr[24] <= s1_e1p_d46_sr[23];
-    s1_e1p_d46_sr[23] <= s1_e1p_d46_sr[22];
-    s1_e1p_d46_sr[22] <= s1_e1p_d46_sr[21];
-    s1_e1p_d46_sr[21] <= s1_e1p_d46_sr[20];
-    s1_e1p_d46_sr[20] <= s1_e1p_d46_sr[19];
-    s1_e1p_d46_sr[19] <= s1_e1p_d46_sr[18];
-    s1_e1p_d46_sr[18] <= s1_e1p_d46_sr[17];
-    s1_e1p_d46_sr[17] <= s1_e1p_d46_sr[16];
-    s1_e1p_d46_sr[16] <= s1_e1p_d46_sr[15];
-    s1_e1p_d46_sr[15] <= s1_e1p_d46_sr[14];
-    s1_e1p_d46_sr[14] <= s1_e1p_d46_sr[13];
-    s1_e1p_d46_sr[13] <= s1_e1p_d46_sr[12];
-    s1_e1p_d46_sr[12] <= s1_e1p_d46_sr[11];
-    s1_e1p_d46_sr[11] <= s1_e1p_d46_sr[10];
-    s1_e1p_d46_sr[10] <= s1_e1p_d46_sr[9];
-    s1_e1p_d46_sr[9] <= s1_e1p_d46_sr[8];
-    s1_e1p_d46_sr[8] <= s1_e1p_d46_sr[7];
-    s1_e1p_d46_sr[7] <= s1_e1p_d46_sr[6];
-    s1_e1p_d46_sr[6] <= s1_e1p_d46_sr[5];
-    s1_e1p_d46_sr[5] <= s1_e1p_d46_sr[4];
-    s1_e1p_d46_sr[4] <= s1_e1p_d46_sr[3];
-    s1_e1p_d46_sr[3] <= s1_e1p_d46_sr[2];
-    s1_e1p_d46_sr[2] <= s1_e1p_d46_sr[1];
-    s1_e1p_d46_sr[1] <= s1_e1p;
-    s1_e1q_d46_sr[46] <= s1_e1q_d46_sr[45];
-    s1_e1q_d46_sr[45] <= s1_e1q_d46_sr[44];
-    s1_e1q_d46_sr[44] <= s1_e1q_d46_sr[43];
-    s1_e1q_d46_sr[43] <= s1_e1q_d46_sr[42];
-    s1_e1q_d46_sr[42] <= s1_e1q_d46_sr[41];
-    s1_e1q_d46_sr[41] <= s1_e1q_d46_sr[40];
-    s1_e1q_d46_sr[40] <= s1_e1q_d46_sr[39];
-    s1_e1q_d46_sr[39] <= s1_e1q_d46_sr[38];
-    s1_e1q_d46_sr[38] <= s1_e1q_d46_sr[37];
-    s1_e1q_d46_sr[37] <= s1_e1q_d46_sr[36];
-    s1_e1q_d46_sr[36] <= s1_e1q_d46_sr[35];
-    s1_e1q_d46_sr[35] <= s1_e1q_d46_sr[34];
-    s1_e1q_d46_sr[34] <= s1_e1q_d46_sr[33];
-    s1_e1q_d46_sr[33] <= s1_e1q_d46_sr[32];
-    s1_e1q_d46_sr[32] <= s1_e1q_d46_sr[31];
-    s1_e1q_d46_sr[31] <= s1_e1q_d46_sr[30];
-    s1_e1q_d46_sr[30] <= s1_e1q_d46_sr[29];
-    s1_e1q_d46_sr[29] <= s1_e1q_d46_sr[28];
-    s1_e1q_d46_sr[28] <= s1_e1q_d46_sr[27];
-    s1_e1q_d46_sr[27] <= s1_e1q_d46_sr[26];
-    s1_e1q_d46_sr[26] <= s1_e1q_d46_sr[25];
-    s1_e1q_d46_sr[25] <= s1_e1q_d46_sr[24];
-    s1_e1q_d46_sr[24] <= s1_e1q_d46_sr[23];
-    s1_e1q_d46_sr[23] <= s1_e1q_d46_sr[22];
-    s1_e1q_d46_sr[22] <= s1_e1q_d46_sr[21];
-    s1_e1q_d46_sr[21] <= s1_e1q_d46_sr[20];
-    s1_e1q_d46_sr[20] <= s1_e1q_d46_sr[19];
-    s1_e1q_d46_sr[19] <= s1_e1q_d46_sr[18];
-    s1_e1q_d46_sr[18] <= s1_e1q_d46_sr[17];
-    s1_e1q_d46_sr[17] <= s1_e1q_d46_sr[16];
-    s1_e1q_d46_sr[16] <= s1_e1q_d46_sr[15];
-    s1_e1q_d46_sr[15] <= s1_e1q_d46_sr[14];
-    s1_e1q_d46_sr[14] <= s1_e1q_d46_sr[13];
-    s1_e1q_d46_sr[13] <= s1_e1q_d46_sr[12];
-    s1_e1q_d46_sr[12] <= s1_e1q_d46_sr[11];
-    s1_e1q_d46_sr[11] <= s1_e1q_d46_sr[10];
-    s1_e1q_d46_sr[10] <= s1_e1q_d46_sr[9];
-    s1_e1q_d46_sr[9] <= s1_e1q_d46_sr[8];
-    s1_e1q_d46_sr[8] <= s1_e1q_d46_sr[7];
-    s1_e1q_d46_sr[7] <= s1_e1q_d46_sr[6];
-    s1_e1q_d46_sr[6] <= s1_e1q_d46_sr[5];
-    s1_e1q_d46_sr[5] <= s1_e1q_d46_sr[4];
-    s1_e1q_d46_sr[4] <= s1_e1q_d46_sr[3];
-    s1_e1q_d46_sr[3] <= s1_e1q_d46_sr[2];
-    s1_e1q_d46_sr[2] <= s1_e1q_d46_sr[1];
-    s1_e1q_d46_sr[1] <= s1_e1q;
-    s1_e2q_d46_sr[46] <= s1_e2q_d46_sr[45];
-    s1_e2q_d46_sr[45] <= s1_e2q_d46_sr[44];
-    s1_e2q_d46_sr[44] <= s1_e2q_d46_sr[43];
-    s1_e2q_d46_sr[43] <= s1_e2q_d46_sr[42];
-    s1_e2q_d46_sr[42] <= s1_e2q_d46_sr[41];
-    s1_e2q_d46_sr[41] <= s1_e2q_d46_sr[40];
-    s1_e2q_d46_sr[40] <= s1_e2q_d46_sr[39];
-    s1_e2q_d46_sr[39] <= s1_e2q_d46_sr[38];
-    s1_e2q_d46_sr[38] <= s1_e2q_d46_sr[37];
-    s1_e2q_d46_sr[37] <= s1_e2q_d46_sr[36];
-    s1_e2q_d46_sr[36] <= s1_e2q_d46_sr[35];
-    s1_e2q_d46_sr[35] <= s1_e2q_d46_sr[34];
-    s1_e2q_d46_sr[34] <= s1_e2q_d46_sr[33];
-    s1_e2q_d46_sr[33] <= s1_e2q_d46_sr[32];
-    s1_e2q_d46_sr[32] <= s1_e2q_d46_sr[31];
-    s1_e2q_d46_sr[31] <= s1_e2q_d46_sr[30];
-    s1_e2q_d46_sr[30] <= s1_e2q_d46_sr[29];
-    s1_e2q_d46_sr[29] <= s1_e2q_d46_sr[28];
-    s1_e2q_d46_sr[28] <= s1_e2q_d46_sr[27];
-    s1_e2q_d46_sr[27] <= s1_e2q_d46_sr[26];
-    s1_e2q_d46_sr[26] <= s1_e2q_d46_sr[25];
-    s1_e2q_d46_sr[25] <= s1_e2q_d46_sr[24];
-    s1_e2q_d46_sr[24] <= s1_e2q_d46_sr[23];
-    s1_e2q_d46_sr[23] <= s1_e2q_d46_sr[22];
-    s1_e2q_d46_sr[22] <= s1_e2q_d46_sr[21];
-    s1_e2q_d46_sr[21] <= s1_e2q_d46_sr[20];
-    s1_e2q_d46_sr[20] <= s1_e2q_d46_sr[19];
-    s1_e2q_d46_sr[19] <= s1_e2q_d46_sr[18];
-    s1_e2q_d46_sr[18] <= s1_e2q_d46_sr[17];
-    s1_e2q_d46_sr[17] <= s1_e2q_d46_sr[16];
-    s1_e2q_d46_sr[16] <= s1_e2q_d46_sr[15];
-    s1_e2q_d46_sr[15] <= s1_e2q_d46_sr[14];
-    s1_e2q_d46_sr[14] <= s1_e2q_d46_sr[13];
-    s1_e2q_d46_sr[13] <= s1_e2q_d46_sr[12];
-    s1_e2q_d46_sr[12] <= s1_e2q_d46_sr[11];
-    s1_e2q_d46_sr[11] <= s1_e2q_d46_sr[10];
-    s1_e2q_d46_sr[10] <= s1_e2q_d46_sr[9];
-    s1_e2q_d46_sr[9] <= s1_e2q_d46_sr[8];
-    s1_e2q_d46_sr[8] <= s1_e2q_d46_sr[7];
-    s1_e2q_d46_sr[7] <= s1_e2q_d46_sr[6];
-    s1_e2q_d46_sr[6] <= s1_e2q_d46_sr[5];
-    s1_e2q_d46_sr[5] <= s1_e2q_d46_sr[4];
-    s1_e2q_d46_sr[4] <= s1_e2q_d46_sr[3];
-    s1_e2q_d46_sr[3] <= s1_e2q_d46_sr[2];
-    s1_e2q_d46_sr[2] <= s1_e2q_d46_sr[1];
-    s1_e2q_d46_sr[1] <= s1_e2q;
-    s1_e2p_d46_sr[46] <= s1_e2p_d46_sr[45];
-    s1_e2p_d46_sr[45] <= s1_e2p_d46_sr[44];
-    s1_e2p_d46_sr[44] <= s1_e2p_d46_sr[43];
-    s1_e2p_d46_sr[43] <= s1_e2p_d46_sr[42];
-    s1_e2p_d46_sr[42] <= s1_e2p_d46_sr[41];
-    s1_e2p_d46_sr[41] <= s1_e2p_d46_sr[40];
-    s1_e2p_d46_sr[40] <= s1_e2p_d46_sr[39];
-    s1_e2p_d46_sr[39] <= s1_e2p_d46_sr[38];
-    s1_e2p_d46_sr[38] <= s1_e2p_d46_sr[37];
-    s1_e2p_d46_sr[37] <= s1_e2p_d46_sr[36];
-    s1_e2p_d46_sr[36] <= s1_e2p_d46_sr[35];
-    s1_e2p_d46_sr[35] <= s1_e2p_d46_sr[34];
-    s1_e2p_d46_sr[34] <= s1_e2p_d46_sr[33];
-    s1_e2p_d46_sr[33] <= s1_e2p_d46_sr[32];
-    s1_e2p_d46_sr[32] <= s1_e2p_d46_sr[31];
-    s1_e2p_d46_sr[31] <= s1_e2p_d46_sr[30];
-    s1_e2p_d46_sr[30] <= s1_e2p_d46_sr[29];
-    s1_e2p_d46_sr[29] <= s1_e2p_d46_sr[28];
-    s1_e2p_d46_sr[28] <= s1_e2p_d46_sr[27];
-    s1_e2p_d46_sr[27] <= s1_e2p_d46_sr[26];
-    s1_e2p_d46_sr[26] <= s1_e2p_d46_sr[25];
-    s1_e2p_d46_sr[25] <= s1_e2p_d46_sr[24];
-    s1_e2p_d46_sr[24] <= s1_e2p_d46_sr[23];
-    s1_e2p_d46_sr[23] <= s1_e2p_d46_sr[22];
-    s1_e2p_d46_sr[22] <= s1_e2p_d46_sr[21];
-    s1_e2p_d46_sr[21] <= s1_e2p_d46_sr[20];
-    s1_e2p_d46_sr[20] <= s1_e2p_d46_sr[19];
-    s1_e2p_d46_sr[19] <= s1_e2p_d46_sr[18];
-    s1_e2p_d46_sr[18] <= s1_e2p_d46_sr[17];
-    s1_e2p_d46_sr[17] <= s1_e2p_d46_sr[16];
-    s1_e2p_d46_sr[16] <= s1_e2p_d46_sr[15];
-    s1_e2p_d46_sr[15] <= s1_e2p_d46_sr[14];
-    s1_e2p_d46_sr[14] <= s1_e2p_d46_sr[13];
-    s1_e2p_d46_sr[13] <= s1_e2p_d46_sr[12];
-    s1_e2p_d46_sr[12] <= s1_e2p_d46_sr[11];
-    s1_e2p_d46_sr[11] <= s1_e2p_d46_sr[10];
-    s1_e2p_d46_sr[10] <= s1_e2p_d46_sr[9];
-    s1_e2p_d46_sr[9] <= s1_e2p_d46_sr[8];
-    s1_e2p_d46_sr[8] <= s1_e2p_d46_sr[7];
-    s1_e2p_d46_sr[7] <= s1_e2p_d46_sr[6];
-    s1_e2p_d46_sr[6] <= s1_e2p_d46_sr[5];
-    s1_e2p_d46_sr[5] <= s1_e2p_d46_sr[4];
-    s1_e2p_d46_sr[4] <= s1_e2p_d46_sr[3];
-    s1_e2p_d46_sr[3] <= s1_e2p_d46_sr[2];
-    s1_e2p_d46_sr[2] <= s1_e2p_d46_sr[1];
-    s1_e2p_d46_sr[1] <= s1_e2p;
-    s53_u <= u_int;
-    s53_v <= v_int;
+  always @(posedge clk) begin : s54_uv_regs
+    s1_e1p_d47_sr[47] <= s1_e1p_d47_sr[46];
+    s1_e1p_d47_sr[46] <= s1_e1p_d47_sr[45];
+    s1_e1p_d47_sr[45] <= s1_e1p_d47_sr[44];
+    s1_e1p_d47_sr[44] <= s1_e1p_d47_sr[43];
+    s1_e1p_d47_sr[43] <= s1_e1p_d47_sr[42];
+    s1_e1p_d47_sr[42] <= s1_e1p_d47_sr[41];
+    s1_e1p_d47_sr[41] <= s1_e1p_d47_sr[40];
+    s1_e1p_d47_sr[40] <= s1_e1p_d47_sr[39];
+    s1_e1p_d47_sr[39] <= s1_e1p_d47_sr[38];
+    s1_e1p_d47_sr[38] <= s1_e1p_d47_sr[37];
+    s1_e1p_d47_sr[37] <= s1_e1p_d47_sr[36];
+    s1_e1p_d47_sr[36] <= s1_e1p_d47_sr[35];
+    s1_e1p_d47_sr[35] <= s1_e1p_d47_sr[34];
+    s1_e1p_d47_sr[34] <= s1_e1p_d47_sr[33];
+    s1_e1p_d47_sr[33] <= s1_e1p_d47_sr[32];
+    s1_e1p_d47_sr[32] <= s1_e1p_d47_sr[31];
+    s1_e1p_d47_sr[31] <= s1_e1p_d47_sr[30];
+    s1_e1p_d47_sr[30] <= s1_e1p_d47_sr[29];
+    s1_e1p_d47_sr[29] <= s1_e1p_d47_sr[28];
+    s1_e1p_d47_sr[28] <= s1_e1p_d47_sr[27];
+    s1_e1p_d47_sr[27] <= s1_e1p_d47_sr[26];
+    s1_e1p_d47_sr[26] <= s1_e1p_d47_sr[25];
+    s1_e1p_d47_sr[25] <= s1_e1p_d47_sr[24];
+    s1_e1p_d47_sr[24] <= s1_e1p_d47_sr[23];
+    s1_e1p_d47_sr[23] <= s1_e1p_d47_sr[22];
+    s1_e1p_d47_sr[22] <= s1_e1p_d47_sr[21];
+    s1_e1p_d47_sr[21] <= s1_e1p_d47_sr[20];
+    s1_e1p_d47_sr[20] <= s1_e1p_d47_sr[19];
+    s1_e1p_d47_sr[19] <= s1_e1p_d47_sr[18];
+    s1_e1p_d47_sr[18] <= s1_e1p_d47_sr[17];
+    s1_e1p_d47_sr[17] <= s1_e1p_d47_sr[16];
+    s1_e1p_d47_sr[16] <= s1_e1p_d47_sr[15];
+    s1_e1p_d47_sr[15] <= s1_e1p_d47_sr[14];
+    s1_e1p_d47_sr[14] <= s1_e1p_d47_sr[13];
+    s1_e1p_d47_sr[13] <= s1_e1p_d47_sr[12];
+    s1_e1p_d47_sr[12] <= s1_e1p_d47_sr[11];
+    s1_e1p_d47_sr[11] <= s1_e1p_d47_sr[10];
+    s1_e1p_d47_sr[10] <= s1_e1p_d47_sr[9];
+    s1_e1p_d47_sr[9] <= s1_e1p_d47_sr[8];
+    s1_e1p_d47_sr[8] <= s1_e1p_d47_sr[7];
+    s1_e1p_d47_sr[7] <= s1_e1p_d47_sr[6];
+    s1_e1p_d47_sr[6] <= s1_e1p_d47_sr[5];
+    s1_e1p_d47_sr[5] <= s1_e1p_d47_sr[4];
+    s1_e1p_d47_sr[4] <= s1_e1p_d47_sr[3];
+    s1_e1p_d47_sr[3] <= s1_e1p_d47_sr[2];
+    s1_e1p_d47_sr[2] <= s1_e1p_d47_sr[1];
+    s1_e1p_d47_sr[1] <= s1_e1p;
+    s1_e1q_d47_sr[47] <= s1_e1q_d47_sr[46];
+    s1_e1q_d47_sr[46] <= s1_e1q_d47_sr[45];
+    s1_e1q_d47_sr[45] <= s1_e1q_d47_sr[44];
+    s1_e1q_d47_sr[44] <= s1_e1q_d47_sr[43];
+    s1_e1q_d47_sr[43] <= s1_e1q_d47_sr[42];
+    s1_e1q_d47_sr[42] <= s1_e1q_d47_sr[41];
+    s1_e1q_d47_sr[41] <= s1_e1q_d47_sr[40];
+    s1_e1q_d47_sr[40] <= s1_e1q_d47_sr[39];
+    s1_e1q_d47_sr[39] <= s1_e1q_d47_sr[38];
+    s1_e1q_d47_sr[38] <= s1_e1q_d47_sr[37];
+    s1_e1q_d47_sr[37] <= s1_e1q_d47_sr[36];
+    s1_e1q_d47_sr[36] <= s1_e1q_d47_sr[35];
+    s1_e1q_d47_sr[35] <= s1_e1q_d47_sr[34];
+    s1_e1q_d47_sr[34] <= s1_e1q_d47_sr[33];
+    s1_e1q_d47_sr[33] <= s1_e1q_d47_sr[32];
+    s1_e1q_d47_sr[32] <= s1_e1q_d47_sr[31];
+    s1_e1q_d47_sr[31] <= s1_e1q_d47_sr[30];
+    s1_e1q_d47_sr[30] <= s1_e1q_d47_sr[29];
+    s1_e1q_d47_sr[29] <= s1_e1q_d47_sr[28];
+    s1_e1q_d47_sr[28] <= s1_e1q_d47_sr[27];
+    s1_e1q_d47_sr[27] <= s1_e1q_d47_sr[26];
+    s1_e1q_d47_sr[26] <= s1_e1q_d47_sr[25];
+    s1_e1q_d47_sr[25] <= s1_e1q_d47_sr[24];
+    s1_e1q_d47_sr[24] <= s1_e1q_d47_sr[23];
+    s1_e1q_d47_sr[23] <= s1_e1q_d47_sr[22];
+    s1_e1q_d47_sr[22] <= s1_e1q_d47_sr[21];
+    s1_e1q_d47_sr[21] <= s1_e1q_d47_sr[20];
+    s1_e1q_d47_sr[20] <= s1_e1q_d47_sr[19];
+    s1_e1q_d47_sr[19] <= s1_e1q_d47_sr[18];
+    s1_e1q_d47_sr[18] <= s1_e1q_d47_sr[17];
+    s1_e1q_d47_sr[17] <= s1_e1q_d47_sr[16];
+    s1_e1q_d47_sr[16] <= s1_e1q_d47_sr[15];
+    s1_e1q_d47_sr[15] <= s1_e1q_d47_sr[14];
+    s1_e1q_d47_sr[14] <= s1_e1q_d47_sr[13];
+    s1_e1q_d47_sr[13] <= s1_e1q_d47_sr[12];
+    s1_e1q_d47_sr[12] <= s1_e1q_d47_sr[11];
+    s1_e1q_d47_sr[11] <= s1_e1q_d47_sr[10];
+    s1_e1q_d47_sr[10] <= s1_e1q_d47_sr[9];
+    s1_e1q_d47_sr[9] <= s1_e1q_d47_sr[8];
+    s1_e1q_d47_sr[8] <= s1_e1q_d47_sr[7];
+    s1_e1q_d47_sr[7] <= s1_e1q_d47_sr[6];
+    s1_e1q_d47_sr[6] <= s1_e1q_d47_sr[5];
+    s1_e1q_d47_sr[5] <= s1_e1q_d47_sr[4];
+    s1_e1q_d47_sr[4] <= s1_e1q_d47_sr[3];
+    s1_e1q_d47_sr[3] <= s1_e1q_d47_sr[2];
+    s1_e1q_d47_sr[2] <= s1_e1q_d47_sr[1];
+    s1_e1q_d47_sr[1] <= s1_e1q;
+    s1_e2q_d47_sr[47] <= s1_e2q_d47_sr[46];
+    s1_e2q_d47_sr[46] <= s1_e2q_d47_sr[45];
+    s1_e2q_d47_sr[45] <= s1_e2q_d47_sr[44];
+    s1_e2q_d47_sr[44] <= s1_e2q_d47_sr[43];
+    s1_e2q_d47_sr[43] <= s1_e2q_d47_sr[42];
+    s1_e2q_d47_sr[42] <= s1_e2q_d47_sr[41];
+    s1_e2q_d47_sr[41] <= s1_e2q_d47_sr[40];
+    s1_e2q_d47_sr[40] <= s1_e2q_d47_sr[39];
+    s1_e2q_d47_sr[39] <= s1_e2q_d47_sr[38];
+    s1_e2q_d47_sr[38] <= s1_e2q_d47_sr[37];
+    s1_e2q_d47_sr[37] <= s1_e2q_d47_sr[36];
+    s1_e2q_d47_sr[36] <= s1_e2q_d47_sr[35];
+    s1_e2q_d47_sr[35] <= s1_e2q_d47_sr[34];
+    s1_e2q_d47_sr[34] <= s1_e2q_d47_sr[33];
+    s1_e2q_d47_sr[33] <= s1_e2q_d47_sr[32];
+    s1_e2q_d47_sr[32] <= s1_e2q_d47_sr[31];
+    s1_e2q_d47_sr[31] <= s1_e2q_d47_sr[30];
+    s1_e2q_d47_sr[30] <= s1_e2q_d47_sr[29];
+    s1_e2q_d47_sr[29] <= s1_e2q_d47_sr[28];
+    s1_e2q_d47_sr[28] <= s1_e2q_d47_sr[27];
+    s1_e2q_d47_sr[27] <= s1_e2q_d47_sr[26];
+    s1_e2q_d47_sr[26] <= s1_e2q_d47_sr[25];
+    s1_e2q_d47_sr[25] <= s1_e2q_d47_sr[24];
+    s1_e2q_d47_sr[24] <= s1_e2q_d47_sr[23];
+    s1_e2q_d47_sr[23] <= s1_e2q_d47_sr[22];
+    s1_e2q_d47_sr[22] <= s1_e2q_d47_sr[21];
+    s1_e2q_d47_sr[21] <= s1_e2q_d47_sr[20];
+    s1_e2q_d47_sr[20] <= s1_e2q_d47_sr[19];
+    s1_e2q_d47_sr[19] <= s1_e2q_d47_sr[18];
+    s1_e2q_d47_sr[18] <= s1_e2q_d47_sr[17];
+    s1_e2q_d47_sr[17] <= s1_e2q_d47_sr[16];
+    s1_e2q_d47_sr[16] <= s1_e2q_d47_sr[15];
+    s1_e2q_d47_sr[15] <= s1_e2q_d47_sr[14];
+    s1_e2q_d47_sr[14] <= s1_e2q_d47_sr[13];
+    s1_e2q_d47_sr[13] <= s1_e2q_d47_sr[12];
+    s1_e2q_d47_sr[12] <= s1_e2q_d47_sr[11];
+    s1_e2q_d47_sr[11] <= s1_e2q_d47_sr[10];
+    s1_e2q_d47_sr[10] <= s1_e2q_d47_sr[9];
+    s1_e2q_d47_sr[9] <= s1_e2q_d47_sr[8];
+    s1_e2q_d47_sr[8] <= s1_e2q_d47_sr[7];
+    s1_e2q_d47_sr[7] <= s1_e2q_d47_sr[6];
+    s1_e2q_d47_sr[6] <= s1_e2q_d47_sr[5];
+    s1_e2q_d47_sr[5] <= s1_e2q_d47_sr[4];
+    s1_e2q_d47_sr[4] <= s1_e2q_d47_sr[3];
+    s1_e2q_d47_sr[3] <= s1_e2q_d47_sr[2];
+    s1_e2q_d47_sr[2] <= s1_e2q_d47_sr[1];
+    s1_e2q_d47_sr[1] <= s1_e2q;
+    s1_e2p_d47_sr[47] <= s1_e2p_d47_sr[46];
+    s1_e2p_d47_sr[46] <= s1_e2p_d47_sr[45];
+    s1_e2p_d47_sr[45] <= s1_e2p_d47_sr[44];
+    s1_e2p_d47_sr[44] <= s1_e2p_d47_sr[43];
+    s1_e2p_d47_sr[43] <= s1_e2p_d47_sr[42];
+    s1_e2p_d47_sr[42] <= s1_e2p_d47_sr[41];
+    s1_e2p_d47_sr[41] <= s1_e2p_d47_sr[40];
+    s1_e2p_d47_sr[40] <= s1_e2p_d47_sr[39];
+    s1_e2p_d47_sr[39] <= s1_e2p_d47_sr[38];
+    s1_e2p_d47_sr[38] <= s1_e2p_d47_sr[37];
+    s1_e2p_d47_sr[37] <= s1_e2p_d47_sr[36];
+    s1_e2p_d47_sr[36] <= s1_e2p_d47_sr[35];
+    s1_e2p_d47_sr[35] <= s1_e2p_d47_sr[34];
+    s1_e2p_d47_sr[34] <= s1_e2p_d47_sr[33];
+    s1_e2p_d47_sr[33] <= s1_e2p_d47_sr[32];
+    s1_e2p_d47_sr[32] <= s1_e2p_d47_sr[31];
+    s1_e2p_d47_sr[31] <= s1_e2p_d47_sr[30];
+    s1_e2p_d47_sr[30] <= s1_e2p_d47_sr[29];
+    s1_e2p_d47_sr[29] <= s1_e2p_d47_sr[28];
+    s1_e2p_d47_sr[28] <= s1_e2p_d47_sr[27];
+    s1_e2p_d47_sr[27] <= s1_e2p_d47_sr[26];
+    s1_e2p_d47_sr[26] <= s1_e2p_d47_sr[25];
+    s1_e2p_d47_sr[25] <= s1_e2p_d47_sr[24];
+    s1_e2p_d47_sr[24] <= s1_e2p_d47_sr[23];
+    s1_e2p_d47_sr[23] <= s1_e2p_d47_sr[22];
+    s1_e2p_d47_sr[22] <= s1_e2p_d47_sr[21];
+    s1_e2p_d47_sr[21] <= s1_e2p_d47_sr[20];
+    s1_e2p_d47_sr[20] <= s1_e2p_d47_sr[19];
+    s1_e2p_d47_sr[19] <= s1_e2p_d47_sr[18];
+    s1_e2p_d47_sr[18] <= s1_e2p_d47_sr[17];
+    s1_e2p_d47_sr[17] <= s1_e2p_d47_sr[16];
+    s1_e2p_d47_sr[16] <= s1_e2p_d47_sr[15];
+    s1_e2p_d47_sr[15] <= s1_e2p_d47_sr[14];
+    s1_e2p_d47_sr[14] <= s1_e2p_d47_sr[13];
+    s1_e2p_d47_sr[13] <= s1_e2p_d47_sr[12];
+    s1_e2p_d47_sr[12] <= s1_e2p_d47_sr[11];
+    s1_e2p_d47_sr[11] <= s1_e2p_d47_sr[10];
+    s1_e2p_d47_sr[10] <= s1_e2p_d47_sr[9];
+    s1_e2p_d47_sr[9] <= s1_e2p_d47_sr[8];
+    s1_e2p_d47_sr[8] <= s1_e2p_d47_sr[7];
+    s1_e2p_d47_sr[7] <= s1_e2p_d47_sr[6];
+    s1_e2p_d47_sr[6] <= s1_e2p_d47_sr[5];
+    s1_e2p_d47_sr[5] <= s1_e2p_d47_sr[4];
+    s1_e2p_d47_sr[4] <= s1_e2p_d47_sr[3];
+    s1_e2p_d47_sr[3] <= s1_e2p_d47_sr[2];
+    s1_e2p_d47_sr[2] <= s1_e2p_d47_sr[1];
+    s1_e2p_d47_sr[1] <= s1_e2p;
+    s54_u <= u_int;
+    s54_v <= v_int;
   end
 
-  // stage s54_test: u + v as two short sums; the signs
-  assign u_s53_u = $unsigned(s53_u);
-  assign bits_u_s53_u = u_s53_u[64:49];
-  assign rs_bits_u_s53_u = {{1{1'b0}}, bits_u_s53_u};
-  assign u_s53_v = $unsigned(s53_v);
-  assign bits_u_s53_v = u_s53_v[64:49];
-  assign rs_bits_u_s53_v = {{1{1'b0}}, bits_u_s53_v};
-  assign uv_sum_high = rs_bits_u_s53_u + rs_bits_u_s53_v;
-  assign u_s53_u_1 = $unsigned(s53_u);
-  assign bits_u_s53_u_1 = u_s53_u_1[48:0];
-  assign rs_bits_u_s53_u_1 = {{1{1'b0}}, bits_u_s53_u_1};
-  assign u_s53_v_1 = $unsigned(s53_v);
-  assign bits_u_s53_v_1 = u_s53_v_1[48:0];
-  assign rs_bits_u_s53_v_1 = {{1{1'b0}}, bits_u_s53_v_1};
-  assign uv_sum_low = rs_bits_u_s53_u_1 + rs_bits_u_s53_v_1;
-  assign s53_u_lt_k_0_1 = s53_u < k_0_1;
-  assign s53_v_lt_k_0_1 = s53_v < k_0_1;
-  assign negative = s53_u_lt_k_0_1 | s53_v_lt_k_0_1;
+  // stage s55_test: u + v as two short sums; the signs
+  assign u_s54_u = $unsigned(s54_u);
+  assign bits_u_s54_u = u_s54_u[64:49];
+  assign rs_bits_u_s54_u = {{1{1'b0}}, bits_u_s54_u};
+  assign u_s54_v = $unsigned(s54_v);
+  assign bits_u_s54_v = u_s54_v[64:49];
+  assign rs_bits_u_s54_v = {{1{1'b0}}, bits_u_s54_v};
+  assign uv_sum_high = rs_bits_u_s54_u + rs_bits_u_s54_v;
+  assign u_s54_u_1 = $unsigned(s54_u);
+  assign bits_u_s54_u_1 = u_s54_u_1[48:0];
+  assign rs_bits_u_s54_u_1 = {{1{1'b0}}, bits_u_s54_u_1};
+  assign u_s54_v_1 = $unsigned(s54_v);
+  assign bits_u_s54_v_1 = u_s54_v_1[48:0];
+  assign rs_bits_u_s54_v_1 = {{1{1'b0}}, bits_u_s54_v_1};
+  assign uv_sum_low = rs_bits_u_s54_u_1 + rs_bits_u_s54_v_1;
+  assign s54_u_lt_k_0_1 = s54_u < k_0_1;
+  assign s54_v_lt_k_0_1 = s54_v < k_0_1;
+  assign negative = s54_u_lt_k_0_1 | s54_v_lt_k_0_1;
 
-  always @(posedge clk) begin : s54_test_regs
-    s54_hs <= uv_sum_high;
-    s54_ls <= uv_sum_low;
-    s54_neg <= negative;
+  always @(posedge clk) begin : s55_test_regs
+    s55_hs <= uv_sum_high;
+    s55_ls <= uv_sum_low;
+    s55_neg <= negative;
   end
 
-  // stage s55_hit: the hit bit
-  assign bits_s54_hs = s54_hs[16:1];
-  assign bits_bits_s54_hs = bits_s54_hs[15:8];
-  assign ne_16 = bits_bits_s54_hs != k_0_2;
-  assign bits_bits_s54_hs_1 = bits_s54_hs[7:0];
-  assign ne_17 = bits_bits_s54_hs_1 != k_0_2;
+  // stage s56_hit: the hit bit
+  assign bits_s55_hs = s55_hs[16:1];
+  assign bits_bits_s55_hs = bits_s55_hs[15:8];
+  assign ne_16 = bits_bits_s55_hs != k_0_2;
+  assign bits_bits_s55_hs_1 = bits_s55_hs[7:0];
+  assign ne_17 = bits_bits_s55_hs_1 != k_0_2;
   assign high = {ne_16, ne_17};
-  assign bits_s54_hs_1 = s54_hs[0];
-  assign bits_s54_ls = s54_ls[49];
-  assign bits_s54_ls_1 = s54_ls[48:0];
-  assign bits_bits_s54_ls_1 = bits_s54_ls_1[48];
-  assign ne_19 = bits_bits_s54_ls_1 != k_0_3;
-  assign bits_bits_s54_ls_1_1 = bits_s54_ls_1[47:40];
-  assign ne_20 = bits_bits_s54_ls_1_1 != k_0_2;
-  assign bits_bits_s54_ls_1_2 = bits_s54_ls_1[39:32];
-  assign ne_21 = bits_bits_s54_ls_1_2 != k_0_2;
-  assign bits_bits_s54_ls_1_3 = bits_s54_ls_1[31:24];
-  assign ne_22 = bits_bits_s54_ls_1_3 != k_0_2;
-  assign bits_bits_s54_ls_1_4 = bits_s54_ls_1[23:16];
-  assign ne_23 = bits_bits_s54_ls_1_4 != k_0_2;
-  assign bits_bits_s54_ls_1_5 = bits_s54_ls_1[15:8];
-  assign ne_24 = bits_bits_s54_ls_1_5 != k_0_2;
-  assign bits_bits_s54_ls_1_6 = bits_s54_ls_1[7:0];
-  assign ne_25 = bits_bits_s54_ls_1_6 != k_0_2;
+  assign bits_s55_hs_1 = s55_hs[0];
+  assign bits_s55_ls = s55_ls[49];
+  assign bits_s55_ls_1 = s55_ls[48:0];
+  assign bits_bits_s55_ls_1 = bits_s55_ls_1[48];
+  assign ne_19 = bits_bits_s55_ls_1 != k_0_3;
+  assign bits_bits_s55_ls_1_1 = bits_s55_ls_1[47:40];
+  assign ne_20 = bits_bits_s55_ls_1_1 != k_0_2;
+  assign bits_bits_s55_ls_1_2 = bits_s55_ls_1[39:32];
+  assign ne_21 = bits_bits_s55_ls_1_2 != k_0_2;
+  assign bits_bits_s55_ls_1_3 = bits_s55_ls_1[31:24];
+  assign ne_22 = bits_bits_s55_ls_1_3 != k_0_2;
+  assign bits_bits_s55_ls_1_4 = bits_s55_ls_1[23:16];
+  assign ne_23 = bits_bits_s55_ls_1_4 != k_0_2;
+  assign bits_bits_s55_ls_1_5 = bits_s55_ls_1[15:8];
+  assign ne_24 = bits_bits_s55_ls_1_5 != k_0_2;
+  assign bits_bits_s55_ls_1_6 = bits_s55_ls_1[7:0];
+  assign ne_25 = bits_bits_s55_ls_1_6 != k_0_2;
   assign low = {ne_19, ne_20, ne_21, ne_22, ne_23, ne_24, ne_25};
   assign low_ne_k_0_4 = low != k_0_4;
   assign high_ne_k_0 = high != k_0;
-  assign or_27 = bits_s54_ls | low_ne_k_0_4;
-  assign bits_s54_hs_1_and_or_27 = bits_s54_hs_1 & or_27;
-  assign or_28 = high_ne_k_0 | bits_s54_hs_1_and_or_27;
-  assign and_29 = bits_s54_ls & low_ne_k_0_4;
+  assign or_27 = bits_s55_ls | low_ne_k_0_4;
+  assign bits_s55_hs_1_and_or_27 = bits_s55_hs_1 & or_27;
+  assign or_28 = high_ne_k_0 | bits_s55_hs_1_and_or_27;
+  assign and_29 = bits_s55_ls & low_ne_k_0_4;
   assign over = or_28 | and_29;
-  assign s54_neg_or_over = s54_neg | over;
-  assign not_s54_neg_or_over = ~s54_neg_or_over;
+  assign s55_neg_or_over = s55_neg | over;
+  assign not_s55_neg_or_over = ~s55_neg_or_over;
   assign u_div_ok_d14 = u_div_ok_d14_sr[14];
-  assign hit_c = not_s54_neg_or_over & u_div_ok_d14;
+  assign hit_c = not_s55_neg_or_over & u_div_ok_d14;
 
-  always @(posedge clk) begin : s55_hit_regs
+  always @(posedge clk) begin : s56_hit_regs
     u_div_ok_d14_sr[14] <= u_div_ok_d14_sr[13];
     u_div_ok_d14_sr[13] <= u_div_ok_d14_sr[12];
     u_div_ok_d14_sr[12] <= u_div_ok_d14_sr[11];
@@ -975,25 +1009,25 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     u_div_ok_d14_sr[3] <= u_div_ok_d14_sr[2];
     u_div_ok_d14_sr[2] <= u_div_ok_d14_sr[1];
     u_div_ok_d14_sr[1] <= u_div_ok;
-    s55_hit <= hit_c;
+    s56_hit <= hit_c;
   end
 
-  // stage s56_result: the barycentric test; t, u, v zeroed on a miss
+  // stage s57_result: the barycentric test; t, u, v zeroed on a miss
   assign u_div_t_1_d15 = u_div_t_1_d15_sr[15];
-  assign s53_u_d2 = s53_u_d2_sr[2];
-  assign s53_v_d2 = s53_v_d2_sr[2];
-  assign s1_tag_d54 = s1_tag_d54_sr[54];
-  assign mux_s55_hit = s55_hit ? u_div_t_1_d15 : k_0_5;
-  assign shr_s53_u_d2 = s53_u_d2 >>> 18;
-  assign rs_shr_s53_u_d2 = $signed(shr_s53_u_d2[31:0]);
-  assign u_rs_shr_s53_u_d2 = $unsigned(rs_shr_s53_u_d2);
-  assign mux_s55_hit_1 = s55_hit ? u_rs_shr_s53_u_d2 : k_0_6;
-  assign shr_s53_v_d2 = s53_v_d2 >>> 18;
-  assign rs_shr_s53_v_d2 = $signed(shr_s53_v_d2[31:0]);
-  assign u_rs_shr_s53_v_d2 = $unsigned(rs_shr_s53_v_d2);
-  assign mux_s55_hit_2 = s55_hit ? u_rs_shr_s53_v_d2 : k_0_6;
+  assign s54_u_d2 = s54_u_d2_sr[2];
+  assign s54_v_d2 = s54_v_d2_sr[2];
+  assign s1_tag_d55 = s1_tag_d55_sr[55];
+  assign mux_s56_hit = s56_hit ? u_div_t_1_d15 : k_0_5;
+  assign shr_s54_u_d2 = s54_u_d2 >>> 18;
+  assign rs_shr_s54_u_d2 = $signed(shr_s54_u_d2[31:0]);
+  assign u_rs_shr_s54_u_d2 = $unsigned(rs_shr_s54_u_d2);
+  assign mux_s56_hit_1 = s56_hit ? u_rs_shr_s54_u_d2 : k_0_6;
+  assign shr_s54_v_d2 = s54_v_d2 >>> 18;
+  assign rs_shr_s54_v_d2 = $signed(shr_s54_v_d2[31:0]);
+  assign u_rs_shr_s54_v_d2 = $unsigned(rs_shr_s54_v_d2);
+  assign mux_s56_hit_2 = s56_hit ? u_rs_shr_s54_v_d2 : k_0_6;
 
-  always @(posedge clk) begin : s56_result_regs
+  always @(posedge clk) begin : s57_result_regs
     u_div_t_1_d15_sr[15] <= u_div_t_1_d15_sr[14];
     u_div_t_1_d15_sr[14] <= u_div_t_1_d15_sr[13];
     u_div_t_1_d15_sr[13] <= u_div_t_1_d15_sr[12];
@@ -1009,191 +1043,194 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     u_div_t_1_d15_sr[3] <= u_div_t_1_d15_sr[2];
     u_div_t_1_d15_sr[2] <= u_div_t_1_d15_sr[1];
     u_div_t_1_d15_sr[1] <= u_div_t_1;
-    s53_u_d2_sr[2] <= s53_u_d2_sr[1];
-    s53_u_d2_sr[1] <= s53_u;
-    s53_v_d2_sr[2] <= s53_v_d2_sr[1];
-    s53_v_d2_sr[1] <= s53_v;
-    if (rst) s1_valid_d54_1 <= 1'h0;
-    else s1_valid_d54_1 <= s1_valid;
-    if (rst) s1_valid_d54_2 <= 1'h0;
-    else s1_valid_d54_2 <= s1_valid_d54_1;
-    if (rst) s1_valid_d54_3 <= 1'h0;
-    else s1_valid_d54_3 <= s1_valid_d54_2;
-    if (rst) s1_valid_d54_4 <= 1'h0;
-    else s1_valid_d54_4 <= s1_valid_d54_3;
-    if (rst) s1_valid_d54_5 <= 1'h0;
-    else s1_valid_d54_5 <= s1_valid_d54_4;
-    if (rst) s1_valid_d54_6 <= 1'h0;
-    else s1_valid_d54_6 <= s1_valid_d54_5;
-    if (rst) s1_valid_d54_7 <= 1'h0;
-    else s1_valid_d54_7 <= s1_valid_d54_6;
-    if (rst) s1_valid_d54_8 <= 1'h0;
-    else s1_valid_d54_8 <= s1_valid_d54_7;
-    if (rst) s1_valid_d54_9 <= 1'h0;
-    else s1_valid_d54_9 <= s1_valid_d54_8;
-    if (rst) s1_valid_d54_10 <= 1'h0;
-    else s1_valid_d54_10 <= s1_valid_d54_9;
-    if (rst) s1_valid_d54_11 <= 1'h0;
-    else s1_valid_d54_11 <= s1_valid_d54_10;
-    if (rst) s1_valid_d54_12 <= 1'h0;
-    else s1_valid_d54_12 <= s1_valid_d54_11;
-    if (rst) s1_valid_d54_13 <= 1'h0;
-    else s1_valid_d54_13 <= s1_valid_d54_12;
-    if (rst) s1_valid_d54_14 <= 1'h0;
-    else s1_valid_d54_14 <= s1_valid_d54_13;
-    if (rst) s1_valid_d54_15 <= 1'h0;
-    else s1_valid_d54_15 <= s1_valid_d54_14;
-    if (rst) s1_valid_d54_16 <= 1'h0;
-    else s1_valid_d54_16 <= s1_valid_d54_15;
-    if (rst) s1_valid_d54_17 <= 1'h0;
-    else s1_valid_d54_17 <= s1_valid_d54_16;
-    if (rst) s1_valid_d54_18 <= 1'h0;
-    else s1_valid_d54_18 <= s1_valid_d54_17;
-    if (rst) s1_valid_d54_19 <= 1'h0;
-    else s1_valid_d54_19 <= s1_valid_d54_18;
-    if (rst) s1_valid_d54_20 <= 1'h0;
-    else s1_valid_d54_20 <= s1_valid_d54_19;
-    if (rst) s1_valid_d54_21 <= 1'h0;
-    else s1_valid_d54_21 <= s1_valid_d54_20;
-    if (rst) s1_valid_d54_22 <= 1'h0;
-    else s1_valid_d54_22 <= s1_valid_d54_21;
-    if (rst) s1_valid_d54_23 <= 1'h0;
-    else s1_valid_d54_23 <= s1_valid_d54_22;
-    if (rst) s1_valid_d54_24 <= 1'h0;
-    else s1_valid_d54_24 <= s1_valid_d54_23;
-    if (rst) s1_valid_d54_25 <= 1'h0;
-    else s1_valid_d54_25 <= s1_valid_d54_24;
-    if (rst) s1_valid_d54_26 <= 1'h0;
-    else s1_valid_d54_26 <= s1_valid_d54_25;
-    if (rst) s1_valid_d54_27 <= 1'h0;
-    else s1_valid_d54_27 <= s1_valid_d54_26;
-    if (rst) s1_valid_d54_28 <= 1'h0;
-    else s1_valid_d54_28 <= s1_valid_d54_27;
-    if (rst) s1_valid_d54_29 <= 1'h0;
-    else s1_valid_d54_29 <= s1_valid_d54_28;
-    if (rst) s1_valid_d54_30 <= 1'h0;
-    else s1_valid_d54_30 <= s1_valid_d54_29;
-    if (rst) s1_valid_d54_31 <= 1'h0;
-    else s1_valid_d54_31 <= s1_valid_d54_30;
-    if (rst) s1_valid_d54_32 <= 1'h0;
-    else s1_valid_d54_32 <= s1_valid_d54_31;
-    if (rst) s1_valid_d54_33 <= 1'h0;
-    else s1_valid_d54_33 <= s1_valid_d54_32;
-    if (rst) s1_valid_d54_34 <= 1'h0;
-    else s1_valid_d54_34 <= s1_valid_d54_33;
-    if (rst) s1_valid_d54_35 <= 1'h0;
-    else s1_valid_d54_35 <= s1_valid_d54_34;
-    if (rst) s1_valid_d54_36 <= 1'h0;
-    else s1_valid_d54_36 <= s1_valid_d54_35;
-    if (rst) s1_valid_d54_37 <= 1'h0;
-    else s1_valid_d54_37 <= s1_valid_d54_36;
-    if (rst) s1_valid_d54_38 <= 1'h0;
-    else s1_valid_d54_38 <= s1_valid_d54_37;
-    if (rst) s1_valid_d54_39 <= 1'h0;
-    else s1_valid_d54_39 <= s1_valid_d54_38;
-    if (rst) s1_valid_d54_40 <= 1'h0;
-    else s1_valid_d54_40 <= s1_valid_d54_39;
-    if (rst) s1_valid_d54_41 <= 1'h0;
-    else s1_valid_d54_41 <= s1_valid_d54_40;
-    if (rst) s1_valid_d54_42 <= 1'h0;
-    else s1_valid_d54_42 <= s1_valid_d54_41;
-    if (rst) s1_valid_d54_43 <= 1'h0;
-    else s1_valid_d54_43 <= s1_valid_d54_42;
-    if (rst) s1_valid_d54_44 <= 1'h0;
-    else s1_valid_d54_44 <= s1_valid_d54_43;
-    if (rst) s1_valid_d54_45 <= 1'h0;
-    else s1_valid_d54_45 <= s1_valid_d54_44;
-    if (rst) s1_valid_d54_46 <= 1'h0;
-    else s1_valid_d54_46 <= s1_valid_d54_45;
-    if (rst) s1_valid_d54_47 <= 1'h0;
-    else s1_valid_d54_47 <= s1_valid_d54_46;
-    if (rst) s1_valid_d54_48 <= 1'h0;
-    else s1_valid_d54_48 <= s1_valid_d54_47;
-    if (rst) s1_valid_d54_49 <= 1'h0;
-    else s1_valid_d54_49 <= s1_valid_d54_48;
-    if (rst) s1_valid_d54_50 <= 1'h0;
-    else s1_valid_d54_50 <= s1_valid_d54_49;
-    if (rst) s1_valid_d54_51 <= 1'h0;
-    else s1_valid_d54_51 <= s1_valid_d54_50;
-    if (rst) s1_valid_d54_52 <= 1'h0;
-    else s1_valid_d54_52 <= s1_valid_d54_51;
-    if (rst) s1_valid_d54_53 <= 1'h0;
-    else s1_valid_d54_53 <= s1_valid_d54_52;
-    if (rst) s1_valid_d54_54 <= 1'h0;
-    else s1_valid_d54_54 <= s1_valid_d54_53;
-    s1_tag_d54_sr[54] <= s1_tag_d54_sr[53];
-    s1_tag_d54_sr[53] <= s1_tag_d54_sr[52];
-    s1_tag_d54_sr[52] <= s1_tag_d54_sr[51];
-    s1_tag_d54_sr[51] <= s1_tag_d54_sr[50];
-    s1_tag_d54_sr[50] <= s1_tag_d54_sr[49];
-    s1_tag_d54_sr[49] <= s1_tag_d54_sr[48];
-    s1_tag_d54_sr[48] <= s1_tag_d54_sr[47];
-    s1_tag_d54_sr[47] <= s1_tag_d54_sr[46];
-    s1_tag_d54_sr[46] <= s1_tag_d54_sr[45];
-    s1_tag_d54_sr[45] <= s1_tag_d54_sr[44];
-    s1_tag_d54_sr[44] <= s1_tag_d54_sr[43];
-    s1_tag_d54_sr[43] <= s1_tag_d54_sr[42];
-    s1_tag_d54_sr[42] <= s1_tag_d54_sr[41];
-    s1_tag_d54_sr[41] <= s1_tag_d54_sr[40];
-    s1_tag_d54_sr[40] <= s1_tag_d54_sr[39];
-    s1_tag_d54_sr[39] <= s1_tag_d54_sr[38];
-    s1_tag_d54_sr[38] <= s1_tag_d54_sr[37];
-    s1_tag_d54_sr[37] <= s1_tag_d54_sr[36];
-    s1_tag_d54_sr[36] <= s1_tag_d54_sr[35];
-    s1_tag_d54_sr[35] <= s1_tag_d54_sr[34];
-    s1_tag_d54_sr[34] <= s1_tag_d54_sr[33];
-    s1_tag_d54_sr[33] <= s1_tag_d54_sr[32];
-    s1_tag_d54_sr[32] <= s1_tag_d54_sr[31];
-    s1_tag_d54_sr[31] <= s1_tag_d54_sr[30];
-    s1_tag_d54_sr[30] <= s1_tag_d54_sr[29];
-    s1_tag_d54_sr[29] <= s1_tag_d54_sr[28];
-    s1_tag_d54_sr[28] <= s1_tag_d54_sr[27];
-    s1_tag_d54_sr[27] <= s1_tag_d54_sr[26];
-    s1_tag_d54_sr[26] <= s1_tag_d54_sr[25];
-    s1_tag_d54_sr[25] <= s1_tag_d54_sr[24];
-    s1_tag_d54_sr[24] <= s1_tag_d54_sr[23];
-    s1_tag_d54_sr[23] <= s1_tag_d54_sr[22];
-    s1_tag_d54_sr[22] <= s1_tag_d54_sr[21];
-    s1_tag_d54_sr[21] <= s1_tag_d54_sr[20];
-    s1_tag_d54_sr[20] <= s1_tag_d54_sr[19];
-    s1_tag_d54_sr[19] <= s1_tag_d54_sr[18];
-    s1_tag_d54_sr[18] <= s1_tag_d54_sr[17];
-    s1_tag_d54_sr[17] <= s1_tag_d54_sr[16];
-    s1_tag_d54_sr[16] <= s1_tag_d54_sr[15];
-    s1_tag_d54_sr[15] <= s1_tag_d54_sr[14];
-    s1_tag_d54_sr[14] <= s1_tag_d54_sr[13];
-    s1_tag_d54_sr[13] <= s1_tag_d54_sr[12];
-    s1_tag_d54_sr[12] <= s1_tag_d54_sr[11];
-    s1_tag_d54_sr[11] <= s1_tag_d54_sr[10];
-    s1_tag_d54_sr[10] <= s1_tag_d54_sr[9];
-    s1_tag_d54_sr[9] <= s1_tag_d54_sr[8];
-    s1_tag_d54_sr[8] <= s1_tag_d54_sr[7];
-    s1_tag_d54_sr[7] <= s1_tag_d54_sr[6];
-    s1_tag_d54_sr[6] <= s1_tag_d54_sr[5];
-    s1_tag_d54_sr[5] <= s1_tag_d54_sr[4];
-    s1_tag_d54_sr[4] <= s1_tag_d54_sr[3];
-    s1_tag_d54_sr[3] <= s1_tag_d54_sr[2];
-    s1_tag_d54_sr[2] <= s1_tag_d54_sr[1];
-    s1_tag_d54_sr[1] <= s1_tag;
-    if (rst) s56_valid_out <= 1'h0;
-    else s56_valid_out <= s1_valid_d54_54;
-    s56_tag_out <= s1_tag_d54;
-    s56_hit <= s55_hit;
-    s56_t <= mux_s55_hit;
-    s56_u <= mux_s55_hit_1;
-    s56_v <= mux_s55_hit_2;
+    s54_u_d2_sr[2] <= s54_u_d2_sr[1];
+    s54_u_d2_sr[1] <= s54_u;
+    s54_v_d2_sr[2] <= s54_v_d2_sr[1];
+    s54_v_d2_sr[1] <= s54_v;
+    if (rst) s1_valid_d55_1 <= 1'h0;
+    else s1_valid_d55_1 <= s1_valid;
+    if (rst) s1_valid_d55_2 <= 1'h0;
+    else s1_valid_d55_2 <= s1_valid_d55_1;
+    if (rst) s1_valid_d55_3 <= 1'h0;
+    else s1_valid_d55_3 <= s1_valid_d55_2;
+    if (rst) s1_valid_d55_4 <= 1'h0;
+    else s1_valid_d55_4 <= s1_valid_d55_3;
+    if (rst) s1_valid_d55_5 <= 1'h0;
+    else s1_valid_d55_5 <= s1_valid_d55_4;
+    if (rst) s1_valid_d55_6 <= 1'h0;
+    else s1_valid_d55_6 <= s1_valid_d55_5;
+    if (rst) s1_valid_d55_7 <= 1'h0;
+    else s1_valid_d55_7 <= s1_valid_d55_6;
+    if (rst) s1_valid_d55_8 <= 1'h0;
+    else s1_valid_d55_8 <= s1_valid_d55_7;
+    if (rst) s1_valid_d55_9 <= 1'h0;
+    else s1_valid_d55_9 <= s1_valid_d55_8;
+    if (rst) s1_valid_d55_10 <= 1'h0;
+    else s1_valid_d55_10 <= s1_valid_d55_9;
+    if (rst) s1_valid_d55_11 <= 1'h0;
+    else s1_valid_d55_11 <= s1_valid_d55_10;
+    if (rst) s1_valid_d55_12 <= 1'h0;
+    else s1_valid_d55_12 <= s1_valid_d55_11;
+    if (rst) s1_valid_d55_13 <= 1'h0;
+    else s1_valid_d55_13 <= s1_valid_d55_12;
+    if (rst) s1_valid_d55_14 <= 1'h0;
+    else s1_valid_d55_14 <= s1_valid_d55_13;
+    if (rst) s1_valid_d55_15 <= 1'h0;
+    else s1_valid_d55_15 <= s1_valid_d55_14;
+    if (rst) s1_valid_d55_16 <= 1'h0;
+    else s1_valid_d55_16 <= s1_valid_d55_15;
+    if (rst) s1_valid_d55_17 <= 1'h0;
+    else s1_valid_d55_17 <= s1_valid_d55_16;
+    if (rst) s1_valid_d55_18 <= 1'h0;
+    else s1_valid_d55_18 <= s1_valid_d55_17;
+    if (rst) s1_valid_d55_19 <= 1'h0;
+    else s1_valid_d55_19 <= s1_valid_d55_18;
+    if (rst) s1_valid_d55_20 <= 1'h0;
+    else s1_valid_d55_20 <= s1_valid_d55_19;
+    if (rst) s1_valid_d55_21 <= 1'h0;
+    else s1_valid_d55_21 <= s1_valid_d55_20;
+    if (rst) s1_valid_d55_22 <= 1'h0;
+    else s1_valid_d55_22 <= s1_valid_d55_21;
+    if (rst) s1_valid_d55_23 <= 1'h0;
+    else s1_valid_d55_23 <= s1_valid_d55_22;
+    if (rst) s1_valid_d55_24 <= 1'h0;
+    else s1_valid_d55_24 <= s1_valid_d55_23;
+    if (rst) s1_valid_d55_25 <= 1'h0;
+    else s1_valid_d55_25 <= s1_valid_d55_24;
+    if (rst) s1_valid_d55_26 <= 1'h0;
+    else s1_valid_d55_26 <= s1_valid_d55_25;
+    if (rst) s1_valid_d55_27 <= 1'h0;
+    else s1_valid_d55_27 <= s1_valid_d55_26;
+    if (rst) s1_valid_d55_28 <= 1'h0;
+    else s1_valid_d55_28 <= s1_valid_d55_27;
+    if (rst) s1_valid_d55_29 <= 1'h0;
+    else s1_valid_d55_29 <= s1_valid_d55_28;
+    if (rst) s1_valid_d55_30 <= 1'h0;
+    else s1_valid_d55_30 <= s1_valid_d55_29;
+    if (rst) s1_valid_d55_31 <= 1'h0;
+    else s1_valid_d55_31 <= s1_valid_d55_30;
+    if (rst) s1_valid_d55_32 <= 1'h0;
+    else s1_valid_d55_32 <= s1_valid_d55_31;
+    if (rst) s1_valid_d55_33 <= 1'h0;
+    else s1_valid_d55_33 <= s1_valid_d55_32;
+    if (rst) s1_valid_d55_34 <= 1'h0;
+    else s1_valid_d55_34 <= s1_valid_d55_33;
+    if (rst) s1_valid_d55_35 <= 1'h0;
+    else s1_valid_d55_35 <= s1_valid_d55_34;
+    if (rst) s1_valid_d55_36 <= 1'h0;
+    else s1_valid_d55_36 <= s1_valid_d55_35;
+    if (rst) s1_valid_d55_37 <= 1'h0;
+    else s1_valid_d55_37 <= s1_valid_d55_36;
+    if (rst) s1_valid_d55_38 <= 1'h0;
+    else s1_valid_d55_38 <= s1_valid_d55_37;
+    if (rst) s1_valid_d55_39 <= 1'h0;
+    else s1_valid_d55_39 <= s1_valid_d55_38;
+    if (rst) s1_valid_d55_40 <= 1'h0;
+    else s1_valid_d55_40 <= s1_valid_d55_39;
+    if (rst) s1_valid_d55_41 <= 1'h0;
+    else s1_valid_d55_41 <= s1_valid_d55_40;
+    if (rst) s1_valid_d55_42 <= 1'h0;
+    else s1_valid_d55_42 <= s1_valid_d55_41;
+    if (rst) s1_valid_d55_43 <= 1'h0;
+    else s1_valid_d55_43 <= s1_valid_d55_42;
+    if (rst) s1_valid_d55_44 <= 1'h0;
+    else s1_valid_d55_44 <= s1_valid_d55_43;
+    if (rst) s1_valid_d55_45 <= 1'h0;
+    else s1_valid_d55_45 <= s1_valid_d55_44;
+    if (rst) s1_valid_d55_46 <= 1'h0;
+    else s1_valid_d55_46 <= s1_valid_d55_45;
+    if (rst) s1_valid_d55_47 <= 1'h0;
+    else s1_valid_d55_47 <= s1_valid_d55_46;
+    if (rst) s1_valid_d55_48 <= 1'h0;
+    else s1_valid_d55_48 <= s1_valid_d55_47;
+    if (rst) s1_valid_d55_49 <= 1'h0;
+    else s1_valid_d55_49 <= s1_valid_d55_48;
+    if (rst) s1_valid_d55_50 <= 1'h0;
+    else s1_valid_d55_50 <= s1_valid_d55_49;
+    if (rst) s1_valid_d55_51 <= 1'h0;
+    else s1_valid_d55_51 <= s1_valid_d55_50;
+    if (rst) s1_valid_d55_52 <= 1'h0;
+    else s1_valid_d55_52 <= s1_valid_d55_51;
+    if (rst) s1_valid_d55_53 <= 1'h0;
+    else s1_valid_d55_53 <= s1_valid_d55_52;
+    if (rst) s1_valid_d55_54 <= 1'h0;
+    else s1_valid_d55_54 <= s1_valid_d55_53;
+    if (rst) s1_valid_d55_55 <= 1'h0;
+    else s1_valid_d55_55 <= s1_valid_d55_54;
+    s1_tag_d55_sr[55] <= s1_tag_d55_sr[54];
+    s1_tag_d55_sr[54] <= s1_tag_d55_sr[53];
+    s1_tag_d55_sr[53] <= s1_tag_d55_sr[52];
+    s1_tag_d55_sr[52] <= s1_tag_d55_sr[51];
+    s1_tag_d55_sr[51] <= s1_tag_d55_sr[50];
+    s1_tag_d55_sr[50] <= s1_tag_d55_sr[49];
+    s1_tag_d55_sr[49] <= s1_tag_d55_sr[48];
+    s1_tag_d55_sr[48] <= s1_tag_d55_sr[47];
+    s1_tag_d55_sr[47] <= s1_tag_d55_sr[46];
+    s1_tag_d55_sr[46] <= s1_tag_d55_sr[45];
+    s1_tag_d55_sr[45] <= s1_tag_d55_sr[44];
+    s1_tag_d55_sr[44] <= s1_tag_d55_sr[43];
+    s1_tag_d55_sr[43] <= s1_tag_d55_sr[42];
+    s1_tag_d55_sr[42] <= s1_tag_d55_sr[41];
+    s1_tag_d55_sr[41] <= s1_tag_d55_sr[40];
+    s1_tag_d55_sr[40] <= s1_tag_d55_sr[39];
+    s1_tag_d55_sr[39] <= s1_tag_d55_sr[38];
+    s1_tag_d55_sr[38] <= s1_tag_d55_sr[37];
+    s1_tag_d55_sr[37] <= s1_tag_d55_sr[36];
+    s1_tag_d55_sr[36] <= s1_tag_d55_sr[35];
+    s1_tag_d55_sr[35] <= s1_tag_d55_sr[34];
+    s1_tag_d55_sr[34] <= s1_tag_d55_sr[33];
+    s1_tag_d55_sr[33] <= s1_tag_d55_sr[32];
+    s1_tag_d55_sr[32] <= s1_tag_d55_sr[31];
+    s1_tag_d55_sr[31] <= s1_tag_d55_sr[30];
+    s1_tag_d55_sr[30] <= s1_tag_d55_sr[29];
+    s1_tag_d55_sr[29] <= s1_tag_d55_sr[28];
+    s1_tag_d55_sr[28] <= s1_tag_d55_sr[27];
+    s1_tag_d55_sr[27] <= s1_tag_d55_sr[26];
+    s1_tag_d55_sr[26] <= s1_tag_d55_sr[25];
+    s1_tag_d55_sr[25] <= s1_tag_d55_sr[24];
+    s1_tag_d55_sr[24] <= s1_tag_d55_sr[23];
+    s1_tag_d55_sr[23] <= s1_tag_d55_sr[22];
+    s1_tag_d55_sr[22] <= s1_tag_d55_sr[21];
+    s1_tag_d55_sr[21] <= s1_tag_d55_sr[20];
+    s1_tag_d55_sr[20] <= s1_tag_d55_sr[19];
+    s1_tag_d55_sr[19] <= s1_tag_d55_sr[18];
+    s1_tag_d55_sr[18] <= s1_tag_d55_sr[17];
+    s1_tag_d55_sr[17] <= s1_tag_d55_sr[16];
+    s1_tag_d55_sr[16] <= s1_tag_d55_sr[15];
+    s1_tag_d55_sr[15] <= s1_tag_d55_sr[14];
+    s1_tag_d55_sr[14] <= s1_tag_d55_sr[13];
+    s1_tag_d55_sr[13] <= s1_tag_d55_sr[12];
+    s1_tag_d55_sr[12] <= s1_tag_d55_sr[11];
+    s1_tag_d55_sr[11] <= s1_tag_d55_sr[10];
+    s1_tag_d55_sr[10] <= s1_tag_d55_sr[9];
+    s1_tag_d55_sr[9] <= s1_tag_d55_sr[8];
+    s1_tag_d55_sr[8] <= s1_tag_d55_sr[7];
+    s1_tag_d55_sr[7] <= s1_tag_d55_sr[6];
+    s1_tag_d55_sr[6] <= s1_tag_d55_sr[5];
+    s1_tag_d55_sr[5] <= s1_tag_d55_sr[4];
+    s1_tag_d55_sr[4] <= s1_tag_d55_sr[3];
+    s1_tag_d55_sr[3] <= s1_tag_d55_sr[2];
+    s1_tag_d55_sr[2] <= s1_tag_d55_sr[1];
+    s1_tag_d55_sr[1] <= s1_tag;
+    if (rst) s57_valid_out <= 1'h0;
+    else s57_valid_out <= s1_valid_d55_55;
+    s57_tag_out <= s1_tag_d55;
+    s57_hit <= s56_hit;
+    s57_t <= mux_s56_hit;
+    s57_u <= mux_s56_hit_1;
+    s57_v <= mux_s56_hit_2;
   end
 
   fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1 u_plane_products (
     .clk(clk),
-    .a0(s_rs_o_p),
-    .b0(s1_np),
-    .a1(s_rs_o_q),
-    .b1(s1_nq),
-    .a2(w_p),
-    .b2(s1_np),
-    .a3(w_q),
-    .b3(s1_nq),
+    .a0(s_rs_s2_o_p),
+    .b0(s1_np_d1),
+    .a1(s_rs_s2_o_q),
+    .b1(s1_nq_d1),
+    .a2(s2_w_p),
+    .b2(s1_np_d1),
+    .a3(s2_w_q),
+    .b3(s1_nq_d1),
     .p0(u_plane_products_p0),
     .p1(u_plane_products_p1),
     .p2(u_plane_products_p2),
@@ -1202,8 +1239,8 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
 
   fxrt_div_n29_a63_b34 u_div (
     .clk(clk),
-    .num(s9_num),
-    .den(s9_den),
+    .num(s10_num),
+    .den(s10_den),
     .t(u_div_t_1),
     .ok(u_div_ok)
   );
@@ -1211,34 +1248,34 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   fxrt_muls_s31xs32_s31xs32_d3l1 u_moved_products (
     .clk(clk),
     .a0(s_rs_u_div_t_1),
-    .b0(w_p_d39),
+    .b0(s2_w_p_d39),
     .a1(s_rs_u_div_t_1),
-    .b1(w_q_d39),
+    .b1(s2_w_q_d39),
     .p0(u_moved_products_p0),
     .p1(u_moved_products_p1)
   );
 
   fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1 u_bary_products (
     .clk(clk),
-    .a0(s1_e1p_d46),
-    .b0(s47_kq),
-    .a1(s1_e1q_d46),
-    .b1(s47_kp),
-    .a2(s1_e2q_d46),
-    .b2(s47_kp),
-    .a3(s1_e2p_d46),
-    .b3(s47_kq),
+    .a0(s1_e1p_d47),
+    .b0(s48_kq),
+    .a1(s1_e1q_d47),
+    .b1(s48_kp),
+    .a2(s1_e2q_d47),
+    .b2(s48_kp),
+    .a3(s1_e2p_d47),
+    .b3(s48_kq),
     .p0(u_bary_products_p0),
     .p1(u_bary_products_p1),
     .p2(u_bary_products_p2),
     .p3(u_bary_products_p3)
   );
 
-  assign valid_out = s56_valid_out;
-  assign tag_out = s56_tag_out;
-  assign hit = s56_hit;
-  assign t = s56_t;
-  assign u = s56_u;
-  assign v = s56_v;
+  assign valid_out = s57_valid_out;
+  assign tag_out = s57_tag_out;
+  assign hit = s57_hit;
+  assign t = s57_t;
+  assign u = s57_u;
+  assign v = s57_v;
 endmodule
 `default_nettype wire

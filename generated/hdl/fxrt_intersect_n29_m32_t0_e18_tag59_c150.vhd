@@ -112,7 +112,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal s1_e2p : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal s1_e2q : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
-  -- stage s7_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  -- stage s2_permute: the ray permuted by r, so the products' operands come from registers
   constant k_2 : unsigned(1 downto 0) := unsigned'("10");
   signal s1_r_eq_k_2 : unsigned(0 downto 0);
   constant k_0 : unsigned(1 downto 0) := unsigned'("00");
@@ -128,21 +128,34 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal w_r : signed(31 downto 0);
   signal w_p : signed(31 downto 0);
   signal w_q : signed(31 downto 0);
-  signal rs_o_p : unsigned(29 downto 0);
-  signal s_rs_o_p : signed(29 downto 0);
-  signal rs_o_q : unsigned(29 downto 0);
-  signal s_rs_o_q : signed(29 downto 0);
-  signal rs_s1_d : signed(32 downto 0);
-  signal rs_o_r : unsigned(29 downto 0);
-  signal s_rs_o_r : signed(29 downto 0);
-  signal rs_s_rs_o_r : signed(32 downto 0);
+  signal s2_o_r : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal s2_o_p : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal s2_o_q : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal s2_w_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s2_w_p : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s2_w_q : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+
+  -- stage s8_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  signal rs_s2_o_p : unsigned(29 downto 0);
+  signal s_rs_s2_o_p : signed(29 downto 0);
+  signal rs_s2_o_q : unsigned(29 downto 0);
+  signal s_rs_s2_o_q : signed(29 downto 0);
+  signal s1_d_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal rs_s1_d_d1 : signed(32 downto 0);
+  signal rs_s2_o_r : unsigned(29 downto 0);
+  signal s_rs_s2_o_r : signed(29 downto 0);
+  signal rs_s_rs_s2_o_r : signed(32 downto 0);
   signal dmo : signed(32 downto 0);
-  signal rs_s1_pp : unsigned(29 downto 0);
-  signal s_rs_s1_pp : signed(29 downto 0);
+  signal s1_pp_d1 : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal rs_s1_pp_d1 : unsigned(29 downto 0);
+  signal s_rs_s1_pp_d1 : signed(29 downto 0);
   signal kp0 : signed(29 downto 0);
-  signal rs_s1_pq : unsigned(29 downto 0);
-  signal s_rs_s1_pq : signed(29 downto 0);
+  signal s1_pq_d1 : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
+  signal rs_s1_pq_d1 : unsigned(29 downto 0);
+  signal s_rs_s1_pq_d1 : signed(29 downto 0);
   signal kq0 : signed(29 downto 0);
+  signal s1_np_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s1_nq_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal u_plane_products_p0 : signed(61 downto 0);
   signal u_plane_products_p1 : signed(61 downto 0);
   signal u_plane_products_p2 : signed(63 downto 0);
@@ -150,9 +163,9 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   type dmo_d5_sr_t is array (1 to 5) of signed(32 downto 0);
   signal dmo_d5_sr : dmo_d5_sr_t := (others => (others => '0'));
   signal dmo_d5 : signed(32 downto 0);
-  type w_r_d5_sr_t is array (1 to 5) of signed(31 downto 0);
-  signal w_r_d5_sr : w_r_d5_sr_t := (others => (others => '0'));
-  signal w_r_d5 : signed(31 downto 0);
+  type s2_w_r_d5_sr_t is array (1 to 5) of signed(31 downto 0);
+  signal s2_w_r_d5_sr : s2_w_r_d5_sr_t := (others => (others => '0'));
+  signal s2_w_r_d5 : signed(31 downto 0);
   type kp0_d5_sr_t is array (1 to 5) of signed(29 downto 0);
   signal kp0_d5_sr : kp0_d5_sr_t := (others => (others => '0'));
   signal kp0_d5 : signed(29 downto 0);
@@ -166,39 +179,39 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal rs_u_plane_products_p2 : signed(64 downto 0);
   signal rs_u_plane_products_p3 : signed(64 downto 0);
   signal wsum : signed(64 downto 0);
-  signal s7_num1 : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
-  signal s7_onq : signed(61 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000");
-  signal s7_wsum : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s7_w_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s8_num1 : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s8_onq : signed(61 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000");
+  signal s8_wsum : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s8_w_r : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
-  -- stage s8_quotient_in: the ω sum rounded
-  signal rs_s7_onq : signed(62 downto 0);
+  -- stage s9_quotient_in: the ω sum rounded
+  signal rs_s8_onq : signed(62 downto 0);
   signal num : signed(62 downto 0);
   constant k_1073741824 : signed(64 downto 0) := signed'("00000000000000000000000000000000001000000000000000000000000000000");
   signal plus_5 : signed(64 downto 0);
   signal shr_plus_5 : signed(64 downto 0);
-  signal s8_num : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
-  signal s8_wr : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-
-  -- stage s9_quotient: numerator and rounded denominator, T bits dropped
-  signal s7_w_r_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal rs_s7_w_r_d1 : signed(33 downto 0);
-  signal rs_s8_wr : signed(33 downto 0);
-  signal den : signed(33 downto 0);
   signal s9_num : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
-  signal s9_den : signed(33 downto 0) := signed'("0000000000000000000000000000000000");
+  signal s9_wr : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s46_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
+  -- stage s10_quotient: numerator and rounded denominator, T bits dropped
+  signal s8_w_r_d1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal rs_s8_w_r_d1 : signed(33 downto 0);
+  signal rs_s9_wr : signed(33 downto 0);
+  signal den : signed(33 downto 0);
+  signal s10_num : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s10_den : signed(33 downto 0) := signed'("0000000000000000000000000000000000");
+
+  -- stage s47_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   signal u_div_t_1 : unsigned(29 downto 0);
   signal u_div_ok : unsigned(0 downto 0);
   signal rs_u_div_t_1 : unsigned(30 downto 0);
   signal s_rs_u_div_t_1 : signed(30 downto 0);
-  type w_p_d39_sr_t is array (1 to 39) of signed(31 downto 0);
-  signal w_p_d39_sr : w_p_d39_sr_t := (others => (others => '0'));
-  signal w_p_d39 : signed(31 downto 0);
-  type w_q_d39_sr_t is array (1 to 39) of signed(31 downto 0);
-  signal w_q_d39_sr : w_q_d39_sr_t := (others => (others => '0'));
-  signal w_q_d39 : signed(31 downto 0);
+  type s2_w_p_d39_sr_t is array (1 to 39) of signed(31 downto 0);
+  signal s2_w_p_d39_sr : s2_w_p_d39_sr_t := (others => (others => '0'));
+  signal s2_w_p_d39 : signed(31 downto 0);
+  type s2_w_q_d39_sr_t is array (1 to 39) of signed(31 downto 0);
+  signal s2_w_q_d39_sr : s2_w_q_d39_sr_t := (others => (others => '0'));
+  signal s2_w_q_d39 : signed(31 downto 0);
   signal u_moved_products_p0 : signed(62 downto 0);
   signal u_moved_products_p1 : signed(62 downto 0);
   constant k_1073741824_1 : signed(62 downto 0) := signed'("000000000000000000000000000000001000000000000000000000000000000");
@@ -206,38 +219,38 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal shr_plus_7 : signed(62 downto 0);
   signal plus_8 : signed(62 downto 0);
   signal shr_plus_8 : signed(62 downto 0);
-  signal s46_tp : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
-  signal s46_tq : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s47_tp : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s47_tq : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s47_point: kp, kq: the hit point relative to the first vertex
+  -- stage s48_point: kp, kq: the hit point relative to the first vertex
   type kp0_d5_d40_sr_t is array (1 to 40) of signed(29 downto 0);
   signal kp0_d5_d40_sr : kp0_d5_d40_sr_t := (others => (others => '0'));
   signal kp0_d5_d40 : signed(29 downto 0);
   signal rs_kp0_d5_d40 : signed(31 downto 0);
-  signal rs_s46_tp : signed(31 downto 0);
+  signal rs_s47_tp : signed(31 downto 0);
   signal kp : signed(31 downto 0);
   type kq0_d5_d40_sr_t is array (1 to 40) of signed(29 downto 0);
   signal kq0_d5_d40_sr : kq0_d5_d40_sr_t := (others => (others => '0'));
   signal kq0_d5_d40 : signed(29 downto 0);
   signal rs_kq0_d5_d40 : signed(31 downto 0);
-  signal rs_s46_tq : signed(31 downto 0);
+  signal rs_s47_tq : signed(31 downto 0);
   signal kq : signed(31 downto 0);
-  signal s47_kp : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal s47_kq : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s48_kp : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s48_kq : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
-  -- stage s53_uv: the barycentric coordinates u, v
-  type s1_e1p_d46_sr_t is array (1 to 46) of signed(31 downto 0);
-  signal s1_e1p_d46_sr : s1_e1p_d46_sr_t := (others => (others => '0'));
-  signal s1_e1p_d46 : signed(31 downto 0);
-  type s1_e1q_d46_sr_t is array (1 to 46) of signed(31 downto 0);
-  signal s1_e1q_d46_sr : s1_e1q_d46_sr_t := (others => (others => '0'));
-  signal s1_e1q_d46 : signed(31 downto 0);
-  type s1_e2q_d46_sr_t is array (1 to 46) of signed(31 downto 0);
-  signal s1_e2q_d46_sr : s1_e2q_d46_sr_t := (others => (others => '0'));
-  signal s1_e2q_d46 : signed(31 downto 0);
-  type s1_e2p_d46_sr_t is array (1 to 46) of signed(31 downto 0);
-  signal s1_e2p_d46_sr : s1_e2p_d46_sr_t := (others => (others => '0'));
-  signal s1_e2p_d46 : signed(31 downto 0);
+  -- stage s54_uv: the barycentric coordinates u, v
+  type s1_e1p_d47_sr_t is array (1 to 47) of signed(31 downto 0);
+  signal s1_e1p_d47_sr : s1_e1p_d47_sr_t := (others => (others => '0'));
+  signal s1_e1p_d47 : signed(31 downto 0);
+  type s1_e1q_d47_sr_t is array (1 to 47) of signed(31 downto 0);
+  signal s1_e1q_d47_sr : s1_e1q_d47_sr_t := (others => (others => '0'));
+  signal s1_e1q_d47 : signed(31 downto 0);
+  type s1_e2q_d47_sr_t is array (1 to 47) of signed(31 downto 0);
+  signal s1_e2q_d47_sr : s1_e2q_d47_sr_t := (others => (others => '0'));
+  signal s1_e2q_d47 : signed(31 downto 0);
+  type s1_e2p_d47_sr_t is array (1 to 47) of signed(31 downto 0);
+  signal s1_e2p_d47_sr : s1_e2p_d47_sr_t := (others => (others => '0'));
+  signal s1_e2p_d47 : signed(31 downto 0);
   signal u_bary_products_p0 : signed(63 downto 0);
   signal u_bary_products_p1 : signed(63 downto 0);
   signal u_bary_products_p2 : signed(63 downto 0);
@@ -248,159 +261,160 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal rs_u_bary_products_p2 : signed(64 downto 0);
   signal rs_u_bary_products_p3 : signed(64 downto 0);
   signal v_int : signed(64 downto 0);
-  signal s53_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s53_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s54_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s54_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s54_test: u + v as two short sums; the signs
-  signal u_s53_u : unsigned(64 downto 0);
-  signal bits_u_s53_u : unsigned(15 downto 0);
-  signal rs_bits_u_s53_u : unsigned(16 downto 0);
-  signal u_s53_v : unsigned(64 downto 0);
-  signal bits_u_s53_v : unsigned(15 downto 0);
-  signal rs_bits_u_s53_v : unsigned(16 downto 0);
+  -- stage s55_test: u + v as two short sums; the signs
+  signal u_s54_u : unsigned(64 downto 0);
+  signal bits_u_s54_u : unsigned(15 downto 0);
+  signal rs_bits_u_s54_u : unsigned(16 downto 0);
+  signal u_s54_v : unsigned(64 downto 0);
+  signal bits_u_s54_v : unsigned(15 downto 0);
+  signal rs_bits_u_s54_v : unsigned(16 downto 0);
   signal uv_sum_high : unsigned(16 downto 0);
-  signal u_s53_u_1 : unsigned(64 downto 0);
-  signal bits_u_s53_u_1 : unsigned(48 downto 0);
-  signal rs_bits_u_s53_u_1 : unsigned(49 downto 0);
-  signal u_s53_v_1 : unsigned(64 downto 0);
-  signal bits_u_s53_v_1 : unsigned(48 downto 0);
-  signal rs_bits_u_s53_v_1 : unsigned(49 downto 0);
+  signal u_s54_u_1 : unsigned(64 downto 0);
+  signal bits_u_s54_u_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s54_u_1 : unsigned(49 downto 0);
+  signal u_s54_v_1 : unsigned(64 downto 0);
+  signal bits_u_s54_v_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s54_v_1 : unsigned(49 downto 0);
   signal uv_sum_low : unsigned(49 downto 0);
   constant k_0_1 : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s53_u_lt_k_0_1 : unsigned(0 downto 0);
-  signal s53_v_lt_k_0_1 : unsigned(0 downto 0);
+  signal s54_u_lt_k_0_1 : unsigned(0 downto 0);
+  signal s54_v_lt_k_0_1 : unsigned(0 downto 0);
   signal negative : unsigned(0 downto 0);
-  signal s54_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
-  signal s54_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
-  signal s54_neg : unsigned(0 downto 0) := unsigned'("0");
+  signal s55_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
+  signal s55_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
+  signal s55_neg : unsigned(0 downto 0) := unsigned'("0");
 
-  -- stage s55_hit: the hit bit
-  signal bits_s54_hs : unsigned(15 downto 0);
-  signal bits_bits_s54_hs : unsigned(7 downto 0);
+  -- stage s56_hit: the hit bit
+  signal bits_s55_hs : unsigned(15 downto 0);
+  signal bits_bits_s55_hs : unsigned(7 downto 0);
   constant k_0_2 : unsigned(7 downto 0) := unsigned'("00000000");
   signal ne_16 : unsigned(0 downto 0);
-  signal bits_bits_s54_hs_1 : unsigned(7 downto 0);
+  signal bits_bits_s55_hs_1 : unsigned(7 downto 0);
   signal ne_17 : unsigned(0 downto 0);
   signal high : unsigned(1 downto 0);
-  signal bits_s54_hs_1 : unsigned(0 downto 0);
-  signal bits_s54_ls : unsigned(0 downto 0);
-  signal bits_s54_ls_1 : unsigned(48 downto 0);
-  signal bits_bits_s54_ls_1 : unsigned(0 downto 0);
+  signal bits_s55_hs_1 : unsigned(0 downto 0);
+  signal bits_s55_ls : unsigned(0 downto 0);
+  signal bits_s55_ls_1 : unsigned(48 downto 0);
+  signal bits_bits_s55_ls_1 : unsigned(0 downto 0);
   constant k_0_3 : unsigned(0 downto 0) := unsigned'("0");
   signal ne_19 : unsigned(0 downto 0);
-  signal bits_bits_s54_ls_1_1 : unsigned(7 downto 0);
+  signal bits_bits_s55_ls_1_1 : unsigned(7 downto 0);
   signal ne_20 : unsigned(0 downto 0);
-  signal bits_bits_s54_ls_1_2 : unsigned(7 downto 0);
+  signal bits_bits_s55_ls_1_2 : unsigned(7 downto 0);
   signal ne_21 : unsigned(0 downto 0);
-  signal bits_bits_s54_ls_1_3 : unsigned(7 downto 0);
+  signal bits_bits_s55_ls_1_3 : unsigned(7 downto 0);
   signal ne_22 : unsigned(0 downto 0);
-  signal bits_bits_s54_ls_1_4 : unsigned(7 downto 0);
+  signal bits_bits_s55_ls_1_4 : unsigned(7 downto 0);
   signal ne_23 : unsigned(0 downto 0);
-  signal bits_bits_s54_ls_1_5 : unsigned(7 downto 0);
+  signal bits_bits_s55_ls_1_5 : unsigned(7 downto 0);
   signal ne_24 : unsigned(0 downto 0);
-  signal bits_bits_s54_ls_1_6 : unsigned(7 downto 0);
+  signal bits_bits_s55_ls_1_6 : unsigned(7 downto 0);
   signal ne_25 : unsigned(0 downto 0);
   signal low : unsigned(6 downto 0);
   constant k_0_4 : unsigned(6 downto 0) := unsigned'("0000000");
   signal low_ne_k_0_4 : unsigned(0 downto 0);
   signal high_ne_k_0 : unsigned(0 downto 0);
   signal or_27 : unsigned(0 downto 0);
-  signal bits_s54_hs_1_and_or_27 : unsigned(0 downto 0);
+  signal bits_s55_hs_1_and_or_27 : unsigned(0 downto 0);
   signal or_28 : unsigned(0 downto 0);
   signal and_29 : unsigned(0 downto 0);
   signal over : unsigned(0 downto 0);
-  signal s54_neg_or_over : unsigned(0 downto 0);
-  signal not_s54_neg_or_over : unsigned(0 downto 0);
+  signal s55_neg_or_over : unsigned(0 downto 0);
+  signal not_s55_neg_or_over : unsigned(0 downto 0);
   type u_div_ok_d14_sr_t is array (1 to 14) of unsigned(0 downto 0);
   signal u_div_ok_d14_sr : u_div_ok_d14_sr_t := (others => (others => '0'));
   signal u_div_ok_d14 : unsigned(0 downto 0);
   signal hit_c : unsigned(0 downto 0);
-  signal s55_hit : unsigned(0 downto 0) := unsigned'("0");
+  signal s56_hit : unsigned(0 downto 0) := unsigned'("0");
 
-  -- stage s56_result: the barycentric test; t, u, v zeroed on a miss
+  -- stage s57_result: the barycentric test; t, u, v zeroed on a miss
   type u_div_t_1_d15_sr_t is array (1 to 15) of unsigned(29 downto 0);
   signal u_div_t_1_d15_sr : u_div_t_1_d15_sr_t := (others => (others => '0'));
   signal u_div_t_1_d15 : unsigned(29 downto 0);
-  type s53_u_d2_sr_t is array (1 to 2) of signed(64 downto 0);
-  signal s53_u_d2_sr : s53_u_d2_sr_t := (others => (others => '0'));
-  signal s53_u_d2 : signed(64 downto 0);
-  type s53_v_d2_sr_t is array (1 to 2) of signed(64 downto 0);
-  signal s53_v_d2_sr : s53_v_d2_sr_t := (others => (others => '0'));
-  signal s53_v_d2 : signed(64 downto 0);
-  signal s1_valid_d54_1 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_2 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_3 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_4 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_5 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_6 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_7 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_8 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_9 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_10 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_11 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_12 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_13 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_14 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_15 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_16 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_17 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_18 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_19 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_20 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_21 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_22 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_23 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_24 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_25 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_26 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_27 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_28 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_29 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_30 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_31 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_32 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_33 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_34 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_35 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_36 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_37 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_38 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_39 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_40 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_41 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_42 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_43 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_44 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_45 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_46 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_47 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_48 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_49 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_50 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_51 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_52 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_53 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d54_54 : unsigned(0 downto 0) := unsigned'("0");
-  type s1_tag_d54_sr_t is array (1 to 54) of unsigned(58 downto 0);
-  signal s1_tag_d54_sr : s1_tag_d54_sr_t := (others => (others => '0'));
-  signal s1_tag_d54 : unsigned(58 downto 0);
+  type s54_u_d2_sr_t is array (1 to 2) of signed(64 downto 0);
+  signal s54_u_d2_sr : s54_u_d2_sr_t := (others => (others => '0'));
+  signal s54_u_d2 : signed(64 downto 0);
+  type s54_v_d2_sr_t is array (1 to 2) of signed(64 downto 0);
+  signal s54_v_d2_sr : s54_v_d2_sr_t := (others => (others => '0'));
+  signal s54_v_d2 : signed(64 downto 0);
+  signal s1_valid_d55_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_6 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_7 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_8 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_9 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_10 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_11 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_12 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_13 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_14 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_15 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_16 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_17 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_18 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_19 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_20 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_21 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_22 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_23 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_24 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_25 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_26 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_27 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_28 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_29 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_30 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_31 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_32 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_33 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_34 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_35 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_36 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_37 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_38 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_39 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_40 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_41 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_42 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_43 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_44 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_45 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_46 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_47 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_48 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_49 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_50 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_51 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_52 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_53 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_54 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d55_55 : unsigned(0 downto 0) := unsigned'("0");
+  type s1_tag_d55_sr_t is array (1 to 55) of unsigned(58 downto 0);
+  signal s1_tag_d55_sr : s1_tag_d55_sr_t := (others => (others => '0'));
+  signal s1_tag_d55 : unsigned(58 downto 0);
   constant k_0_5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal mux_s55_hit : unsigned(29 downto 0);
-  signal shr_s53_u_d2 : signed(64 downto 0);
-  signal rs_shr_s53_u_d2 : signed(31 downto 0);
-  signal u_rs_shr_s53_u_d2 : unsigned(31 downto 0);
+  signal mux_s56_hit : unsigned(29 downto 0);
+  signal shr_s54_u_d2 : signed(64 downto 0);
+  signal rs_shr_s54_u_d2 : signed(31 downto 0);
+  signal u_rs_shr_s54_u_d2 : unsigned(31 downto 0);
   constant k_0_6 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal mux_s55_hit_1 : unsigned(31 downto 0);
-  signal shr_s53_v_d2 : signed(64 downto 0);
-  signal rs_shr_s53_v_d2 : signed(31 downto 0);
-  signal u_rs_shr_s53_v_d2 : unsigned(31 downto 0);
-  signal mux_s55_hit_2 : unsigned(31 downto 0);
-  signal s56_valid_out : unsigned(0 downto 0) := unsigned'("0");
-  signal s56_tag_out : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
-  signal s56_hit : unsigned(0 downto 0) := unsigned'("0");
-  signal s56_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal s56_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal s56_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal mux_s56_hit_1 : unsigned(31 downto 0);
+  signal shr_s54_v_d2 : signed(64 downto 0);
+  signal rs_shr_s54_v_d2 : signed(31 downto 0);
+  signal u_rs_shr_s54_v_d2 : unsigned(31 downto 0);
+  signal mux_s56_hit_2 : unsigned(31 downto 0);
+  signal s57_valid_out : unsigned(0 downto 0) := unsigned'("0");
+  signal s57_tag_out : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal s57_hit : unsigned(0 downto 0) := unsigned'("0");
+  signal s57_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s57_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s57_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 begin
 
   -- not in a stage or state machine
@@ -435,7 +449,7 @@ begin
     end if;
   end process s1_inputs_regs;
 
-  -- stage s7_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  -- stage s2_permute: the ray permuted by r, so the products' operands come from registers
   s1_r_eq_k_2 <= "1" when s1_r = k_2 else "0";
   s1_r_plus_k_1 <= s1_r + k_1;
   perm_p <= k_0 when s1_r_eq_k_2 = "1" else s1_r_plus_k_1;
@@ -472,23 +486,37 @@ begin
       s1_wy when "01",
       s1_wz when "10",
       s1_wx when others;
-  rs_o_p <= resize(o_p, 30);
-  s_rs_o_p <= signed(rs_o_p);
-  rs_o_q <= resize(o_q, 30);
-  s_rs_o_q <= signed(rs_o_q);
-  rs_s1_d <= resize(s1_d, 33);
-  rs_o_r <= resize(o_r, 30);
-  s_rs_o_r <= signed(rs_o_r);
-  rs_s_rs_o_r <= resize(s_rs_o_r, 33);
-  dmo <= rs_s1_d - rs_s_rs_o_r;
-  rs_s1_pp <= resize(s1_pp, 30);
-  s_rs_s1_pp <= signed(rs_s1_pp);
-  kp0 <= s_rs_o_p - s_rs_s1_pp;
-  rs_s1_pq <= resize(s1_pq, 30);
-  s_rs_s1_pq <= signed(rs_s1_pq);
-  kq0 <= s_rs_o_q - s_rs_s1_pq;
+
+  s2_permute_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s2_o_r <= o_r;
+      s2_o_p <= o_p;
+      s2_o_q <= o_q;
+      s2_w_r <= w_r;
+      s2_w_p <= w_p;
+      s2_w_q <= w_q;
+    end if;
+  end process s2_permute_regs;
+
+  -- stage s8_numerator: (d − O_r)·2^F − O_p·np; ω_p·np + ω_q·nq
+  rs_s2_o_p <= resize(s2_o_p, 30);
+  s_rs_s2_o_p <= signed(rs_s2_o_p);
+  rs_s2_o_q <= resize(s2_o_q, 30);
+  s_rs_s2_o_q <= signed(rs_s2_o_q);
+  rs_s1_d_d1 <= resize(s1_d_d1, 33);
+  rs_s2_o_r <= resize(s2_o_r, 30);
+  s_rs_s2_o_r <= signed(rs_s2_o_r);
+  rs_s_rs_s2_o_r <= resize(s_rs_s2_o_r, 33);
+  dmo <= rs_s1_d_d1 - rs_s_rs_s2_o_r;
+  rs_s1_pp_d1 <= resize(s1_pp_d1, 30);
+  s_rs_s1_pp_d1 <= signed(rs_s1_pp_d1);
+  kp0 <= s_rs_s2_o_p - s_rs_s1_pp_d1;
+  rs_s1_pq_d1 <= resize(s1_pq_d1, 30);
+  s_rs_s1_pq_d1 <= signed(rs_s1_pq_d1);
+  kq0 <= s_rs_s2_o_q - s_rs_s1_pq_d1;
   dmo_d5 <= dmo_d5_sr(5);
-  w_r_d5 <= w_r_d5_sr(5);
+  s2_w_r_d5 <= s2_w_r_d5_sr(5);
   kp0_d5 <= kp0_d5_sr(5);
   kq0_d5 <= kq0_d5_sr(5);
   rs_dmo_d5 <= resize(dmo_d5, 63);
@@ -499,101 +527,106 @@ begin
   rs_u_plane_products_p3 <= resize(u_plane_products_p3, 65);
   wsum <= rs_u_plane_products_p2 + rs_u_plane_products_p3;
 
-  s7_numerator_regs : process (clk)
+  s8_numerator_regs : process (clk)
   begin
     if rising_edge(clk) then
+      s1_d_d1 <= s1_d;
+      s1_pp_d1 <= s1_pp;
+      s1_pq_d1 <= s1_pq;
+      s1_np_d1 <= s1_np;
+      s1_nq_d1 <= s1_nq;
       dmo_d5_sr(2 to 5) <= dmo_d5_sr(1 to 4);
       dmo_d5_sr(1) <= dmo;
-      w_r_d5_sr(2 to 5) <= w_r_d5_sr(1 to 4);
-      w_r_d5_sr(1) <= w_r;
+      s2_w_r_d5_sr(2 to 5) <= s2_w_r_d5_sr(1 to 4);
+      s2_w_r_d5_sr(1) <= s2_w_r;
       kp0_d5_sr(2 to 5) <= kp0_d5_sr(1 to 4);
       kp0_d5_sr(1) <= kp0;
       kq0_d5_sr(2 to 5) <= kq0_d5_sr(1 to 4);
       kq0_d5_sr(1) <= kq0;
-      s7_num1 <= num1;
-      s7_onq <= u_plane_products_p1;
-      s7_wsum <= wsum;
-      s7_w_r <= w_r_d5;
+      s8_num1 <= num1;
+      s8_onq <= u_plane_products_p1;
+      s8_wsum <= wsum;
+      s8_w_r <= s2_w_r_d5;
     end if;
-  end process s7_numerator_regs;
+  end process s8_numerator_regs;
 
-  -- stage s8_quotient_in: the ω sum rounded
-  rs_s7_onq <= resize(s7_onq, 63);
-  num <= s7_num1 - rs_s7_onq;
-  plus_5 <= s7_wsum + k_1073741824;
+  -- stage s9_quotient_in: the ω sum rounded
+  rs_s8_onq <= resize(s8_onq, 63);
+  num <= s8_num1 - rs_s8_onq;
+  plus_5 <= s8_wsum + k_1073741824;
   shr_plus_5 <= shift_right(plus_5, 31);
 
-  s8_quotient_in_regs : process (clk)
+  s9_quotient_in_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s8_num <= num;
-      s8_wr <= shr_plus_5;
+      s9_num <= num;
+      s9_wr <= shr_plus_5;
     end if;
-  end process s8_quotient_in_regs;
+  end process s9_quotient_in_regs;
 
-  -- stage s9_quotient: numerator and rounded denominator, T bits dropped
-  rs_s7_w_r_d1 <= resize(s7_w_r_d1, 34);
-  rs_s8_wr <= s8_wr(33 downto 0);
-  den <= rs_s7_w_r_d1 + rs_s8_wr;
+  -- stage s10_quotient: numerator and rounded denominator, T bits dropped
+  rs_s8_w_r_d1 <= resize(s8_w_r_d1, 34);
+  rs_s9_wr <= s9_wr(33 downto 0);
+  den <= rs_s8_w_r_d1 + rs_s9_wr;
 
-  s9_quotient_regs : process (clk)
+  s10_quotient_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s7_w_r_d1 <= s7_w_r;
-      s9_num <= s8_num;
-      s9_den <= den;
+      s8_w_r_d1 <= s8_w_r;
+      s10_num <= s9_num;
+      s10_den <= den;
     end if;
-  end process s9_quotient_regs;
+  end process s10_quotient_regs;
 
-  -- stage s46_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
+  -- stage s47_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   rs_u_div_t_1 <= resize(u_div_t_1, 31);
   s_rs_u_div_t_1 <= signed(rs_u_div_t_1);
-  w_p_d39 <= w_p_d39_sr(39);
-  w_q_d39 <= w_q_d39_sr(39);
+  s2_w_p_d39 <= s2_w_p_d39_sr(39);
+  s2_w_q_d39 <= s2_w_q_d39_sr(39);
   plus_7 <= u_moved_products_p0 + k_1073741824_1;
   shr_plus_7 <= shift_right(plus_7, 31);
   plus_8 <= u_moved_products_p1 + k_1073741824_1;
   shr_plus_8 <= shift_right(plus_8, 31);
 
-  s46_rounded_regs : process (clk)
+  s47_rounded_regs : process (clk)
   begin
     if rising_edge(clk) then
-      w_p_d39_sr(2 to 39) <= w_p_d39_sr(1 to 38);
-      w_p_d39_sr(1) <= w_p;
-      w_q_d39_sr(2 to 39) <= w_q_d39_sr(1 to 38);
-      w_q_d39_sr(1) <= w_q;
-      s46_tp <= shr_plus_7;
-      s46_tq <= shr_plus_8;
+      s2_w_p_d39_sr(2 to 39) <= s2_w_p_d39_sr(1 to 38);
+      s2_w_p_d39_sr(1) <= s2_w_p;
+      s2_w_q_d39_sr(2 to 39) <= s2_w_q_d39_sr(1 to 38);
+      s2_w_q_d39_sr(1) <= s2_w_q;
+      s47_tp <= shr_plus_7;
+      s47_tq <= shr_plus_8;
     end if;
-  end process s46_rounded_regs;
+  end process s47_rounded_regs;
 
-  -- stage s47_point: kp, kq: the hit point relative to the first vertex
+  -- stage s48_point: kp, kq: the hit point relative to the first vertex
   kp0_d5_d40 <= kp0_d5_d40_sr(40);
   rs_kp0_d5_d40 <= resize(kp0_d5_d40, 32);
-  rs_s46_tp <= s46_tp(31 downto 0);
-  kp <= rs_kp0_d5_d40 + rs_s46_tp;
+  rs_s47_tp <= s47_tp(31 downto 0);
+  kp <= rs_kp0_d5_d40 + rs_s47_tp;
   kq0_d5_d40 <= kq0_d5_d40_sr(40);
   rs_kq0_d5_d40 <= resize(kq0_d5_d40, 32);
-  rs_s46_tq <= s46_tq(31 downto 0);
-  kq <= rs_kq0_d5_d40 + rs_s46_tq;
+  rs_s47_tq <= s47_tq(31 downto 0);
+  kq <= rs_kq0_d5_d40 + rs_s47_tq;
 
-  s47_point_regs : process (clk)
+  s48_point_regs : process (clk)
   begin
     if rising_edge(clk) then
       kp0_d5_d40_sr(2 to 40) <= kp0_d5_d40_sr(1 to 39);
       kp0_d5_d40_sr(1) <= kp0_d5;
       kq0_d5_d40_sr(2 to 40) <= kq0_d5_d40_sr(1 to 39);
       kq0_d5_d40_sr(1) <= kq0_d5;
-      s47_kp <= kp;
-      s47_kq <= kq;
+      s48_kp <= kp;
+      s48_kq <= kq;
     end if;
-  end process s47_point_regs;
+  end process s48_point_regs;
 
-  -- stage s53_uv: the barycentric coordinates u, v
-  s1_e1p_d46 <= s1_e1p_d46_sr(46);
-  s1_e1q_d46 <= s1_e1q_d46_sr(46);
-  s1_e2q_d46 <= s1_e2q_d46_sr(46);
-  s1_e2p_d46 <= s1_e2p_d46_sr(46);
+  -- stage s54_uv: the barycentric coordinates u, v
+  s1_e1p_d47 <= s1_e1p_d47_sr(47);
+  s1_e1q_d47 <= s1_e1q_d47_sr(47);
+  s1_e2q_d47 <= s1_e2q_d47_sr(47);
+  s1_e2p_d47 <= s1_e2p_d47_sr(47);
   rs_u_bary_products_p0 <= resize(u_bary_products_p0, 65);
   rs_u_bary_products_p1 <= resize(u_bary_products_p1, 65);
   u_int <= rs_u_bary_products_p0 - rs_u_bary_products_p1;
@@ -601,416 +634,421 @@ begin
   rs_u_bary_products_p3 <= resize(u_bary_products_p3, 65);
   v_int <= rs_u_bary_products_p2 - rs_u_bary_products_p3;
 
-  s53_uv_regs : process (clk)
+  s54_uv_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s1_e1p_d46_sr(2 to 46) <= s1_e1p_d46_sr(1 to 45);
-      s1_e1p_d46_sr(1) <= s1_e1p;
-      s1_e1q_d46_sr(2 to 46) <= s1_e1q_d46_sr(1 to 45);
-      s1_e1q_d46_sr(1) <= s1_e1q;
-      s1_e2q_d46_sr(2 to 46) <= s1_e2q_d46_sr(1 to 45);
-      s1_e2q_d46_sr(1) <= s1_e2q;
-      s1_e2p_d46_sr(2 to 46) <= s1_e2p_d46_sr(1 to 45);
-      s1_e2p_d46_sr(1) <= s1_e2p;
-      s53_u <= u_int;
-      s53_v <= v_int;
+      s1_e1p_d47_sr(2 to 47) <= s1_e1p_d47_sr(1 to 46);
+      s1_e1p_d47_sr(1) <= s1_e1p;
+      s1_e1q_d47_sr(2 to 47) <= s1_e1q_d47_sr(1 to 46);
+      s1_e1q_d47_sr(1) <= s1_e1q;
+      s1_e2q_d47_sr(2 to 47) <= s1_e2q_d47_sr(1 to 46);
+      s1_e2q_d47_sr(1) <= s1_e2q;
+      s1_e2p_d47_sr(2 to 47) <= s1_e2p_d47_sr(1 to 46);
+      s1_e2p_d47_sr(1) <= s1_e2p;
+      s54_u <= u_int;
+      s54_v <= v_int;
     end if;
-  end process s53_uv_regs;
+  end process s54_uv_regs;
 
-  -- stage s54_test: u + v as two short sums; the signs
-  u_s53_u <= unsigned(s53_u);
-  bits_u_s53_u <= unsigned(u_s53_u(64 downto 49));
-  rs_bits_u_s53_u <= resize(bits_u_s53_u, 17);
-  u_s53_v <= unsigned(s53_v);
-  bits_u_s53_v <= unsigned(u_s53_v(64 downto 49));
-  rs_bits_u_s53_v <= resize(bits_u_s53_v, 17);
-  uv_sum_high <= rs_bits_u_s53_u + rs_bits_u_s53_v;
-  u_s53_u_1 <= unsigned(s53_u);
-  bits_u_s53_u_1 <= unsigned(u_s53_u_1(48 downto 0));
-  rs_bits_u_s53_u_1 <= resize(bits_u_s53_u_1, 50);
-  u_s53_v_1 <= unsigned(s53_v);
-  bits_u_s53_v_1 <= unsigned(u_s53_v_1(48 downto 0));
-  rs_bits_u_s53_v_1 <= resize(bits_u_s53_v_1, 50);
-  uv_sum_low <= rs_bits_u_s53_u_1 + rs_bits_u_s53_v_1;
-  s53_u_lt_k_0_1 <= "1" when s53_u < k_0_1 else "0";
-  s53_v_lt_k_0_1 <= "1" when s53_v < k_0_1 else "0";
-  negative <= s53_u_lt_k_0_1 or s53_v_lt_k_0_1;
+  -- stage s55_test: u + v as two short sums; the signs
+  u_s54_u <= unsigned(s54_u);
+  bits_u_s54_u <= unsigned(u_s54_u(64 downto 49));
+  rs_bits_u_s54_u <= resize(bits_u_s54_u, 17);
+  u_s54_v <= unsigned(s54_v);
+  bits_u_s54_v <= unsigned(u_s54_v(64 downto 49));
+  rs_bits_u_s54_v <= resize(bits_u_s54_v, 17);
+  uv_sum_high <= rs_bits_u_s54_u + rs_bits_u_s54_v;
+  u_s54_u_1 <= unsigned(s54_u);
+  bits_u_s54_u_1 <= unsigned(u_s54_u_1(48 downto 0));
+  rs_bits_u_s54_u_1 <= resize(bits_u_s54_u_1, 50);
+  u_s54_v_1 <= unsigned(s54_v);
+  bits_u_s54_v_1 <= unsigned(u_s54_v_1(48 downto 0));
+  rs_bits_u_s54_v_1 <= resize(bits_u_s54_v_1, 50);
+  uv_sum_low <= rs_bits_u_s54_u_1 + rs_bits_u_s54_v_1;
+  s54_u_lt_k_0_1 <= "1" when s54_u < k_0_1 else "0";
+  s54_v_lt_k_0_1 <= "1" when s54_v < k_0_1 else "0";
+  negative <= s54_u_lt_k_0_1 or s54_v_lt_k_0_1;
 
-  s54_test_regs : process (clk)
+  s55_test_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s54_hs <= uv_sum_high;
-      s54_ls <= uv_sum_low;
-      s54_neg <= negative;
+      s55_hs <= uv_sum_high;
+      s55_ls <= uv_sum_low;
+      s55_neg <= negative;
     end if;
-  end process s54_test_regs;
+  end process s55_test_regs;
 
-  -- stage s55_hit: the hit bit
-  bits_s54_hs <= unsigned(s54_hs(16 downto 1));
-  bits_bits_s54_hs <= unsigned(bits_s54_hs(15 downto 8));
-  ne_16 <= "1" when bits_bits_s54_hs /= k_0_2 else "0";
-  bits_bits_s54_hs_1 <= unsigned(bits_s54_hs(7 downto 0));
-  ne_17 <= "1" when bits_bits_s54_hs_1 /= k_0_2 else "0";
+  -- stage s56_hit: the hit bit
+  bits_s55_hs <= unsigned(s55_hs(16 downto 1));
+  bits_bits_s55_hs <= unsigned(bits_s55_hs(15 downto 8));
+  ne_16 <= "1" when bits_bits_s55_hs /= k_0_2 else "0";
+  bits_bits_s55_hs_1 <= unsigned(bits_s55_hs(7 downto 0));
+  ne_17 <= "1" when bits_bits_s55_hs_1 /= k_0_2 else "0";
   high <= unsigned(std_logic_vector'(std_logic_vector(ne_16) & std_logic_vector(ne_17)));
-  bits_s54_hs_1 <= unsigned(s54_hs(0 downto 0));
-  bits_s54_ls <= unsigned(s54_ls(49 downto 49));
-  bits_s54_ls_1 <= unsigned(s54_ls(48 downto 0));
-  bits_bits_s54_ls_1 <= unsigned(bits_s54_ls_1(48 downto 48));
-  ne_19 <= "1" when bits_bits_s54_ls_1 /= k_0_3 else "0";
-  bits_bits_s54_ls_1_1 <= unsigned(bits_s54_ls_1(47 downto 40));
-  ne_20 <= "1" when bits_bits_s54_ls_1_1 /= k_0_2 else "0";
-  bits_bits_s54_ls_1_2 <= unsigned(bits_s54_ls_1(39 downto 32));
-  ne_21 <= "1" when bits_bits_s54_ls_1_2 /= k_0_2 else "0";
-  bits_bits_s54_ls_1_3 <= unsigned(bits_s54_ls_1(31 downto 24));
-  ne_22 <= "1" when bits_bits_s54_ls_1_3 /= k_0_2 else "0";
-  bits_bits_s54_ls_1_4 <= unsigned(bits_s54_ls_1(23 downto 16));
-  ne_23 <= "1" when bits_bits_s54_ls_1_4 /= k_0_2 else "0";
-  bits_bits_s54_ls_1_5 <= unsigned(bits_s54_ls_1(15 downto 8));
-  ne_24 <= "1" when bits_bits_s54_ls_1_5 /= k_0_2 else "0";
-  bits_bits_s54_ls_1_6 <= unsigned(bits_s54_ls_1(7 downto 0));
-  ne_25 <= "1" when bits_bits_s54_ls_1_6 /= k_0_2 else "0";
+  bits_s55_hs_1 <= unsigned(s55_hs(0 downto 0));
+  bits_s55_ls <= unsigned(s55_ls(49 downto 49));
+  bits_s55_ls_1 <= unsigned(s55_ls(48 downto 0));
+  bits_bits_s55_ls_1 <= unsigned(bits_s55_ls_1(48 downto 48));
+  ne_19 <= "1" when bits_bits_s55_ls_1 /= k_0_3 else "0";
+  bits_bits_s55_ls_1_1 <= unsigned(bits_s55_ls_1(47 downto 40));
+  ne_20 <= "1" when bits_bits_s55_ls_1_1 /= k_0_2 else "0";
+  bits_bits_s55_ls_1_2 <= unsigned(bits_s55_ls_1(39 downto 32));
+  ne_21 <= "1" when bits_bits_s55_ls_1_2 /= k_0_2 else "0";
+  bits_bits_s55_ls_1_3 <= unsigned(bits_s55_ls_1(31 downto 24));
+  ne_22 <= "1" when bits_bits_s55_ls_1_3 /= k_0_2 else "0";
+  bits_bits_s55_ls_1_4 <= unsigned(bits_s55_ls_1(23 downto 16));
+  ne_23 <= "1" when bits_bits_s55_ls_1_4 /= k_0_2 else "0";
+  bits_bits_s55_ls_1_5 <= unsigned(bits_s55_ls_1(15 downto 8));
+  ne_24 <= "1" when bits_bits_s55_ls_1_5 /= k_0_2 else "0";
+  bits_bits_s55_ls_1_6 <= unsigned(bits_s55_ls_1(7 downto 0));
+  ne_25 <= "1" when bits_bits_s55_ls_1_6 /= k_0_2 else "0";
   low <= unsigned(std_logic_vector'(std_logic_vector(ne_19) & std_logic_vector(ne_20) & std_logic_vector(ne_21) & std_logic_vector(ne_22) & std_logic_vector(ne_23) & std_logic_vector(ne_24) & std_logic_vector(ne_25)));
   low_ne_k_0_4 <= "1" when low /= k_0_4 else "0";
   high_ne_k_0 <= "1" when high /= k_0 else "0";
-  or_27 <= bits_s54_ls or low_ne_k_0_4;
-  bits_s54_hs_1_and_or_27 <= bits_s54_hs_1 and or_27;
-  or_28 <= high_ne_k_0 or bits_s54_hs_1_and_or_27;
-  and_29 <= bits_s54_ls and low_ne_k_0_4;
+  or_27 <= bits_s55_ls or low_ne_k_0_4;
+  bits_s55_hs_1_and_or_27 <= bits_s55_hs_1 and or_27;
+  or_28 <= high_ne_k_0 or bits_s55_hs_1_and_or_27;
+  and_29 <= bits_s55_ls and low_ne_k_0_4;
   over <= or_28 or and_29;
-  s54_neg_or_over <= s54_neg or over;
-  not_s54_neg_or_over <= not s54_neg_or_over;
+  s55_neg_or_over <= s55_neg or over;
+  not_s55_neg_or_over <= not s55_neg_or_over;
   u_div_ok_d14 <= u_div_ok_d14_sr(14);
-  hit_c <= not_s54_neg_or_over and u_div_ok_d14;
+  hit_c <= not_s55_neg_or_over and u_div_ok_d14;
 
-  s55_hit_regs : process (clk)
+  s56_hit_regs : process (clk)
   begin
     if rising_edge(clk) then
       u_div_ok_d14_sr(2 to 14) <= u_div_ok_d14_sr(1 to 13);
       u_div_ok_d14_sr(1) <= u_div_ok;
-      s55_hit <= hit_c;
+      s56_hit <= hit_c;
     end if;
-  end process s55_hit_regs;
+  end process s56_hit_regs;
 
-  -- stage s56_result: the barycentric test; t, u, v zeroed on a miss
+  -- stage s57_result: the barycentric test; t, u, v zeroed on a miss
   u_div_t_1_d15 <= u_div_t_1_d15_sr(15);
-  s53_u_d2 <= s53_u_d2_sr(2);
-  s53_v_d2 <= s53_v_d2_sr(2);
-  s1_tag_d54 <= s1_tag_d54_sr(54);
-  mux_s55_hit <= u_div_t_1_d15 when s55_hit = "1" else k_0_5;
-  shr_s53_u_d2 <= shift_right(s53_u_d2, 18);
-  rs_shr_s53_u_d2 <= shr_s53_u_d2(31 downto 0);
-  u_rs_shr_s53_u_d2 <= unsigned(rs_shr_s53_u_d2);
-  mux_s55_hit_1 <= u_rs_shr_s53_u_d2 when s55_hit = "1" else k_0_6;
-  shr_s53_v_d2 <= shift_right(s53_v_d2, 18);
-  rs_shr_s53_v_d2 <= shr_s53_v_d2(31 downto 0);
-  u_rs_shr_s53_v_d2 <= unsigned(rs_shr_s53_v_d2);
-  mux_s55_hit_2 <= u_rs_shr_s53_v_d2 when s55_hit = "1" else k_0_6;
+  s54_u_d2 <= s54_u_d2_sr(2);
+  s54_v_d2 <= s54_v_d2_sr(2);
+  s1_tag_d55 <= s1_tag_d55_sr(55);
+  mux_s56_hit <= u_div_t_1_d15 when s56_hit = "1" else k_0_5;
+  shr_s54_u_d2 <= shift_right(s54_u_d2, 18);
+  rs_shr_s54_u_d2 <= shr_s54_u_d2(31 downto 0);
+  u_rs_shr_s54_u_d2 <= unsigned(rs_shr_s54_u_d2);
+  mux_s56_hit_1 <= u_rs_shr_s54_u_d2 when s56_hit = "1" else k_0_6;
+  shr_s54_v_d2 <= shift_right(s54_v_d2, 18);
+  rs_shr_s54_v_d2 <= shr_s54_v_d2(31 downto 0);
+  u_rs_shr_s54_v_d2 <= unsigned(rs_shr_s54_v_d2);
+  mux_s56_hit_2 <= u_rs_shr_s54_v_d2 when s56_hit = "1" else k_0_6;
 
-  s56_result_regs : process (clk)
+  s57_result_regs : process (clk)
   begin
     if rising_edge(clk) then
       u_div_t_1_d15_sr(2 to 15) <= u_div_t_1_d15_sr(1 to 14);
       u_div_t_1_d15_sr(1) <= u_div_t_1;
-      s53_u_d2_sr(2 to 2) <= s53_u_d2_sr(1 to 1);
-      s53_u_d2_sr(1) <= s53_u;
-      s53_v_d2_sr(2 to 2) <= s53_v_d2_sr(1 to 1);
-      s53_v_d2_sr(1) <= s53_v;
+      s54_u_d2_sr(2 to 2) <= s54_u_d2_sr(1 to 1);
+      s54_u_d2_sr(1) <= s54_u;
+      s54_v_d2_sr(2 to 2) <= s54_v_d2_sr(1 to 1);
+      s54_v_d2_sr(1) <= s54_v;
       if rst = '1' then
-        s1_valid_d54_1 <= unsigned'("0");
+        s1_valid_d55_1 <= unsigned'("0");
       else
-        s1_valid_d54_1 <= s1_valid;
+        s1_valid_d55_1 <= s1_valid;
       end if;
       if rst = '1' then
-        s1_valid_d54_2 <= unsigned'("0");
+        s1_valid_d55_2 <= unsigned'("0");
       else
-        s1_valid_d54_2 <= s1_valid_d54_1;
+        s1_valid_d55_2 <= s1_valid_d55_1;
       end if;
       if rst = '1' then
-        s1_valid_d54_3 <= unsigned'("0");
+        s1_valid_d55_3 <= unsigned'("0");
       else
-        s1_valid_d54_3 <= s1_valid_d54_2;
+        s1_valid_d55_3 <= s1_valid_d55_2;
       end if;
       if rst = '1' then
-        s1_valid_d54_4 <= unsigned'("0");
+        s1_valid_d55_4 <= unsigned'("0");
       else
-        s1_valid_d54_4 <= s1_valid_d54_3;
+        s1_valid_d55_4 <= s1_valid_d55_3;
       end if;
       if rst = '1' then
-        s1_valid_d54_5 <= unsigned'("0");
+        s1_valid_d55_5 <= unsigned'("0");
       else
-        s1_valid_d54_5 <= s1_valid_d54_4;
+        s1_valid_d55_5 <= s1_valid_d55_4;
       end if;
       if rst = '1' then
-        s1_valid_d54_6 <= unsigned'("0");
+        s1_valid_d55_6 <= unsigned'("0");
       else
-        s1_valid_d54_6 <= s1_valid_d54_5;
+        s1_valid_d55_6 <= s1_valid_d55_5;
       end if;
       if rst = '1' then
-        s1_valid_d54_7 <= unsigned'("0");
+        s1_valid_d55_7 <= unsigned'("0");
       else
-        s1_valid_d54_7 <= s1_valid_d54_6;
+        s1_valid_d55_7 <= s1_valid_d55_6;
       end if;
       if rst = '1' then
-        s1_valid_d54_8 <= unsigned'("0");
+        s1_valid_d55_8 <= unsigned'("0");
       else
-        s1_valid_d54_8 <= s1_valid_d54_7;
+        s1_valid_d55_8 <= s1_valid_d55_7;
       end if;
       if rst = '1' then
-        s1_valid_d54_9 <= unsigned'("0");
+        s1_valid_d55_9 <= unsigned'("0");
       else
-        s1_valid_d54_9 <= s1_valid_d54_8;
+        s1_valid_d55_9 <= s1_valid_d55_8;
       end if;
       if rst = '1' then
-        s1_valid_d54_10 <= unsigned'("0");
+        s1_valid_d55_10 <= unsigned'("0");
       else
-        s1_valid_d54_10 <= s1_valid_d54_9;
+        s1_valid_d55_10 <= s1_valid_d55_9;
       end if;
       if rst = '1' then
-        s1_valid_d54_11 <= unsigned'("0");
+        s1_valid_d55_11 <= unsigned'("0");
       else
-        s1_valid_d54_11 <= s1_valid_d54_10;
+        s1_valid_d55_11 <= s1_valid_d55_10;
       end if;
       if rst = '1' then
-        s1_valid_d54_12 <= unsigned'("0");
+        s1_valid_d55_12 <= unsigned'("0");
       else
-        s1_valid_d54_12 <= s1_valid_d54_11;
+        s1_valid_d55_12 <= s1_valid_d55_11;
       end if;
       if rst = '1' then
-        s1_valid_d54_13 <= unsigned'("0");
+        s1_valid_d55_13 <= unsigned'("0");
       else
-        s1_valid_d54_13 <= s1_valid_d54_12;
+        s1_valid_d55_13 <= s1_valid_d55_12;
       end if;
       if rst = '1' then
-        s1_valid_d54_14 <= unsigned'("0");
+        s1_valid_d55_14 <= unsigned'("0");
       else
-        s1_valid_d54_14 <= s1_valid_d54_13;
+        s1_valid_d55_14 <= s1_valid_d55_13;
       end if;
       if rst = '1' then
-        s1_valid_d54_15 <= unsigned'("0");
+        s1_valid_d55_15 <= unsigned'("0");
       else
-        s1_valid_d54_15 <= s1_valid_d54_14;
+        s1_valid_d55_15 <= s1_valid_d55_14;
       end if;
       if rst = '1' then
-        s1_valid_d54_16 <= unsigned'("0");
+        s1_valid_d55_16 <= unsigned'("0");
       else
-        s1_valid_d54_16 <= s1_valid_d54_15;
+        s1_valid_d55_16 <= s1_valid_d55_15;
       end if;
       if rst = '1' then
-        s1_valid_d54_17 <= unsigned'("0");
+        s1_valid_d55_17 <= unsigned'("0");
       else
-        s1_valid_d54_17 <= s1_valid_d54_16;
+        s1_valid_d55_17 <= s1_valid_d55_16;
       end if;
       if rst = '1' then
-        s1_valid_d54_18 <= unsigned'("0");
+        s1_valid_d55_18 <= unsigned'("0");
       else
-        s1_valid_d54_18 <= s1_valid_d54_17;
+        s1_valid_d55_18 <= s1_valid_d55_17;
       end if;
       if rst = '1' then
-        s1_valid_d54_19 <= unsigned'("0");
+        s1_valid_d55_19 <= unsigned'("0");
       else
-        s1_valid_d54_19 <= s1_valid_d54_18;
+        s1_valid_d55_19 <= s1_valid_d55_18;
       end if;
       if rst = '1' then
-        s1_valid_d54_20 <= unsigned'("0");
+        s1_valid_d55_20 <= unsigned'("0");
       else
-        s1_valid_d54_20 <= s1_valid_d54_19;
+        s1_valid_d55_20 <= s1_valid_d55_19;
       end if;
       if rst = '1' then
-        s1_valid_d54_21 <= unsigned'("0");
+        s1_valid_d55_21 <= unsigned'("0");
       else
-        s1_valid_d54_21 <= s1_valid_d54_20;
+        s1_valid_d55_21 <= s1_valid_d55_20;
       end if;
       if rst = '1' then
-        s1_valid_d54_22 <= unsigned'("0");
+        s1_valid_d55_22 <= unsigned'("0");
       else
-        s1_valid_d54_22 <= s1_valid_d54_21;
+        s1_valid_d55_22 <= s1_valid_d55_21;
       end if;
       if rst = '1' then
-        s1_valid_d54_23 <= unsigned'("0");
+        s1_valid_d55_23 <= unsigned'("0");
       else
-        s1_valid_d54_23 <= s1_valid_d54_22;
+        s1_valid_d55_23 <= s1_valid_d55_22;
       end if;
       if rst = '1' then
-        s1_valid_d54_24 <= unsigned'("0");
+        s1_valid_d55_24 <= unsigned'("0");
       else
-        s1_valid_d54_24 <= s1_valid_d54_23;
+        s1_valid_d55_24 <= s1_valid_d55_23;
       end if;
       if rst = '1' then
-        s1_valid_d54_25 <= unsigned'("0");
+        s1_valid_d55_25 <= unsigned'("0");
       else
-        s1_valid_d54_25 <= s1_valid_d54_24;
+        s1_valid_d55_25 <= s1_valid_d55_24;
       end if;
       if rst = '1' then
-        s1_valid_d54_26 <= unsigned'("0");
+        s1_valid_d55_26 <= unsigned'("0");
       else
-        s1_valid_d54_26 <= s1_valid_d54_25;
+        s1_valid_d55_26 <= s1_valid_d55_25;
       end if;
       if rst = '1' then
-        s1_valid_d54_27 <= unsigned'("0");
+        s1_valid_d55_27 <= unsigned'("0");
       else
-        s1_valid_d54_27 <= s1_valid_d54_26;
+        s1_valid_d55_27 <= s1_valid_d55_26;
       end if;
       if rst = '1' then
-        s1_valid_d54_28 <= unsigned'("0");
+        s1_valid_d55_28 <= unsigned'("0");
       else
-        s1_valid_d54_28 <= s1_valid_d54_27;
+        s1_valid_d55_28 <= s1_valid_d55_27;
       end if;
       if rst = '1' then
-        s1_valid_d54_29 <= unsigned'("0");
+        s1_valid_d55_29 <= unsigned'("0");
       else
-        s1_valid_d54_29 <= s1_valid_d54_28;
+        s1_valid_d55_29 <= s1_valid_d55_28;
       end if;
       if rst = '1' then
-        s1_valid_d54_30 <= unsigned'("0");
+        s1_valid_d55_30 <= unsigned'("0");
       else
-        s1_valid_d54_30 <= s1_valid_d54_29;
+        s1_valid_d55_30 <= s1_valid_d55_29;
       end if;
       if rst = '1' then
-        s1_valid_d54_31 <= unsigned'("0");
+        s1_valid_d55_31 <= unsigned'("0");
       else
-        s1_valid_d54_31 <= s1_valid_d54_30;
+        s1_valid_d55_31 <= s1_valid_d55_30;
       end if;
       if rst = '1' then
-        s1_valid_d54_32 <= unsigned'("0");
+        s1_valid_d55_32 <= unsigned'("0");
       else
-        s1_valid_d54_32 <= s1_valid_d54_31;
+        s1_valid_d55_32 <= s1_valid_d55_31;
       end if;
       if rst = '1' then
-        s1_valid_d54_33 <= unsigned'("0");
+        s1_valid_d55_33 <= unsigned'("0");
       else
-        s1_valid_d54_33 <= s1_valid_d54_32;
+        s1_valid_d55_33 <= s1_valid_d55_32;
       end if;
       if rst = '1' then
-        s1_valid_d54_34 <= unsigned'("0");
+        s1_valid_d55_34 <= unsigned'("0");
       else
-        s1_valid_d54_34 <= s1_valid_d54_33;
+        s1_valid_d55_34 <= s1_valid_d55_33;
       end if;
       if rst = '1' then
-        s1_valid_d54_35 <= unsigned'("0");
+        s1_valid_d55_35 <= unsigned'("0");
       else
-        s1_valid_d54_35 <= s1_valid_d54_34;
+        s1_valid_d55_35 <= s1_valid_d55_34;
       end if;
       if rst = '1' then
-        s1_valid_d54_36 <= unsigned'("0");
+        s1_valid_d55_36 <= unsigned'("0");
       else
-        s1_valid_d54_36 <= s1_valid_d54_35;
+        s1_valid_d55_36 <= s1_valid_d55_35;
       end if;
       if rst = '1' then
-        s1_valid_d54_37 <= unsigned'("0");
+        s1_valid_d55_37 <= unsigned'("0");
       else
-        s1_valid_d54_37 <= s1_valid_d54_36;
+        s1_valid_d55_37 <= s1_valid_d55_36;
       end if;
       if rst = '1' then
-        s1_valid_d54_38 <= unsigned'("0");
+        s1_valid_d55_38 <= unsigned'("0");
       else
-        s1_valid_d54_38 <= s1_valid_d54_37;
+        s1_valid_d55_38 <= s1_valid_d55_37;
       end if;
       if rst = '1' then
-        s1_valid_d54_39 <= unsigned'("0");
+        s1_valid_d55_39 <= unsigned'("0");
       else
-        s1_valid_d54_39 <= s1_valid_d54_38;
+        s1_valid_d55_39 <= s1_valid_d55_38;
       end if;
       if rst = '1' then
-        s1_valid_d54_40 <= unsigned'("0");
+        s1_valid_d55_40 <= unsigned'("0");
       else
-        s1_valid_d54_40 <= s1_valid_d54_39;
+        s1_valid_d55_40 <= s1_valid_d55_39;
       end if;
       if rst = '1' then
-        s1_valid_d54_41 <= unsigned'("0");
+        s1_valid_d55_41 <= unsigned'("0");
       else
-        s1_valid_d54_41 <= s1_valid_d54_40;
+        s1_valid_d55_41 <= s1_valid_d55_40;
       end if;
       if rst = '1' then
-        s1_valid_d54_42 <= unsigned'("0");
+        s1_valid_d55_42 <= unsigned'("0");
       else
-        s1_valid_d54_42 <= s1_valid_d54_41;
+        s1_valid_d55_42 <= s1_valid_d55_41;
       end if;
       if rst = '1' then
-        s1_valid_d54_43 <= unsigned'("0");
+        s1_valid_d55_43 <= unsigned'("0");
       else
-        s1_valid_d54_43 <= s1_valid_d54_42;
+        s1_valid_d55_43 <= s1_valid_d55_42;
       end if;
       if rst = '1' then
-        s1_valid_d54_44 <= unsigned'("0");
+        s1_valid_d55_44 <= unsigned'("0");
       else
-        s1_valid_d54_44 <= s1_valid_d54_43;
+        s1_valid_d55_44 <= s1_valid_d55_43;
       end if;
       if rst = '1' then
-        s1_valid_d54_45 <= unsigned'("0");
+        s1_valid_d55_45 <= unsigned'("0");
       else
-        s1_valid_d54_45 <= s1_valid_d54_44;
+        s1_valid_d55_45 <= s1_valid_d55_44;
       end if;
       if rst = '1' then
-        s1_valid_d54_46 <= unsigned'("0");
+        s1_valid_d55_46 <= unsigned'("0");
       else
-        s1_valid_d54_46 <= s1_valid_d54_45;
+        s1_valid_d55_46 <= s1_valid_d55_45;
       end if;
       if rst = '1' then
-        s1_valid_d54_47 <= unsigned'("0");
+        s1_valid_d55_47 <= unsigned'("0");
       else
-        s1_valid_d54_47 <= s1_valid_d54_46;
+        s1_valid_d55_47 <= s1_valid_d55_46;
       end if;
       if rst = '1' then
-        s1_valid_d54_48 <= unsigned'("0");
+        s1_valid_d55_48 <= unsigned'("0");
       else
-        s1_valid_d54_48 <= s1_valid_d54_47;
+        s1_valid_d55_48 <= s1_valid_d55_47;
       end if;
       if rst = '1' then
-        s1_valid_d54_49 <= unsigned'("0");
+        s1_valid_d55_49 <= unsigned'("0");
       else
-        s1_valid_d54_49 <= s1_valid_d54_48;
+        s1_valid_d55_49 <= s1_valid_d55_48;
       end if;
       if rst = '1' then
-        s1_valid_d54_50 <= unsigned'("0");
+        s1_valid_d55_50 <= unsigned'("0");
       else
-        s1_valid_d54_50 <= s1_valid_d54_49;
+        s1_valid_d55_50 <= s1_valid_d55_49;
       end if;
       if rst = '1' then
-        s1_valid_d54_51 <= unsigned'("0");
+        s1_valid_d55_51 <= unsigned'("0");
       else
-        s1_valid_d54_51 <= s1_valid_d54_50;
+        s1_valid_d55_51 <= s1_valid_d55_50;
       end if;
       if rst = '1' then
-        s1_valid_d54_52 <= unsigned'("0");
+        s1_valid_d55_52 <= unsigned'("0");
       else
-        s1_valid_d54_52 <= s1_valid_d54_51;
+        s1_valid_d55_52 <= s1_valid_d55_51;
       end if;
       if rst = '1' then
-        s1_valid_d54_53 <= unsigned'("0");
+        s1_valid_d55_53 <= unsigned'("0");
       else
-        s1_valid_d54_53 <= s1_valid_d54_52;
+        s1_valid_d55_53 <= s1_valid_d55_52;
       end if;
       if rst = '1' then
-        s1_valid_d54_54 <= unsigned'("0");
+        s1_valid_d55_54 <= unsigned'("0");
       else
-        s1_valid_d54_54 <= s1_valid_d54_53;
+        s1_valid_d55_54 <= s1_valid_d55_53;
       end if;
-      s1_tag_d54_sr(2 to 54) <= s1_tag_d54_sr(1 to 53);
-      s1_tag_d54_sr(1) <= s1_tag;
       if rst = '1' then
-        s56_valid_out <= unsigned'("0");
+        s1_valid_d55_55 <= unsigned'("0");
       else
-        s56_valid_out <= s1_valid_d54_54;
+        s1_valid_d55_55 <= s1_valid_d55_54;
       end if;
-      s56_tag_out <= s1_tag_d54;
-      s56_hit <= s55_hit;
-      s56_t <= mux_s55_hit;
-      s56_u <= mux_s55_hit_1;
-      s56_v <= mux_s55_hit_2;
+      s1_tag_d55_sr(2 to 55) <= s1_tag_d55_sr(1 to 54);
+      s1_tag_d55_sr(1) <= s1_tag;
+      if rst = '1' then
+        s57_valid_out <= unsigned'("0");
+      else
+        s57_valid_out <= s1_valid_d55_55;
+      end if;
+      s57_tag_out <= s1_tag_d55;
+      s57_hit <= s56_hit;
+      s57_t <= mux_s56_hit;
+      s57_u <= mux_s56_hit_1;
+      s57_v <= mux_s56_hit_2;
     end if;
-  end process s56_result_regs;
+  end process s57_result_regs;
 
   u_plane_products : fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1
     port map (
       clk => clk,
-      a0 => s_rs_o_p,
-      b0 => s1_np,
-      a1 => s_rs_o_q,
-      b1 => s1_nq,
-      a2 => w_p,
-      b2 => s1_np,
-      a3 => w_q,
-      b3 => s1_nq,
+      a0 => s_rs_s2_o_p,
+      b0 => s1_np_d1,
+      a1 => s_rs_s2_o_q,
+      b1 => s1_nq_d1,
+      a2 => s2_w_p,
+      b2 => s1_np_d1,
+      a3 => s2_w_q,
+      b3 => s1_nq_d1,
       p0 => u_plane_products_p0,
       p1 => u_plane_products_p1,
       p2 => u_plane_products_p2,
@@ -1020,8 +1058,8 @@ begin
   u_div : fxrt_div_n29_a63_b34
     port map (
       clk => clk,
-      num => s9_num,
-      den => s9_den,
+      num => s10_num,
+      den => s10_den,
       t => u_div_t_1,
       ok => u_div_ok
     );
@@ -1030,9 +1068,9 @@ begin
     port map (
       clk => clk,
       a0 => s_rs_u_div_t_1,
-      b0 => w_p_d39,
+      b0 => s2_w_p_d39,
       a1 => s_rs_u_div_t_1,
-      b1 => w_q_d39,
+      b1 => s2_w_q_d39,
       p0 => u_moved_products_p0,
       p1 => u_moved_products_p1
     );
@@ -1040,24 +1078,24 @@ begin
   u_bary_products : fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1
     port map (
       clk => clk,
-      a0 => s1_e1p_d46,
-      b0 => s47_kq,
-      a1 => s1_e1q_d46,
-      b1 => s47_kp,
-      a2 => s1_e2q_d46,
-      b2 => s47_kp,
-      a3 => s1_e2p_d46,
-      b3 => s47_kq,
+      a0 => s1_e1p_d47,
+      b0 => s48_kq,
+      a1 => s1_e1q_d47,
+      b1 => s48_kp,
+      a2 => s1_e2q_d47,
+      b2 => s48_kp,
+      a3 => s1_e2p_d47,
+      b3 => s48_kq,
       p0 => u_bary_products_p0,
       p1 => u_bary_products_p1,
       p2 => u_bary_products_p2,
       p3 => u_bary_products_p3
     );
 
-  valid_out <= s56_valid_out;
-  tag_out <= s56_tag_out;
-  hit <= s56_hit;
-  t <= s56_t;
-  u <= s56_u;
-  v <= s56_v;
+  valid_out <= s57_valid_out;
+  tag_out <= s57_tag_out;
+  hit <= s57_hit;
+  t <= s57_t;
+  u <= s57_u;
+  v <= s57_v;
 end architecture rtl;

@@ -3,8 +3,36 @@
 module fxrt_traverse_k64_sf0a3f4 (
   input wire clk,
   input wire rst,
-  input wire [0:0] ray_we,
-  input wire [5:0] ray_slot,
+  input wire [0:0] ray_we_g0,
+  input wire [5:0] ray_slot_g0,
+  input wire [0:0] ray_we_g1,
+  input wire [5:0] ray_slot_g1,
+  input wire [0:0] ray_we_g2,
+  input wire [5:0] ray_slot_g2,
+  input wire [0:0] ray_we_g3,
+  input wire [5:0] ray_slot_g3,
+  input wire [0:0] ray_we_g4,
+  input wire [5:0] ray_slot_g4,
+  input wire [0:0] ray_we_g5,
+  input wire [5:0] ray_slot_g5,
+  input wire [0:0] ray_we_g6,
+  input wire [5:0] ray_slot_g6,
+  input wire [0:0] ray_we_g7,
+  input wire [5:0] ray_slot_g7,
+  input wire [0:0] ray_we_g8,
+  input wire [5:0] ray_slot_g8,
+  input wire [0:0] ray_we_g9,
+  input wire [5:0] ray_slot_g9,
+  input wire [0:0] ray_we_g10,
+  input wire [5:0] ray_slot_g10,
+  input wire [0:0] ray_we_g11,
+  input wire [5:0] ray_slot_g11,
+  input wire [0:0] ray_we_g12,
+  input wire [5:0] ray_slot_g12,
+  input wire [0:0] ray_we_g13,
+  input wire [5:0] ray_slot_g13,
+  input wire [0:0] ray_we_g14,
+  input wire [5:0] ray_slot_g14,
   input wire [28:0] ox,
   input wire [28:0] oy,
   input wire [28:0] oz,
@@ -45,17 +73,53 @@ module fxrt_traverse_k64_sf0a3f4 (
   output wire [6:0] occupied
 );
 
-  (* ram_style = "distributed" *) reg [86:0] ray_o [0:63];
-  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o.hex", ray_o);
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g0 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o_g0.hex", ray_o_g0);
 
-  (* ram_style = "distributed" *) reg [47:0] ray_invx [0:63];
-  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invx.hex", ray_invx);
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g1 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o_g1.hex", ray_o_g1);
 
-  (* ram_style = "distributed" *) reg [47:0] ray_invy [0:63];
-  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invy.hex", ray_invy);
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g2 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o_g2.hex", ray_o_g2);
 
-  (* ram_style = "distributed" *) reg [47:0] ray_invz [0:63];
-  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invz.hex", ray_invz);
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g3 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o_g3.hex", ray_o_g3);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_o_g4 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o_g4.hex", ray_o_g4);
+
+  (* ram_style = "distributed" *) reg [6:0] ray_o_g5 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_o_g5.hex", ray_o_g5);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invx_g0 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invx_g0.hex", ray_invx_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invx_g1 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invx_g1.hex", ray_invx_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invx_g2 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invx_g2.hex", ray_invx_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invy_g0 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invy_g0.hex", ray_invy_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invy_g1 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invy_g1.hex", ray_invy_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invy_g2 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invy_g2.hex", ray_invy_g2);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invz_g0 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invz_g0.hex", ray_invz_g0);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invz_g1 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invz_g1.hex", ray_invz_g1);
+
+  (* ram_style = "distributed" *) reg [15:0] ray_invz_g2 [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_ray_invz_g2.hex", ray_invz_g2);
+
+  (* ram_style = "distributed" *) reg [5:0] free_q_mem [0:63];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_free_q_mem.hex", free_q_mem);
 
   (* ram_style = "distributed" *) reg [11:0] unpark_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_unpark_q_mem.hex", unpark_q_mem);
@@ -92,6 +156,21 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [47:0] u_invx;
   wire [47:0] u_invy;
   wire [47:0] u_invz;
+  wire [15:0] bits_cat_0;
+  wire [15:0] bits_cat_0_1;
+  wire [15:0] bits_cat_0_2;
+  wire [15:0] bits_cat_0_3;
+  wire [15:0] bits_cat_0_4;
+  wire [6:0] bits_cat_0_5;
+  wire [15:0] bits_u_invx;
+  wire [15:0] bits_u_invx_1;
+  wire [15:0] bits_u_invx_2;
+  wire [15:0] bits_u_invy;
+  wire [15:0] bits_u_invy_1;
+  wire [15:0] bits_u_invy_2;
+  wire [15:0] bits_u_invz;
+  wire [15:0] bits_u_invz_1;
+  wire [15:0] bits_u_invz_2;
   wire [0:0] not_just_alloc;
   wire [0:0] has_free_c;
   wire [5:0] bits_leaf_q_head;
@@ -101,476 +180,76 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] bits_leaf_q_head_4;
   wire [0:0] cull_c;
 
-  // stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
-  reg [63:0] free_bits = 64'hffffffffffffffff;
-  wire [0:0] bits_free_bits;
-  wire [0:0] bits_free_bits_1;
-  wire [0:0] bits_free_bits_2;
-  wire [0:0] bits_free_bits_3;
-  wire [0:0] bits_free_bits_4;
-  wire [0:0] bits_free_bits_5;
-  wire [0:0] bits_free_bits_6;
-  wire [0:0] bits_free_bits_7;
-  wire [0:0] bits_free_bits_8;
-  wire [0:0] bits_free_bits_9;
-  wire [0:0] bits_free_bits_10;
-  wire [0:0] bits_free_bits_11;
-  wire [0:0] bits_free_bits_12;
-  wire [0:0] bits_free_bits_13;
-  wire [0:0] bits_free_bits_14;
-  wire [0:0] bits_free_bits_15;
-  wire [0:0] bits_free_bits_16;
-  wire [0:0] bits_free_bits_17;
-  wire [0:0] bits_free_bits_18;
-  wire [0:0] bits_free_bits_19;
-  wire [0:0] bits_free_bits_20;
-  wire [0:0] bits_free_bits_21;
-  wire [0:0] bits_free_bits_22;
-  wire [0:0] bits_free_bits_23;
-  wire [0:0] bits_free_bits_24;
-  wire [0:0] bits_free_bits_25;
-  wire [0:0] bits_free_bits_26;
-  wire [0:0] bits_free_bits_27;
-  wire [0:0] bits_free_bits_28;
-  wire [0:0] bits_free_bits_29;
-  wire [0:0] bits_free_bits_30;
-  wire [0:0] bits_free_bits_31;
-  wire [0:0] bits_free_bits_32;
-  wire [0:0] bits_free_bits_33;
-  wire [0:0] bits_free_bits_34;
-  wire [0:0] bits_free_bits_35;
-  wire [0:0] bits_free_bits_36;
-  wire [0:0] bits_free_bits_37;
-  wire [0:0] bits_free_bits_38;
-  wire [0:0] bits_free_bits_39;
-  wire [0:0] bits_free_bits_40;
-  wire [0:0] bits_free_bits_41;
-  wire [0:0] bits_free_bits_42;
-  wire [0:0] bits_free_bits_43;
-  wire [0:0] bits_free_bits_44;
-  wire [0:0] bits_free_bits_45;
-  wire [0:0] bits_free_bits_46;
-  wire [0:0] bits_free_bits_47;
-  wire [0:0] bits_free_bits_48;
-  wire [0:0] bits_free_bits_49;
-  wire [0:0] bits_free_bits_50;
-  wire [0:0] bits_free_bits_51;
-  wire [0:0] bits_free_bits_52;
-  wire [0:0] bits_free_bits_53;
-  wire [0:0] bits_free_bits_54;
-  wire [0:0] bits_free_bits_55;
-  wire [0:0] bits_free_bits_56;
-  wire [0:0] bits_free_bits_57;
-  wire [0:0] bits_free_bits_58;
-  wire [0:0] bits_free_bits_59;
-  wire [0:0] bits_free_bits_60;
-  wire [0:0] bits_free_bits_61;
-  wire [0:0] bits_free_bits_62;
-  wire [0:0] bits_free_bits_63;
-  wire [0:0] k_0 = 1'h0;
-  wire [0:0] not_bits_free_bits;
-  wire [0:0] or_1;
-  wire [0:0] not_bits_free_bits_2;
-  wire [0:0] or_2;
-  wire [0:0] not_bits_free_bits_4;
-  wire [0:0] or_3;
-  wire [0:0] not_bits_free_bits_6;
-  wire [0:0] or_4;
-  wire [0:0] not_bits_free_bits_8;
-  wire [0:0] or_5;
-  wire [0:0] not_bits_free_bits_10;
-  wire [0:0] or_6;
-  wire [0:0] not_bits_free_bits_12;
-  wire [0:0] or_7;
-  wire [0:0] not_bits_free_bits_14;
-  wire [0:0] or_8;
-  wire [0:0] not_bits_free_bits_16;
-  wire [0:0] or_9;
-  wire [0:0] not_bits_free_bits_18;
-  wire [0:0] or_10;
-  wire [0:0] not_bits_free_bits_20;
-  wire [0:0] or_11;
-  wire [0:0] not_bits_free_bits_22;
-  wire [0:0] or_12;
-  wire [0:0] not_bits_free_bits_24;
-  wire [0:0] or_13;
-  wire [0:0] not_bits_free_bits_26;
-  wire [0:0] or_14;
-  wire [0:0] not_bits_free_bits_28;
-  wire [0:0] or_15;
-  wire [0:0] not_bits_free_bits_30;
-  wire [0:0] or_16;
-  wire [0:0] not_bits_free_bits_32;
-  wire [0:0] or_17;
-  wire [0:0] not_bits_free_bits_34;
-  wire [0:0] or_18;
-  wire [0:0] not_bits_free_bits_36;
-  wire [0:0] or_19;
-  wire [0:0] not_bits_free_bits_38;
-  wire [0:0] or_20;
-  wire [0:0] not_bits_free_bits_40;
-  wire [0:0] or_21;
-  wire [0:0] not_bits_free_bits_42;
-  wire [0:0] or_22;
-  wire [0:0] not_bits_free_bits_44;
-  wire [0:0] or_23;
-  wire [0:0] not_bits_free_bits_46;
-  wire [0:0] or_24;
-  wire [0:0] not_bits_free_bits_48;
-  wire [0:0] or_25;
-  wire [0:0] not_bits_free_bits_50;
-  wire [0:0] or_26;
-  wire [0:0] not_bits_free_bits_52;
-  wire [0:0] or_27;
-  wire [0:0] not_bits_free_bits_54;
-  wire [0:0] or_28;
-  wire [0:0] not_bits_free_bits_56;
-  wire [0:0] or_29;
-  wire [0:0] not_bits_free_bits_58;
-  wire [0:0] or_30;
-  wire [0:0] not_bits_free_bits_60;
-  wire [0:0] or_31;
-  wire [0:0] not_bits_free_bits_62;
-  wire [0:0] or_32;
-  wire [0:0] not_or_1;
-  wire [0:0] mux_or_1;
-  wire [1:0] cat_33;
-  wire [0:0] or_1_or_or_2;
-  wire [0:0] not_or_3;
-  wire [0:0] mux_or_3;
-  wire [1:0] cat_34;
-  wire [0:0] or_3_or_or_4;
-  wire [0:0] not_or_5;
-  wire [0:0] mux_or_5;
-  wire [1:0] cat_35;
-  wire [0:0] or_5_or_or_6;
-  wire [0:0] not_or_7;
-  wire [0:0] mux_or_7;
-  wire [1:0] cat_36;
-  wire [0:0] or_7_or_or_8;
-  wire [0:0] not_or_9;
-  wire [0:0] mux_or_9;
-  wire [1:0] cat_37;
-  wire [0:0] or_9_or_or_10;
-  wire [0:0] not_or_11;
-  wire [0:0] mux_or_11;
-  wire [1:0] cat_38;
-  wire [0:0] or_11_or_or_12;
-  wire [0:0] not_or_13;
-  wire [0:0] mux_or_13;
-  wire [1:0] cat_39;
-  wire [0:0] or_13_or_or_14;
-  wire [0:0] not_or_15;
-  wire [0:0] mux_or_15;
-  wire [1:0] cat_40;
-  wire [0:0] or_15_or_or_16;
-  wire [0:0] not_or_17;
-  wire [0:0] mux_or_17;
-  wire [1:0] cat_41;
-  wire [0:0] or_17_or_or_18;
-  wire [0:0] not_or_19;
-  wire [0:0] mux_or_19;
-  wire [1:0] cat_42;
-  wire [0:0] or_19_or_or_20;
-  wire [0:0] not_or_21;
-  wire [0:0] mux_or_21;
-  wire [1:0] cat_43;
-  wire [0:0] or_21_or_or_22;
-  wire [0:0] not_or_23;
-  wire [0:0] mux_or_23;
-  wire [1:0] cat_44;
-  wire [0:0] or_23_or_or_24;
-  wire [0:0] not_or_25;
-  wire [0:0] mux_or_25;
-  wire [1:0] cat_45;
-  wire [0:0] or_25_or_or_26;
-  wire [0:0] not_or_27;
-  wire [0:0] mux_or_27;
-  wire [1:0] cat_46;
-  wire [0:0] or_27_or_or_28;
-  wire [0:0] not_or_29;
-  wire [0:0] mux_or_29;
-  wire [1:0] cat_47;
-  wire [0:0] or_29_or_or_30;
-  wire [0:0] not_or_31;
-  wire [0:0] mux_or_31;
-  wire [1:0] cat_48;
-  wire [0:0] or_31_or_or_32;
-  wire [0:0] not_or_1_or_or_2;
-  wire [1:0] mux_or_1_or_or_2;
-  wire [2:0] cat_49;
-  wire [0:0] or_50;
-  wire [0:0] not_or_5_or_or_6;
-  wire [1:0] mux_or_5_or_or_6;
-  wire [2:0] cat_51;
-  wire [0:0] or_52;
-  wire [0:0] not_or_9_or_or_10;
-  wire [1:0] mux_or_9_or_or_10;
-  wire [2:0] cat_53;
-  wire [0:0] or_54;
-  wire [0:0] not_or_13_or_or_14;
-  wire [1:0] mux_or_13_or_or_14;
-  wire [2:0] cat_55;
-  wire [0:0] or_56;
-  wire [0:0] not_or_17_or_or_18;
-  wire [1:0] mux_or_17_or_or_18;
-  wire [2:0] cat_57;
-  wire [0:0] or_58;
-  wire [0:0] not_or_21_or_or_22;
-  wire [1:0] mux_or_21_or_or_22;
-  wire [2:0] cat_59;
-  wire [0:0] or_60;
-  wire [0:0] not_or_25_or_or_26;
-  wire [1:0] mux_or_25_or_or_26;
-  wire [2:0] cat_61;
-  wire [0:0] or_62;
-  wire [0:0] not_or_29_or_or_30;
-  wire [1:0] mux_or_29_or_or_30;
-  wire [2:0] cat_63;
-  wire [0:0] or_64;
-  wire [0:0] not_or_50;
-  wire [2:0] mux_or_50;
-  wire [3:0] cat_65;
-  wire [0:0] or_50_or_or_52;
-  wire [0:0] not_or_54;
-  wire [2:0] mux_or_54;
-  wire [3:0] cat_66;
-  wire [0:0] or_54_or_or_56;
-  wire [0:0] not_or_58;
-  wire [2:0] mux_or_58;
-  wire [3:0] cat_67;
-  wire [0:0] or_58_or_or_60;
-  wire [0:0] not_or_62;
-  wire [2:0] mux_or_62;
-  wire [3:0] cat_68;
-  wire [0:0] or_62_or_or_64;
-  wire [0:0] not_or_50_or_or_52;
-  wire [3:0] mux_or_50_or_or_52;
-  wire [4:0] cat_69;
-  wire [0:0] or_70;
-  wire [0:0] not_or_58_or_or_60;
-  wire [3:0] mux_or_58_or_or_60;
-  wire [4:0] cat_71;
-  wire [0:0] or_72;
-  wire [0:0] not_or_70;
-  wire [4:0] mux_or_70;
-  wire [5:0] free_idx_c;
-  wire [0:0] free_any_c;
-  reg [0:0] free_any_r = 1'h1;
-  reg [5:0] free_idx_r = 6'h00;
-  reg [0:0] just_alloc = 1'h0;
-  wire [5:0] k_63 = 6'h3f;
-  wire [0:0] ray_slot_eq_k_63;
-  wire [5:0] k_62 = 6'h3e;
-  wire [0:0] ray_slot_eq_k_62;
-  wire [5:0] k_61 = 6'h3d;
-  wire [0:0] ray_slot_eq_k_61;
-  wire [5:0] k_60 = 6'h3c;
-  wire [0:0] ray_slot_eq_k_60;
-  wire [5:0] k_59 = 6'h3b;
-  wire [0:0] ray_slot_eq_k_59;
-  wire [5:0] k_58 = 6'h3a;
-  wire [0:0] ray_slot_eq_k_58;
-  wire [5:0] k_57 = 6'h39;
-  wire [0:0] ray_slot_eq_k_57;
-  wire [5:0] k_56 = 6'h38;
-  wire [0:0] ray_slot_eq_k_56;
-  wire [5:0] k_55 = 6'h37;
-  wire [0:0] ray_slot_eq_k_55;
-  wire [5:0] k_54 = 6'h36;
-  wire [0:0] ray_slot_eq_k_54;
-  wire [5:0] k_53 = 6'h35;
-  wire [0:0] ray_slot_eq_k_53;
-  wire [5:0] k_52 = 6'h34;
-  wire [0:0] ray_slot_eq_k_52;
-  wire [5:0] k_51 = 6'h33;
-  wire [0:0] ray_slot_eq_k_51;
-  wire [5:0] k_50 = 6'h32;
-  wire [0:0] ray_slot_eq_k_50;
-  wire [5:0] k_49 = 6'h31;
-  wire [0:0] ray_slot_eq_k_49;
-  wire [5:0] k_48 = 6'h30;
-  wire [0:0] ray_slot_eq_k_48;
-  wire [5:0] k_47 = 6'h2f;
-  wire [0:0] ray_slot_eq_k_47;
-  wire [5:0] k_46 = 6'h2e;
-  wire [0:0] ray_slot_eq_k_46;
-  wire [5:0] k_45 = 6'h2d;
-  wire [0:0] ray_slot_eq_k_45;
-  wire [5:0] k_44 = 6'h2c;
-  wire [0:0] ray_slot_eq_k_44;
-  wire [5:0] k_43 = 6'h2b;
-  wire [0:0] ray_slot_eq_k_43;
-  wire [5:0] k_42 = 6'h2a;
-  wire [0:0] ray_slot_eq_k_42;
-  wire [5:0] k_41 = 6'h29;
-  wire [0:0] ray_slot_eq_k_41;
-  wire [5:0] k_40 = 6'h28;
-  wire [0:0] ray_slot_eq_k_40;
-  wire [5:0] k_39 = 6'h27;
-  wire [0:0] ray_slot_eq_k_39;
-  wire [5:0] k_38 = 6'h26;
-  wire [0:0] ray_slot_eq_k_38;
-  wire [5:0] k_37 = 6'h25;
-  wire [0:0] ray_slot_eq_k_37;
-  wire [5:0] k_36 = 6'h24;
-  wire [0:0] ray_slot_eq_k_36;
-  wire [5:0] k_35 = 6'h23;
-  wire [0:0] ray_slot_eq_k_35;
-  wire [5:0] k_34 = 6'h22;
-  wire [0:0] ray_slot_eq_k_34;
-  wire [5:0] k_33 = 6'h21;
-  wire [0:0] ray_slot_eq_k_33;
-  wire [5:0] k_32 = 6'h20;
-  wire [0:0] ray_slot_eq_k_32;
-  wire [5:0] k_31 = 6'h1f;
-  wire [0:0] ray_slot_eq_k_31;
-  wire [5:0] k_30 = 6'h1e;
-  wire [0:0] ray_slot_eq_k_30;
-  wire [5:0] k_29 = 6'h1d;
-  wire [0:0] ray_slot_eq_k_29;
-  wire [5:0] k_28 = 6'h1c;
-  wire [0:0] ray_slot_eq_k_28;
-  wire [5:0] k_27 = 6'h1b;
-  wire [0:0] ray_slot_eq_k_27;
-  wire [5:0] k_26 = 6'h1a;
-  wire [0:0] ray_slot_eq_k_26;
-  wire [5:0] k_25 = 6'h19;
-  wire [0:0] ray_slot_eq_k_25;
-  wire [5:0] k_24 = 6'h18;
-  wire [0:0] ray_slot_eq_k_24;
-  wire [5:0] k_23 = 6'h17;
-  wire [0:0] ray_slot_eq_k_23;
-  wire [5:0] k_22 = 6'h16;
-  wire [0:0] ray_slot_eq_k_22;
-  wire [5:0] k_21 = 6'h15;
-  wire [0:0] ray_slot_eq_k_21;
-  wire [5:0] k_20 = 6'h14;
-  wire [0:0] ray_slot_eq_k_20;
-  wire [5:0] k_19 = 6'h13;
-  wire [0:0] ray_slot_eq_k_19;
-  wire [5:0] k_18 = 6'h12;
-  wire [0:0] ray_slot_eq_k_18;
-  wire [5:0] k_17 = 6'h11;
-  wire [0:0] ray_slot_eq_k_17;
-  wire [5:0] k_16 = 6'h10;
-  wire [0:0] ray_slot_eq_k_16;
-  wire [5:0] k_15 = 6'h0f;
-  wire [0:0] ray_slot_eq_k_15;
-  wire [5:0] k_14 = 6'h0e;
-  wire [0:0] ray_slot_eq_k_14;
-  wire [5:0] k_13 = 6'h0d;
-  wire [0:0] ray_slot_eq_k_13;
-  wire [5:0] k_12 = 6'h0c;
-  wire [0:0] ray_slot_eq_k_12;
-  wire [5:0] k_11 = 6'h0b;
-  wire [0:0] ray_slot_eq_k_11;
-  wire [5:0] k_10 = 6'h0a;
-  wire [0:0] ray_slot_eq_k_10;
-  wire [5:0] k_9 = 6'h09;
-  wire [0:0] ray_slot_eq_k_9;
-  wire [5:0] k_8 = 6'h08;
-  wire [0:0] ray_slot_eq_k_8;
-  wire [5:0] k_7 = 6'h07;
-  wire [0:0] ray_slot_eq_k_7;
-  wire [5:0] k_6 = 6'h06;
-  wire [0:0] ray_slot_eq_k_6;
-  wire [5:0] k_5 = 6'h05;
-  wire [0:0] ray_slot_eq_k_5;
-  wire [5:0] k_4 = 6'h04;
-  wire [0:0] ray_slot_eq_k_4;
-  wire [5:0] k_3 = 6'h03;
-  wire [0:0] ray_slot_eq_k_3;
-  wire [5:0] k_2 = 6'h02;
-  wire [0:0] ray_slot_eq_k_2;
+  // stage slots: the free list: the next free slot for the top, the slots holding a ray
+  reg [5:0] fresh_slot = 6'h00;
+  reg [0:0] fresh_left = 1'h1;
+  wire [0:0] alloc_fresh;
   wire [5:0] k_1 = 6'h01;
-  wire [0:0] ray_slot_eq_k_1;
-  wire [5:0] k_0_1 = 6'h00;
-  wire [0:0] ray_slot_eq_k_0_1;
-  wire [63:0] cat_74;
-  wire [63:0] k_0_2 = 64'h0000000000000000;
-  wire [63:0] taken_mask;
-  wire [0:0] free_slot_eq_k_63;
-  wire [0:0] free_slot_eq_k_62;
-  wire [0:0] free_slot_eq_k_61;
-  wire [0:0] free_slot_eq_k_60;
-  wire [0:0] free_slot_eq_k_59;
-  wire [0:0] free_slot_eq_k_58;
-  wire [0:0] free_slot_eq_k_57;
-  wire [0:0] free_slot_eq_k_56;
-  wire [0:0] free_slot_eq_k_55;
-  wire [0:0] free_slot_eq_k_54;
-  wire [0:0] free_slot_eq_k_53;
-  wire [0:0] free_slot_eq_k_52;
-  wire [0:0] free_slot_eq_k_51;
-  wire [0:0] free_slot_eq_k_50;
-  wire [0:0] free_slot_eq_k_49;
-  wire [0:0] free_slot_eq_k_48;
-  wire [0:0] free_slot_eq_k_47;
-  wire [0:0] free_slot_eq_k_46;
-  wire [0:0] free_slot_eq_k_45;
-  wire [0:0] free_slot_eq_k_44;
-  wire [0:0] free_slot_eq_k_43;
-  wire [0:0] free_slot_eq_k_42;
-  wire [0:0] free_slot_eq_k_41;
-  wire [0:0] free_slot_eq_k_40;
-  wire [0:0] free_slot_eq_k_39;
-  wire [0:0] free_slot_eq_k_38;
-  wire [0:0] free_slot_eq_k_37;
-  wire [0:0] free_slot_eq_k_36;
-  wire [0:0] free_slot_eq_k_35;
-  wire [0:0] free_slot_eq_k_34;
-  wire [0:0] free_slot_eq_k_33;
-  wire [0:0] free_slot_eq_k_32;
-  wire [0:0] free_slot_eq_k_31;
-  wire [0:0] free_slot_eq_k_30;
-  wire [0:0] free_slot_eq_k_29;
-  wire [0:0] free_slot_eq_k_28;
-  wire [0:0] free_slot_eq_k_27;
-  wire [0:0] free_slot_eq_k_26;
-  wire [0:0] free_slot_eq_k_25;
-  wire [0:0] free_slot_eq_k_24;
-  wire [0:0] free_slot_eq_k_23;
-  wire [0:0] free_slot_eq_k_22;
-  wire [0:0] free_slot_eq_k_21;
-  wire [0:0] free_slot_eq_k_20;
-  wire [0:0] free_slot_eq_k_19;
-  wire [0:0] free_slot_eq_k_18;
-  wire [0:0] free_slot_eq_k_17;
-  wire [0:0] free_slot_eq_k_16;
-  wire [0:0] free_slot_eq_k_15;
-  wire [0:0] free_slot_eq_k_14;
-  wire [0:0] free_slot_eq_k_13;
-  wire [0:0] free_slot_eq_k_12;
-  wire [0:0] free_slot_eq_k_11;
-  wire [0:0] free_slot_eq_k_10;
-  wire [0:0] free_slot_eq_k_9;
-  wire [0:0] free_slot_eq_k_8;
-  wire [0:0] free_slot_eq_k_7;
-  wire [0:0] free_slot_eq_k_6;
-  wire [0:0] free_slot_eq_k_5;
-  wire [0:0] free_slot_eq_k_4;
-  wire [0:0] free_slot_eq_k_3;
-  wire [0:0] free_slot_eq_k_2;
-  wire [0:0] free_slot_eq_k_1;
-  wire [0:0] free_slot_eq_k_0_1;
-  wire [63:0] cat_75;
-  wire [63:0] freed_mask;
-  wire [63:0] not_taken_mask;
-  wire [63:0] and_76;
-  wire [63:0] and_76_or_freed_mask;
+  wire [5:0] fresh_slot_plus_k_1;
+  wire [5:0] mux_alloc_fresh;
+  wire [5:0] k_63 = 6'h3f;
+  wire [0:0] fresh_is_last;
+  wire [0:0] and_1;
+  wire [0:0] not_and_1;
+  wire [0:0] fresh_left_and_not_and_1;
+  wire [0:0] not_fresh_left;
+  wire [0:0] free_q_pop;
+  reg [5:0] free_q_wr = 6'h00;
+  reg [5:0] free_q_rd = 6'h00;
+  reg [6:0] free_q_count = 7'h00;
+  wire [5:0] free_q_wr_plus_k_1;
+  wire [5:0] mux_free_q_push;
+  reg [5:0] free_q_rd1 = 6'h01;
+  wire [5:0] free_q_rd_next;
+  wire [5:0] free_q_rd1_plus_k_1;
+  wire [5:0] mux_free_q_pop;
+  wire [0:0] not_free_q_push_c1;
+  wire [6:0] rs_not_free_q_push_c1;
+  wire [6:0] free_q_count_if_pop;
+  wire [6:0] rs_free_q_push_c1;
+  wire [6:0] free_q_count_if_kept;
+  wire [6:0] free_q_count_next;
+  wire [6:0] k_0 = 7'h00;
+  wire [0:0] free_q_count_eq_k_0;
+  wire [6:0] k_1_1 = 7'h01;
+  wire [0:0] free_q_one_left;
+  wire [0:0] and_4;
+  wire [0:0] free_q_drained;
+  reg [0:0] free_q_bypass = 1'h0;
+  wire [0:0] free_q_bypass_c;
+  reg [0:0] free_q_popped = 1'h0;
+  reg [0:0] free_q_nonempty = 1'h0;
+  wire [0:0] k_1_1_lt_free_q_count;
+  wire [0:0] or_7;
+  wire [0:0] not_free_q_pop;
+  wire [0:0] and_8;
+  wire [0:0] free_q_nonempty_c;
+  reg [5:0] free_q_din = 6'h00;
+  reg [5:0] free_q_q_stay = 6'h00;
+  reg [5:0] free_q_q_next = 6'h00;
+  wire [5:0] mux_free_q_popped;
+  reg [5:0] free_q_din_r = 6'h00;
+  wire [5:0] free_q_head;
+  reg [0:0] free_any_r = 1'h1;
+  wire [0:0] free_any_c;
+  reg [5:0] free_idx_r = 6'h00;
+  wire [5:0] free_idx_c;
+  reg [0:0] just_alloc = 1'h0;
   reg [6:0] occupied_r = 7'h00;
   wire [6:0] rs_alloc;
   wire [6:0] occupied_r_plus_rs_alloc;
   wire [6:0] rs_free_valid;
-  wire [6:0] minus_77;
+  wire [6:0] minus_10;
+
+  // register copies free_q_push_copies: free_q_push and 1 copies, to split its fan-out
+  reg [0:0] free_q_push = 1'h0;
+  reg [0:0] free_q_push_c1 = 1'h0;
 
   // stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   wire [0:0] ring_g_valid;
   wire [0:0] unpark_pop;
   wire [0:0] new_pop;
-  wire [11:0] cat_78;
-  reg [0:0] unpark_q_push = 1'h0;
+  wire [11:0] cat_11;
   reg [5:0] unpark_q_wr = 6'h00;
   reg [5:0] unpark_q_rd = 6'h00;
   reg [6:0] unpark_q_count = 7'h00;
@@ -580,24 +259,24 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] unpark_q_rd_next;
   wire [5:0] unpark_q_rd1_plus_k_1;
   wire [5:0] mux_unpark_pop;
-  wire [6:0] rs_unpark_pop;
-  wire [6:0] unpark_q_after_pop;
-  wire [6:0] rs_unpark_q_push;
+  wire [0:0] not_unpark_q_push_c1;
+  wire [6:0] rs_not_unpark_q_push_c1;
+  wire [6:0] unpark_q_count_if_pop;
+  wire [6:0] rs_unpark_q_push_c1;
+  wire [6:0] unpark_q_count_if_kept;
   wire [6:0] unpark_q_count_next;
-  wire [6:0] k_0_3 = 7'h00;
-  wire [0:0] unpark_q_count_eq_k_0_3;
-  wire [6:0] k_1_1 = 7'h01;
+  wire [0:0] unpark_q_count_eq_k_0;
   wire [0:0] unpark_q_one_left;
-  wire [0:0] and_81;
+  wire [0:0] and_14;
   wire [0:0] unpark_q_drained;
   reg [0:0] unpark_q_bypass = 1'h0;
   wire [0:0] unpark_q_bypass_c;
   reg [0:0] unpark_q_popped = 1'h0;
   reg [0:0] unpark_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_unpark_q_count;
-  wire [0:0] or_84;
+  wire [0:0] or_17;
   wire [0:0] not_unpark_pop;
-  wire [0:0] and_85;
+  wire [0:0] and_18;
   wire [0:0] unpark_q_nonempty_c;
   reg [11:0] unpark_q_din = 12'h000;
   reg [11:0] unpark_q_q_stay = 12'h000;
@@ -606,36 +285,49 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [11:0] unpark_q_din_r = 12'h000;
   wire [11:0] unpark_q_head;
   wire [31:0] u_new_tmax;
-  wire [38:0] cat_86;
-  reg [0:0] new_q_push = 1'h0;
+  wire [38:0] cat_19;
   reg [5:0] new_q_wr = 6'h00;
+  reg [5:0] new_q_rd = 6'h00;
   reg [6:0] new_q_count = 7'h00;
   wire [5:0] new_q_wr_plus_k_1;
   wire [5:0] mux_new_q_push;
+  reg [5:0] new_q_rd1 = 6'h01;
   wire [5:0] new_q_rd_next;
   wire [5:0] new_q_rd1_plus_k_1;
   wire [5:0] mux_new_pop;
-  wire [6:0] rs_new_pop;
-  wire [6:0] new_q_after_pop;
-  wire [6:0] rs_new_q_push;
+  wire [0:0] not_new_q_push_c1;
+  wire [6:0] rs_not_new_q_push_c1;
+  wire [6:0] new_q_count_if_pop;
+  wire [6:0] rs_new_q_push_c1;
+  wire [6:0] new_q_count_if_kept;
   wire [6:0] new_q_count_next;
-  wire [0:0] new_q_count_eq_k_0_3;
+  wire [0:0] new_q_count_eq_k_0;
   wire [0:0] new_q_one_left;
-  wire [0:0] and_89;
+  wire [0:0] and_22;
   wire [0:0] new_q_drained;
   reg [0:0] new_q_bypass = 1'h0;
   wire [0:0] new_q_bypass_c;
   reg [0:0] new_q_popped = 1'h0;
   reg [0:0] new_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_new_q_count;
-  wire [0:0] or_92;
+  wire [0:0] or_25;
   wire [0:0] not_new_pop;
-  wire [0:0] and_93;
+  wire [0:0] and_26;
   wire [0:0] new_q_nonempty_c;
   reg [38:0] new_q_din = 39'h0000000000;
   wire [15:0] bits_new_q_din;
   wire [15:0] bits_new_q_din_1;
   wire [6:0] bits_new_q_din_2;
+  reg [5:0] new_q_rd_p1 = 6'h00;
+  reg [5:0] new_q_rd1_p1 = 6'h01;
+  wire [5:0] mux_new_pop_1;
+  wire [5:0] new_q_rd1_p1_plus_k_1;
+  wire [5:0] mux_new_pop_2;
+  reg [5:0] new_q_rd_p2 = 6'h00;
+  reg [5:0] new_q_rd1_p2 = 6'h01;
+  wire [5:0] mux_new_pop_3;
+  wire [5:0] new_q_rd1_p2_plus_k_1;
+  wire [5:0] mux_new_pop_4;
   reg [6:0] new_q_q_stay_g2 = 7'h00;
   reg [15:0] new_q_q_stay_g1 = 16'h0000;
   reg [15:0] new_q_q_stay_g0 = 16'h0000;
@@ -651,43 +343,40 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] take_unpark;
   wire [0:0] not_ring_g_valid_1;
   wire [0:0] not_unpark_q_nonempty;
-  wire [0:0] and_97;
+  wire [0:0] and_30;
   wire [0:0] take_new;
   wire [0:0] take_unpark_or_take_new;
   reg [0:0] q_valid = 1'h0;
-  reg [0:0] q_new = 1'h0;
   wire [5:0] bits_unpark_q_head;
   wire [5:0] bits_new_q_head;
   wire [5:0] mux_take_unpark;
-  reg [5:0] q_slot = 6'h00;
   wire [5:0] bits_unpark_q_head_1;
   reg [5:0] q_sp = 6'h00;
-  wire [0:0] eq_99;
+  wire [5:0] k_0_1 = 6'h00;
+  wire [0:0] eq_32;
   reg [0:0] q_sp_zero = 1'h0;
-  wire [5:0] minus_100;
+  wire [5:0] minus_33;
   reg [5:0] q_sp_m1 = 6'h00;
-  wire [4:0] rs_minus_100;
+  wire [4:0] rs_minus_33;
   wire [10:0] q_stack_raddr;
   wire [5:0] bits_unpark_q_head_2;
-  wire [0:0] eq_102;
+  wire [0:0] eq_35;
   wire [0:0] bits_new_q_head_1;
-  wire [0:0] and_103;
-  wire [0:0] take_unpark_and_eq_102;
+  wire [0:0] and_36;
+  wire [0:0] take_unpark_and_eq_35;
   wire [0:0] q_done_c;
   reg [0:0] q_done = 1'h0;
   wire [31:0] bits_new_q_head_2;
   wire signed [31:0] s_bits_new_q_head_2;
   reg signed [31:0] q_tmax = 32'sh00000000;
 
-  // register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
-  reg [5:0] new_q_rd = 6'h00;
-  reg [5:0] new_q_rd_c1 = 6'h00;
-  reg [5:0] new_q_rd_c2 = 6'h00;
+  // register copies unpark_q_push_copies: unpark_q_push and 1 copies, to split its fan-out
+  reg [0:0] unpark_q_push = 1'h0;
+  reg [0:0] unpark_q_push_c1 = 1'h0;
 
-  // register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
-  reg [5:0] new_q_rd1 = 6'h01;
-  reg [5:0] new_q_rd1_c1 = 6'h01;
-  reg [5:0] new_q_rd1_c2 = 6'h01;
+  // register copies new_q_push_copies: new_q_push and 1 copies, to split its fan-out
+  reg [0:0] new_q_push = 1'h0;
+  reg [0:0] new_q_push_c1 = 1'h0;
 
   // stage ring_r: R: the token back from G, loaded in G
   reg [0:0] r_valid = 1'h0;
@@ -714,7 +403,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] r_valid_and_r_done;
   wire [0:0] not_r_valid;
   wire [0:0] not_r_valid_and_q_valid;
-  wire [0:0] and_105;
+  wire [0:0] and_38;
   wire [0:0] a_done;
   wire [0:0] not_a_sp_zero;
   wire [0:0] a_from_stack;
@@ -729,10 +418,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] a_live;
   reg [0:0] b_valid = 1'h0;
   reg [5:0] b_slot = 6'h00;
-  wire [12:0] k_0_4 = 13'h0000;
+  wire [12:0] k_0_2 = 13'h0000;
   wire [12:0] mux_r_valid;
   reg [12:0] b_node = 13'h0000;
-  wire signed [31:0] k_0_5 = 32'sh00000000;
+  wire signed [31:0] k_0_3 = 32'sh00000000;
   wire signed [31:0] mux_r_valid_1;
   reg signed [31:0] b_tmin = 32'sh00000000;
   wire signed [31:0] mux_r_valid_2;
@@ -744,7 +433,6 @@ module fxrt_traverse_k64_sf0a3f4 (
   initial for (b_from_stack_i = 1; b_from_stack_i <= 2; b_from_stack_i = b_from_stack_i + 1) b_from_stack_sr[b_from_stack_i] = 1'h0;
   wire [0:0] b_from_stack;
   reg [0:0] b2_valid = 1'h0;
-  reg [5:0] b2_slot = 6'h00;
   reg [12:0] b2_node = 13'h0000;
   reg signed [31:0] b2_tmin = 32'sh00000000;
   reg signed [31:0] b2_tmax = 32'sh00000000;
@@ -752,7 +440,6 @@ module fxrt_traverse_k64_sf0a3f4 (
 
   // stage done: the done queue: slots whose ray left the ring in A, for the top
   reg [0:0] done_pop_r = 1'h0;
-  reg [0:0] done_q_push = 1'h0;
   reg [5:0] done_q_wr = 6'h00;
   reg [5:0] done_q_rd = 6'h00;
   reg [6:0] done_q_count = 7'h00;
@@ -762,22 +449,24 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] done_q_rd_next;
   wire [5:0] done_q_rd1_plus_k_1;
   wire [5:0] mux_done_pop_r;
-  wire [6:0] rs_done_pop_r;
-  wire [6:0] done_q_after_pop;
-  wire [6:0] rs_done_q_push;
+  wire [0:0] not_done_q_push_c1;
+  wire [6:0] rs_not_done_q_push_c1;
+  wire [6:0] done_q_count_if_pop;
+  wire [6:0] rs_done_q_push_c1;
+  wire [6:0] done_q_count_if_kept;
   wire [6:0] done_q_count_next;
-  wire [0:0] done_q_count_eq_k_0_3;
+  wire [0:0] done_q_count_eq_k_0;
   wire [0:0] done_q_one_left;
-  wire [0:0] and_109;
+  wire [0:0] and_42;
   wire [0:0] done_q_drained;
   reg [0:0] done_q_bypass = 1'h0;
   wire [0:0] done_q_bypass_c;
   reg [0:0] done_q_popped = 1'h0;
   reg [0:0] done_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_done_q_count;
-  wire [0:0] or_112;
+  wire [0:0] or_45;
   wire [0:0] not_done_pop_r;
-  wire [0:0] and_113;
+  wire [0:0] and_46;
   wire [0:0] done_q_nonempty_c;
   reg [5:0] done_q_din = 6'h00;
   reg [5:0] done_q_q_stay = 6'h00;
@@ -785,6 +474,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] mux_done_q_popped;
   reg [5:0] done_q_din_r = 6'h00;
   wire [5:0] done_q_head;
+
+  // register copies done_q_push_copies: done_q_push and 1 copies, to split its fan-out
+  reg [0:0] done_q_push = 1'h0;
+  reg [0:0] done_q_push_c1 = 1'h0;
 
   // stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   wire [31:0] bits_u_stack_data;
@@ -808,223 +501,392 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [31:0] shr_c_tmin;
   wire signed [31:0] tmin_less;
   reg signed [31:0] cull_x = 32'sh00000000;
-  wire [0:0] bits_has_best;
-  wire [0:0] bits_has_best_1;
-  wire [0:0] bits_has_best_2;
-  wire [0:0] bits_has_best_3;
-  wire [0:0] bits_has_best_4;
-  wire [0:0] bits_has_best_5;
-  wire [0:0] bits_has_best_6;
-  wire [0:0] bits_has_best_7;
-  wire [0:0] bits_has_best_8;
-  wire [0:0] bits_has_best_9;
-  wire [0:0] bits_has_best_10;
-  wire [0:0] bits_has_best_11;
-  wire [0:0] bits_has_best_12;
-  wire [0:0] bits_has_best_13;
-  wire [0:0] bits_has_best_14;
-  wire [0:0] bits_has_best_15;
-  wire [0:0] bits_has_best_16;
-  wire [0:0] bits_has_best_17;
-  wire [0:0] bits_has_best_18;
-  wire [0:0] bits_has_best_19;
-  wire [0:0] bits_has_best_20;
-  wire [0:0] bits_has_best_21;
-  wire [0:0] bits_has_best_22;
-  wire [0:0] bits_has_best_23;
-  wire [0:0] bits_has_best_24;
-  wire [0:0] bits_has_best_25;
-  wire [0:0] bits_has_best_26;
-  wire [0:0] bits_has_best_27;
-  wire [0:0] bits_has_best_28;
-  wire [0:0] bits_has_best_29;
-  wire [0:0] bits_has_best_30;
-  wire [0:0] bits_has_best_31;
-  wire [0:0] bits_has_best_32;
-  wire [0:0] bits_has_best_33;
-  wire [0:0] bits_has_best_34;
-  wire [0:0] bits_has_best_35;
-  wire [0:0] bits_has_best_36;
-  wire [0:0] bits_has_best_37;
-  wire [0:0] bits_has_best_38;
-  wire [0:0] bits_has_best_39;
-  wire [0:0] bits_has_best_40;
-  wire [0:0] bits_has_best_41;
-  wire [0:0] bits_has_best_42;
-  wire [0:0] bits_has_best_43;
-  wire [0:0] bits_has_best_44;
-  wire [0:0] bits_has_best_45;
-  wire [0:0] bits_has_best_46;
-  wire [0:0] bits_has_best_47;
-  wire [0:0] bits_has_best_48;
-  wire [0:0] bits_has_best_49;
-  wire [0:0] bits_has_best_50;
-  wire [0:0] bits_has_best_51;
-  wire [0:0] bits_has_best_52;
-  wire [0:0] bits_has_best_53;
-  wire [0:0] bits_has_best_54;
-  wire [0:0] bits_has_best_55;
-  wire [0:0] bits_has_best_56;
-  wire [0:0] bits_has_best_57;
-  wire [0:0] bits_has_best_58;
-  wire [0:0] bits_has_best_59;
-  wire [0:0] bits_has_best_60;
-  wire [0:0] bits_has_best_61;
-  wire [0:0] bits_has_best_62;
-  wire [0:0] bits_has_best_63;
-  wire [0:0] slot_has_best;
+  wire [63:0] has_best_kept;
+  wire [0:0] and_48;
+  wire [0:0] merge_slot_eq_b2_slot_c1;
+  wire [0:0] b_slot_merged_c;
+  reg [0:0] b_slot_merged = 1'h0;
+  wire [0:0] k_0_4 = 1'h0;
+  wire [0:0] bits_has_best_kept;
+  wire [0:0] bits_has_best_kept_1;
+  wire [0:0] bits_has_best_kept_2;
+  wire [0:0] bits_has_best_kept_3;
+  wire [0:0] bits_has_best_kept_4;
+  wire [0:0] bits_has_best_kept_5;
+  wire [0:0] bits_has_best_kept_6;
+  wire [0:0] bits_has_best_kept_7;
+  wire [0:0] bits_has_best_kept_8;
+  wire [0:0] bits_has_best_kept_9;
+  wire [0:0] bits_has_best_kept_10;
+  wire [0:0] bits_has_best_kept_11;
+  wire [0:0] bits_has_best_kept_12;
+  wire [0:0] bits_has_best_kept_13;
+  wire [0:0] bits_has_best_kept_14;
+  wire [0:0] bits_has_best_kept_15;
+  wire [3:0] bits_b2_slot_c1;
+  wire [0:0] slot_has_best_g0_c;
+  reg [0:0] slot_has_best_g0 = 1'h0;
+  wire [0:0] bits_has_best_kept_16;
+  wire [0:0] bits_has_best_kept_17;
+  wire [0:0] bits_has_best_kept_18;
+  wire [0:0] bits_has_best_kept_19;
+  wire [0:0] bits_has_best_kept_20;
+  wire [0:0] bits_has_best_kept_21;
+  wire [0:0] bits_has_best_kept_22;
+  wire [0:0] bits_has_best_kept_23;
+  wire [0:0] bits_has_best_kept_24;
+  wire [0:0] bits_has_best_kept_25;
+  wire [0:0] bits_has_best_kept_26;
+  wire [0:0] bits_has_best_kept_27;
+  wire [0:0] bits_has_best_kept_28;
+  wire [0:0] bits_has_best_kept_29;
+  wire [0:0] bits_has_best_kept_30;
+  wire [0:0] bits_has_best_kept_31;
+  wire [3:0] bits_b2_slot_c1_1;
+  wire [0:0] slot_has_best_g1_c;
+  reg [0:0] slot_has_best_g1 = 1'h0;
+  wire [0:0] bits_has_best_kept_32;
+  wire [0:0] bits_has_best_kept_33;
+  wire [0:0] bits_has_best_kept_34;
+  wire [0:0] bits_has_best_kept_35;
+  wire [0:0] bits_has_best_kept_36;
+  wire [0:0] bits_has_best_kept_37;
+  wire [0:0] bits_has_best_kept_38;
+  wire [0:0] bits_has_best_kept_39;
+  wire [0:0] bits_has_best_kept_40;
+  wire [0:0] bits_has_best_kept_41;
+  wire [0:0] bits_has_best_kept_42;
+  wire [0:0] bits_has_best_kept_43;
+  wire [0:0] bits_has_best_kept_44;
+  wire [0:0] bits_has_best_kept_45;
+  wire [0:0] bits_has_best_kept_46;
+  wire [0:0] bits_has_best_kept_47;
+  wire [3:0] bits_b2_slot_c1_2;
+  wire [0:0] slot_has_best_g2_c;
+  reg [0:0] slot_has_best_g2 = 1'h0;
+  wire [0:0] bits_has_best_kept_48;
+  wire [0:0] bits_has_best_kept_49;
+  wire [0:0] bits_has_best_kept_50;
+  wire [0:0] bits_has_best_kept_51;
+  wire [0:0] bits_has_best_kept_52;
+  wire [0:0] bits_has_best_kept_53;
+  wire [0:0] bits_has_best_kept_54;
+  wire [0:0] bits_has_best_kept_55;
+  wire [0:0] bits_has_best_kept_56;
+  wire [0:0] bits_has_best_kept_57;
+  wire [0:0] bits_has_best_kept_58;
+  wire [0:0] bits_has_best_kept_59;
+  wire [0:0] bits_has_best_kept_60;
+  wire [0:0] bits_has_best_kept_61;
+  wire [0:0] bits_has_best_kept_62;
+  wire [0:0] bits_has_best_kept_63;
+  wire [3:0] bits_b2_slot_c1_3;
+  wire [0:0] slot_has_best_g3_c;
+  reg [0:0] slot_has_best_g3 = 1'h0;
+  wire [1:0] bits_c_slot_c2;
+  wire [0:0] slot_has_best_c;
+  wire [0:0] slot_has_best_now;
   reg [0:0] cull_has_best = 1'h0;
   wire signed [32:0] rs_s_limit_q;
   wire signed [32:0] rs_cull_x;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_115;
+  wire signed [32:0] minus_51;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_minus_115;
+  wire [0:0] bits_minus_51;
   wire [0:0] culled_c;
   reg [0:0] culled = 1'h0;
   reg [0:0] culled_n = 1'h0;
-  wire [0:0] and_117;
+  wire [0:0] and_53;
   wire [0:0] merge_slot_eq_k_63;
+  wire [5:0] k_62 = 6'h3e;
   wire [0:0] merge_slot_eq_k_62;
+  wire [5:0] k_61 = 6'h3d;
   wire [0:0] merge_slot_eq_k_61;
+  wire [5:0] k_60 = 6'h3c;
   wire [0:0] merge_slot_eq_k_60;
+  wire [5:0] k_59 = 6'h3b;
   wire [0:0] merge_slot_eq_k_59;
+  wire [5:0] k_58 = 6'h3a;
   wire [0:0] merge_slot_eq_k_58;
+  wire [5:0] k_57 = 6'h39;
   wire [0:0] merge_slot_eq_k_57;
+  wire [5:0] k_56 = 6'h38;
   wire [0:0] merge_slot_eq_k_56;
+  wire [5:0] k_55 = 6'h37;
   wire [0:0] merge_slot_eq_k_55;
+  wire [5:0] k_54 = 6'h36;
   wire [0:0] merge_slot_eq_k_54;
+  wire [5:0] k_53 = 6'h35;
   wire [0:0] merge_slot_eq_k_53;
+  wire [5:0] k_52 = 6'h34;
   wire [0:0] merge_slot_eq_k_52;
+  wire [5:0] k_51 = 6'h33;
   wire [0:0] merge_slot_eq_k_51;
+  wire [5:0] k_50 = 6'h32;
   wire [0:0] merge_slot_eq_k_50;
+  wire [5:0] k_49 = 6'h31;
   wire [0:0] merge_slot_eq_k_49;
+  wire [5:0] k_48 = 6'h30;
   wire [0:0] merge_slot_eq_k_48;
+  wire [5:0] k_47 = 6'h2f;
   wire [0:0] merge_slot_eq_k_47;
+  wire [5:0] k_46 = 6'h2e;
   wire [0:0] merge_slot_eq_k_46;
+  wire [5:0] k_45 = 6'h2d;
   wire [0:0] merge_slot_eq_k_45;
+  wire [5:0] k_44 = 6'h2c;
   wire [0:0] merge_slot_eq_k_44;
+  wire [5:0] k_43 = 6'h2b;
   wire [0:0] merge_slot_eq_k_43;
+  wire [5:0] k_42 = 6'h2a;
   wire [0:0] merge_slot_eq_k_42;
+  wire [5:0] k_41 = 6'h29;
   wire [0:0] merge_slot_eq_k_41;
+  wire [5:0] k_40 = 6'h28;
   wire [0:0] merge_slot_eq_k_40;
+  wire [5:0] k_39 = 6'h27;
   wire [0:0] merge_slot_eq_k_39;
+  wire [5:0] k_38 = 6'h26;
   wire [0:0] merge_slot_eq_k_38;
+  wire [5:0] k_37 = 6'h25;
   wire [0:0] merge_slot_eq_k_37;
+  wire [5:0] k_36 = 6'h24;
   wire [0:0] merge_slot_eq_k_36;
+  wire [5:0] k_35 = 6'h23;
   wire [0:0] merge_slot_eq_k_35;
+  wire [5:0] k_34 = 6'h22;
   wire [0:0] merge_slot_eq_k_34;
+  wire [5:0] k_33 = 6'h21;
   wire [0:0] merge_slot_eq_k_33;
+  wire [5:0] k_32 = 6'h20;
   wire [0:0] merge_slot_eq_k_32;
+  wire [5:0] k_31 = 6'h1f;
   wire [0:0] merge_slot_eq_k_31;
+  wire [5:0] k_30 = 6'h1e;
   wire [0:0] merge_slot_eq_k_30;
+  wire [5:0] k_29 = 6'h1d;
   wire [0:0] merge_slot_eq_k_29;
+  wire [5:0] k_28 = 6'h1c;
   wire [0:0] merge_slot_eq_k_28;
+  wire [5:0] k_27 = 6'h1b;
   wire [0:0] merge_slot_eq_k_27;
+  wire [5:0] k_26 = 6'h1a;
   wire [0:0] merge_slot_eq_k_26;
+  wire [5:0] k_25 = 6'h19;
   wire [0:0] merge_slot_eq_k_25;
+  wire [5:0] k_24 = 6'h18;
   wire [0:0] merge_slot_eq_k_24;
+  wire [5:0] k_23 = 6'h17;
   wire [0:0] merge_slot_eq_k_23;
+  wire [5:0] k_22 = 6'h16;
   wire [0:0] merge_slot_eq_k_22;
+  wire [5:0] k_21 = 6'h15;
   wire [0:0] merge_slot_eq_k_21;
+  wire [5:0] k_20 = 6'h14;
   wire [0:0] merge_slot_eq_k_20;
+  wire [5:0] k_19 = 6'h13;
   wire [0:0] merge_slot_eq_k_19;
+  wire [5:0] k_18 = 6'h12;
   wire [0:0] merge_slot_eq_k_18;
+  wire [5:0] k_17 = 6'h11;
   wire [0:0] merge_slot_eq_k_17;
+  wire [5:0] k_16 = 6'h10;
   wire [0:0] merge_slot_eq_k_16;
+  wire [5:0] k_15 = 6'h0f;
   wire [0:0] merge_slot_eq_k_15;
+  wire [5:0] k_14 = 6'h0e;
   wire [0:0] merge_slot_eq_k_14;
+  wire [5:0] k_13 = 6'h0d;
   wire [0:0] merge_slot_eq_k_13;
+  wire [5:0] k_12 = 6'h0c;
   wire [0:0] merge_slot_eq_k_12;
+  wire [5:0] k_11 = 6'h0b;
   wire [0:0] merge_slot_eq_k_11;
+  wire [5:0] k_10 = 6'h0a;
   wire [0:0] merge_slot_eq_k_10;
+  wire [5:0] k_9 = 6'h09;
   wire [0:0] merge_slot_eq_k_9;
+  wire [5:0] k_8 = 6'h08;
   wire [0:0] merge_slot_eq_k_8;
+  wire [5:0] k_7 = 6'h07;
   wire [0:0] merge_slot_eq_k_7;
+  wire [5:0] k_6 = 6'h06;
   wire [0:0] merge_slot_eq_k_6;
+  wire [5:0] k_5 = 6'h05;
   wire [0:0] merge_slot_eq_k_5;
+  wire [5:0] k_4 = 6'h04;
   wire [0:0] merge_slot_eq_k_4;
+  wire [5:0] k_3 = 6'h03;
   wire [0:0] merge_slot_eq_k_3;
+  wire [5:0] k_2 = 6'h02;
   wire [0:0] merge_slot_eq_k_2;
   wire [0:0] merge_slot_eq_k_1;
   wire [0:0] merge_slot_eq_k_0_1;
-  wire [63:0] cat_118;
+  wire [63:0] cat_54;
+  wire [63:0] k_0_5 = 64'h0000000000000000;
   wire [63:0] best_set;
-  wire [0:0] q_slot_eq_k_63;
-  wire [0:0] q_slot_eq_k_62;
-  wire [0:0] q_slot_eq_k_61;
-  wire [0:0] q_slot_eq_k_60;
-  wire [0:0] q_slot_eq_k_59;
-  wire [0:0] q_slot_eq_k_58;
-  wire [0:0] q_slot_eq_k_57;
-  wire [0:0] q_slot_eq_k_56;
-  wire [0:0] q_slot_eq_k_55;
-  wire [0:0] q_slot_eq_k_54;
-  wire [0:0] q_slot_eq_k_53;
-  wire [0:0] q_slot_eq_k_52;
-  wire [0:0] q_slot_eq_k_51;
-  wire [0:0] q_slot_eq_k_50;
-  wire [0:0] q_slot_eq_k_49;
-  wire [0:0] q_slot_eq_k_48;
-  wire [0:0] q_slot_eq_k_47;
-  wire [0:0] q_slot_eq_k_46;
-  wire [0:0] q_slot_eq_k_45;
-  wire [0:0] q_slot_eq_k_44;
-  wire [0:0] q_slot_eq_k_43;
-  wire [0:0] q_slot_eq_k_42;
-  wire [0:0] q_slot_eq_k_41;
-  wire [0:0] q_slot_eq_k_40;
-  wire [0:0] q_slot_eq_k_39;
-  wire [0:0] q_slot_eq_k_38;
-  wire [0:0] q_slot_eq_k_37;
-  wire [0:0] q_slot_eq_k_36;
-  wire [0:0] q_slot_eq_k_35;
-  wire [0:0] q_slot_eq_k_34;
-  wire [0:0] q_slot_eq_k_33;
-  wire [0:0] q_slot_eq_k_32;
-  wire [0:0] q_slot_eq_k_31;
-  wire [0:0] q_slot_eq_k_30;
-  wire [0:0] q_slot_eq_k_29;
-  wire [0:0] q_slot_eq_k_28;
-  wire [0:0] q_slot_eq_k_27;
-  wire [0:0] q_slot_eq_k_26;
-  wire [0:0] q_slot_eq_k_25;
-  wire [0:0] q_slot_eq_k_24;
-  wire [0:0] q_slot_eq_k_23;
-  wire [0:0] q_slot_eq_k_22;
-  wire [0:0] q_slot_eq_k_21;
-  wire [0:0] q_slot_eq_k_20;
-  wire [0:0] q_slot_eq_k_19;
-  wire [0:0] q_slot_eq_k_18;
-  wire [0:0] q_slot_eq_k_17;
-  wire [0:0] q_slot_eq_k_16;
-  wire [0:0] q_slot_eq_k_15;
-  wire [0:0] q_slot_eq_k_14;
-  wire [0:0] q_slot_eq_k_13;
-  wire [0:0] q_slot_eq_k_12;
-  wire [0:0] q_slot_eq_k_11;
-  wire [0:0] q_slot_eq_k_10;
-  wire [0:0] q_slot_eq_k_9;
-  wire [0:0] q_slot_eq_k_8;
-  wire [0:0] q_slot_eq_k_7;
-  wire [0:0] q_slot_eq_k_6;
-  wire [0:0] q_slot_eq_k_5;
-  wire [0:0] q_slot_eq_k_4;
-  wire [0:0] q_slot_eq_k_3;
-  wire [0:0] q_slot_eq_k_2;
-  wire [0:0] q_slot_eq_k_1;
-  wire [0:0] q_slot_eq_k_0_1;
-  wire [63:0] cat_119;
+  wire [0:0] q_slot_c4_eq_k_63;
+  wire [0:0] and_55;
+  wire [0:0] q_slot_c4_eq_k_62;
+  wire [0:0] and_56;
+  wire [0:0] q_slot_c4_eq_k_61;
+  wire [0:0] and_57;
+  wire [0:0] q_slot_c4_eq_k_60;
+  wire [0:0] and_58;
+  wire [0:0] q_slot_c4_eq_k_59;
+  wire [0:0] and_59;
+  wire [0:0] q_slot_c4_eq_k_58;
+  wire [0:0] and_60;
+  wire [0:0] q_slot_c4_eq_k_57;
+  wire [0:0] and_61;
+  wire [0:0] q_slot_c4_eq_k_56;
+  wire [0:0] and_62;
+  wire [0:0] q_slot_c4_eq_k_55;
+  wire [0:0] and_63;
+  wire [0:0] q_slot_c4_eq_k_54;
+  wire [0:0] and_64;
+  wire [0:0] q_slot_c4_eq_k_53;
+  wire [0:0] and_65;
+  wire [0:0] q_slot_c4_eq_k_52;
+  wire [0:0] and_66;
+  wire [0:0] q_slot_c4_eq_k_51;
+  wire [0:0] and_67;
+  wire [0:0] q_slot_c4_eq_k_50;
+  wire [0:0] and_68;
+  wire [0:0] q_slot_c4_eq_k_49;
+  wire [0:0] and_69;
+  wire [0:0] q_slot_c4_eq_k_48;
+  wire [0:0] and_70;
+  wire [15:0] cat_71;
+  wire [0:0] q_slot_c3_eq_k_47;
+  wire [0:0] and_72;
+  wire [0:0] q_slot_c3_eq_k_46;
+  wire [0:0] and_73;
+  wire [0:0] q_slot_c3_eq_k_45;
+  wire [0:0] and_74;
+  wire [0:0] q_slot_c3_eq_k_44;
+  wire [0:0] and_75;
+  wire [0:0] q_slot_c3_eq_k_43;
+  wire [0:0] and_76;
+  wire [0:0] q_slot_c3_eq_k_42;
+  wire [0:0] and_77;
+  wire [0:0] q_slot_c3_eq_k_41;
+  wire [0:0] and_78;
+  wire [0:0] q_slot_c3_eq_k_40;
+  wire [0:0] and_79;
+  wire [0:0] q_slot_c3_eq_k_39;
+  wire [0:0] and_80;
+  wire [0:0] q_slot_c3_eq_k_38;
+  wire [0:0] and_81;
+  wire [0:0] q_slot_c3_eq_k_37;
+  wire [0:0] and_82;
+  wire [0:0] q_slot_c3_eq_k_36;
+  wire [0:0] and_83;
+  wire [0:0] q_slot_c3_eq_k_35;
+  wire [0:0] and_84;
+  wire [0:0] q_slot_c3_eq_k_34;
+  wire [0:0] and_85;
+  wire [0:0] q_slot_c3_eq_k_33;
+  wire [0:0] and_86;
+  wire [0:0] q_slot_c3_eq_k_32;
+  wire [0:0] and_87;
+  wire [15:0] cat_88;
+  wire [0:0] q_slot_c2_eq_k_31;
+  wire [0:0] and_89;
+  wire [0:0] q_slot_c2_eq_k_30;
+  wire [0:0] and_90;
+  wire [0:0] q_slot_c2_eq_k_29;
+  wire [0:0] and_91;
+  wire [0:0] q_slot_c2_eq_k_28;
+  wire [0:0] and_92;
+  wire [0:0] q_slot_c2_eq_k_27;
+  wire [0:0] and_93;
+  wire [0:0] q_slot_c2_eq_k_26;
+  wire [0:0] and_94;
+  wire [0:0] q_slot_c2_eq_k_25;
+  wire [0:0] and_95;
+  wire [0:0] q_slot_c2_eq_k_24;
+  wire [0:0] and_96;
+  wire [0:0] q_slot_c2_eq_k_23;
+  wire [0:0] and_97;
+  wire [0:0] q_slot_c2_eq_k_22;
+  wire [0:0] and_98;
+  wire [0:0] q_slot_c2_eq_k_21;
+  wire [0:0] and_99;
+  wire [0:0] q_slot_c2_eq_k_20;
+  wire [0:0] and_100;
+  wire [0:0] q_slot_c2_eq_k_19;
+  wire [0:0] and_101;
+  wire [0:0] q_slot_c2_eq_k_18;
+  wire [0:0] and_102;
+  wire [0:0] q_slot_c2_eq_k_17;
+  wire [0:0] and_103;
+  wire [0:0] q_slot_c2_eq_k_16;
+  wire [0:0] and_104;
+  wire [15:0] cat_105;
+  wire [0:0] q_slot_c1_eq_k_15;
+  wire [0:0] and_106;
+  wire [0:0] q_slot_c1_eq_k_14;
+  wire [0:0] and_107;
+  wire [0:0] q_slot_c1_eq_k_13;
+  wire [0:0] and_108;
+  wire [0:0] q_slot_c1_eq_k_12;
+  wire [0:0] and_109;
+  wire [0:0] q_slot_c1_eq_k_11;
+  wire [0:0] and_110;
+  wire [0:0] q_slot_c1_eq_k_10;
+  wire [0:0] and_111;
+  wire [0:0] q_slot_c1_eq_k_9;
+  wire [0:0] and_112;
+  wire [0:0] q_slot_c1_eq_k_8;
+  wire [0:0] and_113;
+  wire [0:0] q_slot_c1_eq_k_7;
+  wire [0:0] and_114;
+  wire [0:0] q_slot_c1_eq_k_6;
+  wire [0:0] and_115;
+  wire [0:0] q_slot_c1_eq_k_5;
+  wire [0:0] and_116;
+  wire [0:0] q_slot_c1_eq_k_4;
+  wire [0:0] and_117;
+  wire [0:0] q_slot_c1_eq_k_3;
+  wire [0:0] and_118;
+  wire [0:0] q_slot_c1_eq_k_2;
+  wire [0:0] and_119;
+  wire [0:0] q_slot_c1_eq_k_1;
+  wire [0:0] and_120;
+  wire [0:0] q_slot_c1_eq_k_0_1;
+  wire [0:0] and_121;
+  wire [15:0] cat_122;
   wire [63:0] best_clear_c;
   reg [63:0] best_clear = 64'h0000000000000000;
   wire [63:0] not_best_clear;
-  wire [63:0] and_120;
-  wire [63:0] and_120_or_best_set;
+  wire [63:0] has_best_kept_c;
+  wire [63:0] or_125;
 
   // register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
   reg [5:0] c_slot = 6'h00;
   reg [5:0] c_slot_c1 = 6'h00;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:4 are read
   reg [5:0] c_slot_c2 = 6'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  // register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+  reg [5:0] b2_slot = 6'h00;
+  reg [5:0] b2_slot_c1 = 6'h00;
+
+  // register copies q_new_copies: q_new and 4 copies, to split its fan-out
+  reg [0:0] q_new = 1'h0;
+  reg [0:0] q_new_c1 = 1'h0;
+  reg [0:0] q_new_c2 = 1'h0;
+  reg [0:0] q_new_c3 = 1'h0;
+  reg [0:0] q_new_c4 = 1'h0;
+
+  // register copies q_slot_copies: q_slot and 4 copies, to split its fan-out
+  reg [5:0] q_slot = 6'h00;
+  reg [5:0] q_slot_c1 = 6'h00;
+  reg [5:0] q_slot_c2 = 6'h00;
+  reg [5:0] q_slot_c3 = 6'h00;
+  reg [5:0] q_slot_c4 = 6'h00;
 
   // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   reg [0:0] n_valid_1 = 1'h0;
@@ -1070,38 +932,56 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [31:0] u_n_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_n_tmin;
-  wire [58:0] cat_124;
+  wire [58:0] cat_129;
   reg [0:0] leaf_pop_r = 1'h0;
-  reg [0:0] leaf_q_push = 1'h0;
   reg [5:0] leaf_q_wr = 6'h00;
+  reg [5:0] leaf_q_rd = 6'h00;
   reg [6:0] leaf_q_count = 7'h00;
   wire [5:0] leaf_q_wr_plus_k_1;
   wire [5:0] mux_leaf_q_push;
+  reg [5:0] leaf_q_rd1 = 6'h01;
   wire [5:0] leaf_q_rd_next;
   wire [5:0] leaf_q_rd1_plus_k_1;
   wire [5:0] mux_leaf_pop_r;
-  wire [6:0] rs_leaf_pop_r;
-  wire [6:0] leaf_q_after_pop;
-  wire [6:0] rs_leaf_q_push;
+  wire [0:0] not_leaf_q_push_c1;
+  wire [6:0] rs_not_leaf_q_push_c1;
+  wire [6:0] leaf_q_count_if_pop;
+  wire [6:0] rs_leaf_q_push_c1;
+  wire [6:0] leaf_q_count_if_kept;
   wire [6:0] leaf_q_count_next;
-  wire [0:0] leaf_q_count_eq_k_0_3;
+  wire [0:0] leaf_q_count_eq_k_0;
   wire [0:0] leaf_q_one_left;
-  wire [0:0] and_127;
+  wire [0:0] and_132;
   wire [0:0] leaf_q_drained;
   reg [0:0] leaf_q_bypass = 1'h0;
   wire [0:0] leaf_q_bypass_c;
   reg [0:0] leaf_q_popped = 1'h0;
   reg [0:0] leaf_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_leaf_q_count;
-  wire [0:0] or_130;
+  wire [0:0] or_135;
   wire [0:0] not_leaf_pop_r;
-  wire [0:0] and_131;
+  wire [0:0] and_136;
   wire [0:0] leaf_q_nonempty_c;
   reg [58:0] leaf_q_din = 59'h000000000000000;
   wire [15:0] bits_leaf_q_din;
   wire [15:0] bits_leaf_q_din_1;
   wire [15:0] bits_leaf_q_din_2;
   wire [10:0] bits_leaf_q_din_3;
+  reg [5:0] leaf_q_rd_p1 = 6'h00;
+  reg [5:0] leaf_q_rd1_p1 = 6'h01;
+  wire [5:0] mux_leaf_pop_r_1;
+  wire [5:0] leaf_q_rd1_p1_plus_k_1;
+  wire [5:0] mux_leaf_pop_r_2;
+  reg [5:0] leaf_q_rd_p2 = 6'h00;
+  reg [5:0] leaf_q_rd1_p2 = 6'h01;
+  wire [5:0] mux_leaf_pop_r_3;
+  wire [5:0] leaf_q_rd1_p2_plus_k_1;
+  wire [5:0] mux_leaf_pop_r_4;
+  reg [5:0] leaf_q_rd_p3 = 6'h00;
+  reg [5:0] leaf_q_rd1_p3 = 6'h01;
+  wire [5:0] mux_leaf_pop_r_5;
+  wire [5:0] leaf_q_rd1_p3_plus_k_1;
+  wire [5:0] mux_leaf_pop_r_6;
   reg [10:0] leaf_q_q_stay_g3 = 11'h000;
   reg [15:0] leaf_q_q_stay_g2 = 16'h0000;
   reg [15:0] leaf_q_q_stay_g1 = 16'h0000;
@@ -1119,15 +999,30 @@ module fxrt_traverse_k64_sf0a3f4 (
   integer n_ray_slot_early_i;
   initial for (n_ray_slot_early_i = 1; n_ray_slot_early_i <= 2; n_ray_slot_early_i = n_ray_slot_early_i + 1) n_ray_slot_early_sr[n_ray_slot_early_i] = 6'h00;
   wire [5:0] n_ray_slot_early;
-  reg [86:0] ray_o_q = 87'h0000000000000000000000;
+  reg [6:0] ray_o_q_g5 = 7'h00;
+  reg [15:0] ray_o_q_g4 = 16'h0000;
+  reg [15:0] ray_o_q_g3 = 16'h0000;
+  reg [15:0] ray_o_q_g2 = 16'h0000;
+  reg [15:0] ray_o_q_g1 = 16'h0000;
+  reg [15:0] ray_o_q_g0 = 16'h0000;
+  wire [86:0] ray_o_q;
   wire [28:0] bits_ray_o_q;
   wire [28:0] bits_ray_o_q_1;
   wire [28:0] bits_ray_o_q_2;
-  reg [47:0] ray_invx_q = 48'h000000000000;
+  reg [15:0] ray_invx_q_g2 = 16'h0000;
+  reg [15:0] ray_invx_q_g1 = 16'h0000;
+  reg [15:0] ray_invx_q_g0 = 16'h0000;
+  wire [47:0] ray_invx_q;
   wire signed [47:0] s_ray_invx_q;
-  reg [47:0] ray_invy_q = 48'h000000000000;
+  reg [15:0] ray_invy_q_g2 = 16'h0000;
+  reg [15:0] ray_invy_q_g1 = 16'h0000;
+  reg [15:0] ray_invy_q_g0 = 16'h0000;
+  wire [47:0] ray_invy_q;
   wire signed [47:0] s_ray_invy_q;
-  reg [47:0] ray_invz_q = 48'h000000000000;
+  reg [15:0] ray_invz_q_g2 = 16'h0000;
+  reg [15:0] ray_invz_q_g1 = 16'h0000;
+  reg [15:0] ray_invz_q_g0 = 16'h0000;
+  wire [47:0] ray_invz_q;
   wire signed [47:0] s_ray_invz_q;
   reg [0:0] pu_sel_valid = 1'h0;
   reg [0:0] pu_sel_last = 1'h0;
@@ -1226,7 +1121,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] pu_below_1;
   wire [0:0] not_pu_below_1;
   wire [30:0] bits_pu_shifted_1;
-  wire [0:0] ne_138;
+  wire [0:0] ne_147;
   wire [0:0] pu_above_1;
   wire signed [31:0] rs_pu_shifted_1;
   reg [0:0] pu_above_r_1 = 1'h0;
@@ -1261,23 +1156,26 @@ module fxrt_traverse_k64_sf0a3f4 (
   initial for (negative_i = 1; negative_i <= 9; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
   wire [0:0] negative;
 
-  // register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
-  reg [5:0] leaf_q_rd = 6'h00;
-  reg [5:0] leaf_q_rd_c1 = 6'h00;
-  reg [5:0] leaf_q_rd_c2 = 6'h00;
-  reg [5:0] leaf_q_rd_c3 = 6'h00;
+  // register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
+  reg [0:0] leaf_q_push = 1'h0;
+  reg [0:0] leaf_q_push_c1 = 1'h0;
 
-  // register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
-  reg [5:0] leaf_q_rd1 = 6'h01;
-  reg [5:0] leaf_q_rd1_c1 = 6'h01;
-  reg [5:0] leaf_q_rd1_c2 = 6'h01;
-  reg [5:0] leaf_q_rd1_c3 = 6'h01;
-
-  // register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+  // register copies n_ray_slot_copies: n_ray_slot and 14 copies, to split its fan-out
   reg [5:0] n_ray_slot = 6'h00;
   reg [5:0] n_ray_slot_c1 = 6'h00;
   reg [5:0] n_ray_slot_c2 = 6'h00;
   reg [5:0] n_ray_slot_c3 = 6'h00;
+  reg [5:0] n_ray_slot_c4 = 6'h00;
+  reg [5:0] n_ray_slot_c5 = 6'h00;
+  reg [5:0] n_ray_slot_c6 = 6'h00;
+  reg [5:0] n_ray_slot_c7 = 6'h00;
+  reg [5:0] n_ray_slot_c8 = 6'h00;
+  reg [5:0] n_ray_slot_c9 = 6'h00;
+  reg [5:0] n_ray_slot_c10 = 6'h00;
+  reg [5:0] n_ray_slot_c11 = 6'h00;
+  reg [5:0] n_ray_slot_c12 = 6'h00;
+  reg [5:0] n_ray_slot_c13 = 6'h00;
+  reg [5:0] n_ray_slot_c14 = 6'h00;
 
   // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   wire [0:0] not_leaf_push;
@@ -1331,7 +1229,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_tmin_n1;
   wire signed [32:0] rs_tmax_p1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_142;
+  wire signed [32:0] minus_151;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
@@ -1372,25 +1270,25 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_plane_t;
   wire signed [32:0] rs_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_143;
+  wire signed [32:0] minus_152;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below;
   wire signed [32:0] rs_d0_lo;
   wire signed [32:0] rs_plane_t_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_144;
+  wire signed [32:0] minus_153;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_above;
   wire signed [32:0] rs_plane_t_1_1;
   wire signed [32:0] rs_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_145;
+  wire signed [32:0] minus_154;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
   wire signed [32:0] rs_d1_lo;
   wire signed [32:0] rs_plane_t_1_2;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_146;
+  wire signed [32:0] minus_155;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
@@ -1428,11 +1326,11 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] push;
   reg [0:0] stack_we_r = 1'h0;
   wire [4:0] rs_g_sp;
-  wire [10:0] cat_148;
+  wire [10:0] cat_157;
   reg [10:0] stack_waddr_r = 11'h000;
   wire [31:0] u_far_min;
   wire [31:0] u_g_tmax;
-  wire [76:0] cat_149;
+  wire [76:0] cat_158;
   reg [76:0] stack_wdata_r = 77'h00000000000000000000;
   wire [0:0] enter_near_or_enter_far;
   wire [0:0] g_pop;
@@ -1448,7 +1346,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] g_sp_m1;
   wire [0:0] g_done;
   wire [4:0] rs_g_sp_m1;
-  wire [10:0] cat_150;
+  wire [10:0] cat_159;
   wire [10:0] stack_raddr_next;
 
   // not in a stage or state machine
@@ -1456,6 +1354,21 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign u_invx = $unsigned(invx);
   assign u_invy = $unsigned(invy);
   assign u_invz = $unsigned(invz);
+  assign bits_cat_0 = cat_0[15:0];
+  assign bits_cat_0_1 = cat_0[31:16];
+  assign bits_cat_0_2 = cat_0[47:32];
+  assign bits_cat_0_3 = cat_0[63:48];
+  assign bits_cat_0_4 = cat_0[79:64];
+  assign bits_cat_0_5 = cat_0[86:80];
+  assign bits_u_invx = u_invx[15:0];
+  assign bits_u_invx_1 = u_invx[31:16];
+  assign bits_u_invx_2 = u_invx[47:32];
+  assign bits_u_invy = u_invy[15:0];
+  assign bits_u_invy_1 = u_invy[31:16];
+  assign bits_u_invy_2 = u_invy[47:32];
+  assign bits_u_invz = u_invz[15:0];
+  assign bits_u_invz_1 = u_invz[31:16];
+  assign bits_u_invz_2 = u_invz[47:32];
   assign not_just_alloc = ~just_alloc;
   assign has_free_c = free_any_r & not_just_alloc;
   assign bits_leaf_q_head = leaf_q_head[5:0];
@@ -1466,10 +1379,22 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign cull_c = n_valid_3 & culled_n;
 
   always @(posedge clk) begin : regs
-    if (ray_we) ray_o[ray_slot] <= cat_0;
-    if (ray_we) ray_invx[ray_slot] <= u_invx;
-    if (ray_we) ray_invy[ray_slot] <= u_invy;
-    if (ray_we) ray_invz[ray_slot] <= u_invz;
+    if (ray_we_g0) ray_o_g0[ray_slot_g0] <= bits_cat_0;
+    if (ray_we_g1) ray_o_g1[ray_slot_g1] <= bits_cat_0_1;
+    if (ray_we_g2) ray_o_g2[ray_slot_g2] <= bits_cat_0_2;
+    if (ray_we_g3) ray_o_g3[ray_slot_g3] <= bits_cat_0_3;
+    if (ray_we_g4) ray_o_g4[ray_slot_g4] <= bits_cat_0_4;
+    if (ray_we_g5) ray_o_g5[ray_slot_g5] <= bits_cat_0_5;
+    if (ray_we_g6) ray_invx_g0[ray_slot_g6] <= bits_u_invx;
+    if (ray_we_g7) ray_invx_g1[ray_slot_g7] <= bits_u_invx_1;
+    if (ray_we_g8) ray_invx_g2[ray_slot_g8] <= bits_u_invx_2;
+    if (ray_we_g9) ray_invy_g0[ray_slot_g9] <= bits_u_invy;
+    if (ray_we_g10) ray_invy_g1[ray_slot_g10] <= bits_u_invy_1;
+    if (ray_we_g11) ray_invy_g2[ray_slot_g11] <= bits_u_invy_2;
+    if (ray_we_g12) ray_invz_g0[ray_slot_g12] <= bits_u_invz;
+    if (ray_we_g13) ray_invz_g1[ray_slot_g13] <= bits_u_invz_1;
+    if (ray_we_g14) ray_invz_g2[ray_slot_g14] <= bits_u_invz_2;
+    if (free_q_push) free_q_mem[free_q_wr] <= free_q_din;
     if (unpark_q_push) unpark_q_mem[unpark_q_wr] <= unpark_q_din;
     if (new_q_push) new_q_mem_g0[new_q_wr] <= bits_new_q_din;
     if (new_q_push) new_q_mem_g1[new_q_wr] <= bits_new_q_din_1;
@@ -1482,402 +1407,69 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (leaf_q_push) leaf_q_mem_g3[leaf_q_wr] <= bits_leaf_q_din_3;
   end
 
-  // stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
-  assign bits_free_bits = free_bits[0];
-  assign bits_free_bits_1 = free_bits[1];
-  assign bits_free_bits_2 = free_bits[2];
-  assign bits_free_bits_3 = free_bits[3];
-  assign bits_free_bits_4 = free_bits[4];
-  assign bits_free_bits_5 = free_bits[5];
-  assign bits_free_bits_6 = free_bits[6];
-  assign bits_free_bits_7 = free_bits[7];
-  assign bits_free_bits_8 = free_bits[8];
-  assign bits_free_bits_9 = free_bits[9];
-  assign bits_free_bits_10 = free_bits[10];
-  assign bits_free_bits_11 = free_bits[11];
-  assign bits_free_bits_12 = free_bits[12];
-  assign bits_free_bits_13 = free_bits[13];
-  assign bits_free_bits_14 = free_bits[14];
-  assign bits_free_bits_15 = free_bits[15];
-  assign bits_free_bits_16 = free_bits[16];
-  assign bits_free_bits_17 = free_bits[17];
-  assign bits_free_bits_18 = free_bits[18];
-  assign bits_free_bits_19 = free_bits[19];
-  assign bits_free_bits_20 = free_bits[20];
-  assign bits_free_bits_21 = free_bits[21];
-  assign bits_free_bits_22 = free_bits[22];
-  assign bits_free_bits_23 = free_bits[23];
-  assign bits_free_bits_24 = free_bits[24];
-  assign bits_free_bits_25 = free_bits[25];
-  assign bits_free_bits_26 = free_bits[26];
-  assign bits_free_bits_27 = free_bits[27];
-  assign bits_free_bits_28 = free_bits[28];
-  assign bits_free_bits_29 = free_bits[29];
-  assign bits_free_bits_30 = free_bits[30];
-  assign bits_free_bits_31 = free_bits[31];
-  assign bits_free_bits_32 = free_bits[32];
-  assign bits_free_bits_33 = free_bits[33];
-  assign bits_free_bits_34 = free_bits[34];
-  assign bits_free_bits_35 = free_bits[35];
-  assign bits_free_bits_36 = free_bits[36];
-  assign bits_free_bits_37 = free_bits[37];
-  assign bits_free_bits_38 = free_bits[38];
-  assign bits_free_bits_39 = free_bits[39];
-  assign bits_free_bits_40 = free_bits[40];
-  assign bits_free_bits_41 = free_bits[41];
-  assign bits_free_bits_42 = free_bits[42];
-  assign bits_free_bits_43 = free_bits[43];
-  assign bits_free_bits_44 = free_bits[44];
-  assign bits_free_bits_45 = free_bits[45];
-  assign bits_free_bits_46 = free_bits[46];
-  assign bits_free_bits_47 = free_bits[47];
-  assign bits_free_bits_48 = free_bits[48];
-  assign bits_free_bits_49 = free_bits[49];
-  assign bits_free_bits_50 = free_bits[50];
-  assign bits_free_bits_51 = free_bits[51];
-  assign bits_free_bits_52 = free_bits[52];
-  assign bits_free_bits_53 = free_bits[53];
-  assign bits_free_bits_54 = free_bits[54];
-  assign bits_free_bits_55 = free_bits[55];
-  assign bits_free_bits_56 = free_bits[56];
-  assign bits_free_bits_57 = free_bits[57];
-  assign bits_free_bits_58 = free_bits[58];
-  assign bits_free_bits_59 = free_bits[59];
-  assign bits_free_bits_60 = free_bits[60];
-  assign bits_free_bits_61 = free_bits[61];
-  assign bits_free_bits_62 = free_bits[62];
-  assign bits_free_bits_63 = free_bits[63];
-  assign not_bits_free_bits = ~bits_free_bits;
-  assign or_1 = bits_free_bits | bits_free_bits_1;
-  assign not_bits_free_bits_2 = ~bits_free_bits_2;
-  assign or_2 = bits_free_bits_2 | bits_free_bits_3;
-  assign not_bits_free_bits_4 = ~bits_free_bits_4;
-  assign or_3 = bits_free_bits_4 | bits_free_bits_5;
-  assign not_bits_free_bits_6 = ~bits_free_bits_6;
-  assign or_4 = bits_free_bits_6 | bits_free_bits_7;
-  assign not_bits_free_bits_8 = ~bits_free_bits_8;
-  assign or_5 = bits_free_bits_8 | bits_free_bits_9;
-  assign not_bits_free_bits_10 = ~bits_free_bits_10;
-  assign or_6 = bits_free_bits_10 | bits_free_bits_11;
-  assign not_bits_free_bits_12 = ~bits_free_bits_12;
-  assign or_7 = bits_free_bits_12 | bits_free_bits_13;
-  assign not_bits_free_bits_14 = ~bits_free_bits_14;
-  assign or_8 = bits_free_bits_14 | bits_free_bits_15;
-  assign not_bits_free_bits_16 = ~bits_free_bits_16;
-  assign or_9 = bits_free_bits_16 | bits_free_bits_17;
-  assign not_bits_free_bits_18 = ~bits_free_bits_18;
-  assign or_10 = bits_free_bits_18 | bits_free_bits_19;
-  assign not_bits_free_bits_20 = ~bits_free_bits_20;
-  assign or_11 = bits_free_bits_20 | bits_free_bits_21;
-  assign not_bits_free_bits_22 = ~bits_free_bits_22;
-  assign or_12 = bits_free_bits_22 | bits_free_bits_23;
-  assign not_bits_free_bits_24 = ~bits_free_bits_24;
-  assign or_13 = bits_free_bits_24 | bits_free_bits_25;
-  assign not_bits_free_bits_26 = ~bits_free_bits_26;
-  assign or_14 = bits_free_bits_26 | bits_free_bits_27;
-  assign not_bits_free_bits_28 = ~bits_free_bits_28;
-  assign or_15 = bits_free_bits_28 | bits_free_bits_29;
-  assign not_bits_free_bits_30 = ~bits_free_bits_30;
-  assign or_16 = bits_free_bits_30 | bits_free_bits_31;
-  assign not_bits_free_bits_32 = ~bits_free_bits_32;
-  assign or_17 = bits_free_bits_32 | bits_free_bits_33;
-  assign not_bits_free_bits_34 = ~bits_free_bits_34;
-  assign or_18 = bits_free_bits_34 | bits_free_bits_35;
-  assign not_bits_free_bits_36 = ~bits_free_bits_36;
-  assign or_19 = bits_free_bits_36 | bits_free_bits_37;
-  assign not_bits_free_bits_38 = ~bits_free_bits_38;
-  assign or_20 = bits_free_bits_38 | bits_free_bits_39;
-  assign not_bits_free_bits_40 = ~bits_free_bits_40;
-  assign or_21 = bits_free_bits_40 | bits_free_bits_41;
-  assign not_bits_free_bits_42 = ~bits_free_bits_42;
-  assign or_22 = bits_free_bits_42 | bits_free_bits_43;
-  assign not_bits_free_bits_44 = ~bits_free_bits_44;
-  assign or_23 = bits_free_bits_44 | bits_free_bits_45;
-  assign not_bits_free_bits_46 = ~bits_free_bits_46;
-  assign or_24 = bits_free_bits_46 | bits_free_bits_47;
-  assign not_bits_free_bits_48 = ~bits_free_bits_48;
-  assign or_25 = bits_free_bits_48 | bits_free_bits_49;
-  assign not_bits_free_bits_50 = ~bits_free_bits_50;
-  assign or_26 = bits_free_bits_50 | bits_free_bits_51;
-  assign not_bits_free_bits_52 = ~bits_free_bits_52;
-  assign or_27 = bits_free_bits_52 | bits_free_bits_53;
-  assign not_bits_free_bits_54 = ~bits_free_bits_54;
-  assign or_28 = bits_free_bits_54 | bits_free_bits_55;
-  assign not_bits_free_bits_56 = ~bits_free_bits_56;
-  assign or_29 = bits_free_bits_56 | bits_free_bits_57;
-  assign not_bits_free_bits_58 = ~bits_free_bits_58;
-  assign or_30 = bits_free_bits_58 | bits_free_bits_59;
-  assign not_bits_free_bits_60 = ~bits_free_bits_60;
-  assign or_31 = bits_free_bits_60 | bits_free_bits_61;
-  assign not_bits_free_bits_62 = ~bits_free_bits_62;
-  assign or_32 = bits_free_bits_62 | bits_free_bits_63;
-  assign not_or_1 = ~or_1;
-  assign mux_or_1 = or_1 ? not_bits_free_bits : not_bits_free_bits_2;
-  assign cat_33 = {not_or_1, mux_or_1};
-  assign or_1_or_or_2 = or_1 | or_2;
-  assign not_or_3 = ~or_3;
-  assign mux_or_3 = or_3 ? not_bits_free_bits_4 : not_bits_free_bits_6;
-  assign cat_34 = {not_or_3, mux_or_3};
-  assign or_3_or_or_4 = or_3 | or_4;
-  assign not_or_5 = ~or_5;
-  assign mux_or_5 = or_5 ? not_bits_free_bits_8 : not_bits_free_bits_10;
-  assign cat_35 = {not_or_5, mux_or_5};
-  assign or_5_or_or_6 = or_5 | or_6;
-  assign not_or_7 = ~or_7;
-  assign mux_or_7 = or_7 ? not_bits_free_bits_12 : not_bits_free_bits_14;
-  assign cat_36 = {not_or_7, mux_or_7};
-  assign or_7_or_or_8 = or_7 | or_8;
-  assign not_or_9 = ~or_9;
-  assign mux_or_9 = or_9 ? not_bits_free_bits_16 : not_bits_free_bits_18;
-  assign cat_37 = {not_or_9, mux_or_9};
-  assign or_9_or_or_10 = or_9 | or_10;
-  assign not_or_11 = ~or_11;
-  assign mux_or_11 = or_11 ? not_bits_free_bits_20 : not_bits_free_bits_22;
-  assign cat_38 = {not_or_11, mux_or_11};
-  assign or_11_or_or_12 = or_11 | or_12;
-  assign not_or_13 = ~or_13;
-  assign mux_or_13 = or_13 ? not_bits_free_bits_24 : not_bits_free_bits_26;
-  assign cat_39 = {not_or_13, mux_or_13};
-  assign or_13_or_or_14 = or_13 | or_14;
-  assign not_or_15 = ~or_15;
-  assign mux_or_15 = or_15 ? not_bits_free_bits_28 : not_bits_free_bits_30;
-  assign cat_40 = {not_or_15, mux_or_15};
-  assign or_15_or_or_16 = or_15 | or_16;
-  assign not_or_17 = ~or_17;
-  assign mux_or_17 = or_17 ? not_bits_free_bits_32 : not_bits_free_bits_34;
-  assign cat_41 = {not_or_17, mux_or_17};
-  assign or_17_or_or_18 = or_17 | or_18;
-  assign not_or_19 = ~or_19;
-  assign mux_or_19 = or_19 ? not_bits_free_bits_36 : not_bits_free_bits_38;
-  assign cat_42 = {not_or_19, mux_or_19};
-  assign or_19_or_or_20 = or_19 | or_20;
-  assign not_or_21 = ~or_21;
-  assign mux_or_21 = or_21 ? not_bits_free_bits_40 : not_bits_free_bits_42;
-  assign cat_43 = {not_or_21, mux_or_21};
-  assign or_21_or_or_22 = or_21 | or_22;
-  assign not_or_23 = ~or_23;
-  assign mux_or_23 = or_23 ? not_bits_free_bits_44 : not_bits_free_bits_46;
-  assign cat_44 = {not_or_23, mux_or_23};
-  assign or_23_or_or_24 = or_23 | or_24;
-  assign not_or_25 = ~or_25;
-  assign mux_or_25 = or_25 ? not_bits_free_bits_48 : not_bits_free_bits_50;
-  assign cat_45 = {not_or_25, mux_or_25};
-  assign or_25_or_or_26 = or_25 | or_26;
-  assign not_or_27 = ~or_27;
-  assign mux_or_27 = or_27 ? not_bits_free_bits_52 : not_bits_free_bits_54;
-  assign cat_46 = {not_or_27, mux_or_27};
-  assign or_27_or_or_28 = or_27 | or_28;
-  assign not_or_29 = ~or_29;
-  assign mux_or_29 = or_29 ? not_bits_free_bits_56 : not_bits_free_bits_58;
-  assign cat_47 = {not_or_29, mux_or_29};
-  assign or_29_or_or_30 = or_29 | or_30;
-  assign not_or_31 = ~or_31;
-  assign mux_or_31 = or_31 ? not_bits_free_bits_60 : not_bits_free_bits_62;
-  assign cat_48 = {not_or_31, mux_or_31};
-  assign or_31_or_or_32 = or_31 | or_32;
-  assign not_or_1_or_or_2 = ~or_1_or_or_2;
-  assign mux_or_1_or_or_2 = or_1_or_or_2 ? cat_33 : cat_34;
-  assign cat_49 = {not_or_1_or_or_2, mux_or_1_or_or_2};
-  assign or_50 = or_1_or_or_2 | or_3_or_or_4;
-  assign not_or_5_or_or_6 = ~or_5_or_or_6;
-  assign mux_or_5_or_or_6 = or_5_or_or_6 ? cat_35 : cat_36;
-  assign cat_51 = {not_or_5_or_or_6, mux_or_5_or_or_6};
-  assign or_52 = or_5_or_or_6 | or_7_or_or_8;
-  assign not_or_9_or_or_10 = ~or_9_or_or_10;
-  assign mux_or_9_or_or_10 = or_9_or_or_10 ? cat_37 : cat_38;
-  assign cat_53 = {not_or_9_or_or_10, mux_or_9_or_or_10};
-  assign or_54 = or_9_or_or_10 | or_11_or_or_12;
-  assign not_or_13_or_or_14 = ~or_13_or_or_14;
-  assign mux_or_13_or_or_14 = or_13_or_or_14 ? cat_39 : cat_40;
-  assign cat_55 = {not_or_13_or_or_14, mux_or_13_or_or_14};
-  assign or_56 = or_13_or_or_14 | or_15_or_or_16;
-  assign not_or_17_or_or_18 = ~or_17_or_or_18;
-  assign mux_or_17_or_or_18 = or_17_or_or_18 ? cat_41 : cat_42;
-  assign cat_57 = {not_or_17_or_or_18, mux_or_17_or_or_18};
-  assign or_58 = or_17_or_or_18 | or_19_or_or_20;
-  assign not_or_21_or_or_22 = ~or_21_or_or_22;
-  assign mux_or_21_or_or_22 = or_21_or_or_22 ? cat_43 : cat_44;
-  assign cat_59 = {not_or_21_or_or_22, mux_or_21_or_or_22};
-  assign or_60 = or_21_or_or_22 | or_23_or_or_24;
-  assign not_or_25_or_or_26 = ~or_25_or_or_26;
-  assign mux_or_25_or_or_26 = or_25_or_or_26 ? cat_45 : cat_46;
-  assign cat_61 = {not_or_25_or_or_26, mux_or_25_or_or_26};
-  assign or_62 = or_25_or_or_26 | or_27_or_or_28;
-  assign not_or_29_or_or_30 = ~or_29_or_or_30;
-  assign mux_or_29_or_or_30 = or_29_or_or_30 ? cat_47 : cat_48;
-  assign cat_63 = {not_or_29_or_or_30, mux_or_29_or_or_30};
-  assign or_64 = or_29_or_or_30 | or_31_or_or_32;
-  assign not_or_50 = ~or_50;
-  assign mux_or_50 = or_50 ? cat_49 : cat_51;
-  assign cat_65 = {not_or_50, mux_or_50};
-  assign or_50_or_or_52 = or_50 | or_52;
-  assign not_or_54 = ~or_54;
-  assign mux_or_54 = or_54 ? cat_53 : cat_55;
-  assign cat_66 = {not_or_54, mux_or_54};
-  assign or_54_or_or_56 = or_54 | or_56;
-  assign not_or_58 = ~or_58;
-  assign mux_or_58 = or_58 ? cat_57 : cat_59;
-  assign cat_67 = {not_or_58, mux_or_58};
-  assign or_58_or_or_60 = or_58 | or_60;
-  assign not_or_62 = ~or_62;
-  assign mux_or_62 = or_62 ? cat_61 : cat_63;
-  assign cat_68 = {not_or_62, mux_or_62};
-  assign or_62_or_or_64 = or_62 | or_64;
-  assign not_or_50_or_or_52 = ~or_50_or_or_52;
-  assign mux_or_50_or_or_52 = or_50_or_or_52 ? cat_65 : cat_66;
-  assign cat_69 = {not_or_50_or_or_52, mux_or_50_or_or_52};
-  assign or_70 = or_50_or_or_52 | or_54_or_or_56;
-  assign not_or_58_or_or_60 = ~or_58_or_or_60;
-  assign mux_or_58_or_or_60 = or_58_or_or_60 ? cat_67 : cat_68;
-  assign cat_71 = {not_or_58_or_or_60, mux_or_58_or_or_60};
-  assign or_72 = or_58_or_or_60 | or_62_or_or_64;
-  assign not_or_70 = ~or_70;
-  assign mux_or_70 = or_70 ? cat_69 : cat_71;
-  assign free_idx_c = {not_or_70, mux_or_70};
-  assign free_any_c = or_70 | or_72;
-  assign ray_slot_eq_k_63 = ray_slot == k_63;
-  assign ray_slot_eq_k_62 = ray_slot == k_62;
-  assign ray_slot_eq_k_61 = ray_slot == k_61;
-  assign ray_slot_eq_k_60 = ray_slot == k_60;
-  assign ray_slot_eq_k_59 = ray_slot == k_59;
-  assign ray_slot_eq_k_58 = ray_slot == k_58;
-  assign ray_slot_eq_k_57 = ray_slot == k_57;
-  assign ray_slot_eq_k_56 = ray_slot == k_56;
-  assign ray_slot_eq_k_55 = ray_slot == k_55;
-  assign ray_slot_eq_k_54 = ray_slot == k_54;
-  assign ray_slot_eq_k_53 = ray_slot == k_53;
-  assign ray_slot_eq_k_52 = ray_slot == k_52;
-  assign ray_slot_eq_k_51 = ray_slot == k_51;
-  assign ray_slot_eq_k_50 = ray_slot == k_50;
-  assign ray_slot_eq_k_49 = ray_slot == k_49;
-  assign ray_slot_eq_k_48 = ray_slot == k_48;
-  assign ray_slot_eq_k_47 = ray_slot == k_47;
-  assign ray_slot_eq_k_46 = ray_slot == k_46;
-  assign ray_slot_eq_k_45 = ray_slot == k_45;
-  assign ray_slot_eq_k_44 = ray_slot == k_44;
-  assign ray_slot_eq_k_43 = ray_slot == k_43;
-  assign ray_slot_eq_k_42 = ray_slot == k_42;
-  assign ray_slot_eq_k_41 = ray_slot == k_41;
-  assign ray_slot_eq_k_40 = ray_slot == k_40;
-  assign ray_slot_eq_k_39 = ray_slot == k_39;
-  assign ray_slot_eq_k_38 = ray_slot == k_38;
-  assign ray_slot_eq_k_37 = ray_slot == k_37;
-  assign ray_slot_eq_k_36 = ray_slot == k_36;
-  assign ray_slot_eq_k_35 = ray_slot == k_35;
-  assign ray_slot_eq_k_34 = ray_slot == k_34;
-  assign ray_slot_eq_k_33 = ray_slot == k_33;
-  assign ray_slot_eq_k_32 = ray_slot == k_32;
-  assign ray_slot_eq_k_31 = ray_slot == k_31;
-  assign ray_slot_eq_k_30 = ray_slot == k_30;
-  assign ray_slot_eq_k_29 = ray_slot == k_29;
-  assign ray_slot_eq_k_28 = ray_slot == k_28;
-  assign ray_slot_eq_k_27 = ray_slot == k_27;
-  assign ray_slot_eq_k_26 = ray_slot == k_26;
-  assign ray_slot_eq_k_25 = ray_slot == k_25;
-  assign ray_slot_eq_k_24 = ray_slot == k_24;
-  assign ray_slot_eq_k_23 = ray_slot == k_23;
-  assign ray_slot_eq_k_22 = ray_slot == k_22;
-  assign ray_slot_eq_k_21 = ray_slot == k_21;
-  assign ray_slot_eq_k_20 = ray_slot == k_20;
-  assign ray_slot_eq_k_19 = ray_slot == k_19;
-  assign ray_slot_eq_k_18 = ray_slot == k_18;
-  assign ray_slot_eq_k_17 = ray_slot == k_17;
-  assign ray_slot_eq_k_16 = ray_slot == k_16;
-  assign ray_slot_eq_k_15 = ray_slot == k_15;
-  assign ray_slot_eq_k_14 = ray_slot == k_14;
-  assign ray_slot_eq_k_13 = ray_slot == k_13;
-  assign ray_slot_eq_k_12 = ray_slot == k_12;
-  assign ray_slot_eq_k_11 = ray_slot == k_11;
-  assign ray_slot_eq_k_10 = ray_slot == k_10;
-  assign ray_slot_eq_k_9 = ray_slot == k_9;
-  assign ray_slot_eq_k_8 = ray_slot == k_8;
-  assign ray_slot_eq_k_7 = ray_slot == k_7;
-  assign ray_slot_eq_k_6 = ray_slot == k_6;
-  assign ray_slot_eq_k_5 = ray_slot == k_5;
-  assign ray_slot_eq_k_4 = ray_slot == k_4;
-  assign ray_slot_eq_k_3 = ray_slot == k_3;
-  assign ray_slot_eq_k_2 = ray_slot == k_2;
-  assign ray_slot_eq_k_1 = ray_slot == k_1;
-  assign ray_slot_eq_k_0_1 = ray_slot == k_0_1;
-  assign cat_74 = {ray_slot_eq_k_63, ray_slot_eq_k_62, ray_slot_eq_k_61, ray_slot_eq_k_60, ray_slot_eq_k_59, ray_slot_eq_k_58, ray_slot_eq_k_57, ray_slot_eq_k_56, ray_slot_eq_k_55, ray_slot_eq_k_54, ray_slot_eq_k_53, ray_slot_eq_k_52, ray_slot_eq_k_51, ray_slot_eq_k_50, ray_slot_eq_k_49, ray_slot_eq_k_48, ray_slot_eq_k_47, ray_slot_eq_k_46, ray_slot_eq_k_45, ray_slot_eq_k_44, ray_slot_eq_k_43, ray_slot_eq_k_42, ray_slot_eq_k_41, ray_slot_eq_k_40, ray_slot_eq_k_39, ray_slot_eq_k_38, ray_slot_eq_k_37, ray_slot_eq_k_36, ray_slot_eq_k_35, ray_slot_eq_k_34, ray_slot_eq_k_33, ray_slot_eq_k_32, ray_slot_eq_k_31, ray_slot_eq_k_30, ray_slot_eq_k_29, ray_slot_eq_k_28, ray_slot_eq_k_27, ray_slot_eq_k_26, ray_slot_eq_k_25, ray_slot_eq_k_24, ray_slot_eq_k_23, ray_slot_eq_k_22, ray_slot_eq_k_21, ray_slot_eq_k_20, ray_slot_eq_k_19, ray_slot_eq_k_18, ray_slot_eq_k_17, ray_slot_eq_k_16, ray_slot_eq_k_15, ray_slot_eq_k_14, ray_slot_eq_k_13, ray_slot_eq_k_12, ray_slot_eq_k_11, ray_slot_eq_k_10, ray_slot_eq_k_9, ray_slot_eq_k_8, ray_slot_eq_k_7, ray_slot_eq_k_6, ray_slot_eq_k_5, ray_slot_eq_k_4, ray_slot_eq_k_3, ray_slot_eq_k_2, ray_slot_eq_k_1, ray_slot_eq_k_0_1};
-  assign taken_mask = alloc ? cat_74 : k_0_2;
-  assign free_slot_eq_k_63 = free_slot == k_63;
-  assign free_slot_eq_k_62 = free_slot == k_62;
-  assign free_slot_eq_k_61 = free_slot == k_61;
-  assign free_slot_eq_k_60 = free_slot == k_60;
-  assign free_slot_eq_k_59 = free_slot == k_59;
-  assign free_slot_eq_k_58 = free_slot == k_58;
-  assign free_slot_eq_k_57 = free_slot == k_57;
-  assign free_slot_eq_k_56 = free_slot == k_56;
-  assign free_slot_eq_k_55 = free_slot == k_55;
-  assign free_slot_eq_k_54 = free_slot == k_54;
-  assign free_slot_eq_k_53 = free_slot == k_53;
-  assign free_slot_eq_k_52 = free_slot == k_52;
-  assign free_slot_eq_k_51 = free_slot == k_51;
-  assign free_slot_eq_k_50 = free_slot == k_50;
-  assign free_slot_eq_k_49 = free_slot == k_49;
-  assign free_slot_eq_k_48 = free_slot == k_48;
-  assign free_slot_eq_k_47 = free_slot == k_47;
-  assign free_slot_eq_k_46 = free_slot == k_46;
-  assign free_slot_eq_k_45 = free_slot == k_45;
-  assign free_slot_eq_k_44 = free_slot == k_44;
-  assign free_slot_eq_k_43 = free_slot == k_43;
-  assign free_slot_eq_k_42 = free_slot == k_42;
-  assign free_slot_eq_k_41 = free_slot == k_41;
-  assign free_slot_eq_k_40 = free_slot == k_40;
-  assign free_slot_eq_k_39 = free_slot == k_39;
-  assign free_slot_eq_k_38 = free_slot == k_38;
-  assign free_slot_eq_k_37 = free_slot == k_37;
-  assign free_slot_eq_k_36 = free_slot == k_36;
-  assign free_slot_eq_k_35 = free_slot == k_35;
-  assign free_slot_eq_k_34 = free_slot == k_34;
-  assign free_slot_eq_k_33 = free_slot == k_33;
-  assign free_slot_eq_k_32 = free_slot == k_32;
-  assign free_slot_eq_k_31 = free_slot == k_31;
-  assign free_slot_eq_k_30 = free_slot == k_30;
-  assign free_slot_eq_k_29 = free_slot == k_29;
-  assign free_slot_eq_k_28 = free_slot == k_28;
-  assign free_slot_eq_k_27 = free_slot == k_27;
-  assign free_slot_eq_k_26 = free_slot == k_26;
-  assign free_slot_eq_k_25 = free_slot == k_25;
-  assign free_slot_eq_k_24 = free_slot == k_24;
-  assign free_slot_eq_k_23 = free_slot == k_23;
-  assign free_slot_eq_k_22 = free_slot == k_22;
-  assign free_slot_eq_k_21 = free_slot == k_21;
-  assign free_slot_eq_k_20 = free_slot == k_20;
-  assign free_slot_eq_k_19 = free_slot == k_19;
-  assign free_slot_eq_k_18 = free_slot == k_18;
-  assign free_slot_eq_k_17 = free_slot == k_17;
-  assign free_slot_eq_k_16 = free_slot == k_16;
-  assign free_slot_eq_k_15 = free_slot == k_15;
-  assign free_slot_eq_k_14 = free_slot == k_14;
-  assign free_slot_eq_k_13 = free_slot == k_13;
-  assign free_slot_eq_k_12 = free_slot == k_12;
-  assign free_slot_eq_k_11 = free_slot == k_11;
-  assign free_slot_eq_k_10 = free_slot == k_10;
-  assign free_slot_eq_k_9 = free_slot == k_9;
-  assign free_slot_eq_k_8 = free_slot == k_8;
-  assign free_slot_eq_k_7 = free_slot == k_7;
-  assign free_slot_eq_k_6 = free_slot == k_6;
-  assign free_slot_eq_k_5 = free_slot == k_5;
-  assign free_slot_eq_k_4 = free_slot == k_4;
-  assign free_slot_eq_k_3 = free_slot == k_3;
-  assign free_slot_eq_k_2 = free_slot == k_2;
-  assign free_slot_eq_k_1 = free_slot == k_1;
-  assign free_slot_eq_k_0_1 = free_slot == k_0_1;
-  assign cat_75 = {free_slot_eq_k_63, free_slot_eq_k_62, free_slot_eq_k_61, free_slot_eq_k_60, free_slot_eq_k_59, free_slot_eq_k_58, free_slot_eq_k_57, free_slot_eq_k_56, free_slot_eq_k_55, free_slot_eq_k_54, free_slot_eq_k_53, free_slot_eq_k_52, free_slot_eq_k_51, free_slot_eq_k_50, free_slot_eq_k_49, free_slot_eq_k_48, free_slot_eq_k_47, free_slot_eq_k_46, free_slot_eq_k_45, free_slot_eq_k_44, free_slot_eq_k_43, free_slot_eq_k_42, free_slot_eq_k_41, free_slot_eq_k_40, free_slot_eq_k_39, free_slot_eq_k_38, free_slot_eq_k_37, free_slot_eq_k_36, free_slot_eq_k_35, free_slot_eq_k_34, free_slot_eq_k_33, free_slot_eq_k_32, free_slot_eq_k_31, free_slot_eq_k_30, free_slot_eq_k_29, free_slot_eq_k_28, free_slot_eq_k_27, free_slot_eq_k_26, free_slot_eq_k_25, free_slot_eq_k_24, free_slot_eq_k_23, free_slot_eq_k_22, free_slot_eq_k_21, free_slot_eq_k_20, free_slot_eq_k_19, free_slot_eq_k_18, free_slot_eq_k_17, free_slot_eq_k_16, free_slot_eq_k_15, free_slot_eq_k_14, free_slot_eq_k_13, free_slot_eq_k_12, free_slot_eq_k_11, free_slot_eq_k_10, free_slot_eq_k_9, free_slot_eq_k_8, free_slot_eq_k_7, free_slot_eq_k_6, free_slot_eq_k_5, free_slot_eq_k_4, free_slot_eq_k_3, free_slot_eq_k_2, free_slot_eq_k_1, free_slot_eq_k_0_1};
-  assign freed_mask = free_valid ? cat_75 : k_0_2;
-  assign not_taken_mask = ~taken_mask;
-  assign and_76 = free_bits & not_taken_mask;
-  assign and_76_or_freed_mask = and_76 | freed_mask;
+  // stage slots: the free list: the next free slot for the top, the slots holding a ray
+  assign alloc_fresh = alloc & fresh_left;
+  assign fresh_slot_plus_k_1 = fresh_slot + k_1;
+  assign mux_alloc_fresh = alloc_fresh ? fresh_slot_plus_k_1 : fresh_slot;
+  assign fresh_is_last = fresh_slot == k_63;
+  assign and_1 = alloc_fresh & fresh_is_last;
+  assign not_and_1 = ~and_1;
+  assign fresh_left_and_not_and_1 = fresh_left & not_and_1;
+  assign not_fresh_left = ~fresh_left;
+  assign free_q_pop = alloc & not_fresh_left;
+  assign free_q_wr_plus_k_1 = free_q_wr + k_1;
+  assign mux_free_q_push = free_q_push ? free_q_wr_plus_k_1 : free_q_wr;
+  assign free_q_rd_next = free_q_pop ? free_q_rd1 : free_q_rd;
+  assign free_q_rd1_plus_k_1 = free_q_rd1 + k_1;
+  assign mux_free_q_pop = free_q_pop ? free_q_rd1_plus_k_1 : free_q_rd1;
+  assign not_free_q_push_c1 = ~free_q_push_c1;
+  assign rs_not_free_q_push_c1 = {{6{1'b0}}, not_free_q_push_c1};
+  assign free_q_count_if_pop = free_q_count - rs_not_free_q_push_c1;
+  assign rs_free_q_push_c1 = {{6{1'b0}}, free_q_push_c1};
+  assign free_q_count_if_kept = free_q_count + rs_free_q_push_c1;
+  assign free_q_count_next = free_q_pop ? free_q_count_if_pop : free_q_count_if_kept;
+  assign free_q_count_eq_k_0 = free_q_count == k_0;
+  assign free_q_one_left = free_q_count == k_1_1;
+  assign and_4 = free_q_one_left & free_q_pop;
+  assign free_q_drained = free_q_count_eq_k_0 | and_4;
+  assign free_q_bypass_c = free_q_push_c1 & free_q_drained;
+  assign k_1_1_lt_free_q_count = k_1_1 < free_q_count;
+  assign or_7 = free_q_push_c1 | k_1_1_lt_free_q_count;
+  assign not_free_q_pop = ~free_q_pop;
+  assign and_8 = free_q_one_left & not_free_q_pop;
+  assign free_q_nonempty_c = or_7 | and_8;
+  assign mux_free_q_popped = free_q_popped ? free_q_q_next : free_q_q_stay;
+  assign free_q_head = free_q_bypass ? free_q_din_r : mux_free_q_popped;
+  assign free_any_c = fresh_left | free_q_nonempty;
+  assign free_idx_c = fresh_left ? fresh_slot : free_q_head;
   assign rs_alloc = {{6{1'b0}}, alloc};
   assign occupied_r_plus_rs_alloc = occupied_r + rs_alloc;
   assign rs_free_valid = {{6{1'b0}}, free_valid};
-  assign minus_77 = occupied_r_plus_rs_alloc - rs_free_valid;
+  assign minus_10 = occupied_r_plus_rs_alloc - rs_free_valid;
 
   always @(posedge clk) begin : slots_regs
-    if (rst) free_bits <= 64'hffffffffffffffff;
-    else free_bits <= and_76_or_freed_mask;
+    if (rst) fresh_slot <= 6'h00;
+    else fresh_slot <= mux_alloc_fresh;
+    if (rst) fresh_left <= 1'h1;
+    else fresh_left <= fresh_left_and_not_and_1;
+    if (rst) free_q_wr <= 6'h00;
+    else free_q_wr <= mux_free_q_push;
+    if (rst) free_q_rd <= 6'h00;
+    else free_q_rd <= free_q_rd_next;
+    if (rst) free_q_count <= 7'h00;
+    else free_q_count <= free_q_count_next;
+    if (rst) free_q_rd1 <= 6'h01;
+    else free_q_rd1 <= mux_free_q_pop;
+    if (rst) free_q_bypass <= 1'h0;
+    else free_q_bypass <= free_q_bypass_c;
+    if (rst) free_q_popped <= 1'h0;
+    else free_q_popped <= free_q_pop;
+    if (rst) free_q_nonempty <= 1'h0;
+    else free_q_nonempty <= free_q_nonempty_c;
+    free_q_din <= free_slot;
+    free_q_q_stay <= free_q_mem[free_q_rd];
+    free_q_q_next <= free_q_mem[free_q_rd1];
+    if (free_q_push) free_q_din_r <= free_q_din;
     if (rst) free_any_r <= 1'h1;
     else free_any_r <= free_any_c;
     if (rst) free_idx_r <= 6'h00;
@@ -1885,59 +1477,78 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (rst) just_alloc <= 1'h0;
     else just_alloc <= alloc;
     if (rst) occupied_r <= 7'h00;
-    else occupied_r <= minus_77;
+    else occupied_r <= minus_10;
+  end
+
+  // register copies free_q_push_copies: free_q_push and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : free_q_push_copies_regs
+    if (rst) free_q_push <= 1'h0;
+    else free_q_push <= free_valid;
+    if (rst) free_q_push_c1 <= 1'h0;
+    else free_q_push_c1 <= free_valid;
   end
 
   // stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   assign ring_g_valid = g_valid;
   assign unpark_pop = take_unpark;
   assign new_pop = take_new;
-  assign cat_78 = {merge_slot, merge_sp};
+  assign cat_11 = {merge_slot, merge_sp};
   assign unpark_q_wr_plus_k_1 = unpark_q_wr + k_1;
   assign mux_unpark_q_push = unpark_q_push ? unpark_q_wr_plus_k_1 : unpark_q_wr;
   assign unpark_q_rd_next = unpark_pop ? unpark_q_rd1 : unpark_q_rd;
   assign unpark_q_rd1_plus_k_1 = unpark_q_rd1 + k_1;
   assign mux_unpark_pop = unpark_pop ? unpark_q_rd1_plus_k_1 : unpark_q_rd1;
-  assign rs_unpark_pop = {{6{1'b0}}, unpark_pop};
-  assign unpark_q_after_pop = unpark_q_count - rs_unpark_pop;
-  assign rs_unpark_q_push = {{6{1'b0}}, unpark_q_push};
-  assign unpark_q_count_next = unpark_q_after_pop + rs_unpark_q_push;
-  assign unpark_q_count_eq_k_0_3 = unpark_q_count == k_0_3;
+  assign not_unpark_q_push_c1 = ~unpark_q_push_c1;
+  assign rs_not_unpark_q_push_c1 = {{6{1'b0}}, not_unpark_q_push_c1};
+  assign unpark_q_count_if_pop = unpark_q_count - rs_not_unpark_q_push_c1;
+  assign rs_unpark_q_push_c1 = {{6{1'b0}}, unpark_q_push_c1};
+  assign unpark_q_count_if_kept = unpark_q_count + rs_unpark_q_push_c1;
+  assign unpark_q_count_next = unpark_pop ? unpark_q_count_if_pop : unpark_q_count_if_kept;
+  assign unpark_q_count_eq_k_0 = unpark_q_count == k_0;
   assign unpark_q_one_left = unpark_q_count == k_1_1;
-  assign and_81 = unpark_q_one_left & unpark_pop;
-  assign unpark_q_drained = unpark_q_count_eq_k_0_3 | and_81;
-  assign unpark_q_bypass_c = unpark_q_push & unpark_q_drained;
+  assign and_14 = unpark_q_one_left & unpark_pop;
+  assign unpark_q_drained = unpark_q_count_eq_k_0 | and_14;
+  assign unpark_q_bypass_c = unpark_q_push_c1 & unpark_q_drained;
   assign k_1_1_lt_unpark_q_count = k_1_1 < unpark_q_count;
-  assign or_84 = unpark_q_push | k_1_1_lt_unpark_q_count;
+  assign or_17 = unpark_q_push_c1 | k_1_1_lt_unpark_q_count;
   assign not_unpark_pop = ~unpark_pop;
-  assign and_85 = unpark_q_one_left & not_unpark_pop;
-  assign unpark_q_nonempty_c = or_84 | and_85;
+  assign and_18 = unpark_q_one_left & not_unpark_pop;
+  assign unpark_q_nonempty_c = or_17 | and_18;
   assign mux_unpark_q_popped = unpark_q_popped ? unpark_q_q_next : unpark_q_q_stay;
   assign unpark_q_head = unpark_q_bypass ? unpark_q_din_r : mux_unpark_q_popped;
   assign u_new_tmax = $unsigned(new_tmax);
-  assign cat_86 = {new_slot, u_new_tmax, new_miss};
+  assign cat_19 = {new_slot, u_new_tmax, new_miss};
   assign new_q_wr_plus_k_1 = new_q_wr + k_1;
   assign mux_new_q_push = new_q_push ? new_q_wr_plus_k_1 : new_q_wr;
   assign new_q_rd_next = new_pop ? new_q_rd1 : new_q_rd;
   assign new_q_rd1_plus_k_1 = new_q_rd1 + k_1;
   assign mux_new_pop = new_pop ? new_q_rd1_plus_k_1 : new_q_rd1;
-  assign rs_new_pop = {{6{1'b0}}, new_pop};
-  assign new_q_after_pop = new_q_count - rs_new_pop;
-  assign rs_new_q_push = {{6{1'b0}}, new_q_push};
-  assign new_q_count_next = new_q_after_pop + rs_new_q_push;
-  assign new_q_count_eq_k_0_3 = new_q_count == k_0_3;
+  assign not_new_q_push_c1 = ~new_q_push_c1;
+  assign rs_not_new_q_push_c1 = {{6{1'b0}}, not_new_q_push_c1};
+  assign new_q_count_if_pop = new_q_count - rs_not_new_q_push_c1;
+  assign rs_new_q_push_c1 = {{6{1'b0}}, new_q_push_c1};
+  assign new_q_count_if_kept = new_q_count + rs_new_q_push_c1;
+  assign new_q_count_next = new_pop ? new_q_count_if_pop : new_q_count_if_kept;
+  assign new_q_count_eq_k_0 = new_q_count == k_0;
   assign new_q_one_left = new_q_count == k_1_1;
-  assign and_89 = new_q_one_left & new_pop;
-  assign new_q_drained = new_q_count_eq_k_0_3 | and_89;
-  assign new_q_bypass_c = new_q_push & new_q_drained;
+  assign and_22 = new_q_one_left & new_pop;
+  assign new_q_drained = new_q_count_eq_k_0 | and_22;
+  assign new_q_bypass_c = new_q_push_c1 & new_q_drained;
   assign k_1_1_lt_new_q_count = k_1_1 < new_q_count;
-  assign or_92 = new_q_push | k_1_1_lt_new_q_count;
+  assign or_25 = new_q_push_c1 | k_1_1_lt_new_q_count;
   assign not_new_pop = ~new_pop;
-  assign and_93 = new_q_one_left & not_new_pop;
-  assign new_q_nonempty_c = or_92 | and_93;
+  assign and_26 = new_q_one_left & not_new_pop;
+  assign new_q_nonempty_c = or_25 | and_26;
   assign bits_new_q_din = new_q_din[15:0];
   assign bits_new_q_din_1 = new_q_din[31:16];
   assign bits_new_q_din_2 = new_q_din[38:32];
+  assign mux_new_pop_1 = new_pop ? new_q_rd1_p1 : new_q_rd_p1;
+  assign new_q_rd1_p1_plus_k_1 = new_q_rd1_p1 + k_1;
+  assign mux_new_pop_2 = new_pop ? new_q_rd1_p1_plus_k_1 : new_q_rd1_p1;
+  assign mux_new_pop_3 = new_pop ? new_q_rd1_p2 : new_q_rd_p2;
+  assign new_q_rd1_p2_plus_k_1 = new_q_rd1_p2 + k_1;
+  assign mux_new_pop_4 = new_pop ? new_q_rd1_p2_plus_k_1 : new_q_rd1_p2;
   assign new_q_q_stay = {new_q_q_stay_g2, new_q_q_stay_g1, new_q_q_stay_g0};
   assign new_q_q_next = {new_q_q_next_g2, new_q_q_next_g1, new_q_q_next_g0};
   assign mux_new_q_popped = new_q_popped ? new_q_q_next : new_q_q_stay;
@@ -1946,29 +1557,27 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign take_unpark = not_ring_g_valid & unpark_q_nonempty;
   assign not_ring_g_valid_1 = ~ring_g_valid;
   assign not_unpark_q_nonempty = ~unpark_q_nonempty;
-  assign and_97 = not_ring_g_valid_1 & not_unpark_q_nonempty;
-  assign take_new = and_97 & new_q_nonempty;
+  assign and_30 = not_ring_g_valid_1 & not_unpark_q_nonempty;
+  assign take_new = and_30 & new_q_nonempty;
   assign take_unpark_or_take_new = take_unpark | take_new;
   assign bits_unpark_q_head = unpark_q_head[11:6];
   assign bits_new_q_head = new_q_head[38:33];
   assign mux_take_unpark = take_unpark ? bits_unpark_q_head : bits_new_q_head;
   assign bits_unpark_q_head_1 = unpark_q_head[5:0];
-  assign eq_99 = bits_unpark_q_head_1 == k_0_1;
-  assign minus_100 = bits_unpark_q_head_1 - k_1;
-  assign rs_minus_100 = minus_100[4:0];
-  assign q_stack_raddr = {mux_take_unpark, rs_minus_100};
+  assign eq_32 = bits_unpark_q_head_1 == k_0_1;
+  assign minus_33 = bits_unpark_q_head_1 - k_1;
+  assign rs_minus_33 = minus_33[4:0];
+  assign q_stack_raddr = {mux_take_unpark, rs_minus_33};
   assign bits_unpark_q_head_2 = unpark_q_head[5:0];
-  assign eq_102 = bits_unpark_q_head_2 == k_0_1;
+  assign eq_35 = bits_unpark_q_head_2 == k_0_1;
   assign bits_new_q_head_1 = new_q_head[0];
-  assign and_103 = take_new & bits_new_q_head_1;
-  assign take_unpark_and_eq_102 = take_unpark & eq_102;
-  assign q_done_c = and_103 | take_unpark_and_eq_102;
+  assign and_36 = take_new & bits_new_q_head_1;
+  assign take_unpark_and_eq_35 = take_unpark & eq_35;
+  assign q_done_c = and_36 | take_unpark_and_eq_35;
   assign bits_new_q_head_2 = new_q_head[32:1];
   assign s_bits_new_q_head_2 = $signed(bits_new_q_head_2);
 
   always @(posedge clk) begin : queues_regs
-    if (rst) unpark_q_push <= 1'h0;
-    else unpark_q_push <= merge_valid;
     if (rst) unpark_q_wr <= 6'h00;
     else unpark_q_wr <= mux_unpark_q_push;
     if (rst) unpark_q_rd <= 6'h00;
@@ -1983,61 +1592,65 @@ module fxrt_traverse_k64_sf0a3f4 (
     else unpark_q_popped <= unpark_pop;
     if (rst) unpark_q_nonempty <= 1'h0;
     else unpark_q_nonempty <= unpark_q_nonempty_c;
-    unpark_q_din <= cat_78;
+    unpark_q_din <= cat_11;
     unpark_q_q_stay <= unpark_q_mem[unpark_q_rd];
     unpark_q_q_next <= unpark_q_mem[unpark_q_rd1];
     if (unpark_q_push) unpark_q_din_r <= unpark_q_din;
-    if (rst) new_q_push <= 1'h0;
-    else new_q_push <= new_valid;
     if (rst) new_q_wr <= 6'h00;
     else new_q_wr <= mux_new_q_push;
+    if (rst) new_q_rd <= 6'h00;
+    else new_q_rd <= new_q_rd_next;
     if (rst) new_q_count <= 7'h00;
     else new_q_count <= new_q_count_next;
+    if (rst) new_q_rd1 <= 6'h01;
+    else new_q_rd1 <= mux_new_pop;
     if (rst) new_q_bypass <= 1'h0;
     else new_q_bypass <= new_q_bypass_c;
     if (rst) new_q_popped <= 1'h0;
     else new_q_popped <= new_pop;
     if (rst) new_q_nonempty <= 1'h0;
     else new_q_nonempty <= new_q_nonempty_c;
-    new_q_din <= cat_86;
-    new_q_q_stay_g2 <= new_q_mem_g2[new_q_rd_c2];
-    new_q_q_stay_g1 <= new_q_mem_g1[new_q_rd_c1];
+    new_q_din <= cat_19;
+    if (rst) new_q_rd_p1 <= 6'h00;
+    else new_q_rd_p1 <= mux_new_pop_1;
+    if (rst) new_q_rd1_p1 <= 6'h01;
+    else new_q_rd1_p1 <= mux_new_pop_2;
+    if (rst) new_q_rd_p2 <= 6'h00;
+    else new_q_rd_p2 <= mux_new_pop_3;
+    if (rst) new_q_rd1_p2 <= 6'h01;
+    else new_q_rd1_p2 <= mux_new_pop_4;
+    new_q_q_stay_g2 <= new_q_mem_g2[new_q_rd_p2];
+    new_q_q_stay_g1 <= new_q_mem_g1[new_q_rd_p1];
     new_q_q_stay_g0 <= new_q_mem_g0[new_q_rd];
-    new_q_q_next_g2 <= new_q_mem_g2[new_q_rd1_c2];
-    new_q_q_next_g1 <= new_q_mem_g1[new_q_rd1_c1];
+    new_q_q_next_g2 <= new_q_mem_g2[new_q_rd1_p2];
+    new_q_q_next_g1 <= new_q_mem_g1[new_q_rd1_p1];
     new_q_q_next_g0 <= new_q_mem_g0[new_q_rd1];
     if (new_q_push) new_q_din_r <= new_q_din;
     if (rst) q_valid <= 1'h0;
     else q_valid <= take_unpark_or_take_new;
-    q_new <= take_new;
-    q_slot <= mux_take_unpark;
     q_sp <= bits_unpark_q_head_1;
-    q_sp_zero <= eq_99;
-    q_sp_m1 <= minus_100;
+    q_sp_zero <= eq_32;
+    q_sp_m1 <= minus_33;
     q_done <= q_done_c;
     q_tmax <= s_bits_new_q_head_2;
   end
 
-  // register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
+  // register copies unpark_q_push_copies: unpark_q_push and 1 copies, to split its fan-out
 
-  (* keep *) always @(posedge clk) begin : new_q_rd_copies_regs
-    if (rst) new_q_rd <= 6'h00;
-    else new_q_rd <= new_q_rd_next;
-    if (rst) new_q_rd_c1 <= 6'h00;
-    else new_q_rd_c1 <= new_q_rd_next;
-    if (rst) new_q_rd_c2 <= 6'h00;
-    else new_q_rd_c2 <= new_q_rd_next;
+  (* keep *) always @(posedge clk) begin : unpark_q_push_copies_regs
+    if (rst) unpark_q_push <= 1'h0;
+    else unpark_q_push <= merge_valid;
+    if (rst) unpark_q_push_c1 <= 1'h0;
+    else unpark_q_push_c1 <= merge_valid;
   end
 
-  // register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
+  // register copies new_q_push_copies: new_q_push and 1 copies, to split its fan-out
 
-  (* keep *) always @(posedge clk) begin : new_q_rd1_copies_regs
-    if (rst) new_q_rd1 <= 6'h01;
-    else new_q_rd1 <= mux_new_pop;
-    if (rst) new_q_rd1_c1 <= 6'h01;
-    else new_q_rd1_c1 <= mux_new_pop;
-    if (rst) new_q_rd1_c2 <= 6'h01;
-    else new_q_rd1_c2 <= mux_new_pop;
+  (* keep *) always @(posedge clk) begin : new_q_push_copies_regs
+    if (rst) new_q_push <= 1'h0;
+    else new_q_push <= new_valid;
+    if (rst) new_q_push_c1 <= 1'h0;
+    else new_q_push_c1 <= new_valid;
   end
 
   // stage ring_r: R: the token back from G, loaded in G
@@ -2069,8 +1682,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign r_valid_and_r_done = r_valid & r_done;
   assign not_r_valid = ~r_valid;
   assign not_r_valid_and_q_valid = not_r_valid & q_valid;
-  assign and_105 = not_r_valid_and_q_valid & q_done;
-  assign a_done = r_valid_and_r_done | and_105;
+  assign and_38 = not_r_valid_and_q_valid & q_done;
+  assign a_done = r_valid_and_r_done | and_38;
   assign not_a_sp_zero = ~a_sp_zero;
   assign a_from_stack = a_pop & not_a_sp_zero;
   assign stack_we = stack_we_r;
@@ -2084,8 +1697,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   // stage ring_b: B, B2: the token waits two clocks for the stack word
   assign not_a_done = ~a_done;
   assign a_live = a_valid & not_a_done;
-  assign mux_r_valid = r_valid ? r_node : k_0_4;
-  assign mux_r_valid_1 = r_valid ? r_tmin : k_0_5;
+  assign mux_r_valid = r_valid ? r_node : k_0_2;
+  assign mux_r_valid_1 = r_valid ? r_tmin : k_0_3;
   assign mux_r_valid_2 = r_valid ? r_tmax : q_tmax;
   assign mux_a_from_stack = a_from_stack ? a_sp_m1 : a_sp;
   assign b_from_stack = b_from_stack_sr[2];
@@ -2102,7 +1715,6 @@ module fxrt_traverse_k64_sf0a3f4 (
     b_from_stack_sr[1] <= a_from_stack;
     if (rst) b2_valid <= 1'h0;
     else b2_valid <= b_valid;
-    b2_slot <= b_slot;
     b2_node <= b_node;
     b2_tmin <= b_tmin;
     b2_tmax <= b_tmax;
@@ -2115,28 +1727,28 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign done_q_rd_next = done_pop_r ? done_q_rd1 : done_q_rd;
   assign done_q_rd1_plus_k_1 = done_q_rd1 + k_1;
   assign mux_done_pop_r = done_pop_r ? done_q_rd1_plus_k_1 : done_q_rd1;
-  assign rs_done_pop_r = {{6{1'b0}}, done_pop_r};
-  assign done_q_after_pop = done_q_count - rs_done_pop_r;
-  assign rs_done_q_push = {{6{1'b0}}, done_q_push};
-  assign done_q_count_next = done_q_after_pop + rs_done_q_push;
-  assign done_q_count_eq_k_0_3 = done_q_count == k_0_3;
+  assign not_done_q_push_c1 = ~done_q_push_c1;
+  assign rs_not_done_q_push_c1 = {{6{1'b0}}, not_done_q_push_c1};
+  assign done_q_count_if_pop = done_q_count - rs_not_done_q_push_c1;
+  assign rs_done_q_push_c1 = {{6{1'b0}}, done_q_push_c1};
+  assign done_q_count_if_kept = done_q_count + rs_done_q_push_c1;
+  assign done_q_count_next = done_pop_r ? done_q_count_if_pop : done_q_count_if_kept;
+  assign done_q_count_eq_k_0 = done_q_count == k_0;
   assign done_q_one_left = done_q_count == k_1_1;
-  assign and_109 = done_q_one_left & done_pop_r;
-  assign done_q_drained = done_q_count_eq_k_0_3 | and_109;
-  assign done_q_bypass_c = done_q_push & done_q_drained;
+  assign and_42 = done_q_one_left & done_pop_r;
+  assign done_q_drained = done_q_count_eq_k_0 | and_42;
+  assign done_q_bypass_c = done_q_push_c1 & done_q_drained;
   assign k_1_1_lt_done_q_count = k_1_1 < done_q_count;
-  assign or_112 = done_q_push | k_1_1_lt_done_q_count;
+  assign or_45 = done_q_push_c1 | k_1_1_lt_done_q_count;
   assign not_done_pop_r = ~done_pop_r;
-  assign and_113 = done_q_one_left & not_done_pop_r;
-  assign done_q_nonempty_c = or_112 | and_113;
+  assign and_46 = done_q_one_left & not_done_pop_r;
+  assign done_q_nonempty_c = or_45 | and_46;
   assign mux_done_q_popped = done_q_popped ? done_q_q_next : done_q_q_stay;
   assign done_q_head = done_q_bypass ? done_q_din_r : mux_done_q_popped;
 
   always @(posedge clk) begin : done_regs
     if (rst) done_pop_r <= 1'h0;
     else done_pop_r <= done_pop;
-    if (rst) done_q_push <= 1'h0;
-    else done_q_push <= a_done;
     if (rst) done_q_wr <= 6'h00;
     else done_q_wr <= mux_done_q_push;
     if (rst) done_q_rd <= 6'h00;
@@ -2157,6 +1769,15 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (done_q_push) done_q_din_r <= done_q_din;
   end
 
+  // register copies done_q_push_copies: done_q_push and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : done_q_push_copies_regs
+    if (rst) done_q_push <= 1'h0;
+    else done_q_push <= a_done;
+    if (rst) done_q_push_c1 <= 1'h0;
+    else done_q_push_c1 <= a_done;
+  end
+
   // stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   assign bits_u_stack_data = u_stack_data[31:0];
   assign s_bits_u_stack_data = $signed(bits_u_stack_data);
@@ -2171,142 +1792,164 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign s_limit_q = $signed(limit_q);
   assign shr_c_tmin = c_tmin >>> 6;
   assign tmin_less = c_tmin - shr_c_tmin;
-  assign bits_has_best = has_best[0];
-  assign bits_has_best_1 = has_best[1];
-  assign bits_has_best_2 = has_best[2];
-  assign bits_has_best_3 = has_best[3];
-  assign bits_has_best_4 = has_best[4];
-  assign bits_has_best_5 = has_best[5];
-  assign bits_has_best_6 = has_best[6];
-  assign bits_has_best_7 = has_best[7];
-  assign bits_has_best_8 = has_best[8];
-  assign bits_has_best_9 = has_best[9];
-  assign bits_has_best_10 = has_best[10];
-  assign bits_has_best_11 = has_best[11];
-  assign bits_has_best_12 = has_best[12];
-  assign bits_has_best_13 = has_best[13];
-  assign bits_has_best_14 = has_best[14];
-  assign bits_has_best_15 = has_best[15];
-  assign bits_has_best_16 = has_best[16];
-  assign bits_has_best_17 = has_best[17];
-  assign bits_has_best_18 = has_best[18];
-  assign bits_has_best_19 = has_best[19];
-  assign bits_has_best_20 = has_best[20];
-  assign bits_has_best_21 = has_best[21];
-  assign bits_has_best_22 = has_best[22];
-  assign bits_has_best_23 = has_best[23];
-  assign bits_has_best_24 = has_best[24];
-  assign bits_has_best_25 = has_best[25];
-  assign bits_has_best_26 = has_best[26];
-  assign bits_has_best_27 = has_best[27];
-  assign bits_has_best_28 = has_best[28];
-  assign bits_has_best_29 = has_best[29];
-  assign bits_has_best_30 = has_best[30];
-  assign bits_has_best_31 = has_best[31];
-  assign bits_has_best_32 = has_best[32];
-  assign bits_has_best_33 = has_best[33];
-  assign bits_has_best_34 = has_best[34];
-  assign bits_has_best_35 = has_best[35];
-  assign bits_has_best_36 = has_best[36];
-  assign bits_has_best_37 = has_best[37];
-  assign bits_has_best_38 = has_best[38];
-  assign bits_has_best_39 = has_best[39];
-  assign bits_has_best_40 = has_best[40];
-  assign bits_has_best_41 = has_best[41];
-  assign bits_has_best_42 = has_best[42];
-  assign bits_has_best_43 = has_best[43];
-  assign bits_has_best_44 = has_best[44];
-  assign bits_has_best_45 = has_best[45];
-  assign bits_has_best_46 = has_best[46];
-  assign bits_has_best_47 = has_best[47];
-  assign bits_has_best_48 = has_best[48];
-  assign bits_has_best_49 = has_best[49];
-  assign bits_has_best_50 = has_best[50];
-  assign bits_has_best_51 = has_best[51];
-  assign bits_has_best_52 = has_best[52];
-  assign bits_has_best_53 = has_best[53];
-  assign bits_has_best_54 = has_best[54];
-  assign bits_has_best_55 = has_best[55];
-  assign bits_has_best_56 = has_best[56];
-  assign bits_has_best_57 = has_best[57];
-  assign bits_has_best_58 = has_best[58];
-  assign bits_has_best_59 = has_best[59];
-  assign bits_has_best_60 = has_best[60];
-  assign bits_has_best_61 = has_best[61];
-  assign bits_has_best_62 = has_best[62];
-  assign bits_has_best_63 = has_best[63];
-  assign slot_has_best =
-    (c_slot_c2 == 6'h00) ? bits_has_best :
-    (c_slot_c2 == 6'h01) ? bits_has_best_1 :
-    (c_slot_c2 == 6'h02) ? bits_has_best_2 :
-    (c_slot_c2 == 6'h03) ? bits_has_best_3 :
-    (c_slot_c2 == 6'h04) ? bits_has_best_4 :
-    (c_slot_c2 == 6'h05) ? bits_has_best_5 :
-    (c_slot_c2 == 6'h06) ? bits_has_best_6 :
-    (c_slot_c2 == 6'h07) ? bits_has_best_7 :
-    (c_slot_c2 == 6'h08) ? bits_has_best_8 :
-    (c_slot_c2 == 6'h09) ? bits_has_best_9 :
-    (c_slot_c2 == 6'h0a) ? bits_has_best_10 :
-    (c_slot_c2 == 6'h0b) ? bits_has_best_11 :
-    (c_slot_c2 == 6'h0c) ? bits_has_best_12 :
-    (c_slot_c2 == 6'h0d) ? bits_has_best_13 :
-    (c_slot_c2 == 6'h0e) ? bits_has_best_14 :
-    (c_slot_c2 == 6'h0f) ? bits_has_best_15 :
-    (c_slot_c2 == 6'h10) ? bits_has_best_16 :
-    (c_slot_c2 == 6'h11) ? bits_has_best_17 :
-    (c_slot_c2 == 6'h12) ? bits_has_best_18 :
-    (c_slot_c2 == 6'h13) ? bits_has_best_19 :
-    (c_slot_c2 == 6'h14) ? bits_has_best_20 :
-    (c_slot_c2 == 6'h15) ? bits_has_best_21 :
-    (c_slot_c2 == 6'h16) ? bits_has_best_22 :
-    (c_slot_c2 == 6'h17) ? bits_has_best_23 :
-    (c_slot_c2 == 6'h18) ? bits_has_best_24 :
-    (c_slot_c2 == 6'h19) ? bits_has_best_25 :
-    (c_slot_c2 == 6'h1a) ? bits_has_best_26 :
-    (c_slot_c2 == 6'h1b) ? bits_has_best_27 :
-    (c_slot_c2 == 6'h1c) ? bits_has_best_28 :
-    (c_slot_c2 == 6'h1d) ? bits_has_best_29 :
-    (c_slot_c2 == 6'h1e) ? bits_has_best_30 :
-    (c_slot_c2 == 6'h1f) ? bits_has_best_31 :
-    (c_slot_c2 == 6'h20) ? bits_has_best_32 :
-    (c_slot_c2 == 6'h21) ? bits_has_best_33 :
-    (c_slot_c2 == 6'h22) ? bits_has_best_34 :
-    (c_slot_c2 == 6'h23) ? bits_has_best_35 :
-    (c_slot_c2 == 6'h24) ? bits_has_best_36 :
-    (c_slot_c2 == 6'h25) ? bits_has_best_37 :
-    (c_slot_c2 == 6'h26) ? bits_has_best_38 :
-    (c_slot_c2 == 6'h27) ? bits_has_best_39 :
-    (c_slot_c2 == 6'h28) ? bits_has_best_40 :
-    (c_slot_c2 == 6'h29) ? bits_has_best_41 :
-    (c_slot_c2 == 6'h2a) ? bits_has_best_42 :
-    (c_slot_c2 == 6'h2b) ? bits_has_best_43 :
-    (c_slot_c2 == 6'h2c) ? bits_has_best_44 :
-    (c_slot_c2 == 6'h2d) ? bits_has_best_45 :
-    (c_slot_c2 == 6'h2e) ? bits_has_best_46 :
-    (c_slot_c2 == 6'h2f) ? bits_has_best_47 :
-    (c_slot_c2 == 6'h30) ? bits_has_best_48 :
-    (c_slot_c2 == 6'h31) ? bits_has_best_49 :
-    (c_slot_c2 == 6'h32) ? bits_has_best_50 :
-    (c_slot_c2 == 6'h33) ? bits_has_best_51 :
-    (c_slot_c2 == 6'h34) ? bits_has_best_52 :
-    (c_slot_c2 == 6'h35) ? bits_has_best_53 :
-    (c_slot_c2 == 6'h36) ? bits_has_best_54 :
-    (c_slot_c2 == 6'h37) ? bits_has_best_55 :
-    (c_slot_c2 == 6'h38) ? bits_has_best_56 :
-    (c_slot_c2 == 6'h39) ? bits_has_best_57 :
-    (c_slot_c2 == 6'h3a) ? bits_has_best_58 :
-    (c_slot_c2 == 6'h3b) ? bits_has_best_59 :
-    (c_slot_c2 == 6'h3c) ? bits_has_best_60 :
-    (c_slot_c2 == 6'h3d) ? bits_has_best_61 :
-    (c_slot_c2 == 6'h3e) ? bits_has_best_62 :
-    (c_slot_c2 == 6'h3f) ? bits_has_best_63 :
-    k_0;
+  assign has_best_kept = has_best_kept_c;
+  assign and_48 = merge_valid & merge_hit;
+  assign merge_slot_eq_b2_slot_c1 = merge_slot == b2_slot_c1;
+  assign b_slot_merged_c = and_48 & merge_slot_eq_b2_slot_c1;
+  assign bits_has_best_kept = has_best_kept[0];
+  assign bits_has_best_kept_1 = has_best_kept[1];
+  assign bits_has_best_kept_2 = has_best_kept[2];
+  assign bits_has_best_kept_3 = has_best_kept[3];
+  assign bits_has_best_kept_4 = has_best_kept[4];
+  assign bits_has_best_kept_5 = has_best_kept[5];
+  assign bits_has_best_kept_6 = has_best_kept[6];
+  assign bits_has_best_kept_7 = has_best_kept[7];
+  assign bits_has_best_kept_8 = has_best_kept[8];
+  assign bits_has_best_kept_9 = has_best_kept[9];
+  assign bits_has_best_kept_10 = has_best_kept[10];
+  assign bits_has_best_kept_11 = has_best_kept[11];
+  assign bits_has_best_kept_12 = has_best_kept[12];
+  assign bits_has_best_kept_13 = has_best_kept[13];
+  assign bits_has_best_kept_14 = has_best_kept[14];
+  assign bits_has_best_kept_15 = has_best_kept[15];
+  assign bits_b2_slot_c1 = b2_slot_c1[3:0];
+  assign slot_has_best_g0_c =
+    (bits_b2_slot_c1 == 4'h0) ? bits_has_best_kept :
+    (bits_b2_slot_c1 == 4'h1) ? bits_has_best_kept_1 :
+    (bits_b2_slot_c1 == 4'h2) ? bits_has_best_kept_2 :
+    (bits_b2_slot_c1 == 4'h3) ? bits_has_best_kept_3 :
+    (bits_b2_slot_c1 == 4'h4) ? bits_has_best_kept_4 :
+    (bits_b2_slot_c1 == 4'h5) ? bits_has_best_kept_5 :
+    (bits_b2_slot_c1 == 4'h6) ? bits_has_best_kept_6 :
+    (bits_b2_slot_c1 == 4'h7) ? bits_has_best_kept_7 :
+    (bits_b2_slot_c1 == 4'h8) ? bits_has_best_kept_8 :
+    (bits_b2_slot_c1 == 4'h9) ? bits_has_best_kept_9 :
+    (bits_b2_slot_c1 == 4'ha) ? bits_has_best_kept_10 :
+    (bits_b2_slot_c1 == 4'hb) ? bits_has_best_kept_11 :
+    (bits_b2_slot_c1 == 4'hc) ? bits_has_best_kept_12 :
+    (bits_b2_slot_c1 == 4'hd) ? bits_has_best_kept_13 :
+    (bits_b2_slot_c1 == 4'he) ? bits_has_best_kept_14 :
+    (bits_b2_slot_c1 == 4'hf) ? bits_has_best_kept_15 :
+    k_0_4;
+  assign bits_has_best_kept_16 = has_best_kept[16];
+  assign bits_has_best_kept_17 = has_best_kept[17];
+  assign bits_has_best_kept_18 = has_best_kept[18];
+  assign bits_has_best_kept_19 = has_best_kept[19];
+  assign bits_has_best_kept_20 = has_best_kept[20];
+  assign bits_has_best_kept_21 = has_best_kept[21];
+  assign bits_has_best_kept_22 = has_best_kept[22];
+  assign bits_has_best_kept_23 = has_best_kept[23];
+  assign bits_has_best_kept_24 = has_best_kept[24];
+  assign bits_has_best_kept_25 = has_best_kept[25];
+  assign bits_has_best_kept_26 = has_best_kept[26];
+  assign bits_has_best_kept_27 = has_best_kept[27];
+  assign bits_has_best_kept_28 = has_best_kept[28];
+  assign bits_has_best_kept_29 = has_best_kept[29];
+  assign bits_has_best_kept_30 = has_best_kept[30];
+  assign bits_has_best_kept_31 = has_best_kept[31];
+  assign bits_b2_slot_c1_1 = b2_slot_c1[3:0];
+  assign slot_has_best_g1_c =
+    (bits_b2_slot_c1_1 == 4'h0) ? bits_has_best_kept_16 :
+    (bits_b2_slot_c1_1 == 4'h1) ? bits_has_best_kept_17 :
+    (bits_b2_slot_c1_1 == 4'h2) ? bits_has_best_kept_18 :
+    (bits_b2_slot_c1_1 == 4'h3) ? bits_has_best_kept_19 :
+    (bits_b2_slot_c1_1 == 4'h4) ? bits_has_best_kept_20 :
+    (bits_b2_slot_c1_1 == 4'h5) ? bits_has_best_kept_21 :
+    (bits_b2_slot_c1_1 == 4'h6) ? bits_has_best_kept_22 :
+    (bits_b2_slot_c1_1 == 4'h7) ? bits_has_best_kept_23 :
+    (bits_b2_slot_c1_1 == 4'h8) ? bits_has_best_kept_24 :
+    (bits_b2_slot_c1_1 == 4'h9) ? bits_has_best_kept_25 :
+    (bits_b2_slot_c1_1 == 4'ha) ? bits_has_best_kept_26 :
+    (bits_b2_slot_c1_1 == 4'hb) ? bits_has_best_kept_27 :
+    (bits_b2_slot_c1_1 == 4'hc) ? bits_has_best_kept_28 :
+    (bits_b2_slot_c1_1 == 4'hd) ? bits_has_best_kept_29 :
+    (bits_b2_slot_c1_1 == 4'he) ? bits_has_best_kept_30 :
+    (bits_b2_slot_c1_1 == 4'hf) ? bits_has_best_kept_31 :
+    k_0_4;
+  assign bits_has_best_kept_32 = has_best_kept[32];
+  assign bits_has_best_kept_33 = has_best_kept[33];
+  assign bits_has_best_kept_34 = has_best_kept[34];
+  assign bits_has_best_kept_35 = has_best_kept[35];
+  assign bits_has_best_kept_36 = has_best_kept[36];
+  assign bits_has_best_kept_37 = has_best_kept[37];
+  assign bits_has_best_kept_38 = has_best_kept[38];
+  assign bits_has_best_kept_39 = has_best_kept[39];
+  assign bits_has_best_kept_40 = has_best_kept[40];
+  assign bits_has_best_kept_41 = has_best_kept[41];
+  assign bits_has_best_kept_42 = has_best_kept[42];
+  assign bits_has_best_kept_43 = has_best_kept[43];
+  assign bits_has_best_kept_44 = has_best_kept[44];
+  assign bits_has_best_kept_45 = has_best_kept[45];
+  assign bits_has_best_kept_46 = has_best_kept[46];
+  assign bits_has_best_kept_47 = has_best_kept[47];
+  assign bits_b2_slot_c1_2 = b2_slot_c1[3:0];
+  assign slot_has_best_g2_c =
+    (bits_b2_slot_c1_2 == 4'h0) ? bits_has_best_kept_32 :
+    (bits_b2_slot_c1_2 == 4'h1) ? bits_has_best_kept_33 :
+    (bits_b2_slot_c1_2 == 4'h2) ? bits_has_best_kept_34 :
+    (bits_b2_slot_c1_2 == 4'h3) ? bits_has_best_kept_35 :
+    (bits_b2_slot_c1_2 == 4'h4) ? bits_has_best_kept_36 :
+    (bits_b2_slot_c1_2 == 4'h5) ? bits_has_best_kept_37 :
+    (bits_b2_slot_c1_2 == 4'h6) ? bits_has_best_kept_38 :
+    (bits_b2_slot_c1_2 == 4'h7) ? bits_has_best_kept_39 :
+    (bits_b2_slot_c1_2 == 4'h8) ? bits_has_best_kept_40 :
+    (bits_b2_slot_c1_2 == 4'h9) ? bits_has_best_kept_41 :
+    (bits_b2_slot_c1_2 == 4'ha) ? bits_has_best_kept_42 :
+    (bits_b2_slot_c1_2 == 4'hb) ? bits_has_best_kept_43 :
+    (bits_b2_slot_c1_2 == 4'hc) ? bits_has_best_kept_44 :
+    (bits_b2_slot_c1_2 == 4'hd) ? bits_has_best_kept_45 :
+    (bits_b2_slot_c1_2 == 4'he) ? bits_has_best_kept_46 :
+    (bits_b2_slot_c1_2 == 4'hf) ? bits_has_best_kept_47 :
+    k_0_4;
+  assign bits_has_best_kept_48 = has_best_kept[48];
+  assign bits_has_best_kept_49 = has_best_kept[49];
+  assign bits_has_best_kept_50 = has_best_kept[50];
+  assign bits_has_best_kept_51 = has_best_kept[51];
+  assign bits_has_best_kept_52 = has_best_kept[52];
+  assign bits_has_best_kept_53 = has_best_kept[53];
+  assign bits_has_best_kept_54 = has_best_kept[54];
+  assign bits_has_best_kept_55 = has_best_kept[55];
+  assign bits_has_best_kept_56 = has_best_kept[56];
+  assign bits_has_best_kept_57 = has_best_kept[57];
+  assign bits_has_best_kept_58 = has_best_kept[58];
+  assign bits_has_best_kept_59 = has_best_kept[59];
+  assign bits_has_best_kept_60 = has_best_kept[60];
+  assign bits_has_best_kept_61 = has_best_kept[61];
+  assign bits_has_best_kept_62 = has_best_kept[62];
+  assign bits_has_best_kept_63 = has_best_kept[63];
+  assign bits_b2_slot_c1_3 = b2_slot_c1[3:0];
+  assign slot_has_best_g3_c =
+    (bits_b2_slot_c1_3 == 4'h0) ? bits_has_best_kept_48 :
+    (bits_b2_slot_c1_3 == 4'h1) ? bits_has_best_kept_49 :
+    (bits_b2_slot_c1_3 == 4'h2) ? bits_has_best_kept_50 :
+    (bits_b2_slot_c1_3 == 4'h3) ? bits_has_best_kept_51 :
+    (bits_b2_slot_c1_3 == 4'h4) ? bits_has_best_kept_52 :
+    (bits_b2_slot_c1_3 == 4'h5) ? bits_has_best_kept_53 :
+    (bits_b2_slot_c1_3 == 4'h6) ? bits_has_best_kept_54 :
+    (bits_b2_slot_c1_3 == 4'h7) ? bits_has_best_kept_55 :
+    (bits_b2_slot_c1_3 == 4'h8) ? bits_has_best_kept_56 :
+    (bits_b2_slot_c1_3 == 4'h9) ? bits_has_best_kept_57 :
+    (bits_b2_slot_c1_3 == 4'ha) ? bits_has_best_kept_58 :
+    (bits_b2_slot_c1_3 == 4'hb) ? bits_has_best_kept_59 :
+    (bits_b2_slot_c1_3 == 4'hc) ? bits_has_best_kept_60 :
+    (bits_b2_slot_c1_3 == 4'hd) ? bits_has_best_kept_61 :
+    (bits_b2_slot_c1_3 == 4'he) ? bits_has_best_kept_62 :
+    (bits_b2_slot_c1_3 == 4'hf) ? bits_has_best_kept_63 :
+    k_0_4;
+  assign bits_c_slot_c2 = c_slot_c2[5:4];
+  assign slot_has_best_c =
+    (bits_c_slot_c2 == 2'h0) ? slot_has_best_g0 :
+    (bits_c_slot_c2 == 2'h1) ? slot_has_best_g1 :
+    (bits_c_slot_c2 == 2'h2) ? slot_has_best_g2 :
+    (bits_c_slot_c2 == 2'h3) ? slot_has_best_g3 :
+    k_0_4;
+  assign slot_has_best_now = slot_has_best_c | b_slot_merged;
   assign rs_s_limit_q = $signed({{1{s_limit_q[31]}}, s_limit_q});
   assign rs_cull_x = $signed({{1{cull_x[31]}}, cull_x});
-  assign minus_115 = rs_s_limit_q - rs_cull_x;
-  assign bits_minus_115 = minus_115[32];
-  assign culled_c = cull_has_best & bits_minus_115;
-  assign and_117 = merge_valid & merge_hit;
+  assign minus_51 = rs_s_limit_q - rs_cull_x;
+  assign bits_minus_51 = minus_51[32];
+  assign culled_c = cull_has_best & bits_minus_51;
+  assign and_53 = merge_valid & merge_hit;
   assign merge_slot_eq_k_63 = merge_slot == k_63;
   assign merge_slot_eq_k_62 = merge_slot == k_62;
   assign merge_slot_eq_k_61 = merge_slot == k_61;
@@ -2371,77 +2014,144 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign merge_slot_eq_k_2 = merge_slot == k_2;
   assign merge_slot_eq_k_1 = merge_slot == k_1;
   assign merge_slot_eq_k_0_1 = merge_slot == k_0_1;
-  assign cat_118 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
-  assign best_set = and_117 ? cat_118 : k_0_2;
-  assign q_slot_eq_k_63 = q_slot == k_63;
-  assign q_slot_eq_k_62 = q_slot == k_62;
-  assign q_slot_eq_k_61 = q_slot == k_61;
-  assign q_slot_eq_k_60 = q_slot == k_60;
-  assign q_slot_eq_k_59 = q_slot == k_59;
-  assign q_slot_eq_k_58 = q_slot == k_58;
-  assign q_slot_eq_k_57 = q_slot == k_57;
-  assign q_slot_eq_k_56 = q_slot == k_56;
-  assign q_slot_eq_k_55 = q_slot == k_55;
-  assign q_slot_eq_k_54 = q_slot == k_54;
-  assign q_slot_eq_k_53 = q_slot == k_53;
-  assign q_slot_eq_k_52 = q_slot == k_52;
-  assign q_slot_eq_k_51 = q_slot == k_51;
-  assign q_slot_eq_k_50 = q_slot == k_50;
-  assign q_slot_eq_k_49 = q_slot == k_49;
-  assign q_slot_eq_k_48 = q_slot == k_48;
-  assign q_slot_eq_k_47 = q_slot == k_47;
-  assign q_slot_eq_k_46 = q_slot == k_46;
-  assign q_slot_eq_k_45 = q_slot == k_45;
-  assign q_slot_eq_k_44 = q_slot == k_44;
-  assign q_slot_eq_k_43 = q_slot == k_43;
-  assign q_slot_eq_k_42 = q_slot == k_42;
-  assign q_slot_eq_k_41 = q_slot == k_41;
-  assign q_slot_eq_k_40 = q_slot == k_40;
-  assign q_slot_eq_k_39 = q_slot == k_39;
-  assign q_slot_eq_k_38 = q_slot == k_38;
-  assign q_slot_eq_k_37 = q_slot == k_37;
-  assign q_slot_eq_k_36 = q_slot == k_36;
-  assign q_slot_eq_k_35 = q_slot == k_35;
-  assign q_slot_eq_k_34 = q_slot == k_34;
-  assign q_slot_eq_k_33 = q_slot == k_33;
-  assign q_slot_eq_k_32 = q_slot == k_32;
-  assign q_slot_eq_k_31 = q_slot == k_31;
-  assign q_slot_eq_k_30 = q_slot == k_30;
-  assign q_slot_eq_k_29 = q_slot == k_29;
-  assign q_slot_eq_k_28 = q_slot == k_28;
-  assign q_slot_eq_k_27 = q_slot == k_27;
-  assign q_slot_eq_k_26 = q_slot == k_26;
-  assign q_slot_eq_k_25 = q_slot == k_25;
-  assign q_slot_eq_k_24 = q_slot == k_24;
-  assign q_slot_eq_k_23 = q_slot == k_23;
-  assign q_slot_eq_k_22 = q_slot == k_22;
-  assign q_slot_eq_k_21 = q_slot == k_21;
-  assign q_slot_eq_k_20 = q_slot == k_20;
-  assign q_slot_eq_k_19 = q_slot == k_19;
-  assign q_slot_eq_k_18 = q_slot == k_18;
-  assign q_slot_eq_k_17 = q_slot == k_17;
-  assign q_slot_eq_k_16 = q_slot == k_16;
-  assign q_slot_eq_k_15 = q_slot == k_15;
-  assign q_slot_eq_k_14 = q_slot == k_14;
-  assign q_slot_eq_k_13 = q_slot == k_13;
-  assign q_slot_eq_k_12 = q_slot == k_12;
-  assign q_slot_eq_k_11 = q_slot == k_11;
-  assign q_slot_eq_k_10 = q_slot == k_10;
-  assign q_slot_eq_k_9 = q_slot == k_9;
-  assign q_slot_eq_k_8 = q_slot == k_8;
-  assign q_slot_eq_k_7 = q_slot == k_7;
-  assign q_slot_eq_k_6 = q_slot == k_6;
-  assign q_slot_eq_k_5 = q_slot == k_5;
-  assign q_slot_eq_k_4 = q_slot == k_4;
-  assign q_slot_eq_k_3 = q_slot == k_3;
-  assign q_slot_eq_k_2 = q_slot == k_2;
-  assign q_slot_eq_k_1 = q_slot == k_1;
-  assign q_slot_eq_k_0_1 = q_slot == k_0_1;
-  assign cat_119 = {q_slot_eq_k_63, q_slot_eq_k_62, q_slot_eq_k_61, q_slot_eq_k_60, q_slot_eq_k_59, q_slot_eq_k_58, q_slot_eq_k_57, q_slot_eq_k_56, q_slot_eq_k_55, q_slot_eq_k_54, q_slot_eq_k_53, q_slot_eq_k_52, q_slot_eq_k_51, q_slot_eq_k_50, q_slot_eq_k_49, q_slot_eq_k_48, q_slot_eq_k_47, q_slot_eq_k_46, q_slot_eq_k_45, q_slot_eq_k_44, q_slot_eq_k_43, q_slot_eq_k_42, q_slot_eq_k_41, q_slot_eq_k_40, q_slot_eq_k_39, q_slot_eq_k_38, q_slot_eq_k_37, q_slot_eq_k_36, q_slot_eq_k_35, q_slot_eq_k_34, q_slot_eq_k_33, q_slot_eq_k_32, q_slot_eq_k_31, q_slot_eq_k_30, q_slot_eq_k_29, q_slot_eq_k_28, q_slot_eq_k_27, q_slot_eq_k_26, q_slot_eq_k_25, q_slot_eq_k_24, q_slot_eq_k_23, q_slot_eq_k_22, q_slot_eq_k_21, q_slot_eq_k_20, q_slot_eq_k_19, q_slot_eq_k_18, q_slot_eq_k_17, q_slot_eq_k_16, q_slot_eq_k_15, q_slot_eq_k_14, q_slot_eq_k_13, q_slot_eq_k_12, q_slot_eq_k_11, q_slot_eq_k_10, q_slot_eq_k_9, q_slot_eq_k_8, q_slot_eq_k_7, q_slot_eq_k_6, q_slot_eq_k_5, q_slot_eq_k_4, q_slot_eq_k_3, q_slot_eq_k_2, q_slot_eq_k_1, q_slot_eq_k_0_1};
-  assign best_clear_c = q_new ? cat_119 : k_0_2;
+  assign cat_54 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
+  assign best_set = and_53 ? cat_54 : k_0_5;
+  assign q_slot_c4_eq_k_63 = q_slot_c4 == k_63;
+  assign and_55 = q_new_c4 & q_slot_c4_eq_k_63;
+  assign q_slot_c4_eq_k_62 = q_slot_c4 == k_62;
+  assign and_56 = q_new_c4 & q_slot_c4_eq_k_62;
+  assign q_slot_c4_eq_k_61 = q_slot_c4 == k_61;
+  assign and_57 = q_new_c4 & q_slot_c4_eq_k_61;
+  assign q_slot_c4_eq_k_60 = q_slot_c4 == k_60;
+  assign and_58 = q_new_c4 & q_slot_c4_eq_k_60;
+  assign q_slot_c4_eq_k_59 = q_slot_c4 == k_59;
+  assign and_59 = q_new_c4 & q_slot_c4_eq_k_59;
+  assign q_slot_c4_eq_k_58 = q_slot_c4 == k_58;
+  assign and_60 = q_new_c4 & q_slot_c4_eq_k_58;
+  assign q_slot_c4_eq_k_57 = q_slot_c4 == k_57;
+  assign and_61 = q_new_c4 & q_slot_c4_eq_k_57;
+  assign q_slot_c4_eq_k_56 = q_slot_c4 == k_56;
+  assign and_62 = q_new_c4 & q_slot_c4_eq_k_56;
+  assign q_slot_c4_eq_k_55 = q_slot_c4 == k_55;
+  assign and_63 = q_new_c4 & q_slot_c4_eq_k_55;
+  assign q_slot_c4_eq_k_54 = q_slot_c4 == k_54;
+  assign and_64 = q_new_c4 & q_slot_c4_eq_k_54;
+  assign q_slot_c4_eq_k_53 = q_slot_c4 == k_53;
+  assign and_65 = q_new_c4 & q_slot_c4_eq_k_53;
+  assign q_slot_c4_eq_k_52 = q_slot_c4 == k_52;
+  assign and_66 = q_new_c4 & q_slot_c4_eq_k_52;
+  assign q_slot_c4_eq_k_51 = q_slot_c4 == k_51;
+  assign and_67 = q_new_c4 & q_slot_c4_eq_k_51;
+  assign q_slot_c4_eq_k_50 = q_slot_c4 == k_50;
+  assign and_68 = q_new_c4 & q_slot_c4_eq_k_50;
+  assign q_slot_c4_eq_k_49 = q_slot_c4 == k_49;
+  assign and_69 = q_new_c4 & q_slot_c4_eq_k_49;
+  assign q_slot_c4_eq_k_48 = q_slot_c4 == k_48;
+  assign and_70 = q_new_c4 & q_slot_c4_eq_k_48;
+  assign cat_71 = {and_55, and_56, and_57, and_58, and_59, and_60, and_61, and_62, and_63, and_64, and_65, and_66, and_67, and_68, and_69, and_70};
+  assign q_slot_c3_eq_k_47 = q_slot_c3 == k_47;
+  assign and_72 = q_new_c3 & q_slot_c3_eq_k_47;
+  assign q_slot_c3_eq_k_46 = q_slot_c3 == k_46;
+  assign and_73 = q_new_c3 & q_slot_c3_eq_k_46;
+  assign q_slot_c3_eq_k_45 = q_slot_c3 == k_45;
+  assign and_74 = q_new_c3 & q_slot_c3_eq_k_45;
+  assign q_slot_c3_eq_k_44 = q_slot_c3 == k_44;
+  assign and_75 = q_new_c3 & q_slot_c3_eq_k_44;
+  assign q_slot_c3_eq_k_43 = q_slot_c3 == k_43;
+  assign and_76 = q_new_c3 & q_slot_c3_eq_k_43;
+  assign q_slot_c3_eq_k_42 = q_slot_c3 == k_42;
+  assign and_77 = q_new_c3 & q_slot_c3_eq_k_42;
+  assign q_slot_c3_eq_k_41 = q_slot_c3 == k_41;
+  assign and_78 = q_new_c3 & q_slot_c3_eq_k_41;
+  assign q_slot_c3_eq_k_40 = q_slot_c3 == k_40;
+  assign and_79 = q_new_c3 & q_slot_c3_eq_k_40;
+  assign q_slot_c3_eq_k_39 = q_slot_c3 == k_39;
+  assign and_80 = q_new_c3 & q_slot_c3_eq_k_39;
+  assign q_slot_c3_eq_k_38 = q_slot_c3 == k_38;
+  assign and_81 = q_new_c3 & q_slot_c3_eq_k_38;
+  assign q_slot_c3_eq_k_37 = q_slot_c3 == k_37;
+  assign and_82 = q_new_c3 & q_slot_c3_eq_k_37;
+  assign q_slot_c3_eq_k_36 = q_slot_c3 == k_36;
+  assign and_83 = q_new_c3 & q_slot_c3_eq_k_36;
+  assign q_slot_c3_eq_k_35 = q_slot_c3 == k_35;
+  assign and_84 = q_new_c3 & q_slot_c3_eq_k_35;
+  assign q_slot_c3_eq_k_34 = q_slot_c3 == k_34;
+  assign and_85 = q_new_c3 & q_slot_c3_eq_k_34;
+  assign q_slot_c3_eq_k_33 = q_slot_c3 == k_33;
+  assign and_86 = q_new_c3 & q_slot_c3_eq_k_33;
+  assign q_slot_c3_eq_k_32 = q_slot_c3 == k_32;
+  assign and_87 = q_new_c3 & q_slot_c3_eq_k_32;
+  assign cat_88 = {and_72, and_73, and_74, and_75, and_76, and_77, and_78, and_79, and_80, and_81, and_82, and_83, and_84, and_85, and_86, and_87};
+  assign q_slot_c2_eq_k_31 = q_slot_c2 == k_31;
+  assign and_89 = q_new_c2 & q_slot_c2_eq_k_31;
+  assign q_slot_c2_eq_k_30 = q_slot_c2 == k_30;
+  assign and_90 = q_new_c2 & q_slot_c2_eq_k_30;
+  assign q_slot_c2_eq_k_29 = q_slot_c2 == k_29;
+  assign and_91 = q_new_c2 & q_slot_c2_eq_k_29;
+  assign q_slot_c2_eq_k_28 = q_slot_c2 == k_28;
+  assign and_92 = q_new_c2 & q_slot_c2_eq_k_28;
+  assign q_slot_c2_eq_k_27 = q_slot_c2 == k_27;
+  assign and_93 = q_new_c2 & q_slot_c2_eq_k_27;
+  assign q_slot_c2_eq_k_26 = q_slot_c2 == k_26;
+  assign and_94 = q_new_c2 & q_slot_c2_eq_k_26;
+  assign q_slot_c2_eq_k_25 = q_slot_c2 == k_25;
+  assign and_95 = q_new_c2 & q_slot_c2_eq_k_25;
+  assign q_slot_c2_eq_k_24 = q_slot_c2 == k_24;
+  assign and_96 = q_new_c2 & q_slot_c2_eq_k_24;
+  assign q_slot_c2_eq_k_23 = q_slot_c2 == k_23;
+  assign and_97 = q_new_c2 & q_slot_c2_eq_k_23;
+  assign q_slot_c2_eq_k_22 = q_slot_c2 == k_22;
+  assign and_98 = q_new_c2 & q_slot_c2_eq_k_22;
+  assign q_slot_c2_eq_k_21 = q_slot_c2 == k_21;
+  assign and_99 = q_new_c2 & q_slot_c2_eq_k_21;
+  assign q_slot_c2_eq_k_20 = q_slot_c2 == k_20;
+  assign and_100 = q_new_c2 & q_slot_c2_eq_k_20;
+  assign q_slot_c2_eq_k_19 = q_slot_c2 == k_19;
+  assign and_101 = q_new_c2 & q_slot_c2_eq_k_19;
+  assign q_slot_c2_eq_k_18 = q_slot_c2 == k_18;
+  assign and_102 = q_new_c2 & q_slot_c2_eq_k_18;
+  assign q_slot_c2_eq_k_17 = q_slot_c2 == k_17;
+  assign and_103 = q_new_c2 & q_slot_c2_eq_k_17;
+  assign q_slot_c2_eq_k_16 = q_slot_c2 == k_16;
+  assign and_104 = q_new_c2 & q_slot_c2_eq_k_16;
+  assign cat_105 = {and_89, and_90, and_91, and_92, and_93, and_94, and_95, and_96, and_97, and_98, and_99, and_100, and_101, and_102, and_103, and_104};
+  assign q_slot_c1_eq_k_15 = q_slot_c1 == k_15;
+  assign and_106 = q_new_c1 & q_slot_c1_eq_k_15;
+  assign q_slot_c1_eq_k_14 = q_slot_c1 == k_14;
+  assign and_107 = q_new_c1 & q_slot_c1_eq_k_14;
+  assign q_slot_c1_eq_k_13 = q_slot_c1 == k_13;
+  assign and_108 = q_new_c1 & q_slot_c1_eq_k_13;
+  assign q_slot_c1_eq_k_12 = q_slot_c1 == k_12;
+  assign and_109 = q_new_c1 & q_slot_c1_eq_k_12;
+  assign q_slot_c1_eq_k_11 = q_slot_c1 == k_11;
+  assign and_110 = q_new_c1 & q_slot_c1_eq_k_11;
+  assign q_slot_c1_eq_k_10 = q_slot_c1 == k_10;
+  assign and_111 = q_new_c1 & q_slot_c1_eq_k_10;
+  assign q_slot_c1_eq_k_9 = q_slot_c1 == k_9;
+  assign and_112 = q_new_c1 & q_slot_c1_eq_k_9;
+  assign q_slot_c1_eq_k_8 = q_slot_c1 == k_8;
+  assign and_113 = q_new_c1 & q_slot_c1_eq_k_8;
+  assign q_slot_c1_eq_k_7 = q_slot_c1 == k_7;
+  assign and_114 = q_new_c1 & q_slot_c1_eq_k_7;
+  assign q_slot_c1_eq_k_6 = q_slot_c1 == k_6;
+  assign and_115 = q_new_c1 & q_slot_c1_eq_k_6;
+  assign q_slot_c1_eq_k_5 = q_slot_c1 == k_5;
+  assign and_116 = q_new_c1 & q_slot_c1_eq_k_5;
+  assign q_slot_c1_eq_k_4 = q_slot_c1 == k_4;
+  assign and_117 = q_new_c1 & q_slot_c1_eq_k_4;
+  assign q_slot_c1_eq_k_3 = q_slot_c1 == k_3;
+  assign and_118 = q_new_c1 & q_slot_c1_eq_k_3;
+  assign q_slot_c1_eq_k_2 = q_slot_c1 == k_2;
+  assign and_119 = q_new_c1 & q_slot_c1_eq_k_2;
+  assign q_slot_c1_eq_k_1 = q_slot_c1 == k_1;
+  assign and_120 = q_new_c1 & q_slot_c1_eq_k_1;
+  assign q_slot_c1_eq_k_0_1 = q_slot_c1 == k_0_1;
+  assign and_121 = q_new_c1 & q_slot_c1_eq_k_0_1;
+  assign cat_122 = {and_106, and_107, and_108, and_109, and_110, and_111, and_112, and_113, and_114, and_115, and_116, and_117, and_118, and_119, and_120, and_121};
+  assign best_clear_c = {cat_71, cat_88, cat_105, cat_122};
   assign not_best_clear = ~best_clear;
-  assign and_120 = has_best & not_best_clear;
-  assign and_120_or_best_set = and_120 | best_set;
+  assign has_best_kept_c = has_best & not_best_clear;
+  assign or_125 = has_best_kept | best_set;
 
   always @(posedge clk) begin : ring_c_regs
     if (rst) c_valid <= 1'h0;
@@ -2452,9 +2162,14 @@ module fxrt_traverse_k64_sf0a3f4 (
     c_sp <= b2_sp;
     limit_q <= cull_limit[c_slot_c1];
     if (rst) has_best <= 64'h0000000000000000;
-    else has_best <= and_120_or_best_set;
+    else has_best <= or_125;
     cull_x <= tmin_less;
-    cull_has_best <= slot_has_best;
+    b_slot_merged <= b_slot_merged_c;
+    slot_has_best_g0 <= slot_has_best_g0_c;
+    slot_has_best_g1 <= slot_has_best_g1_c;
+    slot_has_best_g2 <= slot_has_best_g2_c;
+    slot_has_best_g3 <= slot_has_best_g3_c;
+    cull_has_best <= slot_has_best_now;
     culled <= culled_c;
     culled_n <= culled;
     best_clear <= best_clear_c;
@@ -2466,6 +2181,33 @@ module fxrt_traverse_k64_sf0a3f4 (
     c_slot <= b2_slot;
     c_slot_c1 <= b2_slot;
     c_slot_c2 <= b2_slot;
+  end
+
+  // register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : b2_slot_copies_regs
+    b2_slot <= b_slot;
+    b2_slot_c1 <= b_slot;
+  end
+
+  // register copies q_new_copies: q_new and 4 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : q_new_copies_regs
+    q_new <= take_new;
+    q_new_c1 <= take_new;
+    q_new_c2 <= take_new;
+    q_new_c3 <= take_new;
+    q_new_c4 <= take_new;
+  end
+
+  // register copies q_slot_copies: q_slot and 4 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : q_slot_copies_regs
+    q_slot <= mux_take_unpark;
+    q_slot_c1 <= mux_take_unpark;
+    q_slot_c2 <= mux_take_unpark;
+    q_slot_c3 <= mux_take_unpark;
+    q_slot_c4 <= mux_take_unpark;
   end
 
   // stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
@@ -2490,40 +2232,55 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_push = visit_c_and_nw_is_leaf & nw_count_ne_k_0_6;
   assign u_n_tmin = $unsigned(n_tmin);
   assign rs_u_n_tmin = u_n_tmin[30:0];
-  assign cat_124 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
+  assign cat_129 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
   assign leaf_q_wr_plus_k_1 = leaf_q_wr + k_1;
   assign mux_leaf_q_push = leaf_q_push ? leaf_q_wr_plus_k_1 : leaf_q_wr;
   assign leaf_q_rd_next = leaf_pop_r ? leaf_q_rd1 : leaf_q_rd;
   assign leaf_q_rd1_plus_k_1 = leaf_q_rd1 + k_1;
   assign mux_leaf_pop_r = leaf_pop_r ? leaf_q_rd1_plus_k_1 : leaf_q_rd1;
-  assign rs_leaf_pop_r = {{6{1'b0}}, leaf_pop_r};
-  assign leaf_q_after_pop = leaf_q_count - rs_leaf_pop_r;
-  assign rs_leaf_q_push = {{6{1'b0}}, leaf_q_push};
-  assign leaf_q_count_next = leaf_q_after_pop + rs_leaf_q_push;
-  assign leaf_q_count_eq_k_0_3 = leaf_q_count == k_0_3;
+  assign not_leaf_q_push_c1 = ~leaf_q_push_c1;
+  assign rs_not_leaf_q_push_c1 = {{6{1'b0}}, not_leaf_q_push_c1};
+  assign leaf_q_count_if_pop = leaf_q_count - rs_not_leaf_q_push_c1;
+  assign rs_leaf_q_push_c1 = {{6{1'b0}}, leaf_q_push_c1};
+  assign leaf_q_count_if_kept = leaf_q_count + rs_leaf_q_push_c1;
+  assign leaf_q_count_next = leaf_pop_r ? leaf_q_count_if_pop : leaf_q_count_if_kept;
+  assign leaf_q_count_eq_k_0 = leaf_q_count == k_0;
   assign leaf_q_one_left = leaf_q_count == k_1_1;
-  assign and_127 = leaf_q_one_left & leaf_pop_r;
-  assign leaf_q_drained = leaf_q_count_eq_k_0_3 | and_127;
-  assign leaf_q_bypass_c = leaf_q_push & leaf_q_drained;
+  assign and_132 = leaf_q_one_left & leaf_pop_r;
+  assign leaf_q_drained = leaf_q_count_eq_k_0 | and_132;
+  assign leaf_q_bypass_c = leaf_q_push_c1 & leaf_q_drained;
   assign k_1_1_lt_leaf_q_count = k_1_1 < leaf_q_count;
-  assign or_130 = leaf_q_push | k_1_1_lt_leaf_q_count;
+  assign or_135 = leaf_q_push_c1 | k_1_1_lt_leaf_q_count;
   assign not_leaf_pop_r = ~leaf_pop_r;
-  assign and_131 = leaf_q_one_left & not_leaf_pop_r;
-  assign leaf_q_nonempty_c = or_130 | and_131;
+  assign and_136 = leaf_q_one_left & not_leaf_pop_r;
+  assign leaf_q_nonempty_c = or_135 | and_136;
   assign bits_leaf_q_din = leaf_q_din[15:0];
   assign bits_leaf_q_din_1 = leaf_q_din[31:16];
   assign bits_leaf_q_din_2 = leaf_q_din[47:32];
   assign bits_leaf_q_din_3 = leaf_q_din[58:48];
+  assign mux_leaf_pop_r_1 = leaf_pop_r ? leaf_q_rd1_p1 : leaf_q_rd_p1;
+  assign leaf_q_rd1_p1_plus_k_1 = leaf_q_rd1_p1 + k_1;
+  assign mux_leaf_pop_r_2 = leaf_pop_r ? leaf_q_rd1_p1_plus_k_1 : leaf_q_rd1_p1;
+  assign mux_leaf_pop_r_3 = leaf_pop_r ? leaf_q_rd1_p2 : leaf_q_rd_p2;
+  assign leaf_q_rd1_p2_plus_k_1 = leaf_q_rd1_p2 + k_1;
+  assign mux_leaf_pop_r_4 = leaf_pop_r ? leaf_q_rd1_p2_plus_k_1 : leaf_q_rd1_p2;
+  assign mux_leaf_pop_r_5 = leaf_pop_r ? leaf_q_rd1_p3 : leaf_q_rd_p3;
+  assign leaf_q_rd1_p3_plus_k_1 = leaf_q_rd1_p3 + k_1;
+  assign mux_leaf_pop_r_6 = leaf_pop_r ? leaf_q_rd1_p3_plus_k_1 : leaf_q_rd1_p3;
   assign leaf_q_q_stay = {leaf_q_q_stay_g3, leaf_q_q_stay_g2, leaf_q_q_stay_g1, leaf_q_q_stay_g0};
   assign leaf_q_q_next = {leaf_q_q_next_g3, leaf_q_q_next_g2, leaf_q_q_next_g1, leaf_q_q_next_g0};
   assign mux_leaf_q_popped = leaf_q_popped ? leaf_q_q_next : leaf_q_q_stay;
   assign leaf_q_head = leaf_q_bypass ? leaf_q_din_r : mux_leaf_q_popped;
   assign n_ray_slot_early = n_ray_slot_early_sr[2];
+  assign ray_o_q = {ray_o_q_g5, ray_o_q_g4, ray_o_q_g3, ray_o_q_g2, ray_o_q_g1, ray_o_q_g0};
   assign bits_ray_o_q = ray_o_q[28:0];
   assign bits_ray_o_q_1 = ray_o_q[57:29];
   assign bits_ray_o_q_2 = ray_o_q[86:58];
+  assign ray_invx_q = {ray_invx_q_g2, ray_invx_q_g1, ray_invx_q_g0};
   assign s_ray_invx_q = $signed(ray_invx_q);
+  assign ray_invy_q = {ray_invy_q_g2, ray_invy_q_g1, ray_invy_q_g0};
   assign s_ray_invy_q = $signed(ray_invy_q);
+  assign ray_invz_q = {ray_invz_q_g2, ray_invz_q_g1, ray_invz_q_g0};
   assign s_ray_invz_q = $signed(ray_invz_q);
   assign rs_pu_sel_plane = {{1{1'b0}}, pu_sel_plane};
   assign s_rs_pu_sel_plane = $signed(rs_pu_sel_plane);
@@ -2572,8 +2329,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign pu_below_1 = pu_shifted_1[61];
   assign not_pu_below_1 = ~pu_below_1;
   assign bits_pu_shifted_1 = pu_shifted_1[60:30];
-  assign ne_138 = bits_pu_shifted_1 != k_0_7;
-  assign pu_above_1 = not_pu_below_1 & ne_138;
+  assign ne_147 = bits_pu_shifted_1 != k_0_7;
+  assign pu_above_1 = not_pu_below_1 & ne_147;
   assign rs_pu_shifted_1 = $signed(pu_shifted_1[31:0]);
   assign mux_pu_below_r_1 = pu_below_r_1 ? k_m1 : pu_low_r_1;
   assign pu_clamped_1 = pu_above_r_1 ? k_1073741824 : mux_pu_below_r_1;
@@ -2610,37 +2367,62 @@ module fxrt_traverse_k64_sf0a3f4 (
     n_sp_sr[1] <= c_sp;
     if (rst) leaf_pop_r <= 1'h0;
     else leaf_pop_r <= leaf_pop;
-    if (rst) leaf_q_push <= 1'h0;
-    else leaf_q_push <= leaf_push;
     if (rst) leaf_q_wr <= 6'h00;
     else leaf_q_wr <= mux_leaf_q_push;
+    if (rst) leaf_q_rd <= 6'h00;
+    else leaf_q_rd <= leaf_q_rd_next;
     if (rst) leaf_q_count <= 7'h00;
     else leaf_q_count <= leaf_q_count_next;
+    if (rst) leaf_q_rd1 <= 6'h01;
+    else leaf_q_rd1 <= mux_leaf_pop_r;
     if (rst) leaf_q_bypass <= 1'h0;
     else leaf_q_bypass <= leaf_q_bypass_c;
     if (rst) leaf_q_popped <= 1'h0;
     else leaf_q_popped <= leaf_pop_r;
     if (rst) leaf_q_nonempty <= 1'h0;
     else leaf_q_nonempty <= leaf_q_nonempty_c;
-    leaf_q_din <= cat_124;
-    leaf_q_q_stay_g3 <= leaf_q_mem_g3[leaf_q_rd_c3];
-    leaf_q_q_stay_g2 <= leaf_q_mem_g2[leaf_q_rd_c2];
-    leaf_q_q_stay_g1 <= leaf_q_mem_g1[leaf_q_rd_c1];
+    leaf_q_din <= cat_129;
+    if (rst) leaf_q_rd_p1 <= 6'h00;
+    else leaf_q_rd_p1 <= mux_leaf_pop_r_1;
+    if (rst) leaf_q_rd1_p1 <= 6'h01;
+    else leaf_q_rd1_p1 <= mux_leaf_pop_r_2;
+    if (rst) leaf_q_rd_p2 <= 6'h00;
+    else leaf_q_rd_p2 <= mux_leaf_pop_r_3;
+    if (rst) leaf_q_rd1_p2 <= 6'h01;
+    else leaf_q_rd1_p2 <= mux_leaf_pop_r_4;
+    if (rst) leaf_q_rd_p3 <= 6'h00;
+    else leaf_q_rd_p3 <= mux_leaf_pop_r_5;
+    if (rst) leaf_q_rd1_p3 <= 6'h01;
+    else leaf_q_rd1_p3 <= mux_leaf_pop_r_6;
+    leaf_q_q_stay_g3 <= leaf_q_mem_g3[leaf_q_rd_p3];
+    leaf_q_q_stay_g2 <= leaf_q_mem_g2[leaf_q_rd_p2];
+    leaf_q_q_stay_g1 <= leaf_q_mem_g1[leaf_q_rd_p1];
     leaf_q_q_stay_g0 <= leaf_q_mem_g0[leaf_q_rd];
-    leaf_q_q_next_g3 <= leaf_q_mem_g3[leaf_q_rd1_c3];
-    leaf_q_q_next_g2 <= leaf_q_mem_g2[leaf_q_rd1_c2];
-    leaf_q_q_next_g1 <= leaf_q_mem_g1[leaf_q_rd1_c1];
+    leaf_q_q_next_g3 <= leaf_q_mem_g3[leaf_q_rd1_p3];
+    leaf_q_q_next_g2 <= leaf_q_mem_g2[leaf_q_rd1_p2];
+    leaf_q_q_next_g1 <= leaf_q_mem_g1[leaf_q_rd1_p1];
     leaf_q_q_next_g0 <= leaf_q_mem_g0[leaf_q_rd1];
     if (leaf_q_push) leaf_q_din_r <= leaf_q_din;
     n_ray_slot_early_sr[2] <= n_ray_slot_early_sr[1];
     n_ray_slot_early_sr[1] <= c_slot;
-    ray_o_q <= ray_o[n_ray_slot];
-    ray_invx_q <= ray_invx[n_ray_slot_c1];
-    ray_invy_q <= ray_invy[n_ray_slot_c2];
-    ray_invz_q <= ray_invz[n_ray_slot_c3];
+    ray_o_q_g5 <= ray_o_g5[n_ray_slot_c5];
+    ray_o_q_g4 <= ray_o_g4[n_ray_slot_c4];
+    ray_o_q_g3 <= ray_o_g3[n_ray_slot_c3];
+    ray_o_q_g2 <= ray_o_g2[n_ray_slot_c2];
+    ray_o_q_g1 <= ray_o_g1[n_ray_slot_c1];
+    ray_o_q_g0 <= ray_o_g0[n_ray_slot];
+    ray_invx_q_g2 <= ray_invx_g2[n_ray_slot_c8];
+    ray_invx_q_g1 <= ray_invx_g1[n_ray_slot_c7];
+    ray_invx_q_g0 <= ray_invx_g0[n_ray_slot_c6];
+    ray_invy_q_g2 <= ray_invy_g2[n_ray_slot_c11];
+    ray_invy_q_g1 <= ray_invy_g1[n_ray_slot_c10];
+    ray_invy_q_g0 <= ray_invy_g0[n_ray_slot_c9];
+    ray_invz_q_g2 <= ray_invz_g2[n_ray_slot_c14];
+    ray_invz_q_g1 <= ray_invz_g1[n_ray_slot_c13];
+    ray_invz_q_g0 <= ray_invz_g0[n_ray_slot_c12];
     if (rst) pu_sel_valid <= 1'h0;
     else pu_sel_valid <= is_inner;
-    pu_sel_last <= k_0;
+    pu_sel_last <= k_0_4;
     pu_sel_plane <= nw_clip0;
     pu_sel_axis <= nw_axis;
     pu_delta <= pu_diff;
@@ -2730,39 +2512,33 @@ module fxrt_traverse_k64_sf0a3f4 (
     negative_sr[1] <= negative_c;
   end
 
-  // register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
+  // register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
 
-  (* keep *) always @(posedge clk) begin : leaf_q_rd_copies_regs
-    if (rst) leaf_q_rd <= 6'h00;
-    else leaf_q_rd <= leaf_q_rd_next;
-    if (rst) leaf_q_rd_c1 <= 6'h00;
-    else leaf_q_rd_c1 <= leaf_q_rd_next;
-    if (rst) leaf_q_rd_c2 <= 6'h00;
-    else leaf_q_rd_c2 <= leaf_q_rd_next;
-    if (rst) leaf_q_rd_c3 <= 6'h00;
-    else leaf_q_rd_c3 <= leaf_q_rd_next;
+  (* keep *) always @(posedge clk) begin : leaf_q_push_copies_regs
+    if (rst) leaf_q_push <= 1'h0;
+    else leaf_q_push <= leaf_push;
+    if (rst) leaf_q_push_c1 <= 1'h0;
+    else leaf_q_push_c1 <= leaf_push;
   end
 
-  // register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
-
-  (* keep *) always @(posedge clk) begin : leaf_q_rd1_copies_regs
-    if (rst) leaf_q_rd1 <= 6'h01;
-    else leaf_q_rd1 <= mux_leaf_pop_r;
-    if (rst) leaf_q_rd1_c1 <= 6'h01;
-    else leaf_q_rd1_c1 <= mux_leaf_pop_r;
-    if (rst) leaf_q_rd1_c2 <= 6'h01;
-    else leaf_q_rd1_c2 <= mux_leaf_pop_r;
-    if (rst) leaf_q_rd1_c3 <= 6'h01;
-    else leaf_q_rd1_c3 <= mux_leaf_pop_r;
-  end
-
-  // register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+  // register copies n_ray_slot_copies: n_ray_slot and 14 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : n_ray_slot_copies_regs
     n_ray_slot <= n_ray_slot_early;
     n_ray_slot_c1 <= n_ray_slot_early;
     n_ray_slot_c2 <= n_ray_slot_early;
     n_ray_slot_c3 <= n_ray_slot_early;
+    n_ray_slot_c4 <= n_ray_slot_early;
+    n_ray_slot_c5 <= n_ray_slot_early;
+    n_ray_slot_c6 <= n_ray_slot_early;
+    n_ray_slot_c7 <= n_ray_slot_early;
+    n_ray_slot_c8 <= n_ray_slot_early;
+    n_ray_slot_c9 <= n_ray_slot_early;
+    n_ray_slot_c10 <= n_ray_slot_early;
+    n_ray_slot_c11 <= n_ray_slot_early;
+    n_ray_slot_c12 <= n_ray_slot_early;
+    n_ray_slot_c13 <= n_ray_slot_early;
+    n_ray_slot_c14 <= n_ray_slot_early;
   end
 
   // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
@@ -2783,8 +2559,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign tmin_minus_1 = n_tmin - k_1_3;
   assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
-  assign minus_142 = rs_tmin_n1 - rs_tmax_p1;
-  assign tmin_le_tmax_c = minus_142[32];
+  assign minus_151 = rs_tmin_n1 - rs_tmax_p1;
+  assign tmin_le_tmax_c = minus_151[32];
   assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
   assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
   assign d0_hi = d0_hi_sr[7];
@@ -2799,20 +2575,20 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign d1_lo = d1_lo_sr[7];
   assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_143 = rs_plane_t - rs_d0_hi;
-  assign d0_below = minus_143[32];
+  assign minus_152 = rs_plane_t - rs_d0_hi;
+  assign d0_below = minus_152[32];
   assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
   assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign minus_144 = rs_d0_lo - rs_plane_t_1;
-  assign d0_above = minus_144[32];
+  assign minus_153 = rs_d0_lo - rs_plane_t_1;
+  assign d0_above = minus_153[32];
   assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
   assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_145 = rs_plane_t_1_1 - rs_d1_hi;
-  assign d1_below = minus_145[32];
+  assign minus_154 = rs_plane_t_1_1 - rs_d1_hi;
+  assign d1_below = minus_154[32];
   assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
   assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign minus_146 = rs_d1_lo - rs_plane_t_1_2;
-  assign d1_above = minus_146[32];
+  assign minus_155 = rs_d1_lo - rs_plane_t_1_2;
+  assign d1_above = minus_155[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
   assign go_near_c = negative ? d1_above : d0_above;
@@ -2972,10 +2748,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign enter_far = g_inner_and_not_go_near & go_far;
   assign push = enter_near & go_far;
   assign rs_g_sp = g_sp[4:0];
-  assign cat_148 = {g_slot, rs_g_sp};
+  assign cat_157 = {g_slot, rs_g_sp};
   assign u_far_min = $unsigned(far_min);
   assign u_g_tmax = $unsigned(g_tmax);
-  assign cat_149 = {far, u_far_min, u_g_tmax};
+  assign cat_158 = {far, u_far_min, u_g_tmax};
   assign enter_near_or_enter_far = enter_near | enter_far;
   assign g_pop = ~enter_near_or_enter_far;
   assign mux_enter_near = enter_near ? near : far;
@@ -2990,14 +2766,14 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign g_sp_m1 = push ? g_sp : g_sp_minus_k_1;
   assign g_done = g_pop & g_sp_zero;
   assign rs_g_sp_m1 = g_sp_m1[4:0];
-  assign cat_150 = {g_slot, rs_g_sp_m1};
-  assign stack_raddr_next = g_valid ? cat_150 : q_stack_raddr;
+  assign cat_159 = {g_slot, rs_g_sp_m1};
+  assign stack_raddr_next = g_valid ? cat_159 : q_stack_raddr;
 
   always @(posedge clk) begin : ring_g_regs
     if (rst) stack_we_r <= 1'h0;
     else stack_we_r <= push;
-    stack_waddr_r <= cat_148;
-    stack_wdata_r <= cat_149;
+    stack_waddr_r <= cat_157;
+    stack_wdata_r <= cat_158;
   end
 
   fxrt_bram_stack_w77 u_stack (

@@ -7,8 +7,36 @@ entity fxrt_traverse_k64_sf0a3f4 is
   port (
     clk : in std_logic;
     rst : in std_logic;
-    ray_we : in unsigned(0 downto 0);
-    ray_slot : in unsigned(5 downto 0);
+    ray_we_g0 : in unsigned(0 downto 0);
+    ray_slot_g0 : in unsigned(5 downto 0);
+    ray_we_g1 : in unsigned(0 downto 0);
+    ray_slot_g1 : in unsigned(5 downto 0);
+    ray_we_g2 : in unsigned(0 downto 0);
+    ray_slot_g2 : in unsigned(5 downto 0);
+    ray_we_g3 : in unsigned(0 downto 0);
+    ray_slot_g3 : in unsigned(5 downto 0);
+    ray_we_g4 : in unsigned(0 downto 0);
+    ray_slot_g4 : in unsigned(5 downto 0);
+    ray_we_g5 : in unsigned(0 downto 0);
+    ray_slot_g5 : in unsigned(5 downto 0);
+    ray_we_g6 : in unsigned(0 downto 0);
+    ray_slot_g6 : in unsigned(5 downto 0);
+    ray_we_g7 : in unsigned(0 downto 0);
+    ray_slot_g7 : in unsigned(5 downto 0);
+    ray_we_g8 : in unsigned(0 downto 0);
+    ray_slot_g8 : in unsigned(5 downto 0);
+    ray_we_g9 : in unsigned(0 downto 0);
+    ray_slot_g9 : in unsigned(5 downto 0);
+    ray_we_g10 : in unsigned(0 downto 0);
+    ray_slot_g10 : in unsigned(5 downto 0);
+    ray_we_g11 : in unsigned(0 downto 0);
+    ray_slot_g11 : in unsigned(5 downto 0);
+    ray_we_g12 : in unsigned(0 downto 0);
+    ray_slot_g12 : in unsigned(5 downto 0);
+    ray_we_g13 : in unsigned(0 downto 0);
+    ray_slot_g13 : in unsigned(5 downto 0);
+    ray_we_g14 : in unsigned(0 downto 0);
+    ray_slot_g14 : in unsigned(5 downto 0);
     ox : in unsigned(28 downto 0);
     oy : in unsigned(28 downto 0);
     oz : in unsigned(28 downto 0);
@@ -70,17 +98,53 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
     );
   end component;
 
-  type ray_o_t is array (0 to 63) of unsigned(86 downto 0);
-  signal ray_o : ray_o_t := (others => (others => '0'));
+  type ray_o_g0_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_o_g0 : ray_o_g0_t := (others => (others => '0'));
 
-  type ray_invx_t is array (0 to 63) of unsigned(47 downto 0);
-  signal ray_invx : ray_invx_t := (others => (others => '0'));
+  type ray_o_g1_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_o_g1 : ray_o_g1_t := (others => (others => '0'));
 
-  type ray_invy_t is array (0 to 63) of unsigned(47 downto 0);
-  signal ray_invy : ray_invy_t := (others => (others => '0'));
+  type ray_o_g2_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_o_g2 : ray_o_g2_t := (others => (others => '0'));
 
-  type ray_invz_t is array (0 to 63) of unsigned(47 downto 0);
-  signal ray_invz : ray_invz_t := (others => (others => '0'));
+  type ray_o_g3_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_o_g3 : ray_o_g3_t := (others => (others => '0'));
+
+  type ray_o_g4_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_o_g4 : ray_o_g4_t := (others => (others => '0'));
+
+  type ray_o_g5_t is array (0 to 63) of unsigned(6 downto 0);
+  signal ray_o_g5 : ray_o_g5_t := (others => (others => '0'));
+
+  type ray_invx_g0_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invx_g0 : ray_invx_g0_t := (others => (others => '0'));
+
+  type ray_invx_g1_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invx_g1 : ray_invx_g1_t := (others => (others => '0'));
+
+  type ray_invx_g2_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invx_g2 : ray_invx_g2_t := (others => (others => '0'));
+
+  type ray_invy_g0_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invy_g0 : ray_invy_g0_t := (others => (others => '0'));
+
+  type ray_invy_g1_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invy_g1 : ray_invy_g1_t := (others => (others => '0'));
+
+  type ray_invy_g2_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invy_g2 : ray_invy_g2_t := (others => (others => '0'));
+
+  type ray_invz_g0_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invz_g0 : ray_invz_g0_t := (others => (others => '0'));
+
+  type ray_invz_g1_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invz_g1 : ray_invz_g1_t := (others => (others => '0'));
+
+  type ray_invz_g2_t is array (0 to 63) of unsigned(15 downto 0);
+  signal ray_invz_g2 : ray_invz_g2_t := (others => (others => '0'));
+
+  type free_q_mem_t is array (0 to 63) of unsigned(5 downto 0);
+  signal free_q_mem : free_q_mem_t := (others => (others => '0'));
 
   type unpark_q_mem_t is array (0 to 63) of unsigned(11 downto 0);
   signal unpark_q_mem : unpark_q_mem_t := (others => (others => '0'));
@@ -119,6 +183,21 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal u_invx : unsigned(47 downto 0);
   signal u_invy : unsigned(47 downto 0);
   signal u_invz : unsigned(47 downto 0);
+  signal bits_cat_0 : unsigned(15 downto 0);
+  signal bits_cat_0_1 : unsigned(15 downto 0);
+  signal bits_cat_0_2 : unsigned(15 downto 0);
+  signal bits_cat_0_3 : unsigned(15 downto 0);
+  signal bits_cat_0_4 : unsigned(15 downto 0);
+  signal bits_cat_0_5 : unsigned(6 downto 0);
+  signal bits_u_invx : unsigned(15 downto 0);
+  signal bits_u_invx_1 : unsigned(15 downto 0);
+  signal bits_u_invx_2 : unsigned(15 downto 0);
+  signal bits_u_invy : unsigned(15 downto 0);
+  signal bits_u_invy_1 : unsigned(15 downto 0);
+  signal bits_u_invy_2 : unsigned(15 downto 0);
+  signal bits_u_invz : unsigned(15 downto 0);
+  signal bits_u_invz_1 : unsigned(15 downto 0);
+  signal bits_u_invz_2 : unsigned(15 downto 0);
   signal not_just_alloc : unsigned(0 downto 0);
   signal has_free_c : unsigned(0 downto 0);
   signal bits_leaf_q_head : unsigned(5 downto 0);
@@ -128,476 +207,78 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal bits_leaf_q_head_4 : unsigned(5 downto 0);
   signal cull_c : unsigned(0 downto 0);
 
-  -- stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
-  signal free_bits : unsigned(63 downto 0) := unsigned'("1111111111111111111111111111111111111111111111111111111111111111");
-  signal bits_free_bits : unsigned(0 downto 0);
-  signal bits_free_bits_1 : unsigned(0 downto 0);
-  signal bits_free_bits_2 : unsigned(0 downto 0);
-  signal bits_free_bits_3 : unsigned(0 downto 0);
-  signal bits_free_bits_4 : unsigned(0 downto 0);
-  signal bits_free_bits_5 : unsigned(0 downto 0);
-  signal bits_free_bits_6 : unsigned(0 downto 0);
-  signal bits_free_bits_7 : unsigned(0 downto 0);
-  signal bits_free_bits_8 : unsigned(0 downto 0);
-  signal bits_free_bits_9 : unsigned(0 downto 0);
-  signal bits_free_bits_10 : unsigned(0 downto 0);
-  signal bits_free_bits_11 : unsigned(0 downto 0);
-  signal bits_free_bits_12 : unsigned(0 downto 0);
-  signal bits_free_bits_13 : unsigned(0 downto 0);
-  signal bits_free_bits_14 : unsigned(0 downto 0);
-  signal bits_free_bits_15 : unsigned(0 downto 0);
-  signal bits_free_bits_16 : unsigned(0 downto 0);
-  signal bits_free_bits_17 : unsigned(0 downto 0);
-  signal bits_free_bits_18 : unsigned(0 downto 0);
-  signal bits_free_bits_19 : unsigned(0 downto 0);
-  signal bits_free_bits_20 : unsigned(0 downto 0);
-  signal bits_free_bits_21 : unsigned(0 downto 0);
-  signal bits_free_bits_22 : unsigned(0 downto 0);
-  signal bits_free_bits_23 : unsigned(0 downto 0);
-  signal bits_free_bits_24 : unsigned(0 downto 0);
-  signal bits_free_bits_25 : unsigned(0 downto 0);
-  signal bits_free_bits_26 : unsigned(0 downto 0);
-  signal bits_free_bits_27 : unsigned(0 downto 0);
-  signal bits_free_bits_28 : unsigned(0 downto 0);
-  signal bits_free_bits_29 : unsigned(0 downto 0);
-  signal bits_free_bits_30 : unsigned(0 downto 0);
-  signal bits_free_bits_31 : unsigned(0 downto 0);
-  signal bits_free_bits_32 : unsigned(0 downto 0);
-  signal bits_free_bits_33 : unsigned(0 downto 0);
-  signal bits_free_bits_34 : unsigned(0 downto 0);
-  signal bits_free_bits_35 : unsigned(0 downto 0);
-  signal bits_free_bits_36 : unsigned(0 downto 0);
-  signal bits_free_bits_37 : unsigned(0 downto 0);
-  signal bits_free_bits_38 : unsigned(0 downto 0);
-  signal bits_free_bits_39 : unsigned(0 downto 0);
-  signal bits_free_bits_40 : unsigned(0 downto 0);
-  signal bits_free_bits_41 : unsigned(0 downto 0);
-  signal bits_free_bits_42 : unsigned(0 downto 0);
-  signal bits_free_bits_43 : unsigned(0 downto 0);
-  signal bits_free_bits_44 : unsigned(0 downto 0);
-  signal bits_free_bits_45 : unsigned(0 downto 0);
-  signal bits_free_bits_46 : unsigned(0 downto 0);
-  signal bits_free_bits_47 : unsigned(0 downto 0);
-  signal bits_free_bits_48 : unsigned(0 downto 0);
-  signal bits_free_bits_49 : unsigned(0 downto 0);
-  signal bits_free_bits_50 : unsigned(0 downto 0);
-  signal bits_free_bits_51 : unsigned(0 downto 0);
-  signal bits_free_bits_52 : unsigned(0 downto 0);
-  signal bits_free_bits_53 : unsigned(0 downto 0);
-  signal bits_free_bits_54 : unsigned(0 downto 0);
-  signal bits_free_bits_55 : unsigned(0 downto 0);
-  signal bits_free_bits_56 : unsigned(0 downto 0);
-  signal bits_free_bits_57 : unsigned(0 downto 0);
-  signal bits_free_bits_58 : unsigned(0 downto 0);
-  signal bits_free_bits_59 : unsigned(0 downto 0);
-  signal bits_free_bits_60 : unsigned(0 downto 0);
-  signal bits_free_bits_61 : unsigned(0 downto 0);
-  signal bits_free_bits_62 : unsigned(0 downto 0);
-  signal bits_free_bits_63 : unsigned(0 downto 0);
-  constant k_0 : unsigned(0 downto 0) := unsigned'("0");
-  signal not_bits_free_bits : unsigned(0 downto 0);
-  signal or_1 : unsigned(0 downto 0);
-  signal not_bits_free_bits_2 : unsigned(0 downto 0);
-  signal or_2 : unsigned(0 downto 0);
-  signal not_bits_free_bits_4 : unsigned(0 downto 0);
-  signal or_3 : unsigned(0 downto 0);
-  signal not_bits_free_bits_6 : unsigned(0 downto 0);
-  signal or_4 : unsigned(0 downto 0);
-  signal not_bits_free_bits_8 : unsigned(0 downto 0);
-  signal or_5 : unsigned(0 downto 0);
-  signal not_bits_free_bits_10 : unsigned(0 downto 0);
-  signal or_6 : unsigned(0 downto 0);
-  signal not_bits_free_bits_12 : unsigned(0 downto 0);
-  signal or_7 : unsigned(0 downto 0);
-  signal not_bits_free_bits_14 : unsigned(0 downto 0);
-  signal or_8 : unsigned(0 downto 0);
-  signal not_bits_free_bits_16 : unsigned(0 downto 0);
-  signal or_9 : unsigned(0 downto 0);
-  signal not_bits_free_bits_18 : unsigned(0 downto 0);
-  signal or_10 : unsigned(0 downto 0);
-  signal not_bits_free_bits_20 : unsigned(0 downto 0);
-  signal or_11 : unsigned(0 downto 0);
-  signal not_bits_free_bits_22 : unsigned(0 downto 0);
-  signal or_12 : unsigned(0 downto 0);
-  signal not_bits_free_bits_24 : unsigned(0 downto 0);
-  signal or_13 : unsigned(0 downto 0);
-  signal not_bits_free_bits_26 : unsigned(0 downto 0);
-  signal or_14 : unsigned(0 downto 0);
-  signal not_bits_free_bits_28 : unsigned(0 downto 0);
-  signal or_15 : unsigned(0 downto 0);
-  signal not_bits_free_bits_30 : unsigned(0 downto 0);
-  signal or_16 : unsigned(0 downto 0);
-  signal not_bits_free_bits_32 : unsigned(0 downto 0);
-  signal or_17 : unsigned(0 downto 0);
-  signal not_bits_free_bits_34 : unsigned(0 downto 0);
-  signal or_18 : unsigned(0 downto 0);
-  signal not_bits_free_bits_36 : unsigned(0 downto 0);
-  signal or_19 : unsigned(0 downto 0);
-  signal not_bits_free_bits_38 : unsigned(0 downto 0);
-  signal or_20 : unsigned(0 downto 0);
-  signal not_bits_free_bits_40 : unsigned(0 downto 0);
-  signal or_21 : unsigned(0 downto 0);
-  signal not_bits_free_bits_42 : unsigned(0 downto 0);
-  signal or_22 : unsigned(0 downto 0);
-  signal not_bits_free_bits_44 : unsigned(0 downto 0);
-  signal or_23 : unsigned(0 downto 0);
-  signal not_bits_free_bits_46 : unsigned(0 downto 0);
-  signal or_24 : unsigned(0 downto 0);
-  signal not_bits_free_bits_48 : unsigned(0 downto 0);
-  signal or_25 : unsigned(0 downto 0);
-  signal not_bits_free_bits_50 : unsigned(0 downto 0);
-  signal or_26 : unsigned(0 downto 0);
-  signal not_bits_free_bits_52 : unsigned(0 downto 0);
-  signal or_27 : unsigned(0 downto 0);
-  signal not_bits_free_bits_54 : unsigned(0 downto 0);
-  signal or_28 : unsigned(0 downto 0);
-  signal not_bits_free_bits_56 : unsigned(0 downto 0);
-  signal or_29 : unsigned(0 downto 0);
-  signal not_bits_free_bits_58 : unsigned(0 downto 0);
-  signal or_30 : unsigned(0 downto 0);
-  signal not_bits_free_bits_60 : unsigned(0 downto 0);
-  signal or_31 : unsigned(0 downto 0);
-  signal not_bits_free_bits_62 : unsigned(0 downto 0);
-  signal or_32 : unsigned(0 downto 0);
-  signal not_or_1 : unsigned(0 downto 0);
-  signal mux_or_1 : unsigned(0 downto 0);
-  signal cat_33 : unsigned(1 downto 0);
-  signal or_1_or_or_2 : unsigned(0 downto 0);
-  signal not_or_3 : unsigned(0 downto 0);
-  signal mux_or_3 : unsigned(0 downto 0);
-  signal cat_34 : unsigned(1 downto 0);
-  signal or_3_or_or_4 : unsigned(0 downto 0);
-  signal not_or_5 : unsigned(0 downto 0);
-  signal mux_or_5 : unsigned(0 downto 0);
-  signal cat_35 : unsigned(1 downto 0);
-  signal or_5_or_or_6 : unsigned(0 downto 0);
-  signal not_or_7 : unsigned(0 downto 0);
-  signal mux_or_7 : unsigned(0 downto 0);
-  signal cat_36 : unsigned(1 downto 0);
-  signal or_7_or_or_8 : unsigned(0 downto 0);
-  signal not_or_9 : unsigned(0 downto 0);
-  signal mux_or_9 : unsigned(0 downto 0);
-  signal cat_37 : unsigned(1 downto 0);
-  signal or_9_or_or_10 : unsigned(0 downto 0);
-  signal not_or_11 : unsigned(0 downto 0);
-  signal mux_or_11 : unsigned(0 downto 0);
-  signal cat_38 : unsigned(1 downto 0);
-  signal or_11_or_or_12 : unsigned(0 downto 0);
-  signal not_or_13 : unsigned(0 downto 0);
-  signal mux_or_13 : unsigned(0 downto 0);
-  signal cat_39 : unsigned(1 downto 0);
-  signal or_13_or_or_14 : unsigned(0 downto 0);
-  signal not_or_15 : unsigned(0 downto 0);
-  signal mux_or_15 : unsigned(0 downto 0);
-  signal cat_40 : unsigned(1 downto 0);
-  signal or_15_or_or_16 : unsigned(0 downto 0);
-  signal not_or_17 : unsigned(0 downto 0);
-  signal mux_or_17 : unsigned(0 downto 0);
-  signal cat_41 : unsigned(1 downto 0);
-  signal or_17_or_or_18 : unsigned(0 downto 0);
-  signal not_or_19 : unsigned(0 downto 0);
-  signal mux_or_19 : unsigned(0 downto 0);
-  signal cat_42 : unsigned(1 downto 0);
-  signal or_19_or_or_20 : unsigned(0 downto 0);
-  signal not_or_21 : unsigned(0 downto 0);
-  signal mux_or_21 : unsigned(0 downto 0);
-  signal cat_43 : unsigned(1 downto 0);
-  signal or_21_or_or_22 : unsigned(0 downto 0);
-  signal not_or_23 : unsigned(0 downto 0);
-  signal mux_or_23 : unsigned(0 downto 0);
-  signal cat_44 : unsigned(1 downto 0);
-  signal or_23_or_or_24 : unsigned(0 downto 0);
-  signal not_or_25 : unsigned(0 downto 0);
-  signal mux_or_25 : unsigned(0 downto 0);
-  signal cat_45 : unsigned(1 downto 0);
-  signal or_25_or_or_26 : unsigned(0 downto 0);
-  signal not_or_27 : unsigned(0 downto 0);
-  signal mux_or_27 : unsigned(0 downto 0);
-  signal cat_46 : unsigned(1 downto 0);
-  signal or_27_or_or_28 : unsigned(0 downto 0);
-  signal not_or_29 : unsigned(0 downto 0);
-  signal mux_or_29 : unsigned(0 downto 0);
-  signal cat_47 : unsigned(1 downto 0);
-  signal or_29_or_or_30 : unsigned(0 downto 0);
-  signal not_or_31 : unsigned(0 downto 0);
-  signal mux_or_31 : unsigned(0 downto 0);
-  signal cat_48 : unsigned(1 downto 0);
-  signal or_31_or_or_32 : unsigned(0 downto 0);
-  signal not_or_1_or_or_2 : unsigned(0 downto 0);
-  signal mux_or_1_or_or_2 : unsigned(1 downto 0);
-  signal cat_49 : unsigned(2 downto 0);
-  signal or_50 : unsigned(0 downto 0);
-  signal not_or_5_or_or_6 : unsigned(0 downto 0);
-  signal mux_or_5_or_or_6 : unsigned(1 downto 0);
-  signal cat_51 : unsigned(2 downto 0);
-  signal or_52 : unsigned(0 downto 0);
-  signal not_or_9_or_or_10 : unsigned(0 downto 0);
-  signal mux_or_9_or_or_10 : unsigned(1 downto 0);
-  signal cat_53 : unsigned(2 downto 0);
-  signal or_54 : unsigned(0 downto 0);
-  signal not_or_13_or_or_14 : unsigned(0 downto 0);
-  signal mux_or_13_or_or_14 : unsigned(1 downto 0);
-  signal cat_55 : unsigned(2 downto 0);
-  signal or_56 : unsigned(0 downto 0);
-  signal not_or_17_or_or_18 : unsigned(0 downto 0);
-  signal mux_or_17_or_or_18 : unsigned(1 downto 0);
-  signal cat_57 : unsigned(2 downto 0);
-  signal or_58 : unsigned(0 downto 0);
-  signal not_or_21_or_or_22 : unsigned(0 downto 0);
-  signal mux_or_21_or_or_22 : unsigned(1 downto 0);
-  signal cat_59 : unsigned(2 downto 0);
-  signal or_60 : unsigned(0 downto 0);
-  signal not_or_25_or_or_26 : unsigned(0 downto 0);
-  signal mux_or_25_or_or_26 : unsigned(1 downto 0);
-  signal cat_61 : unsigned(2 downto 0);
-  signal or_62 : unsigned(0 downto 0);
-  signal not_or_29_or_or_30 : unsigned(0 downto 0);
-  signal mux_or_29_or_or_30 : unsigned(1 downto 0);
-  signal cat_63 : unsigned(2 downto 0);
-  signal or_64 : unsigned(0 downto 0);
-  signal not_or_50 : unsigned(0 downto 0);
-  signal mux_or_50 : unsigned(2 downto 0);
-  signal cat_65 : unsigned(3 downto 0);
-  signal or_50_or_or_52 : unsigned(0 downto 0);
-  signal not_or_54 : unsigned(0 downto 0);
-  signal mux_or_54 : unsigned(2 downto 0);
-  signal cat_66 : unsigned(3 downto 0);
-  signal or_54_or_or_56 : unsigned(0 downto 0);
-  signal not_or_58 : unsigned(0 downto 0);
-  signal mux_or_58 : unsigned(2 downto 0);
-  signal cat_67 : unsigned(3 downto 0);
-  signal or_58_or_or_60 : unsigned(0 downto 0);
-  signal not_or_62 : unsigned(0 downto 0);
-  signal mux_or_62 : unsigned(2 downto 0);
-  signal cat_68 : unsigned(3 downto 0);
-  signal or_62_or_or_64 : unsigned(0 downto 0);
-  signal not_or_50_or_or_52 : unsigned(0 downto 0);
-  signal mux_or_50_or_or_52 : unsigned(3 downto 0);
-  signal cat_69 : unsigned(4 downto 0);
-  signal or_70 : unsigned(0 downto 0);
-  signal not_or_58_or_or_60 : unsigned(0 downto 0);
-  signal mux_or_58_or_or_60 : unsigned(3 downto 0);
-  signal cat_71 : unsigned(4 downto 0);
-  signal or_72 : unsigned(0 downto 0);
-  signal not_or_70 : unsigned(0 downto 0);
-  signal mux_or_70 : unsigned(4 downto 0);
-  signal free_idx_c : unsigned(5 downto 0);
-  signal free_any_c : unsigned(0 downto 0);
-  signal free_any_r : unsigned(0 downto 0) := unsigned'("1");
-  signal free_idx_r : unsigned(5 downto 0) := unsigned'("000000");
-  signal just_alloc : unsigned(0 downto 0) := unsigned'("0");
-  constant k_63 : unsigned(5 downto 0) := unsigned'("111111");
-  signal ray_slot_eq_k_63 : unsigned(0 downto 0);
-  constant k_62 : unsigned(5 downto 0) := unsigned'("111110");
-  signal ray_slot_eq_k_62 : unsigned(0 downto 0);
-  constant k_61 : unsigned(5 downto 0) := unsigned'("111101");
-  signal ray_slot_eq_k_61 : unsigned(0 downto 0);
-  constant k_60 : unsigned(5 downto 0) := unsigned'("111100");
-  signal ray_slot_eq_k_60 : unsigned(0 downto 0);
-  constant k_59 : unsigned(5 downto 0) := unsigned'("111011");
-  signal ray_slot_eq_k_59 : unsigned(0 downto 0);
-  constant k_58 : unsigned(5 downto 0) := unsigned'("111010");
-  signal ray_slot_eq_k_58 : unsigned(0 downto 0);
-  constant k_57 : unsigned(5 downto 0) := unsigned'("111001");
-  signal ray_slot_eq_k_57 : unsigned(0 downto 0);
-  constant k_56 : unsigned(5 downto 0) := unsigned'("111000");
-  signal ray_slot_eq_k_56 : unsigned(0 downto 0);
-  constant k_55 : unsigned(5 downto 0) := unsigned'("110111");
-  signal ray_slot_eq_k_55 : unsigned(0 downto 0);
-  constant k_54 : unsigned(5 downto 0) := unsigned'("110110");
-  signal ray_slot_eq_k_54 : unsigned(0 downto 0);
-  constant k_53 : unsigned(5 downto 0) := unsigned'("110101");
-  signal ray_slot_eq_k_53 : unsigned(0 downto 0);
-  constant k_52 : unsigned(5 downto 0) := unsigned'("110100");
-  signal ray_slot_eq_k_52 : unsigned(0 downto 0);
-  constant k_51 : unsigned(5 downto 0) := unsigned'("110011");
-  signal ray_slot_eq_k_51 : unsigned(0 downto 0);
-  constant k_50 : unsigned(5 downto 0) := unsigned'("110010");
-  signal ray_slot_eq_k_50 : unsigned(0 downto 0);
-  constant k_49 : unsigned(5 downto 0) := unsigned'("110001");
-  signal ray_slot_eq_k_49 : unsigned(0 downto 0);
-  constant k_48 : unsigned(5 downto 0) := unsigned'("110000");
-  signal ray_slot_eq_k_48 : unsigned(0 downto 0);
-  constant k_47 : unsigned(5 downto 0) := unsigned'("101111");
-  signal ray_slot_eq_k_47 : unsigned(0 downto 0);
-  constant k_46 : unsigned(5 downto 0) := unsigned'("101110");
-  signal ray_slot_eq_k_46 : unsigned(0 downto 0);
-  constant k_45 : unsigned(5 downto 0) := unsigned'("101101");
-  signal ray_slot_eq_k_45 : unsigned(0 downto 0);
-  constant k_44 : unsigned(5 downto 0) := unsigned'("101100");
-  signal ray_slot_eq_k_44 : unsigned(0 downto 0);
-  constant k_43 : unsigned(5 downto 0) := unsigned'("101011");
-  signal ray_slot_eq_k_43 : unsigned(0 downto 0);
-  constant k_42 : unsigned(5 downto 0) := unsigned'("101010");
-  signal ray_slot_eq_k_42 : unsigned(0 downto 0);
-  constant k_41 : unsigned(5 downto 0) := unsigned'("101001");
-  signal ray_slot_eq_k_41 : unsigned(0 downto 0);
-  constant k_40 : unsigned(5 downto 0) := unsigned'("101000");
-  signal ray_slot_eq_k_40 : unsigned(0 downto 0);
-  constant k_39 : unsigned(5 downto 0) := unsigned'("100111");
-  signal ray_slot_eq_k_39 : unsigned(0 downto 0);
-  constant k_38 : unsigned(5 downto 0) := unsigned'("100110");
-  signal ray_slot_eq_k_38 : unsigned(0 downto 0);
-  constant k_37 : unsigned(5 downto 0) := unsigned'("100101");
-  signal ray_slot_eq_k_37 : unsigned(0 downto 0);
-  constant k_36 : unsigned(5 downto 0) := unsigned'("100100");
-  signal ray_slot_eq_k_36 : unsigned(0 downto 0);
-  constant k_35 : unsigned(5 downto 0) := unsigned'("100011");
-  signal ray_slot_eq_k_35 : unsigned(0 downto 0);
-  constant k_34 : unsigned(5 downto 0) := unsigned'("100010");
-  signal ray_slot_eq_k_34 : unsigned(0 downto 0);
-  constant k_33 : unsigned(5 downto 0) := unsigned'("100001");
-  signal ray_slot_eq_k_33 : unsigned(0 downto 0);
-  constant k_32 : unsigned(5 downto 0) := unsigned'("100000");
-  signal ray_slot_eq_k_32 : unsigned(0 downto 0);
-  constant k_31 : unsigned(5 downto 0) := unsigned'("011111");
-  signal ray_slot_eq_k_31 : unsigned(0 downto 0);
-  constant k_30 : unsigned(5 downto 0) := unsigned'("011110");
-  signal ray_slot_eq_k_30 : unsigned(0 downto 0);
-  constant k_29 : unsigned(5 downto 0) := unsigned'("011101");
-  signal ray_slot_eq_k_29 : unsigned(0 downto 0);
-  constant k_28 : unsigned(5 downto 0) := unsigned'("011100");
-  signal ray_slot_eq_k_28 : unsigned(0 downto 0);
-  constant k_27 : unsigned(5 downto 0) := unsigned'("011011");
-  signal ray_slot_eq_k_27 : unsigned(0 downto 0);
-  constant k_26 : unsigned(5 downto 0) := unsigned'("011010");
-  signal ray_slot_eq_k_26 : unsigned(0 downto 0);
-  constant k_25 : unsigned(5 downto 0) := unsigned'("011001");
-  signal ray_slot_eq_k_25 : unsigned(0 downto 0);
-  constant k_24 : unsigned(5 downto 0) := unsigned'("011000");
-  signal ray_slot_eq_k_24 : unsigned(0 downto 0);
-  constant k_23 : unsigned(5 downto 0) := unsigned'("010111");
-  signal ray_slot_eq_k_23 : unsigned(0 downto 0);
-  constant k_22 : unsigned(5 downto 0) := unsigned'("010110");
-  signal ray_slot_eq_k_22 : unsigned(0 downto 0);
-  constant k_21 : unsigned(5 downto 0) := unsigned'("010101");
-  signal ray_slot_eq_k_21 : unsigned(0 downto 0);
-  constant k_20 : unsigned(5 downto 0) := unsigned'("010100");
-  signal ray_slot_eq_k_20 : unsigned(0 downto 0);
-  constant k_19 : unsigned(5 downto 0) := unsigned'("010011");
-  signal ray_slot_eq_k_19 : unsigned(0 downto 0);
-  constant k_18 : unsigned(5 downto 0) := unsigned'("010010");
-  signal ray_slot_eq_k_18 : unsigned(0 downto 0);
-  constant k_17 : unsigned(5 downto 0) := unsigned'("010001");
-  signal ray_slot_eq_k_17 : unsigned(0 downto 0);
-  constant k_16 : unsigned(5 downto 0) := unsigned'("010000");
-  signal ray_slot_eq_k_16 : unsigned(0 downto 0);
-  constant k_15 : unsigned(5 downto 0) := unsigned'("001111");
-  signal ray_slot_eq_k_15 : unsigned(0 downto 0);
-  constant k_14 : unsigned(5 downto 0) := unsigned'("001110");
-  signal ray_slot_eq_k_14 : unsigned(0 downto 0);
-  constant k_13 : unsigned(5 downto 0) := unsigned'("001101");
-  signal ray_slot_eq_k_13 : unsigned(0 downto 0);
-  constant k_12 : unsigned(5 downto 0) := unsigned'("001100");
-  signal ray_slot_eq_k_12 : unsigned(0 downto 0);
-  constant k_11 : unsigned(5 downto 0) := unsigned'("001011");
-  signal ray_slot_eq_k_11 : unsigned(0 downto 0);
-  constant k_10 : unsigned(5 downto 0) := unsigned'("001010");
-  signal ray_slot_eq_k_10 : unsigned(0 downto 0);
-  constant k_9 : unsigned(5 downto 0) := unsigned'("001001");
-  signal ray_slot_eq_k_9 : unsigned(0 downto 0);
-  constant k_8 : unsigned(5 downto 0) := unsigned'("001000");
-  signal ray_slot_eq_k_8 : unsigned(0 downto 0);
-  constant k_7 : unsigned(5 downto 0) := unsigned'("000111");
-  signal ray_slot_eq_k_7 : unsigned(0 downto 0);
-  constant k_6 : unsigned(5 downto 0) := unsigned'("000110");
-  signal ray_slot_eq_k_6 : unsigned(0 downto 0);
-  constant k_5 : unsigned(5 downto 0) := unsigned'("000101");
-  signal ray_slot_eq_k_5 : unsigned(0 downto 0);
-  constant k_4 : unsigned(5 downto 0) := unsigned'("000100");
-  signal ray_slot_eq_k_4 : unsigned(0 downto 0);
-  constant k_3 : unsigned(5 downto 0) := unsigned'("000011");
-  signal ray_slot_eq_k_3 : unsigned(0 downto 0);
-  constant k_2 : unsigned(5 downto 0) := unsigned'("000010");
-  signal ray_slot_eq_k_2 : unsigned(0 downto 0);
+  -- stage slots: the free list: the next free slot for the top, the slots holding a ray
+  signal fresh_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal fresh_left : unsigned(0 downto 0) := unsigned'("1");
+  signal alloc_fresh : unsigned(0 downto 0);
   constant k_1 : unsigned(5 downto 0) := unsigned'("000001");
-  signal ray_slot_eq_k_1 : unsigned(0 downto 0);
-  constant k_0_1 : unsigned(5 downto 0) := unsigned'("000000");
-  signal ray_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_74 : unsigned(63 downto 0);
-  constant k_0_2 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
-  signal taken_mask : unsigned(63 downto 0);
-  signal free_slot_eq_k_63 : unsigned(0 downto 0);
-  signal free_slot_eq_k_62 : unsigned(0 downto 0);
-  signal free_slot_eq_k_61 : unsigned(0 downto 0);
-  signal free_slot_eq_k_60 : unsigned(0 downto 0);
-  signal free_slot_eq_k_59 : unsigned(0 downto 0);
-  signal free_slot_eq_k_58 : unsigned(0 downto 0);
-  signal free_slot_eq_k_57 : unsigned(0 downto 0);
-  signal free_slot_eq_k_56 : unsigned(0 downto 0);
-  signal free_slot_eq_k_55 : unsigned(0 downto 0);
-  signal free_slot_eq_k_54 : unsigned(0 downto 0);
-  signal free_slot_eq_k_53 : unsigned(0 downto 0);
-  signal free_slot_eq_k_52 : unsigned(0 downto 0);
-  signal free_slot_eq_k_51 : unsigned(0 downto 0);
-  signal free_slot_eq_k_50 : unsigned(0 downto 0);
-  signal free_slot_eq_k_49 : unsigned(0 downto 0);
-  signal free_slot_eq_k_48 : unsigned(0 downto 0);
-  signal free_slot_eq_k_47 : unsigned(0 downto 0);
-  signal free_slot_eq_k_46 : unsigned(0 downto 0);
-  signal free_slot_eq_k_45 : unsigned(0 downto 0);
-  signal free_slot_eq_k_44 : unsigned(0 downto 0);
-  signal free_slot_eq_k_43 : unsigned(0 downto 0);
-  signal free_slot_eq_k_42 : unsigned(0 downto 0);
-  signal free_slot_eq_k_41 : unsigned(0 downto 0);
-  signal free_slot_eq_k_40 : unsigned(0 downto 0);
-  signal free_slot_eq_k_39 : unsigned(0 downto 0);
-  signal free_slot_eq_k_38 : unsigned(0 downto 0);
-  signal free_slot_eq_k_37 : unsigned(0 downto 0);
-  signal free_slot_eq_k_36 : unsigned(0 downto 0);
-  signal free_slot_eq_k_35 : unsigned(0 downto 0);
-  signal free_slot_eq_k_34 : unsigned(0 downto 0);
-  signal free_slot_eq_k_33 : unsigned(0 downto 0);
-  signal free_slot_eq_k_32 : unsigned(0 downto 0);
-  signal free_slot_eq_k_31 : unsigned(0 downto 0);
-  signal free_slot_eq_k_30 : unsigned(0 downto 0);
-  signal free_slot_eq_k_29 : unsigned(0 downto 0);
-  signal free_slot_eq_k_28 : unsigned(0 downto 0);
-  signal free_slot_eq_k_27 : unsigned(0 downto 0);
-  signal free_slot_eq_k_26 : unsigned(0 downto 0);
-  signal free_slot_eq_k_25 : unsigned(0 downto 0);
-  signal free_slot_eq_k_24 : unsigned(0 downto 0);
-  signal free_slot_eq_k_23 : unsigned(0 downto 0);
-  signal free_slot_eq_k_22 : unsigned(0 downto 0);
-  signal free_slot_eq_k_21 : unsigned(0 downto 0);
-  signal free_slot_eq_k_20 : unsigned(0 downto 0);
-  signal free_slot_eq_k_19 : unsigned(0 downto 0);
-  signal free_slot_eq_k_18 : unsigned(0 downto 0);
-  signal free_slot_eq_k_17 : unsigned(0 downto 0);
-  signal free_slot_eq_k_16 : unsigned(0 downto 0);
-  signal free_slot_eq_k_15 : unsigned(0 downto 0);
-  signal free_slot_eq_k_14 : unsigned(0 downto 0);
-  signal free_slot_eq_k_13 : unsigned(0 downto 0);
-  signal free_slot_eq_k_12 : unsigned(0 downto 0);
-  signal free_slot_eq_k_11 : unsigned(0 downto 0);
-  signal free_slot_eq_k_10 : unsigned(0 downto 0);
-  signal free_slot_eq_k_9 : unsigned(0 downto 0);
-  signal free_slot_eq_k_8 : unsigned(0 downto 0);
-  signal free_slot_eq_k_7 : unsigned(0 downto 0);
-  signal free_slot_eq_k_6 : unsigned(0 downto 0);
-  signal free_slot_eq_k_5 : unsigned(0 downto 0);
-  signal free_slot_eq_k_4 : unsigned(0 downto 0);
-  signal free_slot_eq_k_3 : unsigned(0 downto 0);
-  signal free_slot_eq_k_2 : unsigned(0 downto 0);
-  signal free_slot_eq_k_1 : unsigned(0 downto 0);
-  signal free_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_75 : unsigned(63 downto 0);
-  signal freed_mask : unsigned(63 downto 0);
-  signal not_taken_mask : unsigned(63 downto 0);
-  signal and_76 : unsigned(63 downto 0);
-  signal and_76_or_freed_mask : unsigned(63 downto 0);
+  signal fresh_slot_plus_k_1 : unsigned(5 downto 0);
+  signal mux_alloc_fresh : unsigned(5 downto 0);
+  constant k_63 : unsigned(5 downto 0) := unsigned'("111111");
+  signal fresh_is_last : unsigned(0 downto 0);
+  signal and_1 : unsigned(0 downto 0);
+  signal not_and_1 : unsigned(0 downto 0);
+  signal fresh_left_and_not_and_1 : unsigned(0 downto 0);
+  signal not_fresh_left : unsigned(0 downto 0);
+  signal free_q_pop : unsigned(0 downto 0);
+  signal free_q_wr : unsigned(5 downto 0) := unsigned'("000000");
+  signal free_q_rd : unsigned(5 downto 0) := unsigned'("000000");
+  signal free_q_count : unsigned(6 downto 0) := unsigned'("0000000");
+  signal free_q_wr_plus_k_1 : unsigned(5 downto 0);
+  signal mux_free_q_push : unsigned(5 downto 0);
+  signal free_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
+  signal free_q_rd_next : unsigned(5 downto 0);
+  signal free_q_rd1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_free_q_pop : unsigned(5 downto 0);
+  signal not_free_q_push_c1 : unsigned(0 downto 0);
+  signal rs_not_free_q_push_c1 : unsigned(6 downto 0);
+  signal free_q_count_if_pop : unsigned(6 downto 0);
+  signal rs_free_q_push_c1 : unsigned(6 downto 0);
+  signal free_q_count_if_kept : unsigned(6 downto 0);
+  signal free_q_count_next : unsigned(6 downto 0);
+  constant k_0 : unsigned(6 downto 0) := unsigned'("0000000");
+  signal free_q_count_eq_k_0 : unsigned(0 downto 0);
+  constant k_1_1 : unsigned(6 downto 0) := unsigned'("0000001");
+  signal free_q_one_left : unsigned(0 downto 0);
+  signal and_4 : unsigned(0 downto 0);
+  signal free_q_drained : unsigned(0 downto 0);
+  signal free_q_bypass : unsigned(0 downto 0) := unsigned'("0");
+  signal free_q_bypass_c : unsigned(0 downto 0);
+  signal free_q_popped : unsigned(0 downto 0) := unsigned'("0");
+  signal free_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
+  signal k_1_1_lt_free_q_count : unsigned(0 downto 0);
+  signal or_7 : unsigned(0 downto 0);
+  signal not_free_q_pop : unsigned(0 downto 0);
+  signal and_8 : unsigned(0 downto 0);
+  signal free_q_nonempty_c : unsigned(0 downto 0);
+  signal free_q_din : unsigned(5 downto 0) := unsigned'("000000");
+  signal free_q_q_stay : unsigned(5 downto 0) := unsigned'("000000");
+  signal free_q_q_next : unsigned(5 downto 0) := unsigned'("000000");
+  signal mux_free_q_popped : unsigned(5 downto 0);
+  signal free_q_din_r : unsigned(5 downto 0) := unsigned'("000000");
+  signal free_q_head : unsigned(5 downto 0);
+  signal free_any_r : unsigned(0 downto 0) := unsigned'("1");
+  signal free_any_c : unsigned(0 downto 0);
+  signal free_idx_r : unsigned(5 downto 0) := unsigned'("000000");
+  signal free_idx_c : unsigned(5 downto 0);
+  signal just_alloc : unsigned(0 downto 0) := unsigned'("0");
   signal occupied_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal rs_alloc : unsigned(6 downto 0);
   signal occupied_r_plus_rs_alloc : unsigned(6 downto 0);
   signal rs_free_valid : unsigned(6 downto 0);
-  signal minus_77 : unsigned(6 downto 0);
+  signal minus_10 : unsigned(6 downto 0);
+
+  -- register copies free_q_push_copies: free_q_push and 1 copies, to split its fan-out
+  signal free_q_push : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of free_q_push : signal is "true";
+  signal free_q_push_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of free_q_push_c1 : signal is "true";
 
   -- stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   signal ring_g_valid : unsigned(0 downto 0);
   signal unpark_pop : unsigned(0 downto 0);
   signal new_pop : unsigned(0 downto 0);
-  signal cat_78 : unsigned(11 downto 0);
-  signal unpark_q_push : unsigned(0 downto 0) := unsigned'("0");
+  signal cat_11 : unsigned(11 downto 0);
   signal unpark_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal unpark_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal unpark_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -607,24 +288,24 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal unpark_q_rd_next : unsigned(5 downto 0);
   signal unpark_q_rd1_plus_k_1 : unsigned(5 downto 0);
   signal mux_unpark_pop : unsigned(5 downto 0);
-  signal rs_unpark_pop : unsigned(6 downto 0);
-  signal unpark_q_after_pop : unsigned(6 downto 0);
-  signal rs_unpark_q_push : unsigned(6 downto 0);
+  signal not_unpark_q_push_c1 : unsigned(0 downto 0);
+  signal rs_not_unpark_q_push_c1 : unsigned(6 downto 0);
+  signal unpark_q_count_if_pop : unsigned(6 downto 0);
+  signal rs_unpark_q_push_c1 : unsigned(6 downto 0);
+  signal unpark_q_count_if_kept : unsigned(6 downto 0);
   signal unpark_q_count_next : unsigned(6 downto 0);
-  constant k_0_3 : unsigned(6 downto 0) := unsigned'("0000000");
-  signal unpark_q_count_eq_k_0_3 : unsigned(0 downto 0);
-  constant k_1_1 : unsigned(6 downto 0) := unsigned'("0000001");
+  signal unpark_q_count_eq_k_0 : unsigned(0 downto 0);
   signal unpark_q_one_left : unsigned(0 downto 0);
-  signal and_81 : unsigned(0 downto 0);
+  signal and_14 : unsigned(0 downto 0);
   signal unpark_q_drained : unsigned(0 downto 0);
   signal unpark_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal unpark_q_bypass_c : unsigned(0 downto 0);
   signal unpark_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal unpark_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_unpark_q_count : unsigned(0 downto 0);
-  signal or_84 : unsigned(0 downto 0);
+  signal or_17 : unsigned(0 downto 0);
   signal not_unpark_pop : unsigned(0 downto 0);
-  signal and_85 : unsigned(0 downto 0);
+  signal and_18 : unsigned(0 downto 0);
   signal unpark_q_nonempty_c : unsigned(0 downto 0);
   signal unpark_q_din : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_q_stay : unsigned(11 downto 0) := unsigned'("000000000000");
@@ -633,36 +314,49 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal unpark_q_din_r : unsigned(11 downto 0) := unsigned'("000000000000");
   signal unpark_q_head : unsigned(11 downto 0);
   signal u_new_tmax : unsigned(31 downto 0);
-  signal cat_86 : unsigned(38 downto 0);
-  signal new_q_push : unsigned(0 downto 0) := unsigned'("0");
+  signal cat_19 : unsigned(38 downto 0);
   signal new_q_wr : unsigned(5 downto 0) := unsigned'("000000");
+  signal new_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal new_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal new_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_new_q_push : unsigned(5 downto 0);
+  signal new_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal new_q_rd_next : unsigned(5 downto 0);
   signal new_q_rd1_plus_k_1 : unsigned(5 downto 0);
   signal mux_new_pop : unsigned(5 downto 0);
-  signal rs_new_pop : unsigned(6 downto 0);
-  signal new_q_after_pop : unsigned(6 downto 0);
-  signal rs_new_q_push : unsigned(6 downto 0);
+  signal not_new_q_push_c1 : unsigned(0 downto 0);
+  signal rs_not_new_q_push_c1 : unsigned(6 downto 0);
+  signal new_q_count_if_pop : unsigned(6 downto 0);
+  signal rs_new_q_push_c1 : unsigned(6 downto 0);
+  signal new_q_count_if_kept : unsigned(6 downto 0);
   signal new_q_count_next : unsigned(6 downto 0);
-  signal new_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  signal new_q_count_eq_k_0 : unsigned(0 downto 0);
   signal new_q_one_left : unsigned(0 downto 0);
-  signal and_89 : unsigned(0 downto 0);
+  signal and_22 : unsigned(0 downto 0);
   signal new_q_drained : unsigned(0 downto 0);
   signal new_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal new_q_bypass_c : unsigned(0 downto 0);
   signal new_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal new_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_new_q_count : unsigned(0 downto 0);
-  signal or_92 : unsigned(0 downto 0);
+  signal or_25 : unsigned(0 downto 0);
   signal not_new_pop : unsigned(0 downto 0);
-  signal and_93 : unsigned(0 downto 0);
+  signal and_26 : unsigned(0 downto 0);
   signal new_q_nonempty_c : unsigned(0 downto 0);
   signal new_q_din : unsigned(38 downto 0) := unsigned'("000000000000000000000000000000000000000");
   signal bits_new_q_din : unsigned(15 downto 0);
   signal bits_new_q_din_1 : unsigned(15 downto 0);
   signal bits_new_q_din_2 : unsigned(6 downto 0);
+  signal new_q_rd_p1 : unsigned(5 downto 0) := unsigned'("000000");
+  signal new_q_rd1_p1 : unsigned(5 downto 0) := unsigned'("000001");
+  signal mux_new_pop_1 : unsigned(5 downto 0);
+  signal new_q_rd1_p1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_new_pop_2 : unsigned(5 downto 0);
+  signal new_q_rd_p2 : unsigned(5 downto 0) := unsigned'("000000");
+  signal new_q_rd1_p2 : unsigned(5 downto 0) := unsigned'("000001");
+  signal mux_new_pop_3 : unsigned(5 downto 0);
+  signal new_q_rd1_p2_plus_k_1 : unsigned(5 downto 0);
+  signal mux_new_pop_4 : unsigned(5 downto 0);
   signal new_q_q_stay_g2 : unsigned(6 downto 0) := unsigned'("0000000");
   signal new_q_q_stay_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal new_q_q_stay_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
@@ -678,49 +372,44 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal take_unpark : unsigned(0 downto 0);
   signal not_ring_g_valid_1 : unsigned(0 downto 0);
   signal not_unpark_q_nonempty : unsigned(0 downto 0);
-  signal and_97 : unsigned(0 downto 0);
+  signal and_30 : unsigned(0 downto 0);
   signal take_new : unsigned(0 downto 0);
   signal take_unpark_or_take_new : unsigned(0 downto 0);
   signal q_valid : unsigned(0 downto 0) := unsigned'("0");
-  signal q_new : unsigned(0 downto 0) := unsigned'("0");
   signal bits_unpark_q_head : unsigned(5 downto 0);
   signal bits_new_q_head : unsigned(5 downto 0);
   signal mux_take_unpark : unsigned(5 downto 0);
-  signal q_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal bits_unpark_q_head_1 : unsigned(5 downto 0);
   signal q_sp : unsigned(5 downto 0) := unsigned'("000000");
-  signal eq_99 : unsigned(0 downto 0);
+  constant k_0_1 : unsigned(5 downto 0) := unsigned'("000000");
+  signal eq_32 : unsigned(0 downto 0);
   signal q_sp_zero : unsigned(0 downto 0) := unsigned'("0");
-  signal minus_100 : unsigned(5 downto 0);
+  signal minus_33 : unsigned(5 downto 0);
   signal q_sp_m1 : unsigned(5 downto 0) := unsigned'("000000");
-  signal rs_minus_100 : unsigned(4 downto 0);
+  signal rs_minus_33 : unsigned(4 downto 0);
   signal q_stack_raddr : unsigned(10 downto 0);
   signal bits_unpark_q_head_2 : unsigned(5 downto 0);
-  signal eq_102 : unsigned(0 downto 0);
+  signal eq_35 : unsigned(0 downto 0);
   signal bits_new_q_head_1 : unsigned(0 downto 0);
-  signal and_103 : unsigned(0 downto 0);
-  signal take_unpark_and_eq_102 : unsigned(0 downto 0);
+  signal and_36 : unsigned(0 downto 0);
+  signal take_unpark_and_eq_35 : unsigned(0 downto 0);
   signal q_done_c : unsigned(0 downto 0);
   signal q_done : unsigned(0 downto 0) := unsigned'("0");
   signal bits_new_q_head_2 : unsigned(31 downto 0);
   signal s_bits_new_q_head_2 : signed(31 downto 0);
   signal q_tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
-  -- register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
-  signal new_q_rd : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of new_q_rd : signal is "true";
-  signal new_q_rd_c1 : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of new_q_rd_c1 : signal is "true";
-  signal new_q_rd_c2 : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of new_q_rd_c2 : signal is "true";
+  -- register copies unpark_q_push_copies: unpark_q_push and 1 copies, to split its fan-out
+  signal unpark_q_push : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of unpark_q_push : signal is "true";
+  signal unpark_q_push_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of unpark_q_push_c1 : signal is "true";
 
-  -- register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
-  signal new_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of new_q_rd1 : signal is "true";
-  signal new_q_rd1_c1 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of new_q_rd1_c1 : signal is "true";
-  signal new_q_rd1_c2 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of new_q_rd1_c2 : signal is "true";
+  -- register copies new_q_push_copies: new_q_push and 1 copies, to split its fan-out
+  signal new_q_push : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of new_q_push : signal is "true";
+  signal new_q_push_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of new_q_push_c1 : signal is "true";
 
   -- stage ring_r: R: the token back from G, loaded in G
   signal r_valid : unsigned(0 downto 0) := unsigned'("0");
@@ -747,7 +436,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal r_valid_and_r_done : unsigned(0 downto 0);
   signal not_r_valid : unsigned(0 downto 0);
   signal not_r_valid_and_q_valid : unsigned(0 downto 0);
-  signal and_105 : unsigned(0 downto 0);
+  signal and_38 : unsigned(0 downto 0);
   signal a_done : unsigned(0 downto 0);
   signal not_a_sp_zero : unsigned(0 downto 0);
   signal a_from_stack : unsigned(0 downto 0);
@@ -762,10 +451,10 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal a_live : unsigned(0 downto 0);
   signal b_valid : unsigned(0 downto 0) := unsigned'("0");
   signal b_slot : unsigned(5 downto 0) := unsigned'("000000");
-  constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
+  constant k_0_2 : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal mux_r_valid : unsigned(12 downto 0);
   signal b_node : unsigned(12 downto 0) := unsigned'("0000000000000");
-  constant k_0_5 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  constant k_0_3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal mux_r_valid_1 : signed(31 downto 0);
   signal b_tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal mux_r_valid_2 : signed(31 downto 0);
@@ -776,7 +465,6 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal b_from_stack_sr : b_from_stack_sr_t := (others => (others => '0'));
   signal b_from_stack : unsigned(0 downto 0);
   signal b2_valid : unsigned(0 downto 0) := unsigned'("0");
-  signal b2_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal b2_node : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal b2_tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal b2_tmax : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -784,7 +472,6 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
 
   -- stage done: the done queue: slots whose ray left the ring in A, for the top
   signal done_pop_r : unsigned(0 downto 0) := unsigned'("0");
-  signal done_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -794,22 +481,24 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal done_q_rd_next : unsigned(5 downto 0);
   signal done_q_rd1_plus_k_1 : unsigned(5 downto 0);
   signal mux_done_pop_r : unsigned(5 downto 0);
-  signal rs_done_pop_r : unsigned(6 downto 0);
-  signal done_q_after_pop : unsigned(6 downto 0);
-  signal rs_done_q_push : unsigned(6 downto 0);
+  signal not_done_q_push_c1 : unsigned(0 downto 0);
+  signal rs_not_done_q_push_c1 : unsigned(6 downto 0);
+  signal done_q_count_if_pop : unsigned(6 downto 0);
+  signal rs_done_q_push_c1 : unsigned(6 downto 0);
+  signal done_q_count_if_kept : unsigned(6 downto 0);
   signal done_q_count_next : unsigned(6 downto 0);
-  signal done_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  signal done_q_count_eq_k_0 : unsigned(0 downto 0);
   signal done_q_one_left : unsigned(0 downto 0);
-  signal and_109 : unsigned(0 downto 0);
+  signal and_42 : unsigned(0 downto 0);
   signal done_q_drained : unsigned(0 downto 0);
   signal done_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_bypass_c : unsigned(0 downto 0);
   signal done_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_done_q_count : unsigned(0 downto 0);
-  signal or_112 : unsigned(0 downto 0);
+  signal or_45 : unsigned(0 downto 0);
   signal not_done_pop_r : unsigned(0 downto 0);
-  signal and_113 : unsigned(0 downto 0);
+  signal and_46 : unsigned(0 downto 0);
   signal done_q_nonempty_c : unsigned(0 downto 0);
   signal done_q_din : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_q_stay : unsigned(5 downto 0) := unsigned'("000000");
@@ -817,6 +506,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal mux_done_q_popped : unsigned(5 downto 0);
   signal done_q_din_r : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_head : unsigned(5 downto 0);
+
+  -- register copies done_q_push_copies: done_q_push and 1 copies, to split its fan-out
+  signal done_q_push : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of done_q_push : signal is "true";
+  signal done_q_push_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of done_q_push_c1 : signal is "true";
 
   -- stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   signal bits_u_stack_data : unsigned(31 downto 0);
@@ -840,216 +535,365 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal shr_c_tmin : signed(31 downto 0);
   signal tmin_less : signed(31 downto 0);
   signal cull_x : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal bits_has_best : unsigned(0 downto 0);
-  signal bits_has_best_1 : unsigned(0 downto 0);
-  signal bits_has_best_2 : unsigned(0 downto 0);
-  signal bits_has_best_3 : unsigned(0 downto 0);
-  signal bits_has_best_4 : unsigned(0 downto 0);
-  signal bits_has_best_5 : unsigned(0 downto 0);
-  signal bits_has_best_6 : unsigned(0 downto 0);
-  signal bits_has_best_7 : unsigned(0 downto 0);
-  signal bits_has_best_8 : unsigned(0 downto 0);
-  signal bits_has_best_9 : unsigned(0 downto 0);
-  signal bits_has_best_10 : unsigned(0 downto 0);
-  signal bits_has_best_11 : unsigned(0 downto 0);
-  signal bits_has_best_12 : unsigned(0 downto 0);
-  signal bits_has_best_13 : unsigned(0 downto 0);
-  signal bits_has_best_14 : unsigned(0 downto 0);
-  signal bits_has_best_15 : unsigned(0 downto 0);
-  signal bits_has_best_16 : unsigned(0 downto 0);
-  signal bits_has_best_17 : unsigned(0 downto 0);
-  signal bits_has_best_18 : unsigned(0 downto 0);
-  signal bits_has_best_19 : unsigned(0 downto 0);
-  signal bits_has_best_20 : unsigned(0 downto 0);
-  signal bits_has_best_21 : unsigned(0 downto 0);
-  signal bits_has_best_22 : unsigned(0 downto 0);
-  signal bits_has_best_23 : unsigned(0 downto 0);
-  signal bits_has_best_24 : unsigned(0 downto 0);
-  signal bits_has_best_25 : unsigned(0 downto 0);
-  signal bits_has_best_26 : unsigned(0 downto 0);
-  signal bits_has_best_27 : unsigned(0 downto 0);
-  signal bits_has_best_28 : unsigned(0 downto 0);
-  signal bits_has_best_29 : unsigned(0 downto 0);
-  signal bits_has_best_30 : unsigned(0 downto 0);
-  signal bits_has_best_31 : unsigned(0 downto 0);
-  signal bits_has_best_32 : unsigned(0 downto 0);
-  signal bits_has_best_33 : unsigned(0 downto 0);
-  signal bits_has_best_34 : unsigned(0 downto 0);
-  signal bits_has_best_35 : unsigned(0 downto 0);
-  signal bits_has_best_36 : unsigned(0 downto 0);
-  signal bits_has_best_37 : unsigned(0 downto 0);
-  signal bits_has_best_38 : unsigned(0 downto 0);
-  signal bits_has_best_39 : unsigned(0 downto 0);
-  signal bits_has_best_40 : unsigned(0 downto 0);
-  signal bits_has_best_41 : unsigned(0 downto 0);
-  signal bits_has_best_42 : unsigned(0 downto 0);
-  signal bits_has_best_43 : unsigned(0 downto 0);
-  signal bits_has_best_44 : unsigned(0 downto 0);
-  signal bits_has_best_45 : unsigned(0 downto 0);
-  signal bits_has_best_46 : unsigned(0 downto 0);
-  signal bits_has_best_47 : unsigned(0 downto 0);
-  signal bits_has_best_48 : unsigned(0 downto 0);
-  signal bits_has_best_49 : unsigned(0 downto 0);
-  signal bits_has_best_50 : unsigned(0 downto 0);
-  signal bits_has_best_51 : unsigned(0 downto 0);
-  signal bits_has_best_52 : unsigned(0 downto 0);
-  signal bits_has_best_53 : unsigned(0 downto 0);
-  signal bits_has_best_54 : unsigned(0 downto 0);
-  signal bits_has_best_55 : unsigned(0 downto 0);
-  signal bits_has_best_56 : unsigned(0 downto 0);
-  signal bits_has_best_57 : unsigned(0 downto 0);
-  signal bits_has_best_58 : unsigned(0 downto 0);
-  signal bits_has_best_59 : unsigned(0 downto 0);
-  signal bits_has_best_60 : unsigned(0 downto 0);
-  signal bits_has_best_61 : unsigned(0 downto 0);
-  signal bits_has_best_62 : unsigned(0 downto 0);
-  signal bits_has_best_63 : unsigned(0 downto 0);
-  signal slot_has_best : unsigned(0 downto 0);
+  signal has_best_kept : unsigned(63 downto 0);
+  signal and_48 : unsigned(0 downto 0);
+  signal merge_slot_eq_b2_slot_c1 : unsigned(0 downto 0);
+  signal b_slot_merged_c : unsigned(0 downto 0);
+  signal b_slot_merged : unsigned(0 downto 0) := unsigned'("0");
+  constant k_0_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_has_best_kept : unsigned(0 downto 0);
+  signal bits_has_best_kept_1 : unsigned(0 downto 0);
+  signal bits_has_best_kept_2 : unsigned(0 downto 0);
+  signal bits_has_best_kept_3 : unsigned(0 downto 0);
+  signal bits_has_best_kept_4 : unsigned(0 downto 0);
+  signal bits_has_best_kept_5 : unsigned(0 downto 0);
+  signal bits_has_best_kept_6 : unsigned(0 downto 0);
+  signal bits_has_best_kept_7 : unsigned(0 downto 0);
+  signal bits_has_best_kept_8 : unsigned(0 downto 0);
+  signal bits_has_best_kept_9 : unsigned(0 downto 0);
+  signal bits_has_best_kept_10 : unsigned(0 downto 0);
+  signal bits_has_best_kept_11 : unsigned(0 downto 0);
+  signal bits_has_best_kept_12 : unsigned(0 downto 0);
+  signal bits_has_best_kept_13 : unsigned(0 downto 0);
+  signal bits_has_best_kept_14 : unsigned(0 downto 0);
+  signal bits_has_best_kept_15 : unsigned(0 downto 0);
+  signal bits_b2_slot_c1 : unsigned(3 downto 0);
+  signal slot_has_best_g0_c : unsigned(0 downto 0);
+  signal slot_has_best_g0 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_has_best_kept_16 : unsigned(0 downto 0);
+  signal bits_has_best_kept_17 : unsigned(0 downto 0);
+  signal bits_has_best_kept_18 : unsigned(0 downto 0);
+  signal bits_has_best_kept_19 : unsigned(0 downto 0);
+  signal bits_has_best_kept_20 : unsigned(0 downto 0);
+  signal bits_has_best_kept_21 : unsigned(0 downto 0);
+  signal bits_has_best_kept_22 : unsigned(0 downto 0);
+  signal bits_has_best_kept_23 : unsigned(0 downto 0);
+  signal bits_has_best_kept_24 : unsigned(0 downto 0);
+  signal bits_has_best_kept_25 : unsigned(0 downto 0);
+  signal bits_has_best_kept_26 : unsigned(0 downto 0);
+  signal bits_has_best_kept_27 : unsigned(0 downto 0);
+  signal bits_has_best_kept_28 : unsigned(0 downto 0);
+  signal bits_has_best_kept_29 : unsigned(0 downto 0);
+  signal bits_has_best_kept_30 : unsigned(0 downto 0);
+  signal bits_has_best_kept_31 : unsigned(0 downto 0);
+  signal bits_b2_slot_c1_1 : unsigned(3 downto 0);
+  signal slot_has_best_g1_c : unsigned(0 downto 0);
+  signal slot_has_best_g1 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_has_best_kept_32 : unsigned(0 downto 0);
+  signal bits_has_best_kept_33 : unsigned(0 downto 0);
+  signal bits_has_best_kept_34 : unsigned(0 downto 0);
+  signal bits_has_best_kept_35 : unsigned(0 downto 0);
+  signal bits_has_best_kept_36 : unsigned(0 downto 0);
+  signal bits_has_best_kept_37 : unsigned(0 downto 0);
+  signal bits_has_best_kept_38 : unsigned(0 downto 0);
+  signal bits_has_best_kept_39 : unsigned(0 downto 0);
+  signal bits_has_best_kept_40 : unsigned(0 downto 0);
+  signal bits_has_best_kept_41 : unsigned(0 downto 0);
+  signal bits_has_best_kept_42 : unsigned(0 downto 0);
+  signal bits_has_best_kept_43 : unsigned(0 downto 0);
+  signal bits_has_best_kept_44 : unsigned(0 downto 0);
+  signal bits_has_best_kept_45 : unsigned(0 downto 0);
+  signal bits_has_best_kept_46 : unsigned(0 downto 0);
+  signal bits_has_best_kept_47 : unsigned(0 downto 0);
+  signal bits_b2_slot_c1_2 : unsigned(3 downto 0);
+  signal slot_has_best_g2_c : unsigned(0 downto 0);
+  signal slot_has_best_g2 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_has_best_kept_48 : unsigned(0 downto 0);
+  signal bits_has_best_kept_49 : unsigned(0 downto 0);
+  signal bits_has_best_kept_50 : unsigned(0 downto 0);
+  signal bits_has_best_kept_51 : unsigned(0 downto 0);
+  signal bits_has_best_kept_52 : unsigned(0 downto 0);
+  signal bits_has_best_kept_53 : unsigned(0 downto 0);
+  signal bits_has_best_kept_54 : unsigned(0 downto 0);
+  signal bits_has_best_kept_55 : unsigned(0 downto 0);
+  signal bits_has_best_kept_56 : unsigned(0 downto 0);
+  signal bits_has_best_kept_57 : unsigned(0 downto 0);
+  signal bits_has_best_kept_58 : unsigned(0 downto 0);
+  signal bits_has_best_kept_59 : unsigned(0 downto 0);
+  signal bits_has_best_kept_60 : unsigned(0 downto 0);
+  signal bits_has_best_kept_61 : unsigned(0 downto 0);
+  signal bits_has_best_kept_62 : unsigned(0 downto 0);
+  signal bits_has_best_kept_63 : unsigned(0 downto 0);
+  signal bits_b2_slot_c1_3 : unsigned(3 downto 0);
+  signal slot_has_best_g3_c : unsigned(0 downto 0);
+  signal slot_has_best_g3 : unsigned(0 downto 0) := unsigned'("0");
+  signal bits_c_slot_c2 : unsigned(1 downto 0);
+  signal slot_has_best_c : unsigned(0 downto 0);
+  signal slot_has_best_now : unsigned(0 downto 0);
   signal cull_has_best : unsigned(0 downto 0) := unsigned'("0");
   signal rs_s_limit_q : signed(32 downto 0);
   signal rs_cull_x : signed(32 downto 0);
-  signal minus_115 : signed(32 downto 0);
-  signal bits_minus_115 : unsigned(0 downto 0);
+  signal minus_51 : signed(32 downto 0);
+  signal bits_minus_51 : unsigned(0 downto 0);
   signal culled_c : unsigned(0 downto 0);
   signal culled : unsigned(0 downto 0) := unsigned'("0");
   signal culled_n : unsigned(0 downto 0) := unsigned'("0");
-  signal and_117 : unsigned(0 downto 0);
+  signal and_53 : unsigned(0 downto 0);
   signal merge_slot_eq_k_63 : unsigned(0 downto 0);
+  constant k_62 : unsigned(5 downto 0) := unsigned'("111110");
   signal merge_slot_eq_k_62 : unsigned(0 downto 0);
+  constant k_61 : unsigned(5 downto 0) := unsigned'("111101");
   signal merge_slot_eq_k_61 : unsigned(0 downto 0);
+  constant k_60 : unsigned(5 downto 0) := unsigned'("111100");
   signal merge_slot_eq_k_60 : unsigned(0 downto 0);
+  constant k_59 : unsigned(5 downto 0) := unsigned'("111011");
   signal merge_slot_eq_k_59 : unsigned(0 downto 0);
+  constant k_58 : unsigned(5 downto 0) := unsigned'("111010");
   signal merge_slot_eq_k_58 : unsigned(0 downto 0);
+  constant k_57 : unsigned(5 downto 0) := unsigned'("111001");
   signal merge_slot_eq_k_57 : unsigned(0 downto 0);
+  constant k_56 : unsigned(5 downto 0) := unsigned'("111000");
   signal merge_slot_eq_k_56 : unsigned(0 downto 0);
+  constant k_55 : unsigned(5 downto 0) := unsigned'("110111");
   signal merge_slot_eq_k_55 : unsigned(0 downto 0);
+  constant k_54 : unsigned(5 downto 0) := unsigned'("110110");
   signal merge_slot_eq_k_54 : unsigned(0 downto 0);
+  constant k_53 : unsigned(5 downto 0) := unsigned'("110101");
   signal merge_slot_eq_k_53 : unsigned(0 downto 0);
+  constant k_52 : unsigned(5 downto 0) := unsigned'("110100");
   signal merge_slot_eq_k_52 : unsigned(0 downto 0);
+  constant k_51 : unsigned(5 downto 0) := unsigned'("110011");
   signal merge_slot_eq_k_51 : unsigned(0 downto 0);
+  constant k_50 : unsigned(5 downto 0) := unsigned'("110010");
   signal merge_slot_eq_k_50 : unsigned(0 downto 0);
+  constant k_49 : unsigned(5 downto 0) := unsigned'("110001");
   signal merge_slot_eq_k_49 : unsigned(0 downto 0);
+  constant k_48 : unsigned(5 downto 0) := unsigned'("110000");
   signal merge_slot_eq_k_48 : unsigned(0 downto 0);
+  constant k_47 : unsigned(5 downto 0) := unsigned'("101111");
   signal merge_slot_eq_k_47 : unsigned(0 downto 0);
+  constant k_46 : unsigned(5 downto 0) := unsigned'("101110");
   signal merge_slot_eq_k_46 : unsigned(0 downto 0);
+  constant k_45 : unsigned(5 downto 0) := unsigned'("101101");
   signal merge_slot_eq_k_45 : unsigned(0 downto 0);
+  constant k_44 : unsigned(5 downto 0) := unsigned'("101100");
   signal merge_slot_eq_k_44 : unsigned(0 downto 0);
+  constant k_43 : unsigned(5 downto 0) := unsigned'("101011");
   signal merge_slot_eq_k_43 : unsigned(0 downto 0);
+  constant k_42 : unsigned(5 downto 0) := unsigned'("101010");
   signal merge_slot_eq_k_42 : unsigned(0 downto 0);
+  constant k_41 : unsigned(5 downto 0) := unsigned'("101001");
   signal merge_slot_eq_k_41 : unsigned(0 downto 0);
+  constant k_40 : unsigned(5 downto 0) := unsigned'("101000");
   signal merge_slot_eq_k_40 : unsigned(0 downto 0);
+  constant k_39 : unsigned(5 downto 0) := unsigned'("100111");
   signal merge_slot_eq_k_39 : unsigned(0 downto 0);
+  constant k_38 : unsigned(5 downto 0) := unsigned'("100110");
   signal merge_slot_eq_k_38 : unsigned(0 downto 0);
+  constant k_37 : unsigned(5 downto 0) := unsigned'("100101");
   signal merge_slot_eq_k_37 : unsigned(0 downto 0);
+  constant k_36 : unsigned(5 downto 0) := unsigned'("100100");
   signal merge_slot_eq_k_36 : unsigned(0 downto 0);
+  constant k_35 : unsigned(5 downto 0) := unsigned'("100011");
   signal merge_slot_eq_k_35 : unsigned(0 downto 0);
+  constant k_34 : unsigned(5 downto 0) := unsigned'("100010");
   signal merge_slot_eq_k_34 : unsigned(0 downto 0);
+  constant k_33 : unsigned(5 downto 0) := unsigned'("100001");
   signal merge_slot_eq_k_33 : unsigned(0 downto 0);
+  constant k_32 : unsigned(5 downto 0) := unsigned'("100000");
   signal merge_slot_eq_k_32 : unsigned(0 downto 0);
+  constant k_31 : unsigned(5 downto 0) := unsigned'("011111");
   signal merge_slot_eq_k_31 : unsigned(0 downto 0);
+  constant k_30 : unsigned(5 downto 0) := unsigned'("011110");
   signal merge_slot_eq_k_30 : unsigned(0 downto 0);
+  constant k_29 : unsigned(5 downto 0) := unsigned'("011101");
   signal merge_slot_eq_k_29 : unsigned(0 downto 0);
+  constant k_28 : unsigned(5 downto 0) := unsigned'("011100");
   signal merge_slot_eq_k_28 : unsigned(0 downto 0);
+  constant k_27 : unsigned(5 downto 0) := unsigned'("011011");
   signal merge_slot_eq_k_27 : unsigned(0 downto 0);
+  constant k_26 : unsigned(5 downto 0) := unsigned'("011010");
   signal merge_slot_eq_k_26 : unsigned(0 downto 0);
+  constant k_25 : unsigned(5 downto 0) := unsigned'("011001");
   signal merge_slot_eq_k_25 : unsigned(0 downto 0);
+  constant k_24 : unsigned(5 downto 0) := unsigned'("011000");
   signal merge_slot_eq_k_24 : unsigned(0 downto 0);
+  constant k_23 : unsigned(5 downto 0) := unsigned'("010111");
   signal merge_slot_eq_k_23 : unsigned(0 downto 0);
+  constant k_22 : unsigned(5 downto 0) := unsigned'("010110");
   signal merge_slot_eq_k_22 : unsigned(0 downto 0);
+  constant k_21 : unsigned(5 downto 0) := unsigned'("010101");
   signal merge_slot_eq_k_21 : unsigned(0 downto 0);
+  constant k_20 : unsigned(5 downto 0) := unsigned'("010100");
   signal merge_slot_eq_k_20 : unsigned(0 downto 0);
+  constant k_19 : unsigned(5 downto 0) := unsigned'("010011");
   signal merge_slot_eq_k_19 : unsigned(0 downto 0);
+  constant k_18 : unsigned(5 downto 0) := unsigned'("010010");
   signal merge_slot_eq_k_18 : unsigned(0 downto 0);
+  constant k_17 : unsigned(5 downto 0) := unsigned'("010001");
   signal merge_slot_eq_k_17 : unsigned(0 downto 0);
+  constant k_16 : unsigned(5 downto 0) := unsigned'("010000");
   signal merge_slot_eq_k_16 : unsigned(0 downto 0);
+  constant k_15 : unsigned(5 downto 0) := unsigned'("001111");
   signal merge_slot_eq_k_15 : unsigned(0 downto 0);
+  constant k_14 : unsigned(5 downto 0) := unsigned'("001110");
   signal merge_slot_eq_k_14 : unsigned(0 downto 0);
+  constant k_13 : unsigned(5 downto 0) := unsigned'("001101");
   signal merge_slot_eq_k_13 : unsigned(0 downto 0);
+  constant k_12 : unsigned(5 downto 0) := unsigned'("001100");
   signal merge_slot_eq_k_12 : unsigned(0 downto 0);
+  constant k_11 : unsigned(5 downto 0) := unsigned'("001011");
   signal merge_slot_eq_k_11 : unsigned(0 downto 0);
+  constant k_10 : unsigned(5 downto 0) := unsigned'("001010");
   signal merge_slot_eq_k_10 : unsigned(0 downto 0);
+  constant k_9 : unsigned(5 downto 0) := unsigned'("001001");
   signal merge_slot_eq_k_9 : unsigned(0 downto 0);
+  constant k_8 : unsigned(5 downto 0) := unsigned'("001000");
   signal merge_slot_eq_k_8 : unsigned(0 downto 0);
+  constant k_7 : unsigned(5 downto 0) := unsigned'("000111");
   signal merge_slot_eq_k_7 : unsigned(0 downto 0);
+  constant k_6 : unsigned(5 downto 0) := unsigned'("000110");
   signal merge_slot_eq_k_6 : unsigned(0 downto 0);
+  constant k_5 : unsigned(5 downto 0) := unsigned'("000101");
   signal merge_slot_eq_k_5 : unsigned(0 downto 0);
+  constant k_4 : unsigned(5 downto 0) := unsigned'("000100");
   signal merge_slot_eq_k_4 : unsigned(0 downto 0);
+  constant k_3 : unsigned(5 downto 0) := unsigned'("000011");
   signal merge_slot_eq_k_3 : unsigned(0 downto 0);
+  constant k_2 : unsigned(5 downto 0) := unsigned'("000010");
   signal merge_slot_eq_k_2 : unsigned(0 downto 0);
   signal merge_slot_eq_k_1 : unsigned(0 downto 0);
   signal merge_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_118 : unsigned(63 downto 0);
+  signal cat_54 : unsigned(63 downto 0);
+  constant k_0_5 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal best_set : unsigned(63 downto 0);
-  signal q_slot_eq_k_63 : unsigned(0 downto 0);
-  signal q_slot_eq_k_62 : unsigned(0 downto 0);
-  signal q_slot_eq_k_61 : unsigned(0 downto 0);
-  signal q_slot_eq_k_60 : unsigned(0 downto 0);
-  signal q_slot_eq_k_59 : unsigned(0 downto 0);
-  signal q_slot_eq_k_58 : unsigned(0 downto 0);
-  signal q_slot_eq_k_57 : unsigned(0 downto 0);
-  signal q_slot_eq_k_56 : unsigned(0 downto 0);
-  signal q_slot_eq_k_55 : unsigned(0 downto 0);
-  signal q_slot_eq_k_54 : unsigned(0 downto 0);
-  signal q_slot_eq_k_53 : unsigned(0 downto 0);
-  signal q_slot_eq_k_52 : unsigned(0 downto 0);
-  signal q_slot_eq_k_51 : unsigned(0 downto 0);
-  signal q_slot_eq_k_50 : unsigned(0 downto 0);
-  signal q_slot_eq_k_49 : unsigned(0 downto 0);
-  signal q_slot_eq_k_48 : unsigned(0 downto 0);
-  signal q_slot_eq_k_47 : unsigned(0 downto 0);
-  signal q_slot_eq_k_46 : unsigned(0 downto 0);
-  signal q_slot_eq_k_45 : unsigned(0 downto 0);
-  signal q_slot_eq_k_44 : unsigned(0 downto 0);
-  signal q_slot_eq_k_43 : unsigned(0 downto 0);
-  signal q_slot_eq_k_42 : unsigned(0 downto 0);
-  signal q_slot_eq_k_41 : unsigned(0 downto 0);
-  signal q_slot_eq_k_40 : unsigned(0 downto 0);
-  signal q_slot_eq_k_39 : unsigned(0 downto 0);
-  signal q_slot_eq_k_38 : unsigned(0 downto 0);
-  signal q_slot_eq_k_37 : unsigned(0 downto 0);
-  signal q_slot_eq_k_36 : unsigned(0 downto 0);
-  signal q_slot_eq_k_35 : unsigned(0 downto 0);
-  signal q_slot_eq_k_34 : unsigned(0 downto 0);
-  signal q_slot_eq_k_33 : unsigned(0 downto 0);
-  signal q_slot_eq_k_32 : unsigned(0 downto 0);
-  signal q_slot_eq_k_31 : unsigned(0 downto 0);
-  signal q_slot_eq_k_30 : unsigned(0 downto 0);
-  signal q_slot_eq_k_29 : unsigned(0 downto 0);
-  signal q_slot_eq_k_28 : unsigned(0 downto 0);
-  signal q_slot_eq_k_27 : unsigned(0 downto 0);
-  signal q_slot_eq_k_26 : unsigned(0 downto 0);
-  signal q_slot_eq_k_25 : unsigned(0 downto 0);
-  signal q_slot_eq_k_24 : unsigned(0 downto 0);
-  signal q_slot_eq_k_23 : unsigned(0 downto 0);
-  signal q_slot_eq_k_22 : unsigned(0 downto 0);
-  signal q_slot_eq_k_21 : unsigned(0 downto 0);
-  signal q_slot_eq_k_20 : unsigned(0 downto 0);
-  signal q_slot_eq_k_19 : unsigned(0 downto 0);
-  signal q_slot_eq_k_18 : unsigned(0 downto 0);
-  signal q_slot_eq_k_17 : unsigned(0 downto 0);
-  signal q_slot_eq_k_16 : unsigned(0 downto 0);
-  signal q_slot_eq_k_15 : unsigned(0 downto 0);
-  signal q_slot_eq_k_14 : unsigned(0 downto 0);
-  signal q_slot_eq_k_13 : unsigned(0 downto 0);
-  signal q_slot_eq_k_12 : unsigned(0 downto 0);
-  signal q_slot_eq_k_11 : unsigned(0 downto 0);
-  signal q_slot_eq_k_10 : unsigned(0 downto 0);
-  signal q_slot_eq_k_9 : unsigned(0 downto 0);
-  signal q_slot_eq_k_8 : unsigned(0 downto 0);
-  signal q_slot_eq_k_7 : unsigned(0 downto 0);
-  signal q_slot_eq_k_6 : unsigned(0 downto 0);
-  signal q_slot_eq_k_5 : unsigned(0 downto 0);
-  signal q_slot_eq_k_4 : unsigned(0 downto 0);
-  signal q_slot_eq_k_3 : unsigned(0 downto 0);
-  signal q_slot_eq_k_2 : unsigned(0 downto 0);
-  signal q_slot_eq_k_1 : unsigned(0 downto 0);
-  signal q_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_119 : unsigned(63 downto 0);
+  signal q_slot_c4_eq_k_63 : unsigned(0 downto 0);
+  signal and_55 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_62 : unsigned(0 downto 0);
+  signal and_56 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_61 : unsigned(0 downto 0);
+  signal and_57 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_60 : unsigned(0 downto 0);
+  signal and_58 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_59 : unsigned(0 downto 0);
+  signal and_59 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_58 : unsigned(0 downto 0);
+  signal and_60 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_57 : unsigned(0 downto 0);
+  signal and_61 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_56 : unsigned(0 downto 0);
+  signal and_62 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_55 : unsigned(0 downto 0);
+  signal and_63 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_54 : unsigned(0 downto 0);
+  signal and_64 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_53 : unsigned(0 downto 0);
+  signal and_65 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_52 : unsigned(0 downto 0);
+  signal and_66 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_51 : unsigned(0 downto 0);
+  signal and_67 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_50 : unsigned(0 downto 0);
+  signal and_68 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_49 : unsigned(0 downto 0);
+  signal and_69 : unsigned(0 downto 0);
+  signal q_slot_c4_eq_k_48 : unsigned(0 downto 0);
+  signal and_70 : unsigned(0 downto 0);
+  signal cat_71 : unsigned(15 downto 0);
+  signal q_slot_c3_eq_k_47 : unsigned(0 downto 0);
+  signal and_72 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_46 : unsigned(0 downto 0);
+  signal and_73 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_45 : unsigned(0 downto 0);
+  signal and_74 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_44 : unsigned(0 downto 0);
+  signal and_75 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_43 : unsigned(0 downto 0);
+  signal and_76 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_42 : unsigned(0 downto 0);
+  signal and_77 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_41 : unsigned(0 downto 0);
+  signal and_78 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_40 : unsigned(0 downto 0);
+  signal and_79 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_39 : unsigned(0 downto 0);
+  signal and_80 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_38 : unsigned(0 downto 0);
+  signal and_81 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_37 : unsigned(0 downto 0);
+  signal and_82 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_36 : unsigned(0 downto 0);
+  signal and_83 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_35 : unsigned(0 downto 0);
+  signal and_84 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_34 : unsigned(0 downto 0);
+  signal and_85 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_33 : unsigned(0 downto 0);
+  signal and_86 : unsigned(0 downto 0);
+  signal q_slot_c3_eq_k_32 : unsigned(0 downto 0);
+  signal and_87 : unsigned(0 downto 0);
+  signal cat_88 : unsigned(15 downto 0);
+  signal q_slot_c2_eq_k_31 : unsigned(0 downto 0);
+  signal and_89 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_30 : unsigned(0 downto 0);
+  signal and_90 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_29 : unsigned(0 downto 0);
+  signal and_91 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_28 : unsigned(0 downto 0);
+  signal and_92 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_27 : unsigned(0 downto 0);
+  signal and_93 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_26 : unsigned(0 downto 0);
+  signal and_94 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_25 : unsigned(0 downto 0);
+  signal and_95 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_24 : unsigned(0 downto 0);
+  signal and_96 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_23 : unsigned(0 downto 0);
+  signal and_97 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_22 : unsigned(0 downto 0);
+  signal and_98 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_21 : unsigned(0 downto 0);
+  signal and_99 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_20 : unsigned(0 downto 0);
+  signal and_100 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_19 : unsigned(0 downto 0);
+  signal and_101 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_18 : unsigned(0 downto 0);
+  signal and_102 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_17 : unsigned(0 downto 0);
+  signal and_103 : unsigned(0 downto 0);
+  signal q_slot_c2_eq_k_16 : unsigned(0 downto 0);
+  signal and_104 : unsigned(0 downto 0);
+  signal cat_105 : unsigned(15 downto 0);
+  signal q_slot_c1_eq_k_15 : unsigned(0 downto 0);
+  signal and_106 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_14 : unsigned(0 downto 0);
+  signal and_107 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_13 : unsigned(0 downto 0);
+  signal and_108 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_12 : unsigned(0 downto 0);
+  signal and_109 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_11 : unsigned(0 downto 0);
+  signal and_110 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_10 : unsigned(0 downto 0);
+  signal and_111 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_9 : unsigned(0 downto 0);
+  signal and_112 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_8 : unsigned(0 downto 0);
+  signal and_113 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_7 : unsigned(0 downto 0);
+  signal and_114 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_6 : unsigned(0 downto 0);
+  signal and_115 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_5 : unsigned(0 downto 0);
+  signal and_116 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_4 : unsigned(0 downto 0);
+  signal and_117 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_3 : unsigned(0 downto 0);
+  signal and_118 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_2 : unsigned(0 downto 0);
+  signal and_119 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_1 : unsigned(0 downto 0);
+  signal and_120 : unsigned(0 downto 0);
+  signal q_slot_c1_eq_k_0_1 : unsigned(0 downto 0);
+  signal and_121 : unsigned(0 downto 0);
+  signal cat_122 : unsigned(15 downto 0);
   signal best_clear_c : unsigned(63 downto 0);
   signal best_clear : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal not_best_clear : unsigned(63 downto 0);
-  signal and_120 : unsigned(63 downto 0);
-  signal and_120_or_best_set : unsigned(63 downto 0);
+  signal has_best_kept_c : unsigned(63 downto 0);
+  signal or_125 : unsigned(63 downto 0);
 
   -- register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
   signal c_slot : unsigned(5 downto 0) := unsigned'("000000");
@@ -1058,6 +902,36 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   attribute keep of c_slot_c1 : signal is "true";
   signal c_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of c_slot_c2 : signal is "true";
+
+  -- register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+  signal b2_slot : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of b2_slot : signal is "true";
+  signal b2_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of b2_slot_c1 : signal is "true";
+
+  -- register copies q_new_copies: q_new and 4 copies, to split its fan-out
+  signal q_new : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of q_new : signal is "true";
+  signal q_new_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of q_new_c1 : signal is "true";
+  signal q_new_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of q_new_c2 : signal is "true";
+  signal q_new_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of q_new_c3 : signal is "true";
+  signal q_new_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of q_new_c4 : signal is "true";
+
+  -- register copies q_slot_copies: q_slot and 4 copies, to split its fan-out
+  signal q_slot : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of q_slot : signal is "true";
+  signal q_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of q_slot_c1 : signal is "true";
+  signal q_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of q_slot_c2 : signal is "true";
+  signal q_slot_c3 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of q_slot_c3 : signal is "true";
+  signal q_slot_c4 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of q_slot_c4 : signal is "true";
 
   -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   signal n_valid_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1096,38 +970,56 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_push : unsigned(0 downto 0);
   signal u_n_tmin : unsigned(31 downto 0);
   signal rs_u_n_tmin : unsigned(30 downto 0);
-  signal cat_124 : unsigned(58 downto 0);
+  signal cat_129 : unsigned(58 downto 0);
   signal leaf_pop_r : unsigned(0 downto 0) := unsigned'("0");
-  signal leaf_q_push : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_wr : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_q_count : unsigned(6 downto 0) := unsigned'("0000000");
   signal leaf_q_wr_plus_k_1 : unsigned(5 downto 0);
   signal mux_leaf_q_push : unsigned(5 downto 0);
+  signal leaf_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
   signal leaf_q_rd_next : unsigned(5 downto 0);
   signal leaf_q_rd1_plus_k_1 : unsigned(5 downto 0);
   signal mux_leaf_pop_r : unsigned(5 downto 0);
-  signal rs_leaf_pop_r : unsigned(6 downto 0);
-  signal leaf_q_after_pop : unsigned(6 downto 0);
-  signal rs_leaf_q_push : unsigned(6 downto 0);
+  signal not_leaf_q_push_c1 : unsigned(0 downto 0);
+  signal rs_not_leaf_q_push_c1 : unsigned(6 downto 0);
+  signal leaf_q_count_if_pop : unsigned(6 downto 0);
+  signal rs_leaf_q_push_c1 : unsigned(6 downto 0);
+  signal leaf_q_count_if_kept : unsigned(6 downto 0);
   signal leaf_q_count_next : unsigned(6 downto 0);
-  signal leaf_q_count_eq_k_0_3 : unsigned(0 downto 0);
+  signal leaf_q_count_eq_k_0 : unsigned(0 downto 0);
   signal leaf_q_one_left : unsigned(0 downto 0);
-  signal and_127 : unsigned(0 downto 0);
+  signal and_132 : unsigned(0 downto 0);
   signal leaf_q_drained : unsigned(0 downto 0);
   signal leaf_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_bypass_c : unsigned(0 downto 0);
   signal leaf_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_leaf_q_count : unsigned(0 downto 0);
-  signal or_130 : unsigned(0 downto 0);
+  signal or_135 : unsigned(0 downto 0);
   signal not_leaf_pop_r : unsigned(0 downto 0);
-  signal and_131 : unsigned(0 downto 0);
+  signal and_136 : unsigned(0 downto 0);
   signal leaf_q_nonempty_c : unsigned(0 downto 0);
   signal leaf_q_din : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal bits_leaf_q_din : unsigned(15 downto 0);
   signal bits_leaf_q_din_1 : unsigned(15 downto 0);
   signal bits_leaf_q_din_2 : unsigned(15 downto 0);
   signal bits_leaf_q_din_3 : unsigned(10 downto 0);
+  signal leaf_q_rd_p1 : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_q_rd1_p1 : unsigned(5 downto 0) := unsigned'("000001");
+  signal mux_leaf_pop_r_1 : unsigned(5 downto 0);
+  signal leaf_q_rd1_p1_plus_k_1 : unsigned(5 downto 0);
+  signal mux_leaf_pop_r_2 : unsigned(5 downto 0);
+  signal leaf_q_rd_p2 : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_q_rd1_p2 : unsigned(5 downto 0) := unsigned'("000001");
+  signal mux_leaf_pop_r_3 : unsigned(5 downto 0);
+  signal leaf_q_rd1_p2_plus_k_1 : unsigned(5 downto 0);
+  signal mux_leaf_pop_r_4 : unsigned(5 downto 0);
+  signal leaf_q_rd_p3 : unsigned(5 downto 0) := unsigned'("000000");
+  signal leaf_q_rd1_p3 : unsigned(5 downto 0) := unsigned'("000001");
+  signal mux_leaf_pop_r_5 : unsigned(5 downto 0);
+  signal leaf_q_rd1_p3_plus_k_1 : unsigned(5 downto 0);
+  signal mux_leaf_pop_r_6 : unsigned(5 downto 0);
   signal leaf_q_q_stay_g3 : unsigned(10 downto 0) := unsigned'("00000000000");
   signal leaf_q_q_stay_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal leaf_q_q_stay_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
@@ -1144,15 +1036,30 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type n_ray_slot_early_sr_t is array (1 to 2) of unsigned(5 downto 0);
   signal n_ray_slot_early_sr : n_ray_slot_early_sr_t := (others => (others => '0'));
   signal n_ray_slot_early : unsigned(5 downto 0);
-  signal ray_o_q : unsigned(86 downto 0) := unsigned'("000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
+  signal ray_o_q_g5 : unsigned(6 downto 0) := unsigned'("0000000");
+  signal ray_o_q_g4 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_o_q : unsigned(86 downto 0);
   signal bits_ray_o_q : unsigned(28 downto 0);
   signal bits_ray_o_q_1 : unsigned(28 downto 0);
   signal bits_ray_o_q_2 : unsigned(28 downto 0);
-  signal ray_invx_q : unsigned(47 downto 0) := unsigned'("000000000000000000000000000000000000000000000000");
+  signal ray_invx_q_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invx_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invx_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invx_q : unsigned(47 downto 0);
   signal s_ray_invx_q : signed(47 downto 0);
-  signal ray_invy_q : unsigned(47 downto 0) := unsigned'("000000000000000000000000000000000000000000000000");
+  signal ray_invy_q_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invy_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invy_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invy_q : unsigned(47 downto 0);
   signal s_ray_invy_q : signed(47 downto 0);
-  signal ray_invz_q : unsigned(47 downto 0) := unsigned'("000000000000000000000000000000000000000000000000");
+  signal ray_invz_q_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invz_q_g1 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invz_q_g0 : unsigned(15 downto 0) := unsigned'("0000000000000000");
+  signal ray_invz_q : unsigned(47 downto 0);
   signal s_ray_invz_q : signed(47 downto 0);
   signal pu_sel_valid : unsigned(0 downto 0) := unsigned'("0");
   signal pu_sel_last : unsigned(0 downto 0) := unsigned'("0");
@@ -1237,7 +1144,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal pu_below_1 : unsigned(0 downto 0);
   signal not_pu_below_1 : unsigned(0 downto 0);
   signal bits_pu_shifted_1 : unsigned(30 downto 0);
-  signal ne_138 : unsigned(0 downto 0);
+  signal ne_147 : unsigned(0 downto 0);
   signal pu_above_1 : unsigned(0 downto 0);
   signal rs_pu_shifted_1 : signed(31 downto 0);
   signal pu_above_r_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1261,27 +1168,13 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal negative_sr : negative_sr_t := (others => (others => '0'));
   signal negative : unsigned(0 downto 0);
 
-  -- register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
-  signal leaf_q_rd : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of leaf_q_rd : signal is "true";
-  signal leaf_q_rd_c1 : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of leaf_q_rd_c1 : signal is "true";
-  signal leaf_q_rd_c2 : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of leaf_q_rd_c2 : signal is "true";
-  signal leaf_q_rd_c3 : unsigned(5 downto 0) := unsigned'("000000");
-  attribute keep of leaf_q_rd_c3 : signal is "true";
+  -- register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
+  signal leaf_q_push : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of leaf_q_push : signal is "true";
+  signal leaf_q_push_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of leaf_q_push_c1 : signal is "true";
 
-  -- register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
-  signal leaf_q_rd1 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of leaf_q_rd1 : signal is "true";
-  signal leaf_q_rd1_c1 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of leaf_q_rd1_c1 : signal is "true";
-  signal leaf_q_rd1_c2 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of leaf_q_rd1_c2 : signal is "true";
-  signal leaf_q_rd1_c3 : unsigned(5 downto 0) := unsigned'("000001");
-  attribute keep of leaf_q_rd1_c3 : signal is "true";
-
-  -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+  -- register copies n_ray_slot_copies: n_ray_slot and 14 copies, to split its fan-out
   signal n_ray_slot : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of n_ray_slot : signal is "true";
   signal n_ray_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
@@ -1290,6 +1183,28 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   attribute keep of n_ray_slot_c2 : signal is "true";
   signal n_ray_slot_c3 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of n_ray_slot_c3 : signal is "true";
+  signal n_ray_slot_c4 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c4 : signal is "true";
+  signal n_ray_slot_c5 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c5 : signal is "true";
+  signal n_ray_slot_c6 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c6 : signal is "true";
+  signal n_ray_slot_c7 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c7 : signal is "true";
+  signal n_ray_slot_c8 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c8 : signal is "true";
+  signal n_ray_slot_c9 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c9 : signal is "true";
+  signal n_ray_slot_c10 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c10 : signal is "true";
+  signal n_ray_slot_c11 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c11 : signal is "true";
+  signal n_ray_slot_c12 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c12 : signal is "true";
+  signal n_ray_slot_c13 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c13 : signal is "true";
+  signal n_ray_slot_c14 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of n_ray_slot_c14 : signal is "true";
 
   -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   signal not_leaf_push : unsigned(0 downto 0);
@@ -1334,7 +1249,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal tmin_m1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_tmin_n1 : signed(32 downto 0);
   signal rs_tmax_p1 : signed(32 downto 0);
-  signal minus_142 : signed(32 downto 0);
+  signal minus_151 : signed(32 downto 0);
   signal tmin_le_tmax_c : unsigned(0 downto 0);
   signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
   signal tmin_n2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -1369,19 +1284,19 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal d1_lo : signed(31 downto 0);
   signal rs_plane_t : signed(32 downto 0);
   signal rs_d0_hi : signed(32 downto 0);
-  signal minus_143 : signed(32 downto 0);
+  signal minus_152 : signed(32 downto 0);
   signal d0_below : unsigned(0 downto 0);
   signal rs_d0_lo : signed(32 downto 0);
   signal rs_plane_t_1 : signed(32 downto 0);
-  signal minus_144 : signed(32 downto 0);
+  signal minus_153 : signed(32 downto 0);
   signal d0_above : unsigned(0 downto 0);
   signal rs_plane_t_1_1 : signed(32 downto 0);
   signal rs_d1_hi : signed(32 downto 0);
-  signal minus_145 : signed(32 downto 0);
+  signal minus_154 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
   signal rs_d1_lo : signed(32 downto 0);
   signal rs_plane_t_1_2 : signed(32 downto 0);
-  signal minus_146 : signed(32 downto 0);
+  signal minus_155 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
@@ -1418,11 +1333,11 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal push : unsigned(0 downto 0);
   signal stack_we_r : unsigned(0 downto 0) := unsigned'("0");
   signal rs_g_sp : unsigned(4 downto 0);
-  signal cat_148 : unsigned(10 downto 0);
+  signal cat_157 : unsigned(10 downto 0);
   signal stack_waddr_r : unsigned(10 downto 0) := unsigned'("00000000000");
   signal u_far_min : unsigned(31 downto 0);
   signal u_g_tmax : unsigned(31 downto 0);
-  signal cat_149 : unsigned(76 downto 0);
+  signal cat_158 : unsigned(76 downto 0);
   signal stack_wdata_r : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal enter_near_or_enter_far : unsigned(0 downto 0);
   signal g_pop : unsigned(0 downto 0);
@@ -1438,7 +1353,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal g_sp_m1 : unsigned(5 downto 0);
   signal g_done : unsigned(0 downto 0);
   signal rs_g_sp_m1 : unsigned(4 downto 0);
-  signal cat_150 : unsigned(10 downto 0);
+  signal cat_159 : unsigned(10 downto 0);
   signal stack_raddr_next : unsigned(10 downto 0);
 begin
 
@@ -1447,6 +1362,21 @@ begin
   u_invx <= unsigned(invx);
   u_invy <= unsigned(invy);
   u_invz <= unsigned(invz);
+  bits_cat_0 <= unsigned(cat_0(15 downto 0));
+  bits_cat_0_1 <= unsigned(cat_0(31 downto 16));
+  bits_cat_0_2 <= unsigned(cat_0(47 downto 32));
+  bits_cat_0_3 <= unsigned(cat_0(63 downto 48));
+  bits_cat_0_4 <= unsigned(cat_0(79 downto 64));
+  bits_cat_0_5 <= unsigned(cat_0(86 downto 80));
+  bits_u_invx <= unsigned(u_invx(15 downto 0));
+  bits_u_invx_1 <= unsigned(u_invx(31 downto 16));
+  bits_u_invx_2 <= unsigned(u_invx(47 downto 32));
+  bits_u_invy <= unsigned(u_invy(15 downto 0));
+  bits_u_invy_1 <= unsigned(u_invy(31 downto 16));
+  bits_u_invy_2 <= unsigned(u_invy(47 downto 32));
+  bits_u_invz <= unsigned(u_invz(15 downto 0));
+  bits_u_invz_1 <= unsigned(u_invz(31 downto 16));
+  bits_u_invz_2 <= unsigned(u_invz(47 downto 32));
   not_just_alloc <= not just_alloc;
   has_free_c <= free_any_r and not_just_alloc;
   bits_leaf_q_head <= unsigned(leaf_q_head(5 downto 0));
@@ -1459,17 +1389,53 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if ray_we = "1" then
-        ray_o(to_integer(ray_slot)) <= cat_0;
+      if ray_we_g0 = "1" then
+        ray_o_g0(to_integer(ray_slot_g0)) <= bits_cat_0;
       end if;
-      if ray_we = "1" then
-        ray_invx(to_integer(ray_slot)) <= u_invx;
+      if ray_we_g1 = "1" then
+        ray_o_g1(to_integer(ray_slot_g1)) <= bits_cat_0_1;
       end if;
-      if ray_we = "1" then
-        ray_invy(to_integer(ray_slot)) <= u_invy;
+      if ray_we_g2 = "1" then
+        ray_o_g2(to_integer(ray_slot_g2)) <= bits_cat_0_2;
       end if;
-      if ray_we = "1" then
-        ray_invz(to_integer(ray_slot)) <= u_invz;
+      if ray_we_g3 = "1" then
+        ray_o_g3(to_integer(ray_slot_g3)) <= bits_cat_0_3;
+      end if;
+      if ray_we_g4 = "1" then
+        ray_o_g4(to_integer(ray_slot_g4)) <= bits_cat_0_4;
+      end if;
+      if ray_we_g5 = "1" then
+        ray_o_g5(to_integer(ray_slot_g5)) <= bits_cat_0_5;
+      end if;
+      if ray_we_g6 = "1" then
+        ray_invx_g0(to_integer(ray_slot_g6)) <= bits_u_invx;
+      end if;
+      if ray_we_g7 = "1" then
+        ray_invx_g1(to_integer(ray_slot_g7)) <= bits_u_invx_1;
+      end if;
+      if ray_we_g8 = "1" then
+        ray_invx_g2(to_integer(ray_slot_g8)) <= bits_u_invx_2;
+      end if;
+      if ray_we_g9 = "1" then
+        ray_invy_g0(to_integer(ray_slot_g9)) <= bits_u_invy;
+      end if;
+      if ray_we_g10 = "1" then
+        ray_invy_g1(to_integer(ray_slot_g10)) <= bits_u_invy_1;
+      end if;
+      if ray_we_g11 = "1" then
+        ray_invy_g2(to_integer(ray_slot_g11)) <= bits_u_invy_2;
+      end if;
+      if ray_we_g12 = "1" then
+        ray_invz_g0(to_integer(ray_slot_g12)) <= bits_u_invz;
+      end if;
+      if ray_we_g13 = "1" then
+        ray_invz_g1(to_integer(ray_slot_g13)) <= bits_u_invz_1;
+      end if;
+      if ray_we_g14 = "1" then
+        ray_invz_g2(to_integer(ray_slot_g14)) <= bits_u_invz_2;
+      end if;
+      if free_q_push = "1" then
+        free_q_mem(to_integer(free_q_wr)) <= free_q_din;
       end if;
       if unpark_q_push = "1" then
         unpark_q_mem(to_integer(unpark_q_wr)) <= unpark_q_din;
@@ -1504,406 +1470,99 @@ begin
     end if;
   end process regs;
 
-  -- stage slots: the free-slot bits, the lowest free slot for the top, the slots holding a ray
-  bits_free_bits <= unsigned(free_bits(0 downto 0));
-  bits_free_bits_1 <= unsigned(free_bits(1 downto 1));
-  bits_free_bits_2 <= unsigned(free_bits(2 downto 2));
-  bits_free_bits_3 <= unsigned(free_bits(3 downto 3));
-  bits_free_bits_4 <= unsigned(free_bits(4 downto 4));
-  bits_free_bits_5 <= unsigned(free_bits(5 downto 5));
-  bits_free_bits_6 <= unsigned(free_bits(6 downto 6));
-  bits_free_bits_7 <= unsigned(free_bits(7 downto 7));
-  bits_free_bits_8 <= unsigned(free_bits(8 downto 8));
-  bits_free_bits_9 <= unsigned(free_bits(9 downto 9));
-  bits_free_bits_10 <= unsigned(free_bits(10 downto 10));
-  bits_free_bits_11 <= unsigned(free_bits(11 downto 11));
-  bits_free_bits_12 <= unsigned(free_bits(12 downto 12));
-  bits_free_bits_13 <= unsigned(free_bits(13 downto 13));
-  bits_free_bits_14 <= unsigned(free_bits(14 downto 14));
-  bits_free_bits_15 <= unsigned(free_bits(15 downto 15));
-  bits_free_bits_16 <= unsigned(free_bits(16 downto 16));
-  bits_free_bits_17 <= unsigned(free_bits(17 downto 17));
-  bits_free_bits_18 <= unsigned(free_bits(18 downto 18));
-  bits_free_bits_19 <= unsigned(free_bits(19 downto 19));
-  bits_free_bits_20 <= unsigned(free_bits(20 downto 20));
-  bits_free_bits_21 <= unsigned(free_bits(21 downto 21));
-  bits_free_bits_22 <= unsigned(free_bits(22 downto 22));
-  bits_free_bits_23 <= unsigned(free_bits(23 downto 23));
-  bits_free_bits_24 <= unsigned(free_bits(24 downto 24));
-  bits_free_bits_25 <= unsigned(free_bits(25 downto 25));
-  bits_free_bits_26 <= unsigned(free_bits(26 downto 26));
-  bits_free_bits_27 <= unsigned(free_bits(27 downto 27));
-  bits_free_bits_28 <= unsigned(free_bits(28 downto 28));
-  bits_free_bits_29 <= unsigned(free_bits(29 downto 29));
-  bits_free_bits_30 <= unsigned(free_bits(30 downto 30));
-  bits_free_bits_31 <= unsigned(free_bits(31 downto 31));
-  bits_free_bits_32 <= unsigned(free_bits(32 downto 32));
-  bits_free_bits_33 <= unsigned(free_bits(33 downto 33));
-  bits_free_bits_34 <= unsigned(free_bits(34 downto 34));
-  bits_free_bits_35 <= unsigned(free_bits(35 downto 35));
-  bits_free_bits_36 <= unsigned(free_bits(36 downto 36));
-  bits_free_bits_37 <= unsigned(free_bits(37 downto 37));
-  bits_free_bits_38 <= unsigned(free_bits(38 downto 38));
-  bits_free_bits_39 <= unsigned(free_bits(39 downto 39));
-  bits_free_bits_40 <= unsigned(free_bits(40 downto 40));
-  bits_free_bits_41 <= unsigned(free_bits(41 downto 41));
-  bits_free_bits_42 <= unsigned(free_bits(42 downto 42));
-  bits_free_bits_43 <= unsigned(free_bits(43 downto 43));
-  bits_free_bits_44 <= unsigned(free_bits(44 downto 44));
-  bits_free_bits_45 <= unsigned(free_bits(45 downto 45));
-  bits_free_bits_46 <= unsigned(free_bits(46 downto 46));
-  bits_free_bits_47 <= unsigned(free_bits(47 downto 47));
-  bits_free_bits_48 <= unsigned(free_bits(48 downto 48));
-  bits_free_bits_49 <= unsigned(free_bits(49 downto 49));
-  bits_free_bits_50 <= unsigned(free_bits(50 downto 50));
-  bits_free_bits_51 <= unsigned(free_bits(51 downto 51));
-  bits_free_bits_52 <= unsigned(free_bits(52 downto 52));
-  bits_free_bits_53 <= unsigned(free_bits(53 downto 53));
-  bits_free_bits_54 <= unsigned(free_bits(54 downto 54));
-  bits_free_bits_55 <= unsigned(free_bits(55 downto 55));
-  bits_free_bits_56 <= unsigned(free_bits(56 downto 56));
-  bits_free_bits_57 <= unsigned(free_bits(57 downto 57));
-  bits_free_bits_58 <= unsigned(free_bits(58 downto 58));
-  bits_free_bits_59 <= unsigned(free_bits(59 downto 59));
-  bits_free_bits_60 <= unsigned(free_bits(60 downto 60));
-  bits_free_bits_61 <= unsigned(free_bits(61 downto 61));
-  bits_free_bits_62 <= unsigned(free_bits(62 downto 62));
-  bits_free_bits_63 <= unsigned(free_bits(63 downto 63));
-  not_bits_free_bits <= not bits_free_bits;
-  or_1 <= bits_free_bits or bits_free_bits_1;
-  not_bits_free_bits_2 <= not bits_free_bits_2;
-  or_2 <= bits_free_bits_2 or bits_free_bits_3;
-  not_bits_free_bits_4 <= not bits_free_bits_4;
-  or_3 <= bits_free_bits_4 or bits_free_bits_5;
-  not_bits_free_bits_6 <= not bits_free_bits_6;
-  or_4 <= bits_free_bits_6 or bits_free_bits_7;
-  not_bits_free_bits_8 <= not bits_free_bits_8;
-  or_5 <= bits_free_bits_8 or bits_free_bits_9;
-  not_bits_free_bits_10 <= not bits_free_bits_10;
-  or_6 <= bits_free_bits_10 or bits_free_bits_11;
-  not_bits_free_bits_12 <= not bits_free_bits_12;
-  or_7 <= bits_free_bits_12 or bits_free_bits_13;
-  not_bits_free_bits_14 <= not bits_free_bits_14;
-  or_8 <= bits_free_bits_14 or bits_free_bits_15;
-  not_bits_free_bits_16 <= not bits_free_bits_16;
-  or_9 <= bits_free_bits_16 or bits_free_bits_17;
-  not_bits_free_bits_18 <= not bits_free_bits_18;
-  or_10 <= bits_free_bits_18 or bits_free_bits_19;
-  not_bits_free_bits_20 <= not bits_free_bits_20;
-  or_11 <= bits_free_bits_20 or bits_free_bits_21;
-  not_bits_free_bits_22 <= not bits_free_bits_22;
-  or_12 <= bits_free_bits_22 or bits_free_bits_23;
-  not_bits_free_bits_24 <= not bits_free_bits_24;
-  or_13 <= bits_free_bits_24 or bits_free_bits_25;
-  not_bits_free_bits_26 <= not bits_free_bits_26;
-  or_14 <= bits_free_bits_26 or bits_free_bits_27;
-  not_bits_free_bits_28 <= not bits_free_bits_28;
-  or_15 <= bits_free_bits_28 or bits_free_bits_29;
-  not_bits_free_bits_30 <= not bits_free_bits_30;
-  or_16 <= bits_free_bits_30 or bits_free_bits_31;
-  not_bits_free_bits_32 <= not bits_free_bits_32;
-  or_17 <= bits_free_bits_32 or bits_free_bits_33;
-  not_bits_free_bits_34 <= not bits_free_bits_34;
-  or_18 <= bits_free_bits_34 or bits_free_bits_35;
-  not_bits_free_bits_36 <= not bits_free_bits_36;
-  or_19 <= bits_free_bits_36 or bits_free_bits_37;
-  not_bits_free_bits_38 <= not bits_free_bits_38;
-  or_20 <= bits_free_bits_38 or bits_free_bits_39;
-  not_bits_free_bits_40 <= not bits_free_bits_40;
-  or_21 <= bits_free_bits_40 or bits_free_bits_41;
-  not_bits_free_bits_42 <= not bits_free_bits_42;
-  or_22 <= bits_free_bits_42 or bits_free_bits_43;
-  not_bits_free_bits_44 <= not bits_free_bits_44;
-  or_23 <= bits_free_bits_44 or bits_free_bits_45;
-  not_bits_free_bits_46 <= not bits_free_bits_46;
-  or_24 <= bits_free_bits_46 or bits_free_bits_47;
-  not_bits_free_bits_48 <= not bits_free_bits_48;
-  or_25 <= bits_free_bits_48 or bits_free_bits_49;
-  not_bits_free_bits_50 <= not bits_free_bits_50;
-  or_26 <= bits_free_bits_50 or bits_free_bits_51;
-  not_bits_free_bits_52 <= not bits_free_bits_52;
-  or_27 <= bits_free_bits_52 or bits_free_bits_53;
-  not_bits_free_bits_54 <= not bits_free_bits_54;
-  or_28 <= bits_free_bits_54 or bits_free_bits_55;
-  not_bits_free_bits_56 <= not bits_free_bits_56;
-  or_29 <= bits_free_bits_56 or bits_free_bits_57;
-  not_bits_free_bits_58 <= not bits_free_bits_58;
-  or_30 <= bits_free_bits_58 or bits_free_bits_59;
-  not_bits_free_bits_60 <= not bits_free_bits_60;
-  or_31 <= bits_free_bits_60 or bits_free_bits_61;
-  not_bits_free_bits_62 <= not bits_free_bits_62;
-  or_32 <= bits_free_bits_62 or bits_free_bits_63;
-  not_or_1 <= not or_1;
-  mux_or_1 <= not_bits_free_bits when or_1 = "1" else not_bits_free_bits_2;
-  cat_33 <= unsigned(std_logic_vector'(std_logic_vector(not_or_1) & std_logic_vector(mux_or_1)));
-  or_1_or_or_2 <= or_1 or or_2;
-  not_or_3 <= not or_3;
-  mux_or_3 <= not_bits_free_bits_4 when or_3 = "1" else not_bits_free_bits_6;
-  cat_34 <= unsigned(std_logic_vector'(std_logic_vector(not_or_3) & std_logic_vector(mux_or_3)));
-  or_3_or_or_4 <= or_3 or or_4;
-  not_or_5 <= not or_5;
-  mux_or_5 <= not_bits_free_bits_8 when or_5 = "1" else not_bits_free_bits_10;
-  cat_35 <= unsigned(std_logic_vector'(std_logic_vector(not_or_5) & std_logic_vector(mux_or_5)));
-  or_5_or_or_6 <= or_5 or or_6;
-  not_or_7 <= not or_7;
-  mux_or_7 <= not_bits_free_bits_12 when or_7 = "1" else not_bits_free_bits_14;
-  cat_36 <= unsigned(std_logic_vector'(std_logic_vector(not_or_7) & std_logic_vector(mux_or_7)));
-  or_7_or_or_8 <= or_7 or or_8;
-  not_or_9 <= not or_9;
-  mux_or_9 <= not_bits_free_bits_16 when or_9 = "1" else not_bits_free_bits_18;
-  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(not_or_9) & std_logic_vector(mux_or_9)));
-  or_9_or_or_10 <= or_9 or or_10;
-  not_or_11 <= not or_11;
-  mux_or_11 <= not_bits_free_bits_20 when or_11 = "1" else not_bits_free_bits_22;
-  cat_38 <= unsigned(std_logic_vector'(std_logic_vector(not_or_11) & std_logic_vector(mux_or_11)));
-  or_11_or_or_12 <= or_11 or or_12;
-  not_or_13 <= not or_13;
-  mux_or_13 <= not_bits_free_bits_24 when or_13 = "1" else not_bits_free_bits_26;
-  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(not_or_13) & std_logic_vector(mux_or_13)));
-  or_13_or_or_14 <= or_13 or or_14;
-  not_or_15 <= not or_15;
-  mux_or_15 <= not_bits_free_bits_28 when or_15 = "1" else not_bits_free_bits_30;
-  cat_40 <= unsigned(std_logic_vector'(std_logic_vector(not_or_15) & std_logic_vector(mux_or_15)));
-  or_15_or_or_16 <= or_15 or or_16;
-  not_or_17 <= not or_17;
-  mux_or_17 <= not_bits_free_bits_32 when or_17 = "1" else not_bits_free_bits_34;
-  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(not_or_17) & std_logic_vector(mux_or_17)));
-  or_17_or_or_18 <= or_17 or or_18;
-  not_or_19 <= not or_19;
-  mux_or_19 <= not_bits_free_bits_36 when or_19 = "1" else not_bits_free_bits_38;
-  cat_42 <= unsigned(std_logic_vector'(std_logic_vector(not_or_19) & std_logic_vector(mux_or_19)));
-  or_19_or_or_20 <= or_19 or or_20;
-  not_or_21 <= not or_21;
-  mux_or_21 <= not_bits_free_bits_40 when or_21 = "1" else not_bits_free_bits_42;
-  cat_43 <= unsigned(std_logic_vector'(std_logic_vector(not_or_21) & std_logic_vector(mux_or_21)));
-  or_21_or_or_22 <= or_21 or or_22;
-  not_or_23 <= not or_23;
-  mux_or_23 <= not_bits_free_bits_44 when or_23 = "1" else not_bits_free_bits_46;
-  cat_44 <= unsigned(std_logic_vector'(std_logic_vector(not_or_23) & std_logic_vector(mux_or_23)));
-  or_23_or_or_24 <= or_23 or or_24;
-  not_or_25 <= not or_25;
-  mux_or_25 <= not_bits_free_bits_48 when or_25 = "1" else not_bits_free_bits_50;
-  cat_45 <= unsigned(std_logic_vector'(std_logic_vector(not_or_25) & std_logic_vector(mux_or_25)));
-  or_25_or_or_26 <= or_25 or or_26;
-  not_or_27 <= not or_27;
-  mux_or_27 <= not_bits_free_bits_52 when or_27 = "1" else not_bits_free_bits_54;
-  cat_46 <= unsigned(std_logic_vector'(std_logic_vector(not_or_27) & std_logic_vector(mux_or_27)));
-  or_27_or_or_28 <= or_27 or or_28;
-  not_or_29 <= not or_29;
-  mux_or_29 <= not_bits_free_bits_56 when or_29 = "1" else not_bits_free_bits_58;
-  cat_47 <= unsigned(std_logic_vector'(std_logic_vector(not_or_29) & std_logic_vector(mux_or_29)));
-  or_29_or_or_30 <= or_29 or or_30;
-  not_or_31 <= not or_31;
-  mux_or_31 <= not_bits_free_bits_60 when or_31 = "1" else not_bits_free_bits_62;
-  cat_48 <= unsigned(std_logic_vector'(std_logic_vector(not_or_31) & std_logic_vector(mux_or_31)));
-  or_31_or_or_32 <= or_31 or or_32;
-  not_or_1_or_or_2 <= not or_1_or_or_2;
-  mux_or_1_or_or_2 <= cat_33 when or_1_or_or_2 = "1" else cat_34;
-  cat_49 <= unsigned(std_logic_vector'(std_logic_vector(not_or_1_or_or_2) & std_logic_vector(mux_or_1_or_or_2)));
-  or_50 <= or_1_or_or_2 or or_3_or_or_4;
-  not_or_5_or_or_6 <= not or_5_or_or_6;
-  mux_or_5_or_or_6 <= cat_35 when or_5_or_or_6 = "1" else cat_36;
-  cat_51 <= unsigned(std_logic_vector'(std_logic_vector(not_or_5_or_or_6) & std_logic_vector(mux_or_5_or_or_6)));
-  or_52 <= or_5_or_or_6 or or_7_or_or_8;
-  not_or_9_or_or_10 <= not or_9_or_or_10;
-  mux_or_9_or_or_10 <= cat_37 when or_9_or_or_10 = "1" else cat_38;
-  cat_53 <= unsigned(std_logic_vector'(std_logic_vector(not_or_9_or_or_10) & std_logic_vector(mux_or_9_or_or_10)));
-  or_54 <= or_9_or_or_10 or or_11_or_or_12;
-  not_or_13_or_or_14 <= not or_13_or_or_14;
-  mux_or_13_or_or_14 <= cat_39 when or_13_or_or_14 = "1" else cat_40;
-  cat_55 <= unsigned(std_logic_vector'(std_logic_vector(not_or_13_or_or_14) & std_logic_vector(mux_or_13_or_or_14)));
-  or_56 <= or_13_or_or_14 or or_15_or_or_16;
-  not_or_17_or_or_18 <= not or_17_or_or_18;
-  mux_or_17_or_or_18 <= cat_41 when or_17_or_or_18 = "1" else cat_42;
-  cat_57 <= unsigned(std_logic_vector'(std_logic_vector(not_or_17_or_or_18) & std_logic_vector(mux_or_17_or_or_18)));
-  or_58 <= or_17_or_or_18 or or_19_or_or_20;
-  not_or_21_or_or_22 <= not or_21_or_or_22;
-  mux_or_21_or_or_22 <= cat_43 when or_21_or_or_22 = "1" else cat_44;
-  cat_59 <= unsigned(std_logic_vector'(std_logic_vector(not_or_21_or_or_22) & std_logic_vector(mux_or_21_or_or_22)));
-  or_60 <= or_21_or_or_22 or or_23_or_or_24;
-  not_or_25_or_or_26 <= not or_25_or_or_26;
-  mux_or_25_or_or_26 <= cat_45 when or_25_or_or_26 = "1" else cat_46;
-  cat_61 <= unsigned(std_logic_vector'(std_logic_vector(not_or_25_or_or_26) & std_logic_vector(mux_or_25_or_or_26)));
-  or_62 <= or_25_or_or_26 or or_27_or_or_28;
-  not_or_29_or_or_30 <= not or_29_or_or_30;
-  mux_or_29_or_or_30 <= cat_47 when or_29_or_or_30 = "1" else cat_48;
-  cat_63 <= unsigned(std_logic_vector'(std_logic_vector(not_or_29_or_or_30) & std_logic_vector(mux_or_29_or_or_30)));
-  or_64 <= or_29_or_or_30 or or_31_or_or_32;
-  not_or_50 <= not or_50;
-  mux_or_50 <= cat_49 when or_50 = "1" else cat_51;
-  cat_65 <= unsigned(std_logic_vector'(std_logic_vector(not_or_50) & std_logic_vector(mux_or_50)));
-  or_50_or_or_52 <= or_50 or or_52;
-  not_or_54 <= not or_54;
-  mux_or_54 <= cat_53 when or_54 = "1" else cat_55;
-  cat_66 <= unsigned(std_logic_vector'(std_logic_vector(not_or_54) & std_logic_vector(mux_or_54)));
-  or_54_or_or_56 <= or_54 or or_56;
-  not_or_58 <= not or_58;
-  mux_or_58 <= cat_57 when or_58 = "1" else cat_59;
-  cat_67 <= unsigned(std_logic_vector'(std_logic_vector(not_or_58) & std_logic_vector(mux_or_58)));
-  or_58_or_or_60 <= or_58 or or_60;
-  not_or_62 <= not or_62;
-  mux_or_62 <= cat_61 when or_62 = "1" else cat_63;
-  cat_68 <= unsigned(std_logic_vector'(std_logic_vector(not_or_62) & std_logic_vector(mux_or_62)));
-  or_62_or_or_64 <= or_62 or or_64;
-  not_or_50_or_or_52 <= not or_50_or_or_52;
-  mux_or_50_or_or_52 <= cat_65 when or_50_or_or_52 = "1" else cat_66;
-  cat_69 <= unsigned(std_logic_vector'(std_logic_vector(not_or_50_or_or_52) & std_logic_vector(mux_or_50_or_or_52)));
-  or_70 <= or_50_or_or_52 or or_54_or_or_56;
-  not_or_58_or_or_60 <= not or_58_or_or_60;
-  mux_or_58_or_or_60 <= cat_67 when or_58_or_or_60 = "1" else cat_68;
-  cat_71 <= unsigned(std_logic_vector'(std_logic_vector(not_or_58_or_or_60) & std_logic_vector(mux_or_58_or_or_60)));
-  or_72 <= or_58_or_or_60 or or_62_or_or_64;
-  not_or_70 <= not or_70;
-  mux_or_70 <= cat_69 when or_70 = "1" else cat_71;
-  free_idx_c <= unsigned(std_logic_vector'(std_logic_vector(not_or_70) & std_logic_vector(mux_or_70)));
-  free_any_c <= or_70 or or_72;
-  ray_slot_eq_k_63 <= "1" when ray_slot = k_63 else "0";
-  ray_slot_eq_k_62 <= "1" when ray_slot = k_62 else "0";
-  ray_slot_eq_k_61 <= "1" when ray_slot = k_61 else "0";
-  ray_slot_eq_k_60 <= "1" when ray_slot = k_60 else "0";
-  ray_slot_eq_k_59 <= "1" when ray_slot = k_59 else "0";
-  ray_slot_eq_k_58 <= "1" when ray_slot = k_58 else "0";
-  ray_slot_eq_k_57 <= "1" when ray_slot = k_57 else "0";
-  ray_slot_eq_k_56 <= "1" when ray_slot = k_56 else "0";
-  ray_slot_eq_k_55 <= "1" when ray_slot = k_55 else "0";
-  ray_slot_eq_k_54 <= "1" when ray_slot = k_54 else "0";
-  ray_slot_eq_k_53 <= "1" when ray_slot = k_53 else "0";
-  ray_slot_eq_k_52 <= "1" when ray_slot = k_52 else "0";
-  ray_slot_eq_k_51 <= "1" when ray_slot = k_51 else "0";
-  ray_slot_eq_k_50 <= "1" when ray_slot = k_50 else "0";
-  ray_slot_eq_k_49 <= "1" when ray_slot = k_49 else "0";
-  ray_slot_eq_k_48 <= "1" when ray_slot = k_48 else "0";
-  ray_slot_eq_k_47 <= "1" when ray_slot = k_47 else "0";
-  ray_slot_eq_k_46 <= "1" when ray_slot = k_46 else "0";
-  ray_slot_eq_k_45 <= "1" when ray_slot = k_45 else "0";
-  ray_slot_eq_k_44 <= "1" when ray_slot = k_44 else "0";
-  ray_slot_eq_k_43 <= "1" when ray_slot = k_43 else "0";
-  ray_slot_eq_k_42 <= "1" when ray_slot = k_42 else "0";
-  ray_slot_eq_k_41 <= "1" when ray_slot = k_41 else "0";
-  ray_slot_eq_k_40 <= "1" when ray_slot = k_40 else "0";
-  ray_slot_eq_k_39 <= "1" when ray_slot = k_39 else "0";
-  ray_slot_eq_k_38 <= "1" when ray_slot = k_38 else "0";
-  ray_slot_eq_k_37 <= "1" when ray_slot = k_37 else "0";
-  ray_slot_eq_k_36 <= "1" when ray_slot = k_36 else "0";
-  ray_slot_eq_k_35 <= "1" when ray_slot = k_35 else "0";
-  ray_slot_eq_k_34 <= "1" when ray_slot = k_34 else "0";
-  ray_slot_eq_k_33 <= "1" when ray_slot = k_33 else "0";
-  ray_slot_eq_k_32 <= "1" when ray_slot = k_32 else "0";
-  ray_slot_eq_k_31 <= "1" when ray_slot = k_31 else "0";
-  ray_slot_eq_k_30 <= "1" when ray_slot = k_30 else "0";
-  ray_slot_eq_k_29 <= "1" when ray_slot = k_29 else "0";
-  ray_slot_eq_k_28 <= "1" when ray_slot = k_28 else "0";
-  ray_slot_eq_k_27 <= "1" when ray_slot = k_27 else "0";
-  ray_slot_eq_k_26 <= "1" when ray_slot = k_26 else "0";
-  ray_slot_eq_k_25 <= "1" when ray_slot = k_25 else "0";
-  ray_slot_eq_k_24 <= "1" when ray_slot = k_24 else "0";
-  ray_slot_eq_k_23 <= "1" when ray_slot = k_23 else "0";
-  ray_slot_eq_k_22 <= "1" when ray_slot = k_22 else "0";
-  ray_slot_eq_k_21 <= "1" when ray_slot = k_21 else "0";
-  ray_slot_eq_k_20 <= "1" when ray_slot = k_20 else "0";
-  ray_slot_eq_k_19 <= "1" when ray_slot = k_19 else "0";
-  ray_slot_eq_k_18 <= "1" when ray_slot = k_18 else "0";
-  ray_slot_eq_k_17 <= "1" when ray_slot = k_17 else "0";
-  ray_slot_eq_k_16 <= "1" when ray_slot = k_16 else "0";
-  ray_slot_eq_k_15 <= "1" when ray_slot = k_15 else "0";
-  ray_slot_eq_k_14 <= "1" when ray_slot = k_14 else "0";
-  ray_slot_eq_k_13 <= "1" when ray_slot = k_13 else "0";
-  ray_slot_eq_k_12 <= "1" when ray_slot = k_12 else "0";
-  ray_slot_eq_k_11 <= "1" when ray_slot = k_11 else "0";
-  ray_slot_eq_k_10 <= "1" when ray_slot = k_10 else "0";
-  ray_slot_eq_k_9 <= "1" when ray_slot = k_9 else "0";
-  ray_slot_eq_k_8 <= "1" when ray_slot = k_8 else "0";
-  ray_slot_eq_k_7 <= "1" when ray_slot = k_7 else "0";
-  ray_slot_eq_k_6 <= "1" when ray_slot = k_6 else "0";
-  ray_slot_eq_k_5 <= "1" when ray_slot = k_5 else "0";
-  ray_slot_eq_k_4 <= "1" when ray_slot = k_4 else "0";
-  ray_slot_eq_k_3 <= "1" when ray_slot = k_3 else "0";
-  ray_slot_eq_k_2 <= "1" when ray_slot = k_2 else "0";
-  ray_slot_eq_k_1 <= "1" when ray_slot = k_1 else "0";
-  ray_slot_eq_k_0_1 <= "1" when ray_slot = k_0_1 else "0";
-  cat_74 <= unsigned(std_logic_vector'(std_logic_vector(ray_slot_eq_k_63) & std_logic_vector(ray_slot_eq_k_62) & std_logic_vector(ray_slot_eq_k_61) & std_logic_vector(ray_slot_eq_k_60) & std_logic_vector(ray_slot_eq_k_59) & std_logic_vector(ray_slot_eq_k_58) & std_logic_vector(ray_slot_eq_k_57) & std_logic_vector(ray_slot_eq_k_56) & std_logic_vector(ray_slot_eq_k_55) & std_logic_vector(ray_slot_eq_k_54) & std_logic_vector(ray_slot_eq_k_53) & std_logic_vector(ray_slot_eq_k_52) & std_logic_vector(ray_slot_eq_k_51) & std_logic_vector(ray_slot_eq_k_50) & std_logic_vector(ray_slot_eq_k_49) & std_logic_vector(ray_slot_eq_k_48) & std_logic_vector(ray_slot_eq_k_47) & std_logic_vector(ray_slot_eq_k_46) & std_logic_vector(ray_slot_eq_k_45) & std_logic_vector(ray_slot_eq_k_44) & std_logic_vector(ray_slot_eq_k_43) & std_logic_vector(ray_slot_eq_k_42) & std_logic_vector(ray_slot_eq_k_41) & std_logic_vector(ray_slot_eq_k_40) & std_logic_vector(ray_slot_eq_k_39) & std_logic_vector(ray_slot_eq_k_38) & std_logic_vector(ray_slot_eq_k_37) & std_logic_vector(ray_slot_eq_k_36) & std_logic_vector(ray_slot_eq_k_35) & std_logic_vector(ray_slot_eq_k_34) & std_logic_vector(ray_slot_eq_k_33) & std_logic_vector(ray_slot_eq_k_32) & std_logic_vector(ray_slot_eq_k_31) & std_logic_vector(ray_slot_eq_k_30) & std_logic_vector(ray_slot_eq_k_29) & std_logic_vector(ray_slot_eq_k_28) & std_logic_vector(ray_slot_eq_k_27) & std_logic_vector(ray_slot_eq_k_26) & std_logic_vector(ray_slot_eq_k_25) & std_logic_vector(ray_slot_eq_k_24) & std_logic_vector(ray_slot_eq_k_23) & std_logic_vector(ray_slot_eq_k_22) & std_logic_vector(ray_slot_eq_k_21) & std_logic_vector(ray_slot_eq_k_20) & std_logic_vector(ray_slot_eq_k_19) & std_logic_vector(ray_slot_eq_k_18) & std_logic_vector(ray_slot_eq_k_17) & std_logic_vector(ray_slot_eq_k_16) & std_logic_vector(ray_slot_eq_k_15) & std_logic_vector(ray_slot_eq_k_14) & std_logic_vector(ray_slot_eq_k_13) & std_logic_vector(ray_slot_eq_k_12) & std_logic_vector(ray_slot_eq_k_11) & std_logic_vector(ray_slot_eq_k_10) & std_logic_vector(ray_slot_eq_k_9) & std_logic_vector(ray_slot_eq_k_8) & std_logic_vector(ray_slot_eq_k_7) & std_logic_vector(ray_slot_eq_k_6) & std_logic_vector(ray_slot_eq_k_5) & std_logic_vector(ray_slot_eq_k_4) & std_logic_vector(ray_slot_eq_k_3) & std_logic_vector(ray_slot_eq_k_2) & std_logic_vector(ray_slot_eq_k_1) & std_logic_vector(ray_slot_eq_k_0_1)));
-  taken_mask <= cat_74 when alloc = "1" else k_0_2;
-  free_slot_eq_k_63 <= "1" when free_slot = k_63 else "0";
-  free_slot_eq_k_62 <= "1" when free_slot = k_62 else "0";
-  free_slot_eq_k_61 <= "1" when free_slot = k_61 else "0";
-  free_slot_eq_k_60 <= "1" when free_slot = k_60 else "0";
-  free_slot_eq_k_59 <= "1" when free_slot = k_59 else "0";
-  free_slot_eq_k_58 <= "1" when free_slot = k_58 else "0";
-  free_slot_eq_k_57 <= "1" when free_slot = k_57 else "0";
-  free_slot_eq_k_56 <= "1" when free_slot = k_56 else "0";
-  free_slot_eq_k_55 <= "1" when free_slot = k_55 else "0";
-  free_slot_eq_k_54 <= "1" when free_slot = k_54 else "0";
-  free_slot_eq_k_53 <= "1" when free_slot = k_53 else "0";
-  free_slot_eq_k_52 <= "1" when free_slot = k_52 else "0";
-  free_slot_eq_k_51 <= "1" when free_slot = k_51 else "0";
-  free_slot_eq_k_50 <= "1" when free_slot = k_50 else "0";
-  free_slot_eq_k_49 <= "1" when free_slot = k_49 else "0";
-  free_slot_eq_k_48 <= "1" when free_slot = k_48 else "0";
-  free_slot_eq_k_47 <= "1" when free_slot = k_47 else "0";
-  free_slot_eq_k_46 <= "1" when free_slot = k_46 else "0";
-  free_slot_eq_k_45 <= "1" when free_slot = k_45 else "0";
-  free_slot_eq_k_44 <= "1" when free_slot = k_44 else "0";
-  free_slot_eq_k_43 <= "1" when free_slot = k_43 else "0";
-  free_slot_eq_k_42 <= "1" when free_slot = k_42 else "0";
-  free_slot_eq_k_41 <= "1" when free_slot = k_41 else "0";
-  free_slot_eq_k_40 <= "1" when free_slot = k_40 else "0";
-  free_slot_eq_k_39 <= "1" when free_slot = k_39 else "0";
-  free_slot_eq_k_38 <= "1" when free_slot = k_38 else "0";
-  free_slot_eq_k_37 <= "1" when free_slot = k_37 else "0";
-  free_slot_eq_k_36 <= "1" when free_slot = k_36 else "0";
-  free_slot_eq_k_35 <= "1" when free_slot = k_35 else "0";
-  free_slot_eq_k_34 <= "1" when free_slot = k_34 else "0";
-  free_slot_eq_k_33 <= "1" when free_slot = k_33 else "0";
-  free_slot_eq_k_32 <= "1" when free_slot = k_32 else "0";
-  free_slot_eq_k_31 <= "1" when free_slot = k_31 else "0";
-  free_slot_eq_k_30 <= "1" when free_slot = k_30 else "0";
-  free_slot_eq_k_29 <= "1" when free_slot = k_29 else "0";
-  free_slot_eq_k_28 <= "1" when free_slot = k_28 else "0";
-  free_slot_eq_k_27 <= "1" when free_slot = k_27 else "0";
-  free_slot_eq_k_26 <= "1" when free_slot = k_26 else "0";
-  free_slot_eq_k_25 <= "1" when free_slot = k_25 else "0";
-  free_slot_eq_k_24 <= "1" when free_slot = k_24 else "0";
-  free_slot_eq_k_23 <= "1" when free_slot = k_23 else "0";
-  free_slot_eq_k_22 <= "1" when free_slot = k_22 else "0";
-  free_slot_eq_k_21 <= "1" when free_slot = k_21 else "0";
-  free_slot_eq_k_20 <= "1" when free_slot = k_20 else "0";
-  free_slot_eq_k_19 <= "1" when free_slot = k_19 else "0";
-  free_slot_eq_k_18 <= "1" when free_slot = k_18 else "0";
-  free_slot_eq_k_17 <= "1" when free_slot = k_17 else "0";
-  free_slot_eq_k_16 <= "1" when free_slot = k_16 else "0";
-  free_slot_eq_k_15 <= "1" when free_slot = k_15 else "0";
-  free_slot_eq_k_14 <= "1" when free_slot = k_14 else "0";
-  free_slot_eq_k_13 <= "1" when free_slot = k_13 else "0";
-  free_slot_eq_k_12 <= "1" when free_slot = k_12 else "0";
-  free_slot_eq_k_11 <= "1" when free_slot = k_11 else "0";
-  free_slot_eq_k_10 <= "1" when free_slot = k_10 else "0";
-  free_slot_eq_k_9 <= "1" when free_slot = k_9 else "0";
-  free_slot_eq_k_8 <= "1" when free_slot = k_8 else "0";
-  free_slot_eq_k_7 <= "1" when free_slot = k_7 else "0";
-  free_slot_eq_k_6 <= "1" when free_slot = k_6 else "0";
-  free_slot_eq_k_5 <= "1" when free_slot = k_5 else "0";
-  free_slot_eq_k_4 <= "1" when free_slot = k_4 else "0";
-  free_slot_eq_k_3 <= "1" when free_slot = k_3 else "0";
-  free_slot_eq_k_2 <= "1" when free_slot = k_2 else "0";
-  free_slot_eq_k_1 <= "1" when free_slot = k_1 else "0";
-  free_slot_eq_k_0_1 <= "1" when free_slot = k_0_1 else "0";
-  cat_75 <= unsigned(std_logic_vector'(std_logic_vector(free_slot_eq_k_63) & std_logic_vector(free_slot_eq_k_62) & std_logic_vector(free_slot_eq_k_61) & std_logic_vector(free_slot_eq_k_60) & std_logic_vector(free_slot_eq_k_59) & std_logic_vector(free_slot_eq_k_58) & std_logic_vector(free_slot_eq_k_57) & std_logic_vector(free_slot_eq_k_56) & std_logic_vector(free_slot_eq_k_55) & std_logic_vector(free_slot_eq_k_54) & std_logic_vector(free_slot_eq_k_53) & std_logic_vector(free_slot_eq_k_52) & std_logic_vector(free_slot_eq_k_51) & std_logic_vector(free_slot_eq_k_50) & std_logic_vector(free_slot_eq_k_49) & std_logic_vector(free_slot_eq_k_48) & std_logic_vector(free_slot_eq_k_47) & std_logic_vector(free_slot_eq_k_46) & std_logic_vector(free_slot_eq_k_45) & std_logic_vector(free_slot_eq_k_44) & std_logic_vector(free_slot_eq_k_43) & std_logic_vector(free_slot_eq_k_42) & std_logic_vector(free_slot_eq_k_41) & std_logic_vector(free_slot_eq_k_40) & std_logic_vector(free_slot_eq_k_39) & std_logic_vector(free_slot_eq_k_38) & std_logic_vector(free_slot_eq_k_37) & std_logic_vector(free_slot_eq_k_36) & std_logic_vector(free_slot_eq_k_35) & std_logic_vector(free_slot_eq_k_34) & std_logic_vector(free_slot_eq_k_33) & std_logic_vector(free_slot_eq_k_32) & std_logic_vector(free_slot_eq_k_31) & std_logic_vector(free_slot_eq_k_30) & std_logic_vector(free_slot_eq_k_29) & std_logic_vector(free_slot_eq_k_28) & std_logic_vector(free_slot_eq_k_27) & std_logic_vector(free_slot_eq_k_26) & std_logic_vector(free_slot_eq_k_25) & std_logic_vector(free_slot_eq_k_24) & std_logic_vector(free_slot_eq_k_23) & std_logic_vector(free_slot_eq_k_22) & std_logic_vector(free_slot_eq_k_21) & std_logic_vector(free_slot_eq_k_20) & std_logic_vector(free_slot_eq_k_19) & std_logic_vector(free_slot_eq_k_18) & std_logic_vector(free_slot_eq_k_17) & std_logic_vector(free_slot_eq_k_16) & std_logic_vector(free_slot_eq_k_15) & std_logic_vector(free_slot_eq_k_14) & std_logic_vector(free_slot_eq_k_13) & std_logic_vector(free_slot_eq_k_12) & std_logic_vector(free_slot_eq_k_11) & std_logic_vector(free_slot_eq_k_10) & std_logic_vector(free_slot_eq_k_9) & std_logic_vector(free_slot_eq_k_8) & std_logic_vector(free_slot_eq_k_7) & std_logic_vector(free_slot_eq_k_6) & std_logic_vector(free_slot_eq_k_5) & std_logic_vector(free_slot_eq_k_4) & std_logic_vector(free_slot_eq_k_3) & std_logic_vector(free_slot_eq_k_2) & std_logic_vector(free_slot_eq_k_1) & std_logic_vector(free_slot_eq_k_0_1)));
-  freed_mask <= cat_75 when free_valid = "1" else k_0_2;
-  not_taken_mask <= not taken_mask;
-  and_76 <= free_bits and not_taken_mask;
-  and_76_or_freed_mask <= and_76 or freed_mask;
+  -- stage slots: the free list: the next free slot for the top, the slots holding a ray
+  alloc_fresh <= alloc and fresh_left;
+  fresh_slot_plus_k_1 <= fresh_slot + k_1;
+  mux_alloc_fresh <= fresh_slot_plus_k_1 when alloc_fresh = "1" else fresh_slot;
+  fresh_is_last <= "1" when fresh_slot = k_63 else "0";
+  and_1 <= alloc_fresh and fresh_is_last;
+  not_and_1 <= not and_1;
+  fresh_left_and_not_and_1 <= fresh_left and not_and_1;
+  not_fresh_left <= not fresh_left;
+  free_q_pop <= alloc and not_fresh_left;
+  free_q_wr_plus_k_1 <= free_q_wr + k_1;
+  mux_free_q_push <= free_q_wr_plus_k_1 when free_q_push = "1" else free_q_wr;
+  free_q_rd_next <= free_q_rd1 when free_q_pop = "1" else free_q_rd;
+  free_q_rd1_plus_k_1 <= free_q_rd1 + k_1;
+  mux_free_q_pop <= free_q_rd1_plus_k_1 when free_q_pop = "1" else free_q_rd1;
+  not_free_q_push_c1 <= not free_q_push_c1;
+  rs_not_free_q_push_c1 <= resize(not_free_q_push_c1, 7);
+  free_q_count_if_pop <= free_q_count - rs_not_free_q_push_c1;
+  rs_free_q_push_c1 <= resize(free_q_push_c1, 7);
+  free_q_count_if_kept <= free_q_count + rs_free_q_push_c1;
+  free_q_count_next <= free_q_count_if_pop when free_q_pop = "1" else free_q_count_if_kept;
+  free_q_count_eq_k_0 <= "1" when free_q_count = k_0 else "0";
+  free_q_one_left <= "1" when free_q_count = k_1_1 else "0";
+  and_4 <= free_q_one_left and free_q_pop;
+  free_q_drained <= free_q_count_eq_k_0 or and_4;
+  free_q_bypass_c <= free_q_push_c1 and free_q_drained;
+  k_1_1_lt_free_q_count <= "1" when k_1_1 < free_q_count else "0";
+  or_7 <= free_q_push_c1 or k_1_1_lt_free_q_count;
+  not_free_q_pop <= not free_q_pop;
+  and_8 <= free_q_one_left and not_free_q_pop;
+  free_q_nonempty_c <= or_7 or and_8;
+  mux_free_q_popped <= free_q_q_next when free_q_popped = "1" else free_q_q_stay;
+  free_q_head <= free_q_din_r when free_q_bypass = "1" else mux_free_q_popped;
+  free_any_c <= fresh_left or free_q_nonempty;
+  free_idx_c <= fresh_slot when fresh_left = "1" else free_q_head;
   rs_alloc <= resize(alloc, 7);
   occupied_r_plus_rs_alloc <= occupied_r + rs_alloc;
   rs_free_valid <= resize(free_valid, 7);
-  minus_77 <= occupied_r_plus_rs_alloc - rs_free_valid;
+  minus_10 <= occupied_r_plus_rs_alloc - rs_free_valid;
 
   slots_regs : process (clk)
   begin
     if rising_edge(clk) then
       if rst = '1' then
-        free_bits <= unsigned'("1111111111111111111111111111111111111111111111111111111111111111");
+        fresh_slot <= unsigned'("000000");
       else
-        free_bits <= and_76_or_freed_mask;
+        fresh_slot <= mux_alloc_fresh;
+      end if;
+      if rst = '1' then
+        fresh_left <= unsigned'("1");
+      else
+        fresh_left <= fresh_left_and_not_and_1;
+      end if;
+      if rst = '1' then
+        free_q_wr <= unsigned'("000000");
+      else
+        free_q_wr <= mux_free_q_push;
+      end if;
+      if rst = '1' then
+        free_q_rd <= unsigned'("000000");
+      else
+        free_q_rd <= free_q_rd_next;
+      end if;
+      if rst = '1' then
+        free_q_count <= unsigned'("0000000");
+      else
+        free_q_count <= free_q_count_next;
+      end if;
+      if rst = '1' then
+        free_q_rd1 <= unsigned'("000001");
+      else
+        free_q_rd1 <= mux_free_q_pop;
+      end if;
+      if rst = '1' then
+        free_q_bypass <= unsigned'("0");
+      else
+        free_q_bypass <= free_q_bypass_c;
+      end if;
+      if rst = '1' then
+        free_q_popped <= unsigned'("0");
+      else
+        free_q_popped <= free_q_pop;
+      end if;
+      if rst = '1' then
+        free_q_nonempty <= unsigned'("0");
+      else
+        free_q_nonempty <= free_q_nonempty_c;
+      end if;
+      free_q_din <= free_slot;
+      free_q_q_stay <= free_q_mem(to_integer(free_q_rd));
+      free_q_q_next <= free_q_mem(to_integer(free_q_rd1));
+      if free_q_push = "1" then
+        free_q_din_r <= free_q_din;
       end if;
       if rst = '1' then
         free_any_r <= unsigned'("1");
@@ -1923,61 +1582,89 @@ begin
       if rst = '1' then
         occupied_r <= unsigned'("0000000");
       else
-        occupied_r <= minus_77;
+        occupied_r <= minus_10;
       end if;
     end if;
   end process slots_regs;
+
+  -- register copies free_q_push_copies: free_q_push and 1 copies, to split its fan-out
+
+  free_q_push_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        free_q_push <= unsigned'("0");
+      else
+        free_q_push <= free_valid;
+      end if;
+      if rst = '1' then
+        free_q_push_c1 <= unsigned'("0");
+      else
+        free_q_push_c1 <= free_valid;
+      end if;
+    end if;
+  end process free_q_push_copies_regs;
 
   -- stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
   ring_g_valid <= g_valid;
   unpark_pop <= take_unpark;
   new_pop <= take_new;
-  cat_78 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot) & std_logic_vector(merge_sp)));
+  cat_11 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot) & std_logic_vector(merge_sp)));
   unpark_q_wr_plus_k_1 <= unpark_q_wr + k_1;
   mux_unpark_q_push <= unpark_q_wr_plus_k_1 when unpark_q_push = "1" else unpark_q_wr;
   unpark_q_rd_next <= unpark_q_rd1 when unpark_pop = "1" else unpark_q_rd;
   unpark_q_rd1_plus_k_1 <= unpark_q_rd1 + k_1;
   mux_unpark_pop <= unpark_q_rd1_plus_k_1 when unpark_pop = "1" else unpark_q_rd1;
-  rs_unpark_pop <= resize(unpark_pop, 7);
-  unpark_q_after_pop <= unpark_q_count - rs_unpark_pop;
-  rs_unpark_q_push <= resize(unpark_q_push, 7);
-  unpark_q_count_next <= unpark_q_after_pop + rs_unpark_q_push;
-  unpark_q_count_eq_k_0_3 <= "1" when unpark_q_count = k_0_3 else "0";
+  not_unpark_q_push_c1 <= not unpark_q_push_c1;
+  rs_not_unpark_q_push_c1 <= resize(not_unpark_q_push_c1, 7);
+  unpark_q_count_if_pop <= unpark_q_count - rs_not_unpark_q_push_c1;
+  rs_unpark_q_push_c1 <= resize(unpark_q_push_c1, 7);
+  unpark_q_count_if_kept <= unpark_q_count + rs_unpark_q_push_c1;
+  unpark_q_count_next <= unpark_q_count_if_pop when unpark_pop = "1" else unpark_q_count_if_kept;
+  unpark_q_count_eq_k_0 <= "1" when unpark_q_count = k_0 else "0";
   unpark_q_one_left <= "1" when unpark_q_count = k_1_1 else "0";
-  and_81 <= unpark_q_one_left and unpark_pop;
-  unpark_q_drained <= unpark_q_count_eq_k_0_3 or and_81;
-  unpark_q_bypass_c <= unpark_q_push and unpark_q_drained;
+  and_14 <= unpark_q_one_left and unpark_pop;
+  unpark_q_drained <= unpark_q_count_eq_k_0 or and_14;
+  unpark_q_bypass_c <= unpark_q_push_c1 and unpark_q_drained;
   k_1_1_lt_unpark_q_count <= "1" when k_1_1 < unpark_q_count else "0";
-  or_84 <= unpark_q_push or k_1_1_lt_unpark_q_count;
+  or_17 <= unpark_q_push_c1 or k_1_1_lt_unpark_q_count;
   not_unpark_pop <= not unpark_pop;
-  and_85 <= unpark_q_one_left and not_unpark_pop;
-  unpark_q_nonempty_c <= or_84 or and_85;
+  and_18 <= unpark_q_one_left and not_unpark_pop;
+  unpark_q_nonempty_c <= or_17 or and_18;
   mux_unpark_q_popped <= unpark_q_q_next when unpark_q_popped = "1" else unpark_q_q_stay;
   unpark_q_head <= unpark_q_din_r when unpark_q_bypass = "1" else mux_unpark_q_popped;
   u_new_tmax <= unsigned(new_tmax);
-  cat_86 <= unsigned(std_logic_vector'(std_logic_vector(new_slot) & std_logic_vector(u_new_tmax) & std_logic_vector(new_miss)));
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(new_slot) & std_logic_vector(u_new_tmax) & std_logic_vector(new_miss)));
   new_q_wr_plus_k_1 <= new_q_wr + k_1;
   mux_new_q_push <= new_q_wr_plus_k_1 when new_q_push = "1" else new_q_wr;
   new_q_rd_next <= new_q_rd1 when new_pop = "1" else new_q_rd;
   new_q_rd1_plus_k_1 <= new_q_rd1 + k_1;
   mux_new_pop <= new_q_rd1_plus_k_1 when new_pop = "1" else new_q_rd1;
-  rs_new_pop <= resize(new_pop, 7);
-  new_q_after_pop <= new_q_count - rs_new_pop;
-  rs_new_q_push <= resize(new_q_push, 7);
-  new_q_count_next <= new_q_after_pop + rs_new_q_push;
-  new_q_count_eq_k_0_3 <= "1" when new_q_count = k_0_3 else "0";
+  not_new_q_push_c1 <= not new_q_push_c1;
+  rs_not_new_q_push_c1 <= resize(not_new_q_push_c1, 7);
+  new_q_count_if_pop <= new_q_count - rs_not_new_q_push_c1;
+  rs_new_q_push_c1 <= resize(new_q_push_c1, 7);
+  new_q_count_if_kept <= new_q_count + rs_new_q_push_c1;
+  new_q_count_next <= new_q_count_if_pop when new_pop = "1" else new_q_count_if_kept;
+  new_q_count_eq_k_0 <= "1" when new_q_count = k_0 else "0";
   new_q_one_left <= "1" when new_q_count = k_1_1 else "0";
-  and_89 <= new_q_one_left and new_pop;
-  new_q_drained <= new_q_count_eq_k_0_3 or and_89;
-  new_q_bypass_c <= new_q_push and new_q_drained;
+  and_22 <= new_q_one_left and new_pop;
+  new_q_drained <= new_q_count_eq_k_0 or and_22;
+  new_q_bypass_c <= new_q_push_c1 and new_q_drained;
   k_1_1_lt_new_q_count <= "1" when k_1_1 < new_q_count else "0";
-  or_92 <= new_q_push or k_1_1_lt_new_q_count;
+  or_25 <= new_q_push_c1 or k_1_1_lt_new_q_count;
   not_new_pop <= not new_pop;
-  and_93 <= new_q_one_left and not_new_pop;
-  new_q_nonempty_c <= or_92 or and_93;
+  and_26 <= new_q_one_left and not_new_pop;
+  new_q_nonempty_c <= or_25 or and_26;
   bits_new_q_din <= unsigned(new_q_din(15 downto 0));
   bits_new_q_din_1 <= unsigned(new_q_din(31 downto 16));
   bits_new_q_din_2 <= unsigned(new_q_din(38 downto 32));
+  mux_new_pop_1 <= new_q_rd1_p1 when new_pop = "1" else new_q_rd_p1;
+  new_q_rd1_p1_plus_k_1 <= new_q_rd1_p1 + k_1;
+  mux_new_pop_2 <= new_q_rd1_p1_plus_k_1 when new_pop = "1" else new_q_rd1_p1;
+  mux_new_pop_3 <= new_q_rd1_p2 when new_pop = "1" else new_q_rd_p2;
+  new_q_rd1_p2_plus_k_1 <= new_q_rd1_p2 + k_1;
+  mux_new_pop_4 <= new_q_rd1_p2_plus_k_1 when new_pop = "1" else new_q_rd1_p2;
   new_q_q_stay <= unsigned(std_logic_vector'(std_logic_vector(new_q_q_stay_g2) & std_logic_vector(new_q_q_stay_g1) & std_logic_vector(new_q_q_stay_g0)));
   new_q_q_next <= unsigned(std_logic_vector'(std_logic_vector(new_q_q_next_g2) & std_logic_vector(new_q_q_next_g1) & std_logic_vector(new_q_q_next_g0)));
   mux_new_q_popped <= new_q_q_next when new_q_popped = "1" else new_q_q_stay;
@@ -1986,34 +1673,29 @@ begin
   take_unpark <= not_ring_g_valid and unpark_q_nonempty;
   not_ring_g_valid_1 <= not ring_g_valid;
   not_unpark_q_nonempty <= not unpark_q_nonempty;
-  and_97 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
-  take_new <= and_97 and new_q_nonempty;
+  and_30 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
+  take_new <= and_30 and new_q_nonempty;
   take_unpark_or_take_new <= take_unpark or take_new;
   bits_unpark_q_head <= unsigned(unpark_q_head(11 downto 6));
   bits_new_q_head <= unsigned(new_q_head(38 downto 33));
   mux_take_unpark <= bits_unpark_q_head when take_unpark = "1" else bits_new_q_head;
   bits_unpark_q_head_1 <= unsigned(unpark_q_head(5 downto 0));
-  eq_99 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
-  minus_100 <= bits_unpark_q_head_1 - k_1;
-  rs_minus_100 <= minus_100(4 downto 0);
-  q_stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(mux_take_unpark) & std_logic_vector(rs_minus_100)));
+  eq_32 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
+  minus_33 <= bits_unpark_q_head_1 - k_1;
+  rs_minus_33 <= minus_33(4 downto 0);
+  q_stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(mux_take_unpark) & std_logic_vector(rs_minus_33)));
   bits_unpark_q_head_2 <= unsigned(unpark_q_head(5 downto 0));
-  eq_102 <= "1" when bits_unpark_q_head_2 = k_0_1 else "0";
+  eq_35 <= "1" when bits_unpark_q_head_2 = k_0_1 else "0";
   bits_new_q_head_1 <= unsigned(new_q_head(0 downto 0));
-  and_103 <= take_new and bits_new_q_head_1;
-  take_unpark_and_eq_102 <= take_unpark and eq_102;
-  q_done_c <= and_103 or take_unpark_and_eq_102;
+  and_36 <= take_new and bits_new_q_head_1;
+  take_unpark_and_eq_35 <= take_unpark and eq_35;
+  q_done_c <= and_36 or take_unpark_and_eq_35;
   bits_new_q_head_2 <= unsigned(new_q_head(32 downto 1));
   s_bits_new_q_head_2 <= signed(bits_new_q_head_2);
 
   queues_regs : process (clk)
   begin
     if rising_edge(clk) then
-      if rst = '1' then
-        unpark_q_push <= unsigned'("0");
-      else
-        unpark_q_push <= merge_valid;
-      end if;
       if rst = '1' then
         unpark_q_wr <= unsigned'("000000");
       else
@@ -2049,16 +1731,11 @@ begin
       else
         unpark_q_nonempty <= unpark_q_nonempty_c;
       end if;
-      unpark_q_din <= cat_78;
+      unpark_q_din <= cat_11;
       unpark_q_q_stay <= unpark_q_mem(to_integer(unpark_q_rd));
       unpark_q_q_next <= unpark_q_mem(to_integer(unpark_q_rd1));
       if unpark_q_push = "1" then
         unpark_q_din_r <= unpark_q_din;
-      end if;
-      if rst = '1' then
-        new_q_push <= unsigned'("0");
-      else
-        new_q_push <= new_valid;
       end if;
       if rst = '1' then
         new_q_wr <= unsigned'("000000");
@@ -2066,9 +1743,19 @@ begin
         new_q_wr <= mux_new_q_push;
       end if;
       if rst = '1' then
+        new_q_rd <= unsigned'("000000");
+      else
+        new_q_rd <= new_q_rd_next;
+      end if;
+      if rst = '1' then
         new_q_count <= unsigned'("0000000");
       else
         new_q_count <= new_q_count_next;
+      end if;
+      if rst = '1' then
+        new_q_rd1 <= unsigned'("000001");
+      else
+        new_q_rd1 <= mux_new_pop;
       end if;
       if rst = '1' then
         new_q_bypass <= unsigned'("0");
@@ -2085,12 +1772,32 @@ begin
       else
         new_q_nonempty <= new_q_nonempty_c;
       end if;
-      new_q_din <= cat_86;
-      new_q_q_stay_g2 <= new_q_mem_g2(to_integer(new_q_rd_c2));
-      new_q_q_stay_g1 <= new_q_mem_g1(to_integer(new_q_rd_c1));
+      new_q_din <= cat_19;
+      if rst = '1' then
+        new_q_rd_p1 <= unsigned'("000000");
+      else
+        new_q_rd_p1 <= mux_new_pop_1;
+      end if;
+      if rst = '1' then
+        new_q_rd1_p1 <= unsigned'("000001");
+      else
+        new_q_rd1_p1 <= mux_new_pop_2;
+      end if;
+      if rst = '1' then
+        new_q_rd_p2 <= unsigned'("000000");
+      else
+        new_q_rd_p2 <= mux_new_pop_3;
+      end if;
+      if rst = '1' then
+        new_q_rd1_p2 <= unsigned'("000001");
+      else
+        new_q_rd1_p2 <= mux_new_pop_4;
+      end if;
+      new_q_q_stay_g2 <= new_q_mem_g2(to_integer(new_q_rd_p2));
+      new_q_q_stay_g1 <= new_q_mem_g1(to_integer(new_q_rd_p1));
       new_q_q_stay_g0 <= new_q_mem_g0(to_integer(new_q_rd));
-      new_q_q_next_g2 <= new_q_mem_g2(to_integer(new_q_rd1_c2));
-      new_q_q_next_g1 <= new_q_mem_g1(to_integer(new_q_rd1_c1));
+      new_q_q_next_g2 <= new_q_mem_g2(to_integer(new_q_rd1_p2));
+      new_q_q_next_g1 <= new_q_mem_g1(to_integer(new_q_rd1_p1));
       new_q_q_next_g0 <= new_q_mem_g0(to_integer(new_q_rd1));
       if new_q_push = "1" then
         new_q_din_r <= new_q_din;
@@ -2100,61 +1807,49 @@ begin
       else
         q_valid <= take_unpark_or_take_new;
       end if;
-      q_new <= take_new;
-      q_slot <= mux_take_unpark;
       q_sp <= bits_unpark_q_head_1;
-      q_sp_zero <= eq_99;
-      q_sp_m1 <= minus_100;
+      q_sp_zero <= eq_32;
+      q_sp_m1 <= minus_33;
       q_done <= q_done_c;
       q_tmax <= s_bits_new_q_head_2;
     end if;
   end process queues_regs;
 
-  -- register copies new_q_rd_copies: new_q_rd and 2 copies, to split its fan-out
+  -- register copies unpark_q_push_copies: unpark_q_push and 1 copies, to split its fan-out
 
-  new_q_rd_copies_regs : process (clk)
+  unpark_q_push_copies_regs : process (clk)
   begin
     if rising_edge(clk) then
       if rst = '1' then
-        new_q_rd <= unsigned'("000000");
+        unpark_q_push <= unsigned'("0");
       else
-        new_q_rd <= new_q_rd_next;
+        unpark_q_push <= merge_valid;
       end if;
       if rst = '1' then
-        new_q_rd_c1 <= unsigned'("000000");
+        unpark_q_push_c1 <= unsigned'("0");
       else
-        new_q_rd_c1 <= new_q_rd_next;
-      end if;
-      if rst = '1' then
-        new_q_rd_c2 <= unsigned'("000000");
-      else
-        new_q_rd_c2 <= new_q_rd_next;
+        unpark_q_push_c1 <= merge_valid;
       end if;
     end if;
-  end process new_q_rd_copies_regs;
+  end process unpark_q_push_copies_regs;
 
-  -- register copies new_q_rd1_copies: new_q_rd1 and 2 copies, to split its fan-out
+  -- register copies new_q_push_copies: new_q_push and 1 copies, to split its fan-out
 
-  new_q_rd1_copies_regs : process (clk)
+  new_q_push_copies_regs : process (clk)
   begin
     if rising_edge(clk) then
       if rst = '1' then
-        new_q_rd1 <= unsigned'("000001");
+        new_q_push <= unsigned'("0");
       else
-        new_q_rd1 <= mux_new_pop;
+        new_q_push <= new_valid;
       end if;
       if rst = '1' then
-        new_q_rd1_c1 <= unsigned'("000001");
+        new_q_push_c1 <= unsigned'("0");
       else
-        new_q_rd1_c1 <= mux_new_pop;
-      end if;
-      if rst = '1' then
-        new_q_rd1_c2 <= unsigned'("000001");
-      else
-        new_q_rd1_c2 <= mux_new_pop;
+        new_q_push_c1 <= new_valid;
       end if;
     end if;
-  end process new_q_rd1_copies_regs;
+  end process new_q_push_copies_regs;
 
   -- stage ring_r: R: the token back from G, loaded in G
 
@@ -2191,8 +1886,8 @@ begin
   r_valid_and_r_done <= r_valid and r_done;
   not_r_valid <= not r_valid;
   not_r_valid_and_q_valid <= not_r_valid and q_valid;
-  and_105 <= not_r_valid_and_q_valid and q_done;
-  a_done <= r_valid_and_r_done or and_105;
+  and_38 <= not_r_valid_and_q_valid and q_done;
+  a_done <= r_valid_and_r_done or and_38;
   not_a_sp_zero <= not a_sp_zero;
   a_from_stack <= a_pop and not_a_sp_zero;
   stack_we <= stack_we_r;
@@ -2209,8 +1904,8 @@ begin
   -- stage ring_b: B, B2: the token waits two clocks for the stack word
   not_a_done <= not a_done;
   a_live <= a_valid and not_a_done;
-  mux_r_valid <= r_node when r_valid = "1" else k_0_4;
-  mux_r_valid_1 <= r_tmin when r_valid = "1" else k_0_5;
+  mux_r_valid <= r_node when r_valid = "1" else k_0_2;
+  mux_r_valid_1 <= r_tmin when r_valid = "1" else k_0_3;
   mux_r_valid_2 <= r_tmax when r_valid = "1" else q_tmax;
   mux_a_from_stack <= a_sp_m1 when a_from_stack = "1" else a_sp;
   b_from_stack <= b_from_stack_sr(2);
@@ -2235,7 +1930,6 @@ begin
       else
         b2_valid <= b_valid;
       end if;
-      b2_slot <= b_slot;
       b2_node <= b_node;
       b2_tmin <= b_tmin;
       b2_tmax <= b_tmax;
@@ -2249,20 +1943,22 @@ begin
   done_q_rd_next <= done_q_rd1 when done_pop_r = "1" else done_q_rd;
   done_q_rd1_plus_k_1 <= done_q_rd1 + k_1;
   mux_done_pop_r <= done_q_rd1_plus_k_1 when done_pop_r = "1" else done_q_rd1;
-  rs_done_pop_r <= resize(done_pop_r, 7);
-  done_q_after_pop <= done_q_count - rs_done_pop_r;
-  rs_done_q_push <= resize(done_q_push, 7);
-  done_q_count_next <= done_q_after_pop + rs_done_q_push;
-  done_q_count_eq_k_0_3 <= "1" when done_q_count = k_0_3 else "0";
+  not_done_q_push_c1 <= not done_q_push_c1;
+  rs_not_done_q_push_c1 <= resize(not_done_q_push_c1, 7);
+  done_q_count_if_pop <= done_q_count - rs_not_done_q_push_c1;
+  rs_done_q_push_c1 <= resize(done_q_push_c1, 7);
+  done_q_count_if_kept <= done_q_count + rs_done_q_push_c1;
+  done_q_count_next <= done_q_count_if_pop when done_pop_r = "1" else done_q_count_if_kept;
+  done_q_count_eq_k_0 <= "1" when done_q_count = k_0 else "0";
   done_q_one_left <= "1" when done_q_count = k_1_1 else "0";
-  and_109 <= done_q_one_left and done_pop_r;
-  done_q_drained <= done_q_count_eq_k_0_3 or and_109;
-  done_q_bypass_c <= done_q_push and done_q_drained;
+  and_42 <= done_q_one_left and done_pop_r;
+  done_q_drained <= done_q_count_eq_k_0 or and_42;
+  done_q_bypass_c <= done_q_push_c1 and done_q_drained;
   k_1_1_lt_done_q_count <= "1" when k_1_1 < done_q_count else "0";
-  or_112 <= done_q_push or k_1_1_lt_done_q_count;
+  or_45 <= done_q_push_c1 or k_1_1_lt_done_q_count;
   not_done_pop_r <= not done_pop_r;
-  and_113 <= done_q_one_left and not_done_pop_r;
-  done_q_nonempty_c <= or_112 or and_113;
+  and_46 <= done_q_one_left and not_done_pop_r;
+  done_q_nonempty_c <= or_45 or and_46;
   mux_done_q_popped <= done_q_q_next when done_q_popped = "1" else done_q_q_stay;
   done_q_head <= done_q_din_r when done_q_bypass = "1" else mux_done_q_popped;
 
@@ -2273,11 +1969,6 @@ begin
         done_pop_r <= unsigned'("0");
       else
         done_pop_r <= done_pop;
-      end if;
-      if rst = '1' then
-        done_q_push <= unsigned'("0");
-      else
-        done_q_push <= a_done;
       end if;
       if rst = '1' then
         done_q_wr <= unsigned'("000000");
@@ -2323,6 +2014,24 @@ begin
     end if;
   end process done_regs;
 
+  -- register copies done_q_push_copies: done_q_push and 1 copies, to split its fan-out
+
+  done_q_push_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        done_q_push <= unsigned'("0");
+      else
+        done_q_push <= a_done;
+      end if;
+      if rst = '1' then
+        done_q_push_c1 <= unsigned'("0");
+      else
+        done_q_push_c1 <= a_done;
+      end if;
+    end if;
+  end process done_q_push_copies_regs;
+
   -- stage ring_c: C: a popped entry from the stack word; the node ROM addressed; the cull test
   bits_u_stack_data <= unsigned(u_stack_data(31 downto 0));
   s_bits_u_stack_data <= signed(bits_u_stack_data);
@@ -2337,143 +2046,169 @@ begin
   s_limit_q <= signed(limit_q);
   shr_c_tmin <= shift_right(c_tmin, 6);
   tmin_less <= c_tmin - shr_c_tmin;
-  bits_has_best <= unsigned(has_best(0 downto 0));
-  bits_has_best_1 <= unsigned(has_best(1 downto 1));
-  bits_has_best_2 <= unsigned(has_best(2 downto 2));
-  bits_has_best_3 <= unsigned(has_best(3 downto 3));
-  bits_has_best_4 <= unsigned(has_best(4 downto 4));
-  bits_has_best_5 <= unsigned(has_best(5 downto 5));
-  bits_has_best_6 <= unsigned(has_best(6 downto 6));
-  bits_has_best_7 <= unsigned(has_best(7 downto 7));
-  bits_has_best_8 <= unsigned(has_best(8 downto 8));
-  bits_has_best_9 <= unsigned(has_best(9 downto 9));
-  bits_has_best_10 <= unsigned(has_best(10 downto 10));
-  bits_has_best_11 <= unsigned(has_best(11 downto 11));
-  bits_has_best_12 <= unsigned(has_best(12 downto 12));
-  bits_has_best_13 <= unsigned(has_best(13 downto 13));
-  bits_has_best_14 <= unsigned(has_best(14 downto 14));
-  bits_has_best_15 <= unsigned(has_best(15 downto 15));
-  bits_has_best_16 <= unsigned(has_best(16 downto 16));
-  bits_has_best_17 <= unsigned(has_best(17 downto 17));
-  bits_has_best_18 <= unsigned(has_best(18 downto 18));
-  bits_has_best_19 <= unsigned(has_best(19 downto 19));
-  bits_has_best_20 <= unsigned(has_best(20 downto 20));
-  bits_has_best_21 <= unsigned(has_best(21 downto 21));
-  bits_has_best_22 <= unsigned(has_best(22 downto 22));
-  bits_has_best_23 <= unsigned(has_best(23 downto 23));
-  bits_has_best_24 <= unsigned(has_best(24 downto 24));
-  bits_has_best_25 <= unsigned(has_best(25 downto 25));
-  bits_has_best_26 <= unsigned(has_best(26 downto 26));
-  bits_has_best_27 <= unsigned(has_best(27 downto 27));
-  bits_has_best_28 <= unsigned(has_best(28 downto 28));
-  bits_has_best_29 <= unsigned(has_best(29 downto 29));
-  bits_has_best_30 <= unsigned(has_best(30 downto 30));
-  bits_has_best_31 <= unsigned(has_best(31 downto 31));
-  bits_has_best_32 <= unsigned(has_best(32 downto 32));
-  bits_has_best_33 <= unsigned(has_best(33 downto 33));
-  bits_has_best_34 <= unsigned(has_best(34 downto 34));
-  bits_has_best_35 <= unsigned(has_best(35 downto 35));
-  bits_has_best_36 <= unsigned(has_best(36 downto 36));
-  bits_has_best_37 <= unsigned(has_best(37 downto 37));
-  bits_has_best_38 <= unsigned(has_best(38 downto 38));
-  bits_has_best_39 <= unsigned(has_best(39 downto 39));
-  bits_has_best_40 <= unsigned(has_best(40 downto 40));
-  bits_has_best_41 <= unsigned(has_best(41 downto 41));
-  bits_has_best_42 <= unsigned(has_best(42 downto 42));
-  bits_has_best_43 <= unsigned(has_best(43 downto 43));
-  bits_has_best_44 <= unsigned(has_best(44 downto 44));
-  bits_has_best_45 <= unsigned(has_best(45 downto 45));
-  bits_has_best_46 <= unsigned(has_best(46 downto 46));
-  bits_has_best_47 <= unsigned(has_best(47 downto 47));
-  bits_has_best_48 <= unsigned(has_best(48 downto 48));
-  bits_has_best_49 <= unsigned(has_best(49 downto 49));
-  bits_has_best_50 <= unsigned(has_best(50 downto 50));
-  bits_has_best_51 <= unsigned(has_best(51 downto 51));
-  bits_has_best_52 <= unsigned(has_best(52 downto 52));
-  bits_has_best_53 <= unsigned(has_best(53 downto 53));
-  bits_has_best_54 <= unsigned(has_best(54 downto 54));
-  bits_has_best_55 <= unsigned(has_best(55 downto 55));
-  bits_has_best_56 <= unsigned(has_best(56 downto 56));
-  bits_has_best_57 <= unsigned(has_best(57 downto 57));
-  bits_has_best_58 <= unsigned(has_best(58 downto 58));
-  bits_has_best_59 <= unsigned(has_best(59 downto 59));
-  bits_has_best_60 <= unsigned(has_best(60 downto 60));
-  bits_has_best_61 <= unsigned(has_best(61 downto 61));
-  bits_has_best_62 <= unsigned(has_best(62 downto 62));
-  bits_has_best_63 <= unsigned(has_best(63 downto 63));
-  with c_slot_c2 select
-    slot_has_best <=
-      bits_has_best when "000000",
-      bits_has_best_1 when "000001",
-      bits_has_best_2 when "000010",
-      bits_has_best_3 when "000011",
-      bits_has_best_4 when "000100",
-      bits_has_best_5 when "000101",
-      bits_has_best_6 when "000110",
-      bits_has_best_7 when "000111",
-      bits_has_best_8 when "001000",
-      bits_has_best_9 when "001001",
-      bits_has_best_10 when "001010",
-      bits_has_best_11 when "001011",
-      bits_has_best_12 when "001100",
-      bits_has_best_13 when "001101",
-      bits_has_best_14 when "001110",
-      bits_has_best_15 when "001111",
-      bits_has_best_16 when "010000",
-      bits_has_best_17 when "010001",
-      bits_has_best_18 when "010010",
-      bits_has_best_19 when "010011",
-      bits_has_best_20 when "010100",
-      bits_has_best_21 when "010101",
-      bits_has_best_22 when "010110",
-      bits_has_best_23 when "010111",
-      bits_has_best_24 when "011000",
-      bits_has_best_25 when "011001",
-      bits_has_best_26 when "011010",
-      bits_has_best_27 when "011011",
-      bits_has_best_28 when "011100",
-      bits_has_best_29 when "011101",
-      bits_has_best_30 when "011110",
-      bits_has_best_31 when "011111",
-      bits_has_best_32 when "100000",
-      bits_has_best_33 when "100001",
-      bits_has_best_34 when "100010",
-      bits_has_best_35 when "100011",
-      bits_has_best_36 when "100100",
-      bits_has_best_37 when "100101",
-      bits_has_best_38 when "100110",
-      bits_has_best_39 when "100111",
-      bits_has_best_40 when "101000",
-      bits_has_best_41 when "101001",
-      bits_has_best_42 when "101010",
-      bits_has_best_43 when "101011",
-      bits_has_best_44 when "101100",
-      bits_has_best_45 when "101101",
-      bits_has_best_46 when "101110",
-      bits_has_best_47 when "101111",
-      bits_has_best_48 when "110000",
-      bits_has_best_49 when "110001",
-      bits_has_best_50 when "110010",
-      bits_has_best_51 when "110011",
-      bits_has_best_52 when "110100",
-      bits_has_best_53 when "110101",
-      bits_has_best_54 when "110110",
-      bits_has_best_55 when "110111",
-      bits_has_best_56 when "111000",
-      bits_has_best_57 when "111001",
-      bits_has_best_58 when "111010",
-      bits_has_best_59 when "111011",
-      bits_has_best_60 when "111100",
-      bits_has_best_61 when "111101",
-      bits_has_best_62 when "111110",
-      bits_has_best_63 when "111111",
-      k_0 when others;
+  has_best_kept <= has_best_kept_c;
+  and_48 <= merge_valid and merge_hit;
+  merge_slot_eq_b2_slot_c1 <= "1" when merge_slot = b2_slot_c1 else "0";
+  b_slot_merged_c <= and_48 and merge_slot_eq_b2_slot_c1;
+  bits_has_best_kept <= unsigned(has_best_kept(0 downto 0));
+  bits_has_best_kept_1 <= unsigned(has_best_kept(1 downto 1));
+  bits_has_best_kept_2 <= unsigned(has_best_kept(2 downto 2));
+  bits_has_best_kept_3 <= unsigned(has_best_kept(3 downto 3));
+  bits_has_best_kept_4 <= unsigned(has_best_kept(4 downto 4));
+  bits_has_best_kept_5 <= unsigned(has_best_kept(5 downto 5));
+  bits_has_best_kept_6 <= unsigned(has_best_kept(6 downto 6));
+  bits_has_best_kept_7 <= unsigned(has_best_kept(7 downto 7));
+  bits_has_best_kept_8 <= unsigned(has_best_kept(8 downto 8));
+  bits_has_best_kept_9 <= unsigned(has_best_kept(9 downto 9));
+  bits_has_best_kept_10 <= unsigned(has_best_kept(10 downto 10));
+  bits_has_best_kept_11 <= unsigned(has_best_kept(11 downto 11));
+  bits_has_best_kept_12 <= unsigned(has_best_kept(12 downto 12));
+  bits_has_best_kept_13 <= unsigned(has_best_kept(13 downto 13));
+  bits_has_best_kept_14 <= unsigned(has_best_kept(14 downto 14));
+  bits_has_best_kept_15 <= unsigned(has_best_kept(15 downto 15));
+  bits_b2_slot_c1 <= unsigned(b2_slot_c1(3 downto 0));
+  with bits_b2_slot_c1 select
+    slot_has_best_g0_c <=
+      bits_has_best_kept when "0000",
+      bits_has_best_kept_1 when "0001",
+      bits_has_best_kept_2 when "0010",
+      bits_has_best_kept_3 when "0011",
+      bits_has_best_kept_4 when "0100",
+      bits_has_best_kept_5 when "0101",
+      bits_has_best_kept_6 when "0110",
+      bits_has_best_kept_7 when "0111",
+      bits_has_best_kept_8 when "1000",
+      bits_has_best_kept_9 when "1001",
+      bits_has_best_kept_10 when "1010",
+      bits_has_best_kept_11 when "1011",
+      bits_has_best_kept_12 when "1100",
+      bits_has_best_kept_13 when "1101",
+      bits_has_best_kept_14 when "1110",
+      bits_has_best_kept_15 when "1111",
+      k_0_4 when others;
+  bits_has_best_kept_16 <= unsigned(has_best_kept(16 downto 16));
+  bits_has_best_kept_17 <= unsigned(has_best_kept(17 downto 17));
+  bits_has_best_kept_18 <= unsigned(has_best_kept(18 downto 18));
+  bits_has_best_kept_19 <= unsigned(has_best_kept(19 downto 19));
+  bits_has_best_kept_20 <= unsigned(has_best_kept(20 downto 20));
+  bits_has_best_kept_21 <= unsigned(has_best_kept(21 downto 21));
+  bits_has_best_kept_22 <= unsigned(has_best_kept(22 downto 22));
+  bits_has_best_kept_23 <= unsigned(has_best_kept(23 downto 23));
+  bits_has_best_kept_24 <= unsigned(has_best_kept(24 downto 24));
+  bits_has_best_kept_25 <= unsigned(has_best_kept(25 downto 25));
+  bits_has_best_kept_26 <= unsigned(has_best_kept(26 downto 26));
+  bits_has_best_kept_27 <= unsigned(has_best_kept(27 downto 27));
+  bits_has_best_kept_28 <= unsigned(has_best_kept(28 downto 28));
+  bits_has_best_kept_29 <= unsigned(has_best_kept(29 downto 29));
+  bits_has_best_kept_30 <= unsigned(has_best_kept(30 downto 30));
+  bits_has_best_kept_31 <= unsigned(has_best_kept(31 downto 31));
+  bits_b2_slot_c1_1 <= unsigned(b2_slot_c1(3 downto 0));
+  with bits_b2_slot_c1_1 select
+    slot_has_best_g1_c <=
+      bits_has_best_kept_16 when "0000",
+      bits_has_best_kept_17 when "0001",
+      bits_has_best_kept_18 when "0010",
+      bits_has_best_kept_19 when "0011",
+      bits_has_best_kept_20 when "0100",
+      bits_has_best_kept_21 when "0101",
+      bits_has_best_kept_22 when "0110",
+      bits_has_best_kept_23 when "0111",
+      bits_has_best_kept_24 when "1000",
+      bits_has_best_kept_25 when "1001",
+      bits_has_best_kept_26 when "1010",
+      bits_has_best_kept_27 when "1011",
+      bits_has_best_kept_28 when "1100",
+      bits_has_best_kept_29 when "1101",
+      bits_has_best_kept_30 when "1110",
+      bits_has_best_kept_31 when "1111",
+      k_0_4 when others;
+  bits_has_best_kept_32 <= unsigned(has_best_kept(32 downto 32));
+  bits_has_best_kept_33 <= unsigned(has_best_kept(33 downto 33));
+  bits_has_best_kept_34 <= unsigned(has_best_kept(34 downto 34));
+  bits_has_best_kept_35 <= unsigned(has_best_kept(35 downto 35));
+  bits_has_best_kept_36 <= unsigned(has_best_kept(36 downto 36));
+  bits_has_best_kept_37 <= unsigned(has_best_kept(37 downto 37));
+  bits_has_best_kept_38 <= unsigned(has_best_kept(38 downto 38));
+  bits_has_best_kept_39 <= unsigned(has_best_kept(39 downto 39));
+  bits_has_best_kept_40 <= unsigned(has_best_kept(40 downto 40));
+  bits_has_best_kept_41 <= unsigned(has_best_kept(41 downto 41));
+  bits_has_best_kept_42 <= unsigned(has_best_kept(42 downto 42));
+  bits_has_best_kept_43 <= unsigned(has_best_kept(43 downto 43));
+  bits_has_best_kept_44 <= unsigned(has_best_kept(44 downto 44));
+  bits_has_best_kept_45 <= unsigned(has_best_kept(45 downto 45));
+  bits_has_best_kept_46 <= unsigned(has_best_kept(46 downto 46));
+  bits_has_best_kept_47 <= unsigned(has_best_kept(47 downto 47));
+  bits_b2_slot_c1_2 <= unsigned(b2_slot_c1(3 downto 0));
+  with bits_b2_slot_c1_2 select
+    slot_has_best_g2_c <=
+      bits_has_best_kept_32 when "0000",
+      bits_has_best_kept_33 when "0001",
+      bits_has_best_kept_34 when "0010",
+      bits_has_best_kept_35 when "0011",
+      bits_has_best_kept_36 when "0100",
+      bits_has_best_kept_37 when "0101",
+      bits_has_best_kept_38 when "0110",
+      bits_has_best_kept_39 when "0111",
+      bits_has_best_kept_40 when "1000",
+      bits_has_best_kept_41 when "1001",
+      bits_has_best_kept_42 when "1010",
+      bits_has_best_kept_43 when "1011",
+      bits_has_best_kept_44 when "1100",
+      bits_has_best_kept_45 when "1101",
+      bits_has_best_kept_46 when "1110",
+      bits_has_best_kept_47 when "1111",
+      k_0_4 when others;
+  bits_has_best_kept_48 <= unsigned(has_best_kept(48 downto 48));
+  bits_has_best_kept_49 <= unsigned(has_best_kept(49 downto 49));
+  bits_has_best_kept_50 <= unsigned(has_best_kept(50 downto 50));
+  bits_has_best_kept_51 <= unsigned(has_best_kept(51 downto 51));
+  bits_has_best_kept_52 <= unsigned(has_best_kept(52 downto 52));
+  bits_has_best_kept_53 <= unsigned(has_best_kept(53 downto 53));
+  bits_has_best_kept_54 <= unsigned(has_best_kept(54 downto 54));
+  bits_has_best_kept_55 <= unsigned(has_best_kept(55 downto 55));
+  bits_has_best_kept_56 <= unsigned(has_best_kept(56 downto 56));
+  bits_has_best_kept_57 <= unsigned(has_best_kept(57 downto 57));
+  bits_has_best_kept_58 <= unsigned(has_best_kept(58 downto 58));
+  bits_has_best_kept_59 <= unsigned(has_best_kept(59 downto 59));
+  bits_has_best_kept_60 <= unsigned(has_best_kept(60 downto 60));
+  bits_has_best_kept_61 <= unsigned(has_best_kept(61 downto 61));
+  bits_has_best_kept_62 <= unsigned(has_best_kept(62 downto 62));
+  bits_has_best_kept_63 <= unsigned(has_best_kept(63 downto 63));
+  bits_b2_slot_c1_3 <= unsigned(b2_slot_c1(3 downto 0));
+  with bits_b2_slot_c1_3 select
+    slot_has_best_g3_c <=
+      bits_has_best_kept_48 when "0000",
+      bits_has_best_kept_49 when "0001",
+      bits_has_best_kept_50 when "0010",
+      bits_has_best_kept_51 when "0011",
+      bits_has_best_kept_52 when "0100",
+      bits_has_best_kept_53 when "0101",
+      bits_has_best_kept_54 when "0110",
+      bits_has_best_kept_55 when "0111",
+      bits_has_best_kept_56 when "1000",
+      bits_has_best_kept_57 when "1001",
+      bits_has_best_kept_58 when "1010",
+      bits_has_best_kept_59 when "1011",
+      bits_has_best_kept_60 when "1100",
+      bits_has_best_kept_61 when "1101",
+      bits_has_best_kept_62 when "1110",
+      bits_has_best_kept_63 when "1111",
+      k_0_4 when others;
+  bits_c_slot_c2 <= unsigned(c_slot_c2(5 downto 4));
+  with bits_c_slot_c2 select
+    slot_has_best_c <=
+      slot_has_best_g0 when "00",
+      slot_has_best_g1 when "01",
+      slot_has_best_g2 when "10",
+      slot_has_best_g3 when "11",
+      k_0_4 when others;
+  slot_has_best_now <= slot_has_best_c or b_slot_merged;
   rs_s_limit_q <= resize(s_limit_q, 33);
   rs_cull_x <= resize(cull_x, 33);
-  minus_115 <= rs_s_limit_q - rs_cull_x;
-  bits_minus_115 <= unsigned(minus_115(32 downto 32));
-  culled_c <= cull_has_best and bits_minus_115;
-  and_117 <= merge_valid and merge_hit;
+  minus_51 <= rs_s_limit_q - rs_cull_x;
+  bits_minus_51 <= unsigned(minus_51(32 downto 32));
+  culled_c <= cull_has_best and bits_minus_51;
+  and_53 <= merge_valid and merge_hit;
   merge_slot_eq_k_63 <= "1" when merge_slot = k_63 else "0";
   merge_slot_eq_k_62 <= "1" when merge_slot = k_62 else "0";
   merge_slot_eq_k_61 <= "1" when merge_slot = k_61 else "0";
@@ -2538,77 +2273,144 @@ begin
   merge_slot_eq_k_2 <= "1" when merge_slot = k_2 else "0";
   merge_slot_eq_k_1 <= "1" when merge_slot = k_1 else "0";
   merge_slot_eq_k_0_1 <= "1" when merge_slot = k_0_1 else "0";
-  cat_118 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
-  best_set <= cat_118 when and_117 = "1" else k_0_2;
-  q_slot_eq_k_63 <= "1" when q_slot = k_63 else "0";
-  q_slot_eq_k_62 <= "1" when q_slot = k_62 else "0";
-  q_slot_eq_k_61 <= "1" when q_slot = k_61 else "0";
-  q_slot_eq_k_60 <= "1" when q_slot = k_60 else "0";
-  q_slot_eq_k_59 <= "1" when q_slot = k_59 else "0";
-  q_slot_eq_k_58 <= "1" when q_slot = k_58 else "0";
-  q_slot_eq_k_57 <= "1" when q_slot = k_57 else "0";
-  q_slot_eq_k_56 <= "1" when q_slot = k_56 else "0";
-  q_slot_eq_k_55 <= "1" when q_slot = k_55 else "0";
-  q_slot_eq_k_54 <= "1" when q_slot = k_54 else "0";
-  q_slot_eq_k_53 <= "1" when q_slot = k_53 else "0";
-  q_slot_eq_k_52 <= "1" when q_slot = k_52 else "0";
-  q_slot_eq_k_51 <= "1" when q_slot = k_51 else "0";
-  q_slot_eq_k_50 <= "1" when q_slot = k_50 else "0";
-  q_slot_eq_k_49 <= "1" when q_slot = k_49 else "0";
-  q_slot_eq_k_48 <= "1" when q_slot = k_48 else "0";
-  q_slot_eq_k_47 <= "1" when q_slot = k_47 else "0";
-  q_slot_eq_k_46 <= "1" when q_slot = k_46 else "0";
-  q_slot_eq_k_45 <= "1" when q_slot = k_45 else "0";
-  q_slot_eq_k_44 <= "1" when q_slot = k_44 else "0";
-  q_slot_eq_k_43 <= "1" when q_slot = k_43 else "0";
-  q_slot_eq_k_42 <= "1" when q_slot = k_42 else "0";
-  q_slot_eq_k_41 <= "1" when q_slot = k_41 else "0";
-  q_slot_eq_k_40 <= "1" when q_slot = k_40 else "0";
-  q_slot_eq_k_39 <= "1" when q_slot = k_39 else "0";
-  q_slot_eq_k_38 <= "1" when q_slot = k_38 else "0";
-  q_slot_eq_k_37 <= "1" when q_slot = k_37 else "0";
-  q_slot_eq_k_36 <= "1" when q_slot = k_36 else "0";
-  q_slot_eq_k_35 <= "1" when q_slot = k_35 else "0";
-  q_slot_eq_k_34 <= "1" when q_slot = k_34 else "0";
-  q_slot_eq_k_33 <= "1" when q_slot = k_33 else "0";
-  q_slot_eq_k_32 <= "1" when q_slot = k_32 else "0";
-  q_slot_eq_k_31 <= "1" when q_slot = k_31 else "0";
-  q_slot_eq_k_30 <= "1" when q_slot = k_30 else "0";
-  q_slot_eq_k_29 <= "1" when q_slot = k_29 else "0";
-  q_slot_eq_k_28 <= "1" when q_slot = k_28 else "0";
-  q_slot_eq_k_27 <= "1" when q_slot = k_27 else "0";
-  q_slot_eq_k_26 <= "1" when q_slot = k_26 else "0";
-  q_slot_eq_k_25 <= "1" when q_slot = k_25 else "0";
-  q_slot_eq_k_24 <= "1" when q_slot = k_24 else "0";
-  q_slot_eq_k_23 <= "1" when q_slot = k_23 else "0";
-  q_slot_eq_k_22 <= "1" when q_slot = k_22 else "0";
-  q_slot_eq_k_21 <= "1" when q_slot = k_21 else "0";
-  q_slot_eq_k_20 <= "1" when q_slot = k_20 else "0";
-  q_slot_eq_k_19 <= "1" when q_slot = k_19 else "0";
-  q_slot_eq_k_18 <= "1" when q_slot = k_18 else "0";
-  q_slot_eq_k_17 <= "1" when q_slot = k_17 else "0";
-  q_slot_eq_k_16 <= "1" when q_slot = k_16 else "0";
-  q_slot_eq_k_15 <= "1" when q_slot = k_15 else "0";
-  q_slot_eq_k_14 <= "1" when q_slot = k_14 else "0";
-  q_slot_eq_k_13 <= "1" when q_slot = k_13 else "0";
-  q_slot_eq_k_12 <= "1" when q_slot = k_12 else "0";
-  q_slot_eq_k_11 <= "1" when q_slot = k_11 else "0";
-  q_slot_eq_k_10 <= "1" when q_slot = k_10 else "0";
-  q_slot_eq_k_9 <= "1" when q_slot = k_9 else "0";
-  q_slot_eq_k_8 <= "1" when q_slot = k_8 else "0";
-  q_slot_eq_k_7 <= "1" when q_slot = k_7 else "0";
-  q_slot_eq_k_6 <= "1" when q_slot = k_6 else "0";
-  q_slot_eq_k_5 <= "1" when q_slot = k_5 else "0";
-  q_slot_eq_k_4 <= "1" when q_slot = k_4 else "0";
-  q_slot_eq_k_3 <= "1" when q_slot = k_3 else "0";
-  q_slot_eq_k_2 <= "1" when q_slot = k_2 else "0";
-  q_slot_eq_k_1 <= "1" when q_slot = k_1 else "0";
-  q_slot_eq_k_0_1 <= "1" when q_slot = k_0_1 else "0";
-  cat_119 <= unsigned(std_logic_vector'(std_logic_vector(q_slot_eq_k_63) & std_logic_vector(q_slot_eq_k_62) & std_logic_vector(q_slot_eq_k_61) & std_logic_vector(q_slot_eq_k_60) & std_logic_vector(q_slot_eq_k_59) & std_logic_vector(q_slot_eq_k_58) & std_logic_vector(q_slot_eq_k_57) & std_logic_vector(q_slot_eq_k_56) & std_logic_vector(q_slot_eq_k_55) & std_logic_vector(q_slot_eq_k_54) & std_logic_vector(q_slot_eq_k_53) & std_logic_vector(q_slot_eq_k_52) & std_logic_vector(q_slot_eq_k_51) & std_logic_vector(q_slot_eq_k_50) & std_logic_vector(q_slot_eq_k_49) & std_logic_vector(q_slot_eq_k_48) & std_logic_vector(q_slot_eq_k_47) & std_logic_vector(q_slot_eq_k_46) & std_logic_vector(q_slot_eq_k_45) & std_logic_vector(q_slot_eq_k_44) & std_logic_vector(q_slot_eq_k_43) & std_logic_vector(q_slot_eq_k_42) & std_logic_vector(q_slot_eq_k_41) & std_logic_vector(q_slot_eq_k_40) & std_logic_vector(q_slot_eq_k_39) & std_logic_vector(q_slot_eq_k_38) & std_logic_vector(q_slot_eq_k_37) & std_logic_vector(q_slot_eq_k_36) & std_logic_vector(q_slot_eq_k_35) & std_logic_vector(q_slot_eq_k_34) & std_logic_vector(q_slot_eq_k_33) & std_logic_vector(q_slot_eq_k_32) & std_logic_vector(q_slot_eq_k_31) & std_logic_vector(q_slot_eq_k_30) & std_logic_vector(q_slot_eq_k_29) & std_logic_vector(q_slot_eq_k_28) & std_logic_vector(q_slot_eq_k_27) & std_logic_vector(q_slot_eq_k_26) & std_logic_vector(q_slot_eq_k_25) & std_logic_vector(q_slot_eq_k_24) & std_logic_vector(q_slot_eq_k_23) & std_logic_vector(q_slot_eq_k_22) & std_logic_vector(q_slot_eq_k_21) & std_logic_vector(q_slot_eq_k_20) & std_logic_vector(q_slot_eq_k_19) & std_logic_vector(q_slot_eq_k_18) & std_logic_vector(q_slot_eq_k_17) & std_logic_vector(q_slot_eq_k_16) & std_logic_vector(q_slot_eq_k_15) & std_logic_vector(q_slot_eq_k_14) & std_logic_vector(q_slot_eq_k_13) & std_logic_vector(q_slot_eq_k_12) & std_logic_vector(q_slot_eq_k_11) & std_logic_vector(q_slot_eq_k_10) & std_logic_vector(q_slot_eq_k_9) & std_logic_vector(q_slot_eq_k_8) & std_logic_vector(q_slot_eq_k_7) & std_logic_vector(q_slot_eq_k_6) & std_logic_vector(q_slot_eq_k_5) & std_logic_vector(q_slot_eq_k_4) & std_logic_vector(q_slot_eq_k_3) & std_logic_vector(q_slot_eq_k_2) & std_logic_vector(q_slot_eq_k_1) & std_logic_vector(q_slot_eq_k_0_1)));
-  best_clear_c <= cat_119 when q_new = "1" else k_0_2;
+  cat_54 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
+  best_set <= cat_54 when and_53 = "1" else k_0_5;
+  q_slot_c4_eq_k_63 <= "1" when q_slot_c4 = k_63 else "0";
+  and_55 <= q_new_c4 and q_slot_c4_eq_k_63;
+  q_slot_c4_eq_k_62 <= "1" when q_slot_c4 = k_62 else "0";
+  and_56 <= q_new_c4 and q_slot_c4_eq_k_62;
+  q_slot_c4_eq_k_61 <= "1" when q_slot_c4 = k_61 else "0";
+  and_57 <= q_new_c4 and q_slot_c4_eq_k_61;
+  q_slot_c4_eq_k_60 <= "1" when q_slot_c4 = k_60 else "0";
+  and_58 <= q_new_c4 and q_slot_c4_eq_k_60;
+  q_slot_c4_eq_k_59 <= "1" when q_slot_c4 = k_59 else "0";
+  and_59 <= q_new_c4 and q_slot_c4_eq_k_59;
+  q_slot_c4_eq_k_58 <= "1" when q_slot_c4 = k_58 else "0";
+  and_60 <= q_new_c4 and q_slot_c4_eq_k_58;
+  q_slot_c4_eq_k_57 <= "1" when q_slot_c4 = k_57 else "0";
+  and_61 <= q_new_c4 and q_slot_c4_eq_k_57;
+  q_slot_c4_eq_k_56 <= "1" when q_slot_c4 = k_56 else "0";
+  and_62 <= q_new_c4 and q_slot_c4_eq_k_56;
+  q_slot_c4_eq_k_55 <= "1" when q_slot_c4 = k_55 else "0";
+  and_63 <= q_new_c4 and q_slot_c4_eq_k_55;
+  q_slot_c4_eq_k_54 <= "1" when q_slot_c4 = k_54 else "0";
+  and_64 <= q_new_c4 and q_slot_c4_eq_k_54;
+  q_slot_c4_eq_k_53 <= "1" when q_slot_c4 = k_53 else "0";
+  and_65 <= q_new_c4 and q_slot_c4_eq_k_53;
+  q_slot_c4_eq_k_52 <= "1" when q_slot_c4 = k_52 else "0";
+  and_66 <= q_new_c4 and q_slot_c4_eq_k_52;
+  q_slot_c4_eq_k_51 <= "1" when q_slot_c4 = k_51 else "0";
+  and_67 <= q_new_c4 and q_slot_c4_eq_k_51;
+  q_slot_c4_eq_k_50 <= "1" when q_slot_c4 = k_50 else "0";
+  and_68 <= q_new_c4 and q_slot_c4_eq_k_50;
+  q_slot_c4_eq_k_49 <= "1" when q_slot_c4 = k_49 else "0";
+  and_69 <= q_new_c4 and q_slot_c4_eq_k_49;
+  q_slot_c4_eq_k_48 <= "1" when q_slot_c4 = k_48 else "0";
+  and_70 <= q_new_c4 and q_slot_c4_eq_k_48;
+  cat_71 <= unsigned(std_logic_vector'(std_logic_vector(and_55) & std_logic_vector(and_56) & std_logic_vector(and_57) & std_logic_vector(and_58) & std_logic_vector(and_59) & std_logic_vector(and_60) & std_logic_vector(and_61) & std_logic_vector(and_62) & std_logic_vector(and_63) & std_logic_vector(and_64) & std_logic_vector(and_65) & std_logic_vector(and_66) & std_logic_vector(and_67) & std_logic_vector(and_68) & std_logic_vector(and_69) & std_logic_vector(and_70)));
+  q_slot_c3_eq_k_47 <= "1" when q_slot_c3 = k_47 else "0";
+  and_72 <= q_new_c3 and q_slot_c3_eq_k_47;
+  q_slot_c3_eq_k_46 <= "1" when q_slot_c3 = k_46 else "0";
+  and_73 <= q_new_c3 and q_slot_c3_eq_k_46;
+  q_slot_c3_eq_k_45 <= "1" when q_slot_c3 = k_45 else "0";
+  and_74 <= q_new_c3 and q_slot_c3_eq_k_45;
+  q_slot_c3_eq_k_44 <= "1" when q_slot_c3 = k_44 else "0";
+  and_75 <= q_new_c3 and q_slot_c3_eq_k_44;
+  q_slot_c3_eq_k_43 <= "1" when q_slot_c3 = k_43 else "0";
+  and_76 <= q_new_c3 and q_slot_c3_eq_k_43;
+  q_slot_c3_eq_k_42 <= "1" when q_slot_c3 = k_42 else "0";
+  and_77 <= q_new_c3 and q_slot_c3_eq_k_42;
+  q_slot_c3_eq_k_41 <= "1" when q_slot_c3 = k_41 else "0";
+  and_78 <= q_new_c3 and q_slot_c3_eq_k_41;
+  q_slot_c3_eq_k_40 <= "1" when q_slot_c3 = k_40 else "0";
+  and_79 <= q_new_c3 and q_slot_c3_eq_k_40;
+  q_slot_c3_eq_k_39 <= "1" when q_slot_c3 = k_39 else "0";
+  and_80 <= q_new_c3 and q_slot_c3_eq_k_39;
+  q_slot_c3_eq_k_38 <= "1" when q_slot_c3 = k_38 else "0";
+  and_81 <= q_new_c3 and q_slot_c3_eq_k_38;
+  q_slot_c3_eq_k_37 <= "1" when q_slot_c3 = k_37 else "0";
+  and_82 <= q_new_c3 and q_slot_c3_eq_k_37;
+  q_slot_c3_eq_k_36 <= "1" when q_slot_c3 = k_36 else "0";
+  and_83 <= q_new_c3 and q_slot_c3_eq_k_36;
+  q_slot_c3_eq_k_35 <= "1" when q_slot_c3 = k_35 else "0";
+  and_84 <= q_new_c3 and q_slot_c3_eq_k_35;
+  q_slot_c3_eq_k_34 <= "1" when q_slot_c3 = k_34 else "0";
+  and_85 <= q_new_c3 and q_slot_c3_eq_k_34;
+  q_slot_c3_eq_k_33 <= "1" when q_slot_c3 = k_33 else "0";
+  and_86 <= q_new_c3 and q_slot_c3_eq_k_33;
+  q_slot_c3_eq_k_32 <= "1" when q_slot_c3 = k_32 else "0";
+  and_87 <= q_new_c3 and q_slot_c3_eq_k_32;
+  cat_88 <= unsigned(std_logic_vector'(std_logic_vector(and_72) & std_logic_vector(and_73) & std_logic_vector(and_74) & std_logic_vector(and_75) & std_logic_vector(and_76) & std_logic_vector(and_77) & std_logic_vector(and_78) & std_logic_vector(and_79) & std_logic_vector(and_80) & std_logic_vector(and_81) & std_logic_vector(and_82) & std_logic_vector(and_83) & std_logic_vector(and_84) & std_logic_vector(and_85) & std_logic_vector(and_86) & std_logic_vector(and_87)));
+  q_slot_c2_eq_k_31 <= "1" when q_slot_c2 = k_31 else "0";
+  and_89 <= q_new_c2 and q_slot_c2_eq_k_31;
+  q_slot_c2_eq_k_30 <= "1" when q_slot_c2 = k_30 else "0";
+  and_90 <= q_new_c2 and q_slot_c2_eq_k_30;
+  q_slot_c2_eq_k_29 <= "1" when q_slot_c2 = k_29 else "0";
+  and_91 <= q_new_c2 and q_slot_c2_eq_k_29;
+  q_slot_c2_eq_k_28 <= "1" when q_slot_c2 = k_28 else "0";
+  and_92 <= q_new_c2 and q_slot_c2_eq_k_28;
+  q_slot_c2_eq_k_27 <= "1" when q_slot_c2 = k_27 else "0";
+  and_93 <= q_new_c2 and q_slot_c2_eq_k_27;
+  q_slot_c2_eq_k_26 <= "1" when q_slot_c2 = k_26 else "0";
+  and_94 <= q_new_c2 and q_slot_c2_eq_k_26;
+  q_slot_c2_eq_k_25 <= "1" when q_slot_c2 = k_25 else "0";
+  and_95 <= q_new_c2 and q_slot_c2_eq_k_25;
+  q_slot_c2_eq_k_24 <= "1" when q_slot_c2 = k_24 else "0";
+  and_96 <= q_new_c2 and q_slot_c2_eq_k_24;
+  q_slot_c2_eq_k_23 <= "1" when q_slot_c2 = k_23 else "0";
+  and_97 <= q_new_c2 and q_slot_c2_eq_k_23;
+  q_slot_c2_eq_k_22 <= "1" when q_slot_c2 = k_22 else "0";
+  and_98 <= q_new_c2 and q_slot_c2_eq_k_22;
+  q_slot_c2_eq_k_21 <= "1" when q_slot_c2 = k_21 else "0";
+  and_99 <= q_new_c2 and q_slot_c2_eq_k_21;
+  q_slot_c2_eq_k_20 <= "1" when q_slot_c2 = k_20 else "0";
+  and_100 <= q_new_c2 and q_slot_c2_eq_k_20;
+  q_slot_c2_eq_k_19 <= "1" when q_slot_c2 = k_19 else "0";
+  and_101 <= q_new_c2 and q_slot_c2_eq_k_19;
+  q_slot_c2_eq_k_18 <= "1" when q_slot_c2 = k_18 else "0";
+  and_102 <= q_new_c2 and q_slot_c2_eq_k_18;
+  q_slot_c2_eq_k_17 <= "1" when q_slot_c2 = k_17 else "0";
+  and_103 <= q_new_c2 and q_slot_c2_eq_k_17;
+  q_slot_c2_eq_k_16 <= "1" when q_slot_c2 = k_16 else "0";
+  and_104 <= q_new_c2 and q_slot_c2_eq_k_16;
+  cat_105 <= unsigned(std_logic_vector'(std_logic_vector(and_89) & std_logic_vector(and_90) & std_logic_vector(and_91) & std_logic_vector(and_92) & std_logic_vector(and_93) & std_logic_vector(and_94) & std_logic_vector(and_95) & std_logic_vector(and_96) & std_logic_vector(and_97) & std_logic_vector(and_98) & std_logic_vector(and_99) & std_logic_vector(and_100) & std_logic_vector(and_101) & std_logic_vector(and_102) & std_logic_vector(and_103) & std_logic_vector(and_104)));
+  q_slot_c1_eq_k_15 <= "1" when q_slot_c1 = k_15 else "0";
+  and_106 <= q_new_c1 and q_slot_c1_eq_k_15;
+  q_slot_c1_eq_k_14 <= "1" when q_slot_c1 = k_14 else "0";
+  and_107 <= q_new_c1 and q_slot_c1_eq_k_14;
+  q_slot_c1_eq_k_13 <= "1" when q_slot_c1 = k_13 else "0";
+  and_108 <= q_new_c1 and q_slot_c1_eq_k_13;
+  q_slot_c1_eq_k_12 <= "1" when q_slot_c1 = k_12 else "0";
+  and_109 <= q_new_c1 and q_slot_c1_eq_k_12;
+  q_slot_c1_eq_k_11 <= "1" when q_slot_c1 = k_11 else "0";
+  and_110 <= q_new_c1 and q_slot_c1_eq_k_11;
+  q_slot_c1_eq_k_10 <= "1" when q_slot_c1 = k_10 else "0";
+  and_111 <= q_new_c1 and q_slot_c1_eq_k_10;
+  q_slot_c1_eq_k_9 <= "1" when q_slot_c1 = k_9 else "0";
+  and_112 <= q_new_c1 and q_slot_c1_eq_k_9;
+  q_slot_c1_eq_k_8 <= "1" when q_slot_c1 = k_8 else "0";
+  and_113 <= q_new_c1 and q_slot_c1_eq_k_8;
+  q_slot_c1_eq_k_7 <= "1" when q_slot_c1 = k_7 else "0";
+  and_114 <= q_new_c1 and q_slot_c1_eq_k_7;
+  q_slot_c1_eq_k_6 <= "1" when q_slot_c1 = k_6 else "0";
+  and_115 <= q_new_c1 and q_slot_c1_eq_k_6;
+  q_slot_c1_eq_k_5 <= "1" when q_slot_c1 = k_5 else "0";
+  and_116 <= q_new_c1 and q_slot_c1_eq_k_5;
+  q_slot_c1_eq_k_4 <= "1" when q_slot_c1 = k_4 else "0";
+  and_117 <= q_new_c1 and q_slot_c1_eq_k_4;
+  q_slot_c1_eq_k_3 <= "1" when q_slot_c1 = k_3 else "0";
+  and_118 <= q_new_c1 and q_slot_c1_eq_k_3;
+  q_slot_c1_eq_k_2 <= "1" when q_slot_c1 = k_2 else "0";
+  and_119 <= q_new_c1 and q_slot_c1_eq_k_2;
+  q_slot_c1_eq_k_1 <= "1" when q_slot_c1 = k_1 else "0";
+  and_120 <= q_new_c1 and q_slot_c1_eq_k_1;
+  q_slot_c1_eq_k_0_1 <= "1" when q_slot_c1 = k_0_1 else "0";
+  and_121 <= q_new_c1 and q_slot_c1_eq_k_0_1;
+  cat_122 <= unsigned(std_logic_vector'(std_logic_vector(and_106) & std_logic_vector(and_107) & std_logic_vector(and_108) & std_logic_vector(and_109) & std_logic_vector(and_110) & std_logic_vector(and_111) & std_logic_vector(and_112) & std_logic_vector(and_113) & std_logic_vector(and_114) & std_logic_vector(and_115) & std_logic_vector(and_116) & std_logic_vector(and_117) & std_logic_vector(and_118) & std_logic_vector(and_119) & std_logic_vector(and_120) & std_logic_vector(and_121)));
+  best_clear_c <= unsigned(std_logic_vector'(std_logic_vector(cat_71) & std_logic_vector(cat_88) & std_logic_vector(cat_105) & std_logic_vector(cat_122)));
   not_best_clear <= not best_clear;
-  and_120 <= has_best and not_best_clear;
-  and_120_or_best_set <= and_120 or best_set;
+  has_best_kept_c <= has_best and not_best_clear;
+  or_125 <= has_best_kept or best_set;
 
   ring_c_regs : process (clk)
   begin
@@ -2626,10 +2428,15 @@ begin
       if rst = '1' then
         has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
       else
-        has_best <= and_120_or_best_set;
+        has_best <= or_125;
       end if;
       cull_x <= tmin_less;
-      cull_has_best <= slot_has_best;
+      b_slot_merged <= b_slot_merged_c;
+      slot_has_best_g0 <= slot_has_best_g0_c;
+      slot_has_best_g1 <= slot_has_best_g1_c;
+      slot_has_best_g2 <= slot_has_best_g2_c;
+      slot_has_best_g3 <= slot_has_best_g3_c;
+      cull_has_best <= slot_has_best_now;
       culled <= culled_c;
       culled_n <= culled;
       best_clear <= best_clear_c;
@@ -2646,6 +2453,42 @@ begin
       c_slot_c2 <= b2_slot;
     end if;
   end process c_slot_copies_regs;
+
+  -- register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+
+  b2_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      b2_slot <= b_slot;
+      b2_slot_c1 <= b_slot;
+    end if;
+  end process b2_slot_copies_regs;
+
+  -- register copies q_new_copies: q_new and 4 copies, to split its fan-out
+
+  q_new_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      q_new <= take_new;
+      q_new_c1 <= take_new;
+      q_new_c2 <= take_new;
+      q_new_c3 <= take_new;
+      q_new_c4 <= take_new;
+    end if;
+  end process q_new_copies_regs;
+
+  -- register copies q_slot_copies: q_slot and 4 copies, to split its fan-out
+
+  q_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      q_slot <= mux_take_unpark;
+      q_slot_c1 <= mux_take_unpark;
+      q_slot_c2 <= mux_take_unpark;
+      q_slot_c3 <= mux_take_unpark;
+      q_slot_c4 <= mux_take_unpark;
+    end if;
+  end process q_slot_copies_regs;
 
   -- stage ring_n: N: the node word; a leaf queued, an inner node to the plane units
   n_slot <= n_slot_sr(3);
@@ -2669,40 +2512,55 @@ begin
   leaf_push <= visit_c_and_nw_is_leaf and nw_count_ne_k_0_6;
   u_n_tmin <= unsigned(n_tmin);
   rs_u_n_tmin <= u_n_tmin(30 downto 0);
-  cat_124 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
+  cat_129 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
   leaf_q_wr_plus_k_1 <= leaf_q_wr + k_1;
   mux_leaf_q_push <= leaf_q_wr_plus_k_1 when leaf_q_push = "1" else leaf_q_wr;
   leaf_q_rd_next <= leaf_q_rd1 when leaf_pop_r = "1" else leaf_q_rd;
   leaf_q_rd1_plus_k_1 <= leaf_q_rd1 + k_1;
   mux_leaf_pop_r <= leaf_q_rd1_plus_k_1 when leaf_pop_r = "1" else leaf_q_rd1;
-  rs_leaf_pop_r <= resize(leaf_pop_r, 7);
-  leaf_q_after_pop <= leaf_q_count - rs_leaf_pop_r;
-  rs_leaf_q_push <= resize(leaf_q_push, 7);
-  leaf_q_count_next <= leaf_q_after_pop + rs_leaf_q_push;
-  leaf_q_count_eq_k_0_3 <= "1" when leaf_q_count = k_0_3 else "0";
+  not_leaf_q_push_c1 <= not leaf_q_push_c1;
+  rs_not_leaf_q_push_c1 <= resize(not_leaf_q_push_c1, 7);
+  leaf_q_count_if_pop <= leaf_q_count - rs_not_leaf_q_push_c1;
+  rs_leaf_q_push_c1 <= resize(leaf_q_push_c1, 7);
+  leaf_q_count_if_kept <= leaf_q_count + rs_leaf_q_push_c1;
+  leaf_q_count_next <= leaf_q_count_if_pop when leaf_pop_r = "1" else leaf_q_count_if_kept;
+  leaf_q_count_eq_k_0 <= "1" when leaf_q_count = k_0 else "0";
   leaf_q_one_left <= "1" when leaf_q_count = k_1_1 else "0";
-  and_127 <= leaf_q_one_left and leaf_pop_r;
-  leaf_q_drained <= leaf_q_count_eq_k_0_3 or and_127;
-  leaf_q_bypass_c <= leaf_q_push and leaf_q_drained;
+  and_132 <= leaf_q_one_left and leaf_pop_r;
+  leaf_q_drained <= leaf_q_count_eq_k_0 or and_132;
+  leaf_q_bypass_c <= leaf_q_push_c1 and leaf_q_drained;
   k_1_1_lt_leaf_q_count <= "1" when k_1_1 < leaf_q_count else "0";
-  or_130 <= leaf_q_push or k_1_1_lt_leaf_q_count;
+  or_135 <= leaf_q_push_c1 or k_1_1_lt_leaf_q_count;
   not_leaf_pop_r <= not leaf_pop_r;
-  and_131 <= leaf_q_one_left and not_leaf_pop_r;
-  leaf_q_nonempty_c <= or_130 or and_131;
+  and_136 <= leaf_q_one_left and not_leaf_pop_r;
+  leaf_q_nonempty_c <= or_135 or and_136;
   bits_leaf_q_din <= unsigned(leaf_q_din(15 downto 0));
   bits_leaf_q_din_1 <= unsigned(leaf_q_din(31 downto 16));
   bits_leaf_q_din_2 <= unsigned(leaf_q_din(47 downto 32));
   bits_leaf_q_din_3 <= unsigned(leaf_q_din(58 downto 48));
+  mux_leaf_pop_r_1 <= leaf_q_rd1_p1 when leaf_pop_r = "1" else leaf_q_rd_p1;
+  leaf_q_rd1_p1_plus_k_1 <= leaf_q_rd1_p1 + k_1;
+  mux_leaf_pop_r_2 <= leaf_q_rd1_p1_plus_k_1 when leaf_pop_r = "1" else leaf_q_rd1_p1;
+  mux_leaf_pop_r_3 <= leaf_q_rd1_p2 when leaf_pop_r = "1" else leaf_q_rd_p2;
+  leaf_q_rd1_p2_plus_k_1 <= leaf_q_rd1_p2 + k_1;
+  mux_leaf_pop_r_4 <= leaf_q_rd1_p2_plus_k_1 when leaf_pop_r = "1" else leaf_q_rd1_p2;
+  mux_leaf_pop_r_5 <= leaf_q_rd1_p3 when leaf_pop_r = "1" else leaf_q_rd_p3;
+  leaf_q_rd1_p3_plus_k_1 <= leaf_q_rd1_p3 + k_1;
+  mux_leaf_pop_r_6 <= leaf_q_rd1_p3_plus_k_1 when leaf_pop_r = "1" else leaf_q_rd1_p3;
   leaf_q_q_stay <= unsigned(std_logic_vector'(std_logic_vector(leaf_q_q_stay_g3) & std_logic_vector(leaf_q_q_stay_g2) & std_logic_vector(leaf_q_q_stay_g1) & std_logic_vector(leaf_q_q_stay_g0)));
   leaf_q_q_next <= unsigned(std_logic_vector'(std_logic_vector(leaf_q_q_next_g3) & std_logic_vector(leaf_q_q_next_g2) & std_logic_vector(leaf_q_q_next_g1) & std_logic_vector(leaf_q_q_next_g0)));
   mux_leaf_q_popped <= leaf_q_q_next when leaf_q_popped = "1" else leaf_q_q_stay;
   leaf_q_head <= leaf_q_din_r when leaf_q_bypass = "1" else mux_leaf_q_popped;
   n_ray_slot_early <= n_ray_slot_early_sr(2);
+  ray_o_q <= unsigned(std_logic_vector'(std_logic_vector(ray_o_q_g5) & std_logic_vector(ray_o_q_g4) & std_logic_vector(ray_o_q_g3) & std_logic_vector(ray_o_q_g2) & std_logic_vector(ray_o_q_g1) & std_logic_vector(ray_o_q_g0)));
   bits_ray_o_q <= unsigned(ray_o_q(28 downto 0));
   bits_ray_o_q_1 <= unsigned(ray_o_q(57 downto 29));
   bits_ray_o_q_2 <= unsigned(ray_o_q(86 downto 58));
+  ray_invx_q <= unsigned(std_logic_vector'(std_logic_vector(ray_invx_q_g2) & std_logic_vector(ray_invx_q_g1) & std_logic_vector(ray_invx_q_g0)));
   s_ray_invx_q <= signed(ray_invx_q);
+  ray_invy_q <= unsigned(std_logic_vector'(std_logic_vector(ray_invy_q_g2) & std_logic_vector(ray_invy_q_g1) & std_logic_vector(ray_invy_q_g0)));
   s_ray_invy_q <= signed(ray_invy_q);
+  ray_invz_q <= unsigned(std_logic_vector'(std_logic_vector(ray_invz_q_g2) & std_logic_vector(ray_invz_q_g1) & std_logic_vector(ray_invz_q_g0)));
   s_ray_invz_q <= signed(ray_invz_q);
   rs_pu_sel_plane <= resize(pu_sel_plane, 30);
   s_rs_pu_sel_plane <= signed(rs_pu_sel_plane);
@@ -2755,8 +2613,8 @@ begin
   pu_below_1 <= unsigned(pu_shifted_1(61 downto 61));
   not_pu_below_1 <= not pu_below_1;
   bits_pu_shifted_1 <= unsigned(pu_shifted_1(60 downto 30));
-  ne_138 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
-  pu_above_1 <= not_pu_below_1 and ne_138;
+  ne_147 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
+  pu_above_1 <= not_pu_below_1 and ne_147;
   rs_pu_shifted_1 <= pu_shifted_1(31 downto 0);
   mux_pu_below_r_1 <= k_m1 when pu_below_r_1 = "1" else pu_low_r_1;
   pu_clamped_1 <= k_1073741824 when pu_above_r_1 = "1" else mux_pu_below_r_1;
@@ -2804,19 +2662,24 @@ begin
         leaf_pop_r <= leaf_pop;
       end if;
       if rst = '1' then
-        leaf_q_push <= unsigned'("0");
-      else
-        leaf_q_push <= leaf_push;
-      end if;
-      if rst = '1' then
         leaf_q_wr <= unsigned'("000000");
       else
         leaf_q_wr <= mux_leaf_q_push;
       end if;
       if rst = '1' then
+        leaf_q_rd <= unsigned'("000000");
+      else
+        leaf_q_rd <= leaf_q_rd_next;
+      end if;
+      if rst = '1' then
         leaf_q_count <= unsigned'("0000000");
       else
         leaf_q_count <= leaf_q_count_next;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1 <= unsigned'("000001");
+      else
+        leaf_q_rd1 <= mux_leaf_pop_r;
       end if;
       if rst = '1' then
         leaf_q_bypass <= unsigned'("0");
@@ -2833,30 +2696,71 @@ begin
       else
         leaf_q_nonempty <= leaf_q_nonempty_c;
       end if;
-      leaf_q_din <= cat_124;
-      leaf_q_q_stay_g3 <= leaf_q_mem_g3(to_integer(leaf_q_rd_c3));
-      leaf_q_q_stay_g2 <= leaf_q_mem_g2(to_integer(leaf_q_rd_c2));
-      leaf_q_q_stay_g1 <= leaf_q_mem_g1(to_integer(leaf_q_rd_c1));
+      leaf_q_din <= cat_129;
+      if rst = '1' then
+        leaf_q_rd_p1 <= unsigned'("000000");
+      else
+        leaf_q_rd_p1 <= mux_leaf_pop_r_1;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1_p1 <= unsigned'("000001");
+      else
+        leaf_q_rd1_p1 <= mux_leaf_pop_r_2;
+      end if;
+      if rst = '1' then
+        leaf_q_rd_p2 <= unsigned'("000000");
+      else
+        leaf_q_rd_p2 <= mux_leaf_pop_r_3;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1_p2 <= unsigned'("000001");
+      else
+        leaf_q_rd1_p2 <= mux_leaf_pop_r_4;
+      end if;
+      if rst = '1' then
+        leaf_q_rd_p3 <= unsigned'("000000");
+      else
+        leaf_q_rd_p3 <= mux_leaf_pop_r_5;
+      end if;
+      if rst = '1' then
+        leaf_q_rd1_p3 <= unsigned'("000001");
+      else
+        leaf_q_rd1_p3 <= mux_leaf_pop_r_6;
+      end if;
+      leaf_q_q_stay_g3 <= leaf_q_mem_g3(to_integer(leaf_q_rd_p3));
+      leaf_q_q_stay_g2 <= leaf_q_mem_g2(to_integer(leaf_q_rd_p2));
+      leaf_q_q_stay_g1 <= leaf_q_mem_g1(to_integer(leaf_q_rd_p1));
       leaf_q_q_stay_g0 <= leaf_q_mem_g0(to_integer(leaf_q_rd));
-      leaf_q_q_next_g3 <= leaf_q_mem_g3(to_integer(leaf_q_rd1_c3));
-      leaf_q_q_next_g2 <= leaf_q_mem_g2(to_integer(leaf_q_rd1_c2));
-      leaf_q_q_next_g1 <= leaf_q_mem_g1(to_integer(leaf_q_rd1_c1));
+      leaf_q_q_next_g3 <= leaf_q_mem_g3(to_integer(leaf_q_rd1_p3));
+      leaf_q_q_next_g2 <= leaf_q_mem_g2(to_integer(leaf_q_rd1_p2));
+      leaf_q_q_next_g1 <= leaf_q_mem_g1(to_integer(leaf_q_rd1_p1));
       leaf_q_q_next_g0 <= leaf_q_mem_g0(to_integer(leaf_q_rd1));
       if leaf_q_push = "1" then
         leaf_q_din_r <= leaf_q_din;
       end if;
       n_ray_slot_early_sr(2 to 2) <= n_ray_slot_early_sr(1 to 1);
       n_ray_slot_early_sr(1) <= c_slot;
-      ray_o_q <= ray_o(to_integer(n_ray_slot));
-      ray_invx_q <= ray_invx(to_integer(n_ray_slot_c1));
-      ray_invy_q <= ray_invy(to_integer(n_ray_slot_c2));
-      ray_invz_q <= ray_invz(to_integer(n_ray_slot_c3));
+      ray_o_q_g5 <= ray_o_g5(to_integer(n_ray_slot_c5));
+      ray_o_q_g4 <= ray_o_g4(to_integer(n_ray_slot_c4));
+      ray_o_q_g3 <= ray_o_g3(to_integer(n_ray_slot_c3));
+      ray_o_q_g2 <= ray_o_g2(to_integer(n_ray_slot_c2));
+      ray_o_q_g1 <= ray_o_g1(to_integer(n_ray_slot_c1));
+      ray_o_q_g0 <= ray_o_g0(to_integer(n_ray_slot));
+      ray_invx_q_g2 <= ray_invx_g2(to_integer(n_ray_slot_c8));
+      ray_invx_q_g1 <= ray_invx_g1(to_integer(n_ray_slot_c7));
+      ray_invx_q_g0 <= ray_invx_g0(to_integer(n_ray_slot_c6));
+      ray_invy_q_g2 <= ray_invy_g2(to_integer(n_ray_slot_c11));
+      ray_invy_q_g1 <= ray_invy_g1(to_integer(n_ray_slot_c10));
+      ray_invy_q_g0 <= ray_invy_g0(to_integer(n_ray_slot_c9));
+      ray_invz_q_g2 <= ray_invz_g2(to_integer(n_ray_slot_c14));
+      ray_invz_q_g1 <= ray_invz_g1(to_integer(n_ray_slot_c13));
+      ray_invz_q_g0 <= ray_invz_g0(to_integer(n_ray_slot_c12));
       if rst = '1' then
         pu_sel_valid <= unsigned'("0");
       else
         pu_sel_valid <= is_inner;
       end if;
-      pu_sel_last <= k_0;
+      pu_sel_last <= k_0_4;
       pu_sel_plane <= nw_clip0;
       pu_sel_axis <= nw_axis;
       pu_delta <= pu_diff;
@@ -2997,63 +2901,25 @@ begin
     end if;
   end process ring_n_regs;
 
-  -- register copies leaf_q_rd_copies: leaf_q_rd and 3 copies, to split its fan-out
+  -- register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
 
-  leaf_q_rd_copies_regs : process (clk)
+  leaf_q_push_copies_regs : process (clk)
   begin
     if rising_edge(clk) then
       if rst = '1' then
-        leaf_q_rd <= unsigned'("000000");
+        leaf_q_push <= unsigned'("0");
       else
-        leaf_q_rd <= leaf_q_rd_next;
+        leaf_q_push <= leaf_push;
       end if;
       if rst = '1' then
-        leaf_q_rd_c1 <= unsigned'("000000");
+        leaf_q_push_c1 <= unsigned'("0");
       else
-        leaf_q_rd_c1 <= leaf_q_rd_next;
-      end if;
-      if rst = '1' then
-        leaf_q_rd_c2 <= unsigned'("000000");
-      else
-        leaf_q_rd_c2 <= leaf_q_rd_next;
-      end if;
-      if rst = '1' then
-        leaf_q_rd_c3 <= unsigned'("000000");
-      else
-        leaf_q_rd_c3 <= leaf_q_rd_next;
+        leaf_q_push_c1 <= leaf_push;
       end if;
     end if;
-  end process leaf_q_rd_copies_regs;
+  end process leaf_q_push_copies_regs;
 
-  -- register copies leaf_q_rd1_copies: leaf_q_rd1 and 3 copies, to split its fan-out
-
-  leaf_q_rd1_copies_regs : process (clk)
-  begin
-    if rising_edge(clk) then
-      if rst = '1' then
-        leaf_q_rd1 <= unsigned'("000001");
-      else
-        leaf_q_rd1 <= mux_leaf_pop_r;
-      end if;
-      if rst = '1' then
-        leaf_q_rd1_c1 <= unsigned'("000001");
-      else
-        leaf_q_rd1_c1 <= mux_leaf_pop_r;
-      end if;
-      if rst = '1' then
-        leaf_q_rd1_c2 <= unsigned'("000001");
-      else
-        leaf_q_rd1_c2 <= mux_leaf_pop_r;
-      end if;
-      if rst = '1' then
-        leaf_q_rd1_c3 <= unsigned'("000001");
-      else
-        leaf_q_rd1_c3 <= mux_leaf_pop_r;
-      end if;
-    end if;
-  end process leaf_q_rd1_copies_regs;
-
-  -- register copies n_ray_slot_copies: n_ray_slot and 3 copies, to split its fan-out
+  -- register copies n_ray_slot_copies: n_ray_slot and 14 copies, to split its fan-out
 
   n_ray_slot_copies_regs : process (clk)
   begin
@@ -3062,6 +2928,17 @@ begin
       n_ray_slot_c1 <= n_ray_slot_early;
       n_ray_slot_c2 <= n_ray_slot_early;
       n_ray_slot_c3 <= n_ray_slot_early;
+      n_ray_slot_c4 <= n_ray_slot_early;
+      n_ray_slot_c5 <= n_ray_slot_early;
+      n_ray_slot_c6 <= n_ray_slot_early;
+      n_ray_slot_c7 <= n_ray_slot_early;
+      n_ray_slot_c8 <= n_ray_slot_early;
+      n_ray_slot_c9 <= n_ray_slot_early;
+      n_ray_slot_c10 <= n_ray_slot_early;
+      n_ray_slot_c11 <= n_ray_slot_early;
+      n_ray_slot_c12 <= n_ray_slot_early;
+      n_ray_slot_c13 <= n_ray_slot_early;
+      n_ray_slot_c14 <= n_ray_slot_early;
     end if;
   end process n_ray_slot_copies_regs;
 
@@ -3084,8 +2961,8 @@ begin
   tmin_minus_1 <= n_tmin - k_1_3;
   rs_tmin_n1 <= resize(tmin_n1, 33);
   rs_tmax_p1 <= resize(tmax_p1, 33);
-  minus_142 <= rs_tmin_n1 - rs_tmax_p1;
-  tmin_le_tmax_c <= unsigned(minus_142(32 downto 32));
+  minus_151 <= rs_tmin_n1 - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(minus_151(32 downto 32));
   mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
   d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
   d0_hi <= d0_hi_sr(7);
@@ -3100,20 +2977,20 @@ begin
   d1_lo <= d1_lo_sr(7);
   rs_plane_t <= resize(plane_t, 33);
   rs_d0_hi <= resize(d0_hi, 33);
-  minus_143 <= rs_plane_t - rs_d0_hi;
-  d0_below <= unsigned(minus_143(32 downto 32));
+  minus_152 <= rs_plane_t - rs_d0_hi;
+  d0_below <= unsigned(minus_152(32 downto 32));
   rs_d0_lo <= resize(d0_lo, 33);
   rs_plane_t_1 <= resize(plane_t, 33);
-  minus_144 <= rs_d0_lo - rs_plane_t_1;
-  d0_above <= unsigned(minus_144(32 downto 32));
+  minus_153 <= rs_d0_lo - rs_plane_t_1;
+  d0_above <= unsigned(minus_153(32 downto 32));
   rs_plane_t_1_1 <= resize(plane_t_1, 33);
   rs_d1_hi <= resize(d1_hi, 33);
-  minus_145 <= rs_plane_t_1_1 - rs_d1_hi;
-  d1_below <= unsigned(minus_145(32 downto 32));
+  minus_154 <= rs_plane_t_1_1 - rs_d1_hi;
+  d1_below <= unsigned(minus_154(32 downto 32));
   rs_d1_lo <= resize(d1_lo, 33);
   rs_plane_t_1_2 <= resize(plane_t_1, 33);
-  minus_146 <= rs_d1_lo - rs_plane_t_1_2;
-  d1_above <= unsigned(minus_146(32 downto 32));
+  minus_155 <= rs_d1_lo - rs_plane_t_1_2;
+  d1_above <= unsigned(minus_155(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
   go_near_c <= d1_above when negative = "1" else d0_above;
@@ -3241,10 +3118,10 @@ begin
   enter_far <= g_inner_and_not_go_near and go_far;
   push <= enter_near and go_far;
   rs_g_sp <= g_sp(4 downto 0);
-  cat_148 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
+  cat_157 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
   u_far_min <= unsigned(far_min);
   u_g_tmax <= unsigned(g_tmax);
-  cat_149 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
+  cat_158 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
   enter_near_or_enter_far <= enter_near or enter_far;
   g_pop <= not enter_near_or_enter_far;
   mux_enter_near <= near when enter_near = "1" else far;
@@ -3259,8 +3136,8 @@ begin
   g_sp_m1 <= g_sp when push = "1" else g_sp_minus_k_1;
   g_done <= g_pop and g_sp_zero;
   rs_g_sp_m1 <= g_sp_m1(4 downto 0);
-  cat_150 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp_m1)));
-  stack_raddr_next <= cat_150 when g_valid = "1" else q_stack_raddr;
+  cat_159 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp_m1)));
+  stack_raddr_next <= cat_159 when g_valid = "1" else q_stack_raddr;
 
   ring_g_regs : process (clk)
   begin
@@ -3270,8 +3147,8 @@ begin
       else
         stack_we_r <= push;
       end if;
-      stack_waddr_r <= cat_148;
-      stack_wdata_r <= cat_149;
+      stack_waddr_r <= cat_157;
+      stack_wdata_r <= cat_158;
     end if;
   end process ring_g_regs;
 
