@@ -337,6 +337,10 @@ mod tests {
         // About 40 % of the cycles in which rays remained, which are at least 4 per ray (the
         // core takes one ray per 4 clocks at most): over 30 % of those.
         assert!(stats.stall_cycles * 10 >= 3 * 4 * stats.rays, "{stats:?}");
-        assert!(stats.cycles > plain.cycles, "stalls cost cycles: {} vs {}", stats.cycles, plain.cycles);
+        // Whether 40 % stalls lengthen so short a frame depends on its slowest ray (the free
+        // list's slot order made them cost nothing here: 898 clocks either way); a source that
+        // stalls 90 % of the time holds the last rays back past it.
+        let (_, heavy) = simulate_rust(&p, &roms, &fed, &Stalls::random(90, 5), &|_| {});
+        assert!(stats.cycles >= plain.cycles && heavy.cycles > plain.cycles, "{stats:?} {heavy:?} {plain:?}");
     }
 }
