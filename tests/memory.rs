@@ -130,7 +130,7 @@ fn external_memory_cores_run_alike_in_every_simulator() {
     // The source stalls too (a third of the clocks): the HDL testbench's source and the Rust
     // one must hold back on the same clocks.
     let stalls = Stalls::random(33, 8);
-    let (want, stats, _) = simulate_external(&p, &roms, &image, &rays, timing, &stalls, &|_| ());
+    let (want, stats, _) = simulate_external(&p, &roms, &image, &rays, timing, &stalls, &|_| ()).unwrap();
     assert_eq!(mismatches(&scene, &rays, &want), 0);
     let mut stream = frame_stream(&p, &scene, &rays, &stalls).unwrap();
     stream.memory = Some((timing, image.bytes.clone()));

@@ -87,8 +87,14 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
         Some(m) => {
             let image = SceneImage::build(&roms, m.spec.shape)?;
             let timing = MemoryTiming::default();
-            let (r, s, ms) = simulate_external(&p, &roms, &image, &rays, timing, &stalls, &|n| bar.set_position(n));
-            (r, s, Some(ms))
+            match simulate_external(&p, &roms, &image, &rays, timing, &stalls, &|n| bar.set_position(n)) {
+                Ok((r, s, ms)) => (r, s, Some(ms)),
+                Err(stopped) => {
+                    bar.finish_and_clear();
+                    eprintln!("fxrt: {stopped}");
+                    return Ok(false);
+                }
+            }
         }
         None => {
             let (r, s) = frame::simulate_rust(&p, &roms, &rays, &stalls, &|n| bar.set_position(n));

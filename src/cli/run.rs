@@ -455,11 +455,19 @@ pub fn sim(c: &SimConfig) -> Result<bool> {
         (Simulation::Rust, _, None) if p.mem.is_some() => {
             let image = scene::memory::SceneImage::build(&roms, c.mem_spec.shape)?;
             let bar = frame::progress_bar(rays.len() as u64, "rust");
-            let (results, stats, ms) =
+            let run =
                 crate::verify::frame_memory::simulate_external(&p, &roms, &image, &rays, c.mem_timing, &stalls, &|n| {
                     bar.set_position(n)
                 });
             bar.finish_and_clear();
+            // A core that stops is a defect found, as a mismatch is: one line, exit 1.
+            let (results, stats, ms) = match run {
+                Ok(r) => r,
+                Err(stopped) => {
+                    eprintln!("fxrt: {stopped}");
+                    return Ok(false);
+                }
+            };
             memory_stats = Some(ms);
             (results, stats)
         }

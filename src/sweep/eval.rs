@@ -18,7 +18,7 @@ use crate::scene::memory::SceneImage;
 use crate::scene::{Scene, Tri, TriangleCounts, builtin, obj};
 use crate::verify::feed::{Stalls, tile_order};
 use crate::verify::frame::{frame_rays, mismatches, simulate_rust};
-use crate::verify::frame_memory::simulate_external;
+use crate::verify::frame_memory::{Stopped, simulate_external};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::sync::OnceLock;
@@ -327,12 +327,16 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
         },
     };
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
-        let (run, memory) = simulate_core(&scene, &ctx.camera, &core_params, &roms, cfg.shape.memory, &extras.memory);
-        if run.mismatches > 0 {
-            row.error = Some(format!("the core disagrees with the golden model on {} rays", run.mismatches));
+        match simulate_core(&scene, &ctx.camera, &core_params, &roms, cfg.shape.memory, &extras.memory) {
+            Ok((run, memory)) => {
+                if run.mismatches > 0 {
+                    row.error = Some(format!("the core disagrees with the golden model on {} rays", run.mismatches));
+                }
+                row.core = Some(run);
+                row.memory = memory;
+            }
+            Err(stopped) => row.error = Some(stopped.to_string()),
         }
-        row.core = Some(run);
-        row.memory = memory;
     }
     if let (Some(dir), Some(_)) = (&extras.synth_dir, &row.cost) {
         let core = core_module_with(&core_params, &roms, false);
@@ -366,7 +370,8 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
 }
 
 /// The frame through the core of `p` in the Rust simulator: the core's figures and, for an
-/// external-memory core (`memory`), the memory side's at `point`'s latency.
+/// external-memory core (`memory`), the memory side's at `point`'s latency; `Stopped` if that
+/// core stopped producing results.
 fn simulate_core(
     scene: &Scene,
     camera: &Camera,
@@ -374,7 +379,7 @@ fn simulate_core(
     roms: &SceneRoms,
     point: MemoryPoint,
     memory: &Option<MemorySweep>,
-) -> (CoreRun, Option<MemoryRun>) {
+) -> std::result::Result<(CoreRun, Option<MemoryRun>), Stopped> {
     let rays = frame_rays(scene, camera);
     let (results, stats, ms) = match (memory, &p.mem) {
         (Some(m), Some(ext)) => {
@@ -382,7 +387,7 @@ fn simulate_core(
             // The image of a scene the core was just built for fits its own layout.
             let image = SceneImage::build(roms, ext.spec.shape).expect("the scene image of a built core");
             let (results, stats, ms) =
-                simulate_external(p, roms, &image, &rays, memory::timing(point), &Stalls::none(), &|_| {});
+                simulate_external(p, roms, &image, &rays, memory::timing(point), &Stalls::none(), &|_| {})?;
             (
                 results,
                 stats,
@@ -404,7 +409,7 @@ fn simulate_core(
         max_stack_depth: stats.max_stack_depth as u64,
         mismatches: mismatches(scene, &rays, &results),
     };
-    (run, ms)
+    Ok((run, ms))
 }
 
 /// `cost` (`core_cost`'s, for the default core) with what the clock target and the core's

@@ -75,15 +75,30 @@ impl MemoryStats {
 
 /// When a run through an external-memory core has stopped making progress. A slow memory
 /// may make a frame take millions of clocks (thousands of triangle tests a ray, each a miss
-/// through a tiny cache), so the bound is not on the frame's clocks but (a) on the clocks
-/// without a result, a node step or a triangle test — a core that fetches the same lines for
-/// ever (a livelock) steps nothing — and (b) on the node steps and tests themselves: a ray
-/// visits each node (or culls it) and tests each leaf entry at most once (doubled for margin).
+/// through a tiny cache), so the bound is not on the frame's clocks but on progress:
+/// - (a) the clocks without a result, a node step, a triangle test or a newly staged triangle
+///   record (a triangle-cache hit: only records not yet staged are looked up, DECISIONS 109);
+///   a core that fetches the same lines for ever (a livelock) stages nothing;
+/// - (b) the node steps and tests themselves: a ray visits each node (or culls it) and tests
+///   each leaf entry at most once (doubled for margin);
+/// - (c) the records staged between two node steps or tests: each slot has one leaf in flight
+///   and stages each of its records once, so more than slots × the staging places per slot
+///   means records are fetched again and again (a leaf that evicts its own lines, DECISIONS 103).
+///
+/// (a) counted only results, steps and tests until campaign seed 24's case 500: a leaf of
+/// ~1,500 records, one to a line, through one outstanding read of latency 175 took 300,000
+/// clocks to stage with no step in between, and the run was stopped while it progressed.
 struct RunLimits {
     quiet: u64,
     walk: u64,
-    /// Node steps and tests seen at the last progress.
+    /// Records the slots can stage between two node steps or tests (c).
+    staged: u64,
+    /// Node steps and tests seen at the last progress, and records staged by then.
     walked_before: u64,
+    staged_before: u64,
+    /// Records staged by the last node step or test, and the clock of the last progress.
+    staged_at_walk: u64,
+    last_progress: u64,
 }
 
 impl RunLimits {
@@ -98,7 +113,45 @@ impl RunLimits {
         // 2,000 lines is far beyond either.
         let quiet = 50_000 + 2_000 * per_line;
         let walk = 2 * rays * (roms.node.1.len() + roms.leaf.1.len()) as u64 + 1;
-        RunLimits { quiet, walk, walked_before: 0 }
+        let staged = p.slot_count() as u64 * (1u64 << mem.stage_bits);
+        RunLimits { quiet, walk, staged, walked_before: 0, staged_before: 0, staged_at_walk: 0, last_progress: 0 }
+    }
+
+    /// Takes the counts after clock `cycle` (whether a result came out, the node steps and
+    /// tests so far, the records staged so far); Err with the reason once the run has stopped
+    /// making progress.
+    fn check(&mut self, cycle: u64, result: bool, walked: u64, staged: u64) -> Result<(), String> {
+        if result || walked > self.walked_before {
+            (self.last_progress, self.walked_before, self.staged_at_walk) = (cycle, walked, staged);
+        } else if staged > self.staged_before && staged - self.staged_at_walk <= self.staged {
+            self.last_progress = cycle;
+        }
+        self.staged_before = staged;
+        let since_walk = staged - self.staged_at_walk;
+        if cycle - self.last_progress >= self.quiet {
+            Err(format!(
+                "{walked} node steps and tests and {staged} records staged, the last {} clocks ago",
+                cycle - self.last_progress
+            ))
+        } else if walked > self.walk {
+            Err(format!("{walked} node steps and tests, more than the {} the rays can take", self.walk))
+        } else if since_walk > self.staged {
+            Err(format!("{since_walk} records staged since the last node step or test, more than the slots hold"))
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Why a run through an external-memory core was given up: it stopped producing results
+/// (`RunLimits`), or its read master flagged a memory error. A defect of the core, not of the
+/// input: `fxrt sim` prints it on one line and exits 1, the campaign records it as a finding.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Stopped(pub String);
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
     }
 }
 
@@ -106,8 +159,8 @@ impl RunLimits {
 /// testbenches' does, every result taken when shown) through the core of `p` (which must have
 /// external memory) in the cycle simulator, the memory model of `timing` answering from
 /// `image` at `SIM_BASE`. Returns the results in the order they came out, the
-/// core's counts and the memory side's. Panics (a test failure) if the core stops producing
-/// results or flags a memory error.
+/// core's counts and the memory side's; `Stopped` if the core stops producing results or
+/// flags a memory error.
 pub fn simulate_external(
     p: &CoreParams,
     roms: &SceneRoms,
@@ -116,7 +169,7 @@ pub fn simulate_external(
     timing: MemoryTiming,
     stalls: &Stalls,
     progress: &dyn Fn(u64),
-) -> (Vec<CoreResult>, CoreStats, MemoryStats) {
+) -> Result<(Vec<CoreResult>, CoreStats, MemoryStats), Stopped> {
     let mem = p.mem.as_ref().expect("an external-memory core");
     let m = core_module(p, roms);
     let mut sim = Sim::new(&m);
@@ -135,7 +188,6 @@ pub fn simulate_external(
     let idle = vec![0i128; ins.len()];
     let mut next = 0;
     let mut limits = RunLimits::new(p, roms, rays.len() as u64, &timing);
-    let mut last_progress = 0;
     sim.set(res_ready, 1);
     sim.set(mem_ins[0], SIM_BASE as i128);
     while results.len() < rays.len() {
@@ -170,22 +222,17 @@ pub fn simulate_external(
                 progress(results.len() as u64);
             }
         }
-        assert!(sim.get(error) == 0, "cycle {}: the read master flagged a memory error", stats.cycles);
-        let walked = stats.visits + stats.culls + stats.busy_cycles;
-        if shown.is_some() || walked > limits.walked_before {
-            (last_progress, limits.walked_before) = (stats.cycles, walked);
+        if sim.get(error) != 0 {
+            return Err(Stopped(format!("clock {}: the read master flagged a memory error", stats.cycles)));
         }
-        assert!(
-            stats.cycles - last_progress < limits.quiet && walked <= limits.walk,
-            "the core stopped producing results ({} of {}; {walked} node steps and tests, the last {} clocks ago)",
-            results.len(),
-            rays.len(),
-            stats.cycles - last_progress
-        );
+        let walked = stats.visits + stats.culls + stats.busy_cycles;
+        limits.check(stats.cycles, shown.is_some(), walked, ms.tri_hits).map_err(|why| {
+            Stopped(format!("the core stopped producing results ({} of {}; {why})", results.len(), rays.len()))
+        })?;
     }
     (ms.reads, ms.beats) = (model.bursts_taken, model.beats);
     ms.finish(stats.rays, stats.cycles);
-    (results, stats, ms)
+    Ok((results, stats, ms))
 }
 
 #[cfg(test)]
@@ -198,6 +245,45 @@ mod tests {
     use crate::scene::memory::MemoryShape;
     use crate::scene::{Scene, SceneSource};
     use crate::verify::frame::{frame_rays, golden_walk, mismatches};
+
+    fn limits(quiet: u64, staged: u64) -> RunLimits {
+        RunLimits {
+            quiet,
+            walk: 1_000,
+            staged,
+            walked_before: 0,
+            staged_before: 0,
+            staged_at_walk: 0,
+            last_progress: 0,
+        }
+    }
+
+    /// A leaf staged a record at a time, far longer than the quiet bound with no node step
+    /// (campaign seed 24, case 500) is progress; a clock count past the bound with nothing at
+    /// all is not, and neither are more records staged between two steps than the slots hold.
+    #[test]
+    fn staging_a_long_leaf_is_progress_but_staging_without_end_is_not() {
+        let mut l = limits(1_000, 50);
+        l.check(1, false, 3, 0).unwrap();
+        // 40 records, one every 300 clocks: 12,000 clocks without a step.
+        for (cycle, staged) in (1..=12_000u64).map(|c| (1 + c, c / 300)) {
+            l.check(cycle, false, 3, staged).unwrap();
+        }
+        // A test (the leaf in the pipeline) resets the count of records staged.
+        l.check(12_002, false, 4, 40).unwrap();
+        let staging = (1..=20_000u64).map(|c| (12_002 + c, 40 + c / 300));
+        let stopped =
+            staging.clone().find_map(|(c, staged)| l.check(c, false, 4, staged).err().map(|why| (staged, why)));
+        let (staged, why) = stopped.expect("staging without end is stopped");
+        assert_eq!(staged, 40 + 51, "{why}");
+        assert!(why.contains("more than the slots hold"), "{why}");
+        let mut l = limits(1_000, 50);
+        l.check(1, true, 0, 0).unwrap();
+        let stopped = (2..3_000).find_map(|c| l.check(c, false, 0, 0).err().map(|why| (c, why)));
+        let (cycle, why) = stopped.expect("a run without progress is stopped");
+        assert_eq!(cycle, 1_001);
+        assert!(why.contains("the last 1000 clocks ago"), "{why}");
+    }
 
     /// Every ray's result is the golden model's, and the walk is `trace_culled`'s step for
     /// step, whatever the memory's latency and pauses.
@@ -215,7 +301,8 @@ mod tests {
             MemoryTiming::default(),
             MemoryTiming { latency: 200, extra_delay: 30, pause_in_256: 60, seed: 7, ..MemoryTiming::default() },
         ] {
-            let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ());
+            let (results, stats, ms) =
+                simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ()).unwrap();
             assert_eq!(mismatches(&scene, &rays, &results), 0, "{timing:?}");
             assert_eq!((stats.visits + stats.culls, stats.busy_cycles), (steps, tests), "{timing:?}");
             assert!(ms.node_hits < ms.node_lookups && ms.tri_hits < ms.tri_lookups, "{ms:?}");
@@ -247,7 +334,8 @@ mod tests {
             let image = SceneImage::build(&roms, spec.shape).unwrap();
             let timing =
                 MemoryTiming { latency: 60, extra_delay: 20, pause_in_256: 50, seed: 3, ..MemoryTiming::default() };
-            let (results, stats, _) = simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ());
+            let (results, stats, _) =
+                simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ()).unwrap();
             assert_eq!(mismatches(&scene, &rays, &results), 0, "{ways} ways");
             assert_eq!((stats.visits + stats.culls, stats.busy_cycles), (steps, tests), "{ways} ways");
         }
@@ -267,7 +355,7 @@ mod tests {
         assert!(p.mem.as_ref().unwrap().node_line_shift() > p.trav.node_bits, "the case it guards");
         let image = SceneImage::build(&roms, spec.shape).unwrap();
         let (results, _, _) =
-            simulate_external(&p, &roms, &image, &rays, MemoryTiming::default(), &Stalls::none(), &|_| ());
+            simulate_external(&p, &roms, &image, &rays, MemoryTiming::default(), &Stalls::none(), &|_| ()).unwrap();
         assert_eq!(mismatches(&scene, &rays, &results), 0);
     }
 }

@@ -149,7 +149,9 @@ pub fn run(case: &Case, b: &Built, hdl: Option<Simulator>) -> CaseOutcome {
     let external = b.image.as_ref().zip(case.memory.map(|m| m.1));
     let (results, stats) = match external {
         Some((image, timing)) => {
-            let (results, stats, _) = simulate_external(&b.core, &b.roms, image, &b.rays, timing, &stalls, &|_| {});
+            // A core that stops is a finding, recorded as a panic is (`run_case`).
+            let run = simulate_external(&b.core, &b.roms, image, &b.rays, timing, &stalls, &|_| {});
+            let (results, stats, _) = run.unwrap_or_else(|stopped| panic!("{stopped}"));
             (results, stats)
         }
         None => simulate_rust(&b.core, &b.roms, &b.rays, &stalls, &|_| {}),
