@@ -332,8 +332,8 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
 
-/// `--device` fits the shape: the ML509's top without `--units` (the XC5VLX110T's 64 DSP48E
-/// take one unit, said on stderr); with `--units` too it is refused, as is a folder of ROM
+/// `--device` fits the shape: the ML509's top (the XC5VLX110T's 64 DSP48E take one unit, said
+/// on stderr); with `--units` too it is refused, as is a folder of ROM
 /// images (the fit runs the scene).
 #[test]
 fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
@@ -592,10 +592,12 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     assert_eq!(o3.status.code(), Some(2), "{}", stderr(&o3));
     assert!(stderr(&o3).starts_with("fxrt: --board: ") && stderr(&o3).contains("--no-bitstream"), "{}", stderr(&o3));
     assert!(!out.exists());
-    // The default core's two traversal units need 70 DSP48E: the ML509 takes one.
-    assert_rejected(&with(&["ml509"]), "--units", &out);
-    let o2 = fxrt(&with(&["ml509", "--units", "1"]));
+    // The default core's two traversal units need 70 DSP48E: with no shape option the ML509's
+    // core is fitted to its XC5VLX110T (one unit); a shape given that does not fit is refused.
+    assert_rejected(&with(&["ml509", "--units", "3", "--slots", "16"]), "--units", &out);
+    let o2 = fxrt(&with(&["ml509"]));
     assert!(o2.status.success(), "{}", stderr(&o2));
+    assert!(stderr(&o2).contains("XC5VLX110T: chosen 1 units"), "{}", stderr(&o2));
     let names: Vec<String> =
         std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     for ext in [".ucf", ".tcl", ".json"] {

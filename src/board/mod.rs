@@ -74,6 +74,14 @@ impl Board {
         }
     }
 
+    /// The board's FPGA.
+    pub fn device(self) -> crate::fpga::device::Device {
+        match self {
+            Board::Ulx3s => crate::fpga::device::Device::Lfe5u85f,
+            Board::Ml509 => crate::fpga::device::Device::Xc5vlx110t,
+        }
+    }
+
     /// DSP48E slices on the XC5VLX110T: the core must fit (`cores::cost::dsp48e_estimate`).
     /// The ULX3S's 156 MULT18X18D hold two traversal units (70 measured) and nextpnr says so
     /// when a design does not fit.

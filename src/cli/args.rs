@@ -25,6 +25,16 @@ pub struct ThreadArgs {
     pub device: Option<crate::fpga::device::Device>,
 }
 
+impl ThreadArgs {
+    /// No shape option: what clap fills in (an explicit default cannot be told apart).
+    pub const DEFAULT: ThreadArgs = ThreadArgs {
+        slots: crate::cores::top::DEFAULT_SLOTS,
+        units: crate::cores::top::DEFAULT_UNITS,
+        pipelines: 1,
+        device: None,
+    };
+}
+
 /// Choices of the hardware that do not change the arithmetic.
 #[derive(Args, Debug, Clone, PartialEq, Eq)]
 pub struct HwArgs {

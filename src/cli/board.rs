@@ -23,6 +23,19 @@ fn board_camera(scene: &Scene, spec: &CameraSpec) -> Result<crate::model::raygen
     crate::model::raygen::RayGen::for_camera(scene, &spec)
 }
 
+/// The core's shape options for board `b`: as given, but with none given (and the scene on
+/// chip) the ML509's core is fitted to its XC5VLX110T — the default two units need 70 DSP48E
+/// of its 64 (DECISIONS 124). The ULX3S's LFE5U-85F holds the default core.
+fn board_threads(c: &GenConfig, b: &BoardConfig) -> super::ThreadArgs {
+    let on_chip = c.memory != super::args::MemoryPlace::External;
+    match b.board {
+        crate::board::Board::Ml509 if on_chip && c.threads == super::ThreadArgs::DEFAULT => {
+            super::ThreadArgs { device: Some(b.board.device()), ..c.threads }
+        }
+        _ => c.threads,
+    }
+}
+
 /// Writes the board design; for the ULX3S (unless --no-bitstream) places, routes and packs it.
 /// False when the bitstream misses its clock.
 pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
@@ -34,7 +47,7 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
     let roms = SceneRoms::of(&scene);
     let external = c.memory == super::args::MemoryPlace::External;
-    let (spec, fit) = super::device::shape(&c.threads, Some(&scene), c.core_spec(), external)?;
+    let (spec, fit) = super::device::shape(&board_threads(c, b), Some(&scene), c.core_spec(), external)?;
     let p = CoreParams::shaped(&roms, &spec);
     p.check()?;
     p.check_device(&roms, c.bram_kbits)?;

@@ -132,12 +132,7 @@ pub fn bench(c: &BenchConfig) -> Result<bool> {
                 tag_width: 32,
                 div_bits: 1,
                 target_mhz: crate::cores::clock::DEFAULT_TARGET_MHZ,
-                threads: super::ThreadArgs {
-                    slots: crate::cores::top::DEFAULT_SLOTS,
-                    units: crate::cores::top::DEFAULT_UNITS,
-                    pipelines: 1,
-                    device: None,
-                },
+                threads: super::ThreadArgs::DEFAULT,
             };
             let p = intersect_params(&params, &scene, &hw)?;
             let vectors = vectors::generate(&scene, vectors, 1);
