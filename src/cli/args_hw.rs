@@ -20,6 +20,10 @@ pub struct DemoArgs {
     /// auto (on chip when it fits the LFE5U-85F's block RAM, as the teapot does).
     #[arg(long, value_enum, default_value = "auto")]
     pub memory: super::args::MemoryPlace,
+    /// Fit the core's slots, units and pipelines to this device (as `gen --device`), and
+    /// count its block RAM for `--memory auto`; the default core and the LFE5U-85F without it.
+    #[arg(long, value_enum)]
+    pub device: Option<crate::fpga::device::Device>,
 }
 
 /// `fxrt sweep`: every parameter takes a list (`12,16,20`), a range (`20..29`, inclusive) or a

@@ -38,6 +38,7 @@ pub struct DemoConfig {
     pub width: u32,
     pub height: u32,
     pub memory: super::args::MemoryPlace,
+    pub device: Option<crate::fpga::device::Device>,
 }
 
 impl DemoArgs {
@@ -45,7 +46,7 @@ impl DemoArgs {
         let (width, height) = self.size;
         check_size(width, height)?;
         crate::io::check_folder(&self.out)?;
-        Ok(DemoConfig { out: self.out.clone(), width, height, memory: self.memory })
+        Ok(DemoConfig { out: self.out.clone(), width, height, memory: self.memory, device: self.device })
     }
 }
 
@@ -54,13 +55,23 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default())?;
     let roms = SceneRoms::of(&scene);
     let target = crate::cores::clock::DEFAULT_TARGET_MHZ;
-    let shape = crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() };
+    let base = crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() };
+    let threads = super::ThreadArgs { device: c.device, ..super::ThreadArgs::DEFAULT };
+    let external = c.memory == super::args::MemoryPlace::External;
+    let (shape, fit) = super::device::shape(&threads, Some(&scene), base, external)?;
     let p = CoreParams::shaped(&roms, &shape);
     p.check()?;
+    // A fitted shape holds the scene on chip by the device's own counts (the fit's: DP16KD on
+    // the ECP5, where the bit count of `check_device` over-states a 4 × 32, P = 2 core).
     let bram_kbits = super::config::ECP5_85F_BRAM_KBITS;
-    let p = super::placement::place_scene(c.memory, MemorySpec::default(), bram_kbits, &roms, &shape, p)?;
-    p.check_device(&roms, bram_kbits)?;
+    let place = if fit.is_some() { super::args::MemoryPlace::Onchip } else { c.memory };
+    let p = super::placement::place_scene(place, MemorySpec::default(), bram_kbits, &roms, &shape, p)?;
+    if fit.is_none() {
+        p.check_device(&roms, bram_kbits)?;
+    }
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
+    super::device::say(fit.as_ref());
+    let fit_json = fit.as_ref().map(|f| serde_json::to_value(f).unwrap_or_default());
     let netlist = std::rc::Rc::new(core_module_with(&p, &roms, false));
     let measured = crate::fpga::ecp5::measured_entry(
         Path::new("generated/measured/ecp5-core.json"),
@@ -75,7 +86,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let hdl = c.out.join("hdl");
     // Kept in memory while the frame is simulated (an interrupted demo leaves nothing), then
     // written with the pictures as one set.
-    let core_files = generate::core_files(&p, &roms, &netlist, o, None, measured.as_ref(), None);
+    let core_files = generate::core_files(&p, &roms, &netlist, o, None, measured.as_ref(), fit_json.as_ref());
     let hdl_files = core_files.len();
 
     // A frame through the core, in the Rust simulator, every pixel against the golden model.
@@ -131,14 +142,15 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
         hdl_files + if p.mem.is_some() { 2 } else { 0 },
     );
     println!(
-        "  frame {}x{}: {} rays reached the scene box, {:.2} clock cycles per ray ({:.3} rays per clock, {} units × {} slots)",
+        "  frame {}x{}: {} rays reached the scene box, {:.2} clock cycles per ray ({:.3} rays per clock, {} units × {} slots{})",
         c.width,
         c.height,
         stats.rays,
         stats.cycles_per_ray(),
         stats.rays_per_clock(),
         p.units,
-        p.slot_count() / p.units.max(1)
+        p.slot_count() / p.units.max(1),
+        if p.pipelines > 1 { format!(", {} intersection pipelines", p.pipelines) } else { String::new() }
     );
     if let (Some(ms), Some(m)) = (&memory, &p.mem) {
         println!(
