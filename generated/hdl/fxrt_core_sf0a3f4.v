@@ -878,7 +878,14 @@ module fxrt_core_sf0a3f4 (
   wire [63:0] mux_res_q_popped_1;
   reg [63:0] res_q_din_r1 = 64'h0000000000000000;
   wire [63:0] res_q_head1;
+  reg [0:0] res_out_valid = 1'h0;
+  wire [0:0] not_res_out_valid;
+  wire [0:0] res_out_room;
   wire [0:0] res_take_c;
+  wire [0:0] not_res_out_room;
+  wire [0:0] res_out_valid_c;
+  reg [63:0] res_out0 = 64'h0000000000000000;
+  reg [63:0] res_out1 = 64'h0000000000000000;
   reg [5:0] res_credits = 6'h10;
   wire [0:0] not_done_valid_r;
   wire [5:0] rs_not_done_valid_r;
@@ -1677,7 +1684,11 @@ module fxrt_core_sf0a3f4 (
   assign res_q_q_next1 = {res_q_q_next1_g3, res_q_q_next1_g2, res_q_q_next1_g1, res_q_q_next1_g0};
   assign mux_res_q_popped_1 = res_q_popped ? res_q_q_next1 : res_q_q_stay1;
   assign res_q_head1 = res_q_bypass ? res_q_din_r1 : mux_res_q_popped_1;
-  assign res_take_c = res_q_nonempty & res_ready;
+  assign not_res_out_valid = ~res_out_valid;
+  assign res_out_room = not_res_out_valid | res_ready;
+  assign res_take_c = res_q_nonempty & res_out_room;
+  assign not_res_out_room = ~res_out_room;
+  assign res_out_valid_c = res_q_nonempty | not_res_out_room;
   assign not_done_valid_r = ~done_valid_r;
   assign rs_not_done_valid_r = {{5{1'b0}}, not_done_valid_r};
   assign res_credits_if_take = res_credits + rs_not_done_valid_r;
@@ -1690,12 +1701,12 @@ module fxrt_core_sf0a3f4 (
   assign mux_done_valid_r = done_valid_r ? res_credits_ge2 : res_credits_ge1;
   assign mux_done_valid_r_1 = done_valid_r ? res_credits_ge3 : res_credits_ge2;
   assign res_credit_ok_c = res_take ? mux_done_valid_r : mux_done_valid_r_1;
-  assign res_t_q = res_q_head0[29:0];
-  assign res_tri_q = res_q_head0[42:30];
-  assign res_hit_q = res_q_head0[43];
-  assign res_id_q = res_q_head0[63:44];
-  assign res_v_q = res_q_head1[31:0];
-  assign res_u_q = res_q_head1[63:32];
+  assign res_t_q = res_out0[29:0];
+  assign res_tri_q = res_out0[42:30];
+  assign res_hit_q = res_out0[43];
+  assign res_id_q = res_out0[63:44];
+  assign res_v_q = res_out1[31:0];
+  assign res_u_q = res_out1[63:32];
 
   always @(posedge clk) begin : result_queue_regs
     if (rst) res_q_wr <= 4'h0;
@@ -1756,6 +1767,10 @@ module fxrt_core_sf0a3f4 (
     res_q_q_next1_g1 <= res_q_mem1_g1[res_q_rd11_p1];
     res_q_q_next1_g0 <= res_q_mem1_g0[res_q_rd1];
     if (res_q_push) res_q_din_r1 <= res_q_din1;
+    if (rst) res_out_valid <= 1'h0;
+    else res_out_valid <= res_out_valid_c;
+    if (res_take) res_out0 <= res_q_head0;
+    if (res_take) res_out1 <= res_q_head1;
     if (rst) res_credits <= 6'h10;
     else res_credits <= res_credits_next;
   end
@@ -2017,7 +2032,7 @@ module fxrt_core_sf0a3f4 (
   );
 
   assign ray_ready = port_empty;
-  assign res_valid = res_q_nonempty;
+  assign res_valid = res_out_valid;
   assign res_id = res_id_q;
   assign res_hit = res_hit_q;
   assign res_tri = res_tri_q;

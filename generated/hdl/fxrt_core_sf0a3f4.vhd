@@ -1069,7 +1069,14 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal mux_res_q_popped_1 : unsigned(63 downto 0);
   signal res_q_din_r1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_q_head1 : unsigned(63 downto 0);
+  signal res_out_valid : unsigned(0 downto 0) := unsigned'("0");
+  signal not_res_out_valid : unsigned(0 downto 0);
+  signal res_out_room : unsigned(0 downto 0);
   signal res_take_c : unsigned(0 downto 0);
+  signal not_res_out_room : unsigned(0 downto 0);
+  signal res_out_valid_c : unsigned(0 downto 0);
+  signal res_out0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal res_out1 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal res_credits : unsigned(5 downto 0) := unsigned'("010000");
   signal not_done_valid_r : unsigned(0 downto 0);
   signal rs_not_done_valid_r : unsigned(5 downto 0);
@@ -2252,7 +2259,11 @@ begin
   res_q_q_next1 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_next1_g3) & std_logic_vector(res_q_q_next1_g2) & std_logic_vector(res_q_q_next1_g1) & std_logic_vector(res_q_q_next1_g0)));
   mux_res_q_popped_1 <= res_q_q_next1 when res_q_popped = "1" else res_q_q_stay1;
   res_q_head1 <= res_q_din_r1 when res_q_bypass = "1" else mux_res_q_popped_1;
-  res_take_c <= res_q_nonempty and res_ready;
+  not_res_out_valid <= not res_out_valid;
+  res_out_room <= not_res_out_valid or res_ready;
+  res_take_c <= res_q_nonempty and res_out_room;
+  not_res_out_room <= not res_out_room;
+  res_out_valid_c <= res_q_nonempty or not_res_out_room;
   not_done_valid_r <= not done_valid_r;
   rs_not_done_valid_r <= resize(not_done_valid_r, 6);
   res_credits_if_take <= res_credits + rs_not_done_valid_r;
@@ -2265,12 +2276,12 @@ begin
   mux_done_valid_r <= res_credits_ge2 when done_valid_r = "1" else res_credits_ge1;
   mux_done_valid_r_1 <= res_credits_ge3 when done_valid_r = "1" else res_credits_ge2;
   res_credit_ok_c <= mux_done_valid_r when res_take = "1" else mux_done_valid_r_1;
-  res_t_q <= unsigned(res_q_head0(29 downto 0));
-  res_tri_q <= unsigned(res_q_head0(42 downto 30));
-  res_hit_q <= unsigned(res_q_head0(43 downto 43));
-  res_id_q <= unsigned(res_q_head0(63 downto 44));
-  res_v_q <= unsigned(res_q_head1(31 downto 0));
-  res_u_q <= unsigned(res_q_head1(63 downto 32));
+  res_t_q <= unsigned(res_out0(29 downto 0));
+  res_tri_q <= unsigned(res_out0(42 downto 30));
+  res_hit_q <= unsigned(res_out0(43 downto 43));
+  res_id_q <= unsigned(res_out0(63 downto 44));
+  res_v_q <= unsigned(res_out1(31 downto 0));
+  res_u_q <= unsigned(res_out1(63 downto 32));
 
   result_queue_regs : process (clk)
   begin
@@ -2393,6 +2404,17 @@ begin
       res_q_q_next1_g0 <= res_q_mem1_g0(to_integer(res_q_rd1));
       if res_q_push = "1" then
         res_q_din_r1 <= res_q_din1;
+      end if;
+      if rst = '1' then
+        res_out_valid <= unsigned'("0");
+      else
+        res_out_valid <= res_out_valid_c;
+      end if;
+      if res_take = "1" then
+        res_out0 <= res_q_head0;
+      end if;
+      if res_take = "1" then
+        res_out1 <= res_q_head1;
       end if;
       if rst = '1' then
         res_credits <= unsigned'("010000");
@@ -2678,7 +2700,7 @@ begin
     );
 
   ray_ready <= port_empty;
-  res_valid <= res_q_nonempty;
+  res_valid <= res_out_valid;
   res_id <= res_id_q;
   res_hit <= res_hit_q;
   res_tri <= res_tri_q;

@@ -52,7 +52,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
       p3 : out signed(63 downto 0)
     );
   end component;
-  component fxrt_div_n29_a63_b34 is
+  component fxrt_div_n29_a63_b34_se is
     port (
       clk : in std_logic;
       num : in signed(62 downto 0);
@@ -201,17 +201,17 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal s10_num : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
   signal s10_den : signed(33 downto 0) := signed'("0000000000000000000000000000000000");
 
-  -- stage s47_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
+  -- stage s49_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   signal u_div_t_1 : unsigned(29 downto 0);
   signal u_div_ok : unsigned(0 downto 0);
   signal rs_u_div_t_1 : unsigned(30 downto 0);
   signal s_rs_u_div_t_1 : signed(30 downto 0);
-  type s2_w_p_d39_sr_t is array (1 to 39) of signed(31 downto 0);
-  signal s2_w_p_d39_sr : s2_w_p_d39_sr_t := (others => (others => '0'));
-  signal s2_w_p_d39 : signed(31 downto 0);
-  type s2_w_q_d39_sr_t is array (1 to 39) of signed(31 downto 0);
-  signal s2_w_q_d39_sr : s2_w_q_d39_sr_t := (others => (others => '0'));
-  signal s2_w_q_d39 : signed(31 downto 0);
+  type s2_w_p_d41_sr_t is array (1 to 41) of signed(31 downto 0);
+  signal s2_w_p_d41_sr : s2_w_p_d41_sr_t := (others => (others => '0'));
+  signal s2_w_p_d41 : signed(31 downto 0);
+  type s2_w_q_d41_sr_t is array (1 to 41) of signed(31 downto 0);
+  signal s2_w_q_d41_sr : s2_w_q_d41_sr_t := (others => (others => '0'));
+  signal s2_w_q_d41 : signed(31 downto 0);
   signal u_moved_products_p0 : signed(62 downto 0);
   signal u_moved_products_p1 : signed(62 downto 0);
   constant k_1073741824_1 : signed(62 downto 0) := signed'("000000000000000000000000000000001000000000000000000000000000000");
@@ -219,38 +219,38 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal shr_plus_7 : signed(62 downto 0);
   signal plus_8 : signed(62 downto 0);
   signal shr_plus_8 : signed(62 downto 0);
-  signal s47_tp : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
-  signal s47_tq : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s49_tp : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
+  signal s49_tq : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s48_point: kp, kq: the hit point relative to the first vertex
-  type kp0_d5_d40_sr_t is array (1 to 40) of signed(29 downto 0);
-  signal kp0_d5_d40_sr : kp0_d5_d40_sr_t := (others => (others => '0'));
-  signal kp0_d5_d40 : signed(29 downto 0);
-  signal rs_kp0_d5_d40 : signed(31 downto 0);
-  signal rs_s47_tp : signed(31 downto 0);
+  -- stage s50_point: kp, kq: the hit point relative to the first vertex
+  type kp0_d5_d42_sr_t is array (1 to 42) of signed(29 downto 0);
+  signal kp0_d5_d42_sr : kp0_d5_d42_sr_t := (others => (others => '0'));
+  signal kp0_d5_d42 : signed(29 downto 0);
+  signal rs_kp0_d5_d42 : signed(31 downto 0);
+  signal rs_s49_tp : signed(31 downto 0);
   signal kp : signed(31 downto 0);
-  type kq0_d5_d40_sr_t is array (1 to 40) of signed(29 downto 0);
-  signal kq0_d5_d40_sr : kq0_d5_d40_sr_t := (others => (others => '0'));
-  signal kq0_d5_d40 : signed(29 downto 0);
-  signal rs_kq0_d5_d40 : signed(31 downto 0);
-  signal rs_s47_tq : signed(31 downto 0);
+  type kq0_d5_d42_sr_t is array (1 to 42) of signed(29 downto 0);
+  signal kq0_d5_d42_sr : kq0_d5_d42_sr_t := (others => (others => '0'));
+  signal kq0_d5_d42 : signed(29 downto 0);
+  signal rs_kq0_d5_d42 : signed(31 downto 0);
+  signal rs_s49_tq : signed(31 downto 0);
   signal kq : signed(31 downto 0);
-  signal s48_kp : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal s48_kq : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s50_kp : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal s50_kq : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
-  -- stage s54_uv: the barycentric coordinates u, v
-  type s1_e1p_d47_sr_t is array (1 to 47) of signed(31 downto 0);
-  signal s1_e1p_d47_sr : s1_e1p_d47_sr_t := (others => (others => '0'));
-  signal s1_e1p_d47 : signed(31 downto 0);
-  type s1_e1q_d47_sr_t is array (1 to 47) of signed(31 downto 0);
-  signal s1_e1q_d47_sr : s1_e1q_d47_sr_t := (others => (others => '0'));
-  signal s1_e1q_d47 : signed(31 downto 0);
-  type s1_e2q_d47_sr_t is array (1 to 47) of signed(31 downto 0);
-  signal s1_e2q_d47_sr : s1_e2q_d47_sr_t := (others => (others => '0'));
-  signal s1_e2q_d47 : signed(31 downto 0);
-  type s1_e2p_d47_sr_t is array (1 to 47) of signed(31 downto 0);
-  signal s1_e2p_d47_sr : s1_e2p_d47_sr_t := (others => (others => '0'));
-  signal s1_e2p_d47 : signed(31 downto 0);
+  -- stage s56_uv: the barycentric coordinates u, v
+  type s1_e1p_d49_sr_t is array (1 to 49) of signed(31 downto 0);
+  signal s1_e1p_d49_sr : s1_e1p_d49_sr_t := (others => (others => '0'));
+  signal s1_e1p_d49 : signed(31 downto 0);
+  type s1_e1q_d49_sr_t is array (1 to 49) of signed(31 downto 0);
+  signal s1_e1q_d49_sr : s1_e1q_d49_sr_t := (others => (others => '0'));
+  signal s1_e1q_d49 : signed(31 downto 0);
+  type s1_e2q_d49_sr_t is array (1 to 49) of signed(31 downto 0);
+  signal s1_e2q_d49_sr : s1_e2q_d49_sr_t := (others => (others => '0'));
+  signal s1_e2q_d49 : signed(31 downto 0);
+  type s1_e2p_d49_sr_t is array (1 to 49) of signed(31 downto 0);
+  signal s1_e2p_d49_sr : s1_e2p_d49_sr_t := (others => (others => '0'));
+  signal s1_e2p_d49 : signed(31 downto 0);
   signal u_bary_products_p0 : signed(63 downto 0);
   signal u_bary_products_p1 : signed(63 downto 0);
   signal u_bary_products_p2 : signed(63 downto 0);
@@ -261,160 +261,170 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal rs_u_bary_products_p2 : signed(64 downto 0);
   signal rs_u_bary_products_p3 : signed(64 downto 0);
   signal v_int : signed(64 downto 0);
-  signal s54_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s54_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s56_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s56_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s55_test: u + v as two short sums; the signs
-  signal u_s54_u : unsigned(64 downto 0);
-  signal bits_u_s54_u : unsigned(15 downto 0);
-  signal rs_bits_u_s54_u : unsigned(16 downto 0);
-  signal u_s54_v : unsigned(64 downto 0);
-  signal bits_u_s54_v : unsigned(15 downto 0);
-  signal rs_bits_u_s54_v : unsigned(16 downto 0);
+  -- stage s57_test: u + v as two short sums; the signs
+  signal u_s56_u : unsigned(64 downto 0);
+  signal bits_u_s56_u : unsigned(15 downto 0);
+  signal rs_bits_u_s56_u : unsigned(16 downto 0);
+  signal u_s56_v : unsigned(64 downto 0);
+  signal bits_u_s56_v : unsigned(15 downto 0);
+  signal rs_bits_u_s56_v : unsigned(16 downto 0);
   signal uv_sum_high : unsigned(16 downto 0);
-  signal u_s54_u_1 : unsigned(64 downto 0);
-  signal bits_u_s54_u_1 : unsigned(48 downto 0);
-  signal rs_bits_u_s54_u_1 : unsigned(49 downto 0);
-  signal u_s54_v_1 : unsigned(64 downto 0);
-  signal bits_u_s54_v_1 : unsigned(48 downto 0);
-  signal rs_bits_u_s54_v_1 : unsigned(49 downto 0);
+  signal u_s56_u_1 : unsigned(64 downto 0);
+  signal bits_u_s56_u_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s56_u_1 : unsigned(49 downto 0);
+  signal u_s56_v_1 : unsigned(64 downto 0);
+  signal bits_u_s56_v_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s56_v_1 : unsigned(49 downto 0);
   signal uv_sum_low : unsigned(49 downto 0);
   constant k_0_1 : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s54_u_lt_k_0_1 : unsigned(0 downto 0);
-  signal s54_v_lt_k_0_1 : unsigned(0 downto 0);
+  signal s56_u_lt_k_0_1 : unsigned(0 downto 0);
+  signal s56_v_lt_k_0_1 : unsigned(0 downto 0);
   signal negative : unsigned(0 downto 0);
-  signal s55_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
-  signal s55_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
-  signal s55_neg : unsigned(0 downto 0) := unsigned'("0");
+  signal s57_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
+  signal s57_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
+  signal s57_neg : unsigned(0 downto 0) := unsigned'("0");
 
-  -- stage s56_hit: the hit bit
-  signal bits_s55_hs : unsigned(15 downto 0);
-  signal bits_bits_s55_hs : unsigned(7 downto 0);
+  -- stage s58_limit: u + v above the limit, by bytes
+  signal bits_s57_hs : unsigned(15 downto 0);
+  signal bits_bits_s57_hs : unsigned(7 downto 0);
   constant k_0_2 : unsigned(7 downto 0) := unsigned'("00000000");
   signal ne_16 : unsigned(0 downto 0);
-  signal bits_bits_s55_hs_1 : unsigned(7 downto 0);
+  signal bits_bits_s57_hs_1 : unsigned(7 downto 0);
   signal ne_17 : unsigned(0 downto 0);
   signal high : unsigned(1 downto 0);
-  signal bits_s55_hs_1 : unsigned(0 downto 0);
-  signal bits_s55_ls : unsigned(0 downto 0);
-  signal bits_s55_ls_1 : unsigned(48 downto 0);
-  signal bits_bits_s55_ls_1 : unsigned(0 downto 0);
+  signal bits_s57_hs_1 : unsigned(0 downto 0);
+  signal bits_s57_ls : unsigned(0 downto 0);
+  signal bits_s57_ls_1 : unsigned(48 downto 0);
+  signal bits_bits_s57_ls_1 : unsigned(0 downto 0);
   constant k_0_3 : unsigned(0 downto 0) := unsigned'("0");
   signal ne_19 : unsigned(0 downto 0);
-  signal bits_bits_s55_ls_1_1 : unsigned(7 downto 0);
+  signal bits_bits_s57_ls_1_1 : unsigned(7 downto 0);
   signal ne_20 : unsigned(0 downto 0);
-  signal bits_bits_s55_ls_1_2 : unsigned(7 downto 0);
+  signal bits_bits_s57_ls_1_2 : unsigned(7 downto 0);
   signal ne_21 : unsigned(0 downto 0);
-  signal bits_bits_s55_ls_1_3 : unsigned(7 downto 0);
+  signal bits_bits_s57_ls_1_3 : unsigned(7 downto 0);
   signal ne_22 : unsigned(0 downto 0);
-  signal bits_bits_s55_ls_1_4 : unsigned(7 downto 0);
+  signal bits_bits_s57_ls_1_4 : unsigned(7 downto 0);
   signal ne_23 : unsigned(0 downto 0);
-  signal bits_bits_s55_ls_1_5 : unsigned(7 downto 0);
+  signal bits_bits_s57_ls_1_5 : unsigned(7 downto 0);
   signal ne_24 : unsigned(0 downto 0);
-  signal bits_bits_s55_ls_1_6 : unsigned(7 downto 0);
+  signal bits_bits_s57_ls_1_6 : unsigned(7 downto 0);
   signal ne_25 : unsigned(0 downto 0);
   signal low : unsigned(6 downto 0);
+  signal s58_high : unsigned(1 downto 0) := unsigned'("00");
+  signal s58_h0 : unsigned(0 downto 0) := unsigned'("0");
+  signal s58_lk : unsigned(0 downto 0) := unsigned'("0");
+  signal s58_low : unsigned(6 downto 0) := unsigned'("0000000");
+  signal s58_neg : unsigned(0 downto 0) := unsigned'("0");
+
+  -- stage s59_hit: the hit bit
   constant k_0_4 : unsigned(6 downto 0) := unsigned'("0000000");
-  signal low_ne_k_0_4 : unsigned(0 downto 0);
-  signal high_ne_k_0 : unsigned(0 downto 0);
+  signal s58_low_ne_k_0_4 : unsigned(0 downto 0);
+  signal s58_high_ne_k_0 : unsigned(0 downto 0);
   signal or_27 : unsigned(0 downto 0);
-  signal bits_s55_hs_1_and_or_27 : unsigned(0 downto 0);
+  signal s58_h0_and_or_27 : unsigned(0 downto 0);
   signal or_28 : unsigned(0 downto 0);
   signal and_29 : unsigned(0 downto 0);
   signal over : unsigned(0 downto 0);
-  signal s55_neg_or_over : unsigned(0 downto 0);
-  signal not_s55_neg_or_over : unsigned(0 downto 0);
-  type u_div_ok_d14_sr_t is array (1 to 14) of unsigned(0 downto 0);
-  signal u_div_ok_d14_sr : u_div_ok_d14_sr_t := (others => (others => '0'));
-  signal u_div_ok_d14 : unsigned(0 downto 0);
+  signal s58_neg_or_over : unsigned(0 downto 0);
+  signal not_s58_neg_or_over : unsigned(0 downto 0);
+  type u_div_ok_d15_sr_t is array (1 to 15) of unsigned(0 downto 0);
+  signal u_div_ok_d15_sr : u_div_ok_d15_sr_t := (others => (others => '0'));
+  signal u_div_ok_d15 : unsigned(0 downto 0);
   signal hit_c : unsigned(0 downto 0);
-  signal s56_hit : unsigned(0 downto 0) := unsigned'("0");
+  signal s59_hit : unsigned(0 downto 0) := unsigned'("0");
 
-  -- stage s57_result: the barycentric test; t, u, v zeroed on a miss
-  type u_div_t_1_d15_sr_t is array (1 to 15) of unsigned(29 downto 0);
-  signal u_div_t_1_d15_sr : u_div_t_1_d15_sr_t := (others => (others => '0'));
-  signal u_div_t_1_d15 : unsigned(29 downto 0);
-  type s54_u_d2_sr_t is array (1 to 2) of signed(64 downto 0);
-  signal s54_u_d2_sr : s54_u_d2_sr_t := (others => (others => '0'));
-  signal s54_u_d2 : signed(64 downto 0);
-  type s54_v_d2_sr_t is array (1 to 2) of signed(64 downto 0);
-  signal s54_v_d2_sr : s54_v_d2_sr_t := (others => (others => '0'));
-  signal s54_v_d2 : signed(64 downto 0);
-  signal s1_valid_d55_1 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_2 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_3 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_4 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_5 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_6 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_7 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_8 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_9 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_10 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_11 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_12 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_13 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_14 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_15 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_16 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_17 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_18 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_19 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_20 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_21 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_22 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_23 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_24 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_25 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_26 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_27 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_28 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_29 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_30 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_31 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_32 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_33 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_34 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_35 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_36 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_37 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_38 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_39 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_40 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_41 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_42 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_43 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_44 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_45 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_46 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_47 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_48 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_49 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_50 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_51 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_52 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_53 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_54 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d55_55 : unsigned(0 downto 0) := unsigned'("0");
-  type s1_tag_d55_sr_t is array (1 to 55) of unsigned(58 downto 0);
-  signal s1_tag_d55_sr : s1_tag_d55_sr_t := (others => (others => '0'));
-  signal s1_tag_d55 : unsigned(58 downto 0);
+  -- stage s60_result: the barycentric test; t, u, v zeroed on a miss
+  type u_div_t_1_d16_sr_t is array (1 to 16) of unsigned(29 downto 0);
+  signal u_div_t_1_d16_sr : u_div_t_1_d16_sr_t := (others => (others => '0'));
+  signal u_div_t_1_d16 : unsigned(29 downto 0);
+  type s56_u_d3_sr_t is array (1 to 3) of signed(64 downto 0);
+  signal s56_u_d3_sr : s56_u_d3_sr_t := (others => (others => '0'));
+  signal s56_u_d3 : signed(64 downto 0);
+  type s56_v_d3_sr_t is array (1 to 3) of signed(64 downto 0);
+  signal s56_v_d3_sr : s56_v_d3_sr_t := (others => (others => '0'));
+  signal s56_v_d3 : signed(64 downto 0);
+  signal s1_valid_d58_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_6 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_7 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_8 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_9 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_10 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_11 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_12 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_13 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_14 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_15 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_16 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_17 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_18 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_19 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_20 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_21 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_22 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_23 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_24 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_25 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_26 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_27 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_28 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_29 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_30 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_31 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_32 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_33 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_34 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_35 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_36 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_37 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_38 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_39 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_40 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_41 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_42 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_43 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_44 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_45 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_46 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_47 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_48 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_49 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_50 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_51 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_52 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_53 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_54 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_55 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_56 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_57 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d58_58 : unsigned(0 downto 0) := unsigned'("0");
+  type s1_tag_d58_sr_t is array (1 to 58) of unsigned(58 downto 0);
+  signal s1_tag_d58_sr : s1_tag_d58_sr_t := (others => (others => '0'));
+  signal s1_tag_d58 : unsigned(58 downto 0);
   constant k_0_5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal mux_s56_hit : unsigned(29 downto 0);
-  signal shr_s54_u_d2 : signed(64 downto 0);
-  signal rs_shr_s54_u_d2 : signed(31 downto 0);
-  signal u_rs_shr_s54_u_d2 : unsigned(31 downto 0);
+  signal mux_s59_hit : unsigned(29 downto 0);
+  signal shr_s56_u_d3 : signed(64 downto 0);
+  signal rs_shr_s56_u_d3 : signed(31 downto 0);
+  signal u_rs_shr_s56_u_d3 : unsigned(31 downto 0);
   constant k_0_6 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal mux_s56_hit_1 : unsigned(31 downto 0);
-  signal shr_s54_v_d2 : signed(64 downto 0);
-  signal rs_shr_s54_v_d2 : signed(31 downto 0);
-  signal u_rs_shr_s54_v_d2 : unsigned(31 downto 0);
-  signal mux_s56_hit_2 : unsigned(31 downto 0);
-  signal s57_valid_out : unsigned(0 downto 0) := unsigned'("0");
-  signal s57_tag_out : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
-  signal s57_hit : unsigned(0 downto 0) := unsigned'("0");
-  signal s57_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal s57_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal s57_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal mux_s59_hit_1 : unsigned(31 downto 0);
+  signal shr_s56_v_d3 : signed(64 downto 0);
+  signal rs_shr_s56_v_d3 : signed(31 downto 0);
+  signal u_rs_shr_s56_v_d3 : unsigned(31 downto 0);
+  signal mux_s59_hit_2 : unsigned(31 downto 0);
+  signal s60_valid_out : unsigned(0 downto 0) := unsigned'("0");
+  signal s60_tag_out : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal s60_hit : unsigned(0 downto 0) := unsigned'("0");
+  signal s60_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s60_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s60_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 begin
 
   -- not in a stage or state machine
@@ -578,55 +588,55 @@ begin
     end if;
   end process s10_quotient_regs;
 
-  -- stage s47_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
+  -- stage s49_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   rs_u_div_t_1 <= resize(u_div_t_1, 31);
   s_rs_u_div_t_1 <= signed(rs_u_div_t_1);
-  s2_w_p_d39 <= s2_w_p_d39_sr(39);
-  s2_w_q_d39 <= s2_w_q_d39_sr(39);
+  s2_w_p_d41 <= s2_w_p_d41_sr(41);
+  s2_w_q_d41 <= s2_w_q_d41_sr(41);
   plus_7 <= u_moved_products_p0 + k_1073741824_1;
   shr_plus_7 <= shift_right(plus_7, 31);
   plus_8 <= u_moved_products_p1 + k_1073741824_1;
   shr_plus_8 <= shift_right(plus_8, 31);
 
-  s47_rounded_regs : process (clk)
+  s49_rounded_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s2_w_p_d39_sr(2 to 39) <= s2_w_p_d39_sr(1 to 38);
-      s2_w_p_d39_sr(1) <= s2_w_p;
-      s2_w_q_d39_sr(2 to 39) <= s2_w_q_d39_sr(1 to 38);
-      s2_w_q_d39_sr(1) <= s2_w_q;
-      s47_tp <= shr_plus_7;
-      s47_tq <= shr_plus_8;
+      s2_w_p_d41_sr(2 to 41) <= s2_w_p_d41_sr(1 to 40);
+      s2_w_p_d41_sr(1) <= s2_w_p;
+      s2_w_q_d41_sr(2 to 41) <= s2_w_q_d41_sr(1 to 40);
+      s2_w_q_d41_sr(1) <= s2_w_q;
+      s49_tp <= shr_plus_7;
+      s49_tq <= shr_plus_8;
     end if;
-  end process s47_rounded_regs;
+  end process s49_rounded_regs;
 
-  -- stage s48_point: kp, kq: the hit point relative to the first vertex
-  kp0_d5_d40 <= kp0_d5_d40_sr(40);
-  rs_kp0_d5_d40 <= resize(kp0_d5_d40, 32);
-  rs_s47_tp <= s47_tp(31 downto 0);
-  kp <= rs_kp0_d5_d40 + rs_s47_tp;
-  kq0_d5_d40 <= kq0_d5_d40_sr(40);
-  rs_kq0_d5_d40 <= resize(kq0_d5_d40, 32);
-  rs_s47_tq <= s47_tq(31 downto 0);
-  kq <= rs_kq0_d5_d40 + rs_s47_tq;
+  -- stage s50_point: kp, kq: the hit point relative to the first vertex
+  kp0_d5_d42 <= kp0_d5_d42_sr(42);
+  rs_kp0_d5_d42 <= resize(kp0_d5_d42, 32);
+  rs_s49_tp <= s49_tp(31 downto 0);
+  kp <= rs_kp0_d5_d42 + rs_s49_tp;
+  kq0_d5_d42 <= kq0_d5_d42_sr(42);
+  rs_kq0_d5_d42 <= resize(kq0_d5_d42, 32);
+  rs_s49_tq <= s49_tq(31 downto 0);
+  kq <= rs_kq0_d5_d42 + rs_s49_tq;
 
-  s48_point_regs : process (clk)
+  s50_point_regs : process (clk)
   begin
     if rising_edge(clk) then
-      kp0_d5_d40_sr(2 to 40) <= kp0_d5_d40_sr(1 to 39);
-      kp0_d5_d40_sr(1) <= kp0_d5;
-      kq0_d5_d40_sr(2 to 40) <= kq0_d5_d40_sr(1 to 39);
-      kq0_d5_d40_sr(1) <= kq0_d5;
-      s48_kp <= kp;
-      s48_kq <= kq;
+      kp0_d5_d42_sr(2 to 42) <= kp0_d5_d42_sr(1 to 41);
+      kp0_d5_d42_sr(1) <= kp0_d5;
+      kq0_d5_d42_sr(2 to 42) <= kq0_d5_d42_sr(1 to 41);
+      kq0_d5_d42_sr(1) <= kq0_d5;
+      s50_kp <= kp;
+      s50_kq <= kq;
     end if;
-  end process s48_point_regs;
+  end process s50_point_regs;
 
-  -- stage s54_uv: the barycentric coordinates u, v
-  s1_e1p_d47 <= s1_e1p_d47_sr(47);
-  s1_e1q_d47 <= s1_e1q_d47_sr(47);
-  s1_e2q_d47 <= s1_e2q_d47_sr(47);
-  s1_e2p_d47 <= s1_e2p_d47_sr(47);
+  -- stage s56_uv: the barycentric coordinates u, v
+  s1_e1p_d49 <= s1_e1p_d49_sr(49);
+  s1_e1q_d49 <= s1_e1q_d49_sr(49);
+  s1_e2q_d49 <= s1_e2q_d49_sr(49);
+  s1_e2p_d49 <= s1_e2p_d49_sr(49);
   rs_u_bary_products_p0 <= resize(u_bary_products_p0, 65);
   rs_u_bary_products_p1 <= resize(u_bary_products_p1, 65);
   u_int <= rs_u_bary_products_p0 - rs_u_bary_products_p1;
@@ -634,409 +644,437 @@ begin
   rs_u_bary_products_p3 <= resize(u_bary_products_p3, 65);
   v_int <= rs_u_bary_products_p2 - rs_u_bary_products_p3;
 
-  s54_uv_regs : process (clk)
+  s56_uv_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s1_e1p_d47_sr(2 to 47) <= s1_e1p_d47_sr(1 to 46);
-      s1_e1p_d47_sr(1) <= s1_e1p;
-      s1_e1q_d47_sr(2 to 47) <= s1_e1q_d47_sr(1 to 46);
-      s1_e1q_d47_sr(1) <= s1_e1q;
-      s1_e2q_d47_sr(2 to 47) <= s1_e2q_d47_sr(1 to 46);
-      s1_e2q_d47_sr(1) <= s1_e2q;
-      s1_e2p_d47_sr(2 to 47) <= s1_e2p_d47_sr(1 to 46);
-      s1_e2p_d47_sr(1) <= s1_e2p;
-      s54_u <= u_int;
-      s54_v <= v_int;
+      s1_e1p_d49_sr(2 to 49) <= s1_e1p_d49_sr(1 to 48);
+      s1_e1p_d49_sr(1) <= s1_e1p;
+      s1_e1q_d49_sr(2 to 49) <= s1_e1q_d49_sr(1 to 48);
+      s1_e1q_d49_sr(1) <= s1_e1q;
+      s1_e2q_d49_sr(2 to 49) <= s1_e2q_d49_sr(1 to 48);
+      s1_e2q_d49_sr(1) <= s1_e2q;
+      s1_e2p_d49_sr(2 to 49) <= s1_e2p_d49_sr(1 to 48);
+      s1_e2p_d49_sr(1) <= s1_e2p;
+      s56_u <= u_int;
+      s56_v <= v_int;
     end if;
-  end process s54_uv_regs;
+  end process s56_uv_regs;
 
-  -- stage s55_test: u + v as two short sums; the signs
-  u_s54_u <= unsigned(s54_u);
-  bits_u_s54_u <= unsigned(u_s54_u(64 downto 49));
-  rs_bits_u_s54_u <= resize(bits_u_s54_u, 17);
-  u_s54_v <= unsigned(s54_v);
-  bits_u_s54_v <= unsigned(u_s54_v(64 downto 49));
-  rs_bits_u_s54_v <= resize(bits_u_s54_v, 17);
-  uv_sum_high <= rs_bits_u_s54_u + rs_bits_u_s54_v;
-  u_s54_u_1 <= unsigned(s54_u);
-  bits_u_s54_u_1 <= unsigned(u_s54_u_1(48 downto 0));
-  rs_bits_u_s54_u_1 <= resize(bits_u_s54_u_1, 50);
-  u_s54_v_1 <= unsigned(s54_v);
-  bits_u_s54_v_1 <= unsigned(u_s54_v_1(48 downto 0));
-  rs_bits_u_s54_v_1 <= resize(bits_u_s54_v_1, 50);
-  uv_sum_low <= rs_bits_u_s54_u_1 + rs_bits_u_s54_v_1;
-  s54_u_lt_k_0_1 <= "1" when s54_u < k_0_1 else "0";
-  s54_v_lt_k_0_1 <= "1" when s54_v < k_0_1 else "0";
-  negative <= s54_u_lt_k_0_1 or s54_v_lt_k_0_1;
+  -- stage s57_test: u + v as two short sums; the signs
+  u_s56_u <= unsigned(s56_u);
+  bits_u_s56_u <= unsigned(u_s56_u(64 downto 49));
+  rs_bits_u_s56_u <= resize(bits_u_s56_u, 17);
+  u_s56_v <= unsigned(s56_v);
+  bits_u_s56_v <= unsigned(u_s56_v(64 downto 49));
+  rs_bits_u_s56_v <= resize(bits_u_s56_v, 17);
+  uv_sum_high <= rs_bits_u_s56_u + rs_bits_u_s56_v;
+  u_s56_u_1 <= unsigned(s56_u);
+  bits_u_s56_u_1 <= unsigned(u_s56_u_1(48 downto 0));
+  rs_bits_u_s56_u_1 <= resize(bits_u_s56_u_1, 50);
+  u_s56_v_1 <= unsigned(s56_v);
+  bits_u_s56_v_1 <= unsigned(u_s56_v_1(48 downto 0));
+  rs_bits_u_s56_v_1 <= resize(bits_u_s56_v_1, 50);
+  uv_sum_low <= rs_bits_u_s56_u_1 + rs_bits_u_s56_v_1;
+  s56_u_lt_k_0_1 <= "1" when s56_u < k_0_1 else "0";
+  s56_v_lt_k_0_1 <= "1" when s56_v < k_0_1 else "0";
+  negative <= s56_u_lt_k_0_1 or s56_v_lt_k_0_1;
 
-  s55_test_regs : process (clk)
+  s57_test_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s55_hs <= uv_sum_high;
-      s55_ls <= uv_sum_low;
-      s55_neg <= negative;
+      s57_hs <= uv_sum_high;
+      s57_ls <= uv_sum_low;
+      s57_neg <= negative;
     end if;
-  end process s55_test_regs;
+  end process s57_test_regs;
 
-  -- stage s56_hit: the hit bit
-  bits_s55_hs <= unsigned(s55_hs(16 downto 1));
-  bits_bits_s55_hs <= unsigned(bits_s55_hs(15 downto 8));
-  ne_16 <= "1" when bits_bits_s55_hs /= k_0_2 else "0";
-  bits_bits_s55_hs_1 <= unsigned(bits_s55_hs(7 downto 0));
-  ne_17 <= "1" when bits_bits_s55_hs_1 /= k_0_2 else "0";
+  -- stage s58_limit: u + v above the limit, by bytes
+  bits_s57_hs <= unsigned(s57_hs(16 downto 1));
+  bits_bits_s57_hs <= unsigned(bits_s57_hs(15 downto 8));
+  ne_16 <= "1" when bits_bits_s57_hs /= k_0_2 else "0";
+  bits_bits_s57_hs_1 <= unsigned(bits_s57_hs(7 downto 0));
+  ne_17 <= "1" when bits_bits_s57_hs_1 /= k_0_2 else "0";
   high <= unsigned(std_logic_vector'(std_logic_vector(ne_16) & std_logic_vector(ne_17)));
-  bits_s55_hs_1 <= unsigned(s55_hs(0 downto 0));
-  bits_s55_ls <= unsigned(s55_ls(49 downto 49));
-  bits_s55_ls_1 <= unsigned(s55_ls(48 downto 0));
-  bits_bits_s55_ls_1 <= unsigned(bits_s55_ls_1(48 downto 48));
-  ne_19 <= "1" when bits_bits_s55_ls_1 /= k_0_3 else "0";
-  bits_bits_s55_ls_1_1 <= unsigned(bits_s55_ls_1(47 downto 40));
-  ne_20 <= "1" when bits_bits_s55_ls_1_1 /= k_0_2 else "0";
-  bits_bits_s55_ls_1_2 <= unsigned(bits_s55_ls_1(39 downto 32));
-  ne_21 <= "1" when bits_bits_s55_ls_1_2 /= k_0_2 else "0";
-  bits_bits_s55_ls_1_3 <= unsigned(bits_s55_ls_1(31 downto 24));
-  ne_22 <= "1" when bits_bits_s55_ls_1_3 /= k_0_2 else "0";
-  bits_bits_s55_ls_1_4 <= unsigned(bits_s55_ls_1(23 downto 16));
-  ne_23 <= "1" when bits_bits_s55_ls_1_4 /= k_0_2 else "0";
-  bits_bits_s55_ls_1_5 <= unsigned(bits_s55_ls_1(15 downto 8));
-  ne_24 <= "1" when bits_bits_s55_ls_1_5 /= k_0_2 else "0";
-  bits_bits_s55_ls_1_6 <= unsigned(bits_s55_ls_1(7 downto 0));
-  ne_25 <= "1" when bits_bits_s55_ls_1_6 /= k_0_2 else "0";
+  bits_s57_hs_1 <= unsigned(s57_hs(0 downto 0));
+  bits_s57_ls <= unsigned(s57_ls(49 downto 49));
+  bits_s57_ls_1 <= unsigned(s57_ls(48 downto 0));
+  bits_bits_s57_ls_1 <= unsigned(bits_s57_ls_1(48 downto 48));
+  ne_19 <= "1" when bits_bits_s57_ls_1 /= k_0_3 else "0";
+  bits_bits_s57_ls_1_1 <= unsigned(bits_s57_ls_1(47 downto 40));
+  ne_20 <= "1" when bits_bits_s57_ls_1_1 /= k_0_2 else "0";
+  bits_bits_s57_ls_1_2 <= unsigned(bits_s57_ls_1(39 downto 32));
+  ne_21 <= "1" when bits_bits_s57_ls_1_2 /= k_0_2 else "0";
+  bits_bits_s57_ls_1_3 <= unsigned(bits_s57_ls_1(31 downto 24));
+  ne_22 <= "1" when bits_bits_s57_ls_1_3 /= k_0_2 else "0";
+  bits_bits_s57_ls_1_4 <= unsigned(bits_s57_ls_1(23 downto 16));
+  ne_23 <= "1" when bits_bits_s57_ls_1_4 /= k_0_2 else "0";
+  bits_bits_s57_ls_1_5 <= unsigned(bits_s57_ls_1(15 downto 8));
+  ne_24 <= "1" when bits_bits_s57_ls_1_5 /= k_0_2 else "0";
+  bits_bits_s57_ls_1_6 <= unsigned(bits_s57_ls_1(7 downto 0));
+  ne_25 <= "1" when bits_bits_s57_ls_1_6 /= k_0_2 else "0";
   low <= unsigned(std_logic_vector'(std_logic_vector(ne_19) & std_logic_vector(ne_20) & std_logic_vector(ne_21) & std_logic_vector(ne_22) & std_logic_vector(ne_23) & std_logic_vector(ne_24) & std_logic_vector(ne_25)));
-  low_ne_k_0_4 <= "1" when low /= k_0_4 else "0";
-  high_ne_k_0 <= "1" when high /= k_0 else "0";
-  or_27 <= bits_s55_ls or low_ne_k_0_4;
-  bits_s55_hs_1_and_or_27 <= bits_s55_hs_1 and or_27;
-  or_28 <= high_ne_k_0 or bits_s55_hs_1_and_or_27;
-  and_29 <= bits_s55_ls and low_ne_k_0_4;
+
+  s58_limit_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s58_high <= high;
+      s58_h0 <= bits_s57_hs_1;
+      s58_lk <= bits_s57_ls;
+      s58_low <= low;
+      s58_neg <= s57_neg;
+    end if;
+  end process s58_limit_regs;
+
+  -- stage s59_hit: the hit bit
+  s58_low_ne_k_0_4 <= "1" when s58_low /= k_0_4 else "0";
+  s58_high_ne_k_0 <= "1" when s58_high /= k_0 else "0";
+  or_27 <= s58_lk or s58_low_ne_k_0_4;
+  s58_h0_and_or_27 <= s58_h0 and or_27;
+  or_28 <= s58_high_ne_k_0 or s58_h0_and_or_27;
+  and_29 <= s58_lk and s58_low_ne_k_0_4;
   over <= or_28 or and_29;
-  s55_neg_or_over <= s55_neg or over;
-  not_s55_neg_or_over <= not s55_neg_or_over;
-  u_div_ok_d14 <= u_div_ok_d14_sr(14);
-  hit_c <= not_s55_neg_or_over and u_div_ok_d14;
+  s58_neg_or_over <= s58_neg or over;
+  not_s58_neg_or_over <= not s58_neg_or_over;
+  u_div_ok_d15 <= u_div_ok_d15_sr(15);
+  hit_c <= not_s58_neg_or_over and u_div_ok_d15;
 
-  s56_hit_regs : process (clk)
+  s59_hit_regs : process (clk)
   begin
     if rising_edge(clk) then
-      u_div_ok_d14_sr(2 to 14) <= u_div_ok_d14_sr(1 to 13);
-      u_div_ok_d14_sr(1) <= u_div_ok;
-      s56_hit <= hit_c;
+      u_div_ok_d15_sr(2 to 15) <= u_div_ok_d15_sr(1 to 14);
+      u_div_ok_d15_sr(1) <= u_div_ok;
+      s59_hit <= hit_c;
     end if;
-  end process s56_hit_regs;
+  end process s59_hit_regs;
 
-  -- stage s57_result: the barycentric test; t, u, v zeroed on a miss
-  u_div_t_1_d15 <= u_div_t_1_d15_sr(15);
-  s54_u_d2 <= s54_u_d2_sr(2);
-  s54_v_d2 <= s54_v_d2_sr(2);
-  s1_tag_d55 <= s1_tag_d55_sr(55);
-  mux_s56_hit <= u_div_t_1_d15 when s56_hit = "1" else k_0_5;
-  shr_s54_u_d2 <= shift_right(s54_u_d2, 18);
-  rs_shr_s54_u_d2 <= shr_s54_u_d2(31 downto 0);
-  u_rs_shr_s54_u_d2 <= unsigned(rs_shr_s54_u_d2);
-  mux_s56_hit_1 <= u_rs_shr_s54_u_d2 when s56_hit = "1" else k_0_6;
-  shr_s54_v_d2 <= shift_right(s54_v_d2, 18);
-  rs_shr_s54_v_d2 <= shr_s54_v_d2(31 downto 0);
-  u_rs_shr_s54_v_d2 <= unsigned(rs_shr_s54_v_d2);
-  mux_s56_hit_2 <= u_rs_shr_s54_v_d2 when s56_hit = "1" else k_0_6;
+  -- stage s60_result: the barycentric test; t, u, v zeroed on a miss
+  u_div_t_1_d16 <= u_div_t_1_d16_sr(16);
+  s56_u_d3 <= s56_u_d3_sr(3);
+  s56_v_d3 <= s56_v_d3_sr(3);
+  s1_tag_d58 <= s1_tag_d58_sr(58);
+  mux_s59_hit <= u_div_t_1_d16 when s59_hit = "1" else k_0_5;
+  shr_s56_u_d3 <= shift_right(s56_u_d3, 18);
+  rs_shr_s56_u_d3 <= shr_s56_u_d3(31 downto 0);
+  u_rs_shr_s56_u_d3 <= unsigned(rs_shr_s56_u_d3);
+  mux_s59_hit_1 <= u_rs_shr_s56_u_d3 when s59_hit = "1" else k_0_6;
+  shr_s56_v_d3 <= shift_right(s56_v_d3, 18);
+  rs_shr_s56_v_d3 <= shr_s56_v_d3(31 downto 0);
+  u_rs_shr_s56_v_d3 <= unsigned(rs_shr_s56_v_d3);
+  mux_s59_hit_2 <= u_rs_shr_s56_v_d3 when s59_hit = "1" else k_0_6;
 
-  s57_result_regs : process (clk)
+  s60_result_regs : process (clk)
   begin
     if rising_edge(clk) then
-      u_div_t_1_d15_sr(2 to 15) <= u_div_t_1_d15_sr(1 to 14);
-      u_div_t_1_d15_sr(1) <= u_div_t_1;
-      s54_u_d2_sr(2 to 2) <= s54_u_d2_sr(1 to 1);
-      s54_u_d2_sr(1) <= s54_u;
-      s54_v_d2_sr(2 to 2) <= s54_v_d2_sr(1 to 1);
-      s54_v_d2_sr(1) <= s54_v;
+      u_div_t_1_d16_sr(2 to 16) <= u_div_t_1_d16_sr(1 to 15);
+      u_div_t_1_d16_sr(1) <= u_div_t_1;
+      s56_u_d3_sr(2 to 3) <= s56_u_d3_sr(1 to 2);
+      s56_u_d3_sr(1) <= s56_u;
+      s56_v_d3_sr(2 to 3) <= s56_v_d3_sr(1 to 2);
+      s56_v_d3_sr(1) <= s56_v;
       if rst = '1' then
-        s1_valid_d55_1 <= unsigned'("0");
+        s1_valid_d58_1 <= unsigned'("0");
       else
-        s1_valid_d55_1 <= s1_valid;
+        s1_valid_d58_1 <= s1_valid;
       end if;
       if rst = '1' then
-        s1_valid_d55_2 <= unsigned'("0");
+        s1_valid_d58_2 <= unsigned'("0");
       else
-        s1_valid_d55_2 <= s1_valid_d55_1;
+        s1_valid_d58_2 <= s1_valid_d58_1;
       end if;
       if rst = '1' then
-        s1_valid_d55_3 <= unsigned'("0");
+        s1_valid_d58_3 <= unsigned'("0");
       else
-        s1_valid_d55_3 <= s1_valid_d55_2;
+        s1_valid_d58_3 <= s1_valid_d58_2;
       end if;
       if rst = '1' then
-        s1_valid_d55_4 <= unsigned'("0");
+        s1_valid_d58_4 <= unsigned'("0");
       else
-        s1_valid_d55_4 <= s1_valid_d55_3;
+        s1_valid_d58_4 <= s1_valid_d58_3;
       end if;
       if rst = '1' then
-        s1_valid_d55_5 <= unsigned'("0");
+        s1_valid_d58_5 <= unsigned'("0");
       else
-        s1_valid_d55_5 <= s1_valid_d55_4;
+        s1_valid_d58_5 <= s1_valid_d58_4;
       end if;
       if rst = '1' then
-        s1_valid_d55_6 <= unsigned'("0");
+        s1_valid_d58_6 <= unsigned'("0");
       else
-        s1_valid_d55_6 <= s1_valid_d55_5;
+        s1_valid_d58_6 <= s1_valid_d58_5;
       end if;
       if rst = '1' then
-        s1_valid_d55_7 <= unsigned'("0");
+        s1_valid_d58_7 <= unsigned'("0");
       else
-        s1_valid_d55_7 <= s1_valid_d55_6;
+        s1_valid_d58_7 <= s1_valid_d58_6;
       end if;
       if rst = '1' then
-        s1_valid_d55_8 <= unsigned'("0");
+        s1_valid_d58_8 <= unsigned'("0");
       else
-        s1_valid_d55_8 <= s1_valid_d55_7;
+        s1_valid_d58_8 <= s1_valid_d58_7;
       end if;
       if rst = '1' then
-        s1_valid_d55_9 <= unsigned'("0");
+        s1_valid_d58_9 <= unsigned'("0");
       else
-        s1_valid_d55_9 <= s1_valid_d55_8;
+        s1_valid_d58_9 <= s1_valid_d58_8;
       end if;
       if rst = '1' then
-        s1_valid_d55_10 <= unsigned'("0");
+        s1_valid_d58_10 <= unsigned'("0");
       else
-        s1_valid_d55_10 <= s1_valid_d55_9;
+        s1_valid_d58_10 <= s1_valid_d58_9;
       end if;
       if rst = '1' then
-        s1_valid_d55_11 <= unsigned'("0");
+        s1_valid_d58_11 <= unsigned'("0");
       else
-        s1_valid_d55_11 <= s1_valid_d55_10;
+        s1_valid_d58_11 <= s1_valid_d58_10;
       end if;
       if rst = '1' then
-        s1_valid_d55_12 <= unsigned'("0");
+        s1_valid_d58_12 <= unsigned'("0");
       else
-        s1_valid_d55_12 <= s1_valid_d55_11;
+        s1_valid_d58_12 <= s1_valid_d58_11;
       end if;
       if rst = '1' then
-        s1_valid_d55_13 <= unsigned'("0");
+        s1_valid_d58_13 <= unsigned'("0");
       else
-        s1_valid_d55_13 <= s1_valid_d55_12;
+        s1_valid_d58_13 <= s1_valid_d58_12;
       end if;
       if rst = '1' then
-        s1_valid_d55_14 <= unsigned'("0");
+        s1_valid_d58_14 <= unsigned'("0");
       else
-        s1_valid_d55_14 <= s1_valid_d55_13;
+        s1_valid_d58_14 <= s1_valid_d58_13;
       end if;
       if rst = '1' then
-        s1_valid_d55_15 <= unsigned'("0");
+        s1_valid_d58_15 <= unsigned'("0");
       else
-        s1_valid_d55_15 <= s1_valid_d55_14;
+        s1_valid_d58_15 <= s1_valid_d58_14;
       end if;
       if rst = '1' then
-        s1_valid_d55_16 <= unsigned'("0");
+        s1_valid_d58_16 <= unsigned'("0");
       else
-        s1_valid_d55_16 <= s1_valid_d55_15;
+        s1_valid_d58_16 <= s1_valid_d58_15;
       end if;
       if rst = '1' then
-        s1_valid_d55_17 <= unsigned'("0");
+        s1_valid_d58_17 <= unsigned'("0");
       else
-        s1_valid_d55_17 <= s1_valid_d55_16;
+        s1_valid_d58_17 <= s1_valid_d58_16;
       end if;
       if rst = '1' then
-        s1_valid_d55_18 <= unsigned'("0");
+        s1_valid_d58_18 <= unsigned'("0");
       else
-        s1_valid_d55_18 <= s1_valid_d55_17;
+        s1_valid_d58_18 <= s1_valid_d58_17;
       end if;
       if rst = '1' then
-        s1_valid_d55_19 <= unsigned'("0");
+        s1_valid_d58_19 <= unsigned'("0");
       else
-        s1_valid_d55_19 <= s1_valid_d55_18;
+        s1_valid_d58_19 <= s1_valid_d58_18;
       end if;
       if rst = '1' then
-        s1_valid_d55_20 <= unsigned'("0");
+        s1_valid_d58_20 <= unsigned'("0");
       else
-        s1_valid_d55_20 <= s1_valid_d55_19;
+        s1_valid_d58_20 <= s1_valid_d58_19;
       end if;
       if rst = '1' then
-        s1_valid_d55_21 <= unsigned'("0");
+        s1_valid_d58_21 <= unsigned'("0");
       else
-        s1_valid_d55_21 <= s1_valid_d55_20;
+        s1_valid_d58_21 <= s1_valid_d58_20;
       end if;
       if rst = '1' then
-        s1_valid_d55_22 <= unsigned'("0");
+        s1_valid_d58_22 <= unsigned'("0");
       else
-        s1_valid_d55_22 <= s1_valid_d55_21;
+        s1_valid_d58_22 <= s1_valid_d58_21;
       end if;
       if rst = '1' then
-        s1_valid_d55_23 <= unsigned'("0");
+        s1_valid_d58_23 <= unsigned'("0");
       else
-        s1_valid_d55_23 <= s1_valid_d55_22;
+        s1_valid_d58_23 <= s1_valid_d58_22;
       end if;
       if rst = '1' then
-        s1_valid_d55_24 <= unsigned'("0");
+        s1_valid_d58_24 <= unsigned'("0");
       else
-        s1_valid_d55_24 <= s1_valid_d55_23;
+        s1_valid_d58_24 <= s1_valid_d58_23;
       end if;
       if rst = '1' then
-        s1_valid_d55_25 <= unsigned'("0");
+        s1_valid_d58_25 <= unsigned'("0");
       else
-        s1_valid_d55_25 <= s1_valid_d55_24;
+        s1_valid_d58_25 <= s1_valid_d58_24;
       end if;
       if rst = '1' then
-        s1_valid_d55_26 <= unsigned'("0");
+        s1_valid_d58_26 <= unsigned'("0");
       else
-        s1_valid_d55_26 <= s1_valid_d55_25;
+        s1_valid_d58_26 <= s1_valid_d58_25;
       end if;
       if rst = '1' then
-        s1_valid_d55_27 <= unsigned'("0");
+        s1_valid_d58_27 <= unsigned'("0");
       else
-        s1_valid_d55_27 <= s1_valid_d55_26;
+        s1_valid_d58_27 <= s1_valid_d58_26;
       end if;
       if rst = '1' then
-        s1_valid_d55_28 <= unsigned'("0");
+        s1_valid_d58_28 <= unsigned'("0");
       else
-        s1_valid_d55_28 <= s1_valid_d55_27;
+        s1_valid_d58_28 <= s1_valid_d58_27;
       end if;
       if rst = '1' then
-        s1_valid_d55_29 <= unsigned'("0");
+        s1_valid_d58_29 <= unsigned'("0");
       else
-        s1_valid_d55_29 <= s1_valid_d55_28;
+        s1_valid_d58_29 <= s1_valid_d58_28;
       end if;
       if rst = '1' then
-        s1_valid_d55_30 <= unsigned'("0");
+        s1_valid_d58_30 <= unsigned'("0");
       else
-        s1_valid_d55_30 <= s1_valid_d55_29;
+        s1_valid_d58_30 <= s1_valid_d58_29;
       end if;
       if rst = '1' then
-        s1_valid_d55_31 <= unsigned'("0");
+        s1_valid_d58_31 <= unsigned'("0");
       else
-        s1_valid_d55_31 <= s1_valid_d55_30;
+        s1_valid_d58_31 <= s1_valid_d58_30;
       end if;
       if rst = '1' then
-        s1_valid_d55_32 <= unsigned'("0");
+        s1_valid_d58_32 <= unsigned'("0");
       else
-        s1_valid_d55_32 <= s1_valid_d55_31;
+        s1_valid_d58_32 <= s1_valid_d58_31;
       end if;
       if rst = '1' then
-        s1_valid_d55_33 <= unsigned'("0");
+        s1_valid_d58_33 <= unsigned'("0");
       else
-        s1_valid_d55_33 <= s1_valid_d55_32;
+        s1_valid_d58_33 <= s1_valid_d58_32;
       end if;
       if rst = '1' then
-        s1_valid_d55_34 <= unsigned'("0");
+        s1_valid_d58_34 <= unsigned'("0");
       else
-        s1_valid_d55_34 <= s1_valid_d55_33;
+        s1_valid_d58_34 <= s1_valid_d58_33;
       end if;
       if rst = '1' then
-        s1_valid_d55_35 <= unsigned'("0");
+        s1_valid_d58_35 <= unsigned'("0");
       else
-        s1_valid_d55_35 <= s1_valid_d55_34;
+        s1_valid_d58_35 <= s1_valid_d58_34;
       end if;
       if rst = '1' then
-        s1_valid_d55_36 <= unsigned'("0");
+        s1_valid_d58_36 <= unsigned'("0");
       else
-        s1_valid_d55_36 <= s1_valid_d55_35;
+        s1_valid_d58_36 <= s1_valid_d58_35;
       end if;
       if rst = '1' then
-        s1_valid_d55_37 <= unsigned'("0");
+        s1_valid_d58_37 <= unsigned'("0");
       else
-        s1_valid_d55_37 <= s1_valid_d55_36;
+        s1_valid_d58_37 <= s1_valid_d58_36;
       end if;
       if rst = '1' then
-        s1_valid_d55_38 <= unsigned'("0");
+        s1_valid_d58_38 <= unsigned'("0");
       else
-        s1_valid_d55_38 <= s1_valid_d55_37;
+        s1_valid_d58_38 <= s1_valid_d58_37;
       end if;
       if rst = '1' then
-        s1_valid_d55_39 <= unsigned'("0");
+        s1_valid_d58_39 <= unsigned'("0");
       else
-        s1_valid_d55_39 <= s1_valid_d55_38;
+        s1_valid_d58_39 <= s1_valid_d58_38;
       end if;
       if rst = '1' then
-        s1_valid_d55_40 <= unsigned'("0");
+        s1_valid_d58_40 <= unsigned'("0");
       else
-        s1_valid_d55_40 <= s1_valid_d55_39;
+        s1_valid_d58_40 <= s1_valid_d58_39;
       end if;
       if rst = '1' then
-        s1_valid_d55_41 <= unsigned'("0");
+        s1_valid_d58_41 <= unsigned'("0");
       else
-        s1_valid_d55_41 <= s1_valid_d55_40;
+        s1_valid_d58_41 <= s1_valid_d58_40;
       end if;
       if rst = '1' then
-        s1_valid_d55_42 <= unsigned'("0");
+        s1_valid_d58_42 <= unsigned'("0");
       else
-        s1_valid_d55_42 <= s1_valid_d55_41;
+        s1_valid_d58_42 <= s1_valid_d58_41;
       end if;
       if rst = '1' then
-        s1_valid_d55_43 <= unsigned'("0");
+        s1_valid_d58_43 <= unsigned'("0");
       else
-        s1_valid_d55_43 <= s1_valid_d55_42;
+        s1_valid_d58_43 <= s1_valid_d58_42;
       end if;
       if rst = '1' then
-        s1_valid_d55_44 <= unsigned'("0");
+        s1_valid_d58_44 <= unsigned'("0");
       else
-        s1_valid_d55_44 <= s1_valid_d55_43;
+        s1_valid_d58_44 <= s1_valid_d58_43;
       end if;
       if rst = '1' then
-        s1_valid_d55_45 <= unsigned'("0");
+        s1_valid_d58_45 <= unsigned'("0");
       else
-        s1_valid_d55_45 <= s1_valid_d55_44;
+        s1_valid_d58_45 <= s1_valid_d58_44;
       end if;
       if rst = '1' then
-        s1_valid_d55_46 <= unsigned'("0");
+        s1_valid_d58_46 <= unsigned'("0");
       else
-        s1_valid_d55_46 <= s1_valid_d55_45;
+        s1_valid_d58_46 <= s1_valid_d58_45;
       end if;
       if rst = '1' then
-        s1_valid_d55_47 <= unsigned'("0");
+        s1_valid_d58_47 <= unsigned'("0");
       else
-        s1_valid_d55_47 <= s1_valid_d55_46;
+        s1_valid_d58_47 <= s1_valid_d58_46;
       end if;
       if rst = '1' then
-        s1_valid_d55_48 <= unsigned'("0");
+        s1_valid_d58_48 <= unsigned'("0");
       else
-        s1_valid_d55_48 <= s1_valid_d55_47;
+        s1_valid_d58_48 <= s1_valid_d58_47;
       end if;
       if rst = '1' then
-        s1_valid_d55_49 <= unsigned'("0");
+        s1_valid_d58_49 <= unsigned'("0");
       else
-        s1_valid_d55_49 <= s1_valid_d55_48;
+        s1_valid_d58_49 <= s1_valid_d58_48;
       end if;
       if rst = '1' then
-        s1_valid_d55_50 <= unsigned'("0");
+        s1_valid_d58_50 <= unsigned'("0");
       else
-        s1_valid_d55_50 <= s1_valid_d55_49;
+        s1_valid_d58_50 <= s1_valid_d58_49;
       end if;
       if rst = '1' then
-        s1_valid_d55_51 <= unsigned'("0");
+        s1_valid_d58_51 <= unsigned'("0");
       else
-        s1_valid_d55_51 <= s1_valid_d55_50;
+        s1_valid_d58_51 <= s1_valid_d58_50;
       end if;
       if rst = '1' then
-        s1_valid_d55_52 <= unsigned'("0");
+        s1_valid_d58_52 <= unsigned'("0");
       else
-        s1_valid_d55_52 <= s1_valid_d55_51;
+        s1_valid_d58_52 <= s1_valid_d58_51;
       end if;
       if rst = '1' then
-        s1_valid_d55_53 <= unsigned'("0");
+        s1_valid_d58_53 <= unsigned'("0");
       else
-        s1_valid_d55_53 <= s1_valid_d55_52;
+        s1_valid_d58_53 <= s1_valid_d58_52;
       end if;
       if rst = '1' then
-        s1_valid_d55_54 <= unsigned'("0");
+        s1_valid_d58_54 <= unsigned'("0");
       else
-        s1_valid_d55_54 <= s1_valid_d55_53;
+        s1_valid_d58_54 <= s1_valid_d58_53;
       end if;
       if rst = '1' then
-        s1_valid_d55_55 <= unsigned'("0");
+        s1_valid_d58_55 <= unsigned'("0");
       else
-        s1_valid_d55_55 <= s1_valid_d55_54;
+        s1_valid_d58_55 <= s1_valid_d58_54;
       end if;
-      s1_tag_d55_sr(2 to 55) <= s1_tag_d55_sr(1 to 54);
-      s1_tag_d55_sr(1) <= s1_tag;
       if rst = '1' then
-        s57_valid_out <= unsigned'("0");
+        s1_valid_d58_56 <= unsigned'("0");
       else
-        s57_valid_out <= s1_valid_d55_55;
+        s1_valid_d58_56 <= s1_valid_d58_55;
       end if;
-      s57_tag_out <= s1_tag_d55;
-      s57_hit <= s56_hit;
-      s57_t <= mux_s56_hit;
-      s57_u <= mux_s56_hit_1;
-      s57_v <= mux_s56_hit_2;
+      if rst = '1' then
+        s1_valid_d58_57 <= unsigned'("0");
+      else
+        s1_valid_d58_57 <= s1_valid_d58_56;
+      end if;
+      if rst = '1' then
+        s1_valid_d58_58 <= unsigned'("0");
+      else
+        s1_valid_d58_58 <= s1_valid_d58_57;
+      end if;
+      s1_tag_d58_sr(2 to 58) <= s1_tag_d58_sr(1 to 57);
+      s1_tag_d58_sr(1) <= s1_tag;
+      if rst = '1' then
+        s60_valid_out <= unsigned'("0");
+      else
+        s60_valid_out <= s1_valid_d58_58;
+      end if;
+      s60_tag_out <= s1_tag_d58;
+      s60_hit <= s59_hit;
+      s60_t <= mux_s59_hit;
+      s60_u <= mux_s59_hit_1;
+      s60_v <= mux_s59_hit_2;
     end if;
-  end process s57_result_regs;
+  end process s60_result_regs;
 
   u_plane_products : fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1
     port map (
@@ -1055,7 +1093,7 @@ begin
       p3 => u_plane_products_p3
     );
 
-  u_div : fxrt_div_n29_a63_b34
+  u_div : fxrt_div_n29_a63_b34_se
     port map (
       clk => clk,
       num => s10_num,
@@ -1068,9 +1106,9 @@ begin
     port map (
       clk => clk,
       a0 => s_rs_u_div_t_1,
-      b0 => s2_w_p_d39,
+      b0 => s2_w_p_d41,
       a1 => s_rs_u_div_t_1,
-      b1 => s2_w_q_d39,
+      b1 => s2_w_q_d41,
       p0 => u_moved_products_p0,
       p1 => u_moved_products_p1
     );
@@ -1078,24 +1116,24 @@ begin
   u_bary_products : fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1
     port map (
       clk => clk,
-      a0 => s1_e1p_d47,
-      b0 => s48_kq,
-      a1 => s1_e1q_d47,
-      b1 => s48_kp,
-      a2 => s1_e2q_d47,
-      b2 => s48_kp,
-      a3 => s1_e2p_d47,
-      b3 => s48_kq,
+      a0 => s1_e1p_d49,
+      b0 => s50_kq,
+      a1 => s1_e1q_d49,
+      b1 => s50_kp,
+      a2 => s1_e2q_d49,
+      b2 => s50_kp,
+      a3 => s1_e2p_d49,
+      b3 => s50_kq,
       p0 => u_bary_products_p0,
       p1 => u_bary_products_p1,
       p2 => u_bary_products_p2,
       p3 => u_bary_products_p3
     );
 
-  valid_out <= s57_valid_out;
-  tag_out <= s57_tag_out;
-  hit <= s57_hit;
-  t <= s57_t;
-  u <= s57_u;
-  v <= s57_v;
+  valid_out <= s60_valid_out;
+  tag_out <= s60_tag_out;
+  hit <= s60_hit;
+  t <= s60_t;
+  u <= s60_u;
+  v <= s60_v;
 end architecture rtl;

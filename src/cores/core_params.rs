@@ -165,9 +165,9 @@ impl CoreParams {
         self.units << self.trav.slot_bits()
     }
     /// Rays taken whose results are not yet taken, at most: the ray port's register, the
-    /// slots and the result queue.
+    /// slots, the result queue and its output register.
     pub fn rays_held(&self) -> u32 {
-        self.slot_count() + super::result_queue::RESULT_QUEUE + 1
+        self.slot_count() + super::result_queue::RESULT_QUEUE + 2
     }
     /// Ray slots of the core: the rays it holds at once.
     pub fn slot_count(&self) -> u32 {

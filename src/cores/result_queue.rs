@@ -1,5 +1,5 @@
 //! The core's result port: a first-word-fall-through queue with credits between the
-//! closest-hit unit and `res_*` (DECISIONS 75, docs/CORE.md).
+//! closest-hit unit and an output register driving `res_*` (DECISIONS 75, docs/CORE.md).
 
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
@@ -9,8 +9,8 @@ use crate::rtl::build::{Builder, S};
 /// leaving its done queue to leaving the result queue, and at most one leaves per clock).
 pub const RESULT_QUEUE: u32 = 16;
 
-/// The result ports behind a queue with credits: a result is taken on a clock with `res_valid`
-/// and `res_ready` both 1 and is held until then. A finished ray leaves its done queue only
+/// The result ports behind a queue with credits and an output register: a result is taken on
+/// a clock with `res_valid` and `res_ready` both 1 and is held until then. A finished ray leaves its done queue only
 /// while the result queue has a place it has not promised (`credit_ok`): when the consumer
 /// stops, rays finish into the done queues, their slots stay taken, and `ray_ready` falls when
 /// the units are full — nothing is lost and nothing waits on a combinational path from
@@ -29,11 +29,27 @@ pub fn result_queue<'b>(
         ["id", "hit", "tri", "t", "u", "v"].into_iter().map(|name| (name, field(name))).collect();
     let words = [b.cat(&[fields["id"], fields["hit"], fields["tri"], fields["t"]]), b.cat(&[fields["u"], fields["v"]])];
     let take = b.wire("res_take", bit);
-    // Two read ports: the take (from `res_ready`) picks between the words after the RAM reads,
-    // not before them (through the read pointer into the RAM it was a slowest path at seed 3,
-    // 7.01 ns, 48 endpoints); the second port costs 33 LUT-RAM cells.
+    // Two read ports: the take picks between the words after the RAM reads, not before them
+    // (through the read pointer into the RAM it was a slowest path at seed 3, 7.01 ns, 48
+    // endpoints); the second port costs 33 LUT-RAM cells.
     let (heads, nonempty) = super::fifo::fifo_words(b, "res_q", RESULT_QUEUE, field("valid"), &words, take, true);
-    b.drive(take, (nonempty & res_ready).name("res_take_c"));
+    // The ports are registers (`res_out_*`), loaded from the queue's head whenever they are
+    // empty or taken: the head's select through the consumer's logic was a slowest path at
+    // seeds 2 and 3 (7.26 ns into the place-and-route wrapper's first XOR). The queue is taken
+    // when the output takes its head.
+    let out_valid = b.reg("res_out_valid", bit, Some(0));
+    let room = (!out_valid | res_ready).name("res_out_room");
+    b.drive(take, (nonempty & room).name("res_take_c"));
+    b.next(out_valid, (nonempty | !room).name("res_out_valid_c"));
+    let heads: Vec<S> = heads
+        .iter()
+        .enumerate()
+        .map(|(k, &head)| {
+            let r = b.reg(&format!("res_out{k}"), head.ty(), None);
+            b.next_when(r, take, head);
+            r
+        })
+        .collect();
     // Places not promised, counted with the pops a clock late (`popped`): the queue then holds
     // at most RESULT_QUEUE − credits + popped results, so a pop needs credits − popped ≥ 1,
     // which credits ≥ 2 a clock earlier (registered: `credit_ok`) guarantees.
@@ -46,7 +62,7 @@ pub fn result_queue<'b>(
     let if_not = (credits - popped.resize(w)).name("res_credits_if_not");
     b.next(credits, take.select(if_taken, if_not).name("res_credits_next"));
     b.next(credit_ok, at_least_two_next(credits, popped, take));
-    b.output("res_valid", nonempty);
+    b.output("res_valid", out_valid);
     // Each word's fields, least significant first (`cat` takes the most significant first).
     let mut out = std::collections::BTreeMap::new();
     for (word, names) in [(0, ["t", "tri", "hit", "id"].as_slice()), (1, ["v", "u"].as_slice())] {

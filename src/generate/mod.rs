@@ -237,7 +237,7 @@ pub fn core_files(
         "result_handshake": "a result is taken on a clock with res_valid and res_ready high and holds res_* until then; no path from res_ready to any output",
         "result_queue_depth": queue,
         "rays_held_max": p.rays_held(),
-        "rays_held_max_is": "rays taken whose results are not yet taken: the port register, the ray slots, the result queue",
+        "rays_held_max_is": "rays taken whose results are not yet taken: the port register, the ray slots, the result queue and its output register",
         "results_in_order": false,
         "result_order": "rays finish out of order; every result carries its ray id (res_id)",
         "debug_ports": o.debug_ports,

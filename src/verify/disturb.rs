@@ -337,10 +337,12 @@ mod tests {
         // About 40 % of the cycles in which rays remained, which are at least 4 per ray (the
         // core takes one ray per 4 clocks at most): over 30 % of those.
         assert!(stats.stall_cycles * 10 >= 3 * 4 * stats.rays, "{stats:?}");
-        // Whether 40 % stalls lengthen so short a frame depends on its slowest ray (the free
-        // list's slot order made them cost nothing here: 898 clocks either way); a source that
-        // stalls 90 % of the time holds the last rays back past it.
+        // Whether 40 % stalls lengthen so short a frame depends on its slowest ray: the slots'
+        // order and timing change with the feed, and the frame's length with them (898 clocks
+        // either way with the free list; with the result port's output register, 903 stalled
+        // against 908 without). A source that stalls 90 % of the time holds the last rays back
+        // past any such change.
         let (_, heavy) = simulate_rust(&p, &roms, &fed, &Stalls::random(90, 5), &|_| {});
-        assert!(stats.cycles >= plain.cycles && heavy.cycles > plain.cycles, "{stats:?} {heavy:?} {plain:?}");
+        assert!(heavy.cycles > plain.cycles, "{stats:?} {heavy:?} {plain:?}");
     }
 }
