@@ -56,7 +56,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut points = Vec::new();
     for &latency in &latencies {
         let timing = MemoryTiming { latency, ..MemoryTiming::default() };
-        let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ());
+        let (results, stats, ms) = simulate_external(&p, &roms, &image, &rays, timing, &Stalls::none(), &|_| ())?;
         assert_eq!(mismatches(&scene, &rays, &results), 0, "latency {latency}");
         let rpc = stats.rays_per_clock();
         println!(

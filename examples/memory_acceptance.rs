@@ -110,7 +110,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (results, stats, ms) =
             simulate_external(&p, &roms, &image, &rays, c.timing, &fxrt::verify::feed::Stalls::none(), &|n| {
                 bar.set_position(n)
-            });
+            })?;
         bar.finish_and_clear();
         let wrong = mismatches(&scene, &rays, &results);
         let t = c.timing;

@@ -155,6 +155,8 @@ impl std::fmt::Display for Stopped {
     }
 }
 
+impl std::error::Error for Stopped {}
+
 /// Streams `rays` (in the order given, the source holding back on the cycles of `stalls` as the
 /// testbenches' does, every result taken when shown) through the core of `p` (which must have
 /// external memory) in the cycle simulator, the memory model of `timing` answering from
