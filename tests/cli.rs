@@ -243,7 +243,7 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
         (core["interface"]["reset_cycles"].clone(), core["interface"]["result_queue_depth"].clone()),
         (1.into(), 16.into())
     );
-    assert_eq!(core["interface"]["rays_held_max"], 128 + 16 + 1);
+    assert_eq!(core["interface"]["rays_held_max"], 128 + 16 + 2);
     assert_eq!(core["clock"]["target_mhz"], 150);
     assert_eq!(core["hashes"]["scene_tag"].as_str().unwrap(), &core_name["fxrt_core_".len()..]);
     assert_eq!(core["hashes"]["scene_sha256"].as_str().unwrap().len(), 64);
@@ -259,7 +259,7 @@ fn gen_rejects_widths_the_rtl_layer_cannot_hold_before_writing() {
         serde_json::from_slice(&std::fs::read(out.join(format!("{core_name}_axis.json"))).unwrap()).unwrap();
     assert_eq!(axis["latency_cycles"]["min"].as_u64(), core["latency_cycles"]["min"].as_u64().map(|l| l + 1), "{axis}");
     assert_eq!(axis["interface"]["reset_cycles"], 1);
-    assert_eq!(axis["interface"]["rays_held_max"], 128 + 16 + 3);
+    assert_eq!(axis["interface"]["rays_held_max"], 128 + 16 + 4);
     assert_eq!(axis["clock"], core["clock"]);
     let files = core["files"]["vhdl"].as_array().unwrap();
     assert_eq!(files.last().unwrap(), &format!("{core_name}.vhd"));
