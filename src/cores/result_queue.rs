@@ -10,12 +10,13 @@ use crate::rtl::build::{Builder, S};
 pub const RESULT_QUEUE: u32 = 16;
 
 /// The result ports behind a queue with credits and an output register: a result is taken on
-/// a clock with `res_valid` and `res_ready` both 1 and is held until then. A finished ray leaves its done queue only
-/// while the result queue has a place it has not promised (`credit_ok`): when the consumer
-/// stops, rays finish into the done queues, their slots stay taken, and `ray_ready` falls when
-/// the units are full — nothing is lost and nothing waits on a combinational path from
-/// `res_ready`. `field(name)` is the closest-hit units' `res_{name}`; `popped` is their
-/// `done_valid` (a ray leaving its queue, a clock after the pop).
+/// a clock with `res_valid` and `res_ready` both 1 and is held until then. A finished ray
+/// leaves its done queue only while the result queue has a place it has not promised
+/// (`credit_ok`): when the consumer stops, rays finish into the done queues, their slots stay
+/// taken, and `ray_ready` falls when the units are full — nothing is lost and nothing waits on
+/// a combinational path from `res_ready`. `field(name)` is the closest-hit units'
+/// `res_{name}`; `popped` is their `done_valid` (a ray leaving its queue, a clock after the
+/// pop).
 pub fn result_queue<'b>(
     b: &'b Builder,
     field: &dyn Fn(&str) -> S<'b>,
