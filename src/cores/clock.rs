@@ -15,6 +15,12 @@ use super::mul::MulStyle;
 /// The default clock target, MHz (chosen by measurement: docs/TIMING.md).
 pub const DEFAULT_TARGET_MHZ: u32 = 150;
 
+/// From this target a value that crosses the die between two placed groups (a plane distance
+/// from the DSP column to the traversal's compares, a leaf from the node ROM's word to the
+/// leaf queue, a product to its subtractor) gets a register at each end: the route alone took
+/// 3.2–3.4 ns of a 6.67 ns clock in the placed default core (DECISIONS 126).
+pub const LANDING_FROM_MHZ: u32 = 141;
+
 /// Targets the cores are pipelined for, MHz: below the lowest the description is the
 /// thesis-like one with one-clock products; above the highest nothing more is split.
 pub const TARGET_RANGE: (u32, u32) = (50, 400);

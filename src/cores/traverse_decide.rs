@@ -76,7 +76,8 @@ impl<'b> Unit<'b> {
     pub(super) fn ring_g(&self, f: &RingF<'b>, r: &Returning<'b>, a: &RingA<'b>, q: &Queued<'b>) {
         let (b, g, node_bits, push) = (self.b, f.g, self.node_bits, &a.push);
         b.stage("ring_g", "G: the decision: push the far child and enter the near one, enter one, or pop");
-        b.drive(q.ring_g_valid, g.valid);
+        // The entry stage's copy: E decides by it beside the queues, across the unit from G.
+        b.drive(q.ring_g_valid, b.copies(g.valid, 1)[0]);
         let child_b = g.node + 1;
         let near = f.negative.select(child_b, g.node).resize(node_bits).name("near");
         let far = f.negative.select(g.node, child_b).resize(node_bits).name("far");

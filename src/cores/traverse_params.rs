@@ -21,6 +21,9 @@ pub struct TraverseParams {
     pub tri_bits: u32,
     /// How the plane-distance product is built (`plane::plane_product`): the clock target's.
     pub product: MulStyle,
+    /// Whether the plane distances and the leaves pushed get a landing register by their
+    /// users (targets from `clock::LANDING_FROM_MHZ`).
+    pub landing: bool,
     /// Clocks of a node ROM read and of a leaf ROM read (`brom::read_cycles`: 3 for block RAM,
     /// whose fabric register the placer puts between the blocks spread over the die and the
     /// logic; 2 for LUTs). The emitted triangle stream is `leaf_rom_cycles` behind `leaf`.
@@ -53,6 +56,7 @@ impl TraverseParams {
             box_hi: scene.box_hi,
             tri_bits: rom::addr_bits(scene.tri_count()),
             product: target.mul_style(),
+            landing: target.splits(super::clock::LANDING_FROM_MHZ),
             node_rom_cycles: read_cycles(scene.node.1.len()),
             leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
             slots,

@@ -266,8 +266,11 @@ impl<'b> Unit<'b> {
         let ring_g_valid = b.wire("ring_g_valid", Ty::BIT);
         let unpark_pop = b.wire("unpark_pop", Ty::BIT);
         let new_pop = b.wire("new_pop", Ty::BIT);
-        let unpark_in = b.cat(&[inp.merge_slot, inp.merge_sp]);
-        let unpark = fifo(b, "unpark_q", sb + spw, k, inp.merge_valid, unpark_in, unpark_pop);
+        // An unparked ray's entry: slot, stack pointer, and whether that is 0 (made here, so
+        // that E's done bit after the head's selects is one gate: `unpark_q_popped` → `q_done`
+        // through the compare was 7.02 ns at a seed).
+        let unpark_in = b.cat(&[inp.merge_slot, inp.merge_sp, inp.merge_sp.eq(0).name("merge_sp_zero")]);
+        let unpark = fifo(b, "unpark_q", sb + spw + 1, k, inp.merge_valid, unpark_in, unpark_pop);
         let new_in = b.cat(&[inp.new_slot, inp.new_tmax.unsigned(), inp.new_miss]);
         let newq = fifo(b, "new_q", sb + dist.width + 1, k, inp.new_valid, new_in, new_pop);
         // E: a queued ray enters when the token now in G will not return (R empty in A); a node
@@ -297,11 +300,11 @@ impl<'b> Unit<'b> {
             Some((take, r)) => take.select(field(r), queued),
             None => queued,
         };
-        let queued_slot = take_unpark.select(unpark.head.slice(spw, sb), newq.head.slice(dist.width + 1, sb));
+        let queued_slot = take_unpark.select(unpark.head.slice(spw + 1, sb), newq.head.slice(dist.width + 1, sb));
         let slot_next = or_retried(|r| r.slot, queued_slot);
         let slot = b.delay("q_slot", slot_next);
         // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
-        let head_sp = or_retried(|r| r.sp, unpark.head.slice(0, spw));
+        let head_sp = or_retried(|r| r.sp, unpark.head.slice(1, spw));
         let sp = b.delay("q_sp", head_sp);
         let sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
         let sp_m1_next = head_sp - 1;
@@ -310,7 +313,7 @@ impl<'b> Unit<'b> {
         // Whether the token taken is done in A, decided here: from `q_new`, `q_miss` and the
         // stack pointer's bits in A, the done and live bits were the slowest paths of a
         // traversal unit at seed 2 of the default core (8.29 ns into `b_valid`).
-        let unpark_empty = unpark.head.slice(0, spw).eq(0);
+        let unpark_empty = unpark.head.bit(0);
         let done_c = ((take_new & newq.head.bit(0)) | (take_unpark & unpark_empty)).name("q_done_c");
         let done = b.delay("q_done", done_c);
         let tmax = b.delay("q_tmax", or_retried(|r| r.tmax, newq.head.slice(1, dist.width).signed()));
@@ -449,10 +452,12 @@ impl<'b> Unit<'b> {
         // (`has_best_kept`, registers of the unit's own) or a merge's set in B's clock for the
         // slot: compared with B's slot and registered beside the groups (the set's decode from
         // the merge ports, across the die, before the groups was 8.07 ns at a seed).
-        let early = b.copies(b_slot, 1)[0];
-        let set_in_b = (inp.merge_valid & inp.merge_hit & inp.merge_slot.eq(early)).name("b_slot_merged_c");
+        // B's slot in a copy per group (and one for the merge compare): one copy reaching the
+        // four groups' selects was 6.66 ns at seed 3.
+        let early = b.copies(b_slot, 1 + k.div_ceil(16) as usize);
+        let set_in_b = (inp.merge_valid & inp.merge_hit & inp.merge_slot.eq(early[0])).name("b_slot_merged_c");
         let set_in_b = b.delay("b_slot_merged", set_in_b);
-        let grouped = slot_bit_2(b, "slot_has_best", has_best_kept, k, early, c_slots[1]);
+        let grouped = slot_bit_2(b, "slot_has_best", has_best_kept, k, &early[1..], c_slots[1]);
         let hb = b.delay("cull_has_best", (grouped | set_in_b).name("slot_has_best_now"));
         let culled_c = (hb & lt_chain(limit, x)).name("culled_c");
         // With a node cache, the lookup a clock after C; the cull test, known then, withdraws
@@ -517,8 +522,24 @@ impl<'b> Unit<'b> {
         let t = token;
         let leaf_in =
             b.cat(&[t.slot, w_first.resize(leaf_bits), w_count, t.tmin.unsigned().resize(p.tmin_width()), t.sp]);
-        let leafq =
-            fifo(b, "leaf_q", leaf_in.width(), k, leaf_push, leaf_in, b.valid_delay("leaf_pop_r", self.inp.leaf_pop));
+        // At a fast target the leaf is registered here, by the node word's decode, and again
+        // in the queue (its push register, by the queue's LUT RAM): the decode into the push
+        // register across the die was the slowest path at seed 3 (`n_valid_3` → `leaf_q_push`,
+        // 7.34 ns, 3.4 of it one route). A leaf then waits a clock more; nothing waits for it.
+        let (leaf_push_q, leaf_in_q) = if p.landing {
+            (b.valid_delay("leaf_push_r", leaf_push), b.delay("leaf_in_r", leaf_in))
+        } else {
+            (leaf_push, leaf_in)
+        };
+        let leafq = fifo(
+            b,
+            "leaf_q",
+            leaf_in.width(),
+            k,
+            leaf_push_q,
+            leaf_in_q,
+            b.valid_delay("leaf_pop_r", self.inp.leaf_pop),
+        );
         // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
         // the units' second stage in N + 1). The read address in a register per RAM: one
         // register reaching all four RAMs' LUT-RAM slices and bank selects had 694 sinks a bit
@@ -538,7 +559,14 @@ impl<'b> Unit<'b> {
             |last: i128, plane: S<'b>| PlaneIssue { valid: is_inner, last: is_inner.k(last), plane, axis: w_axis };
         let pu0 = plane_unit(b, n, p.c, o, inv, issue(0, w_clip0), p.product);
         let pu1 = plane_unit(b, n, p.c, o, inv, issue(1, w_clip1), p.product);
-        let plane_latency = pu0.latency;
+        // At a fast target each distance lands in a register by the compares (the plane
+        // unit's own sits by the DSP column): `plane_t` → `go_near` was the slowest path at
+        // seed 1 (7.03 ns, 3.2 of it the route from the product to the compare chain).
+        let land = |pu: &super::plane::PlaneResult<'b>, name: &str| {
+            if p.landing { b.delay(name, pu.t) } else { pu.t }
+        };
+        let plane_t = [land(&pu0, "plane_t_land0"), land(&pu1, "plane_t_land1")];
+        let plane_latency = pu0.latency + p.landing as u32;
         assert!(plane_latency >= 4, "the decision limits need 3 cycles after N");
         // The axis's direction sign, for the roles of the two distances in F and G.
         let axis1 = b.delay("axis_n1", w_axis);
@@ -554,7 +582,7 @@ impl<'b> Unit<'b> {
             negative,
             child: w_child,
             inv,
-            plane_t: [pu0.t, pu1.t],
+            plane_t,
             plane_latency,
         }
     }
