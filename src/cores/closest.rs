@@ -46,12 +46,19 @@ pub fn input_latency(target: ClockTarget) -> u32 {
     2 * target.splits(STAGED_FROM_MHZ) as u32
 }
 
+/// Copies of the done slot the unit takes (`done_slot_copies`, after `done_slot`): one per
+/// group of 16 of its `slots` slots.
+pub fn done_slot_copies(slots: u32) -> u32 {
+    slots.div_ceil(16)
+}
+
 /// The unit of one lane (intersection pipeline) of the core: `slots` slot numbers, `units`
 /// traversal units, `unit_bits` their numbers' bits, and `lane_bits` bits of the lane number
 /// above them in the tag's global slot (0 with one pipeline), which the unit drops: its RAMs
 /// and ports take the slot number within the lane.
 /// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) from the pipeline; `id_we`, `id_slot`,
-/// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot` →
+/// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot`,
+/// `done_slot_copies` (`done_slot_copies(slots)` copies of it, the first lowest) →
 /// per traversal unit u `merge_valid{u}`, `merge_slot{u}` (the slot within the unit: the global
 /// slot's low bits below the `unit_bits` unit number), `merge_hit{u}`, and for all of them
 /// `merge_limit` (best t + 8, signed n + 3 bits), `merge_sp`; `free_valid`, `free_slot`; res_valid, res_id, res_hit, res_tri, res_t, res_u, res_v
@@ -82,6 +89,11 @@ pub fn closest_core(
     let id_in = b.input("id", Ty::u(id_bits));
     let done_valid = b.input("done_valid", Ty::BIT);
     let done_slot = b.input("done_slot", slot_ty);
+    // Copies of `done_slot` (registers of their own in the top), one per group of 16 slots'
+    // has-best bits.
+    let groups = done_slot_copies(slots);
+    let done_slot_c = b.input("done_slot_copies", Ty::u(groups * slot_ty.width));
+    let done_slots: Vec<S> = (0..groups).map(|g| done_slot_c.slice(g * slot_ty.width, slot_ty.width)).collect();
     let mut at = 0;
     let mut take = |w: u32| {
         let s = tag_in.slice(at, w);
@@ -178,7 +190,7 @@ pub fn closest_core(
     // The slot's has-best bit over two clocks: from the leaf's slot while its last triangle is
     // here, then at fin (a slot's bit cannot change in between: its previous leaf was merged
     // before it was unparked, and it is done only after its last leaf).
-    let m1_has = b.delay("m1_slot_has", slot_bit_2(&b, "fin_has", best_valid, k, slot, fin_slot));
+    let m1_has = b.delay("m1_slot_has", slot_bit_2(&b, "fin_has", best_valid, k, &[slot], fin_slot));
     let m1_empty = b.delay("m1_leaf_empty", acc_empty);
     let m1_tt = b.delay("m1_t_tri", b.cat(&[acc_t, acc_tri]));
     let m1_uv = b.delay("m1_u_v", acc_uv_now);
@@ -214,8 +226,12 @@ pub fn closest_core(
     let m3_slot = b.delay("m3_slot", m2_slot);
     let m3_slots = b.copies(m3_slot, tt_mem.groups() + uv_mem.groups());
     let (tt_slots, uv_slots) = m3_slots.split_at(tt_mem.groups());
-    tt_mem.write(&b, &[we], tt_slots, b.delay("m3_t_tri", m2_tt));
-    uv_mem.write(&b, &[we], uv_slots, b.delay("m3_u_v", m2_uv));
+    // And so does the write enable: a copy per group (one register reaching all was among the
+    // slowest paths at seeds 1 and 2, `best_we` → `best_u_v` cells, 6.68 ns, one LUT).
+    let wes = b.copies(we, tt_mem.groups() + uv_mem.groups());
+    let (tt_wes, uv_wes) = wes.split_at(tt_mem.groups());
+    tt_mem.write(&b, tt_wes, tt_slots, b.delay("m3_t_tri", m2_tt));
+    uv_mem.write(&b, uv_wes, uv_slots, b.delay("m3_u_v", m2_uv));
     let limit = m2_better.select(m2_leaf_limit, m2_slot_limit).name("merged_limit");
     // The merge reaches each traversal unit through registers of its own (valid, slot in the
     // unit, hit): one shared set drove both units' cull-limit LUT-RAM write enables through
@@ -253,7 +269,7 @@ pub fn closest_core(
     let d_id = b.read("done_id", id_mem, id_slot[0]);
     let d1 = b.valid_delay("d1", d0);
     let d1_slot = b.delay("d1_slot", d0_slot);
-    let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, done_slot, d0_slot));
+    let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, &done_slots, d0_slot));
     let none = b.konst(Ty::u(k), 0);
     // The slots' one-hot words are decoded a stage early into registers: the set and the clear
     // then reach the k has-best bits through one LUT (with four units the set's decode after

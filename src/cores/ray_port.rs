@@ -28,15 +28,15 @@ pub struct RayPort<'b> {
     pub phase: S<'b>,
     pub box_o: [S<'b>; 3],
     pub box_inv: [S<'b>; 3],
-    /// A clock after the take: the ray written into its slot (`slot` global), its id, origin,
-    /// direction and reciprocal direction. The slot is also in registers of their own for the
-    /// write addresses of the RAMs it reaches (a LUT-RAM slice per 4 bits and 16 slots each,
-    /// 888 sinks a bit from one register on the teapot-fine core): `ram_slots` the leaf
-    /// streams' ray RAMs (lane by lane, a register per group of columns, `wide_ram`, with
-    /// `ram_we` the write enables alike), `closest_slot` the closest-hit unit's,
-    /// `unit_slot[u]` unit u's (within the unit: one per group of its ray RAMs' columns), and
-    /// `unit_we[u]` unit u's write enables alike, then its `alloc`: registers of the take for
-    /// that unit.
+    /// A clock after the take: `accept` and the ray's slot (`slot` global; `closest_slot` a
+    /// copy for the closest-hit unit's id RAM) and id; each unit's `alloc` (the last of
+    /// `unit_we[u]`). A clock later the ray (origin, direction and reciprocal direction, still
+    /// in `o`, `w`, `inv`) is written into its slot's RAMs, from registers of their own for the
+    /// write enables and addresses of the RAMs it reaches (a LUT-RAM slice per 4 bits and 16
+    /// slots each, 888 sinks a bit from one register on the teapot-fine core): `ram_slots`
+    /// the leaf streams' ray RAMs (lane by lane, a register per group of columns, `wide_ram`,
+    /// with `ram_we` the write enables alike), `unit_slot[u]` unit u's (within the unit: one
+    /// per group of its ray RAMs' columns), and `unit_we[u]` unit u's write enables alike.
     pub accept: S<'b>,
     pub slot: S<'b>,
     pub ram_we: Vec<S<'b>>,
@@ -153,19 +153,33 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
     // visit-order test fails then.)
     let accept = b.valid_delay("accept", take);
     let gslot = b.delay("accept_slot", take_slot);
+    // The ray RAMs are written a clock later still, from a tree: the take loaded every RAM
+    // group's write-enable register across the die, and `turn_free` → `accept` through it was
+    // a slowest path at seeds 2 and 3 (6.84, 6.92 ns, two cells). Now the take loads `accept`,
+    // the closest-hit unit's id write and each unit's `alloc`, and `accept` the write enables.
+    // The data still holds the taken ray then: the port reloads two clocks after a take at
+    // the earliest, and `acc_*` read it a clock late. No ray RAM entry is read that early (the
+    // box-exit unit takes 4 clocks and more).
+    let write = b.valid_delay("accept_w", accept);
+    let wslot = b.delay("accept_w_slot", gslot);
     // One write enable fanned out to all the ray RAMs' cells was a slowest path at seed 2
     // (`accept` → `ray_w`, 7.82 ns, eight such).
     let ram_groups = p.ray_ram_groups() * p.pipelines as usize;
-    let ram_we = super::wide_ram::address_registers(b, accept, ram_groups);
+    let ram_we = super::wide_ram::address_registers(b, write, ram_groups);
     let unit_groups = p.trav.ray_ram_groups();
-    let copies = b.copies(gslot, ram_groups + 1 + units as usize * unit_groups);
-    // A unit's write enables are the take for that unit, registered: `accept` and a select of
-    // the slot's unit bits after it reached every cell of the unit's ray RAMs and its free list.
+    let copies = b.copies(wslot, ram_groups - 1 + units as usize * unit_groups);
+    let ram_slots: Vec<S<'b>> = std::iter::once(wslot).chain(copies[..ram_groups - 1].iter().copied()).collect();
+    // A unit's write enables are the take for that unit, registered twice (its `alloc`, the
+    // last, once): `accept` and a select of the slot's unit bits after it reached every cell of
+    // the unit's ray RAMs and its free list.
     let unit_we = (0..units)
         .map(|u| {
             let mine = (take & is_unit(take_slot, u, sb, ub)).name(&format!("u{u}_take"));
-            let accept = b.valid_delay(&format!("u{u}_accept"), mine);
-            super::wide_ram::address_registers(b, accept, unit_groups + 1)
+            let alloc = b.valid_delay(&format!("u{u}_accept"), mine);
+            let write = b.valid_delay(&format!("u{u}_accept_w"), alloc);
+            let mut wes = super::wide_ram::address_registers(b, write, unit_groups);
+            wes.push(alloc);
+            wes
         })
         .collect();
     let [id, ox, oy, oz, wx, wy, wz, ix, iy, iz] =
@@ -180,9 +194,9 @@ pub fn ray_port<'b>(b: &'b Builder, p: &CoreParams, ins: &[S<'b>]) -> RayPort<'b
         accept,
         slot: gslot,
         ram_we,
-        ram_slots: copies[..ram_groups].to_vec(),
-        closest_slot: copies[ram_groups],
-        unit_slot: copies[ram_groups + 1..]
+        ram_slots,
+        closest_slot: b.copies(gslot, 1)[0],
+        unit_slot: copies[ram_groups - 1..]
             .chunks(unit_groups)
             .map(|c| c.iter().map(|c| c.slice(0, sb)).collect())
             .collect(),

@@ -249,20 +249,33 @@ fn results<'b>(
     // queues sit across the die).
     let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
     let (lb, lsb, lu) = (p.lane_bits(), p.lane_slot_bits(), p.lane_units() as usize);
+    // A copy of the slot per group of 16 has-best bits in each lane's unit (`slot_bit_2`).
+    let groups = super::closest::done_slot_copies(p.total_slots() >> lb) as usize;
+    let done_copies = b.copies(done_slot, groups * emitted.len());
     let outs: Vec<Ports> = emitted
         .iter()
         .enumerate()
         .map(|(lane, e)| {
             let mut cin: Vec<S> = e.pipe.all().to_vec();
             if lb == 0 {
-                cin.extend([port.accept, port.closest_slot, port.id, done_any, done_slot]);
+                let copies: Vec<S> = done_copies.iter().rev().copied().collect();
+                cin.extend([port.accept, port.closest_slot, port.id, done_any, done_slot, b.cat(&copies)]);
             } else {
                 // The lane's own slots: the global slot's top bits are the lane.
                 let nm = |x: &str| p.lane_name(lane as u32, x);
                 let mine = |slot: S<'b>| p.in_lane(slot, lane as u32);
                 let id_we = (port.accept & mine(port.closest_slot)).name(&nm("id_we"));
                 let done = (done_any & mine(done_slot)).name(&nm("done_valid"));
-                cin.extend([id_we, port.closest_slot.slice(0, lsb), port.id, done, done_slot.slice(0, lsb)]);
+                let copies: Vec<S> =
+                    done_copies[lane * groups..][..groups].iter().rev().map(|c| c.slice(0, lsb)).collect();
+                cin.extend([
+                    id_we,
+                    port.closest_slot.slice(0, lsb),
+                    port.id,
+                    done,
+                    done_slot.slice(0, lsb),
+                    b.cat(&copies),
+                ]);
             }
             b.instance(&p.lane_name(lane as u32, "u_closest"), &closest, &cin)
         })
