@@ -14,6 +14,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   input wire [19:0] id,
   input wire [0:0] done_valid,
   input wire [6:0] done_slot,
+  input wire [55:0] done_slot_copies,
   output wire [0:0] merge_valid0,
   output wire [5:0] merge_slot0,
   output wire [0:0] merge_hit0,
@@ -58,6 +59,30 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   initial $readmemh("fxrt_closest_n29_m32_tag59_s128_u2_r2_ray_ids.hex", ray_ids);
 
   // not in a stage or state machine
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_2;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_3;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_4;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_5;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_6;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  wire [6:0] bits_done_slot_copies_7;
+  /* verilator lint_on UNUSEDSIGNAL */
   wire [12:0] tri_s;
   wire [30:0] tmin;
   wire [5:0] sp;
@@ -351,7 +376,6 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg signed [31:0] m2_leaf_limit = 32'sh00000000;
   reg signed [31:0] m2_slot_limit = 32'sh00000000;
   wire [0:0] m2_we;
-  reg [0:0] best_we = 1'h0;
   reg [42:0] m3_t_tri = 43'h00000000000;
   wire [15:0] bits_m3_t_tri;
   wire [15:0] bits_m3_t_tri_1;
@@ -403,7 +427,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_141;
   wire [0:0] bits_best_valid_142;
   wire [0:0] bits_best_valid_143;
-  wire [3:0] bits_done_slot;
+  wire [3:0] bits_bits_done_slot_copies;
   wire [0:0] done_has_g0_c;
   reg [0:0] done_has_g0 = 1'h0;
   wire [0:0] bits_best_valid_144;
@@ -422,7 +446,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_157;
   wire [0:0] bits_best_valid_158;
   wire [0:0] bits_best_valid_159;
-  wire [3:0] bits_done_slot_1;
+  wire [3:0] bits_bits_done_slot_copies_1;
   wire [0:0] done_has_g1_c;
   reg [0:0] done_has_g1 = 1'h0;
   wire [0:0] bits_best_valid_160;
@@ -441,7 +465,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_173;
   wire [0:0] bits_best_valid_174;
   wire [0:0] bits_best_valid_175;
-  wire [3:0] bits_done_slot_2;
+  wire [3:0] bits_bits_done_slot_copies_2;
   wire [0:0] done_has_g2_c;
   reg [0:0] done_has_g2 = 1'h0;
   wire [0:0] bits_best_valid_176;
@@ -460,7 +484,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_189;
   wire [0:0] bits_best_valid_190;
   wire [0:0] bits_best_valid_191;
-  wire [3:0] bits_done_slot_3;
+  wire [3:0] bits_bits_done_slot_copies_3;
   wire [0:0] done_has_g3_c;
   reg [0:0] done_has_g3 = 1'h0;
   wire [0:0] bits_best_valid_192;
@@ -479,7 +503,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_205;
   wire [0:0] bits_best_valid_206;
   wire [0:0] bits_best_valid_207;
-  wire [3:0] bits_done_slot_4;
+  wire [3:0] bits_bits_done_slot_copies_4;
   wire [0:0] done_has_g4_c;
   reg [0:0] done_has_g4 = 1'h0;
   wire [0:0] bits_best_valid_208;
@@ -498,7 +522,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_221;
   wire [0:0] bits_best_valid_222;
   wire [0:0] bits_best_valid_223;
-  wire [3:0] bits_done_slot_5;
+  wire [3:0] bits_bits_done_slot_copies_5;
   wire [0:0] done_has_g5_c;
   reg [0:0] done_has_g5 = 1'h0;
   wire [0:0] bits_best_valid_224;
@@ -517,7 +541,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_237;
   wire [0:0] bits_best_valid_238;
   wire [0:0] bits_best_valid_239;
-  wire [3:0] bits_done_slot_6;
+  wire [3:0] bits_bits_done_slot_copies_6;
   wire [0:0] done_has_g6_c;
   reg [0:0] done_has_g6 = 1'h0;
   wire [0:0] bits_best_valid_240;
@@ -536,7 +560,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] bits_best_valid_253;
   wire [0:0] bits_best_valid_254;
   wire [0:0] bits_best_valid_255;
-  wire [3:0] bits_done_slot_7;
+  wire [3:0] bits_bits_done_slot_copies_7;
   wire [0:0] done_has_g7_c;
   reg [0:0] done_has_g7 = 1'h0;
   wire [2:0] bits_d0_slot;
@@ -799,7 +823,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] m2_slot_eq_k_1_1;
   wire [6:0] k_0_2 = 7'h00;
   wire [0:0] m2_slot_eq_k_0_2;
-  wire [127:0] cat_22;
+  wire [127:0] cat_30;
   reg [127:0] m3_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_set;
   wire [0:0] d0_slot_eq_k_127;
@@ -930,12 +954,12 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   wire [0:0] d0_slot_eq_k_2;
   wire [0:0] d0_slot_eq_k_1_1;
   wire [0:0] d0_slot_eq_k_0_2;
-  wire [127:0] cat_23;
+  wire [127:0] cat_31;
   reg [127:0] d1_onehot = 128'h00000000000000000000000000000000;
   wire [127:0] best_clear;
   wire [127:0] not_best_clear;
-  wire [127:0] and_24;
-  wire [127:0] and_24_or_best_set;
+  wire [127:0] and_32;
+  wire [127:0] and_32_or_best_set;
   reg [0:0] free_valid_r = 1'h0;
   reg [6:0] free_slot_r = 7'h00;
   reg [0:0] res_valid_r = 1'h0;
@@ -977,6 +1001,16 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg [6:0] m3_slot_c6 = 7'h00;
   reg [6:0] m3_slot_c7 = 7'h00;
 
+  // register copies best_we_copies: best_we and 7 copies, to split its fan-out
+  reg [0:0] best_we = 1'h0;
+  reg [0:0] best_we_c1 = 1'h0;
+  reg [0:0] best_we_c2 = 1'h0;
+  reg [0:0] best_we_c3 = 1'h0;
+  reg [0:0] best_we_c4 = 1'h0;
+  reg [0:0] best_we_c5 = 1'h0;
+  reg [0:0] best_we_c6 = 1'h0;
+  reg [0:0] best_we_c7 = 1'h0;
+
   // register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out
   reg [5:0] merge_slot_r = 6'h00;
   reg [5:0] merge_slot_r_c1 = 6'h00;
@@ -997,6 +1031,14 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   reg [6:0] d0_slot_c8 = 7'h00;
 
   // not in a stage or state machine
+  assign bits_done_slot_copies = done_slot_copies[6:0];
+  assign bits_done_slot_copies_1 = done_slot_copies[13:7];
+  assign bits_done_slot_copies_2 = done_slot_copies[20:14];
+  assign bits_done_slot_copies_3 = done_slot_copies[27:21];
+  assign bits_done_slot_copies_4 = done_slot_copies[34:28];
+  assign bits_done_slot_copies_5 = done_slot_copies[41:35];
+  assign bits_done_slot_copies_6 = done_slot_copies[48:42];
+  assign bits_done_slot_copies_7 = done_slot_copies[55:49];
   assign tri_s = tag[12:0];
   assign tmin = tag[43:13];
   assign sp = tag[49:44];
@@ -1390,24 +1432,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_141 = best_valid[13];
   assign bits_best_valid_142 = best_valid[14];
   assign bits_best_valid_143 = best_valid[15];
-  assign bits_done_slot = done_slot[3:0];
+  assign bits_bits_done_slot_copies = bits_done_slot_copies[3:0];
   assign done_has_g0_c =
-    (bits_done_slot == 4'h0) ? bits_best_valid_128 :
-    (bits_done_slot == 4'h1) ? bits_best_valid_129 :
-    (bits_done_slot == 4'h2) ? bits_best_valid_130 :
-    (bits_done_slot == 4'h3) ? bits_best_valid_131 :
-    (bits_done_slot == 4'h4) ? bits_best_valid_132 :
-    (bits_done_slot == 4'h5) ? bits_best_valid_133 :
-    (bits_done_slot == 4'h6) ? bits_best_valid_134 :
-    (bits_done_slot == 4'h7) ? bits_best_valid_135 :
-    (bits_done_slot == 4'h8) ? bits_best_valid_136 :
-    (bits_done_slot == 4'h9) ? bits_best_valid_137 :
-    (bits_done_slot == 4'ha) ? bits_best_valid_138 :
-    (bits_done_slot == 4'hb) ? bits_best_valid_139 :
-    (bits_done_slot == 4'hc) ? bits_best_valid_140 :
-    (bits_done_slot == 4'hd) ? bits_best_valid_141 :
-    (bits_done_slot == 4'he) ? bits_best_valid_142 :
-    (bits_done_slot == 4'hf) ? bits_best_valid_143 :
+    (bits_bits_done_slot_copies == 4'h0) ? bits_best_valid_128 :
+    (bits_bits_done_slot_copies == 4'h1) ? bits_best_valid_129 :
+    (bits_bits_done_slot_copies == 4'h2) ? bits_best_valid_130 :
+    (bits_bits_done_slot_copies == 4'h3) ? bits_best_valid_131 :
+    (bits_bits_done_slot_copies == 4'h4) ? bits_best_valid_132 :
+    (bits_bits_done_slot_copies == 4'h5) ? bits_best_valid_133 :
+    (bits_bits_done_slot_copies == 4'h6) ? bits_best_valid_134 :
+    (bits_bits_done_slot_copies == 4'h7) ? bits_best_valid_135 :
+    (bits_bits_done_slot_copies == 4'h8) ? bits_best_valid_136 :
+    (bits_bits_done_slot_copies == 4'h9) ? bits_best_valid_137 :
+    (bits_bits_done_slot_copies == 4'ha) ? bits_best_valid_138 :
+    (bits_bits_done_slot_copies == 4'hb) ? bits_best_valid_139 :
+    (bits_bits_done_slot_copies == 4'hc) ? bits_best_valid_140 :
+    (bits_bits_done_slot_copies == 4'hd) ? bits_best_valid_141 :
+    (bits_bits_done_slot_copies == 4'he) ? bits_best_valid_142 :
+    (bits_bits_done_slot_copies == 4'hf) ? bits_best_valid_143 :
     k_0;
   assign bits_best_valid_144 = best_valid[16];
   assign bits_best_valid_145 = best_valid[17];
@@ -1425,24 +1467,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_157 = best_valid[29];
   assign bits_best_valid_158 = best_valid[30];
   assign bits_best_valid_159 = best_valid[31];
-  assign bits_done_slot_1 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_1 = bits_done_slot_copies_1[3:0];
   assign done_has_g1_c =
-    (bits_done_slot_1 == 4'h0) ? bits_best_valid_144 :
-    (bits_done_slot_1 == 4'h1) ? bits_best_valid_145 :
-    (bits_done_slot_1 == 4'h2) ? bits_best_valid_146 :
-    (bits_done_slot_1 == 4'h3) ? bits_best_valid_147 :
-    (bits_done_slot_1 == 4'h4) ? bits_best_valid_148 :
-    (bits_done_slot_1 == 4'h5) ? bits_best_valid_149 :
-    (bits_done_slot_1 == 4'h6) ? bits_best_valid_150 :
-    (bits_done_slot_1 == 4'h7) ? bits_best_valid_151 :
-    (bits_done_slot_1 == 4'h8) ? bits_best_valid_152 :
-    (bits_done_slot_1 == 4'h9) ? bits_best_valid_153 :
-    (bits_done_slot_1 == 4'ha) ? bits_best_valid_154 :
-    (bits_done_slot_1 == 4'hb) ? bits_best_valid_155 :
-    (bits_done_slot_1 == 4'hc) ? bits_best_valid_156 :
-    (bits_done_slot_1 == 4'hd) ? bits_best_valid_157 :
-    (bits_done_slot_1 == 4'he) ? bits_best_valid_158 :
-    (bits_done_slot_1 == 4'hf) ? bits_best_valid_159 :
+    (bits_bits_done_slot_copies_1 == 4'h0) ? bits_best_valid_144 :
+    (bits_bits_done_slot_copies_1 == 4'h1) ? bits_best_valid_145 :
+    (bits_bits_done_slot_copies_1 == 4'h2) ? bits_best_valid_146 :
+    (bits_bits_done_slot_copies_1 == 4'h3) ? bits_best_valid_147 :
+    (bits_bits_done_slot_copies_1 == 4'h4) ? bits_best_valid_148 :
+    (bits_bits_done_slot_copies_1 == 4'h5) ? bits_best_valid_149 :
+    (bits_bits_done_slot_copies_1 == 4'h6) ? bits_best_valid_150 :
+    (bits_bits_done_slot_copies_1 == 4'h7) ? bits_best_valid_151 :
+    (bits_bits_done_slot_copies_1 == 4'h8) ? bits_best_valid_152 :
+    (bits_bits_done_slot_copies_1 == 4'h9) ? bits_best_valid_153 :
+    (bits_bits_done_slot_copies_1 == 4'ha) ? bits_best_valid_154 :
+    (bits_bits_done_slot_copies_1 == 4'hb) ? bits_best_valid_155 :
+    (bits_bits_done_slot_copies_1 == 4'hc) ? bits_best_valid_156 :
+    (bits_bits_done_slot_copies_1 == 4'hd) ? bits_best_valid_157 :
+    (bits_bits_done_slot_copies_1 == 4'he) ? bits_best_valid_158 :
+    (bits_bits_done_slot_copies_1 == 4'hf) ? bits_best_valid_159 :
     k_0;
   assign bits_best_valid_160 = best_valid[32];
   assign bits_best_valid_161 = best_valid[33];
@@ -1460,24 +1502,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_173 = best_valid[45];
   assign bits_best_valid_174 = best_valid[46];
   assign bits_best_valid_175 = best_valid[47];
-  assign bits_done_slot_2 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_2 = bits_done_slot_copies_2[3:0];
   assign done_has_g2_c =
-    (bits_done_slot_2 == 4'h0) ? bits_best_valid_160 :
-    (bits_done_slot_2 == 4'h1) ? bits_best_valid_161 :
-    (bits_done_slot_2 == 4'h2) ? bits_best_valid_162 :
-    (bits_done_slot_2 == 4'h3) ? bits_best_valid_163 :
-    (bits_done_slot_2 == 4'h4) ? bits_best_valid_164 :
-    (bits_done_slot_2 == 4'h5) ? bits_best_valid_165 :
-    (bits_done_slot_2 == 4'h6) ? bits_best_valid_166 :
-    (bits_done_slot_2 == 4'h7) ? bits_best_valid_167 :
-    (bits_done_slot_2 == 4'h8) ? bits_best_valid_168 :
-    (bits_done_slot_2 == 4'h9) ? bits_best_valid_169 :
-    (bits_done_slot_2 == 4'ha) ? bits_best_valid_170 :
-    (bits_done_slot_2 == 4'hb) ? bits_best_valid_171 :
-    (bits_done_slot_2 == 4'hc) ? bits_best_valid_172 :
-    (bits_done_slot_2 == 4'hd) ? bits_best_valid_173 :
-    (bits_done_slot_2 == 4'he) ? bits_best_valid_174 :
-    (bits_done_slot_2 == 4'hf) ? bits_best_valid_175 :
+    (bits_bits_done_slot_copies_2 == 4'h0) ? bits_best_valid_160 :
+    (bits_bits_done_slot_copies_2 == 4'h1) ? bits_best_valid_161 :
+    (bits_bits_done_slot_copies_2 == 4'h2) ? bits_best_valid_162 :
+    (bits_bits_done_slot_copies_2 == 4'h3) ? bits_best_valid_163 :
+    (bits_bits_done_slot_copies_2 == 4'h4) ? bits_best_valid_164 :
+    (bits_bits_done_slot_copies_2 == 4'h5) ? bits_best_valid_165 :
+    (bits_bits_done_slot_copies_2 == 4'h6) ? bits_best_valid_166 :
+    (bits_bits_done_slot_copies_2 == 4'h7) ? bits_best_valid_167 :
+    (bits_bits_done_slot_copies_2 == 4'h8) ? bits_best_valid_168 :
+    (bits_bits_done_slot_copies_2 == 4'h9) ? bits_best_valid_169 :
+    (bits_bits_done_slot_copies_2 == 4'ha) ? bits_best_valid_170 :
+    (bits_bits_done_slot_copies_2 == 4'hb) ? bits_best_valid_171 :
+    (bits_bits_done_slot_copies_2 == 4'hc) ? bits_best_valid_172 :
+    (bits_bits_done_slot_copies_2 == 4'hd) ? bits_best_valid_173 :
+    (bits_bits_done_slot_copies_2 == 4'he) ? bits_best_valid_174 :
+    (bits_bits_done_slot_copies_2 == 4'hf) ? bits_best_valid_175 :
     k_0;
   assign bits_best_valid_176 = best_valid[48];
   assign bits_best_valid_177 = best_valid[49];
@@ -1495,24 +1537,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_189 = best_valid[61];
   assign bits_best_valid_190 = best_valid[62];
   assign bits_best_valid_191 = best_valid[63];
-  assign bits_done_slot_3 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_3 = bits_done_slot_copies_3[3:0];
   assign done_has_g3_c =
-    (bits_done_slot_3 == 4'h0) ? bits_best_valid_176 :
-    (bits_done_slot_3 == 4'h1) ? bits_best_valid_177 :
-    (bits_done_slot_3 == 4'h2) ? bits_best_valid_178 :
-    (bits_done_slot_3 == 4'h3) ? bits_best_valid_179 :
-    (bits_done_slot_3 == 4'h4) ? bits_best_valid_180 :
-    (bits_done_slot_3 == 4'h5) ? bits_best_valid_181 :
-    (bits_done_slot_3 == 4'h6) ? bits_best_valid_182 :
-    (bits_done_slot_3 == 4'h7) ? bits_best_valid_183 :
-    (bits_done_slot_3 == 4'h8) ? bits_best_valid_184 :
-    (bits_done_slot_3 == 4'h9) ? bits_best_valid_185 :
-    (bits_done_slot_3 == 4'ha) ? bits_best_valid_186 :
-    (bits_done_slot_3 == 4'hb) ? bits_best_valid_187 :
-    (bits_done_slot_3 == 4'hc) ? bits_best_valid_188 :
-    (bits_done_slot_3 == 4'hd) ? bits_best_valid_189 :
-    (bits_done_slot_3 == 4'he) ? bits_best_valid_190 :
-    (bits_done_slot_3 == 4'hf) ? bits_best_valid_191 :
+    (bits_bits_done_slot_copies_3 == 4'h0) ? bits_best_valid_176 :
+    (bits_bits_done_slot_copies_3 == 4'h1) ? bits_best_valid_177 :
+    (bits_bits_done_slot_copies_3 == 4'h2) ? bits_best_valid_178 :
+    (bits_bits_done_slot_copies_3 == 4'h3) ? bits_best_valid_179 :
+    (bits_bits_done_slot_copies_3 == 4'h4) ? bits_best_valid_180 :
+    (bits_bits_done_slot_copies_3 == 4'h5) ? bits_best_valid_181 :
+    (bits_bits_done_slot_copies_3 == 4'h6) ? bits_best_valid_182 :
+    (bits_bits_done_slot_copies_3 == 4'h7) ? bits_best_valid_183 :
+    (bits_bits_done_slot_copies_3 == 4'h8) ? bits_best_valid_184 :
+    (bits_bits_done_slot_copies_3 == 4'h9) ? bits_best_valid_185 :
+    (bits_bits_done_slot_copies_3 == 4'ha) ? bits_best_valid_186 :
+    (bits_bits_done_slot_copies_3 == 4'hb) ? bits_best_valid_187 :
+    (bits_bits_done_slot_copies_3 == 4'hc) ? bits_best_valid_188 :
+    (bits_bits_done_slot_copies_3 == 4'hd) ? bits_best_valid_189 :
+    (bits_bits_done_slot_copies_3 == 4'he) ? bits_best_valid_190 :
+    (bits_bits_done_slot_copies_3 == 4'hf) ? bits_best_valid_191 :
     k_0;
   assign bits_best_valid_192 = best_valid[64];
   assign bits_best_valid_193 = best_valid[65];
@@ -1530,24 +1572,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_205 = best_valid[77];
   assign bits_best_valid_206 = best_valid[78];
   assign bits_best_valid_207 = best_valid[79];
-  assign bits_done_slot_4 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_4 = bits_done_slot_copies_4[3:0];
   assign done_has_g4_c =
-    (bits_done_slot_4 == 4'h0) ? bits_best_valid_192 :
-    (bits_done_slot_4 == 4'h1) ? bits_best_valid_193 :
-    (bits_done_slot_4 == 4'h2) ? bits_best_valid_194 :
-    (bits_done_slot_4 == 4'h3) ? bits_best_valid_195 :
-    (bits_done_slot_4 == 4'h4) ? bits_best_valid_196 :
-    (bits_done_slot_4 == 4'h5) ? bits_best_valid_197 :
-    (bits_done_slot_4 == 4'h6) ? bits_best_valid_198 :
-    (bits_done_slot_4 == 4'h7) ? bits_best_valid_199 :
-    (bits_done_slot_4 == 4'h8) ? bits_best_valid_200 :
-    (bits_done_slot_4 == 4'h9) ? bits_best_valid_201 :
-    (bits_done_slot_4 == 4'ha) ? bits_best_valid_202 :
-    (bits_done_slot_4 == 4'hb) ? bits_best_valid_203 :
-    (bits_done_slot_4 == 4'hc) ? bits_best_valid_204 :
-    (bits_done_slot_4 == 4'hd) ? bits_best_valid_205 :
-    (bits_done_slot_4 == 4'he) ? bits_best_valid_206 :
-    (bits_done_slot_4 == 4'hf) ? bits_best_valid_207 :
+    (bits_bits_done_slot_copies_4 == 4'h0) ? bits_best_valid_192 :
+    (bits_bits_done_slot_copies_4 == 4'h1) ? bits_best_valid_193 :
+    (bits_bits_done_slot_copies_4 == 4'h2) ? bits_best_valid_194 :
+    (bits_bits_done_slot_copies_4 == 4'h3) ? bits_best_valid_195 :
+    (bits_bits_done_slot_copies_4 == 4'h4) ? bits_best_valid_196 :
+    (bits_bits_done_slot_copies_4 == 4'h5) ? bits_best_valid_197 :
+    (bits_bits_done_slot_copies_4 == 4'h6) ? bits_best_valid_198 :
+    (bits_bits_done_slot_copies_4 == 4'h7) ? bits_best_valid_199 :
+    (bits_bits_done_slot_copies_4 == 4'h8) ? bits_best_valid_200 :
+    (bits_bits_done_slot_copies_4 == 4'h9) ? bits_best_valid_201 :
+    (bits_bits_done_slot_copies_4 == 4'ha) ? bits_best_valid_202 :
+    (bits_bits_done_slot_copies_4 == 4'hb) ? bits_best_valid_203 :
+    (bits_bits_done_slot_copies_4 == 4'hc) ? bits_best_valid_204 :
+    (bits_bits_done_slot_copies_4 == 4'hd) ? bits_best_valid_205 :
+    (bits_bits_done_slot_copies_4 == 4'he) ? bits_best_valid_206 :
+    (bits_bits_done_slot_copies_4 == 4'hf) ? bits_best_valid_207 :
     k_0;
   assign bits_best_valid_208 = best_valid[80];
   assign bits_best_valid_209 = best_valid[81];
@@ -1565,24 +1607,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_221 = best_valid[93];
   assign bits_best_valid_222 = best_valid[94];
   assign bits_best_valid_223 = best_valid[95];
-  assign bits_done_slot_5 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_5 = bits_done_slot_copies_5[3:0];
   assign done_has_g5_c =
-    (bits_done_slot_5 == 4'h0) ? bits_best_valid_208 :
-    (bits_done_slot_5 == 4'h1) ? bits_best_valid_209 :
-    (bits_done_slot_5 == 4'h2) ? bits_best_valid_210 :
-    (bits_done_slot_5 == 4'h3) ? bits_best_valid_211 :
-    (bits_done_slot_5 == 4'h4) ? bits_best_valid_212 :
-    (bits_done_slot_5 == 4'h5) ? bits_best_valid_213 :
-    (bits_done_slot_5 == 4'h6) ? bits_best_valid_214 :
-    (bits_done_slot_5 == 4'h7) ? bits_best_valid_215 :
-    (bits_done_slot_5 == 4'h8) ? bits_best_valid_216 :
-    (bits_done_slot_5 == 4'h9) ? bits_best_valid_217 :
-    (bits_done_slot_5 == 4'ha) ? bits_best_valid_218 :
-    (bits_done_slot_5 == 4'hb) ? bits_best_valid_219 :
-    (bits_done_slot_5 == 4'hc) ? bits_best_valid_220 :
-    (bits_done_slot_5 == 4'hd) ? bits_best_valid_221 :
-    (bits_done_slot_5 == 4'he) ? bits_best_valid_222 :
-    (bits_done_slot_5 == 4'hf) ? bits_best_valid_223 :
+    (bits_bits_done_slot_copies_5 == 4'h0) ? bits_best_valid_208 :
+    (bits_bits_done_slot_copies_5 == 4'h1) ? bits_best_valid_209 :
+    (bits_bits_done_slot_copies_5 == 4'h2) ? bits_best_valid_210 :
+    (bits_bits_done_slot_copies_5 == 4'h3) ? bits_best_valid_211 :
+    (bits_bits_done_slot_copies_5 == 4'h4) ? bits_best_valid_212 :
+    (bits_bits_done_slot_copies_5 == 4'h5) ? bits_best_valid_213 :
+    (bits_bits_done_slot_copies_5 == 4'h6) ? bits_best_valid_214 :
+    (bits_bits_done_slot_copies_5 == 4'h7) ? bits_best_valid_215 :
+    (bits_bits_done_slot_copies_5 == 4'h8) ? bits_best_valid_216 :
+    (bits_bits_done_slot_copies_5 == 4'h9) ? bits_best_valid_217 :
+    (bits_bits_done_slot_copies_5 == 4'ha) ? bits_best_valid_218 :
+    (bits_bits_done_slot_copies_5 == 4'hb) ? bits_best_valid_219 :
+    (bits_bits_done_slot_copies_5 == 4'hc) ? bits_best_valid_220 :
+    (bits_bits_done_slot_copies_5 == 4'hd) ? bits_best_valid_221 :
+    (bits_bits_done_slot_copies_5 == 4'he) ? bits_best_valid_222 :
+    (bits_bits_done_slot_copies_5 == 4'hf) ? bits_best_valid_223 :
     k_0;
   assign bits_best_valid_224 = best_valid[96];
   assign bits_best_valid_225 = best_valid[97];
@@ -1600,24 +1642,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_237 = best_valid[109];
   assign bits_best_valid_238 = best_valid[110];
   assign bits_best_valid_239 = best_valid[111];
-  assign bits_done_slot_6 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_6 = bits_done_slot_copies_6[3:0];
   assign done_has_g6_c =
-    (bits_done_slot_6 == 4'h0) ? bits_best_valid_224 :
-    (bits_done_slot_6 == 4'h1) ? bits_best_valid_225 :
-    (bits_done_slot_6 == 4'h2) ? bits_best_valid_226 :
-    (bits_done_slot_6 == 4'h3) ? bits_best_valid_227 :
-    (bits_done_slot_6 == 4'h4) ? bits_best_valid_228 :
-    (bits_done_slot_6 == 4'h5) ? bits_best_valid_229 :
-    (bits_done_slot_6 == 4'h6) ? bits_best_valid_230 :
-    (bits_done_slot_6 == 4'h7) ? bits_best_valid_231 :
-    (bits_done_slot_6 == 4'h8) ? bits_best_valid_232 :
-    (bits_done_slot_6 == 4'h9) ? bits_best_valid_233 :
-    (bits_done_slot_6 == 4'ha) ? bits_best_valid_234 :
-    (bits_done_slot_6 == 4'hb) ? bits_best_valid_235 :
-    (bits_done_slot_6 == 4'hc) ? bits_best_valid_236 :
-    (bits_done_slot_6 == 4'hd) ? bits_best_valid_237 :
-    (bits_done_slot_6 == 4'he) ? bits_best_valid_238 :
-    (bits_done_slot_6 == 4'hf) ? bits_best_valid_239 :
+    (bits_bits_done_slot_copies_6 == 4'h0) ? bits_best_valid_224 :
+    (bits_bits_done_slot_copies_6 == 4'h1) ? bits_best_valid_225 :
+    (bits_bits_done_slot_copies_6 == 4'h2) ? bits_best_valid_226 :
+    (bits_bits_done_slot_copies_6 == 4'h3) ? bits_best_valid_227 :
+    (bits_bits_done_slot_copies_6 == 4'h4) ? bits_best_valid_228 :
+    (bits_bits_done_slot_copies_6 == 4'h5) ? bits_best_valid_229 :
+    (bits_bits_done_slot_copies_6 == 4'h6) ? bits_best_valid_230 :
+    (bits_bits_done_slot_copies_6 == 4'h7) ? bits_best_valid_231 :
+    (bits_bits_done_slot_copies_6 == 4'h8) ? bits_best_valid_232 :
+    (bits_bits_done_slot_copies_6 == 4'h9) ? bits_best_valid_233 :
+    (bits_bits_done_slot_copies_6 == 4'ha) ? bits_best_valid_234 :
+    (bits_bits_done_slot_copies_6 == 4'hb) ? bits_best_valid_235 :
+    (bits_bits_done_slot_copies_6 == 4'hc) ? bits_best_valid_236 :
+    (bits_bits_done_slot_copies_6 == 4'hd) ? bits_best_valid_237 :
+    (bits_bits_done_slot_copies_6 == 4'he) ? bits_best_valid_238 :
+    (bits_bits_done_slot_copies_6 == 4'hf) ? bits_best_valid_239 :
     k_0;
   assign bits_best_valid_240 = best_valid[112];
   assign bits_best_valid_241 = best_valid[113];
@@ -1635,24 +1677,24 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign bits_best_valid_253 = best_valid[125];
   assign bits_best_valid_254 = best_valid[126];
   assign bits_best_valid_255 = best_valid[127];
-  assign bits_done_slot_7 = done_slot[3:0];
+  assign bits_bits_done_slot_copies_7 = bits_done_slot_copies_7[3:0];
   assign done_has_g7_c =
-    (bits_done_slot_7 == 4'h0) ? bits_best_valid_240 :
-    (bits_done_slot_7 == 4'h1) ? bits_best_valid_241 :
-    (bits_done_slot_7 == 4'h2) ? bits_best_valid_242 :
-    (bits_done_slot_7 == 4'h3) ? bits_best_valid_243 :
-    (bits_done_slot_7 == 4'h4) ? bits_best_valid_244 :
-    (bits_done_slot_7 == 4'h5) ? bits_best_valid_245 :
-    (bits_done_slot_7 == 4'h6) ? bits_best_valid_246 :
-    (bits_done_slot_7 == 4'h7) ? bits_best_valid_247 :
-    (bits_done_slot_7 == 4'h8) ? bits_best_valid_248 :
-    (bits_done_slot_7 == 4'h9) ? bits_best_valid_249 :
-    (bits_done_slot_7 == 4'ha) ? bits_best_valid_250 :
-    (bits_done_slot_7 == 4'hb) ? bits_best_valid_251 :
-    (bits_done_slot_7 == 4'hc) ? bits_best_valid_252 :
-    (bits_done_slot_7 == 4'hd) ? bits_best_valid_253 :
-    (bits_done_slot_7 == 4'he) ? bits_best_valid_254 :
-    (bits_done_slot_7 == 4'hf) ? bits_best_valid_255 :
+    (bits_bits_done_slot_copies_7 == 4'h0) ? bits_best_valid_240 :
+    (bits_bits_done_slot_copies_7 == 4'h1) ? bits_best_valid_241 :
+    (bits_bits_done_slot_copies_7 == 4'h2) ? bits_best_valid_242 :
+    (bits_bits_done_slot_copies_7 == 4'h3) ? bits_best_valid_243 :
+    (bits_bits_done_slot_copies_7 == 4'h4) ? bits_best_valid_244 :
+    (bits_bits_done_slot_copies_7 == 4'h5) ? bits_best_valid_245 :
+    (bits_bits_done_slot_copies_7 == 4'h6) ? bits_best_valid_246 :
+    (bits_bits_done_slot_copies_7 == 4'h7) ? bits_best_valid_247 :
+    (bits_bits_done_slot_copies_7 == 4'h8) ? bits_best_valid_248 :
+    (bits_bits_done_slot_copies_7 == 4'h9) ? bits_best_valid_249 :
+    (bits_bits_done_slot_copies_7 == 4'ha) ? bits_best_valid_250 :
+    (bits_bits_done_slot_copies_7 == 4'hb) ? bits_best_valid_251 :
+    (bits_bits_done_slot_copies_7 == 4'hc) ? bits_best_valid_252 :
+    (bits_bits_done_slot_copies_7 == 4'hd) ? bits_best_valid_253 :
+    (bits_bits_done_slot_copies_7 == 4'he) ? bits_best_valid_254 :
+    (bits_bits_done_slot_copies_7 == 4'hf) ? bits_best_valid_255 :
     k_0;
   assign bits_d0_slot = d0_slot[6:4];
   assign done_has_c =
@@ -1793,7 +1835,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign m2_slot_eq_k_2 = m2_slot == k_2;
   assign m2_slot_eq_k_1_1 = m2_slot == k_1_1;
   assign m2_slot_eq_k_0_2 = m2_slot == k_0_2;
-  assign cat_22 = {m2_slot_eq_k_127, m2_slot_eq_k_126, m2_slot_eq_k_125, m2_slot_eq_k_124, m2_slot_eq_k_123, m2_slot_eq_k_122, m2_slot_eq_k_121, m2_slot_eq_k_120, m2_slot_eq_k_119, m2_slot_eq_k_118, m2_slot_eq_k_117, m2_slot_eq_k_116, m2_slot_eq_k_115, m2_slot_eq_k_114, m2_slot_eq_k_113, m2_slot_eq_k_112, m2_slot_eq_k_111, m2_slot_eq_k_110, m2_slot_eq_k_109, m2_slot_eq_k_108, m2_slot_eq_k_107, m2_slot_eq_k_106, m2_slot_eq_k_105, m2_slot_eq_k_104, m2_slot_eq_k_103, m2_slot_eq_k_102, m2_slot_eq_k_101, m2_slot_eq_k_100, m2_slot_eq_k_99, m2_slot_eq_k_98, m2_slot_eq_k_97, m2_slot_eq_k_96, m2_slot_eq_k_95, m2_slot_eq_k_94, m2_slot_eq_k_93, m2_slot_eq_k_92, m2_slot_eq_k_91, m2_slot_eq_k_90, m2_slot_eq_k_89, m2_slot_eq_k_88, m2_slot_eq_k_87, m2_slot_eq_k_86, m2_slot_eq_k_85, m2_slot_eq_k_84, m2_slot_eq_k_83, m2_slot_eq_k_82, m2_slot_eq_k_81, m2_slot_eq_k_80, m2_slot_eq_k_79, m2_slot_eq_k_78, m2_slot_eq_k_77, m2_slot_eq_k_76, m2_slot_eq_k_75, m2_slot_eq_k_74, m2_slot_eq_k_73, m2_slot_eq_k_72, m2_slot_eq_k_71, m2_slot_eq_k_70, m2_slot_eq_k_69, m2_slot_eq_k_68, m2_slot_eq_k_67, m2_slot_eq_k_66, m2_slot_eq_k_65, m2_slot_eq_k_64, m2_slot_eq_k_63, m2_slot_eq_k_62, m2_slot_eq_k_61, m2_slot_eq_k_60, m2_slot_eq_k_59, m2_slot_eq_k_58, m2_slot_eq_k_57, m2_slot_eq_k_56, m2_slot_eq_k_55, m2_slot_eq_k_54, m2_slot_eq_k_53, m2_slot_eq_k_52, m2_slot_eq_k_51, m2_slot_eq_k_50, m2_slot_eq_k_49, m2_slot_eq_k_48, m2_slot_eq_k_47, m2_slot_eq_k_46, m2_slot_eq_k_45, m2_slot_eq_k_44, m2_slot_eq_k_43, m2_slot_eq_k_42, m2_slot_eq_k_41, m2_slot_eq_k_40, m2_slot_eq_k_39, m2_slot_eq_k_38, m2_slot_eq_k_37, m2_slot_eq_k_36, m2_slot_eq_k_35, m2_slot_eq_k_34, m2_slot_eq_k_33, m2_slot_eq_k_32, m2_slot_eq_k_31, m2_slot_eq_k_30, m2_slot_eq_k_29, m2_slot_eq_k_28, m2_slot_eq_k_27, m2_slot_eq_k_26, m2_slot_eq_k_25, m2_slot_eq_k_24, m2_slot_eq_k_23, m2_slot_eq_k_22, m2_slot_eq_k_21, m2_slot_eq_k_20, m2_slot_eq_k_19, m2_slot_eq_k_18, m2_slot_eq_k_17, m2_slot_eq_k_16, m2_slot_eq_k_15, m2_slot_eq_k_14, m2_slot_eq_k_13, m2_slot_eq_k_12, m2_slot_eq_k_11, m2_slot_eq_k_10, m2_slot_eq_k_9, m2_slot_eq_k_8_1, m2_slot_eq_k_7, m2_slot_eq_k_6, m2_slot_eq_k_5, m2_slot_eq_k_4, m2_slot_eq_k_3, m2_slot_eq_k_2, m2_slot_eq_k_1_1, m2_slot_eq_k_0_2};
+  assign cat_30 = {m2_slot_eq_k_127, m2_slot_eq_k_126, m2_slot_eq_k_125, m2_slot_eq_k_124, m2_slot_eq_k_123, m2_slot_eq_k_122, m2_slot_eq_k_121, m2_slot_eq_k_120, m2_slot_eq_k_119, m2_slot_eq_k_118, m2_slot_eq_k_117, m2_slot_eq_k_116, m2_slot_eq_k_115, m2_slot_eq_k_114, m2_slot_eq_k_113, m2_slot_eq_k_112, m2_slot_eq_k_111, m2_slot_eq_k_110, m2_slot_eq_k_109, m2_slot_eq_k_108, m2_slot_eq_k_107, m2_slot_eq_k_106, m2_slot_eq_k_105, m2_slot_eq_k_104, m2_slot_eq_k_103, m2_slot_eq_k_102, m2_slot_eq_k_101, m2_slot_eq_k_100, m2_slot_eq_k_99, m2_slot_eq_k_98, m2_slot_eq_k_97, m2_slot_eq_k_96, m2_slot_eq_k_95, m2_slot_eq_k_94, m2_slot_eq_k_93, m2_slot_eq_k_92, m2_slot_eq_k_91, m2_slot_eq_k_90, m2_slot_eq_k_89, m2_slot_eq_k_88, m2_slot_eq_k_87, m2_slot_eq_k_86, m2_slot_eq_k_85, m2_slot_eq_k_84, m2_slot_eq_k_83, m2_slot_eq_k_82, m2_slot_eq_k_81, m2_slot_eq_k_80, m2_slot_eq_k_79, m2_slot_eq_k_78, m2_slot_eq_k_77, m2_slot_eq_k_76, m2_slot_eq_k_75, m2_slot_eq_k_74, m2_slot_eq_k_73, m2_slot_eq_k_72, m2_slot_eq_k_71, m2_slot_eq_k_70, m2_slot_eq_k_69, m2_slot_eq_k_68, m2_slot_eq_k_67, m2_slot_eq_k_66, m2_slot_eq_k_65, m2_slot_eq_k_64, m2_slot_eq_k_63, m2_slot_eq_k_62, m2_slot_eq_k_61, m2_slot_eq_k_60, m2_slot_eq_k_59, m2_slot_eq_k_58, m2_slot_eq_k_57, m2_slot_eq_k_56, m2_slot_eq_k_55, m2_slot_eq_k_54, m2_slot_eq_k_53, m2_slot_eq_k_52, m2_slot_eq_k_51, m2_slot_eq_k_50, m2_slot_eq_k_49, m2_slot_eq_k_48, m2_slot_eq_k_47, m2_slot_eq_k_46, m2_slot_eq_k_45, m2_slot_eq_k_44, m2_slot_eq_k_43, m2_slot_eq_k_42, m2_slot_eq_k_41, m2_slot_eq_k_40, m2_slot_eq_k_39, m2_slot_eq_k_38, m2_slot_eq_k_37, m2_slot_eq_k_36, m2_slot_eq_k_35, m2_slot_eq_k_34, m2_slot_eq_k_33, m2_slot_eq_k_32, m2_slot_eq_k_31, m2_slot_eq_k_30, m2_slot_eq_k_29, m2_slot_eq_k_28, m2_slot_eq_k_27, m2_slot_eq_k_26, m2_slot_eq_k_25, m2_slot_eq_k_24, m2_slot_eq_k_23, m2_slot_eq_k_22, m2_slot_eq_k_21, m2_slot_eq_k_20, m2_slot_eq_k_19, m2_slot_eq_k_18, m2_slot_eq_k_17, m2_slot_eq_k_16, m2_slot_eq_k_15, m2_slot_eq_k_14, m2_slot_eq_k_13, m2_slot_eq_k_12, m2_slot_eq_k_11, m2_slot_eq_k_10, m2_slot_eq_k_9, m2_slot_eq_k_8_1, m2_slot_eq_k_7, m2_slot_eq_k_6, m2_slot_eq_k_5, m2_slot_eq_k_4, m2_slot_eq_k_3, m2_slot_eq_k_2, m2_slot_eq_k_1_1, m2_slot_eq_k_0_2};
   assign best_set = best_we ? m3_onehot : k_0_1;
   assign d0_slot_eq_k_127 = d0_slot == k_127;
   assign d0_slot_eq_k_126 = d0_slot == k_126;
@@ -1923,11 +1965,11 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign d0_slot_eq_k_2 = d0_slot == k_2;
   assign d0_slot_eq_k_1_1 = d0_slot == k_1_1;
   assign d0_slot_eq_k_0_2 = d0_slot == k_0_2;
-  assign cat_23 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
+  assign cat_31 = {d0_slot_eq_k_127, d0_slot_eq_k_126, d0_slot_eq_k_125, d0_slot_eq_k_124, d0_slot_eq_k_123, d0_slot_eq_k_122, d0_slot_eq_k_121, d0_slot_eq_k_120, d0_slot_eq_k_119, d0_slot_eq_k_118, d0_slot_eq_k_117, d0_slot_eq_k_116, d0_slot_eq_k_115, d0_slot_eq_k_114, d0_slot_eq_k_113, d0_slot_eq_k_112, d0_slot_eq_k_111, d0_slot_eq_k_110, d0_slot_eq_k_109, d0_slot_eq_k_108, d0_slot_eq_k_107, d0_slot_eq_k_106, d0_slot_eq_k_105, d0_slot_eq_k_104, d0_slot_eq_k_103, d0_slot_eq_k_102, d0_slot_eq_k_101, d0_slot_eq_k_100, d0_slot_eq_k_99, d0_slot_eq_k_98, d0_slot_eq_k_97, d0_slot_eq_k_96, d0_slot_eq_k_95, d0_slot_eq_k_94, d0_slot_eq_k_93, d0_slot_eq_k_92, d0_slot_eq_k_91, d0_slot_eq_k_90, d0_slot_eq_k_89, d0_slot_eq_k_88, d0_slot_eq_k_87, d0_slot_eq_k_86, d0_slot_eq_k_85, d0_slot_eq_k_84, d0_slot_eq_k_83, d0_slot_eq_k_82, d0_slot_eq_k_81, d0_slot_eq_k_80, d0_slot_eq_k_79, d0_slot_eq_k_78, d0_slot_eq_k_77, d0_slot_eq_k_76, d0_slot_eq_k_75, d0_slot_eq_k_74, d0_slot_eq_k_73, d0_slot_eq_k_72, d0_slot_eq_k_71, d0_slot_eq_k_70, d0_slot_eq_k_69, d0_slot_eq_k_68, d0_slot_eq_k_67, d0_slot_eq_k_66, d0_slot_eq_k_65, d0_slot_eq_k_64, d0_slot_eq_k_63, d0_slot_eq_k_62, d0_slot_eq_k_61, d0_slot_eq_k_60, d0_slot_eq_k_59, d0_slot_eq_k_58, d0_slot_eq_k_57, d0_slot_eq_k_56, d0_slot_eq_k_55, d0_slot_eq_k_54, d0_slot_eq_k_53, d0_slot_eq_k_52, d0_slot_eq_k_51, d0_slot_eq_k_50, d0_slot_eq_k_49, d0_slot_eq_k_48, d0_slot_eq_k_47, d0_slot_eq_k_46, d0_slot_eq_k_45, d0_slot_eq_k_44, d0_slot_eq_k_43, d0_slot_eq_k_42, d0_slot_eq_k_41, d0_slot_eq_k_40, d0_slot_eq_k_39, d0_slot_eq_k_38, d0_slot_eq_k_37, d0_slot_eq_k_36, d0_slot_eq_k_35, d0_slot_eq_k_34, d0_slot_eq_k_33, d0_slot_eq_k_32, d0_slot_eq_k_31, d0_slot_eq_k_30, d0_slot_eq_k_29, d0_slot_eq_k_28, d0_slot_eq_k_27, d0_slot_eq_k_26, d0_slot_eq_k_25, d0_slot_eq_k_24, d0_slot_eq_k_23, d0_slot_eq_k_22, d0_slot_eq_k_21, d0_slot_eq_k_20, d0_slot_eq_k_19, d0_slot_eq_k_18, d0_slot_eq_k_17, d0_slot_eq_k_16, d0_slot_eq_k_15, d0_slot_eq_k_14, d0_slot_eq_k_13, d0_slot_eq_k_12, d0_slot_eq_k_11, d0_slot_eq_k_10, d0_slot_eq_k_9, d0_slot_eq_k_8_1, d0_slot_eq_k_7, d0_slot_eq_k_6, d0_slot_eq_k_5, d0_slot_eq_k_4, d0_slot_eq_k_3, d0_slot_eq_k_2, d0_slot_eq_k_1_1, d0_slot_eq_k_0_2};
   assign best_clear = d1 ? d1_onehot : k_0_1;
   assign not_best_clear = ~best_clear;
-  assign and_24 = best_valid & not_best_clear;
-  assign and_24_or_best_set = and_24 | best_set;
+  assign and_32 = best_valid & not_best_clear;
+  assign and_32_or_best_set = and_32 | best_set;
   assign res_id_c = done_id;
   assign res_hit_c = d1_has;
   assign bits_done_t_tri = done_t_tri[12:0];
@@ -1940,13 +1982,13 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
   assign res_v_c = d1_has ? bits_done_u_v_1 : k_0_5;
 
   always @(posedge clk) begin : regs
-    if (best_we) best_t_tri_g0[m3_slot_c1] <= bits_m3_t_tri;
-    if (best_we) best_t_tri_g1[m3_slot_c2] <= bits_m3_t_tri_1;
-    if (best_we) best_t_tri_g2[m3_slot_c3] <= bits_m3_t_tri_2;
-    if (best_we) best_u_v_g0[m3_slot_c4] <= bits_m3_u_v;
-    if (best_we) best_u_v_g1[m3_slot_c5] <= bits_m3_u_v_1;
-    if (best_we) best_u_v_g2[m3_slot_c6] <= bits_m3_u_v_2;
-    if (best_we) best_u_v_g3[m3_slot_c7] <= bits_m3_u_v_3;
+    if (best_we_c1) best_t_tri_g0[m3_slot_c1] <= bits_m3_t_tri;
+    if (best_we_c2) best_t_tri_g1[m3_slot_c2] <= bits_m3_t_tri_1;
+    if (best_we_c3) best_t_tri_g2[m3_slot_c3] <= bits_m3_t_tri_2;
+    if (best_we_c4) best_u_v_g0[m3_slot_c4] <= bits_m3_u_v;
+    if (best_we_c5) best_u_v_g1[m3_slot_c5] <= bits_m3_u_v_1;
+    if (best_we_c6) best_u_v_g2[m3_slot_c6] <= bits_m3_u_v_2;
+    if (best_we_c7) best_u_v_g3[m3_slot_c7] <= bits_m3_u_v_3;
     if (id_we) ray_ids[id_slot] <= id;
     in_tmin_less <= tmin_less;
     in_t_plus_8 <= t_plus_8;
@@ -1985,7 +2027,7 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     cand_u <= in_u;
     cand_v <= in_v;
     if (rst) best_valid <= 128'h00000000000000000000000000000000;
-    else best_valid <= and_24_or_best_set;
+    else best_valid <= and_32_or_best_set;
     if (rst) fin <= 1'h0;
     else fin <= leaf_last;
     fin_sp <= in_sp;
@@ -2019,8 +2061,6 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     m2_u_v <= m1_u_v;
     m2_leaf_limit <= leaf_limit;
     m2_slot_limit <= slot_limit;
-    if (rst) best_we <= 1'h0;
-    else best_we <= m2_we;
     m3_t_tri <= m2_t_tri;
     m3_u_v <= m2_u_v;
     if (rst) merge_valid0_r <= 1'h0;
@@ -2051,8 +2091,8 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     done_has_g6 <= done_has_g6_c;
     done_has_g7 <= done_has_g7_c;
     d1_has <= done_has_c;
-    m3_onehot <= cat_22;
-    d1_onehot <= cat_23;
+    m3_onehot <= cat_30;
+    d1_onehot <= cat_31;
     if (rst) free_valid_r <= 1'h0;
     else free_valid_r <= d1;
     free_slot_r <= d1_slot;
@@ -2086,6 +2126,27 @@ module fxrt_closest_n29_m32_tag59_s128_u2_r2 (
     m3_slot_c5 <= m2_slot;
     m3_slot_c6 <= m2_slot;
     m3_slot_c7 <= m2_slot;
+  end
+
+  // register copies best_we_copies: best_we and 7 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : best_we_copies_regs
+    if (rst) best_we <= 1'h0;
+    else best_we <= m2_we;
+    if (rst) best_we_c1 <= 1'h0;
+    else best_we_c1 <= m2_we;
+    if (rst) best_we_c2 <= 1'h0;
+    else best_we_c2 <= m2_we;
+    if (rst) best_we_c3 <= 1'h0;
+    else best_we_c3 <= m2_we;
+    if (rst) best_we_c4 <= 1'h0;
+    else best_we_c4 <= m2_we;
+    if (rst) best_we_c5 <= 1'h0;
+    else best_we_c5 <= m2_we;
+    if (rst) best_we_c6 <= 1'h0;
+    else best_we_c6 <= m2_we;
+    if (rst) best_we_c7 <= 1'h0;
+    else best_we_c7 <= m2_we;
   end
 
   // register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out

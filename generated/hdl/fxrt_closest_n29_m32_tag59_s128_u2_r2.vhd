@@ -18,6 +18,7 @@ entity fxrt_closest_n29_m32_tag59_s128_u2_r2 is
     id : in unsigned(19 downto 0);
     done_valid : in unsigned(0 downto 0);
     done_slot : in unsigned(6 downto 0);
+    done_slot_copies : in unsigned(55 downto 0);
     merge_valid0 : out unsigned(0 downto 0);
     merge_slot0 : out unsigned(5 downto 0);
     merge_hit0 : out unsigned(0 downto 0);
@@ -67,6 +68,14 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   attribute keep : string;
 
   -- not in a stage or state machine
+  signal bits_done_slot_copies : unsigned(6 downto 0);
+  signal bits_done_slot_copies_1 : unsigned(6 downto 0);
+  signal bits_done_slot_copies_2 : unsigned(6 downto 0);
+  signal bits_done_slot_copies_3 : unsigned(6 downto 0);
+  signal bits_done_slot_copies_4 : unsigned(6 downto 0);
+  signal bits_done_slot_copies_5 : unsigned(6 downto 0);
+  signal bits_done_slot_copies_6 : unsigned(6 downto 0);
+  signal bits_done_slot_copies_7 : unsigned(6 downto 0);
   signal tri_s : unsigned(12 downto 0);
   signal tmin : unsigned(30 downto 0);
   signal sp : unsigned(5 downto 0);
@@ -346,7 +355,6 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal m2_leaf_limit : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal m2_slot_limit : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal m2_we : unsigned(0 downto 0);
-  signal best_we : unsigned(0 downto 0) := unsigned'("0");
   signal m3_t_tri : unsigned(42 downto 0) := unsigned'("0000000000000000000000000000000000000000000");
   signal bits_m3_t_tri : unsigned(15 downto 0);
   signal bits_m3_t_tri_1 : unsigned(15 downto 0);
@@ -398,7 +406,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_141 : unsigned(0 downto 0);
   signal bits_best_valid_142 : unsigned(0 downto 0);
   signal bits_best_valid_143 : unsigned(0 downto 0);
-  signal bits_done_slot : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies : unsigned(3 downto 0);
   signal done_has_g0_c : unsigned(0 downto 0);
   signal done_has_g0 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_144 : unsigned(0 downto 0);
@@ -417,7 +425,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_157 : unsigned(0 downto 0);
   signal bits_best_valid_158 : unsigned(0 downto 0);
   signal bits_best_valid_159 : unsigned(0 downto 0);
-  signal bits_done_slot_1 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_1 : unsigned(3 downto 0);
   signal done_has_g1_c : unsigned(0 downto 0);
   signal done_has_g1 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_160 : unsigned(0 downto 0);
@@ -436,7 +444,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_173 : unsigned(0 downto 0);
   signal bits_best_valid_174 : unsigned(0 downto 0);
   signal bits_best_valid_175 : unsigned(0 downto 0);
-  signal bits_done_slot_2 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_2 : unsigned(3 downto 0);
   signal done_has_g2_c : unsigned(0 downto 0);
   signal done_has_g2 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_176 : unsigned(0 downto 0);
@@ -455,7 +463,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_189 : unsigned(0 downto 0);
   signal bits_best_valid_190 : unsigned(0 downto 0);
   signal bits_best_valid_191 : unsigned(0 downto 0);
-  signal bits_done_slot_3 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_3 : unsigned(3 downto 0);
   signal done_has_g3_c : unsigned(0 downto 0);
   signal done_has_g3 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_192 : unsigned(0 downto 0);
@@ -474,7 +482,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_205 : unsigned(0 downto 0);
   signal bits_best_valid_206 : unsigned(0 downto 0);
   signal bits_best_valid_207 : unsigned(0 downto 0);
-  signal bits_done_slot_4 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_4 : unsigned(3 downto 0);
   signal done_has_g4_c : unsigned(0 downto 0);
   signal done_has_g4 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_208 : unsigned(0 downto 0);
@@ -493,7 +501,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_221 : unsigned(0 downto 0);
   signal bits_best_valid_222 : unsigned(0 downto 0);
   signal bits_best_valid_223 : unsigned(0 downto 0);
-  signal bits_done_slot_5 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_5 : unsigned(3 downto 0);
   signal done_has_g5_c : unsigned(0 downto 0);
   signal done_has_g5 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_224 : unsigned(0 downto 0);
@@ -512,7 +520,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_237 : unsigned(0 downto 0);
   signal bits_best_valid_238 : unsigned(0 downto 0);
   signal bits_best_valid_239 : unsigned(0 downto 0);
-  signal bits_done_slot_6 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_6 : unsigned(3 downto 0);
   signal done_has_g6_c : unsigned(0 downto 0);
   signal done_has_g6 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_best_valid_240 : unsigned(0 downto 0);
@@ -531,7 +539,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal bits_best_valid_253 : unsigned(0 downto 0);
   signal bits_best_valid_254 : unsigned(0 downto 0);
   signal bits_best_valid_255 : unsigned(0 downto 0);
-  signal bits_done_slot_7 : unsigned(3 downto 0);
+  signal bits_bits_done_slot_copies_7 : unsigned(3 downto 0);
   signal done_has_g7_c : unsigned(0 downto 0);
   signal done_has_g7 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_d0_slot : unsigned(2 downto 0);
@@ -794,7 +802,7 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal m2_slot_eq_k_1_1 : unsigned(0 downto 0);
   constant k_0_2 : unsigned(6 downto 0) := unsigned'("0000000");
   signal m2_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_22 : unsigned(127 downto 0);
+  signal cat_30 : unsigned(127 downto 0);
   signal m3_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_set : unsigned(127 downto 0);
   signal d0_slot_eq_k_127 : unsigned(0 downto 0);
@@ -925,12 +933,12 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal d0_slot_eq_k_2 : unsigned(0 downto 0);
   signal d0_slot_eq_k_1_1 : unsigned(0 downto 0);
   signal d0_slot_eq_k_0_2 : unsigned(0 downto 0);
-  signal cat_23 : unsigned(127 downto 0);
+  signal cat_31 : unsigned(127 downto 0);
   signal d1_onehot : unsigned(127 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal best_clear : unsigned(127 downto 0);
   signal not_best_clear : unsigned(127 downto 0);
-  signal and_24 : unsigned(127 downto 0);
-  signal and_24_or_best_set : unsigned(127 downto 0);
+  signal and_32 : unsigned(127 downto 0);
+  signal and_32_or_best_set : unsigned(127 downto 0);
   signal free_valid_r : unsigned(0 downto 0) := unsigned'("0");
   signal free_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
   signal res_valid_r : unsigned(0 downto 0) := unsigned'("0");
@@ -982,6 +990,24 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
   signal m3_slot_c7 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of m3_slot_c7 : signal is "true";
 
+  -- register copies best_we_copies: best_we and 7 copies, to split its fan-out
+  signal best_we : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we : signal is "true";
+  signal best_we_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c1 : signal is "true";
+  signal best_we_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c2 : signal is "true";
+  signal best_we_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c3 : signal is "true";
+  signal best_we_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c4 : signal is "true";
+  signal best_we_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c5 : signal is "true";
+  signal best_we_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c6 : signal is "true";
+  signal best_we_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of best_we_c7 : signal is "true";
+
   -- register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out
   signal merge_slot_r : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of merge_slot_r : signal is "true";
@@ -1016,6 +1042,14 @@ architecture rtl of fxrt_closest_n29_m32_tag59_s128_u2_r2 is
 begin
 
   -- not in a stage or state machine
+  bits_done_slot_copies <= unsigned(done_slot_copies(6 downto 0));
+  bits_done_slot_copies_1 <= unsigned(done_slot_copies(13 downto 7));
+  bits_done_slot_copies_2 <= unsigned(done_slot_copies(20 downto 14));
+  bits_done_slot_copies_3 <= unsigned(done_slot_copies(27 downto 21));
+  bits_done_slot_copies_4 <= unsigned(done_slot_copies(34 downto 28));
+  bits_done_slot_copies_5 <= unsigned(done_slot_copies(41 downto 35));
+  bits_done_slot_copies_6 <= unsigned(done_slot_copies(48 downto 42));
+  bits_done_slot_copies_7 <= unsigned(done_slot_copies(55 downto 49));
   tri_s <= unsigned(tag(12 downto 0));
   tmin <= unsigned(tag(43 downto 13));
   sp <= unsigned(tag(49 downto 44));
@@ -1418,8 +1452,8 @@ begin
   bits_best_valid_141 <= unsigned(best_valid(13 downto 13));
   bits_best_valid_142 <= unsigned(best_valid(14 downto 14));
   bits_best_valid_143 <= unsigned(best_valid(15 downto 15));
-  bits_done_slot <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot select
+  bits_bits_done_slot_copies <= unsigned(bits_done_slot_copies(3 downto 0));
+  with bits_bits_done_slot_copies select
     done_has_g0_c <=
       bits_best_valid_128 when "0000",
       bits_best_valid_129 when "0001",
@@ -1454,8 +1488,8 @@ begin
   bits_best_valid_157 <= unsigned(best_valid(29 downto 29));
   bits_best_valid_158 <= unsigned(best_valid(30 downto 30));
   bits_best_valid_159 <= unsigned(best_valid(31 downto 31));
-  bits_done_slot_1 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_1 select
+  bits_bits_done_slot_copies_1 <= unsigned(bits_done_slot_copies_1(3 downto 0));
+  with bits_bits_done_slot_copies_1 select
     done_has_g1_c <=
       bits_best_valid_144 when "0000",
       bits_best_valid_145 when "0001",
@@ -1490,8 +1524,8 @@ begin
   bits_best_valid_173 <= unsigned(best_valid(45 downto 45));
   bits_best_valid_174 <= unsigned(best_valid(46 downto 46));
   bits_best_valid_175 <= unsigned(best_valid(47 downto 47));
-  bits_done_slot_2 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_2 select
+  bits_bits_done_slot_copies_2 <= unsigned(bits_done_slot_copies_2(3 downto 0));
+  with bits_bits_done_slot_copies_2 select
     done_has_g2_c <=
       bits_best_valid_160 when "0000",
       bits_best_valid_161 when "0001",
@@ -1526,8 +1560,8 @@ begin
   bits_best_valid_189 <= unsigned(best_valid(61 downto 61));
   bits_best_valid_190 <= unsigned(best_valid(62 downto 62));
   bits_best_valid_191 <= unsigned(best_valid(63 downto 63));
-  bits_done_slot_3 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_3 select
+  bits_bits_done_slot_copies_3 <= unsigned(bits_done_slot_copies_3(3 downto 0));
+  with bits_bits_done_slot_copies_3 select
     done_has_g3_c <=
       bits_best_valid_176 when "0000",
       bits_best_valid_177 when "0001",
@@ -1562,8 +1596,8 @@ begin
   bits_best_valid_205 <= unsigned(best_valid(77 downto 77));
   bits_best_valid_206 <= unsigned(best_valid(78 downto 78));
   bits_best_valid_207 <= unsigned(best_valid(79 downto 79));
-  bits_done_slot_4 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_4 select
+  bits_bits_done_slot_copies_4 <= unsigned(bits_done_slot_copies_4(3 downto 0));
+  with bits_bits_done_slot_copies_4 select
     done_has_g4_c <=
       bits_best_valid_192 when "0000",
       bits_best_valid_193 when "0001",
@@ -1598,8 +1632,8 @@ begin
   bits_best_valid_221 <= unsigned(best_valid(93 downto 93));
   bits_best_valid_222 <= unsigned(best_valid(94 downto 94));
   bits_best_valid_223 <= unsigned(best_valid(95 downto 95));
-  bits_done_slot_5 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_5 select
+  bits_bits_done_slot_copies_5 <= unsigned(bits_done_slot_copies_5(3 downto 0));
+  with bits_bits_done_slot_copies_5 select
     done_has_g5_c <=
       bits_best_valid_208 when "0000",
       bits_best_valid_209 when "0001",
@@ -1634,8 +1668,8 @@ begin
   bits_best_valid_237 <= unsigned(best_valid(109 downto 109));
   bits_best_valid_238 <= unsigned(best_valid(110 downto 110));
   bits_best_valid_239 <= unsigned(best_valid(111 downto 111));
-  bits_done_slot_6 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_6 select
+  bits_bits_done_slot_copies_6 <= unsigned(bits_done_slot_copies_6(3 downto 0));
+  with bits_bits_done_slot_copies_6 select
     done_has_g6_c <=
       bits_best_valid_224 when "0000",
       bits_best_valid_225 when "0001",
@@ -1670,8 +1704,8 @@ begin
   bits_best_valid_253 <= unsigned(best_valid(125 downto 125));
   bits_best_valid_254 <= unsigned(best_valid(126 downto 126));
   bits_best_valid_255 <= unsigned(best_valid(127 downto 127));
-  bits_done_slot_7 <= unsigned(done_slot(3 downto 0));
-  with bits_done_slot_7 select
+  bits_bits_done_slot_copies_7 <= unsigned(bits_done_slot_copies_7(3 downto 0));
+  with bits_bits_done_slot_copies_7 select
     done_has_g7_c <=
       bits_best_valid_240 when "0000",
       bits_best_valid_241 when "0001",
@@ -1830,7 +1864,7 @@ begin
   m2_slot_eq_k_2 <= "1" when m2_slot = k_2 else "0";
   m2_slot_eq_k_1_1 <= "1" when m2_slot = k_1_1 else "0";
   m2_slot_eq_k_0_2 <= "1" when m2_slot = k_0_2 else "0";
-  cat_22 <= unsigned(std_logic_vector'(std_logic_vector(m2_slot_eq_k_127) & std_logic_vector(m2_slot_eq_k_126) & std_logic_vector(m2_slot_eq_k_125) & std_logic_vector(m2_slot_eq_k_124) & std_logic_vector(m2_slot_eq_k_123) & std_logic_vector(m2_slot_eq_k_122) & std_logic_vector(m2_slot_eq_k_121) & std_logic_vector(m2_slot_eq_k_120) & std_logic_vector(m2_slot_eq_k_119) & std_logic_vector(m2_slot_eq_k_118) & std_logic_vector(m2_slot_eq_k_117) & std_logic_vector(m2_slot_eq_k_116) & std_logic_vector(m2_slot_eq_k_115) & std_logic_vector(m2_slot_eq_k_114) & std_logic_vector(m2_slot_eq_k_113) & std_logic_vector(m2_slot_eq_k_112) & std_logic_vector(m2_slot_eq_k_111) & std_logic_vector(m2_slot_eq_k_110) & std_logic_vector(m2_slot_eq_k_109) & std_logic_vector(m2_slot_eq_k_108) & std_logic_vector(m2_slot_eq_k_107) & std_logic_vector(m2_slot_eq_k_106) & std_logic_vector(m2_slot_eq_k_105) & std_logic_vector(m2_slot_eq_k_104) & std_logic_vector(m2_slot_eq_k_103) & std_logic_vector(m2_slot_eq_k_102) & std_logic_vector(m2_slot_eq_k_101) & std_logic_vector(m2_slot_eq_k_100) & std_logic_vector(m2_slot_eq_k_99) & std_logic_vector(m2_slot_eq_k_98) & std_logic_vector(m2_slot_eq_k_97) & std_logic_vector(m2_slot_eq_k_96) & std_logic_vector(m2_slot_eq_k_95) & std_logic_vector(m2_slot_eq_k_94) & std_logic_vector(m2_slot_eq_k_93) & std_logic_vector(m2_slot_eq_k_92) & std_logic_vector(m2_slot_eq_k_91) & std_logic_vector(m2_slot_eq_k_90) & std_logic_vector(m2_slot_eq_k_89) & std_logic_vector(m2_slot_eq_k_88) & std_logic_vector(m2_slot_eq_k_87) & std_logic_vector(m2_slot_eq_k_86) & std_logic_vector(m2_slot_eq_k_85) & std_logic_vector(m2_slot_eq_k_84) & std_logic_vector(m2_slot_eq_k_83) & std_logic_vector(m2_slot_eq_k_82) & std_logic_vector(m2_slot_eq_k_81) & std_logic_vector(m2_slot_eq_k_80) & std_logic_vector(m2_slot_eq_k_79) & std_logic_vector(m2_slot_eq_k_78) & std_logic_vector(m2_slot_eq_k_77) & std_logic_vector(m2_slot_eq_k_76) & std_logic_vector(m2_slot_eq_k_75) & std_logic_vector(m2_slot_eq_k_74) & std_logic_vector(m2_slot_eq_k_73) & std_logic_vector(m2_slot_eq_k_72) & std_logic_vector(m2_slot_eq_k_71) & std_logic_vector(m2_slot_eq_k_70) & std_logic_vector(m2_slot_eq_k_69) & std_logic_vector(m2_slot_eq_k_68) & std_logic_vector(m2_slot_eq_k_67) & std_logic_vector(m2_slot_eq_k_66) & std_logic_vector(m2_slot_eq_k_65) & std_logic_vector(m2_slot_eq_k_64) & std_logic_vector(m2_slot_eq_k_63) & std_logic_vector(m2_slot_eq_k_62) & std_logic_vector(m2_slot_eq_k_61) & std_logic_vector(m2_slot_eq_k_60) & std_logic_vector(m2_slot_eq_k_59) & std_logic_vector(m2_slot_eq_k_58) & std_logic_vector(m2_slot_eq_k_57) & std_logic_vector(m2_slot_eq_k_56) & std_logic_vector(m2_slot_eq_k_55) & std_logic_vector(m2_slot_eq_k_54) & std_logic_vector(m2_slot_eq_k_53) & std_logic_vector(m2_slot_eq_k_52) & std_logic_vector(m2_slot_eq_k_51) & std_logic_vector(m2_slot_eq_k_50) & std_logic_vector(m2_slot_eq_k_49) & std_logic_vector(m2_slot_eq_k_48) & std_logic_vector(m2_slot_eq_k_47) & std_logic_vector(m2_slot_eq_k_46) & std_logic_vector(m2_slot_eq_k_45) & std_logic_vector(m2_slot_eq_k_44) & std_logic_vector(m2_slot_eq_k_43) & std_logic_vector(m2_slot_eq_k_42) & std_logic_vector(m2_slot_eq_k_41) & std_logic_vector(m2_slot_eq_k_40) & std_logic_vector(m2_slot_eq_k_39) & std_logic_vector(m2_slot_eq_k_38) & std_logic_vector(m2_slot_eq_k_37) & std_logic_vector(m2_slot_eq_k_36) & std_logic_vector(m2_slot_eq_k_35) & std_logic_vector(m2_slot_eq_k_34) & std_logic_vector(m2_slot_eq_k_33) & std_logic_vector(m2_slot_eq_k_32) & std_logic_vector(m2_slot_eq_k_31) & std_logic_vector(m2_slot_eq_k_30) & std_logic_vector(m2_slot_eq_k_29) & std_logic_vector(m2_slot_eq_k_28) & std_logic_vector(m2_slot_eq_k_27) & std_logic_vector(m2_slot_eq_k_26) & std_logic_vector(m2_slot_eq_k_25) & std_logic_vector(m2_slot_eq_k_24) & std_logic_vector(m2_slot_eq_k_23) & std_logic_vector(m2_slot_eq_k_22) & std_logic_vector(m2_slot_eq_k_21) & std_logic_vector(m2_slot_eq_k_20) & std_logic_vector(m2_slot_eq_k_19) & std_logic_vector(m2_slot_eq_k_18) & std_logic_vector(m2_slot_eq_k_17) & std_logic_vector(m2_slot_eq_k_16) & std_logic_vector(m2_slot_eq_k_15) & std_logic_vector(m2_slot_eq_k_14) & std_logic_vector(m2_slot_eq_k_13) & std_logic_vector(m2_slot_eq_k_12) & std_logic_vector(m2_slot_eq_k_11) & std_logic_vector(m2_slot_eq_k_10) & std_logic_vector(m2_slot_eq_k_9) & std_logic_vector(m2_slot_eq_k_8_1) & std_logic_vector(m2_slot_eq_k_7) & std_logic_vector(m2_slot_eq_k_6) & std_logic_vector(m2_slot_eq_k_5) & std_logic_vector(m2_slot_eq_k_4) & std_logic_vector(m2_slot_eq_k_3) & std_logic_vector(m2_slot_eq_k_2) & std_logic_vector(m2_slot_eq_k_1_1) & std_logic_vector(m2_slot_eq_k_0_2)));
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(m2_slot_eq_k_127) & std_logic_vector(m2_slot_eq_k_126) & std_logic_vector(m2_slot_eq_k_125) & std_logic_vector(m2_slot_eq_k_124) & std_logic_vector(m2_slot_eq_k_123) & std_logic_vector(m2_slot_eq_k_122) & std_logic_vector(m2_slot_eq_k_121) & std_logic_vector(m2_slot_eq_k_120) & std_logic_vector(m2_slot_eq_k_119) & std_logic_vector(m2_slot_eq_k_118) & std_logic_vector(m2_slot_eq_k_117) & std_logic_vector(m2_slot_eq_k_116) & std_logic_vector(m2_slot_eq_k_115) & std_logic_vector(m2_slot_eq_k_114) & std_logic_vector(m2_slot_eq_k_113) & std_logic_vector(m2_slot_eq_k_112) & std_logic_vector(m2_slot_eq_k_111) & std_logic_vector(m2_slot_eq_k_110) & std_logic_vector(m2_slot_eq_k_109) & std_logic_vector(m2_slot_eq_k_108) & std_logic_vector(m2_slot_eq_k_107) & std_logic_vector(m2_slot_eq_k_106) & std_logic_vector(m2_slot_eq_k_105) & std_logic_vector(m2_slot_eq_k_104) & std_logic_vector(m2_slot_eq_k_103) & std_logic_vector(m2_slot_eq_k_102) & std_logic_vector(m2_slot_eq_k_101) & std_logic_vector(m2_slot_eq_k_100) & std_logic_vector(m2_slot_eq_k_99) & std_logic_vector(m2_slot_eq_k_98) & std_logic_vector(m2_slot_eq_k_97) & std_logic_vector(m2_slot_eq_k_96) & std_logic_vector(m2_slot_eq_k_95) & std_logic_vector(m2_slot_eq_k_94) & std_logic_vector(m2_slot_eq_k_93) & std_logic_vector(m2_slot_eq_k_92) & std_logic_vector(m2_slot_eq_k_91) & std_logic_vector(m2_slot_eq_k_90) & std_logic_vector(m2_slot_eq_k_89) & std_logic_vector(m2_slot_eq_k_88) & std_logic_vector(m2_slot_eq_k_87) & std_logic_vector(m2_slot_eq_k_86) & std_logic_vector(m2_slot_eq_k_85) & std_logic_vector(m2_slot_eq_k_84) & std_logic_vector(m2_slot_eq_k_83) & std_logic_vector(m2_slot_eq_k_82) & std_logic_vector(m2_slot_eq_k_81) & std_logic_vector(m2_slot_eq_k_80) & std_logic_vector(m2_slot_eq_k_79) & std_logic_vector(m2_slot_eq_k_78) & std_logic_vector(m2_slot_eq_k_77) & std_logic_vector(m2_slot_eq_k_76) & std_logic_vector(m2_slot_eq_k_75) & std_logic_vector(m2_slot_eq_k_74) & std_logic_vector(m2_slot_eq_k_73) & std_logic_vector(m2_slot_eq_k_72) & std_logic_vector(m2_slot_eq_k_71) & std_logic_vector(m2_slot_eq_k_70) & std_logic_vector(m2_slot_eq_k_69) & std_logic_vector(m2_slot_eq_k_68) & std_logic_vector(m2_slot_eq_k_67) & std_logic_vector(m2_slot_eq_k_66) & std_logic_vector(m2_slot_eq_k_65) & std_logic_vector(m2_slot_eq_k_64) & std_logic_vector(m2_slot_eq_k_63) & std_logic_vector(m2_slot_eq_k_62) & std_logic_vector(m2_slot_eq_k_61) & std_logic_vector(m2_slot_eq_k_60) & std_logic_vector(m2_slot_eq_k_59) & std_logic_vector(m2_slot_eq_k_58) & std_logic_vector(m2_slot_eq_k_57) & std_logic_vector(m2_slot_eq_k_56) & std_logic_vector(m2_slot_eq_k_55) & std_logic_vector(m2_slot_eq_k_54) & std_logic_vector(m2_slot_eq_k_53) & std_logic_vector(m2_slot_eq_k_52) & std_logic_vector(m2_slot_eq_k_51) & std_logic_vector(m2_slot_eq_k_50) & std_logic_vector(m2_slot_eq_k_49) & std_logic_vector(m2_slot_eq_k_48) & std_logic_vector(m2_slot_eq_k_47) & std_logic_vector(m2_slot_eq_k_46) & std_logic_vector(m2_slot_eq_k_45) & std_logic_vector(m2_slot_eq_k_44) & std_logic_vector(m2_slot_eq_k_43) & std_logic_vector(m2_slot_eq_k_42) & std_logic_vector(m2_slot_eq_k_41) & std_logic_vector(m2_slot_eq_k_40) & std_logic_vector(m2_slot_eq_k_39) & std_logic_vector(m2_slot_eq_k_38) & std_logic_vector(m2_slot_eq_k_37) & std_logic_vector(m2_slot_eq_k_36) & std_logic_vector(m2_slot_eq_k_35) & std_logic_vector(m2_slot_eq_k_34) & std_logic_vector(m2_slot_eq_k_33) & std_logic_vector(m2_slot_eq_k_32) & std_logic_vector(m2_slot_eq_k_31) & std_logic_vector(m2_slot_eq_k_30) & std_logic_vector(m2_slot_eq_k_29) & std_logic_vector(m2_slot_eq_k_28) & std_logic_vector(m2_slot_eq_k_27) & std_logic_vector(m2_slot_eq_k_26) & std_logic_vector(m2_slot_eq_k_25) & std_logic_vector(m2_slot_eq_k_24) & std_logic_vector(m2_slot_eq_k_23) & std_logic_vector(m2_slot_eq_k_22) & std_logic_vector(m2_slot_eq_k_21) & std_logic_vector(m2_slot_eq_k_20) & std_logic_vector(m2_slot_eq_k_19) & std_logic_vector(m2_slot_eq_k_18) & std_logic_vector(m2_slot_eq_k_17) & std_logic_vector(m2_slot_eq_k_16) & std_logic_vector(m2_slot_eq_k_15) & std_logic_vector(m2_slot_eq_k_14) & std_logic_vector(m2_slot_eq_k_13) & std_logic_vector(m2_slot_eq_k_12) & std_logic_vector(m2_slot_eq_k_11) & std_logic_vector(m2_slot_eq_k_10) & std_logic_vector(m2_slot_eq_k_9) & std_logic_vector(m2_slot_eq_k_8_1) & std_logic_vector(m2_slot_eq_k_7) & std_logic_vector(m2_slot_eq_k_6) & std_logic_vector(m2_slot_eq_k_5) & std_logic_vector(m2_slot_eq_k_4) & std_logic_vector(m2_slot_eq_k_3) & std_logic_vector(m2_slot_eq_k_2) & std_logic_vector(m2_slot_eq_k_1_1) & std_logic_vector(m2_slot_eq_k_0_2)));
   best_set <= m3_onehot when best_we = "1" else k_0_1;
   d0_slot_eq_k_127 <= "1" when d0_slot = k_127 else "0";
   d0_slot_eq_k_126 <= "1" when d0_slot = k_126 else "0";
@@ -1960,11 +1994,11 @@ begin
   d0_slot_eq_k_2 <= "1" when d0_slot = k_2 else "0";
   d0_slot_eq_k_1_1 <= "1" when d0_slot = k_1_1 else "0";
   d0_slot_eq_k_0_2 <= "1" when d0_slot = k_0_2 else "0";
-  cat_23 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
+  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(d0_slot_eq_k_127) & std_logic_vector(d0_slot_eq_k_126) & std_logic_vector(d0_slot_eq_k_125) & std_logic_vector(d0_slot_eq_k_124) & std_logic_vector(d0_slot_eq_k_123) & std_logic_vector(d0_slot_eq_k_122) & std_logic_vector(d0_slot_eq_k_121) & std_logic_vector(d0_slot_eq_k_120) & std_logic_vector(d0_slot_eq_k_119) & std_logic_vector(d0_slot_eq_k_118) & std_logic_vector(d0_slot_eq_k_117) & std_logic_vector(d0_slot_eq_k_116) & std_logic_vector(d0_slot_eq_k_115) & std_logic_vector(d0_slot_eq_k_114) & std_logic_vector(d0_slot_eq_k_113) & std_logic_vector(d0_slot_eq_k_112) & std_logic_vector(d0_slot_eq_k_111) & std_logic_vector(d0_slot_eq_k_110) & std_logic_vector(d0_slot_eq_k_109) & std_logic_vector(d0_slot_eq_k_108) & std_logic_vector(d0_slot_eq_k_107) & std_logic_vector(d0_slot_eq_k_106) & std_logic_vector(d0_slot_eq_k_105) & std_logic_vector(d0_slot_eq_k_104) & std_logic_vector(d0_slot_eq_k_103) & std_logic_vector(d0_slot_eq_k_102) & std_logic_vector(d0_slot_eq_k_101) & std_logic_vector(d0_slot_eq_k_100) & std_logic_vector(d0_slot_eq_k_99) & std_logic_vector(d0_slot_eq_k_98) & std_logic_vector(d0_slot_eq_k_97) & std_logic_vector(d0_slot_eq_k_96) & std_logic_vector(d0_slot_eq_k_95) & std_logic_vector(d0_slot_eq_k_94) & std_logic_vector(d0_slot_eq_k_93) & std_logic_vector(d0_slot_eq_k_92) & std_logic_vector(d0_slot_eq_k_91) & std_logic_vector(d0_slot_eq_k_90) & std_logic_vector(d0_slot_eq_k_89) & std_logic_vector(d0_slot_eq_k_88) & std_logic_vector(d0_slot_eq_k_87) & std_logic_vector(d0_slot_eq_k_86) & std_logic_vector(d0_slot_eq_k_85) & std_logic_vector(d0_slot_eq_k_84) & std_logic_vector(d0_slot_eq_k_83) & std_logic_vector(d0_slot_eq_k_82) & std_logic_vector(d0_slot_eq_k_81) & std_logic_vector(d0_slot_eq_k_80) & std_logic_vector(d0_slot_eq_k_79) & std_logic_vector(d0_slot_eq_k_78) & std_logic_vector(d0_slot_eq_k_77) & std_logic_vector(d0_slot_eq_k_76) & std_logic_vector(d0_slot_eq_k_75) & std_logic_vector(d0_slot_eq_k_74) & std_logic_vector(d0_slot_eq_k_73) & std_logic_vector(d0_slot_eq_k_72) & std_logic_vector(d0_slot_eq_k_71) & std_logic_vector(d0_slot_eq_k_70) & std_logic_vector(d0_slot_eq_k_69) & std_logic_vector(d0_slot_eq_k_68) & std_logic_vector(d0_slot_eq_k_67) & std_logic_vector(d0_slot_eq_k_66) & std_logic_vector(d0_slot_eq_k_65) & std_logic_vector(d0_slot_eq_k_64) & std_logic_vector(d0_slot_eq_k_63) & std_logic_vector(d0_slot_eq_k_62) & std_logic_vector(d0_slot_eq_k_61) & std_logic_vector(d0_slot_eq_k_60) & std_logic_vector(d0_slot_eq_k_59) & std_logic_vector(d0_slot_eq_k_58) & std_logic_vector(d0_slot_eq_k_57) & std_logic_vector(d0_slot_eq_k_56) & std_logic_vector(d0_slot_eq_k_55) & std_logic_vector(d0_slot_eq_k_54) & std_logic_vector(d0_slot_eq_k_53) & std_logic_vector(d0_slot_eq_k_52) & std_logic_vector(d0_slot_eq_k_51) & std_logic_vector(d0_slot_eq_k_50) & std_logic_vector(d0_slot_eq_k_49) & std_logic_vector(d0_slot_eq_k_48) & std_logic_vector(d0_slot_eq_k_47) & std_logic_vector(d0_slot_eq_k_46) & std_logic_vector(d0_slot_eq_k_45) & std_logic_vector(d0_slot_eq_k_44) & std_logic_vector(d0_slot_eq_k_43) & std_logic_vector(d0_slot_eq_k_42) & std_logic_vector(d0_slot_eq_k_41) & std_logic_vector(d0_slot_eq_k_40) & std_logic_vector(d0_slot_eq_k_39) & std_logic_vector(d0_slot_eq_k_38) & std_logic_vector(d0_slot_eq_k_37) & std_logic_vector(d0_slot_eq_k_36) & std_logic_vector(d0_slot_eq_k_35) & std_logic_vector(d0_slot_eq_k_34) & std_logic_vector(d0_slot_eq_k_33) & std_logic_vector(d0_slot_eq_k_32) & std_logic_vector(d0_slot_eq_k_31) & std_logic_vector(d0_slot_eq_k_30) & std_logic_vector(d0_slot_eq_k_29) & std_logic_vector(d0_slot_eq_k_28) & std_logic_vector(d0_slot_eq_k_27) & std_logic_vector(d0_slot_eq_k_26) & std_logic_vector(d0_slot_eq_k_25) & std_logic_vector(d0_slot_eq_k_24) & std_logic_vector(d0_slot_eq_k_23) & std_logic_vector(d0_slot_eq_k_22) & std_logic_vector(d0_slot_eq_k_21) & std_logic_vector(d0_slot_eq_k_20) & std_logic_vector(d0_slot_eq_k_19) & std_logic_vector(d0_slot_eq_k_18) & std_logic_vector(d0_slot_eq_k_17) & std_logic_vector(d0_slot_eq_k_16) & std_logic_vector(d0_slot_eq_k_15) & std_logic_vector(d0_slot_eq_k_14) & std_logic_vector(d0_slot_eq_k_13) & std_logic_vector(d0_slot_eq_k_12) & std_logic_vector(d0_slot_eq_k_11) & std_logic_vector(d0_slot_eq_k_10) & std_logic_vector(d0_slot_eq_k_9) & std_logic_vector(d0_slot_eq_k_8_1) & std_logic_vector(d0_slot_eq_k_7) & std_logic_vector(d0_slot_eq_k_6) & std_logic_vector(d0_slot_eq_k_5) & std_logic_vector(d0_slot_eq_k_4) & std_logic_vector(d0_slot_eq_k_3) & std_logic_vector(d0_slot_eq_k_2) & std_logic_vector(d0_slot_eq_k_1_1) & std_logic_vector(d0_slot_eq_k_0_2)));
   best_clear <= d1_onehot when d1 = "1" else k_0_1;
   not_best_clear <= not best_clear;
-  and_24 <= best_valid and not_best_clear;
-  and_24_or_best_set <= and_24 or best_set;
+  and_32 <= best_valid and not_best_clear;
+  and_32_or_best_set <= and_32 or best_set;
   res_id_c <= done_id;
   res_hit_c <= d1_has;
   bits_done_t_tri <= unsigned(done_t_tri(12 downto 0));
@@ -1979,25 +2013,25 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if best_we = "1" then
+      if best_we_c1 = "1" then
         best_t_tri_g0(to_integer(m3_slot_c1)) <= bits_m3_t_tri;
       end if;
-      if best_we = "1" then
+      if best_we_c2 = "1" then
         best_t_tri_g1(to_integer(m3_slot_c2)) <= bits_m3_t_tri_1;
       end if;
-      if best_we = "1" then
+      if best_we_c3 = "1" then
         best_t_tri_g2(to_integer(m3_slot_c3)) <= bits_m3_t_tri_2;
       end if;
-      if best_we = "1" then
+      if best_we_c4 = "1" then
         best_u_v_g0(to_integer(m3_slot_c4)) <= bits_m3_u_v;
       end if;
-      if best_we = "1" then
+      if best_we_c5 = "1" then
         best_u_v_g1(to_integer(m3_slot_c5)) <= bits_m3_u_v_1;
       end if;
-      if best_we = "1" then
+      if best_we_c6 = "1" then
         best_u_v_g2(to_integer(m3_slot_c6)) <= bits_m3_u_v_2;
       end if;
-      if best_we = "1" then
+      if best_we_c7 = "1" then
         best_u_v_g3(to_integer(m3_slot_c7)) <= bits_m3_u_v_3;
       end if;
       if id_we = "1" then
@@ -2065,7 +2099,7 @@ begin
       if rst = '1' then
         best_valid <= unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000");
       else
-        best_valid <= and_24_or_best_set;
+        best_valid <= and_32_or_best_set;
       end if;
       if rst = '1' then
         fin <= unsigned'("0");
@@ -2109,11 +2143,6 @@ begin
       m2_u_v <= m1_u_v;
       m2_leaf_limit <= leaf_limit;
       m2_slot_limit <= slot_limit;
-      if rst = '1' then
-        best_we <= unsigned'("0");
-      else
-        best_we <= m2_we;
-      end if;
       m3_t_tri <= m2_t_tri;
       m3_u_v <= m2_u_v;
       if rst = '1' then
@@ -2156,8 +2185,8 @@ begin
       done_has_g6 <= done_has_g6_c;
       done_has_g7 <= done_has_g7_c;
       d1_has <= done_has_c;
-      m3_onehot <= cat_22;
-      d1_onehot <= cat_23;
+      m3_onehot <= cat_30;
+      d1_onehot <= cat_31;
       if rst = '1' then
         free_valid_r <= unsigned'("0");
       else
@@ -2205,6 +2234,54 @@ begin
       m3_slot_c7 <= m2_slot;
     end if;
   end process m3_slot_copies_regs;
+
+  -- register copies best_we_copies: best_we and 7 copies, to split its fan-out
+
+  best_we_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        best_we <= unsigned'("0");
+      else
+        best_we <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c1 <= unsigned'("0");
+      else
+        best_we_c1 <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c2 <= unsigned'("0");
+      else
+        best_we_c2 <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c3 <= unsigned'("0");
+      else
+        best_we_c3 <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c4 <= unsigned'("0");
+      else
+        best_we_c4 <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c5 <= unsigned'("0");
+      else
+        best_we_c5 <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c6 <= unsigned'("0");
+      else
+        best_we_c6 <= m2_we;
+      end if;
+      if rst = '1' then
+        best_we_c7 <= unsigned'("0");
+      else
+        best_we_c7 <= m2_we;
+      end if;
+    end if;
+  end process best_we_copies_regs;
 
   -- register copies merge_slot_r_copies: merge_slot_r and 1 copies, to split its fan-out
 

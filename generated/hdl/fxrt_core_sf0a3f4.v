@@ -137,12 +137,15 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] box_in_invx = 48'sh000000000000;
   reg signed [47:0] box_in_invy = 48'sh000000000000;
   reg signed [47:0] box_in_invz = 48'sh000000000000;
+  reg [0:0] accept = 1'h0;
   wire [0:0] bits_take_slot;
   wire [0:0] bits_take_slot_eq_k_0;
   wire [0:0] u0_take;
+  reg [0:0] u0_accept = 1'h0;
   wire [0:0] bits_take_slot_1;
   wire [0:0] bits_take_slot_1_eq_k_1;
   wire [0:0] u1_take;
+  reg [0:0] u1_accept = 1'h0;
   reg [19:0] acc_in_ray_id = 20'h00000;
   reg [28:0] acc_in_ox = 29'h00000000;
   reg [28:0] acc_in_oy = 29'h00000000;
@@ -153,36 +156,36 @@ module fxrt_core_sf0a3f4 (
   reg signed [47:0] acc_in_invx = 48'sh000000000000;
   reg signed [47:0] acc_in_invy = 48'sh000000000000;
   reg signed [47:0] acc_in_invz = 48'sh000000000000;
-  wire [5:0] bits_accept_slot_c14;
-  wire [5:0] bits_accept_slot_c15;
-  wire [5:0] bits_accept_slot_c16;
-  wire [5:0] bits_accept_slot_c17;
-  wire [5:0] bits_accept_slot_c18;
-  wire [5:0] bits_accept_slot_c19;
-  wire [5:0] bits_accept_slot_c20;
-  wire [5:0] bits_accept_slot_c21;
-  wire [5:0] bits_accept_slot_c22;
-  wire [5:0] bits_accept_slot_c23;
-  wire [5:0] bits_accept_slot_c24;
-  wire [5:0] bits_accept_slot_c25;
-  wire [5:0] bits_accept_slot_c26;
-  wire [5:0] bits_accept_slot_c27;
-  wire [5:0] bits_accept_slot_c28;
-  wire [5:0] bits_accept_slot_c29;
-  wire [5:0] bits_accept_slot_c30;
-  wire [5:0] bits_accept_slot_c31;
-  wire [5:0] bits_accept_slot_c32;
-  wire [5:0] bits_accept_slot_c33;
-  wire [5:0] bits_accept_slot_c34;
-  wire [5:0] bits_accept_slot_c35;
-  wire [5:0] bits_accept_slot_c36;
-  wire [5:0] bits_accept_slot_c37;
-  wire [5:0] bits_accept_slot_c38;
-  wire [5:0] bits_accept_slot_c39;
-  wire [5:0] bits_accept_slot_c40;
-  wire [5:0] bits_accept_slot_c41;
-  wire [5:0] bits_accept_slot_c42;
-  wire [5:0] bits_accept_slot_c43;
+  wire [5:0] bits_accept_w_slot_c12;
+  wire [5:0] bits_accept_w_slot_c13;
+  wire [5:0] bits_accept_w_slot_c14;
+  wire [5:0] bits_accept_w_slot_c15;
+  wire [5:0] bits_accept_w_slot_c16;
+  wire [5:0] bits_accept_w_slot_c17;
+  wire [5:0] bits_accept_w_slot_c18;
+  wire [5:0] bits_accept_w_slot_c19;
+  wire [5:0] bits_accept_w_slot_c20;
+  wire [5:0] bits_accept_w_slot_c21;
+  wire [5:0] bits_accept_w_slot_c22;
+  wire [5:0] bits_accept_w_slot_c23;
+  wire [5:0] bits_accept_w_slot_c24;
+  wire [5:0] bits_accept_w_slot_c25;
+  wire [5:0] bits_accept_w_slot_c26;
+  wire [5:0] bits_accept_w_slot_c27;
+  wire [5:0] bits_accept_w_slot_c28;
+  wire [5:0] bits_accept_w_slot_c29;
+  wire [5:0] bits_accept_w_slot_c30;
+  wire [5:0] bits_accept_w_slot_c31;
+  wire [5:0] bits_accept_w_slot_c32;
+  wire [5:0] bits_accept_w_slot_c33;
+  wire [5:0] bits_accept_w_slot_c34;
+  wire [5:0] bits_accept_w_slot_c35;
+  wire [5:0] bits_accept_w_slot_c36;
+  wire [5:0] bits_accept_w_slot_c37;
+  wire [5:0] bits_accept_w_slot_c38;
+  wire [5:0] bits_accept_w_slot_c39;
+  wire [5:0] bits_accept_w_slot_c40;
+  wire [5:0] bits_accept_w_slot_c41;
 
   // register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
   reg [0:0] port_empty = 1'h1;
@@ -194,163 +197,161 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] box_idle = 1'h1;
   reg [0:0] box_idle_c1 = 1'h1;
 
-  // register copies accept_copies: accept and 11 copies, to split its fan-out
-  reg [0:0] accept = 1'h0;
-  reg [0:0] accept_c1 = 1'h0;
-  reg [0:0] accept_c2 = 1'h0;
-  reg [0:0] accept_c3 = 1'h0;
-  reg [0:0] accept_c4 = 1'h0;
-  reg [0:0] accept_c5 = 1'h0;
-  reg [0:0] accept_c6 = 1'h0;
-  reg [0:0] accept_c7 = 1'h0;
-  reg [0:0] accept_c8 = 1'h0;
-  reg [0:0] accept_c9 = 1'h0;
-  reg [0:0] accept_c10 = 1'h0;
-  reg [0:0] accept_c11 = 1'h0;
+  // register copies accept_w_copies: accept_w and 11 copies, to split its fan-out
+  reg [0:0] accept_w = 1'h0;
+  reg [0:0] accept_w_c1 = 1'h0;
+  reg [0:0] accept_w_c2 = 1'h0;
+  reg [0:0] accept_w_c3 = 1'h0;
+  reg [0:0] accept_w_c4 = 1'h0;
+  reg [0:0] accept_w_c5 = 1'h0;
+  reg [0:0] accept_w_c6 = 1'h0;
+  reg [0:0] accept_w_c7 = 1'h0;
+  reg [0:0] accept_w_c8 = 1'h0;
+  reg [0:0] accept_w_c9 = 1'h0;
+  reg [0:0] accept_w_c10 = 1'h0;
+  reg [0:0] accept_w_c11 = 1'h0;
 
-  // register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
-  /* verilator lint_off UNUSEDSIGNAL */  // not read
+  // register copies accept_w_slot_copies: accept_w_slot and 41 copies, to split its fan-out
+  reg [6:0] accept_w_slot = 7'h00;
+  reg [6:0] accept_w_slot_c1 = 7'h00;
+  reg [6:0] accept_w_slot_c2 = 7'h00;
+  reg [6:0] accept_w_slot_c3 = 7'h00;
+  reg [6:0] accept_w_slot_c4 = 7'h00;
+  reg [6:0] accept_w_slot_c5 = 7'h00;
+  reg [6:0] accept_w_slot_c6 = 7'h00;
+  reg [6:0] accept_w_slot_c7 = 7'h00;
+  reg [6:0] accept_w_slot_c8 = 7'h00;
+  reg [6:0] accept_w_slot_c9 = 7'h00;
+  reg [6:0] accept_w_slot_c10 = 7'h00;
+  reg [6:0] accept_w_slot_c11 = 7'h00;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c12 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c13 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c14 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c15 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c16 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c17 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c18 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c19 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c20 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c21 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c22 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c23 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c24 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c25 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c26 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c27 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c28 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c29 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c30 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c31 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c32 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c33 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c34 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c35 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c36 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c37 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c38 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c39 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c40 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
+  reg [6:0] accept_w_slot_c41 = 7'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  // register copies u0_accept_w_copies: u0_accept_w and 14 copies, to split its fan-out
+  reg [0:0] u0_accept_w = 1'h0;
+  reg [0:0] u0_accept_w_c1 = 1'h0;
+  reg [0:0] u0_accept_w_c2 = 1'h0;
+  reg [0:0] u0_accept_w_c3 = 1'h0;
+  reg [0:0] u0_accept_w_c4 = 1'h0;
+  reg [0:0] u0_accept_w_c5 = 1'h0;
+  reg [0:0] u0_accept_w_c6 = 1'h0;
+  reg [0:0] u0_accept_w_c7 = 1'h0;
+  reg [0:0] u0_accept_w_c8 = 1'h0;
+  reg [0:0] u0_accept_w_c9 = 1'h0;
+  reg [0:0] u0_accept_w_c10 = 1'h0;
+  reg [0:0] u0_accept_w_c11 = 1'h0;
+  reg [0:0] u0_accept_w_c12 = 1'h0;
+  reg [0:0] u0_accept_w_c13 = 1'h0;
+  reg [0:0] u0_accept_w_c14 = 1'h0;
+
+  // register copies u1_accept_w_copies: u1_accept_w and 14 copies, to split its fan-out
+  reg [0:0] u1_accept_w = 1'h0;
+  reg [0:0] u1_accept_w_c1 = 1'h0;
+  reg [0:0] u1_accept_w_c2 = 1'h0;
+  reg [0:0] u1_accept_w_c3 = 1'h0;
+  reg [0:0] u1_accept_w_c4 = 1'h0;
+  reg [0:0] u1_accept_w_c5 = 1'h0;
+  reg [0:0] u1_accept_w_c6 = 1'h0;
+  reg [0:0] u1_accept_w_c7 = 1'h0;
+  reg [0:0] u1_accept_w_c8 = 1'h0;
+  reg [0:0] u1_accept_w_c9 = 1'h0;
+  reg [0:0] u1_accept_w_c10 = 1'h0;
+  reg [0:0] u1_accept_w_c11 = 1'h0;
+  reg [0:0] u1_accept_w_c12 = 1'h0;
+  reg [0:0] u1_accept_w_c13 = 1'h0;
+  reg [0:0] u1_accept_w_c14 = 1'h0;
+
+  // register copies accept_slot_copies: accept_slot and 1 copies, to split its fan-out
   reg [6:0] accept_slot = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
   reg [6:0] accept_slot_c1 = 7'h00;
-  reg [6:0] accept_slot_c2 = 7'h00;
-  reg [6:0] accept_slot_c3 = 7'h00;
-  reg [6:0] accept_slot_c4 = 7'h00;
-  reg [6:0] accept_slot_c5 = 7'h00;
-  reg [6:0] accept_slot_c6 = 7'h00;
-  reg [6:0] accept_slot_c7 = 7'h00;
-  reg [6:0] accept_slot_c8 = 7'h00;
-  reg [6:0] accept_slot_c9 = 7'h00;
-  reg [6:0] accept_slot_c10 = 7'h00;
-  reg [6:0] accept_slot_c11 = 7'h00;
-  reg [6:0] accept_slot_c12 = 7'h00;
-  reg [6:0] accept_slot_c13 = 7'h00;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c14 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c15 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c16 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c17 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c18 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c19 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c20 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c21 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c22 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c23 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c24 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c25 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c26 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c27 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c28 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c29 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c30 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c31 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c32 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c33 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c34 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c35 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c36 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c37 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c38 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c39 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c40 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c41 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c42 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 5:0 are read
-  reg [6:0] accept_slot_c43 = 7'h00;
-  /* verilator lint_on UNUSEDSIGNAL */
-
-  // register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
-  reg [0:0] u0_accept = 1'h0;
-  reg [0:0] u0_accept_c1 = 1'h0;
-  reg [0:0] u0_accept_c2 = 1'h0;
-  reg [0:0] u0_accept_c3 = 1'h0;
-  reg [0:0] u0_accept_c4 = 1'h0;
-  reg [0:0] u0_accept_c5 = 1'h0;
-  reg [0:0] u0_accept_c6 = 1'h0;
-  reg [0:0] u0_accept_c7 = 1'h0;
-  reg [0:0] u0_accept_c8 = 1'h0;
-  reg [0:0] u0_accept_c9 = 1'h0;
-  reg [0:0] u0_accept_c10 = 1'h0;
-  reg [0:0] u0_accept_c11 = 1'h0;
-  reg [0:0] u0_accept_c12 = 1'h0;
-  reg [0:0] u0_accept_c13 = 1'h0;
-  reg [0:0] u0_accept_c14 = 1'h0;
-  reg [0:0] u0_accept_c15 = 1'h0;
-
-  // register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
-  reg [0:0] u1_accept = 1'h0;
-  reg [0:0] u1_accept_c1 = 1'h0;
-  reg [0:0] u1_accept_c2 = 1'h0;
-  reg [0:0] u1_accept_c3 = 1'h0;
-  reg [0:0] u1_accept_c4 = 1'h0;
-  reg [0:0] u1_accept_c5 = 1'h0;
-  reg [0:0] u1_accept_c6 = 1'h0;
-  reg [0:0] u1_accept_c7 = 1'h0;
-  reg [0:0] u1_accept_c8 = 1'h0;
-  reg [0:0] u1_accept_c9 = 1'h0;
-  reg [0:0] u1_accept_c10 = 1'h0;
-  reg [0:0] u1_accept_c11 = 1'h0;
-  reg [0:0] u1_accept_c12 = 1'h0;
-  reg [0:0] u1_accept_c13 = 1'h0;
-  reg [0:0] u1_accept_c14 = 1'h0;
-  reg [0:0] u1_accept_c15 = 1'h0;
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
   reg [6:0] box_slot = 7'h00;
@@ -758,7 +759,7 @@ module fxrt_core_sf0a3f4 (
   wire [6:0] mux_u0_done_avail;
   wire [0:0] or_40;
   reg [0:0] done_valid_r = 1'h0;
-  reg [6:0] done_slot_r = 7'h00;
+  wire [55:0] cat_41;
   wire [0:0] u_closest_merge_valid0;
   wire [5:0] u_closest_merge_slot0;
   wire [0:0] u_closest_merge_hit0;
@@ -777,9 +778,20 @@ module fxrt_core_sf0a3f4 (
   wire [31:0] u_closest_res_u;
   wire [31:0] u_closest_res_v;
 
+  // register copies done_slot_r_copies: done_slot_r and 8 copies, to split its fan-out
+  reg [6:0] done_slot_r = 7'h00;
+  reg [6:0] done_slot_r_c1 = 7'h00;
+  reg [6:0] done_slot_r_c2 = 7'h00;
+  reg [6:0] done_slot_r_c3 = 7'h00;
+  reg [6:0] done_slot_r_c4 = 7'h00;
+  reg [6:0] done_slot_r_c5 = 7'h00;
+  reg [6:0] done_slot_r_c6 = 7'h00;
+  reg [6:0] done_slot_r_c7 = 7'h00;
+  reg [6:0] done_slot_r_c8 = 7'h00;
+
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  wire [63:0] cat_41;
   wire [63:0] cat_42;
+  wire [63:0] cat_43;
   wire [0:0] res_take;
   reg [3:0] res_q_wr = 4'h0;
   reg [3:0] res_q_rd = 4'h0;
@@ -801,16 +813,16 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_q_count_eq_k_0_5;
   wire [4:0] k_1_5 = 5'h01;
   wire [0:0] res_q_one_left;
-  wire [0:0] and_45;
+  wire [0:0] and_46;
   wire [0:0] res_q_drained;
   reg [0:0] res_q_bypass = 1'h0;
   wire [0:0] res_q_bypass_c;
   reg [0:0] res_q_popped = 1'h0;
   reg [0:0] res_q_nonempty = 1'h0;
   wire [0:0] k_1_5_lt_res_q_count;
-  wire [0:0] or_48;
+  wire [0:0] or_49;
   wire [0:0] not_res_take;
-  wire [0:0] and_49;
+  wire [0:0] and_50;
   wire [0:0] res_q_nonempty_c;
   reg [63:0] res_q_din0 = 64'h0000000000000000;
   wire [15:0] bits_res_q_din0;
@@ -916,18 +928,18 @@ module fxrt_core_sf0a3f4 (
   // not in a stage or state machine
 
   always @(posedge clk) begin : regs
-    if (accept) ray_o_g0[accept_slot_c1] <= bits_cat_17;
-    if (accept_c1) ray_o_g1[accept_slot_c2] <= bits_cat_17_1;
-    if (accept_c2) ray_o_g2[accept_slot_c3] <= bits_cat_17_2;
-    if (accept_c3) ray_o_g3[accept_slot_c4] <= bits_cat_17_3;
-    if (accept_c4) ray_o_g4[accept_slot_c5] <= bits_cat_17_4;
-    if (accept_c5) ray_o_g5[accept_slot_c6] <= bits_cat_17_5;
-    if (accept_c6) ray_w_g0[accept_slot_c7] <= bits_cat_18;
-    if (accept_c7) ray_w_g1[accept_slot_c8] <= bits_cat_18_1;
-    if (accept_c8) ray_w_g2[accept_slot_c9] <= bits_cat_18_2;
-    if (accept_c9) ray_w_g3[accept_slot_c10] <= bits_cat_18_3;
-    if (accept_c10) ray_w_g4[accept_slot_c11] <= bits_cat_18_4;
-    if (accept_c11) ray_w_g5[accept_slot_c12] <= bits_cat_18_5;
+    if (accept_w) ray_o_g0[accept_w_slot] <= bits_cat_17;
+    if (accept_w_c1) ray_o_g1[accept_w_slot_c1] <= bits_cat_17_1;
+    if (accept_w_c2) ray_o_g2[accept_w_slot_c2] <= bits_cat_17_2;
+    if (accept_w_c3) ray_o_g3[accept_w_slot_c3] <= bits_cat_17_3;
+    if (accept_w_c4) ray_o_g4[accept_w_slot_c4] <= bits_cat_17_4;
+    if (accept_w_c5) ray_o_g5[accept_w_slot_c5] <= bits_cat_17_5;
+    if (accept_w_c6) ray_w_g0[accept_w_slot_c6] <= bits_cat_18;
+    if (accept_w_c7) ray_w_g1[accept_w_slot_c7] <= bits_cat_18_1;
+    if (accept_w_c8) ray_w_g2[accept_w_slot_c8] <= bits_cat_18_2;
+    if (accept_w_c9) ray_w_g3[accept_w_slot_c9] <= bits_cat_18_3;
+    if (accept_w_c10) ray_w_g4[accept_w_slot_c10] <= bits_cat_18_4;
+    if (accept_w_c11) ray_w_g5[accept_w_slot_c11] <= bits_cat_18_5;
     if (res_q_push) res_q_mem0_g0[res_q_wr] <= bits_res_q_din0;
     if (res_q_push) res_q_mem0_g1[res_q_wr] <= bits_res_q_din0_1;
     if (res_q_push) res_q_mem0_g2[res_q_wr] <= bits_res_q_din0_2;
@@ -974,36 +986,36 @@ module fxrt_core_sf0a3f4 (
   assign bits_take_slot_1 = take_slot[6];
   assign bits_take_slot_1_eq_k_1 = bits_take_slot_1 == k_1;
   assign u1_take = take & bits_take_slot_1_eq_k_1;
-  assign bits_accept_slot_c14 = accept_slot_c14[5:0];
-  assign bits_accept_slot_c15 = accept_slot_c15[5:0];
-  assign bits_accept_slot_c16 = accept_slot_c16[5:0];
-  assign bits_accept_slot_c17 = accept_slot_c17[5:0];
-  assign bits_accept_slot_c18 = accept_slot_c18[5:0];
-  assign bits_accept_slot_c19 = accept_slot_c19[5:0];
-  assign bits_accept_slot_c20 = accept_slot_c20[5:0];
-  assign bits_accept_slot_c21 = accept_slot_c21[5:0];
-  assign bits_accept_slot_c22 = accept_slot_c22[5:0];
-  assign bits_accept_slot_c23 = accept_slot_c23[5:0];
-  assign bits_accept_slot_c24 = accept_slot_c24[5:0];
-  assign bits_accept_slot_c25 = accept_slot_c25[5:0];
-  assign bits_accept_slot_c26 = accept_slot_c26[5:0];
-  assign bits_accept_slot_c27 = accept_slot_c27[5:0];
-  assign bits_accept_slot_c28 = accept_slot_c28[5:0];
-  assign bits_accept_slot_c29 = accept_slot_c29[5:0];
-  assign bits_accept_slot_c30 = accept_slot_c30[5:0];
-  assign bits_accept_slot_c31 = accept_slot_c31[5:0];
-  assign bits_accept_slot_c32 = accept_slot_c32[5:0];
-  assign bits_accept_slot_c33 = accept_slot_c33[5:0];
-  assign bits_accept_slot_c34 = accept_slot_c34[5:0];
-  assign bits_accept_slot_c35 = accept_slot_c35[5:0];
-  assign bits_accept_slot_c36 = accept_slot_c36[5:0];
-  assign bits_accept_slot_c37 = accept_slot_c37[5:0];
-  assign bits_accept_slot_c38 = accept_slot_c38[5:0];
-  assign bits_accept_slot_c39 = accept_slot_c39[5:0];
-  assign bits_accept_slot_c40 = accept_slot_c40[5:0];
-  assign bits_accept_slot_c41 = accept_slot_c41[5:0];
-  assign bits_accept_slot_c42 = accept_slot_c42[5:0];
-  assign bits_accept_slot_c43 = accept_slot_c43[5:0];
+  assign bits_accept_w_slot_c12 = accept_w_slot_c12[5:0];
+  assign bits_accept_w_slot_c13 = accept_w_slot_c13[5:0];
+  assign bits_accept_w_slot_c14 = accept_w_slot_c14[5:0];
+  assign bits_accept_w_slot_c15 = accept_w_slot_c15[5:0];
+  assign bits_accept_w_slot_c16 = accept_w_slot_c16[5:0];
+  assign bits_accept_w_slot_c17 = accept_w_slot_c17[5:0];
+  assign bits_accept_w_slot_c18 = accept_w_slot_c18[5:0];
+  assign bits_accept_w_slot_c19 = accept_w_slot_c19[5:0];
+  assign bits_accept_w_slot_c20 = accept_w_slot_c20[5:0];
+  assign bits_accept_w_slot_c21 = accept_w_slot_c21[5:0];
+  assign bits_accept_w_slot_c22 = accept_w_slot_c22[5:0];
+  assign bits_accept_w_slot_c23 = accept_w_slot_c23[5:0];
+  assign bits_accept_w_slot_c24 = accept_w_slot_c24[5:0];
+  assign bits_accept_w_slot_c25 = accept_w_slot_c25[5:0];
+  assign bits_accept_w_slot_c26 = accept_w_slot_c26[5:0];
+  assign bits_accept_w_slot_c27 = accept_w_slot_c27[5:0];
+  assign bits_accept_w_slot_c28 = accept_w_slot_c28[5:0];
+  assign bits_accept_w_slot_c29 = accept_w_slot_c29[5:0];
+  assign bits_accept_w_slot_c30 = accept_w_slot_c30[5:0];
+  assign bits_accept_w_slot_c31 = accept_w_slot_c31[5:0];
+  assign bits_accept_w_slot_c32 = accept_w_slot_c32[5:0];
+  assign bits_accept_w_slot_c33 = accept_w_slot_c33[5:0];
+  assign bits_accept_w_slot_c34 = accept_w_slot_c34[5:0];
+  assign bits_accept_w_slot_c35 = accept_w_slot_c35[5:0];
+  assign bits_accept_w_slot_c36 = accept_w_slot_c36[5:0];
+  assign bits_accept_w_slot_c37 = accept_w_slot_c37[5:0];
+  assign bits_accept_w_slot_c38 = accept_w_slot_c38[5:0];
+  assign bits_accept_w_slot_c39 = accept_w_slot_c39[5:0];
+  assign bits_accept_w_slot_c40 = accept_w_slot_c40[5:0];
+  assign bits_accept_w_slot_c41 = accept_w_slot_c41[5:0];
 
   always @(posedge clk) begin : ray_port_regs
     if (rst) turn <= 1'h0;
@@ -1034,6 +1046,12 @@ module fxrt_core_sf0a3f4 (
     if (box_idle_c1) box_in_invx <= in_invx;
     if (box_idle_c1) box_in_invy <= in_invy;
     if (box_idle_c1) box_in_invz <= in_invz;
+    if (rst) accept <= 1'h0;
+    else accept <= take;
+    if (rst) u0_accept <= 1'h0;
+    else u0_accept <= u0_take;
+    if (rst) u1_accept <= 1'h0;
+    else u1_accept <= u1_take;
     acc_in_ray_id <= in_ray_id;
     acc_in_ox <= in_ox;
     acc_in_oy <= in_oy;
@@ -1068,156 +1086,157 @@ module fxrt_core_sf0a3f4 (
     else box_idle_c1 <= box_idle_next;
   end
 
-  // register copies accept_copies: accept and 11 copies, to split its fan-out
+  // register copies accept_w_copies: accept_w and 11 copies, to split its fan-out
 
-  (* keep *) always @(posedge clk) begin : accept_copies_regs
-    if (rst) accept <= 1'h0;
-    else accept <= take;
-    if (rst) accept_c1 <= 1'h0;
-    else accept_c1 <= take;
-    if (rst) accept_c2 <= 1'h0;
-    else accept_c2 <= take;
-    if (rst) accept_c3 <= 1'h0;
-    else accept_c3 <= take;
-    if (rst) accept_c4 <= 1'h0;
-    else accept_c4 <= take;
-    if (rst) accept_c5 <= 1'h0;
-    else accept_c5 <= take;
-    if (rst) accept_c6 <= 1'h0;
-    else accept_c6 <= take;
-    if (rst) accept_c7 <= 1'h0;
-    else accept_c7 <= take;
-    if (rst) accept_c8 <= 1'h0;
-    else accept_c8 <= take;
-    if (rst) accept_c9 <= 1'h0;
-    else accept_c9 <= take;
-    if (rst) accept_c10 <= 1'h0;
-    else accept_c10 <= take;
-    if (rst) accept_c11 <= 1'h0;
-    else accept_c11 <= take;
+  (* keep *) always @(posedge clk) begin : accept_w_copies_regs
+    if (rst) accept_w <= 1'h0;
+    else accept_w <= accept;
+    if (rst) accept_w_c1 <= 1'h0;
+    else accept_w_c1 <= accept;
+    if (rst) accept_w_c2 <= 1'h0;
+    else accept_w_c2 <= accept;
+    if (rst) accept_w_c3 <= 1'h0;
+    else accept_w_c3 <= accept;
+    if (rst) accept_w_c4 <= 1'h0;
+    else accept_w_c4 <= accept;
+    if (rst) accept_w_c5 <= 1'h0;
+    else accept_w_c5 <= accept;
+    if (rst) accept_w_c6 <= 1'h0;
+    else accept_w_c6 <= accept;
+    if (rst) accept_w_c7 <= 1'h0;
+    else accept_w_c7 <= accept;
+    if (rst) accept_w_c8 <= 1'h0;
+    else accept_w_c8 <= accept;
+    if (rst) accept_w_c9 <= 1'h0;
+    else accept_w_c9 <= accept;
+    if (rst) accept_w_c10 <= 1'h0;
+    else accept_w_c10 <= accept;
+    if (rst) accept_w_c11 <= 1'h0;
+    else accept_w_c11 <= accept;
   end
 
-  // register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
+  // register copies accept_w_slot_copies: accept_w_slot and 41 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : accept_w_slot_copies_regs
+    accept_w_slot <= accept_slot;
+    accept_w_slot_c1 <= accept_slot;
+    accept_w_slot_c2 <= accept_slot;
+    accept_w_slot_c3 <= accept_slot;
+    accept_w_slot_c4 <= accept_slot;
+    accept_w_slot_c5 <= accept_slot;
+    accept_w_slot_c6 <= accept_slot;
+    accept_w_slot_c7 <= accept_slot;
+    accept_w_slot_c8 <= accept_slot;
+    accept_w_slot_c9 <= accept_slot;
+    accept_w_slot_c10 <= accept_slot;
+    accept_w_slot_c11 <= accept_slot;
+    accept_w_slot_c12 <= accept_slot;
+    accept_w_slot_c13 <= accept_slot;
+    accept_w_slot_c14 <= accept_slot;
+    accept_w_slot_c15 <= accept_slot;
+    accept_w_slot_c16 <= accept_slot;
+    accept_w_slot_c17 <= accept_slot;
+    accept_w_slot_c18 <= accept_slot;
+    accept_w_slot_c19 <= accept_slot;
+    accept_w_slot_c20 <= accept_slot;
+    accept_w_slot_c21 <= accept_slot;
+    accept_w_slot_c22 <= accept_slot;
+    accept_w_slot_c23 <= accept_slot;
+    accept_w_slot_c24 <= accept_slot;
+    accept_w_slot_c25 <= accept_slot;
+    accept_w_slot_c26 <= accept_slot;
+    accept_w_slot_c27 <= accept_slot;
+    accept_w_slot_c28 <= accept_slot;
+    accept_w_slot_c29 <= accept_slot;
+    accept_w_slot_c30 <= accept_slot;
+    accept_w_slot_c31 <= accept_slot;
+    accept_w_slot_c32 <= accept_slot;
+    accept_w_slot_c33 <= accept_slot;
+    accept_w_slot_c34 <= accept_slot;
+    accept_w_slot_c35 <= accept_slot;
+    accept_w_slot_c36 <= accept_slot;
+    accept_w_slot_c37 <= accept_slot;
+    accept_w_slot_c38 <= accept_slot;
+    accept_w_slot_c39 <= accept_slot;
+    accept_w_slot_c40 <= accept_slot;
+    accept_w_slot_c41 <= accept_slot;
+  end
+
+  // register copies u0_accept_w_copies: u0_accept_w and 14 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : u0_accept_w_copies_regs
+    if (rst) u0_accept_w <= 1'h0;
+    else u0_accept_w <= u0_accept;
+    if (rst) u0_accept_w_c1 <= 1'h0;
+    else u0_accept_w_c1 <= u0_accept;
+    if (rst) u0_accept_w_c2 <= 1'h0;
+    else u0_accept_w_c2 <= u0_accept;
+    if (rst) u0_accept_w_c3 <= 1'h0;
+    else u0_accept_w_c3 <= u0_accept;
+    if (rst) u0_accept_w_c4 <= 1'h0;
+    else u0_accept_w_c4 <= u0_accept;
+    if (rst) u0_accept_w_c5 <= 1'h0;
+    else u0_accept_w_c5 <= u0_accept;
+    if (rst) u0_accept_w_c6 <= 1'h0;
+    else u0_accept_w_c6 <= u0_accept;
+    if (rst) u0_accept_w_c7 <= 1'h0;
+    else u0_accept_w_c7 <= u0_accept;
+    if (rst) u0_accept_w_c8 <= 1'h0;
+    else u0_accept_w_c8 <= u0_accept;
+    if (rst) u0_accept_w_c9 <= 1'h0;
+    else u0_accept_w_c9 <= u0_accept;
+    if (rst) u0_accept_w_c10 <= 1'h0;
+    else u0_accept_w_c10 <= u0_accept;
+    if (rst) u0_accept_w_c11 <= 1'h0;
+    else u0_accept_w_c11 <= u0_accept;
+    if (rst) u0_accept_w_c12 <= 1'h0;
+    else u0_accept_w_c12 <= u0_accept;
+    if (rst) u0_accept_w_c13 <= 1'h0;
+    else u0_accept_w_c13 <= u0_accept;
+    if (rst) u0_accept_w_c14 <= 1'h0;
+    else u0_accept_w_c14 <= u0_accept;
+  end
+
+  // register copies u1_accept_w_copies: u1_accept_w and 14 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : u1_accept_w_copies_regs
+    if (rst) u1_accept_w <= 1'h0;
+    else u1_accept_w <= u1_accept;
+    if (rst) u1_accept_w_c1 <= 1'h0;
+    else u1_accept_w_c1 <= u1_accept;
+    if (rst) u1_accept_w_c2 <= 1'h0;
+    else u1_accept_w_c2 <= u1_accept;
+    if (rst) u1_accept_w_c3 <= 1'h0;
+    else u1_accept_w_c3 <= u1_accept;
+    if (rst) u1_accept_w_c4 <= 1'h0;
+    else u1_accept_w_c4 <= u1_accept;
+    if (rst) u1_accept_w_c5 <= 1'h0;
+    else u1_accept_w_c5 <= u1_accept;
+    if (rst) u1_accept_w_c6 <= 1'h0;
+    else u1_accept_w_c6 <= u1_accept;
+    if (rst) u1_accept_w_c7 <= 1'h0;
+    else u1_accept_w_c7 <= u1_accept;
+    if (rst) u1_accept_w_c8 <= 1'h0;
+    else u1_accept_w_c8 <= u1_accept;
+    if (rst) u1_accept_w_c9 <= 1'h0;
+    else u1_accept_w_c9 <= u1_accept;
+    if (rst) u1_accept_w_c10 <= 1'h0;
+    else u1_accept_w_c10 <= u1_accept;
+    if (rst) u1_accept_w_c11 <= 1'h0;
+    else u1_accept_w_c11 <= u1_accept;
+    if (rst) u1_accept_w_c12 <= 1'h0;
+    else u1_accept_w_c12 <= u1_accept;
+    if (rst) u1_accept_w_c13 <= 1'h0;
+    else u1_accept_w_c13 <= u1_accept;
+    if (rst) u1_accept_w_c14 <= 1'h0;
+    else u1_accept_w_c14 <= u1_accept;
+  end
+
+  // register copies accept_slot_copies: accept_slot and 1 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : accept_slot_copies_regs
     accept_slot <= take_slot;
     accept_slot_c1 <= take_slot;
-    accept_slot_c2 <= take_slot;
-    accept_slot_c3 <= take_slot;
-    accept_slot_c4 <= take_slot;
-    accept_slot_c5 <= take_slot;
-    accept_slot_c6 <= take_slot;
-    accept_slot_c7 <= take_slot;
-    accept_slot_c8 <= take_slot;
-    accept_slot_c9 <= take_slot;
-    accept_slot_c10 <= take_slot;
-    accept_slot_c11 <= take_slot;
-    accept_slot_c12 <= take_slot;
-    accept_slot_c13 <= take_slot;
-    accept_slot_c14 <= take_slot;
-    accept_slot_c15 <= take_slot;
-    accept_slot_c16 <= take_slot;
-    accept_slot_c17 <= take_slot;
-    accept_slot_c18 <= take_slot;
-    accept_slot_c19 <= take_slot;
-    accept_slot_c20 <= take_slot;
-    accept_slot_c21 <= take_slot;
-    accept_slot_c22 <= take_slot;
-    accept_slot_c23 <= take_slot;
-    accept_slot_c24 <= take_slot;
-    accept_slot_c25 <= take_slot;
-    accept_slot_c26 <= take_slot;
-    accept_slot_c27 <= take_slot;
-    accept_slot_c28 <= take_slot;
-    accept_slot_c29 <= take_slot;
-    accept_slot_c30 <= take_slot;
-    accept_slot_c31 <= take_slot;
-    accept_slot_c32 <= take_slot;
-    accept_slot_c33 <= take_slot;
-    accept_slot_c34 <= take_slot;
-    accept_slot_c35 <= take_slot;
-    accept_slot_c36 <= take_slot;
-    accept_slot_c37 <= take_slot;
-    accept_slot_c38 <= take_slot;
-    accept_slot_c39 <= take_slot;
-    accept_slot_c40 <= take_slot;
-    accept_slot_c41 <= take_slot;
-    accept_slot_c42 <= take_slot;
-    accept_slot_c43 <= take_slot;
-  end
-
-  // register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
-
-  (* keep *) always @(posedge clk) begin : u0_accept_copies_regs
-    if (rst) u0_accept <= 1'h0;
-    else u0_accept <= u0_take;
-    if (rst) u0_accept_c1 <= 1'h0;
-    else u0_accept_c1 <= u0_take;
-    if (rst) u0_accept_c2 <= 1'h0;
-    else u0_accept_c2 <= u0_take;
-    if (rst) u0_accept_c3 <= 1'h0;
-    else u0_accept_c3 <= u0_take;
-    if (rst) u0_accept_c4 <= 1'h0;
-    else u0_accept_c4 <= u0_take;
-    if (rst) u0_accept_c5 <= 1'h0;
-    else u0_accept_c5 <= u0_take;
-    if (rst) u0_accept_c6 <= 1'h0;
-    else u0_accept_c6 <= u0_take;
-    if (rst) u0_accept_c7 <= 1'h0;
-    else u0_accept_c7 <= u0_take;
-    if (rst) u0_accept_c8 <= 1'h0;
-    else u0_accept_c8 <= u0_take;
-    if (rst) u0_accept_c9 <= 1'h0;
-    else u0_accept_c9 <= u0_take;
-    if (rst) u0_accept_c10 <= 1'h0;
-    else u0_accept_c10 <= u0_take;
-    if (rst) u0_accept_c11 <= 1'h0;
-    else u0_accept_c11 <= u0_take;
-    if (rst) u0_accept_c12 <= 1'h0;
-    else u0_accept_c12 <= u0_take;
-    if (rst) u0_accept_c13 <= 1'h0;
-    else u0_accept_c13 <= u0_take;
-    if (rst) u0_accept_c14 <= 1'h0;
-    else u0_accept_c14 <= u0_take;
-    if (rst) u0_accept_c15 <= 1'h0;
-    else u0_accept_c15 <= u0_take;
-  end
-
-  // register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
-
-  (* keep *) always @(posedge clk) begin : u1_accept_copies_regs
-    if (rst) u1_accept <= 1'h0;
-    else u1_accept <= u1_take;
-    if (rst) u1_accept_c1 <= 1'h0;
-    else u1_accept_c1 <= u1_take;
-    if (rst) u1_accept_c2 <= 1'h0;
-    else u1_accept_c2 <= u1_take;
-    if (rst) u1_accept_c3 <= 1'h0;
-    else u1_accept_c3 <= u1_take;
-    if (rst) u1_accept_c4 <= 1'h0;
-    else u1_accept_c4 <= u1_take;
-    if (rst) u1_accept_c5 <= 1'h0;
-    else u1_accept_c5 <= u1_take;
-    if (rst) u1_accept_c6 <= 1'h0;
-    else u1_accept_c6 <= u1_take;
-    if (rst) u1_accept_c7 <= 1'h0;
-    else u1_accept_c7 <= u1_take;
-    if (rst) u1_accept_c8 <= 1'h0;
-    else u1_accept_c8 <= u1_take;
-    if (rst) u1_accept_c9 <= 1'h0;
-    else u1_accept_c9 <= u1_take;
-    if (rst) u1_accept_c10 <= 1'h0;
-    else u1_accept_c10 <= u1_take;
-    if (rst) u1_accept_c11 <= 1'h0;
-    else u1_accept_c11 <= u1_take;
-    if (rst) u1_accept_c12 <= 1'h0;
-    else u1_accept_c12 <= u1_take;
-    if (rst) u1_accept_c13 <= 1'h0;
-    else u1_accept_c13 <= u1_take;
-    if (rst) u1_accept_c14 <= 1'h0;
-    else u1_accept_c14 <= u1_take;
-    if (rst) u1_accept_c15 <= 1'h0;
-    else u1_accept_c15 <= u1_take;
   end
 
   // stage box_exit: the scene-box exit distance: three plane distances, the smallest
@@ -1612,6 +1631,7 @@ module fxrt_core_sf0a3f4 (
   assign cat_39 = {k_1, u_traverse_1_done_slot};
   assign mux_u0_done_avail = u0_done_avail ? cat_37 : cat_39;
   assign or_40 = u0_done_avail | u1_done_avail;
+  assign cat_41 = {done_slot_r_c8, done_slot_r_c7, done_slot_r_c6, done_slot_r_c5, done_slot_r_c4, done_slot_r_c3, done_slot_r_c2, done_slot_r_c1};
 
   always @(posedge clk) begin : done_regs
     if (rst) res_credit_ok <= 1'h1;
@@ -1622,12 +1642,25 @@ module fxrt_core_sf0a3f4 (
     else u1_done_took <= u1_done_pop;
     if (rst) done_valid_r <= 1'h0;
     else done_valid_r <= or_40;
+  end
+
+  // register copies done_slot_r_copies: done_slot_r and 8 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : done_slot_r_copies_regs
     done_slot_r <= mux_u0_done_avail;
+    done_slot_r_c1 <= mux_u0_done_avail;
+    done_slot_r_c2 <= mux_u0_done_avail;
+    done_slot_r_c3 <= mux_u0_done_avail;
+    done_slot_r_c4 <= mux_u0_done_avail;
+    done_slot_r_c5 <= mux_u0_done_avail;
+    done_slot_r_c6 <= mux_u0_done_avail;
+    done_slot_r_c7 <= mux_u0_done_avail;
+    done_slot_r_c8 <= mux_u0_done_avail;
   end
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  assign cat_41 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
-  assign cat_42 = {u_closest_res_u, u_closest_res_v};
+  assign cat_42 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
+  assign cat_43 = {u_closest_res_u, u_closest_res_v};
   assign res_take = res_take_c;
   assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
   assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
@@ -1642,14 +1675,14 @@ module fxrt_core_sf0a3f4 (
   assign res_q_count_next = res_take ? res_q_count_if_pop : res_q_count_if_kept;
   assign res_q_count_eq_k_0_5 = res_q_count == k_0_5;
   assign res_q_one_left = res_q_count == k_1_5;
-  assign and_45 = res_q_one_left & res_take;
-  assign res_q_drained = res_q_count_eq_k_0_5 | and_45;
+  assign and_46 = res_q_one_left & res_take;
+  assign res_q_drained = res_q_count_eq_k_0_5 | and_46;
   assign res_q_bypass_c = res_q_push_c1 & res_q_drained;
   assign k_1_5_lt_res_q_count = k_1_5 < res_q_count;
-  assign or_48 = res_q_push_c1 | k_1_5_lt_res_q_count;
+  assign or_49 = res_q_push_c1 | k_1_5_lt_res_q_count;
   assign not_res_take = ~res_take;
-  assign and_49 = res_q_one_left & not_res_take;
-  assign res_q_nonempty_c = or_48 | and_49;
+  assign and_50 = res_q_one_left & not_res_take;
+  assign res_q_nonempty_c = or_49 | and_50;
   assign bits_res_q_din0 = res_q_din0[15:0];
   assign bits_res_q_din0_1 = res_q_din0[31:16];
   assign bits_res_q_din0_2 = res_q_din0[47:32];
@@ -1723,7 +1756,7 @@ module fxrt_core_sf0a3f4 (
     else res_q_popped <= res_take;
     if (rst) res_q_nonempty <= 1'h0;
     else res_q_nonempty <= res_q_nonempty_c;
-    res_q_din0 <= cat_41;
+    res_q_din0 <= cat_42;
     if (rst) res_q_rd0_p1 <= 4'h0;
     else res_q_rd0_p1 <= mux_res_take_1;
     if (rst) res_q_rd01_p1 <= 4'h1;
@@ -1745,7 +1778,7 @@ module fxrt_core_sf0a3f4 (
     res_q_q_next0_g1 <= res_q_mem0_g1[res_q_rd01_p1];
     res_q_q_next0_g0 <= res_q_mem0_g0[res_q_rd1];
     if (res_q_push) res_q_din_r0 <= res_q_din0;
-    res_q_din1 <= cat_42;
+    res_q_din1 <= cat_43;
     if (rst) res_q_rd1_p1 <= 4'h0;
     else res_q_rd1_p1 <= mux_res_take_7;
     if (rst) res_q_rd11_p1 <= 4'h1;
@@ -1794,36 +1827,36 @@ module fxrt_core_sf0a3f4 (
   fxrt_traverse_k64_sf0a3f4 u_traverse_0 (
     .clk(clk),
     .rst(rst),
-    .ray_we_g0(u0_accept),
-    .ray_slot_g0(bits_accept_slot_c14),
-    .ray_we_g1(u0_accept_c1),
-    .ray_slot_g1(bits_accept_slot_c15),
-    .ray_we_g2(u0_accept_c2),
-    .ray_slot_g2(bits_accept_slot_c16),
-    .ray_we_g3(u0_accept_c3),
-    .ray_slot_g3(bits_accept_slot_c17),
-    .ray_we_g4(u0_accept_c4),
-    .ray_slot_g4(bits_accept_slot_c18),
-    .ray_we_g5(u0_accept_c5),
-    .ray_slot_g5(bits_accept_slot_c19),
-    .ray_we_g6(u0_accept_c6),
-    .ray_slot_g6(bits_accept_slot_c20),
-    .ray_we_g7(u0_accept_c7),
-    .ray_slot_g7(bits_accept_slot_c21),
-    .ray_we_g8(u0_accept_c8),
-    .ray_slot_g8(bits_accept_slot_c22),
-    .ray_we_g9(u0_accept_c9),
-    .ray_slot_g9(bits_accept_slot_c23),
-    .ray_we_g10(u0_accept_c10),
-    .ray_slot_g10(bits_accept_slot_c24),
-    .ray_we_g11(u0_accept_c11),
-    .ray_slot_g11(bits_accept_slot_c25),
-    .ray_we_g12(u0_accept_c12),
-    .ray_slot_g12(bits_accept_slot_c26),
-    .ray_we_g13(u0_accept_c13),
-    .ray_slot_g13(bits_accept_slot_c27),
-    .ray_we_g14(u0_accept_c14),
-    .ray_slot_g14(bits_accept_slot_c28),
+    .ray_we_g0(u0_accept_w),
+    .ray_slot_g0(bits_accept_w_slot_c12),
+    .ray_we_g1(u0_accept_w_c1),
+    .ray_slot_g1(bits_accept_w_slot_c13),
+    .ray_we_g2(u0_accept_w_c2),
+    .ray_slot_g2(bits_accept_w_slot_c14),
+    .ray_we_g3(u0_accept_w_c3),
+    .ray_slot_g3(bits_accept_w_slot_c15),
+    .ray_we_g4(u0_accept_w_c4),
+    .ray_slot_g4(bits_accept_w_slot_c16),
+    .ray_we_g5(u0_accept_w_c5),
+    .ray_slot_g5(bits_accept_w_slot_c17),
+    .ray_we_g6(u0_accept_w_c6),
+    .ray_slot_g6(bits_accept_w_slot_c18),
+    .ray_we_g7(u0_accept_w_c7),
+    .ray_slot_g7(bits_accept_w_slot_c19),
+    .ray_we_g8(u0_accept_w_c8),
+    .ray_slot_g8(bits_accept_w_slot_c20),
+    .ray_we_g9(u0_accept_w_c9),
+    .ray_slot_g9(bits_accept_w_slot_c21),
+    .ray_we_g10(u0_accept_w_c10),
+    .ray_slot_g10(bits_accept_w_slot_c22),
+    .ray_we_g11(u0_accept_w_c11),
+    .ray_slot_g11(bits_accept_w_slot_c23),
+    .ray_we_g12(u0_accept_w_c12),
+    .ray_slot_g12(bits_accept_w_slot_c24),
+    .ray_we_g13(u0_accept_w_c13),
+    .ray_slot_g13(bits_accept_w_slot_c25),
+    .ray_we_g14(u0_accept_w_c14),
+    .ray_slot_g14(bits_accept_w_slot_c26),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1841,7 +1874,7 @@ module fxrt_core_sf0a3f4 (
     .merge_sp(merge_sp),
     .free_valid(u0_free),
     .free_slot(bits_free_slot_1),
-    .alloc(u0_accept_c15),
+    .alloc(u0_accept),
     .leaf_pop(u0_leaf_pop),
     .done_pop(u0_done_pop),
     .node_word(u0_node_word),
@@ -1867,36 +1900,36 @@ module fxrt_core_sf0a3f4 (
   fxrt_traverse_k64_sf0a3f4 u_traverse_1 (
     .clk(clk),
     .rst(rst),
-    .ray_we_g0(u1_accept),
-    .ray_slot_g0(bits_accept_slot_c29),
-    .ray_we_g1(u1_accept_c1),
-    .ray_slot_g1(bits_accept_slot_c30),
-    .ray_we_g2(u1_accept_c2),
-    .ray_slot_g2(bits_accept_slot_c31),
-    .ray_we_g3(u1_accept_c3),
-    .ray_slot_g3(bits_accept_slot_c32),
-    .ray_we_g4(u1_accept_c4),
-    .ray_slot_g4(bits_accept_slot_c33),
-    .ray_we_g5(u1_accept_c5),
-    .ray_slot_g5(bits_accept_slot_c34),
-    .ray_we_g6(u1_accept_c6),
-    .ray_slot_g6(bits_accept_slot_c35),
-    .ray_we_g7(u1_accept_c7),
-    .ray_slot_g7(bits_accept_slot_c36),
-    .ray_we_g8(u1_accept_c8),
-    .ray_slot_g8(bits_accept_slot_c37),
-    .ray_we_g9(u1_accept_c9),
-    .ray_slot_g9(bits_accept_slot_c38),
-    .ray_we_g10(u1_accept_c10),
-    .ray_slot_g10(bits_accept_slot_c39),
-    .ray_we_g11(u1_accept_c11),
-    .ray_slot_g11(bits_accept_slot_c40),
-    .ray_we_g12(u1_accept_c12),
-    .ray_slot_g12(bits_accept_slot_c41),
-    .ray_we_g13(u1_accept_c13),
-    .ray_slot_g13(bits_accept_slot_c42),
-    .ray_we_g14(u1_accept_c14),
-    .ray_slot_g14(bits_accept_slot_c43),
+    .ray_we_g0(u1_accept_w),
+    .ray_slot_g0(bits_accept_w_slot_c27),
+    .ray_we_g1(u1_accept_w_c1),
+    .ray_slot_g1(bits_accept_w_slot_c28),
+    .ray_we_g2(u1_accept_w_c2),
+    .ray_slot_g2(bits_accept_w_slot_c29),
+    .ray_we_g3(u1_accept_w_c3),
+    .ray_slot_g3(bits_accept_w_slot_c30),
+    .ray_we_g4(u1_accept_w_c4),
+    .ray_slot_g4(bits_accept_w_slot_c31),
+    .ray_we_g5(u1_accept_w_c5),
+    .ray_slot_g5(bits_accept_w_slot_c32),
+    .ray_we_g6(u1_accept_w_c6),
+    .ray_slot_g6(bits_accept_w_slot_c33),
+    .ray_we_g7(u1_accept_w_c7),
+    .ray_slot_g7(bits_accept_w_slot_c34),
+    .ray_we_g8(u1_accept_w_c8),
+    .ray_slot_g8(bits_accept_w_slot_c35),
+    .ray_we_g9(u1_accept_w_c9),
+    .ray_slot_g9(bits_accept_w_slot_c36),
+    .ray_we_g10(u1_accept_w_c10),
+    .ray_slot_g10(bits_accept_w_slot_c37),
+    .ray_we_g11(u1_accept_w_c11),
+    .ray_slot_g11(bits_accept_w_slot_c38),
+    .ray_we_g12(u1_accept_w_c12),
+    .ray_slot_g12(bits_accept_w_slot_c39),
+    .ray_we_g13(u1_accept_w_c13),
+    .ray_slot_g13(bits_accept_w_slot_c40),
+    .ray_we_g14(u1_accept_w_c14),
+    .ray_slot_g14(bits_accept_w_slot_c41),
     .ox(acc_in_ox),
     .oy(acc_in_oy),
     .oz(acc_in_oz),
@@ -1914,7 +1947,7 @@ module fxrt_core_sf0a3f4 (
     .merge_sp(merge_sp),
     .free_valid(u1_free),
     .free_slot(bits_free_slot_3),
-    .alloc(u1_accept_c15),
+    .alloc(u1_accept),
     .leaf_pop(u1_leaf_pop),
     .done_pop(u1_done_pop),
     .node_word(u1_node_word),
@@ -2008,10 +2041,11 @@ module fxrt_core_sf0a3f4 (
     .u(u_intersect_u),
     .v(u_intersect_v),
     .id_we(accept),
-    .id_slot(accept_slot_c13),
+    .id_slot(accept_slot_c1),
     .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),
+    .done_slot_copies(cat_41),
     .merge_valid0(u_closest_merge_valid0),
     .merge_slot0(u_closest_merge_slot0),
     .merge_hit0(u_closest_merge_hit0),

@@ -195,6 +195,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
       id : in unsigned(19 downto 0);
       done_valid : in unsigned(0 downto 0);
       done_slot : in unsigned(6 downto 0);
+      done_slot_copies : in unsigned(55 downto 0);
       merge_valid0 : out unsigned(0 downto 0);
       merge_slot0 : out unsigned(5 downto 0);
       merge_hit0 : out unsigned(0 downto 0);
@@ -329,12 +330,15 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal box_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
+  signal accept : unsigned(0 downto 0) := unsigned'("0");
   signal bits_take_slot : unsigned(0 downto 0);
   signal bits_take_slot_eq_k_0 : unsigned(0 downto 0);
   signal u0_take : unsigned(0 downto 0);
+  signal u0_accept : unsigned(0 downto 0) := unsigned'("0");
   signal bits_take_slot_1 : unsigned(0 downto 0);
   signal bits_take_slot_1_eq_k_1 : unsigned(0 downto 0);
   signal u1_take : unsigned(0 downto 0);
+  signal u1_accept : unsigned(0 downto 0) := unsigned'("0");
   signal acc_in_ray_id : unsigned(19 downto 0) := unsigned'("00000000000000000000");
   signal acc_in_ox : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
   signal acc_in_oy : unsigned(28 downto 0) := unsigned'("00000000000000000000000000000");
@@ -345,36 +349,36 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal acc_in_invx : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invy : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
   signal acc_in_invz : signed(47 downto 0) := signed'("000000000000000000000000000000000000000000000000");
-  signal bits_accept_slot_c14 : unsigned(5 downto 0);
-  signal bits_accept_slot_c15 : unsigned(5 downto 0);
-  signal bits_accept_slot_c16 : unsigned(5 downto 0);
-  signal bits_accept_slot_c17 : unsigned(5 downto 0);
-  signal bits_accept_slot_c18 : unsigned(5 downto 0);
-  signal bits_accept_slot_c19 : unsigned(5 downto 0);
-  signal bits_accept_slot_c20 : unsigned(5 downto 0);
-  signal bits_accept_slot_c21 : unsigned(5 downto 0);
-  signal bits_accept_slot_c22 : unsigned(5 downto 0);
-  signal bits_accept_slot_c23 : unsigned(5 downto 0);
-  signal bits_accept_slot_c24 : unsigned(5 downto 0);
-  signal bits_accept_slot_c25 : unsigned(5 downto 0);
-  signal bits_accept_slot_c26 : unsigned(5 downto 0);
-  signal bits_accept_slot_c27 : unsigned(5 downto 0);
-  signal bits_accept_slot_c28 : unsigned(5 downto 0);
-  signal bits_accept_slot_c29 : unsigned(5 downto 0);
-  signal bits_accept_slot_c30 : unsigned(5 downto 0);
-  signal bits_accept_slot_c31 : unsigned(5 downto 0);
-  signal bits_accept_slot_c32 : unsigned(5 downto 0);
-  signal bits_accept_slot_c33 : unsigned(5 downto 0);
-  signal bits_accept_slot_c34 : unsigned(5 downto 0);
-  signal bits_accept_slot_c35 : unsigned(5 downto 0);
-  signal bits_accept_slot_c36 : unsigned(5 downto 0);
-  signal bits_accept_slot_c37 : unsigned(5 downto 0);
-  signal bits_accept_slot_c38 : unsigned(5 downto 0);
-  signal bits_accept_slot_c39 : unsigned(5 downto 0);
-  signal bits_accept_slot_c40 : unsigned(5 downto 0);
-  signal bits_accept_slot_c41 : unsigned(5 downto 0);
-  signal bits_accept_slot_c42 : unsigned(5 downto 0);
-  signal bits_accept_slot_c43 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c12 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c13 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c14 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c15 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c16 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c17 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c18 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c19 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c20 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c21 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c22 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c23 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c24 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c25 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c26 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c27 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c28 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c29 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c30 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c31 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c32 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c33 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c34 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c35 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c36 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c37 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c38 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c39 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c40 : unsigned(5 downto 0);
+  signal bits_accept_w_slot_c41 : unsigned(5 downto 0);
 
   -- register copies port_empty_copies: port_empty and 3 copies, to split its fan-out
   signal port_empty : unsigned(0 downto 0) := unsigned'("1");
@@ -392,189 +396,187 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_idle_c1 : unsigned(0 downto 0) := unsigned'("1");
   attribute keep of box_idle_c1 : signal is "true";
 
-  -- register copies accept_copies: accept and 11 copies, to split its fan-out
-  signal accept : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept : signal is "true";
-  signal accept_c1 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c1 : signal is "true";
-  signal accept_c2 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c2 : signal is "true";
-  signal accept_c3 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c3 : signal is "true";
-  signal accept_c4 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c4 : signal is "true";
-  signal accept_c5 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c5 : signal is "true";
-  signal accept_c6 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c6 : signal is "true";
-  signal accept_c7 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c7 : signal is "true";
-  signal accept_c8 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c8 : signal is "true";
-  signal accept_c9 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c9 : signal is "true";
-  signal accept_c10 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c10 : signal is "true";
-  signal accept_c11 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of accept_c11 : signal is "true";
+  -- register copies accept_w_copies: accept_w and 11 copies, to split its fan-out
+  signal accept_w : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w : signal is "true";
+  signal accept_w_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c1 : signal is "true";
+  signal accept_w_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c2 : signal is "true";
+  signal accept_w_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c3 : signal is "true";
+  signal accept_w_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c4 : signal is "true";
+  signal accept_w_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c5 : signal is "true";
+  signal accept_w_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c6 : signal is "true";
+  signal accept_w_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c7 : signal is "true";
+  signal accept_w_c8 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c8 : signal is "true";
+  signal accept_w_c9 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c9 : signal is "true";
+  signal accept_w_c10 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c10 : signal is "true";
+  signal accept_w_c11 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of accept_w_c11 : signal is "true";
 
-  -- register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
+  -- register copies accept_w_slot_copies: accept_w_slot and 41 copies, to split its fan-out
+  signal accept_w_slot : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot : signal is "true";
+  signal accept_w_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c1 : signal is "true";
+  signal accept_w_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c2 : signal is "true";
+  signal accept_w_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c3 : signal is "true";
+  signal accept_w_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c4 : signal is "true";
+  signal accept_w_slot_c5 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c5 : signal is "true";
+  signal accept_w_slot_c6 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c6 : signal is "true";
+  signal accept_w_slot_c7 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c7 : signal is "true";
+  signal accept_w_slot_c8 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c8 : signal is "true";
+  signal accept_w_slot_c9 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c9 : signal is "true";
+  signal accept_w_slot_c10 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c10 : signal is "true";
+  signal accept_w_slot_c11 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c11 : signal is "true";
+  signal accept_w_slot_c12 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c12 : signal is "true";
+  signal accept_w_slot_c13 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c13 : signal is "true";
+  signal accept_w_slot_c14 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c14 : signal is "true";
+  signal accept_w_slot_c15 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c15 : signal is "true";
+  signal accept_w_slot_c16 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c16 : signal is "true";
+  signal accept_w_slot_c17 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c17 : signal is "true";
+  signal accept_w_slot_c18 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c18 : signal is "true";
+  signal accept_w_slot_c19 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c19 : signal is "true";
+  signal accept_w_slot_c20 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c20 : signal is "true";
+  signal accept_w_slot_c21 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c21 : signal is "true";
+  signal accept_w_slot_c22 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c22 : signal is "true";
+  signal accept_w_slot_c23 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c23 : signal is "true";
+  signal accept_w_slot_c24 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c24 : signal is "true";
+  signal accept_w_slot_c25 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c25 : signal is "true";
+  signal accept_w_slot_c26 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c26 : signal is "true";
+  signal accept_w_slot_c27 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c27 : signal is "true";
+  signal accept_w_slot_c28 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c28 : signal is "true";
+  signal accept_w_slot_c29 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c29 : signal is "true";
+  signal accept_w_slot_c30 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c30 : signal is "true";
+  signal accept_w_slot_c31 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c31 : signal is "true";
+  signal accept_w_slot_c32 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c32 : signal is "true";
+  signal accept_w_slot_c33 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c33 : signal is "true";
+  signal accept_w_slot_c34 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c34 : signal is "true";
+  signal accept_w_slot_c35 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c35 : signal is "true";
+  signal accept_w_slot_c36 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c36 : signal is "true";
+  signal accept_w_slot_c37 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c37 : signal is "true";
+  signal accept_w_slot_c38 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c38 : signal is "true";
+  signal accept_w_slot_c39 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c39 : signal is "true";
+  signal accept_w_slot_c40 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c40 : signal is "true";
+  signal accept_w_slot_c41 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of accept_w_slot_c41 : signal is "true";
+
+  -- register copies u0_accept_w_copies: u0_accept_w and 14 copies, to split its fan-out
+  signal u0_accept_w : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w : signal is "true";
+  signal u0_accept_w_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c1 : signal is "true";
+  signal u0_accept_w_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c2 : signal is "true";
+  signal u0_accept_w_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c3 : signal is "true";
+  signal u0_accept_w_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c4 : signal is "true";
+  signal u0_accept_w_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c5 : signal is "true";
+  signal u0_accept_w_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c6 : signal is "true";
+  signal u0_accept_w_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c7 : signal is "true";
+  signal u0_accept_w_c8 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c8 : signal is "true";
+  signal u0_accept_w_c9 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c9 : signal is "true";
+  signal u0_accept_w_c10 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c10 : signal is "true";
+  signal u0_accept_w_c11 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c11 : signal is "true";
+  signal u0_accept_w_c12 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c12 : signal is "true";
+  signal u0_accept_w_c13 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c13 : signal is "true";
+  signal u0_accept_w_c14 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u0_accept_w_c14 : signal is "true";
+
+  -- register copies u1_accept_w_copies: u1_accept_w and 14 copies, to split its fan-out
+  signal u1_accept_w : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w : signal is "true";
+  signal u1_accept_w_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c1 : signal is "true";
+  signal u1_accept_w_c2 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c2 : signal is "true";
+  signal u1_accept_w_c3 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c3 : signal is "true";
+  signal u1_accept_w_c4 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c4 : signal is "true";
+  signal u1_accept_w_c5 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c5 : signal is "true";
+  signal u1_accept_w_c6 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c6 : signal is "true";
+  signal u1_accept_w_c7 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c7 : signal is "true";
+  signal u1_accept_w_c8 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c8 : signal is "true";
+  signal u1_accept_w_c9 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c9 : signal is "true";
+  signal u1_accept_w_c10 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c10 : signal is "true";
+  signal u1_accept_w_c11 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c11 : signal is "true";
+  signal u1_accept_w_c12 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c12 : signal is "true";
+  signal u1_accept_w_c13 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c13 : signal is "true";
+  signal u1_accept_w_c14 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of u1_accept_w_c14 : signal is "true";
+
+  -- register copies accept_slot_copies: accept_slot and 1 copies, to split its fan-out
   signal accept_slot : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot : signal is "true";
   signal accept_slot_c1 : unsigned(6 downto 0) := unsigned'("0000000");
   attribute keep of accept_slot_c1 : signal is "true";
-  signal accept_slot_c2 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c2 : signal is "true";
-  signal accept_slot_c3 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c3 : signal is "true";
-  signal accept_slot_c4 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c4 : signal is "true";
-  signal accept_slot_c5 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c5 : signal is "true";
-  signal accept_slot_c6 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c6 : signal is "true";
-  signal accept_slot_c7 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c7 : signal is "true";
-  signal accept_slot_c8 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c8 : signal is "true";
-  signal accept_slot_c9 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c9 : signal is "true";
-  signal accept_slot_c10 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c10 : signal is "true";
-  signal accept_slot_c11 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c11 : signal is "true";
-  signal accept_slot_c12 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c12 : signal is "true";
-  signal accept_slot_c13 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c13 : signal is "true";
-  signal accept_slot_c14 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c14 : signal is "true";
-  signal accept_slot_c15 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c15 : signal is "true";
-  signal accept_slot_c16 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c16 : signal is "true";
-  signal accept_slot_c17 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c17 : signal is "true";
-  signal accept_slot_c18 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c18 : signal is "true";
-  signal accept_slot_c19 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c19 : signal is "true";
-  signal accept_slot_c20 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c20 : signal is "true";
-  signal accept_slot_c21 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c21 : signal is "true";
-  signal accept_slot_c22 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c22 : signal is "true";
-  signal accept_slot_c23 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c23 : signal is "true";
-  signal accept_slot_c24 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c24 : signal is "true";
-  signal accept_slot_c25 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c25 : signal is "true";
-  signal accept_slot_c26 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c26 : signal is "true";
-  signal accept_slot_c27 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c27 : signal is "true";
-  signal accept_slot_c28 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c28 : signal is "true";
-  signal accept_slot_c29 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c29 : signal is "true";
-  signal accept_slot_c30 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c30 : signal is "true";
-  signal accept_slot_c31 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c31 : signal is "true";
-  signal accept_slot_c32 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c32 : signal is "true";
-  signal accept_slot_c33 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c33 : signal is "true";
-  signal accept_slot_c34 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c34 : signal is "true";
-  signal accept_slot_c35 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c35 : signal is "true";
-  signal accept_slot_c36 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c36 : signal is "true";
-  signal accept_slot_c37 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c37 : signal is "true";
-  signal accept_slot_c38 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c38 : signal is "true";
-  signal accept_slot_c39 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c39 : signal is "true";
-  signal accept_slot_c40 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c40 : signal is "true";
-  signal accept_slot_c41 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c41 : signal is "true";
-  signal accept_slot_c42 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c42 : signal is "true";
-  signal accept_slot_c43 : unsigned(6 downto 0) := unsigned'("0000000");
-  attribute keep of accept_slot_c43 : signal is "true";
-
-  -- register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
-  signal u0_accept : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept : signal is "true";
-  signal u0_accept_c1 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c1 : signal is "true";
-  signal u0_accept_c2 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c2 : signal is "true";
-  signal u0_accept_c3 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c3 : signal is "true";
-  signal u0_accept_c4 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c4 : signal is "true";
-  signal u0_accept_c5 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c5 : signal is "true";
-  signal u0_accept_c6 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c6 : signal is "true";
-  signal u0_accept_c7 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c7 : signal is "true";
-  signal u0_accept_c8 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c8 : signal is "true";
-  signal u0_accept_c9 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c9 : signal is "true";
-  signal u0_accept_c10 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c10 : signal is "true";
-  signal u0_accept_c11 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c11 : signal is "true";
-  signal u0_accept_c12 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c12 : signal is "true";
-  signal u0_accept_c13 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c13 : signal is "true";
-  signal u0_accept_c14 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c14 : signal is "true";
-  signal u0_accept_c15 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u0_accept_c15 : signal is "true";
-
-  -- register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
-  signal u1_accept : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept : signal is "true";
-  signal u1_accept_c1 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c1 : signal is "true";
-  signal u1_accept_c2 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c2 : signal is "true";
-  signal u1_accept_c3 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c3 : signal is "true";
-  signal u1_accept_c4 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c4 : signal is "true";
-  signal u1_accept_c5 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c5 : signal is "true";
-  signal u1_accept_c6 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c6 : signal is "true";
-  signal u1_accept_c7 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c7 : signal is "true";
-  signal u1_accept_c8 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c8 : signal is "true";
-  signal u1_accept_c9 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c9 : signal is "true";
-  signal u1_accept_c10 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c10 : signal is "true";
-  signal u1_accept_c11 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c11 : signal is "true";
-  signal u1_accept_c12 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c12 : signal is "true";
-  signal u1_accept_c13 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c13 : signal is "true";
-  signal u1_accept_c14 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c14 : signal is "true";
-  signal u1_accept_c15 : unsigned(0 downto 0) := unsigned'("0");
-  attribute keep of u1_accept_c15 : signal is "true";
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   signal box_slot : unsigned(6 downto 0) := unsigned'("0000000");
@@ -949,7 +951,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal mux_u0_done_avail : unsigned(6 downto 0);
   signal or_40 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
-  signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
+  signal cat_41 : unsigned(55 downto 0);
   signal u_closest_merge_valid0 : unsigned(0 downto 0);
   signal u_closest_merge_slot0 : unsigned(5 downto 0);
   signal u_closest_merge_hit0 : unsigned(0 downto 0);
@@ -968,9 +970,29 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_closest_res_u : unsigned(31 downto 0);
   signal u_closest_res_v : unsigned(31 downto 0);
 
+  -- register copies done_slot_r_copies: done_slot_r and 8 copies, to split its fan-out
+  signal done_slot_r : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r : signal is "true";
+  signal done_slot_r_c1 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c1 : signal is "true";
+  signal done_slot_r_c2 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c2 : signal is "true";
+  signal done_slot_r_c3 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c3 : signal is "true";
+  signal done_slot_r_c4 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c4 : signal is "true";
+  signal done_slot_r_c5 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c5 : signal is "true";
+  signal done_slot_r_c6 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c6 : signal is "true";
+  signal done_slot_r_c7 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c7 : signal is "true";
+  signal done_slot_r_c8 : unsigned(6 downto 0) := unsigned'("0000000");
+  attribute keep of done_slot_r_c8 : signal is "true";
+
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  signal cat_41 : unsigned(63 downto 0);
   signal cat_42 : unsigned(63 downto 0);
+  signal cat_43 : unsigned(63 downto 0);
   signal res_take : unsigned(0 downto 0);
   signal res_q_wr : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd : unsigned(3 downto 0) := unsigned'("0000");
@@ -992,16 +1014,16 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_count_eq_k_0_5 : unsigned(0 downto 0);
   constant k_1_5 : unsigned(4 downto 0) := unsigned'("00001");
   signal res_q_one_left : unsigned(0 downto 0);
-  signal and_45 : unsigned(0 downto 0);
+  signal and_46 : unsigned(0 downto 0);
   signal res_q_drained : unsigned(0 downto 0);
   signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_bypass_c : unsigned(0 downto 0);
   signal res_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_5_lt_res_q_count : unsigned(0 downto 0);
-  signal or_48 : unsigned(0 downto 0);
+  signal or_49 : unsigned(0 downto 0);
   signal not_res_take : unsigned(0 downto 0);
-  signal and_49 : unsigned(0 downto 0);
+  signal and_50 : unsigned(0 downto 0);
   signal res_q_nonempty_c : unsigned(0 downto 0);
   signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal bits_res_q_din0 : unsigned(15 downto 0);
@@ -1112,41 +1134,41 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
-      if accept = "1" then
-        ray_o_g0(to_integer(accept_slot_c1)) <= bits_cat_17;
+      if accept_w = "1" then
+        ray_o_g0(to_integer(accept_w_slot)) <= bits_cat_17;
       end if;
-      if accept_c1 = "1" then
-        ray_o_g1(to_integer(accept_slot_c2)) <= bits_cat_17_1;
+      if accept_w_c1 = "1" then
+        ray_o_g1(to_integer(accept_w_slot_c1)) <= bits_cat_17_1;
       end if;
-      if accept_c2 = "1" then
-        ray_o_g2(to_integer(accept_slot_c3)) <= bits_cat_17_2;
+      if accept_w_c2 = "1" then
+        ray_o_g2(to_integer(accept_w_slot_c2)) <= bits_cat_17_2;
       end if;
-      if accept_c3 = "1" then
-        ray_o_g3(to_integer(accept_slot_c4)) <= bits_cat_17_3;
+      if accept_w_c3 = "1" then
+        ray_o_g3(to_integer(accept_w_slot_c3)) <= bits_cat_17_3;
       end if;
-      if accept_c4 = "1" then
-        ray_o_g4(to_integer(accept_slot_c5)) <= bits_cat_17_4;
+      if accept_w_c4 = "1" then
+        ray_o_g4(to_integer(accept_w_slot_c4)) <= bits_cat_17_4;
       end if;
-      if accept_c5 = "1" then
-        ray_o_g5(to_integer(accept_slot_c6)) <= bits_cat_17_5;
+      if accept_w_c5 = "1" then
+        ray_o_g5(to_integer(accept_w_slot_c5)) <= bits_cat_17_5;
       end if;
-      if accept_c6 = "1" then
-        ray_w_g0(to_integer(accept_slot_c7)) <= bits_cat_18;
+      if accept_w_c6 = "1" then
+        ray_w_g0(to_integer(accept_w_slot_c6)) <= bits_cat_18;
       end if;
-      if accept_c7 = "1" then
-        ray_w_g1(to_integer(accept_slot_c8)) <= bits_cat_18_1;
+      if accept_w_c7 = "1" then
+        ray_w_g1(to_integer(accept_w_slot_c7)) <= bits_cat_18_1;
       end if;
-      if accept_c8 = "1" then
-        ray_w_g2(to_integer(accept_slot_c9)) <= bits_cat_18_2;
+      if accept_w_c8 = "1" then
+        ray_w_g2(to_integer(accept_w_slot_c8)) <= bits_cat_18_2;
       end if;
-      if accept_c9 = "1" then
-        ray_w_g3(to_integer(accept_slot_c10)) <= bits_cat_18_3;
+      if accept_w_c9 = "1" then
+        ray_w_g3(to_integer(accept_w_slot_c9)) <= bits_cat_18_3;
       end if;
-      if accept_c10 = "1" then
-        ray_w_g4(to_integer(accept_slot_c11)) <= bits_cat_18_4;
+      if accept_w_c10 = "1" then
+        ray_w_g4(to_integer(accept_w_slot_c10)) <= bits_cat_18_4;
       end if;
-      if accept_c11 = "1" then
-        ray_w_g5(to_integer(accept_slot_c12)) <= bits_cat_18_5;
+      if accept_w_c11 = "1" then
+        ray_w_g5(to_integer(accept_w_slot_c11)) <= bits_cat_18_5;
       end if;
       if res_q_push = "1" then
         res_q_mem0_g0(to_integer(res_q_wr)) <= bits_res_q_din0;
@@ -1213,36 +1235,36 @@ begin
   bits_take_slot_1 <= unsigned(take_slot(6 downto 6));
   bits_take_slot_1_eq_k_1 <= "1" when bits_take_slot_1 = k_1 else "0";
   u1_take <= take and bits_take_slot_1_eq_k_1;
-  bits_accept_slot_c14 <= unsigned(accept_slot_c14(5 downto 0));
-  bits_accept_slot_c15 <= unsigned(accept_slot_c15(5 downto 0));
-  bits_accept_slot_c16 <= unsigned(accept_slot_c16(5 downto 0));
-  bits_accept_slot_c17 <= unsigned(accept_slot_c17(5 downto 0));
-  bits_accept_slot_c18 <= unsigned(accept_slot_c18(5 downto 0));
-  bits_accept_slot_c19 <= unsigned(accept_slot_c19(5 downto 0));
-  bits_accept_slot_c20 <= unsigned(accept_slot_c20(5 downto 0));
-  bits_accept_slot_c21 <= unsigned(accept_slot_c21(5 downto 0));
-  bits_accept_slot_c22 <= unsigned(accept_slot_c22(5 downto 0));
-  bits_accept_slot_c23 <= unsigned(accept_slot_c23(5 downto 0));
-  bits_accept_slot_c24 <= unsigned(accept_slot_c24(5 downto 0));
-  bits_accept_slot_c25 <= unsigned(accept_slot_c25(5 downto 0));
-  bits_accept_slot_c26 <= unsigned(accept_slot_c26(5 downto 0));
-  bits_accept_slot_c27 <= unsigned(accept_slot_c27(5 downto 0));
-  bits_accept_slot_c28 <= unsigned(accept_slot_c28(5 downto 0));
-  bits_accept_slot_c29 <= unsigned(accept_slot_c29(5 downto 0));
-  bits_accept_slot_c30 <= unsigned(accept_slot_c30(5 downto 0));
-  bits_accept_slot_c31 <= unsigned(accept_slot_c31(5 downto 0));
-  bits_accept_slot_c32 <= unsigned(accept_slot_c32(5 downto 0));
-  bits_accept_slot_c33 <= unsigned(accept_slot_c33(5 downto 0));
-  bits_accept_slot_c34 <= unsigned(accept_slot_c34(5 downto 0));
-  bits_accept_slot_c35 <= unsigned(accept_slot_c35(5 downto 0));
-  bits_accept_slot_c36 <= unsigned(accept_slot_c36(5 downto 0));
-  bits_accept_slot_c37 <= unsigned(accept_slot_c37(5 downto 0));
-  bits_accept_slot_c38 <= unsigned(accept_slot_c38(5 downto 0));
-  bits_accept_slot_c39 <= unsigned(accept_slot_c39(5 downto 0));
-  bits_accept_slot_c40 <= unsigned(accept_slot_c40(5 downto 0));
-  bits_accept_slot_c41 <= unsigned(accept_slot_c41(5 downto 0));
-  bits_accept_slot_c42 <= unsigned(accept_slot_c42(5 downto 0));
-  bits_accept_slot_c43 <= unsigned(accept_slot_c43(5 downto 0));
+  bits_accept_w_slot_c12 <= unsigned(accept_w_slot_c12(5 downto 0));
+  bits_accept_w_slot_c13 <= unsigned(accept_w_slot_c13(5 downto 0));
+  bits_accept_w_slot_c14 <= unsigned(accept_w_slot_c14(5 downto 0));
+  bits_accept_w_slot_c15 <= unsigned(accept_w_slot_c15(5 downto 0));
+  bits_accept_w_slot_c16 <= unsigned(accept_w_slot_c16(5 downto 0));
+  bits_accept_w_slot_c17 <= unsigned(accept_w_slot_c17(5 downto 0));
+  bits_accept_w_slot_c18 <= unsigned(accept_w_slot_c18(5 downto 0));
+  bits_accept_w_slot_c19 <= unsigned(accept_w_slot_c19(5 downto 0));
+  bits_accept_w_slot_c20 <= unsigned(accept_w_slot_c20(5 downto 0));
+  bits_accept_w_slot_c21 <= unsigned(accept_w_slot_c21(5 downto 0));
+  bits_accept_w_slot_c22 <= unsigned(accept_w_slot_c22(5 downto 0));
+  bits_accept_w_slot_c23 <= unsigned(accept_w_slot_c23(5 downto 0));
+  bits_accept_w_slot_c24 <= unsigned(accept_w_slot_c24(5 downto 0));
+  bits_accept_w_slot_c25 <= unsigned(accept_w_slot_c25(5 downto 0));
+  bits_accept_w_slot_c26 <= unsigned(accept_w_slot_c26(5 downto 0));
+  bits_accept_w_slot_c27 <= unsigned(accept_w_slot_c27(5 downto 0));
+  bits_accept_w_slot_c28 <= unsigned(accept_w_slot_c28(5 downto 0));
+  bits_accept_w_slot_c29 <= unsigned(accept_w_slot_c29(5 downto 0));
+  bits_accept_w_slot_c30 <= unsigned(accept_w_slot_c30(5 downto 0));
+  bits_accept_w_slot_c31 <= unsigned(accept_w_slot_c31(5 downto 0));
+  bits_accept_w_slot_c32 <= unsigned(accept_w_slot_c32(5 downto 0));
+  bits_accept_w_slot_c33 <= unsigned(accept_w_slot_c33(5 downto 0));
+  bits_accept_w_slot_c34 <= unsigned(accept_w_slot_c34(5 downto 0));
+  bits_accept_w_slot_c35 <= unsigned(accept_w_slot_c35(5 downto 0));
+  bits_accept_w_slot_c36 <= unsigned(accept_w_slot_c36(5 downto 0));
+  bits_accept_w_slot_c37 <= unsigned(accept_w_slot_c37(5 downto 0));
+  bits_accept_w_slot_c38 <= unsigned(accept_w_slot_c38(5 downto 0));
+  bits_accept_w_slot_c39 <= unsigned(accept_w_slot_c39(5 downto 0));
+  bits_accept_w_slot_c40 <= unsigned(accept_w_slot_c40(5 downto 0));
+  bits_accept_w_slot_c41 <= unsigned(accept_w_slot_c41(5 downto 0));
 
   ray_port_regs : process (clk)
   begin
@@ -1325,6 +1347,21 @@ begin
       if box_idle_c1 = "1" then
         box_in_invz <= in_invz;
       end if;
+      if rst = '1' then
+        accept <= unsigned'("0");
+      else
+        accept <= take;
+      end if;
+      if rst = '1' then
+        u0_accept <= unsigned'("0");
+      else
+        u0_accept <= u0_take;
+      end if;
+      if rst = '1' then
+        u1_accept <= unsigned'("0");
+      else
+        u1_accept <= u1_take;
+      end if;
       acc_in_ray_id <= in_ray_id;
       acc_in_ox <= in_ox;
       acc_in_oy <= in_oy;
@@ -1384,301 +1421,299 @@ begin
     end if;
   end process box_idle_copies_regs;
 
-  -- register copies accept_copies: accept and 11 copies, to split its fan-out
+  -- register copies accept_w_copies: accept_w and 11 copies, to split its fan-out
 
-  accept_copies_regs : process (clk)
+  accept_w_copies_regs : process (clk)
   begin
     if rising_edge(clk) then
       if rst = '1' then
-        accept <= unsigned'("0");
+        accept_w <= unsigned'("0");
       else
-        accept <= take;
+        accept_w <= accept;
       end if;
       if rst = '1' then
-        accept_c1 <= unsigned'("0");
+        accept_w_c1 <= unsigned'("0");
       else
-        accept_c1 <= take;
+        accept_w_c1 <= accept;
       end if;
       if rst = '1' then
-        accept_c2 <= unsigned'("0");
+        accept_w_c2 <= unsigned'("0");
       else
-        accept_c2 <= take;
+        accept_w_c2 <= accept;
       end if;
       if rst = '1' then
-        accept_c3 <= unsigned'("0");
+        accept_w_c3 <= unsigned'("0");
       else
-        accept_c3 <= take;
+        accept_w_c3 <= accept;
       end if;
       if rst = '1' then
-        accept_c4 <= unsigned'("0");
+        accept_w_c4 <= unsigned'("0");
       else
-        accept_c4 <= take;
+        accept_w_c4 <= accept;
       end if;
       if rst = '1' then
-        accept_c5 <= unsigned'("0");
+        accept_w_c5 <= unsigned'("0");
       else
-        accept_c5 <= take;
+        accept_w_c5 <= accept;
       end if;
       if rst = '1' then
-        accept_c6 <= unsigned'("0");
+        accept_w_c6 <= unsigned'("0");
       else
-        accept_c6 <= take;
+        accept_w_c6 <= accept;
       end if;
       if rst = '1' then
-        accept_c7 <= unsigned'("0");
+        accept_w_c7 <= unsigned'("0");
       else
-        accept_c7 <= take;
+        accept_w_c7 <= accept;
       end if;
       if rst = '1' then
-        accept_c8 <= unsigned'("0");
+        accept_w_c8 <= unsigned'("0");
       else
-        accept_c8 <= take;
+        accept_w_c8 <= accept;
       end if;
       if rst = '1' then
-        accept_c9 <= unsigned'("0");
+        accept_w_c9 <= unsigned'("0");
       else
-        accept_c9 <= take;
+        accept_w_c9 <= accept;
       end if;
       if rst = '1' then
-        accept_c10 <= unsigned'("0");
+        accept_w_c10 <= unsigned'("0");
       else
-        accept_c10 <= take;
+        accept_w_c10 <= accept;
       end if;
       if rst = '1' then
-        accept_c11 <= unsigned'("0");
+        accept_w_c11 <= unsigned'("0");
       else
-        accept_c11 <= take;
+        accept_w_c11 <= accept;
       end if;
     end if;
-  end process accept_copies_regs;
+  end process accept_w_copies_regs;
 
-  -- register copies accept_slot_copies: accept_slot and 43 copies, to split its fan-out
+  -- register copies accept_w_slot_copies: accept_w_slot and 41 copies, to split its fan-out
+
+  accept_w_slot_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      accept_w_slot <= accept_slot;
+      accept_w_slot_c1 <= accept_slot;
+      accept_w_slot_c2 <= accept_slot;
+      accept_w_slot_c3 <= accept_slot;
+      accept_w_slot_c4 <= accept_slot;
+      accept_w_slot_c5 <= accept_slot;
+      accept_w_slot_c6 <= accept_slot;
+      accept_w_slot_c7 <= accept_slot;
+      accept_w_slot_c8 <= accept_slot;
+      accept_w_slot_c9 <= accept_slot;
+      accept_w_slot_c10 <= accept_slot;
+      accept_w_slot_c11 <= accept_slot;
+      accept_w_slot_c12 <= accept_slot;
+      accept_w_slot_c13 <= accept_slot;
+      accept_w_slot_c14 <= accept_slot;
+      accept_w_slot_c15 <= accept_slot;
+      accept_w_slot_c16 <= accept_slot;
+      accept_w_slot_c17 <= accept_slot;
+      accept_w_slot_c18 <= accept_slot;
+      accept_w_slot_c19 <= accept_slot;
+      accept_w_slot_c20 <= accept_slot;
+      accept_w_slot_c21 <= accept_slot;
+      accept_w_slot_c22 <= accept_slot;
+      accept_w_slot_c23 <= accept_slot;
+      accept_w_slot_c24 <= accept_slot;
+      accept_w_slot_c25 <= accept_slot;
+      accept_w_slot_c26 <= accept_slot;
+      accept_w_slot_c27 <= accept_slot;
+      accept_w_slot_c28 <= accept_slot;
+      accept_w_slot_c29 <= accept_slot;
+      accept_w_slot_c30 <= accept_slot;
+      accept_w_slot_c31 <= accept_slot;
+      accept_w_slot_c32 <= accept_slot;
+      accept_w_slot_c33 <= accept_slot;
+      accept_w_slot_c34 <= accept_slot;
+      accept_w_slot_c35 <= accept_slot;
+      accept_w_slot_c36 <= accept_slot;
+      accept_w_slot_c37 <= accept_slot;
+      accept_w_slot_c38 <= accept_slot;
+      accept_w_slot_c39 <= accept_slot;
+      accept_w_slot_c40 <= accept_slot;
+      accept_w_slot_c41 <= accept_slot;
+    end if;
+  end process accept_w_slot_copies_regs;
+
+  -- register copies u0_accept_w_copies: u0_accept_w and 14 copies, to split its fan-out
+
+  u0_accept_w_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        u0_accept_w <= unsigned'("0");
+      else
+        u0_accept_w <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c1 <= unsigned'("0");
+      else
+        u0_accept_w_c1 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c2 <= unsigned'("0");
+      else
+        u0_accept_w_c2 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c3 <= unsigned'("0");
+      else
+        u0_accept_w_c3 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c4 <= unsigned'("0");
+      else
+        u0_accept_w_c4 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c5 <= unsigned'("0");
+      else
+        u0_accept_w_c5 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c6 <= unsigned'("0");
+      else
+        u0_accept_w_c6 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c7 <= unsigned'("0");
+      else
+        u0_accept_w_c7 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c8 <= unsigned'("0");
+      else
+        u0_accept_w_c8 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c9 <= unsigned'("0");
+      else
+        u0_accept_w_c9 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c10 <= unsigned'("0");
+      else
+        u0_accept_w_c10 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c11 <= unsigned'("0");
+      else
+        u0_accept_w_c11 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c12 <= unsigned'("0");
+      else
+        u0_accept_w_c12 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c13 <= unsigned'("0");
+      else
+        u0_accept_w_c13 <= u0_accept;
+      end if;
+      if rst = '1' then
+        u0_accept_w_c14 <= unsigned'("0");
+      else
+        u0_accept_w_c14 <= u0_accept;
+      end if;
+    end if;
+  end process u0_accept_w_copies_regs;
+
+  -- register copies u1_accept_w_copies: u1_accept_w and 14 copies, to split its fan-out
+
+  u1_accept_w_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        u1_accept_w <= unsigned'("0");
+      else
+        u1_accept_w <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c1 <= unsigned'("0");
+      else
+        u1_accept_w_c1 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c2 <= unsigned'("0");
+      else
+        u1_accept_w_c2 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c3 <= unsigned'("0");
+      else
+        u1_accept_w_c3 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c4 <= unsigned'("0");
+      else
+        u1_accept_w_c4 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c5 <= unsigned'("0");
+      else
+        u1_accept_w_c5 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c6 <= unsigned'("0");
+      else
+        u1_accept_w_c6 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c7 <= unsigned'("0");
+      else
+        u1_accept_w_c7 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c8 <= unsigned'("0");
+      else
+        u1_accept_w_c8 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c9 <= unsigned'("0");
+      else
+        u1_accept_w_c9 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c10 <= unsigned'("0");
+      else
+        u1_accept_w_c10 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c11 <= unsigned'("0");
+      else
+        u1_accept_w_c11 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c12 <= unsigned'("0");
+      else
+        u1_accept_w_c12 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c13 <= unsigned'("0");
+      else
+        u1_accept_w_c13 <= u1_accept;
+      end if;
+      if rst = '1' then
+        u1_accept_w_c14 <= unsigned'("0");
+      else
+        u1_accept_w_c14 <= u1_accept;
+      end if;
+    end if;
+  end process u1_accept_w_copies_regs;
+
+  -- register copies accept_slot_copies: accept_slot and 1 copies, to split its fan-out
 
   accept_slot_copies_regs : process (clk)
   begin
     if rising_edge(clk) then
       accept_slot <= take_slot;
       accept_slot_c1 <= take_slot;
-      accept_slot_c2 <= take_slot;
-      accept_slot_c3 <= take_slot;
-      accept_slot_c4 <= take_slot;
-      accept_slot_c5 <= take_slot;
-      accept_slot_c6 <= take_slot;
-      accept_slot_c7 <= take_slot;
-      accept_slot_c8 <= take_slot;
-      accept_slot_c9 <= take_slot;
-      accept_slot_c10 <= take_slot;
-      accept_slot_c11 <= take_slot;
-      accept_slot_c12 <= take_slot;
-      accept_slot_c13 <= take_slot;
-      accept_slot_c14 <= take_slot;
-      accept_slot_c15 <= take_slot;
-      accept_slot_c16 <= take_slot;
-      accept_slot_c17 <= take_slot;
-      accept_slot_c18 <= take_slot;
-      accept_slot_c19 <= take_slot;
-      accept_slot_c20 <= take_slot;
-      accept_slot_c21 <= take_slot;
-      accept_slot_c22 <= take_slot;
-      accept_slot_c23 <= take_slot;
-      accept_slot_c24 <= take_slot;
-      accept_slot_c25 <= take_slot;
-      accept_slot_c26 <= take_slot;
-      accept_slot_c27 <= take_slot;
-      accept_slot_c28 <= take_slot;
-      accept_slot_c29 <= take_slot;
-      accept_slot_c30 <= take_slot;
-      accept_slot_c31 <= take_slot;
-      accept_slot_c32 <= take_slot;
-      accept_slot_c33 <= take_slot;
-      accept_slot_c34 <= take_slot;
-      accept_slot_c35 <= take_slot;
-      accept_slot_c36 <= take_slot;
-      accept_slot_c37 <= take_slot;
-      accept_slot_c38 <= take_slot;
-      accept_slot_c39 <= take_slot;
-      accept_slot_c40 <= take_slot;
-      accept_slot_c41 <= take_slot;
-      accept_slot_c42 <= take_slot;
-      accept_slot_c43 <= take_slot;
     end if;
   end process accept_slot_copies_regs;
-
-  -- register copies u0_accept_copies: u0_accept and 15 copies, to split its fan-out
-
-  u0_accept_copies_regs : process (clk)
-  begin
-    if rising_edge(clk) then
-      if rst = '1' then
-        u0_accept <= unsigned'("0");
-      else
-        u0_accept <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c1 <= unsigned'("0");
-      else
-        u0_accept_c1 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c2 <= unsigned'("0");
-      else
-        u0_accept_c2 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c3 <= unsigned'("0");
-      else
-        u0_accept_c3 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c4 <= unsigned'("0");
-      else
-        u0_accept_c4 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c5 <= unsigned'("0");
-      else
-        u0_accept_c5 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c6 <= unsigned'("0");
-      else
-        u0_accept_c6 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c7 <= unsigned'("0");
-      else
-        u0_accept_c7 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c8 <= unsigned'("0");
-      else
-        u0_accept_c8 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c9 <= unsigned'("0");
-      else
-        u0_accept_c9 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c10 <= unsigned'("0");
-      else
-        u0_accept_c10 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c11 <= unsigned'("0");
-      else
-        u0_accept_c11 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c12 <= unsigned'("0");
-      else
-        u0_accept_c12 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c13 <= unsigned'("0");
-      else
-        u0_accept_c13 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c14 <= unsigned'("0");
-      else
-        u0_accept_c14 <= u0_take;
-      end if;
-      if rst = '1' then
-        u0_accept_c15 <= unsigned'("0");
-      else
-        u0_accept_c15 <= u0_take;
-      end if;
-    end if;
-  end process u0_accept_copies_regs;
-
-  -- register copies u1_accept_copies: u1_accept and 15 copies, to split its fan-out
-
-  u1_accept_copies_regs : process (clk)
-  begin
-    if rising_edge(clk) then
-      if rst = '1' then
-        u1_accept <= unsigned'("0");
-      else
-        u1_accept <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c1 <= unsigned'("0");
-      else
-        u1_accept_c1 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c2 <= unsigned'("0");
-      else
-        u1_accept_c2 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c3 <= unsigned'("0");
-      else
-        u1_accept_c3 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c4 <= unsigned'("0");
-      else
-        u1_accept_c4 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c5 <= unsigned'("0");
-      else
-        u1_accept_c5 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c6 <= unsigned'("0");
-      else
-        u1_accept_c6 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c7 <= unsigned'("0");
-      else
-        u1_accept_c7 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c8 <= unsigned'("0");
-      else
-        u1_accept_c8 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c9 <= unsigned'("0");
-      else
-        u1_accept_c9 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c10 <= unsigned'("0");
-      else
-        u1_accept_c10 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c11 <= unsigned'("0");
-      else
-        u1_accept_c11 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c12 <= unsigned'("0");
-      else
-        u1_accept_c12 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c13 <= unsigned'("0");
-      else
-        u1_accept_c13 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c14 <= unsigned'("0");
-      else
-        u1_accept_c14 <= u1_take;
-      end if;
-      if rst = '1' then
-        u1_accept_c15 <= unsigned'("0");
-      else
-        u1_accept_c15 <= u1_take;
-      end if;
-    end if;
-  end process u1_accept_copies_regs;
 
   -- stage box_exit: the scene-box exit distance: three plane distances, the smallest
   box_axis <= box_phase - k_1_1;
@@ -2172,6 +2207,7 @@ begin
   cat_39 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
   mux_u0_done_avail <= cat_37 when u0_done_avail = "1" else cat_39;
   or_40 <= u0_done_avail or u1_done_avail;
+  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(done_slot_r_c8) & std_logic_vector(done_slot_r_c7) & std_logic_vector(done_slot_r_c6) & std_logic_vector(done_slot_r_c5) & std_logic_vector(done_slot_r_c4) & std_logic_vector(done_slot_r_c3) & std_logic_vector(done_slot_r_c2) & std_logic_vector(done_slot_r_c1)));
 
   done_regs : process (clk)
   begin
@@ -2196,13 +2232,29 @@ begin
       else
         done_valid_r <= or_40;
       end if;
-      done_slot_r <= mux_u0_done_avail;
     end if;
   end process done_regs;
 
+  -- register copies done_slot_r_copies: done_slot_r and 8 copies, to split its fan-out
+
+  done_slot_r_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      done_slot_r <= mux_u0_done_avail;
+      done_slot_r_c1 <= mux_u0_done_avail;
+      done_slot_r_c2 <= mux_u0_done_avail;
+      done_slot_r_c3 <= mux_u0_done_avail;
+      done_slot_r_c4 <= mux_u0_done_avail;
+      done_slot_r_c5 <= mux_u0_done_avail;
+      done_slot_r_c6 <= mux_u0_done_avail;
+      done_slot_r_c7 <= mux_u0_done_avail;
+      done_slot_r_c8 <= mux_u0_done_avail;
+    end if;
+  end process done_slot_r_copies_regs;
+
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
-  cat_42 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
+  cat_42 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
+  cat_43 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
   res_take <= res_take_c;
   res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
   mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
@@ -2217,14 +2269,14 @@ begin
   res_q_count_next <= res_q_count_if_pop when res_take = "1" else res_q_count_if_kept;
   res_q_count_eq_k_0_5 <= "1" when res_q_count = k_0_5 else "0";
   res_q_one_left <= "1" when res_q_count = k_1_5 else "0";
-  and_45 <= res_q_one_left and res_take;
-  res_q_drained <= res_q_count_eq_k_0_5 or and_45;
+  and_46 <= res_q_one_left and res_take;
+  res_q_drained <= res_q_count_eq_k_0_5 or and_46;
   res_q_bypass_c <= res_q_push_c1 and res_q_drained;
   k_1_5_lt_res_q_count <= "1" when k_1_5 < res_q_count else "0";
-  or_48 <= res_q_push_c1 or k_1_5_lt_res_q_count;
+  or_49 <= res_q_push_c1 or k_1_5_lt_res_q_count;
   not_res_take <= not res_take;
-  and_49 <= res_q_one_left and not_res_take;
-  res_q_nonempty_c <= or_48 or and_49;
+  and_50 <= res_q_one_left and not_res_take;
+  res_q_nonempty_c <= or_49 or and_50;
   bits_res_q_din0 <= unsigned(res_q_din0(15 downto 0));
   bits_res_q_din0_1 <= unsigned(res_q_din0(31 downto 16));
   bits_res_q_din0_2 <= unsigned(res_q_din0(47 downto 32));
@@ -2321,7 +2373,7 @@ begin
       else
         res_q_nonempty <= res_q_nonempty_c;
       end if;
-      res_q_din0 <= cat_41;
+      res_q_din0 <= cat_42;
       if rst = '1' then
         res_q_rd0_p1 <= unsigned'("0000");
       else
@@ -2363,7 +2415,7 @@ begin
       if res_q_push = "1" then
         res_q_din_r0 <= res_q_din0;
       end if;
-      res_q_din1 <= cat_42;
+      res_q_din1 <= cat_43;
       if rst = '1' then
         res_q_rd1_p1 <= unsigned'("0000");
       else
@@ -2454,36 +2506,36 @@ begin
     port map (
       clk => clk,
       rst => rst,
-      ray_we_g0 => u0_accept,
-      ray_slot_g0 => bits_accept_slot_c14,
-      ray_we_g1 => u0_accept_c1,
-      ray_slot_g1 => bits_accept_slot_c15,
-      ray_we_g2 => u0_accept_c2,
-      ray_slot_g2 => bits_accept_slot_c16,
-      ray_we_g3 => u0_accept_c3,
-      ray_slot_g3 => bits_accept_slot_c17,
-      ray_we_g4 => u0_accept_c4,
-      ray_slot_g4 => bits_accept_slot_c18,
-      ray_we_g5 => u0_accept_c5,
-      ray_slot_g5 => bits_accept_slot_c19,
-      ray_we_g6 => u0_accept_c6,
-      ray_slot_g6 => bits_accept_slot_c20,
-      ray_we_g7 => u0_accept_c7,
-      ray_slot_g7 => bits_accept_slot_c21,
-      ray_we_g8 => u0_accept_c8,
-      ray_slot_g8 => bits_accept_slot_c22,
-      ray_we_g9 => u0_accept_c9,
-      ray_slot_g9 => bits_accept_slot_c23,
-      ray_we_g10 => u0_accept_c10,
-      ray_slot_g10 => bits_accept_slot_c24,
-      ray_we_g11 => u0_accept_c11,
-      ray_slot_g11 => bits_accept_slot_c25,
-      ray_we_g12 => u0_accept_c12,
-      ray_slot_g12 => bits_accept_slot_c26,
-      ray_we_g13 => u0_accept_c13,
-      ray_slot_g13 => bits_accept_slot_c27,
-      ray_we_g14 => u0_accept_c14,
-      ray_slot_g14 => bits_accept_slot_c28,
+      ray_we_g0 => u0_accept_w,
+      ray_slot_g0 => bits_accept_w_slot_c12,
+      ray_we_g1 => u0_accept_w_c1,
+      ray_slot_g1 => bits_accept_w_slot_c13,
+      ray_we_g2 => u0_accept_w_c2,
+      ray_slot_g2 => bits_accept_w_slot_c14,
+      ray_we_g3 => u0_accept_w_c3,
+      ray_slot_g3 => bits_accept_w_slot_c15,
+      ray_we_g4 => u0_accept_w_c4,
+      ray_slot_g4 => bits_accept_w_slot_c16,
+      ray_we_g5 => u0_accept_w_c5,
+      ray_slot_g5 => bits_accept_w_slot_c17,
+      ray_we_g6 => u0_accept_w_c6,
+      ray_slot_g6 => bits_accept_w_slot_c18,
+      ray_we_g7 => u0_accept_w_c7,
+      ray_slot_g7 => bits_accept_w_slot_c19,
+      ray_we_g8 => u0_accept_w_c8,
+      ray_slot_g8 => bits_accept_w_slot_c20,
+      ray_we_g9 => u0_accept_w_c9,
+      ray_slot_g9 => bits_accept_w_slot_c21,
+      ray_we_g10 => u0_accept_w_c10,
+      ray_slot_g10 => bits_accept_w_slot_c22,
+      ray_we_g11 => u0_accept_w_c11,
+      ray_slot_g11 => bits_accept_w_slot_c23,
+      ray_we_g12 => u0_accept_w_c12,
+      ray_slot_g12 => bits_accept_w_slot_c24,
+      ray_we_g13 => u0_accept_w_c13,
+      ray_slot_g13 => bits_accept_w_slot_c25,
+      ray_we_g14 => u0_accept_w_c14,
+      ray_slot_g14 => bits_accept_w_slot_c26,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -2501,7 +2553,7 @@ begin
       merge_sp => merge_sp,
       free_valid => u0_free,
       free_slot => bits_free_slot_1,
-      alloc => u0_accept_c15,
+      alloc => u0_accept,
       leaf_pop => u0_leaf_pop,
       done_pop => u0_done_pop,
       node_word => u0_node_word,
@@ -2528,36 +2580,36 @@ begin
     port map (
       clk => clk,
       rst => rst,
-      ray_we_g0 => u1_accept,
-      ray_slot_g0 => bits_accept_slot_c29,
-      ray_we_g1 => u1_accept_c1,
-      ray_slot_g1 => bits_accept_slot_c30,
-      ray_we_g2 => u1_accept_c2,
-      ray_slot_g2 => bits_accept_slot_c31,
-      ray_we_g3 => u1_accept_c3,
-      ray_slot_g3 => bits_accept_slot_c32,
-      ray_we_g4 => u1_accept_c4,
-      ray_slot_g4 => bits_accept_slot_c33,
-      ray_we_g5 => u1_accept_c5,
-      ray_slot_g5 => bits_accept_slot_c34,
-      ray_we_g6 => u1_accept_c6,
-      ray_slot_g6 => bits_accept_slot_c35,
-      ray_we_g7 => u1_accept_c7,
-      ray_slot_g7 => bits_accept_slot_c36,
-      ray_we_g8 => u1_accept_c8,
-      ray_slot_g8 => bits_accept_slot_c37,
-      ray_we_g9 => u1_accept_c9,
-      ray_slot_g9 => bits_accept_slot_c38,
-      ray_we_g10 => u1_accept_c10,
-      ray_slot_g10 => bits_accept_slot_c39,
-      ray_we_g11 => u1_accept_c11,
-      ray_slot_g11 => bits_accept_slot_c40,
-      ray_we_g12 => u1_accept_c12,
-      ray_slot_g12 => bits_accept_slot_c41,
-      ray_we_g13 => u1_accept_c13,
-      ray_slot_g13 => bits_accept_slot_c42,
-      ray_we_g14 => u1_accept_c14,
-      ray_slot_g14 => bits_accept_slot_c43,
+      ray_we_g0 => u1_accept_w,
+      ray_slot_g0 => bits_accept_w_slot_c27,
+      ray_we_g1 => u1_accept_w_c1,
+      ray_slot_g1 => bits_accept_w_slot_c28,
+      ray_we_g2 => u1_accept_w_c2,
+      ray_slot_g2 => bits_accept_w_slot_c29,
+      ray_we_g3 => u1_accept_w_c3,
+      ray_slot_g3 => bits_accept_w_slot_c30,
+      ray_we_g4 => u1_accept_w_c4,
+      ray_slot_g4 => bits_accept_w_slot_c31,
+      ray_we_g5 => u1_accept_w_c5,
+      ray_slot_g5 => bits_accept_w_slot_c32,
+      ray_we_g6 => u1_accept_w_c6,
+      ray_slot_g6 => bits_accept_w_slot_c33,
+      ray_we_g7 => u1_accept_w_c7,
+      ray_slot_g7 => bits_accept_w_slot_c34,
+      ray_we_g8 => u1_accept_w_c8,
+      ray_slot_g8 => bits_accept_w_slot_c35,
+      ray_we_g9 => u1_accept_w_c9,
+      ray_slot_g9 => bits_accept_w_slot_c36,
+      ray_we_g10 => u1_accept_w_c10,
+      ray_slot_g10 => bits_accept_w_slot_c37,
+      ray_we_g11 => u1_accept_w_c11,
+      ray_slot_g11 => bits_accept_w_slot_c38,
+      ray_we_g12 => u1_accept_w_c12,
+      ray_slot_g12 => bits_accept_w_slot_c39,
+      ray_we_g13 => u1_accept_w_c13,
+      ray_slot_g13 => bits_accept_w_slot_c40,
+      ray_we_g14 => u1_accept_w_c14,
+      ray_slot_g14 => bits_accept_w_slot_c41,
       ox => acc_in_ox,
       oy => acc_in_oy,
       oz => acc_in_oz,
@@ -2575,7 +2627,7 @@ begin
       merge_sp => merge_sp,
       free_valid => u1_free,
       free_slot => bits_free_slot_3,
-      alloc => u1_accept_c15,
+      alloc => u1_accept,
       leaf_pop => u1_leaf_pop,
       done_pop => u1_done_pop,
       node_word => u1_node_word,
@@ -2676,10 +2728,11 @@ begin
       u => u_intersect_u,
       v => u_intersect_v,
       id_we => accept,
-      id_slot => accept_slot_c13,
+      id_slot => accept_slot_c1,
       id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,
+      done_slot_copies => cat_41,
       merge_valid0 => u_closest_merge_valid0,
       merge_slot0 => u_closest_merge_slot0,
       merge_hit0 => u_closest_merge_hit0,

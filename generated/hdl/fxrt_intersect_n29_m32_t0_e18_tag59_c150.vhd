@@ -238,7 +238,7 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal s50_kp : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal s50_kq : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
-  -- stage s56_uv: the barycentric coordinates u, v
+  -- stage s56_bary: e1p·kq, e1q·kp, e2q·kp, e2p·kq
   type s1_e1p_d49_sr_t is array (1 to 49) of signed(31 downto 0);
   signal s1_e1p_d49_sr : s1_e1p_d49_sr_t := (others => (others => '0'));
   signal s1_e1p_d49 : signed(31 downto 0);
@@ -255,176 +255,183 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal u_bary_products_p1 : signed(63 downto 0);
   signal u_bary_products_p2 : signed(63 downto 0);
   signal u_bary_products_p3 : signed(63 downto 0);
-  signal rs_u_bary_products_p0 : signed(64 downto 0);
-  signal rs_u_bary_products_p1 : signed(64 downto 0);
-  signal u_int : signed(64 downto 0);
-  signal rs_u_bary_products_p2 : signed(64 downto 0);
-  signal rs_u_bary_products_p3 : signed(64 downto 0);
-  signal v_int : signed(64 downto 0);
-  signal s56_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s56_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s56_a1 : signed(63 downto 0) := signed'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal s56_a2 : signed(63 downto 0) := signed'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal s56_b1 : signed(63 downto 0) := signed'("0000000000000000000000000000000000000000000000000000000000000000");
+  signal s56_b2 : signed(63 downto 0) := signed'("0000000000000000000000000000000000000000000000000000000000000000");
 
-  -- stage s57_test: u + v as two short sums; the signs
-  signal u_s56_u : unsigned(64 downto 0);
-  signal bits_u_s56_u : unsigned(15 downto 0);
-  signal rs_bits_u_s56_u : unsigned(16 downto 0);
-  signal u_s56_v : unsigned(64 downto 0);
-  signal bits_u_s56_v : unsigned(15 downto 0);
-  signal rs_bits_u_s56_v : unsigned(16 downto 0);
+  -- stage s57_uv: the barycentric coordinates u, v
+  signal rs_s56_a1 : signed(64 downto 0);
+  signal rs_s56_a2 : signed(64 downto 0);
+  signal u_int : signed(64 downto 0);
+  signal rs_s56_b1 : signed(64 downto 0);
+  signal rs_s56_b2 : signed(64 downto 0);
+  signal v_int : signed(64 downto 0);
+  signal s57_u : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+  signal s57_v : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
+
+  -- stage s58_test: u + v as two short sums; the signs
+  signal u_s57_u : unsigned(64 downto 0);
+  signal bits_u_s57_u : unsigned(15 downto 0);
+  signal rs_bits_u_s57_u : unsigned(16 downto 0);
+  signal u_s57_v : unsigned(64 downto 0);
+  signal bits_u_s57_v : unsigned(15 downto 0);
+  signal rs_bits_u_s57_v : unsigned(16 downto 0);
   signal uv_sum_high : unsigned(16 downto 0);
-  signal u_s56_u_1 : unsigned(64 downto 0);
-  signal bits_u_s56_u_1 : unsigned(48 downto 0);
-  signal rs_bits_u_s56_u_1 : unsigned(49 downto 0);
-  signal u_s56_v_1 : unsigned(64 downto 0);
-  signal bits_u_s56_v_1 : unsigned(48 downto 0);
-  signal rs_bits_u_s56_v_1 : unsigned(49 downto 0);
+  signal u_s57_u_1 : unsigned(64 downto 0);
+  signal bits_u_s57_u_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s57_u_1 : unsigned(49 downto 0);
+  signal u_s57_v_1 : unsigned(64 downto 0);
+  signal bits_u_s57_v_1 : unsigned(48 downto 0);
+  signal rs_bits_u_s57_v_1 : unsigned(49 downto 0);
   signal uv_sum_low : unsigned(49 downto 0);
   constant k_0_1 : signed(64 downto 0) := signed'("00000000000000000000000000000000000000000000000000000000000000000");
-  signal s56_u_lt_k_0_1 : unsigned(0 downto 0);
-  signal s56_v_lt_k_0_1 : unsigned(0 downto 0);
+  signal s57_u_lt_k_0_1 : unsigned(0 downto 0);
+  signal s57_v_lt_k_0_1 : unsigned(0 downto 0);
   signal negative : unsigned(0 downto 0);
-  signal s57_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
-  signal s57_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
-  signal s57_neg : unsigned(0 downto 0) := unsigned'("0");
-
-  -- stage s58_limit: u + v above the limit, by bytes
-  signal bits_s57_hs : unsigned(15 downto 0);
-  signal bits_bits_s57_hs : unsigned(7 downto 0);
-  constant k_0_2 : unsigned(7 downto 0) := unsigned'("00000000");
-  signal ne_16 : unsigned(0 downto 0);
-  signal bits_bits_s57_hs_1 : unsigned(7 downto 0);
-  signal ne_17 : unsigned(0 downto 0);
-  signal high : unsigned(1 downto 0);
-  signal bits_s57_hs_1 : unsigned(0 downto 0);
-  signal bits_s57_ls : unsigned(0 downto 0);
-  signal bits_s57_ls_1 : unsigned(48 downto 0);
-  signal bits_bits_s57_ls_1 : unsigned(0 downto 0);
-  constant k_0_3 : unsigned(0 downto 0) := unsigned'("0");
-  signal ne_19 : unsigned(0 downto 0);
-  signal bits_bits_s57_ls_1_1 : unsigned(7 downto 0);
-  signal ne_20 : unsigned(0 downto 0);
-  signal bits_bits_s57_ls_1_2 : unsigned(7 downto 0);
-  signal ne_21 : unsigned(0 downto 0);
-  signal bits_bits_s57_ls_1_3 : unsigned(7 downto 0);
-  signal ne_22 : unsigned(0 downto 0);
-  signal bits_bits_s57_ls_1_4 : unsigned(7 downto 0);
-  signal ne_23 : unsigned(0 downto 0);
-  signal bits_bits_s57_ls_1_5 : unsigned(7 downto 0);
-  signal ne_24 : unsigned(0 downto 0);
-  signal bits_bits_s57_ls_1_6 : unsigned(7 downto 0);
-  signal ne_25 : unsigned(0 downto 0);
-  signal low : unsigned(6 downto 0);
-  signal s58_high : unsigned(1 downto 0) := unsigned'("00");
-  signal s58_h0 : unsigned(0 downto 0) := unsigned'("0");
-  signal s58_lk : unsigned(0 downto 0) := unsigned'("0");
-  signal s58_low : unsigned(6 downto 0) := unsigned'("0000000");
+  signal s58_hs : unsigned(16 downto 0) := unsigned'("00000000000000000");
+  signal s58_ls : unsigned(49 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000");
   signal s58_neg : unsigned(0 downto 0) := unsigned'("0");
 
-  -- stage s59_hit: the hit bit
+  -- stage s59_limit: u + v above the limit, by bytes
+  signal bits_s58_hs : unsigned(15 downto 0);
+  signal bits_bits_s58_hs : unsigned(7 downto 0);
+  constant k_0_2 : unsigned(7 downto 0) := unsigned'("00000000");
+  signal ne_16 : unsigned(0 downto 0);
+  signal bits_bits_s58_hs_1 : unsigned(7 downto 0);
+  signal ne_17 : unsigned(0 downto 0);
+  signal high : unsigned(1 downto 0);
+  signal bits_s58_hs_1 : unsigned(0 downto 0);
+  signal bits_s58_ls : unsigned(0 downto 0);
+  signal bits_s58_ls_1 : unsigned(48 downto 0);
+  signal bits_bits_s58_ls_1 : unsigned(0 downto 0);
+  constant k_0_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal ne_19 : unsigned(0 downto 0);
+  signal bits_bits_s58_ls_1_1 : unsigned(7 downto 0);
+  signal ne_20 : unsigned(0 downto 0);
+  signal bits_bits_s58_ls_1_2 : unsigned(7 downto 0);
+  signal ne_21 : unsigned(0 downto 0);
+  signal bits_bits_s58_ls_1_3 : unsigned(7 downto 0);
+  signal ne_22 : unsigned(0 downto 0);
+  signal bits_bits_s58_ls_1_4 : unsigned(7 downto 0);
+  signal ne_23 : unsigned(0 downto 0);
+  signal bits_bits_s58_ls_1_5 : unsigned(7 downto 0);
+  signal ne_24 : unsigned(0 downto 0);
+  signal bits_bits_s58_ls_1_6 : unsigned(7 downto 0);
+  signal ne_25 : unsigned(0 downto 0);
+  signal low : unsigned(6 downto 0);
+  signal s59_high : unsigned(1 downto 0) := unsigned'("00");
+  signal s59_h0 : unsigned(0 downto 0) := unsigned'("0");
+  signal s59_lk : unsigned(0 downto 0) := unsigned'("0");
+  signal s59_low : unsigned(6 downto 0) := unsigned'("0000000");
+  signal s59_neg : unsigned(0 downto 0) := unsigned'("0");
+
+  -- stage s60_hit: the hit bit
   constant k_0_4 : unsigned(6 downto 0) := unsigned'("0000000");
-  signal s58_low_ne_k_0_4 : unsigned(0 downto 0);
-  signal s58_high_ne_k_0 : unsigned(0 downto 0);
+  signal s59_low_ne_k_0_4 : unsigned(0 downto 0);
+  signal s59_high_ne_k_0 : unsigned(0 downto 0);
   signal or_27 : unsigned(0 downto 0);
-  signal s58_h0_and_or_27 : unsigned(0 downto 0);
+  signal s59_h0_and_or_27 : unsigned(0 downto 0);
   signal or_28 : unsigned(0 downto 0);
   signal and_29 : unsigned(0 downto 0);
   signal over : unsigned(0 downto 0);
-  signal s58_neg_or_over : unsigned(0 downto 0);
-  signal not_s58_neg_or_over : unsigned(0 downto 0);
-  type u_div_ok_d15_sr_t is array (1 to 15) of unsigned(0 downto 0);
-  signal u_div_ok_d15_sr : u_div_ok_d15_sr_t := (others => (others => '0'));
-  signal u_div_ok_d15 : unsigned(0 downto 0);
+  signal s59_neg_or_over : unsigned(0 downto 0);
+  signal not_s59_neg_or_over : unsigned(0 downto 0);
+  type u_div_ok_d16_sr_t is array (1 to 16) of unsigned(0 downto 0);
+  signal u_div_ok_d16_sr : u_div_ok_d16_sr_t := (others => (others => '0'));
+  signal u_div_ok_d16 : unsigned(0 downto 0);
   signal hit_c : unsigned(0 downto 0);
-  signal s59_hit : unsigned(0 downto 0) := unsigned'("0");
-
-  -- stage s60_result: the barycentric test; t, u, v zeroed on a miss
-  type u_div_t_1_d16_sr_t is array (1 to 16) of unsigned(29 downto 0);
-  signal u_div_t_1_d16_sr : u_div_t_1_d16_sr_t := (others => (others => '0'));
-  signal u_div_t_1_d16 : unsigned(29 downto 0);
-  type s56_u_d3_sr_t is array (1 to 3) of signed(64 downto 0);
-  signal s56_u_d3_sr : s56_u_d3_sr_t := (others => (others => '0'));
-  signal s56_u_d3 : signed(64 downto 0);
-  type s56_v_d3_sr_t is array (1 to 3) of signed(64 downto 0);
-  signal s56_v_d3_sr : s56_v_d3_sr_t := (others => (others => '0'));
-  signal s56_v_d3 : signed(64 downto 0);
-  signal s1_valid_d58_1 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_2 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_3 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_4 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_5 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_6 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_7 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_8 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_9 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_10 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_11 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_12 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_13 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_14 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_15 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_16 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_17 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_18 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_19 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_20 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_21 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_22 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_23 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_24 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_25 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_26 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_27 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_28 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_29 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_30 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_31 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_32 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_33 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_34 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_35 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_36 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_37 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_38 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_39 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_40 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_41 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_42 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_43 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_44 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_45 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_46 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_47 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_48 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_49 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_50 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_51 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_52 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_53 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_54 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_55 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_56 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_57 : unsigned(0 downto 0) := unsigned'("0");
-  signal s1_valid_d58_58 : unsigned(0 downto 0) := unsigned'("0");
-  type s1_tag_d58_sr_t is array (1 to 58) of unsigned(58 downto 0);
-  signal s1_tag_d58_sr : s1_tag_d58_sr_t := (others => (others => '0'));
-  signal s1_tag_d58 : unsigned(58 downto 0);
-  constant k_0_5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal mux_s59_hit : unsigned(29 downto 0);
-  signal shr_s56_u_d3 : signed(64 downto 0);
-  signal rs_shr_s56_u_d3 : signed(31 downto 0);
-  signal u_rs_shr_s56_u_d3 : unsigned(31 downto 0);
-  constant k_0_6 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal mux_s59_hit_1 : unsigned(31 downto 0);
-  signal shr_s56_v_d3 : signed(64 downto 0);
-  signal rs_shr_s56_v_d3 : signed(31 downto 0);
-  signal u_rs_shr_s56_v_d3 : unsigned(31 downto 0);
-  signal mux_s59_hit_2 : unsigned(31 downto 0);
-  signal s60_valid_out : unsigned(0 downto 0) := unsigned'("0");
-  signal s60_tag_out : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal s60_hit : unsigned(0 downto 0) := unsigned'("0");
-  signal s60_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
-  signal s60_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
-  signal s60_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+
+  -- stage s61_result: the barycentric test; t, u, v zeroed on a miss
+  type u_div_t_1_d17_sr_t is array (1 to 17) of unsigned(29 downto 0);
+  signal u_div_t_1_d17_sr : u_div_t_1_d17_sr_t := (others => (others => '0'));
+  signal u_div_t_1_d17 : unsigned(29 downto 0);
+  type s57_u_d3_sr_t is array (1 to 3) of signed(64 downto 0);
+  signal s57_u_d3_sr : s57_u_d3_sr_t := (others => (others => '0'));
+  signal s57_u_d3 : signed(64 downto 0);
+  type s57_v_d3_sr_t is array (1 to 3) of signed(64 downto 0);
+  signal s57_v_d3_sr : s57_v_d3_sr_t := (others => (others => '0'));
+  signal s57_v_d3 : signed(64 downto 0);
+  signal s1_valid_d59_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_2 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_3 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_4 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_5 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_6 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_7 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_8 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_9 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_10 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_11 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_12 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_13 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_14 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_15 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_16 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_17 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_18 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_19 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_20 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_21 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_22 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_23 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_24 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_25 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_26 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_27 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_28 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_29 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_30 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_31 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_32 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_33 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_34 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_35 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_36 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_37 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_38 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_39 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_40 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_41 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_42 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_43 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_44 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_45 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_46 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_47 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_48 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_49 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_50 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_51 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_52 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_53 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_54 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_55 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_56 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_57 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_58 : unsigned(0 downto 0) := unsigned'("0");
+  signal s1_valid_d59_59 : unsigned(0 downto 0) := unsigned'("0");
+  type s1_tag_d59_sr_t is array (1 to 59) of unsigned(58 downto 0);
+  signal s1_tag_d59_sr : s1_tag_d59_sr_t := (others => (others => '0'));
+  signal s1_tag_d59 : unsigned(58 downto 0);
+  constant k_0_5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal mux_s60_hit : unsigned(29 downto 0);
+  signal shr_s57_u_d3 : signed(64 downto 0);
+  signal rs_shr_s57_u_d3 : signed(31 downto 0);
+  signal u_rs_shr_s57_u_d3 : unsigned(31 downto 0);
+  constant k_0_6 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal mux_s60_hit_1 : unsigned(31 downto 0);
+  signal shr_s57_v_d3 : signed(64 downto 0);
+  signal rs_shr_s57_v_d3 : signed(31 downto 0);
+  signal u_rs_shr_s57_v_d3 : unsigned(31 downto 0);
+  signal mux_s60_hit_2 : unsigned(31 downto 0);
+  signal s61_valid_out : unsigned(0 downto 0) := unsigned'("0");
+  signal s61_tag_out : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
+  signal s61_hit : unsigned(0 downto 0) := unsigned'("0");
+  signal s61_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s61_u : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s61_v : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
 begin
 
   -- not in a stage or state machine
@@ -632,19 +639,13 @@ begin
     end if;
   end process s50_point_regs;
 
-  -- stage s56_uv: the barycentric coordinates u, v
+  -- stage s56_bary: e1p·kq, e1q·kp, e2q·kp, e2p·kq
   s1_e1p_d49 <= s1_e1p_d49_sr(49);
   s1_e1q_d49 <= s1_e1q_d49_sr(49);
   s1_e2q_d49 <= s1_e2q_d49_sr(49);
   s1_e2p_d49 <= s1_e2p_d49_sr(49);
-  rs_u_bary_products_p0 <= resize(u_bary_products_p0, 65);
-  rs_u_bary_products_p1 <= resize(u_bary_products_p1, 65);
-  u_int <= rs_u_bary_products_p0 - rs_u_bary_products_p1;
-  rs_u_bary_products_p2 <= resize(u_bary_products_p2, 65);
-  rs_u_bary_products_p3 <= resize(u_bary_products_p3, 65);
-  v_int <= rs_u_bary_products_p2 - rs_u_bary_products_p3;
 
-  s56_uv_regs : process (clk)
+  s56_bary_regs : process (clk)
   begin
     if rising_edge(clk) then
       s1_e1p_d49_sr(2 to 49) <= s1_e1p_d49_sr(1 to 48);
@@ -655,426 +656,449 @@ begin
       s1_e2q_d49_sr(1) <= s1_e2q;
       s1_e2p_d49_sr(2 to 49) <= s1_e2p_d49_sr(1 to 48);
       s1_e2p_d49_sr(1) <= s1_e2p;
-      s56_u <= u_int;
-      s56_v <= v_int;
+      s56_a1 <= u_bary_products_p0;
+      s56_a2 <= u_bary_products_p1;
+      s56_b1 <= u_bary_products_p2;
+      s56_b2 <= u_bary_products_p3;
     end if;
-  end process s56_uv_regs;
+  end process s56_bary_regs;
 
-  -- stage s57_test: u + v as two short sums; the signs
-  u_s56_u <= unsigned(s56_u);
-  bits_u_s56_u <= unsigned(u_s56_u(64 downto 49));
-  rs_bits_u_s56_u <= resize(bits_u_s56_u, 17);
-  u_s56_v <= unsigned(s56_v);
-  bits_u_s56_v <= unsigned(u_s56_v(64 downto 49));
-  rs_bits_u_s56_v <= resize(bits_u_s56_v, 17);
-  uv_sum_high <= rs_bits_u_s56_u + rs_bits_u_s56_v;
-  u_s56_u_1 <= unsigned(s56_u);
-  bits_u_s56_u_1 <= unsigned(u_s56_u_1(48 downto 0));
-  rs_bits_u_s56_u_1 <= resize(bits_u_s56_u_1, 50);
-  u_s56_v_1 <= unsigned(s56_v);
-  bits_u_s56_v_1 <= unsigned(u_s56_v_1(48 downto 0));
-  rs_bits_u_s56_v_1 <= resize(bits_u_s56_v_1, 50);
-  uv_sum_low <= rs_bits_u_s56_u_1 + rs_bits_u_s56_v_1;
-  s56_u_lt_k_0_1 <= "1" when s56_u < k_0_1 else "0";
-  s56_v_lt_k_0_1 <= "1" when s56_v < k_0_1 else "0";
-  negative <= s56_u_lt_k_0_1 or s56_v_lt_k_0_1;
+  -- stage s57_uv: the barycentric coordinates u, v
+  rs_s56_a1 <= resize(s56_a1, 65);
+  rs_s56_a2 <= resize(s56_a2, 65);
+  u_int <= rs_s56_a1 - rs_s56_a2;
+  rs_s56_b1 <= resize(s56_b1, 65);
+  rs_s56_b2 <= resize(s56_b2, 65);
+  v_int <= rs_s56_b1 - rs_s56_b2;
 
-  s57_test_regs : process (clk)
+  s57_uv_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s57_hs <= uv_sum_high;
-      s57_ls <= uv_sum_low;
-      s57_neg <= negative;
+      s57_u <= u_int;
+      s57_v <= v_int;
     end if;
-  end process s57_test_regs;
+  end process s57_uv_regs;
 
-  -- stage s58_limit: u + v above the limit, by bytes
-  bits_s57_hs <= unsigned(s57_hs(16 downto 1));
-  bits_bits_s57_hs <= unsigned(bits_s57_hs(15 downto 8));
-  ne_16 <= "1" when bits_bits_s57_hs /= k_0_2 else "0";
-  bits_bits_s57_hs_1 <= unsigned(bits_s57_hs(7 downto 0));
-  ne_17 <= "1" when bits_bits_s57_hs_1 /= k_0_2 else "0";
+  -- stage s58_test: u + v as two short sums; the signs
+  u_s57_u <= unsigned(s57_u);
+  bits_u_s57_u <= unsigned(u_s57_u(64 downto 49));
+  rs_bits_u_s57_u <= resize(bits_u_s57_u, 17);
+  u_s57_v <= unsigned(s57_v);
+  bits_u_s57_v <= unsigned(u_s57_v(64 downto 49));
+  rs_bits_u_s57_v <= resize(bits_u_s57_v, 17);
+  uv_sum_high <= rs_bits_u_s57_u + rs_bits_u_s57_v;
+  u_s57_u_1 <= unsigned(s57_u);
+  bits_u_s57_u_1 <= unsigned(u_s57_u_1(48 downto 0));
+  rs_bits_u_s57_u_1 <= resize(bits_u_s57_u_1, 50);
+  u_s57_v_1 <= unsigned(s57_v);
+  bits_u_s57_v_1 <= unsigned(u_s57_v_1(48 downto 0));
+  rs_bits_u_s57_v_1 <= resize(bits_u_s57_v_1, 50);
+  uv_sum_low <= rs_bits_u_s57_u_1 + rs_bits_u_s57_v_1;
+  s57_u_lt_k_0_1 <= "1" when s57_u < k_0_1 else "0";
+  s57_v_lt_k_0_1 <= "1" when s57_v < k_0_1 else "0";
+  negative <= s57_u_lt_k_0_1 or s57_v_lt_k_0_1;
+
+  s58_test_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      s58_hs <= uv_sum_high;
+      s58_ls <= uv_sum_low;
+      s58_neg <= negative;
+    end if;
+  end process s58_test_regs;
+
+  -- stage s59_limit: u + v above the limit, by bytes
+  bits_s58_hs <= unsigned(s58_hs(16 downto 1));
+  bits_bits_s58_hs <= unsigned(bits_s58_hs(15 downto 8));
+  ne_16 <= "1" when bits_bits_s58_hs /= k_0_2 else "0";
+  bits_bits_s58_hs_1 <= unsigned(bits_s58_hs(7 downto 0));
+  ne_17 <= "1" when bits_bits_s58_hs_1 /= k_0_2 else "0";
   high <= unsigned(std_logic_vector'(std_logic_vector(ne_16) & std_logic_vector(ne_17)));
-  bits_s57_hs_1 <= unsigned(s57_hs(0 downto 0));
-  bits_s57_ls <= unsigned(s57_ls(49 downto 49));
-  bits_s57_ls_1 <= unsigned(s57_ls(48 downto 0));
-  bits_bits_s57_ls_1 <= unsigned(bits_s57_ls_1(48 downto 48));
-  ne_19 <= "1" when bits_bits_s57_ls_1 /= k_0_3 else "0";
-  bits_bits_s57_ls_1_1 <= unsigned(bits_s57_ls_1(47 downto 40));
-  ne_20 <= "1" when bits_bits_s57_ls_1_1 /= k_0_2 else "0";
-  bits_bits_s57_ls_1_2 <= unsigned(bits_s57_ls_1(39 downto 32));
-  ne_21 <= "1" when bits_bits_s57_ls_1_2 /= k_0_2 else "0";
-  bits_bits_s57_ls_1_3 <= unsigned(bits_s57_ls_1(31 downto 24));
-  ne_22 <= "1" when bits_bits_s57_ls_1_3 /= k_0_2 else "0";
-  bits_bits_s57_ls_1_4 <= unsigned(bits_s57_ls_1(23 downto 16));
-  ne_23 <= "1" when bits_bits_s57_ls_1_4 /= k_0_2 else "0";
-  bits_bits_s57_ls_1_5 <= unsigned(bits_s57_ls_1(15 downto 8));
-  ne_24 <= "1" when bits_bits_s57_ls_1_5 /= k_0_2 else "0";
-  bits_bits_s57_ls_1_6 <= unsigned(bits_s57_ls_1(7 downto 0));
-  ne_25 <= "1" when bits_bits_s57_ls_1_6 /= k_0_2 else "0";
+  bits_s58_hs_1 <= unsigned(s58_hs(0 downto 0));
+  bits_s58_ls <= unsigned(s58_ls(49 downto 49));
+  bits_s58_ls_1 <= unsigned(s58_ls(48 downto 0));
+  bits_bits_s58_ls_1 <= unsigned(bits_s58_ls_1(48 downto 48));
+  ne_19 <= "1" when bits_bits_s58_ls_1 /= k_0_3 else "0";
+  bits_bits_s58_ls_1_1 <= unsigned(bits_s58_ls_1(47 downto 40));
+  ne_20 <= "1" when bits_bits_s58_ls_1_1 /= k_0_2 else "0";
+  bits_bits_s58_ls_1_2 <= unsigned(bits_s58_ls_1(39 downto 32));
+  ne_21 <= "1" when bits_bits_s58_ls_1_2 /= k_0_2 else "0";
+  bits_bits_s58_ls_1_3 <= unsigned(bits_s58_ls_1(31 downto 24));
+  ne_22 <= "1" when bits_bits_s58_ls_1_3 /= k_0_2 else "0";
+  bits_bits_s58_ls_1_4 <= unsigned(bits_s58_ls_1(23 downto 16));
+  ne_23 <= "1" when bits_bits_s58_ls_1_4 /= k_0_2 else "0";
+  bits_bits_s58_ls_1_5 <= unsigned(bits_s58_ls_1(15 downto 8));
+  ne_24 <= "1" when bits_bits_s58_ls_1_5 /= k_0_2 else "0";
+  bits_bits_s58_ls_1_6 <= unsigned(bits_s58_ls_1(7 downto 0));
+  ne_25 <= "1" when bits_bits_s58_ls_1_6 /= k_0_2 else "0";
   low <= unsigned(std_logic_vector'(std_logic_vector(ne_19) & std_logic_vector(ne_20) & std_logic_vector(ne_21) & std_logic_vector(ne_22) & std_logic_vector(ne_23) & std_logic_vector(ne_24) & std_logic_vector(ne_25)));
 
-  s58_limit_regs : process (clk)
+  s59_limit_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s58_high <= high;
-      s58_h0 <= bits_s57_hs_1;
-      s58_lk <= bits_s57_ls;
-      s58_low <= low;
-      s58_neg <= s57_neg;
+      s59_high <= high;
+      s59_h0 <= bits_s58_hs_1;
+      s59_lk <= bits_s58_ls;
+      s59_low <= low;
+      s59_neg <= s58_neg;
     end if;
-  end process s58_limit_regs;
+  end process s59_limit_regs;
 
-  -- stage s59_hit: the hit bit
-  s58_low_ne_k_0_4 <= "1" when s58_low /= k_0_4 else "0";
-  s58_high_ne_k_0 <= "1" when s58_high /= k_0 else "0";
-  or_27 <= s58_lk or s58_low_ne_k_0_4;
-  s58_h0_and_or_27 <= s58_h0 and or_27;
-  or_28 <= s58_high_ne_k_0 or s58_h0_and_or_27;
-  and_29 <= s58_lk and s58_low_ne_k_0_4;
+  -- stage s60_hit: the hit bit
+  s59_low_ne_k_0_4 <= "1" when s59_low /= k_0_4 else "0";
+  s59_high_ne_k_0 <= "1" when s59_high /= k_0 else "0";
+  or_27 <= s59_lk or s59_low_ne_k_0_4;
+  s59_h0_and_or_27 <= s59_h0 and or_27;
+  or_28 <= s59_high_ne_k_0 or s59_h0_and_or_27;
+  and_29 <= s59_lk and s59_low_ne_k_0_4;
   over <= or_28 or and_29;
-  s58_neg_or_over <= s58_neg or over;
-  not_s58_neg_or_over <= not s58_neg_or_over;
-  u_div_ok_d15 <= u_div_ok_d15_sr(15);
-  hit_c <= not_s58_neg_or_over and u_div_ok_d15;
+  s59_neg_or_over <= s59_neg or over;
+  not_s59_neg_or_over <= not s59_neg_or_over;
+  u_div_ok_d16 <= u_div_ok_d16_sr(16);
+  hit_c <= not_s59_neg_or_over and u_div_ok_d16;
 
-  s59_hit_regs : process (clk)
+  s60_hit_regs : process (clk)
   begin
     if rising_edge(clk) then
-      u_div_ok_d15_sr(2 to 15) <= u_div_ok_d15_sr(1 to 14);
-      u_div_ok_d15_sr(1) <= u_div_ok;
-      s59_hit <= hit_c;
+      u_div_ok_d16_sr(2 to 16) <= u_div_ok_d16_sr(1 to 15);
+      u_div_ok_d16_sr(1) <= u_div_ok;
+      s60_hit <= hit_c;
     end if;
-  end process s59_hit_regs;
+  end process s60_hit_regs;
 
-  -- stage s60_result: the barycentric test; t, u, v zeroed on a miss
-  u_div_t_1_d16 <= u_div_t_1_d16_sr(16);
-  s56_u_d3 <= s56_u_d3_sr(3);
-  s56_v_d3 <= s56_v_d3_sr(3);
-  s1_tag_d58 <= s1_tag_d58_sr(58);
-  mux_s59_hit <= u_div_t_1_d16 when s59_hit = "1" else k_0_5;
-  shr_s56_u_d3 <= shift_right(s56_u_d3, 18);
-  rs_shr_s56_u_d3 <= shr_s56_u_d3(31 downto 0);
-  u_rs_shr_s56_u_d3 <= unsigned(rs_shr_s56_u_d3);
-  mux_s59_hit_1 <= u_rs_shr_s56_u_d3 when s59_hit = "1" else k_0_6;
-  shr_s56_v_d3 <= shift_right(s56_v_d3, 18);
-  rs_shr_s56_v_d3 <= shr_s56_v_d3(31 downto 0);
-  u_rs_shr_s56_v_d3 <= unsigned(rs_shr_s56_v_d3);
-  mux_s59_hit_2 <= u_rs_shr_s56_v_d3 when s59_hit = "1" else k_0_6;
+  -- stage s61_result: the barycentric test; t, u, v zeroed on a miss
+  u_div_t_1_d17 <= u_div_t_1_d17_sr(17);
+  s57_u_d3 <= s57_u_d3_sr(3);
+  s57_v_d3 <= s57_v_d3_sr(3);
+  s1_tag_d59 <= s1_tag_d59_sr(59);
+  mux_s60_hit <= u_div_t_1_d17 when s60_hit = "1" else k_0_5;
+  shr_s57_u_d3 <= shift_right(s57_u_d3, 18);
+  rs_shr_s57_u_d3 <= shr_s57_u_d3(31 downto 0);
+  u_rs_shr_s57_u_d3 <= unsigned(rs_shr_s57_u_d3);
+  mux_s60_hit_1 <= u_rs_shr_s57_u_d3 when s60_hit = "1" else k_0_6;
+  shr_s57_v_d3 <= shift_right(s57_v_d3, 18);
+  rs_shr_s57_v_d3 <= shr_s57_v_d3(31 downto 0);
+  u_rs_shr_s57_v_d3 <= unsigned(rs_shr_s57_v_d3);
+  mux_s60_hit_2 <= u_rs_shr_s57_v_d3 when s60_hit = "1" else k_0_6;
 
-  s60_result_regs : process (clk)
+  s61_result_regs : process (clk)
   begin
     if rising_edge(clk) then
-      u_div_t_1_d16_sr(2 to 16) <= u_div_t_1_d16_sr(1 to 15);
-      u_div_t_1_d16_sr(1) <= u_div_t_1;
-      s56_u_d3_sr(2 to 3) <= s56_u_d3_sr(1 to 2);
-      s56_u_d3_sr(1) <= s56_u;
-      s56_v_d3_sr(2 to 3) <= s56_v_d3_sr(1 to 2);
-      s56_v_d3_sr(1) <= s56_v;
+      u_div_t_1_d17_sr(2 to 17) <= u_div_t_1_d17_sr(1 to 16);
+      u_div_t_1_d17_sr(1) <= u_div_t_1;
+      s57_u_d3_sr(2 to 3) <= s57_u_d3_sr(1 to 2);
+      s57_u_d3_sr(1) <= s57_u;
+      s57_v_d3_sr(2 to 3) <= s57_v_d3_sr(1 to 2);
+      s57_v_d3_sr(1) <= s57_v;
       if rst = '1' then
-        s1_valid_d58_1 <= unsigned'("0");
+        s1_valid_d59_1 <= unsigned'("0");
       else
-        s1_valid_d58_1 <= s1_valid;
+        s1_valid_d59_1 <= s1_valid;
       end if;
       if rst = '1' then
-        s1_valid_d58_2 <= unsigned'("0");
+        s1_valid_d59_2 <= unsigned'("0");
       else
-        s1_valid_d58_2 <= s1_valid_d58_1;
+        s1_valid_d59_2 <= s1_valid_d59_1;
       end if;
       if rst = '1' then
-        s1_valid_d58_3 <= unsigned'("0");
+        s1_valid_d59_3 <= unsigned'("0");
       else
-        s1_valid_d58_3 <= s1_valid_d58_2;
+        s1_valid_d59_3 <= s1_valid_d59_2;
       end if;
       if rst = '1' then
-        s1_valid_d58_4 <= unsigned'("0");
+        s1_valid_d59_4 <= unsigned'("0");
       else
-        s1_valid_d58_4 <= s1_valid_d58_3;
+        s1_valid_d59_4 <= s1_valid_d59_3;
       end if;
       if rst = '1' then
-        s1_valid_d58_5 <= unsigned'("0");
+        s1_valid_d59_5 <= unsigned'("0");
       else
-        s1_valid_d58_5 <= s1_valid_d58_4;
+        s1_valid_d59_5 <= s1_valid_d59_4;
       end if;
       if rst = '1' then
-        s1_valid_d58_6 <= unsigned'("0");
+        s1_valid_d59_6 <= unsigned'("0");
       else
-        s1_valid_d58_6 <= s1_valid_d58_5;
+        s1_valid_d59_6 <= s1_valid_d59_5;
       end if;
       if rst = '1' then
-        s1_valid_d58_7 <= unsigned'("0");
+        s1_valid_d59_7 <= unsigned'("0");
       else
-        s1_valid_d58_7 <= s1_valid_d58_6;
+        s1_valid_d59_7 <= s1_valid_d59_6;
       end if;
       if rst = '1' then
-        s1_valid_d58_8 <= unsigned'("0");
+        s1_valid_d59_8 <= unsigned'("0");
       else
-        s1_valid_d58_8 <= s1_valid_d58_7;
+        s1_valid_d59_8 <= s1_valid_d59_7;
       end if;
       if rst = '1' then
-        s1_valid_d58_9 <= unsigned'("0");
+        s1_valid_d59_9 <= unsigned'("0");
       else
-        s1_valid_d58_9 <= s1_valid_d58_8;
+        s1_valid_d59_9 <= s1_valid_d59_8;
       end if;
       if rst = '1' then
-        s1_valid_d58_10 <= unsigned'("0");
+        s1_valid_d59_10 <= unsigned'("0");
       else
-        s1_valid_d58_10 <= s1_valid_d58_9;
+        s1_valid_d59_10 <= s1_valid_d59_9;
       end if;
       if rst = '1' then
-        s1_valid_d58_11 <= unsigned'("0");
+        s1_valid_d59_11 <= unsigned'("0");
       else
-        s1_valid_d58_11 <= s1_valid_d58_10;
+        s1_valid_d59_11 <= s1_valid_d59_10;
       end if;
       if rst = '1' then
-        s1_valid_d58_12 <= unsigned'("0");
+        s1_valid_d59_12 <= unsigned'("0");
       else
-        s1_valid_d58_12 <= s1_valid_d58_11;
+        s1_valid_d59_12 <= s1_valid_d59_11;
       end if;
       if rst = '1' then
-        s1_valid_d58_13 <= unsigned'("0");
+        s1_valid_d59_13 <= unsigned'("0");
       else
-        s1_valid_d58_13 <= s1_valid_d58_12;
+        s1_valid_d59_13 <= s1_valid_d59_12;
       end if;
       if rst = '1' then
-        s1_valid_d58_14 <= unsigned'("0");
+        s1_valid_d59_14 <= unsigned'("0");
       else
-        s1_valid_d58_14 <= s1_valid_d58_13;
+        s1_valid_d59_14 <= s1_valid_d59_13;
       end if;
       if rst = '1' then
-        s1_valid_d58_15 <= unsigned'("0");
+        s1_valid_d59_15 <= unsigned'("0");
       else
-        s1_valid_d58_15 <= s1_valid_d58_14;
+        s1_valid_d59_15 <= s1_valid_d59_14;
       end if;
       if rst = '1' then
-        s1_valid_d58_16 <= unsigned'("0");
+        s1_valid_d59_16 <= unsigned'("0");
       else
-        s1_valid_d58_16 <= s1_valid_d58_15;
+        s1_valid_d59_16 <= s1_valid_d59_15;
       end if;
       if rst = '1' then
-        s1_valid_d58_17 <= unsigned'("0");
+        s1_valid_d59_17 <= unsigned'("0");
       else
-        s1_valid_d58_17 <= s1_valid_d58_16;
+        s1_valid_d59_17 <= s1_valid_d59_16;
       end if;
       if rst = '1' then
-        s1_valid_d58_18 <= unsigned'("0");
+        s1_valid_d59_18 <= unsigned'("0");
       else
-        s1_valid_d58_18 <= s1_valid_d58_17;
+        s1_valid_d59_18 <= s1_valid_d59_17;
       end if;
       if rst = '1' then
-        s1_valid_d58_19 <= unsigned'("0");
+        s1_valid_d59_19 <= unsigned'("0");
       else
-        s1_valid_d58_19 <= s1_valid_d58_18;
+        s1_valid_d59_19 <= s1_valid_d59_18;
       end if;
       if rst = '1' then
-        s1_valid_d58_20 <= unsigned'("0");
+        s1_valid_d59_20 <= unsigned'("0");
       else
-        s1_valid_d58_20 <= s1_valid_d58_19;
+        s1_valid_d59_20 <= s1_valid_d59_19;
       end if;
       if rst = '1' then
-        s1_valid_d58_21 <= unsigned'("0");
+        s1_valid_d59_21 <= unsigned'("0");
       else
-        s1_valid_d58_21 <= s1_valid_d58_20;
+        s1_valid_d59_21 <= s1_valid_d59_20;
       end if;
       if rst = '1' then
-        s1_valid_d58_22 <= unsigned'("0");
+        s1_valid_d59_22 <= unsigned'("0");
       else
-        s1_valid_d58_22 <= s1_valid_d58_21;
+        s1_valid_d59_22 <= s1_valid_d59_21;
       end if;
       if rst = '1' then
-        s1_valid_d58_23 <= unsigned'("0");
+        s1_valid_d59_23 <= unsigned'("0");
       else
-        s1_valid_d58_23 <= s1_valid_d58_22;
+        s1_valid_d59_23 <= s1_valid_d59_22;
       end if;
       if rst = '1' then
-        s1_valid_d58_24 <= unsigned'("0");
+        s1_valid_d59_24 <= unsigned'("0");
       else
-        s1_valid_d58_24 <= s1_valid_d58_23;
+        s1_valid_d59_24 <= s1_valid_d59_23;
       end if;
       if rst = '1' then
-        s1_valid_d58_25 <= unsigned'("0");
+        s1_valid_d59_25 <= unsigned'("0");
       else
-        s1_valid_d58_25 <= s1_valid_d58_24;
+        s1_valid_d59_25 <= s1_valid_d59_24;
       end if;
       if rst = '1' then
-        s1_valid_d58_26 <= unsigned'("0");
+        s1_valid_d59_26 <= unsigned'("0");
       else
-        s1_valid_d58_26 <= s1_valid_d58_25;
+        s1_valid_d59_26 <= s1_valid_d59_25;
       end if;
       if rst = '1' then
-        s1_valid_d58_27 <= unsigned'("0");
+        s1_valid_d59_27 <= unsigned'("0");
       else
-        s1_valid_d58_27 <= s1_valid_d58_26;
+        s1_valid_d59_27 <= s1_valid_d59_26;
       end if;
       if rst = '1' then
-        s1_valid_d58_28 <= unsigned'("0");
+        s1_valid_d59_28 <= unsigned'("0");
       else
-        s1_valid_d58_28 <= s1_valid_d58_27;
+        s1_valid_d59_28 <= s1_valid_d59_27;
       end if;
       if rst = '1' then
-        s1_valid_d58_29 <= unsigned'("0");
+        s1_valid_d59_29 <= unsigned'("0");
       else
-        s1_valid_d58_29 <= s1_valid_d58_28;
+        s1_valid_d59_29 <= s1_valid_d59_28;
       end if;
       if rst = '1' then
-        s1_valid_d58_30 <= unsigned'("0");
+        s1_valid_d59_30 <= unsigned'("0");
       else
-        s1_valid_d58_30 <= s1_valid_d58_29;
+        s1_valid_d59_30 <= s1_valid_d59_29;
       end if;
       if rst = '1' then
-        s1_valid_d58_31 <= unsigned'("0");
+        s1_valid_d59_31 <= unsigned'("0");
       else
-        s1_valid_d58_31 <= s1_valid_d58_30;
+        s1_valid_d59_31 <= s1_valid_d59_30;
       end if;
       if rst = '1' then
-        s1_valid_d58_32 <= unsigned'("0");
+        s1_valid_d59_32 <= unsigned'("0");
       else
-        s1_valid_d58_32 <= s1_valid_d58_31;
+        s1_valid_d59_32 <= s1_valid_d59_31;
       end if;
       if rst = '1' then
-        s1_valid_d58_33 <= unsigned'("0");
+        s1_valid_d59_33 <= unsigned'("0");
       else
-        s1_valid_d58_33 <= s1_valid_d58_32;
+        s1_valid_d59_33 <= s1_valid_d59_32;
       end if;
       if rst = '1' then
-        s1_valid_d58_34 <= unsigned'("0");
+        s1_valid_d59_34 <= unsigned'("0");
       else
-        s1_valid_d58_34 <= s1_valid_d58_33;
+        s1_valid_d59_34 <= s1_valid_d59_33;
       end if;
       if rst = '1' then
-        s1_valid_d58_35 <= unsigned'("0");
+        s1_valid_d59_35 <= unsigned'("0");
       else
-        s1_valid_d58_35 <= s1_valid_d58_34;
+        s1_valid_d59_35 <= s1_valid_d59_34;
       end if;
       if rst = '1' then
-        s1_valid_d58_36 <= unsigned'("0");
+        s1_valid_d59_36 <= unsigned'("0");
       else
-        s1_valid_d58_36 <= s1_valid_d58_35;
+        s1_valid_d59_36 <= s1_valid_d59_35;
       end if;
       if rst = '1' then
-        s1_valid_d58_37 <= unsigned'("0");
+        s1_valid_d59_37 <= unsigned'("0");
       else
-        s1_valid_d58_37 <= s1_valid_d58_36;
+        s1_valid_d59_37 <= s1_valid_d59_36;
       end if;
       if rst = '1' then
-        s1_valid_d58_38 <= unsigned'("0");
+        s1_valid_d59_38 <= unsigned'("0");
       else
-        s1_valid_d58_38 <= s1_valid_d58_37;
+        s1_valid_d59_38 <= s1_valid_d59_37;
       end if;
       if rst = '1' then
-        s1_valid_d58_39 <= unsigned'("0");
+        s1_valid_d59_39 <= unsigned'("0");
       else
-        s1_valid_d58_39 <= s1_valid_d58_38;
+        s1_valid_d59_39 <= s1_valid_d59_38;
       end if;
       if rst = '1' then
-        s1_valid_d58_40 <= unsigned'("0");
+        s1_valid_d59_40 <= unsigned'("0");
       else
-        s1_valid_d58_40 <= s1_valid_d58_39;
+        s1_valid_d59_40 <= s1_valid_d59_39;
       end if;
       if rst = '1' then
-        s1_valid_d58_41 <= unsigned'("0");
+        s1_valid_d59_41 <= unsigned'("0");
       else
-        s1_valid_d58_41 <= s1_valid_d58_40;
+        s1_valid_d59_41 <= s1_valid_d59_40;
       end if;
       if rst = '1' then
-        s1_valid_d58_42 <= unsigned'("0");
+        s1_valid_d59_42 <= unsigned'("0");
       else
-        s1_valid_d58_42 <= s1_valid_d58_41;
+        s1_valid_d59_42 <= s1_valid_d59_41;
       end if;
       if rst = '1' then
-        s1_valid_d58_43 <= unsigned'("0");
+        s1_valid_d59_43 <= unsigned'("0");
       else
-        s1_valid_d58_43 <= s1_valid_d58_42;
+        s1_valid_d59_43 <= s1_valid_d59_42;
       end if;
       if rst = '1' then
-        s1_valid_d58_44 <= unsigned'("0");
+        s1_valid_d59_44 <= unsigned'("0");
       else
-        s1_valid_d58_44 <= s1_valid_d58_43;
+        s1_valid_d59_44 <= s1_valid_d59_43;
       end if;
       if rst = '1' then
-        s1_valid_d58_45 <= unsigned'("0");
+        s1_valid_d59_45 <= unsigned'("0");
       else
-        s1_valid_d58_45 <= s1_valid_d58_44;
+        s1_valid_d59_45 <= s1_valid_d59_44;
       end if;
       if rst = '1' then
-        s1_valid_d58_46 <= unsigned'("0");
+        s1_valid_d59_46 <= unsigned'("0");
       else
-        s1_valid_d58_46 <= s1_valid_d58_45;
+        s1_valid_d59_46 <= s1_valid_d59_45;
       end if;
       if rst = '1' then
-        s1_valid_d58_47 <= unsigned'("0");
+        s1_valid_d59_47 <= unsigned'("0");
       else
-        s1_valid_d58_47 <= s1_valid_d58_46;
+        s1_valid_d59_47 <= s1_valid_d59_46;
       end if;
       if rst = '1' then
-        s1_valid_d58_48 <= unsigned'("0");
+        s1_valid_d59_48 <= unsigned'("0");
       else
-        s1_valid_d58_48 <= s1_valid_d58_47;
+        s1_valid_d59_48 <= s1_valid_d59_47;
       end if;
       if rst = '1' then
-        s1_valid_d58_49 <= unsigned'("0");
+        s1_valid_d59_49 <= unsigned'("0");
       else
-        s1_valid_d58_49 <= s1_valid_d58_48;
+        s1_valid_d59_49 <= s1_valid_d59_48;
       end if;
       if rst = '1' then
-        s1_valid_d58_50 <= unsigned'("0");
+        s1_valid_d59_50 <= unsigned'("0");
       else
-        s1_valid_d58_50 <= s1_valid_d58_49;
+        s1_valid_d59_50 <= s1_valid_d59_49;
       end if;
       if rst = '1' then
-        s1_valid_d58_51 <= unsigned'("0");
+        s1_valid_d59_51 <= unsigned'("0");
       else
-        s1_valid_d58_51 <= s1_valid_d58_50;
+        s1_valid_d59_51 <= s1_valid_d59_50;
       end if;
       if rst = '1' then
-        s1_valid_d58_52 <= unsigned'("0");
+        s1_valid_d59_52 <= unsigned'("0");
       else
-        s1_valid_d58_52 <= s1_valid_d58_51;
+        s1_valid_d59_52 <= s1_valid_d59_51;
       end if;
       if rst = '1' then
-        s1_valid_d58_53 <= unsigned'("0");
+        s1_valid_d59_53 <= unsigned'("0");
       else
-        s1_valid_d58_53 <= s1_valid_d58_52;
+        s1_valid_d59_53 <= s1_valid_d59_52;
       end if;
       if rst = '1' then
-        s1_valid_d58_54 <= unsigned'("0");
+        s1_valid_d59_54 <= unsigned'("0");
       else
-        s1_valid_d58_54 <= s1_valid_d58_53;
+        s1_valid_d59_54 <= s1_valid_d59_53;
       end if;
       if rst = '1' then
-        s1_valid_d58_55 <= unsigned'("0");
+        s1_valid_d59_55 <= unsigned'("0");
       else
-        s1_valid_d58_55 <= s1_valid_d58_54;
+        s1_valid_d59_55 <= s1_valid_d59_54;
       end if;
       if rst = '1' then
-        s1_valid_d58_56 <= unsigned'("0");
+        s1_valid_d59_56 <= unsigned'("0");
       else
-        s1_valid_d58_56 <= s1_valid_d58_55;
+        s1_valid_d59_56 <= s1_valid_d59_55;
       end if;
       if rst = '1' then
-        s1_valid_d58_57 <= unsigned'("0");
+        s1_valid_d59_57 <= unsigned'("0");
       else
-        s1_valid_d58_57 <= s1_valid_d58_56;
+        s1_valid_d59_57 <= s1_valid_d59_56;
       end if;
       if rst = '1' then
-        s1_valid_d58_58 <= unsigned'("0");
+        s1_valid_d59_58 <= unsigned'("0");
       else
-        s1_valid_d58_58 <= s1_valid_d58_57;
+        s1_valid_d59_58 <= s1_valid_d59_57;
       end if;
-      s1_tag_d58_sr(2 to 58) <= s1_tag_d58_sr(1 to 57);
-      s1_tag_d58_sr(1) <= s1_tag;
       if rst = '1' then
-        s60_valid_out <= unsigned'("0");
+        s1_valid_d59_59 <= unsigned'("0");
       else
-        s60_valid_out <= s1_valid_d58_58;
+        s1_valid_d59_59 <= s1_valid_d59_58;
       end if;
-      s60_tag_out <= s1_tag_d58;
-      s60_hit <= s59_hit;
-      s60_t <= mux_s59_hit;
-      s60_u <= mux_s59_hit_1;
-      s60_v <= mux_s59_hit_2;
+      s1_tag_d59_sr(2 to 59) <= s1_tag_d59_sr(1 to 58);
+      s1_tag_d59_sr(1) <= s1_tag;
+      if rst = '1' then
+        s61_valid_out <= unsigned'("0");
+      else
+        s61_valid_out <= s1_valid_d59_59;
+      end if;
+      s61_tag_out <= s1_tag_d59;
+      s61_hit <= s60_hit;
+      s61_t <= mux_s60_hit;
+      s61_u <= mux_s60_hit_1;
+      s61_v <= mux_s60_hit_2;
     end if;
-  end process s60_result_regs;
+  end process s61_result_regs;
 
   u_plane_products : fxrt_muls_s30xs32_s30xs32_s32xs32_s32xs32_d3l1
     port map (
@@ -1130,10 +1154,10 @@ begin
       p3 => u_bary_products_p3
     );
 
-  valid_out <= s60_valid_out;
-  tag_out <= s60_tag_out;
-  hit <= s60_hit;
-  t <= s60_t;
-  u <= s60_u;
-  v <= s60_v;
+  valid_out <= s61_valid_out;
+  tag_out <= s61_tag_out;
+  hit <= s61_hit;
+  t <= s61_t;
+  u <= s61_u;
+  v <= s61_v;
 end architecture rtl;

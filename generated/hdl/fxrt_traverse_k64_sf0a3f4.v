@@ -121,7 +121,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   (* ram_style = "distributed" *) reg [5:0] free_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_free_q_mem.hex", free_q_mem);
 
-  (* ram_style = "distributed" *) reg [11:0] unpark_q_mem [0:63];
+  (* ram_style = "distributed" *) reg [12:0] unpark_q_mem [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_unpark_q_mem.hex", unpark_q_mem);
 
   (* ram_style = "distributed" *) reg [15:0] new_q_mem_g0 [0:63];
@@ -249,7 +249,9 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] ring_g_valid;
   wire [0:0] unpark_pop;
   wire [0:0] new_pop;
-  wire [11:0] cat_11;
+  wire [5:0] k_0_1 = 6'h00;
+  wire [0:0] merge_sp_zero;
+  wire [12:0] cat_11;
   reg [5:0] unpark_q_wr = 6'h00;
   reg [5:0] unpark_q_rd = 6'h00;
   reg [6:0] unpark_q_count = 7'h00;
@@ -278,12 +280,12 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] not_unpark_pop;
   wire [0:0] and_18;
   wire [0:0] unpark_q_nonempty_c;
-  reg [11:0] unpark_q_din = 12'h000;
-  reg [11:0] unpark_q_q_stay = 12'h000;
-  reg [11:0] unpark_q_q_next = 12'h000;
-  wire [11:0] mux_unpark_q_popped;
-  reg [11:0] unpark_q_din_r = 12'h000;
-  wire [11:0] unpark_q_head;
+  reg [12:0] unpark_q_din = 13'h0000;
+  reg [12:0] unpark_q_q_stay = 13'h0000;
+  reg [12:0] unpark_q_q_next = 13'h0000;
+  wire [12:0] mux_unpark_q_popped;
+  reg [12:0] unpark_q_din_r = 13'h0000;
+  wire [12:0] unpark_q_head;
   wire [31:0] u_new_tmax;
   wire [38:0] cat_19;
   reg [5:0] new_q_wr = 6'h00;
@@ -352,18 +354,16 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] mux_take_unpark;
   wire [5:0] bits_unpark_q_head_1;
   reg [5:0] q_sp = 6'h00;
-  wire [5:0] k_0_1 = 6'h00;
   wire [0:0] eq_32;
   reg [0:0] q_sp_zero = 1'h0;
   wire [5:0] minus_33;
   reg [5:0] q_sp_m1 = 6'h00;
   wire [4:0] rs_minus_33;
   wire [10:0] q_stack_raddr;
-  wire [5:0] bits_unpark_q_head_2;
-  wire [0:0] eq_35;
+  wire [0:0] bits_unpark_q_head_2;
   wire [0:0] bits_new_q_head_1;
+  wire [0:0] and_35;
   wire [0:0] and_36;
-  wire [0:0] take_unpark_and_eq_35;
   wire [0:0] q_done_c;
   reg [0:0] q_done = 1'h0;
   wire [31:0] bits_new_q_head_2;
@@ -403,7 +403,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] r_valid_and_r_done;
   wire [0:0] not_r_valid;
   wire [0:0] not_r_valid_and_q_valid;
-  wire [0:0] and_38;
+  wire [0:0] and_37;
   wire [0:0] a_done;
   wire [0:0] not_a_sp_zero;
   wire [0:0] a_from_stack;
@@ -457,16 +457,16 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] done_q_count_next;
   wire [0:0] done_q_count_eq_k_0;
   wire [0:0] done_q_one_left;
-  wire [0:0] and_42;
+  wire [0:0] and_41;
   wire [0:0] done_q_drained;
   reg [0:0] done_q_bypass = 1'h0;
   wire [0:0] done_q_bypass_c;
   reg [0:0] done_q_popped = 1'h0;
   reg [0:0] done_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_done_q_count;
-  wire [0:0] or_45;
+  wire [0:0] or_44;
   wire [0:0] not_done_pop_r;
-  wire [0:0] and_46;
+  wire [0:0] and_45;
   wire [0:0] done_q_nonempty_c;
   reg [5:0] done_q_din = 6'h00;
   reg [5:0] done_q_q_stay = 6'h00;
@@ -502,7 +502,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [31:0] tmin_less;
   reg signed [31:0] cull_x = 32'sh00000000;
   wire [63:0] has_best_kept;
-  wire [0:0] and_48;
+  wire [0:0] and_47;
   wire [0:0] merge_slot_eq_b2_slot_c1;
   wire [0:0] b_slot_merged_c;
   reg [0:0] b_slot_merged = 1'h0;
@@ -523,7 +523,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] bits_has_best_kept_13;
   wire [0:0] bits_has_best_kept_14;
   wire [0:0] bits_has_best_kept_15;
-  wire [3:0] bits_b2_slot_c1;
+  wire [3:0] bits_b2_slot_c2;
   wire [0:0] slot_has_best_g0_c;
   reg [0:0] slot_has_best_g0 = 1'h0;
   wire [0:0] bits_has_best_kept_16;
@@ -542,7 +542,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] bits_has_best_kept_29;
   wire [0:0] bits_has_best_kept_30;
   wire [0:0] bits_has_best_kept_31;
-  wire [3:0] bits_b2_slot_c1_1;
+  wire [3:0] bits_b2_slot_c3;
   wire [0:0] slot_has_best_g1_c;
   reg [0:0] slot_has_best_g1 = 1'h0;
   wire [0:0] bits_has_best_kept_32;
@@ -561,7 +561,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] bits_has_best_kept_45;
   wire [0:0] bits_has_best_kept_46;
   wire [0:0] bits_has_best_kept_47;
-  wire [3:0] bits_b2_slot_c1_2;
+  wire [3:0] bits_b2_slot_c4;
   wire [0:0] slot_has_best_g2_c;
   reg [0:0] slot_has_best_g2 = 1'h0;
   wire [0:0] bits_has_best_kept_48;
@@ -580,7 +580,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] bits_has_best_kept_61;
   wire [0:0] bits_has_best_kept_62;
   wire [0:0] bits_has_best_kept_63;
-  wire [3:0] bits_b2_slot_c1_3;
+  wire [3:0] bits_b2_slot_c5;
   wire [0:0] slot_has_best_g3_c;
   reg [0:0] slot_has_best_g3 = 1'h0;
   wire [1:0] bits_c_slot_c2;
@@ -590,13 +590,13 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_s_limit_q;
   wire signed [32:0] rs_cull_x;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_51;
+  wire signed [32:0] minus_50;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] bits_minus_51;
+  wire [0:0] bits_minus_50;
   wire [0:0] culled_c;
   reg [0:0] culled = 1'h0;
   reg [0:0] culled_n = 1'h0;
-  wire [0:0] and_53;
+  wire [0:0] and_52;
   wire [0:0] merge_slot_eq_k_63;
   wire [5:0] k_62 = 6'h3e;
   wire [0:0] merge_slot_eq_k_62;
@@ -722,146 +722,146 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] merge_slot_eq_k_2;
   wire [0:0] merge_slot_eq_k_1;
   wire [0:0] merge_slot_eq_k_0_1;
-  wire [63:0] cat_54;
+  wire [63:0] cat_53;
   wire [63:0] k_0_5 = 64'h0000000000000000;
   wire [63:0] best_set;
   wire [0:0] q_slot_c4_eq_k_63;
-  wire [0:0] and_55;
+  wire [0:0] and_54;
   wire [0:0] q_slot_c4_eq_k_62;
-  wire [0:0] and_56;
+  wire [0:0] and_55;
   wire [0:0] q_slot_c4_eq_k_61;
-  wire [0:0] and_57;
+  wire [0:0] and_56;
   wire [0:0] q_slot_c4_eq_k_60;
-  wire [0:0] and_58;
+  wire [0:0] and_57;
   wire [0:0] q_slot_c4_eq_k_59;
-  wire [0:0] and_59;
+  wire [0:0] and_58;
   wire [0:0] q_slot_c4_eq_k_58;
-  wire [0:0] and_60;
+  wire [0:0] and_59;
   wire [0:0] q_slot_c4_eq_k_57;
-  wire [0:0] and_61;
+  wire [0:0] and_60;
   wire [0:0] q_slot_c4_eq_k_56;
-  wire [0:0] and_62;
+  wire [0:0] and_61;
   wire [0:0] q_slot_c4_eq_k_55;
-  wire [0:0] and_63;
+  wire [0:0] and_62;
   wire [0:0] q_slot_c4_eq_k_54;
-  wire [0:0] and_64;
+  wire [0:0] and_63;
   wire [0:0] q_slot_c4_eq_k_53;
-  wire [0:0] and_65;
+  wire [0:0] and_64;
   wire [0:0] q_slot_c4_eq_k_52;
-  wire [0:0] and_66;
+  wire [0:0] and_65;
   wire [0:0] q_slot_c4_eq_k_51;
-  wire [0:0] and_67;
+  wire [0:0] and_66;
   wire [0:0] q_slot_c4_eq_k_50;
-  wire [0:0] and_68;
+  wire [0:0] and_67;
   wire [0:0] q_slot_c4_eq_k_49;
-  wire [0:0] and_69;
+  wire [0:0] and_68;
   wire [0:0] q_slot_c4_eq_k_48;
-  wire [0:0] and_70;
-  wire [15:0] cat_71;
+  wire [0:0] and_69;
+  wire [15:0] cat_70;
   wire [0:0] q_slot_c3_eq_k_47;
-  wire [0:0] and_72;
+  wire [0:0] and_71;
   wire [0:0] q_slot_c3_eq_k_46;
-  wire [0:0] and_73;
+  wire [0:0] and_72;
   wire [0:0] q_slot_c3_eq_k_45;
-  wire [0:0] and_74;
+  wire [0:0] and_73;
   wire [0:0] q_slot_c3_eq_k_44;
-  wire [0:0] and_75;
+  wire [0:0] and_74;
   wire [0:0] q_slot_c3_eq_k_43;
-  wire [0:0] and_76;
+  wire [0:0] and_75;
   wire [0:0] q_slot_c3_eq_k_42;
-  wire [0:0] and_77;
+  wire [0:0] and_76;
   wire [0:0] q_slot_c3_eq_k_41;
-  wire [0:0] and_78;
+  wire [0:0] and_77;
   wire [0:0] q_slot_c3_eq_k_40;
-  wire [0:0] and_79;
+  wire [0:0] and_78;
   wire [0:0] q_slot_c3_eq_k_39;
-  wire [0:0] and_80;
+  wire [0:0] and_79;
   wire [0:0] q_slot_c3_eq_k_38;
-  wire [0:0] and_81;
+  wire [0:0] and_80;
   wire [0:0] q_slot_c3_eq_k_37;
-  wire [0:0] and_82;
+  wire [0:0] and_81;
   wire [0:0] q_slot_c3_eq_k_36;
-  wire [0:0] and_83;
+  wire [0:0] and_82;
   wire [0:0] q_slot_c3_eq_k_35;
-  wire [0:0] and_84;
+  wire [0:0] and_83;
   wire [0:0] q_slot_c3_eq_k_34;
-  wire [0:0] and_85;
+  wire [0:0] and_84;
   wire [0:0] q_slot_c3_eq_k_33;
-  wire [0:0] and_86;
+  wire [0:0] and_85;
   wire [0:0] q_slot_c3_eq_k_32;
-  wire [0:0] and_87;
-  wire [15:0] cat_88;
+  wire [0:0] and_86;
+  wire [15:0] cat_87;
   wire [0:0] q_slot_c2_eq_k_31;
-  wire [0:0] and_89;
+  wire [0:0] and_88;
   wire [0:0] q_slot_c2_eq_k_30;
-  wire [0:0] and_90;
+  wire [0:0] and_89;
   wire [0:0] q_slot_c2_eq_k_29;
-  wire [0:0] and_91;
+  wire [0:0] and_90;
   wire [0:0] q_slot_c2_eq_k_28;
-  wire [0:0] and_92;
+  wire [0:0] and_91;
   wire [0:0] q_slot_c2_eq_k_27;
-  wire [0:0] and_93;
+  wire [0:0] and_92;
   wire [0:0] q_slot_c2_eq_k_26;
-  wire [0:0] and_94;
+  wire [0:0] and_93;
   wire [0:0] q_slot_c2_eq_k_25;
-  wire [0:0] and_95;
+  wire [0:0] and_94;
   wire [0:0] q_slot_c2_eq_k_24;
-  wire [0:0] and_96;
+  wire [0:0] and_95;
   wire [0:0] q_slot_c2_eq_k_23;
-  wire [0:0] and_97;
+  wire [0:0] and_96;
   wire [0:0] q_slot_c2_eq_k_22;
-  wire [0:0] and_98;
+  wire [0:0] and_97;
   wire [0:0] q_slot_c2_eq_k_21;
-  wire [0:0] and_99;
+  wire [0:0] and_98;
   wire [0:0] q_slot_c2_eq_k_20;
-  wire [0:0] and_100;
+  wire [0:0] and_99;
   wire [0:0] q_slot_c2_eq_k_19;
-  wire [0:0] and_101;
+  wire [0:0] and_100;
   wire [0:0] q_slot_c2_eq_k_18;
-  wire [0:0] and_102;
+  wire [0:0] and_101;
   wire [0:0] q_slot_c2_eq_k_17;
-  wire [0:0] and_103;
+  wire [0:0] and_102;
   wire [0:0] q_slot_c2_eq_k_16;
-  wire [0:0] and_104;
-  wire [15:0] cat_105;
+  wire [0:0] and_103;
+  wire [15:0] cat_104;
   wire [0:0] q_slot_c1_eq_k_15;
-  wire [0:0] and_106;
+  wire [0:0] and_105;
   wire [0:0] q_slot_c1_eq_k_14;
-  wire [0:0] and_107;
+  wire [0:0] and_106;
   wire [0:0] q_slot_c1_eq_k_13;
-  wire [0:0] and_108;
+  wire [0:0] and_107;
   wire [0:0] q_slot_c1_eq_k_12;
-  wire [0:0] and_109;
+  wire [0:0] and_108;
   wire [0:0] q_slot_c1_eq_k_11;
-  wire [0:0] and_110;
+  wire [0:0] and_109;
   wire [0:0] q_slot_c1_eq_k_10;
-  wire [0:0] and_111;
+  wire [0:0] and_110;
   wire [0:0] q_slot_c1_eq_k_9;
-  wire [0:0] and_112;
+  wire [0:0] and_111;
   wire [0:0] q_slot_c1_eq_k_8;
-  wire [0:0] and_113;
+  wire [0:0] and_112;
   wire [0:0] q_slot_c1_eq_k_7;
-  wire [0:0] and_114;
+  wire [0:0] and_113;
   wire [0:0] q_slot_c1_eq_k_6;
-  wire [0:0] and_115;
+  wire [0:0] and_114;
   wire [0:0] q_slot_c1_eq_k_5;
-  wire [0:0] and_116;
+  wire [0:0] and_115;
   wire [0:0] q_slot_c1_eq_k_4;
-  wire [0:0] and_117;
+  wire [0:0] and_116;
   wire [0:0] q_slot_c1_eq_k_3;
-  wire [0:0] and_118;
+  wire [0:0] and_117;
   wire [0:0] q_slot_c1_eq_k_2;
-  wire [0:0] and_119;
+  wire [0:0] and_118;
   wire [0:0] q_slot_c1_eq_k_1;
-  wire [0:0] and_120;
+  wire [0:0] and_119;
   wire [0:0] q_slot_c1_eq_k_0_1;
-  wire [0:0] and_121;
-  wire [15:0] cat_122;
+  wire [0:0] and_120;
+  wire [15:0] cat_121;
   wire [63:0] best_clear_c;
   reg [63:0] best_clear = 64'h0000000000000000;
   wire [63:0] not_best_clear;
   wire [63:0] has_best_kept_c;
-  wire [63:0] or_125;
+  wire [63:0] or_124;
 
   // register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
   reg [5:0] c_slot = 6'h00;
@@ -870,9 +870,21 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [5:0] c_slot_c2 = 6'h00;
   /* verilator lint_on UNUSEDSIGNAL */
 
-  // register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+  // register copies b2_slot_copies: b2_slot and 5 copies, to split its fan-out
   reg [5:0] b2_slot = 6'h00;
   reg [5:0] b2_slot_c1 = 6'h00;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  reg [5:0] b2_slot_c2 = 6'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  reg [5:0] b2_slot_c3 = 6'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  reg [5:0] b2_slot_c4 = 6'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 3:0 are read
+  reg [5:0] b2_slot_c5 = 6'h00;
+  /* verilator lint_on UNUSEDSIGNAL */
 
   // register copies q_new_copies: q_new and 4 copies, to split its fan-out
   reg [0:0] q_new = 1'h0;
@@ -932,7 +944,9 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [31:0] u_n_tmin;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [30:0] rs_u_n_tmin;
-  wire [58:0] cat_129;
+  wire [58:0] cat_128;
+  reg [0:0] leaf_push_r = 1'h0;
+  reg [58:0] leaf_in_r = 59'h000000000000000;
   reg [0:0] leaf_pop_r = 1'h0;
   reg [5:0] leaf_q_wr = 6'h00;
   reg [5:0] leaf_q_rd = 6'h00;
@@ -951,16 +965,16 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [6:0] leaf_q_count_next;
   wire [0:0] leaf_q_count_eq_k_0;
   wire [0:0] leaf_q_one_left;
-  wire [0:0] and_132;
+  wire [0:0] and_131;
   wire [0:0] leaf_q_drained;
   reg [0:0] leaf_q_bypass = 1'h0;
   wire [0:0] leaf_q_bypass_c;
   reg [0:0] leaf_q_popped = 1'h0;
   reg [0:0] leaf_q_nonempty = 1'h0;
   wire [0:0] k_1_1_lt_leaf_q_count;
-  wire [0:0] or_135;
+  wire [0:0] or_134;
   wire [0:0] not_leaf_pop_r;
-  wire [0:0] and_136;
+  wire [0:0] and_135;
   wire [0:0] leaf_q_nonempty_c;
   reg [58:0] leaf_q_din = 59'h000000000000000;
   wire [15:0] bits_leaf_q_din;
@@ -1121,7 +1135,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] pu_below_1;
   wire [0:0] not_pu_below_1;
   wire [30:0] bits_pu_shifted_1;
-  wire [0:0] ne_147;
+  wire [0:0] ne_146;
   wire [0:0] pu_above_1;
   wire signed [31:0] rs_pu_shifted_1;
   reg [0:0] pu_above_r_1 = 1'h0;
@@ -1146,14 +1160,16 @@ module fxrt_traverse_k64_sf0a3f4 (
   /* verilator lint_off UNUSEDSIGNAL */  // not read
   reg [0:0] plane_t_last_1 = 1'h0;
   /* verilator lint_on UNUSEDSIGNAL */
+  reg signed [31:0] plane_t_land0 = 32'sh00000000;
+  reg signed [31:0] plane_t_land1 = 32'sh00000000;
   reg [1:0] axis_n1 = 2'h0;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
   wire signed [47:0] case_axis_n1;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] negative_c;
-  (* mem2reg *) reg [0:0] negative_sr [1:9];
+  (* mem2reg *) reg [0:0] negative_sr [1:10];
   integer negative_i;
-  initial for (negative_i = 1; negative_i <= 9; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
+  initial for (negative_i = 1; negative_i <= 10; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
   wire [0:0] negative;
 
   // register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
@@ -1190,29 +1206,30 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [0:0] f_valid_8 = 1'h0;
   reg [0:0] f_valid_9 = 1'h0;
   reg [0:0] f_valid_10 = 1'h0;
-  (* mem2reg *) reg [0:0] f_inner_sr [1:10];
+  reg [0:0] f_valid_11 = 1'h0;
+  (* mem2reg *) reg [0:0] f_inner_sr [1:11];
   integer f_inner_i;
-  initial for (f_inner_i = 1; f_inner_i <= 10; f_inner_i = f_inner_i + 1) f_inner_sr[f_inner_i] = 1'h0;
+  initial for (f_inner_i = 1; f_inner_i <= 11; f_inner_i = f_inner_i + 1) f_inner_sr[f_inner_i] = 1'h0;
   wire [0:0] f_inner;
-  (* mem2reg *) reg [5:0] f_slot_sr [1:10];
+  (* mem2reg *) reg [5:0] f_slot_sr [1:11];
   integer f_slot_i;
-  initial for (f_slot_i = 1; f_slot_i <= 10; f_slot_i = f_slot_i + 1) f_slot_sr[f_slot_i] = 6'h00;
+  initial for (f_slot_i = 1; f_slot_i <= 11; f_slot_i = f_slot_i + 1) f_slot_sr[f_slot_i] = 6'h00;
   wire [5:0] f_slot;
-  (* mem2reg *) reg signed [31:0] f_tmin_sr [1:10];
+  (* mem2reg *) reg signed [31:0] f_tmin_sr [1:11];
   integer f_tmin_i;
-  initial for (f_tmin_i = 1; f_tmin_i <= 10; f_tmin_i = f_tmin_i + 1) f_tmin_sr[f_tmin_i] = 32'sh00000000;
+  initial for (f_tmin_i = 1; f_tmin_i <= 11; f_tmin_i = f_tmin_i + 1) f_tmin_sr[f_tmin_i] = 32'sh00000000;
   wire signed [31:0] f_tmin;
-  (* mem2reg *) reg signed [31:0] f_tmax_sr [1:10];
+  (* mem2reg *) reg signed [31:0] f_tmax_sr [1:11];
   integer f_tmax_i;
-  initial for (f_tmax_i = 1; f_tmax_i <= 10; f_tmax_i = f_tmax_i + 1) f_tmax_sr[f_tmax_i] = 32'sh00000000;
+  initial for (f_tmax_i = 1; f_tmax_i <= 11; f_tmax_i = f_tmax_i + 1) f_tmax_sr[f_tmax_i] = 32'sh00000000;
   wire signed [31:0] f_tmax;
-  (* mem2reg *) reg [5:0] f_sp_sr [1:10];
+  (* mem2reg *) reg [5:0] f_sp_sr [1:11];
   integer f_sp_i;
-  initial for (f_sp_i = 1; f_sp_i <= 10; f_sp_i = f_sp_i + 1) f_sp_sr[f_sp_i] = 6'h00;
+  initial for (f_sp_i = 1; f_sp_i <= 11; f_sp_i = f_sp_i + 1) f_sp_sr[f_sp_i] = 6'h00;
   wire [5:0] f_sp;
-  (* mem2reg *) reg [12:0] f_child_sr [1:10];
+  (* mem2reg *) reg [12:0] f_child_sr [1:11];
   integer f_child_i;
-  initial for (f_child_i = 1; f_child_i <= 10; f_child_i = f_child_i + 1) f_child_sr[f_child_i] = 13'h0000;
+  initial for (f_child_i = 1; f_child_i <= 11; f_child_i = f_child_i + 1) f_child_sr[f_child_i] = 13'h0000;
   wire [12:0] f_child;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
   wire signed [47:0] case_axis_n1_1;
@@ -1229,7 +1246,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [32:0] rs_tmin_n1;
   wire signed [32:0] rs_tmax_p1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_151;
+  wire signed [32:0] minus_150;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] tmin_le_tmax_c;
   reg [0:0] tmin_le_tmax = 1'h0;
@@ -1242,53 +1259,53 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [31:0] mux_negative_n1;
   wire signed [31:0] d0_hi_c;
   reg signed [31:0] d0_hi_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d0_hi_sr [1:7];
+  (* mem2reg *) reg signed [31:0] d0_hi_sr [1:8];
   integer d0_hi_i;
-  initial for (d0_hi_i = 1; d0_hi_i <= 7; d0_hi_i = d0_hi_i + 1) d0_hi_sr[d0_hi_i] = 32'sh00000000;
+  initial for (d0_hi_i = 1; d0_hi_i <= 8; d0_hi_i = d0_hi_i + 1) d0_hi_sr[d0_hi_i] = 32'sh00000000;
   wire signed [31:0] d0_hi;
   wire signed [31:0] mux_negative_n1_1;
   wire signed [31:0] d0_lo_c;
   reg signed [31:0] d0_lo_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d0_lo_sr [1:7];
+  (* mem2reg *) reg signed [31:0] d0_lo_sr [1:8];
   integer d0_lo_i;
-  initial for (d0_lo_i = 1; d0_lo_i <= 7; d0_lo_i = d0_lo_i + 1) d0_lo_sr[d0_lo_i] = 32'sh00000000;
+  initial for (d0_lo_i = 1; d0_lo_i <= 8; d0_lo_i = d0_lo_i + 1) d0_lo_sr[d0_lo_i] = 32'sh00000000;
   wire signed [31:0] d0_lo;
   wire signed [31:0] mux_negative_n1_2;
   wire signed [31:0] d1_hi_c;
   reg signed [31:0] d1_hi_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d1_hi_sr [1:7];
+  (* mem2reg *) reg signed [31:0] d1_hi_sr [1:8];
   integer d1_hi_i;
-  initial for (d1_hi_i = 1; d1_hi_i <= 7; d1_hi_i = d1_hi_i + 1) d1_hi_sr[d1_hi_i] = 32'sh00000000;
+  initial for (d1_hi_i = 1; d1_hi_i <= 8; d1_hi_i = d1_hi_i + 1) d1_hi_sr[d1_hi_i] = 32'sh00000000;
   wire signed [31:0] d1_hi;
   wire signed [31:0] mux_negative_n1_3;
   wire signed [31:0] d1_lo_c;
   reg signed [31:0] d1_lo_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d1_lo_sr [1:7];
+  (* mem2reg *) reg signed [31:0] d1_lo_sr [1:8];
   integer d1_lo_i;
-  initial for (d1_lo_i = 1; d1_lo_i <= 7; d1_lo_i = d1_lo_i + 1) d1_lo_sr[d1_lo_i] = 32'sh00000000;
+  initial for (d1_lo_i = 1; d1_lo_i <= 8; d1_lo_i = d1_lo_i + 1) d1_lo_sr[d1_lo_i] = 32'sh00000000;
   wire signed [31:0] d1_lo;
-  wire signed [32:0] rs_plane_t;
+  wire signed [32:0] rs_plane_t_land0;
   wire signed [32:0] rs_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_152;
+  wire signed [32:0] minus_151;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below;
   wire signed [32:0] rs_d0_lo;
-  wire signed [32:0] rs_plane_t_1;
+  wire signed [32:0] rs_plane_t_land0_1;
+  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
+  wire signed [32:0] minus_152;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [0:0] d0_above;
+  wire signed [32:0] rs_plane_t_land1;
+  wire signed [32:0] rs_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
   wire signed [32:0] minus_153;
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [0:0] d0_above;
-  wire signed [32:0] rs_plane_t_1_1;
-  wire signed [32:0] rs_d1_hi;
-  /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_154;
-  /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
   wire signed [32:0] rs_d1_lo;
-  wire signed [32:0] rs_plane_t_1_2;
+  wire signed [32:0] rs_plane_t_land1_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
-  wire signed [32:0] minus_155;
+  wire signed [32:0] minus_154;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_above;
   wire [0:0] near_lt_tmax_c;
@@ -1303,7 +1320,6 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg signed [31:0] near_end = 32'sh00000000;
   wire signed [31:0] mux_negative_1;
   reg signed [31:0] far_start = 32'sh00000000;
-  reg [0:0] g_valid = 1'h0;
   reg [5:0] g_slot = 6'h00;
   reg [12:0] g_child = 13'h0000;
   reg signed [31:0] g_tmin = 32'sh00000000;
@@ -1326,11 +1342,11 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [0:0] push;
   reg [0:0] stack_we_r = 1'h0;
   wire [4:0] rs_g_sp;
-  wire [10:0] cat_157;
+  wire [10:0] cat_156;
   reg [10:0] stack_waddr_r = 11'h000;
   wire [31:0] u_far_min;
   wire [31:0] u_g_tmax;
-  wire [76:0] cat_158;
+  wire [76:0] cat_157;
   reg [76:0] stack_wdata_r = 77'h00000000000000000000;
   wire [0:0] enter_near_or_enter_far;
   wire [0:0] g_pop;
@@ -1346,8 +1362,12 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire [5:0] g_sp_m1;
   wire [0:0] g_done;
   wire [4:0] rs_g_sp_m1;
-  wire [10:0] cat_159;
+  wire [10:0] cat_158;
   wire [10:0] stack_raddr_next;
+
+  // register copies g_valid_copies: g_valid and 1 copies, to split its fan-out
+  reg [0:0] g_valid = 1'h0;
+  reg [0:0] g_valid_c1 = 1'h0;
 
   // not in a stage or state machine
   assign cat_0 = {oz, oy, ox};
@@ -1490,10 +1510,11 @@ module fxrt_traverse_k64_sf0a3f4 (
   end
 
   // stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
-  assign ring_g_valid = g_valid;
+  assign ring_g_valid = g_valid_c1;
   assign unpark_pop = take_unpark;
   assign new_pop = take_new;
-  assign cat_11 = {merge_slot, merge_sp};
+  assign merge_sp_zero = merge_sp == k_0_1;
+  assign cat_11 = {merge_slot, merge_sp, merge_sp_zero};
   assign unpark_q_wr_plus_k_1 = unpark_q_wr + k_1;
   assign mux_unpark_q_push = unpark_q_push ? unpark_q_wr_plus_k_1 : unpark_q_wr;
   assign unpark_q_rd_next = unpark_pop ? unpark_q_rd1 : unpark_q_rd;
@@ -1560,20 +1581,19 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign and_30 = not_ring_g_valid_1 & not_unpark_q_nonempty;
   assign take_new = and_30 & new_q_nonempty;
   assign take_unpark_or_take_new = take_unpark | take_new;
-  assign bits_unpark_q_head = unpark_q_head[11:6];
+  assign bits_unpark_q_head = unpark_q_head[12:7];
   assign bits_new_q_head = new_q_head[38:33];
   assign mux_take_unpark = take_unpark ? bits_unpark_q_head : bits_new_q_head;
-  assign bits_unpark_q_head_1 = unpark_q_head[5:0];
+  assign bits_unpark_q_head_1 = unpark_q_head[6:1];
   assign eq_32 = bits_unpark_q_head_1 == k_0_1;
   assign minus_33 = bits_unpark_q_head_1 - k_1;
   assign rs_minus_33 = minus_33[4:0];
   assign q_stack_raddr = {mux_take_unpark, rs_minus_33};
-  assign bits_unpark_q_head_2 = unpark_q_head[5:0];
-  assign eq_35 = bits_unpark_q_head_2 == k_0_1;
+  assign bits_unpark_q_head_2 = unpark_q_head[0];
   assign bits_new_q_head_1 = new_q_head[0];
-  assign and_36 = take_new & bits_new_q_head_1;
-  assign take_unpark_and_eq_35 = take_unpark & eq_35;
-  assign q_done_c = and_36 | take_unpark_and_eq_35;
+  assign and_35 = take_new & bits_new_q_head_1;
+  assign and_36 = take_unpark & bits_unpark_q_head_2;
+  assign q_done_c = and_35 | and_36;
   assign bits_new_q_head_2 = new_q_head[32:1];
   assign s_bits_new_q_head_2 = $signed(bits_new_q_head_2);
 
@@ -1682,8 +1702,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign r_valid_and_r_done = r_valid & r_done;
   assign not_r_valid = ~r_valid;
   assign not_r_valid_and_q_valid = not_r_valid & q_valid;
-  assign and_38 = not_r_valid_and_q_valid & q_done;
-  assign a_done = r_valid_and_r_done | and_38;
+  assign and_37 = not_r_valid_and_q_valid & q_done;
+  assign a_done = r_valid_and_r_done | and_37;
   assign not_a_sp_zero = ~a_sp_zero;
   assign a_from_stack = a_pop & not_a_sp_zero;
   assign stack_we = stack_we_r;
@@ -1735,14 +1755,14 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign done_q_count_next = done_pop_r ? done_q_count_if_pop : done_q_count_if_kept;
   assign done_q_count_eq_k_0 = done_q_count == k_0;
   assign done_q_one_left = done_q_count == k_1_1;
-  assign and_42 = done_q_one_left & done_pop_r;
-  assign done_q_drained = done_q_count_eq_k_0 | and_42;
+  assign and_41 = done_q_one_left & done_pop_r;
+  assign done_q_drained = done_q_count_eq_k_0 | and_41;
   assign done_q_bypass_c = done_q_push_c1 & done_q_drained;
   assign k_1_1_lt_done_q_count = k_1_1 < done_q_count;
-  assign or_45 = done_q_push_c1 | k_1_1_lt_done_q_count;
+  assign or_44 = done_q_push_c1 | k_1_1_lt_done_q_count;
   assign not_done_pop_r = ~done_pop_r;
-  assign and_46 = done_q_one_left & not_done_pop_r;
-  assign done_q_nonempty_c = or_45 | and_46;
+  assign and_45 = done_q_one_left & not_done_pop_r;
+  assign done_q_nonempty_c = or_44 | and_45;
   assign mux_done_q_popped = done_q_popped ? done_q_q_next : done_q_q_stay;
   assign done_q_head = done_q_bypass ? done_q_din_r : mux_done_q_popped;
 
@@ -1793,9 +1813,9 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign shr_c_tmin = c_tmin >>> 6;
   assign tmin_less = c_tmin - shr_c_tmin;
   assign has_best_kept = has_best_kept_c;
-  assign and_48 = merge_valid & merge_hit;
+  assign and_47 = merge_valid & merge_hit;
   assign merge_slot_eq_b2_slot_c1 = merge_slot == b2_slot_c1;
-  assign b_slot_merged_c = and_48 & merge_slot_eq_b2_slot_c1;
+  assign b_slot_merged_c = and_47 & merge_slot_eq_b2_slot_c1;
   assign bits_has_best_kept = has_best_kept[0];
   assign bits_has_best_kept_1 = has_best_kept[1];
   assign bits_has_best_kept_2 = has_best_kept[2];
@@ -1812,24 +1832,24 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_has_best_kept_13 = has_best_kept[13];
   assign bits_has_best_kept_14 = has_best_kept[14];
   assign bits_has_best_kept_15 = has_best_kept[15];
-  assign bits_b2_slot_c1 = b2_slot_c1[3:0];
+  assign bits_b2_slot_c2 = b2_slot_c2[3:0];
   assign slot_has_best_g0_c =
-    (bits_b2_slot_c1 == 4'h0) ? bits_has_best_kept :
-    (bits_b2_slot_c1 == 4'h1) ? bits_has_best_kept_1 :
-    (bits_b2_slot_c1 == 4'h2) ? bits_has_best_kept_2 :
-    (bits_b2_slot_c1 == 4'h3) ? bits_has_best_kept_3 :
-    (bits_b2_slot_c1 == 4'h4) ? bits_has_best_kept_4 :
-    (bits_b2_slot_c1 == 4'h5) ? bits_has_best_kept_5 :
-    (bits_b2_slot_c1 == 4'h6) ? bits_has_best_kept_6 :
-    (bits_b2_slot_c1 == 4'h7) ? bits_has_best_kept_7 :
-    (bits_b2_slot_c1 == 4'h8) ? bits_has_best_kept_8 :
-    (bits_b2_slot_c1 == 4'h9) ? bits_has_best_kept_9 :
-    (bits_b2_slot_c1 == 4'ha) ? bits_has_best_kept_10 :
-    (bits_b2_slot_c1 == 4'hb) ? bits_has_best_kept_11 :
-    (bits_b2_slot_c1 == 4'hc) ? bits_has_best_kept_12 :
-    (bits_b2_slot_c1 == 4'hd) ? bits_has_best_kept_13 :
-    (bits_b2_slot_c1 == 4'he) ? bits_has_best_kept_14 :
-    (bits_b2_slot_c1 == 4'hf) ? bits_has_best_kept_15 :
+    (bits_b2_slot_c2 == 4'h0) ? bits_has_best_kept :
+    (bits_b2_slot_c2 == 4'h1) ? bits_has_best_kept_1 :
+    (bits_b2_slot_c2 == 4'h2) ? bits_has_best_kept_2 :
+    (bits_b2_slot_c2 == 4'h3) ? bits_has_best_kept_3 :
+    (bits_b2_slot_c2 == 4'h4) ? bits_has_best_kept_4 :
+    (bits_b2_slot_c2 == 4'h5) ? bits_has_best_kept_5 :
+    (bits_b2_slot_c2 == 4'h6) ? bits_has_best_kept_6 :
+    (bits_b2_slot_c2 == 4'h7) ? bits_has_best_kept_7 :
+    (bits_b2_slot_c2 == 4'h8) ? bits_has_best_kept_8 :
+    (bits_b2_slot_c2 == 4'h9) ? bits_has_best_kept_9 :
+    (bits_b2_slot_c2 == 4'ha) ? bits_has_best_kept_10 :
+    (bits_b2_slot_c2 == 4'hb) ? bits_has_best_kept_11 :
+    (bits_b2_slot_c2 == 4'hc) ? bits_has_best_kept_12 :
+    (bits_b2_slot_c2 == 4'hd) ? bits_has_best_kept_13 :
+    (bits_b2_slot_c2 == 4'he) ? bits_has_best_kept_14 :
+    (bits_b2_slot_c2 == 4'hf) ? bits_has_best_kept_15 :
     k_0_4;
   assign bits_has_best_kept_16 = has_best_kept[16];
   assign bits_has_best_kept_17 = has_best_kept[17];
@@ -1847,24 +1867,24 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_has_best_kept_29 = has_best_kept[29];
   assign bits_has_best_kept_30 = has_best_kept[30];
   assign bits_has_best_kept_31 = has_best_kept[31];
-  assign bits_b2_slot_c1_1 = b2_slot_c1[3:0];
+  assign bits_b2_slot_c3 = b2_slot_c3[3:0];
   assign slot_has_best_g1_c =
-    (bits_b2_slot_c1_1 == 4'h0) ? bits_has_best_kept_16 :
-    (bits_b2_slot_c1_1 == 4'h1) ? bits_has_best_kept_17 :
-    (bits_b2_slot_c1_1 == 4'h2) ? bits_has_best_kept_18 :
-    (bits_b2_slot_c1_1 == 4'h3) ? bits_has_best_kept_19 :
-    (bits_b2_slot_c1_1 == 4'h4) ? bits_has_best_kept_20 :
-    (bits_b2_slot_c1_1 == 4'h5) ? bits_has_best_kept_21 :
-    (bits_b2_slot_c1_1 == 4'h6) ? bits_has_best_kept_22 :
-    (bits_b2_slot_c1_1 == 4'h7) ? bits_has_best_kept_23 :
-    (bits_b2_slot_c1_1 == 4'h8) ? bits_has_best_kept_24 :
-    (bits_b2_slot_c1_1 == 4'h9) ? bits_has_best_kept_25 :
-    (bits_b2_slot_c1_1 == 4'ha) ? bits_has_best_kept_26 :
-    (bits_b2_slot_c1_1 == 4'hb) ? bits_has_best_kept_27 :
-    (bits_b2_slot_c1_1 == 4'hc) ? bits_has_best_kept_28 :
-    (bits_b2_slot_c1_1 == 4'hd) ? bits_has_best_kept_29 :
-    (bits_b2_slot_c1_1 == 4'he) ? bits_has_best_kept_30 :
-    (bits_b2_slot_c1_1 == 4'hf) ? bits_has_best_kept_31 :
+    (bits_b2_slot_c3 == 4'h0) ? bits_has_best_kept_16 :
+    (bits_b2_slot_c3 == 4'h1) ? bits_has_best_kept_17 :
+    (bits_b2_slot_c3 == 4'h2) ? bits_has_best_kept_18 :
+    (bits_b2_slot_c3 == 4'h3) ? bits_has_best_kept_19 :
+    (bits_b2_slot_c3 == 4'h4) ? bits_has_best_kept_20 :
+    (bits_b2_slot_c3 == 4'h5) ? bits_has_best_kept_21 :
+    (bits_b2_slot_c3 == 4'h6) ? bits_has_best_kept_22 :
+    (bits_b2_slot_c3 == 4'h7) ? bits_has_best_kept_23 :
+    (bits_b2_slot_c3 == 4'h8) ? bits_has_best_kept_24 :
+    (bits_b2_slot_c3 == 4'h9) ? bits_has_best_kept_25 :
+    (bits_b2_slot_c3 == 4'ha) ? bits_has_best_kept_26 :
+    (bits_b2_slot_c3 == 4'hb) ? bits_has_best_kept_27 :
+    (bits_b2_slot_c3 == 4'hc) ? bits_has_best_kept_28 :
+    (bits_b2_slot_c3 == 4'hd) ? bits_has_best_kept_29 :
+    (bits_b2_slot_c3 == 4'he) ? bits_has_best_kept_30 :
+    (bits_b2_slot_c3 == 4'hf) ? bits_has_best_kept_31 :
     k_0_4;
   assign bits_has_best_kept_32 = has_best_kept[32];
   assign bits_has_best_kept_33 = has_best_kept[33];
@@ -1882,24 +1902,24 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_has_best_kept_45 = has_best_kept[45];
   assign bits_has_best_kept_46 = has_best_kept[46];
   assign bits_has_best_kept_47 = has_best_kept[47];
-  assign bits_b2_slot_c1_2 = b2_slot_c1[3:0];
+  assign bits_b2_slot_c4 = b2_slot_c4[3:0];
   assign slot_has_best_g2_c =
-    (bits_b2_slot_c1_2 == 4'h0) ? bits_has_best_kept_32 :
-    (bits_b2_slot_c1_2 == 4'h1) ? bits_has_best_kept_33 :
-    (bits_b2_slot_c1_2 == 4'h2) ? bits_has_best_kept_34 :
-    (bits_b2_slot_c1_2 == 4'h3) ? bits_has_best_kept_35 :
-    (bits_b2_slot_c1_2 == 4'h4) ? bits_has_best_kept_36 :
-    (bits_b2_slot_c1_2 == 4'h5) ? bits_has_best_kept_37 :
-    (bits_b2_slot_c1_2 == 4'h6) ? bits_has_best_kept_38 :
-    (bits_b2_slot_c1_2 == 4'h7) ? bits_has_best_kept_39 :
-    (bits_b2_slot_c1_2 == 4'h8) ? bits_has_best_kept_40 :
-    (bits_b2_slot_c1_2 == 4'h9) ? bits_has_best_kept_41 :
-    (bits_b2_slot_c1_2 == 4'ha) ? bits_has_best_kept_42 :
-    (bits_b2_slot_c1_2 == 4'hb) ? bits_has_best_kept_43 :
-    (bits_b2_slot_c1_2 == 4'hc) ? bits_has_best_kept_44 :
-    (bits_b2_slot_c1_2 == 4'hd) ? bits_has_best_kept_45 :
-    (bits_b2_slot_c1_2 == 4'he) ? bits_has_best_kept_46 :
-    (bits_b2_slot_c1_2 == 4'hf) ? bits_has_best_kept_47 :
+    (bits_b2_slot_c4 == 4'h0) ? bits_has_best_kept_32 :
+    (bits_b2_slot_c4 == 4'h1) ? bits_has_best_kept_33 :
+    (bits_b2_slot_c4 == 4'h2) ? bits_has_best_kept_34 :
+    (bits_b2_slot_c4 == 4'h3) ? bits_has_best_kept_35 :
+    (bits_b2_slot_c4 == 4'h4) ? bits_has_best_kept_36 :
+    (bits_b2_slot_c4 == 4'h5) ? bits_has_best_kept_37 :
+    (bits_b2_slot_c4 == 4'h6) ? bits_has_best_kept_38 :
+    (bits_b2_slot_c4 == 4'h7) ? bits_has_best_kept_39 :
+    (bits_b2_slot_c4 == 4'h8) ? bits_has_best_kept_40 :
+    (bits_b2_slot_c4 == 4'h9) ? bits_has_best_kept_41 :
+    (bits_b2_slot_c4 == 4'ha) ? bits_has_best_kept_42 :
+    (bits_b2_slot_c4 == 4'hb) ? bits_has_best_kept_43 :
+    (bits_b2_slot_c4 == 4'hc) ? bits_has_best_kept_44 :
+    (bits_b2_slot_c4 == 4'hd) ? bits_has_best_kept_45 :
+    (bits_b2_slot_c4 == 4'he) ? bits_has_best_kept_46 :
+    (bits_b2_slot_c4 == 4'hf) ? bits_has_best_kept_47 :
     k_0_4;
   assign bits_has_best_kept_48 = has_best_kept[48];
   assign bits_has_best_kept_49 = has_best_kept[49];
@@ -1917,24 +1937,24 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign bits_has_best_kept_61 = has_best_kept[61];
   assign bits_has_best_kept_62 = has_best_kept[62];
   assign bits_has_best_kept_63 = has_best_kept[63];
-  assign bits_b2_slot_c1_3 = b2_slot_c1[3:0];
+  assign bits_b2_slot_c5 = b2_slot_c5[3:0];
   assign slot_has_best_g3_c =
-    (bits_b2_slot_c1_3 == 4'h0) ? bits_has_best_kept_48 :
-    (bits_b2_slot_c1_3 == 4'h1) ? bits_has_best_kept_49 :
-    (bits_b2_slot_c1_3 == 4'h2) ? bits_has_best_kept_50 :
-    (bits_b2_slot_c1_3 == 4'h3) ? bits_has_best_kept_51 :
-    (bits_b2_slot_c1_3 == 4'h4) ? bits_has_best_kept_52 :
-    (bits_b2_slot_c1_3 == 4'h5) ? bits_has_best_kept_53 :
-    (bits_b2_slot_c1_3 == 4'h6) ? bits_has_best_kept_54 :
-    (bits_b2_slot_c1_3 == 4'h7) ? bits_has_best_kept_55 :
-    (bits_b2_slot_c1_3 == 4'h8) ? bits_has_best_kept_56 :
-    (bits_b2_slot_c1_3 == 4'h9) ? bits_has_best_kept_57 :
-    (bits_b2_slot_c1_3 == 4'ha) ? bits_has_best_kept_58 :
-    (bits_b2_slot_c1_3 == 4'hb) ? bits_has_best_kept_59 :
-    (bits_b2_slot_c1_3 == 4'hc) ? bits_has_best_kept_60 :
-    (bits_b2_slot_c1_3 == 4'hd) ? bits_has_best_kept_61 :
-    (bits_b2_slot_c1_3 == 4'he) ? bits_has_best_kept_62 :
-    (bits_b2_slot_c1_3 == 4'hf) ? bits_has_best_kept_63 :
+    (bits_b2_slot_c5 == 4'h0) ? bits_has_best_kept_48 :
+    (bits_b2_slot_c5 == 4'h1) ? bits_has_best_kept_49 :
+    (bits_b2_slot_c5 == 4'h2) ? bits_has_best_kept_50 :
+    (bits_b2_slot_c5 == 4'h3) ? bits_has_best_kept_51 :
+    (bits_b2_slot_c5 == 4'h4) ? bits_has_best_kept_52 :
+    (bits_b2_slot_c5 == 4'h5) ? bits_has_best_kept_53 :
+    (bits_b2_slot_c5 == 4'h6) ? bits_has_best_kept_54 :
+    (bits_b2_slot_c5 == 4'h7) ? bits_has_best_kept_55 :
+    (bits_b2_slot_c5 == 4'h8) ? bits_has_best_kept_56 :
+    (bits_b2_slot_c5 == 4'h9) ? bits_has_best_kept_57 :
+    (bits_b2_slot_c5 == 4'ha) ? bits_has_best_kept_58 :
+    (bits_b2_slot_c5 == 4'hb) ? bits_has_best_kept_59 :
+    (bits_b2_slot_c5 == 4'hc) ? bits_has_best_kept_60 :
+    (bits_b2_slot_c5 == 4'hd) ? bits_has_best_kept_61 :
+    (bits_b2_slot_c5 == 4'he) ? bits_has_best_kept_62 :
+    (bits_b2_slot_c5 == 4'hf) ? bits_has_best_kept_63 :
     k_0_4;
   assign bits_c_slot_c2 = c_slot_c2[5:4];
   assign slot_has_best_c =
@@ -1946,10 +1966,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign slot_has_best_now = slot_has_best_c | b_slot_merged;
   assign rs_s_limit_q = $signed({{1{s_limit_q[31]}}, s_limit_q});
   assign rs_cull_x = $signed({{1{cull_x[31]}}, cull_x});
-  assign minus_51 = rs_s_limit_q - rs_cull_x;
-  assign bits_minus_51 = minus_51[32];
-  assign culled_c = cull_has_best & bits_minus_51;
-  assign and_53 = merge_valid & merge_hit;
+  assign minus_50 = rs_s_limit_q - rs_cull_x;
+  assign bits_minus_50 = minus_50[32];
+  assign culled_c = cull_has_best & bits_minus_50;
+  assign and_52 = merge_valid & merge_hit;
   assign merge_slot_eq_k_63 = merge_slot == k_63;
   assign merge_slot_eq_k_62 = merge_slot == k_62;
   assign merge_slot_eq_k_61 = merge_slot == k_61;
@@ -2014,144 +2034,144 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign merge_slot_eq_k_2 = merge_slot == k_2;
   assign merge_slot_eq_k_1 = merge_slot == k_1;
   assign merge_slot_eq_k_0_1 = merge_slot == k_0_1;
-  assign cat_54 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
-  assign best_set = and_53 ? cat_54 : k_0_5;
+  assign cat_53 = {merge_slot_eq_k_63, merge_slot_eq_k_62, merge_slot_eq_k_61, merge_slot_eq_k_60, merge_slot_eq_k_59, merge_slot_eq_k_58, merge_slot_eq_k_57, merge_slot_eq_k_56, merge_slot_eq_k_55, merge_slot_eq_k_54, merge_slot_eq_k_53, merge_slot_eq_k_52, merge_slot_eq_k_51, merge_slot_eq_k_50, merge_slot_eq_k_49, merge_slot_eq_k_48, merge_slot_eq_k_47, merge_slot_eq_k_46, merge_slot_eq_k_45, merge_slot_eq_k_44, merge_slot_eq_k_43, merge_slot_eq_k_42, merge_slot_eq_k_41, merge_slot_eq_k_40, merge_slot_eq_k_39, merge_slot_eq_k_38, merge_slot_eq_k_37, merge_slot_eq_k_36, merge_slot_eq_k_35, merge_slot_eq_k_34, merge_slot_eq_k_33, merge_slot_eq_k_32, merge_slot_eq_k_31, merge_slot_eq_k_30, merge_slot_eq_k_29, merge_slot_eq_k_28, merge_slot_eq_k_27, merge_slot_eq_k_26, merge_slot_eq_k_25, merge_slot_eq_k_24, merge_slot_eq_k_23, merge_slot_eq_k_22, merge_slot_eq_k_21, merge_slot_eq_k_20, merge_slot_eq_k_19, merge_slot_eq_k_18, merge_slot_eq_k_17, merge_slot_eq_k_16, merge_slot_eq_k_15, merge_slot_eq_k_14, merge_slot_eq_k_13, merge_slot_eq_k_12, merge_slot_eq_k_11, merge_slot_eq_k_10, merge_slot_eq_k_9, merge_slot_eq_k_8, merge_slot_eq_k_7, merge_slot_eq_k_6, merge_slot_eq_k_5, merge_slot_eq_k_4, merge_slot_eq_k_3, merge_slot_eq_k_2, merge_slot_eq_k_1, merge_slot_eq_k_0_1};
+  assign best_set = and_52 ? cat_53 : k_0_5;
   assign q_slot_c4_eq_k_63 = q_slot_c4 == k_63;
-  assign and_55 = q_new_c4 & q_slot_c4_eq_k_63;
+  assign and_54 = q_new_c4 & q_slot_c4_eq_k_63;
   assign q_slot_c4_eq_k_62 = q_slot_c4 == k_62;
-  assign and_56 = q_new_c4 & q_slot_c4_eq_k_62;
+  assign and_55 = q_new_c4 & q_slot_c4_eq_k_62;
   assign q_slot_c4_eq_k_61 = q_slot_c4 == k_61;
-  assign and_57 = q_new_c4 & q_slot_c4_eq_k_61;
+  assign and_56 = q_new_c4 & q_slot_c4_eq_k_61;
   assign q_slot_c4_eq_k_60 = q_slot_c4 == k_60;
-  assign and_58 = q_new_c4 & q_slot_c4_eq_k_60;
+  assign and_57 = q_new_c4 & q_slot_c4_eq_k_60;
   assign q_slot_c4_eq_k_59 = q_slot_c4 == k_59;
-  assign and_59 = q_new_c4 & q_slot_c4_eq_k_59;
+  assign and_58 = q_new_c4 & q_slot_c4_eq_k_59;
   assign q_slot_c4_eq_k_58 = q_slot_c4 == k_58;
-  assign and_60 = q_new_c4 & q_slot_c4_eq_k_58;
+  assign and_59 = q_new_c4 & q_slot_c4_eq_k_58;
   assign q_slot_c4_eq_k_57 = q_slot_c4 == k_57;
-  assign and_61 = q_new_c4 & q_slot_c4_eq_k_57;
+  assign and_60 = q_new_c4 & q_slot_c4_eq_k_57;
   assign q_slot_c4_eq_k_56 = q_slot_c4 == k_56;
-  assign and_62 = q_new_c4 & q_slot_c4_eq_k_56;
+  assign and_61 = q_new_c4 & q_slot_c4_eq_k_56;
   assign q_slot_c4_eq_k_55 = q_slot_c4 == k_55;
-  assign and_63 = q_new_c4 & q_slot_c4_eq_k_55;
+  assign and_62 = q_new_c4 & q_slot_c4_eq_k_55;
   assign q_slot_c4_eq_k_54 = q_slot_c4 == k_54;
-  assign and_64 = q_new_c4 & q_slot_c4_eq_k_54;
+  assign and_63 = q_new_c4 & q_slot_c4_eq_k_54;
   assign q_slot_c4_eq_k_53 = q_slot_c4 == k_53;
-  assign and_65 = q_new_c4 & q_slot_c4_eq_k_53;
+  assign and_64 = q_new_c4 & q_slot_c4_eq_k_53;
   assign q_slot_c4_eq_k_52 = q_slot_c4 == k_52;
-  assign and_66 = q_new_c4 & q_slot_c4_eq_k_52;
+  assign and_65 = q_new_c4 & q_slot_c4_eq_k_52;
   assign q_slot_c4_eq_k_51 = q_slot_c4 == k_51;
-  assign and_67 = q_new_c4 & q_slot_c4_eq_k_51;
+  assign and_66 = q_new_c4 & q_slot_c4_eq_k_51;
   assign q_slot_c4_eq_k_50 = q_slot_c4 == k_50;
-  assign and_68 = q_new_c4 & q_slot_c4_eq_k_50;
+  assign and_67 = q_new_c4 & q_slot_c4_eq_k_50;
   assign q_slot_c4_eq_k_49 = q_slot_c4 == k_49;
-  assign and_69 = q_new_c4 & q_slot_c4_eq_k_49;
+  assign and_68 = q_new_c4 & q_slot_c4_eq_k_49;
   assign q_slot_c4_eq_k_48 = q_slot_c4 == k_48;
-  assign and_70 = q_new_c4 & q_slot_c4_eq_k_48;
-  assign cat_71 = {and_55, and_56, and_57, and_58, and_59, and_60, and_61, and_62, and_63, and_64, and_65, and_66, and_67, and_68, and_69, and_70};
+  assign and_69 = q_new_c4 & q_slot_c4_eq_k_48;
+  assign cat_70 = {and_54, and_55, and_56, and_57, and_58, and_59, and_60, and_61, and_62, and_63, and_64, and_65, and_66, and_67, and_68, and_69};
   assign q_slot_c3_eq_k_47 = q_slot_c3 == k_47;
-  assign and_72 = q_new_c3 & q_slot_c3_eq_k_47;
+  assign and_71 = q_new_c3 & q_slot_c3_eq_k_47;
   assign q_slot_c3_eq_k_46 = q_slot_c3 == k_46;
-  assign and_73 = q_new_c3 & q_slot_c3_eq_k_46;
+  assign and_72 = q_new_c3 & q_slot_c3_eq_k_46;
   assign q_slot_c3_eq_k_45 = q_slot_c3 == k_45;
-  assign and_74 = q_new_c3 & q_slot_c3_eq_k_45;
+  assign and_73 = q_new_c3 & q_slot_c3_eq_k_45;
   assign q_slot_c3_eq_k_44 = q_slot_c3 == k_44;
-  assign and_75 = q_new_c3 & q_slot_c3_eq_k_44;
+  assign and_74 = q_new_c3 & q_slot_c3_eq_k_44;
   assign q_slot_c3_eq_k_43 = q_slot_c3 == k_43;
-  assign and_76 = q_new_c3 & q_slot_c3_eq_k_43;
+  assign and_75 = q_new_c3 & q_slot_c3_eq_k_43;
   assign q_slot_c3_eq_k_42 = q_slot_c3 == k_42;
-  assign and_77 = q_new_c3 & q_slot_c3_eq_k_42;
+  assign and_76 = q_new_c3 & q_slot_c3_eq_k_42;
   assign q_slot_c3_eq_k_41 = q_slot_c3 == k_41;
-  assign and_78 = q_new_c3 & q_slot_c3_eq_k_41;
+  assign and_77 = q_new_c3 & q_slot_c3_eq_k_41;
   assign q_slot_c3_eq_k_40 = q_slot_c3 == k_40;
-  assign and_79 = q_new_c3 & q_slot_c3_eq_k_40;
+  assign and_78 = q_new_c3 & q_slot_c3_eq_k_40;
   assign q_slot_c3_eq_k_39 = q_slot_c3 == k_39;
-  assign and_80 = q_new_c3 & q_slot_c3_eq_k_39;
+  assign and_79 = q_new_c3 & q_slot_c3_eq_k_39;
   assign q_slot_c3_eq_k_38 = q_slot_c3 == k_38;
-  assign and_81 = q_new_c3 & q_slot_c3_eq_k_38;
+  assign and_80 = q_new_c3 & q_slot_c3_eq_k_38;
   assign q_slot_c3_eq_k_37 = q_slot_c3 == k_37;
-  assign and_82 = q_new_c3 & q_slot_c3_eq_k_37;
+  assign and_81 = q_new_c3 & q_slot_c3_eq_k_37;
   assign q_slot_c3_eq_k_36 = q_slot_c3 == k_36;
-  assign and_83 = q_new_c3 & q_slot_c3_eq_k_36;
+  assign and_82 = q_new_c3 & q_slot_c3_eq_k_36;
   assign q_slot_c3_eq_k_35 = q_slot_c3 == k_35;
-  assign and_84 = q_new_c3 & q_slot_c3_eq_k_35;
+  assign and_83 = q_new_c3 & q_slot_c3_eq_k_35;
   assign q_slot_c3_eq_k_34 = q_slot_c3 == k_34;
-  assign and_85 = q_new_c3 & q_slot_c3_eq_k_34;
+  assign and_84 = q_new_c3 & q_slot_c3_eq_k_34;
   assign q_slot_c3_eq_k_33 = q_slot_c3 == k_33;
-  assign and_86 = q_new_c3 & q_slot_c3_eq_k_33;
+  assign and_85 = q_new_c3 & q_slot_c3_eq_k_33;
   assign q_slot_c3_eq_k_32 = q_slot_c3 == k_32;
-  assign and_87 = q_new_c3 & q_slot_c3_eq_k_32;
-  assign cat_88 = {and_72, and_73, and_74, and_75, and_76, and_77, and_78, and_79, and_80, and_81, and_82, and_83, and_84, and_85, and_86, and_87};
+  assign and_86 = q_new_c3 & q_slot_c3_eq_k_32;
+  assign cat_87 = {and_71, and_72, and_73, and_74, and_75, and_76, and_77, and_78, and_79, and_80, and_81, and_82, and_83, and_84, and_85, and_86};
   assign q_slot_c2_eq_k_31 = q_slot_c2 == k_31;
-  assign and_89 = q_new_c2 & q_slot_c2_eq_k_31;
+  assign and_88 = q_new_c2 & q_slot_c2_eq_k_31;
   assign q_slot_c2_eq_k_30 = q_slot_c2 == k_30;
-  assign and_90 = q_new_c2 & q_slot_c2_eq_k_30;
+  assign and_89 = q_new_c2 & q_slot_c2_eq_k_30;
   assign q_slot_c2_eq_k_29 = q_slot_c2 == k_29;
-  assign and_91 = q_new_c2 & q_slot_c2_eq_k_29;
+  assign and_90 = q_new_c2 & q_slot_c2_eq_k_29;
   assign q_slot_c2_eq_k_28 = q_slot_c2 == k_28;
-  assign and_92 = q_new_c2 & q_slot_c2_eq_k_28;
+  assign and_91 = q_new_c2 & q_slot_c2_eq_k_28;
   assign q_slot_c2_eq_k_27 = q_slot_c2 == k_27;
-  assign and_93 = q_new_c2 & q_slot_c2_eq_k_27;
+  assign and_92 = q_new_c2 & q_slot_c2_eq_k_27;
   assign q_slot_c2_eq_k_26 = q_slot_c2 == k_26;
-  assign and_94 = q_new_c2 & q_slot_c2_eq_k_26;
+  assign and_93 = q_new_c2 & q_slot_c2_eq_k_26;
   assign q_slot_c2_eq_k_25 = q_slot_c2 == k_25;
-  assign and_95 = q_new_c2 & q_slot_c2_eq_k_25;
+  assign and_94 = q_new_c2 & q_slot_c2_eq_k_25;
   assign q_slot_c2_eq_k_24 = q_slot_c2 == k_24;
-  assign and_96 = q_new_c2 & q_slot_c2_eq_k_24;
+  assign and_95 = q_new_c2 & q_slot_c2_eq_k_24;
   assign q_slot_c2_eq_k_23 = q_slot_c2 == k_23;
-  assign and_97 = q_new_c2 & q_slot_c2_eq_k_23;
+  assign and_96 = q_new_c2 & q_slot_c2_eq_k_23;
   assign q_slot_c2_eq_k_22 = q_slot_c2 == k_22;
-  assign and_98 = q_new_c2 & q_slot_c2_eq_k_22;
+  assign and_97 = q_new_c2 & q_slot_c2_eq_k_22;
   assign q_slot_c2_eq_k_21 = q_slot_c2 == k_21;
-  assign and_99 = q_new_c2 & q_slot_c2_eq_k_21;
+  assign and_98 = q_new_c2 & q_slot_c2_eq_k_21;
   assign q_slot_c2_eq_k_20 = q_slot_c2 == k_20;
-  assign and_100 = q_new_c2 & q_slot_c2_eq_k_20;
+  assign and_99 = q_new_c2 & q_slot_c2_eq_k_20;
   assign q_slot_c2_eq_k_19 = q_slot_c2 == k_19;
-  assign and_101 = q_new_c2 & q_slot_c2_eq_k_19;
+  assign and_100 = q_new_c2 & q_slot_c2_eq_k_19;
   assign q_slot_c2_eq_k_18 = q_slot_c2 == k_18;
-  assign and_102 = q_new_c2 & q_slot_c2_eq_k_18;
+  assign and_101 = q_new_c2 & q_slot_c2_eq_k_18;
   assign q_slot_c2_eq_k_17 = q_slot_c2 == k_17;
-  assign and_103 = q_new_c2 & q_slot_c2_eq_k_17;
+  assign and_102 = q_new_c2 & q_slot_c2_eq_k_17;
   assign q_slot_c2_eq_k_16 = q_slot_c2 == k_16;
-  assign and_104 = q_new_c2 & q_slot_c2_eq_k_16;
-  assign cat_105 = {and_89, and_90, and_91, and_92, and_93, and_94, and_95, and_96, and_97, and_98, and_99, and_100, and_101, and_102, and_103, and_104};
+  assign and_103 = q_new_c2 & q_slot_c2_eq_k_16;
+  assign cat_104 = {and_88, and_89, and_90, and_91, and_92, and_93, and_94, and_95, and_96, and_97, and_98, and_99, and_100, and_101, and_102, and_103};
   assign q_slot_c1_eq_k_15 = q_slot_c1 == k_15;
-  assign and_106 = q_new_c1 & q_slot_c1_eq_k_15;
+  assign and_105 = q_new_c1 & q_slot_c1_eq_k_15;
   assign q_slot_c1_eq_k_14 = q_slot_c1 == k_14;
-  assign and_107 = q_new_c1 & q_slot_c1_eq_k_14;
+  assign and_106 = q_new_c1 & q_slot_c1_eq_k_14;
   assign q_slot_c1_eq_k_13 = q_slot_c1 == k_13;
-  assign and_108 = q_new_c1 & q_slot_c1_eq_k_13;
+  assign and_107 = q_new_c1 & q_slot_c1_eq_k_13;
   assign q_slot_c1_eq_k_12 = q_slot_c1 == k_12;
-  assign and_109 = q_new_c1 & q_slot_c1_eq_k_12;
+  assign and_108 = q_new_c1 & q_slot_c1_eq_k_12;
   assign q_slot_c1_eq_k_11 = q_slot_c1 == k_11;
-  assign and_110 = q_new_c1 & q_slot_c1_eq_k_11;
+  assign and_109 = q_new_c1 & q_slot_c1_eq_k_11;
   assign q_slot_c1_eq_k_10 = q_slot_c1 == k_10;
-  assign and_111 = q_new_c1 & q_slot_c1_eq_k_10;
+  assign and_110 = q_new_c1 & q_slot_c1_eq_k_10;
   assign q_slot_c1_eq_k_9 = q_slot_c1 == k_9;
-  assign and_112 = q_new_c1 & q_slot_c1_eq_k_9;
+  assign and_111 = q_new_c1 & q_slot_c1_eq_k_9;
   assign q_slot_c1_eq_k_8 = q_slot_c1 == k_8;
-  assign and_113 = q_new_c1 & q_slot_c1_eq_k_8;
+  assign and_112 = q_new_c1 & q_slot_c1_eq_k_8;
   assign q_slot_c1_eq_k_7 = q_slot_c1 == k_7;
-  assign and_114 = q_new_c1 & q_slot_c1_eq_k_7;
+  assign and_113 = q_new_c1 & q_slot_c1_eq_k_7;
   assign q_slot_c1_eq_k_6 = q_slot_c1 == k_6;
-  assign and_115 = q_new_c1 & q_slot_c1_eq_k_6;
+  assign and_114 = q_new_c1 & q_slot_c1_eq_k_6;
   assign q_slot_c1_eq_k_5 = q_slot_c1 == k_5;
-  assign and_116 = q_new_c1 & q_slot_c1_eq_k_5;
+  assign and_115 = q_new_c1 & q_slot_c1_eq_k_5;
   assign q_slot_c1_eq_k_4 = q_slot_c1 == k_4;
-  assign and_117 = q_new_c1 & q_slot_c1_eq_k_4;
+  assign and_116 = q_new_c1 & q_slot_c1_eq_k_4;
   assign q_slot_c1_eq_k_3 = q_slot_c1 == k_3;
-  assign and_118 = q_new_c1 & q_slot_c1_eq_k_3;
+  assign and_117 = q_new_c1 & q_slot_c1_eq_k_3;
   assign q_slot_c1_eq_k_2 = q_slot_c1 == k_2;
-  assign and_119 = q_new_c1 & q_slot_c1_eq_k_2;
+  assign and_118 = q_new_c1 & q_slot_c1_eq_k_2;
   assign q_slot_c1_eq_k_1 = q_slot_c1 == k_1;
-  assign and_120 = q_new_c1 & q_slot_c1_eq_k_1;
+  assign and_119 = q_new_c1 & q_slot_c1_eq_k_1;
   assign q_slot_c1_eq_k_0_1 = q_slot_c1 == k_0_1;
-  assign and_121 = q_new_c1 & q_slot_c1_eq_k_0_1;
-  assign cat_122 = {and_106, and_107, and_108, and_109, and_110, and_111, and_112, and_113, and_114, and_115, and_116, and_117, and_118, and_119, and_120, and_121};
-  assign best_clear_c = {cat_71, cat_88, cat_105, cat_122};
+  assign and_120 = q_new_c1 & q_slot_c1_eq_k_0_1;
+  assign cat_121 = {and_105, and_106, and_107, and_108, and_109, and_110, and_111, and_112, and_113, and_114, and_115, and_116, and_117, and_118, and_119, and_120};
+  assign best_clear_c = {cat_70, cat_87, cat_104, cat_121};
   assign not_best_clear = ~best_clear;
   assign has_best_kept_c = has_best & not_best_clear;
-  assign or_125 = has_best_kept | best_set;
+  assign or_124 = has_best_kept | best_set;
 
   always @(posedge clk) begin : ring_c_regs
     if (rst) c_valid <= 1'h0;
@@ -2162,7 +2182,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     c_sp <= b2_sp;
     limit_q <= cull_limit[c_slot_c1];
     if (rst) has_best <= 64'h0000000000000000;
-    else has_best <= or_125;
+    else has_best <= or_124;
     cull_x <= tmin_less;
     b_slot_merged <= b_slot_merged_c;
     slot_has_best_g0 <= slot_has_best_g0_c;
@@ -2183,11 +2203,15 @@ module fxrt_traverse_k64_sf0a3f4 (
     c_slot_c2 <= b2_slot;
   end
 
-  // register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+  // register copies b2_slot_copies: b2_slot and 5 copies, to split its fan-out
 
   (* keep *) always @(posedge clk) begin : b2_slot_copies_regs
     b2_slot <= b_slot;
     b2_slot_c1 <= b_slot;
+    b2_slot_c2 <= b_slot;
+    b2_slot_c3 <= b_slot;
+    b2_slot_c4 <= b_slot;
+    b2_slot_c5 <= b_slot;
   end
 
   // register copies q_new_copies: q_new and 4 copies, to split its fan-out
@@ -2232,7 +2256,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_push = visit_c_and_nw_is_leaf & nw_count_ne_k_0_6;
   assign u_n_tmin = $unsigned(n_tmin);
   assign rs_u_n_tmin = u_n_tmin[30:0];
-  assign cat_129 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
+  assign cat_128 = {n_slot, nw_first, nw_count, rs_u_n_tmin, n_sp};
   assign leaf_q_wr_plus_k_1 = leaf_q_wr + k_1;
   assign mux_leaf_q_push = leaf_q_push ? leaf_q_wr_plus_k_1 : leaf_q_wr;
   assign leaf_q_rd_next = leaf_pop_r ? leaf_q_rd1 : leaf_q_rd;
@@ -2246,14 +2270,14 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign leaf_q_count_next = leaf_pop_r ? leaf_q_count_if_pop : leaf_q_count_if_kept;
   assign leaf_q_count_eq_k_0 = leaf_q_count == k_0;
   assign leaf_q_one_left = leaf_q_count == k_1_1;
-  assign and_132 = leaf_q_one_left & leaf_pop_r;
-  assign leaf_q_drained = leaf_q_count_eq_k_0 | and_132;
+  assign and_131 = leaf_q_one_left & leaf_pop_r;
+  assign leaf_q_drained = leaf_q_count_eq_k_0 | and_131;
   assign leaf_q_bypass_c = leaf_q_push_c1 & leaf_q_drained;
   assign k_1_1_lt_leaf_q_count = k_1_1 < leaf_q_count;
-  assign or_135 = leaf_q_push_c1 | k_1_1_lt_leaf_q_count;
+  assign or_134 = leaf_q_push_c1 | k_1_1_lt_leaf_q_count;
   assign not_leaf_pop_r = ~leaf_pop_r;
-  assign and_136 = leaf_q_one_left & not_leaf_pop_r;
-  assign leaf_q_nonempty_c = or_135 | and_136;
+  assign and_135 = leaf_q_one_left & not_leaf_pop_r;
+  assign leaf_q_nonempty_c = or_134 | and_135;
   assign bits_leaf_q_din = leaf_q_din[15:0];
   assign bits_leaf_q_din_1 = leaf_q_din[31:16];
   assign bits_leaf_q_din_2 = leaf_q_din[47:32];
@@ -2329,8 +2353,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign pu_below_1 = pu_shifted_1[61];
   assign not_pu_below_1 = ~pu_below_1;
   assign bits_pu_shifted_1 = pu_shifted_1[60:30];
-  assign ne_147 = bits_pu_shifted_1 != k_0_7;
-  assign pu_above_1 = not_pu_below_1 & ne_147;
+  assign ne_146 = bits_pu_shifted_1 != k_0_7;
+  assign pu_above_1 = not_pu_below_1 & ne_146;
   assign rs_pu_shifted_1 = $signed(pu_shifted_1[31:0]);
   assign mux_pu_below_r_1 = pu_below_r_1 ? k_m1 : pu_low_r_1;
   assign pu_clamped_1 = pu_above_r_1 ? k_1073741824 : mux_pu_below_r_1;
@@ -2341,7 +2365,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     (axis_n1 == 2'h2) ? s_ray_invz_q :
     s_ray_invx_q;
   assign negative_c = case_axis_n1[47];
-  assign negative = negative_sr[9];
+  assign negative = negative_sr[10];
 
   always @(posedge clk) begin : ring_n_regs
     if (rst) n_valid_1 <= 1'h0;
@@ -2365,6 +2389,9 @@ module fxrt_traverse_k64_sf0a3f4 (
     n_sp_sr[3] <= n_sp_sr[2];
     n_sp_sr[2] <= n_sp_sr[1];
     n_sp_sr[1] <= c_sp;
+    if (rst) leaf_push_r <= 1'h0;
+    else leaf_push_r <= leaf_push;
+    leaf_in_r <= cat_128;
     if (rst) leaf_pop_r <= 1'h0;
     else leaf_pop_r <= leaf_pop;
     if (rst) leaf_q_wr <= 6'h00;
@@ -2381,7 +2408,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     else leaf_q_popped <= leaf_pop_r;
     if (rst) leaf_q_nonempty <= 1'h0;
     else leaf_q_nonempty <= leaf_q_nonempty_c;
-    leaf_q_din <= cat_129;
+    leaf_q_din <= leaf_in_r;
     if (rst) leaf_q_rd_p1 <= 6'h00;
     else leaf_q_rd_p1 <= mux_leaf_pop_r_1;
     if (rst) leaf_q_rd1_p1 <= 6'h01;
@@ -2500,7 +2527,10 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (rst) plane_t_valid_1 <= 1'h0;
     else plane_t_valid_1 <= pu_clamp_valid_1;
     plane_t_last_1 <= pu_clamp_last_1;
+    plane_t_land0 <= plane_t;
+    plane_t_land1 <= plane_t_1;
     axis_n1 <= nw_axis;
+    negative_sr[10] <= negative_sr[9];
     negative_sr[9] <= negative_sr[8];
     negative_sr[8] <= negative_sr[7];
     negative_sr[7] <= negative_sr[6];
@@ -2516,9 +2546,9 @@ module fxrt_traverse_k64_sf0a3f4 (
 
   (* keep *) always @(posedge clk) begin : leaf_q_push_copies_regs
     if (rst) leaf_q_push <= 1'h0;
-    else leaf_q_push <= leaf_push;
+    else leaf_q_push <= leaf_push_r;
     if (rst) leaf_q_push_c1 <= 1'h0;
-    else leaf_q_push_c1 <= leaf_push;
+    else leaf_q_push_c1 <= leaf_push_r;
   end
 
   // register copies n_ray_slot_copies: n_ray_slot and 14 copies, to split its fan-out
@@ -2544,12 +2574,12 @@ module fxrt_traverse_k64_sf0a3f4 (
   // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   assign not_leaf_push = ~leaf_push;
   assign n_stays = n_valid_3 & not_leaf_push;
-  assign f_inner = f_inner_sr[10];
-  assign f_slot = f_slot_sr[10];
-  assign f_tmin = f_tmin_sr[10];
-  assign f_tmax = f_tmax_sr[10];
-  assign f_sp = f_sp_sr[10];
-  assign f_child = f_child_sr[10];
+  assign f_inner = f_inner_sr[11];
+  assign f_slot = f_slot_sr[11];
+  assign f_tmin = f_tmin_sr[11];
+  assign f_tmax = f_tmax_sr[11];
+  assign f_sp = f_sp_sr[11];
+  assign f_child = f_child_sr[11];
   assign case_axis_n1_1 =
     (axis_n1 == 2'h1) ? s_ray_invy_q :
     (axis_n1 == 2'h2) ? s_ray_invz_q :
@@ -2559,42 +2589,42 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign tmin_minus_1 = n_tmin - k_1_3;
   assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
-  assign minus_151 = rs_tmin_n1 - rs_tmax_p1;
-  assign tmin_le_tmax_c = minus_151[32];
+  assign minus_150 = rs_tmin_n1 - rs_tmax_p1;
+  assign tmin_le_tmax_c = minus_150[32];
   assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
   assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
-  assign d0_hi = d0_hi_sr[7];
+  assign d0_hi = d0_hi_sr[8];
   assign mux_negative_n1_1 = negative_n1 ? tmin_n2 : tmin_m1_n2;
   assign d0_lo_c = tmin_le_tmax ? mux_negative_n1_1 : k_2147483647;
-  assign d0_lo = d0_lo_sr[7];
+  assign d0_lo = d0_lo_sr[8];
   assign mux_negative_n1_2 = negative_n1 ? tmax_n2 : tmax_p1_n2;
   assign d1_hi_c = tmin_le_tmax ? mux_negative_n1_2 : k_m2147483648;
-  assign d1_hi = d1_hi_sr[7];
+  assign d1_hi = d1_hi_sr[8];
   assign mux_negative_n1_3 = negative_n1 ? tmin_m1_n2 : tmin_n2;
   assign d1_lo_c = tmin_le_tmax ? mux_negative_n1_3 : k_2147483647;
-  assign d1_lo = d1_lo_sr[7];
-  assign rs_plane_t = $signed({{1{plane_t[31]}}, plane_t});
+  assign d1_lo = d1_lo_sr[8];
+  assign rs_plane_t_land0 = $signed({{1{plane_t_land0[31]}}, plane_t_land0});
   assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_152 = rs_plane_t - rs_d0_hi;
-  assign d0_below = minus_152[32];
+  assign minus_151 = rs_plane_t_land0 - rs_d0_hi;
+  assign d0_below = minus_151[32];
   assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
-  assign rs_plane_t_1 = $signed({{1{plane_t[31]}}, plane_t});
-  assign minus_153 = rs_d0_lo - rs_plane_t_1;
-  assign d0_above = minus_153[32];
-  assign rs_plane_t_1_1 = $signed({{1{plane_t_1[31]}}, plane_t_1});
+  assign rs_plane_t_land0_1 = $signed({{1{plane_t_land0[31]}}, plane_t_land0});
+  assign minus_152 = rs_d0_lo - rs_plane_t_land0_1;
+  assign d0_above = minus_152[32];
+  assign rs_plane_t_land1 = $signed({{1{plane_t_land1[31]}}, plane_t_land1});
   assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_154 = rs_plane_t_1_1 - rs_d1_hi;
-  assign d1_below = minus_154[32];
+  assign minus_153 = rs_plane_t_land1 - rs_d1_hi;
+  assign d1_below = minus_153[32];
   assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
-  assign rs_plane_t_1_2 = $signed({{1{plane_t_1[31]}}, plane_t_1});
-  assign minus_155 = rs_d1_lo - rs_plane_t_1_2;
-  assign d1_above = minus_155[32];
+  assign rs_plane_t_land1_1 = $signed({{1{plane_t_land1[31]}}, plane_t_land1});
+  assign minus_154 = rs_d1_lo - rs_plane_t_land1_1;
+  assign d1_above = minus_154[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
   assign go_near_c = negative ? d1_above : d0_above;
   assign go_far_c = negative ? d0_below : d1_below;
-  assign mux_negative = negative ? plane_t_1 : plane_t;
-  assign mux_negative_1 = negative ? plane_t : plane_t_1;
+  assign mux_negative = negative ? plane_t_land1 : plane_t_land0;
+  assign mux_negative_1 = negative ? plane_t_land0 : plane_t_land1;
 
   always @(posedge clk) begin : ring_f_regs
     if (rst) f_valid_1 <= 1'h0;
@@ -2617,6 +2647,9 @@ module fxrt_traverse_k64_sf0a3f4 (
     else f_valid_9 <= f_valid_8;
     if (rst) f_valid_10 <= 1'h0;
     else f_valid_10 <= f_valid_9;
+    if (rst) f_valid_11 <= 1'h0;
+    else f_valid_11 <= f_valid_10;
+    f_inner_sr[11] <= f_inner_sr[10];
     f_inner_sr[10] <= f_inner_sr[9];
     f_inner_sr[9] <= f_inner_sr[8];
     f_inner_sr[8] <= f_inner_sr[7];
@@ -2627,6 +2660,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     f_inner_sr[3] <= f_inner_sr[2];
     f_inner_sr[2] <= f_inner_sr[1];
     f_inner_sr[1] <= is_inner;
+    f_slot_sr[11] <= f_slot_sr[10];
     f_slot_sr[10] <= f_slot_sr[9];
     f_slot_sr[9] <= f_slot_sr[8];
     f_slot_sr[8] <= f_slot_sr[7];
@@ -2637,6 +2671,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     f_slot_sr[3] <= f_slot_sr[2];
     f_slot_sr[2] <= f_slot_sr[1];
     f_slot_sr[1] <= n_slot;
+    f_tmin_sr[11] <= f_tmin_sr[10];
     f_tmin_sr[10] <= f_tmin_sr[9];
     f_tmin_sr[9] <= f_tmin_sr[8];
     f_tmin_sr[8] <= f_tmin_sr[7];
@@ -2647,6 +2682,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     f_tmin_sr[3] <= f_tmin_sr[2];
     f_tmin_sr[2] <= f_tmin_sr[1];
     f_tmin_sr[1] <= n_tmin;
+    f_tmax_sr[11] <= f_tmax_sr[10];
     f_tmax_sr[10] <= f_tmax_sr[9];
     f_tmax_sr[9] <= f_tmax_sr[8];
     f_tmax_sr[8] <= f_tmax_sr[7];
@@ -2657,6 +2693,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     f_tmax_sr[3] <= f_tmax_sr[2];
     f_tmax_sr[2] <= f_tmax_sr[1];
     f_tmax_sr[1] <= n_tmax;
+    f_sp_sr[11] <= f_sp_sr[10];
     f_sp_sr[10] <= f_sp_sr[9];
     f_sp_sr[9] <= f_sp_sr[8];
     f_sp_sr[8] <= f_sp_sr[7];
@@ -2667,6 +2704,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     f_sp_sr[3] <= f_sp_sr[2];
     f_sp_sr[2] <= f_sp_sr[1];
     f_sp_sr[1] <= n_sp;
+    f_child_sr[11] <= f_child_sr[10];
     f_child_sr[10] <= f_child_sr[9];
     f_child_sr[9] <= f_child_sr[8];
     f_child_sr[8] <= f_child_sr[7];
@@ -2688,6 +2726,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     tmax_p1_n2 <= tmax_p1;
     tmin_m1_n2 <= tmin_m1;
     d0_hi_n3 <= d0_hi_c;
+    d0_hi_sr[8] <= d0_hi_sr[7];
     d0_hi_sr[7] <= d0_hi_sr[6];
     d0_hi_sr[6] <= d0_hi_sr[5];
     d0_hi_sr[5] <= d0_hi_sr[4];
@@ -2696,6 +2735,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     d0_hi_sr[2] <= d0_hi_sr[1];
     d0_hi_sr[1] <= d0_hi_n3;
     d0_lo_n3 <= d0_lo_c;
+    d0_lo_sr[8] <= d0_lo_sr[7];
     d0_lo_sr[7] <= d0_lo_sr[6];
     d0_lo_sr[6] <= d0_lo_sr[5];
     d0_lo_sr[5] <= d0_lo_sr[4];
@@ -2704,6 +2744,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     d0_lo_sr[2] <= d0_lo_sr[1];
     d0_lo_sr[1] <= d0_lo_n3;
     d1_hi_n3 <= d1_hi_c;
+    d1_hi_sr[8] <= d1_hi_sr[7];
     d1_hi_sr[7] <= d1_hi_sr[6];
     d1_hi_sr[6] <= d1_hi_sr[5];
     d1_hi_sr[5] <= d1_hi_sr[4];
@@ -2712,6 +2753,7 @@ module fxrt_traverse_k64_sf0a3f4 (
     d1_hi_sr[2] <= d1_hi_sr[1];
     d1_hi_sr[1] <= d1_hi_n3;
     d1_lo_n3 <= d1_lo_c;
+    d1_lo_sr[8] <= d1_lo_sr[7];
     d1_lo_sr[7] <= d1_lo_sr[6];
     d1_lo_sr[6] <= d1_lo_sr[5];
     d1_lo_sr[5] <= d1_lo_sr[4];
@@ -2725,8 +2767,6 @@ module fxrt_traverse_k64_sf0a3f4 (
     go_far <= go_far_c;
     near_end <= mux_negative;
     far_start <= mux_negative_1;
-    if (rst) g_valid <= 1'h0;
-    else g_valid <= f_valid_10;
     g_slot <= f_slot;
     g_child <= f_child;
     g_tmin <= f_tmin;
@@ -2748,10 +2788,10 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign enter_far = g_inner_and_not_go_near & go_far;
   assign push = enter_near & go_far;
   assign rs_g_sp = g_sp[4:0];
-  assign cat_157 = {g_slot, rs_g_sp};
+  assign cat_156 = {g_slot, rs_g_sp};
   assign u_far_min = $unsigned(far_min);
   assign u_g_tmax = $unsigned(g_tmax);
-  assign cat_158 = {far, u_far_min, u_g_tmax};
+  assign cat_157 = {far, u_far_min, u_g_tmax};
   assign enter_near_or_enter_far = enter_near | enter_far;
   assign g_pop = ~enter_near_or_enter_far;
   assign mux_enter_near = enter_near ? near : far;
@@ -2766,14 +2806,23 @@ module fxrt_traverse_k64_sf0a3f4 (
   assign g_sp_m1 = push ? g_sp : g_sp_minus_k_1;
   assign g_done = g_pop & g_sp_zero;
   assign rs_g_sp_m1 = g_sp_m1[4:0];
-  assign cat_159 = {g_slot, rs_g_sp_m1};
-  assign stack_raddr_next = g_valid ? cat_159 : q_stack_raddr;
+  assign cat_158 = {g_slot, rs_g_sp_m1};
+  assign stack_raddr_next = g_valid ? cat_158 : q_stack_raddr;
 
   always @(posedge clk) begin : ring_g_regs
     if (rst) stack_we_r <= 1'h0;
     else stack_we_r <= push;
-    stack_waddr_r <= cat_157;
-    stack_wdata_r <= cat_158;
+    stack_waddr_r <= cat_156;
+    stack_wdata_r <= cat_157;
+  end
+
+  // register copies g_valid_copies: g_valid and 1 copies, to split its fan-out
+
+  (* keep *) always @(posedge clk) begin : g_valid_copies_regs
+    if (rst) g_valid <= 1'h0;
+    else g_valid <= f_valid_11;
+    if (rst) g_valid_c1 <= 1'h0;
+    else g_valid_c1 <= f_valid_11;
   end
 
   fxrt_bram_stack_w77 u_stack (

@@ -146,7 +146,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type free_q_mem_t is array (0 to 63) of unsigned(5 downto 0);
   signal free_q_mem : free_q_mem_t := (others => (others => '0'));
 
-  type unpark_q_mem_t is array (0 to 63) of unsigned(11 downto 0);
+  type unpark_q_mem_t is array (0 to 63) of unsigned(12 downto 0);
   signal unpark_q_mem : unpark_q_mem_t := (others => (others => '0'));
 
   type new_q_mem_g0_t is array (0 to 63) of unsigned(15 downto 0);
@@ -278,7 +278,9 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal ring_g_valid : unsigned(0 downto 0);
   signal unpark_pop : unsigned(0 downto 0);
   signal new_pop : unsigned(0 downto 0);
-  signal cat_11 : unsigned(11 downto 0);
+  constant k_0_1 : unsigned(5 downto 0) := unsigned'("000000");
+  signal merge_sp_zero : unsigned(0 downto 0);
+  signal cat_11 : unsigned(12 downto 0);
   signal unpark_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal unpark_q_rd : unsigned(5 downto 0) := unsigned'("000000");
   signal unpark_q_count : unsigned(6 downto 0) := unsigned'("0000000");
@@ -307,12 +309,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal not_unpark_pop : unsigned(0 downto 0);
   signal and_18 : unsigned(0 downto 0);
   signal unpark_q_nonempty_c : unsigned(0 downto 0);
-  signal unpark_q_din : unsigned(11 downto 0) := unsigned'("000000000000");
-  signal unpark_q_q_stay : unsigned(11 downto 0) := unsigned'("000000000000");
-  signal unpark_q_q_next : unsigned(11 downto 0) := unsigned'("000000000000");
-  signal mux_unpark_q_popped : unsigned(11 downto 0);
-  signal unpark_q_din_r : unsigned(11 downto 0) := unsigned'("000000000000");
-  signal unpark_q_head : unsigned(11 downto 0);
+  signal unpark_q_din : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal unpark_q_q_stay : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal unpark_q_q_next : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal mux_unpark_q_popped : unsigned(12 downto 0);
+  signal unpark_q_din_r : unsigned(12 downto 0) := unsigned'("0000000000000");
+  signal unpark_q_head : unsigned(12 downto 0);
   signal u_new_tmax : unsigned(31 downto 0);
   signal cat_19 : unsigned(38 downto 0);
   signal new_q_wr : unsigned(5 downto 0) := unsigned'("000000");
@@ -381,18 +383,16 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal mux_take_unpark : unsigned(5 downto 0);
   signal bits_unpark_q_head_1 : unsigned(5 downto 0);
   signal q_sp : unsigned(5 downto 0) := unsigned'("000000");
-  constant k_0_1 : unsigned(5 downto 0) := unsigned'("000000");
   signal eq_32 : unsigned(0 downto 0);
   signal q_sp_zero : unsigned(0 downto 0) := unsigned'("0");
   signal minus_33 : unsigned(5 downto 0);
   signal q_sp_m1 : unsigned(5 downto 0) := unsigned'("000000");
   signal rs_minus_33 : unsigned(4 downto 0);
   signal q_stack_raddr : unsigned(10 downto 0);
-  signal bits_unpark_q_head_2 : unsigned(5 downto 0);
-  signal eq_35 : unsigned(0 downto 0);
+  signal bits_unpark_q_head_2 : unsigned(0 downto 0);
   signal bits_new_q_head_1 : unsigned(0 downto 0);
+  signal and_35 : unsigned(0 downto 0);
   signal and_36 : unsigned(0 downto 0);
-  signal take_unpark_and_eq_35 : unsigned(0 downto 0);
   signal q_done_c : unsigned(0 downto 0);
   signal q_done : unsigned(0 downto 0) := unsigned'("0");
   signal bits_new_q_head_2 : unsigned(31 downto 0);
@@ -436,7 +436,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal r_valid_and_r_done : unsigned(0 downto 0);
   signal not_r_valid : unsigned(0 downto 0);
   signal not_r_valid_and_q_valid : unsigned(0 downto 0);
-  signal and_38 : unsigned(0 downto 0);
+  signal and_37 : unsigned(0 downto 0);
   signal a_done : unsigned(0 downto 0);
   signal not_a_sp_zero : unsigned(0 downto 0);
   signal a_from_stack : unsigned(0 downto 0);
@@ -489,16 +489,16 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal done_q_count_next : unsigned(6 downto 0);
   signal done_q_count_eq_k_0 : unsigned(0 downto 0);
   signal done_q_one_left : unsigned(0 downto 0);
-  signal and_42 : unsigned(0 downto 0);
+  signal and_41 : unsigned(0 downto 0);
   signal done_q_drained : unsigned(0 downto 0);
   signal done_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_bypass_c : unsigned(0 downto 0);
   signal done_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal done_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_done_q_count : unsigned(0 downto 0);
-  signal or_45 : unsigned(0 downto 0);
+  signal or_44 : unsigned(0 downto 0);
   signal not_done_pop_r : unsigned(0 downto 0);
-  signal and_46 : unsigned(0 downto 0);
+  signal and_45 : unsigned(0 downto 0);
   signal done_q_nonempty_c : unsigned(0 downto 0);
   signal done_q_din : unsigned(5 downto 0) := unsigned'("000000");
   signal done_q_q_stay : unsigned(5 downto 0) := unsigned'("000000");
@@ -536,7 +536,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal tmin_less : signed(31 downto 0);
   signal cull_x : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal has_best_kept : unsigned(63 downto 0);
-  signal and_48 : unsigned(0 downto 0);
+  signal and_47 : unsigned(0 downto 0);
   signal merge_slot_eq_b2_slot_c1 : unsigned(0 downto 0);
   signal b_slot_merged_c : unsigned(0 downto 0);
   signal b_slot_merged : unsigned(0 downto 0) := unsigned'("0");
@@ -557,7 +557,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal bits_has_best_kept_13 : unsigned(0 downto 0);
   signal bits_has_best_kept_14 : unsigned(0 downto 0);
   signal bits_has_best_kept_15 : unsigned(0 downto 0);
-  signal bits_b2_slot_c1 : unsigned(3 downto 0);
+  signal bits_b2_slot_c2 : unsigned(3 downto 0);
   signal slot_has_best_g0_c : unsigned(0 downto 0);
   signal slot_has_best_g0 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_has_best_kept_16 : unsigned(0 downto 0);
@@ -576,7 +576,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal bits_has_best_kept_29 : unsigned(0 downto 0);
   signal bits_has_best_kept_30 : unsigned(0 downto 0);
   signal bits_has_best_kept_31 : unsigned(0 downto 0);
-  signal bits_b2_slot_c1_1 : unsigned(3 downto 0);
+  signal bits_b2_slot_c3 : unsigned(3 downto 0);
   signal slot_has_best_g1_c : unsigned(0 downto 0);
   signal slot_has_best_g1 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_has_best_kept_32 : unsigned(0 downto 0);
@@ -595,7 +595,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal bits_has_best_kept_45 : unsigned(0 downto 0);
   signal bits_has_best_kept_46 : unsigned(0 downto 0);
   signal bits_has_best_kept_47 : unsigned(0 downto 0);
-  signal bits_b2_slot_c1_2 : unsigned(3 downto 0);
+  signal bits_b2_slot_c4 : unsigned(3 downto 0);
   signal slot_has_best_g2_c : unsigned(0 downto 0);
   signal slot_has_best_g2 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_has_best_kept_48 : unsigned(0 downto 0);
@@ -614,7 +614,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal bits_has_best_kept_61 : unsigned(0 downto 0);
   signal bits_has_best_kept_62 : unsigned(0 downto 0);
   signal bits_has_best_kept_63 : unsigned(0 downto 0);
-  signal bits_b2_slot_c1_3 : unsigned(3 downto 0);
+  signal bits_b2_slot_c5 : unsigned(3 downto 0);
   signal slot_has_best_g3_c : unsigned(0 downto 0);
   signal slot_has_best_g3 : unsigned(0 downto 0) := unsigned'("0");
   signal bits_c_slot_c2 : unsigned(1 downto 0);
@@ -623,12 +623,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal cull_has_best : unsigned(0 downto 0) := unsigned'("0");
   signal rs_s_limit_q : signed(32 downto 0);
   signal rs_cull_x : signed(32 downto 0);
-  signal minus_51 : signed(32 downto 0);
-  signal bits_minus_51 : unsigned(0 downto 0);
+  signal minus_50 : signed(32 downto 0);
+  signal bits_minus_50 : unsigned(0 downto 0);
   signal culled_c : unsigned(0 downto 0);
   signal culled : unsigned(0 downto 0) := unsigned'("0");
   signal culled_n : unsigned(0 downto 0) := unsigned'("0");
-  signal and_53 : unsigned(0 downto 0);
+  signal and_52 : unsigned(0 downto 0);
   signal merge_slot_eq_k_63 : unsigned(0 downto 0);
   constant k_62 : unsigned(5 downto 0) := unsigned'("111110");
   signal merge_slot_eq_k_62 : unsigned(0 downto 0);
@@ -754,146 +754,146 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal merge_slot_eq_k_2 : unsigned(0 downto 0);
   signal merge_slot_eq_k_1 : unsigned(0 downto 0);
   signal merge_slot_eq_k_0_1 : unsigned(0 downto 0);
-  signal cat_54 : unsigned(63 downto 0);
+  signal cat_53 : unsigned(63 downto 0);
   constant k_0_5 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal best_set : unsigned(63 downto 0);
   signal q_slot_c4_eq_k_63 : unsigned(0 downto 0);
-  signal and_55 : unsigned(0 downto 0);
+  signal and_54 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_62 : unsigned(0 downto 0);
-  signal and_56 : unsigned(0 downto 0);
+  signal and_55 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_61 : unsigned(0 downto 0);
-  signal and_57 : unsigned(0 downto 0);
+  signal and_56 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_60 : unsigned(0 downto 0);
-  signal and_58 : unsigned(0 downto 0);
+  signal and_57 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_59 : unsigned(0 downto 0);
-  signal and_59 : unsigned(0 downto 0);
+  signal and_58 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_58 : unsigned(0 downto 0);
-  signal and_60 : unsigned(0 downto 0);
+  signal and_59 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_57 : unsigned(0 downto 0);
-  signal and_61 : unsigned(0 downto 0);
+  signal and_60 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_56 : unsigned(0 downto 0);
-  signal and_62 : unsigned(0 downto 0);
+  signal and_61 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_55 : unsigned(0 downto 0);
-  signal and_63 : unsigned(0 downto 0);
+  signal and_62 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_54 : unsigned(0 downto 0);
-  signal and_64 : unsigned(0 downto 0);
+  signal and_63 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_53 : unsigned(0 downto 0);
-  signal and_65 : unsigned(0 downto 0);
+  signal and_64 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_52 : unsigned(0 downto 0);
-  signal and_66 : unsigned(0 downto 0);
+  signal and_65 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_51 : unsigned(0 downto 0);
-  signal and_67 : unsigned(0 downto 0);
+  signal and_66 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_50 : unsigned(0 downto 0);
-  signal and_68 : unsigned(0 downto 0);
+  signal and_67 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_49 : unsigned(0 downto 0);
-  signal and_69 : unsigned(0 downto 0);
+  signal and_68 : unsigned(0 downto 0);
   signal q_slot_c4_eq_k_48 : unsigned(0 downto 0);
-  signal and_70 : unsigned(0 downto 0);
-  signal cat_71 : unsigned(15 downto 0);
+  signal and_69 : unsigned(0 downto 0);
+  signal cat_70 : unsigned(15 downto 0);
   signal q_slot_c3_eq_k_47 : unsigned(0 downto 0);
-  signal and_72 : unsigned(0 downto 0);
+  signal and_71 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_46 : unsigned(0 downto 0);
-  signal and_73 : unsigned(0 downto 0);
+  signal and_72 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_45 : unsigned(0 downto 0);
-  signal and_74 : unsigned(0 downto 0);
+  signal and_73 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_44 : unsigned(0 downto 0);
-  signal and_75 : unsigned(0 downto 0);
+  signal and_74 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_43 : unsigned(0 downto 0);
-  signal and_76 : unsigned(0 downto 0);
+  signal and_75 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_42 : unsigned(0 downto 0);
-  signal and_77 : unsigned(0 downto 0);
+  signal and_76 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_41 : unsigned(0 downto 0);
-  signal and_78 : unsigned(0 downto 0);
+  signal and_77 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_40 : unsigned(0 downto 0);
-  signal and_79 : unsigned(0 downto 0);
+  signal and_78 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_39 : unsigned(0 downto 0);
-  signal and_80 : unsigned(0 downto 0);
+  signal and_79 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_38 : unsigned(0 downto 0);
-  signal and_81 : unsigned(0 downto 0);
+  signal and_80 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_37 : unsigned(0 downto 0);
-  signal and_82 : unsigned(0 downto 0);
+  signal and_81 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_36 : unsigned(0 downto 0);
-  signal and_83 : unsigned(0 downto 0);
+  signal and_82 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_35 : unsigned(0 downto 0);
-  signal and_84 : unsigned(0 downto 0);
+  signal and_83 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_34 : unsigned(0 downto 0);
-  signal and_85 : unsigned(0 downto 0);
+  signal and_84 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_33 : unsigned(0 downto 0);
-  signal and_86 : unsigned(0 downto 0);
+  signal and_85 : unsigned(0 downto 0);
   signal q_slot_c3_eq_k_32 : unsigned(0 downto 0);
-  signal and_87 : unsigned(0 downto 0);
-  signal cat_88 : unsigned(15 downto 0);
+  signal and_86 : unsigned(0 downto 0);
+  signal cat_87 : unsigned(15 downto 0);
   signal q_slot_c2_eq_k_31 : unsigned(0 downto 0);
-  signal and_89 : unsigned(0 downto 0);
+  signal and_88 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_30 : unsigned(0 downto 0);
-  signal and_90 : unsigned(0 downto 0);
+  signal and_89 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_29 : unsigned(0 downto 0);
-  signal and_91 : unsigned(0 downto 0);
+  signal and_90 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_28 : unsigned(0 downto 0);
-  signal and_92 : unsigned(0 downto 0);
+  signal and_91 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_27 : unsigned(0 downto 0);
-  signal and_93 : unsigned(0 downto 0);
+  signal and_92 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_26 : unsigned(0 downto 0);
-  signal and_94 : unsigned(0 downto 0);
+  signal and_93 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_25 : unsigned(0 downto 0);
-  signal and_95 : unsigned(0 downto 0);
+  signal and_94 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_24 : unsigned(0 downto 0);
-  signal and_96 : unsigned(0 downto 0);
+  signal and_95 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_23 : unsigned(0 downto 0);
-  signal and_97 : unsigned(0 downto 0);
+  signal and_96 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_22 : unsigned(0 downto 0);
-  signal and_98 : unsigned(0 downto 0);
+  signal and_97 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_21 : unsigned(0 downto 0);
-  signal and_99 : unsigned(0 downto 0);
+  signal and_98 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_20 : unsigned(0 downto 0);
-  signal and_100 : unsigned(0 downto 0);
+  signal and_99 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_19 : unsigned(0 downto 0);
-  signal and_101 : unsigned(0 downto 0);
+  signal and_100 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_18 : unsigned(0 downto 0);
-  signal and_102 : unsigned(0 downto 0);
+  signal and_101 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_17 : unsigned(0 downto 0);
-  signal and_103 : unsigned(0 downto 0);
+  signal and_102 : unsigned(0 downto 0);
   signal q_slot_c2_eq_k_16 : unsigned(0 downto 0);
-  signal and_104 : unsigned(0 downto 0);
-  signal cat_105 : unsigned(15 downto 0);
+  signal and_103 : unsigned(0 downto 0);
+  signal cat_104 : unsigned(15 downto 0);
   signal q_slot_c1_eq_k_15 : unsigned(0 downto 0);
-  signal and_106 : unsigned(0 downto 0);
+  signal and_105 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_14 : unsigned(0 downto 0);
-  signal and_107 : unsigned(0 downto 0);
+  signal and_106 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_13 : unsigned(0 downto 0);
-  signal and_108 : unsigned(0 downto 0);
+  signal and_107 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_12 : unsigned(0 downto 0);
-  signal and_109 : unsigned(0 downto 0);
+  signal and_108 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_11 : unsigned(0 downto 0);
-  signal and_110 : unsigned(0 downto 0);
+  signal and_109 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_10 : unsigned(0 downto 0);
-  signal and_111 : unsigned(0 downto 0);
+  signal and_110 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_9 : unsigned(0 downto 0);
-  signal and_112 : unsigned(0 downto 0);
+  signal and_111 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_8 : unsigned(0 downto 0);
-  signal and_113 : unsigned(0 downto 0);
+  signal and_112 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_7 : unsigned(0 downto 0);
-  signal and_114 : unsigned(0 downto 0);
+  signal and_113 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_6 : unsigned(0 downto 0);
-  signal and_115 : unsigned(0 downto 0);
+  signal and_114 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_5 : unsigned(0 downto 0);
-  signal and_116 : unsigned(0 downto 0);
+  signal and_115 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_4 : unsigned(0 downto 0);
-  signal and_117 : unsigned(0 downto 0);
+  signal and_116 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_3 : unsigned(0 downto 0);
-  signal and_118 : unsigned(0 downto 0);
+  signal and_117 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_2 : unsigned(0 downto 0);
-  signal and_119 : unsigned(0 downto 0);
+  signal and_118 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_1 : unsigned(0 downto 0);
-  signal and_120 : unsigned(0 downto 0);
+  signal and_119 : unsigned(0 downto 0);
   signal q_slot_c1_eq_k_0_1 : unsigned(0 downto 0);
-  signal and_121 : unsigned(0 downto 0);
-  signal cat_122 : unsigned(15 downto 0);
+  signal and_120 : unsigned(0 downto 0);
+  signal cat_121 : unsigned(15 downto 0);
   signal best_clear_c : unsigned(63 downto 0);
   signal best_clear : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal not_best_clear : unsigned(63 downto 0);
   signal has_best_kept_c : unsigned(63 downto 0);
-  signal or_125 : unsigned(63 downto 0);
+  signal or_124 : unsigned(63 downto 0);
 
   -- register copies c_slot_copies: c_slot and 2 copies, to split its fan-out
   signal c_slot : unsigned(5 downto 0) := unsigned'("000000");
@@ -903,11 +903,19 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal c_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of c_slot_c2 : signal is "true";
 
-  -- register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+  -- register copies b2_slot_copies: b2_slot and 5 copies, to split its fan-out
   signal b2_slot : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of b2_slot : signal is "true";
   signal b2_slot_c1 : unsigned(5 downto 0) := unsigned'("000000");
   attribute keep of b2_slot_c1 : signal is "true";
+  signal b2_slot_c2 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of b2_slot_c2 : signal is "true";
+  signal b2_slot_c3 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of b2_slot_c3 : signal is "true";
+  signal b2_slot_c4 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of b2_slot_c4 : signal is "true";
+  signal b2_slot_c5 : unsigned(5 downto 0) := unsigned'("000000");
+  attribute keep of b2_slot_c5 : signal is "true";
 
   -- register copies q_new_copies: q_new and 4 copies, to split its fan-out
   signal q_new : unsigned(0 downto 0) := unsigned'("0");
@@ -970,7 +978,9 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_push : unsigned(0 downto 0);
   signal u_n_tmin : unsigned(31 downto 0);
   signal rs_u_n_tmin : unsigned(30 downto 0);
-  signal cat_129 : unsigned(58 downto 0);
+  signal cat_128 : unsigned(58 downto 0);
+  signal leaf_push_r : unsigned(0 downto 0) := unsigned'("0");
+  signal leaf_in_r : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal leaf_pop_r : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_wr : unsigned(5 downto 0) := unsigned'("000000");
   signal leaf_q_rd : unsigned(5 downto 0) := unsigned'("000000");
@@ -989,16 +999,16 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal leaf_q_count_next : unsigned(6 downto 0);
   signal leaf_q_count_eq_k_0 : unsigned(0 downto 0);
   signal leaf_q_one_left : unsigned(0 downto 0);
-  signal and_132 : unsigned(0 downto 0);
+  signal and_131 : unsigned(0 downto 0);
   signal leaf_q_drained : unsigned(0 downto 0);
   signal leaf_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_bypass_c : unsigned(0 downto 0);
   signal leaf_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal leaf_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_1_lt_leaf_q_count : unsigned(0 downto 0);
-  signal or_135 : unsigned(0 downto 0);
+  signal or_134 : unsigned(0 downto 0);
   signal not_leaf_pop_r : unsigned(0 downto 0);
-  signal and_136 : unsigned(0 downto 0);
+  signal and_135 : unsigned(0 downto 0);
   signal leaf_q_nonempty_c : unsigned(0 downto 0);
   signal leaf_q_din : unsigned(58 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000");
   signal bits_leaf_q_din : unsigned(15 downto 0);
@@ -1144,7 +1154,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal pu_below_1 : unsigned(0 downto 0);
   signal not_pu_below_1 : unsigned(0 downto 0);
   signal bits_pu_shifted_1 : unsigned(30 downto 0);
-  signal ne_147 : unsigned(0 downto 0);
+  signal ne_146 : unsigned(0 downto 0);
   signal pu_above_1 : unsigned(0 downto 0);
   signal rs_pu_shifted_1 : signed(31 downto 0);
   signal pu_above_r_1 : unsigned(0 downto 0) := unsigned'("0");
@@ -1161,10 +1171,12 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal pu_first_1 : unsigned(0 downto 0);
   signal plane_t_valid_1 : unsigned(0 downto 0) := unsigned'("0");
   signal plane_t_last_1 : unsigned(0 downto 0) := unsigned'("0");
+  signal plane_t_land0 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
+  signal plane_t_land1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal axis_n1 : unsigned(1 downto 0) := unsigned'("00");
   signal case_axis_n1 : signed(47 downto 0);
   signal negative_c : unsigned(0 downto 0);
-  type negative_sr_t is array (1 to 9) of unsigned(0 downto 0);
+  type negative_sr_t is array (1 to 10) of unsigned(0 downto 0);
   signal negative_sr : negative_sr_t := (others => (others => '0'));
   signal negative : unsigned(0 downto 0);
 
@@ -1219,22 +1231,23 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal f_valid_8 : unsigned(0 downto 0) := unsigned'("0");
   signal f_valid_9 : unsigned(0 downto 0) := unsigned'("0");
   signal f_valid_10 : unsigned(0 downto 0) := unsigned'("0");
-  type f_inner_sr_t is array (1 to 10) of unsigned(0 downto 0);
+  signal f_valid_11 : unsigned(0 downto 0) := unsigned'("0");
+  type f_inner_sr_t is array (1 to 11) of unsigned(0 downto 0);
   signal f_inner_sr : f_inner_sr_t := (others => (others => '0'));
   signal f_inner : unsigned(0 downto 0);
-  type f_slot_sr_t is array (1 to 10) of unsigned(5 downto 0);
+  type f_slot_sr_t is array (1 to 11) of unsigned(5 downto 0);
   signal f_slot_sr : f_slot_sr_t := (others => (others => '0'));
   signal f_slot : unsigned(5 downto 0);
-  type f_tmin_sr_t is array (1 to 10) of signed(31 downto 0);
+  type f_tmin_sr_t is array (1 to 11) of signed(31 downto 0);
   signal f_tmin_sr : f_tmin_sr_t := (others => (others => '0'));
   signal f_tmin : signed(31 downto 0);
-  type f_tmax_sr_t is array (1 to 10) of signed(31 downto 0);
+  type f_tmax_sr_t is array (1 to 11) of signed(31 downto 0);
   signal f_tmax_sr : f_tmax_sr_t := (others => (others => '0'));
   signal f_tmax : signed(31 downto 0);
-  type f_sp_sr_t is array (1 to 10) of unsigned(5 downto 0);
+  type f_sp_sr_t is array (1 to 11) of unsigned(5 downto 0);
   signal f_sp_sr : f_sp_sr_t := (others => (others => '0'));
   signal f_sp : unsigned(5 downto 0);
-  type f_child_sr_t is array (1 to 10) of unsigned(12 downto 0);
+  type f_child_sr_t is array (1 to 11) of unsigned(12 downto 0);
   signal f_child_sr : f_child_sr_t := (others => (others => '0'));
   signal f_child : unsigned(12 downto 0);
   signal case_axis_n1_1 : signed(47 downto 0);
@@ -1249,7 +1262,7 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal tmin_m1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal rs_tmin_n1 : signed(32 downto 0);
   signal rs_tmax_p1 : signed(32 downto 0);
-  signal minus_151 : signed(32 downto 0);
+  signal minus_150 : signed(32 downto 0);
   signal tmin_le_tmax_c : unsigned(0 downto 0);
   signal tmin_le_tmax : unsigned(0 downto 0) := unsigned'("0");
   signal tmin_n2 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -1261,42 +1274,42 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal mux_negative_n1 : signed(31 downto 0);
   signal d0_hi_c : signed(31 downto 0);
   signal d0_hi_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d0_hi_sr_t is array (1 to 7) of signed(31 downto 0);
+  type d0_hi_sr_t is array (1 to 8) of signed(31 downto 0);
   signal d0_hi_sr : d0_hi_sr_t := (others => (others => '0'));
   signal d0_hi : signed(31 downto 0);
   signal mux_negative_n1_1 : signed(31 downto 0);
   signal d0_lo_c : signed(31 downto 0);
   signal d0_lo_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d0_lo_sr_t is array (1 to 7) of signed(31 downto 0);
+  type d0_lo_sr_t is array (1 to 8) of signed(31 downto 0);
   signal d0_lo_sr : d0_lo_sr_t := (others => (others => '0'));
   signal d0_lo : signed(31 downto 0);
   signal mux_negative_n1_2 : signed(31 downto 0);
   signal d1_hi_c : signed(31 downto 0);
   signal d1_hi_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d1_hi_sr_t is array (1 to 7) of signed(31 downto 0);
+  type d1_hi_sr_t is array (1 to 8) of signed(31 downto 0);
   signal d1_hi_sr : d1_hi_sr_t := (others => (others => '0'));
   signal d1_hi : signed(31 downto 0);
   signal mux_negative_n1_3 : signed(31 downto 0);
   signal d1_lo_c : signed(31 downto 0);
   signal d1_lo_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d1_lo_sr_t is array (1 to 7) of signed(31 downto 0);
+  type d1_lo_sr_t is array (1 to 8) of signed(31 downto 0);
   signal d1_lo_sr : d1_lo_sr_t := (others => (others => '0'));
   signal d1_lo : signed(31 downto 0);
-  signal rs_plane_t : signed(32 downto 0);
+  signal rs_plane_t_land0 : signed(32 downto 0);
   signal rs_d0_hi : signed(32 downto 0);
-  signal minus_152 : signed(32 downto 0);
+  signal minus_151 : signed(32 downto 0);
   signal d0_below : unsigned(0 downto 0);
   signal rs_d0_lo : signed(32 downto 0);
-  signal rs_plane_t_1 : signed(32 downto 0);
-  signal minus_153 : signed(32 downto 0);
+  signal rs_plane_t_land0_1 : signed(32 downto 0);
+  signal minus_152 : signed(32 downto 0);
   signal d0_above : unsigned(0 downto 0);
-  signal rs_plane_t_1_1 : signed(32 downto 0);
+  signal rs_plane_t_land1 : signed(32 downto 0);
   signal rs_d1_hi : signed(32 downto 0);
-  signal minus_154 : signed(32 downto 0);
+  signal minus_153 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
   signal rs_d1_lo : signed(32 downto 0);
-  signal rs_plane_t_1_2 : signed(32 downto 0);
-  signal minus_155 : signed(32 downto 0);
+  signal rs_plane_t_land1_1 : signed(32 downto 0);
+  signal minus_154 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
   signal near_lt_tmax_c : unsigned(0 downto 0);
   signal near_lt_tmax : unsigned(0 downto 0) := unsigned'("0");
@@ -1310,7 +1323,6 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal near_end : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal mux_negative_1 : signed(31 downto 0);
   signal far_start : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  signal g_valid : unsigned(0 downto 0) := unsigned'("0");
   signal g_slot : unsigned(5 downto 0) := unsigned'("000000");
   signal g_child : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal g_tmin : signed(31 downto 0) := signed'("00000000000000000000000000000000");
@@ -1333,11 +1345,11 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal push : unsigned(0 downto 0);
   signal stack_we_r : unsigned(0 downto 0) := unsigned'("0");
   signal rs_g_sp : unsigned(4 downto 0);
-  signal cat_157 : unsigned(10 downto 0);
+  signal cat_156 : unsigned(10 downto 0);
   signal stack_waddr_r : unsigned(10 downto 0) := unsigned'("00000000000");
   signal u_far_min : unsigned(31 downto 0);
   signal u_g_tmax : unsigned(31 downto 0);
-  signal cat_158 : unsigned(76 downto 0);
+  signal cat_157 : unsigned(76 downto 0);
   signal stack_wdata_r : unsigned(76 downto 0) := unsigned'("00000000000000000000000000000000000000000000000000000000000000000000000000000");
   signal enter_near_or_enter_far : unsigned(0 downto 0);
   signal g_pop : unsigned(0 downto 0);
@@ -1353,8 +1365,14 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal g_sp_m1 : unsigned(5 downto 0);
   signal g_done : unsigned(0 downto 0);
   signal rs_g_sp_m1 : unsigned(4 downto 0);
-  signal cat_159 : unsigned(10 downto 0);
+  signal cat_158 : unsigned(10 downto 0);
   signal stack_raddr_next : unsigned(10 downto 0);
+
+  -- register copies g_valid_copies: g_valid and 1 copies, to split its fan-out
+  signal g_valid : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of g_valid : signal is "true";
+  signal g_valid_c1 : unsigned(0 downto 0) := unsigned'("0");
+  attribute keep of g_valid_c1 : signal is "true";
 begin
 
   -- not in a stage or state machine
@@ -1606,10 +1624,11 @@ begin
   end process free_q_push_copies_regs;
 
   -- stage queues: E: rays back from a leaf and new rays wait; one enters when no token returns
-  ring_g_valid <= g_valid;
+  ring_g_valid <= g_valid_c1;
   unpark_pop <= take_unpark;
   new_pop <= take_new;
-  cat_11 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot) & std_logic_vector(merge_sp)));
+  merge_sp_zero <= "1" when merge_sp = k_0_1 else "0";
+  cat_11 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot) & std_logic_vector(merge_sp) & std_logic_vector(merge_sp_zero)));
   unpark_q_wr_plus_k_1 <= unpark_q_wr + k_1;
   mux_unpark_q_push <= unpark_q_wr_plus_k_1 when unpark_q_push = "1" else unpark_q_wr;
   unpark_q_rd_next <= unpark_q_rd1 when unpark_pop = "1" else unpark_q_rd;
@@ -1676,20 +1695,19 @@ begin
   and_30 <= not_ring_g_valid_1 and not_unpark_q_nonempty;
   take_new <= and_30 and new_q_nonempty;
   take_unpark_or_take_new <= take_unpark or take_new;
-  bits_unpark_q_head <= unsigned(unpark_q_head(11 downto 6));
+  bits_unpark_q_head <= unsigned(unpark_q_head(12 downto 7));
   bits_new_q_head <= unsigned(new_q_head(38 downto 33));
   mux_take_unpark <= bits_unpark_q_head when take_unpark = "1" else bits_new_q_head;
-  bits_unpark_q_head_1 <= unsigned(unpark_q_head(5 downto 0));
+  bits_unpark_q_head_1 <= unsigned(unpark_q_head(6 downto 1));
   eq_32 <= "1" when bits_unpark_q_head_1 = k_0_1 else "0";
   minus_33 <= bits_unpark_q_head_1 - k_1;
   rs_minus_33 <= minus_33(4 downto 0);
   q_stack_raddr <= unsigned(std_logic_vector'(std_logic_vector(mux_take_unpark) & std_logic_vector(rs_minus_33)));
-  bits_unpark_q_head_2 <= unsigned(unpark_q_head(5 downto 0));
-  eq_35 <= "1" when bits_unpark_q_head_2 = k_0_1 else "0";
+  bits_unpark_q_head_2 <= unsigned(unpark_q_head(0 downto 0));
   bits_new_q_head_1 <= unsigned(new_q_head(0 downto 0));
-  and_36 <= take_new and bits_new_q_head_1;
-  take_unpark_and_eq_35 <= take_unpark and eq_35;
-  q_done_c <= and_36 or take_unpark_and_eq_35;
+  and_35 <= take_new and bits_new_q_head_1;
+  and_36 <= take_unpark and bits_unpark_q_head_2;
+  q_done_c <= and_35 or and_36;
   bits_new_q_head_2 <= unsigned(new_q_head(32 downto 1));
   s_bits_new_q_head_2 <= signed(bits_new_q_head_2);
 
@@ -1886,8 +1904,8 @@ begin
   r_valid_and_r_done <= r_valid and r_done;
   not_r_valid <= not r_valid;
   not_r_valid_and_q_valid <= not_r_valid and q_valid;
-  and_38 <= not_r_valid_and_q_valid and q_done;
-  a_done <= r_valid_and_r_done or and_38;
+  and_37 <= not_r_valid_and_q_valid and q_done;
+  a_done <= r_valid_and_r_done or and_37;
   not_a_sp_zero <= not a_sp_zero;
   a_from_stack <= a_pop and not_a_sp_zero;
   stack_we <= stack_we_r;
@@ -1951,14 +1969,14 @@ begin
   done_q_count_next <= done_q_count_if_pop when done_pop_r = "1" else done_q_count_if_kept;
   done_q_count_eq_k_0 <= "1" when done_q_count = k_0 else "0";
   done_q_one_left <= "1" when done_q_count = k_1_1 else "0";
-  and_42 <= done_q_one_left and done_pop_r;
-  done_q_drained <= done_q_count_eq_k_0 or and_42;
+  and_41 <= done_q_one_left and done_pop_r;
+  done_q_drained <= done_q_count_eq_k_0 or and_41;
   done_q_bypass_c <= done_q_push_c1 and done_q_drained;
   k_1_1_lt_done_q_count <= "1" when k_1_1 < done_q_count else "0";
-  or_45 <= done_q_push_c1 or k_1_1_lt_done_q_count;
+  or_44 <= done_q_push_c1 or k_1_1_lt_done_q_count;
   not_done_pop_r <= not done_pop_r;
-  and_46 <= done_q_one_left and not_done_pop_r;
-  done_q_nonempty_c <= or_45 or and_46;
+  and_45 <= done_q_one_left and not_done_pop_r;
+  done_q_nonempty_c <= or_44 or and_45;
   mux_done_q_popped <= done_q_q_next when done_q_popped = "1" else done_q_q_stay;
   done_q_head <= done_q_din_r when done_q_bypass = "1" else mux_done_q_popped;
 
@@ -2047,9 +2065,9 @@ begin
   shr_c_tmin <= shift_right(c_tmin, 6);
   tmin_less <= c_tmin - shr_c_tmin;
   has_best_kept <= has_best_kept_c;
-  and_48 <= merge_valid and merge_hit;
+  and_47 <= merge_valid and merge_hit;
   merge_slot_eq_b2_slot_c1 <= "1" when merge_slot = b2_slot_c1 else "0";
-  b_slot_merged_c <= and_48 and merge_slot_eq_b2_slot_c1;
+  b_slot_merged_c <= and_47 and merge_slot_eq_b2_slot_c1;
   bits_has_best_kept <= unsigned(has_best_kept(0 downto 0));
   bits_has_best_kept_1 <= unsigned(has_best_kept(1 downto 1));
   bits_has_best_kept_2 <= unsigned(has_best_kept(2 downto 2));
@@ -2066,8 +2084,8 @@ begin
   bits_has_best_kept_13 <= unsigned(has_best_kept(13 downto 13));
   bits_has_best_kept_14 <= unsigned(has_best_kept(14 downto 14));
   bits_has_best_kept_15 <= unsigned(has_best_kept(15 downto 15));
-  bits_b2_slot_c1 <= unsigned(b2_slot_c1(3 downto 0));
-  with bits_b2_slot_c1 select
+  bits_b2_slot_c2 <= unsigned(b2_slot_c2(3 downto 0));
+  with bits_b2_slot_c2 select
     slot_has_best_g0_c <=
       bits_has_best_kept when "0000",
       bits_has_best_kept_1 when "0001",
@@ -2102,8 +2120,8 @@ begin
   bits_has_best_kept_29 <= unsigned(has_best_kept(29 downto 29));
   bits_has_best_kept_30 <= unsigned(has_best_kept(30 downto 30));
   bits_has_best_kept_31 <= unsigned(has_best_kept(31 downto 31));
-  bits_b2_slot_c1_1 <= unsigned(b2_slot_c1(3 downto 0));
-  with bits_b2_slot_c1_1 select
+  bits_b2_slot_c3 <= unsigned(b2_slot_c3(3 downto 0));
+  with bits_b2_slot_c3 select
     slot_has_best_g1_c <=
       bits_has_best_kept_16 when "0000",
       bits_has_best_kept_17 when "0001",
@@ -2138,8 +2156,8 @@ begin
   bits_has_best_kept_45 <= unsigned(has_best_kept(45 downto 45));
   bits_has_best_kept_46 <= unsigned(has_best_kept(46 downto 46));
   bits_has_best_kept_47 <= unsigned(has_best_kept(47 downto 47));
-  bits_b2_slot_c1_2 <= unsigned(b2_slot_c1(3 downto 0));
-  with bits_b2_slot_c1_2 select
+  bits_b2_slot_c4 <= unsigned(b2_slot_c4(3 downto 0));
+  with bits_b2_slot_c4 select
     slot_has_best_g2_c <=
       bits_has_best_kept_32 when "0000",
       bits_has_best_kept_33 when "0001",
@@ -2174,8 +2192,8 @@ begin
   bits_has_best_kept_61 <= unsigned(has_best_kept(61 downto 61));
   bits_has_best_kept_62 <= unsigned(has_best_kept(62 downto 62));
   bits_has_best_kept_63 <= unsigned(has_best_kept(63 downto 63));
-  bits_b2_slot_c1_3 <= unsigned(b2_slot_c1(3 downto 0));
-  with bits_b2_slot_c1_3 select
+  bits_b2_slot_c5 <= unsigned(b2_slot_c5(3 downto 0));
+  with bits_b2_slot_c5 select
     slot_has_best_g3_c <=
       bits_has_best_kept_48 when "0000",
       bits_has_best_kept_49 when "0001",
@@ -2205,10 +2223,10 @@ begin
   slot_has_best_now <= slot_has_best_c or b_slot_merged;
   rs_s_limit_q <= resize(s_limit_q, 33);
   rs_cull_x <= resize(cull_x, 33);
-  minus_51 <= rs_s_limit_q - rs_cull_x;
-  bits_minus_51 <= unsigned(minus_51(32 downto 32));
-  culled_c <= cull_has_best and bits_minus_51;
-  and_53 <= merge_valid and merge_hit;
+  minus_50 <= rs_s_limit_q - rs_cull_x;
+  bits_minus_50 <= unsigned(minus_50(32 downto 32));
+  culled_c <= cull_has_best and bits_minus_50;
+  and_52 <= merge_valid and merge_hit;
   merge_slot_eq_k_63 <= "1" when merge_slot = k_63 else "0";
   merge_slot_eq_k_62 <= "1" when merge_slot = k_62 else "0";
   merge_slot_eq_k_61 <= "1" when merge_slot = k_61 else "0";
@@ -2273,144 +2291,144 @@ begin
   merge_slot_eq_k_2 <= "1" when merge_slot = k_2 else "0";
   merge_slot_eq_k_1 <= "1" when merge_slot = k_1 else "0";
   merge_slot_eq_k_0_1 <= "1" when merge_slot = k_0_1 else "0";
-  cat_54 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
-  best_set <= cat_54 when and_53 = "1" else k_0_5;
+  cat_53 <= unsigned(std_logic_vector'(std_logic_vector(merge_slot_eq_k_63) & std_logic_vector(merge_slot_eq_k_62) & std_logic_vector(merge_slot_eq_k_61) & std_logic_vector(merge_slot_eq_k_60) & std_logic_vector(merge_slot_eq_k_59) & std_logic_vector(merge_slot_eq_k_58) & std_logic_vector(merge_slot_eq_k_57) & std_logic_vector(merge_slot_eq_k_56) & std_logic_vector(merge_slot_eq_k_55) & std_logic_vector(merge_slot_eq_k_54) & std_logic_vector(merge_slot_eq_k_53) & std_logic_vector(merge_slot_eq_k_52) & std_logic_vector(merge_slot_eq_k_51) & std_logic_vector(merge_slot_eq_k_50) & std_logic_vector(merge_slot_eq_k_49) & std_logic_vector(merge_slot_eq_k_48) & std_logic_vector(merge_slot_eq_k_47) & std_logic_vector(merge_slot_eq_k_46) & std_logic_vector(merge_slot_eq_k_45) & std_logic_vector(merge_slot_eq_k_44) & std_logic_vector(merge_slot_eq_k_43) & std_logic_vector(merge_slot_eq_k_42) & std_logic_vector(merge_slot_eq_k_41) & std_logic_vector(merge_slot_eq_k_40) & std_logic_vector(merge_slot_eq_k_39) & std_logic_vector(merge_slot_eq_k_38) & std_logic_vector(merge_slot_eq_k_37) & std_logic_vector(merge_slot_eq_k_36) & std_logic_vector(merge_slot_eq_k_35) & std_logic_vector(merge_slot_eq_k_34) & std_logic_vector(merge_slot_eq_k_33) & std_logic_vector(merge_slot_eq_k_32) & std_logic_vector(merge_slot_eq_k_31) & std_logic_vector(merge_slot_eq_k_30) & std_logic_vector(merge_slot_eq_k_29) & std_logic_vector(merge_slot_eq_k_28) & std_logic_vector(merge_slot_eq_k_27) & std_logic_vector(merge_slot_eq_k_26) & std_logic_vector(merge_slot_eq_k_25) & std_logic_vector(merge_slot_eq_k_24) & std_logic_vector(merge_slot_eq_k_23) & std_logic_vector(merge_slot_eq_k_22) & std_logic_vector(merge_slot_eq_k_21) & std_logic_vector(merge_slot_eq_k_20) & std_logic_vector(merge_slot_eq_k_19) & std_logic_vector(merge_slot_eq_k_18) & std_logic_vector(merge_slot_eq_k_17) & std_logic_vector(merge_slot_eq_k_16) & std_logic_vector(merge_slot_eq_k_15) & std_logic_vector(merge_slot_eq_k_14) & std_logic_vector(merge_slot_eq_k_13) & std_logic_vector(merge_slot_eq_k_12) & std_logic_vector(merge_slot_eq_k_11) & std_logic_vector(merge_slot_eq_k_10) & std_logic_vector(merge_slot_eq_k_9) & std_logic_vector(merge_slot_eq_k_8) & std_logic_vector(merge_slot_eq_k_7) & std_logic_vector(merge_slot_eq_k_6) & std_logic_vector(merge_slot_eq_k_5) & std_logic_vector(merge_slot_eq_k_4) & std_logic_vector(merge_slot_eq_k_3) & std_logic_vector(merge_slot_eq_k_2) & std_logic_vector(merge_slot_eq_k_1) & std_logic_vector(merge_slot_eq_k_0_1)));
+  best_set <= cat_53 when and_52 = "1" else k_0_5;
   q_slot_c4_eq_k_63 <= "1" when q_slot_c4 = k_63 else "0";
-  and_55 <= q_new_c4 and q_slot_c4_eq_k_63;
+  and_54 <= q_new_c4 and q_slot_c4_eq_k_63;
   q_slot_c4_eq_k_62 <= "1" when q_slot_c4 = k_62 else "0";
-  and_56 <= q_new_c4 and q_slot_c4_eq_k_62;
+  and_55 <= q_new_c4 and q_slot_c4_eq_k_62;
   q_slot_c4_eq_k_61 <= "1" when q_slot_c4 = k_61 else "0";
-  and_57 <= q_new_c4 and q_slot_c4_eq_k_61;
+  and_56 <= q_new_c4 and q_slot_c4_eq_k_61;
   q_slot_c4_eq_k_60 <= "1" when q_slot_c4 = k_60 else "0";
-  and_58 <= q_new_c4 and q_slot_c4_eq_k_60;
+  and_57 <= q_new_c4 and q_slot_c4_eq_k_60;
   q_slot_c4_eq_k_59 <= "1" when q_slot_c4 = k_59 else "0";
-  and_59 <= q_new_c4 and q_slot_c4_eq_k_59;
+  and_58 <= q_new_c4 and q_slot_c4_eq_k_59;
   q_slot_c4_eq_k_58 <= "1" when q_slot_c4 = k_58 else "0";
-  and_60 <= q_new_c4 and q_slot_c4_eq_k_58;
+  and_59 <= q_new_c4 and q_slot_c4_eq_k_58;
   q_slot_c4_eq_k_57 <= "1" when q_slot_c4 = k_57 else "0";
-  and_61 <= q_new_c4 and q_slot_c4_eq_k_57;
+  and_60 <= q_new_c4 and q_slot_c4_eq_k_57;
   q_slot_c4_eq_k_56 <= "1" when q_slot_c4 = k_56 else "0";
-  and_62 <= q_new_c4 and q_slot_c4_eq_k_56;
+  and_61 <= q_new_c4 and q_slot_c4_eq_k_56;
   q_slot_c4_eq_k_55 <= "1" when q_slot_c4 = k_55 else "0";
-  and_63 <= q_new_c4 and q_slot_c4_eq_k_55;
+  and_62 <= q_new_c4 and q_slot_c4_eq_k_55;
   q_slot_c4_eq_k_54 <= "1" when q_slot_c4 = k_54 else "0";
-  and_64 <= q_new_c4 and q_slot_c4_eq_k_54;
+  and_63 <= q_new_c4 and q_slot_c4_eq_k_54;
   q_slot_c4_eq_k_53 <= "1" when q_slot_c4 = k_53 else "0";
-  and_65 <= q_new_c4 and q_slot_c4_eq_k_53;
+  and_64 <= q_new_c4 and q_slot_c4_eq_k_53;
   q_slot_c4_eq_k_52 <= "1" when q_slot_c4 = k_52 else "0";
-  and_66 <= q_new_c4 and q_slot_c4_eq_k_52;
+  and_65 <= q_new_c4 and q_slot_c4_eq_k_52;
   q_slot_c4_eq_k_51 <= "1" when q_slot_c4 = k_51 else "0";
-  and_67 <= q_new_c4 and q_slot_c4_eq_k_51;
+  and_66 <= q_new_c4 and q_slot_c4_eq_k_51;
   q_slot_c4_eq_k_50 <= "1" when q_slot_c4 = k_50 else "0";
-  and_68 <= q_new_c4 and q_slot_c4_eq_k_50;
+  and_67 <= q_new_c4 and q_slot_c4_eq_k_50;
   q_slot_c4_eq_k_49 <= "1" when q_slot_c4 = k_49 else "0";
-  and_69 <= q_new_c4 and q_slot_c4_eq_k_49;
+  and_68 <= q_new_c4 and q_slot_c4_eq_k_49;
   q_slot_c4_eq_k_48 <= "1" when q_slot_c4 = k_48 else "0";
-  and_70 <= q_new_c4 and q_slot_c4_eq_k_48;
-  cat_71 <= unsigned(std_logic_vector'(std_logic_vector(and_55) & std_logic_vector(and_56) & std_logic_vector(and_57) & std_logic_vector(and_58) & std_logic_vector(and_59) & std_logic_vector(and_60) & std_logic_vector(and_61) & std_logic_vector(and_62) & std_logic_vector(and_63) & std_logic_vector(and_64) & std_logic_vector(and_65) & std_logic_vector(and_66) & std_logic_vector(and_67) & std_logic_vector(and_68) & std_logic_vector(and_69) & std_logic_vector(and_70)));
+  and_69 <= q_new_c4 and q_slot_c4_eq_k_48;
+  cat_70 <= unsigned(std_logic_vector'(std_logic_vector(and_54) & std_logic_vector(and_55) & std_logic_vector(and_56) & std_logic_vector(and_57) & std_logic_vector(and_58) & std_logic_vector(and_59) & std_logic_vector(and_60) & std_logic_vector(and_61) & std_logic_vector(and_62) & std_logic_vector(and_63) & std_logic_vector(and_64) & std_logic_vector(and_65) & std_logic_vector(and_66) & std_logic_vector(and_67) & std_logic_vector(and_68) & std_logic_vector(and_69)));
   q_slot_c3_eq_k_47 <= "1" when q_slot_c3 = k_47 else "0";
-  and_72 <= q_new_c3 and q_slot_c3_eq_k_47;
+  and_71 <= q_new_c3 and q_slot_c3_eq_k_47;
   q_slot_c3_eq_k_46 <= "1" when q_slot_c3 = k_46 else "0";
-  and_73 <= q_new_c3 and q_slot_c3_eq_k_46;
+  and_72 <= q_new_c3 and q_slot_c3_eq_k_46;
   q_slot_c3_eq_k_45 <= "1" when q_slot_c3 = k_45 else "0";
-  and_74 <= q_new_c3 and q_slot_c3_eq_k_45;
+  and_73 <= q_new_c3 and q_slot_c3_eq_k_45;
   q_slot_c3_eq_k_44 <= "1" when q_slot_c3 = k_44 else "0";
-  and_75 <= q_new_c3 and q_slot_c3_eq_k_44;
+  and_74 <= q_new_c3 and q_slot_c3_eq_k_44;
   q_slot_c3_eq_k_43 <= "1" when q_slot_c3 = k_43 else "0";
-  and_76 <= q_new_c3 and q_slot_c3_eq_k_43;
+  and_75 <= q_new_c3 and q_slot_c3_eq_k_43;
   q_slot_c3_eq_k_42 <= "1" when q_slot_c3 = k_42 else "0";
-  and_77 <= q_new_c3 and q_slot_c3_eq_k_42;
+  and_76 <= q_new_c3 and q_slot_c3_eq_k_42;
   q_slot_c3_eq_k_41 <= "1" when q_slot_c3 = k_41 else "0";
-  and_78 <= q_new_c3 and q_slot_c3_eq_k_41;
+  and_77 <= q_new_c3 and q_slot_c3_eq_k_41;
   q_slot_c3_eq_k_40 <= "1" when q_slot_c3 = k_40 else "0";
-  and_79 <= q_new_c3 and q_slot_c3_eq_k_40;
+  and_78 <= q_new_c3 and q_slot_c3_eq_k_40;
   q_slot_c3_eq_k_39 <= "1" when q_slot_c3 = k_39 else "0";
-  and_80 <= q_new_c3 and q_slot_c3_eq_k_39;
+  and_79 <= q_new_c3 and q_slot_c3_eq_k_39;
   q_slot_c3_eq_k_38 <= "1" when q_slot_c3 = k_38 else "0";
-  and_81 <= q_new_c3 and q_slot_c3_eq_k_38;
+  and_80 <= q_new_c3 and q_slot_c3_eq_k_38;
   q_slot_c3_eq_k_37 <= "1" when q_slot_c3 = k_37 else "0";
-  and_82 <= q_new_c3 and q_slot_c3_eq_k_37;
+  and_81 <= q_new_c3 and q_slot_c3_eq_k_37;
   q_slot_c3_eq_k_36 <= "1" when q_slot_c3 = k_36 else "0";
-  and_83 <= q_new_c3 and q_slot_c3_eq_k_36;
+  and_82 <= q_new_c3 and q_slot_c3_eq_k_36;
   q_slot_c3_eq_k_35 <= "1" when q_slot_c3 = k_35 else "0";
-  and_84 <= q_new_c3 and q_slot_c3_eq_k_35;
+  and_83 <= q_new_c3 and q_slot_c3_eq_k_35;
   q_slot_c3_eq_k_34 <= "1" when q_slot_c3 = k_34 else "0";
-  and_85 <= q_new_c3 and q_slot_c3_eq_k_34;
+  and_84 <= q_new_c3 and q_slot_c3_eq_k_34;
   q_slot_c3_eq_k_33 <= "1" when q_slot_c3 = k_33 else "0";
-  and_86 <= q_new_c3 and q_slot_c3_eq_k_33;
+  and_85 <= q_new_c3 and q_slot_c3_eq_k_33;
   q_slot_c3_eq_k_32 <= "1" when q_slot_c3 = k_32 else "0";
-  and_87 <= q_new_c3 and q_slot_c3_eq_k_32;
-  cat_88 <= unsigned(std_logic_vector'(std_logic_vector(and_72) & std_logic_vector(and_73) & std_logic_vector(and_74) & std_logic_vector(and_75) & std_logic_vector(and_76) & std_logic_vector(and_77) & std_logic_vector(and_78) & std_logic_vector(and_79) & std_logic_vector(and_80) & std_logic_vector(and_81) & std_logic_vector(and_82) & std_logic_vector(and_83) & std_logic_vector(and_84) & std_logic_vector(and_85) & std_logic_vector(and_86) & std_logic_vector(and_87)));
+  and_86 <= q_new_c3 and q_slot_c3_eq_k_32;
+  cat_87 <= unsigned(std_logic_vector'(std_logic_vector(and_71) & std_logic_vector(and_72) & std_logic_vector(and_73) & std_logic_vector(and_74) & std_logic_vector(and_75) & std_logic_vector(and_76) & std_logic_vector(and_77) & std_logic_vector(and_78) & std_logic_vector(and_79) & std_logic_vector(and_80) & std_logic_vector(and_81) & std_logic_vector(and_82) & std_logic_vector(and_83) & std_logic_vector(and_84) & std_logic_vector(and_85) & std_logic_vector(and_86)));
   q_slot_c2_eq_k_31 <= "1" when q_slot_c2 = k_31 else "0";
-  and_89 <= q_new_c2 and q_slot_c2_eq_k_31;
+  and_88 <= q_new_c2 and q_slot_c2_eq_k_31;
   q_slot_c2_eq_k_30 <= "1" when q_slot_c2 = k_30 else "0";
-  and_90 <= q_new_c2 and q_slot_c2_eq_k_30;
+  and_89 <= q_new_c2 and q_slot_c2_eq_k_30;
   q_slot_c2_eq_k_29 <= "1" when q_slot_c2 = k_29 else "0";
-  and_91 <= q_new_c2 and q_slot_c2_eq_k_29;
+  and_90 <= q_new_c2 and q_slot_c2_eq_k_29;
   q_slot_c2_eq_k_28 <= "1" when q_slot_c2 = k_28 else "0";
-  and_92 <= q_new_c2 and q_slot_c2_eq_k_28;
+  and_91 <= q_new_c2 and q_slot_c2_eq_k_28;
   q_slot_c2_eq_k_27 <= "1" when q_slot_c2 = k_27 else "0";
-  and_93 <= q_new_c2 and q_slot_c2_eq_k_27;
+  and_92 <= q_new_c2 and q_slot_c2_eq_k_27;
   q_slot_c2_eq_k_26 <= "1" when q_slot_c2 = k_26 else "0";
-  and_94 <= q_new_c2 and q_slot_c2_eq_k_26;
+  and_93 <= q_new_c2 and q_slot_c2_eq_k_26;
   q_slot_c2_eq_k_25 <= "1" when q_slot_c2 = k_25 else "0";
-  and_95 <= q_new_c2 and q_slot_c2_eq_k_25;
+  and_94 <= q_new_c2 and q_slot_c2_eq_k_25;
   q_slot_c2_eq_k_24 <= "1" when q_slot_c2 = k_24 else "0";
-  and_96 <= q_new_c2 and q_slot_c2_eq_k_24;
+  and_95 <= q_new_c2 and q_slot_c2_eq_k_24;
   q_slot_c2_eq_k_23 <= "1" when q_slot_c2 = k_23 else "0";
-  and_97 <= q_new_c2 and q_slot_c2_eq_k_23;
+  and_96 <= q_new_c2 and q_slot_c2_eq_k_23;
   q_slot_c2_eq_k_22 <= "1" when q_slot_c2 = k_22 else "0";
-  and_98 <= q_new_c2 and q_slot_c2_eq_k_22;
+  and_97 <= q_new_c2 and q_slot_c2_eq_k_22;
   q_slot_c2_eq_k_21 <= "1" when q_slot_c2 = k_21 else "0";
-  and_99 <= q_new_c2 and q_slot_c2_eq_k_21;
+  and_98 <= q_new_c2 and q_slot_c2_eq_k_21;
   q_slot_c2_eq_k_20 <= "1" when q_slot_c2 = k_20 else "0";
-  and_100 <= q_new_c2 and q_slot_c2_eq_k_20;
+  and_99 <= q_new_c2 and q_slot_c2_eq_k_20;
   q_slot_c2_eq_k_19 <= "1" when q_slot_c2 = k_19 else "0";
-  and_101 <= q_new_c2 and q_slot_c2_eq_k_19;
+  and_100 <= q_new_c2 and q_slot_c2_eq_k_19;
   q_slot_c2_eq_k_18 <= "1" when q_slot_c2 = k_18 else "0";
-  and_102 <= q_new_c2 and q_slot_c2_eq_k_18;
+  and_101 <= q_new_c2 and q_slot_c2_eq_k_18;
   q_slot_c2_eq_k_17 <= "1" when q_slot_c2 = k_17 else "0";
-  and_103 <= q_new_c2 and q_slot_c2_eq_k_17;
+  and_102 <= q_new_c2 and q_slot_c2_eq_k_17;
   q_slot_c2_eq_k_16 <= "1" when q_slot_c2 = k_16 else "0";
-  and_104 <= q_new_c2 and q_slot_c2_eq_k_16;
-  cat_105 <= unsigned(std_logic_vector'(std_logic_vector(and_89) & std_logic_vector(and_90) & std_logic_vector(and_91) & std_logic_vector(and_92) & std_logic_vector(and_93) & std_logic_vector(and_94) & std_logic_vector(and_95) & std_logic_vector(and_96) & std_logic_vector(and_97) & std_logic_vector(and_98) & std_logic_vector(and_99) & std_logic_vector(and_100) & std_logic_vector(and_101) & std_logic_vector(and_102) & std_logic_vector(and_103) & std_logic_vector(and_104)));
+  and_103 <= q_new_c2 and q_slot_c2_eq_k_16;
+  cat_104 <= unsigned(std_logic_vector'(std_logic_vector(and_88) & std_logic_vector(and_89) & std_logic_vector(and_90) & std_logic_vector(and_91) & std_logic_vector(and_92) & std_logic_vector(and_93) & std_logic_vector(and_94) & std_logic_vector(and_95) & std_logic_vector(and_96) & std_logic_vector(and_97) & std_logic_vector(and_98) & std_logic_vector(and_99) & std_logic_vector(and_100) & std_logic_vector(and_101) & std_logic_vector(and_102) & std_logic_vector(and_103)));
   q_slot_c1_eq_k_15 <= "1" when q_slot_c1 = k_15 else "0";
-  and_106 <= q_new_c1 and q_slot_c1_eq_k_15;
+  and_105 <= q_new_c1 and q_slot_c1_eq_k_15;
   q_slot_c1_eq_k_14 <= "1" when q_slot_c1 = k_14 else "0";
-  and_107 <= q_new_c1 and q_slot_c1_eq_k_14;
+  and_106 <= q_new_c1 and q_slot_c1_eq_k_14;
   q_slot_c1_eq_k_13 <= "1" when q_slot_c1 = k_13 else "0";
-  and_108 <= q_new_c1 and q_slot_c1_eq_k_13;
+  and_107 <= q_new_c1 and q_slot_c1_eq_k_13;
   q_slot_c1_eq_k_12 <= "1" when q_slot_c1 = k_12 else "0";
-  and_109 <= q_new_c1 and q_slot_c1_eq_k_12;
+  and_108 <= q_new_c1 and q_slot_c1_eq_k_12;
   q_slot_c1_eq_k_11 <= "1" when q_slot_c1 = k_11 else "0";
-  and_110 <= q_new_c1 and q_slot_c1_eq_k_11;
+  and_109 <= q_new_c1 and q_slot_c1_eq_k_11;
   q_slot_c1_eq_k_10 <= "1" when q_slot_c1 = k_10 else "0";
-  and_111 <= q_new_c1 and q_slot_c1_eq_k_10;
+  and_110 <= q_new_c1 and q_slot_c1_eq_k_10;
   q_slot_c1_eq_k_9 <= "1" when q_slot_c1 = k_9 else "0";
-  and_112 <= q_new_c1 and q_slot_c1_eq_k_9;
+  and_111 <= q_new_c1 and q_slot_c1_eq_k_9;
   q_slot_c1_eq_k_8 <= "1" when q_slot_c1 = k_8 else "0";
-  and_113 <= q_new_c1 and q_slot_c1_eq_k_8;
+  and_112 <= q_new_c1 and q_slot_c1_eq_k_8;
   q_slot_c1_eq_k_7 <= "1" when q_slot_c1 = k_7 else "0";
-  and_114 <= q_new_c1 and q_slot_c1_eq_k_7;
+  and_113 <= q_new_c1 and q_slot_c1_eq_k_7;
   q_slot_c1_eq_k_6 <= "1" when q_slot_c1 = k_6 else "0";
-  and_115 <= q_new_c1 and q_slot_c1_eq_k_6;
+  and_114 <= q_new_c1 and q_slot_c1_eq_k_6;
   q_slot_c1_eq_k_5 <= "1" when q_slot_c1 = k_5 else "0";
-  and_116 <= q_new_c1 and q_slot_c1_eq_k_5;
+  and_115 <= q_new_c1 and q_slot_c1_eq_k_5;
   q_slot_c1_eq_k_4 <= "1" when q_slot_c1 = k_4 else "0";
-  and_117 <= q_new_c1 and q_slot_c1_eq_k_4;
+  and_116 <= q_new_c1 and q_slot_c1_eq_k_4;
   q_slot_c1_eq_k_3 <= "1" when q_slot_c1 = k_3 else "0";
-  and_118 <= q_new_c1 and q_slot_c1_eq_k_3;
+  and_117 <= q_new_c1 and q_slot_c1_eq_k_3;
   q_slot_c1_eq_k_2 <= "1" when q_slot_c1 = k_2 else "0";
-  and_119 <= q_new_c1 and q_slot_c1_eq_k_2;
+  and_118 <= q_new_c1 and q_slot_c1_eq_k_2;
   q_slot_c1_eq_k_1 <= "1" when q_slot_c1 = k_1 else "0";
-  and_120 <= q_new_c1 and q_slot_c1_eq_k_1;
+  and_119 <= q_new_c1 and q_slot_c1_eq_k_1;
   q_slot_c1_eq_k_0_1 <= "1" when q_slot_c1 = k_0_1 else "0";
-  and_121 <= q_new_c1 and q_slot_c1_eq_k_0_1;
-  cat_122 <= unsigned(std_logic_vector'(std_logic_vector(and_106) & std_logic_vector(and_107) & std_logic_vector(and_108) & std_logic_vector(and_109) & std_logic_vector(and_110) & std_logic_vector(and_111) & std_logic_vector(and_112) & std_logic_vector(and_113) & std_logic_vector(and_114) & std_logic_vector(and_115) & std_logic_vector(and_116) & std_logic_vector(and_117) & std_logic_vector(and_118) & std_logic_vector(and_119) & std_logic_vector(and_120) & std_logic_vector(and_121)));
-  best_clear_c <= unsigned(std_logic_vector'(std_logic_vector(cat_71) & std_logic_vector(cat_88) & std_logic_vector(cat_105) & std_logic_vector(cat_122)));
+  and_120 <= q_new_c1 and q_slot_c1_eq_k_0_1;
+  cat_121 <= unsigned(std_logic_vector'(std_logic_vector(and_105) & std_logic_vector(and_106) & std_logic_vector(and_107) & std_logic_vector(and_108) & std_logic_vector(and_109) & std_logic_vector(and_110) & std_logic_vector(and_111) & std_logic_vector(and_112) & std_logic_vector(and_113) & std_logic_vector(and_114) & std_logic_vector(and_115) & std_logic_vector(and_116) & std_logic_vector(and_117) & std_logic_vector(and_118) & std_logic_vector(and_119) & std_logic_vector(and_120)));
+  best_clear_c <= unsigned(std_logic_vector'(std_logic_vector(cat_70) & std_logic_vector(cat_87) & std_logic_vector(cat_104) & std_logic_vector(cat_121)));
   not_best_clear <= not best_clear;
   has_best_kept_c <= has_best and not_best_clear;
-  or_125 <= has_best_kept or best_set;
+  or_124 <= has_best_kept or best_set;
 
   ring_c_regs : process (clk)
   begin
@@ -2428,7 +2446,7 @@ begin
       if rst = '1' then
         has_best <= unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
       else
-        has_best <= or_125;
+        has_best <= or_124;
       end if;
       cull_x <= tmin_less;
       b_slot_merged <= b_slot_merged_c;
@@ -2454,13 +2472,17 @@ begin
     end if;
   end process c_slot_copies_regs;
 
-  -- register copies b2_slot_copies: b2_slot and 1 copies, to split its fan-out
+  -- register copies b2_slot_copies: b2_slot and 5 copies, to split its fan-out
 
   b2_slot_copies_regs : process (clk)
   begin
     if rising_edge(clk) then
       b2_slot <= b_slot;
       b2_slot_c1 <= b_slot;
+      b2_slot_c2 <= b_slot;
+      b2_slot_c3 <= b_slot;
+      b2_slot_c4 <= b_slot;
+      b2_slot_c5 <= b_slot;
     end if;
   end process b2_slot_copies_regs;
 
@@ -2512,7 +2534,7 @@ begin
   leaf_push <= visit_c_and_nw_is_leaf and nw_count_ne_k_0_6;
   u_n_tmin <= unsigned(n_tmin);
   rs_u_n_tmin <= u_n_tmin(30 downto 0);
-  cat_129 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
+  cat_128 <= unsigned(std_logic_vector'(std_logic_vector(n_slot) & std_logic_vector(nw_first) & std_logic_vector(nw_count) & std_logic_vector(rs_u_n_tmin) & std_logic_vector(n_sp)));
   leaf_q_wr_plus_k_1 <= leaf_q_wr + k_1;
   mux_leaf_q_push <= leaf_q_wr_plus_k_1 when leaf_q_push = "1" else leaf_q_wr;
   leaf_q_rd_next <= leaf_q_rd1 when leaf_pop_r = "1" else leaf_q_rd;
@@ -2526,14 +2548,14 @@ begin
   leaf_q_count_next <= leaf_q_count_if_pop when leaf_pop_r = "1" else leaf_q_count_if_kept;
   leaf_q_count_eq_k_0 <= "1" when leaf_q_count = k_0 else "0";
   leaf_q_one_left <= "1" when leaf_q_count = k_1_1 else "0";
-  and_132 <= leaf_q_one_left and leaf_pop_r;
-  leaf_q_drained <= leaf_q_count_eq_k_0 or and_132;
+  and_131 <= leaf_q_one_left and leaf_pop_r;
+  leaf_q_drained <= leaf_q_count_eq_k_0 or and_131;
   leaf_q_bypass_c <= leaf_q_push_c1 and leaf_q_drained;
   k_1_1_lt_leaf_q_count <= "1" when k_1_1 < leaf_q_count else "0";
-  or_135 <= leaf_q_push_c1 or k_1_1_lt_leaf_q_count;
+  or_134 <= leaf_q_push_c1 or k_1_1_lt_leaf_q_count;
   not_leaf_pop_r <= not leaf_pop_r;
-  and_136 <= leaf_q_one_left and not_leaf_pop_r;
-  leaf_q_nonempty_c <= or_135 or and_136;
+  and_135 <= leaf_q_one_left and not_leaf_pop_r;
+  leaf_q_nonempty_c <= or_134 or and_135;
   bits_leaf_q_din <= unsigned(leaf_q_din(15 downto 0));
   bits_leaf_q_din_1 <= unsigned(leaf_q_din(31 downto 16));
   bits_leaf_q_din_2 <= unsigned(leaf_q_din(47 downto 32));
@@ -2613,8 +2635,8 @@ begin
   pu_below_1 <= unsigned(pu_shifted_1(61 downto 61));
   not_pu_below_1 <= not pu_below_1;
   bits_pu_shifted_1 <= unsigned(pu_shifted_1(60 downto 30));
-  ne_147 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
-  pu_above_1 <= not_pu_below_1 and ne_147;
+  ne_146 <= "1" when bits_pu_shifted_1 /= k_0_7 else "0";
+  pu_above_1 <= not_pu_below_1 and ne_146;
   rs_pu_shifted_1 <= pu_shifted_1(31 downto 0);
   mux_pu_below_r_1 <= k_m1 when pu_below_r_1 = "1" else pu_low_r_1;
   pu_clamped_1 <= k_1073741824 when pu_above_r_1 = "1" else mux_pu_below_r_1;
@@ -2626,7 +2648,7 @@ begin
       s_ray_invz_q when "10",
       s_ray_invx_q when others;
   negative_c <= unsigned(case_axis_n1(47 downto 47));
-  negative <= negative_sr(9);
+  negative <= negative_sr(10);
 
   ring_n_regs : process (clk)
   begin
@@ -2656,6 +2678,12 @@ begin
       n_tmax_sr(1) <= c_tmax;
       n_sp_sr(2 to 3) <= n_sp_sr(1 to 2);
       n_sp_sr(1) <= c_sp;
+      if rst = '1' then
+        leaf_push_r <= unsigned'("0");
+      else
+        leaf_push_r <= leaf_push;
+      end if;
+      leaf_in_r <= cat_128;
       if rst = '1' then
         leaf_pop_r <= unsigned'("0");
       else
@@ -2696,7 +2724,7 @@ begin
       else
         leaf_q_nonempty <= leaf_q_nonempty_c;
       end if;
-      leaf_q_din <= cat_129;
+      leaf_q_din <= leaf_in_r;
       if rst = '1' then
         leaf_q_rd_p1 <= unsigned'("000000");
       else
@@ -2895,8 +2923,10 @@ begin
         plane_t_valid_1 <= pu_clamp_valid_1;
       end if;
       plane_t_last_1 <= pu_clamp_last_1;
+      plane_t_land0 <= plane_t;
+      plane_t_land1 <= plane_t_1;
       axis_n1 <= nw_axis;
-      negative_sr(2 to 9) <= negative_sr(1 to 8);
+      negative_sr(2 to 10) <= negative_sr(1 to 9);
       negative_sr(1) <= negative_c;
     end if;
   end process ring_n_regs;
@@ -2909,12 +2939,12 @@ begin
       if rst = '1' then
         leaf_q_push <= unsigned'("0");
       else
-        leaf_q_push <= leaf_push;
+        leaf_q_push <= leaf_push_r;
       end if;
       if rst = '1' then
         leaf_q_push_c1 <= unsigned'("0");
       else
-        leaf_q_push_c1 <= leaf_push;
+        leaf_q_push_c1 <= leaf_push_r;
       end if;
     end if;
   end process leaf_q_push_copies_regs;
@@ -2945,12 +2975,12 @@ begin
   -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   not_leaf_push <= not leaf_push;
   n_stays <= n_valid_3 and not_leaf_push;
-  f_inner <= f_inner_sr(10);
-  f_slot <= f_slot_sr(10);
-  f_tmin <= f_tmin_sr(10);
-  f_tmax <= f_tmax_sr(10);
-  f_sp <= f_sp_sr(10);
-  f_child <= f_child_sr(10);
+  f_inner <= f_inner_sr(11);
+  f_slot <= f_slot_sr(11);
+  f_tmin <= f_tmin_sr(11);
+  f_tmax <= f_tmax_sr(11);
+  f_sp <= f_sp_sr(11);
+  f_child <= f_child_sr(11);
   with axis_n1 select
     case_axis_n1_1 <=
       s_ray_invy_q when "01",
@@ -2961,42 +2991,42 @@ begin
   tmin_minus_1 <= n_tmin - k_1_3;
   rs_tmin_n1 <= resize(tmin_n1, 33);
   rs_tmax_p1 <= resize(tmax_p1, 33);
-  minus_151 <= rs_tmin_n1 - rs_tmax_p1;
-  tmin_le_tmax_c <= unsigned(minus_151(32 downto 32));
+  minus_150 <= rs_tmin_n1 - rs_tmax_p1;
+  tmin_le_tmax_c <= unsigned(minus_150(32 downto 32));
   mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
   d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
-  d0_hi <= d0_hi_sr(7);
+  d0_hi <= d0_hi_sr(8);
   mux_negative_n1_1 <= tmin_n2 when negative_n1 = "1" else tmin_m1_n2;
   d0_lo_c <= mux_negative_n1_1 when tmin_le_tmax = "1" else k_2147483647;
-  d0_lo <= d0_lo_sr(7);
+  d0_lo <= d0_lo_sr(8);
   mux_negative_n1_2 <= tmax_n2 when negative_n1 = "1" else tmax_p1_n2;
   d1_hi_c <= mux_negative_n1_2 when tmin_le_tmax = "1" else k_m2147483648;
-  d1_hi <= d1_hi_sr(7);
+  d1_hi <= d1_hi_sr(8);
   mux_negative_n1_3 <= tmin_m1_n2 when negative_n1 = "1" else tmin_n2;
   d1_lo_c <= mux_negative_n1_3 when tmin_le_tmax = "1" else k_2147483647;
-  d1_lo <= d1_lo_sr(7);
-  rs_plane_t <= resize(plane_t, 33);
+  d1_lo <= d1_lo_sr(8);
+  rs_plane_t_land0 <= resize(plane_t_land0, 33);
   rs_d0_hi <= resize(d0_hi, 33);
-  minus_152 <= rs_plane_t - rs_d0_hi;
-  d0_below <= unsigned(minus_152(32 downto 32));
+  minus_151 <= rs_plane_t_land0 - rs_d0_hi;
+  d0_below <= unsigned(minus_151(32 downto 32));
   rs_d0_lo <= resize(d0_lo, 33);
-  rs_plane_t_1 <= resize(plane_t, 33);
-  minus_153 <= rs_d0_lo - rs_plane_t_1;
-  d0_above <= unsigned(minus_153(32 downto 32));
-  rs_plane_t_1_1 <= resize(plane_t_1, 33);
+  rs_plane_t_land0_1 <= resize(plane_t_land0, 33);
+  minus_152 <= rs_d0_lo - rs_plane_t_land0_1;
+  d0_above <= unsigned(minus_152(32 downto 32));
+  rs_plane_t_land1 <= resize(plane_t_land1, 33);
   rs_d1_hi <= resize(d1_hi, 33);
-  minus_154 <= rs_plane_t_1_1 - rs_d1_hi;
-  d1_below <= unsigned(minus_154(32 downto 32));
+  minus_153 <= rs_plane_t_land1 - rs_d1_hi;
+  d1_below <= unsigned(minus_153(32 downto 32));
   rs_d1_lo <= resize(d1_lo, 33);
-  rs_plane_t_1_2 <= resize(plane_t_1, 33);
-  minus_155 <= rs_d1_lo - rs_plane_t_1_2;
-  d1_above <= unsigned(minus_155(32 downto 32));
+  rs_plane_t_land1_1 <= resize(plane_t_land1, 33);
+  minus_154 <= rs_d1_lo - rs_plane_t_land1_1;
+  d1_above <= unsigned(minus_154(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
   go_near_c <= d1_above when negative = "1" else d0_above;
   go_far_c <= d0_below when negative = "1" else d1_below;
-  mux_negative <= plane_t_1 when negative = "1" else plane_t;
-  mux_negative_1 <= plane_t when negative = "1" else plane_t_1;
+  mux_negative <= plane_t_land1 when negative = "1" else plane_t_land0;
+  mux_negative_1 <= plane_t_land0 when negative = "1" else plane_t_land1;
 
   ring_f_regs : process (clk)
   begin
@@ -3051,17 +3081,22 @@ begin
       else
         f_valid_10 <= f_valid_9;
       end if;
-      f_inner_sr(2 to 10) <= f_inner_sr(1 to 9);
+      if rst = '1' then
+        f_valid_11 <= unsigned'("0");
+      else
+        f_valid_11 <= f_valid_10;
+      end if;
+      f_inner_sr(2 to 11) <= f_inner_sr(1 to 10);
       f_inner_sr(1) <= is_inner;
-      f_slot_sr(2 to 10) <= f_slot_sr(1 to 9);
+      f_slot_sr(2 to 11) <= f_slot_sr(1 to 10);
       f_slot_sr(1) <= n_slot;
-      f_tmin_sr(2 to 10) <= f_tmin_sr(1 to 9);
+      f_tmin_sr(2 to 11) <= f_tmin_sr(1 to 10);
       f_tmin_sr(1) <= n_tmin;
-      f_tmax_sr(2 to 10) <= f_tmax_sr(1 to 9);
+      f_tmax_sr(2 to 11) <= f_tmax_sr(1 to 10);
       f_tmax_sr(1) <= n_tmax;
-      f_sp_sr(2 to 10) <= f_sp_sr(1 to 9);
+      f_sp_sr(2 to 11) <= f_sp_sr(1 to 10);
       f_sp_sr(1) <= n_sp;
-      f_child_sr(2 to 10) <= f_child_sr(1 to 9);
+      f_child_sr(2 to 11) <= f_child_sr(1 to 10);
       f_child_sr(1) <= nw_child;
       negative_n1 <= bits_case_axis_n1_1;
       tmin_n1 <= n_tmin;
@@ -3074,16 +3109,16 @@ begin
       tmax_p1_n2 <= tmax_p1;
       tmin_m1_n2 <= tmin_m1;
       d0_hi_n3 <= d0_hi_c;
-      d0_hi_sr(2 to 7) <= d0_hi_sr(1 to 6);
+      d0_hi_sr(2 to 8) <= d0_hi_sr(1 to 7);
       d0_hi_sr(1) <= d0_hi_n3;
       d0_lo_n3 <= d0_lo_c;
-      d0_lo_sr(2 to 7) <= d0_lo_sr(1 to 6);
+      d0_lo_sr(2 to 8) <= d0_lo_sr(1 to 7);
       d0_lo_sr(1) <= d0_lo_n3;
       d1_hi_n3 <= d1_hi_c;
-      d1_hi_sr(2 to 7) <= d1_hi_sr(1 to 6);
+      d1_hi_sr(2 to 8) <= d1_hi_sr(1 to 7);
       d1_hi_sr(1) <= d1_hi_n3;
       d1_lo_n3 <= d1_lo_c;
-      d1_lo_sr(2 to 7) <= d1_lo_sr(1 to 6);
+      d1_lo_sr(2 to 8) <= d1_lo_sr(1 to 7);
       d1_lo_sr(1) <= d1_lo_n3;
       near_lt_tmax <= near_lt_tmax_c;
       far_gt_tmin <= far_gt_tmin_c;
@@ -3091,11 +3126,6 @@ begin
       go_far <= go_far_c;
       near_end <= mux_negative;
       far_start <= mux_negative_1;
-      if rst = '1' then
-        g_valid <= unsigned'("0");
-      else
-        g_valid <= f_valid_10;
-      end if;
       g_slot <= f_slot;
       g_child <= f_child;
       g_tmin <= f_tmin;
@@ -3118,10 +3148,10 @@ begin
   enter_far <= g_inner_and_not_go_near and go_far;
   push <= enter_near and go_far;
   rs_g_sp <= g_sp(4 downto 0);
-  cat_157 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
+  cat_156 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp)));
   u_far_min <= unsigned(far_min);
   u_g_tmax <= unsigned(g_tmax);
-  cat_158 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
+  cat_157 <= unsigned(std_logic_vector'(std_logic_vector(far) & std_logic_vector(u_far_min) & std_logic_vector(u_g_tmax)));
   enter_near_or_enter_far <= enter_near or enter_far;
   g_pop <= not enter_near_or_enter_far;
   mux_enter_near <= near when enter_near = "1" else far;
@@ -3136,8 +3166,8 @@ begin
   g_sp_m1 <= g_sp when push = "1" else g_sp_minus_k_1;
   g_done <= g_pop and g_sp_zero;
   rs_g_sp_m1 <= g_sp_m1(4 downto 0);
-  cat_159 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp_m1)));
-  stack_raddr_next <= cat_159 when g_valid = "1" else q_stack_raddr;
+  cat_158 <= unsigned(std_logic_vector'(std_logic_vector(g_slot) & std_logic_vector(rs_g_sp_m1)));
+  stack_raddr_next <= cat_158 when g_valid = "1" else q_stack_raddr;
 
   ring_g_regs : process (clk)
   begin
@@ -3147,10 +3177,28 @@ begin
       else
         stack_we_r <= push;
       end if;
-      stack_waddr_r <= cat_157;
-      stack_wdata_r <= cat_158;
+      stack_waddr_r <= cat_156;
+      stack_wdata_r <= cat_157;
     end if;
   end process ring_g_regs;
+
+  -- register copies g_valid_copies: g_valid and 1 copies, to split its fan-out
+
+  g_valid_copies_regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        g_valid <= unsigned'("0");
+      else
+        g_valid <= f_valid_11;
+      end if;
+      if rst = '1' then
+        g_valid_c1 <= unsigned'("0");
+      else
+        g_valid_c1 <= f_valid_11;
+      end if;
+    end if;
+  end process g_valid_copies_regs;
 
   u_stack : fxrt_bram_stack_w77
     port map (
