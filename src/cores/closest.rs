@@ -19,7 +19,7 @@
 
 use super::clock::ClockTarget;
 use super::wide_ram::WideRam;
-use super::{lt_chain, slot_bit_2};
+use super::{lt_chain, slot_bit_2, slot_bit_groups};
 use crate::rtl::build::{Builder, S};
 use crate::rtl::{Module, Ty};
 
@@ -46,19 +46,13 @@ pub fn input_latency(target: ClockTarget) -> u32 {
     2 * target.splits(STAGED_FROM_MHZ) as u32
 }
 
-/// Copies of the done slot the unit takes (`done_slot_copies`, after `done_slot`): one per
-/// group of 16 of its `slots` slots.
-pub fn done_slot_copies(slots: u32) -> u32 {
-    slots.div_ceil(16)
-}
-
 /// The unit of one lane (intersection pipeline) of the core: `slots` slot numbers, `units`
 /// traversal units, `unit_bits` their numbers' bits, and `lane_bits` bits of the lane number
 /// above them in the tag's global slot (0 with one pipeline), which the unit drops: its RAMs
 /// and ports take the slot number within the lane.
 /// Ports: valid, tag, hit, t (n + 1 bits), u, v (m bits) from the pipeline; `id_we`, `id_slot`,
 /// `id` (a ray's id, written when its slot is taken); `done_valid`, `done_slot`,
-/// `done_slot_copies` (`done_slot_copies(slots)` copies of it, the first lowest) →
+/// `done_slot_copies` (`slot_bit_groups(slots)` copies of it, the first lowest) →
 /// per traversal unit u `merge_valid{u}`, `merge_slot{u}` (the slot within the unit: the global
 /// slot's low bits below the `unit_bits` unit number), `merge_hit{u}`, and for all of them
 /// `merge_limit` (best t + 8, signed n + 3 bits), `merge_sp`; `free_valid`, `free_slot`; res_valid, res_id, res_hit, res_tri, res_t, res_u, res_v
@@ -91,7 +85,7 @@ pub fn closest_core(
     let done_slot = b.input("done_slot", slot_ty);
     // Copies of `done_slot` (registers of their own in the top), one per group of 16 slots'
     // has-best bits.
-    let groups = done_slot_copies(slots);
+    let groups = slot_bit_groups(slots);
     let done_slot_c = b.input("done_slot_copies", Ty::u(groups * slot_ty.width));
     let done_slots: Vec<S> = (0..groups).map(|g| done_slot_c.slice(g * slot_ty.width, slot_ty.width)).collect();
     let mut at = 0;

@@ -51,6 +51,12 @@ pub fn onehot<'b>(x: S<'b>, k: u32) -> S<'b> {
     x.b.cat(&bits)
 }
 
+/// Groups of `slot_bit_2`'s first clock for `k` bits (16 bits each): a copy of the early
+/// slot register can serve each.
+pub fn slot_bit_groups(k: u32) -> u32 {
+    k.div_ceil(16)
+}
+
 /// Bit `slot` of the k-bit register `bits`, selected over two clocks: groups of 16 bits by the
 /// slot's low bits from `early` into registers, then the group by the high bits of `late`
 /// (`early` a clock later). A 128-to-1 select in one clock was the core's critical path, its
@@ -62,7 +68,7 @@ pub fn onehot<'b>(x: S<'b>, k: u32) -> S<'b> {
 pub fn slot_bit_2<'b>(b: &'b Builder, name: &str, bits: S<'b>, k: u32, early: &[S<'b>], late: S<'b>) -> S<'b> {
     let zero = b.konst(Ty::BIT, 0);
     let low = early[0].width().min(4);
-    let groups: Vec<S> = (0..k.div_ceil(16))
+    let groups: Vec<S> = (0..slot_bit_groups(k))
         .map(|g| {
             let cases: Vec<(u128, S)> = (0..16.min(k - 16 * g)).map(|i| (i as u128, bits.bit(16 * g + i))).collect();
             let early = early[g as usize % early.len()].slice(0, low);

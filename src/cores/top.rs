@@ -250,7 +250,7 @@ fn results<'b>(
     let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
     let (lb, lsb, lu) = (p.lane_bits(), p.lane_slot_bits(), p.lane_units() as usize);
     // A copy of the slot per group of 16 has-best bits in each lane's unit (`slot_bit_2`).
-    let groups = super::closest::done_slot_copies(p.total_slots() >> lb) as usize;
+    let groups = super::slot_bit_groups(p.total_slots() >> lb) as usize;
     let done_copies = b.copies(done_slot, groups * emitted.len());
     let outs: Vec<Ports> = emitted
         .iter()

@@ -8,7 +8,7 @@ use super::free_list::{FreeList, free_list};
 use super::plane::{PlaneIssue, plane_unit};
 use super::traverse_params::{TraverseParams, field};
 use super::wide_ram::{WideRam, group_widths};
-use super::{lt_chain, onehot, slot_bit_2};
+use super::{lt_chain, onehot, slot_bit_2, slot_bit_groups};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 use crate::scene::rom::rom_addr_bits;
@@ -454,7 +454,7 @@ impl<'b> Unit<'b> {
         // the merge ports, across the die, before the groups was 8.07 ns at a seed).
         // B's slot in a copy per group (and one for the merge compare): one copy reaching the
         // four groups' selects was 6.66 ns at seed 3.
-        let early = b.copies(b_slot, 1 + k.div_ceil(16) as usize);
+        let early = b.copies(b_slot, 1 + slot_bit_groups(k) as usize);
         let set_in_b = (inp.merge_valid & inp.merge_hit & inp.merge_slot.eq(early[0])).name("b_slot_merged_c");
         let set_in_b = b.delay("b_slot_merged", set_in_b);
         let grouped = slot_bit_2(b, "slot_has_best", has_best_kept, k, &early[1..], c_slots[1]);
