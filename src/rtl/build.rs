@@ -13,6 +13,13 @@ use std::cell::{Cell, RefCell};
 use std::ops;
 use std::rc::Rc;
 
+/// Delay lines of this many clocks or more are LUT-RAM rings (`Builder::delay_line`): below,
+/// a ring's pointers and read register cost about what the flip-flops they save do.
+pub const RING_FROM: u32 = 8;
+/// The widest slice of a ring with pointers of its own: each pointer drives RING_SLICE / 4
+/// DPR16X4s on an ECP5, so a wide line does not hang on one address net.
+pub const RING_SLICE: u32 = 32;
+
 /// Builds one module. Handles borrow it, so operators need no `&mut`.
 pub struct Builder {
     m: RefCell<Module>,
@@ -186,9 +193,44 @@ impl Builder {
         self.s(self.m.borrow_mut().valid_line(name, x.sig, depth))
     }
 
-    /// `x` `depth` clocks later (a shift register).
-    pub fn delay_line(&self, name: &str, x: S<'_>, depth: u32) -> S<'_> {
-        self.s(self.m.borrow_mut().delay_line(name, x.sig, depth))
+    /// `x` `depth` clocks later: a shift register, or from `RING_FROM` clocks a ring in LUT
+    /// RAM (`ring`), cycle for cycle the same.
+    pub fn delay_line<'b>(&'b self, name: &str, x: S<'b>, depth: u32) -> S<'b> {
+        if depth < RING_FROM {
+            return self.s(self.m.borrow_mut().delay_line(name, x.sig, depth));
+        }
+        let w = x.width();
+        let parts: Vec<S<'b>> = (0..w.div_ceil(RING_SLICE))
+            .rev()
+            .map(|k| {
+                let lo = k * RING_SLICE;
+                let part = if w <= RING_SLICE { name.to_string() } else { format!("{name}_p{k}") };
+                self.ring(&part, x.slice(lo, RING_SLICE.min(w - lo)), depth)
+            })
+            .collect();
+        let bits = if parts.len() == 1 { parts[0] } else { self.cat(&parts) };
+        if x.ty().signed { bits.signed() } else { bits }
+    }
+
+    /// Unsigned `x` `depth` (≥ 2) clocks later through a LUT RAM of `rom_depth(depth)` words
+    /// written every clock at `wp` and read (registered) at `rp` = `wp` − (`depth` − 1): a
+    /// word is read `depth` − 1 clocks after its write, and the read register adds the last
+    /// clock. `rp` is a register loaded from `wp` (a constant add), so it matches `wp` from
+    /// the first clock on; the words never written read as 0, like a shift register's
+    /// initial contents, and neither pointer is reset, so a reset leaves the line's data as a
+    /// shift register's. A flip-flop per bit and clock costs an ECP5 a whole FF; 16 clocks of
+    /// 4 bits fit one DPR16X4.
+    fn ring<'b>(&'b self, name: &str, x: S<'b>, depth: u32) -> S<'b> {
+        let words = crate::bits::rom_depth(depth as usize);
+        let k = crate::bits::rom_addr_bits(words);
+        let wp = self.reg(&format!("{name}_wp"), Ty::u(k), None);
+        let rp = self.reg(&format!("{name}_rp"), Ty::u(k), None);
+        self.next(wp, wp + 1);
+        let back = (words as i128 + 2 - depth as i128).rem_euclid(words as i128);
+        self.next(rp, wp + back);
+        let mem = self.ram(&format!("{name}_mem"), x.width(), vec![0; words]);
+        self.ram_write(mem, self.konst(Ty::BIT, 1), wp, x);
+        self.read(name, mem, rp)
     }
 
     /// `sel ? t : f`; `sel` is one bit.
@@ -525,6 +567,37 @@ mod tests {
         assert_eq!(b.name_of((x + 5).sig), "x_plus_k_5");
         let sum = (x + y).name("sum");
         assert_eq!(b.name_of(sum.sig), "sum");
+    }
+
+    /// A delay line from `RING_FROM` clocks is a LUT-RAM ring, and it shows what a shift
+    /// register would, clock for clock from the first: 0 until the first value arrives, then
+    /// every input `depth` clocks later, for lines narrower and wider than a ring slice, signed
+    /// or not, at depths just under, at and over a power of two.
+    #[test]
+    fn a_ring_delays_exactly_as_a_shift_register() {
+        for (depth, ty) in
+            [(8, Ty::u(1)), (9, Ty::s(40)), (16, Ty::u(32)), (17, Ty::s(7)), (41, Ty::u(70)), (64, Ty::s(33))]
+        {
+            let b = Builder::new("t");
+            let x = b.input("x", ty);
+            let ring = b.delay_line("ring", x, depth);
+            let shift = b.s(b.with(|m| m.delay_line("shift", x.sig, depth)));
+            assert_eq!(ring.ty(), ty);
+            b.output("ring", ring);
+            b.output("shift", shift);
+            let m = b.finish();
+            let shift_lines = m.signals.iter().filter(|s| matches!(s.def, Def::DelayLine { .. })).count();
+            assert_eq!((shift_lines, m.roms.len() as u32), (1, ty.width.div_ceil(RING_SLICE)), "rings in LUT RAM");
+            let mut sim = Sim::new(&m);
+            let (x, ring, shift) = (m.handle(m.inputs[0]), m.handle(m.outputs[0].1), m.handle(m.outputs[1].1));
+            let mut rng = crate::rng::SplitMix64(depth as u64);
+            for t in 0..3 * depth + 5 {
+                sim.set(x, ty.value(ty.wrap(((rng.next_u64() as i128) << 64) | rng.next_u64() as i128)));
+                sim.eval();
+                assert_eq!(sim.get(ring), sim.get(shift), "depth {depth}, {ty:?}, clock {t}");
+                sim.tick();
+            }
+        }
     }
 
     #[test]
