@@ -332,6 +332,17 @@ fn sim_command_checks_every_pixel_and_writes_render_ids() {
     assert!(stderr(&o).contains("--raygen") && stderr(&o).contains("Rust"), "{}", stderr(&o));
 }
 
+/// The core's manifest in folder `dir` written by `fxrt gen`.
+fn manifest_in(dir: &std::path::Path) -> std::path::PathBuf {
+    let is_manifest =
+        |name: &str| name.starts_with("fxrt_core_") && name.ends_with(".json") && !name.ends_with("_axis.json");
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|f| is_manifest(f.file_name().unwrap().to_str().unwrap()))
+        .expect("the core's manifest")
+}
+
 /// `--device` fits the shape: the ML509's top (the XC5VLX110T's 64 DSP48E take one unit, said
 /// on stderr); with `--units` too it is refused, as is a folder of ROM
 /// images (the fit runs the scene).
@@ -348,18 +359,28 @@ fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
     let plain = dir.path().join("plain");
     let g = fxrt(&["gen", "--builtin", "cornell", "--device", "xc5vlx110t", "--out", plain.to_str().unwrap()]);
     assert!(g.status.success(), "{}", stderr(&g));
-    let is_manifest =
-        |name: &str| name.starts_with("fxrt_core_") && name.ends_with(".json") && !name.ends_with("_axis.json");
-    let manifest = std::fs::read_dir(&plain)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|f| is_manifest(f.file_name().unwrap().to_str().unwrap()))
-        .expect("the core's manifest");
-    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest).unwrap()).unwrap();
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest_in(&plain)).unwrap()).unwrap();
     let fit = &doc["device_fit"];
     assert_eq!((fit["device"].as_str(), fit["chosen"]["units"].as_u64()), (Some("xc5vlx110t"), Some(1)), "{fit}");
     assert_eq!(doc["params"]["traversal_units"], 1, "{doc}");
     assert!(fit["candidates"].as_array().is_some_and(|c| c.len() > 3), "{fit}");
+    // Not given, the leaf size and the stack are the fit's too, and the core is the chosen
+    // build's; given, they are kept.
+    assert_eq!(doc["params"]["stack_depth"], fit["chosen"]["stack_depth"], "{doc}");
+    let tried = |fit: &serde_json::Value, key: &str| -> Vec<u64> {
+        let mut v: Vec<u64> = fit["candidates"].as_array().unwrap().iter().map(|c| c[key].as_u64().unwrap()).collect();
+        v.dedup();
+        v
+    };
+    assert_eq!((tried(fit, "leaf_size").len(), tried(fit, "stack_depth").len() > 1), (3, true), "{fit}");
+    let given = dir.path().join("given");
+    let args = ["--leaf-size", "2", "--stack-depth", "24", "--out", given.to_str().unwrap()];
+    let g = fxrt(&[&["gen", "--builtin", "cornell", "--device", "xc5vlx110t"][..], &args].concat());
+    assert!(g.status.success(), "{}", stderr(&g));
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest_in(&given)).unwrap()).unwrap();
+    let fit = &doc["device_fit"];
+    assert_eq!((tried(fit, "leaf_size"), tried(fit, "stack_depth")), (vec![2], vec![24]), "{fit}");
+    assert_eq!(doc["params"]["stack_depth"], 24, "{doc}");
     let other = dir.path().join("other");
     let sim = ["sim", "--builtin", "cornell", "--size", "4x4", "--device", "lfe5u-85f", "--units", "2"];
     assert_rejected(&sim, "--device", &other);

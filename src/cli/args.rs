@@ -70,12 +70,14 @@ pub struct ParamArgs {
     /// Extra bits C of the reciprocal ray direction (m+C bits) used in BIH traversal.
     #[arg(long, default_value_t = 16)]
     pub c: u32,
-    /// Largest number of triangles in a BIH leaf.
-    #[arg(long = "leaf-size", default_value_t = 4)]
-    pub leaf_size: u32,
-    /// Hardware traversal stack entries; bounds the BIH depth.
-    #[arg(long = "stack-depth", default_value_t = 32)]
-    pub stack_depth: u32,
+    /// Largest number of triangles in a BIH leaf [default: 4; with --device the fit tries 3,
+    /// 4 and 5 unless given].
+    #[arg(long = "leaf-size")]
+    pub leaf_size: Option<u32>,
+    /// Hardware traversal stack entries; bounds the BIH depth [default: 32; with --device the
+    /// fit tries 32 and 16 unless given].
+    #[arg(long = "stack-depth")]
+    pub stack_depth: Option<u32>,
     /// The BIH's split planes: middle (the thesis's: halve the box) or sah (binned
     /// surface-area heuristic).
     #[arg(long, default_value = "sah")]

@@ -39,18 +39,21 @@ fn board_threads(c: &GenConfig, b: &BoardConfig) -> super::ThreadArgs {
 /// Writes the board design; for the ULX3S (unless --no-bitstream) places, routes and packs it.
 /// False when the bitstream misses its clock.
 pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
-    let GenScene::Scene { source, params, raygen: Some(spec) } = &c.scene else {
+    let GenScene::Scene { source, params, search, raygen: Some(spec) } = &c.scene else {
         return Err(Error::param("board", "needs the scene itself (an OBJ or --builtin) and a camera"));
     };
-    let scene = Scene::load(source, params)?;
+    let mut scene = Scene::load(source, params)?;
     let g = board_camera(&scene, spec)?;
     super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
-    let roms = SceneRoms::of(&scene);
     let external = c.memory == super::args::MemoryPlace::External;
-    let (spec, fit) = super::device::shape(&board_threads(c, b), Some(&scene), c.core_spec(), external)?;
+    let (spec, fit) = super::device::shape(&board_threads(c, b), Some(&mut scene), *search, c.core_spec(), external)?;
+    let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(&roms, &spec);
     p.check()?;
-    p.check_device(&roms, c.bram_kbits)?;
+    if fit.is_none() {
+        // A fitted shape holds its scene by the device's own counts (`place_checked`).
+        p.check_device(&roms, c.bram_kbits)?;
+    }
     let tools = if b.bitstream {
         Some(Tools::require().map_err(|e| Error::param("board", format!("{} (or --no-bitstream)", e.message)))?)
     } else {

@@ -17,6 +17,7 @@ use crate::model::camera::{Camera, CameraSpec};
 use crate::params::Params;
 use crate::render::tracer::ModelKind;
 use crate::scene::SceneSource;
+use crate::sweep::fit::SceneSearch;
 use crate::verify::simulators::Simulator;
 use std::path::PathBuf;
 
@@ -250,7 +251,8 @@ pub enum GenScene {
     /// A folder written by `fxrt scene` (its parameters are the ones stored there).
     Folder(PathBuf),
     /// A scene quantised with `params`; with a camera when the core has the ray generator.
-    Scene { source: SceneSource, params: Params, raygen: Option<CameraSpec> },
+    /// `search`: what `--device`'s fit may choose of the scene's build.
+    Scene { source: SceneSource, params: Params, search: SceneSearch, raygen: Option<CameraSpec> },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -338,6 +340,7 @@ impl GenArgs {
             None => GenScene::Scene {
                 source: self.scene.source(),
                 params: self.params.params()?,
+                search: self.params.search(),
                 raygen: (self.raygen || self.board.is_some()).then(|| self.camera.spec()),
             },
         };
@@ -448,6 +451,8 @@ fn refuse_core_shape(t: &super::args::ThreadArgs) -> Result<()> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SynthConfig {
     pub params: Params,
+    /// What `--device`'s fit may choose of the scene's build.
+    pub search: SceneSearch,
     pub scene: SceneSource,
     pub hw: HwArgs,
     pub build: PathBuf,
@@ -498,6 +503,7 @@ impl SynthArgs {
             if matches!(family, Family::Ecp5 { .. }) { ECP5_85F_BRAM_KBITS } else { XC5VLX110T_BRAM_KBITS };
         Ok(SynthConfig {
             params: self.params.params()?,
+            search: self.params.search(),
             scene: self.scene.source(),
             hw: self.hw.clone(),
             build,
@@ -512,6 +518,8 @@ impl SynthArgs {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimConfig {
     pub params: Params,
+    /// What `--device`'s fit may choose of the scene's build.
+    pub search: SceneSearch,
     pub scene: SceneSource,
     pub camera: CameraSpec,
     pub sim: Simulation,
@@ -585,6 +593,7 @@ impl SimArgs {
         }
         Ok(SimConfig {
             params,
+            search: self.params.search(),
             scene: self.scene.source(),
             camera: self.camera.spec(),
             sim,
@@ -616,18 +625,24 @@ impl SimArgs {
 
 impl ParamArgs {
     pub fn params(&self) -> Result<Params> {
+        let d = Params::default();
         let p = Params {
             n: self.n,
             m: self.m,
             edge_shift: self.edge_shift,
             t: self.t,
             c: self.c,
-            leaf_size: self.leaf_size,
-            stack_depth: self.stack_depth,
+            leaf_size: self.leaf_size.unwrap_or(d.leaf_size),
+            stack_depth: self.stack_depth.unwrap_or(d.stack_depth),
             tree: self.tree,
         };
         p.validate()?;
         Ok(p)
+    }
+
+    /// What `--device`'s fit may choose of the scene's build: what was not given.
+    pub fn search(&self) -> SceneSearch {
+        SceneSearch { leaf_size: self.leaf_size.is_none(), stack_depth: self.stack_depth.is_none() }
     }
 }
 

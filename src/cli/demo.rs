@@ -52,23 +52,19 @@ impl DemoArgs {
 
 /// Runs the demo; Ok(false) when a pixel of the simulated core differs from the golden model.
 pub fn demo(c: &DemoConfig) -> Result<bool> {
-    let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default())?;
-    let roms = SceneRoms::of(&scene);
+    let mut scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default())?;
     let target = crate::cores::clock::DEFAULT_TARGET_MHZ;
     let base = crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() };
     let threads = super::ThreadArgs { device: c.device, ..super::ThreadArgs::DEFAULT };
     let external = c.memory == super::args::MemoryPlace::External;
-    let (shape, fit) = super::device::shape(&threads, Some(&scene), base, external)?;
+    let search = crate::sweep::fit::SceneSearch::BOTH;
+    let (shape, fit) = super::device::shape(&threads, Some(&mut scene), search, base, external)?;
+    let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(&roms, &shape);
     p.check()?;
-    // A fitted shape holds the scene on chip by the device's own counts (the fit's: DP16KD on
-    // the ECP5, where the bit count of `check_device` over-states a 4 × 32, P = 2 core).
     let bram_kbits = super::config::ECP5_85F_BRAM_KBITS;
-    let place = if fit.is_some() { super::args::MemoryPlace::Onchip } else { c.memory };
-    let p = super::placement::place_scene(place, MemorySpec::default(), bram_kbits, &roms, &shape, p)?;
-    if fit.is_none() {
-        p.check_device(&roms, bram_kbits)?;
-    }
+    let (spec, fitted) = (MemorySpec::default(), fit.is_some());
+    let p = super::placement::place_checked(c.memory, spec, bram_kbits, &roms, &shape, p, fitted)?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;
     super::device::say(fit.as_ref());
     let fit_json = fit.as_ref().map(|f| serde_json::to_value(f).unwrap_or_default());

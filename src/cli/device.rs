@@ -4,13 +4,20 @@ use super::args::ThreadArgs;
 use crate::cores::top::CoreSpec;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-use crate::sweep::fit::Fit;
+use crate::sweep::fit::{Fit, SceneSearch};
 
 /// `base` (ray ids, divider, clock target) with the slots, units and pipelines given, or with
 /// `--device` those of the fit (returned too: `say` tells it once the command has done its
-/// work, so a later refusal stays one line). The fit counts cores with the scene on chip, so
-/// not with `external` memory.
-pub fn shape(t: &ThreadArgs, scene: Option<&Scene>, base: CoreSpec, external: bool) -> Result<(CoreSpec, Option<Fit>)> {
+/// work, so a later refusal stays one line). The fit may rebuild `scene` with another leaf
+/// size or stack depth where `search` allows it: `scene` is then that build. The fit counts
+/// cores with the scene on chip, so not with `external` memory.
+pub fn shape(
+    t: &ThreadArgs,
+    scene: Option<&mut Scene>,
+    search: SceneSearch,
+    base: CoreSpec,
+    external: bool,
+) -> Result<(CoreSpec, Option<Fit>)> {
     let given = CoreSpec { slots: t.slots, units: t.units, pipelines: t.pipelines, ..base };
     let Some(device) = t.device else {
         return Ok((given, None));
@@ -23,7 +30,8 @@ pub fn shape(t: &ThreadArgs, scene: Option<&Scene>, base: CoreSpec, external: bo
     }
     let bar = indicatif::ProgressBar::new_spinner();
     bar.set_message(format!("fitting the core to the {}: shapes run", device.name()));
-    let fit = crate::sweep::fit::fit(device, scene, &base, &|| bar.inc(1))?;
+    let (fit, chosen) = crate::sweep::fit::fit(device, scene, search, &base, &|| bar.inc(1))?;
+    *scene = chosen;
     bar.finish_and_clear();
     Ok((fit.spec(&base), Some(fit)))
 }

@@ -24,19 +24,28 @@ pub fn add_scene_image(
 }
 
 /// The on-chip core `p`, or with `--memory external` (or `auto` when `p`'s ROMs and stacks do
-/// not fit `bram_kbits`) the same shape with its scene in external memory.
-pub fn place_scene(
+/// not fit `bram_kbits`) the same shape with its scene in external memory; its block RAM then
+/// checked against `bram_kbits`. Unless `--device` fitted the shape: a fitted core holds its
+/// scene on chip by the device's own counts (the fit's: DP16KD on the LFE5U-85F, where the bit
+/// count over-states a core of four units), so it is neither moved nor counted again.
+pub fn place_checked(
     place: MemoryPlace,
     spec: crate::cores::memory_params::MemorySpec,
     bram_kbits: u64,
     roms: &SceneRoms,
     shape: &crate::cores::top::CoreSpec,
     p: crate::cores::top::CoreParams,
+    fitted: bool,
 ) -> Result<crate::cores::top::CoreParams> {
+    if fitted {
+        return Ok(p);
+    }
     let external = match place {
         MemoryPlace::Onchip => false,
         MemoryPlace::External => true,
         MemoryPlace::Auto => p.check_device(roms, bram_kbits).is_err(),
     };
-    if external { crate::cores::top::CoreParams::external(roms, shape, spec) } else { Ok(p) }
+    let p = if external { crate::cores::top::CoreParams::external(roms, shape, spec)? } else { p };
+    p.check_device(roms, bram_kbits)?;
+    Ok(p)
 }

@@ -21,6 +21,7 @@ use crate::params::Params;
 use crate::render::{self, tracer};
 use crate::scene::images::SceneRoms;
 use crate::scene::{self, Scene, SceneSource, rom};
+use crate::sweep::fit::SceneSearch;
 use crate::sweep::{run as sweep, slurm};
 use crate::verify::{check, feed, frame, vectors};
 use std::path::Path;
@@ -226,33 +227,33 @@ fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<Inter
 }
 
 pub fn gen_core(c: &GenConfig) -> Result<()> {
-    let (roms, raygen, scene) = match &c.scene {
-        GenScene::Folder(dir) => (SceneRoms::load(dir)?, None, None),
-        GenScene::Scene { source, params, raygen } => {
-            let scene = Scene::load(source, params)?;
-            let raygen = raygen.as_ref().map(|cam| RayGen::for_camera(&scene, cam)).transpose()?;
-            (SceneRoms::of(&scene), raygen, Some(scene))
-        }
+    let (mut scene, search) = match &c.scene {
+        GenScene::Folder(_) => (None, SceneSearch::default()),
+        GenScene::Scene { source, params, search, .. } => (Some(Scene::load(source, params)?), *search),
+    };
+    let raygen = match (&c.scene, &scene) {
+        (GenScene::Scene { raygen: Some(cam), .. }, Some(scene)) => Some(RayGen::for_camera(scene, cam)?),
+        _ => None,
     };
     if let Some(g) = &raygen {
         ids_fit(c.ray_id_width, g.width, g.height)?;
     }
-    let (spec, fit) = super::device::shape(
-        &c.threads,
-        scene.as_ref(),
-        c.core_spec(),
-        c.memory == super::args::MemoryPlace::External,
-    )?;
+    let external = c.memory == super::args::MemoryPlace::External;
+    let (spec, fit) = super::device::shape(&c.threads, scene.as_mut(), search, c.core_spec(), external)?;
+    let roms = match (&c.scene, &scene) {
+        (GenScene::Folder(dir), _) => SceneRoms::load(dir)?,
+        (_, Some(scene)) => SceneRoms::of(scene),
+        (_, None) => unreachable!("a scene is loaded unless the ROMs come from a folder"),
+    };
     let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
-    let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &spec, p)?;
+    let p = super::placement::place_checked(c.memory, c.mem_spec, c.bram_kbits, &roms, &spec, p, fit.is_some())?;
     if p.mem.is_some() && raygen.is_some() {
         return Err(crate::error::Error::param(
             "raygen",
             "not with the scene in external memory yet (--memory onchip)",
         ));
     }
-    p.check_device(&roms, c.bram_kbits)?;
     let o = generate::GenOptions {
         vhdl: c.vhdl,
         verilog: c.verilog,
@@ -319,21 +320,21 @@ pub fn test(c: &TestConfig) -> Result<bool> {
 }
 
 pub fn synth_cores(c: &SynthConfig) -> Result<()> {
-    let scene = Scene::load(&c.scene, &c.params)?;
+    let mut scene = Scene::load(&c.scene, &c.params)?;
     let p = intersect_params(&c.params, &scene, &c.hw)?;
-    let roms = SceneRoms::of(&scene);
     let base = crate::cores::top::CoreSpec {
         id_width: crate::cores::top::DEFAULT_RAY_ID_WIDTH,
         div_bits: c.hw.div_bits,
         target_mhz: c.hw.target_mhz,
         ..Default::default()
     };
-    let (shape, fit) =
-        super::device::shape(&c.hw.threads, Some(&scene), base, c.memory == super::args::MemoryPlace::External)?;
+    let external = c.memory == super::args::MemoryPlace::External;
+    let (shape, fit) = super::device::shape(&c.hw.threads, Some(&mut scene), c.search, base, external)?;
+    let roms = SceneRoms::of(&scene);
     let core = crate::cores::top::CoreParams::shaped(&roms, &shape);
     core.check()?;
-    let core = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core)?;
-    core.check_device(&roms, c.bram_kbits)?;
+    let fitted = fit.is_some();
+    let core = super::placement::place_checked(c.memory, c.mem_spec, c.bram_kbits, &roms, &shape, core, fitted)?;
     super::device::say(fit.as_ref());
     eprintln!(
         "synth: scene {} {}",
@@ -408,18 +409,18 @@ fn synth_ecp5(
 
 /// `fxrt sim`: a frame through the generated core; true when every pixel matched.
 pub fn sim(c: &SimConfig) -> Result<bool> {
-    let scene = Scene::load(&c.scene, &c.params)?;
+    let mut scene = Scene::load(&c.scene, &c.params)?;
     let cam = c.camera.camera(&scene)?;
     let (w, h) = (cam.width, cam.height);
     let id_width = rom::addr_bits((w * h) as usize);
-    let roms = SceneRoms::of(&scene);
     let base =
         crate::cores::top::CoreSpec { id_width, div_bits: c.div_bits, target_mhz: c.target_mhz, ..Default::default() };
-    let (spec, fit) =
-        super::device::shape(&c.threads, Some(&scene), base, c.memory == super::args::MemoryPlace::External)?;
+    let external = c.memory == super::args::MemoryPlace::External;
+    let (spec, fit) = super::device::shape(&c.threads, Some(&mut scene), c.search, base, external)?;
+    let roms = SceneRoms::of(&scene);
     let p = crate::cores::top::CoreParams::shaped(&roms, &spec);
     p.check()?;
-    let p = external_core(c, &roms, &spec, p)?;
+    let p = external_core(c, &roms, &spec, p, fit.is_some())?;
     super::device::say(fit.as_ref());
     let raygen = if c.raygen { Some(RayGen::for_camera(&scene, &c.camera)?) } else { None };
     let rays = match &raygen {
@@ -555,12 +556,12 @@ fn external_core(
     roms: &SceneRoms,
     shape: &crate::cores::top::CoreSpec,
     p: crate::cores::top::CoreParams,
+    fitted: bool,
 ) -> Result<crate::cores::top::CoreParams> {
-    let p = super::placement::place_scene(c.memory, c.mem_spec, c.bram_kbits, roms, shape, p)?;
+    let p = super::placement::place_checked(c.memory, c.mem_spec, c.bram_kbits, roms, shape, p, fitted)?;
     if p.mem.is_some() && c.raygen {
         return Err(crate::error::Error::param("memory", "an external-memory core runs with host rays (no --raygen)"));
     }
-    p.check_device(roms, c.bram_kbits)?;
     Ok(p)
 }
 

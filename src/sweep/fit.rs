@@ -1,7 +1,9 @@
 //! Fitting the core to a device (`--device`, issue 30): the shapes (traversal units U, ray
 //! slots K per unit, intersection pipelines P) whose multipliers and block RAM the device
 //! holds, each run on a short frame of the scene in the Rust simulator, and the one with the
-//! most rays per clock.
+//! most rays per clock. Unless given, the scene's leaf size and stack depth are searched too
+//! (`SceneSearch`): each is a scene build of its own, and the tree they give is the one the
+//! golden model walks.
 //!
 //! What a shape needs is counted from its netlist (`fpga::ecp5::blocks` on the LFE5U-85F:
 //! nextpnr's own counts for every core placed; `cores::cost::dsp48e_estimate` on the Xilinx
@@ -12,6 +14,7 @@ use crate::cores::top::{CoreParams, CoreSpec, core_module_with};
 use crate::error::{Error, Result};
 use crate::fpga::device::Device;
 use crate::model::camera::Camera;
+use crate::params::Params;
 use crate::scene::Scene;
 use crate::scene::images::SceneRoms;
 use crate::verify::feed::Stalls;
@@ -24,10 +27,55 @@ const SLOTS: [u32; 3] = [64, 32, 16];
 /// The short frame each fitting shape runs (a side, pixels): long enough that 256 slots are
 /// full most of the frame.
 pub const FRAME: u32 = 48;
+/// The share of the device's flip-flops a fitted core may take: nextpnr found no legal
+/// placement for a core at 96 % of the LFE5U-85F's (4 × 64 slots, P = 2, before the rings of
+/// `rtl::build::RING_FROM`), and placed the default core at 50 %; the rest is left to the
+/// placer's packing (an ECP5 slice's two FFs share their clock enable and reset).
+pub const FF_SHARE: f64 = 0.8;
+/// Shapes within this fraction of the best on the scene as given are run on its other builds.
+const CLOSE: f64 = 0.75;
+
+/// Which of the scene's build parameters the fit may choose (those the user did not give).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneSearch {
+    /// Leaves of one triangle fewer and one more than `--leaf-size` are tried too.
+    pub leaf_size: bool,
+    /// A stack of half the words (rounded to a power of two, as the stack RAM is) is tried too:
+    /// the tree is then built no deeper than that.
+    pub stack_depth: bool,
+}
+
+impl SceneSearch {
+    pub const BOTH: SceneSearch = SceneSearch { leaf_size: true, stack_depth: true };
+
+    /// The scene parameters tried from `p`, `p` first.
+    fn variants(self, p: &Params) -> Vec<Params> {
+        let leaves = if self.leaf_size {
+            vec![p.leaf_size, p.leaf_size.saturating_sub(1), p.leaf_size + 1]
+        } else {
+            vec![p.leaf_size]
+        };
+        let words = crate::scene::rom::rom_depth(p.stack_depth as usize) as u32;
+        let stacks = if self.stack_depth && words >= 2 { vec![p.stack_depth, words / 2] } else { vec![p.stack_depth] };
+        let mut out = Vec::new();
+        for &leaf_size in &leaves {
+            for &stack_depth in &stacks {
+                let v = Params { leaf_size, stack_depth, ..*p };
+                if v.validate().is_ok() && !out.contains(&v) {
+                    out.push(v);
+                }
+            }
+        }
+        out
+    }
+}
 
 /// One shape and what it needs of the device.
 #[derive(Clone, Debug, Serialize)]
 pub struct Candidate {
+    /// The scene's largest leaf and stack entries (its tree) in this shape.
+    pub leaf_size: u32,
+    pub stack_depth: u32,
     pub units: u32,
     pub slots: u32,
     pub pipelines: u32,
@@ -35,6 +83,9 @@ pub struct Candidate {
     pub multipliers: u32,
     /// DP16KD on the LFE5U-85F; on the Xilinx parts block RAM in Kb (ROMs and stacks).
     pub block_ram: u64,
+    /// Flip-flops: the register bits left in the fabric (`Blocks::fabric_register_bits`, 5 %
+    /// over nextpnr's count for the cores placed: synthesis drops what is constant).
+    pub flip_flops: u64,
     /// Rays per clock on the short frame (shapes that fit and are the most slots of their U, P).
     pub rays_per_clock: Option<f64>,
 }
@@ -45,12 +96,32 @@ pub struct Fit {
     pub device: Device,
     pub multipliers_of: u32,
     pub block_ram_of: u64,
+    /// `FF_SHARE` of the device's flip-flops.
+    pub flip_flops_of: u64,
     pub frame: String,
     pub candidates: Vec<Candidate>,
     pub chosen: Candidate,
 }
 
 impl Candidate {
+    const EMPTY: Candidate = Candidate {
+        leaf_size: 0,
+        stack_depth: 0,
+        units: 0,
+        slots: 0,
+        pipelines: 0,
+        multipliers: 0,
+        block_ram: 0,
+        flip_flops: 0,
+        rays_per_clock: None,
+    };
+
+    /// Whether the shape's needs are within the device's multipliers, block RAM and share of
+    /// flip-flops.
+    fn fits(&self, multipliers: u32, block_ram: u64, flip_flops: u64) -> bool {
+        self.multipliers <= multipliers && self.block_ram <= block_ram && self.flip_flops <= flip_flops
+    }
+
     /// `base` (ray ids, divider, clock target) in this shape.
     pub fn spec(&self, base: &CoreSpec) -> CoreSpec {
         CoreSpec { units: self.units, slots: self.slots, pipelines: self.pipelines, ..*base }
@@ -71,125 +142,189 @@ impl Fit {
             .filter_map(|c| {
                 let r = c.rays_per_clock?;
                 Some(format!(
-                    "device {}: {} units × {} slots, {} pipelines: {} of {} multipliers, {}{unit} of {}{unit} block \
-                     RAM, {r:.4} rays per clock ({})",
+                    "device {}: {}: {} of {} multipliers, {}{unit} of {}{unit} block RAM, {} of {} FFs, {r:.4} rays \
+                     per clock ({})",
                     self.device.name(),
-                    c.units,
-                    c.slots,
-                    c.pipelines,
+                    c.shape(),
                     c.multipliers,
                     self.multipliers_of,
                     c.block_ram,
                     self.block_ram_of,
+                    c.flip_flops,
+                    self.flip_flops_of,
                     self.frame
                 ))
             })
             .collect();
-        let c = &self.chosen;
-        lines.push(format!(
-            "device {}: chosen {} units × {} slots, {} pipelines",
-            self.device.name(),
-            c.units,
-            c.slots,
-            c.pipelines
-        ));
+        lines.push(format!("device {}: chosen {}", self.device.name(), self.chosen.shape()));
         lines
     }
 }
 
-/// What the shape `spec` needs of `device`: (multipliers, block RAM in the device's unit).
-fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64) {
+impl Candidate {
+    /// "4 units × 64 slots, 2 pipelines, leaves ≤ 4, stack 16".
+    fn shape(&self) -> String {
+        format!(
+            "{} units × {} slots, {} pipelines, leaves ≤ {}, stack {}",
+            self.units, self.slots, self.pipelines, self.leaf_size, self.stack_depth
+        )
+    }
+}
+
+/// What the shape `spec` needs of `device`: (multipliers, block RAM in the device's unit,
+/// flip-flops).
+fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64) {
     let core = core_module_with(p, roms, false);
+    let b = crate::fpga::ecp5::blocks::blocks(&core);
     match device {
-        Device::Lfe5u85f => {
-            let b = crate::fpga::ecp5::blocks::blocks(&core);
-            (b.mult18 as u32, b.dp16kd as u64)
-        }
+        Device::Lfe5u85f => (b.mult18 as u32, b.dp16kd as u64, b.fabric_register_bits),
         Device::Xc5vlx110t | Device::Xc7a100t => {
-            (crate::cores::cost::dsp48e_estimate(&core), p.bram_bits(roms).div_ceil(1024))
+            (crate::cores::cost::dsp48e_estimate(&core), p.bram_bits(roms).div_ceil(1024), b.fabric_register_bits)
         }
     }
 }
 
-/// The shapes of `base` (its id width, divider, clock target) for `scene` on `device`, and the
-/// one with the most rays per clock on a `FRAME`² frame of the scene's default view (ties: the
-/// fewer multipliers). `progress` is called once per shape run.
-pub fn fit(device: Device, scene: &Scene, base: &CoreSpec, progress: &(dyn Fn() + Sync)) -> Result<Fit> {
-    let roms = SceneRoms::of(scene);
+/// The shapes of one scene build whose U and P `keep` takes, counted, not yet run.
+fn shapes(
+    device: Device,
+    scene: &Scene,
+    roms: &SceneRoms,
+    base: &CoreSpec,
+    keep: &dyn Fn(u32, u32) -> bool,
+) -> Vec<Candidate> {
+    let mut shapes = Vec::new();
+    for units in 1..=4u32 {
+        for pipelines in [1, 2, 4].into_iter().filter(|p| units.is_multiple_of(*p) && keep(units, *p)) {
+            for slots in SLOTS {
+                let (leaf_size, stack_depth) = (scene.params.leaf_size, scene.params.stack_depth);
+                let c = Candidate { leaf_size, stack_depth, units, slots, pipelines, ..Candidate::EMPTY };
+                // Shapes the closest-hit units cannot number (more than 128 slots a lane).
+                if CoreParams::shaped(roms, &c.spec(base)).check().is_ok() {
+                    shapes.push(c);
+                }
+            }
+        }
+    }
+    shapes.par_iter_mut().for_each(|c| {
+        (c.multipliers, c.block_ram, c.flip_flops) = needs(device, roms, &CoreParams::shaped(roms, &c.spec(base)));
+    });
+    shapes
+}
+
+/// Runs, of `shapes` (one scene build's, most slots first), the most slots that `fits` per U
+/// and P on `rays`, filling in their rays per clock.
+fn run_shapes(
+    shapes: &mut [Candidate],
+    fits: &dyn Fn(&Candidate) -> bool,
+    roms: &SceneRoms,
+    rays: &[crate::verify::frame::PixelRay],
+    base: &CoreSpec,
+    progress: &(dyn Fn() + Sync),
+) {
+    let mut run: Vec<usize> = Vec::new();
+    for (k, c) in shapes.iter().enumerate() {
+        let taken = run.iter().any(|&j| (shapes[j].units, shapes[j].pipelines) == (c.units, c.pipelines));
+        if fits(c) && !taken {
+            run.push(k);
+        }
+    }
+    let measured: Vec<(usize, f64)> = run
+        .par_iter()
+        .map(|&k| {
+            let p = CoreParams::shaped(roms, &shapes[k].spec(base));
+            let (_, stats) = simulate_rust(&p, roms, rays, &Stalls::none(), &|_| {});
+            progress();
+            (k, stats.rays_per_clock())
+        })
+        .collect();
+    for (k, r) in measured {
+        shapes[k].rays_per_clock = Some(r);
+    }
+}
+
+/// The shapes of `base` (its id width, divider, clock target) for `scene` on `device` — with the
+/// scene's leaf size and stack depth varied as `search` allows — and the one with the most rays
+/// per clock on a `FRAME`² frame of the scene's default view (ties: the fewer multipliers, then
+/// the less block RAM). Returns the fit and the scene build it chose. `progress` is called once
+/// per shape run.
+pub fn fit(
+    device: Device,
+    scene: &Scene,
+    search: SceneSearch,
+    base: &CoreSpec,
+    progress: &(dyn Fn() + Sync),
+) -> Result<(Fit, Scene)> {
     let cap = device.capacity();
     let block_ram_of = match device {
         Device::Lfe5u85f => cap.block_rams as u64,
         _ => device.bram_kbits(),
     };
     // What no shape changes (widths, the clock) is said as itself, before any shape is tried.
-    CoreParams::shaped(&roms, &CoreSpec { units: 1, slots: 1, pipelines: 1, ..*base }).check()?;
-    let mut candidates = Vec::new();
-    for units in 1..=4u32 {
-        for pipelines in [1, 2, 4].into_iter().filter(|p| units.is_multiple_of(*p)) {
-            for slots in SLOTS {
-                let mut c = Candidate { units, slots, pipelines, multipliers: 0, block_ram: 0, rays_per_clock: None };
-                let p = CoreParams::shaped(&roms, &c.spec(base));
-                // Shapes the closest-hit units cannot number (more than 128 slots a lane).
-                if p.check().is_err() {
-                    continue;
-                }
-                (c.multipliers, c.block_ram) = needs(device, &roms, &p);
-                candidates.push(c);
-            }
-        }
-    }
-    let fits = |c: &Candidate| c.multipliers <= cap.multipliers && c.block_ram <= block_ram_of;
-    // The most slots that fit, per (U, P).
-    let mut run: Vec<usize> = Vec::new();
-    for (k, c) in candidates.iter().enumerate() {
-        let taken = run.iter().any(|&j| (candidates[j].units, candidates[j].pipelines) == (c.units, c.pipelines));
-        if fits(c) && !taken {
-            run.push(k);
-        }
-    }
-    let cam = Camera::default_for(scene, FRAME, FRAME);
-    let rays = frame_rays(scene, &cam);
-    let measured: Vec<(usize, f64)> = run
+    CoreParams::shaped(&SceneRoms::of(scene), &CoreSpec { units: 1, slots: 1, pipelines: 1, ..*base }).check()?;
+    let builds: Vec<Scene> = search.variants(&scene.params)[1..]
         .par_iter()
-        .map(|&k| {
-            let p = CoreParams::shaped(&roms, &candidates[k].spec(base));
-            let (_, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
-            progress();
-            (k, stats.rays_per_clock())
-        })
-        .collect();
-    for (k, r) in measured {
-        candidates[k].rays_per_clock = Some(r);
+        .map(|p| Scene::build(&scene.name, scene.world.clone(), p))
+        .collect::<Result<_>>()?;
+    let scenes: Vec<&Scene> = std::iter::once(scene).chain(&builds).collect();
+    let flip_flops_of = (cap.ffs as f64 * FF_SHARE) as u64;
+    let fits = |c: &Candidate| c.fits(cap.multipliers, block_ram_of, flip_flops_of);
+    let cam = Camera::default_for(scene, FRAME, FRAME);
+    // Every U and P on the scene as given; on its other builds only the U and P within `CLOSE`
+    // of the best (a leaf or stack size moves the balance of units and pipelines a little, not
+    // by a quarter): 11 runs instead of 36 for the teapot.
+    let fitted = |v: usize, keep: &dyn Fn(u32, u32) -> bool| {
+        let roms = SceneRoms::of(scenes[v]);
+        let mut shapes = shapes(device, scenes[v], &roms, base, keep);
+        run_shapes(&mut shapes, &fits, &roms, &frame_rays(scenes[v], &cam), base, progress);
+        shapes
+    };
+    let mut candidates = fitted(0, &|_, _| true);
+    let best = candidates.iter().filter_map(|c| c.rays_per_clock).fold(0.0, f64::max);
+    let near = candidates.iter().filter(|c| c.rays_per_clock.is_some_and(|r| r >= CLOSE * best));
+    let close: Vec<(u32, u32)> = near.map(|c| (c.units, c.pipelines)).collect();
+    let others: Vec<Vec<Candidate>> =
+        (1..scenes.len()).into_par_iter().map(|v| fitted(v, &|u, p| close.contains(&(u, p)))).collect();
+    let mut of_build = vec![0; candidates.len()];
+    for (v, more) in others.into_iter().enumerate() {
+        of_build.extend(std::iter::repeat_n(v + 1, more.len()));
+        candidates.extend(more);
     }
+    let run: Vec<usize> = (0..candidates.len()).filter(|&k| candidates[k].rays_per_clock.is_some()).collect();
     let better = |a: &Candidate, b: &Candidate| {
         let (ra, rb) = (a.rays_per_clock.unwrap_or(0.0), b.rays_per_clock.unwrap_or(0.0));
-        ra > rb || (ra == rb && a.multipliers < b.multipliers)
+        ra > rb || (ra == rb && (a.multipliers, a.block_ram) < (b.multipliers, b.block_ram))
     };
-    let chosen = run.iter().map(|&k| &candidates[k]).fold(None::<&Candidate>, |best, c| match best {
-        Some(b) if !better(c, b) => Some(b),
-        _ => Some(c),
+    let chosen = run.iter().copied().fold(None::<usize>, |best, k| match best {
+        Some(b) if !better(&candidates[k], &candidates[b]) => Some(b),
+        _ => Some(k),
     });
-    let Some(chosen) = chosen.cloned() else {
+    let Some(chosen) = chosen else {
         return Err(Error::param(
             "device",
             format!(
-                "{}: no core shape for scene {} fits its {} multipliers and {} {}",
+                "{}: no core shape for scene {} fits its {} multipliers, {} {} and {} flip-flops ({} %)",
                 device.name(),
                 scene.name,
                 cap.multipliers,
                 block_ram_of,
-                if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" }
+                if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" },
+                flip_flops_of,
+                (FF_SHARE * 100.0).round()
             ),
         ));
     };
-    Ok(Fit {
+    let v = of_build[chosen];
+    let chosen_scene = if v == 0 { scene.clone() } else { builds.into_iter().nth(v - 1).expect("a scene per build") };
+    let fit = Fit {
         device,
         multipliers_of: cap.multipliers,
         block_ram_of,
+        flip_flops_of,
         frame: format!("{FRAME}x{FRAME}, the scene's default view, Rust simulator"),
+        chosen: candidates[chosen].clone(),
         candidates,
-        chosen,
-    })
+    };
+    Ok((fit, chosen_scene))
 }
 
 #[cfg(test)]
@@ -198,23 +333,56 @@ mod tests {
     use crate::params::Params;
     use crate::scene::SceneSource;
 
-    /// On the LFE5U-85F the teapot's fit is four units of 32 slots and two pipelines: four of
-    /// 64 need 212 DP16KD of its 208, four pipelines 214 MULT18X18D of its 156. The XC5VLX110T's
-    /// 64 DSP48E take one unit (two need 70). Every shape run fits, and the chosen one has the
-    /// most rays per clock of them.
+    /// On the LFE5U-85F the teapot's fit is four units of 64 slots and two pipelines, its tree
+    /// built for a stack of 16: with the stack of 32 asked for by default, four of 64 need 212
+    /// DP16KD of its 208 (four pipelines: 214 MULT18X18D of its 156). The XC5VLX110T's 64 DSP48E
+    /// take one unit (two need 70). Every shape run fits, and the chosen one has the most rays
+    /// per clock of them; the scene returned is the chosen build.
     #[test]
-    fn the_teapot_fits_four_units_and_two_pipelines_on_the_ecp5_and_one_unit_on_the_virtex_5() {
+    fn the_teapot_fits_four_units_of_64_and_two_pipelines_on_the_ecp5_and_one_unit_on_the_virtex_5() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
         let base = CoreSpec { id_width: 12, ..CoreSpec::default() };
-        let ecp5 = fit(Device::Lfe5u85f, &scene, &base, &|| {}).unwrap();
+        let (ecp5, chosen) = fit(Device::Lfe5u85f, &scene, SceneSearch::BOTH, &base, &|| {}).unwrap();
         let c = &ecp5.chosen;
-        assert_eq!((c.units, c.slots, c.pipelines, c.multipliers, c.block_ram), (4, 32, 2, 134, 196), "{ecp5:#?}");
-        let four_64 = ecp5.candidates.iter().find(|c| (c.units, c.slots, c.pipelines) == (4, 64, 2)).unwrap();
+        let got = (c.units, c.slots, c.pipelines, c.leaf_size, c.stack_depth, c.multipliers, c.block_ram);
+        assert_eq!(got, (4, 64, 2, 4, 16, 134, 196), "{ecp5:#?}");
+        assert_eq!((chosen.params.leaf_size, chosen.params.stack_depth), (4, 16));
+        let as_given = |c: &&Candidate| (c.units, c.slots, c.pipelines, c.stack_depth) == (4, 64, 2, 32);
+        let four_64 = ecp5.candidates.iter().filter(|c| c.leaf_size == 4).find(as_given).unwrap();
         assert_eq!((four_64.block_ram, four_64.rays_per_clock), (212, None));
         let run: Vec<&Candidate> = ecp5.candidates.iter().filter(|c| c.rays_per_clock.is_some()).collect();
-        assert!(run.len() >= 5 && run.iter().all(|c| c.multipliers <= 156 && c.block_ram <= 208), "{run:#?}");
+        assert!(run.len() >= 9 && run.iter().all(|c| c.multipliers <= 156 && c.block_ram <= 208), "{run:#?}");
         assert!(run.iter().all(|r| r.rays_per_clock <= c.rays_per_clock));
-        let virtex = fit(Device::Xc5vlx110t, &scene, &base, &|| {}).unwrap();
+        assert!(run.iter().all(|r| r.flip_flops <= ecp5.flip_flops_of), "{run:#?}");
+        assert_eq!(ecp5.flip_flops_of, 66_912);
+        let (virtex, _) = fit(Device::Xc5vlx110t, &scene, SceneSearch::default(), &base, &|| {}).unwrap();
         assert_eq!((virtex.chosen.units, virtex.chosen.pipelines, virtex.chosen.multipliers), (1, 1, 58));
+        assert!(virtex.candidates.iter().all(|c| (c.leaf_size, c.stack_depth) == (4, 32)), "nothing searched");
+    }
+
+    /// A shape fits when each of its needs does: one over (multipliers, block RAM, or the
+    /// flip-flops that kept a placeable 4 × 64 core out before the rings) and it does not.
+    #[test]
+    fn a_shape_fits_only_within_every_limit() {
+        let c = Candidate { multipliers: 134, block_ram: 196, flip_flops: 47_501, ..Candidate::EMPTY };
+        assert!(c.fits(156, 208, 66_912));
+        assert!(!c.fits(133, 208, 66_912));
+        assert!(!c.fits(156, 195, 66_912));
+        assert!(!Candidate { flip_flops: 80_036, ..c }.fits(156, 208, 66_912));
+    }
+
+    /// The builds tried: the scene as given first, each other leaf size and stack only once
+    /// and only where allowed; a stack halves to the power of two below its RAM's words.
+    #[test]
+    fn the_scene_builds_tried_are_the_given_one_then_the_allowed_neighbours() {
+        let p = Params::default();
+        let tried = |s: SceneSearch, p: &Params| -> Vec<(u32, u32)> {
+            s.variants(p).iter().map(|v| (v.leaf_size, v.stack_depth)).collect()
+        };
+        assert_eq!(tried(SceneSearch::default(), &p), [(4, 32)]);
+        assert_eq!(tried(SceneSearch { leaf_size: false, stack_depth: true }, &p), [(4, 32), (4, 16)]);
+        assert_eq!(tried(SceneSearch::BOTH, &p), [(4, 32), (4, 16), (3, 32), (3, 16), (5, 32), (5, 16)]);
+        let small = Params { leaf_size: 1, stack_depth: 20, ..p };
+        assert_eq!(tried(SceneSearch::BOTH, &small), [(1, 20), (1, 16), (2, 20), (2, 16)]);
     }
 }
