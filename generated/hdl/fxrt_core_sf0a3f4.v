@@ -25,6 +25,9 @@ module fxrt_core_sf0a3f4 (
   output wire [31:0] res_v
 );
 
+  (* ram_style = "distributed" *) reg [6:0] box_done_slot_mem [0:15];
+  initial $readmemh("fxrt_core_sf0a3f4_box_done_slot_mem.hex", box_done_slot_mem);
+
   (* ram_style = "distributed" *) reg [15:0] ray_o_g0 [0:127];
   initial $readmemh("fxrt_core_sf0a3f4_ray_o_g0.hex", ray_o_g0);
 
@@ -455,10 +458,13 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] box_miss;
   wire [0:0] box_last;
   reg [0:0] box_done = 1'h0;
-  (* mem2reg *) reg [6:0] box_done_slot_sr [1:11];
-  integer box_done_slot_i;
-  initial for (box_done_slot_i = 1; box_done_slot_i <= 11; box_done_slot_i = box_done_slot_i + 1) box_done_slot_sr[box_done_slot_i] = 7'h00;
-  wire [6:0] box_done_slot;
+  reg [3:0] box_done_slot_wp = 4'h0;
+  reg [3:0] box_done_slot_rp = 4'h0;
+  wire [3:0] k_1_2 = 4'h1;
+  wire [3:0] plus_13;
+  wire [3:0] k_7 = 4'h7;
+  wire [3:0] plus_14;
+  reg [6:0] box_done_slot = 7'h00;
 
   // stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
   wire [0:0] u0_merge_valid;
@@ -478,7 +484,7 @@ module fxrt_core_sf0a3f4 (
   wire [72:0] u0_node_word;
   wire [72:0] u1_node_word;
   wire [0:0] bits_box_done_slot;
-  wire [0:0] eq_13;
+  wire [0:0] eq_15;
   wire [0:0] u0_new;
   wire [0:0] bits_free_slot;
   wire [0:0] bits_free_slot_eq_k_0;
@@ -515,7 +521,7 @@ module fxrt_core_sf0a3f4 (
   wire [6:0] u_traverse_0_occupied;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] bits_box_done_slot_2;
-  wire [0:0] eq_15;
+  wire [0:0] eq_17;
   wire [0:0] u1_new;
   wire [0:0] bits_free_slot_2;
   wire [0:0] bits_free_slot_2_eq_k_1;
@@ -555,23 +561,23 @@ module fxrt_core_sf0a3f4 (
   wire [72:0] u_node_rom_0_data_b;
 
   // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  wire [86:0] cat_17;
-  wire [15:0] bits_cat_17;
-  wire [15:0] bits_cat_17_1;
-  wire [15:0] bits_cat_17_2;
-  wire [15:0] bits_cat_17_3;
-  wire [15:0] bits_cat_17_4;
-  wire [6:0] bits_cat_17_5;
+  wire [86:0] cat_19;
+  wire [15:0] bits_cat_19;
+  wire [15:0] bits_cat_19_1;
+  wire [15:0] bits_cat_19_2;
+  wire [15:0] bits_cat_19_3;
+  wire [15:0] bits_cat_19_4;
+  wire [6:0] bits_cat_19_5;
   wire [31:0] u_acc_in_wz;
   wire [31:0] u_acc_in_wy;
   wire [31:0] u_acc_in_wx;
-  wire [95:0] cat_18;
-  wire [15:0] bits_cat_18;
-  wire [15:0] bits_cat_18_1;
-  wire [15:0] bits_cat_18_2;
-  wire [15:0] bits_cat_18_3;
-  wire [15:0] bits_cat_18_4;
-  wire [15:0] bits_cat_18_5;
+  wire [95:0] cat_20;
+  wire [15:0] bits_cat_20;
+  wire [15:0] bits_cat_20_1;
+  wire [15:0] bits_cat_20_2;
+  wire [15:0] bits_cat_20_3;
+  wire [15:0] bits_cat_20_4;
+  wire [15:0] bits_cat_20_5;
 
   // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   reg [0:0] leaf_active = 1'h0;
@@ -606,39 +612,39 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] case_leaf_turn_1;
   wire [0:0] case_leaf_turn_2;
   wire [0:0] case_leaf_turn_3;
-  wire [0:0] or_23;
+  wire [0:0] or_25;
   wire [0:0] mux_case_leaf_turn_2;
   wire [0:0] leaf_take;
-  wire [0:0] eq_24;
+  wire [0:0] eq_26;
   wire [0:0] u0_leaf_take;
   wire [0:0] not_u0_leaf_take;
-  wire [0:0] and_25;
-  wire [0:0] u0_leaf_fill_or_and_25;
-  wire [0:0] eq_26;
+  wire [0:0] and_27;
+  wire [0:0] u0_leaf_fill_or_and_27;
+  wire [0:0] eq_28;
   wire [0:0] u1_leaf_take;
   wire [0:0] not_u1_leaf_take;
-  wire [0:0] and_27;
-  wire [0:0] u1_leaf_fill_or_and_27;
-  wire [5:0] case_mux_case_leaf_turn_2;
-  wire [6:0] cat_28;
-  wire [0:0] not_leaf_last_entry;
   wire [0:0] and_29;
-  wire [0:0] leaf_take_or_and_29;
+  wire [0:0] u1_leaf_fill_or_and_29;
+  wire [5:0] case_mux_case_leaf_turn_2;
+  wire [6:0] cat_30;
+  wire [0:0] not_leaf_last_entry;
+  wire [0:0] and_31;
+  wire [0:0] leaf_take_or_and_31;
   wire [6:0] mux_leaf_take;
   wire [12:0] case_mux_case_leaf_turn_2_1;
-  wire [12:0] k_1_2 = 13'h0001;
-  wire [12:0] leaf_ptr_plus_k_1_2;
+  wire [12:0] k_1_3 = 13'h0001;
+  wire [12:0] leaf_ptr_plus_k_1_3;
   wire [12:0] mux_leaf_take_1;
   wire [2:0] case_mux_case_leaf_turn_2_2;
-  wire [2:0] k_1_3 = 3'h1;
-  wire [2:0] leaf_left_minus_k_1_3;
+  wire [2:0] k_1_4 = 3'h1;
+  wire [2:0] leaf_left_minus_k_1_4;
   wire [2:0] mux_leaf_take_2;
   wire [30:0] case_mux_case_leaf_turn_2_3;
   wire [30:0] mux_leaf_take_3;
   wire [5:0] case_mux_case_leaf_turn_2_4;
   wire [5:0] mux_leaf_take_4;
   wire [2:0] case_mux_case_leaf_turn_2_5;
-  wire [0:0] eq_30;
+  wire [0:0] eq_32;
   wire [2:0] k_2 = 3'h2;
   wire [0:0] leaf_left_eq_k_2;
   wire [0:0] mux_leaf_take_5;
@@ -646,7 +652,7 @@ module fxrt_core_sf0a3f4 (
   // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   wire [12:0] u_leaf_rom_data;
   wire [12:0] k_0_4 = 13'h0000;
-  wire [58:0] cat_31;
+  wire [58:0] cat_33;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 58:13 are read
   (* mem2reg *) reg [58:0] emit_tag_sr [1:3];
   integer emit_tag_i;
@@ -746,20 +752,20 @@ module fxrt_core_sf0a3f4 (
   reg [0:0] res_credit_ok = 1'h1;
   reg [0:0] u0_done_took = 1'h0;
   wire [0:0] not_u0_done_took;
-  wire [0:0] and_35;
+  wire [0:0] and_37;
   wire [0:0] u0_done_avail;
   reg [0:0] u1_done_took = 1'h0;
   wire [0:0] not_u1_done_took;
-  wire [0:0] and_36;
+  wire [0:0] and_38;
   wire [0:0] u1_done_avail;
-  wire [6:0] cat_37;
+  wire [6:0] cat_39;
   wire [0:0] not_u0_done_avail;
   wire [0:0] u1_done_take;
-  wire [6:0] cat_39;
+  wire [6:0] cat_41;
   wire [6:0] mux_u0_done_avail;
-  wire [0:0] or_40;
+  wire [0:0] or_42;
   reg [0:0] done_valid_r = 1'h0;
-  wire [55:0] cat_41;
+  wire [55:0] cat_43;
   wire [0:0] u_closest_merge_valid0;
   wire [5:0] u_closest_merge_slot0;
   wire [0:0] u_closest_merge_hit0;
@@ -790,18 +796,17 @@ module fxrt_core_sf0a3f4 (
   reg [6:0] done_slot_r_c8 = 7'h00;
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  wire [63:0] cat_42;
-  wire [63:0] cat_43;
+  wire [63:0] cat_44;
+  wire [63:0] cat_45;
   wire [0:0] res_take;
   reg [3:0] res_q_wr = 4'h0;
   reg [3:0] res_q_rd = 4'h0;
   reg [4:0] res_q_count = 5'h00;
-  wire [3:0] k_1_4 = 4'h1;
-  wire [3:0] res_q_wr_plus_k_1_4;
+  wire [3:0] res_q_wr_plus_k_1_2;
   wire [3:0] mux_res_q_push;
   reg [3:0] res_q_rd1 = 4'h1;
   wire [3:0] res_q_rd_next;
-  wire [3:0] res_q_rd1_plus_k_1_4;
+  wire [3:0] res_q_rd1_plus_k_1_2;
   wire [3:0] mux_res_take;
   wire [0:0] not_res_q_push_c1;
   wire [4:0] rs_not_res_q_push_c1;
@@ -813,16 +818,16 @@ module fxrt_core_sf0a3f4 (
   wire [0:0] res_q_count_eq_k_0_5;
   wire [4:0] k_1_5 = 5'h01;
   wire [0:0] res_q_one_left;
-  wire [0:0] and_46;
+  wire [0:0] and_48;
   wire [0:0] res_q_drained;
   reg [0:0] res_q_bypass = 1'h0;
   wire [0:0] res_q_bypass_c;
   reg [0:0] res_q_popped = 1'h0;
   reg [0:0] res_q_nonempty = 1'h0;
   wire [0:0] k_1_5_lt_res_q_count;
-  wire [0:0] or_49;
+  wire [0:0] or_51;
   wire [0:0] not_res_take;
-  wire [0:0] and_50;
+  wire [0:0] and_52;
   wire [0:0] res_q_nonempty_c;
   reg [63:0] res_q_din0 = 64'h0000000000000000;
   wire [15:0] bits_res_q_din0;
@@ -832,17 +837,17 @@ module fxrt_core_sf0a3f4 (
   reg [3:0] res_q_rd0_p1 = 4'h0;
   reg [3:0] res_q_rd01_p1 = 4'h1;
   wire [3:0] mux_res_take_1;
-  wire [3:0] res_q_rd01_p1_plus_k_1_4;
+  wire [3:0] res_q_rd01_p1_plus_k_1_2;
   wire [3:0] mux_res_take_2;
   reg [3:0] res_q_rd0_p2 = 4'h0;
   reg [3:0] res_q_rd01_p2 = 4'h1;
   wire [3:0] mux_res_take_3;
-  wire [3:0] res_q_rd01_p2_plus_k_1_4;
+  wire [3:0] res_q_rd01_p2_plus_k_1_2;
   wire [3:0] mux_res_take_4;
   reg [3:0] res_q_rd0_p3 = 4'h0;
   reg [3:0] res_q_rd01_p3 = 4'h1;
   wire [3:0] mux_res_take_5;
-  wire [3:0] res_q_rd01_p3_plus_k_1_4;
+  wire [3:0] res_q_rd01_p3_plus_k_1_2;
   wire [3:0] mux_res_take_6;
   reg [15:0] res_q_q_stay0_g3 = 16'h0000;
   reg [15:0] res_q_q_stay0_g2 = 16'h0000;
@@ -865,17 +870,17 @@ module fxrt_core_sf0a3f4 (
   reg [3:0] res_q_rd1_p1 = 4'h0;
   reg [3:0] res_q_rd11_p1 = 4'h1;
   wire [3:0] mux_res_take_7;
-  wire [3:0] res_q_rd11_p1_plus_k_1_4;
+  wire [3:0] res_q_rd11_p1_plus_k_1_2;
   wire [3:0] mux_res_take_8;
   reg [3:0] res_q_rd1_p2 = 4'h0;
   reg [3:0] res_q_rd11_p2 = 4'h1;
   wire [3:0] mux_res_take_9;
-  wire [3:0] res_q_rd11_p2_plus_k_1_4;
+  wire [3:0] res_q_rd11_p2_plus_k_1_2;
   wire [3:0] mux_res_take_10;
   reg [3:0] res_q_rd1_p3 = 4'h0;
   reg [3:0] res_q_rd11_p3 = 4'h1;
   wire [3:0] mux_res_take_11;
-  wire [3:0] res_q_rd11_p3_plus_k_1_4;
+  wire [3:0] res_q_rd11_p3_plus_k_1_2;
   wire [3:0] mux_res_take_12;
   reg [15:0] res_q_q_stay1_g3 = 16'h0000;
   reg [15:0] res_q_q_stay1_g2 = 16'h0000;
@@ -928,18 +933,19 @@ module fxrt_core_sf0a3f4 (
   // not in a stage or state machine
 
   always @(posedge clk) begin : regs
-    if (accept_w) ray_o_g0[accept_w_slot] <= bits_cat_17;
-    if (accept_w_c1) ray_o_g1[accept_w_slot_c1] <= bits_cat_17_1;
-    if (accept_w_c2) ray_o_g2[accept_w_slot_c2] <= bits_cat_17_2;
-    if (accept_w_c3) ray_o_g3[accept_w_slot_c3] <= bits_cat_17_3;
-    if (accept_w_c4) ray_o_g4[accept_w_slot_c4] <= bits_cat_17_4;
-    if (accept_w_c5) ray_o_g5[accept_w_slot_c5] <= bits_cat_17_5;
-    if (accept_w_c6) ray_w_g0[accept_w_slot_c6] <= bits_cat_18;
-    if (accept_w_c7) ray_w_g1[accept_w_slot_c7] <= bits_cat_18_1;
-    if (accept_w_c8) ray_w_g2[accept_w_slot_c8] <= bits_cat_18_2;
-    if (accept_w_c9) ray_w_g3[accept_w_slot_c9] <= bits_cat_18_3;
-    if (accept_w_c10) ray_w_g4[accept_w_slot_c10] <= bits_cat_18_4;
-    if (accept_w_c11) ray_w_g5[accept_w_slot_c11] <= bits_cat_18_5;
+    if (k_1) box_done_slot_mem[box_done_slot_wp] <= box_slot;
+    if (accept_w) ray_o_g0[accept_w_slot] <= bits_cat_19;
+    if (accept_w_c1) ray_o_g1[accept_w_slot_c1] <= bits_cat_19_1;
+    if (accept_w_c2) ray_o_g2[accept_w_slot_c2] <= bits_cat_19_2;
+    if (accept_w_c3) ray_o_g3[accept_w_slot_c3] <= bits_cat_19_3;
+    if (accept_w_c4) ray_o_g4[accept_w_slot_c4] <= bits_cat_19_4;
+    if (accept_w_c5) ray_o_g5[accept_w_slot_c5] <= bits_cat_19_5;
+    if (accept_w_c6) ray_w_g0[accept_w_slot_c6] <= bits_cat_20;
+    if (accept_w_c7) ray_w_g1[accept_w_slot_c7] <= bits_cat_20_1;
+    if (accept_w_c8) ray_w_g2[accept_w_slot_c8] <= bits_cat_20_2;
+    if (accept_w_c9) ray_w_g3[accept_w_slot_c9] <= bits_cat_20_3;
+    if (accept_w_c10) ray_w_g4[accept_w_slot_c10] <= bits_cat_20_4;
+    if (accept_w_c11) ray_w_g5[accept_w_slot_c11] <= bits_cat_20_5;
     if (res_q_push) res_q_mem0_g0[res_q_wr] <= bits_res_q_din0;
     if (res_q_push) res_q_mem0_g1[res_q_wr] <= bits_res_q_din0_1;
     if (res_q_push) res_q_mem0_g2[res_q_wr] <= bits_res_q_din0_2;
@@ -1297,7 +1303,8 @@ module fxrt_core_sf0a3f4 (
   assign bits_box_d3 = box_d3[31];
   assign box_miss = or_11 | bits_box_d3;
   assign box_last = plane_t_valid & plane_t_last;
-  assign box_done_slot = box_done_slot_sr[11];
+  assign plus_13 = box_done_slot_wp + k_1_2;
+  assign plus_14 = box_done_slot_wp + k_7;
 
   always @(posedge clk) begin : box_exit_regs
     if (take) box_slot <= take_slot;
@@ -1349,17 +1356,9 @@ module fxrt_core_sf0a3f4 (
     box_lt1_d <= box_lt1;
     if (rst) box_done <= 1'h0;
     else box_done <= box_last;
-    box_done_slot_sr[11] <= box_done_slot_sr[10];
-    box_done_slot_sr[10] <= box_done_slot_sr[9];
-    box_done_slot_sr[9] <= box_done_slot_sr[8];
-    box_done_slot_sr[8] <= box_done_slot_sr[7];
-    box_done_slot_sr[7] <= box_done_slot_sr[6];
-    box_done_slot_sr[6] <= box_done_slot_sr[5];
-    box_done_slot_sr[5] <= box_done_slot_sr[4];
-    box_done_slot_sr[4] <= box_done_slot_sr[3];
-    box_done_slot_sr[3] <= box_done_slot_sr[2];
-    box_done_slot_sr[2] <= box_done_slot_sr[1];
-    box_done_slot_sr[1] <= box_slot;
+    box_done_slot_wp <= plus_13;
+    box_done_slot_rp <= plus_14;
+    box_done_slot <= box_done_slot_mem[box_done_slot_rp];
   end
 
   // stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
@@ -1380,16 +1379,16 @@ module fxrt_core_sf0a3f4 (
   assign u0_node_word = u_node_rom_0_data;
   assign u1_node_word = u_node_rom_0_data_b;
   assign bits_box_done_slot = box_done_slot[6];
-  assign eq_13 = bits_box_done_slot == k_0;
-  assign u0_new = box_done & eq_13;
+  assign eq_15 = bits_box_done_slot == k_0;
+  assign u0_new = box_done & eq_15;
   assign bits_free_slot = free_slot[6];
   assign bits_free_slot_eq_k_0 = bits_free_slot == k_0;
   assign u0_free = free_valid & bits_free_slot_eq_k_0;
   assign bits_box_done_slot_1 = box_done_slot[5:0];
   assign bits_free_slot_1 = free_slot[5:0];
   assign bits_box_done_slot_2 = box_done_slot[6];
-  assign eq_15 = bits_box_done_slot_2 == k_1;
-  assign u1_new = box_done & eq_15;
+  assign eq_17 = bits_box_done_slot_2 == k_1;
+  assign u1_new = box_done & eq_17;
   assign bits_free_slot_2 = free_slot[6];
   assign bits_free_slot_2_eq_k_1 = bits_free_slot_2 == k_1;
   assign u1_free = free_valid & bits_free_slot_2_eq_k_1;
@@ -1397,23 +1396,23 @@ module fxrt_core_sf0a3f4 (
   assign bits_free_slot_3 = free_slot[5:0];
 
   // stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  assign cat_17 = {acc_in_oz, acc_in_oy, acc_in_ox};
-  assign bits_cat_17 = cat_17[15:0];
-  assign bits_cat_17_1 = cat_17[31:16];
-  assign bits_cat_17_2 = cat_17[47:32];
-  assign bits_cat_17_3 = cat_17[63:48];
-  assign bits_cat_17_4 = cat_17[79:64];
-  assign bits_cat_17_5 = cat_17[86:80];
+  assign cat_19 = {acc_in_oz, acc_in_oy, acc_in_ox};
+  assign bits_cat_19 = cat_19[15:0];
+  assign bits_cat_19_1 = cat_19[31:16];
+  assign bits_cat_19_2 = cat_19[47:32];
+  assign bits_cat_19_3 = cat_19[63:48];
+  assign bits_cat_19_4 = cat_19[79:64];
+  assign bits_cat_19_5 = cat_19[86:80];
   assign u_acc_in_wz = $unsigned(acc_in_wz);
   assign u_acc_in_wy = $unsigned(acc_in_wy);
   assign u_acc_in_wx = $unsigned(acc_in_wx);
-  assign cat_18 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
-  assign bits_cat_18 = cat_18[15:0];
-  assign bits_cat_18_1 = cat_18[31:16];
-  assign bits_cat_18_2 = cat_18[47:32];
-  assign bits_cat_18_3 = cat_18[63:48];
-  assign bits_cat_18_4 = cat_18[79:64];
-  assign bits_cat_18_5 = cat_18[95:80];
+  assign cat_20 = {u_acc_in_wz, u_acc_in_wy, u_acc_in_wx};
+  assign bits_cat_20 = cat_20[15:0];
+  assign bits_cat_20_1 = cat_20[31:16];
+  assign bits_cat_20_2 = cat_20[47:32];
+  assign bits_cat_20_3 = cat_20[63:48];
+  assign bits_cat_20_4 = cat_20[79:64];
+  assign bits_cat_20_5 = cat_20[95:80];
 
   // stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   assign leaf_last_entry = leaf_active & leaf_last;
@@ -1439,40 +1438,40 @@ module fxrt_core_sf0a3f4 (
     (leaf_turn == 1'h0) ? k_1 :
     (leaf_turn == 1'h1) ? k_0 :
     k_0;
-  assign or_23 = case_leaf_turn_2 | case_leaf_turn;
+  assign or_25 = case_leaf_turn_2 | case_leaf_turn;
   assign mux_case_leaf_turn_2 = case_leaf_turn_2 ? case_leaf_turn_3 : case_leaf_turn_1;
-  assign leaf_take = leaf_can_take & or_23;
-  assign eq_24 = mux_case_leaf_turn_2 == k_0;
-  assign u0_leaf_take = leaf_take & eq_24;
+  assign leaf_take = leaf_can_take & or_25;
+  assign eq_26 = mux_case_leaf_turn_2 == k_0;
+  assign u0_leaf_take = leaf_take & eq_26;
   assign not_u0_leaf_take = ~u0_leaf_take;
-  assign and_25 = u0_leaf_buf_valid & not_u0_leaf_take;
-  assign u0_leaf_fill_or_and_25 = u0_leaf_fill | and_25;
-  assign eq_26 = mux_case_leaf_turn_2 == k_1;
-  assign u1_leaf_take = leaf_take & eq_26;
+  assign and_27 = u0_leaf_buf_valid & not_u0_leaf_take;
+  assign u0_leaf_fill_or_and_27 = u0_leaf_fill | and_27;
+  assign eq_28 = mux_case_leaf_turn_2 == k_1;
+  assign u1_leaf_take = leaf_take & eq_28;
   assign not_u1_leaf_take = ~u1_leaf_take;
-  assign and_27 = u1_leaf_buf_valid & not_u1_leaf_take;
-  assign u1_leaf_fill_or_and_27 = u1_leaf_fill | and_27;
+  assign and_29 = u1_leaf_buf_valid & not_u1_leaf_take;
+  assign u1_leaf_fill_or_and_29 = u1_leaf_fill | and_29;
   assign case_mux_case_leaf_turn_2 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_slot :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_slot :
     u0_buf_leaf_slot;
-  assign cat_28 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
+  assign cat_30 = {mux_case_leaf_turn_2, case_mux_case_leaf_turn_2};
   assign not_leaf_last_entry = ~leaf_last_entry;
-  assign and_29 = leaf_active & not_leaf_last_entry;
-  assign leaf_take_or_and_29 = leaf_take | and_29;
-  assign mux_leaf_take = leaf_take ? cat_28 : leaf_slot;
+  assign and_31 = leaf_active & not_leaf_last_entry;
+  assign leaf_take_or_and_31 = leaf_take | and_31;
+  assign mux_leaf_take = leaf_take ? cat_30 : leaf_slot;
   assign case_mux_case_leaf_turn_2_1 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_first :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_first :
     u0_buf_leaf_first;
-  assign leaf_ptr_plus_k_1_2 = leaf_ptr + k_1_2;
-  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_2;
+  assign leaf_ptr_plus_k_1_3 = leaf_ptr + k_1_3;
+  assign mux_leaf_take_1 = leaf_take ? case_mux_case_leaf_turn_2_1 : leaf_ptr_plus_k_1_3;
   assign case_mux_case_leaf_turn_2_2 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_count :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_count :
     u0_buf_leaf_count;
-  assign leaf_left_minus_k_1_3 = leaf_left - k_1_3;
-  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_3;
+  assign leaf_left_minus_k_1_4 = leaf_left - k_1_4;
+  assign mux_leaf_take_2 = leaf_take ? case_mux_case_leaf_turn_2_2 : leaf_left_minus_k_1_4;
   assign case_mux_case_leaf_turn_2_3 =
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_tmin :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_tmin :
@@ -1487,13 +1486,13 @@ module fxrt_core_sf0a3f4 (
     (mux_case_leaf_turn_2 == 1'h0) ? u0_buf_leaf_count :
     (mux_case_leaf_turn_2 == 1'h1) ? u1_buf_leaf_count :
     u0_buf_leaf_count;
-  assign eq_30 = case_mux_case_leaf_turn_2_5 == k_1_3;
+  assign eq_32 = case_mux_case_leaf_turn_2_5 == k_1_4;
   assign leaf_left_eq_k_2 = leaf_left == k_2;
-  assign mux_leaf_take_5 = leaf_take ? eq_30 : leaf_left_eq_k_2;
+  assign mux_leaf_take_5 = leaf_take ? eq_32 : leaf_left_eq_k_2;
 
   always @(posedge clk) begin : leaf_stream_regs
     if (rst) leaf_active <= 1'h0;
-    else leaf_active <= leaf_take_or_and_29;
+    else leaf_active <= leaf_take_or_and_31;
     leaf_slot <= mux_leaf_take;
     leaf_ptr <= mux_leaf_take_1;
     leaf_left <= mux_leaf_take_2;
@@ -1504,14 +1503,14 @@ module fxrt_core_sf0a3f4 (
     if (rst) leaf_turn <= 1'h0;
     else if (leaf_take) leaf_turn <= mux_case_leaf_turn_2;
     if (rst) u0_leaf_buf_valid <= 1'h0;
-    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_25;
+    else u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
     if (u0_leaf_fill) u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
     if (u0_leaf_fill) u0_buf_leaf_first <= u_traverse_0_leaf_first;
     if (u0_leaf_fill) u0_buf_leaf_count <= u_traverse_0_leaf_count;
     if (u0_leaf_fill) u0_buf_leaf_tmin <= u_traverse_0_leaf_tmin;
     if (u0_leaf_fill) u0_buf_leaf_sp <= u_traverse_0_leaf_sp;
     if (rst) u1_leaf_buf_valid <= 1'h0;
-    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_27;
+    else u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
     if (u1_leaf_fill) u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
     if (u1_leaf_fill) u1_buf_leaf_first <= u_traverse_1_leaf_first;
     if (u1_leaf_fill) u1_buf_leaf_count <= u_traverse_1_leaf_count;
@@ -1520,7 +1519,7 @@ module fxrt_core_sf0a3f4 (
   end
 
   // stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
-  assign cat_31 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
+  assign cat_33 = {leaf_last_entry, leaf_first_entry, leaf_slot, leaf_sp, leaf_tmin, k_0_4};
   assign emit_tag = emit_tag_sr[3];
   assign bits_emit_tag = emit_tag[58:13];
   assign emit_tag_tri = {bits_emit_tag, u_leaf_rom_data};
@@ -1560,7 +1559,7 @@ module fxrt_core_sf0a3f4 (
   always @(posedge clk) begin : emission_regs
     emit_tag_sr[3] <= emit_tag_sr[2];
     emit_tag_sr[2] <= emit_tag_sr[1];
-    emit_tag_sr[1] <= cat_31;
+    emit_tag_sr[1] <= cat_33;
     if (rst) emit_valid_1 <= 1'h0;
     else emit_valid_1 <= leaf_active;
     if (rst) emit_valid_2 <= 1'h0;
@@ -1620,18 +1619,18 @@ module fxrt_core_sf0a3f4 (
 
   // stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   assign not_u0_done_took = ~u0_done_took;
-  assign and_35 = u_traverse_0_done_valid & not_u0_done_took;
-  assign u0_done_avail = and_35 & res_credit_ok;
+  assign and_37 = u_traverse_0_done_valid & not_u0_done_took;
+  assign u0_done_avail = and_37 & res_credit_ok;
   assign not_u1_done_took = ~u1_done_took;
-  assign and_36 = u_traverse_1_done_valid & not_u1_done_took;
-  assign u1_done_avail = and_36 & res_credit_ok;
-  assign cat_37 = {k_0, u_traverse_0_done_slot};
+  assign and_38 = u_traverse_1_done_valid & not_u1_done_took;
+  assign u1_done_avail = and_38 & res_credit_ok;
+  assign cat_39 = {k_0, u_traverse_0_done_slot};
   assign not_u0_done_avail = ~u0_done_avail;
   assign u1_done_take = u1_done_avail & not_u0_done_avail;
-  assign cat_39 = {k_1, u_traverse_1_done_slot};
-  assign mux_u0_done_avail = u0_done_avail ? cat_37 : cat_39;
-  assign or_40 = u0_done_avail | u1_done_avail;
-  assign cat_41 = {done_slot_r_c8, done_slot_r_c7, done_slot_r_c6, done_slot_r_c5, done_slot_r_c4, done_slot_r_c3, done_slot_r_c2, done_slot_r_c1};
+  assign cat_41 = {k_1, u_traverse_1_done_slot};
+  assign mux_u0_done_avail = u0_done_avail ? cat_39 : cat_41;
+  assign or_42 = u0_done_avail | u1_done_avail;
+  assign cat_43 = {done_slot_r_c8, done_slot_r_c7, done_slot_r_c6, done_slot_r_c5, done_slot_r_c4, done_slot_r_c3, done_slot_r_c2, done_slot_r_c1};
 
   always @(posedge clk) begin : done_regs
     if (rst) res_credit_ok <= 1'h1;
@@ -1641,7 +1640,7 @@ module fxrt_core_sf0a3f4 (
     if (rst) u1_done_took <= 1'h0;
     else u1_done_took <= u1_done_pop;
     if (rst) done_valid_r <= 1'h0;
-    else done_valid_r <= or_40;
+    else done_valid_r <= or_42;
   end
 
   // register copies done_slot_r_copies: done_slot_r and 8 copies, to split its fan-out
@@ -1659,14 +1658,14 @@ module fxrt_core_sf0a3f4 (
   end
 
   // stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  assign cat_42 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
-  assign cat_43 = {u_closest_res_u, u_closest_res_v};
+  assign cat_44 = {u_closest_res_id, u_closest_res_hit, u_closest_res_tri, u_closest_res_t};
+  assign cat_45 = {u_closest_res_u, u_closest_res_v};
   assign res_take = res_take_c;
-  assign res_q_wr_plus_k_1_4 = res_q_wr + k_1_4;
-  assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_4 : res_q_wr;
+  assign res_q_wr_plus_k_1_2 = res_q_wr + k_1_2;
+  assign mux_res_q_push = res_q_push ? res_q_wr_plus_k_1_2 : res_q_wr;
   assign res_q_rd_next = res_take ? res_q_rd1 : res_q_rd;
-  assign res_q_rd1_plus_k_1_4 = res_q_rd1 + k_1_4;
-  assign mux_res_take = res_take ? res_q_rd1_plus_k_1_4 : res_q_rd1;
+  assign res_q_rd1_plus_k_1_2 = res_q_rd1 + k_1_2;
+  assign mux_res_take = res_take ? res_q_rd1_plus_k_1_2 : res_q_rd1;
   assign not_res_q_push_c1 = ~res_q_push_c1;
   assign rs_not_res_q_push_c1 = {{4{1'b0}}, not_res_q_push_c1};
   assign res_q_count_if_pop = res_q_count - rs_not_res_q_push_c1;
@@ -1675,27 +1674,27 @@ module fxrt_core_sf0a3f4 (
   assign res_q_count_next = res_take ? res_q_count_if_pop : res_q_count_if_kept;
   assign res_q_count_eq_k_0_5 = res_q_count == k_0_5;
   assign res_q_one_left = res_q_count == k_1_5;
-  assign and_46 = res_q_one_left & res_take;
-  assign res_q_drained = res_q_count_eq_k_0_5 | and_46;
+  assign and_48 = res_q_one_left & res_take;
+  assign res_q_drained = res_q_count_eq_k_0_5 | and_48;
   assign res_q_bypass_c = res_q_push_c1 & res_q_drained;
   assign k_1_5_lt_res_q_count = k_1_5 < res_q_count;
-  assign or_49 = res_q_push_c1 | k_1_5_lt_res_q_count;
+  assign or_51 = res_q_push_c1 | k_1_5_lt_res_q_count;
   assign not_res_take = ~res_take;
-  assign and_50 = res_q_one_left & not_res_take;
-  assign res_q_nonempty_c = or_49 | and_50;
+  assign and_52 = res_q_one_left & not_res_take;
+  assign res_q_nonempty_c = or_51 | and_52;
   assign bits_res_q_din0 = res_q_din0[15:0];
   assign bits_res_q_din0_1 = res_q_din0[31:16];
   assign bits_res_q_din0_2 = res_q_din0[47:32];
   assign bits_res_q_din0_3 = res_q_din0[63:48];
   assign mux_res_take_1 = res_take ? res_q_rd01_p1 : res_q_rd0_p1;
-  assign res_q_rd01_p1_plus_k_1_4 = res_q_rd01_p1 + k_1_4;
-  assign mux_res_take_2 = res_take ? res_q_rd01_p1_plus_k_1_4 : res_q_rd01_p1;
+  assign res_q_rd01_p1_plus_k_1_2 = res_q_rd01_p1 + k_1_2;
+  assign mux_res_take_2 = res_take ? res_q_rd01_p1_plus_k_1_2 : res_q_rd01_p1;
   assign mux_res_take_3 = res_take ? res_q_rd01_p2 : res_q_rd0_p2;
-  assign res_q_rd01_p2_plus_k_1_4 = res_q_rd01_p2 + k_1_4;
-  assign mux_res_take_4 = res_take ? res_q_rd01_p2_plus_k_1_4 : res_q_rd01_p2;
+  assign res_q_rd01_p2_plus_k_1_2 = res_q_rd01_p2 + k_1_2;
+  assign mux_res_take_4 = res_take ? res_q_rd01_p2_plus_k_1_2 : res_q_rd01_p2;
   assign mux_res_take_5 = res_take ? res_q_rd01_p3 : res_q_rd0_p3;
-  assign res_q_rd01_p3_plus_k_1_4 = res_q_rd01_p3 + k_1_4;
-  assign mux_res_take_6 = res_take ? res_q_rd01_p3_plus_k_1_4 : res_q_rd01_p3;
+  assign res_q_rd01_p3_plus_k_1_2 = res_q_rd01_p3 + k_1_2;
+  assign mux_res_take_6 = res_take ? res_q_rd01_p3_plus_k_1_2 : res_q_rd01_p3;
   assign res_q_q_stay0 = {res_q_q_stay0_g3, res_q_q_stay0_g2, res_q_q_stay0_g1, res_q_q_stay0_g0};
   assign res_q_q_next0 = {res_q_q_next0_g3, res_q_q_next0_g2, res_q_q_next0_g1, res_q_q_next0_g0};
   assign mux_res_q_popped = res_q_popped ? res_q_q_next0 : res_q_q_stay0;
@@ -1705,14 +1704,14 @@ module fxrt_core_sf0a3f4 (
   assign bits_res_q_din1_2 = res_q_din1[47:32];
   assign bits_res_q_din1_3 = res_q_din1[63:48];
   assign mux_res_take_7 = res_take ? res_q_rd11_p1 : res_q_rd1_p1;
-  assign res_q_rd11_p1_plus_k_1_4 = res_q_rd11_p1 + k_1_4;
-  assign mux_res_take_8 = res_take ? res_q_rd11_p1_plus_k_1_4 : res_q_rd11_p1;
+  assign res_q_rd11_p1_plus_k_1_2 = res_q_rd11_p1 + k_1_2;
+  assign mux_res_take_8 = res_take ? res_q_rd11_p1_plus_k_1_2 : res_q_rd11_p1;
   assign mux_res_take_9 = res_take ? res_q_rd11_p2 : res_q_rd1_p2;
-  assign res_q_rd11_p2_plus_k_1_4 = res_q_rd11_p2 + k_1_4;
-  assign mux_res_take_10 = res_take ? res_q_rd11_p2_plus_k_1_4 : res_q_rd11_p2;
+  assign res_q_rd11_p2_plus_k_1_2 = res_q_rd11_p2 + k_1_2;
+  assign mux_res_take_10 = res_take ? res_q_rd11_p2_plus_k_1_2 : res_q_rd11_p2;
   assign mux_res_take_11 = res_take ? res_q_rd11_p3 : res_q_rd1_p3;
-  assign res_q_rd11_p3_plus_k_1_4 = res_q_rd11_p3 + k_1_4;
-  assign mux_res_take_12 = res_take ? res_q_rd11_p3_plus_k_1_4 : res_q_rd11_p3;
+  assign res_q_rd11_p3_plus_k_1_2 = res_q_rd11_p3 + k_1_2;
+  assign mux_res_take_12 = res_take ? res_q_rd11_p3_plus_k_1_2 : res_q_rd11_p3;
   assign res_q_q_stay1 = {res_q_q_stay1_g3, res_q_q_stay1_g2, res_q_q_stay1_g1, res_q_q_stay1_g0};
   assign res_q_q_next1 = {res_q_q_next1_g3, res_q_q_next1_g2, res_q_q_next1_g1, res_q_q_next1_g0};
   assign mux_res_q_popped_1 = res_q_popped ? res_q_q_next1 : res_q_q_stay1;
@@ -1756,7 +1755,7 @@ module fxrt_core_sf0a3f4 (
     else res_q_popped <= res_take;
     if (rst) res_q_nonempty <= 1'h0;
     else res_q_nonempty <= res_q_nonempty_c;
-    res_q_din0 <= cat_42;
+    res_q_din0 <= cat_44;
     if (rst) res_q_rd0_p1 <= 4'h0;
     else res_q_rd0_p1 <= mux_res_take_1;
     if (rst) res_q_rd01_p1 <= 4'h1;
@@ -1778,7 +1777,7 @@ module fxrt_core_sf0a3f4 (
     res_q_q_next0_g1 <= res_q_mem0_g1[res_q_rd01_p1];
     res_q_q_next0_g0 <= res_q_mem0_g0[res_q_rd1];
     if (res_q_push) res_q_din_r0 <= res_q_din0;
-    res_q_din1 <= cat_43;
+    res_q_din1 <= cat_45;
     if (rst) res_q_rd1_p1 <= 4'h0;
     else res_q_rd1_p1 <= mux_res_take_7;
     if (rst) res_q_rd11_p1 <= 4'h1;
@@ -2045,7 +2044,7 @@ module fxrt_core_sf0a3f4 (
     .id(acc_in_ray_id),
     .done_valid(done_valid_r),
     .done_slot(done_slot_r),
-    .done_slot_copies(cat_41),
+    .done_slot_copies(cat_43),
     .merge_valid0(u_closest_merge_valid0),
     .merge_slot0(u_closest_merge_slot0),
     .merge_hit0(u_closest_merge_hit0),

@@ -216,6 +216,9 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
     );
   end component;
 
+  type box_done_slot_mem_t is array (0 to 15) of unsigned(6 downto 0);
+  signal box_done_slot_mem : box_done_slot_mem_t := (others => (others => '0'));
+
   type ray_o_g0_t is array (0 to 127) of unsigned(15 downto 0);
   signal ray_o_g0 : ray_o_g0_t := (others => (others => '0'));
 
@@ -667,9 +670,13 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal box_miss : unsigned(0 downto 0);
   signal box_last : unsigned(0 downto 0);
   signal box_done : unsigned(0 downto 0) := unsigned'("0");
-  type box_done_slot_sr_t is array (1 to 11) of unsigned(6 downto 0);
-  signal box_done_slot_sr : box_done_slot_sr_t := (others => (others => '0'));
-  signal box_done_slot : unsigned(6 downto 0);
+  signal box_done_slot_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal box_done_slot_rp : unsigned(3 downto 0) := unsigned'("0000");
+  constant k_1_2 : unsigned(3 downto 0) := unsigned'("0001");
+  signal plus_13 : unsigned(3 downto 0);
+  constant k_7 : unsigned(3 downto 0) := unsigned'("0111");
+  signal plus_14 : unsigned(3 downto 0);
+  signal box_done_slot : unsigned(6 downto 0) := unsigned'("0000000");
 
   -- stage units_s: the traversal units (K ray slots each) and their node ROMs, one per two units
   signal u0_merge_valid : unsigned(0 downto 0);
@@ -689,7 +696,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u0_node_word : unsigned(72 downto 0);
   signal u1_node_word : unsigned(72 downto 0);
   signal bits_box_done_slot : unsigned(0 downto 0);
-  signal eq_13 : unsigned(0 downto 0);
+  signal eq_15 : unsigned(0 downto 0);
   signal u0_new : unsigned(0 downto 0);
   signal bits_free_slot : unsigned(0 downto 0);
   signal bits_free_slot_eq_k_0 : unsigned(0 downto 0);
@@ -714,7 +721,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_traverse_0_depth : unsigned(5 downto 0);
   signal u_traverse_0_occupied : unsigned(6 downto 0);
   signal bits_box_done_slot_2 : unsigned(0 downto 0);
-  signal eq_15 : unsigned(0 downto 0);
+  signal eq_17 : unsigned(0 downto 0);
   signal u1_new : unsigned(0 downto 0);
   signal bits_free_slot_2 : unsigned(0 downto 0);
   signal bits_free_slot_2_eq_k_1 : unsigned(0 downto 0);
@@ -742,23 +749,23 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal u_node_rom_0_data_b : unsigned(72 downto 0);
 
   -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  signal cat_17 : unsigned(86 downto 0);
-  signal bits_cat_17 : unsigned(15 downto 0);
-  signal bits_cat_17_1 : unsigned(15 downto 0);
-  signal bits_cat_17_2 : unsigned(15 downto 0);
-  signal bits_cat_17_3 : unsigned(15 downto 0);
-  signal bits_cat_17_4 : unsigned(15 downto 0);
-  signal bits_cat_17_5 : unsigned(6 downto 0);
+  signal cat_19 : unsigned(86 downto 0);
+  signal bits_cat_19 : unsigned(15 downto 0);
+  signal bits_cat_19_1 : unsigned(15 downto 0);
+  signal bits_cat_19_2 : unsigned(15 downto 0);
+  signal bits_cat_19_3 : unsigned(15 downto 0);
+  signal bits_cat_19_4 : unsigned(15 downto 0);
+  signal bits_cat_19_5 : unsigned(6 downto 0);
   signal u_acc_in_wz : unsigned(31 downto 0);
   signal u_acc_in_wy : unsigned(31 downto 0);
   signal u_acc_in_wx : unsigned(31 downto 0);
-  signal cat_18 : unsigned(95 downto 0);
-  signal bits_cat_18 : unsigned(15 downto 0);
-  signal bits_cat_18_1 : unsigned(15 downto 0);
-  signal bits_cat_18_2 : unsigned(15 downto 0);
-  signal bits_cat_18_3 : unsigned(15 downto 0);
-  signal bits_cat_18_4 : unsigned(15 downto 0);
-  signal bits_cat_18_5 : unsigned(15 downto 0);
+  signal cat_20 : unsigned(95 downto 0);
+  signal bits_cat_20 : unsigned(15 downto 0);
+  signal bits_cat_20_1 : unsigned(15 downto 0);
+  signal bits_cat_20_2 : unsigned(15 downto 0);
+  signal bits_cat_20_3 : unsigned(15 downto 0);
+  signal bits_cat_20_4 : unsigned(15 downto 0);
+  signal bits_cat_20_5 : unsigned(15 downto 0);
 
   -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   signal leaf_active : unsigned(0 downto 0) := unsigned'("0");
@@ -793,39 +800,39 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal case_leaf_turn_1 : unsigned(0 downto 0);
   signal case_leaf_turn_2 : unsigned(0 downto 0);
   signal case_leaf_turn_3 : unsigned(0 downto 0);
-  signal or_23 : unsigned(0 downto 0);
+  signal or_25 : unsigned(0 downto 0);
   signal mux_case_leaf_turn_2 : unsigned(0 downto 0);
   signal leaf_take : unsigned(0 downto 0);
-  signal eq_24 : unsigned(0 downto 0);
+  signal eq_26 : unsigned(0 downto 0);
   signal u0_leaf_take : unsigned(0 downto 0);
   signal not_u0_leaf_take : unsigned(0 downto 0);
-  signal and_25 : unsigned(0 downto 0);
-  signal u0_leaf_fill_or_and_25 : unsigned(0 downto 0);
-  signal eq_26 : unsigned(0 downto 0);
+  signal and_27 : unsigned(0 downto 0);
+  signal u0_leaf_fill_or_and_27 : unsigned(0 downto 0);
+  signal eq_28 : unsigned(0 downto 0);
   signal u1_leaf_take : unsigned(0 downto 0);
   signal not_u1_leaf_take : unsigned(0 downto 0);
-  signal and_27 : unsigned(0 downto 0);
-  signal u1_leaf_fill_or_and_27 : unsigned(0 downto 0);
-  signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
-  signal cat_28 : unsigned(6 downto 0);
-  signal not_leaf_last_entry : unsigned(0 downto 0);
   signal and_29 : unsigned(0 downto 0);
-  signal leaf_take_or_and_29 : unsigned(0 downto 0);
+  signal u1_leaf_fill_or_and_29 : unsigned(0 downto 0);
+  signal case_mux_case_leaf_turn_2 : unsigned(5 downto 0);
+  signal cat_30 : unsigned(6 downto 0);
+  signal not_leaf_last_entry : unsigned(0 downto 0);
+  signal and_31 : unsigned(0 downto 0);
+  signal leaf_take_or_and_31 : unsigned(0 downto 0);
   signal mux_leaf_take : unsigned(6 downto 0);
   signal case_mux_case_leaf_turn_2_1 : unsigned(12 downto 0);
-  constant k_1_2 : unsigned(12 downto 0) := unsigned'("0000000000001");
-  signal leaf_ptr_plus_k_1_2 : unsigned(12 downto 0);
+  constant k_1_3 : unsigned(12 downto 0) := unsigned'("0000000000001");
+  signal leaf_ptr_plus_k_1_3 : unsigned(12 downto 0);
   signal mux_leaf_take_1 : unsigned(12 downto 0);
   signal case_mux_case_leaf_turn_2_2 : unsigned(2 downto 0);
-  constant k_1_3 : unsigned(2 downto 0) := unsigned'("001");
-  signal leaf_left_minus_k_1_3 : unsigned(2 downto 0);
+  constant k_1_4 : unsigned(2 downto 0) := unsigned'("001");
+  signal leaf_left_minus_k_1_4 : unsigned(2 downto 0);
   signal mux_leaf_take_2 : unsigned(2 downto 0);
   signal case_mux_case_leaf_turn_2_3 : unsigned(30 downto 0);
   signal mux_leaf_take_3 : unsigned(30 downto 0);
   signal case_mux_case_leaf_turn_2_4 : unsigned(5 downto 0);
   signal mux_leaf_take_4 : unsigned(5 downto 0);
   signal case_mux_case_leaf_turn_2_5 : unsigned(2 downto 0);
-  signal eq_30 : unsigned(0 downto 0);
+  signal eq_32 : unsigned(0 downto 0);
   constant k_2 : unsigned(2 downto 0) := unsigned'("010");
   signal leaf_left_eq_k_2 : unsigned(0 downto 0);
   signal mux_leaf_take_5 : unsigned(0 downto 0);
@@ -833,7 +840,7 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
   signal u_leaf_rom_data : unsigned(12 downto 0);
   constant k_0_4 : unsigned(12 downto 0) := unsigned'("0000000000000");
-  signal cat_31 : unsigned(58 downto 0);
+  signal cat_33 : unsigned(58 downto 0);
   type emit_tag_sr_t is array (1 to 3) of unsigned(58 downto 0);
   signal emit_tag_sr : emit_tag_sr_t := (others => (others => '0'));
   signal emit_tag : unsigned(58 downto 0);
@@ -938,20 +945,20 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_credit_ok : unsigned(0 downto 0) := unsigned'("1");
   signal u0_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u0_done_took : unsigned(0 downto 0);
-  signal and_35 : unsigned(0 downto 0);
+  signal and_37 : unsigned(0 downto 0);
   signal u0_done_avail : unsigned(0 downto 0);
   signal u1_done_took : unsigned(0 downto 0) := unsigned'("0");
   signal not_u1_done_took : unsigned(0 downto 0);
-  signal and_36 : unsigned(0 downto 0);
+  signal and_38 : unsigned(0 downto 0);
   signal u1_done_avail : unsigned(0 downto 0);
-  signal cat_37 : unsigned(6 downto 0);
+  signal cat_39 : unsigned(6 downto 0);
   signal not_u0_done_avail : unsigned(0 downto 0);
   signal u1_done_take : unsigned(0 downto 0);
-  signal cat_39 : unsigned(6 downto 0);
+  signal cat_41 : unsigned(6 downto 0);
   signal mux_u0_done_avail : unsigned(6 downto 0);
-  signal or_40 : unsigned(0 downto 0);
+  signal or_42 : unsigned(0 downto 0);
   signal done_valid_r : unsigned(0 downto 0) := unsigned'("0");
-  signal cat_41 : unsigned(55 downto 0);
+  signal cat_43 : unsigned(55 downto 0);
   signal u_closest_merge_valid0 : unsigned(0 downto 0);
   signal u_closest_merge_slot0 : unsigned(5 downto 0);
   signal u_closest_merge_hit0 : unsigned(0 downto 0);
@@ -991,18 +998,17 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   attribute keep of done_slot_r_c8 : signal is "true";
 
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  signal cat_42 : unsigned(63 downto 0);
-  signal cat_43 : unsigned(63 downto 0);
+  signal cat_44 : unsigned(63 downto 0);
+  signal cat_45 : unsigned(63 downto 0);
   signal res_take : unsigned(0 downto 0);
   signal res_q_wr : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_count : unsigned(4 downto 0) := unsigned'("00000");
-  constant k_1_4 : unsigned(3 downto 0) := unsigned'("0001");
-  signal res_q_wr_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_wr_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_q_push : unsigned(3 downto 0);
   signal res_q_rd1 : unsigned(3 downto 0) := unsigned'("0001");
   signal res_q_rd_next : unsigned(3 downto 0);
-  signal res_q_rd1_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd1_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take : unsigned(3 downto 0);
   signal not_res_q_push_c1 : unsigned(0 downto 0);
   signal rs_not_res_q_push_c1 : unsigned(4 downto 0);
@@ -1014,16 +1020,16 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_count_eq_k_0_5 : unsigned(0 downto 0);
   constant k_1_5 : unsigned(4 downto 0) := unsigned'("00001");
   signal res_q_one_left : unsigned(0 downto 0);
-  signal and_46 : unsigned(0 downto 0);
+  signal and_48 : unsigned(0 downto 0);
   signal res_q_drained : unsigned(0 downto 0);
   signal res_q_bypass : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_bypass_c : unsigned(0 downto 0);
   signal res_q_popped : unsigned(0 downto 0) := unsigned'("0");
   signal res_q_nonempty : unsigned(0 downto 0) := unsigned'("0");
   signal k_1_5_lt_res_q_count : unsigned(0 downto 0);
-  signal or_49 : unsigned(0 downto 0);
+  signal or_51 : unsigned(0 downto 0);
   signal not_res_take : unsigned(0 downto 0);
-  signal and_50 : unsigned(0 downto 0);
+  signal and_52 : unsigned(0 downto 0);
   signal res_q_nonempty_c : unsigned(0 downto 0);
   signal res_q_din0 : unsigned(63 downto 0) := unsigned'("0000000000000000000000000000000000000000000000000000000000000000");
   signal bits_res_q_din0 : unsigned(15 downto 0);
@@ -1033,17 +1039,17 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_rd0_p1 : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd01_p1 : unsigned(3 downto 0) := unsigned'("0001");
   signal mux_res_take_1 : unsigned(3 downto 0);
-  signal res_q_rd01_p1_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd01_p1_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take_2 : unsigned(3 downto 0);
   signal res_q_rd0_p2 : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd01_p2 : unsigned(3 downto 0) := unsigned'("0001");
   signal mux_res_take_3 : unsigned(3 downto 0);
-  signal res_q_rd01_p2_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd01_p2_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take_4 : unsigned(3 downto 0);
   signal res_q_rd0_p3 : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd01_p3 : unsigned(3 downto 0) := unsigned'("0001");
   signal mux_res_take_5 : unsigned(3 downto 0);
-  signal res_q_rd01_p3_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd01_p3_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take_6 : unsigned(3 downto 0);
   signal res_q_q_stay0_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal res_q_q_stay0_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
@@ -1066,17 +1072,17 @@ architecture rtl of fxrt_core_sf0a3f4_rtl is
   signal res_q_rd1_p1 : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd11_p1 : unsigned(3 downto 0) := unsigned'("0001");
   signal mux_res_take_7 : unsigned(3 downto 0);
-  signal res_q_rd11_p1_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd11_p1_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take_8 : unsigned(3 downto 0);
   signal res_q_rd1_p2 : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd11_p2 : unsigned(3 downto 0) := unsigned'("0001");
   signal mux_res_take_9 : unsigned(3 downto 0);
-  signal res_q_rd11_p2_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd11_p2_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take_10 : unsigned(3 downto 0);
   signal res_q_rd1_p3 : unsigned(3 downto 0) := unsigned'("0000");
   signal res_q_rd11_p3 : unsigned(3 downto 0) := unsigned'("0001");
   signal mux_res_take_11 : unsigned(3 downto 0);
-  signal res_q_rd11_p3_plus_k_1_4 : unsigned(3 downto 0);
+  signal res_q_rd11_p3_plus_k_1_2 : unsigned(3 downto 0);
   signal mux_res_take_12 : unsigned(3 downto 0);
   signal res_q_q_stay1_g3 : unsigned(15 downto 0) := unsigned'("0000000000000000");
   signal res_q_q_stay1_g2 : unsigned(15 downto 0) := unsigned'("0000000000000000");
@@ -1134,41 +1140,44 @@ begin
   regs : process (clk)
   begin
     if rising_edge(clk) then
+      if k_1 = "1" then
+        box_done_slot_mem(to_integer(box_done_slot_wp)) <= box_slot;
+      end if;
       if accept_w = "1" then
-        ray_o_g0(to_integer(accept_w_slot)) <= bits_cat_17;
+        ray_o_g0(to_integer(accept_w_slot)) <= bits_cat_19;
       end if;
       if accept_w_c1 = "1" then
-        ray_o_g1(to_integer(accept_w_slot_c1)) <= bits_cat_17_1;
+        ray_o_g1(to_integer(accept_w_slot_c1)) <= bits_cat_19_1;
       end if;
       if accept_w_c2 = "1" then
-        ray_o_g2(to_integer(accept_w_slot_c2)) <= bits_cat_17_2;
+        ray_o_g2(to_integer(accept_w_slot_c2)) <= bits_cat_19_2;
       end if;
       if accept_w_c3 = "1" then
-        ray_o_g3(to_integer(accept_w_slot_c3)) <= bits_cat_17_3;
+        ray_o_g3(to_integer(accept_w_slot_c3)) <= bits_cat_19_3;
       end if;
       if accept_w_c4 = "1" then
-        ray_o_g4(to_integer(accept_w_slot_c4)) <= bits_cat_17_4;
+        ray_o_g4(to_integer(accept_w_slot_c4)) <= bits_cat_19_4;
       end if;
       if accept_w_c5 = "1" then
-        ray_o_g5(to_integer(accept_w_slot_c5)) <= bits_cat_17_5;
+        ray_o_g5(to_integer(accept_w_slot_c5)) <= bits_cat_19_5;
       end if;
       if accept_w_c6 = "1" then
-        ray_w_g0(to_integer(accept_w_slot_c6)) <= bits_cat_18;
+        ray_w_g0(to_integer(accept_w_slot_c6)) <= bits_cat_20;
       end if;
       if accept_w_c7 = "1" then
-        ray_w_g1(to_integer(accept_w_slot_c7)) <= bits_cat_18_1;
+        ray_w_g1(to_integer(accept_w_slot_c7)) <= bits_cat_20_1;
       end if;
       if accept_w_c8 = "1" then
-        ray_w_g2(to_integer(accept_w_slot_c8)) <= bits_cat_18_2;
+        ray_w_g2(to_integer(accept_w_slot_c8)) <= bits_cat_20_2;
       end if;
       if accept_w_c9 = "1" then
-        ray_w_g3(to_integer(accept_w_slot_c9)) <= bits_cat_18_3;
+        ray_w_g3(to_integer(accept_w_slot_c9)) <= bits_cat_20_3;
       end if;
       if accept_w_c10 = "1" then
-        ray_w_g4(to_integer(accept_w_slot_c10)) <= bits_cat_18_4;
+        ray_w_g4(to_integer(accept_w_slot_c10)) <= bits_cat_20_4;
       end if;
       if accept_w_c11 = "1" then
-        ray_w_g5(to_integer(accept_w_slot_c11)) <= bits_cat_18_5;
+        ray_w_g5(to_integer(accept_w_slot_c11)) <= bits_cat_20_5;
       end if;
       if res_q_push = "1" then
         res_q_mem0_g0(to_integer(res_q_wr)) <= bits_res_q_din0;
@@ -1777,7 +1786,8 @@ begin
   bits_box_d3 <= unsigned(box_d3(31 downto 31));
   box_miss <= or_11 or bits_box_d3;
   box_last <= plane_t_valid and plane_t_last;
-  box_done_slot <= box_done_slot_sr(11);
+  plus_13 <= box_done_slot_wp + k_1_2;
+  plus_14 <= box_done_slot_wp + k_7;
 
   box_exit_regs : process (clk)
   begin
@@ -1866,8 +1876,9 @@ begin
       else
         box_done <= box_last;
       end if;
-      box_done_slot_sr(2 to 11) <= box_done_slot_sr(1 to 10);
-      box_done_slot_sr(1) <= box_slot;
+      box_done_slot_wp <= plus_13;
+      box_done_slot_rp <= plus_14;
+      box_done_slot <= box_done_slot_mem(to_integer(box_done_slot_rp));
     end if;
   end process box_exit_regs;
 
@@ -1889,16 +1900,16 @@ begin
   u0_node_word <= u_node_rom_0_data;
   u1_node_word <= u_node_rom_0_data_b;
   bits_box_done_slot <= unsigned(box_done_slot(6 downto 6));
-  eq_13 <= "1" when bits_box_done_slot = k_0 else "0";
-  u0_new <= box_done and eq_13;
+  eq_15 <= "1" when bits_box_done_slot = k_0 else "0";
+  u0_new <= box_done and eq_15;
   bits_free_slot <= unsigned(free_slot(6 downto 6));
   bits_free_slot_eq_k_0 <= "1" when bits_free_slot = k_0 else "0";
   u0_free <= free_valid and bits_free_slot_eq_k_0;
   bits_box_done_slot_1 <= unsigned(box_done_slot(5 downto 0));
   bits_free_slot_1 <= unsigned(free_slot(5 downto 0));
   bits_box_done_slot_2 <= unsigned(box_done_slot(6 downto 6));
-  eq_15 <= "1" when bits_box_done_slot_2 = k_1 else "0";
-  u1_new <= box_done and eq_15;
+  eq_17 <= "1" when bits_box_done_slot_2 = k_1 else "0";
+  u1_new <= box_done and eq_17;
   bits_free_slot_2 <= unsigned(free_slot(6 downto 6));
   bits_free_slot_2_eq_k_1 <= "1" when bits_free_slot_2 = k_1 else "0";
   u1_free <= free_valid and bits_free_slot_2_eq_k_1;
@@ -1906,23 +1917,23 @@ begin
   bits_free_slot_3 <= unsigned(free_slot(5 downto 0));
 
   -- stage ray_rams: the accepted ray into the core's ray RAMs, by global slot
-  cat_17 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
-  bits_cat_17 <= unsigned(cat_17(15 downto 0));
-  bits_cat_17_1 <= unsigned(cat_17(31 downto 16));
-  bits_cat_17_2 <= unsigned(cat_17(47 downto 32));
-  bits_cat_17_3 <= unsigned(cat_17(63 downto 48));
-  bits_cat_17_4 <= unsigned(cat_17(79 downto 64));
-  bits_cat_17_5 <= unsigned(cat_17(86 downto 80));
+  cat_19 <= unsigned(std_logic_vector'(std_logic_vector(acc_in_oz) & std_logic_vector(acc_in_oy) & std_logic_vector(acc_in_ox)));
+  bits_cat_19 <= unsigned(cat_19(15 downto 0));
+  bits_cat_19_1 <= unsigned(cat_19(31 downto 16));
+  bits_cat_19_2 <= unsigned(cat_19(47 downto 32));
+  bits_cat_19_3 <= unsigned(cat_19(63 downto 48));
+  bits_cat_19_4 <= unsigned(cat_19(79 downto 64));
+  bits_cat_19_5 <= unsigned(cat_19(86 downto 80));
   u_acc_in_wz <= unsigned(acc_in_wz);
   u_acc_in_wy <= unsigned(acc_in_wy);
   u_acc_in_wx <= unsigned(acc_in_wx);
-  cat_18 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
-  bits_cat_18 <= unsigned(cat_18(15 downto 0));
-  bits_cat_18_1 <= unsigned(cat_18(31 downto 16));
-  bits_cat_18_2 <= unsigned(cat_18(47 downto 32));
-  bits_cat_18_3 <= unsigned(cat_18(63 downto 48));
-  bits_cat_18_4 <= unsigned(cat_18(79 downto 64));
-  bits_cat_18_5 <= unsigned(cat_18(95 downto 80));
+  cat_20 <= unsigned(std_logic_vector'(std_logic_vector(u_acc_in_wz) & std_logic_vector(u_acc_in_wy) & std_logic_vector(u_acc_in_wx)));
+  bits_cat_20 <= unsigned(cat_20(15 downto 0));
+  bits_cat_20_1 <= unsigned(cat_20(31 downto 16));
+  bits_cat_20_2 <= unsigned(cat_20(47 downto 32));
+  bits_cat_20_3 <= unsigned(cat_20(63 downto 48));
+  bits_cat_20_4 <= unsigned(cat_20(79 downto 64));
+  bits_cat_20_5 <= unsigned(cat_20(95 downto 80));
 
   -- stage leaf_stream: the leaf in flight, and the next leaf from the units' queues in turn
   leaf_last_entry <= leaf_active and leaf_last;
@@ -1952,43 +1963,43 @@ begin
       k_1 when "0",
       k_0 when "1",
       k_0 when others;
-  or_23 <= case_leaf_turn_2 or case_leaf_turn;
+  or_25 <= case_leaf_turn_2 or case_leaf_turn;
   mux_case_leaf_turn_2 <= case_leaf_turn_3 when case_leaf_turn_2 = "1" else case_leaf_turn_1;
-  leaf_take <= leaf_can_take and or_23;
-  eq_24 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
-  u0_leaf_take <= leaf_take and eq_24;
+  leaf_take <= leaf_can_take and or_25;
+  eq_26 <= "1" when mux_case_leaf_turn_2 = k_0 else "0";
+  u0_leaf_take <= leaf_take and eq_26;
   not_u0_leaf_take <= not u0_leaf_take;
-  and_25 <= u0_leaf_buf_valid and not_u0_leaf_take;
-  u0_leaf_fill_or_and_25 <= u0_leaf_fill or and_25;
-  eq_26 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
-  u1_leaf_take <= leaf_take and eq_26;
+  and_27 <= u0_leaf_buf_valid and not_u0_leaf_take;
+  u0_leaf_fill_or_and_27 <= u0_leaf_fill or and_27;
+  eq_28 <= "1" when mux_case_leaf_turn_2 = k_1 else "0";
+  u1_leaf_take <= leaf_take and eq_28;
   not_u1_leaf_take <= not u1_leaf_take;
-  and_27 <= u1_leaf_buf_valid and not_u1_leaf_take;
-  u1_leaf_fill_or_and_27 <= u1_leaf_fill or and_27;
+  and_29 <= u1_leaf_buf_valid and not_u1_leaf_take;
+  u1_leaf_fill_or_and_29 <= u1_leaf_fill or and_29;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2 <=
       u0_buf_leaf_slot when "0",
       u1_buf_leaf_slot when "1",
       u0_buf_leaf_slot when others;
-  cat_28 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
+  cat_30 <= unsigned(std_logic_vector'(std_logic_vector(mux_case_leaf_turn_2) & std_logic_vector(case_mux_case_leaf_turn_2)));
   not_leaf_last_entry <= not leaf_last_entry;
-  and_29 <= leaf_active and not_leaf_last_entry;
-  leaf_take_or_and_29 <= leaf_take or and_29;
-  mux_leaf_take <= cat_28 when leaf_take = "1" else leaf_slot;
+  and_31 <= leaf_active and not_leaf_last_entry;
+  leaf_take_or_and_31 <= leaf_take or and_31;
+  mux_leaf_take <= cat_30 when leaf_take = "1" else leaf_slot;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_1 <=
       u0_buf_leaf_first when "0",
       u1_buf_leaf_first when "1",
       u0_buf_leaf_first when others;
-  leaf_ptr_plus_k_1_2 <= leaf_ptr + k_1_2;
-  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_2;
+  leaf_ptr_plus_k_1_3 <= leaf_ptr + k_1_3;
+  mux_leaf_take_1 <= case_mux_case_leaf_turn_2_1 when leaf_take = "1" else leaf_ptr_plus_k_1_3;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_2 <=
       u0_buf_leaf_count when "0",
       u1_buf_leaf_count when "1",
       u0_buf_leaf_count when others;
-  leaf_left_minus_k_1_3 <= leaf_left - k_1_3;
-  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_3;
+  leaf_left_minus_k_1_4 <= leaf_left - k_1_4;
+  mux_leaf_take_2 <= case_mux_case_leaf_turn_2_2 when leaf_take = "1" else leaf_left_minus_k_1_4;
   with mux_case_leaf_turn_2 select
     case_mux_case_leaf_turn_2_3 <=
       u0_buf_leaf_tmin when "0",
@@ -2006,9 +2017,9 @@ begin
       u0_buf_leaf_count when "0",
       u1_buf_leaf_count when "1",
       u0_buf_leaf_count when others;
-  eq_30 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_3 else "0";
+  eq_32 <= "1" when case_mux_case_leaf_turn_2_5 = k_1_4 else "0";
   leaf_left_eq_k_2 <= "1" when leaf_left = k_2 else "0";
-  mux_leaf_take_5 <= eq_30 when leaf_take = "1" else leaf_left_eq_k_2;
+  mux_leaf_take_5 <= eq_32 when leaf_take = "1" else leaf_left_eq_k_2;
 
   leaf_stream_regs : process (clk)
   begin
@@ -2016,7 +2027,7 @@ begin
       if rst = '1' then
         leaf_active <= unsigned'("0");
       else
-        leaf_active <= leaf_take_or_and_29;
+        leaf_active <= leaf_take_or_and_31;
       end if;
       leaf_slot <= mux_leaf_take;
       leaf_ptr <= mux_leaf_take_1;
@@ -2033,7 +2044,7 @@ begin
       if rst = '1' then
         u0_leaf_buf_valid <= unsigned'("0");
       else
-        u0_leaf_buf_valid <= u0_leaf_fill_or_and_25;
+        u0_leaf_buf_valid <= u0_leaf_fill_or_and_27;
       end if;
       if u0_leaf_fill = "1" then
         u0_buf_leaf_slot <= u_traverse_0_leaf_slot;
@@ -2053,7 +2064,7 @@ begin
       if rst = '1' then
         u1_leaf_buf_valid <= unsigned'("0");
       else
-        u1_leaf_buf_valid <= u1_leaf_fill_or_and_27;
+        u1_leaf_buf_valid <= u1_leaf_fill_or_and_29;
       end if;
       if u1_leaf_fill = "1" then
         u1_buf_leaf_slot <= u_traverse_1_leaf_slot;
@@ -2074,7 +2085,7 @@ begin
   end process leaf_stream_regs;
 
   -- stage emission: the leaf ROM, the triangle ROMs and the slot's ray, into the intersection pipeline
-  cat_31 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
+  cat_33 <= unsigned(std_logic_vector'(std_logic_vector(leaf_last_entry) & std_logic_vector(leaf_first_entry) & std_logic_vector(leaf_slot) & std_logic_vector(leaf_sp) & std_logic_vector(leaf_tmin) & std_logic_vector(k_0_4)));
   emit_tag <= emit_tag_sr(3);
   bits_emit_tag <= unsigned(emit_tag(58 downto 13));
   emit_tag_tri <= unsigned(std_logic_vector'(std_logic_vector(bits_emit_tag) & std_logic_vector(u_leaf_rom_data)));
@@ -2115,7 +2126,7 @@ begin
   begin
     if rising_edge(clk) then
       emit_tag_sr(2 to 3) <= emit_tag_sr(1 to 2);
-      emit_tag_sr(1) <= cat_31;
+      emit_tag_sr(1) <= cat_33;
       if rst = '1' then
         emit_valid_1 <= unsigned'("0");
       else
@@ -2196,18 +2207,18 @@ begin
 
   -- stage done: rays done: taken from the units' done queues, lowest unit first, into the closest-hit unit
   not_u0_done_took <= not u0_done_took;
-  and_35 <= u_traverse_0_done_valid and not_u0_done_took;
-  u0_done_avail <= and_35 and res_credit_ok;
+  and_37 <= u_traverse_0_done_valid and not_u0_done_took;
+  u0_done_avail <= and_37 and res_credit_ok;
   not_u1_done_took <= not u1_done_took;
-  and_36 <= u_traverse_1_done_valid and not_u1_done_took;
-  u1_done_avail <= and_36 and res_credit_ok;
-  cat_37 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
+  and_38 <= u_traverse_1_done_valid and not_u1_done_took;
+  u1_done_avail <= and_38 and res_credit_ok;
+  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(k_0) & std_logic_vector(u_traverse_0_done_slot)));
   not_u0_done_avail <= not u0_done_avail;
   u1_done_take <= u1_done_avail and not_u0_done_avail;
-  cat_39 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
-  mux_u0_done_avail <= cat_37 when u0_done_avail = "1" else cat_39;
-  or_40 <= u0_done_avail or u1_done_avail;
-  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(done_slot_r_c8) & std_logic_vector(done_slot_r_c7) & std_logic_vector(done_slot_r_c6) & std_logic_vector(done_slot_r_c5) & std_logic_vector(done_slot_r_c4) & std_logic_vector(done_slot_r_c3) & std_logic_vector(done_slot_r_c2) & std_logic_vector(done_slot_r_c1)));
+  cat_41 <= unsigned(std_logic_vector'(std_logic_vector(k_1) & std_logic_vector(u_traverse_1_done_slot)));
+  mux_u0_done_avail <= cat_39 when u0_done_avail = "1" else cat_41;
+  or_42 <= u0_done_avail or u1_done_avail;
+  cat_43 <= unsigned(std_logic_vector'(std_logic_vector(done_slot_r_c8) & std_logic_vector(done_slot_r_c7) & std_logic_vector(done_slot_r_c6) & std_logic_vector(done_slot_r_c5) & std_logic_vector(done_slot_r_c4) & std_logic_vector(done_slot_r_c3) & std_logic_vector(done_slot_r_c2) & std_logic_vector(done_slot_r_c1)));
 
   done_regs : process (clk)
   begin
@@ -2230,7 +2241,7 @@ begin
       if rst = '1' then
         done_valid_r <= unsigned'("0");
       else
-        done_valid_r <= or_40;
+        done_valid_r <= or_42;
       end if;
     end if;
   end process done_regs;
@@ -2253,14 +2264,14 @@ begin
   end process done_slot_r_copies_regs;
 
   -- stage result_queue: the results, queued for the consumer (`result_queue.rs`)
-  cat_42 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
-  cat_43 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
+  cat_44 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_id) & std_logic_vector(u_closest_res_hit) & std_logic_vector(u_closest_res_tri) & std_logic_vector(u_closest_res_t)));
+  cat_45 <= unsigned(std_logic_vector'(std_logic_vector(u_closest_res_u) & std_logic_vector(u_closest_res_v)));
   res_take <= res_take_c;
-  res_q_wr_plus_k_1_4 <= res_q_wr + k_1_4;
-  mux_res_q_push <= res_q_wr_plus_k_1_4 when res_q_push = "1" else res_q_wr;
+  res_q_wr_plus_k_1_2 <= res_q_wr + k_1_2;
+  mux_res_q_push <= res_q_wr_plus_k_1_2 when res_q_push = "1" else res_q_wr;
   res_q_rd_next <= res_q_rd1 when res_take = "1" else res_q_rd;
-  res_q_rd1_plus_k_1_4 <= res_q_rd1 + k_1_4;
-  mux_res_take <= res_q_rd1_plus_k_1_4 when res_take = "1" else res_q_rd1;
+  res_q_rd1_plus_k_1_2 <= res_q_rd1 + k_1_2;
+  mux_res_take <= res_q_rd1_plus_k_1_2 when res_take = "1" else res_q_rd1;
   not_res_q_push_c1 <= not res_q_push_c1;
   rs_not_res_q_push_c1 <= resize(not_res_q_push_c1, 5);
   res_q_count_if_pop <= res_q_count - rs_not_res_q_push_c1;
@@ -2269,27 +2280,27 @@ begin
   res_q_count_next <= res_q_count_if_pop when res_take = "1" else res_q_count_if_kept;
   res_q_count_eq_k_0_5 <= "1" when res_q_count = k_0_5 else "0";
   res_q_one_left <= "1" when res_q_count = k_1_5 else "0";
-  and_46 <= res_q_one_left and res_take;
-  res_q_drained <= res_q_count_eq_k_0_5 or and_46;
+  and_48 <= res_q_one_left and res_take;
+  res_q_drained <= res_q_count_eq_k_0_5 or and_48;
   res_q_bypass_c <= res_q_push_c1 and res_q_drained;
   k_1_5_lt_res_q_count <= "1" when k_1_5 < res_q_count else "0";
-  or_49 <= res_q_push_c1 or k_1_5_lt_res_q_count;
+  or_51 <= res_q_push_c1 or k_1_5_lt_res_q_count;
   not_res_take <= not res_take;
-  and_50 <= res_q_one_left and not_res_take;
-  res_q_nonempty_c <= or_49 or and_50;
+  and_52 <= res_q_one_left and not_res_take;
+  res_q_nonempty_c <= or_51 or and_52;
   bits_res_q_din0 <= unsigned(res_q_din0(15 downto 0));
   bits_res_q_din0_1 <= unsigned(res_q_din0(31 downto 16));
   bits_res_q_din0_2 <= unsigned(res_q_din0(47 downto 32));
   bits_res_q_din0_3 <= unsigned(res_q_din0(63 downto 48));
   mux_res_take_1 <= res_q_rd01_p1 when res_take = "1" else res_q_rd0_p1;
-  res_q_rd01_p1_plus_k_1_4 <= res_q_rd01_p1 + k_1_4;
-  mux_res_take_2 <= res_q_rd01_p1_plus_k_1_4 when res_take = "1" else res_q_rd01_p1;
+  res_q_rd01_p1_plus_k_1_2 <= res_q_rd01_p1 + k_1_2;
+  mux_res_take_2 <= res_q_rd01_p1_plus_k_1_2 when res_take = "1" else res_q_rd01_p1;
   mux_res_take_3 <= res_q_rd01_p2 when res_take = "1" else res_q_rd0_p2;
-  res_q_rd01_p2_plus_k_1_4 <= res_q_rd01_p2 + k_1_4;
-  mux_res_take_4 <= res_q_rd01_p2_plus_k_1_4 when res_take = "1" else res_q_rd01_p2;
+  res_q_rd01_p2_plus_k_1_2 <= res_q_rd01_p2 + k_1_2;
+  mux_res_take_4 <= res_q_rd01_p2_plus_k_1_2 when res_take = "1" else res_q_rd01_p2;
   mux_res_take_5 <= res_q_rd01_p3 when res_take = "1" else res_q_rd0_p3;
-  res_q_rd01_p3_plus_k_1_4 <= res_q_rd01_p3 + k_1_4;
-  mux_res_take_6 <= res_q_rd01_p3_plus_k_1_4 when res_take = "1" else res_q_rd01_p3;
+  res_q_rd01_p3_plus_k_1_2 <= res_q_rd01_p3 + k_1_2;
+  mux_res_take_6 <= res_q_rd01_p3_plus_k_1_2 when res_take = "1" else res_q_rd01_p3;
   res_q_q_stay0 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_stay0_g3) & std_logic_vector(res_q_q_stay0_g2) & std_logic_vector(res_q_q_stay0_g1) & std_logic_vector(res_q_q_stay0_g0)));
   res_q_q_next0 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_next0_g3) & std_logic_vector(res_q_q_next0_g2) & std_logic_vector(res_q_q_next0_g1) & std_logic_vector(res_q_q_next0_g0)));
   mux_res_q_popped <= res_q_q_next0 when res_q_popped = "1" else res_q_q_stay0;
@@ -2299,14 +2310,14 @@ begin
   bits_res_q_din1_2 <= unsigned(res_q_din1(47 downto 32));
   bits_res_q_din1_3 <= unsigned(res_q_din1(63 downto 48));
   mux_res_take_7 <= res_q_rd11_p1 when res_take = "1" else res_q_rd1_p1;
-  res_q_rd11_p1_plus_k_1_4 <= res_q_rd11_p1 + k_1_4;
-  mux_res_take_8 <= res_q_rd11_p1_plus_k_1_4 when res_take = "1" else res_q_rd11_p1;
+  res_q_rd11_p1_plus_k_1_2 <= res_q_rd11_p1 + k_1_2;
+  mux_res_take_8 <= res_q_rd11_p1_plus_k_1_2 when res_take = "1" else res_q_rd11_p1;
   mux_res_take_9 <= res_q_rd11_p2 when res_take = "1" else res_q_rd1_p2;
-  res_q_rd11_p2_plus_k_1_4 <= res_q_rd11_p2 + k_1_4;
-  mux_res_take_10 <= res_q_rd11_p2_plus_k_1_4 when res_take = "1" else res_q_rd11_p2;
+  res_q_rd11_p2_plus_k_1_2 <= res_q_rd11_p2 + k_1_2;
+  mux_res_take_10 <= res_q_rd11_p2_plus_k_1_2 when res_take = "1" else res_q_rd11_p2;
   mux_res_take_11 <= res_q_rd11_p3 when res_take = "1" else res_q_rd1_p3;
-  res_q_rd11_p3_plus_k_1_4 <= res_q_rd11_p3 + k_1_4;
-  mux_res_take_12 <= res_q_rd11_p3_plus_k_1_4 when res_take = "1" else res_q_rd11_p3;
+  res_q_rd11_p3_plus_k_1_2 <= res_q_rd11_p3 + k_1_2;
+  mux_res_take_12 <= res_q_rd11_p3_plus_k_1_2 when res_take = "1" else res_q_rd11_p3;
   res_q_q_stay1 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_stay1_g3) & std_logic_vector(res_q_q_stay1_g2) & std_logic_vector(res_q_q_stay1_g1) & std_logic_vector(res_q_q_stay1_g0)));
   res_q_q_next1 <= unsigned(std_logic_vector'(std_logic_vector(res_q_q_next1_g3) & std_logic_vector(res_q_q_next1_g2) & std_logic_vector(res_q_q_next1_g1) & std_logic_vector(res_q_q_next1_g0)));
   mux_res_q_popped_1 <= res_q_q_next1 when res_q_popped = "1" else res_q_q_stay1;
@@ -2373,7 +2384,7 @@ begin
       else
         res_q_nonempty <= res_q_nonempty_c;
       end if;
-      res_q_din0 <= cat_42;
+      res_q_din0 <= cat_44;
       if rst = '1' then
         res_q_rd0_p1 <= unsigned'("0000");
       else
@@ -2415,7 +2426,7 @@ begin
       if res_q_push = "1" then
         res_q_din_r0 <= res_q_din0;
       end if;
-      res_q_din1 <= cat_43;
+      res_q_din1 <= cat_45;
       if rst = '1' then
         res_q_rd1_p1 <= unsigned'("0000");
       else
@@ -2732,7 +2743,7 @@ begin
       id => acc_in_ray_id,
       done_valid => done_valid_r,
       done_slot => done_slot_r,
-      done_slot_copies => cat_41,
+      done_slot_copies => cat_43,
       merge_valid0 => u_closest_merge_valid0,
       merge_slot0 => u_closest_merge_slot0,
       merge_hit0 => u_closest_merge_hit0,

@@ -8,6 +8,12 @@ module fxrt_div_n29_a63_b34_se (
   output wire [0:0] ok
 );
 
+  (* ram_style = "distributed" *) reg [0:0] s2_err_d30_mem [0:31];
+  initial $readmemh("fxrt_div_n29_a63_b34_se_s2_err_d30_mem.hex", s2_err_d30_mem);
+
+  (* ram_style = "distributed" *) reg [0:0] overflow_d30_mem [0:31];
+  initial $readmemh("fxrt_div_n29_a63_b34_se_overflow_d30_mem.hex", overflow_d30_mem);
+
   // not in a stage or state machine
 
   // stage s1_negations: signs, zero tests by bytes, both operands negated
@@ -717,23 +723,32 @@ module fxrt_div_n29_a63_b34_se (
   reg [0:0] s32_zero = 1'h0;
 
   // stage s33_result: the result flag
-  (* mem2reg *) reg [0:0] s2_err_d30_sr [1:30];
-  integer s2_err_d30_i;
-  initial for (s2_err_d30_i = 1; s2_err_d30_i <= 30; s2_err_d30_i = s2_err_d30_i + 1) s2_err_d30_sr[s2_err_d30_i] = 1'h0;
-  wire [0:0] s2_err_d30;
-  (* mem2reg *) reg [0:0] overflow_d30_sr [1:30];
-  integer overflow_d30_i;
-  initial for (overflow_d30_i = 1; overflow_d30_i <= 30; overflow_d30_i = overflow_d30_i + 1) overflow_d30_sr[overflow_d30_i] = 1'h0;
-  wire [0:0] overflow_d30;
-  wire [0:0] or_44;
+  reg [4:0] s2_err_d30_wp = 5'h00;
+  reg [4:0] s2_err_d30_rp = 5'h00;
+  wire [4:0] k_1_1 = 5'h01;
+  wire [4:0] s2_err_d30_wp_plus_k_1_1;
+  wire [4:0] k_4 = 5'h04;
+  wire [4:0] s2_err_d30_wp_plus_k_4;
+  reg [0:0] s2_err_d30 = 1'h0;
+  reg [4:0] overflow_d30_wp = 5'h00;
+  reg [4:0] overflow_d30_rp = 5'h00;
+  wire [4:0] plus_44;
+  wire [4:0] overflow_d30_wp_plus_k_4;
+  reg [0:0] overflow_d30 = 1'h0;
+  wire [0:0] or_45;
   wire [0:0] not_s32_ge;
   wire [0:0] s32_zero_and_not_s32_ge;
-  wire [0:0] or_45;
-  wire [0:0] not_or_45;
+  wire [0:0] or_46;
+  wire [0:0] not_or_46;
   reg [29:0] s33_t = 30'h00000000;
   reg [0:0] s33_ok = 1'h0;
 
   // not in a stage or state machine
+
+  always @(posedge clk) begin : regs
+    if (k_1) s2_err_d30_mem[s2_err_d30_wp] <= s2_err;
+    if (k_1) overflow_d30_mem[overflow_d30_wp] <= overflow;
+  end
 
   // stage s1_negations: signs, zero tests by bytes, both operands negated
   assign num_neg = num < k_0;
@@ -1451,77 +1466,25 @@ module fxrt_div_n29_a63_b34_se (
   end
 
   // stage s33_result: the result flag
-  assign s2_err_d30 = s2_err_d30_sr[30];
-  assign overflow_d30 = overflow_d30_sr[30];
-  assign or_44 = s2_err_d30 | overflow_d30;
+  assign s2_err_d30_wp_plus_k_1_1 = s2_err_d30_wp + k_1_1;
+  assign s2_err_d30_wp_plus_k_4 = s2_err_d30_wp + k_4;
+  assign plus_44 = overflow_d30_wp + k_1_1;
+  assign overflow_d30_wp_plus_k_4 = overflow_d30_wp + k_4;
+  assign or_45 = s2_err_d30 | overflow_d30;
   assign not_s32_ge = ~s32_ge;
   assign s32_zero_and_not_s32_ge = s32_zero & not_s32_ge;
-  assign or_45 = or_44 | s32_zero_and_not_s32_ge;
-  assign not_or_45 = ~or_45;
+  assign or_46 = or_45 | s32_zero_and_not_s32_ge;
+  assign not_or_46 = ~or_46;
 
   always @(posedge clk) begin : s33_result_regs
-    s2_err_d30_sr[30] <= s2_err_d30_sr[29];
-    s2_err_d30_sr[29] <= s2_err_d30_sr[28];
-    s2_err_d30_sr[28] <= s2_err_d30_sr[27];
-    s2_err_d30_sr[27] <= s2_err_d30_sr[26];
-    s2_err_d30_sr[26] <= s2_err_d30_sr[25];
-    s2_err_d30_sr[25] <= s2_err_d30_sr[24];
-    s2_err_d30_sr[24] <= s2_err_d30_sr[23];
-    s2_err_d30_sr[23] <= s2_err_d30_sr[22];
-    s2_err_d30_sr[22] <= s2_err_d30_sr[21];
-    s2_err_d30_sr[21] <= s2_err_d30_sr[20];
-    s2_err_d30_sr[20] <= s2_err_d30_sr[19];
-    s2_err_d30_sr[19] <= s2_err_d30_sr[18];
-    s2_err_d30_sr[18] <= s2_err_d30_sr[17];
-    s2_err_d30_sr[17] <= s2_err_d30_sr[16];
-    s2_err_d30_sr[16] <= s2_err_d30_sr[15];
-    s2_err_d30_sr[15] <= s2_err_d30_sr[14];
-    s2_err_d30_sr[14] <= s2_err_d30_sr[13];
-    s2_err_d30_sr[13] <= s2_err_d30_sr[12];
-    s2_err_d30_sr[12] <= s2_err_d30_sr[11];
-    s2_err_d30_sr[11] <= s2_err_d30_sr[10];
-    s2_err_d30_sr[10] <= s2_err_d30_sr[9];
-    s2_err_d30_sr[9] <= s2_err_d30_sr[8];
-    s2_err_d30_sr[8] <= s2_err_d30_sr[7];
-    s2_err_d30_sr[7] <= s2_err_d30_sr[6];
-    s2_err_d30_sr[6] <= s2_err_d30_sr[5];
-    s2_err_d30_sr[5] <= s2_err_d30_sr[4];
-    s2_err_d30_sr[4] <= s2_err_d30_sr[3];
-    s2_err_d30_sr[3] <= s2_err_d30_sr[2];
-    s2_err_d30_sr[2] <= s2_err_d30_sr[1];
-    s2_err_d30_sr[1] <= s2_err;
-    overflow_d30_sr[30] <= overflow_d30_sr[29];
-    overflow_d30_sr[29] <= overflow_d30_sr[28];
-    overflow_d30_sr[28] <= overflow_d30_sr[27];
-    overflow_d30_sr[27] <= overflow_d30_sr[26];
-    overflow_d30_sr[26] <= overflow_d30_sr[25];
-    overflow_d30_sr[25] <= overflow_d30_sr[24];
-    overflow_d30_sr[24] <= overflow_d30_sr[23];
-    overflow_d30_sr[23] <= overflow_d30_sr[22];
-    overflow_d30_sr[22] <= overflow_d30_sr[21];
-    overflow_d30_sr[21] <= overflow_d30_sr[20];
-    overflow_d30_sr[20] <= overflow_d30_sr[19];
-    overflow_d30_sr[19] <= overflow_d30_sr[18];
-    overflow_d30_sr[18] <= overflow_d30_sr[17];
-    overflow_d30_sr[17] <= overflow_d30_sr[16];
-    overflow_d30_sr[16] <= overflow_d30_sr[15];
-    overflow_d30_sr[15] <= overflow_d30_sr[14];
-    overflow_d30_sr[14] <= overflow_d30_sr[13];
-    overflow_d30_sr[13] <= overflow_d30_sr[12];
-    overflow_d30_sr[12] <= overflow_d30_sr[11];
-    overflow_d30_sr[11] <= overflow_d30_sr[10];
-    overflow_d30_sr[10] <= overflow_d30_sr[9];
-    overflow_d30_sr[9] <= overflow_d30_sr[8];
-    overflow_d30_sr[8] <= overflow_d30_sr[7];
-    overflow_d30_sr[7] <= overflow_d30_sr[6];
-    overflow_d30_sr[6] <= overflow_d30_sr[5];
-    overflow_d30_sr[5] <= overflow_d30_sr[4];
-    overflow_d30_sr[4] <= overflow_d30_sr[3];
-    overflow_d30_sr[3] <= overflow_d30_sr[2];
-    overflow_d30_sr[2] <= overflow_d30_sr[1];
-    overflow_d30_sr[1] <= overflow;
+    s2_err_d30_wp <= s2_err_d30_wp_plus_k_1_1;
+    s2_err_d30_rp <= s2_err_d30_wp_plus_k_4;
+    s2_err_d30 <= s2_err_d30_mem[s2_err_d30_rp];
+    overflow_d30_wp <= plus_44;
+    overflow_d30_rp <= overflow_d30_wp_plus_k_4;
+    overflow_d30 <= overflow_d30_mem[overflow_d30_rp];
     s33_t <= s32_q;
-    s33_ok <= not_or_45;
+    s33_ok <= not_or_46;
   end
 
   fxrt_addsub_w35 u_overflow (

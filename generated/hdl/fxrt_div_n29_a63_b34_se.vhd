@@ -25,6 +25,12 @@ architecture rtl of fxrt_div_n29_a63_b34_se is
     );
   end component;
 
+  type s2_err_d30_mem_t is array (0 to 31) of unsigned(0 downto 0);
+  signal s2_err_d30_mem : s2_err_d30_mem_t := (others => (others => '0'));
+
+  type overflow_d30_mem_t is array (0 to 31) of unsigned(0 downto 0);
+  signal overflow_d30_mem : overflow_d30_mem_t := (others => (others => '0'));
+
   -- not in a stage or state machine
 
   -- stage s1_negations: signs, zero tests by bytes, both operands negated
@@ -720,22 +726,40 @@ architecture rtl of fxrt_div_n29_a63_b34_se is
   signal s32_zero : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s33_result: the result flag
-  type s2_err_d30_sr_t is array (1 to 30) of unsigned(0 downto 0);
-  signal s2_err_d30_sr : s2_err_d30_sr_t := (others => (others => '0'));
-  signal s2_err_d30 : unsigned(0 downto 0);
-  type overflow_d30_sr_t is array (1 to 30) of unsigned(0 downto 0);
-  signal overflow_d30_sr : overflow_d30_sr_t := (others => (others => '0'));
-  signal overflow_d30 : unsigned(0 downto 0);
-  signal or_44 : unsigned(0 downto 0);
+  signal s2_err_d30_wp : unsigned(4 downto 0) := unsigned'("00000");
+  signal s2_err_d30_rp : unsigned(4 downto 0) := unsigned'("00000");
+  constant k_1_1 : unsigned(4 downto 0) := unsigned'("00001");
+  signal s2_err_d30_wp_plus_k_1_1 : unsigned(4 downto 0);
+  constant k_4 : unsigned(4 downto 0) := unsigned'("00100");
+  signal s2_err_d30_wp_plus_k_4 : unsigned(4 downto 0);
+  signal s2_err_d30 : unsigned(0 downto 0) := unsigned'("0");
+  signal overflow_d30_wp : unsigned(4 downto 0) := unsigned'("00000");
+  signal overflow_d30_rp : unsigned(4 downto 0) := unsigned'("00000");
+  signal plus_44 : unsigned(4 downto 0);
+  signal overflow_d30_wp_plus_k_4 : unsigned(4 downto 0);
+  signal overflow_d30 : unsigned(0 downto 0) := unsigned'("0");
+  signal or_45 : unsigned(0 downto 0);
   signal not_s32_ge : unsigned(0 downto 0);
   signal s32_zero_and_not_s32_ge : unsigned(0 downto 0);
-  signal or_45 : unsigned(0 downto 0);
-  signal not_or_45 : unsigned(0 downto 0);
+  signal or_46 : unsigned(0 downto 0);
+  signal not_or_46 : unsigned(0 downto 0);
   signal s33_t : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal s33_ok : unsigned(0 downto 0) := unsigned'("0");
 begin
 
   -- not in a stage or state machine
+
+  regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if k_1 = "1" then
+        s2_err_d30_mem(to_integer(s2_err_d30_wp)) <= s2_err;
+      end if;
+      if k_1 = "1" then
+        overflow_d30_mem(to_integer(overflow_d30_wp)) <= overflow;
+      end if;
+    end if;
+  end process regs;
 
   -- stage s1_negations: signs, zero tests by bytes, both operands negated
   num_neg <= "1" when num < k_0 else "0";
@@ -1549,23 +1573,27 @@ begin
   end process s32_q29_regs;
 
   -- stage s33_result: the result flag
-  s2_err_d30 <= s2_err_d30_sr(30);
-  overflow_d30 <= overflow_d30_sr(30);
-  or_44 <= s2_err_d30 or overflow_d30;
+  s2_err_d30_wp_plus_k_1_1 <= s2_err_d30_wp + k_1_1;
+  s2_err_d30_wp_plus_k_4 <= s2_err_d30_wp + k_4;
+  plus_44 <= overflow_d30_wp + k_1_1;
+  overflow_d30_wp_plus_k_4 <= overflow_d30_wp + k_4;
+  or_45 <= s2_err_d30 or overflow_d30;
   not_s32_ge <= not s32_ge;
   s32_zero_and_not_s32_ge <= s32_zero and not_s32_ge;
-  or_45 <= or_44 or s32_zero_and_not_s32_ge;
-  not_or_45 <= not or_45;
+  or_46 <= or_45 or s32_zero_and_not_s32_ge;
+  not_or_46 <= not or_46;
 
   s33_result_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s2_err_d30_sr(2 to 30) <= s2_err_d30_sr(1 to 29);
-      s2_err_d30_sr(1) <= s2_err;
-      overflow_d30_sr(2 to 30) <= overflow_d30_sr(1 to 29);
-      overflow_d30_sr(1) <= overflow;
+      s2_err_d30_wp <= s2_err_d30_wp_plus_k_1_1;
+      s2_err_d30_rp <= s2_err_d30_wp_plus_k_4;
+      s2_err_d30 <= s2_err_d30_mem(to_integer(s2_err_d30_rp));
+      overflow_d30_wp <= plus_44;
+      overflow_d30_rp <= overflow_d30_wp_plus_k_4;
+      overflow_d30 <= overflow_d30_mem(to_integer(overflow_d30_rp));
       s33_t <= s32_q;
-      s33_ok <= not_or_45;
+      s33_ok <= not_or_46;
     end if;
   end process s33_result_regs;
 

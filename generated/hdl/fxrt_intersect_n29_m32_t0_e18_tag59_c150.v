@@ -29,6 +29,42 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   output wire [31:0] v
 );
 
+  (* ram_style = "distributed" *) reg [31:0] s2_w_p_d41_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s2_w_p_d41_mem.hex", s2_w_p_d41_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] s2_w_q_d41_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s2_w_q_d41_mem.hex", s2_w_q_d41_mem);
+
+  (* ram_style = "distributed" *) reg [29:0] kp0_d5_d42_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_kp0_d5_d42_mem.hex", kp0_d5_d42_mem);
+
+  (* ram_style = "distributed" *) reg [29:0] kq0_d5_d42_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_kq0_d5_d42_mem.hex", kq0_d5_d42_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] s1_e1p_d49_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s1_e1p_d49_mem.hex", s1_e1p_d49_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] s1_e1q_d49_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s1_e1q_d49_mem.hex", s1_e1q_d49_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] s1_e2q_d49_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s1_e2q_d49_mem.hex", s1_e2q_d49_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] s1_e2p_d49_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s1_e2p_d49_mem.hex", s1_e2p_d49_mem);
+
+  (* ram_style = "distributed" *) reg [0:0] u_div_ok_d16_mem [0:15];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_u_div_ok_d16_mem.hex", u_div_ok_d16_mem);
+
+  (* ram_style = "distributed" *) reg [29:0] u_div_t_1_d17_mem [0:31];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_u_div_t_1_d17_mem.hex", u_div_t_1_d17_mem);
+
+  (* ram_style = "distributed" *) reg [26:0] s1_tag_d59_p1_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s1_tag_d59_p1_mem.hex", s1_tag_d59_p1_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] s1_tag_d59_p0_mem [0:63];
+  initial $readmemh("fxrt_intersect_n29_m32_t0_e18_tag59_c150_s1_tag_d59_p0_mem.hex", s1_tag_d59_p0_mem);
+
   // not in a stage or state machine
 
   // stage s1_inputs: register the inputs
@@ -151,14 +187,23 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire [0:0] u_div_ok;
   wire [30:0] rs_u_div_t_1;
   wire signed [30:0] s_rs_u_div_t_1;
-  (* mem2reg *) reg signed [31:0] s2_w_p_d41_sr [1:41];
-  integer s2_w_p_d41_i;
-  initial for (s2_w_p_d41_i = 1; s2_w_p_d41_i <= 41; s2_w_p_d41_i = s2_w_p_d41_i + 1) s2_w_p_d41_sr[s2_w_p_d41_i] = 32'sh00000000;
-  wire signed [31:0] s2_w_p_d41;
-  (* mem2reg *) reg signed [31:0] s2_w_q_d41_sr [1:41];
-  integer s2_w_q_d41_i;
-  initial for (s2_w_q_d41_i = 1; s2_w_q_d41_i <= 41; s2_w_q_d41_i = s2_w_q_d41_i + 1) s2_w_q_d41_sr[s2_w_q_d41_i] = 32'sh00000000;
-  wire signed [31:0] s2_w_q_d41;
+  wire [31:0] bits_s2_w_p;
+  reg [5:0] s2_w_p_d41_wp = 6'h00;
+  reg [5:0] s2_w_p_d41_rp = 6'h00;
+  wire [5:0] k_1_1 = 6'h01;
+  wire [5:0] s2_w_p_d41_wp_plus_k_1_1;
+  wire [5:0] k_25 = 6'h19;
+  wire [5:0] s2_w_p_d41_wp_plus_k_25;
+  wire [0:0] k_1_2 = 1'h1;
+  reg [31:0] s2_w_p_d41 = 32'h00000000;
+  wire signed [31:0] s_s2_w_p_d41;
+  wire [31:0] bits_s2_w_q;
+  reg [5:0] s2_w_q_d41_wp = 6'h00;
+  reg [5:0] s2_w_q_d41_rp = 6'h00;
+  wire [5:0] s2_w_q_d41_wp_plus_k_1_1;
+  wire [5:0] s2_w_q_d41_wp_plus_k_25;
+  reg [31:0] s2_w_q_d41 = 32'h00000000;
+  wire signed [31:0] s_s2_w_q_d41;
   wire signed [62:0] u_moved_products_p0;
   wire signed [62:0] u_moved_products_p1;
   wire signed [62:0] k_1073741824_1 = 63'sh0000000040000000;
@@ -174,40 +219,60 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   /* verilator lint_on UNUSEDSIGNAL */
 
   // stage s50_point: kp, kq: the hit point relative to the first vertex
-  (* mem2reg *) reg signed [29:0] kp0_d5_d42_sr [1:42];
-  integer kp0_d5_d42_i;
-  initial for (kp0_d5_d42_i = 1; kp0_d5_d42_i <= 42; kp0_d5_d42_i = kp0_d5_d42_i + 1) kp0_d5_d42_sr[kp0_d5_d42_i] = 30'sh00000000;
-  wire signed [29:0] kp0_d5_d42;
-  wire signed [31:0] rs_kp0_d5_d42;
+  wire [29:0] bits_kp0_d5;
+  reg [5:0] kp0_d5_d42_wp = 6'h00;
+  reg [5:0] kp0_d5_d42_rp = 6'h00;
+  wire [5:0] kp0_d5_d42_wp_plus_k_1_1;
+  wire [5:0] k_24 = 6'h18;
+  wire [5:0] kp0_d5_d42_wp_plus_k_24;
+  reg [29:0] kp0_d5_d42 = 30'h00000000;
+  wire signed [29:0] s_kp0_d5_d42;
+  wire signed [31:0] rs_s_kp0_d5_d42;
   wire signed [31:0] rs_s49_tp;
   wire signed [31:0] kp;
-  (* mem2reg *) reg signed [29:0] kq0_d5_d42_sr [1:42];
-  integer kq0_d5_d42_i;
-  initial for (kq0_d5_d42_i = 1; kq0_d5_d42_i <= 42; kq0_d5_d42_i = kq0_d5_d42_i + 1) kq0_d5_d42_sr[kq0_d5_d42_i] = 30'sh00000000;
-  wire signed [29:0] kq0_d5_d42;
-  wire signed [31:0] rs_kq0_d5_d42;
+  wire [29:0] bits_kq0_d5;
+  reg [5:0] kq0_d5_d42_wp = 6'h00;
+  reg [5:0] kq0_d5_d42_rp = 6'h00;
+  wire [5:0] kq0_d5_d42_wp_plus_k_1_1;
+  wire [5:0] kq0_d5_d42_wp_plus_k_24;
+  reg [29:0] kq0_d5_d42 = 30'h00000000;
+  wire signed [29:0] s_kq0_d5_d42;
+  wire signed [31:0] rs_s_kq0_d5_d42;
   wire signed [31:0] rs_s49_tq;
   wire signed [31:0] kq;
   reg signed [31:0] s50_kp = 32'sh00000000;
   reg signed [31:0] s50_kq = 32'sh00000000;
 
   // stage s56_bary: e1p·kq, e1q·kp, e2q·kp, e2p·kq
-  (* mem2reg *) reg signed [31:0] s1_e1p_d49_sr [1:49];
-  integer s1_e1p_d49_i;
-  initial for (s1_e1p_d49_i = 1; s1_e1p_d49_i <= 49; s1_e1p_d49_i = s1_e1p_d49_i + 1) s1_e1p_d49_sr[s1_e1p_d49_i] = 32'sh00000000;
-  wire signed [31:0] s1_e1p_d49;
-  (* mem2reg *) reg signed [31:0] s1_e1q_d49_sr [1:49];
-  integer s1_e1q_d49_i;
-  initial for (s1_e1q_d49_i = 1; s1_e1q_d49_i <= 49; s1_e1q_d49_i = s1_e1q_d49_i + 1) s1_e1q_d49_sr[s1_e1q_d49_i] = 32'sh00000000;
-  wire signed [31:0] s1_e1q_d49;
-  (* mem2reg *) reg signed [31:0] s1_e2q_d49_sr [1:49];
-  integer s1_e2q_d49_i;
-  initial for (s1_e2q_d49_i = 1; s1_e2q_d49_i <= 49; s1_e2q_d49_i = s1_e2q_d49_i + 1) s1_e2q_d49_sr[s1_e2q_d49_i] = 32'sh00000000;
-  wire signed [31:0] s1_e2q_d49;
-  (* mem2reg *) reg signed [31:0] s1_e2p_d49_sr [1:49];
-  integer s1_e2p_d49_i;
-  initial for (s1_e2p_d49_i = 1; s1_e2p_d49_i <= 49; s1_e2p_d49_i = s1_e2p_d49_i + 1) s1_e2p_d49_sr[s1_e2p_d49_i] = 32'sh00000000;
-  wire signed [31:0] s1_e2p_d49;
+  wire [31:0] bits_s1_e1p;
+  reg [5:0] s1_e1p_d49_wp = 6'h00;
+  reg [5:0] s1_e1p_d49_rp = 6'h00;
+  wire [5:0] s1_e1p_d49_wp_plus_k_1_1;
+  wire [5:0] k_17 = 6'h11;
+  wire [5:0] s1_e1p_d49_wp_plus_k_17;
+  reg [31:0] s1_e1p_d49 = 32'h00000000;
+  wire signed [31:0] s_s1_e1p_d49;
+  wire [31:0] bits_s1_e1q;
+  reg [5:0] s1_e1q_d49_wp = 6'h00;
+  reg [5:0] s1_e1q_d49_rp = 6'h00;
+  wire [5:0] s1_e1q_d49_wp_plus_k_1_1;
+  wire [5:0] s1_e1q_d49_wp_plus_k_17;
+  reg [31:0] s1_e1q_d49 = 32'h00000000;
+  wire signed [31:0] s_s1_e1q_d49;
+  wire [31:0] bits_s1_e2q;
+  reg [5:0] s1_e2q_d49_wp = 6'h00;
+  reg [5:0] s1_e2q_d49_rp = 6'h00;
+  wire [5:0] s1_e2q_d49_wp_plus_k_1_1;
+  wire [5:0] s1_e2q_d49_wp_plus_k_17;
+  reg [31:0] s1_e2q_d49 = 32'h00000000;
+  wire signed [31:0] s_s1_e2q_d49;
+  wire [31:0] bits_s1_e2p;
+  reg [5:0] s1_e2p_d49_wp = 6'h00;
+  reg [5:0] s1_e2p_d49_rp = 6'h00;
+  wire [5:0] s1_e2p_d49_wp_plus_k_1_1;
+  wire [5:0] s1_e2p_d49_wp_plus_k_17;
+  reg [31:0] s1_e2p_d49 = 32'h00000000;
+  wire signed [31:0] s_s1_e2p_d49;
   wire signed [63:0] u_bary_products_p0;
   wire signed [63:0] u_bary_products_p1;
   wire signed [63:0] u_bary_products_p2;
@@ -302,18 +367,24 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   wire [0:0] over;
   wire [0:0] s59_neg_or_over;
   wire [0:0] not_s59_neg_or_over;
-  (* mem2reg *) reg [0:0] u_div_ok_d16_sr [1:16];
-  integer u_div_ok_d16_i;
-  initial for (u_div_ok_d16_i = 1; u_div_ok_d16_i <= 16; u_div_ok_d16_i = u_div_ok_d16_i + 1) u_div_ok_d16_sr[u_div_ok_d16_i] = 1'h0;
-  wire [0:0] u_div_ok_d16;
+  reg [3:0] u_div_ok_d16_wp = 4'h0;
+  reg [3:0] u_div_ok_d16_rp = 4'h0;
+  wire [3:0] k_1_3 = 4'h1;
+  wire [3:0] plus_30;
+  wire [3:0] k_2_1 = 4'h2;
+  wire [3:0] plus_31;
+  reg [0:0] u_div_ok_d16 = 1'h0;
   wire [0:0] hit_c;
   reg [0:0] s60_hit = 1'h0;
 
   // stage s61_result: the barycentric test; t, u, v zeroed on a miss
-  (* mem2reg *) reg [29:0] u_div_t_1_d17_sr [1:17];
-  integer u_div_t_1_d17_i;
-  initial for (u_div_t_1_d17_i = 1; u_div_t_1_d17_i <= 17; u_div_t_1_d17_i = u_div_t_1_d17_i + 1) u_div_t_1_d17_sr[u_div_t_1_d17_i] = 30'h00000000;
-  wire [29:0] u_div_t_1_d17;
+  reg [4:0] u_div_t_1_d17_wp = 5'h00;
+  reg [4:0] u_div_t_1_d17_rp = 5'h00;
+  wire [4:0] k_1_4 = 5'h01;
+  wire [4:0] plus_33;
+  wire [4:0] k_17_1 = 5'h11;
+  wire [4:0] plus_34;
+  reg [29:0] u_div_t_1_d17 = 30'h00000000;
   (* mem2reg *) reg signed [64:0] s57_u_d3_sr [1:3];
   integer s57_u_d3_i;
   initial for (s57_u_d3_i = 1; s57_u_d3_i <= 3; s57_u_d3_i = s57_u_d3_i + 1) s57_u_d3_sr[s57_u_d3_i] = 65'sh00000000000000000;
@@ -381,10 +452,20 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   reg [0:0] s1_valid_d59_57 = 1'h0;
   reg [0:0] s1_valid_d59_58 = 1'h0;
   reg [0:0] s1_valid_d59_59 = 1'h0;
-  (* mem2reg *) reg [58:0] s1_tag_d59_sr [1:59];
-  integer s1_tag_d59_i;
-  initial for (s1_tag_d59_i = 1; s1_tag_d59_i <= 59; s1_tag_d59_i = s1_tag_d59_i + 1) s1_tag_d59_sr[s1_tag_d59_i] = 59'h000000000000000;
-  wire [58:0] s1_tag_d59;
+  wire [26:0] bits_s1_tag;
+  reg [5:0] s1_tag_d59_p1_wp = 6'h00;
+  reg [5:0] s1_tag_d59_p1_rp = 6'h00;
+  wire [5:0] plus_35;
+  wire [5:0] k_7 = 6'h07;
+  wire [5:0] plus_36;
+  reg [26:0] s1_tag_d59_p1 = 27'h0000000;
+  wire [31:0] bits_s1_tag_1;
+  reg [5:0] s1_tag_d59_p0_wp = 6'h00;
+  reg [5:0] s1_tag_d59_p0_rp = 6'h00;
+  wire [5:0] plus_37;
+  wire [5:0] plus_38;
+  reg [31:0] s1_tag_d59_p0 = 32'h00000000;
+  wire [58:0] tag_out_int;
   wire [29:0] k_0_5 = 30'h00000000;
   wire [29:0] mux_s60_hit;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 31:0 are read
@@ -408,6 +489,21 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   reg [31:0] s61_v = 32'h00000000;
 
   // not in a stage or state machine
+
+  always @(posedge clk) begin : regs
+    if (k_1_2) s2_w_p_d41_mem[s2_w_p_d41_wp] <= bits_s2_w_p;
+    if (k_1_2) s2_w_q_d41_mem[s2_w_q_d41_wp] <= bits_s2_w_q;
+    if (k_1_2) kp0_d5_d42_mem[kp0_d5_d42_wp] <= bits_kp0_d5;
+    if (k_1_2) kq0_d5_d42_mem[kq0_d5_d42_wp] <= bits_kq0_d5;
+    if (k_1_2) s1_e1p_d49_mem[s1_e1p_d49_wp] <= bits_s1_e1p;
+    if (k_1_2) s1_e1q_d49_mem[s1_e1q_d49_wp] <= bits_s1_e1q;
+    if (k_1_2) s1_e2q_d49_mem[s1_e2q_d49_wp] <= bits_s1_e2q;
+    if (k_1_2) s1_e2p_d49_mem[s1_e2p_d49_wp] <= bits_s1_e2p;
+    if (k_1_2) u_div_ok_d16_mem[u_div_ok_d16_wp] <= u_div_ok;
+    if (k_1_2) u_div_t_1_d17_mem[u_div_t_1_d17_wp] <= u_div_t_1;
+    if (k_1_2) s1_tag_d59_p1_mem[s1_tag_d59_p1_wp] <= bits_s1_tag;
+    if (k_1_2) s1_tag_d59_p0_mem[s1_tag_d59_p0_wp] <= bits_s1_tag_1;
+  end
 
   // stage s1_inputs: register the inputs
 
@@ -559,402 +655,88 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   // stage s49_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   assign rs_u_div_t_1 = {{1{1'b0}}, u_div_t_1};
   assign s_rs_u_div_t_1 = $signed(rs_u_div_t_1);
-  assign s2_w_p_d41 = s2_w_p_d41_sr[41];
-  assign s2_w_q_d41 = s2_w_q_d41_sr[41];
+  assign bits_s2_w_p = s2_w_p[31:0];
+  assign s2_w_p_d41_wp_plus_k_1_1 = s2_w_p_d41_wp + k_1_1;
+  assign s2_w_p_d41_wp_plus_k_25 = s2_w_p_d41_wp + k_25;
+  assign s_s2_w_p_d41 = $signed(s2_w_p_d41);
+  assign bits_s2_w_q = s2_w_q[31:0];
+  assign s2_w_q_d41_wp_plus_k_1_1 = s2_w_q_d41_wp + k_1_1;
+  assign s2_w_q_d41_wp_plus_k_25 = s2_w_q_d41_wp + k_25;
+  assign s_s2_w_q_d41 = $signed(s2_w_q_d41);
   assign plus_7 = u_moved_products_p0 + k_1073741824_1;
   assign shr_plus_7 = plus_7 >>> 31;
   assign plus_8 = u_moved_products_p1 + k_1073741824_1;
   assign shr_plus_8 = plus_8 >>> 31;
 
   always @(posedge clk) begin : s49_rounded_regs
-    s2_w_p_d41_sr[41] <= s2_w_p_d41_sr[40];
-    s2_w_p_d41_sr[40] <= s2_w_p_d41_sr[39];
-    s2_w_p_d41_sr[39] <= s2_w_p_d41_sr[38];
-    s2_w_p_d41_sr[38] <= s2_w_p_d41_sr[37];
-    s2_w_p_d41_sr[37] <= s2_w_p_d41_sr[36];
-    s2_w_p_d41_sr[36] <= s2_w_p_d41_sr[35];
-    s2_w_p_d41_sr[35] <= s2_w_p_d41_sr[34];
-    s2_w_p_d41_sr[34] <= s2_w_p_d41_sr[33];
-    s2_w_p_d41_sr[33] <= s2_w_p_d41_sr[32];
-    s2_w_p_d41_sr[32] <= s2_w_p_d41_sr[31];
-    s2_w_p_d41_sr[31] <= s2_w_p_d41_sr[30];
-    s2_w_p_d41_sr[30] <= s2_w_p_d41_sr[29];
-    s2_w_p_d41_sr[29] <= s2_w_p_d41_sr[28];
-    s2_w_p_d41_sr[28] <= s2_w_p_d41_sr[27];
-    s2_w_p_d41_sr[27] <= s2_w_p_d41_sr[26];
-    s2_w_p_d41_sr[26] <= s2_w_p_d41_sr[25];
-    s2_w_p_d41_sr[25] <= s2_w_p_d41_sr[24];
-    s2_w_p_d41_sr[24] <= s2_w_p_d41_sr[23];
-    s2_w_p_d41_sr[23] <= s2_w_p_d41_sr[22];
-    s2_w_p_d41_sr[22] <= s2_w_p_d41_sr[21];
-    s2_w_p_d41_sr[21] <= s2_w_p_d41_sr[20];
-    s2_w_p_d41_sr[20] <= s2_w_p_d41_sr[19];
-    s2_w_p_d41_sr[19] <= s2_w_p_d41_sr[18];
-    s2_w_p_d41_sr[18] <= s2_w_p_d41_sr[17];
-    s2_w_p_d41_sr[17] <= s2_w_p_d41_sr[16];
-    s2_w_p_d41_sr[16] <= s2_w_p_d41_sr[15];
-    s2_w_p_d41_sr[15] <= s2_w_p_d41_sr[14];
-    s2_w_p_d41_sr[14] <= s2_w_p_d41_sr[13];
-    s2_w_p_d41_sr[13] <= s2_w_p_d41_sr[12];
-    s2_w_p_d41_sr[12] <= s2_w_p_d41_sr[11];
-    s2_w_p_d41_sr[11] <= s2_w_p_d41_sr[10];
-    s2_w_p_d41_sr[10] <= s2_w_p_d41_sr[9];
-    s2_w_p_d41_sr[9] <= s2_w_p_d41_sr[8];
-    s2_w_p_d41_sr[8] <= s2_w_p_d41_sr[7];
-    s2_w_p_d41_sr[7] <= s2_w_p_d41_sr[6];
-    s2_w_p_d41_sr[6] <= s2_w_p_d41_sr[5];
-    s2_w_p_d41_sr[5] <= s2_w_p_d41_sr[4];
-    s2_w_p_d41_sr[4] <= s2_w_p_d41_sr[3];
-    s2_w_p_d41_sr[3] <= s2_w_p_d41_sr[2];
-    s2_w_p_d41_sr[2] <= s2_w_p_d41_sr[1];
-    s2_w_p_d41_sr[1] <= s2_w_p;
-    s2_w_q_d41_sr[41] <= s2_w_q_d41_sr[40];
-    s2_w_q_d41_sr[40] <= s2_w_q_d41_sr[39];
-    s2_w_q_d41_sr[39] <= s2_w_q_d41_sr[38];
-    s2_w_q_d41_sr[38] <= s2_w_q_d41_sr[37];
-    s2_w_q_d41_sr[37] <= s2_w_q_d41_sr[36];
-    s2_w_q_d41_sr[36] <= s2_w_q_d41_sr[35];
-    s2_w_q_d41_sr[35] <= s2_w_q_d41_sr[34];
-    s2_w_q_d41_sr[34] <= s2_w_q_d41_sr[33];
-    s2_w_q_d41_sr[33] <= s2_w_q_d41_sr[32];
-    s2_w_q_d41_sr[32] <= s2_w_q_d41_sr[31];
-    s2_w_q_d41_sr[31] <= s2_w_q_d41_sr[30];
-    s2_w_q_d41_sr[30] <= s2_w_q_d41_sr[29];
-    s2_w_q_d41_sr[29] <= s2_w_q_d41_sr[28];
-    s2_w_q_d41_sr[28] <= s2_w_q_d41_sr[27];
-    s2_w_q_d41_sr[27] <= s2_w_q_d41_sr[26];
-    s2_w_q_d41_sr[26] <= s2_w_q_d41_sr[25];
-    s2_w_q_d41_sr[25] <= s2_w_q_d41_sr[24];
-    s2_w_q_d41_sr[24] <= s2_w_q_d41_sr[23];
-    s2_w_q_d41_sr[23] <= s2_w_q_d41_sr[22];
-    s2_w_q_d41_sr[22] <= s2_w_q_d41_sr[21];
-    s2_w_q_d41_sr[21] <= s2_w_q_d41_sr[20];
-    s2_w_q_d41_sr[20] <= s2_w_q_d41_sr[19];
-    s2_w_q_d41_sr[19] <= s2_w_q_d41_sr[18];
-    s2_w_q_d41_sr[18] <= s2_w_q_d41_sr[17];
-    s2_w_q_d41_sr[17] <= s2_w_q_d41_sr[16];
-    s2_w_q_d41_sr[16] <= s2_w_q_d41_sr[15];
-    s2_w_q_d41_sr[15] <= s2_w_q_d41_sr[14];
-    s2_w_q_d41_sr[14] <= s2_w_q_d41_sr[13];
-    s2_w_q_d41_sr[13] <= s2_w_q_d41_sr[12];
-    s2_w_q_d41_sr[12] <= s2_w_q_d41_sr[11];
-    s2_w_q_d41_sr[11] <= s2_w_q_d41_sr[10];
-    s2_w_q_d41_sr[10] <= s2_w_q_d41_sr[9];
-    s2_w_q_d41_sr[9] <= s2_w_q_d41_sr[8];
-    s2_w_q_d41_sr[8] <= s2_w_q_d41_sr[7];
-    s2_w_q_d41_sr[7] <= s2_w_q_d41_sr[6];
-    s2_w_q_d41_sr[6] <= s2_w_q_d41_sr[5];
-    s2_w_q_d41_sr[5] <= s2_w_q_d41_sr[4];
-    s2_w_q_d41_sr[4] <= s2_w_q_d41_sr[3];
-    s2_w_q_d41_sr[3] <= s2_w_q_d41_sr[2];
-    s2_w_q_d41_sr[2] <= s2_w_q_d41_sr[1];
-    s2_w_q_d41_sr[1] <= s2_w_q;
+    s2_w_p_d41_wp <= s2_w_p_d41_wp_plus_k_1_1;
+    s2_w_p_d41_rp <= s2_w_p_d41_wp_plus_k_25;
+    s2_w_p_d41 <= s2_w_p_d41_mem[s2_w_p_d41_rp];
+    s2_w_q_d41_wp <= s2_w_q_d41_wp_plus_k_1_1;
+    s2_w_q_d41_rp <= s2_w_q_d41_wp_plus_k_25;
+    s2_w_q_d41 <= s2_w_q_d41_mem[s2_w_q_d41_rp];
     s49_tp <= shr_plus_7;
     s49_tq <= shr_plus_8;
   end
 
   // stage s50_point: kp, kq: the hit point relative to the first vertex
-  assign kp0_d5_d42 = kp0_d5_d42_sr[42];
-  assign rs_kp0_d5_d42 = $signed({{2{kp0_d5_d42[29]}}, kp0_d5_d42});
+  assign bits_kp0_d5 = kp0_d5[29:0];
+  assign kp0_d5_d42_wp_plus_k_1_1 = kp0_d5_d42_wp + k_1_1;
+  assign kp0_d5_d42_wp_plus_k_24 = kp0_d5_d42_wp + k_24;
+  assign s_kp0_d5_d42 = $signed(kp0_d5_d42);
+  assign rs_s_kp0_d5_d42 = $signed({{2{s_kp0_d5_d42[29]}}, s_kp0_d5_d42});
   assign rs_s49_tp = $signed(s49_tp[31:0]);
-  assign kp = rs_kp0_d5_d42 + rs_s49_tp;
-  assign kq0_d5_d42 = kq0_d5_d42_sr[42];
-  assign rs_kq0_d5_d42 = $signed({{2{kq0_d5_d42[29]}}, kq0_d5_d42});
+  assign kp = rs_s_kp0_d5_d42 + rs_s49_tp;
+  assign bits_kq0_d5 = kq0_d5[29:0];
+  assign kq0_d5_d42_wp_plus_k_1_1 = kq0_d5_d42_wp + k_1_1;
+  assign kq0_d5_d42_wp_plus_k_24 = kq0_d5_d42_wp + k_24;
+  assign s_kq0_d5_d42 = $signed(kq0_d5_d42);
+  assign rs_s_kq0_d5_d42 = $signed({{2{s_kq0_d5_d42[29]}}, s_kq0_d5_d42});
   assign rs_s49_tq = $signed(s49_tq[31:0]);
-  assign kq = rs_kq0_d5_d42 + rs_s49_tq;
+  assign kq = rs_s_kq0_d5_d42 + rs_s49_tq;
 
   always @(posedge clk) begin : s50_point_regs
-    kp0_d5_d42_sr[42] <= kp0_d5_d42_sr[41];
-    kp0_d5_d42_sr[41] <= kp0_d5_d42_sr[40];
-    kp0_d5_d42_sr[40] <= kp0_d5_d42_sr[39];
-    kp0_d5_d42_sr[39] <= kp0_d5_d42_sr[38];
-    kp0_d5_d42_sr[38] <= kp0_d5_d42_sr[37];
-    kp0_d5_d42_sr[37] <= kp0_d5_d42_sr[36];
-    kp0_d5_d42_sr[36] <= kp0_d5_d42_sr[35];
-    kp0_d5_d42_sr[35] <= kp0_d5_d42_sr[34];
-    kp0_d5_d42_sr[34] <= kp0_d5_d42_sr[33];
-    kp0_d5_d42_sr[33] <= kp0_d5_d42_sr[32];
-    kp0_d5_d42_sr[32] <= kp0_d5_d42_sr[31];
-    kp0_d5_d42_sr[31] <= kp0_d5_d42_sr[30];
-    kp0_d5_d42_sr[30] <= kp0_d5_d42_sr[29];
-    kp0_d5_d42_sr[29] <= kp0_d5_d42_sr[28];
-    kp0_d5_d42_sr[28] <= kp0_d5_d42_sr[27];
-    kp0_d5_d42_sr[27] <= kp0_d5_d42_sr[26];
-    kp0_d5_d42_sr[26] <= kp0_d5_d42_sr[25];
-    kp0_d5_d42_sr[25] <= kp0_d5_d42_sr[24];
-    kp0_d5_d42_sr[24] <= kp0_d5_d42_sr[23];
-    kp0_d5_d42_sr[23] <= kp0_d5_d42_sr[22];
-    kp0_d5_d42_sr[22] <= kp0_d5_d42_sr[21];
-    kp0_d5_d42_sr[21] <= kp0_d5_d42_sr[20];
-    kp0_d5_d42_sr[20] <= kp0_d5_d42_sr[19];
-    kp0_d5_d42_sr[19] <= kp0_d5_d42_sr[18];
-    kp0_d5_d42_sr[18] <= kp0_d5_d42_sr[17];
-    kp0_d5_d42_sr[17] <= kp0_d5_d42_sr[16];
-    kp0_d5_d42_sr[16] <= kp0_d5_d42_sr[15];
-    kp0_d5_d42_sr[15] <= kp0_d5_d42_sr[14];
-    kp0_d5_d42_sr[14] <= kp0_d5_d42_sr[13];
-    kp0_d5_d42_sr[13] <= kp0_d5_d42_sr[12];
-    kp0_d5_d42_sr[12] <= kp0_d5_d42_sr[11];
-    kp0_d5_d42_sr[11] <= kp0_d5_d42_sr[10];
-    kp0_d5_d42_sr[10] <= kp0_d5_d42_sr[9];
-    kp0_d5_d42_sr[9] <= kp0_d5_d42_sr[8];
-    kp0_d5_d42_sr[8] <= kp0_d5_d42_sr[7];
-    kp0_d5_d42_sr[7] <= kp0_d5_d42_sr[6];
-    kp0_d5_d42_sr[6] <= kp0_d5_d42_sr[5];
-    kp0_d5_d42_sr[5] <= kp0_d5_d42_sr[4];
-    kp0_d5_d42_sr[4] <= kp0_d5_d42_sr[3];
-    kp0_d5_d42_sr[3] <= kp0_d5_d42_sr[2];
-    kp0_d5_d42_sr[2] <= kp0_d5_d42_sr[1];
-    kp0_d5_d42_sr[1] <= kp0_d5;
-    kq0_d5_d42_sr[42] <= kq0_d5_d42_sr[41];
-    kq0_d5_d42_sr[41] <= kq0_d5_d42_sr[40];
-    kq0_d5_d42_sr[40] <= kq0_d5_d42_sr[39];
-    kq0_d5_d42_sr[39] <= kq0_d5_d42_sr[38];
-    kq0_d5_d42_sr[38] <= kq0_d5_d42_sr[37];
-    kq0_d5_d42_sr[37] <= kq0_d5_d42_sr[36];
-    kq0_d5_d42_sr[36] <= kq0_d5_d42_sr[35];
-    kq0_d5_d42_sr[35] <= kq0_d5_d42_sr[34];
-    kq0_d5_d42_sr[34] <= kq0_d5_d42_sr[33];
-    kq0_d5_d42_sr[33] <= kq0_d5_d42_sr[32];
-    kq0_d5_d42_sr[32] <= kq0_d5_d42_sr[31];
-    kq0_d5_d42_sr[31] <= kq0_d5_d42_sr[30];
-    kq0_d5_d42_sr[30] <= kq0_d5_d42_sr[29];
-    kq0_d5_d42_sr[29] <= kq0_d5_d42_sr[28];
-    kq0_d5_d42_sr[28] <= kq0_d5_d42_sr[27];
-    kq0_d5_d42_sr[27] <= kq0_d5_d42_sr[26];
-    kq0_d5_d42_sr[26] <= kq0_d5_d42_sr[25];
-    kq0_d5_d42_sr[25] <= kq0_d5_d42_sr[24];
-    kq0_d5_d42_sr[24] <= kq0_d5_d42_sr[23];
-    kq0_d5_d42_sr[23] <= kq0_d5_d42_sr[22];
-    kq0_d5_d42_sr[22] <= kq0_d5_d42_sr[21];
-    kq0_d5_d42_sr[21] <= kq0_d5_d42_sr[20];
-    kq0_d5_d42_sr[20] <= kq0_d5_d42_sr[19];
-    kq0_d5_d42_sr[19] <= kq0_d5_d42_sr[18];
-    kq0_d5_d42_sr[18] <= kq0_d5_d42_sr[17];
-    kq0_d5_d42_sr[17] <= kq0_d5_d42_sr[16];
-    kq0_d5_d42_sr[16] <= kq0_d5_d42_sr[15];
-    kq0_d5_d42_sr[15] <= kq0_d5_d42_sr[14];
-    kq0_d5_d42_sr[14] <= kq0_d5_d42_sr[13];
-    kq0_d5_d42_sr[13] <= kq0_d5_d42_sr[12];
-    kq0_d5_d42_sr[12] <= kq0_d5_d42_sr[11];
-    kq0_d5_d42_sr[11] <= kq0_d5_d42_sr[10];
-    kq0_d5_d42_sr[10] <= kq0_d5_d42_sr[9];
-    kq0_d5_d42_sr[9] <= kq0_d5_d42_sr[8];
-    kq0_d5_d42_sr[8] <= kq0_d5_d42_sr[7];
-    kq0_d5_d42_sr[7] <= kq0_d5_d42_sr[6];
-    kq0_d5_d42_sr[6] <= kq0_d5_d42_sr[5];
-    kq0_d5_d42_sr[5] <= kq0_d5_d42_sr[4];
-    kq0_d5_d42_sr[4] <= kq0_d5_d42_sr[3];
-    kq0_d5_d42_sr[3] <= kq0_d5_d42_sr[2];
-    kq0_d5_d42_sr[2] <= kq0_d5_d42_sr[1];
-    kq0_d5_d42_sr[1] <= kq0_d5;
+    kp0_d5_d42_wp <= kp0_d5_d42_wp_plus_k_1_1;
+    kp0_d5_d42_rp <= kp0_d5_d42_wp_plus_k_24;
+    kp0_d5_d42 <= kp0_d5_d42_mem[kp0_d5_d42_rp];
+    kq0_d5_d42_wp <= kq0_d5_d42_wp_plus_k_1_1;
+    kq0_d5_d42_rp <= kq0_d5_d42_wp_plus_k_24;
+    kq0_d5_d42 <= kq0_d5_d42_mem[kq0_d5_d42_rp];
     s50_kp <= kp;
     s50_kq <= kq;
   end
 
   // stage s56_bary: e1p·kq, e1q·kp, e2q·kp, e2p·kq
-  assign s1_e1p_d49 = s1_e1p_d49_sr[49];
-  assign s1_e1q_d49 = s1_e1q_d49_sr[49];
-  assign s1_e2q_d49 = s1_e2q_d49_sr[49];
-  assign s1_e2p_d49 = s1_e2p_d49_sr[49];
+  assign bits_s1_e1p = s1_e1p[31:0];
+  assign s1_e1p_d49_wp_plus_k_1_1 = s1_e1p_d49_wp + k_1_1;
+  assign s1_e1p_d49_wp_plus_k_17 = s1_e1p_d49_wp + k_17;
+  assign s_s1_e1p_d49 = $signed(s1_e1p_d49);
+  assign bits_s1_e1q = s1_e1q[31:0];
+  assign s1_e1q_d49_wp_plus_k_1_1 = s1_e1q_d49_wp + k_1_1;
+  assign s1_e1q_d49_wp_plus_k_17 = s1_e1q_d49_wp + k_17;
+  assign s_s1_e1q_d49 = $signed(s1_e1q_d49);
+  assign bits_s1_e2q = s1_e2q[31:0];
+  assign s1_e2q_d49_wp_plus_k_1_1 = s1_e2q_d49_wp + k_1_1;
+  assign s1_e2q_d49_wp_plus_k_17 = s1_e2q_d49_wp + k_17;
+  assign s_s1_e2q_d49 = $signed(s1_e2q_d49);
+  assign bits_s1_e2p = s1_e2p[31:0];
+  assign s1_e2p_d49_wp_plus_k_1_1 = s1_e2p_d49_wp + k_1_1;
+  assign s1_e2p_d49_wp_plus_k_17 = s1_e2p_d49_wp + k_17;
+  assign s_s1_e2p_d49 = $signed(s1_e2p_d49);
 
   always @(posedge clk) begin : s56_bary_regs
-    s1_e1p_d49_sr[49] <= s1_e1p_d49_sr[48];
-    s1_e1p_d49_sr[48] <= s1_e1p_d49_sr[47];
-    s1_e1p_d49_sr[47] <= s1_e1p_d49_sr[46];
-    s1_e1p_d49_sr[46] <= s1_e1p_d49_sr[45];
-    s1_e1p_d49_sr[45] <= s1_e1p_d49_sr[44];
-    s1_e1p_d49_sr[44] <= s1_e1p_d49_sr[43];
-    s1_e1p_d49_sr[43] <= s1_e1p_d49_sr[42];
-    s1_e1p_d49_sr[42] <= s1_e1p_d49_sr[41];
-    s1_e1p_d49_sr[41] <= s1_e1p_d49_sr[40];
-    s1_e1p_d49_sr[40] <= s1_e1p_d49_sr[39];
-    s1_e1p_d49_sr[39] <= s1_e1p_d49_sr[38];
-    s1_e1p_d49_sr[38] <= s1_e1p_d49_sr[37];
-    s1_e1p_d49_sr[37] <= s1_e1p_d49_sr[36];
-    s1_e1p_d49_sr[36] <= s1_e1p_d49_sr[35];
-    s1_e1p_d49_sr[35] <= s1_e1p_d49_sr[34];
-    s1_e1p_d49_sr[34] <= s1_e1p_d49_sr[33];
-    s1_e1p_d49_sr[33] <= s1_e1p_d49_sr[32];
-    s1_e1p_d49_sr[32] <= s1_e1p_d49_sr[31];
-    s1_e1p_d49_sr[31] <= s1_e1p_d49_sr[30];
-    s1_e1p_d49_sr[30] <= s1_e1p_d49_sr[29];
-    s1_e1p_d49_sr[29] <= s1_e1p_d49_sr[28];
-    s1_e1p_d49_sr[28] <= s1_e1p_d49_sr[27];
-    s1_e1p_d49_sr[27] <= s1_e1p_d49_sr[26];
-    s1_e1p_d49_sr[26] <= s1_e1p_d49_sr[25];
-    s1_e1p_d49_sr[25] <= s1_e1p_d49_sr[24];
-    s1_e1p_d49_sr[24] <= s1_e1p_d49_sr[23];
-    s1_e1p_d49_sr[23] <= s1_e1p_d49_sr[22];
-    s1_e1p_d49_sr[22] <= s1_e1p_d49_sr[21];
-    s1_e1p_d49_sr[21] <= s1_e1p_d49_sr[20];
-    s1_e1p_d49_sr[20] <= s1_e1p_d49_sr[19];
-    s1_e1p_d49_sr[19] <= s1_e1p_d49_sr[18];
-    s1_e1p_d49_sr[18] <= s1_e1p_d49_sr[17];
-    s1_e1p_d49_sr[17] <= s1_e1p_d49_sr[16];
-    s1_e1p_d49_sr[16] <= s1_e1p_d49_sr[15];
-    s1_e1p_d49_sr[15] <= s1_e1p_d49_sr[14];
-    s1_e1p_d49_sr[14] <= s1_e1p_d49_sr[13];
-    s1_e1p_d49_sr[13] <= s1_e1p_d49_sr[12];
-    s1_e1p_d49_sr[12] <= s1_e1p_d49_sr[11];
-    s1_e1p_d49_sr[11] <= s1_e1p_d49_sr[10];
-    s1_e1p_d49_sr[10] <= s1_e1p_d49_sr[9];
-    s1_e1p_d49_sr[9] <= s1_e1p_d49_sr[8];
-    s1_e1p_d49_sr[8] <= s1_e1p_d49_sr[7];
-    s1_e1p_d49_sr[7] <= s1_e1p_d49_sr[6];
-    s1_e1p_d49_sr[6] <= s1_e1p_d49_sr[5];
-    s1_e1p_d49_sr[5] <= s1_e1p_d49_sr[4];
-    s1_e1p_d49_sr[4] <= s1_e1p_d49_sr[3];
-    s1_e1p_d49_sr[3] <= s1_e1p_d49_sr[2];
-    s1_e1p_d49_sr[2] <= s1_e1p_d49_sr[1];
-    s1_e1p_d49_sr[1] <= s1_e1p;
-    s1_e1q_d49_sr[49] <= s1_e1q_d49_sr[48];
-    s1_e1q_d49_sr[48] <= s1_e1q_d49_sr[47];
-    s1_e1q_d49_sr[47] <= s1_e1q_d49_sr[46];
-    s1_e1q_d49_sr[46] <= s1_e1q_d49_sr[45];
-    s1_e1q_d49_sr[45] <= s1_e1q_d49_sr[44];
-    s1_e1q_d49_sr[44] <= s1_e1q_d49_sr[43];
-    s1_e1q_d49_sr[43] <= s1_e1q_d49_sr[42];
-    s1_e1q_d49_sr[42] <= s1_e1q_d49_sr[41];
-    s1_e1q_d49_sr[41] <= s1_e1q_d49_sr[40];
-    s1_e1q_d49_sr[40] <= s1_e1q_d49_sr[39];
-    s1_e1q_d49_sr[39] <= s1_e1q_d49_sr[38];
-    s1_e1q_d49_sr[38] <= s1_e1q_d49_sr[37];
-    s1_e1q_d49_sr[37] <= s1_e1q_d49_sr[36];
-    s1_e1q_d49_sr[36] <= s1_e1q_d49_sr[35];
-    s1_e1q_d49_sr[35] <= s1_e1q_d49_sr[34];
-    s1_e1q_d49_sr[34] <= s1_e1q_d49_sr[33];
-    s1_e1q_d49_sr[33] <= s1_e1q_d49_sr[32];
-    s1_e1q_d49_sr[32] <= s1_e1q_d49_sr[31];
-    s1_e1q_d49_sr[31] <= s1_e1q_d49_sr[30];
-    s1_e1q_d49_sr[30] <= s1_e1q_d49_sr[29];
-    s1_e1q_d49_sr[29] <= s1_e1q_d49_sr[28];
-    s1_e1q_d49_sr[28] <= s1_e1q_d49_sr[27];
-    s1_e1q_d49_sr[27] <= s1_e1q_d49_sr[26];
-    s1_e1q_d49_sr[26] <= s1_e1q_d49_sr[25];
-    s1_e1q_d49_sr[25] <= s1_e1q_d49_sr[24];
-    s1_e1q_d49_sr[24] <= s1_e1q_d49_sr[23];
-    s1_e1q_d49_sr[23] <= s1_e1q_d49_sr[22];
-    s1_e1q_d49_sr[22] <= s1_e1q_d49_sr[21];
-    s1_e1q_d49_sr[21] <= s1_e1q_d49_sr[20];
-    s1_e1q_d49_sr[20] <= s1_e1q_d49_sr[19];
-    s1_e1q_d49_sr[19] <= s1_e1q_d49_sr[18];
-    s1_e1q_d49_sr[18] <= s1_e1q_d49_sr[17];
-    s1_e1q_d49_sr[17] <= s1_e1q_d49_sr[16];
-    s1_e1q_d49_sr[16] <= s1_e1q_d49_sr[15];
-    s1_e1q_d49_sr[15] <= s1_e1q_d49_sr[14];
-    s1_e1q_d49_sr[14] <= s1_e1q_d49_sr[13];
-    s1_e1q_d49_sr[13] <= s1_e1q_d49_sr[12];
-    s1_e1q_d49_sr[12] <= s1_e1q_d49_sr[11];
-    s1_e1q_d49_sr[11] <= s1_e1q_d49_sr[10];
-    s1_e1q_d49_sr[10] <= s1_e1q_d49_sr[9];
-    s1_e1q_d49_sr[9] <= s1_e1q_d49_sr[8];
-    s1_e1q_d49_sr[8] <= s1_e1q_d49_sr[7];
-    s1_e1q_d49_sr[7] <= s1_e1q_d49_sr[6];
-    s1_e1q_d49_sr[6] <= s1_e1q_d49_sr[5];
-    s1_e1q_d49_sr[5] <= s1_e1q_d49_sr[4];
-    s1_e1q_d49_sr[4] <= s1_e1q_d49_sr[3];
-    s1_e1q_d49_sr[3] <= s1_e1q_d49_sr[2];
-    s1_e1q_d49_sr[2] <= s1_e1q_d49_sr[1];
-    s1_e1q_d49_sr[1] <= s1_e1q;
-    s1_e2q_d49_sr[49] <= s1_e2q_d49_sr[48];
-    s1_e2q_d49_sr[48] <= s1_e2q_d49_sr[47];
-    s1_e2q_d49_sr[47] <= s1_e2q_d49_sr[46];
-    s1_e2q_d49_sr[46] <= s1_e2q_d49_sr[45];
-    s1_e2q_d49_sr[45] <= s1_e2q_d49_sr[44];
-    s1_e2q_d49_sr[44] <= s1_e2q_d49_sr[43];
-    s1_e2q_d49_sr[43] <= s1_e2q_d49_sr[42];
-    s1_e2q_d49_sr[42] <= s1_e2q_d49_sr[41];
-    s1_e2q_d49_sr[41] <= s1_e2q_d49_sr[40];
-    s1_e2q_d49_sr[40] <= s1_e2q_d49_sr[39];
-    s1_e2q_d49_sr[39] <= s1_e2q_d49_sr[38];
-    s1_e2q_d49_sr[38] <= s1_e2q_d49_sr[37];
-    s1_e2q_d49_sr[37] <= s1_e2q_d49_sr[36];
-    s1_e2q_d49_sr[36] <= s1_e2q_d49_sr[35];
-    s1_e2q_d49_sr[35] <= s1_e2q_d49_sr[34];
-    s1_e2q_d49_sr[34] <= s1_e2q_d49_sr[33];
-    s1_e2q_d49_sr[33] <= s1_e2q_d49_sr[32];
-    s1_e2q_d49_sr[32] <= s1_e2q_d49_sr[31];
-    s1_e2q_d49_sr[31] <= s1_e2q_d49_sr[30];
-    s1_e2q_d49_sr[30] <= s1_e2q_d49_sr[29];
-    s1_e2q_d49_sr[29] <= s1_e2q_d49_sr[28];
-    s1_e2q_d49_sr[28] <= s1_e2q_d49_sr[27];
-    s1_e2q_d49_sr[27] <= s1_e2q_d49_sr[26];
-    s1_e2q_d49_sr[26] <= s1_e2q_d49_sr[25];
-    s1_e2q_d49_sr[25] <= s1_e2q_d49_sr[24];
-    s1_e2q_d49_sr[24] <= s1_e2q_d49_sr[23];
-    s1_e2q_d49_sr[23] <= s1_e2q_d49_sr[22];
-    s1_e2q_d49_sr[22] <= s1_e2q_d49_sr[21];
-    s1_e2q_d49_sr[21] <= s1_e2q_d49_sr[20];
-    s1_e2q_d49_sr[20] <= s1_e2q_d49_sr[19];
-    s1_e2q_d49_sr[19] <= s1_e2q_d49_sr[18];
-    s1_e2q_d49_sr[18] <= s1_e2q_d49_sr[17];
-    s1_e2q_d49_sr[17] <= s1_e2q_d49_sr[16];
-    s1_e2q_d49_sr[16] <= s1_e2q_d49_sr[15];
-    s1_e2q_d49_sr[15] <= s1_e2q_d49_sr[14];
-    s1_e2q_d49_sr[14] <= s1_e2q_d49_sr[13];
-    s1_e2q_d49_sr[13] <= s1_e2q_d49_sr[12];
-    s1_e2q_d49_sr[12] <= s1_e2q_d49_sr[11];
-    s1_e2q_d49_sr[11] <= s1_e2q_d49_sr[10];
-    s1_e2q_d49_sr[10] <= s1_e2q_d49_sr[9];
-    s1_e2q_d49_sr[9] <= s1_e2q_d49_sr[8];
-    s1_e2q_d49_sr[8] <= s1_e2q_d49_sr[7];
-    s1_e2q_d49_sr[7] <= s1_e2q_d49_sr[6];
-    s1_e2q_d49_sr[6] <= s1_e2q_d49_sr[5];
-    s1_e2q_d49_sr[5] <= s1_e2q_d49_sr[4];
-    s1_e2q_d49_sr[4] <= s1_e2q_d49_sr[3];
-    s1_e2q_d49_sr[3] <= s1_e2q_d49_sr[2];
-    s1_e2q_d49_sr[2] <= s1_e2q_d49_sr[1];
-    s1_e2q_d49_sr[1] <= s1_e2q;
-    s1_e2p_d49_sr[49] <= s1_e2p_d49_sr[48];
-    s1_e2p_d49_sr[48] <= s1_e2p_d49_sr[47];
-    s1_e2p_d49_sr[47] <= s1_e2p_d49_sr[46];
-    s1_e2p_d49_sr[46] <= s1_e2p_d49_sr[45];
-    s1_e2p_d49_sr[45] <= s1_e2p_d49_sr[44];
-    s1_e2p_d49_sr[44] <= s1_e2p_d49_sr[43];
-    s1_e2p_d49_sr[43] <= s1_e2p_d49_sr[42];
-    s1_e2p_d49_sr[42] <= s1_e2p_d49_sr[41];
-    s1_e2p_d49_sr[41] <= s1_e2p_d49_sr[40];
-    s1_e2p_d49_sr[40] <= s1_e2p_d49_sr[39];
-    s1_e2p_d49_sr[39] <= s1_e2p_d49_sr[38];
-    s1_e2p_d49_sr[38] <= s1_e2p_d49_sr[37];
-    s1_e2p_d49_sr[37] <= s1_e2p_d49_sr[36];
-    s1_e2p_d49_sr[36] <= s1_e2p_d49_sr[35];
-    s1_e2p_d49_sr[35] <= s1_e2p_d49_sr[34];
-    s1_e2p_d49_sr[34] <= s1_e2p_d49_sr[33];
-    s1_e2p_d49_sr[33] <= s1_e2p_d49_sr[32];
-    s1_e2p_d49_sr[32] <= s1_e2p_d49_sr[31];
-    s1_e2p_d49_sr[31] <= s1_e2p_d49_sr[30];
-    s1_e2p_d49_sr[30] <= s1_e2p_d49_sr[29];
-    s1_e2p_d49_sr[29] <= s1_e2p_d49_sr[28];
-    s1_e2p_d49_sr[28] <= s1_e2p_d49_sr[27];
-    s1_e2p_d49_sr[27] <= s1_e2p_d49_sr[26];
-    s1_e2p_d49_sr[26] <= s1_e2p_d49_sr[25];
-    s1_e2p_d49_sr[25] <= s1_e2p_d49_sr[24];
-    s1_e2p_d49_sr[24] <= s1_e2p_d49_sr[23];
-    s1_e2p_d49_sr[23] <= s1_e2p_d49_sr[22];
-    s1_e2p_d49_sr[22] <= s1_e2p_d49_sr[21];
-    s1_e2p_d49_sr[21] <= s1_e2p_d49_sr[20];
-    s1_e2p_d49_sr[20] <= s1_e2p_d49_sr[19];
-    s1_e2p_d49_sr[19] <= s1_e2p_d49_sr[18];
-    s1_e2p_d49_sr[18] <= s1_e2p_d49_sr[17];
-    s1_e2p_d49_sr[17] <= s1_e2p_d49_sr[16];
-    s1_e2p_d49_sr[16] <= s1_e2p_d49_sr[15];
-    s1_e2p_d49_sr[15] <= s1_e2p_d49_sr[14];
-    s1_e2p_d49_sr[14] <= s1_e2p_d49_sr[13];
-    s1_e2p_d49_sr[13] <= s1_e2p_d49_sr[12];
-    s1_e2p_d49_sr[12] <= s1_e2p_d49_sr[11];
-    s1_e2p_d49_sr[11] <= s1_e2p_d49_sr[10];
-    s1_e2p_d49_sr[10] <= s1_e2p_d49_sr[9];
-    s1_e2p_d49_sr[9] <= s1_e2p_d49_sr[8];
-    s1_e2p_d49_sr[8] <= s1_e2p_d49_sr[7];
-    s1_e2p_d49_sr[7] <= s1_e2p_d49_sr[6];
-    s1_e2p_d49_sr[6] <= s1_e2p_d49_sr[5];
-    s1_e2p_d49_sr[5] <= s1_e2p_d49_sr[4];
-    s1_e2p_d49_sr[4] <= s1_e2p_d49_sr[3];
-    s1_e2p_d49_sr[3] <= s1_e2p_d49_sr[2];
-    s1_e2p_d49_sr[2] <= s1_e2p_d49_sr[1];
-    s1_e2p_d49_sr[1] <= s1_e2p;
+    s1_e1p_d49_wp <= s1_e1p_d49_wp_plus_k_1_1;
+    s1_e1p_d49_rp <= s1_e1p_d49_wp_plus_k_17;
+    s1_e1p_d49 <= s1_e1p_d49_mem[s1_e1p_d49_rp];
+    s1_e1q_d49_wp <= s1_e1q_d49_wp_plus_k_1_1;
+    s1_e1q_d49_rp <= s1_e1q_d49_wp_plus_k_17;
+    s1_e1q_d49 <= s1_e1q_d49_mem[s1_e1q_d49_rp];
+    s1_e2q_d49_wp <= s1_e2q_d49_wp_plus_k_1_1;
+    s1_e2q_d49_rp <= s1_e2q_d49_wp_plus_k_17;
+    s1_e2q_d49 <= s1_e2q_d49_mem[s1_e2q_d49_rp];
+    s1_e2p_d49_wp <= s1_e2p_d49_wp_plus_k_1_1;
+    s1_e2p_d49_rp <= s1_e2p_d49_wp_plus_k_17;
+    s1_e2p_d49 <= s1_e2p_d49_mem[s1_e2p_d49_rp];
     s56_a1 <= u_bary_products_p0;
     s56_a2 <= u_bary_products_p1;
     s56_b1 <= u_bary_products_p2;
@@ -1043,34 +825,29 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   assign over = or_28 | and_29;
   assign s59_neg_or_over = s59_neg | over;
   assign not_s59_neg_or_over = ~s59_neg_or_over;
-  assign u_div_ok_d16 = u_div_ok_d16_sr[16];
+  assign plus_30 = u_div_ok_d16_wp + k_1_3;
+  assign plus_31 = u_div_ok_d16_wp + k_2_1;
   assign hit_c = not_s59_neg_or_over & u_div_ok_d16;
 
   always @(posedge clk) begin : s60_hit_regs
-    u_div_ok_d16_sr[16] <= u_div_ok_d16_sr[15];
-    u_div_ok_d16_sr[15] <= u_div_ok_d16_sr[14];
-    u_div_ok_d16_sr[14] <= u_div_ok_d16_sr[13];
-    u_div_ok_d16_sr[13] <= u_div_ok_d16_sr[12];
-    u_div_ok_d16_sr[12] <= u_div_ok_d16_sr[11];
-    u_div_ok_d16_sr[11] <= u_div_ok_d16_sr[10];
-    u_div_ok_d16_sr[10] <= u_div_ok_d16_sr[9];
-    u_div_ok_d16_sr[9] <= u_div_ok_d16_sr[8];
-    u_div_ok_d16_sr[8] <= u_div_ok_d16_sr[7];
-    u_div_ok_d16_sr[7] <= u_div_ok_d16_sr[6];
-    u_div_ok_d16_sr[6] <= u_div_ok_d16_sr[5];
-    u_div_ok_d16_sr[5] <= u_div_ok_d16_sr[4];
-    u_div_ok_d16_sr[4] <= u_div_ok_d16_sr[3];
-    u_div_ok_d16_sr[3] <= u_div_ok_d16_sr[2];
-    u_div_ok_d16_sr[2] <= u_div_ok_d16_sr[1];
-    u_div_ok_d16_sr[1] <= u_div_ok;
+    u_div_ok_d16_wp <= plus_30;
+    u_div_ok_d16_rp <= plus_31;
+    u_div_ok_d16 <= u_div_ok_d16_mem[u_div_ok_d16_rp];
     s60_hit <= hit_c;
   end
 
   // stage s61_result: the barycentric test; t, u, v zeroed on a miss
-  assign u_div_t_1_d17 = u_div_t_1_d17_sr[17];
+  assign plus_33 = u_div_t_1_d17_wp + k_1_4;
+  assign plus_34 = u_div_t_1_d17_wp + k_17_1;
   assign s57_u_d3 = s57_u_d3_sr[3];
   assign s57_v_d3 = s57_v_d3_sr[3];
-  assign s1_tag_d59 = s1_tag_d59_sr[59];
+  assign bits_s1_tag = s1_tag[58:32];
+  assign plus_35 = s1_tag_d59_p1_wp + k_1_1;
+  assign plus_36 = s1_tag_d59_p1_wp + k_7;
+  assign bits_s1_tag_1 = s1_tag[31:0];
+  assign plus_37 = s1_tag_d59_p0_wp + k_1_1;
+  assign plus_38 = s1_tag_d59_p0_wp + k_7;
+  assign tag_out_int = {s1_tag_d59_p1, s1_tag_d59_p0};
   assign mux_s60_hit = s60_hit ? u_div_t_1_d17 : k_0_5;
   assign shr_s57_u_d3 = s57_u_d3 >>> 18;
   assign rs_shr_s57_u_d3 = $signed(shr_s57_u_d3[31:0]);
@@ -1082,23 +859,9 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   assign mux_s60_hit_2 = s60_hit ? u_rs_shr_s57_v_d3 : k_0_6;
 
   always @(posedge clk) begin : s61_result_regs
-    u_div_t_1_d17_sr[17] <= u_div_t_1_d17_sr[16];
-    u_div_t_1_d17_sr[16] <= u_div_t_1_d17_sr[15];
-    u_div_t_1_d17_sr[15] <= u_div_t_1_d17_sr[14];
-    u_div_t_1_d17_sr[14] <= u_div_t_1_d17_sr[13];
-    u_div_t_1_d17_sr[13] <= u_div_t_1_d17_sr[12];
-    u_div_t_1_d17_sr[12] <= u_div_t_1_d17_sr[11];
-    u_div_t_1_d17_sr[11] <= u_div_t_1_d17_sr[10];
-    u_div_t_1_d17_sr[10] <= u_div_t_1_d17_sr[9];
-    u_div_t_1_d17_sr[9] <= u_div_t_1_d17_sr[8];
-    u_div_t_1_d17_sr[8] <= u_div_t_1_d17_sr[7];
-    u_div_t_1_d17_sr[7] <= u_div_t_1_d17_sr[6];
-    u_div_t_1_d17_sr[6] <= u_div_t_1_d17_sr[5];
-    u_div_t_1_d17_sr[5] <= u_div_t_1_d17_sr[4];
-    u_div_t_1_d17_sr[4] <= u_div_t_1_d17_sr[3];
-    u_div_t_1_d17_sr[3] <= u_div_t_1_d17_sr[2];
-    u_div_t_1_d17_sr[2] <= u_div_t_1_d17_sr[1];
-    u_div_t_1_d17_sr[1] <= u_div_t_1;
+    u_div_t_1_d17_wp <= plus_33;
+    u_div_t_1_d17_rp <= plus_34;
+    u_div_t_1_d17 <= u_div_t_1_d17_mem[u_div_t_1_d17_rp];
     s57_u_d3_sr[3] <= s57_u_d3_sr[2];
     s57_u_d3_sr[2] <= s57_u_d3_sr[1];
     s57_u_d3_sr[1] <= s57_u;
@@ -1223,68 +986,15 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
     else s1_valid_d59_58 <= s1_valid_d59_57;
     if (rst) s1_valid_d59_59 <= 1'h0;
     else s1_valid_d59_59 <= s1_valid_d59_58;
-    s1_tag_d59_sr[59] <= s1_tag_d59_sr[58];
-    s1_tag_d59_sr[58] <= s1_tag_d59_sr[57];
-    s1_tag_d59_sr[57] <= s1_tag_d59_sr[56];
-    s1_tag_d59_sr[56] <= s1_tag_d59_sr[55];
-    s1_tag_d59_sr[55] <= s1_tag_d59_sr[54];
-    s1_tag_d59_sr[54] <= s1_tag_d59_sr[53];
-    s1_tag_d59_sr[53] <= s1_tag_d59_sr[52];
-    s1_tag_d59_sr[52] <= s1_tag_d59_sr[51];
-    s1_tag_d59_sr[51] <= s1_tag_d59_sr[50];
-    s1_tag_d59_sr[50] <= s1_tag_d59_sr[49];
-    s1_tag_d59_sr[49] <= s1_tag_d59_sr[48];
-    s1_tag_d59_sr[48] <= s1_tag_d59_sr[47];
-    s1_tag_d59_sr[47] <= s1_tag_d59_sr[46];
-    s1_tag_d59_sr[46] <= s1_tag_d59_sr[45];
-    s1_tag_d59_sr[45] <= s1_tag_d59_sr[44];
-    s1_tag_d59_sr[44] <= s1_tag_d59_sr[43];
-    s1_tag_d59_sr[43] <= s1_tag_d59_sr[42];
-    s1_tag_d59_sr[42] <= s1_tag_d59_sr[41];
-    s1_tag_d59_sr[41] <= s1_tag_d59_sr[40];
-    s1_tag_d59_sr[40] <= s1_tag_d59_sr[39];
-    s1_tag_d59_sr[39] <= s1_tag_d59_sr[38];
-    s1_tag_d59_sr[38] <= s1_tag_d59_sr[37];
-    s1_tag_d59_sr[37] <= s1_tag_d59_sr[36];
-    s1_tag_d59_sr[36] <= s1_tag_d59_sr[35];
-    s1_tag_d59_sr[35] <= s1_tag_d59_sr[34];
-    s1_tag_d59_sr[34] <= s1_tag_d59_sr[33];
-    s1_tag_d59_sr[33] <= s1_tag_d59_sr[32];
-    s1_tag_d59_sr[32] <= s1_tag_d59_sr[31];
-    s1_tag_d59_sr[31] <= s1_tag_d59_sr[30];
-    s1_tag_d59_sr[30] <= s1_tag_d59_sr[29];
-    s1_tag_d59_sr[29] <= s1_tag_d59_sr[28];
-    s1_tag_d59_sr[28] <= s1_tag_d59_sr[27];
-    s1_tag_d59_sr[27] <= s1_tag_d59_sr[26];
-    s1_tag_d59_sr[26] <= s1_tag_d59_sr[25];
-    s1_tag_d59_sr[25] <= s1_tag_d59_sr[24];
-    s1_tag_d59_sr[24] <= s1_tag_d59_sr[23];
-    s1_tag_d59_sr[23] <= s1_tag_d59_sr[22];
-    s1_tag_d59_sr[22] <= s1_tag_d59_sr[21];
-    s1_tag_d59_sr[21] <= s1_tag_d59_sr[20];
-    s1_tag_d59_sr[20] <= s1_tag_d59_sr[19];
-    s1_tag_d59_sr[19] <= s1_tag_d59_sr[18];
-    s1_tag_d59_sr[18] <= s1_tag_d59_sr[17];
-    s1_tag_d59_sr[17] <= s1_tag_d59_sr[16];
-    s1_tag_d59_sr[16] <= s1_tag_d59_sr[15];
-    s1_tag_d59_sr[15] <= s1_tag_d59_sr[14];
-    s1_tag_d59_sr[14] <= s1_tag_d59_sr[13];
-    s1_tag_d59_sr[13] <= s1_tag_d59_sr[12];
-    s1_tag_d59_sr[12] <= s1_tag_d59_sr[11];
-    s1_tag_d59_sr[11] <= s1_tag_d59_sr[10];
-    s1_tag_d59_sr[10] <= s1_tag_d59_sr[9];
-    s1_tag_d59_sr[9] <= s1_tag_d59_sr[8];
-    s1_tag_d59_sr[8] <= s1_tag_d59_sr[7];
-    s1_tag_d59_sr[7] <= s1_tag_d59_sr[6];
-    s1_tag_d59_sr[6] <= s1_tag_d59_sr[5];
-    s1_tag_d59_sr[5] <= s1_tag_d59_sr[4];
-    s1_tag_d59_sr[4] <= s1_tag_d59_sr[3];
-    s1_tag_d59_sr[3] <= s1_tag_d59_sr[2];
-    s1_tag_d59_sr[2] <= s1_tag_d59_sr[1];
-    s1_tag_d59_sr[1] <= s1_tag;
+    s1_tag_d59_p1_wp <= plus_35;
+    s1_tag_d59_p1_rp <= plus_36;
+    s1_tag_d59_p1 <= s1_tag_d59_p1_mem[s1_tag_d59_p1_rp];
+    s1_tag_d59_p0_wp <= plus_37;
+    s1_tag_d59_p0_rp <= plus_38;
+    s1_tag_d59_p0 <= s1_tag_d59_p0_mem[s1_tag_d59_p0_rp];
     if (rst) s61_valid_out <= 1'h0;
     else s61_valid_out <= s1_valid_d59_59;
-    s61_tag_out <= s1_tag_d59;
+    s61_tag_out <= tag_out_int;
     s61_hit <= s60_hit;
     s61_t <= mux_s60_hit;
     s61_u <= mux_s60_hit_1;
@@ -1318,22 +1028,22 @@ module fxrt_intersect_n29_m32_t0_e18_tag59_c150 (
   fxrt_muls_s31xs32_s31xs32_d3l1 u_moved_products (
     .clk(clk),
     .a0(s_rs_u_div_t_1),
-    .b0(s2_w_p_d41),
+    .b0(s_s2_w_p_d41),
     .a1(s_rs_u_div_t_1),
-    .b1(s2_w_q_d41),
+    .b1(s_s2_w_q_d41),
     .p0(u_moved_products_p0),
     .p1(u_moved_products_p1)
   );
 
   fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1 u_bary_products (
     .clk(clk),
-    .a0(s1_e1p_d49),
+    .a0(s_s1_e1p_d49),
     .b0(s50_kq),
-    .a1(s1_e1q_d49),
+    .a1(s_s1_e1q_d49),
     .b1(s50_kp),
-    .a2(s1_e2q_d49),
+    .a2(s_s1_e2q_d49),
     .b2(s50_kp),
-    .a3(s1_e2p_d49),
+    .a3(s_s1_e2p_d49),
     .b3(s50_kq),
     .p0(u_bary_products_p0),
     .p1(u_bary_products_p1),

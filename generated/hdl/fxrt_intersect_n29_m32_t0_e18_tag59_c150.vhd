@@ -90,6 +90,42 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
     );
   end component;
 
+  type s2_w_p_d41_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s2_w_p_d41_mem : s2_w_p_d41_mem_t := (others => (others => '0'));
+
+  type s2_w_q_d41_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s2_w_q_d41_mem : s2_w_q_d41_mem_t := (others => (others => '0'));
+
+  type kp0_d5_d42_mem_t is array (0 to 63) of unsigned(29 downto 0);
+  signal kp0_d5_d42_mem : kp0_d5_d42_mem_t := (others => (others => '0'));
+
+  type kq0_d5_d42_mem_t is array (0 to 63) of unsigned(29 downto 0);
+  signal kq0_d5_d42_mem : kq0_d5_d42_mem_t := (others => (others => '0'));
+
+  type s1_e1p_d49_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s1_e1p_d49_mem : s1_e1p_d49_mem_t := (others => (others => '0'));
+
+  type s1_e1q_d49_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s1_e1q_d49_mem : s1_e1q_d49_mem_t := (others => (others => '0'));
+
+  type s1_e2q_d49_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s1_e2q_d49_mem : s1_e2q_d49_mem_t := (others => (others => '0'));
+
+  type s1_e2p_d49_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s1_e2p_d49_mem : s1_e2p_d49_mem_t := (others => (others => '0'));
+
+  type u_div_ok_d16_mem_t is array (0 to 15) of unsigned(0 downto 0);
+  signal u_div_ok_d16_mem : u_div_ok_d16_mem_t := (others => (others => '0'));
+
+  type u_div_t_1_d17_mem_t is array (0 to 31) of unsigned(29 downto 0);
+  signal u_div_t_1_d17_mem : u_div_t_1_d17_mem_t := (others => (others => '0'));
+
+  type s1_tag_d59_p1_mem_t is array (0 to 63) of unsigned(26 downto 0);
+  signal s1_tag_d59_p1_mem : s1_tag_d59_p1_mem_t := (others => (others => '0'));
+
+  type s1_tag_d59_p0_mem_t is array (0 to 63) of unsigned(31 downto 0);
+  signal s1_tag_d59_p0_mem : s1_tag_d59_p0_mem_t := (others => (others => '0'));
+
   -- not in a stage or state machine
 
   -- stage s1_inputs: register the inputs
@@ -206,12 +242,23 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal u_div_ok : unsigned(0 downto 0);
   signal rs_u_div_t_1 : unsigned(30 downto 0);
   signal s_rs_u_div_t_1 : signed(30 downto 0);
-  type s2_w_p_d41_sr_t is array (1 to 41) of signed(31 downto 0);
-  signal s2_w_p_d41_sr : s2_w_p_d41_sr_t := (others => (others => '0'));
-  signal s2_w_p_d41 : signed(31 downto 0);
-  type s2_w_q_d41_sr_t is array (1 to 41) of signed(31 downto 0);
-  signal s2_w_q_d41_sr : s2_w_q_d41_sr_t := (others => (others => '0'));
-  signal s2_w_q_d41 : signed(31 downto 0);
+  signal bits_s2_w_p : unsigned(31 downto 0);
+  signal s2_w_p_d41_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s2_w_p_d41_rp : unsigned(5 downto 0) := unsigned'("000000");
+  constant k_1_1 : unsigned(5 downto 0) := unsigned'("000001");
+  signal s2_w_p_d41_wp_plus_k_1_1 : unsigned(5 downto 0);
+  constant k_25 : unsigned(5 downto 0) := unsigned'("011001");
+  signal s2_w_p_d41_wp_plus_k_25 : unsigned(5 downto 0);
+  constant k_1_2 : unsigned(0 downto 0) := unsigned'("1");
+  signal s2_w_p_d41 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_s2_w_p_d41 : signed(31 downto 0);
+  signal bits_s2_w_q : unsigned(31 downto 0);
+  signal s2_w_q_d41_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s2_w_q_d41_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s2_w_q_d41_wp_plus_k_1_1 : unsigned(5 downto 0);
+  signal s2_w_q_d41_wp_plus_k_25 : unsigned(5 downto 0);
+  signal s2_w_q_d41 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_s2_w_q_d41 : signed(31 downto 0);
   signal u_moved_products_p0 : signed(62 downto 0);
   signal u_moved_products_p1 : signed(62 downto 0);
   constant k_1073741824_1 : signed(62 downto 0) := signed'("000000000000000000000000000000001000000000000000000000000000000");
@@ -223,34 +270,60 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal s49_tq : signed(62 downto 0) := signed'("000000000000000000000000000000000000000000000000000000000000000");
 
   -- stage s50_point: kp, kq: the hit point relative to the first vertex
-  type kp0_d5_d42_sr_t is array (1 to 42) of signed(29 downto 0);
-  signal kp0_d5_d42_sr : kp0_d5_d42_sr_t := (others => (others => '0'));
-  signal kp0_d5_d42 : signed(29 downto 0);
-  signal rs_kp0_d5_d42 : signed(31 downto 0);
+  signal bits_kp0_d5 : unsigned(29 downto 0);
+  signal kp0_d5_d42_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal kp0_d5_d42_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal kp0_d5_d42_wp_plus_k_1_1 : unsigned(5 downto 0);
+  constant k_24 : unsigned(5 downto 0) := unsigned'("011000");
+  signal kp0_d5_d42_wp_plus_k_24 : unsigned(5 downto 0);
+  signal kp0_d5_d42 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s_kp0_d5_d42 : signed(29 downto 0);
+  signal rs_s_kp0_d5_d42 : signed(31 downto 0);
   signal rs_s49_tp : signed(31 downto 0);
   signal kp : signed(31 downto 0);
-  type kq0_d5_d42_sr_t is array (1 to 42) of signed(29 downto 0);
-  signal kq0_d5_d42_sr : kq0_d5_d42_sr_t := (others => (others => '0'));
-  signal kq0_d5_d42 : signed(29 downto 0);
-  signal rs_kq0_d5_d42 : signed(31 downto 0);
+  signal bits_kq0_d5 : unsigned(29 downto 0);
+  signal kq0_d5_d42_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal kq0_d5_d42_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal kq0_d5_d42_wp_plus_k_1_1 : unsigned(5 downto 0);
+  signal kq0_d5_d42_wp_plus_k_24 : unsigned(5 downto 0);
+  signal kq0_d5_d42 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
+  signal s_kq0_d5_d42 : signed(29 downto 0);
+  signal rs_s_kq0_d5_d42 : signed(31 downto 0);
   signal rs_s49_tq : signed(31 downto 0);
   signal kq : signed(31 downto 0);
   signal s50_kp : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal s50_kq : signed(31 downto 0) := signed'("00000000000000000000000000000000");
 
   -- stage s56_bary: e1p·kq, e1q·kp, e2q·kp, e2p·kq
-  type s1_e1p_d49_sr_t is array (1 to 49) of signed(31 downto 0);
-  signal s1_e1p_d49_sr : s1_e1p_d49_sr_t := (others => (others => '0'));
-  signal s1_e1p_d49 : signed(31 downto 0);
-  type s1_e1q_d49_sr_t is array (1 to 49) of signed(31 downto 0);
-  signal s1_e1q_d49_sr : s1_e1q_d49_sr_t := (others => (others => '0'));
-  signal s1_e1q_d49 : signed(31 downto 0);
-  type s1_e2q_d49_sr_t is array (1 to 49) of signed(31 downto 0);
-  signal s1_e2q_d49_sr : s1_e2q_d49_sr_t := (others => (others => '0'));
-  signal s1_e2q_d49 : signed(31 downto 0);
-  type s1_e2p_d49_sr_t is array (1 to 49) of signed(31 downto 0);
-  signal s1_e2p_d49_sr : s1_e2p_d49_sr_t := (others => (others => '0'));
-  signal s1_e2p_d49 : signed(31 downto 0);
+  signal bits_s1_e1p : unsigned(31 downto 0);
+  signal s1_e1p_d49_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e1p_d49_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e1p_d49_wp_plus_k_1_1 : unsigned(5 downto 0);
+  constant k_17 : unsigned(5 downto 0) := unsigned'("010001");
+  signal s1_e1p_d49_wp_plus_k_17 : unsigned(5 downto 0);
+  signal s1_e1p_d49 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_s1_e1p_d49 : signed(31 downto 0);
+  signal bits_s1_e1q : unsigned(31 downto 0);
+  signal s1_e1q_d49_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e1q_d49_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e1q_d49_wp_plus_k_1_1 : unsigned(5 downto 0);
+  signal s1_e1q_d49_wp_plus_k_17 : unsigned(5 downto 0);
+  signal s1_e1q_d49 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_s1_e1q_d49 : signed(31 downto 0);
+  signal bits_s1_e2q : unsigned(31 downto 0);
+  signal s1_e2q_d49_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e2q_d49_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e2q_d49_wp_plus_k_1_1 : unsigned(5 downto 0);
+  signal s1_e2q_d49_wp_plus_k_17 : unsigned(5 downto 0);
+  signal s1_e2q_d49 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_s1_e2q_d49 : signed(31 downto 0);
+  signal bits_s1_e2p : unsigned(31 downto 0);
+  signal s1_e2p_d49_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e2p_d49_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_e2p_d49_wp_plus_k_1_1 : unsigned(5 downto 0);
+  signal s1_e2p_d49_wp_plus_k_17 : unsigned(5 downto 0);
+  signal s1_e2p_d49 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_s1_e2p_d49 : signed(31 downto 0);
   signal u_bary_products_p0 : signed(63 downto 0);
   signal u_bary_products_p1 : signed(63 downto 0);
   signal u_bary_products_p2 : signed(63 downto 0);
@@ -337,16 +410,24 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal over : unsigned(0 downto 0);
   signal s59_neg_or_over : unsigned(0 downto 0);
   signal not_s59_neg_or_over : unsigned(0 downto 0);
-  type u_div_ok_d16_sr_t is array (1 to 16) of unsigned(0 downto 0);
-  signal u_div_ok_d16_sr : u_div_ok_d16_sr_t := (others => (others => '0'));
-  signal u_div_ok_d16 : unsigned(0 downto 0);
+  signal u_div_ok_d16_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal u_div_ok_d16_rp : unsigned(3 downto 0) := unsigned'("0000");
+  constant k_1_3 : unsigned(3 downto 0) := unsigned'("0001");
+  signal plus_30 : unsigned(3 downto 0);
+  constant k_2_1 : unsigned(3 downto 0) := unsigned'("0010");
+  signal plus_31 : unsigned(3 downto 0);
+  signal u_div_ok_d16 : unsigned(0 downto 0) := unsigned'("0");
   signal hit_c : unsigned(0 downto 0);
   signal s60_hit : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage s61_result: the barycentric test; t, u, v zeroed on a miss
-  type u_div_t_1_d17_sr_t is array (1 to 17) of unsigned(29 downto 0);
-  signal u_div_t_1_d17_sr : u_div_t_1_d17_sr_t := (others => (others => '0'));
-  signal u_div_t_1_d17 : unsigned(29 downto 0);
+  signal u_div_t_1_d17_wp : unsigned(4 downto 0) := unsigned'("00000");
+  signal u_div_t_1_d17_rp : unsigned(4 downto 0) := unsigned'("00000");
+  constant k_1_4 : unsigned(4 downto 0) := unsigned'("00001");
+  signal plus_33 : unsigned(4 downto 0);
+  constant k_17_1 : unsigned(4 downto 0) := unsigned'("10001");
+  signal plus_34 : unsigned(4 downto 0);
+  signal u_div_t_1_d17 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   type s57_u_d3_sr_t is array (1 to 3) of signed(64 downto 0);
   signal s57_u_d3_sr : s57_u_d3_sr_t := (others => (others => '0'));
   signal s57_u_d3 : signed(64 downto 0);
@@ -412,9 +493,20 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
   signal s1_valid_d59_57 : unsigned(0 downto 0) := unsigned'("0");
   signal s1_valid_d59_58 : unsigned(0 downto 0) := unsigned'("0");
   signal s1_valid_d59_59 : unsigned(0 downto 0) := unsigned'("0");
-  type s1_tag_d59_sr_t is array (1 to 59) of unsigned(58 downto 0);
-  signal s1_tag_d59_sr : s1_tag_d59_sr_t := (others => (others => '0'));
-  signal s1_tag_d59 : unsigned(58 downto 0);
+  signal bits_s1_tag : unsigned(26 downto 0);
+  signal s1_tag_d59_p1_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_tag_d59_p1_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal plus_35 : unsigned(5 downto 0);
+  constant k_7 : unsigned(5 downto 0) := unsigned'("000111");
+  signal plus_36 : unsigned(5 downto 0);
+  signal s1_tag_d59_p1 : unsigned(26 downto 0) := unsigned'("000000000000000000000000000");
+  signal bits_s1_tag_1 : unsigned(31 downto 0);
+  signal s1_tag_d59_p0_wp : unsigned(5 downto 0) := unsigned'("000000");
+  signal s1_tag_d59_p0_rp : unsigned(5 downto 0) := unsigned'("000000");
+  signal plus_37 : unsigned(5 downto 0);
+  signal plus_38 : unsigned(5 downto 0);
+  signal s1_tag_d59_p0 : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal tag_out_int : unsigned(58 downto 0);
   constant k_0_5 : unsigned(29 downto 0) := unsigned'("000000000000000000000000000000");
   signal mux_s60_hit : unsigned(29 downto 0);
   signal shr_s57_u_d3 : signed(64 downto 0);
@@ -435,6 +527,48 @@ architecture rtl of fxrt_intersect_n29_m32_t0_e18_tag59_c150 is
 begin
 
   -- not in a stage or state machine
+
+  regs : process (clk)
+  begin
+    if rising_edge(clk) then
+      if k_1_2 = "1" then
+        s2_w_p_d41_mem(to_integer(s2_w_p_d41_wp)) <= bits_s2_w_p;
+      end if;
+      if k_1_2 = "1" then
+        s2_w_q_d41_mem(to_integer(s2_w_q_d41_wp)) <= bits_s2_w_q;
+      end if;
+      if k_1_2 = "1" then
+        kp0_d5_d42_mem(to_integer(kp0_d5_d42_wp)) <= bits_kp0_d5;
+      end if;
+      if k_1_2 = "1" then
+        kq0_d5_d42_mem(to_integer(kq0_d5_d42_wp)) <= bits_kq0_d5;
+      end if;
+      if k_1_2 = "1" then
+        s1_e1p_d49_mem(to_integer(s1_e1p_d49_wp)) <= bits_s1_e1p;
+      end if;
+      if k_1_2 = "1" then
+        s1_e1q_d49_mem(to_integer(s1_e1q_d49_wp)) <= bits_s1_e1q;
+      end if;
+      if k_1_2 = "1" then
+        s1_e2q_d49_mem(to_integer(s1_e2q_d49_wp)) <= bits_s1_e2q;
+      end if;
+      if k_1_2 = "1" then
+        s1_e2p_d49_mem(to_integer(s1_e2p_d49_wp)) <= bits_s1_e2p;
+      end if;
+      if k_1_2 = "1" then
+        u_div_ok_d16_mem(to_integer(u_div_ok_d16_wp)) <= u_div_ok;
+      end if;
+      if k_1_2 = "1" then
+        u_div_t_1_d17_mem(to_integer(u_div_t_1_d17_wp)) <= u_div_t_1;
+      end if;
+      if k_1_2 = "1" then
+        s1_tag_d59_p1_mem(to_integer(s1_tag_d59_p1_wp)) <= bits_s1_tag;
+      end if;
+      if k_1_2 = "1" then
+        s1_tag_d59_p0_mem(to_integer(s1_tag_d59_p0_wp)) <= bits_s1_tag_1;
+      end if;
+    end if;
+  end process regs;
 
   -- stage s1_inputs: register the inputs
 
@@ -598,8 +732,14 @@ begin
   -- stage s49_rounded: rnd(t·ω_p, F), rnd(t·ω_q, F)
   rs_u_div_t_1 <= resize(u_div_t_1, 31);
   s_rs_u_div_t_1 <= signed(rs_u_div_t_1);
-  s2_w_p_d41 <= s2_w_p_d41_sr(41);
-  s2_w_q_d41 <= s2_w_q_d41_sr(41);
+  bits_s2_w_p <= unsigned(s2_w_p(31 downto 0));
+  s2_w_p_d41_wp_plus_k_1_1 <= s2_w_p_d41_wp + k_1_1;
+  s2_w_p_d41_wp_plus_k_25 <= s2_w_p_d41_wp + k_25;
+  s_s2_w_p_d41 <= signed(s2_w_p_d41);
+  bits_s2_w_q <= unsigned(s2_w_q(31 downto 0));
+  s2_w_q_d41_wp_plus_k_1_1 <= s2_w_q_d41_wp + k_1_1;
+  s2_w_q_d41_wp_plus_k_25 <= s2_w_q_d41_wp + k_25;
+  s_s2_w_q_d41 <= signed(s2_w_q_d41);
   plus_7 <= u_moved_products_p0 + k_1073741824_1;
   shr_plus_7 <= shift_right(plus_7, 31);
   plus_8 <= u_moved_products_p1 + k_1073741824_1;
@@ -608,54 +748,80 @@ begin
   s49_rounded_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s2_w_p_d41_sr(2 to 41) <= s2_w_p_d41_sr(1 to 40);
-      s2_w_p_d41_sr(1) <= s2_w_p;
-      s2_w_q_d41_sr(2 to 41) <= s2_w_q_d41_sr(1 to 40);
-      s2_w_q_d41_sr(1) <= s2_w_q;
+      s2_w_p_d41_wp <= s2_w_p_d41_wp_plus_k_1_1;
+      s2_w_p_d41_rp <= s2_w_p_d41_wp_plus_k_25;
+      s2_w_p_d41 <= s2_w_p_d41_mem(to_integer(s2_w_p_d41_rp));
+      s2_w_q_d41_wp <= s2_w_q_d41_wp_plus_k_1_1;
+      s2_w_q_d41_rp <= s2_w_q_d41_wp_plus_k_25;
+      s2_w_q_d41 <= s2_w_q_d41_mem(to_integer(s2_w_q_d41_rp));
       s49_tp <= shr_plus_7;
       s49_tq <= shr_plus_8;
     end if;
   end process s49_rounded_regs;
 
   -- stage s50_point: kp, kq: the hit point relative to the first vertex
-  kp0_d5_d42 <= kp0_d5_d42_sr(42);
-  rs_kp0_d5_d42 <= resize(kp0_d5_d42, 32);
+  bits_kp0_d5 <= unsigned(kp0_d5(29 downto 0));
+  kp0_d5_d42_wp_plus_k_1_1 <= kp0_d5_d42_wp + k_1_1;
+  kp0_d5_d42_wp_plus_k_24 <= kp0_d5_d42_wp + k_24;
+  s_kp0_d5_d42 <= signed(kp0_d5_d42);
+  rs_s_kp0_d5_d42 <= resize(s_kp0_d5_d42, 32);
   rs_s49_tp <= s49_tp(31 downto 0);
-  kp <= rs_kp0_d5_d42 + rs_s49_tp;
-  kq0_d5_d42 <= kq0_d5_d42_sr(42);
-  rs_kq0_d5_d42 <= resize(kq0_d5_d42, 32);
+  kp <= rs_s_kp0_d5_d42 + rs_s49_tp;
+  bits_kq0_d5 <= unsigned(kq0_d5(29 downto 0));
+  kq0_d5_d42_wp_plus_k_1_1 <= kq0_d5_d42_wp + k_1_1;
+  kq0_d5_d42_wp_plus_k_24 <= kq0_d5_d42_wp + k_24;
+  s_kq0_d5_d42 <= signed(kq0_d5_d42);
+  rs_s_kq0_d5_d42 <= resize(s_kq0_d5_d42, 32);
   rs_s49_tq <= s49_tq(31 downto 0);
-  kq <= rs_kq0_d5_d42 + rs_s49_tq;
+  kq <= rs_s_kq0_d5_d42 + rs_s49_tq;
 
   s50_point_regs : process (clk)
   begin
     if rising_edge(clk) then
-      kp0_d5_d42_sr(2 to 42) <= kp0_d5_d42_sr(1 to 41);
-      kp0_d5_d42_sr(1) <= kp0_d5;
-      kq0_d5_d42_sr(2 to 42) <= kq0_d5_d42_sr(1 to 41);
-      kq0_d5_d42_sr(1) <= kq0_d5;
+      kp0_d5_d42_wp <= kp0_d5_d42_wp_plus_k_1_1;
+      kp0_d5_d42_rp <= kp0_d5_d42_wp_plus_k_24;
+      kp0_d5_d42 <= kp0_d5_d42_mem(to_integer(kp0_d5_d42_rp));
+      kq0_d5_d42_wp <= kq0_d5_d42_wp_plus_k_1_1;
+      kq0_d5_d42_rp <= kq0_d5_d42_wp_plus_k_24;
+      kq0_d5_d42 <= kq0_d5_d42_mem(to_integer(kq0_d5_d42_rp));
       s50_kp <= kp;
       s50_kq <= kq;
     end if;
   end process s50_point_regs;
 
   -- stage s56_bary: e1p·kq, e1q·kp, e2q·kp, e2p·kq
-  s1_e1p_d49 <= s1_e1p_d49_sr(49);
-  s1_e1q_d49 <= s1_e1q_d49_sr(49);
-  s1_e2q_d49 <= s1_e2q_d49_sr(49);
-  s1_e2p_d49 <= s1_e2p_d49_sr(49);
+  bits_s1_e1p <= unsigned(s1_e1p(31 downto 0));
+  s1_e1p_d49_wp_plus_k_1_1 <= s1_e1p_d49_wp + k_1_1;
+  s1_e1p_d49_wp_plus_k_17 <= s1_e1p_d49_wp + k_17;
+  s_s1_e1p_d49 <= signed(s1_e1p_d49);
+  bits_s1_e1q <= unsigned(s1_e1q(31 downto 0));
+  s1_e1q_d49_wp_plus_k_1_1 <= s1_e1q_d49_wp + k_1_1;
+  s1_e1q_d49_wp_plus_k_17 <= s1_e1q_d49_wp + k_17;
+  s_s1_e1q_d49 <= signed(s1_e1q_d49);
+  bits_s1_e2q <= unsigned(s1_e2q(31 downto 0));
+  s1_e2q_d49_wp_plus_k_1_1 <= s1_e2q_d49_wp + k_1_1;
+  s1_e2q_d49_wp_plus_k_17 <= s1_e2q_d49_wp + k_17;
+  s_s1_e2q_d49 <= signed(s1_e2q_d49);
+  bits_s1_e2p <= unsigned(s1_e2p(31 downto 0));
+  s1_e2p_d49_wp_plus_k_1_1 <= s1_e2p_d49_wp + k_1_1;
+  s1_e2p_d49_wp_plus_k_17 <= s1_e2p_d49_wp + k_17;
+  s_s1_e2p_d49 <= signed(s1_e2p_d49);
 
   s56_bary_regs : process (clk)
   begin
     if rising_edge(clk) then
-      s1_e1p_d49_sr(2 to 49) <= s1_e1p_d49_sr(1 to 48);
-      s1_e1p_d49_sr(1) <= s1_e1p;
-      s1_e1q_d49_sr(2 to 49) <= s1_e1q_d49_sr(1 to 48);
-      s1_e1q_d49_sr(1) <= s1_e1q;
-      s1_e2q_d49_sr(2 to 49) <= s1_e2q_d49_sr(1 to 48);
-      s1_e2q_d49_sr(1) <= s1_e2q;
-      s1_e2p_d49_sr(2 to 49) <= s1_e2p_d49_sr(1 to 48);
-      s1_e2p_d49_sr(1) <= s1_e2p;
+      s1_e1p_d49_wp <= s1_e1p_d49_wp_plus_k_1_1;
+      s1_e1p_d49_rp <= s1_e1p_d49_wp_plus_k_17;
+      s1_e1p_d49 <= s1_e1p_d49_mem(to_integer(s1_e1p_d49_rp));
+      s1_e1q_d49_wp <= s1_e1q_d49_wp_plus_k_1_1;
+      s1_e1q_d49_rp <= s1_e1q_d49_wp_plus_k_17;
+      s1_e1q_d49 <= s1_e1q_d49_mem(to_integer(s1_e1q_d49_rp));
+      s1_e2q_d49_wp <= s1_e2q_d49_wp_plus_k_1_1;
+      s1_e2q_d49_rp <= s1_e2q_d49_wp_plus_k_17;
+      s1_e2q_d49 <= s1_e2q_d49_mem(to_integer(s1_e2q_d49_rp));
+      s1_e2p_d49_wp <= s1_e2p_d49_wp_plus_k_1_1;
+      s1_e2p_d49_rp <= s1_e2p_d49_wp_plus_k_17;
+      s1_e2p_d49 <= s1_e2p_d49_mem(to_integer(s1_e2p_d49_rp));
       s56_a1 <= u_bary_products_p0;
       s56_a2 <= u_bary_products_p1;
       s56_b1 <= u_bary_products_p2;
@@ -754,23 +920,32 @@ begin
   over <= or_28 or and_29;
   s59_neg_or_over <= s59_neg or over;
   not_s59_neg_or_over <= not s59_neg_or_over;
-  u_div_ok_d16 <= u_div_ok_d16_sr(16);
+  plus_30 <= u_div_ok_d16_wp + k_1_3;
+  plus_31 <= u_div_ok_d16_wp + k_2_1;
   hit_c <= not_s59_neg_or_over and u_div_ok_d16;
 
   s60_hit_regs : process (clk)
   begin
     if rising_edge(clk) then
-      u_div_ok_d16_sr(2 to 16) <= u_div_ok_d16_sr(1 to 15);
-      u_div_ok_d16_sr(1) <= u_div_ok;
+      u_div_ok_d16_wp <= plus_30;
+      u_div_ok_d16_rp <= plus_31;
+      u_div_ok_d16 <= u_div_ok_d16_mem(to_integer(u_div_ok_d16_rp));
       s60_hit <= hit_c;
     end if;
   end process s60_hit_regs;
 
   -- stage s61_result: the barycentric test; t, u, v zeroed on a miss
-  u_div_t_1_d17 <= u_div_t_1_d17_sr(17);
+  plus_33 <= u_div_t_1_d17_wp + k_1_4;
+  plus_34 <= u_div_t_1_d17_wp + k_17_1;
   s57_u_d3 <= s57_u_d3_sr(3);
   s57_v_d3 <= s57_v_d3_sr(3);
-  s1_tag_d59 <= s1_tag_d59_sr(59);
+  bits_s1_tag <= unsigned(s1_tag(58 downto 32));
+  plus_35 <= s1_tag_d59_p1_wp + k_1_1;
+  plus_36 <= s1_tag_d59_p1_wp + k_7;
+  bits_s1_tag_1 <= unsigned(s1_tag(31 downto 0));
+  plus_37 <= s1_tag_d59_p0_wp + k_1_1;
+  plus_38 <= s1_tag_d59_p0_wp + k_7;
+  tag_out_int <= unsigned(std_logic_vector'(std_logic_vector(s1_tag_d59_p1) & std_logic_vector(s1_tag_d59_p0)));
   mux_s60_hit <= u_div_t_1_d17 when s60_hit = "1" else k_0_5;
   shr_s57_u_d3 <= shift_right(s57_u_d3, 18);
   rs_shr_s57_u_d3 <= shr_s57_u_d3(31 downto 0);
@@ -784,8 +959,9 @@ begin
   s61_result_regs : process (clk)
   begin
     if rising_edge(clk) then
-      u_div_t_1_d17_sr(2 to 17) <= u_div_t_1_d17_sr(1 to 16);
-      u_div_t_1_d17_sr(1) <= u_div_t_1;
+      u_div_t_1_d17_wp <= plus_33;
+      u_div_t_1_d17_rp <= plus_34;
+      u_div_t_1_d17 <= u_div_t_1_d17_mem(to_integer(u_div_t_1_d17_rp));
       s57_u_d3_sr(2 to 3) <= s57_u_d3_sr(1 to 2);
       s57_u_d3_sr(1) <= s57_u;
       s57_v_d3_sr(2 to 3) <= s57_v_d3_sr(1 to 2);
@@ -1085,14 +1261,18 @@ begin
       else
         s1_valid_d59_59 <= s1_valid_d59_58;
       end if;
-      s1_tag_d59_sr(2 to 59) <= s1_tag_d59_sr(1 to 58);
-      s1_tag_d59_sr(1) <= s1_tag;
+      s1_tag_d59_p1_wp <= plus_35;
+      s1_tag_d59_p1_rp <= plus_36;
+      s1_tag_d59_p1 <= s1_tag_d59_p1_mem(to_integer(s1_tag_d59_p1_rp));
+      s1_tag_d59_p0_wp <= plus_37;
+      s1_tag_d59_p0_rp <= plus_38;
+      s1_tag_d59_p0 <= s1_tag_d59_p0_mem(to_integer(s1_tag_d59_p0_rp));
       if rst = '1' then
         s61_valid_out <= unsigned'("0");
       else
         s61_valid_out <= s1_valid_d59_59;
       end if;
-      s61_tag_out <= s1_tag_d59;
+      s61_tag_out <= tag_out_int;
       s61_hit <= s60_hit;
       s61_t <= mux_s60_hit;
       s61_u <= mux_s60_hit_1;
@@ -1130,9 +1310,9 @@ begin
     port map (
       clk => clk,
       a0 => s_rs_u_div_t_1,
-      b0 => s2_w_p_d41,
+      b0 => s_s2_w_p_d41,
       a1 => s_rs_u_div_t_1,
-      b1 => s2_w_q_d41,
+      b1 => s_s2_w_q_d41,
       p0 => u_moved_products_p0,
       p1 => u_moved_products_p1
     );
@@ -1140,13 +1320,13 @@ begin
   u_bary_products : fxrt_muls_s32xs32_s32xs32_s32xs32_s32xs32_d3l1
     port map (
       clk => clk,
-      a0 => s1_e1p_d49,
+      a0 => s_s1_e1p_d49,
       b0 => s50_kq,
-      a1 => s1_e1q_d49,
+      a1 => s_s1_e1q_d49,
       b1 => s50_kp,
-      a2 => s1_e2q_d49,
+      a2 => s_s1_e2q_d49,
       b2 => s50_kp,
-      a3 => s1_e2p_d49,
+      a3 => s_s1_e2p_d49,
       b3 => s50_kq,
       p0 => u_bary_products_p0,
       p1 => u_bary_products_p1,

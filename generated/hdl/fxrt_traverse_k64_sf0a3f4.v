@@ -151,6 +151,39 @@ module fxrt_traverse_k64_sf0a3f4 (
   (* ram_style = "distributed" *) reg [10:0] leaf_q_mem_g3 [0:63];
   initial $readmemh("fxrt_traverse_k64_sf0a3f4_leaf_q_mem_g3.hex", leaf_q_mem_g3);
 
+  (* ram_style = "distributed" *) reg [0:0] negative_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_negative_mem.hex", negative_mem);
+
+  (* ram_style = "distributed" *) reg [0:0] f_inner_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_f_inner_mem.hex", f_inner_mem);
+
+  (* ram_style = "distributed" *) reg [5:0] f_slot_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_f_slot_mem.hex", f_slot_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] f_tmin_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_f_tmin_mem.hex", f_tmin_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] f_tmax_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_f_tmax_mem.hex", f_tmax_mem);
+
+  (* ram_style = "distributed" *) reg [5:0] f_sp_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_f_sp_mem.hex", f_sp_mem);
+
+  (* ram_style = "distributed" *) reg [12:0] f_child_mem [0:15];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_f_child_mem.hex", f_child_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] d0_hi_mem [0:7];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_d0_hi_mem.hex", d0_hi_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] d0_lo_mem [0:7];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_d0_lo_mem.hex", d0_lo_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] d1_hi_mem [0:7];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_d1_hi_mem.hex", d1_hi_mem);
+
+  (* ram_style = "distributed" *) reg [31:0] d1_lo_mem [0:7];
+  initial $readmemh("fxrt_traverse_k64_sf0a3f4_d1_lo_mem.hex", d1_lo_mem);
+
   // not in a stage or state machine
   wire [86:0] cat_0;
   wire [47:0] u_invx;
@@ -1167,10 +1200,13 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [47:0] case_axis_n1;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] negative_c;
-  (* mem2reg *) reg [0:0] negative_sr [1:10];
-  integer negative_i;
-  initial for (negative_i = 1; negative_i <= 10; negative_i = negative_i + 1) negative_sr[negative_i] = 1'h0;
-  wire [0:0] negative;
+  reg [3:0] negative_wp = 4'h0;
+  reg [3:0] negative_rp = 4'h0;
+  wire [3:0] k_1_3 = 4'h1;
+  wire [3:0] negative_wp_plus_k_1_3;
+  wire [3:0] k_8_1 = 4'h8;
+  wire [3:0] negative_wp_plus_k_8_1;
+  reg [0:0] negative = 1'h0;
 
   // register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
   reg [0:0] leaf_q_push = 1'h0;
@@ -1207,30 +1243,41 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [0:0] f_valid_9 = 1'h0;
   reg [0:0] f_valid_10 = 1'h0;
   reg [0:0] f_valid_11 = 1'h0;
-  (* mem2reg *) reg [0:0] f_inner_sr [1:11];
-  integer f_inner_i;
-  initial for (f_inner_i = 1; f_inner_i <= 11; f_inner_i = f_inner_i + 1) f_inner_sr[f_inner_i] = 1'h0;
-  wire [0:0] f_inner;
-  (* mem2reg *) reg [5:0] f_slot_sr [1:11];
-  integer f_slot_i;
-  initial for (f_slot_i = 1; f_slot_i <= 11; f_slot_i = f_slot_i + 1) f_slot_sr[f_slot_i] = 6'h00;
-  wire [5:0] f_slot;
-  (* mem2reg *) reg signed [31:0] f_tmin_sr [1:11];
-  integer f_tmin_i;
-  initial for (f_tmin_i = 1; f_tmin_i <= 11; f_tmin_i = f_tmin_i + 1) f_tmin_sr[f_tmin_i] = 32'sh00000000;
-  wire signed [31:0] f_tmin;
-  (* mem2reg *) reg signed [31:0] f_tmax_sr [1:11];
-  integer f_tmax_i;
-  initial for (f_tmax_i = 1; f_tmax_i <= 11; f_tmax_i = f_tmax_i + 1) f_tmax_sr[f_tmax_i] = 32'sh00000000;
-  wire signed [31:0] f_tmax;
-  (* mem2reg *) reg [5:0] f_sp_sr [1:11];
-  integer f_sp_i;
-  initial for (f_sp_i = 1; f_sp_i <= 11; f_sp_i = f_sp_i + 1) f_sp_sr[f_sp_i] = 6'h00;
-  wire [5:0] f_sp;
-  (* mem2reg *) reg [12:0] f_child_sr [1:11];
-  integer f_child_i;
-  initial for (f_child_i = 1; f_child_i <= 11; f_child_i = f_child_i + 1) f_child_sr[f_child_i] = 13'h0000;
-  wire [12:0] f_child;
+  reg [3:0] f_inner_wp = 4'h0;
+  reg [3:0] f_inner_rp = 4'h0;
+  wire [3:0] f_inner_wp_plus_k_1_3;
+  wire [3:0] k_7_1 = 4'h7;
+  wire [3:0] f_inner_wp_plus_k_7_1;
+  reg [0:0] f_inner = 1'h0;
+  reg [3:0] f_slot_wp = 4'h0;
+  reg [3:0] f_slot_rp = 4'h0;
+  wire [3:0] f_slot_wp_plus_k_1_3;
+  wire [3:0] f_slot_wp_plus_k_7_1;
+  reg [5:0] f_slot = 6'h00;
+  wire [31:0] bits_n_tmin;
+  reg [3:0] f_tmin_wp = 4'h0;
+  reg [3:0] f_tmin_rp = 4'h0;
+  wire [3:0] f_tmin_wp_plus_k_1_3;
+  wire [3:0] f_tmin_wp_plus_k_7_1;
+  reg [31:0] f_tmin = 32'h00000000;
+  wire signed [31:0] s_f_tmin;
+  wire [31:0] bits_n_tmax;
+  reg [3:0] f_tmax_wp = 4'h0;
+  reg [3:0] f_tmax_rp = 4'h0;
+  wire [3:0] f_tmax_wp_plus_k_1_3;
+  wire [3:0] f_tmax_wp_plus_k_7_1;
+  reg [31:0] f_tmax = 32'h00000000;
+  wire signed [31:0] s_f_tmax;
+  reg [3:0] f_sp_wp = 4'h0;
+  reg [3:0] f_sp_rp = 4'h0;
+  wire [3:0] f_sp_wp_plus_k_1_3;
+  wire [3:0] f_sp_wp_plus_k_7_1;
+  reg [5:0] f_sp = 6'h00;
+  reg [3:0] f_child_wp = 4'h0;
+  reg [3:0] f_child_rp = 4'h0;
+  wire [3:0] f_child_wp_plus_k_1_3;
+  wire [3:0] f_child_wp_plus_k_7_1;
+  reg [12:0] f_child = 13'h0000;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 47 are read
   wire signed [47:0] case_axis_n1_1;
   /* verilator lint_on UNUSEDSIGNAL */
@@ -1238,7 +1285,7 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [0:0] negative_n1 = 1'h0;
   reg signed [31:0] tmin_n1 = 32'sh00000000;
   reg signed [31:0] tmax_n1 = 32'sh00000000;
-  wire signed [31:0] k_1_3 = 32'sh00000001;
+  wire signed [31:0] k_1_4 = 32'sh00000001;
   wire signed [31:0] tmax_plus_1;
   reg signed [31:0] tmax_p1 = 32'sh00000000;
   wire signed [31:0] tmin_minus_1;
@@ -1259,50 +1306,64 @@ module fxrt_traverse_k64_sf0a3f4 (
   wire signed [31:0] mux_negative_n1;
   wire signed [31:0] d0_hi_c;
   reg signed [31:0] d0_hi_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d0_hi_sr [1:8];
-  integer d0_hi_i;
-  initial for (d0_hi_i = 1; d0_hi_i <= 8; d0_hi_i = d0_hi_i + 1) d0_hi_sr[d0_hi_i] = 32'sh00000000;
-  wire signed [31:0] d0_hi;
+  wire [31:0] bits_d0_hi_n3;
+  reg [2:0] d0_hi_wp = 3'h0;
+  reg [2:0] d0_hi_rp = 3'h0;
+  wire [2:0] k_1_5 = 3'h1;
+  wire [2:0] d0_hi_wp_plus_k_1_5;
+  wire [2:0] k_2_1 = 3'h2;
+  wire [2:0] d0_hi_wp_plus_k_2_1;
+  reg [31:0] d0_hi = 32'h00000000;
+  wire signed [31:0] s_d0_hi;
   wire signed [31:0] mux_negative_n1_1;
   wire signed [31:0] d0_lo_c;
   reg signed [31:0] d0_lo_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d0_lo_sr [1:8];
-  integer d0_lo_i;
-  initial for (d0_lo_i = 1; d0_lo_i <= 8; d0_lo_i = d0_lo_i + 1) d0_lo_sr[d0_lo_i] = 32'sh00000000;
-  wire signed [31:0] d0_lo;
+  wire [31:0] bits_d0_lo_n3;
+  reg [2:0] d0_lo_wp = 3'h0;
+  reg [2:0] d0_lo_rp = 3'h0;
+  wire [2:0] d0_lo_wp_plus_k_1_5;
+  wire [2:0] d0_lo_wp_plus_k_2_1;
+  reg [31:0] d0_lo = 32'h00000000;
+  wire signed [31:0] s_d0_lo;
   wire signed [31:0] mux_negative_n1_2;
   wire signed [31:0] d1_hi_c;
   reg signed [31:0] d1_hi_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d1_hi_sr [1:8];
-  integer d1_hi_i;
-  initial for (d1_hi_i = 1; d1_hi_i <= 8; d1_hi_i = d1_hi_i + 1) d1_hi_sr[d1_hi_i] = 32'sh00000000;
-  wire signed [31:0] d1_hi;
+  wire [31:0] bits_d1_hi_n3;
+  reg [2:0] d1_hi_wp = 3'h0;
+  reg [2:0] d1_hi_rp = 3'h0;
+  wire [2:0] d1_hi_wp_plus_k_1_5;
+  wire [2:0] d1_hi_wp_plus_k_2_1;
+  reg [31:0] d1_hi = 32'h00000000;
+  wire signed [31:0] s_d1_hi;
   wire signed [31:0] mux_negative_n1_3;
   wire signed [31:0] d1_lo_c;
   reg signed [31:0] d1_lo_n3 = 32'sh00000000;
-  (* mem2reg *) reg signed [31:0] d1_lo_sr [1:8];
-  integer d1_lo_i;
-  initial for (d1_lo_i = 1; d1_lo_i <= 8; d1_lo_i = d1_lo_i + 1) d1_lo_sr[d1_lo_i] = 32'sh00000000;
-  wire signed [31:0] d1_lo;
+  wire [31:0] bits_d1_lo_n3;
+  reg [2:0] d1_lo_wp = 3'h0;
+  reg [2:0] d1_lo_rp = 3'h0;
+  wire [2:0] d1_lo_wp_plus_k_1_5;
+  wire [2:0] d1_lo_wp_plus_k_2_1;
+  reg [31:0] d1_lo = 32'h00000000;
+  wire signed [31:0] s_d1_lo;
   wire signed [32:0] rs_plane_t_land0;
-  wire signed [32:0] rs_d0_hi;
+  wire signed [32:0] rs_s_d0_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
   wire signed [32:0] minus_151;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_below;
-  wire signed [32:0] rs_d0_lo;
+  wire signed [32:0] rs_s_d0_lo;
   wire signed [32:0] rs_plane_t_land0_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
   wire signed [32:0] minus_152;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d0_above;
   wire signed [32:0] rs_plane_t_land1;
-  wire signed [32:0] rs_d1_hi;
+  wire signed [32:0] rs_s_d1_hi;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
   wire signed [32:0] minus_153;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [0:0] d1_below;
-  wire signed [32:0] rs_d1_lo;
+  wire signed [32:0] rs_s_d1_lo;
   wire signed [32:0] rs_plane_t_land1_1;
   /* verilator lint_off UNUSEDSIGNAL */  // only bits 32 are read
   wire signed [32:0] minus_154;
@@ -1329,8 +1390,8 @@ module fxrt_traverse_k64_sf0a3f4 (
   reg [0:0] g_negative = 1'h0;
 
   // stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  wire [12:0] k_1_4 = 13'h0001;
-  wire [12:0] g_child_plus_k_1_4;
+  wire [12:0] k_1_6 = 13'h0001;
+  wire [12:0] g_child_plus_k_1_6;
   wire [12:0] near;
   wire [12:0] far;
   wire signed [31:0] near_max;
@@ -1425,6 +1486,17 @@ module fxrt_traverse_k64_sf0a3f4 (
     if (leaf_q_push) leaf_q_mem_g1[leaf_q_wr] <= bits_leaf_q_din_1;
     if (leaf_q_push) leaf_q_mem_g2[leaf_q_wr] <= bits_leaf_q_din_2;
     if (leaf_q_push) leaf_q_mem_g3[leaf_q_wr] <= bits_leaf_q_din_3;
+    if (k_1_2) negative_mem[negative_wp] <= negative_c;
+    if (k_1_2) f_inner_mem[f_inner_wp] <= is_inner;
+    if (k_1_2) f_slot_mem[f_slot_wp] <= n_slot;
+    if (k_1_2) f_tmin_mem[f_tmin_wp] <= bits_n_tmin;
+    if (k_1_2) f_tmax_mem[f_tmax_wp] <= bits_n_tmax;
+    if (k_1_2) f_sp_mem[f_sp_wp] <= n_sp;
+    if (k_1_2) f_child_mem[f_child_wp] <= nw_child;
+    if (k_1_2) d0_hi_mem[d0_hi_wp] <= bits_d0_hi_n3;
+    if (k_1_2) d0_lo_mem[d0_lo_wp] <= bits_d0_lo_n3;
+    if (k_1_2) d1_hi_mem[d1_hi_wp] <= bits_d1_hi_n3;
+    if (k_1_2) d1_lo_mem[d1_lo_wp] <= bits_d1_lo_n3;
   end
 
   // stage slots: the free list: the next free slot for the top, the slots holding a ray
@@ -2365,7 +2437,8 @@ module fxrt_traverse_k64_sf0a3f4 (
     (axis_n1 == 2'h2) ? s_ray_invz_q :
     s_ray_invx_q;
   assign negative_c = case_axis_n1[47];
-  assign negative = negative_sr[10];
+  assign negative_wp_plus_k_1_3 = negative_wp + k_1_3;
+  assign negative_wp_plus_k_8_1 = negative_wp + k_8_1;
 
   always @(posedge clk) begin : ring_n_regs
     if (rst) n_valid_1 <= 1'h0;
@@ -2530,16 +2603,9 @@ module fxrt_traverse_k64_sf0a3f4 (
     plane_t_land0 <= plane_t;
     plane_t_land1 <= plane_t_1;
     axis_n1 <= nw_axis;
-    negative_sr[10] <= negative_sr[9];
-    negative_sr[9] <= negative_sr[8];
-    negative_sr[8] <= negative_sr[7];
-    negative_sr[7] <= negative_sr[6];
-    negative_sr[6] <= negative_sr[5];
-    negative_sr[5] <= negative_sr[4];
-    negative_sr[4] <= negative_sr[3];
-    negative_sr[3] <= negative_sr[2];
-    negative_sr[2] <= negative_sr[1];
-    negative_sr[1] <= negative_c;
+    negative_wp <= negative_wp_plus_k_1_3;
+    negative_rp <= negative_wp_plus_k_8_1;
+    negative <= negative_mem[negative_rp];
   end
 
   // register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
@@ -2574,50 +2640,72 @@ module fxrt_traverse_k64_sf0a3f4 (
   // stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   assign not_leaf_push = ~leaf_push;
   assign n_stays = n_valid_3 & not_leaf_push;
-  assign f_inner = f_inner_sr[11];
-  assign f_slot = f_slot_sr[11];
-  assign f_tmin = f_tmin_sr[11];
-  assign f_tmax = f_tmax_sr[11];
-  assign f_sp = f_sp_sr[11];
-  assign f_child = f_child_sr[11];
+  assign f_inner_wp_plus_k_1_3 = f_inner_wp + k_1_3;
+  assign f_inner_wp_plus_k_7_1 = f_inner_wp + k_7_1;
+  assign f_slot_wp_plus_k_1_3 = f_slot_wp + k_1_3;
+  assign f_slot_wp_plus_k_7_1 = f_slot_wp + k_7_1;
+  assign bits_n_tmin = n_tmin[31:0];
+  assign f_tmin_wp_plus_k_1_3 = f_tmin_wp + k_1_3;
+  assign f_tmin_wp_plus_k_7_1 = f_tmin_wp + k_7_1;
+  assign s_f_tmin = $signed(f_tmin);
+  assign bits_n_tmax = n_tmax[31:0];
+  assign f_tmax_wp_plus_k_1_3 = f_tmax_wp + k_1_3;
+  assign f_tmax_wp_plus_k_7_1 = f_tmax_wp + k_7_1;
+  assign s_f_tmax = $signed(f_tmax);
+  assign f_sp_wp_plus_k_1_3 = f_sp_wp + k_1_3;
+  assign f_sp_wp_plus_k_7_1 = f_sp_wp + k_7_1;
+  assign f_child_wp_plus_k_1_3 = f_child_wp + k_1_3;
+  assign f_child_wp_plus_k_7_1 = f_child_wp + k_7_1;
   assign case_axis_n1_1 =
     (axis_n1 == 2'h1) ? s_ray_invy_q :
     (axis_n1 == 2'h2) ? s_ray_invz_q :
     s_ray_invx_q;
   assign bits_case_axis_n1_1 = case_axis_n1_1[47];
-  assign tmax_plus_1 = n_tmax + k_1_3;
-  assign tmin_minus_1 = n_tmin - k_1_3;
+  assign tmax_plus_1 = n_tmax + k_1_4;
+  assign tmin_minus_1 = n_tmin - k_1_4;
   assign rs_tmin_n1 = $signed({{1{tmin_n1[31]}}, tmin_n1});
   assign rs_tmax_p1 = $signed({{1{tmax_p1[31]}}, tmax_p1});
   assign minus_150 = rs_tmin_n1 - rs_tmax_p1;
   assign tmin_le_tmax_c = minus_150[32];
   assign mux_negative_n1 = negative_n1 ? tmax_p1_n2 : tmax_n2;
   assign d0_hi_c = tmin_le_tmax ? mux_negative_n1 : k_m2147483648;
-  assign d0_hi = d0_hi_sr[8];
+  assign bits_d0_hi_n3 = d0_hi_n3[31:0];
+  assign d0_hi_wp_plus_k_1_5 = d0_hi_wp + k_1_5;
+  assign d0_hi_wp_plus_k_2_1 = d0_hi_wp + k_2_1;
+  assign s_d0_hi = $signed(d0_hi);
   assign mux_negative_n1_1 = negative_n1 ? tmin_n2 : tmin_m1_n2;
   assign d0_lo_c = tmin_le_tmax ? mux_negative_n1_1 : k_2147483647;
-  assign d0_lo = d0_lo_sr[8];
+  assign bits_d0_lo_n3 = d0_lo_n3[31:0];
+  assign d0_lo_wp_plus_k_1_5 = d0_lo_wp + k_1_5;
+  assign d0_lo_wp_plus_k_2_1 = d0_lo_wp + k_2_1;
+  assign s_d0_lo = $signed(d0_lo);
   assign mux_negative_n1_2 = negative_n1 ? tmax_n2 : tmax_p1_n2;
   assign d1_hi_c = tmin_le_tmax ? mux_negative_n1_2 : k_m2147483648;
-  assign d1_hi = d1_hi_sr[8];
+  assign bits_d1_hi_n3 = d1_hi_n3[31:0];
+  assign d1_hi_wp_plus_k_1_5 = d1_hi_wp + k_1_5;
+  assign d1_hi_wp_plus_k_2_1 = d1_hi_wp + k_2_1;
+  assign s_d1_hi = $signed(d1_hi);
   assign mux_negative_n1_3 = negative_n1 ? tmin_m1_n2 : tmin_n2;
   assign d1_lo_c = tmin_le_tmax ? mux_negative_n1_3 : k_2147483647;
-  assign d1_lo = d1_lo_sr[8];
+  assign bits_d1_lo_n3 = d1_lo_n3[31:0];
+  assign d1_lo_wp_plus_k_1_5 = d1_lo_wp + k_1_5;
+  assign d1_lo_wp_plus_k_2_1 = d1_lo_wp + k_2_1;
+  assign s_d1_lo = $signed(d1_lo);
   assign rs_plane_t_land0 = $signed({{1{plane_t_land0[31]}}, plane_t_land0});
-  assign rs_d0_hi = $signed({{1{d0_hi[31]}}, d0_hi});
-  assign minus_151 = rs_plane_t_land0 - rs_d0_hi;
+  assign rs_s_d0_hi = $signed({{1{s_d0_hi[31]}}, s_d0_hi});
+  assign minus_151 = rs_plane_t_land0 - rs_s_d0_hi;
   assign d0_below = minus_151[32];
-  assign rs_d0_lo = $signed({{1{d0_lo[31]}}, d0_lo});
+  assign rs_s_d0_lo = $signed({{1{s_d0_lo[31]}}, s_d0_lo});
   assign rs_plane_t_land0_1 = $signed({{1{plane_t_land0[31]}}, plane_t_land0});
-  assign minus_152 = rs_d0_lo - rs_plane_t_land0_1;
+  assign minus_152 = rs_s_d0_lo - rs_plane_t_land0_1;
   assign d0_above = minus_152[32];
   assign rs_plane_t_land1 = $signed({{1{plane_t_land1[31]}}, plane_t_land1});
-  assign rs_d1_hi = $signed({{1{d1_hi[31]}}, d1_hi});
-  assign minus_153 = rs_plane_t_land1 - rs_d1_hi;
+  assign rs_s_d1_hi = $signed({{1{s_d1_hi[31]}}, s_d1_hi});
+  assign minus_153 = rs_plane_t_land1 - rs_s_d1_hi;
   assign d1_below = minus_153[32];
-  assign rs_d1_lo = $signed({{1{d1_lo[31]}}, d1_lo});
+  assign rs_s_d1_lo = $signed({{1{s_d1_lo[31]}}, s_d1_lo});
   assign rs_plane_t_land1_1 = $signed({{1{plane_t_land1[31]}}, plane_t_land1});
-  assign minus_154 = rs_d1_lo - rs_plane_t_land1_1;
+  assign minus_154 = rs_s_d1_lo - rs_plane_t_land1_1;
   assign d1_above = minus_154[32];
   assign near_lt_tmax_c = negative ? d1_below : d0_below;
   assign far_gt_tmin_c = negative ? d0_above : d1_above;
@@ -2649,72 +2737,24 @@ module fxrt_traverse_k64_sf0a3f4 (
     else f_valid_10 <= f_valid_9;
     if (rst) f_valid_11 <= 1'h0;
     else f_valid_11 <= f_valid_10;
-    f_inner_sr[11] <= f_inner_sr[10];
-    f_inner_sr[10] <= f_inner_sr[9];
-    f_inner_sr[9] <= f_inner_sr[8];
-    f_inner_sr[8] <= f_inner_sr[7];
-    f_inner_sr[7] <= f_inner_sr[6];
-    f_inner_sr[6] <= f_inner_sr[5];
-    f_inner_sr[5] <= f_inner_sr[4];
-    f_inner_sr[4] <= f_inner_sr[3];
-    f_inner_sr[3] <= f_inner_sr[2];
-    f_inner_sr[2] <= f_inner_sr[1];
-    f_inner_sr[1] <= is_inner;
-    f_slot_sr[11] <= f_slot_sr[10];
-    f_slot_sr[10] <= f_slot_sr[9];
-    f_slot_sr[9] <= f_slot_sr[8];
-    f_slot_sr[8] <= f_slot_sr[7];
-    f_slot_sr[7] <= f_slot_sr[6];
-    f_slot_sr[6] <= f_slot_sr[5];
-    f_slot_sr[5] <= f_slot_sr[4];
-    f_slot_sr[4] <= f_slot_sr[3];
-    f_slot_sr[3] <= f_slot_sr[2];
-    f_slot_sr[2] <= f_slot_sr[1];
-    f_slot_sr[1] <= n_slot;
-    f_tmin_sr[11] <= f_tmin_sr[10];
-    f_tmin_sr[10] <= f_tmin_sr[9];
-    f_tmin_sr[9] <= f_tmin_sr[8];
-    f_tmin_sr[8] <= f_tmin_sr[7];
-    f_tmin_sr[7] <= f_tmin_sr[6];
-    f_tmin_sr[6] <= f_tmin_sr[5];
-    f_tmin_sr[5] <= f_tmin_sr[4];
-    f_tmin_sr[4] <= f_tmin_sr[3];
-    f_tmin_sr[3] <= f_tmin_sr[2];
-    f_tmin_sr[2] <= f_tmin_sr[1];
-    f_tmin_sr[1] <= n_tmin;
-    f_tmax_sr[11] <= f_tmax_sr[10];
-    f_tmax_sr[10] <= f_tmax_sr[9];
-    f_tmax_sr[9] <= f_tmax_sr[8];
-    f_tmax_sr[8] <= f_tmax_sr[7];
-    f_tmax_sr[7] <= f_tmax_sr[6];
-    f_tmax_sr[6] <= f_tmax_sr[5];
-    f_tmax_sr[5] <= f_tmax_sr[4];
-    f_tmax_sr[4] <= f_tmax_sr[3];
-    f_tmax_sr[3] <= f_tmax_sr[2];
-    f_tmax_sr[2] <= f_tmax_sr[1];
-    f_tmax_sr[1] <= n_tmax;
-    f_sp_sr[11] <= f_sp_sr[10];
-    f_sp_sr[10] <= f_sp_sr[9];
-    f_sp_sr[9] <= f_sp_sr[8];
-    f_sp_sr[8] <= f_sp_sr[7];
-    f_sp_sr[7] <= f_sp_sr[6];
-    f_sp_sr[6] <= f_sp_sr[5];
-    f_sp_sr[5] <= f_sp_sr[4];
-    f_sp_sr[4] <= f_sp_sr[3];
-    f_sp_sr[3] <= f_sp_sr[2];
-    f_sp_sr[2] <= f_sp_sr[1];
-    f_sp_sr[1] <= n_sp;
-    f_child_sr[11] <= f_child_sr[10];
-    f_child_sr[10] <= f_child_sr[9];
-    f_child_sr[9] <= f_child_sr[8];
-    f_child_sr[8] <= f_child_sr[7];
-    f_child_sr[7] <= f_child_sr[6];
-    f_child_sr[6] <= f_child_sr[5];
-    f_child_sr[5] <= f_child_sr[4];
-    f_child_sr[4] <= f_child_sr[3];
-    f_child_sr[3] <= f_child_sr[2];
-    f_child_sr[2] <= f_child_sr[1];
-    f_child_sr[1] <= nw_child;
+    f_inner_wp <= f_inner_wp_plus_k_1_3;
+    f_inner_rp <= f_inner_wp_plus_k_7_1;
+    f_inner <= f_inner_mem[f_inner_rp];
+    f_slot_wp <= f_slot_wp_plus_k_1_3;
+    f_slot_rp <= f_slot_wp_plus_k_7_1;
+    f_slot <= f_slot_mem[f_slot_rp];
+    f_tmin_wp <= f_tmin_wp_plus_k_1_3;
+    f_tmin_rp <= f_tmin_wp_plus_k_7_1;
+    f_tmin <= f_tmin_mem[f_tmin_rp];
+    f_tmax_wp <= f_tmax_wp_plus_k_1_3;
+    f_tmax_rp <= f_tmax_wp_plus_k_7_1;
+    f_tmax <= f_tmax_mem[f_tmax_rp];
+    f_sp_wp <= f_sp_wp_plus_k_1_3;
+    f_sp_rp <= f_sp_wp_plus_k_7_1;
+    f_sp <= f_sp_mem[f_sp_rp];
+    f_child_wp <= f_child_wp_plus_k_1_3;
+    f_child_rp <= f_child_wp_plus_k_7_1;
+    f_child <= f_child_mem[f_child_rp];
     negative_n1 <= bits_case_axis_n1_1;
     tmin_n1 <= n_tmin;
     tmax_n1 <= n_tmax;
@@ -2726,41 +2766,21 @@ module fxrt_traverse_k64_sf0a3f4 (
     tmax_p1_n2 <= tmax_p1;
     tmin_m1_n2 <= tmin_m1;
     d0_hi_n3 <= d0_hi_c;
-    d0_hi_sr[8] <= d0_hi_sr[7];
-    d0_hi_sr[7] <= d0_hi_sr[6];
-    d0_hi_sr[6] <= d0_hi_sr[5];
-    d0_hi_sr[5] <= d0_hi_sr[4];
-    d0_hi_sr[4] <= d0_hi_sr[3];
-    d0_hi_sr[3] <= d0_hi_sr[2];
-    d0_hi_sr[2] <= d0_hi_sr[1];
-    d0_hi_sr[1] <= d0_hi_n3;
+    d0_hi_wp <= d0_hi_wp_plus_k_1_5;
+    d0_hi_rp <= d0_hi_wp_plus_k_2_1;
+    d0_hi <= d0_hi_mem[d0_hi_rp];
     d0_lo_n3 <= d0_lo_c;
-    d0_lo_sr[8] <= d0_lo_sr[7];
-    d0_lo_sr[7] <= d0_lo_sr[6];
-    d0_lo_sr[6] <= d0_lo_sr[5];
-    d0_lo_sr[5] <= d0_lo_sr[4];
-    d0_lo_sr[4] <= d0_lo_sr[3];
-    d0_lo_sr[3] <= d0_lo_sr[2];
-    d0_lo_sr[2] <= d0_lo_sr[1];
-    d0_lo_sr[1] <= d0_lo_n3;
+    d0_lo_wp <= d0_lo_wp_plus_k_1_5;
+    d0_lo_rp <= d0_lo_wp_plus_k_2_1;
+    d0_lo <= d0_lo_mem[d0_lo_rp];
     d1_hi_n3 <= d1_hi_c;
-    d1_hi_sr[8] <= d1_hi_sr[7];
-    d1_hi_sr[7] <= d1_hi_sr[6];
-    d1_hi_sr[6] <= d1_hi_sr[5];
-    d1_hi_sr[5] <= d1_hi_sr[4];
-    d1_hi_sr[4] <= d1_hi_sr[3];
-    d1_hi_sr[3] <= d1_hi_sr[2];
-    d1_hi_sr[2] <= d1_hi_sr[1];
-    d1_hi_sr[1] <= d1_hi_n3;
+    d1_hi_wp <= d1_hi_wp_plus_k_1_5;
+    d1_hi_rp <= d1_hi_wp_plus_k_2_1;
+    d1_hi <= d1_hi_mem[d1_hi_rp];
     d1_lo_n3 <= d1_lo_c;
-    d1_lo_sr[8] <= d1_lo_sr[7];
-    d1_lo_sr[7] <= d1_lo_sr[6];
-    d1_lo_sr[6] <= d1_lo_sr[5];
-    d1_lo_sr[5] <= d1_lo_sr[4];
-    d1_lo_sr[4] <= d1_lo_sr[3];
-    d1_lo_sr[3] <= d1_lo_sr[2];
-    d1_lo_sr[2] <= d1_lo_sr[1];
-    d1_lo_sr[1] <= d1_lo_n3;
+    d1_lo_wp <= d1_lo_wp_plus_k_1_5;
+    d1_lo_rp <= d1_lo_wp_plus_k_2_1;
+    d1_lo <= d1_lo_mem[d1_lo_rp];
     near_lt_tmax <= near_lt_tmax_c;
     far_gt_tmin <= far_gt_tmin_c;
     go_near <= go_near_c;
@@ -2769,17 +2789,17 @@ module fxrt_traverse_k64_sf0a3f4 (
     far_start <= mux_negative_1;
     g_slot <= f_slot;
     g_child <= f_child;
-    g_tmin <= f_tmin;
-    g_tmax <= f_tmax;
+    g_tmin <= s_f_tmin;
+    g_tmax <= s_f_tmax;
     g_sp <= f_sp;
     g_inner <= f_inner;
     g_negative <= negative;
   end
 
   // stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  assign g_child_plus_k_1_4 = g_child + k_1_4;
-  assign near = g_negative ? g_child_plus_k_1_4 : g_child;
-  assign far = g_negative ? g_child : g_child_plus_k_1_4;
+  assign g_child_plus_k_1_6 = g_child + k_1_6;
+  assign near = g_negative ? g_child_plus_k_1_6 : g_child;
+  assign far = g_negative ? g_child : g_child_plus_k_1_6;
   assign near_max = near_lt_tmax ? near_end : g_tmax;
   assign far_min = far_gt_tmin ? far_start : g_tmin;
   assign enter_near = g_inner & go_near;

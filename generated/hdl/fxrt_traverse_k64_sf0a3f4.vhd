@@ -176,6 +176,39 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   type leaf_q_mem_g3_t is array (0 to 63) of unsigned(10 downto 0);
   signal leaf_q_mem_g3 : leaf_q_mem_g3_t := (others => (others => '0'));
 
+  type negative_mem_t is array (0 to 15) of unsigned(0 downto 0);
+  signal negative_mem : negative_mem_t := (others => (others => '0'));
+
+  type f_inner_mem_t is array (0 to 15) of unsigned(0 downto 0);
+  signal f_inner_mem : f_inner_mem_t := (others => (others => '0'));
+
+  type f_slot_mem_t is array (0 to 15) of unsigned(5 downto 0);
+  signal f_slot_mem : f_slot_mem_t := (others => (others => '0'));
+
+  type f_tmin_mem_t is array (0 to 15) of unsigned(31 downto 0);
+  signal f_tmin_mem : f_tmin_mem_t := (others => (others => '0'));
+
+  type f_tmax_mem_t is array (0 to 15) of unsigned(31 downto 0);
+  signal f_tmax_mem : f_tmax_mem_t := (others => (others => '0'));
+
+  type f_sp_mem_t is array (0 to 15) of unsigned(5 downto 0);
+  signal f_sp_mem : f_sp_mem_t := (others => (others => '0'));
+
+  type f_child_mem_t is array (0 to 15) of unsigned(12 downto 0);
+  signal f_child_mem : f_child_mem_t := (others => (others => '0'));
+
+  type d0_hi_mem_t is array (0 to 7) of unsigned(31 downto 0);
+  signal d0_hi_mem : d0_hi_mem_t := (others => (others => '0'));
+
+  type d0_lo_mem_t is array (0 to 7) of unsigned(31 downto 0);
+  signal d0_lo_mem : d0_lo_mem_t := (others => (others => '0'));
+
+  type d1_hi_mem_t is array (0 to 7) of unsigned(31 downto 0);
+  signal d1_hi_mem : d1_hi_mem_t := (others => (others => '0'));
+
+  type d1_lo_mem_t is array (0 to 7) of unsigned(31 downto 0);
+  signal d1_lo_mem : d1_lo_mem_t := (others => (others => '0'));
+
   attribute keep : string;
 
   -- not in a stage or state machine
@@ -1176,9 +1209,13 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal axis_n1 : unsigned(1 downto 0) := unsigned'("00");
   signal case_axis_n1 : signed(47 downto 0);
   signal negative_c : unsigned(0 downto 0);
-  type negative_sr_t is array (1 to 10) of unsigned(0 downto 0);
-  signal negative_sr : negative_sr_t := (others => (others => '0'));
-  signal negative : unsigned(0 downto 0);
+  signal negative_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal negative_rp : unsigned(3 downto 0) := unsigned'("0000");
+  constant k_1_3 : unsigned(3 downto 0) := unsigned'("0001");
+  signal negative_wp_plus_k_1_3 : unsigned(3 downto 0);
+  constant k_8_1 : unsigned(3 downto 0) := unsigned'("1000");
+  signal negative_wp_plus_k_8_1 : unsigned(3 downto 0);
+  signal negative : unsigned(0 downto 0) := unsigned'("0");
 
   -- register copies leaf_q_push_copies: leaf_q_push and 1 copies, to split its fan-out
   signal leaf_q_push : unsigned(0 downto 0) := unsigned'("0");
@@ -1232,30 +1269,47 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal f_valid_9 : unsigned(0 downto 0) := unsigned'("0");
   signal f_valid_10 : unsigned(0 downto 0) := unsigned'("0");
   signal f_valid_11 : unsigned(0 downto 0) := unsigned'("0");
-  type f_inner_sr_t is array (1 to 11) of unsigned(0 downto 0);
-  signal f_inner_sr : f_inner_sr_t := (others => (others => '0'));
-  signal f_inner : unsigned(0 downto 0);
-  type f_slot_sr_t is array (1 to 11) of unsigned(5 downto 0);
-  signal f_slot_sr : f_slot_sr_t := (others => (others => '0'));
-  signal f_slot : unsigned(5 downto 0);
-  type f_tmin_sr_t is array (1 to 11) of signed(31 downto 0);
-  signal f_tmin_sr : f_tmin_sr_t := (others => (others => '0'));
-  signal f_tmin : signed(31 downto 0);
-  type f_tmax_sr_t is array (1 to 11) of signed(31 downto 0);
-  signal f_tmax_sr : f_tmax_sr_t := (others => (others => '0'));
-  signal f_tmax : signed(31 downto 0);
-  type f_sp_sr_t is array (1 to 11) of unsigned(5 downto 0);
-  signal f_sp_sr : f_sp_sr_t := (others => (others => '0'));
-  signal f_sp : unsigned(5 downto 0);
-  type f_child_sr_t is array (1 to 11) of unsigned(12 downto 0);
-  signal f_child_sr : f_child_sr_t := (others => (others => '0'));
-  signal f_child : unsigned(12 downto 0);
+  signal f_inner_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_inner_rp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_inner_wp_plus_k_1_3 : unsigned(3 downto 0);
+  constant k_7_1 : unsigned(3 downto 0) := unsigned'("0111");
+  signal f_inner_wp_plus_k_7_1 : unsigned(3 downto 0);
+  signal f_inner : unsigned(0 downto 0) := unsigned'("0");
+  signal f_slot_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_slot_rp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_slot_wp_plus_k_1_3 : unsigned(3 downto 0);
+  signal f_slot_wp_plus_k_7_1 : unsigned(3 downto 0);
+  signal f_slot : unsigned(5 downto 0) := unsigned'("000000");
+  signal bits_n_tmin : unsigned(31 downto 0);
+  signal f_tmin_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_tmin_rp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_tmin_wp_plus_k_1_3 : unsigned(3 downto 0);
+  signal f_tmin_wp_plus_k_7_1 : unsigned(3 downto 0);
+  signal f_tmin : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_f_tmin : signed(31 downto 0);
+  signal bits_n_tmax : unsigned(31 downto 0);
+  signal f_tmax_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_tmax_rp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_tmax_wp_plus_k_1_3 : unsigned(3 downto 0);
+  signal f_tmax_wp_plus_k_7_1 : unsigned(3 downto 0);
+  signal f_tmax : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_f_tmax : signed(31 downto 0);
+  signal f_sp_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_sp_rp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_sp_wp_plus_k_1_3 : unsigned(3 downto 0);
+  signal f_sp_wp_plus_k_7_1 : unsigned(3 downto 0);
+  signal f_sp : unsigned(5 downto 0) := unsigned'("000000");
+  signal f_child_wp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_child_rp : unsigned(3 downto 0) := unsigned'("0000");
+  signal f_child_wp_plus_k_1_3 : unsigned(3 downto 0);
+  signal f_child_wp_plus_k_7_1 : unsigned(3 downto 0);
+  signal f_child : unsigned(12 downto 0) := unsigned'("0000000000000");
   signal case_axis_n1_1 : signed(47 downto 0);
   signal bits_case_axis_n1_1 : unsigned(0 downto 0);
   signal negative_n1 : unsigned(0 downto 0) := unsigned'("0");
   signal tmin_n1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmax_n1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  constant k_1_3 : signed(31 downto 0) := signed'("00000000000000000000000000000001");
+  constant k_1_4 : signed(31 downto 0) := signed'("00000000000000000000000000000001");
   signal tmax_plus_1 : signed(31 downto 0);
   signal tmax_p1 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
   signal tmin_minus_1 : signed(31 downto 0);
@@ -1274,40 +1328,58 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal mux_negative_n1 : signed(31 downto 0);
   signal d0_hi_c : signed(31 downto 0);
   signal d0_hi_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d0_hi_sr_t is array (1 to 8) of signed(31 downto 0);
-  signal d0_hi_sr : d0_hi_sr_t := (others => (others => '0'));
-  signal d0_hi : signed(31 downto 0);
+  signal bits_d0_hi_n3 : unsigned(31 downto 0);
+  signal d0_hi_wp : unsigned(2 downto 0) := unsigned'("000");
+  signal d0_hi_rp : unsigned(2 downto 0) := unsigned'("000");
+  constant k_1_5 : unsigned(2 downto 0) := unsigned'("001");
+  signal d0_hi_wp_plus_k_1_5 : unsigned(2 downto 0);
+  constant k_2_1 : unsigned(2 downto 0) := unsigned'("010");
+  signal d0_hi_wp_plus_k_2_1 : unsigned(2 downto 0);
+  signal d0_hi : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_d0_hi : signed(31 downto 0);
   signal mux_negative_n1_1 : signed(31 downto 0);
   signal d0_lo_c : signed(31 downto 0);
   signal d0_lo_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d0_lo_sr_t is array (1 to 8) of signed(31 downto 0);
-  signal d0_lo_sr : d0_lo_sr_t := (others => (others => '0'));
-  signal d0_lo : signed(31 downto 0);
+  signal bits_d0_lo_n3 : unsigned(31 downto 0);
+  signal d0_lo_wp : unsigned(2 downto 0) := unsigned'("000");
+  signal d0_lo_rp : unsigned(2 downto 0) := unsigned'("000");
+  signal d0_lo_wp_plus_k_1_5 : unsigned(2 downto 0);
+  signal d0_lo_wp_plus_k_2_1 : unsigned(2 downto 0);
+  signal d0_lo : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_d0_lo : signed(31 downto 0);
   signal mux_negative_n1_2 : signed(31 downto 0);
   signal d1_hi_c : signed(31 downto 0);
   signal d1_hi_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d1_hi_sr_t is array (1 to 8) of signed(31 downto 0);
-  signal d1_hi_sr : d1_hi_sr_t := (others => (others => '0'));
-  signal d1_hi : signed(31 downto 0);
+  signal bits_d1_hi_n3 : unsigned(31 downto 0);
+  signal d1_hi_wp : unsigned(2 downto 0) := unsigned'("000");
+  signal d1_hi_rp : unsigned(2 downto 0) := unsigned'("000");
+  signal d1_hi_wp_plus_k_1_5 : unsigned(2 downto 0);
+  signal d1_hi_wp_plus_k_2_1 : unsigned(2 downto 0);
+  signal d1_hi : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_d1_hi : signed(31 downto 0);
   signal mux_negative_n1_3 : signed(31 downto 0);
   signal d1_lo_c : signed(31 downto 0);
   signal d1_lo_n3 : signed(31 downto 0) := signed'("00000000000000000000000000000000");
-  type d1_lo_sr_t is array (1 to 8) of signed(31 downto 0);
-  signal d1_lo_sr : d1_lo_sr_t := (others => (others => '0'));
-  signal d1_lo : signed(31 downto 0);
+  signal bits_d1_lo_n3 : unsigned(31 downto 0);
+  signal d1_lo_wp : unsigned(2 downto 0) := unsigned'("000");
+  signal d1_lo_rp : unsigned(2 downto 0) := unsigned'("000");
+  signal d1_lo_wp_plus_k_1_5 : unsigned(2 downto 0);
+  signal d1_lo_wp_plus_k_2_1 : unsigned(2 downto 0);
+  signal d1_lo : unsigned(31 downto 0) := unsigned'("00000000000000000000000000000000");
+  signal s_d1_lo : signed(31 downto 0);
   signal rs_plane_t_land0 : signed(32 downto 0);
-  signal rs_d0_hi : signed(32 downto 0);
+  signal rs_s_d0_hi : signed(32 downto 0);
   signal minus_151 : signed(32 downto 0);
   signal d0_below : unsigned(0 downto 0);
-  signal rs_d0_lo : signed(32 downto 0);
+  signal rs_s_d0_lo : signed(32 downto 0);
   signal rs_plane_t_land0_1 : signed(32 downto 0);
   signal minus_152 : signed(32 downto 0);
   signal d0_above : unsigned(0 downto 0);
   signal rs_plane_t_land1 : signed(32 downto 0);
-  signal rs_d1_hi : signed(32 downto 0);
+  signal rs_s_d1_hi : signed(32 downto 0);
   signal minus_153 : signed(32 downto 0);
   signal d1_below : unsigned(0 downto 0);
-  signal rs_d1_lo : signed(32 downto 0);
+  signal rs_s_d1_lo : signed(32 downto 0);
   signal rs_plane_t_land1_1 : signed(32 downto 0);
   signal minus_154 : signed(32 downto 0);
   signal d1_above : unsigned(0 downto 0);
@@ -1332,8 +1404,8 @@ architecture rtl of fxrt_traverse_k64_sf0a3f4 is
   signal g_negative : unsigned(0 downto 0) := unsigned'("0");
 
   -- stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  constant k_1_4 : unsigned(12 downto 0) := unsigned'("0000000000001");
-  signal g_child_plus_k_1_4 : unsigned(12 downto 0);
+  constant k_1_6 : unsigned(12 downto 0) := unsigned'("0000000000001");
+  signal g_child_plus_k_1_6 : unsigned(12 downto 0);
   signal near : unsigned(12 downto 0);
   signal far : unsigned(12 downto 0);
   signal near_max : signed(31 downto 0);
@@ -1484,6 +1556,39 @@ begin
       end if;
       if leaf_q_push = "1" then
         leaf_q_mem_g3(to_integer(leaf_q_wr)) <= bits_leaf_q_din_3;
+      end if;
+      if k_1_2 = "1" then
+        negative_mem(to_integer(negative_wp)) <= negative_c;
+      end if;
+      if k_1_2 = "1" then
+        f_inner_mem(to_integer(f_inner_wp)) <= is_inner;
+      end if;
+      if k_1_2 = "1" then
+        f_slot_mem(to_integer(f_slot_wp)) <= n_slot;
+      end if;
+      if k_1_2 = "1" then
+        f_tmin_mem(to_integer(f_tmin_wp)) <= bits_n_tmin;
+      end if;
+      if k_1_2 = "1" then
+        f_tmax_mem(to_integer(f_tmax_wp)) <= bits_n_tmax;
+      end if;
+      if k_1_2 = "1" then
+        f_sp_mem(to_integer(f_sp_wp)) <= n_sp;
+      end if;
+      if k_1_2 = "1" then
+        f_child_mem(to_integer(f_child_wp)) <= nw_child;
+      end if;
+      if k_1_2 = "1" then
+        d0_hi_mem(to_integer(d0_hi_wp)) <= bits_d0_hi_n3;
+      end if;
+      if k_1_2 = "1" then
+        d0_lo_mem(to_integer(d0_lo_wp)) <= bits_d0_lo_n3;
+      end if;
+      if k_1_2 = "1" then
+        d1_hi_mem(to_integer(d1_hi_wp)) <= bits_d1_hi_n3;
+      end if;
+      if k_1_2 = "1" then
+        d1_lo_mem(to_integer(d1_lo_wp)) <= bits_d1_lo_n3;
       end if;
     end if;
   end process regs;
@@ -2648,7 +2753,8 @@ begin
       s_ray_invz_q when "10",
       s_ray_invx_q when others;
   negative_c <= unsigned(case_axis_n1(47 downto 47));
-  negative <= negative_sr(10);
+  negative_wp_plus_k_1_3 <= negative_wp + k_1_3;
+  negative_wp_plus_k_8_1 <= negative_wp + k_8_1;
 
   ring_n_regs : process (clk)
   begin
@@ -2926,8 +3032,9 @@ begin
       plane_t_land0 <= plane_t;
       plane_t_land1 <= plane_t_1;
       axis_n1 <= nw_axis;
-      negative_sr(2 to 10) <= negative_sr(1 to 9);
-      negative_sr(1) <= negative_c;
+      negative_wp <= negative_wp_plus_k_1_3;
+      negative_rp <= negative_wp_plus_k_8_1;
+      negative <= negative_mem(to_integer(negative_rp));
     end if;
   end process ring_n_regs;
 
@@ -2975,51 +3082,73 @@ begin
   -- stage ring_f: N to F: the token rides along, the limits made on the way; F: the compares
   not_leaf_push <= not leaf_push;
   n_stays <= n_valid_3 and not_leaf_push;
-  f_inner <= f_inner_sr(11);
-  f_slot <= f_slot_sr(11);
-  f_tmin <= f_tmin_sr(11);
-  f_tmax <= f_tmax_sr(11);
-  f_sp <= f_sp_sr(11);
-  f_child <= f_child_sr(11);
+  f_inner_wp_plus_k_1_3 <= f_inner_wp + k_1_3;
+  f_inner_wp_plus_k_7_1 <= f_inner_wp + k_7_1;
+  f_slot_wp_plus_k_1_3 <= f_slot_wp + k_1_3;
+  f_slot_wp_plus_k_7_1 <= f_slot_wp + k_7_1;
+  bits_n_tmin <= unsigned(n_tmin(31 downto 0));
+  f_tmin_wp_plus_k_1_3 <= f_tmin_wp + k_1_3;
+  f_tmin_wp_plus_k_7_1 <= f_tmin_wp + k_7_1;
+  s_f_tmin <= signed(f_tmin);
+  bits_n_tmax <= unsigned(n_tmax(31 downto 0));
+  f_tmax_wp_plus_k_1_3 <= f_tmax_wp + k_1_3;
+  f_tmax_wp_plus_k_7_1 <= f_tmax_wp + k_7_1;
+  s_f_tmax <= signed(f_tmax);
+  f_sp_wp_plus_k_1_3 <= f_sp_wp + k_1_3;
+  f_sp_wp_plus_k_7_1 <= f_sp_wp + k_7_1;
+  f_child_wp_plus_k_1_3 <= f_child_wp + k_1_3;
+  f_child_wp_plus_k_7_1 <= f_child_wp + k_7_1;
   with axis_n1 select
     case_axis_n1_1 <=
       s_ray_invy_q when "01",
       s_ray_invz_q when "10",
       s_ray_invx_q when others;
   bits_case_axis_n1_1 <= unsigned(case_axis_n1_1(47 downto 47));
-  tmax_plus_1 <= n_tmax + k_1_3;
-  tmin_minus_1 <= n_tmin - k_1_3;
+  tmax_plus_1 <= n_tmax + k_1_4;
+  tmin_minus_1 <= n_tmin - k_1_4;
   rs_tmin_n1 <= resize(tmin_n1, 33);
   rs_tmax_p1 <= resize(tmax_p1, 33);
   minus_150 <= rs_tmin_n1 - rs_tmax_p1;
   tmin_le_tmax_c <= unsigned(minus_150(32 downto 32));
   mux_negative_n1 <= tmax_p1_n2 when negative_n1 = "1" else tmax_n2;
   d0_hi_c <= mux_negative_n1 when tmin_le_tmax = "1" else k_m2147483648;
-  d0_hi <= d0_hi_sr(8);
+  bits_d0_hi_n3 <= unsigned(d0_hi_n3(31 downto 0));
+  d0_hi_wp_plus_k_1_5 <= d0_hi_wp + k_1_5;
+  d0_hi_wp_plus_k_2_1 <= d0_hi_wp + k_2_1;
+  s_d0_hi <= signed(d0_hi);
   mux_negative_n1_1 <= tmin_n2 when negative_n1 = "1" else tmin_m1_n2;
   d0_lo_c <= mux_negative_n1_1 when tmin_le_tmax = "1" else k_2147483647;
-  d0_lo <= d0_lo_sr(8);
+  bits_d0_lo_n3 <= unsigned(d0_lo_n3(31 downto 0));
+  d0_lo_wp_plus_k_1_5 <= d0_lo_wp + k_1_5;
+  d0_lo_wp_plus_k_2_1 <= d0_lo_wp + k_2_1;
+  s_d0_lo <= signed(d0_lo);
   mux_negative_n1_2 <= tmax_n2 when negative_n1 = "1" else tmax_p1_n2;
   d1_hi_c <= mux_negative_n1_2 when tmin_le_tmax = "1" else k_m2147483648;
-  d1_hi <= d1_hi_sr(8);
+  bits_d1_hi_n3 <= unsigned(d1_hi_n3(31 downto 0));
+  d1_hi_wp_plus_k_1_5 <= d1_hi_wp + k_1_5;
+  d1_hi_wp_plus_k_2_1 <= d1_hi_wp + k_2_1;
+  s_d1_hi <= signed(d1_hi);
   mux_negative_n1_3 <= tmin_m1_n2 when negative_n1 = "1" else tmin_n2;
   d1_lo_c <= mux_negative_n1_3 when tmin_le_tmax = "1" else k_2147483647;
-  d1_lo <= d1_lo_sr(8);
+  bits_d1_lo_n3 <= unsigned(d1_lo_n3(31 downto 0));
+  d1_lo_wp_plus_k_1_5 <= d1_lo_wp + k_1_5;
+  d1_lo_wp_plus_k_2_1 <= d1_lo_wp + k_2_1;
+  s_d1_lo <= signed(d1_lo);
   rs_plane_t_land0 <= resize(plane_t_land0, 33);
-  rs_d0_hi <= resize(d0_hi, 33);
-  minus_151 <= rs_plane_t_land0 - rs_d0_hi;
+  rs_s_d0_hi <= resize(s_d0_hi, 33);
+  minus_151 <= rs_plane_t_land0 - rs_s_d0_hi;
   d0_below <= unsigned(minus_151(32 downto 32));
-  rs_d0_lo <= resize(d0_lo, 33);
+  rs_s_d0_lo <= resize(s_d0_lo, 33);
   rs_plane_t_land0_1 <= resize(plane_t_land0, 33);
-  minus_152 <= rs_d0_lo - rs_plane_t_land0_1;
+  minus_152 <= rs_s_d0_lo - rs_plane_t_land0_1;
   d0_above <= unsigned(minus_152(32 downto 32));
   rs_plane_t_land1 <= resize(plane_t_land1, 33);
-  rs_d1_hi <= resize(d1_hi, 33);
-  minus_153 <= rs_plane_t_land1 - rs_d1_hi;
+  rs_s_d1_hi <= resize(s_d1_hi, 33);
+  minus_153 <= rs_plane_t_land1 - rs_s_d1_hi;
   d1_below <= unsigned(minus_153(32 downto 32));
-  rs_d1_lo <= resize(d1_lo, 33);
+  rs_s_d1_lo <= resize(s_d1_lo, 33);
   rs_plane_t_land1_1 <= resize(plane_t_land1, 33);
-  minus_154 <= rs_d1_lo - rs_plane_t_land1_1;
+  minus_154 <= rs_s_d1_lo - rs_plane_t_land1_1;
   d1_above <= unsigned(minus_154(32 downto 32));
   near_lt_tmax_c <= d1_below when negative = "1" else d0_below;
   far_gt_tmin_c <= d0_above when negative = "1" else d1_above;
@@ -3086,18 +3215,24 @@ begin
       else
         f_valid_11 <= f_valid_10;
       end if;
-      f_inner_sr(2 to 11) <= f_inner_sr(1 to 10);
-      f_inner_sr(1) <= is_inner;
-      f_slot_sr(2 to 11) <= f_slot_sr(1 to 10);
-      f_slot_sr(1) <= n_slot;
-      f_tmin_sr(2 to 11) <= f_tmin_sr(1 to 10);
-      f_tmin_sr(1) <= n_tmin;
-      f_tmax_sr(2 to 11) <= f_tmax_sr(1 to 10);
-      f_tmax_sr(1) <= n_tmax;
-      f_sp_sr(2 to 11) <= f_sp_sr(1 to 10);
-      f_sp_sr(1) <= n_sp;
-      f_child_sr(2 to 11) <= f_child_sr(1 to 10);
-      f_child_sr(1) <= nw_child;
+      f_inner_wp <= f_inner_wp_plus_k_1_3;
+      f_inner_rp <= f_inner_wp_plus_k_7_1;
+      f_inner <= f_inner_mem(to_integer(f_inner_rp));
+      f_slot_wp <= f_slot_wp_plus_k_1_3;
+      f_slot_rp <= f_slot_wp_plus_k_7_1;
+      f_slot <= f_slot_mem(to_integer(f_slot_rp));
+      f_tmin_wp <= f_tmin_wp_plus_k_1_3;
+      f_tmin_rp <= f_tmin_wp_plus_k_7_1;
+      f_tmin <= f_tmin_mem(to_integer(f_tmin_rp));
+      f_tmax_wp <= f_tmax_wp_plus_k_1_3;
+      f_tmax_rp <= f_tmax_wp_plus_k_7_1;
+      f_tmax <= f_tmax_mem(to_integer(f_tmax_rp));
+      f_sp_wp <= f_sp_wp_plus_k_1_3;
+      f_sp_rp <= f_sp_wp_plus_k_7_1;
+      f_sp <= f_sp_mem(to_integer(f_sp_rp));
+      f_child_wp <= f_child_wp_plus_k_1_3;
+      f_child_rp <= f_child_wp_plus_k_7_1;
+      f_child <= f_child_mem(to_integer(f_child_rp));
       negative_n1 <= bits_case_axis_n1_1;
       tmin_n1 <= n_tmin;
       tmax_n1 <= n_tmax;
@@ -3109,17 +3244,21 @@ begin
       tmax_p1_n2 <= tmax_p1;
       tmin_m1_n2 <= tmin_m1;
       d0_hi_n3 <= d0_hi_c;
-      d0_hi_sr(2 to 8) <= d0_hi_sr(1 to 7);
-      d0_hi_sr(1) <= d0_hi_n3;
+      d0_hi_wp <= d0_hi_wp_plus_k_1_5;
+      d0_hi_rp <= d0_hi_wp_plus_k_2_1;
+      d0_hi <= d0_hi_mem(to_integer(d0_hi_rp));
       d0_lo_n3 <= d0_lo_c;
-      d0_lo_sr(2 to 8) <= d0_lo_sr(1 to 7);
-      d0_lo_sr(1) <= d0_lo_n3;
+      d0_lo_wp <= d0_lo_wp_plus_k_1_5;
+      d0_lo_rp <= d0_lo_wp_plus_k_2_1;
+      d0_lo <= d0_lo_mem(to_integer(d0_lo_rp));
       d1_hi_n3 <= d1_hi_c;
-      d1_hi_sr(2 to 8) <= d1_hi_sr(1 to 7);
-      d1_hi_sr(1) <= d1_hi_n3;
+      d1_hi_wp <= d1_hi_wp_plus_k_1_5;
+      d1_hi_rp <= d1_hi_wp_plus_k_2_1;
+      d1_hi <= d1_hi_mem(to_integer(d1_hi_rp));
       d1_lo_n3 <= d1_lo_c;
-      d1_lo_sr(2 to 8) <= d1_lo_sr(1 to 7);
-      d1_lo_sr(1) <= d1_lo_n3;
+      d1_lo_wp <= d1_lo_wp_plus_k_1_5;
+      d1_lo_rp <= d1_lo_wp_plus_k_2_1;
+      d1_lo <= d1_lo_mem(to_integer(d1_lo_rp));
       near_lt_tmax <= near_lt_tmax_c;
       far_gt_tmin <= far_gt_tmin_c;
       go_near <= go_near_c;
@@ -3128,8 +3267,8 @@ begin
       far_start <= mux_negative_1;
       g_slot <= f_slot;
       g_child <= f_child;
-      g_tmin <= f_tmin;
-      g_tmax <= f_tmax;
+      g_tmin <= s_f_tmin;
+      g_tmax <= s_f_tmax;
       g_sp <= f_sp;
       g_inner <= f_inner;
       g_negative <= negative;
@@ -3137,9 +3276,9 @@ begin
   end process ring_f_regs;
 
   -- stage ring_g: G: the decision: push the far child and enter the near one, enter one, or pop
-  g_child_plus_k_1_4 <= g_child + k_1_4;
-  near <= g_child_plus_k_1_4 when g_negative = "1" else g_child;
-  far <= g_child when g_negative = "1" else g_child_plus_k_1_4;
+  g_child_plus_k_1_6 <= g_child + k_1_6;
+  near <= g_child_plus_k_1_6 when g_negative = "1" else g_child;
+  far <= g_child when g_negative = "1" else g_child_plus_k_1_6;
   near_max <= near_end when near_lt_tmax = "1" else g_tmax;
   far_min <= far_start when far_gt_tmin = "1" else g_tmin;
   enter_near <= g_inner and go_near;
