@@ -44,7 +44,7 @@ fn bad_lists_exit_2_with_one_line_before_anything_runs() {
         (vec!["--t", "0..70:8"], "--t: 70 (in '0..70:8') is out of range"),
         (vec!["--edge-shift", "auto,x"], "--edge-shift: 'x'"),
         (vec!["--slots", "2,65"], "--slots: 65 (in '65') is out of range: must be 1..=64"),
-        (vec!["--units", "1..5"], "--units: 5 (in '1..5') is out of range: must be 1..=4"),
+        (vec!["--units", "1..9"], "--units: 9 (in '1..9') is out of range: must be 1..=8"),
         (vec!["--leaf-size", "0,4"], "--leaf-size: 0 (in '0') is out of range: must be 1..=64"),
         (vec!["--m", "12", "--t", "24"], "sweep: no valid parameter set"),
         (vec!["--builtin", "nosuch"], "--builtin: unknown scene 'nosuch'"),

@@ -13,7 +13,7 @@ pub struct ThreadArgs {
     /// Ray slots per traversal unit: the rays each unit holds at once (1..=64).
     #[arg(long, default_value_t = crate::cores::top::DEFAULT_SLOTS)]
     pub slots: u32,
-    /// Traversal units (1..=4).
+    /// Traversal units (1..=8).
     #[arg(long, default_value_t = crate::cores::top::DEFAULT_UNITS)]
     pub units: u32,
     /// Intersection pipelines (1, 2 or 4, dividing --units): each serves --units / P units.

@@ -69,7 +69,7 @@ pub struct SweepArgs {
     /// Ray slots per traversal unit K: the rays each unit holds at once (1..=64).
     #[arg(long, default_value_t = crate::cores::top::DEFAULT_SLOTS.to_string())]
     pub slots: String,
-    /// Traversal units U feeding the one intersection pipeline (1..=4).
+    /// Traversal units U (1..=8).
     #[arg(long, default_value_t = crate::cores::top::DEFAULT_UNITS.to_string())]
     pub units: String,
     /// Vary one parameter at a time around the base set (each at its default if listed,

@@ -274,7 +274,7 @@ fn sweep_leaf_size_slots_and_units_take_lists() {
     for (args, message) in [
         (&["--slots", "2,65"][..], "--slots: 65 (in '65') is out of range: must be 1..=64"),
         (&["--slots", "0..8:4"], "--slots: 0 (in '0..8:4') is out of range: must be 1..=64"),
-        (&["--units", "5"], "--units: 5 (in '5') is out of range: must be 1..=4"),
+        (&["--units", "9"], "--units: 9 (in '9') is out of range: must be 1..=8"),
         (&["--units", "2,,4"], "--units: '2,,4' has an empty item"),
         (&["--leaf-size", "0,4"], "--leaf-size: 0 (in '0') is out of range: must be 1..=64"),
         (&["--leaf-size", "8..4"], "--leaf-size: '8..4' is reversed: write 4..8"),

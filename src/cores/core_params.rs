@@ -18,6 +18,10 @@ use crate::scene::rom::rom_addr_bits;
 /// docs/CORE.md).
 pub const DEFAULT_SLOTS: u32 = 64;
 pub const DEFAULT_UNITS: u32 = 2;
+/// Traversal units a core may have. Eight keep two pipelines fed on the teapot (0.184 rays per
+/// clock, DECISIONS 129) and are what every simulator has run; more fit none of `--device`'s
+/// parts (eight units and two pipelines already take 182 multipliers).
+pub const MAX_UNITS: u32 = 8;
 
 #[derive(Clone, Debug)]
 pub struct CoreParams {
@@ -179,12 +183,13 @@ impl CoreParams {
     fn check_pipelines(&self) -> crate::error::Result<()> {
         use crate::error::Error;
         let pl = self.pipelines;
-        if ![1, 2, 4].contains(&pl) || !self.units.is_multiple_of(pl) {
+        let lane_units = self.units / pl.max(1);
+        if ![1, 2, 4].contains(&pl) || !self.units.is_multiple_of(pl) || (pl > 1 && !lane_units.is_power_of_two()) {
             return Err(Error::param(
                 "pipelines",
                 format!(
-                    "{pl} is out of range: must be 1, 2 or 4 and divide --units ({}): each pipeline serves \
-                     units of its own",
+                    "{pl} is out of range: must be 1, 2 or 4 and divide --units ({}) into a power of two \
+                     units per pipeline: each pipeline serves units of its own, numbered by the top bits",
                     self.units
                 ),
             ));
@@ -214,8 +219,8 @@ impl CoreParams {
         if !(1..=64).contains(&self.trav.slots) {
             return Err(Error::param("slots", format!("{} is out of range: must be 1..=64", self.trav.slots)));
         }
-        if !(1..=4).contains(&self.units) {
-            return Err(Error::param("units", format!("{} is out of range: must be 1..=4", self.units)));
+        if !(1..=MAX_UNITS).contains(&self.units) {
+            return Err(Error::param("units", format!("{} is out of range: must be 1..={MAX_UNITS}", self.units)));
         }
         self.check_pipelines()?;
         // A lane's closest-hit unit keeps a bit per slot number of its lane in one word; a

@@ -336,8 +336,10 @@ fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports
     }
     let depths = trav.iter().map(|t| t.get("depth")).collect();
     b.output("stack_depth", tree(b, "obs_depth", depths, |a, c| a.max(c)));
-    b.output("visits", sum("visit", 3).name("visits_c"));
-    b.output("culls", sum("cull", 3).name("culls_c"));
+    // At most one visit or cull per unit and clock; 3 bits at least, as for four units.
+    let count_bits = (32 - p.units.leading_zeros()).max(3);
+    b.output("visits", sum("visit", count_bits).name("visits_c"));
+    b.output("culls", sum("cull", count_bits).name("culls_c"));
     let occupied = trav.iter().map(|t| t.get("occupied").resize(p.tag.slot_bits + 1)).collect();
     b.output("occupied", tree(b, "obs_occupied", occupied, |a, c| a + c));
     // The walk of every slot (for the visit-order check): the ray written into a slot, and each

@@ -193,7 +193,7 @@ fn shapes(
     keep: &dyn Fn(u32, u32) -> bool,
 ) -> Vec<Candidate> {
     let mut shapes = Vec::new();
-    for units in 1..=4u32 {
+    for units in 1..=crate::cores::core_params::MAX_UNITS {
         for pipelines in [1, 2, 4].into_iter().filter(|p| units.is_multiple_of(*p) && keep(units, *p)) {
             for slots in SLOTS {
                 let (leaf_size, stack_depth) = (scene.params.leaf_size, scene.params.stack_depth);

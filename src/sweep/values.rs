@@ -11,7 +11,7 @@ use crate::params::{EdgeShift, RANGES};
 /// (`MemoryTiming::validate`'s and `check_cache_kb`'s limits).
 pub const CORE_RANGES: &[(&str, u32, u32)] = &[
     ("slots", 1, 64),
-    ("units", 1, 4),
+    ("units", 1, crate::cores::core_params::MAX_UNITS),
     ("mem-latency", 1, crate::verify::memory::MAX_LATENCY),
     ("node-cache-kb", 1, 4096),
     ("tri-cache-kb", 1, 4096),

@@ -53,15 +53,18 @@ fn pipelines_that_cannot_share_the_units_are_refused_naming_pipelines() {
     let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
     let roms = SceneRoms::of(&scene);
     let shape = |units, pipelines| crate::cores::top::CoreSpec { slots: 64, units, pipelines, ..Default::default() };
-    for (units, pipelines) in [(2, 3), (3, 2), (1, 2), (2, 4), (4, 0)] {
+    // Six units in two lanes of three would number lane 1's first unit (3 = 0b011) in lane 0.
+    for (units, pipelines) in [(2, 3), (3, 2), (1, 2), (2, 4), (4, 0), (6, 2)] {
         let err = CoreParams::shaped(&roms, &shape(units, pipelines)).check().unwrap_err();
         assert_eq!(err.subject, "--pipelines", "{units} units, {pipelines} pipelines");
     }
     let err = CoreParams::shaped(&roms, &shape(4, 1)).check().unwrap_err();
     assert!(err.message.contains("more --pipelines"), "{err}");
-    for (units, pipelines) in [(4, 2), (4, 4), (2, 2)] {
+    for (units, pipelines) in [(4, 2), (4, 4), (2, 2), (8, 4)] {
         CoreParams::shaped(&roms, &shape(units, pipelines)).check().unwrap();
     }
+    let err = CoreParams::shaped(&roms, &shape(9, 1)).check().unwrap_err();
+    assert_eq!((err.subject.as_str(), err.message.as_str()), ("--units", "9 is out of range: must be 1..=8"));
     let spec = crate::cores::memory_params::MemorySpec::default();
     let mut external = CoreParams::external(&roms, &shape(2, 1), spec).unwrap();
     external.pipelines = 2;
@@ -185,11 +188,30 @@ fn every_ray_visits_what_the_culled_golden_walk_visits_in_its_order() {
         ("teapot", Params::default(), 150, 16, [2, 2]),
         ("cornell", cornell, 100, 3, [4, 4]),
         ("teapot", Params::default(), 250, 5, [4, 2]),
+        ("cornell", cornell, 150, 2, [8, 2]),
     ] {
         let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 20, 20));
         assert_walks_are_the_culled_golden_walks(name, &scene, &rays, mhz, slots, units);
     }
+}
+
+/// Eight units visit up to eight nodes in a clock: the observation ports' sums (which `fxrt
+/// sim` checks against the golden walk) must hold eight, not the four units' 3 bits.
+#[test]
+fn eight_units_count_every_node_step_and_triangle_test() {
+    let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
+    let roms = SceneRoms::of(&scene);
+    let p = CoreParams::shaped(
+        &roms,
+        &crate::cores::top::CoreSpec { id_width: 16, slots: 16, units: 8, pipelines: 2, ..Default::default() },
+    );
+    p.check().unwrap();
+    let rays = frame_rays(&scene, &Camera::default_for(&scene, 24, 24));
+    let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
+    assert_eq!(mismatches(&scene, &rays, &results), 0);
+    let (steps, tests) = crate::verify::frame::golden_walk(&scene, &rays);
+    assert_eq!((stats.visits + stats.culls, stats.busy_cycles), (steps, tests));
 }
 
 /// Issue 27's small-width disagreement, reduced to two rays: the teapot at n = 4, m = 8,

@@ -96,6 +96,20 @@ pub fn case(seed: u64, index: u64, files: &[std::path::PathBuf]) -> Case {
         let fits: Vec<u32> = [1, 2, 4].into_iter().filter(|p| shape.units % p == 0).collect();
         shape.pipelines = fits[rng.below(fits.len() as u64) as usize];
     }
+    // Drawn after all the rest, so a case keeps its earlier draws: one in eight has 5 to 8
+    // units (DECISIONS 129), its slots cut to what its closest-hit units number, its
+    // pipelines drawn again among those that give each a power of two units.
+    if rng.below(8) == 0 {
+        shape.units = 5 + rng.below(4) as u32;
+        let lanes: Vec<u32> = [1, 2, 4]
+            .into_iter()
+            .filter(|&p| memory.is_none() || p == 1)
+            .filter(|&p| p == 1 || (shape.units % p == 0 && (shape.units / p).is_power_of_two()))
+            .collect();
+        shape.pipelines = lanes[rng.below(lanes.len() as u64) as usize];
+        let per_lane = (shape.units / shape.pipelines).next_power_of_two();
+        shape.slots = shape.slots.min(128 / per_lane);
+    }
     Case { index, scene, params, shape, camera: None, inside, camera_seed, shuffle_seed, stalls, memory }
 }
 
