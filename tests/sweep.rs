@@ -327,6 +327,47 @@ fn core_shapes_are_swept_and_throughput_is_plotted_against_area() {
     assert!(tree(&out) == before);
 }
 
+/// `--device`: the shape fitted once (on the first scene at the base set) is every row's core,
+/// with its pipelines; the fit is in results.json, its choice the fastest shape run among those
+/// within the device, and each row's core agrees with the golden model.
+#[test]
+fn a_device_fits_the_cores_of_a_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fitted");
+    let args = ["sweep", "--builtin", "cornell", "--size", "16x16", "--n", "20,24", "--core-sim"];
+    let o = fxrt(&[&args[..], &["--device", "lfe5u-85f", "--out", out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("device LFE5U-85F: chosen"), "{}", text(&o.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    let fit = &json["spec"]["device_fit"];
+    let chosen = &fit["chosen"];
+    let of = |k: &str| chosen[k].as_u64().unwrap();
+    assert!(of("multipliers") <= fit["multipliers_of"].as_u64().unwrap(), "{fit}");
+    assert!(of("block_ram") <= fit["block_ram_of"].as_u64().unwrap(), "{fit}");
+    let best = fit["candidates"].as_array().unwrap().iter().filter_map(|c| c["rays_per_clock"].as_f64());
+    assert_eq!(chosen["rays_per_clock"].as_f64(), best.reduce(f64::max));
+    let rows = rows(&out);
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        let shape = ["slots", "units", "pipelines"].map(|k| r[k].parse::<u64>().unwrap());
+        assert_eq!(shape, ["slots", "units", "pipelines"].map(of), "{r:?}");
+        assert_eq!(r["core_mismatches"], "0", "{r:?}");
+        let fill: f64 = r["pipeline_fill"].parse().unwrap();
+        assert!(fill > 0.0 && fill <= 1.0, "per pipeline: {r:?}");
+    }
+    // The fit counts cores with the scene on chip.
+    let ext = dir.path().join("ext");
+    let o =
+        fxrt(&[&args[..], &["--device", "lfe5u-85f", "--memory", "external", "--out", ext.to_str().unwrap()]].concat());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).starts_with("fxrt: --device:") && text(&o.stderr).lines().count() == 1,
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!ext.exists());
+}
+
 /// `--memory external --core-sim`: the memory's latency and the node cache's size as axes, a
 /// row per point with the memory side's figures, every ray against the golden model, and rays
 /// per clock and bytes per ray plotted against each and linked in the report.

@@ -72,6 +72,10 @@ pub struct SweepArgs {
     /// Traversal units U (1..=8).
     #[arg(long, default_value_t = crate::cores::top::DEFAULT_UNITS.to_string())]
     pub units: String,
+    /// Fit every core's slots, units and intersection pipelines to this device (as `gen
+    /// --device`), once: on the first scene at the base set, at the leaf size and stack given.
+    #[arg(long, value_enum, conflicts_with_all = ["slots", "units"])]
+    pub device: Option<crate::fpga::device::Device>,
     /// Vary one parameter at a time around the base set (each at its default if listed,
     /// else its first value), like the thesis's figures, instead of the cross product.
     #[arg(long = "one-at-a-time")]

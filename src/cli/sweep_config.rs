@@ -84,7 +84,7 @@ impl SweepArgs {
         let single = Params { stack_depth: self.stack_depth, tree: self.tree, ..Params::default() };
         single.validate()?;
         crate::cores::clock::ClockTarget(self.target_mhz).check()?;
-        Ok(SweepSpec {
+        let mut spec = SweepSpec {
             scenes,
             camera: self.camera.spec(),
             n: values::parse_u32_list("n", &self.n)?,
@@ -101,9 +101,15 @@ impl SweepArgs {
             target_mhz: self.target_mhz,
             slots: values::parse_u32_list("slots", &self.slots)?,
             units: values::parse_u32_list("units", &self.units)?,
+            pipelines: 1,
+            device_fit: None,
             ecp5: self.ecp5()?,
             memory: self.memory.sweep()?,
-        })
+        };
+        if let Some(device) = self.device {
+            fit_to(device, &mut spec)?;
+        }
+        Ok(spec)
     }
 
     /// `--family` and the options of ecp5 alone: the modules in `ECP5_MODULES` order, each
@@ -126,6 +132,31 @@ impl SweepArgs {
             other => Err(Error::param("family", format!("'{other}' is not a sweep family: use xc5v or ecp5"))),
         }
     }
+}
+
+/// `--device`: every core of the sweep takes the shape fitted to `device` on the first scene at
+/// the base set (`sweep::fit`, the scene's leaf size and stack as given: they are axes and
+/// options of the sweep), so rows differ only by what is swept; the fit goes into the spec
+/// (results.json) and its lines to stderr.
+fn fit_to(device: crate::fpga::device::Device, spec: &mut SweepSpec) -> Result<()> {
+    use crate::sweep::fit::SceneSearch;
+    if spec.memory.is_some() {
+        return Err(Error::param("device", "fits cores with the scene on chip: not with --memory external (yet)"));
+    }
+    let base = spec.base().params;
+    let scene = crate::scene::Scene::load(&spec.scenes[0].source(), &base)?;
+    let (width, height) = (spec.camera.width, spec.camera.height);
+    let id_width = crate::scene::rom::addr_bits((width * height) as usize).max(1);
+    let core = crate::cores::top::CoreSpec { id_width, target_mhz: spec.target_mhz, ..Default::default() };
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_message(format!("fitting the core to the {}: shapes run", device.name()));
+    let (fit, _) = crate::sweep::fit::fit(device, &scene, SceneSearch::default(), &core, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    super::device::say(Some(&fit));
+    let c = &fit.chosen;
+    (spec.slots, spec.units, spec.pipelines) = (vec![c.slots], vec![c.units], c.pipelines);
+    spec.device_fit = Some(serde_json::to_value(&fit).map_err(|e| Error::new("sweep", e.to_string()))?);
+    Ok(())
 }
 
 impl super::args_hw::SweepMemoryArgs {

@@ -47,3 +47,12 @@ pub fn default_units() -> Vec<u32> {
 pub fn is_default_units(u: &[u32]) -> bool {
     u == [DEFAULT_UNITS]
 }
+
+/// One intersection pipeline (`SweepSpec::pipelines`, `CoreShape::pipelines`), absent when so.
+pub fn one_pipeline() -> u32 {
+    1
+}
+
+pub fn is_one_pipeline(p: &u32) -> bool {
+    *p == 1
+}

@@ -134,6 +134,9 @@ impl SceneCtx {
             text["slots"] = shape.slots.into();
             text["units"] = shape.units.into();
         }
+        if shape.pipelines > 1 {
+            text["pipelines"] = shape.pipelines.into();
+        }
         if let Some(m) = &spec.memory {
             text["memory"] = serde_json::json!({ "sweep": m, "point": shape.memory });
         }
@@ -185,7 +188,8 @@ pub struct CoreRun {
     pub cycles_per_ray: f64,
     /// Rays per clock: 1 / `cycles_per_ray` (`fxrt sim`'s `rays_per_clock`).
     pub rays_per_clock: f64,
-    /// Cycles in which a triangle entered the pipeline, per cycle.
+    /// Triangles that entered the intersection pipelines, per cycle and pipeline (as `fxrt
+    /// sim`'s `pipeline_fill`).
     pub fill: f64,
     /// Triangles that entered the intersection pipeline, per ray.
     pub triangle_tests_per_ray: f64,
@@ -307,15 +311,9 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     }
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
-    let (slots, units) = (cfg.shape.slots, cfg.shape.units);
-    let core_spec = crate::cores::top::CoreSpec {
-        id_width,
-        div_bits: 1,
-        target_mhz: extras.target_mhz,
-        slots,
-        units,
-        ..Default::default()
-    };
+    let CoreShape { slots, units, pipelines, .. } = cfg.shape;
+    let core_spec =
+        crate::cores::top::CoreSpec { id_width, div_bits: 1, target_mhz: extras.target_mhz, slots, units, pipelines };
     let core_params = match &extras.memory {
         None => CoreParams::shaped(&roms, &core_spec),
         Some(m) => match CoreParams::external(&roms, &core_spec, m.spec(cfg.shape.memory)) {
@@ -402,7 +400,7 @@ fn simulate_core(
     let run = CoreRun {
         cycles_per_ray: stats.cycles_per_ray(),
         rays_per_clock: stats.rays_per_clock(),
-        fill: stats.fill(),
+        fill: stats.fill() / p.pipelines as f64,
         triangle_tests_per_ray: stats.triangle_tests_per_ray(),
         node_steps_per_ray: stats.node_steps_per_ray(),
         slot_occupancy: stats.slot_occupancy(),
@@ -418,7 +416,13 @@ fn simulate_core(
 fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32, shape: CoreShape) -> CoreCost {
     let p = CoreParams::shaped(
         roms,
-        &crate::cores::top::CoreSpec { target_mhz, slots: shape.slots, units: shape.units, ..Default::default() },
+        &crate::cores::top::CoreSpec {
+            target_mhz,
+            slots: shape.slots,
+            units: shape.units,
+            pipelines: shape.pipelines,
+            ..Default::default()
+        },
     );
     let core = core_module_with(&p, roms, false);
     CoreCost {

@@ -29,7 +29,9 @@ use crate::error::{Error, Result};
 pub use crate::model::camera::CameraSpec;
 use crate::params::{EdgeShift, Params, TreeSplit};
 use crate::scene::SceneSource;
-use compat::{default_slots, default_units, is_default_slots, is_default_units, one_or_many};
+use compat::{
+    default_slots, default_units, is_default_slots, is_default_units, is_one_pipeline, one_or_many, one_pipeline,
+};
 use memory::{MemoryPoint, MemorySweep};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -86,6 +88,13 @@ pub struct SweepSpec {
     pub slots: Vec<u32>,
     #[serde(default = "default_units", skip_serializing_if = "is_default_units", with = "one_or_many")]
     pub units: Vec<u32>,
+    /// Intersection pipelines of every core: one, or what `--device` fitted (absent when one).
+    #[serde(default = "one_pipeline", skip_serializing_if = "is_one_pipeline")]
+    pub pipelines: u32,
+    /// `--device`: the fit that chose the slots, units and pipelines (`sweep::fit::Fit::json`),
+    /// made on the first scene at the base set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device_fit: Option<serde_json::Value>,
     /// `--synth --family ecp5`: place and route on the LFE5U-85F instead of Virtex-5 area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ecp5: Option<Ecp5Choice>,
@@ -106,7 +115,7 @@ fn is_default_target_mhz(mhz: &u32) -> bool {
 impl SweepSpec {
     /// Whether every core has the default ray slots and units (`--slots`, `--units` not given).
     pub fn default_core_shape(&self) -> bool {
-        is_default_slots(&self.slots) && is_default_units(&self.units)
+        is_default_slots(&self.slots) && is_default_units(&self.units) && self.pipelines == 1
     }
 }
 
@@ -220,6 +229,9 @@ pub const MAX_CONFIGURATIONS: usize = 1_000_000;
 pub struct CoreShape {
     pub slots: u32,
     pub units: u32,
+    /// Absent from rows with one (every sweep before `--device`).
+    #[serde(default = "one_pipeline", skip_serializing_if = "is_one_pipeline")]
+    pub pipelines: u32,
     /// Absent from rows at the defaults (every on-chip sweep), as before it was swept.
     #[serde(default, skip_serializing_if = "MemoryPoint::is_default")]
     pub memory: MemoryPoint,
@@ -227,7 +239,7 @@ pub struct CoreShape {
 
 impl Default for CoreShape {
     fn default() -> Self {
-        CoreShape { slots: DEFAULT_SLOTS, units: DEFAULT_UNITS, memory: MemoryPoint::default() }
+        CoreShape { slots: DEFAULT_SLOTS, units: DEFAULT_UNITS, pipelines: 1, memory: MemoryPoint::default() }
     }
 }
 
@@ -238,9 +250,10 @@ impl CoreShape {
 }
 
 impl std::fmt::Display for CoreShape {
-    /// `K×U`, e.g. `64×2`.
+    /// `K×U`, e.g. `64×2`; `K×U×P` with P > 1 pipelines.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}×{}", self.slots, self.units)
+        write!(f, "{}×{}", self.slots, self.units)?;
+        if self.pipelines > 1 { write!(f, "×{}", self.pipelines) } else { Ok(()) }
     }
 }
 
@@ -370,7 +383,7 @@ impl SweepSpec {
 
     /// Each parameter at its default if its list holds it, else the list's first value.
     pub fn base(&self) -> Set {
-        let d = Set { params: self.defaults(), shape: CoreShape::default() };
+        let d = Set { params: self.defaults(), shape: CoreShape { pipelines: self.pipelines, ..CoreShape::default() } };
         Axis::ALL.into_iter().fold(d, |s, a| {
             let here = a.value(&d);
             let i = self.values(a).iter().position(|v| *v == here).unwrap_or(0);
@@ -538,6 +551,9 @@ pub fn set_label(s: &Set) -> String {
     let m = s.shape.memory;
     if (s.shape.slots, s.shape.units) != (DEFAULT_SLOTS, DEFAULT_UNITS) {
         label += &format!("_k{}_u{}", s.shape.slots, s.shape.units);
+    }
+    if s.shape.pipelines > 1 {
+        label += &format!("_p{}", s.shape.pipelines);
     }
     if !m.is_default() {
         label += &format!("_lat{}_nc{}_tc{}", m.latency, m.node_cache_kb, m.tri_cache_kb);

@@ -140,8 +140,8 @@ pub const CSV_COLUMNS: &[&str] = &[
 ];
 
 /// Columns of the core's shape, after `stack_depth`, in sweeps whose `--slots` or `--units`
-/// are not the defaults.
-pub const SHAPE_COLUMNS: [&str; 2] = ["slots", "units"];
+/// are not the defaults or whose cores have several pipelines (`--device`).
+pub const SHAPE_COLUMNS: [&str; 3] = ["slots", "units", "pipelines"];
 
 /// Columns of `--core-sim` sweeps after `core_mismatches` (`fxrt sim`'s figures).
 pub const CORE_COLUMNS: [&str; 4] =
@@ -149,7 +149,7 @@ pub const CORE_COLUMNS: [&str; 4] =
 
 /// `fields` (one per `CSV_COLUMNS`) with the shape's and the core's cells where the sweep has
 /// those columns.
-fn with_optional(spec: &SweepSpec, mut fields: Vec<String>, shape: [String; 2], core: [String; 4]) -> Vec<String> {
+fn with_optional(spec: &SweepSpec, mut fields: Vec<String>, shape: [String; 3], core: [String; 4]) -> Vec<String> {
     let after = |c: &str| CSV_COLUMNS.iter().position(|x| *x == c).expect("a column of CSV_COLUMNS") + 1;
     // The later columns first, so that the earlier position still holds.
     if spec.core_sim {
@@ -250,7 +250,7 @@ pub fn csv_bytes(spec: &SweepSpec, rows: &[Row]) -> Vec<u8> {
     // Writing into a Vec cannot fail.
     w.write_record(csv_columns(spec)).expect("csv into memory");
     for r in rows {
-        let shape = [r.shape.slots.to_string(), r.shape.units.to_string()];
+        let shape = [r.shape.slots, r.shape.units, r.shape.pipelines].map(|v| v.to_string());
         let k = r.core.as_ref();
         let core = [
             k.map(|k| k.rays_per_clock.to_string()).unwrap_or_default(),

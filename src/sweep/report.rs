@@ -201,6 +201,16 @@ fn lists(results: &Results, plan: &Plan) -> Vec<(&'static str, String)> {
     if !spec.default_core_shape() {
         v.push(("K (ray slots per unit)", list(&spec.slots)));
         v.push(("U (traversal units)", list(&spec.units)));
+        v.push(("P (intersection pipelines)", spec.pipelines.to_string()));
+    }
+    let fitted =
+        spec.device_fit.as_ref().map(|f| serde_json::from_value::<crate::fpga::device::Device>(f["device"].clone()));
+    if let Some(Ok(device)) = fitted {
+        let name = device.name();
+        v.push((
+            "shape",
+            format!("fitted to the {name} on the first scene at the base set (results.json: spec.device_fit)"),
+        ));
     }
     if let Some(m) = &spec.memory {
         let order = if m.tiles { "8 × 8 tiles" } else { "pixel order" };

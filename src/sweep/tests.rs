@@ -22,6 +22,8 @@ fn spec() -> SweepSpec {
         target_mhz: 150,
         slots: vec![crate::cores::top::DEFAULT_SLOTS],
         units: vec![crate::cores::top::DEFAULT_UNITS],
+        pipelines: 1,
+        device_fit: None,
         ecp5: None,
         memory: None,
     }
