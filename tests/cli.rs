@@ -603,6 +603,11 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     );
     let external = ["gen", "--builtin", "cornell", "--memory", "external", "--pipelines", "2", "--out", o];
     assert_rejected(&external, "--pipelines", &out);
+    // Under --memory auto, several pipelines whose ROM copies and stacks exceed the block RAM
+    // are refused for the block RAM (they used to be moved to external memory unasked, and
+    // refused there for their pipelines).
+    let big = ["--units", "8", "--slots", "32", "--pipelines", "2", "--leaf-size", "3", "--out", o];
+    assert_rejected(&[&["gen", "--builtin", "teapot"][..], &big].concat(), "--bram-kbits", &out);
     // Without the ECP5 tools the ULX3S bitstream cannot be made: refused before anything is
     // written (--no-bitstream writes the HDL).
     let o3 = Command::new(env!("CARGO_BIN_EXE_fxrt"))

@@ -43,7 +43,13 @@ pub fn place_checked(
     let external = match place {
         MemoryPlace::Onchip => false,
         MemoryPlace::External => true,
-        MemoryPlace::Auto => p.check_device(roms, bram_kbits).is_err(),
+        MemoryPlace::Auto => match p.check_device(roms, bram_kbits) {
+            Ok(()) => false,
+            // Several pipelines need the scene on chip (`check_pipelines`): say what does not
+            // fit, not that the external core the user never asked for has one pipeline.
+            Err(e) if shape.pipelines > 1 => return Err(e),
+            Err(_) => true,
+        },
     };
     let p = if external { crate::cores::top::CoreParams::external(roms, shape, spec)? } else { p };
     p.check_device(roms, bram_kbits)?;
