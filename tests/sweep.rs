@@ -355,6 +355,19 @@ fn a_device_fits_the_cores_of_a_sweep() {
         let fill: f64 = r["pipeline_fill"].parse().unwrap();
         assert!(fill > 0.0 && fill <= 1.0, "per pipeline: {r:?}");
     }
+    // Fitted at the narrower first n, four pipelines fit; at n = 24 they need more multipliers
+    // than the device has, and that row says so (its figures still there).
+    let narrow = dir.path().join("narrow");
+    let args = ["sweep", "--builtin", "cornell", "--size", "16x16", "--n", "16,24", "--core-sim"];
+    let o = fxrt(&[&args[..], &["--device", "lfe5u-85f", "--out", narrow.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let narrow_rows = common::sweep_rows(&narrow);
+    assert_eq!((narrow_rows[0]["pipelines"].as_str(), narrow_rows[0]["error"].as_str()), ("4", ""), "{narrow_rows:?}");
+    assert!(narrow_rows[1]["error"].starts_with("--device: the core needs"), "{narrow_rows:?}");
+    assert!(
+        narrow_rows[1]["error"].ends_with("multipliers, the LFE5U-85F has 156")
+            && narrow_rows[1]["core_mismatches"] == "0"
+    );
     // The fit counts cores with the scene on chip.
     let ext = dir.path().join("ext");
     let o =

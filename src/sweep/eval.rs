@@ -268,6 +268,8 @@ pub struct Extras {
     pub pnr: Option<Pnr>,
     /// `--memory external`: the cores read their scene from external memory.
     pub memory: Option<MemorySweep>,
+    /// `--device`: each row's core is counted against the device the shape was fitted to.
+    pub device: Option<crate::fpga::device::Device>,
 }
 
 pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> Evaluated {
@@ -324,6 +326,10 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
             }
         },
     };
+    // The shape was fitted at the base set; a set of wider arithmetic may need more.
+    if let Some(why) = extras.device.and_then(|d| super::fit::lacks(d, &roms, &core_params)) {
+        row.error = Some(format!("--device: {why}"));
+    }
     if let (true, Some(_)) = (extras.core_sim, &row.cost) {
         match simulate_core(&scene, &ctx.camera, &core_params, &roms, cfg.shape.memory, &extras.memory) {
             Ok((run, memory)) => {

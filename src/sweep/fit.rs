@@ -173,6 +173,32 @@ impl Candidate {
 
 /// What the shape `spec` needs of `device`: (multipliers, block RAM in the device's unit,
 /// flip-flops).
+/// The block RAM a fitted core may take (DP16KD on the LFE5U-85F, Kb on the Xilinx parts) and
+/// its `FF_SHARE` of the device's flip-flops.
+fn limits(device: Device) -> (u64, u64) {
+    let cap = device.capacity();
+    let block_ram = if device == Device::Lfe5u85f { cap.block_rams as u64 } else { device.bram_kbits() };
+    (block_ram, (cap.ffs as f64 * FF_SHARE) as u64)
+}
+
+/// What `device` lacks for core `p`, counted as the fit counts (its multipliers, block RAM,
+/// `FF_SHARE` of its flip-flops), in words; None when it holds the core.
+pub fn lacks(device: Device, roms: &SceneRoms, p: &CoreParams) -> Option<String> {
+    let (multipliers, block_ram, flip_flops) = needs(device, roms, p);
+    let (block_ram_of, flip_flops_of) = limits(device);
+    let (name, multipliers_of) = (device.name(), device.capacity().multipliers);
+    let unit = if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" };
+    if multipliers > multipliers_of {
+        Some(format!("the core needs {multipliers} multipliers, the {name} has {multipliers_of}"))
+    } else if block_ram > block_ram_of {
+        Some(format!("the core needs {block_ram} {unit}, the {name} has {block_ram_of}"))
+    } else if flip_flops > flip_flops_of {
+        Some(format!("the core needs {flip_flops} flip-flops, more than {flip_flops_of} of the {name}'s"))
+    } else {
+        None
+    }
+}
+
 fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64) {
     let core = core_module_with(p, roms, false);
     let b = crate::fpga::ecp5::blocks::blocks(&core);
@@ -255,10 +281,7 @@ pub fn fit(
     progress: &(dyn Fn() + Sync),
 ) -> Result<(Fit, Scene)> {
     let cap = device.capacity();
-    let block_ram_of = match device {
-        Device::Lfe5u85f => cap.block_rams as u64,
-        _ => device.bram_kbits(),
-    };
+    let (block_ram_of, flip_flops_of) = limits(device);
     // What no shape changes (widths, the clock) is said as itself, before any shape is tried.
     CoreParams::shaped(&SceneRoms::of(scene), &CoreSpec { units: 1, slots: 1, pipelines: 1, ..*base }).check()?;
     let builds: Vec<Scene> = search.variants(&scene.params)[1..]
@@ -266,7 +289,6 @@ pub fn fit(
         .map(|p| Scene::build(&scene.name, scene.world.clone(), p))
         .collect::<Result<_>>()?;
     let scenes: Vec<&Scene> = std::iter::once(scene).chain(&builds).collect();
-    let flip_flops_of = (cap.ffs as f64 * FF_SHARE) as u64;
     let fits = |c: &Candidate| c.fits(cap.multipliers, block_ram_of, flip_flops_of);
     let cam = Camera::default_for(scene, FRAME, FRAME);
     // Every U and P on the scene as given; on its other builds only the U and P within `CLOSE`

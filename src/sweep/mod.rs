@@ -117,6 +117,11 @@ impl SweepSpec {
     pub fn default_core_shape(&self) -> bool {
         is_default_slots(&self.slots) && is_default_units(&self.units) && self.pipelines == 1
     }
+
+    /// The device `--device` fitted the cores to.
+    pub fn fitted_device(&self) -> Option<crate::fpga::device::Device> {
+        self.device_fit.as_ref().and_then(|f| serde_json::from_value(f["device"].clone()).ok())
+    }
 }
 
 /// What `sweep --synth --family ecp5` places and routes, and with which placement seed.

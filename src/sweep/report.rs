@@ -203,9 +203,7 @@ fn lists(results: &Results, plan: &Plan) -> Vec<(&'static str, String)> {
         v.push(("U (traversal units)", list(&spec.units)));
         v.push(("P (intersection pipelines)", spec.pipelines.to_string()));
     }
-    let fitted =
-        spec.device_fit.as_ref().map(|f| serde_json::from_value::<crate::fpga::device::Device>(f["device"].clone()));
-    if let Some(Ok(device)) = fitted {
+    if let Some(device) = spec.fitted_device() {
         let name = device.name();
         v.push((
             "shape",

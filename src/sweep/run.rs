@@ -64,6 +64,7 @@ pub fn run(
         target_mhz: spec.target_mhz,
         pnr,
         memory: spec.memory.clone(),
+        device: spec.fitted_device(),
     };
     let results: Vec<Result<(Row, bool)>> = mine
         .par_iter()
