@@ -25,15 +25,35 @@ pub fn shape(
     let Some(scene) = scene else {
         return Err(Error::param("device", "needs the scene itself (an OBJ or --builtin), not a folder of ROM images"));
     };
+    let (fit, chosen) = fit_on_chip(device, scene, search, &base, external)?;
+    *scene = chosen;
+    Ok((fit.spec(&base), Some(fit)))
+}
+
+/// `sweep::fit` behind a spinner on stderr; refused (naming `--device`) for a core whose scene
+/// is in `external` memory, as the fit counts cores with the scene on chip.
+pub fn fit_on_chip(
+    device: crate::fpga::device::Device,
+    scene: &Scene,
+    search: SceneSearch,
+    base: &CoreSpec,
+    external: bool,
+) -> Result<(Fit, Scene)> {
+    on_chip(external)?;
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_message(format!("fitting the core to the {}: shapes run", device.name()));
+    let fitted = crate::sweep::fit::fit(device, scene, search, base, &|| bar.inc(1));
+    bar.finish_and_clear();
+    fitted
+}
+
+/// Refuses `--device` for a core whose scene is in `external` memory: the fit counts cores with
+/// the scene on chip.
+pub fn on_chip(external: bool) -> Result<()> {
     if external {
         return Err(Error::param("device", "fits cores with the scene on chip: not with --memory external (yet)"));
     }
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_message(format!("fitting the core to the {}: shapes run", device.name()));
-    let (fit, chosen) = crate::sweep::fit::fit(device, scene, search, &base, &|| bar.inc(1))?;
-    *scene = chosen;
-    bar.finish_and_clear();
-    Ok((fit.spec(&base), Some(fit)))
+    Ok(())
 }
 
 /// The fit's shapes and choice on stderr, a line each.

@@ -139,19 +139,14 @@ impl SweepArgs {
 /// options of the sweep), so rows differ only by what is swept; the fit goes into the spec
 /// (results.json) and its lines to stderr.
 fn fit_to(device: crate::fpga::device::Device, spec: &mut SweepSpec) -> Result<()> {
-    use crate::sweep::fit::SceneSearch;
-    if spec.memory.is_some() {
-        return Err(Error::param("device", "fits cores with the scene on chip: not with --memory external (yet)"));
-    }
+    super::device::on_chip(spec.memory.is_some())?;
     let base = spec.base().params;
     let scene = crate::scene::Scene::load(&spec.scenes[0].source(), &base)?;
     let (width, height) = (spec.camera.width, spec.camera.height);
     let id_width = crate::scene::rom::addr_bits((width * height) as usize).max(1);
     let core = crate::cores::top::CoreSpec { id_width, target_mhz: spec.target_mhz, ..Default::default() };
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_message(format!("fitting the core to the {}: shapes run", device.name()));
-    let (fit, _) = crate::sweep::fit::fit(device, &scene, SceneSearch::default(), &core, &|| bar.inc(1))?;
-    bar.finish_and_clear();
+    let search = crate::sweep::fit::SceneSearch::default();
+    let (fit, _) = super::device::fit_on_chip(device, &scene, search, &core, spec.memory.is_some())?;
     super::device::say(Some(&fit));
     let c = &fit.chosen;
     (spec.slots, spec.units, spec.pipelines) = (vec![c.slots], vec![c.units], c.pipelines);

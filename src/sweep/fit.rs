@@ -171,8 +171,6 @@ impl Candidate {
     }
 }
 
-/// What the shape `spec` needs of `device`: (multipliers, block RAM in the device's unit,
-/// flip-flops).
 /// The block RAM a fitted core may take (DP16KD on the LFE5U-85F, Kb on the Xilinx parts) and
 /// its `FF_SHARE` of the device's flip-flops.
 fn limits(device: Device) -> (u64, u64) {
@@ -181,13 +179,18 @@ fn limits(device: Device) -> (u64, u64) {
     (block_ram, (cap.ffs as f64 * FF_SHARE) as u64)
 }
 
+/// What the fit counts block RAM in on `device`: DP16KD blocks, or Kb on the Xilinx parts.
+fn block_ram_unit(device: Device) -> &'static str {
+    if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" }
+}
+
 /// What `device` lacks for core `p`, counted as the fit counts (its multipliers, block RAM,
 /// `FF_SHARE` of its flip-flops), in words; None when it holds the core.
 pub fn lacks(device: Device, roms: &SceneRoms, p: &CoreParams) -> Option<String> {
     let (multipliers, block_ram, flip_flops) = needs(device, roms, p);
     let (block_ram_of, flip_flops_of) = limits(device);
     let (name, multipliers_of) = (device.name(), device.capacity().multipliers);
-    let unit = if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" };
+    let unit = block_ram_unit(device);
     if multipliers > multipliers_of {
         Some(format!("the core needs {multipliers} multipliers, the {name} has {multipliers_of}"))
     } else if block_ram > block_ram_of {
@@ -199,6 +202,7 @@ pub fn lacks(device: Device, roms: &SceneRoms, p: &CoreParams) -> Option<String>
     }
 }
 
+/// What core `p` needs of `device`: (multipliers, block RAM in the device's unit, flip-flops).
 fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64) {
     let core = core_module_with(p, roms, false);
     let b = crate::fpga::ecp5::blocks::blocks(&core);
@@ -329,7 +333,7 @@ pub fn fit(
                 scene.name,
                 cap.multipliers,
                 block_ram_of,
-                if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" },
+                block_ram_unit(device),
                 flip_flops_of,
                 (FF_SHARE * 100.0).round()
             ),
