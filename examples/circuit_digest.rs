@@ -54,6 +54,7 @@ fn main() {
                     slots: s,
                     units: u,
                     pipelines: 1,
+                    piece: Default::default(),
                 },
             ),
             _ => CoreParams::new(&roms, 20, 1, 150),

@@ -31,6 +31,7 @@ fn cornell(w: u32, h: u32) -> (Scene, SceneRoms, RayGen, CoreParams) {
             slots: 8,
             units: 1,
             pipelines: 1,
+            piece: Default::default(),
         },
     );
     (scene, roms, g, p)

@@ -343,9 +343,9 @@ fn manifest_in(dir: &std::path::Path) -> std::path::PathBuf {
         .expect("the core's manifest")
 }
 
-/// `--device` fits the shape: the ML509's top (the XC5VLX110T's 64 DSP48E take one unit, said
-/// on stderr); with `--units` too it is refused, as is a folder of ROM
-/// images (the fit runs the scene).
+/// `--device` fits the shape: the ML509's top (the XC5VLX110T's 64 DSP48E take two units with
+/// the products cut for them, said on stderr); with `--units` too it is refused, as is a folder
+/// of ROM images (the fit runs the scene).
 #[test]
 fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
     let dir = tempfile::tempdir().unwrap();
@@ -354,15 +354,16 @@ fn device_fits_the_shape_and_conflicts_with_a_shape_given() {
     let board = ["gen", "--builtin", "cornell", "--size", "4x3", "--out", o, "--board", "ml509"];
     let ok = fxrt(&[&board[..], &["--device", "xc5vlx110t"]].concat());
     assert!(ok.status.success(), "{}", stderr(&ok));
-    assert!(stderr(&ok).contains("chosen 1 units × 64 slots, 1 pipelines"), "{}", stderr(&ok));
+    assert!(stderr(&ok).contains("chosen 2 units × 64 slots, 1 pipelines"), "{}", stderr(&ok));
     // The core's manifest states the fit: the device, the shapes counted, the one chosen.
     let plain = dir.path().join("plain");
     let g = fxrt(&["gen", "--builtin", "cornell", "--device", "xc5vlx110t", "--out", plain.to_str().unwrap()]);
     assert!(g.status.success(), "{}", stderr(&g));
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(manifest_in(&plain)).unwrap()).unwrap();
     let fit = &doc["device_fit"];
-    assert_eq!((fit["device"].as_str(), fit["chosen"]["units"].as_u64()), (Some("xc5vlx110t"), Some(1)), "{fit}");
-    assert_eq!(doc["params"]["traversal_units"], 1, "{doc}");
+    assert_eq!((fit["device"].as_str(), fit["chosen"]["units"].as_u64()), (Some("xc5vlx110t"), Some(2)), "{fit}");
+    assert_eq!(doc["params"]["traversal_units"], 2, "{doc}");
+    assert_eq!(doc["params"]["multiplier_pieces"], "25x18", "{doc}");
     assert!(fit["candidates"].as_array().is_some_and(|c| c.len() > 3), "{fit}");
     // Not given, the leaf size and the stack are the fit's too, and the core is the chosen
     // build's; given, they are kept.
@@ -618,12 +619,14 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     assert_eq!(o3.status.code(), Some(2), "{}", stderr(&o3));
     assert!(stderr(&o3).starts_with("fxrt: --board: ") && stderr(&o3).contains("--no-bitstream"), "{}", stderr(&o3));
     assert!(!out.exists());
-    // The default core's two traversal units need 70 DSP48E: with no shape option the ML509's
-    // core is fitted to its XC5VLX110T (one unit); a shape given that does not fit is refused.
+    // With the products cut for the DSP48E the default two traversal units need 60 of the
+    // XC5VLX110T's 64 (cut 18 × 18 as for the ECP5, 70): with no shape option the ML509's core
+    // is fitted to it (two units); a shape given that does not fit is refused.
     assert_rejected(&with(&["ml509", "--units", "3", "--slots", "16"]), "--units", &out);
+    assert_rejected(&with(&["ml509", "--slots", "32", "--dsp", "18x18"]), "--units", &out);
     let o2 = fxrt(&with(&["ml509"]));
     assert!(o2.status.success(), "{}", stderr(&o2));
-    assert!(stderr(&o2).contains("XC5VLX110T: chosen 1 units"), "{}", stderr(&o2));
+    assert!(stderr(&o2).contains("XC5VLX110T: chosen 2 units"), "{}", stderr(&o2));
     let names: Vec<String> =
         std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     for ext in [".ucf", ".tcl", ".json"] {

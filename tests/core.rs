@@ -46,7 +46,15 @@ fn rust_frame_shaped(name: &str, size: u32, target_mhz: u32, shape: (u32, u32, u
     let cam = Camera::default_for(&s, size, size);
     let p = CoreParams::shaped(
         &roms,
-        &fxrt::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz, slots, units, pipelines },
+        &fxrt::cores::top::CoreSpec {
+            id_width: 16,
+            div_bits: 1,
+            target_mhz,
+            slots,
+            units,
+            pipelines,
+            piece: Default::default(),
+        },
     );
     let rays = frame_rays(&s, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
@@ -99,6 +107,7 @@ fn rust_teapot_small_and_extreme_widths() {
                 slots: 64,
                 units: 2,
                 pipelines: 1,
+                piece: Default::default(),
             },
         );
         p.check().unwrap();

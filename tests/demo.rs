@@ -113,8 +113,8 @@ fn the_demo_runs_the_external_memory_core_too() {
     assert!(o.status.success() && !dir.path().join("auto/hdl/scene.bin").exists());
 }
 
-/// `fxrt demo --device`: the core fitted to the device (the XC5VLX110T's 64 DSP48E take one
-/// unit of 64 slots), the fit said on stderr and in the manifest, the frame through that core
+/// `fxrt demo --device`: the core fitted to the device (the XC5VLX110T's 64 DSP48E take two
+/// units of 64 slots, their products cut for the DSP48E), the fit said on stderr and in the manifest, the frame through that core
 /// checked pixel by pixel, and no measured clock claimed for a netlist that was not placed.
 /// With `--memory external` a fit is refused (it counts on-chip cores).
 #[test]
@@ -124,14 +124,15 @@ fn the_demo_fits_the_core_to_a_device() {
     let o = run(&["demo", "--device", "xc5vlx110t", "--size", "12x12", "--out", "v5"]).expect("fxrt runs");
     let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     assert!(o.status.success(), "{out}{err}");
-    assert!(err.contains("device XC5VLX110T: chosen 1 units × 64 slots, 1 pipelines"), "{err}");
-    assert!(out.contains("1 units × 64 slots)") && out.contains("(144 of 144)"), "{out}");
+    assert!(err.contains("device XC5VLX110T: chosen 2 units × 64 slots, 1 pipelines"), "{err}");
+    assert!(out.contains("2 units × 64 slots)") && out.contains("(144 of 144)"), "{out}");
     assert!(out.contains("clock: not measured for this netlist"), "{out}");
     let manifest =
         out.split_whitespace().find(|w| w.starts_with("fxrt_core_") && w.ends_with(".json")).expect("a manifest");
     let m: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("v5/hdl").join(manifest)).unwrap()).unwrap();
-    assert_eq!(m["device_fit"]["chosen"]["units"].as_u64(), Some(1), "{}", m["device_fit"]);
+    assert_eq!(m["device_fit"]["chosen"]["units"].as_u64(), Some(2), "{}", m["device_fit"]);
+    assert_eq!(m["params"]["multiplier_pieces"], "25x18", "{}", m["params"]);
     let o = run(&["demo", "--device", "xc5vlx110t", "--memory", "external", "--out", "x"]).unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(

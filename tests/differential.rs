@@ -57,7 +57,15 @@ fn an_interior_at_default_parameters_matches_and_walks_as_specified() {
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(
         &roms,
-        &fxrt::cores::top::CoreSpec { id_width: 10, div_bits: 1, target_mhz: 150, slots: 64, units: 2, pipelines: 1 },
+        &fxrt::cores::top::CoreSpec {
+            id_width: 10,
+            div_bits: 1,
+            target_mhz: 150,
+            slots: 64,
+            units: 2,
+            pipelines: 1,
+            ..Default::default()
+        },
     );
     let rays = frame_rays(&scene, &cam);
     let (results, stats) = simulate_rust(&p, &roms, &rays, &Stalls::none(), &|_| {});
@@ -92,6 +100,28 @@ fn a_reproducer_of_an_external_memory_case_runs_the_same_frame() {
         .expect("an external-memory case of seed 5 that runs");
     let command = reproduces(&run, out.path());
     assert!(command.contains("--memory external") && command.contains("--mem-latency"), "{command}");
+}
+
+/// The same for a case whose products are cut for the DSP48E (`--dsp 25x18`) at widths where
+/// that shrinks the plane product (n + 1 by m + C bits): the command builds that core, whose
+/// ring is shorter than the 18 × 18 cut's, and `fxrt sim` runs the frame in the same clocks.
+#[test]
+fn a_reproducer_of_a_dsp48_case_builds_the_same_core() {
+    use fxrt::cores::mul::{Piece, pieces};
+    use fxrt::rtl::Ty;
+    let out = tempfile::tempdir().unwrap();
+    let shrinks = |c: &draw::Case| {
+        let (delta, inv) = (Ty::s(c.params.n + 1), Ty::s(c.params.m + c.params.c));
+        pieces(delta, inv, Piece::Dsp48) < pieces(delta, inv, Piece::Mult18)
+    };
+    let run = (0..200)
+        .map(|i| draw::case(5, i, &[]))
+        .filter(|c| c.shape.piece == Piece::Dsp48 && c.memory.is_none() && shrinks(c))
+        .map(|c| exact::run_case(5, c.index, &[], None))
+        .find(|r| matches!(r.verdict, Verdict::Ran(_)))
+        .expect("a DSP48E case of seed 5 that runs");
+    let command = reproduces(&run, out.path());
+    assert!(command.contains("--dsp 25x18"), "{command}");
 }
 
 /// Writes `run` out under `out`, checks the scene reads back and the command gives the same

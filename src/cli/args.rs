@@ -23,6 +23,38 @@ pub struct ThreadArgs {
     /// block RAM it holds, the one with the most rays per clock on a short frame of the scene.
     #[arg(long, value_enum, conflicts_with_all = ["slots", "units", "pipelines"])]
     pub device: Option<crate::fpga::device::Device>,
+    /// The hard multiplier products are cut for: 18x18 (ECP5 MULT18X18D) or 25x18 (the Xilinx
+    /// DSP48E/DSP48E1) [default: the --device's (board's, synth --family's), else 18x18].
+    #[arg(long, value_enum)]
+    pub dsp: Option<DspArg>,
+}
+
+/// `--dsp`: the multiplier a product's pieces are cut for (`cores::mul::Piece`).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DspArg {
+    #[value(name = "18x18")]
+    Mult18,
+    #[value(name = "25x18")]
+    Dsp48,
+}
+
+impl From<DspArg> for crate::cores::mul::Piece {
+    fn from(d: DspArg) -> Self {
+        match d {
+            DspArg::Mult18 => crate::cores::mul::Piece::Mult18,
+            DspArg::Dsp48 => crate::cores::mul::Piece::Dsp48,
+        }
+    }
+}
+
+impl DspArg {
+    /// The `--dsp` value that asks for `piece`.
+    pub fn of(piece: crate::cores::mul::Piece) -> DspArg {
+        match piece {
+            crate::cores::mul::Piece::Mult18 => DspArg::Mult18,
+            crate::cores::mul::Piece::Dsp48 => DspArg::Dsp48,
+        }
+    }
 }
 
 impl ThreadArgs {
@@ -32,7 +64,19 @@ impl ThreadArgs {
         units: crate::cores::top::DEFAULT_UNITS,
         pipelines: 1,
         device: None,
+        dsp: None,
     };
+
+    /// The hard multiplier the core's products are cut for: `--dsp`'s, else the device's, else
+    /// `otherwise` (the board's or the synthesis family's, or the ECP5's).
+    pub fn piece_or(&self, otherwise: crate::cores::mul::Piece) -> crate::cores::mul::Piece {
+        self.dsp.map(Into::into).or(self.device.map(|d| d.piece())).unwrap_or(otherwise)
+    }
+
+    /// Whether the shape options are clap's defaults (`--dsp` is not a shape).
+    pub fn shape_is_default(&self) -> bool {
+        ThreadArgs { dsp: None, ..*self } == ThreadArgs::DEFAULT
+    }
 }
 
 /// Choices of the hardware that do not change the arithmetic.
@@ -50,6 +94,13 @@ pub struct HwArgs {
     pub target_mhz: u32,
     #[command(flatten)]
     pub threads: ThreadArgs,
+}
+
+impl HwArgs {
+    /// The hard multiplier the cores' products are cut for (`ThreadArgs::piece_or`).
+    pub fn piece(&self) -> crate::cores::mul::Piece {
+        self.threads.piece_or(Default::default())
+    }
 }
 
 /// The parameter set (seed 001 §2.1–2.4), shared by every subcommand.

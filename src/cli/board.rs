@@ -24,12 +24,13 @@ fn board_camera(scene: &Scene, spec: &CameraSpec) -> Result<crate::model::raygen
 }
 
 /// The core's shape options for board `b`: as given, but with none given (and the scene on
-/// chip) the ML509's core is fitted to its XC5VLX110T — the default two units need 70 DSP48E
-/// of its 64 (DECISIONS 124). The ULX3S's LFE5U-85F holds the default core.
+/// chip) the ML509's core is fitted to its XC5VLX110T (DECISIONS 124; with its products cut
+/// for the DSP48E that is two units, 60 of its 64, DECISIONS 131). The ULX3S's LFE5U-85F
+/// holds the default core.
 fn board_threads(c: &GenConfig, b: &BoardConfig) -> super::ThreadArgs {
     let on_chip = c.memory != super::args::MemoryPlace::External;
     match b.board {
-        crate::board::Board::Ml509 if on_chip && c.threads == super::ThreadArgs::DEFAULT => {
+        crate::board::Board::Ml509 if on_chip && c.threads.shape_is_default() => {
             super::ThreadArgs { device: Some(b.board.device()), ..c.threads }
         }
         _ => c.threads,
@@ -46,7 +47,9 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
     let g = board_camera(&scene, spec)?;
     super::config::ids_fit(c.ray_id_width, g.width, g.height)?;
     let external = c.memory == super::args::MemoryPlace::External;
-    let (spec, fit) = super::device::shape(&board_threads(c, b), Some(&mut scene), *search, c.core_spec(), external)?;
+    // The board's part cuts the products for its multipliers, with a shape given too.
+    let base = crate::cores::top::CoreSpec { piece: c.threads.piece_or(b.board.device().piece()), ..c.core_spec() };
+    let (spec, fit) = super::device::shape(&board_threads(c, b), Some(&mut scene), *search, base, external)?;
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(&roms, &spec);
     p.check()?;

@@ -288,6 +288,7 @@ impl GenConfig {
             slots: self.threads.slots,
             units: self.threads.units,
             pipelines: self.threads.pipelines,
+            piece: self.threads.piece_or(Default::default()),
         }
     }
 }
@@ -479,6 +480,16 @@ pub enum Family {
     Ecp5 { target_mhz: f64, seeds: Vec<u64>, modules: Vec<String> },
 }
 
+impl Family {
+    /// The hard multiplier the cores synthesised for the family cut their products for.
+    pub fn piece(&self) -> crate::cores::mul::Piece {
+        match self {
+            Family::Ecp5 { .. } => crate::cores::mul::Piece::Mult18,
+            Family::Xc5v | Family::Xc7 => crate::cores::mul::Piece::Dsp48,
+        }
+    }
+}
+
 /// The modules `synth --family ecp5` (and `sweep --synth --family ecp5`) can place and route.
 pub use crate::fpga::ecp5::MODULES as ECP5_MODULES;
 
@@ -497,6 +508,10 @@ impl SynthArgs {
                 return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));
             }
         };
+        if let Some(d) = self.hw.threads.device.filter(|d| d.family() != self.family) {
+            let (name, own) = (d.name(), d.family());
+            return Err(Error::param("device", format!("the {name} is mapped by --family {own}, not {}", self.family)));
+        }
         let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
         check_folder(&build)?;
         let device_kbits =

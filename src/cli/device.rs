@@ -18,6 +18,9 @@ pub fn shape(
     base: CoreSpec,
     external: bool,
 ) -> Result<(CoreSpec, Option<Fit>)> {
+    // A device's core cuts its products for the device's multipliers, fitted or given, unless
+    // --dsp says otherwise.
+    let base = CoreSpec { piece: t.piece_or(base.piece), ..base };
     let given = CoreSpec { slots: t.slots, units: t.units, pipelines: t.pipelines, ..base };
     let Some(device) = t.device else {
         return Ok((given, None));

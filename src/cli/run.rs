@@ -220,8 +220,8 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
 /// The pipeline's widths for a parameter set and scene (E comes from the scene when auto).
 fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<IntersectParams> {
     let (tag_width, div_bits, target_mhz) = (hw.tag_width, hw.div_bits, hw.target_mhz);
-    let p =
-        IntersectParams { n: params.n, m: params.m, t: params.t, e: scene.edge_shift, tag_width, div_bits, target_mhz };
+    let (n, m, t, e, piece) = (params.n, params.m, params.t, scene.edge_shift, hw.piece());
+    let p = IntersectParams { n, m, t, e, tag_width, div_bits, target_mhz, piece };
     p.check()?;
     Ok(p)
 }
@@ -321,11 +321,13 @@ pub fn test(c: &TestConfig) -> Result<bool> {
 
 pub fn synth_cores(c: &SynthConfig) -> Result<()> {
     let mut scene = Scene::load(&c.scene, &c.params)?;
-    let p = intersect_params(&c.params, &scene, &c.hw)?;
+    let piece = c.hw.threads.piece_or(c.family.piece());
+    let p = crate::cores::intersect::IntersectParams { piece, ..intersect_params(&c.params, &scene, &c.hw)? };
     let base = crate::cores::top::CoreSpec {
         id_width: crate::cores::top::DEFAULT_RAY_ID_WIDTH,
         div_bits: c.hw.div_bits,
         target_mhz: c.hw.target_mhz,
+        piece,
         ..Default::default()
     };
     let external = c.memory == super::args::MemoryPlace::External;

@@ -144,7 +144,8 @@ fn fit_to(device: crate::fpga::device::Device, spec: &mut SweepSpec) -> Result<(
     let scene = crate::scene::Scene::load(&spec.scenes[0].source(), &base)?;
     let (width, height) = (spec.camera.width, spec.camera.height);
     let id_width = crate::scene::rom::addr_bits((width * height) as usize).max(1);
-    let core = crate::cores::top::CoreSpec { id_width, target_mhz: spec.target_mhz, ..Default::default() };
+    let (target_mhz, piece) = (spec.target_mhz, device.piece());
+    let core = crate::cores::top::CoreSpec { id_width, target_mhz, piece, ..Default::default() };
     let search = crate::sweep::fit::SceneSearch::default();
     let (fit, _) = super::device::fit_on_chip(device, &scene, search, &core, spec.memory.is_some())?;
     super::device::say(Some(&fit));

@@ -204,6 +204,11 @@ fn synth_defaults_to_virtex_5_and_refuses_other_families() {
     assert_eq!((c.build, c.family), (PathBuf::from("target/fxrt-synth"), Family::Xc5v));
     let Command::Synth(a) = command(&["synth", "--family", "xc7"]) else { panic!() };
     assert_eq!(a.config().unwrap().family, Family::Xc7);
+    // A device is mapped by its own family only; the family decides how products are cut.
+    assert_eq!(refused(&["synth", "--family", "ecp5", "--device", "xc5vlx110t"]), "--device");
+    assert_eq!(refused(&["synth", "--device", "lfe5u-85f"]), "--device");
+    let Command::Synth(a) = command(&["synth", "--family", "xc7", "--device", "xc7a100t"]) else { panic!() };
+    assert_eq!(a.config().unwrap().family.piece(), crate::cores::mul::Piece::Dsp48);
 }
 
 #[test]

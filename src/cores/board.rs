@@ -127,6 +127,7 @@ mod tests {
                 slots: 4,
                 units: 1,
                 pipelines: 1,
+                piece: Default::default(),
             },
         );
         let core = core_module_with(&p, &roms, false);

@@ -10,7 +10,7 @@
 //! 150–200 MHz, two in series at about half that. docs/TIMING.md has what each target
 //! actually reaches.
 
-use super::mul::MulStyle;
+use super::mul::{MulStyle, Piece};
 
 /// The default clock target, MHz (chosen by measurement: docs/TIMING.md).
 pub const DEFAULT_TARGET_MHZ: u32 = 150;
@@ -56,13 +56,13 @@ impl ClockTarget {
     pub fn mul_style(self) -> MulStyle {
         match self.0 {
             0..=75 => MulStyle::COMBINATIONAL,
-            76..=125 => MulStyle { dsp_regs: 2, levels_per_stage: 2 },
+            76..=125 => MulStyle { dsp_regs: 2, levels_per_stage: 2, piece: Piece::Mult18 },
             // Measured at 150 MHz with two tree levels per stage: 108.7 MHz, the path a DSP
             // output through two adders (docs/TIMING.md).
-            126..=175 => MulStyle { dsp_regs: 3, levels_per_stage: 1 },
+            126..=175 => MulStyle { dsp_regs: 3, levels_per_stage: 1, piece: Piece::Mult18 },
             // At 200 MHz the DSP column's output routed to the first tree adder (2.8 ns) held
             // the intersection pipeline at 190.6 MHz: a fabric register lands it first.
-            _ => MulStyle { dsp_regs: 4, levels_per_stage: 1 },
+            _ => MulStyle { dsp_regs: 4, levels_per_stage: 1, piece: Piece::Mult18 },
         }
     }
 

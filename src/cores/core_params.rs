@@ -49,6 +49,9 @@ pub struct CoreSpec {
     pub slots: u32,
     pub units: u32,
     pub pipelines: u32,
+    /// The hard multiplier products are cut for: the ECP5's 18 × 18 unless the core is built
+    /// for a Xilinx part (`--device`, `--board ml509`, `synth --family xc5v|xc7`).
+    pub piece: super::mul::Piece,
 }
 
 /// The ray id width by default (`--ray-id-width`): a 1024 × 1024 frame's pixel numbers.
@@ -63,6 +66,7 @@ impl Default for CoreSpec {
             slots: DEFAULT_SLOTS,
             units: DEFAULT_UNITS,
             pipelines: 1,
+            piece: super::mul::Piece::Mult18,
         }
     }
 }
@@ -76,8 +80,9 @@ impl CoreParams {
     /// The core of `shape` for `scene` (not checked: `check` says what the RTL layer cannot
     /// hold).
     pub fn shaped(scene: &SceneRoms, shape: &CoreSpec) -> CoreParams {
-        let CoreSpec { id_width, div_bits, target_mhz, slots, units, pipelines } = *shape;
-        let trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
+        let CoreSpec { id_width, div_bits, target_mhz, slots, units, pipelines, piece } = *shape;
+        let mut trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
+        trav.product = trav.product.with_piece(piece);
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
         let tag = TagLayout {
             tri_bits: trav.tri_bits,
@@ -94,6 +99,7 @@ impl CoreParams {
             tag_width: tag.width(),
             div_bits,
             target_mhz,
+            piece,
         };
         let tri_rom_cycles = super::brom::tri_read_cycles(scene.tri.1.len());
         CoreParams { isect, trav, tag, units, pipelines, tri_rom_cycles, mem: None }

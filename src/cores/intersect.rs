@@ -25,6 +25,9 @@ pub struct IntersectParams {
     pub div_bits: u32,
     /// The clock the pipeline is built for, MHz (`clock::ClockTarget`).
     pub target_mhz: u32,
+    /// The hard multiplier its products are cut for (absent from JSON when the ECP5's).
+    #[serde(skip_serializing_if = "crate::cores::mul::Piece::is_mult18")]
+    pub piece: crate::cores::mul::Piece,
 }
 
 impl IntersectParams {
@@ -41,8 +44,14 @@ impl IntersectParams {
     pub fn name(&self) -> String {
         let r4 = if self.div_bits == 2 { "_r4" } else { "" };
         format!(
-            "fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}_c{}",
-            self.n, self.m, self.t, self.e, self.tag_width, self.target_mhz
+            "fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}_c{}{}",
+            self.n,
+            self.m,
+            self.t,
+            self.e,
+            self.tag_width,
+            self.target_mhz,
+            self.piece.name_suffix()
         )
     }
     /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
@@ -104,6 +113,10 @@ impl IntersectParams {
 
     pub fn target(&self) -> ClockTarget {
         ClockTarget(self.target_mhz)
+    }
+    /// How its products are built: the clock target's style, cut for its `piece`.
+    pub fn mul_style(&self) -> super::mul::MulStyle {
+        self.target().mul_style().with_piece(self.piece)
     }
 
     /// Clock cycles from an input to its result, counted from the stages the target keeps.
@@ -268,7 +281,7 @@ fn target_policy(p: &IntersectParams) -> Vec<String> {
     // (by the DSP column). From `LANDING_FROM_MHZ` the barycentric products' repeat is kept, by
     // the u and v subtractors: a product's register into the v chain was a slowest path at seed
     // 3 (`u_bary_products.p3` → `s56_v`, 6.90 ns).
-    if tgt.mul_style() != super::mul::MulStyle::COMBINATIONAL {
+    if tgt.mul_style().split() {
         merge.extend(["products", "moved"].map(String::from));
         if !tgt.splits(super::clock::LANDING_FROM_MHZ) {
             merge.push("bary".to_string());
@@ -288,7 +301,7 @@ pub fn intersect_core_with(p: &IntersectParams, extra: Policy) -> (Module, u32) 
     let mut merge = target_policy(p);
     merge.extend(extra.merge);
     let pipe = Pipeline::new(&b, Policy { merge });
-    let style = p.target().mul_style();
+    let style = p.mul_style();
     let [valid, tag, ox, oy, oz, wx, wy, wz, r, pp, pq, d, np, nq, e1p, e1q, e2p, e2q] = ins[..] else {
         unreachable!("input_ports has 18 ports")
     };
@@ -521,6 +534,7 @@ mod tests {
             tag_width: 24,
             div_bits,
             target_mhz,
+            piece: Default::default(),
         };
         let (module, lat) = intersect_core_with(&p, policy);
         let mut sim = Sim::new(&module);
@@ -593,7 +607,16 @@ mod tests {
     #[test]
     fn merged_stages_keep_every_result() {
         let merge = Policy { merge: vec!["moved".into(), "bary".into()] };
-        let p = IntersectParams { n: 29, m: 32, t: 0, e: 18, tag_width: 24, div_bits: 1, target_mhz: 75 };
+        let p = IntersectParams {
+            n: 29,
+            m: 32,
+            t: 0,
+            e: 18,
+            tag_width: 24,
+            div_bits: 1,
+            target_mhz: 75,
+            piece: Default::default(),
+        };
         assert_eq!(intersect_core_with(&p, merge.clone()).1, p.latency() - 2);
         assert_eq!(check_with(Params::default(), 1, 75, 2000, merge), check(Params::default(), 1, 75, 2000));
     }
@@ -607,7 +630,16 @@ mod tests {
         let mut last = 0;
         for mhz in [75, 100, 150, 200, 250] {
             assert_eq!(check(params, 1, mhz, 1500), want, "{mhz} MHz");
-            let p = IntersectParams { n: 20, m: 24, t: 2, e: 10, tag_width: 8, div_bits: 1, target_mhz: mhz };
+            let p = IntersectParams {
+                n: 20,
+                m: 24,
+                t: 2,
+                e: 10,
+                tag_width: 8,
+                div_bits: 1,
+                target_mhz: mhz,
+                piece: Default::default(),
+            };
             assert!(p.latency() >= last, "{mhz} MHz: latency {} after {last}", p.latency());
             last = p.latency();
         }
@@ -616,7 +648,16 @@ mod tests {
     #[test]
     fn latency_at_the_thesis_setting_is_within_41() {
         // One-clock products, as the thesis's pipeline has them.
-        let p = IntersectParams { n: 29, m: 32, t: 0, e: 10, tag_width: 8, div_bits: 1, target_mhz: 75 };
+        let p = IntersectParams {
+            n: 29,
+            m: 32,
+            t: 0,
+            e: 10,
+            tag_width: 8,
+            div_bits: 1,
+            target_mhz: 75,
+            piece: Default::default(),
+        };
         assert!(p.latency() <= 41, "{}", p.latency());
     }
 }

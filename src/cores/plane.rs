@@ -30,7 +30,7 @@ use std::rc::Rc;
 /// between two registers when combinational (latency 1), else DSP-sized pieces with their
 /// registers and a registered adder tree.
 pub fn plane_product<'b>(b: &'b Builder, delta: S<'b>, inv: S<'b>, style: MulStyle) -> (S<'b>, u32) {
-    if style == MulStyle::COMBINATIONAL {
+    if !style.split() {
         return (b.delay("pu_product", delta.xmul(inv).name("pu_mul")), 1);
     }
     let m = Rc::new(product_core(delta.ty(), inv.ty(), style));
@@ -108,7 +108,7 @@ pub fn plane_unit<'b>(
     let above = (!below & shifted.slice(k, w - 1 - k).ne(0)).name("pu_above");
     let dist_w = Ty::s(n + 3).width;
     let low = shifted.resize(dist_w);
-    let split = product_style != MulStyle::COMBINATIONAL;
+    let split = product_style.split();
     let (above, below, low, valid, last) = if split {
         (
             b.delay("pu_above_r", above),

@@ -76,6 +76,23 @@ impl Device {
         }
     }
 
+    /// The hard multiplier a core built for the device cuts its products for.
+    pub const fn piece(self) -> crate::cores::mul::Piece {
+        match self {
+            Device::Lfe5u85f => crate::cores::mul::Piece::Mult18,
+            Device::Xc5vlx110t | Device::Xc7a100t => crate::cores::mul::Piece::Dsp48,
+        }
+    }
+
+    /// The `synth --family` that maps cores for the device.
+    pub const fn family(self) -> &'static str {
+        match self {
+            Device::Lfe5u85f => "ecp5",
+            Device::Xc5vlx110t => "xc5v",
+            Device::Xc7a100t => "xc7",
+        }
+    }
+
     /// Block RAM in kilobits (the `--bram-kbits` budget a device gives).
     pub const fn bram_kbits(self) -> u64 {
         let c = self.capacity();

@@ -5,3 +5,4 @@
 pub mod device;
 pub mod ecp5;
 pub mod xilinx;
+pub mod xilinx_bram;

@@ -306,7 +306,7 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     let roms = SceneRoms::of(&scene);
     match core_cost(&roms) {
         Ok(c) if extras.target_mhz != DEFAULT_TARGET_MHZ || !cfg.shape.is_default() => {
-            row.cost = Some(cost_at(c, &roms, extras.target_mhz, cfg.shape))
+            row.cost = Some(cost_at(c, &roms, extras, cfg.shape))
         }
         Ok(c) => row.cost = Some(c),
         Err(e) => row.error = Some(e.to_string()),
@@ -314,8 +314,17 @@ pub fn evaluate(ctx: &SceneCtx, cfg: &Config, key: String, extras: &Extras) -> E
     // The frame's pixel numbers are the ray ids (as `fxrt sim` does it).
     let id_width = crate::scene::rom::addr_bits((ctx.camera.width * ctx.camera.height) as usize).max(1);
     let CoreShape { slots, units, pipelines, .. } = cfg.shape;
-    let core_spec =
-        crate::cores::top::CoreSpec { id_width, div_bits: 1, target_mhz: extras.target_mhz, slots, units, pipelines };
+    // A core fitted to a device cuts its products for the device's multipliers.
+    let piece = extras.device.map(|d| d.piece()).unwrap_or_default();
+    let core_spec = crate::cores::top::CoreSpec {
+        id_width,
+        div_bits: 1,
+        target_mhz: extras.target_mhz,
+        slots,
+        units,
+        pipelines,
+        piece,
+    };
     let core_params = match &extras.memory {
         None => CoreParams::shaped(&roms, &core_spec),
         Some(m) => match CoreParams::external(&roms, &core_spec, m.spec(cfg.shape.memory)) {
@@ -418,15 +427,17 @@ fn simulate_core(
 
 /// `cost` (`core_cost`'s, for the default core) with what the clock target and the core's
 /// shape change: the divider's and the intersection pipeline's latencies, the registers and
-/// the multipliers' pieces. The ROMs do not depend on them.
-fn cost_at(cost: CoreCost, roms: &SceneRoms, target_mhz: u32, shape: CoreShape) -> CoreCost {
+/// the multipliers' pieces (cut for the device's multipliers under `--device`, as the row's
+/// core is). The ROMs do not depend on them.
+fn cost_at(cost: CoreCost, roms: &SceneRoms, extras: &Extras, shape: CoreShape) -> CoreCost {
     let p = CoreParams::shaped(
         roms,
         &crate::cores::top::CoreSpec {
-            target_mhz,
+            target_mhz: extras.target_mhz,
             slots: shape.slots,
             units: shape.units,
             pipelines: shape.pipelines,
+            piece: extras.device.map(|d| d.piece()).unwrap_or_default(),
             ..Default::default()
         },
     );

@@ -6,8 +6,9 @@
 //! golden model walks.
 //!
 //! What a shape needs is counted from its netlist (`fpga::ecp5::blocks` on the LFE5U-85F:
-//! nextpnr's own counts for every core placed; `cores::cost::dsp48e_estimate` on the Xilinx
-//! parts, with block RAM by bits as `--bram-kbits` counts it). For each U and P only the most
+//! nextpnr's own counts for every core placed; on the Xilinx parts `cores::cost::
+//! dsp48e_estimate` and the RAMB36 sites of `fpga::xilinx_bram`, yosys's mapping). The core is
+//! built with `base`'s multiplier cut (the CLI: the device's, unless `--dsp`). For each U and P only the most
 //! slots that fit are run: more slots hide more of a parked ray's wait and never cost a clock.
 
 use crate::cores::top::{CoreParams, CoreSpec, core_module_with};
@@ -81,7 +82,7 @@ pub struct Candidate {
     pub pipelines: u32,
     /// MULT18X18D (LFE5U-85F) or DSP48E/DSP48E1 (Xilinx).
     pub multipliers: u32,
-    /// DP16KD on the LFE5U-85F; on the Xilinx parts block RAM in Kb (ROMs and stacks).
+    /// DP16KD on the LFE5U-85F; RAMB36 sites on the Xilinx parts (two RAMB18 to a site).
     pub block_ram: u64,
     /// Flip-flops: the register bits left in the fabric (`Blocks::fabric_register_bits`, 5 %
     /// over nextpnr's count for the cores placed: synthesis drops what is constant).
@@ -135,14 +136,14 @@ impl Fit {
 
     /// What the fit found, a line per shape run and the choice.
     pub fn lines(&self) -> Vec<String> {
-        let unit = if self.device == Device::Lfe5u85f { "" } else { " Kb" };
+        let unit = if self.device == Device::Lfe5u85f { "" } else { " RAMB36" };
         let mut lines: Vec<String> = self
             .candidates
             .iter()
             .filter_map(|c| {
                 let r = c.rays_per_clock?;
                 Some(format!(
-                    "device {}: {}: {} of {} multipliers, {}{unit} of {}{unit} block RAM, {} of {} FFs, {r:.4} rays \
+                    "device {}: {}: {} of {} multipliers, {} of {}{unit} block RAM, {} of {} FFs, {r:.4} rays \
                      per clock ({})",
                     self.device.name(),
                     c.shape(),
@@ -171,17 +172,16 @@ impl Candidate {
     }
 }
 
-/// The block RAM a fitted core may take (DP16KD on the LFE5U-85F, Kb on the Xilinx parts) and
-/// its `FF_SHARE` of the device's flip-flops.
+/// The block RAMs a fitted core may take (DP16KD on the LFE5U-85F, RAMB36 sites on the Xilinx
+/// parts) and its `FF_SHARE` of the device's flip-flops.
 fn limits(device: Device) -> (u64, u64) {
     let cap = device.capacity();
-    let block_ram = if device == Device::Lfe5u85f { cap.block_rams as u64 } else { device.bram_kbits() };
-    (block_ram, (cap.ffs as f64 * FF_SHARE) as u64)
+    (cap.block_rams as u64, (cap.ffs as f64 * FF_SHARE) as u64)
 }
 
-/// What the fit counts block RAM in on `device`: DP16KD blocks, or Kb on the Xilinx parts.
+/// What the fit counts block RAM in on `device`: DP16KD blocks, or RAMB36 sites.
 fn block_ram_unit(device: Device) -> &'static str {
-    if device == Device::Lfe5u85f { "block RAMs" } else { "Kb of block RAM" }
+    if device == Device::Lfe5u85f { "block RAMs" } else { "RAMB36 (two RAMB18 to one)" }
 }
 
 /// What `device` lacks for core `p`, counted as the fit counts (its multipliers, block RAM,
@@ -209,7 +209,8 @@ fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64) {
     match device {
         Device::Lfe5u85f => (b.mult18 as u32, b.dp16kd as u64, b.fabric_register_bits),
         Device::Xc5vlx110t | Device::Xc7a100t => {
-            (crate::cores::cost::dsp48e_estimate(&core), p.bram_bits(roms).div_ceil(1024), b.fabric_register_bits)
+            let sites = crate::fpga::xilinx_bram::brams(&core).sites() as u64;
+            (crate::cores::cost::dsp48e_estimate(&core), sites, b.fabric_register_bits)
         }
     }
 }
@@ -362,10 +363,11 @@ mod tests {
     /// On the LFE5U-85F the teapot's fit is four units of 64 slots and two pipelines, its tree
     /// built for a stack of 16: with the stack of 32 asked for by default, four of 64 need 212
     /// DP16KD of its 208 (four pipelines: 214 MULT18X18D of its 156). The XC5VLX110T's 64 DSP48E
-    /// take one unit (two need 70). Every shape run fits, and the chosen one has the most rays
-    /// per clock of them; the scene returned is the chosen build.
+    /// take two units with the products cut for them (60; three need 68), one with the ECP5's
+    /// 18 × 18 cut (two need 70). Every shape run fits, and the chosen one has the most rays per
+    /// clock of them; the scene returned is the chosen build.
     #[test]
-    fn the_teapot_fits_four_units_of_64_and_two_pipelines_on_the_ecp5_and_one_unit_on_the_virtex_5() {
+    fn the_teapot_fits_four_units_of_64_and_two_pipelines_on_the_ecp5_and_two_units_on_the_virtex_5() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
         let base = CoreSpec { id_width: 12, ..CoreSpec::default() };
         let (ecp5, chosen) = fit(Device::Lfe5u85f, &scene, SceneSearch::BOTH, &base, &|| {}).unwrap();
@@ -381,9 +383,16 @@ mod tests {
         assert!(run.iter().all(|r| r.rays_per_clock <= c.rays_per_clock));
         assert!(run.iter().all(|r| r.flip_flops <= ecp5.flip_flops_of), "{run:#?}");
         assert_eq!(ecp5.flip_flops_of, 66_912);
-        let (virtex, _) = fit(Device::Xc5vlx110t, &scene, SceneSearch::default(), &base, &|| {}).unwrap();
-        assert_eq!((virtex.chosen.units, virtex.chosen.pipelines, virtex.chosen.multipliers), (1, 1, 58));
+        let dsp48 = CoreSpec { piece: Device::Xc5vlx110t.piece(), ..base };
+        let (virtex, _) = fit(Device::Xc5vlx110t, &scene, SceneSearch::default(), &dsp48, &|| {}).unwrap();
+        assert_eq!((virtex.chosen.units, virtex.chosen.pipelines, virtex.chosen.multipliers), (2, 1, 60));
+        // Block RAM in RAMB36 sites as yosys maps the memories (`fpga::xilinx_bram`).
+        assert_eq!((virtex.chosen.block_ram, virtex.block_ram_of), (94, 148));
         assert!(virtex.candidates.iter().all(|c| (c.leaf_size, c.stack_depth) == (4, 32)), "nothing searched");
+        let three = virtex.candidates.iter().find(|c| (c.units, c.pipelines) == (3, 1)).unwrap();
+        assert_eq!((three.multipliers, three.rays_per_clock), (68, None));
+        let (square, _) = fit(Device::Xc5vlx110t, &scene, SceneSearch::default(), &base, &|| {}).unwrap();
+        assert_eq!((square.chosen.units, square.chosen.multipliers), (1, 58));
     }
 
     /// A shape fits when each of its needs does: one over (multipliers, block RAM, or the

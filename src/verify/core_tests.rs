@@ -4,6 +4,7 @@
 //! (Moved here from `cores::top`, `cores::traverse` and `cores::raygen`: a core's unit tests
 //! stay beside it; tests that need this layer's harness live in this layer.)
 
+use crate::cores::mul::Piece;
 use crate::cores::raygen::inside_cornell;
 use crate::cores::top::{CoreParams, core_inputs, core_module, core_with_raygen, ray_inputs};
 use crate::model::camera::Camera;
@@ -25,7 +26,15 @@ fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
     let roms = SceneRoms::of(&scene);
     let err = CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 33, units: 3, pipelines: 1 },
+        &crate::cores::top::CoreSpec {
+            id_width: 16,
+            div_bits: 1,
+            target_mhz: 150,
+            slots: 33,
+            units: 3,
+            pipelines: 1,
+            ..Default::default()
+        },
     )
     .check()
     .unwrap_err();
@@ -33,13 +42,29 @@ fn slot_numbers_beyond_the_closest_hit_unit_are_refused_naming_slots() {
     assert!(err.message.contains("99 ray slots, numbered as 3 × 64"), "{err}");
     CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 32, units: 3, pipelines: 1 },
+        &crate::cores::top::CoreSpec {
+            id_width: 16,
+            div_bits: 1,
+            target_mhz: 150,
+            slots: 32,
+            units: 3,
+            pipelines: 1,
+            ..Default::default()
+        },
     )
     .check()
     .unwrap();
     CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: 150, slots: 42, units: 2, pipelines: 1 },
+        &crate::cores::top::CoreSpec {
+            id_width: 16,
+            div_bits: 1,
+            target_mhz: 150,
+            slots: 42,
+            units: 2,
+            pipelines: 1,
+            ..Default::default()
+        },
     )
     .check()
     .unwrap();
@@ -116,12 +141,13 @@ fn assert_walks_are_the_culled_golden_walks(
     mhz: u32,
     slots: u32,
     [units, pipelines]: [u32; 2],
+    piece: Piece,
 ) {
     let g = Golden::new(scene);
     let roms = SceneRoms::of(scene);
     let p = CoreParams::shaped(
         &roms,
-        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: mhz, slots, units, pipelines },
+        &crate::cores::top::CoreSpec { id_width: 16, div_bits: 1, target_mhz: mhz, slots, units, pipelines, piece },
     );
     let m = core_module(&p, &roms);
     let mut sim = Sim::new(&m);
@@ -174,10 +200,21 @@ fn assert_walks_are_the_culled_golden_walks(
 
 /// Every ray of a small frame through the whole core, many at once: each ray's node visits
 /// are those of `Golden::trace_culled`, in its order — at three clock targets, with few
-/// slots (rays wait for slots, slots park and are reused), one slot, and several units.
+/// slots (rays wait for slots, slots park and are reused), one slot, and several units; and
+/// with the products cut for the DSP48E (plane products and, at m = 20, the pipeline's).
 #[test]
 fn every_ray_visits_what_the_culled_golden_walk_visits_in_its_order() {
     let cornell = Params { n: 20, m: 20, ..Params::default() };
+    let dsp48 = [
+        ("teapot", Params::default(), 150, 32, [2, 1]),
+        ("cornell", cornell, 250, 5, [3, 1]),
+        ("cornell", cornell, 100, 3, [4, 2]),
+    ];
+    for (name, params, mhz, slots, units) in dsp48 {
+        let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 20, 20));
+        assert_walks_are_the_culled_golden_walks(name, &scene, &rays, mhz, slots, units, Piece::Dsp48);
+    }
     for (name, params, mhz, slots, units) in [
         ("teapot", Params::default(), 150, 32, [2, 1]),
         ("cornell", cornell, 75, 3, [1, 1]),
@@ -192,7 +229,7 @@ fn every_ray_visits_what_the_culled_golden_walk_visits_in_its_order() {
     ] {
         let scene = Scene::load(&SceneSource::Builtin(name.into()), &params).unwrap();
         let rays = frame_rays(&scene, &Camera::default_for(&scene, 20, 20));
-        assert_walks_are_the_culled_golden_walks(name, &scene, &rays, mhz, slots, units);
+        assert_walks_are_the_culled_golden_walks(name, &scene, &rays, mhz, slots, units, Piece::Mult18);
     }
 }
 
@@ -226,7 +263,7 @@ fn each_token_decides_its_step_with_its_own_direction_sign() {
     let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &params).unwrap();
     let rays = frame_rays(&scene, &Camera::default_for(&scene, 8, 8));
     assert_eq!((rays[0].pixel, rays[1].pixel), (0, 1));
-    assert_walks_are_the_culled_golden_walks("teapot n4 m8", &scene, &rays[..2], 150, 2, [1, 1]);
+    assert_walks_are_the_culled_golden_walks("teapot n4 m8", &scene, &rays[..2], 150, 2, [1, 1], Piece::Mult18);
 }
 
 #[test]

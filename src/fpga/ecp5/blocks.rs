@@ -13,6 +13,7 @@
 use super::bram::{MIN_WORDS, banks, config};
 use super::dsp::DSP_MODULE_PREFIX;
 use crate::cores::brom::{BRAM_PREFIX, BROM_PREFIX};
+use crate::cores::mul::DSP48_MODULE_PREFIX;
 use crate::rtl::emit::verilog::DISTRIBUTED_WORDS;
 use crate::rtl::netlist::{Def, Module, Rom};
 use crate::scene::rom::rom_depth;
@@ -76,6 +77,10 @@ fn register_bits(m: &Module, reads: bool) -> u64 {
 fn own(m: &Module) -> Blocks {
     if m.name.starts_with(DSP_MODULE_PREFIX) {
         return Blocks { mult18: 1, ..Blocks::default() };
+    }
+    // A DSP48E-sized piece (a core cut for the Xilinx parts, DECISIONS 131) would be two.
+    if m.name.starts_with(DSP48_MODULE_PREFIX) {
+        return Blocks { mult18: 2, ..Blocks::default() };
     }
     let block_module = m.roms.len() == 1
         && m.roms[0].words.len() >= MIN_WORDS

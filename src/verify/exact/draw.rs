@@ -44,6 +44,8 @@ pub struct Shape {
     pub pipelines: u32,
     pub target_mhz: u32,
     pub div_bits: u32,
+    /// The multiplier the products are cut for (`--dsp`).
+    pub piece: crate::cores::mul::Piece,
 }
 
 /// One case: everything `fxrt sim` needs to run it again.
@@ -110,6 +112,10 @@ pub fn case(seed: u64, index: u64, files: &[std::path::PathBuf]) -> Case {
         let per_lane = (shape.units / shape.pipelines).next_power_of_two();
         shape.slots = shape.slots.min(128 / per_lane);
     }
+    // Last of all: one case in four cuts its products for the Xilinx DSP48E (DECISIONS 131).
+    if rng.below(4) == 0 {
+        shape.piece = crate::cores::mul::Piece::Dsp48;
+    }
     Case { index, scene, params, shape, camera: None, inside, camera_seed, shuffle_seed, stalls, memory }
 }
 
@@ -170,7 +176,7 @@ fn shape(rng: &mut SplitMix64) -> Shape {
         _ => 1 + rng.below(most as u64) as u32,
     };
     let target_mhz = [50, 75, 100, 125, 126, 150, 175, 200, 250, 300, 400][rng.below(11) as usize];
-    Shape { slots, units, pipelines: 1, target_mhz, div_bits: 1 + rng.below(2) as u32 }
+    Shape { slots, units, pipelines: 1, target_mhz, div_bits: 1 + rng.below(2) as u32, piece: Default::default() }
 }
 
 /// The case's camera for its built scene: inside the scene's world box (a random eye and view

@@ -118,6 +118,7 @@ pub fn build(case: &mut Case, tris: Vec<Tri>) -> crate::error::Result<Built> {
         slots: s.slots,
         units: s.units,
         pipelines: s.pipelines,
+        piece: s.piece,
     };
     let core = CoreParams::shaped(&roms, &spec);
     core.check()?;

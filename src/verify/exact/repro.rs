@@ -54,6 +54,9 @@ pub fn sim_command(case: &Case, obj: &Path, hdl: Option<crate::verify::simulator
     if s.pipelines > 1 {
         write!(cmd, " --pipelines {}", s.pipelines).expect("a String");
     }
+    if s.piece == crate::cores::mul::Piece::Dsp48 {
+        cmd.push_str(" --dsp 25x18");
+    }
     // A case that panicked before its camera was drawn has none: the panic needs no rays.
     if let Some(cam) = case.camera {
         let size = format!("{}x{}", cam.width, cam.height);
@@ -116,7 +119,7 @@ pub fn write(out: &Path, run: &CaseRun) -> Result<PathBuf> {
         "scene": case.scene.label(),
         "params": case.params,
         "slots": case.shape.slots, "units": case.shape.units, "pipelines": case.shape.pipelines,
-        "target_mhz": case.shape.target_mhz, "div_bits": case.shape.div_bits,
+        "target_mhz": case.shape.target_mhz, "div_bits": case.shape.div_bits, "dsp": case.shape.piece.label(),
         "camera": case.camera.map(|c| serde_json::json!({
             "eye": c.eye, "at": c.at, "up": c.up, "fov": c.fov_deg, "size": [c.width, c.height], "inside": case.inside })),
         "shuffle_seed": case.shuffle_seed, "stalls": case.stalls,
