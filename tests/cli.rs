@@ -632,6 +632,14 @@ fn gen_board_rejects_bad_options_and_writes_the_design() {
     for ext in [".ucf", ".tcl", ".json"] {
         assert!(names.iter().any(|n| n.starts_with("fxrt_ml509_") && n.ends_with(ext)), "{ext} in {names:?}");
     }
+    // The board's manifest says the core's shape, its cut and the fit that chose it.
+    let manifest = names.iter().find(|n| n.starts_with("fxrt_ml509_") && n.ends_with(".json")).unwrap();
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join(manifest)).unwrap()).unwrap();
+    assert_eq!(
+        (doc["core"]["traversal_units"].as_u64(), doc["core"]["multiplier_pieces"].as_str()),
+        (Some(2), Some("25x18"))
+    );
+    assert_eq!(doc["device_fit"]["chosen"]["units"], 2, "{doc}");
 }
 
 /// `$FXRT_GOLDEN_PATH` forces the golden model's code path; a name that is no path is refused

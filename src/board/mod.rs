@@ -164,6 +164,11 @@ pub struct BoardDesign {
     pub check: BoardCheck,
     pub pixels: u64,
     pub scene: String,
+    /// The core's shape in the manifest: slots, units, pipelines, leaf size, stack, the
+    /// multiplier cut.
+    pub core: serde_json::Value,
+    /// The fit that chose the shape (`--device`, or the ML509 with no shape given).
+    pub device_fit: Option<serde_json::Value>,
 }
 
 /// The golden model's checksum of the frame `g` generates.
@@ -208,7 +213,13 @@ impl BoardDesign {
             ));
         }
         let top = format!("fxrt_{}{}", board.name(), logic.name.trim_start_matches("fxrt_board"));
-        Ok(BoardDesign { board, clock, logic, top, check, pixels, scene: roms.name.clone() })
+        let core = json!({
+            "ray_slots_per_unit": p.trav.slots, "traversal_units": p.units, "intersection_pipelines": p.pipelines,
+            "leaf_size": roms.params.leaf_size, "stack_depth": p.trav.stack_depth,
+            "multiplier_pieces": p.trav.product.piece.label(),
+        });
+        let scene = roms.name.clone();
+        Ok(BoardDesign { board, clock, logic, top, check, pixels, scene, core, device_fit: None })
     }
 
     fn template(&self) -> TopTemplate<'_> {
@@ -298,6 +309,8 @@ impl BoardDesign {
                 "7..2": format!("frame counter bits {}..{}", self.check.led_shift + LED_FRAME_BITS - 1, self.check.led_shift),
             },
             "reset": "the button (and the PLL not locked), through a three-flip-flop synchroniser",
+            "core": self.core,
+            "device_fit": self.device_fit,
             "files": files,
         })
     }

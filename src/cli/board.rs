@@ -63,7 +63,8 @@ pub fn gen_board(c: &GenConfig, b: &BoardConfig) -> Result<bool> {
         None
     };
     super::device::say(fit.as_ref());
-    let d = BoardDesign::new(b.board, &p, &roms, &scene, &g, b.mhz, b.led_shift, None)?;
+    let mut d = BoardDesign::new(b.board, &p, &roms, &scene, &g, b.mhz, b.led_shift, None)?;
+    d.device_fit = fit.as_ref().map(|f| serde_json::to_value(f).expect("a fit serialises"));
     let design: Vec<(PathBuf, String)> =
         d.files(c.vhdl, c.verilog).into_iter().map(|(n, t)| (c.out.join(n), t)).collect();
     let written = format!(

@@ -81,7 +81,7 @@ pub fn bench_exact(c: &Campaign) -> Result<bool> {
         "cases": report.cases, "refused": report.refused, "refused_by": report.refused_by,
         "rays": report.rays, "cycles": report.cycles,
         "scenes": report.scenes, "parameter_sets": report.parameter_sets, "shapes": report.shapes,
-        "inside_cameras": report.inside_cameras, "external_cases": report.external_cases, "hdl_cases": report.hdl_cases,
+        "inside_cameras": report.inside_cameras, "external_cases": report.external_cases, "dsp48_cases": report.dsp48_cases, "hdl_cases": report.hdl_cases,
         "findings": report.findings, "disagreeing_rays": report.disagreeing_rays, "panics": report.panics,
         "first_disagreement": first,
     });

@@ -329,6 +329,8 @@ pub struct Report {
     pub inside_cameras: u64,
     /// Cases that ran with the scene in external memory (tiny caches, a random memory).
     pub external_cases: u64,
+    /// Cases run with the products cut for the DSP48E (`--dsp 25x18`).
+    pub dsp48_cases: u64,
     /// Cases that also ran in the HDL simulator.
     pub hdl_cases: u64,
     /// Cases with a wrong result, walk or panic, and rays with a wrong result.
@@ -370,6 +372,7 @@ pub fn campaign(c: &Campaign, progress: &dyn Fn(u64, u64)) -> crate::error::Resu
                     report.cycles += o.cycles;
                     report.inside_cameras += run.case.inside as u64;
                     report.external_cases += run.case.memory.is_some() as u64;
+                    report.dsp48_cases += (run.case.shape.piece == crate::cores::mul::Piece::Dsp48) as u64;
                     report.hdl_cases += o.hdl.is_some() as u64;
                     report.disagreeing_rays += o.disagreeing_rays;
                     scenes.insert(run.case.scene.label());
