@@ -21,6 +21,20 @@ pub const DEFAULT_TARGET_MHZ: u32 = 150;
 /// 3.2–3.4 ns of a 6.67 ns clock in the placed default core (DECISIONS 126).
 pub const LANDING_FROM_MHZ: u32 = 141;
 
+/// More traversal units than this spread a core over the die (four fill three quarters of the
+/// LFE5U-85F's LUTs): from the landing target on, such a core lands its plane products in
+/// fabric registers, takes a ray done through a second register before the closest-hit units,
+/// and copies the has-best bit per result field. In the four-unit core each of these paths was
+/// among the slowest at a placement seed (DECISIONS 133); the two-unit default met 150 MHz
+/// without them, and its netlist (and measured clock) stays as it is.
+pub const SPREAD_FROM_UNITS: u32 = 3;
+
+/// Whether a core of `units` traversal units at `target` gets the spread core's registers
+/// (`SPREAD_FROM_UNITS`).
+pub fn spread(units: u32, target: ClockTarget) -> bool {
+    units >= SPREAD_FROM_UNITS && target.splits(LANDING_FROM_MHZ)
+}
+
 /// Targets the cores are pipelined for, MHz: below the lowest the description is the
 /// thesis-like one with one-clock products; above the highest nothing more is split.
 pub const TARGET_RANGE: (u32, u32) = (50, 400);

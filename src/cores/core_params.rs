@@ -83,6 +83,10 @@ impl CoreParams {
         let CoreSpec { id_width, div_bits, target_mhz, slots, units, pipelines, piece } = *shape;
         let mut trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
         trav.product = trav.product.with_piece(piece);
+        if super::clock::spread(units, super::clock::ClockTarget(target_mhz)) {
+            // A fabric register after the DSP block's (`MulStyle::dsp_regs`).
+            trav.product.dsp_regs = trav.product.dsp_regs.max(4);
+        }
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
         let tag = TagLayout {
             tri_bits: trav.tri_bits,

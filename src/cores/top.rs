@@ -245,9 +245,18 @@ fn results<'b>(
         done_any = done_any | dv[u];
     }
     let closest = Rc::new(p.closest_module());
-    // Registered before the closest-hit unit, whose per-slot selects it drives (the units'
-    // queues sit across the die).
-    let (done_any, done_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
+    // Registered by the arbiter (the units' queues sit across the die). A spread core
+    // registers it again before the closest-hit units, whose per-slot selects the second
+    // register's copies drive: with the copies loaded from the arbiter's select, the four-unit
+    // core's slowest paths at a placement seed were a unit's queue flag through the select
+    // into them (8.16 ns, 17 registers loaded from one LUT). The credits count the first
+    // (`popped`): a result then reaches the queue a clock after it is counted, never before.
+    let (picked, picked_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
+    let (done_any, done_slot) = if super::clock::spread(p.units, p.isect.target()) {
+        (b.valid_delay("done_valid_r2", picked), b.delay("done_slot_r2", picked_slot))
+    } else {
+        (picked, picked_slot)
+    };
     let (lb, lsb, lu) = (p.lane_bits(), p.lane_slot_bits(), p.lane_units() as usize);
     // A copy of the slot per group of 16 has-best bits in each lane's unit (`slot_bit_2`).
     let groups = super::slot_bit_groups(p.total_slots() >> lb) as usize;
@@ -291,7 +300,7 @@ fn results<'b>(
             b.drive(*wire, res.get(name));
         }
     }
-    (done_any, outs, credit_ok)
+    (picked, outs, credit_ok)
 }
 
 /// Result field `res_{name}` of the closest-hit units: a lane's shows a result three clocks
@@ -387,4 +396,56 @@ pub fn core_with_raygen(p: &CoreParams, core: &Rc<Module>, g: &crate::model::ray
         }
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+    use crate::rtl::netlist::Def;
+    use crate::scene::{Scene, SceneSource};
+
+    /// Registers of `m` whose names start with `prefix`, with what each loads.
+    fn regs<'m>(m: &'m Module, prefix: &str) -> Vec<(&'m str, &'m str)> {
+        m.signals
+            .iter()
+            .filter_map(|s| match s.def {
+                Def::Reg { next: Some(next), .. } if s.name.starts_with(prefix) => {
+                    Some((s.name.as_str(), m.signals[next.0 as usize].name.as_str()))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// A spread core (four units, `clock::spread`) copies the done slot from a register, not
+    /// from the arbiter's select, copies the has-best bit per result field and lands its plane
+    /// products in fabric registers; the two-unit default has none of these (its netlist is
+    /// the one measured: generated/measured).
+    #[test]
+    fn a_spread_core_registers_its_cross_die_values_and_the_default_does_not() {
+        let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let shape = |units, pipelines| CoreParams::shaped(&roms, &CoreSpec { units, pipelines, ..CoreSpec::default() });
+        for (units, pipelines, spread) in [(4, 2, true), (2, 1, false)] {
+            let p = shape(units, pipelines);
+            let top = core_module(&p, &roms);
+            let copies = regs(&top, "done_slot_r2");
+            if spread {
+                assert!(copies.len() > 1, "{units} units: {copies:?}");
+                for (name, loads) in &copies {
+                    assert_eq!(*loads, "done_slot_r", "{name} loads the arbiter's register");
+                }
+            } else {
+                assert!(copies.is_empty(), "{copies:?}");
+            }
+            let hierarchy = top.hierarchy();
+            let closest = hierarchy.iter().find(|m| m.name.starts_with("fxrt_closest")).unwrap();
+            assert_eq!(regs(closest, "d1_has").len(), if spread { 5 } else { 1 }, "{}", closest.name);
+            let plane = hierarchy.iter().filter(|m| m.name.starts_with("fxrt_mul")).map(|m| m.name.as_str());
+            let landed: Vec<&str> = plane.filter(|n| n.contains("_d4")).collect();
+            assert_eq!(landed.is_empty(), !spread, "{units} units: {landed:?}");
+            assert_eq!(p.trav.product.dsp_regs, if spread { 4 } else { 3 });
+        }
+    }
 }
