@@ -47,16 +47,6 @@ impl From<DspArg> for crate::cores::mul::Piece {
     }
 }
 
-impl DspArg {
-    /// The `--dsp` value that asks for `piece`.
-    pub fn of(piece: crate::cores::mul::Piece) -> DspArg {
-        match piece {
-            crate::cores::mul::Piece::Mult18 => DspArg::Mult18,
-            crate::cores::mul::Piece::Dsp48 => DspArg::Dsp48,
-        }
-    }
-}
-
 impl ThreadArgs {
     /// No shape option: what clap fills in (an explicit default cannot be told apart).
     pub const DEFAULT: ThreadArgs = ThreadArgs {

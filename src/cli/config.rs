@@ -466,8 +466,6 @@ pub struct SynthConfig {
 
 /// Block RAM of the LFE5U-85F, Kb: 208 DP16KD of 18 Kb.
 pub const ECP5_85F_BRAM_KBITS: u64 = Device::Lfe5u85f.bram_kbits();
-/// Block RAM of the XC5VLX110T, Kb (the thesis's device).
-pub const XC5VLX110T_BRAM_KBITS: u64 = Device::Xc5vlx110t.bram_kbits();
 
 /// Where `fxrt synth` maps the cores.
 #[derive(Clone, Debug, PartialEq)]
@@ -481,12 +479,19 @@ pub enum Family {
 }
 
 impl Family {
-    /// The hard multiplier the cores synthesised for the family cut their products for.
-    pub fn piece(&self) -> crate::cores::mul::Piece {
+    /// The family's part (the one its flow maps for).
+    pub fn device(&self) -> Device {
         match self {
-            Family::Ecp5 { .. } => crate::cores::mul::Piece::Mult18,
-            Family::Xc5v | Family::Xc7 => crate::cores::mul::Piece::Dsp48,
+            Family::Ecp5 { .. } => Device::Lfe5u85f,
+            Family::Xc5v => Device::Xc5vlx110t,
+            Family::Xc7 => Device::Xc7a100t,
         }
+    }
+
+    /// The hard multiplier the cores synthesised for the family cut their products for: its
+    /// part's.
+    pub fn piece(&self) -> crate::cores::mul::Piece {
+        self.device().piece()
     }
 }
 
@@ -514,8 +519,8 @@ impl SynthArgs {
         }
         let build = self.build.clone().unwrap_or_else(|| PathBuf::from("target/fxrt-synth"));
         check_folder(&build)?;
-        let device_kbits =
-            if matches!(family, Family::Ecp5 { .. }) { ECP5_85F_BRAM_KBITS } else { XC5VLX110T_BRAM_KBITS };
+        // The family's part's (the XC7A100T's for xc7, not the XC5VLX110T's).
+        let device_kbits = family.device().bram_kbits();
         Ok(SynthConfig {
             params: self.params.params()?,
             search: self.params.search(),

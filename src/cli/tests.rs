@@ -201,9 +201,10 @@ fn synth_defaults_to_virtex_5_and_refuses_other_families() {
     assert_eq!(refused(&["synth", "--family", "xc4"]), "--family");
     let Command::Synth(a) = command(&["synth"]) else { panic!() };
     let c = a.config().unwrap();
-    assert_eq!((c.build, c.family), (PathBuf::from("target/fxrt-synth"), Family::Xc5v));
+    assert_eq!((c.build, c.family, c.bram_kbits), (PathBuf::from("target/fxrt-synth"), Family::Xc5v, 5_328));
+    // Each family's block RAM is its own part's.
     let Command::Synth(a) = command(&["synth", "--family", "xc7"]) else { panic!() };
-    assert_eq!(a.config().unwrap().family, Family::Xc7);
+    assert_eq!((a.config().unwrap().family, a.config().unwrap().bram_kbits), (Family::Xc7, 4_860));
     // A device is mapped by its own family only; the family decides how products are cut.
     assert_eq!(refused(&["synth", "--family", "ecp5", "--device", "xc5vlx110t"]), "--device");
     assert_eq!(refused(&["synth", "--device", "lfe5u-85f"]), "--device");
