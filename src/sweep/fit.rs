@@ -33,6 +33,12 @@ pub const FRAME: u32 = 48;
 /// `rtl::build::RING_FROM`), and placed the default core at 50 %; the rest is left to the
 /// placer's packing (an ECP5 slice's two FFs share their clock enable and reset).
 pub const FF_SHARE: f64 = 0.8;
+/// The share of the device's LUTs a fitted core may take: the four-unit, two-pipeline core
+/// placed at 77 % of the LFE5U-85F's LUT4 (at 124–134 MHz, its paths mostly routing).
+pub const LUT_SHARE: f64 = 0.8;
+/// Xilinx LUT6 (with those used as shift registers and LUT RAM) per ECP5 LUT4 of the same
+/// core: yosys 0.23 `synth_xilinx -family xc5v` against `fpga::ecp5::luts` (docs/HDL.md).
+pub const LUT6_PER_LUT4: f64 = 0.39;
 /// Shapes within this fraction of the best on the scene as given are run on its other builds.
 const CLOSE: f64 = 0.75;
 
@@ -87,6 +93,9 @@ pub struct Candidate {
     /// Flip-flops: the register bits left in the fabric (`Blocks::fabric_register_bits`, 5 %
     /// over nextpnr's count for the cores placed: synthesis drops what is constant).
     pub flip_flops: u64,
+    /// LUTs: on the LFE5U-85F the LUT4 nextpnr places (`fpga::ecp5::luts`, with its carry and
+    /// LUT-RAM cells), on the Xilinx parts `LUT6_PER_LUT4` of that.
+    pub luts: u64,
     /// Rays per clock on the short frame (shapes that fit and are the most slots of their U, P).
     pub rays_per_clock: Option<f64>,
 }
@@ -99,6 +108,8 @@ pub struct Fit {
     pub block_ram_of: u64,
     /// `FF_SHARE` of the device's flip-flops.
     pub flip_flops_of: u64,
+    /// `LUT_SHARE` of the device's LUTs.
+    pub luts_of: u64,
     pub frame: String,
     pub candidates: Vec<Candidate>,
     pub chosen: Candidate,
@@ -114,13 +125,17 @@ impl Candidate {
         multipliers: 0,
         block_ram: 0,
         flip_flops: 0,
+        luts: 0,
         rays_per_clock: None,
     };
 
-    /// Whether the shape's needs are within the device's multipliers, block RAM and share of
-    /// flip-flops.
-    fn fits(&self, multipliers: u32, block_ram: u64, flip_flops: u64) -> bool {
-        self.multipliers <= multipliers && self.block_ram <= block_ram && self.flip_flops <= flip_flops
+    /// Whether the shape's needs are within the device's multipliers, block RAM and shares of
+    /// flip-flops and LUTs.
+    fn fits(&self, multipliers: u32, l: &Limits) -> bool {
+        self.multipliers <= multipliers
+            && self.block_ram <= l.block_ram
+            && self.flip_flops <= l.flip_flops
+            && self.luts <= l.luts
     }
 
     /// `base` (ray ids, divider, clock target) in this shape.
@@ -143,8 +158,8 @@ impl Fit {
             .filter_map(|c| {
                 let r = c.rays_per_clock?;
                 Some(format!(
-                    "device {}: {}: {} of {} multipliers, {} of {}{unit} block RAM, {} of {} FFs, {r:.4} rays \
-                     per clock ({})",
+                    "device {}: {}: {} of {} multipliers, {} of {}{unit} block RAM, {} of {} FFs, {} of {} \
+                     LUTs, {r:.4} rays per clock ({})",
                     self.device.name(),
                     c.shape(),
                     c.multipliers,
@@ -153,6 +168,8 @@ impl Fit {
                     self.block_ram_of,
                     c.flip_flops,
                     self.flip_flops_of,
+                    c.luts,
+                    self.luts_of,
                     self.frame
                 ))
             })
@@ -172,11 +189,23 @@ impl Candidate {
     }
 }
 
-/// The block RAMs a fitted core may take (DP16KD on the LFE5U-85F, RAMB36 sites on the Xilinx
-/// parts) and its `FF_SHARE` of the device's flip-flops.
-fn limits(device: Device) -> (u64, u64) {
+/// What a fitted core may take of a device besides its multipliers.
+struct Limits {
+    /// DP16KD on the LFE5U-85F, RAMB36 sites on the Xilinx parts.
+    block_ram: u64,
+    /// `FF_SHARE` of its flip-flops.
+    flip_flops: u64,
+    /// `LUT_SHARE` of its LUTs.
+    luts: u64,
+}
+
+fn limits(device: Device) -> Limits {
     let cap = device.capacity();
-    (cap.block_rams as u64, (cap.ffs as f64 * FF_SHARE) as u64)
+    Limits {
+        block_ram: cap.block_rams as u64,
+        flip_flops: (cap.ffs as f64 * FF_SHARE) as u64,
+        luts: (cap.luts as f64 * LUT_SHARE) as u64,
+    }
 }
 
 /// What the fit counts block RAM in on `device`: DP16KD blocks, or RAMB36 sites.
@@ -185,10 +214,11 @@ fn block_ram_unit(device: Device) -> &'static str {
 }
 
 /// What `device` lacks for core `p`, counted as the fit counts (its multipliers, block RAM,
-/// `FF_SHARE` of its flip-flops), in words; None when it holds the core.
+/// `FF_SHARE` of its flip-flops, `LUT_SHARE` of its LUTs), in words; None when it holds the
+/// core.
 pub fn lacks(device: Device, roms: &SceneRoms, p: &CoreParams) -> Option<String> {
-    let (multipliers, block_ram, flip_flops) = needs(device, roms, p);
-    let (block_ram_of, flip_flops_of) = limits(device);
+    let (multipliers, block_ram, flip_flops, luts) = needs(device, roms, p);
+    let Limits { block_ram: block_ram_of, flip_flops: flip_flops_of, luts: luts_of } = limits(device);
     let (name, multipliers_of) = (device.name(), device.capacity().multipliers);
     let unit = block_ram_unit(device);
     if multipliers > multipliers_of {
@@ -197,20 +227,25 @@ pub fn lacks(device: Device, roms: &SceneRoms, p: &CoreParams) -> Option<String>
         Some(format!("the core needs {block_ram} {unit}, the {name} has {block_ram_of}"))
     } else if flip_flops > flip_flops_of {
         Some(format!("the core needs {flip_flops} flip-flops, more than {flip_flops_of} of the {name}'s"))
+    } else if luts > luts_of {
+        Some(format!("the core needs {luts} LUTs, more than {luts_of} of the {name}'s"))
     } else {
         None
     }
 }
 
-/// What core `p` needs of `device`: (multipliers, block RAM in the device's unit, flip-flops).
-fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64) {
+/// What core `p` needs of `device`: (multipliers, block RAM in the device's unit, flip-flops,
+/// LUTs).
+fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64, u64) {
     let core = core_module_with(p, roms, false);
     let b = crate::fpga::ecp5::blocks::blocks(&core);
+    let lut4 = crate::fpga::ecp5::luts::luts(&core).comb();
     match device {
-        Device::Lfe5u85f => (b.mult18 as u32, b.dp16kd as u64, b.fabric_register_bits),
+        Device::Lfe5u85f => (b.mult18 as u32, b.dp16kd as u64, b.fabric_register_bits, lut4),
         Device::Xc5vlx110t | Device::Xc7a100t => {
             let sites = crate::fpga::xilinx_bram::brams(&core).sites() as u64;
-            (crate::cores::cost::dsp48e_estimate(&core), sites, b.fabric_register_bits)
+            let lut6 = (lut4 as f64 * LUT6_PER_LUT4).round() as u64;
+            (crate::cores::cost::dsp48e_estimate(&core), sites, b.fabric_register_bits, lut6)
         }
     }
 }
@@ -237,7 +272,8 @@ fn shapes(
         }
     }
     shapes.par_iter_mut().for_each(|c| {
-        (c.multipliers, c.block_ram, c.flip_flops) = needs(device, roms, &CoreParams::shaped(roms, &c.spec(base)));
+        (c.multipliers, c.block_ram, c.flip_flops, c.luts) =
+            needs(device, roms, &CoreParams::shaped(roms, &c.spec(base)));
     });
     shapes
 }
@@ -286,7 +322,7 @@ pub fn fit(
     progress: &(dyn Fn() + Sync),
 ) -> Result<(Fit, Scene)> {
     let cap = device.capacity();
-    let (block_ram_of, flip_flops_of) = limits(device);
+    let limit = limits(device);
     // What no shape changes (widths, the clock) is said as itself, before any shape is tried.
     CoreParams::shaped(&SceneRoms::of(scene), &CoreSpec { units: 1, slots: 1, pipelines: 1, ..*base }).check()?;
     let builds: Vec<Scene> = search.variants(&scene.params)[1..]
@@ -294,7 +330,7 @@ pub fn fit(
         .map(|p| Scene::build(&scene.name, scene.world.clone(), p))
         .collect::<Result<_>>()?;
     let scenes: Vec<&Scene> = std::iter::once(scene).chain(&builds).collect();
-    let fits = |c: &Candidate| c.fits(cap.multipliers, block_ram_of, flip_flops_of);
+    let fits = |c: &Candidate| c.fits(cap.multipliers, &limit);
     let cam = Camera::default_for(scene, FRAME, FRAME);
     // Every U and P on the scene as given; on its other builds only the U and P within `CLOSE`
     // of the best (a leaf or stack size moves the balance of units and pipelines a little, not
@@ -329,14 +365,17 @@ pub fn fit(
         return Err(Error::param(
             "device",
             format!(
-                "{}: no core shape for scene {} fits its {} multipliers, {} {} and {} flip-flops ({} %)",
+                "{}: no core shape for scene {} fits its {} multipliers, {} {}, {} flip-flops ({} %) and {} LUTs \
+                 ({} %)",
                 device.name(),
                 scene.name,
                 cap.multipliers,
-                block_ram_of,
+                limit.block_ram,
                 block_ram_unit(device),
-                flip_flops_of,
-                (FF_SHARE * 100.0).round()
+                limit.flip_flops,
+                (FF_SHARE * 100.0).round(),
+                limit.luts,
+                (LUT_SHARE * 100.0).round()
             ),
         ));
     };
@@ -345,8 +384,9 @@ pub fn fit(
     let fit = Fit {
         device,
         multipliers_of: cap.multipliers,
-        block_ram_of,
-        flip_flops_of,
+        block_ram_of: limit.block_ram,
+        flip_flops_of: limit.flip_flops,
+        luts_of: limit.luts,
         frame: format!("{FRAME}x{FRAME}, the scene's default view, Rust simulator"),
         chosen: candidates[chosen].clone(),
         candidates,
@@ -382,7 +422,9 @@ mod tests {
         assert!(run.len() >= 9 && run.iter().all(|c| c.multipliers <= 156 && c.block_ram <= 208), "{run:#?}");
         assert!(run.iter().all(|r| r.rays_per_clock <= c.rays_per_clock));
         assert!(run.iter().all(|r| r.flip_flops <= ecp5.flip_flops_of), "{run:#?}");
-        assert_eq!(ecp5.flip_flops_of, 66_912);
+        assert_eq!((ecp5.flip_flops_of, ecp5.luts_of), (66_912, 66_912));
+        // The chosen core's LUT4 as `fpga::ecp5::luts` counts them, near the 64,321 placed.
+        assert!(run.iter().all(|r| r.luts <= ecp5.luts_of) && (60_000..66_912).contains(&c.luts), "{c:#?}");
         let dsp48 = CoreSpec { piece: Device::Xc5vlx110t.piece(), ..base };
         let (virtex, _) = fit(Device::Xc5vlx110t, &scene, SceneSearch::default(), &dsp48, &|| {}).unwrap();
         assert_eq!((virtex.chosen.units, virtex.chosen.pipelines, virtex.chosen.multipliers), (2, 1, 60));
@@ -399,11 +441,14 @@ mod tests {
     /// flip-flops that kept a placeable 4 × 64 core out before the rings) and it does not.
     #[test]
     fn a_shape_fits_only_within_every_limit() {
-        let c = Candidate { multipliers: 134, block_ram: 196, flip_flops: 47_501, ..Candidate::EMPTY };
-        assert!(c.fits(156, 208, 66_912));
-        assert!(!c.fits(133, 208, 66_912));
-        assert!(!c.fits(156, 195, 66_912));
-        assert!(!Candidate { flip_flops: 80_036, ..c }.fits(156, 208, 66_912));
+        let c = Candidate { multipliers: 134, block_ram: 196, flip_flops: 47_501, luts: 64_321, ..Candidate::EMPTY };
+        let l = limits(Device::Lfe5u85f);
+        assert_eq!((l.block_ram, l.flip_flops, l.luts), (208, 66_912, 66_912));
+        assert!(c.fits(156, &l));
+        assert!(!c.fits(133, &l));
+        assert!(!c.fits(156, &Limits { block_ram: 195, ..l }));
+        assert!(!Candidate { flip_flops: 80_036, ..c }.fits(156, &l));
+        assert!(!Candidate { luts: 66_913, ..c }.fits(156, &l));
     }
 
     /// The builds tried: the scene as given first, each other leaf size and stack only once

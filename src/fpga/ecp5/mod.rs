@@ -13,6 +13,7 @@ pub mod blocks;
 pub mod bram;
 pub mod carry;
 pub mod dsp;
+pub mod luts;
 pub mod seeds;
 pub mod sta;
 
