@@ -144,14 +144,15 @@ pub fn files(p: &IntersectParams, vhdl: bool, verilog: bool) -> Vec<(String, Str
 
 /// What the core needs of each device `--device` knows, counted from its netlist before any
 /// synthesis: on the ECP5 the flow's own mapping (`fpga::ecp5::blocks`: MULT18X18D and DP16KD,
-/// equal to what nextpnr placed for every core measured), on the Xilinx parts yosys's slicing
-/// of each product into 25 × 18 DSP48s (`cores::cost`) and its block RAM mapping
-/// (`fpga::xilinx_bram`).
+/// equal to what nextpnr placed for every core measured, and the LUT4 of `fpga::ecp5::luts`),
+/// on the Xilinx parts yosys's slicing of each product into 25 × 18 DSP48s (`cores::cost`), its
+/// block RAM mapping (`fpga::xilinx_bram`) and the LUT6 of `Luts::lut6`.
 fn predicted(core: &Module) -> Value {
     use crate::fpga::device::Device;
     let b = crate::fpga::ecp5::blocks::blocks(core);
     let dsp = crate::cores::cost::dsp48e_estimate(core);
     let x = crate::fpga::xilinx_bram::brams(core);
+    let luts = crate::fpga::ecp5::luts::luts(core);
     let of = |d: Device| d.capacity();
     json!({
         "how": "counted from the netlist by the flows' mapping rules, before synthesis (docs/HDL.md)",
@@ -159,14 +160,17 @@ fn predicted(core: &Module) -> Value {
             "mult18": b.mult18, "mult18_of": of(Device::Lfe5u85f).multipliers,
             "dp16kd": b.dp16kd, "dp16kd_of": of(Device::Lfe5u85f).block_rams,
             "lut_ram_bits": b.lut_ram_bits, "fabric_register_bits": b.fabric_register_bits,
+            "lut4": luts.comb(), "lut4_of": of(Device::Lfe5u85f).luts,
         },
         Device::Xc5vlx110t.name(): {
             "dsp48e": dsp, "dsp48e_of": of(Device::Xc5vlx110t).multipliers,
             "ramb36": x.ramb36, "ramb18": x.ramb18, "ramb36_sites": x.sites(), "ramb36_sites_of": of(Device::Xc5vlx110t).block_rams,
+            "lut6": luts.lut6(), "lut6_of": of(Device::Xc5vlx110t).luts,
         },
         Device::Xc7a100t.name(): {
             "dsp48e1": dsp, "dsp48e1_of": of(Device::Xc7a100t).multipliers,
             "ramb36": x.ramb36, "ramb18": x.ramb18, "ramb36_sites": x.sites(), "ramb36_sites_of": of(Device::Xc7a100t).block_rams,
+            "lut6": luts.lut6(), "lut6_of": of(Device::Xc7a100t).luts,
         },
     })
 }

@@ -36,9 +36,6 @@ pub const FF_SHARE: f64 = 0.8;
 /// The share of the device's LUTs a fitted core may take: the four-unit, two-pipeline core
 /// placed at 77 % of the LFE5U-85F's LUT4 (at 124–134 MHz, its paths mostly routing).
 pub const LUT_SHARE: f64 = 0.8;
-/// Xilinx LUT6 (with those used as shift registers and LUT RAM) per ECP5 LUT4 of the same
-/// core: yosys 0.23 `synth_xilinx -family xc5v` against `fpga::ecp5::luts` (docs/HDL.md).
-pub const LUT6_PER_LUT4: f64 = 0.39;
 /// Shapes within this fraction of the best on the scene as given are run on its other builds.
 const CLOSE: f64 = 0.75;
 
@@ -94,7 +91,7 @@ pub struct Candidate {
     /// over nextpnr's count for the cores placed: synthesis drops what is constant).
     pub flip_flops: u64,
     /// LUTs: on the LFE5U-85F the LUT4 nextpnr places (`fpga::ecp5::luts`, with its carry and
-    /// LUT-RAM cells), on the Xilinx parts `LUT6_PER_LUT4` of that.
+    /// LUT-RAM cells), on the Xilinx parts the LUT6 of `Luts::lut6`.
     pub luts: u64,
     /// Rays per clock on the short frame (shapes that fit and are the most slots of their U, P).
     pub rays_per_clock: Option<f64>,
@@ -239,13 +236,12 @@ pub fn lacks(device: Device, roms: &SceneRoms, p: &CoreParams) -> Option<String>
 fn needs(device: Device, roms: &SceneRoms, p: &CoreParams) -> (u32, u64, u64, u64) {
     let core = core_module_with(p, roms, false);
     let b = crate::fpga::ecp5::blocks::blocks(&core);
-    let lut4 = crate::fpga::ecp5::luts::luts(&core).comb();
+    let luts = crate::fpga::ecp5::luts::luts(&core);
     match device {
-        Device::Lfe5u85f => (b.mult18 as u32, b.dp16kd as u64, b.fabric_register_bits, lut4),
+        Device::Lfe5u85f => (b.mult18 as u32, b.dp16kd as u64, b.fabric_register_bits, luts.comb()),
         Device::Xc5vlx110t | Device::Xc7a100t => {
             let sites = crate::fpga::xilinx_bram::brams(&core).sites() as u64;
-            let lut6 = (lut4 as f64 * LUT6_PER_LUT4).round() as u64;
-            (crate::cores::cost::dsp48e_estimate(&core), sites, b.fabric_register_bits, lut6)
+            (crate::cores::cost::dsp48e_estimate(&core), sites, b.fabric_register_bits, luts.lut6())
         }
     }
 }

@@ -27,6 +27,11 @@ use crate::scene::rom::rom_depth;
 /// `(COMB − LUT4 − 2 CCU2C) / DPR16X4` of their yosys statistics and nextpnr reports.
 pub const COMB_PER_DPR: f64 = 6.4;
 
+/// Xilinx LUT6 (with those used as shift registers and LUT RAM) per LUT4 `Luts::comb` counts
+/// for the same core: yosys 0.23 `synth_xilinx -family xc5v` mapped the XC5VLX110T's fit to
+/// 12,150 (docs/HDL.md).
+pub const LUT6_PER_LUT4: f64 = 0.39;
+
 /// What yosys maps beyond the logic rules count: their LUT4 are 89–92 % of yosys's for the
 /// default core's traversal unit, closest-hit unit and intersection pipeline synthesised alone
 /// (reset and enable logic folded into LUTs, the read-first bypasses of LUT RAM, the ORs of
@@ -56,6 +61,11 @@ impl Luts {
     /// The `TRELLIS_COMB` cells nextpnr would place (its reports' LUT4 count).
     pub fn comb(&self) -> u64 {
         (LOGIC_SCALE * self.lut4 + 2.0 * self.ccu2c + COMB_PER_DPR * self.dpr16x4).round() as u64
+    }
+
+    /// The LUT6 yosys would map on a Virtex-5 or 7-series part (`LUT6_PER_LUT4`).
+    pub fn lut6(&self) -> u64 {
+        (self.comb() as f64 * LUT6_PER_LUT4).round() as u64
     }
 }
 
