@@ -73,6 +73,15 @@ fn register_bits(m: &Module, reads: bool) -> u64 {
         .sum()
 }
 
+/// Whether `m` is a block ROM or block RAM module the flow maps to DP16KDs (its one memory
+/// deep enough).
+pub(super) fn is_block_module(m: &Module) -> bool {
+    m.roms.len() == 1
+        && m.roms[0].words.len() >= MIN_WORDS
+        && (m.name.starts_with(BROM_PREFIX)
+            || (m.name.starts_with(BRAM_PREFIX) && side_by_side(m.roms[0].words.len(), m.roms[0].width).is_some()))
+}
+
 /// The module's own memories and multiplier pieces, without its instances.
 fn own(m: &Module) -> Blocks {
     if m.name.starts_with(DSP_MODULE_PREFIX) {
@@ -82,10 +91,7 @@ fn own(m: &Module) -> Blocks {
     if m.name.starts_with(DSP48_MODULE_PREFIX) {
         return Blocks { mult18: 2, ..Blocks::default() };
     }
-    let block_module = m.roms.len() == 1
-        && m.roms[0].words.len() >= MIN_WORDS
-        && (m.name.starts_with(BROM_PREFIX)
-            || (m.name.starts_with(BRAM_PREFIX) && side_by_side(m.roms[0].words.len(), m.roms[0].width).is_some()));
+    let block_module = is_block_module(m);
     // A block memory module's read register and first register after it are the block's (one
     // per read port: each output).
     let inside = if block_module { m.roms[0].width as u64 * m.outputs.len() as u64 } else { 0 };

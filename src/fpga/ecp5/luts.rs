@@ -145,9 +145,7 @@ fn own(m: &Module) -> Luts {
     if m.name.starts_with(super::dsp::DSP_MODULE_PREFIX) || m.name.starts_with(crate::cores::mul::DSP48_MODULE_PREFIX) {
         return Luts::default();
     }
-    let block_module = m.roms.len() == 1
-        && m.roms[0].words.len() >= MIN_WORDS
-        && (m.name.starts_with(crate::cores::brom::BROM_PREFIX) || m.name.starts_with(crate::cores::brom::BRAM_PREFIX));
+    let block_module = super::blocks::is_block_module(m);
     let mut out = Luts::default();
     for s in &m.signals {
         out += operator(m, &s.def, s.ty.width);
