@@ -27,6 +27,7 @@ fn setup_bits(params: Params, div_bits: u32, count: usize) -> (IntersectParams, 
         div_bits,
         target_mhz: fxrt::cores::clock::DEFAULT_TARGET_MHZ,
         piece: Default::default(),
+        spread: false,
     };
     p.check().unwrap();
     let v = generate(&scene, count, 7);

@@ -221,7 +221,7 @@ pub fn scene(c: &SceneConfig) -> Result<()> {
 fn intersect_params(params: &Params, scene: &Scene, hw: &HwArgs) -> Result<IntersectParams> {
     let (tag_width, div_bits, target_mhz) = (hw.tag_width, hw.div_bits, hw.target_mhz);
     let (n, m, t, e, piece) = (params.n, params.m, params.t, scene.edge_shift, hw.piece());
-    let p = IntersectParams { n, m, t, e, tag_width, div_bits, target_mhz, piece };
+    let p = IntersectParams { n, m, t, e, tag_width, div_bits, target_mhz, piece, spread: false };
     p.check()?;
     Ok(p)
 }

@@ -195,9 +195,24 @@ pub fn closest_core(
     // the chain, the OR and the AND into the write enable in one clock were the default core's
     // slowest path at seed 1 (8.27 ns, 38 cells). The merge is reported from M2 as before; the
     // slot's best is read again only after its ray has been unparked, many clocks later.
-    let tt_less = lt_chain(b.cat(&[m1_empty, m1_tt]), b.cat(&[zero, st_tt])).name("leaf_tt_less");
-    let m2 = b.valid_delay("m2", m1);
-    let m2_less = b.delay("m2_tt_less", tt_less);
+    let spread = super::clock::spread(units << lane_bits, target);
+    let (leaf_key, slot_key) = (b.cat(&[m1_empty, m1_tt]), b.cat(&[zero, st_tt]));
+    let (m2, m2_less) = if spread {
+        // In a spread core the chain is cut in two halves registered apart (less above, or
+        // equal above and less below): the whole chain after the slot's LUT-RAM read was among
+        // the slowest paths of the four-unit core at a placement seed (7.37 ns).
+        let (w, lo) = (leaf_key.width(), leaf_key.width() / 2);
+        let (leaf_hi, slot_hi) = (leaf_key.slice(lo, w - lo), slot_key.slice(lo, w - lo));
+        let hi_less = b.delay("m2_tt_hi_less", lt_chain(leaf_hi, slot_hi).name("leaf_tt_hi_less"));
+        let hi_equal = b.delay("m2_tt_hi_equal", leaf_hi.eq(slot_hi).name("leaf_tt_hi_equal"));
+        let lo_less =
+            b.delay("m2_tt_lo_less", lt_chain(leaf_key.slice(0, lo), slot_key.slice(0, lo)).name("leaf_tt_lo_less"));
+        (b.valid_delay("m2", m1), (hi_less | (hi_equal & lo_less)).name("m2_tt_less"))
+    } else {
+        let tt_less = lt_chain(leaf_key, slot_key).name("leaf_tt_less");
+        let m2 = b.valid_delay("m2", m1);
+        (m2, b.delay("m2_tt_less", tt_less))
+    };
     let m2_first_hit = b.delay("m2_first_hit", (!m1_has & !m1_empty).name("m1_first_hit"));
     let m2_better = (m2_less | m2_first_hit).name("leaf_better");
     let m2_hit = b.delay("m2_hit", (m1_has | !m1_empty).name("m1_hit"));
@@ -276,8 +291,7 @@ pub fn closest_core(
     // The has-best bit masks four fields of 13–32 bits each: in a spread core a copy of its
     // register per field (one register reaching all 150 or so result bits was the slowest path
     // at a placement seed of the four-unit core, `d1_has` → `res_t`, 8.05 ns through one LUT).
-    let has_copies =
-        if super::clock::spread(units << lane_bits, target) { b.copies(d1_has, 4) } else { vec![d1_has; 4] };
+    let has_copies = if spread { b.copies(d1_has, 4) } else { vec![d1_has; 4] };
     let res = |name: &str, x, mask: Option<S>| {
         let x = mask.map_or(x, |has| has.select(x, x.k(0)));
         b.output(&format!("res_{name}"), b.delay(&format!("res_{name}_r"), x.name(&format!("res_{name}_c"))));

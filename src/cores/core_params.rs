@@ -83,7 +83,8 @@ impl CoreParams {
         let CoreSpec { id_width, div_bits, target_mhz, slots, units, pipelines, piece } = *shape;
         let mut trav = TraverseParams::new(scene, id_width, super::clock::ClockTarget(target_mhz), slots);
         trav.product = trav.product.with_piece(piece);
-        if super::clock::spread(units, super::clock::ClockTarget(target_mhz)) {
+        let spread = super::clock::spread(units, super::clock::ClockTarget(target_mhz));
+        if spread {
             // A fabric register after the DSP block's (`MulStyle::dsp_regs`).
             trav.product.dsp_regs = trav.product.dsp_regs.max(4);
         }
@@ -104,6 +105,7 @@ impl CoreParams {
             div_bits,
             target_mhz,
             piece,
+            spread,
         };
         let tri_rom_cycles = super::brom::tri_read_cycles(scene.tri.1.len());
         CoreParams { isect, trav, tag, units, pipelines, tri_rom_cycles, mem: None }

@@ -28,6 +28,10 @@ pub struct IntersectParams {
     /// The hard multiplier its products are cut for (absent from JSON when the ECP5's).
     #[serde(skip_serializing_if = "crate::cores::mul::Piece::is_mult18")]
     pub piece: crate::cores::mul::Piece,
+    /// The pipeline sits in a spread core (`clock::spread`): each product lands in a fabric
+    /// register after the DSP block's (absent from JSON when not).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub spread: bool,
 }
 
 impl IntersectParams {
@@ -44,14 +48,15 @@ impl IntersectParams {
     pub fn name(&self) -> String {
         let r4 = if self.div_bits == 2 { "_r4" } else { "" };
         format!(
-            "fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}_c{}{}",
+            "fxrt_intersect_n{}_m{}_t{}_e{}_tag{}{r4}_c{}{}{}",
             self.n,
             self.m,
             self.t,
             self.e,
             self.tag_width,
             self.target_mhz,
-            self.piece.name_suffix()
+            self.piece.name_suffix(),
+            if self.spread { "_sp" } else { "" }
         )
     }
     /// Rejects widths the RTL layer cannot hold (signals are at most 128 bits), naming the
@@ -116,7 +121,14 @@ impl IntersectParams {
     }
     /// How its products are built: the clock target's style, cut for its `piece`.
     pub fn mul_style(&self) -> super::mul::MulStyle {
-        self.target().mul_style().with_piece(self.piece)
+        let style = self.target().mul_style().with_piece(self.piece);
+        if self.spread {
+            // A product's DSP output routed into its adder tree's first carry chain was among
+            // the slowest paths of the four-unit core at both placement seeds (7.2–7.3 ns).
+            super::mul::MulStyle { dsp_regs: style.dsp_regs.max(4), ..style }
+        } else {
+            style
+        }
     }
 
     /// Clock cycles from an input to its result, counted from the stages the target keeps.
@@ -535,6 +547,7 @@ mod tests {
             div_bits,
             target_mhz,
             piece: Default::default(),
+            spread: false,
         };
         let (module, lat) = intersect_core_with(&p, policy);
         let mut sim = Sim::new(&module);
@@ -616,6 +629,7 @@ mod tests {
             div_bits: 1,
             target_mhz: 75,
             piece: Default::default(),
+            spread: false,
         };
         assert_eq!(intersect_core_with(&p, merge.clone()).1, p.latency() - 2);
         assert_eq!(check_with(Params::default(), 1, 75, 2000, merge), check(Params::default(), 1, 75, 2000));
@@ -639,6 +653,7 @@ mod tests {
                 div_bits: 1,
                 target_mhz: mhz,
                 piece: Default::default(),
+                spread: false,
             };
             assert!(p.latency() >= last, "{mhz} MHz: latency {} after {last}", p.latency());
             last = p.latency();
@@ -657,6 +672,7 @@ mod tests {
             div_bits: 1,
             target_mhz: 75,
             piece: Default::default(),
+            spread: false,
         };
         assert!(p.latency() <= 41, "{}", p.latency());
     }

@@ -252,7 +252,7 @@ fn results<'b>(
     // into them (8.16 ns, 17 registers loaded from one LUT). The credits count the first
     // (`popped`): a result then reaches the queue a clock after it is counted, never before.
     let (picked, picked_slot) = (b.valid_delay("done_valid_r", done_any), b.delay("done_slot_r", done_slot));
-    let (done_any, done_slot) = if super::clock::spread(p.units, p.isect.target()) {
+    let (done_any, done_slot) = if p.isect.spread {
         (b.valid_delay("done_valid_r2", picked), b.delay("done_slot_r2", picked_slot))
     } else {
         (picked, picked_slot)
@@ -446,6 +446,12 @@ mod tests {
             let landed: Vec<&str> = plane.filter(|n| n.contains("_d4")).collect();
             assert_eq!(landed.is_empty(), !spread, "{units} units: {landed:?}");
             assert_eq!(p.trav.product.dsp_regs, if spread { 4 } else { 3 });
+            // The intersection pipelines' products land too, and the closest-hit compare is cut.
+            assert_eq!(p.isect.mul_style().dsp_regs, if spread { 4 } else { 3 });
+            let pipes: Vec<&str> =
+                hierarchy.iter().filter(|m| m.name.starts_with("fxrt_intersect")).map(|m| m.name.as_str()).collect();
+            assert!(!pipes.is_empty() && pipes.iter().all(|n| n.ends_with("_sp") == spread), "{pipes:?}");
+            assert_eq!(regs(closest, "m2_tt_hi_less").len(), spread as usize, "{}", closest.name);
         }
     }
 }
