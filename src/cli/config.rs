@@ -464,9 +464,6 @@ pub struct SynthConfig {
     pub bram_kbits: u64,
 }
 
-/// Block RAM of the LFE5U-85F, Kb: 208 DP16KD of 18 Kb.
-pub const ECP5_85F_BRAM_KBITS: u64 = Device::Lfe5u85f.bram_kbits();
-
 /// Where `fxrt synth` maps the cores.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Family {

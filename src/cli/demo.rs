@@ -62,7 +62,8 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(&roms, &shape);
     p.check()?;
-    let bram_kbits = super::config::ECP5_85F_BRAM_KBITS;
+    // The demo runs on the ULX3S's LFE5U-85F.
+    let bram_kbits = crate::fpga::device::Device::Lfe5u85f.bram_kbits();
     let (spec, fitted) = (MemorySpec::default(), fit.is_some());
     let p = super::placement::place_checked(c.memory, spec, bram_kbits, &roms, &shape, p, fitted)?;
     super::config::ids_fit(RAY_ID_WIDTH, c.width, c.height)?;

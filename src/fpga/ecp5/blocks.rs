@@ -52,11 +52,18 @@ fn lut_bits(r: &Rom) -> u64 {
 
 /// A memory of a module that is neither a block ROM nor a block RAM module: what yosys does.
 fn inferred(r: &Rom) -> Blocks {
-    let deep = if r.write.is_some() { r.words.len() > DISTRIBUTED_WORDS } else { r.words.len() >= MIN_WORDS };
-    match deep.then(|| side_by_side(r.words.len(), r.width)).flatten() {
+    match inferred_dp16kd(r) {
         Some(dp16kd) => Blocks { dp16kd, ..Blocks::default() },
         None => Blocks { lut_ram_bits: lut_bits(r), ..Blocks::default() },
     }
+}
+
+/// The DP16KDs yosys maps such a memory to, or `None` when it keeps it in LUTs (LUT RAM for a
+/// RAM, logic for a ROM): a RAM over `DISTRIBUTED_WORDS` words or a ROM of `MIN_WORDS` or more
+/// that the blocks can hold side by side.
+pub(super) fn inferred_dp16kd(r: &Rom) -> Option<usize> {
+    let deep = if r.write.is_some() { r.words.len() > DISTRIBUTED_WORDS } else { r.words.len() >= MIN_WORDS };
+    deep.then(|| side_by_side(r.words.len(), r.width)).flatten()
 }
 
 /// Register bits of the module itself: registers, shift registers and, with `reads`, the read

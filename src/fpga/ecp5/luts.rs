@@ -16,8 +16,6 @@
 //! and the through-LUTs packing adds): `Luts::comb`. docs/HDL.md compares it with placed
 //! and synthesised cores.
 
-use super::bram::MIN_WORDS;
-use crate::rtl::emit::verilog::DISTRIBUTED_WORDS;
 use crate::rtl::netlist::{Def, Module, Rom};
 use crate::rtl::width::{BinOp, UnOp};
 use crate::scene::rom::rom_depth;
@@ -76,12 +74,10 @@ fn half_up(w: u32) -> f64 {
 /// A memory's cells when it is kept in LUTs: LUT RAM (with its read ports) for a RAM, logic for
 /// a ROM; nothing for a block memory.
 fn memory(r: &Rom, reads: usize, block_module: bool) -> Luts {
-    let words = r.words.len();
-    let deep = if r.write.is_some() { words > DISTRIBUTED_WORDS } else { words >= MIN_WORDS };
-    if block_module || deep {
+    if block_module || super::blocks::inferred_dp16kd(r).is_some() {
         return Luts::default();
     }
-    let depth = rom_depth(words) as f64;
+    let depth = rom_depth(r.words.len()) as f64;
     let sixteens = (depth / 16.0).ceil();
     let width = r.width as f64;
     if r.write.is_some() {
