@@ -1,7 +1,9 @@
 //! Traversal figures of the BIH, middle split against SAH (DECISIONS.md 72): for every
 //! built-in scene (Cornell at n = m = 20, the others at the default parameters), the primary
 //! rays of a W×H frame from the default camera, traced with `Golden::trace_culled` (the
-//! hardware's early-out walk): node steps per ray (visits + culled entries), triangle tests
+//! hardware's early-out walk): node steps per ray (visits + culled entries), leaf visits per
+//! ray and those of them entered straight from the parent's step (the steps a parent that sends
+//! its leaf child to the leaf stream would save; docs/CORE.md, the ceiling), triangle tests
 //! per ray, and the tree's size (nodes, leaf entries: the ROM depths). Every ray's hit is also
 //! checked against `Golden::trace` (the full walk); they must agree.
 //!
@@ -33,9 +35,9 @@ fn main() {
         .unwrap_or(fxrt::scene::builtin::BUILTIN_NAMES.iter().map(|s| s.to_string()).collect());
     let size: u32 = opt("--size").map(|s| s.parse().unwrap()).unwrap_or(128);
     println!(
-        "| scene | leaf | split | node steps/ray | of which culled | tri tests/ray | nodes | leaf entries | depth | max leaf | build s |"
+        "| scene | leaf | split | node steps/ray | of which culled | leaf visits/ray | of which from the parent | tri tests/ray | nodes | leaf entries | depth | max leaf | build s |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for name in &scenes {
         for &leaf in &leaves {
             for &tree in &splits {
@@ -50,6 +52,7 @@ fn main() {
                 let g = Golden::new(&scene);
                 let cam = Camera::default_for(&scene, size, size);
                 let (mut rays, mut steps, mut culls, mut tests) = (0u64, 0u64, 0u64, 0u64);
+                let (mut leaves, mut from_parent) = (0u64, 0u64);
                 for py in 0..size {
                     for px in 0..size {
                         let Some(q) = quantize_ray(&scene, &g, &cam.ray(px, py)) else { continue };
@@ -60,14 +63,18 @@ fn main() {
                         steps += (s.nodes + s.culled) as u64;
                         culls += s.culled as u64;
                         tests += s.tri_tests as u64;
+                        leaves += s.leaves as u64;
+                        from_parent += s.leaves_from_parent as u64;
                     }
                 }
                 let per = |x: u64| x as f64 / rays as f64;
                 let b = &scene.bih_stats;
                 println!(
-                    "| {name} | {leaf} | {tree} | {:.1} | {:.1} | {:.1} | {} | {} | {} | {} | {build:.2} |",
+                    "| {name} | {leaf} | {tree} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {} | {build:.2} |",
                     per(steps),
                     per(culls),
+                    per(leaves),
+                    per(from_parent),
                     per(tests),
                     b.nodes,
                     scene.bih.leaf_tris.len(),

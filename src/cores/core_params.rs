@@ -85,8 +85,7 @@ impl CoreParams {
         trav.product = trav.product.with_piece(piece);
         let spread = super::clock::spread(units, super::clock::ClockTarget(target_mhz));
         if spread {
-            // A fabric register after the DSP block's (`MulStyle::dsp_regs`).
-            trav.product.dsp_regs = trav.product.dsp_regs.max(4);
+            trav.product = trav.product.landed();
         }
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
         let tag = TagLayout {

@@ -125,7 +125,7 @@ impl IntersectParams {
         if self.spread {
             // A product's DSP output routed into its adder tree's first carry chain was among
             // the slowest paths of the four-unit core at both placement seeds (7.2–7.3 ns).
-            super::mul::MulStyle { dsp_regs: style.dsp_regs.max(4), ..style }
+            style.landed()
         } else {
             style
         }

@@ -85,6 +85,13 @@ impl MulStyle {
     pub fn with_piece(self, piece: Piece) -> MulStyle {
         MulStyle { piece, ..self }
     }
+
+    /// This style with every piece's product landed in a fabric register after the DSP block
+    /// (`dsp_regs` at least 4): what a spread core (`clock::spread`) builds, whose DSP columns
+    /// lie far from the adder trees that pick the pieces up.
+    pub fn landed(self) -> MulStyle {
+        MulStyle { dsp_regs: self.dsp_regs.max(4), ..self }
+    }
 }
 
 /// Number of limbs of `limb` unsigned bits (the top one signed when `t` is) an operand of type

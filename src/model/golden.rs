@@ -41,6 +41,12 @@ pub struct TraversalStats {
     pub culled: u32,
     pub tri_tests: u32,
     pub max_stack: u32,
+    /// Leaves visited (among `nodes`), and of them those entered straight from their parent's
+    /// step (not popped, not the root): the node steps a traversal unit would save if a
+    /// parent's step sent such a leaf to the leaf stream itself (docs/CORE.md, the ceiling).
+    /// `walk` counts them; `render::fast` leaves them 0.
+    pub leaves: u32,
+    pub leaves_from_parent: u32,
 }
 
 /// The constants of one parameter set, precomputed for speed.
@@ -164,6 +170,7 @@ impl Golden {
         let mut sp = 0usize;
         let (mut node, mut tmin, mut tmax) = (0u32, 0i64, tmax0);
         let nodes = &scene.bih.nodes;
+        let mut from_parent = false;
         loop {
             let mut go_pop = visitor.prune(tmin);
             stats.culled += go_pop as u32;
@@ -192,6 +199,8 @@ impl Golden {
                             visitor.triangle(t, tmin);
                         }
                         stats.tri_tests += count;
+                        stats.leaves += 1;
+                        stats.leaves_from_parent += from_parent as u32;
                         go_pop = true;
                     }
                 }
@@ -204,6 +213,7 @@ impl Golden {
                 // SAFETY: entries below the stack pointer were written by a push.
                 (node, tmin, tmax) = unsafe { stack[sp].assume_init() };
             }
+            from_parent = !go_pop;
         }
     }
 
