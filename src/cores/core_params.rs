@@ -86,6 +86,8 @@ impl CoreParams {
         let spread = super::clock::spread(units, super::clock::ClockTarget(target_mhz));
         if spread {
             trav.product = trav.product.landed();
+            // A spread core's units are its limit: a parent sends its leaf child itself.
+            trav = trav.sending_leaves(scene);
         }
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
         let tag = TagLayout {

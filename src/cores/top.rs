@@ -132,6 +132,11 @@ fn traversal_units<'b>(
     let unit = Rc::new(traverse_core(&p.trav));
     let node_words: Vec<S> =
         (0..units).map(|u| b.wire(&format!("u{u}_node_word"), Ty::u(p.trav.node_layout.width))).collect();
+    let pair_width = 2 * p.trav.leaf_fields_bits();
+    let pair_words: Vec<S> = match p.trav.pair_rom_cycles {
+        Some(_) => (0..units).map(|u| b.wire(&format!("u{u}_pair_word"), Ty::u(pair_width))).collect(),
+        None => Vec::new(),
+    };
     // With external memory, the node cache's answer besides the word (hit, wait, done).
     let node_in: Vec<NodeIn> = match &p.mem {
         Some(_) => (0..units)
@@ -186,6 +191,9 @@ fn traversal_units<'b>(
             if let Some([_, hit, wait, done]) = node_in.get(u as usize) {
                 ins.extend([("node_hit", *hit), ("node_wait", *wait), ("node_done", *done)]);
             }
+            if let Some(&word) = pair_words.get(u as usize) {
+                ins.push(("pair_word", word));
+            }
             let t = b.instance_named(&format!("u_traverse_{u}"), &unit, &ins);
             b.drive(port.unit_has_free[u as usize], t.get("has_free"));
             b.drive(port.unit_free_slot[u as usize], t.get("free_slot_out"));
@@ -194,6 +202,16 @@ fn traversal_units<'b>(
         .collect();
     if p.mem.is_none() {
         node_roms(b, p, scene, &trav, &node_words);
+    }
+    if let (Some(cycles), Some(image)) = (p.trav.pair_rom_cycles, crate::cores::traverse::pair_image(scene)) {
+        // The pair ROM (DECISIONS 137): one per two units, as the node ROM.
+        let addrs: Vec<S> = trav.iter().map(|t| t.get("pair_addr")).collect();
+        let label = |pair: usize| format!("u_pair_rom_{pair}");
+        let rom_name = format!("pair_{}", p.trav.scene_tag);
+        let words = rom_reads(b, &label, &rom_name, pair_width, &image, &addrs, cycles);
+        for (wire, word) in pair_words.iter().zip(words) {
+            b.drive(*wire, word);
+        }
     }
     Units { trav, merge_unit, merge, free, leaf_pop, done_pop, node_in }
 }
@@ -345,9 +363,12 @@ fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports
     }
     let depths = trav.iter().map(|t| t.get("depth")).collect();
     b.output("stack_depth", tree(b, "obs_depth", depths, |a, c| a.max(c)));
-    // At most one visit or cull per unit and clock; 3 bits at least, as for four units.
-    let count_bits = (32 - p.units.leading_zeros()).max(3);
-    b.output("visits", sum("visit", count_bits).name("visits_c"));
+    // At most one visit or cull per unit and clock (two visits where a parent sends its leaf
+    // child: one in N, one in G); 3 bits at least, as for four units.
+    let sends = p.trav.pair_rom_cycles.is_some();
+    let count_bits = (32 - (p.units << sends as u32).leading_zeros()).max(3);
+    let visits = if sends { sum("visit", count_bits) + sum("sent", count_bits) } else { sum("visit", count_bits) };
+    b.output("visits", visits.name("visits_c"));
     b.output("culls", sum("cull", count_bits).name("culls_c"));
     let occupied = trav.iter().map(|t| t.get("occupied").resize(p.tag.slot_bits + 1)).collect();
     b.output("occupied", tree(b, "obs_occupied", occupied, |a, c| a + c));
@@ -360,6 +381,11 @@ fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports
         b.output(&format!("visit{u}"), t.get("visit"));
         b.output(&format!("visit{u}_slot"), t.get("visit_slot"));
         b.output(&format!("visit{u}_node"), t.get("visit_node"));
+        if sends {
+            b.output(&format!("sent{u}"), t.get("sent"));
+            b.output(&format!("sent{u}_slot"), t.get("sent_slot"));
+            b.output(&format!("sent{u}_node"), t.get("sent_node"));
+        }
     }
 }
 
@@ -452,6 +478,11 @@ mod tests {
                 hierarchy.iter().filter(|m| m.name.starts_with("fxrt_intersect")).map(|m| m.name.as_str()).collect();
             assert!(!pipes.is_empty() && pipes.iter().all(|n| n.ends_with("_sp") == spread), "{pipes:?}");
             assert_eq!(regs(closest, "m2_tt_hi_less").len(), spread as usize, "{}", closest.name);
+            // Its units send their near leaves from the parent's step, from a pair ROM per two
+            // units (DECISIONS 137).
+            let pair_roms = top.instances.iter().filter(|i| i.module.name.starts_with("fxrt_brom_pair_")).count();
+            assert_eq!(pair_roms, if spread { units as usize / 2 } else { 0 });
+            assert_eq!(top.outputs.iter().any(|o| o.0 == "sent0"), spread);
         }
     }
 }

@@ -41,7 +41,7 @@ use crate::rtl::Module;
 use crate::rtl::build::Builder;
 use crate::rtl::build::S;
 
-pub use super::traverse_params::{TraverseParams, field, word_bits};
+pub use super::traverse_params::{TraverseParams, field, pair_image, word_bits};
 
 /// The unit. Inputs: the ray RAM write (`ray_we_gI`, `ray_slot_gI` for each group I of the
 /// RAMs' LUT-RAM columns, `TraverseParams::ray_ram_groups`; ox, oy, oz, invx, invy, invz),
@@ -71,28 +71,45 @@ pub fn traverse_core(p: &TraverseParams) -> Module {
     let (c, [culled_first, culled], lookup) = u.ring_c(bt, b_from_stack, a.stack_top, &q);
     let n = u.ring_n(c, culled, &q);
     let f = u.ring_f(&n);
-    u.ring_g(&f, &r, &a, &q);
+    let sent = u.ring_g(&f, &r, &a, &q);
     b.end_stage();
+    let leafq = match (n.leafq.as_ref(), sent.as_ref()) {
+        (Some(leafq), None) => leafq,
+        (None, Some((leafq, [valid, slot, node]))) => {
+            b.output("sent", *valid);
+            b.output("sent_slot", *slot);
+            b.output("sent_node", *node);
+            leafq
+        }
+        _ => unreachable!("one leaf queue, in N or in G"),
+    };
     match lookup {
         // With a node cache: the lookup a clock after C.
         Some([valid, node]) => {
             b.output("node_look", valid);
             b.output("node_look_culled", culled_first);
-            u.outputs(&slots, node, &n, &done);
+            u.outputs(&slots, node, &n, leafq, &done);
         }
-        None => u.outputs(&slots, c.node, &n, &done),
+        None => u.outputs(&slots, c.node, &n, leafq, &done),
     }
     b.finish()
 }
 
 impl<'b> Unit<'b> {
     /// The output ports (see `traverse_core`).
-    pub(super) fn outputs(&self, slots: &FreeList<'b>, node_addr: S<'b>, nn: &RingN<'b>, done: &Fifo<'b>) {
+    pub(super) fn outputs(
+        &self,
+        slots: &FreeList<'b>,
+        node_addr: S<'b>,
+        nn: &RingN<'b>,
+        leafq: &Fifo<'b>,
+        done: &Fifo<'b>,
+    ) {
         let (b, p, nt) = (self.b, self.p, nn.token);
         b.output("node_addr", node_addr);
         b.output("has_free", (slots.free_any & !slots.just_alloc).name("has_free_c"));
         b.output("free_slot_out", slots.free_idx);
-        let lh = nn.leafq.head;
+        let lh = leafq.head;
         let mut at = 0;
         let mut take = |w: u32| {
             let s = lh.slice(at, w);
@@ -103,7 +120,7 @@ impl<'b> Unit<'b> {
         let leaf_bits = self.leaf_bits;
         let (l_sp, l_tmin, l_count, l_first, l_slot) =
             (take(self.spw), take(p.tmin_width()), take(count_w), take(leaf_bits), take(self.sb));
-        b.output("leaf_valid", nn.leafq.nonempty);
+        b.output("leaf_valid", leafq.nonempty);
         b.output("leaf_slot", l_slot);
         b.output("leaf_first", l_first);
         b.output("leaf_count", l_count);

@@ -2,8 +2,9 @@
 //! token rides along while the limits of `bih::inner_step`'s decision are made; in F the two
 //! plane distances are compared by their roles; in G the decision pushes, enters or pops.
 
+use super::fifo::Fifo;
 use super::lt_chain;
-use super::traverse_stages::{Queued, Returning, RingA, RingF, RingN, Token, Unit};
+use super::traverse_stages::{LeafSent, Queued, Returning, RingA, RingF, RingN, Token, Unit};
 use crate::rtl::build::S;
 
 impl<'b> Unit<'b> {
@@ -13,7 +14,11 @@ impl<'b> Unit<'b> {
     pub(super) fn ring_f(&self, nn: &RingN<'b>) -> RingF<'b> {
         let (b, n, l, nt, axis1, negative) = (self.b, self.p.n, nn.plane_latency, nn.token, nn.axis1, nn.negative);
         b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
-        let ring = (nt.valid & !nn.leaves).name("n_stays");
+        let ring = match nn.leaves {
+            Some(leaves) => nt.valid & !leaves,
+            None => nt.valid,
+        }
+        .name("n_stays");
         let f_valid = b.valid_line("f_valid", ring, l);
         let f_inner = b.delay_line("f_inner", nn.is_inner, l);
         let f_slot = b.delay_line("f_slot", nt.slot, l);
@@ -54,7 +59,8 @@ impl<'b> Unit<'b> {
         };
         let near_lt_tmax = reg("near_lt_tmax", d1_below, d0_below);
         let far_gt_tmin = reg("far_gt_tmin", d0_above, d1_above);
-        let go_near = reg("go_near", d1_above, d0_above);
+        let go_near_c = negative.select(d1_above, d0_above).name("go_near_c");
+        let go_near = b.delay("go_near", go_near_c);
         let go_far = reg("go_far", d0_below, d1_below);
         let near_end = b.delay("near_end", negative.select(d1, d0));
         let far_start = b.delay("far_start", negative.select(d0, d1));
@@ -66,18 +72,39 @@ impl<'b> Unit<'b> {
             tmax: b.delay("g_tmax", f_tmax),
             sp: b.delay("g_sp", f_sp),
         };
+        // A leaf to queue in G: the node's own, or the near child entered (`enter_near` of G).
+        let send = nn.send.map(|ls| {
+            let send_c = (f_valid & (ls.own | (f_inner & go_near_c & ls.near_leaf))).name("leaf_send_c");
+            LeafSent {
+                send: b.valid_delay("g_leaf_send", send_c),
+                own: b.delay("g_own_leaf", ls.own),
+                fields: b.delay("g_leaf_fields", ls.fields),
+                returns: b.valid_delay("g_returns", (f_valid & !send_c).name("returns_c")),
+            }
+        });
         let inner = b.delay("g_inner", f_inner);
         let negative = b.delay("g_negative", negative);
-        RingF { g, inner, negative, near_lt_tmax, far_gt_tmin, go_near, go_far, near_end, far_start }
+        RingF { g, inner, negative, near_lt_tmax, far_gt_tmin, go_near, go_far, near_end, far_start, send }
     }
 
     /// G: the decision: push the far child (stack[slot][sp]) and enter the near one, enter one
     /// child, or pop. The token goes into R and is back at A in the next cycle.
-    pub(super) fn ring_g(&self, f: &RingF<'b>, r: &Returning<'b>, a: &RingA<'b>, q: &Queued<'b>) {
+    /// With `pair_rom_cycles`, G also queues a leaf (the token's own, or its near child
+    /// entered), and the token does not go round: returns the leaf queue and the observation
+    /// of a near child sent (valid, slot, node).
+    pub(super) fn ring_g(
+        &self,
+        f: &RingF<'b>,
+        r: &Returning<'b>,
+        a: &RingA<'b>,
+        q: &Queued<'b>,
+    ) -> Option<(Fifo<'b>, [S<'b>; 3])> {
         let (b, g, node_bits, push) = (self.b, f.g, self.node_bits, &a.push);
         b.stage("ring_g", "G: the decision: push the far child and enter the near one, enter one, or pop");
+        // Whether G's token goes round: every valid one, unless it queues a leaf.
+        let returns = f.send.map_or(g.valid, |s| s.returns);
         // The entry stage's copy: E decides by it beside the queues, across the unit from G.
-        b.drive(q.ring_g_valid, b.copies(g.valid, 1)[0]);
+        b.drive(q.ring_g_valid, b.copies(returns, 1)[0]);
         let child_b = g.node + 1;
         let near = f.negative.select(child_b, g.node).resize(node_bits).name("near");
         let far = f.negative.select(g.node, child_b).resize(node_bits).name("far");
@@ -95,14 +122,15 @@ impl<'b> Unit<'b> {
         b.drive(push[1], b.delay("stack_waddr_r", b.cat(&[g.slot, g.sp.resize(stack_bits)])));
         b.drive(push[2], b.delay("stack_wdata_r", b.cat(&[far, far_min.unsigned(), g.tmax.unsigned()])));
         let rt = r.token;
-        b.next(rt.valid, g.valid);
+        b.next(rt.valid, returns);
         let pop = (!(enter_near | enter_far)).name("g_pop");
         b.next(r.pop, pop);
         b.next(rt.slot, g.slot);
         b.next(rt.node, enter_near.select(near, far));
         b.next(rt.tmin, enter_far.select(far_min, g.tmin));
         b.next(rt.tmax, enter_near.select(near_max, g.tmax));
-        b.next(rt.sp, push_now.select(g.sp + 1, g.sp));
+        let sp_next = push_now.select(g.sp + 1, g.sp);
+        b.next(rt.sp, sp_next);
         let sp_zero = g.sp.eq(0).name("g_sp_zero");
         b.next(r.sp_zero, !push_now & sp_zero);
         let sp_m1 = push_now.select(g.sp, g.sp - 1).name("g_sp_m1");
@@ -111,6 +139,10 @@ impl<'b> Unit<'b> {
         // The stack read address of the token in A next clock: the returning one's, else the
         // queued one's (E takes one exactly when G's token does not return).
         let returning = b.cat(&[g.slot, sp_m1.resize(stack_bits)]);
-        b.next(a.raddr, g.valid.select(returning, q.raddr_next).name("stack_raddr_next"));
+        b.next(a.raddr, returns.select(returning, q.raddr_next).name("stack_raddr_next"));
+        f.send.map(|s| {
+            let leafq = self.leaf_queue(s.send, g.slot, &[s.fields], g.tmin, sp_next);
+            (leafq, [(s.send & !s.own).name("sent_c"), g.slot, near])
+        })
     }
 }

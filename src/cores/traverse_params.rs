@@ -42,6 +42,10 @@ pub struct TraverseParams {
     /// Whether the nodes come through a cache (`with_node_cache`): a lookup in C + 1 answered in
     /// N, a miss parked in the retry queue.
     pub node_cache: bool,
+    /// With `Some`: a parent's step sends its near child to the leaf queue itself when that
+    /// child is a leaf with entries (DECISIONS 137), from the pair ROM (`pair_image`): the
+    /// unit sends `pair_addr` a clock after N and gets `pair_word` this many clocks later.
+    pub pair_rom_cycles: Option<u32>,
 }
 
 impl TraverseParams {
@@ -66,7 +70,20 @@ impl TraverseParams {
             leaf_bits: rom_addr_bits(scene.leaf.1.len()),
             root: 0,
             node_cache: false,
+            pair_rom_cycles: None,
         }
+    }
+
+    /// This unit with leaves sent by their parents (`pair_rom_cycles`), where the scene's
+    /// node table allows it (`pair_image`).
+    pub fn sending_leaves(mut self, scene: &SceneRoms) -> TraverseParams {
+        self.pair_rom_cycles = pair_image(scene).map(|image| read_cycles(image.len()));
+        self
+    }
+
+    /// Bits of a leaf's (first, count) in a pair word.
+    pub fn leaf_fields_bits(&self) -> u32 {
+        self.leaf_bits + self.node_layout.field("count").width
     }
 
     /// The unit of an external-memory core: node records of the scene image (`layout`), read
@@ -79,6 +96,8 @@ impl TraverseParams {
         self.root = crate::scene::memory::ROOT_RECORD;
         self.node_rom_cycles = 1 + super::cache::LATENCY;
         self.node_cache = true;
+        // The pair ROM would hold the whole tree's leaves on chip.
+        self.pair_rom_cycles = None;
         self
     }
     /// Reciprocal directions: m + C bits.
@@ -112,6 +131,30 @@ impl TraverseParams {
     }
 }
 
+/// The pair ROM of a scene's node table: word i holds, for the children 2i + 1 (low half) and
+/// 2i + 2 (high half), each child's leaf fields `first` (the leaf table's address bits) above
+/// `count`, or 0 when the child is not a leaf with entries. Word i answers the inner nodes
+/// whose `child` is 2i + 1: every inner node's, as `scene::bih` numbers them (the root 0, then
+/// the children in pairs). None for a node table numbered otherwise (a folder's ROMs), and for
+/// a tree without inner nodes.
+pub fn pair_image(scene: &SceneRoms) -> Option<Vec<u128>> {
+    let (layout, words) = (&scene.node.0, &scene.node.1);
+    let f = |name: &str| layout.field(name);
+    let (axis, first, count, child) = (f("axis"), f("first"), f("count"), f("child"));
+    let fields_bits = rom_addr_bits(scene.leaf.1.len()) + count.width;
+    let is_leaf = |w: &Word| word_bits(w, axis.lsb, axis.width) == 3;
+    let leaf_fields = |w: &Word| -> u128 {
+        let n = word_bits(w, count.lsb, count.width);
+        if is_leaf(w) && n != 0 { word_bits(w, first.lsb, first.width) << count.width | n } else { 0 }
+    };
+    let children_odd = words.iter().filter(|w| !is_leaf(w)).all(|w| word_bits(w, child.lsb, child.width) % 2 == 1);
+    // A tree of one leaf has no parent to send it.
+    (words.len() >= 3 && children_odd && 2 * fields_bits <= 128).then(|| {
+        let at = |k: usize| words.get(k).map_or(0, leaf_fields);
+        (0..words.len().div_ceil(2)).map(|i| at(2 * i + 2) << fields_bits | at(2 * i + 1)).collect()
+    })
+}
+
 /// Bits [lsb, lsb + width) of a ROM word (width ≤ 128).
 pub fn word_bits(w: &Word, lsb: u32, width: u32) -> u128 {
     (0..width).fold(0u128, |acc, b| {
@@ -124,4 +167,41 @@ pub fn word_bits(w: &Word, lsb: u32, width: u32) -> u128 {
 pub fn field<'b>(name: &str, word: S<'b>, f: &Field, word_lsb: u32) -> S<'b> {
     let raw = word.slice(f.lsb - word_lsb, f.width);
     if f.signed { raw.signed().name(name) } else { raw.name(name) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+    use crate::scene::bih::Node;
+    use crate::scene::{Scene, SceneSource};
+
+    /// Each pair word holds its two children's leaf fields (a leaf with entries) or 0, as the
+    /// scene's tree has them; a node table whose inner nodes do not name odd children (a
+    /// folder's ROMs numbered otherwise) gets no pair ROM.
+    #[test]
+    fn a_pair_word_holds_its_children_leaf_fields() {
+        let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
+        let mut roms = SceneRoms::of(&scene);
+        let image = pair_image(&roms).expect("the tree's children are numbered in pairs");
+        let p = TraverseParams::new(&roms, 16, ClockTarget(150), 4).sending_leaves(&roms);
+        let count_bits = roms.node.0.field("count").width;
+        let fields_bits = p.leaf_fields_bits();
+        let mut sent = 0;
+        for (k, node) in scene.bih.nodes.iter().enumerate().skip(1) {
+            let (word, half) = (image[(k - 1) / 2], (k - 1) % 2);
+            let got = word >> (half as u32 * fields_bits) & ((1 << fields_bits) - 1);
+            let want = match *node {
+                Node::Leaf { first, count } if count > 0 => (first as u128) << count_bits | count as u128,
+                _ => 0,
+            };
+            assert_eq!(got, want, "node {k}");
+            sent += (want != 0) as usize;
+        }
+        assert!(sent > 1000, "{sent} leaves");
+        let child = roms.node.0.field("child").clone();
+        let inner = roms.node.1.iter_mut().find(|w| w.get(roms.node.0.field("axis")) != 3).unwrap();
+        inner.0[(child.lsb / 64) as usize] ^= 1 << (child.lsb % 64);
+        assert!(pair_image(&roms).is_none());
+    }
 }

@@ -6,6 +6,7 @@ use super::brom::bram;
 use super::fifo::{Fifo, fifo};
 use super::free_list::{FreeList, free_list};
 use super::plane::{PlaneIssue, plane_unit};
+pub(super) use super::traverse_leaf::{LeafSend, LeafSent};
 use super::traverse_params::{TraverseParams, field};
 use super::wide_ram::{WideRam, group_widths};
 use super::{lt_chain, onehot, slot_bit_2, slot_bit_groups};
@@ -80,6 +81,8 @@ pub(super) struct Inputs<'b> {
     pub(super) leaf_pop: S<'b>,
     pub(super) done_pop: S<'b>,
     pub(super) node_word: S<'b>,
+    /// With `pair_rom_cycles`: the pair ROM's word at `pair_addr`, that many clocks after it.
+    pub(super) pair_word: Option<S<'b>>,
     /// With a node cache: its answer in N besides the word (hit; when a miss, the fill to wait
     /// for) and its `done` counter.
     pub(super) cache: Option<NodeAnswer<'b>>,
@@ -173,9 +176,13 @@ pub(super) struct RingN<'b> {
     pub(super) culled: S<'b>,
     pub(super) visit: S<'b>,
     pub(super) is_inner: S<'b>,
-    /// The token leaves the ring: a leaf queued, or (with a node cache) a miss.
-    pub(super) leaves: S<'b>,
-    pub(super) leafq: Fifo<'b>,
+    /// The token leaves the ring: a leaf queued, or (with a node cache) a miss. None when no
+    /// token leaves in N (leaves are queued in G: `send`).
+    pub(super) leaves: Option<S<'b>>,
+    /// The leaf queue, when leaves are queued in N.
+    pub(super) leafq: Option<Fifo<'b>>,
+    /// With `pair_rom_cycles`: the leaf G may send, as F sees it.
+    pub(super) send: Option<LeafSend<'b>>,
     /// The node's axis a clock after N, and whether the ray's direction is negative on it
     /// (as seen in F).
     pub(super) axis1: S<'b>,
@@ -197,6 +204,8 @@ pub(super) struct RingF<'b> {
     pub(super) go_far: S<'b>,
     pub(super) near_end: S<'b>,
     pub(super) far_start: S<'b>,
+    /// With `pair_rom_cycles`: G's leaf to queue.
+    pub(super) send: Option<LeafSent<'b>>,
 }
 
 impl<'b> Unit<'b> {
@@ -232,6 +241,7 @@ impl<'b> Unit<'b> {
             // ports): the unit sends the address in C and gets the word `node_rom_cycles`
             // later, in N.
             node_word: b.input("node_word", Ty::u(p.node_layout.width)),
+            pair_word: p.pair_rom_cycles.map(|_| b.input("pair_word", Ty::u(2 * p.leaf_fields_bits()))),
             cache: p.node_cache.then(|| NodeAnswer {
                 hit: b.input("node_hit", bit),
                 wait: b.input("node_wait", Ty::u(super::cache::SEQ_BITS)),
@@ -498,7 +508,7 @@ impl<'b> Unit<'b> {
     /// is queued for the leaf stream and leaves the ring; an inner node issues both plane
     /// distances, one to each of two plane units, with the slot's ray from the ray RAMs.
     pub(super) fn ring_n(&self, c: Token<'b>, culled: S<'b>, q: &Queued<'b>) -> RingN<'b> {
-        let (b, p, n, k, word) = (self.b, self.p, self.p.n, self.p.slots, self.inp.node_word);
+        let (b, p, n, word) = (self.b, self.p, self.p.n, self.inp.node_word);
         b.stage("ring_n", "N: the node word; a leaf queued, an inner node to the plane units");
         let token = c.delayed(b, "n", p.node_rom_cycles, |_, x| x);
         let node_l = &p.node_layout;
@@ -513,33 +523,19 @@ impl<'b> Unit<'b> {
         }
         .name("visit_c");
         let is_inner = (visit & !w_leaf).name("is_inner");
-        let leaf_push = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
-        let leaves = match (self.inp.cache, q.retry) {
-            (Some(cache), Some(r)) => leaf_push | self.retry_push(token, culled, cache, r.push, r.entry),
-            _ => leaf_push,
-        };
-        let leaf_bits = self.leaf_bits;
-        let t = token;
-        let leaf_in =
-            b.cat(&[t.slot, w_first.resize(leaf_bits), w_count, t.tmin.unsigned().resize(p.tmin_width()), t.sp]);
-        // At a fast target the leaf is registered here, by the node word's decode, and again
-        // in the queue (its push register, by the queue's LUT RAM): the decode into the push
-        // register across the die was the slowest path at seed 3 (`n_valid_3` → `leaf_q_push`,
-        // 7.34 ns, 3.4 of it one route). A leaf then waits a clock more; nothing waits for it.
-        let (leaf_push_q, leaf_in_q) = if p.landing {
-            (b.valid_delay("leaf_push_r", leaf_push), b.delay("leaf_in_r", leaf_in))
+        let own_leaf = (visit & w_leaf & w_count.ne(0)).name("leaf_push");
+        let own_fields = [w_first.resize(self.leaf_bits), w_count];
+        // Leaves are queued here, unless G queues them (`pair_rom_cycles`).
+        let (leaves, leafq) = if p.pair_rom_cycles.is_some() {
+            (None, None)
         } else {
-            (leaf_push, leaf_in)
+            let leaves = match (self.inp.cache, q.retry) {
+                (Some(cache), Some(r)) => own_leaf | self.retry_push(token, culled, cache, r.push, r.entry),
+                _ => own_leaf,
+            };
+            let t = token;
+            (Some(leaves), Some(self.leaf_queue(own_leaf, t.slot, &own_fields, t.tmin, t.sp)))
         };
-        let leafq = fifo(
-            b,
-            "leaf_q",
-            leaf_in.width(),
-            k,
-            leaf_push_q,
-            leaf_in_q,
-            b.valid_delay("leaf_pop_r", self.inp.leaf_pop),
-        );
         // The plane units, one per clip plane, fed the slot's ray from the ray RAMs (read in N, in
         // the units' second stage in N + 1). The read address in a register per RAM: one
         // register reaching all four RAMs' LUT-RAM slices and bank selects had 694 sinks a bit
@@ -570,7 +566,11 @@ impl<'b> Unit<'b> {
         assert!(plane_latency >= 4, "the decision limits need 3 cycles after N");
         // The axis's direction sign, for the roles of the two distances in F and G.
         let axis1 = b.delay("axis_n1", w_axis);
-        let negative = b.delay_line("negative", b.pick(axis1, inv).msb().name("negative_c"), plane_latency - 1);
+        let negative_c = b.pick(axis1, inv).msb().name("negative_c");
+        let negative = b.delay_line("negative", negative_c, plane_latency - 1);
+        let send = p
+            .pair_rom_cycles
+            .map(|r| self.leaf_send(r, plane_latency, [own_leaf, b.cat(&own_fields), w_child, negative_c]));
         RingN {
             token,
             culled,
@@ -578,6 +578,7 @@ impl<'b> Unit<'b> {
             is_inner,
             leaves,
             leafq,
+            send,
             axis1,
             negative,
             child: w_child,

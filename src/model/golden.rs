@@ -47,6 +47,9 @@ pub struct TraversalStats {
     /// `walk` counts them; `render::fast` leaves them 0.
     pub leaves: u32,
     pub leaves_from_parent: u32,
+    /// Of those, the leaves entered as the near child (with or without the far one pushed),
+    /// with entries: what a spread core's unit sends from its parent's step (DECISIONS 137).
+    pub near_leaves: u32,
 }
 
 /// The constants of one parameter set, precomputed for speed.
@@ -170,7 +173,7 @@ impl Golden {
         let mut sp = 0usize;
         let (mut node, mut tmin, mut tmax) = (0u32, 0i64, tmax0);
         let nodes = &scene.bih.nodes;
-        let mut from_parent = false;
+        let (mut from_parent, mut near) = (false, false);
         loop {
             let mut go_pop = visitor.prune(tmin);
             stats.culled += go_pop as u32;
@@ -183,14 +186,14 @@ impl Golden {
                         let d0 = self.plane_t(ray, a, clip0);
                         let d1 = self.plane_t(ray, a, clip1);
                         match inner_step(child, ray.inv[a] >= 0, d0, d1, tmin, tmax) {
-                            Step::Both { near, near_max, far, far_min } => {
+                            Step::Both { near: child, near_max, far, far_min } => {
                                 stack[sp].write((far, far_min, tmax));
                                 sp += 1;
                                 stats.max_stack = stats.max_stack.max(sp as u32);
-                                (node, tmax) = (near, near_max);
+                                (node, tmax, near) = (child, near_max, true);
                             }
-                            Step::Near(near, near_max) => (node, tmax) = (near, near_max),
-                            Step::Far(far, far_min) => (node, tmin) = (far, far_min),
+                            Step::Near(child, near_max) => (node, tmax, near) = (child, near_max, true),
+                            Step::Far(far, far_min) => (node, tmin, near) = (far, far_min, false),
                             Step::Neither => go_pop = true,
                         }
                     }
@@ -201,6 +204,7 @@ impl Golden {
                         stats.tri_tests += count;
                         stats.leaves += 1;
                         stats.leaves_from_parent += from_parent as u32;
+                        stats.near_leaves += (from_parent && near && count > 0) as u32;
                         go_pop = true;
                     }
                 }

@@ -133,7 +133,8 @@ impl Visitor for Visits<'_> {
 
 /// Streams `rays` through the whole core (every result taken the clock it is shown) and
 /// checks that each ray's node visits, seen on the units' observation ports by slot, are
-/// those of `Golden::trace_culled`, in its order.
+/// those of `Golden::trace_culled`, in its order. Returns the visits seen in the units' N
+/// stages and the leaves their G stages sent (a spread core's, DECISIONS 137).
 fn assert_walks_are_the_culled_golden_walks(
     label: &str,
     scene: &Scene,
@@ -142,7 +143,7 @@ fn assert_walks_are_the_culled_golden_walks(
     slots: u32,
     [units, pipelines]: [u32; 2],
     piece: Piece,
-) {
+) -> [u64; 2] {
     let g = Golden::new(scene);
     let roms = SceneRoms::of(scene);
     let p = CoreParams::shaped(
@@ -159,10 +160,17 @@ fn assert_walks_are_the_culled_golden_walks(
     let (ready, res_valid, res_id) = (port("ray_ready"), port("res_valid"), port("res_id"));
     sim.set(port("res_ready"), 1);
     let (accept, accept_id, slot_out) = (port("accept"), port("accept_id"), port("accept_slot"));
+    // The node visits in N and, where a parent sends its leaf child, the leaves sent in G.
+    let has = |name: &str| m.outputs.iter().any(|o| o.0 == name);
     let visit: Vec<_> = (0..units)
-        .map(|u| (port(&format!("visit{u}")), port(&format!("visit{u}_slot")), port(&format!("visit{u}_node"))))
+        .flat_map(|u| [format!("visit{u}"), format!("sent{u}")].map(|v| (u, v)))
+        .filter(|(_, v)| has(v))
+        .map(|(u, v)| {
+            (u, v.starts_with("sent") as usize, port(&v), port(&format!("{v}_slot")), port(&format!("{v}_node")))
+        })
         .collect();
     let mut walks: Vec<Vec<u32>> = vec![Vec::new(); rays.len()];
+    let mut seen = [0u64; 2];
     let mut in_slot = vec![usize::MAX; p.total_slots() as usize];
     let (mut next, mut done) = (0, 0);
     let sb = p.trav.slot_bits();
@@ -179,8 +187,9 @@ fn assert_walks_are_the_culled_golden_walks(
             in_slot[sim.get(slot_out) as usize] = sim.get(accept_id) as usize;
         }
         sim.tick();
-        for (u, &(v, s, node)) in visit.iter().enumerate() {
+        for &(u, kind, v, s, node) in &visit {
             if sim.get(v) == 1 {
+                seen[kind] += 1;
                 let slot = ((u as i128) << sb | sim.get(s)) as usize;
                 walks[in_slot[slot]].push(sim.get(node) as u32);
             }
@@ -196,6 +205,26 @@ fn assert_walks_are_the_culled_golden_walks(
         g.walk(scene, &r.ray, &mut want);
         assert_eq!(walks[k], want.1, "{label} at {mhz} MHz, {slots}×{units} slots, ray {k} (pixel {})", r.pixel);
     }
+    seen
+}
+
+/// A spread core's unit sends a leaf with entries entered as the near child from its
+/// parent's step, without a node step of its own (DECISIONS 137): over a frame the leaves
+/// sent are the golden walk's near leaves, and the visits in N are all the other nodes.
+#[test]
+fn a_spread_cores_units_send_the_near_leaves_from_the_parents_step() {
+    let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
+    let rays = frame_rays(&scene, &Camera::default_for(&scene, 16, 16));
+    let [in_n, sent] =
+        assert_walks_are_the_culled_golden_walks("teapot", &scene, &rays, 150, 16, [4, 2], Piece::Mult18);
+    let g = Golden::new(&scene);
+    let (mut nodes, mut near_leaves) = (0u64, 0u64);
+    for r in &rays {
+        let (_, s) = g.trace_culled(&scene, &r.ray);
+        (nodes, near_leaves) = (nodes + s.nodes as u64, near_leaves + s.near_leaves as u64);
+    }
+    assert!(near_leaves > 0);
+    assert_eq!((in_n, sent), (nodes - near_leaves, near_leaves));
 }
 
 /// Every ray of a small frame through the whole core, many at once: each ray's node visits
