@@ -86,7 +86,11 @@ impl CoreParams {
         let spread = super::clock::spread(units, super::clock::ClockTarget(target_mhz));
         if spread {
             trav.product = trav.product.landed();
-            // A spread core's units are its limit: a parent sends its leaf child itself.
+        }
+        if spread && pipelines > 1 {
+            // Its units are its limit: a parent sends its near leaf child itself (DECISIONS
+            // 137). With one pipeline the pipeline is (the four-unit throughput build keeps it
+            // 97 % busy), and the pair ROMs would buy nothing.
             trav = trav.sending_leaves(scene);
         }
         let unit_bits = if units > 1 { rom_addr_bits(units as usize) } else { 0 };
