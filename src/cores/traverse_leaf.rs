@@ -3,30 +3,8 @@
 //! (DECISIONS 137): the pair ROM's fields of the near child, carried from N to G.
 
 use super::fifo::{Fifo, fifo};
-use super::traverse_stages::Unit;
+use super::traverse_stages::{LeafSend, Unit};
 use crate::rtl::build::S;
-
-/// With `pair_rom_cycles`, in F: whether the token's own node is a leaf with entries (popped,
-/// or the root), the leaf fields (first above count) G would queue — the node's own, else its
-/// near child's from the pair ROM — and whether the near child is a leaf with entries.
-#[derive(Clone, Copy)]
-pub(super) struct LeafSend<'b> {
-    pub(super) own: S<'b>,
-    pub(super) fields: S<'b>,
-    pub(super) near_leaf: S<'b>,
-}
-
-/// With `pair_rom_cycles`, in G (registers loaded in F): a leaf is queued (`send`: the
-/// token's own node, else its near child entered), the token's own node is that leaf
-/// (`own`), its fields, and whether the token goes round again (`returns`: valid, nothing
-/// queued).
-#[derive(Clone, Copy)]
-pub(super) struct LeafSent<'b> {
-    pub(super) send: S<'b>,
-    pub(super) own: S<'b>,
-    pub(super) fields: S<'b>,
-    pub(super) returns: S<'b>,
-}
 
 impl<'b> Unit<'b> {
     /// The leaf queue for the leaf stream: (slot, first, count, tmin, sp) pushed with `push`.

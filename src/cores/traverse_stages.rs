@@ -6,7 +6,6 @@ use super::brom::bram;
 use super::fifo::{Fifo, fifo};
 use super::free_list::{FreeList, free_list};
 use super::plane::{PlaneIssue, plane_unit};
-pub(super) use super::traverse_leaf::{LeafSend, LeafSent};
 use super::traverse_params::{TraverseParams, field};
 use super::wide_ram::{WideRam, group_widths};
 use super::{lt_chain, onehot, slot_bit_2, slot_bit_groups};
@@ -191,6 +190,28 @@ pub(super) struct RingN<'b> {
     pub(super) inv: [S<'b>; 3],
     pub(super) plane_t: [S<'b>; 2],
     pub(super) plane_latency: u32,
+}
+
+/// With `pair_rom_cycles`, in F: whether the token's own node is a leaf with entries (popped,
+/// or the root), the leaf fields (first above count) G would queue — the node's own, else its
+/// near child's from the pair ROM — and whether the near child is a leaf with entries.
+#[derive(Clone, Copy)]
+pub(super) struct LeafSend<'b> {
+    pub(super) own: S<'b>,
+    pub(super) fields: S<'b>,
+    pub(super) near_leaf: S<'b>,
+}
+
+/// With `pair_rom_cycles`, in G (registers loaded in F): a leaf is queued (`send`: the
+/// token's own node, else its near child entered), the token's own node is that leaf
+/// (`own`), its fields, and whether the token goes round again (`returns`: valid, nothing
+/// queued).
+#[derive(Clone, Copy)]
+pub(super) struct LeafSent<'b> {
+    pub(super) send: S<'b>,
+    pub(super) own: S<'b>,
+    pub(super) fields: S<'b>,
+    pub(super) returns: S<'b>,
 }
 
 /// G's operands: the token, and F's compares by role.
