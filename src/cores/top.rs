@@ -203,8 +203,10 @@ fn traversal_units<'b>(
     if p.mem.is_none() {
         node_roms(b, p, scene, &trav, &node_words);
     }
-    if let (Some(cycles), Some(image)) = (p.trav.pair_rom_cycles, crate::cores::traverse::pair_image(scene)) {
+    if let Some(cycles) = p.trav.pair_rom_cycles {
         // The pair ROM (DECISIONS 137): one per two units, as the node ROM.
+        let image =
+            crate::cores::traverse::pair_image(scene).expect("a unit sends leaves only where the pair image is");
         let addrs: Vec<S> = trav.iter().map(|t| t.get("pair_addr")).collect();
         let label = |pair: usize| format!("u_pair_rom_{pair}");
         let rom_name = format!("pair_{}", p.trav.scene_tag);
@@ -367,7 +369,8 @@ fn observe<'b>(b: &'b Builder, p: &CoreParams, port: &RayPort<'b>, trav: &[Ports
     // child: one in N, one in G); 3 bits at least, as for four units.
     let sends = p.trav.pair_rom_cycles.is_some();
     let count_bits = (32 - (p.units << sends as u32).leading_zeros()).max(3);
-    let visits = if sends { sum("visit", count_bits) + sum("sent", count_bits) } else { sum("visit", count_bits) };
+    let visit_ports: &[&str] = if sends { &["visit", "sent"] } else { &["visit"] };
+    let visits = visit_ports.iter().map(|port| sum(port, count_bits)).reduce(|a, c| a + c).expect("a port");
     b.output("visits", visits.name("visits_c"));
     b.output("culls", sum("cull", count_bits).name("culls_c"));
     let occupied = trav.iter().map(|t| t.get("occupied").resize(p.tag.slot_bits + 1)).collect();

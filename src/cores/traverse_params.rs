@@ -77,13 +77,13 @@ impl TraverseParams {
     /// This unit with leaves sent by their parents (`pair_rom_cycles`), where the scene's
     /// node table allows it (`pair_image`).
     pub fn sending_leaves(mut self, scene: &SceneRoms) -> TraverseParams {
-        self.pair_rom_cycles = pair_image(scene).map(|image| read_cycles(image.len()));
+        self.pair_rom_cycles = pair_rom_words(scene).map(read_cycles);
         self
     }
 
     /// Bits of a leaf's (first, count) in a pair word.
     pub fn leaf_fields_bits(&self) -> u32 {
-        self.leaf_bits + self.node_layout.field("count").width
+        leaf_fields_bits(self.leaf_bits, &self.node_layout)
     }
 
     /// The unit of an external-memory core: node records of the scene image (`layout`), read
@@ -131,6 +131,12 @@ impl TraverseParams {
     }
 }
 
+/// Bits of a leaf's (first, count) in a pair word: `first`'s `leaf_bits` (the leaf table's
+/// address bits) above the node word's `count`.
+fn leaf_fields_bits(leaf_bits: u32, node_layout: &Layout) -> u32 {
+    leaf_bits + node_layout.field("count").width
+}
+
 /// The pair ROM of a scene's node table: word i holds, for the children 2i + 1 (low half) and
 /// 2i + 2 (high half), each child's leaf fields `first` (the leaf table's address bits) above
 /// `count`, or 0 when the child is not a leaf with entries. Word i answers the inner nodes
@@ -138,21 +144,35 @@ impl TraverseParams {
 /// the children in pairs). None for a node table numbered otherwise (a folder's ROMs), and for
 /// a tree without inner nodes.
 pub fn pair_image(scene: &SceneRoms) -> Option<Vec<u128>> {
-    let (layout, words) = (&scene.node.0, &scene.node.1);
+    let words = pair_rom_words(scene)?;
+    let (layout, nodes) = (&scene.node.0, &scene.node.1);
     let f = |name: &str| layout.field(name);
-    let (axis, first, count, child) = (f("axis"), f("first"), f("count"), f("child"));
-    let fields_bits = rom_addr_bits(scene.leaf.1.len()) + count.width;
-    let is_leaf = |w: &Word| word_bits(w, axis.lsb, axis.width) == 3;
+    let (first, count) = (f("first"), f("count"));
+    let fields_bits = leaf_fields_bits(rom_addr_bits(scene.leaf.1.len()), layout);
     let leaf_fields = |w: &Word| -> u128 {
         let n = word_bits(w, count.lsb, count.width);
-        if is_leaf(w) && n != 0 { word_bits(w, first.lsb, first.width) << count.width | n } else { 0 }
+        if is_leaf(layout, w) && n != 0 { word_bits(w, first.lsb, first.width) << count.width | n } else { 0 }
     };
-    let children_odd = words.iter().filter(|w| !is_leaf(w)).all(|w| word_bits(w, child.lsb, child.width) % 2 == 1);
-    // A tree of one leaf has no parent to send it.
-    (words.len() >= 3 && children_odd && 2 * fields_bits <= 128).then(|| {
-        let at = |k: usize| words.get(k).map_or(0, leaf_fields);
-        (0..words.len().div_ceil(2)).map(|i| at(2 * i + 2) << fields_bits | at(2 * i + 1)).collect()
-    })
+    let at = |k: usize| nodes.get(k).map_or(0, leaf_fields);
+    Some((0..words).map(|i| at(2 * i + 2) << fields_bits | at(2 * i + 1)).collect())
+}
+
+/// The pair ROM's words where the node table allows one (`pair_image`): every inner node's
+/// child odd, three nodes at least (a tree of one leaf has no parent to send it), and a pair
+/// word within 128 bits.
+fn pair_rom_words(scene: &SceneRoms) -> Option<usize> {
+    let (layout, nodes) = (&scene.node.0, &scene.node.1);
+    let child = layout.field("child");
+    let fields_bits = leaf_fields_bits(rom_addr_bits(scene.leaf.1.len()), layout);
+    let children_odd =
+        nodes.iter().filter(|w| !is_leaf(layout, w)).all(|w| word_bits(w, child.lsb, child.width) % 2 == 1);
+    (nodes.len() >= 3 && children_odd && 2 * fields_bits <= 128).then(|| nodes.len().div_ceil(2))
+}
+
+/// Whether a node word is a leaf (axis 3).
+fn is_leaf(layout: &Layout, w: &Word) -> bool {
+    let axis = layout.field("axis");
+    word_bits(w, axis.lsb, axis.width) == 3
 }
 
 /// Bits [lsb, lsb + width) of a ROM word (width ≤ 128).
