@@ -44,7 +44,8 @@ pub const PARAM_BYTES: usize = 8;
 /// A parameter set from eight bytes, each mapped into its parameter's whole range
 /// (`params::RANGES`), so cross-parameter limits are fuzzed too (`validate` refuses what breaks
 /// them): n, m, t, c, edge shift (high bit: auto), leaf size, tree split (low bit: SAH), stack
-/// depth. Missing bytes are zero.
+/// depth; the tree byte's other bits, with the SAH, the step price (`sah_step_percent`: 40 per
+/// step of the seven bits). Missing bytes are zero.
 pub fn params_from(bytes: &[u8]) -> Params {
     let b = |i: usize| bytes.get(i).copied().unwrap_or(0) as u32;
     Params {
@@ -56,6 +57,7 @@ pub fn params_from(bytes: &[u8]) -> Params {
         leaf_size: 1 + b(5) % 64,
         tree: if b(6) & 1 == 1 { TreeSplit::Sah } else { TreeSplit::Middle },
         stack_depth: 1 + b(7),
+        sah_step_percent: if b(6) & 1 == 1 { (b(6) >> 1) * 40 } else { 0 },
     }
 }
 

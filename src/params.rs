@@ -103,6 +103,15 @@ pub struct Params {
     /// them middle-split) read back as they were.
     #[serde(default = "TreeSplit::absent", skip_serializing_if = "TreeSplit::is_middle")]
     pub tree: TreeSplit,
+    /// With the SAH: 0, or the price of a node step in hundredths of a triangle test, by which
+    /// a node within the leaf size is split further when the SAH prices the split below the
+    /// leaf (`scene::bih`; DECISIONS 139). Absent from JSON when 0, so older files read back.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sah_step_percent: u32,
+}
+
+fn is_zero(x: &u32) -> bool {
+    *x == 0
 }
 
 impl Default for Params {
@@ -116,6 +125,7 @@ impl Default for Params {
             leaf_size: 4,
             stack_depth: 32,
             tree: TreeSplit::Sah,
+            sah_step_percent: 0,
         }
     }
 }
@@ -132,6 +142,7 @@ pub const RANGES: &[(&str, u32, u32)] = &[
     ("edge-shift", 0, 120),
     ("leaf-size", 1, 64),
     ("stack-depth", 1, 256),
+    ("sah-step-percent", 0, 10_000),
 ];
 
 fn check_range(name: &str, value: u32) -> Result<()> {
@@ -165,6 +176,13 @@ impl Params {
         check_range("c", self.c)?;
         check_range("leaf-size", self.leaf_size)?;
         check_range("stack-depth", self.stack_depth)?;
+        check_range("sah-step-percent", self.sah_step_percent)?;
+        if self.sah_step_percent > 0 && self.tree != TreeSplit::Sah {
+            return Err(Error::param(
+                "sah-step-percent",
+                format!("{} prices the SAH's splits; --tree {} has none", self.sah_step_percent, self.tree),
+            ));
+        }
         if let EdgeShift::Fixed(e) = self.edge_shift {
             check_range("edge-shift", e)?;
         }

@@ -68,6 +68,7 @@ const DEFAULTS: Params = Params {
     leaf_size: 4,
     stack_depth: 32,
     tree: fxrt::params::TreeSplit::Middle,
+    sah_step_percent: 0,
 };
 
 #[test]

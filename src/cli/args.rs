@@ -123,6 +123,12 @@ pub struct ParamArgs {
     /// surface-area heuristic).
     #[arg(long, default_value = "sah")]
     pub tree: TreeSplit,
+    /// With --tree sah: the price of a node step in hundredths of a triangle test (0..=10000);
+    /// a node within --leaf-size is split further while the SAH prices the split below the
+    /// leaf. 0: nodes within --leaf-size are leaves [default: 0; with --device the fit tries 0
+    /// and 175 unless given].
+    #[arg(long = "sah-step-percent")]
+    pub sah_step_percent: Option<u32>,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -652,6 +652,7 @@ impl ParamArgs {
             leaf_size: self.leaf_size.unwrap_or(d.leaf_size),
             stack_depth: self.stack_depth.unwrap_or(d.stack_depth),
             tree: self.tree,
+            sah_step_percent: self.sah_step_percent.unwrap_or(d.sah_step_percent),
         };
         p.validate()?;
         Ok(p)
@@ -659,7 +660,11 @@ impl ParamArgs {
 
     /// What `--device`'s fit may choose of the scene's build: what was not given.
     pub fn search(&self) -> SceneSearch {
-        SceneSearch { leaf_size: self.leaf_size.is_none(), stack_depth: self.stack_depth.is_none() }
+        SceneSearch {
+            leaf_size: self.leaf_size.is_none(),
+            stack_depth: self.stack_depth.is_none(),
+            sah_step: self.sah_step_percent.is_none(),
+        }
     }
 }
 

@@ -57,7 +57,7 @@ pub fn demo(c: &DemoConfig) -> Result<bool> {
     let base = crate::cores::top::CoreSpec { id_width: RAY_ID_WIDTH, target_mhz: target, ..Default::default() };
     let threads = super::ThreadArgs { device: c.device, ..super::ThreadArgs::DEFAULT };
     let external = c.memory == super::args::MemoryPlace::External;
-    let search = crate::sweep::fit::SceneSearch::BOTH;
+    let search = crate::sweep::fit::SceneSearch::ALL;
     let (shape, fit) = super::device::shape(&threads, Some(&mut scene), search, base, external)?;
     let roms = SceneRoms::of(&scene);
     let p = CoreParams::shaped(&roms, &shape);

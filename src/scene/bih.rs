@@ -110,6 +110,9 @@ struct Builder<'a> {
     leaf_size: usize,
     max_depth: usize,
     split: Split,
+    /// `Params::sah_step_percent`: 0, or the SAH's price of a node step in hundredths of a
+    /// triangle test, by which nodes within the leaf size are split further.
+    step_percent: u32,
     bih: Bih,
     stats: BihStats,
 }
@@ -119,9 +122,19 @@ pub const SAH_BINS: usize = 32;
 
 /// Builds the hierarchy over triangles with the given integer bounding boxes. `scene` is the
 /// box the first split halves (the root's box, which holds every triangle); `max_depth`
-/// bounds the inner nodes on any path.
-pub fn build(bounds: &[IBox], scene: IBox, leaf_size: usize, max_depth: usize, split: Split) -> (Bih, BihStats) {
-    let mut b = Builder { bounds, leaf_size, max_depth, split, bih: Bih::default(), stats: BihStats::default() };
+/// bounds the inner nodes on any path. With the SAH and a `step_percent` (0: none), a node
+/// within `leaf_size` is split further while the SAH prices the split below the leaf
+/// (`Builder::split_pays`).
+pub fn build(
+    bounds: &[IBox],
+    scene: IBox,
+    leaf_size: usize,
+    max_depth: usize,
+    split: Split,
+    step_percent: u32,
+) -> (Bih, BihStats) {
+    let mut b =
+        Builder { bounds, leaf_size, max_depth, split, step_percent, bih: Bih::default(), stats: BihStats::default() };
     let mut ids: Vec<u32> = (0..bounds.len() as u32).collect();
     b.bih.nodes.push(Node::Leaf { first: 0, count: 0 });
     b.node(0, &mut ids, scene, 0);
@@ -145,13 +158,30 @@ impl Builder<'_> {
 
     fn node(&mut self, at: usize, ids: &mut [u32], split_box: IBox, depth: usize) {
         self.stats.depth = self.stats.depth.max(depth);
-        if ids.len() <= self.leaf_size || depth >= self.max_depth {
+        let within = ids.len() <= self.leaf_size;
+        if depth >= self.max_depth || (within && (self.split == Split::Middle || self.step_percent == 0)) {
             return self.leaf(at, ids);
         }
         match self.split {
             Split::Middle => self.middle(at, ids, split_box, depth),
-            Split::Sah => self.sah(at, ids, split_box, depth),
+            Split::Sah => match sah_split(self.bounds, ids, &split_box) {
+                Some(s) if !within || self.split_pays(&s, ids.len(), &split_box) => {
+                    self.sah(at, ids, s, split_box, depth)
+                }
+                // Every centroid is the same point (no plane separates them), or the node is
+                // within the leaf size and its best split does not pay.
+                _ => self.leaf(at, ids),
+            },
         }
+    }
+
+    /// Whether the SAH prices `s`, the best split of a node of `count` triangles within the
+    /// leaf size, below the leaf: with the node step costing `step_percent` hundredths of a
+    /// triangle test, a leaf costs A · count tests and the split A · step + s.cost (A the
+    /// node box's half-area; s.cost the children's Σ half-area · count), in exact u128.
+    fn split_pays(&self, s: &SahSplit, count: usize, node_box: &IBox) -> bool {
+        let a = node_box.half_area();
+        a * self.step_percent as u128 + 100 * s.cost < 100 * a * count as u128
     }
 
     /// Turns `at` into an inner node over `ids`, whose first `n_left` go left, and builds
@@ -214,11 +244,7 @@ impl Builder<'_> {
     /// The binned SAH split (DECISIONS.md 72, docs/ARITHMETIC.md §5). `node_box` is the box
     /// traversal confines the node's rays to: the scene box clipped by the planes of every
     /// ancestor, so it holds all of `ids`.
-    fn sah(&mut self, at: usize, ids: &mut [u32], node_box: IBox, depth: usize) {
-        let Some(s) = sah_split(self.bounds, ids, &node_box) else {
-            // Every centroid is the same point: no plane separates them.
-            return self.leaf(at, ids);
-        };
+    fn sah(&mut self, at: usize, ids: &mut [u32], s: SahSplit, node_box: IBox, depth: usize) {
         let n_left = partition(ids, |t| s.goes_left(&self.bounds[*t as usize]));
         debug_assert_eq!(n_left, s.n_left);
         let axis = s.axis;
@@ -378,7 +404,7 @@ mod tests {
                       leaf_size in 1usize..6, max_depth in 1usize..12, split in prop::sample::select(Split::ALL.to_vec())) {
             let bounds: Vec<IBox> = boxes.iter().map(|&(x, y, z, a, b, c)| IBox { lo: [x, y, z], hi: [x + a, y + b, z + c] }).collect();
             let scene = IBox { lo: [0; 3], hi: [1060; 3] };
-            let (bih, stats) = build(&bounds, scene, leaf_size, max_depth, split);
+            let (bih, stats) = build(&bounds, scene, leaf_size, max_depth, split, 0);
             walkable(&bih, &stats, &bounds, max_depth)?;
         }
     }
@@ -396,7 +422,7 @@ mod tests {
                 IBox { lo: [o.0 + x, o.1 + y, o.2 + z], hi: [o.0 + x + a, o.1 + y + b, o.2 + z + d] }
             }).collect();
             let scene = IBox { lo: [0; 3], hi: [4500; 3] };
-            let (bih, stats) = build(&bounds, scene, leaf_size, max_depth, Split::Sah);
+            let (bih, stats) = build(&bounds, scene, leaf_size, max_depth, Split::Sah, 0);
             let depth = walkable(&bih, &stats, &bounds, max_depth)?;
             prop_assert_eq!(stats.inner + stats.leaves, stats.nodes);
             if depth < max_depth {
@@ -411,7 +437,7 @@ mod tests {
                 }
             }
             // Deterministic: the same input builds the same tree.
-            let again = build(&bounds, scene, leaf_size, max_depth, Split::Sah).0;
+            let again = build(&bounds, scene, leaf_size, max_depth, Split::Sah, 0).0;
             prop_assert_eq!(again.nodes, bih.nodes);
             prop_assert_eq!(again.leaf_tris, bih.leaf_tris);
         }
@@ -427,22 +453,25 @@ mod tests {
             bounds.push(IBox { lo: [600 + i, 0, 0], hi: [610 + i, 10, 10] });
         }
         let scene = IBox { lo: [0; 3], hi: [1000, 10, 10] };
-        let (bih, _) = build(&bounds, scene, 8, 32, Split::Sah);
+        let (bih, _) = build(&bounds, scene, 8, 32, Split::Sah, 0);
         assert_eq!(bih.nodes[0], Node::Inner { axis: 0, clip0: 17, clip1: 600, child: 1 });
         assert_eq!(bih.nodes[1], Node::Leaf { first: 0, count: 8 });
         assert_eq!(bih.leaf_tris[..8], [0, 2, 4, 6, 8, 10, 12, 14]);
     }
+
+    /// Boxes a, b, c along x in a 100 × 10 × 10 node.
+    const THREE_BOXES: [IBox; 3] = [
+        IBox { lo: [0, 0, 0], hi: [10, 10, 10] },
+        IBox { lo: [5, 0, 0], hi: [20, 10, 10] },
+        IBox { lo: [90, 0, 0], hi: [100, 10, 10] },
+    ];
 
     /// The cost of a candidate is Σ half-area(child box) · count, the child boxes being the
     /// node box clipped at clip0 and clip1 on the split axis; the cheapest wins.
     #[test]
     fn sah_cost_is_clipped_area_times_count() {
         // Three unit-ish boxes along x in a 100 × 10 × 10 node: {a, b} | {c} is the best cut.
-        let bounds = [
-            IBox { lo: [0, 0, 0], hi: [10, 10, 10] },
-            IBox { lo: [5, 0, 0], hi: [20, 10, 10] },
-            IBox { lo: [90, 0, 0], hi: [100, 10, 10] },
-        ];
+        let bounds = THREE_BOXES;
         let node = IBox { lo: [0; 3], hi: [100, 10, 10] };
         let s = sah_split(&bounds, &[0, 1, 2], &node).unwrap();
         assert_eq!((s.axis, s.n_left), (0, 2));
@@ -453,11 +482,29 @@ mod tests {
         assert_eq!(sah_split(&[bounds[0]; 3], &[0, 1, 2], &node), None);
     }
 
+    /// With a node-step price the SAH splits a node within the leaf size exactly when
+    /// A · step + cost < A · count. The three boxes above: A = 2100, the best split's cost
+    /// 1300, three triangles: it pays below 5000 / 21 = 238.1 % (then the pair {a, b}, whose
+    /// split would cost 500 · 2.38 + 700 against 1000, stays a leaf); without a price, or at
+    /// 239 %, the node is one leaf; the middle split has no price.
+    #[test]
+    fn a_priced_node_step_splits_a_node_within_the_leaf_size_where_the_sah_says_it_pays() {
+        let bounds = THREE_BOXES;
+        let node = IBox { lo: [0; 3], hi: [100, 10, 10] };
+        let nodes = |split, step| build(&bounds, node, 4, 32, split, step).0.nodes;
+        assert_eq!(nodes(Split::Sah, 0).len(), 1);
+        assert_eq!(nodes(Split::Sah, 239).len(), 1);
+        let priced = nodes(Split::Sah, 238);
+        assert_eq!(priced[0], Node::Inner { axis: 0, clip0: 20, clip1: 90, child: 1 });
+        assert_eq!(priced[1..], [Node::Leaf { first: 0, count: 2 }, Node::Leaf { first: 2, count: 1 }]);
+        assert_eq!(nodes(Split::Middle, 238).len(), 1);
+    }
+
     #[test]
     fn identical_triangles_end_in_one_leaf() {
         let bounds = vec![IBox { lo: [5; 3], hi: [9; 3] }; 20];
         for split in Split::ALL {
-            let (bih, stats) = build(&bounds, IBox { lo: [0; 3], hi: [100; 3] }, 4, 32, split);
+            let (bih, stats) = build(&bounds, IBox { lo: [0; 3], hi: [100; 3] }, 4, 32, split, 0);
             assert_eq!(bih.nodes.len(), 1);
             assert_eq!(stats.max_leaf_size, 20);
             assert_eq!(stats.oversized_leaves, 1);

@@ -119,8 +119,14 @@ impl Scene {
         let grid_box = IBox::of_points(&grid_tris.iter().flatten().copied().collect::<Vec<_>>());
         let grid_box = IBox { lo: [0; 3], hi: grid_box.hi.map(|h| h + GUARD) };
         let bounds: Vec<IBox> = grid_tris.iter().map(|t| IBox::of_points(t)).collect();
-        let (bih, bih_stats) =
-            bih::build(&bounds, grid_box, params.leaf_size as usize, params.stack_depth as usize, params.tree);
+        let (bih, bih_stats) = bih::build(
+            &bounds,
+            grid_box,
+            params.leaf_size as usize,
+            params.stack_depth as usize,
+            params.tree,
+            params.sah_step_percent,
+        );
         Ok(Scene {
             name: name.to_string(),
             params: *params,

@@ -38,6 +38,10 @@ pub const FF_SHARE: f64 = 0.8;
 pub const LUT_SHARE: f64 = 0.8;
 /// Shapes within this fraction of the best on the scene as given are run on its other builds.
 const CLOSE: f64 = 0.75;
+/// The SAH node-step price the fit tries beside the scene's (`Params::sah_step_percent`): on
+/// the teapot at leaves ≤ 4 and 5 it balances four units' node steps against two pipelines'
+/// tests best (DECISIONS 139).
+pub const FIT_SAH_STEP_PERCENT: u32 = 150;
 
 /// Which of the scene's build parameters the fit may choose (those the user did not give).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -47,10 +51,12 @@ pub struct SceneSearch {
     /// A stack of half the words (rounded to a power of two, as the stack RAM is) is tried too:
     /// the tree is then built no deeper than that.
     pub stack_depth: bool,
+    /// With the SAH, `FIT_SAH_STEP_PERCENT` is tried too.
+    pub sah_step: bool,
 }
 
 impl SceneSearch {
-    pub const BOTH: SceneSearch = SceneSearch { leaf_size: true, stack_depth: true };
+    pub const ALL: SceneSearch = SceneSearch { leaf_size: true, stack_depth: true, sah_step: true };
 
     /// The scene parameters tried from `p`, `p` first.
     fn variants(self, p: &Params) -> Vec<Params> {
@@ -61,12 +67,19 @@ impl SceneSearch {
         };
         let words = crate::scene::rom::rom_depth(p.stack_depth as usize) as u32;
         let stacks = if self.stack_depth && words >= 2 { vec![p.stack_depth, words / 2] } else { vec![p.stack_depth] };
+        let steps = if self.sah_step && p.tree == crate::params::TreeSplit::Sah {
+            vec![p.sah_step_percent, FIT_SAH_STEP_PERCENT]
+        } else {
+            vec![p.sah_step_percent]
+        };
         let mut out = Vec::new();
         for &leaf_size in &leaves {
             for &stack_depth in &stacks {
-                let v = Params { leaf_size, stack_depth, ..*p };
-                if v.validate().is_ok() && !out.contains(&v) {
-                    out.push(v);
+                for &sah_step_percent in &steps {
+                    let v = Params { leaf_size, stack_depth, sah_step_percent, ..*p };
+                    if v.validate().is_ok() && !out.contains(&v) {
+                        out.push(v);
+                    }
                 }
             }
         }
@@ -80,6 +93,8 @@ pub struct Candidate {
     /// The scene's largest leaf and stack entries (its tree) in this shape.
     pub leaf_size: u32,
     pub stack_depth: u32,
+    /// The tree's SAH node-step price (`Params::sah_step_percent`; 0: none).
+    pub sah_step_percent: u32,
     pub units: u32,
     pub slots: u32,
     pub pipelines: u32,
@@ -116,6 +131,7 @@ impl Candidate {
     const EMPTY: Candidate = Candidate {
         leaf_size: 0,
         stack_depth: 0,
+        sah_step_percent: 0,
         units: 0,
         slots: 0,
         pipelines: 0,
@@ -177,10 +193,12 @@ impl Fit {
 }
 
 impl Candidate {
-    /// "4 units × 64 slots, 2 pipelines, leaves ≤ 4, stack 16".
+    /// "4 units × 64 slots, 2 pipelines, leaves ≤ 4, stack 16" (", SAH step 175 %" when priced).
     fn shape(&self) -> String {
+        let step =
+            if self.sah_step_percent > 0 { format!(", SAH step {} %", self.sah_step_percent) } else { String::new() };
         format!(
-            "{} units × {} slots, {} pipelines, leaves ≤ {}, stack {}",
+            "{} units × {} slots, {} pipelines, leaves ≤ {}, stack {}{step}",
             self.units, self.slots, self.pipelines, self.leaf_size, self.stack_depth
         )
     }
@@ -259,7 +277,9 @@ fn shapes(
         for pipelines in [1, 2, 4].into_iter().filter(|p| units.is_multiple_of(*p) && keep(units, *p)) {
             for slots in SLOTS {
                 let (leaf_size, stack_depth) = (scene.params.leaf_size, scene.params.stack_depth);
-                let c = Candidate { leaf_size, stack_depth, units, slots, pipelines, ..Candidate::EMPTY };
+                let sah_step_percent = scene.params.sah_step_percent;
+                let c =
+                    Candidate { leaf_size, stack_depth, sah_step_percent, units, slots, pipelines, ..Candidate::EMPTY };
                 // Shapes the closest-hit units cannot number (more than 128 slots a lane).
                 if CoreParams::shaped(roms, &c.spec(base)).check().is_ok() {
                     shapes.push(c);
@@ -397,7 +417,8 @@ mod tests {
     use crate::scene::SceneSource;
 
     /// On the LFE5U-85F the teapot's fit is four units of 64 slots and two pipelines, its tree
-    /// built for a stack of 16 (208 DP16KD with its pair ROMs, DECISIONS 137): with the stack
+    /// built for a stack of 16, leaves ≤ 5 and node steps priced (208 DP16KD with its pair ROMs,
+    /// DECISIONS 137 and 139): with the stack
     /// of 32 asked for by default, four of 64 need 224 DP16KD of its 208 (four pipelines: 214 MULT18X18D of its 156). The XC5VLX110T's 64 DSP48E
     /// take two units with the products cut for them (60; three need 68), one with the ECP5's
     /// 18 × 18 cut (two need 70). Every shape run fits, and the chosen one has the most rays per
@@ -406,13 +427,16 @@ mod tests {
     fn the_teapot_fits_four_units_of_64_and_two_pipelines_on_the_ecp5_and_two_units_on_the_virtex_5() {
         let scene = Scene::load(&SceneSource::Builtin("teapot".into()), &Params::default()).unwrap();
         let base = CoreSpec { id_width: 12, ..CoreSpec::default() };
-        let (ecp5, chosen) = fit(Device::Lfe5u85f, &scene, SceneSearch::BOTH, &base, &|| {}).unwrap();
+        let (ecp5, chosen) = fit(Device::Lfe5u85f, &scene, SceneSearch::ALL, &base, &|| {}).unwrap();
         let c = &ecp5.chosen;
         let got = (c.units, c.slots, c.pipelines, c.leaf_size, c.stack_depth, c.multipliers, c.block_ram);
-        assert_eq!(got, (4, 64, 2, 4, 16, 134, 208), "{ecp5:#?}");
-        assert_eq!((chosen.params.leaf_size, chosen.params.stack_depth), (4, 16));
+        assert_eq!(got, (4, 64, 2, 5, 16, 134, 208), "{ecp5:#?}");
+        assert_eq!(c.sah_step_percent, FIT_SAH_STEP_PERCENT);
+        let p = &chosen.params;
+        assert_eq!((p.leaf_size, p.stack_depth, p.sah_step_percent), (5, 16, FIT_SAH_STEP_PERCENT));
         let as_given = |c: &&Candidate| (c.units, c.slots, c.pipelines, c.stack_depth) == (4, 64, 2, 32);
-        let four_64 = ecp5.candidates.iter().filter(|c| c.leaf_size == 4).find(as_given).unwrap();
+        let four_64 =
+            ecp5.candidates.iter().filter(|c| (c.leaf_size, c.sah_step_percent) == (4, 0)).find(as_given).unwrap();
         assert_eq!((four_64.block_ram, four_64.rays_per_clock), (224, None));
         let run: Vec<&Candidate> = ecp5.candidates.iter().filter(|c| c.rays_per_clock.is_some()).collect();
         assert!(run.len() >= 9 && run.iter().all(|c| c.multipliers <= 156 && c.block_ram <= 208), "{run:#?}");
@@ -447,18 +471,25 @@ mod tests {
         assert!(!Candidate { luts: 66_913, ..c }.fits(156, &l));
     }
 
-    /// The builds tried: the scene as given first, each other leaf size and stack only once
-    /// and only where allowed; a stack halves to the power of two below its RAM's words.
+    /// The builds tried: the scene as given first, each other leaf size, stack and SAH step
+    /// price only once and only where allowed; a stack halves to the power of two below its
+    /// RAM's words; a step price only with the SAH.
     #[test]
     fn the_scene_builds_tried_are_the_given_one_then_the_allowed_neighbours() {
         let p = Params::default();
-        let tried = |s: SceneSearch, p: &Params| -> Vec<(u32, u32)> {
-            s.variants(p).iter().map(|v| (v.leaf_size, v.stack_depth)).collect()
+        let tried = |s: SceneSearch, p: &Params| -> Vec<(u32, u32, u32)> {
+            s.variants(p).iter().map(|v| (v.leaf_size, v.stack_depth, v.sah_step_percent)).collect()
         };
-        assert_eq!(tried(SceneSearch::default(), &p), [(4, 32)]);
-        assert_eq!(tried(SceneSearch { leaf_size: false, stack_depth: true }, &p), [(4, 32), (4, 16)]);
-        assert_eq!(tried(SceneSearch::BOTH, &p), [(4, 32), (4, 16), (3, 32), (3, 16), (5, 32), (5, 16)]);
+        let leaf_and_stack = SceneSearch { sah_step: false, ..SceneSearch::ALL };
+        assert_eq!(tried(SceneSearch::default(), &p), [(4, 32, 0)]);
+        assert_eq!(tried(SceneSearch { stack_depth: true, ..SceneSearch::default() }, &p), [(4, 32, 0), (4, 16, 0)]);
+        assert_eq!(tried(leaf_and_stack, &p), [(4, 32, 0), (4, 16, 0), (3, 32, 0), (3, 16, 0), (5, 32, 0), (5, 16, 0)]);
         let small = Params { leaf_size: 1, stack_depth: 20, ..p };
-        assert_eq!(tried(SceneSearch::BOTH, &small), [(1, 20), (1, 16), (2, 20), (2, 16)]);
+        assert_eq!(tried(leaf_and_stack, &small), [(1, 20, 0), (1, 16, 0), (2, 20, 0), (2, 16, 0)]);
+        let f = FIT_SAH_STEP_PERCENT;
+        assert_eq!(tried(SceneSearch { sah_step: true, ..SceneSearch::default() }, &p), [(4, 32, 0), (4, 32, f)]);
+        assert_eq!(tried(SceneSearch::ALL, &p).len(), 12);
+        let middle = Params { tree: crate::params::TreeSplit::Middle, ..p };
+        assert_eq!(tried(SceneSearch { sah_step: true, ..SceneSearch::default() }, &middle), [(4, 32, 0)]);
     }
 }

@@ -144,7 +144,8 @@ fn memory(rng: &mut SplitMix64) -> (MemorySpec, MemoryTiming) {
 
 /// A parameter set from the whole valid range: n and m first (every n from 4 to 40 as likely),
 /// then T, C and E within the limits they imply; leaf size and stack depth mostly small, where
-/// leaves and depth-limited trees change most. Sets the RTL layer cannot hold are redrawn by
+/// leaves and depth-limited trees change most; with the SAH, half the sets price node steps
+/// (`sah_step_percent`). Sets the RTL layer cannot hold are redrawn by
 /// the caller (`Params::validate` and `CoreParams::check` say which).
 fn params(rng: &mut SplitMix64) -> Params {
     let n = 4 + rng.below(37) as u32;
@@ -156,9 +157,13 @@ fn params(rng: &mut SplitMix64) -> Params {
     let leaf_size = [1, 2, 3, 4, 4, 6, 8, 16, 64][rng.below(9) as usize];
     let stack_depth = [32, 32, 32, 4, 8, 12, 64][rng.below(7) as usize];
     let tree = if rng.below(2) == 0 { TreeSplit::Sah } else { TreeSplit::Middle };
-    let mut p = Params { n, m, t, c, leaf_size, stack_depth, tree, edge_shift: EdgeShift::Auto };
+    let mut p = Params { n, m, t, c, leaf_size, stack_depth, tree, edge_shift: EdgeShift::Auto, sah_step_percent: 0 };
     if rng.below(2) == 0 {
         p.edge_shift = EdgeShift::Fixed(rng.below(max_edge_shift(&p) as u64 + 1) as u32);
+    }
+    // Drawn last, so the draws before it are what they were before the option (DECISIONS 139).
+    if tree == TreeSplit::Sah && rng.below(2) == 0 {
+        p.sah_step_percent = [50, 100, 175, 300][rng.below(4) as usize];
     }
     p
 }

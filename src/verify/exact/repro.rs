@@ -51,6 +51,9 @@ pub fn sim_command(case: &Case, obj: &Path, hdl: Option<crate::verify::simulator
         s.target_mhz,
         s.div_bits,
     );
+    if p.sah_step_percent > 0 {
+        write!(cmd, " --sah-step-percent {}", p.sah_step_percent).expect("a String");
+    }
     if s.pipelines > 1 {
         write!(cmd, " --pipelines {}", s.pipelines).expect("a String");
     }
