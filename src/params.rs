@@ -82,7 +82,7 @@ impl fmt::Display for TreeSplit {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Params {
     /// Bits of the vertex grid: the scene's longest side maps to 2^n − 1.
     pub n: u32,
@@ -112,6 +112,27 @@ pub struct Params {
 
 fn is_zero(x: &u32) -> bool {
     *x == 0
+}
+
+/// As derived, but without `sah_step_percent` when it is 0: the scene's hash, and so every
+/// scene tag in a module name, reads this text (`SceneRoms::hash`), and an unpriced tree's
+/// cores keep the names (and `generated/measured`'s netlist hashes) they had before the field.
+impl fmt::Debug for Params {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut d = f.debug_struct("Params");
+        d.field("n", &self.n)
+            .field("m", &self.m)
+            .field("edge_shift", &self.edge_shift)
+            .field("t", &self.t)
+            .field("c", &self.c)
+            .field("leaf_size", &self.leaf_size)
+            .field("stack_depth", &self.stack_depth)
+            .field("tree", &self.tree);
+        if self.sah_step_percent != 0 {
+            d.field("sah_step_percent", &self.sah_step_percent);
+        }
+        d.finish()
+    }
 }
 
 impl Default for Params {
