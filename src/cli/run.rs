@@ -11,7 +11,7 @@ use super::config::{
 use super::sweep_config::{SweepConfig, SweepRun};
 use crate::cores::intersect::IntersectParams;
 use crate::error::Result;
-use crate::fpga::xilinx;
+use crate::fpga::{ecp5, xilinx};
 use crate::generate;
 use crate::io::OutputSet;
 use crate::model::camera::Camera;
@@ -265,7 +265,7 @@ pub fn gen_core(c: &GenConfig) -> Result<()> {
     // manifest's latency and the AXI frame's layout are made from it.
     let core = std::rc::Rc::new(crate::cores::top::core_module_with(&p, &roms, c.debug_ports));
     let measured = match c.measured.as_deref() {
-        Some(f) => Some(crate::fpga::ecp5::measured_core(f, &p, &core, &roms.name)?),
+        Some(f) => Some(ecp5::measured_core(f, &p, &core, &roms.name)?),
         None => None,
     };
     let mut files = OutputSet::new();
@@ -375,11 +375,11 @@ fn synth_ecp5(
     modules: &[String],
     scene: &str,
 ) -> Result<()> {
-    let tools = crate::fpga::ecp5::Tools::require()?;
+    let tools = ecp5::Tools::require()?;
     let jobs = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut timings = Vec::new();
     for name in modules {
-        let (m, latency) = crate::fpga::ecp5::module_of(name, p, core, roms);
+        let (m, latency) = ecp5::module_of(name, p, core, roms);
         eprintln!(
             "ecp5: placing and routing {} at seed{} {} ({} at a time; minutes for the larger modules)",
             m.name,
@@ -388,10 +388,12 @@ fn synth_ecp5(
             jobs.min(seeds.len())
         );
         let dir = c.build.join(&m.name);
-        let seen =
-            |t: &crate::fpga::ecp5::Timing| eprintln!("ecp5: {} seed {}: {:.1} MHz", t.module, t.seed, t.fmax_mhz);
-        let placed =
-            crate::fpga::ecp5::seeds::place_and_route_seeds(&tools, &m, latency, target_mhz, seeds, jobs, &dir, &seen)?;
+        // A spinner per seed shows its nextpnr's phase: the whole core takes hours a seed.
+        let logs: Vec<_> = seeds.iter().map(|&s| (s, ecp5::seeds::seed_dir(&dir, seeds, s))).collect();
+        let placed = ecp5::progress::watching(&logs, |say| {
+            let seen = |t: &ecp5::Timing| say(&format!("ecp5: {} seed {}: {:.1} MHz", t.module, t.seed, t.fmax_mhz));
+            ecp5::seeds::place_and_route_seeds(&tools, &m, latency, target_mhz, seeds, jobs, &dir, &seen)
+        })?;
         if seeds.len() > 1 {
             eprintln!(
                 "ecp5: {}: median {:.1} MHz (seed {}), {:.1}–{:.1} over {} seeds",
@@ -595,7 +597,7 @@ fn sweep_cmd(c: SweepConfig) -> Result<bool> {
     }
     // Refused before the first line of output (sweep::run checks again for other callers).
     if spec.ecp5.is_some() {
-        crate::fpga::ecp5::Tools::require()?;
+        ecp5::Tools::require()?;
     }
     eprintln!(
         "sweep: {} configurations ({} parameter sets × {} scenes){}{}",

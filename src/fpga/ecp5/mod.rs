@@ -14,6 +14,7 @@ pub mod bram;
 pub mod carry;
 pub mod dsp;
 pub mod luts;
+pub mod progress;
 pub mod seeds;
 pub mod sta;
 

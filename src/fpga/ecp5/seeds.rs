@@ -10,7 +10,7 @@ use super::{
 use crate::error::{Error, Result};
 use crate::rtl::Module;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 /// The most seeds one run takes (each is minutes to an hour of place and route).
@@ -94,6 +94,11 @@ impl Placed {
     }
 }
 
+/// Where seed `seed` of `seeds` is placed: `dir` itself for a single seed, else `dir/seed-N`.
+pub fn seed_dir(dir: &Path, seeds: &[u64], seed: u64) -> PathBuf {
+    if seeds.len() == 1 { dir.to_path_buf() } else { dir.join(format!("seed-{seed}")) }
+}
+
 /// Synthesises `m` (in its pin wrapper) once in `dir`, then places and routes it at each of
 /// `seeds` in `dir/seed-N` (the netlist copied there), `jobs` nextpnr runs at a time, and
 /// reports each seed as it ends through `done`.
@@ -119,7 +124,7 @@ pub fn place_and_route_seeds(
     let name = m.name.clone();
     let (yosys, nextpnr_version) = tools.versions();
     let place = |seed: u64| -> Result<Timing> {
-        let seed_dir = if seeds.len() == 1 { dir.to_path_buf() } else { dir.join(format!("seed-{seed}")) };
+        let seed_dir = seed_dir(dir, seeds, seed);
         if seeds.len() > 1 {
             std::fs::create_dir_all(&seed_dir).map_err(|e| Error::file(&seed_dir, e.to_string()))?;
             let json = dir.join("design.json");
