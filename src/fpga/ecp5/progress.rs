@@ -65,17 +65,9 @@ fn phase_of_line(line: &str) -> Option<String> {
     None
 }
 
-/// 366459 → "366,459".
+/// 366459 → "366,459" (indicatif's grouping).
 fn thousands(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
+    indicatif::HumanCount(n).to_string()
 }
 
 /// The last `TAIL_BYTES` of `path`, or `None` while it does not exist.
