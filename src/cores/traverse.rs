@@ -25,8 +25,12 @@
 //! - G: the decision: push the far child (stack[slot][sp]) and enter the near one, enter one
 //!   child, or pop. The token goes into R and is back at A in the next cycle.
 //!
-//! Ring length P = N + L + 2 clocks (18 at the default 150 MHz with block ROMs): a slot steps
-//! once per P clocks, so K ≥ P slots keep the ring full when no slot is parked.
+//! - F2 (only in a unit that sends leaves, `pair_rom_cycles`): F's compares registered; the
+//!   leaf to send, and so whether the token returns, is decided from them.
+//!
+//! Ring length P = N + L + 2 clocks (18 at the default 150 MHz with block ROMs; one more with
+//! F2): a slot steps once per P clocks, so K ≥ P slots keep the ring full when no slot is
+//! parked.
 //!
 //! Slots: a free list (`free_list.rs`: slots unused since reset in order, then slots given back
 //! in the order they came back); the top takes the slot offered (`alloc`) and writes the

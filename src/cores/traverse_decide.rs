@@ -1,6 +1,8 @@
 //! The traversal unit's last stages (`traverse.rs` says what the unit does): from N to F the
 //! token rides along while the limits of `bih::inner_step`'s decision are made; in F the two
-//! plane distances are compared by their roles; in G the decision pushes, enters or pops.
+//! plane distances are compared by their roles; in G the decision pushes, enters or pops. A
+//! unit that sends leaves (`pair_rom_cycles`) has F2 between F and G, where the leaf to send
+//! is chosen from F's registered compare.
 
 use super::fifo::Fifo;
 use super::lt_chain;
@@ -10,7 +12,9 @@ use crate::rtl::build::S;
 impl<'b> Unit<'b> {
     /// N → F: the token rides along; the limits are made on the way (as `inner_step`'s
     /// compares, every one a strict less-than; when tmin > tmax no distance passes any limit).
-    /// F: both distances arrive and are compared by their roles, registered for G.
+    /// F: both distances arrive and are compared by their roles, registered for G. With
+    /// `pair_rom_cycles`, F2: the registered compares and the token ride a clock more, and
+    /// the leaf to send (and so whether the token returns) is decided from them.
     pub(super) fn ring_f(&self, nn: &RingN<'b>) -> RingF<'b> {
         let (b, n, l, nt, axis1, negative) = (self.b, self.p.n, nn.plane_latency, nn.token, nn.axis1, nn.negative);
         b.stage("ring_f", "N to F: the token rides along, the limits made on the way; F: the compares");
@@ -19,13 +23,16 @@ impl<'b> Unit<'b> {
             None => nt.valid,
         }
         .name("n_stays");
-        let f_valid = b.valid_line("f_valid", ring, l);
-        let f_inner = b.delay_line("f_inner", nn.is_inner, l);
-        let f_slot = b.delay_line("f_slot", nt.slot, l);
-        let f_tmin = b.delay_line("f_tmin", nt.tmin, l);
-        let f_tmax = b.delay_line("f_tmax", nt.tmax, l);
-        let f_sp = b.delay_line("f_sp", nt.sp, l);
-        let f_child = b.delay_line("f_child", nn.child, l);
+        // The token rides to F, and in a sending unit on to F2 (`f2`).
+        let f2 = nn.send.is_some();
+        let to_last = l + f2 as u32;
+        let f_valid = b.valid_line("f_valid", ring, to_last);
+        let f_inner = b.delay_line("f_inner", nn.is_inner, to_last);
+        let f_slot = b.delay_line("f_slot", nt.slot, to_last);
+        let f_tmin = b.delay_line("f_tmin", nt.tmin, to_last);
+        let f_tmax = b.delay_line("f_tmax", nt.tmax, to_last);
+        let f_sp = b.delay_line("f_sp", nt.sp, to_last);
+        let f_child = b.delay_line("f_child", nn.child, to_last);
         let neg1 = b.delay("negative_n1", b.pick(axis1, nn.inv).msb());
         let (tmin1, tmax1) = (b.delay("tmin_n1", nt.tmin), b.delay("tmax_n1", nt.tmax));
         let tmax_p1 = b.delay("tmax_p1", (nt.tmax + 1).name("tmax_plus_1"));
@@ -48,22 +55,28 @@ impl<'b> Unit<'b> {
         let d1_hi = limit_reg("d1_hi", tmax2, tmax_p1_2, never_below);
         let d1_lo = limit_reg("d1_lo", tmin_m1_2, tmin2, never_above);
 
-        // F: the compares, registered by role for G.
+        // F: the compares, registered by role (for G; in a sending unit for F2, then G).
+        // `to_g` is F's register of a value for G, and in a sending unit F2's after it.
+        let to_g = |name: &str, x: S<'b>| {
+            let r = b.delay(name, x);
+            if f2 { b.delay(&format!("{name}_f2"), r) } else { r }
+        };
         let [d0, d1] = nn.plane_t;
         let d0_below = lt_chain(d0, d0_hi).name("d0_below");
         let d0_above = lt_chain(d0_lo, d0).name("d0_above");
         let d1_below = lt_chain(d1, d1_hi).name("d1_below");
         let d1_above = lt_chain(d1_lo, d1).name("d1_above");
         let reg = |name: &str, if_negative: S<'b>, if_positive: S<'b>| {
-            b.delay(name, negative.select(if_negative, if_positive).name(&format!("{name}_c")))
+            to_g(name, negative.select(if_negative, if_positive).name(&format!("{name}_c")))
         };
         let near_lt_tmax = reg("near_lt_tmax", d1_below, d0_below);
         let far_gt_tmin = reg("far_gt_tmin", d0_above, d1_above);
         let go_near_c = negative.select(d1_above, d0_above).name("go_near_c");
-        let go_near = b.delay("go_near", go_near_c);
+        let go_near_f = b.delay("go_near", go_near_c);
+        let go_near = if f2 { b.delay("go_near_f2", go_near_f) } else { go_near_f };
         let go_far = reg("go_far", d0_below, d1_below);
-        let near_end = b.delay("near_end", negative.select(d1, d0));
-        let far_start = b.delay("far_start", negative.select(d0, d1));
+        let near_end = to_g("near_end", negative.select(d1, d0));
+        let far_start = to_g("far_start", negative.select(d0, d1));
         let g = Token {
             valid: b.valid_delay("g_valid", f_valid),
             slot: b.delay("g_slot", f_slot),
@@ -73,8 +86,11 @@ impl<'b> Unit<'b> {
             sp: b.delay("g_sp", f_sp),
         };
         // A leaf to queue in G: the node's own, or the near child entered (`enter_near` of G).
+        // Decided in F2 from F's registered compare: with the compare's carry chain, the
+        // decision and its route to the copies of `g_returns` by the entry stage were the
+        // slowest paths of the fitted core at seed 1 (7.62 ns, 2.5 of it one route).
         let send = nn.send.map(|ls| {
-            let send_c = (f_valid & (ls.own | (f_inner & go_near_c & ls.near_leaf))).name("leaf_send_c");
+            let send_c = (f_valid & (ls.own | (f_inner & go_near_f & ls.near_leaf))).name("leaf_send_c");
             LeafSent {
                 send: b.valid_delay("g_leaf_send", send_c),
                 own: b.delay("g_own_leaf", ls.own),
@@ -83,7 +99,7 @@ impl<'b> Unit<'b> {
             }
         });
         let inner = b.delay("g_inner", f_inner);
-        let negative = b.delay("g_negative", negative);
+        let negative = to_g("g_negative", negative);
         RingF { g, inner, negative, near_lt_tmax, far_gt_tmin, go_near, go_far, near_end, far_start, send }
     }
 

@@ -29,10 +29,10 @@ impl<'b> Unit<'b> {
         fifo(b, "leaf_q", leaf_in.width(), p.slots, push_q, in_q, pop)
     }
 
-    /// N to F with `pair_rom_cycles` (`r`): the pair ROM is addressed a clock after N by the
+    /// N to F2 with `pair_rom_cycles` (`r`): the pair ROM is addressed a clock after N by the
     /// node's child pair and answers r clocks later; its near half (by the direction's sign,
     /// known a clock after N) or, for a node that is itself a leaf with entries, the node's
-    /// own fields ride to F. `n` holds, as N sees them: the node's own leaf bit and fields,
+    /// own fields ride to F2 (a clock after F). `n` holds, as N sees them: the node's own leaf bit and fields,
     /// its `child`, and the sign a clock after N.
     pub(super) fn leaf_send(&self, r: u32, plane_latency: u32, n: [S<'b>; 4]) -> LeafSend<'b> {
         let (b, p) = (self.b, self.p);
@@ -48,11 +48,12 @@ impl<'b> Unit<'b> {
         let own = b.delay_line("own_leaf_p", own_leaf, arrives);
         let fields = own.select(b.delay_line("own_fields_p", own_fields, arrives), near);
         let near_leaf = near.slice(0, p.node_layout.field("count").width).ne(0);
-        let to_f = plane_latency - arrives;
+        // To F2, a clock after F.
+        let to_f2 = plane_latency - arrives + 1;
         LeafSend {
-            own: b.delay_line("own_leaf_f", own, to_f),
-            fields: b.delay_line("leaf_fields_f", fields.name("leaf_fields_p"), to_f),
-            near_leaf: b.delay_line("near_leaf_f", near_leaf.name("near_leaf_p"), to_f),
+            own: b.delay_line("own_leaf_f2", own, to_f2),
+            fields: b.delay_line("leaf_fields_f2", fields.name("leaf_fields_p"), to_f2),
+            near_leaf: b.delay_line("near_leaf_f2", near_leaf.name("near_leaf_p"), to_f2),
         }
     }
 }
