@@ -167,8 +167,23 @@ pub fn closest_core(
     // path at seed 2 (`d0_slot_c1` → `done_t_tri`, 7.39 ns).
     let tt_mem = WideRam::new(&b, "best_t_tri", t.width() + tri.width(), k as usize);
     let uv_mem = WideRam::new(&b, "best_u_v", 2 * m_bits, k as usize);
-    let id_mem = b.ram("ray_ids", id_bits, vec![0; k as usize]);
-    b.ram_write(id_mem, id_we, id_slot, id_in);
+    let spread = super::clock::spread(units << lane_bits, target);
+    let id_mem = if spread {
+        let id_mem = WideRam::new(&b, "ray_ids", id_bits, k as usize);
+        // The id lands in registers of its own here, one write enable and address per group
+        // of columns, and is written a clock later: the top's `accept` through the lane select
+        // and the write-enable decode into every cell was a slowest path of the fitted core at
+        // seed 1 (7.18 ns, 20 groups of endpoints over 6.67). The id is read when the ray is
+        // done, many clocks later.
+        let we = super::wide_ram::address_registers(&b, b.valid_delay("id_we_r", id_we), id_mem.groups());
+        let at = super::wide_ram::address_registers(&b, b.delay("id_slot_r", id_slot), id_mem.groups());
+        id_mem.write(&b, &we, &at, b.delay("id_r", id_in));
+        id_mem
+    } else {
+        let id_mem = WideRam::whole(&b, "ray_ids", id_bits, k as usize);
+        id_mem.write(&b, &[id_we], &[id_slot], id_in);
+        id_mem
+    };
     let best_valid = b.reg("best_valid", Ty::u(k), Some(0));
 
     // The merge: fin (the cycle after a leaf's last triangle: the accumulator is final), M1
@@ -195,7 +210,6 @@ pub fn closest_core(
     // the chain, the OR and the AND into the write enable in one clock were the default core's
     // slowest path at seed 1 (8.27 ns, 38 cells). The merge is reported from M2 as before; the
     // slot's best is read again only after its ray has been unparked, many clocks later.
-    let spread = super::clock::spread(units << lane_bits, target);
     let (leaf_key, slot_key) = (b.cat(&[m1_empty, m1_tt]), b.cat(&[zero, st_tt]));
     let (m2, m2_less) = if spread {
         // In a spread core the chain is cut in two halves registered apart (less above, or
@@ -270,12 +284,12 @@ pub fn closest_core(
     let d0 = b.valid_delay("d0", done_valid);
     let d0_slot = b.delay("d0_slot", done_slot);
     // A register per RAM it addresses (426 sinks a bit as one; DECISIONS 114).
-    let d0_slots = b.copies(d0_slot, tt_mem.groups() + uv_mem.groups() + 1);
+    let d0_slots = b.copies(d0_slot, tt_mem.groups() + uv_mem.groups() + id_mem.groups());
     let (tt_slots, rest) = d0_slots.split_at(tt_mem.groups());
     let (uv_slots, id_slot) = rest.split_at(uv_mem.groups());
     let d_tt = tt_mem.read(&b, "done_t_tri", tt_slots);
     let d_uv = uv_mem.read(&b, "done_u_v", uv_slots);
-    let d_id = b.read("done_id", id_mem, id_slot[0]);
+    let d_id = id_mem.read(&b, "done_id", id_slot);
     let d1 = b.valid_delay("d1", d0);
     let d1_slot = b.delay("d1_slot", d0_slot);
     let d1_has = b.delay("d1_has", slot_bit_2(&b, "done_has", best_valid, k, &done_slots, d0_slot));

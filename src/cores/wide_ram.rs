@@ -53,6 +53,12 @@ impl WideRam {
         WideRam { mems }
     }
 
+    /// The RAM in one group whatever its width: where its write and read have no fan-out to
+    /// split (a core that is not spread over the die).
+    pub fn whole(b: &Builder, name: &str, width: u32, depth: usize) -> WideRam {
+        WideRam { mems: vec![(b.ram(name, width, vec![0; depth]), width)] }
+    }
+
     /// How many groups (so how many read-address registers a read wants).
     pub fn groups(&self) -> usize {
         self.mems.len()
