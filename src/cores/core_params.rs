@@ -86,6 +86,7 @@ impl CoreParams {
         let spread = super::clock::spread(units, super::clock::ClockTarget(target_mhz));
         if spread {
             trav.product = trav.product.landed();
+            trav.spread = true;
         }
         if spread && pipelines > 1 {
             // Its units are its limit: a parent sends its near leaf child itself (DECISIONS

@@ -24,6 +24,9 @@ pub struct TraverseParams {
     /// Whether the plane distances and the leaves pushed get a landing register by their
     /// users (targets from `clock::LANDING_FROM_MHZ`).
     pub landing: bool,
+    /// Whether the unit is a spread core's (`clock::spread`), with the registers such a core
+    /// gets across the die.
+    pub spread: bool,
     /// Clocks of a node ROM read and of a leaf ROM read (`brom::read_cycles`: 3 for block RAM,
     /// whose fabric register the placer puts between the blocks spread over the die and the
     /// logic; 2 for LUTs). The emitted triangle stream is `leaf_rom_cycles` behind `leaf`.
@@ -61,6 +64,7 @@ impl TraverseParams {
             tri_bits: rom::addr_bits(scene.tri_count()),
             product: target.mul_style(),
             landing: target.splits(super::clock::LANDING_FROM_MHZ),
+            spread: false,
             node_rom_cycles: read_cycles(scene.node.1.len()),
             leaf_rom_cycles: read_cycles(scene.leaf.1.len()),
             slots,

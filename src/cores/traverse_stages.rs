@@ -180,7 +180,7 @@ pub(super) struct RingN<'b> {
     pub(super) leaves: Option<S<'b>>,
     /// The leaf queue, when leaves are queued in N.
     pub(super) leafq: Option<Fifo<'b>>,
-    /// With `pair_rom_cycles`: the leaf G may send, as F sees it.
+    /// With `pair_rom_cycles`: the leaf G may send, as F2 sees it.
     pub(super) send: Option<LeafSend<'b>>,
     /// The node's axis a clock after N, and whether the ray's direction is negative on it
     /// (as seen in F).
@@ -192,7 +192,7 @@ pub(super) struct RingN<'b> {
     pub(super) plane_latency: u32,
 }
 
-/// With `pair_rom_cycles`, in F: whether the token's own node is a leaf with entries (popped,
+/// With `pair_rom_cycles`, in F2: whether the token's own node is a leaf with entries (popped,
 /// or the root), the leaf fields (first above count) G would queue — the node's own, else its
 /// near child's from the pair ROM — and whether the near child is a leaf with entries.
 #[derive(Clone, Copy)]
@@ -202,7 +202,7 @@ pub(super) struct LeafSend<'b> {
     pub(super) near_leaf: S<'b>,
 }
 
-/// With `pair_rom_cycles`, in G (registers loaded in F): a leaf is queued (`send`: the
+/// With `pair_rom_cycles`, in G (registers loaded in F2): a leaf is queued (`send`: the
 /// token's own node, else its near child entered), the token's own node is that leaf
 /// (`own`), its fields, and whether the token goes round again (`returns`: valid, nothing
 /// queued).
@@ -300,8 +300,20 @@ impl<'b> Unit<'b> {
         // An unparked ray's entry: slot, stack pointer, and whether that is 0 (made here, so
         // that E's done bit after the head's selects is one gate: `unpark_q_popped` → `q_done`
         // through the compare was 7.02 ns at a seed).
-        let unpark_in = b.cat(&[inp.merge_slot, inp.merge_sp, inp.merge_sp.eq(0).name("merge_sp_zero")]);
-        let unpark = fifo(b, "unpark_q", sb + spw + 1, k, inp.merge_valid, unpark_in, unpark_pop);
+        // In a spread core the entry holds sp − 1 as well: the head's select, the subtract and
+        // the ring's select into the stack's read address were a slowest path of the fitted
+        // core at seed 1 (`unpark_q_popped` → `stack_raddr`, 7.10 ns).
+        let merge_sp_m1 = self.p.spread.then(|| (inp.merge_sp - 1).resize(spw).name("merge_sp_m1"));
+        let mut unpark_fields = vec![inp.merge_slot, inp.merge_sp, inp.merge_sp.eq(0).name("merge_sp_zero")];
+        unpark_fields.extend(merge_sp_m1);
+        let unpark_in = b.cat(&unpark_fields);
+        let m1_bits = merge_sp_m1.map_or(0, |_| spw);
+        let unpark = fifo(b, "unpark_q", sb + spw + 1 + m1_bits, k, inp.merge_valid, unpark_in, unpark_pop);
+        // The head without sp − 1 (the entry the fields below are cut from), and sp − 1.
+        let (unpark_head, unpark_sp_m1) = match merge_sp_m1 {
+            Some(_) => (unpark.head.slice(m1_bits, sb + spw + 1), Some(unpark.head.slice(0, spw))),
+            None => (unpark.head, None),
+        };
         let new_in = b.cat(&[inp.new_slot, inp.new_tmax.unsigned(), inp.new_miss]);
         let newq = fifo(b, "new_q", sb + dist.width + 1, k, inp.new_valid, new_in, new_pop);
         // E: a queued ray enters when the token now in G will not return (R empty in A); a node
@@ -331,20 +343,23 @@ impl<'b> Unit<'b> {
             Some((take, r)) => take.select(field(r), queued),
             None => queued,
         };
-        let queued_slot = take_unpark.select(unpark.head.slice(spw + 1, sb), newq.head.slice(dist.width + 1, sb));
+        let queued_slot = take_unpark.select(unpark_head.slice(spw + 1, sb), newq.head.slice(dist.width + 1, sb));
         let slot_next = or_retried(|r| r.slot, queued_slot);
         let slot = b.delay("q_slot", slot_next);
         // An unparked ray's stack pointer, with sp = 0 and sp − 1 made here, so that A is muxes.
-        let head_sp = or_retried(|r| r.sp, unpark.head.slice(1, spw));
+        let head_sp = or_retried(|r| r.sp, unpark_head.slice(1, spw));
         let sp = b.delay("q_sp", head_sp);
         let sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
-        let sp_m1_next = head_sp - 1;
+        let sp_m1_next = match unpark_sp_m1 {
+            Some(m1) => or_retried(|r| (r.sp - 1).resize(r.sp.width()), m1),
+            None => head_sp - 1,
+        };
         let sp_m1 = b.delay("q_sp_m1", sp_m1_next);
         let raddr_next = b.cat(&[slot_next, sp_m1_next.resize(self.stack_bits)]).name("q_stack_raddr");
         // Whether the token taken is done in A, decided here: from `q_new`, `q_miss` and the
         // stack pointer's bits in A, the done and live bits were the slowest paths of a
         // traversal unit at seed 2 of the default core (8.29 ns into `b_valid`).
-        let unpark_empty = unpark.head.bit(0);
+        let unpark_empty = unpark_head.bit(0);
         let done_c = ((take_new & newq.head.bit(0)) | (take_unpark & unpark_empty)).name("q_done_c");
         let done = b.delay("q_done", done_c);
         let tmax = b.delay("q_tmax", or_retried(|r| r.tmax, newq.head.slice(1, dist.width).signed()));
@@ -467,13 +482,21 @@ impl<'b> Unit<'b> {
             "tmax" => from_stack.select(top_tmax, x),
             _ => x,
         });
-        let limit_mem = b.ram("cull_limit", dist.width, vec![0; k as usize]);
+        // In a spread core the limit's LUT RAM is read in groups of columns, each at a copy of
+        // the slot of its own (`wide_ram`): one copy into all its cells was a slowest path of
+        // the fitted core at seed 1 (`c_slot_c1` → `limit_q`, 7.06 ns).
+        let limit_mem = if self.p.spread {
+            WideRam::new(b, "cull_limit", dist.width, k as usize)
+        } else {
+            WideRam::whole(b, "cull_limit", dist.width, k as usize)
+        };
         let limit_we = (inp.merge_valid & inp.merge_hit).name("limit_we");
-        b.ram_write(limit_mem, limit_we, inp.merge_slot, inp.merge_limit.unsigned());
+        limit_mem.write(b, &[limit_we], &[inp.merge_slot], inp.merge_limit.unsigned());
         // The slot addresses the limit's LUT RAM and selects the has-best bit: a register each
         // (the select behind the shared one was 10.2 ns at a seed of the external core).
-        let c_slots = b.copies(c.slot, 2);
-        let limit = b.read("limit_q", limit_mem, c_slots[0]).signed();
+        let c_slots = b.copies(c.slot, limit_mem.groups() + 1);
+        let limit = limit_mem.read(b, "limit_q", &c_slots[..limit_mem.groups()]).signed();
+        let c_slot_has = c_slots[limit_mem.groups()];
         let has_best = b.reg("has_best", Ty::u(k), Some(0));
         let x = b.delay("cull_x", (c.tmin - (c.tmin >> 6)).name("tmin_less"));
         let has_best_kept = b.wire("has_best_kept", Ty::u(k));
@@ -488,7 +511,7 @@ impl<'b> Unit<'b> {
         let early = b.copies(b_slot, 1 + slot_bit_groups(k) as usize);
         let set_in_b = (inp.merge_valid & inp.merge_hit & inp.merge_slot.eq(early[0])).name("b_slot_merged_c");
         let set_in_b = b.delay("b_slot_merged", set_in_b);
-        let grouped = slot_bit_2(b, "slot_has_best", has_best_kept, k, &early[1..], c_slots[1]);
+        let grouped = slot_bit_2(b, "slot_has_best", has_best_kept, k, &early[1..], c_slot_has);
         let hb = b.delay("cull_has_best", (grouped | set_in_b).name("slot_has_best_now"));
         let culled_c = (hb & lt_chain(limit, x)).name("culled_c");
         // With a node cache, the lookup a clock after C; the cull test, known then, withdraws
