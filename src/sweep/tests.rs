@@ -266,6 +266,8 @@ fn ecp5_columns_follow_the_modules() {
         seed: 1,
         netlist_sha256: String::new(),
         slow_paths: Vec::new(),
+        groups_over: None,
+        endpoints_over: None,
     };
     let modules = vec!["divider".to_string(), "intersect".into(), "core".into()];
     let s = SweepSpec { synth: true, core_sim: true, ecp5: Some(Ecp5Choice { modules, seed: 1 }), ..spec() };

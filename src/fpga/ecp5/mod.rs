@@ -167,6 +167,12 @@ pub struct Timing {
     /// clock is lost besides the one critical path nextpnr names. Empty when not analysed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub slow_paths: Vec<sta::SlowPath>,
+    /// How many endpoint groups, and endpoint pins, in all are slower than the target's
+    /// period (`slow_paths` lists the slowest few). None when not analysed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub groups_over: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub endpoints_over: Option<usize>,
 }
 
 /// SHA-256 (hex) of a module's Verilog (every file of its hierarchy, names and contents, in
@@ -373,6 +379,8 @@ pub fn timing_from_report(
         seed,
         netlist_sha256: String::new(),
         slow_paths: Vec::new(),
+        groups_over: None,
+        endpoints_over: None,
     }
 }
 
@@ -381,7 +389,7 @@ pub const SLOW_PATHS: usize = 12;
 
 /// The slowest endpoint groups of the design nextpnr routed in `dir` (its `timing.sdf`), with
 /// the endpoints slower than the `target_mhz` period counted.
-pub fn slow_paths_of(dir: &Path, target_mhz: f64) -> Result<Vec<sta::SlowPath>> {
+pub fn slow_paths_of(dir: &Path, target_mhz: f64) -> Result<sta::Slowest> {
     let path = dir.join("timing.sdf");
     let text = std::fs::read_to_string(&path).map_err(|e| Error::file(&path, e.to_string()))?;
     sta::slowest_paths(&text, SLOW_PATHS, 1000.0 / target_mhz).map_err(|e| Error::file(&path, e))

@@ -143,7 +143,9 @@ pub fn place_and_route_seeds(
             nextpnr_version.clone(),
         );
         t.netlist_sha256 = netlist_sha256.clone();
-        t.slow_paths = slow_paths_of(&seed_dir, target_mhz)?;
+        let slowest = slow_paths_of(&seed_dir, target_mhz)?;
+        (t.groups_over, t.endpoints_over) = (Some(slowest.groups_over), Some(slowest.endpoints_over));
+        t.slow_paths = slowest.paths;
         done(&t);
         Ok(t)
     };

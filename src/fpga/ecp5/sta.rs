@@ -247,7 +247,7 @@ fn group(name: &str) -> String {
 
 /// The `count` slowest endpoint groups of the routed design in `sdf` (nextpnr's `--sdf`), each
 /// with its slowest path and how many of its endpoint pins are slower than `floor_ns`.
-pub fn slowest_paths(sdf: &str, count: usize, floor_ns: f64) -> Result<Vec<SlowPath>, String> {
+pub fn slowest_paths(sdf: &str, count: usize, floor_ns: f64) -> Result<Slowest, String> {
     let top = parse(sdf)?;
     let mut g = Graph::default();
     for cell in top.items().iter().filter(|x| x.head() == Some("CELL")) {
@@ -329,11 +329,23 @@ pub fn slowest_paths(sdf: &str, count: usize, floor_ns: f64) -> Result<Vec<SlowP
     }
     let mut paths: Vec<SlowPath> = groups.into_values().collect();
     paths.sort_by(|a, b| b.delay_ns.total_cmp(&a.delay_ns).then_with(|| a.end.cmp(&b.end)));
+    let over = paths.iter().filter(|p| p.delay_ns > floor_ns);
+    let (groups_over, endpoints_over) = (over.clone().count(), over.map(|p| p.endpoints_over).sum());
     paths.truncate(count);
     for p in &mut paths {
         p.delay_ns = (p.delay_ns * 1000.0).round() / 1000.0;
     }
-    Ok(paths)
+    Ok(Slowest { paths, groups_over, endpoints_over })
+}
+
+/// `slowest_paths`' answer: the slowest `count` endpoint groups, and how many groups and
+/// endpoint pins in all are slower than the floor (the work left to close timing, which the
+/// list's length hides).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Slowest {
+    pub paths: Vec<SlowPath>,
+    pub groups_over: usize,
+    pub endpoints_over: usize,
 }
 
 #[cfg(test)]
@@ -356,7 +368,8 @@ mod tests {
           (CELL (CELLTYPE "TRELLIS_FF") (INSTANCE b_ff_3)
             (DELAY (ABSOLUTE (IOPATH CLK Q (400:450:500) (400:450:500))))
             (TIMINGCHECK (SETUPHOLD (posedge DI) (posedge CLK) (30:40:50) (0:0:0)))))"#;
-        let paths = slowest_paths(sdf, 5, 0.5).unwrap();
+        let slowest = slowest_paths(sdf, 5, 0.5).unwrap();
+        let paths = &slowest.paths;
         assert_eq!(paths.len(), 1);
         let p = &paths[0];
         // 500 + 200 + 240 + 70 + 50 ps.
@@ -366,6 +379,11 @@ mod tests {
         assert_eq!(p.cells, 1);
         assert_eq!(p.endpoints_over, 1);
         assert_eq!(group("u.x_TRELLIS_FF_Q_12/DI"), "u.x");
+        // The counts cover every group over the floor, listed or not, and only those.
+        let unlisted = slowest_paths(sdf, 0, 0.5).unwrap();
+        assert_eq!((unlisted.paths.len(), unlisted.groups_over, unlisted.endpoints_over), (0, 1, 1));
+        let fast = slowest_paths(sdf, 5, 2.0).unwrap();
+        assert_eq!((fast.paths.len(), fast.groups_over, fast.endpoints_over), (1, 0, 0));
     }
 
     #[test]
