@@ -13,7 +13,7 @@
 //! written, which a read-first RAM answers with the old word, so it comes from a copy of the
 //! pushed word instead (`bypass`).
 
-use super::wide_ram::WideRam;
+use super::wide_ram::{GROUP_BITS, WideRam};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 
@@ -25,9 +25,20 @@ pub struct Fifo<'b> {
 /// A queue of `width`-bit entries, at least `depth` deep (a power of two).
 pub fn fifo<'b>(b: &'b Builder, name: &str, width: u32, depth: u32, push: S<'b>, din: S<'b>, pop: S<'b>) -> Fifo<'b> {
     assert_eq!(din.width(), width, "{name}: entry width");
-    let (heads, nonempty) = queue(b, name, depth, push, &[din], pop, true);
+    let (heads, nonempty) = queue(b, name, depth, push, &[din], pop, (true, GROUP_BITS));
     Fifo { head: heads[0], nonempty }
 }
+
+/// `fifo` with its RAM in groups of at most `NARROW_GROUP_BITS` bits, each read at pointers of
+/// its own: for a wide queue of a spread core, where a 16-bit group's pointer into its 16
+/// LUT-RAM cells and the head's register was a slowest path (`wide_ram`).
+pub fn narrow_fifo<'b>(b: &'b Builder, name: &str, depth: u32, push: S<'b>, din: S<'b>, pop: S<'b>) -> Fifo<'b> {
+    let (heads, nonempty) = queue(b, name, depth, push, &[din], pop, (true, NARROW_GROUP_BITS));
+    Fifo { head: heads[0], nonempty }
+}
+
+/// The groups' width in a `narrow_fifo`: two LUT-RAM columns.
+pub const NARROW_GROUP_BITS: u32 = 8;
 
 /// Splits a queue entry packed with `b.cat` (fields most significant first, of `widths`).
 pub fn unpack<'b>(entry: S<'b>, widths: &[u32]) -> Vec<S<'b>> {
@@ -53,13 +64,13 @@ pub fn fifo_words<'b>(
     pop: S<'b>,
     two_reads: bool,
 ) -> (Vec<S<'b>>, S<'b>) {
-    queue(b, name, depth, push, dins, pop, two_reads)
+    queue(b, name, depth, push, dins, pop, (two_reads, GROUP_BITS))
 }
 
 /// The queue; with `two_reads` the RAM has two read ports and the pop picks after it (the
 /// control queues and the result queue, in LUT RAM: the pop comes late, from a consumer), else
 /// one read port at the next read pointer (half the RAM, the pop before the read: the AXI
-/// read port's bookkeeping).
+/// read port's bookkeeping). With two reads the RAM is in groups of at most `group_bits`.
 fn queue<'b>(
     b: &'b Builder,
     name: &str,
@@ -67,7 +78,7 @@ fn queue<'b>(
     push: S<'b>,
     dins: &[S<'b>],
     pop: S<'b>,
-    two_reads: bool,
+    (two_reads, group_bits): (bool, u32),
 ) -> (Vec<S<'b>>, S<'b>) {
     let push = b.valid_delay(&format!("{name}_push"), push);
     // The count's and flags' own copy: the push register also drives every LUT-RAM cell's
@@ -116,7 +127,7 @@ fn queue<'b>(
             // The RAM is cut into groups of columns, each read at copies of the pointers of its
             // own (`wide_ram`).
             let q = if let Some(popped) = popped {
-                let ram = WideRam::new(b, &word("mem"), din.width(), depth as usize);
+                let ram = WideRam::in_groups_of(b, &word("mem"), din.width(), depth as usize, group_bits);
                 ram.write(b, &[push], &[wr], din);
                 let (rds, rd1s) = pointer_copies(b, &word("rd"), [rd, rd1], pop, ram.groups());
                 let q_stay = ram.read(b, &word("q_stay"), &rds);
@@ -169,12 +180,14 @@ mod tests {
     /// including pushes into an empty queue while popping its last entry.
     #[test]
     fn behaves_like_a_queue() {
-        for (depth, two_reads) in [(2u32, true), (4, true), (16, true), (4, false), (16, false)] {
+        let cases = [(2u32, true, GROUP_BITS), (4, true, GROUP_BITS), (16, true, GROUP_BITS), (16, true, 8)];
+        for (depth, two_reads, group_bits) in cases.into_iter().chain([(4, false, GROUP_BITS), (16, false, GROUP_BITS)])
+        {
             let b = Builder::new("t");
             let push = b.input("push", Ty::BIT);
             let din = b.input("din", Ty::u(40));
             let pop = b.input("pop", Ty::BIT);
-            let (heads, nonempty) = queue(&b, "q", depth, push, &[din], pop, two_reads);
+            let (heads, nonempty) = queue(&b, "q", depth, push, &[din], pop, (two_reads, group_bits));
             b.output("head", heads[0]);
             b.output("nonempty", nonempty);
             let m = b.finish();
@@ -200,7 +213,7 @@ mod tests {
                 }
                 // A push reaches the queue a clock later.
                 model.extend(in_flight.drain(..));
-                // Entries of 40 bits, so the RAM is three groups of columns (`wide_ram`).
+                // Entries of 40 bits, so the RAM is three groups of columns (`wide_ram`), five of 8 bits.
                 let entry = (pushed as i128 * 0x9e37_79b9_7f) & ((1 << 40) - 1);
                 if do_push {
                     in_flight.push(entry);

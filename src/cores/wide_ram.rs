@@ -18,8 +18,14 @@ pub const GROUP_BITS: u32 = 16;
 /// width needs, all but the last a multiple of 4 bits (whole LUT-RAM cells) and as even as that
 /// allows.
 pub fn group_widths(width: u32) -> Vec<u32> {
-    let groups = width.div_ceil(GROUP_BITS);
-    let each = width.div_ceil(groups).next_multiple_of(4).min(GROUP_BITS);
+    group_widths_of(width, GROUP_BITS)
+}
+
+/// `group_widths` with groups of at most `most` bits (a multiple of 4).
+pub fn group_widths_of(width: u32, most: u32) -> Vec<u32> {
+    assert!(most > 0 && most % 4 == 0, "groups of whole LUT-RAM cells");
+    let groups = width.div_ceil(most);
+    let each = width.div_ceil(groups).next_multiple_of(4).min(most);
     let mut left = width;
     let mut widths = Vec::new();
     while left > 0 {
@@ -40,7 +46,12 @@ impl WideRam {
     /// A RAM of `depth` words of `width` bits, all 0 at start; one group keeps the name `name`,
     /// several are `name_g0`, `name_g1`, … from the low bits.
     pub fn new(b: &Builder, name: &str, width: u32, depth: usize) -> WideRam {
-        let widths = group_widths(width);
+        Self::in_groups_of(b, name, width, depth, GROUP_BITS)
+    }
+
+    /// `new` with groups of at most `most` bits.
+    pub fn in_groups_of(b: &Builder, name: &str, width: u32, depth: usize, most: u32) -> WideRam {
+        let widths = group_widths_of(width, most);
         let one = widths.len() == 1;
         let mems = widths
             .iter()
@@ -134,6 +145,8 @@ mod tests {
         }
         assert_eq!(group_widths(96), vec![16; 6]);
         assert_eq!(group_widths(34), vec![12, 12, 10]);
+        assert_eq!(group_widths_of(56, 8), vec![8; 7]);
+        assert_eq!(group_widths_of(34, 8), vec![8, 8, 8, 8, 2]);
     }
 
     /// Words written at random addresses read back whole, each group at its own address
