@@ -26,6 +26,7 @@ pub mod top;
 pub mod top_memory;
 pub mod traverse;
 mod traverse_decide;
+mod traverse_entry;
 mod traverse_leaf;
 mod traverse_params;
 mod traverse_retry;
