@@ -92,6 +92,11 @@ impl MulStyle {
     pub fn landed(self) -> MulStyle {
         MulStyle { dsp_regs: self.dsp_regs.max(4), ..self }
     }
+
+    /// Whether every piece's product lands in a fabric register (`landed`): a spread core's.
+    pub fn is_landed(self) -> bool {
+        self.dsp_regs >= 4
+    }
 }
 
 /// Number of limbs of `limb` unsigned bits (the top one signed when `t` is) an operand of type

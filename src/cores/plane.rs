@@ -107,7 +107,7 @@ pub fn plane_unit<'b>(
     let axis = b.delay("pu_sel_axis", issue.axis);
     // 2. delta: P − O never leaves ±(2^n − 1), so n + 1 signed bits hold it.
     let delta = b.delay("pu_delta", (plane.xsigned() - b.pick(axis, o).xsigned()).name("pu_diff"));
-    let inv_a = b.delay("pu_inv", pick_inv(b, axis, inv, product.dsp_regs >= 4).name("pu_inv_axis"));
+    let inv_a = b.delay("pu_inv", pick_inv(b, axis, inv, product.is_landed()).name("pu_inv_axis"));
     let (valid, last) = (b.valid_delay("pu_delta_valid", valid), b.delay("pu_delta_last", last));
     // 3. product
     let product_style = product;

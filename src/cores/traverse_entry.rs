@@ -22,7 +22,7 @@ impl<'b> Unit<'b> {
         // In a spread core the entry holds sp − 1 as well: the head's select, the subtract and
         // the ring's select into the stack's read address were a slowest path of the fitted
         // core at seed 1 (`unpark_q_popped` → `stack_raddr`, 7.10 ns).
-        let merge_sp_m1 = self.p.spread.then(|| (inp.merge_sp - 1).resize(spw).name("merge_sp_m1"));
+        let merge_sp_m1 = self.p.spread.then(|| (inp.merge_sp - 1).name("merge_sp_m1"));
         let mut unpark_fields = vec![inp.merge_slot, inp.merge_sp, inp.merge_sp.eq(0).name("merge_sp_zero")];
         unpark_fields.extend(merge_sp_m1);
         let unpark_in = b.cat(&unpark_fields);
@@ -70,7 +70,7 @@ impl<'b> Unit<'b> {
         let sp = b.delay("q_sp", head_sp);
         let sp_zero = b.delay("q_sp_zero", head_sp.eq(0));
         let sp_m1_next = match unpark_sp_m1 {
-            Some(m1) => or_retried(|r| (r.sp - 1).resize(r.sp.width()), m1),
+            Some(m1) => or_retried(|r| r.sp - 1, m1),
             None => head_sp - 1,
         };
         let sp_m1 = b.delay("q_sp_m1", sp_m1_next);
