@@ -193,7 +193,9 @@ pub fn simulate_external(
     sim.set(res_ready, 1);
     sim.set(mem_ins[0], SIM_BASE as i128);
     while results.len() < rays.len() {
-        let offered = rays.get(next).filter(|_| !stalls.at(stats.cycles));
+        // A clock the source holds back a ray it has (counted as the on-chip runs count it).
+        let stalled = next < rays.len() && stalls.at(stats.cycles);
+        let offered = rays.get(next).filter(|_| !stalled);
         let values = offered.map(|r| ray_inputs(r.pixel as u64, &r.ray));
         for (s, v) in ins.iter().zip(values.as_deref().unwrap_or(&idle)) {
             sim.set(*s, *v);
@@ -215,6 +217,7 @@ pub fn simulate_external(
         sim.tick();
         model.clock(&master);
         stats.cycles += 1;
+        stats.stall_cycles += stalled as u64;
         stats.count(&observed.map(|o| sim.get(o)));
         ms.count(&mem_observed.map(|o| sim.get(o)));
         next += fire as usize;
@@ -310,6 +313,34 @@ mod tests {
             assert!(ms.node_hits < ms.node_lookups && ms.tri_hits < ms.tri_lookups, "{ms:?}");
             eprintln!("{timing:?}: {} cycles, {:?}", stats.cycles, ms);
         }
+    }
+
+    /// The clocks the source holds a ray back are counted as the on-chip runs count them
+    /// (`stall_cycles`; it was 0 on a stalled feed, where Verilator's testbench counted 1,814):
+    /// at least the stalls among the first clocks, one per ray (rays remain at least that
+    /// long), at most those of the whole run, and none without stalls.
+    #[test]
+    fn a_stalled_source_is_counted_through_an_external_core() {
+        let scene = Scene::load(&SceneSource::Builtin("cornell".into()), &Params::default()).unwrap();
+        let roms = SceneRoms::of(&scene);
+        let rays = frame_rays(&scene, &Camera::default_for(&scene, 6, 6));
+        let spec = MemorySpec { node_cache_kb: 1, tri_cache_kb: 1, ..MemorySpec::default() };
+        let p = CoreParams::external(&roms, &CoreSpec { slots: 8, ..CoreSpec::default() }, spec).unwrap();
+        let image = SceneImage::build(&roms, MemoryShape::default()).unwrap();
+        let stalls = Stalls::random(40, 5);
+        let run = |stalls: &Stalls| {
+            simulate_external(&p, &roms, &image, &rays, MemoryTiming::default(), stalls, &|_| ()).unwrap()
+        };
+        let (results, stats, _) = run(&stalls);
+        assert_eq!(mismatches(&scene, &rays, &results), 0);
+        let hits = |clocks: u64| (0..clocks).filter(|&c| stalls.at(c)).count() as u64;
+        assert!(
+            (hits(rays.len() as u64)..=hits(stats.cycles)).contains(&stats.stall_cycles),
+            "{} stalled clocks of {}",
+            stats.stall_cycles,
+            stats.cycles
+        );
+        assert_eq!(run(&Stalls::none()).1.stall_cycles, 0);
     }
 
     /// A leaf spanning more lines than the triangle cache has sets (the Cornell box in one
