@@ -211,23 +211,33 @@ pub fn closest_core(
     // slowest path at seed 1 (8.27 ns, 38 cells). The merge is reported from M2 as before; the
     // slot's best is read again only after its ray has been unparked, many clocks later.
     let (leaf_key, slot_key) = (b.cat(&[m1_empty, m1_tt]), b.cat(&[zero, st_tt]));
+    // The write enable and the first hit, when made before M2's registers (a spread core): see
+    // `best_we`.
+    let (mut we_parts, mut first_hit_early) = (None, None);
     let (m2, m2_less) = if spread {
         // In a spread core the chain is cut in two halves registered apart (less above, or
         // equal above and less below): the whole chain after the slot's LUT-RAM read was among
         // the slowest paths of the four-unit core at a placement seed (7.37 ns).
         let (w, lo) = (leaf_key.width(), leaf_key.width() / 2);
         let (leaf_hi, slot_hi) = (leaf_key.slice(lo, w - lo), slot_key.slice(lo, w - lo));
-        let hi_less = b.delay("m2_tt_hi_less", lt_chain(leaf_hi, slot_hi).name("leaf_tt_hi_less"));
-        let hi_equal = b.delay("m2_tt_hi_equal", leaf_hi.eq(slot_hi).name("leaf_tt_hi_equal"));
+        let (hi_less_c, hi_equal_c) =
+            (lt_chain(leaf_hi, slot_hi).name("leaf_tt_hi_less"), leaf_hi.eq(slot_hi).name("leaf_tt_hi_equal"));
+        let hi_less = b.delay("m2_tt_hi_less", hi_less_c);
+        let hi_equal = b.delay("m2_tt_hi_equal", hi_equal_c);
         let lo_less =
             b.delay("m2_tt_lo_less", lt_chain(leaf_key.slice(0, lo), slot_key.slice(0, lo)).name("leaf_tt_lo_less"));
+        let m1_first_hit = *first_hit_early.insert((!m1_has & !m1_empty).name("m1_first_hit"));
+        let we_either = b.valid_delay("m2_we_either", (m1 & (m1_first_hit | hi_less_c)).name("m1_we_either"));
+        let we_if_lo = b.valid_delay("m2_we_if_lo", (m1 & hi_equal_c).name("m1_we_if_lo"));
+        we_parts = Some((we_either | (we_if_lo & lo_less)).name("m2_we"));
         (b.valid_delay("m2", m1), (hi_less | (hi_equal & lo_less)).name("m2_tt_less"))
     } else {
         let tt_less = lt_chain(leaf_key, slot_key).name("leaf_tt_less");
         let m2 = b.valid_delay("m2", m1);
         (m2, b.delay("m2_tt_less", tt_less))
     };
-    let m2_first_hit = b.delay("m2_first_hit", (!m1_has & !m1_empty).name("m1_first_hit"));
+    let m1_first_hit = first_hit_early.unwrap_or_else(|| (!m1_has & !m1_empty).name("m1_first_hit"));
+    let m2_first_hit = b.delay("m2_first_hit", m1_first_hit);
     let m2_better = (m2_less | m2_first_hit).name("leaf_better");
     let m2_hit = b.delay("m2_hit", (m1_has | !m1_empty).name("m1_hit"));
     let m2_slot = b.delay("m2_slot", m1_slot);
@@ -244,7 +254,11 @@ pub fn closest_core(
     // The write enable is one register of its own (not m3 ∧ better after them): it fans out
     // to every LUT-RAM cell of both best RAMs, spread over the die, and the AND's LUT placed
     // between them cost three placement seeds of the four-unit core 10.8–14.2 ns.
-    let we = b.valid_delay("best_we", (m2 & m2_better).name("m2_we"));
+    // In a spread core the enable is one LUT after M2's registers: the leaf's hit into a slot
+    // without one or the upper half's less (with m1) is registered apart from the upper half's
+    // equal, so M2 has `either ∨ (if_lo ∧ lo_less)` left (the ORs and ANDs after the three
+    // halves' registers into the enable's copies were 6.83 ns at a seed of the fitted core).
+    let we = b.valid_delay("best_we", we_parts.unwrap_or_else(|| (m2 & m2_better).name("m2_we")));
     // The write address fans out to every LUT-RAM cell of both best RAMs: a register each.
     let m3_slot = b.delay("m3_slot", m2_slot);
     let m3_slots = b.copies(m3_slot, tt_mem.groups() + uv_mem.groups());

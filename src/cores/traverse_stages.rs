@@ -243,7 +243,7 @@ impl<'b> Unit<'b> {
             .unzip();
         let o_in = ["ox", "oy", "oz"].map(|s| b.input(s, Ty::u(n)));
         let inv_in = ["invx", "invy", "invz"].map(|s| b.input(s, Ty::s(p.inv_width())));
-        let inp = Inputs {
+        let mut inp = Inputs {
             new_valid: b.input("new_valid", bit),
             new_slot: b.input("new_slot", slot_ty),
             new_tmax: b.input("new_tmax", dist),
@@ -269,6 +269,18 @@ impl<'b> Unit<'b> {
                 done: b.input("node_done", Ty::u(super::cache::SEQ_BITS)),
             }),
         };
+        if p.spread {
+            // A spread unit registers the merge where it arrives: the closest-hit unit's
+            // `merge_valid` register, across the die, into the k has-best bits' LUTs was a
+            // slowest path of the fitted core at a seed (6.77 ns, 10 endpoint groups). Every
+            // use of a merge (the has-best set, the cull limit's write, the unpark) is a clock
+            // later alike, so a slot is unparked with its limit and bit as before.
+            inp.merge_valid = b.valid_delay("merge_valid_in", inp.merge_valid);
+            inp.merge_slot = b.delay("merge_slot_in", inp.merge_slot);
+            inp.merge_hit = b.delay("merge_hit_in", inp.merge_hit);
+            inp.merge_limit = b.delay("merge_limit_in", inp.merge_limit);
+            inp.merge_sp = b.delay("merge_sp_in", inp.merge_sp);
+        }
         let [o_mem, ix_mem, iy_mem, iz_mem] = ["ray_o", "ray_invx", "ray_invy", "ray_invz"]
             .map(|name| WideRam::new(b, name, if name == "ray_o" { 3 * n } else { p.inv_width() }, k as usize));
         let data =
