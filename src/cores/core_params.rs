@@ -6,7 +6,7 @@ use super::closest::TagLayout;
 use super::intersect::IntersectParams;
 use super::memory_params::{ExternalMemory, MemorySpec};
 use super::traverse::TraverseParams;
-use super::wide_ram::group_widths;
+use super::wide_ram::{GROUP_BITS, NARROW_GROUP_BITS, group_widths_of};
 use crate::model::golden::GridRay;
 use crate::rtl::Ty;
 use crate::rtl::width::MAX_WIDTH;
@@ -153,7 +153,17 @@ impl CoreParams {
     /// LUT-RAM groups of a lane's ray RAMs (`wide_ram`), in `ray_ram_widths` order: each is
     /// written from a write enable and an address register of its own.
     pub fn ray_ram_groups(&self) -> usize {
-        self.ray_ram_widths().iter().map(|&w| group_widths(w).len()).sum()
+        let widths = self.ray_ram_widths().into_iter().enumerate();
+        widths.map(|(k, w)| group_widths_of(w, self.ray_ram_group_bits(k)).len()).sum()
+    }
+    /// The widest group of a lane's ray RAM `k` (in `ray_ram_widths` order). A spread core
+    /// reads its directions in narrow groups: the emission's slot register into a 16-bit
+    /// group's 32 LUT-RAM cells (128 slots) and the select after them was a slowest path at a
+    /// seed of the fitted core (`emit_slot` → `ray_w_q`, 6.95 ns). The origins keep wide
+    /// groups: narrow ones everywhere cost the fitted core's LUT margin (a write decode per
+    /// group and 16 words).
+    pub fn ray_ram_group_bits(&self, k: usize) -> u32 {
+        if self.isect.spread && k > 0 { NARROW_GROUP_BITS } else { GROUP_BITS }
     }
     /// Traversal units per lane.
     pub fn lane_units(&self) -> u32 {

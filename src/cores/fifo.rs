@@ -13,7 +13,7 @@
 //! written, which a read-first RAM answers with the old word, so it comes from a copy of the
 //! pushed word instead (`bypass`).
 
-use super::wide_ram::{GROUP_BITS, WideRam};
+use super::wide_ram::{GROUP_BITS, NARROW_GROUP_BITS, WideRam};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, S};
 
@@ -36,9 +36,6 @@ pub fn narrow_fifo<'b>(b: &'b Builder, name: &str, depth: u32, push: S<'b>, din:
     let (heads, nonempty) = queue(b, name, depth, push, &[din], pop, (true, NARROW_GROUP_BITS));
     Fifo { head: heads[0], nonempty }
 }
-
-/// The groups' width in a `narrow_fifo`: two LUT-RAM columns.
-pub const NARROW_GROUP_BITS: u32 = 8;
 
 /// Splits a queue entry packed with `b.cat` (fields most significant first, of `widths`).
 pub fn unpack<'b>(entry: S<'b>, widths: &[u32]) -> Vec<S<'b>> {

@@ -7,7 +7,7 @@ use super::core_params::{CoreParams, tri_rom_groups};
 use super::intersect::intersect_core;
 use super::ray_port::RayPort;
 use super::traverse::{field, word_bits};
-use super::wide_ram::{WideRam, address_registers, group_widths, runs};
+use super::wide_ram::{WideRam, address_registers, group_widths_of, runs};
 use crate::rtl::Ty;
 use crate::rtl::build::{Builder, Ports, S};
 use crate::scene::images::SceneRoms;
@@ -59,7 +59,8 @@ pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> R
     let [wx, wy, wz] = port.w;
     // The RAMs as `ray_ram_widths` lays them out, each made and then written its word in turn.
     let widths = p.ray_ram_widths();
-    let counts: Vec<usize> = widths.iter().map(|&w| group_widths(w).len()).collect();
+    let counts: Vec<usize> =
+        widths.iter().enumerate().map(|(k, &w)| group_widths_of(w, p.ray_ram_group_bits(k)).len()).collect();
     let (wes, ats) = (runs(&accept, &counts), runs(&gslot, &counts));
     let names: &[&str] = if widths.len() == 2 { &["ray_o", "ray_w"] } else { &["ray_o", "ray_wx", "ray_wy", "ray_wz"] };
     let word = |k: usize| match (k, widths.len()) {
@@ -69,7 +70,7 @@ pub fn ray_rams(b: &Builder, p: &CoreParams, port: &RayPort<'_>, lane: u32) -> R
     };
     let mut rams: Vec<WideRam> = (0..widths.len())
         .map(|k| {
-            let ram = WideRam::new(b, &name(names[k]), widths[k], slots);
+            let ram = WideRam::in_groups_of(b, &name(names[k]), widths[k], slots, p.ray_ram_group_bits(k));
             ram.write(b, &wes[k], &ats[k], word(k));
             ram
         })

@@ -14,6 +14,10 @@ use crate::rtl::build::{Builder, S};
 /// The widest group: four LUT-RAM columns.
 pub const GROUP_BITS: u32 = 16;
 
+/// The narrow groups of a spread core's busiest reads (`fifo::narrow_fifo`, the lanes'
+/// direction RAMs): two LUT-RAM columns.
+pub const NARROW_GROUP_BITS: u32 = 8;
+
 /// The groups' widths, lowest bits first: as many groups of `GROUP_BITS` or fewer bits as the
 /// width needs, all but the last a multiple of 4 bits (whole LUT-RAM cells) and as even as that
 /// allows.
