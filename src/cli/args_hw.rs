@@ -246,6 +246,10 @@ pub struct SynthArgs {
     /// cores); the report gives the median seed's figures and the spread.
     #[arg(long = "seeds", visible_alias = "seed", default_value = "1")]
     pub seeds: String,
+    /// ecp5: nextpnr-ecp5's placer, heap (its default) or static (electrostatic; on the
+    /// fitted four-unit core a fifth less wire to route, docs/TIMING.md).
+    #[arg(long, default_value = "heap")]
+    pub placer: String,
     /// ecp5: which modules to place and route (each takes minutes; the whole core is the
     /// longest): any of divider, intersect, traverse, closest, core.
     #[arg(long, value_delimiter = ',', default_value = "divider,intersect,traverse,closest,core")]

@@ -471,8 +471,8 @@ pub enum Family {
     Xc5v,
     /// 7-series (Artix-7) area from Debian's yosys, a second reference.
     Xc7,
-    /// LFE5U-85F place and route: the clock constraint, nextpnr's seeds and the modules.
-    Ecp5 { target_mhz: f64, seeds: Vec<u64>, modules: Vec<String> },
+    /// LFE5U-85F place and route: the clock constraint, nextpnr's seeds, placer and the modules.
+    Ecp5 { target_mhz: f64, seeds: Vec<u64>, placer: crate::fpga::ecp5::Placer, modules: Vec<String> },
 }
 
 impl Family {
@@ -504,7 +504,8 @@ impl SynthArgs {
                 crate::cores::clock::ClockTarget(self.hw.target_mhz).check()?;
                 crate::fpga::ecp5::check_modules(&self.modules)?;
                 let seeds = crate::fpga::ecp5::seeds::parse_seeds(&self.seeds)?;
-                Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seeds, modules: self.modules.clone() }
+                let placer = crate::fpga::ecp5::Placer::parse(&self.placer)?;
+                Family::Ecp5 { target_mhz: self.hw.target_mhz as f64, seeds, placer, modules: self.modules.clone() }
             }
             other => {
                 return Err(Error::param("family", format!("'{other}' is not supported: use xc5v, xc7 or ecp5")));

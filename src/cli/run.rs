@@ -343,8 +343,9 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
         scene.name,
         if core.mem.is_some() { "in external memory (AXI4 read port, caches on chip)" } else { "in on-chip ROMs" }
     );
-    if let Family::Ecp5 { target_mhz, seeds, modules } = &c.family {
-        return synth_ecp5(c, &p, &core, &roms, *target_mhz, seeds, modules, &scene.name);
+    if let Family::Ecp5 { target_mhz, seeds, placer, modules } = &c.family {
+        let tools = ecp5::Tools { placer: *placer, ..ecp5::Tools::require()? };
+        return synth_ecp5(c, &tools, &p, &core, &roms, *target_mhz, seeds, modules, &scene.name);
     }
     let family = if c.family == Family::Xc7 { "xc7" } else { "xc5v" };
     let mut cores = Vec::new();
@@ -367,6 +368,7 @@ pub fn synth_cores(c: &SynthConfig) -> Result<()> {
 #[allow(clippy::too_many_arguments)]
 fn synth_ecp5(
     c: &SynthConfig,
+    tools: &ecp5::Tools,
     p: &IntersectParams,
     core: &crate::cores::top::CoreParams,
     roms: &SceneRoms,
@@ -375,13 +377,13 @@ fn synth_ecp5(
     modules: &[String],
     scene: &str,
 ) -> Result<()> {
-    let tools = ecp5::Tools::require()?;
     let jobs = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut timings = Vec::new();
     for name in modules {
         let (m, latency) = ecp5::module_of(name, p, core, roms);
         eprintln!(
-            "ecp5: placing and routing {} at seed{} {} ({} at a time; minutes for the larger modules)",
+            "ecp5: placing ({}) and routing {} at seed{} {} ({} at a time; minutes for the larger modules)",
+            tools.placer.name(),
             m.name,
             if seeds.len() == 1 { "" } else { "s" },
             seeds.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", "),
@@ -392,7 +394,7 @@ fn synth_ecp5(
         let logs: Vec<_> = seeds.iter().map(|&s| (s, ecp5::seeds::seed_dir(&dir, seeds, s))).collect();
         let placed = ecp5::progress::watching(&logs, |say| {
             let seen = |t: &ecp5::Timing| say(&format!("ecp5: {} seed {}: {:.1} MHz", t.module, t.seed, t.fmax_mhz));
-            ecp5::seeds::place_and_route_seeds(&tools, &m, latency, target_mhz, seeds, jobs, &dir, &seen)
+            ecp5::seeds::place_and_route_seeds(tools, &m, latency, target_mhz, seeds, jobs, &dir, &seen)
         })?;
         if seeds.len() > 1 {
             eprintln!(

