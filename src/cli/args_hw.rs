@@ -246,8 +246,9 @@ pub struct SynthArgs {
     /// cores); the report gives the median seed's figures and the spread.
     #[arg(long = "seeds", visible_alias = "seed", default_value = "1")]
     pub seeds: String,
-    /// ecp5: nextpnr-ecp5's placer, heap (its default) or static (electrostatic; on the
-    /// fitted four-unit core a fifth less wire to route, docs/TIMING.md).
+    /// ecp5: nextpnr-ecp5's placer, heap (its default; the clock figures) or static
+    /// (electrostatic: routes the fitted four-unit core in under an hour, but about a fifth
+    /// slower a clock; docs/TIMING.md).
     #[arg(long, default_value = "heap")]
     pub placer: String,
     /// ecp5: which modules to place and route (each takes minutes; the whole core is the
