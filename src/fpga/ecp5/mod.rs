@@ -36,8 +36,8 @@ pub const PACKAGE: &str = "CABGA381";
 pub const SPEED: u32 = 6;
 
 /// nextpnr-ecp5's placer (`--placer`): HeAP, its default, or the electrostatic `static`
-/// placer. On the fitted four-unit core static left a fifth less wire and routed in 50
-/// minutes where HeAP takes hours, but its clock was 102 MHz against HeAP's 131 (a unit's
+/// placer. On the fitted four-unit core static left up to a fifth less wire and routed in
+/// about an hour where HeAP takes hours, but clocked 102–116 MHz against HeAP's 131 (a unit's
 /// queue control spread apart): a quick routability check, not the clock (DECISIONS 143).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Placer {
